@@ -1,0 +1,45 @@
+/*
+ * kdtree.h — the kd-tree over a scene's spheres, triangles and boxes.
+ *
+ * Built on the host with the surface area heuristic and flattened into the node array
+ * and primitive-id array the kernels traverse (KdNode in kernels/types.h; the layout,
+ * the SAH constants and the termination rules are in docs/kdtree.md). Infinite planes
+ * are not in the tree. Primitive ids are global ids (spheres, then triangles, then
+ * boxes: see RenderParams).
+ */
+#ifndef CLPT_KDTREE_H
+#define CLPT_KDTREE_H
+
+#include <stddef.h>
+
+#include "status.h"
+#include "types.h"
+
+typedef struct {
+    const Sphere *spheres;     size_t n_spheres;
+    const Triangle *triangles; size_t n_triangles;
+    const Box *boxes;          size_t n_boxes;
+} KdInput;
+
+typedef struct {
+    double build_seconds;
+    uint n_nodes, n_leaves, n_empty_leaves;
+    uint max_depth;                /* deepest leaf, root = 0 */
+    double mean_prims_per_leaf;    /* over non-empty leaves */
+    double sah_cost;               /* expected cost of a random ray through the root box */
+    size_t bytes;                  /* nodes + leaf primitive ids */
+} KdStats;
+
+typedef struct {
+    KdNode *nodes;      uint n_nodes;        /* nodes[0] is the root */
+    uint *leaf_prims;   uint n_leaf_prims;
+    vec3 lo, hi;                              /* box of the root */
+    KdStats stats;
+} KdTree;
+
+/* Builds the tree; on success *out owns its arrays (release with kd_free). An empty
+ * input gives a single empty leaf. Threads: 0 = all cores. */
+Status kd_build(const KdInput *in, int threads, KdTree *out, Error *err);
+void kd_free(KdTree *t);
+
+#endif /* CLPT_KDTREE_H */

@@ -1,0 +1,249 @@
+/* scene.c — scene storage, material helpers and the light list. */
+#include "scene.h"
+
+#include "kmath.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+void scene_init(Scene *s)
+{
+    memset(s, 0, sizeof *s);
+    s->camera.from = v3(0.0f, 0.0f, 0.0f);
+    s->camera.at = v3(0.0f, 0.0f, -1.0f);
+    s->camera.up = v3(0.0f, 1.0f, 0.0f);
+    s->camera.vfov = 40.0f;
+    s->camera.aperture = 0.0f;
+    s->camera.focus_dist = 0.0f;
+    s->image.width = 512;
+    s->image.height = 512;
+    s->image.spp = 64;
+    s->image.max_depth = 8;
+    s->image.seed = 1;
+    s->bg_type = BG_CONSTANT;
+    s->bg_color = v3(0.0f, 0.0f, 0.0f);
+    s->bg_zenith = v3(0.0f, 0.0f, 0.0f);
+}
+
+void scene_free(Scene *s)
+{
+    for (size_t i = 0; i < s->n_materials; i++) free(s->material_names[i]);
+    free(s->material_names);
+    free(s->materials);
+    free(s->spheres);
+    free(s->triangles);
+    free(s->shading);
+    free(s->boxes);
+    free(s->planes);
+    free(s->lights);
+    free(s->path);
+    memset(s, 0, sizeof *s);
+}
+
+int array_reserve(void **ptr, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap) return 0;
+    size_t new_cap = *cap ? *cap : 16;
+    while (new_cap < need) {
+        if (new_cap > SIZE_MAX / 2) return -1;
+        new_cap *= 2;
+    }
+    if (new_cap > SIZE_MAX / elem) return -1;
+    void *p = realloc(*ptr, new_cap * elem);
+    if (!p) return -1;
+    *ptr = p;
+    *cap = new_cap;
+    return 0;
+}
+
+/* One generic append for every primitive array: the id space is 32-bit (NO_INDEX is
+ * reserved), so the total primitive count is capped below 2^32 - 1. */
+static Status append(void **arr, size_t *n, size_t *cap, const void *item, size_t elem,
+                     const Scene *s, Error *err)
+{
+    size_t total = s->n_spheres + s->n_triangles + s->n_boxes + s->n_planes;
+    if (total >= (size_t)NO_INDEX - 1)
+        return error_set(err, ST_INPUT, "too many primitives (the limit is %u)", NO_INDEX - 2);
+    if (array_reserve(arr, cap, *n + 1, elem))
+        return error_set(err, ST_INTERNAL, "out of memory growing the scene");
+    memcpy((char *)*arr + *n * elem, item, elem);
+    (*n)++;
+    return ST_OK;
+}
+
+Status scene_add_material(Scene *s, const char *name, Material m, uint *index, Error *err)
+{
+    size_t cap_names = s->cap_materials;
+    if (array_reserve((void **)&s->materials, &s->cap_materials, s->n_materials + 1, sizeof m) ||
+        array_reserve((void **)&s->material_names, &cap_names, s->n_materials + 1, sizeof(char *)))
+        return error_set(err, ST_INTERNAL, "out of memory growing the material list");
+    /* both arrays share one capacity: take the smaller so neither is overrun */
+    if (cap_names < s->cap_materials) s->cap_materials = cap_names;
+    char *copy = malloc(strlen(name) + 1);
+    if (!copy) return error_set(err, ST_INTERNAL, "out of memory");
+    strcpy(copy, name);
+    s->materials[s->n_materials] = m;
+    s->material_names[s->n_materials] = copy;
+    if (index) *index = (uint)s->n_materials;
+    s->n_materials++;
+    return ST_OK;
+}
+
+Status scene_add_sphere(Scene *s, Sphere sp, Error *err)
+{
+    sp.light = NO_INDEX;
+    return append((void **)&s->spheres, &s->n_spheres, &s->cap_spheres, &sp, sizeof sp, s, err);
+}
+
+Status scene_add_triangle(Scene *s, Triangle t, Error *err)
+{
+    t.light = NO_INDEX;
+    return append((void **)&s->triangles, &s->n_triangles, &s->cap_triangles, &t, sizeof t, s, err);
+}
+
+Status scene_add_shading(Scene *s, TriShading sh, uint *index, Error *err)
+{
+    if (s->n_shading >= (size_t)NO_INDEX - 1)
+        return error_set(err, ST_INPUT, "too many shading records");
+    if (array_reserve((void **)&s->shading, &s->cap_shading, s->n_shading + 1, sizeof sh))
+        return error_set(err, ST_INTERNAL, "out of memory growing the scene");
+    s->shading[s->n_shading] = sh;
+    if (index) *index = (uint)s->n_shading;
+    s->n_shading++;
+    return ST_OK;
+}
+
+Status scene_add_box(Scene *s, Box b, Error *err)
+{
+    b.light = NO_INDEX;
+    return append((void **)&s->boxes, &s->n_boxes, &s->cap_boxes, &b, sizeof b, s, err);
+}
+
+Status scene_add_plane(Scene *s, Plane p, Error *err)
+{
+    return append((void **)&s->planes, &s->n_planes, &s->cap_planes, &p, sizeof p, s, err);
+}
+
+uint scene_find_material(const Scene *s, const char *name)
+{
+    for (size_t i = 0; i < s->n_materials; i++)
+        if (strcmp(s->material_names[i], name) == 0) return (uint)i;
+    return NO_INDEX;
+}
+
+uint scene_first_triangle(const Scene *s) { return (uint)s->n_spheres; }
+uint scene_first_box(const Scene *s) { return (uint)(s->n_spheres + s->n_triangles); }
+uint scene_first_plane(const Scene *s) { return (uint)(s->n_spheres + s->n_triangles + s->n_boxes); }
+
+static Material material_base(uint type)
+{
+    Material m;
+    memset(&m, 0, sizeof m);
+    m.type = type;
+    m.texture = NO_INDEX;
+    m.ior = 1.5f;
+    return m;
+}
+
+Material material_diffuse(vec3 albedo)
+{
+    Material m = material_base(MAT_DIFFUSE);
+    m.albedo = albedo;
+    return m;
+}
+
+Material material_metal(vec3 albedo, float fuzz)
+{
+    Material m = material_base(MAT_METAL);
+    m.albedo = albedo;
+    m.fuzz = fuzz;
+    return m;
+}
+
+Material material_dielectric(float ior)
+{
+    Material m = material_base(MAT_DIELECTRIC);
+    m.albedo = v3s(1.0f);
+    m.ior = ior;
+    return m;
+}
+
+Material material_emissive(vec3 radiance)
+{
+    Material m = material_base(MAT_EMISSIVE);
+    m.emission = radiance;
+    return m;
+}
+
+static int is_emissive(const Scene *s, uint material)
+{
+    if (material >= s->n_materials) return 0;
+    const Material *m = &s->materials[material];
+    return m->type == MAT_EMISSIVE && v3_luminance(m->emission) > 0.0f;
+}
+
+static double triangle_area(const Triangle *t)
+{
+    vec3 c = v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0));
+    return 0.5 * sqrt((double)c.x * c.x + (double)c.y * c.y + (double)c.z * c.z);
+}
+
+static double box_area(const Box *b)
+{
+    double dx = (double)b->hi.x - b->lo.x, dy = (double)b->hi.y - b->lo.y, dz = (double)b->hi.z - b->lo.z;
+    return 2.0 * (dx * dy + dy * dz + dz * dx);
+}
+
+Status scene_prepare_lights(Scene *s, Error *err)
+{
+    free(s->lights);
+    s->lights = NULL;
+    s->n_lights = 0;
+    size_t n = 0;
+    for (size_t i = 0; i < s->n_spheres; i++) n += (size_t)is_emissive(s, s->spheres[i].material);
+    for (size_t i = 0; i < s->n_triangles; i++) n += (size_t)is_emissive(s, s->triangles[i].material);
+    for (size_t i = 0; i < s->n_boxes; i++) n += (size_t)is_emissive(s, s->boxes[i].material);
+    if (n == 0) return ST_OK;
+    if (n >= (size_t)NO_INDEX) return error_set(err, ST_INPUT, "too many emissive primitives");
+    Light *lights = calloc(n, sizeof *lights);
+    double *power = calloc(n, sizeof *power);
+    if (!lights || !power) {
+        free(lights);
+        free(power);
+        return error_set(err, ST_INTERNAL, "out of memory building the light list");
+    }
+    size_t k = 0;
+    double total = 0.0;
+#define ADD_LIGHT(arr, count, first, area_expr)                                          \
+    for (size_t i = 0; i < (count); i++) {                                                \
+        if (!is_emissive(s, arr[i].material)) continue;                                   \
+        double area = (area_expr);                                                        \
+        lights[k].type = LIGHT_AREA;                                                      \
+        lights[k].prim = (uint)((first) + i);                                             \
+        lights[k].area = (float)area;                                                     \
+        power[k] = area * v3_luminance(s->materials[arr[i].material].emission);          \
+        total += power[k];                                                                \
+        arr[i].light = (uint)k;                                                           \
+        k++;                                                                              \
+    }
+    ADD_LIGHT(s->spheres, s->n_spheres, 0, 4.0 * M_PI * (double)s->spheres[i].radius * s->spheres[i].radius)
+    ADD_LIGHT(s->triangles, s->n_triangles, scene_first_triangle(s), triangle_area(&s->triangles[i]))
+    ADD_LIGHT(s->boxes, s->n_boxes, scene_first_box(s), box_area(&s->boxes[i]))
+#undef ADD_LIGHT
+    /* Degenerate emitters (zero area) get zero power; if all are degenerate, choose
+     * uniformly so the distribution stays valid. */
+    double acc = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double p = total > 0.0 ? power[i] / total : 1.0 / (double)n;
+        acc += p;
+        lights[i].pick_pdf = (float)p;
+        lights[i].cdf = (float)acc;
+    }
+    lights[n - 1].cdf = 1.0f;  /* exact top so a uniform sample in [0,1) always lands */
+    free(power);
+    s->lights = lights;
+    s->n_lights = n;
+    return ST_OK;
+}

@@ -1,0 +1,66 @@
+/*
+ * compat.h — lets every file under kernels/ compile both as OpenCL C 1.2 and as C11.
+ *
+ * The kernel stage functions are written once. OpenCL compilers see them through
+ * entry.cl; the scalar C device (host/device_cpu.c) and the tests #include the very
+ * same files. This header is the only place where the two languages differ.
+ *
+ * Rules for kernel code (so that both compilers produce the same bits):
+ *  - float literals always carry the f suffix (no silent double promotion in C);
+ *  - only + - * / and sqrt are used on floats, plus the k_* functions of kmath.h that
+ *    are built from them; no libm / OpenCL builtins with implementation-defined
+ *    precision (sin, exp, pow ...), because PoCL, NVIDIA and glibc round them
+ *    differently and the image would then depend on the device;
+ *  - contraction into fused multiply-add is disabled on both sides (the pragma below
+ *    and -ffp-contract=off in the Makefile); the host asks OpenCL for correctly
+ *    rounded divide and sqrt where the device supports it.
+ */
+#ifndef CLPT_COMPAT_H
+#define CLPT_COMPAT_H
+
+#ifdef __OPENCL_VERSION__
+/* ---------------------------------------------------------------- OpenCL C */
+#pragma OPENCL FP_CONTRACT OFF
+
+#define KERNEL_OPENCL 1
+#define KFN static inline       /* every helper: never bare `inline` (C99 rules) */
+#define GLOBAL __global
+#define CONSTANT __constant
+
+#define k_sqrt(x) sqrt(x)
+#define k_fabs(x) fabs(x)
+#define k_fmin(a, b) fmin(a, b)
+#define k_fmax(a, b) fmax(a, b)
+#define k_floor(x) floor(x)
+#define k_as_float(u) as_float(u)
+#define k_as_uint(f) as_uint(f)
+#define k_as_int(f) as_int(f)
+#define k_int_as_float(i) as_float(i)
+
+#else
+/* ---------------------------------------------------------------- C11 */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#define KFN static inline
+#define GLOBAL
+#define CONSTANT const
+
+typedef unsigned int uint;   /* same as glibc's <sys/types.h> typedef */
+typedef unsigned char uchar;
+
+#define k_sqrt(x) sqrtf(x)
+#define k_fabs(x) fabsf(x)
+#define k_fmin(a, b) fminf(a, b)
+#define k_fmax(a, b) fmaxf(a, b)
+#define k_floor(x) floorf(x)
+
+static inline float k_as_float(uint u) { float f; memcpy(&f, &u, sizeof f); return f; }
+static inline uint k_as_uint(float f) { uint u; memcpy(&u, &f, sizeof u); return u; }
+static inline int k_as_int(float f) { int i; memcpy(&i, &f, sizeof i); return i; }
+static inline float k_int_as_float(int i) { float f; memcpy(&f, &i, sizeof f); return f; }
+
+#endif
+
+#endif /* CLPT_COMPAT_H */

@@ -1,0 +1,197 @@
+/*
+ * types.h — every struct that crosses the host/device boundary, defined once.
+ *
+ * Included by the OpenCL kernels and by the host C code, so the layout has exactly one
+ * definition. Only 4-byte scalars appear in these structs (float, uint, int) and vec3 is
+ * a plain struct of three floats: OpenCL's float3 is 16 bytes but 12 in C, and bool,
+ * size_t and pointers differ between the two worlds. Every struct's size is a multiple
+ * of 16 bytes, with explicit padding, noted beside it; the host build checks the sizes
+ * and offsets with _Static_assert, and tests/test_kernels.c asks each OpenCL device for
+ * the same numbers (kernel k_layout in entry.cl).
+ */
+#ifndef CLPT_TYPES_H
+#define CLPT_TYPES_H
+
+#include "compat.h"
+
+/* Sentinel for "no index" in any uint field (no light, no shading record, a miss). */
+#define NO_INDEX 0xffffffffu
+
+/* Longest kd-tree descent the traversal stack can hold; the builder never exceeds it. */
+#define KD_MAX_DEPTH 64
+
+/* Fixed-point scale of the film: radiance is accumulated as 64-bit integers in units of
+ * 2^-FILM_FRAC_BITS, so that adding batches in any grouping gives the same bits. */
+#define FILM_FRAC_BITS 24
+/* A single sample's contribution is clamped to this radiance (and NaN/inf dropped), which
+ * keeps 2^31 samples of a pixel far from int64 overflow. */
+#define FILM_MAX_SAMPLE 65536.0f
+
+typedef struct { float x, y, z; } vec3;                 /* 12 bytes, align 4 */
+
+typedef struct {                                        /* 32 bytes */
+    vec3 o;  float tmin;
+    vec3 d;  float tmax;
+} Ray;
+
+typedef struct {                                        /* 16 bytes */
+    float t;        /* distance along the (unnormalised) ray direction */
+    uint prim;      /* global primitive id (see RenderParams), NO_INDEX for a miss */
+    float u, v;     /* triangles: barycentrics of p1 and p2; boxes: u = face index */
+} Hit;
+
+/* kd-tree node, 8 bytes (layout in docs/kdtree.md).
+ * Interior: bits = axis (0,1,2) in the low 2 bits | index of the "above" child << 2;
+ *           the "below" child is the next node; split = the plane position (float bits).
+ * Leaf:     bits = 3 | primitive count << 2; data = the single primitive id when the
+ *           count is 1, otherwise the offset of the leaf's ids in the leaf_prims array. */
+typedef struct {
+    uint data;      /* interior: as_uint(split position); leaf: prim id or offset */
+    uint bits;
+} KdNode;
+
+#define KD_LEAF 3u
+
+/* Global primitive ids: [0, n_spheres) spheres, then triangles, then boxes, then
+ * planes. Spheres, triangles and boxes are in the kd-tree; infinite planes are not. */
+typedef struct {                                        /* 32 bytes */
+    vec3 center;  float radius;
+    uint material;
+    uint light;     /* index into lights[] if emissive, else NO_INDEX */
+    uint pad0, pad1;
+} Sphere;
+
+typedef struct {                                        /* 48 bytes */
+    vec3 p0;  uint material;
+    vec3 p1;  uint light;
+    vec3 p2;  uint shading;   /* index into TriShading[] or NO_INDEX (flat, no uv) */
+} Triangle;
+
+typedef struct {                                        /* 64 bytes */
+    vec3 n0, n1, n2;          /* per-vertex shading normals (unit) */
+    float uv0[2], uv1[2], uv2[2];
+    uint flags;               /* TRI_HAS_NORMALS | TRI_HAS_UV */
+} TriShading;
+#define TRI_HAS_NORMALS 1u
+#define TRI_HAS_UV 2u
+
+typedef struct {                                        /* 32 bytes */
+    vec3 lo;  uint material;
+    vec3 hi;  uint light;
+} Box;
+
+typedef struct {                                        /* 32 bytes */
+    vec3 normal;  float offset;  /* the points p with dot(normal, p) == offset */
+    uint material;
+    uint pad0, pad1, pad2;
+} Plane;
+
+enum MaterialType {
+    MAT_DIFFUSE = 0,     /* Lambertian, albedo */
+    MAT_METAL = 1,       /* mirror reflection perturbed by fuzz, tinted by albedo */
+    MAT_DIELECTRIC = 2,  /* smooth glass, Fresnel reflection/refraction, ior */
+    MAT_EMISSIVE = 3     /* emits `emission`, reflects nothing */
+};
+
+typedef struct {                                        /* 64 bytes */
+    uint type;                /* enum MaterialType */
+    uint texture;             /* albedo texture index, NO_INDEX when none */
+    float ior;
+    float fuzz;
+    vec3 albedo;    float shininess;
+    vec3 emission;  uint flags;
+    vec3 specular;  float pad0;
+} Material;
+
+enum LightType { LIGHT_AREA = 0 };
+
+/* Emissive primitives, in one array with a cumulative distribution for choosing one
+ * proportionally to its power (area x luminance of emission). */
+typedef struct {                                        /* 80 bytes */
+    uint type;                /* enum LightType */
+    uint prim;                /* area lights: global primitive id */
+    float cdf;                /* P(choose a light with index <= this one) */
+    float pick_pdf;           /* P(choose this light) */
+    float area;
+    float pad0, pad1, pad2;
+    vec3 position;  float pad3;
+    vec3 direction; float pad4;
+    vec3 intensity; float pad5;
+} Light;
+
+enum CameraType { CAMERA_PERSPECTIVE = 0 };
+
+/* A thin-lens camera prepared on the host: the ray through film position (s, t) in
+ * [0,1]^2 (t = 0 at the top row) starts at origin + lens offset and passes through
+ * corner + s*horizontal - t*vertical (corner is the top-left of the focus plane). */
+typedef struct {                                        /* 96 bytes */
+    vec3 origin;      float lens_radius;
+    vec3 corner;      uint type;
+    vec3 horizontal;  float pad0;
+    vec3 vertical;    float pad1;
+    vec3 lens_u;      float pad2;   /* unit vectors spanning the lens plane */
+    vec3 lens_v;      float pad3;
+} Camera;
+
+enum BackgroundType { BG_CONSTANT = 0, BG_SKY = 1 };
+
+/* Everything constant over a render, uploaded once per device. */
+typedef struct {                                        /* 208 bytes */
+    Camera camera;
+    vec3 bg_color;    uint bg_type;   /* constant colour, or the sky's horizon colour */
+    vec3 bg_zenith;   uint pad0;      /* sky colour straight up (+y) */
+    uint width, height;
+    uint max_depth;                   /* longest path, in bounces after the camera ray */
+    uint rr_depth;                    /* Russian roulette starts at this bounce */
+    uint seed;
+    uint n_spheres, n_triangles, n_boxes, n_planes;
+    uint n_lights;
+    uint n_nodes, n_leaf_prims;
+    vec3 bounds_lo;   uint pad1;      /* box of the kd-tree root */
+    vec3 bounds_hi;   uint pad2;
+} RenderParams;
+
+/* One path of the wavefront; lives in a device buffer between kernel launches. */
+typedef struct {                                        /* 64 bytes */
+    vec3 throughput;  uint pixel;
+    vec3 radiance;    uint sample;
+    vec3 shadow_L;    uint bounce;    /* contribution waiting for its shadow ray */
+    float bsdf_pdf;                   /* solid-angle pdf of the last bounce (MIS) */
+    uint flags;                       /* PATH_* */
+    uint rng_key;                     /* hash of (seed, pixel, sample) */
+    uint pad0;
+} PathState;
+
+#define PATH_SPECULAR 1u      /* last bounce was a delta lobe: no MIS on emission */
+
+/* Stage results reported by shade_path to its caller, which does the queueing. */
+#define SHADE_CONTINUE 1u     /* the path goes on with the ray written back */
+#define SHADE_SHADOW 2u       /* a shadow ray was written; shadow_L waits on it */
+
+#ifndef __OPENCL_VERSION__
+#include <stddef.h>
+#define CLPT_CHECK_SIZE(T, n) _Static_assert(sizeof(T) == (n), #T " must be " #n " bytes")
+CLPT_CHECK_SIZE(vec3, 12);
+CLPT_CHECK_SIZE(Ray, 32);
+CLPT_CHECK_SIZE(Hit, 16);
+CLPT_CHECK_SIZE(KdNode, 8);
+CLPT_CHECK_SIZE(Sphere, 32);
+CLPT_CHECK_SIZE(Triangle, 48);
+CLPT_CHECK_SIZE(TriShading, 64);
+CLPT_CHECK_SIZE(Box, 32);
+CLPT_CHECK_SIZE(Plane, 32);
+CLPT_CHECK_SIZE(Material, 64);
+CLPT_CHECK_SIZE(Light, 80);
+CLPT_CHECK_SIZE(Camera, 96);
+CLPT_CHECK_SIZE(RenderParams, 208);
+CLPT_CHECK_SIZE(PathState, 64);
+_Static_assert(offsetof(RenderParams, bg_color) == 96, "RenderParams.bg_color");
+_Static_assert(offsetof(RenderParams, width) == 128, "RenderParams.width");
+_Static_assert(offsetof(RenderParams, bounds_lo) == 176, "RenderParams.bounds_lo");
+_Static_assert(offsetof(PathState, bsdf_pdf) == 48, "PathState.bsdf_pdf");
+_Static_assert(offsetof(Material, albedo) == 16, "Material.albedo");
+_Static_assert(offsetof(Light, position) == 32, "Light.position");
+#undef CLPT_CHECK_SIZE
+#endif
+
+#endif /* CLPT_TYPES_H */

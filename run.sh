@@ -1,0 +1,19 @@
+#!/bin/sh
+# run.sh — the two commands of the README, usable on a fresh Debian 12 machine:
+#
+#   ./run.sh render   install what is missing, build, render scenes/cornell-box.scene
+#                     to cornell-box.png
+#   ./run.sh test     install what is missing, build, run the test suite
+#
+# Packages are installed when run as root; otherwise the exact apt-get command is
+# printed and nothing else happens (see tools/deps.sh).
+set -eu
+cd "$(dirname "$0")"
+what=${1:-render}
+case "$what" in
+    render|test) ;;
+    *) echo "usage: ./run.sh render|test" >&2; exit 2 ;;
+esac
+sh tools/deps.sh base
+jobs=$(getconf _NPROCESSORS_ONLN 2>/dev/null || echo 2)
+exec make -j"$jobs" "$what"

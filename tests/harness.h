@@ -1,0 +1,92 @@
+/*
+ * harness.h — a minimal test harness. Each tests/test_*.c is a program:
+ *
+ *     static void test_something(void) { CHECK(x == 1); CHECK_NEAR(a, b, 1e-6); }
+ *     int main(void) { RUN(test_something); return harness_report(); }
+ *
+ * A test passes when none of its checks fail. A failed check prints file:line and the
+ * expression (and values) and the test goes on, so one run shows every failure.
+ * harness_report() prints "N passed, M failed" and returns the exit status.
+ */
+#ifndef CLPT_HARNESS_H
+#define CLPT_HARNESS_H
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static int harness_passed, harness_failed, harness_current_failed;
+static const char *harness_current = "";
+
+#define CHECK(cond)                                                                    \
+    do {                                                                               \
+        if (!(cond)) {                                                                 \
+            fprintf(stderr, "  FAIL %s:%d [%s]: %s\n", __FILE__, __LINE__,             \
+                    harness_current, #cond);                                           \
+            harness_current_failed++;                                                  \
+        }                                                                              \
+    } while (0)
+
+#define CHECK_MSG(cond, ...)                                                           \
+    do {                                                                               \
+        if (!(cond)) {                                                                 \
+            fprintf(stderr, "  FAIL %s:%d [%s]: %s: ", __FILE__, __LINE__,             \
+                    harness_current, #cond);                                           \
+            fprintf(stderr, __VA_ARGS__);                                              \
+            fputc('\n', stderr);                                                       \
+            harness_current_failed++;                                                  \
+        }                                                                              \
+    } while (0)
+
+#define CHECK_NEAR(a, b, tol)                                                          \
+    do {                                                                               \
+        double ha_ = (double)(a), hb_ = (double)(b);                                   \
+        if (!(fabs(ha_ - hb_) <= (double)(tol))) {                                     \
+            fprintf(stderr, "  FAIL %s:%d [%s]: %s = %.9g, %s = %.9g, tolerance %g\n", \
+                    __FILE__, __LINE__, harness_current, #a, ha_, #b, hb_,             \
+                    (double)(tol));                                                    \
+            harness_current_failed++;                                                  \
+        }                                                                              \
+    } while (0)
+
+#define CHECK_EQ_INT(a, b)                                                             \
+    do {                                                                               \
+        long long ha_ = (long long)(a), hb_ = (long long)(b);                          \
+        if (ha_ != hb_) {                                                              \
+            fprintf(stderr, "  FAIL %s:%d [%s]: %s = %lld, expected %s = %lld\n",      \
+                    __FILE__, __LINE__, harness_current, #a, ha_, #b, hb_);            \
+            harness_current_failed++;                                                  \
+        }                                                                              \
+    } while (0)
+
+#define CHECK_STR_CONTAINS(hay, needle)                                                \
+    do {                                                                               \
+        const char *hh_ = (hay), *hn_ = (needle);                                      \
+        if (!hh_ || !strstr(hh_, hn_)) {                                               \
+            fprintf(stderr, "  FAIL %s:%d [%s]: \"%s\" does not contain \"%s\"\n",     \
+                    __FILE__, __LINE__, harness_current, hh_ ? hh_ : "(null)", hn_);   \
+            harness_current_failed++;                                                  \
+        }                                                                              \
+    } while (0)
+
+#define RUN(fn)                                                                        \
+    do {                                                                               \
+        harness_current = #fn;                                                         \
+        harness_current_failed = 0;                                                    \
+        fn();                                                                          \
+        if (harness_current_failed) {                                                  \
+            harness_failed++;                                                          \
+            fprintf(stderr, "FAIL %s\n", #fn);                                         \
+        } else {                                                                       \
+            harness_passed++;                                                          \
+            fprintf(stderr, "ok   %s\n", #fn);                                         \
+        }                                                                              \
+    } while (0)
+
+static inline int harness_report(void)
+{
+    printf("%d passed, %d failed\n", harness_passed, harness_failed);
+    return harness_failed ? 1 : 0;
+}
+
+#endif /* CLPT_HARNESS_H */

@@ -1,0 +1,42 @@
+#!/bin/sh
+# Runs every test program in BUILD/tests and prints the total: "N passed, M failed".
+# Each program prints its own "N passed, M failed" as its last line of stdout.
+set -u
+build=${1:-build}
+# PoCL compiles kernels on first use; keep its cache inside the build folder so test
+# runs do not write to the user's home and reruns are fast.
+: "${POCL_CACHE_DIR:=$PWD/$build/pocl-cache}"
+export POCL_CACHE_DIR
+export CLPT_CACHE_DIR="${CLPT_CACHE_DIR:-$PWD/$build/kernel-cache}"
+mkdir -p "$POCL_CACHE_DIR" "$CLPT_CACHE_DIR"
+
+passed=0
+failed=0
+for t in "$build"/tests/test_*; do
+    [ -x "$t" ] || continue
+    case "$t" in *.d) continue ;; esac
+    name=$(basename "$t")
+    start=$(date +%s)
+    out=$("$t" 2>"$build/tests/$name.log")
+    rc=$?
+    line=$(printf '%s\n' "$out" | tail -n 1)
+    p=$(printf '%s\n' "$line" | sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed$/\1/p')
+    f=$(printf '%s\n' "$line" | sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed$/\2/p')
+    secs=$(( $(date +%s) - start ))
+    if [ -z "$p" ]; then
+        # crashed or printed no summary: count the whole program as one failure
+        p=0; f=1
+        echo "CRASH $name (exit $rc, no summary line); log: $build/tests/$name.log"
+        tail -n 20 "$build/tests/$name.log" | sed 's/^/    /'
+    elif [ "$f" -ne 0 ] || [ "$rc" -ne 0 ]; then
+        [ "$f" -eq 0 ] && f=1
+        echo "FAIL  $name: $line (${secs}s)"
+        grep -E 'FAIL' "$build/tests/$name.log" | head -n 30 | sed 's/^/    /'
+    else
+        echo "ok    $name: $line (${secs}s)"
+    fi
+    passed=$((passed + p))
+    failed=$((failed + f))
+done
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]

@@ -1,0 +1,49 @@
+#!/bin/sh
+# deps.sh PROFILE... — makes sure the Debian packages a task needs are installed.
+#
+# Profiles: base (build and run clpt, run the tests), sanitize (make test-asan),
+# valgrind (make test-valgrind), fuzz (make fuzz), embree (the traversal benchmark).
+# Missing packages are installed when run as root (apt-get); otherwise the exact
+# command to run is printed and the script fails, so nothing half-works.
+set -eu
+
+pkgs_for() {
+    case "$1" in
+        base) echo "make gcc libc6-dev pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers libstb-dev" ;;
+        sanitize) echo "clang libclang-rt-14-dev" ;;
+        valgrind) echo "valgrind" ;;
+        fuzz) echo "clang libclang-rt-14-dev" ;;
+        embree) echo "libembree-dev" ;;
+        *) echo "deps.sh: unknown profile '$1'" >&2; exit 2 ;;
+    esac
+}
+
+[ $# -gt 0 ] || set -- base
+wanted=""
+for profile in "$@"; do wanted="$wanted $(pkgs_for "$profile")"; done
+
+if ! command -v dpkg-query >/dev/null 2>&1; then
+    echo "deps.sh: this is not a Debian-based system; install the equivalents of:$wanted" >&2
+    exit 0
+fi
+
+missing=""
+for p in $wanted; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+        case " $missing " in *" $p "*) ;; *) missing="$missing $p" ;; esac
+    fi
+done
+[ -z "$missing" ] && exit 0
+
+if [ "$(id -u)" -eq 0 ]; then
+    echo "deps.sh: installing missing packages:$missing" >&2
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq >&2
+    # shellcheck disable=SC2086
+    apt-get install -y -qq --no-install-recommends $missing >&2
+else
+    echo "clpt needs these Debian packages, which are missing:$missing" >&2
+    echo "Install them with:" >&2
+    echo "    sudo apt-get install -y$missing" >&2
+    exit 1
+fi

@@ -37,6 +37,8 @@
 #define k_as_int(f) as_int(f)
 #define k_int_as_float(i) as_float(i)
 
+typedef long kint64;         /* 64-bit in every OpenCL C implementation */
+
 #else
 /* ---------------------------------------------------------------- C11 */
 #include <math.h>
@@ -49,6 +51,7 @@
 
 typedef unsigned int uint;   /* same as glibc's <sys/types.h> typedef */
 typedef unsigned char uchar;
+typedef int64_t kint64;
 
 #define k_sqrt(x) sqrtf(x)
 #define k_fabs(x) fabsf(x)

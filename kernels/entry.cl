@@ -3,8 +3,90 @@
  * gathers the scene buffers into a SceneView and calls the per-path stage functions of
  * raygen.cl, traverse.cl, shade.cl and film.cl, which the scalar C device calls too.
  * Queueing (which paths are still alive) happens here, not in the stage functions.
+ *
+ * A wave covers the pixels [first_pixel, first_pixel + wave_pixels) and `layers`
+ * consecutive sample indices: path i renders pixel first_pixel + i % wave_pixels with
+ * sample index first_sample + i / wave_pixels. Each bounce is intersect → shade → shadow
+ * over the queue of live paths; shade appends survivors to the next queue.
  */
-#include "types.h"
+#include "film.cl"
+#include "raygen.cl"
+#include "shade.cl"
+#include "traverse.cl"
+
+#define SCENE_ARGS                                                                       \
+    __global const RenderParams *params, __global const KdNode *nodes,                   \
+    __global const uint *leaf_prims, __global const Sphere *spheres,                     \
+    __global const Triangle *triangles, __global const Box *boxes,                       \
+    __global const Plane *planes, __global const Material *materials,                    \
+    __global const Light *lights, __global const TriShading *shading
+
+#define SCENE_VIEW(sc)                                                                   \
+    SceneView sc;                                                                        \
+    sc.params = params; sc.nodes = nodes; sc.leaf_prims = leaf_prims;                    \
+    sc.spheres = spheres; sc.triangles = triangles; sc.boxes = boxes;                    \
+    sc.planes = planes; sc.materials = materials; sc.lights = lights;                    \
+    sc.shading = shading
+
+/* Births the wave's paths and queues them all. */
+__kernel void k_raygen(__global const RenderParams *params, uint first_pixel, uint wave_pixels,
+                       uint first_sample, uint n_paths, __global PathState *paths,
+                       __global Ray *rays, __global uint *queue)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= n_paths) return;
+    raygen_path(params, first_pixel + i % wave_pixels, first_sample + i / wave_pixels, &paths[i], &rays[i]);
+    queue[i] = i;
+}
+
+/* Closest hit for every queued path. */
+__kernel void k_intersect(SCENE_ARGS, __global const uint *queue, uint n,
+                          __global const Ray *rays, __global Hit *hits)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= n) return;
+    SCENE_VIEW(sc);
+    uint path = queue[i];
+    hits[path] = trace_closest(&sc, rays[path]);
+}
+
+/* Shades every queued path; counters[0] counts the next queue, counters[1] the shadow
+ * rays. Their order in the queues varies from run to run, the paths' results do not. */
+__kernel void k_shade(SCENE_ARGS, __global const uint *queue, uint n, __global Ray *rays,
+                      __global const Hit *hits, __global PathState *paths,
+                      __global Ray *shadow_rays, __global uint *next_queue,
+                      __global uint *shadow_queue, __global uint *counters)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= n) return;
+    SCENE_VIEW(sc);
+    uint path = queue[i];
+    uint r = shade_path(&sc, &rays[path], hits[path], &paths[path], &shadow_rays[path]);
+    if (r & SHADE_CONTINUE) next_queue[atomic_inc(&counters[0])] = path;
+    if (r & SHADE_SHADOW) shadow_queue[atomic_inc(&counters[1])] = path;
+}
+
+/* Any-hit test of every queued shadow ray, resolving the waiting contributions. */
+__kernel void k_shadow(SCENE_ARGS, __global const uint *shadow_queue, uint n,
+                       __global const Ray *shadow_rays, __global PathState *paths)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= n) return;
+    SCENE_VIEW(sc);
+    uint path = shadow_queue[i];
+    shadow_resolve(&paths[path], trace_any(&sc, shadow_rays[path]));
+}
+
+/* Adds the finished wave to the film: one work-item per pixel, so no two work-items
+ * touch the same film entry. */
+__kernel void k_film(__global const PathState *paths, uint first_pixel, uint wave_pixels,
+                     uint layers, __global long *film)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= wave_pixels) return;
+    for (uint l = 0u; l < layers; l++)
+        film_add(film, first_pixel + i, paths[l * wave_pixels + i].radiance);
+}
 
 /* Writes sizeof and offsetof of the shared structs, for the host to compare with its
  * own layout (tests/test_kernels.c): a mismatch would silently corrupt every buffer. */
@@ -26,12 +108,12 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)sizeof(Camera);
     out[i++] = (uint)sizeof(RenderParams);
     out[i++] = (uint)sizeof(PathState);
-    out[i++] = (uint)offsetof(RenderParams, bg_color);
-    out[i++] = (uint)offsetof(RenderParams, width);
-    out[i++] = (uint)offsetof(RenderParams, bounds_lo);
-    out[i++] = (uint)offsetof(PathState, bsdf_pdf);
-    out[i++] = (uint)offsetof(Material, albedo);
-    out[i++] = (uint)offsetof(Light, position);
-    out[i++] = (uint)offsetof(Camera, lens_u);
-    out[i++] = (uint)offsetof(TriShading, uv0);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, bg_color);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, width);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, bounds_lo);
+    out[i++] = (uint)__builtin_offsetof(PathState, bsdf_pdf);
+    out[i++] = (uint)__builtin_offsetof(Material, albedo);
+    out[i++] = (uint)__builtin_offsetof(Light, position);
+    out[i++] = (uint)__builtin_offsetof(Camera, lens_u);
+    out[i++] = (uint)__builtin_offsetof(TriShading, uv0);
 }

@@ -1,0 +1,144 @@
+/*
+ * lights.h — next-event estimation: choosing an emissive primitive, sampling a point on
+ * it as seen from a shading point, and the density of that choice (for multiple
+ * importance sampling against BSDF sampling). All densities are per unit solid angle at
+ * the shading point and include the probability of choosing the light. Emission is
+ * two-sided: a light looks the same from either side of its surface.
+ */
+#ifndef CLPT_LIGHTS_H
+#define CLPT_LIGHTS_H
+
+#include "sampling.h"
+#include "scene_view.h"
+
+typedef struct {
+    vec3 p;        /* point on the light */
+    vec3 n;        /* its unit normal */
+    vec3 Le;       /* emitted radiance */
+    float pdf;     /* solid-angle density at the reference point, choice included */
+} LightSample;
+
+KFN uint prim_material(const SceneView *sc, uint prim)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
+    uint first_plane = first_box + p->n_boxes;
+    if (prim < first_tri) return sc->spheres[prim].material;
+    if (prim < first_box) return sc->triangles[prim - first_tri].material;
+    if (prim < first_plane) return sc->boxes[prim - first_box].material;
+    return sc->planes[prim - first_plane].material;
+}
+
+/* Chooses a light with probability pick_pdf (binary search of the cdf) and rescales u
+ * to a fresh uniform number in [0,1) for the caller's further use. */
+KFN uint light_choose(const SceneView *sc, float u, float *u_rest)
+{
+    uint lo = 0u, hi = sc->params->n_lights - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi) >> 1;
+        if (u < sc->lights[mid].cdf) hi = mid; else lo = mid + 1u;
+    }
+    Light l = sc->lights[lo];
+    float below = l.cdf - l.pick_pdf;
+    *u_rest = k_clamp((u - below) / l.pick_pdf, 0.0f, 0.99999994f);
+    return lo;
+}
+
+/* 1 - cos(theta_max) of the cone a sphere of radius r subtends at distance^2 d2, written
+ * as sin^2 / (1 + cos) so that small, far spheres do not cancel to zero. */
+KFN float sphere_cone_one_minus_cos(float r, float d2)
+{
+    float sin2 = r * r / d2;
+    float cos_max = k_safe_sqrt(1.0f - sin2);
+    return sin2 / (1.0f + cos_max);
+}
+
+/* Solid-angle density of light `li` producing point x (normal n) seen from ref. */
+KFN float light_pdf(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
+{
+    Light l = sc->lights[li];
+    vec3 to = v3_sub(x, ref);
+    float dist2 = v3_dot(to, to);
+    if (l.prim < sc->params->n_spheres) {
+        Sphere sp = sc->spheres[l.prim];
+        vec3 wc = v3_sub(sp.center, ref);
+        float dc2 = v3_dot(wc, wc);
+        if (dc2 > sp.radius * sp.radius)
+            return l.pick_pdf / (K_TWO_PI * sphere_cone_one_minus_cos(sp.radius, dc2));
+    }
+    float cos_l = k_fabs(v3_dot(n, to)) / k_sqrt(dist2);
+    if (cos_l <= 0.0f || l.area <= 0.0f) return 0.0f;
+    return l.pick_pdf * dist2 / (cos_l * l.area);
+}
+
+/* Samples a point on one light as seen from ref. Returns 0 if the sample is useless
+ * (degenerate light, or ref on the light's plane). */
+KFN int light_sample(const SceneView *sc, vec3 ref, float u_pick, float u1, float u2,
+                     LightSample *ls)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    float u_rest;
+    uint li = light_choose(sc, u_pick, &u_rest);
+    Light l = sc->lights[li];
+    uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
+    ls->Le = sc->materials[prim_material(sc, l.prim)].emission;
+
+    if (l.prim < first_tri) {
+        Sphere sp = sc->spheres[l.prim];
+        vec3 wc = v3_sub(sp.center, ref);
+        float dc2 = v3_dot(wc, wc);
+        if (dc2 > sp.radius * sp.radius) {
+            /* outside: uniform over the cone of directions that see the sphere */
+            float dc = k_sqrt(dc2);
+            vec3 w = v3_scale(wc, 1.0f / dc);
+            float omc = sphere_cone_one_minus_cos(sp.radius, dc2);
+            float x = u1 * omc;                          /* 1 - cos(theta) */
+            float cos_t = 1.0f - x;
+            float sin_t = k_safe_sqrt(x * (2.0f - x));
+            float sphi, cphi;
+            k_sincos(K_TWO_PI * u2, &sphi, &cphi);
+            vec3 t, b;
+            k_onb(w, &t, &b);
+            vec3 dir = k_to_world(v3(sin_t * cphi, sin_t * sphi, cos_t), t, b, w);
+            float ds = dc * cos_t - k_safe_sqrt(sp.radius * sp.radius - dc2 * sin_t * sin_t);
+            vec3 n = v3_norm(v3_sub(v3_madd(ref, dir, ds), sp.center));
+            ls->n = n;
+            ls->p = v3_madd(sp.center, n, sp.radius);
+            ls->pdf = l.pick_pdf / (K_TWO_PI * omc);
+            return ls->pdf > 0.0f;
+        }
+        /* inside: uniform over the whole surface, all of which is visible */
+        vec3 n = sample_sphere_dir(u1, u2);
+        ls->n = n;
+        ls->p = v3_madd(sp.center, n, sp.radius);
+    } else if (l.prim < first_box) {
+        Triangle tr = sc->triangles[l.prim - first_tri];
+        float b1, b2;
+        sample_triangle(u1, u2, &b1, &b2);
+        ls->p = v3_add(v3_add(v3_scale(tr.p0, 1.0f - b1 - b2), v3_scale(tr.p1, b1)), v3_scale(tr.p2, b2));
+        ls->n = v3_norm(v3_cross(v3_sub(tr.p1, tr.p0), v3_sub(tr.p2, tr.p0)));
+    } else {
+        /* a box: a face chosen by area with the rest of the choice number, then a uniform
+         * point on it */
+        Box bx = sc->boxes[l.prim - first_box];
+        vec3 e = v3_sub(bx.hi, bx.lo);
+        float ax = e.y * e.z, ay = e.x * e.z, az = e.x * e.y;
+        float pick = u_rest * (ax + ay + az);
+        int axis = pick < ax ? 0 : (pick < ax + ay ? 1 : 2);
+        float face_area = axis == 0 ? ax : (axis == 1 ? ay : az);
+        float below = axis == 0 ? 0.0f : (axis == 1 ? ax : ax + ay);
+        float side = (pick - below) / face_area;         /* uniform in [0,1): which of the pair */
+        int upper = side >= 0.5f;
+        float c0 = upper ? 1.0f : 0.0f;
+        vec3 q = v3(bx.lo.x + e.x * (axis == 0 ? c0 : u1),
+                    bx.lo.y + e.y * (axis == 1 ? c0 : (axis == 0 ? u1 : u2)),
+                    bx.lo.z + e.z * (axis == 2 ? c0 : u2));
+        float sign = upper ? 1.0f : -1.0f;
+        ls->p = q;
+        ls->n = v3(axis == 0 ? sign : 0.0f, axis == 1 ? sign : 0.0f, axis == 2 ? sign : 0.0f);
+    }
+    ls->pdf = light_pdf(sc, li, ref, ls->p, ls->n);
+    return ls->pdf > 0.0f;
+}
+
+#endif /* CLPT_LIGHTS_H */

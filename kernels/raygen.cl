@@ -1,0 +1,43 @@
+/*
+ * raygen.cl — where a path is born: the camera ray through a jittered point of its pixel
+ * (box filter), from a point on the thin lens when the aperture is open.
+ */
+#ifndef CLPT_RAYGEN_CL
+#define CLPT_RAYGEN_CL
+
+#include "rng.h"
+#include "sampling.h"
+
+KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
+                     GLOBAL PathState *ps, GLOBAL Ray *ray)
+{
+    const Camera cam = p->camera;
+    uint key = rng_path_key(p->seed, pixel, sample);
+    uint x = pixel % p->width, y = pixel / p->width;
+    float s = ((float)x + rng_uniform(key, 0u, DIM_PIXEL_X)) / (float)p->width;
+    float t = ((float)y + rng_uniform(key, 0u, DIM_PIXEL_Y)) / (float)p->height;
+    vec3 target = v3_sub(v3_madd(cam.corner, cam.horizontal, s), v3_scale(cam.vertical, t));
+    vec3 origin = cam.origin;
+    if (cam.lens_radius > 0.0f) {
+        float lx, ly;
+        sample_disk(rng_uniform(key, 0u, DIM_LENS_U), rng_uniform(key, 0u, DIM_LENS_V), &lx, &ly);
+        origin = v3_madd(v3_madd(origin, cam.lens_u, lx * cam.lens_radius), cam.lens_v, ly * cam.lens_radius);
+    }
+    ray->o = origin;
+    ray->d = v3_norm(v3_sub(target, origin));
+    ray->tmin = 0.0f;
+    ray->tmax = INFINITY;
+
+    ps->throughput = v3s(1.0f);
+    ps->radiance = v3s(0.0f);
+    ps->shadow_L = v3s(0.0f);
+    ps->pixel = pixel;
+    ps->sample = sample;
+    ps->bounce = 0u;
+    ps->bsdf_pdf = 0.0f;
+    ps->flags = PATH_SPECULAR;  /* what the camera sees directly gets full weight */
+    ps->rng_key = key;
+    ps->pad0 = 0u;
+}
+
+#endif /* CLPT_RAYGEN_CL */

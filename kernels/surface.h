@@ -1,0 +1,100 @@
+/*
+ * surface.h — from a hit record to the local geometry the shader needs: position,
+ * geometric and shading normals, material, light and surface coordinates; and the
+ * robust ray-origin offset that keeps a new ray from hitting the surface it leaves.
+ */
+#ifndef CLPT_SURFACE_H
+#define CLPT_SURFACE_H
+
+#include "kmath.h"
+#include "scene_view.h"
+
+typedef struct {
+    vec3 p;          /* hit position */
+    vec3 ng;         /* geometric normal, unit, outward (sphere, box) or by winding */
+    vec3 ns;         /* shading normal, unit, on the same side as ng */
+    uint material;
+    uint light;      /* index in lights[] or NO_INDEX */
+    float u, v;      /* surface coordinates (triangle barycentrics or texture uv) */
+} Surface;
+
+KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    Surface s;
+    uint id = hit.prim;
+    s.p = v3_madd(ray.o, ray.d, hit.t);
+    s.u = hit.u;
+    s.v = hit.v;
+    s.light = NO_INDEX;
+    uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
+    uint first_plane = first_box + p->n_boxes;
+    if (id < first_tri) {
+        Sphere sp = sc->spheres[id];
+        vec3 n = v3_norm(v3_sub(s.p, sp.center));
+        /* re-project onto the sphere: o + t*d drifts off it by the error in t */
+        s.p = v3_madd(sp.center, n, sp.radius);
+        s.ng = n;
+        s.ns = n;
+        s.material = sp.material;
+        s.light = sp.light;
+    } else if (id < first_box) {
+        Triangle tr = sc->triangles[id - first_tri];
+        float w = 1.0f - hit.u - hit.v;
+        /* barycentric interpolation is far more precise than o + t*d for a far hit */
+        s.p = v3_add(v3_add(v3_scale(tr.p0, w), v3_scale(tr.p1, hit.u)), v3_scale(tr.p2, hit.v));
+        s.ng = v3_norm(v3_cross(v3_sub(tr.p1, tr.p0), v3_sub(tr.p2, tr.p0)));
+        s.ns = s.ng;
+        s.material = tr.material;
+        s.light = tr.light;
+        if (tr.shading != NO_INDEX) {
+            TriShading sh = sc->shading[tr.shading];
+            if (sh.flags & TRI_HAS_NORMALS) {
+                vec3 n = v3_add(v3_add(v3_scale(sh.n0, w), v3_scale(sh.n1, hit.u)), v3_scale(sh.n2, hit.v));
+                float len = v3_len(n);
+                if (len > 0.0f) {
+                    n = v3_scale(n, 1.0f / len);
+                    s.ns = v3_dot(n, s.ng) < 0.0f ? v3_neg(n) : n;
+                }
+            }
+            if (sh.flags & TRI_HAS_UV) {
+                s.u = w * sh.uv0[0] + hit.u * sh.uv1[0] + hit.v * sh.uv2[0];
+                s.v = w * sh.uv0[1] + hit.u * sh.uv1[1] + hit.v * sh.uv2[1];
+            }
+        }
+    } else if (id < first_plane) {
+        Box b = sc->boxes[id - first_box];
+        int face = (int)hit.u;                    /* 0:-x 1:+x 2:-y 3:+y 4:-z 5:+z */
+        float sign = (face & 1) ? 1.0f : -1.0f;
+        int axis = face >> 1;
+        s.ng = v3(axis == 0 ? sign : 0.0f, axis == 1 ? sign : 0.0f, axis == 2 ? sign : 0.0f);
+        s.ns = s.ng;
+        s.material = b.material;
+        s.light = b.light;
+    } else {
+        Plane pl = sc->planes[id - first_plane];
+        s.ng = pl.normal;
+        s.ns = pl.normal;
+        s.material = pl.material;
+    }
+    return s;
+}
+
+/* A point just off the surface at p on the side n points to. The offset is a fixed
+ * number of float ulps of p (integer arithmetic on the bit pattern), so it scales with
+ * the magnitude of the coordinates instead of a global epsilon; near the origin, where
+ * ulps vanish, a small absolute offset takes over. After Wächter & Binder, "A Fast and
+ * Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, ch. 6 (2019). */
+KFN float offset_coord(float p, float n)
+{
+    int ulps = (int)(256.0f * n);
+    float moved = k_int_as_float(k_as_int(p) + (p < 0.0f ? -ulps : ulps));
+    return k_fabs(p) < 0.03125f ? p + 1.52587890625e-5f * n : moved;
+}
+
+KFN vec3 offset_ray_origin(vec3 p, vec3 n)
+{
+    return v3(offset_coord(p.x, n.x), offset_coord(p.y, n.y), offset_coord(p.z, n.z));
+}
+
+#endif /* CLPT_SURFACE_H */

@@ -1,6 +1,5 @@
 /* test_image.c — format from the extension, sRGB encoding, PNG/PPM/PFM round trips and
  * the atomic writer's failure behaviour. */
-#define _XOPEN_SOURCE 700
 #include <dirent.h>
 #include <ftw.h>
 #include <stdint.h>

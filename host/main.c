@@ -1,10 +1,312 @@
-/* main.c — command line → render → exit code. */
+/*
+ * main.c — command line → scene → kd-tree → devices → render → image → exit code.
+ *
+ * The whole life of a render reads top to bottom in run(). Errors travel up as Status
+ * values with their message in one Error, printed once here; the status is the exit code.
+ */
+#include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
-#include "status.h"
+#include "device.h"
+#include "film.h"
+#include "image_write.h"
+#include "options.h"
+#include "progress.h"
+#include "render_scene.h"
+#include "scene.h"
+#include "schedule.h"
+#include "timer.h"
 
-int main(void)
+#define CLPT_VERSION "0.1.0"
+
+static volatile sig_atomic_t stop_requested;
+
+static void on_stop_signal(int sig)
 {
-    fprintf(stderr, "clpt: not built yet\n");
-    return ST_INTERNAL;
+    (void)sig;
+    stop_requested = 1;
+}
+
+static void install_signal_handlers(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+typedef struct {
+    const char *output;
+    int quiet;
+    int progressive_failed;
+} RenderContext;
+
+static void print_warning(void *ctx, const char *msg)
+{
+    (void)ctx;
+    fprintf(stderr, "\r\033[Kclpt: warning: %s\n", msg);
+}
+
+static Status write_film(const Film *film, const char *path, Error *err)
+{
+    size_t n = (size_t)film->width * film->height * 3u;
+    float *rgb = malloc(n * sizeof *rgb);
+    if (!rgb) return error_set(err, ST_INTERNAL, "out of memory resolving the image");
+    film_resolve(film, rgb);
+    Status st = image_write(path, rgb, film->width, film->height, err);
+    free(rgb);
+    return st;
+}
+
+/* Progressive output: rewrites the image during the render (atomically, so a viewer
+ * never sees half a file). A failure is reported once and does not stop the render. */
+static void on_progress_tick(void *vctx, const Film *film)
+{
+    RenderContext *ctx = vctx;
+    if (film->samples == 0) return;
+    Error err = { 0 };
+    if (write_film(film, ctx->output, &err) != ST_OK && !ctx->progressive_failed) {
+        ctx->progressive_failed = 1;
+        print_warning(NULL, err.msg);
+    }
+    error_clear(&err);
+}
+
+/* Output name when -o is not given: the scene's file name with .png, in the current
+ * folder. */
+static char *default_output(const char *scene_path)
+{
+    const char *base = strrchr(scene_path, '/');
+    base = base ? base + 1 : scene_path;
+    size_t n = strlen(base);
+    const char *dot = strrchr(base, '.');
+    if (dot && dot != base) n = (size_t)(dot - base);
+    char *out = malloc(n + 5);
+    if (out) {
+        memcpy(out, base, n);
+        memcpy(out + n, ".png", 5);
+    }
+    return out;
+}
+
+static void apply_overrides(const Options *o, Scene *s)
+{
+    if (o->spp >= 0) s->image.spp = (uint)o->spp;
+    if (o->width >= 0) s->image.width = (uint)o->width;
+    if (o->height >= 0) s->image.height = (uint)o->height;
+    if (o->seed >= 0) s->image.seed = (uint)o->seed;
+    if (o->max_depth >= 0) s->image.max_depth = (uint)o->max_depth;
+}
+
+static void print_scene_stats(const Scene *s, const KdTree *kd)
+{
+    const KdStats *k = &kd->stats;
+    size_t in_tree = s->n_spheres + s->n_triangles + s->n_boxes;
+    printf("scene: %zu spheres, %zu triangles, %zu boxes, %zu planes, %zu materials, %zu lights\n",
+           s->n_spheres, s->n_triangles, s->n_boxes, s->n_planes, s->n_materials, s->n_lights);
+    printf("kd-tree: built in %.3f s; %u nodes, %u leaves (%u empty), depth %u, "
+           "%.2f primitives per non-empty leaf, SAH cost %.2f, %.1f KiB (%.1f bytes per primitive)\n",
+           k->build_seconds, k->n_nodes, k->n_leaves, k->n_empty_leaves, k->max_depth,
+           k->mean_prims_per_leaf, k->sah_cost, (double)k->bytes / 1024.0,
+           in_tree ? (double)k->bytes / (double)in_tree : 0.0);
+}
+
+static void print_render_stats(const ScheduleStats *st, Device **devs, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        const DeviceCounters *c = &devs[i]->counters;
+        if (devs[i]->desc.kind == DEVICE_OPENCL)
+            printf("device %zu '%s': kernels %s in %.3f s, scene upload %.3f s\n", i, devs[i]->desc.name,
+                   c->from_cache ? "loaded from cache" : "compiled", c->compile_seconds, c->upload_seconds);
+    }
+    printf("%-32s %7s %12s %8s %8s %12s %10s %6s %s\n", "device", "batches", "samples", "busy s",
+           "idle s", "Msamples/s", "Mrays/s", "share", "batch sizes (min/max/last spp)");
+    for (size_t i = 0; i < st->n_devices && st->devices; i++) {
+        const DeviceRunStats *d = &st->devices[i];
+        double busy = d->busy_seconds > 0.0 ? d->busy_seconds : 1e-9;
+        printf("%-32.32s %7u %12llu %8.2f %8.2f %12.3f %10.3f %5.1f%% %u/%u/%u%s%s\n", d->name, d->batches,
+               (unsigned long long)d->samples, d->busy_seconds, d->idle_seconds, (double)d->samples / busy / 1e6,
+               (double)d->rays / busy / 1e6,
+               st->samples ? 100.0 * (double)d->samples / (double)st->samples : 0.0, d->batch_min, d->batch_max,
+               d->batch_last, d->failed ? "  FAILED: " : "", d->failed ? d->failure : "");
+    }
+    double secs = st->seconds > 0.0 ? st->seconds : 1e-9;
+    printf("%-32s %7s %12llu %8.2f %8s %12.3f %10.3f %5.1f%%\n", "total", "",
+           (unsigned long long)st->samples, st->seconds, "", (double)st->samples / secs / 1e6,
+           (double)st->rays / secs / 1e6, 100.0);
+}
+
+/* Opens the chosen devices and gives each the scene. A device that fails is dropped with
+ * a warning as long as another one works. */
+static Status open_devices(const Options *o, const DeviceScene *ds, Device ***out, size_t *n_out, Error *err)
+{
+    DeviceDesc *all = NULL;
+    size_t n_all = 0, *chosen = NULL, n_chosen = 0;
+    char warning[1100];
+    Status st = device_list(&all, &n_all, warning, sizeof warning, err);
+    if (st) return st;
+    if (warning[0]) print_warning(NULL, warning);
+    if ((st = device_select(o->device_spec, all, n_all, &chosen, &n_chosen, err))) {
+        free(all);
+        return st;
+    }
+    Device **devs = calloc(n_chosen, sizeof *devs);
+    if (!devs) {
+        free(all);
+        free(chosen);
+        return error_set(err, ST_INTERNAL, "out of memory");
+    }
+    DeviceConfig cfg = { o->threads, o->kernel_dir, o->wave_paths };
+    size_t n = 0;
+    Error last = { 0 };
+    for (size_t i = 0; i < n_chosen; i++) {
+        Device *d = NULL;
+        error_clear(&last);
+        st = device_open(&all[chosen[i]], &cfg, &d, &last);
+        if (st == ST_OK) st = d->ops->load_scene(d, ds, &last);
+        if (st == ST_OK) {
+            devs[n++] = d;
+            continue;
+        }
+        device_close(d);
+        if (n_chosen > 1) {
+            print_warning(NULL, last.msg);
+            if (last.detail) fprintf(stderr, "%s\n", last.detail);
+            fprintf(stderr, "clpt: warning: device '%s' dropped; rendering with the others\n", all[chosen[i]].name);
+        }
+    }
+    free(all);
+    free(chosen);
+    if (n == 0) {
+        free(devs);
+        if (n_chosen == 1) {
+            *err = last;   /* the one device's own error, with its build log */
+            return last.status ? last.status : ST_DEVICE;
+        }
+        error_clear(&last);
+        return error_set(err, ST_DEVICE, "none of the %zu chosen devices could be used", n_chosen);
+    }
+    error_clear(&last);
+    *out = devs;
+    *n_out = n;
+    return ST_OK;
+}
+
+static Status run(int argc, char **argv, Error *err)
+{
+    Options o;
+    Status st = options_parse(argc, argv, &o, err);
+    if (st) return st;
+    if (o.help) {
+        options_print_help(stdout);
+        return ST_OK;
+    }
+    if (o.version) {
+        printf("clpt %s\n", CLPT_VERSION);
+        return ST_OK;
+    }
+    if (o.list_devices) {
+        DeviceDesc *all = NULL;
+        size_t n = 0;
+        char warning[1100];
+        if ((st = device_list(&all, &n, warning, sizeof warning, err))) return st;
+        if (warning[0]) print_warning(NULL, warning);
+        device_list_print(stdout, all, n);
+        free(all);
+        return ST_OK;
+    }
+
+    char *default_out = NULL;
+    const char *output = o.output;
+    if (!output && !(output = default_out = default_output(o.scene_path)))
+        return error_set(err, ST_INTERNAL, "out of memory");
+    ImageFormat format;
+    Scene scene;
+    scene_init(&scene);
+    RenderScene rs;
+    memset(&rs, 0, sizeof rs);
+    Film film;
+    memset(&film, 0, sizeof film);
+    Device **devs = NULL;
+    size_t n_devs = 0;
+    ScheduleStats stats;
+    memset(&stats, 0, sizeof stats);
+    double t_start = timer_now();
+
+    if ((st = image_format_from_path(output, &format, err))) goto done;
+    if ((st = scene_load(o.scene_path, &scene, err))) goto done;
+    apply_overrides(&o, &scene);
+    if ((st = render_scene_prepare(&scene, 0, &rs, err))) goto done;
+    const DeviceScene *ds = &rs.ds;
+    if (o.stats) print_scene_stats(&scene, &rs.kd);
+
+    if ((st = open_devices(&o, ds, &devs, &n_devs, err))) goto done;
+    if ((st = film_init(&film, ds->params.width, ds->params.height, err))) goto done;
+
+    install_signal_handlers();
+    RenderContext ctx = { output, o.quiet, 0 };
+    ScheduleConfig cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.spp = scene.image.spp;
+    cfg.time_limit = o.time_limit;
+    cfg.fixed_batch = o.batch;
+    cfg.show_progress = progress_should_enable(o.quiet);
+    cfg.stop = &stop_requested;
+    cfg.on_tick = o.progressive_seconds > 0.0 ? on_progress_tick : NULL;
+    cfg.tick_seconds = o.progressive_seconds;
+    cfg.on_warning = print_warning;
+    cfg.ctx = &ctx;
+    Status render_st = schedule_run(devs, n_devs, &cfg, &film, &stats, err);
+    if (render_st != ST_OK && film.samples == 0) {
+        st = render_st;
+        goto done;
+    }
+    /* Whatever was finished is written, also after an interrupt or device failures. */
+    Error werr = { 0 };
+    if ((st = write_film(&film, output, &werr))) {
+        if (render_st == ST_OK) {
+            *err = werr;
+        } else {
+            fprintf(stderr, "clpt: error: %s\n", werr.msg);
+            error_clear(&werr);
+            st = render_st;
+        }
+        goto done;
+    }
+    if (o.stats) print_render_stats(&stats, devs, n_devs);
+    if (!o.quiet || render_st != ST_OK || stats.interrupted) {
+        double secs = stats.seconds > 0.0 ? stats.seconds : 1e-9;
+        fprintf(stderr, "clpt: %s %ux%u, %llu spp%s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n",
+                stats.interrupted ? "interrupted:" : (stats.time_up ? "time limit reached:" : "rendered"),
+                film.width, film.height, (unsigned long long)film.samples,
+                film.samples < scene.image.spp ? " (partial)" : "", stats.seconds, timer_now() - t_start,
+                (double)stats.samples / secs / 1e6, (double)stats.rays / secs / 1e6, output);
+    }
+    st = render_st != ST_OK ? render_st : (stats.interrupted ? ST_INTERRUPTED : ST_OK);
+
+done:
+    schedule_stats_free(&stats);
+    for (size_t i = 0; i < n_devs; i++) device_close(devs[i]);
+    free(devs);
+    film_free(&film);
+    render_scene_free(&rs);
+    scene_free(&scene);
+    free(default_out);
+    return st;
+}
+
+int main(int argc, char **argv)
+{
+    Error err = { 0 };
+    Status st = run(argc, argv, &err);
+    if (st != ST_OK && st != ST_INTERRUPTED) {
+        error_print(&err);
+        if (st == ST_USAGE) fprintf(stderr, "Try 'clpt --help' for more information.\n");
+    }
+    error_clear(&err);
+    return (int)st;
 }

@@ -36,7 +36,15 @@ void error_prefix(Error *err, const char *fmt, ...)
     va_end(ap);
     char old[sizeof err->msg];
     memcpy(old, err->msg, sizeof old);
-    snprintf(err->msg, sizeof err->msg, "%s: %s", prefix, old);
+    /* prefix, ": ", then as much of the old message as fits */
+    size_t cap = sizeof err->msg - 1, n = strlen(prefix);
+    if (n > cap) n = cap;
+    memcpy(err->msg, prefix, n);
+    for (const char *s = ": "; *s && n < cap; s++) err->msg[n++] = *s;
+    size_t m = strlen(old);
+    if (m > cap - n) m = cap - n;
+    memcpy(err->msg + n, old, m);
+    err->msg[n + m] = '\0';
 }
 
 void error_clear(Error *err)

@@ -77,14 +77,15 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     Surface s = surface_at(sc, r, hit);
     Material m = sc->materials[s.material];
 
-    if (m.type == MAT_EMISSIVE) {
+    if (!v3_is_zero(m.emission)) {
+        /* emission reached by BSDF sampling is weighted against the light sampling that
+         * could have found it too; after a delta bounce only BSDF sampling could */
         float w = 1.0f;
         if (!(ps->flags & PATH_SPECULAR) && s.light != NO_INDEX)
             w = mis_power(ps->bsdf_pdf, light_pdf(sc, s.light, r.o, s.p, s.ng));
         ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, m.emission), w));
-        return 0u;   /* lights do not reflect */
     }
-    if (bounce >= p->max_depth) return 0u;
+    if (m.type == MAT_EMISSIVE || bounce >= p->max_depth) return 0u;   /* pure emitters do not reflect */
 
     /* normals turned toward the side the ray came from */
     int front = v3_dot(r.d, s.ng) < 0.0f;

@@ -86,6 +86,8 @@ typedef struct {                                        /* 32 bytes */
     uint pad0, pad1, pad2;
 } Plane;
 
+/* Every type may also emit `emission` (two-sided); a non-zero emission makes the
+ * primitives with that material lights. */
 enum MaterialType {
     MAT_DIFFUSE = 0,     /* Lambertian, albedo */
     MAT_METAL = 1,       /* mirror reflection perturbed by fuzz, tinted by albedo */

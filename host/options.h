@@ -1,0 +1,30 @@
+/* options.h — the command line. Every flag is documented in options_print_help. */
+#ifndef CLPT_OPTIONS_H
+#define CLPT_OPTIONS_H
+
+#include <stdio.h>
+
+#include "status.h"
+
+typedef struct {
+    const char *scene_path;
+    const char *output;           /* NULL: <scene name>.png in the current folder */
+    /* overrides of the scene file; -1 = keep the scene's value */
+    long spp, width, height, seed, max_depth;
+    const char *device_spec;      /* NULL: default selection */
+    int threads;                  /* scalar device workers, 0 = every core */
+    double time_limit;            /* seconds, 0 = none */
+    double progressive_seconds;   /* 0 = no progressive output */
+    int list_devices, stats, quiet, help, version;
+    /* developer flags */
+    const char *kernel_dir;
+    unsigned batch;               /* fixed batch size, 0 = adaptive */
+    unsigned wave_paths;          /* OpenCL wave size, 0 = automatic */
+} Options;
+
+/* Parses argv; on ST_USAGE err holds the message. --help and --version set flags and
+ * succeed without a scene. */
+Status options_parse(int argc, char **argv, Options *o, Error *err);
+void options_print_help(FILE *f);
+
+#endif /* CLPT_OPTIONS_H */

@@ -1,0 +1,63 @@
+/* render_util.h — renders a Scene into a Film with chosen devices, the way main does
+ * (render_scene_prepare + schedule_run), for the image-level tests. */
+#ifndef CLPT_RENDER_UTIL_H
+#define CLPT_RENDER_UTIL_H
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "device.h"
+#include "film.h"
+#include "render_scene.h"
+#include "schedule.h"
+
+/* devices: a --device spec; batch: fixed batch size (0 = adaptive). The film is
+ * initialised here; free it with film_free. */
+static Status render_util_run(Scene *s, const char *devices, uint batch, Film *film, Error *err)
+{
+    RenderScene rs;
+    DeviceDesc *all = NULL;
+    size_t n_all = 0, *chosen = NULL, n_chosen = 0, n_open = 0;
+    Device **devs = NULL;
+    ScheduleStats stats;
+    memset(&stats, 0, sizeof stats);
+    char warning[1100];
+    memset(film, 0, sizeof *film);
+    Status st = render_scene_prepare(s, 0, &rs, err);
+    if (st) return st;
+    if ((st = device_list(&all, &n_all, warning, sizeof warning, err))) goto out;
+    if ((st = device_select(devices, all, n_all, &chosen, &n_chosen, err))) goto out;
+    devs = calloc(n_chosen, sizeof *devs);
+    for (size_t i = 0; i < n_chosen; i++) {
+        if ((st = device_open(&all[chosen[i]], NULL, &devs[i], err))) goto out;
+        n_open++;
+        if ((st = devs[i]->ops->load_scene(devs[i], &rs.ds, err))) goto out;
+    }
+    if ((st = film_init(film, rs.ds.params.width, rs.ds.params.height, err))) goto out;
+    ScheduleConfig cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.spp = s->image.spp;
+    cfg.fixed_batch = batch;
+    st = schedule_run(devs, n_chosen, &cfg, film, &stats, err);
+out:
+    schedule_stats_free(&stats);
+    for (size_t i = 0; i < n_open; i++) device_close(devs[i]);
+    free(devs);
+    free(chosen);
+    free(all);
+    render_scene_free(&rs);
+    return st;
+}
+
+static double film_mean(const Film *f)
+{
+    size_t n = (size_t)f->width * f->height * 3u;
+    float *rgb = malloc(n * sizeof *rgb);
+    film_resolve(f, rgb);
+    double sum = 0.0;
+    for (size_t i = 0; i < n; i++) sum += rgb[i];
+    free(rgb);
+    return sum / (double)n;
+}
+
+#endif /* CLPT_RENDER_UTIL_H */

@@ -37,6 +37,11 @@
 #define k_as_int(f) as_int(f)
 #define k_int_as_float(i) as_float(i)
 
+/* OpenCL C has no <stddef.h>; every OpenCL compiler in use is clang-based. */
+#ifndef offsetof
+#define offsetof(type, member) __builtin_offsetof(type, member)
+#endif
+
 #else
 /* ---------------------------------------------------------------- C11 */
 #include <math.h>

@@ -2,6 +2,7 @@
 #include "schedule.h"
 
 #include <errno.h>
+#include <stdarg.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>

@@ -36,9 +36,9 @@ KFN BsdfSample bsdf_sample_diffuse(vec3 albedo, vec3 n, float u1, float u2)
     BsdfSample s;
     vec3 t, b;
     k_onb(n, &t, &b);
-    vec3 local = sample_cosine_hemisphere(u1, u2);
-    s.wi = k_to_world(local, t, b, n);
-    s.pdf = local.z * K_INV_PI;
+    vec3 v_local = sample_cosine_hemisphere(u1, u2);
+    s.wi = k_to_world(v_local, t, b, n);
+    s.pdf = v_local.z * K_INV_PI;
     s.weight = albedo;
     s.specular = 0;
     return s;

@@ -83,9 +83,9 @@ KFN void k_onb(vec3 n, vec3 *t, vec3 *b)
 }
 
 /* Local (x along t, y along b, z along n) to world. */
-KFN vec3 k_to_world(vec3 local, vec3 t, vec3 b, vec3 n)
+KFN vec3 k_to_world(vec3 v_local, vec3 t, vec3 b, vec3 n)
 {
-    return v3_add(v3_add(v3_scale(t, local.x), v3_scale(b, local.y)), v3_scale(n, local.z));
+    return v3_add(v3_add(v3_scale(t, v_local.x), v3_scale(b, v_local.y)), v3_scale(n, v_local.z));
 }
 
 #endif /* CLPT_KMATH_H */

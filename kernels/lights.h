@@ -53,6 +53,14 @@ KFN float sphere_cone_one_minus_cos(float r, float d2)
     return sin2 / (1.0f + cos_max);
 }
 
+/* Whether ref is far enough outside sphere sp to sample the cone it subtends. From a
+ * point on the sphere itself the cone degenerates (its near intersection is the point),
+ * so such points, and points inside, sample the whole surface by area instead. */
+KFN int sphere_cone_sampling(Sphere sp, float dc2)
+{
+    return dc2 > sp.radius * sp.radius * 1.0001f;
+}
+
 /* Solid-angle density of light `li` producing point x (normal n) seen from ref. */
 KFN float light_pdf(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
 {
@@ -63,7 +71,7 @@ KFN float light_pdf(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
         Sphere sp = sc->spheres[l.prim];
         vec3 wc = v3_sub(sp.center, ref);
         float dc2 = v3_dot(wc, wc);
-        if (dc2 > sp.radius * sp.radius)
+        if (sphere_cone_sampling(sp, dc2))
             return l.pick_pdf / (K_TWO_PI * sphere_cone_one_minus_cos(sp.radius, dc2));
     }
     float cos_l = k_fabs(v3_dot(n, to)) / k_sqrt(dist2);
@@ -87,7 +95,7 @@ KFN int light_sample(const SceneView *sc, vec3 ref, float u_pick, float u1, floa
         Sphere sp = sc->spheres[l.prim];
         vec3 wc = v3_sub(sp.center, ref);
         float dc2 = v3_dot(wc, wc);
-        if (dc2 > sp.radius * sp.radius) {
+        if (sphere_cone_sampling(sp, dc2)) {
             /* outside: uniform over the cone of directions that see the sphere */
             float dc = k_sqrt(dc2);
             vec3 w = v3_scale(wc, 1.0f / dc);
@@ -107,7 +115,7 @@ KFN int light_sample(const SceneView *sc, vec3 ref, float u_pick, float u1, floa
             ls->pdf = l.pick_pdf / (K_TWO_PI * omc);
             return ls->pdf > 0.0f;
         }
-        /* inside: uniform over the whole surface, all of which is visible */
+        /* on or inside the sphere: uniform over the whole surface */
         vec3 n = sample_sphere_dir(u1, u2);
         ls->n = n;
         ls->p = v3_madd(sp.center, n, sp.radius);

@@ -1,0 +1,191 @@
+/*
+ * bench_render.c — rendering throughput of the shipped scenes on every device.
+ *
+ *   build/bench/bench_render [--reps N] [--json FILE] [SCENE:WIDTHxHEIGHT:SPP ...]
+ *
+ * For each scene and each device (every OpenCL device alone, then the scalar device),
+ * renders the scene with a fixed seed `reps` times and reports the median samples/s and
+ * rays/s, with the ratio to the scalar device measured in the same run, plus the kd-tree
+ * build time and the kernel build/cache-load time. Prints a table and writes JSON.
+ * Machines here are shared and noisy: read medians and ratios, not single times.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "device.h"
+#include "film.h"
+#include "render_scene.h"
+#include "schedule.h"
+#include "timer.h"
+
+typedef struct {
+    const char *path;
+    uint width, height, spp;
+} BenchScene;
+
+static const BenchScene default_scenes[] = {
+    { "scenes/cornell-box.scene", 512, 512, 16 },
+    { "scenes/one-weekend.scene", 400, 225, 16 },
+    { "scenes/mesh.scene", 320, 320, 16 },
+};
+
+typedef struct {
+    double samples_per_s, rays_per_s, compile_s;
+    int from_cache, ok;
+} Result;
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static Result bench_device(const DeviceDesc *desc, const RenderScene *rs, uint spp, int reps)
+{
+    Result res = { 0 };
+    Error err = { 0 };
+    Device *dev = NULL;
+    if (device_open(desc, NULL, &dev, &err) || dev->ops->load_scene(dev, &rs->ds, &err)) {
+        fprintf(stderr, "bench: %s: %s\n", desc->name, err.msg);
+        device_close(dev);
+        error_clear(&err);
+        return res;
+    }
+    res.compile_s = dev->counters.compile_seconds;
+    res.from_cache = dev->counters.from_cache;
+    double sps[32], rps[32];
+    if (reps > 32) reps = 32;
+    for (int r = 0; r < reps; r++) {
+        Film film;
+        ScheduleConfig cfg;
+        ScheduleStats st;
+        memset(&cfg, 0, sizeof cfg);
+        cfg.spp = spp;
+        if (film_init(&film, rs->ds.params.width, rs->ds.params.height, &err)) break;
+        uint64_t rays0 = dev->counters.rays, samples0 = dev->counters.samples;
+        double t0 = timer_now();
+        Status s = schedule_run(&dev, 1, &cfg, &film, &st, &err);
+        double secs = timer_now() - t0;
+        schedule_stats_free(&st);
+        film_free(&film);
+        if (s) {
+            fprintf(stderr, "bench: %s: %s\n", desc->name, err.msg);
+            device_close(dev);
+            error_clear(&err);
+            return res;
+        }
+        sps[r] = (double)(dev->counters.samples - samples0) / secs;
+        rps[r] = (double)(dev->counters.rays - rays0) / secs;
+    }
+    res.samples_per_s = median(sps, reps);
+    res.rays_per_s = median(rps, reps);
+    res.ok = 1;
+    device_close(dev);
+    return res;
+}
+
+int main(int argc, char **argv)
+{
+    int reps = 3;
+    const char *json_path = "build/bench/render.json";
+    BenchScene scenes[16];
+    int n_scenes = 0;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--reps") == 0 && i + 1 < argc) reps = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--json") == 0 && i + 1 < argc) json_path = argv[++i];
+        else if (n_scenes < 16) {
+            static char paths[16][512];
+            unsigned w, h, spp;
+            if (sscanf(argv[i], "%511[^:]:%ux%u:%u", paths[n_scenes], &w, &h, &spp) != 4) {
+                fprintf(stderr, "usage: bench_render [--reps N] [--json FILE] [SCENE:WIDTHxHEIGHT:SPP ...]\n");
+                return 2;
+            }
+            scenes[n_scenes] = (BenchScene){ paths[n_scenes], w, h, spp };
+            n_scenes++;
+        }
+    }
+    if (reps < 1) reps = 1;
+    if (n_scenes == 0) {
+        n_scenes = (int)(sizeof default_scenes / sizeof default_scenes[0]);
+        memcpy(scenes, default_scenes, sizeof default_scenes);
+    }
+
+    DeviceDesc *all = NULL;
+    size_t n_all = 0;
+    char warning[1100];
+    Error err = { 0 };
+    if (device_list(&all, &n_all, warning, sizeof warning, &err)) {
+        fprintf(stderr, "bench: %s\n", err.msg);
+        return 1;
+    }
+    FILE *json = fopen(json_path, "w");
+    if (json) fprintf(json, "{\n  \"reps\": %d,\n  \"results\": [\n", reps);
+    printf("clpt render benchmark: median of %d runs per device; ratio = samples/s relative to the scalar device\n\n", reps);
+    printf("%-28s %-36s %12s %10s %7s %10s %s\n", "scene", "device", "Msamples/s", "Mrays/s", "ratio",
+           "kernels s", "kd-tree");
+    int first_json = 1;
+    for (int si = 0; si < n_scenes; si++) {
+        Scene scene;
+        scene_init(&scene);
+        RenderScene rs;
+        if (scene_load(scenes[si].path, &scene, &err)) {
+            fprintf(stderr, "bench: %s\n", err.msg);
+            error_clear(&err);
+            scene_free(&scene);
+            continue;
+        }
+        scene.image.width = scenes[si].width;
+        scene.image.height = scenes[si].height;
+        if (render_scene_prepare(&scene, 0, &rs, &err)) {
+            fprintf(stderr, "bench: %s\n", err.msg);
+            error_clear(&err);
+            scene_free(&scene);
+            continue;
+        }
+        Result *res = calloc(n_all, sizeof *res);
+        /* the scalar device (last) first: it is the reference for the ratios */
+        for (size_t k = n_all; k-- > 0;) res[k] = bench_device(&all[k], &rs, scenes[si].spp, reps);
+        double ref = res[n_all - 1].samples_per_s;
+        char label[64];
+        snprintf(label, sizeof label, "%s %ux%u", strrchr(scenes[si].path, '/') ? strrchr(scenes[si].path, '/') + 1
+                                                                                : scenes[si].path,
+                 scenes[si].width, scenes[si].height);
+        for (size_t k = 0; k < n_all; k++) {
+            if (!res[k].ok) continue;
+            char kern[32] = "-";
+            if (all[k].kind == DEVICE_OPENCL)
+                snprintf(kern, sizeof kern, "%.3f%s", res[k].compile_s, res[k].from_cache ? " (cache)" : "");
+            printf("%-28.28s %-36.36s %12.3f %10.3f %6.2fx %10s %.3f s, SAH %.1f\n", label,
+                   all[k].kind == DEVICE_SCALAR ? "scalar (all cores)" : all[k].name, res[k].samples_per_s / 1e6,
+                   res[k].rays_per_s / 1e6, ref > 0.0 ? res[k].samples_per_s / ref : 0.0, kern,
+                   rs.kd.stats.build_seconds, rs.kd.stats.sah_cost);
+            if (json) {
+                fprintf(json, "%s    {\"scene\": \"%s\", \"width\": %u, \"height\": %u, \"spp\": %u, \"device\": \"%s\", "
+                              "\"kind\": \"%s\", \"samples_per_s\": %.1f, \"rays_per_s\": %.1f, \"ratio_to_scalar\": %.4f, "
+                              "\"kernel_build_s\": %.4f, \"kernel_from_cache\": %d, \"kd_build_s\": %.4f, \"sah_cost\": %.3f}",
+                        first_json ? "" : ",\n", scenes[si].path, scenes[si].width, scenes[si].height, scenes[si].spp,
+                        all[k].name, all[k].kind == DEVICE_SCALAR ? "scalar" : "opencl", res[k].samples_per_s,
+                        res[k].rays_per_s, ref > 0.0 ? res[k].samples_per_s / ref : 0.0, res[k].compile_s,
+                        res[k].from_cache, rs.kd.stats.build_seconds, rs.kd.stats.sah_cost);
+                first_json = 0;
+            }
+        }
+        free(res);
+        render_scene_free(&rs);
+        scene_free(&scene);
+    }
+    if (json) {
+        fprintf(json, "\n  ]\n}\n");
+        fclose(json);
+        printf("\nJSON: %s\n", json_path);
+    }
+    free(all);
+    return 0;
+}

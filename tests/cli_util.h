@@ -1,0 +1,96 @@
+/* cli_util.h — runs the clpt program as a user would and captures what it prints. */
+#ifndef CLPT_CLI_UTIL_H
+#define CLPT_CLI_UTIL_H
+
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#define CLI_PROGRAM "build/clpt"
+#define CLI_OUT_MAX 65536
+
+typedef struct {
+    int status;                 /* exit code, or 128 + signal */
+    char out[CLI_OUT_MAX];      /* stdout */
+    char err[CLI_OUT_MAX];      /* stderr */
+} CliResult;
+
+static void cli_slurp(int fd, char *buf)
+{
+    lseek(fd, 0, SEEK_SET);
+    ssize_t n = read(fd, buf, CLI_OUT_MAX - 1);
+    buf[n > 0 ? n : 0] = '\0';
+}
+
+/* argv without the program name, NULL-terminated. Runs from the repository root (where
+ * make test runs). Returns the child's pid through *pid_out if non-NULL and does not
+ * wait when `wait_for` is 0 (the caller then calls cli_finish). */
+typedef struct {
+    pid_t pid;
+    int out_fd, err_fd;
+} CliChild;
+
+static CliChild cli_start(const char *const *args)
+{
+    CliChild c;
+    char out_name[] = "/tmp/clpt-cli-out-XXXXXX", err_name[] = "/tmp/clpt-cli-err-XXXXXX";
+    c.out_fd = mkstemp(out_name);
+    c.err_fd = mkstemp(err_name);
+    unlink(out_name);
+    unlink(err_name);
+    const char *argv[64];
+    int n = 0;
+    argv[n++] = CLI_PROGRAM;
+    for (; args[n - 1] && n < 63; n++) argv[n] = args[n - 1];
+    argv[n] = NULL;
+    c.pid = fork();
+    if (c.pid == 0) {
+        dup2(c.out_fd, 1);
+        dup2(c.err_fd, 2);
+        execv(CLI_PROGRAM, (char *const *)argv);
+        _exit(127);
+    }
+    return c;
+}
+
+static void cli_finish(CliChild c, CliResult *r)
+{
+    int wstatus = 0;
+    waitpid(c.pid, &wstatus, 0);
+    r->status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
+    cli_slurp(c.out_fd, r->out);
+    cli_slurp(c.err_fd, r->err);
+    close(c.out_fd);
+    close(c.err_fd);
+}
+
+static void cli_run(const char *const *args, CliResult *r)
+{
+    cli_finish(cli_start(args), r);
+}
+
+static int file_exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+/* Writes text to a new temporary file with the given suffix; returns its path (static
+ * buffer per call site is the caller's: pass one in). */
+static void write_temp(char *path, size_t size, const char *suffix, const char *text)
+{
+    snprintf(path, size, "/tmp/clpt-test-XXXXXX%s", suffix);
+    int fd = mkstemps(path, (int)strlen(suffix));
+    if (fd >= 0) {
+        ssize_t w = write(fd, text, strlen(text));
+        (void)w;
+        close(fd);
+    }
+}
+
+#endif /* CLPT_CLI_UTIL_H */

@@ -3,6 +3,7 @@
 #include "harness.h"
 
 #include "kmath.h"
+#include "lexer.h"
 #include "scene.h"
 
 #include <dirent.h>
@@ -64,6 +65,56 @@ static Status load_text(const char *name, const char *text, Scene *s, Error *err
 }
 
 static int vec_eq(vec3 a, float x, float y, float z) { return a.x == x && a.y == y && a.z == z; }
+
+/* ------------------------------------------------------------------ the lexer */
+
+static void test_lexer(void)
+{
+    static const char text[] = "key{ [1.5e3]\t\"a \\\"b\\\\\" # comment\r\n  0x1p-2 +7 -0 }";
+    Lexer lx;
+    Error err = {0};
+    CHECK_EQ_INT(lex_open_text(&lx, "mem", text, sizeof text - 1, &err), ST_OK);
+    struct { TokenKind kind; const char *text; uint line, col; } want[] = {
+        {TOK_WORD, "key", 1, 1},   {TOK_LBRACE, "{", 1, 4},   {TOK_LBRACKET, "[", 1, 6},
+        {TOK_WORD, "1.5e3", 1, 7}, {TOK_RBRACKET, "]", 1, 12}, {TOK_STRING, "a \"b\\", 1, 14},
+        {TOK_WORD, "0x1p-2", 2, 3}, {TOK_WORD, "+7", 2, 10},  {TOK_WORD, "-0", 2, 13},
+        {TOK_RBRACE, "}", 2, 16},  {TOK_EOF, "", 2, 17},      {TOK_EOF, "", 2, 17},
+    };
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++) {
+        Token t;
+        CHECK_EQ_INT(lex_next(&lx, &t, &err), ST_OK);
+        CHECK_MSG(t.kind == want[i].kind && t.len == strlen(want[i].text) &&
+                      memcmp(t.text, want[i].text, t.len) == 0 && t.line == want[i].line &&
+                      t.col == want[i].col,
+                  "token %zu: kind %d '%.*s' at %u:%u", i, t.kind, (int)t.len, t.text, t.line, t.col);
+        float f;
+        if (i == 3) CHECK(tok_float(&t, &f) == 0 && f == 1500.0f);
+        if (i == 6) CHECK(tok_float(&t, &f) == 0 && f == 0.25f);
+        unsigned long long u;
+        if (i == 7) CHECK(tok_uint(&t, &u) == 0 && u == 7);
+        if (i == 8) CHECK(tok_uint(&t, &u) != 0);
+        if (i == 0) CHECK(tok_is(&t, "key") && !tok_is(&t, "ke") && !tok_is(&t, "keys"));
+        if (i == 5) CHECK(!tok_is(&t, "a \"b\\"));   /* strings are never keywords */
+    }
+    lex_close(&lx);
+
+    static const char nums[] = "18446744073709551615 18446744073709551616 1e-50 0x1p200 12a";
+    CHECK_EQ_INT(lex_open_text(&lx, "mem", nums, sizeof nums - 1, &err), ST_OK);
+    Token t;
+    unsigned long long u = 0;
+    float f = 1.0f;
+    lex_next(&lx, &t, &err);
+    CHECK(tok_uint(&t, &u) == 0 && u == 18446744073709551615ull);
+    lex_next(&lx, &t, &err);
+    CHECK(tok_uint(&t, &u) != 0);                 /* 2^64 does not fit */
+    lex_next(&lx, &t, &err);
+    CHECK(tok_float(&t, &f) == 0 && f == 0.0f);   /* underflow is a finite zero */
+    lex_next(&lx, &t, &err);
+    CHECK(tok_float(&t, &f) != 0);                /* beyond float range */
+    lex_next(&lx, &t, &err);
+    CHECK(tok_float(&t, &f) != 0 && tok_uint(&t, &u) != 0);
+    lex_close(&lx);
+}
 
 /* ------------------------------------------------------------------ good input */
 
@@ -665,6 +716,7 @@ int main(void)
         perror("mkdtemp");
         return 1;
     }
+    RUN(test_lexer);
     RUN(test_camera_and_image);
     RUN(test_defaults_kept);
     RUN(test_backgrounds);

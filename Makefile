@@ -59,6 +59,11 @@ $(BUILD)/embed: tools/embed.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(CC) -std=c11 -O1 -Wall -Wextra -o $@ $<
 
+# Writes scenes/one-weekend.scene (tests/test_scene.c checks the committed copy).
+$(BUILD)/gen_weekend: tools/gen_weekend.c | $(DEPS_OK)
+	@mkdir -p $(@D)
+	$(CC) -std=c11 -O1 -Wall -Wextra -o $@ $<
+
 $(BUILD)/kernel_source.c: $(KERNELS) $(BUILD)/embed
 	$(BUILD)/embed clpt_kernel_source kernels/entry.cl > $@.tmp && mv $@.tmp $@
 

@@ -75,12 +75,13 @@ static Status append(void **arr, size_t *n, size_t *cap, const void *item, size_
 
 Status scene_add_material(Scene *s, const char *name, Material m, uint *index, Error *err)
 {
+    /* Both arrays share cap_materials. The names grow first, through a copy of it: if
+     * the materials then fail to grow, the recorded capacity is still the smaller one
+     * (the materials'), so neither array can be overrun by a later call. */
     size_t cap_names = s->cap_materials;
-    if (array_reserve((void **)&s->materials, &s->cap_materials, s->n_materials + 1, sizeof m) ||
-        array_reserve((void **)&s->material_names, &cap_names, s->n_materials + 1, sizeof(char *)))
+    if (array_reserve((void **)&s->material_names, &cap_names, s->n_materials + 1, sizeof(char *)) ||
+        array_reserve((void **)&s->materials, &s->cap_materials, s->n_materials + 1, sizeof m))
         return error_set(err, ST_INTERNAL, "out of memory growing the material list");
-    /* both arrays share one capacity: take the smaller so neither is overrun */
-    if (cap_names < s->cap_materials) s->cap_materials = cap_names;
     char *copy = malloc(strlen(name) + 1);
     if (!copy) return error_set(err, ST_INTERNAL, "out of memory");
     strcpy(copy, name);

@@ -1,0 +1,709 @@
+/*
+ * scene_parse.c — the scene file reader (the format is docs/scene-format.md).
+ *
+ * Every statement but `include` is `KEYWORD [NAME] { key value ... }`. One generic
+ * routine reads a block against a table of the keys it allows (KeySpec): it rejects
+ * unknown and repeated keys and checks each value's type and range where the value is,
+ * so errors point at the offending token. The per-statement functions then only check
+ * what involves several keys (a camera's up against its view direction, a box's min
+ * against its max) and append to the scene.
+ */
+#include "scene.h"
+
+#include "kmath.h"
+#include "lexer.h"
+#include "obj.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define INCLUDE_DEPTH_MAX 16
+
+typedef enum {
+    VK_NUMBER,      /* one float within the key's range */
+    VK_UINT,        /* one unsigned integer within the key's range */
+    VK_VEC3,        /* three floats */
+    VK_COLOR,       /* three floats >= 0 */
+    VK_DIR,         /* three floats, not all zero */
+    VK_WORD,        /* a bare word (checked by the statement) */
+    VK_MATERIAL,    /* a material name, or an inline anonymous material block */
+    VK_PATH         /* a string or a word */
+} ValueKind;
+
+typedef struct {
+    const char *key;
+    ValueKind kind;
+    int required;
+    double lo, hi;          /* VK_NUMBER, VK_UINT: the allowed range */
+    int lo_open, hi_open;   /* whether the bound itself is excluded */
+    const char *what;       /* VK_NUMBER, VK_UINT, VK_WORD: "a number in (0, 180)" */
+} KeySpec;
+
+typedef struct {
+    int given;
+    Token key;              /* where the key was written */
+    Token value;            /* its first value token */
+    float f;
+    unsigned long long u;
+    vec3 v;
+    uint material;
+    Token word;             /* VK_WORD, VK_PATH */
+} Value;
+
+#define MAX_KEYS 8
+
+typedef struct {
+    Scene *s;
+    Error *err;
+    uint depth;                       /* include nesting: 0 for the top file */
+    char *camera_at, *image_at, *background_at;   /* "file:line:col" once given */
+    char **material_at;               /* per material index, where it was defined */
+    size_t n_material_at, cap_material_at;
+    int depth_exceeded;               /* the include limit error is not annotated further */
+} Parser;
+
+/* ------------------------------------------------------------------ helpers */
+
+static char *where_dup(const Lexer *lx, const Token *tok)
+{
+    int n = snprintf(NULL, 0, "%s:%u:%u", lx->path, tok->line, tok->col);
+    char *w = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    if (w) snprintf(w, (size_t)n + 1, "%s:%u:%u", lx->path, tok->line, tok->col);
+    return w;
+}
+
+/* Appends text to the message already in err (used to say which scene line pulled in
+ * the file where an error happened). */
+static void error_append(Error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void error_append(Error *err, const char *fmt, ...)
+{
+    if (!err) return;
+    size_t n = strlen(err->msg);
+    if (n + 1 >= sizeof err->msg) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->msg + n, sizeof err->msg - n, fmt, ap);
+    va_end(ap);
+}
+
+/* The path of `file` as seen from the folder of the file `from` (absolute paths and
+ * files in the current folder stay as they are). */
+static char *path_beside(const char *from, const char *file, size_t file_len)
+{
+    const char *slash = strrchr(from, '/');
+    size_t dir = (file_len > 0 && file[0] == '/') || !slash ? 0 : (size_t)(slash - from) + 1;
+    char *out = malloc(dir + file_len + 1);
+    if (!out) return NULL;
+    memcpy(out, from, dir);
+    memcpy(out + dir, file, file_len);
+    out[dir + file_len] = '\0';
+    return out;
+}
+
+static const char *kind_what(const KeySpec *k)
+{
+    switch (k->kind) {
+    case VK_VEC3: return "3 numbers";
+    case VK_COLOR: return "3 numbers >= 0 (a colour)";
+    case VK_DIR: return "a non-zero vector (3 numbers)";
+    case VK_MATERIAL: return "a material name or an inline 'material { ... }' block";
+    case VK_PATH: return "a file name";
+    case VK_NUMBER:
+    case VK_UINT:
+    case VK_WORD: return k->what;
+    }
+    return "a value";
+}
+
+static int in_range(const KeySpec *k, double x)
+{
+    if (x < k->lo || (k->lo_open && x == k->lo)) return 0;
+    if (x > k->hi || (k->hi_open && x == k->hi)) return 0;
+    return 1;
+}
+
+/* "a camera key (from, at, up) or '}'" */
+static void list_keys(char *buf, size_t size, const char *block, const KeySpec *keys, size_t n)
+{
+    size_t o = (size_t)snprintf(buf, size, "a %s key (", block);
+    for (size_t i = 0; i < n && o < size; i++)
+        o += (size_t)snprintf(buf + o, size - o, "%s%s", i ? ", " : "", keys[i].key);
+    if (o < size) snprintf(buf + o, size - o, ") or '}'");
+}
+
+static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
+                                   const char *name, uint *index);
+
+static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
+{
+    Error *err = p->err;
+    char what[160];
+    snprintf(what, sizeof what, "%s for '%s'", kind_what(k), k->key);
+    Token t;
+    Status st = lex_next(lx, &t, err);
+    if (st) return st;
+    v->value = t;
+    switch (k->kind) {
+    case VK_NUMBER:
+        if (tok_float(&t, &v->f) || !in_range(k, v->f)) return lex_expected(lx, &t, what, err);
+        return ST_OK;
+    case VK_UINT:
+        if (tok_uint(&t, &v->u) || !in_range(k, (double)v->u)) return lex_expected(lx, &t, what, err);
+        return ST_OK;
+    case VK_VEC3:
+    case VK_COLOR:
+    case VK_DIR: {
+        float c[3];
+        for (int i = 0; i < 3; i++) {
+            if (i > 0 && (st = lex_next(lx, &t, err))) return st;
+            if (tok_float(&t, &c[i]) || (k->kind == VK_COLOR && c[i] < 0.0f))
+                return lex_expected(lx, &t, what, err);
+        }
+        v->v = v3(c[0], c[1], c[2]);
+        if (k->kind == VK_DIR && v3_is_zero(v->v))
+            return lex_error_at(lx, &v->value, err, "expected %s, found 0 0 0", what);
+        return ST_OK;
+    }
+    case VK_WORD:
+        if (t.kind != TOK_WORD) return lex_expected(lx, &t, what, err);
+        v->word = t;
+        return ST_OK;
+    case VK_PATH:
+        if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
+            return lex_expected(lx, &t, what, err);
+        v->word = t;
+        return ST_OK;
+    case VK_MATERIAL:
+        if (t.kind == TOK_LBRACE) return parse_material_block(p, lx, &v->key, 1, NULL, &v->material);
+        if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
+            return lex_expected(lx, &t, what, err);
+        {
+            char *name = tok_copy(&t);
+            if (!name) return error_set(err, ST_INTERNAL, "out of memory");
+            v->material = scene_find_material(p->s, name);
+            if (v->material == NO_INDEX) {
+                char shown[64];
+                tok_describe(&t, shown, sizeof shown);
+                free(name);
+                return lex_error_at(lx, &t, err,
+                                    "material '%s' is not defined (materials must be defined "
+                                    "before they are used)", shown);
+            }
+            free(name);
+        }
+        return ST_OK;
+    }
+    return error_set(err, ST_INTERNAL, "unhandled value kind");
+}
+
+/* Reads `{ key value ... }` after the statement keyword `kw` (from after the brace when
+ * the caller has already taken it), filling vals[i] for keys[i]; checks that every
+ * required key was given. */
+static Status parse_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
+                          const char *block, const KeySpec *keys, size_t n, Value *vals)
+{
+    Error *err = p->err;
+    memset(vals, 0, n * sizeof *vals);
+    Token t;
+    Status st = brace_taken ? ST_OK : lex_next(lx, &t, err);
+    if (st) return st;
+    if (!brace_taken && t.kind != TOK_LBRACE) {
+        char what[80];
+        snprintf(what, sizeof what, "'{' to open the %s block", block);
+        return lex_expected(lx, &t, what, err);
+    }
+    for (;;) {
+        if ((st = lex_next(lx, &t, err))) return st;
+        if (t.kind == TOK_RBRACE) break;
+        if (t.kind == TOK_EOF)
+            return lex_error_at(lx, &t, err,
+                                "expected '}' to close the %s block opened at line %u, "
+                                "found end of file", block, kw->line);
+        size_t i = n;
+        if (t.kind == TOK_WORD)
+            for (i = 0; i < n; i++)
+                if (tok_is(&t, keys[i].key)) break;
+        if (i == n) {
+            char what[256];
+            list_keys(what, sizeof what, block, keys, n);
+            return lex_expected(lx, &t, what, err);
+        }
+        if (vals[i].given)
+            return lex_error_at(lx, &t, err, "key '%s' repeated in the %s block (first given at %u:%u)",
+                                keys[i].key, block, vals[i].key.line, vals[i].key.col);
+        vals[i].given = 1;
+        vals[i].key = t;
+        if ((st = read_value(p, lx, &keys[i], &vals[i]))) return st;
+    }
+    for (size_t i = 0; i < n; i++)
+        if (keys[i].required && !vals[i].given)
+            return lex_error_at(lx, kw, err, "the %s block needs '%s' (it has no default)",
+                                block, keys[i].key);
+    return ST_OK;
+}
+
+/* Rejects a second camera/image/background block, naming where the first one was. */
+static Status once(Parser *p, const Lexer *lx, const Token *kw, char **seen)
+{
+    if (*seen)
+        return lex_error_at(lx, kw, p->err, "a second %.*s block (the first is at %s)",
+                            (int)kw->len, kw->text, *seen);
+    *seen = where_dup(lx, kw);
+    if (!*seen) return error_set(p->err, ST_INTERNAL, "out of memory");
+    return ST_OK;
+}
+
+static double len_d(vec3 a) { return sqrt((double)a.x * a.x + (double)a.y * a.y + (double)a.z * a.z); }
+
+static vec3 cross_d(vec3 a, vec3 b, double *length)
+{
+    double x = (double)a.y * b.z - (double)a.z * b.y;
+    double y = (double)a.z * b.x - (double)a.x * b.z;
+    double z = (double)a.x * b.y - (double)a.y * b.x;
+    *length = sqrt(x * x + y * y + z * z);
+    return v3((float)x, (float)y, (float)z);
+}
+
+/* ------------------------------------------------------------------ statements */
+
+enum { CAM_FROM, CAM_AT, CAM_UP, CAM_FOV, CAM_APERTURE, CAM_FOCUS, CAM_N };
+static const KeySpec camera_keys[CAM_N] = {
+    [CAM_FROM] = {"from", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [CAM_AT] = {"at", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [CAM_UP] = {"up", VK_DIR, 0, 0, 0, 0, 0, NULL},
+    [CAM_FOV] = {"fov", VK_NUMBER, 0, 0, 180, 1, 1, "a number of degrees in (0, 180)"},
+    [CAM_APERTURE] = {"aperture", VK_NUMBER, 0, 0, INFINITY, 0, 1, "a number >= 0"},
+    [CAM_FOCUS] = {"focus", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a distance > 0"},
+};
+
+static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[CAM_N];
+    Status st = once(p, lx, kw, &p->camera_at);
+    if (!st) st = parse_block(p, lx, kw, 0, "camera", camera_keys, CAM_N, v);
+    if (st) return st;
+    SceneCamera *c = &p->s->camera;
+    if (v[CAM_FROM].given) c->from = v[CAM_FROM].v;
+    if (v[CAM_AT].given) c->at = v[CAM_AT].v;
+    if (v[CAM_UP].given) c->up = v[CAM_UP].v;
+    if (v[CAM_FOV].given) c->vfov = v[CAM_FOV].f;
+    if (v[CAM_APERTURE].given) c->aperture = v[CAM_APERTURE].f;
+    if (v[CAM_FOCUS].given) c->focus_dist = v[CAM_FOCUS].f;
+    /* blame the key that made the camera invalid, or the block if the defaults did */
+    const Token *view_tok = v[CAM_AT].given ? &v[CAM_AT].key : v[CAM_FROM].given ? &v[CAM_FROM].key : kw;
+    vec3 dir = v3_sub(c->at, c->from);
+    double dist = len_d(dir);
+    if (!(dist > 0.0))
+        return lex_error_at(lx, view_tok, p->err, "camera 'from' and 'at' are the same point");
+    if (!isfinite(dist))
+        return lex_error_at(lx, view_tok, p->err, "camera 'from' and 'at' are too far apart");
+    double cl;
+    cross_d(dir, c->up, &cl);
+    /* sine of the angle between up and the view direction */
+    if (!(cl / (dist * len_d(c->up)) > 1e-6))
+        return lex_error_at(lx, v[CAM_UP].given ? &v[CAM_UP].key : view_tok, p->err,
+                            "camera 'up' is parallel to the view direction (from 'from' to 'at')");
+    return ST_OK;
+}
+
+enum { IMG_WIDTH, IMG_HEIGHT, IMG_SPP, IMG_DEPTH, IMG_SEED, IMG_N };
+static const KeySpec image_keys[IMG_N] = {
+    [IMG_WIDTH] = {"width", VK_UINT, 0, 1, 16384, 0, 0, "an integer in 1..16384"},
+    [IMG_HEIGHT] = {"height", VK_UINT, 0, 1, 16384, 0, 0, "an integer in 1..16384"},
+    [IMG_SPP] = {"spp", VK_UINT, 0, 1, 1000000, 0, 0, "an integer in 1..1000000"},
+    [IMG_DEPTH] = {"depth", VK_UINT, 0, 0, 1024, 0, 0, "an integer in 0..1024"},
+    [IMG_SEED] = {"seed", VK_UINT, 0, 0, 4294967295.0, 0, 0, "an integer in 0..4294967295"},
+};
+
+static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[IMG_N];
+    Status st = once(p, lx, kw, &p->image_at);
+    if (!st) st = parse_block(p, lx, kw, 0, "image", image_keys, IMG_N, v);
+    if (st) return st;
+    SceneImage *im = &p->s->image;
+    if (v[IMG_WIDTH].given) im->width = (uint)v[IMG_WIDTH].u;
+    if (v[IMG_HEIGHT].given) im->height = (uint)v[IMG_HEIGHT].u;
+    if (v[IMG_SPP].given) im->spp = (uint)v[IMG_SPP].u;
+    if (v[IMG_DEPTH].given) im->max_depth = (uint)v[IMG_DEPTH].u;
+    if (v[IMG_SEED].given) im->seed = (uint)v[IMG_SEED].u;
+    return ST_OK;
+}
+
+enum { BG_COLOR, BG_HORIZON, BG_ZENITH, BG_N };
+static const KeySpec background_keys[BG_N] = {
+    [BG_COLOR] = {"color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [BG_HORIZON] = {"horizon", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [BG_ZENITH] = {"zenith", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+};
+
+static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[BG_N];
+    Status st = once(p, lx, kw, &p->background_at);
+    if (!st) st = parse_block(p, lx, kw, 0, "background", background_keys, BG_N, v);
+    if (st) return st;
+    Scene *s = p->s;
+    int sky = v[BG_HORIZON].given || v[BG_ZENITH].given;
+    if (v[BG_COLOR].given && sky) {
+        const Token *t = v[BG_HORIZON].given ? &v[BG_HORIZON].key : &v[BG_ZENITH].key;
+        if (t->line < v[BG_COLOR].key.line ||
+            (t->line == v[BG_COLOR].key.line && t->col < v[BG_COLOR].key.col))
+            t = &v[BG_COLOR].key;
+        return lex_error_at(lx, t, p->err,
+                            "a background is either 'color' (constant) or 'horizon' and "
+                            "'zenith' (sky), not both");
+    }
+    if (!v[BG_COLOR].given && !sky)
+        return lex_error_at(lx, kw, p->err,
+                            "the background block needs 'color', or 'horizon' and 'zenith'");
+    if (sky && !(v[BG_HORIZON].given && v[BG_ZENITH].given))
+        return lex_error_at(lx, kw, p->err, "a sky background needs both 'horizon' and 'zenith'");
+    if (sky) {
+        s->bg_type = BG_SKY;
+        s->bg_color = v[BG_HORIZON].v;
+        s->bg_zenith = v[BG_ZENITH].v;
+    } else {
+        s->bg_type = BG_CONSTANT;
+        s->bg_color = v[BG_COLOR].v;
+        s->bg_zenith = v[BG_COLOR].v;
+    }
+    return ST_OK;
+}
+
+enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE, MAT_KEY_N };
+static const KeySpec material_keys[MAT_KEY_N] = {
+    [MAT_KEY_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0,
+                      "a material type (diffuse, metal, dielectric, emissive)"},
+    [MAT_KEY_ALBEDO] = {"albedo", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_FUZZ] = {"fuzz", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_IOR] = {"ior", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
+    [MAT_KEY_RADIANCE] = {"radiance", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+};
+
+/* Which keys each material type takes (bit i = material_keys[i]), and which it needs. */
+static const struct {
+    const char *name;
+    uint type;
+    unsigned allowed, required;
+} material_types[] = {
+    {"diffuse", MAT_DIFFUSE, 1u << MAT_KEY_ALBEDO, 1u << MAT_KEY_ALBEDO},
+    {"metal", MAT_METAL, 1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_FUZZ, 1u << MAT_KEY_ALBEDO},
+    {"dielectric", MAT_DIELECTRIC, 1u << MAT_KEY_IOR, 0},
+    {"emissive", MAT_EMISSIVE, 1u << MAT_KEY_RADIANCE, 1u << MAT_KEY_RADIANCE},
+};
+#define N_MATERIAL_TYPES (sizeof material_types / sizeof material_types[0])
+
+/* Reads a material's `{ ... }`; a NULL name makes an anonymous (inline) material. */
+static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
+                                   const char *name, uint *index)
+{
+    Value v[MAT_KEY_N];
+    Status st = parse_block(p, lx, kw, brace_taken, "material", material_keys, MAT_KEY_N, v);
+    if (st) return st;
+    size_t ti;
+    for (ti = 0; ti < N_MATERIAL_TYPES; ti++)
+        if (tok_is(&v[MAT_KEY_TYPE].word, material_types[ti].name)) break;
+    if (ti == N_MATERIAL_TYPES)
+        return lex_expected(lx, &v[MAT_KEY_TYPE].word, material_keys[MAT_KEY_TYPE].what, p->err);
+    unsigned allowed = material_types[ti].allowed | 1u << MAT_KEY_TYPE;
+    for (int i = 0; i < MAT_KEY_N; i++) {
+        if (!v[i].given || (allowed & (1u << i))) continue;
+        char what[160];
+        size_t o = (size_t)snprintf(what, sizeof what, "a %s material key (type",
+                                    material_types[ti].name);
+        for (int j = 1; j < MAT_KEY_N; j++)
+            if (allowed & (1u << j))
+                o += (size_t)snprintf(what + o, sizeof what - o, ", %s", material_keys[j].key);
+        snprintf(what + o, sizeof what - o, ") or '}'");
+        return lex_expected(lx, &v[i].key, what, p->err);
+    }
+    for (int i = 0; i < MAT_KEY_N; i++)
+        if ((material_types[ti].required & (1u << i)) && !v[i].given)
+            return lex_error_at(lx, kw, p->err, "a material of type %s needs '%s'",
+                                material_types[ti].name, material_keys[i].key);
+    Material m;
+    switch (material_types[ti].type) {
+    case MAT_METAL:
+        m = material_metal(v[MAT_KEY_ALBEDO].v, v[MAT_KEY_FUZZ].given ? v[MAT_KEY_FUZZ].f : 0.0f);
+        break;
+    case MAT_DIELECTRIC:
+        m = material_dielectric(v[MAT_KEY_IOR].given ? v[MAT_KEY_IOR].f : 1.5f);
+        break;
+    case MAT_EMISSIVE:
+        m = material_emissive(v[MAT_KEY_RADIANCE].v);
+        break;
+    default:
+        m = material_diffuse(v[MAT_KEY_ALBEDO].v);
+        break;
+    }
+    /* inline materials get the empty name, which no named material can have, so a
+     * lookup never finds them */
+    if ((st = scene_add_material(p->s, name ? name : "", m, index, p->err))) return st;
+    if (array_reserve((void **)&p->material_at, &p->cap_material_at, p->s->n_materials,
+                      sizeof(char *)))
+        return error_set(p->err, ST_INTERNAL, "out of memory");
+    while (p->n_material_at < p->s->n_materials) p->material_at[p->n_material_at++] = NULL;
+    /* only for messages: a failed copy just loses the "defined at" part */
+    if (name) p->material_at[*index] = where_dup(lx, kw);
+    return ST_OK;
+}
+
+static Status parse_material(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token t;
+    Status st = lex_next(lx, &t, p->err);
+    if (st) return st;
+    if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
+        return lex_expected(lx, &t, "a material name", p->err);
+    char *name = tok_copy(&t);
+    if (!name) return error_set(p->err, ST_INTERNAL, "out of memory");
+    uint prev = scene_find_material(p->s, name);
+    if (prev != NO_INDEX) {
+        char shown[64];
+        tok_describe(&t, shown, sizeof shown);
+        const char *where = prev < p->n_material_at ? p->material_at[prev] : NULL;
+        st = lex_error_at(lx, &t, p->err, "material '%s' is already defined%s%s%s", shown,
+                          where ? " (at " : "", where ? where : "", where ? ")" : "");
+        free(name);
+        return st;
+    }
+    uint index;
+    st = parse_material_block(p, lx, kw, 0, name, &index);
+    free(name);
+    return st;
+}
+
+enum { SPH_CENTER, SPH_RADIUS, SPH_MATERIAL, SPH_N };
+static const KeySpec sphere_keys[SPH_N] = {
+    [SPH_CENTER] = {"center", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [SPH_RADIUS] = {"radius", VK_NUMBER, 1, 0, INFINITY, 1, 1, "a radius > 0"},
+    [SPH_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+static Status parse_sphere(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[SPH_N];
+    Status st = parse_block(p, lx, kw, 0, "sphere", sphere_keys, SPH_N, v);
+    if (st) return st;
+    Sphere sp;
+    memset(&sp, 0, sizeof sp);
+    sp.center = v[SPH_CENTER].v;
+    sp.radius = v[SPH_RADIUS].f;
+    sp.material = v[SPH_MATERIAL].material;
+    return scene_add_sphere(p->s, sp, p->err);
+}
+
+enum { PL_POINT, PL_NORMAL, PL_MATERIAL, PL_N };
+static const KeySpec plane_keys[PL_N] = {
+    [PL_POINT] = {"point", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [PL_NORMAL] = {"normal", VK_DIR, 1, 0, 0, 0, 0, NULL},
+    [PL_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+static Status parse_plane(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[PL_N];
+    Status st = parse_block(p, lx, kw, 0, "plane", plane_keys, PL_N, v);
+    if (st) return st;
+    vec3 n = v[PL_NORMAL].v, q = v[PL_POINT].v;
+    double len = len_d(n);
+    if (!isfinite(len))
+        return lex_error_at(lx, &v[PL_NORMAL].key, p->err, "plane 'normal' is too long to normalise");
+    double nx = n.x / len, ny = n.y / len, nz = n.z / len;
+    Plane pl;
+    memset(&pl, 0, sizeof pl);
+    pl.normal = v3((float)nx, (float)ny, (float)nz);
+    pl.offset = (float)(nx * q.x + ny * q.y + nz * q.z);
+    pl.material = v[PL_MATERIAL].material;
+    return scene_add_plane(p->s, pl, p->err);
+}
+
+static Status add_triangle(Parser *p, const Lexer *lx, const Token *kw, vec3 a, vec3 b, vec3 c,
+                           uint material, const char *which)
+{
+    double area2;
+    cross_d(v3_sub(b, a), v3_sub(c, a), &area2);
+    if (!(area2 > 0.0))
+        return lex_error_at(lx, kw, p->err, "degenerate %.*s: the corners %s lie on one line",
+                            (int)kw->len, kw->text, which);
+    Triangle t;
+    memset(&t, 0, sizeof t);
+    t.p0 = a;
+    t.p1 = b;
+    t.p2 = c;
+    t.material = material;
+    t.shading = NO_INDEX;
+    return scene_add_triangle(p->s, t, p->err);
+}
+
+enum { TRI_V0, TRI_V1, TRI_V2, TRI_V3, TRI_MATERIAL, TRI_N };
+static const KeySpec triangle_keys[TRI_N - 1] = {
+    {"v0", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    {"v1", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    {"v2", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+static const KeySpec quad_keys[TRI_N] = {
+    [TRI_V0] = {"v0", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [TRI_V1] = {"v1", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [TRI_V2] = {"v2", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [TRI_V3] = {"v3", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [TRI_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+static Status parse_triangle(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[TRI_N - 1];
+    Status st = parse_block(p, lx, kw, 0, "triangle", triangle_keys, TRI_N - 1, v);
+    if (st) return st;
+    return add_triangle(p, lx, kw, v[0].v, v[1].v, v[2].v, v[3].material, "v0 v1 v2");
+}
+
+static Status parse_quad(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[TRI_N];
+    Status st = parse_block(p, lx, kw, 0, "quad", quad_keys, TRI_N, v);
+    if (st) return st;
+    uint m = v[TRI_MATERIAL].material;
+    st = add_triangle(p, lx, kw, v[TRI_V0].v, v[TRI_V1].v, v[TRI_V2].v, m, "v0 v1 v2");
+    if (!st) st = add_triangle(p, lx, kw, v[TRI_V0].v, v[TRI_V2].v, v[TRI_V3].v, m, "v0 v2 v3");
+    return st;
+}
+
+enum { BOX_MIN, BOX_MAX, BOX_MATERIAL, BOX_N };
+static const KeySpec box_keys[BOX_N] = {
+    [BOX_MIN] = {"min", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [BOX_MAX] = {"max", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [BOX_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+static Status parse_box(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[BOX_N];
+    Status st = parse_block(p, lx, kw, 0, "box", box_keys, BOX_N, v);
+    if (st) return st;
+    vec3 lo = v[BOX_MIN].v, hi = v[BOX_MAX].v;
+    static const char axis[3] = {'x', 'y', 'z'};
+    for (int i = 0; i < 3; i++)
+        if (!(v3_get(lo, i) < v3_get(hi, i)))
+            return lex_error_at(lx, &v[BOX_MAX].key, p->err,
+                                "box 'max' must be greater than 'min' on every axis, "
+                                "but on %c it is %.9g <= %.9g",
+                                axis[i], (double)v3_get(hi, i), (double)v3_get(lo, i));
+    Box b;
+    memset(&b, 0, sizeof b);
+    b.lo = lo;
+    b.hi = hi;
+    b.material = v[BOX_MATERIAL].material;
+    return scene_add_box(p->s, b, p->err);
+}
+
+enum { MESH_FILE, MESH_MATERIAL, MESH_N };
+static const KeySpec mesh_keys[MESH_N] = {
+    [MESH_FILE] = {"file", VK_PATH, 1, 0, 0, 0, 0, NULL},
+    [MESH_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+static Status parse_mesh(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[MESH_N];
+    Status st = parse_block(p, lx, kw, 0, "mesh", mesh_keys, MESH_N, v);
+    if (st) return st;
+    const Token *f = &v[MESH_FILE].word;
+    char *path = path_beside(lx->path, f->text, f->len);
+    if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
+    st = obj_load(path, p->s, v[MESH_MATERIAL].material, p->err);
+    free(path);
+    if (st == ST_IO)
+        error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+    else if (st)
+        error_append(p->err, " (in the mesh of %s:%u:%u)", lx->path, kw->line, kw->col);
+    return st;
+}
+
+static Status parse_file(Parser *p, const char *path);
+
+static Status parse_include(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token t;
+    Status st = lex_next(lx, &t, p->err);
+    if (st) return st;
+    if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
+        return lex_expected(lx, &t, "a file name after 'include'", p->err);
+    if (p->depth + 1 >= INCLUDE_DEPTH_MAX) {
+        p->depth_exceeded = 1;
+        return lex_error_at(lx, kw, p->err,
+                            "includes nested more than %d deep (does a file include itself?)",
+                            INCLUDE_DEPTH_MAX);
+    }
+    char *path = path_beside(lx->path, t.text, t.len);
+    if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
+    p->depth++;
+    st = parse_file(p, path);
+    p->depth--;
+    free(path);
+    if (st == ST_IO)
+        error_prefix(p->err, "%s:%u:%u", lx->path, t.line, t.col);
+    else if (st && !p->depth_exceeded)
+        error_append(p->err, " (included from %s:%u:%u)", lx->path, kw->line, kw->col);
+    return st;
+}
+
+static const struct {
+    const char *keyword;
+    Status (*parse)(Parser *p, Lexer *lx, const Token *kw);
+} statements[] = {
+    {"camera", parse_camera},   {"image", parse_image},       {"background", parse_background},
+    {"material", parse_material}, {"sphere", parse_sphere},   {"plane", parse_plane},
+    {"triangle", parse_triangle}, {"quad", parse_quad},       {"box", parse_box},
+    {"mesh", parse_mesh},       {"include", parse_include},
+};
+#define N_STATEMENTS (sizeof statements / sizeof statements[0])
+
+static Status parse_file(Parser *p, const char *path)
+{
+    Lexer lx;
+    Status st = lex_open_file(&lx, path, p->err);
+    if (st) return st;
+    for (;;) {
+        Token t;
+        if ((st = lex_next(&lx, &t, p->err)) || t.kind == TOK_EOF) break;
+        size_t i = N_STATEMENTS;
+        if (t.kind == TOK_WORD)
+            for (i = 0; i < N_STATEMENTS; i++)
+                if (tok_is(&t, statements[i].keyword)) break;
+        if (i == N_STATEMENTS) {
+            st = lex_expected(&lx, &t,
+                              "a statement (camera, image, background, material, sphere, "
+                              "plane, triangle, quad, box, mesh, include)", p->err);
+            break;
+        }
+        if ((st = statements[i].parse(p, &lx, &t))) break;
+    }
+    lex_close(&lx);
+    return st;
+}
+
+Status scene_load(const char *path, Scene *s, Error *err)
+{
+    free(s->path);
+    size_t n = strlen(path);
+    s->path = malloc(n + 1);
+    if (!s->path) return error_set(err, ST_INTERNAL, "out of memory");
+    memcpy(s->path, path, n + 1);
+    Parser p;
+    memset(&p, 0, sizeof p);
+    p.s = s;
+    p.err = err;
+    Status st = parse_file(&p, path);
+    free(p.camera_at);
+    free(p.image_at);
+    free(p.background_at);
+    for (size_t i = 0; i < p.n_material_at; i++) free(p.material_at[i]);
+    free(p.material_at);
+    return st;
+}

@@ -20,7 +20,7 @@ typedef struct {
     char err[CLI_OUT_MAX];      /* stderr */
 } CliResult;
 
-static void cli_slurp(int fd, char *buf)
+static inline void cli_slurp(int fd, char *buf)
 {
     lseek(fd, 0, SEEK_SET);
     ssize_t n = read(fd, buf, CLI_OUT_MAX - 1);
@@ -35,7 +35,7 @@ typedef struct {
     int out_fd, err_fd;
 } CliChild;
 
-static CliChild cli_start(const char *const *args)
+static inline CliChild cli_start(const char *const *args)
 {
     CliChild c;
     char out_name[] = "/tmp/clpt-cli-out-XXXXXX", err_name[] = "/tmp/clpt-cli-err-XXXXXX";
@@ -58,7 +58,7 @@ static CliChild cli_start(const char *const *args)
     return c;
 }
 
-static void cli_finish(CliChild c, CliResult *r)
+static inline void cli_finish(CliChild c, CliResult *r)
 {
     int wstatus = 0;
     waitpid(c.pid, &wstatus, 0);
@@ -69,12 +69,12 @@ static void cli_finish(CliChild c, CliResult *r)
     close(c.err_fd);
 }
 
-static void cli_run(const char *const *args, CliResult *r)
+static inline void cli_run(const char *const *args, CliResult *r)
 {
     cli_finish(cli_start(args), r);
 }
 
-static int file_exists(const char *path)
+static inline int file_exists(const char *path)
 {
     struct stat st;
     return stat(path, &st) == 0;
@@ -82,7 +82,7 @@ static int file_exists(const char *path)
 
 /* Writes text to a new temporary file with the given suffix; returns its path (static
  * buffer per call site is the caller's: pass one in). */
-static void write_temp(char *path, size_t size, const char *suffix, const char *text)
+static inline void write_temp(char *path, size_t size, const char *suffix, const char *text)
 {
     snprintf(path, size, "/tmp/clpt-test-XXXXXX%s", suffix);
     int fd = mkstemps(path, (int)strlen(suffix));

@@ -13,7 +13,7 @@
 
 /* devices: a --device spec; batch: fixed batch size (0 = adaptive). The film is
  * initialised here; free it with film_free. */
-static Status render_util_run(Scene *s, const char *devices, uint batch, Film *film, Error *err)
+static inline Status render_util_run(Scene *s, const char *devices, uint batch, Film *film, Error *err)
 {
     RenderScene rs;
     DeviceDesc *all = NULL;
@@ -49,7 +49,7 @@ out:
     return st;
 }
 
-static double film_mean(const Film *f)
+static inline double film_mean(const Film *f)
 {
     size_t n = (size_t)f->width * f->height * 3u;
     float *rgb = malloc(n * sizeof *rgb);

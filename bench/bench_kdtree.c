@@ -4,7 +4,7 @@
  *   bench_kdtree MESH [threads] [rays]
  *
  * MESH is an ASCII PLY file (vertex x y z, then faces as vertex lists, fanned into
- * triangles), "soup:N" (N random triangles in a unit cube) or "sphere:N" (a sphere
+ * triangles), an OBJ file (only its v and f lines), "soup:N" (N random triangles in a unit cube) or "sphere:N" (a sphere
  * tessellated into about N triangles). The tree is built with the given threads (0 =
  * all cores) and with one thread, and the two node arrays must be identical. Rays go
  * from points around the mesh towards points inside its box; before timing, the
@@ -99,6 +99,43 @@ static int load_ply(const char *path, Mesh *m)
     return 0;
 }
 
+/* Just the geometry of an OBJ: "v x y z" and "f a/.. b/.. c/.." (negative = relative). */
+static int load_obj(const char *path, Mesh *m)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) { fprintf(stderr, "%s: %s\n", path, strerror(errno)); return -1; }
+    vec3 *v = NULL;
+    size_t nv = 0, cap = 0;
+    char line[4096];
+    int rc = 0;
+    while (!rc && fgets(line, sizeof line, f)) {
+        if (line[0] == 'v' && line[1] == ' ') {
+            if (nv == cap) {
+                cap = cap ? 2 * cap : 4096;
+                vec3 *nvp = realloc(v, cap * sizeof *v);
+                if (!nvp) { rc = -1; break; }
+                v = nvp;
+            }
+            float x, y, z;
+            if (sscanf(line + 2, "%f %f %f", &x, &y, &z) == 3) v[nv++] = v3(x, y, z);
+        } else if (line[0] == 'f' && line[1] == ' ') {
+            long idx[64];
+            int k = 0;
+            for (char *tok = strtok(line + 2, " \t\r\n"); tok && k < 64; tok = strtok(NULL, " \t\r\n")) {
+                long i = strtol(tok, NULL, 10);
+                idx[k++] = i < 0 ? (long)nv + i : i - 1;
+            }
+            for (int j = 2; j < k; j++)
+                if (idx[0] >= 0 && idx[j - 1] >= 0 && idx[j] >= 0 && (size_t)idx[0] < nv &&
+                    (size_t)idx[j - 1] < nv && (size_t)idx[j] < nv)
+                    rc |= mesh_add(m, v[idx[0]], v[idx[j - 1]], v[idx[j]]);
+        }
+    }
+    free(v);
+    fclose(f);
+    return rc;
+}
+
 static int make_soup(Mesh *m, long n)
 {
     for (long i = 0; i < n; i++) {
@@ -147,7 +184,7 @@ static Hit brute_closest(const SceneView *sc, Ray ray)
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fprintf(stderr, "usage: %s MESH.ply|soup:N|sphere:N [threads] [rays]\n", argv[0]);
+        fprintf(stderr, "usage: %s MESH.ply|MESH.obj|soup:N|sphere:N [threads] [rays]\n", argv[0]);
         return 2;
     }
     int threads = argc > 2 ? atoi(argv[2]) : 0;
@@ -156,6 +193,7 @@ int main(int argc, char **argv)
     double t0 = now();
     int rc = !strncmp(argv[1], "soup:", 5) ? make_soup(&m, atol(argv[1] + 5))
            : !strncmp(argv[1], "sphere:", 7) ? make_sphere(&m, atol(argv[1] + 7))
+           : strstr(argv[1], ".obj") ? load_obj(argv[1], &m)
            : load_ply(argv[1], &m);
     if (rc) return 1;
     printf("mesh %s: %zu triangles (loaded in %.2f s)\n", argv[1], m.n, now() - t0);

@@ -35,7 +35,7 @@
 /* Consecutive splits whose estimated cost is not below the leaf's that are tried
  * before giving up (pbrt's badRefines); kept only if the subtree beats the leaf. */
 #ifndef KD_MAX_BAD_REFINES
-#define KD_MAX_BAD_REFINES 2
+#define KD_MAX_BAD_REFINES 1
 #endif
 /* Subtrees with at least this many primitives are handed to other threads. */
 #ifndef KD_TASK_MIN_PRIMS

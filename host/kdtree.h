@@ -21,7 +21,7 @@
 #define KD_COST_TRAVERSAL 1.0
 #endif
 #ifndef KD_COST_INTERSECT
-#define KD_COST_INTERSECT 1.5
+#define KD_COST_INTERSECT 0.3
 #endif
 
 typedef struct {

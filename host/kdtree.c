@@ -436,8 +436,9 @@ static void sweep_axis(const Event *e, uint n, uint nprims, int k, const Aabb *b
     double side = (a + b) * inv_sa, cap = a * b * inv_sa;
     /* One event at a time, without branching on the event type: the plane at a
      * position is costed once its last event (ends, then planar, then starts) has
-     * been counted; nl and nr then count the primitives strictly left and right of
-     * it, and `planar` those lying in it. Every event is costed, and the cost used
+     * been counted; nl and nr then count the primitives reaching into the left and
+     * the right side (one that straddles the plane in both), and `planar` those
+     * lying in it. Every event is costed, and the cost used
      * only at the last event of a position, since mispredicted branches would cost
      * more than the arithmetic. */
     uint nl = 0, nr = nprims, planar = 0, starts = 0;

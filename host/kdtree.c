@@ -649,7 +649,7 @@ static int task_push(Worker *w, const NodeLists *nl, int depth, int bad, BNode *
     if (!t.lists) return -1;
     memcpy(t.lists, w->arena + nl->off, n * sizeof(Event));
     pthread_mutex_lock(&b->lock);
-    if (b->q_head + b->q_len == b->q_cap) {
+    if (b->q_head > 0 && b->q_head + b->q_len == b->q_cap) {
         memmove(b->queue, b->queue + b->q_head, b->q_len * sizeof *b->queue);
         b->q_head = 0;
     }

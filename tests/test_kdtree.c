@@ -71,6 +71,7 @@ static Status scene_build(int threads)
 {
     KdInput in = { scene.sph, scene.ns, scene.tri, scene.nt, scene.box, scene.nb };
     Error err = { 0 };
+    kd_free(&scene.tree);
     Status st = kd_build(&in, threads, &scene.tree, &err);
     if (st != ST_OK) {
         fprintf(stderr, "  kd_build: %s\n", err.msg);

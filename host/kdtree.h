@@ -15,6 +15,15 @@
 #include "status.h"
 #include "types.h"
 
+/* Surface area heuristic costs of one traversal step and one primitive test (relative
+ * units; docs/kdtree.md says how they were chosen). */
+#ifndef KD_COST_TRAVERSAL
+#define KD_COST_TRAVERSAL 1.0
+#endif
+#ifndef KD_COST_INTERSECT
+#define KD_COST_INTERSECT 0.3
+#endif
+
 typedef struct {
     const Sphere *spheres;     size_t n_spheres;
     const Triangle *triangles; size_t n_triangles;
@@ -27,7 +36,10 @@ typedef struct {
     uint max_depth;                /* deepest leaf, root = 0 */
     double mean_prims_per_leaf;    /* over non-empty leaves */
     double sah_cost;               /* expected cost of a random ray through the root box */
+    double leaf_sah_cost;          /* the same for a single leaf holding every primitive */
     size_t bytes;                  /* nodes + leaf primitive ids */
+    uint n_prims;                  /* primitives in the tree */
+    uint n_skipped;                /* left out: bounds not finite (NaN or inf coordinates) */
 } KdStats;
 
 typedef struct {

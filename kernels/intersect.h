@@ -1,0 +1,181 @@
+/*
+ * intersect.h -- ray against sphere, triangle, axis-aligned box and plane.
+ *
+ * A ray is o + t*d with d of any length; a hit needs tmin < t < tmax (strict), so a
+ * caller shrinks tmax to the closest hit so far and a tie keeps the first primitive
+ * found. Each test writes t, u and v of *hit and returns 1 on a hit; it leaves the
+ * primitive id to the caller. Per-ray constants (1/d and the triangle test's shear)
+ * are computed once by ray_prepare.
+ *
+ * Zero direction components give 1/d = +-inf (IEEE), and every comparison is written
+ * so that a NaN (0 * inf, a NaN ray) makes the test fail rather than loop or crash.
+ */
+#ifndef CLPT_INTERSECT_H
+#define CLPT_INTERSECT_H
+
+#include "kmath.h"
+
+#define K_INF k_as_float(0x7f800000u)
+
+typedef struct {
+    vec3 inv_d;            /* 1/d per component: +-inf where that component is +-0 */
+    int kx, ky, kz;        /* axes of the triangle test; kz is where |d| is largest */
+    float sx, sy, sz;      /* shear taking d to (0, 0, 1) in the permuted frame */
+} RayPre;
+
+KFN RayPre ray_prepare(Ray ray)
+{
+    RayPre p;
+    p.inv_d = v3(1.0f / ray.d.x, 1.0f / ray.d.y, 1.0f / ray.d.z);
+    float ax = k_fabs(ray.d.x), ay = k_fabs(ray.d.y), az = k_fabs(ray.d.z);
+    int kz = (ax >= ay && ax >= az) ? 0 : (ay >= az ? 1 : 2);
+    int kx = kz == 2 ? 0 : kz + 1;
+    int ky = kx == 2 ? 0 : kx + 1;
+    float dz = v3_get(ray.d, kz);
+    /* Keep the winding (the sign of the determinant) independent of the permutation. */
+    if (dz < 0.0f) { int swap = kx; kx = ky; ky = swap; }
+    p.kx = kx; p.ky = ky; p.kz = kz;
+    p.sx = v3_get(ray.d, kx) / dz;
+    p.sy = v3_get(ray.d, ky) / dz;
+    p.sz = 1.0f / dz;
+    return p;
+}
+
+/* ------------------------------------------------------------------ sphere */
+
+/* Ray Tracing Gems ch. 7 (Haines et al., "Precision Improvements for Ray/Sphere
+ * Intersection"): the discriminant from the squared distance between the centre and
+ * the line, which does not cancel catastrophically for distant spheres, and the two
+ * roots as c/q and q/a, so the smaller one does not lose its digits either. */
+KFN int sphere_intersect(Sphere s, Ray ray, Hit *hit)
+{
+    vec3 f = v3_sub(ray.o, s.center);
+    float a = v3_dot(ray.d, ray.d);
+    float b = v3_dot(f, ray.d);                    /* half the usual b */
+    float c = v3_dot(f, f) - s.radius * s.radius;
+    vec3 l = v3_sub(f, v3_scale(ray.d, b / a));    /* centre to the closest point of the line */
+    float disc = a * (s.radius * s.radius - v3_dot(l, l));
+    if (!(disc >= 0.0f)) return 0;
+    float q = -(b + k_copysign(k_sqrt(disc), b));
+    float t0 = c / q, t1 = q / a;
+    float tn = k_fmin(t0, t1), tf = k_fmax(t0, t1);
+    float t = tn > ray.tmin ? tn : tf;
+    if (!(t > ray.tmin && t < ray.tmax)) return 0;
+    hit->t = t;
+    hit->u = 0.0f;
+    hit->v = 0.0f;
+    return 1;
+}
+
+/* ---------------------------------------------------------------- triangle */
+
+/* The error-free product of Dekker (1971): a*b == p + e exactly, given round-to-nearest
+ * and no contraction into fma (compat.h) and no overflow; returns e. */
+KFN float k_two_product_error(float a, float b, float p)
+{
+    float ca = 4097.0f * a, cb = 4097.0f * b;
+    float ah = ca - (ca - a), bh = cb - (cb - b);
+    float al = a - ah, bl = b - bh;
+    return ((ah * bh - p) + ah * bl + al * bh) + al * bl;
+}
+
+/* a*d - b*c when its float evaluation gave exactly 0, i.e. when the rounded products
+ * are equal: then the true value is the difference of the two rounding errors, whose
+ * sign this returns exactly (what Woop et al. do by re-evaluating in double). */
+KFN float k_edge_exact(float a, float d, float b, float c)
+{
+    float p = a * d;
+    return k_two_product_error(a, d, p) - k_two_product_error(b, c, p);
+}
+
+/* Woop, Benthin & Wald, "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013. The
+ * vertices go to a frame where the ray is the +z axis through the origin; the edge
+ * functions U, V, W are then 2D cross products. An edge shared by two triangles gives
+ * the same product difference with opposite sign in both, so a ray through the edge
+ * cannot slip between them. A value that is exactly 0 is re-evaluated exactly
+ * (k_edge_exact); a value still 0 is on the edge and counts as inside for both
+ * triangles, so such a ray hits both (at the same t) rather than neither. */
+KFN int triangle_intersect(const RayPre *rp, Triangle tri, Ray ray, Hit *hit)
+{
+    vec3 A = v3_sub(tri.p0, ray.o), B = v3_sub(tri.p1, ray.o), C = v3_sub(tri.p2, ray.o);
+    float az = v3_get(A, rp->kz), bz = v3_get(B, rp->kz), cz = v3_get(C, rp->kz);
+    float ax = v3_get(A, rp->kx) - rp->sx * az, ay = v3_get(A, rp->ky) - rp->sy * az;
+    float bx = v3_get(B, rp->kx) - rp->sx * bz, by = v3_get(B, rp->ky) - rp->sy * bz;
+    float cx = v3_get(C, rp->kx) - rp->sx * cz, cy = v3_get(C, rp->ky) - rp->sy * cz;
+    float U = cx * by - cy * bx;
+    float V = ax * cy - ay * cx;
+    float W = bx * ay - by * ax;
+    if (U == 0.0f || V == 0.0f || W == 0.0f) {
+        if (U == 0.0f) U = k_edge_exact(cx, by, cy, bx);
+        if (V == 0.0f) V = k_edge_exact(ax, cy, ay, cx);
+        if (W == 0.0f) W = k_edge_exact(bx, ay, by, ax);
+    }
+    if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
+    float det = U + V + W;
+    if (det == 0.0f) return 0;
+    float T = U * (rp->sz * az) + V * (rp->sz * bz) + W * (rp->sz * cz);
+    float inv_det = 1.0f / det;
+    float t = T * inv_det;
+    if (!(t > ray.tmin && t < ray.tmax)) return 0;
+    hit->t = t;
+    hit->u = V * inv_det;
+    hit->v = W * inv_det;
+    return 1;
+}
+
+/* --------------------------------------------------------------------- box */
+
+/* The parameter interval [*tn, *tf] in which the ray is inside the slab lo..hi of one
+ * axis. With d == 0 along the axis, 1/d = +-inf makes it everything or nothing; 0*inf
+ * = NaN happens only when the origin lies on a face plane, and then it is inside the
+ * closed slab: everything. */
+KFN void k_slab(float lo, float hi, float o, float inv, float *tn, float *tf)
+{
+    float t1 = (lo - o) * inv, t2 = (hi - o) * inv;
+    int in_plane = !(t1 == t1) || !(t2 == t2);
+    *tn = in_plane ? -K_INF : k_fmin(t1, t2);
+    *tf = in_plane ? K_INF : k_fmax(t1, t2);
+}
+
+/* Slab test of a solid box (lo <= hi). From outside the hit is where the ray enters,
+ * from inside where it leaves; u is the face of the hit as a float: 0 -x, 1 +x, 2 -y,
+ * 3 +y, 4 -z, 5 +z. A box flat along an axis is hit on its face there. */
+KFN int box_intersect(const RayPre *rp, Box b, Ray ray, Hit *hit)
+{
+    float nx, fx, ny, fy, nz, fz;
+    k_slab(b.lo.x, b.hi.x, ray.o.x, rp->inv_d.x, &nx, &fx);
+    k_slab(b.lo.y, b.hi.y, ray.o.y, rp->inv_d.y, &ny, &fy);
+    k_slab(b.lo.z, b.hi.z, ray.o.z, rp->inv_d.z, &nz, &fz);
+    float tn = k_fmax(nx, k_fmax(ny, nz));
+    float tf = k_fmin(fx, k_fmin(fy, fz));
+    if (!(tn <= tf)) return 0;
+    int entering = tn > ray.tmin;
+    float t = entering ? tn : tf;
+    if (!(t > ray.tmin && t < ray.tmax)) return 0;
+    /* The face: the axis whose slab bound is t, and whether that bound is the lo plane
+     * (a ray going +axis enters there and leaves through hi). */
+    int axis;
+    if (entering) axis = (nx >= ny && nx >= nz) ? 0 : (ny >= nz ? 1 : 2);
+    else axis = (fx <= fy && fx <= fz) ? 0 : (fy <= fz ? 1 : 2);
+    float d = v3_get(ray.d, axis);
+    int hi_face = entering ? (d < 0.0f) : (d > 0.0f);
+    hit->t = t;
+    hit->u = (float)(2 * axis + hi_face);
+    hit->v = 0.0f;
+    return 1;
+}
+
+/* ------------------------------------------------------------------- plane */
+
+/* Both sides; a ray parallel to the plane gives 0/0 or x/0 and misses. */
+KFN int plane_intersect(Plane pl, Ray ray, Hit *hit)
+{
+    float t = (pl.offset - v3_dot(pl.normal, ray.o)) / v3_dot(pl.normal, ray.d);
+    if (!(t > ray.tmin && t < ray.tmax)) return 0;
+    hit->t = t;
+    hit->u = 0.0f;
+    hit->v = 0.0f;
+    return 1;
+}
+
+#endif /* CLPT_INTERSECT_H */

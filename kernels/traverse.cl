@@ -1,0 +1,155 @@
+/*
+ * traverse.cl -- closest-hit and any-hit queries against the scene.
+ *
+ * Infinite planes are tested one by one; everything else is found through the kd-tree
+ * (layout in docs/kdtree.md): the ray is clipped to the root box and walked front to
+ * back with a private stack, as pbrt's KdTreeAggregate does. A leaf's primitives are
+ * tested against the whole remaining ray, not just the leaf's part of it, so a hit
+ * found in a leaf may lie beyond the leaf; the walk stops once the closest hit is no
+ * farther than the end of the current leaf, since every cell still on the stack
+ * starts there or later. Rays must have tmin >= 0 (every ray of a path tracer does):
+ * the near/far order of the children is decided from the origin.
+ */
+#ifndef CLPT_TRAVERSE_CL
+#define CLPT_TRAVERSE_CL
+
+#include "intersect.h"
+#include "scene_view.h"
+
+/* Tests global primitive `id` (a sphere, triangle or box: planes are not in the tree)
+ * against the ray, whose tmax is the closest hit so far. */
+KFN int trace_prim(const SceneView *sc, uint id, const RayPre *rp, Ray ray, Hit *hit)
+{
+    GLOBAL const RenderParams *pr = sc->params;
+    uint first_tri = pr->n_spheres, first_box = first_tri + pr->n_triangles;
+    if (id >= first_tri && id < first_box)
+        return triangle_intersect(rp, sc->triangles[id - first_tri], ray, hit);
+    if (id < first_tri)
+        return sphere_intersect(sc->spheres[id], ray, hit);
+    return box_intersect(rp, sc->boxes[id - first_box], ray, hit);
+}
+
+/* Clips the ray's [tmin, tmax] to the root box; 0 if nothing is left. The far end is
+ * widened by a few ulps (pbrt's 1 + 2*gamma(3)) so that rounding in the slab test
+ * cannot cut off a primitive lying on the box's far face. */
+KFN int trace_clip_root(GLOBAL const RenderParams *pr, Ray ray, const RayPre *rp,
+                        float *t0, float *t1)
+{
+    /* A NaN (or +inf - inf) in the ray would make every split plane "in the plane" and
+     * the walk visit the whole tree; such a ray hits nothing anyway. */
+    float s = ray.o.x + ray.o.y + ray.o.z + ray.d.x + ray.d.y + ray.d.z;
+    if (!(s == s)) return 0;
+    float nx, fx, ny, fy, nz, fz;
+    k_slab(pr->bounds_lo.x, pr->bounds_hi.x, ray.o.x, rp->inv_d.x, &nx, &fx);
+    k_slab(pr->bounds_lo.y, pr->bounds_hi.y, ray.o.y, rp->inv_d.y, &ny, &fy);
+    k_slab(pr->bounds_lo.z, pr->bounds_hi.z, ray.o.z, rp->inv_d.z, &nz, &fz);
+    float tn = k_fmax(ray.tmin, k_fmax(nx, k_fmax(ny, nz)));
+    float tf = k_fmin(ray.tmax, k_fmin(fx, k_fmin(fy, fz)) * 1.00000036f);
+    *t0 = tn;
+    *t1 = tf;
+    return tn <= tf;
+}
+
+/* The kd-tree walk shared by both queries. With `any` set it returns at the first hit;
+ * otherwise it keeps the closest one in *best (whose t starts as the ray's tmax). */
+KFN void trace_tree(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit *best)
+{
+    float t0, t1;
+    if (!trace_clip_root(sc->params, ray, rp, &t0, &t1)) return;
+    GLOBAL const KdNode *nodes = sc->nodes;
+    uint stack_node[KD_MAX_DEPTH];
+    float stack_t0[KD_MAX_DEPTH], stack_t1[KD_MAX_DEPTH];
+    int sp = 0;
+    uint node = 0;
+    for (;;) {
+        KdNode n = nodes[node];
+        uint axis = n.bits & 3u;
+        if (axis != KD_LEAF) {
+            float split = k_as_float(n.data);
+            float o = v3_get(ray.o, (int)axis);
+            float tp = (split - o) * v3_get(rp->inv_d, (int)axis);
+            /* A ray starting on the plane belongs to the side it is heading into. */
+            int below_first = o < split || (o == split && v3_get(ray.d, (int)axis) <= 0.0f);
+            uint above = n.bits >> 2;
+            uint first = below_first ? node + 1u : above;
+            uint second = below_first ? above : node + 1u;
+            /* Branch-free choice between: the near child only (the plane is beyond
+             * the interval or behind the origin), the far child only (crossed before
+             * t0), or both, near first and far pushed. tp is NaN only for a ray lying
+             * in the split plane: it is on the boundary of both children for its
+             * whole interval. The push slot is written either way: an interior node
+             * is at depth <= KD_MAX_DEPTH - 2, so sp stays in range. */
+            int in_plane = !(tp == tp);
+            int crosses = tp > 0.0f && tp <= t1;
+            int far_only = crosses && tp < t0;
+            int both = (crosses && !far_only) || in_plane;
+            stack_node[sp] = second;
+            stack_t0[sp] = in_plane ? t0 : tp;
+            stack_t1[sp] = t1;
+            sp += both;
+            node = far_only ? second : first;
+            t1 = both && !in_plane ? tp : t1;
+            continue;
+        }
+        /* One call site for the primitive test, so that it is inlined. */
+        uint count = n.bits >> 2;
+        for (uint i = 0; i < count; i++) {
+            uint id = count == 1u ? n.data : sc->leaf_prims[n.data + i];
+            Ray r = ray;
+            r.tmax = best->t;
+            Hit h;
+            if (trace_prim(sc, id, rp, r, &h)) {
+                h.prim = id;
+                *best = h;
+                if (any) return;
+            }
+        }
+        if (sp == 0 || best->t <= t1) return;
+        sp--;
+        node = stack_node[sp];
+        t0 = stack_t0[sp];
+        t1 = stack_t1[sp];
+    }
+}
+
+/* Nearest hit in (ray.tmin, ray.tmax); prim = NO_INDEX when there is none. */
+KFN Hit trace_closest(const SceneView *sc, Ray ray)
+{
+    GLOBAL const RenderParams *pr = sc->params;
+    Hit best;
+    best.t = ray.tmax;
+    best.prim = NO_INDEX;
+    best.u = 0.0f;
+    best.v = 0.0f;
+    RayPre rp = ray_prepare(ray);
+    uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes;
+    for (uint i = 0; i < pr->n_planes; i++) {
+        Ray r = ray;
+        r.tmax = best.t;
+        Hit h;
+        if (plane_intersect(sc->planes[i], r, &h)) {
+            h.prim = first_plane + i;
+            best = h;
+        }
+    }
+    trace_tree(sc, ray, &rp, 0, &best);
+    return best;
+}
+
+/* 1 if anything is hit in (ray.tmin, ray.tmax): shadow rays. */
+KFN int trace_any(const SceneView *sc, Ray ray)
+{
+    GLOBAL const RenderParams *pr = sc->params;
+    Hit h;
+    for (uint i = 0; i < pr->n_planes; i++)
+        if (plane_intersect(sc->planes[i], ray, &h)) return 1;
+    RayPre rp = ray_prepare(ray);
+    h.t = ray.tmax;
+    h.prim = NO_INDEX;
+    h.u = 0.0f;
+    h.v = 0.0f;
+    trace_tree(sc, ray, &rp, 1, &h);
+    return h.prim != NO_INDEX;
+}
+
+#endif /* CLPT_TRAVERSE_CL */

@@ -1,0 +1,750 @@
+/*
+ * test_kdtree.c -- the kd-tree build (host/kdtree.c), the primitive intersections
+ * (kernels/intersect.h) and the traversal (kernels/traverse.cl, compiled here as C).
+ *
+ * The tree's structure is checked directly (nesting, which primitives each leaf must
+ * hold, its SAH cost), and the traversal against brute force: every primitive tested
+ * with the same intersection functions, on random scenes and random rays.
+ */
+#include <stdint.h>
+#include <stdlib.h>
+
+#include "harness.h"
+#include "kdtree.h"
+#include "traverse.cl"
+
+/* ------------------------------------------------------------------ helpers */
+
+static uint64_t rng = 1;
+static void rng_seed(uint64_t s) { rng = s * 0x9e3779b97f4a7c15ull + 1; }
+static float frand(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return (float)(rng >> 40) / 16777216.0f;
+}
+static float frange(float a, float b) { return a + (b - a) * frand(); }
+static vec3 vrand(float a, float b) { return v3(frange(a, b), frange(a, b), frange(a, b)); }
+
+typedef struct {
+    Sphere sph[512];     uint ns;
+    Triangle tri[4096];  uint nt;
+    Box box[256];        uint nb;
+    Plane pln[4];        uint np;
+    KdTree tree;
+    RenderParams params;
+    SceneView view;
+} TestScene;
+
+static TestScene scene;   /* large: static rather than on the stack */
+
+static void scene_clear(void)
+{
+    kd_free(&scene.tree);
+    scene.ns = scene.nt = scene.nb = scene.np = 0;
+}
+
+static void add_sphere(vec3 c, float r)
+{
+    Sphere s = { c, r, 0, NO_INDEX, 0, 0 };
+    scene.sph[scene.ns++] = s;
+}
+static void add_triangle(vec3 a, vec3 b, vec3 c)
+{
+    Triangle t = { a, 0, b, NO_INDEX, c, NO_INDEX };
+    scene.tri[scene.nt++] = t;
+}
+static void add_box(vec3 lo, vec3 hi)
+{
+    Box b = { lo, 0, hi, NO_INDEX };
+    scene.box[scene.nb++] = b;
+}
+static void add_plane(vec3 n, float offset)
+{
+    Plane p = { n, offset, 0, 0, 0, 0 };
+    scene.pln[scene.np++] = p;
+}
+
+/* Builds the tree and the SceneView the kernel functions read. */
+static Status scene_build(int threads)
+{
+    KdInput in = { scene.sph, scene.ns, scene.tri, scene.nt, scene.box, scene.nb };
+    Error err = { 0 };
+    kd_free(&scene.tree);
+    Status st = kd_build(&in, threads, &scene.tree, &err);
+    if (st != ST_OK) {
+        fprintf(stderr, "  kd_build: %s\n", err.msg);
+        return st;
+    }
+    memset(&scene.params, 0, sizeof scene.params);
+    scene.params.n_spheres = scene.ns;
+    scene.params.n_triangles = scene.nt;
+    scene.params.n_boxes = scene.nb;
+    scene.params.n_planes = scene.np;
+    scene.params.n_nodes = scene.tree.n_nodes;
+    scene.params.n_leaf_prims = scene.tree.n_leaf_prims;
+    scene.params.bounds_lo = scene.tree.lo;
+    scene.params.bounds_hi = scene.tree.hi;
+    SceneView v = { &scene.params, scene.tree.nodes, scene.tree.leaf_prims, scene.sph, scene.tri,
+                    scene.box, scene.pln, NULL, NULL, NULL };
+    scene.view = v;
+    return ST_OK;
+}
+
+/* Every primitive tested; primitives the builder leaves out (bounds not finite) are
+ * left out here too. */
+static int prim_finite(uint id)
+{
+    if (id < scene.ns) {
+        const Sphere *s = &scene.sph[id];
+        return isfinite(s->center.x) && isfinite(s->center.y) && isfinite(s->center.z) &&
+               isfinite(s->radius);
+    }
+    id -= scene.ns;
+    if (id < scene.nt) {
+        const Triangle *t = &scene.tri[id];
+        const float *f = &t->p0.x;
+        return isfinite(f[0]) && isfinite(f[1]) && isfinite(f[2]) && isfinite(t->p1.x) &&
+               isfinite(t->p1.y) && isfinite(t->p1.z) && isfinite(t->p2.x) &&
+               isfinite(t->p2.y) && isfinite(t->p2.z);
+    }
+    id -= scene.nt;
+    const Box *b = &scene.box[id];
+    return isfinite(b->lo.x) && isfinite(b->lo.y) && isfinite(b->lo.z) && isfinite(b->hi.x) &&
+           isfinite(b->hi.y) && isfinite(b->hi.z);
+}
+
+static Hit brute_closest(Ray ray)
+{
+    RayPre rp = ray_prepare(ray);
+    Hit best = { ray.tmax, NO_INDEX, 0.0f, 0.0f };
+    uint n = scene.ns + scene.nt + scene.nb;
+    for (uint id = 0; id < n + scene.np; id++) {
+        Ray r = ray;
+        r.tmax = best.t;
+        Hit h;
+        int hit;
+        if (id >= n) hit = plane_intersect(scene.pln[id - n], r, &h);
+        else if (!prim_finite(id)) continue;
+        else hit = trace_prim(&scene.view, id, &rp, r, &h);
+        if (hit) {
+            h.prim = id;
+            best = h;
+        }
+    }
+    return best;
+}
+
+static Ray make_ray(vec3 o, vec3 d, float tmin, float tmax)
+{
+    Ray r = { o, tmin, d, tmax };
+    return r;
+}
+
+/* Compares the kd-tree's answers with brute force for one ray; returns 1 if they
+ * agree: the same primitive and t (the same function computed both), or primitives
+ * tied at t within 1e-5 relative; any-hit true exactly when there is a closest hit. */
+static int ray_agrees(Ray ray, int verbose)
+{
+    Hit a = trace_closest(&scene.view, ray), b = brute_closest(ray);
+    int any = trace_any(&scene.view, ray);
+    int ok;
+    if (a.prim == NO_INDEX || b.prim == NO_INDEX) ok = a.prim == b.prim;
+    else if (a.prim == b.prim) ok = a.t == b.t && a.u == b.u && a.v == b.v;
+    else ok = fabsf(a.t - b.t) <= 1e-5f * fmaxf(fabsf(b.t), 1e-30f);
+    ok = ok && any == (b.prim != NO_INDEX);
+    if (!ok && verbose)
+        fprintf(stderr, "  ray o=(%.9g %.9g %.9g) d=(%.9g %.9g %.9g) tmin %g tmax %g: kd %u t=%.9g, "
+                "brute %u t=%.9g, any %d\n", ray.o.x, ray.o.y, ray.o.z, ray.d.x, ray.d.y, ray.d.z,
+                ray.tmin, ray.tmax, a.prim, a.t, b.prim, b.t, any);
+    return ok;
+}
+
+/* A random ray of one of several kinds: from outside or inside the scene's box, with
+ * zero direction components, with a short tmax or a positive tmin. */
+static Ray random_ray(float lo, float hi)
+{
+    float mid = 0.5f * (lo + hi), span = hi - lo;
+    int kind = (int)(frand() * 6.0f);
+    vec3 o = vrand(lo, hi), d = vrand(-1.0f, 1.0f);
+    float tmin = 0.0f, tmax = K_INF;
+    switch (kind) {
+    case 0:   /* from far outside towards a point inside */
+        o = v3_add(v3s(mid), v3_scale(v3_norm(vrand(-1.0f, 1.0f)), span * 1.5f));
+        d = v3_sub(vrand(lo, hi), o);
+        break;
+    case 1:   /* one or two components exactly zero */
+        d.x = frand() < 0.5f ? 0.0f : d.x;
+        d.y = frand() < 0.5f ? 0.0f : d.y;
+        if (d.x != 0.0f && d.y != 0.0f) d.z = 0.0f;
+        if (v3_is_zero(d)) d.z = -1.0f;
+        break;
+    case 2:   /* short segment (shadow-ray like) */
+        tmax = frange(0.0f, 1.0f);
+        break;
+    case 3:   /* starting a little way along */
+        tmin = frange(0.0f, 0.5f);
+        d = v3_scale(d, frange(0.1f, 10.0f));
+        break;
+    default:
+        break;
+    }
+    return make_ray(o, d, tmin, tmax);
+}
+
+static void random_triangle(float lo, float hi, float size)
+{
+    vec3 c = vrand(lo, hi);
+    add_triangle(v3_add(c, vrand(-size, size)), v3_add(c, vrand(-size, size)), v3_add(c, vrand(-size, size)));
+}
+
+/* Spheres, triangles of mixed sizes, boxes, axis-aligned flat triangles on integer
+ * planes (so they lie exactly on candidate split planes), planes. */
+static void random_scene(uint64_t seed, uint ns, uint nt, uint nb, uint np)
+{
+    scene_clear();
+    rng_seed(seed);
+    for (uint i = 0; i < ns; i++) add_sphere(vrand(-4.0f, 4.0f), frange(0.05f, 0.8f));
+    for (uint i = 0; i < nt; i++) {
+        uint kind = i % 4;
+        if (kind == 0) random_triangle(-4.0f, 4.0f, 2.0f);
+        else if (kind == 1) random_triangle(-4.0f, 4.0f, 0.3f);
+        else if (kind == 2) {
+            /* axis-aligned, in the plane axis = integer */
+            int axis = (int)(frand() * 3.0f) % 3;
+            float at = (float)((int)frange(-4.0f, 5.0f));
+            vec3 p[3];
+            for (int j = 0; j < 3; j++) {
+                p[j] = vrand(-4.0f, 4.0f);
+                if (axis == 0) p[j].x = at;
+                else if (axis == 1) p[j].y = at;
+                else p[j].z = at;
+            }
+            add_triangle(p[0], p[1], p[2]);
+        } else random_triangle(-4.0f, 4.0f, 1.0f);
+    }
+    for (uint i = 0; i < nb; i++) {
+        vec3 lo = vrand(-4.0f, 4.0f), hi = v3_add(lo, vrand(0.0f, 1.5f));
+        if (i % 5 == 0) hi.y = lo.y;    /* flat */
+        add_box(lo, hi);
+    }
+    if (np > 0) add_plane(v3(0.0f, 1.0f, 0.0f), -5.0f);
+    if (np > 1) add_plane(v3_norm(v3(1.0f, 0.5f, 0.2f)), 6.0f);
+}
+
+/* ------------------------------------------------------------------ intersection */
+
+static void test_sphere(void)
+{
+    Sphere s = { v3(0.0f, 0.0f, -5.0f), 1.0f, 0, NO_INDEX, 0, 0 };
+    Hit h;
+    CHECK(sphere_intersect(s, make_ray(v3s(0.0f), v3(0.0f, 0.0f, -1.0f), 0.0f, K_INF), &h));
+    CHECK_NEAR(h.t, 4.0f, 1e-6);
+    /* unnormalised direction: t scales inversely */
+    CHECK(sphere_intersect(s, make_ray(v3s(0.0f), v3(0.0f, 0.0f, -2.0f), 0.0f, K_INF), &h));
+    CHECK_NEAR(h.t, 2.0f, 1e-6);
+    /* from inside: the far root */
+    CHECK(sphere_intersect(s, make_ray(v3(0.0f, 0.0f, -5.0f), v3(1.0f, 0.0f, 0.0f), 0.0f, K_INF), &h));
+    CHECK_NEAR(h.t, 1.0f, 1e-6);
+    /* strict interval: tmax at the near root excludes it */
+    CHECK(!sphere_intersect(s, make_ray(v3s(0.0f), v3(0.0f, 0.0f, -1.0f), 0.0f, 4.0f), &h));
+    /* tmin past the near root gives the far one */
+    CHECK(sphere_intersect(s, make_ray(v3s(0.0f), v3(0.0f, 0.0f, -1.0f), 4.5f, K_INF), &h));
+    CHECK_NEAR(h.t, 6.0f, 1e-6);
+    CHECK(!sphere_intersect(s, make_ray(v3s(0.0f), v3(0.0f, 1.0f, 0.0f), 0.0f, K_INF), &h));
+    CHECK(!sphere_intersect(s, make_ray(v3s(0.0f), v3s(0.0f), 0.0f, K_INF), &h));
+    /* a small sphere far away keeps its precision (the naive discriminant loses it) */
+    Sphere far = { v3(0.0f, 0.0f, -10000.0f), 0.01f, 0, NO_INDEX, 0, 0 };
+    CHECK(sphere_intersect(far, make_ray(v3s(0.0f), v3(0.0f, 0.0f, -1.0f), 0.0f, K_INF), &h));
+    CHECK_NEAR(h.t, 9999.99f, 1e-3);
+    CHECK(sphere_intersect(far, make_ray(v3s(0.0f), v3(0.0f, 0.0000009f, -1.0f), 0.0f, K_INF), &h));
+}
+
+static void test_triangle(void)
+{
+    Triangle t = { v3(0.0f, 0.0f, -2.0f), 0, v3(2.0f, 0.0f, -2.0f), NO_INDEX, v3(0.0f, 2.0f, -2.0f), NO_INDEX };
+    rng_seed(7);
+    for (int i = 0; i < 1000; i++) {
+        vec3 o = vrand(-3.0f, 3.0f), target = v3(frange(0.0f, 2.0f), frange(0.0f, 2.0f), -2.0f);
+        Ray r = make_ray(o, v3_scale(v3_sub(target, o), frange(0.5f, 3.0f)), 0.0f, K_INF);
+        RayPre rp = ray_prepare(r);
+        Hit h;
+        int inside = target.x + target.y < 2.0f;
+        int hit = triangle_intersect(&rp, t, r, &h);
+        if (fabsf(target.x + target.y - 2.0f) > 1e-4f && o.z != -2.0f) CHECK_EQ_INT(hit, inside);
+        if (hit) {
+            /* p = (1-u-v) p0 + u p1 + v p2 is the point o + t d */
+            vec3 p = v3_madd(r.o, r.d, h.t);
+            vec3 q = v3_add(v3_add(v3_scale(t.p0, 1.0f - h.u - h.v), v3_scale(t.p1, h.u)), v3_scale(t.p2, h.v));
+            CHECK(v3_len(v3_sub(p, q)) < 1e-4f);
+        }
+    }
+    /* both faces */
+    Hit h;
+    Ray down = make_ray(v3(0.5f, 0.5f, 0.0f), v3(0.0f, 0.0f, -1.0f), 0.0f, K_INF);
+    Ray up = make_ray(v3(0.5f, 0.5f, -4.0f), v3(0.0f, 0.0f, 1.0f), 0.0f, K_INF);
+    RayPre rpd = ray_prepare(down), rpu = ray_prepare(up);
+    CHECK(triangle_intersect(&rpd, t, down, &h));
+    CHECK_NEAR(h.t, 2.0f, 1e-6);
+    CHECK_NEAR(h.u, 0.25f, 1e-6);
+    CHECK_NEAR(h.v, 0.25f, 1e-6);
+    CHECK(triangle_intersect(&rpu, t, up, &h));
+    CHECK_NEAR(h.t, 2.0f, 1e-6);
+    /* degenerate (zero area) and parallel: misses, no NaN trouble */
+    Triangle flat = { v3(0.0f, 0.0f, -2.0f), 0, v3(1.0f, 1.0f, -2.0f), NO_INDEX, v3(2.0f, 2.0f, -2.0f), NO_INDEX };
+    CHECK(!triangle_intersect(&rpd, flat, down, &h));
+    Ray side = make_ray(v3(-1.0f, 0.5f, -2.0f), v3(1.0f, 0.0f, 0.0f), 0.0f, K_INF);
+    RayPre rps = ray_prepare(side);
+    CHECK(!triangle_intersect(&rps, t, side, &h));
+    Ray nan_ray = make_ray(v3(NAN, 0.0f, 0.0f), v3(0.0f, 0.0f, -1.0f), 0.0f, K_INF);
+    RayPre rpn = ray_prepare(nan_ray);
+    CHECK(!triangle_intersect(&rpn, t, nan_ray, &h));
+}
+
+/* Rays through the shared edges and vertices of a mesh never slip through. */
+static void test_watertight(void)
+{
+    /* A 6x6 grid of quads on a tilted plane, each split into two triangles. */
+    enum { G = 6 };
+    vec3 v[G + 1][G + 1];
+    for (int i = 0; i <= G; i++)
+        for (int j = 0; j <= G; j++) {
+            float x = (float)i * 0.7f, y = (float)j * 0.45f;
+            v[i][j] = v3(x, y, 0.3f * x - 0.17f * y + 1.0f);
+        }
+    Triangle tris[2 * G * G];
+    int n = 0;
+    for (int i = 0; i < G; i++)
+        for (int j = 0; j < G; j++) {
+            Triangle a = { v[i][j], 0, v[i + 1][j], NO_INDEX, v[i + 1][j + 1], NO_INDEX };
+            Triangle b = { v[i][j], 0, v[i + 1][j + 1], NO_INDEX, v[i][j + 1], NO_INDEX };
+            tris[n++] = a;
+            tris[n++] = b;
+        }
+    rng_seed(11);
+    int misses = 0, rays = 0;
+    for (int k = 0; k < 20000; k++) {
+        /* aim at an interior vertex, or at a point of an interior edge */
+        int i = 1 + (int)(frand() * (G - 1)), j = 1 + (int)(frand() * (G - 1));
+        vec3 target = v[i][j];
+        int which = k % 4;
+        float s = frand();
+        if (which == 1) target = v3_add(v[i][j], v3_scale(v3_sub(v[i + 1][j], v[i][j]), s));
+        if (which == 2) target = v3_add(v[i][j], v3_scale(v3_sub(v[i][j + 1], v[i][j]), s));
+        if (which == 3) target = v3_add(v[i][j], v3_scale(v3_sub(v[i + 1][j + 1], v[i][j]), s));
+        vec3 o = v3_add(target, v3_scale(vrand(-1.0f, 1.0f), 5.0f));
+        if (k % 7 == 0) o = v3(target.x, target.y, 10.0f);   /* d has two zero components */
+        Ray r = make_ray(o, v3_sub(target, o), 0.0f, K_INF);
+        RayPre rp = ray_prepare(r);
+        int hit = 0;
+        Hit h;
+        for (int t = 0; t < n; t++) hit |= triangle_intersect(&rp, tris[t], r, &h);
+        misses += !hit;
+        rays++;
+    }
+    CHECK_EQ_INT(misses, 0);
+    fprintf(stderr, "  watertight: %d rays through edges and vertices, %d misses\n", rays, misses);
+}
+
+static void test_box(void)
+{
+    Box b = { v3(-1.0f, -1.0f, -1.0f), 0, v3(1.0f, 1.0f, 1.0f), NO_INDEX };
+    Ray r = make_ray(v3s(0.0f), v3s(0.0f), 0.0f, K_INF);
+    Hit h;
+    /* from outside along each axis: the entry face; from inside: the exit face */
+    for (int axis = 0; axis < 3; axis++)
+        for (int sgn = 0; sgn < 2; sgn++) {
+            float dir = sgn ? -1.0f : 1.0f;
+            vec3 d = v3(axis == 0 ? dir : 0.0f, axis == 1 ? dir : 0.0f, axis == 2 ? dir : 0.0f);
+            r = make_ray(v3_scale(d, -3.0f), v3_scale(d, 2.0f), 0.0f, K_INF);
+            RayPre rp = ray_prepare(r);
+            CHECK(box_intersect(&rp, b, r, &h));
+            CHECK_NEAR(h.t, 1.0f, 1e-6);
+            CHECK_EQ_INT((int)h.u, 2 * axis + sgn);           /* entering +x hits the -x face */
+            r = make_ray(v3(0.1f, 0.2f, 0.3f), d, 0.0f, K_INF);
+            rp = ray_prepare(r);
+            CHECK(box_intersect(&rp, b, r, &h));
+            CHECK_EQ_INT((int)h.u, 2 * axis + (1 - sgn));     /* leaving +x through +x */
+        }
+    /* oblique, hits the +y face first */
+    r = make_ray(v3(0.0f, 5.0f, 0.0f), v3(0.1f, -1.0f, 0.05f), 0.0f, K_INF);
+    RayPre rp = ray_prepare(r);
+    CHECK(box_intersect(&rp, b, r, &h));
+    CHECK_EQ_INT((int)h.u, 3);
+    CHECK_NEAR(h.t, 4.0f, 1e-6);
+    /* miss, parallel outside, a flat box hit on its face */
+    r = make_ray(v3(0.0f, 5.0f, 0.0f), v3(1.0f, 0.0f, 0.0f), 0.0f, K_INF);
+    rp = ray_prepare(r);
+    CHECK(!box_intersect(&rp, b, r, &h));
+    Box flat = { v3(-1.0f, 0.0f, -1.0f), 0, v3(1.0f, 0.0f, 1.0f), NO_INDEX };
+    r = make_ray(v3(0.2f, 3.0f, 0.1f), v3(0.0f, -1.0f, 0.0f), 0.0f, K_INF);
+    rp = ray_prepare(r);
+    CHECK(box_intersect(&rp, flat, r, &h));
+    CHECK_NEAR(h.t, 3.0f, 1e-6);
+    CHECK_EQ_INT((int)h.u, 3);
+}
+
+static void test_plane(void)
+{
+    Plane p = { v3(0.0f, 1.0f, 0.0f), 2.0f, 0, 0, 0, 0 };
+    Hit h;
+    CHECK(plane_intersect(p, make_ray(v3s(0.0f), v3(0.0f, 1.0f, 0.0f), 0.0f, K_INF), &h));
+    CHECK_NEAR(h.t, 2.0f, 1e-6);
+    CHECK(plane_intersect(p, make_ray(v3(0.0f, 5.0f, 0.0f), v3(0.3f, -0.5f, 0.0f), 0.0f, K_INF), &h));
+    CHECK_NEAR(h.t, 6.0f, 1e-6);
+    CHECK(!plane_intersect(p, make_ray(v3s(0.0f), v3(1.0f, 0.0f, 0.0f), 0.0f, K_INF), &h));
+    CHECK(!plane_intersect(p, make_ray(v3s(0.0f), v3(0.0f, -1.0f, 0.0f), 0.0f, K_INF), &h));
+}
+
+/* ------------------------------------------------------------------ tree structure */
+
+/* Separating-axis test of a triangle against a box given by centre and half extents
+ * (Akenine-Moller), in double: a check independent of the builder's clipping. */
+static int axis_separates(double v[3][3], const double h[3], const double a[3])
+{
+    double p0 = v[0][0] * a[0] + v[0][1] * a[1] + v[0][2] * a[2];
+    double p1 = v[1][0] * a[0] + v[1][1] * a[1] + v[1][2] * a[2];
+    double p2 = v[2][0] * a[0] + v[2][1] * a[1] + v[2][2] * a[2];
+    double r = h[0] * fabs(a[0]) + h[1] * fabs(a[1]) + h[2] * fabs(a[2]);
+    double mn = fmin(p0, fmin(p1, p2)), mx = fmax(p0, fmax(p1, p2));
+    return mn > r || mx < -r;
+}
+
+static int triangle_overlaps_box(const Triangle *t, const double lo[3], const double hi[3])
+{
+    double c[3], h[3], v[3][3];
+    const vec3 *p[3] = { &t->p0, &t->p1, &t->p2 };
+    for (int k = 0; k < 3; k++) {
+        c[k] = 0.5 * (lo[k] + hi[k]);
+        h[k] = 0.5 * (hi[k] - lo[k]);
+    }
+    for (int i = 0; i < 3; i++) {
+        v[i][0] = p[i]->x - c[0];
+        v[i][1] = p[i]->y - c[1];
+        v[i][2] = p[i]->z - c[2];
+    }
+    double e[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) e[i][k] = v[(i + 1) % 3][k] - v[i][k];
+    for (int k = 0; k < 3; k++) {
+        double a[3] = { k == 0, k == 1, k == 2 };
+        if (axis_separates(v, h, a)) return 0;
+    }
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            double u[3] = { k == 0, k == 1, k == 2 };
+            double a[3] = { e[i][1] * u[2] - e[i][2] * u[1], e[i][2] * u[0] - e[i][0] * u[2],
+                            e[i][0] * u[1] - e[i][1] * u[0] };
+            if (axis_separates(v, h, a)) return 0;
+        }
+    double n[3] = { e[0][1] * e[1][2] - e[0][2] * e[1][1], e[0][2] * e[1][0] - e[0][0] * e[1][2],
+                    e[0][0] * e[1][1] - e[0][1] * e[1][0] };
+    return !axis_separates(v, h, n);
+}
+
+static int bounds_overlap_box(const double plo[3], const double phi[3], const double lo[3], const double hi[3])
+{
+    for (int k = 0; k < 3; k++)
+        if (plo[k] > hi[k] || phi[k] < lo[k]) return 0;
+    return 1;
+}
+
+/* Must primitive `id` be in a leaf with box lo..hi? Yes if its geometry (a sphere's
+ * or box's bounding box, a triangle itself) meets the box shrunk by eps: touching the
+ * boundary, or lying in it (a flat primitive on a split plane), asks for nothing. */
+static int must_contain(uint id, const double lo_in[3], const double hi_in[3], double eps)
+{
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; k++) {
+        lo[k] = lo_in[k] + eps;
+        hi[k] = hi_in[k] - eps;
+        if (lo[k] > hi[k]) return 0;
+    }
+    if (id < scene.ns) {
+        const Sphere *s = &scene.sph[id];
+        double r = fabs(s->radius), c[3] = { s->center.x, s->center.y, s->center.z };
+        double plo[3] = { c[0] - r, c[1] - r, c[2] - r }, phi[3] = { c[0] + r, c[1] + r, c[2] + r };
+        return bounds_overlap_box(plo, phi, lo, hi);
+    }
+    if (id < scene.ns + scene.nt) return triangle_overlaps_box(&scene.tri[id - scene.ns], lo, hi);
+    const Box *b = &scene.box[id - scene.ns - scene.nt];
+    double plo[3] = { b->lo.x, b->lo.y, b->lo.z }, phi[3] = { b->hi.x, b->hi.y, b->hi.z };
+    return bounds_overlap_box(plo, phi, lo, hi);
+}
+
+typedef struct { double lo[3], hi[3]; } DBox;
+
+static double half_area(const DBox *b)
+{
+    double dx = b->hi[0] - b->lo[0], dy = b->hi[1] - b->lo[1], dz = b->hi[2] - b->lo[2];
+    return dx * dy + dy * dz + dz * dx;
+}
+
+/* Walks the flattened tree checking nesting, leaf contents and the statistics. */
+static void check_tree(void)
+{
+    const KdTree *t = &scene.tree;
+    uint n_prims = scene.ns + scene.nt + scene.nb;
+    DBox root = { { t->lo.x, t->lo.y, t->lo.z }, { t->hi.x, t->hi.y, t->hi.z } };
+    double diag = sqrt(k_sqr((float)(root.hi[0] - root.lo[0])) + k_sqr((float)(root.hi[1] - root.lo[1])) +
+                       k_sqr((float)(root.hi[2] - root.lo[2])));
+    double eps = 1e-5 * diag, root_area = half_area(&root);
+    /* the root box holds every primitive's bounds */
+    for (uint id = 0; id < n_prims; id++) {
+        DBox huge = { { -1e30, -1e30, -1e30 }, { 1e30, 1e30, 1e30 } };
+        if (!prim_finite(id)) continue;
+        CHECK(must_contain(id, huge.lo, huge.hi, 0.0));
+    }
+    uint stack_node[KD_MAX_DEPTH + 1];
+    DBox stack_box[KD_MAX_DEPTH + 1];
+    int stack_depth[KD_MAX_DEPTH + 1], sp = 0;
+    stack_node[sp] = 0;
+    stack_box[sp] = root;
+    stack_depth[sp++] = 0;
+    unsigned char *seen = calloc(n_prims + 1, 1);
+    uint leaves = 0, empty = 0, max_depth = 0, visited = 0, missing = 0, bad_nesting = 0;
+    double sah = 0.0;
+    while (sp > 0) {
+        sp--;
+        uint ni = stack_node[sp];
+        DBox box = stack_box[sp];
+        int depth = stack_depth[sp];
+        visited++;
+        if ((uint)depth > max_depth) max_depth = (uint)depth;
+        CHECK(ni < t->n_nodes);
+        if (ni >= t->n_nodes) break;
+        KdNode n = t->nodes[ni];
+        uint axis = n.bits & 3u;
+        if (axis != KD_LEAF) {
+            float split = k_as_float(n.data);
+            uint above = n.bits >> 2;
+            /* children nest: the split is strictly inside the parent's extent */
+            if (!(split > box.lo[axis] && split < box.hi[axis])) bad_nesting++;
+            CHECK(above > ni + 1 && above < t->n_nodes);
+            sah += KD_COST_TRAVERSAL * half_area(&box) / root_area;
+            DBox below = box, up = box;
+            below.hi[axis] = split;
+            up.lo[axis] = split;
+            CHECK(sp + 2 <= KD_MAX_DEPTH);
+            if (sp + 2 > KD_MAX_DEPTH) break;
+            stack_node[sp] = above; stack_box[sp] = up; stack_depth[sp++] = depth + 1;
+            stack_node[sp] = ni + 1; stack_box[sp] = below; stack_depth[sp++] = depth + 1;
+            continue;
+        }
+        uint count = n.bits >> 2;
+        leaves++;
+        empty += count == 0;
+        sah += KD_COST_INTERSECT * count * half_area(&box) / root_area;
+        unsigned char *in_leaf = calloc(n_prims + 1, 1);
+        for (uint i = 0; i < count; i++) {
+            uint id = count == 1 ? n.data : t->leaf_prims[n.data + i];
+            CHECK(id < n_prims);
+            if (id >= n_prims) continue;
+            if (count > 1 && i > 0) CHECK(t->leaf_prims[n.data + i - 1] < id);  /* sorted, unique */
+            in_leaf[id] = 1;
+            seen[id] = 1;
+        }
+        for (uint id = 0; id < n_prims; id++)
+            if (!in_leaf[id] && prim_finite(id) && must_contain(id, box.lo, box.hi, eps)) missing++;
+        free(in_leaf);
+    }
+    CHECK_EQ_INT(bad_nesting, 0);
+    CHECK_EQ_INT(missing, 0);
+    CHECK_EQ_INT(visited, t->n_nodes);
+    for (uint id = 0; id < n_prims; id++)
+        if (prim_finite(id)) CHECK(seen[id]);
+    free(seen);
+    const KdStats *st = &t->stats;
+    CHECK_EQ_INT(st->n_nodes, t->n_nodes);
+    CHECK_EQ_INT(st->n_leaves, leaves);
+    CHECK_EQ_INT(st->n_empty_leaves, empty);
+    CHECK_EQ_INT(st->max_depth, max_depth);
+    CHECK(st->max_depth <= KD_MAX_DEPTH - 1);
+    CHECK_EQ_INT(st->bytes, (size_t)t->n_nodes * sizeof(KdNode) + (size_t)t->n_leaf_prims * sizeof(uint));
+    CHECK_NEAR(st->sah_cost, sah, 1e-6 * sah);
+    CHECK(st->sah_cost <= st->leaf_sah_cost);
+    CHECK_NEAR(st->leaf_sah_cost, KD_COST_INTERSECT * st->n_prims, 1e-9);
+}
+
+static void test_structure(void)
+{
+    const uint64_t seeds[] = { 1, 2, 3, 4 };
+    for (int i = 0; i < 4; i++) {
+        random_scene(seeds[i], 30, 160, 20, 0);
+        CHECK(scene_build(0) == ST_OK);
+        check_tree();
+        CHECK_EQ_INT(scene.tree.stats.n_prims, 210);
+    }
+    /* only tiny triangles: leaves hold them without copies all over */
+    scene_clear();
+    rng_seed(9);
+    for (int i = 0; i < 2000; i++) random_triangle(0.0f, 10.0f, 0.02f);
+    CHECK(scene_build(1) == ST_OK);
+    check_tree();
+    const KdStats *st = &scene.tree.stats;
+    CHECK(st->mean_prims_per_leaf * (st->n_leaves - st->n_empty_leaves) < 1.5 * 2000);
+    CHECK(st->sah_cost < 0.1 * st->leaf_sah_cost);
+    fprintf(stderr, "  2000 tiny triangles: SAH cost %.1f (one leaf: %.1f), %.2f refs per triangle\n", st->sah_cost,
+            st->leaf_sah_cost, st->mean_prims_per_leaf * (st->n_leaves - st->n_empty_leaves) / 2000.0);
+}
+
+/* ------------------------------------------------------------------ traversal */
+
+static void test_against_brute_force(void)
+{
+    struct { uint64_t seed; uint ns, nt, nb, np; int rays; } cases[] = {
+        { 21, 40, 200, 25, 2, 30000 },
+        { 22, 0, 400, 0, 0, 30000 },
+        { 23, 120, 0, 60, 1, 20000 },
+        { 24, 10, 300, 10, 2, 30000 },
+    };
+    int total = 0, bad = 0;
+    for (int c = 0; c < 4; c++) {
+        random_scene(cases[c].seed, cases[c].ns, cases[c].nt, cases[c].nb, cases[c].np);
+        CHECK(scene_build(0) == ST_OK);
+        int hits = 0;
+        for (int i = 0; i < cases[c].rays; i++) {
+            Ray r = random_ray(-5.0f, 5.0f);
+            bad += !ray_agrees(r, bad < 5);
+            hits += trace_any(&scene.view, r);
+            total++;
+        }
+        CHECK(hits > cases[c].rays / 10);    /* the scenes are not trivially missed */
+    }
+    CHECK_EQ_INT(bad, 0);
+    fprintf(stderr, "  %d random rays, %d disagree with brute force\n", total, bad);
+}
+
+static void test_empty_scene(void)
+{
+    scene_clear();
+    CHECK(scene_build(0) == ST_OK);
+    CHECK_EQ_INT(scene.tree.n_nodes, 1);
+    CHECK_EQ_INT(scene.tree.nodes[0].bits, KD_LEAF);
+    CHECK_EQ_INT(scene.tree.stats.n_leaves, 1);
+    CHECK_EQ_INT(scene.tree.stats.n_empty_leaves, 1);
+    Ray r = make_ray(v3s(0.0f), v3(0.0f, 0.0f, 1.0f), 0.0f, K_INF);
+    CHECK_EQ_INT(trace_closest(&scene.view, r).prim, NO_INDEX);
+    CHECK(!trace_any(&scene.view, r));
+    /* planes alone (not in the tree) */
+    add_plane(v3(0.0f, 0.0f, 1.0f), 3.0f);
+    CHECK(scene_build(2) == ST_OK);
+    Hit h = trace_closest(&scene.view, r);
+    CHECK_EQ_INT(h.prim, 0);
+    CHECK_NEAR(h.t, 3.0f, 1e-6);
+    CHECK(trace_any(&scene.view, r));
+    r.tmax = 2.0f;
+    CHECK(!trace_any(&scene.view, r));
+    scene_clear();
+}
+
+/* Broken input must not break the build: primitives with NaN or inf are left out,
+ * zero-area triangles stay in (and are never hit). */
+static void test_bad_primitives(void)
+{
+    random_scene(31, 10, 100, 10, 0);
+    add_triangle(v3(NAN, 0.0f, 0.0f), v3(1.0f, 0.0f, 0.0f), v3(0.0f, 1.0f, 0.0f));
+    add_triangle(v3(0.0f, 0.0f, 0.0f), v3(INFINITY, 0.0f, 0.0f), v3(0.0f, 1.0f, 0.0f));
+    add_triangle(v3(1.0f, 1.0f, 1.0f), v3(1.0f, 1.0f, 1.0f), v3(1.0f, 1.0f, 1.0f));   /* a point */
+    add_triangle(v3(0.0f, 0.0f, 0.0f), v3(1.0f, 1.0f, 1.0f), v3(2.0f, 2.0f, 2.0f));   /* a line */
+    add_sphere(v3(0.0f, NAN, 0.0f), 1.0f);
+    add_box(v3(0.0f, 0.0f, 0.0f), v3(1.0f, -INFINITY, 1.0f));
+    CHECK(scene_build(0) == ST_OK);
+    CHECK_EQ_INT(scene.tree.stats.n_skipped, 4);
+    CHECK_EQ_INT(scene.tree.stats.n_prims, 10 + 100 + 10 + 2);
+    CHECK(isfinite(scene.tree.lo.x) && isfinite(scene.tree.hi.y));
+    check_tree();
+    int bad = 0;
+    for (int i = 0; i < 5000; i++) bad += !ray_agrees(random_ray(-5.0f, 5.0f), bad < 3);
+    CHECK_EQ_INT(bad, 0);
+}
+
+/* Axis-aligned flat triangles exactly on the planes the builder splits at, and rays
+ * along the axes (two zero direction components), starting inside and outside. */
+static void test_flat_on_split_planes(void)
+{
+    scene_clear();
+    /* A stack of unit squares at z = 0..7 and a wall of them at x = 0..7, with
+     * vertices on integer coordinates. */
+    for (int i = 0; i < 8; i++)
+        for (int a = 0; a < 4; a++)
+            for (int b = 0; b < 4; b++) {
+                float z = (float)i, x0 = (float)a, y0 = (float)b;
+                add_triangle(v3(x0, y0, z), v3(x0 + 1.0f, y0, z), v3(x0 + 1.0f, y0 + 1.0f, z));
+                add_triangle(v3(x0, y0, z), v3(x0 + 1.0f, y0 + 1.0f, z), v3(x0, y0 + 1.0f, z));
+                add_triangle(v3(z, x0 + 4.0f, y0), v3(z, x0 + 5.0f, y0), v3(z, x0 + 5.0f, y0 + 1.0f));
+            }
+    CHECK(scene_build(0) == ST_OK);
+    CHECK(scene.tree.stats.n_nodes > 1);
+    check_tree();
+    rng_seed(41);
+    int bad = 0, hits = 0, n = 0;
+    for (int i = 0; i < 20000; i++) {
+        vec3 o = vrand(-1.0f, 9.0f);
+        vec3 d;
+        int kind = i % 4;
+        if (kind == 0) d = v3(0.0f, 0.0f, frand() < 0.5f ? -1.0f : 1.0f);        /* along z */
+        else if (kind == 1) d = v3(frand() < 0.5f ? -1.0f : 1.0f, 0.0f, 0.0f);   /* along x */
+        else if (kind == 2) {                                                     /* integer origin */
+            o = v3((float)(int)frange(-1.0f, 9.0f), (float)(int)frange(-1.0f, 9.0f), (float)(int)frange(-1.0f, 9.0f));
+            d = vrand(-1.0f, 1.0f);
+        } else d = vrand(-1.0f, 1.0f);
+        Ray r = make_ray(o, d, 0.0f, K_INF);
+        bad += !ray_agrees(r, bad < 5);
+        hits += trace_closest(&scene.view, r).prim != NO_INDEX;
+        n++;
+    }
+    CHECK_EQ_INT(bad, 0);
+    CHECK(hits > n / 8);
+    fprintf(stderr, "  %d rays, %d hits, %d disagree with brute force\n", n, hits, bad);
+    /* rays lying in the planes of the squares (candidate split planes), parallel to
+     * them: they graze the squares (no hit) and meet the wall at x = 0 */
+    for (int z = 0; z < 8; z++) {
+        Ray in_plane = make_ray(v3(-1.0f, 5.5f, (float)z), v3(1.0f, 0.0f, 0.0f), 0.0f, K_INF);
+        Hit h = trace_closest(&scene.view, in_plane);
+        CHECK(ray_agrees(in_plane, 1));
+        if (z < 4) CHECK(h.prim != NO_INDEX && h.t == 1.0f);
+    }
+}
+
+/* The node array does not depend on the number of threads. */
+static void test_deterministic(void)
+{
+    scene_clear();
+    rng_seed(51);
+    for (int i = 0; i < 4000; i++) random_triangle(-10.0f, 10.0f, 0.4f);
+    for (int i = 0; i < 200; i++) add_sphere(vrand(-10.0f, 10.0f), frange(0.05f, 0.3f));
+    CHECK(scene_build(1) == ST_OK);
+    KdTree one = scene.tree;
+    memset(&scene.tree, 0, sizeof scene.tree);
+    const int threads[] = { 2, 3, 0 };
+    for (int i = 0; i < 3; i++) {
+        CHECK(scene_build(threads[i]) == ST_OK);
+        CHECK_EQ_INT(scene.tree.n_nodes, one.n_nodes);
+        CHECK_EQ_INT(scene.tree.n_leaf_prims, one.n_leaf_prims);
+        if (scene.tree.n_nodes == one.n_nodes)
+            CHECK(!memcmp(scene.tree.nodes, one.nodes, one.n_nodes * sizeof *one.nodes));
+        if (scene.tree.n_leaf_prims == one.n_leaf_prims)
+            CHECK(!memcmp(scene.tree.leaf_prims, one.leaf_prims, one.n_leaf_prims * sizeof(uint)));
+        kd_free(&scene.tree);
+    }
+    kd_free(&one);
+}
+
+int main(void)
+{
+    RUN(test_sphere);
+    RUN(test_triangle);
+    RUN(test_watertight);
+    RUN(test_box);
+    RUN(test_plane);
+    RUN(test_structure);
+    RUN(test_against_brute_force);
+    RUN(test_empty_scene);
+    RUN(test_bad_primitives);
+    RUN(test_flat_on_split_planes);
+    RUN(test_deterministic);
+    scene_clear();
+    return harness_report();
+}

@@ -43,6 +43,7 @@ static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *
 {
     PathState ps;
     Ray ray, shadow;
+    memset(&shadow, 0, sizeof shadow);   /* written by shade_path only when it traces one */
     uint64_t rays = 0;
     raygen_path(sc->params, pixel, sample, &ps, &ray);
     for (;;) {

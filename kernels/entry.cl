@@ -51,19 +51,42 @@ __kernel void k_intersect(SCENE_ARGS, __global const uint *queue, uint n,
 }
 
 /* Shades every queued path; counters[0] counts the next queue, counters[1] the shadow
- * rays. Their order in the queues varies from run to run, the paths' results do not. */
+ * rays. Their order in the queues varies from run to run, the paths' results do not.
+ * Slots are reserved per work-group (local atomics, then one global atomic_add per
+ * queue), because one global atomic per path made the shared counters the hottest
+ * cache line of the whole render on a CPU. No early return: every work-item must reach
+ * the barriers. */
 __kernel void k_shade(SCENE_ARGS, __global const uint *queue, uint n, __global Ray *rays,
                       __global const Hit *hits, __global PathState *paths,
                       __global Ray *shadow_rays, __global uint *next_queue,
                       __global uint *shadow_queue, __global uint *counters)
 {
+    __local uint group_count[2];
+    __local uint group_base[2];
     uint i = (uint)get_global_id(0);
-    if (i >= n) return;
-    SCENE_VIEW(sc);
-    uint path = queue[i];
-    uint r = shade_path(&sc, &rays[path], hits[path], &paths[path], &shadow_rays[path]);
-    if (r & SHADE_CONTINUE) next_queue[atomic_inc(&counters[0])] = path;
-    if (r & SHADE_SHADOW) shadow_queue[atomic_inc(&counters[1])] = path;
+    uint lid = (uint)get_local_id(0);
+    if (lid == 0u) {
+        group_count[0] = 0u;
+        group_count[1] = 0u;
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+    uint r = 0u, path = 0u;
+    if (i < n) {
+        SCENE_VIEW(sc);
+        path = queue[i];
+        r = shade_path(&sc, &rays[path], hits[path], &paths[path], &shadow_rays[path]);
+    }
+    uint slot_next = 0u, slot_shadow = 0u;
+    if (r & SHADE_CONTINUE) slot_next = atomic_inc(&group_count[0]);
+    if (r & SHADE_SHADOW) slot_shadow = atomic_inc(&group_count[1]);
+    barrier(CLK_LOCAL_MEM_FENCE);
+    if (lid == 0u) {
+        group_base[0] = group_count[0] ? atomic_add(&counters[0], group_count[0]) : 0u;
+        group_base[1] = group_count[1] ? atomic_add(&counters[1], group_count[1]) : 0u;
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+    if (r & SHADE_CONTINUE) next_queue[group_base[0] + slot_next] = path;
+    if (r & SHADE_SHADOW) shadow_queue[group_base[1] + slot_shadow] = path;
 }
 
 /* Any-hit test of every queued shadow ray, resolving the waiting contributions. */

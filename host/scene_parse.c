@@ -374,7 +374,7 @@ static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE, MAT_KEY_EMISSION, MAT_KEY_N };
+enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE, MAT_KEY_EMISSION, MAT_KEY_SIDES, MAT_KEY_N };
 static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0,
                       "a material type (diffuse, metal, dielectric, emissive)"},
@@ -383,6 +383,7 @@ static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_IOR] = {"ior", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
     [MAT_KEY_RADIANCE] = {"radiance", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_EMISSION] = {"emission", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_SIDES] = {"sides", VK_UINT, 0, 1, 2, 0, 0, "1 or 2 (the sides that emit)"},
 };
 
 /* Which keys each material type takes (bit i = material_keys[i]), and which it needs. */
@@ -391,10 +392,13 @@ static const struct {
     uint type;
     unsigned allowed, required;
 } material_types[] = {
-    {"diffuse", MAT_DIFFUSE, 1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_EMISSION, 1u << MAT_KEY_ALBEDO},
-    {"metal", MAT_METAL, 1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_FUZZ | 1u << MAT_KEY_EMISSION, 1u << MAT_KEY_ALBEDO},
-    {"dielectric", MAT_DIELECTRIC, 1u << MAT_KEY_IOR | 1u << MAT_KEY_EMISSION, 0},
-    {"emissive", MAT_EMISSIVE, 1u << MAT_KEY_RADIANCE, 1u << MAT_KEY_RADIANCE},
+    {"diffuse", MAT_DIFFUSE, 1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES,
+     1u << MAT_KEY_ALBEDO},
+    {"metal", MAT_METAL,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_FUZZ | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES,
+     1u << MAT_KEY_ALBEDO},
+    {"dielectric", MAT_DIELECTRIC, 1u << MAT_KEY_IOR | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES, 0},
+    {"emissive", MAT_EMISSIVE, 1u << MAT_KEY_RADIANCE | 1u << MAT_KEY_SIDES, 1u << MAT_KEY_RADIANCE},
 };
 #define N_MATERIAL_TYPES (sizeof material_types / sizeof material_types[0])
 
@@ -443,6 +447,7 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
     }
     /* a surface that both reflects and glows (the furnace test's sphere) */
     if (v[MAT_KEY_EMISSION].given) m.emission = v[MAT_KEY_EMISSION].v;
+    if (v[MAT_KEY_SIDES].given && v[MAT_KEY_SIDES].u == 2) m.flags |= MAT_TWO_SIDED;
     /* inline materials get the empty name, which no named material can have, so a
      * lookup never finds them */
     if ((st = scene_add_material(p->s, name ? name : "", m, index, p->err))) return st;

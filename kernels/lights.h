@@ -2,8 +2,10 @@
  * lights.h — next-event estimation: choosing an emissive primitive, sampling a point on
  * it as seen from a shading point, and the density of that choice (for multiple
  * importance sampling against BSDF sampling). All densities are per unit solid angle at
- * the shading point and include the probability of choosing the light. Emission is
- * two-sided: a light looks the same from either side of its surface.
+ * the shading point and include the probability of choosing the light. A light emits
+ * from its front side (outward for spheres and boxes, the winding normal's side for
+ * triangles) unless its material is MAT_TWO_SIDED; a sample of a point whose lit side
+ * faces away is rejected.
  */
 #ifndef CLPT_LIGHTS_H
 #define CLPT_LIGHTS_H
@@ -27,6 +29,14 @@ KFN uint prim_material(const SceneView *sc, uint prim)
     if (prim < first_box) return sc->triangles[prim - first_tri].material;
     if (prim < first_plane) return sc->boxes[prim - first_box].material;
     return sc->planes[prim - first_plane].material;
+}
+
+/* Whether primitive `prim` (a light) emits toward direction `toward` from a point with
+ * outward/winding normal n. */
+KFN int light_faces(const SceneView *sc, uint prim, vec3 n, vec3 toward)
+{
+    Material m = sc->materials[prim_material(sc, prim)];
+    return (m.flags & MAT_TWO_SIDED) || v3_dot(n, toward) > 0.0f;
 }
 
 /* Chooses a light with probability pick_pdf (binary search of the cdf) and rescales u
@@ -113,7 +123,7 @@ KFN int light_sample(const SceneView *sc, vec3 ref, float u_pick, float u1, floa
             ls->n = n;
             ls->p = v3_madd(sp.center, n, sp.radius);
             ls->pdf = l.pick_pdf / (K_TWO_PI * omc);
-            return ls->pdf > 0.0f;
+            return ls->pdf > 0.0f && light_faces(sc, l.prim, n, v3_sub(ref, ls->p));
         }
         /* on or inside the sphere: uniform over the whole surface */
         vec3 n = sample_sphere_dir(u1, u2);
@@ -146,7 +156,7 @@ KFN int light_sample(const SceneView *sc, vec3 ref, float u_pick, float u1, floa
         ls->n = v3(axis == 0 ? sign : 0.0f, axis == 1 ? sign : 0.0f, axis == 2 ? sign : 0.0f);
     }
     ls->pdf = light_pdf(sc, li, ref, ls->p, ls->n);
-    return ls->pdf > 0.0f;
+    return ls->pdf > 0.0f && light_faces(sc, l.prim, ls->n, v3_sub(ref, ls->p));
 }
 
 #endif /* CLPT_LIGHTS_H */

@@ -77,7 +77,7 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     Surface s = surface_at(sc, r, hit);
     Material m = sc->materials[s.material];
 
-    if (!v3_is_zero(m.emission)) {
+    if (!v3_is_zero(m.emission) && ((m.flags & MAT_TWO_SIDED) || v3_dot(r.d, s.ng) < 0.0f)) {
         /* emission reached by BSDF sampling is weighted against the light sampling that
          * could have found it too; after a delta bounce only BSDF sampling could */
         float w = 1.0f;

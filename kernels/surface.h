@@ -31,9 +31,11 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
     uint first_plane = first_box + p->n_boxes;
     if (id < first_tri) {
         Sphere sp = sc->spheres[id];
+        /* p stays o + t*d: projecting it onto the sphere (center + r*n) would round it to
+         * the precision of the centre's coordinates, 6e-5 for the One-Weekend ground
+         * (r = 1000 at y = -1000), far coarser than the error of t, and the surface
+         * would shadow itself in rings */
         vec3 n = v3_norm(v3_sub(s.p, sp.center));
-        /* re-project onto the sphere: o + t*d drifts off it by the error in t */
-        s.p = v3_madd(sp.center, n, sp.radius);
         s.ng = n;
         s.ns = n;
         s.material = sp.material;

@@ -86,8 +86,10 @@ typedef struct {                                        /* 32 bytes */
     uint pad0, pad1, pad2;
 } Plane;
 
-/* Every type may also emit `emission` (two-sided); a non-zero emission makes the
- * primitives with that material lights. */
+/* Every type may also emit `emission`; a non-zero emission makes the primitives with
+ * that material lights. Emission leaves the front side only (the side the outward normal
+ * of a sphere or box, or the winding normal (p1-p0)x(p2-p0) of a triangle, points to),
+ * unless the material has MAT_TWO_SIDED. */
 enum MaterialType {
     MAT_DIFFUSE = 0,     /* Lambertian, albedo */
     MAT_METAL = 1,       /* mirror reflection perturbed by fuzz, tinted by albedo */
@@ -101,9 +103,11 @@ typedef struct {                                        /* 64 bytes */
     float ior;
     float fuzz;
     vec3 albedo;    float shininess;
-    vec3 emission;  uint flags;
+    vec3 emission;  uint flags;   /* MAT_* flags */
     vec3 specular;  float pad0;
 } Material;
+
+#define MAT_TWO_SIDED 1u        /* emits from both sides of its surface */
 
 enum LightType { LIGHT_AREA = 0 };
 

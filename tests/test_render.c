@@ -25,6 +25,7 @@ static void furnace_scene(Scene *s, uint spp)
     s->camera.vfov = 90.0f;
     Material m = material_diffuse(v3s(0.5f));
     m.emission = v3s(0.5f);
+    m.flags = MAT_TWO_SIDED;   /* seen from inside */
     uint mi;
     scene_add_material(s, "furnace", m, &mi, NULL);
     Sphere sp = { v3(0.0f, 0.0f, 0.0f), 1.0f, mi, NO_INDEX, 0, 0 };

@@ -196,7 +196,7 @@ static void test_materials(void)
                           "material glass { type dielectric ior 1.33 }\n"
                           "material glass2 { type dielectric }\n"
                           "material lamp { type emissive radiance 4 3 2 }\n"
-                          "material glow { type diffuse albedo 0.5 0.5 0.5 emission 0.25 0.5 1 }\n",
+                          "material glow { type diffuse albedo 0.5 0.5 0.5 emission 0.25 0.5 1 sides 2 }\n",
                           &s, &err);
     CHECK_EQ_INT(st, ST_OK);
     CHECK_EQ_INT(s.n_materials, 7);
@@ -204,6 +204,8 @@ static void test_materials(void)
         CHECK_EQ_INT(s.materials[6].type, MAT_DIFFUSE);
         CHECK(vec_eq(s.materials[6].emission, 0.25f, 0.5f, 1.0f));
         CHECK(vec_eq(s.materials[0].emission, 0.0f, 0.0f, 0.0f));
+        CHECK_EQ_INT(s.materials[6].flags, MAT_TWO_SIDED);
+        CHECK_EQ_INT(s.materials[5].flags, 0);
         CHECK_EQ_INT(s.materials[0].type, MAT_DIFFUSE);
         CHECK(vec_eq(s.materials[0].albedo, 0.9f, 0.1f, 0.1f));
         CHECK_EQ_INT(s.materials[0].texture, NO_INDEX);
@@ -537,7 +539,7 @@ static void test_bad_materials_and_shapes(void)
               ":1:19: expected a material type (diffuse, metal, dielectric, emissive), found 'plastic'");
     check_bad("material m { albedo 1 1 1 }", ST_INPUT, ":1:1: the material block needs 'type' (it has no default)");
     check_bad("material m { type diffuse albedo 1 1 1 fuzz 0.5 }", ST_INPUT,
-              ":1:40: expected a diffuse material key (type, albedo, emission) or '}', found 'fuzz'");
+              ":1:40: expected a diffuse material key (type, albedo, emission, sides) or '}', found 'fuzz'");
     check_bad("material m { type metal albedo 1 1 1 fuzz 1.5 }", ST_INPUT,
               ":1:43: expected a number in [0, 1] for 'fuzz', found '1.5'");
     check_bad("material m { type dielectric ior 0 }", ST_INPUT, ":1:34: expected a number > 0 for 'ior', found '0'");

@@ -4,7 +4,11 @@
 #   make test       build and run the test suite (ends with "N passed, M failed")
 #   make render     render the default scene to cornell-box.png
 #   make bench      throughput benchmarks (bench/)
+#   make test-asan  the test suite built with AddressSanitizer + UBSan (build-asan/)
+#   make test-valgrind  small renders (PoCL and scalar) under valgrind memcheck
+#   make fuzz       each libFuzzer target in fuzz/ for FUZZ_SECONDS (build-fuzz/)
 #
+# docs/hardening.md describes the last three; docs/fuzzing.md how to add a fuzz target.
 # Every target first checks the system packages (tools/deps.sh): installs them when run
 # as root, prints the exact apt-get line otherwise.
 
@@ -34,11 +38,17 @@ HOST_OBJ  := $(HOST_SRC:host/%.c=$(BUILD)/host/%.o) $(BUILD)/kernel_source.o
 KERNELS   := $(wildcard kernels/*.h kernels/*.cl)
 TEST_SRC  := $(wildcard tests/test_*.c)
 TEST_BIN  := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
+# Every fuzz/fuzz_NAME.c is a libFuzzer target (make fuzz) and, linked with
+# fuzz/replay.c, the test build/tests/test_fuzz_NAME, which replays its regression files
+# (tests/data/fuzz/NAME/) and seed files through the same entry point.
+FUZZ_SRC  := $(wildcard fuzz/fuzz_*.c)
+FUZZ_REPLAY := $(FUZZ_SRC:fuzz/fuzz_%.c=$(BUILD)/tests/test_fuzz_%)
+FUZZ_BIN  := $(FUZZ_SRC:fuzz/%.c=$(BUILD)/fuzz/%)
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 DEPS_OK   := $(BUILD)/.deps-ok
 
-.PHONY: all deps test render bench clean
+.PHONY: all deps test render bench clean test-asan test-valgrind fuzz fuzz-build
 .DEFAULT_GOAL := all
 
 all: $(BUILD)/$(PROG)
@@ -84,7 +94,16 @@ $(BUILD)/$(PROG): $(BUILD)/host/main.o $(BUILD)/lib$(PROG).a
 
 $(BUILD)/tests/%: tests/%.c tests/harness.h $(BUILD)/lib$(PROG).a
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -MMD -MP -o $@ $< $(BUILD)/lib$(PROG).a $(LDFLAGS) $(LDLIBS)
+	$(CC) $(CPPFLAGS) -Itests -DCLPT_BUILD_DIR='"$(BUILD)"' $(CFLAGS) -MMD -MP -o $@ $< $(BUILD)/lib$(PROG).a $(LDFLAGS) $(LDLIBS)
+
+$(BUILD)/tests/test_fuzz_%: fuzz/fuzz_%.c fuzz/replay.c fuzz/fuzz.h tests/harness.h $(BUILD)/lib$(PROG).a
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) -Itests -Ifuzz -DFUZZ_NAME='"$*"' $(CFLAGS) -o $@ $< fuzz/replay.c $(BUILD)/lib$(PROG).a $(LDFLAGS) $(LDLIBS)
+
+# Only built by `make fuzz`, where CC is clang and the library is instrumented.
+$(BUILD)/fuzz/%: fuzz/%.c fuzz/fuzz.h $(BUILD)/lib$(PROG).a
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) -Ifuzz $(CFLAGS) -fsanitize=fuzzer -o $@ $< $(BUILD)/lib$(PROG).a $(LDFLAGS) $(LDLIBS)
 
 $(BUILD)/bench/%: bench/%.c $(BUILD)/lib$(PROG).a
 	@mkdir -p $(@D)
@@ -93,7 +112,7 @@ $(BUILD)/bench/%: bench/%.c $(BUILD)/lib$(PROG).a
 -include $(wildcard $(BUILD)/host/*.d $(BUILD)/tests/*.d $(BUILD)/bench/*.d)
 
 # ---------------------------------------------------------------- use
-test: deps $(BUILD)/$(PROG) $(TEST_BIN)
+test: deps $(BUILD)/$(PROG) $(TEST_BIN) $(FUZZ_REPLAY)
 	@sh tests/run.sh $(BUILD)
 
 render: deps $(BUILD)/$(PROG)
@@ -102,5 +121,34 @@ render: deps $(BUILD)/$(PROG)
 bench: deps $(BUILD)/$(PROG) $(BENCH_BIN)
 	@sh bench/run.sh $(BUILD)
 
+# ---------------------------------------------------------------- hardening
+# The sanitizer and fuzzing builds are the ordinary build in their own folders, with
+# clang and instrumentation: every host file and the scalar device (the kernels compiled
+# as C) are checked; the OpenCL runtime is not instrumented (tools/sanitizers/ says
+# what is suppressed there, and why).
+SAN_FLAGS  := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+SAN_ENV    := ASAN_OPTIONS=detect_stack_use_after_return=1:check_initialization_order=1:strict_init_order=1 \
+              LSAN_OPTIONS=suppressions=$(CURDIR)/tools/sanitizers/lsan.supp:print_suppressions=0 \
+              UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+FUZZ_SECONDS ?= 60
+
+test-asan:
+	@sh tools/deps.sh base sanitize
+	@$(SAN_ENV) $(MAKE) --no-print-directory BUILD=build-asan CC=clang OPT=-O1 \
+	    EXTRA_CFLAGS="$(SAN_FLAGS)" EXTRA_LDFLAGS="$(SAN_FLAGS)" test
+
+test-valgrind: deps $(BUILD)/$(PROG)
+	@sh tools/deps.sh valgrind
+	@sh tools/valgrind.sh $(BUILD)
+
+fuzz-build:
+	@sh tools/deps.sh base fuzz
+	@$(MAKE) --no-print-directory BUILD=build-fuzz CC=clang OPT=-O1 \
+	    EXTRA_CFLAGS="$(SAN_FLAGS) -fsanitize=fuzzer-no-link" EXTRA_LDFLAGS="$(SAN_FLAGS)" \
+	    $(FUZZ_SRC:fuzz/%.c=build-fuzz/fuzz/%)
+
+fuzz: fuzz-build
+	@$(SAN_ENV) sh tools/fuzz.sh build-fuzz $(FUZZ_SECONDS) $(FUZZ_SRC:fuzz/fuzz_%.c=%)
+
 clean:
-	rm -rf $(BUILD)
+	rm -rf $(BUILD) build-asan build-fuzz

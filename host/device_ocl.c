@@ -71,6 +71,14 @@ static Status make_buffer(OclDevice *od, cl_mem_flags flags, size_t bytes, const
         return error_set(err, ST_DEVICE,
                          "device '%s': the %s need %.1f MiB, more than the device's largest allocation (%.1f MiB)",
                          od->info.name, what, (double)size / 1048576.0, (double)od->info.max_alloc / 1048576.0);
+    /* CL_MEM_COPY_HOST_PTR copies `size` bytes: a source shorter than the 16-byte
+     * minimum (a leaf list of one index) goes through a zero-padded copy instead of
+     * being read past its end. */
+    unsigned char padded[16] = { 0 };
+    if (src && bytes && bytes < size) {
+        memcpy(padded, src, bytes);
+        src = padded;
+    }
     cl_int rc;
     *out = clCreateBuffer(od->ctx, flags | (src && bytes ? CL_MEM_COPY_HOST_PTR : 0), size,
                           src && bytes ? (void *)(uintptr_t)src : NULL, &rc);

@@ -48,6 +48,9 @@ void scene_free(Scene *s);
 
 /* Reads a scene file (docs/scene-format.md) into an initialised scene. */
 Status scene_load(const char *path, Scene *s, Error *err);
+/* The same for `len` bytes of scene text in memory (copied), named `path` in messages;
+ * included files and meshes are still read from disk, beside `path`. */
+Status scene_load_text(const char *path, const char *text, size_t len, Scene *s, Error *err);
 
 /* Appending; each fails only when memory runs out (ST_INTERNAL). */
 Status scene_add_material(Scene *s, const char *name, Material m, uint *index, Error *err);

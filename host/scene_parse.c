@@ -672,31 +672,39 @@ static const struct {
 };
 #define N_STATEMENTS (sizeof statements / sizeof statements[0])
 
-static Status parse_file(Parser *p, const char *path)
+static Status parse_statements(Parser *p, Lexer *lx)
 {
-    Lexer lx;
-    Status st = lex_open_file(&lx, path, p->err);
-    if (st) return st;
+    Status st;
     for (;;) {
         Token t;
-        if ((st = lex_next(&lx, &t, p->err)) || t.kind == TOK_EOF) break;
+        if ((st = lex_next(lx, &t, p->err)) || t.kind == TOK_EOF) break;
         size_t i = N_STATEMENTS;
         if (t.kind == TOK_WORD)
             for (i = 0; i < N_STATEMENTS; i++)
                 if (tok_is(&t, statements[i].keyword)) break;
         if (i == N_STATEMENTS) {
-            st = lex_expected(&lx, &t,
+            st = lex_expected(lx, &t,
                               "a statement (camera, image, background, material, sphere, "
                               "plane, triangle, quad, box, mesh, include)", p->err);
             break;
         }
-        if ((st = statements[i].parse(p, &lx, &t))) break;
+        if ((st = statements[i].parse(p, lx, &t))) break;
     }
+    return st;
+}
+
+static Status parse_file(Parser *p, const char *path)
+{
+    Lexer lx;
+    Status st = lex_open_file(&lx, path, p->err);
+    if (st) return st;
+    st = parse_statements(p, &lx);
     lex_close(&lx);
     return st;
 }
 
-Status scene_load(const char *path, Scene *s, Error *err)
+/* scene_load and scene_load_text: `text` NULL reads the file `path`. */
+static Status load(const char *path, const char *text, size_t len, Scene *s, Error *err)
 {
     free(s->path);
     size_t n = strlen(path);
@@ -707,11 +715,29 @@ Status scene_load(const char *path, Scene *s, Error *err)
     memset(&p, 0, sizeof p);
     p.s = s;
     p.err = err;
-    Status st = parse_file(&p, path);
+    Status st;
+    if (text) {
+        Lexer lx;
+        st = lex_open_text(&lx, path, text, len, err);
+        if (!st) st = parse_statements(&p, &lx);
+        lex_close(&lx);
+    } else {
+        st = parse_file(&p, path);
+    }
     free(p.camera_at);
     free(p.image_at);
     free(p.background_at);
     for (size_t i = 0; i < p.n_material_at; i++) free(p.material_at[i]);
     free(p.material_at);
     return st;
+}
+
+Status scene_load(const char *path, Scene *s, Error *err)
+{
+    return load(path, NULL, 0, s, err);
+}
+
+Status scene_load_text(const char *path, const char *text, size_t len, Scene *s, Error *err)
+{
+    return load(path, text, len, s, err);
 }

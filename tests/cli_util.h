@@ -11,7 +11,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#define CLI_PROGRAM "build/clpt"
+/* The Makefile passes its build folder (build, build-asan), so each build's tests run
+ * that build's program. */
+#ifndef CLPT_BUILD_DIR
+#define CLPT_BUILD_DIR "build"
+#endif
+#define CLI_PROGRAM CLPT_BUILD_DIR "/clpt"
 #define CLI_OUT_MAX 65536
 
 typedef struct {

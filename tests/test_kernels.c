@@ -111,7 +111,13 @@ static void build_scene(void)
 static cl_mem buffer(size_t bytes, const void *src)
 {
     cl_int rc;
-    if (bytes < 16) bytes = 16;
+    /* OpenCL has no buffers under 16 bytes here; a shorter source is padded, not read
+     * past its end */
+    unsigned char padded[16] = { 0 };
+    if (bytes < 16) {
+        if (src) src = memcpy(padded, src, bytes);
+        bytes = 16;
+    }
     cl_mem m = clCreateBuffer(cl.ctx, CL_MEM_READ_WRITE | (src ? CL_MEM_COPY_HOST_PTR : 0), bytes,
                               (void *)(uintptr_t)src, &rc);
     CHECK_MSG(rc == CL_SUCCESS, "clCreateBuffer: %s", ocl_error_name(rc));

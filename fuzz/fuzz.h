@@ -1,0 +1,37 @@
+/*
+ * fuzz.h — what every fuzz target includes (docs/fuzzing.md says how to add one).
+ *
+ * A target is one file, fuzz/fuzz_NAME.c, with
+ *
+ *     FUZZ_SEEDS("obj");           file extensions that seed the corpus
+ *     int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) { ...; return 0; }
+ *
+ * The Makefile finds it by its name. `make fuzz` builds it with libFuzzer, ASan and
+ * UBSan into build-fuzz/fuzz/fuzz_NAME, and tools/fuzz.sh runs it with a corpus seeded
+ * from the files under tests/data/ and scenes/ with those extensions (it reads the
+ * FUZZ_SEEDS line from the source). `make test` links the same file with fuzz/replay.c
+ * into build/tests/test_fuzz_NAME, which feeds it every file of tests/data/fuzz/NAME/
+ * (the regression files: each input that once crashed it) and the seed files.
+ *
+ * A target must not leak, must not print (the replay test and libFuzzer read stdout),
+ * and should abort() when the code under test breaks one of its own promises (a
+ * message-less error, an index out of range): libFuzzer saves such inputs like crashes.
+ */
+#ifndef CLPT_FUZZ_H
+#define CLPT_FUZZ_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+/* Space-separated file extensions, without dots. */
+#define FUZZ_SEEDS(exts) const char fuzz_seed_extensions[] = exts
+extern const char fuzz_seed_extensions[];
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+/* Stops the run when a promise of the code under test is broken: libFuzzer reports an
+ * abort as a crash and keeps the input. */
+#define FUZZ_ASSERT(cond) do { if (!(cond)) abort(); } while (0)
+
+#endif /* CLPT_FUZZ_H */

@@ -1,6 +1,8 @@
 /* device.c — listing, selecting and opening devices. */
 #include "device.h"
 
+#include "fault.h"
+
 #include <ctype.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,6 +28,7 @@ Status device_list(DeviceDesc **out, size_t *n, char *warning, size_t warning_si
         all[i].kind = DEVICE_OPENCL;
         all[i].index = (unsigned)i;
         all[i].ocl = ocl[i];
+        fault_device_memory((unsigned)i, &all[i].ocl.global_mem, &all[i].ocl.max_alloc);
         snprintf(all[i].name, sizeof all[i].name, "%s", ocl[i].name);
     }
     all[n_ocl].kind = DEVICE_SCALAR;

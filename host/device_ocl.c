@@ -12,6 +12,8 @@
 #include <string.h>
 
 #include "device.h"
+#include "device_memory.h"
+#include "fault.h"
 #include "ocl_program.h"
 #include "timer.h"
 
@@ -136,19 +138,20 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
         { s->lights, (size_t)p->n_lights * sizeof(Light), "lights" },
         { s->shading, (size_t)s->n_shading * sizeof(TriShading), "shading normals" },
     };
-    cl_ulong total = 0;
-    for (int i = 0; i < SCENE_N; i++) total += in[i].bytes;
     uint n_pixels = p->width * p->height;
     uint wave = od->wave_paths;
     size_t film_bytes = (size_t)n_pixels * 3u * sizeof(cl_long);
-    cl_ulong wave_bytes = (cl_ulong)wave * (sizeof(PathState) + 2 * sizeof(Ray) + sizeof(Hit) + 3 * sizeof(uint));
-    if (total + film_bytes + wave_bytes > od->info.global_mem)
-        return error_set(err, ST_DEVICE,
-                         "device '%s': the scene (%.1f MiB), film (%.1f MiB) and path buffers (%.1f MiB) "
-                         "do not fit its %.1f MiB of memory",
-                         od->info.name, (double)total / 1048576.0, (double)film_bytes / 1048576.0,
-                         (double)wave_bytes / 1048576.0, (double)od->info.global_mem / 1048576.0);
-    Status st;
+    /* every buffer below, checked against the device before the first is allocated */
+    DeviceBuffer fit[SCENE_N + 5];
+    for (int i = 0; i < SCENE_N; i++) fit[i] = (DeviceBuffer){ in[i].what, in[i].bytes };
+    fit[SCENE_N + 0] = (DeviceBuffer){ "path states", (uint64_t)wave * sizeof(PathState) };
+    fit[SCENE_N + 1] = (DeviceBuffer){ "rays and shadow rays", (uint64_t)wave * 2 * sizeof(Ray) };
+    fit[SCENE_N + 2] = (DeviceBuffer){ "hits", (uint64_t)wave * sizeof(Hit) };
+    fit[SCENE_N + 3] = (DeviceBuffer){ "path queues", (uint64_t)wave * 3 * sizeof(uint) };
+    fit[SCENE_N + 4] = (DeviceBuffer){ "film", film_bytes };
+    Status st = device_memory_check(od->info.name, od->info.global_mem, od->info.max_alloc, fit,
+                                    SCENE_N + 5, err);
+    if (st) return st;
     for (int i = 0; i < SCENE_N; i++)
         if ((st = make_buffer(od, CL_MEM_READ_ONLY, in[i].bytes, in[i].src, in[i].what, &od->scene[i], err)))
             return st;
@@ -325,7 +328,8 @@ static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error
     od->queue = clCreateCommandQueue(od->ctx, od->info.id, 0, &rc);
     if (rc != CL_SUCCESS) return ocl_fail(err, &od->info, "clCreateCommandQueue", rc);
     OclProgramStats ps;
-    Status st = ocl_program_build(od->ctx, &od->info, cfg ? cfg->kernel_dir : NULL, NULL, &od->program, &ps, err);
+    Status st = ocl_program_build(od->ctx, &od->info, cfg ? cfg->kernel_dir : NULL,
+                                  fault_build_options(d->desc.index), &od->program, &ps, err);
     if (st) return st;
     d->counters.compile_seconds = ps.seconds;
     d->counters.from_cache = ps.from_cache;

@@ -1,13 +1,15 @@
 /* film.c — the host's fixed-point accumulator and its conversion to radiance. */
 #include "film.h"
 
+#include "fault.h"
+
 #include <stdlib.h>
 #include <string.h>
 
 Status film_init(Film *f, uint width, uint height, Error *err)
 {
     memset(f, 0, sizeof *f);
-    f->sum = calloc((size_t)width * height * 3u, sizeof *f->sum);
+    if (!fault_alloc_fails("film")) f->sum = calloc((size_t)width * height * 3u, sizeof *f->sum);
     if (!f->sum)
         return error_set(err, ST_INTERNAL, "out of memory for a %ux%u film", width, height);
     f->width = width;

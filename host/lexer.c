@@ -1,12 +1,15 @@
 /* lexer.c — whitespace-separated tokens with positions (see lexer.h). */
 #include "lexer.h"
 
+#include "limit.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 Status lex_open_text(Lexer *lx, const char *path, const char *text, size_t len, Error *err)
 {
@@ -33,12 +36,35 @@ Status lex_read_file(const char *path, char **data, size_t *len, Error *err)
     FILE *f = fopen(path, "rb");
     if (!f) return error_set(err, ST_IO, "cannot open '%s': %s", path, strerror(errno));
     size_t cap = 1 << 16, n = 0;
+    struct stat sb;
+    if (fstat(fileno(f), &sb) == 0) {
+        /* /dev/zero or /dev/urandom would be read until memory runs out; a pipe
+         * (`clpt <(gen-scene)`) is read, up to the size limit */
+        if (S_ISCHR(sb.st_mode) || S_ISBLK(sb.st_mode)) {
+            fclose(f);
+            return error_set(err, ST_IO, "cannot read '%s': it is a device, not a file", path);
+        }
+        if (S_ISREG(sb.st_mode)) {
+            Status st = limit_file_size(path, (uint64_t)sb.st_size, err);
+            if (st) {
+                fclose(f);
+                return st;
+            }
+            /* the whole file and the NUL in one allocation */
+            if ((uint64_t)sb.st_size + 2 > cap) cap = (size_t)sb.st_size + 2;
+        }
+    }
     char *buf = malloc(cap);
     if (!buf) {
         fclose(f);
         return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
     }
     for (;;) {
+        if (n > CLPT_MAX_FILE_BYTES) {
+            free(buf);
+            fclose(f);
+            return limit_file_size(path, n, err);
+        }
         if (cap - n < 2) {
             char *grown = cap <= ((size_t)-1) / 2 ? realloc(buf, cap * 2) : NULL;
             if (!grown) {

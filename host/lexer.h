@@ -49,13 +49,15 @@ typedef struct {
     size_t line_start;   /* offset of the current line's first byte */
 } Lexer;
 
-/* Reads the whole file. ST_IO "cannot open 'path': <strerror>" when it cannot. */
+/* Reads the whole file. ST_IO "cannot open 'path': <strerror>" when it cannot, or when
+ * it is a device (/dev/zero); ST_INPUT when it is larger than CLPT_MAX_FILE_BYTES
+ * (limit.h), checked before reading when the size is known. */
 Status lex_open_file(Lexer *lx, const char *path, Error *err);
 /* Lexes `len` bytes of `text` (copied), reported under the name `path`. */
 Status lex_open_text(Lexer *lx, const char *path, const char *text, size_t len, Error *err);
 void lex_close(Lexer *lx);
 /* Reads a whole file into a NUL-terminated heap buffer (*data, *len without the NUL);
- * the same ST_IO message as lex_open_file. Used by loaders that do their own lexing. */
+ * the same errors as lex_open_file. Used by loaders that do their own lexing. */
 Status lex_read_file(const char *path, char **data, size_t *len, Error *err);
 
 /* The next token (TOK_EOF at the end, repeatedly). Fails on an unterminated string,

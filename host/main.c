@@ -12,6 +12,7 @@
 #include "device.h"
 #include "film.h"
 #include "image_write.h"
+#include "limit.h"
 #include "options.h"
 #include "progress.h"
 #include "render_scene.h"
@@ -176,7 +177,8 @@ static Status open_devices(const Options *o, const DeviceScene *ds, Device ***ou
         if (n_chosen > 1) {
             print_warning(NULL, last.msg);
             if (last.detail) fprintf(stderr, "%s\n", last.detail);
-            fprintf(stderr, "clpt: warning: device '%s' dropped; rendering with the others\n", all[chosen[i]].name);
+            fprintf(stderr, "clpt: warning: device %u '%s' dropped; rendering with the others\n",
+                    all[chosen[i]].index, all[chosen[i]].name);
         }
     }
     free(all);
@@ -240,6 +242,9 @@ static Status run(int argc, char **argv, Error *err)
     if ((st = image_format_from_path(output, &format, err))) goto done;
     if ((st = scene_load(o.scene_path, &scene, err))) goto done;
     apply_overrides(&o, &scene);
+    if ((o.width >= 0 || o.height >= 0) &&
+        (st = limit_pixels(scene.image.width, scene.image.height, ST_USAGE, "--width/--height", err)))
+        goto done;
     if ((st = render_scene_prepare(&scene, 0, &rs, err))) goto done;
     const DeviceScene *ds = &rs.ds;
     if (o.stats) print_scene_stats(&scene, &rs.kd);

@@ -1,6 +1,8 @@
 /* options.c — command-line parsing, strict: every value is checked whole and in range. */
 #include "options.h"
 
+#include "limit.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -128,11 +130,11 @@ Status options_parse(int argc, char **argv, Options *o, Error *err)
         if (IS("--device")) { if (!(v = VALUE())) return ST_USAGE; o->device_spec = v; continue; }
         if (IS("--kernel-dir")) { if (!(v = VALUE())) return ST_USAGE; o->kernel_dir = v; continue; }
         struct { const char *name; long lo, hi; long *dst; } ints[] = {
-            { "--spp", 1, 1000000, &o->spp },
-            { "--width", 1, 16384, &o->width },
-            { "--height", 1, 16384, &o->height },
+            { "--spp", 1, CLPT_MAX_SPP, &o->spp },
+            { "--width", 1, CLPT_MAX_IMAGE_SIDE, &o->width },
+            { "--height", 1, CLPT_MAX_IMAGE_SIDE, &o->height },
             { "--seed", 0, 4294967295L, &o->seed },
-            { "--max-depth", 0, 1024, &o->max_depth },
+            { "--max-depth", 0, CLPT_MAX_DEPTH, &o->max_depth },
         };
         int matched = 0;
         for (size_t k = 0; k < sizeof ints / sizeof ints[0]; k++) {

@@ -12,6 +12,7 @@
 
 #include "kmath.h"
 #include "lexer.h"
+#include "limit.h"
 #include "obj.h"
 
 #include <math.h>
@@ -19,8 +20,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define INCLUDE_DEPTH_MAX 16
 
 typedef enum {
     VK_NUMBER,      /* one float within the key's range */
@@ -311,10 +310,12 @@ static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
 
 enum { IMG_WIDTH, IMG_HEIGHT, IMG_SPP, IMG_DEPTH, IMG_SEED, IMG_N };
 static const KeySpec image_keys[IMG_N] = {
-    [IMG_WIDTH] = {"width", VK_UINT, 0, 1, 16384, 0, 0, "an integer in 1..16384"},
-    [IMG_HEIGHT] = {"height", VK_UINT, 0, 1, 16384, 0, 0, "an integer in 1..16384"},
-    [IMG_SPP] = {"spp", VK_UINT, 0, 1, 1000000, 0, 0, "an integer in 1..1000000"},
-    [IMG_DEPTH] = {"depth", VK_UINT, 0, 0, 1024, 0, 0, "an integer in 0..1024"},
+    [IMG_WIDTH] = {"width", VK_UINT, 0, 1, CLPT_MAX_IMAGE_SIDE, 0, 0,
+                   "an integer in 1.." CLPT_STR(CLPT_MAX_IMAGE_SIDE)},
+    [IMG_HEIGHT] = {"height", VK_UINT, 0, 1, CLPT_MAX_IMAGE_SIDE, 0, 0,
+                    "an integer in 1.." CLPT_STR(CLPT_MAX_IMAGE_SIDE)},
+    [IMG_SPP] = {"spp", VK_UINT, 0, 1, CLPT_MAX_SPP, 0, 0, "an integer in 1.." CLPT_STR(CLPT_MAX_SPP)},
+    [IMG_DEPTH] = {"depth", VK_UINT, 0, 0, CLPT_MAX_DEPTH, 0, 0, "an integer in 0.." CLPT_STR(CLPT_MAX_DEPTH)},
     [IMG_SEED] = {"seed", VK_UINT, 0, 0, 4294967295.0, 0, 0, "an integer in 0..4294967295"},
 };
 
@@ -330,6 +331,12 @@ static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
     if (v[IMG_SPP].given) im->spp = (uint)v[IMG_SPP].u;
     if (v[IMG_DEPTH].given) im->max_depth = (uint)v[IMG_DEPTH].u;
     if (v[IMG_SEED].given) im->seed = (uint)v[IMG_SEED].u;
+    if (limit_pixels(im->width, im->height, ST_INPUT, "", NULL) != ST_OK) {
+        const Token *t = v[IMG_HEIGHT].given ? &v[IMG_HEIGHT].key : &v[IMG_WIDTH].key;
+        return lex_error_at(lx, t, p->err,
+                            "an image of %ux%u pixels is larger than clpt renders (at most %u "
+                            "pixels, as in 16384x8192)", im->width, im->height, CLPT_MAX_PIXELS);
+    }
     return ST_OK;
 }
 
@@ -642,11 +649,11 @@ static Status parse_include(Parser *p, Lexer *lx, const Token *kw)
     if (st) return st;
     if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
         return lex_expected(lx, &t, "a file name after 'include'", p->err);
-    if (p->depth + 1 >= INCLUDE_DEPTH_MAX) {
+    if (p->depth + 1 >= CLPT_MAX_INCLUDE_DEPTH) {
         p->depth_exceeded = 1;
         return lex_error_at(lx, kw, p->err,
                             "includes nested more than %d deep (does a file include itself?)",
-                            INCLUDE_DEPTH_MAX);
+                            CLPT_MAX_INCLUDE_DEPTH);
     }
     char *path = path_beside(lx->path, t.text, t.len);
     if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");

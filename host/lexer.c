@@ -246,6 +246,23 @@ char *tok_copy(const Token *tok)
     return s;
 }
 
+/* Length of the UTF-8 sequence starting at s (a byte >= 0x80), or 0 when it is not a
+ * valid one: the bytes of a binary file are then shown as \xNN, so that messages stay
+ * valid text. */
+static size_t utf8_length(const char *s, size_t avail)
+{
+    const unsigned char *u = (const unsigned char *)s;
+    size_t k = u[0] >= 0xf0 && u[0] <= 0xf4 ? 4 : u[0] >= 0xe0 ? 3 : u[0] >= 0xc2 && u[0] <= 0xdf ? 2 : 0;
+    if (u[0] > 0xf4 || k == 0 || k > avail) return 0;
+    for (size_t j = 1; j < k; j++)
+        if ((u[j] & 0xc0) != 0x80) return 0;
+    /* overlong or surrogate forms, and code points above U+10FFFF */
+    if ((u[0] == 0xe0 && u[1] < 0xa0) || (u[0] == 0xed && u[1] >= 0xa0) ||
+        (u[0] == 0xf0 && u[1] < 0x90) || (u[0] == 0xf4 && u[1] >= 0x90))
+        return 0;
+    return k;
+}
+
 void tok_describe(const Token *tok, char *buf, size_t size)
 {
     if (size == 0) return;
@@ -260,15 +277,19 @@ void tok_describe(const Token *tok, char *buf, size_t size)
     int quoted = tok->kind == TOK_STRING;
     if (quoted && ROOM(1)) buf[o++] = '"';
     size_t i;
-    for (i = 0; i < tok->len && i < SHOWN; i++) {
+    for (i = 0; i < tok->len && i < SHOWN;) {
         unsigned char c = (unsigned char)tok->text[i];
-        if (is_control(c)) {
+        size_t k = c < 0x80 ? 1 : utf8_length(tok->text + i, tok->len - i);
+        if (is_control(c) || k == 0) {
             if (!ROOM(4)) break;
             snprintf(buf + o, size - o, "\\x%02x", c);
             o += 4;
+            i++;
         } else {
-            if (!ROOM(1)) break;
-            buf[o++] = (char)c;
+            if (!ROOM(k)) break;
+            memcpy(buf + o, tok->text + i, k);
+            o += k;
+            i += k;
         }
     }
     if (i < tok->len && ROOM(3)) {

@@ -70,7 +70,7 @@ int tok_is(const Token *tok, const char *word);
 char *tok_copy(const Token *tok);
 /* Writes a short printable rendering of the token into buf, for messages: the word,
  * the string in quotes, or "end of file"; long tokens are cut with "...", control
- * bytes shown as \xNN. */
+ * bytes and bytes that are not UTF-8 shown as \xNN. */
 void tok_describe(const Token *tok, char *buf, size_t size);
 
 /* ST_INPUT "path:line:col: expected <what>, found '<token>'" at the token. */

@@ -1,0 +1,140 @@
+/*
+ * test_device_errors.c — OpenCL failures as the user meets them, by running the
+ * program: a kernel that does not build (exit 5 with the device, the call, the options
+ * and the whole build log), a device too small for the render (checked before any
+ * upload), and either failure on one of two devices (that device is dropped with a
+ * warning and the other renders). Two PoCL devices are made with POCL_DEVICES; the
+ * failures on one of them with the test-only variables of host/fault.h.
+ */
+
+#include "cli_util.h"
+#include "device_memory.h"
+#include "harness.h"
+
+static CliResult r;   /* large: static */
+
+#define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
+#define SMALL "--width", "16", "--height", "12", "--spp", "2"
+#define OUT "/tmp/clpt-test-device-errors.png"
+
+static void test_broken_kernel_dir(void)
+{
+    char dir[] = "/tmp/clpt-test-kdir-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char path[300];
+    snprintf(path, sizeof path, "%s/entry.cl", dir);
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    if (!f) return;
+    fputs("__kernel void k_raygen(__global float *out)\n{\n    out[0] = clpt_undefined_on_purpose;\n}\n", f);
+    fclose(f);
+    unlink(OUT);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--kernel-dir", dir, SMALL, "-o", OUT), &r);
+    CHECK_EQ_INT(r.status, 5);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: device 'pthread");                   /* the device */
+    CHECK_STR_CONTAINS(r.err, "clBuildProgram failed: CL_BUILD_PROGRAM_FAILURE"); /* call, error name */
+    CHECK_STR_CONTAINS(r.err, "options \"-cl-std=CL1.2");                         /* the options */
+    char inc[320];
+    snprintf(inc, sizeof inc, "-I %s\"", dir);
+    CHECK_STR_CONTAINS(r.err, inc);
+    CHECK_STR_CONTAINS(r.err, "(build log follows)");
+    CHECK_STR_CONTAINS(r.err, "entry.cl:3:");                                     /* the log itself */
+    CHECK_STR_CONTAINS(r.err, "clpt_undefined_on_purpose");
+    CHECK(!file_exists(OUT));
+    unlink(path);
+    rmdir(dir);
+}
+
+static void test_build_failure_on_one_device(void)
+{
+    setenv("CLPT_TEST_BUILD_FAIL", "1", 1);
+    unlink(OUT);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0,1", SMALL, "-o", OUT), &r);
+    CHECK_MSG(r.status == 0, "exit %d: %s", r.status, r.err);
+    CHECK_STR_CONTAINS(r.err, "clBuildProgram failed: CL_BUILD_PROGRAM_FAILURE");
+    CHECK_STR_CONTAINS(r.err, "unknown type name 'clpt_test_build_failure_forced_by_CLPT_TEST_BUILD_FAIL'");
+    CHECK_STR_CONTAINS(r.err, "clpt: warning: device 1 'pthread");
+    CHECK_STR_CONTAINS(r.err, "dropped; rendering with the others");
+    CHECK_STR_CONTAINS(r.err, "rendered 16x12, 2 spp");
+    CHECK(file_exists(OUT));
+    /* alone, the same device is an error */
+    unlink(OUT);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "1", SMALL, "-o", OUT), &r);
+    CHECK_EQ_INT(r.status, 5);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: device 'pthread");
+    CHECK_STR_CONTAINS(r.err, "-D__kernel=clpt_test_build_failure_forced_by_CLPT_TEST_BUILD_FAIL");
+    CHECK(!file_exists(OUT));
+    unsetenv("CLPT_TEST_BUILD_FAIL");
+}
+
+static void test_device_too_small(void)
+{
+    /* 1 MiB: the path-state buffer alone is larger */
+    setenv("CLPT_TEST_DEVICE_MEMORY", "0:1048576", 1);
+    cli_run(ARGS("--list-devices"), &r);
+    CHECK_STR_CONTAINS(r.out, "1 MiB");
+    unlink(OUT);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", SMALL, "-o", OUT), &r);
+    CHECK_EQ_INT(r.status, 5);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: device 'pthread");
+    CHECK_STR_CONTAINS(r.err, "the path states need 4.0 MiB in one buffer, more than its largest allocation (1.0 MiB)");
+    CHECK(!file_exists(OUT));
+    /* 8 MB: every buffer fits alone, not all together */
+    setenv("CLPT_TEST_DEVICE_MEMORY", "0:8000000", 1);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", SMALL, "-o", OUT), &r);
+    CHECK_EQ_INT(r.status, 5);
+    CHECK_STR_CONTAINS(r.err, "the render needs 9.8 MiB (path states 4.0 MiB, rays and shadow rays 4.0 MiB");
+    CHECK_STR_CONTAINS(r.err, "more than its 7.6 MiB of memory");
+    /* fewer paths per wave fit */
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--wave-paths", "4096", SMALL, "-o", OUT), &r);
+    CHECK_MSG(r.status == 0, "exit %d: %s", r.status, r.err);
+    CHECK(file_exists(OUT));
+    unsetenv("CLPT_TEST_DEVICE_MEMORY");
+}
+
+static void test_small_device_dropped(void)
+{
+    setenv("CLPT_TEST_DEVICE_MEMORY", "1:1048576", 1);
+    unlink(OUT);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0,1", SMALL, "-o", OUT), &r);
+    CHECK_MSG(r.status == 0, "exit %d: %s", r.status, r.err);
+    CHECK_STR_CONTAINS(r.err, "more than its largest allocation (1.0 MiB)");
+    CHECK_STR_CONTAINS(r.err, "clpt: warning: device 1 'pthread");
+    CHECK(file_exists(OUT));
+    /* both too small: nothing can render */
+    setenv("CLPT_TEST_DEVICE_MEMORY", "0:1048576,1:1048576", 1);
+    unlink(OUT);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0,1", SMALL, "-o", OUT), &r);
+    CHECK_EQ_INT(r.status, 5);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: none of the 2 chosen devices could be used");
+    CHECK(!file_exists(OUT));
+    unsetenv("CLPT_TEST_DEVICE_MEMORY");
+    unlink(OUT);
+}
+
+static void test_memory_check(void)
+{
+    DeviceBuffer b[3] = { { "triangles", 600 << 20 }, { "film", 100 << 20 }, { "hits", 300 << 20 } };
+    Error err = { 0 };
+    CHECK_EQ_INT(device_memory_check("gpu", 1000u << 20, 600u << 20, b, 3, &err), ST_OK);
+    CHECK_EQ_INT(device_memory_check("gpu", 1000u << 20, 599u << 20, b, 3, &err), ST_DEVICE);
+    CHECK_STR_CONTAINS(err.msg, "device 'gpu': the triangles need 600.0 MiB in one buffer, more than its "
+                                "largest allocation (599.0 MiB)");
+    CHECK_EQ_INT(device_memory_check("gpu", 999u << 20, 600u << 20, b, 3, &err), ST_DEVICE);
+    CHECK_STR_CONTAINS(err.msg, "device 'gpu': the render needs 1000.0 MiB (triangles 600.0 MiB, hits 300.0 MiB, "
+                                "film 100.0 MiB), more than its 999.0 MiB of memory");
+    CHECK_STR_CONTAINS(err.msg, "lower --wave-paths");
+    error_clear(&err);
+}
+
+int main(void)
+{
+    /* before anything loads the ICD in a child: two PoCL CPU devices, 0 and 1 */
+    setenv("POCL_DEVICES", "pthread pthread", 1);
+    RUN(test_memory_check);
+    RUN(test_broken_kernel_dir);
+    RUN(test_build_failure_on_one_device);
+    RUN(test_device_too_small);
+    RUN(test_small_device_dropped);
+    return harness_report();
+}

@@ -504,10 +504,16 @@ static Status parse_sphere(Parser *p, Lexer *lx, const Token *kw)
     Value v[SPH_N];
     Status st = parse_block(p, lx, kw, 0, "sphere", sphere_keys, SPH_N, v);
     if (st) return st;
+    vec3 c = v[SPH_CENTER].v;
+    float r = v[SPH_RADIUS].f;
+    /* a bounding box that overflows would leave the sphere out of the kd-tree */
+    if (!isfinite(fabsf(c.x) + r) || !isfinite(fabsf(c.y) + r) || !isfinite(fabsf(c.z) + r))
+        return lex_error_at(lx, &v[SPH_RADIUS].key, p->err,
+                            "the sphere reaches beyond the largest float (about 3.4e38)");
     Sphere sp;
     memset(&sp, 0, sizeof sp);
-    sp.center = v[SPH_CENTER].v;
-    sp.radius = v[SPH_RADIUS].f;
+    sp.center = c;
+    sp.radius = r;
     sp.material = v[SPH_MATERIAL].material;
     return scene_add_sphere(p->s, sp, p->err);
 }
@@ -542,6 +548,10 @@ static Status add_triangle(Parser *p, const Lexer *lx, const Token *kw, vec3 a, 
 {
     double area2;
     cross_d(v3_sub(b, a), v3_sub(c, a), &area2);
+    /* the kernels compute edges in float: corners 6e38 apart give infinite edges */
+    if (isnan(area2) || isinf(area2))
+        return lex_error_at(lx, kw, p->err, "%.*s: the corners %s are too far apart (their "
+                            "differences overflow single precision)", (int)kw->len, kw->text, which);
     if (!(area2 > 0.0))
         return lex_error_at(lx, kw, p->err, "degenerate %.*s: the corners %s lie on one line",
                             (int)kw->len, kw->text, which);

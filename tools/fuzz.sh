@@ -5,7 +5,8 @@
 # Each target's corpus lives in BUILD/corpus/NAME (kept between runs, so later runs
 # start where earlier ones stopped); it is seeded with the target's regression files
 # (tests/data/fuzz/NAME/) and the files under tests/data/ and scenes/ whose extension
-# is in the target's FUZZ_SEEDS("...") line. A crash, leak, timeout (-timeout) or
+# is in the target's FUZZ_SEEDS("...") line; fuzz/fuzz_NAME.dict, when there is one, is
+# its dictionary. A crash, leak, timeout (-timeout) or
 # out-of-memory (-rss_limit_mb, -malloc_limit_mb) fails the run; the input is saved in
 # BUILD/artifacts/NAME/. One line per target goes to BUILD/fuzz-report.txt: executions,
 # seconds, executions per second, corpus size and the outcome.
@@ -31,12 +32,15 @@ for name in "$@"; do
             while read -r f; do cp "$f" "$seeds/$(echo "$f" | tr / _)"; done
     done
     [ -d "tests/data/fuzz/$name" ] && cp tests/data/fuzz/"$name"/* "$seeds/" 2>/dev/null
+    # an optional dictionary, fuzz/fuzz_NAME.dict: the format's words, for mutations
+    dict=""
+    [ -f "fuzz/fuzz_$name.dict" ] && dict="-dict=fuzz/fuzz_$name.dict"
     start=$(date +%s)
     # -timeout: seconds for one input; -rss_limit_mb/-malloc_limit_mb: a parser that
     # allocates that much for inputs of a few kilobytes is a bug (limits before
     # allocation); -max_len: the longest seed (the shipped scenes) fits.
     "$bin" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
-        -max_len=8192 -print_final_stats=1 -artifact_prefix="$artifacts" \
+        -max_len=8192 -print_final_stats=1 -artifact_prefix="$artifacts" $dict \
         "$corpus" "$seeds" >"$log" 2>&1
     rc=$?
     secs=$(( $(date +%s) - start ))
@@ -53,8 +57,8 @@ for name in "$@"; do
     line="fuzz_$name: $runs runs in ${secs} s ($rate/s), corpus $files files: $outcome"
     echo "$line" | tee -a "$report"
     if [ "$rc" -ne 0 ]; then
-        echo "    log: $log; the input is in $artifacts" >&2
-        echo "    make it a regression file: cp ${artifacts}crash-... tests/data/fuzz/$name/, then fix" >&2
+        echo "    log: $log; the input: $(ls "$artifacts" | sed "s|^|$artifacts|" | tr '\n' ' ')" >&2
+        echo "    make it a regression file (docs/fuzzing.md): copy it to tests/data/fuzz/$name/, then fix" >&2
         tail -n 30 "$log" | sed 's/^/    /' >&2
     fi
 done

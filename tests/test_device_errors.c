@@ -13,6 +13,35 @@
 
 static CliResult r;   /* large: static */
 
+/* The --list-devices indices of the two PoCL devices ("0" and "1" where PoCL is the
+ * only OpenCL platform), as --device and the fault variables take them. */
+static char pocl_a[8] = "0", pocl_b[8] = "1", pocl_ab[20] = "0,1";
+static char cap_a[40], cap_b[40], cap_ab[80], fail_b[8];
+
+static void find_pocl_devices(void)
+{
+    cli_run((const char *const[]){ "--list-devices", NULL }, &r);
+    unsigned idx[2];
+    int n = 0;
+    char *save = NULL;
+    for (char *line = strtok_r(r.out, "\n", &save); line && n < 2; line = strtok_r(NULL, "\n", &save)) {
+        unsigned i;
+        char kind[16];
+        if (sscanf(line, "%u %15s", &i, kind) == 2 && strcmp(kind, "opencl") == 0 && strstr(line, "pthread"))
+            idx[n++] = i;
+    }
+    if (n == 2) {
+        snprintf(pocl_a, sizeof pocl_a, "%u", idx[0]);
+        snprintf(pocl_b, sizeof pocl_b, "%u", idx[1]);
+        snprintf(pocl_ab, sizeof pocl_ab, "%u,%u", idx[0], idx[1]);
+    }
+    CHECK_MSG(n == 2, "expected two PoCL devices in --list-devices, found %d", n);
+    snprintf(cap_a, sizeof cap_a, "%s:1048576", pocl_a);
+    snprintf(cap_b, sizeof cap_b, "%s:1048576", pocl_b);
+    snprintf(cap_ab, sizeof cap_ab, "%s,%s", cap_a, cap_b);
+    snprintf(fail_b, sizeof fail_b, "%s", pocl_b);
+}
+
 #define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
 #define SMALL "--width", "16", "--height", "12", "--spp", "2"
 #define OUT "/tmp/clpt-test-device-errors.png"
@@ -29,7 +58,7 @@ static void test_broken_kernel_dir(void)
     fputs("__kernel void k_raygen(__global float *out)\n{\n    out[0] = clpt_undefined_on_purpose;\n}\n", f);
     fclose(f);
     unlink(OUT);
-    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--kernel-dir", dir, SMALL, "-o", OUT), &r);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", pocl_a, "--kernel-dir", dir, SMALL, "-o", OUT), &r);
     CHECK_EQ_INT(r.status, 5);
     CHECK_STR_CONTAINS(r.err, "clpt: error: device 'pthread");                   /* the device */
     CHECK_STR_CONTAINS(r.err, "clBuildProgram failed: CL_BUILD_PROGRAM_FAILURE"); /* call, error name */
@@ -47,19 +76,21 @@ static void test_broken_kernel_dir(void)
 
 static void test_build_failure_on_one_device(void)
 {
-    setenv("CLPT_TEST_BUILD_FAIL", "1", 1);
+    setenv("CLPT_TEST_BUILD_FAIL", fail_b, 1);
     unlink(OUT);
-    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0,1", SMALL, "-o", OUT), &r);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", pocl_ab, SMALL, "-o", OUT), &r);
     CHECK_MSG(r.status == 0, "exit %d: %s", r.status, r.err);
     CHECK_STR_CONTAINS(r.err, "clBuildProgram failed: CL_BUILD_PROGRAM_FAILURE");
     CHECK_STR_CONTAINS(r.err, "unknown type name 'clpt_test_build_failure_forced_by_CLPT_TEST_BUILD_FAIL'");
-    CHECK_STR_CONTAINS(r.err, "clpt: warning: device 1 'pthread");
+    char dropped[64];
+    snprintf(dropped, sizeof dropped, "clpt: warning: device %s 'pthread", pocl_b);
+    CHECK_STR_CONTAINS(r.err, dropped);
     CHECK_STR_CONTAINS(r.err, "dropped; rendering with the others");
     CHECK_STR_CONTAINS(r.err, "rendered 16x12, 2 spp");
     CHECK(file_exists(OUT));
     /* alone, the same device is an error */
     unlink(OUT);
-    cli_run(ARGS("scenes/cornell-box.scene", "--device", "1", SMALL, "-o", OUT), &r);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", pocl_b, SMALL, "-o", OUT), &r);
     CHECK_EQ_INT(r.status, 5);
     CHECK_STR_CONTAINS(r.err, "clpt: error: device 'pthread");
     CHECK_STR_CONTAINS(r.err, "-D__kernel=clpt_test_build_failure_forced_by_CLPT_TEST_BUILD_FAIL");
@@ -70,23 +101,25 @@ static void test_build_failure_on_one_device(void)
 static void test_device_too_small(void)
 {
     /* 1 MiB: the path-state buffer alone is larger */
-    setenv("CLPT_TEST_DEVICE_MEMORY", "0:1048576", 1);
+    setenv("CLPT_TEST_DEVICE_MEMORY", cap_a, 1);
     cli_run(ARGS("--list-devices"), &r);
     CHECK_STR_CONTAINS(r.out, "1 MiB");
     unlink(OUT);
-    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", SMALL, "-o", OUT), &r);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", pocl_a, SMALL, "-o", OUT), &r);
     CHECK_EQ_INT(r.status, 5);
     CHECK_STR_CONTAINS(r.err, "clpt: error: device 'pthread");
     CHECK_STR_CONTAINS(r.err, "the path states need 4.0 MiB in one buffer, more than its largest allocation (1.0 MiB)");
     CHECK(!file_exists(OUT));
     /* 8 MB: every buffer fits alone, not all together */
-    setenv("CLPT_TEST_DEVICE_MEMORY", "0:8000000", 1);
-    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", SMALL, "-o", OUT), &r);
+    char cap[40];
+    snprintf(cap, sizeof cap, "%s:8000000", pocl_a);
+    setenv("CLPT_TEST_DEVICE_MEMORY", cap, 1);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", pocl_a, SMALL, "-o", OUT), &r);
     CHECK_EQ_INT(r.status, 5);
     CHECK_STR_CONTAINS(r.err, "the render needs 9.8 MiB (path states 4.0 MiB, rays and shadow rays 4.0 MiB");
     CHECK_STR_CONTAINS(r.err, "more than its 7.6 MiB of memory");
     /* fewer paths per wave fit */
-    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--wave-paths", "4096", SMALL, "-o", OUT), &r);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", pocl_a, "--wave-paths", "4096", SMALL, "-o", OUT), &r);
     CHECK_MSG(r.status == 0, "exit %d: %s", r.status, r.err);
     CHECK(file_exists(OUT));
     unsetenv("CLPT_TEST_DEVICE_MEMORY");
@@ -94,17 +127,19 @@ static void test_device_too_small(void)
 
 static void test_small_device_dropped(void)
 {
-    setenv("CLPT_TEST_DEVICE_MEMORY", "1:1048576", 1);
+    setenv("CLPT_TEST_DEVICE_MEMORY", cap_b, 1);
     unlink(OUT);
-    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0,1", SMALL, "-o", OUT), &r);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", pocl_ab, SMALL, "-o", OUT), &r);
     CHECK_MSG(r.status == 0, "exit %d: %s", r.status, r.err);
     CHECK_STR_CONTAINS(r.err, "more than its largest allocation (1.0 MiB)");
-    CHECK_STR_CONTAINS(r.err, "clpt: warning: device 1 'pthread");
+    char dropped[64];
+    snprintf(dropped, sizeof dropped, "clpt: warning: device %s 'pthread", pocl_b);
+    CHECK_STR_CONTAINS(r.err, dropped);
     CHECK(file_exists(OUT));
     /* both too small: nothing can render */
-    setenv("CLPT_TEST_DEVICE_MEMORY", "0:1048576,1:1048576", 1);
+    setenv("CLPT_TEST_DEVICE_MEMORY", cap_ab, 1);
     unlink(OUT);
-    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0,1", SMALL, "-o", OUT), &r);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", pocl_ab, SMALL, "-o", OUT), &r);
     CHECK_EQ_INT(r.status, 5);
     CHECK_STR_CONTAINS(r.err, "clpt: error: none of the 2 chosen devices could be used");
     CHECK(!file_exists(OUT));
@@ -131,6 +166,7 @@ int main(void)
 {
     /* before anything loads the ICD in a child: two PoCL CPU devices, 0 and 1 */
     setenv("POCL_DEVICES", "pthread pthread", 1);
+    RUN(find_pocl_devices);
     RUN(test_memory_check);
     RUN(test_broken_kernel_dir);
     RUN(test_build_failure_on_one_device);

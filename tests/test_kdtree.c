@@ -87,7 +87,7 @@ static Status scene_build(int threads)
     scene.params.bounds_lo = scene.tree.lo;
     scene.params.bounds_hi = scene.tree.hi;
     SceneView v = { &scene.params, scene.tree.nodes, scene.tree.leaf_prims, scene.sph, scene.tri,
-                    scene.box, scene.pln, NULL, NULL, NULL };
+                    scene.box, scene.pln, NULL, NULL, NULL, NULL, NULL, NULL };
     scene.view = v;
     return ST_OK;
 }

@@ -22,12 +22,15 @@
 #include "shade.cl"
 #include "traverse.cl"
 
+/* Scene buffers every kernel takes first (SCENE_ARGS in entry.cl). */
+#define N_SCENE 13
+
 typedef struct {
     OclDeviceInfo dev;
     cl_context ctx;
     cl_command_queue q;
     cl_program prog;
-    cl_mem scene[10];
+    cl_mem scene[N_SCENE];
     int ok;
 } Cl;
 
@@ -106,6 +109,9 @@ static void build_scene(void)
     view.materials = rs.ds.materials;
     view.lights = rs.ds.lights;
     view.shading = rs.ds.shading;
+    view.textures = rs.ds.textures;
+    view.texels = rs.ds.texels;
+    view.pixel_mask = rs.ds.pixel_mask;
 }
 
 static cl_mem buffer(size_t bytes, const void *src)
@@ -144,7 +150,7 @@ static void run(cl_kernel k, size_t n)
 
 static void set_scene_args(cl_kernel k)
 {
-    for (cl_uint i = 0; i < 10; i++) SET(k, i, cl.scene[i]);
+    for (cl_uint i = 0; i < N_SCENE; i++) SET(k, i, cl.scene[i]);
 }
 
 static int setup_opencl(void)
@@ -184,6 +190,9 @@ static int setup_opencl(void)
     cl.scene[7] = buffer(ds->n_materials * sizeof(Material), ds->materials);
     cl.scene[8] = buffer(p->n_lights * sizeof(Light), ds->lights);
     cl.scene[9] = buffer(ds->n_shading * sizeof(TriShading), ds->shading);
+    cl.scene[10] = buffer(p->n_textures * sizeof(Texture), ds->textures);
+    cl.scene[11] = buffer(ds->n_texels * sizeof(uint), ds->texels);
+    cl.scene[12] = buffer(ds->pixel_mask ? p->width * p->height * sizeof(uint) : 0, ds->pixel_mask);
     return 1;
 }
 
@@ -205,7 +214,10 @@ static void test_layout(void)
                     sizeof(Camera), sizeof(RenderParams), sizeof(PathState), offsetof(RenderParams, bg_color),
                     offsetof(RenderParams, width), offsetof(RenderParams, bounds_lo), offsetof(PathState, bsdf_pdf),
                     offsetof(Material, albedo), offsetof(Light, position), offsetof(Camera, lens_u),
-                    offsetof(TriShading, uv0) };
+                    offsetof(TriShading, uv0), sizeof(Texture), offsetof(Texture, m),
+                    offsetof(Texture, color1), offsetof(RenderParams, ambient),
+                    offsetof(RenderParams, strata), offsetof(Material, reflective),
+                    offsetof(Light, cos_inner), offsetof(Camera, forward) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);
@@ -288,10 +300,10 @@ static void test_intersect(void)
     cl_kernel k = kernel("k_intersect");
     set_scene_args(k);
     uint n = N;
-    SET(k, 10, qb);
-    SET(k, 11, n);
-    SET(k, 12, rb);
-    SET(k, 13, hb);
+    SET(k, N_SCENE + 0, qb);
+    SET(k, N_SCENE + 1, n);
+    SET(k, N_SCENE + 2, rb);
+    SET(k, N_SCENE + 3, hb);
     run(k, N);
     Hit *dh = malloc(N * sizeof *dh);
     read_back(hb, N * sizeof *dh, dh);
@@ -343,15 +355,15 @@ static void test_shade_and_shadow(void)
     cl_kernel k = kernel("k_shade");
     set_scene_args(k);
     uint n = N;
-    SET(k, 10, qb);
-    SET(k, 11, n);
-    SET(k, 12, rb);
-    SET(k, 13, hb);
-    SET(k, 14, pb);
-    SET(k, 15, srb);
-    SET(k, 16, nqb);
-    SET(k, 17, sqb);
-    SET(k, 18, cb);
+    SET(k, N_SCENE + 0, qb);
+    SET(k, N_SCENE + 1, n);
+    SET(k, N_SCENE + 2, rb);
+    SET(k, N_SCENE + 3, hb);
+    SET(k, N_SCENE + 4, pb);
+    SET(k, N_SCENE + 5, srb);
+    SET(k, N_SCENE + 6, nqb);
+    SET(k, N_SCENE + 7, sqb);
+    SET(k, N_SCENE + 8, cb);
     run(k, N);
     PathState *dps = malloc(N * sizeof *dps);
     Ray *drays = malloc(N * sizeof *drays), *dshadow = malloc(N * sizeof *dshadow);
@@ -404,10 +416,10 @@ static void test_shade_and_shadow(void)
     cl_kernel ks = kernel("k_shadow");
     set_scene_args(ks);
     uint ns = counts[1];
-    SET(ks, 10, sqb);
-    SET(ks, 11, ns);
-    SET(ks, 12, srb);
-    SET(ks, 13, pb);
+    SET(ks, N_SCENE + 0, sqb);
+    SET(ks, N_SCENE + 1, ns);
+    SET(ks, N_SCENE + 2, srb);
+    SET(ks, N_SCENE + 3, pb);
     run(ks, ns ? ns : 1);
     read_back(pb, N * sizeof *dps, dps);
     uint occluded = 0, sbad = 0, sexact = 0;
@@ -482,7 +494,7 @@ int main(void)
     RUN(test_intersect);
     RUN(test_shade_and_shadow);
     RUN(test_film);
-    for (int i = 0; i < 10; i++) clReleaseMemObject(cl.scene[i]);
+    for (int i = 0; i < N_SCENE; i++) clReleaseMemObject(cl.scene[i]);
     clReleaseProgram(cl.prog);
     clReleaseCommandQueue(cl.q);
     clReleaseContext(cl.ctx);

@@ -13,6 +13,7 @@
 #include "kmath.h"
 #include "lexer.h"
 #include "obj.h"
+#include "texture.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -30,7 +31,8 @@ typedef enum {
     VK_DIR,         /* three floats, not all zero */
     VK_WORD,        /* a bare word (checked by the statement) */
     VK_MATERIAL,    /* a material name, or an inline anonymous material block */
-    VK_PATH         /* a string or a word */
+    VK_PATH,        /* a string or a word */
+    VK_TEXTURE      /* the name of a texture defined before */
 } ValueKind;
 
 typedef struct {
@@ -111,6 +113,7 @@ static const char *kind_what(const KeySpec *k)
     case VK_DIR: return "a non-zero vector (3 numbers)";
     case VK_MATERIAL: return "a material name or an inline 'material { ... }' block";
     case VK_PATH: return "a file name";
+    case VK_TEXTURE: return "a texture name";
     case VK_NUMBER:
     case VK_UINT:
     case VK_WORD: return k->what;
@@ -176,6 +179,20 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
             return lex_expected(lx, &t, what, err);
         v->word = t;
         return ST_OK;
+    case VK_TEXTURE: {
+        if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0) return lex_expected(lx, &t, what, err);
+        char *name = tok_copy(&t);
+        if (!name) return error_set(err, ST_INTERNAL, "out of memory");
+        v->u = scene_find_texture(p->s, name);
+        free(name);
+        if (v->u == NO_INDEX) {
+            char shown[64];
+            tok_describe(&t, shown, sizeof shown);
+            return lex_error_at(lx, &t, err, "texture '%s' is not defined (textures must be defined "
+                                "before they are used)", shown);
+        }
+        return ST_OK;
+    }
     case VK_MATERIAL:
         if (t.kind == TOK_LBRACE) return parse_material_block(p, lx, &v->key, 1, NULL, &v->material);
         if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
@@ -333,11 +350,12 @@ static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-enum { BG_COLOR, BG_HORIZON, BG_ZENITH, BG_N };
+enum { BG_COLOR, BG_HORIZON, BG_ZENITH, BG_AMBIENT, BG_N };
 static const KeySpec background_keys[BG_N] = {
     [BG_COLOR] = {"color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [BG_HORIZON] = {"horizon", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [BG_ZENITH] = {"zenith", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [BG_AMBIENT] = {"ambient", VK_COLOR, 0, 0, 0, 0, 0, NULL},
 };
 
 static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
@@ -347,6 +365,7 @@ static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
     if (!st) st = parse_block(p, lx, kw, 0, "background", background_keys, BG_N, v);
     if (st) return st;
     Scene *s = p->s;
+    if (v[BG_AMBIENT].given) s->ambient = v[BG_AMBIENT].v;   /* the whitted integrator's */
     int sky = v[BG_HORIZON].given || v[BG_ZENITH].given;
     if (v[BG_COLOR].given && sky) {
         const Token *t = v[BG_HORIZON].given ? &v[BG_HORIZON].key : &v[BG_ZENITH].key;
@@ -374,16 +393,22 @@ static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE, MAT_KEY_EMISSION, MAT_KEY_SIDES, MAT_KEY_N };
+enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE, MAT_KEY_EMISSION, MAT_KEY_SIDES,
+       MAT_KEY_SPECULAR, MAT_KEY_SHININESS, MAT_KEY_REFLECTIVE, MAT_KEY_TRANSPARENT, MAT_KEY_TEXTURE, MAT_KEY_N };
 static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0,
-                      "a material type (diffuse, metal, dielectric, emissive)"},
+                      "a material type (diffuse, metal, dielectric, emissive, phong)"},
     [MAT_KEY_ALBEDO] = {"albedo", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_FUZZ] = {"fuzz", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
     [MAT_KEY_IOR] = {"ior", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
     [MAT_KEY_RADIANCE] = {"radiance", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_EMISSION] = {"emission", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_SIDES] = {"sides", VK_UINT, 0, 1, 2, 0, 0, "1 or 2 (the sides that emit)"},
+    [MAT_KEY_SPECULAR] = {"specular", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_SHININESS] = {"shininess", VK_NUMBER, 0, 0, 1e6, 0, 0, "a number in [0, 1e6]"},
+    [MAT_KEY_REFLECTIVE] = {"reflective", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_TRANSPARENT] = {"transparent", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_TEXTURE] = {"texture", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
 };
 
 /* Which keys each material type takes (bit i = material_keys[i]), and which it needs. */
@@ -392,13 +417,20 @@ static const struct {
     uint type;
     unsigned allowed, required;
 } material_types[] = {
-    {"diffuse", MAT_DIFFUSE, 1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES,
+    {"diffuse", MAT_DIFFUSE,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES | 1u << MAT_KEY_TEXTURE,
      1u << MAT_KEY_ALBEDO},
     {"metal", MAT_METAL,
-     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_FUZZ | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_FUZZ | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES |
+     1u << MAT_KEY_TEXTURE,
      1u << MAT_KEY_ALBEDO},
     {"dielectric", MAT_DIELECTRIC, 1u << MAT_KEY_IOR | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES, 0},
     {"emissive", MAT_EMISSIVE, 1u << MAT_KEY_RADIANCE | 1u << MAT_KEY_SIDES, 1u << MAT_KEY_RADIANCE},
+    {"phong", MAT_PHONG,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_SPECULAR | 1u << MAT_KEY_SHININESS | 1u << MAT_KEY_REFLECTIVE |
+     1u << MAT_KEY_TRANSPARENT | 1u << MAT_KEY_IOR | 1u << MAT_KEY_TEXTURE | 1u << MAT_KEY_EMISSION |
+     1u << MAT_KEY_SIDES,
+     1u << MAT_KEY_ALBEDO},
 };
 #define N_MATERIAL_TYPES (sizeof material_types / sizeof material_types[0])
 
@@ -441,6 +473,13 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
     case MAT_EMISSIVE:
         m = material_emissive(v[MAT_KEY_RADIANCE].v);
         break;
+    case MAT_PHONG:
+        m = material_phong(v[MAT_KEY_ALBEDO].v, v[MAT_KEY_SPECULAR].given ? v[MAT_KEY_SPECULAR].v : v3s(0.0f),
+                           v[MAT_KEY_SHININESS].given ? v[MAT_KEY_SHININESS].f : 0.0f);
+        if (v[MAT_KEY_REFLECTIVE].given) m.reflective = v[MAT_KEY_REFLECTIVE].v;
+        if (v[MAT_KEY_TRANSPARENT].given) m.transparent = v[MAT_KEY_TRANSPARENT].v;
+        m.ior = v[MAT_KEY_IOR].given ? v[MAT_KEY_IOR].f : 1.5f;
+        break;
     default:
         m = material_diffuse(v[MAT_KEY_ALBEDO].v);
         break;
@@ -448,6 +487,7 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
     /* a surface that both reflects and glows (the furnace test's sphere) */
     if (v[MAT_KEY_EMISSION].given) m.emission = v[MAT_KEY_EMISSION].v;
     if (v[MAT_KEY_SIDES].given && v[MAT_KEY_SIDES].u == 2) m.flags |= MAT_TWO_SIDED;
+    if (v[MAT_KEY_TEXTURE].given) m.texture = (uint)v[MAT_KEY_TEXTURE].u;
     /* inline materials get the empty name, which no named material can have, so a
      * lookup never finds them */
     if ((st = scene_add_material(p->s, name ? name : "", m, index, p->err))) return st;
@@ -633,6 +673,131 @@ static Status parse_mesh(Parser *p, Lexer *lx, const Token *kw)
     return st;
 }
 
+/* ------------------------------------------------------------------ lights, textures */
+
+enum { LT_TYPE, LT_POSITION, LT_DIRECTION, LT_INTENSITY, LT_ATTEN, LT_ANGLE, LT_INNER, LT_N };
+static const KeySpec light_keys[LT_N] = {
+    [LT_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0, "a light type (point, spot, directional)"},
+    [LT_POSITION] = {"position", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [LT_DIRECTION] = {"direction", VK_DIR, 0, 0, 0, 0, 0, NULL},
+    [LT_INTENSITY] = {"intensity", VK_COLOR, 1, 0, 0, 0, 0, NULL},
+    [LT_ATTEN] = {"attenuation", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [LT_ANGLE] = {"angle", VK_NUMBER, 0, 0, 180, 1, 1, "a number of degrees in (0, 180)"},
+    [LT_INNER] = {"inner", VK_NUMBER, 0, 0, 180, 0, 1, "a number of degrees in [0, 180)"},
+};
+
+static Status parse_light(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[LT_N];
+    Status st = parse_block(p, lx, kw, 0, "light", light_keys, LT_N, v);
+    if (st) return st;
+    static const struct { const char *name; uint type; unsigned allowed; } types[] = {
+        {"point", LIGHT_POINT, 1u << LT_POSITION | 1u << LT_ATTEN},
+        {"spot", LIGHT_SPOT, 1u << LT_POSITION | 1u << LT_DIRECTION | 1u << LT_ATTEN | 1u << LT_ANGLE | 1u << LT_INNER},
+        {"directional", LIGHT_DIRECTIONAL, 1u << LT_DIRECTION},
+    };
+    size_t ti;
+    for (ti = 0; ti < 3; ti++)
+        if (tok_is(&v[LT_TYPE].word, types[ti].name)) break;
+    if (ti == 3) return lex_expected(lx, &v[LT_TYPE].word, light_keys[LT_TYPE].what, p->err);
+    unsigned allowed = types[ti].allowed | 1u << LT_TYPE | 1u << LT_INTENSITY;
+    for (int i = 0; i < LT_N; i++)
+        if (v[i].given && !(allowed & (1u << i)))
+            return lex_error_at(lx, &v[i].key, p->err, "a %s light has no '%s'", types[ti].name, light_keys[i].key);
+    Light l = light_default(types[ti].type);
+    l.intensity = v[LT_INTENSITY].v;
+    if (v[LT_POSITION].given) l.position = v[LT_POSITION].v;
+    if (v[LT_DIRECTION].given) {
+        vec3 d = v[LT_DIRECTION].v;
+        double len = len_d(d);
+        l.direction = v3((float)(d.x / len), (float)(d.y / len), (float)(d.z / len));
+    }
+    if (v[LT_ATTEN].given) {
+        if (v3_is_zero(v[LT_ATTEN].v))
+            return lex_error_at(lx, &v[LT_ATTEN].key, p->err, "'attenuation' (constant linear quadratic) must not be all 0");
+        l.atten0 = v[LT_ATTEN].v.x;
+        l.atten1 = v[LT_ATTEN].v.y;
+        l.atten2 = v[LT_ATTEN].v.z;
+    }
+    float outer = v[LT_ANGLE].given ? v[LT_ANGLE].f : 30.0f, inner = v[LT_INNER].given ? v[LT_INNER].f : outer;
+    if (inner > outer) return lex_error_at(lx, &v[LT_INNER].key, p->err, "'inner' must not exceed 'angle'");
+    l.cos_outer = (float)cos((double)outer * M_PI / 180.0);
+    l.cos_inner = (float)cos((double)inner * M_PI / 180.0);
+    return scene_add_light(p->s, l, p->err);
+}
+
+enum { TX_TYPE, TX_FILE, TX_ENCODING, TX_WRAP, TX_COLOR0, TX_COLOR1, TX_SPACE, TX_SCALE, TX_N };
+static const KeySpec texture_keys[TX_N] = {
+    [TX_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0, "a texture type (image, checker)"},
+    [TX_FILE] = {"file", VK_PATH, 0, 0, 0, 0, 0, NULL},
+    [TX_ENCODING] = {"encoding", VK_WORD, 0, 0, 0, 0, 0, "srgb or linear"},
+    [TX_WRAP] = {"wrap", VK_WORD, 0, 0, 0, 0, 0, "repeat or clamp"},
+    [TX_COLOR0] = {"color0", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [TX_COLOR1] = {"color1", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [TX_SPACE] = {"space", VK_WORD, 0, 0, 0, 0, 0, "uv or solid"},
+    [TX_SCALE] = {"scale", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
+};
+
+static Status parse_texture(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token t;
+    Status st = lex_next(lx, &t, p->err);
+    if (st) return st;
+    if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
+        return lex_expected(lx, &t, "a texture name", p->err);
+    char *name = tok_copy(&t);
+    if (!name) return error_set(p->err, ST_INTERNAL, "out of memory");
+    if (scene_find_texture(p->s, name) != NO_INDEX) {
+        char shown[64];
+        tok_describe(&t, shown, sizeof shown);
+        free(name);
+        return lex_error_at(lx, &t, p->err, "texture '%s' is already defined", shown);
+    }
+    Value v[TX_N];
+    if ((st = parse_block(p, lx, kw, 0, "texture", texture_keys, TX_N, v))) {
+        free(name);
+        return st;
+    }
+    int image = tok_is(&v[TX_TYPE].word, "image");
+    unsigned allowed = 1u << TX_TYPE | 1u << TX_SCALE;
+    if (image) allowed |= 1u << TX_FILE | 1u << TX_ENCODING | 1u << TX_WRAP;
+    else if (tok_is(&v[TX_TYPE].word, "checker")) allowed |= 1u << TX_COLOR0 | 1u << TX_COLOR1 | 1u << TX_SPACE;
+    else st = lex_expected(lx, &v[TX_TYPE].word, texture_keys[TX_TYPE].what, p->err);
+    for (int i = 0; !st && i < TX_N; i++)
+        if (v[i].given && !(allowed & (1u << i)))
+            st = lex_error_at(lx, &v[i].key, p->err, "an %s texture has no '%s'", image ? "image" : "checker",
+                              texture_keys[i].key);
+    struct { int index; const char *a, *b; } words[] = {
+        {TX_ENCODING, "srgb", "linear"}, {TX_WRAP, "repeat", "clamp"}, {TX_SPACE, "uv", "solid"} };
+    int second[TX_N] = {0};
+    for (size_t i = 0; !st && i < sizeof words / sizeof words[0]; i++) {
+        const Value *w = &v[words[i].index];
+        if (!w->given) continue;
+        if (tok_is(&w->word, words[i].b)) second[words[i].index] = 1;
+        else if (!tok_is(&w->word, words[i].a))
+            st = lex_expected(lx, &w->word, texture_keys[words[i].index].what, p->err);
+    }
+    if (!st && image && !v[TX_FILE].given)
+        st = lex_error_at(lx, kw, p->err, "an image texture needs 'file'");
+    float scale = v[TX_SCALE].given ? v[TX_SCALE].f : 1.0f;
+    if (!st && image) {
+        const Token *f = &v[TX_FILE].word;
+        char *path = path_beside(lx->path, f->text, f->len);
+        if (!path) st = error_set(p->err, ST_INTERNAL, "out of memory");
+        uint index;
+        if (!st) st = texture_load_image(p->s, name, path, second[TX_ENCODING], second[TX_WRAP], &index, p->err);
+        free(path);
+        if (st == ST_IO || st == ST_INPUT) error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+        if (!st) texture_set_scale_offset(&p->s->textures[index], scale, scale, 0.0f, 0.0f);
+    } else if (!st) {
+        Texture tx = texture_checker(v[TX_COLOR0].given ? v[TX_COLOR0].v : v3s(0.8f),
+                                     v[TX_COLOR1].given ? v[TX_COLOR1].v : v3s(0.2f), scale, second[TX_SPACE]);
+        st = scene_add_texture(p->s, name, NULL, tx, NULL, p->err);
+    }
+    free(name);
+    return st;
+}
+
 static Status parse_file(Parser *p, const char *path);
 
 static Status parse_include(Parser *p, Lexer *lx, const Token *kw)
@@ -668,7 +833,8 @@ static const struct {
     {"camera", parse_camera},   {"image", parse_image},       {"background", parse_background},
     {"material", parse_material}, {"sphere", parse_sphere},   {"plane", parse_plane},
     {"triangle", parse_triangle}, {"quad", parse_quad},       {"box", parse_box},
-    {"mesh", parse_mesh},       {"include", parse_include},
+    {"mesh", parse_mesh},       {"include", parse_include},   {"light", parse_light},
+    {"texture", parse_texture},
 };
 #define N_STATEMENTS (sizeof statements / sizeof statements[0])
 
@@ -687,7 +853,7 @@ static Status parse_file(Parser *p, const char *path)
         if (i == N_STATEMENTS) {
             st = lex_expected(&lx, &t,
                               "a statement (camera, image, background, material, sphere, "
-                              "plane, triangle, quad, box, mesh, include)", p->err);
+                              "plane, triangle, quad, box, mesh, light, texture, include)", p->err);
             break;
         }
         if ((st = statements[i].parse(p, &lx, &t))) break;

@@ -175,7 +175,7 @@ KFN float k_acos(float x)
 KFN float k_srgb_to_linear(float c)
 {
     if (c <= 0.04045f) return c * (1.0f / 12.92f);
-    return k_pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
+    return k_pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
 /* 0 below e0, 1 above e1, the cubic 3t^2 - 2t^3 between. */

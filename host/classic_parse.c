@@ -630,7 +630,7 @@ static Status parse_checkerboard(Classic *c, const Token *kw)
     Material a = c->s->materials[idx[0]], b = c->s->materials[idx[1]];
     if (a.texture != NO_INDEX || b.texture != NO_INDEX)
         return lex_error_at(&c->lx, kw, c->err, "a Checkerboard of textured materials is not supported");
-    Texture tx = texture_checker(a.albedo, b.albedo, 1.0f, 1);
+    Texture tx = texture_make_checker(a.albedo, b.albedo, 1.0f, 1);
     float mm[12];
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 4; j++) mm[4 * i + j] = (float)m.m[i][j];

@@ -790,7 +790,7 @@ static Status parse_texture(Parser *p, Lexer *lx, const Token *kw)
         if (st == ST_IO || st == ST_INPUT) error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
         if (!st) texture_set_scale_offset(&p->s->textures[index], scale, scale, 0.0f, 0.0f);
     } else if (!st) {
-        Texture tx = texture_checker(v[TX_COLOR0].given ? v[TX_COLOR0].v : v3s(0.8f),
+        Texture tx = texture_make_checker(v[TX_COLOR0].given ? v[TX_COLOR0].v : v3s(0.8f),
                                      v[TX_COLOR1].given ? v[TX_COLOR1].v : v3s(0.2f), scale, second[TX_SPACE]);
         st = scene_add_texture(p->s, name, NULL, tx, NULL, p->err);
     }

@@ -19,7 +19,7 @@ static Texture texture_base(uint type)
     return t;
 }
 
-Texture texture_checker(vec3 c0, vec3 c1, float scale, int solid)
+Texture texture_make_checker(vec3 c0, vec3 c1, float scale, int solid)
 {
     Texture t = texture_base(TEX_CHECKER);
     t.flags = solid ? TEX_SOLID : 0u;

@@ -13,7 +13,7 @@
 
 /* A checkerboard of colours c0 and c1 with cells 1/scale wide: in 3D at the hit point
  * when `solid`, else on the surface's (u, v). */
-Texture texture_checker(vec3 c0, vec3 c1, float scale, int solid);
+Texture texture_make_checker(vec3 c0, vec3 c1, float scale, int solid);
 
 /* Sets the map from (u, v) (or the 3D point of a solid texture) to texture space to
  * scale first, then offset: (s_u u + o_u, s_v v + o_v) (the z row, for solid

@@ -507,7 +507,10 @@ static Status parse_lights(Classic *c, const Token *kw)
         Token t;
         if ((st = next(c, &t))) return st;
         if (t.kind == TOK_RBRACE && i == n) return ST_OK;
-        if (t.kind == TOK_RBRACE || t.kind == TOK_EOF)
+        if (t.kind == TOK_EOF)
+            return lex_error_at(&c->lx, &t, c->err, "expected '}' to close the Lights block opened at line %u, "
+                                "found end of file", kw->line);
+        if (t.kind == TOK_RBRACE)
             return lex_error_at(&c->lx, &t, c->err, "the Lights block at line %u declares numLights %llu "
                                 "but has %llu", kw->line, n, i);
         if (i == n) {
@@ -650,7 +653,10 @@ static Status parse_materials(Classic *c, const Token *kw)
         Token t;
         if ((st = next(c, &t))) return st;
         if (t.kind == TOK_RBRACE && i == n) return ST_OK;
-        if (t.kind == TOK_RBRACE || t.kind == TOK_EOF)
+        if (t.kind == TOK_EOF)
+            return lex_error_at(&c->lx, &t, c->err, "expected '}' to close the Materials block opened at line %u, "
+                                "found end of file", kw->line);
+        if (t.kind == TOK_RBRACE)
             return lex_error_at(&c->lx, &t, c->err, "the Materials block at line %u declares numMaterials %llu "
                                 "but has %llu", kw->line, n, i);
         if (i == n) {
@@ -955,7 +961,10 @@ static Status parse_group(Classic *c, const Token *kw, const Mat4 *m)
         Token t;
         if ((st = next(c, &t))) return st;
         if (t.kind == TOK_RBRACE && count == n) return ST_OK;
-        if (t.kind == TOK_RBRACE || t.kind == TOK_EOF)
+        if (t.kind == TOK_EOF)
+            return lex_error_at(&c->lx, &t, c->err, "expected '}' to close the Group block opened at line %u, "
+                                "found end of file", kw->line);
+        if (t.kind == TOK_RBRACE)
             return lex_error_at(&c->lx, &t, c->err, "the Group at line %u declares numObjects %llu but has %llu",
                                 kw->line, n, count);
         if (tok_is(&t, "MaterialIndex")) {

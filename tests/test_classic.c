@@ -598,6 +598,27 @@ static void test_scene_format_additions(void)
     error_clear(&err);
 }
 
+/* The shipped classic scenes and their counterparts load, in the format they claim. */
+static void test_shipped_scenes(void)
+{
+    static const char *const names[] = { "spheres", "glass", "mesh", "textured", "ortho" };
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        for (int ours = 0; ours < 2; ours++) {
+            char path[128];
+            snprintf(path, sizeof path, "scenes/classic/%s.%s", names[i], ours ? "scene" : "txt");
+            Scene s;
+            Error err = {0};
+            scene_init(&s);
+            Status st = scene_load_format(path, SCENE_FORMAT_AUTO, &s, &err);
+            CHECK_MSG(st == ST_OK, "%s: %s", path, err.msg);
+            CHECK_EQ_INT(s.integrator, ours ? INTEGRATOR_PATH : INTEGRATOR_WHITTED);
+            CHECK(s.n_delta_lights >= 2);
+            CHECK(s.n_spheres + s.n_triangles > 0);
+            error_clear(&err);
+            scene_free(&s);
+        }
+}
+
 /* ---------------------------------------------------------------- the command line */
 
 static void test_cli(void)
@@ -665,6 +686,7 @@ int main(void)
     RUN(test_detect);
     RUN(test_errors);
     RUN(test_scene_format_additions);
+    RUN(test_shipped_scenes);
     RUN(test_cli);
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);

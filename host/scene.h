@@ -33,6 +33,9 @@ typedef struct {
     vec3 bg_color, bg_zenith;
 
     Material *materials;   char **material_names;  size_t n_materials, cap_materials;
+    /* Per material: the albedo texture file a mesh's MTL names (map_Kd, resolved to a
+     * path), or NULL; n_material_textures <= n_materials (missing entries are NULL). */
+    char **material_textures;  size_t n_material_textures;
     Sphere *spheres;       size_t n_spheres, cap_spheres;
     Triangle *triangles;   size_t n_triangles, cap_triangles;
     TriShading *shading;   size_t n_shading, cap_shading;
@@ -56,6 +59,11 @@ Status scene_add_triangle(Scene *s, Triangle t, Error *err);
 Status scene_add_shading(Scene *s, TriShading sh, uint *index, Error *err);
 Status scene_add_box(Scene *s, Box b, Error *err);
 Status scene_add_plane(Scene *s, Plane p, Error *err);
+
+/* Records `path` (copied) as the albedo texture file of material `index`. */
+Status scene_set_material_texture(Scene *s, uint index, const char *path, Error *err);
+/* The texture file of material `index`, or NULL. */
+const char *scene_material_texture(const Scene *s, uint index);
 
 /* Index of the material with this name, or NO_INDEX. */
 uint scene_find_material(const Scene *s, const char *name);

@@ -13,6 +13,8 @@ void options_print_help(FILE *f)
 "\n"
 "Renders SCENE (a scene file, see docs/scene-format.md) with a path tracer whose\n"
 "kernels run on OpenCL devices (GPUs, or CPUs through PoCL) and on a scalar C device.\n"
+"SCENE may also be a mesh (.obj or .ply): it is shown lit by a sky and a sun, seen by\n"
+"a camera that frames it (docs/meshes.md).\n"
 "\n"
 "Output and image:\n"
 "  -o, --output FILE          image to write: .png (8-bit sRGB), .ppm (8-bit sRGB) or\n"

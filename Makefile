@@ -90,6 +90,15 @@ $(BUILD)/bench/%: bench/%.c $(BUILD)/lib$(PROG).a
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -o $@ $< $(BUILD)/lib$(PROG).a $(LDFLAGS) $(LDLIBS)
 
+# The traversal benchmark compares with Embree 3: only it links libembree3, and only
+# `make bench` builds it, so the renderer and the tests never need Embree.
+$(BUILD)/.embree-ok:
+	@sh tools/deps.sh embree
+	@mkdir -p $(BUILD) && touch $@
+
+$(BUILD)/bench/bench_traverse: LDLIBS += -lembree3
+$(BUILD)/bench/bench_traverse: | $(BUILD)/.embree-ok
+
 -include $(wildcard $(BUILD)/host/*.d $(BUILD)/tests/*.d $(BUILD)/bench/*.d)
 
 # ---------------------------------------------------------------- use

@@ -176,7 +176,7 @@ static Hit brute_closest(const SceneView *sc, Ray ray)
         Ray r = ray;
         r.tmax = best.t;
         Hit h;
-        if (triangle_intersect(&rp, sc->triangles[i], r, &h)) { h.prim = i; best = h; }
+        if (triangle_intersect(&rp, &sc->triangles[i], r, &h)) { h.prim = i; best = h; }
     }
     return best;
 }

@@ -262,6 +262,46 @@ void mesh_bounds(const Scene *s, size_t first, size_t n, vec3 *lo, vec3 *hi)
     *hi = v3(h[0], h[1], h[2]);
 }
 
+/* ------------------------------------------------------------------ procedural */
+
+Status mesh_make_sphere(Scene *s, size_t min_triangles, uint material, Error *err)
+{
+    /* rows j = 1 .. nv-1 of nu vertices between the poles: 2 * nu * (nv - 1) triangles */
+    size_t nv = 2;
+    while (4 * nv * (nv - 1) < min_triangles) nv++;
+    size_t nu = 2 * nv, n_vert = nu * (nv - 1) + 2;
+    vec3 *v = malloc(n_vert * sizeof *v);
+    if (!v) return error_set(err, ST_INTERNAL, "out of memory for a sphere of %zu triangles", min_triangles);
+    v[0] = v3(0.0f, 1.0f, 0.0f);
+    v[n_vert - 1] = v3(0.0f, -1.0f, 0.0f);
+    for (size_t j = 1; j < nv; j++)
+        for (size_t i = 0; i < nu; i++) {
+            double theta = M_PI * (double)j / (double)nv, phi = 2.0 * M_PI * (double)i / (double)nu;
+            double r = 1.0 + 0.06 * sin(7.0 * theta) * cos(5.0 * phi) + 0.02 * sin(23.0 * phi);
+            v[1 + (j - 1) * nu + i] = v3((float)(r * sin(theta) * cos(phi)), (float)(r * cos(theta)),
+                                         (float)(-r * sin(theta) * sin(phi)));
+        }
+    MeshSink k;
+    Status st = mesh_sink_open(&k, s, NULL, "sphere", err);
+    if (!st) st = mesh_sink_reserve(&k, 2 * nu * (nv - 1), 0);
+#define RING(j, i) v[1 + ((j) - 1) * nu + (i) % nu]
+    for (size_t i = 0; i < nu && !st; i++) {
+        vec3 top[3] = { v[0], RING(1, i), RING(1, i + 1) };
+        vec3 bottom[3] = { v[n_vert - 1], RING(nv - 1, i + 1), RING(nv - 1, i) };
+        st = mesh_sink_triangle(&k, top, NULL, NULL, material);
+        if (!st) st = mesh_sink_triangle(&k, bottom, NULL, NULL, material);
+        for (size_t j = 1; j + 1 < nv && !st; j++) {
+            vec3 a[3] = { RING(j, i), RING(j + 1, i), RING(j + 1, i + 1) };
+            vec3 b[3] = { RING(j, i), RING(j + 1, i + 1), RING(j, i + 1) };
+            st = mesh_sink_triangle(&k, a, NULL, NULL, material);
+            if (!st) st = mesh_sink_triangle(&k, b, NULL, NULL, material);
+        }
+    }
+#undef RING
+    free(v);
+    return st;
+}
+
 /* ------------------------------------------------------------------ numbers */
 
 static const float pow10_exact[11] = { 1e0f, 1e1f, 1e2f, 1e3f, 1e4f, 1e5f,

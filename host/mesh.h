@@ -74,6 +74,12 @@ Status mesh_load(const char *path, Scene *s, const MeshOptions *o, Error *err);
 typedef enum { MESH_NONE = 0, MESH_OBJ, MESH_PLY } MeshKind;
 MeshKind mesh_kind(const char *path);
 
+/* A closed, bumpy sphere of radius about 1 around the origin with at least
+ * `min_triangles` triangles (a UV sphere whose radius varies with latitude and
+ * longitude), every edge shared by exactly two triangles with bit-identical corners,
+ * wound so the winding normals point out. For benchmarks and watertightness tests. */
+Status mesh_make_sphere(Scene *s, size_t min_triangles, uint material, Error *err);
+
 /* Bounding box of triangles [first, first + n) of the scene; lo > hi when n is 0. */
 void mesh_bounds(const Scene *s, size_t first, size_t n, vec3 *lo, vec3 *hi);
 

@@ -140,3 +140,26 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Camera, lens_u);
     out[i++] = (uint)__builtin_offsetof(TriShading, uv0);
 }
+
+/* ------------------------------------------------------------------------------------
+ * Trace-only kernels for the traversal benchmark (bench/bench_traverse.c): one ray per
+ * work-item from a plain array, no path state. Kept apart from the render kernels above.
+ * ------------------------------------------------------------------------------------ */
+
+/* Closest hit of rays[i] into hits[i]. */
+__kernel void k_trace_closest(SCENE_ARGS, __global const Ray *rays, uint n, __global Hit *hits)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= n) return;
+    SCENE_VIEW(sc);
+    hits[i] = trace_closest(&sc, rays[i]);
+}
+
+/* Whether rays[i] hits anything, into occluded[i] (1 or 0). */
+__kernel void k_trace_any(SCENE_ARGS, __global const Ray *rays, uint n, __global uint *occluded)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= n) return;
+    SCENE_VIEW(sc);
+    occluded[i] = (uint)trace_any(&sc, rays[i]);
+}

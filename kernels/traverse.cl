@@ -22,8 +22,8 @@ KFN int trace_prim(const SceneView *sc, uint id, const RayPre *rp, Ray ray, Hit 
 {
     GLOBAL const RenderParams *pr = sc->params;
     uint first_tri = pr->n_spheres, first_box = first_tri + pr->n_triangles;
-    if (id >= first_tri && id < first_box)
-        return triangle_intersect(rp, sc->triangles[id - first_tri], ray, hit);
+    if ((id >= first_tri) & (id < first_box))
+        return triangle_intersect(rp, &sc->triangles[id - first_tri], ray, hit);
     if (id < first_tri)
         return sphere_intersect(sc->spheres[id], ray, hit);
     return box_intersect(rp, sc->boxes[id - first_box], ray, hit);
@@ -40,9 +40,9 @@ KFN int trace_clip_root(GLOBAL const RenderParams *pr, Ray ray, const RayPre *rp
     float s = ray.o.x + ray.o.y + ray.o.z + ray.d.x + ray.d.y + ray.d.z;
     if (!(s == s)) return 0;
     float nx, fx, ny, fy, nz, fz;
-    k_slab(pr->bounds_lo.x, pr->bounds_hi.x, ray.o.x, rp->inv_d.x, &nx, &fx);
-    k_slab(pr->bounds_lo.y, pr->bounds_hi.y, ray.o.y, rp->inv_d.y, &ny, &fy);
-    k_slab(pr->bounds_lo.z, pr->bounds_hi.z, ray.o.z, rp->inv_d.z, &nz, &fz);
+    k_slab(pr->bounds_lo.x, pr->bounds_hi.x, ray.o.x, rp->inv_d[0], &nx, &fx);
+    k_slab(pr->bounds_lo.y, pr->bounds_hi.y, ray.o.y, rp->inv_d[1], &ny, &fy);
+    k_slab(pr->bounds_lo.z, pr->bounds_hi.z, ray.o.z, rp->inv_d[2], &nz, &fz);
     float tn = k_fmax(ray.tmin, k_fmax(nx, k_fmax(ny, nz)));
     float tf = k_fmin(ray.tmax, k_fmin(fx, k_fmin(fy, fz)) * 1.00000036f);
     *t0 = tn;
@@ -66,19 +66,22 @@ KFN void trace_tree(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit
         uint axis = n.bits & 3u;
         if (axis != KD_LEAF) {
             float split = k_as_float(n.data);
-            float o = v3_get(ray.o, (int)axis);
-            float tp = (split - o) * v3_get(rp->inv_d, (int)axis);
+            float o = rp->org[axis];
+            float tp = (split - o) * rp->inv_d[axis];
             /* A ray starting on the plane belongs to the side it is heading into. */
-            int below_first = o < split || (o == split && v3_get(ray.d, (int)axis) <= 0.0f);
+            int below_first = (o < split) | ((o == split) & (rp->dir[axis] <= 0.0f));
             uint above = n.bits >> 2;
             uint first = below_first ? node + 1u : above;
             uint second = below_first ? above : node + 1u;
-            /* Branch-free choice between: the near child only (the plane is beyond
-             * the interval or behind the origin), the far child only (crossed before
-             * t0), or both, near first and far pushed. tp is NaN only for a ray lying
-             * in the split plane: it is on the boundary of both children for its
-             * whole interval. The push slot is written either way: an interior node
-             * is at depth <= KD_MAX_DEPTH - 2, so sp stays in range. */
+            /* Choose between: the near child only (the plane is beyond the interval or
+             * behind the origin), the far child only (crossed before t0), or both, near
+             * first and far pushed. tp is NaN only for a ray lying in the split plane:
+             * it is on the boundary of both children for its whole interval. The push
+             * slot is written either way: an interior node is at depth <= KD_MAX_DEPTH
+             * - 2, so sp stays in range. Compilers turn some of these choices into
+             * branches; for coherent rays (camera, shadow) they predict well, and a
+             * version made of bit selects only was slower on those and no faster on
+             * diffuse rays (docs/kdtree.md). */
             int in_plane = !(tp == tp);
             int crosses = tp > 0.0f && tp <= t1;
             int far_only = crosses && tp < t0;
@@ -104,7 +107,7 @@ KFN void trace_tree(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit
                 if (any) return;
             }
         }
-        if (sp == 0 || best->t <= t1) return;
+        if ((sp == 0) | (best->t <= t1)) return;
         sp--;
         node = stack_node[sp];
         t0 = stack_t0[sp];

@@ -271,7 +271,7 @@ static void test_triangle(void)
         RayPre rp = ray_prepare(r);
         Hit h;
         int inside = target.x + target.y < 2.0f;
-        int hit = triangle_intersect(&rp, t, r, &h);
+        int hit = triangle_intersect(&rp, &t, r, &h);
         if (fabsf(target.x + target.y - 2.0f) > 1e-4f && o.z != -2.0f) CHECK_EQ_INT(hit, inside);
         if (hit) {
             /* p = (1-u-v) p0 + u p1 + v p2 is the point o + t d */
@@ -285,21 +285,21 @@ static void test_triangle(void)
     Ray down = make_ray(v3(0.5f, 0.5f, 0.0f), v3(0.0f, 0.0f, -1.0f), 0.0f, K_INF);
     Ray up = make_ray(v3(0.5f, 0.5f, -4.0f), v3(0.0f, 0.0f, 1.0f), 0.0f, K_INF);
     RayPre rpd = ray_prepare(down), rpu = ray_prepare(up);
-    CHECK(triangle_intersect(&rpd, t, down, &h));
+    CHECK(triangle_intersect(&rpd, &t, down, &h));
     CHECK_NEAR(h.t, 2.0f, 1e-6);
     CHECK_NEAR(h.u, 0.25f, 1e-6);
     CHECK_NEAR(h.v, 0.25f, 1e-6);
-    CHECK(triangle_intersect(&rpu, t, up, &h));
+    CHECK(triangle_intersect(&rpu, &t, up, &h));
     CHECK_NEAR(h.t, 2.0f, 1e-6);
     /* degenerate (zero area) and parallel: misses, no NaN trouble */
     Triangle flat = { v3(0.0f, 0.0f, -2.0f), 0, v3(1.0f, 1.0f, -2.0f), NO_INDEX, v3(2.0f, 2.0f, -2.0f), NO_INDEX };
-    CHECK(!triangle_intersect(&rpd, flat, down, &h));
+    CHECK(!triangle_intersect(&rpd, &flat, down, &h));
     Ray side = make_ray(v3(-1.0f, 0.5f, -2.0f), v3(1.0f, 0.0f, 0.0f), 0.0f, K_INF);
     RayPre rps = ray_prepare(side);
-    CHECK(!triangle_intersect(&rps, t, side, &h));
+    CHECK(!triangle_intersect(&rps, &t, side, &h));
     Ray nan_ray = make_ray(v3(NAN, 0.0f, 0.0f), v3(0.0f, 0.0f, -1.0f), 0.0f, K_INF);
     RayPre rpn = ray_prepare(nan_ray);
-    CHECK(!triangle_intersect(&rpn, t, nan_ray, &h));
+    CHECK(!triangle_intersect(&rpn, &t, nan_ray, &h));
 }
 
 /* Rays through the shared edges and vertices of a mesh never slip through. */
@@ -339,7 +339,7 @@ static void test_watertight(void)
         RayPre rp = ray_prepare(r);
         int hit = 0;
         Hit h;
-        for (int t = 0; t < n; t++) hit |= triangle_intersect(&rp, tris[t], r, &h);
+        for (int t = 0; t < n; t++) hit |= triangle_intersect(&rp, &tris[t], r, &h);
         misses += !hit;
         rays++;
     }

@@ -274,12 +274,12 @@ static Status parse_header(PlyReader *r)
     const char *p = r->data;
     int have_format = 0;
     for (uint line_no = 1;; line_no++) {
+        r->line = line_no;
+        r->line_start = p;
         if (p >= r->end)
             return fail(r, p, 1, "the header ends without 'end_header'");
         const char *nl = memchr(p, '\n', (size_t)(r->end - p));
         const char *le = nl ? nl : r->end;
-        r->line = line_no;
-        r->line_start = p;
         Words w;
         split_words(p, le, &w);
         if (line_no == 1) {
@@ -319,34 +319,27 @@ static Status parse_header(PlyReader *r)
     }
 }
 
-/* Checks what the header promises against the bytes that follow it, before anything is
- * allocated from the counts, and checks the vertex and face elements. */
+/* The start of header line `line` (1-based), for messages about an element. */
+static const char *header_line(const PlyReader *r, uint line)
+{
+    const char *p = r->data;
+    for (uint l = 1; l < line && p < r->end; l++) {
+        const char *nl = memchr(p, '\n', (size_t)(r->end - p));
+        p = nl ? nl + 1 : r->end;
+    }
+    return p;
+}
+
+/* Checks the vertex and face elements, then what the header promises against the bytes
+ * that follow it, before anything is allocated from the counts. */
 static Status check_header(PlyReader *r)
 {
-    double avail = (double)(r->end - r->p), need = 0.0;
     for (size_t i = 0; i < r->n_el; i++) {
         const PlyElement *e = &r->el[i];
-        const char *line = r->data;
-        for (uint l = 1; l < e->line && line < r->end; l++) {
-            const char *nl = memchr(line, '\n', (size_t)(r->end - line));
-            line = nl ? nl + 1 : r->end;
-        }
+        const char *line = header_line(r, e->line);
         if (e->n_props == 0 && e->count > 0)
             return fail(r, line, 1, "element '%.*s' has %llu records but no properties", (int)e->name_len,
                         e->name, (unsigned long long)e->count);
-        double min = 0.0;
-        for (size_t k = 0; k < e->n_props; k++) {
-            const PlyProp *p = &e->props[k];
-            if (r->format == F_ASCII) min += 2.0;
-            else min += types[p->is_list ? p->count_type : p->type].size;
-        }
-        need += (double)e->count * min;
-        /* the last ascii value needs no separator after it */
-        if (need > avail + (r->format == F_ASCII ? 1.0 : 0.0))
-            return fail(r, line, 1,
-                        "element '%.*s' declares %llu records of at least %.0f bytes each, more than "
-                        "the %.0f bytes after the header can hold (a truncated file or a wrong count)",
-                        (int)e->name_len, e->name, (unsigned long long)e->count, min, avail);
         if (e->kind == EL_VERTEX) {
             int have[R_N] = { 0 };
             for (size_t k = 0; k < e->n_props; k++) have[e->props[k].role] = 1;
@@ -365,6 +358,23 @@ static Status check_header(PlyReader *r)
             for (size_t k = 0; k < e->n_props; k++) have |= e->props[k].role == R_INDICES;
             if (!have) return fail(r, line, 1, "the face element has no 'vertex_indices' list");
         }
+    }
+    double avail = (double)(r->end - r->p), need = 0.0;
+    for (size_t i = 0; i < r->n_el; i++) {
+        const PlyElement *e = &r->el[i];
+        double min = 0.0;
+        for (size_t k = 0; k < e->n_props; k++) {
+            const PlyProp *p = &e->props[k];
+            if (r->format == F_ASCII) min += 2.0;
+            else min += types[p->is_list ? p->count_type : p->type].size;
+        }
+        need += (double)e->count * min;
+        /* the last ascii value needs no separator after it */
+        if (need > avail + (r->format == F_ASCII ? 1.0 : 0.0))
+            return fail(r, header_line(r, e->line), 1,
+                        "element '%.*s' declares %llu records of at least %.0f bytes each, more than "
+                        "the %.0f bytes after the header can hold (a truncated file or a wrong count)",
+                        (int)e->name_len, e->name, (unsigned long long)e->count, min, avail);
     }
     return ST_OK;
 }

@@ -50,6 +50,12 @@ KFN int trace_clip_root(GLOBAL const RenderParams *pr, Ray ray, const RayPre *rp
     return tn <= tf;
 }
 
+/* Relative slack of the traversal's plane-crossing tests: far above the rounding error
+ * of the distances compared (about 3 ulps, 4e-7, each), far below any cost. */
+#define KD_T_SLACK 1e-6f
+#define KD_T_ABOVE (1.0f + KD_T_SLACK)
+#define KD_T_BELOW (1.0f - KD_T_SLACK)
+
 /* The kd-tree walk shared by both queries. With `any` set it returns at the first hit;
  * otherwise it keeps the closest one in *best (whose t starts as the ray's tmax). */
 KFN void trace_tree(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit *best)
@@ -75,16 +81,19 @@ KFN void trace_tree(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit
             uint second = below_first ? above : node + 1u;
             /* Choose between: the near child only (the plane is beyond the interval or
              * behind the origin), the far child only (crossed before t0), or both, near
-             * first and far pushed. tp is NaN only for a ray lying in the split plane:
-             * it is on the boundary of both children for its whole interval. The push
-             * slot is written either way: an interior node is at depth <= KD_MAX_DEPTH
-             * - 2, so sp stays in range. Compilers turn some of these choices into
+             * first and far pushed. The comparisons with t0 and t1 have a slack of
+             * KD_T_SLACK: tp and the ends of the interval are each rounded (a few ulps),
+             * and a ray through a vertex or edge lying on the plane must not skip the
+             * child holding the triangle it hits. tp is NaN only for a ray lying in the
+             * split plane: it is on the boundary of both children for its whole
+             * interval. The push slot is written either way: an interior node is at
+             * depth <= KD_MAX_DEPTH - 2, so sp stays in range. Compilers turn some of these choices into
              * branches; for coherent rays (camera, shadow) they predict well, and a
              * version made of bit selects only was slower on those and no faster on
              * diffuse rays (docs/kdtree.md). */
             int in_plane = !(tp == tp);
-            int crosses = tp > 0.0f && tp <= t1;
-            int far_only = crosses && tp < t0;
+            int crosses = tp > 0.0f && tp <= t1 * KD_T_ABOVE;
+            int far_only = crosses && tp < t0 * KD_T_BELOW;
             int both = (crosses && !far_only) || in_plane;
             stack_node[sp] = second;
             stack_t0[sp] = in_plane ? t0 : tp;

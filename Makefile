@@ -64,6 +64,10 @@ $(BUILD)/gen_weekend: tools/gen_weekend.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(CC) -std=c11 -O1 -Wall -Wextra -o $@ $<
 
+# Writes a closed sphere mesh of any size as a binary PLY (docs/meshes.md).
+$(BUILD)/gen_mesh: tools/gen_mesh.c $(BUILD)/lib$(PROG).a
+	$(CC) $(CPPFLAGS) $(CFLAGS) -o $@ $< $(BUILD)/lib$(PROG).a $(LDFLAGS) $(LDLIBS)
+
 $(BUILD)/kernel_source.c: $(KERNELS) $(BUILD)/embed
 	$(BUILD)/embed clpt_kernel_source kernels/entry.cl > $@.tmp && mv $@.tmp $@
 

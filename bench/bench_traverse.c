@@ -59,7 +59,7 @@
 typedef struct {
     int reps, size, pocl, embree;
     int threads[MAX_THREADS];
-    size_t local;                /* OpenCL work-group size, 0 = the driver's choice */
+    size_t local;                /* OpenCL work-group size (64, as the renderer), 0 = the driver's choice */
 } Options;
 
 static size_t pocl_local;
@@ -160,6 +160,7 @@ static vec3 unit_d(double x, double y, double z)
 typedef struct {
     const SceneView *sc;
     const RaySet *set;
+    int pairs;                   /* trace_closest2/trace_any2, as the PoCL kernels do */
     Hit *hits;
     uint *occ;
     atomic_uint next;
@@ -175,20 +176,33 @@ static void *trace_worker(void *arg)
         uint begin = atomic_fetch_add(&j->next, CHUNK);
         if (begin >= s->n) break;
         uint end = s->n - begin < CHUNK ? s->n : begin + CHUNK;
+        uint i = begin;
+        if (j->pairs && s->any) {
+            for (; i + 1 < end; i += 2) {
+                int a, b;
+                trace_any2(j->sc, s->rays[i], s->rays[i + 1], &a, &b);
+                j->occ[i] = (uint)a;
+                j->occ[i + 1] = (uint)b;
+            }
+        } else if (j->pairs) {
+            for (; i + 1 < end; i += 2) trace_closest2(j->sc, s->rays[i], s->rays[i + 1], &j->hits[i], &j->hits[i + 1]);
+        }
         if (s->any)
-            for (uint i = begin; i < end; i++) j->occ[i] = (uint)trace_any(j->sc, s->rays[i]);
+            for (; i < end; i++) j->occ[i] = (uint)trace_any(j->sc, s->rays[i]);
         else
-            for (uint i = begin; i < end; i++) j->hits[i] = trace_closest(j->sc, s->rays[i]);
+            for (; i < end; i++) j->hits[i] = trace_closest(j->sc, s->rays[i]);
     }
     return NULL;
 }
 
-/* Traces the set with `threads` threads; returns the seconds it took. */
-static double trace_c(const SceneView *sc, const RaySet *s, int threads, Hit *hits, uint *occ)
+/* Traces the set with `threads` threads, one ray at a time or in pairs; returns the
+ * seconds it took. */
+static double trace_c(const SceneView *sc, const RaySet *s, int threads, int pairs, Hit *hits, uint *occ)
 {
     TraceJob j;
     j.sc = sc;
     j.set = s;
+    j.pairs = pairs;
     j.hits = hits;
     j.occ = occ;
     atomic_init(&j.next, 0u);
@@ -250,7 +264,7 @@ static int make_rays(Mesh *m, int size, RaySet sets[3])
             p->rays[(size_t)y * size + x] = ray;
         }
     p->n = n;
-    trace_c(&m->view, p, 2, hits, NULL);
+    trace_c(&m->view, p, 2, 0, hits, NULL);
     for (uint i = 0; i < n; i++) {
         if (hits[i].prim == NO_INDEX) continue;
         const Triangle *t = &m->scene.triangles[hits[i].prim];
@@ -276,7 +290,7 @@ static int make_rays(Mesh *m, int size, RaySet sets[3])
         sets[k].ref_hits = malloc((sets[k].n + 1) * sizeof *sets[k].ref_hits);
         sets[k].ref_occ = malloc((sets[k].n + 1) * sizeof *sets[k].ref_occ);
         if (!sets[k].ref_hits || !sets[k].ref_occ) return -1;
-        trace_c(&m->view, &sets[k], 2, sets[k].ref_hits, sets[k].ref_occ);
+        trace_c(&m->view, &sets[k], 2, 0, sets[k].ref_hits, sets[k].ref_occ);
     }
     return 0;
 }
@@ -404,7 +418,8 @@ static double pocl_trace(Pocl *pc, const RaySet *s)
     cl_kernel k = s->any ? pc->ka : pc->kc;
     cl_uint n = s->n;
     if (clSetKernelArg(k, SC_N + 1, sizeof n, &n) != CL_SUCCESS) return -1.0;
-    size_t local = pocl_local, global = local ? (n + local - 1) / local * local : n;
+    size_t items = (n + 1u) / 2u;   /* two rays per work-item */
+    size_t local = pocl_local, global = local ? (items + local - 1) / local * local : items;
     double c0 = cpu_now(), t0 = timer_now();
     cl_int rc = clEnqueueNDRangeKernel(pc->q, k, 1, NULL, &global, local ? &local : NULL, 0, NULL, NULL);
     if (rc == CL_SUCCESS) rc = clFinish(pc->q);
@@ -729,7 +744,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
             double sc[MAX_REPS], cc[MAX_REPS], sp[MAX_REPS], cp[MAX_REPS], s1[MAX_REPS], c1[MAX_REPS],
                 s8[MAX_REPS], c8[MAX_REPS];
             for (int i = 0; i < o->reps; i++) {
-                sc[i] = trace_c(&m.view, s, th, tmp_h, tmp_o);
+                sc[i] = trace_c(&m.view, s, th, 1, tmp_h, tmp_o);
                 cc[i] = last_cpu_seconds;
                 if (pocl_ok[t]) {
                     sp[i] = pocl_trace(&pocl[t], s);
@@ -815,7 +830,7 @@ static const char *const default_meshes[] = {
 
 int main(int argc, char **argv)
 {
-    Options o = { 5, 1024, 1, 1, { 1, 2 }, 0 };
+    Options o = { 5, 1024, 1, 1, { 1, 2 }, 64 };
     const char *meshes[64];
     int n_meshes = 0;
     for (int i = 1; i < argc; i++) {

@@ -146,20 +146,34 @@ __kernel void k_layout(__global uint *out)
  * work-item from a plain array, no path state. Kept apart from the render kernels above.
  * ------------------------------------------------------------------------------------ */
 
-/* Closest hit of rays[i] into hits[i]. */
+/* Closest hits of rays[2i] and rays[2i+1], walked in turns (trace_closest2). */
 __kernel void k_trace_closest(SCENE_ARGS, __global const Ray *rays, uint n, __global Hit *hits)
 {
-    uint i = (uint)get_global_id(0);
-    if (i >= n) return;
+    uint a = 2u * (uint)get_global_id(0), b = a + 1u;
+    if (a >= n) return;
     SCENE_VIEW(sc);
-    hits[i] = trace_closest(&sc, rays[i]);
+    if (b < n) {
+        Hit ha, hb;
+        trace_closest2(&sc, rays[a], rays[b], &ha, &hb);
+        hits[a] = ha;
+        hits[b] = hb;
+    } else {
+        hits[a] = trace_closest(&sc, rays[a]);
+    }
 }
 
-/* Whether rays[i] hits anything, into occluded[i] (1 or 0). */
+/* Whether rays[2i] and rays[2i+1] hit anything, into occluded[] (1 or 0). */
 __kernel void k_trace_any(SCENE_ARGS, __global const Ray *rays, uint n, __global uint *occluded)
 {
-    uint i = (uint)get_global_id(0);
-    if (i >= n) return;
+    uint a = 2u * (uint)get_global_id(0), b = a + 1u;
+    if (a >= n) return;
     SCENE_VIEW(sc);
-    occluded[i] = (uint)trace_any(&sc, rays[i]);
+    if (b < n) {
+        int oa, ob;
+        trace_any2(&sc, rays[a], rays[b], &oa, &ob);
+        occluded[a] = (uint)oa;
+        occluded[b] = (uint)ob;
+    } else {
+        occluded[a] = (uint)trace_any(&sc, rays[a]);
+    }
 }

@@ -618,6 +618,34 @@ static void test_against_brute_force(void)
     fprintf(stderr, "  %d random rays, %d disagree with brute force\n", total, bad);
 }
 
+/* Two rays walked in turns (trace_closest2, trace_any2) give each ray bit for bit what
+ * it gets alone, on every kind of scene and ray (planes, spheres, boxes, NaN, zero
+ * components). */
+static void test_pairs(void)
+{
+    struct { uint64_t seed; uint ns, nt, nb, np; } cases[] = {
+        { 81, 40, 200, 25, 2 }, { 82, 0, 400, 0, 0 }, { 83, 120, 0, 60, 1 },
+    };
+    int differ = 0, total = 0;
+    for (int c = 0; c < 3; c++) {
+        random_scene(cases[c].seed, cases[c].ns, cases[c].nt, cases[c].nb, cases[c].np);
+        CHECK(scene_build(0) == ST_OK);
+        for (int i = 0; i < 10000; i++) {
+            Ray a = random_ray(-5.0f, 5.0f), b = random_ray(-5.0f, 5.0f);
+            if (i % 97 == 0) a.o.x = NAN;
+            Hit ha, hb, sa = trace_closest(&scene.view, a), sb = trace_closest(&scene.view, b);
+            trace_closest2(&scene.view, a, b, &ha, &hb);
+            int oa, ob;
+            trace_any2(&scene.view, a, b, &oa, &ob);
+            differ += memcmp(&ha, &sa, sizeof ha) != 0 || memcmp(&hb, &sb, sizeof hb) != 0;
+            differ += oa != trace_any(&scene.view, a) || ob != trace_any(&scene.view, b);
+            total++;
+        }
+    }
+    CHECK_EQ_INT(differ, 0);
+    fprintf(stderr, "  %d pairs of rays, %d differ from the rays traced alone\n", total, differ);
+}
+
 static void test_empty_scene(void)
 {
     scene_clear();
@@ -929,6 +957,7 @@ int main(void)
     RUN(test_plane);
     RUN(test_structure);
     RUN(test_against_brute_force);
+    RUN(test_pairs);
     RUN(test_empty_scene);
     RUN(test_bad_primitives);
     RUN(test_flat_on_split_planes);

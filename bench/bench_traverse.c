@@ -701,13 +701,18 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
            "SAH cost %.2f (one leaf %.0f), %.1f bytes/triangle (nodes + leaf lists)\n",
            ks->build_seconds, o->threads[MAX_THREADS - 1], m.kd_build_1, ks->n_nodes, ks->n_leaves,
            ks->max_depth, ks->sah_cost, ks->leaf_sah_cost, (double)ks->bytes / (double)(nt ? nt : 1));
-    if (have_embree)
+    if (have_embree) {
+        char ratio[96] = "";
+        /* a ratio of times below a millisecond says nothing */
+        if (emb[0].build_seconds > 1e-3 && emb[MAX_THREADS - 1].build_seconds > 1e-3)
+            snprintf(ratio, sizeof ratio, "; kd build / Embree build: %.2f (%d threads), %.2f (1)",
+                     ks->build_seconds / emb[MAX_THREADS - 1].build_seconds, o->threads[MAX_THREADS - 1],
+                     m.kd_build_1 / emb[0].build_seconds);
         printf("Embree 3 (RTC_BUILD_QUALITY_HIGH): build %.3f s (%d threads) / %.3f s (1 thread), %.1f "
-               "bytes/triangle allocated by the build; kd build / Embree build: %.2f (%d threads), %.2f (1)\n",
+               "bytes/triangle allocated by the build%s\n",
                emb[MAX_THREADS - 1].build_seconds, o->threads[MAX_THREADS - 1], emb[0].build_seconds,
-               (double)emb[MAX_THREADS - 1].build_bytes / (double)(nt ? nt : 1),
-               ks->build_seconds / emb[MAX_THREADS - 1].build_seconds, o->threads[MAX_THREADS - 1],
-               m.kd_build_1 / emb[0].build_seconds);
+               (double)emb[MAX_THREADS - 1].build_bytes / (double)(nt ? nt : 1), ratio);
+    }
 
     SetResult res[3];
     memset(res, 0, sizeof res);
@@ -791,8 +796,9 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
                r->c[1], r->e1[0], r->e1[1], r->e8[0], r->e8[1], r->e1[1] > 0.0 ? r->pocl[1] / r->e1[1] : 0.0,
                r->e1[0] > 0.0 ? r->c[0] / r->e1[0] : 0.0, ed, pd);
     }
-    printf("\nThe same runs in Mrays per CPU-second of the whole process (insensitive to other jobs "
-           "taking the cores; at %d threads, ideal scaling would be %d times the wall-clock rate of one):\n\n", b, b);
+    printf("\nThe same runs in Mrays per CPU-second (the CPU time of the whole process: the work per core, "
+           "which other jobs taking the cores do not change; with ideal scaling the %d-thread columns equal "
+           "the 1-thread ones):\n\n", b);
     printf("| rays | PoCL %dt | PoCL %dt | C %dt | C %dt | Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | "
            "PoCL/Embree-1 %dt | PoCL/Embree-1 %dt |\n", a, b, a, b, a, b, a, b, a, b);
     printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");

@@ -19,7 +19,8 @@
  *   shadow   for each primary hit, one ray from the same offset point to a point light at
  *            c + 2 r * normalize(-0.5, 1, 0.35), direction = light - origin, t in (0,
  *            1 - 1e-4).
- * Primary and diffuse rays are closest-hit queries, shadow rays any-hit queries.
+ * Primary and diffuse rays are traced as closest-hit and as any-hit queries, shadow rays
+ * as any-hit queries.
  *
  * Before anything is timed, the hits of the scalar C traversal are compared with
  * Embree's rtcIntersect1/rtcOccluded1 (same triangle, or t within 1e-4 relative; any-hit:
@@ -140,11 +141,16 @@ static void mesh_close(Mesh *m)
 
 /* ------------------------------------------------------------------ rays */
 
+/* The queries: closest and any hit of the primary and diffuse rays, any hit of the
+ * shadow rays (the any-hit sets share the closest-hit sets' rays). */
+#define N_SETS 5
+
 typedef struct {
     const char *name;
     Ray *rays;
+    int owns;                    /* rays belongs to this set */
     uint n;
-    int any;                     /* any-hit (shadow) or closest-hit */
+    int any;                     /* any-hit or closest-hit */
     Hit *ref_hits;               /* scalar C results: closest */
     uint *ref_occ;               /* any */
 } RaySet;
@@ -218,7 +224,7 @@ static double trace_c(const SceneView *sc, const RaySet *s, int threads, int pai
 }
 
 /* The ray sets of a mesh (see the top of this file). */
-static int make_rays(Mesh *m, int size, RaySet sets[3])
+static int make_rays(Mesh *m, int size, RaySet sets[N_SETS])
 {
     double lo[3] = { m->tree.lo.x, m->tree.lo.y, m->tree.lo.z }, hi[3] = { m->tree.hi.x, m->tree.hi.y, m->tree.hi.z };
     double c[3], r = 0.0;
@@ -241,12 +247,13 @@ static int make_rays(Mesh *m, int size, RaySet sets[3])
                     (float)(c[2] + 2.0 * r * 0.35 / 1.1726));   /* |(-0.5, 1, 0.35)| = 1.1726 */
 
     uint n = (uint)size * (uint)size;
-    RaySet *p = &sets[0], *d = &sets[1], *s = &sets[2];
-    memset(sets, 0, 3 * sizeof *sets);
+    RaySet *p = &sets[0], *d = &sets[2], *s = &sets[4];
+    memset(sets, 0, N_SETS * sizeof *sets);
     p->name = "primary";
     d->name = "diffuse";
     s->name = "shadow";
     s->any = 1;
+    p->owns = d->owns = s->owns = 1;
     p->rays = malloc(n * sizeof *p->rays);
     d->rays = malloc(n * sizeof *d->rays);
     s->rays = malloc(n * sizeof *s->rays);
@@ -286,7 +293,11 @@ static int make_rays(Mesh *m, int size, RaySet sets[3])
         s->rays[s->n++] = sr;
     }
     free(hits);
-    for (int k = 0; k < 3; k++) {
+    sets[1] = *p;
+    sets[3] = *d;
+    sets[1].owns = sets[3].owns = 0;
+    sets[1].any = sets[3].any = 1;
+    for (int k = 0; k < N_SETS; k++) {
         sets[k].ref_hits = malloc((sets[k].n + 1) * sizeof *sets[k].ref_hits);
         sets[k].ref_occ = malloc((sets[k].n + 1) * sizeof *sets[k].ref_occ);
         if (!sets[k].ref_hits || !sets[k].ref_occ) return -1;
@@ -295,10 +306,10 @@ static int make_rays(Mesh *m, int size, RaySet sets[3])
     return 0;
 }
 
-static void rays_free(RaySet sets[3])
+static void rays_free(RaySet sets[N_SETS])
 {
-    for (int k = 0; k < 3; k++) {
-        free(sets[k].rays);
+    for (int k = 0; k < N_SETS; k++) {
+        if (sets[k].owns) free(sets[k].rays);
         free(sets[k].ref_hits);
         free(sets[k].ref_occ);
     }
@@ -688,7 +699,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
     int have_embree = o->embree;
     for (int t = 0; t < MAX_THREADS && have_embree; t++)
         if (embree_build(&emb[t], &m, o->threads[t])) have_embree = 0;
-    RaySet sets[3];
+    RaySet sets[N_SETS];
     if (make_rays(&m, o->size, sets)) {
         fprintf(stderr, "bench_traverse: out of memory for the rays\n");
         rays_free(sets);
@@ -714,15 +725,15 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
                (double)emb[MAX_THREADS - 1].build_bytes / (double)(nt ? nt : 1), ratio);
     }
 
-    SetResult res[3];
+    SetResult res[N_SETS];
     memset(res, 0, sizeof res);
     uint max_n = 0;
-    for (int k = 0; k < 3; k++) max_n = sets[k].n > max_n ? sets[k].n : max_n;
+    for (int k = 0; k < N_SETS; k++) max_n = sets[k].n > max_n ? sets[k].n : max_n;
     int pocl_ok[MAX_THREADS] = { 0 };
     for (int t = 0; t < MAX_THREADS && have_pocl; t++) pocl_ok[t] = pocl[t].ok && pocl_upload(&pocl[t], &m, max_n) == 0;
     Hit *eh = malloc((max_n + 1) * sizeof *eh);
     uint *eo = malloc((max_n + 1) * sizeof *eo);
-    for (int k = 0; k < 3 && eh && eo; k++) {
+    for (int k = 0; k < N_SETS && eh && eo; k++) {
         RaySet *s = &sets[k];
         SetResult *r = &res[k];
         for (uint i = 0; i < s->n; i++) r->hits += s->any ? s->ref_occ[i] : s->ref_hits[i].prim != NO_INDEX;
@@ -784,7 +795,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
            "Embree-8 %dt | Embree-8 %dt | PoCL/Embree-1 %dt | C/Embree-1 %dt | vs Embree | PoCL vs C |\n",
            a, b, a, b, a, b, a, b, b, a);
     printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < N_SETS; k++) {
         const SetResult *r = &res[k];
         char pd[32], ed[32];
         if (r->pocl_diff < 0) snprintf(pd, sizeof pd, "-");
@@ -802,9 +813,10 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
     printf("| rays | PoCL %dt | PoCL %dt | C %dt | C %dt | Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | "
            "PoCL/Embree-1 %dt | PoCL/Embree-1 %dt |\n", a, b, a, b, a, b, a, b, a, b);
     printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < N_SETS; k++) {
         const SetResult *r = &res[k];
-        printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n", sets[k].name,
+        printf("| %s %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n", sets[k].name,
+               sets[k].any ? "any" : "closest",
                r->cpu_pocl[0], r->cpu_pocl[1], r->cpu_c[0], r->cpu_c[1], r->cpu_e1[0], r->cpu_e1[1], r->cpu_e8[0],
                r->cpu_e8[1], r->cpu_e1[0] > 0.0 ? r->cpu_pocl[0] / r->cpu_e1[0] : 0.0,
                r->cpu_e1[1] > 0.0 ? r->cpu_pocl[1] / r->cpu_e1[1] : 0.0);

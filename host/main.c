@@ -13,6 +13,8 @@
 #include "device.h"
 #include "film.h"
 #include "image_write.h"
+#include "mesh.h"
+#include "mesh_view.h"
 #include "options.h"
 #include "passes.h"
 #include "progress.h"
@@ -151,7 +153,8 @@ static void print_scene_stats(const Scene *s, const KdTree *kd)
     printf("scene: %zu spheres, %zu triangles, %zu boxes, %zu planes, %zu materials, %zu lights\n",
            s->n_spheres, s->n_triangles, s->n_boxes, s->n_planes, s->n_materials, s->n_lights);
     printf("kd-tree: built in %.3f s; %u nodes, %u leaves (%u empty), depth %u, "
-           "%.2f primitives per non-empty leaf, SAH cost %.2f, %.1f KiB (%.1f bytes per primitive)\n",
+           "%.2f primitives per non-empty leaf, SAH cost %.2f, %.1f KiB (nodes + leaf lists: "
+           "%.1f bytes per primitive)\n",
            k->build_seconds, k->n_nodes, k->n_leaves, k->n_empty_leaves, k->max_depth,
            k->mean_prims_per_leaf, k->sah_cost, (double)k->bytes / 1024.0,
            in_tree ? (double)k->bytes / (double)in_tree : 0.0);
@@ -280,8 +283,13 @@ static Status run(int argc, char **argv, Error *err)
     double t_start = timer_now();
 
     if ((st = image_format_from_path(output, &format, err))) goto done;
-    if ((st = scene_load_format(o.scene_path, (SceneFormat)o.format, &scene, err))) goto done;
+    /* a mesh file given in place of a scene is shown in a scene made around it */
+    int bare_mesh = mesh_kind(o.scene_path) != MESH_NONE;
+    if ((st = bare_mesh ? mesh_view_load(o.scene_path, &scene, err)
+                        : scene_load_format(o.scene_path, (SceneFormat)o.format, &scene, err)))
+        goto done;
     apply_overrides(&o, &scene);
+    if (bare_mesh) mesh_view_fit(&scene);
     if (o.adaptive > 0.0 && scene.integrator != INTEGRATOR_WHITTED) {
         st = error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
         goto done;

@@ -36,6 +36,8 @@ void scene_free(Scene *s)
 {
     for (size_t i = 0; i < s->n_materials; i++) free(s->material_names[i]);
     free(s->material_names);
+    for (size_t i = 0; i < s->n_material_textures; i++) free(s->material_textures[i]);
+    free(s->material_textures);
     free(s->materials);
     free(s->spheres);
     free(s->triangles);
@@ -204,6 +206,30 @@ uint scene_find_texture(const Scene *s, const char *name)
     for (size_t i = 0; i < s->n_textures; i++)
         if (s->texture_names[i] && strcmp(s->texture_names[i], name) == 0) return (uint)i;
     return NO_INDEX;
+}
+
+Status scene_set_material_texture(Scene *s, uint index, const char *path, Error *err)
+{
+    if (index >= s->n_materials)
+        return error_set(err, ST_INTERNAL, "texture for material %u of %zu", index, s->n_materials);
+    if (index >= s->n_material_textures) {
+        char **grown = realloc(s->material_textures, (index + 1) * sizeof *grown);
+        if (!grown) return error_set(err, ST_INTERNAL, "out of memory");
+        for (size_t i = s->n_material_textures; i <= index; i++) grown[i] = NULL;
+        s->material_textures = grown;
+        s->n_material_textures = (size_t)index + 1;
+    }
+    char *copy = malloc(strlen(path) + 1);
+    if (!copy) return error_set(err, ST_INTERNAL, "out of memory");
+    strcpy(copy, path);
+    free(s->material_textures[index]);
+    s->material_textures[index] = copy;
+    return ST_OK;
+}
+
+const char *scene_material_texture(const Scene *s, uint index)
+{
+    return index < s->n_material_textures ? s->material_textures[index] : NULL;
 }
 
 uint scene_find_material(const Scene *s, const char *name)

@@ -35,6 +35,9 @@ typedef struct {
     vec3 bg_color, bg_zenith;
 
     Material *materials;   char **material_names;  size_t n_materials, cap_materials;
+    /* Per material: the albedo texture file a mesh's MTL names (map_Kd, resolved to a
+     * path), or NULL; n_material_textures <= n_materials (missing entries are NULL). */
+    char **material_textures;  size_t n_material_textures;
     Sphere *spheres;       size_t n_spheres, cap_spheres;
     Triangle *triangles;   size_t n_triangles, cap_triangles;
     TriShading *shading;   size_t n_shading, cap_shading;
@@ -80,6 +83,11 @@ Status scene_add_texture(Scene *s, const char *name, const char *source, Texture
 /* Appends n texels; *offset receives the index of the first. */
 Status scene_add_texels(Scene *s, const uint *texels, size_t n, uint *offset, Error *err);
 uint scene_find_texture(const Scene *s, const char *name);
+
+/* Records `path` (copied) as the albedo texture file of material `index`. */
+Status scene_set_material_texture(Scene *s, uint index, const char *path, Error *err);
+/* The texture file of material `index`, or NULL. */
+const char *scene_material_texture(const Scene *s, uint index);
 
 /* Index of the material with this name, or NO_INDEX. */
 uint scene_find_material(const Scene *s, const char *name);

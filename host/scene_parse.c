@@ -12,6 +12,7 @@
 
 #include "kmath.h"
 #include "lexer.h"
+#include "mesh.h"
 #include "obj.h"
 #include "texture.h"
 
@@ -32,7 +33,10 @@ typedef enum {
     VK_WORD,        /* a bare word (checked by the statement) */
     VK_MATERIAL,    /* a material name, or an inline anonymous material block */
     VK_PATH,        /* a string or a word */
-    VK_TEXTURE      /* the name of a texture defined before */
+    VK_TEXTURE,     /* the name of a texture defined before */
+    VK_ROTATE,      /* an axis (three floats, not all zero) and an angle in degrees */
+    VK_SCALE,       /* one non-zero float, or three */
+    VK_MATRIX       /* sixteen floats, a 4x4 matrix row by row */
 } ValueKind;
 
 typedef struct {
@@ -53,9 +57,8 @@ typedef struct {
     vec3 v;
     uint material;
     Token word;             /* VK_WORD, VK_PATH */
+    float a[16];            /* VK_ROTATE (axis, degrees), VK_SCALE (x y z), VK_MATRIX */
 } Value;
-
-#define MAX_KEYS 8
 
 typedef struct {
     Scene *s;
@@ -65,7 +68,26 @@ typedef struct {
     char **material_at;               /* per material index, where it was defined */
     size_t n_material_at, cap_material_at;
     int depth_exceeded;               /* the include limit error is not annotated further */
+    Token pending;                    /* a token read ahead and given back (VK_SCALE) */
+    int has_pending;
 } Parser;
+
+/* The next token, or the one given back by unread_token. */
+static Status next_token(Parser *p, Lexer *lx, Token *t)
+{
+    if (p->has_pending) {
+        *t = p->pending;
+        p->has_pending = 0;
+        return ST_OK;
+    }
+    return lex_next(lx, t, p->err);
+}
+
+static void unread_token(Parser *p, const Token *t)
+{
+    p->pending = *t;
+    p->has_pending = 1;
+}
 
 /* ------------------------------------------------------------------ helpers */
 
@@ -114,6 +136,9 @@ static const char *kind_what(const KeySpec *k)
     case VK_MATERIAL: return "a material name or an inline 'material { ... }' block";
     case VK_PATH: return "a file name";
     case VK_TEXTURE: return "a texture name";
+    case VK_ROTATE: return "an axis and an angle in degrees (4 numbers, the axis not 0 0 0)";
+    case VK_SCALE: return "a non-zero scale factor, or three (x y z)";
+    case VK_MATRIX: return "16 numbers (a 4x4 matrix, row by row)";
     case VK_NUMBER:
     case VK_UINT:
     case VK_WORD: return k->what;
@@ -146,7 +171,7 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
     char what[160];
     snprintf(what, sizeof what, "%s for '%s'", kind_what(k), k->key);
     Token t;
-    Status st = lex_next(lx, &t, err);
+    Status st = next_token(p, lx, &t);
     if (st) return st;
     v->value = t;
     switch (k->kind) {
@@ -161,7 +186,7 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
     case VK_DIR: {
         float c[3];
         for (int i = 0; i < 3; i++) {
-            if (i > 0 && (st = lex_next(lx, &t, err))) return st;
+            if (i > 0 && (st = next_token(p, lx, &t))) return st;
             if (tok_float(&t, &c[i]) || (k->kind == VK_COLOR && c[i] < 0.0f))
                 return lex_expected(lx, &t, what, err);
         }
@@ -170,6 +195,30 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
             return lex_error_at(lx, &v->value, err, "expected %s, found 0 0 0", what);
         return ST_OK;
     }
+    case VK_ROTATE:
+    case VK_MATRIX: {
+        int n = k->kind == VK_ROTATE ? 4 : 16;
+        for (int i = 0; i < n; i++) {
+            if (i > 0 && (st = next_token(p, lx, &t))) return st;
+            if (tok_float(&t, &v->a[i])) return lex_expected(lx, &t, what, err);
+        }
+        if (k->kind == VK_ROTATE && v->a[0] == 0.0f && v->a[1] == 0.0f && v->a[2] == 0.0f)
+            return lex_error_at(lx, &v->value, err, "expected %s, found the axis 0 0 0", what);
+        return ST_OK;
+    }
+    case VK_SCALE:
+        /* one factor, or three: the token after the first tells which */
+        if (tok_float(&t, &v->a[0]) || v->a[0] == 0.0f) return lex_expected(lx, &t, what, err);
+        if ((st = next_token(p, lx, &t))) return st;
+        if (tok_float(&t, &v->a[1])) {
+            unread_token(p, &t);
+            v->a[1] = v->a[2] = v->a[0];
+            return ST_OK;
+        }
+        if (v->a[1] == 0.0f) return lex_expected(lx, &t, what, err);
+        if ((st = next_token(p, lx, &t))) return st;
+        if (tok_float(&t, &v->a[2]) || v->a[2] == 0.0f) return lex_expected(lx, &t, what, err);
+        return ST_OK;
     case VK_WORD:
         if (t.kind != TOK_WORD) return lex_expected(lx, &t, what, err);
         v->word = t;
@@ -225,7 +274,7 @@ static Status parse_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken
     Error *err = p->err;
     memset(vals, 0, n * sizeof *vals);
     Token t;
-    Status st = brace_taken ? ST_OK : lex_next(lx, &t, err);
+    Status st = brace_taken ? ST_OK : next_token(p, lx, &t);
     if (st) return st;
     if (!brace_taken && t.kind != TOK_LBRACE) {
         char what[80];
@@ -233,7 +282,7 @@ static Status parse_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken
         return lex_expected(lx, &t, what, err);
     }
     for (;;) {
-        if ((st = lex_next(lx, &t, err))) return st;
+        if ((st = next_token(p, lx, &t))) return st;
         if (t.kind == TOK_RBRACE) break;
         if (t.kind == TOK_EOF)
             return lex_error_at(lx, &t, err,
@@ -503,7 +552,7 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
 static Status parse_material(Parser *p, Lexer *lx, const Token *kw)
 {
     Token t;
-    Status st = lex_next(lx, &t, p->err);
+    Status st = next_token(p, lx, &t);
     if (st) return st;
     if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
         return lex_expected(lx, &t, "a material name", p->err);
@@ -650,11 +699,74 @@ static Status parse_box(Parser *p, Lexer *lx, const Token *kw)
     return scene_add_box(p->s, b, p->err);
 }
 
-enum { MESH_FILE, MESH_MATERIAL, MESH_N };
+enum { MESH_FILE, MESH_MATERIAL, MESH_TRANSLATE, MESH_ROTATE, MESH_RX, MESH_RY, MESH_RZ, MESH_SCALE,
+       MESH_MATRIX, MESH_N };
 static const KeySpec mesh_keys[MESH_N] = {
     [MESH_FILE] = {"file", VK_PATH, 1, 0, 0, 0, 0, NULL},
-    [MESH_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+    [MESH_MATERIAL] = {"material", VK_MATERIAL, 0, 0, 0, 0, 0, NULL},
+    [MESH_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [MESH_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},
+    [MESH_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [MESH_RY] = {"ry", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [MESH_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [MESH_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
+    [MESH_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
 };
+
+/* The instance transform of a mesh block: scale, then rotate, rx, ry, rz, then
+ * translate; or a whole affine matrix, which excludes the others. */
+static Status mesh_transform(Parser *p, const Lexer *lx, const Token *kw, const Value *v, Transform *out)
+{
+    Transform t = transform_identity();
+    if (v[MESH_MATRIX].given) {
+        for (int i = MESH_TRANSLATE; i < MESH_MATRIX; i++)
+            if (v[i].given) {
+                const Token *later = &v[i].key;
+                if (v[MESH_MATRIX].key.line > later->line ||
+                    (v[MESH_MATRIX].key.line == later->line && v[MESH_MATRIX].key.col > later->col))
+                    later = &v[MESH_MATRIX].key;
+                return lex_error_at(lx, later, p->err,
+                                    "'matrix' cannot be combined with translate, rotate, rx, ry, rz or scale "
+                                    "(fold them into the matrix)");
+            }
+        const float *a = v[MESH_MATRIX].a;
+        if (a[12] != 0.0f || a[13] != 0.0f || a[14] != 0.0f || a[15] != 1.0f)
+            return lex_error_at(lx, &v[MESH_MATRIX].key, p->err,
+                                "the last row of 'matrix' must be 0 0 0 1 (an affine transform), found "
+                                "%g %g %g %g", (double)a[12], (double)a[13], (double)a[14], (double)a[15]);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 4; j++) t.m[i][j] = a[4 * i + j];
+    } else {
+        if (v[MESH_SCALE].given) {
+            const float *a = v[MESH_SCALE].a;
+            t = transform_scale(a[0], a[1], a[2]);
+        }
+        Transform r;
+        if (v[MESH_ROTATE].given) {
+            const float *a = v[MESH_ROTATE].a;
+            r = transform_rotate(a[0], a[1], a[2], a[3]);
+            t = transform_compose(&r, &t);
+        }
+        for (int axis = 0; axis < 3; axis++) {
+            const Value *rv = &v[MESH_RX + axis];
+            if (!rv->given) continue;
+            r = transform_rotate(axis == 0, axis == 1, axis == 2, rv->f);
+            t = transform_compose(&r, &t);
+        }
+        if (v[MESH_TRANSLATE].given) {
+            vec3 d = v[MESH_TRANSLATE].v;
+            r = transform_translate(d.x, d.y, d.z);
+            t = transform_compose(&r, &t);
+        }
+    }
+    double det = transform_det(&t);
+    if (!(fabs(det) > 1e-300) || !isfinite(det)) {
+        const Token *at = v[MESH_MATRIX].given ? &v[MESH_MATRIX].key : v[MESH_SCALE].given ? &v[MESH_SCALE].key : kw;
+        return lex_error_at(lx, at, p->err, "the mesh transform is singular (it flattens the mesh)");
+    }
+    *out = t;
+    return ST_OK;
+}
 
 static Status parse_mesh(Parser *p, Lexer *lx, const Token *kw)
 {
@@ -662,9 +774,15 @@ static Status parse_mesh(Parser *p, Lexer *lx, const Token *kw)
     Status st = parse_block(p, lx, kw, 0, "mesh", mesh_keys, MESH_N, v);
     if (st) return st;
     const Token *f = &v[MESH_FILE].word;
+    MeshOptions o = mesh_options(v[MESH_MATERIAL].given ? v[MESH_MATERIAL].material : NO_INDEX);
+    if ((st = mesh_transform(p, lx, kw, v, &o.xf))) return st;
     char *path = path_beside(lx->path, f->text, f->len);
     if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
-    st = obj_load(path, p->s, v[MESH_MATERIAL].material, p->err);
+    if (mesh_kind(path) == MESH_NONE) {
+        free(path);
+        return lex_expected(lx, f, "a mesh file name ending in .obj or .ply", p->err);
+    }
+    st = mesh_load(path, p->s, &o, p->err);
     free(path);
     if (st == ST_IO)
         error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
@@ -803,7 +921,7 @@ static Status parse_file(Parser *p, const char *path);
 static Status parse_include(Parser *p, Lexer *lx, const Token *kw)
 {
     Token t;
-    Status st = lex_next(lx, &t, p->err);
+    Status st = next_token(p, lx, &t);
     if (st) return st;
     if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
         return lex_expected(lx, &t, "a file name after 'include'", p->err);
@@ -845,7 +963,7 @@ static Status parse_file(Parser *p, const char *path)
     if (st) return st;
     for (;;) {
         Token t;
-        if ((st = lex_next(&lx, &t, p->err)) || t.kind == TOK_EOF) break;
+        if ((st = next_token(p, &lx, &t)) || t.kind == TOK_EOF) break;
         size_t i = N_STATEMENTS;
         if (t.kind == TOK_WORD)
             for (i = 0; i < N_STATEMENTS; i++)

@@ -176,3 +176,40 @@ __kernel void k_whitted(SCENE_ARGS, uint first_pixel, uint wave_pixels, uint fir
     barrier(CLK_LOCAL_MEM_FENCE);
     if (get_local_id(0) == 0 && group_rays) atomic_add(&counters[0], group_rays);
 }
+
+/* ------------------------------------------------------------------------------------
+ * Trace-only kernels for the traversal benchmark (bench/bench_traverse.c): one ray per
+ * work-item from a plain array, no path state. Kept apart from the render kernels above.
+ * ------------------------------------------------------------------------------------ */
+
+/* Closest hits of rays[2i] and rays[2i+1], walked in turns (trace_closest2). */
+__kernel void k_trace_closest(SCENE_ARGS, __global const Ray *rays, uint n, __global Hit *hits)
+{
+    uint a = 2u * (uint)get_global_id(0), b = a + 1u;
+    if (a >= n) return;
+    SCENE_VIEW(sc);
+    if (b < n) {
+        Hit ha, hb;
+        trace_closest2(&sc, rays[a], rays[b], &ha, &hb);
+        hits[a] = ha;
+        hits[b] = hb;
+    } else {
+        hits[a] = trace_closest(&sc, rays[a]);
+    }
+}
+
+/* Whether rays[2i] and rays[2i+1] hit anything, into occluded[] (1 or 0). */
+__kernel void k_trace_any(SCENE_ARGS, __global const Ray *rays, uint n, __global uint *occluded)
+{
+    uint a = 2u * (uint)get_global_id(0), b = a + 1u;
+    if (a >= n) return;
+    SCENE_VIEW(sc);
+    if (b < n) {
+        int oa, ob;
+        trace_any2(&sc, rays[a], rays[b], &oa, &ob);
+        occluded[a] = (uint)oa;
+        occluded[b] = (uint)ob;
+    } else {
+        occluded[a] = (uint)trace_any(&sc, rays[a]);
+    }
+}

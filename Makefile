@@ -74,6 +74,10 @@ $(BUILD)/gen_weekend: tools/gen_weekend.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(CC) -std=c11 -O1 -Wall -Wextra -o $@ $<
 
+# Writes a closed sphere mesh of any size as a binary PLY (docs/meshes.md).
+$(BUILD)/gen_mesh: tools/gen_mesh.c $(BUILD)/lib$(PROG).a
+	$(CC) $(CPPFLAGS) $(CFLAGS) -o $@ $< $(BUILD)/lib$(PROG).a $(LDFLAGS) $(LDLIBS)
+
 $(BUILD)/kernel_source.c: $(KERNELS) $(BUILD)/embed
 	$(BUILD)/embed clpt_kernel_source kernels/entry.cl > $@.tmp && mv $@.tmp $@
 
@@ -108,6 +112,15 @@ $(BUILD)/fuzz/%: fuzz/%.c fuzz/fuzz.h $(BUILD)/lib$(PROG).a
 $(BUILD)/bench/%: bench/%.c $(BUILD)/lib$(PROG).a
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -o $@ $< $(BUILD)/lib$(PROG).a $(LDFLAGS) $(LDLIBS)
+
+# The traversal benchmark compares with Embree 3: only it links libembree3, and only
+# `make bench` builds it, so the renderer and the tests never need Embree.
+$(BUILD)/.embree-ok:
+	@sh tools/deps.sh embree
+	@mkdir -p $(BUILD) && touch $@
+
+$(BUILD)/bench/bench_traverse: LDLIBS += -lembree3
+$(BUILD)/bench/bench_traverse: | $(BUILD)/.embree-ok
 
 -include $(wildcard $(BUILD)/host/*.d $(BUILD)/tests/*.d $(BUILD)/bench/*.d)
 

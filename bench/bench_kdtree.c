@@ -1,17 +1,17 @@
 /*
  * bench_kdtree.c -- kd-tree build time, tree statistics and scalar traversal rate.
  *
- *   bench_kdtree MESH [threads] [rays]
+ *   bench_kdtree [MESH [threads [rays]]]
  *
- * MESH is an ASCII PLY file (vertex x y z, then faces as vertex lists, fanned into
- * triangles), an OBJ file (only its v and f lines), "soup:N" (N random triangles in a unit cube) or "sphere:N" (a sphere
- * tessellated into about N triangles). The tree is built with the given threads (0 =
- * all cores) and with one thread, and the two node arrays must be identical. Rays go
+ * MESH is a .ply or .obj file (read by host/mesh.c), "soup:N" (N random triangles in a
+ * unit cube) or "sphere:N" (the closed bumpy sphere of mesh_make_sphere, about N
+ * triangles); without one, the full dragon of ../shared/models (or sphere:1000000 when
+ * it is not there). The tree is built with the given threads (0 = all cores, the
+ * default) and with one thread, and the two node arrays must be identical. Rays go
  * from points around the mesh towards points inside its box; before timing, the
  * first ones are checked against brute force. Traversal is the kernel code compiled
  * as C on one core.
  */
-#include <errno.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -20,6 +20,7 @@
 #include <time.h>
 
 #include "kdtree.h"
+#include "mesh.h"
 #include "traverse.cl"
 
 static double now(void)
@@ -54,86 +55,25 @@ static int mesh_add(Mesh *m, vec3 a, vec3 b, vec3 c)
     return 0;
 }
 
-/* Just enough PLY for the Stanford scans: ASCII, x y z among the vertex properties,
- * one face list property. */
-static int load_ply(const char *path, Mesh *m)
+/* An .obj or .ply file through the renderer's readers (host/mesh.c). */
+static int load_mesh(const char *path, Mesh *m)
 {
-    FILE *f = fopen(path, "r");
-    if (!f) { fprintf(stderr, "%s: %s\n", path, strerror(errno)); return -1; }
-    char line[512];
-    long nv = 0, nf = 0;
-    int nprops = 0, ix = -1, iy = -1, iz = -1, in_vertex = 0;
-    while (fgets(line, sizeof line, f)) {
-        char name[64];
-        if (sscanf(line, "element vertex %ld", &nv) == 1) { in_vertex = 1; continue; }
-        if (sscanf(line, "element face %ld", &nf) == 1) { in_vertex = 0; continue; }
-        if (in_vertex && sscanf(line, "property float %63s", name) == 1) {
-            if (!strcmp(name, "x")) ix = nprops;
-            if (!strcmp(name, "y")) iy = nprops;
-            if (!strcmp(name, "z")) iz = nprops;
-            nprops++;
+    Scene sc;
+    scene_init(&sc);
+    Error err = { 0 };
+    MeshOptions o = mesh_options(0);
+    if (mesh_load(path, &sc, &o, &err)) {
+        fprintf(stderr, "%s\n", err.msg);
+        scene_free(&sc);
+        return -1;
+    }
+    for (size_t i = 0; i < sc.n_triangles; i++)
+        if (mesh_add(m, sc.triangles[i].p0, sc.triangles[i].p1, sc.triangles[i].p2)) {
+            scene_free(&sc);
+            return -1;
         }
-        if (!strncmp(line, "end_header", 10)) break;
-    }
-    if (ix < 0 || iy < 0 || iz < 0 || nv <= 0) { fclose(f); fprintf(stderr, "%s: unsupported PLY\n", path); return -1; }
-    vec3 *v = malloc((size_t)nv * sizeof *v);
-    if (!v) { fclose(f); return -1; }
-    for (long i = 0; i < nv; i++) {
-        float p[16] = { 0 };
-        for (int j = 0; j < nprops; j++)
-            if (fscanf(f, "%f", &p[j < 16 ? j : 15]) != 1) { free(v); fclose(f); return -1; }
-        v[i] = v3(p[ix], p[iy], p[iz]);
-    }
-    for (long i = 0; i < nf; i++) {
-        int k;
-        long idx[64];
-        if (fscanf(f, "%d", &k) != 1 || k < 3 || k > 64) break;
-        for (int j = 0; j < k; j++)
-            if (fscanf(f, "%ld", &idx[j]) != 1) { k = 0; break; }
-        for (int j = 2; j < k; j++)
-            if (idx[0] < nv && idx[j - 1] < nv && idx[j] < nv && mesh_add(m, v[idx[0]], v[idx[j - 1]], v[idx[j]]))
-                { free(v); fclose(f); return -1; }
-    }
-    free(v);
-    fclose(f);
+    scene_free(&sc);
     return 0;
-}
-
-/* Just the geometry of an OBJ: "v x y z" and "f a/.. b/.. c/.." (negative = relative). */
-static int load_obj(const char *path, Mesh *m)
-{
-    FILE *f = fopen(path, "r");
-    if (!f) { fprintf(stderr, "%s: %s\n", path, strerror(errno)); return -1; }
-    vec3 *v = NULL;
-    size_t nv = 0, cap = 0;
-    char line[4096];
-    int rc = 0;
-    while (!rc && fgets(line, sizeof line, f)) {
-        if (line[0] == 'v' && line[1] == ' ') {
-            if (nv == cap) {
-                cap = cap ? 2 * cap : 4096;
-                vec3 *nvp = realloc(v, cap * sizeof *v);
-                if (!nvp) { rc = -1; break; }
-                v = nvp;
-            }
-            float x, y, z;
-            if (sscanf(line + 2, "%f %f %f", &x, &y, &z) == 3) v[nv++] = v3(x, y, z);
-        } else if (line[0] == 'f' && line[1] == ' ') {
-            long idx[64];
-            int k = 0;
-            for (char *tok = strtok(line + 2, " \t\r\n"); tok && k < 64; tok = strtok(NULL, " \t\r\n")) {
-                long i = strtol(tok, NULL, 10);
-                idx[k++] = i < 0 ? (long)nv + i : i - 1;
-            }
-            for (int j = 2; j < k; j++)
-                if (idx[0] >= 0 && idx[j - 1] >= 0 && idx[j] >= 0 && (size_t)idx[0] < nv &&
-                    (size_t)idx[j - 1] < nv && (size_t)idx[j] < nv)
-                    rc |= mesh_add(m, v[idx[0]], v[idx[j - 1]], v[idx[j]]);
-        }
-    }
-    free(v);
-    fclose(f);
-    return rc;
 }
 
 static int make_soup(Mesh *m, long n)
@@ -148,24 +88,17 @@ static int make_soup(Mesh *m, long n)
     return 0;
 }
 
-static vec3 sphere_point(int i, int j, int nu, int nv)
-{
-    float su, cu, sv, cv;
-    k_sincos(K_TWO_PI * (float)i / (float)nu, &su, &cu);
-    k_sincos(K_PI * (float)j / (float)nv, &sv, &cv);
-    return v3(sv * cu, cv, sv * su);
-}
-
+/* The closed bumpy sphere of mesh_make_sphere. */
 static int make_sphere(Mesh *m, long n)
 {
-    int nv = (int)sqrt((double)n / 4.0) + 2, nu = 2 * nv;
-    for (int j = 0; j < nv; j++)
-        for (int i = 0; i < nu; i++) {
-            vec3 a = sphere_point(i, j, nu, nv), b = sphere_point(i + 1, j, nu, nv);
-            vec3 c = sphere_point(i + 1, j + 1, nu, nv), d = sphere_point(i, j + 1, nu, nv);
-            if (mesh_add(m, a, b, c) || mesh_add(m, a, c, d)) return -1;
-        }
-    return 0;
+    Scene sc;
+    scene_init(&sc);
+    Error err = { 0 };
+    int rc = mesh_make_sphere(&sc, (size_t)n, 0, &err) ? -1 : 0;
+    for (size_t i = 0; i < sc.n_triangles && !rc; i++)
+        rc = mesh_add(m, sc.triangles[i].p0, sc.triangles[i].p1, sc.triangles[i].p2);
+    scene_free(&sc);
+    return rc;
 }
 
 static Hit brute_closest(const SceneView *sc, Ray ray)
@@ -176,27 +109,27 @@ static Hit brute_closest(const SceneView *sc, Ray ray)
         Ray r = ray;
         r.tmax = best.t;
         Hit h;
-        if (triangle_intersect(&rp, sc->triangles[i], r, &h)) { h.prim = i; best = h; }
+        if (triangle_intersect(&rp, &sc->triangles[i], r, &h)) { h.prim = i; best = h; }
     }
     return best;
 }
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) {
-        fprintf(stderr, "usage: %s MESH.ply|MESH.obj|soup:N|sphere:N [threads] [rays]\n", argv[0]);
-        return 2;
-    }
+    /* without arguments (make bench): the full dragon when it is there */
+    const char *mesh = argc > 1 ? argv[1] : "../shared/models/dragon/dragon_vrip.ply";
+    FILE *probe = argc > 1 ? NULL : fopen(mesh, "rb");
+    if (argc < 2 && !probe) mesh = "sphere:1000000";
+    if (probe) fclose(probe);
     int threads = argc > 2 ? atoi(argv[2]) : 0;
-    long n_rays = argc > 3 ? atol(argv[3]) : 1000000;
+    long n_rays = argc > 3 ? atol(argv[3]) : 300000;
     Mesh m = { 0 };
     double t0 = now();
-    int rc = !strncmp(argv[1], "soup:", 5) ? make_soup(&m, atol(argv[1] + 5))
-           : !strncmp(argv[1], "sphere:", 7) ? make_sphere(&m, atol(argv[1] + 7))
-           : strstr(argv[1], ".obj") ? load_obj(argv[1], &m)
-           : load_ply(argv[1], &m);
+    int rc = !strncmp(mesh, "soup:", 5) ? make_soup(&m, atol(mesh + 5))
+           : !strncmp(mesh, "sphere:", 7) ? make_sphere(&m, atol(mesh + 7))
+           : load_mesh(mesh, &m);
     if (rc) return 1;
-    printf("mesh %s: %zu triangles (loaded in %.2f s)\n", argv[1], m.n, now() - t0);
+    printf("mesh %s: %zu triangles (loaded in %.2f s)\n", mesh, m.n, now() - t0);
 
     KdInput in = { NULL, 0, m.t, m.n, NULL, 0 };
     KdTree tree, tree1;
@@ -223,7 +156,7 @@ int main(int argc, char **argv)
     params.n_leaf_prims = tree.n_leaf_prims;
     params.bounds_lo = tree.lo;
     params.bounds_hi = tree.hi;
-    SceneView sc = { &params, tree.nodes, tree.leaf_prims, NULL, m.t, NULL, NULL, NULL, NULL, NULL };
+    SceneView sc = { &params, tree.nodes, tree.leaf_prims, NULL, m.t, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL };
 
     vec3 c = v3_scale(v3_add(tree.lo, tree.hi), 0.5f), ext = v3_sub(tree.hi, tree.lo);
     float radius = 0.75f * v3_len(ext);

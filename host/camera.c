@@ -1,5 +1,6 @@
-/* camera.c — the thin-lens camera of "Ray Tracing in One Weekend", prepared in double
- * precision on the host so every device starts from the same float values. */
+/* camera.c — the thin-lens camera of "Ray Tracing in One Weekend" and the orthographic
+ * camera of the classic ray tracer, prepared in double precision on the host so every
+ * device starts from the same float values. */
 #include "camera.h"
 
 #include "kmath.h"
@@ -27,7 +28,10 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
     double dist = sqrt(ddot(back, back));
     if (!(dist > 0.0) || !isfinite(dist))
         return error_set(err, ST_INPUT, "camera: 'from' and 'at' must be distinct finite points");
-    if (!(desc->vfov > 0.0f && desc->vfov < 180.0f))
+    if (desc->type == CAMERA_ORTHOGRAPHIC && !(desc->ortho_height > 0.0f && isfinite(desc->ortho_height)))
+        return error_set(err, ST_INPUT, "camera: the orthographic view size must be > 0, got %g",
+                         (double)desc->ortho_height);
+    if (desc->type != CAMERA_ORTHOGRAPHIC && !(desc->vfov > 0.0f && desc->vfov < 180.0f))
         return error_set(err, ST_INPUT, "camera: fov must be between 0 and 180 degrees, got %g",
                          (double)desc->vfov);
     if (!(desc->aperture >= 0.0f) || !isfinite(desc->aperture))
@@ -39,6 +43,24 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
         return error_set(err, ST_INPUT, "camera: 'up' must not be zero or parallel to the view direction");
     u = dscale(u, 1.0 / ulen);
     dvec3 v = dcross(w, u);
+
+    if (desc->type == CAMERA_ORTHOGRAPHIC) {
+        /* the view rectangle through the camera centre, ortho_height tall */
+        double vp_h = desc->ortho_height, vp_w = vp_h * (double)width / (double)height;
+        dvec3 horizontal = dscale(u, vp_w), vertical = dscale(v, vp_h);
+        dvec3 corner = { from.x - horizontal.x / 2 + vertical.x / 2, from.y - horizontal.y / 2 + vertical.y / 2,
+                         from.z - horizontal.z / 2 + vertical.z / 2 };
+        memset(out, 0, sizeof *out);
+        out->type = CAMERA_ORTHOGRAPHIC;
+        out->origin = fv(from);
+        out->corner = fv(corner);
+        out->horizontal = fv(horizontal);
+        out->vertical = fv(vertical);
+        out->lens_u = fv(u);
+        out->lens_v = fv(v);
+        out->forward = fv(dscale(w, -1.0));
+        return ST_OK;
+    }
 
     double focus = desc->focus_dist > 0.0f ? (double)desc->focus_dist : dist;
     if (!isfinite(focus))
@@ -60,5 +82,6 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
     out->vertical = fv(vertical);
     out->lens_u = fv(u);
     out->lens_v = fv(v);
+    out->forward = fv(dscale(w, -1.0));
     return ST_OK;
 }

@@ -32,6 +32,9 @@ typedef struct {
     const Material *materials;    uint n_materials;
     const Light *lights;
     const TriShading *shading;    uint n_shading;
+    const Texture *textures;      /* params.n_textures */
+    const uint *texels;           size_t n_texels;
+    const uint *pixel_mask;       /* width * height entries when params.use_mask, else NULL */
 } DeviceScene;
 
 typedef enum { DEVICE_OPENCL, DEVICE_SCALAR } DeviceKind;

@@ -22,6 +22,7 @@
 #include "raygen.cl"
 #include "shade.cl"
 #include "traverse.cl"
+#include "whitted.cl"
 
 /* Pixels handed to a worker at a time: small enough to balance the end of a batch,
  * large enough that taking work is rare. */
@@ -73,7 +74,14 @@ static void *cpu_worker(void *arg)
         for (uint pixel = begin; pixel < end; pixel++) {
             for (uint s = 0; s < cd->count; s++) {
                 vec3 L;
-                rays += render_path(&cd->view, pixel, cd->first_sample + s, &L);
+                if (cd->params.integrator == INTEGRATOR_PATH) {
+                    rays += render_path(&cd->view, pixel, cd->first_sample + s, &L);
+                } else {
+                    /* the classic ray tracer and the auxiliary images: kernels/whitted.cl */
+                    uint n = 0;
+                    L = whitted_sample(&cd->view, pixel, cd->first_sample + s, &n);
+                    rays += n;
+                }
                 film_add(cd->film, pixel, L);
             }
         }
@@ -101,6 +109,9 @@ static Status cpu_load_scene(Device *d, const DeviceScene *scene, Error *err)
     cd->view.materials = scene->materials;
     cd->view.lights = scene->lights;
     cd->view.shading = scene->shading;
+    cd->view.textures = scene->textures;
+    cd->view.texels = scene->texels;
+    cd->view.pixel_mask = scene->pixel_mask;
     d->n_pixels = n_pixels;
     return ST_OK;
 }

@@ -22,7 +22,8 @@
 #define OCL_LOCAL_SIZE 64u
 
 enum { SCENE_PARAMS, SCENE_NODES, SCENE_LEAF_PRIMS, SCENE_SPHERES, SCENE_TRIANGLES,
-       SCENE_BOXES, SCENE_PLANES, SCENE_MATERIALS, SCENE_LIGHTS, SCENE_SHADING, SCENE_N };
+       SCENE_BOXES, SCENE_PLANES, SCENE_MATERIALS, SCENE_LIGHTS, SCENE_SHADING,
+       SCENE_TEXTURES, SCENE_TEXELS, SCENE_PIXEL_MASK, SCENE_N };
 
 typedef struct {
     OclDeviceInfo info;
@@ -30,6 +31,8 @@ typedef struct {
     cl_command_queue queue;
     cl_program program;
     cl_kernel k_raygen, k_intersect, k_shade, k_shadow, k_film;
+    cl_kernel k_whitted;    /* the classic ray tracer and auxiliary images */
+    uint integrator;        /* enum Integrator of the loaded scene */
     cl_mem scene[SCENE_N];
     cl_mem paths, rays, hits, shadow_rays, queue_a, queue_b, shadow_queue, counters, film;
     uint wave_paths;        /* capacity of the wave buffers */
@@ -137,6 +140,9 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
         { s->materials, (size_t)s->n_materials * sizeof(Material), "materials" },
         { s->lights, (size_t)p->n_lights * sizeof(Light), "lights" },
         { s->shading, (size_t)s->n_shading * sizeof(TriShading), "shading normals" },
+        { s->textures, (size_t)p->n_textures * sizeof(Texture), "textures" },
+        { s->texels, s->n_texels * sizeof(uint), "texture images" },
+        { s->pixel_mask, s->pixel_mask ? (size_t)p->width * p->height * sizeof(uint) : 0, "pixel mask" },
     };
     uint n_pixels = p->width * p->height;
     uint wave = od->wave_paths;
@@ -170,12 +176,44 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
                                                        film_bytes < 16 ? 16 : film_bytes, 0, NULL, NULL));
     OCL_TRY("clFinish", clFinish(od->queue));
     if ((st = set_scene_args(od, od->k_intersect, err)) || (st = set_scene_args(od, od->k_shade, err)) ||
-        (st = set_scene_args(od, od->k_shadow, err)))
+        (st = set_scene_args(od, od->k_shadow, err)) || (st = set_scene_args(od, od->k_whitted, err)))
         return st;
+    od->integrator = p->integrator;
     od->width = p->width;
     od->height = p->height;
     d->n_pixels = n_pixels;
     d->counters.upload_seconds += timer_now() - t0;
+    return ST_OK;
+}
+
+/* The classic ray tracer's wave (kernels/whitted.cl): one k_whitted launch computes
+ * every sample whole, then k_film adds them as for the path tracer. */
+static Status render_wave_whitted(OclDevice *od, uint first_pixel, uint wave_pixels, uint first_sample,
+                                  uint layers, uint64_t *rays, Error *err)
+{
+    uint n_paths = wave_pixels * layers;
+    Status st;
+    cl_uint zero = 0, count = 0;
+    OCL_TRY("clEnqueueWriteBuffer", clEnqueueWriteBuffer(od->queue, od->counters, CL_FALSE, 0, sizeof zero,
+                                                         &zero, 0, NULL, NULL));
+    cl_kernel k = od->k_whitted;
+    ARG(k, SCENE_N + 0, first_pixel);
+    ARG(k, SCENE_N + 1, wave_pixels);
+    ARG(k, SCENE_N + 2, first_sample);
+    ARG(k, SCENE_N + 3, n_paths);
+    ARG(k, SCENE_N + 4, od->paths);
+    ARG(k, SCENE_N + 5, od->counters);
+    if ((st = launch(od, k, "k_whitted", n_paths, err))) return st;
+    k = od->k_film;
+    ARG(k, 0, od->paths);
+    ARG(k, 1, first_pixel);
+    ARG(k, 2, wave_pixels);
+    ARG(k, 3, layers);
+    ARG(k, 4, od->film);
+    if ((st = launch(od, k, "k_film", wave_pixels, err))) return st;
+    OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, od->counters, CL_TRUE, 0, sizeof count,
+                                                       &count, 0, NULL, NULL));
+    *rays += count;
     return ST_OK;
 }
 
@@ -184,6 +222,8 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
 static Status render_wave(OclDevice *od, uint first_pixel, uint wave_pixels, uint first_sample,
                           uint layers, uint64_t *rays, Error *err)
 {
+    if (od->integrator != INTEGRATOR_PATH)
+        return render_wave_whitted(od, first_pixel, wave_pixels, first_sample, layers, rays, err);
     uint n_paths = wave_pixels * layers;
     Status st;
     cl_kernel k = od->k_raygen;
@@ -306,7 +346,7 @@ static void ocl_destroy(Device *d)
     OclDevice *od = d->impl;
     if (od) {
         release_buffers(od);
-        cl_kernel ks[] = { od->k_raygen, od->k_intersect, od->k_shade, od->k_shadow, od->k_film };
+        cl_kernel ks[] = { od->k_raygen, od->k_intersect, od->k_shade, od->k_shadow, od->k_film, od->k_whitted };
         for (size_t i = 0; i < sizeof ks / sizeof ks[0]; i++)
             if (ks[i]) clReleaseKernel(ks[i]);
         if (od->program) clReleaseProgram(od->program);
@@ -337,7 +377,8 @@ static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error
         (st = ocl_program_kernel(od->program, &od->info, "k_intersect", &od->k_intersect, err)) ||
         (st = ocl_program_kernel(od->program, &od->info, "k_shade", &od->k_shade, err)) ||
         (st = ocl_program_kernel(od->program, &od->info, "k_shadow", &od->k_shadow, err)) ||
-        (st = ocl_program_kernel(od->program, &od->info, "k_film", &od->k_film, err)))
+        (st = ocl_program_kernel(od->program, &od->info, "k_film", &od->k_film, err)) ||
+        (st = ocl_program_kernel(od->program, &od->info, "k_whitted", &od->k_whitted, err)))
         return st;
     int gpu = (od->info.type & CL_DEVICE_TYPE_GPU) != 0;
     /* A GPU needs about a million paths in flight to hide memory latency; a CPU is full

@@ -1,5 +1,5 @@
 /*
- * image_write.c — PNG/PPM/PFM encoding over an atomic temp-file-and-rename writer.
+ * image_write.c — PNG/PPM/BMP/PFM encoding over an atomic temp-file-and-rename writer.
  *
  * PNG compression is stb_image_write's (Debian's libstb); it hands us the finished file
  * in memory through a callback, so every byte on disk goes through our own checked writes.
@@ -20,7 +20,7 @@
 
 #include <stb_image_write.h>
 
-#define SUPPORTED_EXTENSIONS ".png, .ppm, .pfm"
+#define SUPPORTED_EXTENSIONS ".png, .ppm, .pfm, .bmp"
 
 Status image_format_from_path(const char *path, ImageFormat *fmt, Error *err)
 {
@@ -34,6 +34,7 @@ Status image_format_from_path(const char *path, ImageFormat *fmt, Error *err)
     if (strcasecmp(dot, ".png") == 0) *fmt = IMAGE_PNG;
     else if (strcasecmp(dot, ".ppm") == 0) *fmt = IMAGE_PPM;
     else if (strcasecmp(dot, ".pfm") == 0) *fmt = IMAGE_PFM;
+    else if (strcasecmp(dot, ".bmp") == 0) *fmt = IMAGE_BMP;
     else
         return error_set(err, ST_USAGE,
                          "cannot tell the image format of '%s': unsupported extension '%s' "
@@ -55,6 +56,14 @@ float image_srgb_encode(float linear)
 unsigned char image_to_srgb8(float linear)
 {
     return (unsigned char)floor((double)image_srgb_encode(linear) * 255.0 + 0.5);
+}
+
+unsigned char image_to_linear8(float linear)
+{
+    double x = linear;
+    if (!(x > 0.0)) return 0;
+    if (x >= 1.0) return 255;
+    return (unsigned char)floor(x * 255.0 + 0.5);
 }
 
 /* ------------------------------------------------------------------ atomic file */
@@ -220,6 +229,49 @@ static void write_png(AtomicFile *af, const unsigned char *srgb, unsigned w, uns
     }
 }
 
+static void put_le(unsigned char *p, uint32_t v, int bytes)
+{
+    for (int i = 0; i < bytes; i++) p[i] = (unsigned char)(v >> (8 * i));
+}
+
+/* BMP: the 14-byte file header and the 40-byte BITMAPINFOHEADER, then 24-bit BGR rows
+ * bottom to top, each padded to a multiple of 4 bytes. */
+static void write_bmp(AtomicFile *af, const unsigned char *rgb8, unsigned w, unsigned h)
+{
+    size_t row = ((size_t)w * 3 + 3) & ~(size_t)3;
+    unsigned char header[54];
+    memset(header, 0, sizeof header);
+    header[0] = 'B';
+    header[1] = 'M';
+    put_le(header + 2, (uint32_t)(sizeof header + row * h), 4);
+    put_le(header + 10, sizeof header, 4);
+    put_le(header + 14, 40, 4);
+    put_le(header + 18, w, 4);
+    put_le(header + 22, h, 4);
+    put_le(header + 26, 1, 2);       /* planes */
+    put_le(header + 28, 24, 2);      /* bits per pixel; compression 0 (none) */
+    put_le(header + 34, (uint32_t)(row * h), 4);
+    put_le(header + 38, 2835, 4);    /* 72 dpi */
+    put_le(header + 42, 2835, 4);
+    atomic_write(af, header, sizeof header);
+    unsigned char *line = calloc(row, 1);
+    if (!line) {
+        errno = ENOMEM;
+        atomic_fail(af, "BMP encoding");
+        return;
+    }
+    for (unsigned y = h; y-- > 0;) {
+        const unsigned char *src = rgb8 + (size_t)y * w * 3;
+        for (size_t x = 0; x < w; x++) {
+            line[3 * x + 0] = src[3 * x + 2];
+            line[3 * x + 1] = src[3 * x + 1];
+            line[3 * x + 2] = src[3 * x + 0];
+        }
+        atomic_write(af, line, row);
+    }
+    free(line);
+}
+
 /* PFM: a text header, scale -1 meaning little-endian floats, then the rows bottom to top.
  * Bytes are assembled explicitly so the file is the same on a big-endian host. */
 static Status write_pfm(AtomicFile *af, const float *rgb, unsigned w, unsigned h, Error *err)
@@ -249,6 +301,12 @@ static Status write_pfm(AtomicFile *af, const float *rgb, unsigned w, unsigned h
 Status image_write(const char *path, const float *rgb, unsigned width, unsigned height,
                    Error *err)
 {
+    return image_write_encoded(path, rgb, width, height, IMAGE_SRGB, err);
+}
+
+Status image_write_encoded(const char *path, const float *rgb, unsigned width, unsigned height,
+                           ImageEncoding encoding, Error *err)
+{
     ImageFormat fmt;
     Status st = image_format_from_path(path, &fmt, err);
     if (st != ST_OK) return st;
@@ -268,7 +326,8 @@ Status image_write(const char *path, const float *rgb, unsigned width, unsigned 
     if (fmt != IMAGE_PFM) {
         srgb = malloc(count);
         if (!srgb) return error_set(err, ST_INTERNAL, "cannot write '%s': out of memory", path);
-        for (size_t i = 0; i < count; i++) srgb[i] = image_to_srgb8(rgb[i]);
+        for (size_t i = 0; i < count; i++)
+            srgb[i] = encoding == IMAGE_LINEAR ? image_to_linear8(rgb[i]) : image_to_srgb8(rgb[i]);
     }
 
     AtomicFile af;
@@ -280,6 +339,7 @@ Status image_write(const char *path, const float *rgb, unsigned width, unsigned 
     switch (fmt) {
     case IMAGE_PNG: write_png(&af, srgb, width, height); break;
     case IMAGE_PPM: write_ppm(&af, srgb, width, height); break;
+    case IMAGE_BMP: write_bmp(&af, srgb, width, height); break;
     case IMAGE_PFM: st = write_pfm(&af, rgb, width, height, err); break;
     }
     free(srgb);

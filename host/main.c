@@ -9,11 +9,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "classic_parse.h"
 #include "device.h"
 #include "film.h"
 #include "image_write.h"
 #include "limit.h"
+#include "mesh.h"
+#include "mesh_view.h"
 #include "options.h"
+#include "passes.h"
 #include "progress.h"
 #include "render_scene.h"
 #include "scene.h"
@@ -44,6 +48,7 @@ typedef struct {
     const char *output;
     int quiet;
     int progressive_failed;
+    ImageEncoding encoding;
 } RenderContext;
 
 static void print_warning(void *ctx, const char *msg)
@@ -52,13 +57,13 @@ static void print_warning(void *ctx, const char *msg)
     fprintf(stderr, "\r\033[Kclpt: warning: %s\n", msg);
 }
 
-static Status write_film(const Film *film, const char *path, Error *err)
+static Status write_film(const Film *film, const char *path, ImageEncoding encoding, Error *err)
 {
     size_t n = (size_t)film->width * film->height * 3u;
     float *rgb = malloc(n * sizeof *rgb);
     if (!rgb) return error_set(err, ST_INTERNAL, "out of memory resolving the image");
     film_resolve(film, rgb);
-    Status st = image_write(path, rgb, film->width, film->height, err);
+    Status st = image_write_encoded(path, rgb, film->width, film->height, encoding, err);
     free(rgb);
     return st;
 }
@@ -70,7 +75,7 @@ static void on_progress_tick(void *vctx, const Film *film)
     RenderContext *ctx = vctx;
     if (film->samples == 0) return;
     Error err = { 0 };
-    if (write_film(film, ctx->output, &err) != ST_OK && !ctx->progressive_failed) {
+    if (write_film(film, ctx->output, ctx->encoding, &err) != ST_OK && !ctx->progressive_failed) {
         ctx->progressive_failed = 1;
         print_warning(NULL, err.msg);
     }
@@ -101,6 +106,45 @@ static void apply_overrides(const Options *o, Scene *s)
     if (o->height >= 0) s->image.height = (uint)o->height;
     if (o->seed >= 0) s->image.seed = (uint)o->seed;
     if (o->max_depth >= 0) s->image.max_depth = (uint)o->max_depth;
+    if (o->integrator >= 0) s->integrator = (uint)o->integrator;
+    if (o->gamma >= 0) s->linear_output = o->gamma == 1;
+}
+
+/* The adaptive pass and the auxiliary images, after the main image is in rgb (and
+ * written). A failure here is the run's failure; the main image stays written. */
+static Status run_passes(const Options *o, const PassContext *pc, const char *output, ImageEncoding encoding,
+                         float *rgb, uint spp, Error *err)
+{
+    uint w = pc->rs->ds.params.width, h = pc->rs->ds.params.height;
+    Status st = ST_OK;
+    if (o->adaptive > 0.0) {
+        size_t marked = 0;
+        double secs = 0.0;
+        if ((st = passes_adaptive(pc, rgb, spp, (float)o->adaptive, o->adaptive_spp, &marked, &secs, err)))
+            return st;
+        if ((st = image_write_encoded(output, rgb, w, h, encoding, err))) return st;
+        if (!o->quiet)
+            fprintf(stderr, "clpt: adaptive pass: %zu of %u pixels (%.1f%%) got %u more samples in %.2f s -> %s\n",
+                    marked, w * h, 100.0 * (double)marked / ((double)w * h), o->adaptive_spp, secs, output);
+    }
+    for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
+        if (!(o->aovs & (1u << aov))) continue;
+        char *path = passes_aov_path(output, options_aov_name(aov));
+        if (!path) return error_set(err, ST_INTERNAL, "out of memory");
+        ImageFormat fmt = IMAGE_PNG;
+        image_format_from_path(path, &fmt, err);
+        double secs = 0.0;
+        DepthScale depth = { fmt == IMAGE_PFM ? DEPTH_RAW : (o->depth_far > 0.0 ? DEPTH_RANGE : DEPTH_AUTO),
+                             o->depth_near, o->depth_far };
+        st = passes_aov(pc, aov, spp, &depth, rgb, &secs, err);
+        /* auxiliary images hold data, not light: no sRGB curve */
+        if (!st) st = image_write_encoded(path, rgb, w, h, IMAGE_LINEAR, err);
+        if (!st && !o->quiet)
+            fprintf(stderr, "clpt: %s image in %.2f s -> %s\n", options_aov_name(aov), secs, path);
+        free(path);
+        if (st) return st;
+    }
+    return ST_OK;
 }
 
 static void print_scene_stats(const Scene *s, const KdTree *kd)
@@ -110,7 +154,8 @@ static void print_scene_stats(const Scene *s, const KdTree *kd)
     printf("scene: %zu spheres, %zu triangles, %zu boxes, %zu planes, %zu materials, %zu lights\n",
            s->n_spheres, s->n_triangles, s->n_boxes, s->n_planes, s->n_materials, s->n_lights);
     printf("kd-tree: built in %.3f s; %u nodes, %u leaves (%u empty), depth %u, "
-           "%.2f primitives per non-empty leaf, SAH cost %.2f, %.1f KiB (%.1f bytes per primitive)\n",
+           "%.2f primitives per non-empty leaf, SAH cost %.2f, %.1f KiB (nodes + leaf lists: "
+           "%.1f bytes per primitive)\n",
            k->build_seconds, k->n_nodes, k->n_leaves, k->n_empty_leaves, k->max_depth,
            k->mean_prims_per_leaf, k->sah_cost, (double)k->bytes / 1024.0,
            in_tree ? (double)k->bytes / (double)in_tree : 0.0);
@@ -240,11 +285,21 @@ static Status run(int argc, char **argv, Error *err)
     double t_start = timer_now();
 
     if ((st = image_format_from_path(output, &format, err))) goto done;
-    if ((st = scene_load(o.scene_path, &scene, err))) goto done;
+    /* a mesh file given in place of a scene is shown in a scene made around it */
+    int bare_mesh = mesh_kind(o.scene_path) != MESH_NONE;
+    if ((st = bare_mesh ? mesh_view_load(o.scene_path, &scene, err)
+                        : scene_load_format(o.scene_path, (SceneFormat)o.format, &scene, err)))
+        goto done;
     apply_overrides(&o, &scene);
     if ((o.width >= 0 || o.height >= 0) &&
         (st = limit_pixels(scene.image.width, scene.image.height, ST_USAGE, "--width/--height", err)))
         goto done;
+    if (bare_mesh) mesh_view_fit(&scene);
+    if (o.adaptive > 0.0 && scene.integrator != INTEGRATOR_WHITTED) {
+        st = error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
+        goto done;
+    }
+    ImageEncoding encoding = scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB;
     if ((st = render_scene_prepare(&scene, 0, &rs, err))) goto done;
     const DeviceScene *ds = &rs.ds;
     if (o.stats) print_scene_stats(&scene, &rs.kd);
@@ -253,7 +308,7 @@ static Status run(int argc, char **argv, Error *err)
     if ((st = film_init(&film, ds->params.width, ds->params.height, err))) goto done;
 
     install_signal_handlers();
-    RenderContext ctx = { output, o.quiet, 0 };
+    RenderContext ctx = { output, o.quiet, 0, encoding };
     ScheduleConfig cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.spp = scene.image.spp;
@@ -272,7 +327,7 @@ static Status run(int argc, char **argv, Error *err)
     }
     /* Whatever was finished is written, also after an interrupt or device failures. */
     Error werr = { 0 };
-    if ((st = write_film(&film, output, &werr))) {
+    if ((st = write_film(&film, output, encoding, &werr))) {
         if (render_st == ST_OK) {
             *err = werr;
         } else {
@@ -292,6 +347,21 @@ static Status run(int argc, char **argv, Error *err)
                 (double)stats.samples / secs / 1e6, (double)stats.rays / secs / 1e6, output);
     }
     st = render_st != ST_OK ? render_st : (stats.interrupted ? ST_INTERRUPTED : ST_OK);
+    if (st == ST_OK && (o.adaptive > 0.0 || o.aovs)) {
+        size_t n = (size_t)film.width * film.height * 3u;
+        float *rgb = malloc(n * sizeof *rgb);
+        if (!rgb) {
+            st = error_set(err, ST_INTERNAL, "out of memory");
+            goto done;
+        }
+        film_resolve(&film, rgb);
+        ScheduleConfig pcfg = cfg;
+        pcfg.show_progress = 0;
+        PassContext pc = { devs, n_devs, &rs, &pcfg };
+        st = run_passes(&o, &pc, output, encoding, rgb, (uint)film.samples, err);
+        free(rgb);
+        if (st == ST_OK && stop_requested) st = ST_INTERRUPTED;
+    }
 
 done:
     schedule_stats_free(&stats);

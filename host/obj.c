@@ -7,9 +7,11 @@
  * few digits take an exact fast path (see parse_float); the rest go to strtof.
  */
 #include "obj.h"
+#include "texture.h"
 
 #include "kmath.h"
 #include "lexer.h"
+#include "mtl.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -28,7 +30,13 @@ typedef struct {
     const char *line_start;
     uint line;
     Scene *s;
-    uint material;
+    const MeshOptions *opt;
+    MeshSink sink;
+    uint material;               /* of the faces being read; NO_INDEX: the default */
+    uint default_material;       /* the default, once needed */
+    MtlLibrary lib;              /* the mtllib files read so far */
+    uint *lib_index;             /* per library entry: its scene material, or NO_INDEX */
+    size_t n_lib_index, cap_lib_index;
     Error *err;
     vec3 *pos;     size_t n_pos, cap_pos;
     float *uv;     size_t n_uv, cap_uv;       /* pairs */
@@ -120,45 +128,11 @@ static Status fail_at(ObjReader *r, const char *q, const char *what)
 
 /* ------------------------------------------------------------------ numbers */
 
-static const float pow10_exact[11] = {1e0f, 1e1f, 1e2f, 1e3f, 1e4f, 1e5f,
-                                      1e6f, 1e7f, 1e8f, 1e9f, 1e10f};
-
-/* Reads one number at the cursor, exactly as strtof would round it. The fast path
- * takes plain decimals whose digits form an integer m <= 2^24 with at most 10 of them
- * after the point: m and 10^k (k <= 10, since 5^10 < 2^24) are then exact floats, so
- * the single IEEE division m / 10^k is the correctly rounded value, which is strtof's
- * answer. Everything else (exponents, long mantissas, hex) goes to strtof. */
+/* Reads one number at the cursor, exactly as strtof would round it. */
 static int parse_float(ObjReader *r, float *out)
 {
-    const char *q = r->p;
-    /* strtof would skip leading white space (\v, \f) that OBJ does not allow */
-    if (q >= r->end || isspace((unsigned char)*q)) return -1;
-    int neg = 0;
-    if (q < r->end && (*q == '-' || *q == '+')) neg = *q++ == '-';
-    uint64_t m = 0;
-    int digits = 0, frac = 0, seen_point = 0;
-    for (; q < r->end; q++) {
-        if (*q >= '0' && *q <= '9') {
-            if (digits < 19) m = m * 10 + (uint64_t)(*q - '0');
-            digits += m > 0 || *q != '0';   /* leading zeros are free */
-            frac += seen_point;
-        } else if (*q == '.' && !seen_point) {
-            seen_point = 1;
-        } else {
-            break;
-        }
-    }
-    int has_digit = q > r->p + (neg || *r->p == '+') + seen_point;
-    if (has_digit && is_delim(r, q) && digits < 19 && m <= (1u << 24) && frac <= 10) {
-        float v = (float)m / pow10_exact[frac];
-        *out = neg ? -v : v;
-        r->p = q;
-        return 0;
-    }
-    char *e;
-    float v = strtof(r->p, &e);
-    if (e == r->p || !is_delim(r, e) || !isfinite(v)) return -1;
-    *out = v;
+    const char *e = mesh_parse_float(r->p, r->end, out);
+    if (!e || !is_delim(r, e)) return -1;
     r->p = e;
     return 0;
 }
@@ -278,38 +252,46 @@ static Status read_index(ObjReader *r, const char *tok, size_t count, const char
     return ST_OK;
 }
 
-static Status emit_triangle(ObjReader *r, const Corner *a, const Corner *b, const Corner *c)
+/* The scene material of the faces being read: the override, the current usemtl's, or
+ * the default (added on first use when the caller gave none). */
+static Status face_material(ObjReader *r, uint *out)
 {
-    Triangle t;
-    memset(&t, 0, sizeof t);
-    t.p0 = r->pos[a->v];
-    t.p1 = r->pos[b->v];
-    t.p2 = r->pos[c->v];
-    t.material = r->material;
-    t.shading = NO_INDEX;
-    uint flags = 0;
-    if (a->n != NO_INDEX && b->n != NO_INDEX && c->n != NO_INDEX &&
-        !v3_is_zero(r->nrm[a->n]) && !v3_is_zero(r->nrm[b->n]) && !v3_is_zero(r->nrm[c->n]))
-        flags |= TRI_HAS_NORMALS;
-    if (a->t != NO_INDEX && b->t != NO_INDEX && c->t != NO_INDEX) flags |= TRI_HAS_UV;
-    if (flags) {
-        TriShading sh;
-        memset(&sh, 0, sizeof sh);
-        sh.flags = flags;
-        if (flags & TRI_HAS_NORMALS) {
-            sh.n0 = r->nrm[a->n];
-            sh.n1 = r->nrm[b->n];
-            sh.n2 = r->nrm[c->n];
-        }
-        if (flags & TRI_HAS_UV) {
-            memcpy(sh.uv0, &r->uv[2 * a->t], sizeof sh.uv0);
-            memcpy(sh.uv1, &r->uv[2 * b->t], sizeof sh.uv1);
-            memcpy(sh.uv2, &r->uv[2 * c->t], sizeof sh.uv2);
-        }
-        Status st = scene_add_shading(r->s, sh, &t.shading, r->err);
+    if (r->opt->material != NO_INDEX) {
+        *out = r->opt->material;
+        return ST_OK;
+    }
+    if (r->material != NO_INDEX) {
+        *out = r->material;
+        return ST_OK;
+    }
+    if (r->default_material == NO_INDEX) {
+        Status st = scene_add_material(r->s, "", material_diffuse(v3s(MESH_DEFAULT_ALBEDO)),
+                                       &r->default_material, r->err);
         if (st) return st;
     }
-    return scene_add_triangle(r->s, t, r->err);
+    *out = r->default_material;
+    return ST_OK;
+}
+
+static Status emit_triangle(ObjReader *r, const Corner *a, const Corner *b, const Corner *c)
+{
+    const Corner *k[3] = { a, b, c };
+    vec3 p[3], n[3];
+    float uv[6];
+    int has_n = 1, has_uv = 1;
+    for (int i = 0; i < 3; i++) {
+        p[i] = r->pos[k[i]->v];
+        has_n = has_n && k[i]->n != NO_INDEX && !v3_is_zero(r->nrm[k[i]->n]);
+        has_uv = has_uv && k[i]->t != NO_INDEX;
+    }
+    for (int i = 0; i < 3; i++) {
+        if (has_n) n[i] = r->nrm[k[i]->n];
+        if (has_uv) memcpy(&uv[2 * i], &r->uv[2 * k[i]->t], 2 * sizeof *uv);
+    }
+    uint material;
+    Status st = face_material(r, &material);
+    if (st) return st;
+    return mesh_sink_triangle(&r->sink, p, has_n ? n : NULL, has_uv ? uv : NULL, material);
 }
 
 static Status read_f(ObjReader *r, const char *kw)
@@ -350,17 +332,84 @@ static Status read_f(ObjReader *r, const char *kw)
     return ST_OK;
 }
 
-/* Statements accepted and skipped: grouping, smoothing and materials (MTL support
- * comes with the meshes work), and line and point elements, which have no surface. */
-static const char *const ignored[] = {"o", "g", "s", "usemtl", "mtllib", "l", "p"};
+/* The rest of the statement, blanks trimmed (names may contain spaces). */
+static void rest_of_line(ObjReader *r, const char **b, const char **e)
+{
+    skip_hspace(r);
+    *b = r->p;
+    while (!at_eol(r)) r->p++;
+    const char *q = r->p;
+    while (q > *b && (q[-1] == ' ' || q[-1] == '\t' || q[-1] == '\r')) q--;
+    *e = q;
+}
+
+/* mtllib FILE...: each file is read into the library now (relative to the OBJ). A file
+ * that cannot be opened is skipped, as most OBJ readers do: meshes often travel without
+ * their MTL, and their faces then get the default material. */
+static Status read_mtllib(ObjReader *r)
+{
+    if (r->opt->material != NO_INDEX) return ST_OK;   /* overridden: the MTL is not needed */
+    for (;;) {
+        skip_hspace(r);
+        if (at_eol(r)) break;
+        const char *name = r->p;
+        while (!is_delim(r, r->p)) r->p++;
+        char *path = mesh_resolve_path(r->path, name, (size_t)(r->p - name));
+        if (!path) return error_set(r->err, ST_INTERNAL, "out of memory reading '%s'", r->path);
+        Status st = mtl_load(path, &r->lib, r->err);
+        free(path);
+        if (st == ST_IO) {
+            error_clear(r->err);
+            continue;
+        }
+        if (st) return st;
+    }
+    return ST_OK;
+}
+
+/* usemtl NAME: the faces that follow get the library's material NAME, added to the
+ * scene the first time it is used. A name no MTL defines gives the default material
+ * (McGuire's glossy Cornell boxes use a 'light' their MTL lacks). */
+static Status read_usemtl(ObjReader *r)
+{
+    const char *name, *end;
+    rest_of_line(r, &name, &end);
+    if (r->opt->material != NO_INDEX) return ST_OK;
+    const MtlMaterial *m = mtl_find(&r->lib, name, (size_t)(end - name));
+    if (!m) {
+        r->material = NO_INDEX;
+        return ST_OK;
+    }
+    size_t i = (size_t)(m - r->lib.items);
+    if (array_reserve((void **)&r->lib_index, &r->cap_lib_index, r->lib.n, sizeof *r->lib_index))
+        return error_set(r->err, ST_INTERNAL, "out of memory reading '%s'", r->path);
+    while (r->n_lib_index < r->lib.n) r->lib_index[r->n_lib_index++] = NO_INDEX;
+    if (r->lib_index[i] == NO_INDEX) {
+        Status st = scene_add_material(r->s, "", m->m, &r->lib_index[i], r->err);
+        if (!st && m->texture) st = scene_set_material_texture(r->s, r->lib_index[i], m->texture, r->err);
+        /* map_Kd: the diffuse colour comes from the image (sRGB, repeating) */
+        if (!st && m->texture) {
+            uint tex;
+            st = texture_load_image(r->s, NULL, m->texture, 0, 0, &tex, r->err);
+            if (!st) r->s->materials[r->lib_index[i]].texture = tex;
+        }
+        if (st) return st;
+    }
+    r->material = r->lib_index[i];
+    return ST_OK;
+}
+
+/* Statements accepted and skipped: grouping and smoothing, and line and point
+ * elements, which have no surface. */
+static const char *const ignored[] = {"o", "g", "s", "l", "p"};
 
 static int word_is(const char *q, size_t len, const char *w)
 {
     return strlen(w) == len && memcmp(q, w, len) == 0;
 }
 
-Status obj_parse(const char *path, const char *text, size_t len, Scene *s, uint material,
-                 Error *err)
+Status obj_parse_with(const char *path, const char *text, size_t len, Scene *s, const MeshOptions *o,
+                      Error *err)
 {
     ObjReader r;
     memset(&r, 0, sizeof r);
@@ -370,10 +419,12 @@ Status obj_parse(const char *path, const char *text, size_t len, Scene *s, uint 
     r.line_start = text;
     r.line = 1;
     r.s = s;
-    r.material = material;
+    r.opt = o;
+    r.material = NO_INDEX;
+    r.default_material = o->default_material;
     r.err = err;
-    Status st = ST_OK;
-    while (r.p < r.end) {
+    Status st = mesh_sink_open(&r.sink, s, &o->xf, path, err);
+    while (!st && r.p < r.end) {
         skip_hspace(&r);
         if (at_eol(&r)) {
             next_line(&r);
@@ -390,6 +441,10 @@ Status obj_parse(const char *path, const char *text, size_t len, Scene *s, uint 
             st = read_vt(&r);
         } else if (word_is(kw, kl, "vn")) {
             st = read_vn(&r);
+        } else if (word_is(kw, kl, "usemtl")) {
+            st = read_usemtl(&r);
+        } else if (word_is(kw, kl, "mtllib")) {
+            st = read_mtllib(&r);
         } else {
             size_t i, n = sizeof ignored / sizeof ignored[0];
             for (i = 0; i < n; i++)
@@ -404,16 +459,30 @@ Status obj_parse(const char *path, const char *text, size_t len, Scene *s, uint 
     free(r.uv);
     free(r.nrm);
     free(r.face);
+    free(r.lib_index);
+    mtl_free(&r.lib);
     return st;
 }
 
-Status obj_load(const char *path, Scene *s, uint material, Error *err)
+Status obj_parse(const char *path, const char *text, size_t len, Scene *s, uint material, Error *err)
+{
+    MeshOptions o = mesh_options(material);
+    return obj_parse_with(path, text, len, s, &o, err);
+}
+
+Status obj_load_with(const char *path, Scene *s, const MeshOptions *o, Error *err)
 {
     char *text;
     size_t len;
     Status st = lex_read_file(path, &text, &len, err);
     if (st) return st;
-    st = obj_parse(path, text, len, s, material, err);
+    st = obj_parse_with(path, text, len, s, o, err);
     free(text);
     return st;
+}
+
+Status obj_load(const char *path, Scene *s, uint material, Error *err)
+{
+    MeshOptions o = mesh_options(material);
+    return obj_load_with(path, s, &o, err);
 }

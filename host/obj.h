@@ -7,26 +7,36 @@
  * three corners all carry normals and/or texture coordinates gets a TriShading record
  * (normals made unit length; a zero-length normal drops the normals of that triangle),
  * otherwise its shading index is NO_INDEX. Degenerate triangles are kept as written.
- * `o`, `g`, `s`, `usemtl`, `mtllib`, `l` and `p` are accepted and ignored: every
- * triangle gets the one material given by the caller (materials from MTL files come
- * with the meshes work). `#` comments, blank lines, CRLF line ends and `\` line
- * continuations are accepted.
+ * `mtllib` reads MTL files (mtl.h; names resolved from the OBJ's folder, without
+ * regard to case when the exact name is missing) and `usemtl` gives the faces that
+ * follow that material, added to the scene on first use (with its map_Kd path, see
+ * scene_set_material_texture); faces before any `usemtl` get the default material.
+ * When the caller gives a material, every triangle gets it and `mtllib`/`usemtl` are
+ * not read. `o`, `g`, `s`, `l` and `p` are accepted and ignored. `#` comments, blank
+ * lines, CRLF line ends and `\` line continuations are accepted.
  *
  * Errors: ST_IO "cannot open 'path': <reason>"; ST_INPUT "path:line:col: expected ...,
  * found '...'" for anything malformed (bad numbers, index 0 or out of range, a face
- * with fewer than 3 vertices, an unknown statement).
+ * with fewer than 3 vertices, an unknown statement, a usemtl name no mtllib defines);
+ * an MTL file that cannot be read is ST_IO prefixed with the mtllib's position.
  */
 #ifndef CLPT_OBJ_H
 #define CLPT_OBJ_H
 
-#include "scene.h"
+#include "mesh.h"
 
-/* Appends the mesh's triangles (and shading records) to the scene, all with
- * `material`. On failure the scene may hold some of the mesh's triangles. */
+/* Appends the mesh's triangles (and shading records) to the scene, transformed and
+ * with materials as the options say (mesh.h). On failure the scene may hold some of
+ * the mesh's triangles. */
+Status obj_load_with(const char *path, Scene *s, const MeshOptions *o, Error *err);
+
+/* Parses OBJ text already in memory; `path` names it in messages and is the folder
+ * MTL files are found from. `text` must be NUL-terminated at text[len]. */
+Status obj_parse_with(const char *path, const char *text, size_t len, Scene *s,
+                      const MeshOptions *o, Error *err);
+
+/* The same without a transform, every triangle with `material` (NO_INDEX: the MTL's). */
 Status obj_load(const char *path, Scene *s, uint material, Error *err);
-
-/* Parses OBJ text already in memory; `path` names it in messages. `text` must be
- * NUL-terminated at text[len]. */
 Status obj_parse(const char *path, const char *text, size_t len, Scene *s, uint material,
                  Error *err);
 

@@ -1,7 +1,9 @@
 /* options.c — command-line parsing, strict: every value is checked whole and in range. */
 #include "options.h"
 
+#include "classic_parse.h"
 #include "limit.h"
+#include "types.h"
 
 #include <errno.h>
 #include <math.h>
@@ -13,12 +15,15 @@ void options_print_help(FILE *f)
     fputs(
 "usage: clpt [options] SCENE\n"
 "\n"
-"Renders SCENE (a scene file, see docs/scene-format.md) with a path tracer whose\n"
-"kernels run on OpenCL devices (GPUs, or CPUs through PoCL) and on a scalar C device.\n"
+"Renders SCENE (a scene file, see docs/scene-format.md, or a scene of the MIT 6.837\n"
+"course family, see docs/classic-format.md) with a path tracer or a classic Whitted\n"
+"ray tracer whose kernels run on OpenCL devices (GPUs, or CPUs through PoCL) and on a\n"
+"scalar C device. SCENE may also be a mesh (.obj or .ply): it is shown lit by a sky\n"
+"and a sun, seen by a camera that frames it (docs/meshes.md).\n"
 "\n"
 "Output and image:\n"
-"  -o, --output FILE          image to write: .png (8-bit sRGB), .ppm (8-bit sRGB) or\n"
-"                             .pfm (linear float); default: SCENE's name with .png,\n"
+"  -o, --output FILE          image to write: .png, .ppm or .bmp (8-bit sRGB) or .pfm\n"
+"                             (linear float); default: SCENE's name with .png,\n"
 "                             in the current folder. Written atomically.\n"
 "      --spp N                samples per pixel (overrides the scene)\n"
 "      --width N              image width in pixels (overrides the scene)\n"
@@ -30,7 +35,31 @@ void options_print_help(FILE *f)
 "                             holds the whole batches finished by then\n"
 "      --progressive-output SECONDS\n"
 "                             rewrite the output image every SECONDS during the render\n"
+"      --gamma srgb|none      8-bit images with the sRGB curve or without (linear\n"
+"                             values times 255); default: srgb, none for classic scenes\n"
+"      --aov LIST             also write auxiliary images of the first hit, comma-\n"
+"                             separated: normal (as colours), depth (grey: near white,\n"
+"                             far black), albedo; to OUTPUT-normal.png etc.\n"
+"      --depth-range NEAR,FAR the depth image is linear from white at NEAR to black at\n"
+"                             FAR (default: inverse distance, nearest hit white)\n"
 "\n"
+"Scene and integrator:\n"
+"      --format auto|clpt|classic\n"
+"                             scene file format; default: told from the content\n"
+"      --integrator path|whitted\n"
+"                             path tracing (default) or the classic ray tracer (the\n"
+"                             default for classic scenes): Phong shading, hard\n"
+"                             shadows, mirror and refraction rays up to --max-depth;\n"
+"                             one ray through each pixel centre unless --spp N\n"
+"                             (jittered; an m x m grid when N = m*m)\n"
+"      --adaptive THRESHOLD   whitted: after the first pass, render --adaptive-spp\n"
+"                             more samples in each pixel that differs from a neighbour\n"
+"                             by more than THRESHOLD (0..1) in some channel\n"
+"      --adaptive-spp N       extra samples per such pixel (default 16)\n"
+"\n",
+        f);
+    /* two literals: C99 compilers need only support 4095 characters in one */
+    fputs(
 "Devices:\n"
 "      --list-devices         print every OpenCL platform and device, and the scalar\n"
 "                             device, with their indices, then exit\n"
@@ -91,10 +120,45 @@ static Status parse_seconds(const char *flag, const char *s, double *out, Error 
     return ST_OK;
 }
 
+const char *options_aov_name(unsigned aov)
+{
+    switch (aov) {
+    case INTEGRATOR_AOV_NORMAL: return "normal";
+    case INTEGRATOR_AOV_DEPTH: return "depth";
+    case INTEGRATOR_AOV_ALBEDO: return "albedo";
+    default: return NULL;
+    }
+}
+
+/* "normal,depth" -> the bits 1 << INTEGRATOR_AOV_NORMAL | 1 << INTEGRATOR_AOV_DEPTH */
+static Status options_parse_aovs(const char *list, unsigned *bits, Error *err)
+{
+    const char *p = list;
+    do {
+        const char *end = strchr(p, ',');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        unsigned found = 0;
+        for (unsigned a = INTEGRATOR_AOV_NORMAL; a <= INTEGRATOR_AOV_ALBEDO; a++) {
+            const char *name = options_aov_name(a);
+            if (strlen(name) == len && strncmp(p, name, len) == 0) found = a;
+        }
+        if (!found)
+            return error_set(err, ST_USAGE, "--aov expects a comma-separated list of normal, depth, "
+                             "albedo; got '%s'", list);
+        *bits |= 1u << found;
+        p = end ? end + 1 : NULL;
+    } while (p);
+    return ST_OK;
+}
+
 Status options_parse(int argc, char **argv, Options *o, Error *err)
 {
     memset(o, 0, sizeof *o);
     o->spp = o->width = o->height = o->seed = o->max_depth = -1;
+    o->integrator = -1;
+    o->gamma = -1;
+    o->format = SCENE_FORMAT_AUTO;
+    o->adaptive_spp = 16;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         /* --flag=value is accepted too */
@@ -160,6 +224,66 @@ Status options_parse(int argc, char **argv, Options *o, Error *err)
             if (!(v = VALUE())) return ST_USAGE;
             if ((st = parse_long(a, v, 1, 1L << 26, &n, err))) return st;
             o->wave_paths = (unsigned)n;
+            continue;
+        }
+        if (IS("--integrator")) {
+            if (!(v = VALUE())) return ST_USAGE;
+            if (strcmp(v, "path") == 0) o->integrator = INTEGRATOR_PATH;
+            else if (strcmp(v, "whitted") == 0) o->integrator = INTEGRATOR_WHITTED;
+            else return error_set(err, ST_USAGE, "--integrator expects 'path' or 'whitted', got '%s'", v);
+            continue;
+        }
+        if (IS("--format")) {
+            if (!(v = VALUE())) return ST_USAGE;
+            if (strcmp(v, "auto") == 0) o->format = SCENE_FORMAT_AUTO;
+            else if (strcmp(v, "clpt") == 0) o->format = SCENE_FORMAT_CLPT;
+            else if (strcmp(v, "classic") == 0) o->format = SCENE_FORMAT_CLASSIC;
+            else return error_set(err, ST_USAGE, "--format expects 'auto', 'clpt' or 'classic', got '%s'", v);
+            continue;
+        }
+        if (IS("--gamma")) {
+            if (!(v = VALUE())) return ST_USAGE;
+            if (strcmp(v, "srgb") == 0) o->gamma = 0;
+            else if (strcmp(v, "none") == 0) o->gamma = 1;
+            else return error_set(err, ST_USAGE, "--gamma expects 'srgb' or 'none', got '%s'", v);
+            continue;
+        }
+        if (IS("--aov")) {
+            if (!(v = VALUE())) return ST_USAGE;
+            if ((st = options_parse_aovs(v, &o->aovs, err))) return st;
+            continue;
+        }
+        if (IS("--adaptive")) {
+            if (!(v = VALUE())) return ST_USAGE;
+            char *end;
+            errno = 0;
+            double t = strtod(v, &end);
+            if (!*v || *end || errno || !(t > 0.0 && t <= 1.0))
+                return error_set(err, ST_USAGE, "--adaptive expects a threshold in (0, 1], got '%s'", v);
+            o->adaptive = t;
+            continue;
+        }
+        if (IS("--depth-range")) {
+            if (!(v = VALUE())) return ST_USAGE;
+            char *end;
+            errno = 0;
+            double lo = strtod(v, &end), hi = 0.0;
+            int ok = end != v && *end == ',' && !errno;
+            if (ok) {
+                const char *second = end + 1;
+                hi = strtod(second, &end);
+                ok = end != second && !*end && !errno;
+            }
+            if (!ok || !isfinite(lo) || !isfinite(hi) || !(lo >= 0.0) || !(hi > lo))
+                return error_set(err, ST_USAGE, "--depth-range expects NEAR,FAR with 0 <= NEAR < FAR, got '%s'", v);
+            o->depth_near = lo;
+            o->depth_far = hi;
+            continue;
+        }
+        if (IS("--adaptive-spp")) {
+            if (!(v = VALUE())) return ST_USAGE;
+            if ((st = parse_long(a, v, 1, 65536, &n, err))) return st;
+            o->adaptive_spp = (unsigned)n;
             continue;
         }
         if (IS("--time-limit")) {

@@ -20,11 +20,21 @@ typedef struct {
     const char *kernel_dir;
     unsigned batch;               /* fixed batch size, 0 = adaptive */
     unsigned wave_paths;          /* OpenCL wave size, 0 = automatic */
+    /* the classic ray tracer (docs/classic-format.md) */
+    int integrator;               /* enum Integrator (path or whitted), -1 = the scene's */
+    int format;                   /* enum SceneFormat (classic_parse.h) */
+    unsigned aovs;                /* bit (INTEGRATOR_AOV_x): auxiliary images to write */
+    double adaptive;              /* whitted: neighbour difference threshold, 0 = off */
+    unsigned adaptive_spp;        /* extra samples per flagged pixel */
+    int gamma;                    /* -1 the scene's, 0 sRGB, 1 none (linear 8-bit) */
+    double depth_near, depth_far; /* --depth-range; far 0 = automatic */
 } Options;
 
 /* Parses argv; on ST_USAGE err holds the message. --help and --version set flags and
  * succeed without a scene. */
 Status options_parse(int argc, char **argv, Options *o, Error *err);
 void options_print_help(FILE *f);
+/* "normal", "depth" or "albedo" for INTEGRATOR_AOV_*, else NULL. */
+const char *options_aov_name(unsigned aov);
 
 #endif /* CLPT_OPTIONS_H */

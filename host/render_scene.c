@@ -1,6 +1,7 @@
 /* render_scene.c — see render_scene.h. */
 #include "render_scene.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "camera.h"
@@ -8,6 +9,15 @@
 /* Russian roulette starts after this many bounces: early bounces carry most of the
  * image, so killing paths there adds noise for little time saved. */
 #define RR_START_BOUNCE 3u
+
+uint render_scene_strata(uint spp)
+{
+    if (spp <= 1u) return 0u;
+    uint m = (uint)sqrt((double)spp);
+    while (m * m > spp) m--;
+    while ((m + 1u) * (m + 1u) <= spp) m++;
+    return m * m == spp ? m : 1u;
+}
 
 Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *err)
 {
@@ -46,6 +56,20 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     out->ds.lights = s->lights;
     out->ds.shading = s->shading;
     out->ds.n_shading = (uint)s->n_shading;
+
+    /* the classic ray tracer's part (kernels/whitted.cl) */
+    p->ambient = s->ambient;
+    p->integrator = s->integrator;
+    p->mis_mode = MIS_BOTH;
+    p->n_area_lights = (uint)(s->n_lights - s->n_delta_lights);
+    p->n_textures = (uint)s->n_textures;
+    p->use_mask = 0;
+    p->strata = render_scene_strata(s->image.spp);
+    p->sample_offset = 0;
+    out->ds.textures = s->textures;
+    out->ds.texels = s->texels;
+    out->ds.n_texels = s->n_texels;
+    out->ds.pixel_mask = NULL;
     return ST_OK;
 }
 

@@ -20,4 +20,9 @@ typedef struct {
 Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *err);
 void render_scene_free(RenderScene *r);
 
+/* How the whitted integrator places spp samples in a pixel (RenderParams.strata): 1 is
+ * the pixel centre (0), a square number an m x m jittered grid (m), any other number
+ * uniform jitter (1). */
+uint render_scene_strata(uint spp);
+
 #endif /* CLPT_RENDER_SCENE_H */

@@ -13,7 +13,9 @@
 #include "kmath.h"
 #include "lexer.h"
 #include "limit.h"
+#include "mesh.h"
 #include "obj.h"
+#include "texture.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -29,7 +31,11 @@ typedef enum {
     VK_DIR,         /* three floats, not all zero */
     VK_WORD,        /* a bare word (checked by the statement) */
     VK_MATERIAL,    /* a material name, or an inline anonymous material block */
-    VK_PATH         /* a string or a word */
+    VK_PATH,        /* a string or a word */
+    VK_TEXTURE,     /* the name of a texture defined before */
+    VK_ROTATE,      /* an axis (three floats, not all zero) and an angle in degrees */
+    VK_SCALE,       /* one non-zero float, or three */
+    VK_MATRIX       /* sixteen floats, a 4x4 matrix row by row */
 } ValueKind;
 
 typedef struct {
@@ -50,9 +56,8 @@ typedef struct {
     vec3 v;
     uint material;
     Token word;             /* VK_WORD, VK_PATH */
+    float a[16];            /* VK_ROTATE (axis, degrees), VK_SCALE (x y z), VK_MATRIX */
 } Value;
-
-#define MAX_KEYS 8
 
 typedef struct {
     Scene *s;
@@ -62,7 +67,26 @@ typedef struct {
     char **material_at;               /* per material index, where it was defined */
     size_t n_material_at, cap_material_at;
     int depth_exceeded;               /* the include limit error is not annotated further */
+    Token pending;                    /* a token read ahead and given back (VK_SCALE) */
+    int has_pending;
 } Parser;
+
+/* The next token, or the one given back by unread_token. */
+static Status next_token(Parser *p, Lexer *lx, Token *t)
+{
+    if (p->has_pending) {
+        *t = p->pending;
+        p->has_pending = 0;
+        return ST_OK;
+    }
+    return lex_next(lx, t, p->err);
+}
+
+static void unread_token(Parser *p, const Token *t)
+{
+    p->pending = *t;
+    p->has_pending = 1;
+}
 
 /* ------------------------------------------------------------------ helpers */
 
@@ -110,6 +134,10 @@ static const char *kind_what(const KeySpec *k)
     case VK_DIR: return "a non-zero vector (3 numbers)";
     case VK_MATERIAL: return "a material name or an inline 'material { ... }' block";
     case VK_PATH: return "a file name";
+    case VK_TEXTURE: return "a texture name";
+    case VK_ROTATE: return "an axis and an angle in degrees (4 numbers, the axis not 0 0 0)";
+    case VK_SCALE: return "a non-zero scale factor, or three (x y z)";
+    case VK_MATRIX: return "16 numbers (a 4x4 matrix, row by row)";
     case VK_NUMBER:
     case VK_UINT:
     case VK_WORD: return k->what;
@@ -142,7 +170,7 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
     char what[160];
     snprintf(what, sizeof what, "%s for '%s'", kind_what(k), k->key);
     Token t;
-    Status st = lex_next(lx, &t, err);
+    Status st = next_token(p, lx, &t);
     if (st) return st;
     v->value = t;
     switch (k->kind) {
@@ -157,7 +185,7 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
     case VK_DIR: {
         float c[3];
         for (int i = 0; i < 3; i++) {
-            if (i > 0 && (st = lex_next(lx, &t, err))) return st;
+            if (i > 0 && (st = next_token(p, lx, &t))) return st;
             if (tok_float(&t, &c[i]) || (k->kind == VK_COLOR && c[i] < 0.0f))
                 return lex_expected(lx, &t, what, err);
         }
@@ -166,6 +194,30 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
             return lex_error_at(lx, &v->value, err, "expected %s, found 0 0 0", what);
         return ST_OK;
     }
+    case VK_ROTATE:
+    case VK_MATRIX: {
+        int n = k->kind == VK_ROTATE ? 4 : 16;
+        for (int i = 0; i < n; i++) {
+            if (i > 0 && (st = next_token(p, lx, &t))) return st;
+            if (tok_float(&t, &v->a[i])) return lex_expected(lx, &t, what, err);
+        }
+        if (k->kind == VK_ROTATE && v->a[0] == 0.0f && v->a[1] == 0.0f && v->a[2] == 0.0f)
+            return lex_error_at(lx, &v->value, err, "expected %s, found the axis 0 0 0", what);
+        return ST_OK;
+    }
+    case VK_SCALE:
+        /* one factor, or three: the token after the first tells which */
+        if (tok_float(&t, &v->a[0]) || v->a[0] == 0.0f) return lex_expected(lx, &t, what, err);
+        if ((st = next_token(p, lx, &t))) return st;
+        if (tok_float(&t, &v->a[1])) {
+            unread_token(p, &t);
+            v->a[1] = v->a[2] = v->a[0];
+            return ST_OK;
+        }
+        if (v->a[1] == 0.0f) return lex_expected(lx, &t, what, err);
+        if ((st = next_token(p, lx, &t))) return st;
+        if (tok_float(&t, &v->a[2]) || v->a[2] == 0.0f) return lex_expected(lx, &t, what, err);
+        return ST_OK;
     case VK_WORD:
         if (t.kind != TOK_WORD) return lex_expected(lx, &t, what, err);
         v->word = t;
@@ -175,6 +227,20 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
             return lex_expected(lx, &t, what, err);
         v->word = t;
         return ST_OK;
+    case VK_TEXTURE: {
+        if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0) return lex_expected(lx, &t, what, err);
+        char *name = tok_copy(&t);
+        if (!name) return error_set(err, ST_INTERNAL, "out of memory");
+        v->u = scene_find_texture(p->s, name);
+        free(name);
+        if (v->u == NO_INDEX) {
+            char shown[64];
+            tok_describe(&t, shown, sizeof shown);
+            return lex_error_at(lx, &t, err, "texture '%s' is not defined (textures must be defined "
+                                "before they are used)", shown);
+        }
+        return ST_OK;
+    }
     case VK_MATERIAL:
         if (t.kind == TOK_LBRACE) return parse_material_block(p, lx, &v->key, 1, NULL, &v->material);
         if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
@@ -207,7 +273,7 @@ static Status parse_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken
     Error *err = p->err;
     memset(vals, 0, n * sizeof *vals);
     Token t;
-    Status st = brace_taken ? ST_OK : lex_next(lx, &t, err);
+    Status st = brace_taken ? ST_OK : next_token(p, lx, &t);
     if (st) return st;
     if (!brace_taken && t.kind != TOK_LBRACE) {
         char what[80];
@@ -215,7 +281,7 @@ static Status parse_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken
         return lex_expected(lx, &t, what, err);
     }
     for (;;) {
-        if ((st = lex_next(lx, &t, err))) return st;
+        if ((st = next_token(p, lx, &t))) return st;
         if (t.kind == TOK_RBRACE) break;
         if (t.kind == TOK_EOF)
             return lex_error_at(lx, &t, err,
@@ -340,11 +406,12 @@ static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-enum { BG_COLOR, BG_HORIZON, BG_ZENITH, BG_N };
+enum { BG_COLOR, BG_HORIZON, BG_ZENITH, BG_AMBIENT, BG_N };
 static const KeySpec background_keys[BG_N] = {
     [BG_COLOR] = {"color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [BG_HORIZON] = {"horizon", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [BG_ZENITH] = {"zenith", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [BG_AMBIENT] = {"ambient", VK_COLOR, 0, 0, 0, 0, 0, NULL},
 };
 
 static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
@@ -354,6 +421,7 @@ static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
     if (!st) st = parse_block(p, lx, kw, 0, "background", background_keys, BG_N, v);
     if (st) return st;
     Scene *s = p->s;
+    if (v[BG_AMBIENT].given) s->ambient = v[BG_AMBIENT].v;   /* the whitted integrator's */
     int sky = v[BG_HORIZON].given || v[BG_ZENITH].given;
     if (v[BG_COLOR].given && sky) {
         const Token *t = v[BG_HORIZON].given ? &v[BG_HORIZON].key : &v[BG_ZENITH].key;
@@ -381,16 +449,22 @@ static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE, MAT_KEY_EMISSION, MAT_KEY_SIDES, MAT_KEY_N };
+enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE, MAT_KEY_EMISSION, MAT_KEY_SIDES,
+       MAT_KEY_SPECULAR, MAT_KEY_SHININESS, MAT_KEY_REFLECTIVE, MAT_KEY_TRANSPARENT, MAT_KEY_TEXTURE, MAT_KEY_N };
 static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0,
-                      "a material type (diffuse, metal, dielectric, emissive)"},
+                      "a material type (diffuse, metal, dielectric, emissive, phong)"},
     [MAT_KEY_ALBEDO] = {"albedo", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_FUZZ] = {"fuzz", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
     [MAT_KEY_IOR] = {"ior", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
     [MAT_KEY_RADIANCE] = {"radiance", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_EMISSION] = {"emission", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_SIDES] = {"sides", VK_UINT, 0, 1, 2, 0, 0, "1 or 2 (the sides that emit)"},
+    [MAT_KEY_SPECULAR] = {"specular", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_SHININESS] = {"shininess", VK_NUMBER, 0, 0, 1e6, 0, 0, "a number in [0, 1e6]"},
+    [MAT_KEY_REFLECTIVE] = {"reflective", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_TRANSPARENT] = {"transparent", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_TEXTURE] = {"texture", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
 };
 
 /* Which keys each material type takes (bit i = material_keys[i]), and which it needs. */
@@ -399,13 +473,20 @@ static const struct {
     uint type;
     unsigned allowed, required;
 } material_types[] = {
-    {"diffuse", MAT_DIFFUSE, 1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES,
+    {"diffuse", MAT_DIFFUSE,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES | 1u << MAT_KEY_TEXTURE,
      1u << MAT_KEY_ALBEDO},
     {"metal", MAT_METAL,
-     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_FUZZ | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_FUZZ | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES |
+     1u << MAT_KEY_TEXTURE,
      1u << MAT_KEY_ALBEDO},
     {"dielectric", MAT_DIELECTRIC, 1u << MAT_KEY_IOR | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES, 0},
     {"emissive", MAT_EMISSIVE, 1u << MAT_KEY_RADIANCE | 1u << MAT_KEY_SIDES, 1u << MAT_KEY_RADIANCE},
+    {"phong", MAT_PHONG,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_SPECULAR | 1u << MAT_KEY_SHININESS | 1u << MAT_KEY_REFLECTIVE |
+     1u << MAT_KEY_TRANSPARENT | 1u << MAT_KEY_IOR | 1u << MAT_KEY_TEXTURE | 1u << MAT_KEY_EMISSION |
+     1u << MAT_KEY_SIDES,
+     1u << MAT_KEY_ALBEDO},
 };
 #define N_MATERIAL_TYPES (sizeof material_types / sizeof material_types[0])
 
@@ -448,6 +529,13 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
     case MAT_EMISSIVE:
         m = material_emissive(v[MAT_KEY_RADIANCE].v);
         break;
+    case MAT_PHONG:
+        m = material_phong(v[MAT_KEY_ALBEDO].v, v[MAT_KEY_SPECULAR].given ? v[MAT_KEY_SPECULAR].v : v3s(0.0f),
+                           v[MAT_KEY_SHININESS].given ? v[MAT_KEY_SHININESS].f : 0.0f);
+        if (v[MAT_KEY_REFLECTIVE].given) m.reflective = v[MAT_KEY_REFLECTIVE].v;
+        if (v[MAT_KEY_TRANSPARENT].given) m.transparent = v[MAT_KEY_TRANSPARENT].v;
+        m.ior = v[MAT_KEY_IOR].given ? v[MAT_KEY_IOR].f : 1.5f;
+        break;
     default:
         m = material_diffuse(v[MAT_KEY_ALBEDO].v);
         break;
@@ -455,6 +543,7 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
     /* a surface that both reflects and glows (the furnace test's sphere) */
     if (v[MAT_KEY_EMISSION].given) m.emission = v[MAT_KEY_EMISSION].v;
     if (v[MAT_KEY_SIDES].given && v[MAT_KEY_SIDES].u == 2) m.flags |= MAT_TWO_SIDED;
+    if (v[MAT_KEY_TEXTURE].given) m.texture = (uint)v[MAT_KEY_TEXTURE].u;
     /* inline materials get the empty name, which no named material can have, so a
      * lookup never finds them */
     if ((st = scene_add_material(p->s, name ? name : "", m, index, p->err))) return st;
@@ -470,7 +559,7 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
 static Status parse_material(Parser *p, Lexer *lx, const Token *kw)
 {
     Token t;
-    Status st = lex_next(lx, &t, p->err);
+    Status st = next_token(p, lx, &t);
     if (st) return st;
     if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
         return lex_expected(lx, &t, "a material name", p->err);
@@ -627,11 +716,74 @@ static Status parse_box(Parser *p, Lexer *lx, const Token *kw)
     return scene_add_box(p->s, b, p->err);
 }
 
-enum { MESH_FILE, MESH_MATERIAL, MESH_N };
+enum { MESH_FILE, MESH_MATERIAL, MESH_TRANSLATE, MESH_ROTATE, MESH_RX, MESH_RY, MESH_RZ, MESH_SCALE,
+       MESH_MATRIX, MESH_N };
 static const KeySpec mesh_keys[MESH_N] = {
     [MESH_FILE] = {"file", VK_PATH, 1, 0, 0, 0, 0, NULL},
-    [MESH_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+    [MESH_MATERIAL] = {"material", VK_MATERIAL, 0, 0, 0, 0, 0, NULL},
+    [MESH_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [MESH_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},
+    [MESH_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [MESH_RY] = {"ry", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [MESH_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [MESH_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
+    [MESH_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
 };
+
+/* The instance transform of a mesh block: scale, then rotate, rx, ry, rz, then
+ * translate; or a whole affine matrix, which excludes the others. */
+static Status mesh_transform(Parser *p, const Lexer *lx, const Token *kw, const Value *v, Transform *out)
+{
+    Transform t = transform_identity();
+    if (v[MESH_MATRIX].given) {
+        for (int i = MESH_TRANSLATE; i < MESH_MATRIX; i++)
+            if (v[i].given) {
+                const Token *later = &v[i].key;
+                if (v[MESH_MATRIX].key.line > later->line ||
+                    (v[MESH_MATRIX].key.line == later->line && v[MESH_MATRIX].key.col > later->col))
+                    later = &v[MESH_MATRIX].key;
+                return lex_error_at(lx, later, p->err,
+                                    "'matrix' cannot be combined with translate, rotate, rx, ry, rz or scale "
+                                    "(fold them into the matrix)");
+            }
+        const float *a = v[MESH_MATRIX].a;
+        if (a[12] != 0.0f || a[13] != 0.0f || a[14] != 0.0f || a[15] != 1.0f)
+            return lex_error_at(lx, &v[MESH_MATRIX].key, p->err,
+                                "the last row of 'matrix' must be 0 0 0 1 (an affine transform), found "
+                                "%g %g %g %g", (double)a[12], (double)a[13], (double)a[14], (double)a[15]);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 4; j++) t.m[i][j] = a[4 * i + j];
+    } else {
+        if (v[MESH_SCALE].given) {
+            const float *a = v[MESH_SCALE].a;
+            t = transform_scale(a[0], a[1], a[2]);
+        }
+        Transform r;
+        if (v[MESH_ROTATE].given) {
+            const float *a = v[MESH_ROTATE].a;
+            r = transform_rotate(a[0], a[1], a[2], a[3]);
+            t = transform_compose(&r, &t);
+        }
+        for (int axis = 0; axis < 3; axis++) {
+            const Value *rv = &v[MESH_RX + axis];
+            if (!rv->given) continue;
+            r = transform_rotate(axis == 0, axis == 1, axis == 2, rv->f);
+            t = transform_compose(&r, &t);
+        }
+        if (v[MESH_TRANSLATE].given) {
+            vec3 d = v[MESH_TRANSLATE].v;
+            r = transform_translate(d.x, d.y, d.z);
+            t = transform_compose(&r, &t);
+        }
+    }
+    double det = transform_det(&t);
+    if (!(fabs(det) > 1e-300) || !isfinite(det)) {
+        const Token *at = v[MESH_MATRIX].given ? &v[MESH_MATRIX].key : v[MESH_SCALE].given ? &v[MESH_SCALE].key : kw;
+        return lex_error_at(lx, at, p->err, "the mesh transform is singular (it flattens the mesh)");
+    }
+    *out = t;
+    return ST_OK;
+}
 
 static Status parse_mesh(Parser *p, Lexer *lx, const Token *kw)
 {
@@ -639,9 +791,15 @@ static Status parse_mesh(Parser *p, Lexer *lx, const Token *kw)
     Status st = parse_block(p, lx, kw, 0, "mesh", mesh_keys, MESH_N, v);
     if (st) return st;
     const Token *f = &v[MESH_FILE].word;
+    MeshOptions o = mesh_options(v[MESH_MATERIAL].given ? v[MESH_MATERIAL].material : NO_INDEX);
+    if ((st = mesh_transform(p, lx, kw, v, &o.xf))) return st;
     char *path = path_beside(lx->path, f->text, f->len);
     if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
-    st = obj_load(path, p->s, v[MESH_MATERIAL].material, p->err);
+    if (mesh_kind(path) == MESH_NONE) {
+        free(path);
+        return lex_expected(lx, f, "a mesh file name ending in .obj or .ply", p->err);
+    }
+    st = mesh_load(path, p->s, &o, p->err);
     free(path);
     if (st == ST_IO)
         error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
@@ -650,12 +808,137 @@ static Status parse_mesh(Parser *p, Lexer *lx, const Token *kw)
     return st;
 }
 
+/* ------------------------------------------------------------------ lights, textures */
+
+enum { LT_TYPE, LT_POSITION, LT_DIRECTION, LT_INTENSITY, LT_ATTEN, LT_ANGLE, LT_INNER, LT_N };
+static const KeySpec light_keys[LT_N] = {
+    [LT_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0, "a light type (point, spot, directional)"},
+    [LT_POSITION] = {"position", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [LT_DIRECTION] = {"direction", VK_DIR, 0, 0, 0, 0, 0, NULL},
+    [LT_INTENSITY] = {"intensity", VK_COLOR, 1, 0, 0, 0, 0, NULL},
+    [LT_ATTEN] = {"attenuation", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [LT_ANGLE] = {"angle", VK_NUMBER, 0, 0, 180, 1, 1, "a number of degrees in (0, 180)"},
+    [LT_INNER] = {"inner", VK_NUMBER, 0, 0, 180, 0, 1, "a number of degrees in [0, 180)"},
+};
+
+static Status parse_light(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[LT_N];
+    Status st = parse_block(p, lx, kw, 0, "light", light_keys, LT_N, v);
+    if (st) return st;
+    static const struct { const char *name; uint type; unsigned allowed; } types[] = {
+        {"point", LIGHT_POINT, 1u << LT_POSITION | 1u << LT_ATTEN},
+        {"spot", LIGHT_SPOT, 1u << LT_POSITION | 1u << LT_DIRECTION | 1u << LT_ATTEN | 1u << LT_ANGLE | 1u << LT_INNER},
+        {"directional", LIGHT_DIRECTIONAL, 1u << LT_DIRECTION},
+    };
+    size_t ti;
+    for (ti = 0; ti < 3; ti++)
+        if (tok_is(&v[LT_TYPE].word, types[ti].name)) break;
+    if (ti == 3) return lex_expected(lx, &v[LT_TYPE].word, light_keys[LT_TYPE].what, p->err);
+    unsigned allowed = types[ti].allowed | 1u << LT_TYPE | 1u << LT_INTENSITY;
+    for (int i = 0; i < LT_N; i++)
+        if (v[i].given && !(allowed & (1u << i)))
+            return lex_error_at(lx, &v[i].key, p->err, "a %s light has no '%s'", types[ti].name, light_keys[i].key);
+    Light l = light_default(types[ti].type);
+    l.intensity = v[LT_INTENSITY].v;
+    if (v[LT_POSITION].given) l.position = v[LT_POSITION].v;
+    if (v[LT_DIRECTION].given) {
+        vec3 d = v[LT_DIRECTION].v;
+        double len = len_d(d);
+        l.direction = v3((float)(d.x / len), (float)(d.y / len), (float)(d.z / len));
+    }
+    if (v[LT_ATTEN].given) {
+        if (v3_is_zero(v[LT_ATTEN].v))
+            return lex_error_at(lx, &v[LT_ATTEN].key, p->err, "'attenuation' (constant linear quadratic) must not be all 0");
+        l.atten0 = v[LT_ATTEN].v.x;
+        l.atten1 = v[LT_ATTEN].v.y;
+        l.atten2 = v[LT_ATTEN].v.z;
+    }
+    float outer = v[LT_ANGLE].given ? v[LT_ANGLE].f : 30.0f, inner = v[LT_INNER].given ? v[LT_INNER].f : outer;
+    if (inner > outer) return lex_error_at(lx, &v[LT_INNER].key, p->err, "'inner' must not exceed 'angle'");
+    l.cos_outer = (float)cos((double)outer * M_PI / 180.0);
+    l.cos_inner = (float)cos((double)inner * M_PI / 180.0);
+    return scene_add_light(p->s, l, p->err);
+}
+
+enum { TX_TYPE, TX_FILE, TX_ENCODING, TX_WRAP, TX_COLOR0, TX_COLOR1, TX_SPACE, TX_SCALE, TX_N };
+static const KeySpec texture_keys[TX_N] = {
+    [TX_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0, "a texture type (image, checker)"},
+    [TX_FILE] = {"file", VK_PATH, 0, 0, 0, 0, 0, NULL},
+    [TX_ENCODING] = {"encoding", VK_WORD, 0, 0, 0, 0, 0, "srgb or linear"},
+    [TX_WRAP] = {"wrap", VK_WORD, 0, 0, 0, 0, 0, "repeat or clamp"},
+    [TX_COLOR0] = {"color0", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [TX_COLOR1] = {"color1", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [TX_SPACE] = {"space", VK_WORD, 0, 0, 0, 0, 0, "uv or solid"},
+    [TX_SCALE] = {"scale", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
+};
+
+static Status parse_texture(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token t;
+    Status st = lex_next(lx, &t, p->err);
+    if (st) return st;
+    if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
+        return lex_expected(lx, &t, "a texture name", p->err);
+    char *name = tok_copy(&t);
+    if (!name) return error_set(p->err, ST_INTERNAL, "out of memory");
+    if (scene_find_texture(p->s, name) != NO_INDEX) {
+        char shown[64];
+        tok_describe(&t, shown, sizeof shown);
+        free(name);
+        return lex_error_at(lx, &t, p->err, "texture '%s' is already defined", shown);
+    }
+    Value v[TX_N];
+    if ((st = parse_block(p, lx, kw, 0, "texture", texture_keys, TX_N, v))) {
+        free(name);
+        return st;
+    }
+    int image = tok_is(&v[TX_TYPE].word, "image");
+    unsigned allowed = 1u << TX_TYPE | 1u << TX_SCALE;
+    if (image) allowed |= 1u << TX_FILE | 1u << TX_ENCODING | 1u << TX_WRAP;
+    else if (tok_is(&v[TX_TYPE].word, "checker")) allowed |= 1u << TX_COLOR0 | 1u << TX_COLOR1 | 1u << TX_SPACE;
+    else st = lex_expected(lx, &v[TX_TYPE].word, texture_keys[TX_TYPE].what, p->err);
+    for (int i = 0; !st && i < TX_N; i++)
+        if (v[i].given && !(allowed & (1u << i)))
+            st = lex_error_at(lx, &v[i].key, p->err, "an %s texture has no '%s'", image ? "image" : "checker",
+                              texture_keys[i].key);
+    struct { int index; const char *a, *b; } words[] = {
+        {TX_ENCODING, "srgb", "linear"}, {TX_WRAP, "repeat", "clamp"}, {TX_SPACE, "uv", "solid"} };
+    int second[TX_N] = {0};
+    for (size_t i = 0; !st && i < sizeof words / sizeof words[0]; i++) {
+        const Value *w = &v[words[i].index];
+        if (!w->given) continue;
+        if (tok_is(&w->word, words[i].b)) second[words[i].index] = 1;
+        else if (!tok_is(&w->word, words[i].a))
+            st = lex_expected(lx, &w->word, texture_keys[words[i].index].what, p->err);
+    }
+    if (!st && image && !v[TX_FILE].given)
+        st = lex_error_at(lx, kw, p->err, "an image texture needs 'file'");
+    float scale = v[TX_SCALE].given ? v[TX_SCALE].f : 1.0f;
+    if (!st && image) {
+        const Token *f = &v[TX_FILE].word;
+        char *path = path_beside(lx->path, f->text, f->len);
+        if (!path) st = error_set(p->err, ST_INTERNAL, "out of memory");
+        uint index;
+        if (!st) st = texture_load_image(p->s, name, path, second[TX_ENCODING], second[TX_WRAP], &index, p->err);
+        free(path);
+        if (st == ST_IO || st == ST_INPUT) error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+        if (!st) texture_set_scale_offset(&p->s->textures[index], scale, scale, 0.0f, 0.0f);
+    } else if (!st) {
+        Texture tx = texture_make_checker(v[TX_COLOR0].given ? v[TX_COLOR0].v : v3s(0.8f),
+                                     v[TX_COLOR1].given ? v[TX_COLOR1].v : v3s(0.2f), scale, second[TX_SPACE]);
+        st = scene_add_texture(p->s, name, NULL, tx, NULL, p->err);
+    }
+    free(name);
+    return st;
+}
+
 static Status parse_file(Parser *p, const char *path);
 
 static Status parse_include(Parser *p, Lexer *lx, const Token *kw)
 {
     Token t;
-    Status st = lex_next(lx, &t, p->err);
+    Status st = next_token(p, lx, &t);
     if (st) return st;
     if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
         return lex_expected(lx, &t, "a file name after 'include'", p->err);
@@ -685,7 +968,8 @@ static const struct {
     {"camera", parse_camera},   {"image", parse_image},       {"background", parse_background},
     {"material", parse_material}, {"sphere", parse_sphere},   {"plane", parse_plane},
     {"triangle", parse_triangle}, {"quad", parse_quad},       {"box", parse_box},
-    {"mesh", parse_mesh},       {"include", parse_include},
+    {"mesh", parse_mesh},       {"include", parse_include},   {"light", parse_light},
+    {"texture", parse_texture},
 };
 #define N_STATEMENTS (sizeof statements / sizeof statements[0])
 
@@ -694,7 +978,7 @@ static Status parse_statements(Parser *p, Lexer *lx)
     Status st;
     for (;;) {
         Token t;
-        if ((st = lex_next(lx, &t, p->err)) || t.kind == TOK_EOF) break;
+        if ((st = next_token(p, lx, &t)) || t.kind == TOK_EOF) break;
         size_t i = N_STATEMENTS;
         if (t.kind == TOK_WORD)
             for (i = 0; i < N_STATEMENTS; i++)
@@ -702,7 +986,7 @@ static Status parse_statements(Parser *p, Lexer *lx)
         if (i == N_STATEMENTS) {
             st = lex_expected(lx, &t,
                               "a statement (camera, image, background, material, sphere, "
-                              "plane, triangle, quad, box, mesh, include)", p->err);
+                              "plane, triangle, quad, box, mesh, light, texture, include)", p->err);
             break;
         }
         if ((st = statements[i].parse(p, lx, &t))) break;

@@ -85,4 +85,106 @@ KFN BsdfSample bsdf_sample_dielectric(float ior, vec3 d, vec3 n, int entering, f
     return s;
 }
 
+/* ---------------------------------------------------------------- Phong
+ * The modified Phong BRDF (Lafortune & Willems 1994), which conserves energy:
+ *     f(wo, wi) = kd / pi + ks (n + 2) / (2 pi) cos^n(alpha),
+ * alpha the angle between wi and the mirror direction of wo. With kd + ks <= 1 per
+ * channel it never reflects more than it receives. MAT_PHONG adds a perfect mirror
+ * (`reflective`, kr) and a smooth refracting part (`transparent`, kt, with Fresnel);
+ * phong_lobes scales all four down together when they sum above 1 in some channel, so
+ * a classic material (diffuse 1 1 1 plus a specular colour) stays physical. */
+
+typedef struct {
+    vec3 kd, ks, kr, kt;      /* scaled so that kd + ks + kr + kt <= 1 per channel */
+    float n;                  /* shininess */
+    float p_glossy;           /* chance of sampling the kd + ks part ... */
+    float p_mirror;           /* ... the mirror ... */
+    float p_spec;             /* within the glossy part: the ks lobe rather than kd */
+} PhongLobes;                 /* ... and the rest is the refracting part */
+
+KFN PhongLobes phong_lobes(Material m, vec3 kd)
+{
+    PhongLobes l;
+    vec3 sum = v3_add(v3_add(kd, m.specular), v3_add(m.reflective, m.transparent));
+    float scale = v3_max_comp(sum) > 1.0f ? 1.0f / v3_max_comp(sum) : 1.0f;
+    l.kd = v3_scale(kd, scale);
+    l.ks = v3_scale(m.specular, scale);
+    l.kr = v3_scale(m.reflective, scale);
+    l.kt = v3_scale(m.transparent, scale);
+    l.n = k_fmax(m.shininess, 0.0f);
+    float wd = v3_luminance(l.kd), ws = v3_luminance(l.ks);
+    float wr = v3_luminance(l.kr), wt = v3_luminance(l.kt);
+    float total = wd + ws + wr + wt;
+    l.p_glossy = total > 0.0f ? (wd + ws) / total : 0.0f;
+    l.p_mirror = total > 0.0f ? wr / total : 0.0f;
+    l.p_spec = wd + ws > 0.0f ? ws / (wd + ws) : 0.0f;
+    return l;
+}
+
+/* The kd + ks part: f(wo, wi) into *f and the density with which phong_sample picks wi
+ * (choice of the glossy part included) as the return value. `d` is the incoming ray
+ * direction (wo = -d), n the shading normal on its side. */
+KFN float phong_eval(PhongLobes l, vec3 d, vec3 n, vec3 wi, vec3 *f)
+{
+    float cos_i = v3_dot(n, wi);
+    if (cos_i <= 0.0f) {
+        *f = v3s(0.0f);
+        return 0.0f;
+    }
+    float cos_a = k_fmax(v3_dot(reflect_dir(d, n), wi), 0.0f);
+    float lobe = k_pow(cos_a, l.n);
+    *f = v3_add(v3_scale(l.kd, K_INV_PI), v3_scale(l.ks, (l.n + 2.0f) * (0.5f * K_INV_PI) * lobe));
+    float pdf = (1.0f - l.p_spec) * cos_i * K_INV_PI + l.p_spec * (l.n + 1.0f) * (0.5f * K_INV_PI) * lobe;
+    return l.p_glossy * pdf;
+}
+
+/* Samples one of the lobes: u_lobe picks glossy / mirror / refraction (and within the
+ * glossy part diffuse or specular, by rescaling it), u1 u2 the direction. `entering`
+ * and ng as for bsdf_sample_dielectric (ng faces the incoming side); u_fresnel chooses
+ * reflection or refraction at the refracting part. Only a refracted sample leaves below
+ * the geometric surface (a glossy one there is the caller's to drop). */
+KFN BsdfSample phong_sample(PhongLobes l, Material m, vec3 d, vec3 ns, vec3 ng, int entering,
+                            float u_lobe, float u1, float u2, float u_fresnel)
+{
+    BsdfSample s;
+    if (u_lobe < l.p_glossy) {
+        float u = u_lobe / l.p_glossy;
+        vec3 t, b;
+        if (u < l.p_spec) {
+            /* cos^n lobe about the mirror direction: cos(alpha) = u1^(1/(n+1)) */
+            vec3 r = reflect_dir(d, ns);
+            float cos_a = k_pow(u1, 1.0f / (l.n + 1.0f));
+            float sin_a = k_safe_sqrt(1.0f - cos_a * cos_a);
+            float sphi, cphi;
+            k_sincos(K_TWO_PI * u2, &sphi, &cphi);
+            k_onb(r, &t, &b);
+            s.wi = v3_norm(k_to_world(v3(sin_a * cphi, sin_a * sphi, cos_a), t, b, r));
+        } else {
+            k_onb(ns, &t, &b);
+            s.wi = k_to_world(sample_cosine_hemisphere(u1, u2), t, b, ns);
+        }
+        vec3 f;
+        s.pdf = phong_eval(l, d, ns, s.wi, &f);
+        float cos_i = v3_dot(ns, s.wi);
+        s.weight = s.pdf > 0.0f ? v3_scale(f, cos_i / s.pdf) : v3s(0.0f);
+        s.specular = 0;
+        return s;
+    }
+    s.pdf = 0.0f;
+    s.specular = 1;
+    if (u_lobe < l.p_glossy + l.p_mirror) {
+        /* about the shading normal, unless that would go below the surface */
+        s.wi = reflect_dir(d, ns);
+        if (v3_dot(s.wi, ng) <= 0.0f) s.wi = reflect_dir(d, ng);
+        s.weight = v3_scale(l.kr, 1.0f / l.p_mirror);
+        return s;
+    }
+    /* the refracting part, like glass, tinted by kt */
+    BsdfSample g = bsdf_sample_dielectric(m.ior, d, ng, entering, u_fresnel);
+    float p_t = 1.0f - l.p_glossy - l.p_mirror;
+    s.wi = g.wi;
+    s.weight = p_t > 0.0f ? v3_scale(l.kt, 1.0f / p_t) : v3s(0.0f);
+    return s;
+}
+
 #endif /* CLPT_BSDF_H */

@@ -13,20 +13,24 @@
 #include "raygen.cl"
 #include "shade.cl"
 #include "traverse.cl"
+#include "whitted.cl"
 
 #define SCENE_ARGS                                                                       \
     __global const RenderParams *params, __global const KdNode *nodes,                   \
     __global const uint *leaf_prims, __global const Sphere *spheres,                     \
     __global const Triangle *triangles, __global const Box *boxes,                       \
     __global const Plane *planes, __global const Material *materials,                    \
-    __global const Light *lights, __global const TriShading *shading
+    __global const Light *lights, __global const TriShading *shading,                    \
+    __global const Texture *textures, __global const uint *texels,                       \
+    __global const uint *pixel_mask
 
 #define SCENE_VIEW(sc)                                                                   \
     SceneView sc;                                                                        \
     sc.params = params; sc.nodes = nodes; sc.leaf_prims = leaf_prims;                    \
     sc.spheres = spheres; sc.triangles = triangles; sc.boxes = boxes;                    \
     sc.planes = planes; sc.materials = materials; sc.lights = lights;                    \
-    sc.shading = shading
+    sc.shading = shading; sc.textures = textures; sc.texels = texels;                    \
+    sc.pixel_mask = pixel_mask
 
 /* Births the wave's paths and queues them all. */
 __kernel void k_raygen(__global const RenderParams *params, uint first_pixel, uint wave_pixels,
@@ -139,4 +143,73 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Light, position);
     out[i++] = (uint)__builtin_offsetof(Camera, lens_u);
     out[i++] = (uint)__builtin_offsetof(TriShading, uv0);
+    out[i++] = (uint)sizeof(Texture);
+    out[i++] = (uint)__builtin_offsetof(Texture, m);
+    out[i++] = (uint)__builtin_offsetof(Texture, color1);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, ambient);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, strata);
+    out[i++] = (uint)__builtin_offsetof(Material, reflective);
+    out[i++] = (uint)__builtin_offsetof(Light, cos_inner);
+    out[i++] = (uint)__builtin_offsetof(Camera, forward);
+}
+
+/* ---------------------------------------------------------------- classic ray tracer
+ * The whitted integrator and the auxiliary images (kernels/whitted.cl): one work-item
+ * computes one pixel sample whole, with its own stack of mirror and refracted rays, and
+ * leaves the radiance in its path state for k_film. Path i is pixel first_pixel +
+ * i % wave_pixels, sample first_sample + i / wave_pixels, as in k_raygen. counters[0]
+ * receives the number of rays traced (summed per work-group first). No early return:
+ * every work-item must reach the barriers. */
+__kernel void k_whitted(SCENE_ARGS, uint first_pixel, uint wave_pixels, uint first_sample, uint n_paths,
+                        __global PathState *paths, __global uint *counters)
+{
+    __local uint group_rays;
+    uint i = (uint)get_global_id(0);
+    if (get_local_id(0) == 0) group_rays = 0u;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    uint rays = 0u;
+    if (i < n_paths) {
+        SCENE_VIEW(sc);
+        paths[i].radiance = whitted_sample(&sc, first_pixel + i % wave_pixels, first_sample + i / wave_pixels, &rays);
+    }
+    if (rays) atomic_add(&group_rays, rays);
+    barrier(CLK_LOCAL_MEM_FENCE);
+    if (get_local_id(0) == 0 && group_rays) atomic_add(&counters[0], group_rays);
+}
+
+/* ------------------------------------------------------------------------------------
+ * Trace-only kernels for the traversal benchmark (bench/bench_traverse.c): one ray per
+ * work-item from a plain array, no path state. Kept apart from the render kernels above.
+ * ------------------------------------------------------------------------------------ */
+
+/* Closest hits of rays[2i] and rays[2i+1], walked in turns (trace_closest2). */
+__kernel void k_trace_closest(SCENE_ARGS, __global const Ray *rays, uint n, __global Hit *hits)
+{
+    uint a = 2u * (uint)get_global_id(0), b = a + 1u;
+    if (a >= n) return;
+    SCENE_VIEW(sc);
+    if (b < n) {
+        Hit ha, hb;
+        trace_closest2(&sc, rays[a], rays[b], &ha, &hb);
+        hits[a] = ha;
+        hits[b] = hb;
+    } else {
+        hits[a] = trace_closest(&sc, rays[a]);
+    }
+}
+
+/* Whether rays[2i] and rays[2i+1] hit anything, into occluded[] (1 or 0). */
+__kernel void k_trace_any(SCENE_ARGS, __global const Ray *rays, uint n, __global uint *occluded)
+{
+    uint a = 2u * (uint)get_global_id(0), b = a + 1u;
+    if (a >= n) return;
+    SCENE_VIEW(sc);
+    if (b < n) {
+        int oa, ob;
+        trace_any2(&sc, rays[a], rays[b], &oa, &ob);
+        occluded[a] = (uint)oa;
+        occluded[b] = (uint)ob;
+    } else {
+        occluded[a] = (uint)trace_any(&sc, rays[a]);
+    }
 }

@@ -71,6 +71,120 @@ KFN float k_cbrt(float x)
     return y;
 }
 
+/* ------------------------------------------------------------------ exp, log, pow
+ * For Phong exponents, sRGB decoding and the Phong lobe's sampling. Built from the
+ * float's bits and short polynomials, so every compiler gets the same bits; relative
+ * error a few 1e-7 (k_pow: that times |y log2 x|). */
+
+/* log2(x) for x > 0 (subnormals included); -inf at 0, NaN below. */
+KFN float k_log2(float x)
+{
+    if (!(x > 0.0f)) return x == 0.0f ? -k_as_float(0x7f800000u) : k_as_float(0x7fc00000u);
+    if (x == k_as_float(0x7f800000u)) return x;
+    float bias = 0.0f;
+    if (x < 1.17549435e-38f) {            /* subnormal: scale into the normal range */
+        x *= 16777216.0f;
+        bias = -24.0f;
+    }
+    uint bits = k_as_uint(x);
+    int e = (int)((bits >> 23) & 0xffu) - 127;
+    float m = k_as_float((bits & 0x007fffffu) | 0x3f800000u);   /* [1, 2) */
+    if (m > 1.41421356f) {                 /* centre the mantissa on 1: [0.707, 1.414] */
+        m *= 0.5f;
+        e += 1;
+    }
+    /* ln m = 2 atanh(t), t = (m-1)/(m+1), |t| <= 0.1716: the series to t^11 is exact to
+     * about 1e-9 */
+    float t = (m - 1.0f) / (m + 1.0f);
+    float t2 = t * t;
+    float ln_m = 2.0f * t * (1.0f + t2 * (0.333333333f + t2 * (0.2f + t2 * (0.142857143f +
+                 t2 * (0.111111111f + t2 * 0.0909090909f)))));
+    return ((float)e + bias) + ln_m * 1.44269504f;
+}
+
+/* 2^y; 0 below the subnormal range, +inf above the float range, NaN for NaN. */
+KFN float k_exp2(float y)
+{
+    if (y != y) return y;
+    if (y < -150.0f) return 0.0f;
+    if (y >= 128.0f) return k_as_float(0x7f800000u);
+    float fi = k_floor(y + 0.5f);
+    float x = (y - fi) * 0.693147181f;     /* |x| <= ln2 / 2: Taylor to x^7, error 5e-9 */
+    float p = 1.0f + x * (1.0f + x * (0.5f + x * (0.166666667f + x * (4.16666667e-2f +
+              x * (8.33333333e-3f + x * (1.38888889e-3f + x * 1.98412698e-4f))))));
+    int i = (int)fi;
+    /* 2^i from its bits, in two steps where it would leave the normal range */
+    if (i > 127) { p *= 2.0f; i -= 1; }
+    if (i < -126) { p *= 5.96046448e-8f; i += 24; }
+    return p * k_int_as_float((i + 127) << 23);
+}
+
+/* x^y for x >= 0 (negative x is treated as 0); 0^0 = 1, as in C. */
+KFN float k_pow(float x, float y)
+{
+    if (y == 0.0f) return 1.0f;
+    if (!(x > 0.0f)) return y > 0.0f ? 0.0f : k_as_float(0x7f800000u);
+    if (x == 1.0f) return 1.0f;
+    return k_exp2(y * k_log2(x));
+}
+
+/* ------------------------------------------------------------------ inverse trig
+ * For the sphere's (u, v) parameterisation. Absolute error below 1e-6. */
+
+/* atan(x): reduced to |t| <= tan(pi/8) by 1/x and (x-1)/(x+1), then the Taylor
+ * series to t^19 (error below 5e-10 there). */
+KFN float k_atan(float x)
+{
+    float a = k_fabs(x);
+    if (a != a) return x;
+    int inverted = a > 1.0f;
+    if (inverted) a = 1.0f / a;
+    int shifted = a > 0.414213562f;
+    float t = shifted ? (a - 1.0f) / (a + 1.0f) : a;
+    float t2 = t * t;
+    float r = t * (1.0f + t2 * (-0.333333333f + t2 * (0.2f + t2 * (-0.142857143f + t2 * (0.111111111f +
+              t2 * (-0.0909090909f + t2 * (0.0769230769f + t2 * (-0.0666666667f + t2 * (0.0588235294f +
+              t2 * -0.0526315789f)))))))));
+    if (shifted) r += 0.785398163f;
+    if (inverted) r = 1.57079633f - r;
+    return k_copysign(r, x);
+}
+
+/* atan2(y, x) in [-pi, pi]; 0 for (0, 0). */
+KFN float k_atan2(float y, float x)
+{
+    if (x == 0.0f && y == 0.0f) return 0.0f;
+    if (k_fabs(x) >= k_fabs(y)) {
+        float r = k_atan(y / x);
+        if (x < 0.0f) r += y >= 0.0f ? K_PI : -K_PI;
+        return r;
+    }
+    return (y > 0.0f ? 1.57079633f : -1.57079633f) - k_atan(x / y);
+}
+
+/* acos(x) in [0, pi], x clamped to [-1, 1]. */
+KFN float k_acos(float x)
+{
+    x = k_clamp(x, -1.0f, 1.0f);
+    return k_atan2(k_safe_sqrt((1.0f - x) * (1.0f + x)), x);
+}
+
+/* ------------------------------------------------------------------ colour */
+
+/* The sRGB transfer function's inverse (IEC 61966-2-1): encoded [0,1] to linear. */
+KFN float k_srgb_to_linear(float c)
+{
+    if (c <= 0.04045f) return c * (1.0f / 12.92f);
+    return k_pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+/* 0 below e0, 1 above e1, the cubic 3t^2 - 2t^3 between. */
+KFN float k_smoothstep(float e0, float e1, float x)
+{
+    float t = k_clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
+    return t * t * (3.0f - 2.0f * t);
+}
+
 /* An orthonormal basis around unit n (Duff et al., "Building an Orthonormal Basis,
  * Revisited", JCGT 2017): branch-free and continuous except at n.z == 0 sign flips. */
 KFN void k_onb(vec3 n, vec3 *t, vec3 *b)

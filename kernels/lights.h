@@ -1,23 +1,33 @@
 /*
- * lights.h — next-event estimation: choosing an emissive primitive, sampling a point on
- * it as seen from a shading point, and the density of that choice (for multiple
- * importance sampling against BSDF sampling). All densities are per unit solid angle at
- * the shading point and include the probability of choosing the light. A light emits
- * from its front side (outward for spheres and boxes, the winding normal's side for
- * triangles) unless its material is MAT_TWO_SIDED; a sample of a point whose lit side
- * faces away is rejected.
+ * lights.h — next-event estimation: choosing a light, sampling it as seen from a
+ * shading point, and the density of that choice (for multiple importance sampling
+ * against BSDF sampling).
+ *
+ * Area lights (emissive primitives): a point on the light; densities are per unit solid
+ * angle at the shading point and include the probability of choosing the light. A light
+ * emits from its front side (outward for spheres and boxes, the winding normal's side
+ * for triangles) unless its material is MAT_TWO_SIDED; a sample of a point whose lit
+ * side faces away is rejected.
+ * Delta lights (point, spot, directional): the one direction toward the light; `Le` is
+ * then the irradiance across that direction (intensity over the attenuation, times the
+ * spot's falloff) and `pdf` the probability of choosing the light alone.
  */
 #ifndef CLPT_LIGHTS_H
 #define CLPT_LIGHTS_H
 
 #include "sampling.h"
 #include "scene_view.h"
+#include "surface.h"
 
 typedef struct {
-    vec3 p;        /* point on the light */
-    vec3 n;        /* its unit normal */
-    vec3 Le;       /* emitted radiance */
-    float pdf;     /* solid-angle density at the reference point, choice included */
+    vec3 p;        /* point on the light (directional: unused) */
+    vec3 n;        /* its unit normal (area lights) */
+    vec3 Le;       /* emitted radiance (area), irradiance across wi (delta lights) */
+    vec3 wi;       /* unit direction from the reference point toward the light */
+    float dist;    /* distance to p (directional: infinity) */
+    float pdf;     /* solid-angle density at the reference point (area), or the
+                    * probability of the choice (delta), choice included */
+    int delta;     /* a point, spot or directional light */
 } LightSample;
 
 KFN uint prim_material(const SceneView *sc, uint prim)
@@ -40,7 +50,8 @@ KFN int light_faces(const SceneView *sc, uint prim, vec3 n, vec3 toward)
 }
 
 /* Chooses a light with probability pick_pdf (binary search of the cdf) and rescales u
- * to a fresh uniform number in [0,1) for the caller's further use. */
+ * to a fresh uniform number in [0,1) for the caller's further use. u must be below the
+ * cdf of the last light it may choose. */
 KFN uint light_choose(const SceneView *sc, float u, float *u_rest)
 {
     uint lo = 0u, hi = sc->params->n_lights - 1u;
@@ -71,8 +82,9 @@ KFN int sphere_cone_sampling(Sphere sp, float dc2)
     return dc2 > sp.radius * sp.radius * 1.0001f;
 }
 
-/* Solid-angle density of light `li` producing point x (normal n) seen from ref. */
-KFN float light_pdf(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
+/* Solid-angle density at ref of area light `li` producing point x (normal n), the
+ * choice of the light excluded. */
+KFN float light_pdf_area(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
 {
     Light l = sc->lights[li];
     vec3 to = v3_sub(x, ref);
@@ -82,24 +94,62 @@ KFN float light_pdf(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
         vec3 wc = v3_sub(sp.center, ref);
         float dc2 = v3_dot(wc, wc);
         if (sphere_cone_sampling(sp, dc2))
-            return l.pick_pdf / (K_TWO_PI * sphere_cone_one_minus_cos(sp.radius, dc2));
+            return 1.0f / (K_TWO_PI * sphere_cone_one_minus_cos(sp.radius, dc2));
     }
     float cos_l = k_fabs(v3_dot(n, to)) / k_sqrt(dist2);
     if (cos_l <= 0.0f || l.area <= 0.0f) return 0.0f;
-    return l.pick_pdf * dist2 / (cos_l * l.area);
+    return dist2 / (cos_l * l.area);
 }
 
-/* Samples a point on one light as seen from ref. Returns 0 if the sample is useless
- * (degenerate light, or ref on the light's plane). */
-KFN int light_sample(const SceneView *sc, vec3 ref, float u_pick, float u1, float u2,
-                     LightSample *ls)
+/* The same with the choice of the light among all lights included (for MIS). */
+KFN float light_pdf(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
+{
+    return sc->lights[li].pick_pdf * light_pdf_area(sc, li, ref, x, n);
+}
+
+/* The light of delta light l arriving at ref: direction, distance and irradiance
+ * across the direction. Returns 0 when none arrives (outside a spot's cone, ref on
+ * the light). */
+KFN int light_delta_at(Light l, vec3 ref, LightSample *ls)
+{
+    ls->delta = 1;
+    ls->n = v3s(0.0f);
+    if (l.type == LIGHT_DIRECTIONAL) {
+        ls->wi = v3_neg(l.direction);
+        ls->dist = k_as_float(0x7f800000u);
+        ls->p = ref;
+        ls->Le = l.intensity;
+        return 1;
+    }
+    vec3 to = v3_sub(l.position, ref);
+    float d2 = v3_dot(to, to);
+    float dist = k_sqrt(d2);
+    float atten = l.atten0 + l.atten1 * dist + l.atten2 * d2;
+    if (!(dist > 0.0f) || !(atten > 0.0f)) return 0;
+    ls->wi = v3_scale(to, 1.0f / dist);
+    ls->dist = dist;
+    ls->p = l.position;
+    float scale = 1.0f / atten;
+    if (l.type == LIGHT_SPOT) {
+        float c = -v3_dot(ls->wi, l.direction);
+        scale *= l.cos_inner > l.cos_outer ? k_smoothstep(l.cos_outer, l.cos_inner, c)
+                                           : (c >= l.cos_outer ? 1.0f : 0.0f);
+    }
+    ls->Le = v3_scale(l.intensity, scale);
+    return scale > 0.0f;
+}
+
+/* Samples a point on area light li as seen from ref, with u_rest (the rest of the
+ * choice number) choosing a box's face; pdf excludes the choice of the light. Returns
+ * 0 if the sample is useless (degenerate light, ref on the light's plane). */
+KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, float u_rest, float u1, float u2,
+                          LightSample *ls)
 {
     GLOBAL const RenderParams *p = sc->params;
-    float u_rest;
-    uint li = light_choose(sc, u_pick, &u_rest);
     Light l = sc->lights[li];
     uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
     ls->Le = sc->materials[prim_material(sc, l.prim)].emission;
+    ls->delta = 0;
 
     if (l.prim < first_tri) {
         Sphere sp = sc->spheres[l.prim];
@@ -122,13 +172,12 @@ KFN int light_sample(const SceneView *sc, vec3 ref, float u_pick, float u1, floa
             vec3 n = v3_norm(v3_sub(v3_madd(ref, dir, ds), sp.center));
             ls->n = n;
             ls->p = v3_madd(sp.center, n, sp.radius);
-            ls->pdf = l.pick_pdf / (K_TWO_PI * omc);
-            return ls->pdf > 0.0f && light_faces(sc, l.prim, n, v3_sub(ref, ls->p));
+        } else {
+            /* on or inside the sphere: uniform over the whole surface */
+            vec3 n = sample_sphere_dir(u1, u2);
+            ls->n = n;
+            ls->p = v3_madd(sp.center, n, sp.radius);
         }
-        /* on or inside the sphere: uniform over the whole surface */
-        vec3 n = sample_sphere_dir(u1, u2);
-        ls->n = n;
-        ls->p = v3_madd(sp.center, n, sp.radius);
     } else if (l.prim < first_box) {
         Triangle tr = sc->triangles[l.prim - first_tri];
         float b1, b2;
@@ -155,8 +204,60 @@ KFN int light_sample(const SceneView *sc, vec3 ref, float u_pick, float u1, floa
         ls->p = q;
         ls->n = v3(axis == 0 ? sign : 0.0f, axis == 1 ? sign : 0.0f, axis == 2 ? sign : 0.0f);
     }
-    ls->pdf = light_pdf(sc, li, ref, ls->p, ls->n);
+    vec3 to = v3_sub(ls->p, ref);
+    ls->dist = v3_len(to);
+    if (!(ls->dist > 0.0f)) return 0;
+    ls->wi = v3_scale(to, 1.0f / ls->dist);
+    ls->pdf = light_pdf_area(sc, li, ref, ls->p, ls->n);
     return ls->pdf > 0.0f && light_faces(sc, l.prim, ls->n, v3_sub(ref, ls->p));
+}
+
+/* Chooses a light among the first ones whose cdf reaches `cdf_top` (1: all of them;
+ * the area lights' total: only those) and samples it from ref. The pdf includes the
+ * choice. Returns 0 if the sample carries no light. */
+KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, float u_pick, float u1, float u2,
+                        LightSample *ls)
+{
+    float u_rest;
+    uint li = light_choose(sc, u_pick * cdf_top, &u_rest);
+    Light l = sc->lights[li];
+    float choice = l.pick_pdf / cdf_top;
+    if (l.type != LIGHT_AREA) {
+        if (!light_delta_at(l, ref, ls)) return 0;
+        ls->pdf = choice;
+        return choice > 0.0f;
+    }
+    if (!light_sample_area(sc, li, ref, u_rest, u1, u2, ls)) return 0;
+    ls->pdf *= choice;
+    return ls->pdf > 0.0f;
+}
+
+/* Samples any light (next-event estimation of the path integrator). */
+KFN int light_sample(const SceneView *sc, vec3 ref, float u_pick, float u1, float u2, LightSample *ls)
+{
+    return light_sample_in(sc, ref, 1.0f, u_pick, u1, u2, ls);
+}
+
+/* The shadow ray from surface point p (geometric normal ng turned toward the light) to
+ * the light sample: from just above the surface to just before an area light, which
+ * must not count as its own occluder; to a point light; or off to infinity. */
+KFN Ray light_shadow_ray(vec3 p, vec3 ng, LightSample ls)
+{
+    Ray r;
+    r.o = offset_ray_origin(p, ng);
+    r.tmin = 0.0f;
+    if (ls.delta && !(ls.dist < k_as_float(0x7f800000u))) {
+        r.d = ls.wi;
+        r.tmax = k_as_float(0x7f800000u);
+    } else if (ls.delta) {
+        r.d = v3_sub(ls.p, r.o);
+        r.tmax = 1.0f;
+    } else {
+        vec3 target = offset_ray_origin(ls.p, v3_dot(ls.n, ls.wi) > 0.0f ? v3_neg(ls.n) : ls.n);
+        r.d = v3_sub(target, r.o);
+        r.tmax = 0.9999f;
+    }
+    return r;
 }
 
 #endif /* CLPT_LIGHTS_H */

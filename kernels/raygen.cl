@@ -1,6 +1,7 @@
 /*
  * raygen.cl — where a path is born: the camera ray through a jittered point of its pixel
- * (box filter), from a point on the thin lens when the aperture is open.
+ * (box filter), from a point on the thin lens when the aperture is open; or, for an
+ * orthographic camera, the parallel ray through that point of the view rectangle.
  */
 #ifndef CLPT_RAYGEN_CL
 #define CLPT_RAYGEN_CL
@@ -8,25 +9,39 @@
 #include "rng.h"
 #include "sampling.h"
 
-KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
-                     GLOBAL PathState *ps, GLOBAL Ray *ray)
+/* The camera ray through film position (s, t) (see Camera in types.h); `key` gives
+ * the lens sample when the aperture is open. */
+KFN Ray camera_ray(GLOBAL const RenderParams *p, float s, float t, uint key)
 {
     const Camera cam = p->camera;
-    uint key = rng_path_key(p->seed, pixel, sample);
-    uint x = pixel % p->width, y = pixel / p->width;
-    float s = ((float)x + rng_uniform(key, 0u, DIM_PIXEL_X)) / (float)p->width;
-    float t = ((float)y + rng_uniform(key, 0u, DIM_PIXEL_Y)) / (float)p->height;
+    Ray ray;
     vec3 target = v3_sub(v3_madd(cam.corner, cam.horizontal, s), v3_scale(cam.vertical, t));
+    ray.tmin = 0.0f;
+    ray.tmax = INFINITY;
+    if (cam.type == CAMERA_ORTHOGRAPHIC) {
+        ray.o = target;
+        ray.d = cam.forward;
+        return ray;
+    }
     vec3 origin = cam.origin;
     if (cam.lens_radius > 0.0f) {
         float lx, ly;
         sample_disk(rng_uniform(key, 0u, DIM_LENS_U), rng_uniform(key, 0u, DIM_LENS_V), &lx, &ly);
         origin = v3_madd(v3_madd(origin, cam.lens_u, lx * cam.lens_radius), cam.lens_v, ly * cam.lens_radius);
     }
-    ray->o = origin;
-    ray->d = v3_norm(v3_sub(target, origin));
-    ray->tmin = 0.0f;
-    ray->tmax = INFINITY;
+    ray.o = origin;
+    ray.d = v3_norm(v3_sub(target, origin));
+    return ray;
+}
+
+KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
+                     GLOBAL PathState *ps, GLOBAL Ray *ray)
+{
+    uint key = rng_path_key(p->seed, pixel, sample);
+    uint x = pixel % p->width, y = pixel / p->width;
+    float s = ((float)x + rng_uniform(key, 0u, DIM_PIXEL_X)) / (float)p->width;
+    float t = ((float)y + rng_uniform(key, 0u, DIM_PIXEL_Y)) / (float)p->height;
+    *ray = camera_ray(p, s, t, key);
 
     ps->throughput = v3s(1.0f);
     ps->radiance = v3s(0.0f);

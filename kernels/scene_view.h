@@ -19,6 +19,9 @@ typedef struct {
     GLOBAL const Material *materials;
     GLOBAL const Light *lights;
     GLOBAL const TriShading *shading;
+    GLOBAL const Texture *textures;
+    GLOBAL const uint *texels;          /* every image texture's texels (Texture.offset) */
+    GLOBAL const uint *pixel_mask;      /* per pixel, read when params->use_mask is set */
 } SceneView;
 
 #endif /* CLPT_SCENE_VIEW_H */

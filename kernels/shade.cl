@@ -11,6 +11,7 @@
 #include "lights.h"
 #include "rng.h"
 #include "surface.h"
+#include "texture.h"
 
 /* Power heuristic (beta = 2) weight of a strategy with density a against one with b. */
 KFN float mis_power(float a, float b)
@@ -28,35 +29,38 @@ KFN vec3 background_radiance(GLOBAL const RenderParams *p, vec3 d)
     return p->bg_color;
 }
 
-/* Next-event estimation at a diffuse surface: samples a light, and if it is above the
- * surface writes the shadow ray and the contribution it would bring (MIS-weighted
- * against cosine sampling). Returns 1 when a shadow ray was written. */
-KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s, vec3 n_face,
-                           vec3 ng_face, vec3 albedo, GLOBAL Ray *shadow_ray)
+/* Next-event estimation at a diffuse or Phong surface: samples a light, and if it is
+ * above the surface writes the shadow ray and the contribution it would bring: MIS-
+ * weighted against BSDF sampling for an area light (unless the test switch
+ * mis_mode says otherwise), fully for a delta light, which BSDF sampling cannot find.
+ * `d` is the incoming ray direction; `lobes` is 0 (null) for a diffuse surface. Returns
+ * 1 when a shadow ray was written. */
+KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s, vec3 d, vec3 n_face,
+                           vec3 ng_face, const PhongLobes *lobes, vec3 albedo,
+                           GLOBAL Ray *shadow_ray)
 {
     uint key = ps->rng_key, b = ps->bounce;
+    uint mis_mode = sc->params->mis_mode;
     LightSample ls;
     if (!light_sample(sc, s.p, rng_uniform(key, b, DIM_LIGHT_PICK), rng_uniform(key, b, DIM_LIGHT_U),
                       rng_uniform(key, b, DIM_LIGHT_V), &ls))
         return 0;
-    vec3 to = v3_sub(ls.p, s.p);
-    float dist = v3_len(to);
-    if (!(dist > 0.0f)) return 0;
-    vec3 wi = v3_scale(to, 1.0f / dist);
+    if (!ls.delta && mis_mode == MIS_BSDF_ONLY) return 0;
+    vec3 wi = ls.wi;
     float cos_s = v3_dot(n_face, wi);
     if (cos_s <= 0.0f || v3_dot(ng_face, wi) <= 0.0f) return 0;
-    float bsdf_pdf = cos_s * K_INV_PI;
-    float w = mis_power(ls.pdf, bsdf_pdf);
-    vec3 f_cos = v3_scale(albedo, K_INV_PI * cos_s * w / ls.pdf);
+    vec3 f;
+    float bsdf_pdf;
+    if (lobes) {
+        bsdf_pdf = phong_eval(*lobes, d, n_face, wi, &f);
+    } else {
+        f = v3_scale(albedo, K_INV_PI);
+        bsdf_pdf = cos_s * K_INV_PI;
+    }
+    float w = ls.delta || mis_mode == MIS_LIGHT_ONLY ? 1.0f : mis_power(ls.pdf, bsdf_pdf);
+    vec3 f_cos = v3_scale(f, cos_s * w / ls.pdf);
     ps->shadow_L = v3_mul(v3_mul(ps->throughput, f_cos), ls.Le);
-    /* from just above the surface to just before the light: the light itself must not
-     * count as an occluder */
-    vec3 o = offset_ray_origin(s.p, ng_face);
-    vec3 target = offset_ray_origin(ls.p, v3_dot(ls.n, wi) > 0.0f ? v3_neg(ls.n) : ls.n);
-    shadow_ray->o = o;
-    shadow_ray->d = v3_sub(target, o);
-    shadow_ray->tmin = 0.0f;
-    shadow_ray->tmax = 0.9999f;
+    *shadow_ray = light_shadow_ray(s.p, ng_face, ls);
     return 1;
 }
 
@@ -82,7 +86,8 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
          * could have found it too; after a delta bounce only BSDF sampling could */
         float w = 1.0f;
         if (!(ps->flags & PATH_SPECULAR) && s.light != NO_INDEX)
-            w = mis_power(ps->bsdf_pdf, light_pdf(sc, s.light, r.o, s.p, s.ng));
+            w = p->mis_mode == MIS_BOTH ? mis_power(ps->bsdf_pdf, light_pdf(sc, s.light, r.o, s.p, s.ng))
+                                        : (p->mis_mode == MIS_BSDF_ONLY ? 1.0f : 0.0f);
         ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, m.emission), w));
     }
     if (m.type == MAT_EMISSIVE || bounce >= p->max_depth) return 0u;   /* pure emitters do not reflect */
@@ -94,13 +99,23 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     uint result = 0u;
     BsdfSample bs;
 
+    vec3 albedo = material_albedo(sc, m, s, ng_face);
+
     if (m.type == MAT_DIFFUSE) {
-        if (p->n_lights > 0u && shade_light_sample(sc, ps, s, ns_face, ng_face, m.albedo, shadow_ray))
+        if (p->n_lights > 0u && shade_light_sample(sc, ps, s, r.d, ns_face, ng_face, 0, albedo, shadow_ray))
             result |= SHADE_SHADOW;
-        bs = bsdf_sample_diffuse(m.albedo, ns_face, rng_uniform(key, bounce, DIM_BSDF_U),
+        bs = bsdf_sample_diffuse(albedo, ns_face, rng_uniform(key, bounce, DIM_BSDF_U),
                                  rng_uniform(key, bounce, DIM_BSDF_V));
+    } else if (m.type == MAT_PHONG) {
+        PhongLobes lobes = phong_lobes(m, albedo);
+        if (p->n_lights > 0u && lobes.p_glossy > 0.0f &&
+            shade_light_sample(sc, ps, s, r.d, ns_face, ng_face, &lobes, albedo, shadow_ray))
+            result |= SHADE_SHADOW;
+        bs = phong_sample(lobes, m, r.d, ns_face, ng_face, front, rng_uniform(key, bounce, DIM_BSDF_LOBE),
+                          rng_uniform(key, bounce, DIM_BSDF_U), rng_uniform(key, bounce, DIM_BSDF_V),
+                          rng_uniform(key, bounce, DIM_BSDF_W));
     } else if (m.type == MAT_METAL) {
-        bs = bsdf_sample_metal(m.albedo, m.fuzz, r.d, ns_face, rng_uniform(key, bounce, DIM_BSDF_U),
+        bs = bsdf_sample_metal(albedo, m.fuzz, r.d, ns_face, rng_uniform(key, bounce, DIM_BSDF_U),
                                rng_uniform(key, bounce, DIM_BSDF_V), rng_uniform(key, bounce, DIM_BSDF_W));
     } else {
         bs = bsdf_sample_dielectric(m.ior, r.d, ng_face, front, rng_uniform(key, bounce, DIM_BSDF_LOBE));
@@ -109,7 +124,7 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     /* a reflected direction must leave on the incoming side, a refracted one on the
      * other; anything else is a sample below the geometric surface and carries nothing */
     float side = v3_dot(bs.wi, ng_face);
-    int transmitted = m.type == MAT_DIELECTRIC && side < 0.0f;
+    int transmitted = (m.type == MAT_DIELECTRIC || m.type == MAT_PHONG) && bs.specular && side < 0.0f;
     if (side == 0.0f || (side < 0.0f && !transmitted)) return result;
 
     vec3 thr = v3_mul(ps->throughput, bs.weight);

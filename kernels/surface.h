@@ -15,6 +15,7 @@ typedef struct {
     vec3 ns;         /* shading normal, unit, on the same side as ng */
     uint material;
     uint light;      /* index in lights[] or NO_INDEX */
+    uint prim;       /* global primitive id (textures compute their coordinates from it) */
     float u, v;      /* surface coordinates (triangle barycentrics or texture uv) */
 } Surface;
 
@@ -27,6 +28,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
     s.u = hit.u;
     s.v = hit.v;
     s.light = NO_INDEX;
+    s.prim = id;
     uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
     uint first_plane = first_box + p->n_boxes;
     if (id < first_tri) {

@@ -94,10 +94,14 @@ enum MaterialType {
     MAT_DIFFUSE = 0,     /* Lambertian, albedo */
     MAT_METAL = 1,       /* mirror reflection perturbed by fuzz, tinted by albedo */
     MAT_DIELECTRIC = 2,  /* smooth glass, Fresnel reflection/refraction, ior */
-    MAT_EMISSIVE = 3     /* emits `emission`, reflects nothing */
+    MAT_EMISSIVE = 3,    /* emits `emission`, reflects nothing */
+    MAT_PHONG = 4        /* albedo = diffuse colour, specular, shininess, plus mirror
+                          * (`reflective`) and Fresnel-weighted see-through
+                          * (`transparent`, ior) parts: the classic ray tracer's
+                          * material (docs/classic-format.md) */
 };
 
-typedef struct {                                        /* 64 bytes */
+typedef struct {                                        /* 96 bytes */
     uint type;                /* enum MaterialType */
     uint texture;             /* albedo texture index, NO_INDEX when none */
     float ior;
@@ -105,44 +109,92 @@ typedef struct {                                        /* 64 bytes */
     vec3 albedo;    float shininess;
     vec3 emission;  uint flags;   /* MAT_* flags */
     vec3 specular;  float pad0;
+    vec3 reflective;  float pad1; /* MAT_PHONG: perfect mirror part */
+    vec3 transparent; float pad2; /* MAT_PHONG: refracted part (split by Fresnel) */
 } Material;
 
 #define MAT_TWO_SIDED 1u        /* emits from both sides of its surface */
 
-enum LightType { LIGHT_AREA = 0 };
+/* Area lights are the emissive primitives; point, spot and directional lights are
+ * delta lights (a single direction reaches a point: no MIS, hard shadows). */
+enum LightType { LIGHT_AREA = 0, LIGHT_POINT = 1, LIGHT_DIRECTIONAL = 2, LIGHT_SPOT = 3 };
 
-/* Emissive primitives, in one array with a cumulative distribution for choosing one
- * proportionally to its power (area x luminance of emission). */
+/* Every light, in one array with a cumulative distribution for choosing one
+ * proportionally to its estimated power (host/scene.c). Area lights come first
+ * (RenderParams.n_area_lights of them), then the delta lights.
+ * A delta light's `intensity` is radiant intensity (point, spot: W/sr) or irradiance
+ * (directional: W/m^2 across the beam); point and spot lights are divided by the
+ * attenuation atten0 + atten1*d + atten2*d^2 at distance d (inverse square: 0 0 1). */
 typedef struct {                                        /* 80 bytes */
     uint type;                /* enum LightType */
-    uint prim;                /* area lights: global primitive id */
+    uint prim;                /* area lights: global primitive id; else NO_INDEX */
     float cdf;                /* P(choose a light with index <= this one) */
     float pick_pdf;           /* P(choose this light) */
-    float area;
-    float pad0, pad1, pad2;
-    vec3 position;  float pad3;
-    vec3 direction; float pad4;
-    vec3 intensity; float pad5;
+    float area;               /* area lights */
+    float atten0, atten1, atten2;
+    vec3 position;  float cos_outer;   /* spot: no light outside this cone (cosine) */
+    vec3 direction; float cos_inner;   /* unit, where the light goes; spot: full inside */
+    vec3 intensity; float pad0;
 } Light;
 
-enum CameraType { CAMERA_PERSPECTIVE = 0 };
+enum CameraType { CAMERA_PERSPECTIVE = 0, CAMERA_ORTHOGRAPHIC = 1 };
 
-/* A thin-lens camera prepared on the host: the ray through film position (s, t) in
- * [0,1]^2 (t = 0 at the top row) starts at origin + lens offset and passes through
- * corner + s*horizontal - t*vertical (corner is the top-left of the focus plane). */
-typedef struct {                                        /* 96 bytes */
+/* A camera prepared on the host. Perspective (thin lens): the ray through film position
+ * (s, t) in [0,1]^2 (t = 0 at the top row) starts at origin + lens offset and passes
+ * through corner + s*horizontal - t*vertical (corner is the top-left of the focus
+ * plane). Orthographic: the ray starts at corner + s*horizontal - t*vertical (a
+ * rectangle through the camera centre) and goes along `forward`. */
+typedef struct {                                        /* 112 bytes */
     vec3 origin;      float lens_radius;
     vec3 corner;      uint type;
     vec3 horizontal;  float pad0;
     vec3 vertical;    float pad1;
     vec3 lens_u;      float pad2;   /* unit vectors spanning the lens plane */
     vec3 lens_v;      float pad3;
+    vec3 forward;     float pad4;   /* unit view direction */
 } Camera;
+
+/* Textures (kernels/texture.h), in one table; image texels live in one uint array. */
+enum TextureType {
+    TEX_IMAGE = 0,       /* bilinear lookup of width x height texels at offset */
+    TEX_CHECKER = 1      /* color0/color1 alternating on unit cells of texture space */
+};
+#define TEX_SRGB 1u      /* 8-bit texels are sRGB-encoded: decoded before filtering */
+#define TEX_CLAMP 2u     /* coordinates outside [0,1] clamp to the edge (else repeat) */
+#define TEX_FLOAT 4u     /* texels are 3 floats (as uint bits) each; else packed RGBA8 */
+#define TEX_SOLID 8u     /* checker: at the 3D hit point; else at the surface (u, v) */
+
+typedef struct {                                        /* 112 bytes */
+    uint type;                /* enum TextureType */
+    uint flags;               /* TEX_* */
+    uint offset;              /* first uint of the image in texels[] */
+    uint width;
+    uint height;
+    uint pad0, pad1, pad2;
+    float m[12];              /* 3x4 row-major map to texture space: of (x, y, z, 1) for
+                               * TEX_SOLID, else of (u, v, 0, 1) */
+    vec3 color0;  float pad3;
+    vec3 color1;  float pad4;
+} Texture;
 
 enum BackgroundType { BG_CONSTANT = 0, BG_SKY = 1 };
 
+/* What a sample computes: light transport (path, whitted) or an auxiliary image of the
+ * first hit (kernels/whitted.cl). */
+enum Integrator {
+    INTEGRATOR_PATH = 0,
+    INTEGRATOR_WHITTED = 1,
+    INTEGRATOR_AOV_NORMAL = 2,   /* shading normal n as (n + 1) / 2 */
+    INTEGRATOR_AOV_DEPTH = 3,    /* (distance, 1, 0) at a hit, 0 0 0 for a miss */
+    INTEGRATOR_AOV_ALBEDO = 4    /* diffuse colour (textured) */
+};
+
+/* Which strategies the path integrator combines for area lights: both with the power
+ * heuristic, or one alone (tests/test_mis.c checks that all three agree). */
+enum MisMode { MIS_BOTH = 0, MIS_LIGHT_ONLY = 1, MIS_BSDF_ONLY = 2 };
+
 /* Everything constant over a render, uploaded once per device. */
-typedef struct {                                        /* 208 bytes */
+typedef struct {                                        /* 272 bytes */
     Camera camera;
     vec3 bg_color;    uint bg_type;   /* constant colour, or the sky's horizon colour */
     vec3 bg_zenith;   uint pad0;      /* sky colour straight up (+y) */
@@ -155,6 +207,16 @@ typedef struct {                                        /* 208 bytes */
     uint n_nodes, n_leaf_prims;
     vec3 bounds_lo;   uint pad1;      /* box of the kd-tree root */
     vec3 bounds_hi;   uint pad2;
+    /* integrators and light kinds of the classic ray tracer (kernels/whitted.cl) */
+    vec3 ambient;     uint integrator;  /* whitted: ambient light; enum Integrator */
+    uint mis_mode;                    /* enum MisMode */
+    uint n_area_lights;               /* lights[0 .. n_area_lights) are area lights */
+    uint n_textures;
+    uint use_mask;                    /* whitted: render only pixels with pixel_mask != 0 */
+    uint strata;                      /* whitted pixel samples: 0 the pixel centre, 1
+                                       * uniform jitter, m >= 2 an m x m jittered grid */
+    uint sample_offset;               /* added to the sample index (adaptive passes) */
+    uint pad3, pad4;
 } RenderParams;
 
 /* One path of the wavefront; lives in a device buffer between kernel launches. */
@@ -186,14 +248,21 @@ CLPT_CHECK_SIZE(Triangle, 48);
 CLPT_CHECK_SIZE(TriShading, 64);
 CLPT_CHECK_SIZE(Box, 32);
 CLPT_CHECK_SIZE(Plane, 32);
-CLPT_CHECK_SIZE(Material, 64);
+CLPT_CHECK_SIZE(Material, 96);
 CLPT_CHECK_SIZE(Light, 80);
-CLPT_CHECK_SIZE(Camera, 96);
-CLPT_CHECK_SIZE(RenderParams, 208);
+CLPT_CHECK_SIZE(Camera, 112);
+CLPT_CHECK_SIZE(RenderParams, 272);
 CLPT_CHECK_SIZE(PathState, 64);
-_Static_assert(offsetof(RenderParams, bg_color) == 96, "RenderParams.bg_color");
-_Static_assert(offsetof(RenderParams, width) == 128, "RenderParams.width");
-_Static_assert(offsetof(RenderParams, bounds_lo) == 176, "RenderParams.bounds_lo");
+CLPT_CHECK_SIZE(Texture, 112);
+_Static_assert(offsetof(RenderParams, bg_color) == 112, "RenderParams.bg_color");
+_Static_assert(offsetof(RenderParams, width) == 144, "RenderParams.width");
+_Static_assert(offsetof(RenderParams, bounds_lo) == 192, "RenderParams.bounds_lo");
+_Static_assert(offsetof(RenderParams, ambient) == 224, "RenderParams.ambient");
+_Static_assert(offsetof(RenderParams, strata) == 256, "RenderParams.strata");
+_Static_assert(offsetof(Material, reflective) == 64, "Material.reflective");
+_Static_assert(offsetof(Light, cos_inner) == 60, "Light.cos_inner");
+_Static_assert(offsetof(Texture, m) == 32, "Texture.m");
+_Static_assert(offsetof(Texture, color1) == 96, "Texture.color1");
 _Static_assert(offsetof(PathState, bsdf_pdf) == 48, "PathState.bsdf_pdf");
 _Static_assert(offsetof(Material, albedo) == 16, "Material.albedo");
 _Static_assert(offsetof(Light, position) == 32, "Light.position");

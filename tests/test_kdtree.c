@@ -11,6 +11,8 @@
 
 #include "harness.h"
 #include "kdtree.h"
+#include "mesh.h"
+#include "surface.h"
 #include "traverse.cl"
 
 /* ------------------------------------------------------------------ helpers */
@@ -87,7 +89,7 @@ static Status scene_build(int threads)
     scene.params.bounds_lo = scene.tree.lo;
     scene.params.bounds_hi = scene.tree.hi;
     SceneView v = { &scene.params, scene.tree.nodes, scene.tree.leaf_prims, scene.sph, scene.tri,
-                    scene.box, scene.pln, NULL, NULL, NULL };
+                    scene.box, scene.pln, NULL, NULL, NULL, NULL, NULL, NULL };
     scene.view = v;
     return ST_OK;
 }
@@ -271,7 +273,7 @@ static void test_triangle(void)
         RayPre rp = ray_prepare(r);
         Hit h;
         int inside = target.x + target.y < 2.0f;
-        int hit = triangle_intersect(&rp, t, r, &h);
+        int hit = triangle_intersect(&rp, &t, r, &h);
         if (fabsf(target.x + target.y - 2.0f) > 1e-4f && o.z != -2.0f) CHECK_EQ_INT(hit, inside);
         if (hit) {
             /* p = (1-u-v) p0 + u p1 + v p2 is the point o + t d */
@@ -285,21 +287,21 @@ static void test_triangle(void)
     Ray down = make_ray(v3(0.5f, 0.5f, 0.0f), v3(0.0f, 0.0f, -1.0f), 0.0f, K_INF);
     Ray up = make_ray(v3(0.5f, 0.5f, -4.0f), v3(0.0f, 0.0f, 1.0f), 0.0f, K_INF);
     RayPre rpd = ray_prepare(down), rpu = ray_prepare(up);
-    CHECK(triangle_intersect(&rpd, t, down, &h));
+    CHECK(triangle_intersect(&rpd, &t, down, &h));
     CHECK_NEAR(h.t, 2.0f, 1e-6);
     CHECK_NEAR(h.u, 0.25f, 1e-6);
     CHECK_NEAR(h.v, 0.25f, 1e-6);
-    CHECK(triangle_intersect(&rpu, t, up, &h));
+    CHECK(triangle_intersect(&rpu, &t, up, &h));
     CHECK_NEAR(h.t, 2.0f, 1e-6);
     /* degenerate (zero area) and parallel: misses, no NaN trouble */
     Triangle flat = { v3(0.0f, 0.0f, -2.0f), 0, v3(1.0f, 1.0f, -2.0f), NO_INDEX, v3(2.0f, 2.0f, -2.0f), NO_INDEX };
-    CHECK(!triangle_intersect(&rpd, flat, down, &h));
+    CHECK(!triangle_intersect(&rpd, &flat, down, &h));
     Ray side = make_ray(v3(-1.0f, 0.5f, -2.0f), v3(1.0f, 0.0f, 0.0f), 0.0f, K_INF);
     RayPre rps = ray_prepare(side);
-    CHECK(!triangle_intersect(&rps, t, side, &h));
+    CHECK(!triangle_intersect(&rps, &t, side, &h));
     Ray nan_ray = make_ray(v3(NAN, 0.0f, 0.0f), v3(0.0f, 0.0f, -1.0f), 0.0f, K_INF);
     RayPre rpn = ray_prepare(nan_ray);
-    CHECK(!triangle_intersect(&rpn, t, nan_ray, &h));
+    CHECK(!triangle_intersect(&rpn, &t, nan_ray, &h));
 }
 
 /* Rays through the shared edges and vertices of a mesh never slip through. */
@@ -339,7 +341,7 @@ static void test_watertight(void)
         RayPre rp = ray_prepare(r);
         int hit = 0;
         Hit h;
-        for (int t = 0; t < n; t++) hit |= triangle_intersect(&rp, tris[t], r, &h);
+        for (int t = 0; t < n; t++) hit |= triangle_intersect(&rp, &tris[t], r, &h);
         misses += !hit;
         rays++;
     }
@@ -616,6 +618,34 @@ static void test_against_brute_force(void)
     fprintf(stderr, "  %d random rays, %d disagree with brute force\n", total, bad);
 }
 
+/* Two rays walked in turns (trace_closest2, trace_any2) give each ray bit for bit what
+ * it gets alone, on every kind of scene and ray (planes, spheres, boxes, NaN, zero
+ * components). */
+static void test_pairs(void)
+{
+    struct { uint64_t seed; uint ns, nt, nb, np; } cases[] = {
+        { 81, 40, 200, 25, 2 }, { 82, 0, 400, 0, 0 }, { 83, 120, 0, 60, 1 },
+    };
+    int differ = 0, total = 0;
+    for (int c = 0; c < 3; c++) {
+        random_scene(cases[c].seed, cases[c].ns, cases[c].nt, cases[c].nb, cases[c].np);
+        CHECK(scene_build(0) == ST_OK);
+        for (int i = 0; i < 10000; i++) {
+            Ray a = random_ray(-5.0f, 5.0f), b = random_ray(-5.0f, 5.0f);
+            if (i % 97 == 0) a.o.x = NAN;
+            Hit ha, hb, sa = trace_closest(&scene.view, a), sb = trace_closest(&scene.view, b);
+            trace_closest2(&scene.view, a, b, &ha, &hb);
+            int oa, ob;
+            trace_any2(&scene.view, a, b, &oa, &ob);
+            differ += memcmp(&ha, &sa, sizeof ha) != 0 || memcmp(&hb, &sb, sizeof hb) != 0;
+            differ += oa != trace_any(&scene.view, a) || ob != trace_any(&scene.view, b);
+            total++;
+        }
+    }
+    CHECK_EQ_INT(differ, 0);
+    fprintf(stderr, "  %d pairs of rays, %d differ from the rays traced alone\n", total, differ);
+}
+
 static void test_empty_scene(void)
 {
     scene_clear();
@@ -732,6 +762,192 @@ static void test_deterministic(void)
     kd_free(&one);
 }
 
+/* ------------------------------------------------------------------ real meshes */
+
+typedef struct {
+    Scene scene;
+    KdTree tree;
+    RenderParams params;
+    SceneView view;
+} MeshScene;
+
+/* Loads a mesh file (or "sphere:N", the closed procedural sphere) and builds its tree. */
+static int mesh_scene_open(MeshScene *m, const char *what)
+{
+    memset(m, 0, sizeof *m);
+    scene_init(&m->scene);
+    Error err = { 0 };
+    Status st;
+    if (strncmp(what, "sphere:", 7) == 0) {
+        st = mesh_make_sphere(&m->scene, (size_t)atol(what + 7), 0, &err);
+    } else {
+        MeshOptions o = mesh_options(0);
+        st = mesh_load(what, &m->scene, &o, &err);
+    }
+    KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0 };
+    if (st == ST_OK) st = kd_build(&in, 0, &m->tree, &err);
+    if (st != ST_OK) {
+        fprintf(stderr, "  %s: %s\n", what, err.msg);
+        return -1;
+    }
+    m->params.n_triangles = (uint)m->scene.n_triangles;
+    m->params.n_nodes = m->tree.n_nodes;
+    m->params.n_leaf_prims = m->tree.n_leaf_prims;
+    m->params.bounds_lo = m->tree.lo;
+    m->params.bounds_hi = m->tree.hi;
+    SceneView v = { &m->params, m->tree.nodes, m->tree.leaf_prims, NULL, m->scene.triangles, NULL, NULL, NULL, NULL, NULL };
+    m->view = v;
+    return 0;
+}
+
+static void mesh_scene_close(MeshScene *m)
+{
+    kd_free(&m->tree);
+    scene_free(&m->scene);
+}
+
+static vec3 triangle_point(const Triangle *t, float u, float v)
+{
+    if (u + v > 1.0f) {
+        u = 1.0f - u;
+        v = 1.0f - v;
+    }
+    return v3_add(v3_add(v3_scale(t->p0, 1.0f - u - v), v3_scale(t->p1, u)), v3_scale(t->p2, v));
+}
+
+/* Kd-tree against every triangle on rays a renderer traces over a scanned mesh: from
+ * outside at points of the mesh, from points of the surface into the hemisphere (like
+ * diffuse bounces) and toward other points of it (like shadow rays). */
+static void check_mesh_brute_force(const char *what, int rays)
+{
+    MeshScene m;
+    if (mesh_scene_open(&m, what)) {
+        CHECK(!"mesh loads");
+        mesh_scene_close(&m);
+        return;
+    }
+    uint nt = (uint)m.scene.n_triangles;
+    vec3 c = v3_scale(v3_add(m.tree.lo, m.tree.hi), 0.5f);
+    float r = 0.5f * v3_len(v3_sub(m.tree.hi, m.tree.lo));
+    rng_seed(61);
+    int bad = 0, hits = 0;
+    for (int i = 0; i < rays; i++) {
+        const Triangle *a = &m.scene.triangles[(uint)(frand() * nt) % nt];
+        const Triangle *b = &m.scene.triangles[(uint)(frand() * nt) % nt];
+        vec3 pa = triangle_point(a, frand(), frand()), pb = triangle_point(b, frand(), frand());
+        vec3 ng = v3_norm(v3_cross(v3_sub(a->p1, a->p0), v3_sub(a->p2, a->p0)));
+        vec3 off = offset_ray_origin(pa, frand() < 0.5f ? ng : v3_neg(ng));
+        Ray ray;
+        switch (i % 4) {
+        case 0:   /* camera-like, from a sphere around the mesh */
+            ray = make_ray(v3_add(c, v3_scale(v3_norm(vrand(-1.0f, 1.0f)), 2.0f * r)), v3s(0.0f), 0.0f, K_INF);
+            ray.d = v3_sub(pa, ray.o);
+            break;
+        case 1:   /* diffuse-like */
+            ray = make_ray(off, vrand(-1.0f, 1.0f), 0.0f, K_INF);
+            break;
+        case 2:   /* shadow-like: to another point of the surface */
+            ray = make_ray(off, v3_sub(pb, off), 0.0f, 1.0f - 1e-4f);
+            break;
+        default:  /* anywhere in the box, a positive tmin */
+            ray = make_ray(v3_add(m.tree.lo, v3_mul(v3_sub(m.tree.hi, m.tree.lo), vrand(0.0f, 1.0f))),
+                           vrand(-1.0f, 1.0f), frange(0.0f, 0.1f) * r, K_INF);
+            break;
+        }
+        Hit kd = trace_closest(&m.view, ray);
+        RayPre rp = ray_prepare(ray);
+        Hit bf = { ray.tmax, NO_INDEX, 0.0f, 0.0f };
+        for (uint id = 0; id < nt; id++) {
+            Ray rr = ray;
+            rr.tmax = bf.t;
+            Hit h;
+            if (triangle_intersect(&rp, &m.scene.triangles[id], rr, &h)) {
+                h.prim = id;
+                bf = h;
+            }
+        }
+        int ok;
+        if (kd.prim == NO_INDEX || bf.prim == NO_INDEX) ok = kd.prim == bf.prim;
+        else if (kd.prim == bf.prim) ok = kd.t == bf.t && kd.u == bf.u && kd.v == bf.v;
+        else ok = kd.t == bf.t;   /* two triangles at the same distance (a shared edge) */
+        ok = ok && trace_any(&m.view, ray) == (bf.prim != NO_INDEX);
+        if (!ok && bad++ < 3)
+            fprintf(stderr, "  %s ray %d: kd %u t=%.9g, brute force %u t=%.9g\n", what, i, kd.prim, kd.t, bf.prim, bf.t);
+        hits += bf.prim != NO_INDEX;
+    }
+    CHECK_EQ_INT(bad, 0);
+    CHECK(hits > rays / 4);
+    fprintf(stderr, "  %s: %u triangles, %d rays (%d hit), %d disagree with brute force\n", what, nt, rays, hits, bad);
+    mesh_scene_close(&m);
+}
+
+static void test_real_meshes(void)
+{
+    check_mesh_brute_force("tests/data/models/bun_zipper_res4.ply", 20000);
+    const char *res3 = "../shared/models/bunny/bun_zipper_res3.ply";
+    FILE *f = fopen(res3, "rb");
+    if (f) {
+        fclose(f);
+        check_mesh_brute_force(res3, 8000);
+    } else {
+        fprintf(stderr, "  %s not found: only the small bunny is checked\n", res3);
+    }
+}
+
+/* From inside a closed mesh, a million rays aimed exactly at its vertices and at points
+ * of its edges: not one may slip out between the triangles. */
+static void test_watertight_mesh(void)
+{
+    MeshScene m;
+    if (mesh_scene_open(&m, "sphere:20000")) {
+        CHECK(!"sphere builds");
+        mesh_scene_close(&m);
+        return;
+    }
+    uint nt = (uint)m.scene.n_triangles;
+    rng_seed(71);
+    int misses = 0, any_misses = 0;
+    const int rays = 1000000;
+    for (int i = 0; i < rays; i++) {
+        const Triangle *t = &m.scene.triangles[(uint)(frand() * nt) % nt];
+        const vec3 *corner[3] = { &t->p0, &t->p1, &t->p2 };
+        int k = (int)(frand() * 3.0f) % 3;
+        vec3 target = *corner[k];
+        if (i % 2) {   /* a point of the edge from corner k to the next */
+            vec3 next = *corner[(k + 1) % 3];
+            target = v3_add(target, v3_scale(v3_sub(next, target), frand()));
+        }
+        vec3 o = vrand(-0.3f, 0.3f);
+        if (i % 5 == 0) o = v3s(0.0f);
+        if (i % 7 == 0) {
+            /* d with two zero components: the origin moved in along the target's largest
+             * coordinate, which keeps it inside the sphere */
+            float ax = fabsf(target.x), ay = fabsf(target.y), az = fabsf(target.z);
+            o = target;
+            if (ax >= ay && ax >= az) o.x *= 0.2f;
+            else if (ay >= az) o.y *= 0.2f;
+            else o.z *= 0.2f;
+        }
+        Ray ray = make_ray(o, v3_sub(target, o), 0.0f, K_INF);
+        Hit h = trace_closest(&m.view, ray);
+        if (h.prim == NO_INDEX) {
+            if (misses++ < 3) {
+                RayPre rp = ray_prepare(ray);
+                int bf = 0;
+                for (uint id = 0; id < nt; id++) { Hit hh; bf += triangle_intersect(&rp, &m.scene.triangles[id], ray, &hh); }
+                fprintf(stderr, "  miss: o=(%.9g %.9g %.9g) target=(%.9g %.9g %.9g) brute force hits %d\n", o.x, o.y, o.z, target.x,
+                        target.y, target.z, bf);
+            }
+        }
+        any_misses += !trace_any(&m.view, ray);
+    }
+    CHECK_EQ_INT(misses, 0);
+    CHECK_EQ_INT(any_misses, 0);
+    fprintf(stderr, "  closed sphere of %u triangles: %d rays at vertices and edges from inside, %d misses\n", nt,
+            rays, misses);
+    mesh_scene_close(&m);
+}
+
 int main(void)
 {
     RUN(test_sphere);
@@ -741,10 +957,13 @@ int main(void)
     RUN(test_plane);
     RUN(test_structure);
     RUN(test_against_brute_force);
+    RUN(test_pairs);
     RUN(test_empty_scene);
     RUN(test_bad_primitives);
     RUN(test_flat_on_split_planes);
     RUN(test_deterministic);
+    RUN(test_real_meshes);
+    RUN(test_watertight_mesh);
     scene_clear();
     return harness_report();
 }

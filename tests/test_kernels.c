@@ -11,23 +11,29 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "harness.h"
 #include "ocl_program.h"
 #include "render_scene.h"
+#include "texture.h"
 
 /* the kernel stage functions, compiled as C: the reference */
 #include "film.cl"
 #include "raygen.cl"
 #include "shade.cl"
 #include "traverse.cl"
+#include "whitted.cl"
+
+/* Scene buffers every kernel takes first (SCENE_ARGS in entry.cl). */
+#define N_SCENE 13
 
 typedef struct {
     OclDeviceInfo dev;
     cl_context ctx;
     cl_command_queue q;
     cl_program prog;
-    cl_mem scene[10];
+    cl_mem scene[N_SCENE];
     int ok;
 } Cl;
 
@@ -44,6 +50,36 @@ static float frand(void)
 }
 static float frange(float lo, float hi) { return lo + (hi - lo) * frand(); }
 static vec3 vrand(float lo, float hi) { return v3(frange(lo, hi), frange(lo, hi), frange(lo, hi)); }
+
+/* Textures of each kind: an sRGB 8-bit image, a linear float image (clamped), a surface
+ * checker and a solid one. Returns the indices in t[4]. */
+static void add_textures(uint t[4])
+{
+    uint px[8 * 4], offset;
+    for (uint i = 0; i < 8 * 4; i++) px[i] = ((i * 37u) & 255u) | ((i * 91u) & 255u) << 8 | ((i * 13u) & 255u) << 16;
+    scene_add_texels(&scene, px, 8 * 4, &offset, NULL);
+    Texture img = texture_make_checker(v3s(0.0f), v3s(0.0f), 1.0f, 0);
+    img.type = TEX_IMAGE;
+    img.flags = TEX_SRGB;
+    img.offset = offset;
+    img.width = 8;
+    img.height = 4;
+    texture_set_scale_offset(&img, 3.0f, 2.0f, 0.1f, 0.0f);
+    scene_add_texture(&scene, "image", NULL, img, &t[0], NULL);
+    float f[6] = { 0.2f, 0.4f, 0.6f, 0.9f, 0.1f, 0.3f };
+    uint bits[6];
+    memcpy(bits, f, sizeof bits);
+    scene_add_texels(&scene, bits, 6, &offset, NULL);
+    img.flags = TEX_FLOAT | TEX_CLAMP;
+    img.offset = offset;
+    img.width = 2;
+    img.height = 1;
+    scene_add_texture(&scene, "float", NULL, img, &t[1], NULL);
+    scene_add_texture(&scene, "uv", NULL, texture_make_checker(v3(0.9f, 0.9f, 0.9f), v3(0.1f, 0.2f, 0.3f), 4.0f, 0),
+                      &t[2], NULL);
+    scene_add_texture(&scene, "solid", NULL, texture_make_checker(v3(0.8f, 0.1f, 0.1f), v3(0.1f, 0.1f, 0.8f), 1.5f, 1),
+                      &t[3], NULL);
+}
 
 /* A small scene with every primitive type and material type, and lights of each
  * lightable shape. */
@@ -69,16 +105,35 @@ static void build_scene(void)
     Material g = material_diffuse(v3s(0.4f));
     g.emission = v3(0.5f, 0.2f, 0.1f);
     scene_add_material(&scene, "glow", g, &glow, NULL);
-    uint mats[] = { diffuse, metal, glass, diffuse, glow };
-    for (int i = 0; i < 12; i++) {
-        Sphere s = { vrand(-3.0f, 3.0f), frange(0.2f, 0.8f), mats[i % 5], NO_INDEX, 0, 0 };
+    /* the classic ray tracer's materials, textured in every way */
+    uint tex[4], phong, mirror, clear, checked;
+    add_textures(tex);
+    Material ph = material_phong(v3(0.6f, 0.5f, 0.4f), v3(0.3f, 0.3f, 0.3f), 25.0f);
+    ph.texture = tex[0];
+    scene_add_material(&scene, "phong", ph, &phong, NULL);
+    ph = material_phong(v3(0.1f, 0.1f, 0.1f), v3(0.5f, 0.5f, 0.5f), 200.0f);
+    ph.reflective = v3(0.6f, 0.6f, 0.5f);
+    ph.texture = tex[1];
+    scene_add_material(&scene, "mirror", ph, &mirror, NULL);
+    ph = material_phong(v3s(0.0f), v3(0.2f, 0.2f, 0.2f), 60.0f);
+    ph.transparent = v3(0.9f, 0.9f, 0.8f);
+    ph.reflective = v3s(0.05f);
+    ph.ior = 1.4f;
+    scene_add_material(&scene, "clear", ph, &clear, NULL);
+    Material ch = material_diffuse(v3s(0.5f));
+    ch.texture = tex[2];
+    scene_add_material(&scene, "checked", ch, &checked, NULL);
+    scene.materials[diffuse].texture = tex[3];
+    uint mats[] = { diffuse, metal, glass, phong, glow, mirror, clear, checked };
+    for (int i = 0; i < 16; i++) {
+        Sphere s = { vrand(-3.0f, 3.0f), frange(0.2f, 0.8f), mats[i % 8], NO_INDEX, 0, 0 };
         scene_add_sphere(&scene, s, NULL);
     }
     Sphere light_sphere = { v3(0.0f, 5.0f, 0.0f), 0.5f, lamp, NO_INDEX, 0, 0 };
     scene_add_sphere(&scene, light_sphere, NULL);
     for (int i = 0; i < 30; i++) {
         vec3 c = vrand(-3.0f, 3.0f);
-        Triangle t = { v3_add(c, vrand(-1.0f, 1.0f)), mats[i % 5], v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX,
+        Triangle t = { v3_add(c, vrand(-1.0f, 1.0f)), mats[i % 8], v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX,
                        v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX };
         scene_add_triangle(&scene, t, NULL);
     }
@@ -86,13 +141,33 @@ static void build_scene(void)
     scene_add_triangle(&scene, lt, NULL);
     for (int i = 0; i < 4; i++) {
         vec3 lo = vrand(-3.0f, 2.0f);
-        Box b = { lo, mats[i % 5], v3_add(lo, vrand(0.2f, 1.0f)), NO_INDEX };
+        Box b = { lo, mats[(i * 3) % 8], v3_add(lo, vrand(0.2f, 1.0f)), NO_INDEX };
         scene_add_box(&scene, b, NULL);
     }
     Box lb = { v3(2.0f, 3.0f, 2.0f), lamp, v3(2.5f, 3.2f, 2.4f), NO_INDEX };
     scene_add_box(&scene, lb, NULL);
-    Plane floor = { v3(0.0f, 1.0f, 0.0f), -3.5f, diffuse, 0, 0, 0 };
+    Plane floor = { v3(0.0f, 1.0f, 0.0f), -3.5f, checked, 0, 0, 0 };
     scene_add_plane(&scene, floor, NULL);
+    /* delta lights of every kind, with the classic and the physical attenuation */
+    Light pt = light_default(LIGHT_POINT);
+    pt.position = v3(-2.0f, 4.0f, 3.0f);
+    pt.intensity = v3(8.0f, 8.0f, 7.0f);
+    scene_add_light(&scene, pt, NULL);
+    Light spot = light_default(LIGHT_SPOT);
+    spot.position = v3(2.0f, 5.0f, 2.0f);
+    spot.direction = v3_norm(v3(-0.3f, -1.0f, -0.2f));
+    spot.intensity = v3(20.0f, 18.0f, 15.0f);
+    spot.cos_outer = 0.8f;
+    spot.cos_inner = 0.9f;
+    spot.atten0 = 1.0f;
+    spot.atten1 = 0.1f;
+    spot.atten2 = 0.0f;
+    scene_add_light(&scene, spot, NULL);
+    Light dir = light_default(LIGHT_DIRECTIONAL);
+    dir.direction = v3_norm(v3(0.4f, -1.0f, -0.3f));
+    dir.intensity = v3(1.0f, 1.0f, 1.2f);
+    scene_add_light(&scene, dir, NULL);
+    scene.ambient = v3(0.05f, 0.05f, 0.05f);
     Error err = { 0 };
     Status st = render_scene_prepare(&scene, 1, &rs, &err);
     if (st) fprintf(stderr, "scene setup failed: %s\n", err.msg);
@@ -106,6 +181,9 @@ static void build_scene(void)
     view.materials = rs.ds.materials;
     view.lights = rs.ds.lights;
     view.shading = rs.ds.shading;
+    view.textures = rs.ds.textures;
+    view.texels = rs.ds.texels;
+    view.pixel_mask = rs.ds.pixel_mask;
 }
 
 static cl_mem buffer(size_t bytes, const void *src)
@@ -150,7 +228,7 @@ static void run(cl_kernel k, size_t n)
 
 static void set_scene_args(cl_kernel k)
 {
-    for (cl_uint i = 0; i < 10; i++) SET(k, i, cl.scene[i]);
+    for (cl_uint i = 0; i < N_SCENE; i++) SET(k, i, cl.scene[i]);
 }
 
 static int setup_opencl(void)
@@ -190,6 +268,9 @@ static int setup_opencl(void)
     cl.scene[7] = buffer(ds->n_materials * sizeof(Material), ds->materials);
     cl.scene[8] = buffer(p->n_lights * sizeof(Light), ds->lights);
     cl.scene[9] = buffer(ds->n_shading * sizeof(TriShading), ds->shading);
+    cl.scene[10] = buffer(p->n_textures * sizeof(Texture), ds->textures);
+    cl.scene[11] = buffer(ds->n_texels * sizeof(uint), ds->texels);
+    cl.scene[12] = buffer(ds->pixel_mask ? p->width * p->height * sizeof(uint) : 0, ds->pixel_mask);
     return 1;
 }
 
@@ -211,7 +292,10 @@ static void test_layout(void)
                     sizeof(Camera), sizeof(RenderParams), sizeof(PathState), offsetof(RenderParams, bg_color),
                     offsetof(RenderParams, width), offsetof(RenderParams, bounds_lo), offsetof(PathState, bsdf_pdf),
                     offsetof(Material, albedo), offsetof(Light, position), offsetof(Camera, lens_u),
-                    offsetof(TriShading, uv0) };
+                    offsetof(TriShading, uv0), sizeof(Texture), offsetof(Texture, m),
+                    offsetof(Texture, color1), offsetof(RenderParams, ambient),
+                    offsetof(RenderParams, strata), offsetof(Material, reflective),
+                    offsetof(Light, cos_inner), offsetof(Camera, forward) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);
@@ -294,10 +378,10 @@ static void test_intersect(void)
     cl_kernel k = kernel("k_intersect");
     set_scene_args(k);
     uint n = N;
-    SET(k, 10, qb);
-    SET(k, 11, n);
-    SET(k, 12, rb);
-    SET(k, 13, hb);
+    SET(k, N_SCENE + 0, qb);
+    SET(k, N_SCENE + 1, n);
+    SET(k, N_SCENE + 2, rb);
+    SET(k, N_SCENE + 3, hb);
     run(k, N);
     Hit *dh = malloc(N * sizeof *dh);
     read_back(hb, N * sizeof *dh, dh);
@@ -349,15 +433,15 @@ static void test_shade_and_shadow(void)
     cl_kernel k = kernel("k_shade");
     set_scene_args(k);
     uint n = N;
-    SET(k, 10, qb);
-    SET(k, 11, n);
-    SET(k, 12, rb);
-    SET(k, 13, hb);
-    SET(k, 14, pb);
-    SET(k, 15, srb);
-    SET(k, 16, nqb);
-    SET(k, 17, sqb);
-    SET(k, 18, cb);
+    SET(k, N_SCENE + 0, qb);
+    SET(k, N_SCENE + 1, n);
+    SET(k, N_SCENE + 2, rb);
+    SET(k, N_SCENE + 3, hb);
+    SET(k, N_SCENE + 4, pb);
+    SET(k, N_SCENE + 5, srb);
+    SET(k, N_SCENE + 6, nqb);
+    SET(k, N_SCENE + 7, sqb);
+    SET(k, N_SCENE + 8, cb);
     run(k, N);
     PathState *dps = malloc(N * sizeof *dps);
     Ray *drays = malloc(N * sizeof *drays), *dshadow = malloc(N * sizeof *dshadow);
@@ -410,10 +494,10 @@ static void test_shade_and_shadow(void)
     cl_kernel ks = kernel("k_shadow");
     set_scene_args(ks);
     uint ns = counts[1];
-    SET(ks, 10, sqb);
-    SET(ks, 11, ns);
-    SET(ks, 12, srb);
-    SET(ks, 13, pb);
+    SET(ks, N_SCENE + 0, sqb);
+    SET(ks, N_SCENE + 1, ns);
+    SET(ks, N_SCENE + 2, srb);
+    SET(ks, N_SCENE + 3, pb);
     run(ks, ns ? ns : 1);
     read_back(pb, N * sizeof *dps, dps);
     uint occluded = 0, sbad = 0, sexact = 0;
@@ -473,6 +557,155 @@ static void test_film(void)
     clReleaseMemObject(fb);
 }
 
+/* k_whitted against whitted_sample in C: the classic ray tracer and each auxiliary
+ * image, pixel centres and a jittered grid, with and without the adaptive pass's mask. */
+static void test_whitted(void)
+{
+    const RenderParams *base = &rs.ds.params;
+    uint npix = base->width * base->height, layers = 2, n = npix * layers, first_sample = 3;
+    uint *mask = malloc(npix * sizeof *mask);
+    for (uint i = 0; i < npix; i++) mask[i] = (i * 7u) % 5u < 2u;
+    cl_mem mb = buffer(npix * sizeof *mask, mask), pb = buffer(n * sizeof(PathState), NULL);
+    cl_kernel k = kernel("k_whitted");
+    struct { uint integrator, strata, use_mask; const char *name; } modes[] = {
+        { INTEGRATOR_WHITTED, 0, 0, "whitted, pixel centres" },
+        { INTEGRATOR_WHITTED, 3, 0, "whitted, 3x3 jittered" },
+        { INTEGRATOR_WHITTED, 1, 1, "whitted, jittered, masked" },
+        { INTEGRATOR_AOV_NORMAL, 0, 0, "normal image" },
+        { INTEGRATOR_AOV_DEPTH, 1, 0, "depth image" },
+        { INTEGRATOR_AOV_ALBEDO, 0, 0, "albedo image" },
+    };
+    for (size_t m = 0; m < sizeof modes / sizeof modes[0]; m++) {
+        RenderParams p = *base;
+        p.integrator = modes[m].integrator;
+        p.strata = modes[m].strata;
+        p.use_mask = modes[m].use_mask;
+        p.sample_offset = 5;
+        cl_mem parb = buffer(sizeof p, &p);
+        cl_uint zero = 0;
+        cl_mem cb = buffer(sizeof zero, &zero);
+        set_scene_args(k);
+        SET(k, 0, parb);
+        SET(k, 12, mb);
+        uint first_pixel = 0;
+        SET(k, N_SCENE + 0, first_pixel);
+        SET(k, N_SCENE + 1, npix);
+        SET(k, N_SCENE + 2, first_sample);
+        SET(k, N_SCENE + 3, n);
+        SET(k, N_SCENE + 4, pb);
+        SET(k, N_SCENE + 5, cb);
+        size_t global = (n + 63) / 64 * 64, local = 64;
+        cl_int rc = clEnqueueNDRangeKernel(cl.q, k, 1, NULL, &global, &local, 0, NULL, NULL);
+        CHECK_MSG(rc == CL_SUCCESS, "clEnqueueNDRangeKernel: %s", ocl_error_name(rc));
+        CHECK(clFinish(cl.q) == CL_SUCCESS);
+        PathState *dp = malloc(n * sizeof *dp);
+        cl_uint drays = 0;
+        read_back(pb, n * sizeof *dp, dp);
+        read_back(cb, sizeof drays, &drays);
+        SceneView v = view;
+        v.params = &p;
+        v.pixel_mask = mask;
+        uint exact = 0, bad = 0, crays = 0, lit = 0;
+        for (uint i = 0; i < n; i++) {
+            uint r = 0;
+            vec3 L = whitted_sample(&v, i % npix, first_sample + i / npix, &r);
+            crays += r;
+            lit += v3_max_comp(L) > 0.0f;
+            exact += memcmp(&L, &dp[i].radiance, sizeof L) == 0;
+            if (!v3_close(L, dp[i].radiance, 1e-5f)) bad++;
+        }
+        fprintf(stderr, "  k_whitted (%s): %u samples, %u rays, %u non-black, %u bit-identical to C\n",
+                modes[m].name, n, crays, lit, exact);
+        CHECK_MSG(bad == 0, "%s: %u of %u samples differ", modes[m].name, bad, n);
+        CHECK_EQ_INT(drays, crays);
+        CHECK(lit > n / 4);
+        free(dp);
+        clReleaseMemObject(parb);
+        clReleaseMemObject(cb);
+    }
+    clReleaseKernel(k);
+    clReleaseMemObject(mb);
+    clReleaseMemObject(pb);
+    free(mask);
+}
+
+/* The functions of kmath.h that stand in for libm, through a test kernel built from a
+ * folder holding just an entry.cl that includes kmath.h: the same bits as the C build
+ * on every input, subnormals, zeros and the extremes included. */
+static void test_kmath(void)
+{
+    char dir[] = "/tmp/clpt-test-kmath-XXXXXX", path[128], inc[1200], cwd[1024];
+    CHECK(mkdtemp(dir) != NULL);
+    CHECK(getcwd(cwd, sizeof cwd) != NULL);
+    snprintf(path, sizeof path, "%s/entry.cl", dir);
+    snprintf(inc, sizeof inc, "-I %s/kernels", cwd);
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    if (!f) return;
+    fputs("#include \"kmath.h\"\n"
+          "__kernel void k_math(__global const float *in, __global float *out, uint n)\n"
+          "{\n"
+          "    uint i = (uint)get_global_id(0);\n"
+          "    if (i >= n) return;\n"
+          "    float x = in[2u * i], y = in[2u * i + 1u], s, c;\n"
+          "    k_sincos(y, &s, &c);\n"
+          "    out[8u * i + 0u] = k_log2(x);\n"
+          "    out[8u * i + 1u] = k_exp2(y);\n"
+          "    out[8u * i + 2u] = k_pow(x, k_fabs(y));\n"
+          "    out[8u * i + 3u] = k_atan2(y, x - 1.0f);\n"
+          "    out[8u * i + 4u] = k_acos(x - 1.0f);\n"
+          "    out[8u * i + 5u] = k_srgb_to_linear(k_fmin(x, 1.0f));\n"
+          "    out[8u * i + 6u] = s + c;\n"
+          "    out[8u * i + 7u] = k_smoothstep(0.2f, 0.7f, x) + k_cbrt(x);\n"
+          "}\n", f);
+    fclose(f);
+    cl_program prog = NULL;
+    OclProgramStats ps;
+    Error err = {0};
+    Status st = ocl_program_build(cl.ctx, &cl.dev, dir, inc, &prog, &ps, &err);
+    CHECK_MSG(st == ST_OK, "%s\n%s", err.msg, err.detail ? err.detail : "");
+    error_clear(&err);
+    unlink(path);
+    rmdir(dir);
+    if (st != ST_OK) return;
+    enum { N = 40000 };
+    float *in = malloc(2 * N * sizeof *in), *dout = malloc(8 * N * sizeof *dout);
+    for (uint i = 0; i < N; i++) {
+        float x = frand() * 2.0f;
+        if (i % 7 == 0) x = k_exp2(frange(-149.0f, 20.0f));       /* subnormal to large */
+        if (i % 101 == 0) x = (float)(i % 3);                      /* 0, 1, 2 exactly */
+        in[2 * i] = x;
+        in[2 * i + 1] = frange(-160.0f, 160.0f);
+        if (i % 3 == 0) in[2 * i + 1] = frange(0.0f, 300.0f);   /* Phong exponents */
+    }
+    cl_mem ib = buffer(2 * N * sizeof *in, in), ob = buffer(8 * N * sizeof *dout, NULL);
+    cl_kernel k = NULL;
+    CHECK(ocl_program_kernel(prog, &cl.dev, "k_math", &k, &err) == ST_OK);
+    uint n = N;
+    SET(k, 0, ib);
+    SET(k, 1, ob);
+    SET(k, 2, n);
+    run(k, N);
+    read_back(ob, 8 * N * sizeof *dout, dout);
+    uint exact = 0;
+    for (uint i = 0; i < N; i++) {
+        float x = in[2 * i], y = in[2 * i + 1], s, c;
+        k_sincos(y, &s, &c);
+        float cv[8] = { k_log2(x), k_exp2(y), k_pow(x, k_fabs(y)), k_atan2(y, x - 1.0f), k_acos(x - 1.0f),
+                        k_srgb_to_linear(k_fmin(x, 1.0f)), s + c, k_smoothstep(0.2f, 0.7f, x) + k_cbrt(x) };
+        exact += memcmp(cv, dout + 8 * i, sizeof cv) == 0;
+    }
+    fprintf(stderr, "  kmath (log2 exp2 pow atan2 acos sRGB sincos cbrt): %u of %u inputs bit-identical to C\n",
+            exact, (uint)N);
+    CHECK_EQ_INT(exact, N);
+    free(in);
+    free(dout);
+    clReleaseKernel(k);
+    clReleaseMemObject(ib);
+    clReleaseMemObject(ob);
+    clReleaseProgram(prog);
+}
+
 int main(void)
 {
     build_scene();
@@ -488,7 +721,9 @@ int main(void)
     RUN(test_intersect);
     RUN(test_shade_and_shadow);
     RUN(test_film);
-    for (int i = 0; i < 10; i++) clReleaseMemObject(cl.scene[i]);
+    RUN(test_whitted);
+    RUN(test_kmath);
+    for (int i = 0; i < N_SCENE; i++) clReleaseMemObject(cl.scene[i]);
     clReleaseProgram(cl.prog);
     clReleaseCommandQueue(cl.q);
     clReleaseContext(cl.ctx);

@@ -1,8 +1,10 @@
 /* test_obj.c — the Wavefront OBJ loader: index forms, triangulation, shading records,
- * line endings, exact number parsing, and the messages for malformed files. */
+ * line endings, exact number parsing, and the messages for malformed files; MTL
+ * materials and their mapping onto ours, texture paths, transforms. */
 #include "harness.h"
 
 #include "kmath.h"
+#include "mtl.h"
 #include "obj.h"
 
 #include <stdint.h>
@@ -298,6 +300,197 @@ static void test_files(void)
     scene_free(&s);
 }
 
+/* ------------------------------------------------------------------ MTL */
+
+static int color_is(vec3 c, float r, float g, float b) { return c.x == r && c.y == g && c.z == b; }
+
+static const MtlMaterial *find(const MtlLibrary *lib, const char *name)
+{
+    return mtl_find(lib, name, strlen(name));
+}
+
+static void test_mtl_mapping(void)
+{
+    MtlLibrary lib;
+    memset(&lib, 0, sizeof lib);
+    Error err = {0};
+    Status st = mtl_load("tests/data/mtl/materials.mtl", &lib, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(lib.n, 7);
+    const MtlMaterial *m;
+    if ((m = find(&lib, "red")) != NULL) {
+        CHECK_EQ_INT(m->m.type, MAT_DIFFUSE);
+        CHECK(color_is(m->m.albedo, 0.8f, 0.1f, 0.1f));
+        CHECK(m->m.shininess == 10.0f && m->texture == NULL);
+    } else CHECK(!"red");
+    if ((m = find(&lib, "lamp")) != NULL) {
+        CHECK_EQ_INT(m->m.type, MAT_EMISSIVE);
+        CHECK(color_is(m->m.emission, 17.0f, 12.0f, 4.0f));
+    } else CHECK(!"lamp");
+    if ((m = find(&lib, "glass")) != NULL) {
+        CHECK_EQ_INT(m->m.type, MAT_DIELECTRIC);
+        CHECK(m->m.ior == 1.33f);
+        CHECK(color_is(m->m.specular, 0.3f, 0.3f, 0.3f) && m->m.shininess == 200.0f);
+    } else CHECK(!"glass");
+    if ((m = find(&lib, "mirror")) != NULL) {
+        CHECK_EQ_INT(m->m.type, MAT_METAL);
+        CHECK(color_is(m->m.albedo, 0.9f, 0.8f, 0.7f));
+        CHECK_NEAR(m->m.fuzz, sqrt(2.0 / 2000.0), 1e-7);
+    } else CHECK(!"mirror");
+    if ((m = find(&lib, "glossy")) != NULL) {
+        /* Ks and Ns are kept for the shader, the type stays diffuse; a single Kd is grey */
+        CHECK_EQ_INT(m->m.type, MAT_DIFFUSE);
+        CHECK(color_is(m->m.albedo, 0.5f, 0.5f, 0.5f));
+        CHECK(color_is(m->m.specular, 0.8f, 0.8f, 0.8f) && m->m.shininess == 40.0f);
+    } else CHECK(!"glossy");
+    if ((m = find(&lib, "textured")) != NULL) {
+        /* options skipped, the name matched without regard to case, folder included */
+        CHECK_MSG(m->texture && strcmp(m->texture, "tests/data/mtl/textures/brick.png") == 0, "%s",
+                  m->texture ? m->texture : "(none)");
+    } else CHECK(!"textured");
+    if ((m = find(&lib, "dissolved")) != NULL) CHECK_EQ_INT(m->m.type, MAT_DIELECTRIC);
+    else CHECK(!"dissolved");
+    mtl_free(&lib);
+}
+
+static void check_mtl_bad(const char *text, const char *want)
+{
+    MtlLibrary lib;
+    memset(&lib, 0, sizeof lib);
+    Error err = {0};
+    Status st = mtl_parse("t.mtl", text, strlen(text), &lib, &err);
+    CHECK_MSG(st == ST_INPUT, "%s: status %d", text, (int)st);
+    CHECK_MSG(strstr(err.msg, want) != NULL, "got \"%s\", want \"%s\"", err.msg, want);
+    mtl_free(&lib);
+}
+
+static void test_mtl_errors(void)
+{
+    check_mtl_bad("newmtl a\nKd 1 x 1\n", "t.mtl:2:6: expected a colour (1 or 3 numbers >= 0) after 'Kd', found 'x'");
+    check_mtl_bad("newmtl a\nKd 1 1\n", "t.mtl:2:7: expected a colour (1 or 3 numbers >= 0) after 'Kd', found end of line");
+    check_mtl_bad("newmtl a\nKe -1 0 0\n", "t.mtl:2:4: expected a colour (1 or 3 numbers >= 0) after 'Ke', found '-1'");
+    check_mtl_bad("newmtl a\nNs\n", "t.mtl:2:3: expected a number >= 0 after 'Ns', found end of line");
+    check_mtl_bad("newmtl a\nd 2\n", "t.mtl:2:1: expected a value in [0, 1], found 'd'");
+    check_mtl_bad("newmtl a\nillum 2.5\n", "t.mtl:2:1: expected an illumination model 0..10 after 'illum'");
+    check_mtl_bad("newmtl a\nKd 1 1 1 1\n", "t.mtl:2:10: expected end of line, found '1'");
+    check_mtl_bad("Kd 1 1 1\n", "t.mtl:1:1: expected 'newmtl' before the first material statement, found 'Kd'");
+    check_mtl_bad("newmtl\n", "t.mtl:1:7: expected a material name after 'newmtl', found end of line");
+    check_mtl_bad("newmtl a\nmap_Kd -zoom 2 x.png\n", "t.mtl:2:8: expected a texture option");
+    /* unknown statements are extensions: ignored */
+    MtlLibrary lib;
+    memset(&lib, 0, sizeof lib);
+    Error err = {0};
+    const char *text = "newmtl a\r\nPr 0.5\r\nfoo bar\r\nKd 0.25 0.5 1\r\n";
+    CHECK_EQ_INT(mtl_parse("t.mtl", text, strlen(text), &lib, &err), ST_OK);
+    CHECK_EQ_INT(lib.n, 1);
+    if (lib.n == 1) CHECK(color_is(lib.items[0].m.albedo, 0.25f, 0.5f, 1.0f));
+    mtl_free(&lib);
+}
+
+/* usemtl picks the MTL's materials, added to the scene once each, in order of use. */
+static void test_obj_materials(void)
+{
+    Scene s;
+    scene_init(&s);
+    Error err = {0};
+    Status st = obj_load("tests/data/mtl/scene.obj", &s, NO_INDEX, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_triangles, 11);
+    /* default (first face), red, lamp, glass, mirror, glossy, textured, dissolved */
+    CHECK_EQ_INT(s.n_materials, 8);
+    if (s.n_triangles == 11 && s.n_materials == 8) {
+        static const uint want[11] = { 0, 1, 2, 3, 4, 5, 6, 6, 7, 1, 0 };
+        for (int i = 0; i < 11; i++) CHECK_EQ_INT(s.triangles[i].material, want[i]);
+        CHECK_EQ_INT(s.materials[0].type, MAT_DIFFUSE);
+        CHECK(color_is(s.materials[0].albedo, MESH_DEFAULT_ALBEDO, MESH_DEFAULT_ALBEDO, MESH_DEFAULT_ALBEDO));
+        CHECK_EQ_INT(s.materials[2].type, MAT_EMISSIVE);
+        CHECK_EQ_INT(s.materials[3].type, MAT_DIELECTRIC);
+        CHECK_EQ_INT(s.materials[4].type, MAT_METAL);
+        CHECK(scene_material_texture(&s, 6) && strcmp(scene_material_texture(&s, 6), "tests/data/mtl/textures/brick.png") == 0);
+        CHECK(scene_material_texture(&s, 1) == NULL);
+        /* the map_Kd image is loaded as the material's albedo texture */
+        CHECK(s.materials[6].texture != NO_INDEX && s.n_textures == 1);
+        CHECK_EQ_INT(s.materials[1].texture, NO_INDEX);
+        CHECK(scene_material_texture(&s, 99) == NULL);
+    }
+    scene_free(&s);
+    /* a material given by the caller replaces them all, and the MTL is not read */
+    scene_init(&s);
+    CHECK_EQ_INT(obj_load("tests/data/mtl/scene.obj", &s, 5, &err), ST_OK);
+    CHECK_EQ_INT(s.n_materials, 0);
+    for (size_t i = 0; i < s.n_triangles; i++) CHECK_EQ_INT(s.triangles[i].material, 5);
+    scene_free(&s);
+    /* an MTL that is not there: every face gets the default material */
+    scene_init(&s);
+    CHECK_EQ_INT(obj_load("tests/data/mtl/no-mtl.obj", &s, NO_INDEX, &err), ST_OK);
+    CHECK_EQ_INT(s.n_materials, 1);
+    CHECK_EQ_INT(s.n_triangles, 1);
+    scene_free(&s);
+    /* an error inside an MTL names the MTL's line */
+    scene_init(&s);
+    const char *bad = "mtllib clpt-test-bad.mtl\n";
+    FILE *f = fopen("/tmp/clpt-test-bad.mtl", "w");
+    if (f) {
+        fputs("newmtl x\nKd 1 1 q\n", f);
+        fclose(f);
+    }
+    st = obj_parse("/tmp/clpt-test-scene.obj", bad, strlen(bad), &s, NO_INDEX, &err);
+    CHECK_EQ_INT(st, ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "/tmp/clpt-test-bad.mtl:2:8: expected a colour");
+    remove("/tmp/clpt-test-bad.mtl");
+    scene_free(&s);
+}
+
+/* The Sponza's MTL names its textures in another case than the files have. */
+static void test_sponza(void)
+{
+    const char *path = "../shared/models/sponza-dabrovic/sponza.obj";
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        fprintf(stderr, "  %s not found: skipped\n", path);
+        return;
+    }
+    fclose(f);
+    Scene s;
+    scene_init(&s);
+    Error err = {0};
+    Status st = obj_load(path, &s, NO_INDEX, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_triangles, 66450);
+    int textures = 0, missing = 0;
+    for (size_t i = 0; i < s.n_materials; i++) {
+        const char *t = scene_material_texture(&s, (uint)i);
+        if (!t) continue;
+        textures++;
+        FILE *tf = fopen(t, "rb");
+        if (tf) fclose(tf);
+        else if (missing++ < 3) fprintf(stderr, "  missing texture %s\n", t);
+    }
+    CHECK(textures > 10);
+    CHECK_EQ_INT(missing, 0);
+    scene_free(&s);
+}
+
+/* A transform moves the corners and turns the normals (inverse transpose). */
+static void test_obj_transform(void)
+{
+    const char *text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 1 1 0\nf 1//1 2//1 3//1\n";
+    Scene s;
+    scene_init(&s);
+    Error err = {0};
+    MeshOptions o = mesh_options(0);
+    o.xf = transform_scale(2.0, 1.0, 1.0);
+    CHECK_EQ_INT(obj_parse_with("t.obj", text, strlen(text), &s, &o, &err), ST_OK);
+    CHECK_EQ_INT(s.n_shading, 1);
+    if (s.n_shading == 1) {
+        CHECK(vec_eq(s.triangles[0].p1, 2, 0, 0));
+        /* (1, 1, 0) under the inverse transpose diag(1/2, 1, 1): (0.5, 1, 0), made unit */
+        CHECK_NEAR(s.shading[0].n0.x, 0.5 / sqrt(1.25), 1e-7);
+        CHECK_NEAR(s.shading[0].n0.y, 1.0 / sqrt(1.25), 1e-7);
+    }
+    scene_free(&s);
+}
+
 int main(void)
 {
     RUN(test_index_forms);
@@ -307,5 +500,10 @@ int main(void)
     RUN(test_numbers_exact);
     RUN(test_bad_input);
     RUN(test_files);
+    RUN(test_mtl_mapping);
+    RUN(test_mtl_errors);
+    RUN(test_obj_materials);
+    RUN(test_sponza);
+    RUN(test_obj_transform);
     return harness_report();
 }

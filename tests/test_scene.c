@@ -462,7 +462,7 @@ static void test_bad_syntax(void)
 {
     check_bad("camera { }\ncam { }\n", ST_INPUT,
               ":2:1: expected a statement (camera, image, background, material, sphere, plane, "
-              "triangle, quad, box, mesh, include), found 'cam'");
+              "triangle, quad, box, mesh, light, texture, include), found 'cam'");
     check_bad("}", ST_INPUT, ":1:1: expected a statement (camera");
     check_bad("camera fov 30", ST_INPUT, ":1:8: expected '{' to open the camera block, found 'fov'");
     check_bad("camera { fromm 1 2 3 }", ST_INPUT,
@@ -535,10 +535,10 @@ static void test_bad_materials_and_shapes(void)
                   ST_INPUT, want);
     }
     check_bad("material m { type plastic }", ST_INPUT,
-              ":1:19: expected a material type (diffuse, metal, dielectric, emissive), found 'plastic'");
+              ":1:19: expected a material type (diffuse, metal, dielectric, emissive, phong), found 'plastic'");
     check_bad("material m { albedo 1 1 1 }", ST_INPUT, ":1:1: the material block needs 'type' (it has no default)");
     check_bad("material m { type diffuse albedo 1 1 1 fuzz 0.5 }", ST_INPUT,
-              ":1:40: expected a diffuse material key (type, albedo, emission, sides) or '}', found 'fuzz'");
+              ":1:40: expected a diffuse material key (type, albedo, emission, sides, texture) or '}', found 'fuzz'");
     check_bad("material m { type metal albedo 1 1 1 fuzz 1.5 }", ST_INPUT,
               ":1:43: expected a number in [0, 1] for 'fuzz', found '1.5'");
     check_bad("material m { type dielectric ior 0 }", ST_INPUT, ":1:34: expected a number > 0 for 'ior', found '0'");

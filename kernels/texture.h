@@ -1,0 +1,143 @@
+/*
+ * texture.h — the colour of a texture at a surface point: image textures (bilinear,
+ * sRGB-decoded, repeat or clamp) and checkerboards (solid, or on the surface's (u, v)).
+ *
+ * Surface coordinates: triangles use their texture coordinates (or barycentrics when
+ * the mesh has none); spheres the longitude/latitude map, u = 0.5 + atan2(n.x, n.z)/2pi
+ * (u = 0.5 faces +z, growing towards +x) and v = 1 - acos(n.y)/pi (1 at the +y pole);
+ * planes the coordinates along two unit tangents (plane_tangent); boxes, per face, the
+ * fractions along the face's two other axes. Image rows run top to bottom: v = 1 is the
+ * first row of the file.
+ */
+#ifndef CLPT_TEXTURE_H
+#define CLPT_TEXTURE_H
+
+#include "surface.h"
+
+/* The unit tangent of a plane's (u, v) frame: the world axis least aligned with n (x,
+ * then y, then z on ties), made perpendicular to n. The bitangent is cross(n, t). For
+ * the floor (n = +y) this is u = x, v = -z. */
+KFN vec3 plane_tangent(vec3 n)
+{
+    float ax = k_fabs(n.x), ay = k_fabs(n.y), az = k_fabs(n.z);
+    vec3 a = (ax <= ay && ax <= az) ? v3(1.0f, 0.0f, 0.0f) : (ay <= az ? v3(0.0f, 1.0f, 0.0f) : v3(0.0f, 0.0f, 1.0f));
+    return v3_norm(v3_sub(a, v3_scale(n, v3_dot(n, a))));
+}
+
+/* (u, v) of the surface point s (see the top of this file). */
+KFN void surface_uv(const SceneView *sc, Surface s, float *u, float *v)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
+    uint first_plane = first_box + p->n_boxes;
+    if (s.prim < first_tri) {
+        vec3 n = s.ng;
+        *u = 0.5f + k_atan2(n.x, n.z) * (1.0f / K_TWO_PI);
+        *v = 1.0f - k_acos(n.y) * K_INV_PI;
+    } else if (s.prim < first_box) {
+        *u = s.u;
+        *v = s.v;
+    } else if (s.prim < first_plane) {
+        Box b = sc->boxes[s.prim - first_box];
+        vec3 f = v3((s.p.x - b.lo.x) / (b.hi.x - b.lo.x), (s.p.y - b.lo.y) / (b.hi.y - b.lo.y),
+                    (s.p.z - b.lo.z) / (b.hi.z - b.lo.z));
+        float ax = k_fabs(s.ng.x), ay = k_fabs(s.ng.y);
+        *u = ax > 0.5f ? f.z : f.x;
+        *v = ay > 0.5f ? f.z : f.y;
+    } else {
+        vec3 t = plane_tangent(s.ng);
+        *u = v3_dot(s.p, t);
+        *v = v3_dot(s.p, v3_cross(s.ng, t));
+    }
+}
+
+/* Row i of the texture's 3x4 matrix applied to (x, y, z, 1). */
+KFN float tex_row(Texture tx, int i, vec3 q)
+{
+    return tx.m[4 * i] * q.x + tx.m[4 * i + 1] * q.y + tx.m[4 * i + 2] * q.z + tx.m[4 * i + 3];
+}
+
+KFN vec3 texel_fetch(const SceneView *sc, Texture tx, uint x, uint y)
+{
+    uint i = y * tx.width + x;
+    if (tx.flags & TEX_FLOAT) {
+        GLOBAL const uint *t = sc->texels + tx.offset + 3u * i;
+        return v3(k_as_float(t[0]), k_as_float(t[1]), k_as_float(t[2]));
+    }
+    uint c = sc->texels[tx.offset + i];
+    vec3 rgb = v3((float)(c & 255u) / 255.0f, (float)((c >> 8) & 255u) / 255.0f,
+                  (float)((c >> 16) & 255u) / 255.0f);
+    if (tx.flags & TEX_SRGB)
+        rgb = v3(k_srgb_to_linear(rgb.x), k_srgb_to_linear(rgb.y), k_srgb_to_linear(rgb.z));
+    return rgb;
+}
+
+/* Texel index i (any integer, as a float) brought into [0, n) by the wrap mode. */
+KFN uint tex_wrap(float i, uint n, uint clamp)
+{
+    float fn = (float)n;
+    if (clamp) return (uint)k_clamp(i, 0.0f, fn - 1.0f);
+    float r = i - fn * k_floor(i / fn);
+    return r >= fn ? 0u : (uint)r;      /* rounding can give exactly n */
+}
+
+/* Bilinear filtering between the four texel centres around (u, v); texel (i, j) has its
+ * centre at u = (i + 0.5)/width, v = 1 - (j + 0.5)/height. */
+KFN vec3 texture_image(const SceneView *sc, Texture tx, float u, float v)
+{
+    uint clamp = tx.flags & TEX_CLAMP;
+    if (!(u == u)) u = 0.0f;
+    if (!(v == v)) v = 0.0f;
+    /* keep the texel indices small whatever the coordinates (exactly periodic when
+     * repeating, a margin beyond the edge when clamping) */
+    if (clamp) {
+        u = k_clamp(u, -1.0f, 2.0f);
+        v = k_clamp(v, -1.0f, 2.0f);
+    } else {
+        u = u - k_floor(u);
+        v = v - k_floor(v);
+    }
+    float x = u * (float)tx.width - 0.5f, y = (1.0f - v) * (float)tx.height - 0.5f;
+    float x0 = k_floor(x), y0 = k_floor(y);
+    float fx = x - x0, fy = y - y0;
+    uint xa = tex_wrap(x0, tx.width, clamp), xb = tex_wrap(x0 + 1.0f, tx.width, clamp);
+    uint ya = tex_wrap(y0, tx.height, clamp), yb = tex_wrap(y0 + 1.0f, tx.height, clamp);
+    vec3 top = v3_add(v3_scale(texel_fetch(sc, tx, xa, ya), 1.0f - fx), v3_scale(texel_fetch(sc, tx, xb, ya), fx));
+    vec3 bot = v3_add(v3_scale(texel_fetch(sc, tx, xa, yb), 1.0f - fx), v3_scale(texel_fetch(sc, tx, xb, yb), fx));
+    return v3_add(v3_scale(top, 1.0f - fy), v3_scale(bot, fy));
+}
+
+/* color0 on cells whose integer coordinates sum to an even number, else color1. */
+KFN vec3 texture_checker(Texture tx, vec3 q)
+{
+    float sum = k_floor(q.x) + k_floor(q.y) + k_floor(q.z);
+    float half_sum = sum * 0.5f;
+    return half_sum == k_floor(half_sum) ? tx.color0 : tx.color1;
+}
+
+/* Texture `index` at surface point s, seen from the side ng_face points to. A solid
+ * checker is looked up a hair (1e-4) behind the surface, so a plane lying exactly on a
+ * cell boundary (the classic floor at y = 0) takes one cell's colour instead of
+ * flickering between two with the rounding of each hit. */
+KFN vec3 texture_eval(const SceneView *sc, uint index, Surface s, vec3 ng_face)
+{
+    Texture tx = sc->textures[index];
+    if (tx.type == TEX_CHECKER && (tx.flags & TEX_SOLID)) {
+        vec3 q = v3_madd(s.p, ng_face, -1e-4f);
+        return texture_checker(tx, v3(tex_row(tx, 0, q), tex_row(tx, 1, q), tex_row(tx, 2, q)));
+    }
+    float u, v;
+    surface_uv(sc, s, &u, &v);
+    vec3 q = v3(u, v, 0.0f);
+    vec3 t = v3(tex_row(tx, 0, q), tex_row(tx, 1, q), tex_row(tx, 2, q));
+    if (tx.type == TEX_CHECKER) return texture_checker(tx, t);
+    return texture_image(sc, tx, t.x, t.y);
+}
+
+/* The material's diffuse colour (albedo) at s: its texture there, or its constant. */
+KFN vec3 material_albedo(const SceneView *sc, Material m, Surface s, vec3 ng_face)
+{
+    return m.texture == NO_INDEX ? m.albedo : texture_eval(sc, m.texture, s, ng_face);
+}
+
+#endif /* CLPT_TEXTURE_H */

@@ -1,0 +1,695 @@
+/*
+ * test_classic.c — the classic scene format (host/classic_parse.c): every keyword, the
+ * format's defaults, transforms, material scoping, CRLF, where mesh and texture files
+ * are looked for, format detection, and malformed files with their file:line:column
+ * messages; the light, texture and phong additions to our own format; the command-line
+ * flags of the classic ray tracer.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "harness.h"
+#include "cli_util.h"
+
+#include "classic_parse.h"
+#include "kmath.h"
+#include "scene.h"
+
+#include <stb_image_write.h>
+
+static char dir[64];           /* a temporary folder for this test's files */
+
+static void write_file(const char *name, const char *text)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "wb");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+/* Loads `text` written to DIR/name as a classic scene. */
+static Status load(const char *name, const char *text, Scene *s, Error *err)
+{
+    char path[256];
+    write_file(name, text);
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    scene_init(s);
+    memset(err, 0, sizeof *err);
+    return classic_load(path, s, err);
+}
+
+static int near3(vec3 a, double x, double y, double z, double tol)
+{
+    return fabs(a.x - x) <= tol && fabs(a.y - y) <= tol && fabs(a.z - z) <= tol;
+}
+
+static const char *camera = "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }\n";
+
+/* ---------------------------------------------------------------- every keyword */
+
+static const char *everything =
+    "PerspectiveCamera {\n"
+    "    center 0 1 10\n"
+    "    direction 0 0 -2\n"
+    "    up 0 1 0\n"
+    "    angle 40\n"
+    "    width 320\n"
+    "    height 240\n"
+    "}\n"
+    "Lights {\n"
+    "    numLights 4\n"
+    "    DirectionalLight { direction 0 -2 0 color 0.5 0.5 0.5 }\n"
+    "    PointLight { position 1 2 3 color 1 0.5 0.25 falloff 0.1 }\n"
+    "    PointLight { position 0 5 0 color 1 1 1 attenuation 1 0.5 0.25 }\n"
+    "    SpotLight { position 0 4 0 direction 0 -1 0 color 2 2 2 angle 60 innerAngle 30 }\n"
+    "}\n"
+    "Background { color 0.1 0.2 0.3 ambientLight 0.05 0.06 0.07 }\n"
+    "Materials {\n"
+    "    numMaterials 5\n"
+    "    Material { }\n"
+    "    PhongMaterial {\n"
+    "        diffuseColor 0.5 0.6 0.7\n"
+    "        specularColor 0.2 0.3 0.4\n"
+    "        shininess 25\n"
+    "        reflectiveColor 0.1 0.2 0.3\n"
+    "        transparentColor 0.4 0.5 0.6\n"
+    "        indexOfRefraction 1.33\n"
+    "        texture tex.png\n"
+    "    }\n"
+    "    PhongMaterial { diffuseColor 0.9 0.1 0.1 exponent 7 }\n"
+    "    Material { diffuseColor 0.1 0.1 0.9 }\n"
+    "    Checkerboard { Transform { UniformScale 2 } materialIndex 2 materialIndex 3 }\n"
+    "}\n"
+    "Group {\n"
+    "    numObjects 5\n"
+    "    MaterialIndex 1\n"
+    "    Sphere { center 1 2 3 radius 0.5 }\n"
+    "    Plane { normal 0 2 0 offset -2 }\n"
+    "    MaterialIndex 4\n"
+    "    Triangle { vertex0 0 0 0 vertex1 1 0 0 vertex2 0 1 0 }\n"
+    "    TriangleMesh { obj_file quad.obj }\n"
+    "    Group {\n"
+    "        numObjects 1\n"
+    "        MaterialIndex 2\n"
+    "        Transform {\n"
+    "            Translate 1 0 0\n"
+    "            Scale 2 2 2\n"
+    "            UniformScale 1\n"
+    "            XRotate 0\n"
+    "            YRotate 0\n"
+    "            ZRotate 0\n"
+    "            Rotate { 0 1 0 0 }\n"
+    "            Matrix4f { 1 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1 }\n"
+    "            Matrix { 1 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1 }\n"
+    "            Sphere { center 0 0 0 radius 1 }\n"
+    "        }\n"
+    "    }\n"
+    "}\n";
+
+static void write_assets(void)
+{
+    write_file("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                           "f 1/1 2/2 3/3 4/4\n");
+    unsigned char px[12] = { 255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255 };
+    char path[256];
+    snprintf(path, sizeof path, "%s/tex.png", dir);
+    stbi_write_png(path, 2, 2, 3, px, 6);
+}
+
+static void test_every_keyword(void)
+{
+    Scene s;
+    Error err;
+    Status st = load("everything.txt", everything, &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (st) {
+        scene_free(&s);
+        return;
+    }
+    /* how the course's renderer draws it */
+    CHECK_EQ_INT(s.integrator, INTEGRATOR_WHITTED);
+    CHECK_EQ_INT(s.linear_output, 1);
+    CHECK_EQ_INT(s.image.spp, 1);
+    /* camera and image size */
+    CHECK_EQ_INT(s.camera.type, CAMERA_PERSPECTIVE);
+    CHECK(near3(s.camera.from, 0, 1, 10, 0));
+    CHECK(near3(s.camera.at, 0, 1, 9, 1e-6));                 /* direction made unit */
+    CHECK(s.camera.vfov == 40.0f);
+    CHECK_EQ_INT(s.image.width, 320);
+    CHECK_EQ_INT(s.image.height, 240);
+    /* lights: intensity pi x colour, the format's attenuations */
+    CHECK_EQ_INT(s.n_delta_lights, 4);
+    if (s.n_delta_lights == 4) {
+        const Light *l = s.delta_lights;
+        CHECK_EQ_INT(l[0].type, LIGHT_DIRECTIONAL);
+        CHECK(near3(l[0].direction, 0, -1, 0, 0));
+        CHECK(near3(l[0].intensity, 0.5 * M_PI, 0.5 * M_PI, 0.5 * M_PI, 1e-6));
+        CHECK_EQ_INT(l[1].type, LIGHT_POINT);
+        CHECK(near3(l[1].position, 1, 2, 3, 0));
+        CHECK(l[1].atten0 == 1.0f && l[1].atten1 == 0.0f && l[1].atten2 == 0.1f);
+        CHECK(near3(l[1].intensity, M_PI, 0.5 * M_PI, 0.25 * M_PI, 1e-6));
+        CHECK(l[2].atten0 == 1.0f && l[2].atten1 == 0.5f && l[2].atten2 == 0.25f);
+        CHECK_EQ_INT(l[3].type, LIGHT_SPOT);
+        CHECK_NEAR(l[3].cos_outer, 0.5, 1e-6);
+        CHECK_NEAR(l[3].cos_inner, sqrt(3.0) / 2, 1e-6);
+        CHECK(l[3].atten0 == 1.0f && l[3].atten2 == 0.0f);    /* no falloff by default */
+    }
+    CHECK(near3(s.bg_color, 0.1, 0.2, 0.3, 1e-7));
+    CHECK(near3(s.ambient, 0.05, 0.06, 0.07, 1e-7));
+    /* materials: the defaults, every Phong field, the texture, the checkerboard */
+    CHECK_EQ_INT(s.n_materials, 5);
+    if (s.n_materials == 5) {
+        Material m0 = s.materials[0], m1 = s.materials[1], m2 = s.materials[2], m4 = s.materials[4];
+        CHECK_EQ_INT(m0.type, MAT_PHONG);
+        CHECK(near3(m0.albedo, 1, 1, 1, 0) && v3_is_zero(m0.specular) && m0.shininess == 0.0f);
+        CHECK(v3_is_zero(m0.reflective) && v3_is_zero(m0.transparent) && m0.ior == 1.0f);
+        CHECK(m0.texture == NO_INDEX);
+        CHECK(near3(m1.albedo, 0.5, 0.6, 0.7, 1e-7) && near3(m1.specular, 0.2, 0.3, 0.4, 1e-7));
+        CHECK(m1.shininess == 25.0f && m1.ior == 1.33f);
+        CHECK(near3(m1.reflective, 0.1, 0.2, 0.3, 1e-7) && near3(m1.transparent, 0.4, 0.5, 0.6, 1e-7));
+        CHECK(m1.texture != NO_INDEX);
+        if (m1.texture != NO_INDEX) {
+            Texture t = s.textures[m1.texture];
+            /* classic textures are linear, as the course reads them */
+            CHECK(t.type == TEX_IMAGE && t.width == 2 && t.height == 2 && t.flags == 0u);
+        }
+        CHECK(m2.shininess == 7.0f);
+        CHECK(m4.texture != NO_INDEX && near3(m4.albedo, 0.9, 0.1, 0.1, 1e-7));
+        if (m4.texture != NO_INDEX) {
+            Texture t = s.textures[m4.texture];
+            CHECK(t.type == TEX_CHECKER && (t.flags & TEX_SOLID));
+            CHECK(near3(t.color0, 0.9, 0.1, 0.1, 1e-7) && near3(t.color1, 0.1, 0.1, 0.9, 1e-7));
+            CHECK(t.m[0] == 2.0f && t.m[5] == 2.0f && t.m[10] == 2.0f && t.m[3] == 0.0f);
+        }
+    }
+    /* objects */
+    CHECK_EQ_INT(s.n_spheres, 2);
+    CHECK_EQ_INT(s.n_planes, 1);
+    CHECK_EQ_INT(s.n_triangles, 3);
+    if (s.n_spheres == 2) {
+        CHECK(near3(s.spheres[0].center, 1, 2, 3, 0) && s.spheres[0].radius == 0.5f);
+        CHECK_EQ_INT(s.spheres[0].material, 1);
+        CHECK(near3(s.spheres[1].center, 1, 0, 0, 1e-6) && fabs(s.spheres[1].radius - 2.0f) < 1e-6);
+        CHECK_EQ_INT(s.spheres[1].material, 2);
+    }
+    if (s.n_planes == 1) {
+        CHECK(near3(s.planes[0].normal, 0, 1, 0, 1e-7));
+        CHECK_NEAR(s.planes[0].offset, -1.0, 1e-6);           /* 2y = -2 */
+        CHECK_EQ_INT(s.planes[0].material, 1);
+    }
+    if (s.n_triangles == 3) {
+        CHECK_EQ_INT(s.triangles[0].material, 4);
+        CHECK(s.triangles[1].shading != NO_INDEX);            /* the OBJ's texture coordinates */
+    }
+    scene_free(&s);
+}
+
+static void test_orthographic(void)
+{
+    Scene s;
+    Error err;
+    Status st = load("ortho.txt", "OrthographicCamera { center 0 0 5 lookat 0 0 0 up 0 1 0 size 4 }\n"
+                                   "Group { numObjects 1 Sphere { center 0 0 0 radius 1 } }\n", &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.camera.type, CAMERA_ORTHOGRAPHIC);
+    CHECK(s.camera.ortho_height == 4.0f);
+    CHECK(near3(s.camera.at, 0, 0, 4, 1e-6));
+    /* no lights and no ambientLight: flat colours, as the course's parser draws it */
+    CHECK(near3(s.ambient, 1, 1, 1, 0));
+    CHECK(near3(s.bg_color, 0.5, 0.5, 0.5, 0));               /* the format's background */
+    /* no materials at all: a white one is made for the sphere */
+    CHECK_EQ_INT(s.n_materials, 1);
+    scene_free(&s);
+}
+
+/* ---------------------------------------------------------------- transforms */
+
+static Status load_objects(const char *objects, Scene *s, Error *err)
+{
+    char text[4096];
+    snprintf(text, sizeof text, "%sMaterials { numMaterials 2 Material { } Material { diffuseColor 1 0 0 texture tex.png } }\n"
+             "Lights { numLights 1 PointLight { position 0 9 0 color 1 1 1 } }\n%s", camera, objects);
+    return load("objects.txt", text, s, err);
+}
+
+static void test_transforms(void)
+{
+    Scene s;
+    Error err;
+    /* the first transformation listed is the last applied: T(S(p)) */
+    CHECK_EQ_INT(load_objects("Group { numObjects 1 Transform { Translate 1 2 3 Scale 2 2 2 "
+                              "Sphere { center 1 0 0 radius 1 } } }", &s, &err), ST_OK);
+    if (s.n_spheres == 1) {
+        CHECK(near3(s.spheres[0].center, 3, 2, 3, 1e-6));
+        CHECK_NEAR(s.spheres[0].radius, 2.0, 1e-6);
+    }
+    scene_free(&s);
+    /* right-handed rotations: +x about +y by 90 degrees is -z; Rotate about z: +x to +y;
+     * Matrix4f lists columns, Matrix rows (the same translation written both ways) */
+    CHECK_EQ_INT(load_objects("Group { numObjects 4\n"
+                              " Transform { YRotate 90 Triangle { vertex0 1 0 0 vertex1 0 1 0 vertex2 0 0 1 } }\n"
+                              " Transform { Rotate { 0 0 2 90 } Triangle { vertex0 1 0 0 vertex1 0 1 0 vertex2 0 0 1 } }\n"
+                              " Transform { Matrix4f { 1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1 } "
+                              "Triangle { vertex0 0 0 0 vertex1 1 0 0 vertex2 0 1 0 } }\n"
+                              " Transform { Matrix { 1 0 0 5  0 1 0 6  0 0 1 7  0 0 0 1 } "
+                              "Triangle { vertex0 0 0 0 vertex1 1 0 0 vertex2 0 1 0 } }\n"
+                              "}", &s, &err), ST_OK);
+    if (s.n_triangles == 4) {
+        CHECK(near3(s.triangles[0].p0, 0, 0, -1, 1e-6));
+        CHECK(near3(s.triangles[0].p2, 1, 0, 0, 1e-6));
+        CHECK(near3(s.triangles[1].p0, 0, 1, 0, 1e-6));
+        CHECK(near3(s.triangles[1].p1, -1, 0, 0, 1e-6));
+        CHECK(near3(s.triangles[2].p0, 5, 6, 7, 0));
+        CHECK(near3(s.triangles[3].p1, 6, 6, 7, 0));
+    }
+    scene_free(&s);
+    /* nested transforms compose; a plane moves and tilts with its transform; a mirror
+     * keeps a triangle's outward side outward */
+    CHECK_EQ_INT(load_objects("Group { numObjects 4\n"
+                              " Transform { Translate 1 0 0 Transform { UniformScale 2 Sphere { center 1 0 0 radius 1 } } }\n"
+                              " Transform { Translate 0 2 0 Plane { normal 0 1 0 offset -1 } }\n"
+                              " Transform { Scale 1 2 1 Plane { normal 1 1 0 offset 0 } }\n"
+                              " Transform { Scale -1 1 1 Triangle { vertex0 0 0 0 vertex1 1 0 0 vertex2 0 1 0 } }\n"
+                              "}", &s, &err), ST_OK);
+    if (s.n_spheres == 1) {
+        CHECK(near3(s.spheres[0].center, 3, 0, 0, 1e-6));
+        CHECK_NEAR(s.spheres[0].radius, 2.0, 1e-6);
+    }
+    if (s.n_planes == 2) {
+        CHECK(near3(s.planes[0].normal, 0, 1, 0, 1e-7));
+        CHECK_NEAR(s.planes[0].offset, 1.0, 1e-6);
+        CHECK(near3(s.planes[1].normal, 2 / sqrt(5.0), 1 / sqrt(5.0), 0, 1e-6));
+        CHECK_NEAR(s.planes[1].offset, 0.0, 1e-6);
+    }
+    if (s.n_triangles == 1) {
+        Triangle t = s.triangles[0];
+        vec3 n = v3_cross(v3_sub(t.p1, t.p0), v3_sub(t.p2, t.p0));
+        CHECK(n.z > 0.0f);
+    }
+    scene_free(&s);
+    /* a sphere that a transform squashes, or a textured one it turns, becomes a mesh
+     * with normals and texture coordinates */
+    CHECK_EQ_INT(load_objects("Group { numObjects 2\n"
+                              " Transform { Scale 1 0.5 1 Sphere { radius 1 } }\n"
+                              " MaterialIndex 1 Transform { YRotate 45 Sphere { radius 1 } }\n"
+                              "}", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_spheres, 0);
+    CHECK_EQ_INT(s.n_triangles, 2 * (2 * 48 * 96 - 2 * 96));
+    CHECK_EQ_INT(s.n_shading, s.n_triangles);
+    int on_ellipsoid = 1;
+    for (size_t i = 0; i < s.n_triangles / 2; i++) {
+        vec3 p = s.triangles[i].p0;
+        on_ellipsoid &= fabs(p.x * p.x + 4.0 * p.y * p.y + p.z * p.z - 1.0) < 1e-5;
+    }
+    CHECK(on_ellipsoid);
+    scene_free(&s);
+    /* a singular transform flattens its object */
+    CHECK_EQ_INT(load_objects("Group { numObjects 1 Transform { Scale 0 1 1 Sphere { radius 1 } } }", &s, &err),
+                 ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "singular");
+    scene_free(&s);
+}
+
+/* MaterialIndex ignores the group hierarchy, as in the course's parser; objects before
+ * any MaterialIndex get material 0. */
+static void test_material_scoping(void)
+{
+    Scene s;
+    Error err;
+    CHECK_EQ_INT(load_objects("Group { numObjects 3\n"
+                              " Sphere { radius 1 }\n"
+                              " Group { numObjects 1 MaterialIndex 1 Sphere { radius 1 } }\n"
+                              " Sphere { radius 2 }\n"
+                              "}", &s, &err), ST_OK);
+    if (s.n_spheres == 3) {
+        CHECK_EQ_INT(s.spheres[0].material, 0);
+        CHECK_EQ_INT(s.spheres[1].material, 1);
+        CHECK_EQ_INT(s.spheres[2].material, 1);
+    }
+    CHECK(v3_is_zero(s.ambient));                              /* lights, no ambientLight */
+    scene_free(&s);
+}
+
+static void test_crlf(void)
+{
+    size_t n = strlen(everything);
+    char *crlf = malloc(2 * n + 1), *o = crlf;
+    for (size_t i = 0; i < n; i++) {
+        if (everything[i] == '\n') *o++ = '\r';
+        *o++ = everything[i];
+    }
+    *o = '\0';
+    Scene a, b;
+    Error err;
+    CHECK_EQ_INT(load("lf.txt", everything, &a, &err), ST_OK);
+    CHECK_EQ_INT(load("crlf.txt", crlf, &b, &err), ST_OK);
+    CHECK_EQ_INT(a.n_triangles, b.n_triangles);
+    CHECK_EQ_INT(a.n_materials, b.n_materials);
+    CHECK(a.n_spheres == b.n_spheres && memcmp(a.spheres, b.spheres, a.n_spheres * sizeof *a.spheres) == 0);
+    /* an error's column is unchanged by the CR */
+    CHECK_EQ_INT(load("bad.txt", "PerspectiveCamera {\r\n  centre 0 0 0\r\n}\r\n", &a, &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "bad.txt:2:3: expected a PerspectiveCamera field");
+    free(crlf);
+    scene_free(&a);
+    scene_free(&b);
+}
+
+/* Mesh and texture files: beside the scene, else from the current folder. */
+static void test_paths(void)
+{
+    char sub[128], cwd[1024], text[1024];
+    snprintf(sub, sizeof sub, "%s/scenes", dir);
+    mkdir(sub, 0755);
+    CHECK(getcwd(cwd, sizeof cwd) != NULL);
+    snprintf(text, sizeof text, "%sGroup { numObjects 1 TriangleMesh { obj_file quad.obj } }\n", camera);
+    write_file("scenes/beside.txt", text);
+    write_file("scenes/quad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    char path[256];
+    Scene s;
+    Error err = {0};
+    /* beside the scene: one triangle (DIR/scenes/quad.obj), not DIR/quad.obj's two */
+    snprintf(path, sizeof path, "%s/scenes/beside.txt", dir);
+    scene_init(&s);
+    CHECK_EQ_INT(classic_load(path, &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_triangles, 1);
+    scene_free(&s);
+    /* only in the current folder (a course's code folder) */
+    char sub2[160];
+    snprintf(sub2, sizeof sub2, "%s/scenes/elsewhere", dir);
+    mkdir(sub2, 0755);
+    write_file("scenes/elsewhere/x.txt", text);
+    snprintf(path, sizeof path, "%s/scenes/elsewhere/x.txt", dir);
+    CHECK(chdir(dir) == 0);
+    scene_init(&s);
+    CHECK_EQ_INT(classic_load(path, &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_triangles, 2);                            /* DIR/quad.obj */
+    scene_free(&s);
+    CHECK(chdir(cwd) == 0);
+    /* neither: an I/O error at the file name, naming both places */
+    scene_init(&s);
+    CHECK_EQ_INT(classic_load(path, &s, &err), ST_IO);
+    CHECK_STR_CONTAINS(err.msg, "x.txt:2:46: cannot open 'quad.obj'");
+    CHECK_STR_CONTAINS(err.msg, "elsewhere/quad.obj");
+    scene_free(&s);
+    error_clear(&err);
+}
+
+static void test_detect(void)
+{
+    CHECK(classic_detect("PerspectiveCamera {", 19));
+    CHECK(classic_detect("\r\n  # a comment\n\tOrthographicCamera{", 36));
+    const char *tops[] = { "Lights {", "Background {", "Materials {", "Group {" };
+    for (int i = 0; i < 4; i++) CHECK(classic_detect(tops[i], strlen(tops[i])));
+    CHECK(!classic_detect("camera { from 0 0 0 }", 21));
+    CHECK(!classic_detect("PerspectiveCameraX {", 20));
+    CHECK(!classic_detect("", 0));
+    CHECK(!classic_detect("# only a comment", 16));
+    /* auto detection loads either format */
+    char path[256];
+    Scene s;
+    Error err = {0};
+    write_file("ours.scene", "camera { from 0 0 5 }\nsphere { center 0 0 0 radius 1 material { type diffuse albedo 1 1 1 } }\n");
+    snprintf(path, sizeof path, "%s/ours.scene", dir);
+    scene_init(&s);
+    CHECK_EQ_INT(scene_load_format(path, SCENE_FORMAT_AUTO, &s, &err), ST_OK);
+    CHECK_EQ_INT(s.integrator, INTEGRATOR_PATH);
+    CHECK_EQ_INT(s.n_spheres, 1);
+    scene_free(&s);
+    write_file("theirs.txt", "# a course scene\nPerspectiveCamera { center 0 0 5 direction 0 0 -1 up 0 1 0 angle 30 }\n"
+                             "Group { numObjects 1 Sphere { center 0 0 0 radius 1 } }\n");
+    snprintf(path, sizeof path, "%s/theirs.txt", dir);
+    scene_init(&s);
+    CHECK_EQ_INT(scene_load_format(path, SCENE_FORMAT_AUTO, &s, &err), ST_OK);
+    CHECK_EQ_INT(s.integrator, INTEGRATOR_WHITTED);
+    scene_free(&s);
+    /* forcing the wrong format is an error of that format */
+    scene_init(&s);
+    CHECK_EQ_INT(scene_load_format(path, SCENE_FORMAT_CLPT, &s, &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "theirs.txt:2:1: expected a statement");
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* ---------------------------------------------------------------- malformed files */
+
+static void test_errors(void)
+{
+    static const struct { const char *text, *message; Status status; } cases[] = {
+        { "Camera { }", "x.txt:1:1: expected a scene block (PerspectiveCamera, OrthographicCamera, Lights, "
+                        "Background, Materials, Group), found 'Camera'", ST_INPUT },
+        { "Group { numObjects 1 }", "x.txt:1:22: the Group at line 1 declares numObjects 1 but has 0", ST_INPUT },
+        { "Group { numObjects 2\n Sphere { radius 1 }\n}",
+          "x.txt:3:1: the Group at line 1 declares numObjects 2 but has 1", ST_INPUT },
+        { "Group { numObjects 1\n Sphere { radius 1 }\n Sphere { radius 1 } }",
+          "x.txt:3:2: expected '}' closing the Group (numObjects 1), found 'Sphere'", ST_INPUT },
+        { "Materials { numMaterials 1 Material { } }\nGroup { numObjects 1 MaterialIndex 1 Sphere { radius 1 } }",
+          "x.txt:2:36: expected a material index in 0..0, found '1'", ST_INPUT },
+        { "Group { numObjects 1 MaterialIndex 0 Sphere { radius 1 } }",
+          "x.txt:1:36: expected a material index, but no materials are defined before it, found '0'", ST_INPUT },
+        { "Lights { numLights 2 PointLight { position 0 0 0 color 1 1 1 } }",
+          "x.txt:1:64: the Lights block at line 1 declares numLights 2 but has 1", ST_INPUT },
+        { "Lights { numLights 1 AreaLight { } }",
+          "x.txt:1:22: expected a light (DirectionalLight, PointLight, SpotLight), found 'AreaLight'", ST_INPUT },
+        { "Materials { numMaterials 1 Noise { } }",
+          "x.txt:1:28: expected a material (PhongMaterial, Material, Checkerboard), found 'Noise'", ST_INPUT },
+        { "Group { numObjects 1 Sphere { center 0 0 0 } }", "x.txt:1:22: the Sphere block needs 'radius'", ST_INPUT },
+        { "Group { numObjects 1 Sphere { centre 0 0 0 } }",
+          "x.txt:1:31: expected a Sphere field (center, radius) or '}', found 'centre'", ST_INPUT },
+        { "Group { numObjects 1 Sphere { radius 1 radius 2 } }",
+          "x.txt:1:40: 'radius' repeated in the Sphere block (first given at 1:31)", ST_INPUT },
+        { "Group { numObjects 1 Sphere { radius abc } }",
+          "x.txt:1:38: expected a number > 0 for 'radius', found 'abc'", ST_INPUT },
+        { "Group { numObjects 1 Sphere { radius -1 } }",
+          "x.txt:1:38: expected a number > 0 for 'radius', found '-1'", ST_INPUT },
+        { "Materials { numMaterials 1 Material { diffuseColor 1 -1 0 } }",
+          "x.txt:1:54: expected 3 numbers >= 0 (a colour) for 'diffuseColor', found '-1'", ST_INPUT },
+        { "Materials { numMaterials 1 Material { shininess 2 exponent 3 } }",
+          "x.txt:1:51: a Material block takes 'shininess' or 'exponent', not both", ST_INPUT },
+        { "Lights { numLights 1 PointLight { position 0 0 0 color 1 1 1 attenuation 0 0 0 } }",
+          "x.txt:1:62: 'attenuation' is constant linear quadratic, not all 0", ST_INPUT },
+        { "Lights { numLights 1 PointLight { position 0 0 0 color 1 1 1 falloff 1 attenuation 1 0 0 } }",
+          "x.txt:1:72: a PointLight block takes 'falloff' or 'attenuation', not both", ST_INPUT },
+        { "Group { numObjects 1 Sphere { radius 1 }", "x.txt:1:41: expected '}' to close the Group block opened at line 1, found end of file", ST_INPUT },
+        { "Group { numObjects 1 Sphere { radius 1 ", "x.txt:1:40: expected '}' to close the Sphere block opened "
+                                                    "at line 1, found end of file", ST_INPUT },
+        { "Group { numObjects 1 Transform { Translate 1 0 0 } }",
+          "x.txt:1:50: expected a transformation (Translate, Scale, UniformScale, XRotate, YRotate, ZRotate, "
+          "Rotate, Matrix4f, Matrix) or the object it applies to, found '}'", ST_INPUT },
+        { "Group { numObjects 1 Transform { Rotate 0 1 0 90 Sphere { radius 1 } } }",
+          "x.txt:1:41: expected '{' before Rotate's axis and degrees, found '0'", ST_INPUT },
+        { "Group { numObjects 1 Transform { Matrix4f { 1 0 0 } Sphere { radius 1 } } }",
+          "x.txt:1:51: expected 16 numbers for the matrix, found '}'", ST_INPUT },
+        { "Group { numObjects 1 Transform { Translate 1 0 0 Cube { } } }",
+          "x.txt:1:50: expected an object (Group, Sphere, Plane, Triangle, TriangleMesh, Transform)", ST_INPUT },
+        { "Group { numObjects 1 Sphere { radius 1 } }", "x.txt:1:43: the scene has no camera", ST_INPUT },
+        { "PerspectiveCamera { center 0 0 0 direction 0 1 0 up 0 2 0 angle 30 }",
+          "x.txt:1:50: 'up' is parallel to the view direction", ST_INPUT },
+        { "PerspectiveCamera { center 0 0 0 direction 0 0 -1 up 0 1 0 angle 180 }",
+          "x.txt:1:60: 'angle' is the field of view in degrees, in (0, 180); found 180", ST_INPUT },
+        { "PerspectiveCamera { center 0 0 0 direction 0 0 -1 up 0 1 0 size 3 }",
+          "x.txt:1:60: 'size' belongs to the OrthographicCamera; a PerspectiveCamera has 'angle'", ST_INPUT },
+        { "PerspectiveCamera { center 0 0 0 direction 0 0 0 up 0 1 0 angle 30 }",
+          "x.txt:1:44: expected a non-zero vector (3 numbers) for 'direction', found 0 0 0", ST_INPUT },
+        { "OrthographicCamera { center 0 0 0 up 0 1 0 size 3 }",
+          "x.txt:1:1: the OrthographicCamera block needs 'direction' (or 'lookat')", ST_INPUT },
+        { "PerspectiveCamera { center 0 0 0 direction 0 0 -1 up 0 1 0 angle 30 width 0 }",
+          "x.txt:1:75: expected a whole number in 1..16384 for 'width', found '0'", ST_INPUT },
+        { "Background { color 0 0 0 }\nBackground { color 0 0 0 }", "x.txt:2:1: a second Background block", ST_INPUT },
+        { "Group { numObjects 1 TriangleMesh { obj_file nowhere.obj } }",
+          "x.txt:1:46: cannot open 'nowhere.obj'", ST_IO },
+        { "Materials { numMaterials 1 Material { texture nowhere.png } }",
+          "x.txt:1:47: cannot open 'nowhere.png'", ST_IO },
+        { "Materials { numMaterials 1 Material { texture quad.obj } }",
+          "x.txt:1:47: '", ST_INPUT },
+        { "Group { numObjects 1 TriangleMesh { obj_file broken.obj } }",
+          "broken.obj:2:1: expected", ST_INPUT },
+    };
+    write_file("broken.obj", "v 0 0 0\nbogus 1 2 3\n");
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        Scene s;
+        Error err;
+        Status st = load("x.txt", cases[i].text, &s, &err);
+        CHECK_MSG(st == cases[i].status, "case %zu: status %d, expected %d (%s)", i, st, cases[i].status, err.msg);
+        const char *at = strstr(err.msg, cases[i].message);
+        CHECK_MSG(at != NULL, "case %zu:\n    got:      %s\n    expected: ...%s", i, err.msg, cases[i].message);
+        error_clear(&err);
+        scene_free(&s);
+    }
+    /* an error inside a mesh names the scene line that read it */
+    Scene s;
+    Error err;
+    load("x.txt", cases[sizeof cases / sizeof cases[0] - 1].text, &s, &err);
+    CHECK_STR_CONTAINS(err.msg, "(in the TriangleMesh of ");
+    CHECK_STR_CONTAINS(err.msg, "x.txt:1:22)");
+    scene_free(&s);
+}
+
+/* ---------------------------------------------------------------- our format */
+
+static void test_scene_format_additions(void)
+{
+    char path[256];
+    write_file("ours2.scene",
+               "texture grid { type image file tex.png wrap clamp encoding linear scale 4 }\n"
+               "texture board { type checker color0 1 1 1 color1 0 0 0 space solid scale 2 }\n"
+               "material shiny { type phong albedo 0.5 0.5 0.5 specular 0.4 0.4 0.4 shininess 60\n"
+               "                 reflective 0.1 0.1 0.1 transparent 0.2 0.2 0.2 ior 1.3 texture grid }\n"
+               "material floor { type diffuse albedo 1 1 1 texture board }\n"
+               "light { type point position 0 4 0 intensity 10 10 10 }\n"
+               "light { type spot position 0 4 0 direction 0 -1 0 intensity 5 5 5 angle 40 inner 20 attenuation 1 0 0 }\n"
+               "light { type directional direction 1 -1 0 intensity 2 2 2 }\n"
+               "background { color 0 0 0 ambient 0.1 0.1 0.1 }\n"
+               "sphere { center 0 0 0 radius 1 material shiny }\n");
+    snprintf(path, sizeof path, "%s/ours2.scene", dir);
+    Scene s;
+    Error err = {0};
+    scene_init(&s);
+    Status st = scene_load(path, &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_textures, 2);
+    CHECK_EQ_INT(s.n_delta_lights, 3);
+    if (st == ST_OK && s.n_textures == 2 && s.n_delta_lights == 3) {
+        Texture g = s.textures[0], b = s.textures[1];
+        CHECK(g.type == TEX_IMAGE && g.flags == TEX_CLAMP && g.m[0] == 4.0f && g.m[5] == 4.0f);
+        CHECK(b.type == TEX_CHECKER && b.flags == TEX_SOLID && b.m[10] == 2.0f);
+        Material m = s.materials[scene_find_material(&s, "shiny")];
+        CHECK(m.type == MAT_PHONG && m.shininess == 60.0f && m.ior == 1.3f && m.texture == 0);
+        CHECK(near3(m.transparent, 0.2, 0.2, 0.2, 1e-7) && near3(m.reflective, 0.1, 0.1, 0.1, 1e-7));
+        CHECK_EQ_INT(s.materials[scene_find_material(&s, "floor")].texture, 1);
+        const Light *l = s.delta_lights;
+        CHECK(l[0].type == LIGHT_POINT && l[0].atten2 == 1.0f && l[0].atten0 == 0.0f);  /* inverse square */
+        CHECK(near3(l[0].intensity, 10, 10, 10, 0));
+        CHECK(l[1].type == LIGHT_SPOT && l[1].atten0 == 1.0f && l[1].atten2 == 0.0f);
+        CHECK_NEAR(l[1].cos_outer, cos(40 * M_PI / 180), 1e-6);
+        CHECK(l[2].type == LIGHT_DIRECTIONAL && near3(l[2].direction, M_SQRT1_2, -M_SQRT1_2, 0, 1e-6));
+        CHECK(near3(s.ambient, 0.1, 0.1, 0.1, 1e-7));
+        /* the light list: no area lights, then the three delta lights */
+        CHECK_EQ_INT(scene_prepare_lights(&s, &err), ST_OK);
+        CHECK_EQ_INT(s.n_lights, 3);
+        CHECK(s.n_lights == 3 && s.lights[2].cdf == 1.0f && s.lights[0].pick_pdf > 0.0f);
+    }
+    scene_free(&s);
+    static const struct { const char *text, *message; } bad[] = {
+        { "material m { type diffuse albedo 1 1 1 texture nope }", "1:48: texture 'nope' is not defined" },
+        { "light { type area intensity 1 1 1 }", "1:14: expected a light type (point, spot, directional), found 'area'" },
+        { "light { type directional position 0 0 0 intensity 1 1 1 }", "1:26: a directional light has no 'position'" },
+        { "light { type point }", "1:1: the light block needs 'intensity'" },
+        { "texture t { type image }", "1:1: an image texture needs 'file'" },
+        { "texture t { type checker file x.png }", "1:26: an checker texture has no 'file'" },
+        { "texture t { type checker space world }", "1:32: expected uv or solid, found 'world'" },
+        { "texture t { type noise }", "1:18: expected a texture type (image, checker), found 'noise'" },
+        { "material m { type phong albedo 1 1 1 fuzz 0.1 }", "1:38: expected a phong material key (type, albedo, ior" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        write_file("bad.scene", bad[i].text);
+        snprintf(path, sizeof path, "%s/bad.scene", dir);
+        scene_init(&s);
+        CHECK_EQ_INT(scene_load(path, &s, &err), ST_INPUT);
+        CHECK_MSG(strstr(err.msg, bad[i].message) != NULL, "case %zu:\n    got:      %s\n    expected: ...%s", i,
+                  err.msg, bad[i].message);
+        scene_free(&s);
+    }
+    error_clear(&err);
+}
+
+/* The shipped classic scenes and their counterparts load, in the format they claim. */
+static void test_shipped_scenes(void)
+{
+    static const char *const names[] = { "spheres", "glass", "mesh", "textured", "ortho" };
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        for (int ours = 0; ours < 2; ours++) {
+            char path[128];
+            snprintf(path, sizeof path, "scenes/classic/%s.%s", names[i], ours ? "scene" : "txt");
+            Scene s;
+            Error err = {0};
+            scene_init(&s);
+            Status st = scene_load_format(path, SCENE_FORMAT_AUTO, &s, &err);
+            CHECK_MSG(st == ST_OK, "%s: %s", path, err.msg);
+            CHECK_EQ_INT(s.integrator, ours ? INTEGRATOR_PATH : INTEGRATOR_WHITTED);
+            CHECK(s.n_delta_lights >= 2);
+            CHECK(s.n_spheres + s.n_triangles > 0);
+            error_clear(&err);
+            scene_free(&s);
+        }
+}
+
+/* ---------------------------------------------------------------- the command line */
+
+static void test_cli(void)
+{
+    char scene[256], out[256], bmp[256];
+    snprintf(scene, sizeof scene, "%s/cli.txt", dir);
+    snprintf(out, sizeof out, "%s/cli.png", dir);
+    snprintf(bmp, sizeof bmp, "%s/cli.bmp", dir);
+    write_file("cli.txt", "PerspectiveCamera { center 0 0 5 direction 0 0 -1 up 0 1 0 angle 30 width 24 height 16 }\n"
+                          "Lights { numLights 1 PointLight { position 2 2 5 color 1 1 1 } }\n"
+                          "Group { numObjects 1 Sphere { center 0 0 0 radius 1 } }\n");
+    CliResult *r = malloc(sizeof *r);
+    const char *bad[][8] = {
+        { scene, "--integrator", "photon", NULL },
+        { scene, "--format", "pbrt", NULL },
+        { scene, "--aov", "normal,motion", NULL },
+        { scene, "--gamma", "2.2", NULL },
+        { scene, "--adaptive", "0", NULL },
+        { scene, "--adaptive", "0.1", "--integrator", "path", NULL },
+        { scene, "--depth-range", "5,1", NULL },
+    };
+    const char *expect[] = { "--integrator expects 'path' or 'whitted'", "--format expects", "--aov expects",
+                             "--gamma expects", "--adaptive expects a threshold", "--adaptive needs the whitted",
+                             "--depth-range expects NEAR,FAR" };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        cli_run(bad[i], r);
+        CHECK_EQ_INT(r->status, 2);
+        CHECK_STR_CONTAINS(r->err, expect[i]);
+    }
+    /* the wrong format forced: an input error */
+    const char *forced[] = { scene, "--format", "clpt", "-o", out, "-q", NULL };
+    cli_run(forced, r);
+    CHECK_EQ_INT(r->status, 3);
+    /* a BMP with every auxiliary image, detected format, adaptive pass */
+    const char *ok[] = { scene, "-o", bmp, "--aov", "normal,depth,albedo", "--adaptive", "0.05", "--device", "scalar",
+                         "--format", "classic", NULL };
+    cli_run(ok, r);
+    CHECK_MSG(r->status == 0, "%s", r->err);
+    CHECK_STR_CONTAINS(r->err, "adaptive pass:");
+    const char *aovs[] = { "cli-normal.bmp", "cli-depth.bmp", "cli-albedo.bmp", "cli.bmp" };
+    for (int i = 0; i < 4; i++) {
+        char p[300];
+        snprintf(p, sizeof p, "%s/%s", dir, aovs[i]);
+        struct stat sb;
+        CHECK_MSG(stat(p, &sb) == 0 && sb.st_size == 54 + 24 * 3 * 16, "%s", p);
+        unlink(p);
+    }
+    free(r);
+}
+
+int main(void)
+{
+    snprintf(dir, sizeof dir, "/tmp/clpt-test-classic-XXXXXX");
+    if (!mkdtemp(dir)) {
+        fprintf(stderr, "cannot make a temporary folder\n");
+        return 1;
+    }
+    write_assets();
+    RUN(test_every_keyword);
+    RUN(test_orthographic);
+    RUN(test_transforms);
+    RUN(test_material_scoping);
+    RUN(test_crlf);
+    RUN(test_paths);
+    RUN(test_detect);
+    RUN(test_errors);
+    RUN(test_scene_format_additions);
+    RUN(test_shipped_scenes);
+    RUN(test_cli);
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", dir);
+    return harness_report();
+}

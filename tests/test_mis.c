@@ -1,0 +1,244 @@
+/*
+ * test_mis.c — the path integrator's light sampling: light sampling alone, BSDF sampling
+ * alone and their combination by multiple importance sampling converge to the same
+ * image for area lights over a diffuse and over a glossy (Phong) floor, which checks
+ * that the Phong BRDF, its sampling and its density agree with each other; delta lights
+ * give the path integrator the same direct light as the classic ray tracer; the Phong
+ * BRDF never reflects more than it receives.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+#include "kmath.h"
+#include "render_util.h"
+
+enum { W = 32, H = 24, BLOCK = 8 };
+
+/* A floor of material `floor_mat`, a sphere light and a quad light, seen from above at
+ * an angle; direct light only (depth 1) so that the estimators are the two strategies
+ * and nothing else. */
+static void area_scene(Scene *s, Material floor_mat, uint spp)
+{
+    scene_init(s);
+    s->image.width = W;
+    s->image.height = H;
+    s->image.spp = spp;
+    s->image.max_depth = 1;
+    s->image.seed = 11;
+    s->camera.from = v3(0.0f, 3.0f, 5.0f);
+    s->camera.at = v3(0.0f, 0.0f, 0.0f);
+    s->camera.vfov = 50.0f;
+    uint fm, lamp, quad_lamp;
+    scene_add_material(s, "floor", floor_mat, &fm, NULL);
+    scene_add_material(s, "lamp", material_emissive(v3(6.0f, 5.0f, 4.0f)), &lamp, NULL);
+    Material ql = material_emissive(v3(2.0f, 3.0f, 4.0f));
+    ql.flags = MAT_TWO_SIDED;
+    scene_add_material(s, "quad", ql, &quad_lamp, NULL);
+    Plane pl;
+    memset(&pl, 0, sizeof pl);
+    pl.normal = v3(0.0f, 1.0f, 0.0f);
+    pl.material = fm;
+    scene_add_plane(s, pl, NULL);
+    Sphere sp = { v3(-1.0f, 1.5f, 0.0f), 0.8f, lamp, NO_INDEX, 0, 0 };
+    scene_add_sphere(s, sp, NULL);
+    Triangle a = { v3(0.3f, 1.5f, -1.5f), quad_lamp, v3(2.3f, 1.5f, -1.5f), NO_INDEX, v3(2.3f, 1.5f, 0.5f), NO_INDEX };
+    Triangle b = { v3(0.3f, 1.5f, -1.5f), quad_lamp, v3(2.3f, 1.5f, 0.5f), NO_INDEX, v3(0.3f, 1.5f, 0.5f), NO_INDEX };
+    scene_add_triangle(s, a, NULL);
+    scene_add_triangle(s, b, NULL);
+}
+
+/* Renders with one MIS mode; the scheduler is bypassed by setting the mode on the
+ * prepared scene, so render_util's prepare is redone here. */
+static Status render_mode(Scene *s, uint mode, const char *devices, float *rgb, Error *err)
+{
+    RenderScene rs;
+    DeviceDesc *all = NULL;
+    size_t n_all = 0, *chosen = NULL, n_chosen = 0, n_open = 0;
+    Device *devs[4];
+    char warning[1100];
+    Film film;
+    memset(&film, 0, sizeof film);
+    Status st = render_scene_prepare(s, 0, &rs, err);
+    if (st) return st;
+    rs.ds.params.mis_mode = mode;
+    if ((st = device_list(&all, &n_all, warning, sizeof warning, err))) goto out;
+    if ((st = device_select(devices, all, n_all, &chosen, &n_chosen, err))) goto out;
+    for (size_t i = 0; i < n_chosen && i < 4; i++) {
+        if ((st = device_open(&all[chosen[i]], NULL, &devs[i], err))) goto out;
+        n_open++;
+        if ((st = devs[i]->ops->load_scene(devs[i], &rs.ds, err))) goto out;
+    }
+    if ((st = film_init(&film, W, H, err))) goto out;
+    ScheduleConfig cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.spp = s->image.spp;
+    ScheduleStats stats;
+    st = schedule_run(devs, n_open, &cfg, &film, &stats, err);
+    schedule_stats_free(&stats);
+    if (!st) film_resolve(&film, rgb);
+out:
+    for (size_t i = 0; i < n_open; i++) device_close(devs[i]);
+    film_free(&film);
+    free(all);
+    free(chosen);
+    render_scene_free(&rs);
+    return st;
+}
+
+/* Mean of each BLOCK x BLOCK block (12 of them) and of the whole image. */
+static void block_means(const float *rgb, double blocks[12], double *mean)
+{
+    memset(blocks, 0, 12 * sizeof *blocks);
+    *mean = 0.0;
+    for (uint y = 0; y < H; y++)
+        for (uint x = 0; x < W; x++) {
+            double v = (rgb[3 * (y * W + x)] + rgb[3 * (y * W + x) + 1] + rgb[3 * (y * W + x) + 2]) / 3.0;
+            blocks[(y / BLOCK) * (W / BLOCK) + x / BLOCK] += v / (BLOCK * BLOCK);
+            *mean += v / (W * H);
+        }
+}
+
+/* The three strategies on one scene. Light sampling alone is noisy where a glossy lobe
+ * reflects a light (its blocks get the looser tolerance); the image means and BSDF
+ * sampling against MIS are held tight. */
+static void check_strategies_agree(const char *name, Material floor_mat, uint spp, double tol_mean,
+                                   double tol_block, double tol_light_block)
+{
+    Scene s;
+    area_scene(&s, floor_mat, spp);
+    float *img[3];
+    double blocks[3][12], mean[3];
+    const char *names[3] = { "MIS", "light sampling", "BSDF sampling" };
+    Error err = {0};
+    for (uint m = 0; m < 3; m++) {
+        img[m] = malloc(W * H * 3 * sizeof *img[m]);
+        Status st = render_mode(&s, m, "scalar", img[m], &err);
+        CHECK_MSG(st == ST_OK, "%s", err.msg);
+        block_means(img[m], blocks[m], &mean[m]);
+    }
+    double worst[3] = { 0.0, 0.0, 0.0 };
+    for (uint m = 1; m < 3; m++)
+        for (int b = 0; b < 12; b++) {
+            double ref = blocks[0][b];
+            double rel = fabs(blocks[m][b] - ref) / (ref > 0.05 ? ref : 0.05);
+            if (rel > worst[m]) worst[m] = rel;
+        }
+    fprintf(stderr, "  %s, %u spp: image mean %s %.4f, %s %.4f, %s %.4f; worst 8x8 block difference to MIS: "
+            "light %.1f%%, BSDF %.1f%%\n", name, spp, names[0], mean[0], names[1], mean[1], names[2], mean[2],
+            100.0 * worst[1], 100.0 * worst[2]);
+    CHECK(mean[0] > 0.05);
+    CHECK(fabs(mean[1] - mean[0]) < tol_mean * mean[0]);
+    CHECK(fabs(mean[2] - mean[0]) < tol_mean * mean[0]);
+    CHECK(fabs(mean[1] - mean[2]) < tol_mean * mean[0]);
+    CHECK(worst[1] < tol_light_block);
+    CHECK(worst[2] < tol_block);
+    for (int m = 0; m < 3; m++) free(img[m]);
+    scene_free(&s);
+    error_clear(&err);
+}
+
+static void test_mis_diffuse(void)
+{
+    check_strategies_agree("diffuse floor", material_diffuse(v3(0.7f, 0.6f, 0.5f)), 512, 0.015, 0.08, 0.08);
+}
+
+/* Light sampling only evaluates the Phong BRDF; BSDF sampling depends on its sampling
+ * and density too: their agreement checks the three against each other. */
+static void test_mis_phong(void)
+{
+    check_strategies_agree("Phong floor (kd 0.3, ks 0.6, n 20)",
+                           material_phong(v3(0.3f, 0.3f, 0.3f), v3(0.6f, 0.6f, 0.6f), 20.0f), 512, 0.015, 0.12, 0.2);
+    check_strategies_agree("Phong floor (kd 0.1, ks 0.8, n 200)",
+                           material_phong(v3(0.1f, 0.1f, 0.1f), v3(0.8f, 0.8f, 0.8f), 200.0f), 512, 0.025, 0.2, 0.35);
+}
+
+/* A directional light: the path integrator's next-event estimate is exact (one light,
+ * one direction), so every pixel must be kd/pi x E cos, as the classic ray tracer says. */
+static void test_delta_lights_match_whitted(void)
+{
+    Scene s;
+    area_scene(&s, material_diffuse(v3(0.7f, 0.6f, 0.5f)), 4);
+    s.n_spheres = 0;
+    s.n_triangles = 0;                              /* only the floor */
+    Light dl = light_default(LIGHT_DIRECTIONAL);
+    dl.direction = v3_norm(v3(0.3f, -1.0f, 0.2f));
+    dl.intensity = v3s(2.0f);
+    scene_add_light(&s, dl, NULL);
+    float *path = malloc(W * H * 3 * sizeof *path), *whitted = malloc(W * H * 3 * sizeof *whitted);
+    Error err = {0};
+    CHECK(render_mode(&s, MIS_BOTH, "scalar", path, &err) == ST_OK);
+    s.integrator = INTEGRATOR_WHITTED;
+    CHECK(render_mode(&s, MIS_BOTH, "cpu", whitted, &err) == ST_OK);
+    double cos_t = 1.0 / sqrt(0.09 + 1.0 + 0.04), want = 0.7 / M_PI * 2.0 * cos_t, worst = 0.0;
+    for (uint i = 0; i < W * H; i++) {
+        if (path[3 * i] == 0.0f) continue;          /* sky */
+        double e = fabs(path[3 * i] - want) + fabs(whitted[3 * i] - want);
+        if (e > worst) worst = e;
+    }
+    CHECK(worst < 1e-5);
+    /* a point light: the path tracer's jittered pixels average to the whitted centres */
+    s.n_delta_lights = 0;
+    Light pl = light_default(LIGHT_POINT);
+    pl.position = v3(0.5f, 2.0f, 1.0f);
+    pl.intensity = v3s(5.0f);
+    scene_add_light(&s, pl, NULL);
+    s.image.spp = 16;
+    s.integrator = INTEGRATOR_PATH;
+    CHECK(render_mode(&s, MIS_BOTH, "scalar", path, &err) == ST_OK);
+    s.integrator = INTEGRATOR_WHITTED;
+    CHECK(render_mode(&s, MIS_BOTH, "scalar", whitted, &err) == ST_OK);
+    double sp = 0.0, sw = 0.0;
+    for (uint i = 0; i < W * H * 3; i++) {
+        sp += path[i];
+        sw += whitted[i];
+    }
+    fprintf(stderr, "  point light: path mean %.5f, whitted mean %.5f\n", sp / (W * H * 3), sw / (W * H * 3));
+    CHECK(fabs(sp - sw) < 0.01 * sw);
+    free(path);
+    free(whitted);
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* A Phong sphere in a white furnace (background 1, no lights): with kd + ks <= 1 it can
+ * only darken; kd 1 alone reflects everything. */
+static void test_phong_energy(void)
+{
+    const float mats[3][3] = { { 1.0f, 0.0f, 1.0f }, { 0.5f, 0.5f, 10.0f }, { 1.0f, 1.0f, 50.0f } };
+    for (int i = 0; i < 3; i++) {
+        Scene s;
+        scene_init(&s);
+        s.image.width = W;
+        s.image.height = H;
+        s.image.spp = 64;
+        s.image.max_depth = 64;
+        s.camera.from = v3(0.0f, 0.0f, 3.0f);
+        s.camera.vfov = 25.0f;
+        s.bg_color = s.bg_zenith = v3s(1.0f);
+        Sphere sp = { v3s(0.0f), 1.0f, 0, NO_INDEX, 0, 0 };
+        scene_add_material(&s, "p", material_phong(v3s(mats[i][0]), v3s(mats[i][1]), mats[i][2]), &sp.material, NULL);
+        scene_add_sphere(&s, sp, NULL);
+        float *rgb = malloc(W * H * 3 * sizeof *rgb);
+        Error err = {0};
+        CHECK(render_mode(&s, MIS_BOTH, "scalar", rgb, &err) == ST_OK);
+        double mean = 0.0;
+        for (uint k = 0; k < W * H * 3; k++) mean += rgb[k] / (W * H * 3);
+        fprintf(stderr, "  furnace, kd %g ks %g n %g: mean %.4f\n", (double)mats[i][0], (double)mats[i][1],
+                (double)mats[i][2], mean);
+        if (i == 0) CHECK(fabs(mean - 1.0) < 0.01);
+        else CHECK(mean < 1.0 + 0.01 && mean > 0.5);
+        free(rgb);
+        scene_free(&s);
+    }
+}
+
+int main(void)
+{
+    RUN(test_mis_diffuse);
+    RUN(test_mis_phong);
+    RUN(test_delta_lights_match_whitted);
+    RUN(test_phong_energy);
+    return harness_report();
+}

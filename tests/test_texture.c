@@ -1,0 +1,344 @@
+/*
+ * test_texture.c — texture lookups (kernels/texture.h) and image loading (host/texture.c):
+ * the sRGB decoding and the other functions of kmath.h built from + - * / sqrt against
+ * libm in double, bilinear filtering at known points, repeat and clamp, checkerboards,
+ * the surface parameterisations, and reading images through stb_image.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "harness.h"
+
+#include "shade.cl"     /* kernels/texture.h and what it needs, compiled as C */
+#include "texture.h"    /* host/texture.h: this folder's include path finds host/ first */
+
+#include <stb_image_write.h>
+
+/* ---------------------------------------------------------------- kmath */
+
+static void test_srgb_decode(void)
+{
+    double worst = 0.0;
+    for (int i = 0; i < 256; i++) {
+        double c = i / 255.0;
+        double want = c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
+        double got = k_srgb_to_linear((float)i / 255.0f);
+        double e = fabs(got - want);
+        if (e > worst) worst = e;
+    }
+    fprintf(stderr, "  sRGB decode: worst error %.3g over the 256 byte values\n", worst);
+    CHECK(worst < 1e-6);
+    CHECK(k_srgb_to_linear(0.0f) == 0.0f);
+    CHECK(k_srgb_to_linear(1.0f) == 1.0f);                 /* white stays exactly white */
+    CHECK_NEAR(k_srgb_to_linear(128.0f / 255.0f), 0.2158605, 1e-6);
+    CHECK_NEAR(k_srgb_to_linear(0.04045f), 0.04045 / 12.92, 1e-9);
+}
+
+static void test_exp_log_pow(void)
+{
+    double worst_log = 0.0, worst_exp = 0.0, worst_pow = 0.0;
+    for (int i = 0; i < 20000; i++) {
+        double x = pow(10.0, -30.0 + 60.0 * i / 20000.0);
+        double want_log = log2((double)(float)x);
+        double e = fabs(k_log2((float)x) - want_log) / (fabs(want_log) > 1.0 ? fabs(want_log) : 1.0);
+        if (e > worst_log) worst_log = e;
+        double y = -120.0 + 240.0 * i / 20000.0;
+        double r = fabs(k_exp2((float)y) / exp2((double)(float)y) - 1.0);
+        if (r > worst_exp) worst_exp = r;
+        double b = (i % 1000 + 0.5) / 1000.0, n = (double)(i / 1000) * 13.0;   /* Phong: cos^n */
+        double want = pow((double)(float)b, (double)(float)n);
+        if (want > 1e-30) {
+            double rp = fabs(k_pow((float)b, (float)n) / want - 1.0);
+            if (rp > worst_pow) worst_pow = rp;
+        }
+    }
+    fprintf(stderr, "  log2 error %.3g (relative above 1), exp2 rel error %.3g, pow rel error %.3g (exponents to 247)\n",
+            worst_log, worst_exp, worst_pow);
+    CHECK(worst_log < 3e-7);
+    CHECK(worst_exp < 3e-7);
+    CHECK(worst_pow < 2e-5);
+    CHECK(k_pow(0.0f, 0.0f) == 1.0f && k_pow(0.0f, 3.0f) == 0.0f && k_pow(1.0f, 1e6f) == 1.0f);
+    CHECK(k_pow(0.5f, 1.0f) == 0.5f || fabs(k_pow(0.5f, 1.0f) - 0.5) < 1e-7);
+    CHECK(k_exp2(-200.0f) == 0.0f && isinf(k_exp2(200.0f)));
+    CHECK(k_exp2(-140.0f) > 0.0f);                          /* subnormal results */
+    CHECK(isinf(k_log2(0.0f)) && k_log2(0.0f) < 0.0f);
+    CHECK_NEAR(k_log2(1e-40f), log2((double)1e-40f), 2e-5);  /* subnormal arguments (ulp 1.5e-5) */
+    CHECK(k_exp2(0.0f) == 1.0f && k_exp2(3.0f) == 8.0f);
+}
+
+static void test_inverse_trig(void)
+{
+    double worst_atan2 = 0.0, worst_acos = 0.0;
+    for (int i = 0; i < 20000; i++) {
+        double a = 2.0 * M_PI * i / 20000.0 - M_PI;
+        float y = (float)sin(a) * 3.0f, x = (float)cos(a) * 3.0f;
+        double e = fabs(k_atan2(y, x) - atan2((double)y, (double)x));
+        if (e > worst_atan2) worst_atan2 = e;
+        float c = (float)(-1.0 + 2.0 * i / 19999.0);
+        double ea = fabs(k_acos(c) - acos((double)c));
+        if (ea > worst_acos) worst_acos = ea;
+    }
+    fprintf(stderr, "  atan2 abs error %.3g, acos abs error %.3g\n", worst_atan2, worst_acos);
+    CHECK(worst_atan2 < 1e-6);
+    CHECK(worst_acos < 1e-6);
+    CHECK(k_atan2(0.0f, 0.0f) == 0.0f);
+    CHECK_NEAR(k_atan2(0.0f, -1.0f), M_PI, 1e-6);
+    CHECK_NEAR(k_atan2(-1.0f, 0.0f), -M_PI / 2, 1e-6);
+    CHECK_NEAR(k_acos(2.0f), 0.0, 1e-7);                   /* clamped */
+}
+
+/* ---------------------------------------------------------------- lookups */
+
+static Scene scene;
+static RenderParams params;
+static SceneView view;
+
+/* A scene with no geometry, only textures, for evaluating lookups directly. */
+static void view_setup(void)
+{
+    memset(&params, 0, sizeof params);
+    memset(&view, 0, sizeof view);
+    params.n_textures = (uint)scene.n_textures;
+    view.params = &params;
+    view.textures = scene.textures;
+    view.texels = scene.texels;
+}
+
+/* A 2x2 float (linear) texture: top row (v near 1) red, green; bottom row blue, white. */
+static uint float_texture(uint flags)
+{
+    float px[12] = { 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1 };
+    uint bits[12], offset, index;
+    memcpy(bits, px, sizeof bits);
+    Error err = {0};
+    CHECK(scene_add_texels(&scene, bits, 12, &offset, &err) == ST_OK);
+    Texture t = texture_make_checker(v3s(0.0f), v3s(0.0f), 1.0f, 0);
+    t.type = TEX_IMAGE;
+    t.flags = TEX_FLOAT | flags;
+    t.offset = offset;
+    t.width = 2;
+    t.height = 2;
+    texture_set_scale_offset(&t, 1.0f, 1.0f, 0.0f, 0.0f);
+    CHECK(scene_add_texture(&scene, NULL, NULL, t, &index, &err) == ST_OK);
+    return index;
+}
+
+static int v3_near(vec3 a, double x, double y, double z, double tol)
+{
+    return fabs(a.x - x) <= tol && fabs(a.y - y) <= tol && fabs(a.z - z) <= tol;
+}
+
+static void test_bilinear_and_wrap(void)
+{
+    scene_init(&scene);
+    uint rep = float_texture(0), clamp = float_texture(TEX_CLAMP);
+    view_setup();
+    Texture r = scene.textures[rep], c = scene.textures[clamp];
+    /* texel centres give the texels exactly */
+    CHECK(v3_near(texture_image(&view, r, 0.25f, 0.75f), 1, 0, 0, 0.0));
+    CHECK(v3_near(texture_image(&view, r, 0.75f, 0.75f), 0, 1, 0, 0.0));
+    CHECK(v3_near(texture_image(&view, r, 0.25f, 0.25f), 0, 0, 1, 0.0));
+    CHECK(v3_near(texture_image(&view, r, 0.75f, 0.25f), 1, 1, 1, 0.0));
+    /* the middle: the mean of the four */
+    CHECK(v3_near(texture_image(&view, r, 0.5f, 0.5f), 0.5, 0.5, 0.5, 1e-7));
+    /* between two centres, a quarter of the way: 3/4 of the nearer one */
+    CHECK(v3_near(texture_image(&view, r, 0.375f, 0.75f), 0.75, 0.25, 0, 1e-7));
+    /* the left edge: repeat blends with the right column, clamp does not */
+    CHECK(v3_near(texture_image(&view, r, 0.0f, 0.75f), 0.5, 0.5, 0, 1e-7));
+    CHECK(v3_near(texture_image(&view, c, 0.0f, 0.75f), 1, 0, 0, 0.0));
+    /* far outside: repeat is periodic, clamp holds the edge texel */
+    CHECK(v3_near(texture_image(&view, r, 7.25f, -2.25f), 1, 0, 0, 1e-6));
+    CHECK(v3_near(texture_image(&view, c, 7.25f, -2.25f), 1, 1, 1, 0.0));
+    CHECK(v3_near(texture_image(&view, r, -0.75f, 0.75f), 1, 0, 0, 1e-6));
+    /* NaN coordinates do not crash or poison */
+    vec3 n = texture_image(&view, r, NAN, NAN);
+    CHECK(n.x == n.x && n.y == n.y && n.z == n.z);
+    scene_free(&scene);
+}
+
+static void test_srgb_texels(void)
+{
+    scene_init(&scene);
+    uint px[2] = { 128u | 64u << 8 | 255u << 16 | 255u << 24, 0xffffffffu }, offset, a, b;
+    Error err = {0};
+    CHECK(scene_add_texels(&scene, px, 2, &offset, &err) == ST_OK);
+    Texture t = texture_make_checker(v3s(0.0f), v3s(0.0f), 1.0f, 0);
+    t.type = TEX_IMAGE;
+    t.offset = offset;
+    t.width = 2;
+    t.height = 1;
+    t.flags = TEX_SRGB;
+    CHECK(scene_add_texture(&scene, NULL, NULL, t, &a, &err) == ST_OK);
+    t.flags = 0;                                            /* the same bytes, linear */
+    CHECK(scene_add_texture(&scene, NULL, NULL, t, &b, &err) == ST_OK);
+    view_setup();
+    vec3 s = texel_fetch(&view, scene.textures[a], 0, 0), l = texel_fetch(&view, scene.textures[b], 0, 0);
+    CHECK_NEAR(s.x, 0.2158605, 1e-6);
+    CHECK_NEAR(s.y, 0.0512695, 1e-6);
+    CHECK(s.z == 1.0f);
+    CHECK_NEAR(l.x, 128.0 / 255.0, 1e-7);
+    CHECK_NEAR(l.y, 64.0 / 255.0, 1e-7);
+    /* filtering happens after decoding: halfway between 0.2158 and 1 in linear terms */
+    vec3 mid = texture_image(&view, scene.textures[a], 0.5f, 0.5f);
+    CHECK_NEAR(mid.x, 0.5 * (0.2158605 + 1.0), 1e-6);
+    scene_free(&scene);
+}
+
+static void test_checker(void)
+{
+    Texture t = texture_make_checker(v3(1, 0, 0), v3(0, 0, 1), 2.0f, 1);   /* cells 0.5 wide */
+    CHECK(v3_near(texture_checker(t, v3(0.1f, 0.2f, 0.3f)), 1, 0, 0, 0.0));
+    CHECK(v3_near(texture_checker(t, v3(1.1f, 0.2f, 0.3f)), 0, 0, 1, 0.0));
+    CHECK(v3_near(texture_checker(t, v3(-0.1f, 0.2f, 0.3f)), 0, 0, 1, 0.0));
+    CHECK(v3_near(texture_checker(t, v3(-0.1f, -0.2f, 0.3f)), 1, 0, 0, 0.0));
+    CHECK(v3_near(texture_checker(t, v3(1e7f, 3.0f, 0.0f)), 0, 0, 1, 0.0));
+    /* a solid checker through texture_eval: the matrix scales by 2 */
+    scene_init(&scene);
+    uint index;
+    Error err = {0};
+    CHECK(scene_add_texture(&scene, NULL, NULL, t, &index, &err) == ST_OK);
+    view_setup();
+    Surface s;
+    memset(&s, 0, sizeof s);
+    s.ng = v3(0, 1, 0);
+    /* on the plane y = 0, exactly on a cell boundary: every point of a cell the same
+     * colour whatever the rounding of y (the lookup is a hair below the surface) */
+    int same = 1;
+    for (int i = 0; i < 100; i++) {
+        float y = (i % 3 - 1) * 1e-7f;
+        s.p = v3(0.1f + 0.003f * (float)i, y, 0.2f);
+        vec3 c = texture_eval(&view, index, s, s.ng);
+        same &= v3_near(c, 0, 0, 1, 0.0);                   /* floor(-eps) = -1: odd */
+    }
+    CHECK(same);
+    scene_free(&scene);
+}
+
+static void test_surface_uv(void)
+{
+    scene_init(&scene);
+    Sphere sp = { v3(1, 2, 3), 2.0f, 0, NO_INDEX, 0, 0 };
+    Plane pl;
+    memset(&pl, 0, sizeof pl);
+    pl.normal = v3(0, 1, 0);
+    Error err = {0};
+    scene_add_sphere(&scene, sp, &err);
+    scene_add_plane(&scene, pl, &err);
+    view_setup();
+    params.n_spheres = 1;
+    params.n_planes = 1;
+    view.spheres = scene.spheres;
+    view.planes = scene.planes;
+    Surface s;
+    memset(&s, 0, sizeof s);
+    float u, v;
+    s.prim = 0;
+    s.ng = v3(0, 0, 1);                                     /* facing +z: the map's centre */
+    surface_uv(&view, s, &u, &v);
+    CHECK_NEAR(u, 0.5, 1e-6);
+    CHECK_NEAR(v, 0.5, 1e-6);
+    s.ng = v3(1, 0, 0);                                     /* +x: a quarter turn east */
+    surface_uv(&view, s, &u, &v);
+    CHECK_NEAR(u, 0.75, 1e-6);
+    s.ng = v3(0, 1, 0);                                     /* north pole: the top row */
+    surface_uv(&view, s, &u, &v);
+    CHECK_NEAR(v, 1.0, 1e-6);
+    s.ng = v3(0, -1, 0);
+    surface_uv(&view, s, &u, &v);
+    CHECK_NEAR(v, 0.0, 1e-6);
+    /* the floor: u along +x, v along -z */
+    s.prim = 1;
+    s.ng = v3(0, 1, 0);
+    s.p = v3(2.5f, 0.0f, -1.25f);
+    surface_uv(&view, s, &u, &v);
+    CHECK_NEAR(u, 2.5, 1e-6);
+    CHECK_NEAR(v, 1.25, 1e-6);
+    vec3 t = plane_tangent(v3(0, 0, 1));                    /* a wall facing +z: u along x */
+    CHECK(v3_near(t, 1, 0, 0, 1e-7));
+    t = plane_tangent(v3_norm(v3(1, 2, 3)));
+    CHECK_NEAR(v3_dot(t, v3_norm(v3(1, 2, 3))), 0.0, 1e-6);
+    CHECK_NEAR(v3_len(t), 1.0, 1e-6);
+    scene_free(&scene);
+}
+
+/* ---------------------------------------------------------------- image files */
+
+static char tmp_dir[64];
+
+static void test_load_images(void)
+{
+    snprintf(tmp_dir, sizeof tmp_dir, "/tmp/clpt-test-texture-XXXXXX");
+    CHECK(mkdtemp(tmp_dir) != NULL);
+    char png[128], hdr[128], bad[128], missing[128];
+    snprintf(png, sizeof png, "%s/a.png", tmp_dir);
+    snprintf(hdr, sizeof hdr, "%s/a.hdr", tmp_dir);
+    snprintf(bad, sizeof bad, "%s/bad.png", tmp_dir);
+    snprintf(missing, sizeof missing, "%s/missing.png", tmp_dir);
+    /* 3x2 RGB: distinct bytes per texel; row 0 is the top */
+    unsigned char rgb[18];
+    for (int i = 0; i < 18; i++) rgb[i] = (unsigned char)(i * 14);
+    CHECK(stbi_write_png(png, 3, 2, 3, rgb, 9) != 0);
+    float frgb[6] = { 0.5f, 2.0f, 7.0f, 0.25f, 0.125f, 1.0f };
+    CHECK(stbi_write_hdr(hdr, 2, 1, 3, frgb) != 0);
+    FILE *f = fopen(bad, "wb");
+    if (f) {
+        fputs("not an image", f);
+        fclose(f);
+    }
+
+    scene_init(&scene);
+    Error err = {0};
+    uint a, b, c, h;
+    CHECK_EQ_INT(texture_load_image(&scene, "grid", png, 0, 0, &a, &err), ST_OK);
+    CHECK_EQ_INT(scene.n_texels, 6);
+    Texture ta = scene.textures[a];
+    CHECK(ta.type == TEX_IMAGE && ta.width == 3 && ta.height == 2 && ta.flags == TEX_SRGB);
+    CHECK_EQ_INT(scene.texels[ta.offset + 4], 168u | 182u << 8 | 196u << 16 | 255u << 24);   /* x 1, y 1 */
+    CHECK_EQ_INT(scene_find_texture(&scene, "grid"), a);
+    /* the same file again shares the texels; a different encoding reads it again */
+    CHECK_EQ_INT(texture_load_image(&scene, NULL, png, 0, 1, &b, &err), ST_OK);
+    CHECK_EQ_INT(scene.n_texels, 6);
+    CHECK(scene.textures[b].offset == ta.offset && scene.textures[b].flags == (TEX_SRGB | TEX_CLAMP));
+    CHECK_EQ_INT(texture_load_image(&scene, NULL, png, 1, 0, &c, &err), ST_OK);
+    CHECK_EQ_INT(scene.n_texels, 12);
+    CHECK(scene.textures[c].flags == 0u);
+    /* HDR: linear floats, 3 per texel */
+    CHECK_EQ_INT(texture_load_image(&scene, NULL, hdr, 0, 0, &h, &err), ST_OK);
+    Texture th = scene.textures[h];
+    CHECK(th.flags == TEX_FLOAT && th.width == 2 && th.height == 1);
+    view_setup();
+    vec3 t0 = texel_fetch(&view, th, 0, 0);
+    CHECK_NEAR(t0.x, 0.5, 0.01);          /* RGBE keeps 8 bits of mantissa */
+    CHECK_NEAR(t0.y, 2.0, 0.02);
+    CHECK_NEAR(t0.z, 7.0, 0.05);
+    /* the 8-bit lookup decodes: texel (1, 1) holds bytes 168 182 196 */
+    vec3 t1 = texel_fetch(&view, scene.textures[a], 1, 1);
+    CHECK_NEAR(t1.x, pow((168 / 255.0 + 0.055) / 1.055, 2.4), 1e-6);
+    /* errors */
+    CHECK_EQ_INT(texture_load_image(&scene, NULL, missing, 0, 0, &a, &err), ST_IO);
+    CHECK_STR_CONTAINS(err.msg, "cannot open");
+    CHECK_STR_CONTAINS(err.msg, "missing.png");
+    CHECK_EQ_INT(texture_load_image(&scene, NULL, bad, 0, 0, &a, &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "not an image");
+    error_clear(&err);
+    scene_free(&scene);
+    unlink(png);
+    unlink(hdr);
+    unlink(bad);
+    rmdir(tmp_dir);
+}
+
+int main(void)
+{
+    RUN(test_srgb_decode);
+    RUN(test_exp_log_pow);
+    RUN(test_inverse_trig);
+    RUN(test_bilinear_and_wrap);
+    RUN(test_srgb_texels);
+    RUN(test_checker);
+    RUN(test_surface_uv);
+    RUN(test_load_images);
+    return harness_report();
+}

@@ -1,0 +1,622 @@
+/*
+ * test_whitted.c — the classic ray tracer (kernels/whitted.cl) against closed forms:
+ * a diffuse plane under a point light has the irradiance of the inverse-square-free
+ * (and the attenuated) classic light at every pixel; a Phong highlight peaks where the
+ * mirror direction meets the eye; points in shadow get no direct light; spot and
+ * directional lights; mirror and refraction rays; the auxiliary images; pixel
+ * sampling and the adaptive pass; the same bits on PoCL and the scalar device; BMP and
+ * linear 8-bit output.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "harness.h"
+#include "render_util.h"
+
+#include "camera.h"
+#include "image_write.h"
+#include "passes.h"
+#include "whitted.cl"
+
+#define KD_R 0.8
+#define KD_G 0.6
+#define KD_B 0.4
+
+/* A floor (plane y = 0, Phong diffuse colour KD, no specular) seen from (from) looking
+ * at the origin, 1 sample per pixel centre, no ambient, black background. */
+static void floor_scene(Scene *s, uint w, uint h, vec3 from, vec3 up)
+{
+    scene_init(s);
+    s->image.width = w;
+    s->image.height = h;
+    s->image.spp = 1;
+    s->image.max_depth = 4;
+    s->integrator = INTEGRATOR_WHITTED;
+    s->camera.from = from;
+    s->camera.at = v3(0.0f, 0.0f, 0.0f);
+    s->camera.up = up;
+    s->camera.vfov = 60.0f;
+    uint m;
+    scene_add_material(s, "floor", material_phong(v3((float)KD_R, (float)KD_G, (float)KD_B), v3s(0.0f), 0.0f), &m, NULL);
+    Plane pl;
+    memset(&pl, 0, sizeof pl);
+    pl.normal = v3(0.0f, 1.0f, 0.0f);
+    pl.material = m;
+    scene_add_plane(s, pl, NULL);
+}
+
+/* A classic light of colour c (intensity pi c), attenuation a0 a1 a2. */
+static void add_point(Scene *s, vec3 pos, float c, float a0, float a1, float a2)
+{
+    Light l = light_default(LIGHT_POINT);
+    l.position = pos;
+    l.intensity = v3s(c * (float)M_PI);
+    l.atten0 = a0;
+    l.atten1 = a1;
+    l.atten2 = a2;
+    scene_add_light(s, l, NULL);
+}
+
+typedef struct { double x, y, z; } D3;
+
+static D3 d3(vec3 v) { D3 r = { v.x, v.y, v.z }; return r; }
+
+/* The camera ray through the centre of pixel (x, y), in double from the float camera. */
+static void pixel_ray(const Camera *c, uint w, uint h, uint x, uint y, D3 *o, D3 *d)
+{
+    double s = (x + 0.5) / w, t = (y + 0.5) / h;
+    D3 cr = d3(c->corner), hz = d3(c->horizontal), vt = d3(c->vertical);
+    *o = d3(c->origin);
+    d->x = cr.x + s * hz.x - t * vt.x - o->x;
+    d->y = cr.y + s * hz.y - t * vt.y - o->y;
+    d->z = cr.z + s * hz.z - t * vt.z - o->z;
+}
+
+static float *render(Scene *s, const char *devices, Film *film)
+{
+    Error err = {0};
+    Status st = render_util_run(s, devices, 0, film, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    size_t n = (size_t)film->width * film->height * 3u;
+    float *rgb = calloc(n ? n : 1, sizeof *rgb);
+    if (st == ST_OK) film_resolve(film, rgb);
+    error_clear(&err);
+    return rgb;
+}
+
+/* Every floor pixel: kd c cos(theta) / (a0 + a1 d + a2 d^2), within 1e-4. */
+static void check_plane_irradiance(float a0, float a1, float a2)
+{
+    Scene s;
+    const uint W = 64, H = 48;
+    floor_scene(&s, W, H, v3(0.0f, 3.0f, 4.0f), v3(0.0f, 1.0f, 0.0f));
+    vec3 lp = v3(1.0f, 2.5f, 0.5f);
+    add_point(&s, lp, 0.9f, a0, a1, a2);
+    Camera cam;
+    Error err = {0};
+    CHECK(camera_setup(&s.camera, W, H, &cam, &err) == ST_OK);
+    Film film;
+    float *rgb = render(&s, "scalar", &film);
+    double worst = 0.0;
+    uint checked = 0;
+    for (uint y = 0; y < H; y++)
+        for (uint x = 0; x < W; x++) {
+            D3 o, d;
+            pixel_ray(&cam, W, H, x, y, &o, &d);
+            if (!(d.y < 0.0)) continue;
+            double t = -o.y / d.y;
+            D3 p = { o.x + t * d.x, 0.0, o.z + t * d.z };
+            D3 l = { lp.x - p.x, lp.y - p.y, lp.z - p.z };
+            double dist = sqrt(l.x * l.x + l.y * l.y + l.z * l.z);
+            double e = 0.9 * (l.y / dist) / (a0 + a1 * dist + a2 * dist * dist);
+            double want[3] = { KD_R * e, KD_G * e, KD_B * e };
+            for (int c = 0; c < 3; c++) {
+                double err_c = fabs(rgb[3 * (y * W + x) + c] - want[c]);
+                if (err_c > worst) worst = err_c;
+            }
+            checked++;
+        }
+    fprintf(stderr, "  attenuation %g %g %g: %u floor pixels, worst error %.2g\n", (double)a0, (double)a1,
+            (double)a2, checked, worst);
+    CHECK(checked > W * H / 3);
+    CHECK(worst < 1e-4);
+    free(rgb);
+    film_free(&film);
+    scene_free(&s);
+}
+
+static void test_plane_under_point_light(void)
+{
+    check_plane_irradiance(1.0f, 0.0f, 0.0f);      /* the course's default: no falloff */
+    check_plane_irradiance(1.0f, 0.0f, 0.3f);      /* falloff 0.3 */
+    check_plane_irradiance(0.5f, 0.2f, 0.1f);      /* attenuation 0.5 0.2 0.1 */
+}
+
+/* The same pixels on PoCL and on the scalar device, bit for bit. */
+static void test_devices_agree(void)
+{
+    Scene s;
+    floor_scene(&s, 40, 30, v3(0.0f, 3.0f, 4.0f), v3(0.0f, 1.0f, 0.0f));
+    add_point(&s, v3(1.0f, 2.5f, 0.5f), 0.9f, 1.0f, 0.0f, 0.0f);
+    Sphere sp = { v3(0.0f, 0.6f, 0.0f), 0.6f, 0, NO_INDEX, 0, 0 };
+    Material mirror = material_phong(v3s(0.1f), v3s(0.5f), 50.0f);
+    mirror.reflective = v3s(0.5f);
+    mirror.transparent = v3s(0.4f);
+    mirror.ior = 1.5f;
+    scene_add_material(&s, "glassy", mirror, &sp.material, NULL);
+    scene_add_sphere(&s, sp, NULL);
+    s.image.spp = 4;                                   /* a 2x2 jittered grid */
+    s.ambient = v3s(0.05f);
+    Film a, b;
+    float *ra = render(&s, "scalar", &a), *rb = render(&s, "cpu", &b);
+    size_t n = (size_t)a.width * a.height * 3u;
+    CHECK(a.samples == 4 && b.samples == 4);
+    CHECK(memcmp(a.sum, b.sum, n * sizeof *a.sum) == 0);
+    free(ra);
+    free(rb);
+    film_free(&a);
+    film_free(&b);
+    scene_free(&s);
+}
+
+/* Projects world point p into film coordinates (s, t) of camera c. */
+static void project(const Camera *c, D3 p, double *s, double *t)
+{
+    /* solve lambda (p - o) = (corner - o) + s h - t v for lambda, s, t (Cramer) */
+    D3 o = d3(c->origin), q = { p.x - o.x, p.y - o.y, p.z - o.z };
+    D3 k = { c->corner.x - o.x, c->corner.y - o.y, c->corner.z - o.z };
+    D3 h = d3(c->horizontal), v = d3(c->vertical);
+    /* columns: q, -h, v ; rhs k */
+    double m[3][3] = { { q.x, -h.x, v.x }, { q.y, -h.y, v.y }, { q.z, -h.z, v.z } }, rhs[3] = { k.x, k.y, k.z };
+    double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                 m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    double x[3];
+    for (int col = 0; col < 3; col++) {
+        double a[3][3];
+        memcpy(a, m, sizeof a);
+        for (int r = 0; r < 3; r++) a[r][col] = rhs[r];
+        x[col] = (a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                  a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])) / det;
+    }
+    *s = x[1];
+    *t = x[2];
+}
+
+/* A purely specular floor: the brightest pixel is where the mirror image of the eye, the
+ * floor point and the light line up. */
+static void test_phong_highlight(void)
+{
+    Scene s;
+    const uint W = 160, H = 120;
+    floor_scene(&s, W, H, v3(0.0f, 2.0f, 5.0f), v3(0.0f, 1.0f, 0.0f));
+    s.materials[0] = material_phong(v3s(0.0f), v3s(1.0f), 400.0f);
+    vec3 lp = v3(1.0f, 3.0f, -2.0f);
+    add_point(&s, lp, 1.0f, 1.0f, 0.0f, 0.0f);
+    Camera cam;
+    Error err = {0};
+    CHECK(camera_setup(&s.camera, W, H, &cam, &err) == ST_OK);
+    Film film;
+    float *rgb = render(&s, "scalar", &film);
+    uint best = 0;
+    for (uint i = 1; i < W * H; i++)
+        if (rgb[3 * i] > rgb[3 * best]) best = i;
+    /* eye (0 2 5) mirrored: (0 -2 5); the line to the light meets y = 0 at s = 2/5 */
+    D3 p = { 0.4 * lp.x, 0.0, 5.0 + 0.4 * (lp.z - 5.0) };
+    double fs, ft;
+    project(&cam, p, &fs, &ft);
+    double px = fs * W - 0.5, py = ft * H - 0.5;
+    fprintf(stderr, "  highlight: brightest pixel (%u, %u) = %.4f, mirror point at pixel (%.2f, %.2f)\n", best % W,
+            best / W, (double)rgb[3 * best], px, py);
+    CHECK(fabs((double)(best % W) - px) <= 1.0 && fabs((double)(best / W) - py) <= 1.0);
+    CHECK(rgb[3 * best] > 0.95f && rgb[3 * best] <= 1.0f + 1e-5f);   /* ks c (r.l)^n near 1 */
+    free(rgb);
+    film_free(&film);
+    scene_free(&s);
+}
+
+/* Does the segment from p to the light pass through the sphere (with a margin)? */
+static int segment_hits_sphere(D3 p, D3 l, D3 c, double r)
+{
+    D3 d = { l.x - p.x, l.y - p.y, l.z - p.z }, f = { p.x - c.x, p.y - c.y, p.z - c.z };
+    double a = d.x * d.x + d.y * d.y + d.z * d.z, b = f.x * d.x + f.y * d.y + f.z * d.z;
+    double u = -b / a;
+    if (u < 0.0) u = 0.0;
+    if (u > 1.0) u = 1.0;
+    D3 q = { f.x + u * d.x, f.y + u * d.y, f.z + u * d.z };
+    return sqrt(q.x * q.x + q.y * q.y + q.z * q.z) < r;
+}
+
+/* A sphere between the light and the floor: shadowed floor points get no direct light
+ * at all (exactly the ambient term), the others the closed form. */
+static void test_shadow(void)
+{
+    for (int with_ambient = 0; with_ambient < 2; with_ambient++) {
+        Scene s;
+        const uint W = 64, H = 64;
+        floor_scene(&s, W, H, v3(3.0f, 4.0f, 0.5f), v3(0.0f, 1.0f, 0.0f));
+        vec3 lp = v3(0.0f, 3.0f, 0.0f);
+        add_point(&s, lp, 1.0f, 1.0f, 0.0f, 0.0f);
+        Sphere sp = { v3(0.0f, 1.0f, 0.0f), 0.5f, 0, NO_INDEX, 0, 0 };
+        scene_add_sphere(&s, sp, NULL);
+        if (with_ambient) s.ambient = v3(0.1f, 0.2f, 0.3f);
+        Camera cam;
+        Error err = {0};
+        CHECK(camera_setup(&s.camera, W, H, &cam, &err) == ST_OK);
+        Film film;
+        float *rgb = render(&s, "cpu", &film);
+        uint shadowed = 0, lit = 0, bad = 0;
+        D3 c = { 0.0, 1.0, 0.0 }, l = d3(lp);
+        for (uint y = 0; y < H; y++)
+            for (uint x = 0; x < W; x++) {
+                D3 o, d;
+                pixel_ray(&cam, W, H, x, y, &o, &d);
+                if (!(d.y < 0.0)) continue;
+                double t = -o.y / d.y;
+                D3 p = { o.x + t * d.x, 0.0, o.z + t * d.z };
+                if (segment_hits_sphere(o, p, c, 0.51)) continue;          /* the camera sees the sphere */
+                const float *px = rgb + 3 * (y * W + x);
+                double amb[3] = { 0.1 * KD_R, 0.2 * KD_G, 0.3 * KD_B };
+                if (segment_hits_sphere(p, l, c, 0.49)) {
+                    shadowed++;
+                    for (int k = 0; k < 3; k++)
+                        if (fabs(px[k] - (with_ambient ? amb[k] : 0.0)) > (with_ambient ? 1e-6 : 0.0)) bad++;
+                } else if (!segment_hits_sphere(p, l, c, 0.51)) {
+                    lit++;
+                    D3 v = { l.x - p.x, l.y - p.y, l.z - p.z };
+                    double e = (v.y / sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
+                    double want[3] = { KD_R * e, KD_G * e, KD_B * e };
+                    for (int k = 0; k < 3; k++)
+                        if (fabs(px[k] - want[k] - (with_ambient ? amb[k] : 0.0)) > 1e-4) bad++;
+                }
+            }
+        fprintf(stderr, "  shadow%s: %u shadowed floor pixels, %u lit, %u wrong\n", with_ambient ? " (ambient)" : "",
+                shadowed, lit, bad);
+        CHECK(shadowed > 50 && lit > 1000);
+        CHECK_EQ_INT(bad, 0);
+        free(rgb);
+        film_free(&film);
+        scene_free(&s);
+    }
+}
+
+/* A directional light lights the floor evenly; a spot light fully inside its inner cone,
+ * not at all outside its outer one, in between by a smooth step. */
+static void test_directional_and_spot(void)
+{
+    Scene s;
+    const uint W = 48, H = 48;
+    floor_scene(&s, W, H, v3(0.0f, 6.0f, 0.01f), v3(0.0f, 0.0f, -1.0f));
+    Light dl = light_default(LIGHT_DIRECTIONAL);
+    dl.direction = v3_norm(v3(1.0f, -2.0f, 0.0f));
+    dl.intensity = v3s(0.5f * (float)M_PI);
+    scene_add_light(&s, dl, NULL);
+    Film film;
+    float *rgb = render(&s, "scalar", &film);
+    double cos_t = 2.0 / sqrt(5.0), worst = 0.0;
+    for (uint i = 0; i < W * H; i++) {
+        double e = fabs(rgb[3 * i] - KD_R * 0.5 * cos_t);
+        if (e > worst) worst = e;
+    }
+    CHECK(worst < 1e-5);
+    free(rgb);
+    film_free(&film);
+    /* the spot straight down from (0 2 0): inner 20, outer 40 degrees */
+    s.n_delta_lights = 0;
+    Light sl = light_default(LIGHT_SPOT);
+    sl.position = v3(0.0f, 2.0f, 0.0f);
+    sl.direction = v3(0.0f, -1.0f, 0.0f);
+    sl.intensity = v3s((float)M_PI);
+    sl.atten0 = 1.0f;
+    sl.atten2 = 0.0f;
+    sl.cos_inner = (float)cos(20.0 * M_PI / 180.0);
+    sl.cos_outer = (float)cos(40.0 * M_PI / 180.0);
+    scene_add_light(&s, sl, NULL);
+    Camera cam;
+    Error err = {0};
+    CHECK(camera_setup(&s.camera, W, H, &cam, &err) == ST_OK);
+    rgb = render(&s, "scalar", &film);
+    uint inner = 0, outer = 0, between = 0, bad = 0;
+    for (uint y = 0; y < H; y++)
+        for (uint x = 0; x < W; x++) {
+            D3 o, d;
+            pixel_ray(&cam, W, H, x, y, &o, &d);
+            double t = -o.y / d.y;
+            D3 p = { o.x + t * d.x, 0.0, o.z + t * d.z };
+            double r = sqrt(p.x * p.x + p.z * p.z), dist = sqrt(r * r + 4.0), c = 2.0 / dist;
+            float v = rgb[3 * (y * W + x)];
+            if (c > cos(19.0 * M_PI / 180.0)) {
+                inner++;
+                bad += fabs(v - KD_R * c) > 1e-4;
+            } else if (c < cos(41.0 * M_PI / 180.0)) {
+                outer++;
+                bad += v != 0.0f;
+            } else if (c < cos(21.0 * M_PI / 180.0) && c > cos(39.0 * M_PI / 180.0)) {
+                between++;
+                bad += !(v > 0.0f && v < KD_R * c);
+            }
+        }
+    fprintf(stderr, "  spot: %u pixels inside, %u outside, %u on the edge, %u wrong\n", inner, outer, between, bad);
+    CHECK(inner > 20 && outer > 200 && between > 50);
+    CHECK_EQ_INT(bad, 0);
+    free(rgb);
+    film_free(&film);
+    scene_free(&s);
+}
+
+/* A tinted mirror sphere in a constant background: the sphere's pixels are exactly the
+ * background times the tint (the mirror ray carries it whole), the rest the background;
+ * a clear glass sphere returns the background too, to within what the depth limit and
+ * the weight cut-off drop. */
+static void test_mirror_and_glass(void)
+{
+    for (int glass = 0; glass < 2; glass++) {
+        Scene s;
+        scene_init(&s);
+        s.image.width = 48;
+        s.image.height = 48;
+        s.image.spp = 1;
+        s.image.max_depth = 24;
+        s.integrator = INTEGRATOR_WHITTED;
+        s.camera.from = v3(0.0f, 0.0f, 4.0f);
+        s.camera.vfov = 40.0f;
+        s.bg_color = s.bg_zenith = v3(0.5f, 0.25f, 1.0f);
+        Material m = material_phong(v3s(0.0f), v3s(0.0f), 0.0f);
+        if (glass) {
+            m.transparent = v3s(1.0f);
+            m.ior = 1.5f;
+        } else {
+            m.reflective = v3(1.0f, 0.5f, 0.25f);
+        }
+        Sphere sp = { v3(0.0f, 0.0f, 0.0f), 1.0f, 0, NO_INDEX, 0, 0 };
+        scene_add_material(&s, "m", m, &sp.material, NULL);
+        scene_add_sphere(&s, sp, NULL);
+        Film film;
+        float *rgb = render(&s, "scalar", &film);
+        uint tinted = 0, plain = 0, other = 0;
+        double worst = 0.0;
+        for (uint i = 0; i < 48 * 48; i++) {
+            const float *p = rgb + 3 * i;
+            if (p[0] == 0.5f && p[1] == 0.25f && p[2] == 1.0f) plain++;
+            else if (!glass && p[0] == 0.5f && p[1] == 0.125f && p[2] == 0.25f) tinted++;
+            else other++;
+            double e = fabs(p[0] - 0.5) + fabs(p[1] - 0.25) + fabs(p[2] - 1.0);
+            if (e > worst) worst = e;
+        }
+        if (glass) {
+            fprintf(stderr, "  glass sphere: worst deviation from the background %.2g\n", worst);
+            CHECK(worst < 2e-3);
+            CHECK(other > 500);                   /* it does go through the sphere */
+        } else {
+            CHECK(tinted > 500 && plain > 500);
+            CHECK_EQ_INT(other, 0);
+        }
+        free(rgb);
+        film_free(&film);
+        scene_free(&s);
+    }
+}
+
+/* Snell's law, total internal reflection, Fresnel at normal incidence. */
+static void test_refraction(void)
+{
+    vec3 n = v3(0.0f, 1.0f, 0.0f), t;
+    float si = 0.5f;
+    vec3 d = v3(si, -sqrtf(1.0f - si * si), 0.0f);
+    CHECK(refract_dir(d, n, 1.5f, &t));
+    CHECK_NEAR(t.x * 1.5, si, 1e-6);                      /* n1 sin(i) = n2 sin(t) */
+    CHECK(t.y < 0.0f);
+    CHECK_NEAR(v3_len(t), 1.0, 1e-6);
+    si = 0.8f;                                             /* from glass: 1.5 * 0.8 > 1 */
+    d = v3(si, -sqrtf(1.0f - si * si), 0.0f);
+    CHECK(!refract_dir(d, n, 1.0f / 1.5f, &t));
+    CHECK_NEAR(fresnel_dielectric(1.0f, 1.5f), 0.04, 1e-6);
+    CHECK(fresnel_dielectric(0.6f, 1.0f / 1.5f) == 1.0f);
+}
+
+/* The auxiliary images of the floor: its normal, its distance, its colour. */
+static void test_aovs(void)
+{
+    const uint W = 32, H = 24;
+    uint modes[] = { INTEGRATOR_AOV_NORMAL, INTEGRATOR_AOV_DEPTH, INTEGRATOR_AOV_ALBEDO };
+    for (int m = 0; m < 3; m++) {
+        Scene s;
+        floor_scene(&s, W, H, v3(0.0f, 3.0f, 4.0f), v3(0.0f, 1.0f, 0.0f));
+        s.integrator = modes[m];
+        Camera cam;
+        Error err = {0};
+        CHECK(camera_setup(&s.camera, W, H, &cam, &err) == ST_OK);
+        Film film;
+        float *rgb = render(&s, "scalar", &film);
+        uint bad = 0, floor = 0;
+        for (uint y = 0; y < H; y++)
+            for (uint x = 0; x < W; x++) {
+                D3 o, d;
+                pixel_ray(&cam, W, H, x, y, &o, &d);
+                const float *p = rgb + 3 * (y * W + x);
+                if (!(d.y < 0.0)) {
+                    bad += !(p[0] == 0.0f && p[1] == 0.0f && p[2] == 0.0f);
+                    continue;
+                }
+                floor++;
+                double t = -o.y / d.y, len = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+                if (modes[m] == INTEGRATOR_AOV_NORMAL) bad += !(p[0] == 0.5f && p[1] == 1.0f && p[2] == 0.5f);
+                if (modes[m] == INTEGRATOR_AOV_DEPTH) bad += fabs(p[0] - t * len) > 1e-4 * t * len || p[1] != 1.0f;
+                if (modes[m] == INTEGRATOR_AOV_ALBEDO)
+                    bad += fabs(p[0] - KD_R) > 1e-7 || fabs(p[1] - KD_G) > 1e-7 || fabs(p[2] - KD_B) > 1e-7;
+            }
+        CHECK(floor > W * H / 3);
+        CHECK_MSG(bad == 0, "aov %u: %u pixels wrong", modes[m], bad);
+        free(rgb);
+        film_free(&film);
+        scene_free(&s);
+    }
+}
+
+/* One ray through the pixel centre; an m x m grid puts one sample in each cell. */
+static void test_pixel_sampling(void)
+{
+    RenderParams p;
+    memset(&p, 0, sizeof p);
+    p.width = 10;
+    p.height = 10;
+    p.seed = 3;
+    p.camera.type = CAMERA_ORTHOGRAPHIC;       /* the ray's origin is the film point */
+    p.camera.horizontal = v3(10.0f, 0.0f, 0.0f);
+    p.camera.vertical = v3(0.0f, 10.0f, 0.0f);
+    p.camera.forward = v3(0.0f, 0.0f, -1.0f);
+    uint key;
+    Ray r = whitted_camera_ray(&p, 34, 0, &key);   /* pixel (4, 3) */
+    CHECK(r.o.x == 4.5f && r.o.y == -3.5f);
+    r = whitted_camera_ray(&p, 34, 7, &key);
+    CHECK(r.o.x == 4.5f && r.o.y == -3.5f);        /* every sample, without jitter */
+    p.strata = 2;
+    int cells[4] = { 0, 0, 0, 0 };
+    for (uint sm = 0; sm < 4; sm++) {
+        r = whitted_camera_ray(&p, 34, sm, &key);
+        float fx = r.o.x - 4.0f, fy = -r.o.y - 3.0f;
+        CHECK(fx > 0.0f && fx < 1.0f && fy > 0.0f && fy < 1.0f);
+        cells[(fx >= 0.5f) + 2 * (fy >= 0.5f)]++;
+    }
+    CHECK(cells[0] == 1 && cells[1] == 1 && cells[2] == 1 && cells[3] == 1);
+    CHECK_EQ_INT(render_scene_strata(1), 0);
+    CHECK_EQ_INT(render_scene_strata(16), 4);
+    CHECK_EQ_INT(render_scene_strata(10), 1);
+    CHECK_EQ_INT(render_scene_strata(1000000), 1000);
+}
+
+/* The adaptive pass: only pixels next to a strong difference get more samples, and an
+ * edge pixel ends up between the colours on either side. */
+static void test_adaptive(void)
+{
+    float img[5 * 3 * 3];
+    for (int i = 0; i < 15; i++) {
+        float v = (i % 5) >= 3 ? 1.0f : 0.0f;
+        img[3 * i] = img[3 * i + 1] = img[3 * i + 2] = v;
+    }
+    img[3 * 7] = 0.05f;                                   /* a small difference: no mark */
+    uint mask[15];
+    CHECK_EQ_INT(passes_mark_edges(img, 5, 3, 0.1f, mask), 6);
+    for (int i = 0; i < 15; i++) CHECK_EQ_INT(mask[i], (i % 5 == 2 || i % 5 == 3) ? 1u : 0u);
+
+    /* end to end: a red sphere on black */
+    Scene s;
+    scene_init(&s);
+    s.image.width = 40;
+    s.image.height = 40;
+    s.image.spp = 1;
+    s.integrator = INTEGRATOR_WHITTED;
+    s.camera.from = v3(0.0f, 0.0f, 4.0f);
+    s.camera.vfov = 40.0f;
+    s.ambient = v3s(1.0f);
+    Sphere sp = { v3(0.0f, 0.0f, 0.0f), 1.0f, 0, NO_INDEX, 0, 0 };
+    scene_add_material(&s, "red", material_phong(v3(1.0f, 0.0f, 0.0f), v3s(0.0f), 0.0f), &sp.material, NULL);
+    scene_add_sphere(&s, sp, NULL);
+    RenderScene rs;
+    Error err = {0};
+    CHECK(render_scene_prepare(&s, 1, &rs, &err) == ST_OK);
+    DeviceDesc *all = NULL;
+    size_t n_all = 0, *chosen = NULL, n_chosen = 0;
+    char warning[1100];
+    CHECK(device_list(&all, &n_all, warning, sizeof warning, &err) == ST_OK);
+    CHECK(device_select("scalar,cpu", all, n_all, &chosen, &n_chosen, &err) == ST_OK);
+    Device *devs[4];
+    size_t n_dev = 0;
+    for (size_t i = 0; i < n_chosen && n_dev < 4; i++)
+        if (device_open(&all[chosen[i]], NULL, &devs[n_dev], &err) == ST_OK) n_dev++;
+    CHECK(n_dev == 2);
+    for (size_t i = 0; i < n_dev; i++) CHECK(devs[i]->ops->load_scene(devs[i], &rs.ds, &err) == ST_OK);
+    Film film;
+    film_init(&film, 40, 40, &err);
+    ScheduleConfig cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.spp = 1;
+    ScheduleStats stats;
+    CHECK(schedule_run(devs, n_dev, &cfg, &film, &stats, &err) == ST_OK);
+    schedule_stats_free(&stats);
+    float *base = malloc(40 * 40 * 3 * sizeof *base), *rgb = malloc(40 * 40 * 3 * sizeof *rgb);
+    film_resolve(&film, base);
+    memcpy(rgb, base, 40 * 40 * 3 * sizeof *rgb);
+    PassContext pc = { devs, n_dev, &rs, &cfg };
+    size_t marked = 0;
+    double secs = 0.0;
+    CHECK(passes_adaptive(&pc, rgb, 1, 0.25f, 16, &marked, &secs, &err) == ST_OK);
+    uint changed = 0, between = 0, changed_unmarked = 0;
+    uint mask2[1600];
+    passes_mark_edges(base, 40, 40, 0.25f, mask2);
+    for (uint i = 0; i < 1600; i++) {
+        int diff = rgb[3 * i] != base[3 * i];
+        changed += diff;
+        if (diff && !mask2[i]) changed_unmarked++;
+        between += mask2[i] && rgb[3 * i] > 0.02f && rgb[3 * i] < 0.98f;
+    }
+    fprintf(stderr, "  adaptive: %zu of 1600 pixels marked, %u changed, %u now between the two colours\n", marked,
+            changed, between);
+    CHECK(marked > 40 && marked < 400);                   /* the silhouette, not the image */
+    CHECK_EQ_INT(changed_unmarked, 0);
+    CHECK(between > 20);
+    CHECK(rs.ds.params.use_mask == 0 && rs.ds.pixel_mask == NULL);   /* restored */
+    for (size_t i = 0; i < n_dev; i++) device_close(devs[i]);
+    free(all);
+    free(chosen);
+    free(base);
+    free(rgb);
+    film_free(&film);
+    render_scene_free(&rs);
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* BMP: header, bottom-up BGR rows padded to 4 bytes; linear or sRGB bytes. */
+static void test_bmp(void)
+{
+    char path[] = "/tmp/clpt-test-bmp-XXXXXX.bmp";
+    int fd = mkstemps(path, 4);
+    CHECK(fd >= 0);
+    if (fd >= 0) close(fd);
+    float rgb[2 * 3 * 3] = { 0.5f, 0.0f, 1.0f,  1.0f, 1.0f, 1.0f,  0.0f, 0.0f, 0.0f,
+                             0.2f, 0.4f, 0.6f,  2.0f, -1.0f, NAN,  0.25f, 0.5f, 0.75f };
+    Error err = {0};
+    for (int enc = 0; enc < 2; enc++) {
+        CHECK_EQ_INT(image_write_encoded(path, rgb, 3, 2, enc ? IMAGE_LINEAR : IMAGE_SRGB, &err), ST_OK);
+        unsigned char b[128];
+        FILE *f = fopen(path, "rb");
+        size_t n = f ? fread(b, 1, sizeof b, f) : 0;
+        if (f) fclose(f);
+        CHECK_EQ_INT(n, 54 + 2 * 12);                     /* rows of 9 bytes padded to 12 */
+        CHECK(b[0] == 'B' && b[1] == 'M' && b[10] == 54 && b[14] == 40 && b[18] == 3 && b[22] == 2 && b[28] == 24);
+        /* the first row in the file is the image's bottom row: (0.2 0.4 0.6) first */
+        const unsigned char *bottom = b + 54, *top = b + 54 + 12;
+        if (enc) {
+            CHECK(bottom[0] == 153 && bottom[1] == 102 && bottom[2] == 51);     /* B G R */
+            CHECK(top[0] == 255 && top[1] == 0 && top[2] == 128);
+            CHECK(bottom[3] == 0 && bottom[4] == 0 && bottom[5] == 255);      /* NaN 0, clamps */
+        } else {
+            CHECK(top[2] == image_to_srgb8(0.5f) && top[2] == 188);
+        }
+        CHECK(bottom[9] == 0 && bottom[10] == 0 && bottom[11] == 0);          /* padding */
+    }
+    ImageFormat fmt;
+    CHECK(image_format_from_path("a.BMP", &fmt, &err) == ST_OK && fmt == IMAGE_BMP);
+    CHECK_EQ_INT(image_to_linear8(0.5f), 128);
+    CHECK_EQ_INT(image_to_linear8(1.5f), 255);
+    unlink(path);
+    error_clear(&err);
+}
+
+int main(void)
+{
+    RUN(test_plane_under_point_light);
+    RUN(test_devices_agree);
+    RUN(test_phong_highlight);
+    RUN(test_shadow);
+    RUN(test_directional_and_spot);
+    RUN(test_mirror_and_glass);
+    RUN(test_refraction);
+    RUN(test_aovs);
+    RUN(test_pixel_sampling);
+    RUN(test_adaptive);
+    RUN(test_bmp);
+    return harness_report();
+}

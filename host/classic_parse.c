@@ -1028,7 +1028,8 @@ int classic_detect(const char *text, size_t len)
     return 0;
 }
 
-Status classic_load(const char *path, Scene *s, Error *err)
+/* classic_load and classic_load_text: `text` NULL reads the file `path`. */
+static Status load(const char *path, const char *text, size_t len, Scene *s, Error *err)
 {
     free(s->path);
     s->path = malloc(strlen(path) + 1);
@@ -1046,7 +1047,7 @@ Status classic_load(const char *path, Scene *s, Error *err)
     if (!c.dir) return error_set(err, ST_INTERNAL, "out of memory");
     memcpy(c.dir, path, dl);
     c.dir[dl] = '\0';
-    Status st = lex_open_file(&c.lx, path, err);
+    Status st = text ? lex_open_text(&c.lx, path, text, len, err) : lex_open_file(&c.lx, path, err);
     if (st) {
         free(c.dir);
         return st;
@@ -1079,6 +1080,16 @@ Status classic_load(const char *path, Scene *s, Error *err)
     lex_close(&c.lx);
     free(c.dir);
     return st;
+}
+
+Status classic_load(const char *path, Scene *s, Error *err)
+{
+    return load(path, NULL, 0, s, err);
+}
+
+Status classic_load_text(const char *path, const char *text, size_t len, Scene *s, Error *err)
+{
+    return load(path, text, len, s, err);
 }
 
 Status scene_load_format(const char *path, SceneFormat format, Scene *s, Error *err)

@@ -29,6 +29,9 @@ int classic_detect(const char *text, size_t len);
 
 /* Reads a classic scene file into an initialised scene. */
 Status classic_load(const char *path, Scene *s, Error *err);
+/* The same for `len` bytes of text in memory (copied), named `path` in messages; meshes
+ * and textures are still read from disk, beside `path`. */
+Status classic_load_text(const char *path, const char *text, size_t len, Scene *s, Error *err);
 
 /* Reads `path` in the given format; SCENE_FORMAT_AUTO reads the start of the file to
  * choose. */

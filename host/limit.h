@@ -24,6 +24,10 @@
 #define CLPT_MAX_DEPTH 1024
 /* Nesting of scene `include`s (a file including itself stops here). */
 #define CLPT_MAX_INCLUDE_DEPTH 16
+/* Texels of one texture image (8192 x 8192): decoded to 4 bytes a texel (12 for HDR)
+ * and copied once more into the scene. Compressed images (PNG, JPEG) can claim this
+ * from a few bytes, so the size is read from the header before decoding. */
+#define CLPT_MAX_TEXTURE_PIXELS (8192u * 8192u)
 /* Any one input file: it is read whole into memory. */
 #define CLPT_MAX_FILE_BYTES ((uint64_t)4 << 30)
 

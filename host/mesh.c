@@ -193,6 +193,13 @@ Status mesh_sink_triangle(MeshSink *k, const vec3 p[3], const vec3 *n, const flo
     const int *o = order[k->mirrored];
     vec3 q[3];
     for (int i = 0; i < 3; i++) q[i] = k->transformed ? transform_point(&k->xf, p[o[i]]) : p[o[i]];
+    /* a binary file's NaN, or a double (or a transformed point) beyond the float range */
+    for (int i = 0; i < 3; i++)
+        if (!isfinite(q[i].x) || !isfinite(q[i].y) || !isfinite(q[i].z))
+            return error_set(k->err, ST_INPUT,
+                             "%s: a corner of triangle %zu is not a finite single-precision point%s",
+                             k->path, k->s->n_triangles - k->first_triangle + 1,
+                             k->transformed ? " after the mesh transform" : "");
     Triangle t;
     memset(&t, 0, sizeof t);
     t.p0 = q[0];

@@ -296,7 +296,7 @@ static Status read_statement(MtlReader *r, const char *kw, const char *kw_end)
         if (!st && (f != floorf(f) || f > 10.0f))
             st = error_set(r->err, ST_INPUT, "%s:%u:%u: expected an illumination model 0..10 after 'illum'",
                            r->path, r->line, (uint)(kw - r->line_start + 1));
-        raw->illum = (int)f;
+        if (!st) raw->illum = (int)f;   /* converting an out-of-range float is undefined */
         break;
     }
     default: return read_map_kd(r);

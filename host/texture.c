@@ -1,7 +1,11 @@
 /* texture.c — image and checkerboard textures (see texture.h). */
 #include "texture.h"
 
+#include "limit.h"
+
+#include <ctype.h>
 #include <errno.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -50,6 +54,39 @@ static uint pack_rgba(const unsigned char *p)
     return (uint)p[0] | (uint)p[1] << 8 | (uint)p[2] << 16 | (uint)p[3] << 24;
 }
 
+/* A binary PNM (P5, P6) must hold the pixels its header declares. stb_image 2.27
+ * (Debian 12's libstb) reads past its buffer when a 16-bit one (maxval > 255) is short,
+ * and fills a short 8-bit one with black; both are truncated files, so both are errors,
+ * found before stb_image sees them. Anything that is not a binary PNM header passes. */
+static Status pnm_check(const char *path, Error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return ST_OK;   /* stb_image reports it */
+    unsigned char head[4096];
+    size_t n = fread(head, 1, sizeof head, f);
+    long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    fclose(f);
+    if (n < 2 || size < 0 || head[0] != 'P' || (head[1] != '5' && head[1] != '6')) return ST_OK;
+    uint64_t v[3];
+    size_t p = 2;
+    for (int i = 0; i < 3; i++) {
+        /* blanks and # comments, as stb_image skips them */
+        for (;;) {
+            while (p < n && isspace(head[p])) p++;
+            if (p >= n || head[p] != '#') break;
+            while (p < n && head[p] != '\n' && head[p] != '\r') p++;
+        }
+        if (p >= n || !isdigit(head[p])) return ST_OK;   /* malformed: stb_image rejects it */
+        v[i] = 0;
+        while (p < n && isdigit(head[p]))
+            if ((v[i] = v[i] * 10 + (uint64_t)(head[p++] - '0')) > UINT32_MAX) return ST_OK;
+    }
+    p++;   /* the one blank after maxval */
+    uint64_t channels = head[1] == '6' ? 3 : 1, bytes = v[2] > 255 ? 2 : 1;
+    return limit_count(path, "pixels", v[0] * v[1], channels * bytes,
+                       (uint64_t)size > p ? (uint64_t)size - p : 0, err);
+}
+
 Status texture_load_image(Scene *s, const char *name, const char *path, int linear, int clamp,
                           uint *index, Error *err)
 {
@@ -71,6 +108,13 @@ Status texture_load_image(Scene *s, const char *name, const char *path, int line
     if (!f) return error_set(err, ST_IO, "cannot open '%s': %s", path, strerror(errno));
     fclose(f);
     int w = 0, h = 0, channels = 0;
+    Status pst = pnm_check(path, err);
+    if (pst) return pst;
+    /* the size from the header, before stb_image allocates for it */
+    if (stbi_info(path, &w, &h, &channels) &&
+        (uint64_t)(unsigned)w * (uint64_t)(unsigned)h > CLPT_MAX_TEXTURE_PIXELS)
+        return error_set(err, ST_INPUT, "'%s': a %dx%d image is larger than the textures clpt "
+                         "reads (at most %u pixels, as in 8192x8192)", path, w, h, CLPT_MAX_TEXTURE_PIXELS);
     uint *texels = NULL;
     size_t n = 0;
     if (stbi_is_hdr(path)) {

@@ -19,9 +19,12 @@
 
 #include "harness.h"
 #include "kmath.h"
+#include "mtl.h"
 #include "obj.h"
+#include "ply.h"
 #include "render_util.h"
 #include "scene.h"
+#include "texture.h"
 
 #define DIR_BAD "tests/data/bad"
 
@@ -55,15 +58,26 @@ static int read_expect(const char *path, Expect *e)
     return e->status[0] ? 0 : -1;
 }
 
-/* Loads `path` with the reader its extension names. */
+/* Loads `path` with the reader its extension names (a new format adds a line). */
 static Status load(const char *path, Scene *s, Error *err)
 {
     if (has_suffix(path, ".scene")) return scene_load(path, s, err);
-    if (has_suffix(path, ".obj")) {
-        uint m;
+    uint m, index;
+    if (has_suffix(path, ".obj") || has_suffix(path, ".ply")) {
         Status st = scene_add_material(s, "m", material_diffuse(v3(0.5f, 0.5f, 0.5f)), &m, err);
-        return st ? st : obj_load(path, s, m, err);
+        MeshOptions o = mesh_options(m);
+        return st ? st : has_suffix(path, ".obj") ? obj_load(path, s, m, err) : ply_load(path, s, &o, err);
     }
+    if (has_suffix(path, ".mtl")) {
+        MtlLibrary lib;
+        memset(&lib, 0, sizeof lib);
+        Status st = mtl_load(path, &lib, err);
+        mtl_free(&lib);
+        return st;
+    }
+    static const char *const images[] = { ".png", ".bmp", ".tga", ".hdr", ".ppm", ".pgm", ".jpg" };
+    for (size_t i = 0; i < sizeof images / sizeof images[0]; i++)
+        if (has_suffix(path, images[i])) return texture_load_image(s, NULL, path, 0, 0, &index, err);
     return error_set(err, ST_INTERNAL, "no reader for %s: add one to tests/test_bad_input.c", path);
 }
 

@@ -1,7 +1,8 @@
 #!/bin/sh
 # valgrind.sh BUILD — small renders under valgrind memcheck (make test-valgrind):
 # the scalar device (the kernels compiled as C, several threads), PoCL (the OpenCL host
-# code, and the kernels PoCL compiles, running on clpt's buffers), an OBJ mesh, and an
+# code, and the kernels PoCL compiles, running on clpt's buffers), an OBJ mesh, a PLY
+# mesh on its own, a classic scene with image textures (the whitted integrator), and an
 # error path. Each must be clean: no invalid access, no use of uninitialised memory, no
 # definite or indirect leak outside the OpenCL runtime (tools/sanitizers/valgrind.supp
 # says what is suppressed there and why).
@@ -47,6 +48,8 @@ check() {
 small="--width 16 --height 12 --spp 2 -q"
 check scalar 0 scenes/cornell-box.scene --device scalar --threads 2 $small -o "$out/scalar.png"
 check mesh 0 scenes/mesh.scene --device scalar --threads 2 $small -o "$out/mesh.pfm"
+check ply-view 0 tests/data/models/bun_zipper_res4.ply --device scalar --threads 2 $small -o "$out/ply.png"
+check classic-textured 0 scenes/classic/textured.txt --device scalar --threads 2 $small -o "$out/classic.png"
 check pocl 0 scenes/cornell-box.scene --device cpu $small -o "$out/pocl.png"
 check bad-scene 3 tests/data/bad/not-a-number.scene --device scalar $small -o "$out/never.png"
 echo "$passed passed, $failed failed"

@@ -1,7 +1,7 @@
 /*
- * fuzz_lexer.c — the tokenizer (host/lexer.c) on arbitrary bytes: every token is
- * described and converted as the parsers do, and each must lie inside the text, in
- * order, with positions that only move forward.
+ * fuzz_lexer.c — the tokenizer (host/lexer.c, used by the scene and classic readers) on
+ * arbitrary bytes: every token is described and converted as the parsers do, and each
+ * must lie inside the text, in order, with positions that only move forward.
  */
 #include "fuzz.h"
 #include "lexer.h"
@@ -9,7 +9,7 @@
 #include <math.h>
 #include <string.h>
 
-FUZZ_SEEDS("scene obj");
+FUZZ_SEEDS("scene txt");
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {

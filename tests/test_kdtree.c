@@ -795,7 +795,8 @@ static int mesh_scene_open(MeshScene *m, const char *what)
     m->params.n_leaf_prims = m->tree.n_leaf_prims;
     m->params.bounds_lo = m->tree.lo;
     m->params.bounds_hi = m->tree.hi;
-    SceneView v = { &m->params, m->tree.nodes, m->tree.leaf_prims, NULL, m->scene.triangles, NULL, NULL, NULL, NULL, NULL };
+    SceneView v = { .params = &m->params, .nodes = m->tree.nodes, .leaf_prims = m->tree.leaf_prims,
+                    .triangles = m->scene.triangles };
     m->view = v;
     return 0;
 }

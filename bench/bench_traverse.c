@@ -128,7 +128,12 @@ static int mesh_open(Mesh *m, const char *name, Error *err)
     p->n_leaf_prims = m->tree.n_leaf_prims;
     p->bounds_lo = m->tree.lo;
     p->bounds_hi = m->tree.hi;
-    SceneView v = { p, m->tree.nodes, m->tree.leaf_prims, NULL, m->scene.triangles, NULL, NULL, NULL, NULL, NULL };
+    SceneView v;
+    memset(&v, 0, sizeof v);
+    v.params = p;
+    v.nodes = m->tree.nodes;
+    v.leaf_prims = m->tree.leaf_prims;
+    v.triangles = m->scene.triangles;
     m->view = v;
     return 0;
 }
@@ -317,7 +322,9 @@ static void rays_free(RaySet sets[N_SETS])
 
 /* ------------------------------------------------------------------ PoCL */
 
-enum { SC_PARAMS, SC_NODES, SC_LEAF, SC_SPHERES, SC_TRIS, SC_BOXES, SC_PLANES, SC_MATS, SC_LIGHTS, SC_SHADING, SC_N };
+/* The kernels' scene arguments, in SCENE_ARGS order (kernels/entry.cl). */
+enum { SC_PARAMS, SC_NODES, SC_LEAF, SC_SPHERES, SC_TRIS, SC_BOXES, SC_PLANES, SC_MATS, SC_LIGHTS, SC_SHADING,
+       SC_TEXTURES, SC_TEXELS, SC_MASK, SC_N };
 
 typedef struct {
     int ok;

@@ -332,7 +332,8 @@ typedef struct {
     cl_device_id sub;            /* the 1-compute-unit sub-device, or NULL */
     cl_context ctx;
     cl_command_queue q;
-    cl_kernel kc, ka;
+    cl_kernel kc, ka;            /* two rays per work-item */
+    cl_kernel kc1, ka1;          /* one ray per work-item */
     cl_program prog;
     cl_mem scene[SC_N], rays, out;
     size_t rays_cap;
@@ -362,7 +363,9 @@ static int pocl_open(Pocl *pc, const OclDeviceInfo *dev, cl_device_id sub)
     Error err = { 0 };
     if (ocl_program_build(pc->ctx, &pc->info, NULL, NULL, &pc->prog, NULL, &err) ||
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest", &pc->kc, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any", &pc->ka, &err)) {
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any", &pc->ka, &err) ||
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest1", &pc->kc1, &err) ||
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any1", &pc->ka1, &err)) {
         fprintf(stderr, "bench_traverse: %s\n", err.msg);
         error_clear(&err);
         return -1;
@@ -387,6 +390,8 @@ static void pocl_close(Pocl *pc)
     pocl_release_buffers(pc);
     if (pc->kc) clReleaseKernel(pc->kc);
     if (pc->ka) clReleaseKernel(pc->ka);
+    if (pc->kc1) clReleaseKernel(pc->kc1);
+    if (pc->ka1) clReleaseKernel(pc->ka1);
     if (pc->prog) clReleaseProgram(pc->prog);
     if (pc->q) clReleaseCommandQueue(pc->q);
     if (pc->ctx) clReleaseContext(pc->ctx);
@@ -419,8 +424,8 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
     for (int i = 0; i < SC_N; i++)
         if (!pc->scene[i]) return -1;
     if (!pc->rays || !pc->out) return -1;
-    cl_kernel ks[2] = { pc->kc, pc->ka };
-    for (int k = 0; k < 2; k++) {
+    cl_kernel ks[4] = { pc->kc, pc->ka, pc->kc1, pc->ka1 };
+    for (int k = 0; k < 4; k++) {
         for (cl_uint i = 0; i < SC_N; i++)
             if (clSetKernelArg(ks[k], i, sizeof(cl_mem), &pc->scene[i]) != CL_SUCCESS) return -1;
         if (clSetKernelArg(ks[k], SC_N, sizeof(cl_mem), &pc->rays) != CL_SUCCESS ||
@@ -430,13 +435,14 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
     return 0;
 }
 
-/* Traces the set (its rays already uploaded); returns seconds, or -1. */
-static double pocl_trace(Pocl *pc, const RaySet *s)
+/* Traces the set (its rays already uploaded), two rays per work-item or one; returns
+ * seconds, or -1. */
+static double pocl_trace(Pocl *pc, const RaySet *s, int pairs)
 {
-    cl_kernel k = s->any ? pc->ka : pc->kc;
+    cl_kernel k = pairs ? (s->any ? pc->ka : pc->kc) : (s->any ? pc->ka1 : pc->kc1);
     cl_uint n = s->n;
     if (clSetKernelArg(k, SC_N + 1, sizeof n, &n) != CL_SUCCESS) return -1.0;
-    size_t items = (n + 1u) / 2u;   /* two rays per work-item */
+    size_t items = pairs ? (n + 1u) / 2u : n;
     size_t local = pocl_local, global = local ? (items + local - 1) / local * local : items;
     double c0 = cpu_now(), t0 = timer_now();
     cl_int rc = clEnqueueNDRangeKernel(pc->q, k, 1, NULL, &global, local ? &local : NULL, 0, NULL, NULL);
@@ -747,11 +753,16 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
         /* check first */
         r->pocl_diff = r->embree_diff = -1;
         for (int t = 0; t < MAX_THREADS; t++) {
-            if (!pocl_ok[t] || pocl_put_rays(&pocl[t], s) || pocl_trace(&pocl[t], s) < 0.0) {
+            if (!pocl_ok[t] || pocl_put_rays(&pocl[t], s) || pocl_trace(&pocl[t], s, 0) < 0.0) {
                 pocl_ok[t] = 0;
                 continue;
             }
             long d = pocl_compare(&pocl[t], s);
+            if (pocl_trace(&pocl[t], s, 1) < 0.0) {
+                pocl_ok[t] = 0;
+                continue;
+            }
+            d += pocl_compare(&pocl[t], s);
             r->pocl_diff = r->pocl_diff < 0 ? d : r->pocl_diff + d;
         }
         if (have_embree) {
@@ -770,7 +781,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
                 sc[i] = trace_c(&m.view, s, th, 1, tmp_h, tmp_o);
                 cc[i] = last_cpu_seconds;
                 if (pocl_ok[t]) {
-                    sp[i] = pocl_trace(&pocl[t], s);
+                    sp[i] = pocl_trace(&pocl[t], s, 1);
                     cp[i] = last_cpu_seconds;
                 }
                 if (have_embree) {

@@ -883,10 +883,64 @@ static void *sort_job(void *arg)
 
 typedef struct { const BNode *node; uint parent; int depth; Aabb box; } FlatItem;
 
-static Status flatten(const BNode *root, const Aabb *root_box, KdTree *t, Error *err)
+/* A leaf's sorted global ids. */
+static const uint *leaf_ids(const BNode *n) { return n->count == 1 ? &n->id : n->ids; }
+
+/* How many of a leaf's ids are triangles (they come after the spheres, before the
+ * boxes, and the ids are sorted: a contiguous run). */
+static void leaf_split_ids(const BNode *n, const KdInput *in, uint *first_tri, uint *n_tri)
+{
+    uint lo = (uint)in->n_spheres, hi = lo + (uint)in->n_triangles;
+    const uint *ids = leaf_ids(n);
+    uint a = 0, c = 0;
+    while (a < n->count && ids[a] < lo) a++;
+    while (a + c < n->count && ids[a + c] < hi) c++;
+    *first_tri = a;
+    *n_tri = c;
+}
+
+/* Words of a leaf's record in the leaf data (types.h). */
+static size_t leaf_words(const BNode *n, const KdInput *in)
+{
+    uint first, nt;
+    leaf_split_ids(n, in, &first, &nt);
+    size_t w = (size_t)(nt + KD_GROUP - 1) / KD_GROUP * KD_GROUP_WORDS;
+    uint others = n->count - nt;
+    return w + (others ? 1 + others : 0);
+}
+
+/* Writes a leaf's record at out: its triangles in groups (the last one repeated in the
+ * unused lanes), then the other ids. */
+static void leaf_write(const BNode *n, const KdInput *in, uint *out)
+{
+    uint first, nt;
+    leaf_split_ids(n, in, &first, &nt);
+    const uint *ids = leaf_ids(n);
+    uint base = (uint)in->n_spheres;
+    for (uint g = 0; g < nt; g += KD_GROUP, out += KD_GROUP_WORDS) {
+        for (uint l = 0; l < KD_GROUP; l++) {
+            uint id = ids[first + (g + l < nt ? g + l : nt - 1)];
+            const Triangle *t = &in->triangles[id - base];
+            const vec3 *c[3] = { &t->p0, &t->p1, &t->p2 };
+            out[l] = id;
+            for (int v = 0; v < 3; v++) {
+                const float f[3] = { c[v]->x, c[v]->y, c[v]->z };
+                for (int k = 0; k < 3; k++) memcpy(&out[KD_GROUP + (uint)(3 * v + k) * KD_GROUP + l], &f[k], sizeof(float));
+            }
+        }
+    }
+    uint others = n->count - nt;
+    if (others) {
+        *out++ = others;
+        for (uint i = 0; i < n->count; i++)
+            if (i < first || i >= first + nt) *out++ = ids[i];
+    }
+}
+
+static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in, KdTree *t, Error *err)
 {
     /* Count first, to allocate exactly. Depth-first, "below" child first. */
-    size_t n_nodes = 0, n_ids = 0;
+    size_t n_nodes = 0, n_words = 0;
     const BNode *stack[KD_MAX_DEPTH + 2];
     int sp = 0;
     stack[sp++] = root;
@@ -894,24 +948,24 @@ static Status flatten(const BNode *root, const Aabb *root_box, KdTree *t, Error 
         const BNode *n = stack[--sp];
         n_nodes++;
         if (n->axis == KD_LEAF) {
-            if (n->count > 1) n_ids += n->count;
+            n_words += leaf_words(n, in);
         } else {
             stack[sp++] = n->child[1];
             stack[sp++] = n->child[0];
         }
     }
-    if (n_nodes > KD_MAX_PRIMS || n_ids > UINT32_MAX - 1)
-        return error_set(err, ST_INTERNAL, "kd-tree: %zu nodes and %zu leaf ids do not fit the node layout",
-                         n_nodes, n_ids);
+    if (n_nodes > KD_MAX_PRIMS || n_words > UINT32_MAX - 1)
+        return error_set(err, ST_INTERNAL, "kd-tree: %zu nodes and %zu words of leaf data do not fit the node layout",
+                         n_nodes, n_words);
     t->nodes = malloc(n_nodes * sizeof *t->nodes);
-    t->leaf_prims = malloc((n_ids + 1) * sizeof *t->leaf_prims);
+    t->leaf_prims = malloc((n_words + 1) * sizeof *t->leaf_prims);
     if (!t->nodes || !t->leaf_prims)
         return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu nodes", n_nodes);
 
     KdStats *st = &t->stats;
     double inv_root = box_half_area(root_box) > 0.0 ? 1.0 / box_half_area(root_box) : 0.0;
-    size_t refs = 0;
-    uint idx = 0, ids = 0;
+    size_t refs = 0, groups = 0;
+    uint idx = 0, words = 0;
     FlatItem items[KD_MAX_DEPTH + 2];
     int ip = 0;
     items[ip++] = (FlatItem){ root, NO_INDEX, 0, *root_box };
@@ -927,14 +981,14 @@ static Status flatten(const BNode *root, const Aabb *root_box, KdTree *t, Error 
             if (n->count == 0) st->n_empty_leaves++;
             refs += n->count;
             st->sah_cost += KD_COST_INTERSECT * n->count * rel;
-            t->nodes[me].bits = KD_LEAF | (n->count << 2);
-            if (n->count == 1) {
-                t->nodes[me].data = n->id;
-            } else {
-                t->nodes[me].data = ids;
-                if (n->count) memcpy(t->leaf_prims + ids, n->ids, n->count * sizeof *n->ids);
-                ids += n->count;
-            }
+            uint first, nt;
+            leaf_split_ids(n, in, &first, &nt);
+            uint ng = (nt + KD_GROUP - 1) / KD_GROUP;
+            groups += ng;
+            t->nodes[me].bits = KD_LEAF | (n->count > nt ? KD_LEAF_OTHERS : 0u) | (ng << 3);
+            t->nodes[me].data = n->count ? words : 0u;
+            if (n->count) leaf_write(n, in, t->leaf_prims + words);
+            words += (uint)leaf_words(n, in);
             continue;
         }
         st->sah_cost += KD_COST_TRAVERSAL * rel;
@@ -950,12 +1004,29 @@ static Status flatten(const BNode *root, const Aabb *root_box, KdTree *t, Error 
         items[ip++] = below;
     }
     t->n_nodes = idx;
-    t->n_leaf_prims = ids;
+    t->n_leaf_prims = words;
     st->n_nodes = idx;
     uint full = st->n_leaves - st->n_empty_leaves;
     st->mean_prims_per_leaf = full ? (double)refs / full : 0.0;
-    st->bytes = (size_t)idx * sizeof(KdNode) + (size_t)ids * sizeof(uint);
+    st->bytes = (size_t)idx * sizeof(KdNode) + (size_t)words * sizeof(uint);
+    st->bytes_corners = groups * KD_GROUP * 9 * sizeof(float);
     return ST_OK;
+}
+
+/* A leaf's primitive ids (its triangles without the repeated lanes, then the others). */
+uint kd_leaf_ids(const KdTree *t, uint node, uint *out, uint cap)
+{
+    KdNode n = t->nodes[node];
+    uint m = 0;
+    if ((n.bits & 3u) != KD_LEAF) return 0;
+    const uint *g = t->leaf_prims + n.data;
+    for (uint i = 0; i < n.bits >> 3; i++, g += KD_GROUP_WORDS)
+        for (uint l = 0; l < KD_GROUP; l++)
+            if ((l == 0 || g[l] != g[l - 1]) && m < cap) out[m++] = g[l];
+    if (n.bits & KD_LEAF_OTHERS)
+        for (uint i = 1; i <= g[0]; i++)
+            if (m < cap) out[m++] = g[i];
+    return m;
 }
 
 /* ------------------------------------------------------------------ entry points */
@@ -1105,7 +1176,7 @@ Status kd_build(const KdInput *in, int threads, KdTree *out, Error *err)
         goto fail;
     }
 
-    st = flatten(root_node, &root, out, err);
+    st = flatten(root_node, &root, in, out, err);
     if (st != ST_OK) goto fail;
     out->lo = (vec3){ root.lo[0], root.lo[1], root.lo[2] };
     out->hi = (vec3){ root.hi[0], root.hi[1], root.hi[2] };

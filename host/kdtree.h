@@ -37,7 +37,8 @@ typedef struct {
     double mean_prims_per_leaf;    /* over non-empty leaves */
     double sah_cost;               /* expected cost of a random ray through the root box */
     double leaf_sah_cost;          /* the same for a single leaf holding every primitive */
-    size_t bytes;                  /* nodes + leaf primitive ids */
+    size_t bytes;                  /* nodes + leaf data (ids and the triangles' corners) */
+    size_t bytes_corners;          /* of which the copies of the triangles' corners */
     uint n_prims;                  /* primitives in the tree */
     uint n_skipped;                /* left out: bounds not finite (NaN or inf coordinates) */
 } KdStats;
@@ -53,5 +54,9 @@ typedef struct {
  * input gives a single empty leaf. Threads: 0 = all cores. */
 Status kd_build(const KdInput *in, int threads, KdTree *out, Error *err);
 void kd_free(KdTree *t);
+
+/* The primitive ids of leaf `node` (at most cap of them) into out; returns how many
+ * (0 for an interior node). */
+uint kd_leaf_ids(const KdTree *t, uint node, uint *out, uint cap);
 
 #endif /* CLPT_KDTREE_H */

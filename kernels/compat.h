@@ -24,6 +24,9 @@
 
 #define KERNEL_OPENCL 1
 #define KFN static inline       /* every helper: never bare `inline` (C99 rules) */
+/* Hot helpers that must be inlined whatever the compiler's size heuristics say: a call
+ * forces their state through memory (PoCL kept the kd-tree walk's state in memory). */
+#define KFN_INLINE static inline __attribute__((always_inline))
 #define GLOBAL __global
 #define CONSTANT __constant
 
@@ -37,6 +40,8 @@
 
 typedef long kint64;         /* 64-bit in every OpenCL C implementation */
 
+#define k_load4(p) vload4(0, p)
+
 #else
 /* ---------------------------------------------------------------- C11 */
 #include <math.h>
@@ -44,6 +49,7 @@ typedef long kint64;         /* 64-bit in every OpenCL C implementation */
 #include <string.h>
 
 #define KFN static inline
+#define KFN_INLINE static inline __attribute__((always_inline))
 #define GLOBAL
 #define CONSTANT const
 
@@ -59,6 +65,14 @@ static inline float k_as_float(uint u) { float f; memcpy(&f, &u, sizeof f); retu
 static inline uint k_as_uint(float f) { uint u; memcpy(&u, &f, sizeof u); return u; }
 static inline int k_as_int(float f) { int i; memcpy(&i, &f, sizeof i); return i; }
 static inline float k_int_as_float(int i) { float f; memcpy(&f, &i, sizeof f); return f; }
+
+/* OpenCL's 4-wide vectors as GCC vector extensions, which compute each lane with the
+ * same IEEE operation as OpenCL does. Kernel code uses only operators (with vector or
+ * scalar operands), comparisons (-1 or 0 per lane, as OpenCL's), lane subscripts and
+ * k_load4 on them. */
+typedef float float4 __attribute__((vector_size(16)));
+typedef int int4 __attribute__((vector_size(16)));
+static inline float4 k_load4(const float *p) { float4 v; memcpy(&v, p, sizeof v); return v; }
 
 #endif
 

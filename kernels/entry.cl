@@ -213,3 +213,21 @@ __kernel void k_trace_any(SCENE_ARGS, __global const Ray *rays, uint n, __global
         occluded[a] = (uint)trace_any(&sc, rays[a]);
     }
 }
+
+/* Closest hit of rays[i], one ray per work-item (trace_closest, as k_intersect). */
+__kernel void k_trace_closest1(SCENE_ARGS, __global const Ray *rays, uint n, __global Hit *hits)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= n) return;
+    SCENE_VIEW(sc);
+    hits[i] = trace_closest(&sc, rays[i]);
+}
+
+/* Whether rays[i] hits anything, one ray per work-item (trace_any, as k_shadow). */
+__kernel void k_trace_any1(SCENE_ARGS, __global const Ray *rays, uint n, __global uint *occluded)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= n) return;
+    SCENE_VIEW(sc);
+    occluded[i] = (uint)trace_any(&sc, rays[i]);
+}

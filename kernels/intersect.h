@@ -23,6 +23,7 @@
 typedef struct {
     float org[3], dir[3];
     float inv_d[3];        /* 1/d per component: +-inf where that component is +-0 */
+    uint neg;              /* bit a set when dir[a] has its sign bit set (-0 included) */
     int kx, ky, kz;        /* axes of the triangle test; kz is where |d| is largest */
     float sx, sy, sz;      /* shear taking d to (0, 0, 1) in the permuted frame */
 } RayPre;
@@ -35,6 +36,7 @@ KFN RayPre ray_prepare(Ray ray)
     p.inv_d[0] = 1.0f / ray.d.x;
     p.inv_d[1] = 1.0f / ray.d.y;
     p.inv_d[2] = 1.0f / ray.d.z;
+    p.neg = (k_as_uint(ray.d.x) >> 31) | ((k_as_uint(ray.d.y) >> 31) << 1) | ((k_as_uint(ray.d.z) >> 31) << 2);
     float ax = k_fabs(ray.d.x), ay = k_fabs(ray.d.y), az = k_fabs(ray.d.z);
     int kz = (ax >= ay && ax >= az) ? 0 : (ay >= az ? 1 : 2);
     int kx = kz == 2 ? 0 : kz + 1;
@@ -138,6 +140,50 @@ KFN int triangle_intersect(const RayPre *rp, GLOBAL const Triangle *tri, Ray ray
     hit->u = V * inv_det;
     hit->v = W * inv_det;
     return 1;
+}
+
+/* triangle_intersect on the KD_GROUP (4) triangles of a kd-tree leaf group at once:
+ * `rows` are the group's corners, 9 rows of 4 floats (types.h). Each lane computes the
+ * very operations of triangle_intersect, so a lane's t, u and v are bit for bit what
+ * triangle_intersect gives for that triangle, with tmax fixed for the group. Returns
+ * the lanes hit as bits (lane i: 1 << i) and their t, u and v. */
+KFN_INLINE uint triangle_intersect4(const RayPre *rp, GLOBAL const float *rows, float tmin, float tmax,
+                                    float4 *t_out, float4 *u_out, float4 *v_out)
+{
+    int kx = rp->kx, ky = rp->ky, kz = rp->kz;
+    float ox = rp->org[kx], oy = rp->org[ky], oz = rp->org[kz];
+    float sx = rp->sx, sy = rp->sy, sz = rp->sz;
+    float4 az = k_load4(rows + 4 * kz) - oz;
+    float4 bz = k_load4(rows + 4 * (3 + kz)) - oz;
+    float4 cz = k_load4(rows + 4 * (6 + kz)) - oz;
+    float4 ax = (k_load4(rows + 4 * kx) - ox) - sx * az;
+    float4 ay = (k_load4(rows + 4 * ky) - oy) - sy * az;
+    float4 bx = (k_load4(rows + 4 * (3 + kx)) - ox) - sx * bz;
+    float4 by = (k_load4(rows + 4 * (3 + ky)) - oy) - sy * bz;
+    float4 cx = (k_load4(rows + 4 * (6 + kx)) - ox) - sx * cz;
+    float4 cy = (k_load4(rows + 4 * (6 + ky)) - oy) - sy * cz;
+    float4 U = cx * by - cy * bx;
+    float4 V = ax * cy - ay * cx;
+    float4 W = bx * ay - by * ax;
+    int4 zero = (U == 0.0f) | (V == 0.0f) | (W == 0.0f);
+    if ((zero[0] | zero[1] | zero[2] | zero[3]) != 0) {
+        for (int i = 0; i < 4; i++) {
+            if (U[i] == 0.0f) U[i] = k_edge_exact(cx[i], by[i], cy[i], bx[i]);
+            if (V[i] == 0.0f) V[i] = k_edge_exact(ax[i], cy[i], ay[i], cx[i]);
+            if (W[i] == 0.0f) W[i] = k_edge_exact(bx[i], ay[i], by[i], ax[i]);
+        }
+    }
+    int4 neg = (U < 0.0f) | (V < 0.0f) | (W < 0.0f);
+    int4 pos = (U > 0.0f) | (V > 0.0f) | (W > 0.0f);
+    float4 det = U + V + W;
+    float4 T = U * (sz * az) + V * (sz * bz) + W * (sz * cz);
+    float4 inv_det = 1.0f / det;
+    float4 t = T * inv_det;
+    int4 ok = ~(neg & pos) & (det != 0.0f) & (t > tmin) & (t < tmax);
+    *t_out = t;
+    *u_out = V * inv_det;
+    *v_out = W * inv_det;
+    return (uint)(ok[0] & 1) | (uint)(ok[1] & 2) | (uint)(ok[2] & 4) | (uint)(ok[3] & 8);
 }
 
 #ifndef __OPENCL_VERSION__

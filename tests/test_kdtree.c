@@ -534,19 +534,43 @@ static void check_tree(void)
             stack_node[sp] = ni + 1; stack_box[sp] = below; stack_depth[sp++] = depth + 1;
             continue;
         }
-        uint count = n.bits >> 2;
+        uint *ids = malloc((n_prims + 1) * sizeof *ids);
+        uint count = kd_leaf_ids(t, ni, ids, n_prims + 1);
+        CHECK(count <= n_prims);
         leaves++;
         empty += count == 0;
         sah += KD_COST_INTERSECT * count * half_area(&box) / root_area;
         unsigned char *in_leaf = calloc(n_prims + 1, 1);
         for (uint i = 0; i < count; i++) {
-            uint id = count == 1 ? n.data : t->leaf_prims[n.data + i];
+            uint id = ids[i];
             CHECK(id < n_prims);
             if (id >= n_prims) continue;
-            if (count > 1 && i > 0) CHECK(t->leaf_prims[n.data + i - 1] < id);  /* sorted, unique */
+            CHECK(!in_leaf[id]);   /* unique */
             in_leaf[id] = 1;
             seen[id] = 1;
         }
+        free(ids);
+        /* the leaf record: its groups hold the triangles' corners, in increasing id
+         * order, the last one repeated in the unused lanes; then the others' count */
+        const uint *g = t->leaf_prims + n.data;
+        uint prev = 0, groups = n.bits >> 3;
+        for (uint gi = 0; gi < groups; gi++, g += KD_GROUP_WORDS)
+            for (uint l = 0; l < KD_GROUP; l++) {
+                uint id = g[l];
+                CHECK(id >= scene.ns && id < scene.ns + scene.nt);
+                if (id < scene.ns || id >= scene.ns + scene.nt) continue;
+                CHECK(gi + l == 0 || id >= prev);
+                prev = id;
+                const Triangle *tr = &scene.tri[id - scene.ns];
+                const float want[9] = { tr->p0.x, tr->p0.y, tr->p0.z, tr->p1.x, tr->p1.y, tr->p1.z,
+                                        tr->p2.x, tr->p2.y, tr->p2.z };
+                for (uint r = 0; r < 9; r++) {
+                    float got;
+                    memcpy(&got, &g[KD_GROUP + r * KD_GROUP + l], sizeof got);
+                    CHECK(memcmp(&got, &want[r], sizeof got) == 0);
+                }
+            }
+        if (n.bits & KD_LEAF_OTHERS) CHECK(g[0] >= 1 && g[0] <= count);
         for (uint id = 0; id < n_prims; id++)
             if (!in_leaf[id] && prim_finite(id) && must_contain(id, box.lo, box.hi, eps)) missing++;
         free(in_leaf);
@@ -795,7 +819,12 @@ static int mesh_scene_open(MeshScene *m, const char *what)
     m->params.n_leaf_prims = m->tree.n_leaf_prims;
     m->params.bounds_lo = m->tree.lo;
     m->params.bounds_hi = m->tree.hi;
-    SceneView v = { &m->params, m->tree.nodes, m->tree.leaf_prims, NULL, m->scene.triangles, NULL, NULL, NULL, NULL, NULL };
+    SceneView v;
+    memset(&v, 0, sizeof v);
+    v.params = &m->params;
+    v.nodes = m->tree.nodes;
+    v.leaf_prims = m->tree.leaf_prims;
+    v.triangles = m->scene.triangles;
     m->view = v;
     return 0;
 }

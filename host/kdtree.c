@@ -421,7 +421,7 @@ typedef struct {
 
 static double sah_split_cost(double sa_l, double sa_r, uint nl, uint nr)
 {
-    double c = KD_COST_TRAVERSAL + KD_COST_INTERSECT * (sa_l * nl + sa_r * nr);
+    double c = KD_COST_TRAVERSAL + sa_l * kd_leaf_cost(nl) + sa_r * kd_leaf_cost(nr);
     return c * ((nl == 0 || nr == 0) ? KD_EMPTY_BONUS : 1.0);
 }
 
@@ -677,7 +677,7 @@ static int build_node(Worker *w, NodeLists nl, int depth, int bad, int tentative
     if (!node) return -1;
     *out = node;
     double sa = box_half_area(&nl.box);
-    double leaf_cost = KD_COST_INTERSECT * nl.nprims;
+    double leaf_cost = kd_leaf_cost(nl.nprims);
     *cost = leaf_cost * sa;
 
     Split best = { -1, 0.0f, 0, INFINITY };
@@ -980,7 +980,7 @@ static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in
             st->n_leaves++;
             if (n->count == 0) st->n_empty_leaves++;
             refs += n->count;
-            st->sah_cost += KD_COST_INTERSECT * n->count * rel;
+            st->sah_cost += kd_leaf_cost(n->count) * rel;
             uint first, nt;
             leaf_split_ids(n, in, &first, &nt);
             uint ng = (nt + KD_GROUP - 1) / KD_GROUP;
@@ -1180,7 +1180,7 @@ Status kd_build(const KdInput *in, int threads, KdTree *out, Error *err)
     if (st != ST_OK) goto fail;
     out->lo = (vec3){ root.lo[0], root.lo[1], root.lo[2] };
     out->hi = (vec3){ root.hi[0], root.hi[1], root.hi[2] };
-    out->stats.leaf_sah_cost = KD_COST_INTERSECT * b.n_prims;
+    out->stats.leaf_sah_cost = kd_leaf_cost(b.n_prims);
     build_free(&b, w, n_workers);
     out->stats.build_seconds = now_seconds() - t_start;
     return ST_OK;

@@ -21,8 +21,20 @@
 #define KD_COST_TRAVERSAL 1.0
 #endif
 #ifndef KD_COST_INTERSECT
-#define KD_COST_INTERSECT 0.3
+#define KD_COST_INTERSECT 0.1
 #endif
+
+#ifndef KD_GROUPED_COST
+#define KD_GROUPED_COST 1
+#endif
+
+/* SAH cost of testing a leaf of n primitives: its triangles are tested KD_GROUP at a
+ * time, so a leaf costs per group of KD_GROUP, each lane at KD_COST_INTERSECT. */
+static inline double kd_leaf_cost(unsigned n)
+{
+    if (!KD_GROUPED_COST) return KD_COST_INTERSECT * n;
+    return KD_COST_INTERSECT * KD_GROUP * (double)((n + KD_GROUP - 1u) / KD_GROUP);
+}
 
 typedef struct {
     const Sphere *spheres;     size_t n_spheres;

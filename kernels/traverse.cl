@@ -179,6 +179,9 @@ KFN_INLINE int kd_walk_begin(const SceneView *sc, Ray ray, const RayPre *rp, KdW
     return trace_clip_root(sc->params, ray, rp, &w->t0, &w->t1);
 }
 
+#ifndef KD_BRANCH
+#define KD_BRANCH 1
+#endif
 /* The kd-tree walk shared by both queries. With `any` set it returns at the first hit;
  * otherwise it keeps the closest one in *best (whose t starts as the ray's tmax). */
 KFN_INLINE void trace_tree(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit *best)
@@ -188,7 +191,7 @@ KFN_INLINE void trace_tree(const SceneView *sc, Ray ray, const RayPre *rp, int a
     GLOBAL const KdNode *nodes = sc->nodes;
     for (;;) {
         KdNode n = nodes[w.node];
-        if ((n.bits & 3u) != KD_LEAF) kd_step(rp, n, &w, 1);
+        if ((n.bits & 3u) != KD_LEAF) kd_step(rp, n, &w, KD_BRANCH);
         else if (kd_leaf(sc, ray, rp, any, n, &w, best)) return;
     }
 }

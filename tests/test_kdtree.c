@@ -539,7 +539,7 @@ static void check_tree(void)
         CHECK(count <= n_prims);
         leaves++;
         empty += count == 0;
-        sah += KD_COST_INTERSECT * count * half_area(&box) / root_area;
+        sah += kd_leaf_cost(count) * half_area(&box) / root_area;
         unsigned char *in_leaf = calloc(n_prims + 1, 1);
         for (uint i = 0; i < count; i++) {
             uint id = ids[i];
@@ -590,7 +590,7 @@ static void check_tree(void)
     CHECK_EQ_INT(st->bytes, (size_t)t->n_nodes * sizeof(KdNode) + (size_t)t->n_leaf_prims * sizeof(uint));
     CHECK_NEAR(st->sah_cost, sah, 1e-6 * sah);
     CHECK(st->sah_cost <= st->leaf_sah_cost);
-    CHECK_NEAR(st->leaf_sah_cost, KD_COST_INTERSECT * st->n_prims, 1e-9);
+    CHECK_NEAR(st->leaf_sah_cost, kd_leaf_cost(st->n_prims), 1e-9);
 }
 
 static void test_structure(void)

@@ -57,14 +57,19 @@ KFN int trace_clip_root(GLOBAL const RenderParams *pr, Ray ray, const RayPre *rp
 #define KD_T_BELOW (1.0f - KD_T_SLACK)
 
 /* A kd-tree walk in progress: the node about to be visited, the part [t0, t1] of the
- * ray inside it, and the cells still to visit (far children, with their parts). */
+ * ray inside it, and the depth of its stack of cells still to visit (far children,
+ * with their parts), which is kept apart: the compilers keep a struct's scalars in
+ * registers only when no part of it is indexed by a variable. */
 typedef struct {
     uint node;
     float t0, t1;
     int sp;
-    uint stack_node[KD_MAX_DEPTH];
-    float stack_t0[KD_MAX_DEPTH], stack_t1[KD_MAX_DEPTH];
 } KdWalk;
+
+typedef struct {
+    uint node[KD_MAX_DEPTH];
+    float t0[KD_MAX_DEPTH], t1[KD_MAX_DEPTH];
+} KdStack;
 
 /* b if c is 1, a if c is 0 (c is 0 or 1), by masks: no branch. */
 KFN_INLINE uint k_select_u(uint a, uint b, uint c)
@@ -95,7 +100,7 @@ KFN_INLINE float k_select_f(float a, float b, uint c)
  * coherent rays and which keeps the plane test off the chain of node loads; without it
  * every choice is a bit select, for walks taking turns (trace_pair), where the other
  * walk's chain hides the longer one. The two compute the same. */
-KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, int branch)
+KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, KdStack *st, int branch)
 {
     uint axis = n.bits & 3u;
     float tp = (k_as_float(n.data) - rp->org[axis]) * rp->inv_d[axis];
@@ -110,9 +115,9 @@ KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, int branch)
     }
     uint both = (uint)!(tp > t1 * KD_T_ABOVE) & (far_only ^ 1u);
     int sp = w->sp;
-    w->stack_node[sp] = far;
-    w->stack_t0[sp] = tp > t0 ? tp : t0;
-    w->stack_t1[sp] = t1;
+    st->node[sp] = far;
+    st->t0[sp] = tp > t0 ? tp : t0;
+    st->t1[sp] = t1;
     w->sp = sp + (int)both;
     /* Beyond the interval min(tp, t1) is t1: only "both" shortens it. */
     w->t1 = k_select_f(tp < t1 ? tp : t1, t1, far_only);
@@ -126,7 +131,8 @@ KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, int branch)
  * tested a group at a time (triangle_intersect4); of the lanes hit the nearest counts,
  * the first of equals, which is what testing them one by one in lane order gives. One
  * call site per walk for the tests, so that they are inlined. */
-KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, KdNode n, KdWalk *w, Hit *best)
+KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, KdNode n, KdWalk *w,
+                       const KdStack *st, Hit *best)
 {
     GLOBAL const uint *g = sc->leaf_prims + n.data;
     uint groups = n.bits >> 3;
@@ -165,9 +171,9 @@ KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, 
     if ((w->sp == 0) | (best->t <= w->t1)) return 1;
     int sp = w->sp - 1;
     w->sp = sp;
-    w->node = w->stack_node[sp];
-    w->t0 = w->stack_t0[sp];
-    w->t1 = w->stack_t1[sp];
+    w->node = st->node[sp];
+    w->t0 = st->t0[sp];
+    w->t1 = st->t1[sp];
     return 0;
 }
 
@@ -179,20 +185,18 @@ KFN_INLINE int kd_walk_begin(const SceneView *sc, Ray ray, const RayPre *rp, KdW
     return trace_clip_root(sc->params, ray, rp, &w->t0, &w->t1);
 }
 
-#ifndef KD_BRANCH
-#define KD_BRANCH 1
-#endif
 /* The kd-tree walk shared by both queries. With `any` set it returns at the first hit;
  * otherwise it keeps the closest one in *best (whose t starts as the ray's tmax). */
 KFN_INLINE void trace_tree(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit *best)
 {
     KdWalk w;
+    KdStack st;
     if (!kd_walk_begin(sc, ray, rp, &w)) return;
     GLOBAL const KdNode *nodes = sc->nodes;
     for (;;) {
         KdNode n = nodes[w.node];
-        if ((n.bits & 3u) != KD_LEAF) kd_step(rp, n, &w, KD_BRANCH);
-        else if (kd_leaf(sc, ray, rp, any, n, &w, best)) return;
+        if ((n.bits & 3u) != KD_LEAF) kd_step(rp, n, &w, &st, 1);
+        else if (kd_leaf(sc, ray, rp, any, n, &w, &st, best)) return;
     }
 }
 
@@ -247,14 +251,13 @@ KFN int trace_any(const SceneView *sc, Ray ray)
  * that the walks' scalars stay in registers. */
 typedef struct {
     Ray ray;
-    RayPre rp;
     Hit best;
     int any;            /* any-hit query: stop at the first hit */
     int active;         /* still walking */
 } TraceRay;
 
 /* The planes, then the ray clipped to the root box, as trace_closest and trace_any do. */
-KFN_INLINE void trace_ray_begin(const SceneView *sc, Ray ray, int any, TraceRay *t, KdWalk *w)
+KFN_INLINE void trace_ray_begin(const SceneView *sc, Ray ray, int any, TraceRay *t, RayPre *rp, KdWalk *w)
 {
     GLOBAL const RenderParams *pr = sc->params;
     t->ray = ray;
@@ -278,50 +281,52 @@ KFN_INLINE void trace_ray_begin(const SceneView *sc, Ray ray, int any, TraceRay 
             if (any) return;
         }
     }
-    t->rp = ray_prepare(ray);
-    t->active = kd_walk_begin(sc, ray, &t->rp, w);
+    *rp = ray_prepare(ray);
+    t->active = kd_walk_begin(sc, ray, rp, w);
 }
 
 /* The rest of one walk, alone. */
-KFN_INLINE void trace_ray_finish(const SceneView *sc, TraceRay *t, KdWalk *w)
+KFN_INLINE void trace_ray_finish(const SceneView *sc, TraceRay *t, const RayPre *rp, KdWalk *w, KdStack *st)
 {
     GLOBAL const KdNode *nodes = sc->nodes;
     while (t->active) {
         KdNode n = nodes[w->node];
-        if ((n.bits & 3u) != KD_LEAF) kd_step(&t->rp, n, w, 1);
-        else t->active = !kd_leaf(sc, t->ray, &t->rp, t->any, n, w, &t->best);
+        if ((n.bits & 3u) != KD_LEAF) kd_step(rp, n, w, st, 1);
+        else t->active = !kd_leaf(sc, t->ray, rp, t->any, n, w, st, &t->best);
     }
 }
 
-/* Walks both in turns while both are active, then finishes the other. */
-KFN_INLINE void trace_pair(const SceneView *sc, TraceRay *a, KdWalk *wa, TraceRay *b, KdWalk *wb)
-{
-    GLOBAL const KdNode *nodes = sc->nodes;
-    while (a->active & b->active) {
-        KdNode na = nodes[wa->node], nb = nodes[wb->node];
-        uint la = (uint)((na.bits & 3u) == KD_LEAF), lb = (uint)((nb.bits & 3u) == KD_LEAF);
-        if ((la | lb) == 0u) {
-            kd_step(&a->rp, na, wa, 0);
-            kd_step(&b->rp, nb, wb, 0);
-            continue;
-        }
-        if (la) a->active = !kd_leaf(sc, a->ray, &a->rp, a->any, na, wa, &a->best);
-        else kd_step(&a->rp, na, wa, 0);
-        if (lb) b->active = !kd_leaf(sc, b->ray, &b->rp, b->any, nb, wb, &b->best);
-        else kd_step(&b->rp, nb, wb, 0);
-    }
-    trace_ray_finish(sc, a, wa);
-    trace_ray_finish(sc, b, wb);
-}
+/* Both rays' walks in turns while both are active, then the other one's rest. */
+#define TRACE_PAIR(sc, a, pa, wa, sa, b, pb, wb, sb)                                     \
+    do {                                                                                 \
+        GLOBAL const KdNode *nodes_ = (sc)->nodes;                                       \
+        while ((a).active & (b).active) {                                                \
+            KdNode na = nodes_[(wa).node], nb = nodes_[(wb).node];                       \
+            uint la = (uint)((na.bits & 3u) == KD_LEAF), lb = (uint)((nb.bits & 3u) == KD_LEAF); \
+            if ((la | lb) == 0u) {                                                       \
+                kd_step(&(pa), na, &(wa), &(sa), 0);                                     \
+                kd_step(&(pb), nb, &(wb), &(sb), 0);                                     \
+                continue;                                                                \
+            }                                                                            \
+            if (la) (a).active = !kd_leaf(sc, (a).ray, &(pa), (a).any, na, &(wa), &(sa), &(a).best); \
+            else kd_step(&(pa), na, &(wa), &(sa), 0);                                    \
+            if (lb) (b).active = !kd_leaf(sc, (b).ray, &(pb), (b).any, nb, &(wb), &(sb), &(b).best); \
+            else kd_step(&(pb), nb, &(wb), &(sb), 0);                                    \
+        }                                                                                \
+        trace_ray_finish(sc, &(a), &(pa), &(wa), &(sa));                                 \
+        trace_ray_finish(sc, &(b), &(pb), &(wb), &(sb));                                 \
+    } while (0)
 
 /* trace_closest of two rays. */
 KFN void trace_closest2(const SceneView *sc, Ray ra, Ray rb, Hit *ha, Hit *hb)
 {
     TraceRay a, b;
+    RayPre pa, pb;
     KdWalk wa, wb;
-    trace_ray_begin(sc, ra, 0, &a, &wa);
-    trace_ray_begin(sc, rb, 0, &b, &wb);
-    trace_pair(sc, &a, &wa, &b, &wb);
+    KdStack sa, sb;
+    trace_ray_begin(sc, ra, 0, &a, &pa, &wa);
+    trace_ray_begin(sc, rb, 0, &b, &pb, &wb);
+    TRACE_PAIR(sc, a, pa, wa, sa, b, pb, wb, sb);
     *ha = a.best;
     *hb = b.best;
 }
@@ -330,10 +335,12 @@ KFN void trace_closest2(const SceneView *sc, Ray ra, Ray rb, Hit *ha, Hit *hb)
 KFN void trace_any2(const SceneView *sc, Ray ra, Ray rb, int *oa, int *ob)
 {
     TraceRay a, b;
+    RayPre pa, pb;
     KdWalk wa, wb;
-    trace_ray_begin(sc, ra, 1, &a, &wa);
-    trace_ray_begin(sc, rb, 1, &b, &wb);
-    trace_pair(sc, &a, &wa, &b, &wb);
+    KdStack sa, sb;
+    trace_ray_begin(sc, ra, 1, &a, &pa, &wa);
+    trace_ray_begin(sc, rb, 1, &b, &pb, &wb);
+    TRACE_PAIR(sc, a, pa, wa, sa, b, pb, wb, sb);
     *oa = a.best.prim != NO_INDEX;
     *ob = b.best.prim != NO_INDEX;
 }

@@ -881,7 +881,11 @@ static void *sort_job(void *arg)
 
 /* ------------------------------------------------------------------ flatten */
 
-typedef struct { const BNode *node; uint parent; int depth; Aabb box; } FlatItem;
+/* scale: the product of the empty-space bonus over the node's ancestors that have an
+ * empty child (the factor the builder's cost applies to this node's terms). */
+typedef struct { const BNode *node; uint parent; int depth; Aabb box; double scale; } FlatItem;
+
+static int leaf_is_empty(const BNode *n) { return n->axis == KD_LEAF && n->count == 0; }
 
 /* A leaf's sorted global ids. */
 static const uint *leaf_ids(const BNode *n) { return n->count == 1 ? &n->id : n->ids; }
@@ -968,7 +972,7 @@ static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in
     uint idx = 0, words = 0;
     FlatItem items[KD_MAX_DEPTH + 2];
     int ip = 0;
-    items[ip++] = (FlatItem){ root, NO_INDEX, 0, *root_box };
+    items[ip++] = (FlatItem){ root, NO_INDEX, 0, *root_box, 1.0 };
     while (ip) {
         FlatItem it = items[--ip];
         const BNode *n = it.node;
@@ -981,6 +985,7 @@ static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in
             if (n->count == 0) st->n_empty_leaves++;
             refs += n->count;
             st->sah_cost += kd_leaf_cost(n->count) * rel;
+            st->sah_cost_bonus += kd_leaf_cost(n->count) * rel * it.scale;
             uint first, nt;
             leaf_split_ids(n, in, &first, &nt);
             uint ng = (nt + KD_GROUP - 1) / KD_GROUP;
@@ -991,13 +996,15 @@ static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in
             words += (uint)leaf_words(n, in);
             continue;
         }
+        double scale = it.scale * (leaf_is_empty(n->child[0]) || leaf_is_empty(n->child[1]) ? KD_EMPTY_BONUS : 1.0);
         st->sah_cost += KD_COST_TRAVERSAL * rel;
+        st->sah_cost_bonus += KD_COST_TRAVERSAL * rel * scale;
         uint split_bits;
         memcpy(&split_bits, &n->split, sizeof split_bits);
         t->nodes[me].data = split_bits;
         t->nodes[me].bits = n->axis;    /* the above child's index is added when reached */
-        FlatItem above = { n->child[1], me, it.depth + 1, it.box };
-        FlatItem below = { n->child[0], NO_INDEX, it.depth + 1, it.box };
+        FlatItem above = { n->child[1], me, it.depth + 1, it.box, scale };
+        FlatItem below = { n->child[0], NO_INDEX, it.depth + 1, it.box, scale };
         above.box.lo[n->axis] = n->split;
         below.box.hi[n->axis] = n->split;
         items[ip++] = above;

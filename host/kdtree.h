@@ -21,7 +21,7 @@
 #define KD_COST_TRAVERSAL 1.0
 #endif
 #ifndef KD_COST_INTERSECT
-#define KD_COST_INTERSECT 0.1
+#define KD_COST_INTERSECT 0.075
 #endif
 
 #ifndef KD_GROUPED_COST
@@ -48,6 +48,7 @@ typedef struct {
     uint max_depth;                /* deepest leaf, root = 0 */
     double mean_prims_per_leaf;    /* over non-empty leaves */
     double sah_cost;               /* expected cost of a random ray through the root box */
+    double sah_cost_bonus;         /* the same with the empty-space bonus: what the build minimises */
     double leaf_sah_cost;          /* the same for a single leaf holding every primitive */
     size_t bytes;                  /* nodes + leaf data (ids and the triangles' corners) */
     size_t bytes_corners;          /* of which the copies of the triangles' corners */

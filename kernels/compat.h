@@ -40,7 +40,8 @@
 
 typedef long kint64;         /* 64-bit in every OpenCL C implementation */
 
-#define k_load4(p) vload4(0, p)
+#define k_load4(v, p) ((v) = vload4(0, p))
+#define k_load8(v, p) ((v) = vload8(0, p))
 
 #else
 /* ---------------------------------------------------------------- C11 */
@@ -69,10 +70,14 @@ static inline float k_int_as_float(int i) { float f; memcpy(&f, &i, sizeof f); r
 /* OpenCL's 4-wide vectors as GCC vector extensions, which compute each lane with the
  * same IEEE operation as OpenCL does. Kernel code uses only operators (with vector or
  * scalar operands), comparisons (-1 or 0 per lane, as OpenCL's), lane subscripts and
- * k_load4 on them. */
+ * k_load4/k_load8 (v = the vector at p) on them. Vectors are
+ * never passed or returned by value (8 lanes without AVX would change the ABI). */
 typedef float float4 __attribute__((vector_size(16)));
 typedef int int4 __attribute__((vector_size(16)));
-static inline float4 k_load4(const float *p) { float4 v; memcpy(&v, p, sizeof v); return v; }
+typedef float float8 __attribute__((vector_size(32)));
+typedef int int8 __attribute__((vector_size(32)));
+#define k_load4(v, p) memcpy(&(v), (p), sizeof(float4))
+#define k_load8(v, p) memcpy(&(v), (p), sizeof(float8))
 
 #endif
 

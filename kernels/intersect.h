@@ -142,48 +142,71 @@ KFN int triangle_intersect(const RayPre *rp, GLOBAL const Triangle *tri, Ray ray
     return 1;
 }
 
-/* triangle_intersect on the KD_GROUP (4) triangles of a kd-tree leaf group at once:
- * `rows` are the group's corners, 9 rows of 4 floats (types.h). Each lane computes the
+/* The vector type of a leaf group's lanes (KD_GROUP of them, types.h). */
+#if KD_GROUP == 8
+typedef float8 floatg;
+typedef int8 intg;
+#define k_loadg(v, p) k_load8(v, p)
+#define K_ANY_LANE(m) (((m)[0] | (m)[1] | (m)[2] | (m)[3] | (m)[4] | (m)[5] | (m)[6] | (m)[7]) != 0)
+#define K_LANE_BITS(m)                                                                   \
+    ((uint)((m)[0] & 1) | (uint)((m)[1] & 2) | (uint)((m)[2] & 4) | (uint)((m)[3] & 8) |    \
+     (uint)((m)[4] & 16) | (uint)((m)[5] & 32) | (uint)((m)[6] & 64) | (uint)((m)[7] & 128))
+#else
+typedef float4 floatg;
+typedef int4 intg;
+#define k_loadg(v, p) k_load4(v, p)
+#define K_ANY_LANE(m) (((m)[0] | (m)[1] | (m)[2] | (m)[3]) != 0)
+#define K_LANE_BITS(m) ((uint)((m)[0] & 1) | (uint)((m)[1] & 2) | (uint)((m)[2] & 4) | (uint)((m)[3] & 8))
+#endif
+
+/* triangle_intersect on the KD_GROUP triangles of a kd-tree leaf group at once: `rows`
+ * are the group's corners, 9 rows of KD_GROUP floats (types.h). Each lane computes the
  * very operations of triangle_intersect, so a lane's t, u and v are bit for bit what
  * triangle_intersect gives for that triangle, with tmax fixed for the group. Returns
  * the lanes hit as bits (lane i: 1 << i) and their t, u and v. */
-KFN_INLINE uint triangle_intersect4(const RayPre *rp, GLOBAL const float *rows, float tmin, float tmax,
-                                    float4 *t_out, float4 *u_out, float4 *v_out)
+KFN_INLINE uint triangle_intersect_group(const RayPre *rp, GLOBAL const float *rows, float tmin, float tmax,
+                                         floatg *t_out, floatg *u_out, floatg *v_out)
 {
+    const int w = (int)KD_GROUP;
     int kx = rp->kx, ky = rp->ky, kz = rp->kz;
     float ox = rp->org[kx], oy = rp->org[ky], oz = rp->org[kz];
     float sx = rp->sx, sy = rp->sy, sz = rp->sz;
-    float4 az = k_load4(rows + 4 * kz) - oz;
-    float4 bz = k_load4(rows + 4 * (3 + kz)) - oz;
-    float4 cz = k_load4(rows + 4 * (6 + kz)) - oz;
-    float4 ax = (k_load4(rows + 4 * kx) - ox) - sx * az;
-    float4 ay = (k_load4(rows + 4 * ky) - oy) - sy * az;
-    float4 bx = (k_load4(rows + 4 * (3 + kx)) - ox) - sx * bz;
-    float4 by = (k_load4(rows + 4 * (3 + ky)) - oy) - sy * bz;
-    float4 cx = (k_load4(rows + 4 * (6 + kx)) - ox) - sx * cz;
-    float4 cy = (k_load4(rows + 4 * (6 + ky)) - oy) - sy * cz;
-    float4 U = cx * by - cy * bx;
-    float4 V = ax * cy - ay * cx;
-    float4 W = bx * ay - by * ax;
-    int4 zero = (U == 0.0f) | (V == 0.0f) | (W == 0.0f);
-    if ((zero[0] | zero[1] | zero[2] | zero[3]) != 0) {
-        for (int i = 0; i < 4; i++) {
+    floatg p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z;
+    k_loadg(p0x, rows + w * kx);
+    k_loadg(p0y, rows + w * ky);
+    k_loadg(p0z, rows + w * kz);
+    k_loadg(p1x, rows + w * (3 + kx));
+    k_loadg(p1y, rows + w * (3 + ky));
+    k_loadg(p1z, rows + w * (3 + kz));
+    k_loadg(p2x, rows + w * (6 + kx));
+    k_loadg(p2y, rows + w * (6 + ky));
+    k_loadg(p2z, rows + w * (6 + kz));
+    floatg az = p0z - oz, bz = p1z - oz, cz = p2z - oz;
+    floatg ax = (p0x - ox) - sx * az, ay = (p0y - oy) - sy * az;
+    floatg bx = (p1x - ox) - sx * bz, by = (p1y - oy) - sy * bz;
+    floatg cx = (p2x - ox) - sx * cz, cy = (p2y - oy) - sy * cz;
+    floatg U = cx * by - cy * bx;
+    floatg V = ax * cy - ay * cx;
+    floatg W = bx * ay - by * ax;
+    intg zero = (U == 0.0f) | (V == 0.0f) | (W == 0.0f);
+    if (K_ANY_LANE(zero)) {
+        for (int i = 0; i < w; i++) {
             if (U[i] == 0.0f) U[i] = k_edge_exact(cx[i], by[i], cy[i], bx[i]);
             if (V[i] == 0.0f) V[i] = k_edge_exact(ax[i], cy[i], ay[i], cx[i]);
             if (W[i] == 0.0f) W[i] = k_edge_exact(bx[i], ay[i], by[i], ax[i]);
         }
     }
-    int4 neg = (U < 0.0f) | (V < 0.0f) | (W < 0.0f);
-    int4 pos = (U > 0.0f) | (V > 0.0f) | (W > 0.0f);
-    float4 det = U + V + W;
-    float4 T = U * (sz * az) + V * (sz * bz) + W * (sz * cz);
-    float4 inv_det = 1.0f / det;
-    float4 t = T * inv_det;
-    int4 ok = ~(neg & pos) & (det != 0.0f) & (t > tmin) & (t < tmax);
+    intg neg = (U < 0.0f) | (V < 0.0f) | (W < 0.0f);
+    intg pos = (U > 0.0f) | (V > 0.0f) | (W > 0.0f);
+    floatg det = U + V + W;
+    floatg T = U * (sz * az) + V * (sz * bz) + W * (sz * cz);
+    floatg inv_det = 1.0f / det;
+    floatg t = T * inv_det;
+    intg ok = ~(neg & pos) & (det != 0.0f) & (t > tmin) & (t < tmax);
     *t_out = t;
     *u_out = V * inv_det;
     *v_out = W * inv_det;
-    return (uint)(ok[0] & 1) | (uint)(ok[1] & 2) | (uint)(ok[2] & 4) | (uint)(ok[3] & 8);
+    return K_LANE_BITS(ok);
 }
 
 #ifndef __OPENCL_VERSION__

@@ -42,6 +42,8 @@ typedef long kint64;         /* 64-bit in every OpenCL C implementation */
 
 #define k_load4(v, p) ((v) = vload4(0, p))
 #define k_load8(v, p) ((v) = vload8(0, p))
+#define k_store4(v, p) vstore4(v, 0, p)
+#define k_store8(v, p) vstore8(v, 0, p)
 
 #else
 /* ---------------------------------------------------------------- C11 */
@@ -70,7 +72,7 @@ static inline float k_int_as_float(int i) { float f; memcpy(&f, &i, sizeof f); r
 /* OpenCL's 4-wide vectors as GCC vector extensions, which compute each lane with the
  * same IEEE operation as OpenCL does. Kernel code uses only operators (with vector or
  * scalar operands), comparisons (-1 or 0 per lane, as OpenCL's), lane subscripts and
- * k_load4/k_load8 (v = the vector at p) on them. Vectors are
+ * k_load4/k_load8 (v = the vector at p) and k_store4/k_store8 on them. Vectors are
  * never passed or returned by value (8 lanes without AVX would change the ABI). */
 typedef float float4 __attribute__((vector_size(16)));
 typedef int int4 __attribute__((vector_size(16)));
@@ -78,6 +80,8 @@ typedef float float8 __attribute__((vector_size(32)));
 typedef int int8 __attribute__((vector_size(32)));
 #define k_load4(v, p) memcpy(&(v), (p), sizeof(float4))
 #define k_load8(v, p) memcpy(&(v), (p), sizeof(float8))
+#define k_store4(v, p) memcpy((p), &(v), sizeof(float4))
+#define k_store8(v, p) memcpy((p), &(v), sizeof(float8))
 
 #endif
 

@@ -137,20 +137,10 @@ KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, 
     GLOBAL const uint *g = sc->leaf_prims + n.data;
     uint groups = n.bits >> 3;
     for (uint i = 0; i < groups; i++, g += KD_GROUP_WORDS) {
-        floatg t, u, v;
-        uint hit = triangle_intersect_group(rp, (GLOBAL const float *)(g + KD_GROUP), ray.tmin, best->t, &t, &u, &v);
-        if (hit) {
-            int lane = 0;
-            float bt = best->t;
-            for (int l = 0; l < (int)KD_GROUP; l++)
-                if (((hit >> l) & 1u) && t[l] < bt) {
-                    bt = t[l];
-                    lane = l;
-                }
-            best->t = bt;
-            best->u = u[lane];
-            best->v = v[lane];
-            best->prim = g[lane];
+        Hit h;
+        if (triangle_intersect_group(rp, (GLOBAL const float *)(g + KD_GROUP), ray.tmin, best->t, &h)) {
+            h.prim = g[h.prim];
+            *best = h;
             if (any) return 1;
         }
     }

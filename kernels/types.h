@@ -57,7 +57,7 @@ typedef struct {
 
 #define KD_LEAF 3u
 #define KD_LEAF_OTHERS 4u
-#define KD_GROUP 8u      /* 4 works too (intersect.h); 8 measured faster on PoCL */
+#define KD_GROUP 8u
 #define KD_GROUP_WORDS (KD_GROUP * 10u)
 
 /* Global primitive ids: [0, n_spheres) spheres, then triangles, then boxes, then

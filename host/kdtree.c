@@ -958,7 +958,7 @@ static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in
             stack[sp++] = n->child[0];
         }
     }
-    if (n_nodes > KD_MAX_PRIMS || n_words > UINT32_MAX - 1)
+    if (n_nodes > (UINT32_MAX >> 4) || n_words > UINT32_MAX - 1)
         return error_set(err, ST_INTERNAL, "kd-tree: %zu nodes and %zu words of leaf data do not fit the node layout",
                          n_nodes, n_words);
     t->nodes = malloc(n_nodes * sizeof *t->nodes);
@@ -977,7 +977,7 @@ static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in
         FlatItem it = items[--ip];
         const BNode *n = it.node;
         uint me = idx++;
-        if (it.parent != NO_INDEX) t->nodes[it.parent].bits |= me << 2;
+        if (it.parent != NO_INDEX) t->nodes[it.parent].bits |= me << 4;
         if ((uint)it.depth > st->max_depth) st->max_depth = (uint)it.depth;
         double rel = inv_root > 0.0 ? box_half_area(&it.box) * inv_root : 1.0;
         if (n->axis == KD_LEAF) {
@@ -1002,7 +1002,9 @@ static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in
         uint split_bits;
         memcpy(&split_bits, &n->split, sizeof split_bits);
         t->nodes[me].data = split_bits;
-        t->nodes[me].bits = n->axis;    /* the above child's index is added when reached */
+        /* the above child's index is added when reached */
+        t->nodes[me].bits = n->axis | (leaf_is_empty(n->child[0]) ? KD_EMPTY_BELOW : 0u) |
+                            (leaf_is_empty(n->child[1]) ? KD_EMPTY_ABOVE : 0u);
         FlatItem above = { n->child[1], me, it.depth + 1, it.box, scale };
         FlatItem below = { n->child[0], NO_INDEX, it.depth + 1, it.box, scale };
         above.box.lo[n->axis] = n->split;

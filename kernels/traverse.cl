@@ -104,8 +104,9 @@ KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, KdStack *st, int 
 {
     uint axis = n.bits & 3u;
     float tp = (k_as_float(n.data) - rp->org[axis]) * rp->inv_d[axis];
-    uint below = w->node + 1u, above = n.bits >> 2;
-    uint near = k_select_u(below, above, (rp->neg >> axis) & 1u);
+    uint below = w->node + 1u, above = n.bits >> 4;
+    uint near_above = (rp->neg >> axis) & 1u;
+    uint near = k_select_u(below, above, near_above);
     uint far = near ^ below ^ above;
     float t0 = w->t0, t1 = w->t1;
     uint far_only = (uint)(tp < t0 * KD_T_BELOW);
@@ -114,11 +115,12 @@ KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, KdStack *st, int 
         return;
     }
     uint both = (uint)!(tp > t1 * KD_T_ABOVE) & (far_only ^ 1u);
+    uint far_empty = (n.bits >> (3u - near_above)) & 1u;
     int sp = w->sp;
     st->node[sp] = far;
     st->t0[sp] = tp > t0 ? tp : t0;
     st->t1[sp] = t1;
-    w->sp = sp + (int)both;
+    w->sp = sp + (int)(both & (far_empty ^ 1u));
     /* Beyond the interval min(tp, t1) is t1: only "both" shortens it. */
     w->t1 = k_select_f(tp < t1 ? tp : t1, t1, far_only);
     w->node = k_select_u(near, far, far_only);

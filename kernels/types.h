@@ -41,8 +41,9 @@ typedef struct {                                        /* 16 bytes */
 } Hit;
 
 /* kd-tree node, 8 bytes (layout in docs/kdtree.md).
- * Interior: bits = axis (0,1,2) in the low 2 bits | index of the "above" child << 2;
- *           the "below" child is the next node; split = the plane position (float bits).
+ * Interior: bits = axis (0,1,2) in the low 2 bits | KD_EMPTY_BELOW, KD_EMPTY_ABOVE when
+ *           that child is an empty leaf | index of the "above" child << 4; the "below"
+ *           child is the next node; data = the plane position (float bits).
  * Leaf:     bits = 3 | KD_LEAF_OTHERS if it holds spheres or boxes | triangle groups << 3;
  *           data = the offset of its record in the leaf data array (the leaf_prims
  *           buffer, 32-bit words): that many triangle groups of KD_GROUP_WORDS words
@@ -56,6 +57,8 @@ typedef struct {
 } KdNode;
 
 #define KD_LEAF 3u
+#define KD_EMPTY_BELOW 4u
+#define KD_EMPTY_ABOVE 8u
 #define KD_LEAF_OTHERS 4u
 #define KD_GROUP 8u
 #define KD_GROUP_WORDS (KD_GROUP * 10u)

@@ -520,7 +520,10 @@ static void check_tree(void)
         uint axis = n.bits & 3u;
         if (axis != KD_LEAF) {
             float split = k_as_float(n.data);
-            uint above = n.bits >> 2;
+            uint above = n.bits >> 4;
+            /* the empty-child marks say exactly which children are empty leaves */
+            CHECK_EQ_INT((n.bits & KD_EMPTY_BELOW) != 0, t->nodes[ni + 1].bits == KD_LEAF);
+            if (above < t->n_nodes) CHECK_EQ_INT((n.bits & KD_EMPTY_ABOVE) != 0, t->nodes[above].bits == KD_LEAF);
             /* children nest: the split is strictly inside the parent's extent */
             if (!(split > box.lo[axis] && split < box.hi[axis])) bad_nesting++;
             CHECK(above > ni + 1 && above < t->n_nodes);

@@ -681,9 +681,12 @@ static long embree_compare(const RaySet *s, const Hit *eh, const uint *eo)
 
 /* ------------------------------------------------------------------ one mesh */
 
+/* PoCL kernels: one ray per work-item (as the renderer's k_intersect/k_shadow), two */
+#define N_KERNELS 2
+
 typedef struct {
-    double pocl[MAX_THREADS], c[MAX_THREADS], e1[MAX_THREADS], e8[MAX_THREADS];   /* Mrays/s */
-    double cpu_pocl[MAX_THREADS], cpu_c[MAX_THREADS], cpu_e1[MAX_THREADS], cpu_e8[MAX_THREADS];
+    double pocl[N_KERNELS][MAX_THREADS], c[MAX_THREADS], e1[MAX_THREADS], e8[MAX_THREADS];   /* Mrays/s */
+    double cpu_pocl[N_KERNELS][MAX_THREADS], cpu_c[MAX_THREADS], cpu_e1[MAX_THREADS], cpu_e8[MAX_THREADS];
                                  /* Mrays per CPU-second */
     long pocl_diff, embree_diff;
     uint hits;
@@ -722,9 +725,11 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
     const char *base = strrchr(name, '/') ? strrchr(name, '/') + 1 : name;
     printf("\n### %s: %zu triangles (loaded in %.3f s)\n\n", base, nt, m.load_seconds);
     printf("kd-tree: build %.3f s (%d threads) / %.3f s (1 thread); %u nodes, %u leaves, depth %u, "
-           "SAH cost %.2f (one leaf %.0f), %.1f bytes/triangle (nodes + leaf lists)\n",
+           "SAH cost %.2f (with the empty-space bonus %.2f; one leaf %.0f), %.1f bytes/triangle: nodes and ids "
+           "%.1f, triangle corners in the leaves %.1f\n",
            ks->build_seconds, o->threads[MAX_THREADS - 1], m.kd_build_1, ks->n_nodes, ks->n_leaves,
-           ks->max_depth, ks->sah_cost, ks->leaf_sah_cost, (double)ks->bytes / (double)(nt ? nt : 1));
+           ks->max_depth, ks->sah_cost, ks->sah_cost_bonus, ks->leaf_sah_cost, (double)ks->bytes / (double)(nt ? nt : 1),
+           (double)(ks->bytes - ks->bytes_corners) / (double)(nt ? nt : 1), (double)ks->bytes_corners / (double)(nt ? nt : 1));
     if (have_embree) {
         char ratio[96] = "";
         /* a ratio of times below a millisecond says nothing */
@@ -775,14 +780,14 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
             int th = o->threads[t];
             /* the variants take turns within each repetition, so that a change in the
              * machine's load affects them alike */
-            double sc[MAX_REPS], cc[MAX_REPS], sp[MAX_REPS], cp[MAX_REPS], s1[MAX_REPS], c1[MAX_REPS],
-                s8[MAX_REPS], c8[MAX_REPS];
+            double sc[MAX_REPS], cc[MAX_REPS], sp[N_KERNELS][MAX_REPS], cp[N_KERNELS][MAX_REPS], s1[MAX_REPS],
+                c1[MAX_REPS], s8[MAX_REPS], c8[MAX_REPS];
             for (int i = 0; i < o->reps; i++) {
                 sc[i] = trace_c(&m.view, s, th, 1, tmp_h, tmp_o);
                 cc[i] = last_cpu_seconds;
-                if (pocl_ok[t]) {
-                    sp[i] = pocl_trace(&pocl[t], s, 1);
-                    cp[i] = last_cpu_seconds;
+                for (int kp = 0; kp < N_KERNELS && pocl_ok[t]; kp++) {
+                    sp[kp][i] = pocl_trace(&pocl[t], s, kp);
+                    cp[kp][i] = last_cpu_seconds;
                 }
                 if (have_embree) {
                     s1[i] = embree_trace(emb[t].scene, s, 0, th, NULL, NULL);
@@ -793,9 +798,9 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
             }
             r->c[t] = rate(s->n, sc, o->reps);
             r->cpu_c[t] = rate(s->n, cc, o->reps);
-            if (pocl_ok[t]) {
-                r->pocl[t] = rate(s->n, sp, o->reps);
-                r->cpu_pocl[t] = rate(s->n, cp, o->reps);
+            for (int kp = 0; kp < N_KERNELS && pocl_ok[t]; kp++) {
+                r->pocl[kp][t] = rate(s->n, sp[kp], o->reps);
+                r->cpu_pocl[kp][t] = rate(s->n, cp[kp], o->reps);
             }
             if (have_embree) {
                 r->e1[t] = rate(s->n, s1, o->reps);
@@ -809,9 +814,9 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
     free(eo);
 
     int a = o->threads[0], b = o->threads[MAX_THREADS - 1];
-    printf("\n| rays | query | count | hits | PoCL %dt | PoCL %dt | C %dt | C %dt | Embree-1 %dt | Embree-1 %dt | "
-           "Embree-8 %dt | Embree-8 %dt | PoCL/Embree-1 %dt | C/Embree-1 %dt | vs Embree | PoCL vs C |\n",
-           a, b, a, b, a, b, a, b, b, a);
+    printf("\n| rays | query | count | hits | PoCL-1 %dt | PoCL-1 %dt | PoCL-2 %dt | PoCL-2 %dt | C %dt | C %dt | "
+           "Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | vs Embree | PoCL vs C |\n",
+           a, b, a, b, a, b, a, b, a, b);
     printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int k = 0; k < N_SETS; k++) {
         const SetResult *r = &res[k];
@@ -821,23 +826,25 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
         if (r->embree_diff < 0) snprintf(ed, sizeof ed, "-");
         else snprintf(ed, sizeof ed, "%ld disagree", r->embree_diff);
         printf("| %s | %s | %u | %u | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %s |\n",
-               sets[k].name, sets[k].any ? "any" : "closest", sets[k].n, r->hits, r->pocl[0], r->pocl[1], r->c[0],
-               r->c[1], r->e1[0], r->e1[1], r->e8[0], r->e8[1], r->e1[1] > 0.0 ? r->pocl[1] / r->e1[1] : 0.0,
-               r->e1[0] > 0.0 ? r->c[0] / r->e1[0] : 0.0, ed, pd);
+               sets[k].name, sets[k].any ? "any" : "closest", sets[k].n, r->hits, r->pocl[0][0], r->pocl[0][1],
+               r->pocl[1][0], r->pocl[1][1], r->c[0], r->c[1], r->e1[0], r->e1[1], r->e8[0], r->e8[1], ed, pd);
     }
     printf("\nThe same runs in Mrays per CPU-second (the CPU time of the whole process: the work per core, "
            "which other jobs taking the cores do not change; with ideal scaling the %d-thread columns equal "
-           "the 1-thread ones):\n\n", b);
-    printf("| rays | PoCL %dt | PoCL %dt | C %dt | C %dt | Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | "
-           "PoCL/Embree-1 %dt | PoCL/Embree-1 %dt |\n", a, b, a, b, a, b, a, b, a, b);
-    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+           "the 1-thread ones), and PoCL over Embree single rays:\n\n", b);
+    printf("| rays | PoCL-1 %dt | PoCL-1 %dt | PoCL-2 %dt | PoCL-2 %dt | C %dt | C %dt | Embree-1 %dt | Embree-1 %dt | "
+           "Embree-8 %dt | Embree-8 %dt | PoCL-1/Embree-1 %dt | PoCL-1/Embree-1 %dt | PoCL-2/Embree-1 %dt | "
+           "PoCL-2/Embree-1 %dt |\n", a, b, a, b, a, b, a, b, a, b, a, b, a, b);
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int k = 0; k < N_SETS; k++) {
         const SetResult *r = &res[k];
-        printf("| %s %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n", sets[k].name,
-               sets[k].any ? "any" : "closest",
-               r->cpu_pocl[0], r->cpu_pocl[1], r->cpu_c[0], r->cpu_c[1], r->cpu_e1[0], r->cpu_e1[1], r->cpu_e8[0],
-               r->cpu_e8[1], r->cpu_e1[0] > 0.0 ? r->cpu_pocl[0] / r->cpu_e1[0] : 0.0,
-               r->cpu_e1[1] > 0.0 ? r->cpu_pocl[1] / r->cpu_e1[1] : 0.0);
+        double q[N_KERNELS][MAX_THREADS];
+        for (int kp = 0; kp < N_KERNELS; kp++)
+            for (int t = 0; t < MAX_THREADS; t++) q[kp][t] = r->cpu_e1[t] > 0.0 ? r->cpu_pocl[kp][t] / r->cpu_e1[t] : 0.0;
+        printf("| %s %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n",
+               sets[k].name, sets[k].any ? "any" : "closest", r->cpu_pocl[0][0], r->cpu_pocl[0][1], r->cpu_pocl[1][0],
+               r->cpu_pocl[1][1], r->cpu_c[0], r->cpu_c[1], r->cpu_e1[0], r->cpu_e1[1], r->cpu_e8[0], r->cpu_e8[1],
+               q[0][0], q[0][1], q[1][0], q[1][1]);
     }
     fflush(stdout);
     for (int t = 0; t < MAX_THREADS; t++) embree_free(&emb[t]);

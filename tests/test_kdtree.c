@@ -349,6 +349,82 @@ static void test_watertight(void)
     fprintf(stderr, "  watertight: %d rays through edges and vertices, %d misses\n", rays, misses);
 }
 
+/* The leaf group test (8 triangles at once) gives every lane bit for bit what the
+ * one-triangle test gives, and reports the nearest lane, the first of equals. The groups
+ * mix ordinary triangles, triangles sharing edges (rays through the edges give exact
+ * zeros, re-evaluated exactly), repeats (as the unused lanes of a group hold) and
+ * degenerate ones. */
+static void test_group_intersect(void)
+{
+    rng_seed(12);
+    int checked = 0, hits = 0, bad = 0;
+    for (int k = 0; k < 3000; k++) {
+        Triangle tri[KD_GROUP];
+        vec3 a = vrand(-2.0f, 2.0f), b = vrand(-2.0f, 2.0f), c = vrand(-2.0f, 2.0f);
+        for (uint l = 0; l < KD_GROUP; l++) {
+            vec3 p0 = vrand(-2.0f, 2.0f), p1 = vrand(-2.0f, 2.0f), p2 = vrand(-2.0f, 2.0f);
+            if (l == 1) { p0 = a; p1 = b; p2 = c; }                  /* a fan around edge a-b */
+            if (l == 2) { p0 = b; p1 = a; p2 = vrand(-2.0f, 2.0f); }
+            if (l == 3) { p0 = a; p1 = a; p2 = c; }                  /* degenerate */
+            if (l == 7 && k % 2) { p0 = tri[6].p0; p1 = tri[6].p1; p2 = tri[6].p2; }   /* a repeat */
+            Triangle t = { p0, 0, p1, NO_INDEX, p2, NO_INDEX };
+            tri[l] = t;
+        }
+        float rows[9 * KD_GROUP];
+        for (uint l = 0; l < KD_GROUP; l++) {
+            const float f[9] = { tri[l].p0.x, tri[l].p0.y, tri[l].p0.z, tri[l].p1.x, tri[l].p1.y,
+                                 tri[l].p1.z, tri[l].p2.x, tri[l].p2.y, tri[l].p2.z };
+            for (uint r = 0; r < 9; r++) rows[r * KD_GROUP + l] = f[r];
+        }
+        if (k % 4 == 3) {
+            /* small integer corners and rays along an axis through integer points: edge
+             * functions exactly 0, which the exact re-evaluation decides */
+            for (uint l = 0; l < KD_GROUP; l++) {
+                vec3 *p[3] = { &tri[l].p0, &tri[l].p1, &tri[l].p2 };
+                for (int q = 0; q < 3; q++)
+                    *p[q] = v3(floorf(frange(0.0f, 3.0f)), floorf(frange(0.0f, 3.0f)), floorf(frange(0.0f, 3.0f)));
+            }
+            for (uint l = 0; l < KD_GROUP; l++) {
+                const float f[9] = { tri[l].p0.x, tri[l].p0.y, tri[l].p0.z, tri[l].p1.x, tri[l].p1.y,
+                                     tri[l].p1.z, tri[l].p2.x, tri[l].p2.y, tri[l].p2.z };
+                for (uint r = 0; r < 9; r++) rows[r * KD_GROUP + l] = f[r];
+            }
+            a = v3(floorf(frange(0.0f, 3.0f)), floorf(frange(0.0f, 3.0f)), -1.0f);
+        }
+        /* aim at the shared edge, a vertex or anywhere */
+        float s = frand();
+        vec3 target = k % 3 == 0 ? v3_add(a, v3_scale(v3_sub(b, a), s)) : k % 3 == 1 ? a : vrand(-2.0f, 2.0f);
+        vec3 o = v3_add(target, v3_scale(vrand(-1.0f, 1.0f), 4.0f));
+        if (k % 4 == 3) {
+            target = v3(a.x, a.y, 5.0f);
+            o = a;
+        }
+        float tmax = k % 5 == 0 ? frange(0.2f, 1.2f) : K_INF;
+        Ray r = make_ray(o, v3_sub(target, o), k % 7 == 0 ? 0.5f : 0.0f, tmax);
+        RayPre rp = ray_prepare(r);
+        Hit g;
+        uint mask = triangle_intersect_group(&rp, rows, r.tmin, r.tmax, &g);
+        Hit best = { r.tmax, NO_INDEX, 0.0f, 0.0f };
+        for (uint l = 0; l < KD_GROUP; l++) {
+            Hit h;
+            int one = triangle_intersect(&rp, &tri[l], r, &h);
+            bad += one != (int)((mask >> l) & 1u);
+            if (one && h.t < best.t) {
+                best = h;
+                best.prim = l;
+            }
+            checked++;
+        }
+        if (best.prim != NO_INDEX) {
+            hits++;
+            bad += mask == 0 || g.prim != best.prim || memcmp(&g.t, &best.t, sizeof g.t) != 0 ||
+                   memcmp(&g.u, &best.u, sizeof g.u) != 0 || memcmp(&g.v, &best.v, sizeof g.v) != 0;
+        }
+    }
+    CHECK_EQ_INT(bad, 0);
+    fprintf(stderr, "  %d lanes, %d groups hit, %d differ from the one-triangle test\n", checked, hits, bad);
+}
+
 static void test_box(void)
 {
     Box b = { v3(-1.0f, -1.0f, -1.0f), 0, v3(1.0f, 1.0f, 1.0f), NO_INDEX };
@@ -989,6 +1065,7 @@ int main(void)
     RUN(test_sphere);
     RUN(test_triangle);
     RUN(test_watertight);
+    RUN(test_group_intersect);
     RUN(test_box);
     RUN(test_plane);
     RUN(test_structure);

@@ -361,7 +361,7 @@ static int pocl_open(Pocl *pc, const OclDeviceInfo *dev, cl_device_id sub)
     pc->q = clCreateCommandQueue(pc->ctx, pc->info.id, 0, &rc);
     if (rc != CL_SUCCESS) return pocl_fail("clCreateCommandQueue", rc);
     Error err = { 0 };
-    if (ocl_program_build(pc->ctx, &pc->info, NULL, NULL, &pc->prog, NULL, &err) ||
+    if (ocl_program_build(pc->ctx, &pc->info, NULL, "-D CLPT_BENCH_KERNELS", &pc->prog, NULL, &err) ||
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest", &pc->kc, &err) ||
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_any", &pc->ka, &err) ||
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest1", &pc->kc1, &err) ||

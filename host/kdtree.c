@@ -962,7 +962,10 @@ static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in
         return error_set(err, ST_INTERNAL, "kd-tree: %zu nodes and %zu words of leaf data do not fit the node layout",
                          n_nodes, n_words);
     t->nodes = malloc(n_nodes * sizeof *t->nodes);
-    t->leaf_prims = malloc((n_words + 1) * sizeof *t->leaf_prims);
+    /* Cache-line aligned, so that no row of a group's corners straddles two lines (the
+     * groups are 320 bytes long; OpenCL buffers are aligned at least as well). */
+    size_t leaf_bytes = ((n_words + 1) * sizeof *t->leaf_prims + 63) / 64 * 64;
+    t->leaf_prims = aligned_alloc(64, leaf_bytes);
     if (!t->nodes || !t->leaf_prims)
         return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu nodes", n_nodes);
 

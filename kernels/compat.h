@@ -71,17 +71,14 @@ static inline float k_int_as_float(int i) { float f; memcpy(&f, &i, sizeof f); r
 
 /* OpenCL's 4-wide vectors as GCC vector extensions, which compute each lane with the
  * same IEEE operation as OpenCL does. Kernel code uses only operators (with vector or
- * scalar operands), comparisons (-1 or 0 per lane, as OpenCL's), lane subscripts and
- * k_load4/k_load8 (v = the vector at p) and k_store4/k_store8 on them. Vectors are
- * never passed or returned by value (8 lanes without AVX would change the ABI). */
+ * scalar operands), comparisons (-1 or 0 per lane, as OpenCL's), lane subscripts,
+ * k_load4 (v = the 4 floats at p) and k_store4 on them. Kernels that use 8 lanes on
+ * OpenCL (float8, k_load8, k_store8) run them as two halves of 4 in C: without AVX gcc
+ * splits 8-wide vectors badly (intersect.h). */
 typedef float float4 __attribute__((vector_size(16)));
 typedef int int4 __attribute__((vector_size(16)));
-typedef float float8 __attribute__((vector_size(32)));
-typedef int int8 __attribute__((vector_size(32)));
 #define k_load4(v, p) memcpy(&(v), (p), sizeof(float4))
-#define k_load8(v, p) memcpy(&(v), (p), sizeof(float8))
 #define k_store4(v, p) memcpy((p), &(v), sizeof(float4))
-#define k_store8(v, p) memcpy((p), &(v), sizeof(float8))
 
 #endif
 

@@ -155,13 +155,16 @@ KFN int triangle_intersect(const RayPre *rp, GLOBAL const Triangle *tri, Ray ray
  * their t, u and v in the arrays ta, ua, va (at [first, first + W)). ANY(m) and BITS(m)
  * reduce a comparison's lanes; written out lane by lane, since LLVM compiles a loop over
  * the lanes into much slower code. */
+#if KD_GROUP != 8
+#error "triangle_intersect_group is written for groups of 8 lanes"
+#endif
 #define K_ANY4(m) (((m)[0] | (m)[1] | (m)[2] | (m)[3]) != 0)
 #define K_BITS4(m) ((uint)((m)[0] & 1) | (uint)((m)[1] & 2) | (uint)((m)[2] & 4) | (uint)((m)[3] & 8))
 #define K_ANY8(m) (((m)[0] | (m)[1] | (m)[2] | (m)[3] | (m)[4] | (m)[5] | (m)[6] | (m)[7]) != 0)
 #define K_BITS8(m)                                                                       \
     ((uint)((m)[0] & 1) | (uint)((m)[1] & 2) | (uint)((m)[2] & 4) | (uint)((m)[3] & 8) |    \
      (uint)((m)[4] & 16) | (uint)((m)[5] & 32) | (uint)((m)[6] & 64) | (uint)((m)[7] & 128))
-#define TRI_LANES_BODY(VT, IT, W, LOAD, STORE, ANY, BITS)                                           \
+#define TRI_LANES_BODY(VT, IT, W, LOAD, STORE, ANY, BITS)                               \
     int kx = rp->kx, ky = rp->ky, kz = rp->kz;                                           \
     float ox = rp->org[kx], oy = rp->org[ky], oz = rp->org[kz];                          \
     float sx = rp->sx, sy = rp->sy, sz = rp->sz;                                         \

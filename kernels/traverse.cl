@@ -2,13 +2,13 @@
  * traverse.cl -- closest-hit and any-hit queries against the scene.
  *
  * Infinite planes are tested one by one; everything else is found through the kd-tree
- * (layout in docs/kdtree.md): the ray is clipped to the root box and walked front to
- * back with a private stack, as pbrt's KdTreeAggregate does. A leaf's primitives are
- * tested against the whole remaining ray, not just the leaf's part of it, so a hit
+ * (layout and the reasons for this code's shape in docs/kdtree.md): the ray is clipped
+ * to the root box and walked front to back with a private stack. A leaf's primitives
+ * are tested against the whole remaining ray, not just the leaf's part of it, so a hit
  * found in a leaf may lie beyond the leaf; the walk stops once the closest hit is no
  * farther than the end of the current leaf, since every cell still on the stack
  * starts there or later. Rays must have tmin >= 0 (every ray of a path tracer does):
- * the near/far order of the children is decided from the origin.
+ * the slack of the plane tests is relative to the interval's ends, taken non-negative.
  */
 #ifndef CLPT_TRAVERSE_CL
 #define CLPT_TRAVERSE_CL
@@ -17,7 +17,8 @@
 #include "scene_view.h"
 
 /* Tests global primitive `id` (a sphere, triangle or box: planes are not in the tree)
- * against the ray, whose tmax is the closest hit so far. */
+ * against the ray, whose tmax is the closest hit so far. The walk tests triangles by
+ * leaf group and calls this for spheres and boxes. */
 KFN_INLINE int trace_prim(const SceneView *sc, uint id, const RayPre *rp, Ray ray, Hit *hit)
 {
     GLOBAL const RenderParams *pr = sc->params;
@@ -93,12 +94,13 @@ KFN_INLINE float k_select_f(float a, float b, uint c)
  * child holding the triangle it hits. tp is NaN only for a ray lying in the split plane:
  * it is on the boundary of both children for its whole interval, and every comparison
  * with NaN is false, which takes both children with the interval unchanged. The push
- * slot is written in every case and kept only when both children are taken (an interior
- * node is at depth <= KD_MAX_DEPTH - 2, so sp stays in range).
+ * slot is written in every case and kept only when both children are taken and the far
+ * one is not an empty leaf (KD_EMPTY_*: nothing to test there; an interior node is at
+ * depth <= KD_MAX_DEPTH - 2, so sp stays in range).
  *
  * With `branch` set the far-only case is a branch, which the processor predicts for
  * coherent rays and which keeps the plane test off the chain of node loads; without it
- * every choice is a bit select, for walks taking turns (trace_pair), where the other
+ * every choice is a bit select, for walks taking turns (TRACE_PAIR), where the other
  * walk's chain hides the longer one. The two compute the same. */
 KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, KdStack *st, int branch)
 {
@@ -130,9 +132,9 @@ KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, KdStack *st, int 
  * best->t); returns 1 when the walk is over: an any-hit query hit, or nothing is left on
  * the stack, or the closest hit is no farther than the end of this cell (every cell on
  * the stack starts there or later). Otherwise pops the next cell. The triangles are
- * tested a group at a time (triangle_intersect4); of the lanes hit the nearest counts,
- * the first of equals, which is what testing them one by one in lane order gives. One
- * call site per walk for the tests, so that they are inlined. */
+ * tested a group at a time (triangle_intersect_group: the nearest lane hit, the first
+ * of equals, which is what testing them one by one in lane order gives), then the
+ * spheres and boxes one by one. */
 KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, KdNode n, KdWalk *w,
                        const KdStack *st, Hit *best)
 {
@@ -238,9 +240,11 @@ KFN int trace_any(const SceneView *sc, Ray ray)
  * plane test of this one is done, and for incoherent rays the branches of that test are
  * mispredicted often. Walking two independent rays in turns, with the interior step
  * written as bit selects rather than branches, lets the processor overlap the two
- * chains (docs/kdtree.md). The result of each ray is bit for bit that of trace_closest /
- * trace_any: the same nodes in the same order, the same tests. Everything is inlined so
- * that the walks' scalars stay in registers. */
+ * chains. On PoCL that pays only for incoherent rays of large meshes and costs camera
+ * and shadow rays 15-25% (docs/kdtree.md); the renderer walks one ray per work-item,
+ * the benchmark times both. The result of each ray is bit for bit that of
+ * trace_closest / trace_any: the same nodes in the same order, the same tests.
+ * Everything is inlined so that the walks' scalars stay in registers. */
 typedef struct {
     Ray ray;
     Hit best;

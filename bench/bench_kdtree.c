@@ -142,11 +142,13 @@ int main(int argc, char **argv)
     const KdStats *s = &tree.stats;
     printf("build: %.3f s with %d threads, %.3f s with 1 (identical trees: %s)\n",
            s->build_seconds, threads, tree1.stats.build_seconds, same ? "yes" : "NO");
-    printf("nodes %u, leaves %u (%u empty), max depth %u, %.2f prims/leaf, %u leaf ids\n",
+    printf("nodes %u, leaves %u (%u empty), max depth %u, %.2f prims/leaf, %u words of leaf data\n",
            s->n_nodes, s->n_leaves, s->n_empty_leaves, s->max_depth, s->mean_prims_per_leaf,
            tree.n_leaf_prims);
-    printf("SAH cost %.2f (single leaf %.0f), %zu bytes = %.2f bytes/triangle, %.2f refs/triangle\n",
-           s->sah_cost, s->leaf_sah_cost, s->bytes, (double)s->bytes / (double)(m.n ? m.n : 1),
+    printf("SAH cost %.2f (with the empty-space bonus %.2f, single leaf %.0f), %zu bytes = %.2f bytes/triangle "
+           "(%.2f of them the triangles' corners in the leaves), %.2f refs/triangle\n",
+           s->sah_cost, s->sah_cost_bonus, s->leaf_sah_cost, s->bytes, (double)s->bytes / (double)(m.n ? m.n : 1),
+           (double)s->bytes_corners / (double)(m.n ? m.n : 1),
            (s->mean_prims_per_leaf * (s->n_leaves - s->n_empty_leaves)) / (double)(m.n ? m.n : 1));
 
     RenderParams params;

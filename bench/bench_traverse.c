@@ -128,7 +128,12 @@ static int mesh_open(Mesh *m, const char *name, Error *err)
     p->n_leaf_prims = m->tree.n_leaf_prims;
     p->bounds_lo = m->tree.lo;
     p->bounds_hi = m->tree.hi;
-    SceneView v = { p, m->tree.nodes, m->tree.leaf_prims, NULL, m->scene.triangles, NULL, NULL, NULL, NULL, NULL };
+    SceneView v;
+    memset(&v, 0, sizeof v);
+    v.params = p;
+    v.nodes = m->tree.nodes;
+    v.leaf_prims = m->tree.leaf_prims;
+    v.triangles = m->scene.triangles;
     m->view = v;
     return 0;
 }
@@ -317,7 +322,9 @@ static void rays_free(RaySet sets[N_SETS])
 
 /* ------------------------------------------------------------------ PoCL */
 
-enum { SC_PARAMS, SC_NODES, SC_LEAF, SC_SPHERES, SC_TRIS, SC_BOXES, SC_PLANES, SC_MATS, SC_LIGHTS, SC_SHADING, SC_N };
+/* The kernels' scene arguments, in SCENE_ARGS order (kernels/entry.cl). */
+enum { SC_PARAMS, SC_NODES, SC_LEAF, SC_SPHERES, SC_TRIS, SC_BOXES, SC_PLANES, SC_MATS, SC_LIGHTS, SC_SHADING,
+       SC_TEXTURES, SC_TEXELS, SC_MASK, SC_N };
 
 typedef struct {
     int ok;
@@ -325,7 +332,8 @@ typedef struct {
     cl_device_id sub;            /* the 1-compute-unit sub-device, or NULL */
     cl_context ctx;
     cl_command_queue q;
-    cl_kernel kc, ka;
+    cl_kernel kc, ka;            /* two rays per work-item */
+    cl_kernel kc1, ka1;          /* one ray per work-item */
     cl_program prog;
     cl_mem scene[SC_N], rays, out;
     size_t rays_cap;
@@ -353,9 +361,11 @@ static int pocl_open(Pocl *pc, const OclDeviceInfo *dev, cl_device_id sub)
     pc->q = clCreateCommandQueue(pc->ctx, pc->info.id, 0, &rc);
     if (rc != CL_SUCCESS) return pocl_fail("clCreateCommandQueue", rc);
     Error err = { 0 };
-    if (ocl_program_build(pc->ctx, &pc->info, NULL, NULL, &pc->prog, NULL, &err) ||
+    if (ocl_program_build(pc->ctx, &pc->info, NULL, "-D CLPT_BENCH_KERNELS", &pc->prog, NULL, &err) ||
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest", &pc->kc, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any", &pc->ka, &err)) {
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any", &pc->ka, &err) ||
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest1", &pc->kc1, &err) ||
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any1", &pc->ka1, &err)) {
         fprintf(stderr, "bench_traverse: %s\n", err.msg);
         error_clear(&err);
         return -1;
@@ -380,6 +390,8 @@ static void pocl_close(Pocl *pc)
     pocl_release_buffers(pc);
     if (pc->kc) clReleaseKernel(pc->kc);
     if (pc->ka) clReleaseKernel(pc->ka);
+    if (pc->kc1) clReleaseKernel(pc->kc1);
+    if (pc->ka1) clReleaseKernel(pc->ka1);
     if (pc->prog) clReleaseProgram(pc->prog);
     if (pc->q) clReleaseCommandQueue(pc->q);
     if (pc->ctx) clReleaseContext(pc->ctx);
@@ -412,8 +424,8 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
     for (int i = 0; i < SC_N; i++)
         if (!pc->scene[i]) return -1;
     if (!pc->rays || !pc->out) return -1;
-    cl_kernel ks[2] = { pc->kc, pc->ka };
-    for (int k = 0; k < 2; k++) {
+    cl_kernel ks[4] = { pc->kc, pc->ka, pc->kc1, pc->ka1 };
+    for (int k = 0; k < 4; k++) {
         for (cl_uint i = 0; i < SC_N; i++)
             if (clSetKernelArg(ks[k], i, sizeof(cl_mem), &pc->scene[i]) != CL_SUCCESS) return -1;
         if (clSetKernelArg(ks[k], SC_N, sizeof(cl_mem), &pc->rays) != CL_SUCCESS ||
@@ -423,13 +435,14 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
     return 0;
 }
 
-/* Traces the set (its rays already uploaded); returns seconds, or -1. */
-static double pocl_trace(Pocl *pc, const RaySet *s)
+/* Traces the set (its rays already uploaded), two rays per work-item or one; returns
+ * seconds, or -1. */
+static double pocl_trace(Pocl *pc, const RaySet *s, int pairs)
 {
-    cl_kernel k = s->any ? pc->ka : pc->kc;
+    cl_kernel k = pairs ? (s->any ? pc->ka : pc->kc) : (s->any ? pc->ka1 : pc->kc1);
     cl_uint n = s->n;
     if (clSetKernelArg(k, SC_N + 1, sizeof n, &n) != CL_SUCCESS) return -1.0;
-    size_t items = (n + 1u) / 2u;   /* two rays per work-item */
+    size_t items = pairs ? (n + 1u) / 2u : n;
     size_t local = pocl_local, global = local ? (items + local - 1) / local * local : items;
     double c0 = cpu_now(), t0 = timer_now();
     cl_int rc = clEnqueueNDRangeKernel(pc->q, k, 1, NULL, &global, local ? &local : NULL, 0, NULL, NULL);
@@ -668,9 +681,12 @@ static long embree_compare(const RaySet *s, const Hit *eh, const uint *eo)
 
 /* ------------------------------------------------------------------ one mesh */
 
+/* PoCL kernels: one ray per work-item (as the renderer's k_intersect/k_shadow), two */
+#define N_KERNELS 2
+
 typedef struct {
-    double pocl[MAX_THREADS], c[MAX_THREADS], e1[MAX_THREADS], e8[MAX_THREADS];   /* Mrays/s */
-    double cpu_pocl[MAX_THREADS], cpu_c[MAX_THREADS], cpu_e1[MAX_THREADS], cpu_e8[MAX_THREADS];
+    double pocl[N_KERNELS][MAX_THREADS], c[MAX_THREADS], e1[MAX_THREADS], e8[MAX_THREADS];   /* Mrays/s */
+    double cpu_pocl[N_KERNELS][MAX_THREADS], cpu_c[MAX_THREADS], cpu_e1[MAX_THREADS], cpu_e8[MAX_THREADS];
                                  /* Mrays per CPU-second */
     long pocl_diff, embree_diff;
     uint hits;
@@ -709,9 +725,11 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
     const char *base = strrchr(name, '/') ? strrchr(name, '/') + 1 : name;
     printf("\n### %s: %zu triangles (loaded in %.3f s)\n\n", base, nt, m.load_seconds);
     printf("kd-tree: build %.3f s (%d threads) / %.3f s (1 thread); %u nodes, %u leaves, depth %u, "
-           "SAH cost %.2f (one leaf %.0f), %.1f bytes/triangle (nodes + leaf lists)\n",
+           "SAH cost %.2f (with the empty-space bonus %.2f; one leaf %.0f), %.1f bytes/triangle: nodes and ids "
+           "%.1f, triangle corners in the leaves %.1f\n",
            ks->build_seconds, o->threads[MAX_THREADS - 1], m.kd_build_1, ks->n_nodes, ks->n_leaves,
-           ks->max_depth, ks->sah_cost, ks->leaf_sah_cost, (double)ks->bytes / (double)(nt ? nt : 1));
+           ks->max_depth, ks->sah_cost, ks->sah_cost_bonus, ks->leaf_sah_cost, (double)ks->bytes / (double)(nt ? nt : 1),
+           (double)(ks->bytes - ks->bytes_corners) / (double)(nt ? nt : 1), (double)ks->bytes_corners / (double)(nt ? nt : 1));
     if (have_embree) {
         char ratio[96] = "";
         /* a ratio of times below a millisecond says nothing */
@@ -740,11 +758,16 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
         /* check first */
         r->pocl_diff = r->embree_diff = -1;
         for (int t = 0; t < MAX_THREADS; t++) {
-            if (!pocl_ok[t] || pocl_put_rays(&pocl[t], s) || pocl_trace(&pocl[t], s) < 0.0) {
+            if (!pocl_ok[t] || pocl_put_rays(&pocl[t], s) || pocl_trace(&pocl[t], s, 0) < 0.0) {
                 pocl_ok[t] = 0;
                 continue;
             }
             long d = pocl_compare(&pocl[t], s);
+            if (pocl_trace(&pocl[t], s, 1) < 0.0) {
+                pocl_ok[t] = 0;
+                continue;
+            }
+            d += pocl_compare(&pocl[t], s);
             r->pocl_diff = r->pocl_diff < 0 ? d : r->pocl_diff + d;
         }
         if (have_embree) {
@@ -757,14 +780,14 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
             int th = o->threads[t];
             /* the variants take turns within each repetition, so that a change in the
              * machine's load affects them alike */
-            double sc[MAX_REPS], cc[MAX_REPS], sp[MAX_REPS], cp[MAX_REPS], s1[MAX_REPS], c1[MAX_REPS],
-                s8[MAX_REPS], c8[MAX_REPS];
+            double sc[MAX_REPS], cc[MAX_REPS], sp[N_KERNELS][MAX_REPS], cp[N_KERNELS][MAX_REPS], s1[MAX_REPS],
+                c1[MAX_REPS], s8[MAX_REPS], c8[MAX_REPS];
             for (int i = 0; i < o->reps; i++) {
                 sc[i] = trace_c(&m.view, s, th, 1, tmp_h, tmp_o);
                 cc[i] = last_cpu_seconds;
-                if (pocl_ok[t]) {
-                    sp[i] = pocl_trace(&pocl[t], s);
-                    cp[i] = last_cpu_seconds;
+                for (int kp = 0; kp < N_KERNELS && pocl_ok[t]; kp++) {
+                    sp[kp][i] = pocl_trace(&pocl[t], s, kp);
+                    cp[kp][i] = last_cpu_seconds;
                 }
                 if (have_embree) {
                     s1[i] = embree_trace(emb[t].scene, s, 0, th, NULL, NULL);
@@ -775,9 +798,9 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
             }
             r->c[t] = rate(s->n, sc, o->reps);
             r->cpu_c[t] = rate(s->n, cc, o->reps);
-            if (pocl_ok[t]) {
-                r->pocl[t] = rate(s->n, sp, o->reps);
-                r->cpu_pocl[t] = rate(s->n, cp, o->reps);
+            for (int kp = 0; kp < N_KERNELS && pocl_ok[t]; kp++) {
+                r->pocl[kp][t] = rate(s->n, sp[kp], o->reps);
+                r->cpu_pocl[kp][t] = rate(s->n, cp[kp], o->reps);
             }
             if (have_embree) {
                 r->e1[t] = rate(s->n, s1, o->reps);
@@ -791,9 +814,9 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
     free(eo);
 
     int a = o->threads[0], b = o->threads[MAX_THREADS - 1];
-    printf("\n| rays | query | count | hits | PoCL %dt | PoCL %dt | C %dt | C %dt | Embree-1 %dt | Embree-1 %dt | "
-           "Embree-8 %dt | Embree-8 %dt | PoCL/Embree-1 %dt | C/Embree-1 %dt | vs Embree | PoCL vs C |\n",
-           a, b, a, b, a, b, a, b, b, a);
+    printf("\n| rays | query | count | hits | PoCL-1 %dt | PoCL-1 %dt | PoCL-2 %dt | PoCL-2 %dt | C %dt | C %dt | "
+           "Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | vs Embree | PoCL vs C |\n",
+           a, b, a, b, a, b, a, b, a, b);
     printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int k = 0; k < N_SETS; k++) {
         const SetResult *r = &res[k];
@@ -803,23 +826,25 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
         if (r->embree_diff < 0) snprintf(ed, sizeof ed, "-");
         else snprintf(ed, sizeof ed, "%ld disagree", r->embree_diff);
         printf("| %s | %s | %u | %u | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %s |\n",
-               sets[k].name, sets[k].any ? "any" : "closest", sets[k].n, r->hits, r->pocl[0], r->pocl[1], r->c[0],
-               r->c[1], r->e1[0], r->e1[1], r->e8[0], r->e8[1], r->e1[1] > 0.0 ? r->pocl[1] / r->e1[1] : 0.0,
-               r->e1[0] > 0.0 ? r->c[0] / r->e1[0] : 0.0, ed, pd);
+               sets[k].name, sets[k].any ? "any" : "closest", sets[k].n, r->hits, r->pocl[0][0], r->pocl[0][1],
+               r->pocl[1][0], r->pocl[1][1], r->c[0], r->c[1], r->e1[0], r->e1[1], r->e8[0], r->e8[1], ed, pd);
     }
     printf("\nThe same runs in Mrays per CPU-second (the CPU time of the whole process: the work per core, "
            "which other jobs taking the cores do not change; with ideal scaling the %d-thread columns equal "
-           "the 1-thread ones):\n\n", b);
-    printf("| rays | PoCL %dt | PoCL %dt | C %dt | C %dt | Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | "
-           "PoCL/Embree-1 %dt | PoCL/Embree-1 %dt |\n", a, b, a, b, a, b, a, b, a, b);
-    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+           "the 1-thread ones), and PoCL over Embree single rays:\n\n", b);
+    printf("| rays | PoCL-1 %dt | PoCL-1 %dt | PoCL-2 %dt | PoCL-2 %dt | C %dt | C %dt | Embree-1 %dt | Embree-1 %dt | "
+           "Embree-8 %dt | Embree-8 %dt | PoCL-1/Embree-1 %dt | PoCL-1/Embree-1 %dt | PoCL-2/Embree-1 %dt | "
+           "PoCL-2/Embree-1 %dt |\n", a, b, a, b, a, b, a, b, a, b, a, b, a, b);
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int k = 0; k < N_SETS; k++) {
         const SetResult *r = &res[k];
-        printf("| %s %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n", sets[k].name,
-               sets[k].any ? "any" : "closest",
-               r->cpu_pocl[0], r->cpu_pocl[1], r->cpu_c[0], r->cpu_c[1], r->cpu_e1[0], r->cpu_e1[1], r->cpu_e8[0],
-               r->cpu_e8[1], r->cpu_e1[0] > 0.0 ? r->cpu_pocl[0] / r->cpu_e1[0] : 0.0,
-               r->cpu_e1[1] > 0.0 ? r->cpu_pocl[1] / r->cpu_e1[1] : 0.0);
+        double q[N_KERNELS][MAX_THREADS];
+        for (int kp = 0; kp < N_KERNELS; kp++)
+            for (int t = 0; t < MAX_THREADS; t++) q[kp][t] = r->cpu_e1[t] > 0.0 ? r->cpu_pocl[kp][t] / r->cpu_e1[t] : 0.0;
+        printf("| %s %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n",
+               sets[k].name, sets[k].any ? "any" : "closest", r->cpu_pocl[0][0], r->cpu_pocl[0][1], r->cpu_pocl[1][0],
+               r->cpu_pocl[1][1], r->cpu_c[0], r->cpu_c[1], r->cpu_e1[0], r->cpu_e1[1], r->cpu_e8[0], r->cpu_e8[1],
+               q[0][0], q[0][1], q[1][0], q[1][1]);
     }
     fflush(stdout);
     for (int t = 0; t < MAX_THREADS; t++) embree_free(&emb[t]);

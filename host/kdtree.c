@@ -421,7 +421,7 @@ typedef struct {
 
 static double sah_split_cost(double sa_l, double sa_r, uint nl, uint nr)
 {
-    double c = KD_COST_TRAVERSAL + KD_COST_INTERSECT * (sa_l * nl + sa_r * nr);
+    double c = KD_COST_TRAVERSAL + sa_l * kd_leaf_cost(nl) + sa_r * kd_leaf_cost(nr);
     return c * ((nl == 0 || nr == 0) ? KD_EMPTY_BONUS : 1.0);
 }
 
@@ -677,7 +677,7 @@ static int build_node(Worker *w, NodeLists nl, int depth, int bad, int tentative
     if (!node) return -1;
     *out = node;
     double sa = box_half_area(&nl.box);
-    double leaf_cost = KD_COST_INTERSECT * nl.nprims;
+    double leaf_cost = kd_leaf_cost(nl.nprims);
     *cost = leaf_cost * sa;
 
     Split best = { -1, 0.0f, 0, INFINITY };
@@ -881,12 +881,70 @@ static void *sort_job(void *arg)
 
 /* ------------------------------------------------------------------ flatten */
 
-typedef struct { const BNode *node; uint parent; int depth; Aabb box; } FlatItem;
+/* scale: the product of the empty-space bonus over the node's ancestors that have an
+ * empty child (the factor the builder's cost applies to this node's terms). */
+typedef struct { const BNode *node; uint parent; int depth; Aabb box; double scale; } FlatItem;
 
-static Status flatten(const BNode *root, const Aabb *root_box, KdTree *t, Error *err)
+static int leaf_is_empty(const BNode *n) { return n->axis == KD_LEAF && n->count == 0; }
+
+/* A leaf's sorted global ids. */
+static const uint *leaf_ids(const BNode *n) { return n->count == 1 ? &n->id : n->ids; }
+
+/* How many of a leaf's ids are triangles (they come after the spheres, before the
+ * boxes, and the ids are sorted: a contiguous run). */
+static void leaf_split_ids(const BNode *n, const KdInput *in, uint *first_tri, uint *n_tri)
+{
+    uint lo = (uint)in->n_spheres, hi = lo + (uint)in->n_triangles;
+    const uint *ids = leaf_ids(n);
+    uint a = 0, c = 0;
+    while (a < n->count && ids[a] < lo) a++;
+    while (a + c < n->count && ids[a + c] < hi) c++;
+    *first_tri = a;
+    *n_tri = c;
+}
+
+/* Words of a leaf's record in the leaf data (types.h). */
+static size_t leaf_words(const BNode *n, const KdInput *in)
+{
+    uint first, nt;
+    leaf_split_ids(n, in, &first, &nt);
+    size_t w = (size_t)(nt + KD_GROUP - 1) / KD_GROUP * KD_GROUP_WORDS;
+    uint others = n->count - nt;
+    return w + (others ? 1 + others : 0);
+}
+
+/* Writes a leaf's record at out: its triangles in groups (the last one repeated in the
+ * unused lanes), then the other ids. */
+static void leaf_write(const BNode *n, const KdInput *in, uint *out)
+{
+    uint first, nt;
+    leaf_split_ids(n, in, &first, &nt);
+    const uint *ids = leaf_ids(n);
+    uint base = (uint)in->n_spheres;
+    for (uint g = 0; g < nt; g += KD_GROUP, out += KD_GROUP_WORDS) {
+        for (uint l = 0; l < KD_GROUP; l++) {
+            uint id = ids[first + (g + l < nt ? g + l : nt - 1)];
+            const Triangle *t = &in->triangles[id - base];
+            const vec3 *c[3] = { &t->p0, &t->p1, &t->p2 };
+            out[l] = id;
+            for (int v = 0; v < 3; v++) {
+                const float f[3] = { c[v]->x, c[v]->y, c[v]->z };
+                for (int k = 0; k < 3; k++) memcpy(&out[KD_GROUP + (uint)(3 * v + k) * KD_GROUP + l], &f[k], sizeof(float));
+            }
+        }
+    }
+    uint others = n->count - nt;
+    if (others) {
+        *out++ = others;
+        for (uint i = 0; i < n->count; i++)
+            if (i < first || i >= first + nt) *out++ = ids[i];
+    }
+}
+
+static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in, KdTree *t, Error *err)
 {
     /* Count first, to allocate exactly. Depth-first, "below" child first. */
-    size_t n_nodes = 0, n_ids = 0;
+    size_t n_nodes = 0, n_words = 0;
     const BNode *stack[KD_MAX_DEPTH + 2];
     int sp = 0;
     stack[sp++] = root;
@@ -894,68 +952,93 @@ static Status flatten(const BNode *root, const Aabb *root_box, KdTree *t, Error 
         const BNode *n = stack[--sp];
         n_nodes++;
         if (n->axis == KD_LEAF) {
-            if (n->count > 1) n_ids += n->count;
+            n_words += leaf_words(n, in);
         } else {
             stack[sp++] = n->child[1];
             stack[sp++] = n->child[0];
         }
     }
-    if (n_nodes > KD_MAX_PRIMS || n_ids > UINT32_MAX - 1)
-        return error_set(err, ST_INTERNAL, "kd-tree: %zu nodes and %zu leaf ids do not fit the node layout",
-                         n_nodes, n_ids);
+    if (n_nodes > (UINT32_MAX >> 4) || n_words > UINT32_MAX - 1)
+        return error_set(err, ST_INTERNAL, "kd-tree: %zu nodes and %zu words of leaf data do not fit the node layout",
+                         n_nodes, n_words);
     t->nodes = malloc(n_nodes * sizeof *t->nodes);
-    t->leaf_prims = malloc((n_ids + 1) * sizeof *t->leaf_prims);
+    /* Cache-line aligned, so that no row of a group's corners straddles two lines (the
+     * groups are 320 bytes long; OpenCL buffers are aligned at least as well). */
+    size_t leaf_bytes = ((n_words + 1) * sizeof *t->leaf_prims + 63) / 64 * 64;
+    t->leaf_prims = aligned_alloc(64, leaf_bytes);
     if (!t->nodes || !t->leaf_prims)
         return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu nodes", n_nodes);
 
     KdStats *st = &t->stats;
     double inv_root = box_half_area(root_box) > 0.0 ? 1.0 / box_half_area(root_box) : 0.0;
-    size_t refs = 0;
-    uint idx = 0, ids = 0;
+    size_t refs = 0, groups = 0;
+    uint idx = 0, words = 0;
     FlatItem items[KD_MAX_DEPTH + 2];
     int ip = 0;
-    items[ip++] = (FlatItem){ root, NO_INDEX, 0, *root_box };
+    items[ip++] = (FlatItem){ root, NO_INDEX, 0, *root_box, 1.0 };
     while (ip) {
         FlatItem it = items[--ip];
         const BNode *n = it.node;
         uint me = idx++;
-        if (it.parent != NO_INDEX) t->nodes[it.parent].bits |= me << 2;
+        if (it.parent != NO_INDEX) t->nodes[it.parent].bits |= me << 4;
         if ((uint)it.depth > st->max_depth) st->max_depth = (uint)it.depth;
         double rel = inv_root > 0.0 ? box_half_area(&it.box) * inv_root : 1.0;
         if (n->axis == KD_LEAF) {
             st->n_leaves++;
             if (n->count == 0) st->n_empty_leaves++;
             refs += n->count;
-            st->sah_cost += KD_COST_INTERSECT * n->count * rel;
-            t->nodes[me].bits = KD_LEAF | (n->count << 2);
-            if (n->count == 1) {
-                t->nodes[me].data = n->id;
-            } else {
-                t->nodes[me].data = ids;
-                if (n->count) memcpy(t->leaf_prims + ids, n->ids, n->count * sizeof *n->ids);
-                ids += n->count;
-            }
+            st->sah_cost += kd_leaf_cost(n->count) * rel;
+            st->sah_cost_bonus += kd_leaf_cost(n->count) * rel * it.scale;
+            uint first, nt;
+            leaf_split_ids(n, in, &first, &nt);
+            uint ng = (nt + KD_GROUP - 1) / KD_GROUP;
+            groups += ng;
+            t->nodes[me].bits = KD_LEAF | (n->count > nt ? KD_LEAF_OTHERS : 0u) | (ng << 3);
+            t->nodes[me].data = n->count ? words : 0u;
+            if (n->count) leaf_write(n, in, t->leaf_prims + words);
+            words += (uint)leaf_words(n, in);
             continue;
         }
+        double scale = it.scale * (leaf_is_empty(n->child[0]) || leaf_is_empty(n->child[1]) ? KD_EMPTY_BONUS : 1.0);
         st->sah_cost += KD_COST_TRAVERSAL * rel;
+        st->sah_cost_bonus += KD_COST_TRAVERSAL * rel * scale;
         uint split_bits;
         memcpy(&split_bits, &n->split, sizeof split_bits);
         t->nodes[me].data = split_bits;
-        t->nodes[me].bits = n->axis;    /* the above child's index is added when reached */
-        FlatItem above = { n->child[1], me, it.depth + 1, it.box };
-        FlatItem below = { n->child[0], NO_INDEX, it.depth + 1, it.box };
+        /* the above child's index is added when reached */
+        t->nodes[me].bits = n->axis | (leaf_is_empty(n->child[0]) ? KD_EMPTY_BELOW : 0u) |
+                            (leaf_is_empty(n->child[1]) ? KD_EMPTY_ABOVE : 0u);
+        FlatItem above = { n->child[1], me, it.depth + 1, it.box, scale };
+        FlatItem below = { n->child[0], NO_INDEX, it.depth + 1, it.box, scale };
         above.box.lo[n->axis] = n->split;
         below.box.hi[n->axis] = n->split;
         items[ip++] = above;
         items[ip++] = below;
     }
     t->n_nodes = idx;
-    t->n_leaf_prims = ids;
+    t->n_leaf_prims = words;
     st->n_nodes = idx;
     uint full = st->n_leaves - st->n_empty_leaves;
     st->mean_prims_per_leaf = full ? (double)refs / full : 0.0;
-    st->bytes = (size_t)idx * sizeof(KdNode) + (size_t)ids * sizeof(uint);
+    st->bytes = (size_t)idx * sizeof(KdNode) + (size_t)words * sizeof(uint);
+    st->bytes_corners = groups * KD_GROUP * 9 * sizeof(float);
     return ST_OK;
+}
+
+/* A leaf's primitive ids (its triangles without the repeated lanes, then the others). */
+uint kd_leaf_ids(const KdTree *t, uint node, uint *out, uint cap)
+{
+    KdNode n = t->nodes[node];
+    uint m = 0;
+    if ((n.bits & 3u) != KD_LEAF) return 0;
+    const uint *g = t->leaf_prims + n.data;
+    for (uint i = 0; i < n.bits >> 3; i++, g += KD_GROUP_WORDS)
+        for (uint l = 0; l < KD_GROUP; l++)
+            if ((l == 0 || g[l] != g[l - 1]) && m < cap) out[m++] = g[l];
+    if (n.bits & KD_LEAF_OTHERS)
+        for (uint i = 1; i <= g[0]; i++)
+            if (m < cap) out[m++] = g[i];
+    return m;
 }
 
 /* ------------------------------------------------------------------ entry points */
@@ -1105,11 +1188,11 @@ Status kd_build(const KdInput *in, int threads, KdTree *out, Error *err)
         goto fail;
     }
 
-    st = flatten(root_node, &root, out, err);
+    st = flatten(root_node, &root, in, out, err);
     if (st != ST_OK) goto fail;
     out->lo = (vec3){ root.lo[0], root.lo[1], root.lo[2] };
     out->hi = (vec3){ root.hi[0], root.hi[1], root.hi[2] };
-    out->stats.leaf_sah_cost = KD_COST_INTERSECT * b.n_prims;
+    out->stats.leaf_sah_cost = kd_leaf_cost(b.n_prims);
     build_free(&b, w, n_workers);
     out->stats.build_seconds = now_seconds() - t_start;
     return ST_OK;

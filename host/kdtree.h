@@ -21,8 +21,20 @@
 #define KD_COST_TRAVERSAL 1.0
 #endif
 #ifndef KD_COST_INTERSECT
-#define KD_COST_INTERSECT 0.3
+#define KD_COST_INTERSECT 0.075
 #endif
+
+#ifndef KD_GROUPED_COST
+#define KD_GROUPED_COST 1
+#endif
+
+/* SAH cost of testing a leaf of n primitives: its triangles are tested KD_GROUP at a
+ * time, so a leaf costs per group of KD_GROUP, each lane at KD_COST_INTERSECT. */
+static inline double kd_leaf_cost(unsigned n)
+{
+    if (!KD_GROUPED_COST) return KD_COST_INTERSECT * n;
+    return KD_COST_INTERSECT * KD_GROUP * (double)((n + KD_GROUP - 1u) / KD_GROUP);
+}
 
 typedef struct {
     const Sphere *spheres;     size_t n_spheres;
@@ -36,8 +48,10 @@ typedef struct {
     uint max_depth;                /* deepest leaf, root = 0 */
     double mean_prims_per_leaf;    /* over non-empty leaves */
     double sah_cost;               /* expected cost of a random ray through the root box */
+    double sah_cost_bonus;         /* the same with the empty-space bonus: what the build minimises */
     double leaf_sah_cost;          /* the same for a single leaf holding every primitive */
-    size_t bytes;                  /* nodes + leaf primitive ids */
+    size_t bytes;                  /* nodes + leaf data (ids and the triangles' corners) */
+    size_t bytes_corners;          /* of which the copies of the triangles' corners */
     uint n_prims;                  /* primitives in the tree */
     uint n_skipped;                /* left out: bounds not finite (NaN or inf coordinates) */
 } KdStats;
@@ -53,5 +67,9 @@ typedef struct {
  * input gives a single empty leaf. Threads: 0 = all cores. */
 Status kd_build(const KdInput *in, int threads, KdTree *out, Error *err);
 void kd_free(KdTree *t);
+
+/* The primitive ids of leaf `node` (at most cap of them) into out; returns how many
+ * (0 for an interior node). */
+uint kd_leaf_ids(const KdTree *t, uint node, uint *out, uint cap);
 
 #endif /* CLPT_KDTREE_H */

@@ -153,12 +153,13 @@ static void print_scene_stats(const Scene *s, const KdTree *kd)
     size_t in_tree = s->n_spheres + s->n_triangles + s->n_boxes;
     printf("scene: %zu spheres, %zu triangles, %zu boxes, %zu planes, %zu materials, %zu lights\n",
            s->n_spheres, s->n_triangles, s->n_boxes, s->n_planes, s->n_materials, s->n_lights);
+    double per = in_tree ? 1.0 / (double)in_tree : 0.0;
     printf("kd-tree: built in %.3f s; %u nodes, %u leaves (%u empty), depth %u, "
-           "%.2f primitives per non-empty leaf, SAH cost %.2f, %.1f KiB (nodes + leaf lists: "
-           "%.1f bytes per primitive)\n",
+           "%.2f primitives per non-empty leaf, SAH cost %.2f, %.1f KiB (nodes and leaf ids %.1f, copies "
+           "of the triangles' corners in the leaves %.1f bytes per primitive)\n",
            k->build_seconds, k->n_nodes, k->n_leaves, k->n_empty_leaves, k->max_depth,
            k->mean_prims_per_leaf, k->sah_cost, (double)k->bytes / 1024.0,
-           in_tree ? (double)k->bytes / (double)in_tree : 0.0);
+           (double)(k->bytes - k->bytes_corners) * per, (double)k->bytes_corners * per);
 }
 
 static void print_render_stats(const ScheduleStats *st, Device **devs, size_t n)

@@ -24,6 +24,9 @@
 
 #define KERNEL_OPENCL 1
 #define KFN static inline       /* every helper: never bare `inline` (C99 rules) */
+/* Hot helpers that must be inlined whatever the compiler's size heuristics say: a call
+ * forces their state through memory (PoCL kept the kd-tree walk's state in memory). */
+#define KFN_INLINE static inline __attribute__((always_inline))
 #define GLOBAL __global
 #define CONSTANT __constant
 
@@ -37,6 +40,11 @@
 
 typedef long kint64;         /* 64-bit in every OpenCL C implementation */
 
+#define k_load4(v, p) ((v) = vload4(0, p))
+#define k_load8(v, p) ((v) = vload8(0, p))
+#define k_store4(v, p) vstore4(v, 0, p)
+#define k_store8(v, p) vstore8(v, 0, p)
+
 #else
 /* ---------------------------------------------------------------- C11 */
 #include <math.h>
@@ -44,6 +52,7 @@ typedef long kint64;         /* 64-bit in every OpenCL C implementation */
 #include <string.h>
 
 #define KFN static inline
+#define KFN_INLINE static inline __attribute__((always_inline))
 #define GLOBAL
 #define CONSTANT const
 
@@ -59,6 +68,17 @@ static inline float k_as_float(uint u) { float f; memcpy(&f, &u, sizeof f); retu
 static inline uint k_as_uint(float f) { uint u; memcpy(&u, &f, sizeof u); return u; }
 static inline int k_as_int(float f) { int i; memcpy(&i, &f, sizeof i); return i; }
 static inline float k_int_as_float(int i) { float f; memcpy(&f, &i, sizeof f); return f; }
+
+/* OpenCL's 4-wide vectors as GCC vector extensions, which compute each lane with the
+ * same IEEE operation as OpenCL does. Kernel code uses only operators (with vector or
+ * scalar operands), comparisons (-1 or 0 per lane, as OpenCL's), lane subscripts,
+ * k_load4 (v = the 4 floats at p) and k_store4 on them. Kernels that use 8 lanes on
+ * OpenCL (float8, k_load8, k_store8) run them as two halves of 4 in C: without AVX gcc
+ * splits 8-wide vectors badly (intersect.h). */
+typedef float float4 __attribute__((vector_size(16)));
+typedef int int4 __attribute__((vector_size(16)));
+#define k_load4(v, p) memcpy(&(v), (p), sizeof(float4))
+#define k_store4(v, p) memcpy((p), &(v), sizeof(float4))
 
 #endif
 

@@ -178,9 +178,12 @@ __kernel void k_whitted(SCENE_ARGS, uint first_pixel, uint wave_pixels, uint fir
 }
 
 /* ------------------------------------------------------------------------------------
- * Trace-only kernels for the traversal benchmark (bench/bench_traverse.c): one ray per
- * work-item from a plain array, no path state. Kept apart from the render kernels above.
+ * Trace-only kernels for the traversal benchmark (bench/bench_traverse.c): rays from a
+ * plain array, no path state. Kept apart from the render kernels above, and compiled
+ * only when the benchmark asks (-D CLPT_BENCH_KERNELS): each holds whole inlined walks,
+ * which took PoCL 2.5 s of every program build.
  * ------------------------------------------------------------------------------------ */
+#ifdef CLPT_BENCH_KERNELS
 
 /* Closest hits of rays[2i] and rays[2i+1], walked in turns (trace_closest2). */
 __kernel void k_trace_closest(SCENE_ARGS, __global const Ray *rays, uint n, __global Hit *hits)
@@ -213,3 +216,22 @@ __kernel void k_trace_any(SCENE_ARGS, __global const Ray *rays, uint n, __global
         occluded[a] = (uint)trace_any(&sc, rays[a]);
     }
 }
+
+/* Closest hit of rays[i], one ray per work-item (trace_closest, as k_intersect). */
+__kernel void k_trace_closest1(SCENE_ARGS, __global const Ray *rays, uint n, __global Hit *hits)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= n) return;
+    SCENE_VIEW(sc);
+    hits[i] = trace_closest(&sc, rays[i]);
+}
+
+/* Whether rays[i] hits anything, one ray per work-item (trace_any, as k_shadow). */
+__kernel void k_trace_any1(SCENE_ARGS, __global const Ray *rays, uint n, __global uint *occluded)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= n) return;
+    SCENE_VIEW(sc);
+    occluded[i] = (uint)trace_any(&sc, rays[i]);
+}
+#endif /* CLPT_BENCH_KERNELS */

@@ -23,6 +23,7 @@
 typedef struct {
     float org[3], dir[3];
     float inv_d[3];        /* 1/d per component: +-inf where that component is +-0 */
+    uint neg;              /* bit a set when dir[a] has its sign bit set (-0 included) */
     int kx, ky, kz;        /* axes of the triangle test; kz is where |d| is largest */
     float sx, sy, sz;      /* shear taking d to (0, 0, 1) in the permuted frame */
 } RayPre;
@@ -35,6 +36,7 @@ KFN RayPre ray_prepare(Ray ray)
     p.inv_d[0] = 1.0f / ray.d.x;
     p.inv_d[1] = 1.0f / ray.d.y;
     p.inv_d[2] = 1.0f / ray.d.z;
+    p.neg = (k_as_uint(ray.d.x) >> 31) | ((k_as_uint(ray.d.y) >> 31) << 1) | ((k_as_uint(ray.d.z) >> 31) << 2);
     float ax = k_fabs(ray.d.x), ay = k_fabs(ray.d.y), az = k_fabs(ray.d.z);
     int kz = (ax >= ay && ax >= az) ? 0 : (ay >= az ? 1 : 2);
     int kx = kz == 2 ? 0 : kz + 1;
@@ -138,6 +140,118 @@ KFN int triangle_intersect(const RayPre *rp, GLOBAL const Triangle *tri, Ray ray
     hit->u = V * inv_det;
     hit->v = W * inv_det;
     return 1;
+}
+
+/* triangle_intersect on the KD_GROUP (8) triangles of a kd-tree leaf group at once.
+ * `rows` are the group's corners, 9 rows of KD_GROUP floats (types.h). Each lane
+ * computes the very operations of triangle_intersect, so a lane's t, u and v are bit
+ * for bit what triangle_intersect gives for that triangle, tmax fixed for the group.
+ * OpenCL runs the 8 lanes as one float8; C runs them as two float4 halves, because
+ * without AVX (the C build targets any x86-64) gcc splits 8-wide vectors badly, and
+ * the same operations per lane give the same bits either way.
+ *
+ * TRI_LANES_BODY is the body for W lanes of vector type VT (comparisons IT) starting
+ * at lane `first`: it leaves the lanes hit as bits in `mask` and, when there are any,
+ * their t, u and v in the arrays ta, ua, va (at [first, first + W)). ANY(m) and BITS(m)
+ * reduce a comparison's lanes; written out lane by lane, since LLVM compiles a loop over
+ * the lanes into much slower code. */
+#if KD_GROUP != 8
+#error "triangle_intersect_group is written for groups of 8 lanes"
+#endif
+#define K_ANY4(m) (((m)[0] | (m)[1] | (m)[2] | (m)[3]) != 0)
+#define K_BITS4(m) ((uint)((m)[0] & 1) | (uint)((m)[1] & 2) | (uint)((m)[2] & 4) | (uint)((m)[3] & 8))
+#define K_ANY8(m) (((m)[0] | (m)[1] | (m)[2] | (m)[3] | (m)[4] | (m)[5] | (m)[6] | (m)[7]) != 0)
+#define K_BITS8(m)                                                                       \
+    ((uint)((m)[0] & 1) | (uint)((m)[1] & 2) | (uint)((m)[2] & 4) | (uint)((m)[3] & 8) |    \
+     (uint)((m)[4] & 16) | (uint)((m)[5] & 32) | (uint)((m)[6] & 64) | (uint)((m)[7] & 128))
+#define TRI_LANES_BODY(VT, IT, W, LOAD, STORE, ANY, BITS)                               \
+    int kx = rp->kx, ky = rp->ky, kz = rp->kz;                                           \
+    float ox = rp->org[kx], oy = rp->org[ky], oz = rp->org[kz];                          \
+    float sx = rp->sx, sy = rp->sy, sz = rp->sz;                                         \
+    GLOBAL const float *r = rows + first;                                                \
+    VT p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z;                                      \
+    LOAD(p0x, r + KD_GROUP * kx);                                                        \
+    LOAD(p0y, r + KD_GROUP * ky);                                                        \
+    LOAD(p0z, r + KD_GROUP * kz);                                                        \
+    LOAD(p1x, r + KD_GROUP * (3 + kx));                                                  \
+    LOAD(p1y, r + KD_GROUP * (3 + ky));                                                  \
+    LOAD(p1z, r + KD_GROUP * (3 + kz));                                                  \
+    LOAD(p2x, r + KD_GROUP * (6 + kx));                                                  \
+    LOAD(p2y, r + KD_GROUP * (6 + ky));                                                  \
+    LOAD(p2z, r + KD_GROUP * (6 + kz));                                                  \
+    VT az = p0z - oz, bz = p1z - oz, cz = p2z - oz;                                      \
+    VT ax = (p0x - ox) - sx * az, ay = (p0y - oy) - sy * az;                             \
+    VT bx = (p1x - ox) - sx * bz, by = (p1y - oy) - sy * bz;                             \
+    VT cx = (p2x - ox) - sx * cz, cy = (p2y - oy) - sy * cz;                             \
+    VT U = cx * by - cy * bx;                                                            \
+    VT V = ax * cy - ay * cx;                                                            \
+    VT W_ = bx * ay - by * ax;                                                           \
+    IT zero = (U == 0.0f) | (V == 0.0f) | (W_ == 0.0f);                                  \
+    if (ANY(zero)) {                                                                     \
+        for (int i = 0; i < W; i++) {                                                    \
+            if (U[i] == 0.0f) U[i] = k_edge_exact(cx[i], by[i], cy[i], bx[i]);           \
+            if (V[i] == 0.0f) V[i] = k_edge_exact(ax[i], cy[i], ay[i], cx[i]);           \
+            if (W_[i] == 0.0f) W_[i] = k_edge_exact(bx[i], ay[i], by[i], ax[i]);         \
+        }                                                                                \
+    }                                                                                    \
+    IT neg = (U < 0.0f) | (V < 0.0f) | (W_ < 0.0f);                                      \
+    IT pos = (U > 0.0f) | (V > 0.0f) | (W_ > 0.0f);                                      \
+    VT det = U + V + W_;                                                                 \
+    VT T = U * (sz * az) + V * (sz * bz) + W_ * (sz * cz);                               \
+    VT inv_det = 1.0f / det;                                                             \
+    VT t = T * inv_det;                                                                  \
+    IT ok = ~(neg & pos) & (det != 0.0f) & (t > tmin) & (t < tmax);                      \
+    uint mask = BITS(ok);                                                                \
+    if (mask) {                                                                          \
+        VT u = V * inv_det, v = W_ * inv_det;                                            \
+        STORE(t, ta + first);                                                            \
+        STORE(u, ua + first);                                                            \
+        STORE(v, va + first);                                                            \
+    }
+
+#ifdef __OPENCL_VERSION__
+KFN_INLINE uint tri_lanes(const RayPre *rp, GLOBAL const float *rows, int first, float tmin, float tmax,
+                          float *ta, float *ua, float *va)
+{
+    TRI_LANES_BODY(float8, int8, 8, k_load8, k_store8, K_ANY8, K_BITS8)
+    return mask;
+}
+#else
+KFN_INLINE uint tri_lanes(const RayPre *rp, GLOBAL const float *rows, int first, float tmin, float tmax,
+                          float *ta, float *ua, float *va)
+{
+    TRI_LANES_BODY(float4, int4, 4, k_load4, k_store4, K_ANY4, K_BITS4)
+    return mask;
+}
+#endif
+
+/* The group's lanes hit (bits, lane i: 1 << i); when there are any, *hit gets the
+ * nearest one's t, u and v and its lane in hit->prim (the first of equals: what testing
+ * the lanes one by one in order would keep). */
+KFN_INLINE uint triangle_intersect_group(const RayPre *rp, GLOBAL const float *rows, float tmin, float tmax,
+                                         Hit *hit)
+{
+    float ta[KD_GROUP], ua[KD_GROUP], va[KD_GROUP];
+#ifdef __OPENCL_VERSION__
+    uint mask = tri_lanes(rp, rows, 0, tmin, tmax, ta, ua, va);
+#else
+    uint mask = tri_lanes(rp, rows, 0, tmin, tmax, ta, ua, va);
+    mask |= tri_lanes(rp, rows, 4, tmin, tmax, ta, ua, va) << 4;
+#endif
+    if (mask) {
+        uint lane = 0u;
+        float bt = tmax;
+        for (uint l = 0; l < KD_GROUP; l++)
+            if (((mask >> l) & 1u) && ta[l] < bt) {
+                bt = ta[l];
+                lane = l;
+            }
+        hit->t = bt;
+        hit->u = ua[lane];
+        hit->v = va[lane];
+        hit->prim = lane;
+    }
+    return mask;
 }
 
 #ifndef __OPENCL_VERSION__

@@ -2,13 +2,13 @@
  * traverse.cl -- closest-hit and any-hit queries against the scene.
  *
  * Infinite planes are tested one by one; everything else is found through the kd-tree
- * (layout in docs/kdtree.md): the ray is clipped to the root box and walked front to
- * back with a private stack, as pbrt's KdTreeAggregate does. A leaf's primitives are
- * tested against the whole remaining ray, not just the leaf's part of it, so a hit
+ * (layout and the reasons for this code's shape in docs/kdtree.md): the ray is clipped
+ * to the root box and walked front to back with a private stack. A leaf's primitives
+ * are tested against the whole remaining ray, not just the leaf's part of it, so a hit
  * found in a leaf may lie beyond the leaf; the walk stops once the closest hit is no
  * farther than the end of the current leaf, since every cell still on the stack
  * starts there or later. Rays must have tmin >= 0 (every ray of a path tracer does):
- * the near/far order of the children is decided from the origin.
+ * the slack of the plane tests is relative to the interval's ends, taken non-negative.
  */
 #ifndef CLPT_TRAVERSE_CL
 #define CLPT_TRAVERSE_CL
@@ -17,8 +17,9 @@
 #include "scene_view.h"
 
 /* Tests global primitive `id` (a sphere, triangle or box: planes are not in the tree)
- * against the ray, whose tmax is the closest hit so far. */
-KFN int trace_prim(const SceneView *sc, uint id, const RayPre *rp, Ray ray, Hit *hit)
+ * against the ray, whose tmax is the closest hit so far. The walk tests triangles by
+ * leaf group and calls this for spheres and boxes. */
+KFN_INLINE int trace_prim(const SceneView *sc, uint id, const RayPre *rp, Ray ray, Hit *hit)
 {
     GLOBAL const RenderParams *pr = sc->params;
     uint first_tri = pr->n_spheres, first_box = first_tri + pr->n_triangles;
@@ -56,71 +57,140 @@ KFN int trace_clip_root(GLOBAL const RenderParams *pr, Ray ray, const RayPre *rp
 #define KD_T_ABOVE (1.0f + KD_T_SLACK)
 #define KD_T_BELOW (1.0f - KD_T_SLACK)
 
-/* The kd-tree walk shared by both queries. With `any` set it returns at the first hit;
- * otherwise it keeps the closest one in *best (whose t starts as the ray's tmax). */
-KFN void trace_tree(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit *best)
-{
+/* A kd-tree walk in progress: the node about to be visited, the part [t0, t1] of the
+ * ray inside it, and the depth of its stack of cells still to visit (far children,
+ * with their parts), which is kept apart: the compilers keep a struct's scalars in
+ * registers only when no part of it is indexed by a variable. */
+typedef struct {
+    uint node;
     float t0, t1;
-    if (!trace_clip_root(sc->params, ray, rp, &t0, &t1)) return;
-    GLOBAL const KdNode *nodes = sc->nodes;
-    uint stack_node[KD_MAX_DEPTH];
-    float stack_t0[KD_MAX_DEPTH], stack_t1[KD_MAX_DEPTH];
-    int sp = 0;
-    uint node = 0;
-    for (;;) {
-        KdNode n = nodes[node];
-        uint axis = n.bits & 3u;
-        if (axis != KD_LEAF) {
-            float split = k_as_float(n.data);
-            float o = rp->org[axis];
-            float tp = (split - o) * rp->inv_d[axis];
-            /* A ray starting on the plane belongs to the side it is heading into. */
-            int below_first = (o < split) | ((o == split) & (rp->dir[axis] <= 0.0f));
-            uint above = n.bits >> 2;
-            uint first = below_first ? node + 1u : above;
-            uint second = below_first ? above : node + 1u;
-            /* Choose between: the near child only (the plane is beyond the interval or
-             * behind the origin), the far child only (crossed before t0), or both, near
-             * first and far pushed. The comparisons with t0 and t1 have a slack of
-             * KD_T_SLACK: tp and the ends of the interval are each rounded (a few ulps),
-             * and a ray through a vertex or edge lying on the plane must not skip the
-             * child holding the triangle it hits. tp is NaN only for a ray lying in the
-             * split plane: it is on the boundary of both children for its whole
-             * interval. The push slot is written either way: an interior node is at
-             * depth <= KD_MAX_DEPTH - 2, so sp stays in range. Compilers turn some of these choices into
-             * branches; for coherent rays (camera, shadow) they predict well, and a
-             * version made of bit selects only was slower on those and no faster on
-             * diffuse rays (docs/kdtree.md). */
-            int in_plane = !(tp == tp);
-            int crosses = tp > 0.0f && tp <= t1 * KD_T_ABOVE;
-            int far_only = crosses && tp < t0 * KD_T_BELOW;
-            int both = (crosses && !far_only) || in_plane;
-            stack_node[sp] = second;
-            stack_t0[sp] = in_plane ? t0 : tp;
-            stack_t1[sp] = t1;
-            sp += both;
-            node = far_only ? second : first;
-            t1 = both && !in_plane ? tp : t1;
-            continue;
+    int sp;
+} KdWalk;
+
+typedef struct {
+    uint node[KD_MAX_DEPTH];
+    float t0[KD_MAX_DEPTH], t1[KD_MAX_DEPTH];
+} KdStack;
+
+/* b if c is 1, a if c is 0 (c is 0 or 1), by masks: no branch. */
+KFN_INLINE uint k_select_u(uint a, uint b, uint c)
+{
+    return a ^ ((a ^ b) & (0u - c));
+}
+
+KFN_INLINE float k_select_f(float a, float b, uint c)
+{
+    return k_as_float(k_select_u(k_as_uint(a), k_as_uint(b), c));
+}
+
+/* One interior node n (the walk's current node). The near child is the one the ray
+ * enters first, which the sign of its direction along the axis decides (-0 counts as
+ * negative: with 1/-0 = -inf a plane beside the origin is then "behind", and the far
+ * child, the origin's side, is taken alone). Three cases: the plane lies beyond the
+ * interval (near child only), before it (far child only, whatever the sign), or inside
+ * it (near child on [t0, tp], far child pushed with [tp, t1]). The comparisons with t0
+ * and t1 have a slack of KD_T_SLACK: tp and the ends of the interval are each rounded
+ * (a few ulps), and a ray through a vertex or edge lying on the plane must not skip the
+ * child holding the triangle it hits. tp is NaN only for a ray lying in the split plane:
+ * it is on the boundary of both children for its whole interval, and every comparison
+ * with NaN is false, which takes both children with the interval unchanged. The push
+ * slot is written in every case and kept only when both children are taken and the far
+ * one is not an empty leaf (KD_EMPTY_*: nothing to test there; an interior node is at
+ * depth <= KD_MAX_DEPTH - 2, so sp stays in range).
+ *
+ * With `branch` set the far-only case is a branch, which the processor predicts for
+ * coherent rays and which keeps the plane test off the chain of node loads; without it
+ * every choice is a bit select, for walks taking turns (TRACE_PAIR), where the other
+ * walk's chain hides the longer one. The two compute the same. */
+KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, KdStack *st, int branch)
+{
+    uint axis = n.bits & 3u;
+    float tp = (k_as_float(n.data) - rp->org[axis]) * rp->inv_d[axis];
+    uint below = w->node + 1u, above = n.bits >> 4;
+    uint near_above = (rp->neg >> axis) & 1u;
+    uint near = k_select_u(below, above, near_above);
+    uint far = near ^ below ^ above;
+    float t0 = w->t0, t1 = w->t1;
+    uint far_only = (uint)(tp < t0 * KD_T_BELOW);
+    if (branch && far_only) {
+        w->node = far;
+        return;
+    }
+    uint both = (uint)!(tp > t1 * KD_T_ABOVE) & (far_only ^ 1u);
+    uint far_empty = (n.bits >> (3u - near_above)) & 1u;
+    int sp = w->sp;
+    st->node[sp] = far;
+    st->t0[sp] = tp > t0 ? tp : t0;
+    st->t1[sp] = t1;
+    w->sp = sp + (int)(both & (far_empty ^ 1u));
+    /* Beyond the interval min(tp, t1) is t1: only "both" shortens it. */
+    w->t1 = k_select_f(tp < t1 ? tp : t1, t1, far_only);
+    w->node = k_select_u(near, far, far_only);
+}
+
+/* Tests the primitives of leaf n against the ray (tmax: the closest hit so far, in
+ * best->t); returns 1 when the walk is over: an any-hit query hit, or nothing is left on
+ * the stack, or the closest hit is no farther than the end of this cell (every cell on
+ * the stack starts there or later). Otherwise pops the next cell. The triangles are
+ * tested a group at a time (triangle_intersect_group: the nearest lane hit, the first
+ * of equals, which is what testing them one by one in lane order gives), then the
+ * spheres and boxes one by one. */
+KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, KdNode n, KdWalk *w,
+                       const KdStack *st, Hit *best)
+{
+    GLOBAL const uint *g = sc->leaf_prims + n.data;
+    uint groups = n.bits >> 3;
+    for (uint i = 0; i < groups; i++, g += KD_GROUP_WORDS) {
+        Hit h;
+        if (triangle_intersect_group(rp, (GLOBAL const float *)(g + KD_GROUP), ray.tmin, best->t, &h)) {
+            h.prim = g[h.prim];
+            *best = h;
+            if (any) return 1;
         }
-        /* One call site for the primitive test, so that it is inlined. */
-        uint count = n.bits >> 2;
-        for (uint i = 0; i < count; i++) {
-            uint id = count == 1u ? n.data : sc->leaf_prims[n.data + i];
+    }
+    if (n.bits & KD_LEAF_OTHERS) {
+        uint count = g[0];
+        for (uint i = 1; i <= count; i++) {
+            uint id = g[i];
             Ray r = ray;
             r.tmax = best->t;
             Hit h;
             if (trace_prim(sc, id, rp, r, &h)) {
                 h.prim = id;
                 *best = h;
-                if (any) return;
+                if (any) return 1;
             }
         }
-        if ((sp == 0) | (best->t <= t1)) return;
-        sp--;
-        node = stack_node[sp];
-        t0 = stack_t0[sp];
-        t1 = stack_t1[sp];
+    }
+    if ((w->sp == 0) | (best->t <= w->t1)) return 1;
+    int sp = w->sp - 1;
+    w->sp = sp;
+    w->node = st->node[sp];
+    w->t0 = st->t0[sp];
+    w->t1 = st->t1[sp];
+    return 0;
+}
+
+/* The ray clipped to the root box: 0 when it misses the box. */
+KFN_INLINE int kd_walk_begin(const SceneView *sc, Ray ray, const RayPre *rp, KdWalk *w)
+{
+    w->node = 0u;
+    w->sp = 0;
+    return trace_clip_root(sc->params, ray, rp, &w->t0, &w->t1);
+}
+
+/* The kd-tree walk shared by both queries. With `any` set it returns at the first hit;
+ * otherwise it keeps the closest one in *best (whose t starts as the ray's tmax). */
+KFN_INLINE void trace_tree(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit *best)
+{
+    KdWalk w;
+    KdStack st;
+    if (!kd_walk_begin(sc, ray, rp, &w)) return;
+    GLOBAL const KdNode *nodes = sc->nodes;
+    for (;;) {
+        KdNode n = nodes[w.node];
+        if ((n.bits & 3u) != KD_LEAF) kd_step(rp, n, &w, &st, 1);
+        else if (kd_leaf(sc, ray, rp, any, n, &w, &st, best)) return;
     }
 }
 
@@ -168,155 +238,91 @@ KFN int trace_any(const SceneView *sc, Ray ray)
 
 /* A kd-tree walk is a chain of dependent loads: the next node is known only once the
  * plane test of this one is done, and for incoherent rays the branches of that test are
- * mispredicted about half the time. Walking two independent rays in turns, with the
- * interior step written as bit selects rather than branches, lets the processor overlap
- * the two chains: diffuse rays ran 20-30% faster this way on the scalar C build, and
- * camera rays no slower (docs/kdtree.md). The result of each ray is bit for bit that of
- * trace_closest / trace_any: the same nodes in the same order, the same tests. */
+ * mispredicted often. Walking two independent rays in turns, with the interior step
+ * written as bit selects rather than branches, lets the processor overlap the two
+ * chains. On PoCL that pays only for incoherent rays of large meshes and costs camera
+ * and shadow rays 15-25% (docs/kdtree.md); the renderer walks one ray per work-item,
+ * the benchmark times both. The result of each ray is bit for bit that of
+ * trace_closest / trace_any: the same nodes in the same order, the same tests.
+ * Everything is inlined so that the walks' scalars stay in registers. */
 typedef struct {
-    uint stack_node[KD_MAX_DEPTH];
-    float stack_t0[KD_MAX_DEPTH], stack_t1[KD_MAX_DEPTH];
-    int sp;
-    int active;         /* still walking */
-    int any;            /* any-hit query: stop at the first hit */
-    uint node;
-    float t0, t1;
     Ray ray;
-    RayPre rp;
     Hit best;
-} TraceState;
-
-/* b if c is 1, a if c is 0 (c is 0 or 1), by masks: no branch. */
-KFN uint k_select_u(uint a, uint b, uint c)
-{
-    uint m = 0u - c;
-    return (a & ~m) | (b & m);
-}
-
-KFN float k_select_f(float a, float b, uint c)
-{
-    return k_as_float(k_select_u(k_as_uint(a), k_as_uint(b), c));
-}
+    int any;            /* any-hit query: stop at the first hit */
+    int active;         /* still walking */
+} TraceRay;
 
 /* The planes, then the ray clipped to the root box, as trace_closest and trace_any do. */
-KFN void trace_state_begin(const SceneView *sc, Ray ray, int any, TraceState *s)
+KFN_INLINE void trace_ray_begin(const SceneView *sc, Ray ray, int any, TraceRay *t, RayPre *rp, KdWalk *w)
 {
     GLOBAL const RenderParams *pr = sc->params;
-    s->ray = ray;
-    s->any = any;
-    s->best.t = ray.tmax;
-    s->best.prim = NO_INDEX;
-    s->best.u = 0.0f;
-    s->best.v = 0.0f;
-    s->sp = 0;
-    s->node = 0u;
+    t->ray = ray;
+    t->any = any;
+    t->best.t = ray.tmax;
+    t->best.prim = NO_INDEX;
+    t->best.u = 0.0f;
+    t->best.v = 0.0f;
+    t->active = 0;
+    w->node = 0u;
+    w->sp = 0;
+    w->t0 = w->t1 = 0.0f;
     uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes;
     for (uint i = 0; i < pr->n_planes; i++) {
         Ray r = ray;
-        r.tmax = any ? ray.tmax : s->best.t;
+        r.tmax = t->best.t;
         Hit h;
         if (plane_intersect(sc->planes[i], r, &h)) {
             h.prim = first_plane + i;
-            if (any) {
-                s->best.prim = h.prim;
-                s->active = 0;
-                return;
-            }
-            s->best = h;
+            t->best = h;
+            if (any) return;
         }
     }
-    s->rp = ray_prepare(ray);
-    s->active = trace_clip_root(pr, ray, &s->rp, &s->t0, &s->t1);
+    *rp = ray_prepare(ray);
+    t->active = kd_walk_begin(sc, ray, rp, w);
 }
 
-/* One interior step; returns 1, with the node in *leaf, when the walk is at a leaf. */
-KFN int trace_state_interior(const SceneView *sc, TraceState *s, KdNode *leaf)
+/* The rest of one walk, alone. */
+KFN_INLINE void trace_ray_finish(const SceneView *sc, TraceRay *t, const RayPre *rp, KdWalk *w, KdStack *st)
 {
-    KdNode n = sc->nodes[s->node];
-    uint axis = n.bits & 3u;
-    if (axis == KD_LEAF) {
-        *leaf = n;
-        return 1;
+    GLOBAL const KdNode *nodes = sc->nodes;
+    while (t->active) {
+        KdNode n = nodes[w->node];
+        if ((n.bits & 3u) != KD_LEAF) kd_step(rp, n, w, st, 1);
+        else t->active = !kd_leaf(sc, t->ray, rp, t->any, n, w, st, &t->best);
     }
-    float split = k_as_float(n.data);
-    float o = s->rp.org[axis];
-    float tp = (split - o) * s->rp.inv_d[axis];
-    uint below_first = (uint)(o < split) | ((uint)(o == split) & (uint)(s->rp.dir[axis] <= 0.0f));
-    uint above = n.bits >> 2, below = s->node + 1u;
-    uint first = k_select_u(above, below, below_first);
-    uint second = first ^ above ^ below;
-    uint in_plane = (uint)!(tp == tp);
-    uint crosses = (uint)(tp > 0.0f) & (uint)(tp <= s->t1 * KD_T_ABOVE);
-    uint far_only = crosses & (uint)(tp < s->t0 * KD_T_BELOW);
-    uint both = (crosses & (far_only ^ 1u)) | in_plane;
-    int sp = s->sp;
-    s->stack_node[sp] = second;
-    s->stack_t0[sp] = k_select_f(tp, s->t0, in_plane);
-    s->stack_t1[sp] = s->t1;
-    s->sp = sp + (int)both;
-    s->node = k_select_u(first, second, far_only);
-    s->t1 = k_select_f(s->t1, tp, both & (in_plane ^ 1u));
-    return 0;
 }
 
-/* The leaf's primitives, then the next cell from the stack (or the end of the walk). */
-KFN void trace_state_leaf(const SceneView *sc, TraceState *s, KdNode n)
-{
-    uint count = n.bits >> 2;
-    for (uint i = 0; i < count; i++) {
-        uint id = count == 1u ? n.data : sc->leaf_prims[n.data + i];
-        Ray r = s->ray;
-        r.tmax = s->best.t;
-        Hit h;
-        if (trace_prim(sc, id, &s->rp, r, &h)) {
-            h.prim = id;
-            s->best = h;
-            if (s->any) {
-                s->active = 0;
-                return;
-            }
-        }
-    }
-    if ((s->sp == 0) | (s->best.t <= s->t1)) {
-        s->active = 0;
-        return;
-    }
-    s->sp--;
-    s->node = s->stack_node[s->sp];
-    s->t0 = s->stack_t0[s->sp];
-    s->t1 = s->stack_t1[s->sp];
-}
-
-KFN void trace_state_finish(const SceneView *sc, TraceState *s)
-{
-    KdNode leaf;
-    while (s->active)
-        if (trace_state_interior(sc, s, &leaf)) trace_state_leaf(sc, s, leaf);
-}
-
-/* Walks both in turns while both are active, then finishes the other. */
-KFN void trace_pair(const SceneView *sc, TraceState *a, TraceState *b)
-{
-    KdNode la, lb;
-    la.data = lb.data = 0u;
-    la.bits = lb.bits = KD_LEAF;
-    while (a->active & b->active) {
-        int at_a = trace_state_interior(sc, a, &la);
-        int at_b = trace_state_interior(sc, b, &lb);
-        if (at_a) trace_state_leaf(sc, a, la);
-        if (at_b) trace_state_leaf(sc, b, lb);
-    }
-    trace_state_finish(sc, a);
-    trace_state_finish(sc, b);
-}
+/* Both rays' walks in turns while both are active, then the other one's rest. */
+#define TRACE_PAIR(sc, a, pa, wa, sa, b, pb, wb, sb)                                     \
+    do {                                                                                 \
+        GLOBAL const KdNode *nodes_ = (sc)->nodes;                                       \
+        while ((a).active & (b).active) {                                                \
+            KdNode na = nodes_[(wa).node], nb = nodes_[(wb).node];                       \
+            uint la = (uint)((na.bits & 3u) == KD_LEAF), lb = (uint)((nb.bits & 3u) == KD_LEAF); \
+            if ((la | lb) == 0u) {                                                       \
+                kd_step(&(pa), na, &(wa), &(sa), 0);                                     \
+                kd_step(&(pb), nb, &(wb), &(sb), 0);                                     \
+                continue;                                                                \
+            }                                                                            \
+            if (la) (a).active = !kd_leaf(sc, (a).ray, &(pa), (a).any, na, &(wa), &(sa), &(a).best); \
+            else kd_step(&(pa), na, &(wa), &(sa), 0);                                    \
+            if (lb) (b).active = !kd_leaf(sc, (b).ray, &(pb), (b).any, nb, &(wb), &(sb), &(b).best); \
+            else kd_step(&(pb), nb, &(wb), &(sb), 0);                                    \
+        }                                                                                \
+        trace_ray_finish(sc, &(a), &(pa), &(wa), &(sa));                                 \
+        trace_ray_finish(sc, &(b), &(pb), &(wb), &(sb));                                 \
+    } while (0)
 
 /* trace_closest of two rays. */
 KFN void trace_closest2(const SceneView *sc, Ray ra, Ray rb, Hit *ha, Hit *hb)
 {
-    TraceState a, b;
-    trace_state_begin(sc, ra, 0, &a);
-    trace_state_begin(sc, rb, 0, &b);
-    trace_pair(sc, &a, &b);
+    TraceRay a, b;
+    RayPre pa, pb;
+    KdWalk wa, wb;
+    KdStack sa, sb;
+    trace_ray_begin(sc, ra, 0, &a, &pa, &wa);
+    trace_ray_begin(sc, rb, 0, &b, &pb, &wb);
+    TRACE_PAIR(sc, a, pa, wa, sa, b, pb, wb, sb);
     *ha = a.best;
     *hb = b.best;
 }
@@ -324,10 +330,13 @@ KFN void trace_closest2(const SceneView *sc, Ray ra, Ray rb, Hit *ha, Hit *hb)
 /* trace_any of two rays. */
 KFN void trace_any2(const SceneView *sc, Ray ra, Ray rb, int *oa, int *ob)
 {
-    TraceState a, b;
-    trace_state_begin(sc, ra, 1, &a);
-    trace_state_begin(sc, rb, 1, &b);
-    trace_pair(sc, &a, &b);
+    TraceRay a, b;
+    RayPre pa, pb;
+    KdWalk wa, wb;
+    KdStack sa, sb;
+    trace_ray_begin(sc, ra, 1, &a, &pa, &wa);
+    trace_ray_begin(sc, rb, 1, &b, &pb, &wb);
+    TRACE_PAIR(sc, a, pa, wa, sa, b, pb, wb, sb);
     *oa = a.best.prim != NO_INDEX;
     *ob = b.best.prim != NO_INDEX;
 }

@@ -41,16 +41,27 @@ typedef struct {                                        /* 16 bytes */
 } Hit;
 
 /* kd-tree node, 8 bytes (layout in docs/kdtree.md).
- * Interior: bits = axis (0,1,2) in the low 2 bits | index of the "above" child << 2;
- *           the "below" child is the next node; split = the plane position (float bits).
- * Leaf:     bits = 3 | primitive count << 2; data = the single primitive id when the
- *           count is 1, otherwise the offset of the leaf's ids in the leaf_prims array. */
+ * Interior: bits = axis (0,1,2) in the low 2 bits | KD_EMPTY_BELOW, KD_EMPTY_ABOVE when
+ *           that child is an empty leaf | index of the "above" child << 4; the "below"
+ *           child is the next node; data = the plane position (float bits).
+ * Leaf:     bits = 3 | KD_LEAF_OTHERS if it holds spheres or boxes | triangle groups << 3;
+ *           data = the offset of its record in the leaf data array (the leaf_prims
+ *           buffer, 32-bit words): that many triangle groups of KD_GROUP_WORDS words
+ *           each, then, with KD_LEAF_OTHERS, a count and the global ids of the
+ *           spheres and boxes. A group holds KD_GROUP triangles: their global ids, then
+ *           the corners as 9 rows of KD_GROUP floats (p0.x, p0.y, p0.z, p1.x, ... p2.z),
+ *           the last triangle repeated in the unused lanes. */
 typedef struct {
-    uint data;      /* interior: as_uint(split position); leaf: prim id or offset */
+    uint data;      /* interior: as_uint(split position); leaf: offset in the leaf data */
     uint bits;
 } KdNode;
 
 #define KD_LEAF 3u
+#define KD_EMPTY_BELOW 4u
+#define KD_EMPTY_ABOVE 8u
+#define KD_LEAF_OTHERS 4u
+#define KD_GROUP 8u
+#define KD_GROUP_WORDS (KD_GROUP * 10u)
 
 /* Global primitive ids: [0, n_spheres) spheres, then triangles, then boxes, then
  * planes. Spheres, triangles and boxes are in the kd-tree; infinite planes are not. */

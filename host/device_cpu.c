@@ -102,6 +102,7 @@ static Status cpu_load_scene(Device *d, const DeviceScene *scene, Error *err)
     cd->view.lights = scene->lights;
     cd->view.shading = scene->shading;
     d->n_pixels = n_pixels;
+    d->max_in_flight = 1;
     return ST_OK;
 }
 

@@ -1,12 +1,21 @@
 /*
  * device_ocl.c — an OpenCL device rendering batches as a wavefront.
  *
- * The scene is uploaded once. A batch is cut into waves of at most `wave_paths` paths
- * (a range of pixels times a few consecutive sample indices). Per wave: k_raygen births
- * every path, then each bounce runs k_intersect → k_shade → k_shadow over the queue of
- * live paths only (k_shade compacts survivors into the other queue; the host reads the
- * two counts to size the next launches), and k_film adds the wave into the device's
- * fixed-point film. Rays, hits and path states never leave the device.
+ * The scene is uploaded once. A batch is cut into waves of `wave_paths` paths, numbered
+ * sample-major over the image, so every wave but a batch's last is full. Per wave:
+ * k_raygen births every path, then each bounce runs k_intersect → k_shade → k_shadow
+ * over the queue of live paths only (k_shade compacts survivors into the other queue),
+ * and k_film adds the wave into the batch's device film. Rays, hits and path states
+ * never leave the device.
+ *
+ * The host never waits for the device to go idle inside a batch. The queue lengths stay
+ * on the device (entry.cl); the host launches bounce b over an upper bound of its live
+ * paths — the exact count of bounce b when its read-back has already arrived, else the
+ * count of bounce b - 1 — while the device still works on bounce b - 1, and it stops
+ * launching once a count reads zero. Work-items beyond the device-side count return at
+ * once. Between batches the films are double buffered: the read-back of batch k runs
+ * while batch k + 1's kernels run, and take_film collects it afterwards (at most
+ * FILM_SLOTS batches in flight, see device.h).
  */
 #include <stdlib.h>
 #include <string.h>
@@ -16,11 +25,31 @@
 #include "timer.h"
 
 /* Work-group size for every launch: a multiple of every GPU's SIMD width; the global
- * size is rounded up to it and the kernels ignore the excess work-items. */
+ * size is rounded up to it and the kernels ignore the excess work-items. On PoCL 3.1
+ * (CPU) sizes 8 to 128 measured the same. */
 #define OCL_LOCAL_SIZE 64u
+/* Device films: one being rendered into while the previous one is read back. */
+#define FILM_SLOTS 2
+/* Waves whose count read-backs may still be in flight (for the ray statistics). */
+#define COUNT_RING 4
 
 enum { SCENE_PARAMS, SCENE_NODES, SCENE_LEAF_PRIMS, SCENE_SPHERES, SCENE_TRIANGLES,
        SCENE_BOXES, SCENE_PLANES, SCENE_MATERIALS, SCENE_LIGHTS, SCENE_SHADING, SCENE_N };
+
+/* A batch's film on the device and where its read-back lands. */
+typedef struct {
+    cl_mem film;
+    int64_t *host;
+    cl_event read_done;     /* the read-back in flight; NULL while the slot is free */
+} FilmSlot;
+
+/* The queue lengths of one wave as read back: counts[2b] live paths and counts[2b + 1]
+ * shadow rays at bounce b (entry.cl), for the ray statistics. */
+typedef struct {
+    cl_uint *counts;
+    cl_event last_read;     /* the wave's last count read-back; NULL when accounted */
+    uint n_bounces;
+} WaveCounts;
 
 typedef struct {
     OclDeviceInfo info;
@@ -29,10 +58,16 @@ typedef struct {
     cl_program program;
     cl_kernel k_raygen, k_intersect, k_shade, k_shadow, k_film;
     cl_mem scene[SCENE_N];
-    cl_mem paths, rays, hits, shadow_rays, queue_a, queue_b, shadow_queue, counters, film;
+    cl_mem paths, rays, hits, shadow_rays, queue_a, queue_b, shadow_queue, counts;
+    FilmSlot slots[FILM_SLOTS];
+    uint n_slots;           /* 2, or 1 when two films do not fit the device */
+    uint head, tail;        /* batches rendered and taken, counted from 0 */
+    WaveCounts ring[COUNT_RING];
+    uint ring_next;
+    uint max_bounces;       /* bounces 0 .. max_depth; counts holds 2 * max_bounces + 1 */
     uint wave_paths;        /* capacity of the wave buffers */
     size_t local_size;      /* 0: let the driver choose */
-    uint width, height;
+    uint n_pixels;
 } OclDevice;
 
 #define OCL_TRY(call_name, expr)                                                       \
@@ -47,8 +82,16 @@ static void release_mem(cl_mem *m)
     *m = NULL;
 }
 
+static void release_event(cl_event *e)
+{
+    if (*e) clReleaseEvent(*e);
+    *e = NULL;
+}
+
 static void release_buffers(OclDevice *od)
 {
+    /* events first: a pending read-back must not land in freed memory */
+    if (od->queue) clFinish(od->queue);
     for (int i = 0; i < SCENE_N; i++) release_mem(&od->scene[i]);
     release_mem(&od->paths);
     release_mem(&od->rays);
@@ -57,8 +100,19 @@ static void release_buffers(OclDevice *od)
     release_mem(&od->queue_a);
     release_mem(&od->queue_b);
     release_mem(&od->shadow_queue);
-    release_mem(&od->counters);
-    release_mem(&od->film);
+    release_mem(&od->counts);
+    for (int i = 0; i < FILM_SLOTS; i++) {
+        release_event(&od->slots[i].read_done);
+        release_mem(&od->slots[i].film);
+        free(od->slots[i].host);
+        od->slots[i].host = NULL;
+    }
+    for (int i = 0; i < COUNT_RING; i++) {
+        release_event(&od->ring[i].last_read);
+        free(od->ring[i].counts);
+        od->ring[i].counts = NULL;
+    }
+    od->head = od->tail = 0;
 }
 
 /* A device buffer of `bytes` (at least 16: OpenCL has no empty buffers), filled from
@@ -96,6 +150,43 @@ static Status set_scene_args(OclDevice *od, cl_kernel k, Error *err)
     return ST_OK;
 }
 
+/* The arguments that stay the same for the whole render, set once after the upload;
+ * only queues, slots, wave positions and the film change per launch. */
+static Status set_fixed_args(OclDevice *od, Error *err)
+{
+    Status st;
+    if ((st = set_scene_args(od, od->k_intersect, err)) || (st = set_scene_args(od, od->k_shade, err)) ||
+        (st = set_scene_args(od, od->k_shadow, err)))
+        return st;
+    cl_kernel k = od->k_raygen;
+    ARG(k, 0, od->scene[SCENE_PARAMS]);
+    ARG(k, 3, od->n_pixels);
+    ARG(k, 5, od->paths);
+    ARG(k, 6, od->rays);
+    ARG(k, 7, od->queue_a);
+    ARG(k, 8, od->counts);
+    k = od->k_intersect;
+    ARG(k, SCENE_N + 1, od->counts);
+    ARG(k, SCENE_N + 3, od->rays);
+    ARG(k, SCENE_N + 4, od->hits);
+    k = od->k_shade;
+    ARG(k, SCENE_N + 1, od->counts);
+    ARG(k, SCENE_N + 3, od->rays);
+    ARG(k, SCENE_N + 4, od->hits);
+    ARG(k, SCENE_N + 5, od->paths);
+    ARG(k, SCENE_N + 6, od->shadow_rays);
+    ARG(k, SCENE_N + 8, od->shadow_queue);
+    k = od->k_shadow;
+    ARG(k, SCENE_N + 0, od->shadow_queue);
+    ARG(k, SCENE_N + 1, od->counts);
+    ARG(k, SCENE_N + 3, od->shadow_rays);
+    ARG(k, SCENE_N + 4, od->paths);
+    k = od->k_film;
+    ARG(k, 0, od->paths);
+    ARG(k, 2, od->n_pixels);
+    return ST_OK;
+}
+
 static Status launch(OclDevice *od, cl_kernel k, const char *name, uint n, Error *err)
 {
     if (n == 0) return ST_OK;
@@ -107,6 +198,36 @@ static Status launch(OclDevice *od, cl_kernel k, const char *name, uint n, Error
         error_prefix(err, "kernel %s over %u items", name, n);
         return ST_DEVICE;
     }
+    return ST_OK;
+}
+
+/* 1 when the command of `ev` has finished, 0 while it runs; an error when it failed. */
+static Status event_done(OclDevice *od, cl_event ev, int *done, Error *err)
+{
+    cl_int status;
+    OCL_TRY("clGetEventInfo", clGetEventInfo(ev, CL_EVENT_COMMAND_EXECUTION_STATUS, sizeof status, &status, NULL));
+    if (status < 0) return ocl_failf(err, &od->info, "a queued command", status, "reported by its event");
+    *done = status == CL_COMPLETE;
+    return ST_OK;
+}
+
+/* Adds the rays of a wave whose counts have arrived to the statistics; with `wait` it
+ * waits for them, otherwise a wave still in flight is left for later. */
+static Status account_wave(Device *d, WaveCounts *wc, int wait, Error *err)
+{
+    OclDevice *od = d->impl;
+    if (!wc->last_read) return ST_OK;
+    if (wait) {
+        OCL_TRY("clWaitForEvents", clWaitForEvents(1, &wc->last_read));
+    } else {
+        int done = 0;
+        Status st = event_done(od, wc->last_read, &done, err);
+        if (st || !done) return st;
+    }
+    uint64_t rays = 0;
+    for (uint b = 0; b < wc->n_bounces; b++) rays += (uint64_t)wc->counts[2 * b] + wc->counts[2 * b + 1];
+    d->counters.rays += rays;
+    release_event(&wc->last_read);
     return ST_OK;
 }
 
@@ -132,8 +253,13 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     for (int i = 0; i < SCENE_N; i++) total += in[i].bytes;
     uint n_pixels = p->width * p->height;
     uint wave = od->wave_paths;
+    od->max_bounces = p->max_depth + 1u;
+    size_t counts_bytes = (2u * (size_t)od->max_bounces + 1u) * sizeof(cl_uint);
     size_t film_bytes = (size_t)n_pixels * 3u * sizeof(cl_long);
     cl_ulong wave_bytes = (cl_ulong)wave * (sizeof(PathState) + 2 * sizeof(Ray) + sizeof(Hit) + 3 * sizeof(uint));
+    /* Double-buffered films when they fit, else one: the device then waits for each
+     * read-back, nothing worse. */
+    od->n_slots = total + 2 * (cl_ulong)film_bytes + wave_bytes <= od->info.global_mem ? 2 : 1;
     if (total + film_bytes + wave_bytes > od->info.global_mem)
         return error_set(err, ST_DEVICE,
                          "device '%s': the scene (%.1f MiB), film (%.1f MiB) and path buffers (%.1f MiB) "
@@ -151,142 +277,151 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
         (st = make_buffer(od, CL_MEM_READ_WRITE, (size_t)wave * sizeof(uint), NULL, "path queue", &od->queue_a, err)) ||
         (st = make_buffer(od, CL_MEM_READ_WRITE, (size_t)wave * sizeof(uint), NULL, "path queue", &od->queue_b, err)) ||
         (st = make_buffer(od, CL_MEM_READ_WRITE, (size_t)wave * sizeof(uint), NULL, "shadow queue", &od->shadow_queue, err)) ||
-        (st = make_buffer(od, CL_MEM_READ_WRITE, 2 * sizeof(cl_uint), NULL, "queue counters", &od->counters, err)) ||
-        (st = make_buffer(od, CL_MEM_READ_WRITE, film_bytes, NULL, "film", &od->film, err)))
+        (st = make_buffer(od, CL_MEM_READ_WRITE, counts_bytes, NULL, "queue counters", &od->counts, err)))
         return st;
     cl_long zero = 0;
-    OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, od->film, &zero, sizeof zero, 0,
-                                                       film_bytes < 16 ? 16 : film_bytes, 0, NULL, NULL));
+    for (uint i = 0; i < od->n_slots; i++) {
+        FilmSlot *fs = &od->slots[i];
+        if ((st = make_buffer(od, CL_MEM_READ_WRITE, film_bytes, NULL, "film", &fs->film, err))) return st;
+        if (!(fs->host = malloc(film_bytes < 16 ? 16 : film_bytes)))
+            return error_set(err, ST_INTERNAL, "out of memory for the read-back of the film");
+        OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, fs->film, &zero, sizeof zero, 0,
+                                                           film_bytes < 16 ? 16 : film_bytes, 0, NULL, NULL));
+    }
+    for (int i = 0; i < COUNT_RING; i++)
+        if (!(od->ring[i].counts = calloc(counts_bytes, 1)))
+            return error_set(err, ST_INTERNAL, "out of memory for queue counters");
     OCL_TRY("clFinish", clFinish(od->queue));
-    if ((st = set_scene_args(od, od->k_intersect, err)) || (st = set_scene_args(od, od->k_shade, err)) ||
-        (st = set_scene_args(od, od->k_shadow, err)))
-        return st;
-    od->width = p->width;
-    od->height = p->height;
+    od->n_pixels = n_pixels;
+    if ((st = set_fixed_args(od, err))) return st;
     d->n_pixels = n_pixels;
+    d->max_in_flight = od->n_slots;
     d->counters.upload_seconds += timer_now() - t0;
     return ST_OK;
 }
 
-/* One wave: pixels [first_pixel, first_pixel + wave_pixels) x samples
- * [first_sample, first_sample + layers). Returns the number of rays traced. */
-static Status render_wave(OclDevice *od, uint first_pixel, uint wave_pixels, uint first_sample,
-                          uint layers, uint64_t *rays, Error *err)
+/* One wave: path numbers [first_pixel, first_pixel + n_paths) counted from pixel 0 of
+ * sample `first_sample` (entry.cl), added into `film`. */
+static Status render_wave(Device *d, cl_mem film, uint first_pixel, uint first_sample, uint n_paths, Error *err)
 {
-    uint n_paths = wave_pixels * layers;
+    OclDevice *od = d->impl;
     Status st;
+    WaveCounts *wc = &od->ring[od->ring_next];
+    od->ring_next = (od->ring_next + 1) % COUNT_RING;
+    if ((st = account_wave(d, wc, 1, err))) return st;
+    cl_uint *hc = wc->counts;
+    hc[0] = n_paths;
+
+    cl_uint zero = 0;
+    OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, od->counts, &zero, sizeof zero, 0,
+                                                       (2u * (size_t)od->max_bounces + 1u) * sizeof zero, 0, NULL, NULL));
     cl_kernel k = od->k_raygen;
-    ARG(k, 0, od->scene[SCENE_PARAMS]);
     ARG(k, 1, first_pixel);
-    ARG(k, 2, wave_pixels);
-    ARG(k, 3, first_sample);
+    ARG(k, 2, first_sample);
     ARG(k, 4, n_paths);
-    ARG(k, 5, od->paths);
-    ARG(k, 6, od->rays);
-    ARG(k, 7, od->queue_a);
     if ((st = launch(od, k, "k_raygen", n_paths, err))) return st;
 
     cl_mem cur = od->queue_a, next = od->queue_b;
-    uint n = n_paths;
-    while (n > 0) {
+    cl_event prev = NULL, ev = NULL;
+    uint bound = n_paths, b = 0;
+    for (;;) {
+        cl_uint slot = 2u * b, shadow_slot = 2u * b + 1u;
         k = od->k_intersect;
         ARG(k, SCENE_N + 0, cur);
-        ARG(k, SCENE_N + 1, n);
-        ARG(k, SCENE_N + 2, od->rays);
-        ARG(k, SCENE_N + 3, od->hits);
-        if ((st = launch(od, k, "k_intersect", n, err))) return st;
-
-        cl_uint zero2[2] = { 0, 0 };
-        OCL_TRY("clEnqueueWriteBuffer", clEnqueueWriteBuffer(od->queue, od->counters, CL_FALSE, 0,
-                                                             sizeof zero2, zero2, 0, NULL, NULL));
+        ARG(k, SCENE_N + 2, slot);
+        if ((st = launch(od, k, "k_intersect", bound, err))) goto fail;
         k = od->k_shade;
         ARG(k, SCENE_N + 0, cur);
-        ARG(k, SCENE_N + 1, n);
-        ARG(k, SCENE_N + 2, od->rays);
-        ARG(k, SCENE_N + 3, od->hits);
-        ARG(k, SCENE_N + 4, od->paths);
-        ARG(k, SCENE_N + 5, od->shadow_rays);
-        ARG(k, SCENE_N + 6, next);
-        ARG(k, SCENE_N + 7, od->shadow_queue);
-        ARG(k, SCENE_N + 8, od->counters);
-        if ((st = launch(od, k, "k_shade", n, err))) return st;
-
-        cl_uint counts[2];
-        OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, od->counters, CL_TRUE, 0,
-                                                           sizeof counts, counts, 0, NULL, NULL));
-        *rays += n;
-        if (counts[1] > 0) {
-            k = od->k_shadow;
-            ARG(k, SCENE_N + 0, od->shadow_queue);
-            ARG(k, SCENE_N + 1, counts[1]);
-            ARG(k, SCENE_N + 2, od->shadow_rays);
-            ARG(k, SCENE_N + 3, od->paths);
-            if ((st = launch(od, k, "k_shadow", counts[1], err))) return st;
-            *rays += counts[1];
+        ARG(k, SCENE_N + 2, slot);
+        ARG(k, SCENE_N + 7, next);
+        if ((st = launch(od, k, "k_shade", bound, err))) goto fail;
+        k = od->k_shadow;
+        ARG(k, SCENE_N + 2, shadow_slot);
+        if ((st = launch(od, k, "k_shadow", bound, err))) goto fail;
+        cl_int rc = clEnqueueReadBuffer(od->queue, od->counts, CL_FALSE, shadow_slot * sizeof(cl_uint),
+                                        2 * sizeof(cl_uint), &hc[shadow_slot], 0, NULL, &ev);
+        if (rc == CL_SUCCESS) rc = clFlush(od->queue);
+        if (rc != CL_SUCCESS) {
+            st = ocl_fail(err, &od->info, "clEnqueueReadBuffer", rc);
+            goto fail;
         }
+        b++;
+        /* While the device runs bounce b - 1, learn how many paths bounce b - 2 left
+         * alive: a bound for bounce b, unless bounce b's own count is already in. */
+        if (prev) {
+            rc = clWaitForEvents(1, &prev);
+            release_event(&prev);
+            if (rc != CL_SUCCESS) {
+                st = ocl_fail(err, &od->info, "clWaitForEvents", rc);
+                goto fail;
+            }
+        }
+        prev = ev;
+        ev = NULL;
+        int have_next = 0;
+        if ((st = event_done(od, prev, &have_next, err))) goto fail;
+        bound = have_next ? hc[2u * b] : hc[2u * (b - 1u)];
+        if (bound == 0 || b >= od->max_bounces) break;
         cl_mem t = cur;
         cur = next;
         next = t;
-        n = counts[0];
     }
+    wc->last_read = prev;
+    wc->n_bounces = b;
 
     k = od->k_film;
-    ARG(k, 0, od->paths);
     ARG(k, 1, first_pixel);
-    ARG(k, 2, wave_pixels);
-    ARG(k, 3, layers);
-    ARG(k, 4, od->film);
-    return launch(od, k, "k_film", wave_pixels, err);
+    ARG(k, 3, n_paths);
+    ARG(k, 4, film);
+    return launch(od, k, "k_film", n_paths < od->n_pixels ? n_paths : od->n_pixels, err);
+
+fail:
+    release_event(&prev);
+    release_event(&ev);
+    return st;
 }
 
 static Status ocl_render(Device *d, uint first_sample, uint count, Error *err)
 {
     OclDevice *od = d->impl;
-    uint n_pixels = d->n_pixels;
-    uint64_t rays = 0;
+    FilmSlot *fs = &od->slots[od->head % od->n_slots];
+    if (fs->read_done)
+        return error_set(err, ST_INTERNAL, "device '%s': more than %u batches in flight", od->info.name, od->n_slots);
+    uint64_t n_pixels = od->n_pixels, total = n_pixels * count;
     Status st;
-    if (n_pixels >= od->wave_paths) {
-        /* big image: waves of one sample over a range of pixels */
-        for (uint s = 0; s < count; s++)
-            for (uint p0 = 0; p0 < n_pixels; p0 += od->wave_paths) {
-                uint np = n_pixels - p0 < od->wave_paths ? n_pixels - p0 : od->wave_paths;
-                if ((st = render_wave(od, p0, np, first_sample + s, 1, &rays, err))) return st;
-            }
-    } else {
-        /* small image: several samples of every pixel per wave */
-        uint max_layers = od->wave_paths / n_pixels;
-        for (uint s = 0; s < count;) {
-            uint layers = count - s < max_layers ? count - s : max_layers;
-            if ((st = render_wave(od, 0, n_pixels, first_sample + s, layers, &rays, err))) return st;
-            s += layers;
-        }
+    for (uint64_t p0 = 0; p0 < total; p0 += od->wave_paths) {
+        uint n = total - p0 < od->wave_paths ? (uint)(total - p0) : od->wave_paths;
+        if ((st = render_wave(d, fs->film, (uint)(p0 % n_pixels), first_sample + (uint)(p0 / n_pixels), n, err)))
+            return st;
     }
-    OCL_TRY("clFinish", clFinish(od->queue));
-    d->counters.rays += rays;
-    d->counters.samples += (uint64_t)n_pixels * count;
+    /* The film comes back while the next batch renders; zeroed on the device after. */
+    size_t bytes = (size_t)n_pixels * 3u * sizeof(cl_long);
+    OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, fs->film, CL_FALSE, 0, bytes, fs->host, 0, NULL,
+                                                       &fs->read_done));
+    cl_long zero = 0;
+    OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, fs->film, &zero, sizeof zero, 0, bytes, 0, NULL, NULL));
+    OCL_TRY("clFlush", clFlush(od->queue));
+    od->head++;
+    d->counters.samples += n_pixels * count;
     return ST_OK;
 }
 
 static Status ocl_take_film(Device *d, int64_t *film, Error *err)
 {
     OclDevice *od = d->impl;
-    size_t n = (size_t)d->n_pixels * 3u;
-    cl_long *tmp = malloc(n * sizeof *tmp);
-    if (!tmp) return error_set(err, ST_INTERNAL, "out of memory reading the film back");
-    cl_int rc = clEnqueueReadBuffer(od->queue, od->film, CL_TRUE, 0, n * sizeof *tmp, tmp, 0, NULL, NULL);
-    if (rc == CL_SUCCESS) {
-        cl_long zero = 0;
-        rc = clEnqueueFillBuffer(od->queue, od->film, &zero, sizeof zero, 0, n * sizeof *tmp, 0, NULL, NULL);
-        if (rc != CL_SUCCESS) {
-            free(tmp);
-            return ocl_fail(err, &od->info, "clEnqueueFillBuffer", rc);
-        }
-    } else {
-        free(tmp);
-        return ocl_fail(err, &od->info, "clEnqueueReadBuffer", rc);
+    FilmSlot *fs = &od->slots[od->tail % od->n_slots];
+    if (!fs->read_done) return error_set(err, ST_INTERNAL, "device '%s': no batch to take", od->info.name);
+    OCL_TRY("clWaitForEvents", clWaitForEvents(1, &fs->read_done));
+    release_event(&fs->read_done);
+    od->tail++;
+    size_t n = (size_t)od->n_pixels * 3u;
+    for (size_t i = 0; i < n; i++) film[i] += fs->host[i];
+    /* Every wave of this batch is done; with nothing else in flight, so is every wave. */
+    int idle = od->head == od->tail;
+    for (int i = 0; i < COUNT_RING; i++) {
+        Status st = account_wave(d, &od->ring[i], idle, err);
+        if (st) return st;
     }
-    for (size_t i = 0; i < n; i++) film[i] += tmp[i];
-    free(tmp);
     return ST_OK;
 }
 

@@ -64,12 +64,11 @@ static Status write_film(const Film *film, const char *path, Error *err)
 
 /* Progressive output: rewrites the image during the render (atomically, so a viewer
  * never sees half a file). A failure is reported once and does not stop the render. */
-static void on_progress_tick(void *vctx, const Film *film)
+static void on_progress_tick(void *vctx, const ScheduleSnapshot *snap)
 {
     RenderContext *ctx = vctx;
-    if (film->samples == 0) return;
     Error err = { 0 };
-    if (write_film(film, ctx->output, &err) != ST_OK && !ctx->progressive_failed) {
+    if (write_film(snap->film, ctx->output, &err) != ST_OK && !ctx->progressive_failed) {
         ctx->progressive_failed = 1;
         print_warning(NULL, err.msg);
     }

@@ -4,10 +4,18 @@
  * raygen.cl, traverse.cl, shade.cl and film.cl, which the scalar C device calls too.
  * Queueing (which paths are still alive) happens here, not in the stage functions.
  *
- * A wave covers the pixels [first_pixel, first_pixel + wave_pixels) and `layers`
- * consecutive sample indices: path i renders pixel first_pixel + i % wave_pixels with
- * sample index first_sample + i / wave_pixels. Each bounce is intersect → shade → shadow
- * over the queue of live paths; shade appends survivors to the next queue.
+ * Paths are numbered sample-major over the image: path number p renders pixel
+ * p % n_pixels with sample index p / n_pixels (counted from the batch's first sample),
+ * and a wave is a contiguous run of path numbers starting at pixel `first_pixel`, so
+ * every wave of a batch is full whatever the image size. Each bounce is intersect →
+ * shade → shadow over the queue of live paths; shade appends survivors to the next
+ * queue.
+ *
+ * Queue lengths live on the device: counts[2b] is the number of live paths at bounce b
+ * (k_raygen writes counts[0]), counts[2b + 1] the number of shadow rays k_shade queued at
+ * bounce b. Each kernel reads its own length there and the host launches it over an
+ * upper bound, so the host never has to wait for a count before launching the next
+ * bounce (device_ocl.c).
  */
 #include "film.cl"
 #include "raygen.cl"
@@ -28,38 +36,41 @@
     sc.planes = planes; sc.materials = materials; sc.lights = lights;                    \
     sc.shading = shading
 
-/* Births the wave's paths and queues them all. */
-__kernel void k_raygen(__global const RenderParams *params, uint first_pixel, uint wave_pixels,
-                       uint first_sample, uint n_paths, __global PathState *paths,
-                       __global Ray *rays, __global uint *queue)
+/* Births the wave's paths and queues them all: path i of the wave is path number
+ * first_pixel + i of the batch (see the top of this file). */
+__kernel void k_raygen(__global const RenderParams *params, uint first_pixel, uint first_sample,
+                       uint n_pixels, uint n_paths, __global PathState *paths,
+                       __global Ray *rays, __global uint *queue, __global uint *counts)
 {
     uint i = (uint)get_global_id(0);
     if (i >= n_paths) return;
-    raygen_path(params, first_pixel + i % wave_pixels, first_sample + i / wave_pixels, &paths[i], &rays[i]);
+    uint p = first_pixel + i;
+    raygen_path(params, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i]);
     queue[i] = i;
+    if (i == 0u) counts[0] = n_paths;
 }
 
-/* Closest hit for every queued path. */
-__kernel void k_intersect(SCENE_ARGS, __global const uint *queue, uint n,
-                          __global const Ray *rays, __global Hit *hits)
+/* Closest hit for every queued path; the queue holds counts[slot] paths. */
+__kernel void k_intersect(SCENE_ARGS, __global const uint *queue, __global const uint *counts,
+                          uint slot, __global const Ray *rays, __global Hit *hits)
 {
     uint i = (uint)get_global_id(0);
-    if (i >= n) return;
+    if (i >= counts[slot]) return;
     SCENE_VIEW(sc);
     uint path = queue[i];
     hits[path] = trace_closest(&sc, rays[path]);
 }
 
-/* Shades every queued path; counters[0] counts the next queue, counters[1] the shadow
- * rays. Their order in the queues varies from run to run, the paths' results do not.
- * Slots are reserved per work-group (local atomics, then one global atomic_add per
- * queue), because one global atomic per path made the shared counters the hottest
- * cache line of the whole render on a CPU. No early return: every work-item must reach
- * the barriers. */
-__kernel void k_shade(SCENE_ARGS, __global const uint *queue, uint n, __global Ray *rays,
-                      __global const Hit *hits, __global PathState *paths,
+/* Shades the counts[slot] queued paths (slot = 2 * bounce); counts[slot + 2] counts the
+ * next queue, counts[slot + 1] the shadow rays. Their order in the queues varies from
+ * run to run, the paths' results do not. Slots are reserved per work-group (local
+ * atomics, then one global atomic_add per queue), because one global atomic per path
+ * made the shared counters the hottest cache line of the whole render on a CPU. No
+ * early return: every work-item must reach the barriers. */
+__kernel void k_shade(SCENE_ARGS, __global const uint *queue, __global uint *counts, uint slot,
+                      __global Ray *rays, __global const Hit *hits, __global PathState *paths,
                       __global Ray *shadow_rays, __global uint *next_queue,
-                      __global uint *shadow_queue, __global uint *counters)
+                      __global uint *shadow_queue)
 {
     __local uint group_count[2];
     __local uint group_base[2];
@@ -71,7 +82,7 @@ __kernel void k_shade(SCENE_ARGS, __global const uint *queue, uint n, __global R
     }
     barrier(CLK_LOCAL_MEM_FENCE);
     uint r = 0u, path = 0u;
-    if (i < n) {
+    if (i < counts[slot]) {
         SCENE_VIEW(sc);
         path = queue[i];
         r = shade_path(&sc, &rays[path], hits[path], &paths[path], &shadow_rays[path]);
@@ -81,34 +92,37 @@ __kernel void k_shade(SCENE_ARGS, __global const uint *queue, uint n, __global R
     if (r & SHADE_SHADOW) slot_shadow = atomic_inc(&group_count[1]);
     barrier(CLK_LOCAL_MEM_FENCE);
     if (lid == 0u) {
-        group_base[0] = group_count[0] ? atomic_add(&counters[0], group_count[0]) : 0u;
-        group_base[1] = group_count[1] ? atomic_add(&counters[1], group_count[1]) : 0u;
+        group_base[0] = group_count[0] ? atomic_add(&counts[slot + 2u], group_count[0]) : 0u;
+        group_base[1] = group_count[1] ? atomic_add(&counts[slot + 1u], group_count[1]) : 0u;
     }
     barrier(CLK_LOCAL_MEM_FENCE);
     if (r & SHADE_CONTINUE) next_queue[group_base[0] + slot_next] = path;
     if (r & SHADE_SHADOW) shadow_queue[group_base[1] + slot_shadow] = path;
 }
 
-/* Any-hit test of every queued shadow ray, resolving the waiting contributions. */
-__kernel void k_shadow(SCENE_ARGS, __global const uint *shadow_queue, uint n,
-                       __global const Ray *shadow_rays, __global PathState *paths)
+/* Any-hit test of the counts[slot] queued shadow rays (slot = 2 * bounce + 1),
+ * resolving the waiting contributions. */
+__kernel void k_shadow(SCENE_ARGS, __global const uint *shadow_queue, __global const uint *counts,
+                       uint slot, __global const Ray *shadow_rays, __global PathState *paths)
 {
     uint i = (uint)get_global_id(0);
-    if (i >= n) return;
+    if (i >= counts[slot]) return;
     SCENE_VIEW(sc);
     uint path = shadow_queue[i];
     shadow_resolve(&paths[path], trace_any(&sc, shadow_rays[path]));
 }
 
-/* Adds the finished wave to the film: one work-item per pixel, so no two work-items
- * touch the same film entry. */
-__kernel void k_film(__global const PathState *paths, uint first_pixel, uint wave_pixels,
-                     uint layers, __global long *film)
+/* Adds the finished wave of n_paths paths to the film. Work-item j owns one pixel, the
+ * one of wave path j, and adds every path of the wave on that pixel (j, j + n_pixels,
+ * ...), so no two work-items touch the same film entry; launched over
+ * min(n_paths, n_pixels) work-items. */
+__kernel void k_film(__global const PathState *paths, uint first_pixel, uint n_pixels,
+                     uint n_paths, __global long *film)
 {
-    uint i = (uint)get_global_id(0);
-    if (i >= wave_pixels) return;
-    for (uint l = 0u; l < layers; l++)
-        film_add(film, first_pixel + i, paths[l * wave_pixels + i].radiance);
+    uint j = (uint)get_global_id(0);
+    if (j >= n_paths || j >= n_pixels) return;
+    uint pixel = (first_pixel + j) % n_pixels;
+    for (uint i = j; i < n_paths; i += n_pixels) film_add(film, pixel, paths[i].radiance);
 }
 
 /* Writes sizeof and offsetof of the shared structs, for the host to compare with its

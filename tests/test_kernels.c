@@ -225,17 +225,21 @@ static void test_raygen(void)
     const RenderParams *p = &rs.ds.params;
     uint npix = p->width * p->height, n = npix * LAYERS, first_pixel = 0, first_sample = 5;
     cl_mem paths = buffer(n * sizeof(PathState), NULL), rays = buffer(n * sizeof(Ray), NULL),
-           queue = buffer(n * sizeof(uint), NULL);
+           queue = buffer(n * sizeof(uint), NULL), counts = buffer(sizeof(uint), NULL);
     cl_kernel k = kernel("k_raygen");
     SET(k, 0, cl.scene[0]);
     SET(k, 1, first_pixel);
-    SET(k, 2, npix);
-    SET(k, 3, first_sample);
+    SET(k, 2, first_sample);
+    SET(k, 3, npix);
     SET(k, 4, n);
     SET(k, 5, paths);
     SET(k, 6, rays);
     SET(k, 7, queue);
+    SET(k, 8, counts);
     run(k, n);
+    uint n_queued = 0;
+    read_back(counts, sizeof n_queued, &n_queued);
+    CHECK_EQ_INT(n_queued, n);
     PathState *dp = malloc(n * sizeof *dp);
     Ray *dr = malloc(n * sizeof *dr);
     uint *dq = malloc(n * sizeof *dq);
@@ -261,6 +265,7 @@ static void test_raygen(void)
     clReleaseMemObject(paths);
     clReleaseMemObject(rays);
     clReleaseMemObject(queue);
+    clReleaseMemObject(counts);
 }
 
 /* Random rays through the scene's box, from inside and outside it. */
@@ -284,15 +289,18 @@ static void test_intersect(void)
         rays[i] = random_ray();
         queue[i] = N - 1 - i;                   /* a permuted queue, as after compaction */
     }
-    cl_mem rb = buffer(N * sizeof *rays, rays), qb = buffer(N * sizeof *queue, queue), hb = buffer(N * sizeof(Hit), NULL);
+    /* the queue length is read on the device, from counts[slot] */
+    uint counts[3] = { 0, 0, N }, slot = 2;
+    cl_mem rb = buffer(N * sizeof *rays, rays), qb = buffer(N * sizeof *queue, queue), hb = buffer(N * sizeof(Hit), NULL),
+           cb = buffer(sizeof counts, counts);
     cl_kernel k = kernel("k_intersect");
     set_scene_args(k);
-    uint n = N;
     SET(k, 10, qb);
-    SET(k, 11, n);
-    SET(k, 12, rb);
-    SET(k, 13, hb);
-    run(k, N);
+    SET(k, 11, cb);
+    SET(k, 12, slot);
+    SET(k, 13, rb);
+    SET(k, 14, hb);
+    run(k, N + 100);                            /* launched over more than the queue */
     Hit *dh = malloc(N * sizeof *dh);
     read_back(hb, N * sizeof *dh, dh);
     uint exact = 0, bad = 0, hits = 0;
@@ -312,6 +320,7 @@ static void test_intersect(void)
     clReleaseMemObject(rb);
     clReleaseMemObject(qb);
     clReleaseMemObject(hb);
+    clReleaseMemObject(cb);
 }
 
 /* Shade and shadow: path states at various bounces with random throughput, the hits of
@@ -338,30 +347,33 @@ static void test_shade_and_shadow(void)
     cl_mem pb = buffer(N * sizeof *ps, ps), rb = buffer(N * sizeof *rays, rays), hb = buffer(N * sizeof *hits, hits),
            qb = buffer(N * sizeof *queue, queue), srb = buffer(N * sizeof(Ray), NULL),
            nqb = buffer(N * sizeof(uint), NULL), sqb = buffer(N * sizeof(uint), NULL);
-    cl_uint zero2[2] = { 0, 0 };
-    cl_mem cb = buffer(sizeof zero2, zero2);
+    /* bounce 1 of a wave: the queue length in counts[2], the shade kernel counts the
+     * shadow rays into counts[3] and the next queue into counts[4] */
+    cl_uint init_counts[5] = { 0, 0, N, 0, 0 }, slot = 2;
+    cl_mem cb = buffer(sizeof init_counts, init_counts);
     cl_kernel k = kernel("k_shade");
     set_scene_args(k);
-    uint n = N;
     SET(k, 10, qb);
-    SET(k, 11, n);
-    SET(k, 12, rb);
-    SET(k, 13, hb);
-    SET(k, 14, pb);
-    SET(k, 15, srb);
-    SET(k, 16, nqb);
-    SET(k, 17, sqb);
-    SET(k, 18, cb);
-    run(k, N);
+    SET(k, 11, cb);
+    SET(k, 12, slot);
+    SET(k, 13, rb);
+    SET(k, 14, hb);
+    SET(k, 15, pb);
+    SET(k, 16, srb);
+    SET(k, 17, nqb);
+    SET(k, 18, sqb);
+    run(k, N + 100);
     PathState *dps = malloc(N * sizeof *dps);
     Ray *drays = malloc(N * sizeof *drays), *dshadow = malloc(N * sizeof *dshadow);
-    uint *dnext = malloc(N * sizeof *dnext), *dshq = malloc(N * sizeof *dshq), counts[2];
+    uint *dnext = malloc(N * sizeof *dnext), *dshq = malloc(N * sizeof *dshq), all_counts[5], counts[2];
     read_back(pb, N * sizeof *dps, dps);
     read_back(rb, N * sizeof *drays, drays);
     read_back(srb, N * sizeof *dshadow, dshadow);
     read_back(nqb, N * sizeof *dnext, dnext);
     read_back(sqb, N * sizeof *dshq, dshq);
-    read_back(cb, sizeof counts, counts);
+    read_back(cb, sizeof all_counts, all_counts);
+    counts[0] = all_counts[4];
+    counts[1] = all_counts[3];
 
     /* The C side, and the flags each path should have produced. */
     uint *flags = calloc(N, sizeof *flags);
@@ -403,12 +415,13 @@ static void test_shade_and_shadow(void)
     /* k_shadow over the shadow queue the device produced */
     cl_kernel ks = kernel("k_shadow");
     set_scene_args(ks);
-    uint ns = counts[1];
+    uint shadow_slot = 3;
     SET(ks, 10, sqb);
-    SET(ks, 11, ns);
-    SET(ks, 12, srb);
-    SET(ks, 13, pb);
-    run(ks, ns ? ns : 1);
+    SET(ks, 11, cb);
+    SET(ks, 12, shadow_slot);
+    SET(ks, 13, srb);
+    SET(ks, 14, pb);
+    run(ks, N);
     read_back(pb, N * sizeof *dps, dps);
     uint occluded = 0, sbad = 0, sexact = 0;
     for (uint i = 0; i < N; i++) {
@@ -431,11 +444,13 @@ static void test_shade_and_shadow(void)
     for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) clReleaseMemObject(ms[i]);
 }
 
+/* A wave that starts at pixel 100 of a 600-pixel image and wraps around it three times
+ * and a bit: pixels get three or four of its paths. */
 static void test_film(void)
 {
-    uint npix = 500, layers = 4, first_pixel = 100, n_film = first_pixel + npix;
-    PathState *ps = calloc((size_t)npix * layers, sizeof *ps);
-    for (uint i = 0; i < npix * layers; i++) {
+    uint n_film = 600, first_pixel = 100, n_paths = 2000;
+    PathState *ps = calloc(n_paths, sizeof *ps);
+    for (uint i = 0; i < n_paths; i++) {
         ps[i].radiance = vrand(0.0f, 3.0f);
         if (i % 97 == 0) ps[i].radiance.x = NAN;           /* dropped, not propagated */
         if (i % 89 == 0) ps[i].radiance.y = 1e30f;         /* clamped */
@@ -443,17 +458,16 @@ static void test_film(void)
     }
     int64_t *film = calloc((size_t)n_film * 3, sizeof *film), *cfilm = calloc((size_t)n_film * 3, sizeof *cfilm);
     for (uint i = 0; i < n_film * 3; i++) film[i] = cfilm[i] = (int64_t)i * 1000;   /* already holds samples */
-    cl_mem pb = buffer((size_t)npix * layers * sizeof *ps, ps), fb = buffer((size_t)n_film * 3 * sizeof *film, film);
+    cl_mem pb = buffer((size_t)n_paths * sizeof *ps, ps), fb = buffer((size_t)n_film * 3 * sizeof *film, film);
     cl_kernel k = kernel("k_film");
     SET(k, 0, pb);
     SET(k, 1, first_pixel);
-    SET(k, 2, npix);
-    SET(k, 3, layers);
+    SET(k, 2, n_film);
+    SET(k, 3, n_paths);
     SET(k, 4, fb);
-    run(k, npix);
+    run(k, n_film);
     read_back(fb, (size_t)n_film * 3 * sizeof *film, film);
-    for (uint l = 0; l < layers; l++)
-        for (uint i = 0; i < npix; i++) film_add(cfilm, first_pixel + i, ps[l * npix + i].radiance);
+    for (uint i = 0; i < n_paths; i++) film_add(cfilm, (first_pixel + i) % n_film, ps[i].radiance);
     uint bad = 0;
     for (uint i = 0; i < n_film * 3; i++) bad += film[i] != cfilm[i];
     CHECK_MSG(bad == 0, "%u film entries differ (fixed point must match exactly)", bad);

@@ -174,7 +174,9 @@ static void print_render_stats(const ScheduleStats *st, uint spp, Device **devs,
     for (size_t i = 0; i < st->done.n && i < 8; i++)
         printf(" [%u,%u)", st->done.ranges[i].first, st->done.ranges[i].first + st->done.ranges[i].count);
     printf("%s%s\n", st->done.n > 8 ? " ..." : "", st->done.n == 0 ? " none" : "");
-    if (st->checkpoints) printf("checkpoints: %u written during the render\n", st->checkpoints);
+    if (st->checkpoints)
+        printf("checkpoints: %u written during the render, %.1f ms each (film copied under the lock in %.2f ms)\n",
+               st->checkpoints, 1e3 * st->checkpoint_seconds / st->checkpoints, 1e3 * st->snapshot_seconds / st->checkpoints);
 }
 
 /* Opens the chosen devices and gives each the scene. A device that fails is dropped with

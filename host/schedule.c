@@ -349,14 +349,18 @@ Status schedule_run(Device **devices, size_t n, const ScheduleConfig *cfg, Film 
                          now - last_checkpoint >= cfg->checkpoint_seconds;
         if (active > 0 && (tick || checkpoint) && take_snapshot(&sh, &snap, &snap_done) == 0) {
             ScheduleSnapshot s = { &snap, snap_done.ranges, snap_done.n };
+            double t_snap = timer_now();
+            stats->snapshot_seconds += t_snap - now;
             if (tick) {
                 last_tick = now;
                 if (snap.samples > 0) cfg->on_tick(cfg->ctx, &s);
             }
             if (checkpoint) {
+                double t0 = timer_now();
                 last_checkpoint = now;
                 cfg->on_checkpoint(cfg->ctx, &s);
                 stats->checkpoints++;
+                stats->checkpoint_seconds += timer_now() - t0;
             }
         }
         if (active == 0) break;

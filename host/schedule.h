@@ -72,6 +72,8 @@ typedef struct {
     uint spp_done;                   /* samples per pixel in the film (every pixel) */
     int interrupted, time_up;
     unsigned checkpoints;            /* on_checkpoint calls */
+    double snapshot_seconds;         /* copying the film under its lock, in total */
+    double checkpoint_seconds;       /* in on_checkpoint (encoding, writing), in total */
     size_t n_devices;
     DeviceRunStats *devices;         /* n_devices, owned */
     BatchSet done;                   /* the sample indices in the film, owned */

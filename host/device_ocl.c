@@ -66,6 +66,7 @@ typedef struct {
     uint ring_next;
     uint max_bounces;       /* bounces 0 .. max_depth; counts holds 2 * max_bounces + 1 */
     uint wave_paths;        /* capacity of the wave buffers */
+    int has_lights;         /* else no shadow rays: k_shadow is not launched */
     size_t local_size;      /* 0: let the driver choose */
     uint n_pixels;
 } OclDevice;
@@ -293,6 +294,7 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
             return error_set(err, ST_INTERNAL, "out of memory for queue counters");
     OCL_TRY("clFinish", clFinish(od->queue));
     od->n_pixels = n_pixels;
+    od->has_lights = p->n_lights > 0;
     if ((st = set_fixed_args(od, err))) return st;
     d->n_pixels = n_pixels;
     d->max_in_flight = od->n_slots;
@@ -335,9 +337,11 @@ static Status render_wave(Device *d, cl_mem film, uint first_pixel, uint first_s
         ARG(k, SCENE_N + 2, slot);
         ARG(k, SCENE_N + 7, next);
         if ((st = launch(od, k, "k_shade", bound, err))) goto fail;
+        /* without lights there are no shadow rays (and each launch costs PoCL some
+         * tens of microseconds) */
         k = od->k_shadow;
         ARG(k, SCENE_N + 2, shadow_slot);
-        if ((st = launch(od, k, "k_shadow", bound, err))) goto fail;
+        if (od->has_lights && (st = launch(od, k, "k_shadow", bound, err))) goto fail;
         cl_int rc = clEnqueueReadBuffer(od->queue, od->counts, CL_FALSE, shadow_slot * sizeof(cl_uint),
                                         2 * sizeof(cl_uint), &hc[shadow_slot], 0, NULL, &ev);
         if (rc == CL_SUCCESS) rc = clFlush(od->queue);

@@ -276,7 +276,11 @@ static Status run(int argc, char **argv, Error *err)
     memset(&stats, 0, sizeof stats);
     Checkpoint resume;
     memset(&resume, 0, sizeof resume);
-    RenderContext ctx = { output, o.quiet, 0, o.checkpoint_path, { { 0 }, 0, 0, 0, 0, 0 }, 0 };
+    RenderContext ctx;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.output = output;
+    ctx.quiet = o.quiet;
+    ctx.checkpoint = o.checkpoint_path;
     double t_start = timer_now();
 
     if ((st = image_format_from_path(output, &format, err))) goto done;

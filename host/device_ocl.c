@@ -43,8 +43,8 @@ typedef struct {
     cl_event read_done;     /* the read-back in flight; NULL while the slot is free */
 } FilmSlot;
 
-/* The queue lengths of one wave as read back: counts[2b] live paths and counts[2b + 1]
- * shadow rays at bounce b (entry.cl), for the ray statistics. */
+/* The queue lengths of one wave as read back, in the device's layout (entry.cl): slot 2b
+ * live paths and slot 2b + 1 shadow rays at bounce b, QUEUE_COUNT_STRIDE apart. */
 typedef struct {
     cl_uint *counts;
     cl_event last_read;     /* the wave's last count read-back; NULL when accounted */
@@ -64,7 +64,7 @@ typedef struct {
     uint head, tail;        /* batches rendered and taken, counted from 0 */
     WaveCounts ring[COUNT_RING];
     uint ring_next;
-    uint max_bounces;       /* bounces 0 .. max_depth; counts holds 2 * max_bounces + 1 */
+    uint max_bounces;       /* bounces 0 .. max_depth: 2 * max_bounces + 1 count slots */
     uint wave_paths;        /* capacity of the wave buffers */
     int has_lights;         /* else no shadow rays: k_shadow is not launched */
     size_t local_size;      /* 0: let the driver choose */
@@ -226,7 +226,8 @@ static Status account_wave(Device *d, WaveCounts *wc, int wait, Error *err)
         if (st || !done) return st;
     }
     uint64_t rays = 0;
-    for (uint b = 0; b < wc->n_bounces; b++) rays += (uint64_t)wc->counts[2 * b] + wc->counts[2 * b + 1];
+    for (uint b = 0; b < wc->n_bounces; b++)
+        rays += (uint64_t)wc->counts[2 * b * QUEUE_COUNT_STRIDE] + wc->counts[(2 * b + 1) * QUEUE_COUNT_STRIDE];
     d->counters.rays += rays;
     release_event(&wc->last_read);
     return ST_OK;
@@ -255,7 +256,7 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     uint n_pixels = p->width * p->height;
     uint wave = od->wave_paths;
     od->max_bounces = p->max_depth + 1u;
-    size_t counts_bytes = (2u * (size_t)od->max_bounces + 1u) * sizeof(cl_uint);
+    size_t counts_bytes = (2u * (size_t)od->max_bounces + 1u) * QUEUE_COUNT_STRIDE * sizeof(cl_uint);
     size_t film_bytes = (size_t)n_pixels * 3u * sizeof(cl_long);
     cl_ulong wave_bytes = (cl_ulong)wave * (sizeof(PathState) + 2 * sizeof(Ray) + sizeof(Hit) + 3 * sizeof(uint));
     /* Double-buffered films when they fit, else one: the device then waits for each
@@ -316,7 +317,8 @@ static Status render_wave(Device *d, cl_mem film, uint first_pixel, uint first_s
 
     cl_uint zero = 0;
     OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, od->counts, &zero, sizeof zero, 0,
-                                                       (2u * (size_t)od->max_bounces + 1u) * sizeof zero, 0, NULL, NULL));
+                                                       (2u * (size_t)od->max_bounces + 1u) * QUEUE_COUNT_STRIDE *
+                                                           sizeof zero, 0, NULL, NULL));
     cl_kernel k = od->k_raygen;
     ARG(k, 1, first_pixel);
     ARG(k, 2, first_sample);
@@ -342,8 +344,10 @@ static Status render_wave(Device *d, cl_mem film, uint first_pixel, uint first_s
         k = od->k_shadow;
         ARG(k, SCENE_N + 2, shadow_slot);
         if (od->has_lights && (st = launch(od, k, "k_shadow", bound, err))) goto fail;
-        cl_int rc = clEnqueueReadBuffer(od->queue, od->counts, CL_FALSE, shadow_slot * sizeof(cl_uint),
-                                        2 * sizeof(cl_uint), &hc[shadow_slot], 0, NULL, &ev);
+        /* slots 2b + 1 and 2b + 2: the shadow rays of this bounce, the live paths of the next */
+        size_t at = shadow_slot * QUEUE_COUNT_STRIDE;
+        cl_int rc = clEnqueueReadBuffer(od->queue, od->counts, CL_FALSE, at * sizeof(cl_uint),
+                                        (QUEUE_COUNT_STRIDE + 1) * sizeof(cl_uint), &hc[at], 0, NULL, &ev);
         if (rc == CL_SUCCESS) rc = clFlush(od->queue);
         if (rc != CL_SUCCESS) {
             st = ocl_fail(err, &od->info, "clEnqueueReadBuffer", rc);
@@ -364,7 +368,7 @@ static Status render_wave(Device *d, cl_mem film, uint first_pixel, uint first_s
         ev = NULL;
         int have_next = 0;
         if ((st = event_done(od, prev, &have_next, err))) goto fail;
-        bound = have_next ? hc[2u * b] : hc[2u * (b - 1u)];
+        bound = have_next ? hc[2u * b * QUEUE_COUNT_STRIDE] : hc[2u * (b - 1u) * QUEUE_COUNT_STRIDE];
         if (bound == 0 || b >= od->max_bounces) break;
         cl_mem t = cur;
         cur = next;

@@ -11,11 +11,11 @@
  * shade → shadow over the queue of live paths; shade appends survivors to the next
  * queue.
  *
- * Queue lengths live on the device: counts[2b] is the number of live paths at bounce b
- * (k_raygen writes counts[0]), counts[2b + 1] the number of shadow rays k_shade queued at
- * bounce b. Each kernel reads its own length there and the host launches it over an
- * upper bound, so the host never has to wait for a count before launching the next
- * bounce (device_ocl.c).
+ * Queue lengths live on the device, in count slots QUEUE_COUNT_STRIDE uints apart (one
+ * per cache line, types.h): slot 2b holds the number of live paths at bounce b (k_raygen
+ * writes slot 0), slot 2b + 1 the number of shadow rays k_shade queued at bounce b. Each
+ * kernel reads its own length there and the host launches it over an upper bound, so the
+ * host never has to wait for a count before launching the next bounce (device_ocl.c).
  */
 #include "film.cl"
 #include "raygen.cl"
@@ -28,6 +28,8 @@
     __global const Triangle *triangles, __global const Box *boxes,                       \
     __global const Plane *planes, __global const Material *materials,                    \
     __global const Light *lights, __global const TriShading *shading
+
+#define COUNT(slot) counts[(slot) * QUEUE_COUNT_STRIDE]
 
 #define SCENE_VIEW(sc)                                                                   \
     SceneView sc;                                                                        \
@@ -47,22 +49,22 @@ __kernel void k_raygen(__global const RenderParams *params, uint first_pixel, ui
     uint p = first_pixel + i;
     raygen_path(params, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i]);
     queue[i] = i;
-    if (i == 0u) counts[0] = n_paths;
+    if (i == 0u) COUNT(0u) = n_paths;
 }
 
-/* Closest hit for every queued path; the queue holds counts[slot] paths. */
+/* Closest hit for every queued path; the queue holds COUNT(slot) paths. */
 __kernel void k_intersect(SCENE_ARGS, __global const uint *queue, __global const uint *counts,
                           uint slot, __global const Ray *rays, __global Hit *hits)
 {
     uint i = (uint)get_global_id(0);
-    if (i >= counts[slot]) return;
+    if (i >= COUNT(slot)) return;
     SCENE_VIEW(sc);
     uint path = queue[i];
     hits[path] = trace_closest(&sc, rays[path]);
 }
 
-/* Shades the counts[slot] queued paths (slot = 2 * bounce); counts[slot + 2] counts the
- * next queue, counts[slot + 1] the shadow rays. Their order in the queues varies from
+/* Shades the COUNT(slot) queued paths (slot = 2 * bounce); COUNT(slot + 2) counts the
+ * next queue, COUNT(slot + 1) the shadow rays. Their order in the queues varies from
  * run to run, the paths' results do not. Slots are reserved per work-group (local
  * atomics, then one global atomic_add per queue), because one global atomic per path
  * made the shared counters the hottest cache line of the whole render on a CPU. No
@@ -82,7 +84,7 @@ __kernel void k_shade(SCENE_ARGS, __global const uint *queue, __global uint *cou
     }
     barrier(CLK_LOCAL_MEM_FENCE);
     uint r = 0u, path = 0u;
-    if (i < counts[slot]) {
+    if (i < COUNT(slot)) {
         SCENE_VIEW(sc);
         path = queue[i];
         r = shade_path(&sc, &rays[path], hits[path], &paths[path], &shadow_rays[path]);
@@ -92,21 +94,21 @@ __kernel void k_shade(SCENE_ARGS, __global const uint *queue, __global uint *cou
     if (r & SHADE_SHADOW) slot_shadow = atomic_inc(&group_count[1]);
     barrier(CLK_LOCAL_MEM_FENCE);
     if (lid == 0u) {
-        group_base[0] = group_count[0] ? atomic_add(&counts[slot + 2u], group_count[0]) : 0u;
-        group_base[1] = group_count[1] ? atomic_add(&counts[slot + 1u], group_count[1]) : 0u;
+        group_base[0] = group_count[0] ? atomic_add(&COUNT(slot + 2u), group_count[0]) : 0u;
+        group_base[1] = group_count[1] ? atomic_add(&COUNT(slot + 1u), group_count[1]) : 0u;
     }
     barrier(CLK_LOCAL_MEM_FENCE);
     if (r & SHADE_CONTINUE) next_queue[group_base[0] + slot_next] = path;
     if (r & SHADE_SHADOW) shadow_queue[group_base[1] + slot_shadow] = path;
 }
 
-/* Any-hit test of the counts[slot] queued shadow rays (slot = 2 * bounce + 1),
+/* Any-hit test of the COUNT(slot) queued shadow rays (slot = 2 * bounce + 1),
  * resolving the waiting contributions. */
 __kernel void k_shadow(SCENE_ARGS, __global const uint *shadow_queue, __global const uint *counts,
                        uint slot, __global const Ray *shadow_rays, __global PathState *paths)
 {
     uint i = (uint)get_global_id(0);
-    if (i >= counts[slot]) return;
+    if (i >= COUNT(slot)) return;
     SCENE_VIEW(sc);
     uint path = shadow_queue[i];
     shadow_resolve(&paths[path], trace_any(&sc, shadow_rays[path]));

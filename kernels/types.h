@@ -170,6 +170,11 @@ typedef struct {                                        /* 64 bytes */
 
 #define PATH_SPECULAR 1u      /* last bounce was a delta lobe: no MIS on emission */
 
+/* The wavefront's queue lengths (entry.cl) are spaced this many uints apart, one per
+ * 64-byte cache line: k_shade reads one count while other work-groups add atomically to
+ * the next ones, and on a CPU a shared line would bounce between the cores. */
+#define QUEUE_COUNT_STRIDE 16u
+
 /* Stage results reported by shade_path to its caller, which does the queueing. */
 #define SHADE_CONTINUE 1u     /* the path goes on with the ray written back */
 #define SHADE_SHADOW 2u       /* a shadow ray was written; shadow_L waits on it */

@@ -238,7 +238,7 @@ static void test_raygen(void)
     SET(k, 8, counts);
     run(k, n);
     uint n_queued = 0;
-    read_back(counts, sizeof n_queued, &n_queued);
+    read_back(counts, sizeof n_queued, &n_queued);   /* slot 0 */
     CHECK_EQ_INT(n_queued, n);
     PathState *dp = malloc(n * sizeof *dp);
     Ray *dr = malloc(n * sizeof *dr);
@@ -289,8 +289,9 @@ static void test_intersect(void)
         rays[i] = random_ray();
         queue[i] = N - 1 - i;                   /* a permuted queue, as after compaction */
     }
-    /* the queue length is read on the device, from counts[slot] */
-    uint counts[3] = { 0, 0, N }, slot = 2;
+    /* the queue length is read on the device, from count slot 2 */
+    uint counts[3 * QUEUE_COUNT_STRIDE] = { 0 }, slot = 2;
+    counts[slot * QUEUE_COUNT_STRIDE] = N;
     cl_mem rb = buffer(N * sizeof *rays, rays), qb = buffer(N * sizeof *queue, queue), hb = buffer(N * sizeof(Hit), NULL),
            cb = buffer(sizeof counts, counts);
     cl_kernel k = kernel("k_intersect");
@@ -347,9 +348,10 @@ static void test_shade_and_shadow(void)
     cl_mem pb = buffer(N * sizeof *ps, ps), rb = buffer(N * sizeof *rays, rays), hb = buffer(N * sizeof *hits, hits),
            qb = buffer(N * sizeof *queue, queue), srb = buffer(N * sizeof(Ray), NULL),
            nqb = buffer(N * sizeof(uint), NULL), sqb = buffer(N * sizeof(uint), NULL);
-    /* bounce 1 of a wave: the queue length in counts[2], the shade kernel counts the
-     * shadow rays into counts[3] and the next queue into counts[4] */
-    cl_uint init_counts[5] = { 0, 0, N, 0, 0 }, slot = 2;
+    /* bounce 1 of a wave: the queue length in count slot 2, the shade kernel counts the
+     * shadow rays into slot 3 and the next queue into slot 4 */
+    cl_uint init_counts[5 * QUEUE_COUNT_STRIDE] = { 0 }, slot = 2;
+    init_counts[slot * QUEUE_COUNT_STRIDE] = N;
     cl_mem cb = buffer(sizeof init_counts, init_counts);
     cl_kernel k = kernel("k_shade");
     set_scene_args(k);
@@ -365,15 +367,16 @@ static void test_shade_and_shadow(void)
     run(k, N + 100);
     PathState *dps = malloc(N * sizeof *dps);
     Ray *drays = malloc(N * sizeof *drays), *dshadow = malloc(N * sizeof *dshadow);
-    uint *dnext = malloc(N * sizeof *dnext), *dshq = malloc(N * sizeof *dshq), all_counts[5], counts[2];
+    uint *dnext = malloc(N * sizeof *dnext), *dshq = malloc(N * sizeof *dshq), all_counts[5 * QUEUE_COUNT_STRIDE],
+         counts[2];
     read_back(pb, N * sizeof *dps, dps);
     read_back(rb, N * sizeof *drays, drays);
     read_back(srb, N * sizeof *dshadow, dshadow);
     read_back(nqb, N * sizeof *dnext, dnext);
     read_back(sqb, N * sizeof *dshq, dshq);
     read_back(cb, sizeof all_counts, all_counts);
-    counts[0] = all_counts[4];
-    counts[1] = all_counts[3];
+    counts[0] = all_counts[4 * QUEUE_COUNT_STRIDE];
+    counts[1] = all_counts[3 * QUEUE_COUNT_STRIDE];
 
     /* The C side, and the flags each path should have produced. */
     uint *flags = calloc(N, sizeof *flags);

@@ -9,13 +9,12 @@
  * and a wave is a contiguous run of path numbers starting at pixel `first_pixel`, so
  * every wave of a batch is full whatever the image size. Each bounce is intersect →
  * shade → shadow over the queue of live paths; shade appends survivors to the next
- * queue.
+ * queue and counts them, and the host launches the next bounce over exactly that many.
  *
- * Queue lengths live on the device, in count slots QUEUE_COUNT_STRIDE uints apart (one
- * per cache line, types.h): slot 2b holds the number of live paths at bounce b (k_raygen
- * writes slot 0), slot 2b + 1 the number of shadow rays k_shade queued at bounce b. Each
- * kernel reads its own length there and the host launches it over an upper bound, so the
- * host never has to wait for a count before launching the next bounce (device_ocl.c).
+ * k_shade counts into per-wave count slots QUEUE_COUNT_STRIDE uints apart (one per
+ * cache line, types.h): at bounce b, slot 2b + 1 counts its shadow rays and slot 2b + 2
+ * the paths that go on. Every bounce has its own slots, so a wave's counters are zeroed
+ * once and the host can read them back while later bounces run.
  */
 #include "film.cl"
 #include "raygen.cl"
@@ -29,8 +28,6 @@
     __global const Plane *planes, __global const Material *materials,                    \
     __global const Light *lights, __global const TriShading *shading
 
-#define COUNT(slot) counts[(slot) * QUEUE_COUNT_STRIDE]
-
 #define SCENE_VIEW(sc)                                                                   \
     SceneView sc;                                                                        \
     sc.params = params; sc.nodes = nodes; sc.leaf_prims = leaf_prims;                    \
@@ -42,37 +39,36 @@
  * first_pixel + i of the batch (see the top of this file). */
 __kernel void k_raygen(__global const RenderParams *params, uint first_pixel, uint first_sample,
                        uint n_pixels, uint n_paths, __global PathState *paths,
-                       __global Ray *rays, __global uint *queue, __global uint *counts)
+                       __global Ray *rays, __global uint *queue)
 {
     uint i = (uint)get_global_id(0);
     if (i >= n_paths) return;
     uint p = first_pixel + i;
     raygen_path(params, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i]);
     queue[i] = i;
-    if (i == 0u) COUNT(0u) = n_paths;
 }
 
-/* Closest hit for every queued path; the queue holds COUNT(slot) paths. */
-__kernel void k_intersect(SCENE_ARGS, __global const uint *queue, __global const uint *counts,
-                          uint slot, __global const Ray *rays, __global Hit *hits)
+/* Closest hit for every queued path. */
+__kernel void k_intersect(SCENE_ARGS, __global const uint *queue, uint n,
+                          __global const Ray *rays, __global Hit *hits)
 {
     uint i = (uint)get_global_id(0);
-    if (i >= COUNT(slot)) return;
+    if (i >= n) return;
     SCENE_VIEW(sc);
     uint path = queue[i];
     hits[path] = trace_closest(&sc, rays[path]);
 }
 
-/* Shades the COUNT(slot) queued paths (slot = 2 * bounce); COUNT(slot + 2) counts the
- * next queue, COUNT(slot + 1) the shadow rays. Their order in the queues varies from
- * run to run, the paths' results do not. Slots are reserved per work-group (local
- * atomics, then one global atomic_add per queue), because one global atomic per path
- * made the shared counters the hottest cache line of the whole render on a CPU. No
- * early return: every work-item must reach the barriers. */
-__kernel void k_shade(SCENE_ARGS, __global const uint *queue, __global uint *counts, uint slot,
-                      __global Ray *rays, __global const Hit *hits, __global PathState *paths,
+/* Shades every queued path; count slot `slot` counts the shadow rays, slot + 1 the next
+ * queue (see the top of this file). Their order in the queues varies from run to run,
+ * the paths' results do not. Slots are reserved per work-group (local atomics, then one
+ * global atomic_add per queue), because one global atomic per path made the shared
+ * counters the hottest cache line of the whole render on a CPU. No early return: every
+ * work-item must reach the barriers. */
+__kernel void k_shade(SCENE_ARGS, __global const uint *queue, uint n, __global Ray *rays,
+                      __global const Hit *hits, __global PathState *paths,
                       __global Ray *shadow_rays, __global uint *next_queue,
-                      __global uint *shadow_queue)
+                      __global uint *shadow_queue, __global uint *counts, uint slot)
 {
     __local uint group_count[2];
     __local uint group_base[2];
@@ -84,7 +80,7 @@ __kernel void k_shade(SCENE_ARGS, __global const uint *queue, __global uint *cou
     }
     barrier(CLK_LOCAL_MEM_FENCE);
     uint r = 0u, path = 0u;
-    if (i < COUNT(slot)) {
+    if (i < n) {
         SCENE_VIEW(sc);
         path = queue[i];
         r = shade_path(&sc, &rays[path], hits[path], &paths[path], &shadow_rays[path]);
@@ -94,21 +90,20 @@ __kernel void k_shade(SCENE_ARGS, __global const uint *queue, __global uint *cou
     if (r & SHADE_SHADOW) slot_shadow = atomic_inc(&group_count[1]);
     barrier(CLK_LOCAL_MEM_FENCE);
     if (lid == 0u) {
-        group_base[0] = group_count[0] ? atomic_add(&COUNT(slot + 2u), group_count[0]) : 0u;
-        group_base[1] = group_count[1] ? atomic_add(&COUNT(slot + 1u), group_count[1]) : 0u;
+        group_base[0] = group_count[0] ? atomic_add(&counts[(slot + 1u) * QUEUE_COUNT_STRIDE], group_count[0]) : 0u;
+        group_base[1] = group_count[1] ? atomic_add(&counts[slot * QUEUE_COUNT_STRIDE], group_count[1]) : 0u;
     }
     barrier(CLK_LOCAL_MEM_FENCE);
     if (r & SHADE_CONTINUE) next_queue[group_base[0] + slot_next] = path;
     if (r & SHADE_SHADOW) shadow_queue[group_base[1] + slot_shadow] = path;
 }
 
-/* Any-hit test of the COUNT(slot) queued shadow rays (slot = 2 * bounce + 1),
- * resolving the waiting contributions. */
-__kernel void k_shadow(SCENE_ARGS, __global const uint *shadow_queue, __global const uint *counts,
-                       uint slot, __global const Ray *shadow_rays, __global PathState *paths)
+/* Any-hit test of every queued shadow ray, resolving the waiting contributions. */
+__kernel void k_shadow(SCENE_ARGS, __global const uint *shadow_queue, uint n,
+                       __global const Ray *shadow_rays, __global PathState *paths)
 {
     uint i = (uint)get_global_id(0);
-    if (i >= COUNT(slot)) return;
+    if (i >= n) return;
     SCENE_VIEW(sc);
     uint path = shadow_queue[i];
     shadow_resolve(&paths[path], trace_any(&sc, shadow_rays[path]));

@@ -170,9 +170,9 @@ typedef struct {                                        /* 64 bytes */
 
 #define PATH_SPECULAR 1u      /* last bounce was a delta lobe: no MIS on emission */
 
-/* The wavefront's queue lengths (entry.cl) are spaced this many uints apart, one per
- * 64-byte cache line: k_shade reads one count while other work-groups add atomically to
- * the next ones, and on a CPU a shared line would bounce between the cores. */
+/* The wavefront's queue counters (entry.cl) are spaced this many uints apart, one per
+ * 64-byte cache line, so that the two counters k_shade adds to atomically and the
+ * counts the host reads back never share a line. */
 #define QUEUE_COUNT_STRIDE 16u
 
 /* Stage results reported by shade_path to its caller, which does the queueing. */

@@ -225,7 +225,7 @@ static void test_raygen(void)
     const RenderParams *p = &rs.ds.params;
     uint npix = p->width * p->height, n = npix * LAYERS, first_pixel = 0, first_sample = 5;
     cl_mem paths = buffer(n * sizeof(PathState), NULL), rays = buffer(n * sizeof(Ray), NULL),
-           queue = buffer(n * sizeof(uint), NULL), counts = buffer(sizeof(uint), NULL);
+           queue = buffer(n * sizeof(uint), NULL);
     cl_kernel k = kernel("k_raygen");
     SET(k, 0, cl.scene[0]);
     SET(k, 1, first_pixel);
@@ -235,11 +235,7 @@ static void test_raygen(void)
     SET(k, 5, paths);
     SET(k, 6, rays);
     SET(k, 7, queue);
-    SET(k, 8, counts);
     run(k, n);
-    uint n_queued = 0;
-    read_back(counts, sizeof n_queued, &n_queued);   /* slot 0 */
-    CHECK_EQ_INT(n_queued, n);
     PathState *dp = malloc(n * sizeof *dp);
     Ray *dr = malloc(n * sizeof *dr);
     uint *dq = malloc(n * sizeof *dq);
@@ -265,7 +261,6 @@ static void test_raygen(void)
     clReleaseMemObject(paths);
     clReleaseMemObject(rays);
     clReleaseMemObject(queue);
-    clReleaseMemObject(counts);
 }
 
 /* Random rays through the scene's box, from inside and outside it. */
@@ -289,19 +284,15 @@ static void test_intersect(void)
         rays[i] = random_ray();
         queue[i] = N - 1 - i;                   /* a permuted queue, as after compaction */
     }
-    /* the queue length is read on the device, from count slot 2 */
-    uint counts[3 * QUEUE_COUNT_STRIDE] = { 0 }, slot = 2;
-    counts[slot * QUEUE_COUNT_STRIDE] = N;
-    cl_mem rb = buffer(N * sizeof *rays, rays), qb = buffer(N * sizeof *queue, queue), hb = buffer(N * sizeof(Hit), NULL),
-           cb = buffer(sizeof counts, counts);
+    cl_mem rb = buffer(N * sizeof *rays, rays), qb = buffer(N * sizeof *queue, queue), hb = buffer(N * sizeof(Hit), NULL);
     cl_kernel k = kernel("k_intersect");
     set_scene_args(k);
+    uint n = N;
     SET(k, 10, qb);
-    SET(k, 11, cb);
-    SET(k, 12, slot);
-    SET(k, 13, rb);
-    SET(k, 14, hb);
-    run(k, N + 100);                            /* launched over more than the queue */
+    SET(k, 11, n);
+    SET(k, 12, rb);
+    SET(k, 13, hb);
+    run(k, N + 100);                            /* surplus work-items must do nothing */
     Hit *dh = malloc(N * sizeof *dh);
     read_back(hb, N * sizeof *dh, dh);
     uint exact = 0, bad = 0, hits = 0;
@@ -321,7 +312,6 @@ static void test_intersect(void)
     clReleaseMemObject(rb);
     clReleaseMemObject(qb);
     clReleaseMemObject(hb);
-    clReleaseMemObject(cb);
 }
 
 /* Shade and shadow: path states at various bounces with random throughput, the hits of
@@ -348,22 +338,23 @@ static void test_shade_and_shadow(void)
     cl_mem pb = buffer(N * sizeof *ps, ps), rb = buffer(N * sizeof *rays, rays), hb = buffer(N * sizeof *hits, hits),
            qb = buffer(N * sizeof *queue, queue), srb = buffer(N * sizeof(Ray), NULL),
            nqb = buffer(N * sizeof(uint), NULL), sqb = buffer(N * sizeof(uint), NULL);
-    /* bounce 1 of a wave: the queue length in count slot 2, the shade kernel counts the
-     * shadow rays into slot 3 and the next queue into slot 4 */
-    cl_uint init_counts[5 * QUEUE_COUNT_STRIDE] = { 0 }, slot = 2;
-    init_counts[slot * QUEUE_COUNT_STRIDE] = N;
+    /* bounce 1 of a wave: the shade kernel counts its shadow rays into count slot 3 and
+     * the next queue into slot 4 (entry.cl) */
+    cl_uint init_counts[5 * QUEUE_COUNT_STRIDE] = { 0 }, slot = 3;
     cl_mem cb = buffer(sizeof init_counts, init_counts);
     cl_kernel k = kernel("k_shade");
     set_scene_args(k);
+    uint n = N;
     SET(k, 10, qb);
-    SET(k, 11, cb);
-    SET(k, 12, slot);
-    SET(k, 13, rb);
-    SET(k, 14, hb);
-    SET(k, 15, pb);
-    SET(k, 16, srb);
-    SET(k, 17, nqb);
-    SET(k, 18, sqb);
+    SET(k, 11, n);
+    SET(k, 12, rb);
+    SET(k, 13, hb);
+    SET(k, 14, pb);
+    SET(k, 15, srb);
+    SET(k, 16, nqb);
+    SET(k, 17, sqb);
+    SET(k, 18, cb);
+    SET(k, 19, slot);
     run(k, N + 100);
     PathState *dps = malloc(N * sizeof *dps);
     Ray *drays = malloc(N * sizeof *drays), *dshadow = malloc(N * sizeof *dshadow);
@@ -418,13 +409,12 @@ static void test_shade_and_shadow(void)
     /* k_shadow over the shadow queue the device produced */
     cl_kernel ks = kernel("k_shadow");
     set_scene_args(ks);
-    uint shadow_slot = 3;
+    uint ns = counts[1];
     SET(ks, 10, sqb);
-    SET(ks, 11, cb);
-    SET(ks, 12, shadow_slot);
-    SET(ks, 13, srb);
-    SET(ks, 14, pb);
-    run(ks, N);
+    SET(ks, 11, ns);
+    SET(ks, 12, srb);
+    SET(ks, 13, pb);
+    run(ks, ns + 50);
     read_back(pb, N * sizeof *dps, dps);
     uint occluded = 0, sbad = 0, sexact = 0;
     for (uint i = 0; i < N; i++) {

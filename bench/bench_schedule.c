@@ -17,7 +17,10 @@
  *
  * Scheduler overhead: one device rendering the same samples through schedule_run
  * (adaptive batches, film merges, a host thread) and alone (one direct render call),
- * alternated in one process, for the PoCL device and the scalar device.
+ * alternated in one process, for the PoCL device and the scalar device, with four times
+ * the samples of the scaling runs so that most batches have their steady size. (The
+ * scalar device renders all samples of a pixel in a row, and more of them in a row run
+ * a little faster, so part of its overhead is the batch size itself.)
  *
  * On a shared machine other processes steal cores and scaling numbers mean nothing, so
  * every timed run is checked: the machine's busy time (/proc/stat) minus this program's
@@ -258,13 +261,14 @@ static int child_overhead(const BenchScene *bs, const char *spec, int reps)
     Film film;
     ScheduleStats st;
     direct(&s, 1);
+    uint spp = 4u * bs->spp;
     int repeated = 0, tainted = 0;
     double t_start = timer_now();
     for (int r = 0; r < reps; r++) {
         for (;;) {
             Meter m = meter_read(RUSAGE_SELF);
-            d[r] = direct(&s, bs->spp);
-            sc[r] = scheduled(&s, bs->spp, &film, &st);
+            d[r] = direct(&s, spp);
+            sc[r] = scheduled(&s, spp, &film, &st);
             film_free(&film);
             schedule_stats_free(&st);
             if (meter_foreign(m, RUSAGE_SELF) <= MAX_FOREIGN) break;
@@ -422,7 +426,8 @@ int main(int argc, char **argv)
     };
     double o_direct[2] = { 0, 0 }, o_sched[2] = { 0, 0 };
     int o_repeated = 0, o_tainted = 0;
-    printf("\nscheduler overhead (the same device alone, one render call, vs through the scheduler):\n");
+    printf("\nscheduler overhead, %u spp (the same device alone, one render call, vs through the scheduler):\n",
+           4u * bs.spp);
     printf("%-34s %12s %12s %10s\n", "device", "alone", "scheduled", "overhead");
     for (int i = 0; i < 2; i++) {
         char budget_text[32];

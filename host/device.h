@@ -8,6 +8,12 @@
  * which the host takes (adds into its film and clears) after each batch. Because the film
  * is integer and every random number is keyed by (pixel, sample, bounce, dimension), the
  * image does not depend on which device rendered which batch.
+ *
+ * Batches may be pipelined: `render` may return while the batch's film is still on its
+ * way back, and up to `max_in_flight` batches may be rendered before their films are
+ * taken; `take_film` takes them in the order they were rendered, waiting if needed. The
+ * OpenCL device uses this to read one batch's film back while the next one renders; the
+ * scalar device finishes each batch in `render` (max_in_flight 1).
  */
 #ifndef CLPT_DEVICE_H
 #define CLPT_DEVICE_H
@@ -66,7 +72,9 @@ typedef struct Device Device;
 
 typedef struct {
     Status (*load_scene)(Device *d, const DeviceScene *scene, Error *err);
+    /* Renders samples [first_sample, first_sample + count) of every pixel. */
     Status (*render)(Device *d, uint first_sample, uint count, Error *err);
+    /* Adds the film of the oldest batch not yet taken into `film` (n_pixels * 3). */
     Status (*take_film)(Device *d, int64_t *film, Error *err);
     void (*destroy)(Device *d);
 } DeviceOps;
@@ -76,6 +84,8 @@ struct Device {
     DeviceDesc desc;
     DeviceCounters counters;
     uint n_pixels;                /* set by load_scene */
+    uint max_in_flight;           /* batches rendered and not yet taken, at most (>= 1;
+                                     set by load_scene) */
     void *impl;
 };
 

@@ -24,17 +24,27 @@
 #include "traverse.cl"
 #include "whitted.cl"
 
-/* Pixels handed to a worker at a time: small enough to balance the end of a batch,
- * large enough that taking work is rare. */
-#define CPU_CHUNK_PIXELS 64u
+/* Paths (pixels x samples of the batch) handed to a worker at a time: small enough that
+ * the workers finish a batch together (a chunk takes well under a millisecond), large
+ * enough that taking work is rare. */
+#define CPU_CHUNK_PATHS 1024u
 
+/* The workers live as long as the device and wait between batches, so that a batch
+ * costs no thread creation; `generation` counts the batches handed out. */
 typedef struct {
     RenderParams params;
     SceneView view;
     int64_t *film;
     int threads;
+    pthread_t tids[256];
+    int started;                 /* workers running (0: the calling thread renders) */
+    pthread_mutex_t lock;
+    pthread_cond_t go, done;
+    unsigned generation;
+    int working;                 /* workers still on the current batch */
+    int quit;
     /* the batch being rendered */
-    uint first_sample, count;
+    uint first_sample, count, chunk_pixels;
     atomic_uint next_chunk;
     atomic_ullong rays;
 } CpuDevice;
@@ -61,16 +71,16 @@ static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *
     return rays;
 }
 
-static void *cpu_worker(void *arg)
+/* Renders chunks of the current batch until none is left. */
+static void render_chunks(CpuDevice *cd)
 {
-    CpuDevice *cd = arg;
     uint n_pixels = cd->params.width * cd->params.height;
     uint64_t rays = 0;
     for (;;) {
         uint chunk = atomic_fetch_add(&cd->next_chunk, 1u);
-        uint begin = chunk * CPU_CHUNK_PIXELS;
-        if (begin >= n_pixels) break;
-        uint end = begin + CPU_CHUNK_PIXELS < n_pixels ? begin + CPU_CHUNK_PIXELS : n_pixels;
+        if (chunk >= (n_pixels + cd->chunk_pixels - 1) / cd->chunk_pixels) break;
+        uint begin = chunk * cd->chunk_pixels;
+        uint end = n_pixels - begin > cd->chunk_pixels ? begin + cd->chunk_pixels : n_pixels;
         for (uint pixel = begin; pixel < end; pixel++) {
             for (uint s = 0; s < cd->count; s++) {
                 vec3 L;
@@ -87,7 +97,24 @@ static void *cpu_worker(void *arg)
         }
     }
     atomic_fetch_add(&cd->rays, (unsigned long long)rays);
-    return NULL;
+}
+
+static void *cpu_worker(void *arg)
+{
+    CpuDevice *cd = arg;
+    unsigned seen = 0;
+    for (;;) {
+        pthread_mutex_lock(&cd->lock);
+        while (cd->generation == seen && !cd->quit) pthread_cond_wait(&cd->go, &cd->lock);
+        seen = cd->generation;
+        int quit = cd->quit;
+        pthread_mutex_unlock(&cd->lock);
+        if (quit) return NULL;
+        render_chunks(cd);
+        pthread_mutex_lock(&cd->lock);
+        if (--cd->working == 0) pthread_cond_signal(&cd->done);
+        pthread_mutex_unlock(&cd->lock);
+    }
 }
 
 static Status cpu_load_scene(Device *d, const DeviceScene *scene, Error *err)
@@ -113,6 +140,7 @@ static Status cpu_load_scene(Device *d, const DeviceScene *scene, Error *err)
     cd->view.texels = scene->texels;
     cd->view.pixel_mask = scene->pixel_mask;
     d->n_pixels = n_pixels;
+    d->max_in_flight = 1;
     return ST_OK;
 }
 
@@ -121,14 +149,19 @@ static Status cpu_render(Device *d, uint first_sample, uint count, Error *err)
     CpuDevice *cd = d->impl;
     cd->first_sample = first_sample;
     cd->count = count;
+    cd->chunk_pixels = CPU_CHUNK_PATHS / count ? CPU_CHUNK_PATHS / count : 1u;
     atomic_store(&cd->next_chunk, 0u);
     atomic_store(&cd->rays, 0ull);
-    pthread_t tids[256];
-    int started = 0;
-    for (; started < cd->threads; started++)
-        if (pthread_create(&tids[started], NULL, cpu_worker, cd) != 0) break;
-    if (started == 0) cpu_worker(cd);   /* no thread could start: work on this one */
-    for (int i = 0; i < started; i++) pthread_join(tids[i], NULL);
+    if (cd->started == 0) {
+        render_chunks(cd);   /* no worker could start: work on this thread */
+    } else {
+        pthread_mutex_lock(&cd->lock);
+        cd->working = cd->started;
+        cd->generation++;
+        pthread_cond_broadcast(&cd->go);
+        while (cd->working > 0) pthread_cond_wait(&cd->done, &cd->lock);
+        pthread_mutex_unlock(&cd->lock);
+    }
     d->counters.rays += atomic_load(&cd->rays);
     d->counters.samples += (uint64_t)d->n_pixels * count;
     (void)err;
@@ -148,7 +181,17 @@ static Status cpu_take_film(Device *d, int64_t *film, Error *err)
 static void cpu_destroy(Device *d)
 {
     CpuDevice *cd = d->impl;
-    if (cd) free(cd->film);
+    if (cd) {
+        pthread_mutex_lock(&cd->lock);
+        cd->quit = 1;
+        pthread_cond_broadcast(&cd->go);
+        pthread_mutex_unlock(&cd->lock);
+        for (int i = 0; i < cd->started; i++) pthread_join(cd->tids[i], NULL);
+        pthread_cond_destroy(&cd->go);
+        pthread_cond_destroy(&cd->done);
+        pthread_mutex_destroy(&cd->lock);
+        free(cd->film);
+    }
     free(cd);
     free(d);
 }
@@ -167,6 +210,12 @@ Status device_cpu_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device *
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     int threads = cfg && cfg->threads > 0 ? cfg->threads : (int)(cores > 0 ? cores : 1);
     cd->threads = threads > 256 ? 256 : threads;
+    pthread_mutex_init(&cd->lock, NULL);
+    pthread_cond_init(&cd->go, NULL);
+    pthread_cond_init(&cd->done, NULL);
+    /* fewer workers than asked when threads cannot be created; none: the caller's */
+    while (cd->started < cd->threads && pthread_create(&cd->tids[cd->started], NULL, cpu_worker, cd) == 0)
+        cd->started++;
     d->ops = &cpu_ops;
     d->desc = *desc;
     snprintf(d->desc.name, sizeof d->desc.name, "scalar (%d thread%s)", cd->threads, cd->threads == 1 ? "" : "s");

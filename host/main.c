@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "checkpoint.h"
 #include "classic_parse.h"
 #include "device.h"
 #include "film.h"
@@ -49,6 +50,9 @@ typedef struct {
     int quiet;
     int progressive_failed;
     ImageEncoding encoding;
+    const char *checkpoint;       /* NULL: none */
+    CheckpointId checkpoint_id;
+    int checkpoint_failed;
 } RenderContext;
 
 static void print_warning(void *ctx, const char *msg)
@@ -70,16 +74,43 @@ static Status write_film(const Film *film, const char *path, ImageEncoding encod
 
 /* Progressive output: rewrites the image during the render (atomically, so a viewer
  * never sees half a file). A failure is reported once and does not stop the render. */
-static void on_progress_tick(void *vctx, const Film *film)
+static void on_progress_tick(void *vctx, const ScheduleSnapshot *snap)
 {
     RenderContext *ctx = vctx;
-    if (film->samples == 0) return;
     Error err = { 0 };
-    if (write_film(film, ctx->output, ctx->encoding, &err) != ST_OK && !ctx->progressive_failed) {
+    if (write_film(snap->film, ctx->output, ctx->encoding, &err) != ST_OK && !ctx->progressive_failed) {
         ctx->progressive_failed = 1;
         print_warning(NULL, err.msg);
     }
     error_clear(&err);
+}
+
+/* Periodic checkpoints; a failure is reported once (the next one may succeed) and does
+ * not stop the render. */
+static void on_checkpoint(void *vctx, const ScheduleSnapshot *snap)
+{
+    RenderContext *ctx = vctx;
+    Error err = { 0 };
+    if (checkpoint_write(ctx->checkpoint, &ctx->checkpoint_id, snap->film, snap->done, snap->n_done, &err) != ST_OK &&
+        !ctx->checkpoint_failed) {
+        ctx->checkpoint_failed = 1;
+        print_warning(NULL, err.msg);
+    }
+    error_clear(&err);
+}
+
+/* --resume: the checkpoint, checked against this render, becomes the film's start. */
+static Status resume_film(const char *path, const CheckpointId *id, Checkpoint *ck, Film *film, int quiet, Error *err)
+{
+    Status st = checkpoint_read(path, ck, err);
+    if (st == ST_OK) st = checkpoint_check(ck, path, id, err);
+    if (st != ST_OK) return st;
+    memcpy(film->sum, ck->film.sum, (size_t)film->width * film->height * 3u * sizeof *film->sum);
+    film->samples = ck->film.samples;
+    if (!quiet)
+        fprintf(stderr, "clpt: resuming from '%s': %llu of %u samples per pixel already done\n", path,
+                (unsigned long long)film->samples, id->spp);
+    return ST_OK;
 }
 
 /* Output name when -o is not given: the scene's file name with .png, in the current
@@ -162,7 +193,7 @@ static void print_scene_stats(const Scene *s, const KdTree *kd)
            (double)(k->bytes - k->bytes_corners) * per, (double)k->bytes_corners * per);
 }
 
-static void print_render_stats(const ScheduleStats *st, Device **devs, size_t n)
+static void print_render_stats(const ScheduleStats *st, uint spp, Device **devs, size_t n)
 {
     for (size_t i = 0; i < n; i++) {
         const DeviceCounters *c = &devs[i]->counters;
@@ -185,6 +216,14 @@ static void print_render_stats(const ScheduleStats *st, Device **devs, size_t n)
     printf("%-32s %7s %12llu %8.2f %8s %12.3f %10.3f %5.1f%%\n", "total", "",
            (unsigned long long)st->samples, st->seconds, "", (double)st->samples / secs / 1e6,
            (double)st->rays / secs / 1e6, 100.0);
+    /* Batches cover the whole image, so every pixel holds the same samples. */
+    printf("film: %u of %u samples per pixel, the same in every pixel; sample indices", st->spp_done, spp);
+    for (size_t i = 0; i < st->done.n && i < 8; i++)
+        printf(" [%u,%u)", st->done.ranges[i].first, st->done.ranges[i].first + st->done.ranges[i].count);
+    printf("%s%s\n", st->done.n > 8 ? " ..." : "", st->done.n == 0 ? " none" : "");
+    if (st->checkpoints)
+        printf("checkpoints: %u written during the render, %.1f ms each (film copied under the lock in %.2f ms)\n",
+               st->checkpoints, 1e3 * st->checkpoint_seconds / st->checkpoints, 1e3 * st->snapshot_seconds / st->checkpoints);
 }
 
 /* Opens the chosen devices and gives each the scene. A device that fails is dropped with
@@ -283,6 +322,13 @@ static Status run(int argc, char **argv, Error *err)
     size_t n_devs = 0;
     ScheduleStats stats;
     memset(&stats, 0, sizeof stats);
+    Checkpoint resume;
+    memset(&resume, 0, sizeof resume);
+    RenderContext ctx;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.output = output;
+    ctx.quiet = o.quiet;
+    ctx.checkpoint = o.checkpoint_path;
     double t_start = timer_now();
 
     if ((st = image_format_from_path(output, &format, err))) goto done;
@@ -304,15 +350,22 @@ static Status run(int argc, char **argv, Error *err)
     if ((st = render_scene_prepare(&scene, 0, &rs, err))) goto done;
     const DeviceScene *ds = &rs.ds;
     if (o.stats) print_scene_stats(&scene, &rs.kd);
+    checkpoint_id(ds, scene.image.spp, &ctx.checkpoint_id);
+    if ((st = film_init(&film, ds->params.width, ds->params.height, err))) goto done;
+    if (o.resume_path && (st = resume_film(o.resume_path, &ctx.checkpoint_id, &resume, &film, o.quiet, err)))
+        goto done;
 
     if ((st = open_devices(&o, ds, &devs, &n_devs, err))) goto done;
-    if ((st = film_init(&film, ds->params.width, ds->params.height, err))) goto done;
 
     install_signal_handlers();
-    RenderContext ctx = { output, o.quiet, 0, encoding };
+    ctx.encoding = encoding;
     ScheduleConfig cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.spp = scene.image.spp;
+    cfg.done = resume.done;
+    cfg.n_done = resume.n_done;
+    cfg.on_checkpoint = o.checkpoint_path ? on_checkpoint : NULL;
+    cfg.checkpoint_seconds = o.checkpoint_seconds;
     cfg.time_limit = o.time_limit;
     cfg.fixed_batch = o.batch;
     cfg.show_progress = progress_should_enable(o.quiet);
@@ -338,7 +391,27 @@ static Status run(int argc, char **argv, Error *err)
         }
         goto done;
     }
-    if (o.stats) print_render_stats(&stats, devs, n_devs);
+    /* The last checkpoint holds everything finished: after an interrupt or a failure it
+     * is what a resume starts from, so failing to write it then is an error. */
+    if (o.checkpoint_path && film.samples > 0) {
+        Error cerr = { 0 };
+        Status cst = batch_set_total(&stats.done) == film.samples
+                         ? checkpoint_write(o.checkpoint_path, &ctx.checkpoint_id, &film, stats.done.ranges,
+                                            stats.done.n, &cerr)
+                         : error_set(&cerr, ST_INTERNAL, "the record of finished samples is incomplete; "
+                                                         "no final checkpoint written");
+        if (cst != ST_OK) {
+            int complete = render_st == ST_OK && !stats.interrupted && !stats.time_up;
+            if (complete) {
+                print_warning(NULL, cerr.msg);
+            } else {
+                fprintf(stderr, "clpt: error: %s\n", cerr.msg);
+                if (render_st == ST_OK && !stats.interrupted) render_st = cst;
+            }
+        }
+        error_clear(&cerr);
+    }
+    if (o.stats) print_render_stats(&stats, scene.image.spp, devs, n_devs);
     if (!o.quiet || render_st != ST_OK || stats.interrupted) {
         double secs = stats.seconds > 0.0 ? stats.seconds : 1e-9;
         fprintf(stderr, "clpt: %s %ux%u, %llu spp%s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n",
@@ -369,6 +442,7 @@ done:
     for (size_t i = 0; i < n_devs; i++) device_close(devs[i]);
     free(devs);
     film_free(&film);
+    checkpoint_free(&resume);
     render_scene_free(&rs);
     scene_free(&scene);
     free(default_out);

@@ -43,6 +43,18 @@ void options_print_help(FILE *f)
 "      --depth-range NEAR,FAR the depth image is linear from white at NEAR to black at\n"
 "                             FAR (default: inverse distance, nearest hit white)\n"
 "\n"
+"Checkpoints (docs/checkpoint.md):\n"
+"      --checkpoint FILE      save the render's state to FILE (atomically) every\n"
+"                             --checkpoint-interval seconds, on Ctrl-C/SIGTERM and at\n"
+"                             the end\n"
+"      --checkpoint-interval SECONDS\n"
+"                             seconds between checkpoints (default 60)\n"
+"      --resume FILE          continue the render saved in FILE: only the samples not in\n"
+"                             it are rendered, and the image is the same bits as an\n"
+"                             uninterrupted render's. The scene and settings must be the\n"
+"                             ones it was made with (else exit status 3). Checkpoints go\n"
+"                             on into FILE unless --checkpoint names another file\n"
+"\n"
 "Scene and integrator:\n"
 "      --format auto|clpt|classic\n"
 "                             scene file format; default: told from the content\n"
@@ -89,7 +101,8 @@ void options_print_help(FILE *f)
 "                             $XDG_CACHE_HOME/clpt or ~/.cache/clpt)\n"
 "\n"
 "Exit status:\n"
-"  0  success                 3  input error (bad scene or mesh file)\n"
+"  0  success                 3  input error (bad scene, mesh or checkpoint file,\n"
+"                                or a checkpoint of another render)\n"
 "  1  internal error          4  I/O error (a file could not be read or written)\n"
 "  2  usage error             5  device error (no usable device, or every device failed)\n"
 "  6  interrupted (SIGINT/SIGTERM): the image so far was written\n",
@@ -193,6 +206,17 @@ Status options_parse(int argc, char **argv, Options *o, Error *err)
         }
         if (IS("--device")) { if (!(v = VALUE())) return ST_USAGE; o->device_spec = v; continue; }
         if (IS("--kernel-dir")) { if (!(v = VALUE())) return ST_USAGE; o->kernel_dir = v; continue; }
+        if (IS("--checkpoint") || IS("--resume")) {
+            if (!(v = VALUE())) return ST_USAGE;
+            if (!*v) return error_set(err, ST_USAGE, "%s needs a file name", a);
+            *(IS("--resume") ? &o->resume_path : &o->checkpoint_path) = v;
+            continue;
+        }
+        if (IS("--checkpoint-interval")) {
+            if (!(v = VALUE())) return ST_USAGE;
+            if ((st = parse_seconds(a, v, &o->checkpoint_seconds, err))) return st;
+            continue;
+        }
         struct { const char *name; long lo, hi; long *dst; } ints[] = {
             { "--spp", 1, CLPT_MAX_SPP, &o->spp },
             { "--width", 1, CLPT_MAX_IMAGE_SIDE, &o->width },
@@ -305,6 +329,10 @@ Status options_parse(int argc, char **argv, Options *o, Error *err)
             return error_set(err, ST_USAGE, "more than one scene given: '%s' and '%s'", o->scene_path, a);
         o->scene_path = a;
     }
+    if (o->checkpoint_seconds > 0.0 && !o->checkpoint_path && !o->resume_path)
+        return error_set(err, ST_USAGE, "--checkpoint-interval needs --checkpoint FILE (or --resume FILE)");
+    if (o->resume_path && !o->checkpoint_path) o->checkpoint_path = o->resume_path;
+    if (o->checkpoint_seconds <= 0.0) o->checkpoint_seconds = 60.0;
     if (!o->scene_path && !o->help && !o->version && !o->list_devices)
         return error_set(err, ST_USAGE, "no scene given (usage: clpt [options] SCENE; see --help)");
     return ST_OK;

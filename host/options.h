@@ -15,6 +15,9 @@ typedef struct {
     int threads;                  /* scalar device workers, 0 = every core */
     double time_limit;            /* seconds, 0 = none */
     double progressive_seconds;   /* 0 = no progressive output */
+    const char *checkpoint_path;  /* NULL: no checkpoints (but see resume_path) */
+    double checkpoint_seconds;    /* between checkpoints; 60 unless given */
+    const char *resume_path;      /* NULL: a fresh render */
     int list_devices, stats, quiet, help, version;
     /* developer flags */
     const char *kernel_dir;

@@ -4,10 +4,17 @@
  * raygen.cl, traverse.cl, shade.cl and film.cl, which the scalar C device calls too.
  * Queueing (which paths are still alive) happens here, not in the stage functions.
  *
- * A wave covers the pixels [first_pixel, first_pixel + wave_pixels) and `layers`
- * consecutive sample indices: path i renders pixel first_pixel + i % wave_pixels with
- * sample index first_sample + i / wave_pixels. Each bounce is intersect → shade → shadow
- * over the queue of live paths; shade appends survivors to the next queue.
+ * Paths are numbered sample-major over the image: path number p renders pixel
+ * p % n_pixels with sample index p / n_pixels (counted from the batch's first sample),
+ * and a wave is a contiguous run of path numbers starting at pixel `first_pixel`, so
+ * every wave of a batch is full whatever the image size. Each bounce is intersect →
+ * shade → shadow over the queue of live paths; shade appends survivors to the next
+ * queue and counts them, and the host launches the next bounce over exactly that many.
+ *
+ * k_shade counts into per-wave count slots QUEUE_COUNT_STRIDE uints apart (one per
+ * cache line, types.h): at bounce b, slot 2b + 1 counts its shadow rays and slot 2b + 2
+ * the paths that go on. Every bounce has its own slots, so a wave's counters are zeroed
+ * once and the host can read them back while later bounces run.
  */
 #include "film.cl"
 #include "raygen.cl"
@@ -32,14 +39,16 @@
     sc.shading = shading; sc.textures = textures; sc.texels = texels;                    \
     sc.pixel_mask = pixel_mask
 
-/* Births the wave's paths and queues them all. */
-__kernel void k_raygen(__global const RenderParams *params, uint first_pixel, uint wave_pixels,
-                       uint first_sample, uint n_paths, __global PathState *paths,
+/* Births the wave's paths and queues them all: path i of the wave is path number
+ * first_pixel + i of the batch (see the top of this file). */
+__kernel void k_raygen(__global const RenderParams *params, uint first_pixel, uint first_sample,
+                       uint n_pixels, uint n_paths, __global PathState *paths,
                        __global Ray *rays, __global uint *queue)
 {
     uint i = (uint)get_global_id(0);
     if (i >= n_paths) return;
-    raygen_path(params, first_pixel + i % wave_pixels, first_sample + i / wave_pixels, &paths[i], &rays[i]);
+    uint p = first_pixel + i;
+    raygen_path(params, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i]);
     queue[i] = i;
 }
 
@@ -54,16 +63,16 @@ __kernel void k_intersect(SCENE_ARGS, __global const uint *queue, uint n,
     hits[path] = trace_closest(&sc, rays[path]);
 }
 
-/* Shades every queued path; counters[0] counts the next queue, counters[1] the shadow
- * rays. Their order in the queues varies from run to run, the paths' results do not.
- * Slots are reserved per work-group (local atomics, then one global atomic_add per
- * queue), because one global atomic per path made the shared counters the hottest
- * cache line of the whole render on a CPU. No early return: every work-item must reach
- * the barriers. */
+/* Shades every queued path; count slot `slot` counts the shadow rays, slot + 1 the next
+ * queue (see the top of this file). Their order in the queues varies from run to run,
+ * the paths' results do not. Slots are reserved per work-group (local atomics, then one
+ * global atomic_add per queue), because one global atomic per path made the shared
+ * counters the hottest cache line of the whole render on a CPU. No early return: every
+ * work-item must reach the barriers. */
 __kernel void k_shade(SCENE_ARGS, __global const uint *queue, uint n, __global Ray *rays,
                       __global const Hit *hits, __global PathState *paths,
                       __global Ray *shadow_rays, __global uint *next_queue,
-                      __global uint *shadow_queue, __global uint *counters)
+                      __global uint *shadow_queue, __global uint *counts, uint slot)
 {
     __local uint group_count[2];
     __local uint group_base[2];
@@ -85,8 +94,8 @@ __kernel void k_shade(SCENE_ARGS, __global const uint *queue, uint n, __global R
     if (r & SHADE_SHADOW) slot_shadow = atomic_inc(&group_count[1]);
     barrier(CLK_LOCAL_MEM_FENCE);
     if (lid == 0u) {
-        group_base[0] = group_count[0] ? atomic_add(&counters[0], group_count[0]) : 0u;
-        group_base[1] = group_count[1] ? atomic_add(&counters[1], group_count[1]) : 0u;
+        group_base[0] = group_count[0] ? atomic_add(&counts[(slot + 1u) * QUEUE_COUNT_STRIDE], group_count[0]) : 0u;
+        group_base[1] = group_count[1] ? atomic_add(&counts[slot * QUEUE_COUNT_STRIDE], group_count[1]) : 0u;
     }
     barrier(CLK_LOCAL_MEM_FENCE);
     if (r & SHADE_CONTINUE) next_queue[group_base[0] + slot_next] = path;
@@ -104,15 +113,17 @@ __kernel void k_shadow(SCENE_ARGS, __global const uint *shadow_queue, uint n,
     shadow_resolve(&paths[path], trace_any(&sc, shadow_rays[path]));
 }
 
-/* Adds the finished wave to the film: one work-item per pixel, so no two work-items
- * touch the same film entry. */
-__kernel void k_film(__global const PathState *paths, uint first_pixel, uint wave_pixels,
-                     uint layers, __global long *film)
+/* Adds the finished wave of n_paths paths to the film. Work-item j owns one pixel, the
+ * one of wave path j, and adds every path of the wave on that pixel (j, j + n_pixels,
+ * ...), so no two work-items touch the same film entry; launched over
+ * min(n_paths, n_pixels) work-items. */
+__kernel void k_film(__global const PathState *paths, uint first_pixel, uint n_pixels,
+                     uint n_paths, __global long *film)
 {
-    uint i = (uint)get_global_id(0);
-    if (i >= wave_pixels) return;
-    for (uint l = 0u; l < layers; l++)
-        film_add(film, first_pixel + i, paths[l * wave_pixels + i].radiance);
+    uint j = (uint)get_global_id(0);
+    if (j >= n_paths || j >= n_pixels) return;
+    uint pixel = (first_pixel + j) % n_pixels;
+    for (uint i = j; i < n_paths; i += n_pixels) film_add(film, pixel, paths[i].radiance);
 }
 
 /* Writes sizeof and offsetof of the shared structs, for the host to compare with its
@@ -156,11 +167,11 @@ __kernel void k_layout(__global uint *out)
 /* ---------------------------------------------------------------- classic ray tracer
  * The whitted integrator and the auxiliary images (kernels/whitted.cl): one work-item
  * computes one pixel sample whole, with its own stack of mirror and refracted rays, and
- * leaves the radiance in its path state for k_film. Path i is pixel first_pixel +
- * i % wave_pixels, sample first_sample + i / wave_pixels, as in k_raygen. counters[0]
+ * leaves the radiance in its path state for k_film. Path numbers are sample-major as in
+ * k_raygen: work-item i is path first_pixel + i of sample first_sample. counters[0]
  * receives the number of rays traced (summed per work-group first). No early return:
  * every work-item must reach the barriers. */
-__kernel void k_whitted(SCENE_ARGS, uint first_pixel, uint wave_pixels, uint first_sample, uint n_paths,
+__kernel void k_whitted(SCENE_ARGS, uint first_pixel, uint first_sample, uint n_pixels, uint n_paths,
                         __global PathState *paths, __global uint *counters)
 {
     __local uint group_rays;
@@ -170,7 +181,8 @@ __kernel void k_whitted(SCENE_ARGS, uint first_pixel, uint wave_pixels, uint fir
     uint rays = 0u;
     if (i < n_paths) {
         SCENE_VIEW(sc);
-        paths[i].radiance = whitted_sample(&sc, first_pixel + i % wave_pixels, first_sample + i / wave_pixels, &rays);
+        uint p = first_pixel + i;
+        paths[i].radiance = whitted_sample(&sc, p % n_pixels, first_sample + p / n_pixels, &rays);
     }
     if (rays) atomic_add(&group_rays, rays);
     barrier(CLK_LOCAL_MEM_FENCE);

@@ -243,6 +243,11 @@ typedef struct {                                        /* 64 bytes */
 
 #define PATH_SPECULAR 1u      /* last bounce was a delta lobe: no MIS on emission */
 
+/* The wavefront's queue counters (entry.cl) are spaced this many uints apart, one per
+ * 64-byte cache line, so that the two counters k_shade adds to atomically and the
+ * counts the host reads back never share a line. */
+#define QUEUE_COUNT_STRIDE 16u
+
 /* Stage results reported by shade_path to its caller, which does the queueing. */
 #define SHADE_CONTINUE 1u     /* the path goes on with the ray written back */
 #define SHADE_SHADOW 2u       /* a shadow ray was written; shadow_L waits on it */

@@ -319,8 +319,8 @@ static void test_raygen(void)
     cl_kernel k = kernel("k_raygen");
     SET(k, 0, cl.scene[0]);
     SET(k, 1, first_pixel);
-    SET(k, 2, npix);
-    SET(k, 3, first_sample);
+    SET(k, 2, first_sample);
+    SET(k, 3, npix);
     SET(k, 4, n);
     SET(k, 5, paths);
     SET(k, 6, rays);
@@ -382,7 +382,7 @@ static void test_intersect(void)
     SET(k, N_SCENE + 1, n);
     SET(k, N_SCENE + 2, rb);
     SET(k, N_SCENE + 3, hb);
-    run(k, N);
+    run(k, N + 100);                            /* surplus work-items must do nothing */
     Hit *dh = malloc(N * sizeof *dh);
     read_back(hb, N * sizeof *dh, dh);
     uint exact = 0, bad = 0, hits = 0;
@@ -428,8 +428,10 @@ static void test_shade_and_shadow(void)
     cl_mem pb = buffer(N * sizeof *ps, ps), rb = buffer(N * sizeof *rays, rays), hb = buffer(N * sizeof *hits, hits),
            qb = buffer(N * sizeof *queue, queue), srb = buffer(N * sizeof(Ray), NULL),
            nqb = buffer(N * sizeof(uint), NULL), sqb = buffer(N * sizeof(uint), NULL);
-    cl_uint zero2[2] = { 0, 0 };
-    cl_mem cb = buffer(sizeof zero2, zero2);
+    /* bounce 1 of a wave: the shade kernel counts its shadow rays into count slot 3 and
+     * the next queue into slot 4 (entry.cl) */
+    cl_uint init_counts[5 * QUEUE_COUNT_STRIDE] = { 0 }, slot = 3;
+    cl_mem cb = buffer(sizeof init_counts, init_counts);
     cl_kernel k = kernel("k_shade");
     set_scene_args(k);
     uint n = N;
@@ -442,16 +444,20 @@ static void test_shade_and_shadow(void)
     SET(k, N_SCENE + 6, nqb);
     SET(k, N_SCENE + 7, sqb);
     SET(k, N_SCENE + 8, cb);
-    run(k, N);
+    SET(k, N_SCENE + 9, slot);
+    run(k, N + 100);
     PathState *dps = malloc(N * sizeof *dps);
     Ray *drays = malloc(N * sizeof *drays), *dshadow = malloc(N * sizeof *dshadow);
-    uint *dnext = malloc(N * sizeof *dnext), *dshq = malloc(N * sizeof *dshq), counts[2];
+    uint *dnext = malloc(N * sizeof *dnext), *dshq = malloc(N * sizeof *dshq), all_counts[5 * QUEUE_COUNT_STRIDE],
+         counts[2];
     read_back(pb, N * sizeof *dps, dps);
     read_back(rb, N * sizeof *drays, drays);
     read_back(srb, N * sizeof *dshadow, dshadow);
     read_back(nqb, N * sizeof *dnext, dnext);
     read_back(sqb, N * sizeof *dshq, dshq);
-    read_back(cb, sizeof counts, counts);
+    read_back(cb, sizeof all_counts, all_counts);
+    counts[0] = all_counts[4 * QUEUE_COUNT_STRIDE];
+    counts[1] = all_counts[3 * QUEUE_COUNT_STRIDE];
 
     /* The C side, and the flags each path should have produced. */
     uint *flags = calloc(N, sizeof *flags);
@@ -498,7 +504,7 @@ static void test_shade_and_shadow(void)
     SET(ks, N_SCENE + 1, ns);
     SET(ks, N_SCENE + 2, srb);
     SET(ks, N_SCENE + 3, pb);
-    run(ks, ns ? ns : 1);
+    run(ks, ns + 50);
     read_back(pb, N * sizeof *dps, dps);
     uint occluded = 0, sbad = 0, sexact = 0;
     for (uint i = 0; i < N; i++) {
@@ -521,11 +527,13 @@ static void test_shade_and_shadow(void)
     for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) clReleaseMemObject(ms[i]);
 }
 
+/* A wave that starts at pixel 100 of a 600-pixel image and wraps around it three times
+ * and a bit: pixels get three or four of its paths. */
 static void test_film(void)
 {
-    uint npix = 500, layers = 4, first_pixel = 100, n_film = first_pixel + npix;
-    PathState *ps = calloc((size_t)npix * layers, sizeof *ps);
-    for (uint i = 0; i < npix * layers; i++) {
+    uint n_film = 600, first_pixel = 100, n_paths = 2000;
+    PathState *ps = calloc(n_paths, sizeof *ps);
+    for (uint i = 0; i < n_paths; i++) {
         ps[i].radiance = vrand(0.0f, 3.0f);
         if (i % 97 == 0) ps[i].radiance.x = NAN;           /* dropped, not propagated */
         if (i % 89 == 0) ps[i].radiance.y = 1e30f;         /* clamped */
@@ -533,17 +541,16 @@ static void test_film(void)
     }
     int64_t *film = calloc((size_t)n_film * 3, sizeof *film), *cfilm = calloc((size_t)n_film * 3, sizeof *cfilm);
     for (uint i = 0; i < n_film * 3; i++) film[i] = cfilm[i] = (int64_t)i * 1000;   /* already holds samples */
-    cl_mem pb = buffer((size_t)npix * layers * sizeof *ps, ps), fb = buffer((size_t)n_film * 3 * sizeof *film, film);
+    cl_mem pb = buffer((size_t)n_paths * sizeof *ps, ps), fb = buffer((size_t)n_film * 3 * sizeof *film, film);
     cl_kernel k = kernel("k_film");
     SET(k, 0, pb);
     SET(k, 1, first_pixel);
-    SET(k, 2, npix);
-    SET(k, 3, layers);
+    SET(k, 2, n_film);
+    SET(k, 3, n_paths);
     SET(k, 4, fb);
-    run(k, npix);
+    run(k, n_film);
     read_back(fb, (size_t)n_film * 3 * sizeof *film, film);
-    for (uint l = 0; l < layers; l++)
-        for (uint i = 0; i < npix; i++) film_add(cfilm, first_pixel + i, ps[l * npix + i].radiance);
+    for (uint i = 0; i < n_paths; i++) film_add(cfilm, (first_pixel + i) % n_film, ps[i].radiance);
     uint bad = 0;
     for (uint i = 0; i < n_film * 3; i++) bad += film[i] != cfilm[i];
     CHECK_MSG(bad == 0, "%u film entries differ (fixed point must match exactly)", bad);
@@ -589,8 +596,8 @@ static void test_whitted(void)
         SET(k, 12, mb);
         uint first_pixel = 0;
         SET(k, N_SCENE + 0, first_pixel);
-        SET(k, N_SCENE + 1, npix);
-        SET(k, N_SCENE + 2, first_sample);
+        SET(k, N_SCENE + 1, first_sample);
+        SET(k, N_SCENE + 2, npix);
         SET(k, N_SCENE + 3, n);
         SET(k, N_SCENE + 4, pb);
         SET(k, N_SCENE + 5, cb);

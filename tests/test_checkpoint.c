@@ -1,0 +1,354 @@
+/*
+ * test_checkpoint.c — checkpoint and resume: the file round-trips, damaged files and
+ * checkpoints of other renders are refused with exit status 3, and a render killed with
+ * SIGKILL at several moments (and resumed each time, on other devices) ends with the
+ * same PFM bytes as a render never interrupted. Also SIGINT writes a final checkpoint.
+ * Runs with two PoCL devices (POCL_DEVICES="pthread pthread") plus the scalar device.
+ */
+#include <dirent.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "checkpoint.h"
+#include "cli_util.h"
+#include "harness.h"
+#include "render_scene.h"
+#include "scene.h"
+#include "timer.h"
+
+static char dir[64];
+static char path_ref[128], path_out[128], path_ck[128];
+static CliResult r;
+#define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
+
+/* A small, quick render with many batches, so that checkpoints catch it part-way. */
+#define SCENE "scenes/cornell-box.scene"
+#define SIZE "--width", "48", "--height", "36"
+#define SPP_TEXT "400"
+#define SPP 400u
+
+static void make_dir(void)
+{
+    snprintf(dir, sizeof dir, "/tmp/clpt-test-ckpt-XXXXXX");
+    if (!mkdtemp(dir)) perror("mkdtemp");
+    snprintf(path_ref, sizeof path_ref, "%s/ref.pfm", dir);
+    snprintf(path_out, sizeof path_out, "%s/out.pfm", dir);
+    snprintf(path_ck, sizeof path_ck, "%s/render.ckpt", dir);
+}
+
+/* Removes the folder and whatever is left in it (temporary files of killed writes). */
+static void remove_dir(void)
+{
+    DIR *d = opendir(dir);
+    if (d) {
+        struct dirent *e;
+        char p[512];
+        while ((e = readdir(d)))
+            if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
+                snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
+                unlink(p);
+            }
+        closedir(d);
+    }
+    rmdir(dir);
+}
+
+static int read_file(const char *path, unsigned char **data, size_t *len)
+{
+    *data = NULL;
+    *len = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    *data = malloc(n > 0 ? (size_t)n : 1);
+    *len = fread(*data, 1, (size_t)n, f);
+    fclose(f);
+    return *len == (size_t)n;
+}
+
+static int write_file(const char *path, const unsigned char *data, size_t len)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) return 0;
+    size_t w = fwrite(data, 1, len, f);
+    return (fclose(f) == 0) & (w == len);
+}
+
+static int files_equal(const char *a, const char *b)
+{
+    unsigned char *x, *y;
+    size_t nx, ny;
+    int ok = read_file(a, &x, &nx) && read_file(b, &y, &ny) && nx == ny && memcmp(x, y, nx) == 0;
+    free(x);
+    free(y);
+    return ok;
+}
+
+static void sleep_s(double s)
+{
+    struct timespec ts = { (time_t)s, (long)((s - (double)(time_t)s) * 1e9) };
+    nanosleep(&ts, NULL);
+}
+
+/* Samples per pixel in the checkpoint at `path`, or -1 when there is none (yet). */
+static long checkpoint_samples(const char *path)
+{
+    Checkpoint c;
+    Error err = { 0 };
+    long n = checkpoint_read(path, &c, &err) == ST_OK ? (long)c.film.samples : -1;
+    checkpoint_free(&c);
+    error_clear(&err);
+    return n;
+}
+
+/* ------------------------------------------------------------------ the file itself */
+
+static void fill_film(Film *f, uint w, uint h, uint64_t samples)
+{
+    Error err = { 0 };
+    film_init(f, w, h, &err);
+    for (size_t i = 0; i < (size_t)w * h * 3u; i++) f->sum[i] = (int64_t)(i * 2654435761u) - ((int64_t)1 << 20);
+    f->sum[0] = INT64_MIN;       /* extremes survive the encoding */
+    f->sum[1] = INT64_MAX;
+    f->samples = samples;
+}
+
+static void test_write_read_round_trip(void)
+{
+    CheckpointId id;
+    memset(&id, 0, sizeof id);
+    for (int i = 0; i < CHECKPOINT_KEY_SIZE; i++) id.key[i] = (unsigned char)(i * 7);
+    id.width = 5;
+    id.height = 3;
+    id.spp = 100;
+    id.seed = 42;
+    id.max_depth = 8;
+    Film f;
+    fill_film(&f, 5, 3, 30);
+    const Batch done[] = { { 0, 10 }, { 20, 5 }, { 40, 15 } };
+    Error err = { 0 };
+    CHECK(checkpoint_write(path_ck, &id, &f, done, 3, &err) == ST_OK);
+    Checkpoint c;
+    CHECK(checkpoint_read(path_ck, &c, &err) == ST_OK);
+    CHECK(memcmp(&c.id, &id, sizeof id) == 0);
+    CHECK(c.film.width == 5 && c.film.height == 3 && c.film.samples == 30);
+    CHECK(c.film.sum && memcmp(c.film.sum, f.sum, 5 * 3 * 3 * sizeof *f.sum) == 0);
+    CHECK(c.n_done == 3 && c.done && memcmp(c.done, done, sizeof done) == 0);
+    CHECK(checkpoint_check(&c, path_ck, &id, &err) == ST_OK);
+    checkpoint_free(&c);
+
+    /* no temporary file is left beside it */
+    DIR *d = opendir(dir);
+    int others = 0;
+    struct dirent *e;
+    while (d && (e = readdir(d)))
+        others += strstr(e->d_name, ".tmp.") != NULL;
+    if (d) closedir(d);
+    CHECK_EQ_INT(others, 0);
+
+    /* an unwritable place is an I/O error naming the file */
+    CHECK(checkpoint_write("/nonexistent-folder/x.ckpt", &id, &f, done, 3, &err) == ST_IO);
+    CHECK_STR_CONTAINS(err.msg, "/nonexistent-folder/x.ckpt");
+    error_clear(&err);
+    film_free(&f);
+}
+
+static void expect_refused(const unsigned char *data, size_t len, const char *words)
+{
+    char p[160];
+    snprintf(p, sizeof p, "%s/damaged.ckpt", dir);
+    CHECK(write_file(p, data, len));
+    Checkpoint c;
+    Error err = { 0 };
+    CHECK_EQ_INT(checkpoint_read(p, &c, &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, words);
+    checkpoint_free(&c);
+    error_clear(&err);
+    unlink(p);
+}
+
+static void test_damaged_files_are_refused(void)
+{
+    unsigned char *good;
+    size_t len;
+    CHECK(read_file(path_ck, &good, &len));    /* from the round trip */
+    unsigned char *bad = malloc(len);
+    memcpy(bad, good, len);
+    bad[len / 2] ^= 0x10;
+    expect_refused(bad, len, "checksum");
+    memcpy(bad, good, len);
+    bad[0] = 'X';
+    expect_refused(bad, len, "magic");
+    memcpy(bad, good, len);
+    bad[8] = 9;
+    expect_refused(bad, len, "version 9");
+    expect_refused(good, len - 100, "truncated");
+    expect_refused(good, 20, "truncated");
+    expect_refused(good, 0, "too short");
+    /* a header whose counts promise more than the file holds: refused before any
+     * allocation from them */
+    memcpy(bad, good, len);
+    bad[48] = 0xff, bad[49] = 0xff, bad[50] = 0xff;
+    expect_refused(bad, len, "checksum");
+    free(bad);
+    free(good);
+
+    Checkpoint c;
+    Error err = { 0 };
+    CHECK_EQ_INT(checkpoint_read("/nonexistent.ckpt", &c, &err), ST_IO);
+    checkpoint_free(&c);
+    error_clear(&err);
+}
+
+/* The render key: stable for the same scene and settings, different when anything that
+ * changes the image changes, with a message naming what differs. */
+static void test_render_key(void)
+{
+    CheckpointId ids[5];
+    for (int k = 0; k < 5; k++) {
+        Scene s;
+        Error err = { 0 };
+        scene_init(&s);
+        CHECK(scene_load(SCENE, &s, &err) == ST_OK);
+        s.image.width = 48;
+        s.image.height = 36;
+        if (k == 2) s.image.seed = 7;
+        if (k == 3) s.materials[0].albedo.x += 0.01f;
+        RenderScene rs;
+        CHECK(render_scene_prepare(&s, 0, &rs, &err) == ST_OK);
+        checkpoint_id(&rs.ds, k == 4 ? 401u : 400u, &ids[k]);
+        render_scene_free(&rs);
+        scene_free(&s);
+    }
+    CHECK(memcmp(&ids[0], &ids[1], sizeof ids[0]) == 0);
+    for (int k = 2; k < 5; k++) CHECK_MSG(memcmp(ids[0].key, ids[k].key, CHECKPOINT_KEY_SIZE) != 0, "change %d", k);
+    Checkpoint c;
+    memset(&c, 0, sizeof c);
+    Error err = { 0 };
+    c.id = ids[2];
+    CHECK_EQ_INT(checkpoint_check(&c, "x.ckpt", &ids[0], &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "seed");
+    c.id = ids[3];
+    CHECK_EQ_INT(checkpoint_check(&c, "x.ckpt", &ids[0], &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "scene differs");
+    c.id = ids[4];
+    CHECK_EQ_INT(checkpoint_check(&c, "x.ckpt", &ids[0], &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "samples per pixel");
+    error_clear(&err);
+}
+
+/* ------------------------------------------------------------------ the program */
+
+static void render_reference(void)
+{
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", SIZE, "--spp", SPP_TEXT, "-o", path_ref), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+}
+
+/* Starts a render that checkpoints every 0.1 s, waits until its checkpoint holds more
+ * than `after` samples per pixel (the run has made progress), lets it go on for
+ * `extra` seconds and kills it with SIGKILL. Returns the samples per pixel the
+ * checkpoint holds then. */
+static long run_and_kill(const char *devices, int resume, long after, double extra)
+{
+    CliChild c = resume ? cli_start(ARGS(SCENE, "-q", "--device", devices, SIZE, "--spp", SPP_TEXT, "--batch", "2",
+                                         "-o", path_out, "--resume", path_ck, "--checkpoint-interval", "0.1"))
+                        : cli_start(ARGS(SCENE, "-q", "--device", devices, SIZE, "--spp", SPP_TEXT, "--batch", "2",
+                                         "-o", path_out, "--checkpoint", path_ck, "--checkpoint-interval", "0.1"));
+    double t0 = timer_now();
+    while (checkpoint_samples(path_ck) <= after && timer_now() - t0 < 20.0 && waitpid(c.pid, NULL, WNOHANG) == 0)
+        sleep_s(0.005);
+    sleep_s(extra);
+    kill(c.pid, SIGKILL);
+    cli_finish(c, &r);
+    return checkpoint_samples(path_ck);
+}
+
+static void test_sigkill_then_resume_gives_the_same_image(void)
+{
+    unlink(path_ck);
+    /* three kills at different moments, each run on other devices; the last resume
+     * finishes the image */
+    const char *devices[] = { "scalar", "0", "0,1,scalar" };
+    const double extra[] = { 0.0, 0.07, 0.15 };
+    long held = 0;
+    int partial = 0;
+    for (int k = 0; k < 3; k++) {
+        long now = run_and_kill(devices[k], k > 0, held, extra[k]);
+        CHECK_MSG(now >= held && now > 0, "kill %d: the checkpoint holds %ld spp, before %ld", k, now, held);
+        fprintf(stderr, "  kill %d (devices %s): the checkpoint holds %ld of %u spp\n", k, devices[k], now, SPP);
+        partial += now > 0 && now < (long)SPP;
+        held = now;
+    }
+    CHECK_MSG(partial >= 2, "only %d of 3 kills caught the render part-way", partial);
+    cli_run(ARGS(SCENE, "--device", "0,scalar", SIZE, "--spp", SPP_TEXT, "-o", path_out, "--resume", path_ck), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_STR_CONTAINS(r.err, "resuming from");
+    CHECK_MSG(files_equal(path_ref, path_out), "the resumed image differs from the uninterrupted one");
+    CHECK_EQ_INT(checkpoint_samples(path_ck), SPP);    /* the final state is saved too */
+}
+
+static void test_sigint_writes_a_checkpoint(void)
+{
+    unlink(path_ck);
+    CliChild c = cli_start(ARGS(SCENE, "--device", "scalar", SIZE, "--spp", SPP_TEXT, "--batch", "2", "-o", path_out,
+                                "--checkpoint", path_ck, "--checkpoint-interval", "0.1"));
+    double t0 = timer_now();
+    while (checkpoint_samples(path_ck) <= 0 && timer_now() - t0 < 20.0) sleep_s(0.005);
+    kill(c.pid, SIGINT);
+    cli_finish(c, &r);
+    CHECK_EQ_INT(r.status, 6);
+    CHECK_STR_CONTAINS(r.err, "interrupted");
+    long held = checkpoint_samples(path_ck);
+    CHECK_MSG(held > 0 && held < (long)SPP, "the checkpoint after SIGINT holds %ld spp", held);
+    cli_run(ARGS(SCENE, "-q", "--device", "0", SIZE, "--spp", SPP_TEXT, "-o", path_out, "--resume", path_ck), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_MSG(files_equal(path_ref, path_out), "the image resumed after SIGINT differs");
+}
+
+static void test_other_renders_are_refused(void)
+{
+    /* path_ck holds the finished render of the tests above */
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", SIZE, "--spp", "401", "-o", path_out, "--resume", path_ck), &r);
+    CHECK_EQ_INT(r.status, 3);
+    CHECK_STR_CONTAINS(r.err, "belongs to another render");
+    CHECK_STR_CONTAINS(r.err, "samples per pixel");
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", "--width", "36", "--height", "48", "--spp", SPP_TEXT, "-o",
+                 path_out, "--resume", path_ck), &r);
+    CHECK_EQ_INT(r.status, 3);
+    CHECK_STR_CONTAINS(r.err, "48x36");
+    /* another scene with every setting forced equal: only the key tells them apart */
+    cli_run(ARGS("scenes/mesh.scene", "-q", "--device", "scalar", SIZE, "--spp", SPP_TEXT, "--seed", "1",
+                 "--max-depth", "8", "-o", path_out, "--resume", path_ck), &r);
+    CHECK_EQ_INT(r.status, 3);
+    CHECK_STR_CONTAINS(r.err, "scene differs");
+    /* not a checkpoint at all, and no file */
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", SIZE, "--spp", SPP_TEXT, "-o", path_out, "--resume", path_ref), &r);
+    CHECK_EQ_INT(r.status, 3);
+    CHECK_STR_CONTAINS(r.err, "not a usable clpt checkpoint");
+    char missing[160];
+    snprintf(missing, sizeof missing, "%s/missing.ckpt", dir);
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", SIZE, "-o", path_out, "--resume", missing), &r);
+    CHECK_EQ_INT(r.status, 4);
+    cli_run(ARGS(SCENE, "-q", "--checkpoint-interval", "5"), &r);
+    CHECK_EQ_INT(r.status, 2);
+}
+
+int main(void)
+{
+    /* before anything loads the OpenCL ICD: two PoCL CPU devices */
+    setenv("POCL_DEVICES", "pthread pthread", 1);
+    make_dir();
+    RUN(test_write_read_round_trip);
+    RUN(test_damaged_files_are_refused);
+    RUN(test_render_key);
+    RUN(render_reference);
+    RUN(test_sigkill_then_resume_gives_the_same_image);
+    RUN(test_sigint_writes_a_checkpoint);
+    RUN(test_other_renders_are_refused);
+    remove_dir();
+    return harness_report();
+}

@@ -37,7 +37,7 @@ int batch_queue_skip_done(BatchQueue *q, const Batch *done, size_t n)
     Batch *sorted = n ? malloc(n * sizeof *sorted) : NULL;
     if (n && !sorted) return -2;
     if (n) memcpy(sorted, done, n * sizeof *sorted);
-    qsort(sorted, n, sizeof *sorted, cmp_batch);
+    if (n) qsort(sorted, n, sizeof *sorted, cmp_batch);   /* qsort(NULL, 0) is undefined */
     int rc = 0;
     uint at = 0, skipped = 0;
     size_t n_todo = 0;

@@ -514,11 +514,16 @@ static Status read_list(PlyReader *r, const PlyProp *p, int indices)
     Status st = read_value(r, p->count_type, &c);
     if (st) return st;
     if (c < 0.0) return fail(r, at, 0, "a negative list count, %.0f", c);
+    /* The count is checked against the bytes left before anything is reserved from it:
+     * a list is at least one byte per binary value or two per ascii value (a digit and a
+     * separator, none after the last), so a lying count fails here instead of asking for
+     * gigabytes. */
+    double left = (double)(r->end - r->p);
+    double least = r->format == F_ASCII ? 2.0 * c - 1.0 : c * (double)types[p->type].size;
+    if (least > left) return truncated(r);
     size_t n = (size_t)c;
     if (!indices && r->format != F_ASCII) {
-        size_t bytes = n * (size_t)types[p->type].size;
-        if ((size_t)(r->end - r->p) < bytes) return truncated(r);
-        r->p += bytes;
+        r->p += n * (size_t)types[p->type].size;
         return ST_OK;
     }
     if (indices && array_reserve((void **)&r->poly, &r->cap_poly, n, sizeof *r->poly)) return out_of_memory(r);

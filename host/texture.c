@@ -87,6 +87,47 @@ static Status pnm_check(const char *path, Error *err)
                        (uint64_t)size > p ? (uint64_t)size - p : 0, err);
 }
 
+/* Every PNG chunk must fit in the file. stb_image 2.27 reserves an IDAT chunk's declared
+ * length before reading it, so a corrupt length of a few gigabytes in a small file is a
+ * huge allocation (found by fuzz_texture); the walk over the chunk headers finds it
+ * first. Anything that is not a PNG passes. */
+static Status png_check(const char *path, Error *err)
+{
+    static const unsigned char signature[8] = { 0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n' };
+    FILE *f = fopen(path, "rb");
+    if (!f) return ST_OK;   /* stb_image reports it */
+    unsigned char head[8];
+    long size = -1;
+    Status st = ST_OK;
+    if (fread(head, 1, 8, f) != 8 || memcmp(head, signature, 8) != 0 || fseek(f, 0, SEEK_END) != 0 ||
+        (size = ftell(f)) < 0 || fseek(f, 8, SEEK_SET) != 0) {
+        fclose(f);
+        return ST_OK;
+    }
+    uint64_t at = 8;
+    while (at + 8 <= (uint64_t)size) {
+        unsigned char c[8];
+        if (fread(c, 1, 8, f) != 8) break;
+        uint64_t length = (uint64_t)c[0] << 24 | (uint64_t)c[1] << 16 | (uint64_t)c[2] << 8 | c[3];
+        /* the chunk's data and its 4-byte CRC */
+        if (length > (uint64_t)size - at - 8) {
+            char type[5];
+            for (int i = 0; i < 4; i++) type[i] = isprint(c[4 + i]) ? (char)c[4 + i] : '?';
+            type[4] = '\0';
+            st = error_set(err, ST_INPUT, "'%s': the PNG chunk '%s' at byte offset %llu declares %llu bytes, more "
+                           "than the %llu left in the file (a truncated or corrupt file)", path, type,
+                           (unsigned long long)at, (unsigned long long)length,
+                           (unsigned long long)((uint64_t)size - at - 8));
+            break;
+        }
+        if (memcmp(c + 4, "IEND", 4) == 0) break;
+        at += 12 + length;
+        if (fseek(f, (long)at, SEEK_SET) != 0) break;
+    }
+    fclose(f);
+    return st;
+}
+
 Status texture_load_image(Scene *s, const char *name, const char *path, int linear, int clamp,
                           uint *index, Error *err)
 {
@@ -109,6 +150,7 @@ Status texture_load_image(Scene *s, const char *name, const char *path, int line
     fclose(f);
     int w = 0, h = 0, channels = 0;
     Status pst = pnm_check(path, err);
+    if (!pst) pst = png_check(path, err);
     if (pst) return pst;
     /* the size from the header, before stb_image allocates for it */
     if (stbi_info(path, &w, &h, &channels) &&

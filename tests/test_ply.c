@@ -295,6 +295,32 @@ static void test_bad_binary_data(void)
     free(data);
 }
 
+/* A list count the remaining bytes cannot hold is refused before anything is reserved
+ * from it (the fuzzer found a 2^31 face list that asked for 8 GB). */
+static void test_lying_list_count(void)
+{
+    static const char header[] = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+                                 "property float y\nproperty float z\nelement face 1\n"
+                                 "property list int int vertex_indices\nend_header\n";
+    size_t hl = sizeof header - 1, len = hl + 9 * 4 + 4 + 3 * 4;
+    char *data = calloc(1, len + 1);
+    memcpy(data, header, hl);
+    int32_t huge = INT32_MAX;
+    memcpy(data + hl + 9 * 4, &huge, 4);
+    Scene s;
+    scene_init(&s);
+    Error err = { 0 };
+    MeshOptions o = mesh_options(0);
+    Status st = ply_parse("list.ply", data, len, &s, &o, &err);
+    expect_error("binary list count 2^31-1", st, &err, "list.ply: byte offset");
+    CHECK_STR_CONTAINS(err.msg, "the file ends inside a record");
+    scene_free(&s);
+    free(data);
+    check_text_error(HDR "element face 1\nproperty list uint int vertex_indices\nend_header\n"
+                     "0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n",
+                     "the file ends inside a record");
+}
+
 static void test_missing_file(void)
 {
     Scene s;
@@ -344,6 +370,7 @@ int main(void)
     RUN(test_bad_header);
     RUN(test_bad_ascii_data);
     RUN(test_bad_binary_data);
+    RUN(test_lying_list_count);
     RUN(test_missing_file);
     RUN(test_stanford);
     return harness_report();

@@ -79,7 +79,7 @@ static int write_file(const char *path, const unsigned char *data, size_t len)
 
 static int files_equal(const char *a, const char *b)
 {
-    unsigned char *x, *y;
+    unsigned char *x = NULL, *y = NULL;
     size_t nx, ny;
     int ok = read_file(a, &x, &nx) && read_file(b, &y, &ny) && nx == ny && memcmp(x, y, nx) == 0;
     free(x);

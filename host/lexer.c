@@ -301,15 +301,20 @@ void tok_describe(const Token *tok, char *buf, size_t size)
     buf[o] = '\0';
 }
 
-Status lex_expected(const Lexer *lx, const Token *tok, const char *what, Error *err)
+Status tok_expected(const char *path, const Token *tok, const char *what, Error *err)
 {
     char found[64];
     tok_describe(tok, found, sizeof found);
     if (tok->kind == TOK_EOF)
         return error_set(err, ST_INPUT, "%s:%u:%u: expected %s, found end of file",
-                         lx->path, tok->line, tok->col, what);
-    return error_set(err, ST_INPUT, "%s:%u:%u: expected %s, found '%s'", lx->path, tok->line,
+                         path, tok->line, tok->col, what);
+    return error_set(err, ST_INPUT, "%s:%u:%u: expected %s, found '%s'", path, tok->line,
                      tok->col, what, found);
+}
+
+Status lex_expected(const Lexer *lx, const Token *tok, const char *what, Error *err)
+{
+    return tok_expected(lx->path, tok, what, err);
 }
 
 Status lex_error_at(const Lexer *lx, const Token *tok, Error *err, const char *fmt, ...)

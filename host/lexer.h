@@ -73,7 +73,10 @@ char *tok_copy(const Token *tok);
  * bytes and bytes that are not UTF-8 shown as \xNN. */
 void tok_describe(const Token *tok, char *buf, size_t size);
 
-/* ST_INPUT "path:line:col: expected <what>, found '<token>'" at the token. */
+/* ST_INPUT "path:line:col: expected <what>, found '<token>'" at the token; for readers
+ * with their own line scanning (OBJ, MTL) that make a word into a Token for messages. */
+Status tok_expected(const char *path, const Token *tok, const char *what, Error *err);
+/* The same for a token of the lexer's file. */
 Status lex_expected(const Lexer *lx, const Token *tok, const char *what, Error *err);
 /* ST_INPUT "path:line:col: <message>" at the token, with a printf-style message. */
 Status lex_error_at(const Lexer *lx, const Token *tok, Error *err, const char *fmt, ...)

@@ -75,16 +75,8 @@ static Status fail_at(MtlReader *r, const char *q, const char *what)
                          col, what);
     const char *e = q;
     while (e < r->line_end && !is_blank(*e)) e++;
-    Token t;
-    t.kind = TOK_WORD;
-    t.text = q;
-    t.len = (size_t)(e - q);
-    t.line = r->line;
-    t.col = col;
-    char shown[64];
-    tok_describe(&t, shown, sizeof shown);
-    return error_set(r->err, ST_INPUT, "%s:%u:%u: expected %s, found '%s'", r->path, r->line, col,
-                     what, shown);
+    Token t = { .kind = TOK_WORD, .text = q, .len = (size_t)(e - q), .line = r->line, .col = col };
+    return tok_expected(r->path, &t, what, r->err);
 }
 
 static int token_number(const char *t, const char *e, float *out)

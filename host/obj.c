@@ -114,16 +114,8 @@ static Status fail_at(ObjReader *r, const char *q, const char *what)
                          r->line, col, what);
     const char *e = q;
     while (!is_delim(r, e)) e++;
-    Token t;
-    t.kind = TOK_WORD;
-    t.text = q;
-    t.len = (size_t)(e - q);
-    t.line = r->line;
-    t.col = col;
-    char shown[64];
-    tok_describe(&t, shown, sizeof shown);
-    return error_set(r->err, ST_INPUT, "%s:%u:%u: expected %s, found '%s'", r->path, r->line, col,
-                     what, shown);
+    Token t = { .kind = TOK_WORD, .text = q, .len = (size_t)(e - q), .line = r->line, .col = col };
+    return tok_expected(r->path, &t, what, r->err);
 }
 
 /* ------------------------------------------------------------------ numbers */

@@ -2,14 +2,13 @@
 #include "checkpoint.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
+#include "atomic_file.h"
 #include "ocl_program.h"
 #include "sha256.h"
 
@@ -86,91 +85,26 @@ static uint64_t get64(const unsigned char *b)
 
 /* ------------------------------------------------------------------ writing */
 
-/* The file being written under a temporary name beside the target; the first failure
- * is remembered with its step and errno, later writes are skipped. The payload is
- * hashed as it goes, for the trailer. */
+/* The checkpoint file being written, with the hash of its payload as it goes (for the
+ * trailer). */
 typedef struct {
-    const char *path;
-    char *tmp;
-    int fd;
-    const char *failed_step;
-    int failed_errno;
+    AtomicFile af;
     Sha256 hash;
-    unsigned char buf[1 << 16];
-    size_t used;
-} Writer;
+} CheckpointOut;
 
-static void writer_fail(Writer *w, const char *step)
+static void out_put(CheckpointOut *o, const void *data, size_t n, int hashed)
 {
-    if (w->failed_step) return;
-    w->failed_step = step;
-    w->failed_errno = errno ? errno : EIO;
-}
-
-static void writer_flush(Writer *w)
-{
-    size_t off = 0;
-    while (!w->failed_step && off < w->used) {
-        errno = 0;
-        ssize_t n = write(w->fd, w->buf + off, w->used - off);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) writer_fail(w, "write");
-        else off += (size_t)n;
-    }
-    w->used = 0;
-}
-
-static void writer_put(Writer *w, const void *data, size_t n, int hashed)
-{
-    if (hashed) sha256_update(&w->hash, data, n);
-    const unsigned char *p = data;
-    while (n > 0 && !w->failed_step) {
-        size_t k = sizeof w->buf - w->used < n ? sizeof w->buf - w->used : n;
-        memcpy(w->buf + w->used, p, k);
-        w->used += k;
-        p += k;
-        n -= k;
-        if (w->used == sizeof w->buf) writer_flush(w);
-    }
-}
-
-static void sync_parent_folder(const char *path)
-{
-    const char *slash = strrchr(path, '/');
-    char *dir = !slash ? strdup(".") : (slash == path ? strdup("/") : strndup(path, (size_t)(slash - path)));
-    if (!dir) return;
-    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd >= 0) {
-        (void)fsync(fd);
-        close(fd);
-    }
-    free(dir);
+    if (hashed) sha256_update(&o->hash, data, n);
+    atomic_write(&o->af, data, n);
 }
 
 Status checkpoint_write(const char *path, const CheckpointId *id, const Film *film, const Batch *done,
                         size_t n_done, Error *err)
 {
-    static const char suffix[] = ".tmp.XXXXXX";
-    Writer *w = calloc(1, sizeof *w);
-    size_t len = strlen(path);
-    if (w) w->tmp = malloc(len + sizeof suffix);
-    if (!w || !w->tmp) {
-        free(w);
-        return error_set(err, ST_INTERNAL, "cannot write checkpoint '%s': out of memory", path);
-    }
-    w->path = path;
-    memcpy(w->tmp, path, len);
-    memcpy(w->tmp + len, suffix, sizeof suffix);
-    errno = 0;
-    w->fd = mkostemp(w->tmp, O_CLOEXEC);
-    if (w->fd < 0) {
-        Status st = error_set(err, ST_IO, "cannot write checkpoint '%s': cannot create a temporary file beside it: %s",
-                              path, strerror(errno));
-        free(w->tmp);
-        free(w);
-        return st;
-    }
-    sha256_init(&w->hash);
+    CheckpointOut o;
+    Status st = atomic_open(&o.af, path, "checkpoint", err);
+    if (st) return st;
+    sha256_init(&o.hash);
 
     size_t n_values = (size_t)film->width * film->height * 3u;
     uint64_t payload = (uint64_t)n_done * 8u + (uint64_t)n_values * 8u;
@@ -188,37 +122,23 @@ Status checkpoint_write(const char *path, const CheckpointId *id, const Film *fi
     put32(header + 68, (uint32_t)n_done);
     put64(header + 72, film->samples);
     put64(header + 80, payload);
-    writer_put(w, header, sizeof header, 1);
+    out_put(&o, header, sizeof header, 1);
     for (size_t i = 0; i < n_done; i++) {
         unsigned char r[8];
         put32(r, done[i].first);
         put32(r + 4, done[i].count);
-        writer_put(w, r, sizeof r, 1);
+        out_put(&o, r, sizeof r, 1);
     }
     unsigned char chunk[4096 * 8];
-    for (size_t i = 0; i < n_values && !w->failed_step;) {
+    for (size_t i = 0; i < n_values && !o.af.failed_step;) {
         size_t k = 0;
         for (; k < 4096 && i < n_values; k++, i++) put64(chunk + 8 * k, (uint64_t)film->sum[i]);
-        writer_put(w, chunk, 8 * k, 1);
+        out_put(&o, chunk, 8 * k, 1);
     }
     unsigned char digest[SHA256_DIGEST_SIZE];
-    sha256_final(&w->hash, digest);
-    writer_put(w, digest, sizeof digest, 0);
-    writer_flush(w);
-    if (!w->failed_step && fsync(w->fd) != 0) writer_fail(w, "fsync");
-    if (close(w->fd) != 0) writer_fail(w, "close");
-    if (!w->failed_step && rename(w->tmp, path) != 0) writer_fail(w, "cannot rename the temporary file over it");
-    Status st = ST_OK;
-    if (w->failed_step) {
-        unlink(w->tmp);
-        st = error_set(err, ST_IO, "cannot write checkpoint '%s': %s: %s", path, w->failed_step,
-                       strerror(w->failed_errno));
-    } else {
-        sync_parent_folder(path);
-    }
-    free(w->tmp);
-    free(w);
-    return st;
+    sha256_final(&o.hash, digest);
+    out_put(&o, digest, sizeof digest, 0);
+    return atomic_commit(&o.af, err);
 }
 
 /* ------------------------------------------------------------------ reading */

@@ -1,13 +1,14 @@
 /*
- * image_write.c — PNG/PPM/BMP/PFM encoding over an atomic temp-file-and-rename writer.
+ * image_write.c — PNG/PPM/BMP/PFM encoding, written through atomic_file.h (temp file, rename).
  *
  * PNG compression is stb_image_write's (Debian's libstb); it hands us the finished file
  * in memory through a callback, so every byte on disk goes through our own checked writes.
  */
 #include "image_write.h"
 
+#include "atomic_file.h"
+
 #include <errno.h>
-#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
 #include <stdint.h>
@@ -15,8 +16,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <stb_image_write.h>
 
@@ -64,144 +63,6 @@ unsigned char image_to_linear8(float linear)
     if (!(x > 0.0)) return 0;
     if (x >= 1.0) return 255;
     return (unsigned char)floor(x * 255.0 + 0.5);
-}
-
-/* ------------------------------------------------------------------ atomic file */
-
-/* A file being written under a temporary name. The first failure is remembered (step and
- * errno) and later writes are skipped, so the encoders need not check each call. */
-typedef struct {
-    const char *path; /* the target */
-    char *tmp;        /* "<path>.tmp.XXXXXX" once created, else NULL */
-    FILE *f;
-    const char *failed_step;
-    int failed_errno;
-} AtomicFile;
-
-static void atomic_fail(AtomicFile *af, const char *step)
-{
-    if (af->failed_step) return;
-    af->failed_step = step;
-    af->failed_errno = errno ? errno : EIO;
-}
-
-static Status atomic_error(const AtomicFile *af, Error *err)
-{
-    return error_set(err, ST_IO, "cannot write '%s': %s: %s", af->path, af->failed_step,
-                     strerror(af->failed_errno));
-}
-
-/* Drops the temporary file; the target is never touched before the final rename. */
-static void atomic_abort(AtomicFile *af)
-{
-    if (af->f) fclose(af->f);
-    af->f = NULL;
-    if (af->tmp) unlink(af->tmp);
-    free(af->tmp);
-    af->tmp = NULL;
-}
-
-/* The temporary file lives in the target's folder so that the final rename stays within
- * one filesystem, where it is atomic. */
-static Status atomic_open(AtomicFile *af, const char *path, Error *err)
-{
-    static const char suffix[] = ".tmp.XXXXXX";
-    memset(af, 0, sizeof *af);
-    af->path = path;
-    size_t n = strlen(path);
-    af->tmp = malloc(n + sizeof suffix);
-    if (!af->tmp)
-        return error_set(err, ST_INTERNAL, "cannot write '%s': out of memory", path);
-    memcpy(af->tmp, path, n);
-    memcpy(af->tmp + n, suffix, sizeof suffix);
-    errno = 0;
-    int fd = mkostemp(af->tmp, O_CLOEXEC);
-    if (fd < 0) {
-        atomic_fail(af, "cannot create a temporary file beside it");
-        free(af->tmp);
-        af->tmp = NULL; /* nothing was created, so nothing to remove */
-        return atomic_error(af, err);
-    }
-    af->f = fdopen(fd, "wb");
-    if (!af->f) {
-        atomic_fail(af, "fdopen");
-        close(fd);
-        Status st = atomic_error(af, err);
-        atomic_abort(af);
-        return st;
-    }
-    return ST_OK;
-}
-
-static void atomic_write(AtomicFile *af, const void *data, size_t n)
-{
-    if (af->failed_step || n == 0) return;
-    errno = 0;
-    if (fwrite(data, 1, n, af->f) != n) atomic_fail(af, "write");
-}
-
-/* mkstemp creates files 0600; give the image the mode an ordinary fopen() would have,
- * 0666 less the umask. umask() can only be read by changing it, which would race with
- * other threads creating files, so read it from /proc (022 when that is unavailable). */
-static mode_t image_file_mode(void)
-{
-    unsigned mask = 022;
-    FILE *f = fopen("/proc/self/status", "re");
-    if (f) {
-        char line[256];
-        while (fgets(line, sizeof line, f))
-            if (sscanf(line, "Umask: %o", &mask) == 1) break;
-        fclose(f);
-    }
-    return (mode_t)(0666u & ~mask);
-}
-
-/* Syncs the folder so that the rename itself survives a power loss. Best effort: by now
- * the image is complete and in place, so a failure here is not worth failing the write. */
-static void sync_parent_folder(const char *path)
-{
-    const char *slash = strrchr(path, '/');
-    char *dir = NULL;
-    if (!slash) dir = strdup(".");
-    else if (slash == path) dir = strdup("/");
-    else dir = strndup(path, (size_t)(slash - path));
-    if (!dir) return;
-    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd >= 0) {
-        (void)fsync(fd);
-        close(fd);
-    }
-    free(dir);
-}
-
-/* Flushes and syncs the data (write errors such as a full disk often surface only here),
- * sets the mode, then renames the finished file over the target. */
-static Status atomic_commit(AtomicFile *af, Error *err)
-{
-    if (!af->failed_step) {
-        errno = 0;
-        if (fflush(af->f) != 0) atomic_fail(af, "write");
-    }
-    if (!af->failed_step && fsync(fileno(af->f)) != 0) atomic_fail(af, "fsync");
-    if (!af->failed_step && fchmod(fileno(af->f), image_file_mode()) != 0)
-        atomic_fail(af, "chmod");
-    if (!af->failed_step) {
-        errno = 0;
-        int rc = fclose(af->f);
-        af->f = NULL;
-        if (rc != 0) atomic_fail(af, "close");
-    }
-    if (!af->failed_step && rename(af->tmp, af->path) != 0)
-        atomic_fail(af, "cannot rename the temporary file over it");
-    if (af->failed_step) {
-        Status st = atomic_error(af, err);
-        atomic_abort(af);
-        return st;
-    }
-    free(af->tmp);
-    af->tmp = NULL;
-    sync_parent_folder(af->path);
-    return ST_OK;
 }
 
 /* ------------------------------------------------------------------ encoders */
@@ -331,7 +192,7 @@ Status image_write_encoded(const char *path, const float *rgb, unsigned width, u
     }
 
     AtomicFile af;
-    st = atomic_open(&af, path, err);
+    st = atomic_open(&af, path, "", err);
     if (st != ST_OK) {
         free(srgb);
         return st;

@@ -9,6 +9,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "atomic_file.h"
 #include "sha256.h"
 
 /* Cache file layout (integers little-endian):
@@ -192,32 +193,25 @@ static int oclp__cache_read(const char *path, const unsigned char key[SHA256_DIG
     return 1;
 }
 
-/* Writes a cache entry atomically: a temporary file in the same folder, then rename.
- * Failure is silent by design (the caller has a working program either way). */
+/* Writes a cache entry atomically (a reader never sees half an entry). Failure is
+ * silent by design: the caller has a working program either way. */
 static void oclp__cache_write(const char *path, const unsigned char key[SHA256_DIGEST_SIZE],
                               const unsigned char *payload, size_t len)
 {
-    char tmp[1100];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp-XXXXXX", path) >= (int)sizeof tmp) return;
-    int fd = mkstemp(tmp);
-    if (fd < 0) return;
     unsigned char head[OCLP__HEADER] = {0};
     memcpy(head, OCLP__MAGIC, 8);
     oclp__put_le(head + 8, OCLP__VERSION, 4);
     oclp__put_le(head + 16, len, 8);
     memcpy(head + 24, key, SHA256_DIGEST_SIZE);
     sha256(payload, len, head + 56);
-    FILE *f = fdopen(fd, "wb");
-    if (!f) {
-        close(fd);
-        unlink(tmp);
-        return;
+    AtomicFile af;
+    Error ignored = {0};
+    if (atomic_open(&af, path, "kernel cache entry", &ignored) == ST_OK) {
+        atomic_write(&af, head, sizeof head);
+        atomic_write(&af, payload, len);
+        (void)atomic_commit(&af, &ignored);
     }
-    int ok = fwrite(head, 1, sizeof head, f) == sizeof head && fwrite(payload, 1, len, f) == len;
-    /* mkstemp creates the file 0600; entries are as shareable as the folder allows. */
-    fchmod(fd, 0644);
-    ok = fclose(f) == 0 && ok;
-    if (!ok || rename(tmp, path) != 0) unlink(tmp);
+    error_clear(&ignored);
 }
 
 /* The compiled binary of `prog` for dev; the program may span several devices of the

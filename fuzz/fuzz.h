@@ -20,9 +20,13 @@
 #ifndef CLPT_FUZZ_H
 #define CLPT_FUZZ_H
 
+#include "scene.h"
+
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* Space-separated file extensions, without dots. */
 #define FUZZ_SEEDS(exts) const char fuzz_seed_extensions[] = exts
@@ -33,5 +37,30 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 /* Stops the run when a promise of the code under test is broken: libFuzzer reports an
  * abort as a crash and keeps the input. */
 #define FUZZ_ASSERT(cond) do { if (!(cond)) abort(); } while (0)
+
+/* The input as a NUL-terminated string (the text readers want one); NULL when out of
+ * memory. Free it. */
+static inline char *fuzz_text(const uint8_t *data, size_t size)
+{
+    char *text = malloc(size + 1);
+    if (!text) return NULL;
+    memcpy(text, data, size);
+    text[size] = '\0';
+    return text;
+}
+
+static inline int fuzz_finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+
+/* What a mesh reader promises of every triangle it appended: finite corners, the given
+ * material, a shading record that exists (or none). */
+static inline void fuzz_check_triangles(const Scene *s, uint material)
+{
+    for (size_t i = 0; i < s->n_triangles; i++) {
+        const Triangle *t = &s->triangles[i];
+        FUZZ_ASSERT(t->material == material);
+        FUZZ_ASSERT(fuzz_finite3(t->p0) && fuzz_finite3(t->p1) && fuzz_finite3(t->p2));
+        FUZZ_ASSERT(t->shading == NO_INDEX || t->shading < s->n_shading);
+    }
+}
 
 #endif /* CLPT_FUZZ_H */

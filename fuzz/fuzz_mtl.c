@@ -11,14 +11,12 @@
 
 FUZZ_SEEDS("mtl");
 
-static int usable(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z) && v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f; }
+static int usable(vec3 v) { return fuzz_finite3(v) && v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f; }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    char *text = malloc(size + 1);
+    char *text = fuzz_text(data, size);
     if (!text) return 0;
-    memcpy(text, data, size);
-    text[size] = '\0';
     MtlLibrary lib;
     memset(&lib, 0, sizeof lib);
     Error err = { 0 };

@@ -12,15 +12,11 @@
 
 FUZZ_SEEDS("obj");
 
-static int finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
-
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     /* obj_parse wants the text NUL-terminated */
-    char *text = malloc(size + 1);
+    char *text = fuzz_text(data, size);
     if (!text) return 0;
-    memcpy(text, data, size);
-    text[size] = '\0';
     Scene s;
     scene_init(&s);
     Error err = { 0 };
@@ -28,12 +24,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (scene_add_material(&s, "m", material_diffuse(v3(0.5f, 0.5f, 0.5f)), &m, &err) == ST_OK) {
         Status st = obj_parse("fuzz.obj", text, size, &s, m, &err);
         if (st) FUZZ_ASSERT(st == ST_INPUT && err.msg[0]);
-        for (size_t i = 0; i < s.n_triangles; i++) {
-            const Triangle *t = &s.triangles[i];
-            FUZZ_ASSERT(t->material == m);
-            FUZZ_ASSERT(finite3(t->p0) && finite3(t->p1) && finite3(t->p2));
-            FUZZ_ASSERT(t->shading == NO_INDEX || t->shading < s.n_shading);
-        }
+        fuzz_check_triangles(&s, m);
     }
     scene_free(&s);
     error_clear(&err);

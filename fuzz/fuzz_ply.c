@@ -12,15 +12,11 @@
 
 FUZZ_SEEDS("ply");
 
-static int finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
-
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     /* ply_parse wants a NUL after the data */
-    char *copy = malloc(size + 1);
+    char *copy = fuzz_text(data, size);
     if (!copy) return 0;
-    memcpy(copy, data, size);
-    copy[size] = '\0';
     Scene s;
     scene_init(&s);
     Error err = { 0 };
@@ -29,12 +25,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         MeshOptions o = mesh_options(m);
         Status st = ply_parse("fuzz.ply", copy, size, &s, &o, &err);
         if (st) FUZZ_ASSERT(st == ST_INPUT && err.msg[0]);
-        for (size_t i = 0; i < s.n_triangles; i++) {
-            const Triangle *t = &s.triangles[i];
-            FUZZ_ASSERT(t->material == m);
-            FUZZ_ASSERT(finite3(t->p0) && finite3(t->p1) && finite3(t->p2));
-            FUZZ_ASSERT(t->shading == NO_INDEX || t->shading < s.n_shading);
-        }
+        fuzz_check_triangles(&s, m);
     }
     scene_free(&s);
     error_clear(&err);

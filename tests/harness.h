@@ -83,6 +83,20 @@ static const char *harness_current = "";
         }                                                                              \
     } while (0)
 
+/* The team's standard meshes live in ../shared/models, beside the checkout (and in CI).
+ * A test that reads one calls this first: in a checkout without them it says what it
+ * skips, on stderr, and the rest of the test still runs. */
+static inline int shared_model_present(const char *path, const char *skipped)
+{
+    FILE *f = fopen(path, "rb");
+    if (f) {
+        fclose(f);
+        return 1;
+    }
+    fprintf(stderr, "  %s not found: %s\n", path, skipped);
+    return 0;
+}
+
 static inline int harness_report(void)
 {
     printf("%d passed, %d failed\n", harness_passed, harness_failed);

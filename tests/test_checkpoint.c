@@ -321,7 +321,7 @@ static void test_other_renders_are_refused(void)
     CHECK_EQ_INT(r.status, 3);
     CHECK_STR_CONTAINS(r.err, "48x36");
     /* another scene with every setting forced equal: only the key tells them apart */
-    cli_run(ARGS("scenes/mesh.scene", "-q", "--device", "scalar", SIZE, "--spp", SPP_TEXT, "--seed", "1",
+    cli_run(ARGS("scenes/one-weekend.scene", "-q", "--device", "scalar", SIZE, "--spp", SPP_TEXT, "--seed", "1",
                  "--max-depth", "8", "-o", path_out, "--resume", path_ck), &r);
     CHECK_EQ_INT(r.status, 3);
     CHECK_STR_CONTAINS(r.err, "scene differs");

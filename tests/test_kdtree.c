@@ -997,13 +997,7 @@ static void test_real_meshes(void)
 {
     check_mesh_brute_force("tests/data/models/bun_zipper_res4.ply", 20000);
     const char *res3 = "../shared/models/bunny/bun_zipper_res3.ply";
-    FILE *f = fopen(res3, "rb");
-    if (f) {
-        fclose(f);
-        check_mesh_brute_force(res3, 8000);
-    } else {
-        fprintf(stderr, "  %s not found: only the small bunny is checked\n", res3);
-    }
+    if (shared_model_present(res3, "only the small bunny is checked")) check_mesh_brute_force(res3, 8000);
 }
 
 /* From inside a closed mesh, a million rays aimed exactly at its vertices and at points

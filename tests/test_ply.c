@@ -347,12 +347,7 @@ static void test_stanford(void)
     CHECK_EQ_INT(s.n_triangles, 948);
     scene_free(&s);
     const char *dragon = "../shared/models/dragon/dragon_vrip.ply";
-    FILE *f = fopen(dragon, "rb");
-    if (!f) {
-        fprintf(stderr, "  %s not found: the full dragon is not read\n", dragon);
-        return;
-    }
-    fclose(f);
+    if (!shared_model_present(dragon, "the full dragon is not read")) return;
     double t0 = cpu_seconds();
     CHECK_EQ_INT(load(dragon, &s, &err), ST_OK);
     double secs = cpu_seconds() - t0;

@@ -9,8 +9,9 @@
 #   make fuzz       each libFuzzer target in fuzz/ for FUZZ_SECONDS (build-fuzz/)
 #
 # docs/hardening.md describes the last three; docs/fuzzing.md how to add a fuzz target.
-# Every target first checks the system packages (tools/deps.sh): installs them when run
-# as root, prints the exact apt-get line otherwise.
+# Packages are installed by run.sh and .ci/run (tools/deps.sh), never by a make target:
+# `make deps` installs the build's packages by hand; the Embree benchmark and the
+# hardening targets only check theirs and print the exact apt-get line when one is missing.
 
 # ---------------------------------------------------------------- settings
 PROG      := clpt
@@ -33,7 +34,7 @@ LDLIBS    := -lOpenCL -lstb -lm
 # scalar device would round differently from OpenCL.
 KERNEL_C_WARN := -Wdouble-promotion -Werror=double-promotion
 
-HOST_SRC  := $(filter-out host/main.c,$(wildcard host/*.c))
+HOST_SRC  := $(filter-out host/main.c,$(wildcard host/*.c host/*/*.c))
 HOST_OBJ  := $(HOST_SRC:host/%.c=$(BUILD)/host/%.o) $(BUILD)/kernel_source.o
 KERNELS   := $(wildcard kernels/*.h kernels/*.cl)
 TEST_SRC  := $(wildcard tests/test_*.c)
@@ -46,7 +47,6 @@ FUZZ_REPLAY := $(FUZZ_SRC:fuzz/fuzz_%.c=$(BUILD)/tests/test_fuzz_%)
 FUZZ_BIN  := $(FUZZ_SRC:fuzz/%.c=$(BUILD)/fuzz/%)
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
-DEPS_OK   := $(BUILD)/.deps-ok
 
 .PHONY: all deps test render bench clean test-asan test-valgrind fuzz fuzz-build
 .DEFAULT_GOAL := all
@@ -54,23 +54,16 @@ DEPS_OK   := $(BUILD)/.deps-ok
 all: $(BUILD)/$(PROG)
 
 # ---------------------------------------------------------------- system packages
-# The stamp is refreshed only when the check passes, so a later removal is noticed by
-# `make deps` (always run by test/render/bench) even if the stamp exists.
 deps:
 	@sh tools/deps.sh base
-	@mkdir -p $(BUILD) && touch $(DEPS_OK)
-
-$(DEPS_OK):
-	@sh tools/deps.sh base
-	@mkdir -p $(BUILD) && touch $@
 
 # ---------------------------------------------------------------- build
-$(BUILD)/embed: tools/embed.c | $(DEPS_OK)
+$(BUILD)/embed: tools/embed.c
 	@mkdir -p $(@D)
 	$(CC) -std=c11 -O1 -Wall -Wextra -o $@ $<
 
 # Writes scenes/one-weekend.scene (tests/test_scene.c checks the committed copy).
-$(BUILD)/gen_weekend: tools/gen_weekend.c | $(DEPS_OK)
+$(BUILD)/gen_weekend: tools/gen_weekend.c
 	@mkdir -p $(@D)
 	$(CC) -std=c11 -O1 -Wall -Wextra -o $@ $<
 
@@ -84,11 +77,11 @@ $(BUILD)/kernel_source.c: $(KERNELS) $(BUILD)/embed
 $(BUILD)/kernel_source.o: $(BUILD)/kernel_source.c
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c -o $@ $<
 
-$(BUILD)/host/%.o: host/%.c $(DEPS_OK)
+$(BUILD)/host/%.o: host/%.c
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(FILE_WARN) -MMD -MP -c -o $@ $<
 
-$(BUILD)/host/device_cpu.o: FILE_WARN := $(KERNEL_C_WARN)
+$(BUILD)/host/device/device_scalar.o: FILE_WARN := $(KERNEL_C_WARN)
 
 $(BUILD)/lib$(PROG).a: $(HOST_OBJ)
 	rm -f $@ && ar rcs $@ $^
@@ -116,22 +109,23 @@ $(BUILD)/bench/%: bench/%.c $(BUILD)/lib$(PROG).a
 # The traversal benchmark compares with Embree 3: only it links libembree3, and only
 # `make bench` builds it, so the renderer and the tests never need Embree.
 $(BUILD)/.embree-ok:
-	@sh tools/deps.sh embree
+	@sh tools/deps.sh --check embree
 	@mkdir -p $(BUILD) && touch $@
 
 $(BUILD)/bench/bench_traverse: LDLIBS += -lembree3
 $(BUILD)/bench/bench_traverse: | $(BUILD)/.embree-ok
 
--include $(wildcard $(BUILD)/host/*.d $(BUILD)/tests/*.d $(BUILD)/bench/*.d)
+-include $(wildcard $(BUILD)/host/*.d $(BUILD)/host/*/*.d $(BUILD)/tests/*.d $(BUILD)/bench/*.d)
 
 # ---------------------------------------------------------------- use
-test: deps $(BUILD)/$(PROG) $(TEST_BIN) $(FUZZ_REPLAY)
+test: $(BUILD)/$(PROG) $(TEST_BIN) $(FUZZ_REPLAY)
+	@sh tools/check_layers.sh
 	@sh tests/run.sh $(BUILD)
 
-render: deps $(BUILD)/$(PROG)
+render: $(BUILD)/$(PROG)
 	$(BUILD)/$(PROG) scenes/cornell-box.scene -o cornell-box.png
 
-bench: deps $(BUILD)/$(PROG) $(BENCH_BIN)
+bench: $(BUILD)/$(PROG) $(BENCH_BIN)
 	@sh bench/run.sh $(BUILD)
 
 # ---------------------------------------------------------------- hardening
@@ -146,16 +140,16 @@ SAN_ENV    := ASAN_OPTIONS=detect_stack_use_after_return=1:check_initialization_
 FUZZ_SECONDS ?= 60
 
 test-asan:
-	@sh tools/deps.sh base sanitize
+	@sh tools/deps.sh --check base sanitize
 	@$(SAN_ENV) $(MAKE) --no-print-directory BUILD=build-asan CC=clang OPT=-O1 \
 	    EXTRA_CFLAGS="$(SAN_FLAGS)" EXTRA_LDFLAGS="$(SAN_FLAGS)" test
 
-test-valgrind: deps $(BUILD)/$(PROG)
-	@sh tools/deps.sh valgrind
+test-valgrind: $(BUILD)/$(PROG)
+	@sh tools/deps.sh --check valgrind
 	@sh tools/valgrind.sh $(BUILD)
 
 fuzz-build:
-	@sh tools/deps.sh base fuzz
+	@sh tools/deps.sh --check base fuzz
 	@$(MAKE) --no-print-directory BUILD=build-fuzz CC=clang OPT=-O1 \
 	    EXTRA_CFLAGS="$(SAN_FLAGS) -fsanitize=fuzzer-no-link" EXTRA_LDFLAGS="$(SAN_FLAGS)" \
 	    $(FUZZ_SRC:fuzz/%.c=build-fuzz/fuzz/%)

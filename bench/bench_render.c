@@ -13,11 +13,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "device.h"
-#include "film.h"
-#include "render_scene.h"
-#include "schedule.h"
-#include "timer.h"
+#include "device/device.h"
+#include "render/film.h"
+#include "render/render_scene.h"
+#include "render/schedule.h"
+#include "base/timer.h"
 
 typedef struct {
     const char *path;

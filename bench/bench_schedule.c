@@ -37,12 +37,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "device.h"
-#include "film.h"
-#include "render_scene.h"
-#include "schedule.h"
-#include "sha256.h"
-#include "timer.h"
+#include "device/device.h"
+#include "render/film.h"
+#include "render/render_scene.h"
+#include "render/schedule.h"
+#include "base/sha256.h"
+#include "base/timer.h"
 
 #define MAX_REPS 15
 #define MAX_FOREIGN 0.10

@@ -43,13 +43,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "kdtree.h"
-#include "mesh.h"
-#include "ocl_program.h"
+#include "accel/kdtree.h"
+#include "io/mesh.h"
+#include "device/ocl_program.h"
 #include "rng.h"
 #include "sampling.h"
 #include "surface.h"
-#include "timer.h"
+#include "base/timer.h"
 #include "traverse.cl"
 
 #define MAX_REPS 31

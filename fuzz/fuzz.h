@@ -20,7 +20,7 @@
 #ifndef CLPT_FUZZ_H
 #define CLPT_FUZZ_H
 
-#include "scene.h"
+#include "scene/scene.h"
 
 #include <math.h>
 #include <stddef.h>

@@ -1,12 +1,12 @@
 /*
- * fuzz_classic.c — the reader of the MIT 6.837 scene family (host/classic_parse.c,
+ * fuzz_classic.c — the reader of the MIT 6.837 scene family (host/io/classic_parse.c,
  * docs/classic-format.md) on arbitrary text, and, for a scene that loads, everything
  * that prepares it for the devices at a small image size. Meshes and textures are
  * looked up beside "fuzz.txt" in the current folder (the project root).
  */
-#include "classic_parse.h"
+#include "io/classic_parse.h"
 #include "fuzz.h"
-#include "render_scene.h"
+#include "render/render_scene.h"
 
 #include <math.h>
 

@@ -1,10 +1,10 @@
 /*
- * fuzz_lexer.c — the tokenizer (host/lexer.c, used by the scene and classic readers) on
+ * fuzz_lexer.c — the tokenizer (host/io/lexer.c, used by the scene and classic readers) on
  * arbitrary bytes: every token is described and converted as the parsers do, and each
  * must lie inside the text, in order, with positions that only move forward.
  */
 #include "fuzz.h"
-#include "lexer.h"
+#include "io/lexer.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,10 +1,10 @@
 /*
- * fuzz_mtl.c — the MTL material library reader (host/mtl.c) on arbitrary text. Every
+ * fuzz_mtl.c — the MTL material library reader (host/io/mtl.c) on arbitrary text. Every
  * material it keeps must have a name and values the kernels can use (finite, albedo
  * and emission not negative).
  */
 #include "fuzz.h"
-#include "mtl.h"
+#include "io/mtl.h"
 
 #include <math.h>
 #include <string.h>

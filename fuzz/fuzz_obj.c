@@ -1,11 +1,11 @@
 /*
- * fuzz_obj.c — the Wavefront OBJ reader (host/obj.c) on arbitrary text. Every triangle
+ * fuzz_obj.c — the Wavefront OBJ reader (host/io/obj.c) on arbitrary text. Every triangle
  * it appends must be finite, carry the given material, and point at a shading record
  * that exists.
  */
 #include "fuzz.h"
 #include "kmath.h"
-#include "obj.h"
+#include "io/obj.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,11 +1,11 @@
 /*
- * fuzz_ply.c — the PLY reader (host/ply.c) on arbitrary bytes: ascii and both binary
+ * fuzz_ply.c — the PLY reader (host/io/ply.c) on arbitrary bytes: ascii and both binary
  * encodings, with header counts that need not match the data. Every triangle it appends
  * must be finite, carry the given material and point at a shading record that exists.
  */
 #include "fuzz.h"
 #include "kmath.h"
-#include "ply.h"
+#include "io/ply.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,13 +1,13 @@
 /*
- * fuzz_scene.c — the scene reader (host/scene_parse.c) on arbitrary text, and, for a
+ * fuzz_scene.c — the scene reader (host/io/scene_parse.c) on arbitrary text, and, for a
  * scene that loads, everything that prepares it for the devices (lights, camera,
  * kd-tree) at a small image size. Included files and meshes are looked up beside
  * "fuzz.scene" in the current folder (the project root), so the inputs can pull in the
  * shipped scenes and test meshes.
  */
 #include "fuzz.h"
-#include "render_scene.h"
-#include "scene.h"
+#include "render/render_scene.h"
+#include "scene/scene.h"
 
 #include <math.h>
 

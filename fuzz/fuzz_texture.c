@@ -1,13 +1,13 @@
 /*
- * fuzz_texture.c — image textures (host/texture.c, decoding through stb_image) on
+ * fuzz_texture.c — image textures (host/io/texture.c, decoding through stb_image) on
  * arbitrary bytes. The loader reads files, so each input is written to a temporary
  * file first. A file that decodes must give a texture whose texels all lie in the
  * scene's texel array; the size limit must hold before stb_image allocates (a header
  * claiming a huge image in a few bytes is an input error, not an out-of-memory).
  */
 #include "fuzz.h"
-#include "limit.h"
-#include "texture.h"
+#include "base/limit.h"
+#include "io/texture.h"
 
 #include <stdio.h>
 #include <unistd.h>

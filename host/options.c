@@ -1,8 +1,8 @@
 /* options.c — command-line parsing, strict: every value is checked whole and in range. */
 #include "options.h"
 
-#include "classic_parse.h"
-#include "limit.h"
+#include "io/classic_parse.h"
+#include "base/limit.h"
 #include "types.h"
 
 #include <errno.h>

@@ -4,7 +4,7 @@
 
 #include <stdio.h>
 
-#include "status.h"
+#include "base/status.h"
 
 typedef struct {
     const char *scene_path;

@@ -2,7 +2,7 @@
  * compat.h — lets every file under kernels/ compile both as OpenCL C 1.2 and as C11.
  *
  * The kernel stage functions are written once. OpenCL compilers see them through
- * entry.cl; the scalar C device (host/device_cpu.c) and the tests #include the very
+ * entry.cl; the scalar C device (host/device/device_scalar.c) and the tests #include the very
  * same files. This header is the only place where the two languages differ.
  *
  * Rules for kernel code (so that both compilers produce the same bits):

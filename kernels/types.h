@@ -131,7 +131,7 @@ typedef struct {                                        /* 96 bytes */
 enum LightType { LIGHT_AREA = 0, LIGHT_POINT = 1, LIGHT_DIRECTIONAL = 2, LIGHT_SPOT = 3 };
 
 /* Every light, in one array with a cumulative distribution for choosing one
- * proportionally to its estimated power (host/scene.c). Area lights come first
+ * proportionally to its estimated power (host/scene/scene.c). Area lights come first
  * (RenderParams.n_area_lights of them), then the delta lights.
  * A delta light's `intensity` is radiant intensity (point, spot: W/sr) or irradiance
  * (directional: W/m^2 across the beam); point and spot lights are divided by the

@@ -15,7 +15,7 @@
  * Units: a delta light's Le is the irradiance across its direction, and the local term
  * is (kd cos + ks max(0, r.wi)^shininess) Le / pi (r: the mirror direction of the view
  * ray). For kd alone this is a Lambertian surface's exact response; a classic-format
- * light of colour c has intensity pi c (host/classic_parse.c), which gives the course's
+ * light of colour c has intensity pi c (host/io/classic_parse.c), which gives the course's
  * formula kd c cos + ks c (r.l)^s exactly.
  */
 #ifndef CLPT_WHITTED_CL

@@ -6,10 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "device.h"
-#include "film.h"
-#include "render_scene.h"
-#include "schedule.h"
+#include "device/device.h"
+#include "render/film.h"
+#include "render/render_scene.h"
+#include "render/schedule.h"
 
 /* devices: a --device spec; batch: fixed batch size (0 = adaptive). The film is
  * initialised here; free it with film_free. */

@@ -19,12 +19,12 @@
 
 #include "harness.h"
 #include "kmath.h"
-#include "mtl.h"
-#include "obj.h"
-#include "ply.h"
+#include "io/mtl.h"
+#include "io/obj.h"
+#include "io/ply.h"
 #include "render_util.h"
-#include "scene.h"
-#include "texture.h"
+#include "scene/scene.h"
+#include "io/texture.h"
 
 #define DIR_BAD "tests/data/bad"
 

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <time.h>
 
-#include "batch_queue.h"
+#include "render/batch_queue.h"
 #include "harness.h"
 
 static void test_sequential_take(void)

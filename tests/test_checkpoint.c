@@ -10,12 +10,12 @@
 #include <stdlib.h>
 #include <time.h>
 
-#include "checkpoint.h"
+#include "render/checkpoint.h"
 #include "cli_util.h"
 #include "harness.h"
-#include "render_scene.h"
-#include "scene.h"
-#include "timer.h"
+#include "render/render_scene.h"
+#include "scene/scene.h"
+#include "base/timer.h"
 
 static char dir[64];
 static char path_ref[128], path_out[128], path_ck[128];

@@ -1,5 +1,5 @@
 /*
- * test_classic.c — the classic scene format (host/classic_parse.c): every keyword, the
+ * test_classic.c — the classic scene format (host/io/classic_parse.c): every keyword, the
  * format's defaults, transforms, material scoping, CRLF, where mesh and texture files
  * are looked for, format detection, and malformed files with their file:line:column
  * messages; the light, texture and phong additions to our own format; the command-line
@@ -14,9 +14,9 @@
 #include "harness.h"
 #include "cli_util.h"
 
-#include "classic_parse.h"
+#include "io/classic_parse.h"
 #include "kmath.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 #include <stb_image_write.h>
 

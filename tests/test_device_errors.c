@@ -4,11 +4,11 @@
  * and the whole build log), a device too small for the render (checked before any
  * upload), and either failure on one of two devices (that device is dropped with a
  * warning and the other renders). Two PoCL devices are made with POCL_DEVICES; the
- * failures on one of them with the test-only variables of host/fault.h.
+ * failures on one of them with the test-only variables of host/base/fault.h.
  */
 
 #include "cli_util.h"
-#include "device_memory.h"
+#include "device/device_memory.h"
 #include "harness.h"
 
 static CliResult r;   /* large: static */

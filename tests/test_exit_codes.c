@@ -1,6 +1,6 @@
 /* test_exit_codes.c — every exit code of docs/exit-codes.md, by running the program:
  * 0 success, 1 internal, 2 usage, 3 input, 4 I/O, 5 device, 6 interrupted. Codes 1 and
- * 5 are provoked with the test-only variables of host/fault.h. */
+ * 5 are provoked with the test-only variables of host/base/fault.h. */
 #include <time.h>
 
 #include "cli_util.h"

@@ -12,7 +12,7 @@
 #include <stb_image.h>
 
 #include "harness.h"
-#include "image_write.h"
+#include "io/image_write.h"
 
 enum { W = 7, H = 5 };
 

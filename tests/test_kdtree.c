@@ -1,5 +1,5 @@
 /*
- * test_kdtree.c -- the kd-tree build (host/kdtree.c), the primitive intersections
+ * test_kdtree.c -- the kd-tree build (host/accel/kdtree.c), the primitive intersections
  * (kernels/intersect.h) and the traversal (kernels/traverse.cl, compiled here as C).
  *
  * The tree's structure is checked directly (nesting, which primitives each leaf must
@@ -10,8 +10,8 @@
 #include <stdlib.h>
 
 #include "harness.h"
-#include "kdtree.h"
-#include "mesh.h"
+#include "accel/kdtree.h"
+#include "io/mesh.h"
 #include "surface.h"
 #include "traverse.cl"
 

@@ -14,9 +14,9 @@
 #include <unistd.h>
 
 #include "harness.h"
-#include "ocl_program.h"
-#include "render_scene.h"
-#include "texture.h"
+#include "device/ocl_program.h"
+#include "render/render_scene.h"
+#include "io/texture.h"
 
 /* the kernel stage functions, compiled as C: the reference */
 #include "film.cl"

@@ -1,4 +1,4 @@
-/* test_limits.c — the limits of host/limit.h, checked before allocation: header counts
+/* test_limits.c — the limits of host/base/limit.h, checked before allocation: header counts
  * against the bytes that follow, byte counts that overflow, image sizes, and files that
  * are too large, endless (/dev/zero) or streamed (a pipe). */
 #include <fcntl.h>
@@ -9,9 +9,9 @@
 #include <unistd.h>
 
 #include "harness.h"
-#include "lexer.h"
-#include "limit.h"
-#include "scene.h"
+#include "io/lexer.h"
+#include "base/limit.h"
+#include "scene/scene.h"
 
 static void test_count(void)
 {

@@ -1,13 +1,13 @@
-/* test_mesh.c — what the mesh readers share (host/mesh.c): transforms and the sink,
+/* test_mesh.c — what the mesh readers share (host/io/mesh.c): transforms and the sink,
  * case-insensitive paths, the procedural sphere; the mesh block of scene files with its
- * transform keys; a bare mesh shown on its own (host/mesh_view.c), in-process and
+ * transform keys; a bare mesh shown on its own (host/io/mesh_view.c), in-process and
  * through the command line. */
 #include "harness.h"
 
 #include "cli_util.h"
 #include "kmath.h"
-#include "mesh.h"
-#include "mesh_view.h"
+#include "io/mesh.h"
+#include "io/mesh_view.h"
 
 #include <stdint.h>
 #include <stdlib.h>

@@ -4,8 +4,8 @@
 #include "harness.h"
 
 #include "kmath.h"
-#include "mtl.h"
-#include "obj.h"
+#include "io/mtl.h"
+#include "io/obj.h"
 
 #include <stdint.h>
 #include <stdlib.h>

@@ -19,9 +19,9 @@
 #include <unistd.h>
 
 #include "harness.h"
-#include "ocl.h"
-#include "ocl_program.h"
-#include "sha256.h"
+#include "device/ocl.h"
+#include "device/ocl_program.h"
+#include "base/sha256.h"
 #include "types.h"
 
 /* Number of values k_layout writes (see kernels/entry.cl). */

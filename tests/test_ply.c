@@ -3,8 +3,8 @@
 #include "harness.h"
 
 #include "kmath.h"
-#include "lexer.h"
-#include "ply.h"
+#include "io/lexer.h"
+#include "io/ply.h"
 
 #include <stdint.h>
 #include <stdlib.h>

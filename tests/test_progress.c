@@ -7,7 +7,7 @@
 #include <unistd.h>
 
 #include "harness.h"
-#include "progress.h"
+#include "base/progress.h"
 
 static const char *duration(double s)
 {

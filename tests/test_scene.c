@@ -3,8 +3,8 @@
 #include "harness.h"
 
 #include "kmath.h"
-#include "lexer.h"
-#include "scene.h"
+#include "io/lexer.h"
+#include "scene/scene.h"
 
 #include <stdint.h>
 #include <stdlib.h>

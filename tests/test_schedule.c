@@ -12,7 +12,7 @@
 #include "cli_util.h"
 #include "harness.h"
 #include "render_util.h"
-#include "timer.h"
+#include "base/timer.h"
 
 static Scene base;
 

@@ -1,5 +1,5 @@
 /*
- * test_texture.c — texture lookups (kernels/texture.h) and image loading (host/texture.c):
+ * test_texture.c — texture lookups (kernels/texture.h) and image loading (host/io/texture.c):
  * the sRGB decoding and the other functions of kmath.h built from + - * / sqrt against
  * libm in double, bilinear filtering at known points, repeat and clamp, checkerboards,
  * the surface parameterisations, and reading images through stb_image.
@@ -12,7 +12,7 @@
 #include "harness.h"
 
 #include "shade.cl"     /* kernels/texture.h and what it needs, compiled as C */
-#include "texture.h"    /* host/texture.h: this folder's include path finds host/ first */
+#include "io/texture.h"    /* host/io/texture.h: this folder's include path finds host/ first */
 
 #include <stb_image_write.h>
 

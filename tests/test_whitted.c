@@ -15,9 +15,9 @@
 #include "harness.h"
 #include "render_util.h"
 
-#include "camera.h"
-#include "image_write.h"
-#include "passes.h"
+#include "scene/camera.h"
+#include "io/image_write.h"
+#include "render/passes.h"
 #include "whitted.cl"
 
 #define KD_R 0.8

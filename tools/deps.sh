@@ -1,5 +1,9 @@
 #!/bin/sh
-# deps.sh PROFILE... — makes sure the Debian packages a task needs are installed.
+# deps.sh [--check] PROFILE... — makes sure the Debian packages a task needs are installed.
+#
+# With --check nothing is installed, even as root: a missing package is reported with
+# the apt-get line and the script fails (what make targets use; run.sh and .ci/run
+# install).
 #
 # Profiles: base (build and run clpt, run the tests), sanitize (make test-asan),
 # valgrind (make test-valgrind), fuzz (make fuzz), embree (the traversal benchmark).
@@ -18,6 +22,8 @@ pkgs_for() {
     esac
 }
 
+check_only=0
+if [ "${1:-}" = "--check" ]; then check_only=1; shift; fi
 [ $# -gt 0 ] || set -- base
 wanted=""
 for profile in "$@"; do wanted="$wanted $(pkgs_for "$profile")"; done
@@ -35,7 +41,7 @@ for p in $wanted; do
 done
 [ -z "$missing" ] && exit 0
 
-if [ "$(id -u)" -eq 0 ]; then
+if [ "$check_only" -eq 0 ] && [ "$(id -u)" -eq 0 ]; then
     echo "deps.sh: installing missing packages:$missing" >&2
     export DEBIAN_FRONTEND=noninteractive
     apt-get update -qq >&2
@@ -44,6 +50,10 @@ if [ "$(id -u)" -eq 0 ]; then
 else
     echo "clpt needs these Debian packages, which are missing:$missing" >&2
     echo "Install them with:" >&2
-    echo "    sudo apt-get install -y$missing" >&2
+    if [ "$(id -u)" -eq 0 ]; then
+        echo "    apt-get install -y$missing" >&2
+    else
+        echo "    sudo apt-get install -y$missing" >&2
+    fi
     exit 1
 fi

@@ -1,0 +1,1214 @@
+/*
+ * kdtree.c -- the kd-tree build: exact SAH over every candidate plane, in O(N log N).
+ *
+ * Wald & Havran, "On building fast kd-trees for ray tracing, and on doing that in
+ * O(N log N)" (IEEE RT 2006). Each primitive's box in a node gives, per axis, a start
+ * and an end event (or one planar event when the box is flat there). The events of
+ * each axis are sorted once, at the root; a node sweeps its three sorted lists to cost
+ * every plane, and splitting a node splits its lists into the children's lists in
+ * order. Primitives that straddle the split are clipped to each child ("perfect
+ * splits": triangles by Sutherland-Hodgman against the child box, spheres and boxes by
+ * their bounding box) and only their few new events are sorted and merged in.
+ *
+ * Event lists live in a per-thread stack ("arena") of 64-bit keys: a node's lists are
+ * always at the top; its children's lists are written above and then moved down over
+ * it, the child to visit first on top. Build nodes and leaf ids go to per-thread pools
+ * that can be rolled back, which is how a non-improving split that did not pay off is
+ * retracted. Large subtrees become tasks for the other threads; the tree is flattened
+ * afterwards in depth-first order, so the result does not depend on the thread count.
+ * Constants and layout: docs/kdtree.md.
+ */
+#include "accel/kdtree.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+/* Cost factor of a split that leaves one child empty (Wald & Havran's lambda). */
+#ifndef KD_EMPTY_BONUS
+#define KD_EMPTY_BONUS 0.8
+#endif
+/* Consecutive splits whose estimated cost is not below the leaf's that are tried
+ * before giving up (pbrt's badRefines); kept only if the subtree beats the leaf. */
+#ifndef KD_MAX_BAD_REFINES
+#define KD_MAX_BAD_REFINES 1
+#endif
+/* Subtrees with at least this many primitives are handed to other threads. */
+#ifndef KD_TASK_MIN_PRIMS
+#define KD_TASK_MIN_PRIMS 2048
+#endif
+/* Primitive indices share a 64-bit event key with the position and the event type. */
+#define KD_MAX_PRIMS ((1u << 30) - 1u)
+#define POOL_CHUNK_BYTES (1u << 20)
+
+typedef uint64_t Event;
+enum { EV_END = 0, EV_PLANAR = 1, EV_START = 2 };
+enum { SIDE_LEFT = 0, SIDE_RIGHT = 1, SIDE_BOTH = 2 };
+
+typedef struct { float lo[3], hi[3]; } Aabb;
+
+/* ------------------------------------------------------------------ events */
+
+/* Float to unsigned with the same order (-0 is normalised to +0 by the callers). */
+static uint32_t float_key(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+}
+
+static float key_float(uint32_t k)
+{
+    uint32_t u = (k & 0x80000000u) ? (k & 0x7fffffffu) : ~k;
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+/* Ordered by position, then end < planar < start (the sweep relies on it), then
+ * primitive: a total order, so any correct sort gives the same lists. */
+static Event event_make(float pos, uint type, uint prim)
+{
+    return ((uint64_t)float_key(pos + 0.0f) << 32) | ((uint64_t)type << 30) | prim;
+}
+static uint32_t event_pos(Event e) { return (uint32_t)(e >> 32); }
+static uint event_type(Event e) { return (uint)(e >> 30) & 3u; }
+static uint event_prim(Event e) { return (uint)e & KD_MAX_PRIMS; }
+
+/* Appends the events of one primitive's box on axis k. */
+static size_t events_emit(Event *out, const Aabb *b, int k, uint prim)
+{
+    if (b->lo[k] == b->hi[k]) {
+        out[0] = event_make(b->lo[k], EV_PLANAR, prim);
+        return 1;
+    }
+    out[0] = event_make(b->lo[k], EV_START, prim);
+    out[1] = event_make(b->hi[k], EV_END, prim);
+    return 2;
+}
+
+#define RADIX_BIG_BITS 16
+#define RADIX_BUCKETS (1u << RADIX_BIG_BITS)
+
+/* LSD radix sort (tmp holds n events; count holds RADIX_BUCKETS counters), skipping
+ * digits that all keys share: 16-bit digits for big lists, 8-bit ones for the
+ * straddling primitives' few new events, insertion sort for tiny lists. */
+static void events_sort(Event *a, Event *tmp, size_t *count, size_t n)
+{
+    if (n < 64) {
+        for (size_t i = 1; i < n; i++) {
+            Event e = a[i];
+            size_t j = i;
+            for (; j > 0 && a[j - 1] > e; j--) a[j] = a[j - 1];
+            a[j] = e;
+        }
+        return;
+    }
+    int bits = n >= RADIX_BUCKETS ? RADIX_BIG_BITS : 8;
+    size_t buckets = (size_t)1 << bits, mask = buckets - 1;
+    Event *src = a, *dst = tmp;
+    for (int shift = 0; shift < 64; shift += bits) {
+        memset(count, 0, buckets * sizeof *count);
+        for (size_t i = 0; i < n; i++) count[(src[i] >> shift) & mask]++;
+        if (count[(src[0] >> shift) & mask] == n) continue;
+        size_t sum = 0;
+        for (size_t d = 0; d < buckets; d++) {
+            size_t c = count[d];
+            count[d] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++) dst[count[(src[i] >> shift) & mask]++] = src[i];
+        Event *swap = src;
+        src = dst;
+        dst = swap;
+    }
+    if (src != a) memcpy(a, src, n * sizeof *a);
+}
+
+static int uint_cmp(const void *a, const void *b)
+{
+    uint x = *(const uint *)a, y = *(const uint *)b;
+    return (x > y) - (x < y);
+}
+
+static void ids_sort(uint *ids, uint n)
+{
+    if (n > 32) {
+        qsort(ids, n, sizeof *ids, uint_cmp);
+        return;
+    }
+    for (uint i = 1; i < n; i++) {
+        uint x = ids[i], j = i;
+        for (; j > 0 && ids[j - 1] > x; j--) ids[j] = ids[j - 1];
+        ids[j] = x;
+    }
+}
+
+/* ------------------------------------------------------------------ geometry */
+
+static double box_half_area(const Aabb *b)
+{
+    double dx = (double)b->hi[0] - b->lo[0], dy = (double)b->hi[1] - b->lo[1];
+    double dz = (double)b->hi[2] - b->lo[2];
+    return dx * dy + dy * dz + dz * dx;
+}
+
+static int box_intersect_with(Aabb *b, const Aabb *with)
+{
+    for (int k = 0; k < 3; k++) {
+        b->lo[k] = fmaxf(b->lo[k], with->lo[k]);
+        b->hi[k] = fminf(b->hi[k], with->hi[k]);
+        if (!(b->lo[k] <= b->hi[k])) return 0;
+    }
+    return 1;
+}
+
+static float round_down(double d)
+{
+    float f = (float)d;
+    return (double)f > d ? nextafterf(f, -INFINITY) : f;
+}
+
+static float round_up(double d)
+{
+    float f = (float)d;
+    return (double)f < d ? nextafterf(f, INFINITY) : f;
+}
+
+static Aabb triangle_bounds(const Triangle *t)
+{
+    Aabb a = { { t->p0.x, t->p0.y, t->p0.z }, { t->p0.x, t->p0.y, t->p0.z } };
+    const vec3 *v[2] = { &t->p1, &t->p2 };
+    for (int i = 0; i < 2; i++) {
+        const float p[3] = { v[i]->x, v[i]->y, v[i]->z };
+        for (int k = 0; k < 3; k++) {
+            a.lo[k] = fminf(a.lo[k], p[k]);
+            a.hi[k] = fmaxf(a.hi[k], p[k]);
+        }
+    }
+    return a;
+}
+
+/* Box of the part of triangle t inside box c (Sutherland-Hodgman in double, rounded
+ * outward to float so the box is conservative); 0 when nothing is inside. */
+static int clip_triangle(const Triangle *t, const Aabb *c, Aabb *out)
+{
+    /* A convex polygon gains at most one vertex per plane (3 + 6); rounding could in
+     * principle make it slightly non-convex, so there is room for more, and a
+     * polygon that still outgrows it gets the conservative box instead. */
+    double buf[2][32][3];
+    const vec3 *v[3] = { &t->p0, &t->p1, &t->p2 };
+    for (int i = 0; i < 3; i++) {
+        buf[0][i][0] = v[i]->x;
+        buf[0][i][1] = v[i]->y;
+        buf[0][i][2] = v[i]->z;
+    }
+    int n = 3, cur = 0;
+    for (int plane = 0; plane < 6; plane++) {
+        int k = plane >> 1, upper = plane & 1;
+        double bound = upper ? c->hi[k] : c->lo[k];
+        double (*in)[3] = buf[cur], (*res)[3] = buf[cur ^ 1];
+        int outside = 0;
+        for (int i = 0; i < n; i++)
+            outside += upper ? in[i][k] > bound : in[i][k] < bound;
+        if (outside == 0) continue;
+        if (outside == n) return 0;
+        if (n > 16) {
+            *out = triangle_bounds(t);
+            return box_intersect_with(out, c);
+        }
+        int m = 0;
+        for (int i = 0; i < n; i++) {
+            const double *a = in[i], *b = in[(i + 1) % n];
+            int a_in = upper ? a[k] <= bound : a[k] >= bound;
+            int b_in = upper ? b[k] <= bound : b[k] >= bound;
+            if (a_in) {
+                memcpy(res[m], a, sizeof res[m]);
+                m++;
+            }
+            if (a_in != b_in) {
+                double s = (bound - a[k]) / (b[k] - a[k]);
+                for (int j = 0; j < 3; j++) res[m][j] = a[j] + s * (b[j] - a[j]);
+                res[m][k] = bound;
+                m++;
+            }
+        }
+        n = m;
+        cur ^= 1;
+    }
+    double lo[3], hi[3];
+    for (int j = 0; j < 3; j++) lo[j] = hi[j] = buf[cur][0][j];
+    for (int i = 1; i < n; i++)
+        for (int j = 0; j < 3; j++) {
+            lo[j] = fmin(lo[j], buf[cur][i][j]);
+            hi[j] = fmax(hi[j], buf[cur][i][j]);
+        }
+    for (int j = 0; j < 3; j++) {
+        out->lo[j] = round_down(lo[j]);
+        out->hi[j] = round_up(hi[j]);
+    }
+    return box_intersect_with(out, c);
+}
+
+/* ------------------------------------------------------------------ pools */
+
+/* Bump allocator in chunks, with marks to roll back to (retracted subtrees). */
+typedef struct PoolChunk {
+    struct PoolChunk *next;
+    size_t cap, used;
+    max_align_t data[];
+} PoolChunk;
+
+typedef struct { PoolChunk *first, *cur; } Pool;
+typedef struct { PoolChunk *chunk; size_t used; } PoolMark;
+
+static void *pool_alloc(Pool *p, size_t size)
+{
+    size = (size + 15u) & ~(size_t)15u;
+    PoolChunk *c = p->cur;
+    if (!c || c->used + size > c->cap) {
+        size_t cap = size > POOL_CHUNK_BYTES ? size : POOL_CHUNK_BYTES;
+        PoolChunk *fresh = malloc(sizeof *fresh + cap);
+        if (!fresh) return NULL;
+        fresh->next = NULL;
+        fresh->cap = cap;
+        fresh->used = 0;
+        if (c) c->next = fresh;
+        else p->first = fresh;
+        p->cur = c = fresh;
+    }
+    void *r = (char *)c->data + c->used;
+    c->used += size;
+    return r;
+}
+
+static PoolMark pool_mark(const Pool *p)
+{
+    PoolMark m = { p->cur, p->cur ? p->cur->used : 0 };
+    return m;
+}
+
+static void pool_free_from(PoolChunk *c)
+{
+    while (c) {
+        PoolChunk *next = c->next;
+        free(c);
+        c = next;
+    }
+}
+
+static void pool_release(Pool *p, PoolMark m)
+{
+    if (!m.chunk) {
+        pool_free_from(p->first);
+        p->first = p->cur = NULL;
+        return;
+    }
+    pool_free_from(m.chunk->next);
+    m.chunk->next = NULL;
+    m.chunk->used = m.used;
+    p->cur = m.chunk;
+}
+
+/* reserve_*(&array, &capacity, need): grows the array to hold `need` elements
+ * (doubling); 0 on success, -1 when out of memory (the array is then unchanged). */
+#define DEFINE_RESERVE(name, T)                                                        \
+    static int name(T **ptr, size_t *cap, size_t need)                                 \
+    {                                                                                  \
+        if (need <= *cap) return 0;                                                    \
+        size_t n = *cap ? *cap : 256;                                                  \
+        while (n < need) n *= 2;                                                       \
+        T *p = realloc(*ptr, n * sizeof *p);                                           \
+        if (!p) return -1;                                                             \
+        *ptr = p;                                                                      \
+        *cap = n;                                                                      \
+        return 0;                                                                      \
+    }
+
+/* ------------------------------------------------------------------ build state */
+
+typedef struct BNode {
+    uint axis;                  /* 0..2, or KD_LEAF */
+    float split;
+    uint count;                 /* leaf: number of ids */
+    uint *ids;                  /* leaf: sorted global ids (count > 1) */
+    uint id;                    /* leaf: the id when count == 1 */
+    struct BNode *child[2];     /* below, above */
+} BNode;
+
+typedef struct {
+    Event *lists;               /* the three axes' lists, back to back (malloc) */
+    uint n[3], nprims;
+    Aabb box;
+    int depth, bad;
+    BNode **out;
+} Task;
+
+typedef struct Build Build;
+
+typedef struct {
+    Build *b;
+    uint8_t *side;                  /* per primitive: SIDE_* for the node being split */
+    Event *arena;  size_t arena_cap, top;
+    Event *fresh;  size_t fresh_cap;
+    Event *sort_tmp; size_t sort_tmp_cap;
+    size_t *radix_count;            /* RADIX_BUCKETS counters */
+    uint *both;    size_t both_cap;
+    uint *saved;   size_t saved_cap, saved_top;   /* a tentative node's ids, for retraction */
+    Pool nodes, ids;
+} Worker;
+
+struct Build {
+    uint n_prims;
+    uint *gid;                  /* global id of each primitive */
+    uint *tri;                  /* triangle index, or NO_INDEX for spheres and boxes */
+    Aabb *bounds;               /* box of each whole primitive */
+    const Triangle *triangles;
+    int max_depth;
+    int threads;
+
+    pthread_mutex_t lock;
+    pthread_cond_t cond;
+    Task *queue;  size_t q_head, q_len, q_cap;
+    int outstanding;            /* queued + running tasks */
+    int failed;
+};
+
+DEFINE_RESERVE(reserve_events, Event)
+DEFINE_RESERVE(reserve_uints, uint)
+DEFINE_RESERVE(reserve_tasks, Task)
+
+static void worker_free(Worker *w)
+{
+    free(w->side);
+    free(w->arena);
+    free(w->fresh);
+    free(w->sort_tmp);
+    free(w->radix_count);
+    free(w->both);
+    free(w->saved);
+    pool_release(&w->nodes, (PoolMark){ NULL, 0 });
+    pool_release(&w->ids, (PoolMark){ NULL, 0 });
+}
+
+static int build_failed(Build *b)
+{
+    pthread_mutex_lock(&b->lock);
+    int f = b->failed;
+    pthread_mutex_unlock(&b->lock);
+    return f;
+}
+
+static void build_fail(Build *b)
+{
+    pthread_mutex_lock(&b->lock);
+    b->failed = 1;
+    pthread_mutex_unlock(&b->lock);
+}
+
+/* ------------------------------------------------------------------ SAH sweep */
+
+typedef struct {
+    int axis;                   /* -1: no candidate plane */
+    float pos;
+    int planar_left;            /* primitives lying in the plane go left */
+    double cost;                /* in units of SA(node): comparable with the leaf's */
+} Split;
+
+static double sah_split_cost(double sa_l, double sa_r, uint nl, uint nr)
+{
+    double c = KD_COST_TRAVERSAL + sa_l * kd_leaf_cost(nl) + sa_r * kd_leaf_cost(nr);
+    return c * ((nl == 0 || nr == 0) ? KD_EMPTY_BONUS : 1.0);
+}
+
+/* Costs every plane of axis k strictly inside the node (a plane on the boundary would
+ * only cut off a flat, empty cell); keeps the best in *best. */
+static void sweep_axis(const Event *e, uint n, uint nprims, int k, const Aabb *box,
+                       double inv_sa, Split *best)
+{
+    int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+    double lo = box->lo[k], hi = box->hi[k];
+    double a = (double)box->hi[k1] - box->lo[k1], b = (double)box->hi[k2] - box->lo[k2];
+    double side = (a + b) * inv_sa, cap = a * b * inv_sa;
+    /* One event at a time, without branching on the event type: the plane at a
+     * position is costed once its last event (ends, then planar, then starts) has
+     * been counted; nl and nr then count the primitives reaching into the left and
+     * the right side (one that straddles the plane in both), and `planar` those
+     * lying in it. Every event is costed, and the cost used
+     * only at the last event of a position, since mispredicted branches would cost
+     * more than the arithmetic. */
+    uint nl = 0, nr = nprims, planar = 0, starts = 0;
+    for (uint i = 0; i < n; i++) {
+        uint t = event_type(e[i]);
+        uint32_t pk = event_pos(e[i]);
+        nr -= (t != EV_START);
+        planar += (t == EV_PLANAR);
+        starts += (t == EV_START);
+        int last = i + 1 == n || event_pos(e[i + 1]) != pk;
+        double p = key_float(pk);
+        double sa_l = (p - lo) * side + cap, sa_r = (hi - p) * side + cap;
+        double cl = sah_split_cost(sa_l, sa_r, nl + planar, nr);
+        double cr = sah_split_cost(sa_l, sa_r, nl, nr + planar);
+        double c = cl <= cr ? cl : cr;
+        if (last && p > lo && p < hi && c < best->cost) {
+            best->cost = c;
+            best->axis = k;
+            best->pos = (float)p;
+            best->planar_left = cl <= cr;
+        }
+        nl += last ? starts + planar : 0;
+        starts = last ? 0 : starts;
+        planar = last ? 0 : planar;
+    }
+}
+
+/* ------------------------------------------------------------------ the recursion */
+
+typedef struct {
+    size_t off;                 /* lists in the arena: axis 0, 1, 2 back to back */
+    uint n[3];
+    uint nprims;
+    Aabb box;
+} NodeLists;
+
+/* The node's global ids in increasing order (neighbouring leaves then read the
+ * primitive arrays in a similar order). */
+static void collect_ids(const Worker *w, const NodeLists *nl, uint *ids)
+{
+    const Event *e = w->arena + nl->off;
+    uint m = 0;
+    for (uint i = 0; i < nl->n[0]; i++)
+        if (event_type(e[i]) != EV_END) ids[m++] = w->b->gid[event_prim(e[i])];
+    ids_sort(ids, m);
+}
+
+static int make_leaf(Worker *w, const NodeLists *nl, BNode *node)
+{
+    node->axis = KD_LEAF;
+    node->count = nl->nprims;
+    node->ids = NULL;
+    node->id = 0;
+    node->child[0] = node->child[1] = NULL;
+    if (nl->nprims == 0) return 0;
+    uint *ids = nl->nprims == 1 ? &node->id : pool_alloc(&w->ids, nl->nprims * sizeof *ids);
+    if (!ids) return -1;
+    collect_ids(w, nl, ids);
+    if (nl->nprims > 1) node->ids = ids;
+    return 0;
+}
+
+/* Leaf from ids saved before a tentative split. */
+static int make_leaf_from(Worker *w, const uint *ids, uint count, BNode *node)
+{
+    node->axis = KD_LEAF;
+    node->count = count;
+    node->ids = NULL;
+    node->id = count == 1 ? ids[0] : 0;
+    node->child[0] = node->child[1] = NULL;
+    if (count > 1) {
+        node->ids = pool_alloc(&w->ids, count * sizeof *node->ids);
+        if (!node->ids) return -1;
+        memcpy(node->ids, ids, count * sizeof *node->ids);
+    }
+    return 0;
+}
+
+/* Splits the node's lists into the children's: on return the right child's lists are
+ * at nl->off and the left child's right above them, at the top of the arena. */
+static int split_lists(Worker *w, const NodeLists *nl, const Split *s,
+                       NodeLists *left, NodeLists *right)
+{
+    Build *b = w->b;
+    int k = s->axis;
+    uint32_t pk = float_key(s->pos + 0.0f);
+    uint8_t *side = w->side;
+
+    /* Classify by the events of the split axis; a primitive's start precedes its end. */
+    const Event *ek = w->arena + nl->off + (k > 0 ? nl->n[0] : 0) + (k > 1 ? nl->n[1] : 0);
+    uint8_t in_plane = s->planar_left ? SIDE_LEFT : SIDE_RIGHT;
+    for (uint i = 0; i < nl->n[k]; i++) {
+        Event e = ek[i];
+        uint p = event_prim(e), t = event_type(e);
+        uint32_t pos = event_pos(e);
+        uint8_t at_start = pos >= pk ? SIDE_RIGHT : SIDE_BOTH;
+        uint8_t at_end = pos <= pk ? SIDE_LEFT : side[p];
+        uint8_t planar = pos < pk ? SIDE_LEFT : pos > pk ? SIDE_RIGHT : in_plane;
+        side[p] = t == EV_START ? at_start : t == EV_END ? at_end : planar;
+    }
+    uint n_left = 0, n_right = 0, n_both = 0;
+    if (reserve_uints(&w->both, &w->both_cap, nl->nprims + 1)) return -1;
+    for (uint i = 0; i < nl->n[k]; i++) {
+        Event e = ek[i];
+        uint p = event_prim(e), counted = event_type(e) != EV_END;
+        uint8_t sd = side[p];
+        n_left += counted & (sd == SIDE_LEFT);
+        n_right += counted & (sd == SIDE_RIGHT);
+        w->both[n_both] = p;
+        n_both += counted & (sd == SIDE_BOTH);
+    }
+
+    /* Clip the straddling primitives to each child: 6 fresh lists of up to 2 events
+     * per primitive (left x,y,z then right x,y,z). */
+    Aabb box_l = nl->box, box_r = nl->box;
+    box_l.hi[k] = s->pos;
+    box_r.lo[k] = s->pos;
+    if (reserve_events(&w->fresh, &w->fresh_cap, (size_t)12 * n_both + 1))
+        return -1;
+    Event *fresh[2][3];
+    size_t n_fresh[2][3] = { { 0, 0, 0 }, { 0, 0, 0 } };
+    for (int c = 0; c < 2; c++)
+        for (int j = 0; j < 3; j++) fresh[c][j] = w->fresh + (size_t)(c * 3 + j) * 2 * n_both;
+    for (uint i = 0; i < n_both; i++) {
+        uint p = w->both[i];
+        for (int c = 0; c < 2; c++) {
+            const Aabb *cb = c ? &box_r : &box_l;
+            Aabb clipped = b->bounds[p];
+            int inside = b->tri[p] != NO_INDEX ? clip_triangle(&b->triangles[b->tri[p]], cb, &clipped)
+                                               : box_intersect_with(&clipped, cb);
+            if (!inside) continue;
+            if (c) n_right++;
+            else n_left++;
+            for (int j = 0; j < 3; j++)
+                n_fresh[c][j] += events_emit(fresh[c][j] + n_fresh[c][j], &clipped, j, p);
+        }
+    }
+    size_t most = 0;
+    for (int c = 0; c < 2; c++)
+        for (int j = 0; j < 3; j++) most = n_fresh[c][j] > most ? n_fresh[c][j] : most;
+    if (reserve_events(&w->sort_tmp, &w->sort_tmp_cap, most + 1)) return -1;
+    for (int c = 0; c < 2; c++)
+        for (int j = 0; j < 3; j++) events_sort(fresh[c][j], w->sort_tmp, w->radix_count, n_fresh[c][j]);
+
+    /* Write the children's lists above the node's, right child first, each axis in
+     * one pass that keeps every event for both children (writing both is cheaper
+     * than branching) and merges in the fresh events in order. Each list gets room
+     * for all of the node's events of its axis plus its fresh ones. */
+    size_t node_size = (size_t)nl->n[0] + nl->n[1] + nl->n[2];
+    size_t need = node_size * 2 + 12 * (size_t)n_both + 1;
+    if (reserve_events(&w->arena, &w->arena_cap, w->top + need)) return -1;
+    const Event *src = w->arena + nl->off;
+    size_t start[2][3], count[2][3];
+    size_t room = w->top;
+    for (int c = 1; c >= 0; c--)
+        for (int j = 0; j < 3; j++) {
+            start[c][j] = room;
+            room += nl->n[j] + n_fresh[c][j];
+        }
+    for (int j = 0; j < 3; j++) {
+        Event *dl = w->arena + start[0][j], *dr = w->arena + start[1][j];
+        const Event *fl = fresh[0][j], *fr = fresh[1][j];
+        size_t nfl = n_fresh[0][j], nfr = n_fresh[1][j], il = 0, ir = 0, ml = 0, mr = 0;
+        for (uint i = 0; i < nl->n[j]; i++) {
+            Event e = src[i];
+            uint8_t sd = side[event_prim(e)];
+            while (il < nfl && fl[il] < e) dl[ml++] = fl[il++];
+            while (ir < nfr && fr[ir] < e) dr[mr++] = fr[ir++];
+            dl[ml] = e;
+            dr[mr] = e;
+            ml += sd == SIDE_LEFT;
+            mr += sd == SIDE_RIGHT;
+        }
+        while (il < nfl) dl[ml++] = fl[il++];
+        while (ir < nfr) dr[mr++] = fr[ir++];
+        count[0][j] = ml;
+        count[1][j] = mr;
+        src += nl->n[j];
+    }
+    /* Destination ranges come in the same order as the sources, and each ends before
+     * the next source begins (the sources have room for at least their events). */
+    size_t dst = nl->off;
+    for (int c = 1; c >= 0; c--)
+        for (int j = 0; j < 3; j++) {
+            memmove(w->arena + dst, w->arena + start[c][j], count[c][j] * sizeof *w->arena);
+            dst += count[c][j];
+        }
+    right->off = nl->off;
+    left->off = nl->off + count[1][0] + count[1][1] + count[1][2];
+    for (int j = 0; j < 3; j++) {
+        right->n[j] = (uint)count[1][j];
+        left->n[j] = (uint)count[0][j];
+    }
+    right->nprims = n_right;
+    left->nprims = n_left;
+    right->box = box_r;
+    left->box = box_l;
+    w->top = dst;
+    return 0;
+}
+
+static int task_push(Worker *w, const NodeLists *nl, int depth, int bad, BNode **out)
+{
+    Build *b = w->b;
+    size_t n = (size_t)nl->n[0] + nl->n[1] + nl->n[2];
+    Task t = { malloc(n * sizeof(Event) + 1), { nl->n[0], nl->n[1], nl->n[2] }, nl->nprims,
+               nl->box, depth, bad, out };
+    if (!t.lists) return -1;
+    memcpy(t.lists, w->arena + nl->off, n * sizeof(Event));
+    pthread_mutex_lock(&b->lock);
+    if (b->q_head > 0 && b->q_head + b->q_len == b->q_cap) {
+        memmove(b->queue, b->queue + b->q_head, b->q_len * sizeof *b->queue);
+        b->q_head = 0;
+    }
+    if (reserve_tasks(&b->queue, &b->q_cap, b->q_len + 1)) {
+        pthread_mutex_unlock(&b->lock);
+        free(t.lists);
+        return -1;
+    }
+    b->queue[b->q_head + b->q_len++] = t;
+    b->outstanding++;
+    pthread_cond_signal(&b->cond);
+    pthread_mutex_unlock(&b->lock);
+    return 0;
+}
+
+/* Builds the subtree of the node whose lists are at the top of the arena and stores it
+ * in *out. *cost gets the subtree's cost (with the empty bonus, in absolute area units)
+ * when `tentative`; subtrees handed to other threads are built only outside tentative
+ * splits, where that cost is not needed. Returns -1 when memory runs out. */
+static int build_node(Worker *w, NodeLists nl, int depth, int bad, int tentative,
+                      BNode **out, double *cost)
+{
+    Build *b = w->b;
+    BNode *node = pool_alloc(&w->nodes, sizeof *node);
+    if (!node) return -1;
+    *out = node;
+    double sa = box_half_area(&nl.box);
+    double leaf_cost = kd_leaf_cost(nl.nprims);
+    *cost = leaf_cost * sa;
+
+    Split best = { -1, 0.0f, 0, INFINITY };
+    if (nl.nprims > 0 && depth < b->max_depth && sa > 0.0) {
+        const Event *e = w->arena + nl.off;
+        for (int k = 0; k < 3; k++) {
+            if (nl.box.hi[k] > nl.box.lo[k]) sweep_axis(e, nl.n[k], nl.nprims, k, &nl.box, 1.0 / sa, &best);
+            e += nl.n[k];
+        }
+    }
+    int improves = best.axis >= 0 && best.cost < leaf_cost;
+    if (best.axis < 0 || (!improves && bad >= KD_MAX_BAD_REFINES)) return make_leaf(w, &nl, node);
+
+    /* A non-improving split is tried only if its subtree turns out cheaper than the
+     * leaf: keep the leaf's ids and the pools' positions to go back to. */
+    int try_bad = !improves;
+    size_t saved_at = w->saved_top;
+    PoolMark nodes_mark = pool_mark(&w->nodes), ids_mark = pool_mark(&w->ids);
+    if (try_bad) {
+        if (reserve_uints(&w->saved, &w->saved_cap, saved_at + nl.nprims + 1)) return -1;
+        collect_ids(w, &nl, w->saved + saved_at);
+        w->saved_top = saved_at + nl.nprims;
+        tentative = 1;
+    }
+
+    NodeLists left, right;
+    if (split_lists(w, &nl, &best, &left, &right)) return -1;
+    node->axis = (uint)best.axis;
+    node->split = best.pos;
+    node->count = 0;
+    node->ids = NULL;
+    node->child[0] = node->child[1] = NULL;
+    int child_bad = improves ? 0 : bad + 1;
+    double cost_l = 0.0, cost_r = 0.0;
+
+    if (!tentative && b->threads > 1 && right.nprims >= KD_TASK_MIN_PRIMS) {
+        if (task_push(w, &right, depth + 1, child_bad, &node->child[1])) return -1;
+        /* The right child's lists are copied out: move the left child's down. */
+        size_t n = (size_t)left.n[0] + left.n[1] + left.n[2];
+        memmove(w->arena + nl.off, w->arena + left.off, n * sizeof *w->arena);
+        left.off = nl.off;
+        w->top = nl.off + n;
+        return build_node(w, left, depth + 1, child_bad, 0, &node->child[0], &cost_l);
+    }
+    if (build_node(w, left, depth + 1, child_bad, tentative, &node->child[0], &cost_l)) return -1;
+    w->top = right.off + right.n[0] + right.n[1] + right.n[2];
+    if (build_node(w, right, depth + 1, child_bad, tentative, &node->child[1], &cost_r)) return -1;
+
+    double split_cost = KD_COST_TRAVERSAL * sa + cost_l + cost_r;
+    if (left.nprims == 0 || right.nprims == 0) split_cost *= KD_EMPTY_BONUS;
+    *cost = split_cost;
+    if (try_bad) {
+        w->saved_top = saved_at;
+        if (split_cost >= leaf_cost * sa) {
+            /* Retract: the subtree below this split does not beat a leaf. The node
+             * itself was allocated before the marks and stays. */
+            pool_release(&w->ids, ids_mark);
+            pool_release(&w->nodes, nodes_mark);
+            *cost = leaf_cost * sa;
+            return make_leaf_from(w, w->saved + saved_at, nl.nprims, node);
+        }
+    }
+    return 0;
+}
+
+/* Runs queued subtree tasks until none is queued or running. */
+static void worker_run(Worker *w)
+{
+    Build *b = w->b;
+    pthread_mutex_lock(&b->lock);
+    for (;;) {
+        while (b->q_len == 0 && b->outstanding > 0) pthread_cond_wait(&b->cond, &b->lock);
+        if (b->q_len == 0) break;
+        Task t = b->queue[b->q_head++];
+        b->q_len--;
+        int skip = b->failed;
+        pthread_mutex_unlock(&b->lock);
+
+        int fail = 0;
+        if (!skip) {
+            size_t n = (size_t)t.n[0] + t.n[1] + t.n[2];
+            fail = reserve_events(&w->arena, &w->arena_cap, n + 1);
+            if (!fail) {
+                memcpy(w->arena, t.lists, n * sizeof *w->arena);
+                w->top = n;
+                NodeLists nl = { 0, { t.n[0], t.n[1], t.n[2] }, t.nprims, t.box };
+                double cost;
+                fail = build_node(w, nl, t.depth, t.bad, 0, t.out, &cost);
+            }
+        }
+        free(t.lists);
+
+        pthread_mutex_lock(&b->lock);
+        if (fail) b->failed = 1;
+        if (--b->outstanding == 0) pthread_cond_broadcast(&b->cond);
+    }
+    pthread_mutex_unlock(&b->lock);
+}
+
+static void *worker_thread(void *arg)
+{
+    worker_run(arg);
+    return NULL;
+}
+
+/* ------------------------------------------------------------------ input */
+
+static int aabb_finite(const Aabb *a)
+{
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(a->lo[k]) || !isfinite(a->hi[k])) return 0;
+    return 1;
+}
+
+static Aabb sphere_bounds(const Sphere *s)
+{
+    /* Rounded outward: the centre +- radius in float can land a hair inside. */
+    float r = fabsf(s->radius);
+    const float c[3] = { s->center.x, s->center.y, s->center.z };
+    Aabb a;
+    for (int k = 0; k < 3; k++) {
+        a.lo[k] = nextafterf(c[k] - r, -INFINITY);
+        a.hi[k] = nextafterf(c[k] + r, INFINITY);
+    }
+    return a;
+}
+
+static int triangle_finite(const Triangle *t)
+{
+    return isfinite(t->p0.x) && isfinite(t->p0.y) && isfinite(t->p0.z) &&
+           isfinite(t->p1.x) && isfinite(t->p1.y) && isfinite(t->p1.z) &&
+           isfinite(t->p2.x) && isfinite(t->p2.y) && isfinite(t->p2.z);
+}
+
+static Aabb box_bounds(const Box *bx)
+{
+    const float lo[3] = { bx->lo.x, bx->lo.y, bx->lo.z }, hi[3] = { bx->hi.x, bx->hi.y, bx->hi.z };
+    Aabb a;
+    for (int k = 0; k < 3; k++) {
+        a.lo[k] = fminf(lo[k], hi[k]);
+        a.hi[k] = fmaxf(lo[k], hi[k]);
+    }
+    /* fminf drops a NaN operand: keep it so the finiteness test sees it. */
+    for (int k = 0; k < 3; k++)
+        if (isnan(lo[k]) || isnan(hi[k])) a.lo[k] = NAN;
+    return a;
+}
+
+/* Collects the primitives (global ids, bounds). A primitive whose bounds are not
+ * finite (a NaN or inf coordinate or radius) is left out of the tree, and so can never
+ * be hit: no finite ray could hit it meaningfully, and one infinite box would make
+ * every SAH area infinite. */
+static Status gather(Build *b, const KdInput *in, uint *skipped, Error *err)
+{
+    size_t total = in->n_spheres + in->n_triangles + in->n_boxes;
+    if (total > KD_MAX_PRIMS)
+        return error_set(err, ST_INPUT, "kd-tree: %zu primitives, more than the %u supported",
+                         total, KD_MAX_PRIMS);
+    b->gid = malloc((total + 1) * sizeof *b->gid);
+    b->tri = malloc((total + 1) * sizeof *b->tri);
+    b->bounds = malloc((total + 1) * sizeof *b->bounds);
+    if (!b->gid || !b->tri || !b->bounds)
+        return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu primitives", total);
+    uint n = 0, gid = 0;
+    for (size_t i = 0; i < in->n_spheres; i++, gid++) {
+        Aabb a = sphere_bounds(&in->spheres[i]);
+        if (!aabb_finite(&a)) continue;
+        b->gid[n] = gid; b->tri[n] = NO_INDEX; b->bounds[n++] = a;
+    }
+    for (size_t i = 0; i < in->n_triangles; i++, gid++) {
+        Aabb a = triangle_bounds(&in->triangles[i]);
+        if (!triangle_finite(&in->triangles[i])) continue;
+        b->gid[n] = gid; b->tri[n] = (uint)i; b->bounds[n++] = a;
+    }
+    for (size_t i = 0; i < in->n_boxes; i++, gid++) {
+        Aabb a = box_bounds(&in->boxes[i]);
+        if (!aabb_finite(&a)) continue;
+        b->gid[n] = gid; b->tri[n] = NO_INDEX; b->bounds[n++] = a;
+    }
+    b->n_prims = n;
+    *skipped = (uint)(total - n);
+    b->triangles = in->triangles;
+    return ST_OK;
+}
+
+typedef struct { Build *b; Event *lists; size_t n[3]; int k; int failed; } SortJob;
+
+static void *sort_job(void *arg)
+{
+    SortJob *j = arg;
+    size_t off = 0;
+    for (int k = 0; k < j->k; k++) off += j->n[k];
+    Event *tmp = malloc(j->n[j->k] * sizeof *tmp + 1);
+    size_t *count = malloc(RADIX_BUCKETS * sizeof *count);
+    if (tmp && count) events_sort(j->lists + off, tmp, count, j->n[j->k]);
+    else j->failed = 1;
+    free(tmp);
+    free(count);
+    return NULL;
+}
+
+/* ------------------------------------------------------------------ flatten */
+
+/* scale: the product of the empty-space bonus over the node's ancestors that have an
+ * empty child (the factor the builder's cost applies to this node's terms). */
+typedef struct { const BNode *node; uint parent; int depth; Aabb box; double scale; } FlatItem;
+
+static int leaf_is_empty(const BNode *n) { return n->axis == KD_LEAF && n->count == 0; }
+
+/* A leaf's sorted global ids. */
+static const uint *leaf_ids(const BNode *n) { return n->count == 1 ? &n->id : n->ids; }
+
+/* How many of a leaf's ids are triangles (they come after the spheres, before the
+ * boxes, and the ids are sorted: a contiguous run). */
+static void leaf_split_ids(const BNode *n, const KdInput *in, uint *first_tri, uint *n_tri)
+{
+    uint lo = (uint)in->n_spheres, hi = lo + (uint)in->n_triangles;
+    const uint *ids = leaf_ids(n);
+    uint a = 0, c = 0;
+    while (a < n->count && ids[a] < lo) a++;
+    while (a + c < n->count && ids[a + c] < hi) c++;
+    *first_tri = a;
+    *n_tri = c;
+}
+
+/* Words of a leaf's record in the leaf data (types.h). */
+static size_t leaf_words(const BNode *n, const KdInput *in)
+{
+    uint first, nt;
+    leaf_split_ids(n, in, &first, &nt);
+    size_t w = (size_t)(nt + KD_GROUP - 1) / KD_GROUP * KD_GROUP_WORDS;
+    uint others = n->count - nt;
+    return w + (others ? 1 + others : 0);
+}
+
+/* Writes a leaf's record at out: its triangles in groups (the last one repeated in the
+ * unused lanes), then the other ids. */
+static void leaf_write(const BNode *n, const KdInput *in, uint *out)
+{
+    uint first, nt;
+    leaf_split_ids(n, in, &first, &nt);
+    const uint *ids = leaf_ids(n);
+    uint base = (uint)in->n_spheres;
+    for (uint g = 0; g < nt; g += KD_GROUP, out += KD_GROUP_WORDS) {
+        for (uint l = 0; l < KD_GROUP; l++) {
+            uint id = ids[first + (g + l < nt ? g + l : nt - 1)];
+            const Triangle *t = &in->triangles[id - base];
+            const vec3 *c[3] = { &t->p0, &t->p1, &t->p2 };
+            out[l] = id;
+            for (int v = 0; v < 3; v++) {
+                const float f[3] = { c[v]->x, c[v]->y, c[v]->z };
+                for (int k = 0; k < 3; k++) memcpy(&out[KD_GROUP + (uint)(3 * v + k) * KD_GROUP + l], &f[k], sizeof(float));
+            }
+        }
+    }
+    uint others = n->count - nt;
+    if (others) {
+        *out++ = others;
+        for (uint i = 0; i < n->count; i++)
+            if (i < first || i >= first + nt) *out++ = ids[i];
+    }
+}
+
+static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in, KdTree *t, Error *err)
+{
+    /* Count first, to allocate exactly. Depth-first, "below" child first. */
+    size_t n_nodes = 0, n_words = 0;
+    const BNode *stack[KD_MAX_DEPTH + 2];
+    int sp = 0;
+    stack[sp++] = root;
+    while (sp) {
+        const BNode *n = stack[--sp];
+        n_nodes++;
+        if (n->axis == KD_LEAF) {
+            n_words += leaf_words(n, in);
+        } else {
+            stack[sp++] = n->child[1];
+            stack[sp++] = n->child[0];
+        }
+    }
+    if (n_nodes > (UINT32_MAX >> 4) || n_words > UINT32_MAX - 1)
+        return error_set(err, ST_INTERNAL, "kd-tree: %zu nodes and %zu words of leaf data do not fit the node layout",
+                         n_nodes, n_words);
+    t->nodes = malloc(n_nodes * sizeof *t->nodes);
+    /* Cache-line aligned, so that no row of a group's corners straddles two lines (the
+     * groups are 320 bytes long; OpenCL buffers are aligned at least as well). */
+    size_t leaf_bytes = ((n_words + 1) * sizeof *t->leaf_prims + 63) / 64 * 64;
+    t->leaf_prims = aligned_alloc(64, leaf_bytes);
+    if (!t->nodes || !t->leaf_prims)
+        return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu nodes", n_nodes);
+
+    KdStats *st = &t->stats;
+    double inv_root = box_half_area(root_box) > 0.0 ? 1.0 / box_half_area(root_box) : 0.0;
+    size_t refs = 0, groups = 0;
+    uint idx = 0, words = 0;
+    FlatItem items[KD_MAX_DEPTH + 2];
+    int ip = 0;
+    items[ip++] = (FlatItem){ root, NO_INDEX, 0, *root_box, 1.0 };
+    while (ip) {
+        FlatItem it = items[--ip];
+        const BNode *n = it.node;
+        uint me = idx++;
+        if (it.parent != NO_INDEX) t->nodes[it.parent].bits |= me << 4;
+        if ((uint)it.depth > st->max_depth) st->max_depth = (uint)it.depth;
+        double rel = inv_root > 0.0 ? box_half_area(&it.box) * inv_root : 1.0;
+        if (n->axis == KD_LEAF) {
+            st->n_leaves++;
+            if (n->count == 0) st->n_empty_leaves++;
+            refs += n->count;
+            st->sah_cost += kd_leaf_cost(n->count) * rel;
+            st->sah_cost_bonus += kd_leaf_cost(n->count) * rel * it.scale;
+            uint first, nt;
+            leaf_split_ids(n, in, &first, &nt);
+            uint ng = (nt + KD_GROUP - 1) / KD_GROUP;
+            groups += ng;
+            t->nodes[me].bits = KD_LEAF | (n->count > nt ? KD_LEAF_OTHERS : 0u) | (ng << 3);
+            t->nodes[me].data = n->count ? words : 0u;
+            if (n->count) leaf_write(n, in, t->leaf_prims + words);
+            words += (uint)leaf_words(n, in);
+            continue;
+        }
+        double scale = it.scale * (leaf_is_empty(n->child[0]) || leaf_is_empty(n->child[1]) ? KD_EMPTY_BONUS : 1.0);
+        st->sah_cost += KD_COST_TRAVERSAL * rel;
+        st->sah_cost_bonus += KD_COST_TRAVERSAL * rel * scale;
+        uint split_bits;
+        memcpy(&split_bits, &n->split, sizeof split_bits);
+        t->nodes[me].data = split_bits;
+        /* the above child's index is added when reached */
+        t->nodes[me].bits = n->axis | (leaf_is_empty(n->child[0]) ? KD_EMPTY_BELOW : 0u) |
+                            (leaf_is_empty(n->child[1]) ? KD_EMPTY_ABOVE : 0u);
+        FlatItem above = { n->child[1], me, it.depth + 1, it.box, scale };
+        FlatItem below = { n->child[0], NO_INDEX, it.depth + 1, it.box, scale };
+        above.box.lo[n->axis] = n->split;
+        below.box.hi[n->axis] = n->split;
+        items[ip++] = above;
+        items[ip++] = below;
+    }
+    t->n_nodes = idx;
+    t->n_leaf_prims = words;
+    st->n_nodes = idx;
+    uint full = st->n_leaves - st->n_empty_leaves;
+    st->mean_prims_per_leaf = full ? (double)refs / full : 0.0;
+    st->bytes = (size_t)idx * sizeof(KdNode) + (size_t)words * sizeof(uint);
+    st->bytes_corners = groups * KD_GROUP * 9 * sizeof(float);
+    return ST_OK;
+}
+
+/* A leaf's primitive ids (its triangles without the repeated lanes, then the others). */
+uint kd_leaf_ids(const KdTree *t, uint node, uint *out, uint cap)
+{
+    KdNode n = t->nodes[node];
+    uint m = 0;
+    if ((n.bits & 3u) != KD_LEAF) return 0;
+    const uint *g = t->leaf_prims + n.data;
+    for (uint i = 0; i < n.bits >> 3; i++, g += KD_GROUP_WORDS)
+        for (uint l = 0; l < KD_GROUP; l++)
+            if ((l == 0 || g[l] != g[l - 1]) && m < cap) out[m++] = g[l];
+    if (n.bits & KD_LEAF_OTHERS)
+        for (uint i = 1; i <= g[0]; i++)
+            if (m < cap) out[m++] = g[i];
+    return m;
+}
+
+/* ------------------------------------------------------------------ entry points */
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void build_free(Build *b, Worker *w, int n_workers)
+{
+    for (int i = 0; i < n_workers; i++) worker_free(&w[i]);
+    free(w);
+    for (size_t i = 0; i < b->q_len; i++) free(b->queue[b->q_head + i].lists);
+    free(b->queue);
+    free(b->gid);
+    free(b->tri);
+    free(b->bounds);
+    pthread_mutex_destroy(&b->lock);
+    pthread_cond_destroy(&b->cond);
+}
+
+static Status build_single_leaf(KdTree *out, Error *err)
+{
+    out->nodes = malloc(sizeof *out->nodes);
+    out->leaf_prims = malloc(sizeof *out->leaf_prims);
+    if (!out->nodes || !out->leaf_prims) {
+        kd_free(out);
+        return error_set(err, ST_INTERNAL, "kd-tree: out of memory");
+    }
+    out->nodes[0].data = 0;
+    out->nodes[0].bits = KD_LEAF;
+    out->n_nodes = 1;
+    out->n_leaf_prims = 0;
+    out->stats.n_nodes = 1;
+    out->stats.n_leaves = 1;
+    out->stats.n_empty_leaves = 1;
+    out->stats.bytes = sizeof(KdNode);
+    return ST_OK;
+}
+
+Status kd_build(const KdInput *in, int threads, KdTree *out, Error *err)
+{
+    double t_start = now_seconds();
+    memset(out, 0, sizeof *out);
+    if (threads <= 0) {
+        long n = sysconf(_SC_NPROCESSORS_ONLN);
+        threads = n > 0 ? (int)n : 1;
+    }
+    if (threads > 256) threads = 256;
+
+    Build b;
+    memset(&b, 0, sizeof b);
+    pthread_mutex_init(&b.lock, NULL);
+    pthread_cond_init(&b.cond, NULL);
+    Worker *w = NULL;
+    int n_workers = 0;
+    uint skipped = 0;
+    Status st = gather(&b, in, &skipped, err);
+    if (st != ST_OK) goto fail;
+    out->stats.n_skipped = skipped;
+    out->stats.n_prims = b.n_prims;
+    if (b.n_prims == 0) {
+        st = build_single_leaf(out, err);
+        out->stats.n_skipped = skipped;
+        build_free(&b, w, 0);
+        out->stats.build_seconds = now_seconds() - t_start;
+        return st;
+    }
+
+    Aabb root = b.bounds[0];
+    for (uint i = 1; i < b.n_prims; i++)
+        for (int k = 0; k < 3; k++) {
+            root.lo[k] = fminf(root.lo[k], b.bounds[i].lo[k]);
+            root.hi[k] = fmaxf(root.hi[k], b.bounds[i].hi[k]);
+        }
+    int log2n = 0;
+    while ((2u << log2n) <= b.n_prims && log2n < 31) log2n++;
+    b.max_depth = (int)lround(8.0 + 1.3 * log2n);
+    if (b.max_depth > KD_MAX_DEPTH - 1) b.max_depth = KD_MAX_DEPTH - 1;
+    b.threads = threads;
+
+    w = calloc((size_t)threads, sizeof *w);
+    if (!w) { st = error_set(err, ST_INTERNAL, "kd-tree: out of memory"); goto fail; }
+    n_workers = threads;
+    for (int i = 0; i < threads; i++) {
+        w[i].b = &b;
+        w[i].side = malloc(b.n_prims);
+        w[i].radix_count = malloc(RADIX_BUCKETS * sizeof *w[i].radix_count);
+        if (!w[i].side || !w[i].radix_count) { st = error_set(err, ST_INTERNAL, "kd-tree: out of memory"); goto fail; }
+    }
+
+    /* The root's events, sorted per axis (the axes in parallel). */
+    size_t n_ev[3] = { 0, 0, 0 };
+    for (uint i = 0; i < b.n_prims; i++)
+        for (int k = 0; k < 3; k++) n_ev[k] += b.bounds[i].lo[k] == b.bounds[i].hi[k] ? 1 : 2;
+    size_t total_ev = n_ev[0] + n_ev[1] + n_ev[2];
+    if (reserve_events(&w[0].arena, &w[0].arena_cap, total_ev * 3 + 1)) {
+        st = error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu events", total_ev);
+        goto fail;
+    }
+    Event *ev = w[0].arena;
+    size_t pos[3] = { 0, n_ev[0], n_ev[0] + n_ev[1] };
+    for (uint i = 0; i < b.n_prims; i++)
+        for (int k = 0; k < 3; k++) pos[k] += events_emit(ev + pos[k], &b.bounds[i], k, i);
+    SortJob jobs[3];
+    pthread_t tid[3];
+    int started[3] = { 0, 0, 0 };
+    for (int k = 0; k < 3; k++) {
+        jobs[k] = (SortJob){ &b, ev, { n_ev[0], n_ev[1], n_ev[2] }, k, 0 };
+        if (k < threads - 1 && k < 2 && pthread_create(&tid[k], NULL, sort_job, &jobs[k]) == 0)
+            started[k] = 1;
+        else
+            sort_job(&jobs[k]);
+    }
+    for (int k = 0; k < 3; k++)
+        if (started[k]) pthread_join(tid[k], NULL);
+    if (jobs[0].failed || jobs[1].failed || jobs[2].failed) {
+        st = error_set(err, ST_INTERNAL, "kd-tree: out of memory sorting events");
+        goto fail;
+    }
+    w[0].top = total_ev;
+
+    /* Worker 0 (this thread) builds from the root; the others wait for tasks. */
+    pthread_t *threads_id = calloc((size_t)threads, sizeof *threads_id);
+    if (!threads_id) { st = error_set(err, ST_INTERNAL, "kd-tree: out of memory"); goto fail; }
+    b.outstanding = 1;
+    int n_started = 0;
+    for (int i = 1; i < threads; i++)
+        if (pthread_create(&threads_id[i], NULL, worker_thread, &w[i]) == 0) n_started = i;
+        else break;
+    if (n_started == 0) b.threads = 1;
+    BNode *root_node = NULL;
+    NodeLists nl = { 0, { (uint)n_ev[0], (uint)n_ev[1], (uint)n_ev[2] }, b.n_prims, root };
+    double cost;
+    if (build_node(&w[0], nl, 0, 0, 0, &root_node, &cost)) build_fail(&b);
+    pthread_mutex_lock(&b.lock);
+    if (--b.outstanding == 0) pthread_cond_broadcast(&b.cond);
+    pthread_mutex_unlock(&b.lock);
+    worker_run(&w[0]);
+    for (int i = 1; i <= n_started; i++) pthread_join(threads_id[i], NULL);
+    free(threads_id);
+    if (build_failed(&b)) {
+        st = error_set(err, ST_INTERNAL, "kd-tree: out of memory building the tree");
+        goto fail;
+    }
+
+    st = flatten(root_node, &root, in, out, err);
+    if (st != ST_OK) goto fail;
+    out->lo = (vec3){ root.lo[0], root.lo[1], root.lo[2] };
+    out->hi = (vec3){ root.hi[0], root.hi[1], root.hi[2] };
+    out->stats.leaf_sah_cost = kd_leaf_cost(b.n_prims);
+    build_free(&b, w, n_workers);
+    out->stats.build_seconds = now_seconds() - t_start;
+    return ST_OK;
+
+fail:
+    build_free(&b, w, n_workers);
+    kd_free(out);
+    return st;
+}
+
+void kd_free(KdTree *t)
+{
+    free(t->nodes);
+    free(t->leaf_prims);
+    t->nodes = NULL;
+    t->leaf_prims = NULL;
+    t->n_nodes = 0;
+    t->n_leaf_prims = 0;
+}

@@ -1,0 +1,136 @@
+/* atomic_file.c — temporary file, sync, rename (see atomic_file.h). */
+#include "base/atomic_file.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+void atomic_fail(AtomicFile *af, const char *step)
+{
+    if (af->failed_step) return;
+    af->failed_step = step;
+    af->failed_errno = errno ? errno : EIO;
+}
+
+static Status atomic_error(const AtomicFile *af, Error *err)
+{
+    return error_set(err, ST_IO, "cannot write %s%s'%s': %s: %s", af->what, af->what[0] ? " " : "", af->path,
+                     af->failed_step, strerror(af->failed_errno));
+}
+
+void atomic_abort(AtomicFile *af)
+{
+    if (af->f) fclose(af->f);
+    af->f = NULL;
+    if (af->tmp) unlink(af->tmp);
+    free(af->tmp);
+    af->tmp = NULL;
+}
+
+/* The temporary file lives in the target's folder so that the final rename stays within
+ * one filesystem, where it is atomic. */
+Status atomic_open(AtomicFile *af, const char *path, const char *what, Error *err)
+{
+    static const char suffix[] = ".tmp.XXXXXX";
+    memset(af, 0, sizeof *af);
+    af->path = path;
+    af->what = what ? what : "";
+    size_t n = strlen(path);
+    af->tmp = malloc(n + sizeof suffix);
+    if (!af->tmp) {
+        af->failed_step = "out of memory";
+        af->failed_errno = ENOMEM;
+        return atomic_error(af, err);
+    }
+    memcpy(af->tmp, path, n);
+    memcpy(af->tmp + n, suffix, sizeof suffix);
+    errno = 0;
+    int fd = mkostemp(af->tmp, O_CLOEXEC);
+    if (fd < 0) {
+        atomic_fail(af, "cannot create a temporary file beside it");
+        free(af->tmp);
+        af->tmp = NULL; /* nothing was created, so nothing to remove */
+        return atomic_error(af, err);
+    }
+    af->f = fdopen(fd, "wb");
+    if (!af->f) {
+        atomic_fail(af, "fdopen");
+        close(fd);
+        Status st = atomic_error(af, err);
+        atomic_abort(af);
+        return st;
+    }
+    return ST_OK;
+}
+
+void atomic_write(AtomicFile *af, const void *data, size_t n)
+{
+    if (af->failed_step || n == 0) return;
+    errno = 0;
+    if (fwrite(data, 1, n, af->f) != n) atomic_fail(af, "write");
+}
+
+/* mkstemp creates files 0600; give the file the mode an ordinary fopen() would have,
+ * 0666 less the umask. umask() can only be read by changing it, which would race with
+ * other threads creating files, so read it from /proc (022 when that is unavailable). */
+static mode_t ordinary_file_mode(void)
+{
+    unsigned mask = 022;
+    FILE *f = fopen("/proc/self/status", "re");
+    if (f) {
+        char line[256];
+        while (fgets(line, sizeof line, f))
+            if (sscanf(line, "Umask: %o", &mask) == 1) break;
+        fclose(f);
+    }
+    return (mode_t)(0666u & ~mask);
+}
+
+/* Syncs the folder so that the rename itself survives a power loss. Best effort: by now
+ * the file is complete and in place, so a failure here is not worth failing the write. */
+static void sync_parent_folder(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    char *dir = NULL;
+    if (!slash) dir = strdup(".");
+    else if (slash == path) dir = strdup("/");
+    else dir = strndup(path, (size_t)(slash - path));
+    if (!dir) return;
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) {
+        (void)fsync(fd);
+        close(fd);
+    }
+    free(dir);
+}
+
+/* Write errors such as a full disk often surface only at the flush or the sync. */
+Status atomic_commit(AtomicFile *af, Error *err)
+{
+    if (!af->failed_step) {
+        errno = 0;
+        if (fflush(af->f) != 0) atomic_fail(af, "write");
+    }
+    if (!af->failed_step && fsync(fileno(af->f)) != 0) atomic_fail(af, "fsync");
+    if (!af->failed_step && fchmod(fileno(af->f), ordinary_file_mode()) != 0) atomic_fail(af, "chmod");
+    if (!af->failed_step) {
+        errno = 0;
+        int rc = fclose(af->f);
+        af->f = NULL;
+        if (rc != 0) atomic_fail(af, "close");
+    }
+    if (!af->failed_step && rename(af->tmp, af->path) != 0)
+        atomic_fail(af, "cannot rename the temporary file over it");
+    if (af->failed_step) {
+        Status st = atomic_error(af, err);
+        atomic_abort(af);
+        return st;
+    }
+    free(af->tmp);
+    af->tmp = NULL;
+    sync_parent_folder(af->path);
+    return ST_OK;
+}

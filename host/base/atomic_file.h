@@ -1,0 +1,43 @@
+/*
+ * atomic_file.h — a file written whole or not at all: the bytes go to a temporary file
+ * beside the target, which is synced and renamed over it only once everything is
+ * written. A reader sees the old file or the complete new one, never a half-written
+ * one, whatever kills the process. Used by the images, the checkpoints and the kernel
+ * cache.
+ *
+ * The first failure is remembered (its step and errno) and later writes are skipped,
+ * so writers need not check each call; atomic_commit reports it.
+ */
+#ifndef CLPT_ATOMIC_FILE_H
+#define CLPT_ATOMIC_FILE_H
+
+#include "base/status.h"
+
+#include <stddef.h>
+#include <stdio.h>
+
+typedef struct {
+    const char *path;        /* the target */
+    const char *what;        /* for messages: "cannot write <what> '<path>'" ("" for none) */
+    char *tmp;               /* "<path>.tmp.XXXXXX" once created, else NULL */
+    FILE *f;
+    const char *failed_step; /* the first failure, or NULL */
+    int failed_errno;
+} AtomicFile;
+
+/* Creates the temporary file beside `path`. `what` names the kind of file in messages
+ * ("checkpoint"; "" for an image). On failure nothing is left behind. */
+Status atomic_open(AtomicFile *af, const char *path, const char *what, Error *err);
+/* Appends n bytes (skipped after a failure). */
+void atomic_write(AtomicFile *af, const void *data, size_t n);
+/* Records a failure of the writer's own (an encoder's), with errno or EIO. */
+void atomic_fail(AtomicFile *af, const char *step);
+/* Flushes, syncs, gives the file the mode an ordinary fopen() would (0666 less the
+ * umask), renames it over the target and syncs the folder. On any failure, including
+ * an earlier one, the temporary file is removed, the target left as it was, and the
+ * error is "cannot write <what> '<path>': <step>: <errno text>". */
+Status atomic_commit(AtomicFile *af, Error *err);
+/* Gives up: removes the temporary file; the target is untouched. */
+void atomic_abort(AtomicFile *af);
+
+#endif

@@ -1,0 +1,61 @@
+/*
+ * limit.h — the largest inputs clpt accepts, checked before anything is allocated for
+ * them, so that a corrupt header or an absurd setting gives a clear message instead of
+ * an out-of-memory kill, an overflowed size or hours of work. Every parser and option
+ * uses these constants and helpers; docs/hardening.md lists them with their reasons.
+ */
+#ifndef CLPT_LIMIT_H
+#define CLPT_LIMIT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "base/status.h"
+
+/* Image width and height, each. */
+#define CLPT_MAX_IMAGE_SIDE 16384
+/* Pixels in an image (16384 x 8192): the host film alone is 24 bytes a pixel, and every
+ * device and scheduling worker holds another film of the same size. */
+#define CLPT_MAX_PIXELS (16384u * 8192u)
+/* Samples per pixel. The film adds samples in 64-bit fixed point with 24 fractional
+ * bits, each clamped to 65536 (2^16): 2^20 samples stay below 2^60, far from overflow. */
+#define CLPT_MAX_SPP 1000000
+/* Longest path, in bounces after the camera ray. */
+#define CLPT_MAX_DEPTH 1024
+/* Nesting of scene `include`s (a file including itself stops here). */
+#define CLPT_MAX_INCLUDE_DEPTH 16
+/* Texels of one texture image (8192 x 8192): decoded to 4 bytes a texel (12 for HDR)
+ * and copied once more into the scene. Compressed images (PNG, JPEG) can claim this
+ * from a few bytes, so the size is read from the header before decoding. */
+#define CLPT_MAX_TEXTURE_PIXELS (8192u * 8192u)
+/* Any one input file: it is read whole into memory. */
+#define CLPT_MAX_FILE_BYTES ((uint64_t)4 << 30)
+
+/* Stringified, for messages built at compile time ("an integer in 1.." CLPT_STR(...)). */
+#define CLPT_STR_(x) #x
+#define CLPT_STR(x) CLPT_STR_(x)
+
+/* For readers of formats that announce counts before the data (PLY's `element vertex
+ * N`, a binary header's triangle count): fails with ST_INPUT unless `count` items of at
+ * least `min_bytes` each fit in the `bytes_left` bytes that remain of the file, so that
+ * no array is sized from a count the file cannot hold. `where` locates the count
+ * ("file.ply:3:16"), `what` names the items ("vertices"). The message reads
+ *   "<where>: the header declares <count> <what>, but the <bytes_left> bytes after it
+ *    hold at most <max> (at least <min_bytes> bytes each): the file is truncated or
+ *    the count is wrong" */
+Status limit_count(const char *where, const char *what, uint64_t count, uint64_t min_bytes,
+                   uint64_t bytes_left, Error *err);
+
+/* `count` elements of `size` bytes each, as a byte count: 0 and *bytes set when the
+ * product fits in size_t, -1 when it overflows. */
+int limit_bytes(uint64_t count, uint64_t size, size_t *bytes);
+
+/* Fails with `status` when width x height exceeds CLPT_MAX_PIXELS (each side is
+ * checked where it is read); `where` starts the message ("scene.scene:3:9", or the
+ * flags that set the size). */
+Status limit_pixels(uint64_t width, uint64_t height, Status status, const char *where, Error *err);
+
+/* Whether a file of `bytes` may be read; ST_INPUT naming `path` and the limit if not. */
+Status limit_file_size(const char *path, uint64_t bytes, Error *err);
+
+#endif /* CLPT_LIMIT_H */

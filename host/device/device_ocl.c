@@ -1,0 +1,563 @@
+/*
+ * device_ocl.c — an OpenCL device rendering batches as a wavefront.
+ *
+ * The scene is uploaded once. A batch is cut into waves of paths numbered sample-major
+ * over the image (entry.cl), so every wave is full whatever the image size. Per wave:
+ * k_raygen births every path, then each bounce runs k_intersect → k_shade → k_shadow
+ * over the live paths only (k_shade compacts survivors into the other queue and counts
+ * them), and k_film adds the wave into the batch's device film. Rays, hits and path
+ * states never leave the device.
+ *
+ * Every launch covers exactly the live paths: the host reads the two counts k_shade
+ * wrote before it launches the next bounce. So that the device never waits for that
+ * round trip, two waves are in flight, each with its own buffers: while the host waits
+ * for wave A's counts, the device runs wave B's bounce, and the other way round. (An
+ * earlier design launched each bounce over an upper bound without waiting; on PoCL the
+ * surplus work-items unbalanced its threads and it was 2-8% slower than exact launches.)
+ * Between batches the films are double buffered: the read-back of batch k runs while
+ * batch k + 1's kernels run, and take_film collects it afterwards (at most FILM_SLOTS
+ * batches in flight, see device.h).
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "device/device.h"
+#include "device/device_memory.h"
+#include "base/fault.h"
+#include "device/ocl_program.h"
+#include "base/timer.h"
+
+/* Work-group size for every launch: a multiple of every GPU's SIMD width; the global
+ * size is rounded up to it and the kernels ignore the excess work-items. On PoCL 3.1
+ * (CPU) sizes 8 to 128 measured the same. */
+#define OCL_LOCAL_SIZE 64u
+/* Device films: one being rendered into while the previous one is read back. */
+#define FILM_SLOTS 2
+/* Waves in flight, each with its own path buffers. */
+#define WAVE_SLOTS 2
+/* A batch smaller than two waves is still split in two (the second wave hides the
+ * first one's round trips), unless the halves would be smaller than this. */
+#define MIN_SPLIT_PATHS 4096u
+
+enum { SCENE_PARAMS, SCENE_NODES, SCENE_LEAF_PRIMS, SCENE_SPHERES, SCENE_TRIANGLES,
+       SCENE_BOXES, SCENE_PLANES, SCENE_MATERIALS, SCENE_LIGHTS, SCENE_SHADING,
+       SCENE_TEXTURES, SCENE_TEXELS, SCENE_PIXEL_MASK, SCENE_N };
+
+/* A batch's film on the device and where its read-back lands. */
+typedef struct {
+    cl_mem film;
+    int64_t *host;
+    cl_event read_done;     /* the read-back in flight; NULL while the slot is free */
+} FilmSlot;
+
+/* One wave in flight: its buffers, its kernels (arguments that never change are set
+ * once), and where it is. */
+typedef struct {
+    cl_mem paths, rays, hits, shadow_rays, queue_a, queue_b, shadow_queue, counts;
+    cl_kernel k_raygen, k_intersect, k_shade, k_shadow, k_film;
+    int active;
+    uint first_pixel, first_sample, n_paths;
+    uint bounce;            /* the bounce whose counts are on their way back */
+    uint live;              /* paths that entered it */
+    cl_mem cur, next;       /* its queue, and the queue it fills */
+    cl_event read;          /* the read-back of its counts */
+    cl_uint got[QUEUE_COUNT_STRIDE + 1];   /* count slots 2b + 1 and 2b + 2 */
+} WaveSlot;
+
+typedef struct {
+    OclDeviceInfo info;
+    cl_context ctx;
+    cl_command_queue queue;
+    cl_program program;
+    cl_kernel k_whitted;    /* the classic ray tracer (kernels/whitted.cl) */
+    uint integrator;        /* enum Integrator of the loaded scene */
+    cl_mem scene[SCENE_N];
+    WaveSlot waves[WAVE_SLOTS];
+    FilmSlot slots[FILM_SLOTS];
+    uint n_slots;           /* 2, or 1 when two films do not fit the device */
+    uint head, tail;        /* batches rendered and taken, counted from 0 */
+    uint max_bounces;       /* bounces 0 .. max_depth: 2 * max_bounces + 1 count slots */
+    uint wave_paths;        /* capacity of each wave's buffers */
+    size_t local_size;      /* 0: let the driver choose */
+    uint n_pixels;
+    cl_mem film;            /* the film the batch being rendered goes to */
+    uint64_t rays;          /* rays of the batch being rendered */
+} OclDevice;
+
+#define OCL_TRY(call_name, expr)                                                       \
+    do {                                                                               \
+        cl_int rc_ = (expr);                                                           \
+        if (rc_ != CL_SUCCESS) return ocl_fail(err, &od->info, call_name, rc_);        \
+    } while (0)
+
+static void release_mem(cl_mem *m)
+{
+    if (*m) clReleaseMemObject(*m);
+    *m = NULL;
+}
+
+static void release_event(cl_event *e)
+{
+    if (*e) clReleaseEvent(*e);
+    *e = NULL;
+}
+
+static void release_kernel(cl_kernel *k)
+{
+    if (*k) clReleaseKernel(*k);
+    *k = NULL;
+}
+
+static void release_buffers(OclDevice *od)
+{
+    /* nothing may still be writing into host memory that is about to be freed */
+    if (od->queue) clFinish(od->queue);
+    for (int i = 0; i < SCENE_N; i++) release_mem(&od->scene[i]);
+    for (int i = 0; i < WAVE_SLOTS; i++) {
+        WaveSlot *w = &od->waves[i];
+        release_event(&w->read);
+        cl_mem *ms[] = { &w->paths, &w->rays, &w->hits, &w->shadow_rays, &w->queue_a, &w->queue_b,
+                         &w->shadow_queue, &w->counts };
+        for (size_t j = 0; j < sizeof ms / sizeof ms[0]; j++) release_mem(ms[j]);
+        w->active = 0;
+    }
+    for (int i = 0; i < FILM_SLOTS; i++) {
+        release_event(&od->slots[i].read_done);
+        release_mem(&od->slots[i].film);
+        free(od->slots[i].host);
+        od->slots[i].host = NULL;
+    }
+    od->head = od->tail = 0;
+}
+
+/* A device buffer of `bytes` (at least 16: OpenCL has no empty buffers), filled from
+ * `src` when given. */
+static Status make_buffer(OclDevice *od, cl_mem_flags flags, size_t bytes, const void *src,
+                          const char *what, cl_mem *out, Error *err)
+{
+    size_t size = bytes < 16 ? 16 : bytes;
+    /* CL_MEM_COPY_HOST_PTR copies `size` bytes: a source shorter than the 16-byte
+     * minimum (a leaf list of one index) goes through a zero-padded copy instead of
+     * being read past its end. */
+    unsigned char padded[16] = { 0 };
+    if (src && bytes && bytes < size) {
+        memcpy(padded, src, bytes);
+        src = padded;
+    }
+    if ((cl_ulong)size > od->info.max_alloc)
+        return error_set(err, ST_DEVICE,
+                         "device '%s': the %s need %.1f MiB, more than the device's largest allocation (%.1f MiB)",
+                         od->info.name, what, (double)size / 1048576.0, (double)od->info.max_alloc / 1048576.0);
+    cl_int rc;
+    *out = clCreateBuffer(od->ctx, flags | (src && bytes ? CL_MEM_COPY_HOST_PTR : 0), size,
+                          src && bytes ? (void *)(uintptr_t)src : NULL, &rc);
+    if (rc != CL_SUCCESS) {
+        ocl_fail(err, &od->info, "clCreateBuffer", rc);
+        error_prefix(err, "allocating %.1f MiB for the %s", (double)size / 1048576.0, what);
+        return ST_DEVICE;
+    }
+    return ST_OK;
+}
+
+static Status set_arg(OclDevice *od, cl_kernel k, cl_uint i, size_t size, const void *value, Error *err)
+{
+    OCL_TRY("clSetKernelArg", clSetKernelArg(k, i, size, value));
+    return ST_OK;
+}
+
+#define ARG(k, i, v) do { Status st_ = set_arg(od, k, i, sizeof(v), &(v), err); if (st_) return st_; } while (0)
+
+static Status set_scene_args(OclDevice *od, cl_kernel k, Error *err)
+{
+    for (cl_uint i = 0; i < SCENE_N; i++) ARG(k, i, od->scene[i]);
+    return ST_OK;
+}
+
+/* The arguments of a wave's kernels that stay the same for the whole render, set once
+ * after the upload; per launch only queues, counts, positions and the film change. */
+static Status set_fixed_args(OclDevice *od, WaveSlot *w, Error *err)
+{
+    Status st;
+    if ((st = set_scene_args(od, w->k_intersect, err)) || (st = set_scene_args(od, w->k_shade, err)) ||
+        (st = set_scene_args(od, w->k_shadow, err)))
+        return st;
+    cl_kernel k = w->k_raygen;
+    ARG(k, 0, od->scene[SCENE_PARAMS]);
+    ARG(k, 3, od->n_pixels);
+    ARG(k, 5, w->paths);
+    ARG(k, 6, w->rays);
+    ARG(k, 7, w->queue_a);
+    k = w->k_intersect;
+    ARG(k, SCENE_N + 2, w->rays);
+    ARG(k, SCENE_N + 3, w->hits);
+    k = w->k_shade;
+    ARG(k, SCENE_N + 2, w->rays);
+    ARG(k, SCENE_N + 3, w->hits);
+    ARG(k, SCENE_N + 4, w->paths);
+    ARG(k, SCENE_N + 5, w->shadow_rays);
+    ARG(k, SCENE_N + 7, w->shadow_queue);
+    ARG(k, SCENE_N + 8, w->counts);
+    k = w->k_shadow;
+    ARG(k, SCENE_N + 0, w->shadow_queue);
+    ARG(k, SCENE_N + 2, w->shadow_rays);
+    ARG(k, SCENE_N + 3, w->paths);
+    k = w->k_film;
+    ARG(k, 0, w->paths);
+    ARG(k, 2, od->n_pixels);
+    return ST_OK;
+}
+
+static Status launch(OclDevice *od, cl_kernel k, const char *name, uint n, Error *err)
+{
+    if (n == 0) return ST_OK;
+    size_t local = od->local_size;
+    size_t global = local ? ((size_t)n + local - 1) / local * local : (size_t)n;
+    cl_int rc = clEnqueueNDRangeKernel(od->queue, k, 1, NULL, &global, local ? &local : NULL, 0, NULL, NULL);
+    if (rc != CL_SUCCESS) {
+        ocl_fail(err, &od->info, "clEnqueueNDRangeKernel", rc);
+        error_prefix(err, "kernel %s over %u items", name, n);
+        return ST_DEVICE;
+    }
+    return ST_OK;
+}
+
+static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
+{
+    OclDevice *od = d->impl;
+    double t0 = timer_now();
+    release_buffers(od);
+    const RenderParams *p = &s->params;
+    struct { const void *src; size_t bytes; const char *what; } in[SCENE_N] = {
+        { p, sizeof *p, "render parameters" },
+        { s->nodes, (size_t)p->n_nodes * sizeof(KdNode), "kd-tree nodes" },
+        { s->leaf_prims, (size_t)p->n_leaf_prims * sizeof(uint), "kd-tree leaf lists" },
+        { s->spheres, (size_t)p->n_spheres * sizeof(Sphere), "spheres" },
+        { s->triangles, (size_t)p->n_triangles * sizeof(Triangle), "triangles" },
+        { s->boxes, (size_t)p->n_boxes * sizeof(Box), "boxes" },
+        { s->planes, (size_t)p->n_planes * sizeof(Plane), "planes" },
+        { s->materials, (size_t)s->n_materials * sizeof(Material), "materials" },
+        { s->lights, (size_t)p->n_lights * sizeof(Light), "lights" },
+        { s->shading, (size_t)s->n_shading * sizeof(TriShading), "shading normals" },
+        { s->textures, (size_t)p->n_textures * sizeof(Texture), "textures" },
+        { s->texels, s->n_texels * sizeof(uint), "texture images" },
+        { s->pixel_mask, s->pixel_mask ? (size_t)p->width * p->height * sizeof(uint) : 0, "pixel mask" },
+    };
+    uint n_pixels = p->width * p->height;
+    uint wave = od->wave_paths;
+    od->max_bounces = p->max_depth + 1u;
+    size_t counts_bytes = (2u * (size_t)od->max_bounces + 1u) * QUEUE_COUNT_STRIDE * sizeof(cl_uint);
+    size_t film_bytes = (size_t)n_pixels * 3u * sizeof(cl_long);
+    /* Every buffer below is checked against the device before the first is allocated:
+     * double-buffered films when they fit, else one (the device then waits for each
+     * read-back, nothing worse). */
+    /* one entry per allocation below: each must fit the largest allocation, all of them
+     * the device's memory */
+    DeviceBuffer fit[SCENE_N + WAVE_SLOTS * 8 + FILM_SLOTS];
+    size_t n_fit = 0;
+    for (int i = 0; i < SCENE_N; i++) fit[n_fit++] = (DeviceBuffer){ in[i].what, in[i].bytes };
+    static const char *const wave_names[WAVE_SLOTS][5] = {
+        { "wave 1 path states", "wave 1 rays", "wave 1 hits", "wave 1 path queues", "wave 1 counters" },
+        { "wave 2 path states", "wave 2 rays", "wave 2 hits", "wave 2 path queues", "wave 2 counters" },
+    };
+    for (int i = 0; i < WAVE_SLOTS; i++) {
+        fit[n_fit++] = (DeviceBuffer){ wave_names[i][0], (uint64_t)wave * sizeof(PathState) };
+        fit[n_fit++] = (DeviceBuffer){ wave_names[i][1], (uint64_t)wave * sizeof(Ray) };   /* rays */
+        fit[n_fit++] = (DeviceBuffer){ wave_names[i][1], (uint64_t)wave * sizeof(Ray) };   /* shadow rays */
+        fit[n_fit++] = (DeviceBuffer){ wave_names[i][2], (uint64_t)wave * sizeof(Hit) };
+        for (int q = 0; q < 3; q++) fit[n_fit++] = (DeviceBuffer){ wave_names[i][3], (uint64_t)wave * sizeof(uint) };
+        fit[n_fit++] = (DeviceBuffer){ wave_names[i][4], counts_bytes };
+    }
+    fit[n_fit++] = (DeviceBuffer){ "film", film_bytes };
+    Status st;
+    fit[n_fit] = (DeviceBuffer){ "second film", film_bytes };
+    if (device_memory_check(od->info.name, od->info.global_mem, od->info.max_alloc, fit, n_fit + 1, NULL) == ST_OK)
+        od->n_slots = 2;
+    else if ((st = device_memory_check(od->info.name, od->info.global_mem, od->info.max_alloc, fit, n_fit, err)))
+        return st;
+    else
+        od->n_slots = 1;
+    for (int i = 0; i < SCENE_N; i++)
+        if ((st = make_buffer(od, CL_MEM_READ_ONLY, in[i].bytes, in[i].src, in[i].what, &od->scene[i], err)))
+            return st;
+    cl_mem_flags rw = CL_MEM_READ_WRITE;
+    for (int i = 0; i < WAVE_SLOTS; i++) {
+        WaveSlot *w = &od->waves[i];
+        if ((st = make_buffer(od, rw, (size_t)wave * sizeof(PathState), NULL, "path states", &w->paths, err)) ||
+            (st = make_buffer(od, rw, (size_t)wave * sizeof(Ray), NULL, "rays", &w->rays, err)) ||
+            (st = make_buffer(od, rw, (size_t)wave * sizeof(Hit), NULL, "hits", &w->hits, err)) ||
+            (st = make_buffer(od, rw, (size_t)wave * sizeof(Ray), NULL, "shadow rays", &w->shadow_rays, err)) ||
+            (st = make_buffer(od, rw, (size_t)wave * sizeof(uint), NULL, "path queue", &w->queue_a, err)) ||
+            (st = make_buffer(od, rw, (size_t)wave * sizeof(uint), NULL, "path queue", &w->queue_b, err)) ||
+            (st = make_buffer(od, rw, (size_t)wave * sizeof(uint), NULL, "shadow queue", &w->shadow_queue, err)) ||
+            (st = make_buffer(od, rw, counts_bytes, NULL, "queue counters", &w->counts, err)))
+            return st;
+    }
+    cl_long zero = 0;
+    for (uint i = 0; i < od->n_slots; i++) {
+        FilmSlot *fs = &od->slots[i];
+        if ((st = make_buffer(od, rw, film_bytes, NULL, "film", &fs->film, err))) return st;
+        if (!(fs->host = malloc(film_bytes < 16 ? 16 : film_bytes)))
+            return error_set(err, ST_INTERNAL, "out of memory for the read-back of the film");
+        OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, fs->film, &zero, sizeof zero, 0,
+                                                           film_bytes < 16 ? 16 : film_bytes, 0, NULL, NULL));
+    }
+    OCL_TRY("clFinish", clFinish(od->queue));
+    od->n_pixels = n_pixels;
+    for (int i = 0; i < WAVE_SLOTS; i++)
+        if ((st = set_fixed_args(od, &od->waves[i], err))) return st;
+    if ((st = set_scene_args(od, od->k_whitted, err))) return st;
+    od->integrator = p->integrator;
+    d->n_pixels = n_pixels;
+    d->max_in_flight = od->n_slots;
+    d->counters.upload_seconds += timer_now() - t0;
+    return ST_OK;
+}
+
+/* Launches bounce b of wave w over its `n` live paths, then the read-back of the two
+ * counts k_shade leaves: the bounce's shadow rays and the next bounce's live paths. */
+static Status bounce_launch(OclDevice *od, WaveSlot *w, uint b, uint n, Error *err)
+{
+    Status st;
+    cl_uint slot = 2u * b + 1u;
+    cl_kernel k = w->k_intersect;
+    ARG(k, SCENE_N + 0, w->cur);
+    ARG(k, SCENE_N + 1, n);
+    if ((st = launch(od, k, "k_intersect", n, err))) return st;
+    k = w->k_shade;
+    ARG(k, SCENE_N + 0, w->cur);
+    ARG(k, SCENE_N + 1, n);
+    ARG(k, SCENE_N + 6, w->next);
+    ARG(k, SCENE_N + 9, slot);
+    if ((st = launch(od, k, "k_shade", n, err))) return st;
+    OCL_TRY("clEnqueueReadBuffer",
+            clEnqueueReadBuffer(od->queue, w->counts, CL_FALSE, (size_t)slot * QUEUE_COUNT_STRIDE * sizeof(cl_uint),
+                                sizeof w->got, w->got, 0, NULL, &w->read));
+    OCL_TRY("clFlush", clFlush(od->queue));
+    w->bounce = b;
+    w->live = n;
+    return ST_OK;
+}
+
+/* Starts a wave of path numbers [first_pixel, first_pixel + n_paths) counted from pixel
+ * 0 of sample first_sample (entry.cl). */
+static Status wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint first_sample, uint n_paths, Error *err)
+{
+    Status st;
+    cl_uint zero = 0;
+    OCL_TRY("clEnqueueFillBuffer",
+            clEnqueueFillBuffer(od->queue, w->counts, &zero, sizeof zero, 0,
+                                (2u * (size_t)od->max_bounces + 1u) * QUEUE_COUNT_STRIDE * sizeof zero, 0, NULL, NULL));
+    cl_kernel k = w->k_raygen;
+    ARG(k, 1, first_pixel);
+    ARG(k, 2, first_sample);
+    ARG(k, 4, n_paths);
+    if ((st = launch(od, k, "k_raygen", n_paths, err))) return st;
+    w->first_pixel = first_pixel;
+    w->first_sample = first_sample;
+    w->n_paths = n_paths;
+    w->cur = w->queue_a;
+    w->next = w->queue_b;
+    w->active = 1;
+    return bounce_launch(od, w, 0, n_paths, err);
+}
+
+/* Waits for the counts of the wave's last bounce, then launches its shadow rays and
+ * its next bounce, or, when no path is left, adds the wave into the film. */
+static Status wave_advance(OclDevice *od, WaveSlot *w, Error *err)
+{
+    Status st;
+    cl_int rc = clWaitForEvents(1, &w->read);
+    release_event(&w->read);
+    if (rc != CL_SUCCESS) return ocl_fail(err, &od->info, "clWaitForEvents", rc);
+    uint shadows = w->got[0], next = w->got[QUEUE_COUNT_STRIDE];
+    od->rays += (uint64_t)w->live + shadows;
+    cl_kernel k = w->k_shadow;
+    ARG(k, SCENE_N + 1, shadows);
+    if ((st = launch(od, k, "k_shadow", shadows, err))) return st;
+    if (next > 0 && w->bounce + 1u < od->max_bounces) {
+        cl_mem t = w->cur;
+        w->cur = w->next;
+        w->next = t;
+        return bounce_launch(od, w, w->bounce + 1u, next, err);
+    }
+    k = w->k_film;
+    ARG(k, 1, w->first_pixel);
+    ARG(k, 3, w->n_paths);
+    ARG(k, 4, od->film);
+    w->active = 0;
+    return launch(od, k, "k_film", w->n_paths < od->n_pixels ? w->n_paths : od->n_pixels, err);
+}
+
+/* The classic ray tracer's batch (kernels/whitted.cl): per wave, one k_whitted launch
+ * computes every sample whole and counts its rays, then k_film adds the wave as for the
+ * path tracer. Waves are numbered as in entry.cl. */
+static Status render_whitted(OclDevice *od, uint first_sample, uint64_t total, Error *err)
+{
+    WaveSlot *w = &od->waves[0];
+    Status st;
+    for (uint64_t next_path = 0; next_path < total;) {
+        uint n = total - next_path < od->wave_paths ? (uint)(total - next_path) : od->wave_paths;
+        uint first_pixel = (uint)(next_path % od->n_pixels), sample = first_sample + (uint)(next_path / od->n_pixels);
+        cl_uint zero = 0, count = 0;
+        OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, w->counts, &zero, sizeof zero, 0,
+                                                           sizeof zero, 0, NULL, NULL));
+        cl_kernel k = od->k_whitted;
+        ARG(k, SCENE_N + 0, first_pixel);
+        ARG(k, SCENE_N + 1, sample);
+        ARG(k, SCENE_N + 2, od->n_pixels);
+        ARG(k, SCENE_N + 3, n);
+        ARG(k, SCENE_N + 4, w->paths);
+        ARG(k, SCENE_N + 5, w->counts);
+        if ((st = launch(od, k, "k_whitted", n, err))) return st;
+        k = w->k_film;
+        ARG(k, 1, first_pixel);
+        ARG(k, 3, n);
+        ARG(k, 4, od->film);
+        if ((st = launch(od, k, "k_film", n < od->n_pixels ? n : od->n_pixels, err))) return st;
+        OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, w->counts, CL_TRUE, 0, sizeof count, &count,
+                                                           0, NULL, NULL));
+        od->rays += count;
+        next_path += n;
+    }
+    return ST_OK;
+}
+
+static Status ocl_render(Device *d, uint first_sample, uint count, Error *err)
+{
+    OclDevice *od = d->impl;
+    FilmSlot *fs = &od->slots[od->head % od->n_slots];
+    if (fs->read_done)
+        return error_set(err, ST_INTERNAL, "device '%s': more than %u batches in flight", od->info.name, od->n_slots);
+    uint64_t n_pixels = od->n_pixels, total = n_pixels * count;
+    /* Waves of equal size, at least two when the batch is big enough to split. */
+    uint64_t n_waves = (total + od->wave_paths - 1) / od->wave_paths;
+    if (n_waves < WAVE_SLOTS && total >= (uint64_t)WAVE_SLOTS * MIN_SPLIT_PATHS) n_waves = WAVE_SLOTS;
+    uint64_t wave = (total + n_waves - 1) / n_waves, next_path = 0;
+    od->film = fs->film;
+    od->rays = 0;
+    Status st = ST_OK;
+    for (int i = 0; i < WAVE_SLOTS; i++) od->waves[i].active = 0;
+    if (od->integrator != INTEGRATOR_PATH) {
+        st = render_whitted(od, first_sample, total, err);
+        total = 0;   /* the wave loop below then has nothing to do */
+    }
+    for (; st == ST_OK;) {
+        int any = 0;
+        for (int i = 0; i < WAVE_SLOTS && st == ST_OK; i++) {
+            WaveSlot *w = &od->waves[i];
+            if (w->active) st = wave_advance(od, w, err);
+            if (st == ST_OK && !w->active && next_path < total) {
+                uint n = total - next_path < wave ? (uint)(total - next_path) : (uint)wave;
+                st = wave_start(od, w, (uint)(next_path % n_pixels), first_sample + (uint)(next_path / n_pixels), n, err);
+                next_path += n;
+            }
+            any |= w->active;
+        }
+        if (st != ST_OK || !any) break;
+    }
+    if (st != ST_OK) {
+        for (int i = 0; i < WAVE_SLOTS; i++) release_event(&od->waves[i].read);
+        return st;
+    }
+    /* The film comes back while the next batch renders; zeroed on the device after. */
+    size_t bytes = (size_t)n_pixels * 3u * sizeof(cl_long);
+    OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, fs->film, CL_FALSE, 0, bytes, fs->host, 0, NULL,
+                                                       &fs->read_done));
+    cl_long zero = 0;
+    OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, fs->film, &zero, sizeof zero, 0, bytes, 0, NULL, NULL));
+    OCL_TRY("clFlush", clFlush(od->queue));
+    od->head++;
+    d->counters.samples += n_pixels * count;
+    d->counters.rays += od->rays;
+    return ST_OK;
+}
+
+static Status ocl_take_film(Device *d, int64_t *film, Error *err)
+{
+    OclDevice *od = d->impl;
+    FilmSlot *fs = &od->slots[od->tail % od->n_slots];
+    if (!fs->read_done) return error_set(err, ST_INTERNAL, "device '%s': no batch to take", od->info.name);
+    OCL_TRY("clWaitForEvents", clWaitForEvents(1, &fs->read_done));
+    release_event(&fs->read_done);
+    od->tail++;
+    size_t n = (size_t)od->n_pixels * 3u;
+    for (size_t i = 0; i < n; i++) film[i] += fs->host[i];
+    return ST_OK;
+}
+
+static void ocl_destroy(Device *d)
+{
+    OclDevice *od = d->impl;
+    if (od) {
+        release_buffers(od);
+        for (int i = 0; i < WAVE_SLOTS; i++) {
+            WaveSlot *w = &od->waves[i];
+            cl_kernel *ks[] = { &w->k_raygen, &w->k_intersect, &w->k_shade, &w->k_shadow, &w->k_film };
+            for (size_t j = 0; j < sizeof ks / sizeof ks[0]; j++) release_kernel(ks[j]);
+        }
+        release_kernel(&od->k_whitted);
+        if (od->program) clReleaseProgram(od->program);
+        if (od->queue) clReleaseCommandQueue(od->queue);
+        if (od->ctx) clReleaseContext(od->ctx);
+        free(od);
+    }
+    free(d);
+}
+
+static const DeviceOps ocl_ops = { ocl_load_scene, ocl_render, ocl_take_film, ocl_destroy };
+
+static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error *err)
+{
+    cl_int rc;
+    cl_context_properties props[] = { CL_CONTEXT_PLATFORM, (cl_context_properties)od->info.platform, 0 };
+    od->ctx = clCreateContext(props, 1, &od->info.id, NULL, NULL, &rc);
+    if (rc != CL_SUCCESS) return ocl_fail(err, &od->info, "clCreateContext", rc);
+    od->queue = clCreateCommandQueue(od->ctx, od->info.id, 0, &rc);
+    if (rc != CL_SUCCESS) return ocl_fail(err, &od->info, "clCreateCommandQueue", rc);
+    OclProgramStats ps;
+    Status st = ocl_program_build(od->ctx, &od->info, cfg ? cfg->kernel_dir : NULL,
+                                  fault_build_options(d->desc.index), &od->program, &ps, err);
+    if (st) return st;
+    d->counters.compile_seconds = ps.seconds;
+    d->counters.from_cache = ps.from_cache;
+    /* each wave has its own kernel objects, so that their fixed arguments are set once */
+    for (int i = 0; i < WAVE_SLOTS; i++) {
+        WaveSlot *w = &od->waves[i];
+        if ((st = ocl_program_kernel(od->program, &od->info, "k_raygen", &w->k_raygen, err)) ||
+            (st = ocl_program_kernel(od->program, &od->info, "k_intersect", &w->k_intersect, err)) ||
+            (st = ocl_program_kernel(od->program, &od->info, "k_shade", &w->k_shade, err)) ||
+            (st = ocl_program_kernel(od->program, &od->info, "k_shadow", &w->k_shadow, err)) ||
+            (st = ocl_program_kernel(od->program, &od->info, "k_film", &w->k_film, err)))
+            return st;
+    }
+    if ((st = ocl_program_kernel(od->program, &od->info, "k_whitted", &od->k_whitted, err))) return st;
+    int gpu = (od->info.type & CL_DEVICE_TYPE_GPU) != 0;
+    /* A GPU needs about a million paths in flight to hide memory latency; a CPU is full
+     * with far fewer (on PoCL 2^16 to 2^18 measured the same, 2^14 a few percent and
+     * 2^12 a tenth slower). */
+    od->wave_paths = cfg && cfg->wave_paths ? cfg->wave_paths : (gpu ? (1u << 20) : (1u << 16));
+    od->local_size = od->info.max_work_group >= OCL_LOCAL_SIZE ? OCL_LOCAL_SIZE : 0;
+    return ST_OK;
+}
+
+Status device_ocl_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err)
+{
+    Device *d = calloc(1, sizeof *d);
+    OclDevice *od = calloc(1, sizeof *od);
+    if (!d || !od) {
+        free(d);
+        free(od);
+        return error_set(err, ST_INTERNAL, "out of memory opening device '%s'", desc->name);
+    }
+    d->ops = &ocl_ops;
+    d->desc = *desc;
+    d->impl = od;
+    od->info = desc->ocl;
+    Status st = ocl_setup(d, od, cfg, err);
+    if (st) {
+        ocl_destroy(d);
+        return st;
+    }
+    *out = d;
+    return ST_OK;
+}

@@ -1,0 +1,225 @@
+/*
+ * device_scalar.c — the scalar C device: the kernel stage functions of kernels/ compiled as
+ * plain C (one source with the OpenCL build, through kernels/compat.h) and run by a pool
+ * of pthreads. It is the reference the tests compare OpenCL against, and it renders when
+ * no OpenCL platform is installed.
+ *
+ * Where the OpenCL device runs the stages as a wavefront (all paths intersect, then all
+ * shade, ...), this device runs each path from birth to death before the next, calling
+ * the same stage functions in the same order, so each path computes the same bits while
+ * its state stays in cache.
+ */
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "device/device.h"
+
+/* The kernel sources, compiled here as C. */
+#include "film.cl"
+#include "raygen.cl"
+#include "shade.cl"
+#include "traverse.cl"
+#include "whitted.cl"
+
+/* Paths (pixels x samples of the batch) handed to a worker at a time: small enough that
+ * the workers finish a batch together (a chunk takes well under a millisecond), large
+ * enough that taking work is rare. */
+#define CPU_CHUNK_PATHS 1024u
+
+/* The workers live as long as the device and wait between batches, so that a batch
+ * costs no thread creation; `generation` counts the batches handed out. */
+typedef struct {
+    RenderParams params;
+    SceneView view;
+    int64_t *film;
+    int threads;
+    pthread_t tids[256];
+    int started;                 /* workers running (0: the calling thread renders) */
+    pthread_mutex_t lock;
+    pthread_cond_t go, done;
+    unsigned generation;
+    int working;                 /* workers still on the current batch */
+    int quit;
+    /* the batch being rendered */
+    uint first_sample, count, chunk_pixels;
+    atomic_uint next_chunk;
+    atomic_ullong rays;
+} CpuDevice;
+
+/* Renders one path to its end; returns the number of rays it traced. */
+static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *radiance)
+{
+    PathState ps;
+    Ray ray, shadow;
+    memset(&shadow, 0, sizeof shadow);   /* written by shade_path only when it traces one */
+    uint64_t rays = 0;
+    raygen_path(sc->params, pixel, sample, &ps, &ray);
+    for (;;) {
+        Hit hit = trace_closest(sc, ray);
+        rays++;
+        uint r = shade_path(sc, &ray, hit, &ps, &shadow);
+        if (r & SHADE_SHADOW) {
+            shadow_resolve(&ps, trace_any(sc, shadow));
+            rays++;
+        }
+        if (!(r & SHADE_CONTINUE)) break;
+    }
+    *radiance = ps.radiance;
+    return rays;
+}
+
+/* Renders chunks of the current batch until none is left. */
+static void render_chunks(CpuDevice *cd)
+{
+    uint n_pixels = cd->params.width * cd->params.height;
+    uint64_t rays = 0;
+    for (;;) {
+        uint chunk = atomic_fetch_add(&cd->next_chunk, 1u);
+        if (chunk >= (n_pixels + cd->chunk_pixels - 1) / cd->chunk_pixels) break;
+        uint begin = chunk * cd->chunk_pixels;
+        uint end = n_pixels - begin > cd->chunk_pixels ? begin + cd->chunk_pixels : n_pixels;
+        for (uint pixel = begin; pixel < end; pixel++) {
+            for (uint s = 0; s < cd->count; s++) {
+                vec3 L;
+                if (cd->params.integrator == INTEGRATOR_PATH) {
+                    rays += render_path(&cd->view, pixel, cd->first_sample + s, &L);
+                } else {
+                    /* the classic ray tracer and the auxiliary images: kernels/whitted.cl */
+                    uint n = 0;
+                    L = whitted_sample(&cd->view, pixel, cd->first_sample + s, &n);
+                    rays += n;
+                }
+                film_add(cd->film, pixel, L);
+            }
+        }
+    }
+    atomic_fetch_add(&cd->rays, (unsigned long long)rays);
+}
+
+static void *cpu_worker(void *arg)
+{
+    CpuDevice *cd = arg;
+    unsigned seen = 0;
+    for (;;) {
+        pthread_mutex_lock(&cd->lock);
+        while (cd->generation == seen && !cd->quit) pthread_cond_wait(&cd->go, &cd->lock);
+        seen = cd->generation;
+        int quit = cd->quit;
+        pthread_mutex_unlock(&cd->lock);
+        if (quit) return NULL;
+        render_chunks(cd);
+        pthread_mutex_lock(&cd->lock);
+        if (--cd->working == 0) pthread_cond_signal(&cd->done);
+        pthread_mutex_unlock(&cd->lock);
+    }
+}
+
+static Status cpu_load_scene(Device *d, const DeviceScene *scene, Error *err)
+{
+    CpuDevice *cd = d->impl;
+    uint n_pixels = scene->params.width * scene->params.height;
+    free(cd->film);
+    cd->film = calloc((size_t)n_pixels * 3u, sizeof *cd->film);
+    if (!cd->film) return error_set(err, ST_INTERNAL, "scalar device: out of memory for the film");
+    /* The scene arrays are the host's own: this device reads them in place. */
+    cd->params = scene->params;
+    cd->view.params = &cd->params;
+    cd->view.nodes = scene->nodes;
+    cd->view.leaf_prims = scene->leaf_prims;
+    cd->view.spheres = scene->spheres;
+    cd->view.triangles = scene->triangles;
+    cd->view.boxes = scene->boxes;
+    cd->view.planes = scene->planes;
+    cd->view.materials = scene->materials;
+    cd->view.lights = scene->lights;
+    cd->view.shading = scene->shading;
+    cd->view.textures = scene->textures;
+    cd->view.texels = scene->texels;
+    cd->view.pixel_mask = scene->pixel_mask;
+    d->n_pixels = n_pixels;
+    d->max_in_flight = 1;
+    return ST_OK;
+}
+
+static Status cpu_render(Device *d, uint first_sample, uint count, Error *err)
+{
+    CpuDevice *cd = d->impl;
+    cd->first_sample = first_sample;
+    cd->count = count;
+    cd->chunk_pixels = CPU_CHUNK_PATHS / count ? CPU_CHUNK_PATHS / count : 1u;
+    atomic_store(&cd->next_chunk, 0u);
+    atomic_store(&cd->rays, 0ull);
+    if (cd->started == 0) {
+        render_chunks(cd);   /* no worker could start: work on this thread */
+    } else {
+        pthread_mutex_lock(&cd->lock);
+        cd->working = cd->started;
+        cd->generation++;
+        pthread_cond_broadcast(&cd->go);
+        while (cd->working > 0) pthread_cond_wait(&cd->done, &cd->lock);
+        pthread_mutex_unlock(&cd->lock);
+    }
+    d->counters.rays += atomic_load(&cd->rays);
+    d->counters.samples += (uint64_t)d->n_pixels * count;
+    (void)err;
+    return ST_OK;
+}
+
+static Status cpu_take_film(Device *d, int64_t *film, Error *err)
+{
+    CpuDevice *cd = d->impl;
+    size_t n = (size_t)d->n_pixels * 3u;
+    for (size_t i = 0; i < n; i++) film[i] += cd->film[i];
+    memset(cd->film, 0, n * sizeof *cd->film);
+    (void)err;
+    return ST_OK;
+}
+
+static void cpu_destroy(Device *d)
+{
+    CpuDevice *cd = d->impl;
+    if (cd) {
+        pthread_mutex_lock(&cd->lock);
+        cd->quit = 1;
+        pthread_cond_broadcast(&cd->go);
+        pthread_mutex_unlock(&cd->lock);
+        for (int i = 0; i < cd->started; i++) pthread_join(cd->tids[i], NULL);
+        pthread_cond_destroy(&cd->go);
+        pthread_cond_destroy(&cd->done);
+        pthread_mutex_destroy(&cd->lock);
+        free(cd->film);
+    }
+    free(cd);
+    free(d);
+}
+
+static const DeviceOps cpu_ops = { cpu_load_scene, cpu_render, cpu_take_film, cpu_destroy };
+
+Status device_scalar_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err)
+{
+    Device *d = calloc(1, sizeof *d);
+    CpuDevice *cd = calloc(1, sizeof *cd);
+    if (!d || !cd) {
+        free(d);
+        free(cd);
+        return error_set(err, ST_INTERNAL, "scalar device: out of memory");
+    }
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int threads = cfg && cfg->threads > 0 ? cfg->threads : (int)(cores > 0 ? cores : 1);
+    cd->threads = threads > 256 ? 256 : threads;
+    pthread_mutex_init(&cd->lock, NULL);
+    pthread_cond_init(&cd->go, NULL);
+    pthread_cond_init(&cd->done, NULL);
+    /* fewer workers than asked when threads cannot be created; none: the caller's */
+    while (cd->started < cd->threads && pthread_create(&cd->tids[cd->started], NULL, cpu_worker, cd) == 0)
+        cd->started++;
+    d->ops = &cpu_ops;
+    d->desc = *desc;
+    snprintf(d->desc.name, sizeof d->desc.name, "scalar (%d thread%s)", cd->threads, cd->threads == 1 ? "" : "s");
+    d->impl = cd;
+    *out = d;
+    return ST_OK;
+}

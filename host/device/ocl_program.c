@@ -1,0 +1,404 @@
+#include "device/ocl_program.h"
+
+#include <errno.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "base/atomic_file.h"
+#include "base/sha256.h"
+
+/* Cache file layout (integers little-endian):
+ *   0  8  magic "CLPTKBIN"
+ *   8  4  format version (OCLP__VERSION)
+ *  12  4  zero
+ *  16  8  payload length in bytes
+ *  24 32  SHA-256 key of the entry (also its file name), so a misplaced file is refused
+ *  56 32  SHA-256 of the payload, so a torn or flipped file is refused
+ *  88     payload: the device's CL_PROGRAM_BINARIES entry */
+#define OCLP__MAGIC "CLPTKBIN"
+#define OCLP__VERSION 1u
+#define OCLP__HEADER 88
+/* No device binary of this program comes near this; a larger length is corruption. */
+#define OCLP__MAX_PAYLOAD ((uint64_t)1 << 30)
+
+static double oclp__now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static void oclp__put_le(unsigned char *p, uint64_t v, int bytes)
+{
+    for (int i = 0; i < bytes; i++) p[i] = (unsigned char)(v >> (8 * i));
+}
+
+static uint64_t oclp__get_le(const unsigned char *p, int bytes)
+{
+    uint64_t v = 0;
+    for (int i = 0; i < bytes; i++) v |= (uint64_t)p[i] << (8 * i);
+    return v;
+}
+
+/* ---------------------------------------------------------------- source and options */
+
+/* Reads a whole file into a NUL-terminated heap buffer. */
+static Status oclp__read_file(const char *path, char **text, size_t *len, Error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return error_set(err, ST_IO, "%s: cannot open: %s", path, strerror(errno));
+    char *buf = NULL;
+    size_t n = 0, cap = 0;
+    for (;;) {
+        if (n + 4096 + 1 > cap) {
+            cap = (n + 4096 + 1) * 2;
+            char *grown = realloc(buf, cap);
+            if (!grown) {
+                free(buf);
+                fclose(f);
+                return error_set(err, ST_INTERNAL, "%s: out of memory reading it", path);
+            }
+            buf = grown;
+        }
+        size_t got = fread(buf + n, 1, cap - n - 1, f);
+        n += got;
+        if (got == 0) break;
+    }
+    int failed = ferror(f);
+    fclose(f);
+    if (failed) {
+        free(buf);
+        return error_set(err, ST_IO, "%s: read error", path);
+    }
+    buf[n] = '\0';
+    *text = buf;
+    *len = n;
+    return ST_OK;
+}
+
+static Status oclp__options(const OclDeviceInfo *dev, const char *kernel_dir, const char *extra,
+                            char *buf, size_t cap, Error *err)
+{
+    size_t n = (size_t)snprintf(buf, cap, "-cl-std=CL1.2");
+    if (dev->correctly_rounded_divide_sqrt && n < cap)
+        n += (size_t)snprintf(buf + n, cap - n, " -cl-fp32-correctly-rounded-divide-sqrt");
+    if (kernel_dir && n < cap) {
+        /* The option string is split at blanks by the drivers, and quoting is not
+         * handled alike by all of them: refuse what cannot be passed reliably. */
+        if (strpbrk(kernel_dir, " \t\n\"'\\"))
+            return error_set(err, ST_USAGE, "kernel folder '%s': the path must not contain "
+                             "blanks, quotes or backslashes (OpenCL build options cannot "
+                             "carry them portably)", kernel_dir);
+        n += (size_t)snprintf(buf + n, cap - n, " -I %s", kernel_dir);
+    }
+    if (extra && extra[0] && n < cap) n += (size_t)snprintf(buf + n, cap - n, " %s", extra);
+    if (n >= cap) return error_set(err, ST_USAGE, "OpenCL build options too long (%zu bytes)", n);
+    return ST_OK;
+}
+
+/* ---------------------------------------------------------------- the cache */
+
+int ocl_program_cache_dir(char *buf, size_t cap)
+{
+    const char *v = getenv("CLPT_CACHE_DIR");
+    int n;
+    if (v && v[0]) {
+        n = snprintf(buf, cap, "%s", v);
+    } else if ((v = getenv("XDG_CACHE_HOME")) && v[0] == '/') {
+        /* The XDG spec says a relative XDG_CACHE_HOME is invalid and must be ignored. */
+        n = snprintf(buf, cap, "%s/clpt", v);
+    } else if ((v = getenv("HOME")) && v[0]) {
+        n = snprintf(buf, cap, "%s/.cache/clpt", v);
+    } else {
+        return 0;
+    }
+    return n > 0 && (size_t)n < cap;
+}
+
+/* mkdir -p; returns 0 on success. */
+static int oclp__make_dirs(const char *path)
+{
+    char tmp[1024];
+    size_t n = strlen(path);
+    if (n == 0 || n >= sizeof tmp) return -1;
+    memcpy(tmp, path, n + 1);
+    for (char *p = tmp + 1; *p; p++) {
+        if (*p != '/') continue;
+        *p = '\0';
+        if (mkdir(tmp, 0755) != 0 && errno != EEXIST) return -1;
+        *p = '/';
+    }
+    if (mkdir(tmp, 0755) != 0 && errno != EEXIST) return -1;
+    struct stat sb;
+    return stat(tmp, &sb) == 0 && S_ISDIR(sb.st_mode) && access(tmp, W_OK) == 0 ? 0 : -1;
+}
+
+/* Hashes one field as length + bytes, so that no two different field lists can give the
+ * same byte stream ("ab"+"c" versus "a"+"bc"). */
+static void oclp__hash_field(Sha256 *h, const char *s, size_t n)
+{
+    unsigned char len[8];
+    oclp__put_le(len, n, 8);
+    sha256_update(h, len, sizeof len);
+    sha256_update(h, s, n);
+}
+
+static void oclp__key(const OclDeviceInfo *dev, const char *src, size_t src_len,
+                      const char *options, unsigned char key[SHA256_DIGEST_SIZE])
+{
+    Sha256 h;
+    sha256_init(&h);
+    static const char tag[] = "clpt kernel cache v1";
+    oclp__hash_field(&h, tag, sizeof tag - 1);
+    oclp__hash_field(&h, src, src_len);
+    const char *fields[] = {dev->name, dev->vendor, dev->driver_version, dev->platform_name,
+                            dev->platform_version, dev->device_version, options};
+    for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++)
+        oclp__hash_field(&h, fields[i], strlen(fields[i]));
+    sha256_final(&h, key);
+}
+
+/* Reads and checks a cache entry. Returns 1 and a heap payload when the file is whole
+ * and belongs to `key`; 0 when there is no file; -1 when it is damaged. */
+static int oclp__cache_read(const char *path, const unsigned char key[SHA256_DIGEST_SIZE],
+                            unsigned char **payload, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return errno == ENOENT ? 0 : -1;
+    unsigned char head[OCLP__HEADER];
+    int ok = fread(head, 1, sizeof head, f) == sizeof head &&
+             memcmp(head, OCLP__MAGIC, 8) == 0 && oclp__get_le(head + 8, 4) == OCLP__VERSION &&
+             memcmp(head + 24, key, SHA256_DIGEST_SIZE) == 0;
+    uint64_t n = ok ? oclp__get_le(head + 16, 8) : 0;
+    ok = ok && n > 0 && n <= OCLP__MAX_PAYLOAD;
+    unsigned char *buf = ok ? malloc((size_t)n + 1) : NULL;
+    ok = buf && fread(buf, 1, (size_t)n, f) == n && fgetc(f) == EOF;
+    fclose(f);
+    if (ok) {
+        unsigned char sum[SHA256_DIGEST_SIZE];
+        sha256(buf, (size_t)n, sum);
+        ok = memcmp(sum, head + 56, SHA256_DIGEST_SIZE) == 0;
+    }
+    if (!ok) {
+        free(buf);
+        return -1;
+    }
+    *payload = buf;
+    *len = (size_t)n;
+    return 1;
+}
+
+/* Writes a cache entry atomically (a reader never sees half an entry). Failure is
+ * silent by design: the caller has a working program either way. */
+static void oclp__cache_write(const char *path, const unsigned char key[SHA256_DIGEST_SIZE],
+                              const unsigned char *payload, size_t len)
+{
+    unsigned char head[OCLP__HEADER] = {0};
+    memcpy(head, OCLP__MAGIC, 8);
+    oclp__put_le(head + 8, OCLP__VERSION, 4);
+    oclp__put_le(head + 16, len, 8);
+    memcpy(head + 24, key, SHA256_DIGEST_SIZE);
+    sha256(payload, len, head + 56);
+    AtomicFile af;
+    Error ignored = {0};
+    if (atomic_open(&af, path, "kernel cache entry", &ignored) == ST_OK) {
+        atomic_write(&af, head, sizeof head);
+        atomic_write(&af, payload, len);
+        (void)atomic_commit(&af, &ignored);
+    }
+    error_clear(&ignored);
+}
+
+/* The compiled binary of `prog` for dev; the program may span several devices of the
+ * context, and CL_PROGRAM_BINARIES wants a buffer for each of them. */
+static int oclp__binary(cl_program prog, const OclDeviceInfo *dev, unsigned char **out,
+                        size_t *len)
+{
+    cl_uint n = 0;
+    if (clGetProgramInfo(prog, CL_PROGRAM_NUM_DEVICES, sizeof n, &n, NULL) != CL_SUCCESS || !n)
+        return 0;
+    int found = 0;
+    cl_device_id *devs = calloc(n, sizeof *devs);
+    size_t *sizes = calloc(n, sizeof *sizes);
+    unsigned char **bins = calloc(n, sizeof *bins);
+    if (!devs || !sizes || !bins) goto cleanup;
+    if (clGetProgramInfo(prog, CL_PROGRAM_DEVICES, n * sizeof *devs, devs, NULL) != CL_SUCCESS ||
+        clGetProgramInfo(prog, CL_PROGRAM_BINARY_SIZES, n * sizeof *sizes, sizes, NULL) !=
+            CL_SUCCESS)
+        goto cleanup;
+    cl_uint me = n;
+    for (cl_uint i = 0; i < n; i++) {
+        if (devs[i] == dev->id) me = i;
+        bins[i] = malloc(sizes[i] ? sizes[i] : 1);
+        if (!bins[i]) goto cleanup;
+    }
+    if (me == n || sizes[me] == 0) goto cleanup;
+    if (clGetProgramInfo(prog, CL_PROGRAM_BINARIES, n * sizeof *bins, bins, NULL) != CL_SUCCESS)
+        goto cleanup;
+    *out = bins[me];
+    *len = sizes[me];
+    bins[me] = NULL;
+    found = 1;
+cleanup:
+    if (bins)
+        for (cl_uint i = 0; i < n; i++) free(bins[i]);
+    free(bins);
+    free(sizes);
+    free(devs);
+    return found;
+}
+
+/* Creates and builds a program from a cached binary; 0 (and nothing to release) when
+ * the driver refuses it. */
+static int oclp__from_binary(cl_context ctx, const OclDeviceInfo *dev, const unsigned char *bin,
+                             size_t len, const char *options, cl_program *out)
+{
+    cl_int rc, bin_status = CL_INVALID_BINARY;
+    cl_program prog = clCreateProgramWithBinary(ctx, 1, &dev->id, &len, &bin, &bin_status, &rc);
+    if (rc != CL_SUCCESS || bin_status != CL_SUCCESS) {
+        if (prog) clReleaseProgram(prog);
+        return 0;
+    }
+    if (clBuildProgram(prog, 1, &dev->id, options, NULL, NULL) != CL_SUCCESS) {
+        clReleaseProgram(prog);
+        return 0;
+    }
+    *out = prog;
+    return 1;
+}
+
+/* ---------------------------------------------------------------- building */
+
+static char *oclp__build_log(cl_program prog, const OclDeviceInfo *dev)
+{
+    size_t n = 0;
+    if (clGetProgramBuildInfo(prog, dev->id, CL_PROGRAM_BUILD_LOG, 0, NULL, &n) != CL_SUCCESS)
+        return NULL;
+    char *log = malloc(n + 1);
+    if (!log) return NULL;
+    if (clGetProgramBuildInfo(prog, dev->id, CL_PROGRAM_BUILD_LOG, n, log, NULL) != CL_SUCCESS) {
+        free(log);
+        return NULL;
+    }
+    log[n] = '\0';
+    return log;
+}
+
+static Status oclp__from_source(cl_context ctx, const OclDeviceInfo *dev, const char *src,
+                                size_t len, const char *options, cl_program *out, Error *err)
+{
+    cl_int rc;
+    cl_program prog = clCreateProgramWithSource(ctx, 1, &src, &len, &rc);
+    if (rc != CL_SUCCESS) return ocl_fail(err, dev, "clCreateProgramWithSource", rc);
+    rc = clBuildProgram(prog, 1, &dev->id, options, NULL, NULL);
+    if (rc != CL_SUCCESS) {
+        char *log = oclp__build_log(prog, dev);
+        Status st = ocl_failf(err, dev, "clBuildProgram", rc, "options \"%s\"%s", options,
+                              log && log[0] ? " (build log follows)" : " (no build log)");
+        error_set_detail(err, log);
+        free(log);
+        clReleaseProgram(prog);
+        return st;
+    }
+    *out = prog;
+    return ST_OK;
+}
+
+Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *kernel_dir,
+                         const char *extra_options, cl_program *out, OclProgramStats *stats,
+                         Error *err)
+{
+    double t0 = oclp__now();
+    OclProgramStats local;
+    if (!stats) stats = &local;
+    memset(stats, 0, sizeof *stats);
+    *out = NULL;
+
+    /* The options are composed in the stats record itself, so what it reports is
+     * exactly what was used. */
+    const char *options = stats->options;
+    Status st = oclp__options(dev, kernel_dir, extra_options, stats->options,
+                              sizeof stats->options, err);
+    if (st != ST_OK) return st;
+
+    char *file_src = NULL;
+    const char *src = clpt_kernel_source;
+    size_t src_len = clpt_kernel_source_len;
+    if (kernel_dir) {
+        char path[1024];
+        if (snprintf(path, sizeof path, "%s/entry.cl", kernel_dir) >= (int)sizeof path)
+            return error_set(err, ST_USAGE, "kernel folder path too long: %s", kernel_dir);
+        char *text = NULL;
+        size_t text_len = 0;
+        st = oclp__read_file(path, &text, &text_len, err);
+        if (st != ST_OK) return st;
+        /* Drivers compile a copy in a temporary file (PoCL does), so without a #line
+         * marker the build log would name that copy instead of entry.cl. The path holds
+         * no quote or backslash (checked with the options above). */
+        size_t head = strlen(path) + 16;
+        file_src = malloc(head + text_len + 1);
+        if (!file_src) {
+            free(text);
+            return error_set(err, ST_INTERNAL, "%s: out of memory", path);
+        }
+        src_len = (size_t)snprintf(file_src, head, "#line 1 \"%s\"\n", path);
+        memcpy(file_src + src_len, text, text_len + 1);
+        src_len += text_len;
+        free(text);
+        src = file_src;
+    }
+
+    /* Developer mode is never cached: the included files are not part of the key. */
+    char dir[900], path[sizeof stats->cache_path] = "";
+    unsigned char key[SHA256_DIGEST_SIZE];
+    if (!kernel_dir && ocl_program_cache_dir(dir, sizeof dir) && oclp__make_dirs(dir) == 0) {
+        char hex[65];
+        oclp__key(dev, src, src_len, options, key);
+        sha256_hex(key, hex);
+        snprintf(path, sizeof path, "%s/%s.bin", dir, hex);
+    }
+
+    if (path[0]) {
+        unsigned char *bin = NULL;
+        size_t bin_len = 0;
+        int got = oclp__cache_read(path, key, &bin, &bin_len);
+        if (got == 1 && oclp__from_binary(ctx, dev, bin, bin_len, options, out))
+            stats->from_cache = 1;
+        else if (got != 0)
+            unlink(path); /* damaged or refused: rebuilt and replaced below */
+        free(bin);
+    }
+
+    if (!stats->from_cache) {
+        st = oclp__from_source(ctx, dev, src, src_len, options, out, err);
+        if (st == ST_OK && path[0]) {
+            unsigned char *bin = NULL;
+            size_t bin_len = 0;
+            if (oclp__binary(*out, dev, &bin, &bin_len))
+                oclp__cache_write(path, key, bin, bin_len);
+            free(bin);
+        }
+    }
+    free(file_src);
+    stats->seconds = oclp__now() - t0;
+    if (st != ST_OK) return st;
+    memcpy(stats->cache_path, path, sizeof path);
+    return ST_OK;
+}
+
+Status ocl_program_kernel(cl_program prog, const OclDeviceInfo *dev, const char *name,
+                          cl_kernel *out, Error *err)
+{
+    cl_int rc;
+    *out = clCreateKernel(prog, name, &rc);
+    if (rc != CL_SUCCESS) {
+        *out = NULL;
+        return ocl_failf(err, dev, "clCreateKernel", rc, "kernel '%s'", name);
+    }
+    return ST_OK;
+}

@@ -1,0 +1,212 @@
+/*
+ * image_write.c — PNG/PPM/BMP/PFM encoding, written through atomic_file.h (temp file, rename).
+ *
+ * PNG compression is stb_image_write's (Debian's libstb); it hands us the finished file
+ * in memory through a callback, so every byte on disk goes through our own checked writes.
+ */
+#include "io/image_write.h"
+
+#include "base/atomic_file.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include <stb_image_write.h>
+
+#define SUPPORTED_EXTENSIONS ".png, .ppm, .pfm, .bmp"
+
+Status image_format_from_path(const char *path, ImageFormat *fmt, Error *err)
+{
+    const char *slash = strrchr(path, '/');
+    const char *name = slash ? slash + 1 : path;
+    const char *dot = strrchr(name, '.');
+    if (!dot || dot == name)
+        return error_set(err, ST_USAGE,
+                         "cannot tell the image format of '%s': it has no extension "
+                         "(supported: " SUPPORTED_EXTENSIONS ")", path);
+    if (strcasecmp(dot, ".png") == 0) *fmt = IMAGE_PNG;
+    else if (strcasecmp(dot, ".ppm") == 0) *fmt = IMAGE_PPM;
+    else if (strcasecmp(dot, ".pfm") == 0) *fmt = IMAGE_PFM;
+    else if (strcasecmp(dot, ".bmp") == 0) *fmt = IMAGE_BMP;
+    else
+        return error_set(err, ST_USAGE,
+                         "cannot tell the image format of '%s': unsupported extension '%s' "
+                         "(supported: " SUPPORTED_EXTENSIONS ")", path, dot);
+    return ST_OK;
+}
+
+/* ------------------------------------------------------------------ sRGB encoding */
+
+float image_srgb_encode(float linear)
+{
+    double x = linear;
+    if (!(x > 0.0)) return 0.0f; /* also catches NaN */
+    if (x >= 1.0) return 1.0f;
+    if (x <= 0.0031308) return (float)(12.92 * x);
+    return (float)(1.055 * pow(x, 1.0 / 2.4) - 0.055);
+}
+
+unsigned char image_to_srgb8(float linear)
+{
+    return (unsigned char)floor((double)image_srgb_encode(linear) * 255.0 + 0.5);
+}
+
+unsigned char image_to_linear8(float linear)
+{
+    double x = linear;
+    if (!(x > 0.0)) return 0;
+    if (x >= 1.0) return 255;
+    return (unsigned char)floor(x * 255.0 + 0.5);
+}
+
+/* ------------------------------------------------------------------ encoders */
+
+static void write_ppm(AtomicFile *af, const unsigned char *srgb, unsigned w, unsigned h)
+{
+    char header[64];
+    int n = snprintf(header, sizeof header, "P6\n%u %u\n255\n", w, h);
+    atomic_write(af, header, (size_t)n);
+    atomic_write(af, srgb, (size_t)w * h * 3);
+}
+
+static void png_sink(void *context, void *data, int size)
+{
+    atomic_write(context, data, (size_t)size);
+}
+
+static void write_png(AtomicFile *af, const unsigned char *srgb, unsigned w, unsigned h)
+{
+    errno = 0;
+    if (!stbi_write_png_to_func(png_sink, af, (int)w, (int)h, 3, srgb, (int)(w * 3))) {
+        /* stb fails only when its allocations do */
+        if (!errno) errno = ENOMEM;
+        atomic_fail(af, "PNG encoding");
+    }
+}
+
+static void put_le(unsigned char *p, uint32_t v, int bytes)
+{
+    for (int i = 0; i < bytes; i++) p[i] = (unsigned char)(v >> (8 * i));
+}
+
+/* BMP: the 14-byte file header and the 40-byte BITMAPINFOHEADER, then 24-bit BGR rows
+ * bottom to top, each padded to a multiple of 4 bytes. */
+static void write_bmp(AtomicFile *af, const unsigned char *rgb8, unsigned w, unsigned h)
+{
+    size_t row = ((size_t)w * 3 + 3) & ~(size_t)3;
+    unsigned char header[54];
+    memset(header, 0, sizeof header);
+    header[0] = 'B';
+    header[1] = 'M';
+    put_le(header + 2, (uint32_t)(sizeof header + row * h), 4);
+    put_le(header + 10, sizeof header, 4);
+    put_le(header + 14, 40, 4);
+    put_le(header + 18, w, 4);
+    put_le(header + 22, h, 4);
+    put_le(header + 26, 1, 2);       /* planes */
+    put_le(header + 28, 24, 2);      /* bits per pixel; compression 0 (none) */
+    put_le(header + 34, (uint32_t)(row * h), 4);
+    put_le(header + 38, 2835, 4);    /* 72 dpi */
+    put_le(header + 42, 2835, 4);
+    atomic_write(af, header, sizeof header);
+    unsigned char *line = calloc(row, 1);
+    if (!line) {
+        errno = ENOMEM;
+        atomic_fail(af, "BMP encoding");
+        return;
+    }
+    for (unsigned y = h; y-- > 0;) {
+        const unsigned char *src = rgb8 + (size_t)y * w * 3;
+        for (size_t x = 0; x < w; x++) {
+            line[3 * x + 0] = src[3 * x + 2];
+            line[3 * x + 1] = src[3 * x + 1];
+            line[3 * x + 2] = src[3 * x + 0];
+        }
+        atomic_write(af, line, row);
+    }
+    free(line);
+}
+
+/* PFM: a text header, scale -1 meaning little-endian floats, then the rows bottom to top.
+ * Bytes are assembled explicitly so the file is the same on a big-endian host. */
+static Status write_pfm(AtomicFile *af, const float *rgb, unsigned w, unsigned h, Error *err)
+{
+    char header[64];
+    int n = snprintf(header, sizeof header, "PF\n%u %u\n-1.0\n", w, h);
+    atomic_write(af, header, (size_t)n);
+    size_t row_floats = (size_t)w * 3;
+    unsigned char *row = malloc(row_floats * 4);
+    if (!row) return error_set(err, ST_INTERNAL, "cannot write '%s': out of memory", af->path);
+    for (unsigned y = h; y-- > 0;) {
+        const float *src = rgb + (size_t)y * row_floats;
+        for (size_t i = 0; i < row_floats; i++) {
+            uint32_t bits;
+            memcpy(&bits, &src[i], 4);
+            row[4 * i + 0] = (unsigned char)(bits & 0xffu);
+            row[4 * i + 1] = (unsigned char)((bits >> 8) & 0xffu);
+            row[4 * i + 2] = (unsigned char)((bits >> 16) & 0xffu);
+            row[4 * i + 3] = (unsigned char)(bits >> 24);
+        }
+        atomic_write(af, row, row_floats * 4);
+    }
+    free(row);
+    return ST_OK;
+}
+
+Status image_write(const char *path, const float *rgb, unsigned width, unsigned height,
+                   Error *err)
+{
+    return image_write_encoded(path, rgb, width, height, IMAGE_SRGB, err);
+}
+
+Status image_write_encoded(const char *path, const float *rgb, unsigned width, unsigned height,
+                           ImageEncoding encoding, Error *err)
+{
+    ImageFormat fmt;
+    Status st = image_format_from_path(path, &fmt, err);
+    if (st != ST_OK) return st;
+    if (width == 0 || height == 0 || !rgb)
+        return error_set(err, ST_INTERNAL, "cannot write '%s': empty image (%ux%u)", path,
+                         width, height);
+    /* stb takes int sizes and an int row stride; PFM rows need w*12 bytes. */
+    if (width > (unsigned)(INT_MAX / 3) || height > (unsigned)INT_MAX ||
+        (size_t)width * height > SIZE_MAX / 12)
+        return error_set(err, ST_INTERNAL, "cannot write '%s': image too large (%ux%u)", path,
+                         width, height);
+
+    /* Encode before creating the temporary file: running out of memory then leaves no
+     * trace on disk. */
+    unsigned char *srgb = NULL;
+    size_t count = (size_t)width * height * 3;
+    if (fmt != IMAGE_PFM) {
+        srgb = malloc(count);
+        if (!srgb) return error_set(err, ST_INTERNAL, "cannot write '%s': out of memory", path);
+        for (size_t i = 0; i < count; i++)
+            srgb[i] = encoding == IMAGE_LINEAR ? image_to_linear8(rgb[i]) : image_to_srgb8(rgb[i]);
+    }
+
+    AtomicFile af;
+    st = atomic_open(&af, path, "", err);
+    if (st != ST_OK) {
+        free(srgb);
+        return st;
+    }
+    switch (fmt) {
+    case IMAGE_PNG: write_png(&af, srgb, width, height); break;
+    case IMAGE_PPM: write_ppm(&af, srgb, width, height); break;
+    case IMAGE_BMP: write_bmp(&af, srgb, width, height); break;
+    case IMAGE_PFM: st = write_pfm(&af, rgb, width, height, err); break;
+    }
+    free(srgb);
+    if (st != ST_OK) {
+        atomic_abort(&af);
+        return st;
+    }
+    return atomic_commit(&af, err);
+}

@@ -1,0 +1,50 @@
+/*
+ * image_write.h — writing the final image: PNG, PPM and BMP (8-bit sRGB, or 8-bit linear
+ * when asked) or PFM (linear float).
+ *
+ * The format follows the output path's extension. Every write is atomic: the data goes to
+ * a temporary file in the target's folder, which is synced and then renamed over the
+ * target, so a reader (or a crash, a full disk, a Ctrl-C) never sees a half-written image
+ * and a failed write leaves any earlier file at that path untouched.
+ *
+ * PNG, PPM and BMP store sRGB-encoded bytes: NaN becomes 0, values are clamped to [0,1],
+ * the exact sRGB transfer function is applied and the result rounded to nearest. With
+ * IMAGE_LINEAR the transfer function is left out (value * 255, rounded), which is how
+ * the classic ray tracers of computer-graphics courses write their images.
+ * PFM stores the linear radiance unchanged, bit for bit — NaN, infinities and negative
+ * values included — because it is the format for exact data: determinism tests compare
+ * PFM files bitwise, and clamping there would hide the very values they look for.
+ */
+#ifndef CLPT_IMAGE_WRITE_H
+#define CLPT_IMAGE_WRITE_H
+
+#include "base/status.h"
+
+typedef enum { IMAGE_PNG, IMAGE_PPM, IMAGE_PFM, IMAGE_BMP } ImageFormat;
+
+/* How 8-bit formats encode linear values. */
+typedef enum { IMAGE_SRGB, IMAGE_LINEAR } ImageEncoding;
+
+/* The format named by path's extension (.png .ppm .pfm .bmp, any case). An unknown or
+ * missing extension is ST_USAGE, with a message that lists the supported ones. */
+Status image_format_from_path(const char *path, ImageFormat *fmt, Error *err);
+
+/* Writes rgb (linear radiance, width*height*3 floats, top row first) to path, atomically,
+ * in the format of its extension. ST_USAGE for an unknown extension, ST_IO when the file
+ * cannot be written (the message names the path and the step that failed), ST_INTERNAL for
+ * an empty or impossibly large image or when memory runs out. */
+Status image_write(const char *path, const float *rgb, unsigned width, unsigned height,
+                   Error *err);
+/* The same with a choice of 8-bit encoding (PFM is always linear float). */
+Status image_write_encoded(const char *path, const float *rgb, unsigned width, unsigned height,
+                           ImageEncoding encoding, Error *err);
+
+/* The sRGB transfer function (IEC 61966-2-1) applied to a linear value: NaN and values
+ * <= 0 give 0, values >= 1 give 1. */
+float image_srgb_encode(float linear);
+/* image_srgb_encode scaled to 0..255 and rounded to nearest: the byte PNG and PPM store. */
+unsigned char image_to_srgb8(float linear);
+/* A linear value clamped to [0,1] (NaN: 0), scaled to 0..255 and rounded to nearest. */
+unsigned char image_to_linear8(float linear);
+
+#endif /* CLPT_IMAGE_WRITE_H */

@@ -1,0 +1,367 @@
+/* lexer.c — whitespace-separated tokens with positions (see lexer.h). */
+#include "io/lexer.h"
+
+#include "base/limit.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+Status lex_open_text(Lexer *lx, const char *path, const char *text, size_t len, Error *err)
+{
+    memset(lx, 0, sizeof *lx);
+    size_t plen = strlen(path);
+    lx->path = malloc(plen + 1);
+    lx->src = malloc(len + 1);
+    if (!lx->path || !lx->src) {
+        lex_close(lx);
+        return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+    }
+    memcpy(lx->path, path, plen + 1);
+    memcpy(lx->src, text, len);
+    lx->src[len] = '\0';
+    lx->len = len;
+    lx->line = 1;
+    return ST_OK;
+}
+
+Status lex_read_file(const char *path, char **data, size_t *len, Error *err)
+{
+    *data = NULL;
+    *len = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) return error_set(err, ST_IO, "cannot open '%s': %s", path, strerror(errno));
+    size_t cap = 1 << 16, n = 0;
+    struct stat sb;
+    if (fstat(fileno(f), &sb) == 0) {
+        /* /dev/zero or /dev/urandom would be read until memory runs out; a pipe
+         * (`clpt <(gen-scene)`) is read, up to the size limit */
+        if (S_ISCHR(sb.st_mode) || S_ISBLK(sb.st_mode)) {
+            fclose(f);
+            return error_set(err, ST_IO, "cannot read '%s': it is a device, not a file", path);
+        }
+        if (S_ISREG(sb.st_mode)) {
+            Status st = limit_file_size(path, (uint64_t)sb.st_size, err);
+            if (st) {
+                fclose(f);
+                return st;
+            }
+            /* the whole file and the NUL in one allocation */
+            if ((uint64_t)sb.st_size + 2 > cap) cap = (size_t)sb.st_size + 2;
+        }
+    }
+    char *buf = malloc(cap);
+    if (!buf) {
+        fclose(f);
+        return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+    }
+    for (;;) {
+        if (n > CLPT_MAX_FILE_BYTES) {
+            free(buf);
+            fclose(f);
+            return limit_file_size(path, n, err);
+        }
+        if (cap - n < 2) {
+            char *grown = cap <= ((size_t)-1) / 2 ? realloc(buf, cap * 2) : NULL;
+            if (!grown) {
+                free(buf);
+                fclose(f);
+                return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+            }
+            buf = grown;
+            cap *= 2;
+        }
+        size_t got = fread(buf + n, 1, cap - 1 - n, f);
+        n += got;
+        if (got == 0) break;
+    }
+    if (ferror(f)) {
+        /* fopen succeeds on a directory; the read then fails with EISDIR */
+        int e = errno;
+        free(buf);
+        fclose(f);
+        return error_set(err, ST_IO, "cannot open '%s': %s", path, strerror(e ? e : EIO));
+    }
+    fclose(f);
+    buf[n] = '\0';
+    *data = buf;
+    *len = n;
+    return ST_OK;
+}
+
+Status lex_open_file(Lexer *lx, const char *path, Error *err)
+{
+    memset(lx, 0, sizeof *lx);
+    char *data;
+    size_t len;
+    Status st = lex_read_file(path, &data, &len, err);
+    if (st) return st;
+    size_t plen = strlen(path);
+    lx->path = malloc(plen + 1);
+    if (!lx->path) {
+        free(data);
+        return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+    }
+    memcpy(lx->path, path, plen + 1);
+    lx->src = data;
+    lx->len = len;
+    lx->line = 1;
+    return ST_OK;
+}
+
+void lex_close(Lexer *lx)
+{
+    free(lx->path);
+    free(lx->src);
+    memset(lx, 0, sizeof *lx);
+}
+
+static int is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; }
+static int is_control(unsigned char c) { return c < 0x20 || c == 0x7f; }
+static int is_word_byte(unsigned char c)
+{
+    return !is_control(c) && c != ' ' && c != '{' && c != '}' && c != '[' && c != ']' &&
+           c != '"' && c != '#';
+}
+
+/* Skips whitespace and comments, counting lines. */
+static void skip_blank(Lexer *lx)
+{
+    while (lx->pos < lx->len) {
+        char c = lx->src[lx->pos];
+        if (c == '\n') {
+            lx->pos++;
+            lx->line++;
+            lx->line_start = lx->pos;
+        } else if (is_space(c)) {
+            lx->pos++;
+        } else if (c == '#') {
+            while (lx->pos < lx->len && lx->src[lx->pos] != '\n') lx->pos++;
+        } else {
+            break;
+        }
+    }
+}
+
+static void set_token(Lexer *lx, Token *tok, TokenKind kind, size_t start, size_t len)
+{
+    tok->kind = kind;
+    tok->text = lx->src + start;
+    tok->len = len;
+    tok->line = lx->line;
+    tok->col = (uint)(start - lx->line_start + 1);
+}
+
+/* Lexes "..." starting at the opening quote; unescapes in place, which only ever
+ * shortens the text, so the bytes after the string are untouched. */
+static Status lex_string(Lexer *lx, Token *tok, Error *err)
+{
+    size_t open = lx->pos;
+    size_t out = open + 1;
+    size_t p = open + 1;
+    set_token(lx, tok, TOK_STRING, open, 0);   /* positioned at the opening quote */
+    tok->text = lx->src + open + 1;
+    for (;;) {
+        if (p >= lx->len || lx->src[p] == '\n' || lx->src[p] == '\r') {
+            return error_set(err, ST_INPUT,
+                             "%s:%u:%u: expected '\"' closing the string that starts here, "
+                             "found end of %s", lx->path, tok->line, tok->col,
+                             p >= lx->len ? "file" : "line");
+        }
+        char c = lx->src[p];
+        if (c == '"') break;
+        if (c == '\\') {
+            char e = p + 1 < lx->len ? lx->src[p + 1] : '\0';
+            if (e != '"' && e != '\\') {
+                uint col = (uint)(p - lx->line_start + 1);
+                if (is_control((unsigned char)e) || e == '\0')
+                    return error_set(err, ST_INPUT,
+                                     "%s:%u:%u: expected '\\\"' or '\\\\' (the only escapes in a "
+                                     "string), found '\\' before byte 0x%02x",
+                                     lx->path, lx->line, col, (unsigned char)e);
+                return error_set(err, ST_INPUT,
+                                 "%s:%u:%u: expected '\\\"' or '\\\\' (the only escapes in a "
+                                 "string), found '\\%c'", lx->path, lx->line, col, e);
+            }
+            lx->src[out++] = e;
+            p += 2;
+            continue;
+        }
+        if (is_control((unsigned char)c) && c != '\t') {
+            uint col = (uint)(p - lx->line_start + 1);
+            return error_set(err, ST_INPUT, "%s:%u:%u: unexpected control byte 0x%02x in a string",
+                             lx->path, lx->line, col, (unsigned char)c);
+        }
+        lx->src[out++] = c;
+        p++;
+    }
+    tok->len = out - (open + 1);
+    lx->pos = p + 1;
+    return ST_OK;
+}
+
+Status lex_next(Lexer *lx, Token *tok, Error *err)
+{
+    skip_blank(lx);
+    if (lx->pos >= lx->len) {
+        set_token(lx, tok, TOK_EOF, lx->len, 0);
+        return ST_OK;
+    }
+    size_t start = lx->pos;
+    unsigned char c = (unsigned char)lx->src[start];
+    switch (c) {
+    case '{': set_token(lx, tok, TOK_LBRACE, start, 1); lx->pos++; return ST_OK;
+    case '}': set_token(lx, tok, TOK_RBRACE, start, 1); lx->pos++; return ST_OK;
+    case '[': set_token(lx, tok, TOK_LBRACKET, start, 1); lx->pos++; return ST_OK;
+    case ']': set_token(lx, tok, TOK_RBRACKET, start, 1); lx->pos++; return ST_OK;
+    case '"': return lex_string(lx, tok, err);
+    default: break;
+    }
+    if (is_control(c))
+        return error_set(err, ST_INPUT, "%s:%u:%u: unexpected control byte 0x%02x",
+                         lx->path, lx->line, (uint)(start - lx->line_start + 1), c);
+    size_t p = start;
+    while (p < lx->len && is_word_byte((unsigned char)lx->src[p])) p++;
+    set_token(lx, tok, TOK_WORD, start, p - start);
+    lx->pos = p;
+    return ST_OK;
+}
+
+int tok_is(const Token *tok, const char *word)
+{
+    size_t n = strlen(word);
+    return tok->kind == TOK_WORD && tok->len == n && memcmp(tok->text, word, n) == 0;
+}
+
+char *tok_copy(const Token *tok)
+{
+    char *s = malloc(tok->len + 1);
+    if (!s) return NULL;
+    memcpy(s, tok->text, tok->len);
+    s[tok->len] = '\0';
+    return s;
+}
+
+/* Length of the UTF-8 sequence starting at s (a byte >= 0x80), or 0 when it is not a
+ * valid one: the bytes of a binary file are then shown as \xNN, so that messages stay
+ * valid text. */
+static size_t utf8_length(const char *s, size_t avail)
+{
+    const unsigned char *u = (const unsigned char *)s;
+    size_t k = u[0] >= 0xf0 && u[0] <= 0xf4 ? 4 : u[0] >= 0xe0 ? 3 : u[0] >= 0xc2 && u[0] <= 0xdf ? 2 : 0;
+    if (u[0] > 0xf4 || k == 0 || k > avail) return 0;
+    for (size_t j = 1; j < k; j++)
+        if ((u[j] & 0xc0) != 0x80) return 0;
+    /* overlong or surrogate forms, and code points above U+10FFFF */
+    if ((u[0] == 0xe0 && u[1] < 0xa0) || (u[0] == 0xed && u[1] >= 0xa0) ||
+        (u[0] == 0xf0 && u[1] < 0x90) || (u[0] == 0xf4 && u[1] >= 0x90))
+        return 0;
+    return k;
+}
+
+void tok_describe(const Token *tok, char *buf, size_t size)
+{
+    if (size == 0) return;
+    if (tok->kind == TOK_EOF) {
+        snprintf(buf, size, "end of file");
+        return;
+    }
+    enum { SHOWN = 40 };
+    size_t o = 0;
+    /* Room for one more byte plus what the longest step writes: "\xNN" or the ending. */
+#define ROOM(k) (o + (k) < size)
+    int quoted = tok->kind == TOK_STRING;
+    if (quoted && ROOM(1)) buf[o++] = '"';
+    size_t i;
+    for (i = 0; i < tok->len && i < SHOWN;) {
+        unsigned char c = (unsigned char)tok->text[i];
+        size_t k = c < 0x80 ? 1 : utf8_length(tok->text + i, tok->len - i);
+        if (is_control(c) || k == 0) {
+            if (!ROOM(4)) break;
+            snprintf(buf + o, size - o, "\\x%02x", c);
+            o += 4;
+            i++;
+        } else {
+            if (!ROOM(k)) break;
+            memcpy(buf + o, tok->text + i, k);
+            o += k;
+            i += k;
+        }
+    }
+    if (i < tok->len && ROOM(3)) {
+        memcpy(buf + o, "...", 3);
+        o += 3;
+    }
+    if (quoted && ROOM(1)) buf[o++] = '"';
+#undef ROOM
+    buf[o] = '\0';
+}
+
+Status tok_expected(const char *path, const Token *tok, const char *what, Error *err)
+{
+    char found[64];
+    tok_describe(tok, found, sizeof found);
+    if (tok->kind == TOK_EOF)
+        return error_set(err, ST_INPUT, "%s:%u:%u: expected %s, found end of file",
+                         path, tok->line, tok->col, what);
+    return error_set(err, ST_INPUT, "%s:%u:%u: expected %s, found '%s'", path, tok->line,
+                     tok->col, what, found);
+}
+
+Status lex_expected(const Lexer *lx, const Token *tok, const char *what, Error *err)
+{
+    return tok_expected(lx->path, tok, what, err);
+}
+
+Status lex_error_at(const Lexer *lx, const Token *tok, Error *err, const char *fmt, ...)
+{
+    char msg[768];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return error_set(err, ST_INPUT, "%s:%u:%u: %s", lx->path, tok->line, tok->col, msg);
+}
+
+int tok_float(const Token *tok, float *out)
+{
+    if (tok->kind != TOK_WORD || tok->len == 0) return -1;
+    char local[128];
+    char *buf = local;
+    if (tok->len >= sizeof local) {
+        buf = malloc(tok->len + 1);
+        if (!buf) return -1;
+    }
+    memcpy(buf, tok->text, tok->len);
+    buf[tok->len] = '\0';
+    char *end;
+    float v = strtof(buf, &end);
+    /* strtof skips leading whitespace; a word has none, so `end` decides alone */
+    int ok = end == buf + tok->len && isfinite(v);
+    if (buf != local) free(buf);
+    if (!ok) return -1;
+    *out = v;
+    return 0;
+}
+
+int tok_uint(const Token *tok, unsigned long long *out)
+{
+    if (tok->kind != TOK_WORD) return -1;
+    size_t i = 0;
+    if (i < tok->len && tok->text[i] == '+') i++;
+    if (i == tok->len) return -1;
+    unsigned long long v = 0;
+    for (; i < tok->len; i++) {
+        char c = tok->text[i];
+        if (c < '0' || c > '9') return -1;
+        unsigned d = (unsigned)(c - '0');
+        if (v > (~0ull - d) / 10) return -1;
+        v = v * 10 + d;
+    }
+    *out = v;
+    return 0;
+}

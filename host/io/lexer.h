@@ -1,0 +1,93 @@
+/*
+ * lexer.h — a tokenizer for line-oriented text formats, with file:line:column positions.
+ *
+ * Tokens are separated by whitespace; `#` starts a comment that runs to the end of the
+ * line. The token kinds are:
+ *   - words: any run of bytes other than whitespace, control characters and  { } [ ] " #
+ *     (keywords, names and numbers are all words; the parser decides which it wants);
+ *   - strings: "..." on one line, with the escapes \" and \\ only;
+ *   - the punctuation { } [ ], each a token of its own, so `sphere{` is two tokens.
+ *
+ * The lexer owns a private copy of the whole text. Strings are unescaped in place, so a
+ * token's text stays valid (and unchanged) until lex_close; no token is ever allocated.
+ * Token text is NOT NUL-terminated: use tok_is / tok_copy / lex_float and friends.
+ *
+ * Lines and columns start at 1; a column counts bytes (a tab is one column).
+ * Every error message starts with "path:line:col: " and is an ST_INPUT error, except
+ * a file that cannot be read (ST_IO, "cannot open 'path': <reason>").
+ */
+#ifndef CLPT_LEXER_H
+#define CLPT_LEXER_H
+
+#include <stddef.h>
+
+#include "base/status.h"
+#include "types.h"
+
+typedef enum {
+    TOK_EOF = 0,
+    TOK_WORD,
+    TOK_STRING,
+    TOK_LBRACE,     /* { */
+    TOK_RBRACE,     /* } */
+    TOK_LBRACKET,   /* [ */
+    TOK_RBRACKET    /* ] */
+} TokenKind;
+
+typedef struct {
+    TokenKind kind;
+    const char *text;    /* the word, or the string's unescaped contents; not terminated */
+    size_t len;
+    uint line, col;
+} Token;
+
+typedef struct {
+    char *path;          /* as given, for messages */
+    char *src;           /* the text, NUL-terminated copy */
+    size_t len, pos;
+    uint line;
+    size_t line_start;   /* offset of the current line's first byte */
+} Lexer;
+
+/* Reads the whole file. ST_IO "cannot open 'path': <strerror>" when it cannot, or when
+ * it is a device (/dev/zero); ST_INPUT when it is larger than CLPT_MAX_FILE_BYTES
+ * (limit.h), checked before reading when the size is known. */
+Status lex_open_file(Lexer *lx, const char *path, Error *err);
+/* Lexes `len` bytes of `text` (copied), reported under the name `path`. */
+Status lex_open_text(Lexer *lx, const char *path, const char *text, size_t len, Error *err);
+void lex_close(Lexer *lx);
+/* Reads a whole file into a NUL-terminated heap buffer (*data, *len without the NUL);
+ * the same errors as lex_open_file. Used by loaders that do their own lexing. */
+Status lex_read_file(const char *path, char **data, size_t *len, Error *err);
+
+/* The next token (TOK_EOF at the end, repeatedly). Fails on an unterminated string,
+ * an unknown escape or a control character. */
+Status lex_next(Lexer *lx, Token *tok, Error *err);
+
+/* 1 if the token is the word `word` (strings never match: "camera" is not a keyword). */
+int tok_is(const Token *tok, const char *word);
+/* A heap-allocated, NUL-terminated copy of the token text; NULL when out of memory. */
+char *tok_copy(const Token *tok);
+/* Writes a short printable rendering of the token into buf, for messages: the word,
+ * the string in quotes, or "end of file"; long tokens are cut with "...", control
+ * bytes and bytes that are not UTF-8 shown as \xNN. */
+void tok_describe(const Token *tok, char *buf, size_t size);
+
+/* ST_INPUT "path:line:col: expected <what>, found '<token>'" at the token; for readers
+ * with their own line scanning (OBJ, MTL) that make a word into a Token for messages. */
+Status tok_expected(const char *path, const Token *tok, const char *what, Error *err);
+/* The same for a token of the lexer's file. */
+Status lex_expected(const Lexer *lx, const Token *tok, const char *what, Error *err);
+/* ST_INPUT "path:line:col: <message>" at the token, with a printf-style message. */
+Status lex_error_at(const Lexer *lx, const Token *tok, Error *err, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+/* Parses the token as a whole number in C float syntax (integers too) into *out.
+ * Returns 0 on success, -1 when it is not a word, not entirely a number, or not finite
+ * (nan, inf, or out of float range). */
+int tok_float(const Token *tok, float *out);
+/* Parses the token as an unsigned decimal integer (optional '+', digits only) into
+ * *out. Returns 0 on success, -1 when it is not one or exceeds 2^64 - 1. */
+int tok_uint(const Token *tok, unsigned long long *out);
+
+#endif /* CLPT_LEXER_H */

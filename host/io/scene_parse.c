@@ -1,0 +1,1044 @@
+/*
+ * scene_parse.c — the scene file reader (the format is docs/scene-format.md).
+ *
+ * Every statement but `include` is `KEYWORD [NAME] { key value ... }`. One generic
+ * routine reads a block against a table of the keys it allows (KeySpec): it rejects
+ * unknown and repeated keys and checks each value's type and range where the value is,
+ * so errors point at the offending token. The per-statement functions then only check
+ * what involves several keys (a camera's up against its view direction, a box's min
+ * against its max) and append to the scene.
+ */
+#include "scene/scene.h"
+
+#include "kmath.h"
+#include "io/lexer.h"
+#include "base/limit.h"
+#include "io/mesh.h"
+#include "io/obj.h"
+#include "io/texture.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef enum {
+    VK_NUMBER,      /* one float within the key's range */
+    VK_UINT,        /* one unsigned integer within the key's range */
+    VK_VEC3,        /* three floats */
+    VK_COLOR,       /* three floats >= 0 */
+    VK_DIR,         /* three floats, not all zero */
+    VK_WORD,        /* a bare word (checked by the statement) */
+    VK_MATERIAL,    /* a material name, or an inline anonymous material block */
+    VK_PATH,        /* a string or a word */
+    VK_TEXTURE,     /* the name of a texture defined before */
+    VK_ROTATE,      /* an axis (three floats, not all zero) and an angle in degrees */
+    VK_SCALE,       /* one non-zero float, or three */
+    VK_MATRIX       /* sixteen floats, a 4x4 matrix row by row */
+} ValueKind;
+
+typedef struct {
+    const char *key;
+    ValueKind kind;
+    int required;
+    double lo, hi;          /* VK_NUMBER, VK_UINT: the allowed range */
+    int lo_open, hi_open;   /* whether the bound itself is excluded */
+    const char *what;       /* VK_NUMBER, VK_UINT, VK_WORD: "a number in (0, 180)" */
+} KeySpec;
+
+typedef struct {
+    int given;
+    Token key;              /* where the key was written */
+    Token value;            /* its first value token */
+    float f;
+    unsigned long long u;
+    vec3 v;
+    uint material;
+    Token word;             /* VK_WORD, VK_PATH */
+    float a[16];            /* VK_ROTATE (axis, degrees), VK_SCALE (x y z), VK_MATRIX */
+} Value;
+
+typedef struct {
+    Scene *s;
+    Error *err;
+    uint depth;                       /* include nesting: 0 for the top file */
+    char *camera_at, *image_at, *background_at;   /* "file:line:col" once given */
+    char **material_at;               /* per material index, where it was defined */
+    size_t n_material_at, cap_material_at;
+    int depth_exceeded;               /* the include limit error is not annotated further */
+    Token pending;                    /* a token read ahead and given back (VK_SCALE) */
+    int has_pending;
+} Parser;
+
+/* The next token, or the one given back by unread_token. */
+static Status next_token(Parser *p, Lexer *lx, Token *t)
+{
+    if (p->has_pending) {
+        *t = p->pending;
+        p->has_pending = 0;
+        return ST_OK;
+    }
+    return lex_next(lx, t, p->err);
+}
+
+static void unread_token(Parser *p, const Token *t)
+{
+    p->pending = *t;
+    p->has_pending = 1;
+}
+
+/* ------------------------------------------------------------------ helpers */
+
+static char *where_dup(const Lexer *lx, const Token *tok)
+{
+    int n = snprintf(NULL, 0, "%s:%u:%u", lx->path, tok->line, tok->col);
+    char *w = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    if (w) snprintf(w, (size_t)n + 1, "%s:%u:%u", lx->path, tok->line, tok->col);
+    return w;
+}
+
+/* Appends text to the message already in err (used to say which scene line pulled in
+ * the file where an error happened). */
+static void error_append(Error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void error_append(Error *err, const char *fmt, ...)
+{
+    if (!err) return;
+    size_t n = strlen(err->msg);
+    if (n + 1 >= sizeof err->msg) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->msg + n, sizeof err->msg - n, fmt, ap);
+    va_end(ap);
+}
+
+/* The path of `file` as seen from the folder of the file `from` (absolute paths and
+ * files in the current folder stay as they are). */
+static char *path_beside(const char *from, const char *file, size_t file_len)
+{
+    const char *slash = strrchr(from, '/');
+    size_t dir = (file_len > 0 && file[0] == '/') || !slash ? 0 : (size_t)(slash - from) + 1;
+    char *out = malloc(dir + file_len + 1);
+    if (!out) return NULL;
+    memcpy(out, from, dir);
+    memcpy(out + dir, file, file_len);
+    out[dir + file_len] = '\0';
+    return out;
+}
+
+static const char *kind_what(const KeySpec *k)
+{
+    switch (k->kind) {
+    case VK_VEC3: return "3 numbers";
+    case VK_COLOR: return "3 numbers >= 0 (a colour)";
+    case VK_DIR: return "a non-zero vector (3 numbers)";
+    case VK_MATERIAL: return "a material name or an inline 'material { ... }' block";
+    case VK_PATH: return "a file name";
+    case VK_TEXTURE: return "a texture name";
+    case VK_ROTATE: return "an axis and an angle in degrees (4 numbers, the axis not 0 0 0)";
+    case VK_SCALE: return "a non-zero scale factor, or three (x y z)";
+    case VK_MATRIX: return "16 numbers (a 4x4 matrix, row by row)";
+    case VK_NUMBER:
+    case VK_UINT:
+    case VK_WORD: return k->what;
+    }
+    return "a value";
+}
+
+static int in_range(const KeySpec *k, double x)
+{
+    if (x < k->lo || (k->lo_open && x == k->lo)) return 0;
+    if (x > k->hi || (k->hi_open && x == k->hi)) return 0;
+    return 1;
+}
+
+/* "a camera key (from, at, up) or '}'" */
+static void list_keys(char *buf, size_t size, const char *block, const KeySpec *keys, size_t n)
+{
+    size_t o = (size_t)snprintf(buf, size, "a %s key (", block);
+    for (size_t i = 0; i < n && o < size; i++)
+        o += (size_t)snprintf(buf + o, size - o, "%s%s", i ? ", " : "", keys[i].key);
+    if (o < size) snprintf(buf + o, size - o, ") or '}'");
+}
+
+static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
+                                   const char *name, uint *index);
+
+static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
+{
+    Error *err = p->err;
+    char what[160];
+    snprintf(what, sizeof what, "%s for '%s'", kind_what(k), k->key);
+    Token t;
+    Status st = next_token(p, lx, &t);
+    if (st) return st;
+    v->value = t;
+    switch (k->kind) {
+    case VK_NUMBER:
+        if (tok_float(&t, &v->f) || !in_range(k, v->f)) return lex_expected(lx, &t, what, err);
+        return ST_OK;
+    case VK_UINT:
+        if (tok_uint(&t, &v->u) || !in_range(k, (double)v->u)) return lex_expected(lx, &t, what, err);
+        return ST_OK;
+    case VK_VEC3:
+    case VK_COLOR:
+    case VK_DIR: {
+        float c[3];
+        for (int i = 0; i < 3; i++) {
+            if (i > 0 && (st = next_token(p, lx, &t))) return st;
+            if (tok_float(&t, &c[i]) || (k->kind == VK_COLOR && c[i] < 0.0f))
+                return lex_expected(lx, &t, what, err);
+        }
+        v->v = v3(c[0], c[1], c[2]);
+        if (k->kind == VK_DIR && v3_is_zero(v->v))
+            return lex_error_at(lx, &v->value, err, "expected %s, found 0 0 0", what);
+        return ST_OK;
+    }
+    case VK_ROTATE:
+    case VK_MATRIX: {
+        int n = k->kind == VK_ROTATE ? 4 : 16;
+        for (int i = 0; i < n; i++) {
+            if (i > 0 && (st = next_token(p, lx, &t))) return st;
+            if (tok_float(&t, &v->a[i])) return lex_expected(lx, &t, what, err);
+        }
+        if (k->kind == VK_ROTATE && v->a[0] == 0.0f && v->a[1] == 0.0f && v->a[2] == 0.0f)
+            return lex_error_at(lx, &v->value, err, "expected %s, found the axis 0 0 0", what);
+        return ST_OK;
+    }
+    case VK_SCALE:
+        /* one factor, or three: the token after the first tells which */
+        if (tok_float(&t, &v->a[0]) || v->a[0] == 0.0f) return lex_expected(lx, &t, what, err);
+        if ((st = next_token(p, lx, &t))) return st;
+        if (tok_float(&t, &v->a[1])) {
+            unread_token(p, &t);
+            v->a[1] = v->a[2] = v->a[0];
+            return ST_OK;
+        }
+        if (v->a[1] == 0.0f) return lex_expected(lx, &t, what, err);
+        if ((st = next_token(p, lx, &t))) return st;
+        if (tok_float(&t, &v->a[2]) || v->a[2] == 0.0f) return lex_expected(lx, &t, what, err);
+        return ST_OK;
+    case VK_WORD:
+        if (t.kind != TOK_WORD) return lex_expected(lx, &t, what, err);
+        v->word = t;
+        return ST_OK;
+    case VK_PATH:
+        if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
+            return lex_expected(lx, &t, what, err);
+        v->word = t;
+        return ST_OK;
+    case VK_TEXTURE: {
+        if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0) return lex_expected(lx, &t, what, err);
+        char *name = tok_copy(&t);
+        if (!name) return error_set(err, ST_INTERNAL, "out of memory");
+        v->u = scene_find_texture(p->s, name);
+        free(name);
+        if (v->u == NO_INDEX) {
+            char shown[64];
+            tok_describe(&t, shown, sizeof shown);
+            return lex_error_at(lx, &t, err, "texture '%s' is not defined (textures must be defined "
+                                "before they are used)", shown);
+        }
+        return ST_OK;
+    }
+    case VK_MATERIAL:
+        if (t.kind == TOK_LBRACE) return parse_material_block(p, lx, &v->key, 1, NULL, &v->material);
+        if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
+            return lex_expected(lx, &t, what, err);
+        {
+            char *name = tok_copy(&t);
+            if (!name) return error_set(err, ST_INTERNAL, "out of memory");
+            v->material = scene_find_material(p->s, name);
+            if (v->material == NO_INDEX) {
+                char shown[64];
+                tok_describe(&t, shown, sizeof shown);
+                free(name);
+                return lex_error_at(lx, &t, err,
+                                    "material '%s' is not defined (materials must be defined "
+                                    "before they are used)", shown);
+            }
+            free(name);
+        }
+        return ST_OK;
+    }
+    return error_set(err, ST_INTERNAL, "unhandled value kind");
+}
+
+/* Reads `{ key value ... }` after the statement keyword `kw` (from after the brace when
+ * the caller has already taken it), filling vals[i] for keys[i]; checks that every
+ * required key was given. */
+static Status parse_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
+                          const char *block, const KeySpec *keys, size_t n, Value *vals)
+{
+    Error *err = p->err;
+    memset(vals, 0, n * sizeof *vals);
+    Token t;
+    Status st = brace_taken ? ST_OK : next_token(p, lx, &t);
+    if (st) return st;
+    if (!brace_taken && t.kind != TOK_LBRACE) {
+        char what[80];
+        snprintf(what, sizeof what, "'{' to open the %s block", block);
+        return lex_expected(lx, &t, what, err);
+    }
+    for (;;) {
+        if ((st = next_token(p, lx, &t))) return st;
+        if (t.kind == TOK_RBRACE) break;
+        if (t.kind == TOK_EOF)
+            return lex_error_at(lx, &t, err,
+                                "expected '}' to close the %s block opened at line %u, "
+                                "found end of file", block, kw->line);
+        size_t i = n;
+        if (t.kind == TOK_WORD)
+            for (i = 0; i < n; i++)
+                if (tok_is(&t, keys[i].key)) break;
+        if (i == n) {
+            char what[256];
+            list_keys(what, sizeof what, block, keys, n);
+            return lex_expected(lx, &t, what, err);
+        }
+        if (vals[i].given)
+            return lex_error_at(lx, &t, err, "key '%s' repeated in the %s block (first given at %u:%u)",
+                                keys[i].key, block, vals[i].key.line, vals[i].key.col);
+        vals[i].given = 1;
+        vals[i].key = t;
+        if ((st = read_value(p, lx, &keys[i], &vals[i]))) return st;
+    }
+    for (size_t i = 0; i < n; i++)
+        if (keys[i].required && !vals[i].given)
+            return lex_error_at(lx, kw, err, "the %s block needs '%s' (it has no default)",
+                                block, keys[i].key);
+    return ST_OK;
+}
+
+/* Rejects a second camera/image/background block, naming where the first one was. */
+static Status once(Parser *p, const Lexer *lx, const Token *kw, char **seen)
+{
+    if (*seen)
+        return lex_error_at(lx, kw, p->err, "a second %.*s block (the first is at %s)",
+                            (int)kw->len, kw->text, *seen);
+    *seen = where_dup(lx, kw);
+    if (!*seen) return error_set(p->err, ST_INTERNAL, "out of memory");
+    return ST_OK;
+}
+
+static double len_d(vec3 a) { return sqrt((double)a.x * a.x + (double)a.y * a.y + (double)a.z * a.z); }
+
+static vec3 cross_d(vec3 a, vec3 b, double *length)
+{
+    double x = (double)a.y * b.z - (double)a.z * b.y;
+    double y = (double)a.z * b.x - (double)a.x * b.z;
+    double z = (double)a.x * b.y - (double)a.y * b.x;
+    *length = sqrt(x * x + y * y + z * z);
+    return v3((float)x, (float)y, (float)z);
+}
+
+/* ------------------------------------------------------------------ statements */
+
+enum { CAM_FROM, CAM_AT, CAM_UP, CAM_FOV, CAM_APERTURE, CAM_FOCUS, CAM_N };
+static const KeySpec camera_keys[CAM_N] = {
+    [CAM_FROM] = {"from", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [CAM_AT] = {"at", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [CAM_UP] = {"up", VK_DIR, 0, 0, 0, 0, 0, NULL},
+    [CAM_FOV] = {"fov", VK_NUMBER, 0, 0, 180, 1, 1, "a number of degrees in (0, 180)"},
+    [CAM_APERTURE] = {"aperture", VK_NUMBER, 0, 0, INFINITY, 0, 1, "a number >= 0"},
+    [CAM_FOCUS] = {"focus", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a distance > 0"},
+};
+
+static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[CAM_N];
+    Status st = once(p, lx, kw, &p->camera_at);
+    if (!st) st = parse_block(p, lx, kw, 0, "camera", camera_keys, CAM_N, v);
+    if (st) return st;
+    SceneCamera *c = &p->s->camera;
+    if (v[CAM_FROM].given) c->from = v[CAM_FROM].v;
+    if (v[CAM_AT].given) c->at = v[CAM_AT].v;
+    if (v[CAM_UP].given) c->up = v[CAM_UP].v;
+    if (v[CAM_FOV].given) c->vfov = v[CAM_FOV].f;
+    if (v[CAM_APERTURE].given) c->aperture = v[CAM_APERTURE].f;
+    if (v[CAM_FOCUS].given) c->focus_dist = v[CAM_FOCUS].f;
+    /* blame the key that made the camera invalid, or the block if the defaults did */
+    const Token *view_tok = v[CAM_AT].given ? &v[CAM_AT].key : v[CAM_FROM].given ? &v[CAM_FROM].key : kw;
+    vec3 dir = v3_sub(c->at, c->from);
+    double dist = len_d(dir);
+    if (!(dist > 0.0))
+        return lex_error_at(lx, view_tok, p->err, "camera 'from' and 'at' are the same point");
+    if (!isfinite(dist))
+        return lex_error_at(lx, view_tok, p->err, "camera 'from' and 'at' are too far apart");
+    double cl;
+    cross_d(dir, c->up, &cl);
+    /* sine of the angle between up and the view direction */
+    if (!(cl / (dist * len_d(c->up)) > 1e-6))
+        return lex_error_at(lx, v[CAM_UP].given ? &v[CAM_UP].key : view_tok, p->err,
+                            "camera 'up' is parallel to the view direction (from 'from' to 'at')");
+    return ST_OK;
+}
+
+enum { IMG_WIDTH, IMG_HEIGHT, IMG_SPP, IMG_DEPTH, IMG_SEED, IMG_N };
+static const KeySpec image_keys[IMG_N] = {
+    [IMG_WIDTH] = {"width", VK_UINT, 0, 1, CLPT_MAX_IMAGE_SIDE, 0, 0,
+                   "an integer in 1.." CLPT_STR(CLPT_MAX_IMAGE_SIDE)},
+    [IMG_HEIGHT] = {"height", VK_UINT, 0, 1, CLPT_MAX_IMAGE_SIDE, 0, 0,
+                    "an integer in 1.." CLPT_STR(CLPT_MAX_IMAGE_SIDE)},
+    [IMG_SPP] = {"spp", VK_UINT, 0, 1, CLPT_MAX_SPP, 0, 0, "an integer in 1.." CLPT_STR(CLPT_MAX_SPP)},
+    [IMG_DEPTH] = {"depth", VK_UINT, 0, 0, CLPT_MAX_DEPTH, 0, 0, "an integer in 0.." CLPT_STR(CLPT_MAX_DEPTH)},
+    [IMG_SEED] = {"seed", VK_UINT, 0, 0, 4294967295.0, 0, 0, "an integer in 0..4294967295"},
+};
+
+static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[IMG_N];
+    Status st = once(p, lx, kw, &p->image_at);
+    if (!st) st = parse_block(p, lx, kw, 0, "image", image_keys, IMG_N, v);
+    if (st) return st;
+    SceneImage *im = &p->s->image;
+    if (v[IMG_WIDTH].given) im->width = (uint)v[IMG_WIDTH].u;
+    if (v[IMG_HEIGHT].given) im->height = (uint)v[IMG_HEIGHT].u;
+    if (v[IMG_SPP].given) im->spp = (uint)v[IMG_SPP].u;
+    if (v[IMG_DEPTH].given) im->max_depth = (uint)v[IMG_DEPTH].u;
+    if (v[IMG_SEED].given) im->seed = (uint)v[IMG_SEED].u;
+    if (limit_pixels(im->width, im->height, ST_INPUT, "", NULL) != ST_OK) {
+        const Token *t = v[IMG_HEIGHT].given ? &v[IMG_HEIGHT].key : &v[IMG_WIDTH].key;
+        return lex_error_at(lx, t, p->err,
+                            "an image of %ux%u pixels is larger than clpt renders (at most %u "
+                            "pixels, as in 16384x8192)", im->width, im->height, CLPT_MAX_PIXELS);
+    }
+    return ST_OK;
+}
+
+enum { BG_COLOR, BG_HORIZON, BG_ZENITH, BG_AMBIENT, BG_N };
+static const KeySpec background_keys[BG_N] = {
+    [BG_COLOR] = {"color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [BG_HORIZON] = {"horizon", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [BG_ZENITH] = {"zenith", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [BG_AMBIENT] = {"ambient", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+};
+
+static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[BG_N];
+    Status st = once(p, lx, kw, &p->background_at);
+    if (!st) st = parse_block(p, lx, kw, 0, "background", background_keys, BG_N, v);
+    if (st) return st;
+    Scene *s = p->s;
+    if (v[BG_AMBIENT].given) s->ambient = v[BG_AMBIENT].v;   /* the whitted integrator's */
+    int sky = v[BG_HORIZON].given || v[BG_ZENITH].given;
+    if (v[BG_COLOR].given && sky) {
+        const Token *t = v[BG_HORIZON].given ? &v[BG_HORIZON].key : &v[BG_ZENITH].key;
+        if (t->line < v[BG_COLOR].key.line ||
+            (t->line == v[BG_COLOR].key.line && t->col < v[BG_COLOR].key.col))
+            t = &v[BG_COLOR].key;
+        return lex_error_at(lx, t, p->err,
+                            "a background is either 'color' (constant) or 'horizon' and "
+                            "'zenith' (sky), not both");
+    }
+    if (!v[BG_COLOR].given && !sky)
+        return lex_error_at(lx, kw, p->err,
+                            "the background block needs 'color', or 'horizon' and 'zenith'");
+    if (sky && !(v[BG_HORIZON].given && v[BG_ZENITH].given))
+        return lex_error_at(lx, kw, p->err, "a sky background needs both 'horizon' and 'zenith'");
+    if (sky) {
+        s->bg_type = BG_SKY;
+        s->bg_color = v[BG_HORIZON].v;
+        s->bg_zenith = v[BG_ZENITH].v;
+    } else {
+        s->bg_type = BG_CONSTANT;
+        s->bg_color = v[BG_COLOR].v;
+        s->bg_zenith = v[BG_COLOR].v;
+    }
+    return ST_OK;
+}
+
+enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE, MAT_KEY_EMISSION, MAT_KEY_SIDES,
+       MAT_KEY_SPECULAR, MAT_KEY_SHININESS, MAT_KEY_REFLECTIVE, MAT_KEY_TRANSPARENT, MAT_KEY_TEXTURE, MAT_KEY_N };
+static const KeySpec material_keys[MAT_KEY_N] = {
+    [MAT_KEY_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0,
+                      "a material type (diffuse, metal, dielectric, emissive, phong)"},
+    [MAT_KEY_ALBEDO] = {"albedo", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_FUZZ] = {"fuzz", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_IOR] = {"ior", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
+    [MAT_KEY_RADIANCE] = {"radiance", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_EMISSION] = {"emission", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_SIDES] = {"sides", VK_UINT, 0, 1, 2, 0, 0, "1 or 2 (the sides that emit)"},
+    [MAT_KEY_SPECULAR] = {"specular", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_SHININESS] = {"shininess", VK_NUMBER, 0, 0, 1e6, 0, 0, "a number in [0, 1e6]"},
+    [MAT_KEY_REFLECTIVE] = {"reflective", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_TRANSPARENT] = {"transparent", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_TEXTURE] = {"texture", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
+};
+
+/* Which keys each material type takes (bit i = material_keys[i]), and which it needs. */
+static const struct {
+    const char *name;
+    uint type;
+    unsigned allowed, required;
+} material_types[] = {
+    {"diffuse", MAT_DIFFUSE,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES | 1u << MAT_KEY_TEXTURE,
+     1u << MAT_KEY_ALBEDO},
+    {"metal", MAT_METAL,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_FUZZ | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES |
+     1u << MAT_KEY_TEXTURE,
+     1u << MAT_KEY_ALBEDO},
+    {"dielectric", MAT_DIELECTRIC, 1u << MAT_KEY_IOR | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES, 0},
+    {"emissive", MAT_EMISSIVE, 1u << MAT_KEY_RADIANCE | 1u << MAT_KEY_SIDES, 1u << MAT_KEY_RADIANCE},
+    {"phong", MAT_PHONG,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_SPECULAR | 1u << MAT_KEY_SHININESS | 1u << MAT_KEY_REFLECTIVE |
+     1u << MAT_KEY_TRANSPARENT | 1u << MAT_KEY_IOR | 1u << MAT_KEY_TEXTURE | 1u << MAT_KEY_EMISSION |
+     1u << MAT_KEY_SIDES,
+     1u << MAT_KEY_ALBEDO},
+};
+#define N_MATERIAL_TYPES (sizeof material_types / sizeof material_types[0])
+
+/* Reads a material's `{ ... }`; a NULL name makes an anonymous (inline) material. */
+static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
+                                   const char *name, uint *index)
+{
+    Value v[MAT_KEY_N];
+    Status st = parse_block(p, lx, kw, brace_taken, "material", material_keys, MAT_KEY_N, v);
+    if (st) return st;
+    size_t ti;
+    for (ti = 0; ti < N_MATERIAL_TYPES; ti++)
+        if (tok_is(&v[MAT_KEY_TYPE].word, material_types[ti].name)) break;
+    if (ti == N_MATERIAL_TYPES)
+        return lex_expected(lx, &v[MAT_KEY_TYPE].word, material_keys[MAT_KEY_TYPE].what, p->err);
+    unsigned allowed = material_types[ti].allowed | 1u << MAT_KEY_TYPE;
+    for (int i = 0; i < MAT_KEY_N; i++) {
+        if (!v[i].given || (allowed & (1u << i))) continue;
+        char what[160];
+        size_t o = (size_t)snprintf(what, sizeof what, "a %s material key (type",
+                                    material_types[ti].name);
+        for (int j = 1; j < MAT_KEY_N; j++)
+            if (allowed & (1u << j))
+                o += (size_t)snprintf(what + o, sizeof what - o, ", %s", material_keys[j].key);
+        snprintf(what + o, sizeof what - o, ") or '}'");
+        return lex_expected(lx, &v[i].key, what, p->err);
+    }
+    for (int i = 0; i < MAT_KEY_N; i++)
+        if ((material_types[ti].required & (1u << i)) && !v[i].given)
+            return lex_error_at(lx, kw, p->err, "a material of type %s needs '%s'",
+                                material_types[ti].name, material_keys[i].key);
+    Material m;
+    switch (material_types[ti].type) {
+    case MAT_METAL:
+        m = material_metal(v[MAT_KEY_ALBEDO].v, v[MAT_KEY_FUZZ].given ? v[MAT_KEY_FUZZ].f : 0.0f);
+        break;
+    case MAT_DIELECTRIC:
+        m = material_dielectric(v[MAT_KEY_IOR].given ? v[MAT_KEY_IOR].f : 1.5f);
+        break;
+    case MAT_EMISSIVE:
+        m = material_emissive(v[MAT_KEY_RADIANCE].v);
+        break;
+    case MAT_PHONG:
+        m = material_phong(v[MAT_KEY_ALBEDO].v, v[MAT_KEY_SPECULAR].given ? v[MAT_KEY_SPECULAR].v : v3s(0.0f),
+                           v[MAT_KEY_SHININESS].given ? v[MAT_KEY_SHININESS].f : 0.0f);
+        if (v[MAT_KEY_REFLECTIVE].given) m.reflective = v[MAT_KEY_REFLECTIVE].v;
+        if (v[MAT_KEY_TRANSPARENT].given) m.transparent = v[MAT_KEY_TRANSPARENT].v;
+        m.ior = v[MAT_KEY_IOR].given ? v[MAT_KEY_IOR].f : 1.5f;
+        break;
+    default:
+        m = material_diffuse(v[MAT_KEY_ALBEDO].v);
+        break;
+    }
+    /* a surface that both reflects and glows (the furnace test's sphere) */
+    if (v[MAT_KEY_EMISSION].given) m.emission = v[MAT_KEY_EMISSION].v;
+    if (v[MAT_KEY_SIDES].given && v[MAT_KEY_SIDES].u == 2) m.flags |= MAT_TWO_SIDED;
+    if (v[MAT_KEY_TEXTURE].given) m.texture = (uint)v[MAT_KEY_TEXTURE].u;
+    /* inline materials get the empty name, which no named material can have, so a
+     * lookup never finds them */
+    if ((st = scene_add_material(p->s, name ? name : "", m, index, p->err))) return st;
+    if (array_reserve((void **)&p->material_at, &p->cap_material_at, p->s->n_materials,
+                      sizeof(char *)))
+        return error_set(p->err, ST_INTERNAL, "out of memory");
+    while (p->n_material_at < p->s->n_materials) p->material_at[p->n_material_at++] = NULL;
+    /* only for messages: a failed copy just loses the "defined at" part */
+    if (name) p->material_at[*index] = where_dup(lx, kw);
+    return ST_OK;
+}
+
+static Status parse_material(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token t;
+    Status st = next_token(p, lx, &t);
+    if (st) return st;
+    if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
+        return lex_expected(lx, &t, "a material name", p->err);
+    char *name = tok_copy(&t);
+    if (!name) return error_set(p->err, ST_INTERNAL, "out of memory");
+    uint prev = scene_find_material(p->s, name);
+    if (prev != NO_INDEX) {
+        char shown[64];
+        tok_describe(&t, shown, sizeof shown);
+        const char *where = prev < p->n_material_at ? p->material_at[prev] : NULL;
+        st = lex_error_at(lx, &t, p->err, "material '%s' is already defined%s%s%s", shown,
+                          where ? " (at " : "", where ? where : "", where ? ")" : "");
+        free(name);
+        return st;
+    }
+    uint index;
+    st = parse_material_block(p, lx, kw, 0, name, &index);
+    free(name);
+    return st;
+}
+
+enum { SPH_CENTER, SPH_RADIUS, SPH_MATERIAL, SPH_N };
+static const KeySpec sphere_keys[SPH_N] = {
+    [SPH_CENTER] = {"center", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [SPH_RADIUS] = {"radius", VK_NUMBER, 1, 0, INFINITY, 1, 1, "a radius > 0"},
+    [SPH_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+static Status parse_sphere(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[SPH_N];
+    Status st = parse_block(p, lx, kw, 0, "sphere", sphere_keys, SPH_N, v);
+    if (st) return st;
+    vec3 c = v[SPH_CENTER].v;
+    float r = v[SPH_RADIUS].f;
+    /* a bounding box that overflows would leave the sphere out of the kd-tree */
+    if (!isfinite(fabsf(c.x) + r) || !isfinite(fabsf(c.y) + r) || !isfinite(fabsf(c.z) + r))
+        return lex_error_at(lx, &v[SPH_RADIUS].key, p->err,
+                            "the sphere reaches beyond the largest float (about 3.4e38)");
+    Sphere sp;
+    memset(&sp, 0, sizeof sp);
+    sp.center = c;
+    sp.radius = r;
+    sp.material = v[SPH_MATERIAL].material;
+    return scene_add_sphere(p->s, sp, p->err);
+}
+
+enum { PL_POINT, PL_NORMAL, PL_MATERIAL, PL_N };
+static const KeySpec plane_keys[PL_N] = {
+    [PL_POINT] = {"point", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [PL_NORMAL] = {"normal", VK_DIR, 1, 0, 0, 0, 0, NULL},
+    [PL_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+static Status parse_plane(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[PL_N];
+    Status st = parse_block(p, lx, kw, 0, "plane", plane_keys, PL_N, v);
+    if (st) return st;
+    vec3 n = v[PL_NORMAL].v, q = v[PL_POINT].v;
+    double len = len_d(n);
+    if (!isfinite(len))
+        return lex_error_at(lx, &v[PL_NORMAL].key, p->err, "plane 'normal' is too long to normalise");
+    double nx = n.x / len, ny = n.y / len, nz = n.z / len;
+    Plane pl;
+    memset(&pl, 0, sizeof pl);
+    pl.normal = v3((float)nx, (float)ny, (float)nz);
+    pl.offset = (float)(nx * q.x + ny * q.y + nz * q.z);
+    pl.material = v[PL_MATERIAL].material;
+    return scene_add_plane(p->s, pl, p->err);
+}
+
+static Status add_triangle(Parser *p, const Lexer *lx, const Token *kw, vec3 a, vec3 b, vec3 c,
+                           uint material, const char *which)
+{
+    double area2;
+    cross_d(v3_sub(b, a), v3_sub(c, a), &area2);
+    /* the kernels compute edges in float: corners 6e38 apart give infinite edges */
+    if (isnan(area2) || isinf(area2))
+        return lex_error_at(lx, kw, p->err, "%.*s: the corners %s are too far apart (their "
+                            "differences overflow single precision)", (int)kw->len, kw->text, which);
+    if (!(area2 > 0.0))
+        return lex_error_at(lx, kw, p->err, "degenerate %.*s: the corners %s lie on one line",
+                            (int)kw->len, kw->text, which);
+    Triangle t;
+    memset(&t, 0, sizeof t);
+    t.p0 = a;
+    t.p1 = b;
+    t.p2 = c;
+    t.material = material;
+    t.shading = NO_INDEX;
+    return scene_add_triangle(p->s, t, p->err);
+}
+
+enum { TRI_V0, TRI_V1, TRI_V2, TRI_V3, TRI_MATERIAL, TRI_N };
+static const KeySpec triangle_keys[TRI_N - 1] = {
+    {"v0", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    {"v1", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    {"v2", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+static const KeySpec quad_keys[TRI_N] = {
+    [TRI_V0] = {"v0", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [TRI_V1] = {"v1", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [TRI_V2] = {"v2", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [TRI_V3] = {"v3", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [TRI_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+static Status parse_triangle(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[TRI_N - 1];
+    Status st = parse_block(p, lx, kw, 0, "triangle", triangle_keys, TRI_N - 1, v);
+    if (st) return st;
+    return add_triangle(p, lx, kw, v[0].v, v[1].v, v[2].v, v[3].material, "v0 v1 v2");
+}
+
+static Status parse_quad(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[TRI_N];
+    Status st = parse_block(p, lx, kw, 0, "quad", quad_keys, TRI_N, v);
+    if (st) return st;
+    uint m = v[TRI_MATERIAL].material;
+    st = add_triangle(p, lx, kw, v[TRI_V0].v, v[TRI_V1].v, v[TRI_V2].v, m, "v0 v1 v2");
+    if (!st) st = add_triangle(p, lx, kw, v[TRI_V0].v, v[TRI_V2].v, v[TRI_V3].v, m, "v0 v2 v3");
+    return st;
+}
+
+enum { BOX_MIN, BOX_MAX, BOX_MATERIAL, BOX_N };
+static const KeySpec box_keys[BOX_N] = {
+    [BOX_MIN] = {"min", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [BOX_MAX] = {"max", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [BOX_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+static Status parse_box(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[BOX_N];
+    Status st = parse_block(p, lx, kw, 0, "box", box_keys, BOX_N, v);
+    if (st) return st;
+    vec3 lo = v[BOX_MIN].v, hi = v[BOX_MAX].v;
+    static const char axis[3] = {'x', 'y', 'z'};
+    for (int i = 0; i < 3; i++)
+        if (!(v3_get(lo, i) < v3_get(hi, i)))
+            return lex_error_at(lx, &v[BOX_MAX].key, p->err,
+                                "box 'max' must be greater than 'min' on every axis, "
+                                "but on %c it is %.9g <= %.9g",
+                                axis[i], (double)v3_get(hi, i), (double)v3_get(lo, i));
+    Box b;
+    memset(&b, 0, sizeof b);
+    b.lo = lo;
+    b.hi = hi;
+    b.material = v[BOX_MATERIAL].material;
+    return scene_add_box(p->s, b, p->err);
+}
+
+enum { MESH_FILE, MESH_MATERIAL, MESH_TRANSLATE, MESH_ROTATE, MESH_RX, MESH_RY, MESH_RZ, MESH_SCALE,
+       MESH_MATRIX, MESH_N };
+static const KeySpec mesh_keys[MESH_N] = {
+    [MESH_FILE] = {"file", VK_PATH, 1, 0, 0, 0, 0, NULL},
+    [MESH_MATERIAL] = {"material", VK_MATERIAL, 0, 0, 0, 0, 0, NULL},
+    [MESH_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [MESH_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},
+    [MESH_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [MESH_RY] = {"ry", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [MESH_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [MESH_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
+    [MESH_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
+};
+
+/* The instance transform of a mesh block: scale, then rotate, rx, ry, rz, then
+ * translate; or a whole affine matrix, which excludes the others. */
+static Status mesh_transform(Parser *p, const Lexer *lx, const Token *kw, const Value *v, Transform *out)
+{
+    Transform t = transform_identity();
+    if (v[MESH_MATRIX].given) {
+        for (int i = MESH_TRANSLATE; i < MESH_MATRIX; i++)
+            if (v[i].given) {
+                const Token *later = &v[i].key;
+                if (v[MESH_MATRIX].key.line > later->line ||
+                    (v[MESH_MATRIX].key.line == later->line && v[MESH_MATRIX].key.col > later->col))
+                    later = &v[MESH_MATRIX].key;
+                return lex_error_at(lx, later, p->err,
+                                    "'matrix' cannot be combined with translate, rotate, rx, ry, rz or scale "
+                                    "(fold them into the matrix)");
+            }
+        const float *a = v[MESH_MATRIX].a;
+        if (a[12] != 0.0f || a[13] != 0.0f || a[14] != 0.0f || a[15] != 1.0f)
+            return lex_error_at(lx, &v[MESH_MATRIX].key, p->err,
+                                "the last row of 'matrix' must be 0 0 0 1 (an affine transform), found "
+                                "%g %g %g %g", (double)a[12], (double)a[13], (double)a[14], (double)a[15]);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 4; j++) t.m[i][j] = a[4 * i + j];
+    } else {
+        if (v[MESH_SCALE].given) {
+            const float *a = v[MESH_SCALE].a;
+            t = transform_scale(a[0], a[1], a[2]);
+        }
+        Transform r;
+        if (v[MESH_ROTATE].given) {
+            const float *a = v[MESH_ROTATE].a;
+            r = transform_rotate(a[0], a[1], a[2], a[3]);
+            t = transform_compose(&r, &t);
+        }
+        for (int axis = 0; axis < 3; axis++) {
+            const Value *rv = &v[MESH_RX + axis];
+            if (!rv->given) continue;
+            r = transform_rotate(axis == 0, axis == 1, axis == 2, rv->f);
+            t = transform_compose(&r, &t);
+        }
+        if (v[MESH_TRANSLATE].given) {
+            vec3 d = v[MESH_TRANSLATE].v;
+            r = transform_translate(d.x, d.y, d.z);
+            t = transform_compose(&r, &t);
+        }
+    }
+    double det = transform_det(&t);
+    if (!(fabs(det) > 1e-300) || !isfinite(det)) {
+        const Token *at = v[MESH_MATRIX].given ? &v[MESH_MATRIX].key : v[MESH_SCALE].given ? &v[MESH_SCALE].key : kw;
+        return lex_error_at(lx, at, p->err, "the mesh transform is singular (it flattens the mesh)");
+    }
+    *out = t;
+    return ST_OK;
+}
+
+static Status parse_mesh(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[MESH_N];
+    Status st = parse_block(p, lx, kw, 0, "mesh", mesh_keys, MESH_N, v);
+    if (st) return st;
+    const Token *f = &v[MESH_FILE].word;
+    MeshOptions o = mesh_options(v[MESH_MATERIAL].given ? v[MESH_MATERIAL].material : NO_INDEX);
+    if ((st = mesh_transform(p, lx, kw, v, &o.xf))) return st;
+    char *path = path_beside(lx->path, f->text, f->len);
+    if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
+    if (mesh_kind(path) == MESH_NONE) {
+        free(path);
+        return lex_expected(lx, f, "a mesh file name ending in .obj or .ply", p->err);
+    }
+    st = mesh_load(path, p->s, &o, p->err);
+    free(path);
+    if (st == ST_IO)
+        error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+    else if (st)
+        error_append(p->err, " (in the mesh of %s:%u:%u)", lx->path, kw->line, kw->col);
+    return st;
+}
+
+/* ------------------------------------------------------------------ lights, textures */
+
+enum { LT_TYPE, LT_POSITION, LT_DIRECTION, LT_INTENSITY, LT_ATTEN, LT_ANGLE, LT_INNER, LT_N };
+static const KeySpec light_keys[LT_N] = {
+    [LT_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0, "a light type (point, spot, directional)"},
+    [LT_POSITION] = {"position", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [LT_DIRECTION] = {"direction", VK_DIR, 0, 0, 0, 0, 0, NULL},
+    [LT_INTENSITY] = {"intensity", VK_COLOR, 1, 0, 0, 0, 0, NULL},
+    [LT_ATTEN] = {"attenuation", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [LT_ANGLE] = {"angle", VK_NUMBER, 0, 0, 180, 1, 1, "a number of degrees in (0, 180)"},
+    [LT_INNER] = {"inner", VK_NUMBER, 0, 0, 180, 0, 1, "a number of degrees in [0, 180)"},
+};
+
+static Status parse_light(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[LT_N];
+    Status st = parse_block(p, lx, kw, 0, "light", light_keys, LT_N, v);
+    if (st) return st;
+    static const struct { const char *name; uint type; unsigned allowed; } types[] = {
+        {"point", LIGHT_POINT, 1u << LT_POSITION | 1u << LT_ATTEN},
+        {"spot", LIGHT_SPOT, 1u << LT_POSITION | 1u << LT_DIRECTION | 1u << LT_ATTEN | 1u << LT_ANGLE | 1u << LT_INNER},
+        {"directional", LIGHT_DIRECTIONAL, 1u << LT_DIRECTION},
+    };
+    size_t ti;
+    for (ti = 0; ti < 3; ti++)
+        if (tok_is(&v[LT_TYPE].word, types[ti].name)) break;
+    if (ti == 3) return lex_expected(lx, &v[LT_TYPE].word, light_keys[LT_TYPE].what, p->err);
+    unsigned allowed = types[ti].allowed | 1u << LT_TYPE | 1u << LT_INTENSITY;
+    for (int i = 0; i < LT_N; i++)
+        if (v[i].given && !(allowed & (1u << i)))
+            return lex_error_at(lx, &v[i].key, p->err, "a %s light has no '%s'", types[ti].name, light_keys[i].key);
+    Light l = light_default(types[ti].type);
+    l.intensity = v[LT_INTENSITY].v;
+    if (v[LT_POSITION].given) l.position = v[LT_POSITION].v;
+    if (v[LT_DIRECTION].given) {
+        vec3 d = v[LT_DIRECTION].v;
+        double len = len_d(d);
+        l.direction = v3((float)(d.x / len), (float)(d.y / len), (float)(d.z / len));
+    }
+    if (v[LT_ATTEN].given) {
+        if (v3_is_zero(v[LT_ATTEN].v))
+            return lex_error_at(lx, &v[LT_ATTEN].key, p->err, "'attenuation' (constant linear quadratic) must not be all 0");
+        l.atten0 = v[LT_ATTEN].v.x;
+        l.atten1 = v[LT_ATTEN].v.y;
+        l.atten2 = v[LT_ATTEN].v.z;
+    }
+    float outer = v[LT_ANGLE].given ? v[LT_ANGLE].f : 30.0f, inner = v[LT_INNER].given ? v[LT_INNER].f : outer;
+    if (inner > outer) return lex_error_at(lx, &v[LT_INNER].key, p->err, "'inner' must not exceed 'angle'");
+    l.cos_outer = (float)cos((double)outer * M_PI / 180.0);
+    l.cos_inner = (float)cos((double)inner * M_PI / 180.0);
+    return scene_add_light(p->s, l, p->err);
+}
+
+enum { TX_TYPE, TX_FILE, TX_ENCODING, TX_WRAP, TX_COLOR0, TX_COLOR1, TX_SPACE, TX_SCALE, TX_N };
+static const KeySpec texture_keys[TX_N] = {
+    [TX_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0, "a texture type (image, checker)"},
+    [TX_FILE] = {"file", VK_PATH, 0, 0, 0, 0, 0, NULL},
+    [TX_ENCODING] = {"encoding", VK_WORD, 0, 0, 0, 0, 0, "srgb or linear"},
+    [TX_WRAP] = {"wrap", VK_WORD, 0, 0, 0, 0, 0, "repeat or clamp"},
+    [TX_COLOR0] = {"color0", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [TX_COLOR1] = {"color1", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [TX_SPACE] = {"space", VK_WORD, 0, 0, 0, 0, 0, "uv or solid"},
+    [TX_SCALE] = {"scale", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
+};
+
+static Status parse_texture(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token t;
+    Status st = lex_next(lx, &t, p->err);
+    if (st) return st;
+    if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
+        return lex_expected(lx, &t, "a texture name", p->err);
+    char *name = tok_copy(&t);
+    if (!name) return error_set(p->err, ST_INTERNAL, "out of memory");
+    if (scene_find_texture(p->s, name) != NO_INDEX) {
+        char shown[64];
+        tok_describe(&t, shown, sizeof shown);
+        free(name);
+        return lex_error_at(lx, &t, p->err, "texture '%s' is already defined", shown);
+    }
+    Value v[TX_N];
+    if ((st = parse_block(p, lx, kw, 0, "texture", texture_keys, TX_N, v))) {
+        free(name);
+        return st;
+    }
+    int image = tok_is(&v[TX_TYPE].word, "image");
+    unsigned allowed = 1u << TX_TYPE | 1u << TX_SCALE;
+    if (image) allowed |= 1u << TX_FILE | 1u << TX_ENCODING | 1u << TX_WRAP;
+    else if (tok_is(&v[TX_TYPE].word, "checker")) allowed |= 1u << TX_COLOR0 | 1u << TX_COLOR1 | 1u << TX_SPACE;
+    else st = lex_expected(lx, &v[TX_TYPE].word, texture_keys[TX_TYPE].what, p->err);
+    for (int i = 0; !st && i < TX_N; i++)
+        if (v[i].given && !(allowed & (1u << i)))
+            st = lex_error_at(lx, &v[i].key, p->err, "an %s texture has no '%s'", image ? "image" : "checker",
+                              texture_keys[i].key);
+    struct { int index; const char *a, *b; } words[] = {
+        {TX_ENCODING, "srgb", "linear"}, {TX_WRAP, "repeat", "clamp"}, {TX_SPACE, "uv", "solid"} };
+    int second[TX_N] = {0};
+    for (size_t i = 0; !st && i < sizeof words / sizeof words[0]; i++) {
+        const Value *w = &v[words[i].index];
+        if (!w->given) continue;
+        if (tok_is(&w->word, words[i].b)) second[words[i].index] = 1;
+        else if (!tok_is(&w->word, words[i].a))
+            st = lex_expected(lx, &w->word, texture_keys[words[i].index].what, p->err);
+    }
+    if (!st && image && !v[TX_FILE].given)
+        st = lex_error_at(lx, kw, p->err, "an image texture needs 'file'");
+    float scale = v[TX_SCALE].given ? v[TX_SCALE].f : 1.0f;
+    if (!st && image) {
+        const Token *f = &v[TX_FILE].word;
+        char *path = path_beside(lx->path, f->text, f->len);
+        if (!path) st = error_set(p->err, ST_INTERNAL, "out of memory");
+        uint index;
+        if (!st) st = texture_load_image(p->s, name, path, second[TX_ENCODING], second[TX_WRAP], &index, p->err);
+        free(path);
+        if (st == ST_IO || st == ST_INPUT) error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+        if (!st) texture_set_scale_offset(&p->s->textures[index], scale, scale, 0.0f, 0.0f);
+    } else if (!st) {
+        Texture tx = texture_make_checker(v[TX_COLOR0].given ? v[TX_COLOR0].v : v3s(0.8f),
+                                     v[TX_COLOR1].given ? v[TX_COLOR1].v : v3s(0.2f), scale, second[TX_SPACE]);
+        st = scene_add_texture(p->s, name, NULL, tx, NULL, p->err);
+    }
+    free(name);
+    return st;
+}
+
+static Status parse_file(Parser *p, const char *path);
+
+static Status parse_include(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token t;
+    Status st = next_token(p, lx, &t);
+    if (st) return st;
+    if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
+        return lex_expected(lx, &t, "a file name after 'include'", p->err);
+    if (p->depth + 1 >= CLPT_MAX_INCLUDE_DEPTH) {
+        p->depth_exceeded = 1;
+        return lex_error_at(lx, kw, p->err,
+                            "includes nested more than %d deep (does a file include itself?)",
+                            CLPT_MAX_INCLUDE_DEPTH);
+    }
+    char *path = path_beside(lx->path, t.text, t.len);
+    if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
+    p->depth++;
+    st = parse_file(p, path);
+    p->depth--;
+    free(path);
+    if (st == ST_IO)
+        error_prefix(p->err, "%s:%u:%u", lx->path, t.line, t.col);
+    else if (st && !p->depth_exceeded)
+        error_append(p->err, " (included from %s:%u:%u)", lx->path, kw->line, kw->col);
+    return st;
+}
+
+static const struct {
+    const char *keyword;
+    Status (*parse)(Parser *p, Lexer *lx, const Token *kw);
+} statements[] = {
+    {"camera", parse_camera},   {"image", parse_image},       {"background", parse_background},
+    {"material", parse_material}, {"sphere", parse_sphere},   {"plane", parse_plane},
+    {"triangle", parse_triangle}, {"quad", parse_quad},       {"box", parse_box},
+    {"mesh", parse_mesh},       {"include", parse_include},   {"light", parse_light},
+    {"texture", parse_texture},
+};
+#define N_STATEMENTS (sizeof statements / sizeof statements[0])
+
+static Status parse_statements(Parser *p, Lexer *lx)
+{
+    Status st;
+    for (;;) {
+        Token t;
+        if ((st = next_token(p, lx, &t)) || t.kind == TOK_EOF) break;
+        size_t i = N_STATEMENTS;
+        if (t.kind == TOK_WORD)
+            for (i = 0; i < N_STATEMENTS; i++)
+                if (tok_is(&t, statements[i].keyword)) break;
+        if (i == N_STATEMENTS) {
+            st = lex_expected(lx, &t,
+                              "a statement (camera, image, background, material, sphere, "
+                              "plane, triangle, quad, box, mesh, light, texture, include)", p->err);
+            break;
+        }
+        if ((st = statements[i].parse(p, lx, &t))) break;
+    }
+    return st;
+}
+
+static Status parse_file(Parser *p, const char *path)
+{
+    Lexer lx;
+    Status st = lex_open_file(&lx, path, p->err);
+    if (st) return st;
+    st = parse_statements(p, &lx);
+    lex_close(&lx);
+    return st;
+}
+
+/* scene_load and scene_load_text: `text` NULL reads the file `path`. */
+static Status load(const char *path, const char *text, size_t len, Scene *s, Error *err)
+{
+    free(s->path);
+    size_t n = strlen(path);
+    s->path = malloc(n + 1);
+    if (!s->path) return error_set(err, ST_INTERNAL, "out of memory");
+    memcpy(s->path, path, n + 1);
+    Parser p;
+    memset(&p, 0, sizeof p);
+    p.s = s;
+    p.err = err;
+    Status st;
+    if (text) {
+        Lexer lx;
+        st = lex_open_text(&lx, path, text, len, err);
+        if (!st) st = parse_statements(&p, &lx);
+        lex_close(&lx);
+    } else {
+        st = parse_file(&p, path);
+    }
+    free(p.camera_at);
+    free(p.image_at);
+    free(p.background_at);
+    for (size_t i = 0; i < p.n_material_at; i++) free(p.material_at[i]);
+    free(p.material_at);
+    return st;
+}
+
+Status scene_load(const char *path, Scene *s, Error *err)
+{
+    return load(path, NULL, 0, s, err);
+}
+
+Status scene_load_text(const char *path, const char *text, size_t len, Scene *s, Error *err)
+{
+    return load(path, text, len, s, err);
+}

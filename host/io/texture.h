@@ -1,0 +1,35 @@
+/*
+ * texture.h — textures for the scene (kernels/texture.h evaluates them): image files
+ * read through Debian's stb_image (PNG, JPEG, BMP, TGA, GIF, PSD, PNM and Radiance HDR),
+ * and checkerboards.
+ *
+ * An image's texels are stored once per (file, colour encoding) however many textures
+ * use it: each texture record only adds its own wrap mode and (u, v) transform.
+ */
+#ifndef CLPT_TEXTURE_H_HOST
+#define CLPT_TEXTURE_H_HOST
+
+#include "scene/scene.h"
+
+/* A checkerboard of colours c0 and c1 with cells 1/scale wide: in 3D at the hit point
+ * when `solid`, else on the surface's (u, v). */
+Texture texture_make_checker(vec3 c0, vec3 c1, float scale, int solid);
+
+/* Sets the map from (u, v) (or the 3D point of a solid texture) to texture space to
+ * scale first, then offset: (s_u u + o_u, s_v v + o_v) (the z row, for solid
+ * textures, scales by s_u). */
+void texture_set_scale_offset(Texture *t, float su, float sv, float ou, float ov);
+
+/* Sets the full 3x4 row-major map to texture space. */
+void texture_set_matrix(Texture *t, const float m[12]);
+
+/* Reads the image file at `path` (or reuses the texels of an earlier read of it with
+ * the same encoding) and adds an image texture for it to the scene, with the given name
+ * (NULL: anonymous). 8-bit images are sRGB-encoded colours unless `linear`; HDR images
+ * are linear floats. `clamp` clamps coordinates at the edges instead of repeating.
+ * Errors: ST_IO "cannot open 'path': reason" when the file cannot be read, ST_INPUT
+ * "'path': not an image stb_image can read (reason)" when it cannot be decoded. */
+Status texture_load_image(Scene *s, const char *name, const char *path, int linear, int clamp,
+                          uint *index, Error *err);
+
+#endif /* CLPT_TEXTURE_H_HOST */

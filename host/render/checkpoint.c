@@ -1,0 +1,275 @@
+/* checkpoint.c — see checkpoint.h; the file format is documented in docs/checkpoint.md. */
+#include "render/checkpoint.h"
+
+#include <errno.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "base/atomic_file.h"
+#include "device/ocl_program.h"
+#include "base/sha256.h"
+
+#define CKPT_MAGIC "CLPTCKPT"
+#define CKPT_VERSION 1u
+#define CKPT_HEADER_SIZE 128u
+#define CKPT_TRAILER_SIZE SHA256_DIGEST_SIZE
+
+/* ------------------------------------------------------------------ render key */
+
+static void hash_part(Sha256 *h, const char *name, const void *data, size_t bytes)
+{
+    /* name and length first, so that no two different scenes hash the same bytes */
+    uint64_t n = bytes;
+    sha256_update(h, name, strlen(name) + 1);
+    sha256_update(h, &n, sizeof n);
+    if (bytes) sha256_update(h, data, bytes);
+}
+
+void checkpoint_id(const DeviceScene *ds, uint spp, CheckpointId *id)
+{
+    const RenderParams *p = &ds->params;
+    Sha256 h;
+    sha256_init(&h);
+    hash_part(&h, "clpt render key 1", NULL, 0);
+    /* The kernels decide every bit of a sample: a clpt with other kernels must not add
+     * its samples to this film. */
+    hash_part(&h, "kernels", clpt_kernel_source, clpt_kernel_source_len);
+    hash_part(&h, "params", p, sizeof *p);
+    hash_part(&h, "spp", &spp, sizeof spp);
+    hash_part(&h, "nodes", ds->nodes, (size_t)p->n_nodes * sizeof *ds->nodes);
+    hash_part(&h, "leaf prims", ds->leaf_prims, (size_t)p->n_leaf_prims * sizeof *ds->leaf_prims);
+    hash_part(&h, "spheres", ds->spheres, (size_t)p->n_spheres * sizeof *ds->spheres);
+    hash_part(&h, "triangles", ds->triangles, (size_t)p->n_triangles * sizeof *ds->triangles);
+    hash_part(&h, "boxes", ds->boxes, (size_t)p->n_boxes * sizeof *ds->boxes);
+    hash_part(&h, "planes", ds->planes, (size_t)p->n_planes * sizeof *ds->planes);
+    hash_part(&h, "materials", ds->materials, (size_t)ds->n_materials * sizeof *ds->materials);
+    hash_part(&h, "lights", ds->lights, (size_t)p->n_lights * sizeof *ds->lights);
+    hash_part(&h, "shading", ds->shading, (size_t)ds->n_shading * sizeof *ds->shading);
+    memset(id, 0, sizeof *id);
+    sha256_final(&h, id->key);
+    id->width = p->width;
+    id->height = p->height;
+    id->spp = spp;
+    id->seed = p->seed;
+    id->max_depth = p->max_depth;
+}
+
+/* ------------------------------------------------------------------ little-endian */
+
+static void put32(unsigned char *b, uint32_t v)
+{
+    for (int i = 0; i < 4; i++) b[i] = (unsigned char)(v >> (8 * i));
+}
+
+static void put64(unsigned char *b, uint64_t v)
+{
+    for (int i = 0; i < 8; i++) b[i] = (unsigned char)(v >> (8 * i));
+}
+
+static uint32_t get32(const unsigned char *b)
+{
+    uint32_t v = 0;
+    for (int i = 3; i >= 0; i--) v = v << 8 | b[i];
+    return v;
+}
+
+static uint64_t get64(const unsigned char *b)
+{
+    uint64_t v = 0;
+    for (int i = 7; i >= 0; i--) v = v << 8 | b[i];
+    return v;
+}
+
+/* ------------------------------------------------------------------ writing */
+
+/* The checkpoint file being written, with the hash of its payload as it goes (for the
+ * trailer). */
+typedef struct {
+    AtomicFile af;
+    Sha256 hash;
+} CheckpointOut;
+
+static void out_put(CheckpointOut *o, const void *data, size_t n, int hashed)
+{
+    if (hashed) sha256_update(&o->hash, data, n);
+    atomic_write(&o->af, data, n);
+}
+
+Status checkpoint_write(const char *path, const CheckpointId *id, const Film *film, const Batch *done,
+                        size_t n_done, Error *err)
+{
+    CheckpointOut o;
+    Status st = atomic_open(&o.af, path, "checkpoint", err);
+    if (st) return st;
+    sha256_init(&o.hash);
+
+    size_t n_values = (size_t)film->width * film->height * 3u;
+    uint64_t payload = (uint64_t)n_done * 8u + (uint64_t)n_values * 8u;
+    unsigned char header[CKPT_HEADER_SIZE];
+    memset(header, 0, sizeof header);
+    memcpy(header, CKPT_MAGIC, 8);
+    put32(header + 8, CKPT_VERSION);
+    put32(header + 12, CKPT_HEADER_SIZE);
+    memcpy(header + 16, id->key, CHECKPOINT_KEY_SIZE);
+    put32(header + 48, id->width);
+    put32(header + 52, id->height);
+    put32(header + 56, id->spp);
+    put32(header + 60, id->seed);
+    put32(header + 64, id->max_depth);
+    put32(header + 68, (uint32_t)n_done);
+    put64(header + 72, film->samples);
+    put64(header + 80, payload);
+    out_put(&o, header, sizeof header, 1);
+    for (size_t i = 0; i < n_done; i++) {
+        unsigned char r[8];
+        put32(r, done[i].first);
+        put32(r + 4, done[i].count);
+        out_put(&o, r, sizeof r, 1);
+    }
+    unsigned char chunk[4096 * 8];
+    for (size_t i = 0; i < n_values && !o.af.failed_step;) {
+        size_t k = 0;
+        for (; k < 4096 && i < n_values; k++, i++) put64(chunk + 8 * k, (uint64_t)film->sum[i]);
+        out_put(&o, chunk, 8 * k, 1);
+    }
+    unsigned char digest[SHA256_DIGEST_SIZE];
+    sha256_final(&o.hash, digest);
+    out_put(&o, digest, sizeof digest, 0);
+    return atomic_commit(&o.af, err);
+}
+
+/* ------------------------------------------------------------------ reading */
+
+void checkpoint_free(Checkpoint *c)
+{
+    film_free(&c->film);
+    free(c->done);
+    memset(c, 0, sizeof *c);
+}
+
+static Status bad(Error *err, const char *path, const char *what)
+{
+    return error_set(err, ST_INPUT, "'%s' is not a usable clpt checkpoint: %s", path, what);
+}
+
+Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
+{
+    memset(c, 0, sizeof *c);
+    FILE *f = fopen(path, "rb");
+    if (!f) return error_set(err, ST_IO, "cannot read checkpoint '%s': %s", path, strerror(errno));
+    Status st = ST_OK;
+    unsigned char *data = NULL;
+    struct stat sb;
+    if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        st = error_set(err, ST_IO, "cannot read checkpoint '%s': not a regular file", path);
+        goto out;
+    }
+    /* Everything is checked against the file's size before anything is allocated from
+     * the header's counts. */
+    uint64_t size = (uint64_t)sb.st_size;
+    if (size < CKPT_HEADER_SIZE + CKPT_TRAILER_SIZE) {
+        st = bad(err, path, size >= 8 ? "truncated (shorter than its header)" : "too short to be one");
+        goto out;
+    }
+    if (size > SIZE_MAX || !(data = malloc((size_t)size))) {
+        st = error_set(err, ST_INTERNAL, "out of memory reading checkpoint '%s' (%llu bytes)", path,
+                       (unsigned long long)size);
+        goto out;
+    }
+    if (fread(data, 1, (size_t)size, f) != (size_t)size) {
+        st = error_set(err, ST_IO, "cannot read checkpoint '%s': %s", path, ferror(f) ? strerror(errno) : "short read");
+        goto out;
+    }
+    if (memcmp(data, CKPT_MAGIC, 8) != 0) {
+        st = bad(err, path, "wrong magic (not a checkpoint file)");
+        goto out;
+    }
+    uint32_t version = get32(data + 8);
+    if (version != CKPT_VERSION) {
+        char msg[128];
+        snprintf(msg, sizeof msg, "format version %u, this clpt reads version %u", version, CKPT_VERSION);
+        st = bad(err, path, msg);
+        goto out;
+    }
+    uint64_t payload = get64(data + 80);
+    if (get32(data + 12) != CKPT_HEADER_SIZE || payload != size - CKPT_HEADER_SIZE - CKPT_TRAILER_SIZE) {
+        st = bad(err, path, "truncated or extended (its size does not match its header)");
+        goto out;
+    }
+    unsigned char digest[SHA256_DIGEST_SIZE];
+    sha256(data, (size_t)(size - CKPT_TRAILER_SIZE), digest);
+    if (memcmp(digest, data + size - CKPT_TRAILER_SIZE, SHA256_DIGEST_SIZE) != 0) {
+        st = bad(err, path, "corrupt (checksum mismatch)");
+        goto out;
+    }
+    CheckpointId *id = &c->id;
+    memcpy(id->key, data + 16, CHECKPOINT_KEY_SIZE);
+    id->width = get32(data + 48);
+    id->height = get32(data + 52);
+    id->spp = get32(data + 56);
+    id->seed = get32(data + 60);
+    id->max_depth = get32(data + 64);
+    uint32_t n_done = get32(data + 68);
+    uint64_t samples = get64(data + 72);
+    uint64_t n_values = (uint64_t)id->width * id->height * 3u;
+    if (id->width == 0 || id->height == 0 || payload != (uint64_t)n_done * 8u + n_values * 8u) {
+        st = bad(err, path, "inconsistent header (image size and payload disagree)");
+        goto out;
+    }
+    if ((st = film_init(&c->film, id->width, id->height, err))) goto out;
+    c->done = malloc((n_done ? n_done : 1) * sizeof *c->done);
+    if (!c->done) {
+        st = error_set(err, ST_INTERNAL, "out of memory reading checkpoint '%s'", path);
+        goto out;
+    }
+    const unsigned char *p = data + CKPT_HEADER_SIZE;
+    uint64_t total = 0, end = 0;
+    for (uint32_t i = 0; i < n_done; i++, p += 8) {
+        Batch b = { get32(p), get32(p + 4) };
+        /* sorted, disjoint, non-empty and within the render's samples */
+        if (b.count == 0 || b.first < end || (uint64_t)b.first + b.count > id->spp) {
+            st = bad(err, path, "inconsistent sample ranges");
+            goto out;
+        }
+        end = (uint64_t)b.first + b.count;
+        total += b.count;
+        c->done[i] = b;
+    }
+    c->n_done = n_done;
+    if (total != samples) {
+        st = bad(err, path, "inconsistent sample count");
+        goto out;
+    }
+    c->film.samples = samples;
+    for (uint64_t i = 0; i < n_values; i++, p += 8) c->film.sum[i] = (int64_t)get64(p);
+
+out:
+    free(data);
+    fclose(f);
+    return st;
+}
+
+Status checkpoint_check(const Checkpoint *c, const char *path, const CheckpointId *e, Error *err)
+{
+    const CheckpointId *g = &c->id;
+    char what[256];
+    if (g->width != e->width || g->height != e->height)
+        snprintf(what, sizeof what, "it is %ux%u pixels, this render %ux%u", g->width, g->height, e->width, e->height);
+    else if (g->spp != e->spp)
+        snprintf(what, sizeof what, "it is for %u samples per pixel, this render %u", g->spp, e->spp);
+    else if (g->seed != e->seed)
+        snprintf(what, sizeof what, "its seed is %u, this render's %u", g->seed, e->seed);
+    else if (g->max_depth != e->max_depth)
+        snprintf(what, sizeof what, "its maximum depth is %u, this render's %u", g->max_depth, e->max_depth);
+    else if (memcmp(g->key, e->key, CHECKPOINT_KEY_SIZE) != 0)
+        snprintf(what, sizeof what, "the scene differs (geometry, materials, camera or lights), or it was made "
+                                    "by a clpt with other kernels");
+    else
+        return ST_OK;
+    return error_set(err, ST_INPUT,
+                     "checkpoint '%s' belongs to another render: %s; refusing to resume (resume with the scene and "
+                     "settings it was made with, or start afresh without --resume)", path, what);
+}

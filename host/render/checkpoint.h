@@ -1,0 +1,59 @@
+/*
+ * checkpoint.h — saving and resuming the accumulation state of a render.
+ *
+ * A checkpoint holds the integer film (every pixel's fixed-point sums), the number of
+ * samples per pixel in it and which sample indices those are, plus an identity of the
+ * render: a SHA-256 "render key" over everything that determines the image (the prepared
+ * scene with its kd-tree, camera, size, seed, depth, the samples per pixel asked for, and
+ * the kernel source), and a few of those settings in clear for the error messages.
+ * Because the film is integer and every sample is a pure function of its indices, a
+ * render resumed from a checkpoint ends with the same bits as one never interrupted.
+ *
+ * Files are written atomically (temporary file beside the target, fsync, rename), so a
+ * kill at any moment leaves the previous checkpoint or the new one, never a torn one.
+ * The format (little-endian, versioned header, SHA-256 trailer) is in docs/checkpoint.md.
+ */
+#ifndef CLPT_CHECKPOINT_H
+#define CLPT_CHECKPOINT_H
+
+#include <stddef.h>
+
+#include "render/batch_queue.h"
+#include "device/device.h"
+#include "render/film.h"
+#include "base/status.h"
+
+#define CHECKPOINT_KEY_SIZE 32
+
+/* What a checkpoint belongs to. */
+typedef struct {
+    unsigned char key[CHECKPOINT_KEY_SIZE];
+    uint width, height, spp, seed, max_depth;
+} CheckpointId;
+
+typedef struct {
+    CheckpointId id;
+    Film film;            /* sums and samples per pixel */
+    Batch *done;          /* the sample ranges in the film: sorted, disjoint */
+    size_t n_done;
+} Checkpoint;
+
+/* The identity of the render of `ds` with `spp` samples per pixel. */
+void checkpoint_id(const DeviceScene *ds, uint spp, CheckpointId *id);
+
+/* Writes the film and its sample ranges to `path`, atomically. ST_IO naming the path and
+ * the failed step when it cannot be written. */
+Status checkpoint_write(const char *path, const CheckpointId *id, const Film *film, const Batch *done,
+                        size_t n_done, Error *err);
+
+/* Reads and validates a checkpoint: ST_IO when it cannot be read, ST_INPUT when it is not
+ * a checkpoint, of an unknown version, truncated, corrupt (checksum) or inconsistent.
+ * Free with checkpoint_free (also after a failure). */
+Status checkpoint_read(const char *path, Checkpoint *c, Error *err);
+
+/* ST_INPUT, naming the first difference, unless `c` belongs to the render `expected`. */
+Status checkpoint_check(const Checkpoint *c, const char *path, const CheckpointId *expected, Error *err);
+
+void checkpoint_free(Checkpoint *c);
+
+#endif /* CLPT_CHECKPOINT_H */

@@ -1,0 +1,154 @@
+/* passes.c — the adaptive pass and the auxiliary images (see passes.h). */
+#include "render/passes.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* Loads the (changed) scene into every device, renders spp samples into a new film. */
+static Status render_pass(const PassContext *pc, uint spp, Film *film, double *seconds, Error *err)
+{
+    const DeviceScene *ds = &pc->rs->ds;
+    Status st;
+    for (size_t i = 0; i < pc->n_devices; i++)
+        if ((st = pc->devices[i]->ops->load_scene(pc->devices[i], ds, err))) return st;
+    if ((st = film_init(film, ds->params.width, ds->params.height, err))) return st;
+    ScheduleConfig cfg = *pc->cfg;
+    cfg.spp = spp;
+    cfg.on_tick = NULL;
+    cfg.time_limit = 0.0;
+    ScheduleStats stats;
+    st = schedule_run(pc->devices, pc->n_devices, &cfg, film, &stats, err);
+    *seconds += stats.seconds;
+    schedule_stats_free(&stats);
+    return st;
+}
+
+static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; }
+
+size_t passes_mark_edges(const float *rgb, uint width, uint height, float threshold, uint *mask)
+{
+    size_t n = (size_t)width * height;
+    memset(mask, 0, n * sizeof *mask);
+    for (uint y = 0; y < height; y++)
+        for (uint x = 0; x < width; x++) {
+            size_t i = (size_t)y * width + x;
+            size_t nb[2] = { x + 1 < width ? i + 1 : i, y + 1 < height ? i + width : i };
+            for (int k = 0; k < 2; k++) {
+                size_t j = nb[k];
+                if (j == i) continue;
+                for (int c = 0; c < 3; c++) {
+                    float d = clamp01(rgb[3 * i + c]) - clamp01(rgb[3 * j + c]);
+                    if (d > threshold || -d > threshold) {
+                        mask[i] = mask[j] = 1u;
+                        break;
+                    }
+                }
+            }
+        }
+    size_t marked = 0;
+    for (size_t i = 0; i < n; i++) marked += mask[i];
+    return marked;
+}
+
+Status passes_adaptive(const PassContext *pc, float *rgb, uint base_spp, float threshold, uint extra,
+                       size_t *marked, double *seconds, Error *err)
+{
+    RenderParams *p = &pc->rs->ds.params;
+    size_t n = (size_t)p->width * p->height;
+    *marked = 0;
+    *seconds = 0.0;
+    uint *mask = malloc(n * sizeof *mask);
+    if (!mask) return error_set(err, ST_INTERNAL, "out of memory for the adaptive pass");
+    *marked = passes_mark_edges(rgb, p->width, p->height, threshold, mask);
+    if (*marked == 0) {
+        free(mask);
+        return ST_OK;
+    }
+    RenderParams saved = *p;
+    p->use_mask = 1;
+    /* fresh jittered samples: keys after the main pass's, never the pixel centre again */
+    p->strata = render_scene_strata(extra) ? render_scene_strata(extra) : 1u;
+    p->sample_offset = saved.sample_offset + base_spp;
+    pc->rs->ds.pixel_mask = mask;
+    Film film;
+    Status st = render_pass(pc, extra, &film, seconds, err);
+    *p = saved;
+    pc->rs->ds.pixel_mask = NULL;
+    if (st == ST_OK && film.samples > 0) {
+        float *more = malloc(n * 3 * sizeof *more);
+        if (!more) {
+            st = error_set(err, ST_INTERNAL, "out of memory for the adaptive pass");
+        } else {
+            film_resolve(&film, more);
+            double wa = (double)base_spp, wb = (double)film.samples;
+            for (size_t i = 0; i < n; i++)
+                if (mask[i])
+                    for (int c = 0; c < 3; c++)
+                        rgb[3 * i + c] = (float)((wa * rgb[3 * i + c] + wb * more[3 * i + c]) / (wa + wb));
+            free(more);
+        }
+    }
+    film_free(&film);
+    free(mask);
+    return st;
+}
+
+/* Depth samples arrive as (distance, 1, 0) per hit: the resolved pixel is (mean
+ * distance x coverage, coverage, 0). See passes.h for the grey scales. */
+static void depth_to_grey(float *rgb, size_t n, const DepthScale *scale)
+{
+    double lo = scale->near, hi = scale->far;
+    if (scale->mode == DEPTH_AUTO) {
+        int any = 0;
+        for (size_t i = 0; i < n; i++) {
+            if (!(rgb[3 * i + 1] > 0.0f)) continue;
+            double d = (double)rgb[3 * i] / rgb[3 * i + 1];
+            if (!any || d < lo) lo = d;
+            if (!any || d > hi) hi = d;
+            any = 1;
+        }
+    }
+    for (size_t i = 0; i < n; i++) {
+        float cover = rgb[3 * i + 1];
+        float g = 0.0f;
+        if (cover > 0.0f) {
+            double d = (double)rgb[3 * i] / cover, t = 1.0;
+            if (scale->mode == DEPTH_RAW) t = d;
+            else if (scale->mode == DEPTH_RANGE) t = hi > lo ? (hi - d) / (hi - lo) : 1.0;
+            else if (hi > lo && d > 0.0) t = (lo / d - lo / hi) / (1.0 - lo / hi);
+            if (scale->mode != DEPTH_RAW) t = (t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t)) * cover;
+            g = (float)t;
+        }
+        rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = g;
+    }
+}
+
+Status passes_aov(const PassContext *pc, uint aov, uint spp, const DepthScale *depth, float *rgb,
+                  double *seconds, Error *err)
+{
+    RenderParams *p = &pc->rs->ds.params;
+    RenderParams saved = *p;
+    p->integrator = aov;
+    p->strata = render_scene_strata(spp);
+    *seconds = 0.0;
+    Film film;
+    Status st = render_pass(pc, spp, &film, seconds, err);
+    *p = saved;
+    if (st == ST_OK) {
+        film_resolve(&film, rgb);
+        if (aov == INTEGRATOR_AOV_DEPTH) depth_to_grey(rgb, (size_t)p->width * p->height, depth);
+    }
+    film_free(&film);
+    return st;
+}
+
+char *passes_aov_path(const char *output, const char *name)
+{
+    const char *slash = strrchr(output, '/');
+    const char *dot = strrchr(output, '.');
+    size_t stem = dot && (!slash || dot > slash + 1) ? (size_t)(dot - output) : strlen(output);
+    size_t n = strlen(output) + strlen(name) + 2;
+    char *out = malloc(n);
+    if (out) snprintf(out, n, "%.*s-%s%s", (int)stem, output, name, output + stem);
+    return out;
+}

@@ -1,0 +1,57 @@
+/*
+ * passes.h — the render passes of the classic ray tracer after the main image: the
+ * adaptive supersampling pass, and the auxiliary images (normals, depth, albedo).
+ *
+ * Each pass changes a few render parameters (the integrator, a pixel mask, the pixel
+ * sampling), loads the scene into the devices again and renders with the scheduler as
+ * the main image did, so it runs on every selected device and gives the same bits on
+ * any of them.
+ */
+#ifndef CLPT_PASSES_H
+#define CLPT_PASSES_H
+
+#include "render/film.h"
+#include "render/render_scene.h"
+#include "render/schedule.h"
+
+typedef struct {
+    Device **devices;
+    size_t n_devices;
+    RenderScene *rs;                 /* its params are changed during a pass, restored after */
+    const ScheduleConfig *cfg;       /* progress, stop flag, warnings of the main render */
+} PassContext;
+
+/* Marks (mask[i] = 1) every pixel whose colour, clamped to [0,1], differs from one of its
+ * 4 neighbours by more than `threshold` in some channel, and both of the pair; returns
+ * how many are marked. */
+size_t passes_mark_edges(const float *rgb, uint width, uint height, float threshold, uint *mask);
+
+/* The adaptive pass: `rgb` holds the main image (`base_spp` samples per pixel); renders
+ * `extra` more jittered samples in every pixel passes_mark_edges marks and averages them
+ * in. *marked receives the number of such pixels, *seconds the pass's time. An
+ * interrupted pass averages in what it finished. */
+Status passes_adaptive(const PassContext *pc, float *rgb, uint base_spp, float threshold, uint extra,
+                       size_t *marked, double *seconds, Error *err);
+
+/* How distances become the depth image's grey (misses are always black):
+ *  DEPTH_AUTO   inverse distance normalised over the image, near/d: white at the nearest
+ *               hit, falling to black at the farthest, which keeps contrast in the
+ *               foreground when a plane runs to the horizon;
+ *  DEPTH_RANGE  linear, white at `near`, black at `far` and beyond (the courses' -depth);
+ *  DEPTH_RAW    the distance itself (for .pfm files). */
+typedef enum { DEPTH_AUTO, DEPTH_RANGE, DEPTH_RAW } DepthMode;
+typedef struct {
+    DepthMode mode;
+    double near, far;
+} DepthScale;
+
+/* Renders auxiliary image `aov` (INTEGRATOR_AOV_*) with `spp` samples per pixel (the main
+ * image's pixel sampling) into rgb: normals as (n + 1) / 2, albedo as it is, depth as
+ * grey by `depth`. */
+Status passes_aov(const PassContext *pc, uint aov, uint spp, const DepthScale *depth, float *rgb,
+                  double *seconds, Error *err);
+
+/* The file name of an auxiliary image: "out.png" and "normal" give "out-normal.png". */
+char *passes_aov_path(const char *output, const char *name);
+
+#endif /* CLPT_PASSES_H */

@@ -1,0 +1,80 @@
+/* render_scene.c — see render_scene.h. */
+#include "render/render_scene.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "scene/camera.h"
+
+/* Russian roulette starts after this many bounces: early bounces carry most of the
+ * image, so killing paths there adds noise for little time saved. */
+#define RR_START_BOUNCE 3u
+
+uint render_scene_strata(uint spp)
+{
+    if (spp <= 1u) return 0u;
+    uint m = (uint)sqrt((double)spp);
+    while (m * m > spp) m--;
+    while ((m + 1u) * (m + 1u) <= spp) m++;
+    return m * m == spp ? m : 1u;
+}
+
+Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *err)
+{
+    memset(out, 0, sizeof *out);
+    Status st;
+    if ((st = scene_prepare_lights(s, err))) return st;
+    RenderParams *p = &out->ds.params;
+    if ((st = camera_setup(&s->camera, s->image.width, s->image.height, &p->camera, err))) return st;
+    KdInput in = { s->spheres, s->n_spheres, s->triangles, s->n_triangles, s->boxes, s->n_boxes };
+    if ((st = kd_build(&in, kd_threads, &out->kd, err))) return st;
+    p->bg_type = s->bg_type;
+    p->bg_color = s->bg_color;
+    p->bg_zenith = s->bg_zenith;
+    p->width = s->image.width;
+    p->height = s->image.height;
+    p->max_depth = s->image.max_depth;
+    p->rr_depth = RR_START_BOUNCE;
+    p->seed = s->image.seed;
+    p->n_spheres = (uint)s->n_spheres;
+    p->n_triangles = (uint)s->n_triangles;
+    p->n_boxes = (uint)s->n_boxes;
+    p->n_planes = (uint)s->n_planes;
+    p->n_lights = (uint)s->n_lights;
+    p->n_nodes = out->kd.n_nodes;
+    p->n_leaf_prims = out->kd.n_leaf_prims;
+    p->bounds_lo = out->kd.lo;
+    p->bounds_hi = out->kd.hi;
+    out->ds.nodes = out->kd.nodes;
+    out->ds.leaf_prims = out->kd.leaf_prims;
+    out->ds.spheres = s->spheres;
+    out->ds.triangles = s->triangles;
+    out->ds.boxes = s->boxes;
+    out->ds.planes = s->planes;
+    out->ds.materials = s->materials;
+    out->ds.n_materials = (uint)s->n_materials;
+    out->ds.lights = s->lights;
+    out->ds.shading = s->shading;
+    out->ds.n_shading = (uint)s->n_shading;
+
+    /* the classic ray tracer's part (kernels/whitted.cl) */
+    p->ambient = s->ambient;
+    p->integrator = s->integrator;
+    p->mis_mode = MIS_BOTH;
+    p->n_area_lights = (uint)(s->n_lights - s->n_delta_lights);
+    p->n_textures = (uint)s->n_textures;
+    p->use_mask = 0;
+    p->strata = render_scene_strata(s->image.spp);
+    p->sample_offset = 0;
+    out->ds.textures = s->textures;
+    out->ds.texels = s->texels;
+    out->ds.n_texels = s->n_texels;
+    out->ds.pixel_mask = NULL;
+    return ST_OK;
+}
+
+void render_scene_free(RenderScene *r)
+{
+    kd_free(&r->kd);
+    memset(r, 0, sizeof *r);
+}

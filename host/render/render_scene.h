@@ -1,0 +1,28 @@
+/*
+ * render_scene.h — a loaded scene made ready for the devices: lights listed, camera
+ * prepared, kd-tree built, and everything gathered into the DeviceScene every device
+ * uploads. Used by main and by the tests, so both render the same way.
+ */
+#ifndef CLPT_RENDER_SCENE_H
+#define CLPT_RENDER_SCENE_H
+
+#include "device/device.h"
+#include "accel/kdtree.h"
+#include "scene/scene.h"
+
+typedef struct {
+    KdTree kd;
+    DeviceScene ds;       /* points into the Scene and the kd-tree: keep both alive */
+} RenderScene;
+
+/* The scene's image settings (size, depth, seed) are taken as they are now, so apply
+ * command-line overrides first. kd_threads: 0 = every core. */
+Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *err);
+void render_scene_free(RenderScene *r);
+
+/* How the whitted integrator places spp samples in a pixel (RenderParams.strata): 1 is
+ * the pixel centre (0), a square number an m x m jittered grid (m), any other number
+ * uniform jitter (1). */
+uint render_scene_strata(uint spp);
+
+#endif /* CLPT_RENDER_SCENE_H */

@@ -1,0 +1,87 @@
+/* camera.c — the thin-lens camera of "Ray Tracing in One Weekend" and the orthographic
+ * camera of the classic ray tracer, prepared in double precision on the host so every
+ * device starts from the same float values. */
+#include "scene/camera.h"
+
+#include "kmath.h"
+
+#include <math.h>
+#include <string.h>
+
+typedef struct { double x, y, z; } dvec3;
+
+static dvec3 dv(vec3 a) { dvec3 r = { a.x, a.y, a.z }; return r; }
+static dvec3 dsub(dvec3 a, dvec3 b) { dvec3 r = { a.x - b.x, a.y - b.y, a.z - b.z }; return r; }
+static dvec3 dscale(dvec3 a, double s) { dvec3 r = { a.x * s, a.y * s, a.z * s }; return r; }
+static double ddot(dvec3 a, dvec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static dvec3 dcross(dvec3 a, dvec3 b)
+{
+    dvec3 r = { a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x };
+    return r;
+}
+static vec3 fv(dvec3 a) { return v3((float)a.x, (float)a.y, (float)a.z); }
+
+Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *out, Error *err)
+{
+    dvec3 from = dv(desc->from), at = dv(desc->at), up = dv(desc->up);
+    dvec3 back = dsub(from, at);
+    double dist = sqrt(ddot(back, back));
+    if (!(dist > 0.0) || !isfinite(dist))
+        return error_set(err, ST_INPUT, "camera: 'from' and 'at' must be distinct finite points");
+    if (desc->type == CAMERA_ORTHOGRAPHIC && !(desc->ortho_height > 0.0f && isfinite(desc->ortho_height)))
+        return error_set(err, ST_INPUT, "camera: the orthographic view size must be > 0, got %g",
+                         (double)desc->ortho_height);
+    if (desc->type != CAMERA_ORTHOGRAPHIC && !(desc->vfov > 0.0f && desc->vfov < 180.0f))
+        return error_set(err, ST_INPUT, "camera: fov must be between 0 and 180 degrees, got %g",
+                         (double)desc->vfov);
+    if (!(desc->aperture >= 0.0f) || !isfinite(desc->aperture))
+        return error_set(err, ST_INPUT, "camera: aperture must be >= 0, got %g", (double)desc->aperture);
+    dvec3 w = dscale(back, 1.0 / dist);
+    dvec3 u = dcross(up, w);
+    double ulen = sqrt(ddot(u, u));
+    if (!(ulen > 1e-9 * sqrt(ddot(up, up))) || !(ulen > 0.0))
+        return error_set(err, ST_INPUT, "camera: 'up' must not be zero or parallel to the view direction");
+    u = dscale(u, 1.0 / ulen);
+    dvec3 v = dcross(w, u);
+
+    if (desc->type == CAMERA_ORTHOGRAPHIC) {
+        /* the view rectangle through the camera centre, ortho_height tall */
+        double vp_h = desc->ortho_height, vp_w = vp_h * (double)width / (double)height;
+        dvec3 horizontal = dscale(u, vp_w), vertical = dscale(v, vp_h);
+        dvec3 corner = { from.x - horizontal.x / 2 + vertical.x / 2, from.y - horizontal.y / 2 + vertical.y / 2,
+                         from.z - horizontal.z / 2 + vertical.z / 2 };
+        memset(out, 0, sizeof *out);
+        out->type = CAMERA_ORTHOGRAPHIC;
+        out->origin = fv(from);
+        out->corner = fv(corner);
+        out->horizontal = fv(horizontal);
+        out->vertical = fv(vertical);
+        out->lens_u = fv(u);
+        out->lens_v = fv(v);
+        out->forward = fv(dscale(w, -1.0));
+        return ST_OK;
+    }
+
+    double focus = desc->focus_dist > 0.0f ? (double)desc->focus_dist : dist;
+    if (!isfinite(focus))
+        return error_set(err, ST_INPUT, "camera: focus distance must be finite");
+    double h = tan((double)desc->vfov * M_PI / 360.0);
+    double vp_h = 2.0 * h * focus;
+    double vp_w = vp_h * (double)width / (double)height;
+    dvec3 horizontal = dscale(u, vp_w), vertical = dscale(v, vp_h);
+    dvec3 corner = { from.x - horizontal.x / 2 + vertical.x / 2 - focus * w.x,
+                     from.y - horizontal.y / 2 + vertical.y / 2 - focus * w.y,
+                     from.z - horizontal.z / 2 + vertical.z / 2 - focus * w.z };
+
+    memset(out, 0, sizeof *out);
+    out->type = CAMERA_PERSPECTIVE;
+    out->origin = fv(from);
+    out->lens_radius = (float)(desc->aperture * 0.5);
+    out->corner = fv(corner);
+    out->horizontal = fv(horizontal);
+    out->vertical = fv(vertical);
+    out->lens_u = fv(u);
+    out->lens_v = fv(v);
+    out->forward = fv(dscale(w, -1.0));
+    return ST_OK;
+}

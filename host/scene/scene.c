@@ -1,0 +1,429 @@
+/* scene.c — scene storage, material helpers and the light list. */
+#include "scene/scene.h"
+
+#include "kmath.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+void scene_init(Scene *s)
+{
+    memset(s, 0, sizeof *s);
+    s->camera.from = v3(0.0f, 0.0f, 0.0f);
+    s->camera.at = v3(0.0f, 0.0f, -1.0f);
+    s->camera.up = v3(0.0f, 1.0f, 0.0f);
+    s->camera.vfov = 40.0f;
+    s->camera.aperture = 0.0f;
+    s->camera.focus_dist = 0.0f;
+    s->image.width = 512;
+    s->image.height = 512;
+    s->image.spp = 64;
+    s->image.max_depth = 8;
+    s->image.seed = 1;
+    s->bg_type = BG_CONSTANT;
+    s->bg_color = v3(0.0f, 0.0f, 0.0f);
+    s->bg_zenith = v3(0.0f, 0.0f, 0.0f);
+    s->camera.type = CAMERA_PERSPECTIVE;
+    s->camera.ortho_height = 1.0f;
+    s->ambient = v3(0.0f, 0.0f, 0.0f);
+    s->integrator = INTEGRATOR_PATH;
+    s->linear_output = 0;
+}
+
+void scene_free(Scene *s)
+{
+    for (size_t i = 0; i < s->n_materials; i++) free(s->material_names[i]);
+    free(s->material_names);
+    for (size_t i = 0; i < s->n_material_textures; i++) free(s->material_textures[i]);
+    free(s->material_textures);
+    free(s->materials);
+    free(s->spheres);
+    free(s->triangles);
+    free(s->shading);
+    free(s->boxes);
+    free(s->planes);
+    free(s->lights);
+    free(s->delta_lights);
+    for (size_t i = 0; i < s->n_textures; i++) {
+        free(s->texture_names[i]);
+        free(s->texture_sources[i]);
+    }
+    free(s->texture_names);
+    free(s->texture_sources);
+    free(s->textures);
+    free(s->texels);
+    free(s->path);
+    memset(s, 0, sizeof *s);
+}
+
+int array_reserve(void **ptr, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap) return 0;
+    size_t new_cap = *cap ? *cap : 16;
+    while (new_cap < need) {
+        if (new_cap > SIZE_MAX / 2) return -1;
+        new_cap *= 2;
+    }
+    if (new_cap > SIZE_MAX / elem) return -1;
+    void *p = realloc(*ptr, new_cap * elem);
+    if (!p) return -1;
+    *ptr = p;
+    *cap = new_cap;
+    return 0;
+}
+
+/* One generic append for every primitive array: the id space is 32-bit (NO_INDEX is
+ * reserved), so the total primitive count is capped below 2^32 - 1. */
+static Status append(void **arr, size_t *n, size_t *cap, const void *item, size_t elem,
+                     const Scene *s, Error *err)
+{
+    size_t total = s->n_spheres + s->n_triangles + s->n_boxes + s->n_planes;
+    if (total >= (size_t)NO_INDEX - 1)
+        return error_set(err, ST_INPUT, "too many primitives (the limit is %u)", NO_INDEX - 2);
+    if (array_reserve(arr, cap, *n + 1, elem))
+        return error_set(err, ST_INTERNAL, "out of memory growing the scene");
+    memcpy((char *)*arr + *n * elem, item, elem);
+    (*n)++;
+    return ST_OK;
+}
+
+Status scene_add_material(Scene *s, const char *name, Material m, uint *index, Error *err)
+{
+    /* Both arrays share cap_materials. The names grow first, through a copy of it: if
+     * the materials then fail to grow, the recorded capacity is still the smaller one
+     * (the materials'), so neither array can be overrun by a later call. */
+    size_t cap_names = s->cap_materials;
+    if (array_reserve((void **)&s->material_names, &cap_names, s->n_materials + 1, sizeof(char *)) ||
+        array_reserve((void **)&s->materials, &s->cap_materials, s->n_materials + 1, sizeof m))
+        return error_set(err, ST_INTERNAL, "out of memory growing the material list");
+    char *copy = malloc(strlen(name) + 1);
+    if (!copy) return error_set(err, ST_INTERNAL, "out of memory");
+    strcpy(copy, name);
+    s->materials[s->n_materials] = m;
+    s->material_names[s->n_materials] = copy;
+    if (index) *index = (uint)s->n_materials;
+    s->n_materials++;
+    return ST_OK;
+}
+
+Status scene_add_sphere(Scene *s, Sphere sp, Error *err)
+{
+    sp.light = NO_INDEX;
+    return append((void **)&s->spheres, &s->n_spheres, &s->cap_spheres, &sp, sizeof sp, s, err);
+}
+
+Status scene_add_triangle(Scene *s, Triangle t, Error *err)
+{
+    t.light = NO_INDEX;
+    return append((void **)&s->triangles, &s->n_triangles, &s->cap_triangles, &t, sizeof t, s, err);
+}
+
+Status scene_add_shading(Scene *s, TriShading sh, uint *index, Error *err)
+{
+    if (s->n_shading >= (size_t)NO_INDEX - 1)
+        return error_set(err, ST_INPUT, "too many shading records");
+    if (array_reserve((void **)&s->shading, &s->cap_shading, s->n_shading + 1, sizeof sh))
+        return error_set(err, ST_INTERNAL, "out of memory growing the scene");
+    s->shading[s->n_shading] = sh;
+    if (index) *index = (uint)s->n_shading;
+    s->n_shading++;
+    return ST_OK;
+}
+
+Status scene_add_box(Scene *s, Box b, Error *err)
+{
+    b.light = NO_INDEX;
+    return append((void **)&s->boxes, &s->n_boxes, &s->cap_boxes, &b, sizeof b, s, err);
+}
+
+Status scene_add_plane(Scene *s, Plane p, Error *err)
+{
+    return append((void **)&s->planes, &s->n_planes, &s->cap_planes, &p, sizeof p, s, err);
+}
+
+Status scene_add_light(Scene *s, Light l, Error *err)
+{
+    if (s->n_delta_lights >= (size_t)NO_INDEX / 2)
+        return error_set(err, ST_INPUT, "too many lights");
+    if (array_reserve((void **)&s->delta_lights, &s->cap_delta_lights, s->n_delta_lights + 1, sizeof l))
+        return error_set(err, ST_INTERNAL, "out of memory growing the light list");
+    l.prim = NO_INDEX;
+    s->delta_lights[s->n_delta_lights++] = l;
+    return ST_OK;
+}
+
+static char *dup_or_null(const char *text, int *failed)
+{
+    if (!text) return NULL;
+    char *copy = malloc(strlen(text) + 1);
+    if (!copy) *failed = 1;
+    else strcpy(copy, text);
+    return copy;
+}
+
+Status scene_add_texture(Scene *s, const char *name, const char *source, Texture t, uint *index,
+                         Error *err)
+{
+    if (s->n_textures >= (size_t)NO_INDEX - 1) return error_set(err, ST_INPUT, "too many textures");
+    /* the three arrays share cap_textures: grow the two side arrays through copies of
+     * it, so that a failure leaves the recorded capacity the smallest of the three */
+    size_t cap_a = s->cap_textures, cap_b = s->cap_textures;
+    if (array_reserve((void **)&s->texture_names, &cap_a, s->n_textures + 1, sizeof(char *)) ||
+        array_reserve((void **)&s->texture_sources, &cap_b, s->n_textures + 1, sizeof(char *)) ||
+        array_reserve((void **)&s->textures, &s->cap_textures, s->n_textures + 1, sizeof t))
+        return error_set(err, ST_INTERNAL, "out of memory growing the texture list");
+    int failed = 0;
+    char *n = dup_or_null(name, &failed), *src = dup_or_null(source, &failed);
+    if (failed) {
+        free(n);
+        free(src);
+        return error_set(err, ST_INTERNAL, "out of memory");
+    }
+    s->textures[s->n_textures] = t;
+    s->texture_names[s->n_textures] = n;
+    s->texture_sources[s->n_textures] = src;
+    if (index) *index = (uint)s->n_textures;
+    s->n_textures++;
+    return ST_OK;
+}
+
+Status scene_add_texels(Scene *s, const uint *texels, size_t n, uint *offset, Error *err)
+{
+    if (n > (size_t)NO_INDEX - 1 - s->n_texels)
+        return error_set(err, ST_INPUT, "the textures are too large together (more than 2^32 texels)");
+    if (array_reserve((void **)&s->texels, &s->cap_texels, s->n_texels + n, sizeof *texels))
+        return error_set(err, ST_INTERNAL, "out of memory for the texture images");
+    memcpy(s->texels + s->n_texels, texels, n * sizeof *texels);
+    *offset = (uint)s->n_texels;
+    s->n_texels += n;
+    return ST_OK;
+}
+
+uint scene_find_texture(const Scene *s, const char *name)
+{
+    for (size_t i = 0; i < s->n_textures; i++)
+        if (s->texture_names[i] && strcmp(s->texture_names[i], name) == 0) return (uint)i;
+    return NO_INDEX;
+}
+
+Status scene_set_material_texture(Scene *s, uint index, const char *path, Error *err)
+{
+    if (index >= s->n_materials)
+        return error_set(err, ST_INTERNAL, "texture for material %u of %zu", index, s->n_materials);
+    if (index >= s->n_material_textures) {
+        char **grown = realloc(s->material_textures, (index + 1) * sizeof *grown);
+        if (!grown) return error_set(err, ST_INTERNAL, "out of memory");
+        for (size_t i = s->n_material_textures; i <= index; i++) grown[i] = NULL;
+        s->material_textures = grown;
+        s->n_material_textures = (size_t)index + 1;
+    }
+    char *copy = malloc(strlen(path) + 1);
+    if (!copy) return error_set(err, ST_INTERNAL, "out of memory");
+    strcpy(copy, path);
+    free(s->material_textures[index]);
+    s->material_textures[index] = copy;
+    return ST_OK;
+}
+
+const char *scene_material_texture(const Scene *s, uint index)
+{
+    return index < s->n_material_textures ? s->material_textures[index] : NULL;
+}
+
+uint scene_find_material(const Scene *s, const char *name)
+{
+    for (size_t i = 0; i < s->n_materials; i++)
+        if (strcmp(s->material_names[i], name) == 0) return (uint)i;
+    return NO_INDEX;
+}
+
+uint scene_first_triangle(const Scene *s) { return (uint)s->n_spheres; }
+uint scene_first_box(const Scene *s) { return (uint)(s->n_spheres + s->n_triangles); }
+uint scene_first_plane(const Scene *s) { return (uint)(s->n_spheres + s->n_triangles + s->n_boxes); }
+
+static Material material_base(uint type)
+{
+    Material m;
+    memset(&m, 0, sizeof m);
+    m.type = type;
+    m.texture = NO_INDEX;
+    m.ior = 1.5f;
+    return m;
+}
+
+Material material_diffuse(vec3 albedo)
+{
+    Material m = material_base(MAT_DIFFUSE);
+    m.albedo = albedo;
+    return m;
+}
+
+Material material_metal(vec3 albedo, float fuzz)
+{
+    Material m = material_base(MAT_METAL);
+    m.albedo = albedo;
+    m.fuzz = fuzz;
+    return m;
+}
+
+Material material_dielectric(float ior)
+{
+    Material m = material_base(MAT_DIELECTRIC);
+    m.albedo = v3s(1.0f);
+    m.ior = ior;
+    return m;
+}
+
+Material material_emissive(vec3 radiance)
+{
+    Material m = material_base(MAT_EMISSIVE);
+    m.emission = radiance;
+    return m;
+}
+
+Material material_phong(vec3 diffuse, vec3 specular, float shininess)
+{
+    Material m = material_base(MAT_PHONG);
+    m.albedo = diffuse;
+    m.specular = specular;
+    m.shininess = shininess;
+    m.ior = 1.0f;
+    return m;
+}
+
+Light light_default(uint type)
+{
+    Light l;
+    memset(&l, 0, sizeof l);
+    l.type = type;
+    l.prim = NO_INDEX;
+    l.atten2 = 1.0f;
+    l.direction = v3(0.0f, -1.0f, 0.0f);
+    l.cos_outer = (float)cos(M_PI / 6.0);
+    l.cos_inner = l.cos_outer;
+    return l;
+}
+
+static int is_emissive(const Scene *s, uint material)
+{
+    if (material >= s->n_materials) return 0;
+    /* any material may emit (a diffuse emitter is what the furnace test needs) */
+    return v3_luminance(s->materials[material].emission) > 0.0f;
+}
+
+static double triangle_area(const Triangle *t)
+{
+    vec3 c = v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0));
+    return 0.5 * sqrt((double)c.x * c.x + (double)c.y * c.y + (double)c.z * c.z);
+}
+
+static double box_area(const Box *b)
+{
+    double dx = (double)b->hi.x - b->lo.x, dy = (double)b->hi.y - b->lo.y, dz = (double)b->hi.z - b->lo.z;
+    return 2.0 * (dx * dy + dy * dz + dz * dx);
+}
+
+/* Radius of the bounding sphere of the finite primitives (1 when there are none): the
+ * size of the region a point or directional light shines on, for its power estimate. */
+static double scene_radius(const Scene *s)
+{
+    double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+#define GROW(p, r)                                                                        \
+    do {                                                                                  \
+        double c_[3] = { (p).x, (p).y, (p).z };                                           \
+        for (int a_ = 0; a_ < 3; a_++) {                                                  \
+            if (c_[a_] - (r) < lo[a_]) lo[a_] = c_[a_] - (r);                             \
+            if (c_[a_] + (r) > hi[a_]) hi[a_] = c_[a_] + (r);                             \
+        }                                                                                 \
+    } while (0)
+    for (size_t i = 0; i < s->n_spheres; i++) GROW(s->spheres[i].center, (double)s->spheres[i].radius);
+    for (size_t i = 0; i < s->n_triangles; i++) {
+        GROW(s->triangles[i].p0, 0.0);
+        GROW(s->triangles[i].p1, 0.0);
+        GROW(s->triangles[i].p2, 0.0);
+    }
+    for (size_t i = 0; i < s->n_boxes; i++) {
+        GROW(s->boxes[i].lo, 0.0);
+        GROW(s->boxes[i].hi, 0.0);
+    }
+#undef GROW
+    if (!(hi[0] >= lo[0])) return 1.0;
+    double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
+    double r = 0.5 * sqrt(dx * dx + dy * dy + dz * dz);
+    return r > 0.0 && isfinite(r) ? r : 1.0;
+}
+
+/* Estimated power of a delta light over a scene of radius r (see scene.h). */
+static double delta_light_power(const Light *l, double r)
+{
+    double lum = v3_luminance(l->intensity);
+    if (l->type == LIGHT_DIRECTIONAL) return M_PI * r * r * lum;
+    double atten = (double)l->atten0 + (double)l->atten1 * r + (double)l->atten2 * r * r;
+    double solid_angle = 4.0 * M_PI;
+    if (l->type == LIGHT_SPOT)
+        solid_angle = 2.0 * M_PI * (1.0 - 0.5 * ((double)l->cos_inner + (double)l->cos_outer));
+    return atten > 0.0 ? solid_angle * r * r * lum / atten : 0.0;
+}
+
+Status scene_prepare_lights(Scene *s, Error *err)
+{
+    free(s->lights);
+    s->lights = NULL;
+    s->n_lights = 0;
+    size_t n = 0;
+    for (size_t i = 0; i < s->n_spheres; i++) n += (size_t)is_emissive(s, s->spheres[i].material);
+    for (size_t i = 0; i < s->n_triangles; i++) n += (size_t)is_emissive(s, s->triangles[i].material);
+    for (size_t i = 0; i < s->n_boxes; i++) n += (size_t)is_emissive(s, s->boxes[i].material);
+    n += s->n_delta_lights;
+    if (n == 0) return ST_OK;
+    if (n >= (size_t)NO_INDEX) return error_set(err, ST_INPUT, "too many emissive primitives");
+    Light *lights = calloc(n, sizeof *lights);
+    double *power = calloc(n, sizeof *power);
+    if (!lights || !power) {
+        free(lights);
+        free(power);
+        return error_set(err, ST_INTERNAL, "out of memory building the light list");
+    }
+    size_t k = 0;
+    double total = 0.0;
+#define ADD_LIGHT(arr, count, first, area_expr)                                          \
+    for (size_t i = 0; i < (count); i++) {                                                \
+        if (!is_emissive(s, arr[i].material)) continue;                                   \
+        double area = (area_expr);                                                        \
+        lights[k].type = LIGHT_AREA;                                                      \
+        lights[k].prim = (uint)((first) + i);                                             \
+        lights[k].area = (float)area;                                                     \
+        power[k] = M_PI * area * v3_luminance(s->materials[arr[i].material].emission);   \
+        total += power[k];                                                                \
+        arr[i].light = (uint)k;                                                           \
+        k++;                                                                              \
+    }
+    ADD_LIGHT(s->spheres, s->n_spheres, 0, 4.0 * M_PI * (double)s->spheres[i].radius * s->spheres[i].radius)
+    ADD_LIGHT(s->triangles, s->n_triangles, scene_first_triangle(s), triangle_area(&s->triangles[i]))
+    ADD_LIGHT(s->boxes, s->n_boxes, scene_first_box(s), box_area(&s->boxes[i]))
+#undef ADD_LIGHT
+    double radius = s->n_delta_lights ? scene_radius(s) : 1.0;
+    for (size_t i = 0; i < s->n_delta_lights; i++, k++) {
+        lights[k] = s->delta_lights[i];
+        lights[k].prim = NO_INDEX;
+        power[k] = delta_light_power(&s->delta_lights[i], radius);
+        if (!(power[k] >= 0.0) || !isfinite(power[k])) power[k] = 0.0;
+        total += power[k];
+    }
+    /* Degenerate or black lights get zero power; if all are, choose uniformly so the
+     * distribution stays valid. */
+    double acc = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double p = total > 0.0 ? power[i] / total : 1.0 / (double)n;
+        acc += p;
+        lights[i].pick_pdf = (float)p;
+        lights[i].cdf = (float)acc;
+    }
+    lights[n - 1].cdf = 1.0f;  /* exact top so a uniform sample in [0,1) always lands */
+    free(power);
+    s->lights = lights;
+    s->n_lights = n;
+    return ST_OK;
+}

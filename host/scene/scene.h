@@ -1,0 +1,126 @@
+/*
+ * scene.h — the scene as the host holds it: camera and image settings as written in the
+ * scene file, named materials, and the primitive arrays in the exact layout the kernels
+ * read (kernels/types.h), so uploading is a copy.
+ */
+#ifndef CLPT_SCENE_H
+#define CLPT_SCENE_H
+
+#include <stddef.h>
+
+#include "base/status.h"
+#include "types.h"
+
+typedef struct {
+    vec3 from, at, up;
+    float vfov;          /* vertical field of view, degrees */
+    float aperture;      /* lens diameter; 0 is a pinhole */
+    float focus_dist;    /* distance to the plane in focus; <= 0 means |at - from| */
+    uint type;           /* enum CameraType */
+    float ortho_height;  /* orthographic: height of the view rectangle (world units) */
+} SceneCamera;
+
+typedef struct {
+    uint width, height;
+    uint spp;            /* samples per pixel */
+    uint max_depth;      /* bounces after the camera ray */
+    uint seed;
+} SceneImage;
+
+typedef struct {
+    char *path;                  /* scene file as given on the command line */
+    SceneCamera camera;
+    SceneImage image;
+    uint bg_type;                /* enum BackgroundType */
+    vec3 bg_color, bg_zenith;
+
+    Material *materials;   char **material_names;  size_t n_materials, cap_materials;
+    /* Per material: the albedo texture file a mesh's MTL names (map_Kd, resolved to a
+     * path), or NULL; n_material_textures <= n_materials (missing entries are NULL). */
+    char **material_textures;  size_t n_material_textures;
+    Sphere *spheres;       size_t n_spheres, cap_spheres;
+    Triangle *triangles;   size_t n_triangles, cap_triangles;
+    TriShading *shading;   size_t n_shading, cap_shading;
+    Box *boxes;            size_t n_boxes, cap_boxes;
+    Plane *planes;         size_t n_planes, cap_planes;
+    Light *lights;         size_t n_lights;     /* filled by scene_prepare_lights */
+
+    /* the classic ray tracer's additions (docs/classic-format.md) */
+    Light *delta_lights;   size_t n_delta_lights, cap_delta_lights;  /* point, spot, directional */
+    Texture *textures;     char **texture_names;  char **texture_sources;
+    size_t n_textures, cap_textures;            /* names: NULL for anonymous textures;
+                                                 * sources: the image file, else NULL */
+    uint *texels;          size_t n_texels, cap_texels;   /* every image, Texture.offset */
+    vec3 ambient;                /* whitted: ambient light (times the diffuse colour) */
+    uint integrator;             /* enum Integrator the scene asks for (INTEGRATOR_PATH
+                                  * or INTEGRATOR_WHITTED); --integrator overrides it */
+    int linear_output;           /* 8-bit images without the sRGB curve (classic scenes) */
+} Scene;
+
+/* Defaults: 512x512, 64 spp, depth 8, seed 1, black background, camera at the origin
+ * looking down -z with a 40 degree field of view. */
+void scene_init(Scene *s);
+void scene_free(Scene *s);
+
+/* Reads a scene file (docs/scene-format.md) into an initialised scene. */
+Status scene_load(const char *path, Scene *s, Error *err);
+/* The same for `len` bytes of scene text in memory (copied), named `path` in messages;
+ * included files and meshes are still read from disk, beside `path`. */
+Status scene_load_text(const char *path, const char *text, size_t len, Scene *s, Error *err);
+
+/* Appending; each fails only when memory runs out (ST_INTERNAL). */
+Status scene_add_material(Scene *s, const char *name, Material m, uint *index, Error *err);
+Status scene_add_sphere(Scene *s, Sphere sp, Error *err);
+Status scene_add_triangle(Scene *s, Triangle t, Error *err);
+Status scene_add_shading(Scene *s, TriShading sh, uint *index, Error *err);
+Status scene_add_box(Scene *s, Box b, Error *err);
+Status scene_add_plane(Scene *s, Plane p, Error *err);
+/* A point, spot or directional light (type, position, direction, intensity, attenuation
+ * and cone set by the caller; direction unit). */
+Status scene_add_light(Scene *s, Light l, Error *err);
+/* A texture; `name` (NULL for none) is for scene_find_texture, `source` (NULL for none)
+ * the image file it was read from. Image textures' texels must already be appended
+ * with scene_add_texels. */
+Status scene_add_texture(Scene *s, const char *name, const char *source, Texture t, uint *index,
+                         Error *err);
+/* Appends n texels; *offset receives the index of the first. */
+Status scene_add_texels(Scene *s, const uint *texels, size_t n, uint *offset, Error *err);
+uint scene_find_texture(const Scene *s, const char *name);
+
+/* Records `path` (copied) as the albedo texture file of material `index`. */
+Status scene_set_material_texture(Scene *s, uint index, const char *path, Error *err);
+/* The texture file of material `index`, or NULL. */
+const char *scene_material_texture(const Scene *s, uint index);
+
+/* Index of the material with this name, or NO_INDEX. */
+uint scene_find_material(const Scene *s, const char *name);
+
+/* Global primitive id of the first triangle, box and plane (spheres start at 0). */
+uint scene_first_triangle(const Scene *s);
+uint scene_first_box(const Scene *s);
+uint scene_first_plane(const Scene *s);
+
+/* Builds the light list: the emissive spheres, triangles and boxes (area lights), then
+ * the delta lights, with a choice probability proportional to each light's estimated
+ * power (area lights: pi x area x luminance of the emission; point and spot lights: the
+ * power through a sphere of the scene's radius around them; directional lights: the
+ * power through a disc of the scene's radius), and sets each primitive's `light`. */
+Status scene_prepare_lights(Scene *s, Error *err);
+
+/* Material helpers with the defaults of docs/scene-format.md. */
+Material material_diffuse(vec3 albedo);
+Material material_metal(vec3 albedo, float fuzz);
+Material material_dielectric(float ior);
+Material material_emissive(vec3 radiance);
+/* The classic Phong material: diffuse colour, specular colour and shininess, no mirror
+ * or transparent part, index of refraction 1. */
+Material material_phong(vec3 diffuse, vec3 specular, float shininess);
+/* A light with defaults: intensity 0, inverse-square attenuation, direction -y, a spot
+ * cone of 30 degrees (cos_outer) with no soft edge. */
+Light light_default(uint type);
+
+/* Grows *ptr (an array of `elem`-byte items with capacity *cap) to hold `need` items.
+ * Returns 0 on success, -1 when out of memory (the array is then unchanged). */
+int array_reserve(void **ptr, size_t *cap, size_t need, size_t elem);
+
+#endif /* CLPT_SCENE_H */

@@ -1,0 +1,64 @@
+#!/bin/sh
+# check_layers.sh — host/ is layered; a file may include headers of its own layer and of
+# the layers below it, never above. The layers, lowest first:
+#
+#   base    errors, files, hashing, limits, timing, progress (needs nothing of clpt)
+#   scene   the scene containers: materials, shapes, transforms, the mesh sink, camera
+#   io      everything that reads or writes a file: the one loader and its parsers,
+#           images in and out
+#   accel   the kd-tree over the scene's triangles
+#   device  OpenCL and the scalar device behind one interface
+#   render  scheduler, film, checkpoints, passes
+#   app     host/*.c: options and main, on top of everything
+#
+# Headers of kernels/ (shared structs, math) may be included from any layer. Prints
+# every include that points up and exits 1 if there is one; run by `make test`.
+set -eu
+cd "$(dirname "$0")/.."
+layers="base scene io accel device render app"
+
+rank() {
+    i=0
+    for l in $layers; do
+        [ "$l" = "$1" ] && { echo $i; return; }
+        i=$((i + 1))
+    done
+    echo -1
+}
+
+bad=0
+files=0
+for f in host/*.[ch] host/*/*.[ch]; do
+    [ -f "$f" ] || continue
+    files=$((files + 1))
+    dir=$(dirname "$f")
+    case "$dir" in host) own=app ;; *) own=${dir#host/} ;; esac
+    own_rank=$(rank "$own")
+    if [ "$own_rank" -lt 0 ]; then
+        echo "check_layers: $f is in host/$own, which is not a layer ($layers)" >&2
+        bad=1
+        continue
+    fi
+    # shellcheck disable=SC2013
+    for inc in $(sed -n 's/^[[:space:]]*#[[:space:]]*include[[:space:]]*"\([^"]*\)".*/\1/p' "$f"); do
+        case "$inc" in
+            */*) layer=${inc%%/*} ;;
+            *)
+                # a bare name is a kernels/ header or a header of the app layer
+                if [ -f "kernels/$inc" ] || [ -f "$dir/$inc" -a "$own" = app ]; then continue; fi
+                echo "check_layers: $f includes \"$inc\": name the layer (\"LAYER/$inc\")" >&2
+                bad=1
+                continue ;;
+        esac
+        r=$(rank "$layer")
+        if [ "$r" -lt 0 ] || [ ! -f "host/$inc" ]; then
+            echo "check_layers: $f includes \"$inc\", which is not a header of host/" >&2
+            bad=1
+        elif [ "$r" -gt "$own_rank" ]; then
+            echo "check_layers: $f ($own) includes \"$inc\" ($layer): an include points up" >&2
+            bad=1
+        fi
+    done
+done
+[ "$bad" -eq 0 ] && echo "check_layers: $files files in host/, every include points down or sideways"
+exit "$bad"

@@ -372,26 +372,29 @@ static Status run_info_command(const Options *o, int *done, Error *err)
 
 /* ------------------------------------------------------------------ outputs, checked first */
 
+/* What a named file is to this run. */
+typedef enum { FILE_IMAGE, FILE_CHECKPOINT, FILE_RESUME, FILE_SCENE } FileRole;
+
 /* A file as the filesystem knows it: its device and inode when it exists, else its
  * folder's and its own name, so that "x.png" and "./x.png" are one file before either
  * exists. */
 typedef struct {
     const char *path;
-    const char *role;     /* for messages: "the output image", "the checkpoint" */
-    int is_output;
+    const char *what;     /* for messages: "the output image", "the checkpoint" */
+    FileRole role;
     int known;            /* dev/ino were found */
     dev_t dev;
     ino_t ino;
     const char *name;     /* NULL: dev/ino are the file's own; else its folder's */
 } NamedFile;
 
-static void named_file_init(NamedFile *f, const char *path, const char *role, int is_output)
+static void named_file_init(NamedFile *f, const char *path, const char *what, FileRole role)
 {
     struct stat sb;
     memset(f, 0, sizeof *f);
     f->path = path;
+    f->what = what;
     f->role = role;
-    f->is_output = is_output;
     if (stat(path, &sb) == 0) {
         f->known = 1;
     } else {
@@ -414,22 +417,25 @@ static int named_file_same(const NamedFile *a, const NamedFile *b)
     return strcmp(a->name, b->name) == 0;
 }
 
+static int is_output(FileRole role)
+{
+    return role == FILE_IMAGE || role == FILE_CHECKPOINT;
+}
+
 /* Two outputs naming one file would leave one's bytes in the other (a checkpoint where
  * the image should be), and an output over an input destroys the input: both are
  * refused before anything is done. A checkpoint over the one it resumes from is how
  * --resume goes on, and allowed. */
-static Status outputs_check_distinct(const NamedFile *files, size_t n, const char *resume, Error *err)
+static Status outputs_check_distinct(const NamedFile *files, size_t n, Error *err)
 {
     for (size_t i = 0; i < n; i++)
         for (size_t j = i + 1; j < n; j++) {
             const NamedFile *a = &files[i], *b = &files[j];
-            if (!a->is_output && !b->is_output) continue;
-            if (resume && (a->path == resume || b->path == resume) && strcmp(a->role, "the checkpoint") == 0 &&
-                strcmp(b->role, "the checkpoint to resume") == 0)
-                continue;
+            if (!is_output(a->role) && !is_output(b->role)) continue;
+            if (a->role == FILE_CHECKPOINT && b->role == FILE_RESUME) continue;
             if (!named_file_same(a, b)) continue;
             return error_set(err, ST_USAGE, "%s '%s' and %s '%s' are the same file; give each its own name",
-                             a->role, a->path, b->role, b->path);
+                             a->what, a->path, b->what, b->path);
         }
     return ST_OK;
 }
@@ -443,7 +449,7 @@ static Status outputs_check(const Run *r, Error *err)
     char *aov_paths[3] = { NULL, NULL, NULL };
     size_t n = 0;
     Status st = ST_OK;
-    named_file_init(&files[n++], r->output, "the output image", 1);
+    named_file_init(&files[n++], r->output, "the output image", FILE_IMAGE);
     for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
         if (!(o->aovs & (1u << aov))) continue;
         char *path = aov_paths[aov - INTEGRATOR_AOV_NORMAL] = passes_aov_path(r->output, options_aov_name(aov));
@@ -451,15 +457,15 @@ static Status outputs_check(const Run *r, Error *err)
             st = error_set(err, ST_INTERNAL, "out of memory");
             goto out;
         }
-        named_file_init(&files[n++], path, "the --aov image", 1);
+        named_file_init(&files[n++], path, "the --aov image", FILE_IMAGE);
     }
-    if (o->checkpoint_path) named_file_init(&files[n++], o->checkpoint_path, "the checkpoint", 1);
-    if (o->resume_path) named_file_init(&files[n++], o->resume_path, "the checkpoint to resume", 0);
-    named_file_init(&files[n++], o->scene_path, "the scene", 0);
-    if ((st = outputs_check_distinct(files, n, o->resume_path, err))) goto out;
+    if (o->checkpoint_path) named_file_init(&files[n++], o->checkpoint_path, "the checkpoint", FILE_CHECKPOINT);
+    if (o->resume_path) named_file_init(&files[n++], o->resume_path, "the checkpoint to resume", FILE_RESUME);
+    named_file_init(&files[n++], o->scene_path, "the scene", FILE_SCENE);
+    if ((st = outputs_check_distinct(files, n, err))) goto out;
     for (size_t i = 0; i < n && st == ST_OK; i++)
-        if (files[i].is_output)
-            st = atomic_probe(files[i].path, strcmp(files[i].role, "the checkpoint") == 0 ? "checkpoint" : "", err);
+        if (is_output(files[i].role))
+            st = atomic_probe(files[i].path, files[i].role == FILE_CHECKPOINT ? "checkpoint" : "", err);
 out:
     for (size_t i = 0; i < 3; i++) free(aov_paths[i]);
     return st;
@@ -646,9 +652,13 @@ static Status run(int argc, char **argv, Error *err)
     if (st == ST_OK) st = run_info_command(&r.o, &done, err);
     if (st != ST_OK || done) return st;
 
-    if (!(st = outputs_choose(&r, err)) && !(st = outputs_check(&r, err)) &&
-        !(st = load_scene_input(&r.o, &r.scene, &r.bare_mesh, err)) && !(st = scene_apply_options(&r, err)) &&
-        !(st = render_prepare(&r, err)) && !(st = open_devices(&r.o, &r.rs.ds, &r.devs, &r.n_devs, err))) {
+    st = outputs_choose(&r, err);
+    if (st == ST_OK) st = outputs_check(&r, err);
+    if (st == ST_OK) st = load_scene_input(&r.o, &r.scene, &r.bare_mesh, err);
+    if (st == ST_OK) st = scene_apply_options(&r, err);
+    if (st == ST_OK) st = render_prepare(&r, err);
+    if (st == ST_OK) st = open_devices(&r.o, &r.rs.ds, &r.devs, &r.n_devs, err);
+    if (st == ST_OK) {
         render_run(&r, err);
         st = results_write(&r, err);
     }

@@ -634,8 +634,9 @@ static Status results_write(Run *r, Error *err)
     Status st = r->render_st != ST_OK ? r->render_st : (r->stats.interrupted ? ST_INTERRUPTED : ST_OK);
     Error next = { 0 };
     st = keep_first(st, err, results_write_checkpoint(r, &next), &next);
-    st = keep_first(st, err, write_film(&r->film, r->output, r->encoding, &next), &next);
-    if (st == ST_IO) return st;   /* the image, or the checkpoint of a timed-out render */
+    Status image_st = write_film(&r->film, r->output, r->encoding, &next);
+    st = keep_first(st, err, image_st, &next);
+    if (image_st != ST_OK) return st;   /* the summary's "-> OUTPUT" would be untrue */
     results_print_summary(r);
     if (st == ST_OK && (r->o.adaptive > 0.0 || r->o.aovs)) st = results_run_passes(r, err);
     return st;
@@ -703,6 +704,7 @@ int main(int argc, char **argv)
     Status st = run(argc, argv, &err);
     st = stdout_close(st, &err);
     if (st != ST_OK && st != ST_INTERRUPTED) {
+        if (!err.msg[0]) err.status = st;   /* never "error: success" for a lost message */
         error_print(&err);
         if (st == ST_USAGE) fprintf(stderr, "Try 'clpt --help' for more information.\n");
     }

@@ -1,14 +1,21 @@
 /*
- * main.c — command line → scene → kd-tree → devices → render → image → exit code.
+ * main.c — command line → outputs checked → scene → kd-tree → devices → render →
+ * checkpoint and image → exit code.
  *
- * The whole life of a render reads top to bottom in run(). Errors travel up as Status
- * values with their message in one Error, printed once here; the status is the exit code.
+ * The whole life of a render reads top to bottom in run(), one named step a line.
+ * Errors travel up as Status values with their message in one Error, printed once here;
+ * the status is the exit code.
  */
+#include <errno.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include "base/atomic_file.h"
 #include "render/checkpoint.h"
 #include "io/classic_parse.h"
 #include "device/device.h"
@@ -55,10 +62,33 @@ typedef struct {
     int checkpoint_failed;
 } RenderContext;
 
+/* On a terminal the progress bar may be on the line: the warning first clears it. In
+ * a log (stderr not a terminal) there is no bar, and escape codes would be noise. */
 static void print_warning(void *ctx, const char *msg)
 {
     (void)ctx;
-    fprintf(stderr, "\r\033[Kclpt: warning: %s\n", msg);
+    fprintf(stderr, "%sclpt: warning: %s\n", isatty(STDERR_FILENO) ? "\r\033[K" : "", msg);
+}
+
+/* An error that is not the run's exit status (that one is printed by main). */
+static void print_error(const Error *e)
+{
+    fprintf(stderr, "clpt: error: %s\n", e->msg);
+}
+
+/* The run's status stays the first failure: a later one (`next`, its message in
+ * `next_err`) is printed on its own, or becomes the status when there was none. */
+static Status keep_first(Status st, Error *err, Status next, Error *next_err)
+{
+    if (next == ST_OK) return st;
+    if (st != ST_OK) {
+        print_error(next_err);
+        error_clear(next_err);
+        return st;
+    }
+    error_clear(err);
+    *err = *next_err;
+    return next;
 }
 
 static Status write_film(const Film *film, const char *path, ImageEncoding encoding, Error *err)
@@ -235,7 +265,11 @@ static Status open_devices(const Options *o, const DeviceScene *ds, Device ***ou
     char warning[1100];
     Status st = device_list(&all, &n_all, warning, sizeof warning, err);
     if (st) return st;
+    /* said here, once per run, and only when it decides where the render goes */
     if (warning[0]) print_warning(NULL, warning);
+    else if (n_all == 1 && !o->device_spec)
+        print_warning(NULL, "no OpenCL platform found (none installed, or OCL_ICD_VENDORS names none): "
+                            "rendering on the scalar device");
     if ((st = device_select(o->device_spec, all, n_all, &chosen, &n_chosen, err))) {
         free(all);
         return st;
@@ -283,177 +317,394 @@ static Status open_devices(const Options *o, const DeviceScene *ds, Device ***ou
     return ST_OK;
 }
 
-static Status run(int argc, char **argv, Error *err)
-{
+/* Everything one render holds, freed by run_free whatever step failed. */
+typedef struct {
     Options o;
-    Status st = options_parse(argc, argv, &o, err);
-    if (st) return st;
-    if (o.help) {
+    const char *output;
+    char *default_out;
+    ImageEncoding encoding;
+    int bare_mesh;
+    Scene scene;
+    RenderScene rs;
+    Film film;
+    Device **devs;
+    size_t n_devs;
+    ScheduleConfig cfg;
+    ScheduleStats stats;
+    Status render_st;
+    Checkpoint resume;
+    RenderContext ctx;
+    double t_start;
+} Run;
+
+static void run_free(Run *r)
+{
+    schedule_stats_free(&r->stats);
+    for (size_t i = 0; i < r->n_devs; i++) device_close(r->devs[i]);
+    free(r->devs);
+    film_free(&r->film);
+    checkpoint_free(&r->resume);
+    render_scene_free(&r->rs);
+    scene_free(&r->scene);
+    free(r->default_out);
+}
+
+/* --help, --version and --list-devices: print and exit. *done tells whether one ran. */
+static Status run_info_command(const Options *o, int *done, Error *err)
+{
+    *done = o->help || o->version || o->list_devices;
+    if (o->help) {
         options_print_help(stdout);
-        return ST_OK;
-    }
-    if (o.version) {
+    } else if (o->version) {
         printf("clpt %s\n", CLPT_VERSION);
-        return ST_OK;
-    }
-    if (o.list_devices) {
+    } else if (o->list_devices) {
         DeviceDesc *all = NULL;
         size_t n = 0;
         char warning[1100];
-        if ((st = device_list(&all, &n, warning, sizeof warning, err))) return st;
+        Status st = device_list(&all, &n, warning, sizeof warning, err);
+        if (st) return st;
         if (warning[0]) print_warning(NULL, warning);
         device_list_print(stdout, all, n);
         free(all);
+    }
+    return ST_OK;
+}
+
+/* ------------------------------------------------------------------ outputs, checked first */
+
+/* What a named file is to this run. */
+typedef enum { FILE_IMAGE, FILE_CHECKPOINT, FILE_RESUME, FILE_SCENE } FileRole;
+
+/* A file as the filesystem knows it: its device and inode when it exists, else its
+ * folder's and its own name, so that "x.png" and "./x.png" are one file before either
+ * exists. */
+typedef struct {
+    const char *path;
+    const char *what;     /* for messages: "the output image", "the checkpoint" */
+    FileRole role;
+    int known;            /* dev/ino were found */
+    dev_t dev;
+    ino_t ino;
+    const char *name;     /* NULL: dev/ino are the file's own; else its folder's */
+} NamedFile;
+
+static void named_file_init(NamedFile *f, const char *path, const char *what, FileRole role)
+{
+    struct stat sb;
+    memset(f, 0, sizeof *f);
+    f->path = path;
+    f->what = what;
+    f->role = role;
+    if (stat(path, &sb) == 0) {
+        f->known = 1;
+    } else {
+        const char *slash = strrchr(path, '/');
+        char dir[4096];
+        snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + 1 : 1, slash ? path : ".");
+        if (stat(dir, &sb) != 0) return;
+        f->known = 1;
+        f->name = slash ? slash + 1 : path;
+    }
+    f->dev = sb.st_dev;
+    f->ino = sb.st_ino;
+}
+
+static int named_file_same(const NamedFile *a, const NamedFile *b)
+{
+    if (strcmp(a->path, b->path) == 0) return 1;
+    if (!a->known || !b->known || a->dev != b->dev || a->ino != b->ino) return 0;
+    if (!a->name || !b->name) return !a->name && !b->name;
+    return strcmp(a->name, b->name) == 0;
+}
+
+static int is_output(FileRole role)
+{
+    return role == FILE_IMAGE || role == FILE_CHECKPOINT;
+}
+
+/* Two outputs naming one file would leave one's bytes in the other (a checkpoint where
+ * the image should be), and an output over an input destroys the input: both are
+ * refused before anything is done. A checkpoint over the one it resumes from is how
+ * --resume goes on, and allowed. */
+static Status outputs_check_distinct(const NamedFile *files, size_t n, Error *err)
+{
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = i + 1; j < n; j++) {
+            const NamedFile *a = &files[i], *b = &files[j];
+            if (!is_output(a->role) && !is_output(b->role)) continue;
+            if (a->role == FILE_CHECKPOINT && b->role == FILE_RESUME) continue;
+            if (!named_file_same(a, b)) continue;
+            return error_set(err, ST_USAGE, "%s '%s' and %s '%s' are the same file; give each its own name",
+                             a->what, a->path, b->what, b->path);
+        }
+    return ST_OK;
+}
+
+/* Each output can be written: checked now, so that a missing or unwritable folder is
+ * found in a second, not after hours of rendering (when nothing could be saved). */
+static Status outputs_check(const Run *r, Error *err)
+{
+    const Options *o = &r->o;
+    NamedFile files[8];
+    char *aov_paths[3] = { NULL, NULL, NULL };
+    size_t n = 0;
+    Status st = ST_OK;
+    named_file_init(&files[n++], r->output, "the output image", FILE_IMAGE);
+    for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
+        if (!(o->aovs & (1u << aov))) continue;
+        char *path = aov_paths[aov - INTEGRATOR_AOV_NORMAL] = passes_aov_path(r->output, options_aov_name(aov));
+        if (!path) {
+            st = error_set(err, ST_INTERNAL, "out of memory");
+            goto out;
+        }
+        named_file_init(&files[n++], path, "the --aov image", FILE_IMAGE);
+    }
+    if (o->checkpoint_path) named_file_init(&files[n++], o->checkpoint_path, "the checkpoint", FILE_CHECKPOINT);
+    if (o->resume_path) named_file_init(&files[n++], o->resume_path, "the checkpoint to resume", FILE_RESUME);
+    named_file_init(&files[n++], o->scene_path, "the scene", FILE_SCENE);
+    if ((st = outputs_check_distinct(files, n, err))) goto out;
+    for (size_t i = 0; i < n && st == ST_OK; i++)
+        if (is_output(files[i].role))
+            st = atomic_probe(files[i].path, files[i].role == FILE_CHECKPOINT ? "checkpoint" : "", err);
+out:
+    for (size_t i = 0; i < 3; i++) free(aov_paths[i]);
+    return st;
+}
+
+/* The output's name (-o, or the scene's name with .png) and its format. */
+static Status outputs_choose(Run *r, Error *err)
+{
+    ImageFormat format;
+    r->output = r->o.output;
+    if (!r->output && !(r->output = r->default_out = default_output(r->o.scene_path)))
+        return error_set(err, ST_INTERNAL, "out of memory");
+    return image_format_from_path(r->output, &format, err);
+}
+
+/* ------------------------------------------------------------------ scene */
+
+/* The input file as a scene: a mesh file given in place of a scene is shown in a scene
+ * made around it. */
+static Status load_scene_input(const Options *o, Scene *scene, int *bare_mesh, Error *err)
+{
+    *bare_mesh = mesh_kind(o->scene_path) != MESH_NONE;
+    return *bare_mesh ? mesh_view_load(o->scene_path, scene, err)
+                      : scene_load_format(o->scene_path, (SceneFormat)o->format, scene, err);
+}
+
+/* The command line's overrides, checked against the scene they apply to. */
+static Status scene_apply_options(Run *r, Error *err)
+{
+    const Options *o = &r->o;
+    Status st;
+    apply_overrides(o, &r->scene);
+    if ((o->width >= 0 || o->height >= 0) &&
+        (st = limit_pixels(r->scene.image.width, r->scene.image.height, ST_USAGE, "--width/--height", err)))
+        return st;
+    if (r->bare_mesh) mesh_view_fit(&r->scene);
+    if (o->adaptive > 0.0 && r->scene.integrator != INTEGRATOR_WHITTED)
+        return error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
+    r->encoding = r->scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB;
+    return ST_OK;
+}
+
+/* kd-tree and device buffers, the render's identity, the film (from --resume). */
+static Status render_prepare(Run *r, Error *err)
+{
+    Status st;
+    if ((st = render_scene_prepare(&r->scene, 0, &r->rs, err))) return st;
+    const DeviceScene *ds = &r->rs.ds;
+    if (r->o.stats) print_scene_stats(&r->scene, &r->rs.kd);
+    checkpoint_id(ds, r->scene.image.spp, &r->ctx.checkpoint_id);
+    if ((st = film_init(&r->film, ds->params.width, ds->params.height, err))) return st;
+    if (r->o.resume_path)
+        return resume_film(r->o.resume_path, &r->ctx.checkpoint_id, &r->resume, &r->film, r->o.quiet, err);
+    return ST_OK;
+}
+
+/* ------------------------------------------------------------------ render */
+
+static void render_configure(Run *r)
+{
+    const Options *o = &r->o;
+    ScheduleConfig *cfg = &r->cfg;
+    r->ctx.output = r->output;
+    r->ctx.quiet = o->quiet;
+    r->ctx.checkpoint = o->checkpoint_path;
+    r->ctx.encoding = r->encoding;
+    memset(cfg, 0, sizeof *cfg);
+    cfg->spp = r->scene.image.spp;
+    cfg->done = r->resume.done;
+    cfg->n_done = r->resume.n_done;
+    cfg->on_checkpoint = o->checkpoint_path ? on_checkpoint : NULL;
+    cfg->checkpoint_seconds = o->checkpoint_seconds;
+    cfg->time_limit = o->time_limit;
+    cfg->fixed_batch = o->batch;
+    cfg->show_progress = progress_should_enable(o->quiet);
+    cfg->stop = &stop_requested;
+    cfg->on_tick = o->progressive_seconds > 0.0 ? on_progress_tick : NULL;
+    cfg->tick_seconds = o->progressive_seconds;
+    cfg->on_warning = print_warning;
+    cfg->ctx = &r->ctx;
+}
+
+/* The render itself. Its status is kept apart: after a failure or an interrupt, what
+ * was finished is still saved. */
+static void render_run(Run *r, Error *err)
+{
+    install_signal_handlers();
+    render_configure(r);
+    r->render_st = schedule_run(r->devs, r->n_devs, &r->cfg, &r->film, &r->stats, err);
+}
+
+/* ------------------------------------------------------------------ results */
+
+/* No batch finished: the outputs are left as they were (a black image over a good one
+ * helps nobody), and the exit status says so. */
+static Status results_nothing_rendered(const Run *r, Error *err)
+{
+    if (r->render_st != ST_OK) return r->render_st;
+    if (r->stats.interrupted) {
+        fprintf(stderr, "clpt: interrupted before the first batch finished: nothing was rendered, and '%s' was "
+                        "left as it was\n", r->output);
+        return ST_INTERRUPTED;
+    }
+    return error_set(err, ST_NOTHING_RENDERED,
+                     "the time limit of %g s was reached before the first batch finished: nothing was rendered, "
+                     "and '%s' was left as it was (allow more time, or a smaller --batch)",
+                     r->o.time_limit, r->output);
+}
+
+/* The last checkpoint holds everything finished: after an interrupt, a time limit or
+ * a failure it is what a resume starts from, so it is written before the image, and
+ * failing to write it is then an error. After a complete render the image is what
+ * matters, and a failed checkpoint only a warning. */
+static Status results_write_checkpoint(Run *r, Error *cerr)
+{
+    if (!r->o.checkpoint_path) return ST_OK;
+    Status cst = batch_set_total(&r->stats.done) == r->film.samples
+                     ? checkpoint_write(r->o.checkpoint_path, &r->ctx.checkpoint_id, &r->film,
+                                        r->stats.done.ranges, r->stats.done.n, cerr)
+                     : error_set(cerr, ST_INTERNAL, "the record of finished samples is incomplete; "
+                                                    "no final checkpoint written");
+    int complete = r->render_st == ST_OK && !r->stats.interrupted && !r->stats.time_up;
+    if (cst != ST_OK && complete) {
+        print_warning(NULL, cerr->msg);
+        error_clear(cerr);
         return ST_OK;
     }
+    return cst;
+}
 
-    char *default_out = NULL;
-    const char *output = o.output;
-    if (!output && !(output = default_out = default_output(o.scene_path)))
-        return error_set(err, ST_INTERNAL, "out of memory");
-    ImageFormat format;
-    Scene scene;
-    scene_init(&scene);
-    RenderScene rs;
-    memset(&rs, 0, sizeof rs);
-    Film film;
-    memset(&film, 0, sizeof film);
-    Device **devs = NULL;
-    size_t n_devs = 0;
-    ScheduleStats stats;
-    memset(&stats, 0, sizeof stats);
-    Checkpoint resume;
-    memset(&resume, 0, sizeof resume);
-    RenderContext ctx;
-    memset(&ctx, 0, sizeof ctx);
-    ctx.output = output;
-    ctx.quiet = o.quiet;
-    ctx.checkpoint = o.checkpoint_path;
-    double t_start = timer_now();
+static void results_print_summary(const Run *r)
+{
+    const ScheduleStats *s = &r->stats;
+    if (r->o.stats) print_render_stats(s, r->scene.image.spp, r->devs, r->n_devs);
+    if (r->o.quiet && r->render_st == ST_OK && !s->interrupted) return;
+    double secs = s->seconds > 0.0 ? s->seconds : 1e-9;
+    fprintf(stderr, "clpt: %s %ux%u, %llu spp%s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n",
+            s->interrupted ? "interrupted:" : (s->time_up ? "time limit reached:" : "rendered"), r->film.width,
+            r->film.height, (unsigned long long)r->film.samples,
+            r->film.samples < r->scene.image.spp ? " (partial)" : "", s->seconds, timer_now() - r->t_start,
+            (double)s->samples / secs / 1e6, (double)s->rays / secs / 1e6, r->output);
+}
 
-    if ((st = image_format_from_path(output, &format, err))) goto done;
-    /* a mesh file given in place of a scene is shown in a scene made around it */
-    int bare_mesh = mesh_kind(o.scene_path) != MESH_NONE;
-    if ((st = bare_mesh ? mesh_view_load(o.scene_path, &scene, err)
-                        : scene_load_format(o.scene_path, (SceneFormat)o.format, &scene, err)))
-        goto done;
-    apply_overrides(&o, &scene);
-    if ((o.width >= 0 || o.height >= 0) &&
-        (st = limit_pixels(scene.image.width, scene.image.height, ST_USAGE, "--width/--height", err)))
-        goto done;
-    if (bare_mesh) mesh_view_fit(&scene);
-    if (o.adaptive > 0.0 && scene.integrator != INTEGRATOR_WHITTED) {
-        st = error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
-        goto done;
-    }
-    ImageEncoding encoding = scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB;
-    if ((st = render_scene_prepare(&scene, 0, &rs, err))) goto done;
-    const DeviceScene *ds = &rs.ds;
-    if (o.stats) print_scene_stats(&scene, &rs.kd);
-    checkpoint_id(ds, scene.image.spp, &ctx.checkpoint_id);
-    if ((st = film_init(&film, ds->params.width, ds->params.height, err))) goto done;
-    if (o.resume_path && (st = resume_film(o.resume_path, &ctx.checkpoint_id, &resume, &film, o.quiet, err)))
-        goto done;
-
-    if ((st = open_devices(&o, ds, &devs, &n_devs, err))) goto done;
-
-    install_signal_handlers();
-    ctx.encoding = encoding;
-    ScheduleConfig cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.spp = scene.image.spp;
-    cfg.done = resume.done;
-    cfg.n_done = resume.n_done;
-    cfg.on_checkpoint = o.checkpoint_path ? on_checkpoint : NULL;
-    cfg.checkpoint_seconds = o.checkpoint_seconds;
-    cfg.time_limit = o.time_limit;
-    cfg.fixed_batch = o.batch;
-    cfg.show_progress = progress_should_enable(o.quiet);
-    cfg.stop = &stop_requested;
-    cfg.on_tick = o.progressive_seconds > 0.0 ? on_progress_tick : NULL;
-    cfg.tick_seconds = o.progressive_seconds;
-    cfg.on_warning = print_warning;
-    cfg.ctx = &ctx;
-    Status render_st = schedule_run(devs, n_devs, &cfg, &film, &stats, err);
-    if (render_st != ST_OK && film.samples == 0) {
-        st = render_st;
-        goto done;
-    }
-    /* Whatever was finished is written, also after an interrupt or device failures. */
-    Error werr = { 0 };
-    if ((st = write_film(&film, output, encoding, &werr))) {
-        if (render_st == ST_OK) {
-            *err = werr;
-        } else {
-            fprintf(stderr, "clpt: error: %s\n", werr.msg);
-            error_clear(&werr);
-            st = render_st;
-        }
-        goto done;
-    }
-    /* The last checkpoint holds everything finished: after an interrupt or a failure it
-     * is what a resume starts from, so failing to write it then is an error. */
-    if (o.checkpoint_path && film.samples > 0) {
-        Error cerr = { 0 };
-        Status cst = batch_set_total(&stats.done) == film.samples
-                         ? checkpoint_write(o.checkpoint_path, &ctx.checkpoint_id, &film, stats.done.ranges,
-                                            stats.done.n, &cerr)
-                         : error_set(&cerr, ST_INTERNAL, "the record of finished samples is incomplete; "
-                                                         "no final checkpoint written");
-        if (cst != ST_OK) {
-            int complete = render_st == ST_OK && !stats.interrupted && !stats.time_up;
-            if (complete) {
-                print_warning(NULL, cerr.msg);
-            } else {
-                fprintf(stderr, "clpt: error: %s\n", cerr.msg);
-                if (render_st == ST_OK && !stats.interrupted) render_st = cst;
-            }
-        }
-        error_clear(&cerr);
-    }
-    if (o.stats) print_render_stats(&stats, scene.image.spp, devs, n_devs);
-    if (!o.quiet || render_st != ST_OK || stats.interrupted) {
-        double secs = stats.seconds > 0.0 ? stats.seconds : 1e-9;
-        fprintf(stderr, "clpt: %s %ux%u, %llu spp%s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n",
-                stats.interrupted ? "interrupted:" : (stats.time_up ? "time limit reached:" : "rendered"),
-                film.width, film.height, (unsigned long long)film.samples,
-                film.samples < scene.image.spp ? " (partial)" : "", stats.seconds, timer_now() - t_start,
-                (double)stats.samples / secs / 1e6, (double)stats.rays / secs / 1e6, output);
-    }
-    st = render_st != ST_OK ? render_st : (stats.interrupted ? ST_INTERRUPTED : ST_OK);
-    if (st == ST_OK && (o.adaptive > 0.0 || o.aovs)) {
-        size_t n = (size_t)film.width * film.height * 3u;
-        float *rgb = malloc(n * sizeof *rgb);
-        if (!rgb) {
-            st = error_set(err, ST_INTERNAL, "out of memory");
-            goto done;
-        }
-        film_resolve(&film, rgb);
-        ScheduleConfig pcfg = cfg;
-        pcfg.show_progress = 0;
-        PassContext pc = { devs, n_devs, &rs, &pcfg };
-        st = run_passes(&o, &pc, output, encoding, rgb, (uint)film.samples, err);
-        free(rgb);
-        if (st == ST_OK && stop_requested) st = ST_INTERRUPTED;
-    }
-
-done:
-    schedule_stats_free(&stats);
-    for (size_t i = 0; i < n_devs; i++) device_close(devs[i]);
-    free(devs);
-    film_free(&film);
-    checkpoint_free(&resume);
-    render_scene_free(&rs);
-    scene_free(&scene);
-    free(default_out);
+/* The adaptive pass and the auxiliary images, after a complete main image. */
+static Status results_run_passes(Run *r, Error *err)
+{
+    size_t n = (size_t)r->film.width * r->film.height * 3u;
+    float *rgb = malloc(n * sizeof *rgb);
+    if (!rgb) return error_set(err, ST_INTERNAL, "out of memory");
+    film_resolve(&r->film, rgb);
+    ScheduleConfig pcfg = r->cfg;
+    pcfg.show_progress = 0;
+    PassContext pc = { r->devs, r->n_devs, &r->rs, &pcfg };
+    Status st = run_passes(&r->o, &pc, r->output, r->encoding, rgb, (uint)r->film.samples, err);
+    free(rgb);
+    if (st == ST_OK && stop_requested) st = ST_INTERRUPTED;
     return st;
+}
+
+/* Whatever was finished is saved, also after an interrupt or device failures: the
+ * checkpoint, then the image. The status is the first failure: the render's, else the
+ * interrupt, else a write's. */
+static Status results_write(Run *r, Error *err)
+{
+    if (r->film.samples == 0) return results_nothing_rendered(r, err);
+    Status st = r->render_st != ST_OK ? r->render_st : (r->stats.interrupted ? ST_INTERRUPTED : ST_OK);
+    Error next = { 0 };
+    st = keep_first(st, err, results_write_checkpoint(r, &next), &next);
+    Status image_st = write_film(&r->film, r->output, r->encoding, &next);
+    st = keep_first(st, err, image_st, &next);
+    if (image_st != ST_OK) return st;   /* the summary's "-> OUTPUT" would be untrue */
+    results_print_summary(r);
+    if (st == ST_OK && (r->o.adaptive > 0.0 || r->o.aovs)) st = results_run_passes(r, err);
+    return st;
+}
+
+static Status run(int argc, char **argv, Error *err)
+{
+    Run r;
+    memset(&r, 0, sizeof r);
+    scene_init(&r.scene);
+    r.t_start = timer_now();
+    int done = 0;
+    Status st = options_parse(argc, argv, &r.o, err);
+    if (st == ST_OK) st = run_info_command(&r.o, &done, err);
+    if (st != ST_OK || done) return st;
+
+    st = outputs_choose(&r, err);
+    if (st == ST_OK) st = outputs_check(&r, err);
+    if (st == ST_OK) st = load_scene_input(&r.o, &r.scene, &r.bare_mesh, err);
+    if (st == ST_OK) st = scene_apply_options(&r, err);
+    if (st == ST_OK) st = render_prepare(&r, err);
+    if (st == ST_OK) st = open_devices(&r.o, &r.rs.ds, &r.devs, &r.n_devs, err);
+    if (st == ST_OK) {
+        render_run(&r, err);
+        st = results_write(&r, err);
+    }
+    run_free(&r);
+    return st;
+}
+
+/* What was printed to stdout (--help, --list-devices, --stats) reached it: a full disk
+ * or a closed terminal is an I/O error, not a silent success. A reader that left early
+ * (`clpt --stats scene | head -1`) got what it wanted: that is success (SIGPIPE is
+ * ignored so that the image is still written). */
+static Status stdout_close(Status st, Error *err)
+{
+    errno = 0;
+    int failed = ferror(stdout);
+    if (fflush(stdout) != 0) failed = 1;
+    int e = errno;
+    if (fclose(stdout) != 0 && !failed) {
+        failed = 1;
+        e = errno;
+    }
+    if (!failed) return st;
+    if (e == 0) {
+        /* the failure was in an earlier printf; a pipe without a reader shows POLLERR */
+        struct pollfd p = { STDOUT_FILENO, POLLOUT, 0 };
+        if (poll(&p, 1, 0) == 1 && (p.revents & POLLERR)) e = EPIPE;
+    }
+    if (e == EPIPE) return st;
+    Error out = { 0 };
+    error_set(&out, ST_IO, "cannot write to standard output: %s", e ? strerror(e) : "write error");
+    return keep_first(st, err, ST_IO, &out);
 }
 
 int main(int argc, char **argv)
 {
     Error err = { 0 };
+    signal(SIGPIPE, SIG_IGN);
+    /* Into a file or pipe, stdout is written at exit in one go (--help and --stats fit
+     * in 64 KiB), so that stdout_close sees the failure and its errno. */
+    static char stdout_buffer[1u << 16];   /* glibc ignores the size without a buffer */
+    if (!isatty(STDOUT_FILENO)) setvbuf(stdout, stdout_buffer, _IOFBF, sizeof stdout_buffer);
     Status st = run(argc, argv, &err);
+    st = stdout_close(st, &err);
     if (st != ST_OK && st != ST_INTERRUPTED) {
+        if (!err.msg[0]) err.status = st;   /* never "error: success" for a lost message */
         error_print(&err);
         if (st == ST_USAGE) fprintf(stderr, "Try 'clpt --help' for more information.\n");
     }

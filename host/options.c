@@ -10,102 +10,120 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Every line within 80 columns (tests/test_cli.c checks): a terminal's width. */
 void options_print_help(FILE *f)
 {
     fputs(
 "usage: clpt [options] SCENE\n"
 "\n"
-"Renders SCENE (a scene file, see docs/scene-format.md, or a scene of the MIT 6.837\n"
-"course family, see docs/classic-format.md) with a path tracer or a classic Whitted\n"
-"ray tracer whose kernels run on OpenCL devices (GPUs, or CPUs through PoCL) and on a\n"
-"scalar C device. SCENE may also be a mesh (.obj or .ply): it is shown lit by a sky\n"
-"and a sun, seen by a camera that frames it (docs/meshes.md).\n"
+"Renders SCENE (a scene file, see docs/scene-format.md, or a scene of the\n"
+"MIT 6.837 course family, see docs/classic-format.md) with a path tracer or a\n"
+"classic Whitted ray tracer whose kernels run on OpenCL devices (GPUs, or CPUs\n"
+"through PoCL) and on a scalar C device. SCENE may also be a mesh (.obj or\n"
+".ply): it is shown lit by a sky and a sun, seen by a camera that frames it\n"
+"(docs/meshes.md).\n"
 "\n"
 "Output and image:\n"
-"  -o, --output FILE          image to write: .png, .ppm or .bmp (8-bit sRGB) or .pfm\n"
-"                             (linear float); default: SCENE's name with .png,\n"
-"                             in the current folder. Written atomically.\n"
+"  -o, --output FILE          image to write: .png, .ppm or .bmp (8-bit sRGB)\n"
+"                             or .pfm (linear float); default: SCENE's name\n"
+"                             with .png, in the current folder. Written\n"
+"                             atomically; a symlink is followed and an\n"
+"                             existing file keeps its permissions. Checked\n"
+"                             before rendering\n"
 "      --spp N                samples per pixel (overrides the scene)\n"
 "      --width N              image width in pixels (overrides the scene)\n"
 "      --height N             image height in pixels (overrides the scene)\n"
-"      --seed N               random seed; the same seed gives the same image on any\n"
-"                             devices and batch sizes\n"
+"      --seed N               random seed; the same seed gives the same image\n"
+"                             on any devices and batch sizes\n"
 "      --max-depth N          longest path, in bounces (overrides the scene)\n"
-"      --time-limit SECONDS   stop starting new batches after this long; the image\n"
-"                             holds the whole batches finished by then\n"
+"      --time-limit SECONDS   stop starting new batches after this long; the\n"
+"                             image holds the whole batches finished by then\n"
+"                             (none: the output is left alone, exit status 7)\n"
 "      --progressive-output SECONDS\n"
-"                             rewrite the output image every SECONDS during the render\n"
-"      --gamma srgb|none      8-bit images with the sRGB curve or without (linear\n"
-"                             values times 255); default: srgb, none for classic scenes\n"
-"      --aov LIST             also write auxiliary images of the first hit, comma-\n"
-"                             separated: normal (as colours), depth (grey: near white,\n"
-"                             far black), albedo; to OUTPUT-normal.png etc.\n"
-"      --depth-range NEAR,FAR the depth image is linear from white at NEAR to black at\n"
-"                             FAR (default: inverse distance, nearest hit white)\n"
+"                             rewrite the output image every SECONDS during\n"
+"                             the render\n"
+"      --gamma srgb|none      8-bit images with the sRGB curve or without\n"
+"                             (linear values times 255); default: srgb, none\n"
+"                             for classic scenes\n"
+"      --aov LIST             also write auxiliary images of the first hit,\n"
+"                             comma-separated: normal (as colours), depth\n"
+"                             (grey: near white, far black), albedo; to\n"
+"                             OUTPUT-normal.png etc.\n"
+"      --depth-range NEAR,FAR the depth image is linear from white at NEAR to\n"
+"                             black at FAR (default: inverse distance, nearest\n"
+"                             hit white)\n"
 "\n"
 "Checkpoints (docs/checkpoint.md):\n"
-"      --checkpoint FILE      save the render's state to FILE (atomically) every\n"
-"                             --checkpoint-interval seconds, on Ctrl-C/SIGTERM and at\n"
-"                             the end\n"
+"      --checkpoint FILE      save the render's state to FILE (atomically)\n"
+"                             every --checkpoint-interval seconds, on\n"
+"                             Ctrl-C/SIGTERM and at the end\n"
 "      --checkpoint-interval SECONDS\n"
 "                             seconds between checkpoints (default 60)\n"
-"      --resume FILE          continue the render saved in FILE: only the samples not in\n"
-"                             it are rendered, and the image is the same bits as an\n"
-"                             uninterrupted render's. The scene and settings must be the\n"
-"                             ones it was made with (else exit status 3). Checkpoints go\n"
-"                             on into FILE unless --checkpoint names another file\n"
+"      --resume FILE          continue the render saved in FILE: only the\n"
+"                             samples not in it are rendered, and the image is\n"
+"                             the same bits as an uninterrupted render's. The\n"
+"                             scene and settings must be the ones it was made\n"
+"                             with (else exit status 3). Checkpoints go on\n"
+"                             into FILE unless --checkpoint names another file\n"
 "\n"
 "Scene and integrator:\n"
 "      --format auto|clpt|classic\n"
 "                             scene file format; default: told from the content\n"
 "      --integrator path|whitted\n"
-"                             path tracing (default) or the classic ray tracer (the\n"
-"                             default for classic scenes): Phong shading, hard\n"
-"                             shadows, mirror and refraction rays up to --max-depth;\n"
-"                             one ray through each pixel centre unless --spp N\n"
-"                             (jittered; an m x m grid when N = m*m)\n"
-"      --adaptive THRESHOLD   whitted: after the first pass, render --adaptive-spp\n"
-"                             more samples in each pixel that differs from a neighbour\n"
-"                             by more than THRESHOLD (0..1) in some channel\n"
+"                             path tracing (default) or the classic ray tracer\n"
+"                             (the default for classic scenes): Phong shading,\n"
+"                             hard shadows, mirror and refraction rays up to\n"
+"                             --max-depth; one ray through each pixel centre\n"
+"                             unless --spp N (jittered; an m x m grid when\n"
+"                             N = m*m)\n"
+"      --adaptive THRESHOLD   whitted: after the first pass, render\n"
+"                             --adaptive-spp more samples in each pixel that\n"
+"                             differs from a neighbour by more than THRESHOLD\n"
+"                             (0..1) in some channel\n"
 "      --adaptive-spp N       extra samples per such pixel (default 16)\n"
 "\n",
         f);
     /* two literals: C99 compilers need only support 4095 characters in one */
     fputs(
 "Devices:\n"
-"      --list-devices         print every OpenCL platform and device, and the scalar\n"
-"                             device, with their indices, then exit\n"
-"      --device SPEC          devices to render with, comma-separated: an index from\n"
-"                             --list-devices, 'all', 'gpu', 'cpu' (OpenCL CPU devices),\n"
-"                             'scalar', or part of a device or platform name.\n"
-"                             Default: every OpenCL GPU, else the OpenCL CPU devices,\n"
-"                             else the scalar device\n"
-"      --threads N            worker threads of the scalar device (default: all cores)\n"
+"      --list-devices         print every OpenCL platform and device, and the\n"
+"                             scalar device, with their indices, then exit\n"
+"      --device SPEC          devices to render with, comma-separated: an index\n"
+"                             from --list-devices, 'all', 'gpu', 'cpu' (OpenCL\n"
+"                             CPU devices), 'scalar', or part of a device or\n"
+"                             platform name. Default: every OpenCL GPU, else\n"
+"                             the OpenCL CPU devices, else the scalar device\n"
+"      --threads N            worker threads of the scalar device (default:\n"
+"                             all cores)\n"
 "\n"
 "Reporting:\n"
-"      --stats                print scene, kd-tree, kernel build and per-device\n"
-"                             statistics to stdout\n"
+"      --stats                print scene, kd-tree, kernel build and\n"
+"                             per-device statistics to stdout\n"
 "  -q, --quiet                no progress bar and no summary line\n"
 "  -h, --help                 print this help and exit\n"
 "      --version              print the version and exit\n"
 "\n"
 "Developer options:\n"
-"      --kernel-dir DIR       compile the kernels from DIR/entry.cl instead of the copy\n"
-"                             built into the program (no kernel cache)\n"
-"      --batch N              fixed batch size in samples per pixel (default: adaptive,\n"
-"                             about 0.25 s of work per batch)\n"
-"      --wave-paths N         paths per OpenCL wave (default: 2^20 on GPUs, 2^16 on CPUs)\n"
+"      --kernel-dir DIR       compile the kernels from DIR/entry.cl instead of\n"
+"                             the copy built into the program (no kernel cache)\n"
+"      --batch N              fixed batch size in samples per pixel (default:\n"
+"                             adaptive, about 0.25 s of work per batch)\n"
+"      --wave-paths N         paths per OpenCL wave (default: 2^20 on GPUs,\n"
+"                             2^16 on CPUs)\n"
 "\n"
 "Environment:\n"
 "  CLPT_CACHE_DIR             where compiled kernels are cached (default:\n"
 "                             $XDG_CACHE_HOME/clpt or ~/.cache/clpt)\n"
 "\n"
-"Exit status:\n"
-"  0  success                 3  input error (bad scene, mesh or checkpoint file,\n"
-"                                or a checkpoint of another render)\n"
-"  1  internal error          4  I/O error (a file could not be read or written)\n"
-"  2  usage error             5  device error (no usable device, or every device failed)\n"
-"  6  interrupted (SIGINT/SIGTERM): the image so far was written\n",
+"Exit status (docs/exit-codes.md):\n"
+"  0  success                 4  I/O error (a file could not be read or\n"
+"  1  internal error             written, or standard output failed)\n"
+"  2  usage error             5  device error (no usable device, or every\n"
+"  3  input error (bad scene,    device failed)\n"
+"     mesh or checkpoint      6  interrupted (SIGINT/SIGTERM): what was\n"
+"     file, or a checkpoint      finished was written\n"
+"     of another render)      7  nothing rendered: --time-limit ran out before\n"
+"                                the first batch; the output was left alone\n",
         f);
 }
 
@@ -164,7 +182,160 @@ static Status options_parse_aovs(const char *list, unsigned *bits, Error *err)
     return ST_OK;
 }
 
-Status options_parse(int argc, char **argv, Options *o, Error *err)
+/* --depth-range NEAR,FAR */
+static Status parse_depth_range(const char *v, Options *o, Error *err)
+{
+    char *end;
+    errno = 0;
+    double lo = strtod(v, &end), hi = 0.0;
+    int ok = end != v && *end == ',' && !errno;
+    if (ok) {
+        const char *second = end + 1;
+        hi = strtod(second, &end);
+        ok = end != second && !*end && !errno;
+    }
+    if (!ok || !isfinite(lo) || !isfinite(hi) || !(lo >= 0.0) || !(hi > lo))
+        return error_set(err, ST_USAGE, "--depth-range expects NEAR,FAR with 0 <= NEAR < FAR, got '%s'", v);
+    o->depth_near = lo;
+    o->depth_far = hi;
+    return ST_OK;
+}
+
+static Status parse_adaptive(const char *v, Options *o, Error *err)
+{
+    char *end;
+    errno = 0;
+    double t = strtod(v, &end);
+    if (!*v || *end || errno || !(t > 0.0 && t <= 1.0))
+        return error_set(err, ST_USAGE, "--adaptive expects a threshold in (0, 1], got '%s'", v);
+    o->adaptive = t;
+    return ST_OK;
+}
+
+/* One of `names` (NULL-terminated): its index into *out. */
+static Status parse_choice(const char *flag, const char *v, const char *const *names, const int *values,
+                           const char *expected, int *out, Error *err)
+{
+    for (size_t i = 0; names[i]; i++)
+        if (strcmp(v, names[i]) == 0) {
+            *out = values[i];
+            return ST_OK;
+        }
+    return error_set(err, ST_USAGE, "%s expects %s, got '%s'", flag, expected, v);
+}
+
+/* Flags without a value: 1 when `a` is one (and it is set). */
+static int options_set_switch(const char *a, Options *o)
+{
+    struct { const char *name, *alias; int *dst; } switches[] = {
+        { "--help", "-h", &o->help },      { "--version", NULL, &o->version },
+        { "--list-devices", NULL, &o->list_devices }, { "--stats", NULL, &o->stats },
+        { "--quiet", "-q", &o->quiet },
+    };
+    for (size_t k = 0; k < sizeof switches / sizeof switches[0]; k++)
+        if (strcmp(a, switches[k].name) == 0 || (switches[k].alias && strcmp(a, switches[k].alias) == 0)) {
+            *switches[k].dst = 1;
+            return 1;
+        }
+    return 0;
+}
+
+/* Flags whose value is a file, folder or device list, kept as given. */
+static Status options_set_name(const char *a, const char *v, Options *o, int *found, Error *err)
+{
+    struct { const char *name, *alias, *what; const char **dst; } names[] = {
+        { "--output", "-o", "file name", &o->output },
+        { "--checkpoint", NULL, "file name", &o->checkpoint_path },
+        { "--resume", NULL, "file name", &o->resume_path },
+        { "--device", NULL, "device list", &o->device_spec },
+        { "--kernel-dir", NULL, "folder name", &o->kernel_dir },
+    };
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
+        if (strcmp(a, names[k].name) != 0 && !(names[k].alias && strcmp(a, names[k].alias) == 0)) continue;
+        *found = 1;
+        if (!*v) return error_set(err, ST_USAGE, "%s needs a %s", a, names[k].what);
+        *names[k].dst = v;
+        return ST_OK;
+    }
+    return ST_OK;
+}
+
+/* Flags whose value is a number. */
+static Status options_set_number(const char *a, const char *v, Options *o, int *found, Error *err)
+{
+    long n;
+    Status st;
+    struct { const char *name; long lo, hi; long *dst; } longs[] = {
+        { "--spp", 1, CLPT_MAX_SPP, &o->spp },
+        { "--width", 1, CLPT_MAX_IMAGE_SIDE, &o->width },
+        { "--height", 1, CLPT_MAX_IMAGE_SIDE, &o->height },
+        { "--seed", 0, 4294967295L, &o->seed },
+        { "--max-depth", 0, CLPT_MAX_DEPTH, &o->max_depth },
+    };
+    struct { const char *name; long lo, hi; unsigned *dst; } uints[] = {
+        { "--batch", 1, 1000000, &o->batch },
+        { "--wave-paths", 1, 1L << 26, &o->wave_paths },
+        { "--adaptive-spp", 1, 65536, &o->adaptive_spp },
+    };
+    struct { const char *name; double *dst; } seconds[] = {
+        { "--checkpoint-interval", &o->checkpoint_seconds },
+        { "--time-limit", &o->time_limit },
+        { "--progressive-output", &o->progressive_seconds },
+    };
+    *found = 1;
+    for (size_t k = 0; k < sizeof longs / sizeof longs[0]; k++)
+        if (strcmp(a, longs[k].name) == 0) return parse_long(a, v, longs[k].lo, longs[k].hi, longs[k].dst, err);
+    for (size_t k = 0; k < sizeof uints / sizeof uints[0]; k++)
+        if (strcmp(a, uints[k].name) == 0) {
+            if ((st = parse_long(a, v, uints[k].lo, uints[k].hi, &n, err))) return st;
+            *uints[k].dst = (unsigned)n;
+            return ST_OK;
+        }
+    for (size_t k = 0; k < sizeof seconds / sizeof seconds[0]; k++)
+        if (strcmp(a, seconds[k].name) == 0) return parse_seconds(a, v, seconds[k].dst, err);
+    if (strcmp(a, "--threads") == 0) {
+        if ((st = parse_long(a, v, 1, 256, &n, err))) return st;
+        o->threads = (int)n;
+        return ST_OK;
+    }
+    if (strcmp(a, "--adaptive") == 0) return parse_adaptive(v, o, err);
+    if (strcmp(a, "--depth-range") == 0) return parse_depth_range(v, o, err);
+    *found = 0;
+    return ST_OK;
+}
+
+/* Flags whose value is a word from a list. */
+static Status options_set_choice(const char *a, const char *v, Options *o, int *found, Error *err)
+{
+    static const char *const integrators[] = { "path", "whitted", NULL };
+    static const int integrator_values[] = { INTEGRATOR_PATH, INTEGRATOR_WHITTED };
+    static const char *const formats[] = { "auto", "clpt", "classic", NULL };
+    static const int format_values[] = { SCENE_FORMAT_AUTO, SCENE_FORMAT_CLPT, SCENE_FORMAT_CLASSIC };
+    static const char *const gammas[] = { "srgb", "none", NULL };
+    static const int gamma_values[] = { 0, 1 };
+    *found = 1;
+    if (strcmp(a, "--integrator") == 0)
+        return parse_choice(a, v, integrators, integrator_values, "'path' or 'whitted'", &o->integrator, err);
+    if (strcmp(a, "--format") == 0)
+        return parse_choice(a, v, formats, format_values, "'auto', 'clpt' or 'classic'", &o->format, err);
+    if (strcmp(a, "--gamma") == 0)
+        return parse_choice(a, v, gammas, gamma_values, "'srgb' or 'none'", &o->gamma, err);
+    if (strcmp(a, "--aov") == 0) return options_parse_aovs(v, &o->aovs, err);
+    *found = 0;
+    return ST_OK;
+}
+
+/* A flag that takes a value, with its value (the next argument, or after '=' in
+ * --flag=value). *found is 0 when `a` is no such flag. */
+static Status options_set_value(const char *a, const char *v, Options *o, int *found, Error *err)
+{
+    Status st = options_set_name(a, v, o, found, err);
+    if (!*found) st = options_set_number(a, v, o, found, err);
+    if (!*found) st = options_set_choice(a, v, o, found, err);
+    return st;
+}
+
+static void options_defaults(Options *o)
 {
     memset(o, 0, sizeof *o);
     o->spp = o->width = o->height = o->seed = o->max_depth = -1;
@@ -172,163 +343,45 @@ Status options_parse(int argc, char **argv, Options *o, Error *err)
     o->gamma = -1;
     o->format = SCENE_FORMAT_AUTO;
     o->adaptive_spp = 16;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        /* --flag=value is accepted too */
-        char flag[64];
-        const char *inline_value = NULL;
-        if (a[0] == '-' && a[1] == '-' && strchr(a, '=')) {
-            size_t n = (size_t)(strchr(a, '=') - a);
-            if (n >= sizeof flag) return error_set(err, ST_USAGE, "unknown option '%s' (see --help)", a);
-            memcpy(flag, a, n);
-            flag[n] = '\0';
-            inline_value = a + n + 1;
-            a = flag;
-        }
-#define IS(name) (strcmp(a, name) == 0)
-#define VALUE()                                                                             \
-    (inline_value ? inline_value                                                            \
-                  : (i + 1 < argc ? argv[++i]                                               \
-                                  : (error_set(err, ST_USAGE, "%s needs a value", a), (const char *)NULL)))
-        const char *v;
-        long n;
-        Status st;
-        if (IS("-h") || IS("--help")) { o->help = 1; continue; }
-        if (IS("--version")) { o->version = 1; continue; }
-        if (IS("--list-devices")) { o->list_devices = 1; continue; }
-        if (IS("--stats")) { o->stats = 1; continue; }
-        if (IS("-q") || IS("--quiet")) { o->quiet = 1; continue; }
-        if (IS("-o") || IS("--output")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if (!*v) return error_set(err, ST_USAGE, "%s needs a file name", a);
-            o->output = v;
-            continue;
-        }
-        if (IS("--device")) { if (!(v = VALUE())) return ST_USAGE; o->device_spec = v; continue; }
-        if (IS("--kernel-dir")) { if (!(v = VALUE())) return ST_USAGE; o->kernel_dir = v; continue; }
-        if (IS("--checkpoint") || IS("--resume")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if (!*v) return error_set(err, ST_USAGE, "%s needs a file name", a);
-            *(IS("--resume") ? &o->resume_path : &o->checkpoint_path) = v;
-            continue;
-        }
-        if (IS("--checkpoint-interval")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if ((st = parse_seconds(a, v, &o->checkpoint_seconds, err))) return st;
-            continue;
-        }
-        struct { const char *name; long lo, hi; long *dst; } ints[] = {
-            { "--spp", 1, CLPT_MAX_SPP, &o->spp },
-            { "--width", 1, CLPT_MAX_IMAGE_SIDE, &o->width },
-            { "--height", 1, CLPT_MAX_IMAGE_SIDE, &o->height },
-            { "--seed", 0, 4294967295L, &o->seed },
-            { "--max-depth", 0, CLPT_MAX_DEPTH, &o->max_depth },
-        };
-        int matched = 0;
-        for (size_t k = 0; k < sizeof ints / sizeof ints[0]; k++) {
-            if (!IS(ints[k].name)) continue;
-            if (!(v = VALUE())) return ST_USAGE;
-            if ((st = parse_long(a, v, ints[k].lo, ints[k].hi, ints[k].dst, err))) return st;
-            matched = 1;
-        }
-        if (matched) continue;
-        if (IS("--threads")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if ((st = parse_long(a, v, 1, 256, &n, err))) return st;
-            o->threads = (int)n;
-            continue;
-        }
-        if (IS("--batch")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if ((st = parse_long(a, v, 1, 1000000, &n, err))) return st;
-            o->batch = (unsigned)n;
-            continue;
-        }
-        if (IS("--wave-paths")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if ((st = parse_long(a, v, 1, 1L << 26, &n, err))) return st;
-            o->wave_paths = (unsigned)n;
-            continue;
-        }
-        if (IS("--integrator")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if (strcmp(v, "path") == 0) o->integrator = INTEGRATOR_PATH;
-            else if (strcmp(v, "whitted") == 0) o->integrator = INTEGRATOR_WHITTED;
-            else return error_set(err, ST_USAGE, "--integrator expects 'path' or 'whitted', got '%s'", v);
-            continue;
-        }
-        if (IS("--format")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if (strcmp(v, "auto") == 0) o->format = SCENE_FORMAT_AUTO;
-            else if (strcmp(v, "clpt") == 0) o->format = SCENE_FORMAT_CLPT;
-            else if (strcmp(v, "classic") == 0) o->format = SCENE_FORMAT_CLASSIC;
-            else return error_set(err, ST_USAGE, "--format expects 'auto', 'clpt' or 'classic', got '%s'", v);
-            continue;
-        }
-        if (IS("--gamma")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if (strcmp(v, "srgb") == 0) o->gamma = 0;
-            else if (strcmp(v, "none") == 0) o->gamma = 1;
-            else return error_set(err, ST_USAGE, "--gamma expects 'srgb' or 'none', got '%s'", v);
-            continue;
-        }
-        if (IS("--aov")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if ((st = options_parse_aovs(v, &o->aovs, err))) return st;
-            continue;
-        }
-        if (IS("--adaptive")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            char *end;
-            errno = 0;
-            double t = strtod(v, &end);
-            if (!*v || *end || errno || !(t > 0.0 && t <= 1.0))
-                return error_set(err, ST_USAGE, "--adaptive expects a threshold in (0, 1], got '%s'", v);
-            o->adaptive = t;
-            continue;
-        }
-        if (IS("--depth-range")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            char *end;
-            errno = 0;
-            double lo = strtod(v, &end), hi = 0.0;
-            int ok = end != v && *end == ',' && !errno;
-            if (ok) {
-                const char *second = end + 1;
-                hi = strtod(second, &end);
-                ok = end != second && !*end && !errno;
-            }
-            if (!ok || !isfinite(lo) || !isfinite(hi) || !(lo >= 0.0) || !(hi > lo))
-                return error_set(err, ST_USAGE, "--depth-range expects NEAR,FAR with 0 <= NEAR < FAR, got '%s'", v);
-            o->depth_near = lo;
-            o->depth_far = hi;
-            continue;
-        }
-        if (IS("--adaptive-spp")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if ((st = parse_long(a, v, 1, 65536, &n, err))) return st;
-            o->adaptive_spp = (unsigned)n;
-            continue;
-        }
-        if (IS("--time-limit")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if ((st = parse_seconds(a, v, &o->time_limit, err))) return st;
-            continue;
-        }
-        if (IS("--progressive-output")) {
-            if (!(v = VALUE())) return ST_USAGE;
-            if ((st = parse_seconds(a, v, &o->progressive_seconds, err))) return st;
-            continue;
-        }
-#undef IS
-#undef VALUE
-        if (inline_value) return error_set(err, ST_USAGE, "unknown option '%s' (see --help)", a);
-        if (a[0] == '-' && a[1] != '\0')
-            return error_set(err, ST_USAGE, "unknown option '%s' (see --help)", a);
-        if (o->scene_path)
-            return error_set(err, ST_USAGE, "more than one scene given: '%s' and '%s'", o->scene_path, a);
-        o->scene_path = a;
+}
+
+/* argv[*i]: a switch, a flag and its value (advancing *i), or the scene. */
+static Status options_parse_arg(int argc, char **argv, int *i, Options *o, Error *err)
+{
+    const char *a = argv[*i];
+    /* --flag=value is accepted too */
+    char flag[64];
+    const char *value = NULL;
+    const char *eq = a[0] == '-' && a[1] == '-' ? strchr(a, '=') : NULL;
+    if (eq) {
+        size_t n = (size_t)(eq - a);
+        if (n >= sizeof flag) return error_set(err, ST_USAGE, "unknown option '%s' (see --help)", a);
+        memcpy(flag, a, n);
+        flag[n] = '\0';
+        value = eq + 1;
+        a = flag;
     }
+    if (!value && options_set_switch(a, o)) return ST_OK;
+    /* a flag that takes a value takes the next argument when not given one with '=' */
+    const char *next = *i + 1 < argc ? argv[*i + 1] : NULL;
+    int found = 0;
+    Status st = options_set_value(a, value ? value : (next ? next : ""), o, &found, err);
+    if (found) {
+        if (!value && !next) return error_set(err, ST_USAGE, "%s needs a value", a);
+        if (!value) ++*i;
+        return st;
+    }
+    if (value || (a[0] == '-' && a[1] != '\0'))
+        return error_set(err, ST_USAGE, "unknown option '%s' (see --help)", a);
+    if (o->scene_path)
+        return error_set(err, ST_USAGE, "more than one scene given: '%s' and '%s'", o->scene_path, a);
+    o->scene_path = a;
+    return ST_OK;
+}
+
+/* What depends on several flags. */
+static Status options_finish(Options *o, Error *err)
+{
     if (o->checkpoint_seconds > 0.0 && !o->checkpoint_path && !o->resume_path)
         return error_set(err, ST_USAGE, "--checkpoint-interval needs --checkpoint FILE (or --resume FILE)");
     if (o->resume_path && !o->checkpoint_path) o->checkpoint_path = o->resume_path;
@@ -336,4 +389,14 @@ Status options_parse(int argc, char **argv, Options *o, Error *err)
     if (!o->scene_path && !o->help && !o->version && !o->list_devices)
         return error_set(err, ST_USAGE, "no scene given (usage: clpt [options] SCENE; see --help)");
     return ST_OK;
+}
+
+Status options_parse(int argc, char **argv, Options *o, Error *err)
+{
+    options_defaults(o);
+    for (int i = 1; i < argc; i++) {
+        Status st = options_parse_arg(argc, argv, &i, o, err);
+        if (st) return st;
+    }
+    return options_finish(o, err);
 }

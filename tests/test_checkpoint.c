@@ -110,9 +110,10 @@ static void fill_film(Film *f, uint w, uint h, uint64_t samples)
 {
     Error err = { 0 };
     film_init(f, w, h, &err);
-    for (size_t i = 0; i < (size_t)w * h * 3u; i++) f->sum[i] = (int64_t)(i * 2654435761u) - ((int64_t)1 << 20);
-    f->sum[0] = INT64_MIN;       /* extremes survive the encoding */
-    f->sum[1] = INT64_MAX;
+    int64_t max = (int64_t)samples << 40;   /* every sample at the largest radiance */
+    for (size_t i = 0; i < (size_t)w * h * 3u; i++) f->sum[i] = (int64_t)(i * 2654435761u) % max;
+    f->sum[0] = 0;               /* the extremes a film can hold survive the encoding */
+    f->sum[1] = max;
     f->samples = samples;
 }
 
@@ -201,6 +202,44 @@ static void test_damaged_files_are_refused(void)
     CHECK_EQ_INT(checkpoint_read("/nonexistent.ckpt", &c, &err), ST_IO);
     checkpoint_free(&c);
     error_clear(&err);
+}
+
+/* A crafted file with a valid checksum whose film values no render can produce: near
+ * INT64_MAX, the resume's further batches would overflow the signed sums (negative
+ * pixels); negative, the pixel would be negative at once. */
+static void expect_film_refused(int64_t value, uint spp, const char *words)
+{
+    CheckpointId id;
+    memset(&id, 0, sizeof id);
+    id.width = 2;
+    id.height = 2;
+    id.spp = spp;
+    Film f;
+    fill_film(&f, 2, 2, 10);
+    f.sum[7] = value;
+    const Batch done[] = { { 0, 10 } };
+    char p[160];
+    snprintf(p, sizeof p, "%s/crafted.ckpt", dir);
+    Error err = { 0 };
+    CHECK(checkpoint_write(p, &id, &f, done, 1, &err) == ST_OK);
+    Checkpoint c;
+    CHECK_EQ_INT(checkpoint_read(p, &c, &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, words);
+    checkpoint_free(&c);
+    error_clear(&err);
+    film_free(&f);
+    unlink(p);
+}
+
+static void test_film_values_are_bounded(void)
+{
+    expect_film_refused(INT64_MAX, 100, "film value 9223372036854775807 of pixel 2 is outside what 10 samples can "
+                                        "hold (0..10995116277760)");
+    expect_film_refused(((int64_t)10 << 40) + 1, 100, "outside what 10 samples can hold");
+    expect_film_refused(-1, 100, "film value -1 of pixel 2");
+    expect_film_refused(INT64_MIN, 100, "film value -9223372036854775808");
+    /* the bound relies on the samples per pixel a render can ask for */
+    expect_film_refused(0, 4000000000u, "samples per pixel outside 1..1000000");
 }
 
 /* The render key: stable for the same scene and settings, different when anything that
@@ -344,6 +383,7 @@ int main(void)
     make_dir();
     RUN(test_write_read_round_trip);
     RUN(test_damaged_files_are_refused);
+    RUN(test_film_values_are_bounded);
     RUN(test_render_key);
     RUN(render_reference);
     RUN(test_sigkill_then_resume_gives_the_same_image);

@@ -1,5 +1,7 @@
 /* test_cli.c — the program as a user meets it: help, exit codes, error messages, the
  * device flag, and a real render to each output format. */
+#include <time.h>
+
 #include "cli_util.h"
 #include "harness.h"
 
@@ -136,6 +138,296 @@ static void test_stats(void)
     unlink("/tmp/clpt-test-stats.png");
 }
 
+
+#define SMALL "--device", "scalar", "--width", "8", "--height", "8", "--spp", "1"
+
+static int count_of(const char *hay, const char *needle)
+{
+    int n = 0;
+    for (const char *p = hay; (p = strstr(p, needle)); p += strlen(needle)) n++;
+    return n;
+}
+
+static void wait_for_file(const char *path)
+{
+    for (int i = 0; i < 400 && !file_exists(path); i++) {
+        struct timespec ts = { 0, 25000000L };
+        nanosleep(&ts, NULL);
+    }
+}
+
+static void write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+static int file_holds(const char *path, const char *text)
+{
+    char buf[256] = { 0 };
+    FILE *f = fopen(path, "r");
+    if (!f) return 0;
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    return n == strlen(text) && memcmp(buf, text, n) == 0;
+}
+
+/* Runs clpt with its stdout on `out_fd` (SIGPIPE as a shell leaves it: default). */
+static void run_with_stdout(const char *const *args, int out_fd, CliResult *res)
+{
+    char err_name[] = "/tmp/clpt-cli-err-XXXXXX";
+    int err_fd = mkstemp(err_name);
+    unlink(err_name);
+    const char *argv[64] = { CLI_PROGRAM };
+    int n = 1;
+    for (; args[n - 1] && n < 63; n++) argv[n] = args[n - 1];
+    argv[n] = NULL;
+    pid_t pid = fork();
+    if (pid == 0) {
+        signal(SIGPIPE, SIG_DFL);
+        dup2(out_fd, 1);
+        dup2(err_fd, 2);
+        execv(CLI_PROGRAM, (char *const *)argv);
+        _exit(127);
+    }
+    int wstatus = 0;
+    waitpid(pid, &wstatus, 0);
+    res->status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
+    res->out[0] = '\0';
+    cli_slurp(err_fd, res->err);
+    close(err_fd);
+}
+
+static void test_help_fits_80_columns(void)
+{
+    cli_run(ARGS("--help"), &r);
+    CHECK_EQ_INT(r.status, 0);
+    int line = 1;
+    for (const char *p = r.out; *p; line++) {
+        const char *end = strchr(p, '\n');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        CHECK_MSG(len <= 80, "--help line %d has %zu columns: %.*s", line, len, (int)len, p);
+        p += len + (end ? 1 : 0);
+    }
+}
+
+/* A bad output is found before the render, not after it (when nothing, not even the
+ * checkpoint, could be saved). */
+static void test_bad_outputs_found_before_rendering(void)
+{
+    const char *ck = "/tmp/clpt-test-early.ckpt", *out = "/tmp/clpt-test-early.png";
+    unlink(ck);
+    unlink(out);
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "--checkpoint", ck, "-o", "/nonexistent-dir/x.png"), &r);
+    CHECK_EQ_INT(r.status, 4);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: cannot write '/nonexistent-dir/x.png': cannot create a temporary file "
+                              "beside it: No such file or directory");
+    CHECK(strstr(r.err, "Msamples/s") == NULL);   /* no render ran */
+    CHECK(!file_exists(ck));
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "--checkpoint", "/nonexistent-dir/x.ckpt", "-o", out), &r);
+    CHECK_EQ_INT(r.status, 4);
+    CHECK_STR_CONTAINS(r.err, "cannot write checkpoint '/nonexistent-dir/x.ckpt'");
+    CHECK(strstr(r.err, "Msamples/s") == NULL);
+    CHECK(!file_exists(out));
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", "/tmp"), &r);   /* a folder named like an image */
+    CHECK_EQ_INT(r.status, 2);
+    mkdir("/tmp/clpt-test-dir.png", 0700);
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", "/tmp/clpt-test-dir.png"), &r);
+    CHECK_EQ_INT(r.status, 4);
+    CHECK_STR_CONTAINS(r.err, "cannot write '/tmp/clpt-test-dir.png': not a file: Is a directory");
+    rmdir("/tmp/clpt-test-dir.png");
+    if (geteuid() == 0) {
+        printf("     (skipped the read-only folder case: root writes anywhere)\n");
+        return;
+    }
+    mkdir("/tmp/clpt-test-ro", 0500);
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", "/tmp/clpt-test-ro/x.png"), &r);
+    CHECK_EQ_INT(r.status, 4);
+    CHECK_STR_CONTAINS(r.err, "Permission denied");
+    CHECK(strstr(r.err, "Msamples/s") == NULL);
+    rmdir("/tmp/clpt-test-ro");
+}
+
+/* Two outputs naming one file, or an output naming the scene: refused, nothing written. */
+static void test_outputs_must_be_distinct_files(void)
+{
+    const char *out = "/tmp/clpt-test-same.png";
+    unlink(out);
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "--checkpoint", out, "-o", out), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: the output image '/tmp/clpt-test-same.png' and the checkpoint "
+                              "'/tmp/clpt-test-same.png' are the same file; give each its own name");
+    CHECK(!file_exists(out));
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "--checkpoint", "/tmp/../tmp/clpt-test-same.png", "-o", out), &r);
+    CHECK_EQ_INT(r.status, 2);
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "--aov", "depth", "--checkpoint", "/tmp/clpt-test-same-depth.png",
+                 "-o", out),
+            &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "the --aov image '/tmp/clpt-test-same-depth.png' and the checkpoint");
+    /* the scene itself, by name and through a hard link */
+    const char *scene = "/tmp/clpt-test-scene.png", *link_name = "/tmp/clpt-test-scene-link.png";
+    char text[64 * 1024];
+    FILE *f = fopen("scenes/cornell-box.scene", "r");
+    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
+    if (f) fclose(f);
+    text[n] = '\0';
+    write_text(scene, text);
+    unlink(link_name);
+    CHECK(link(scene, link_name) == 0);
+    cli_run(ARGS(scene, "--format", "clpt", SMALL, "-o", scene), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "the output image '/tmp/clpt-test-scene.png' and the scene");
+    cli_run(ARGS(scene, "--format", "clpt", SMALL, "-o", link_name), &r);
+    CHECK_EQ_INT(r.status, 2);
+    struct stat sb;
+    CHECK(stat(scene, &sb) == 0 && (size_t)sb.st_size == n);   /* untouched */
+    cli_run(ARGS(scene, "--format", "clpt", SMALL, "--checkpoint", scene, "-o", out), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "the checkpoint '/tmp/clpt-test-scene.png' and the scene");
+    CHECK(stat(scene, &sb) == 0 && (size_t)sb.st_size == n);
+    unlink(scene);
+    unlink(link_name);
+}
+
+/* As editors do: a symlinked output is written through the link, and an existing file
+ * keeps its permissions. */
+static void test_output_symlink_and_mode_kept(void)
+{
+    const char *target = "/tmp/clpt-test-target.png", *sym = "/tmp/clpt-test-symlink.png";
+    unlink(target);
+    unlink(sym);
+    write_text(target, "old");
+    chmod(target, 0600);
+    CHECK(symlink("clpt-test-target.png", sym) == 0);
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-q", "-o", sym), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    struct stat sb;
+    CHECK(lstat(sym, &sb) == 0 && S_ISLNK(sb.st_mode));
+    CHECK(stat(target, &sb) == 0 && sb.st_size > 8 && (sb.st_mode & 07777) == 0600);
+    CHECK(!file_holds(target, "old"));
+    /* a dangling link is followed too: its target is created */
+    unlink(target);
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-q", "-o", sym), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(lstat(sym, &sb) == 0 && S_ISLNK(sb.st_mode));
+    CHECK(file_exists(target));
+    unlink(target);
+    unlink(sym);
+}
+
+/* --time-limit that ends before the first batch: the old image stays, and the exit
+ * status (7) says nothing was rendered. */
+static void test_time_limit_without_samples_keeps_the_output(void)
+{
+    const char *out = "/tmp/clpt-test-keep.png";
+    write_text(out, "keep");
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", "--width", "64", "--height", "64", "--spp", "100",
+                 "--time-limit", "1e-9", "-o", out),
+            &r);
+    CHECK_EQ_INT(r.status, 7);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: the time limit of 1e-09 s was reached before the first batch "
+                              "finished: nothing was rendered, and '/tmp/clpt-test-keep.png' was left as it was");
+    CHECK(file_holds(out, "keep"));
+    unlink(out);
+}
+
+/* A final checkpoint that cannot be written after --time-limit is an I/O error with
+ * its message (it printed "clpt: error: success"). The folder goes away mid-render. */
+static void test_failed_checkpoint_after_time_limit_says_why(void)
+{
+    char ck_dir[] = "/tmp/clpt-test-ckdir-XXXXXX";
+    if (!mkdtemp(ck_dir)) return;
+    char ck[64];
+    snprintf(ck, sizeof ck, "%s/c.ckpt", ck_dir);
+    const char *out = "/tmp/clpt-test-tl.pfm";
+    unlink(out);
+    CliChild c = cli_start(ARGS("scenes/cornell-box.scene", "--device", "scalar", "--threads", "1", "--width", "32",
+                                "--height", "32", "--spp", "1000000", "--time-limit", "1.5", "--progressive-output",
+                                "0.1", "--checkpoint", ck, "-o", out));
+    wait_for_file(out);
+    CHECK(rmdir(ck_dir) == 0);
+    cli_finish(c, &r);
+    CHECK_EQ_INT(r.status, 4);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: cannot write checkpoint");
+    CHECK(strstr(r.err, "error: success") == NULL);
+    CHECK(file_exists(out));   /* the image is still written */
+    unlink(out);
+}
+
+/* stdout that cannot be written is an I/O error; a reader that leaves early
+ * (`| head -1`) is not, and the image is written. */
+static void test_stdout_failures(void)
+{
+    int full = open("/dev/full", O_WRONLY);
+    CHECK(full >= 0);
+    if (full >= 0) {
+        run_with_stdout(ARGS("--help"), full, &r);
+        CHECK_EQ_INT(r.status, 4);
+        CHECK_STR_CONTAINS(r.err, "clpt: error: cannot write to standard output: No space left on device");
+        run_with_stdout(ARGS("--list-devices"), full, &r);
+        CHECK_EQ_INT(r.status, 4);
+        run_with_stdout(ARGS("scenes/cornell-box.scene", SMALL, "--stats", "-o", "/tmp/clpt-test-full.png"), full, &r);
+        CHECK_EQ_INT(r.status, 4);
+        CHECK(file_exists("/tmp/clpt-test-full.png"));
+        unlink("/tmp/clpt-test-full.png");
+        close(full);
+    }
+    int fds[2];
+    CHECK(pipe(fds) == 0);
+    close(fds[0]);   /* the reader is gone before clpt writes */
+    const char *out = "/tmp/clpt-test-pipe.png";
+    unlink(out);
+    run_with_stdout(ARGS("scenes/cornell-box.scene", SMALL, "--stats", "-o", out), fds[1], &r);
+    close(fds[1]);
+    CHECK_EQ_INT(r.status, 0);
+    CHECK(strstr(r.err, "error") == NULL);
+    CHECK(file_exists(out));
+    unlink(out);
+}
+
+static void test_device_list_with_empty_item(void)
+{
+    const char *specs[] = { ",", "scalar,", ",,scalar", " ", "scalar, ,0" };
+    for (size_t i = 0; i < sizeof specs / sizeof specs[0]; i++) {
+        cli_run(ARGS("scenes/cornell-box.scene", "--device", specs[i], "--width", "8", "--height", "8", "--spp", "1",
+                     "-o", "/tmp/clpt-never.png"),
+                &r);
+        CHECK_EQ_INT(r.status, 2);
+        CHECK_STR_CONTAINS(r.err, "has an empty item");
+    }
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "", "--width", "8", "--height", "8", "--spp", "1", "-o",
+                 "/tmp/clpt-never.png"),
+            &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "--device needs a device list");
+    CHECK(!file_exists("/tmp/clpt-never.png"));
+}
+
+/* With no OpenCL platform the scalar device renders, and that is said once, as plain
+ * text when stderr is not a terminal. */
+static void test_no_opencl_said_once_without_escapes(void)
+{
+    const char *out = "/tmp/clpt-test-noocl.png";
+    const char *vendors[] = { "/nonexistent", "/tmp/clpt-test-empty-vendors" };
+    mkdir(vendors[1], 0700);
+    for (size_t i = 0; i < 2; i++) {
+        setenv("OCL_ICD_VENDORS", vendors[i], 1);
+        cli_run(ARGS("scenes/cornell-box.scene", "--width", "8", "--height", "8", "--spp", "1", "-o", out), &r);
+        unsetenv("OCL_ICD_VENDORS");
+        CHECK_MSG(r.status == 0, "%s", r.err);
+        CHECK_EQ_INT(count_of(r.err, "no OpenCL platform found"), 1);
+        CHECK_STR_CONTAINS(r.err, "clpt: warning: no OpenCL platform found (none installed, or OCL_ICD_VENDORS "
+                                  "names none): rendering on the scalar device");
+        CHECK(strchr(r.err, '\033') == NULL && strchr(r.err, '\r') == NULL);
+    }
+    rmdir(vendors[1]);
+    unlink(out);
+}
+
 int main(void)
 {
     RUN(test_help_documents_every_flag);
@@ -148,5 +440,14 @@ int main(void)
     RUN(test_quiet_prints_nothing);
     RUN(test_unwritable_output_is_io_error);
     RUN(test_stats);
+    RUN(test_help_fits_80_columns);
+    RUN(test_bad_outputs_found_before_rendering);
+    RUN(test_outputs_must_be_distinct_files);
+    RUN(test_output_symlink_and_mode_kept);
+    RUN(test_time_limit_without_samples_keeps_the_output);
+    RUN(test_failed_checkpoint_after_time_limit_says_why);
+    RUN(test_stdout_failures);
+    RUN(test_device_list_with_empty_item);
+    RUN(test_no_opencl_said_once_without_escapes);
     return harness_report();
 }

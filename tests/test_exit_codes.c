@@ -1,5 +1,6 @@
 /* test_exit_codes.c — every exit code of docs/exit-codes.md, by running the program:
- * 0 success, 1 internal, 2 usage, 3 input, 4 I/O, 5 device, 6 interrupted. Codes 1 and
+ * 0 success, 1 internal, 2 usage, 3 input, 4 I/O, 5 device, 6 interrupted, 7 nothing
+ * rendered. Codes 1 and
  * 5 are provoked with the test-only variables of host/base/fault.h. */
 #include <time.h>
 
@@ -97,12 +98,28 @@ static void test_6_interrupted(void)
     unlink(out);
 }
 
+static void test_7_nothing_rendered(void)
+{
+    const char *out = "/tmp/clpt-test-exit7.png";
+    FILE *f = fopen(out, "w");
+    if (f) {
+        fputs("an older image", f);
+        fclose(f);
+    }
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", SMALL, "--time-limit", "1e-9", "-o", out), &r);
+    CHECK_EQ_INT(r.status, 7);
+    CHECK_STR_CONTAINS(r.err, "nothing was rendered, and '/tmp/clpt-test-exit7.png' was left as it was");
+    struct stat sb;
+    CHECK(stat(out, &sb) == 0 && sb.st_size == 14);
+    unlink(out);
+}
+
 /* the table in --help and in docs/exit-codes.md */
 static void test_documented(void)
 {
     cli_run(ARGS("--help"), &r);
     const char *help[] = { "0  success", "1  internal error", "2  usage error", "3  input error", "4  I/O error",
-                           "5  device error", "6  interrupted" };
+                           "5  device error", "6  interrupted", "7  nothing rendered" };
     for (size_t i = 0; i < sizeof help / sizeof help[0]; i++) CHECK_STR_CONTAINS(r.out, help[i]);
     FILE *f = fopen("docs/exit-codes.md", "r");
     CHECK(f != NULL);
@@ -112,7 +129,7 @@ static void test_documented(void)
     doc[n] = '\0';
     fclose(f);
     const char *rows[] = { "| 0    | success", "| 1    | internal", "| 2    | usage", "| 3    | input", "| 4    | I/O",
-                           "| 5    | device", "| 6    | interrupted" };
+                           "| 5    | device", "| 6    | interrupted", "| 7    | nothing rendered" };
     for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++) CHECK_STR_CONTAINS(doc, rows[i]);
 }
 
@@ -125,6 +142,7 @@ int main(void)
     RUN(test_4_io);
     RUN(test_5_device);
     RUN(test_6_interrupted);
+    RUN(test_7_nothing_rendered);
     RUN(test_documented);
     return harness_report();
 }

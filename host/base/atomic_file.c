@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -28,6 +29,43 @@ void atomic_abort(AtomicFile *af)
     if (af->tmp) unlink(af->tmp);
     free(af->tmp);
     af->tmp = NULL;
+    free(af->target);
+    af->target = NULL;
+}
+
+/* `link`'s folder joined with a relative symlink text `rel` (an absolute one stands
+ * alone). */
+static char *join_beside(const char *link, const char *rel)
+{
+    const char *slash = strrchr(link, '/');
+    size_t dir = rel[0] == '/' || !slash ? 0 : (size_t)(slash - link) + 1;
+    size_t n = strlen(rel);
+    char *out = malloc(dir + n + 1);
+    if (!out) return NULL;
+    memcpy(out, link, dir);
+    memcpy(out + dir, rel, n + 1);
+    return out;
+}
+
+/* The file a write to `path` should replace: symlinks are followed (also dangling ones,
+ * whose target is then created), as editors do, so that the link keeps pointing at the
+ * new content and the temporary file lands in the target's folder, where the rename is
+ * atomic. NULL when out of memory; a loop stops after 40 links, as the kernel does. */
+static char *resolve_target(const char *path)
+{
+    char *cur = strdup(path);
+    for (int depth = 0; cur && depth < 40; depth++) {
+        struct stat sb;
+        if (lstat(cur, &sb) != 0 || !S_ISLNK(sb.st_mode)) return cur;
+        char text[PATH_MAX];
+        ssize_t n = readlink(cur, text, sizeof text - 1);
+        if (n <= 0) return cur;
+        text[n] = '\0';
+        char *next = join_beside(cur, text);
+        free(cur);
+        cur = next;
+    }
+    return cur;
 }
 
 /* The temporary file lives in the target's folder so that the final rename stays within
@@ -38,14 +76,31 @@ Status atomic_open(AtomicFile *af, const char *path, const char *what, Error *er
     memset(af, 0, sizeof *af);
     af->path = path;
     af->what = what ? what : "";
-    size_t n = strlen(path);
-    af->tmp = malloc(n + sizeof suffix);
+    af->target = resolve_target(path);
+    af->tmp = af->target ? malloc(strlen(af->target) + sizeof suffix) : NULL;
     if (!af->tmp) {
         af->failed_step = "out of memory";
         af->failed_errno = ENOMEM;
-        return atomic_error(af, err);
+        Status st = atomic_error(af, err);
+        atomic_abort(af);
+        return st;
     }
-    memcpy(af->tmp, path, n);
+    struct stat sb;
+    if (stat(af->target, &sb) == 0) {
+        if (S_ISDIR(sb.st_mode)) {
+            errno = EISDIR;
+            atomic_fail(af, "not a file");
+            free(af->tmp);
+            af->tmp = NULL;
+            Status st = atomic_error(af, err);
+            atomic_abort(af);
+            return st;
+        }
+        af->keep_mode = 1;
+        af->mode = sb.st_mode & 07777;
+    }
+    size_t n = strlen(af->target);
+    memcpy(af->tmp, af->target, n);
     memcpy(af->tmp + n, suffix, sizeof suffix);
     errno = 0;
     int fd = mkostemp(af->tmp, O_CLOEXEC);
@@ -53,7 +108,9 @@ Status atomic_open(AtomicFile *af, const char *path, const char *what, Error *er
         atomic_fail(af, "cannot create a temporary file beside it");
         free(af->tmp);
         af->tmp = NULL; /* nothing was created, so nothing to remove */
-        return atomic_error(af, err);
+        Status st = atomic_error(af, err);
+        atomic_abort(af);
+        return st;
     }
     af->f = fdopen(fd, "wb");
     if (!af->f) {
@@ -64,6 +121,14 @@ Status atomic_open(AtomicFile *af, const char *path, const char *what, Error *er
         return st;
     }
     return ST_OK;
+}
+
+Status atomic_probe(const char *path, const char *what, Error *err)
+{
+    AtomicFile af;
+    Status st = atomic_open(&af, path, what, err);
+    if (st == ST_OK) atomic_abort(&af);
+    return st;
 }
 
 void atomic_write(AtomicFile *af, const void *data, size_t n)
@@ -115,14 +180,15 @@ Status atomic_commit(AtomicFile *af, Error *err)
         if (fflush(af->f) != 0) atomic_fail(af, "write");
     }
     if (!af->failed_step && fsync(fileno(af->f)) != 0) atomic_fail(af, "fsync");
-    if (!af->failed_step && fchmod(fileno(af->f), ordinary_file_mode()) != 0) atomic_fail(af, "chmod");
+    if (!af->failed_step && fchmod(fileno(af->f), af->keep_mode ? af->mode : ordinary_file_mode()) != 0)
+        atomic_fail(af, "chmod");
     if (!af->failed_step) {
         errno = 0;
         int rc = fclose(af->f);
         af->f = NULL;
         if (rc != 0) atomic_fail(af, "close");
     }
-    if (!af->failed_step && rename(af->tmp, af->path) != 0)
+    if (!af->failed_step && rename(af->tmp, af->target) != 0)
         atomic_fail(af, "cannot rename the temporary file over it");
     if (af->failed_step) {
         Status st = atomic_error(af, err);
@@ -131,6 +197,8 @@ Status atomic_commit(AtomicFile *af, Error *err)
     }
     free(af->tmp);
     af->tmp = NULL;
-    sync_parent_folder(af->path);
+    sync_parent_folder(af->target);
+    free(af->target);
+    af->target = NULL;
     return ST_OK;
 }

@@ -5,6 +5,13 @@
  * one, whatever kills the process. Used by the images, the checkpoints and the kernel
  * cache.
  *
+ * The target is the file a plain fopen() would write: a symlink is followed (the link
+ * stays and its target gets the new content), and an existing file keeps its
+ * permission bits. A file with several hard links is replaced under the name given,
+ * so its other names keep the old content: writing into the shared inode in place
+ * would give up the whole-or-nothing promise, which matters more for images that a
+ * viewer or a later resume reads while clpt writes them (docs/exit-codes.md).
+ *
  * The first failure is remembered (its step and errno) and later writes are skipped,
  * so writers need not check each call; atomic_commit reports it.
  */
@@ -19,7 +26,10 @@
 typedef struct {
     const char *path;        /* the target */
     const char *what;        /* for messages: "cannot write <what> '<path>'" ("" for none) */
-    char *tmp;               /* "<path>.tmp.XXXXXX" once created, else NULL */
+    char *target;            /* path with its symlinks followed: what is replaced */
+    char *tmp;               /* "<target>.tmp.XXXXXX" once created, else NULL */
+    int keep_mode;           /* the target exists: give the new file its mode */
+    unsigned mode;
     FILE *f;
     const char *failed_step; /* the first failure, or NULL */
     int failed_errno;
@@ -28,12 +38,16 @@ typedef struct {
 /* Creates the temporary file beside `path`. `what` names the kind of file in messages
  * ("checkpoint"; "" for an image). On failure nothing is left behind. */
 Status atomic_open(AtomicFile *af, const char *path, const char *what, Error *err);
+/* Checks, before a long render, that `path` can be written: creates and removes the
+ * temporary file atomic_open would. Fails as atomic_open would (ST_IO, the same
+ * message: a missing or unwritable folder, a folder in the file's place). */
+Status atomic_probe(const char *path, const char *what, Error *err);
 /* Appends n bytes (skipped after a failure). */
 void atomic_write(AtomicFile *af, const void *data, size_t n);
 /* Records a failure of the writer's own (an encoder's), with errno or EIO. */
 void atomic_fail(AtomicFile *af, const char *step);
-/* Flushes, syncs, gives the file the mode an ordinary fopen() would (0666 less the
- * umask), renames it over the target and syncs the folder. On any failure, including
+/* Flushes, syncs, gives the file the mode of the file it replaces, or for a new file
+ * the mode an ordinary fopen() would (0666 less the umask), renames it over the target and syncs the folder. On any failure, including
  * an earlier one, the temporary file is removed, the target left as it was, and the
  * error is "cannot write <what> '<path>': <step>: <errno text>". */
 Status atomic_commit(AtomicFile *af, Error *err);

@@ -75,6 +75,7 @@ const char *status_name(Status s)
     case ST_IO: return "I/O error";
     case ST_DEVICE: return "device error";
     case ST_INTERRUPTED: return "interrupted";
+    case ST_NOTHING_RENDERED: return "nothing rendered";
     }
     return "unknown status";
 }

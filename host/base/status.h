@@ -18,7 +18,8 @@ typedef enum {
     ST_INPUT = 3,         /* a scene, mesh or other input file is malformed */
     ST_IO = 4,            /* a file could not be read or written */
     ST_DEVICE = 5,        /* no usable device, or a device failed */
-    ST_INTERRUPTED = 6    /* stopped by SIGINT/SIGTERM; the partial image was written */
+    ST_INTERRUPTED = 6,   /* stopped by SIGINT/SIGTERM; the partial image was written */
+    ST_NOTHING_RENDERED = 7 /* --time-limit ran out before a batch finished; no output written */
 } Status;
 
 typedef struct {

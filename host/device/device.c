@@ -107,6 +107,32 @@ static Status no_such_device(const char *item, const DeviceDesc *all, size_t n, 
                      item, list);
 }
 
+/* Adds the devices one item of --device names. */
+static Status select_item(const char *item, const DeviceDesc *all, size_t n, size_t *chosen, size_t *k,
+                          Error *err)
+{
+    size_t before = *k;
+    if (is_index(item)) {
+        unsigned long idx = strtoul(item, NULL, 10);
+        if (idx >= n) return no_such_device(item, all, n, err);
+        add_choice(chosen, k, idx);
+        return ST_OK;
+    }
+    int matched = 0;
+    for (size_t i = 0; i < n; i++) {
+        int m;
+        if (strcmp(item, "all") == 0) m = 1;
+        else if (strcmp(item, "scalar") == 0) m = all[i].kind == DEVICE_SCALAR;
+        else if (strcmp(item, "gpu") == 0) m = all[i].kind == DEVICE_OPENCL && (all[i].ocl.type & CL_DEVICE_TYPE_GPU);
+        else if (strcmp(item, "cpu") == 0) m = all[i].kind == DEVICE_OPENCL && (all[i].ocl.type & CL_DEVICE_TYPE_CPU);
+        else m = contains_ci(all[i].name, item) ||
+                 (all[i].kind == DEVICE_OPENCL && contains_ci(all[i].ocl.platform_name, item));
+        if (m) { add_choice(chosen, k, i); matched = 1; }
+    }
+    if (!matched && *k == before) return no_such_device(item, all, n, err);
+    return ST_OK;
+}
+
 Status device_select(const char *spec, const DeviceDesc *all, size_t n, size_t **chosen_out,
                      size_t *n_chosen, Error *err)
 {
@@ -131,29 +157,22 @@ Status device_select(const char *spec, const DeviceDesc *all, size_t n, size_t *
     }
     strcpy(copy, spec);
     Status st = ST_OK;
-    for (char *save = NULL, *item = strtok_r(copy, ",", &save); item; item = strtok_r(NULL, ",", &save)) {
+    /* split by hand: strtok would skip empty items, and "," or "gpu,,cpu" is a typo to
+     * report, not a request for the default devices */
+    for (char *item = copy, *next; item; item = next) {
+        char *comma = strchr(item, ',');
+        next = comma ? comma + 1 : NULL;
+        if (comma) *comma = '\0';
         while (isspace((unsigned char)*item)) item++;
         size_t len = strlen(item);
         while (len && isspace((unsigned char)item[len - 1])) item[--len] = '\0';
-        size_t before = k;
-        if (is_index(item)) {
-            unsigned long idx = strtoul(item, NULL, 10);
-            if (idx < n) add_choice(chosen, &k, idx);
-            else { st = no_such_device(item, all, n, err); break; }
-            continue;
+        if (len == 0) {
+            st = error_set(err, ST_USAGE, "--device '%s' has an empty item; expected a comma-separated list "
+                           "of indices, 'all', 'gpu', 'cpu', 'scalar' or device names", spec);
+            break;
         }
-        int matched = 0;
-        for (size_t i = 0; i < n; i++) {
-            int m;
-            if (strcmp(item, "all") == 0) m = 1;
-            else if (strcmp(item, "scalar") == 0) m = all[i].kind == DEVICE_SCALAR;
-            else if (strcmp(item, "gpu") == 0) m = all[i].kind == DEVICE_OPENCL && (all[i].ocl.type & CL_DEVICE_TYPE_GPU);
-            else if (strcmp(item, "cpu") == 0) m = all[i].kind == DEVICE_OPENCL && (all[i].ocl.type & CL_DEVICE_TYPE_CPU);
-            else m = contains_ci(all[i].name, item) ||
-                     (all[i].kind == DEVICE_OPENCL && contains_ci(all[i].ocl.platform_name, item));
-            if (m) { add_choice(chosen, &k, i); matched = 1; }
-        }
-        if (!matched && k == before) { st = no_such_device(item, all, n, err); break; }
+        st = select_item(item, all, n, chosen, &k, err);
+        if (st != ST_OK) break;
     }
     free(copy);
     if (st != ST_OK) {

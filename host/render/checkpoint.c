@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 
 #include "base/atomic_file.h"
+#include "base/limit.h"
 #include "device/ocl_program.h"
 #include "base/sha256.h"
 
@@ -155,6 +156,35 @@ static Status bad(Error *err, const char *path, const char *what)
     return error_set(err, ST_INPUT, "'%s' is not a usable clpt checkpoint: %s", path, what);
 }
 
+/* The largest film value one sample can add: the kernels clamp a sample's radiance to
+ * FILM_MAX_SAMPLE and round it to units of 2^-FILM_FRAC_BITS (kernels/film.cl). */
+#define FILM_MAX_SAMPLE_FIXED ((uint64_t)FILM_MAX_SAMPLE << FILM_FRAC_BITS)
+
+/* Each value must be one that `samples` samples can produce: between 0 and samples
+ * times the largest sample. A crafted file could otherwise start the film near
+ * INT64_MAX, and the further batches of the resume would overflow the signed sums
+ * (undefined behaviour; negative pixels in practice). With samples <= CLPT_MAX_SPP
+ * (< 2^20) and the largest sample 2^40, every film stays below 2^60, whatever is
+ * resumed and added. */
+static Status read_film_values(const unsigned char *p, uint64_t n_values, uint64_t samples, const char *path,
+                               int64_t *sum, Error *err)
+{
+    uint64_t max = samples * FILM_MAX_SAMPLE_FIXED;
+    for (uint64_t i = 0; i < n_values; i++, p += 8) {
+        uint64_t v = get64(p);
+        if (v > max) {
+            char msg[256];
+            uint64_t pixel = i / 3u;
+            snprintf(msg, sizeof msg, "film value %s%llu of pixel %llu is outside what %llu samples can hold "
+                     "(0..%llu)", v >> 63 ? "-" : "", (unsigned long long)(v >> 63 ? -v : v),
+                     (unsigned long long)pixel, (unsigned long long)samples, (unsigned long long)max);
+            return bad(err, path, msg);
+        }
+        sum[i] = (int64_t)v;
+    }
+    return ST_OK;
+}
+
 Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
 {
     memset(c, 0, sizeof *c);
@@ -219,6 +249,11 @@ Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
         st = bad(err, path, "inconsistent header (image size and payload disagree)");
         goto out;
     }
+    /* No render asks for more; the bound on the film values below relies on it. */
+    if (id->spp == 0 || id->spp > CLPT_MAX_SPP) {
+        st = bad(err, path, "inconsistent header (samples per pixel outside 1.." CLPT_STR(CLPT_MAX_SPP) ")");
+        goto out;
+    }
     if ((st = film_init(&c->film, id->width, id->height, err))) goto out;
     c->done = malloc((n_done ? n_done : 1) * sizeof *c->done);
     if (!c->done) {
@@ -244,7 +279,7 @@ Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
         goto out;
     }
     c->film.samples = samples;
-    for (uint64_t i = 0; i < n_values; i++, p += 8) c->film.sum[i] = (int64_t)get64(p);
+    if ((st = read_film_values(p, n_values, samples, path, c->film.sum, err))) goto out;
 
 out:
     free(data);

@@ -13,6 +13,7 @@
 #include "render/checkpoint.h"
 #include "io/classic_parse.h"
 #include "device/device.h"
+#include "device/ocl_program.h"
 #include "render/film.h"
 #include "io/image_write.h"
 #include "base/limit.h"
@@ -262,6 +263,7 @@ static Status open_devices(const Options *o, const DeviceScene *ds, Device ***ou
         return error_set(err, ST_INTERNAL, "out of memory");
     }
     DeviceConfig cfg = { o->threads, o->kernel_dir, o->wave_paths };
+    ocl_program_announce_builds(!o->quiet);
     size_t n = 0;
     Error last = { 0 };
     for (size_t i = 0; i < n_chosen; i++) {

@@ -284,7 +284,9 @@ void progress_begin(Progress *p, const char *label, double total_units, const ch
                     int mode)
 {
     progress_begin_at(p, label, total_units, unit_name, mode, monotonic_seconds());
-    if (p->enabled) progress_draw(p, p->start, 0);
+    /* a log's first line waits for the first update, so that progress_set_step is in
+     * effect (and a log gets no line for work that ends at once) */
+    if (p->enabled == PROGRESS_TERMINAL) progress_draw(p, p->start, 0);
 }
 
 void progress_update(Progress *p, double done_units)

@@ -11,7 +11,7 @@
  * done/total, the rate, the elapsed time and the ETA, fitted to the terminal's width. It
  * is redrawn in place ("\r" and erase-to-end-of-line) at most 10 times a second, however
  * often update is called. Where stderr is a file or a pipe (PROGRESS_LOG) a plain line,
- * with no control characters, is written when the work begins and then every
+ * with no control characters, is written at the first update and then every
  * PROGRESS_LOG_INTERVAL_S seconds, so a batch log shows a long render advancing; the
  * end adds nothing there (the caller's summary follows). PROGRESS_OFF prints nothing.
  *
@@ -46,7 +46,7 @@ typedef struct {
     double changed_done;
 } Progress;
 
-/* Starts the clock and, when enabled, draws the line at 0%. label and unit_name are
+/* Starts the clock and, on a terminal, draws the line at 0%. label and unit_name are
  * copied (and truncated if long). mode is PROGRESS_OFF, _TERMINAL or _LOG. */
 void progress_begin(Progress *p, const char *label, double total_units, const char *unit_name,
                     int mode);

@@ -19,6 +19,7 @@
 #include "render/checkpoint.h"
 #include "io/classic_parse.h"
 #include "device/device.h"
+#include "device/ocl_program.h"
 #include "render/film.h"
 #include "io/image_write.h"
 #include "base/limit.h"
@@ -35,15 +36,29 @@
 #define CLPT_VERSION "0.1.0"
 
 static volatile sig_atomic_t stop_requested;
+static int stderr_is_terminal;
 
+/* The first SIGINT or SIGTERM stops the render within about a second and writes what
+ * is finished (exit 6); a second one, of either kind, ends the process at once by the
+ * signal's default action, writing nothing more. */
 static void on_stop_signal(int sig)
 {
-    (void)sig;
+    if (stop_requested) {
+        signal(sig, SIG_DFL);
+        raise(sig);   /* delivered as soon as this handler returns */
+        return;
+    }
     stop_requested = 1;
+    /* on a terminal the progress bar holds the line: start a fresh one */
+    static const char msg[] = "\nclpt: stopping: writing what is finished (press Ctrl-C again to quit at once)\n";
+    size_t skip = stderr_is_terminal ? 0 : 1;
+    ssize_t w = write(STDERR_FILENO, msg + skip, sizeof msg - 1 - skip);
+    (void)w;
 }
 
 static void install_signal_handlers(void)
 {
+    stderr_is_terminal = isatty(STDERR_FILENO);
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_stop_signal;
@@ -281,6 +296,7 @@ static Status open_devices(const Options *o, const DeviceScene *ds, Device ***ou
         return error_set(err, ST_INTERNAL, "out of memory");
     }
     DeviceConfig cfg = { o->threads, o->kernel_dir, o->wave_paths };
+    ocl_program_announce_builds(!o->quiet);
     size_t n = 0;
     Error last = { 0 };
     for (size_t i = 0; i < n_chosen; i++) {

@@ -2,7 +2,8 @@
  * test_checkpoint.c — checkpoint and resume: the file round-trips, damaged files and
  * checkpoints of other renders are refused with exit status 3, and a render killed with
  * SIGKILL at several moments (and resumed each time, on other devices) ends with the
- * same PFM bytes as a render never interrupted. Also SIGINT writes a final checkpoint.
+ * same PFM bytes as a render never interrupted. Also SIGINT writes a final checkpoint,
+ * holding whole batches only.
  * Runs with two PoCL devices (POCL_DEVICES="pthread pthread") plus the scalar device.
  */
 #include <dirent.h>
@@ -348,6 +349,39 @@ static void test_sigint_writes_a_checkpoint(void)
     CHECK_MSG(files_equal(path_ref, path_out), "the image resumed after SIGINT differs");
 }
 
+/* An interrupt drops the batch in flight whole: the image and the checkpoint hold whole
+ * batches only, the same bits as a render of that many samples, and a resume from the
+ * checkpoint ends with the image of a render never interrupted. */
+static void test_sigint_keeps_whole_batches(void)
+{
+#define BIG "--width", "160", "--height", "120"
+    char ref_part[160], ref_full[160], held_text[16];
+    snprintf(ref_part, sizeof ref_part, "%s/part.pfm", dir);
+    snprintf(ref_full, sizeof ref_full, "%s/full.pfm", dir);
+    unlink(path_ck);
+    CliChild c = cli_start(ARGS(SCENE, "--device", "scalar", BIG, "--spp", "64", "--batch", "16", "-o", path_out,
+                                "--checkpoint", path_ck, "--checkpoint-interval", "0.05"));
+    double t0 = timer_now();
+    while (checkpoint_samples(path_ck) <= 0 && timer_now() - t0 < 30.0) sleep_s(0.005);
+    kill(c.pid, SIGINT);   /* most likely part-way through the second batch */
+    cli_finish(c, &r);
+    CHECK_EQ_INT(r.status, 6);
+    long held = checkpoint_samples(path_ck);
+    CHECK_MSG(held > 0 && held < 64 && held % 16 == 0, "the checkpoint after SIGINT holds %ld spp", held);
+    snprintf(held_text, sizeof held_text, "%ld", held);
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", BIG, "--spp", held_text, "-o", ref_part), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_MSG(files_equal(ref_part, path_out), "the image after SIGINT differs from a %ld spp render", held);
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", BIG, "--spp", "64", "-o", path_out, "--resume", path_ck), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", BIG, "--spp", "64", "-o", ref_full), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_MSG(files_equal(ref_full, path_out), "the image resumed after SIGINT differs from an uninterrupted one");
+    unlink(ref_part);
+    unlink(ref_full);
+#undef BIG
+}
+
 static void test_other_renders_are_refused(void)
 {
     /* path_ck holds the finished render of the tests above */
@@ -389,6 +423,7 @@ int main(void)
     RUN(test_sigkill_then_resume_gives_the_same_image);
     RUN(test_sigint_writes_a_checkpoint);
     RUN(test_other_renders_are_refused);
+    RUN(test_sigint_keeps_whole_batches);
     remove_dir();
     return harness_report();
 }

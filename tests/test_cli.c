@@ -425,6 +425,64 @@ static void test_no_opencl_said_once_without_escapes(void)
         CHECK(strchr(r.err, '\033') == NULL && strchr(r.err, '\r') == NULL);
     }
     rmdir(vendors[1]);
+}
+
+/* stderr to a file (a batch log): plain progress lines, the first when the render
+ * begins and then every 5 s, with no carriage return or escape code anywhere */
+static void test_log_shows_plain_progress(void)
+{
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", "--threads", "1", "--width", "64", "--height",
+                 "64", "--spp", "1000000", "--time-limit", "5.6", "-o", "/tmp/clpt-test-log.png"),
+            &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(strchr(r.err, '\r') == NULL);
+    CHECK(strchr(r.err, '\033') == NULL);
+    CHECK_MSG(strncmp(r.err, "clpt: render 0%, ", 17) == 0, "%s", r.err);
+    const char *nl = strchr(r.err, '\n');
+    CHECK(nl && nl - r.err > 40 && strstr(r.err, "/1000000 spp, ") < nl && strstr(r.err, " 00:00 elapsed, ETA ") < nl);
+    const char *second = strstr(r.err + 1, "clpt: render ");
+    CHECK_MSG(second != NULL, "one progress line only: %s", r.err);
+    if (second) {
+        CHECK(strncmp(second, "clpt: render 0%, ", 17) == 0);
+        CHECK_STR_CONTAINS(second, "samples/s, 00:05 elapsed, ETA ");
+        CHECK(strstr(second, "-- samples/s") == NULL);
+    }
+    CHECK_STR_CONTAINS(r.err, "clpt: time limit reached:");
+    unlink("/tmp/clpt-test-log.png");
+}
+
+/* the first build of the kernels for a device says so; a cache hit and -q do not */
+static void test_kernel_build_notice(void)
+{
+    char cache[] = "/tmp/clpt-test-cache-XXXXXX";
+    if (!mkdtemp(cache)) return;
+    const char *saved = getenv("CLPT_CACHE_DIR");
+    char *old = saved ? strdup(saved) : NULL;
+    setenv("CLPT_CACHE_DIR", cache, 1);
+    const char *out = "/tmp/clpt-test-notice.png";
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--width", "8", "--height", "8", "--spp", "1", "-q",
+                 "-o", out), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(strstr(r.err, "compiling kernels") == NULL);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--width", "8", "--height", "8", "--spp", "1", "-o",
+                 out), &r);
+    CHECK(strstr(r.err, "compiling kernels") == NULL);     /* the quiet run filled the cache */
+    char cmd[200];
+    snprintf(cmd, sizeof cmd, "rm -f %s/*.bin", cache);
+    CHECK(system(cmd) == 0);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--width", "8", "--height", "8", "--spp", "1", "-o",
+                 out), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_STR_CONTAINS(r.err, "clpt: compiling kernels for ");
+    CHECK_STR_CONTAINS(r.err, " (first run; cached afterwards)...\n");
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--width", "8", "--height", "8", "--spp", "1", "-o",
+                 out), &r);
+    CHECK(strstr(r.err, "compiling kernels") == NULL);
+    if (old) setenv("CLPT_CACHE_DIR", old, 1);
+    else unsetenv("CLPT_CACHE_DIR");
+    free(old);
+    snprintf(cmd, sizeof cmd, "rm -rf %s", cache);
+    CHECK(system(cmd) == 0);
     unlink(out);
 }
 
@@ -449,5 +507,7 @@ int main(void)
     RUN(test_stdout_failures);
     RUN(test_device_list_with_empty_item);
     RUN(test_no_opencl_said_once_without_escapes);
+    RUN(test_log_shows_plain_progress);
+    RUN(test_kernel_build_notice);
     return harness_report();
 }

@@ -1,5 +1,7 @@
-/* test_progress.c — the formatting helpers, the fitted status line, and what a disabled
- * and an enabled progress bar actually write to stderr. */
+/* test_progress.c — the formatting helpers, the fitted status line, the recent rate and
+ * ETA on a fake clock, and what a disabled progress, a bar and a log actually write to
+ * stderr. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -194,7 +196,7 @@ static void drive_disabled(void)
     progress_begin(&p, "render", 100.0, "samples", 0);
     for (int i = 0; i <= 100; i++) progress_update(&p, i);
     progress_end(&p);
-    /* stderr is a regular file here, not a terminal */
+    /* stderr is a regular file here, not a terminal: plain lines */
     should_enable_result = progress_should_enable(0);
 }
 
@@ -223,8 +225,8 @@ static void test_disabled_prints_nothing(void)
     CHECK(out != NULL);
     if (out) CHECK_EQ_INT(strlen(out), 0);
     free(out);
-    CHECK_EQ_INT(should_enable_result, 0);
-    CHECK_EQ_INT(progress_should_enable(1), 0);
+    CHECK_EQ_INT(should_enable_result, PROGRESS_LOG);
+    CHECK_EQ_INT(progress_should_enable(1), PROGRESS_OFF);
 }
 
 static void test_enabled_draws_line(void)
@@ -253,6 +255,92 @@ static void test_enabled_draws_line(void)
     free(out);
 }
 
+/* A render whose first batches are slow (start-up, small batches) and then steady at
+ * 1000 units/s: the average since the start stays far below that for long; the recent
+ * rate, and so the ETA, find it within a few seconds. */
+static void test_recent_rate_and_eta(void)
+{
+    Progress p;
+    progress_begin_at(&p, "render", 100000.0, "samples", PROGRESS_OFF, 100.0);
+    CHECK(progress_rate(&p, 0.0) < 0.0);
+    CHECK(progress_eta(&p, 100.0) < 0.0);
+    /* 4 s of start-up for the first 1000 units */
+    progress_observe(&p, 104.0, 1000.0);
+    CHECK(fabs(progress_rate(&p, 4.0) - 250.0) < 1e-9);
+    /* then a batch of 1000 every second */
+    double done = 1000.0, now = 104.0;
+    for (int i = 0; i < 10; i++) {
+        now += 1.0;
+        done += 1000.0;
+        progress_observe(&p, now, done);
+    }
+    /* the average since the start: 11000 / 14 s = 786/s, an ETA of 113 s; the truth is 89 s */
+    double rate = progress_rate(&p, now - p.start), eta = progress_eta(&p, now);
+    CHECK_MSG(rate > 950.0 && rate <= 1000.0, "recent rate %.1f", rate);
+    CHECK_MSG(eta > 89.0 && eta < 94.0, "ETA %.1f s, want about 89", eta);
+    /* between batches the ETA counts down instead of standing still */
+    CHECK_MSG(fabs(progress_eta(&p, now + 0.5) - (eta - 0.5)) < 1e-9, "ETA half a second later %.2f",
+              progress_eta(&p, now + 0.5));
+    /* observations without progress change nothing */
+    progress_observe(&p, now + 0.5, done);
+    CHECK(fabs(progress_rate(&p, 0.0) - rate) < 1e-12);
+    /* a slow-down shows within a few seconds, too */
+    for (int i = 0; i < 10; i++) {
+        now += 2.0;
+        done += 1000.0;
+        progress_observe(&p, now, done);
+    }
+    rate = progress_rate(&p, now - p.start);
+    CHECK_MSG(rate > 500.0 && rate < 520.0, "recent rate after the slow-down %.1f", rate);
+    /* never below zero past the end */
+    CHECK(progress_eta(&p, now + 1e6) == 0.0);
+}
+
+static void test_format_log(void)
+{
+    Progress p;
+    char line[256];
+    progress_begin_at(&p, "render", 64.0 * 10000.0, "samples", PROGRESS_LOG, 0.0);
+    progress_set_step(&p, 10000.0, "spp");
+    progress_format_log(&p, 0.0, line, sizeof line);
+    CHECK_STR(line, "clpt: render 0%, 0/64 spp, -- samples/s, 00:00 elapsed, ETA --:--");
+    progress_observe(&p, 2.0, 8.0 * 10000.0);
+    progress_observe(&p, 3.0, 24.0 * 10000.0);
+    progress_format_log(&p, 3.0, line, sizeof line);
+    CHECK_STR_CONTAINS(line, "clpt: render 37%, 24/64 spp, ");
+    CHECK_STR_CONTAINS(line, "ksamples/s, 00:03 elapsed, ETA 00:");
+    for (const char *c = line; *c; c++) CHECK((unsigned char)*c >= ' ');
+}
+
+static void drive_log_begin_end(void)
+{
+    Progress p;
+    progress_begin(&p, "render", 100.0, "samples", PROGRESS_LOG);
+    progress_end(&p);
+}
+
+static void drive_log(void)
+{
+    Progress p;
+    progress_begin(&p, "render", 100.0, "samples", PROGRESS_LOG);
+    for (int i = 0; i <= 100; i++) progress_update(&p, i);
+    progress_end(&p);
+}
+
+/* in a log: one plain line at the first update (the next comes after
+ * PROGRESS_LOG_INTERVAL_S), no carriage returns or escape codes, nothing at the end */
+static void test_log_writes_plain_lines(void)
+{
+    char *out = capture_stderr(drive_log);
+    CHECK(out != NULL);
+    if (!out) return;
+    CHECK_STR(out, "clpt: render 0%, 0/100 samples, -- samples/s, 00:00 elapsed, ETA --:--\n");
+    free(out);
+    out = capture_stderr(drive_log_begin_end);
+    CHECK_STR(out ? out : "(null)", "");
+    free(out);
+}
+
 int main(void)
 {
     RUN(test_format_duration);
@@ -260,5 +348,8 @@ int main(void)
     RUN(test_format_line);
     RUN(test_disabled_prints_nothing);
     RUN(test_enabled_draws_line);
+    RUN(test_recent_rate_and_eta);
+    RUN(test_format_log);
+    RUN(test_log_writes_plain_lines);
     return harness_report();
 }

@@ -123,15 +123,15 @@ void progress_format_line(const Progress *p, double elapsed, int columns, int fi
     if (!(frac > 0.0)) frac = 0.0;
     if (frac > 1.0) frac = 1.0;
     int pct = (int)floor(frac * 100.0); /* floor: 100% only when truly done */
-    double rate = elapsed > 0.0 ? p->done / elapsed : -1.0;
+    /* the final line reports the average; a running one the recent rate */
+    double rate = final ? (elapsed > 0.0 ? p->done / elapsed : -1.0) : progress_rate(p, elapsed);
 
     char done[32], total[32], rate_s[64], el[16], eta[16];
     progress_format_count(p->done, done, sizeof done);
     progress_format_count(p->total, total, sizeof total);
     progress_format_rate(rate, p->unit, rate_s, sizeof rate_s);
     progress_format_duration(elapsed, el, sizeof el);
-    progress_format_duration(known_total && rate > 0.0 ? (p->total - p->done) / rate : -1.0, eta,
-                             sizeof eta);
+    progress_format_duration(known_total ? progress_eta(p, p->start + elapsed) : -1.0, eta, sizeof eta);
 
     /* The full form, and a short one (percentage and times) for narrow terminals. Counts
      * and rates are padded to their widest form ("999k", "1.23 M<unit>/s") so the bar
@@ -161,6 +161,84 @@ void progress_format_line(const Progress *p, double elapsed, int columns, int fi
     snprintf(buf, avail + 1, "%s", line);
 }
 
+void progress_begin_at(Progress *p, const char *label, double total_units, const char *unit_name,
+                       int mode, double now)
+{
+    memset(p, 0, sizeof *p);
+    p->enabled = mode;
+    snprintf(p->label, sizeof p->label, "%s", label ? label : "");
+    snprintf(p->unit, sizeof p->unit, "%s", unit_name ? unit_name : "units");
+    p->total = total_units;
+    p->start = now;
+    p->changed = now;
+}
+
+void progress_set_step(Progress *p, double units_per_step, const char *name)
+{
+    p->step = units_per_step > 0.0 ? units_per_step : 0.0;
+    snprintf(p->step_name, sizeof p->step_name, "%s", name ? name : "");
+}
+
+/* Work arrives in batches, so the rate is measured from one change of `done` to the
+ * next and weighted by how long that took: an interval of dt seconds counts
+ * 1 - exp(-dt / window), so what happened more than a few windows ago hardly counts
+ * (the first measurement, start-up included, is replaced within seconds). */
+void progress_observe(Progress *p, double now, double done_units)
+{
+    p->done = done_units;
+    double dt = now - p->changed;
+    if (done_units == p->changed_done || !(dt > 0.0)) return;
+    double r = (done_units - p->changed_done) / dt;
+    if (p->rate > 0.0) {
+        double w = 1.0 - exp(-dt / PROGRESS_RATE_WINDOW_S);
+        p->rate += w * (r - p->rate);
+    } else {
+        p->rate = r;
+    }
+    p->changed = now;
+    p->changed_done = done_units;
+}
+
+double progress_rate(const Progress *p, double elapsed)
+{
+    if (p->rate > 0.0) return p->rate;
+    return elapsed > 0.0 && p->done > 0.0 ? p->done / elapsed : -1.0;
+}
+
+double progress_eta(const Progress *p, double now)
+{
+    if (!(p->total > 0.0)) return -1.0;
+    if (p->rate > 0.0) {
+        /* counts down between batches instead of standing still until the next one */
+        double left = (p->total - p->changed_done) / p->rate - (now - p->changed);
+        return left > 0.0 ? left : 0.0;
+    }
+    double rate = progress_rate(p, now - p->start);
+    return rate > 0.0 ? (p->total - p->done) / rate : -1.0;
+}
+
+void progress_format_log(const Progress *p, double now, char *buf, size_t size)
+{
+    double elapsed = now - p->start;
+    char done[32], total[32], rate_s[64], el[16], eta[16], amount[96], pct[16] = "";
+    if (p->step > 0.0) {
+        snprintf(amount, sizeof amount, "%.0f/%.0f %s", floor(p->done / p->step), floor(p->total / p->step),
+                 p->step_name);
+    } else {
+        progress_format_count(p->done, done, sizeof done);
+        progress_format_count(p->total, total, sizeof total);
+        snprintf(amount, sizeof amount, "%s/%s %s", done, total, p->unit);
+    }
+    if (p->total > 0.0) {
+        double frac = p->done / p->total;
+        snprintf(pct, sizeof pct, " %d%%,", (int)floor((frac > 1.0 ? 1.0 : frac > 0.0 ? frac : 0.0) * 100.0));
+    }
+    progress_format_rate(progress_rate(p, elapsed), p->unit, rate_s, sizeof rate_s);
+    progress_format_duration(elapsed, el, sizeof el);
+    progress_format_duration(progress_eta(p, now), eta, sizeof eta);
+    snprintf(buf, size, "clpt: %s%s %s, %s, %s elapsed, ETA %s", p->label, pct, amount, rate_s, el, eta);
+}
+
 /* ------------------------------------------------------------------ clock and terminal */
 
 static double monotonic_seconds(void)
@@ -180,9 +258,14 @@ static int terminal_columns(void)
 static void progress_draw(Progress *p, double now, int final)
 {
     char line[512];
-    progress_format_line(p, now - p->start, terminal_columns(), final, line, sizeof line);
-    /* One write per redraw: "\r", the line, erase whatever a longer earlier line left. */
-    fprintf(stderr, "\r%s\033[K%s", line, final ? "\n" : "");
+    if (p->enabled == PROGRESS_LOG) {
+        progress_format_log(p, now, line, sizeof line);
+        fprintf(stderr, "%s\n", line);
+    } else {
+        progress_format_line(p, now - p->start, terminal_columns(), final, line, sizeof line);
+        /* One write per redraw: "\r", the line, erase whatever a longer earlier line left. */
+        fprintf(stderr, "\r%s\033[K%s", line, final ? "\n" : "");
+    }
     fflush(stderr);
     p->last_draw = now;
     p->drawn = 1;
@@ -190,37 +273,36 @@ static void progress_draw(Progress *p, double now, int final)
 
 int progress_should_enable(int quiet)
 {
-    if (quiet || !isatty(STDERR_FILENO)) return 0;
+    if (quiet) return PROGRESS_OFF;
+    if (!isatty(STDERR_FILENO)) return PROGRESS_LOG;
     /* No TERM at all gives no reason to think "\r" and ESC[K are understood either. */
     const char *term = getenv("TERM");
-    return term && term[0] && strcmp(term, "dumb") != 0;
+    return term && term[0] && strcmp(term, "dumb") != 0 ? PROGRESS_TERMINAL : PROGRESS_LOG;
 }
 
 void progress_begin(Progress *p, const char *label, double total_units, const char *unit_name,
-                    int enabled)
+                    int mode)
 {
-    memset(p, 0, sizeof *p);
-    p->enabled = enabled;
-    snprintf(p->label, sizeof p->label, "%s", label ? label : "");
-    snprintf(p->unit, sizeof p->unit, "%s", unit_name ? unit_name : "units");
-    p->total = total_units;
-    p->start = monotonic_seconds();
-    if (p->enabled) progress_draw(p, p->start, 0);
+    progress_begin_at(p, label, total_units, unit_name, mode, monotonic_seconds());
+    /* a log's first line waits for the first update, so that progress_set_step is in
+     * effect (and a log gets no line for work that ends at once) */
+    if (p->enabled == PROGRESS_TERMINAL) progress_draw(p, p->start, 0);
 }
 
 void progress_update(Progress *p, double done_units)
 {
-    p->done = done_units;
-    if (!p->enabled) return;
     double now = monotonic_seconds();
-    if (p->drawn && now - p->last_draw < REDRAW_INTERVAL_S) return;
+    progress_observe(p, now, done_units);
+    if (!p->enabled) return;
+    double interval = p->enabled == PROGRESS_LOG ? PROGRESS_LOG_INTERVAL_S : REDRAW_INTERVAL_S;
+    if (p->drawn && now - p->last_draw < interval) return;
     progress_draw(p, now, 0);
 }
 
 void progress_end(Progress *p)
 {
-    if (!p->enabled) return;
-    progress_draw(p, monotonic_seconds(), 1);
+    /* a log's last word is the caller's summary */
+    if (p->enabled == PROGRESS_TERMINAL) progress_draw(p, monotonic_seconds(), 1);
     /* A second end (say, on an error path after the normal one) prints nothing more. */
-    p->enabled = 0;
+    p->enabled = PROGRESS_OFF;
 }

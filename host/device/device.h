@@ -14,10 +14,18 @@
  * taken; `take_film` takes them in the order they were rendered, waiting if needed. The
  * OpenCL device uses this to read one batch's film back while the next one renders; the
  * scalar device finishes each batch in `render` (max_in_flight 1).
+ *
+ * A batch can be cancelled: while `cancel` points to a flag that another thread sets,
+ * `render` checks it between small steps of work (the scalar device between chunks of
+ * about a thousand paths, the OpenCL device between the launches of its waves) and,
+ * once it is set, drops the batch's partial film and returns ST_INTERRUPTED. Batches
+ * rendered before stay whole and can still be taken, so a film holds whole batches
+ * only and the image stays the same whichever moment the cancel came.
  */
 #ifndef CLPT_DEVICE_H
 #define CLPT_DEVICE_H
 
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 
@@ -72,7 +80,8 @@ typedef struct Device Device;
 
 typedef struct {
     Status (*load_scene)(Device *d, const DeviceScene *scene, Error *err);
-    /* Renders samples [first_sample, first_sample + count) of every pixel. */
+    /* Renders samples [first_sample, first_sample + count) of every pixel; ST_INTERRUPTED,
+     * with nothing of the batch kept, when *d->cancel was set meanwhile. */
     Status (*render)(Device *d, uint first_sample, uint count, Error *err);
     /* Adds the film of the oldest batch not yet taken into `film` (n_pixels * 3). */
     Status (*take_film)(Device *d, int64_t *film, Error *err);
@@ -86,6 +95,7 @@ struct Device {
     uint n_pixels;                /* set by load_scene */
     uint max_in_flight;           /* batches rendered and not yet taken, at most (>= 1;
                                      set by load_scene) */
+    const atomic_int *cancel;     /* set by the caller; NULL: never cancelled */
     void *impl;
 };
 

@@ -80,6 +80,7 @@ typedef struct {
     uint wave_paths;        /* capacity of each wave's buffers */
     size_t local_size;      /* 0: let the driver choose */
     uint n_pixels;
+    const atomic_int *cancel;   /* the Device's, while a batch renders */
     cl_mem film;            /* the film the batch being rendered goes to */
     uint64_t rays;          /* rays of the batch being rendered */
 } OclDevice;
@@ -388,6 +389,30 @@ static Status wave_advance(OclDevice *od, WaveSlot *w, Error *err)
     return launch(od, k, "k_film", w->n_paths < od->n_pixels ? w->n_paths : od->n_pixels, err);
 }
 
+/* Whether the batch is to be dropped: checked before each launch step of a wave (a
+ * bounce of a wave takes milliseconds), so a cancel is seen about that quickly. */
+static int cancel_requested(const OclDevice *od)
+{
+    return od->cancel && atomic_load_explicit(od->cancel, memory_order_relaxed);
+}
+
+/* Drops a cancelled batch: lets what was enqueued finish (nothing may still write to
+ * the film or to the wave buffers), forgets the waves and clears the batch's film. The
+ * batches before, with their read-backs, are whole and stay to be taken. */
+static Status cancel_batch(OclDevice *od, FilmSlot *fs, Error *err)
+{
+    OCL_TRY("clFinish", clFinish(od->queue));
+    for (int i = 0; i < WAVE_SLOTS; i++) {
+        release_event(&od->waves[i].read);
+        od->waves[i].active = 0;
+    }
+    cl_long zero = 0;
+    size_t bytes = (size_t)od->n_pixels * 3u * sizeof(cl_long);
+    OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, fs->film, &zero, sizeof zero, 0, bytes, 0, NULL, NULL));
+    OCL_TRY("clFinish", clFinish(od->queue));
+    return error_set(err, ST_INTERRUPTED, "device '%s': batch cancelled", od->info.name);
+}
+
 /* The classic ray tracer's batch (kernels/whitted.cl): per wave, one k_whitted launch
  * computes every sample whole and counts its rays, then k_film adds the wave as for the
  * path tracer. Waves are numbered as in entry.cl. */
@@ -396,6 +421,7 @@ static Status render_whitted(OclDevice *od, uint first_sample, uint64_t total, E
     WaveSlot *w = &od->waves[0];
     Status st;
     for (uint64_t next_path = 0; next_path < total;) {
+        if (cancel_requested(od)) return ST_INTERRUPTED;
         uint n = total - next_path < od->wave_paths ? (uint)(total - next_path) : od->wave_paths;
         uint first_pixel = (uint)(next_path % od->n_pixels), sample = first_sample + (uint)(next_path / od->n_pixels);
         cl_uint zero = 0, count = 0;
@@ -434,6 +460,7 @@ static Status ocl_render(Device *d, uint first_sample, uint count, Error *err)
     if (n_waves < WAVE_SLOTS && total >= (uint64_t)WAVE_SLOTS * MIN_SPLIT_PATHS) n_waves = WAVE_SLOTS;
     uint64_t wave = (total + n_waves - 1) / n_waves, next_path = 0;
     od->film = fs->film;
+    od->cancel = d->cancel;
     od->rays = 0;
     Status st = ST_OK;
     for (int i = 0; i < WAVE_SLOTS; i++) od->waves[i].active = 0;
@@ -442,6 +469,10 @@ static Status ocl_render(Device *d, uint first_sample, uint count, Error *err)
         total = 0;   /* the wave loop below then has nothing to do */
     }
     for (; st == ST_OK;) {
+        if (cancel_requested(od)) {
+            st = ST_INTERRUPTED;
+            break;
+        }
         int any = 0;
         for (int i = 0; i < WAVE_SLOTS && st == ST_OK; i++) {
             WaveSlot *w = &od->waves[i];
@@ -455,6 +486,7 @@ static Status ocl_render(Device *d, uint first_sample, uint count, Error *err)
         }
         if (st != ST_OK || !any) break;
     }
+    if (st == ST_INTERRUPTED) return cancel_batch(od, fs, err);
     if (st != ST_OK) {
         for (int i = 0; i < WAVE_SLOTS; i++) release_event(&od->waves[i].read);
         return st;

@@ -47,6 +47,8 @@ typedef struct {
     uint first_sample, count, chunk_pixels;
     atomic_uint next_chunk;
     atomic_ullong rays;
+    const atomic_int *cancel;    /* the Device's, for the workers */
+    atomic_int cancelled;        /* a worker saw the cancel before the batch was whole */
 } CpuDevice;
 
 /* Renders one path to its end; returns the number of rays it traced. */
@@ -71,12 +73,22 @@ static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *
     return rays;
 }
 
-/* Renders chunks of the current batch until none is left. */
+/* Whether the batch is to be dropped; checked before each chunk, so a cancel is seen
+ * within a chunk's time (well under a millisecond) on every worker. */
+static int cancel_requested(CpuDevice *cd)
+{
+    if (!cd->cancel || !atomic_load_explicit(cd->cancel, memory_order_relaxed)) return 0;
+    atomic_store(&cd->cancelled, 1);
+    return 1;
+}
+
+/* Renders chunks of the current batch until none is left or the batch is cancelled. */
 static void render_chunks(CpuDevice *cd)
 {
     uint n_pixels = cd->params.width * cd->params.height;
     uint64_t rays = 0;
     for (;;) {
+        if (cancel_requested(cd)) break;
         uint chunk = atomic_fetch_add(&cd->next_chunk, 1u);
         if (chunk >= (n_pixels + cd->chunk_pixels - 1) / cd->chunk_pixels) break;
         uint begin = chunk * cd->chunk_pixels;
@@ -152,6 +164,8 @@ static Status cpu_render(Device *d, uint first_sample, uint count, Error *err)
     cd->chunk_pixels = CPU_CHUNK_PATHS / count ? CPU_CHUNK_PATHS / count : 1u;
     atomic_store(&cd->next_chunk, 0u);
     atomic_store(&cd->rays, 0ull);
+    atomic_store(&cd->cancelled, 0);
+    cd->cancel = d->cancel;
     if (cd->started == 0) {
         render_chunks(cd);   /* no worker could start: work on this thread */
     } else {
@@ -163,8 +177,12 @@ static Status cpu_render(Device *d, uint first_sample, uint count, Error *err)
         pthread_mutex_unlock(&cd->lock);
     }
     d->counters.rays += atomic_load(&cd->rays);
+    if (atomic_load(&cd->cancelled)) {
+        /* part of the batch is in the film: drop it all, so only whole batches count */
+        memset(cd->film, 0, (size_t)d->n_pixels * 3u * sizeof *cd->film);
+        return error_set(err, ST_INTERRUPTED, "scalar device: batch cancelled");
+    }
     d->counters.samples += (uint64_t)d->n_pixels * count;
-    (void)err;
     return ST_OK;
 }
 

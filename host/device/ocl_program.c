@@ -2,6 +2,7 @@
 
 #include <errno.h>
 #include <stdint.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -309,6 +310,24 @@ static Status oclp__from_source(cl_context ctx, const OclDeviceInfo *dev, const 
     return ST_OK;
 }
 
+/* ---------------------------------------------------------------- the notice */
+
+static atomic_int oclp__announce_builds;
+
+void ocl_program_announce_builds(int on)
+{
+    atomic_store(&oclp__announce_builds, on);
+}
+
+/* A build from source takes seconds to a minute with nothing else to show: say why. */
+static void oclp__announce(const OclDeviceInfo *dev, int cached_afterwards)
+{
+    if (!atomic_load(&oclp__announce_builds)) return;
+    fprintf(stderr, "clpt: compiling kernels for %s%s...\n", dev->name,
+            cached_afterwards ? " (first run; cached afterwards)" : "");
+    fflush(stderr);
+}
+
 Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *kernel_dir,
                          const char *extra_options, cl_program *out, OclProgramStats *stats,
                          Error *err)
@@ -375,6 +394,7 @@ Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *k
     }
 
     if (!stats->from_cache) {
+        oclp__announce(dev, path[0] != '\0');
         st = oclp__from_source(ctx, dev, src, src_len, options, out, err);
         if (st == ST_OK && path[0]) {
             unsigned char *bin = NULL;

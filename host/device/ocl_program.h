@@ -47,6 +47,11 @@ Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *k
                          const char *extra_options, cl_program *out, OclProgramStats *stats,
                          Error *err);
 
+/* Whether a build from source (a cache miss, or --kernel-dir) first says so on stderr:
+ * "clpt: compiling kernels for <device> (first run; cached afterwards)...". Off until
+ * turned on (the program does, unless -q). */
+void ocl_program_announce_builds(int on);
+
 /* clCreateKernel, failing with the device and kernel name in the message. */
 Status ocl_program_kernel(cl_program prog, const OclDeviceInfo *dev, const char *name,
                           cl_kernel *out, Error *err);

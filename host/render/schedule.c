@@ -5,6 +5,7 @@
 #include <stdarg.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,6 +40,8 @@ struct Shared {
     pthread_mutex_t state_lock;
     pthread_cond_t state_cond;
     size_t active;              /* workers still running */
+    atomic_int cancel;          /* interrupted: the devices drop the batches they render */
+    int queue_ready;            /* queue and locks made (shared_free frees them) */
     double start;
     Worker *workers;
     size_t n_workers;
@@ -119,99 +122,147 @@ static void merge_batch(Worker *w, Batch b)
     memset(w->scratch, 0, len * sizeof *w->scratch);
 }
 
+/* The batches a worker has handed to its device and not yet taken, oldest first. */
+typedef struct {
+    Batch b[MAX_PIPELINE];
+    uint n;
+} Flight;
+
+static Batch flight_pop_oldest(Flight *fl)
+{
+    Batch b = fl->b[0];
+    memmove(&fl->b[0], &fl->b[1], --fl->n * sizeof *fl->b);
+    return b;
+}
+
+static size_t active_workers(Shared *sh)
+{
+    pthread_mutex_lock(&sh->state_lock);
+    size_t n = sh->active;
+    pthread_mutex_unlock(&sh->state_lock);
+    return n;
+}
+
+/* No more batches for this worker: the render was interrupted (the calling thread has
+ * closed the queue and raised the cancel) or its time is up (closed here). */
+static int worker_stopping(Worker *w)
+{
+    Shared *sh = w->shared;
+    if (atomic_load(&sh->cancel)) return 1;
+    if (!time_is_up(sh)) return 0;
+    batch_queue_close(&sh->queue);
+    return 1;
+}
+
+static void give_back(Worker *w, Batch b)
+{
+    if (batch_queue_give_back(&w->shared->queue, b) != 0)
+        warn(w->shared, "out of memory returning a batch; the image will have fewer samples");
+}
+
+/* Takes the film of the oldest batch in flight and adds it into the shared film. */
+static Status worker_take_oldest(Worker *w, Flight *fl, Error *err)
+{
+    double t0 = timer_now();
+    Status st = w->dev->ops->take_film(w->dev, w->scratch, err);
+    w->stats.busy_seconds += timer_now() - t0;
+    if (st != ST_OK) {
+        size_t film_len = (size_t)w->shared->film->width * w->shared->film->height * 3u;
+        memset(w->scratch, 0, film_len * sizeof *w->scratch);
+        return st;
+    }
+    Batch b = flight_pop_oldest(fl);
+    merge_batch(w, b);
+    batch_queue_done(&w->shared->queue, b);
+    w->stats.batches++;
+    return ST_OK;
+}
+
+/* After a batch failed or was cancelled, the batches rendered before it may be whole on
+ * the device: keeps those whose films can still be taken. */
+static void worker_keep_finished(Worker *w, Flight *fl)
+{
+    Error err = { 0 };
+    while (fl->n > 0 && worker_take_oldest(w, fl, &err) == ST_OK) {}
+    error_clear(&err);
+}
+
+/* render returns when the device has worked through the batch (for a pipelined device,
+ * all but the film's read-back): its time gives the device's speed. */
+static void worker_record_batch(Worker *w, Batch b, double seconds)
+{
+    w->stats.busy_seconds += seconds;
+    w->seconds_per_sample = seconds / (double)b.count;
+    w->stats.batch_last = b.count;
+    if (!w->stats.batch_min || b.count < w->stats.batch_min) w->stats.batch_min = b.count;
+    if (b.count > w->stats.batch_max) w->stats.batch_max = b.count;
+}
+
+/* Hands the device its next batch. Returns 1 when one was rendered, 0 when none could
+ * be taken or the render did not succeed (*st says which: a failure, or ST_INTERRUPTED
+ * for a cancelled batch, which is dropped whole). Only a worker with nothing in flight
+ * may wait for a batch, or it could wait for its own. */
+static int worker_render_next(Worker *w, Flight *fl, Status *st, Error *err)
+{
+    Shared *sh = w->shared;
+    Batch b;
+    uint want = choose_batch(w, active_workers(sh));
+    if (!(fl->n ? batch_queue_try_take(&sh->queue, want, &b) : batch_queue_take(&sh->queue, want, &b))) return 0;
+    double t0 = timer_now();
+    if (w->fail_at_batch >= 0 && (long)w->started == w->fail_at_batch)
+        *st = error_set(err, ST_DEVICE, "failure injected by CLPT_TEST_FAIL");
+    else
+        *st = w->dev->ops->render(w->dev, b.first, b.count, err);
+    w->started++;
+    if (*st != ST_OK) {
+        give_back(w, b);
+        worker_keep_finished(w, fl);
+        return 0;
+    }
+    fl->b[fl->n++] = b;
+    worker_record_batch(w, b, timer_now() - t0);
+    return 1;
+}
+
+/* A failed device drops out: whatever it had in flight goes to the others. */
+static void worker_drop_device(Worker *w, Flight *fl, Error *err)
+{
+    w->stats.failed = 1;
+    snprintf(w->stats.failure, sizeof w->stats.failure, "%s", err->msg);
+    for (uint i = 0; i < fl->n; i++) give_back(w, fl->b[i]);
+    fl->n = 0;
+    warn(w->shared, "device '%s' failed and was dropped; its samples go to the other devices: %s", w->stats.name,
+         err->msg);
+}
+
+/* One host thread per device: keeps the device's pipeline full (the next batch is
+ * handed over before the last one's film is taken) until the queue is empty, the
+ * render is interrupted or the device fails. */
 static void *worker_main(void *arg)
 {
     Worker *w = arg;
     Shared *sh = w->shared;
-    const ScheduleConfig *cfg = sh->cfg;
-    size_t film_len = (size_t)sh->film->width * sh->film->height * 3u;
     uint depth = w->dev->max_in_flight ? w->dev->max_in_flight : 1u;
     if (depth > MAX_PIPELINE) depth = MAX_PIPELINE;
-    Batch flight[MAX_PIPELINE];   /* rendered, film not yet taken; oldest first */
-    uint n_flight = 0;
+    Flight fl = { .n = 0 };
     double thread_start = timer_now();
     uint64_t samples_before = w->dev->counters.samples, rays_before = w->dev->counters.rays;
     Error err = { 0 };
     Status st = ST_OK;
     for (;;) {
-        int stopping = cfg->stop && *cfg->stop;
-        if (!stopping && time_is_up(sh)) {
-            batch_queue_close(&sh->queue);
-            stopping = 1;
+        if (!worker_stopping(w) && fl.n < depth) {
+            if (worker_render_next(w, &fl, &st, &err)) continue;
+            if (st != ST_OK) break;
         }
-        /* Keep the device's pipeline full: the next batch is handed over before the
-         * last one's film is taken. Only a worker with nothing in flight may wait for
-         * a batch, or it could wait for its own. */
-        if (!stopping && n_flight < depth) {
-            pthread_mutex_lock(&sh->state_lock);
-            size_t n_active = sh->active;
-            pthread_mutex_unlock(&sh->state_lock);
-            Batch b;
-            uint want = choose_batch(w, n_active);
-            int got = n_flight ? batch_queue_try_take(&sh->queue, want, &b) : batch_queue_take(&sh->queue, want, &b);
-            if (got) {
-                flight[n_flight++] = b;
-                double t0 = timer_now();
-                if (w->fail_at_batch >= 0 && (long)w->started == w->fail_at_batch)
-                    st = error_set(&err, ST_DEVICE, "failure injected by CLPT_TEST_FAIL");
-                else
-                    st = w->dev->ops->render(w->dev, b.first, b.count, &err);
-                w->started++;
-                double t1 = timer_now();
-                if (st != ST_OK) {
-                    /* The batches before this one may be complete on the device: keep
-                     * what can still be taken. */
-                    Batch failed = flight[--n_flight];
-                    if (batch_queue_give_back(&sh->queue, failed) != 0)
-                        warn(sh, "out of memory returning a batch; the image will have fewer samples");
-                    Error take_err = { 0 };
-                    while (n_flight > 0 && w->dev->ops->take_film(w->dev, w->scratch, &take_err) == ST_OK) {
-                        Batch done = flight[0];
-                        memmove(&flight[0], &flight[1], --n_flight * sizeof *flight);
-                        merge_batch(w, done);
-                        batch_queue_done(&sh->queue, done);
-                        w->stats.batches++;
-                    }
-                    memset(w->scratch, 0, film_len * sizeof *w->scratch);
-                    error_clear(&take_err);
-                    break;
-                }
-                w->stats.busy_seconds += t1 - t0;
-                /* render returns when the device has worked through the batch (for a
-                 * pipelined device, all but the film's read-back) */
-                w->seconds_per_sample = (t1 - t0) / (double)b.count;
-                w->stats.batch_last = b.count;
-                if (!w->stats.batch_min || b.count < w->stats.batch_min) w->stats.batch_min = b.count;
-                if (b.count > w->stats.batch_max) w->stats.batch_max = b.count;
-                continue;
-            }
-        }
-        if (n_flight == 0) break;
-
-        double t0 = timer_now();
-        st = w->dev->ops->take_film(w->dev, w->scratch, &err);
-        w->stats.busy_seconds += timer_now() - t0;
-        if (st != ST_OK) {
-            memset(w->scratch, 0, film_len * sizeof *w->scratch);
-            break;
-        }
-        Batch b = flight[0];
-        memmove(&flight[0], &flight[1], --n_flight * sizeof *flight);
-        merge_batch(w, b);
-        batch_queue_done(&sh->queue, b);
-        w->stats.batches++;
+        if (fl.n == 0) break;
+        if ((st = worker_take_oldest(w, &fl, &err)) != ST_OK) break;
     }
-    if (st != ST_OK) {
-        /* Whatever this device had in flight goes to the others. */
-        w->stats.failed = 1;
-        snprintf(w->stats.failure, sizeof w->stats.failure, "%s", err.msg);
-        for (uint i = 0; i < n_flight; i++)
-            if (batch_queue_give_back(&sh->queue, flight[i]) != 0)
-                warn(sh, "out of memory returning a batch; the image will have fewer samples");
-        warn(sh, "device '%s' failed and was dropped; its samples go to the other devices: %s", w->stats.name,
-             err.msg);
-        error_clear(&err);
+    if (st == ST_INTERRUPTED) {
+        for (uint i = 0; i < fl.n; i++) give_back(w, fl.b[i]);   /* films that could not be taken */
+    } else if (st != ST_OK) {
+        worker_drop_device(w, &fl, &err);
     }
+    error_clear(&err);
     w->stats.idle_seconds = (timer_now() - thread_start) - w->stats.busy_seconds;
     w->stats.samples = w->dev->counters.samples - samples_before;
     w->stats.rays = w->dev->counters.rays - rays_before;
@@ -255,154 +306,212 @@ void schedule_stats_free(ScheduleStats *s)
     batch_set_free(&s->done);
 }
 
+/* The queue of batches, the locks, and the record of what a resumed film holds. */
+static Status shared_init(Shared *sh, const ScheduleConfig *cfg, Film *film, Error *err)
+{
+    memset(sh, 0, sizeof *sh);
+    sh->cfg = cfg;
+    sh->film = film;
+    atomic_init(&sh->cancel, 0);
+    if (batch_queue_init(&sh->queue, cfg->spp) != 0) return error_set(err, ST_INTERNAL, "cannot create a mutex");
+    pthread_mutex_init(&sh->film_lock, NULL);
+    pthread_mutex_init(&sh->state_lock, NULL);
+    pthread_cond_init(&sh->state_cond, NULL);
+    sh->queue_ready = 1;
+    for (size_t i = 0; i < cfg->n_done; i++)
+        if (batch_set_add(&sh->done, cfg->done[i]) != 0) return error_set(err, ST_INTERNAL, "out of memory starting the render");
+    int rc = batch_queue_skip_done(&sh->queue, cfg->done, cfg->n_done);
+    if (rc == -2) return error_set(err, ST_INTERNAL, "out of memory starting the render");
+    if (rc != 0)
+        return error_set(err, ST_INTERNAL, "the finished sample ranges overlap or exceed %u samples", cfg->spp);
+    return ST_OK;
+}
+
+/* Frees what shared_init and workers_create made (after a failure of either, too). */
+static void shared_free(Shared *sh)
+{
+    if (sh->workers)
+        for (size_t i = 0; i < sh->n_workers; i++) free(sh->workers[i].scratch);
+    free(sh->workers);
+    batch_set_free(&sh->done);
+    if (!sh->queue_ready) return;
+    pthread_cond_destroy(&sh->state_cond);
+    pthread_mutex_destroy(&sh->state_lock);
+    pthread_mutex_destroy(&sh->film_lock);
+    batch_queue_free(&sh->queue);
+}
+
+/* One Worker per device, each with a film of its own for the batch being merged; the
+ * devices see the shared cancel flag. */
+static Status workers_create(Shared *sh, Device **devices, size_t n, Error *err)
+{
+    size_t film_len = (size_t)sh->film->width * sh->film->height * 3u;
+    sh->workers = calloc(n, sizeof *sh->workers);
+    if (!sh->workers) return error_set(err, ST_INTERNAL, "out of memory starting the render");
+    sh->n_workers = n;
+    for (size_t i = 0; i < n; i++) {
+        Worker *w = &sh->workers[i];
+        w->shared = sh;
+        w->dev = devices[i];
+        w->index = i;
+        w->fail_at_batch = injected_failure(i);
+        snprintf(w->stats.name, sizeof w->stats.name, "%s", devices[i]->desc.name);
+        w->scratch = calloc(film_len, sizeof *w->scratch);
+        if (!w->scratch) return error_set(err, ST_INTERNAL, "out of memory for device films");
+    }
+    return ST_OK;
+}
+
+/* Starts a thread per worker. A thread that cannot start counts as a failed device. */
+static void workers_start(Shared *sh, pthread_t *threads)
+{
+    sh->start = timer_now();
+    for (size_t i = 0; i < sh->n_workers; i++) {
+        Worker *w = &sh->workers[i];
+        w->dev->cancel = &sh->cancel;
+        pthread_mutex_lock(&sh->state_lock);
+        sh->active++;
+        pthread_mutex_unlock(&sh->state_lock);
+        if (pthread_create(&threads[i], NULL, worker_main, w) != 0) {
+            pthread_mutex_lock(&sh->state_lock);
+            sh->active--;
+            pthread_mutex_unlock(&sh->state_lock);
+            threads[i] = 0;
+            w->stats.failed = 1;
+            snprintf(w->stats.failure, sizeof w->stats.failure, "cannot start a host thread: %s", strerror(errno));
+        }
+    }
+}
+
+static void workers_join(Shared *sh, pthread_t *threads)
+{
+    for (size_t i = 0; i < sh->n_workers; i++) {
+        if (threads[i]) pthread_join(threads[i], NULL);
+        sh->workers[i].dev->cancel = NULL;
+    }
+}
+
+/* A stop request (a signal) closes the queue and cancels the batches being rendered:
+ * they are dropped whole, so the film keeps whole batches only. */
+static int check_interrupt(Shared *sh)
+{
+    const ScheduleConfig *cfg = sh->cfg;
+    if (!cfg->stop || !*cfg->stop) return 0;
+    if (!atomic_load(&sh->cancel)) {
+        batch_queue_close(&sh->queue);
+        atomic_store(&sh->cancel, 1);
+    }
+    return 1;
+}
+
+/* The calling thread's part while the workers render. */
+typedef struct {
+    Film snap;                  /* copies for the callbacks */
+    BatchSet snap_done;
+    double last_tick, last_checkpoint;
+} Monitor;
+
+/* Calls on_tick and on_checkpoint when they are due, with a snapshot. */
+static void monitor_callbacks(Shared *sh, Monitor *m, ScheduleStats *stats)
+{
+    const ScheduleConfig *cfg = sh->cfg;
+    double now = timer_now();
+    int tick = cfg->on_tick && cfg->tick_seconds > 0.0 && now - m->last_tick >= cfg->tick_seconds;
+    int checkpoint = cfg->on_checkpoint && cfg->checkpoint_seconds > 0.0 &&
+                     now - m->last_checkpoint >= cfg->checkpoint_seconds;
+    if (!(tick || checkpoint) || take_snapshot(sh, &m->snap, &m->snap_done) != 0) return;
+    ScheduleSnapshot s = { &m->snap, m->snap_done.ranges, m->snap_done.n };
+    stats->snapshot_seconds += timer_now() - now;
+    if (tick) {
+        m->last_tick = now;
+        if (m->snap.samples > 0) cfg->on_tick(cfg->ctx, &s);
+    }
+    if (checkpoint) {
+        double t0 = timer_now();
+        m->last_checkpoint = now;
+        cfg->on_checkpoint(cfg->ctx, &s);
+        stats->checkpoints++;
+        stats->checkpoint_seconds += timer_now() - t0;
+    }
+}
+
+/* Shows progress, passes on interrupts and calls the callbacks until every worker is
+ * done. */
+static void monitor_run(Shared *sh, Monitor *m, uint done_before, ScheduleStats *stats)
+{
+    const ScheduleConfig *cfg = sh->cfg;
+    Progress progress;
+    double pixels = (double)sh->film->width * (double)sh->film->height;
+    progress_begin(&progress, "render", (double)(cfg->spp - done_before) * pixels, "samples", cfg->show_progress);
+    progress_set_step(&progress, pixels, "spp");
+    m->last_tick = m->last_checkpoint = sh->start;
+    for (;;) {
+        wait_tick(sh, 0.1);
+        size_t active = active_workers(sh);
+        if (check_interrupt(sh)) stats->interrupted = 1;
+        progress_update(&progress, (double)(batch_queue_completed(&sh->queue) - done_before) * pixels);
+        if (active == 0) break;
+        monitor_callbacks(sh, m, stats);
+    }
+    progress_end(&progress);
+}
+
+/* Gathers the devices' statistics and the record of the film's samples; the status
+ * says whether the render ended as it should have. */
+static Status collect_stats(Shared *sh, const Film *film, ScheduleStats *stats, Error *err)
+{
+    const ScheduleConfig *cfg = sh->cfg;
+    size_t n = sh->n_workers;
+    uint completed = batch_queue_completed(&sh->queue);
+    stats->seconds = timer_now() - sh->start;
+    stats->spp_done = (uint)film->samples;
+    stats->time_up = cfg->time_limit > 0.0 && completed < cfg->spp && !stats->interrupted;
+    stats->n_devices = n;
+    stats->devices = calloc(n, sizeof *stats->devices);
+    stats->done = sh->done;
+    memset(&sh->done, 0, sizeof sh->done);
+    if (sh->done_lost) batch_set_free(&stats->done);
+    size_t failed = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (stats->devices) stats->devices[i] = sh->workers[i].stats;
+        stats->samples += sh->workers[i].stats.samples;
+        stats->rays += sh->workers[i].stats.rays;
+        failed += (size_t)sh->workers[i].stats.failed;
+    }
+    if (failed == n)
+        return error_set(err, ST_DEVICE, "every device failed (last: %s: %s); %u of %u samples per pixel were finished",
+                         sh->workers[n - 1].stats.name, sh->workers[n - 1].stats.failure, (unsigned)film->samples,
+                         cfg->spp);
+    if (!stats->interrupted && !stats->time_up && completed < cfg->spp)
+        return error_set(err, ST_INTERNAL, "the render ended with %u of %u samples per pixel done", completed, cfg->spp);
+    return ST_OK;
+}
+
 Status schedule_run(Device **devices, size_t n, const ScheduleConfig *cfg, Film *film,
                     ScheduleStats *stats, Error *err)
 {
     memset(stats, 0, sizeof *stats);
     if (n == 0) return error_set(err, ST_DEVICE, "no device to render with");
     Shared sh;
-    memset(&sh, 0, sizeof sh);
-    sh.cfg = cfg;
-    sh.film = film;
-    size_t film_len = (size_t)film->width * film->height * 3u;
-    Status st = ST_OK;
-    Film snap;
-    memset(&snap, 0, sizeof snap);
-    BatchSet snap_done;
-    memset(&snap_done, 0, sizeof snap_done);
+    Monitor m;
+    memset(&m, 0, sizeof m);
     pthread_t *threads = NULL;
-    if (batch_queue_init(&sh.queue, cfg->spp) != 0) return error_set(err, ST_INTERNAL, "cannot create a mutex");
-    pthread_mutex_init(&sh.film_lock, NULL);
-    pthread_mutex_init(&sh.state_lock, NULL);
-    pthread_cond_init(&sh.state_cond, NULL);
-    for (size_t i = 0; i < cfg->n_done; i++)
-        if (batch_set_add(&sh.done, cfg->done[i]) != 0) {
-            st = error_set(err, ST_INTERNAL, "out of memory starting the render");
-            goto cleanup;
-        }
-    int rc = batch_queue_skip_done(&sh.queue, cfg->done, cfg->n_done);
-    if (rc != 0) {
-        st = rc == -2 ? error_set(err, ST_INTERNAL, "out of memory starting the render")
-                      : error_set(err, ST_INTERNAL, "the finished sample ranges overlap or exceed %u samples", cfg->spp);
-        goto cleanup;
-    }
-    uint done_before = batch_queue_completed(&sh.queue);
-    sh.workers = calloc(n, sizeof *sh.workers);
-    threads = calloc(n, sizeof *threads);
-    if (!sh.workers || !threads) {
+    Status st = shared_init(&sh, cfg, film, err);
+    uint done_before = sh.queue_ready ? batch_queue_completed(&sh.queue) : 0;
+    if (st == ST_OK) st = workers_create(&sh, devices, n, err);
+    if (st == ST_OK && !(threads = calloc(n, sizeof *threads)))
         st = error_set(err, ST_INTERNAL, "out of memory starting the render");
-        goto cleanup;
+    if (st == ST_OK && (cfg->on_tick || cfg->on_checkpoint))
+        st = film_init(&m.snap, film->width, film->height, err);
+    if (st == ST_OK) {
+        workers_start(&sh, threads);
+        monitor_run(&sh, &m, done_before, stats);
+        workers_join(&sh, threads);
+        st = collect_stats(&sh, film, stats, err);
     }
-    if ((cfg->on_tick || cfg->on_checkpoint) && film_init(&snap, film->width, film->height, err) != ST_OK) {
-        st = ST_INTERNAL;
-        goto cleanup;
-    }
-    for (size_t i = 0; i < n; i++) {
-        Worker *w = &sh.workers[i];
-        w->shared = &sh;
-        w->dev = devices[i];
-        w->index = i;
-        w->fail_at_batch = injected_failure(i);
-        snprintf(w->stats.name, sizeof w->stats.name, "%s", devices[i]->desc.name);
-        w->scratch = calloc(film_len, sizeof *w->scratch);
-        if (!w->scratch) {
-            st = error_set(err, ST_INTERNAL, "out of memory for device films");
-            goto cleanup;
-        }
-    }
-    sh.n_workers = n;
-    sh.start = timer_now();
-    sh.active = 0;
-    for (size_t i = 0; i < n; i++) {
-        pthread_mutex_lock(&sh.state_lock);
-        sh.active++;
-        pthread_mutex_unlock(&sh.state_lock);
-        if (pthread_create(&threads[i], NULL, worker_main, &sh.workers[i]) != 0) {
-            pthread_mutex_lock(&sh.state_lock);
-            sh.active--;
-            pthread_mutex_unlock(&sh.state_lock);
-            threads[i] = 0;
-            sh.workers[i].stats.failed = 1;
-            snprintf(sh.workers[i].stats.failure, sizeof sh.workers[i].stats.failure,
-                     "cannot start a host thread: %s", strerror(errno));
-        }
-    }
-
-    Progress progress;
-    double pixels = (double)film->width * (double)film->height;
-    progress_begin(&progress, "render", (double)(cfg->spp - done_before) * pixels, "samples", cfg->show_progress);
-    double last_tick = sh.start, last_checkpoint = sh.start;
-    for (;;) {
-        wait_tick(&sh, 0.1);
-        pthread_mutex_lock(&sh.state_lock);
-        size_t active = sh.active;
-        pthread_mutex_unlock(&sh.state_lock);
-        if (cfg->stop && *cfg->stop) {
-            batch_queue_close(&sh.queue);
-            stats->interrupted = 1;
-        }
-        double done = (double)(batch_queue_completed(&sh.queue) - done_before) * pixels;
-        progress_update(&progress, done);
-        double now = timer_now();
-        int tick = cfg->on_tick && cfg->tick_seconds > 0.0 && now - last_tick >= cfg->tick_seconds;
-        int checkpoint = cfg->on_checkpoint && cfg->checkpoint_seconds > 0.0 &&
-                         now - last_checkpoint >= cfg->checkpoint_seconds;
-        if (active > 0 && (tick || checkpoint) && take_snapshot(&sh, &snap, &snap_done) == 0) {
-            ScheduleSnapshot s = { &snap, snap_done.ranges, snap_done.n };
-            double t_snap = timer_now();
-            stats->snapshot_seconds += t_snap - now;
-            if (tick) {
-                last_tick = now;
-                if (snap.samples > 0) cfg->on_tick(cfg->ctx, &s);
-            }
-            if (checkpoint) {
-                double t0 = timer_now();
-                last_checkpoint = now;
-                cfg->on_checkpoint(cfg->ctx, &s);
-                stats->checkpoints++;
-                stats->checkpoint_seconds += timer_now() - t0;
-            }
-        }
-        if (active == 0) break;
-    }
-    progress_end(&progress);
-    for (size_t i = 0; i < n; i++)
-        if (threads[i]) pthread_join(threads[i], NULL);
-
-    uint completed = batch_queue_completed(&sh.queue);
-    stats->seconds = timer_now() - sh.start;
-    stats->spp_done = (uint)film->samples;
-    stats->time_up = cfg->time_limit > 0.0 && completed < cfg->spp && !stats->interrupted;
-    stats->n_devices = n;
-    stats->devices = calloc(n, sizeof *stats->devices);
-    stats->done = sh.done;
-    memset(&sh.done, 0, sizeof sh.done);
-    if (sh.done_lost) batch_set_free(&stats->done);
-    size_t failed = 0;
-    for (size_t i = 0; i < n; i++) {
-        if (stats->devices) stats->devices[i] = sh.workers[i].stats;
-        stats->samples += sh.workers[i].stats.samples;
-        stats->rays += sh.workers[i].stats.rays;
-        failed += (size_t)sh.workers[i].stats.failed;
-    }
-    if (failed == n)
-        st = error_set(err, ST_DEVICE, "every device failed (last: %s: %s); %u of %u samples per pixel were finished",
-                       sh.workers[n - 1].stats.name, sh.workers[n - 1].stats.failure,
-                       (unsigned)film->samples, cfg->spp);
-    else if (!stats->interrupted && !stats->time_up && completed < cfg->spp)
-        st = error_set(err, ST_INTERNAL, "the render ended with %u of %u samples per pixel done", completed, cfg->spp);
-
-cleanup:
-    if (sh.workers)
-        for (size_t i = 0; i < n; i++) free(sh.workers[i].scratch);
-    free(sh.workers);
     free(threads);
-    film_free(&snap);
-    batch_set_free(&snap_done);
-    batch_set_free(&sh.done);
-    pthread_cond_destroy(&sh.state_cond);
-    pthread_mutex_destroy(&sh.state_lock);
-    pthread_mutex_destroy(&sh.film_lock);
-    batch_queue_free(&sh.queue);
+    film_free(&m.snap);
+    batch_set_free(&m.snap_done);
+    shared_free(&sh);
     return st;
 }

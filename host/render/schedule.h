@@ -7,8 +7,9 @@
  * back, so it never waits for the host between batches. Batch sizes adapt per device so
  * that one batch takes about `target_batch_seconds`, and shrink toward the end so that
  * all devices finish together. A device that fails gives its batches back and stops; the
- * others finish the image. The calling thread shows progress and calls the periodic
- * callbacks (progressive output, checkpoints) with a consistent copy of the film.
+ * others finish the image. The calling thread shows progress, passes a stop request on
+ * to the devices as a cancel, and calls the periodic callbacks (progressive output,
+ * checkpoints) with a consistent copy of the film.
  *
  * Batches are whole-image sample ranges, so every pixel of the film always holds the
  * same number of samples (Film.samples); which sample indices those are is the set
@@ -42,8 +43,11 @@ typedef struct {
     double time_limit;               /* seconds; 0 = none. Whole batches only. */
     double target_batch_seconds;     /* 0 = 0.25 */
     uint fixed_batch;                /* > 0: every batch has this many samples (tests) */
-    int show_progress;
-    volatile sig_atomic_t *stop;     /* set asynchronously (a signal) to stop early */
+    int show_progress;               /* progress.h: PROGRESS_OFF, _TERMINAL or _LOG */
+    /* Set asynchronously (a signal) to stop early: within about 0.1 s no batch is handed
+     * out any more and the batches being rendered are cancelled (device.h) and dropped
+     * whole; the film keeps the batches finished before. */
+    volatile sig_atomic_t *stop;
     /* Called from the calling thread about every `tick_seconds` (progressive output) and
      * every `checkpoint_seconds`, with a snapshot taken under the film's lock; the devices
      * keep rendering meanwhile. NULL for none. */

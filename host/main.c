@@ -337,6 +337,7 @@ static Status run(int argc, char **argv, Error *err)
     if ((st = bare_mesh ? mesh_view_load(o.scene_path, &scene, err)
                         : scene_load_format(o.scene_path, (SceneFormat)o.format, &scene, err)))
         goto done;
+    for (size_t i = 0; i < scene.n_warnings; i++) print_warning(NULL, scene.warnings[i]);
     apply_overrides(&o, &scene);
     if ((o.width >= 0 || o.height >= 0) &&
         (st = limit_pixels(scene.image.width, scene.image.height, ST_USAGE, "--width/--height", err)))

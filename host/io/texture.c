@@ -134,10 +134,9 @@ Status texture_load_image(Scene *s, const char *name, const char *path, int line
     Texture t = texture_base(TEX_IMAGE);
     uint encoding = linear ? 0u : TEX_SRGB;
     /* the same file read before with the same encoding: share its texels */
-    for (size_t i = 0; i < s->n_textures; i++) {
-        const Texture *o = &s->textures[i];
-        if (!s->texture_sources[i] || strcmp(s->texture_sources[i], path) != 0) continue;
-        if ((o->flags & TEX_FLOAT) == 0 && (o->flags & TEX_SRGB) != encoding) continue;
+    uint same = scene_find_texture_source(s, path, linear);
+    if (same != NO_INDEX) {
+        const Texture *o = &s->textures[same];
         t.offset = o->offset;
         t.width = o->width;
         t.height = o->height;

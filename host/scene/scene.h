@@ -9,6 +9,7 @@
 #include <stddef.h>
 
 #include "base/status.h"
+#include "base/strmap.h"
 #include "types.h"
 
 typedef struct {
@@ -55,6 +56,16 @@ typedef struct {
     uint integrator;             /* enum Integrator the scene asks for (INTEGRATOR_PATH
                                   * or INTEGRATOR_WHITTED); --integrator overrides it */
     int linear_output;           /* 8-bit images without the sRGB curve (classic scenes) */
+
+    /* Lookups by name, so that a scene or MTL with many materials reads in linear time:
+     * material name -> first material of that name, texture name -> first texture of
+     * that name, and "S" / "L" + image file -> the first texture read from it in sRGB /
+     * linear encoding (texture_load_image shares its texels). */
+    StrMap material_by_name, texture_by_name, texture_by_source;
+
+    /* Problems the readers worked around (a missing map_Kd image), for main to print
+     * once the scene is read; each names the file and line. */
+    char **warnings;       size_t n_warnings;
 } Scene;
 
 /* Defaults: 512x512, 64 spp, depth 8, seed 1, black background, camera at the origin
@@ -86,11 +97,18 @@ Status scene_add_texture(Scene *s, const char *name, const char *source, Texture
 /* Appends n texels; *offset receives the index of the first. */
 Status scene_add_texels(Scene *s, const uint *texels, size_t n, uint *offset, Error *err);
 uint scene_find_texture(const Scene *s, const char *name);
+/* The first texture read from image file `path` whose texels fit the encoding asked
+ * for (linear or sRGB; HDR textures fit both), or NO_INDEX. */
+uint scene_find_texture_source(const Scene *s, const char *path, int linear);
 
 /* Records `path` (copied) as the albedo texture file of material `index`. */
 Status scene_set_material_texture(Scene *s, uint index, const char *path, Error *err);
 /* The texture file of material `index`, or NULL. */
 const char *scene_material_texture(const Scene *s, uint index);
+
+/* Records a warning (scene.warnings; past the first 20, one line says that more were
+ * dropped); fails only when memory runs out. */
+Status scene_warn(Scene *s, Error *err, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 
 /* Index of the material with this name, or NO_INDEX. */
 uint scene_find_material(const Scene *s, const char *name);

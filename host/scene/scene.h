@@ -125,6 +125,24 @@ uint scene_first_plane(const Scene *s);
  * power through a disc of the scene's radius), and sets each primitive's `light`. */
 Status scene_prepare_lights(Scene *s, Error *err);
 
+/* Refuses (ST_INPUT, naming `s->path` and the shape) what single precision cannot
+ * render, which would otherwise come out black or missing without a word
+ * (docs/scene-format.md, "Precision"):
+ *   - a sphere whose radius, or distance from the camera, is above 2^62: the kernels
+ *     square them;
+ *   - a sphere more than 2^22 times larger than the camera's distance from its
+ *     surface: the camera ray's hit loses every digit (measured: a ground sphere of
+ *     radius 2e7 under a camera 1 above it renders black, 1.5e7 renders right);
+ *   - triangles too small for their normals: when most of the scene's triangles (or a
+ *     mesh's: scene_count_tiny_triangles) have an area but a normal whose squared
+ *     length underflows in float (below 2^-140), they shade black or vanish. */
+Status scene_check_precision(const Scene *s, Error *err);
+/* Of triangles [first, end): *with_area those whose corners span an area (in double),
+ * *tiny those of them whose normal the kernels cannot normalise in float; *lo and *hi
+ * (may be NULL) their bounds. */
+void scene_count_tiny_triangles(const Scene *s, size_t first, size_t end, size_t *tiny, size_t *with_area,
+                                vec3 *lo, vec3 *hi);
+
 /* Material helpers with the defaults of docs/scene-format.md. */
 Material material_diffuse(vec3 albedo);
 Material material_metal(vec3 albedo, float fuzz);

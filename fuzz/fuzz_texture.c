@@ -14,7 +14,7 @@
 
 #include <stb_image.h>
 
-FUZZ_SEEDS("png bmp tga hdr ppm pgm jpg");
+FUZZ_SEEDS("png bmp tga hdr psd ppm pgm jpg");
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {

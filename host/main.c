@@ -504,8 +504,11 @@ static Status outputs_choose(Run *r, Error *err)
 static Status load_scene_input(const Options *o, Scene *scene, int *bare_mesh, Error *err)
 {
     *bare_mesh = mesh_kind(o->scene_path) != MESH_NONE;
-    return *bare_mesh ? mesh_view_load(o->scene_path, scene, err)
-                      : scene_load_format(o->scene_path, (SceneFormat)o->format, scene, err);
+    Status st = *bare_mesh ? mesh_view_load(o->scene_path, scene, err)
+                           : scene_load_format(o->scene_path, (SceneFormat)o->format, scene, err);
+    if (st == ST_OK)
+        for (size_t i = 0; i < scene->n_warnings; i++) print_warning(NULL, scene->warnings[i]);
+    return st;
 }
 
 /* The command line's overrides, checked against the scene they apply to. */

@@ -14,6 +14,7 @@
 #include "harness.h"
 #include "cli_util.h"
 
+#include "base/limit.h"
 #include "io/classic_parse.h"
 #include "kmath.h"
 #include "scene/scene.h"
@@ -314,6 +315,40 @@ static void test_transforms(void)
                  ST_INPUT);
     CHECK_STR_CONTAINS(err.msg, "singular");
     scene_free(&s);
+}
+
+/* Each sphere that a transform squashes becomes 9,024 triangles: 1,000 of them in a 65
+ * KB file made 9 million triangles and took 4.6 GB. Past CLPT_MAX_TESSELLATED_TRIANGLES
+ * (116 such spheres), the sphere that would cross it is an error. */
+static void test_tessellation_limit(void)
+{
+    enum { N = 1000 };
+    size_t cap = 200 + (size_t)N * 80, len = 0;
+    char *objects = malloc(cap);
+    if (!objects) abort();
+    len += (size_t)snprintf(objects, cap, "Group { numObjects %d\n", N);
+    for (int i = 0; i < N; i++)
+        len += (size_t)snprintf(objects + len, cap - len, "Transform { Scale 1 0.5 1 Sphere { radius 1 } }\n");
+    snprintf(objects + len, cap - len, "}\n");
+    char *text = malloc(cap + 1024);
+    if (!text) abort();
+    snprintf(text, cap + 1024, "%sMaterials { numMaterials 1 Material { } }\n%s", camera, objects);
+    Scene s;
+    Error err;
+    CHECK_EQ_INT(load("ellipsoids.txt", text, &s, &err), ST_INPUT);
+    char want[512];
+    /* the camera block's lines, the materials line, the Group line, then sphere 117 */
+    int line = 2;
+    for (const char *q = camera; *q; q++) line += *q == '\n';
+    snprintf(want, sizeof want, "%s/ellipsoids.txt:%d:27: its transform makes this sphere a mesh of 9024 "
+             "triangles, and the meshes of the scene's spheres would then hold more than 1048576 "
+             "(CLPT_MAX_TESSELLATED_TRIANGLES, 116 such spheres): scale spheres uniformly, or use fewer",
+             dir, line + 117);
+    CHECK_MSG(strcmp(err.msg, want) == 0, "%s", err.msg);
+    CHECK(s.n_triangles <= CLPT_MAX_TESSELLATED_TRIANGLES);
+    scene_free(&s);
+    free(text);
+    free(objects);
 }
 
 /* MaterialIndex ignores the group hierarchy, as in the course's parser; objects before
@@ -681,6 +716,7 @@ int main(void)
     RUN(test_every_keyword);
     RUN(test_orthographic);
     RUN(test_transforms);
+    RUN(test_tessellation_limit);
     RUN(test_material_scoping);
     RUN(test_crlf);
     RUN(test_paths);

@@ -8,8 +8,10 @@
 #include "io/obj.h"
 
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 static int vec_eq(vec3 a, float x, float y, float z) { return a.x == x && a.y == y && a.z == z; }
 
@@ -488,6 +490,144 @@ static void test_obj_transform(void)
     scene_free(&s);
 }
 
+static double cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Appends text to a growing buffer (aborts the test program when memory runs out). */
+static void put(char **buf, size_t *len, size_t *cap, const char *text)
+{
+    size_t n = strlen(text);
+    if (*len + n + 1 > *cap) {
+        *cap = (*len + n + 1) * 2;
+        *buf = realloc(*buf, *cap);
+        if (!*buf) abort();
+    }
+    memcpy(*buf + *len, text, n + 1);
+    *len += n;
+}
+
+static int write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) return -1;
+    int ok = fputs(text, f) >= 0;
+    return fclose(f) == 0 && ok ? 0 : -1;
+}
+
+/* 80,000 MTL materials, and an OBJ whose faces use each of them in turn: each 'newmtl'
+ * and each 'usemtl' searched the library from the start (23 s and 65 s). Read in linear
+ * time, both take a few tenths of a second; 3 s of CPU time is a generous bound. */
+static void test_many_materials(void)
+{
+    enum { N = 80000 };
+    char dir[] = "/tmp/clpt-test-obj-XXXXXX";
+    if (!mkdtemp(dir)) {
+        CHECK_MSG(0, "mkdtemp failed");
+        return;
+    }
+    char mtl_path[64], obj_path[64], line[96];
+    snprintf(mtl_path, sizeof mtl_path, "%s/many.mtl", dir);
+    snprintf(obj_path, sizeof obj_path, "%s/many.obj", dir);
+    char *mtl = NULL, *obj = NULL;
+    size_t mtl_len = 0, mtl_cap = 0, obj_len = 0, obj_cap = 0;
+    put(&obj, &obj_len, &obj_cap, "mtllib many.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    for (int i = 0; i < N; i++) {
+        snprintf(line, sizeof line, "newmtl m%d\nKd 0.5 0.25 %d\n", i, i % 2);
+        put(&mtl, &mtl_len, &mtl_cap, line);
+        snprintf(line, sizeof line, "usemtl m%d\nf 1 2 3\nmtllib many.mtl\n", N - 1 - i);
+        put(&obj, &obj_len, &obj_cap, line);
+    }
+    CHECK(write_file(mtl_path, mtl) == 0);
+
+    MtlLibrary lib;
+    memset(&lib, 0, sizeof lib);
+    Error err = { 0 };
+    double t0 = cpu_seconds();
+    Status st = mtl_parse(mtl_path, mtl, mtl_len, &lib, &err);
+    double secs = cpu_seconds() - t0;
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(lib.n, N);
+    const MtlMaterial *last = mtl_find(&lib, "m79999", 6);
+    CHECK(last && last == &lib.items[N - 1] && last->m.albedo.z == 1.0f);
+    CHECK_MSG(secs < 3.0, "%d materials: %.2f s of CPU time", N, secs);
+    mtl_free(&lib);
+
+    Scene s;
+    scene_init(&s);
+    t0 = cpu_seconds();
+    st = obj_parse(obj_path, obj, obj_len, &s, NO_INDEX, &err);
+    secs = cpu_seconds() - t0;
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_triangles, N);
+    CHECK_EQ_INT(s.n_materials, N);
+    if (s.n_triangles == N && s.n_materials == N) {
+        /* the first face uses m79999 (even: Kd z 1), the last m0 */
+        CHECK(s.materials[s.triangles[0].material].albedo.z == 1.0f);
+        CHECK(s.materials[s.triangles[N - 1].material].albedo.z == 0.0f);
+    }
+    CHECK_MSG(secs < 3.0, "%d usemtl and mtllib: %.2f s of CPU time", N, secs);
+    scene_free(&s);
+    free(mtl);
+    free(obj);
+    remove(mtl_path);
+    remove(dir);
+}
+
+/* An MTL file or a map_Kd image that cannot be opened is a warning naming where it is
+ * named; the faces and the material render without it. */
+static void test_missing_files_warn(void)
+{
+    char dir[] = "/tmp/clpt-test-obj-XXXXXX";
+    if (!mkdtemp(dir)) {
+        CHECK_MSG(0, "mkdtemp failed");
+        return;
+    }
+    char mtl_path[64], obj_path[64], want[256];
+    snprintf(mtl_path, sizeof mtl_path, "%s/t.mtl", dir);
+    snprintf(obj_path, sizeof obj_path, "%s/t.obj", dir);
+    CHECK(write_file(mtl_path, "newmtl red\nKd 1 0 0\n  map_Kd  -clamp on red.png\n") == 0);
+    const char *obj = "mtllib gone.mtl t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+    Scene s;
+    scene_init(&s);
+    Error err = { 0 };
+    Status st = obj_parse(obj_path, obj, strlen(obj), &s, NO_INDEX, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_warnings, 2);
+    if (s.n_warnings == 2) {
+        snprintf(want, sizeof want, "%s:1:8: cannot open '%s/gone.mtl': No such file or directory; the faces "
+                 "that use its materials get the default material", obj_path, dir);
+        CHECK_MSG(strcmp(s.warnings[0], want) == 0, "%s", s.warnings[0]);
+        snprintf(want, sizeof want, "%s:3:21: cannot open '%s/red.png': No such file or directory; the "
+                 "material is rendered without this map_Kd texture", mtl_path, dir);
+        CHECK_MSG(strcmp(s.warnings[1], want) == 0, "%s", s.warnings[1]);
+    }
+    CHECK_EQ_INT(s.n_materials, 1);
+    CHECK_EQ_INT(s.n_textures, 0);
+    if (s.n_materials == 1) {
+        CHECK_EQ_INT(s.materials[0].texture, NO_INDEX);
+        CHECK(s.materials[0].albedo.x == 1.0f && s.materials[0].albedo.y == 0.0f);
+        CHECK(scene_material_texture(&s, 0) == NULL);
+    }
+    scene_free(&s);
+    /* a map_Kd file that is there but not an image is still an error */
+    char png_path[64];
+    snprintf(png_path, sizeof png_path, "%s/red.png", dir);
+    CHECK(write_file(png_path, "not an image") == 0);
+    scene_init(&s);
+    st = obj_parse(obj_path, obj, strlen(obj), &s, NO_INDEX, &err);
+    CHECK_EQ_INT(st, ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "red.png");
+    scene_free(&s);
+    error_clear(&err);
+    remove(png_path);
+    remove(mtl_path);
+    remove(dir);
+}
+
 int main(void)
 {
     RUN(test_index_forms);
@@ -502,5 +642,7 @@ int main(void)
     RUN(test_obj_materials);
     RUN(test_sponza);
     RUN(test_obj_transform);
+    RUN(test_many_materials);
+    RUN(test_missing_files_warn);
     return harness_report();
 }

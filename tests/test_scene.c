@@ -9,6 +9,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #define GEN_WEEKEND_NO_MAIN
@@ -675,6 +676,53 @@ static void test_data_good(void)
     scene_free(&s);
 }
 
+static double cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* 200,000 named materials and 100,000 named textures, each used by the next material:
+ * every definition and use searched the names from the start (78 s for the
+ * materials). Read in linear time this takes well under a second; 3 s of CPU time is
+ * a generous bound. */
+static void test_many_names(void)
+{
+    enum { N = 200000 };
+    size_t cap = (size_t)N * 96, len = 0;
+    char *text = malloc(cap);
+    if (!text) abort();
+    for (int i = 0; i < N; i++) {
+        if (i % 2 == 0)
+            len += (size_t)snprintf(text + len, cap - len, "texture t%d { type checker }\n", i);
+        len += (size_t)snprintf(text + len, cap - len, "material m%d { type diffuse albedo 1 1 1%s", i,
+                                i % 2 == 0 ? " texture " : " }\n");
+        if (i % 2 == 0) len += (size_t)snprintf(text + len, cap - len, "t%d }\n", i);
+    }
+    snprintf(text + len, cap - len, "sphere { center 0 0 0 radius 1 material m%d }\n", N - 1);
+    Scene s;
+    Error err;
+    double t0 = cpu_seconds();
+    Status st = load_text("many.scene", text, &s, &err);
+    double secs = cpu_seconds() - t0;
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_materials, N);
+    CHECK_EQ_INT(s.n_textures, N / 2);
+    CHECK_EQ_INT(scene_find_material(&s, "m123456"), 123456);
+    CHECK_EQ_INT(scene_find_texture(&s, "t123456"), 61728);
+    if (s.n_materials == N) CHECK_EQ_INT(s.materials[123456].texture, 61728);
+    if (s.n_spheres == 1) CHECK_EQ_INT(s.spheres[0].material, N - 1);
+    CHECK_MSG(secs < 3.0, "%d materials: %.2f s of CPU time", N, secs);
+    scene_free(&s);
+    free(text);
+    /* the second definition of a name is still refused, with the first's place */
+    CHECK_EQ_INT(load_text("twice.scene", "material a { type diffuse albedo 1 1 1 }\nmaterial b { type diffuse albedo 1 1 1 }\n"
+                           "material a { type diffuse albedo 1 1 1 }\n", &s, &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "twice.scene:3:10: material 'a' is already defined (at ");
+    scene_free(&s);
+}
+
 int main(void)
 {
     snprintf(tmp_dir, sizeof tmp_dir, "/tmp/clpt-test-scene-XXXXXX");
@@ -699,6 +747,7 @@ int main(void)
     RUN(test_bad_files);
     RUN(test_huge_token);
     RUN(test_data_good);
+    RUN(test_many_names);
     tmp_cleanup();
     return harness_report();
 }

@@ -349,6 +349,58 @@ static void test_load_images(void)
     rmdir(tmp_dir);
 }
 
+/* The 4x3 pictures of tests/data/images/generate.py in every format stb_image reads
+ * without compression or with run-length packets decode to the same texels, and every
+ * shorter prefix of the TGA, BMP, PSD and HDR files is refused: stb_image decoded those
+ * with uninitialised or zero pixels. */
+static void test_truncated_images(void)
+{
+    static const char *const names[] = { "tiny.tga", "tiny-rle.tga", "tiny.bmp", "tiny.psd", "tiny-rle.psd",
+                                         "tiny.hdr", "tiny-rle.hdr" };
+    char cut_path[64];
+    snprintf(cut_path, sizeof cut_path, "/tmp/clpt-test-cut-%d.img", (int)getpid());
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        char path[128];
+        snprintf(path, sizeof path, "tests/data/images/%s", names[i]);
+        unsigned char bytes[256];
+        size_t size = 0;
+        FILE *f = fopen(path, "rb");
+        if (f) {
+            size = fread(bytes, 1, sizeof bytes, f);
+            fclose(f);
+        }
+        CHECK_MSG(size > 0, "%s", path);
+        scene_init(&scene);
+        Error err = { 0 };
+        uint t;
+        Status st = texture_load_image(&scene, NULL, path, 1, 0, &t, &err);
+        CHECK_MSG(st == ST_OK, "%s: %s", path, err.msg);
+        int is_hdr = strstr(names[i], ".hdr") != NULL;
+        if (st == ST_OK && !is_hdr) {
+            Texture tx = scene.textures[t];
+            CHECK_EQ_INT(tx.width, 4);
+            CHECK_EQ_INT(tx.height, 3);
+            for (uint y = 0; y < 3 && tx.width == 4 && tx.height == 3; y++)
+                for (uint x = 0; x < 4; x++) {
+                    uint want = (x * 60) % 256 | ((y * 90) % 256) << 8 | (((x + y) * 40) % 256) << 16 | 255u << 24;
+                    CHECK_MSG(scene.texels[tx.offset + y * 4 + x] == want, "%s: texel %u %u", path, x, y);
+                }
+        }
+        scene_free(&scene);
+        for (size_t cut = 1; cut < size; cut++) {
+            if ((f = fopen(cut_path, "wb")) == NULL) break;
+            fwrite(bytes, 1, cut, f);
+            fclose(f);
+            scene_init(&scene);
+            st = texture_load_image(&scene, NULL, cut_path, 1, 0, &t, &err);
+            CHECK_MSG(st == ST_INPUT, "%s cut to %zu bytes: status %d", path, cut, (int)st);
+            scene_free(&scene);
+            error_clear(&err);
+        }
+    }
+    unlink(cut_path);
+}
+
 int main(void)
 {
     RUN(test_srgb_decode);
@@ -359,5 +411,6 @@ int main(void)
     RUN(test_checker);
     RUN(test_surface_uv);
     RUN(test_load_images);
+    RUN(test_truncated_images);
     return harness_report();
 }

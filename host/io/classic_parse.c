@@ -18,6 +18,7 @@
 #include <sys/stat.h>
 
 #include "kmath.h"
+#include "base/limit.h"
 #include "io/lexer.h"
 #include "io/obj.h"
 #include "io/texture.h"
@@ -160,6 +161,7 @@ typedef struct {
     uint fallback;             /* white material for objects before any material */
     int seen_camera, seen_lights, seen_background, seen_materials;
     int ambient_given;
+    size_t tessellated;        /* triangles made from spheres so far */
 } Classic;
 
 static Status next(Classic *c, Token *t) { return lex_next(&c->lx, t, c->err); }
@@ -704,9 +706,20 @@ static Status add_tri(Classic *c, vec3 a, vec3 b, vec3 d, uint material, uint sh
 }
 
 /* A sphere under a transform that does not keep it a (plain) sphere: a latitude-
- * longitude mesh with the sphere's normals and (u, v) (kernels/texture.h) carried over. */
-static Status tessellate_sphere(Classic *c, vec3 center, float radius, const Mat4 *m, uint material)
+ * longitude mesh with the sphere's normals and (u, v) (kernels/texture.h) carried over.
+ * The kernels have no ellipsoids, so the mesh costs 9,024 triangles a sphere; their
+ * total is capped (CLPT_MAX_TESSELLATED_TRIANGLES) before they are made. */
+static Status tessellate_sphere(Classic *c, const Token *kw, vec3 center, float radius, const Mat4 *m,
+                                uint material)
 {
+    enum { PER_SPHERE = 2 * SPHERE_SEGMENTS * (SPHERE_BANDS - 1) };
+    if (PER_SPHERE > CLPT_MAX_TESSELLATED_TRIANGLES - c->tessellated)
+        return lex_error_at(&c->lx, kw, c->err, "its transform makes this sphere a mesh of %d triangles, and the "
+                            "meshes of the scene's spheres would then hold more than %u "
+                            "(CLPT_MAX_TESSELLATED_TRIANGLES, %u such spheres): scale spheres uniformly, or "
+                            "use fewer", PER_SPHERE, CLPT_MAX_TESSELLATED_TRIANGLES,
+                            CLPT_MAX_TESSELLATED_TRIANGLES / PER_SPHERE);
+    c->tessellated += PER_SPHERE;
     double nm[3][3];
     if (!mat_normal(m, nm)) return error_set(c->err, ST_INTERNAL, "singular transform");
     int flip = det3(m) < 0.0;
@@ -762,7 +775,7 @@ static Status parse_sphere(Classic *c, const Token *kw, const Mat4 *m)
     int rotates;
     int textured = c->s->materials[material].texture != NO_INDEX;
     if (!mat_similarity(m, &scale, &rotates) || (rotates && textured))
-        return tessellate_sphere(c, center, v[SPH_RADIUS].f, m, material);
+        return tessellate_sphere(c, kw, center, v[SPH_RADIUS].f, m, material);
     Sphere sp;
     memset(&sp, 0, sizeof sp);
     sp.center = mat_point(m, center);

@@ -17,7 +17,7 @@ typedef struct {
     float ns, ni, d;
     int illum;
     int has_kd, has_ni, has_d;
-    char *texture;
+    char *texture, *texture_at;
 } MtlRaw;
 
 typedef struct {
@@ -36,17 +36,17 @@ void mtl_free(MtlLibrary *lib)
     for (size_t i = 0; i < lib->n; i++) {
         free(lib->items[i].name);
         free(lib->items[i].texture);
+        free(lib->items[i].texture_at);
     }
     free(lib->items);
+    strmap_free(&lib->by_name);
     memset(lib, 0, sizeof *lib);
 }
 
 const MtlMaterial *mtl_find(const MtlLibrary *lib, const char *name, size_t len)
 {
-    for (size_t i = 0; i < lib->n; i++)
-        if (strlen(lib->items[i].name) == len && memcmp(lib->items[i].name, name, len) == 0)
-            return &lib->items[i];
-    return NULL;
+    uint32_t i;
+    return strmap_find(&lib->by_name, name, len, &i) ? &lib->items[i] : NULL;
 }
 
 /* ------------------------------------------------------------------ tokens */
@@ -147,6 +147,7 @@ static Material raw_to_material(const MtlRaw *raw)
 static void raw_reset(MtlRaw *raw)
 {
     free(raw->texture);
+    free(raw->texture_at);
     memset(raw, 0, sizeof *raw);
     raw->d = 1.0f;
     raw->illum = -1;
@@ -159,8 +160,11 @@ static void finish_material(MtlReader *r)
     MtlMaterial *item = &r->lib->items[r->cur];
     item->m = raw_to_material(&r->raw);
     free(item->texture);
+    free(item->texture_at);
     item->texture = r->raw.texture;
+    item->texture_at = r->raw.texture_at;
     r->raw.texture = NULL;
+    r->raw.texture_at = NULL;
     raw_reset(&r->raw);
     r->cur = -1;
 }
@@ -174,21 +178,23 @@ static Status read_newmtl(MtlReader *r)
     if (e == name) return fail_at(r, name, "a material name after 'newmtl'");
     size_t len = (size_t)(e - name);
     MtlLibrary *lib = r->lib;
-    long idx = -1;
-    for (size_t i = 0; i < lib->n; i++)
-        if (strlen(lib->items[i].name) == len && memcmp(lib->items[i].name, name, len) == 0) idx = (long)i;
-    if (idx < 0) {
-        if (array_reserve((void **)&lib->items, &lib->cap, lib->n + 1, sizeof *lib->items))
+    uint32_t idx;
+    if (!strmap_find(&lib->by_name, name, len, &idx)) {
+        if (lib->n >= UINT32_MAX ||
+            array_reserve((void **)&lib->items, &lib->cap, lib->n + 1, sizeof *lib->items))
             return error_set(r->err, ST_INTERNAL, "out of memory reading '%s'", r->path);
         MtlMaterial *m = &lib->items[lib->n];
         memset(m, 0, sizeof *m);
         m->name = malloc(len + 1);
-        if (!m->name) return error_set(r->err, ST_INTERNAL, "out of memory reading '%s'", r->path);
+        if (!m->name || strmap_add(&lib->by_name, name, len, (uint32_t)lib->n) < 0) {
+            free(m->name);
+            return error_set(r->err, ST_INTERNAL, "out of memory reading '%s'", r->path);
+        }
         memcpy(m->name, name, len);
         m->name[len] = '\0';
-        idx = (long)lib->n++;
+        idx = (uint32_t)lib->n++;
     }
-    r->cur = idx;
+    r->cur = (long)idx;
     r->p = r->line_end;
     return ST_OK;
 }
@@ -234,9 +240,20 @@ static Status read_map_kd(MtlReader *r)
     while (e > name && is_blank(e[-1])) e--;
     if (e == name) return fail_at(r, name, "a texture file name after 'map_Kd'");
     char *path = mesh_resolve_path(r->path, name, (size_t)(e - name));
-    if (!path) return error_set(r->err, ST_INTERNAL, "out of memory reading '%s'", r->path);
+    char at[64];
+    snprintf(at, sizeof at, ":%u:%u", r->line, (uint)(name - r->line_start + 1));
+    char *where = malloc(strlen(r->path) + strlen(at) + 1);
+    if (!path || !where) {
+        free(path);
+        free(where);
+        return error_set(r->err, ST_INTERNAL, "out of memory reading '%s'", r->path);
+    }
+    strcpy(where, r->path);
+    strcat(where, at);
     free(r->raw.texture);
+    free(r->raw.texture_at);
     r->raw.texture = path;
+    r->raw.texture_at = where;
     r->p = r->line_end;
     return ST_OK;
 }
@@ -323,7 +340,6 @@ Status mtl_parse(const char *path, const char *text, size_t len, MtlLibrary *lib
     }
     if (!st) finish_material(&r);
     raw_reset(&r.raw);
-    free(r.raw.texture);
     return st;
 }
 

@@ -19,17 +19,20 @@
 #ifndef CLPT_MTL_H
 #define CLPT_MTL_H
 
+#include "base/strmap.h"
 #include "scene/scene.h"
 
 typedef struct {
     char *name;
     Material m;
     char *texture;       /* resolved map_Kd path, or NULL */
+    char *texture_at;    /* where map_Kd names it ("file.mtl:12:8"), for messages */
 } MtlMaterial;
 
 typedef struct {
     MtlMaterial *items;
     size_t n, cap;
+    StrMap by_name;      /* name -> index in items, so that reading is linear */
 } MtlLibrary;
 
 /* Reads an MTL file and appends its materials; a name defined again replaces the

@@ -35,6 +35,7 @@ typedef struct {
     uint material;               /* of the faces being read; NO_INDEX: the default */
     uint default_material;       /* the default, once needed */
     MtlLibrary lib;              /* the mtllib files read so far */
+    StrMap mtl_read;             /* their paths, each read once however often named */
     uint *lib_index;             /* per library entry: its scene material, or NO_INDEX */
     size_t n_lib_index, cap_lib_index;
     Error *err;
@@ -336,8 +337,8 @@ static void rest_of_line(ObjReader *r, const char **b, const char **e)
 }
 
 /* mtllib FILE...: each file is read into the library now (relative to the OBJ). A file
- * that cannot be opened is skipped, as most OBJ readers do: meshes often travel without
- * their MTL, and their faces then get the default material. */
+ * that cannot be opened is skipped with a warning, as most OBJ readers do: meshes often
+ * travel without their MTL, and their faces then get the default material. */
 static Status read_mtllib(ObjReader *r)
 {
     if (r->opt->material != NO_INDEX) return ST_OK;   /* overridden: the MTL is not needed */
@@ -348,15 +349,46 @@ static Status read_mtllib(ObjReader *r)
         while (!is_delim(r, r->p)) r->p++;
         char *path = mesh_resolve_path(r->path, name, (size_t)(r->p - name));
         if (!path) return error_set(r->err, ST_INTERNAL, "out of memory reading '%s'", r->path);
+        /* a file named again is not read again: 80,000 'mtllib' lines would otherwise
+         * read the library 80,000 times */
+        int again = strmap_add(&r->mtl_read, path, strlen(path), 0);
+        if (again) {
+            free(path);
+            if (again < 0) return error_set(r->err, ST_INTERNAL, "out of memory reading '%s'", r->path);
+            continue;
+        }
         Status st = mtl_load(path, &r->lib, r->err);
         free(path);
         if (st == ST_IO) {
+            char msg[sizeof r->err->msg];
+            snprintf(msg, sizeof msg, "%s", r->err->msg);
             error_clear(r->err);
-            continue;
+            st = scene_warn(r->s, r->err, "%s:%u:%u: %s; the faces that use its materials get the default "
+                            "material", r->path, r->line, (uint)(name - r->line_start + 1), msg);
         }
         if (st) return st;
     }
     return ST_OK;
+}
+
+/* map_Kd: the diffuse colour of scene material `index` comes from the image (sRGB,
+ * repeating). An image that cannot be read is a warning naming the MTL line, not an
+ * error, for the same reason as a missing MTL file: models travel without their
+ * textures, and the material still renders, with its Kd. A corrupt image is an error. */
+static Status add_map_kd(ObjReader *r, const MtlMaterial *m, uint index)
+{
+    uint tex;
+    Error image_err = { 0 };
+    Status st = texture_load_image(r->s, NULL, m->texture, 0, 0, &tex, &image_err);
+    if (st == ST_IO)
+        st = scene_warn(r->s, r->err, "%s: %s; the material is rendered without this map_Kd texture",
+                        m->texture_at, image_err.msg);
+    else if (st)
+        st = error_set(r->err, st, "%s", image_err.msg);
+    else if (!(st = scene_set_material_texture(r->s, index, m->texture, r->err)))
+        r->s->materials[index].texture = tex;
+    error_clear(&image_err);
+    return st;
 }
 
 /* usemtl NAME: the faces that follow get the library's material NAME, added to the
@@ -378,13 +410,7 @@ static Status read_usemtl(ObjReader *r)
     while (r->n_lib_index < r->lib.n) r->lib_index[r->n_lib_index++] = NO_INDEX;
     if (r->lib_index[i] == NO_INDEX) {
         Status st = scene_add_material(r->s, "", m->m, &r->lib_index[i], r->err);
-        if (!st && m->texture) st = scene_set_material_texture(r->s, r->lib_index[i], m->texture, r->err);
-        /* map_Kd: the diffuse colour comes from the image (sRGB, repeating) */
-        if (!st && m->texture) {
-            uint tex;
-            st = texture_load_image(r->s, NULL, m->texture, 0, 0, &tex, r->err);
-            if (!st) r->s->materials[r->lib_index[i]].texture = tex;
-        }
+        if (!st && m->texture) st = add_map_kd(r, m, r->lib_index[i]);
         if (st) return st;
     }
     r->material = r->lib_index[i];
@@ -453,6 +479,7 @@ Status obj_parse_with(const char *path, const char *text, size_t len, Scene *s, 
     free(r.face);
     free(r.lib_index);
     mtl_free(&r.lib);
+    strmap_free(&r.mtl_read);
     return st;
 }
 

@@ -62,7 +62,9 @@ typedef struct {
     const char *name;  size_t name_len;
     uint64_t count;
     uint line;                    /* of its header line */
+    const char *line_at;          /* the start of that line */
     PlyProp *props;  size_t n_props, cap_props;
+    unsigned roles_taken;         /* bit R_*: a property has that role */
     int kind;
 } PlyElement;
 
@@ -76,6 +78,7 @@ typedef struct {
     int swap;                     /* binary data of the other byte order than this host's */
     Error *err;
     PlyElement *el;  size_t n_el, cap_el;
+    int seen_kind[3];             /* EL_VERTEX, EL_FACE: that element was declared */
     /* what the current record is, for messages */
     const PlyElement *cur_el;
     uint64_t cur_rec;
@@ -235,9 +238,10 @@ static Status add_property(PlyReader *r, const Words *w, const char *line)
                         (int)p.name_len, p.name, (int)p.name_len, p.name);
         p.role = R_INDICES;
     }
-    /* a role already taken by an earlier property stays with it */
-    for (size_t k = 0; k < e->n_props; k++)
-        if (p.role != R_NONE && e->props[k].role == p.role) p.role = R_NONE;
+    /* a role already taken by an earlier property stays with it (a bit set rather
+     * than a scan of the earlier properties, which was quadratic in their number) */
+    if (e->roles_taken & (1u << p.role)) p.role = R_NONE;
+    if (p.role != R_NONE) e->roles_taken |= 1u << p.role;
     if (array_reserve((void **)&e->props, &e->cap_props, e->n_props + 1, sizeof *e->props)) return out_of_memory(r);
     e->props[e->n_props++] = p;
     return ST_OK;
@@ -260,10 +264,11 @@ static Status add_element(PlyReader *r, const Words *w, const char *line, uint l
     e->name_len = w->len[1];
     e->count = count;
     e->line = line_no;
+    e->line_at = line;
     e->kind = word_eq(w, 1, "vertex") ? EL_VERTEX : word_eq(w, 1, "face") ? EL_FACE : EL_OTHER;
-    for (size_t i = 0; i < r->n_el; i++)
-        if (r->el[i].kind != EL_OTHER && r->el[i].kind == e->kind)
-            return fail(r, line, 1, "a second '%.*s' element", (int)e->name_len, e->name);
+    if (e->kind != EL_OTHER && r->seen_kind[e->kind])
+        return fail(r, line, 1, "a second '%.*s' element", (int)e->name_len, e->name);
+    r->seen_kind[e->kind] = 1;
     r->n_el++;
     return ST_OK;
 }
@@ -319,24 +324,13 @@ static Status parse_header(PlyReader *r)
     }
 }
 
-/* The start of header line `line` (1-based), for messages about an element. */
-static const char *header_line(const PlyReader *r, uint line)
-{
-    const char *p = r->data;
-    for (uint l = 1; l < line && p < r->end; l++) {
-        const char *nl = memchr(p, '\n', (size_t)(r->end - p));
-        p = nl ? nl + 1 : r->end;
-    }
-    return p;
-}
-
 /* Checks the vertex and face elements, then what the header promises against the bytes
  * that follow it, before anything is allocated from the counts. */
 static Status check_header(PlyReader *r)
 {
     for (size_t i = 0; i < r->n_el; i++) {
         const PlyElement *e = &r->el[i];
-        const char *line = header_line(r, e->line);
+        const char *line = e->line_at;
         if (e->n_props == 0 && e->count > 0)
             return fail(r, line, 1, "element '%.*s' has %llu records but no properties", (int)e->name_len,
                         e->name, (unsigned long long)e->count);
@@ -371,7 +365,7 @@ static Status check_header(PlyReader *r)
         need += (double)e->count * min;
         /* the last ascii value needs no separator after it */
         if (need > avail + (r->format == F_ASCII ? 1.0 : 0.0))
-            return fail(r, header_line(r, e->line), 1,
+            return fail(r, e->line_at, 1,
                         "element '%.*s' declares %llu records of at least %.0f bytes each, more than "
                         "the %.0f bytes after the header can hold (a truncated file or a wrong count)",
                         (int)e->name_len, e->name, (unsigned long long)e->count, min, avail);

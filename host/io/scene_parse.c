@@ -11,6 +11,7 @@
 #include "scene/scene.h"
 
 #include "kmath.h"
+#include "scene/camera.h"
 #include "io/lexer.h"
 #include "base/limit.h"
 #include "io/mesh.h"
@@ -371,6 +372,14 @@ static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
     if (!(cl / (dist * len_d(c->up)) > 1e-6))
         return lex_error_at(lx, v[CAM_UP].given ? &v[CAM_UP].key : view_tok, p->err,
                             "camera 'up' is parallel to the view direction (from 'from' to 'at')");
+    double focus = camera_focus(c);
+    if (focus < camera_min_focus(c->from))
+        return lex_error_at(lx, v[CAM_FOCUS].given ? &v[CAM_FOCUS].key : view_tok, p->err,
+                            "the camera's focus distance (%s) %g is too short for single precision "
+                            "with a lens at 'from' %g %g %g: at least %g",
+                            v[CAM_FOCUS].given ? "'focus'" : "from 'from' to 'at'", focus,
+                            (double)c->from.x, (double)c->from.y, (double)c->from.z,
+                            camera_min_focus(c->from));
     return ST_OK;
 }
 
@@ -785,6 +794,21 @@ static Status mesh_transform(Parser *p, const Lexer *lx, const Token *kw, const 
     return ST_OK;
 }
 
+/* A mesh too small for single precision shades black or vanishes (a mesh 1e-30
+ * across): refused when most of its triangles' normals underflow (a few slivers in a
+ * mesh of normal size are harmless, and only those are lost). */
+static Status check_mesh_size(Parser *p, const Lexer *lx, const Token *f, const char *path, size_t first)
+{
+    size_t tiny, with_area;
+    vec3 lo, hi;
+    scene_count_tiny_triangles(p->s, first, p->s->n_triangles, &tiny, &with_area, &lo, &hi);
+    if (tiny == 0 || tiny * 2 < with_area) return ST_OK;
+    return lex_error_at(lx, f, p->err, "the mesh '%s' is too small for single precision: %zu of its %zu "
+                        "triangles have normals that underflow (it spans %g x %g x %g after its transform); "
+                        "scale it up", path, tiny, with_area, (double)(hi.x - lo.x), (double)(hi.y - lo.y),
+                        (double)(hi.z - lo.z));
+}
+
 static Status parse_mesh(Parser *p, Lexer *lx, const Token *kw)
 {
     Value v[MESH_N];
@@ -799,12 +823,15 @@ static Status parse_mesh(Parser *p, Lexer *lx, const Token *kw)
         free(path);
         return lex_expected(lx, f, "a mesh file name ending in .obj or .ply", p->err);
     }
+    size_t first = p->s->n_triangles;
     st = mesh_load(path, p->s, &o, p->err);
-    free(path);
     if (st == ST_IO)
         error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
     else if (st)
         error_append(p->err, " (in the mesh of %s:%u:%u)", lx->path, kw->line, kw->col);
+    else
+        st = check_mesh_size(p, lx, f, path, first);
+    free(path);
     return st;
 }
 
@@ -1025,6 +1052,7 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
     } else {
         st = parse_file(&p, path);
     }
+    if (!st) st = scene_check_precision(s, err);
     free(p.camera_at);
     free(p.image_at);
     free(p.background_at);

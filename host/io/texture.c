@@ -128,16 +128,208 @@ static Status png_check(const char *path, Error *err)
     return st;
 }
 
+/* ------------------------------------------------------------------ the data that
+ * TGA, BMP, PSD and HDR headers promise. stb_image 2.27 decodes a short file without
+ * complaint: an uncompressed TGA's missing rows stay uninitialised (valgrind sees them
+ * read in texture_eval), BMP and PSD pixels and run-length packets read past the end as
+ * zeros, and an HDR allocates for its claimed size before reading a byte of it (1.5 GB
+ * from a 51-byte file). So before stb_image decodes, the bytes the header promises are
+ * checked against the file: a fixed size for uncompressed data, and for run-length
+ * data a walk over the packets exactly as stb_image reads them, which costs one pass
+ * over the file and allocates nothing. A structure stb_image rejects itself (a bad
+ * packet, an unknown depth) passes here and is reported by stb_image. */
+
+/* A cursor over the file; reads past its end set `short_read`. */
+typedef struct {
+    FILE *f;
+    uint64_t pos, size;
+    int short_read;
+} Walk;
+
+static int walk_byte(Walk *w)
+{
+    int c = w->pos < w->size ? getc(w->f) : EOF;
+    if (c == EOF) {
+        w->short_read = 1;
+        return 0;
+    }
+    w->pos++;
+    return c;
+}
+
+static void walk_skip(Walk *w, uint64_t n)
+{
+    if (n > w->size - w->pos) {
+        w->short_read = 1;
+        w->pos = w->size;
+    } else if (n <= 64) {
+        for (uint64_t i = 0; i < n; i++) walk_byte(w);
+    } else {
+        w->pos += n;
+        if (fseeko(w->f, (off_t)w->pos, SEEK_SET) != 0) w->short_read = 1;
+    }
+}
+
+static uint64_t le16(const unsigned char *p) { return (uint64_t)p[0] | (uint64_t)p[1] << 8; }
+static uint64_t le32(const unsigned char *p) { return le16(p) | le16(p + 2) << 16; }
+static uint64_t be16(const unsigned char *p) { return (uint64_t)p[0] << 8 | p[1]; }
+static uint64_t be32(const unsigned char *p) { return be16(p) << 16 | be16(p + 2); }
+
+/* Uncompressed data of `need` bytes from byte `start`. */
+static Status check_fixed(const char *path, const char *format, int w, int h, uint64_t start, uint64_t need,
+                          uint64_t size, Error *err)
+{
+    if (start <= size && need <= size - start) return ST_OK;
+    return error_set(err, ST_INPUT, "'%s': a truncated %s file: its %dx%d pixels need %llu bytes after byte "
+                     "%llu, and the file has %llu bytes", path, format, w, h, (unsigned long long)need,
+                     (unsigned long long)start, (unsigned long long)size);
+}
+
+static Status check_walked(const Walk *wk, const char *path, const char *format, int w, int h, Error *err)
+{
+    if (!wk->short_read) return ST_OK;
+    return error_set(err, ST_INPUT, "'%s': a truncated %s file: its run-length data ends (at byte %llu) "
+                     "before the %dx%d pixels its header declares", path, format,
+                     (unsigned long long)wk->size, w, h);
+}
+
+/* stb_image's TGA reader: an 18-byte header, the image ID, the palette (after
+ * `palette_start` bytes stb_image skips), then pixels of 1 to 4 bytes, raw or in
+ * packets of up to 128 (a header byte, then one pixel repeated or that many pixels). */
+static Status tga_check(Walk *wk, const unsigned char *hd, const char *path, int w, int h, Error *err)
+{
+    int indexed = hd[1], type = hd[2], bpp = hd[16], rle = type >= 8;
+    uint64_t pixel = indexed ? (bpp == 8 ? 1u : 2u) : (uint64_t)(bpp + 7) / 8;
+    uint64_t start = 18 + (uint64_t)hd[0];
+    if (indexed) start += le16(hd + 3) + le16(hd + 5) * (uint64_t)((hd[7] + 7) / 8);
+    uint64_t n = (uint64_t)w * (uint64_t)h;
+    if (!rle) return check_fixed(path, "TGA", w, h, start, n * pixel, wk->size, err);
+    walk_skip(wk, start - wk->pos);
+    for (uint64_t i = 0; i < n && !wk->short_read;) {
+        int cmd = walk_byte(wk);
+        uint64_t count = 1 + (uint64_t)(cmd & 127);
+        if (count > n - i) count = n - i;
+        walk_skip(wk, (cmd & 128 ? 1 : count) * pixel);
+        i += count;
+    }
+    return check_walked(wk, path, "TGA", w, h, err);
+}
+
+/* stb_image's BMP reader: uncompressed rows of w pixels of `bpp` bits, each padded to
+ * 4 bytes, from the header's data offset (run-length BMPs it refuses). */
+static Status bmp_check(Walk *wk, const unsigned char *hd, const char *path, int w, int h, Error *err)
+{
+    uint64_t hsz = le32(hd + 14), bpp = hsz == 12 ? le16(hd + 24) : le16(hd + 28);
+    if (bpp != 1 && bpp != 4 && bpp != 8 && bpp != 16 && bpp != 24 && bpp != 32) return ST_OK;
+    uint64_t row = ((uint64_t)w * bpp + 7) / 8, stride = ((uint64_t)w * bpp + 31) / 32 * 4;
+    return check_fixed(path, "BMP", w, h, le32(hd + 10), stride * (uint64_t)(h - 1) + row, wk->size, err);
+}
+
+/* stb_image's PSD reader: a 26-byte header, three sections with a 4-byte length each,
+ * the compression, then the first four channels one after the other: raw, or after a
+ * table of 2-byte row lengths it skips, PackBits packets (a header byte n: n + 1 bytes
+ * copied, 257 - n copies of one byte, or 128, nothing) over the whole channel. */
+static Status psd_check(Walk *wk, const unsigned char *hd, const char *path, int w, int h, Error *err)
+{
+    uint64_t channels = be16(hd + 12), depth = be16(hd + 22), n = (uint64_t)w * (uint64_t)h;
+    walk_skip(wk, 26);
+    for (int section = 0; section < 3 && !wk->short_read; section++) {
+        unsigned char len[4];
+        for (int i = 0; i < 4; i++) len[i] = (unsigned char)walk_byte(wk);
+        walk_skip(wk, be32(len));
+    }
+    unsigned char comp[2];
+    comp[0] = (unsigned char)walk_byte(wk);
+    comp[1] = (unsigned char)walk_byte(wk);
+    if (wk->short_read) return check_walked(wk, path, "PSD", w, h, err);
+    uint64_t read = channels < 4 ? channels : 4;
+    if (be16(comp) == 0) return check_fixed(path, "PSD", w, h, wk->pos, read * n * (depth / 8), wk->size, err);
+    if (be16(comp) != 1) return ST_OK;
+    walk_skip(wk, (uint64_t)h * channels * 2);
+    for (uint64_t c = 0; c < read && !wk->short_read; c++)
+        for (uint64_t done = 0; done < n && !wk->short_read;) {
+            int len = walk_byte(wk);
+            if (len == 128) continue;
+            uint64_t count = len < 128 ? (uint64_t)len + 1 : 257 - (uint64_t)len;
+            if (count > n - done) return ST_OK;   /* stb_image: "bad RLE data" */
+            walk_skip(wk, len < 128 ? count : 1);
+            done += count;
+        }
+    return check_walked(wk, path, "PSD", w, h, err);
+}
+
+/* stb_image's Radiance HDR reader: text lines up to an empty one, the size line, then
+ * 4 bytes a pixel, flat when the width is below 8 or above 32767 or a scanline does not
+ * start with the marker 2 2 (from there stb_image reads the whole image flat), else per
+ * scanline the marker, the width, and each of the 4 components in packets (n > 128: one
+ * byte repeated n - 128 times; else n bytes). */
+static Status hdr_check(Walk *wk, const char *path, int w, int h, Error *err)
+{
+    /* the identifier line, the header lines, the empty line, the size line */
+    int lines_after_empty = -1;
+    for (int prev = '\n'; lines_after_empty < 1 && !wk->short_read;) {
+        int c = walk_byte(wk);
+        if (c == '\n') {
+            if (prev == '\n' && lines_after_empty < 0) lines_after_empty = 0;
+            else if (lines_after_empty >= 0) lines_after_empty++;
+        }
+        prev = c;
+    }
+    if (wk->short_read) return ST_OK;   /* stb_image rejects the header */
+    uint64_t n = (uint64_t)w * (uint64_t)h;
+    if (w < 8 || w >= 32768) return check_fixed(path, "HDR", w, h, wk->pos, n * 4, wk->size, err);
+    for (int j = 0; j < h && !wk->short_read; j++) {
+        uint64_t line_start = wk->pos;
+        int c1 = walk_byte(wk), c2 = walk_byte(wk), hi = walk_byte(wk);
+        if (c1 != 2 || c2 != 2 || (hi & 0x80))
+            return check_fixed(path, "HDR", w, h, line_start, n * 4, wk->size, err);
+        if ((hi << 8 | walk_byte(wk)) != w) return ST_OK;   /* stb_image: "invalid decoded scanline length" */
+        for (int k = 0; k < 4 && !wk->short_read; k++)
+            for (int i = 0; i < w && !wk->short_read;) {
+                int count = walk_byte(wk);
+                int run = count > 128;
+                if (run) count -= 128;
+                if (count > w - i) return ST_OK;   /* stb_image: "bad RLE data in HDR" */
+                walk_skip(wk, run ? 1u : (uint64_t)count);
+                i += count;
+            }
+    }
+    return check_walked(wk, path, "HDR", w, h, err);
+}
+
+/* Dispatches on the format by its signature; TGA, which has none, is what stb_image
+ * recognised that has a colour-map type of 0 or 1 in its second byte (no other
+ * format's signature has). */
+static Status data_check(const char *path, int w, int h, Error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return ST_OK;   /* stb_image reports it */
+    unsigned char hd[32] = { 0 };
+    size_t got = fread(hd, 1, sizeof hd, f);
+    off_t size = fseeko(f, 0, SEEK_END) == 0 ? ftello(f) : -1;
+    Status st = ST_OK;
+    if (size >= 0 && fseeko(f, 0, SEEK_SET) == 0 && w > 0 && h > 0) {
+        Walk wk = { f, 0, (uint64_t)size, 0 };
+        /* a header shorter than its format's is read as stb_image reads it: the
+         * missing bytes are zeros */
+        if (got >= 2 && memcmp(hd, "BM", 2) == 0) st = bmp_check(&wk, hd, path, w, h, err);
+        else if (got >= 4 && memcmp(hd, "8BPS", 4) == 0) st = psd_check(&wk, hd, path, w, h, err);
+        else if (got >= 2 && memcmp(hd, "#?", 2) == 0) st = hdr_check(&wk, path, w, h, err);
+        else if (got >= 2 && hd[1] <= 1) st = tga_check(&wk, hd, path, w, h, err);
+    }
+    fclose(f);
+    return st;
+}
+
 Status texture_load_image(Scene *s, const char *name, const char *path, int linear, int clamp,
                           uint *index, Error *err)
 {
     Texture t = texture_base(TEX_IMAGE);
     uint encoding = linear ? 0u : TEX_SRGB;
     /* the same file read before with the same encoding: share its texels */
-    for (size_t i = 0; i < s->n_textures; i++) {
-        const Texture *o = &s->textures[i];
-        if (!s->texture_sources[i] || strcmp(s->texture_sources[i], path) != 0) continue;
-        if ((o->flags & TEX_FLOAT) == 0 && (o->flags & TEX_SRGB) != encoding) continue;
+    uint same = scene_find_texture_source(s, path, linear);
+    if (same != NO_INDEX) {
+        const Texture *o = &s->textures[same];
         t.offset = o->offset;
         t.width = o->width;
         t.height = o->height;
@@ -152,11 +344,13 @@ Status texture_load_image(Scene *s, const char *name, const char *path, int line
     Status pst = pnm_check(path, err);
     if (!pst) pst = png_check(path, err);
     if (pst) return pst;
-    /* the size from the header, before stb_image allocates for it */
-    if (stbi_info(path, &w, &h, &channels) &&
-        (uint64_t)(unsigned)w * (uint64_t)(unsigned)h > CLPT_MAX_TEXTURE_PIXELS)
+    /* the size from the header, and the data it promises, before stb_image allocates
+     * for it */
+    int known = stbi_info(path, &w, &h, &channels);
+    if (known && (uint64_t)(unsigned)w * (uint64_t)(unsigned)h > CLPT_MAX_TEXTURE_PIXELS)
         return error_set(err, ST_INPUT, "'%s': a %dx%d image is larger than the textures clpt "
                          "reads (at most %u pixels, as in 8192x8192)", path, w, h, CLPT_MAX_TEXTURE_PIXELS);
+    if (known && (pst = data_check(path, w, h, err))) return pst;
     uint *texels = NULL;
     size_t n = 0;
     if (stbi_is_hdr(path)) {

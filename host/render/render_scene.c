@@ -26,6 +26,7 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     if ((st = scene_prepare_lights(s, err))) return st;
     RenderParams *p = &out->ds.params;
     if ((st = camera_setup(&s->camera, s->image.width, s->image.height, &p->camera, err))) return st;
+    if ((st = scene_check_precision(s, err))) return st;
     KdInput in = { s->spheres, s->n_spheres, s->triangles, s->n_triangles, s->boxes, s->n_boxes };
     if ((st = kd_build(&in, kd_threads, &out->kd, err))) return st;
     p->bg_type = s->bg_type;

@@ -21,6 +21,24 @@ static dvec3 dcross(dvec3 a, dvec3 b)
 }
 static vec3 fv(dvec3 a) { return v3((float)a.x, (float)a.y, (float)a.z); }
 
+double camera_min_focus(vec3 from)
+{
+    double m = fmax(fabs((double)from.x), fmax(fabs((double)from.y), fabs((double)from.z)));
+    return fmax(m * 0x1p-12, 0x1p-60);
+}
+
+double camera_focus(const SceneCamera *desc)
+{
+    dvec3 back = dsub(dv(desc->from), dv(desc->at));
+    double focus = desc->focus_dist > 0.0f ? (double)desc->focus_dist : sqrt(ddot(back, back));
+    /* a pinhole's rays do not depend on the distance of the view rectangle: put it
+     * where float keeps the directions precise (a target 1e-40 from the eye rendered
+     * black) */
+    if (desc->aperture == 0.0f && focus < camera_min_focus(desc->from))
+        focus = fmax(1.0, camera_min_focus(desc->from) * 0x1p12);
+    return focus;
+}
+
 Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *out, Error *err)
 {
     dvec3 from = dv(desc->from), at = dv(desc->at), up = dv(desc->up);
@@ -62,9 +80,13 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
         return ST_OK;
     }
 
-    double focus = desc->focus_dist > 0.0f ? (double)desc->focus_dist : dist;
+    double focus = camera_focus(desc);
     if (!isfinite(focus))
         return error_set(err, ST_INPUT, "camera: focus distance must be finite");
+    if (focus < camera_min_focus(desc->from))
+        return error_set(err, ST_INPUT, "camera: the focus distance %g is too short for single precision "
+                         "at 'from' %g %g %g (at least %g)", focus, (double)desc->from.x,
+                         (double)desc->from.y, (double)desc->from.z, camera_min_focus(desc->from));
     double h = tan((double)desc->vfov * M_PI / 360.0);
     double vp_h = 2.0 * h * focus;
     double vp_w = vp_h * (double)width / (double)height;

@@ -8,4 +8,14 @@
  * direction, a field of view outside (0, 180), a non-positive focus distance. */
 Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *out, Error *err);
 
+/* The shortest focus distance single precision renders from `from`: the kernels build
+ * a ray's direction as a point on the plane in focus minus the eye, in float, so a
+ * plane closer than 2^-12 of the eye's largest coordinate loses more than a pixel's
+ * worth of direction at 4096 pixels (and below 2^-60 its squares leave the normal
+ * floats). A pinhole camera moves its plane out to a precise distance (the image does
+ * not depend on it); a lens camera with a shorter focus is refused. */
+double camera_min_focus(vec3 from);
+/* The focus distance camera_setup uses (see camera_min_focus). */
+double camera_focus(const SceneCamera *desc);
+
 #endif /* CLPT_CAMERA_H */

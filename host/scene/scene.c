@@ -4,7 +4,9 @@
 #include "kmath.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -55,6 +57,11 @@ void scene_free(Scene *s)
     free(s->textures);
     free(s->texels);
     free(s->path);
+    for (size_t i = 0; i < s->n_warnings; i++) free(s->warnings[i]);
+    free(s->warnings);
+    strmap_free(&s->material_by_name);
+    strmap_free(&s->texture_by_name);
+    strmap_free(&s->texture_by_source);
     memset(s, 0, sizeof *s);
 }
 
@@ -101,6 +108,10 @@ Status scene_add_material(Scene *s, const char *name, Material m, uint *index, E
     char *copy = malloc(strlen(name) + 1);
     if (!copy) return error_set(err, ST_INTERNAL, "out of memory");
     strcpy(copy, name);
+    if (strmap_add(&s->material_by_name, name, strlen(name), (uint32_t)s->n_materials) < 0) {
+        free(copy);
+        return error_set(err, ST_INTERNAL, "out of memory");
+    }
     s->materials[s->n_materials] = m;
     s->material_names[s->n_materials] = copy;
     if (index) *index = (uint)s->n_materials;
@@ -163,6 +174,44 @@ static char *dup_or_null(const char *text, int *failed)
     return copy;
 }
 
+/* The texture_by_source key: the encoding's letter, then the path. */
+static char *source_key(const char *path, int linear, size_t *len)
+{
+    size_t n = strlen(path);
+    char *key = malloc(n + 2);
+    if (!key) return NULL;
+    key[0] = linear ? 'L' : 'S';
+    memcpy(key + 1, path, n + 1);
+    *len = n + 1;
+    return key;
+}
+
+/* Records the texture about to be added as read from `source`, for the encodings its
+ * texels serve (both for float texels), unless an earlier one does so already. 0, or
+ * -1 when out of memory. */
+static int texture_source_add(Scene *s, const char *source, uint flags)
+{
+    for (int linear = 0; linear < 2; linear++) {
+        if (!(flags & TEX_FLOAT) && (linear ? (flags & TEX_SRGB) != 0 : (flags & TEX_SRGB) == 0)) continue;
+        size_t len;
+        char *key = source_key(source, linear, &len);
+        int r = key ? strmap_add(&s->texture_by_source, key, len, (uint32_t)s->n_textures) : -1;
+        free(key);
+        if (r < 0) return -1;
+    }
+    return 0;
+}
+
+uint scene_find_texture_source(const Scene *s, const char *path, int linear)
+{
+    size_t len;
+    char *key = source_key(path, linear, &len);
+    uint32_t index = NO_INDEX;
+    if (key && !strmap_find(&s->texture_by_source, key, len, &index)) index = NO_INDEX;
+    free(key);
+    return index;
+}
+
 Status scene_add_texture(Scene *s, const char *name, const char *source, Texture t, uint *index,
                          Error *err)
 {
@@ -176,6 +225,9 @@ Status scene_add_texture(Scene *s, const char *name, const char *source, Texture
         return error_set(err, ST_INTERNAL, "out of memory growing the texture list");
     int failed = 0;
     char *n = dup_or_null(name, &failed), *src = dup_or_null(source, &failed);
+    if (!failed && name && strmap_add(&s->texture_by_name, name, strlen(name), (uint32_t)s->n_textures) < 0)
+        failed = 1;
+    if (!failed && source && texture_source_add(s, source, t.flags) < 0) failed = 1;
     if (failed) {
         free(n);
         free(src);
@@ -203,9 +255,8 @@ Status scene_add_texels(Scene *s, const uint *texels, size_t n, uint *offset, Er
 
 uint scene_find_texture(const Scene *s, const char *name)
 {
-    for (size_t i = 0; i < s->n_textures; i++)
-        if (s->texture_names[i] && strcmp(s->texture_names[i], name) == 0) return (uint)i;
-    return NO_INDEX;
+    uint32_t index;
+    return strmap_find(&s->texture_by_name, name, strlen(name), &index) ? index : NO_INDEX;
 }
 
 Status scene_set_material_texture(Scene *s, uint index, const char *path, Error *err)
@@ -232,11 +283,33 @@ const char *scene_material_texture(const Scene *s, uint index)
     return index < s->n_material_textures ? s->material_textures[index] : NULL;
 }
 
+Status scene_warn(Scene *s, Error *err, const char *fmt, ...)
+{
+    /* a file with thousands of the same problem would bury the render's output */
+    enum { MAX_WARNINGS = 20 };
+    if (s->n_warnings > MAX_WARNINGS) return ST_OK;
+    char msg[1024];
+    if (s->n_warnings == MAX_WARNINGS) {
+        snprintf(msg, sizeof msg, "more warnings follow; only the first %d are shown", MAX_WARNINGS);
+    } else {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, sizeof msg, fmt, ap);
+        va_end(ap);
+    }
+    char **grown = realloc(s->warnings, (s->n_warnings + 1) * sizeof *grown);
+    if (!grown) return error_set(err, ST_INTERNAL, "out of memory");
+    s->warnings = grown;
+    grown[s->n_warnings] = malloc(strlen(msg) + 1);
+    if (!grown[s->n_warnings]) return error_set(err, ST_INTERNAL, "out of memory");
+    strcpy(grown[s->n_warnings++], msg);
+    return ST_OK;
+}
+
 uint scene_find_material(const Scene *s, const char *name)
 {
-    for (size_t i = 0; i < s->n_materials; i++)
-        if (strcmp(s->material_names[i], name) == 0) return (uint)i;
-    return NO_INDEX;
+    uint32_t index;
+    return strmap_find(&s->material_by_name, name, strlen(name), &index) ? index : NO_INDEX;
 }
 
 uint scene_first_triangle(const Scene *s) { return (uint)s->n_spheres; }
@@ -425,5 +498,80 @@ Status scene_prepare_lights(Scene *s, Error *err)
     free(power);
     s->lights = lights;
     s->n_lights = n;
+    return ST_OK;
+}
+
+/* ------------------------------------------------------------------ precision */
+
+/* Radii and distances the kernels square: 2^62 squared is 2^124, far enough below
+ * FLT_MAX (2^128) for sums of three squares. */
+#define PRECISION_MAX_SQUARED_DISTANCE 0x1p62
+/* A sphere's radius over the camera's distance from its surface: at 2^24 the camera
+ * ray's hit computes |o - c|^2 - r^2 with no digit left; 2^22 leaves a margin. */
+#define PRECISION_MAX_SPHERE_RATIO 0x1p22
+
+static vec3 vmin(vec3 a, vec3 b) { return v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }
+static vec3 vmax(vec3 a, vec3 b) { return v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
+
+void scene_count_tiny_triangles(const Scene *s, size_t first, size_t end, size_t *tiny, size_t *with_area,
+                                vec3 *lo, vec3 *hi)
+{
+    *tiny = *with_area = 0;
+    vec3 l = v3s(INFINITY), h = v3s(-INFINITY);
+    for (size_t i = first; i < end && i < s->n_triangles; i++) {
+        const Triangle *t = &s->triangles[i];
+        l = vmin(l, vmin(t->p0, vmin(t->p1, t->p2)));
+        h = vmax(h, vmax(t->p0, vmax(t->p1, t->p2)));
+        /* the kernels' geometric normal (surface.h): float edges, cross, length */
+        vec3 e1 = v3_sub(t->p1, t->p0), e2 = v3_sub(t->p2, t->p0);
+        double x = (double)e1.y * e2.z - (double)e1.z * e2.y, y = (double)e1.z * e2.x - (double)e1.x * e2.z,
+               z = (double)e1.x * e2.y - (double)e1.y * e2.x;
+        if (!(x * x + y * y + z * z > 0.0)) continue;
+        (*with_area)++;
+        /* a subnormal squared length still normalises (measured: the bunny 1.5e-9
+         * across renders right, 1.5e-11 black); below 2^-140 it keeps too few bits */
+        vec3 n = v3_cross(e1, e2);
+        if (!(v3_dot(n, n) >= 0x1p-140f)) (*tiny)++;
+    }
+    if (lo) *lo = l;
+    if (hi) *hi = h;
+}
+
+static Status check_sphere(const Scene *s, size_t i, Error *err)
+{
+    const Sphere *sp = &s->spheres[i];
+    double fx = (double)s->camera.from.x - sp->center.x, fy = (double)s->camera.from.y - sp->center.y,
+           fz = (double)s->camera.from.z - sp->center.z;
+    double r = sp->radius, dist = sqrt(fx * fx + fy * fy + fz * fz);
+    double gap = fabs(dist - r);
+    const char *path = s->path ? s->path : "scene";
+    if (r > PRECISION_MAX_SQUARED_DISTANCE || dist > PRECISION_MAX_SQUARED_DISTANCE)
+        return error_set(err, ST_INPUT, "%s: sphere %zu (centre %g %g %g, radius %g) is too large or too far "
+                         "from the camera for single precision: its radius and its distance from the camera "
+                         "(%g) must be at most 2^62 (%g)", path, i + 1, (double)sp->center.x,
+                         (double)sp->center.y, (double)sp->center.z, r, dist, PRECISION_MAX_SQUARED_DISTANCE);
+    if (r > PRECISION_MAX_SPHERE_RATIO * gap)
+        return error_set(err, ST_INPUT, "%s: sphere %zu (centre %g %g %g, radius %g) is %g from the camera, "
+                         "more than 2^22 times closer than its radius: single precision cannot find where "
+                         "the camera's rays meet it (use a plane for a ground this large, or move the camera "
+                         "at least %g from it)", path, i + 1, (double)sp->center.x, (double)sp->center.y,
+                         (double)sp->center.z, r, gap, r / PRECISION_MAX_SPHERE_RATIO);
+    return ST_OK;
+}
+
+Status scene_check_precision(const Scene *s, Error *err)
+{
+    for (size_t i = 0; i < s->n_spheres; i++) {
+        Status st = check_sphere(s, i, err);
+        if (st) return st;
+    }
+    size_t tiny, with_area;
+    vec3 lo, hi;
+    scene_count_tiny_triangles(s, 0, s->n_triangles, &tiny, &with_area, &lo, &hi);
+    if (tiny > 0 && tiny * 2 >= with_area)
+        return error_set(err, ST_INPUT, "%s: %zu of the scene's %zu triangles are too small for single "
+                         "precision (their normals underflow; the triangles span %g x %g x %g): scale them up",
+                         s->path ? s->path : "scene", tiny, with_area, (double)(hi.x - lo.x),
+                         (double)(hi.y - lo.y), (double)(hi.z - lo.z));
     return ST_OK;
 }

@@ -9,6 +9,7 @@
 #include <stddef.h>
 
 #include "base/status.h"
+#include "base/strmap.h"
 #include "types.h"
 
 typedef struct {
@@ -55,6 +56,16 @@ typedef struct {
     uint integrator;             /* enum Integrator the scene asks for (INTEGRATOR_PATH
                                   * or INTEGRATOR_WHITTED); --integrator overrides it */
     int linear_output;           /* 8-bit images without the sRGB curve (classic scenes) */
+
+    /* Lookups by name, so that a scene or MTL with many materials reads in linear time:
+     * material name -> first material of that name, texture name -> first texture of
+     * that name, and "S" / "L" + image file -> the first texture read from it in sRGB /
+     * linear encoding (texture_load_image shares its texels). */
+    StrMap material_by_name, texture_by_name, texture_by_source;
+
+    /* Problems the readers worked around (a missing map_Kd image), for main to print
+     * once the scene is read; each names the file and line. */
+    char **warnings;       size_t n_warnings;
 } Scene;
 
 /* Defaults: 512x512, 64 spp, depth 8, seed 1, black background, camera at the origin
@@ -86,11 +97,18 @@ Status scene_add_texture(Scene *s, const char *name, const char *source, Texture
 /* Appends n texels; *offset receives the index of the first. */
 Status scene_add_texels(Scene *s, const uint *texels, size_t n, uint *offset, Error *err);
 uint scene_find_texture(const Scene *s, const char *name);
+/* The first texture read from image file `path` whose texels fit the encoding asked
+ * for (linear or sRGB; HDR textures fit both), or NO_INDEX. */
+uint scene_find_texture_source(const Scene *s, const char *path, int linear);
 
 /* Records `path` (copied) as the albedo texture file of material `index`. */
 Status scene_set_material_texture(Scene *s, uint index, const char *path, Error *err);
 /* The texture file of material `index`, or NULL. */
 const char *scene_material_texture(const Scene *s, uint index);
+
+/* Records a warning (scene.warnings; past the first 20, one line says that more were
+ * dropped); fails only when memory runs out. */
+Status scene_warn(Scene *s, Error *err, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 
 /* Index of the material with this name, or NO_INDEX. */
 uint scene_find_material(const Scene *s, const char *name);
@@ -106,6 +124,24 @@ uint scene_first_plane(const Scene *s);
  * power through a sphere of the scene's radius around them; directional lights: the
  * power through a disc of the scene's radius), and sets each primitive's `light`. */
 Status scene_prepare_lights(Scene *s, Error *err);
+
+/* Refuses (ST_INPUT, naming `s->path` and the shape) what single precision cannot
+ * render, which would otherwise come out black or missing without a word
+ * (docs/scene-format.md, "Precision"):
+ *   - a sphere whose radius, or distance from the camera, is above 2^62: the kernels
+ *     square them;
+ *   - a sphere more than 2^22 times larger than the camera's distance from its
+ *     surface: the camera ray's hit loses every digit (measured: a ground sphere of
+ *     radius 2e7 under a camera 1 above it renders black, 1.5e7 renders right);
+ *   - triangles too small for their normals: when most of the scene's triangles (or a
+ *     mesh's: scene_count_tiny_triangles) have an area but a normal whose squared
+ *     length underflows in float (below 2^-140), they shade black or vanish. */
+Status scene_check_precision(const Scene *s, Error *err);
+/* Of triangles [first, end): *with_area those whose corners span an area (in double),
+ * *tiny those of them whose normal the kernels cannot normalise in float; *lo and *hi
+ * (may be NULL) their bounds. */
+void scene_count_tiny_triangles(const Scene *s, size_t first, size_t end, size_t *tiny, size_t *with_area,
+                                vec3 *lo, vec3 *hi);
 
 /* Material helpers with the defaults of docs/scene-format.md. */
 Material material_diffuse(vec3 albedo);

@@ -373,6 +373,7 @@ struct Build {
 
     pthread_mutex_t lock;
     pthread_cond_t cond;
+    Worker *workers;  int n_workers;
     Task *queue;  size_t q_head, q_len, q_cap;
     int outstanding;            /* queued + running tasks */
     int failed;
@@ -863,22 +864,6 @@ static Status gather(Build *b, const KdInput *in, uint *skipped, Error *err)
     return ST_OK;
 }
 
-typedef struct { Build *b; Event *lists; size_t n[3]; int k; int failed; } SortJob;
-
-static void *sort_job(void *arg)
-{
-    SortJob *j = arg;
-    size_t off = 0;
-    for (int k = 0; k < j->k; k++) off += j->n[k];
-    Event *tmp = malloc(j->n[j->k] * sizeof *tmp + 1);
-    size_t *count = malloc(RADIX_BUCKETS * sizeof *count);
-    if (tmp && count) events_sort(j->lists + off, tmp, count, j->n[j->k]);
-    else j->failed = 1;
-    free(tmp);
-    free(count);
-    return NULL;
-}
-
 /* ------------------------------------------------------------------ flatten */
 
 /* scale: the product of the empty-space bonus over the node's ancestors that have an
@@ -941,23 +926,27 @@ static void leaf_write(const BNode *n, const KdInput *in, uint *out)
     }
 }
 
-static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in, KdTree *t, Error *err)
+/* Nodes and words of leaf data of the tree below root, to allocate them exactly. */
+static void flat_size(const BNode *root, const KdInput *in, size_t *n_nodes, size_t *n_words)
 {
-    /* Count first, to allocate exactly. Depth-first, "below" child first. */
-    size_t n_nodes = 0, n_words = 0;
     const BNode *stack[KD_MAX_DEPTH + 2];
     int sp = 0;
     stack[sp++] = root;
+    *n_nodes = *n_words = 0;
     while (sp) {
         const BNode *n = stack[--sp];
-        n_nodes++;
+        ++*n_nodes;
         if (n->axis == KD_LEAF) {
-            n_words += leaf_words(n, in);
+            *n_words += leaf_words(n, in);
         } else {
             stack[sp++] = n->child[1];
             stack[sp++] = n->child[0];
         }
     }
+}
+
+static Status flat_alloc(KdTree *t, size_t n_nodes, size_t n_words, Error *err)
+{
     if (n_nodes > (UINT32_MAX >> 4) || n_words > UINT32_MAX - 1)
         return error_set(err, ST_INTERNAL, "kd-tree: %zu nodes and %zu words of leaf data do not fit the node layout",
                          n_nodes, n_words);
@@ -968,60 +957,96 @@ static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in
     t->leaf_prims = aligned_alloc(64, leaf_bytes);
     if (!t->nodes || !t->leaf_prims)
         return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu nodes", n_nodes);
+    return ST_OK;
+}
 
-    KdStats *st = &t->stats;
+/* The flat arrays being written, and the sums behind the statistics. */
+typedef struct {
+    KdTree *t;
+    const KdInput *in;
+    size_t refs, groups;        /* leaf references, groups of triangles */
+    uint words;                 /* leaf data written so far */
+} Flat;
+
+/* Writes leaf node `me` and its record; rel: its box's area relative to the root's. */
+static void flat_leaf(Flat *f, const FlatItem *it, uint me, double rel)
+{
+    const BNode *n = it->node;
+    KdStats *st = &f->t->stats;
+    st->n_leaves++;
+    if (n->count == 0) st->n_empty_leaves++;
+    f->refs += n->count;
+    st->sah_cost += kd_leaf_cost(n->count) * rel;
+    st->sah_cost_bonus += kd_leaf_cost(n->count) * rel * it->scale;
+    uint first, nt;
+    leaf_split_ids(n, f->in, &first, &nt);
+    uint ng = (nt + KD_GROUP - 1) / KD_GROUP;
+    f->groups += ng;
+    f->t->nodes[me].bits = KD_LEAF | (n->count > nt ? KD_LEAF_OTHERS : 0u) | (ng << 3);
+    f->t->nodes[me].data = n->count ? f->words : 0u;
+    if (n->count) leaf_write(n, f->in, f->t->leaf_prims + f->words);
+    f->words += (uint)leaf_words(n, f->in);
+}
+
+/* Writes interior node `me` (its above child's index is added when that is reached)
+ * and pushes its children, below on top, onto items. */
+static void flat_interior(Flat *f, const FlatItem *it, uint me, double rel, FlatItem *items, int *ip)
+{
+    const BNode *n = it->node;
+    KdStats *st = &f->t->stats;
+    int empty_below = leaf_is_empty(n->child[0]), empty_above = leaf_is_empty(n->child[1]);
+    double scale = it->scale * (empty_below || empty_above ? KD_EMPTY_BONUS : 1.0);
+    st->sah_cost += KD_COST_TRAVERSAL * rel;
+    st->sah_cost_bonus += KD_COST_TRAVERSAL * rel * scale;
+    uint split_bits;
+    memcpy(&split_bits, &n->split, sizeof split_bits);
+    f->t->nodes[me].data = split_bits;
+    f->t->nodes[me].bits = n->axis | (empty_below ? KD_EMPTY_BELOW : 0u) | (empty_above ? KD_EMPTY_ABOVE : 0u);
+    FlatItem above = { n->child[1], me, it->depth + 1, it->box, scale };
+    FlatItem below = { n->child[0], NO_INDEX, it->depth + 1, it->box, scale };
+    above.box.lo[n->axis] = n->split;
+    below.box.hi[n->axis] = n->split;
+    items[(*ip)++] = above;
+    items[(*ip)++] = below;
+}
+
+static void flat_stats_finish(Flat *f)
+{
+    KdStats *st = &f->t->stats;
+    st->n_nodes = f->t->n_nodes;
+    uint full = st->n_leaves - st->n_empty_leaves;
+    st->mean_prims_per_leaf = full ? (double)f->refs / full : 0.0;
+    st->bytes = (size_t)f->t->n_nodes * sizeof(KdNode) + (size_t)f->words * sizeof(uint);
+    st->bytes_corners = f->groups * KD_GROUP * 9 * sizeof(float);
+}
+
+/* Writes the tree into t's node and leaf arrays in depth-first order, the below child
+ * first, and sums the statistics on the way. */
+static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in, KdTree *t, Error *err)
+{
+    size_t n_nodes, n_words;
+    flat_size(root, in, &n_nodes, &n_words);
+    Status s = flat_alloc(t, n_nodes, n_words, err);
+    if (s != ST_OK) return s;
+
+    Flat f = { t, in, 0, 0, 0 };
     double inv_root = box_half_area(root_box) > 0.0 ? 1.0 / box_half_area(root_box) : 0.0;
-    size_t refs = 0, groups = 0;
-    uint idx = 0, words = 0;
+    uint idx = 0;
     FlatItem items[KD_MAX_DEPTH + 2];
     int ip = 0;
     items[ip++] = (FlatItem){ root, NO_INDEX, 0, *root_box, 1.0 };
     while (ip) {
         FlatItem it = items[--ip];
-        const BNode *n = it.node;
         uint me = idx++;
         if (it.parent != NO_INDEX) t->nodes[it.parent].bits |= me << 4;
-        if ((uint)it.depth > st->max_depth) st->max_depth = (uint)it.depth;
+        if ((uint)it.depth > t->stats.max_depth) t->stats.max_depth = (uint)it.depth;
         double rel = inv_root > 0.0 ? box_half_area(&it.box) * inv_root : 1.0;
-        if (n->axis == KD_LEAF) {
-            st->n_leaves++;
-            if (n->count == 0) st->n_empty_leaves++;
-            refs += n->count;
-            st->sah_cost += kd_leaf_cost(n->count) * rel;
-            st->sah_cost_bonus += kd_leaf_cost(n->count) * rel * it.scale;
-            uint first, nt;
-            leaf_split_ids(n, in, &first, &nt);
-            uint ng = (nt + KD_GROUP - 1) / KD_GROUP;
-            groups += ng;
-            t->nodes[me].bits = KD_LEAF | (n->count > nt ? KD_LEAF_OTHERS : 0u) | (ng << 3);
-            t->nodes[me].data = n->count ? words : 0u;
-            if (n->count) leaf_write(n, in, t->leaf_prims + words);
-            words += (uint)leaf_words(n, in);
-            continue;
-        }
-        double scale = it.scale * (leaf_is_empty(n->child[0]) || leaf_is_empty(n->child[1]) ? KD_EMPTY_BONUS : 1.0);
-        st->sah_cost += KD_COST_TRAVERSAL * rel;
-        st->sah_cost_bonus += KD_COST_TRAVERSAL * rel * scale;
-        uint split_bits;
-        memcpy(&split_bits, &n->split, sizeof split_bits);
-        t->nodes[me].data = split_bits;
-        /* the above child's index is added when reached */
-        t->nodes[me].bits = n->axis | (leaf_is_empty(n->child[0]) ? KD_EMPTY_BELOW : 0u) |
-                            (leaf_is_empty(n->child[1]) ? KD_EMPTY_ABOVE : 0u);
-        FlatItem above = { n->child[1], me, it.depth + 1, it.box, scale };
-        FlatItem below = { n->child[0], NO_INDEX, it.depth + 1, it.box, scale };
-        above.box.lo[n->axis] = n->split;
-        below.box.hi[n->axis] = n->split;
-        items[ip++] = above;
-        items[ip++] = below;
+        if (it.node->axis == KD_LEAF) flat_leaf(&f, &it, me, rel);
+        else flat_interior(&f, &it, me, rel, items, &ip);
     }
     t->n_nodes = idx;
-    t->n_leaf_prims = words;
-    st->n_nodes = idx;
-    uint full = st->n_leaves - st->n_empty_leaves;
-    st->mean_prims_per_leaf = full ? (double)refs / full : 0.0;
-    st->bytes = (size_t)idx * sizeof(KdNode) + (size_t)words * sizeof(uint);
-    st->bytes_corners = groups * KD_GROUP * 9 * sizeof(float);
+    t->n_leaf_prims = f.words;
+    flat_stats_finish(&f);
     return ST_OK;
 }
 
@@ -1050,10 +1075,28 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void build_free(Build *b, Worker *w, int n_workers)
+/* threads <= 0 means every core; more than 256 would only add idle workers. */
+static int threads_resolve(int threads)
 {
-    for (int i = 0; i < n_workers; i++) worker_free(&w[i]);
-    free(w);
+    if (threads <= 0) {
+        long n = sysconf(_SC_NPROCESSORS_ONLN);
+        threads = n > 0 ? (int)n : 1;
+    }
+    return threads > 256 ? 256 : threads;
+}
+
+static void build_init(Build *b, int threads)
+{
+    memset(b, 0, sizeof *b);
+    pthread_mutex_init(&b->lock, NULL);
+    pthread_cond_init(&b->cond, NULL);
+    b->threads = threads;
+}
+
+static void build_free(Build *b)
+{
+    for (int i = 0; i < b->n_workers; i++) worker_free(&b->workers[i]);
+    free(b->workers);
     for (size_t i = 0; i < b->q_len; i++) free(b->queue[b->q_head + i].lists);
     free(b->queue);
     free(b->gid);
@@ -1063,14 +1106,149 @@ static void build_free(Build *b, Worker *w, int n_workers)
     pthread_cond_destroy(&b->cond);
 }
 
+static Aabb root_box(const Build *b)
+{
+    Aabb root = b->bounds[0];
+    for (uint i = 1; i < b->n_prims; i++)
+        for (int k = 0; k < 3; k++) {
+            root.lo[k] = fminf(root.lo[k], b->bounds[i].lo[k]);
+            root.hi[k] = fmaxf(root.hi[k], b->bounds[i].hi[k]);
+        }
+    return root;
+}
+
+/* Deepest level a node may be split at: round(8 + 1.3 floor(log2 N)), as in pbrt
+ * (docs/kdtree.md). */
+static int depth_limit(uint n_prims)
+{
+    int log2n = 0;
+    while ((2u << log2n) <= n_prims && log2n < 31) log2n++;
+    int d = (int)lround(8.0 + 1.3 * log2n);
+    return d > KD_MAX_DEPTH - 1 ? KD_MAX_DEPTH - 1 : d;
+}
+
+/* One worker per thread, each with its own side array and radix counters. */
+static Status workers_create(Build *b, Error *err)
+{
+    b->workers = calloc((size_t)b->threads, sizeof *b->workers);
+    if (!b->workers) return error_set(err, ST_INTERNAL, "kd-tree: out of memory");
+    b->n_workers = b->threads;
+    for (int i = 0; i < b->threads; i++) {
+        Worker *w = &b->workers[i];
+        w->b = b;
+        w->side = malloc(b->n_prims);
+        w->radix_count = malloc(RADIX_BUCKETS * sizeof *w->radix_count);
+        if (!w->side || !w->radix_count) return error_set(err, ST_INTERNAL, "kd-tree: out of memory");
+    }
+    return ST_OK;
+}
+
+typedef struct { Event *list; size_t n; int failed; } SortJob;
+
+static void *sort_job(void *arg)
+{
+    SortJob *j = arg;
+    Event *tmp = malloc(j->n * sizeof *tmp + 1);
+    size_t *count = malloc(RADIX_BUCKETS * sizeof *count);
+    if (tmp && count) events_sort(j->list, tmp, count, j->n);
+    else j->failed = 1;
+    free(tmp);
+    free(count);
+    return NULL;
+}
+
+/* Sorts the three lists of ev (n[k] events each, back to back), two of them on threads
+ * of their own when there are threads to spare. */
+static Status events_sort_axes(Event *ev, const size_t n[3], int threads, Error *err)
+{
+    SortJob jobs[3];
+    pthread_t tid[3];
+    int started[3] = { 0, 0, 0 };
+    for (int k = 0; k < 3; k++) {
+        jobs[k] = (SortJob){ ev, n[k], 0 };
+        ev += n[k];
+        if (k < threads - 1 && k < 2 && pthread_create(&tid[k], NULL, sort_job, &jobs[k]) == 0)
+            started[k] = 1;
+        else
+            sort_job(&jobs[k]);
+    }
+    for (int k = 0; k < 3; k++)
+        if (started[k]) pthread_join(tid[k], NULL);
+    if (jobs[0].failed || jobs[1].failed || jobs[2].failed)
+        return error_set(err, ST_INTERNAL, "kd-tree: out of memory sorting events");
+    return ST_OK;
+}
+
+/* The root's sorted event lists, at the bottom of worker 0's arena, described by *nl.
+ * The arena gets room for three times the root's events: the children's lists are
+ * written above their parent's. */
+static Status root_events(Build *b, const Aabb *root, NodeLists *nl, Error *err)
+{
+    Worker *w = &b->workers[0];
+    size_t n_ev[3] = { 0, 0, 0 };
+    for (uint i = 0; i < b->n_prims; i++)
+        for (int k = 0; k < 3; k++) n_ev[k] += b->bounds[i].lo[k] == b->bounds[i].hi[k] ? 1 : 2;
+    size_t total_ev = n_ev[0] + n_ev[1] + n_ev[2];
+    if (reserve_events(&w->arena, &w->arena_cap, total_ev * 3 + 1))
+        return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu events", total_ev);
+    Event *ev = w->arena;
+    size_t pos[3] = { 0, n_ev[0], n_ev[0] + n_ev[1] };
+    for (uint i = 0; i < b->n_prims; i++)
+        for (int k = 0; k < 3; k++) pos[k] += events_emit(ev + pos[k], &b->bounds[i], k, i);
+    Status st = events_sort_axes(ev, n_ev, b->threads, err);
+    if (st != ST_OK) return st;
+    w->top = total_ev;
+    *nl = (NodeLists){ 0, { (uint)n_ev[0], (uint)n_ev[1], (uint)n_ev[2] }, b->n_prims, *root };
+    return ST_OK;
+}
+
+/* Builds the tree below the root: worker 0 (this thread) starts at the root and the
+ * other workers wait for the subtrees it hands out; all return when none is left. */
+static Status subtrees_build(Build *b, NodeLists root, BNode **out, Error *err)
+{
+    pthread_t *tid = calloc((size_t)b->threads, sizeof *tid);
+    if (!tid) return error_set(err, ST_INTERNAL, "kd-tree: out of memory");
+    b->outstanding = 1;
+    int n_started = 0;
+    for (int i = 1; i < b->threads; i++)
+        if (pthread_create(&tid[i], NULL, worker_thread, &b->workers[i]) == 0) n_started = i;
+        else break;
+    if (n_started == 0) b->threads = 1;
+    double cost;
+    if (build_node(&b->workers[0], root, 0, 0, 0, out, &cost)) build_fail(b);
+    pthread_mutex_lock(&b->lock);
+    if (--b->outstanding == 0) pthread_cond_broadcast(&b->cond);
+    pthread_mutex_unlock(&b->lock);
+    worker_run(&b->workers[0]);
+    for (int i = 1; i <= n_started; i++) pthread_join(tid[i], NULL);
+    free(tid);
+    if (build_failed(b)) return error_set(err, ST_INTERNAL, "kd-tree: out of memory building the tree");
+    return ST_OK;
+}
+
+/* The tree over the gathered primitives (at least one). */
+static Status build_tree(Build *b, const KdInput *in, KdTree *out, Error *err)
+{
+    Aabb root = root_box(b);
+    b->max_depth = depth_limit(b->n_prims);
+    NodeLists nl;
+    BNode *root_node = NULL;
+    Status st;
+    if ((st = workers_create(b, err))) return st;
+    if ((st = root_events(b, &root, &nl, err))) return st;
+    if ((st = subtrees_build(b, nl, &root_node, err))) return st;
+    if ((st = flatten(root_node, &root, in, out, err))) return st;
+    out->lo = (vec3){ root.lo[0], root.lo[1], root.lo[2] };
+    out->hi = (vec3){ root.hi[0], root.hi[1], root.hi[2] };
+    out->stats.leaf_sah_cost = kd_leaf_cost(b->n_prims);
+    return ST_OK;
+}
+
 static Status build_single_leaf(KdTree *out, Error *err)
 {
     out->nodes = malloc(sizeof *out->nodes);
     out->leaf_prims = malloc(sizeof *out->leaf_prims);
-    if (!out->nodes || !out->leaf_prims) {
-        kd_free(out);
-        return error_set(err, ST_INTERNAL, "kd-tree: out of memory");
-    }
+    if (!out->nodes || !out->leaf_prims) return error_set(err, ST_INTERNAL, "kd-tree: out of memory");
     out->nodes[0].data = 0;
     out->nodes[0].bits = KD_LEAF;
     out->n_nodes = 1;
@@ -1082,124 +1260,22 @@ static Status build_single_leaf(KdTree *out, Error *err)
     return ST_OK;
 }
 
+/* Gathers the primitives' bounds, builds the tree (or a single empty leaf when no
+ * primitive is left), flattens it and fills in the statistics. */
 Status kd_build(const KdInput *in, int threads, KdTree *out, Error *err)
 {
     double t_start = now_seconds();
     memset(out, 0, sizeof *out);
-    if (threads <= 0) {
-        long n = sysconf(_SC_NPROCESSORS_ONLN);
-        threads = n > 0 ? (int)n : 1;
-    }
-    if (threads > 256) threads = 256;
-
     Build b;
-    memset(&b, 0, sizeof b);
-    pthread_mutex_init(&b.lock, NULL);
-    pthread_cond_init(&b.cond, NULL);
-    Worker *w = NULL;
-    int n_workers = 0;
-    uint skipped = 0;
-    Status st = gather(&b, in, &skipped, err);
-    if (st != ST_OK) goto fail;
-    out->stats.n_skipped = skipped;
-    out->stats.n_prims = b.n_prims;
-    if (b.n_prims == 0) {
-        st = build_single_leaf(out, err);
-        out->stats.n_skipped = skipped;
-        build_free(&b, w, 0);
-        out->stats.build_seconds = now_seconds() - t_start;
-        return st;
+    build_init(&b, threads_resolve(threads));
+    Status st = gather(&b, in, &out->stats.n_skipped, err);
+    if (st == ST_OK) {
+        out->stats.n_prims = b.n_prims;
+        st = b.n_prims == 0 ? build_single_leaf(out, err) : build_tree(&b, in, out, err);
     }
-
-    Aabb root = b.bounds[0];
-    for (uint i = 1; i < b.n_prims; i++)
-        for (int k = 0; k < 3; k++) {
-            root.lo[k] = fminf(root.lo[k], b.bounds[i].lo[k]);
-            root.hi[k] = fmaxf(root.hi[k], b.bounds[i].hi[k]);
-        }
-    int log2n = 0;
-    while ((2u << log2n) <= b.n_prims && log2n < 31) log2n++;
-    b.max_depth = (int)lround(8.0 + 1.3 * log2n);
-    if (b.max_depth > KD_MAX_DEPTH - 1) b.max_depth = KD_MAX_DEPTH - 1;
-    b.threads = threads;
-
-    w = calloc((size_t)threads, sizeof *w);
-    if (!w) { st = error_set(err, ST_INTERNAL, "kd-tree: out of memory"); goto fail; }
-    n_workers = threads;
-    for (int i = 0; i < threads; i++) {
-        w[i].b = &b;
-        w[i].side = malloc(b.n_prims);
-        w[i].radix_count = malloc(RADIX_BUCKETS * sizeof *w[i].radix_count);
-        if (!w[i].side || !w[i].radix_count) { st = error_set(err, ST_INTERNAL, "kd-tree: out of memory"); goto fail; }
-    }
-
-    /* The root's events, sorted per axis (the axes in parallel). */
-    size_t n_ev[3] = { 0, 0, 0 };
-    for (uint i = 0; i < b.n_prims; i++)
-        for (int k = 0; k < 3; k++) n_ev[k] += b.bounds[i].lo[k] == b.bounds[i].hi[k] ? 1 : 2;
-    size_t total_ev = n_ev[0] + n_ev[1] + n_ev[2];
-    if (reserve_events(&w[0].arena, &w[0].arena_cap, total_ev * 3 + 1)) {
-        st = error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu events", total_ev);
-        goto fail;
-    }
-    Event *ev = w[0].arena;
-    size_t pos[3] = { 0, n_ev[0], n_ev[0] + n_ev[1] };
-    for (uint i = 0; i < b.n_prims; i++)
-        for (int k = 0; k < 3; k++) pos[k] += events_emit(ev + pos[k], &b.bounds[i], k, i);
-    SortJob jobs[3];
-    pthread_t tid[3];
-    int started[3] = { 0, 0, 0 };
-    for (int k = 0; k < 3; k++) {
-        jobs[k] = (SortJob){ &b, ev, { n_ev[0], n_ev[1], n_ev[2] }, k, 0 };
-        if (k < threads - 1 && k < 2 && pthread_create(&tid[k], NULL, sort_job, &jobs[k]) == 0)
-            started[k] = 1;
-        else
-            sort_job(&jobs[k]);
-    }
-    for (int k = 0; k < 3; k++)
-        if (started[k]) pthread_join(tid[k], NULL);
-    if (jobs[0].failed || jobs[1].failed || jobs[2].failed) {
-        st = error_set(err, ST_INTERNAL, "kd-tree: out of memory sorting events");
-        goto fail;
-    }
-    w[0].top = total_ev;
-
-    /* Worker 0 (this thread) builds from the root; the others wait for tasks. */
-    pthread_t *threads_id = calloc((size_t)threads, sizeof *threads_id);
-    if (!threads_id) { st = error_set(err, ST_INTERNAL, "kd-tree: out of memory"); goto fail; }
-    b.outstanding = 1;
-    int n_started = 0;
-    for (int i = 1; i < threads; i++)
-        if (pthread_create(&threads_id[i], NULL, worker_thread, &w[i]) == 0) n_started = i;
-        else break;
-    if (n_started == 0) b.threads = 1;
-    BNode *root_node = NULL;
-    NodeLists nl = { 0, { (uint)n_ev[0], (uint)n_ev[1], (uint)n_ev[2] }, b.n_prims, root };
-    double cost;
-    if (build_node(&w[0], nl, 0, 0, 0, &root_node, &cost)) build_fail(&b);
-    pthread_mutex_lock(&b.lock);
-    if (--b.outstanding == 0) pthread_cond_broadcast(&b.cond);
-    pthread_mutex_unlock(&b.lock);
-    worker_run(&w[0]);
-    for (int i = 1; i <= n_started; i++) pthread_join(threads_id[i], NULL);
-    free(threads_id);
-    if (build_failed(&b)) {
-        st = error_set(err, ST_INTERNAL, "kd-tree: out of memory building the tree");
-        goto fail;
-    }
-
-    st = flatten(root_node, &root, in, out, err);
-    if (st != ST_OK) goto fail;
-    out->lo = (vec3){ root.lo[0], root.lo[1], root.lo[2] };
-    out->hi = (vec3){ root.hi[0], root.hi[1], root.hi[2] };
-    out->stats.leaf_sah_cost = kd_leaf_cost(b.n_prims);
-    build_free(&b, w, n_workers);
+    build_free(&b);
+    if (st != ST_OK) kd_free(out);
     out->stats.build_seconds = now_seconds() - t_start;
-    return ST_OK;
-
-fail:
-    build_free(&b, w, n_workers);
-    kd_free(out);
     return st;
 }
 

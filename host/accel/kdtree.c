@@ -193,6 +193,47 @@ static Aabb triangle_bounds(const Triangle *t)
     return a;
 }
 
+/* Clips the polygon in[0..n) to the side of the plane x_k = bound inside the box (below
+ * it when `upper`, above it otherwise) into res; returns the new vertex count. */
+static int clip_polygon_plane(double (*in)[3], int n, int k, int upper, double bound, double (*res)[3])
+{
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        const double *a = in[i], *b = in[(i + 1) % n];
+        int a_in = upper ? a[k] <= bound : a[k] >= bound;
+        int b_in = upper ? b[k] <= bound : b[k] >= bound;
+        if (a_in) {
+            memcpy(res[m], a, sizeof res[m]);
+            m++;
+        }
+        if (a_in != b_in) {
+            double s = (bound - a[k]) / (b[k] - a[k]);
+            for (int j = 0; j < 3; j++) res[m][j] = a[j] + s * (b[j] - a[j]);
+            res[m][k] = bound;
+            m++;
+        }
+    }
+    return m;
+}
+
+/* Box of the polygon v[0..n), rounded outward to float so that it is conservative. */
+static Aabb polygon_bounds(double (*v)[3], int n)
+{
+    double lo[3], hi[3];
+    for (int j = 0; j < 3; j++) lo[j] = hi[j] = v[0][j];
+    for (int i = 1; i < n; i++)
+        for (int j = 0; j < 3; j++) {
+            lo[j] = fmin(lo[j], v[i][j]);
+            hi[j] = fmax(hi[j], v[i][j]);
+        }
+    Aabb out;
+    for (int j = 0; j < 3; j++) {
+        out.lo[j] = round_down(lo[j]);
+        out.hi[j] = round_up(hi[j]);
+    }
+    return out;
+}
+
 /* Box of the part of triangle t inside box c (Sutherland-Hodgman in double, rounded
  * outward to float so the box is conservative); 0 when nothing is inside. */
 static int clip_triangle(const Triangle *t, const Aabb *c, Aabb *out)
@@ -211,7 +252,7 @@ static int clip_triangle(const Triangle *t, const Aabb *c, Aabb *out)
     for (int plane = 0; plane < 6; plane++) {
         int k = plane >> 1, upper = plane & 1;
         double bound = upper ? c->hi[k] : c->lo[k];
-        double (*in)[3] = buf[cur], (*res)[3] = buf[cur ^ 1];
+        double (*in)[3] = buf[cur];
         int outside = 0;
         for (int i = 0; i < n; i++)
             outside += upper ? in[i][k] > bound : in[i][k] < bound;
@@ -221,36 +262,10 @@ static int clip_triangle(const Triangle *t, const Aabb *c, Aabb *out)
             *out = triangle_bounds(t);
             return box_intersect_with(out, c);
         }
-        int m = 0;
-        for (int i = 0; i < n; i++) {
-            const double *a = in[i], *b = in[(i + 1) % n];
-            int a_in = upper ? a[k] <= bound : a[k] >= bound;
-            int b_in = upper ? b[k] <= bound : b[k] >= bound;
-            if (a_in) {
-                memcpy(res[m], a, sizeof res[m]);
-                m++;
-            }
-            if (a_in != b_in) {
-                double s = (bound - a[k]) / (b[k] - a[k]);
-                for (int j = 0; j < 3; j++) res[m][j] = a[j] + s * (b[j] - a[j]);
-                res[m][k] = bound;
-                m++;
-            }
-        }
-        n = m;
+        n = clip_polygon_plane(in, n, k, upper, bound, buf[cur ^ 1]);
         cur ^= 1;
     }
-    double lo[3], hi[3];
-    for (int j = 0; j < 3; j++) lo[j] = hi[j] = buf[cur][0][j];
-    for (int i = 1; i < n; i++)
-        for (int j = 0; j < 3; j++) {
-            lo[j] = fmin(lo[j], buf[cur][i][j]);
-            hi[j] = fmax(hi[j], buf[cur][i][j]);
-        }
-    for (int j = 0; j < 3; j++) {
-        out->lo[j] = round_down(lo[j]);
-        out->hi[j] = round_up(hi[j]);
-    }
+    *out = polygon_bounds(buf[cur], n);
     return box_intersect_with(out, c);
 }
 
@@ -518,17 +533,20 @@ static int make_leaf_from(Worker *w, const uint *ids, uint count, BNode *node)
     return 0;
 }
 
-/* Splits the node's lists into the children's: on return the right child's lists are
- * at nl->off and the left child's right above them, at the top of the arena. */
-static int split_lists(Worker *w, const NodeLists *nl, const Split *s,
-                       NodeLists *left, NodeLists *right)
+/* The straddling primitives' new events: per child (left, right) and axis, a sorted list
+ * of up to 2 events per straddling primitive. */
+typedef struct { Event *list[2][3]; size_t n[2][3]; } FreshLists;
+
+/* Sets each primitive's side of split s in w->side, counts those wholly on each side in
+ * n_side[2] and lists the straddling ones in w->both; returns how many straddle, or -1
+ * when memory runs out. */
+static long classify_sides(Worker *w, const NodeLists *nl, const Split *s, uint n_side[2])
 {
-    Build *b = w->b;
     int k = s->axis;
     uint32_t pk = float_key(s->pos + 0.0f);
     uint8_t *side = w->side;
 
-    /* Classify by the events of the split axis; a primitive's start precedes its end. */
+    /* By the events of the split axis; a primitive's start precedes its end. */
     const Event *ek = w->arena + nl->off + (k > 0 ? nl->n[0] : 0) + (k > 1 ? nl->n[1] : 0);
     uint8_t in_plane = s->planar_left ? SIDE_LEFT : SIDE_RIGHT;
     for (uint i = 0; i < nl->n[k]; i++) {
@@ -551,58 +569,66 @@ static int split_lists(Worker *w, const NodeLists *nl, const Split *s,
         w->both[n_both] = p;
         n_both += counted & (sd == SIDE_BOTH);
     }
+    n_side[0] = n_left;
+    n_side[1] = n_right;
+    return n_both;
+}
 
-    /* Clip the straddling primitives to each child: 6 fresh lists of up to 2 events
-     * per primitive (left x,y,z then right x,y,z). */
-    Aabb box_l = nl->box, box_r = nl->box;
-    box_l.hi[k] = s->pos;
-    box_r.lo[k] = s->pos;
-    if (reserve_events(&w->fresh, &w->fresh_cap, (size_t)12 * n_both + 1))
-        return -1;
-    Event *fresh[2][3];
-    size_t n_fresh[2][3] = { { 0, 0, 0 }, { 0, 0, 0 } };
+/* Clips the n_both straddling primitives to each child's box and gives each child
+ * their events, sorted; one that reaches into a child is counted in n_side there. */
+static int clip_straddlers(Worker *w, uint n_both, const Aabb child[2], uint n_side[2], FreshLists *f)
+{
+    const Build *b = w->b;
+    if (reserve_events(&w->fresh, &w->fresh_cap, (size_t)12 * n_both + 1)) return -1;
     for (int c = 0; c < 2; c++)
-        for (int j = 0; j < 3; j++) fresh[c][j] = w->fresh + (size_t)(c * 3 + j) * 2 * n_both;
+        for (int j = 0; j < 3; j++) {
+            f->list[c][j] = w->fresh + (size_t)(c * 3 + j) * 2 * n_both;
+            f->n[c][j] = 0;
+        }
     for (uint i = 0; i < n_both; i++) {
         uint p = w->both[i];
         for (int c = 0; c < 2; c++) {
-            const Aabb *cb = c ? &box_r : &box_l;
             Aabb clipped = b->bounds[p];
-            int inside = b->tri[p] != NO_INDEX ? clip_triangle(&b->triangles[b->tri[p]], cb, &clipped)
-                                               : box_intersect_with(&clipped, cb);
+            int inside = b->tri[p] != NO_INDEX ? clip_triangle(&b->triangles[b->tri[p]], &child[c], &clipped)
+                                               : box_intersect_with(&clipped, &child[c]);
             if (!inside) continue;
-            if (c) n_right++;
-            else n_left++;
+            n_side[c]++;
             for (int j = 0; j < 3; j++)
-                n_fresh[c][j] += events_emit(fresh[c][j] + n_fresh[c][j], &clipped, j, p);
+                f->n[c][j] += events_emit(f->list[c][j] + f->n[c][j], &clipped, j, p);
         }
     }
     size_t most = 0;
     for (int c = 0; c < 2; c++)
-        for (int j = 0; j < 3; j++) most = n_fresh[c][j] > most ? n_fresh[c][j] : most;
+        for (int j = 0; j < 3; j++) most = f->n[c][j] > most ? f->n[c][j] : most;
     if (reserve_events(&w->sort_tmp, &w->sort_tmp_cap, most + 1)) return -1;
     for (int c = 0; c < 2; c++)
-        for (int j = 0; j < 3; j++) events_sort(fresh[c][j], w->sort_tmp, w->radix_count, n_fresh[c][j]);
+        for (int j = 0; j < 3; j++) events_sort(f->list[c][j], w->sort_tmp, w->radix_count, f->n[c][j]);
+    return 0;
+}
 
-    /* Write the children's lists above the node's, right child first, each axis in
-     * one pass that keeps every event for both children (writing both is cheaper
-     * than branching) and merges in the fresh events in order. Each list gets room
-     * for all of the node's events of its axis plus its fresh ones. */
+/* Writes the children's lists above the top of the arena, right child first, each axis
+ * in one pass that keeps every event for both children (writing both is cheaper than
+ * branching) and merges in the fresh events in order. Each list gets room for all of
+ * the node's events of its axis plus its fresh ones; start and count say where each
+ * list is and how long. */
+static int children_write(Worker *w, const NodeLists *nl, uint n_both, const FreshLists *f,
+                          size_t start[2][3], size_t count[2][3])
+{
     size_t node_size = (size_t)nl->n[0] + nl->n[1] + nl->n[2];
     size_t need = node_size * 2 + 12 * (size_t)n_both + 1;
     if (reserve_events(&w->arena, &w->arena_cap, w->top + need)) return -1;
+    const uint8_t *side = w->side;
     const Event *src = w->arena + nl->off;
-    size_t start[2][3], count[2][3];
     size_t room = w->top;
     for (int c = 1; c >= 0; c--)
         for (int j = 0; j < 3; j++) {
             start[c][j] = room;
-            room += nl->n[j] + n_fresh[c][j];
+            room += nl->n[j] + f->n[c][j];
         }
     for (int j = 0; j < 3; j++) {
         Event *dl = w->arena + start[0][j], *dr = w->arena + start[1][j];
-        const Event *fl = fresh[0][j], *fr = fresh[1][j];
-        size_t nfl = n_fresh[0][j], nfr = n_fresh[1][j], il = 0, ir = 0, ml = 0, mr = 0;
+        const Event *fl = f->list[0][j], *fr = f->list[1][j];
+        size_t nfl = f->n[0][j], nfr = f->n[1][j], il = 0, ir = 0, ml = 0, mr = 0;
         for (uint i = 0; i < nl->n[j]; i++) {
             Event e = src[i];
             uint8_t sd = side[event_prim(e)];
@@ -619,8 +645,16 @@ static int split_lists(Worker *w, const NodeLists *nl, const Split *s,
         count[1][j] = mr;
         src += nl->n[j];
     }
-    /* Destination ranges come in the same order as the sources, and each ends before
-     * the next source begins (the sources have room for at least their events). */
+    return 0;
+}
+
+/* Moves the children's lists down over the node's, right child first, and sets their
+ * offsets and lengths. Destination ranges come in the same order as the sources, and
+ * each ends before the next source begins (the sources have room for at least their
+ * events). */
+static void children_move_down(Worker *w, const NodeLists *nl, size_t start[2][3], size_t count[2][3],
+                               NodeLists *left, NodeLists *right)
+{
     size_t dst = nl->off;
     for (int c = 1; c >= 0; c--)
         for (int j = 0; j < 3; j++) {
@@ -633,11 +667,30 @@ static int split_lists(Worker *w, const NodeLists *nl, const Split *s,
         right->n[j] = (uint)count[1][j];
         left->n[j] = (uint)count[0][j];
     }
-    right->nprims = n_right;
-    left->nprims = n_left;
-    right->box = box_r;
-    left->box = box_l;
     w->top = dst;
+}
+
+/* Splits the node's lists into the children's: on return the right child's lists are
+ * at nl->off and the left child's right above them, at the top of the arena. Primitives
+ * that straddle the split are clipped to each child's box. */
+static int split_lists(Worker *w, const NodeLists *nl, const Split *s,
+                       NodeLists *left, NodeLists *right)
+{
+    uint n_side[2];
+    long n_both = classify_sides(w, nl, s, n_side);
+    if (n_both < 0) return -1;
+    Aabb child[2] = { nl->box, nl->box };
+    child[0].hi[s->axis] = s->pos;
+    child[1].lo[s->axis] = s->pos;
+    FreshLists fresh;
+    if (clip_straddlers(w, (uint)n_both, child, n_side, &fresh)) return -1;
+    size_t start[2][3], count[2][3];
+    if (children_write(w, nl, (uint)n_both, &fresh, start, count)) return -1;
+    children_move_down(w, nl, start, count, left, right);
+    left->nprims = n_side[0];
+    right->nprims = n_side[1];
+    left->box = child[0];
+    right->box = child[1];
     return 0;
 }
 
@@ -666,6 +719,45 @@ static int task_push(Worker *w, const NodeLists *nl, int depth, int bad, BNode *
     return 0;
 }
 
+/* The cheapest plane of the node over the three axes (axis -1 when it is not to be
+ * split: no primitive, too deep, or a box without area). */
+static Split best_split(const Worker *w, const NodeLists *nl, double sa, int depth)
+{
+    Split best = { -1, 0.0f, 0, INFINITY };
+    if (nl->nprims == 0 || depth >= w->b->max_depth || !(sa > 0.0)) return best;
+    const Event *e = w->arena + nl->off;
+    for (int k = 0; k < 3; k++) {
+        if (nl->box.hi[k] > nl->box.lo[k]) sweep_axis(e, nl->n[k], nl->nprims, k, &nl->box, 1.0 / sa, &best);
+        e += nl->n[k];
+    }
+    return best;
+}
+
+static void make_interior(BNode *node, const Split *s)
+{
+    node->axis = (uint)s->axis;
+    node->split = s->pos;
+    node->count = 0;
+    node->ids = NULL;
+    node->child[0] = node->child[1] = NULL;
+}
+
+static int build_node(Worker *w, NodeLists nl, int depth, int bad, int tentative,
+                      BNode **out, double *cost);
+
+/* Hands the right child to another thread and builds the left one here: the right
+ * child's lists are copied out, so the left child's move down over the node's. */
+static int build_left_hand_off_right(Worker *w, size_t node_off, NodeLists left, const NodeLists *right,
+                                     int depth, int bad, BNode *node, double *cost_l)
+{
+    if (task_push(w, right, depth, bad, &node->child[1])) return -1;
+    size_t n = (size_t)left.n[0] + left.n[1] + left.n[2];
+    memmove(w->arena + node_off, w->arena + left.off, n * sizeof *w->arena);
+    left.off = node_off;
+    w->top = node_off + n;
+    return build_node(w, left, depth, bad, 0, &node->child[0], cost_l);
+}
+
 /* Builds the subtree of the node whose lists are at the top of the arena and stores it
  * in *out. *cost gets the subtree's cost (with the empty bonus, in absolute area units)
  * when `tentative`; subtrees handed to other threads are built only outside tentative
@@ -673,7 +765,6 @@ static int task_push(Worker *w, const NodeLists *nl, int depth, int bad, BNode *
 static int build_node(Worker *w, NodeLists nl, int depth, int bad, int tentative,
                       BNode **out, double *cost)
 {
-    Build *b = w->b;
     BNode *node = pool_alloc(&w->nodes, sizeof *node);
     if (!node) return -1;
     *out = node;
@@ -681,14 +772,7 @@ static int build_node(Worker *w, NodeLists nl, int depth, int bad, int tentative
     double leaf_cost = kd_leaf_cost(nl.nprims);
     *cost = leaf_cost * sa;
 
-    Split best = { -1, 0.0f, 0, INFINITY };
-    if (nl.nprims > 0 && depth < b->max_depth && sa > 0.0) {
-        const Event *e = w->arena + nl.off;
-        for (int k = 0; k < 3; k++) {
-            if (nl.box.hi[k] > nl.box.lo[k]) sweep_axis(e, nl.n[k], nl.nprims, k, &nl.box, 1.0 / sa, &best);
-            e += nl.n[k];
-        }
-    }
+    Split best = best_split(w, &nl, sa, depth);
     int improves = best.axis >= 0 && best.cost < leaf_cost;
     if (best.axis < 0 || (!improves && bad >= KD_MAX_BAD_REFINES)) return make_leaf(w, &nl, node);
 
@@ -706,23 +790,12 @@ static int build_node(Worker *w, NodeLists nl, int depth, int bad, int tentative
 
     NodeLists left, right;
     if (split_lists(w, &nl, &best, &left, &right)) return -1;
-    node->axis = (uint)best.axis;
-    node->split = best.pos;
-    node->count = 0;
-    node->ids = NULL;
-    node->child[0] = node->child[1] = NULL;
+    make_interior(node, &best);
     int child_bad = improves ? 0 : bad + 1;
     double cost_l = 0.0, cost_r = 0.0;
 
-    if (!tentative && b->threads > 1 && right.nprims >= KD_TASK_MIN_PRIMS) {
-        if (task_push(w, &right, depth + 1, child_bad, &node->child[1])) return -1;
-        /* The right child's lists are copied out: move the left child's down. */
-        size_t n = (size_t)left.n[0] + left.n[1] + left.n[2];
-        memmove(w->arena + nl.off, w->arena + left.off, n * sizeof *w->arena);
-        left.off = nl.off;
-        w->top = nl.off + n;
-        return build_node(w, left, depth + 1, child_bad, 0, &node->child[0], &cost_l);
-    }
+    if (!tentative && w->b->threads > 1 && right.nprims >= KD_TASK_MIN_PRIMS)
+        return build_left_hand_off_right(w, nl.off, left, &right, depth + 1, child_bad, node, &cost_l);
     if (build_node(w, left, depth + 1, child_bad, tentative, &node->child[0], &cost_l)) return -1;
     w->top = right.off + right.n[0] + right.n[1] + right.n[2];
     if (build_node(w, right, depth + 1, child_bad, tentative, &node->child[1], &cost_r)) return -1;

@@ -25,8 +25,10 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
+
+#include "base/timer.h"
+#include "scene/scene.h"
 
 /* Cost factor of a split that leaves one child empty (Wald & Havran's lambda). */
 #ifndef KD_EMPTY_BONUS
@@ -329,19 +331,13 @@ static void pool_release(Pool *p, PoolMark m)
     p->cur = m.chunk;
 }
 
-/* reserve_*(&array, &capacity, need): grows the array to hold `need` elements
- * (doubling); 0 on success, -1 when out of memory (the array is then unchanged). */
+/* reserve_*(&array, &capacity, need): array_reserve (scene.h: doubling, overflow
+ * checked) with the element type checked; 0 on success, -1 when out of memory (the
+ * array is then unchanged). */
 #define DEFINE_RESERVE(name, T)                                                        \
     static int name(T **ptr, size_t *cap, size_t need)                                 \
     {                                                                                  \
-        if (need <= *cap) return 0;                                                    \
-        size_t n = *cap ? *cap : 256;                                                  \
-        while (n < need) n *= 2;                                                       \
-        T *p = realloc(*ptr, n * sizeof *p);                                           \
-        if (!p) return -1;                                                             \
-        *ptr = p;                                                                      \
-        *cap = n;                                                                      \
-        return 0;                                                                      \
+        return array_reserve((void **)ptr, cap, need, sizeof **ptr);                   \
     }
 
 /* ------------------------------------------------------------------ build state */
@@ -900,6 +896,16 @@ static Aabb box_bounds(const Box *bx)
     return a;
 }
 
+/* Appends primitive `gid` (triangle `tri`, or NO_INDEX) with bounds a, unless they are
+ * not `finite`. */
+static void gather_one(Build *b, uint gid, uint tri, const Aabb *a, int finite)
+{
+    if (!finite) return;
+    b->gid[b->n_prims] = gid;
+    b->tri[b->n_prims] = tri;
+    b->bounds[b->n_prims++] = *a;
+}
+
 /* Collects the primitives (global ids, bounds). A primitive whose bounds are not
  * finite (a NaN or inf coordinate or radius) is left out of the tree, and so can never
  * be hit: no finite ray could hit it meaningfully, and one infinite box would make
@@ -915,24 +921,21 @@ static Status gather(Build *b, const KdInput *in, uint *skipped, Error *err)
     b->bounds = malloc((total + 1) * sizeof *b->bounds);
     if (!b->gid || !b->tri || !b->bounds)
         return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu primitives", total);
-    uint n = 0, gid = 0;
+    uint gid = 0;
+    b->n_prims = 0;
     for (size_t i = 0; i < in->n_spheres; i++, gid++) {
         Aabb a = sphere_bounds(&in->spheres[i]);
-        if (!aabb_finite(&a)) continue;
-        b->gid[n] = gid; b->tri[n] = NO_INDEX; b->bounds[n++] = a;
+        gather_one(b, gid, NO_INDEX, &a, aabb_finite(&a));
     }
     for (size_t i = 0; i < in->n_triangles; i++, gid++) {
         Aabb a = triangle_bounds(&in->triangles[i]);
-        if (!triangle_finite(&in->triangles[i])) continue;
-        b->gid[n] = gid; b->tri[n] = (uint)i; b->bounds[n++] = a;
+        gather_one(b, gid, (uint)i, &a, triangle_finite(&in->triangles[i]));
     }
     for (size_t i = 0; i < in->n_boxes; i++, gid++) {
         Aabb a = box_bounds(&in->boxes[i]);
-        if (!aabb_finite(&a)) continue;
-        b->gid[n] = gid; b->tri[n] = NO_INDEX; b->bounds[n++] = a;
+        gather_one(b, gid, NO_INDEX, &a, aabb_finite(&a));
     }
-    b->n_prims = n;
-    *skipped = (uint)(total - n);
+    *skipped = (uint)(total - b->n_prims);
     b->triangles = in->triangles;
     return ST_OK;
 }
@@ -1141,13 +1144,6 @@ uint kd_leaf_ids(const KdTree *t, uint node, uint *out, uint cap)
 
 /* ------------------------------------------------------------------ entry points */
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* threads <= 0 means every core; more than 256 would only add idle workers. */
 static int threads_resolve(int threads)
 {
@@ -1337,7 +1333,7 @@ static Status build_single_leaf(KdTree *out, Error *err)
  * primitive is left), flattens it and fills in the statistics. */
 Status kd_build(const KdInput *in, int threads, KdTree *out, Error *err)
 {
-    double t_start = now_seconds();
+    double t_start = timer_now();
     memset(out, 0, sizeof *out);
     Build b;
     build_init(&b, threads_resolve(threads));
@@ -1348,7 +1344,7 @@ Status kd_build(const KdInput *in, int threads, KdTree *out, Error *err)
     }
     build_free(&b);
     if (st != ST_OK) kd_free(out);
-    out->stats.build_seconds = now_seconds() - t_start;
+    out->stats.build_seconds = timer_now() - t_start;
     return st;
 }
 

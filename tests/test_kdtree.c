@@ -869,6 +869,126 @@ static void test_deterministic(void)
     kd_free(&one);
 }
 
+/* FNV-1a over the flat tree (counts, nodes, leaf data, root box): what the kernels read. */
+static uint64_t tree_hash(const KdTree *t)
+{
+    const struct { const void *p; size_t n; } part[] = {
+        { &t->n_nodes, sizeof t->n_nodes },
+        { &t->n_leaf_prims, sizeof t->n_leaf_prims },
+        { t->nodes, t->n_nodes * sizeof *t->nodes },
+        { t->leaf_prims, t->n_leaf_prims * sizeof *t->leaf_prims },
+        { &t->lo, sizeof t->lo },
+        { &t->hi, sizeof t->hi },
+    };
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (size_t i = 0; i < sizeof part / sizeof part[0]; i++)
+        for (size_t j = 0; j < part[i].n; j++) {
+            h ^= ((const unsigned char *)part[i].p)[j];
+            h *= 0x100000001b3ull;
+        }
+    return h;
+}
+
+/* A closed bumpy sphere of 12 n^2 triangles: each face of a cube in an n x n grid,
+ * pushed onto the sphere. Only + - * / and sqrtf (exact in IEEE arithmetic), so the
+ * mesh, unlike mesh_make_sphere's (libm's sin and cos), is the same on every machine. */
+static Triangle *cube_sphere(uint n, size_t *count)
+{
+    Triangle *t = malloc((size_t)12 * n * n * sizeof *t);
+    if (!t) return NULL;
+    size_t m = 0;
+    for (int face = 0; face < 6; face++) {
+        int k = face >> 1;
+        float s = face & 1 ? 1.0f : -1.0f;
+        for (uint i = 0; i < n; i++)
+            for (uint j = 0; j < n; j++) {
+                vec3 p[4];
+                for (int c = 0; c < 4; c++) {
+                    float u = -1.0f + 2.0f * (float)(i + (uint)(c & 1)) / (float)n;
+                    float v = -1.0f + 2.0f * (float)(j + (uint)(c >> 1)) / (float)n;
+                    float q[3];
+                    q[k] = s;
+                    q[(k + 1) % 3] = s * u;
+                    q[(k + 2) % 3] = v;
+                    float bump = 1.0f + 0.05f * u * v * (1.0f - u * u);
+                    float len = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+                    p[c] = v3_scale(v3(q[0], q[1], q[2]), bump / len);
+                }
+                t[m++] = (Triangle){ p[0], 0, p[1], NO_INDEX, p[3], NO_INDEX };
+                t[m++] = (Triangle){ p[0], 0, p[3], NO_INDEX, p[2], NO_INDEX };
+            }
+    }
+    *count = m;
+    return t;
+}
+
+/* Spheres, triangles of three sizes (a quarter of them flat in z on integer planes, so
+ * they lie on candidate split planes) and boxes (a fifth flat in y), each number drawn
+ * in a statement of its own: random_scene's draws are function arguments, whose order
+ * of evaluation C leaves open (gcc and clang differ), so its scene depends on the
+ * compiler. */
+static void mixed_scene(void)
+{
+    scene_clear();
+    rng_seed(81);
+    float r[9];
+    for (uint i = 0; i < 4000; i++) {
+        for (int j = 0; j < 9; j++) r[j] = frange(-4.0f, 4.0f);
+        vec3 a = v3(r[0], r[1], r[2]);
+        if (i < 400) {
+            add_sphere(a, 0.05f + 0.1f * fabsf(r[3]));
+        } else if (i < 600) {
+            vec3 hi = v3_add(a, v3(0.4f * fabsf(r[3]), i % 5 ? 0.4f * fabsf(r[4]) : 0.0f, 0.4f * fabsf(r[5])));
+            add_box(a, hi);
+        } else {
+            float size = i % 3 == 0 ? 0.5f : i % 3 == 1 ? 0.1f : 0.03f;
+            vec3 b = v3_add(a, v3(size * r[3], size * r[4], size * r[5]));
+            vec3 c = v3_add(a, v3(size * r[6], size * r[7], size * r[8]));
+            if (i % 4 == 0) a.z = b.z = c.z = (float)(int)r[2];
+            add_triangle(a, b, c);
+        }
+    }
+}
+
+/* The trees of two fixed inputs, pinned by hash: a change to the build that changes any
+ * node or leaf word (a refactoring should not) shows here. Both inputs are made without
+ * libm and without draws in function arguments, so they are the same bits with any C
+ * compiler. When a change to the SAH or the layout is meant, check the trees (make
+ * bench, docs/kdtree.md) and pin the new hashes. */
+static void test_pinned_trees(void)
+{
+    size_t nt = 0;
+    Triangle *tri = cube_sphere(40, &nt);
+    CHECK(tri != NULL);
+    if (!tri) return;
+    KdInput in = { NULL, 0, tri, nt, NULL, 0 };
+    const int threads[] = { 1, 3, 0 };
+    for (int i = 0; i < 3; i++) {
+        KdTree t;
+        Error err = { 0 };
+        if (kd_build(&in, threads[i], &t, &err) != ST_OK) {
+            CHECK_MSG(0, "%s", err.msg);
+            continue;
+        }
+        CHECK(t.n_nodes > 1000);
+        CHECK_MSG(tree_hash(&t) == 0x8f9182d907c91c8bull, "cube sphere, %d threads: %016llx", threads[i],
+                  (unsigned long long)tree_hash(&t));
+        kd_free(&t);
+    }
+    free(tri);
+
+    mixed_scene();
+    for (int i = 0; i < 3; i++) {
+        if (scene_build(threads[i]) != ST_OK) {
+            CHECK(!"mixed scene builds");
+            continue;
+        }
+        CHECK(scene.tree.n_nodes > 100);
+        CHECK_MSG(tree_hash(&scene.tree) == 0x9958cac2f43dba5eull, "mixed scene, %d threads: %016llx", threads[i],
+                  (unsigned long long)tree_hash(&scene.tree));
+    }
+}
+
 /* ------------------------------------------------------------------ real meshes */
 
 typedef struct {
@@ -1069,6 +1189,7 @@ int main(void)
     RUN(test_bad_primitives);
     RUN(test_flat_on_split_planes);
     RUN(test_deterministic);
+    RUN(test_pinned_trees);
     RUN(test_real_meshes);
     RUN(test_watertight_mesh);
     scene_clear();

@@ -25,8 +25,10 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
+
+#include "base/timer.h"
+#include "scene/scene.h"
 
 /* Cost factor of a split that leaves one child empty (Wald & Havran's lambda). */
 #ifndef KD_EMPTY_BONUS
@@ -193,6 +195,47 @@ static Aabb triangle_bounds(const Triangle *t)
     return a;
 }
 
+/* Clips the polygon in[0..n) to the side of the plane x_k = bound inside the box (below
+ * it when `upper`, above it otherwise) into res; returns the new vertex count. */
+static int clip_polygon_plane(double (*in)[3], int n, int k, int upper, double bound, double (*res)[3])
+{
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        const double *a = in[i], *b = in[(i + 1) % n];
+        int a_in = upper ? a[k] <= bound : a[k] >= bound;
+        int b_in = upper ? b[k] <= bound : b[k] >= bound;
+        if (a_in) {
+            memcpy(res[m], a, sizeof res[m]);
+            m++;
+        }
+        if (a_in != b_in) {
+            double s = (bound - a[k]) / (b[k] - a[k]);
+            for (int j = 0; j < 3; j++) res[m][j] = a[j] + s * (b[j] - a[j]);
+            res[m][k] = bound;
+            m++;
+        }
+    }
+    return m;
+}
+
+/* Box of the polygon v[0..n), rounded outward to float so that it is conservative. */
+static Aabb polygon_bounds(double (*v)[3], int n)
+{
+    double lo[3], hi[3];
+    for (int j = 0; j < 3; j++) lo[j] = hi[j] = v[0][j];
+    for (int i = 1; i < n; i++)
+        for (int j = 0; j < 3; j++) {
+            lo[j] = fmin(lo[j], v[i][j]);
+            hi[j] = fmax(hi[j], v[i][j]);
+        }
+    Aabb out;
+    for (int j = 0; j < 3; j++) {
+        out.lo[j] = round_down(lo[j]);
+        out.hi[j] = round_up(hi[j]);
+    }
+    return out;
+}
+
 /* Box of the part of triangle t inside box c (Sutherland-Hodgman in double, rounded
  * outward to float so the box is conservative); 0 when nothing is inside. */
 static int clip_triangle(const Triangle *t, const Aabb *c, Aabb *out)
@@ -211,7 +254,7 @@ static int clip_triangle(const Triangle *t, const Aabb *c, Aabb *out)
     for (int plane = 0; plane < 6; plane++) {
         int k = plane >> 1, upper = plane & 1;
         double bound = upper ? c->hi[k] : c->lo[k];
-        double (*in)[3] = buf[cur], (*res)[3] = buf[cur ^ 1];
+        double (*in)[3] = buf[cur];
         int outside = 0;
         for (int i = 0; i < n; i++)
             outside += upper ? in[i][k] > bound : in[i][k] < bound;
@@ -221,36 +264,10 @@ static int clip_triangle(const Triangle *t, const Aabb *c, Aabb *out)
             *out = triangle_bounds(t);
             return box_intersect_with(out, c);
         }
-        int m = 0;
-        for (int i = 0; i < n; i++) {
-            const double *a = in[i], *b = in[(i + 1) % n];
-            int a_in = upper ? a[k] <= bound : a[k] >= bound;
-            int b_in = upper ? b[k] <= bound : b[k] >= bound;
-            if (a_in) {
-                memcpy(res[m], a, sizeof res[m]);
-                m++;
-            }
-            if (a_in != b_in) {
-                double s = (bound - a[k]) / (b[k] - a[k]);
-                for (int j = 0; j < 3; j++) res[m][j] = a[j] + s * (b[j] - a[j]);
-                res[m][k] = bound;
-                m++;
-            }
-        }
-        n = m;
+        n = clip_polygon_plane(in, n, k, upper, bound, buf[cur ^ 1]);
         cur ^= 1;
     }
-    double lo[3], hi[3];
-    for (int j = 0; j < 3; j++) lo[j] = hi[j] = buf[cur][0][j];
-    for (int i = 1; i < n; i++)
-        for (int j = 0; j < 3; j++) {
-            lo[j] = fmin(lo[j], buf[cur][i][j]);
-            hi[j] = fmax(hi[j], buf[cur][i][j]);
-        }
-    for (int j = 0; j < 3; j++) {
-        out->lo[j] = round_down(lo[j]);
-        out->hi[j] = round_up(hi[j]);
-    }
+    *out = polygon_bounds(buf[cur], n);
     return box_intersect_with(out, c);
 }
 
@@ -314,19 +331,13 @@ static void pool_release(Pool *p, PoolMark m)
     p->cur = m.chunk;
 }
 
-/* reserve_*(&array, &capacity, need): grows the array to hold `need` elements
- * (doubling); 0 on success, -1 when out of memory (the array is then unchanged). */
+/* reserve_*(&array, &capacity, need): array_reserve (scene.h: doubling, overflow
+ * checked) with the element type checked; 0 on success, -1 when out of memory (the
+ * array is then unchanged). */
 #define DEFINE_RESERVE(name, T)                                                        \
     static int name(T **ptr, size_t *cap, size_t need)                                 \
     {                                                                                  \
-        if (need <= *cap) return 0;                                                    \
-        size_t n = *cap ? *cap : 256;                                                  \
-        while (n < need) n *= 2;                                                       \
-        T *p = realloc(*ptr, n * sizeof *p);                                           \
-        if (!p) return -1;                                                             \
-        *ptr = p;                                                                      \
-        *cap = n;                                                                      \
-        return 0;                                                                      \
+        return array_reserve((void **)ptr, cap, need, sizeof **ptr);                   \
     }
 
 /* ------------------------------------------------------------------ build state */
@@ -373,6 +384,7 @@ struct Build {
 
     pthread_mutex_t lock;
     pthread_cond_t cond;
+    Worker *workers;  int n_workers;
     Task *queue;  size_t q_head, q_len, q_cap;
     int outstanding;            /* queued + running tasks */
     int failed;
@@ -517,17 +529,20 @@ static int make_leaf_from(Worker *w, const uint *ids, uint count, BNode *node)
     return 0;
 }
 
-/* Splits the node's lists into the children's: on return the right child's lists are
- * at nl->off and the left child's right above them, at the top of the arena. */
-static int split_lists(Worker *w, const NodeLists *nl, const Split *s,
-                       NodeLists *left, NodeLists *right)
+/* The straddling primitives' new events: per child (left, right) and axis, a sorted list
+ * of up to 2 events per straddling primitive. */
+typedef struct { Event *list[2][3]; size_t n[2][3]; } FreshLists;
+
+/* Sets each primitive's side of split s in w->side, counts those wholly on each side in
+ * n_side[2] and lists the straddling ones in w->both; returns how many straddle, or -1
+ * when memory runs out. */
+static long classify_sides(Worker *w, const NodeLists *nl, const Split *s, uint n_side[2])
 {
-    Build *b = w->b;
     int k = s->axis;
     uint32_t pk = float_key(s->pos + 0.0f);
     uint8_t *side = w->side;
 
-    /* Classify by the events of the split axis; a primitive's start precedes its end. */
+    /* By the events of the split axis; a primitive's start precedes its end. */
     const Event *ek = w->arena + nl->off + (k > 0 ? nl->n[0] : 0) + (k > 1 ? nl->n[1] : 0);
     uint8_t in_plane = s->planar_left ? SIDE_LEFT : SIDE_RIGHT;
     for (uint i = 0; i < nl->n[k]; i++) {
@@ -550,58 +565,66 @@ static int split_lists(Worker *w, const NodeLists *nl, const Split *s,
         w->both[n_both] = p;
         n_both += counted & (sd == SIDE_BOTH);
     }
+    n_side[0] = n_left;
+    n_side[1] = n_right;
+    return n_both;
+}
 
-    /* Clip the straddling primitives to each child: 6 fresh lists of up to 2 events
-     * per primitive (left x,y,z then right x,y,z). */
-    Aabb box_l = nl->box, box_r = nl->box;
-    box_l.hi[k] = s->pos;
-    box_r.lo[k] = s->pos;
-    if (reserve_events(&w->fresh, &w->fresh_cap, (size_t)12 * n_both + 1))
-        return -1;
-    Event *fresh[2][3];
-    size_t n_fresh[2][3] = { { 0, 0, 0 }, { 0, 0, 0 } };
+/* Clips the n_both straddling primitives to each child's box and gives each child
+ * their events, sorted; one that reaches into a child is counted in n_side there. */
+static int clip_straddlers(Worker *w, uint n_both, const Aabb child[2], uint n_side[2], FreshLists *f)
+{
+    const Build *b = w->b;
+    if (reserve_events(&w->fresh, &w->fresh_cap, (size_t)12 * n_both + 1)) return -1;
     for (int c = 0; c < 2; c++)
-        for (int j = 0; j < 3; j++) fresh[c][j] = w->fresh + (size_t)(c * 3 + j) * 2 * n_both;
+        for (int j = 0; j < 3; j++) {
+            f->list[c][j] = w->fresh + (size_t)(c * 3 + j) * 2 * n_both;
+            f->n[c][j] = 0;
+        }
     for (uint i = 0; i < n_both; i++) {
         uint p = w->both[i];
         for (int c = 0; c < 2; c++) {
-            const Aabb *cb = c ? &box_r : &box_l;
             Aabb clipped = b->bounds[p];
-            int inside = b->tri[p] != NO_INDEX ? clip_triangle(&b->triangles[b->tri[p]], cb, &clipped)
-                                               : box_intersect_with(&clipped, cb);
+            int inside = b->tri[p] != NO_INDEX ? clip_triangle(&b->triangles[b->tri[p]], &child[c], &clipped)
+                                               : box_intersect_with(&clipped, &child[c]);
             if (!inside) continue;
-            if (c) n_right++;
-            else n_left++;
+            n_side[c]++;
             for (int j = 0; j < 3; j++)
-                n_fresh[c][j] += events_emit(fresh[c][j] + n_fresh[c][j], &clipped, j, p);
+                f->n[c][j] += events_emit(f->list[c][j] + f->n[c][j], &clipped, j, p);
         }
     }
     size_t most = 0;
     for (int c = 0; c < 2; c++)
-        for (int j = 0; j < 3; j++) most = n_fresh[c][j] > most ? n_fresh[c][j] : most;
+        for (int j = 0; j < 3; j++) most = f->n[c][j] > most ? f->n[c][j] : most;
     if (reserve_events(&w->sort_tmp, &w->sort_tmp_cap, most + 1)) return -1;
     for (int c = 0; c < 2; c++)
-        for (int j = 0; j < 3; j++) events_sort(fresh[c][j], w->sort_tmp, w->radix_count, n_fresh[c][j]);
+        for (int j = 0; j < 3; j++) events_sort(f->list[c][j], w->sort_tmp, w->radix_count, f->n[c][j]);
+    return 0;
+}
 
-    /* Write the children's lists above the node's, right child first, each axis in
-     * one pass that keeps every event for both children (writing both is cheaper
-     * than branching) and merges in the fresh events in order. Each list gets room
-     * for all of the node's events of its axis plus its fresh ones. */
+/* Writes the children's lists above the top of the arena, right child first, each axis
+ * in one pass that keeps every event for both children (writing both is cheaper than
+ * branching) and merges in the fresh events in order. Each list gets room for all of
+ * the node's events of its axis plus its fresh ones; start and count say where each
+ * list is and how long. */
+static int children_write(Worker *w, const NodeLists *nl, uint n_both, const FreshLists *f,
+                          size_t start[2][3], size_t count[2][3])
+{
     size_t node_size = (size_t)nl->n[0] + nl->n[1] + nl->n[2];
     size_t need = node_size * 2 + 12 * (size_t)n_both + 1;
     if (reserve_events(&w->arena, &w->arena_cap, w->top + need)) return -1;
+    const uint8_t *side = w->side;
     const Event *src = w->arena + nl->off;
-    size_t start[2][3], count[2][3];
     size_t room = w->top;
     for (int c = 1; c >= 0; c--)
         for (int j = 0; j < 3; j++) {
             start[c][j] = room;
-            room += nl->n[j] + n_fresh[c][j];
+            room += nl->n[j] + f->n[c][j];
         }
     for (int j = 0; j < 3; j++) {
         Event *dl = w->arena + start[0][j], *dr = w->arena + start[1][j];
-        const Event *fl = fresh[0][j], *fr = fresh[1][j];
-        size_t nfl = n_fresh[0][j], nfr = n_fresh[1][j], il = 0, ir = 0, ml = 0, mr = 0;
+        const Event *fl = f->list[0][j], *fr = f->list[1][j];
+        size_t nfl = f->n[0][j], nfr = f->n[1][j], il = 0, ir = 0, ml = 0, mr = 0;
         for (uint i = 0; i < nl->n[j]; i++) {
             Event e = src[i];
             uint8_t sd = side[event_prim(e)];
@@ -618,8 +641,16 @@ static int split_lists(Worker *w, const NodeLists *nl, const Split *s,
         count[1][j] = mr;
         src += nl->n[j];
     }
-    /* Destination ranges come in the same order as the sources, and each ends before
-     * the next source begins (the sources have room for at least their events). */
+    return 0;
+}
+
+/* Moves the children's lists down over the node's, right child first, and sets their
+ * offsets and lengths. Destination ranges come in the same order as the sources, and
+ * each ends before the next source begins (the sources have room for at least their
+ * events). */
+static void children_move_down(Worker *w, const NodeLists *nl, size_t start[2][3], size_t count[2][3],
+                               NodeLists *left, NodeLists *right)
+{
     size_t dst = nl->off;
     for (int c = 1; c >= 0; c--)
         for (int j = 0; j < 3; j++) {
@@ -632,11 +663,30 @@ static int split_lists(Worker *w, const NodeLists *nl, const Split *s,
         right->n[j] = (uint)count[1][j];
         left->n[j] = (uint)count[0][j];
     }
-    right->nprims = n_right;
-    left->nprims = n_left;
-    right->box = box_r;
-    left->box = box_l;
     w->top = dst;
+}
+
+/* Splits the node's lists into the children's: on return the right child's lists are
+ * at nl->off and the left child's right above them, at the top of the arena. Primitives
+ * that straddle the split are clipped to each child's box. */
+static int split_lists(Worker *w, const NodeLists *nl, const Split *s,
+                       NodeLists *left, NodeLists *right)
+{
+    uint n_side[2];
+    long n_both = classify_sides(w, nl, s, n_side);
+    if (n_both < 0) return -1;
+    Aabb child[2] = { nl->box, nl->box };
+    child[0].hi[s->axis] = s->pos;
+    child[1].lo[s->axis] = s->pos;
+    FreshLists fresh;
+    if (clip_straddlers(w, (uint)n_both, child, n_side, &fresh)) return -1;
+    size_t start[2][3], count[2][3];
+    if (children_write(w, nl, (uint)n_both, &fresh, start, count)) return -1;
+    children_move_down(w, nl, start, count, left, right);
+    left->nprims = n_side[0];
+    right->nprims = n_side[1];
+    left->box = child[0];
+    right->box = child[1];
     return 0;
 }
 
@@ -665,6 +715,45 @@ static int task_push(Worker *w, const NodeLists *nl, int depth, int bad, BNode *
     return 0;
 }
 
+/* The cheapest plane of the node over the three axes (axis -1 when it is not to be
+ * split: no primitive, too deep, or a box without area). */
+static Split best_split(const Worker *w, const NodeLists *nl, double sa, int depth)
+{
+    Split best = { -1, 0.0f, 0, INFINITY };
+    if (nl->nprims == 0 || depth >= w->b->max_depth || !(sa > 0.0)) return best;
+    const Event *e = w->arena + nl->off;
+    for (int k = 0; k < 3; k++) {
+        if (nl->box.hi[k] > nl->box.lo[k]) sweep_axis(e, nl->n[k], nl->nprims, k, &nl->box, 1.0 / sa, &best);
+        e += nl->n[k];
+    }
+    return best;
+}
+
+static void make_interior(BNode *node, const Split *s)
+{
+    node->axis = (uint)s->axis;
+    node->split = s->pos;
+    node->count = 0;
+    node->ids = NULL;
+    node->child[0] = node->child[1] = NULL;
+}
+
+static int build_node(Worker *w, NodeLists nl, int depth, int bad, int tentative,
+                      BNode **out, double *cost);
+
+/* Hands the right child to another thread and builds the left one here: the right
+ * child's lists are copied out, so the left child's move down over the node's. */
+static int build_left_hand_off_right(Worker *w, size_t node_off, NodeLists left, const NodeLists *right,
+                                     int depth, int bad, BNode *node, double *cost_l)
+{
+    if (task_push(w, right, depth, bad, &node->child[1])) return -1;
+    size_t n = (size_t)left.n[0] + left.n[1] + left.n[2];
+    memmove(w->arena + node_off, w->arena + left.off, n * sizeof *w->arena);
+    left.off = node_off;
+    w->top = node_off + n;
+    return build_node(w, left, depth, bad, 0, &node->child[0], cost_l);
+}
+
 /* Builds the subtree of the node whose lists are at the top of the arena and stores it
  * in *out. *cost gets the subtree's cost (with the empty bonus, in absolute area units)
  * when `tentative`; subtrees handed to other threads are built only outside tentative
@@ -672,7 +761,6 @@ static int task_push(Worker *w, const NodeLists *nl, int depth, int bad, BNode *
 static int build_node(Worker *w, NodeLists nl, int depth, int bad, int tentative,
                       BNode **out, double *cost)
 {
-    Build *b = w->b;
     BNode *node = pool_alloc(&w->nodes, sizeof *node);
     if (!node) return -1;
     *out = node;
@@ -680,14 +768,7 @@ static int build_node(Worker *w, NodeLists nl, int depth, int bad, int tentative
     double leaf_cost = kd_leaf_cost(nl.nprims);
     *cost = leaf_cost * sa;
 
-    Split best = { -1, 0.0f, 0, INFINITY };
-    if (nl.nprims > 0 && depth < b->max_depth && sa > 0.0) {
-        const Event *e = w->arena + nl.off;
-        for (int k = 0; k < 3; k++) {
-            if (nl.box.hi[k] > nl.box.lo[k]) sweep_axis(e, nl.n[k], nl.nprims, k, &nl.box, 1.0 / sa, &best);
-            e += nl.n[k];
-        }
-    }
+    Split best = best_split(w, &nl, sa, depth);
     int improves = best.axis >= 0 && best.cost < leaf_cost;
     if (best.axis < 0 || (!improves && bad >= KD_MAX_BAD_REFINES)) return make_leaf(w, &nl, node);
 
@@ -705,23 +786,12 @@ static int build_node(Worker *w, NodeLists nl, int depth, int bad, int tentative
 
     NodeLists left, right;
     if (split_lists(w, &nl, &best, &left, &right)) return -1;
-    node->axis = (uint)best.axis;
-    node->split = best.pos;
-    node->count = 0;
-    node->ids = NULL;
-    node->child[0] = node->child[1] = NULL;
+    make_interior(node, &best);
     int child_bad = improves ? 0 : bad + 1;
     double cost_l = 0.0, cost_r = 0.0;
 
-    if (!tentative && b->threads > 1 && right.nprims >= KD_TASK_MIN_PRIMS) {
-        if (task_push(w, &right, depth + 1, child_bad, &node->child[1])) return -1;
-        /* The right child's lists are copied out: move the left child's down. */
-        size_t n = (size_t)left.n[0] + left.n[1] + left.n[2];
-        memmove(w->arena + nl.off, w->arena + left.off, n * sizeof *w->arena);
-        left.off = nl.off;
-        w->top = nl.off + n;
-        return build_node(w, left, depth + 1, child_bad, 0, &node->child[0], &cost_l);
-    }
+    if (!tentative && w->b->threads > 1 && right.nprims >= KD_TASK_MIN_PRIMS)
+        return build_left_hand_off_right(w, nl.off, left, &right, depth + 1, child_bad, node, &cost_l);
     if (build_node(w, left, depth + 1, child_bad, tentative, &node->child[0], &cost_l)) return -1;
     w->top = right.off + right.n[0] + right.n[1] + right.n[2];
     if (build_node(w, right, depth + 1, child_bad, tentative, &node->child[1], &cost_r)) return -1;
@@ -826,6 +896,16 @@ static Aabb box_bounds(const Box *bx)
     return a;
 }
 
+/* Appends primitive `gid` (triangle `tri`, or NO_INDEX) with bounds a, unless they are
+ * not `finite`. */
+static void gather_one(Build *b, uint gid, uint tri, const Aabb *a, int finite)
+{
+    if (!finite) return;
+    b->gid[b->n_prims] = gid;
+    b->tri[b->n_prims] = tri;
+    b->bounds[b->n_prims++] = *a;
+}
+
 /* Collects the primitives (global ids, bounds). A primitive whose bounds are not
  * finite (a NaN or inf coordinate or radius) is left out of the tree, and so can never
  * be hit: no finite ray could hit it meaningfully, and one infinite box would make
@@ -841,42 +921,23 @@ static Status gather(Build *b, const KdInput *in, uint *skipped, Error *err)
     b->bounds = malloc((total + 1) * sizeof *b->bounds);
     if (!b->gid || !b->tri || !b->bounds)
         return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu primitives", total);
-    uint n = 0, gid = 0;
+    uint gid = 0;
+    b->n_prims = 0;
     for (size_t i = 0; i < in->n_spheres; i++, gid++) {
         Aabb a = sphere_bounds(&in->spheres[i]);
-        if (!aabb_finite(&a)) continue;
-        b->gid[n] = gid; b->tri[n] = NO_INDEX; b->bounds[n++] = a;
+        gather_one(b, gid, NO_INDEX, &a, aabb_finite(&a));
     }
     for (size_t i = 0; i < in->n_triangles; i++, gid++) {
         Aabb a = triangle_bounds(&in->triangles[i]);
-        if (!triangle_finite(&in->triangles[i])) continue;
-        b->gid[n] = gid; b->tri[n] = (uint)i; b->bounds[n++] = a;
+        gather_one(b, gid, (uint)i, &a, triangle_finite(&in->triangles[i]));
     }
     for (size_t i = 0; i < in->n_boxes; i++, gid++) {
         Aabb a = box_bounds(&in->boxes[i]);
-        if (!aabb_finite(&a)) continue;
-        b->gid[n] = gid; b->tri[n] = NO_INDEX; b->bounds[n++] = a;
+        gather_one(b, gid, NO_INDEX, &a, aabb_finite(&a));
     }
-    b->n_prims = n;
-    *skipped = (uint)(total - n);
+    *skipped = (uint)(total - b->n_prims);
     b->triangles = in->triangles;
     return ST_OK;
-}
-
-typedef struct { Build *b; Event *lists; size_t n[3]; int k; int failed; } SortJob;
-
-static void *sort_job(void *arg)
-{
-    SortJob *j = arg;
-    size_t off = 0;
-    for (int k = 0; k < j->k; k++) off += j->n[k];
-    Event *tmp = malloc(j->n[j->k] * sizeof *tmp + 1);
-    size_t *count = malloc(RADIX_BUCKETS * sizeof *count);
-    if (tmp && count) events_sort(j->lists + off, tmp, count, j->n[j->k]);
-    else j->failed = 1;
-    free(tmp);
-    free(count);
-    return NULL;
 }
 
 /* ------------------------------------------------------------------ flatten */
@@ -941,23 +1002,27 @@ static void leaf_write(const BNode *n, const KdInput *in, uint *out)
     }
 }
 
-static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in, KdTree *t, Error *err)
+/* Nodes and words of leaf data of the tree below root, to allocate them exactly. */
+static void flat_size(const BNode *root, const KdInput *in, size_t *n_nodes, size_t *n_words)
 {
-    /* Count first, to allocate exactly. Depth-first, "below" child first. */
-    size_t n_nodes = 0, n_words = 0;
     const BNode *stack[KD_MAX_DEPTH + 2];
     int sp = 0;
     stack[sp++] = root;
+    *n_nodes = *n_words = 0;
     while (sp) {
         const BNode *n = stack[--sp];
-        n_nodes++;
+        ++*n_nodes;
         if (n->axis == KD_LEAF) {
-            n_words += leaf_words(n, in);
+            *n_words += leaf_words(n, in);
         } else {
             stack[sp++] = n->child[1];
             stack[sp++] = n->child[0];
         }
     }
+}
+
+static Status flat_alloc(KdTree *t, size_t n_nodes, size_t n_words, Error *err)
+{
     if (n_nodes > (UINT32_MAX >> 4) || n_words > UINT32_MAX - 1)
         return error_set(err, ST_INTERNAL, "kd-tree: %zu nodes and %zu words of leaf data do not fit the node layout",
                          n_nodes, n_words);
@@ -968,60 +1033,96 @@ static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in
     t->leaf_prims = aligned_alloc(64, leaf_bytes);
     if (!t->nodes || !t->leaf_prims)
         return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu nodes", n_nodes);
+    return ST_OK;
+}
 
-    KdStats *st = &t->stats;
+/* The flat arrays being written, and the sums behind the statistics. */
+typedef struct {
+    KdTree *t;
+    const KdInput *in;
+    size_t refs, groups;        /* leaf references, groups of triangles */
+    uint words;                 /* leaf data written so far */
+} Flat;
+
+/* Writes leaf node `me` and its record; rel: its box's area relative to the root's. */
+static void flat_leaf(Flat *f, const FlatItem *it, uint me, double rel)
+{
+    const BNode *n = it->node;
+    KdStats *st = &f->t->stats;
+    st->n_leaves++;
+    if (n->count == 0) st->n_empty_leaves++;
+    f->refs += n->count;
+    st->sah_cost += kd_leaf_cost(n->count) * rel;
+    st->sah_cost_bonus += kd_leaf_cost(n->count) * rel * it->scale;
+    uint first, nt;
+    leaf_split_ids(n, f->in, &first, &nt);
+    uint ng = (nt + KD_GROUP - 1) / KD_GROUP;
+    f->groups += ng;
+    f->t->nodes[me].bits = KD_LEAF | (n->count > nt ? KD_LEAF_OTHERS : 0u) | (ng << 3);
+    f->t->nodes[me].data = n->count ? f->words : 0u;
+    if (n->count) leaf_write(n, f->in, f->t->leaf_prims + f->words);
+    f->words += (uint)leaf_words(n, f->in);
+}
+
+/* Writes interior node `me` (its above child's index is added when that is reached)
+ * and pushes its children, below on top, onto items. */
+static void flat_interior(Flat *f, const FlatItem *it, uint me, double rel, FlatItem *items, int *ip)
+{
+    const BNode *n = it->node;
+    KdStats *st = &f->t->stats;
+    int empty_below = leaf_is_empty(n->child[0]), empty_above = leaf_is_empty(n->child[1]);
+    double scale = it->scale * (empty_below || empty_above ? KD_EMPTY_BONUS : 1.0);
+    st->sah_cost += KD_COST_TRAVERSAL * rel;
+    st->sah_cost_bonus += KD_COST_TRAVERSAL * rel * scale;
+    uint split_bits;
+    memcpy(&split_bits, &n->split, sizeof split_bits);
+    f->t->nodes[me].data = split_bits;
+    f->t->nodes[me].bits = n->axis | (empty_below ? KD_EMPTY_BELOW : 0u) | (empty_above ? KD_EMPTY_ABOVE : 0u);
+    FlatItem above = { n->child[1], me, it->depth + 1, it->box, scale };
+    FlatItem below = { n->child[0], NO_INDEX, it->depth + 1, it->box, scale };
+    above.box.lo[n->axis] = n->split;
+    below.box.hi[n->axis] = n->split;
+    items[(*ip)++] = above;
+    items[(*ip)++] = below;
+}
+
+static void flat_stats_finish(Flat *f)
+{
+    KdStats *st = &f->t->stats;
+    st->n_nodes = f->t->n_nodes;
+    uint full = st->n_leaves - st->n_empty_leaves;
+    st->mean_prims_per_leaf = full ? (double)f->refs / full : 0.0;
+    st->bytes = (size_t)f->t->n_nodes * sizeof(KdNode) + (size_t)f->words * sizeof(uint);
+    st->bytes_corners = f->groups * KD_GROUP * 9 * sizeof(float);
+}
+
+/* Writes the tree into t's node and leaf arrays in depth-first order, the below child
+ * first, and sums the statistics on the way. */
+static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in, KdTree *t, Error *err)
+{
+    size_t n_nodes, n_words;
+    flat_size(root, in, &n_nodes, &n_words);
+    Status s = flat_alloc(t, n_nodes, n_words, err);
+    if (s != ST_OK) return s;
+
+    Flat f = { t, in, 0, 0, 0 };
     double inv_root = box_half_area(root_box) > 0.0 ? 1.0 / box_half_area(root_box) : 0.0;
-    size_t refs = 0, groups = 0;
-    uint idx = 0, words = 0;
+    uint idx = 0;
     FlatItem items[KD_MAX_DEPTH + 2];
     int ip = 0;
     items[ip++] = (FlatItem){ root, NO_INDEX, 0, *root_box, 1.0 };
     while (ip) {
         FlatItem it = items[--ip];
-        const BNode *n = it.node;
         uint me = idx++;
         if (it.parent != NO_INDEX) t->nodes[it.parent].bits |= me << 4;
-        if ((uint)it.depth > st->max_depth) st->max_depth = (uint)it.depth;
+        if ((uint)it.depth > t->stats.max_depth) t->stats.max_depth = (uint)it.depth;
         double rel = inv_root > 0.0 ? box_half_area(&it.box) * inv_root : 1.0;
-        if (n->axis == KD_LEAF) {
-            st->n_leaves++;
-            if (n->count == 0) st->n_empty_leaves++;
-            refs += n->count;
-            st->sah_cost += kd_leaf_cost(n->count) * rel;
-            st->sah_cost_bonus += kd_leaf_cost(n->count) * rel * it.scale;
-            uint first, nt;
-            leaf_split_ids(n, in, &first, &nt);
-            uint ng = (nt + KD_GROUP - 1) / KD_GROUP;
-            groups += ng;
-            t->nodes[me].bits = KD_LEAF | (n->count > nt ? KD_LEAF_OTHERS : 0u) | (ng << 3);
-            t->nodes[me].data = n->count ? words : 0u;
-            if (n->count) leaf_write(n, in, t->leaf_prims + words);
-            words += (uint)leaf_words(n, in);
-            continue;
-        }
-        double scale = it.scale * (leaf_is_empty(n->child[0]) || leaf_is_empty(n->child[1]) ? KD_EMPTY_BONUS : 1.0);
-        st->sah_cost += KD_COST_TRAVERSAL * rel;
-        st->sah_cost_bonus += KD_COST_TRAVERSAL * rel * scale;
-        uint split_bits;
-        memcpy(&split_bits, &n->split, sizeof split_bits);
-        t->nodes[me].data = split_bits;
-        /* the above child's index is added when reached */
-        t->nodes[me].bits = n->axis | (leaf_is_empty(n->child[0]) ? KD_EMPTY_BELOW : 0u) |
-                            (leaf_is_empty(n->child[1]) ? KD_EMPTY_ABOVE : 0u);
-        FlatItem above = { n->child[1], me, it.depth + 1, it.box, scale };
-        FlatItem below = { n->child[0], NO_INDEX, it.depth + 1, it.box, scale };
-        above.box.lo[n->axis] = n->split;
-        below.box.hi[n->axis] = n->split;
-        items[ip++] = above;
-        items[ip++] = below;
+        if (it.node->axis == KD_LEAF) flat_leaf(&f, &it, me, rel);
+        else flat_interior(&f, &it, me, rel, items, &ip);
     }
     t->n_nodes = idx;
-    t->n_leaf_prims = words;
-    st->n_nodes = idx;
-    uint full = st->n_leaves - st->n_empty_leaves;
-    st->mean_prims_per_leaf = full ? (double)refs / full : 0.0;
-    st->bytes = (size_t)idx * sizeof(KdNode) + (size_t)words * sizeof(uint);
-    st->bytes_corners = groups * KD_GROUP * 9 * sizeof(float);
+    t->n_leaf_prims = f.words;
+    flat_stats_finish(&f);
     return ST_OK;
 }
 
@@ -1043,17 +1144,28 @@ uint kd_leaf_ids(const KdTree *t, uint node, uint *out, uint cap)
 
 /* ------------------------------------------------------------------ entry points */
 
-static double now_seconds(void)
+/* threads <= 0 means every core; more than 256 would only add idle workers. */
+static int threads_resolve(int threads)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    if (threads <= 0) {
+        long n = sysconf(_SC_NPROCESSORS_ONLN);
+        threads = n > 0 ? (int)n : 1;
+    }
+    return threads > 256 ? 256 : threads;
 }
 
-static void build_free(Build *b, Worker *w, int n_workers)
+static void build_init(Build *b, int threads)
 {
-    for (int i = 0; i < n_workers; i++) worker_free(&w[i]);
-    free(w);
+    memset(b, 0, sizeof *b);
+    pthread_mutex_init(&b->lock, NULL);
+    pthread_cond_init(&b->cond, NULL);
+    b->threads = threads;
+}
+
+static void build_free(Build *b)
+{
+    for (int i = 0; i < b->n_workers; i++) worker_free(&b->workers[i]);
+    free(b->workers);
     for (size_t i = 0; i < b->q_len; i++) free(b->queue[b->q_head + i].lists);
     free(b->queue);
     free(b->gid);
@@ -1063,14 +1175,149 @@ static void build_free(Build *b, Worker *w, int n_workers)
     pthread_cond_destroy(&b->cond);
 }
 
+static Aabb root_box(const Build *b)
+{
+    Aabb root = b->bounds[0];
+    for (uint i = 1; i < b->n_prims; i++)
+        for (int k = 0; k < 3; k++) {
+            root.lo[k] = fminf(root.lo[k], b->bounds[i].lo[k]);
+            root.hi[k] = fmaxf(root.hi[k], b->bounds[i].hi[k]);
+        }
+    return root;
+}
+
+/* Deepest level a node may be split at: round(8 + 1.3 floor(log2 N)), as in pbrt
+ * (docs/kdtree.md). */
+static int depth_limit(uint n_prims)
+{
+    int log2n = 0;
+    while ((2u << log2n) <= n_prims && log2n < 31) log2n++;
+    int d = (int)lround(8.0 + 1.3 * log2n);
+    return d > KD_MAX_DEPTH - 1 ? KD_MAX_DEPTH - 1 : d;
+}
+
+/* One worker per thread, each with its own side array and radix counters. */
+static Status workers_create(Build *b, Error *err)
+{
+    b->workers = calloc((size_t)b->threads, sizeof *b->workers);
+    if (!b->workers) return error_set(err, ST_INTERNAL, "kd-tree: out of memory");
+    b->n_workers = b->threads;
+    for (int i = 0; i < b->threads; i++) {
+        Worker *w = &b->workers[i];
+        w->b = b;
+        w->side = malloc(b->n_prims);
+        w->radix_count = malloc(RADIX_BUCKETS * sizeof *w->radix_count);
+        if (!w->side || !w->radix_count) return error_set(err, ST_INTERNAL, "kd-tree: out of memory");
+    }
+    return ST_OK;
+}
+
+typedef struct { Event *list; size_t n; int failed; } SortJob;
+
+static void *sort_job(void *arg)
+{
+    SortJob *j = arg;
+    Event *tmp = malloc(j->n * sizeof *tmp + 1);
+    size_t *count = malloc(RADIX_BUCKETS * sizeof *count);
+    if (tmp && count) events_sort(j->list, tmp, count, j->n);
+    else j->failed = 1;
+    free(tmp);
+    free(count);
+    return NULL;
+}
+
+/* Sorts the three lists of ev (n[k] events each, back to back), two of them on threads
+ * of their own when there are threads to spare. */
+static Status events_sort_axes(Event *ev, const size_t n[3], int threads, Error *err)
+{
+    SortJob jobs[3];
+    pthread_t tid[3];
+    int started[3] = { 0, 0, 0 };
+    for (int k = 0; k < 3; k++) {
+        jobs[k] = (SortJob){ ev, n[k], 0 };
+        ev += n[k];
+        if (k < threads - 1 && k < 2 && pthread_create(&tid[k], NULL, sort_job, &jobs[k]) == 0)
+            started[k] = 1;
+        else
+            sort_job(&jobs[k]);
+    }
+    for (int k = 0; k < 3; k++)
+        if (started[k]) pthread_join(tid[k], NULL);
+    if (jobs[0].failed || jobs[1].failed || jobs[2].failed)
+        return error_set(err, ST_INTERNAL, "kd-tree: out of memory sorting events");
+    return ST_OK;
+}
+
+/* The root's sorted event lists, at the bottom of worker 0's arena, described by *nl.
+ * The arena gets room for three times the root's events: the children's lists are
+ * written above their parent's. */
+static Status root_events(Build *b, const Aabb *root, NodeLists *nl, Error *err)
+{
+    Worker *w = &b->workers[0];
+    size_t n_ev[3] = { 0, 0, 0 };
+    for (uint i = 0; i < b->n_prims; i++)
+        for (int k = 0; k < 3; k++) n_ev[k] += b->bounds[i].lo[k] == b->bounds[i].hi[k] ? 1 : 2;
+    size_t total_ev = n_ev[0] + n_ev[1] + n_ev[2];
+    if (reserve_events(&w->arena, &w->arena_cap, total_ev * 3 + 1))
+        return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu events", total_ev);
+    Event *ev = w->arena;
+    size_t pos[3] = { 0, n_ev[0], n_ev[0] + n_ev[1] };
+    for (uint i = 0; i < b->n_prims; i++)
+        for (int k = 0; k < 3; k++) pos[k] += events_emit(ev + pos[k], &b->bounds[i], k, i);
+    Status st = events_sort_axes(ev, n_ev, b->threads, err);
+    if (st != ST_OK) return st;
+    w->top = total_ev;
+    *nl = (NodeLists){ 0, { (uint)n_ev[0], (uint)n_ev[1], (uint)n_ev[2] }, b->n_prims, *root };
+    return ST_OK;
+}
+
+/* Builds the tree below the root: worker 0 (this thread) starts at the root and the
+ * other workers wait for the subtrees it hands out; all return when none is left. */
+static Status subtrees_build(Build *b, NodeLists root, BNode **out, Error *err)
+{
+    pthread_t *tid = calloc((size_t)b->threads, sizeof *tid);
+    if (!tid) return error_set(err, ST_INTERNAL, "kd-tree: out of memory");
+    b->outstanding = 1;
+    int n_started = 0;
+    for (int i = 1; i < b->threads; i++)
+        if (pthread_create(&tid[i], NULL, worker_thread, &b->workers[i]) == 0) n_started = i;
+        else break;
+    if (n_started == 0) b->threads = 1;
+    double cost;
+    if (build_node(&b->workers[0], root, 0, 0, 0, out, &cost)) build_fail(b);
+    pthread_mutex_lock(&b->lock);
+    if (--b->outstanding == 0) pthread_cond_broadcast(&b->cond);
+    pthread_mutex_unlock(&b->lock);
+    worker_run(&b->workers[0]);
+    for (int i = 1; i <= n_started; i++) pthread_join(tid[i], NULL);
+    free(tid);
+    if (build_failed(b)) return error_set(err, ST_INTERNAL, "kd-tree: out of memory building the tree");
+    return ST_OK;
+}
+
+/* The tree over the gathered primitives (at least one). */
+static Status build_tree(Build *b, const KdInput *in, KdTree *out, Error *err)
+{
+    Aabb root = root_box(b);
+    b->max_depth = depth_limit(b->n_prims);
+    NodeLists nl;
+    BNode *root_node = NULL;
+    Status st;
+    if ((st = workers_create(b, err))) return st;
+    if ((st = root_events(b, &root, &nl, err))) return st;
+    if ((st = subtrees_build(b, nl, &root_node, err))) return st;
+    if ((st = flatten(root_node, &root, in, out, err))) return st;
+    out->lo = (vec3){ root.lo[0], root.lo[1], root.lo[2] };
+    out->hi = (vec3){ root.hi[0], root.hi[1], root.hi[2] };
+    out->stats.leaf_sah_cost = kd_leaf_cost(b->n_prims);
+    return ST_OK;
+}
+
 static Status build_single_leaf(KdTree *out, Error *err)
 {
     out->nodes = malloc(sizeof *out->nodes);
     out->leaf_prims = malloc(sizeof *out->leaf_prims);
-    if (!out->nodes || !out->leaf_prims) {
-        kd_free(out);
-        return error_set(err, ST_INTERNAL, "kd-tree: out of memory");
-    }
+    if (!out->nodes || !out->leaf_prims) return error_set(err, ST_INTERNAL, "kd-tree: out of memory");
     out->nodes[0].data = 0;
     out->nodes[0].bits = KD_LEAF;
     out->n_nodes = 1;
@@ -1082,124 +1329,22 @@ static Status build_single_leaf(KdTree *out, Error *err)
     return ST_OK;
 }
 
+/* Gathers the primitives' bounds, builds the tree (or a single empty leaf when no
+ * primitive is left), flattens it and fills in the statistics. */
 Status kd_build(const KdInput *in, int threads, KdTree *out, Error *err)
 {
-    double t_start = now_seconds();
+    double t_start = timer_now();
     memset(out, 0, sizeof *out);
-    if (threads <= 0) {
-        long n = sysconf(_SC_NPROCESSORS_ONLN);
-        threads = n > 0 ? (int)n : 1;
-    }
-    if (threads > 256) threads = 256;
-
     Build b;
-    memset(&b, 0, sizeof b);
-    pthread_mutex_init(&b.lock, NULL);
-    pthread_cond_init(&b.cond, NULL);
-    Worker *w = NULL;
-    int n_workers = 0;
-    uint skipped = 0;
-    Status st = gather(&b, in, &skipped, err);
-    if (st != ST_OK) goto fail;
-    out->stats.n_skipped = skipped;
-    out->stats.n_prims = b.n_prims;
-    if (b.n_prims == 0) {
-        st = build_single_leaf(out, err);
-        out->stats.n_skipped = skipped;
-        build_free(&b, w, 0);
-        out->stats.build_seconds = now_seconds() - t_start;
-        return st;
+    build_init(&b, threads_resolve(threads));
+    Status st = gather(&b, in, &out->stats.n_skipped, err);
+    if (st == ST_OK) {
+        out->stats.n_prims = b.n_prims;
+        st = b.n_prims == 0 ? build_single_leaf(out, err) : build_tree(&b, in, out, err);
     }
-
-    Aabb root = b.bounds[0];
-    for (uint i = 1; i < b.n_prims; i++)
-        for (int k = 0; k < 3; k++) {
-            root.lo[k] = fminf(root.lo[k], b.bounds[i].lo[k]);
-            root.hi[k] = fmaxf(root.hi[k], b.bounds[i].hi[k]);
-        }
-    int log2n = 0;
-    while ((2u << log2n) <= b.n_prims && log2n < 31) log2n++;
-    b.max_depth = (int)lround(8.0 + 1.3 * log2n);
-    if (b.max_depth > KD_MAX_DEPTH - 1) b.max_depth = KD_MAX_DEPTH - 1;
-    b.threads = threads;
-
-    w = calloc((size_t)threads, sizeof *w);
-    if (!w) { st = error_set(err, ST_INTERNAL, "kd-tree: out of memory"); goto fail; }
-    n_workers = threads;
-    for (int i = 0; i < threads; i++) {
-        w[i].b = &b;
-        w[i].side = malloc(b.n_prims);
-        w[i].radix_count = malloc(RADIX_BUCKETS * sizeof *w[i].radix_count);
-        if (!w[i].side || !w[i].radix_count) { st = error_set(err, ST_INTERNAL, "kd-tree: out of memory"); goto fail; }
-    }
-
-    /* The root's events, sorted per axis (the axes in parallel). */
-    size_t n_ev[3] = { 0, 0, 0 };
-    for (uint i = 0; i < b.n_prims; i++)
-        for (int k = 0; k < 3; k++) n_ev[k] += b.bounds[i].lo[k] == b.bounds[i].hi[k] ? 1 : 2;
-    size_t total_ev = n_ev[0] + n_ev[1] + n_ev[2];
-    if (reserve_events(&w[0].arena, &w[0].arena_cap, total_ev * 3 + 1)) {
-        st = error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu events", total_ev);
-        goto fail;
-    }
-    Event *ev = w[0].arena;
-    size_t pos[3] = { 0, n_ev[0], n_ev[0] + n_ev[1] };
-    for (uint i = 0; i < b.n_prims; i++)
-        for (int k = 0; k < 3; k++) pos[k] += events_emit(ev + pos[k], &b.bounds[i], k, i);
-    SortJob jobs[3];
-    pthread_t tid[3];
-    int started[3] = { 0, 0, 0 };
-    for (int k = 0; k < 3; k++) {
-        jobs[k] = (SortJob){ &b, ev, { n_ev[0], n_ev[1], n_ev[2] }, k, 0 };
-        if (k < threads - 1 && k < 2 && pthread_create(&tid[k], NULL, sort_job, &jobs[k]) == 0)
-            started[k] = 1;
-        else
-            sort_job(&jobs[k]);
-    }
-    for (int k = 0; k < 3; k++)
-        if (started[k]) pthread_join(tid[k], NULL);
-    if (jobs[0].failed || jobs[1].failed || jobs[2].failed) {
-        st = error_set(err, ST_INTERNAL, "kd-tree: out of memory sorting events");
-        goto fail;
-    }
-    w[0].top = total_ev;
-
-    /* Worker 0 (this thread) builds from the root; the others wait for tasks. */
-    pthread_t *threads_id = calloc((size_t)threads, sizeof *threads_id);
-    if (!threads_id) { st = error_set(err, ST_INTERNAL, "kd-tree: out of memory"); goto fail; }
-    b.outstanding = 1;
-    int n_started = 0;
-    for (int i = 1; i < threads; i++)
-        if (pthread_create(&threads_id[i], NULL, worker_thread, &w[i]) == 0) n_started = i;
-        else break;
-    if (n_started == 0) b.threads = 1;
-    BNode *root_node = NULL;
-    NodeLists nl = { 0, { (uint)n_ev[0], (uint)n_ev[1], (uint)n_ev[2] }, b.n_prims, root };
-    double cost;
-    if (build_node(&w[0], nl, 0, 0, 0, &root_node, &cost)) build_fail(&b);
-    pthread_mutex_lock(&b.lock);
-    if (--b.outstanding == 0) pthread_cond_broadcast(&b.cond);
-    pthread_mutex_unlock(&b.lock);
-    worker_run(&w[0]);
-    for (int i = 1; i <= n_started; i++) pthread_join(threads_id[i], NULL);
-    free(threads_id);
-    if (build_failed(&b)) {
-        st = error_set(err, ST_INTERNAL, "kd-tree: out of memory building the tree");
-        goto fail;
-    }
-
-    st = flatten(root_node, &root, in, out, err);
-    if (st != ST_OK) goto fail;
-    out->lo = (vec3){ root.lo[0], root.lo[1], root.lo[2] };
-    out->hi = (vec3){ root.hi[0], root.hi[1], root.hi[2] };
-    out->stats.leaf_sah_cost = kd_leaf_cost(b.n_prims);
-    build_free(&b, w, n_workers);
-    out->stats.build_seconds = now_seconds() - t_start;
-    return ST_OK;
-
-fail:
-    build_free(&b, w, n_workers);
-    kd_free(out);
+    build_free(&b);
+    if (st != ST_OK) kd_free(out);
+    out->stats.build_seconds = timer_now() - t_start;
     return st;
 }
 

@@ -15,7 +15,7 @@
 #include "render/film.h"
 #include "io/image_write.h"
 #include "base/limit.h"
-#include "io/mesh.h"
+#include "io/mesh_load.h"
 #include "io/mesh_view.h"
 #include "options.h"
 #include "render/passes.h"

@@ -1,4 +1,5 @@
-/* test_mesh.c — what the mesh readers share (host/io/mesh.c): transforms and the sink,
+/* test_mesh.c — what the mesh readers share (host/scene/transform.c, host/scene/mesh_sink.c,
+ * host/io/mesh_load.c, host/io/mesh_text.c): transforms and the sink,
  * case-insensitive paths, the procedural sphere; the mesh block of scene files with its
  * transform keys; a bare mesh shown on its own (host/io/mesh_view.c), in-process and
  * through the command line. */
@@ -6,7 +7,8 @@
 
 #include "cli_util.h"
 #include "kmath.h"
-#include "io/mesh.h"
+#include "io/mesh_load.h"
+#include "io/mesh_text.h"
 #include "io/mesh_view.h"
 
 #include <stdint.h>

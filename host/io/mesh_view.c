@@ -2,7 +2,7 @@
 #include "io/mesh_view.h"
 
 #include "kmath.h"
-#include "io/mesh.h"
+#include "io/mesh_load.h"
 
 #include <math.h>
 #include <stdlib.h>

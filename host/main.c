@@ -10,12 +10,10 @@
 #include <string.h>
 
 #include "render/checkpoint.h"
-#include "io/classic_parse.h"
 #include "device/device.h"
 #include "render/film.h"
 #include "io/image_write.h"
 #include "base/limit.h"
-#include "io/mesh_load.h"
 #include "io/mesh_view.h"
 #include "options.h"
 #include "render/passes.h"
@@ -23,6 +21,7 @@
 #include "render/render_scene.h"
 #include "scene/scene.h"
 #include "render/schedule.h"
+#include "io/scene_load.h"
 #include "base/timer.h"
 
 #define CLPT_VERSION "0.1.0"
@@ -332,16 +331,14 @@ static Status run(int argc, char **argv, Error *err)
     double t_start = timer_now();
 
     if ((st = image_format_from_path(output, &format, err))) goto done;
-    /* a mesh file given in place of a scene is shown in a scene made around it */
-    int bare_mesh = mesh_kind(o.scene_path) != MESH_NONE;
-    if ((st = bare_mesh ? mesh_view_load(o.scene_path, &scene, err)
-                        : scene_load_format(o.scene_path, (SceneFormat)o.format, &scene, err)))
-        goto done;
+    SceneKind kind;
+    if ((st = scene_load_file(o.scene_path, (SceneFormat)o.format, &scene, &kind, err))) goto done;
     apply_overrides(&o, &scene);
     if ((o.width >= 0 || o.height >= 0) &&
         (st = limit_pixels(scene.image.width, scene.image.height, ST_USAGE, "--width/--height", err)))
         goto done;
-    if (bare_mesh) mesh_view_fit(&scene);
+    /* a mesh file given in place of a scene is shown by a camera that frames it */
+    if (kind == SCENE_KIND_MESH && (st = mesh_view_fit(&scene, err))) goto done;
     if (o.adaptive > 0.0 && scene.integrator != INTEGRATOR_WHITTED) {
         st = error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
         goto done;

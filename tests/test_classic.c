@@ -15,6 +15,7 @@
 #include "cli_util.h"
 
 #include "io/classic_parse.h"
+#include "io/scene_load.h"
 #include "kmath.h"
 #include "scene/scene.h"
 
@@ -418,7 +419,7 @@ static void test_detect(void)
     write_file("ours.scene", "camera { from 0 0 5 }\nsphere { center 0 0 0 radius 1 material { type diffuse albedo 1 1 1 } }\n");
     snprintf(path, sizeof path, "%s/ours.scene", dir);
     scene_init(&s);
-    CHECK_EQ_INT(scene_load_format(path, SCENE_FORMAT_AUTO, &s, &err), ST_OK);
+    CHECK_EQ_INT(scene_load_file(path, SCENE_FORMAT_AUTO, &s, NULL, &err), ST_OK);
     CHECK_EQ_INT(s.integrator, INTEGRATOR_PATH);
     CHECK_EQ_INT(s.n_spheres, 1);
     scene_free(&s);
@@ -426,12 +427,12 @@ static void test_detect(void)
                              "Group { numObjects 1 Sphere { center 0 0 0 radius 1 } }\n");
     snprintf(path, sizeof path, "%s/theirs.txt", dir);
     scene_init(&s);
-    CHECK_EQ_INT(scene_load_format(path, SCENE_FORMAT_AUTO, &s, &err), ST_OK);
+    CHECK_EQ_INT(scene_load_file(path, SCENE_FORMAT_AUTO, &s, NULL, &err), ST_OK);
     CHECK_EQ_INT(s.integrator, INTEGRATOR_WHITTED);
     scene_free(&s);
     /* forcing the wrong format is an error of that format */
     scene_init(&s);
-    CHECK_EQ_INT(scene_load_format(path, SCENE_FORMAT_CLPT, &s, &err), ST_INPUT);
+    CHECK_EQ_INT(scene_load_file(path, SCENE_FORMAT_CLPT, &s, NULL, &err), ST_INPUT);
     CHECK_STR_CONTAINS(err.msg, "theirs.txt:2:1: expected a statement");
     scene_free(&s);
     error_clear(&err);
@@ -610,7 +611,7 @@ static void test_shipped_scenes(void)
             Scene s;
             Error err = {0};
             scene_init(&s);
-            Status st = scene_load_format(path, SCENE_FORMAT_AUTO, &s, &err);
+            Status st = scene_load_file(path, SCENE_FORMAT_AUTO, &s, NULL, &err);
             CHECK_MSG(st == ST_OK, "%s: %s", path, err.msg);
             CHECK_EQ_INT(s.integrator, ours ? INTEGRATOR_PATH : INTEGRATOR_WHITTED);
             CHECK(s.n_delta_lights >= 2);

@@ -320,7 +320,7 @@ static void test_mesh_view(void)
     check_framed(&s);
     s.image.width = 100;
     s.image.height = 400;
-    mesh_view_fit(&s);
+    CHECK_EQ_INT(mesh_view_fit(&s, &err), ST_OK);
     check_framed(&s);
     scene_free(&s);
     /* MTL materials are kept */

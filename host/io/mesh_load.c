@@ -26,3 +26,13 @@ Status mesh_load(const char *path, Scene *s, const MeshOptions *o, Error *err)
     }
     return error_set(err, ST_INPUT, "'%s': not a mesh file (expected a name ending in .obj or .ply)", path);
 }
+
+Status mesh_parse(const char *path, const char *data, size_t len, Scene *s, const MeshOptions *o, Error *err)
+{
+    switch (mesh_kind(path)) {
+    case MESH_OBJ: return obj_parse_with(path, data, len, s, o, err);
+    case MESH_PLY: return ply_parse(path, data, len, s, o, err);
+    case MESH_NONE: break;
+    }
+    return error_set(err, ST_INPUT, "'%s': not a mesh file (expected a name ending in .obj or .ply)", path);
+}

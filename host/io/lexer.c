@@ -6,6 +6,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <poll.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,12 +14,17 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static size_t bom_length(const char *text, size_t len);
+/* Some Windows editors start text files with a UTF-8 byte order mark: it is no part of
+ * the text, and left in it would be an invisible first "word". */
+size_t lex_bom_length(const char *text, size_t len)
+{
+    return len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
+}
 
 Status lex_open_text(Lexer *lx, const char *path, const char *text, size_t len, Error *err)
 {
     memset(lx, 0, sizeof *lx);
-    size_t skip = bom_length(text, len);
+    size_t skip = lex_bom_length(text, len);
     text += skip;
     len -= skip;
     size_t plen = strlen(path);
@@ -34,13 +40,6 @@ Status lex_open_text(Lexer *lx, const char *path, const char *text, size_t len, 
     lx->len = len;
     lx->line = 1;
     return ST_OK;
-}
-
-/* A UTF-8 byte order mark, which some Windows editors put at the start of text files:
- * it is no part of the text, and left in it would be an invisible first "word". */
-static size_t bom_length(const char *text, size_t len)
-{
-    return len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
 }
 
 /* Opens path for reading and checks what it is, without blocking: a FIFO is opened with
@@ -68,16 +67,8 @@ static Status open_input(const char *path, int allow_pipe, int *fd_out, struct s
         close(fd);
         return error_set(err, ST_IO, "cannot read '%s': %s", path, what);
     }
-    if (S_ISFIFO(sb->st_mode)) {
-        /* the scene as a FIFO: opened again without O_NONBLOCK, which waits for a writer
-         * as any reader of a FIFO does (a non-blocking read would see end of file) */
-        close(fd);
-        if ((fd = open(path, O_RDONLY | O_CLOEXEC)) < 0)
-            return error_set(err, ST_IO, "cannot open '%s': %s", path, strerror(errno));
-    } else {
-        int flags = fcntl(fd, F_GETFL);
-        if (flags >= 0) fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
-    }
+    int flags = fcntl(fd, F_GETFL);
+    if (flags >= 0) fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
     *fd_out = fd;
     return ST_OK;
 }
@@ -131,6 +122,11 @@ static Status read_whole(const char *path, int allow_pipe, char **data, size_t *
             buf = grown;
             cap *= 2;
         }
+        /* A FIFO opened before its writer reads as ended: poll waits for the writer's
+         * data or its hanging up, as a blocking open would, while this reader keeps the
+         * FIFO (and what a quick writer left in it) open. */
+        struct pollfd pfd = { fd, POLLIN, 0 };
+        if (S_ISFIFO(sb.st_mode) && poll(&pfd, 1, -1) < 0 && errno == EINTR) continue;
         ssize_t got = read(fd, buf + n, cap - 1 - n);
         if (got < 0 && errno == EINTR) continue;
         if (got < 0) {
@@ -143,7 +139,7 @@ static Status read_whole(const char *path, int allow_pipe, char **data, size_t *
         n += (size_t)got;
     }
     close(fd);
-    size_t skip = bom_length(buf, n);
+    size_t skip = lex_bom_length(buf, n);
     if (skip) memmove(buf, buf + skip, n - skip);
     n -= skip;
     buf[n] = '\0';

@@ -68,6 +68,9 @@ Status lex_read_input(const char *path, char **data, size_t *len, Error *err);
  * name (texture images): ST_OK when `path` is a regular file clpt may read. */
 Status lex_check_file(const char *path, Error *err);
 
+/* 3 when text starts with a UTF-8 byte order mark (EF BB BF), else 0. */
+size_t lex_bom_length(const char *text, size_t len);
+
 /* The next token (TOK_EOF at the end, repeatedly). Fails on an unterminated string,
  * an unknown escape or a control character. */
 Status lex_next(Lexer *lx, Token *tok, Error *err);

@@ -22,6 +22,10 @@ SceneKind scene_load_kind(const char *path, const char *text, size_t len, SceneF
 Status scene_load_bytes(const char *path, const char *text, size_t len, SceneFormat format, Scene *s,
                         SceneKind *kind, Error *err)
 {
+    /* dropped here too, for bytes that did not come through lex_read_input */
+    size_t bom = lex_bom_length(text, len);
+    text += bom;
+    len -= bom;
     SceneKind k = scene_load_kind(path, text, len, format);
     if (kind) *kind = k;
     if (k == SCENE_KIND_CLASSIC) return classic_load_text(path, text, len, s, err);

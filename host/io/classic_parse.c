@@ -44,7 +44,7 @@ static vec3 normal_apply(double n[3][3], vec3 v)
 
 /* Whether the linear part is s times an orthogonal matrix (a sphere stays a sphere of
  * radius s*r); *rotates tells whether that orthogonal matrix is not the identity. */
-static int transform_similarity(const Transform *m, double *s, int *rotates)
+static int similarity(const Transform *m, double *s, int *rotates)
 {
     const double (*a)[4] = m->m;
     double g[3][3], trace = 0.0;
@@ -681,7 +681,7 @@ static Status parse_sphere(Classic *c, const Token *kw, const Transform *m)
     double scale;
     int rotates;
     int textured = c->s->materials[material].texture != NO_INDEX;
-    if (!transform_similarity(m, &scale, &rotates) || (rotates && textured))
+    if (!similarity(m, &scale, &rotates) || (rotates && textured))
         return tessellate_sphere(c, center, v[SPH_RADIUS].f, m, material);
     Sphere sp;
     memset(&sp, 0, sizeof sp);

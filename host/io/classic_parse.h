@@ -21,7 +21,8 @@
  * Materials, Group), else 0. */
 int classic_detect(const char *text, size_t len);
 
-/* Reads a classic scene file into an initialised scene. */
+/* Reads a classic scene file (a regular file: io/scene_load.h reads the command line's
+ * input, which may be a pipe) into an initialised scene. */
 Status classic_load(const char *path, Scene *s, Error *err);
 /* The same for `len` bytes of text in memory (copied), named `path` in messages; meshes
  * and textures are still read from disk, beside `path`. */

@@ -14,7 +14,8 @@
  *
  * Lines and columns start at 1; a column counts bytes (a tab is one column).
  * Every error message starts with "path:line:col: " and is an ST_INPUT error, except
- * a file that cannot be read (ST_IO, "cannot open 'path': <reason>").
+ * a file that cannot be read (ST_IO, "cannot open 'path': <reason>", or "cannot read
+ * 'path': ..." when it is not a regular file).
  */
 #ifndef CLPT_LEXER_H
 #define CLPT_LEXER_H

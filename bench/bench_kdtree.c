@@ -3,7 +3,7 @@
  *
  *   bench_kdtree [MESH [threads [rays]]]
  *
- * MESH is a .ply or .obj file (read by host/io/mesh.c), "soup:N" (N random triangles in a
+ * MESH is a .ply or .obj file (read by host/io/mesh_load.c), "soup:N" (N random triangles in a
  * unit cube) or "sphere:N" (the closed bumpy sphere of mesh_make_sphere, about N
  * triangles); without one, the full dragon of ../shared/models (or sphere:1000000 when
  * it is not there). The tree is built with the given threads (0 = all cores, the
@@ -20,7 +20,7 @@
 #include <time.h>
 
 #include "accel/kdtree.h"
-#include "io/mesh.h"
+#include "io/mesh_load.h"
 #include "traverse.cl"
 
 static double now(void)
@@ -55,7 +55,7 @@ static int mesh_add(Mesh *m, vec3 a, vec3 b, vec3 c)
     return 0;
 }
 
-/* An .obj or .ply file through the renderer's readers (host/io/mesh.c). */
+/* An .obj or .ply file through the renderer's readers (host/io/mesh_load.c). */
 static int load_mesh(const char *path, Mesh *m)
 {
     Scene sc;

@@ -44,7 +44,7 @@
 #include <string.h>
 
 #include "accel/kdtree.h"
-#include "io/mesh.h"
+#include "io/mesh_load.h"
 #include "device/ocl_program.h"
 #include "rng.h"
 #include "sampling.h"

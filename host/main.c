@@ -17,13 +17,11 @@
 
 #include "base/atomic_file.h"
 #include "render/checkpoint.h"
-#include "io/classic_parse.h"
 #include "device/device.h"
 #include "device/ocl_program.h"
 #include "render/film.h"
 #include "io/image_write.h"
 #include "base/limit.h"
-#include "io/mesh.h"
 #include "io/mesh_view.h"
 #include "options.h"
 #include "render/passes.h"
@@ -31,6 +29,7 @@
 #include "render/render_scene.h"
 #include "scene/scene.h"
 #include "render/schedule.h"
+#include "io/scene_load.h"
 #include "base/timer.h"
 
 #define CLPT_VERSION "0.1.0"
@@ -503,9 +502,9 @@ static Status outputs_choose(Run *r, Error *err)
  * made around it. */
 static Status load_scene_input(const Options *o, Scene *scene, int *bare_mesh, Error *err)
 {
-    *bare_mesh = mesh_kind(o->scene_path) != MESH_NONE;
-    Status st = *bare_mesh ? mesh_view_load(o->scene_path, scene, err)
-                           : scene_load_format(o->scene_path, (SceneFormat)o->format, scene, err);
+    SceneKind kind = SCENE_KIND_CLPT;
+    Status st = scene_load_file(o->scene_path, (SceneFormat)o->format, scene, &kind, err);
+    *bare_mesh = st == ST_OK && kind == SCENE_KIND_MESH;
     if (st == ST_OK)
         for (size_t i = 0; i < scene->n_warnings; i++) print_warning(NULL, scene->warnings[i]);
     return st;
@@ -520,7 +519,8 @@ static Status scene_apply_options(Run *r, Error *err)
     if ((o->width >= 0 || o->height >= 0) &&
         (st = limit_pixels(r->scene.image.width, r->scene.image.height, ST_USAGE, "--width/--height", err)))
         return st;
-    if (r->bare_mesh) mesh_view_fit(&r->scene);
+    /* a mesh file given in place of a scene is shown by a camera that frames it */
+    if (r->bare_mesh && (st = mesh_view_fit(&r->scene, err))) return st;
     if (o->adaptive > 0.0 && r->scene.integrator != INTEGRATOR_WHITTED)
         return error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
     r->encoding = r->scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB;

@@ -1,7 +1,7 @@
 /* options.c — command-line parsing, strict: every value is checked whole and in range. */
 #include "options.h"
 
-#include "io/classic_parse.h"
+#include "io/scene_load.h"
 #include "base/limit.h"
 #include "types.h"
 

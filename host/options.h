@@ -25,7 +25,7 @@ typedef struct {
     unsigned wave_paths;          /* OpenCL wave size, 0 = automatic */
     /* the classic ray tracer (docs/classic-format.md) */
     int integrator;               /* enum Integrator (path or whitted), -1 = the scene's */
-    int format;                   /* enum SceneFormat (classic_parse.h) */
+    int format;                   /* enum SceneFormat (io/scene_load.h) */
     unsigned aovs;                /* bit (INTEGRATOR_AOV_x): auxiliary images to write */
     double adaptive;              /* whitted: neighbour difference threshold, 0 = off */
     unsigned adaptive_spp;        /* extra samples per flagged pixel */

@@ -24,6 +24,7 @@
 #include "io/ply.h"
 #include "render_util.h"
 #include "scene/scene.h"
+#include "io/scene_load.h"
 #include "io/texture.h"
 
 #define DIR_BAD "tests/data/bad"
@@ -61,7 +62,8 @@ static int read_expect(const char *path, Expect *e)
 /* Loads `path` with the reader its extension names (a new format adds a line). */
 static Status load(const char *path, Scene *s, Error *err)
 {
-    if (has_suffix(path, ".scene")) return scene_load(path, s, err);
+    /* scenes of both formats through the one loader, as clpt reads them */
+    if (has_suffix(path, ".scene") || has_suffix(path, ".txt")) return scene_load_file(path, SCENE_FORMAT_AUTO, s, NULL, err);
     uint m, index;
     if (has_suffix(path, ".obj") || has_suffix(path, ".ply")) {
         Status st = scene_add_material(s, "m", material_diffuse(v3(0.5f, 0.5f, 0.5f)), &m, err);
@@ -130,7 +132,7 @@ static void check_file(const char *path)
         if (st == ST_OK && e.triangles >= 0)
             CHECK_MSG((long)s.n_triangles == e.triangles, "%s: %zu triangles, expected %ld", path, s.n_triangles,
                       e.triangles);
-        if (st == ST_OK && has_suffix(path, ".scene")) check_renders(path, &s, e.mean);
+        if (st == ST_OK && (has_suffix(path, ".scene") || has_suffix(path, ".txt"))) check_renders(path, &s, e.mean);
     } else {
         CHECK_MSG(e.message[0], "%s: an error needs its '# message:' line; this one is:\n    %s", path, err.msg);
         CHECK_MSG(st == want, "%s: status %d, expected %d (%s)", path, st, want, err.msg);

@@ -16,6 +16,7 @@
 
 #include "base/limit.h"
 #include "io/classic_parse.h"
+#include "io/scene_load.h"
 #include "kmath.h"
 #include "scene/scene.h"
 
@@ -453,7 +454,7 @@ static void test_detect(void)
     write_file("ours.scene", "camera { from 0 0 5 }\nsphere { center 0 0 0 radius 1 material { type diffuse albedo 1 1 1 } }\n");
     snprintf(path, sizeof path, "%s/ours.scene", dir);
     scene_init(&s);
-    CHECK_EQ_INT(scene_load_format(path, SCENE_FORMAT_AUTO, &s, &err), ST_OK);
+    CHECK_EQ_INT(scene_load_file(path, SCENE_FORMAT_AUTO, &s, NULL, &err), ST_OK);
     CHECK_EQ_INT(s.integrator, INTEGRATOR_PATH);
     CHECK_EQ_INT(s.n_spheres, 1);
     scene_free(&s);
@@ -461,13 +462,63 @@ static void test_detect(void)
                              "Group { numObjects 1 Sphere { center 0 0 0 radius 1 } }\n");
     snprintf(path, sizeof path, "%s/theirs.txt", dir);
     scene_init(&s);
-    CHECK_EQ_INT(scene_load_format(path, SCENE_FORMAT_AUTO, &s, &err), ST_OK);
+    CHECK_EQ_INT(scene_load_file(path, SCENE_FORMAT_AUTO, &s, NULL, &err), ST_OK);
     CHECK_EQ_INT(s.integrator, INTEGRATOR_WHITTED);
     scene_free(&s);
     /* forcing the wrong format is an error of that format */
     scene_init(&s);
-    CHECK_EQ_INT(scene_load_format(path, SCENE_FORMAT_CLPT, &s, &err), ST_INPUT);
+    CHECK_EQ_INT(scene_load_file(path, SCENE_FORMAT_CLPT, &s, NULL, &err), ST_INPUT);
     CHECK_STR_CONTAINS(err.msg, "theirs.txt:2:1: expected a statement");
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* Group and Transform are read recursively: 40,000 levels of either overflowed the
+ * stack (a segmentation fault); past CLPT_MAX_NESTING levels they are an error, and up
+ * to it they load. */
+static void test_nesting_limit(void)
+{
+    static const char *const opens[] = { "Transform { Translate 0 0 0 ", "Group { numObjects 1 " };
+    for (int g = 0; g < 2; g++) {
+        size_t depths[2] = { CLPT_MAX_NESTING - 1, 40000 };   /* inside the top Group */
+        for (int k = 0; k < 2; k++) {
+            size_t n = depths[k], ol = strlen(opens[g]);
+            size_t cap = strlen(camera) + 64 + n * (ol + 2);
+            char *text = malloc(cap);
+            if (!text) continue;
+            size_t o = (size_t)snprintf(text, cap, "%sGroup { numObjects 1 ", camera);
+            for (size_t i = 0; i < n; i++, o += ol) memcpy(text + o, opens[g], ol);
+            o += (size_t)snprintf(text + o, cap - o, "Sphere { radius 1 }");
+            for (size_t i = 0; i <= n; i++, o += 2) memcpy(text + o, " }", 2);
+            Scene s;
+            Error err = {0};
+            scene_init(&s);
+            Status st = classic_load_text("x.txt", text, o, &s, &err);
+            if (k == 0) {
+                CHECK_MSG(st == ST_OK, "%zu levels: %s", n + 1, err.msg);
+                CHECK_EQ_INT(s.n_spheres + (s.n_triangles > 0), 1);
+            } else {
+                char want[160];
+                snprintf(want, sizeof want, "x.txt:2:%zu: Group and Transform blocks nested more than %d deep",
+                         21 + (size_t)(CLPT_MAX_NESTING - 1) * ol + 1, CLPT_MAX_NESTING);
+                CHECK_EQ_INT(st, ST_INPUT);
+                CHECK_MSG(strcmp(err.msg, want) == 0, "got %s, expected %s", err.msg, want);
+            }
+            scene_free(&s);
+            error_clear(&err);
+            free(text);
+        }
+    }
+}
+
+/* The matrices of the classic format are affine: a projective last row is refused. */
+static void test_projective_matrix(void)
+{
+    Scene s;
+    Error err = {0};
+    CHECK_EQ_INT(load_objects("Group { numObjects 1 Transform { Matrix4f { 1 0 0 0.5  0 1 0 0  0 0 1 0  0 0 0 1 } "
+                              "Sphere { radius 1 } } }", &s, &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "objects.txt:4:45: the matrix's last row is 0.5 0 0 1; it must be 0 0 0 1 (an affine transform)");
     scene_free(&s);
     error_clear(&err);
 }
@@ -645,7 +696,7 @@ static void test_shipped_scenes(void)
             Scene s;
             Error err = {0};
             scene_init(&s);
-            Status st = scene_load_format(path, SCENE_FORMAT_AUTO, &s, &err);
+            Status st = scene_load_file(path, SCENE_FORMAT_AUTO, &s, NULL, &err);
             CHECK_MSG(st == ST_OK, "%s: %s", path, err.msg);
             CHECK_EQ_INT(s.integrator, ours ? INTEGRATOR_PATH : INTEGRATOR_WHITTED);
             CHECK(s.n_delta_lights >= 2);
@@ -722,6 +773,8 @@ int main(void)
     RUN(test_paths);
     RUN(test_detect);
     RUN(test_errors);
+    RUN(test_nesting_limit);
+    RUN(test_projective_matrix);
     RUN(test_scene_format_additions);
     RUN(test_shipped_scenes);
     RUN(test_cli);

@@ -486,6 +486,93 @@ static void test_kernel_build_notice(void)
     unlink(out);
 }
 
+/* Runs `script` with sh -c, $CLPT naming the program: for pipes and FIFOs, which need a
+ * shell around clpt. Each clpt in a script runs under `timeout`, so that a regression
+ * that blocks on a pipe fails the test (exit 124) instead of hanging it. */
+static void shell_run(const char *script, CliResult *res)
+{
+    char out_name[] = "/tmp/clpt-cli-out-XXXXXX", err_name[] = "/tmp/clpt-cli-err-XXXXXX";
+    int out_fd = mkstemp(out_name), err_fd = mkstemp(err_name);
+    unlink(out_name);
+    unlink(err_name);
+    pid_t pid = fork();
+    if (pid == 0) {
+        dup2(out_fd, 1);
+        dup2(err_fd, 2);
+        setenv("CLPT", CLI_PROGRAM, 1);
+        execl("/bin/sh", "sh", "-c", script, (char *)NULL);
+        _exit(127);
+    }
+    CliChild c = { pid, out_fd, err_fd };
+    cli_finish(c, res);
+}
+
+#define PIPE_FLAGS "-q --device scalar --width 16 --height 12 --spp 2"
+
+/* The scene read from a pipe or a FIFO is read once: it renders the same image as from
+ * the file (it was read twice, once to tell the format, and rendered empty). */
+static void test_scene_from_pipe(void)
+{
+    shell_run("set -e; d=$(mktemp -d /tmp/clpt-test-pipe-XXXXXX); trap 'rm -rf \"$d\"' EXIT\n"
+              "timeout 60 \"$CLPT\" " PIPE_FLAGS " -o \"$d/file.pfm\" scenes/cornell-box.scene\n"
+              "cat scenes/cornell-box.scene | timeout 60 \"$CLPT\" " PIPE_FLAGS " -o \"$d/stdin.pfm\" /dev/stdin\n"
+              "cmp \"$d/file.pfm\" \"$d/stdin.pfm\"\n"
+              "mkfifo \"$d/fifo\"; cat scenes/cornell-box.scene > \"$d/fifo\" &\n"
+              "timeout 60 \"$CLPT\" " PIPE_FLAGS " -o \"$d/fifo.pfm\" \"$d/fifo\"\n"
+              "cmp \"$d/file.pfm\" \"$d/fifo.pfm\"\n"
+              /* a classic scene is told from ours by its content: read once, it is both */
+              "timeout 60 \"$CLPT\" " PIPE_FLAGS " -o \"$d/classic.pfm\" scenes/classic/spheres.txt\n"
+              "cat scenes/classic/spheres.txt | timeout 60 \"$CLPT\" " PIPE_FLAGS " -o \"$d/classic-stdin.pfm\" /dev/stdin\n"
+              "cmp \"$d/classic.pfm\" \"$d/classic-stdin.pfm\"\n"
+              /* --format still chooses */
+              "cat scenes/classic/spheres.txt | timeout 60 \"$CLPT\" " PIPE_FLAGS " --format classic "
+              "-o \"$d/classic-forced.pfm\" /dev/stdin\n"
+              "cmp \"$d/classic.pfm\" \"$d/classic-forced.pfm\"\n"
+              "echo all-same\n", &r);
+    CHECK_MSG(r.status == 0, "exit %d: %s", r.status, r.err);
+    CHECK_STR_CONTAINS(r.out, "all-same");
+}
+
+/* What a scene names (a mesh, a texture, an include, an MTL file) must be a regular
+ * file: a FIFO there is refused at once (it blocked clpt for ever), a directory is an
+ * I/O error (exit 4). */
+static void test_named_files_must_be_regular(void)
+{
+    static const struct {
+        const char *scene;      /* written to $d/s.scene; $d/x.* are FIFOs or folders */
+        const char *message;
+    } cases[] = {
+        { "mesh { file \"x.obj\" material m }",
+          "/s.scene:3:13: cannot read '" },
+        { "texture t { type image file \"x.png\" }",
+          "cannot read '" },
+        { "include \"x.scene\"",
+          "/s.scene:3:9: cannot read '" },
+    };
+    for (int dir = 0; dir < 2; dir++)
+        for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+            char script[2048];
+            snprintf(script, sizeof script,
+                     "d=$(mktemp -d /tmp/clpt-test-fifo-XXXXXX); trap 'rm -rf \"$d\"' EXIT\n"
+                     "for x in x.obj x.png x.scene; do %s \"$d/$x\"; done\n"
+                     "printf 'camera { from 0 0 5 at 0 0 0 }\\nmaterial m { type diffuse albedo 1 1 1 }\\n%%s\\n' '%s' "
+                     "> \"$d/s.scene\"\n"
+                     "timeout 20 \"$CLPT\" " PIPE_FLAGS " -o \"$d/o.png\" \"$d/s.scene\"\n",
+                     dir ? "mkdir" : "mkfifo", cases[i].scene);
+            shell_run(script, &r);
+            CHECK_MSG(r.status == 4, "%s (%s): exit %d: %s", cases[i].scene, dir ? "a folder" : "a FIFO", r.status,
+                      r.err);
+            CHECK_STR_CONTAINS(r.err, cases[i].message);
+            CHECK_STR_CONTAINS(r.err, dir ? "it is a directory, not a file" : "it is a pipe, not a regular file");
+        }
+    /* an OBJ's MTL file that is a FIFO is skipped like a missing one, without waiting */
+    shell_run("d=$(mktemp -d /tmp/clpt-test-fifo-XXXXXX); trap 'rm -rf \"$d\"' EXIT\n"
+              "mkfifo \"$d/x.mtl\"\n"
+              "printf 'mtllib x.mtl\\nv 0 0 0\\nv 1 0 0\\nv 0 1 0\\nusemtl a\\nf 1 2 3\\n' > \"$d/m.obj\"\n"
+              "timeout 20 \"$CLPT\" " PIPE_FLAGS " -o \"$d/o.png\" \"$d/m.obj\"\n", &r);
+    CHECK_MSG(r.status == 0, "exit %d: %s", r.status, r.err);
+}
+
 int main(void)
 {
     RUN(test_help_documents_every_flag);
@@ -509,5 +596,7 @@ int main(void)
     RUN(test_no_opencl_said_once_without_escapes);
     RUN(test_log_shows_plain_progress);
     RUN(test_kernel_build_notice);
+    RUN(test_scene_from_pipe);
+    RUN(test_named_files_must_be_regular);
     return harness_report();
 }

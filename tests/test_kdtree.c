@@ -11,7 +11,7 @@
 
 #include "harness.h"
 #include "accel/kdtree.h"
-#include "io/mesh.h"
+#include "io/mesh_load.h"
 #include "surface.h"
 #include "traverse.cl"
 

@@ -10,6 +10,7 @@
 
 #include "harness.h"
 #include "io/lexer.h"
+#include "io/scene_load.h"
 #include "base/limit.h"
 #include "scene/scene.h"
 
@@ -115,7 +116,8 @@ static void test_pipe(void)
     Scene s;
     Error err = { 0 };
     scene_init(&s);
-    CHECK_EQ_INT(scene_load(path, &s, &err), ST_OK);
+    /* through the one loader, which reads the scene once and lets it be a pipe */
+    CHECK_EQ_INT(scene_load_file(path, SCENE_FORMAT_AUTO, &s, NULL, &err), ST_OK);
     CHECK_EQ_INT(s.image.width, 7);
     pthread_join(writer, NULL);
     scene_free(&s);

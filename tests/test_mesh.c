@@ -1,4 +1,5 @@
-/* test_mesh.c — what the mesh readers share (host/io/mesh.c): transforms and the sink,
+/* test_mesh.c — what the mesh readers share (host/scene/transform.c, host/scene/mesh_sink.c,
+ * host/io/mesh_load.c, host/io/mesh_text.c): transforms and the sink,
  * case-insensitive paths, the procedural sphere; the mesh block of scene files with its
  * transform keys; a bare mesh shown on its own (host/io/mesh_view.c), in-process and
  * through the command line. */
@@ -6,7 +7,8 @@
 
 #include "cli_util.h"
 #include "kmath.h"
-#include "io/mesh.h"
+#include "io/mesh_load.h"
+#include "io/mesh_text.h"
 #include "io/mesh_view.h"
 
 #include <stdint.h>
@@ -318,7 +320,7 @@ static void test_mesh_view(void)
     check_framed(&s);
     s.image.width = 100;
     s.image.height = 400;
-    mesh_view_fit(&s);
+    CHECK_EQ_INT(mesh_view_fit(&s, &err), ST_OK);
     check_framed(&s);
     scene_free(&s);
     /* MTL materials are kept */
@@ -332,6 +334,42 @@ static void test_mesh_view(void)
     CHECK_EQ_INT(mesh_view_load("/tmp/clpt-test-mesh-empty.obj", &s, &err), ST_INPUT);
     CHECK_STR_CONTAINS(err.msg, "clpt-test-mesh-empty.obj: the mesh has no triangles to show");
     scene_free(&s);
+    /* corners near the float range: the camera that frames them would be beyond it (the
+     * message named the camera, not the file) */
+    write_file("far.obj", "v 2e38 0 0\nv 0 2e38 0\nv 0 0 0\nf 1 2 3\n");
+    scene_init(&s);
+    CHECK_EQ_INT(mesh_view_load("/tmp/clpt-test-mesh-far.obj", &s, &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "/tmp/clpt-test-mesh-far.obj: the mesh is too large to ");
+    CHECK_STR_CONTAINS(err.msg, "beyond the largest float (about 3.4e38)");
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* A triangle whose corners are finite but so far apart that the kernels' float edges
+ * overflow is refused by the sink, naming the mesh file and the triangle (it was kept,
+ * and never hit). */
+static void test_sink_huge_corners(void)
+{
+    Scene s;
+    scene_init(&s);
+    Error err = { 0 };
+    MeshSink k;
+    CHECK_EQ_INT(mesh_sink_open(&k, &s, NULL, "far.ply", &err), ST_OK);
+    vec3 ok[3] = { v3(1e38f, 0.0f, 0.0f), v3(0.0f, 1e38f, 0.0f), v3(0.0f, 0.0f, 1.0f) };
+    vec3 far[3] = { v3(3e38f, 0.0f, 0.0f), v3(-3e38f, 0.0f, 0.0f), v3(0.0f, 1.0f, 0.0f) };
+    CHECK_EQ_INT(mesh_sink_triangle(&k, ok, NULL, NULL, 0), ST_OK);
+    CHECK_EQ_INT(mesh_sink_triangle(&k, far, NULL, NULL, 0), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "far.ply: the corners of triangle 2 are too far apart (their differences "
+                                "overflow single precision)");
+    /* and after the transform, which can carry near corners far apart */
+    Transform big = transform_scale(1e30, 1e30, 1e30);
+    CHECK_EQ_INT(mesh_sink_open(&k, &s, &big, "scaled.obj", &err), ST_OK);
+    CHECK_EQ_INT(mesh_sink_triangle(&k, (const vec3[3]){ v3(3e8f, 0.0f, 0.0f), v3(-3e8f, 0.0f, 0.0f),
+                                                          v3(0.0f, 1.0f, 0.0f) }, NULL, NULL, 0), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "scaled.obj: the corners of triangle 1 are too far apart");
+    CHECK_STR_CONTAINS(err.msg, "after the mesh transform");
+    scene_free(&s);
+    error_clear(&err);
 }
 
 /* `clpt model.ply -o model.png` renders, with the mesh's name as the default output. */
@@ -364,6 +402,7 @@ int main(void)
     RUN(test_scene_mesh_block);
     RUN(test_scene_mesh_errors);
     RUN(test_mesh_view);
+    RUN(test_sink_huge_corners);
     RUN(test_cli);
     return harness_report();
 }

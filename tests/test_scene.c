@@ -574,9 +574,9 @@ static void test_bad_files(void)
     scene_free(&s);
 
     scene_init(&s);
-    st = scene_load("tests", &s, &err);   /* a folder opens but cannot be read */
+    st = scene_load("tests", &s, &err);   /* a folder is refused before it is read */
     CHECK_EQ_INT(st, ST_IO);
-    CHECK_STR_CONTAINS(err.msg, "cannot open 'tests': Is a directory");
+    CHECK_STR_CONTAINS(err.msg, "cannot read 'tests': it is a directory, not a file");
     scene_free(&s);
 
     {

@@ -1,5 +1,5 @@
 /*
- * gen_mesh.c — writes the closed bumpy sphere of mesh_make_sphere (host/io/mesh.c) with at
+ * gen_mesh.c — writes the closed bumpy sphere of mesh_make_sphere (host/scene/mesh_sink.c) with at
  * least N triangles as a binary little-endian PLY, for trying clpt on meshes of any
  * size (the 10-million-triangle check of docs/meshes.md):
  *
@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "io/mesh.h"
+#include "scene/mesh_sink.h"
 
 /* Vertex index of a position, by a hash table over the bit patterns. */
 typedef struct { vec3 *v; uint32_t *slot; size_t n, cap; } VertexSet;

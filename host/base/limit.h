@@ -24,6 +24,10 @@
 #define CLPT_MAX_DEPTH 1024
 /* Nesting of scene `include`s (a file including itself stops here). */
 #define CLPT_MAX_INCLUDE_DEPTH 16
+/* Nesting of the classic format's Group and Transform blocks, which are read
+ * recursively: each level takes a few hundred bytes of stack, and 40,000 levels
+ * overflowed it. Course scenes nest a handful deep. */
+#define CLPT_MAX_NESTING 256
 /* Texels of one texture image (8192 x 8192): decoded to 4 bytes a texel (12 for HDR)
  * and copied once more into the scene. Compressed images (PNG, JPEG) can claim this
  * from a few bytes, so the size is read from the header before decoding. */

@@ -21,6 +21,7 @@
 #include "base/limit.h"
 #include "io/lexer.h"
 #include "io/obj.h"
+#include "scene/transform.h"
 #include "io/texture.h"
 
 /* The tessellation of a sphere that a transform makes an ellipsoid (or rotates, when
@@ -28,92 +29,9 @@
 #define SPHERE_BANDS 48
 #define SPHERE_SEGMENTS 96
 
-/* ------------------------------------------------------------------ 4x4 matrices */
+/* ------------------------------------------------------------------ transforms */
 
-typedef struct { double m[4][4]; } Mat4;
-
-static Mat4 mat_identity(void)
-{
-    Mat4 r;
-    memset(&r, 0, sizeof r);
-    for (int i = 0; i < 4; i++) r.m[i][i] = 1.0;
-    return r;
-}
-
-static Mat4 mat_mul(const Mat4 *a, const Mat4 *b)
-{
-    Mat4 r;
-    for (int i = 0; i < 4; i++)
-        for (int j = 0; j < 4; j++) {
-            double sum = 0.0;
-            for (int k = 0; k < 4; k++) sum += a->m[i][k] * b->m[k][j];
-            r.m[i][j] = sum;
-        }
-    return r;
-}
-
-static Mat4 mat_scale(double x, double y, double z)
-{
-    Mat4 r = mat_identity();
-    r.m[0][0] = x;
-    r.m[1][1] = y;
-    r.m[2][2] = z;
-    return r;
-}
-
-static Mat4 mat_translate(vec3 t)
-{
-    Mat4 r = mat_identity();
-    r.m[0][3] = t.x;
-    r.m[1][3] = t.y;
-    r.m[2][3] = t.z;
-    return r;
-}
-
-/* Rotation by `degrees` about the unit axis (x, y, z), right-handed (Rodrigues). */
-static Mat4 mat_rotate(double x, double y, double z, double degrees)
-{
-    double a = degrees * M_PI / 180.0, c = cos(a), s = sin(a), t = 1.0 - c;
-    Mat4 r = mat_identity();
-    r.m[0][0] = t * x * x + c;     r.m[0][1] = t * x * y - s * z; r.m[0][2] = t * x * z + s * y;
-    r.m[1][0] = t * x * y + s * z; r.m[1][1] = t * y * y + c;     r.m[1][2] = t * y * z - s * x;
-    r.m[2][0] = t * x * z - s * y; r.m[2][1] = t * y * z + s * x; r.m[2][2] = t * z * z + c;
-    return r;
-}
-
-static vec3 mat_point(const Mat4 *m, vec3 p)
-{
-    double x = m->m[0][0] * p.x + m->m[0][1] * p.y + m->m[0][2] * p.z + m->m[0][3];
-    double y = m->m[1][0] * p.x + m->m[1][1] * p.y + m->m[1][2] * p.z + m->m[1][3];
-    double z = m->m[2][0] * p.x + m->m[2][1] * p.y + m->m[2][2] * p.z + m->m[2][3];
-    double w = m->m[3][0] * p.x + m->m[3][1] * p.y + m->m[3][2] * p.z + m->m[3][3];
-    if (w != 1.0 && w != 0.0) { x /= w; y /= w; z /= w; }
-    return v3((float)x, (float)y, (float)z);
-}
-
-static double det3(const Mat4 *m)
-{
-    const double (*a)[4] = m->m;
-    return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-           a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-}
-
-/* The matrix that carries normals: the inverse transpose of the linear part, n[i][j]
- * (cofactors over the determinant). Returns 0 when the linear part is singular. */
-static int mat_normal(const Mat4 *m, double n[3][3])
-{
-    double d = det3(m);
-    if (!(fabs(d) > 1e-300) || !isfinite(d)) return 0;
-    const double (*a)[4] = m->m;
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) {
-            int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-            n[i][j] = (a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1]) / d;
-        }
-    return 1;
-}
-
-/* n carried by mat_normal's matrix and made unit length (0 0 0 if it vanishes). */
+/* n carried by transform_normal_matrix's matrix and made unit length (0 0 0 if it vanishes). */
 static vec3 normal_apply(double n[3][3], vec3 v)
 {
     double x = n[0][0] * v.x + n[0][1] * v.y + n[0][2] * v.z;
@@ -126,7 +44,7 @@ static vec3 normal_apply(double n[3][3], vec3 v)
 
 /* Whether the linear part is s times an orthogonal matrix (a sphere stays a sphere of
  * radius s*r); *rotates tells whether that orthogonal matrix is not the identity. */
-static int mat_similarity(const Mat4 *m, double *s, int *rotates)
+static int similarity(const Transform *m, double *s, int *rotates)
 {
     const double (*a)[4] = m->m;
     double g[3][3], trace = 0.0;
@@ -162,6 +80,7 @@ typedef struct {
     int seen_camera, seen_lights, seen_background, seen_materials;
     int ambient_given;
     size_t tessellated;        /* triangles made from spheres so far */
+    uint depth;                /* Group and Transform blocks open around the reader */
 } Classic;
 
 static Status next(Classic *c, Token *t) { return lex_next(&c->lx, t, c->err); }
@@ -598,7 +517,7 @@ static Status parse_phong(Classic *c, const Token *kw)
     return add_material(c, m);
 }
 
-static Status parse_transform_ops(Classic *c, Mat4 *m, Token *stop);
+static Status parse_transform_ops(Classic *c, Transform *m, Token *stop);
 
 /* The classic solid checkerboard: the first material with its diffuse colour
  * alternating with the second's on the unit cells of the (transformed) point. */
@@ -606,7 +525,7 @@ static Status parse_checkerboard(Classic *c, const Token *kw)
 {
     Status st = expect_brace(c, TOK_LBRACE, "'{' to open the Checkerboard block");
     if (st) return st;
-    Mat4 m = mat_identity();
+    Transform m = transform_identity();
     Token t;
     if ((st = next(c, &t))) return st;
     if (tok_is(&t, "Transform")) {
@@ -675,7 +594,7 @@ static Status parse_materials(Classic *c, const Token *kw)
 
 /* ------------------------------------------------------------------ objects */
 
-static Status parse_object(Classic *c, const Token *kw, const Mat4 *m);
+static Status parse_object(Classic *c, const Token *kw, const Transform *m);
 
 /* The material of the next object: the last MaterialIndex, else material 0, else
  * (no materials at all) a white diffuse one made on first use. */
@@ -709,7 +628,7 @@ static Status add_tri(Classic *c, vec3 a, vec3 b, vec3 d, uint material, uint sh
  * longitude mesh with the sphere's normals and (u, v) (kernels/texture.h) carried over.
  * The kernels have no ellipsoids, so the mesh costs 9,024 triangles a sphere; their
  * total is capped (CLPT_MAX_TESSELLATED_TRIANGLES) before they are made. */
-static Status tessellate_sphere(Classic *c, const Token *kw, vec3 center, float radius, const Mat4 *m,
+static Status tessellate_sphere(Classic *c, const Token *kw, vec3 center, float radius, const Transform *m,
                                 uint material)
 {
     enum { PER_SPHERE = 2 * SPHERE_SEGMENTS * (SPHERE_BANDS - 1) };
@@ -721,8 +640,8 @@ static Status tessellate_sphere(Classic *c, const Token *kw, vec3 center, float 
                             CLPT_MAX_TESSELLATED_TRIANGLES / PER_SPHERE);
     c->tessellated += PER_SPHERE;
     double nm[3][3];
-    if (!mat_normal(m, nm)) return error_set(c->err, ST_INTERNAL, "singular transform");
-    int flip = det3(m) < 0.0;
+    if (!transform_normal_matrix(m, nm)) return error_set(c->err, ST_INTERNAL, "singular transform");
+    int flip = transform_det(m) < 0.0;
     enum { NB = SPHERE_BANDS, NS = SPHERE_SEGMENTS };
     for (int i = 0; i < NB; i++)
         for (int j = 0; j < NS; j++) {
@@ -733,7 +652,7 @@ static Status tessellate_sphere(Classic *c, const Token *kw, vec3 center, float 
                 double theta = M_PI * bi / NB, phi = 2.0 * M_PI * sj / NS;
                 /* u = 0.5 + atan2(x, z) / 2pi: phi measured from -z through +x */
                 vec3 dir = v3((float)(-sin(theta) * sin(phi)), (float)cos(theta), (float)(-sin(theta) * cos(phi)));
-                p[k] = mat_point(m, v3_madd(center, dir, radius));
+                p[k] = transform_point(m, v3_madd(center, dir, radius));
                 n[k] = normal_apply(nm, dir);
                 uv[k][0] = (float)sj / NS;
                 uv[k][1] = 1.0f - (float)bi / NB;
@@ -764,7 +683,7 @@ static const ClassicKey sphere_keys[SPH_N] = {
     [SPH_CENTER] = {"center", CK_VEC3, 0}, [SPH_RADIUS] = {"radius", CK_POSITIVE, 1},
 };
 
-static Status parse_sphere(Classic *c, const Token *kw, const Mat4 *m)
+static Status parse_sphere(Classic *c, const Token *kw, const Transform *m)
 {
     ClassicValue v[SPH_N];
     Status st = read_block(c, kw, "Sphere", sphere_keys, SPH_N, v);
@@ -774,11 +693,11 @@ static Status parse_sphere(Classic *c, const Token *kw, const Mat4 *m)
     double scale;
     int rotates;
     int textured = c->s->materials[material].texture != NO_INDEX;
-    if (!mat_similarity(m, &scale, &rotates) || (rotates && textured))
+    if (!similarity(m, &scale, &rotates) || (rotates && textured))
         return tessellate_sphere(c, kw, center, v[SPH_RADIUS].f, m, material);
     Sphere sp;
     memset(&sp, 0, sizeof sp);
-    sp.center = mat_point(m, center);
+    sp.center = transform_point(m, center);
     sp.radius = (float)(scale * v[SPH_RADIUS].f);
     sp.material = material;
     if (!(sp.radius > 0.0f) || !isfinite(sp.radius))
@@ -792,7 +711,7 @@ static const ClassicKey plane_keys[PL_N] = {
 };
 
 /* The plane dot(normal, p) = offset (normal of any length). */
-static Status parse_plane(Classic *c, const Token *kw, const Mat4 *m)
+static Status parse_plane(Classic *c, const Token *kw, const Transform *m)
 {
     ClassicValue v[PL_N];
     Status st = read_block(c, kw, "Plane", plane_keys, PL_N, v);
@@ -803,8 +722,8 @@ static Status parse_plane(Classic *c, const Token *kw, const Mat4 *m)
     double k = v[PL_OFFSET].f / n2;
     vec3 q = v3((float)(n.x * k), (float)(n.y * k), (float)(n.z * k));   /* a point on it */
     double nm[3][3];
-    if (!mat_normal(m, nm)) return error_set(c->err, ST_INTERNAL, "singular transform");
-    vec3 nw = normal_apply(nm, n), qw = mat_point(m, q);
+    if (!transform_normal_matrix(m, nm)) return error_set(c->err, ST_INTERNAL, "singular transform");
+    vec3 nw = normal_apply(nm, n), qw = transform_point(m, q);
     if (v3_is_zero(nw)) return lex_error_at(&c->lx, &v[PL_NORMAL].key, c->err, "the plane's normal is too long");
     Plane pl;
     memset(&pl, 0, sizeof pl);
@@ -819,21 +738,21 @@ static const ClassicKey triangle_keys[TRI_N] = {
     [TRI_V0] = {"vertex0", CK_VEC3, 1}, [TRI_V1] = {"vertex1", CK_VEC3, 1}, [TRI_V2] = {"vertex2", CK_VEC3, 1},
 };
 
-static Status parse_triangle(Classic *c, const Token *kw, const Mat4 *m)
+static Status parse_triangle(Classic *c, const Token *kw, const Transform *m)
 {
     ClassicValue v[TRI_N];
     Status st = read_block(c, kw, "Triangle", triangle_keys, TRI_N, v);
     uint material;
     if (st || (st = object_material(c, &material))) return st;
-    vec3 a = mat_point(m, v[TRI_V0].v), b = mat_point(m, v[TRI_V1].v), d = mat_point(m, v[TRI_V2].v);
+    vec3 a = transform_point(m, v[TRI_V0].v), b = transform_point(m, v[TRI_V1].v), d = transform_point(m, v[TRI_V2].v);
     /* a mirroring transform turns the winding around; keep the outward side outward */
-    return det3(m) < 0.0 ? add_tri(c, a, d, b, material, NO_INDEX) : add_tri(c, a, b, d, material, NO_INDEX);
+    return transform_det(m) < 0.0 ? add_tri(c, a, d, b, material, NO_INDEX) : add_tri(c, a, b, d, material, NO_INDEX);
 }
 
 enum { MESH_FILE, MESH_N };
 static const ClassicKey mesh_keys[MESH_N] = { [MESH_FILE] = {"obj_file", CK_PATH, 1} };
 
-static Status parse_mesh(Classic *c, const Token *kw, const Mat4 *m)
+static Status parse_mesh(Classic *c, const Token *kw, const Transform *m)
 {
     ClassicValue v[MESH_N];
     Status st = read_block(c, kw, "TriangleMesh", mesh_keys, MESH_N, v);
@@ -841,8 +760,10 @@ static Status parse_mesh(Classic *c, const Token *kw, const Mat4 *m)
     if (st || (st = object_material(c, &material))) return st;
     char *path;
     if ((st = resolve_path(c, &v[MESH_FILE].word, &path))) return st;
-    size_t t0 = c->s->n_triangles, s0 = c->s->n_shading;
-    st = obj_load(path, c->s, material, c->err);
+    /* the sink applies the transform as it does to a mesh of our format */
+    MeshOptions o = mesh_options(material);
+    o.xf = *m;
+    st = obj_load_with(path, c->s, &o, c->err);
     free(path);
     if (st == ST_IO) {
         error_prefix(c->err, "%s:%u:%u", c->lx.path, v[MESH_FILE].word.line, v[MESH_FILE].word.col);
@@ -852,67 +773,38 @@ static Status parse_mesh(Classic *c, const Token *kw, const Mat4 *m)
         size_t len = strlen(c->err->msg);
         snprintf(c->err->msg + len, sizeof c->err->msg - len, " (in the TriangleMesh of %s:%u:%u)", c->lx.path,
                  kw->line, kw->col);
-        return st;
     }
-    double nm[3][3];
-    if (!mat_normal(m, nm)) return error_set(c->err, ST_INTERNAL, "singular transform");
-    int flip = det3(m) < 0.0;
-    for (size_t i = t0; i < c->s->n_triangles; i++) {
-        Triangle *t = &c->s->triangles[i];
-        t->p0 = mat_point(m, t->p0);
-        t->p1 = mat_point(m, t->p1);
-        t->p2 = mat_point(m, t->p2);
-        if (flip) {
-            vec3 tmp = t->p1;
-            t->p1 = t->p2;
-            t->p2 = tmp;
-        }
-    }
-    for (size_t i = s0; i < c->s->n_shading; i++) {
-        TriShading *sh = &c->s->shading[i];
-        sh->n0 = normal_apply(nm, sh->n0);
-        sh->n1 = normal_apply(nm, sh->n1);
-        sh->n2 = normal_apply(nm, sh->n2);
-        if (flip) {
-            vec3 tn = sh->n1;
-            sh->n1 = sh->n2;
-            sh->n2 = tn;
-            float tuv[2];
-            memcpy(tuv, sh->uv1, sizeof tuv);
-            memcpy(sh->uv1, sh->uv2, sizeof tuv);
-            memcpy(sh->uv2, tuv, sizeof tuv);
-        }
-    }
-    return ST_OK;
+    return st;
 }
 
 /* Reads transformations into *m (each applied on the right: the first one listed is
  * the last applied to the object, as in the course's parser) up to the first token that
  * is not one, returned in *stop. Matrix4f and Matrix multiply on the left, as there. */
-static Status parse_transform_ops(Classic *c, Mat4 *m, Token *stop)
+static Status parse_transform_ops(Classic *c, Transform *m, Token *stop)
 {
     Status st;
     for (;;) {
         Token t;
         if ((st = next(c, &t))) return st;
-        Mat4 x;
+        Transform x;
         float f;
         if (tok_is(&t, "Translate") || tok_is(&t, "Scale")) {
             ClassicKey k = { tok_is(&t, "Translate") ? "Translate" : "Scale", CK_VEC3, 0 };
             ClassicValue v;
             if ((st = read_value(c, &k, &v))) return st;
-            x = tok_is(&t, "Translate") ? mat_translate(v.v) : mat_scale(v.v.x, v.v.y, v.v.z);
-            *m = mat_mul(m, &x);
+            x = tok_is(&t, "Translate") ? transform_translate(v.v.x, v.v.y, v.v.z)
+                                         : transform_scale(v.v.x, v.v.y, v.v.z);
+            *m = transform_compose(m, &x);
         } else if (tok_is(&t, "UniformScale")) {
             if ((st = read_float(c, &f, NULL, "a number for 'UniformScale'"))) return st;
-            x = mat_scale(f, f, f);
-            *m = mat_mul(m, &x);
+            x = transform_scale(f, f, f);
+            *m = transform_compose(m, &x);
         } else if (tok_is(&t, "XRotate") || tok_is(&t, "YRotate") || tok_is(&t, "ZRotate")) {
             char what[64];
             snprintf(what, sizeof what, "a number of degrees for '%.*s'", (int)t.len, t.text);
             if ((st = read_float(c, &f, NULL, what))) return st;
-            x = mat_rotate(t.text[0] == 'X', t.text[0] == 'Y', t.text[0] == 'Z', f);
-            *m = mat_mul(m, &x);
+            x = transform_rotate(t.text[0] == 'X', t.text[0] == 'Y', t.text[0] == 'Z', f);
+            *m = transform_compose(m, &x);
         } else if (tok_is(&t, "Rotate")) {
             float a[4];
             Token at;
@@ -925,21 +817,28 @@ static Status parse_transform_ops(Classic *c, Mat4 *m, Token *stop)
             double len = sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]);
             if (!(len > 0.0) || !isfinite(len))
                 return lex_error_at(&c->lx, &t, c->err, "Rotate's axis must be a non-zero vector");
-            x = mat_rotate(a[0] / len, a[1] / len, a[2] / len, a[3]);
-            *m = mat_mul(m, &x);
+            x = transform_rotate(a[0], a[1], a[2], a[3]);
+            *m = transform_compose(m, &x);
         } else if (tok_is(&t, "Matrix4f") || tok_is(&t, "Matrix")) {
             /* Matrix4f (2012): the numbers column by column; Matrix (2004): row by row */
             int by_column = tok_is(&t, "Matrix4f");
             if ((st = expect_brace(c, TOK_LBRACE, "'{' before the matrix's 16 numbers"))) return st;
-            x = mat_identity();
+            double r[4][4];
+            Token first = t;
             for (int j = 0; j < 4; j++)
                 for (int i = 0; i < 4; i++) {
-                    if ((st = read_float(c, &f, NULL, "16 numbers for the matrix"))) return st;
-                    if (by_column) x.m[i][j] = f;
-                    else x.m[j][i] = f;
+                    if ((st = read_float(c, &f, i + j == 0 ? &first : NULL, "16 numbers for the matrix"))) return st;
+                    if (by_column) r[i][j] = f;
+                    else r[j][i] = f;
                 }
             if ((st = expect_brace(c, TOK_RBRACE, "'}' after the matrix's 16 numbers"))) return st;
-            *m = mat_mul(&x, m);
+            /* the kernels take spheres, planes and triangles through affine maps only */
+            if (r[3][0] != 0.0 || r[3][1] != 0.0 || r[3][2] != 0.0 || r[3][3] != 1.0)
+                return lex_error_at(&c->lx, &first, c->err, "the matrix's last row is %g %g %g %g; it must be "
+                                    "0 0 0 1 (an affine transform)", r[3][0], r[3][1], r[3][2], r[3][3]);
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 4; j++) x.m[i][j] = r[i][j];
+            *m = transform_compose(&x, m);
         } else {
             *stop = t;
             return ST_OK;
@@ -947,25 +846,25 @@ static Status parse_transform_ops(Classic *c, Mat4 *m, Token *stop)
     }
 }
 
-static Status parse_transform(Classic *c, const Token *kw, const Mat4 *parent)
+static Status parse_transform(Classic *c, const Token *kw, const Transform *parent)
 {
     Status st = expect_brace(c, TOK_LBRACE, "'{' to open the Transform block");
     if (st) return st;
-    Mat4 m = mat_identity();
+    Transform m = transform_identity();
     Token t;
     if ((st = parse_transform_ops(c, &m, &t))) return st;
     if (t.kind != TOK_WORD)
         return expected(c, &t, "a transformation (Translate, Scale, UniformScale, XRotate, YRotate, ZRotate, "
                         "Rotate, Matrix4f, Matrix) or the object it applies to");
-    Mat4 world = mat_mul(parent, &m);
-    double d = det3(&world);
+    Transform world = transform_compose(parent, &m);
+    double d = transform_det(&world);
     if (!(fabs(d) > 1e-30) || !isfinite(d))
         return lex_error_at(&c->lx, kw, c->err, "the Transform is singular (it flattens its object)");
     if ((st = parse_object(c, &t, &world))) return st;
     return expect_brace(c, TOK_RBRACE, "'}' closing the Transform (it holds one object)");
 }
 
-static Status parse_group(Classic *c, const Token *kw, const Mat4 *m)
+static Status parse_group(Classic *c, const Token *kw, const Transform *m)
 {
     Status st = expect_brace(c, TOK_LBRACE, "'{' to open the Group block");
     unsigned long long n;
@@ -1005,14 +904,29 @@ static Status parse_group(Classic *c, const Token *kw, const Mat4 *m)
     }
 }
 
-static Status parse_object(Classic *c, const Token *kw, const Mat4 *m)
+/* Group and Transform recurse: a limit on their nesting keeps the stack bounded. */
+static Status enter_block(Classic *c, const Token *kw)
 {
-    if (tok_is(kw, "Group")) return parse_group(c, kw, m);
+    if (c->depth >= CLPT_MAX_NESTING)
+        return lex_error_at(&c->lx, kw, c->err, "Group and Transform blocks nested more than %d deep",
+                            CLPT_MAX_NESTING);
+    c->depth++;
+    return ST_OK;
+}
+
+static Status parse_object(Classic *c, const Token *kw, const Transform *m)
+{
+    if (tok_is(kw, "Group") || tok_is(kw, "Transform")) {
+        Status st = enter_block(c, kw);
+        if (st) return st;
+        st = tok_is(kw, "Group") ? parse_group(c, kw, m) : parse_transform(c, kw, m);
+        c->depth--;
+        return st;
+    }
     if (tok_is(kw, "Sphere")) return parse_sphere(c, kw, m);
     if (tok_is(kw, "Plane")) return parse_plane(c, kw, m);
     if (tok_is(kw, "Triangle")) return parse_triangle(c, kw, m);
     if (tok_is(kw, "TriangleMesh")) return parse_mesh(c, kw, m);
-    if (tok_is(kw, "Transform")) return parse_transform(c, kw, m);
     return expected(c, kw, "an object (Group, Sphere, Plane, Triangle, TriangleMesh, Transform) or "
                     "MaterialIndex");
 }
@@ -1071,7 +985,7 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
     s->image.spp = 1;
     s->bg_type = BG_CONSTANT;
     s->bg_color = s->bg_zenith = v3s(0.5f);
-    Mat4 identity = mat_identity();
+    Transform identity = transform_identity();
     Token t;
     for (;;) {
         if ((st = next(&c, &t)) || t.kind == TOK_EOF) break;
@@ -1080,7 +994,7 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
         else if (tok_is(&t, "Lights")) st = parse_lights(&c, &t);
         else if (tok_is(&t, "Background")) st = parse_background(&c, &t);
         else if (tok_is(&t, "Materials")) st = parse_materials(&c, &t);
-        else if (tok_is(&t, "Group")) st = parse_group(&c, &t, &identity);
+        else if (tok_is(&t, "Group")) st = parse_object(&c, &t, &identity);
         else
             st = expected(&c, &t, "a scene block (PerspectiveCamera, OrthographicCamera, Lights, Background, "
                           "Materials, Group)");
@@ -1103,17 +1017,4 @@ Status classic_load(const char *path, Scene *s, Error *err)
 Status classic_load_text(const char *path, const char *text, size_t len, Scene *s, Error *err)
 {
     return load(path, text, len, s, err);
-}
-
-Status scene_load_format(const char *path, SceneFormat format, Scene *s, Error *err)
-{
-    if (format == SCENE_FORMAT_AUTO) {
-        char *text;
-        size_t len;
-        Status st = lex_read_file(path, &text, &len, err);
-        if (st) return st;
-        format = classic_detect(text, len) ? SCENE_FORMAT_CLASSIC : SCENE_FORMAT_CLPT;
-        free(text);
-    }
-    return format == SCENE_FORMAT_CLASSIC ? classic_load(path, s, err) : scene_load(path, s, err);
 }

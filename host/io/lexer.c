@@ -4,16 +4,29 @@
 #include "base/limit.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
+#include <poll.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
+
+/* Some Windows editors start text files with a UTF-8 byte order mark: it is no part of
+ * the text, and left in it would be an invisible first "word". */
+size_t lex_bom_length(const char *text, size_t len)
+{
+    return len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
+}
 
 Status lex_open_text(Lexer *lx, const char *path, const char *text, size_t len, Error *err)
 {
     memset(lx, 0, sizeof *lx);
+    size_t skip = lex_bom_length(text, len);
+    text += skip;
+    len -= skip;
     size_t plen = strlen(path);
     lx->path = malloc(plen + 1);
     lx->src = malloc(len + 1);
@@ -29,68 +42,120 @@ Status lex_open_text(Lexer *lx, const char *path, const char *text, size_t len, 
     return ST_OK;
 }
 
-Status lex_read_file(const char *path, char **data, size_t *len, Error *err)
+/* Opens path for reading and checks what it is, without blocking: a FIFO is opened with
+ * O_NONBLOCK (a plain open would wait for a writer). Only a regular file, or a pipe or
+ * FIFO when `allow_pipe`, is returned open. */
+static Status open_input(const char *path, int allow_pipe, int *fd_out, struct stat *sb, Error *err)
+{
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return error_set(err, ST_IO, "cannot open '%s': %s", path, strerror(errno));
+    const char *what = NULL;
+    if (fstat(fd, sb) != 0) {
+        int e = errno;
+        close(fd);
+        return error_set(err, ST_IO, "cannot open '%s': %s", path, strerror(e));
+    }
+    if (S_ISDIR(sb->st_mode)) what = "it is a directory, not a file";
+    /* /dev/zero or /dev/urandom would be read until memory runs out */
+    else if (S_ISCHR(sb->st_mode) || S_ISBLK(sb->st_mode)) what = "it is a device, not a file";
+    else if ((S_ISFIFO(sb->st_mode) || S_ISSOCK(sb->st_mode)) && !allow_pipe)
+        what = "it is a pipe, not a regular file (only the scene itself may be a pipe; meshes, textures, "
+               "includes and MTL files are read from regular files)";
+    else if (!S_ISREG(sb->st_mode) && !S_ISFIFO(sb->st_mode) && !S_ISSOCK(sb->st_mode))
+        what = "it is not a regular file";
+    if (what) {
+        close(fd);
+        return error_set(err, ST_IO, "cannot read '%s': %s", path, what);
+    }
+    int flags = fcntl(fd, F_GETFL);
+    if (flags >= 0) fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+    *fd_out = fd;
+    return ST_OK;
+}
+
+Status lex_check_file(const char *path, Error *err)
+{
+    int fd;
+    struct stat sb;
+    Status st = open_input(path, 0, &fd, &sb, err);
+    if (st) return st;
+    close(fd);
+    return limit_file_size(path, (uint64_t)sb.st_size, err);
+}
+
+/* lex_read_file and lex_read_input: the whole file in one buffer, read once. */
+static Status read_whole(const char *path, int allow_pipe, char **data, size_t *len, Error *err)
 {
     *data = NULL;
     *len = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) return error_set(err, ST_IO, "cannot open '%s': %s", path, strerror(errno));
-    size_t cap = 1 << 16, n = 0;
+    int fd;
     struct stat sb;
-    if (fstat(fileno(f), &sb) == 0) {
-        /* /dev/zero or /dev/urandom would be read until memory runs out; a pipe
-         * (`clpt <(gen-scene)`) is read, up to the size limit */
-        if (S_ISCHR(sb.st_mode) || S_ISBLK(sb.st_mode)) {
-            fclose(f);
-            return error_set(err, ST_IO, "cannot read '%s': it is a device, not a file", path);
+    Status st = open_input(path, allow_pipe, &fd, &sb, err);
+    if (st) return st;
+    size_t cap = 1 << 16, n = 0;
+    if (S_ISREG(sb.st_mode)) {
+        if ((st = limit_file_size(path, (uint64_t)sb.st_size, err))) {
+            close(fd);
+            return st;
         }
-        if (S_ISREG(sb.st_mode)) {
-            Status st = limit_file_size(path, (uint64_t)sb.st_size, err);
-            if (st) {
-                fclose(f);
-                return st;
-            }
-            /* the whole file and the NUL in one allocation */
-            if ((uint64_t)sb.st_size + 2 > cap) cap = (size_t)sb.st_size + 2;
-        }
+        /* the whole file and the NUL in one allocation */
+        if ((uint64_t)sb.st_size + 2 > cap) cap = (size_t)sb.st_size + 2;
     }
     char *buf = malloc(cap);
     if (!buf) {
-        fclose(f);
+        close(fd);
         return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
     }
     for (;;) {
         if (n > CLPT_MAX_FILE_BYTES) {
             free(buf);
-            fclose(f);
+            close(fd);
             return limit_file_size(path, n, err);
         }
         if (cap - n < 2) {
             char *grown = cap <= ((size_t)-1) / 2 ? realloc(buf, cap * 2) : NULL;
             if (!grown) {
                 free(buf);
-                fclose(f);
+                close(fd);
                 return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
             }
             buf = grown;
             cap *= 2;
         }
-        size_t got = fread(buf + n, 1, cap - 1 - n, f);
-        n += got;
+        /* A FIFO opened before its writer reads as ended: poll waits for the writer's
+         * data or its hanging up, as a blocking open would, while this reader keeps the
+         * FIFO (and what a quick writer left in it) open. */
+        struct pollfd pfd = { fd, POLLIN, 0 };
+        if (S_ISFIFO(sb.st_mode) && poll(&pfd, 1, -1) < 0 && errno == EINTR) continue;
+        ssize_t got = read(fd, buf + n, cap - 1 - n);
+        if (got < 0 && errno == EINTR) continue;
+        if (got < 0) {
+            int e = errno;
+            free(buf);
+            close(fd);
+            return error_set(err, ST_IO, "cannot read '%s': %s", path, strerror(e));
+        }
         if (got == 0) break;
+        n += (size_t)got;
     }
-    if (ferror(f)) {
-        /* fopen succeeds on a directory; the read then fails with EISDIR */
-        int e = errno;
-        free(buf);
-        fclose(f);
-        return error_set(err, ST_IO, "cannot open '%s': %s", path, strerror(e ? e : EIO));
-    }
-    fclose(f);
+    close(fd);
+    size_t skip = lex_bom_length(buf, n);
+    if (skip) memmove(buf, buf + skip, n - skip);
+    n -= skip;
     buf[n] = '\0';
     *data = buf;
     *len = n;
     return ST_OK;
+}
+
+Status lex_read_file(const char *path, char **data, size_t *len, Error *err)
+{
+    return read_whole(path, 0, data, len, err);
+}
+
+Status lex_read_input(const char *path, char **data, size_t *len, Error *err)
+{
+    return read_whole(path, 1, data, len, err);
 }
 
 Status lex_open_file(Lexer *lx, const char *path, Error *err)

@@ -14,7 +14,8 @@
  *
  * Lines and columns start at 1; a column counts bytes (a tab is one column).
  * Every error message starts with "path:line:col: " and is an ST_INPUT error, except
- * a file that cannot be read (ST_IO, "cannot open 'path': <reason>").
+ * a file that cannot be read (ST_IO, "cannot open 'path': <reason>", or "cannot read
+ * 'path': ..." when it is not a regular file).
  */
 #ifndef CLPT_LEXER_H
 #define CLPT_LEXER_H
@@ -49,16 +50,27 @@ typedef struct {
     size_t line_start;   /* offset of the current line's first byte */
 } Lexer;
 
-/* Reads the whole file. ST_IO "cannot open 'path': <strerror>" when it cannot, or when
- * it is a device (/dev/zero); ST_INPUT when it is larger than CLPT_MAX_FILE_BYTES
- * (limit.h), checked before reading when the size is known. */
+/* Reads the whole file. ST_IO "cannot open 'path': <strerror>" when it cannot, and
+ * "cannot read 'path': it is a directory, not a file" (a device, a pipe: not a regular
+ * file) when it is not a regular file, found without blocking on a FIFO; ST_INPUT when
+ * it is larger than CLPT_MAX_FILE_BYTES (limit.h), checked before reading. A UTF-8 byte
+ * order mark at the start is dropped, here and in every function below that takes text. */
 Status lex_open_file(Lexer *lx, const char *path, Error *err);
 /* Lexes `len` bytes of `text` (copied), reported under the name `path`. */
 Status lex_open_text(Lexer *lx, const char *path, const char *text, size_t len, Error *err);
 void lex_close(Lexer *lx);
-/* Reads a whole file into a NUL-terminated heap buffer (*data, *len without the NUL);
- * the same errors as lex_open_file. Used by loaders that do their own lexing. */
+/* Reads a whole regular file into a NUL-terminated heap buffer (*data, *len without the
+ * NUL); the same errors as lex_open_file. Used by loaders that do their own lexing. */
 Status lex_read_file(const char *path, char **data, size_t *len, Error *err);
+/* The same, but a pipe or FIFO is read too (to its end, once): for the scene named on
+ * the command line, which may be `<(gen-scene)` or /dev/stdin. */
+Status lex_read_input(const char *path, char **data, size_t *len, Error *err);
+/* The checks of lex_read_file without the reading, for files another library opens by
+ * name (texture images): ST_OK when `path` is a regular file clpt may read. */
+Status lex_check_file(const char *path, Error *err);
+
+/* 3 when text starts with a UTF-8 byte order mark (EF BB BF), else 0. */
+size_t lex_bom_length(const char *text, size_t len);
 
 /* The next token (TOK_EOF at the end, repeatedly). Fails on an unterminated string,
  * an unknown escape or a control character. */

@@ -2,7 +2,7 @@
 #include "io/mesh_view.h"
 
 #include "kmath.h"
-#include "io/mesh.h"
+#include "io/mesh_load.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -50,33 +50,43 @@ static vec3 along(const double c[3], const double dir[3], double dist)
               (float)(c[2] + dir[2] / len * dist));
 }
 
-void mesh_view_fit(Scene *s)
+Status mesh_view_fit(Scene *s, Error *err)
 {
     double c[3], r;
-    if (!mesh_sphere(s, c, &r)) return;
+    if (!mesh_sphere(s, c, &r)) return ST_OK;
     /* the narrower of the two fields of view must hold the sphere */
     double half_v = VIEW_FOV_DEGREES * M_PI / 360.0;
     double aspect = (double)s->image.width / (double)s->image.height;
     double half_h = atan(tan(half_v) * aspect);
     double half = fmin(half_v, half_h);
     double dist = 1.05 * r / sin(half);
-    s->camera.from = along(c, view_dir, dist);
+    vec3 from = along(c, view_dir, dist);
+    if (!isfinite(from.x) || !isfinite(from.y) || !isfinite(from.z))
+        return error_set(err, ST_INPUT, "%s: the mesh is too large to frame: a camera %g units from its "
+                         "centre is beyond the largest float (about 3.4e38)", s->path ? s->path : "mesh", dist);
+    s->camera.from = from;
     s->camera.at = v3((float)c[0], (float)c[1], (float)c[2]);
     s->camera.up = v3(0.0f, 1.0f, 0.0f);
     s->camera.vfov = (float)VIEW_FOV_DEGREES;
     s->camera.aperture = 0.0f;
     s->camera.focus_dist = 0.0f;
+    return ST_OK;
 }
 
 Status mesh_view_load(const char *path, Scene *s, Error *err)
+{
+    MeshOptions o = mesh_options(NO_INDEX);
+    Status st = mesh_load(path, s, &o, err);
+    return st ? st : mesh_view_frame(path, s, err);
+}
+
+Status mesh_view_frame(const char *path, Scene *s, Error *err)
 {
     free(s->path);
     s->path = malloc(strlen(path) + 1);
     if (!s->path) return error_set(err, ST_INTERNAL, "out of memory");
     strcpy(s->path, path);
-    MeshOptions o = mesh_options(NO_INDEX);
-    Status st = mesh_load(path, s, &o, err);
-    if (st) return st;
+    Status st;
     double c[3], r;
     if (!mesh_sphere(s, c, &r))
         return error_set(err, ST_INPUT, "%s: the mesh has no triangles to show", path);
@@ -89,6 +99,9 @@ Status mesh_view_load(const char *path, Scene *s, Error *err)
     memset(&sun, 0, sizeof sun);
     sun.center = along(c, sun_dir, dist);
     sun.radius = (float)(dist * sin(half));
+    if (!isfinite(sun.center.x) || !isfinite(sun.center.y) || !isfinite(sun.center.z) || !isfinite(sun.radius))
+        return error_set(err, ST_INPUT, "%s: the mesh is too large to light: its sun, %g units away, is beyond "
+                         "the largest float (about 3.4e38)", path, dist);
     /* a disc of radiance L subtending half-angle a gives irradiance L * pi * sin^2(a) */
     float radiance = (float)(SUN_IRRADIANCE / (M_PI * sin(half) * sin(half)));
     uint m;
@@ -96,6 +109,5 @@ Status mesh_view_load(const char *path, Scene *s, Error *err)
     if ((st = scene_add_material(s, "", sun_m, &m, err))) return st;
     sun.material = m;
     if ((st = scene_add_sphere(s, sun, err))) return st;
-    mesh_view_fit(s);
-    return ST_OK;
+    return mesh_view_fit(s, err);
 }

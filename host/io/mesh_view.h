@@ -16,9 +16,13 @@
 /* Loads the mesh (an .obj or .ply file) into an initialised scene and adds the sky, the
  * sun and a camera for the scene's image size. ST_INPUT when it has no triangle. */
 Status mesh_view_load(const char *path, Scene *s, Error *err);
+/* The same around the triangles already in the scene, read from the mesh `path`. */
+Status mesh_view_frame(const char *path, Scene *s, Error *err);
 
 /* Points the camera at the mesh again for the scene's current image size (call after
- * changing width or height: a tall image needs the camera farther back). */
-void mesh_view_fit(Scene *s);
+ * changing width or height: a tall image needs the camera farther back). ST_INPUT,
+ * naming the mesh file, when the camera would be beyond the float range (a mesh whose
+ * corners are near it). */
+Status mesh_view_fit(Scene *s, Error *err);
 
 #endif /* CLPT_MESH_VIEW_H */

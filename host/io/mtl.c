@@ -3,7 +3,7 @@
 
 #include "kmath.h"
 #include "io/lexer.h"
-#include "io/mesh.h"
+#include "io/mesh_text.h"
 
 #include <math.h>
 #include <stdio.h>

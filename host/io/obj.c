@@ -11,6 +11,7 @@
 
 #include "kmath.h"
 #include "io/lexer.h"
+#include "io/mesh_text.h"
 #include "io/mtl.h"
 
 #include <ctype.h>

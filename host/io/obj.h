@@ -23,10 +23,10 @@
 #ifndef CLPT_OBJ_H
 #define CLPT_OBJ_H
 
-#include "io/mesh.h"
+#include "scene/mesh_sink.h"
 
 /* Appends the mesh's triangles (and shading records) to the scene, transformed and
- * with materials as the options say (mesh.h). On failure the scene may hold some of
+ * with materials as the options say (scene/mesh_sink.h). On failure the scene may hold some of
  * the mesh's triangles. */
 Status obj_load_with(const char *path, Scene *s, const MeshOptions *o, Error *err);
 

@@ -15,6 +15,7 @@
 
 #include "kmath.h"
 #include "io/lexer.h"
+#include "io/mesh_text.h"
 
 #include <math.h>
 #include <stdarg.h>

@@ -19,10 +19,10 @@
 #ifndef CLPT_PLY_H
 #define CLPT_PLY_H
 
-#include "io/mesh.h"
+#include "scene/mesh_sink.h"
 
 /* Appends the mesh's triangles to the scene, transformed as the options say; every
- * triangle gets o->material, or the default material (mesh.h) when it is NO_INDEX. */
+ * triangle gets o->material, or the default material (scene/mesh_sink.h) when it is NO_INDEX. */
 Status ply_load(const char *path, Scene *s, const MeshOptions *o, Error *err);
 
 /* Parses PLY data already in memory (len bytes, with a NUL at data[len]); `path`

@@ -14,7 +14,7 @@
 #include "scene/camera.h"
 #include "io/lexer.h"
 #include "base/limit.h"
-#include "io/mesh.h"
+#include "io/mesh_load.h"
 #include "io/obj.h"
 #include "io/texture.h"
 

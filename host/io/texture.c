@@ -2,6 +2,7 @@
 #include "io/texture.h"
 
 #include "base/limit.h"
+#include "io/lexer.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -337,9 +338,9 @@ Status texture_load_image(Scene *s, const char *name, const char *path, int line
         return scene_add_texture(s, name, path, t, index, err);
     }
 
-    FILE *f = fopen(path, "rb");
-    if (!f) return error_set(err, ST_IO, "cannot open '%s': %s", path, strerror(errno));
-    fclose(f);
+    /* stb_image opens files by name: a FIFO would block it, a directory read as empty */
+    Status fst = lex_check_file(path, err);
+    if (fst) return fst;
     int w = 0, h = 0, channels = 0;
     Status pst = pnm_check(path, err);
     if (!pst) pst = png_check(path, err);

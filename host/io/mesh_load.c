@@ -1,0 +1,38 @@
+/* mesh_load.c — a mesh file read by the reader its extension names (mesh_load.h). */
+#include "io/mesh_load.h"
+
+#include "io/obj.h"
+#include "io/ply.h"
+
+#include <string.h>
+#include <strings.h>
+
+MeshKind mesh_kind(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(slash ? slash + 1 : path, '.');
+    if (!dot) return MESH_NONE;
+    if (strcasecmp(dot, ".obj") == 0) return MESH_OBJ;
+    if (strcasecmp(dot, ".ply") == 0) return MESH_PLY;
+    return MESH_NONE;
+}
+
+Status mesh_load(const char *path, Scene *s, const MeshOptions *o, Error *err)
+{
+    switch (mesh_kind(path)) {
+    case MESH_OBJ: return obj_load_with(path, s, o, err);
+    case MESH_PLY: return ply_load(path, s, o, err);
+    case MESH_NONE: break;
+    }
+    return error_set(err, ST_INPUT, "'%s': not a mesh file (expected a name ending in .obj or .ply)", path);
+}
+
+Status mesh_parse(const char *path, const char *data, size_t len, Scene *s, const MeshOptions *o, Error *err)
+{
+    switch (mesh_kind(path)) {
+    case MESH_OBJ: return obj_parse_with(path, data, len, s, o, err);
+    case MESH_PLY: return ply_parse(path, data, len, s, o, err);
+    case MESH_NONE: break;
+    }
+    return error_set(err, ST_INPUT, "'%s': not a mesh file (expected a name ending in .obj or .ply)", path);
+}

@@ -1,0 +1,47 @@
+/* scene_load.c — read the input once, then parse it in its format (scene_load.h). */
+#include "io/scene_load.h"
+
+#include <stdlib.h>
+
+#include "io/classic_parse.h"
+#include "io/lexer.h"
+#include "io/mesh_load.h"
+#include "io/mesh_view.h"
+
+SceneKind scene_load_kind(const char *path, const char *text, size_t len, SceneFormat format)
+{
+    switch (format) {
+    case SCENE_FORMAT_CLPT: return SCENE_KIND_CLPT;
+    case SCENE_FORMAT_CLASSIC: return SCENE_KIND_CLASSIC;
+    case SCENE_FORMAT_AUTO: break;
+    }
+    if (mesh_kind(path) != MESH_NONE) return SCENE_KIND_MESH;
+    return classic_detect(text, len) ? SCENE_KIND_CLASSIC : SCENE_KIND_CLPT;
+}
+
+Status scene_load_bytes(const char *path, const char *text, size_t len, SceneFormat format, Scene *s,
+                        SceneKind *kind, Error *err)
+{
+    /* dropped here too, for bytes that did not come through lex_read_input */
+    size_t bom = lex_bom_length(text, len);
+    text += bom;
+    len -= bom;
+    SceneKind k = scene_load_kind(path, text, len, format);
+    if (kind) *kind = k;
+    if (k == SCENE_KIND_CLASSIC) return classic_load_text(path, text, len, s, err);
+    if (k == SCENE_KIND_CLPT) return scene_load_text(path, text, len, s, err);
+    MeshOptions o = mesh_options(NO_INDEX);
+    Status st = mesh_parse(path, text, len, s, &o, err);
+    return st ? st : mesh_view_frame(path, s, err);
+}
+
+Status scene_load_file(const char *path, SceneFormat format, Scene *s, SceneKind *kind, Error *err)
+{
+    char *text;
+    size_t len;
+    Status st = lex_read_input(path, &text, &len, err);
+    if (st) return st;
+    st = scene_load_bytes(path, text, len, format, s, kind, err);
+    free(text);
+    return st;
+}

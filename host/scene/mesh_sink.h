@@ -1,0 +1,69 @@
+/*
+ * mesh_sink.h — where the mesh readers (obj.c, ply.c) and the classic format's meshes
+ * put their triangles, and the options a mesh is read with.
+ *
+ * A reader hands the sink triangles in the file's own coordinates; the sink applies the
+ * instance transform (positions by the affine matrix, normals by its inverse transpose,
+ * in double, rounded once to float), swaps two corners when the transform mirrors so
+ * that the winding normal keeps pointing to the same side of the surface, refuses a
+ * triangle the kernels could not intersect in float (a corner that is not finite, or
+ * corners so far apart that their differences overflow), naming the mesh file, and
+ * appends the triangle (and a TriShading record when the corners carry normals or
+ * texture coordinates) to the scene. docs/meshes.md describes the formats and the
+ * materials. This is the scene layer: it reads no file (io/mesh_load.h does).
+ */
+#ifndef CLPT_MESH_SINK_H
+#define CLPT_MESH_SINK_H
+
+#include "scene/scene.h"
+#include "scene/transform.h"
+
+typedef struct {
+    /* Material of every triangle, or NO_INDEX to take the materials the file names (an
+     * OBJ's MTL files); faces that name none then get default_material, which is a
+     * neutral diffuse material added on first use when it is NO_INDEX too. */
+    uint material;
+    uint default_material;
+    Transform xf;
+} MeshOptions;
+
+/* Every triangle gets `material` (NO_INDEX: the file's own), no transform. */
+MeshOptions mesh_options(uint material);
+
+/* The neutral grey of a mesh that names no material. */
+#define MESH_DEFAULT_ALBEDO 0.75f
+
+typedef struct {
+    Scene *s;
+    Error *err;
+    const char *path;            /* the mesh file, for messages */
+    Transform xf;
+    double nxf[3][3];            /* inverse transpose of xf's linear part */
+    int transformed, mirrored;
+    size_t first_triangle;       /* the scene's triangle count when the sink opened */
+} MeshSink;
+
+/* Fails (ST_INPUT) when the transform is singular or not finite. */
+Status mesh_sink_open(MeshSink *k, Scene *s, const Transform *xf, const char *path, Error *err);
+/* Makes room for `triangles` more triangles and `shading` more shading records, so a
+ * reader that knows its counts grows the arrays once. */
+Status mesh_sink_reserve(MeshSink *k, size_t triangles, size_t shading);
+/* Appends one triangle. n: three unit normals or NULL; uv: three (u, v) pairs or NULL.
+ * A normal that comes out zero (or not finite) after the transform drops the normals of
+ * that triangle. */
+Status mesh_sink_triangle(MeshSink *k, const vec3 p[3], const vec3 *n, const float *uv,
+                          uint material);
+
+/* A closed, bumpy sphere of radius about 1 around the origin with at least
+ * `min_triangles` triangles (a UV sphere whose radius varies with latitude and
+ * longitude), every edge shared by exactly two triangles with bit-identical corners,
+ * wound so the winding normals point out. For benchmarks and watertightness tests. */
+Status mesh_make_sphere(Scene *s, size_t min_triangles, uint material, Error *err);
+
+/* Bounding box of triangles [first, first + n) of the scene; lo > hi when n is 0. */
+void mesh_bounds(const Scene *s, size_t first, size_t n, vec3 *lo, vec3 *hi);
+
+/* Bounding box of triangles [first, first + n) of the scene; lo > hi when n is 0. */
+void mesh_bounds(const Scene *s, size_t first, size_t n, vec3 *lo, vec3 *hi);
+
+#endif /* CLPT_MESH_SINK_H */

@@ -25,11 +25,8 @@
 #ifndef CLPT_OCL_PROGRAM_H
 #define CLPT_OCL_PROGRAM_H
 
+#include "device/kernel_source.h"
 #include "device/ocl.h"
-
-/* Defined by the generated build/kernel_source.c: the flattened kernels/entry.cl. */
-extern const char clpt_kernel_source[];
-extern const size_t clpt_kernel_source_len;
 
 typedef struct {
     double seconds;        /* wall time of the whole ocl_program_build call */

@@ -140,6 +140,35 @@ static int child_two_devices(void)
     return 0;
 }
 
+/* Child mode: builds the embedded program for the first device, as a run of clpt does,
+ * and prints what happened. */
+static int child_build(void)
+{
+    OclDeviceInfo *list = NULL;
+    size_t n = 0;
+    Error err = {0};
+    if (ocl_enumerate(&list, &n, &err) != ST_OK || n == 0) {
+        printf("no device %s\n", err.msg);
+        free(list);
+        return 1;
+    }
+    cl_int rc;
+    cl_context c = clCreateContext(NULL, 1, &list[0].id, NULL, NULL, &rc);
+    Status st = ST_DEVICE;
+    OclProgramStats stats;
+    memset(&stats, 0, sizeof stats);
+    if (rc == CL_SUCCESS) {
+        cl_program prog = NULL;
+        st = ocl_program_build(c, &list[0], NULL, NULL, &prog, &stats, &err);
+        if (prog) clReleaseProgram(prog);
+        clReleaseContext(c);
+    }
+    printf("build status %d from_cache %d\n", (int)st, stats.from_cache);
+    free(list);
+    error_clear(&err);
+    return st == ST_OK ? 0 : 1;
+}
+
 /* Child mode: prints what enumeration returns. */
 static int child_enumerate(void)
 {
@@ -466,6 +495,69 @@ static void test_corrupt_cache(void)
     expect_recovery("valid checksum, garbage binary", replace_payload_with_garbage);
 }
 
+/* Damages 64 payload bytes a third of the way in and gives the entry the checksum of
+ * its new payload: a whole entry that PoCL accepts and then aborts on (an assertion
+ * in pocl_llvm_read_program_llvm_irs), leaving what it read in its own cache. */
+static void damage_with_valid_checksum(const char *path)
+{
+    long size = 0;
+    unsigned char *buf = slurp(path, &size);
+    if (!buf || size < 88 + 3 * 64) {
+        free(buf);
+        return;
+    }
+    long from = 88 + (size - 88) / 3;
+    for (long i = from; i < from + 64; i++) buf[i] ^= 0xffu;
+    sha256(buf + 88, (size_t)(size - 88), buf + 56);
+    FILE *f = fopen(path, "wb");
+    if (f) {
+        fwrite(buf, 1, (size_t)size, f);
+        fclose(f);
+    }
+    free(buf);
+}
+
+/* An entry with a valid checksum and a payload the driver crashes on (in child runs
+ * with a cold PoCL cache, as after clearing ~/.cache/pocl): the run that meets it may
+ * die inside the driver, but the entry is no longer where the next run looks, and the
+ * next run builds afresh past what PoCL kept of it, then stores a good entry that the
+ * run after loads. Before, every later run crashed. */
+static void test_crashing_cache_entry(void)
+{
+    Error err = {0};
+    cl_program prog = NULL;
+    OclProgramStats s;
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, NULL, &prog, &s, &err), ST_OK);
+    if (prog) clReleaseProgram(prog);
+    char dir[400], pocl[400], entry[600], out[512];
+    snprintf(dir, sizeof dir, "%s/crash-cache", tmp_root);
+    snprintf(pocl, sizeof pocl, "%s/crash-pocl", tmp_root);
+    CHECK(mkdir(dir, 0755) == 0);
+    const char *name = strrchr(s.cache_path, '/');
+    snprintf(entry, sizeof entry, "%s%s", dir, name ? name : "/missing");
+    long size = 0;
+    unsigned char *good = slurp(s.cache_path, &size);
+    FILE *f = good ? fopen(entry, "wb") : NULL;
+    CHECK(f != NULL);
+    if (!f) {
+        free(good);
+        return;
+    }
+    fwrite(good, 1, (size_t)size, f);
+    fclose(f);
+    free(good);
+    damage_with_valid_checksum(entry);
+
+    int first = run_child("--build", "CLPT_TEST_UNUSED", "1", dir, pocl, out, sizeof out);
+    fprintf(stderr, "  run meeting the damaged entry: exit %d, %s", first, out[0] ? out : "(no output)\n");
+    CHECK_MSG(access(entry, F_OK) != 0 || first == 0, "the damaged entry is still in place after a crash");
+    CHECK_EQ_INT(run_child("--build", "CLPT_TEST_UNUSED", "1", dir, pocl, out, sizeof out), 0);
+    CHECK_STR_CONTAINS(out, "build status 0 from_cache 0\n");
+    CHECK_EQ_INT(run_child("--build", "CLPT_TEST_UNUSED", "1", dir, pocl, out, sizeof out), 0);
+    CHECK_STR_CONTAINS(out, "build status 0 from_cache 1\n");
+    error_clear(&err);
+}
+
 static void test_cache_location(void)
 {
     char saved_clpt[400], buf[1024];
@@ -591,6 +683,7 @@ int main(int argc, char **argv)
 {
     if (argc == 2 && strcmp(argv[1], "--two-devices") == 0) return child_two_devices();
     if (argc == 2 && strcmp(argv[1], "--enumerate") == 0) return child_enumerate();
+    if (argc == 2 && strcmp(argv[1], "--build") == 0) return child_build();
 
     snprintf(tmp_root, sizeof tmp_root, "%s/clpt-test-ocl-XXXXXX",
              getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -624,6 +717,7 @@ int main(int argc, char **argv)
     if (ctx) {
         RUN(test_build_and_cache);
         RUN(test_corrupt_cache);
+        RUN(test_crashing_cache_entry);
         RUN(test_cache_location);
         RUN(test_kernel_dir);
         RUN(test_build_failure);

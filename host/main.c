@@ -226,6 +226,29 @@ static void print_render_stats(const ScheduleStats *st, uint spp, Device **devs,
                st->checkpoints, 1e3 * st->checkpoint_seconds / st->checkpoints, 1e3 * st->snapshot_seconds / st->checkpoints);
 }
 
+/* No device of the default choice could be used: warns, and replaces *chosen with the
+ * next group of the default order; 0 when none is left. */
+static int fall_back(const DeviceDesc *all, size_t n_all, size_t **chosen, size_t *n_chosen, const Error *last)
+{
+    size_t *next = NULL, n_next = 0;
+    Error err = { 0 };
+    if (device_select_fallback(all, n_all, (*chosen)[0], &next, &n_next, &err) != ST_OK || n_next == 0) {
+        free(next);
+        error_clear(&err);
+        return 0;
+    }
+    if (*n_chosen == 1) {   /* several were each reported as they were dropped */
+        print_warning(NULL, last->msg);
+        if (last->detail) fprintf(stderr, "%s\n", last->detail);
+    }
+    fprintf(stderr, "clpt: warning: the default device%s cannot be used; falling back to device %u '%s'%s\n",
+            *n_chosen > 1 ? "s" : "", all[next[0]].index, all[next[0]].name, n_next > 1 ? " and others" : "");
+    free(*chosen);
+    *chosen = next;
+    *n_chosen = n_next;
+    return 1;
+}
+
 /* Opens the chosen devices and gives each the scene. A device that fails is dropped with
  * a warning as long as another one works. */
 static Status open_devices(const Options *o, const DeviceScene *ds, Device ***out, size_t *n_out, Error *err)
@@ -240,7 +263,7 @@ static Status open_devices(const Options *o, const DeviceScene *ds, Device ***ou
         free(all);
         return st;
     }
-    Device **devs = calloc(n_chosen, sizeof *devs);
+    Device **devs = calloc(n_all, sizeof *devs);
     if (!devs) {
         free(all);
         free(chosen);
@@ -249,6 +272,7 @@ static Status open_devices(const Options *o, const DeviceScene *ds, Device ***ou
     DeviceConfig cfg = { o->threads, o->kernel_dir, o->wave_paths };
     size_t n = 0;
     Error last = { 0 };
+try_chosen:
     for (size_t i = 0; i < n_chosen; i++) {
         Device *d = NULL;
         error_clear(&last);
@@ -266,6 +290,8 @@ static Status open_devices(const Options *o, const DeviceScene *ds, Device ***ou
                     all[chosen[i]].index, all[chosen[i]].name);
         }
     }
+    if (n == 0 && (!o->device_spec || !o->device_spec[0]) && fall_back(all, n_all, &chosen, &n_chosen, &last))
+        goto try_chosen;
     free(all);
     free(chosen);
     if (n == 0) {

@@ -182,6 +182,32 @@ Status device_select(const char *spec, const DeviceDesc *all, size_t n, size_t *
     return ST_OK;
 }
 
+/* The default choice's groups, in the order it tries them; accelerators and custom
+ * devices are never chosen by default. */
+enum { GROUP_GPU, GROUP_CPU, GROUP_SCALAR, GROUP_NONE };
+
+static int default_group(const DeviceDesc *d)
+{
+    if (d->kind == DEVICE_SCALAR) return GROUP_SCALAR;
+    if (d->type & DEVICE_TYPE_GPU) return GROUP_GPU;
+    if (d->type & DEVICE_TYPE_CPU) return GROUP_CPU;
+    return GROUP_NONE;
+}
+
+Status device_select_fallback(const DeviceDesc *all, size_t n, size_t failed, size_t **chosen_out,
+                              size_t *n_chosen, Error *err)
+{
+    size_t *chosen = calloc(n ? n : 1, sizeof *chosen);
+    if (!chosen) return error_set(err, ST_INTERNAL, "out of memory");
+    size_t k = 0;
+    for (int g = default_group(&all[failed]) + 1; g < GROUP_NONE && k == 0; g++)
+        for (size_t i = 0; i < n; i++)
+            if (default_group(&all[i]) == g) add_choice(chosen, &k, i);
+    *chosen_out = chosen;
+    *n_chosen = k;
+    return ST_OK;
+}
+
 Status device_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err)
 {
     if (desc->kind == DEVICE_SCALAR) return device_scalar_open(desc, cfg, out, err);

@@ -132,6 +132,13 @@ void device_list_print(FILE *f, const DeviceDesc *all, size_t n);
 Status device_select(const char *spec, const DeviceDesc *all, size_t n, size_t **chosen,
                      size_t *n_chosen, Error *err);
 
+/* The default choice falls back group by group: when no device of the default choice
+ * can be used (their kernels do not build, say), `chosen` receives the next group of
+ * the default order after the one of all[failed] that has any device (OpenCL GPUs,
+ * then OpenCL CPUs, then the scalar device); none when no group is left. */
+Status device_select_fallback(const DeviceDesc *all, size_t n, size_t failed, size_t **chosen,
+                              size_t *n_chosen, Error *err);
+
 Status device_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err);
 void device_close(Device *d);
 

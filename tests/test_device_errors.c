@@ -45,7 +45,9 @@ static void find_pocl_devices(void)
 
 #define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
 #define SMALL "--width", "16", "--height", "12", "--spp", "2"
-#define OUT "/tmp/clpt-test-device-errors.png"
+/* per process: test runs of other checkouts on the same machine use /tmp too */
+static char out_path[64];
+#define OUT out_path
 
 static void test_broken_kernel_dir(void)
 {
@@ -189,6 +191,7 @@ int main(void)
 {
     /* before anything loads the ICD in a child: two PoCL CPU devices, 0 and 1 */
     setenv("POCL_DEVICES", "pthread pthread", 1);
+    snprintf(out_path, sizeof out_path, "/tmp/clpt-test-device-errors-%ld.png", (long)getpid());
     RUN(find_pocl_devices);
     RUN(test_memory_check);
     RUN(test_broken_kernel_dir);
@@ -196,5 +199,6 @@ int main(void)
     RUN(test_default_device_falls_back);
     RUN(test_device_too_small);
     RUN(test_small_device_dropped);
+    unlink(OUT);
     return harness_report();
 }

@@ -22,6 +22,7 @@ static Status render_pass(const PassContext *pc, uint spp, Film *film, double *s
 {
     const DeviceScene *ds = &pc->rs->ds;
     Status st;
+    memset(film, 0, sizeof *film);   /* the caller frees it whatever happens */
     if ((st = update_devices(pc, err))) return st;
     if ((st = film_init(film, ds->params.width, ds->params.height, err))) return st;
     ScheduleConfig cfg = *pc->cfg;

@@ -20,6 +20,7 @@
 
 #include "harness.h"
 #include "device/ocl.h"
+#include "device/ocl_args.h"
 #include "device/ocl_program.h"
 #include "base/sha256.h"
 #include "types.h"
@@ -558,6 +559,63 @@ static void test_crashing_cache_entry(void)
     error_clear(&err);
 }
 
+/* Every argument position device_ocl.c sets by name (ocl_args.h) is the kernel's
+ * argument of that name, and the scene buffers are the first arguments of every scene
+ * kernel in the order of kernels/scene_buffers.h. */
+static void check_arg_name(cl_program prog, const char *kernel, cl_uint arg, const char *name)
+{
+    cl_int rc;
+    cl_kernel k = clCreateKernel(prog, kernel, &rc);
+    char got[64] = "";
+    if (rc == CL_SUCCESS) {
+        rc = clGetKernelArgInfo(k, arg, CL_KERNEL_ARG_NAME, sizeof got, got, NULL);
+        clReleaseKernel(k);
+    }
+    CHECK_MSG(rc == CL_SUCCESS && strcmp(got, name) == 0, "%s argument %u is '%s' (%s), ocl_args.h says '%s'",
+              kernel, arg, got, ocl_error_name(rc), name);
+}
+
+static void test_kernel_argument_names(void)
+{
+    Error err = {0};
+    cl_program prog = NULL;
+    /* argument names are kept only when asked for (PoCL drops them from a binary) */
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, "-cl-kernel-arg-info", &prog, NULL, &err), ST_OK);
+    CHECK_MSG(prog != NULL, "%s", err.msg);
+    if (!prog) return;
+#define BUFFER_NAME_(kind, Type, name, count, what) #name,
+    static const char *const buffers[SCENE_BUF_COUNT] = { SCENE_BUFFERS(BUFFER_NAME_) };
+#undef BUFFER_NAME_
+    static const char *const scene_kernels[] = { "k_intersect", "k_shade", "k_shadow", "k_whitted" };
+    for (size_t k = 0; k < sizeof scene_kernels / sizeof scene_kernels[0]; k++)
+        for (cl_uint i = 0; i < SCENE_BUF_COUNT; i++) check_arg_name(prog, scene_kernels[k], i, buffers[i]);
+    static const struct { const char *kernel; cl_uint arg; const char *name; } named[] = {
+        { "k_raygen", ARG_RAYGEN_PARAMS, "params" }, { "k_raygen", ARG_RAYGEN_FIRST_PIXEL, "first_pixel" },
+        { "k_raygen", ARG_RAYGEN_FIRST_SAMPLE, "first_sample" }, { "k_raygen", ARG_RAYGEN_N_PIXELS, "n_pixels" },
+        { "k_raygen", ARG_RAYGEN_N_PATHS, "n_paths" }, { "k_raygen", ARG_RAYGEN_PATHS, "paths" },
+        { "k_raygen", ARG_RAYGEN_RAYS, "rays" }, { "k_raygen", ARG_RAYGEN_QUEUE, "queue" },
+        { "k_intersect", ARG_INTERSECT_QUEUE, "queue" }, { "k_intersect", ARG_INTERSECT_N, "n" },
+        { "k_intersect", ARG_INTERSECT_RAYS, "rays" }, { "k_intersect", ARG_INTERSECT_HITS, "hits" },
+        { "k_shade", ARG_SHADE_QUEUE, "queue" }, { "k_shade", ARG_SHADE_N, "n" },
+        { "k_shade", ARG_SHADE_RAYS, "rays" }, { "k_shade", ARG_SHADE_HITS, "hits" },
+        { "k_shade", ARG_SHADE_PATHS, "paths" }, { "k_shade", ARG_SHADE_SHADOW_RAYS, "shadow_rays" },
+        { "k_shade", ARG_SHADE_NEXT_QUEUE, "next_queue" }, { "k_shade", ARG_SHADE_SHADOW_QUEUE, "shadow_queue" },
+        { "k_shade", ARG_SHADE_COUNTS, "counts" }, { "k_shade", ARG_SHADE_SLOT, "slot" },
+        { "k_shadow", ARG_SHADOW_QUEUE, "shadow_queue" }, { "k_shadow", ARG_SHADOW_N, "n" },
+        { "k_shadow", ARG_SHADOW_RAYS, "shadow_rays" }, { "k_shadow", ARG_SHADOW_PATHS, "paths" },
+        { "k_film", ARG_FILM_PATHS, "paths" }, { "k_film", ARG_FILM_FIRST_PIXEL, "first_pixel" },
+        { "k_film", ARG_FILM_N_PIXELS, "n_pixels" }, { "k_film", ARG_FILM_N_PATHS, "n_paths" },
+        { "k_film", ARG_FILM_FILM, "film" },
+        { "k_whitted", ARG_WHITTED_FIRST_PIXEL, "first_pixel" }, { "k_whitted", ARG_WHITTED_FIRST_SAMPLE, "first_sample" },
+        { "k_whitted", ARG_WHITTED_N_PIXELS, "n_pixels" }, { "k_whitted", ARG_WHITTED_N_PATHS, "n_paths" },
+        { "k_whitted", ARG_WHITTED_PATHS, "paths" }, { "k_whitted", ARG_WHITTED_COUNTERS, "counters" },
+    };
+    for (size_t i = 0; i < sizeof named / sizeof named[0]; i++)
+        check_arg_name(prog, named[i].kernel, named[i].arg, named[i].name);
+    clReleaseProgram(prog);
+    error_clear(&err);
+}
+
 static void test_cache_location(void)
 {
     char saved_clpt[400], buf[1024];
@@ -718,6 +776,7 @@ int main(int argc, char **argv)
         RUN(test_build_and_cache);
         RUN(test_corrupt_cache);
         RUN(test_crashing_cache_entry);
+        RUN(test_kernel_argument_names);
         RUN(test_cache_location);
         RUN(test_kernel_dir);
         RUN(test_build_failure);

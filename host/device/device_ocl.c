@@ -24,6 +24,7 @@
 #include "device/device.h"
 #include "device/device_memory.h"
 #include "base/fault.h"
+#include "device/ocl_args.h"
 #include "device/ocl_program.h"
 #include "base/timer.h"
 
@@ -38,18 +39,6 @@
 /* A batch smaller than two waves is still split in two (the second wave hides the
  * first one's round trips), unless the halves would be smaller than this. */
 #define MIN_SPLIT_PATHS 4096u
-
-/* Argument positions of the kernels of entry.cl. Kernels taking SCENE_ARGS have the
- * scene buffers first, at SCENE_BUF_nodes ... (kernels/scene_buffers.h), then theirs. */
-#define SCENE_N SCENE_BUF_COUNT
-enum { ARG_RAYGEN_PARAMS, ARG_RAYGEN_FIRST_PIXEL, ARG_RAYGEN_FIRST_SAMPLE, ARG_RAYGEN_N_PIXELS,
-       ARG_RAYGEN_N_PATHS, ARG_RAYGEN_PATHS, ARG_RAYGEN_RAYS, ARG_RAYGEN_QUEUE };
-enum { ARG_INTERSECT_QUEUE = SCENE_N, ARG_INTERSECT_N, ARG_INTERSECT_RAYS, ARG_INTERSECT_HITS };
-enum { ARG_SHADE_QUEUE = SCENE_N, ARG_SHADE_N, ARG_SHADE_RAYS, ARG_SHADE_HITS, ARG_SHADE_PATHS,
-       ARG_SHADE_SHADOW_RAYS, ARG_SHADE_NEXT_QUEUE, ARG_SHADE_SHADOW_QUEUE, ARG_SHADE_COUNTS,
-       ARG_SHADE_SLOT };
-enum { ARG_SHADOW_QUEUE = SCENE_N, ARG_SHADOW_N, ARG_SHADOW_RAYS, ARG_SHADOW_PATHS };
-enum { ARG_FILM_PATHS, ARG_FILM_FIRST_PIXEL, ARG_FILM_N_PIXELS, ARG_FILM_N_PATHS, ARG_FILM_FILM };
 
 /* A batch's film on the device and where its read-back lands. */
 typedef struct {

@@ -158,7 +158,7 @@ int main(int argc, char **argv)
     params.n_leaf_prims = tree.n_leaf_prims;
     params.bounds_lo = tree.lo;
     params.bounds_hi = tree.hi;
-    SceneView sc = { &params, tree.nodes, tree.leaf_prims, NULL, m.t, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL };
+    SceneView sc = { .params = &params, .nodes = tree.nodes, .leaf_prims = tree.leaf_prims, .triangles = m.t };
 
     vec3 c = v3_scale(v3_add(tree.lo, tree.hi), 0.5f), ext = v3_sub(tree.hi, tree.lo);
     float radius = 0.75f * v3_len(ext);

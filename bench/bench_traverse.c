@@ -44,6 +44,7 @@
 #include <string.h>
 
 #include "accel/kdtree.h"
+#include "device/device.h"
 #include "io/mesh_load.h"
 #include "device/ocl_program.h"
 #include "rng.h"
@@ -96,7 +97,7 @@ typedef struct {
     Scene scene;
     KdTree tree;
     double kd_build_1;           /* one-thread build, seconds */
-    RenderParams params;
+    DeviceScene ds;              /* the kd-tree and triangles, every other buffer empty */
     SceneView view;
     double load_seconds;
 } Mesh;
@@ -122,19 +123,16 @@ static int mesh_open(Mesh *m, const char *name, Error *err)
     m->kd_build_1 = one.stats.build_seconds;
     kd_free(&one);
     if (kd_build(&in, 2, &m->tree, err)) return -1;
-    RenderParams *p = &m->params;
+    RenderParams *p = &m->ds.params;
     p->n_triangles = (uint)m->scene.n_triangles;
     p->n_nodes = m->tree.n_nodes;
     p->n_leaf_prims = m->tree.n_leaf_prims;
     p->bounds_lo = m->tree.lo;
     p->bounds_hi = m->tree.hi;
-    SceneView v;
-    memset(&v, 0, sizeof v);
-    v.params = p;
-    v.nodes = m->tree.nodes;
-    v.leaf_prims = m->tree.leaf_prims;
-    v.triangles = m->scene.triangles;
-    m->view = v;
+    m->ds.nodes = m->tree.nodes;
+    m->ds.leaf_prims = m->tree.leaf_prims;
+    m->ds.triangles = m->scene.triangles;
+    device_scene_view(&m->ds, &m->view);
     return 0;
 }
 
@@ -322,9 +320,8 @@ static void rays_free(RaySet sets[N_SETS])
 
 /* ------------------------------------------------------------------ PoCL */
 
-/* The kernels' scene arguments, in SCENE_ARGS order (kernels/entry.cl). */
-enum { SC_PARAMS, SC_NODES, SC_LEAF, SC_SPHERES, SC_TRIS, SC_BOXES, SC_PLANES, SC_MATS, SC_LIGHTS, SC_SHADING,
-       SC_TEXTURES, SC_TEXELS, SC_MASK, SC_N };
+/* The kernels' scene arguments come first, in kernels/scene_buffers.h order. */
+#define SC_N SCENE_BUF_COUNT
 
 typedef struct {
     int ok;
@@ -412,13 +409,10 @@ static cl_mem pocl_buffer(Pocl *pc, const void *src, size_t bytes)
 static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
 {
     pocl_release_buffers(pc);
-    const RenderParams *p = &m->params;
-    pc->scene[SC_PARAMS] = pocl_buffer(pc, p, sizeof *p);
-    pc->scene[SC_NODES] = pocl_buffer(pc, m->tree.nodes, (size_t)p->n_nodes * sizeof(KdNode));
-    pc->scene[SC_LEAF] = pocl_buffer(pc, m->tree.leaf_prims, (size_t)p->n_leaf_prims * sizeof(uint));
-    pc->scene[SC_TRIS] = pocl_buffer(pc, m->scene.triangles, (size_t)p->n_triangles * sizeof(Triangle));
-    for (int i = 0; i < SC_N; i++)
-        if (!pc->scene[i]) pc->scene[i] = pocl_buffer(pc, NULL, 16);
+    for (unsigned i = 0; i < SC_N; i++) {
+        SceneBufferBytes b = device_scene_buffer(&m->ds, i);
+        pc->scene[i] = pocl_buffer(pc, b.data, b.bytes);
+    }
     pc->rays = pocl_buffer(pc, NULL, (size_t)max_rays * sizeof(Ray));
     pc->out = pocl_buffer(pc, NULL, (size_t)max_rays * sizeof(Hit));
     for (int i = 0; i < SC_N; i++)

@@ -270,6 +270,56 @@ static void print_render_stats(const ScheduleStats *st, uint spp, Device **devs,
                st->checkpoints, 1e3 * st->checkpoint_seconds / st->checkpoints, 1e3 * st->snapshot_seconds / st->checkpoints);
 }
 
+/* No device of the default choice could be used: warns, and replaces *chosen with the
+ * next group of the default order; 0 when none is left. */
+static int fall_back(const DeviceDesc *all, size_t n_all, size_t **chosen, size_t *n_chosen, const Error *last)
+{
+    size_t *next = NULL, n_next = 0;
+    Error err = { 0 };
+    if (device_select_fallback(all, n_all, (*chosen)[0], &next, &n_next, &err) != ST_OK || n_next == 0) {
+        free(next);
+        error_clear(&err);
+        return 0;
+    }
+    if (*n_chosen == 1) {   /* several were each reported as they were dropped */
+        print_warning(NULL, last->msg);
+        if (last->detail) fprintf(stderr, "%s\n", last->detail);
+    }
+    fprintf(stderr, "clpt: warning: the default device%s cannot be used; falling back to device %u '%s'%s\n",
+            *n_chosen > 1 ? "s" : "", all[next[0]].index, all[next[0]].name, n_next > 1 ? " and others" : "");
+    free(*chosen);
+    *chosen = next;
+    *n_chosen = n_next;
+    return 1;
+}
+
+/* Opens each chosen device into devs and gives it the scene; returns how many could be
+ * used. A device that fails is dropped with a warning when there are others; *last
+ * keeps the last failure. */
+static size_t open_chosen(const DeviceDesc *all, const size_t *chosen, size_t n_chosen, const DeviceConfig *cfg,
+                          const DeviceScene *ds, Device **devs, Error *last)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < n_chosen; i++) {
+        Device *d = NULL;
+        error_clear(last);
+        Status st = device_open(&all[chosen[i]], cfg, &d, last);
+        if (st == ST_OK) st = d->ops->load_scene(d, ds, last);
+        if (st == ST_OK) {
+            devs[n++] = d;
+            continue;
+        }
+        device_close(d);
+        if (n_chosen > 1) {
+            print_warning(NULL, last->msg);
+            if (last->detail) fprintf(stderr, "%s\n", last->detail);
+            fprintf(stderr, "clpt: warning: device %u '%s' dropped; rendering with the others\n",
+                    all[chosen[i]].index, all[chosen[i]].name);
+        }
+    }
+    return n;
+}
+
 /* Opens the chosen devices and gives each the scene. A device that fails is dropped with
  * a warning as long as another one works. */
 static Status open_devices(const Options *o, const DeviceScene *ds, Device ***out, size_t *n_out, Error *err)
@@ -288,7 +338,7 @@ static Status open_devices(const Options *o, const DeviceScene *ds, Device ***ou
         free(all);
         return st;
     }
-    Device **devs = calloc(n_chosen, sizeof *devs);
+    Device **devs = calloc(n_all, sizeof *devs);
     if (!devs) {
         free(all);
         free(chosen);
@@ -298,23 +348,10 @@ static Status open_devices(const Options *o, const DeviceScene *ds, Device ***ou
     ocl_program_announce_builds(!o->quiet);
     size_t n = 0;
     Error last = { 0 };
-    for (size_t i = 0; i < n_chosen; i++) {
-        Device *d = NULL;
-        error_clear(&last);
-        st = device_open(&all[chosen[i]], &cfg, &d, &last);
-        if (st == ST_OK) st = d->ops->load_scene(d, ds, &last);
-        if (st == ST_OK) {
-            devs[n++] = d;
-            continue;
-        }
-        device_close(d);
-        if (n_chosen > 1) {
-            print_warning(NULL, last.msg);
-            if (last.detail) fprintf(stderr, "%s\n", last.detail);
-            fprintf(stderr, "clpt: warning: device %u '%s' dropped; rendering with the others\n",
-                    all[chosen[i]].index, all[chosen[i]].name);
-        }
-    }
+    int by_default = !o->device_spec || !o->device_spec[0];
+    do
+        n = open_chosen(all, chosen, n_chosen, &cfg, ds, devs, &last);
+    while (n == 0 && by_default && fall_back(all, n_all, &chosen, &n_chosen, &last));
     free(all);
     free(chosen);
     if (n == 0) {

@@ -18,7 +18,11 @@
 #ifndef CLPT_COMPAT_H
 #define CLPT_COMPAT_H
 
-#ifdef __OPENCL_VERSION__
+/* Keyed on __OPENCL_C_VERSION__, which every OpenCL C 1.2 compiler defines (the
+ * language version), online or offline (clang -cl-std=CL1.2, ocloc ...);
+ * __OPENCL_VERSION__ names the device's OpenCL version and is only promised when
+ * compiling for a device. The other kernel files test KERNEL_OPENCL. */
+#if defined(__OPENCL_C_VERSION__)
 /* ---------------------------------------------------------------- OpenCL C */
 #pragma OPENCL FP_CONTRACT OFF
 
@@ -45,6 +49,8 @@ typedef long kint64;         /* 64-bit in every OpenCL C implementation */
 #define k_store4(v, p) vstore4(v, 0, p)
 #define k_store8(v, p) vstore8(v, 0, p)
 
+#elif defined(__OPENCL_VERSION__)
+#error "an OpenCL compiler without __OPENCL_C_VERSION__: clpt's kernels need OpenCL C 1.2 (-cl-std=CL1.2)"
 #else
 /* ---------------------------------------------------------------- C11 */
 #include <math.h>

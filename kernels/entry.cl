@@ -22,22 +22,15 @@
 #include "traverse.cl"
 #include "whitted.cl"
 
-#define SCENE_ARGS                                                                       \
-    __global const RenderParams *params, __global const KdNode *nodes,                   \
-    __global const uint *leaf_prims, __global const Sphere *spheres,                     \
-    __global const Triangle *triangles, __global const Box *boxes,                       \
-    __global const Plane *planes, __global const Material *materials,                    \
-    __global const Light *lights, __global const TriShading *shading,                    \
-    __global const Texture *textures, __global const uint *texels,                       \
-    __global const uint *pixel_mask
-
+/* The scene buffers as __kernel parameters, one per line of scene_buffers.h, each
+ * followed by a comma (every kernel taking them has parameters after them), and their
+ * gathering into a SceneView named sc. */
+#define SCENE_ARG_(kind, Type, name, count, what) __global const Type *name,
+#define SCENE_ARGS SCENE_BUFFERS(SCENE_ARG_)
+#define SCENE_VIEW_SET_(kind, Type, name, count, what) sc.name = name;
 #define SCENE_VIEW(sc)                                                                   \
     SceneView sc;                                                                        \
-    sc.params = params; sc.nodes = nodes; sc.leaf_prims = leaf_prims;                    \
-    sc.spheres = spheres; sc.triangles = triangles; sc.boxes = boxes;                    \
-    sc.planes = planes; sc.materials = materials; sc.lights = lights;                    \
-    sc.shading = shading; sc.textures = textures; sc.texels = texels;                    \
-    sc.pixel_mask = pixel_mask
+    SCENE_BUFFERS(SCENE_VIEW_SET_)
 
 /* Births the wave's paths and queues them all: path i of the wave is path number
  * first_pixel + i of the batch (see the top of this file). */
@@ -53,7 +46,7 @@ __kernel void k_raygen(__global const RenderParams *params, uint first_pixel, ui
 }
 
 /* Closest hit for every queued path. */
-__kernel void k_intersect(SCENE_ARGS, __global const uint *queue, uint n,
+__kernel void k_intersect(SCENE_ARGS __global const uint *queue, uint n,
                           __global const Ray *rays, __global Hit *hits)
 {
     uint i = (uint)get_global_id(0);
@@ -69,7 +62,7 @@ __kernel void k_intersect(SCENE_ARGS, __global const uint *queue, uint n,
  * global atomic_add per queue), because one global atomic per path made the shared
  * counters the hottest cache line of the whole render on a CPU. No early return: every
  * work-item must reach the barriers. */
-__kernel void k_shade(SCENE_ARGS, __global const uint *queue, uint n, __global Ray *rays,
+__kernel void k_shade(SCENE_ARGS __global const uint *queue, uint n, __global Ray *rays,
                       __global const Hit *hits, __global PathState *paths,
                       __global Ray *shadow_rays, __global uint *next_queue,
                       __global uint *shadow_queue, __global uint *counts, uint slot)
@@ -103,7 +96,7 @@ __kernel void k_shade(SCENE_ARGS, __global const uint *queue, uint n, __global R
 }
 
 /* Any-hit test of every queued shadow ray, resolving the waiting contributions. */
-__kernel void k_shadow(SCENE_ARGS, __global const uint *shadow_queue, uint n,
+__kernel void k_shadow(SCENE_ARGS __global const uint *shadow_queue, uint n,
                        __global const Ray *shadow_rays, __global PathState *paths)
 {
     uint i = (uint)get_global_id(0);
@@ -171,7 +164,7 @@ __kernel void k_layout(__global uint *out)
  * k_raygen: work-item i is path first_pixel + i of sample first_sample. counters[0]
  * receives the number of rays traced (summed per work-group first). No early return:
  * every work-item must reach the barriers. */
-__kernel void k_whitted(SCENE_ARGS, uint first_pixel, uint first_sample, uint n_pixels, uint n_paths,
+__kernel void k_whitted(SCENE_ARGS uint first_pixel, uint first_sample, uint n_pixels, uint n_paths,
                         __global PathState *paths, __global uint *counters)
 {
     __local uint group_rays;
@@ -198,7 +191,7 @@ __kernel void k_whitted(SCENE_ARGS, uint first_pixel, uint first_sample, uint n_
 #ifdef CLPT_BENCH_KERNELS
 
 /* Closest hits of rays[2i] and rays[2i+1], walked in turns (trace_closest2). */
-__kernel void k_trace_closest(SCENE_ARGS, __global const Ray *rays, uint n, __global Hit *hits)
+__kernel void k_trace_closest(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
 {
     uint a = 2u * (uint)get_global_id(0), b = a + 1u;
     if (a >= n) return;
@@ -214,7 +207,7 @@ __kernel void k_trace_closest(SCENE_ARGS, __global const Ray *rays, uint n, __gl
 }
 
 /* Whether rays[2i] and rays[2i+1] hit anything, into occluded[] (1 or 0). */
-__kernel void k_trace_any(SCENE_ARGS, __global const Ray *rays, uint n, __global uint *occluded)
+__kernel void k_trace_any(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
 {
     uint a = 2u * (uint)get_global_id(0), b = a + 1u;
     if (a >= n) return;
@@ -230,7 +223,7 @@ __kernel void k_trace_any(SCENE_ARGS, __global const Ray *rays, uint n, __global
 }
 
 /* Closest hit of rays[i], one ray per work-item (trace_closest, as k_intersect). */
-__kernel void k_trace_closest1(SCENE_ARGS, __global const Ray *rays, uint n, __global Hit *hits)
+__kernel void k_trace_closest1(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
 {
     uint i = (uint)get_global_id(0);
     if (i >= n) return;
@@ -239,7 +232,7 @@ __kernel void k_trace_closest1(SCENE_ARGS, __global const Ray *rays, uint n, __g
 }
 
 /* Whether rays[i] hits anything, one ray per work-item (trace_any, as k_shadow). */
-__kernel void k_trace_any1(SCENE_ARGS, __global const Ray *rays, uint n, __global uint *occluded)
+__kernel void k_trace_any1(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
 {
     uint i = (uint)get_global_id(0);
     if (i >= n) return;

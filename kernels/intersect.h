@@ -209,7 +209,7 @@ KFN int triangle_intersect(const RayPre *rp, GLOBAL const Triangle *tri, Ray ray
         STORE(v, va + first);                                                            \
     }
 
-#ifdef __OPENCL_VERSION__
+#ifdef KERNEL_OPENCL
 KFN_INLINE uint tri_lanes(const RayPre *rp, GLOBAL const float *rows, int first, float tmin, float tmax,
                           float *ta, float *ua, float *va)
 {
@@ -232,7 +232,7 @@ KFN_INLINE uint triangle_intersect_group(const RayPre *rp, GLOBAL const float *r
                                          Hit *hit)
 {
     float ta[KD_GROUP], ua[KD_GROUP], va[KD_GROUP];
-#ifdef __OPENCL_VERSION__
+#ifdef KERNEL_OPENCL
     uint mask = tri_lanes(rp, rows, 0, tmin, tmax, ta, ua, va);
 #else
     uint mask = tri_lanes(rp, rows, 0, tmin, tmax, ta, ua, va);
@@ -254,7 +254,7 @@ KFN_INLINE uint triangle_intersect_group(const RayPre *rp, GLOBAL const float *r
     return mask;
 }
 
-#ifndef __OPENCL_VERSION__
+#ifndef KERNEL_OPENCL
 _Static_assert(offsetof(Triangle, p1) == 16 && offsetof(Triangle, p2) == 32,
                "triangle_intersect reads the corners at float offsets 0, 4 and 8");
 #endif

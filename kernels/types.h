@@ -252,7 +252,7 @@ typedef struct {                                        /* 64 bytes */
 #define SHADE_CONTINUE 1u     /* the path goes on with the ray written back */
 #define SHADE_SHADOW 2u       /* a shadow ray was written; shadow_L waits on it */
 
-#ifndef __OPENCL_VERSION__
+#ifndef KERNEL_OPENCL
 #include <stddef.h>
 #define CLPT_CHECK_SIZE(T, n) _Static_assert(sizeof(T) == (n), #T " must be " #n " bytes")
 CLPT_CHECK_SIZE(vec3, 12);

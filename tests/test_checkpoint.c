@@ -280,6 +280,52 @@ static void test_render_key(void)
     error_clear(&err);
 }
 
+/* Every scene buffer of kernels/scene_buffers.h is part of the render key: flipping
+ * its first, middle or last byte changes the key (textures and texels were left out
+ * once, and a resume after a texture edit was accepted). Each buffer gets 2 elements
+ * from a pool of bytes, so the loop needs no knowledge of what the buffers hold. */
+static _Alignas(64) unsigned char key_pool[SCENE_BUF_COUNT][4096];
+
+static void test_render_key_covers_every_scene_buffer(void)
+{
+    DeviceScene ds;
+    memset(&ds, 0, sizeof ds);
+    for (unsigned i = 0; i < SCENE_BUF_COUNT; i++)
+        for (size_t j = 0; j < sizeof key_pool[i]; j++) key_pool[i][j] = (unsigned char)(i * 31u + j);
+#define POOL_ONE_(Type, name)
+#define POOL_MANY_(Type, name) ds.name = (const Type *)(const void *)key_pool[SCENE_BUF_##name];
+#define POOL_(kind, Type, name, count, what) POOL_##kind##_(Type, name)
+    SCENE_BUFFERS(POOL_)
+#undef POOL_
+#undef POOL_MANY_
+#undef POOL_ONE_
+    RenderParams *p = &ds.params;
+    p->width = 2;
+    p->height = 1;
+    p->n_nodes = p->n_leaf_prims = p->n_spheres = p->n_triangles = p->n_boxes = p->n_planes = 2;
+    p->n_lights = p->n_textures = 2;
+    ds.n_materials = ds.n_shading = 2;
+    ds.n_texels = 2;
+    CheckpointId base, changed;
+    checkpoint_id(&ds, 4u, &base);
+    for (unsigned i = 0; i < SCENE_BUF_COUNT; i++) {
+        SceneBufferBytes b = device_scene_buffer(&ds, i);
+        CHECK_MSG(b.bytes > 0 && b.bytes <= sizeof key_pool[i], "buffer %u (%s): %zu bytes", i, b.what, b.bytes);
+        if (b.bytes == 0 || b.bytes > sizeof key_pool[i]) continue;
+        size_t at[3] = { 0, b.bytes / 2, b.bytes - 1 };
+        for (int k = 0; k < 3; k++) {
+            unsigned char *byte = (unsigned char *)(uintptr_t)b.data + at[k];
+            *byte ^= 0x01u;
+            checkpoint_id(&ds, 4u, &changed);
+            *byte ^= 0x01u;
+            CHECK_MSG(memcmp(base.key, changed.key, CHECKPOINT_KEY_SIZE) != 0, "byte %zu of the %s is not in the key",
+                      at[k], b.what);
+        }
+    }
+    checkpoint_id(&ds, 4u, &changed);
+    CHECK(memcmp(&base, &changed, sizeof base) == 0);   /* every byte restored: the same key */
+}
+
 /* ------------------------------------------------------------------ the program */
 
 static void render_reference(void)
@@ -419,6 +465,7 @@ int main(void)
     RUN(test_damaged_files_are_refused);
     RUN(test_film_values_are_bounded);
     RUN(test_render_key);
+    RUN(test_render_key_covers_every_scene_buffer);
     RUN(render_reference);
     RUN(test_sigkill_then_resume_gives_the_same_image);
     RUN(test_sigint_writes_a_checkpoint);

@@ -2,9 +2,10 @@
  * test_device_errors.c — OpenCL failures as the user meets them, by running the
  * program: a kernel that does not build (exit 5 with the device, the call, the options
  * and the whole build log), a device too small for the render (checked before any
- * upload), and either failure on one of two devices (that device is dropped with a
- * warning and the other renders). Two PoCL devices are made with POCL_DEVICES; the
- * failures on one of them with the test-only variables of host/base/fault.h.
+ * upload), either failure on one of two devices (that device is dropped with a
+ * warning and the other renders), and the default choice falling back to the scalar
+ * device when no OpenCL device can build its kernels. Two PoCL devices are made with
+ * POCL_DEVICES; the failures with the test-only variables of host/base/fault.h.
  */
 
 #include "cli_util.h"
@@ -44,7 +45,9 @@ static void find_pocl_devices(void)
 
 #define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
 #define SMALL "--width", "16", "--height", "12", "--spp", "2"
-#define OUT "/tmp/clpt-test-device-errors.png"
+/* per process: test runs of other checkouts on the same machine use /tmp too */
+static char out_path[64];
+#define OUT out_path
 
 static void test_broken_kernel_dir(void)
 {
@@ -94,6 +97,28 @@ static void test_build_failure_on_one_device(void)
     CHECK_EQ_INT(r.status, 5);
     CHECK_STR_CONTAINS(r.err, "clpt: error: device 'pthread");
     CHECK_STR_CONTAINS(r.err, "-D__kernel=clpt_test_build_failure_forced_by_CLPT_TEST_BUILD_FAIL");
+    CHECK(!file_exists(OUT));
+    unsetenv("CLPT_TEST_BUILD_FAIL");
+}
+
+/* The default choice (no --device) is every OpenCL CPU here; when none of them can
+ * build its kernels, the next group of the default order renders, with a warning: the
+ * scalar device. A device named with --device gets no such fallback. */
+static void test_default_device_falls_back(void)
+{
+    setenv("CLPT_TEST_BUILD_FAIL", pocl_ab, 1);
+    unlink(OUT);
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", OUT), &r);
+    CHECK_MSG(r.status == 0, "exit %d: %s", r.status, r.err);
+    CHECK_STR_CONTAINS(r.err, "clBuildProgram failed: CL_BUILD_PROGRAM_FAILURE");
+    CHECK_STR_CONTAINS(r.err, "clpt: warning: the default devices cannot be used; falling back to device ");
+    CHECK_STR_CONTAINS(r.err, " 'scalar'");
+    CHECK_STR_CONTAINS(r.err, "rendered 16x12, 2 spp");
+    CHECK(file_exists(OUT));
+    unlink(OUT);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", pocl_ab, SMALL, "-o", OUT), &r);
+    CHECK_EQ_INT(r.status, 5);
+    CHECK(strstr(r.err, "falling back") == NULL);
     CHECK(!file_exists(OUT));
     unsetenv("CLPT_TEST_BUILD_FAIL");
 }
@@ -166,11 +191,14 @@ int main(void)
 {
     /* before anything loads the ICD in a child: two PoCL CPU devices, 0 and 1 */
     setenv("POCL_DEVICES", "pthread pthread", 1);
+    snprintf(out_path, sizeof out_path, "/tmp/clpt-test-device-errors-%ld.png", (long)getpid());
     RUN(find_pocl_devices);
     RUN(test_memory_check);
     RUN(test_broken_kernel_dir);
     RUN(test_build_failure_on_one_device);
+    RUN(test_default_device_falls_back);
     RUN(test_device_too_small);
     RUN(test_small_device_dropped);
+    unlink(OUT);
     return harness_report();
 }

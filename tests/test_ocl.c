@@ -20,6 +20,7 @@
 
 #include "harness.h"
 #include "device/ocl.h"
+#include "device/ocl_args.h"
 #include "device/ocl_program.h"
 #include "base/sha256.h"
 #include "types.h"
@@ -138,6 +139,35 @@ static int child_two_devices(void)
     }
     free(list);
     return 0;
+}
+
+/* Child mode: builds the embedded program for the first device, as a run of clpt does,
+ * and prints what happened. */
+static int child_build(void)
+{
+    OclDeviceInfo *list = NULL;
+    size_t n = 0;
+    Error err = {0};
+    if (ocl_enumerate(&list, &n, &err) != ST_OK || n == 0) {
+        printf("no device %s\n", err.msg);
+        free(list);
+        return 1;
+    }
+    cl_int rc;
+    cl_context c = clCreateContext(NULL, 1, &list[0].id, NULL, NULL, &rc);
+    Status st = ST_DEVICE;
+    OclProgramStats stats;
+    memset(&stats, 0, sizeof stats);
+    if (rc == CL_SUCCESS) {
+        cl_program prog = NULL;
+        st = ocl_program_build(c, &list[0], NULL, NULL, &prog, &stats, &err);
+        if (prog) clReleaseProgram(prog);
+        clReleaseContext(c);
+    }
+    printf("build status %d from_cache %d\n", (int)st, stats.from_cache);
+    free(list);
+    error_clear(&err);
+    return st == ST_OK ? 0 : 1;
 }
 
 /* Child mode: prints what enumeration returns. */
@@ -466,6 +496,126 @@ static void test_corrupt_cache(void)
     expect_recovery("valid checksum, garbage binary", replace_payload_with_garbage);
 }
 
+/* Damages 64 payload bytes a third of the way in and gives the entry the checksum of
+ * its new payload: a whole entry that PoCL accepts and then aborts on (an assertion
+ * in pocl_llvm_read_program_llvm_irs), leaving what it read in its own cache. */
+static void damage_with_valid_checksum(const char *path)
+{
+    long size = 0;
+    unsigned char *buf = slurp(path, &size);
+    if (!buf || size < 88 + 3 * 64) {
+        free(buf);
+        return;
+    }
+    long from = 88 + (size - 88) / 3;
+    for (long i = from; i < from + 64; i++) buf[i] ^= 0xffu;
+    sha256(buf + 88, (size_t)(size - 88), buf + 56);
+    FILE *f = fopen(path, "wb");
+    if (f) {
+        fwrite(buf, 1, (size_t)size, f);
+        fclose(f);
+    }
+    free(buf);
+}
+
+/* An entry with a valid checksum and a payload the driver crashes on (in child runs
+ * with a cold PoCL cache, as after clearing ~/.cache/pocl): the run that meets it may
+ * die inside the driver, but the entry is no longer where the next run looks, and the
+ * next run builds afresh past what PoCL kept of it, then stores a good entry that the
+ * run after loads. Before, every later run crashed. */
+static void test_crashing_cache_entry(void)
+{
+    Error err = {0};
+    cl_program prog = NULL;
+    OclProgramStats s;
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, NULL, &prog, &s, &err), ST_OK);
+    if (prog) clReleaseProgram(prog);
+    char dir[400], pocl[400], entry[600], out[512];
+    snprintf(dir, sizeof dir, "%s/crash-cache", tmp_root);
+    snprintf(pocl, sizeof pocl, "%s/crash-pocl", tmp_root);
+    CHECK(mkdir(dir, 0755) == 0);
+    const char *name = strrchr(s.cache_path, '/');
+    snprintf(entry, sizeof entry, "%s%s", dir, name ? name : "/missing");
+    long size = 0;
+    unsigned char *good = slurp(s.cache_path, &size);
+    FILE *f = good ? fopen(entry, "wb") : NULL;
+    CHECK(f != NULL);
+    if (!f) {
+        free(good);
+        return;
+    }
+    fwrite(good, 1, (size_t)size, f);
+    fclose(f);
+    free(good);
+    damage_with_valid_checksum(entry);
+
+    int first = run_child("--build", "CLPT_TEST_UNUSED", "1", dir, pocl, out, sizeof out);
+    fprintf(stderr, "  run meeting the damaged entry: exit %d, %s", first, out[0] ? out : "(no output)\n");
+    CHECK_MSG(access(entry, F_OK) != 0 || first == 0, "the damaged entry is still in place after a crash");
+    CHECK_EQ_INT(run_child("--build", "CLPT_TEST_UNUSED", "1", dir, pocl, out, sizeof out), 0);
+    CHECK_STR_CONTAINS(out, "build status 0 from_cache 0\n");
+    CHECK_EQ_INT(run_child("--build", "CLPT_TEST_UNUSED", "1", dir, pocl, out, sizeof out), 0);
+    CHECK_STR_CONTAINS(out, "build status 0 from_cache 1\n");
+    error_clear(&err);
+}
+
+/* Every argument position device_ocl.c sets by name (ocl_args.h) is the kernel's
+ * argument of that name, and the scene buffers are the first arguments of every scene
+ * kernel in the order of kernels/scene_buffers.h. */
+static void check_arg_name(cl_program prog, const char *kernel, cl_uint arg, const char *name)
+{
+    cl_int rc;
+    cl_kernel k = clCreateKernel(prog, kernel, &rc);
+    char got[64] = "";
+    if (rc == CL_SUCCESS) {
+        rc = clGetKernelArgInfo(k, arg, CL_KERNEL_ARG_NAME, sizeof got, got, NULL);
+        clReleaseKernel(k);
+    }
+    CHECK_MSG(rc == CL_SUCCESS && strcmp(got, name) == 0, "%s argument %u is '%s' (%s), ocl_args.h says '%s'",
+              kernel, arg, got, ocl_error_name(rc), name);
+}
+
+static void test_kernel_argument_names(void)
+{
+    Error err = {0};
+    cl_program prog = NULL;
+    /* argument names are kept only when asked for (PoCL drops them from a binary) */
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, "-cl-kernel-arg-info", &prog, NULL, &err), ST_OK);
+    CHECK_MSG(prog != NULL, "%s", err.msg);
+    if (!prog) return;
+#define BUFFER_NAME_(kind, Type, name, count, what) #name,
+    static const char *const buffers[SCENE_BUF_COUNT] = { SCENE_BUFFERS(BUFFER_NAME_) };
+#undef BUFFER_NAME_
+    static const char *const scene_kernels[] = { "k_intersect", "k_shade", "k_shadow", "k_whitted" };
+    for (size_t k = 0; k < sizeof scene_kernels / sizeof scene_kernels[0]; k++)
+        for (cl_uint i = 0; i < SCENE_BUF_COUNT; i++) check_arg_name(prog, scene_kernels[k], i, buffers[i]);
+    static const struct { const char *kernel; cl_uint arg; const char *name; } named[] = {
+        { "k_raygen", ARG_RAYGEN_PARAMS, "params" }, { "k_raygen", ARG_RAYGEN_FIRST_PIXEL, "first_pixel" },
+        { "k_raygen", ARG_RAYGEN_FIRST_SAMPLE, "first_sample" }, { "k_raygen", ARG_RAYGEN_N_PIXELS, "n_pixels" },
+        { "k_raygen", ARG_RAYGEN_N_PATHS, "n_paths" }, { "k_raygen", ARG_RAYGEN_PATHS, "paths" },
+        { "k_raygen", ARG_RAYGEN_RAYS, "rays" }, { "k_raygen", ARG_RAYGEN_QUEUE, "queue" },
+        { "k_intersect", ARG_INTERSECT_QUEUE, "queue" }, { "k_intersect", ARG_INTERSECT_N, "n" },
+        { "k_intersect", ARG_INTERSECT_RAYS, "rays" }, { "k_intersect", ARG_INTERSECT_HITS, "hits" },
+        { "k_shade", ARG_SHADE_QUEUE, "queue" }, { "k_shade", ARG_SHADE_N, "n" },
+        { "k_shade", ARG_SHADE_RAYS, "rays" }, { "k_shade", ARG_SHADE_HITS, "hits" },
+        { "k_shade", ARG_SHADE_PATHS, "paths" }, { "k_shade", ARG_SHADE_SHADOW_RAYS, "shadow_rays" },
+        { "k_shade", ARG_SHADE_NEXT_QUEUE, "next_queue" }, { "k_shade", ARG_SHADE_SHADOW_QUEUE, "shadow_queue" },
+        { "k_shade", ARG_SHADE_COUNTS, "counts" }, { "k_shade", ARG_SHADE_SLOT, "slot" },
+        { "k_shadow", ARG_SHADOW_QUEUE, "shadow_queue" }, { "k_shadow", ARG_SHADOW_N, "n" },
+        { "k_shadow", ARG_SHADOW_RAYS, "shadow_rays" }, { "k_shadow", ARG_SHADOW_PATHS, "paths" },
+        { "k_film", ARG_FILM_PATHS, "paths" }, { "k_film", ARG_FILM_FIRST_PIXEL, "first_pixel" },
+        { "k_film", ARG_FILM_N_PIXELS, "n_pixels" }, { "k_film", ARG_FILM_N_PATHS, "n_paths" },
+        { "k_film", ARG_FILM_FILM, "film" },
+        { "k_whitted", ARG_WHITTED_FIRST_PIXEL, "first_pixel" }, { "k_whitted", ARG_WHITTED_FIRST_SAMPLE, "first_sample" },
+        { "k_whitted", ARG_WHITTED_N_PIXELS, "n_pixels" }, { "k_whitted", ARG_WHITTED_N_PATHS, "n_paths" },
+        { "k_whitted", ARG_WHITTED_PATHS, "paths" }, { "k_whitted", ARG_WHITTED_COUNTERS, "counters" },
+    };
+    for (size_t i = 0; i < sizeof named / sizeof named[0]; i++)
+        check_arg_name(prog, named[i].kernel, named[i].arg, named[i].name);
+    clReleaseProgram(prog);
+    error_clear(&err);
+}
+
 static void test_cache_location(void)
 {
     char saved_clpt[400], buf[1024];
@@ -591,6 +741,7 @@ int main(int argc, char **argv)
 {
     if (argc == 2 && strcmp(argv[1], "--two-devices") == 0) return child_two_devices();
     if (argc == 2 && strcmp(argv[1], "--enumerate") == 0) return child_enumerate();
+    if (argc == 2 && strcmp(argv[1], "--build") == 0) return child_build();
 
     snprintf(tmp_root, sizeof tmp_root, "%s/clpt-test-ocl-XXXXXX",
              getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -624,6 +775,8 @@ int main(int argc, char **argv)
     if (ctx) {
         RUN(test_build_and_cache);
         RUN(test_corrupt_cache);
+        RUN(test_crashing_cache_entry);
+        RUN(test_kernel_argument_names);
         RUN(test_cache_location);
         RUN(test_kernel_dir);
         RUN(test_build_failure);

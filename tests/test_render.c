@@ -102,10 +102,116 @@ static void test_opencl_matches_scalar(void)
     error_clear(&err);
 }
 
+/* Renders spp samples with the one device d as it is loaded now; 0 on failure. */
+static int render_on(Device *d, const RenderParams *p, uint spp, Film *film)
+{
+    Error err = { 0 };
+    ScheduleConfig cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.spp = spp;
+    ScheduleStats stats;
+    memset(&stats, 0, sizeof stats);
+    Status st = film_init(film, p->width, p->height, &err);
+    if (st == ST_OK) st = schedule_run(&d, 1, &cfg, film, &stats, &err);
+    schedule_stats_free(&stats);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    return st == ST_OK;
+}
+
+static int films_equal(const Film *a, const Film *b)
+{
+    size_t n = (size_t)a->width * a->height * 3u;
+    return a->sum && b->sum && a->samples == b->samples && memcmp(a->sum, b->sum, n * sizeof *a->sum) == 0;
+}
+
+/* One change of the params block and mask, made with update_params on a loaded device,
+ * must give the very film a device given the changed scene whole gives. */
+static void check_update(const DeviceDesc *desc, RenderScene *rs, const RenderParams *changed, const uint *mask)
+{
+    Error err = { 0 };
+    Device *kept = NULL, *fresh = NULL;
+    Film before, updated, reloaded;
+    memset(&before, 0, sizeof before);
+    memset(&updated, 0, sizeof updated);
+    memset(&reloaded, 0, sizeof reloaded);
+    DeviceScene ds = rs->ds;
+    Status st = device_open(desc, NULL, &kept, &err);
+    if (st == ST_OK) st = kept->ops->load_scene(kept, &ds, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (st == ST_OK && render_on(kept, &ds.params, 4, &before)) {
+        st = kept->ops->update_params(kept, changed, mask, &err);
+        CHECK_MSG(st == ST_OK, "update_params: %s", err.msg);
+        if (st == ST_OK) render_on(kept, changed, 4, &updated);
+    }
+    ds.params = *changed;
+    ds.pixel_mask = mask;
+    st = device_open(desc, NULL, &fresh, &err);
+    if (st == ST_OK) st = fresh->ops->load_scene(fresh, &ds, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (st == ST_OK) render_on(fresh, changed, 4, &reloaded);
+    CHECK_MSG(films_equal(&updated, &reloaded), "device %s: update_params and a full load differ", desc->name);
+    CHECK_MSG(before.sum && updated.sum && !films_equal(&before, &updated), "device %s: update_params changed nothing",
+              desc->name);
+    film_free(&before);
+    film_free(&updated);
+    film_free(&reloaded);
+    device_close(kept);
+    device_close(fresh);
+    error_clear(&err);
+}
+
+/* update_params (the passes' way to change the render without uploading the scene
+ * again) on the scalar device and on PoCL: another seed and a deeper path, then the
+ * classic integrator over a pixel mask. */
+static void check_update_params(const char *spec)
+{
+    Scene s;
+    Error err = { 0 };
+    scene_init(&s);
+    Status st = scene_load("scenes/cornell-box.scene", &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    s.image.width = 24;
+    s.image.height = 16;
+    s.image.max_depth = 3;
+    RenderScene rs;
+    memset(&rs, 0, sizeof rs);
+    if (st == ST_OK) st = render_scene_prepare(&s, 0, &rs, &err);
+    DeviceDesc *all = NULL;
+    size_t n_all = 0, *chosen = NULL, n_chosen = 0;
+    char warning[1100];
+    if (st == ST_OK) st = device_list(&all, &n_all, warning, sizeof warning, &err);
+    if (st == ST_OK) st = device_select(spec, all, n_all, &chosen, &n_chosen, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (st == ST_OK) {
+        RenderParams p = rs.ds.params;
+        p.seed = 1234u;
+        p.max_depth = 9u;   /* more bounces than loaded: the OpenCL counters grow */
+        check_update(&all[chosen[0]], &rs, &p, NULL);
+        uint mask[24 * 16];
+        for (uint i = 0; i < 24u * 16u; i++) mask[i] = (i % 3u) != 0u;
+        p = rs.ds.params;
+        p.integrator = INTEGRATOR_WHITTED;
+        p.use_mask = 1;
+        p.strata = 1;
+        check_update(&all[chosen[0]], &rs, &p, mask);
+    }
+    free(chosen);
+    free(all);
+    render_scene_free(&rs);
+    scene_free(&s);
+    error_clear(&err);
+}
+
+static void test_update_params_scalar(void) { check_update_params("scalar"); }
+static void test_update_params_opencl(void) { check_update_params("cpu"); }
+
 int main(void)
 {
     RUN(test_furnace_scalar);
     RUN(test_furnace_opencl);
     RUN(test_opencl_matches_scalar);
+    RUN(test_update_params_scalar);
+    RUN(test_update_params_opencl);
     return harness_report();
 }

@@ -2,6 +2,7 @@
 #include "device/device.h"
 
 #include "base/fault.h"
+#include "device/ocl.h"
 
 #include <ctype.h>
 #include <stdlib.h>
@@ -25,15 +26,32 @@ Status device_list(DeviceDesc **out, size_t *n, char *warning, size_t warning_si
         return error_set(err, ST_INTERNAL, "out of memory listing devices");
     }
     for (size_t i = 0; i < n_ocl; i++) {
-        all[i].kind = DEVICE_OPENCL;
-        all[i].index = (unsigned)i;
-        all[i].ocl = ocl[i];
-        fault_device_memory((unsigned)i, &all[i].ocl.global_mem, &all[i].ocl.max_alloc);
-        snprintf(all[i].name, sizeof all[i].name, "%s", ocl[i].name);
+        DeviceDesc *d = &all[i];
+        const OclDeviceInfo *o = &ocl[i];
+        d->kind = DEVICE_OPENCL;
+        d->index = (unsigned)i;
+        snprintf(d->name, sizeof d->name, "%s", o->name);
+        d->type = ((o->type & CL_DEVICE_TYPE_CPU) ? DEVICE_TYPE_CPU : 0u) |
+                  ((o->type & CL_DEVICE_TYPE_GPU) ? DEVICE_TYPE_GPU : 0u) |
+                  ((o->type & CL_DEVICE_TYPE_ACCELERATOR) ? DEVICE_TYPE_ACCELERATOR : 0u);
+        d->type_name = ocl_device_type_name(o->type);
+        d->compute_units = o->compute_units;
+        d->global_mem = o->global_mem;
+        d->max_alloc = o->max_alloc;
+        fault_device_memory((unsigned)i, &d->global_mem, &d->max_alloc);
+        snprintf(d->platform_name, sizeof d->platform_name, "%s", o->platform_name);
+        snprintf(d->driver_version, sizeof d->driver_version, "%s", o->driver_version);
+        d->ocl_platform = o->platform;
+        d->ocl_device = o->id;
+        d->ocl_platform_index = o->platform_index;
+        d->ocl_device_index = o->device_index;
     }
-    all[n_ocl].kind = DEVICE_SCALAR;
-    all[n_ocl].index = (unsigned)n_ocl;
-    snprintf(all[n_ocl].name, sizeof all[n_ocl].name, "scalar");
+    DeviceDesc *scalar = &all[n_ocl];
+    scalar->kind = DEVICE_SCALAR;
+    scalar->index = (unsigned)n_ocl;
+    snprintf(scalar->name, sizeof scalar->name, "scalar");
+    scalar->type = DEVICE_TYPE_CPU;
+    scalar->type_name = "CPU";
     free(ocl);
     *out = all;
     *n = n_ocl + 1;
@@ -53,10 +71,9 @@ void device_list_print(FILE *f, const DeviceDesc *all, size_t n)
         const DeviceDesc *d = &all[i];
         char mem[32];
         if (d->kind == DEVICE_OPENCL) {
-            format_bytes(d->ocl.global_mem, mem, sizeof mem);
-            fprintf(f, "%-3u %-8s %-6s %-5u %-10s %s (%s, %s)\n", d->index, "opencl",
-                    ocl_device_type_name(d->ocl.type), d->ocl.compute_units, mem, d->name,
-                    d->ocl.platform_name, d->ocl.driver_version);
+            format_bytes(d->global_mem, mem, sizeof mem);
+            fprintf(f, "%-3u %-8s %-6s %-5u %-10s %s (%s, %s)\n", d->index, "opencl", d->type_name,
+                    d->compute_units, mem, d->name, d->platform_name, d->driver_version);
         } else {
             long cores = sysconf(_SC_NPROCESSORS_ONLN);
             long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
@@ -123,10 +140,10 @@ static Status select_item(const char *item, const DeviceDesc *all, size_t n, siz
         int m;
         if (strcmp(item, "all") == 0) m = 1;
         else if (strcmp(item, "scalar") == 0) m = all[i].kind == DEVICE_SCALAR;
-        else if (strcmp(item, "gpu") == 0) m = all[i].kind == DEVICE_OPENCL && (all[i].ocl.type & CL_DEVICE_TYPE_GPU);
-        else if (strcmp(item, "cpu") == 0) m = all[i].kind == DEVICE_OPENCL && (all[i].ocl.type & CL_DEVICE_TYPE_CPU);
+        else if (strcmp(item, "gpu") == 0) m = all[i].kind == DEVICE_OPENCL && (all[i].type & DEVICE_TYPE_GPU);
+        else if (strcmp(item, "cpu") == 0) m = all[i].kind == DEVICE_OPENCL && (all[i].type & DEVICE_TYPE_CPU);
         else m = contains_ci(all[i].name, item) ||
-                 (all[i].kind == DEVICE_OPENCL && contains_ci(all[i].ocl.platform_name, item));
+                 (all[i].kind == DEVICE_OPENCL && contains_ci(all[i].platform_name, item));
         if (m) { add_choice(chosen, k, i); matched = 1; }
     }
     if (!matched && *k == before) return no_such_device(item, all, n, err);
@@ -141,10 +158,10 @@ Status device_select(const char *spec, const DeviceDesc *all, size_t n, size_t *
     size_t k = 0;
     if (!spec || !*spec) {
         for (size_t i = 0; i < n; i++)
-            if (all[i].kind == DEVICE_OPENCL && (all[i].ocl.type & CL_DEVICE_TYPE_GPU)) add_choice(chosen, &k, i);
+            if (all[i].kind == DEVICE_OPENCL && (all[i].type & DEVICE_TYPE_GPU)) add_choice(chosen, &k, i);
         if (k == 0)
             for (size_t i = 0; i < n; i++)
-                if (all[i].kind == DEVICE_OPENCL && (all[i].ocl.type & CL_DEVICE_TYPE_CPU)) add_choice(chosen, &k, i);
+                if (all[i].kind == DEVICE_OPENCL && (all[i].type & DEVICE_TYPE_CPU)) add_choice(chosen, &k, i);
         if (k == 0) add_choice(chosen, &k, n - 1);   /* the scalar device is always last */
         *chosen_out = chosen;
         *n_chosen = k;
@@ -184,6 +201,32 @@ Status device_select(const char *spec, const DeviceDesc *all, size_t n, size_t *
     return ST_OK;
 }
 
+/* The default choice's groups, in the order it tries them; accelerators and custom
+ * devices are never chosen by default. */
+enum { GROUP_GPU, GROUP_CPU, GROUP_SCALAR, GROUP_NONE };
+
+static int default_group(const DeviceDesc *d)
+{
+    if (d->kind == DEVICE_SCALAR) return GROUP_SCALAR;
+    if (d->type & DEVICE_TYPE_GPU) return GROUP_GPU;
+    if (d->type & DEVICE_TYPE_CPU) return GROUP_CPU;
+    return GROUP_NONE;
+}
+
+Status device_select_fallback(const DeviceDesc *all, size_t n, size_t failed, size_t **chosen_out,
+                              size_t *n_chosen, Error *err)
+{
+    size_t *chosen = calloc(n ? n : 1, sizeof *chosen);
+    if (!chosen) return error_set(err, ST_INTERNAL, "out of memory");
+    size_t k = 0;
+    for (int g = default_group(&all[failed]) + 1; g < GROUP_NONE && k == 0; g++)
+        for (size_t i = 0; i < n; i++)
+            if (default_group(&all[i]) == g) add_choice(chosen, &k, i);
+    *chosen_out = chosen;
+    *n_chosen = k;
+    return ST_OK;
+}
+
 Status device_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err)
 {
     if (desc->kind == DEVICE_SCALAR) return device_scalar_open(desc, cfg, out, err);
@@ -193,4 +236,29 @@ Status device_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out
 void device_close(Device *d)
 {
     if (d) d->ops->destroy(d);
+}
+
+/* The X-macro helpers that turn a line of kernels/scene_buffers.h into a buffer's
+ * address: a ONE buffer is held by value, a MANY buffer is a pointer already. */
+#define SCENE_DATA_ONE_(ds, name) ((const void *)&(ds)->name)
+#define SCENE_DATA_MANY_(ds, name) ((const void *)(ds)->name)
+
+SceneBufferBytes device_scene_buffer(const DeviceScene *ds, unsigned b)
+{
+    switch (b) {
+#define SCENE_BUFFER_CASE_(kind, Type, name, count, what)                                   \
+    case SCENE_BUF_##name:                                                                  \
+        return (SceneBufferBytes){ SCENE_DATA_##kind##_(ds, name), (size_t)(count) * sizeof(Type), what };
+        SCENE_BUFFERS(SCENE_BUFFER_CASE_)
+#undef SCENE_BUFFER_CASE_
+    default:
+        return (SceneBufferBytes){ NULL, 0, "no such scene buffer" };
+    }
+}
+
+void device_scene_view(const DeviceScene *ds, SceneView *view)
+{
+#define SCENE_VIEW_SET_(kind, Type, name, count, what) view->name = (const Type *)SCENE_DATA_##kind##_(ds, name);
+    SCENE_BUFFERS(SCENE_VIEW_SET_)
+#undef SCENE_VIEW_SET_
 }

@@ -29,37 +29,62 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "device/ocl.h"
 #include "base/status.h"
+#include "scene_view.h"
 #include "types.h"
 
-/* Everything a device needs, in kernel layout; counts of spheres, triangles, boxes,
- * planes and lights are in params. Arrays may be NULL when their count is 0. */
+/* Everything a device needs, in kernel layout: one field per line of
+ * kernels/scene_buffers.h (the params block by value, every other buffer as a pointer,
+ * NULL when its count is 0), then the counts that list finds here rather than in params.
+ * pixel_mask has width * height entries when params.use_mask is set, else it is NULL. */
+#define DEVICE_SCENE_FIELD_ONE_(Type, name) Type name;
+#define DEVICE_SCENE_FIELD_MANY_(Type, name) const Type *name;
+#define DEVICE_SCENE_FIELD_(kind, Type, name, count, what) DEVICE_SCENE_FIELD_##kind##_(Type, name)
 typedef struct {
-    RenderParams params;
-    const KdNode *nodes;          /* params.n_nodes */
-    const uint *leaf_prims;       /* params.n_leaf_prims */
-    const Sphere *spheres;
-    const Triangle *triangles;
-    const Box *boxes;
-    const Plane *planes;
-    const Material *materials;    uint n_materials;
-    const Light *lights;
-    const TriShading *shading;    uint n_shading;
-    const Texture *textures;      /* params.n_textures */
-    const uint *texels;           size_t n_texels;
-    const uint *pixel_mask;       /* width * height entries when params.use_mask, else NULL */
+    SCENE_BUFFERS(DEVICE_SCENE_FIELD_)
+    uint n_materials;
+    uint n_shading;
+    size_t n_texels;
 } DeviceScene;
+#undef DEVICE_SCENE_FIELD_
+#undef DEVICE_SCENE_FIELD_MANY_
+#undef DEVICE_SCENE_FIELD_ONE_
+
+/* One scene buffer of a DeviceScene as bytes: what a device uploads and the render key
+ * hashes. data may be NULL when bytes is 0. */
+typedef struct {
+    const void *data;
+    size_t bytes;
+    const char *what;     /* "triangles", "texture images" ... (scene_buffers.h) */
+} SceneBufferBytes;
+
+/* Buffer `b` (SCENE_BUF_nodes ...) of ds; b < SCENE_BUF_COUNT. */
+SceneBufferBytes device_scene_buffer(const DeviceScene *ds, unsigned b);
+
+/* Points every field of `view` at ds's buffers (the scalar device and the tests run the
+ * kernel stage functions on the host's own arrays). */
+void device_scene_view(const DeviceScene *ds, SceneView *view);
 
 typedef enum { DEVICE_OPENCL, DEVICE_SCALAR } DeviceKind;
 
+/* The kind of processor, as OpenCL reports it (a device may be several). */
+enum { DEVICE_TYPE_CPU = 1u, DEVICE_TYPE_GPU = 2u, DEVICE_TYPE_ACCELERATOR = 4u };
+
 /* One entry of --list-devices. OpenCL devices come first, in platform order; the scalar
- * device is last. */
+ * device is last. Plain C: what is OpenCL about a device stays in device_ocl.c, which
+ * alone turns the opaque handles back into OpenCL objects. */
 typedef struct {
     DeviceKind kind;
     unsigned index;               /* position in the listing, what --device N means */
     char name[256];
-    OclDeviceInfo ocl;            /* valid for DEVICE_OPENCL */
+    unsigned type;                /* DEVICE_TYPE_* bits */
+    const char *type_name;        /* "GPU", "CPU" ... (a static string) */
+    unsigned compute_units;
+    uint64_t global_mem, max_alloc;   /* bytes (OpenCL: after any CLPT_TEST_DEVICE_MEMORY cap) */
+    char platform_name[256];      /* OpenCL only, as the rest below */
+    char driver_version[128];
+    void *ocl_platform, *ocl_device;  /* cl_platform_id, cl_device_id */
+    unsigned ocl_platform_index, ocl_device_index;
 } DeviceDesc;
 
 typedef struct {
@@ -80,6 +105,11 @@ typedef struct Device Device;
 
 typedef struct {
     Status (*load_scene)(Device *d, const DeviceScene *scene, Error *err);
+    /* Replaces the params block and the pixel mask of the loaded scene, keeping every
+     * other buffer (a pass that changes the integrator, the samples or the mask need
+     * not upload the kd-tree again). The image size must be the one loaded; pixel_mask
+     * NULL is no mask. */
+    Status (*update_params)(Device *d, const RenderParams *params, const uint *pixel_mask, Error *err);
     /* Renders samples [first_sample, first_sample + count) of every pixel; ST_INTERRUPTED,
      * with nothing of the batch kept, when *d->cancel was set meanwhile. */
     Status (*render)(Device *d, uint first_sample, uint count, Error *err);
@@ -111,6 +141,13 @@ void device_list_print(FILE *f, const DeviceDesc *all, size_t n);
  * into `all`, without duplicates. A spec matching nothing is ST_USAGE, with the list. */
 Status device_select(const char *spec, const DeviceDesc *all, size_t n, size_t **chosen,
                      size_t *n_chosen, Error *err);
+
+/* The default choice falls back group by group: when no device of the default choice
+ * can be used (their kernels do not build, say), `chosen` receives the next group of
+ * the default order after the one of all[failed] that has any device (OpenCL GPUs,
+ * then OpenCL CPUs, then the scalar device); none when no group is left. */
+Status device_select_fallback(const DeviceDesc *all, size_t n, size_t failed, size_t **chosen,
+                              size_t *n_chosen, Error *err);
 
 Status device_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err);
 void device_close(Device *d);

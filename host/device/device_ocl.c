@@ -24,6 +24,7 @@
 #include "device/device.h"
 #include "device/device_memory.h"
 #include "base/fault.h"
+#include "device/ocl_args.h"
 #include "device/ocl_program.h"
 #include "base/timer.h"
 
@@ -38,10 +39,6 @@
 /* A batch smaller than two waves is still split in two (the second wave hides the
  * first one's round trips), unless the halves would be smaller than this. */
 #define MIN_SPLIT_PATHS 4096u
-
-enum { SCENE_PARAMS, SCENE_NODES, SCENE_LEAF_PRIMS, SCENE_SPHERES, SCENE_TRIANGLES,
-       SCENE_BOXES, SCENE_PLANES, SCENE_MATERIALS, SCENE_LIGHTS, SCENE_SHADING,
-       SCENE_TEXTURES, SCENE_TEXELS, SCENE_PIXEL_MASK, SCENE_N };
 
 /* A batch's film on the device and where its read-back lands. */
 typedef struct {
@@ -77,6 +74,7 @@ typedef struct {
     uint n_slots;           /* 2, or 1 when two films do not fit the device */
     uint head, tail;        /* batches rendered and taken, counted from 0 */
     uint max_bounces;       /* bounces 0 .. max_depth: 2 * max_bounces + 1 count slots */
+    uint counts_bounces;    /* the bounces the wave count buffers have room for */
     uint wave_paths;        /* capacity of each wave's buffers */
     size_t local_size;      /* 0: let the driver choose */
     uint n_pixels;
@@ -183,28 +181,28 @@ static Status set_fixed_args(OclDevice *od, WaveSlot *w, Error *err)
         (st = set_scene_args(od, w->k_shadow, err)))
         return st;
     cl_kernel k = w->k_raygen;
-    ARG(k, 0, od->scene[SCENE_PARAMS]);
-    ARG(k, 3, od->n_pixels);
-    ARG(k, 5, w->paths);
-    ARG(k, 6, w->rays);
-    ARG(k, 7, w->queue_a);
+    ARG(k, ARG_RAYGEN_PARAMS, od->scene[SCENE_BUF_params]);
+    ARG(k, ARG_RAYGEN_N_PIXELS, od->n_pixels);
+    ARG(k, ARG_RAYGEN_PATHS, w->paths);
+    ARG(k, ARG_RAYGEN_RAYS, w->rays);
+    ARG(k, ARG_RAYGEN_QUEUE, w->queue_a);
     k = w->k_intersect;
-    ARG(k, SCENE_N + 2, w->rays);
-    ARG(k, SCENE_N + 3, w->hits);
+    ARG(k, ARG_INTERSECT_RAYS, w->rays);
+    ARG(k, ARG_INTERSECT_HITS, w->hits);
     k = w->k_shade;
-    ARG(k, SCENE_N + 2, w->rays);
-    ARG(k, SCENE_N + 3, w->hits);
-    ARG(k, SCENE_N + 4, w->paths);
-    ARG(k, SCENE_N + 5, w->shadow_rays);
-    ARG(k, SCENE_N + 7, w->shadow_queue);
-    ARG(k, SCENE_N + 8, w->counts);
+    ARG(k, ARG_SHADE_RAYS, w->rays);
+    ARG(k, ARG_SHADE_HITS, w->hits);
+    ARG(k, ARG_SHADE_PATHS, w->paths);
+    ARG(k, ARG_SHADE_SHADOW_RAYS, w->shadow_rays);
+    ARG(k, ARG_SHADE_SHADOW_QUEUE, w->shadow_queue);
+    ARG(k, ARG_SHADE_COUNTS, w->counts);
     k = w->k_shadow;
-    ARG(k, SCENE_N + 0, w->shadow_queue);
-    ARG(k, SCENE_N + 2, w->shadow_rays);
-    ARG(k, SCENE_N + 3, w->paths);
+    ARG(k, ARG_SHADOW_QUEUE, w->shadow_queue);
+    ARG(k, ARG_SHADOW_RAYS, w->shadow_rays);
+    ARG(k, ARG_SHADOW_PATHS, w->paths);
     k = w->k_film;
-    ARG(k, 0, w->paths);
-    ARG(k, 2, od->n_pixels);
+    ARG(k, ARG_FILM_PATHS, w->paths);
+    ARG(k, ARG_FILM_N_PIXELS, od->n_pixels);
     return ST_OK;
 }
 
@@ -228,24 +226,12 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     double t0 = timer_now();
     release_buffers(od);
     const RenderParams *p = &s->params;
-    struct { const void *src; size_t bytes; const char *what; } in[SCENE_N] = {
-        { p, sizeof *p, "render parameters" },
-        { s->nodes, (size_t)p->n_nodes * sizeof(KdNode), "kd-tree nodes" },
-        { s->leaf_prims, (size_t)p->n_leaf_prims * sizeof(uint), "kd-tree leaf lists" },
-        { s->spheres, (size_t)p->n_spheres * sizeof(Sphere), "spheres" },
-        { s->triangles, (size_t)p->n_triangles * sizeof(Triangle), "triangles" },
-        { s->boxes, (size_t)p->n_boxes * sizeof(Box), "boxes" },
-        { s->planes, (size_t)p->n_planes * sizeof(Plane), "planes" },
-        { s->materials, (size_t)s->n_materials * sizeof(Material), "materials" },
-        { s->lights, (size_t)p->n_lights * sizeof(Light), "lights" },
-        { s->shading, (size_t)s->n_shading * sizeof(TriShading), "shading normals" },
-        { s->textures, (size_t)p->n_textures * sizeof(Texture), "textures" },
-        { s->texels, s->n_texels * sizeof(uint), "texture images" },
-        { s->pixel_mask, s->pixel_mask ? (size_t)p->width * p->height * sizeof(uint) : 0, "pixel mask" },
-    };
+    SceneBufferBytes in[SCENE_N];
+    for (unsigned i = 0; i < SCENE_N; i++) in[i] = device_scene_buffer(s, i);
     uint n_pixels = p->width * p->height;
     uint wave = od->wave_paths;
     od->max_bounces = p->max_depth + 1u;
+    od->counts_bounces = od->max_bounces;
     size_t counts_bytes = (2u * (size_t)od->max_bounces + 1u) * QUEUE_COUNT_STRIDE * sizeof(cl_uint);
     size_t film_bytes = (size_t)n_pixels * 3u * sizeof(cl_long);
     /* Every buffer below is checked against the device before the first is allocated:
@@ -278,7 +264,7 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     else
         od->n_slots = 1;
     for (int i = 0; i < SCENE_N; i++)
-        if ((st = make_buffer(od, CL_MEM_READ_ONLY, in[i].bytes, in[i].src, in[i].what, &od->scene[i], err)))
+        if ((st = make_buffer(od, CL_MEM_READ_ONLY, in[i].bytes, in[i].data, in[i].what, &od->scene[i], err)))
             return st;
     cl_mem_flags rw = CL_MEM_READ_WRITE;
     for (int i = 0; i < WAVE_SLOTS; i++) {
@@ -310,6 +296,61 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     od->integrator = p->integrator;
     d->n_pixels = n_pixels;
     d->max_in_flight = od->n_slots;
+    d->counters.upload_seconds += timer_now() - t0;
+    return ST_OK;
+}
+
+/* Gives every wave count buffers for `bounces` bounces, when they have room for fewer. */
+static Status grow_counts(OclDevice *od, uint bounces, Error *err)
+{
+    if (bounces <= od->counts_bounces) return ST_OK;
+    size_t bytes = (2u * (size_t)bounces + 1u) * QUEUE_COUNT_STRIDE * sizeof(cl_uint);
+    Status st;
+    for (int i = 0; i < WAVE_SLOTS; i++) {
+        WaveSlot *w = &od->waves[i];
+        release_mem(&w->counts);
+        if ((st = make_buffer(od, CL_MEM_READ_WRITE, bytes, NULL, "queue counters", &w->counts, err))) return st;
+        ARG(w->k_shade, ARG_SHADE_COUNTS, w->counts);
+    }
+    od->counts_bounces = bounces;
+    return ST_OK;
+}
+
+/* Sets the scene buffer `b` as the argument of every kernel that takes the scene. */
+static Status set_scene_arg(OclDevice *od, unsigned b, Error *err)
+{
+    for (int i = 0; i < WAVE_SLOTS; i++) {
+        WaveSlot *w = &od->waves[i];
+        ARG(w->k_intersect, b, od->scene[b]);
+        ARG(w->k_shade, b, od->scene[b]);
+        ARG(w->k_shadow, b, od->scene[b]);
+    }
+    ARG(od->k_whitted, b, od->scene[b]);
+    return ST_OK;
+}
+
+/* The params block is written in place (the buffer keeps its size); the pixel mask
+ * gets a buffer of its own size, set as every kernel's argument. */
+static Status ocl_update_params(Device *d, const RenderParams *p, const uint *pixel_mask, Error *err)
+{
+    OclDevice *od = d->impl;
+    if (p->width * p->height != od->n_pixels)
+        return error_set(err, ST_INTERNAL, "device '%s': new render parameters for %ux%u pixels, the scene was "
+                         "loaded for %u pixels", od->info.name, p->width, p->height, od->n_pixels);
+    double t0 = timer_now();
+    Status st;
+    /* every launch so far has read the old block and mask */
+    OCL_TRY("clFinish", clFinish(od->queue));
+    OCL_TRY("clEnqueueWriteBuffer", clEnqueueWriteBuffer(od->queue, od->scene[SCENE_BUF_params], CL_TRUE, 0,
+                                                         sizeof *p, p, 0, NULL, NULL));
+    release_mem(&od->scene[SCENE_BUF_pixel_mask]);
+    size_t mask_bytes = pixel_mask ? (size_t)od->n_pixels * sizeof(uint) : 0;
+    if ((st = make_buffer(od, CL_MEM_READ_ONLY, mask_bytes, pixel_mask, "pixel mask",
+                          &od->scene[SCENE_BUF_pixel_mask], err)) ||
+        (st = set_scene_arg(od, SCENE_BUF_pixel_mask, err)) || (st = grow_counts(od, p->max_depth + 1u, err)))
+        return st;
+    od->max_bounces = p->max_depth + 1u;
+    od->integrator = p->integrator;
     d->counters.upload_seconds += timer_now() - t0;
     return ST_OK;
 }
@@ -536,7 +577,13 @@ static void ocl_destroy(Device *d)
     free(d);
 }
 
-static const DeviceOps ocl_ops = { ocl_load_scene, ocl_render, ocl_take_film, ocl_destroy };
+static const DeviceOps ocl_ops = {
+    .load_scene = ocl_load_scene,
+    .update_params = ocl_update_params,
+    .render = ocl_render,
+    .take_film = ocl_take_film,
+    .destroy = ocl_destroy,
+};
 
 static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error *err)
 {
@@ -572,6 +619,27 @@ static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error
     return ST_OK;
 }
 
+/* The OpenCL description of the device `desc` lists (its handles are opaque outside
+ * this file), with the memory sizes the listing reports (they may carry a test cap). */
+static Status ocl_find(const DeviceDesc *desc, OclDeviceInfo *info, Error *err)
+{
+    OclDeviceInfo *all = NULL;
+    size_t n = 0;
+    Status st = ocl_enumerate(&all, &n, err);
+    if (st) return st;
+    size_t i = 0;
+    while (i < n && all[i].id != (cl_device_id)desc->ocl_device) i++;
+    if (i == n) {
+        free(all);
+        return error_set(err, ST_DEVICE, "device '%s': no longer listed by OpenCL", desc->name);
+    }
+    *info = all[i];
+    info->global_mem = desc->global_mem;
+    info->max_alloc = desc->max_alloc;
+    free(all);
+    return ST_OK;
+}
+
 Status device_ocl_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err)
 {
     Device *d = calloc(1, sizeof *d);
@@ -584,8 +652,8 @@ Status device_ocl_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device *
     d->ops = &ocl_ops;
     d->desc = *desc;
     d->impl = od;
-    od->info = desc->ocl;
-    Status st = ocl_setup(d, od, cfg, err);
+    Status st = ocl_find(desc, &od->info, err);
+    if (st == ST_OK) st = ocl_setup(d, od, cfg, err);
     if (st) {
         ocl_destroy(d);
         return st;

@@ -136,23 +136,24 @@ static Status cpu_load_scene(Device *d, const DeviceScene *scene, Error *err)
     free(cd->film);
     cd->film = calloc((size_t)n_pixels * 3u, sizeof *cd->film);
     if (!cd->film) return error_set(err, ST_INTERNAL, "scalar device: out of memory for the film");
-    /* The scene arrays are the host's own: this device reads them in place. */
+    /* The scene arrays are the host's own: this device reads them in place, except the
+     * params block, copied so that update_params can replace it. */
     cd->params = scene->params;
+    device_scene_view(scene, &cd->view);
     cd->view.params = &cd->params;
-    cd->view.nodes = scene->nodes;
-    cd->view.leaf_prims = scene->leaf_prims;
-    cd->view.spheres = scene->spheres;
-    cd->view.triangles = scene->triangles;
-    cd->view.boxes = scene->boxes;
-    cd->view.planes = scene->planes;
-    cd->view.materials = scene->materials;
-    cd->view.lights = scene->lights;
-    cd->view.shading = scene->shading;
-    cd->view.textures = scene->textures;
-    cd->view.texels = scene->texels;
-    cd->view.pixel_mask = scene->pixel_mask;
     d->n_pixels = n_pixels;
     d->max_in_flight = 1;
+    return ST_OK;
+}
+
+static Status cpu_update_params(Device *d, const RenderParams *params, const uint *pixel_mask, Error *err)
+{
+    CpuDevice *cd = d->impl;
+    if (params->width != cd->params.width || params->height != cd->params.height)
+        return error_set(err, ST_INTERNAL, "scalar device: new render parameters for %ux%u pixels, the scene "
+                         "was loaded for %ux%u", params->width, params->height, cd->params.width, cd->params.height);
+    cd->params = *params;
+    cd->view.pixel_mask = pixel_mask;
     return ST_OK;
 }
 
@@ -214,7 +215,13 @@ static void cpu_destroy(Device *d)
     free(d);
 }
 
-static const DeviceOps cpu_ops = { cpu_load_scene, cpu_render, cpu_take_film, cpu_destroy };
+static const DeviceOps cpu_ops = {
+    .load_scene = cpu_load_scene,
+    .update_params = cpu_update_params,
+    .render = cpu_render,
+    .take_film = cpu_take_film,
+    .destroy = cpu_destroy,
+};
 
 Status device_scalar_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err)
 {

@@ -1,6 +1,8 @@
 #include "device/ocl_program.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <signal.h>
 #include <stdint.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -254,8 +256,24 @@ cleanup:
     return found;
 }
 
+/* Whether a program built from a cached binary is what clpt needs: built for the
+ * device (clBuildProgram can succeed while the device's status says otherwise) and
+ * holding the kernel every clpt program has. */
+static int oclp__usable(cl_program prog, const OclDeviceInfo *dev)
+{
+    cl_build_status bs = CL_BUILD_NONE;
+    if (clGetProgramBuildInfo(prog, dev->id, CL_PROGRAM_BUILD_STATUS, sizeof bs, &bs, NULL) != CL_SUCCESS ||
+        bs != CL_BUILD_SUCCESS)
+        return 0;
+    cl_int rc;
+    cl_kernel k = clCreateKernel(prog, "k_layout", &rc);
+    if (rc != CL_SUCCESS) return 0;
+    clReleaseKernel(k);
+    return 1;
+}
+
 /* Creates and builds a program from a cached binary; 0 (and nothing to release) when
- * the driver refuses it. */
+ * the driver refuses it or the result is not usable. */
 static int oclp__from_binary(cl_context ctx, const OclDeviceInfo *dev, const unsigned char *bin,
                              size_t len, const char *options, cl_program *out)
 {
@@ -265,12 +283,87 @@ static int oclp__from_binary(cl_context ctx, const OclDeviceInfo *dev, const uns
         if (prog) clReleaseProgram(prog);
         return 0;
     }
-    if (clBuildProgram(prog, 1, &dev->id, options, NULL, NULL) != CL_SUCCESS) {
+    if (clBuildProgram(prog, 1, &dev->id, options, NULL, NULL) != CL_SUCCESS || !oclp__usable(prog, dev)) {
         clReleaseProgram(prog);
         return 0;
     }
     *out = prog;
     return 1;
+}
+
+/* Whether an earlier run died while its driver read the entry at `path`: it left
+ * PATH.PID.trying behind (oclp__cache_load) and process PID is gone. Removes such
+ * leftovers. A run still trying the entry is left alone. */
+static int oclp__crashed_before(const char *path)
+{
+    char dir[1024];
+    const char *slash = strrchr(path, '/');
+    if (!slash || (size_t)(slash - path) >= sizeof dir) return 0;
+    memcpy(dir, path, (size_t)(slash - path));
+    dir[slash - path] = '\0';
+    const char *base = slash + 1;
+    size_t base_len = strlen(base);
+    DIR *d = opendir(dir);
+    if (!d) return 0;
+    int crashed = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        const char *name = e->d_name;
+        size_t len = strlen(name);
+        if (len <= base_len + 8 || strncmp(name, base, base_len) != 0 || name[base_len] != '.' ||
+            strcmp(name + len - 7, ".trying") != 0)
+            continue;
+        char *end = NULL;
+        long pid = strtol(name + base_len + 1, &end, 10);
+        if (pid <= 0 || end != name + len - 7) continue;
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;   /* still running */
+        char stale[1100];
+        if (snprintf(stale, sizeof stale, "%s/%s", dir, name) < (int)sizeof stale) unlink(stale);
+        crashed = 1;
+    }
+    closedir(d);
+    return crashed;
+}
+
+/* Loads the program from the cache entry at `path`; 1 on success. The entry is moved
+ * aside to PATH.PID.trying while the driver reads it, and put back only once the
+ * program proved usable: a payload whose checksum is right but which the driver cannot
+ * take (PoCL 3 aborts the process on some damaged binaries, in
+ * clCreateProgramWithBinary or clBuildProgram) then costs at most the one run it
+ * crashed, instead of crashing every later run. A refused entry is deleted. A
+ * concurrent run meanwhile finds no entry and builds from source.
+ *
+ * The driver may have kept what it read in a cache of its own (PoCL does, under the
+ * program's hash, and then crashes on it when the same source is built again): when a
+ * run died trying the entry, `path`.crashed is left as a mark, and while it exists the
+ * source is built with a line that changes the driver's key (oclp__from_source). */
+static int oclp__cache_load(cl_context ctx, const OclDeviceInfo *dev, const char *path,
+                            const unsigned char key[SHA256_DIGEST_SIZE], const char *options,
+                            cl_program *out)
+{
+    char trying[1100], crashed[1100];
+    if (snprintf(trying, sizeof trying, "%s.%ld.trying", path, (long)getpid()) >= (int)sizeof trying ||
+        snprintf(crashed, sizeof crashed, "%s.crashed", path) >= (int)sizeof crashed)
+        return 0;
+    unsigned char *bin = NULL;
+    size_t bin_len = 0;
+    int got = oclp__cache_read(path, key, &bin, &bin_len);
+    if (got == 0) {
+        if (oclp__crashed_before(path)) {
+            FILE *mark = fopen(crashed, "w");
+            if (mark) fclose(mark);
+        }
+        return 0;
+    }
+    if (got < 0 || rename(path, trying) != 0) {
+        unlink(path);     /* damaged: rebuilt and replaced by the caller */
+        free(bin);
+        return 0;
+    }
+    int ok = oclp__from_binary(ctx, dev, bin, bin_len, options, out);
+    if (ok && rename(trying, path) != 0) oclp__cache_write(path, key, bin, bin_len);
+    if (!ok) unlink(trying);
+    free(bin);
+    return ok;
 }
 
 /* ---------------------------------------------------------------- building */
@@ -290,11 +383,19 @@ static char *oclp__build_log(cl_program prog, const OclDeviceInfo *dev)
     return log;
 }
 
+/* Appended to the source while a cache entry's mark says a run crashed loading it
+ * (oclp__cache_load): a different source is a different key in the driver's own cache,
+ * so the driver compiles afresh instead of reading what the bad binary left there. A
+ * declaration, not a comment: PoCL keys its cache on the preprocessed source. */
+static const char oclp__fresh_line[] = "\ntypedef int clpt_built_afresh_after_a_crash;\n";
+
 static Status oclp__from_source(cl_context ctx, const OclDeviceInfo *dev, const char *src,
-                                size_t len, const char *options, cl_program *out, Error *err)
+                                size_t len, const char *options, int fresh, cl_program *out, Error *err)
 {
     cl_int rc;
-    cl_program prog = clCreateProgramWithSource(ctx, 1, &src, &len, &rc);
+    const char *parts[2] = { src, oclp__fresh_line };
+    size_t lens[2] = { len, sizeof oclp__fresh_line - 1 };
+    cl_program prog = clCreateProgramWithSource(ctx, fresh ? 2 : 1, parts, lens, &rc);
     if (rc != CL_SUCCESS) return ocl_fail(err, dev, "clCreateProgramWithSource", rc);
     rc = clBuildProgram(prog, 1, &dev->id, options, NULL, NULL);
     if (rc != CL_SUCCESS) {
@@ -382,20 +483,14 @@ Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *k
         snprintf(path, sizeof path, "%s/%s.bin", dir, hex);
     }
 
-    if (path[0]) {
-        unsigned char *bin = NULL;
-        size_t bin_len = 0;
-        int got = oclp__cache_read(path, key, &bin, &bin_len);
-        if (got == 1 && oclp__from_binary(ctx, dev, bin, bin_len, options, out))
-            stats->from_cache = 1;
-        else if (got != 0)
-            unlink(path); /* damaged or refused: rebuilt and replaced below */
-        free(bin);
-    }
+    if (path[0] && oclp__cache_load(ctx, dev, path, key, options, out)) stats->from_cache = 1;
 
     if (!stats->from_cache) {
         oclp__announce(dev, path[0] != '\0');
-        st = oclp__from_source(ctx, dev, src, src_len, options, out, err);
+        char crashed[sizeof path + 16];
+        snprintf(crashed, sizeof crashed, "%s.crashed", path);
+        int fresh = path[0] && access(crashed, F_OK) == 0;
+        st = oclp__from_source(ctx, dev, src, src_len, options, fresh, out, err);
         if (st == ST_OK && path[0]) {
             unsigned char *bin = NULL;
             size_t bin_len = 0;

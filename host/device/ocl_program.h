@@ -18,18 +18,18 @@
  * holds a magic, the key, the payload length and the payload's SHA-256, then the
  * device's CL_PROGRAM_BINARIES. Files are written to a temporary name in the same folder
  * and renamed, so a concurrent run sees either no file or a whole one. Anything wrong
- * with an entry (truncated, corrupt, refused by the driver) deletes it and the program
- * is rebuilt from source and stored again. A cache that cannot be created or written
- * only means building from source: it never fails a run.
+ * with an entry (truncated, corrupt, refused by the driver, or a program that did not
+ * build for the device or lacks clpt's kernels) deletes it and the program is rebuilt
+ * from source and stored again. While the driver reads an entry it is moved aside, so
+ * an entry the driver crashes on is gone for the next run, which compiles afresh past
+ * whatever the driver kept of it (ocl_program.c, oclp__cache_load). A cache that cannot
+ * be created or written only means building from source: it never fails a run.
  */
 #ifndef CLPT_OCL_PROGRAM_H
 #define CLPT_OCL_PROGRAM_H
 
+#include "device/kernel_source.h"
 #include "device/ocl.h"
-
-/* Defined by the generated build/kernel_source.c: the flattened kernels/entry.cl. */
-extern const char clpt_kernel_source[];
-extern const size_t clpt_kernel_source_len;
 
 typedef struct {
     double seconds;        /* wall time of the whole ocl_program_build call */

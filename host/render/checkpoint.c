@@ -10,7 +10,7 @@
 
 #include "base/atomic_file.h"
 #include "base/limit.h"
-#include "device/ocl_program.h"
+#include "device/kernel_source.h"
 #include "base/sha256.h"
 
 #define CKPT_MAGIC "CLPTCKPT"
@@ -34,21 +34,17 @@ void checkpoint_id(const DeviceScene *ds, uint spp, CheckpointId *id)
     const RenderParams *p = &ds->params;
     Sha256 h;
     sha256_init(&h);
-    hash_part(&h, "clpt render key 1", NULL, 0);
+    hash_part(&h, "clpt render key 2", NULL, 0);
     /* The kernels decide every bit of a sample: a clpt with other kernels must not add
      * its samples to this film. */
     hash_part(&h, "kernels", clpt_kernel_source, clpt_kernel_source_len);
-    hash_part(&h, "params", p, sizeof *p);
     hash_part(&h, "spp", &spp, sizeof spp);
-    hash_part(&h, "nodes", ds->nodes, (size_t)p->n_nodes * sizeof *ds->nodes);
-    hash_part(&h, "leaf prims", ds->leaf_prims, (size_t)p->n_leaf_prims * sizeof *ds->leaf_prims);
-    hash_part(&h, "spheres", ds->spheres, (size_t)p->n_spheres * sizeof *ds->spheres);
-    hash_part(&h, "triangles", ds->triangles, (size_t)p->n_triangles * sizeof *ds->triangles);
-    hash_part(&h, "boxes", ds->boxes, (size_t)p->n_boxes * sizeof *ds->boxes);
-    hash_part(&h, "planes", ds->planes, (size_t)p->n_planes * sizeof *ds->planes);
-    hash_part(&h, "materials", ds->materials, (size_t)ds->n_materials * sizeof *ds->materials);
-    hash_part(&h, "lights", ds->lights, (size_t)p->n_lights * sizeof *ds->lights);
-    hash_part(&h, "shading", ds->shading, (size_t)ds->n_shading * sizeof *ds->shading);
+    /* every scene buffer of kernels/scene_buffers.h, the params block first: a buffer
+     * added to that list is part of the key without a change here */
+    for (unsigned i = 0; i < SCENE_BUF_COUNT; i++) {
+        SceneBufferBytes b = device_scene_buffer(ds, i);
+        hash_part(&h, b.what, b.data, b.bytes);
+    }
     memset(id, 0, sizeof *id);
     sha256_final(&h, id->key);
     id->width = p->width;

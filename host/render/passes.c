@@ -4,13 +4,26 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Loads the (changed) scene into every device, renders spp samples into a new film. */
+/* Gives every device the params block and pixel mask of pc->rs. */
+static Status update_devices(const PassContext *pc, Error *err)
+{
+    const DeviceScene *ds = &pc->rs->ds;
+    Status st;
+    for (size_t i = 0; i < pc->n_devices; i++) {
+        Device *d = pc->devices[i];
+        if ((st = d->ops->update_params(d, &ds->params, ds->pixel_mask, err))) return st;
+    }
+    return ST_OK;
+}
+
+/* Gives every device the pass's params block and pixel mask (the scene's other buffers
+ * stay as loaded), renders spp samples into a new film. */
 static Status render_pass(const PassContext *pc, uint spp, Film *film, double *seconds, Error *err)
 {
     const DeviceScene *ds = &pc->rs->ds;
     Status st;
-    for (size_t i = 0; i < pc->n_devices; i++)
-        if ((st = pc->devices[i]->ops->load_scene(pc->devices[i], ds, err))) return st;
+    memset(film, 0, sizeof *film);   /* the caller frees it whatever happens */
+    if ((st = update_devices(pc, err))) return st;
     if ((st = film_init(film, ds->params.width, ds->params.height, err))) return st;
     ScheduleConfig cfg = *pc->cfg;
     cfg.spp = spp;
@@ -74,6 +87,9 @@ Status passes_adaptive(const PassContext *pc, float *rgb, uint base_spp, float t
     Status st = render_pass(pc, extra, &film, seconds, err);
     *p = saved;
     pc->rs->ds.pixel_mask = NULL;
+    /* the devices too: none keeps the mask freed below */
+    Status restored = update_devices(pc, st == ST_OK ? err : NULL);
+    if (st == ST_OK) st = restored;
     if (st == ST_OK && film.samples > 0) {
         float *more = malloc(n * 3 * sizeof *more);
         if (!more) {
@@ -134,6 +150,8 @@ Status passes_aov(const PassContext *pc, uint aov, uint spp, const DepthScale *d
     Film film;
     Status st = render_pass(pc, spp, &film, seconds, err);
     *p = saved;
+    Status restored = update_devices(pc, st == ST_OK ? err : NULL);
+    if (st == ST_OK) st = restored;
     if (st == ST_OK) {
         film_resolve(&film, rgb);
         if (aov == INTEGRATOR_AOV_DEPTH) depth_to_grey(rgb, (size_t)p->width * p->height, depth);

@@ -3,9 +3,10 @@
  * adaptive supersampling pass, and the auxiliary images (normals, depth, albedo).
  *
  * Each pass changes a few render parameters (the integrator, a pixel mask, the pixel
- * sampling), loads the scene into the devices again and renders with the scheduler as
- * the main image did, so it runs on every selected device and gives the same bits on
- * any of them.
+ * sampling), hands them to the devices (update_params: the scene's other buffers stay
+ * as loaded) and renders with the scheduler as the main image did, so it runs on every
+ * selected device and gives the same bits on any of them. After the pass the devices
+ * get the main render's parameters back.
  */
 #ifndef CLPT_PASSES_H
 #define CLPT_PASSES_H

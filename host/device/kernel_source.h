@@ -1,0 +1,14 @@
+/*
+ * kernel_source.h — the kernel source embedded at build time (tools/embed.c flattens
+ * kernels/entry.cl and its includes into build/kernel_source.c): what the OpenCL devices
+ * compile, and what the checkpoint render key hashes. Plain C, no OpenCL types.
+ */
+#ifndef CLPT_KERNEL_SOURCE_H
+#define CLPT_KERNEL_SOURCE_H
+
+#include <stddef.h>
+
+extern const char clpt_kernel_source[];
+extern const size_t clpt_kernel_source_len;
+
+#endif /* CLPT_KERNEL_SOURCE_H */

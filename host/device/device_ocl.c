@@ -362,14 +362,14 @@ static Status bounce_launch(OclDevice *od, WaveSlot *w, uint b, uint n, Error *e
     Status st;
     cl_uint slot = 2u * b + 1u;
     cl_kernel k = w->k_intersect;
-    ARG(k, SCENE_N + 0, w->cur);
-    ARG(k, SCENE_N + 1, n);
+    ARG(k, ARG_INTERSECT_QUEUE, w->cur);
+    ARG(k, ARG_INTERSECT_N, n);
     if ((st = launch(od, k, "k_intersect", n, err))) return st;
     k = w->k_shade;
-    ARG(k, SCENE_N + 0, w->cur);
-    ARG(k, SCENE_N + 1, n);
-    ARG(k, SCENE_N + 6, w->next);
-    ARG(k, SCENE_N + 9, slot);
+    ARG(k, ARG_SHADE_QUEUE, w->cur);
+    ARG(k, ARG_SHADE_N, n);
+    ARG(k, ARG_SHADE_NEXT_QUEUE, w->next);
+    ARG(k, ARG_SHADE_SLOT, slot);
     if ((st = launch(od, k, "k_shade", n, err))) return st;
     OCL_TRY("clEnqueueReadBuffer",
             clEnqueueReadBuffer(od->queue, w->counts, CL_FALSE, (size_t)slot * QUEUE_COUNT_STRIDE * sizeof(cl_uint),
@@ -390,9 +390,9 @@ static Status wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint firs
             clEnqueueFillBuffer(od->queue, w->counts, &zero, sizeof zero, 0,
                                 (2u * (size_t)od->max_bounces + 1u) * QUEUE_COUNT_STRIDE * sizeof zero, 0, NULL, NULL));
     cl_kernel k = w->k_raygen;
-    ARG(k, 1, first_pixel);
-    ARG(k, 2, first_sample);
-    ARG(k, 4, n_paths);
+    ARG(k, ARG_RAYGEN_FIRST_PIXEL, first_pixel);
+    ARG(k, ARG_RAYGEN_FIRST_SAMPLE, first_sample);
+    ARG(k, ARG_RAYGEN_N_PATHS, n_paths);
     if ((st = launch(od, k, "k_raygen", n_paths, err))) return st;
     w->first_pixel = first_pixel;
     w->first_sample = first_sample;
@@ -414,7 +414,7 @@ static Status wave_advance(OclDevice *od, WaveSlot *w, Error *err)
     uint shadows = w->got[0], next = w->got[QUEUE_COUNT_STRIDE];
     od->rays += (uint64_t)w->live + shadows;
     cl_kernel k = w->k_shadow;
-    ARG(k, SCENE_N + 1, shadows);
+    ARG(k, ARG_SHADOW_N, shadows);
     if ((st = launch(od, k, "k_shadow", shadows, err))) return st;
     if (next > 0 && w->bounce + 1u < od->max_bounces) {
         cl_mem t = w->cur;
@@ -423,9 +423,9 @@ static Status wave_advance(OclDevice *od, WaveSlot *w, Error *err)
         return bounce_launch(od, w, w->bounce + 1u, next, err);
     }
     k = w->k_film;
-    ARG(k, 1, w->first_pixel);
-    ARG(k, 3, w->n_paths);
-    ARG(k, 4, od->film);
+    ARG(k, ARG_FILM_FIRST_PIXEL, w->first_pixel);
+    ARG(k, ARG_FILM_N_PATHS, w->n_paths);
+    ARG(k, ARG_FILM_FILM, od->film);
     w->active = 0;
     return launch(od, k, "k_film", w->n_paths < od->n_pixels ? w->n_paths : od->n_pixels, err);
 }
@@ -469,17 +469,17 @@ static Status render_whitted(OclDevice *od, uint first_sample, uint64_t total, E
         OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, w->counts, &zero, sizeof zero, 0,
                                                            sizeof zero, 0, NULL, NULL));
         cl_kernel k = od->k_whitted;
-        ARG(k, SCENE_N + 0, first_pixel);
-        ARG(k, SCENE_N + 1, sample);
-        ARG(k, SCENE_N + 2, od->n_pixels);
-        ARG(k, SCENE_N + 3, n);
-        ARG(k, SCENE_N + 4, w->paths);
-        ARG(k, SCENE_N + 5, w->counts);
+        ARG(k, ARG_WHITTED_FIRST_PIXEL, first_pixel);
+        ARG(k, ARG_WHITTED_FIRST_SAMPLE, sample);
+        ARG(k, ARG_WHITTED_N_PIXELS, od->n_pixels);
+        ARG(k, ARG_WHITTED_N_PATHS, n);
+        ARG(k, ARG_WHITTED_PATHS, w->paths);
+        ARG(k, ARG_WHITTED_COUNTERS, w->counts);
         if ((st = launch(od, k, "k_whitted", n, err))) return st;
         k = w->k_film;
-        ARG(k, 1, first_pixel);
-        ARG(k, 3, n);
-        ARG(k, 4, od->film);
+        ARG(k, ARG_FILM_FIRST_PIXEL, first_pixel);
+        ARG(k, ARG_FILM_N_PATHS, n);
+        ARG(k, ARG_FILM_FILM, od->film);
         if ((st = launch(od, k, "k_film", n < od->n_pixels ? n : od->n_pixels, err))) return st;
         OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, w->counts, CL_TRUE, 0, sizeof count, &count,
                                                            0, NULL, NULL));

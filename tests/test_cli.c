@@ -573,6 +573,18 @@ static void test_named_files_must_be_regular(void)
     CHECK_MSG(r.status == 0, "exit %d: %s", r.status, r.err);
 }
 
+/* A FIFO named by --resume is refused at once (fopen waited for a writer for ever). */
+static void test_resume_from_fifo_refused(void)
+{
+    shell_run("d=$(mktemp -d /tmp/clpt-test-fifo-XXXXXX); trap 'rm -rf \"$d\"' EXIT\n"
+              "mkfifo \"$d/r.ckpt\"\n"
+              "timeout 20 \"$CLPT\" " PIPE_FLAGS " --resume \"$d/r.ckpt\" -o \"$d/o.png\" scenes/cornell-box.scene\n",
+              &r);
+    CHECK_MSG(r.status == 4, "exit %d: %s", r.status, r.err);
+    CHECK_STR_CONTAINS(r.err, "cannot read checkpoint");
+    CHECK_STR_CONTAINS(r.err, "not a regular file");
+}
+
 int main(void)
 {
     RUN(test_help_documents_every_flag);
@@ -598,5 +610,6 @@ int main(void)
     RUN(test_kernel_build_notice);
     RUN(test_scene_from_pipe);
     RUN(test_named_files_must_be_regular);
+    RUN(test_resume_from_fifo_refused);
     return harness_report();
 }

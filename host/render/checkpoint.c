@@ -2,11 +2,13 @@
 #include "render/checkpoint.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "base/atomic_file.h"
 #include "base/limit.h"
@@ -184,8 +186,15 @@ static Status read_film_values(const unsigned char *p, uint64_t n_values, uint64
 Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
 {
     memset(c, 0, sizeof *c);
-    FILE *f = fopen(path, "rb");
-    if (!f) return error_set(err, ST_IO, "cannot read checkpoint '%s': %s", path, strerror(errno));
+    /* Opened without blocking, so that a FIFO named by --resume is refused below instead
+     * of waiting for a writer that never comes. */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    FILE *f = fd >= 0 ? fdopen(fd, "rb") : NULL;
+    if (!f) {
+        Status io = error_set(err, ST_IO, "cannot read checkpoint '%s': %s", path, strerror(errno));
+        if (fd >= 0) close(fd);
+        return io;
+    }
     Status st = ST_OK;
     unsigned char *data = NULL;
     struct stat sb;

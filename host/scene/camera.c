@@ -39,6 +39,22 @@ double camera_focus(const SceneCamera *desc)
     return focus;
 }
 
+/* The kernel camera, rounded to float once from the double frame. */
+static void camera_fill(Camera *out, uint type, dvec3 from, dvec3 corner, dvec3 horizontal, dvec3 vertical,
+                        dvec3 u, dvec3 v, dvec3 w, float lens_radius)
+{
+    memset(out, 0, sizeof *out);
+    out->type = type;
+    out->origin = fv(from);
+    out->lens_radius = lens_radius;
+    out->corner = fv(corner);
+    out->horizontal = fv(horizontal);
+    out->vertical = fv(vertical);
+    out->lens_u = fv(u);
+    out->lens_v = fv(v);
+    out->forward = fv(dscale(w, -1.0));
+}
+
 Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *out, Error *err)
 {
     dvec3 from = dv(desc->from), at = dv(desc->at), up = dv(desc->up);
@@ -68,15 +84,7 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
         dvec3 horizontal = dscale(u, vp_w), vertical = dscale(v, vp_h);
         dvec3 corner = { from.x - horizontal.x / 2 + vertical.x / 2, from.y - horizontal.y / 2 + vertical.y / 2,
                          from.z - horizontal.z / 2 + vertical.z / 2 };
-        memset(out, 0, sizeof *out);
-        out->type = CAMERA_ORTHOGRAPHIC;
-        out->origin = fv(from);
-        out->corner = fv(corner);
-        out->horizontal = fv(horizontal);
-        out->vertical = fv(vertical);
-        out->lens_u = fv(u);
-        out->lens_v = fv(v);
-        out->forward = fv(dscale(w, -1.0));
+        camera_fill(out, CAMERA_ORTHOGRAPHIC, from, corner, horizontal, vertical, u, v, w, 0.0f);
         return ST_OK;
     }
 
@@ -95,15 +103,6 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
                      from.y - horizontal.y / 2 + vertical.y / 2 - focus * w.y,
                      from.z - horizontal.z / 2 + vertical.z / 2 - focus * w.z };
 
-    memset(out, 0, sizeof *out);
-    out->type = CAMERA_PERSPECTIVE;
-    out->origin = fv(from);
-    out->lens_radius = (float)(desc->aperture * 0.5);
-    out->corner = fv(corner);
-    out->horizontal = fv(horizontal);
-    out->vertical = fv(vertical);
-    out->lens_u = fv(u);
-    out->lens_v = fv(v);
-    out->forward = fv(dscale(w, -1.0));
+    camera_fill(out, CAMERA_PERSPECTIVE, from, corner, horizontal, vertical, u, v, w, (float)(desc->aperture * 0.5));
     return ST_OK;
 }

@@ -15,6 +15,7 @@
 #include "render_util.h"
 
 #include "io/classic_parse.h"
+#include "io/scene_load.h"
 #include "io/texture.h"
 #include "background.h"
 
@@ -210,6 +211,53 @@ static void test_orientation(void)
     scene_free(&s);
 }
 
+/* clpt's own format: `background { cubemap "DIR" }`, the same lookup, exclusive with
+ * the colour keys. */
+static void test_clpt_format(void)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/own.scene", dir);
+    FILE *f = fopen(path, "wb");
+    if (f) {
+        fputs("image { width 5 height 5 spp 4 }\ncamera { from 0 0 0 at 0 0 -1 fov 30 }\n"
+              "background { cubemap \"cube\" }\n", f);
+        fclose(f);
+    }
+    Scene s;
+    Error err = {0};
+    scene_init(&s);
+    CHECK_EQ_INT(scene_load_file(path, SCENE_FORMAT_AUTO, &s, NULL, &err), ST_OK);
+    CHECK_EQ_INT(s.integrator, INTEGRATOR_PATH);
+    CHECK_EQ_INT(s.bg_type, BG_CUBEMAP);
+    float *a = render(&s, "scalar"), *b = render(&s, "cpu");
+    check_pixel(a, b, 5 * 5 * 3, 2 * 5 + 2, CUBE_BACK, "clpt format, looking along -z");
+    free(a);
+    free(b);
+    scene_free(&s);
+    error_clear(&err);
+    f = fopen(path, "wb");
+    if (f) {
+        fputs("background { color 1 1 1 cubemap \"cube\" }\n", f);
+        fclose(f);
+    }
+    scene_init(&s);
+    CHECK_EQ_INT(scene_load_file(path, SCENE_FORMAT_AUTO, &s, NULL, &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "own.scene:1:26: a background is either 'cubemap' or a colour");
+    scene_free(&s);
+    error_clear(&err);
+    f = fopen(path, "wb");
+    if (f) {
+        fputs("background { cubemap \"holes\" }\n", f);
+        fclose(f);
+    }
+    scene_init(&s);
+    CHECK_EQ_INT(scene_load_file(path, SCENE_FORMAT_AUTO, &s, NULL, &err), ST_IO);
+    CHECK_STR_CONTAINS(err.msg, "own.scene:1:22: cannot open '");
+    CHECK_STR_CONTAINS(err.msg, "holes/down.png'");
+    scene_free(&s);
+    error_clear(&err);
+}
+
 /* A face missing, and a cube map that names a file: I/O errors at the name. */
 static void test_errors(void)
 {
@@ -258,6 +306,7 @@ int main(void)
     RUN(test_mirror);
     RUN(test_orientation);
     RUN(test_errors);
+    RUN(test_clpt_format);
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", dir);

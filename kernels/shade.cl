@@ -7,6 +7,7 @@
 #ifndef CLPT_SHADE_CL
 #define CLPT_SHADE_CL
 
+#include "background.h"
 #include "bsdf.h"
 #include "lights.h"
 #include "rng.h"
@@ -18,15 +19,6 @@ KFN float mis_power(float a, float b)
 {
     float a2 = a * a, b2 = b * b;
     return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
-}
-
-KFN vec3 background_radiance(GLOBAL const RenderParams *p, vec3 d)
-{
-    if (p->bg_type == BG_SKY) {
-        float t = 0.5f * (d.y + 1.0f);
-        return v3_add(v3_scale(p->bg_color, 1.0f - t), v3_scale(p->bg_zenith, t));
-    }
-    return p->bg_color;
 }
 
 /* Next-event estimation at a diffuse or Phong surface: samples a light, and if it is
@@ -74,7 +66,9 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     uint key = ps->rng_key, bounce = ps->bounce;
 
     if (hit.prim == NO_INDEX) {
-        ps->radiance = v3_add(ps->radiance, v3_mul(ps->throughput, background_radiance(p, r.d)));
+        /* the background is no light that next-event estimation samples (a cube map is
+         * not importance-sampled): what BSDF sampling finds counts fully, unweighted */
+        ps->radiance = v3_add(ps->radiance, v3_mul(ps->throughput, background_radiance(sc, r.d)));
         return 0u;
     }
 

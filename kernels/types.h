@@ -188,7 +188,11 @@ typedef struct {                                        /* 112 bytes */
     vec3 color1;  float pad4;
 } Texture;
 
-enum BackgroundType { BG_CONSTANT = 0, BG_SKY = 1 };
+enum BackgroundType { BG_CONSTANT = 0, BG_SKY = 1, BG_CUBEMAP = 2 };
+
+/* A cube-map background is six consecutive image textures from
+ * RenderParams.bg_cubemap on, in the course's order (kernels/background.h). */
+enum CubeFace { CUBE_LEFT = 0, CUBE_RIGHT = 1, CUBE_UP = 2, CUBE_DOWN = 3, CUBE_FRONT = 4, CUBE_BACK = 5 };
 
 /* What a sample computes: light transport (path, whitted) or an auxiliary image of the
  * first hit (kernels/whitted.cl). */
@@ -208,7 +212,8 @@ enum MisMode { MIS_BOTH = 0, MIS_LIGHT_ONLY = 1, MIS_BSDF_ONLY = 2 };
 typedef struct {                                        /* 272 bytes */
     Camera camera;
     vec3 bg_color;    uint bg_type;   /* constant colour, or the sky's horizon colour */
-    vec3 bg_zenith;   uint pad0;      /* sky colour straight up (+y) */
+    vec3 bg_zenith;   uint bg_cubemap;  /* sky colour straight up (+y); BG_CUBEMAP: the
+                                       * texture index of its first face (CUBE_LEFT) */
     uint width, height;
     uint max_depth;                   /* longest path, in bounces after the camera ray */
     uint rr_depth;                    /* Russian roulette starts at this bounce */

@@ -143,7 +143,7 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, uint key, uint *rays)
         node++;
         vec3 d = e.ray.d;
         if (hit.prim == NO_INDEX) {
-            L = v3_add(L, v3_mul(e.weight, background_radiance(p, d)));
+            L = v3_add(L, v3_mul(e.weight, background_radiance(sc, d)));
             continue;
         }
         Surface s = surface_at(sc, e.ray, hit);

@@ -81,6 +81,28 @@ static void add_textures(uint t[4])
                       &t[3], NULL);
 }
 
+/* Six 3x2 linear, clamped image faces of varied texels for a cube-map background (the
+ * scene keeps its sky; the tests switch params to the cube map). Returns the first. */
+static uint cube_first;
+static void add_cube_faces(void)
+{
+    for (uint f = 0; f < 6; f++) {
+        uint px[6], offset, index;
+        for (uint i = 0; i < 6; i++)
+            px[i] = ((f * 41u + i * 67u) & 255u) | ((f * 13u + i * 29u + 80u) & 255u) << 8 |
+                    ((f * 97u + i * 5u + 30u) & 255u) << 16;
+        scene_add_texels(&scene, px, 6, &offset, NULL);
+        Texture t = texture_make_checker(v3s(0.0f), v3s(0.0f), 1.0f, 0);
+        t.type = TEX_IMAGE;
+        t.flags = TEX_CLAMP;
+        t.offset = offset;
+        t.width = 3;
+        t.height = 2;
+        scene_add_texture(&scene, NULL, NULL, t, &index, NULL);
+        if (f == 0) cube_first = index;
+    }
+}
+
 /* A small scene with every primitive type and material type, and lights of each
  * lightable shape. */
 static void build_scene(void)
@@ -108,6 +130,7 @@ static void build_scene(void)
     /* the classic ray tracer's materials, textured in every way */
     uint tex[4], phong, mirror, clear, checked;
     add_textures(tex);
+    add_cube_faces();
     Material ph = material_phong(v3(0.6f, 0.5f, 0.4f), v3(0.3f, 0.3f, 0.3f), 25.0f);
     ph.texture = tex[0];
     scene_add_material(&scene, "phong", ph, &phong, NULL);
@@ -504,6 +527,70 @@ static void test_shade_and_shadow(void)
     for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) clReleaseMemObject(ms[i]);
 }
 
+/* Paths that escape, shaded by k_shade with a cube-map background: random directions
+ * reach every face, and PoCL gives the C build's bits. */
+static void test_shade_cubemap(void)
+{
+    enum { N = 4096 };
+    RenderParams p = rs.ds.params;
+    p.bg_type = BG_CUBEMAP;
+    p.bg_cubemap = cube_first;
+    PathState *ps = malloc(N * sizeof *ps);
+    Ray *rays = malloc(N * sizeof *rays);
+    Hit *hits = calloc(N, sizeof *hits);
+    uint *queue = malloc(N * sizeof *queue);
+    for (uint i = 0; i < N; i++) {
+        raygen_path(&p, i % (p.width * p.height), i, &ps[i], &rays[i]);
+        rays[i] = random_ray();
+        ps[i].throughput = vrand(0.05f, 1.0f);
+        hits[i].prim = NO_INDEX;
+        queue[i] = i;
+    }
+    cl_mem parb = buffer(sizeof p, &p), pb = buffer(N * sizeof *ps, ps), rb = buffer(N * sizeof *rays, rays),
+           hb = buffer(N * sizeof *hits, hits), qb = buffer(N * sizeof *queue, queue),
+           srb = buffer(N * sizeof(Ray), NULL), nqb = buffer(N * sizeof(uint), NULL),
+           sqb = buffer(N * sizeof(uint), NULL);
+    cl_uint init_counts[5 * QUEUE_COUNT_STRIDE] = { 0 }, slot = 3;
+    cl_mem cb = buffer(sizeof init_counts, init_counts);
+    cl_kernel k = kernel("k_shade");
+    set_scene_args(k);
+    SET(k, 0, parb);
+    uint n = N;
+    SET(k, N_SCENE + 0, qb);
+    SET(k, N_SCENE + 1, n);
+    SET(k, N_SCENE + 2, rb);
+    SET(k, N_SCENE + 3, hb);
+    SET(k, N_SCENE + 4, pb);
+    SET(k, N_SCENE + 5, srb);
+    SET(k, N_SCENE + 6, nqb);
+    SET(k, N_SCENE + 7, sqb);
+    SET(k, N_SCENE + 8, cb);
+    SET(k, N_SCENE + 9, slot);
+    run(k, N);
+    PathState *dps = malloc(N * sizeof *dps);
+    read_back(pb, N * sizeof *dps, dps);
+    SceneView v = view;
+    v.params = &p;
+    uint exact = 0, bad = 0, lit = 0;
+    for (uint i = 0; i < N; i++) {
+        PathState c = ps[i];
+        Ray r = rays[i], shadow;
+        CHECK_EQ_INT(shade_path(&v, &r, hits[i], &c, &shadow), 0);
+        lit += v3_max_comp(v3_sub(c.radiance, ps[i].radiance)) > 0.0f;
+        exact += memcmp(&c.radiance, &dps[i].radiance, sizeof c.radiance) == 0;
+        if (!v3_close(c.radiance, dps[i].radiance, 1e-5f)) bad++;
+    }
+    fprintf(stderr, "  k_shade (cube-map background): %u escaping paths, %u lit, %u bit-identical to C\n",
+            (uint)N, lit, exact);
+    CHECK(lit > N / 2);
+    CHECK_MSG(bad == 0, "%u of %u escaping paths differ", bad, (uint)N);
+    CHECK_EQ_INT(exact, N);
+    free(ps); free(rays); free(hits); free(queue); free(dps);
+    clReleaseKernel(k);
+    cl_mem ms[] = { parb, pb, rb, hb, qb, srb, nqb, sqb, cb };
+    for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) clReleaseMemObject(ms[i]);
+}
+
 /* A wave that starts at pixel 100 of a 600-pixel image and wraps around it three times
  * and a bit: pixels get three or four of its paths. */
 static void test_film(void)
@@ -551,13 +638,14 @@ static void test_whitted(void)
     for (uint i = 0; i < npix; i++) mask[i] = (i * 7u) % 5u < 2u;
     cl_mem mb = buffer(npix * sizeof *mask, mask), pb = buffer(n * sizeof(PathState), NULL);
     cl_kernel k = kernel("k_whitted");
-    struct { uint integrator, strata, use_mask; const char *name; } modes[] = {
-        { INTEGRATOR_WHITTED, 0, 0, "whitted, pixel centres" },
-        { INTEGRATOR_WHITTED, 3, 0, "whitted, 3x3 jittered" },
-        { INTEGRATOR_WHITTED, 1, 1, "whitted, jittered, masked" },
-        { INTEGRATOR_AOV_NORMAL, 0, 0, "normal image" },
-        { INTEGRATOR_AOV_DEPTH, 1, 0, "depth image" },
-        { INTEGRATOR_AOV_ALBEDO, 0, 0, "albedo image" },
+    struct { uint integrator, strata, use_mask, cube; const char *name; } modes[] = {
+        { INTEGRATOR_WHITTED, 0, 0, 0, "whitted, pixel centres" },
+        { INTEGRATOR_WHITTED, 3, 0, 0, "whitted, 3x3 jittered" },
+        { INTEGRATOR_WHITTED, 1, 1, 0, "whitted, jittered, masked" },
+        { INTEGRATOR_WHITTED, 1, 0, 1, "whitted, cube-map background" },
+        { INTEGRATOR_AOV_NORMAL, 0, 0, 0, "normal image" },
+        { INTEGRATOR_AOV_DEPTH, 1, 0, 0, "depth image" },
+        { INTEGRATOR_AOV_ALBEDO, 0, 0, 0, "albedo image" },
     };
     for (size_t m = 0; m < sizeof modes / sizeof modes[0]; m++) {
         RenderParams p = *base;
@@ -565,6 +653,10 @@ static void test_whitted(void)
         p.strata = modes[m].strata;
         p.use_mask = modes[m].use_mask;
         p.sample_offset = 5;
+        if (modes[m].cube) {
+            p.bg_type = BG_CUBEMAP;
+            p.bg_cubemap = cube_first;
+        }
         cl_mem parb = buffer(sizeof p, &p);
         cl_uint zero = 0;
         cl_mem cb = buffer(sizeof zero, &zero);
@@ -720,6 +812,7 @@ int main(void)
     RUN(test_raygen);
     RUN(test_intersect);
     RUN(test_shade_and_shadow);
+    RUN(test_shade_cubemap);
     RUN(test_film);
     RUN(test_whitted);
     RUN(test_kmath);

@@ -443,10 +443,30 @@ static Status parse_lights(Classic *c, const Token *kw)
     }
 }
 
-enum { BG_COLOR, BG_AMBIENT, BG_N };
+enum { BG_COLOR, BG_AMBIENT, BG_CUBE, BG_N };
 static const ClassicKey background_keys[BG_N] = {
     [BG_COLOR] = {"color", CK_COLOR, 0}, [BG_AMBIENT] = {"ambientLight", CK_COLOR, 0},
+    [BG_CUBE] = {"cubeMap", CK_PATH, 0},
 };
+
+/* `cubeMap DIR`: escaping rays see the six images of DIR (the course's getBackgroundColor
+ * returns the cube map's texel when there is one, whatever the colour says). */
+static Status parse_cubemap(Classic *c, const Token *word)
+{
+    char *path;
+    Status st = resolve_path(c, word, &path);
+    if (st) return st;
+    uint first;
+    st = texture_load_cubemap(c->s, path, &first, c->err);
+    free(path);
+    if (st) {
+        if (st == ST_IO || st == ST_INPUT) error_prefix(c->err, "%s:%u:%u", c->lx.path, word->line, word->col);
+        return st;
+    }
+    c->s->bg_type = BG_CUBEMAP;
+    c->s->bg_cubemap = first;
+    return ST_OK;
+}
 
 static Status parse_background(Classic *c, const Token *kw)
 {
@@ -463,6 +483,7 @@ static Status parse_background(Classic *c, const Token *kw)
         c->s->ambient = v[BG_AMBIENT].v;
         c->ambient_given = 1;
     }
+    if (v[BG_CUBE].given) return parse_cubemap(c, &v[BG_CUBE].word);
     return ST_OK;
 }
 

@@ -415,13 +415,31 @@ static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-enum { BG_COLOR, BG_HORIZON, BG_ZENITH, BG_AMBIENT, BG_N };
+enum { BG_COLOR, BG_HORIZON, BG_ZENITH, BG_AMBIENT, BG_CUBE, BG_N };
 static const KeySpec background_keys[BG_N] = {
     [BG_COLOR] = {"color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [BG_HORIZON] = {"horizon", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [BG_ZENITH] = {"zenith", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [BG_AMBIENT] = {"ambient", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [BG_CUBE] = {"cubemap", VK_PATH, 0, 0, 0, 0, 0, NULL},
 };
+
+/* `cubemap "DIR"`: the classic format's cube map (six images, the MIT 6.837 course's
+ * names and orientation; host/io/texture.c), the folder found beside the scene file. */
+static Status parse_background_cubemap(Parser *p, Lexer *lx, const Value *v)
+{
+    const Token *f = &v->word;
+    char *path = path_beside(lx->path, f->text, f->len);
+    if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
+    uint first;
+    Status st = texture_load_cubemap(p->s, path, &first, p->err);
+    free(path);
+    if (st == ST_IO || st == ST_INPUT) error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+    if (st) return st;
+    p->s->bg_type = BG_CUBEMAP;
+    p->s->bg_cubemap = first;
+    return ST_OK;
+}
 
 static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
 {
@@ -432,6 +450,11 @@ static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
     Scene *s = p->s;
     if (v[BG_AMBIENT].given) s->ambient = v[BG_AMBIENT].v;   /* the whitted integrator's */
     int sky = v[BG_HORIZON].given || v[BG_ZENITH].given;
+    if (v[BG_CUBE].given && (v[BG_COLOR].given || sky))
+        return lex_error_at(lx, &v[BG_CUBE].key, p->err,
+                            "a background is either 'cubemap' or a colour ('color', or 'horizon' and "
+                            "'zenith'), not both");
+    if (v[BG_CUBE].given) return parse_background_cubemap(p, lx, &v[BG_CUBE]);
     if (v[BG_COLOR].given && sky) {
         const Token *t = v[BG_HORIZON].given ? &v[BG_HORIZON].key : &v[BG_ZENITH].key;
         if (t->line < v[BG_COLOR].key.line ||
@@ -443,7 +466,8 @@ static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
     }
     if (!v[BG_COLOR].given && !sky)
         return lex_error_at(lx, kw, p->err,
-                            "the background block needs 'color', or 'horizon' and 'zenith'");
+                            "the background block needs 'color', or 'horizon' and 'zenith', "
+                            "or 'cubemap'");
     if (sky && !(v[BG_HORIZON].given && v[BG_ZENITH].given))
         return lex_error_at(lx, kw, p->err, "a sky background needs both 'horizon' and 'zenith'");
     if (sky) {

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <stb_image.h>
 
@@ -390,4 +391,40 @@ Status texture_load_image(Scene *s, const char *name, const char *path, int line
     t.height = (uint)h;
     if (clamp) t.flags |= TEX_CLAMP;
     return scene_add_texture(s, name, path, t, index, err);
+}
+
+/* The course's face names, in the order of enum CubeFace, and the extensions its
+ * versions used (Fall 2019: .png; the earlier starter code: .bmp). */
+static const char *const cube_faces[6] = { "left", "right", "up", "down", "front", "back" };
+static const char *const cube_exts[2] = { ".png", ".bmp" };
+
+Status texture_load_cubemap(Scene *s, const char *dir, uint *first, Error *err)
+{
+    struct stat sb;
+    if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode))
+        return error_set(err, ST_IO, "'%s': not a folder (a cube map names a folder holding the images "
+                         "left, right, up, down, front and back, .png or .bmp)", dir);
+    size_t dl = strlen(dir);
+    char *path = malloc(dl + 16);
+    if (!path) return error_set(err, ST_INTERNAL, "out of memory");
+    Status st = ST_OK;
+    for (uint f = 0; f < 6 && !st; f++) {
+        int found = -1;
+        for (int e = 0; e < 2 && found < 0; e++) {
+            snprintf(path, dl + 16, "%s/%s%s", dir, cube_faces[f], cube_exts[e]);
+            if (stat(path, &sb) == 0) found = e;
+        }
+        if (found < 0) {
+            st = error_set(err, ST_IO, "cannot open '%s/%s%s' (nor '%s/%s%s'): the cube map's %s face",
+                           dir, cube_faces[f], cube_exts[0], dir, cube_faces[f], cube_exts[1], cube_faces[f]);
+            break;
+        }
+        snprintf(path, dl + 16, "%s/%s%s", dir, cube_faces[f], cube_exts[found]);
+        uint index;
+        /* the file's bytes / 255, as the course reads them; clamped at the edges */
+        st = texture_load_image(s, NULL, path, 1, 1, &index, err);
+        if (!st && f == 0) *first = index;
+    }
+    free(path);
+    return st;
 }

@@ -32,4 +32,12 @@ void texture_set_matrix(Texture *t, const float m[12]);
 Status texture_load_image(Scene *s, const char *name, const char *path, int linear, int clamp,
                           uint *index, Error *err);
 
+/* Reads the six faces of a cube map from the folder `dir` (the MIT 6.837 course's
+ * CubeMap: left, right, up, down, front and back, each NAME.png or else NAME.bmp) as
+ * linear, clamped image textures with consecutive indices, the first (left) in *first,
+ * in the order of enum CubeFace. Errors: ST_IO "cannot open 'DIR/NAME.png' (nor
+ * 'DIR/NAME.bmp'): the cube map's NAME face" for a missing face, ST_IO "'DIR': not a
+ * folder ..." when dir is not one, and texture_load_image's for a face that is there. */
+Status texture_load_cubemap(Scene *s, const char *dir, uint *first, Error *err);
+
 #endif /* CLPT_TEXTURE_H_HOST */

@@ -32,6 +32,7 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     p->bg_type = s->bg_type;
     p->bg_color = s->bg_color;
     p->bg_zenith = s->bg_zenith;
+    p->bg_cubemap = s->bg_cubemap;
     p->width = s->image.width;
     p->height = s->image.height;
     p->max_depth = s->image.max_depth;

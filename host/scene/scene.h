@@ -34,6 +34,7 @@ typedef struct {
     SceneImage image;
     uint bg_type;                /* enum BackgroundType */
     vec3 bg_color, bg_zenith;
+    uint bg_cubemap;             /* BG_CUBEMAP: index of the first of its six textures */
 
     Material *materials;   char **material_names;  size_t n_materials, cap_materials;
     /* Per material: the albedo texture file a mesh's MTL names (map_Kd, resolved to a

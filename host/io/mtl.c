@@ -177,6 +177,12 @@ static Status read_newmtl(MtlReader *r)
     while (e > name && is_blank(e[-1])) e--;
     if (e == name) return fail_at(r, name, "a material name after 'newmtl'");
     size_t len = (size_t)(e - name);
+    /* A NUL would end the name for every C string function that later reads it (and for
+     * an OBJ's usemtl), while the name map keys the whole bytes: refuse it. */
+    const char *nul = memchr(name, '\0', len);
+    if (nul)
+        return error_set(r->err, ST_INPUT, "%s:%u:%u: a NUL byte in the material name", r->path, r->line,
+                         (uint)(nul - r->line_start + 1));
     MtlLibrary *lib = r->lib;
     uint32_t idx;
     if (!strmap_find(&lib->by_name, name, len, &idx)) {

@@ -154,7 +154,7 @@ static void test_every_keyword(void)
         CHECK(near3(l[0].intensity, 0.5 * M_PI, 0.5 * M_PI, 0.5 * M_PI, 1e-6));
         CHECK_EQ_INT(l[1].type, LIGHT_POINT);
         CHECK(near3(l[1].position, 1, 2, 3, 0));
-        CHECK(l[1].atten0 == 1.0f && l[1].atten1 == 0.0f && l[1].atten2 == 0.1f);
+        CHECK(l[1].atten0 == 0.0f && l[1].atten1 == 0.0f && l[1].atten2 == 0.1f);
         CHECK(near3(l[1].intensity, M_PI, 0.5 * M_PI, 0.25 * M_PI, 1e-6));
         CHECK(l[2].atten0 == 1.0f && l[2].atten1 == 0.5f && l[2].atten2 == 0.25f);
         CHECK_EQ_INT(l[3].type, LIGHT_SPOT);
@@ -725,7 +725,7 @@ static void test_cli(void)
         { scene, "--gamma", "2.2", NULL },
         { scene, "--adaptive", "0", NULL },
         { scene, "--adaptive", "0.1", "--integrator", "path", NULL },
-        { scene, "--depth-range", "5,1", NULL },
+        { scene, "--depth-range", "5,5", NULL },    /* 5,1 inverts the ramp (accepted) */
     };
     const char *expect[] = { "--integrator expects 'path' or 'whitted'", "--format expects", "--aov expects",
                              "--gamma expects", "--adaptive expects a threshold", "--adaptive needs the whitted",
@@ -741,7 +741,7 @@ static void test_cli(void)
     CHECK_EQ_INT(r->status, 3);
     /* a BMP with every auxiliary image, detected format, adaptive pass */
     const char *ok[] = { scene, "-o", bmp, "--aov", "normal,depth,albedo", "--adaptive", "0.05", "--device", "scalar",
-                         "--format", "classic", NULL };
+                         "--format", "classic", "--depth-range", "18,8", NULL };
     cli_run(ok, r);
     CHECK_MSG(r->status == 0, "%s", r->err);
     CHECK_STR_CONTAINS(r->err, "adaptive pass:");

@@ -680,6 +680,45 @@ static void test_course_reflection(void)
     }
 }
 
+/* Fall 2019's meshes without `vn` get smooth normals: a two-triangle tent whose faces
+ * have normals (-1, 0, 1) / sqrt 2 and (1, 0, 1) / sqrt 2 shares its ridge B C, whose
+ * vertex normal is then +z. The orthographic pixel (3, 3) of 8 x 8 over 4 units sees
+ * x = -0.25 on the left face, barycentric 0.25 for the apex A: its normal is
+ * normalize(0.25 nA + 0.75 z) = (-0.18737, 0, 0.98229) (flat before: (-0.70711, 0,
+ * 0.70711)), and still flat with a sized camera (Tsinghua). */
+static void test_course_mesh_normals(void)
+{
+    char dirname[] = "/tmp/clpt-conv-XXXXXX";
+    CHECK(mkdtemp(dirname) != NULL);
+    char obj[64];
+    snprintf(obj, sizeof obj, "%s/tent.obj", dirname);
+    FILE *f = fopen(obj, "w");
+    CHECK(f != NULL);
+    if (!f) return;
+    fputs("v -1 0 0\nv 0 -1 1\nv 0 1 1\nv 1 0 0\nf 1 2 3\nf 2 4 3\n", f);
+    fclose(f);
+    double a = 0.25 * sqrt(0.5), len = sqrt(a * a + (a + 0.75) * (a + 0.75));
+    double smooth[3] = { (-a / len + 1) / 2, 0.5, ((a + 0.75) / len + 1) / 2 };
+    double flat[3] = { (-sqrt(0.5) + 1) / 2, 0.5, (sqrt(0.5) + 1) / 2 };
+    for (int sized = 0; sized < 2; sized++) {
+        char scene[512];
+        snprintf(scene, sizeof scene,
+                 "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 4 %s}\n"
+                 "Materials { numMaterials 1 Material { diffuseColor 1 1 1 } }\n"
+                 "Group { numObjects 1 MaterialIndex 0 TriangleMesh { obj_file %s } }\n",
+                 sized ? "width 8 height 8 " : "", obj);
+        float *rgb = render_classic(scene, 8, 8, INTEGRATOR_AOV_NORMAL, "both");
+        const float *p = rgb + 3 * (3 * 8 + 3);
+        const double *want = sized ? flat : smooth;
+        fprintf(stderr, "  tent mesh, %s camera: normal image at (3, 3) %.5f %.5f %.5f\n", sized ? "Tsinghua" : "MIT",
+                (double)p[0], (double)p[1], (double)p[2]);
+        for (int c = 0; c < 3; c++) CHECK_NEAR(p[c], want[c], 1e-5);
+        free(rgb);
+    }
+    remove(obj);
+    rmdir(dirname);
+}
+
 /* The normal image of a classic scene writes (0 + 1) / 2 where the ray escapes; the
  * depth image's --depth-range NEAR > FAR ramps black at the near distance to white at
  * the far one, misses black. */
@@ -764,6 +803,7 @@ int main(void)
     RUN(test_course_falloff);
     RUN(test_course_camera);
     RUN(test_course_reflection);
+    RUN(test_course_mesh_normals);
     RUN(test_course_aovs);
     return harness_report();
 }

@@ -209,7 +209,7 @@ static Status run_passes(const Options *o, const PassContext *pc, const char *ou
         ImageFormat fmt = IMAGE_PNG;
         image_format_from_path(path, &fmt, err);
         double secs = 0.0;
-        DepthScale depth = { fmt == IMAGE_PFM ? DEPTH_RAW : (o->depth_far > 0.0 ? DEPTH_RANGE : DEPTH_AUTO),
+        DepthScale depth = { fmt == IMAGE_PFM ? DEPTH_RAW : (o->depth_far != o->depth_near ? DEPTH_RANGE : DEPTH_AUTO),
                              o->depth_near, o->depth_far };
         st = passes_aov(pc, aov, spp, &depth, rgb, &secs, err);
         /* auxiliary images hold data, not light: no sRGB curve */

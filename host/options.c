@@ -50,8 +50,8 @@ void options_print_help(FILE *f)
 "                             (grey: near white, far black), albedo; to\n"
 "                             OUTPUT-normal.png etc.\n"
 "      --depth-range NEAR,FAR the depth image is linear from white at NEAR to\n"
-"                             black at FAR (default: inverse distance, nearest\n"
-"                             hit white)\n"
+"                             black at FAR (NEAR > FAR inverts it; default:\n"
+"                             inverse distance, nearest hit white)\n"
 "\n"
 "Checkpoints (docs/checkpoint.md):\n"
 "      --checkpoint FILE      save the render's state to FILE (atomically)\n"
@@ -194,8 +194,11 @@ static Status parse_depth_range(const char *v, Options *o, Error *err)
         hi = strtod(second, &end);
         ok = end != second && !*end && !errno;
     }
-    if (!ok || !isfinite(lo) || !isfinite(hi) || !(lo >= 0.0) || !(hi > lo))
-        return error_set(err, ST_USAGE, "--depth-range expects NEAR,FAR with 0 <= NEAR < FAR, got '%s'", v);
+    /* NEAR > FAR turns the ramp round: --depth-range 18,8 is the courses' -depth 8 18
+     * (near black, far white) */
+    if (!ok || !isfinite(lo) || !isfinite(hi) || !(lo >= 0.0) || !(hi >= 0.0) || !(hi != lo))
+        return error_set(err, ST_USAGE, "--depth-range expects NEAR,FAR, two different distances >= 0 "
+                         "(NEAR > FAR inverts the grey), got '%s'", v);
     o->depth_near = lo;
     o->depth_far = hi;
     return ST_OK;

@@ -30,7 +30,7 @@ typedef struct {
     double adaptive;              /* whitted: neighbour difference threshold, 0 = off */
     unsigned adaptive_spp;        /* extra samples per flagged pixel */
     int gamma;                    /* -1 the scene's, 0 sRGB, 1 none (linear 8-bit) */
-    double depth_near, depth_far; /* --depth-range; far 0 = automatic */
+    double depth_near, depth_far; /* --depth-range; near == far (0) = automatic */
 } Options;
 
 /* Parses argv; on ST_USAGE err holds the message. --help and --version set flags and

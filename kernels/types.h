@@ -232,7 +232,9 @@ typedef struct {                                        /* 272 bytes */
     uint strata;                      /* whitted pixel samples: 0 the pixel centre, 1
                                        * uniform jitter, m >= 2 an m x m jittered grid */
     uint sample_offset;               /* added to the sample index (adaptive passes) */
-    uint pad3, pad4;
+    uint pad3;
+    uint normal_miss_grey;            /* the normal image's misses: (0 + 1) / 2 grey (the
+                                       * courses' convention, classic scenes), else black */
 } RenderParams;
 
 /* One path of the wavefront; lives in a device buffer between kernel launches. */

@@ -200,7 +200,8 @@ KFN vec3 whitted_aov(const SceneView *sc, Ray ray, uint mode, uint *rays)
 {
     Hit hit = trace_closest(sc, ray);
     (*rays)++;
-    if (hit.prim == NO_INDEX) return v3s(0.0f);
+    if (hit.prim == NO_INDEX)
+        return v3s(mode == INTEGRATOR_AOV_NORMAL && sc->params->normal_miss_grey ? 0.5f : 0.0f);
     Surface s = surface_at(sc, ray, hit);
     if (mode == INTEGRATOR_AOV_NORMAL) return v3_scale(v3_add(s.ns, v3s(1.0f)), 0.5f);
     if (mode == INTEGRATOR_AOV_DEPTH) return v3(hit.t * v3_len(ray.d), 1.0f, 0.0f);

@@ -18,6 +18,7 @@
 #include "io/classic_parse.h"
 #include "io/scene_load.h"
 #include "kmath.h"
+#include "scene/mesh_sink.h"
 #include "scene/scene.h"
 
 #include <stb_image_write.h>
@@ -154,7 +155,7 @@ static void test_every_keyword(void)
         CHECK(near3(l[0].intensity, 0.5 * M_PI, 0.5 * M_PI, 0.5 * M_PI, 1e-6));
         CHECK_EQ_INT(l[1].type, LIGHT_POINT);
         CHECK(near3(l[1].position, 1, 2, 3, 0));
-        CHECK(l[1].atten0 == 1.0f && l[1].atten1 == 0.0f && l[1].atten2 == 0.1f);
+        CHECK(l[1].atten0 == 0.0f && l[1].atten1 == 0.0f && l[1].atten2 == 0.1f);
         CHECK(near3(l[1].intensity, M_PI, 0.5 * M_PI, 0.25 * M_PI, 1e-6));
         CHECK(l[2].atten0 == 1.0f && l[2].atten1 == 0.5f && l[2].atten2 == 0.25f);
         CHECK_EQ_INT(l[3].type, LIGHT_SPOT);
@@ -725,7 +726,7 @@ static void test_cli(void)
         { scene, "--gamma", "2.2", NULL },
         { scene, "--adaptive", "0", NULL },
         { scene, "--adaptive", "0.1", "--integrator", "path", NULL },
-        { scene, "--depth-range", "5,1", NULL },
+        { scene, "--depth-range", "5,5", NULL },    /* 5,1 inverts the ramp (accepted) */
     };
     const char *expect[] = { "--integrator expects 'path' or 'whitted'", "--format expects", "--aov expects",
                              "--gamma expects", "--adaptive expects a threshold", "--adaptive needs the whitted",
@@ -741,7 +742,7 @@ static void test_cli(void)
     CHECK_EQ_INT(r->status, 3);
     /* a BMP with every auxiliary image, detected format, adaptive pass */
     const char *ok[] = { scene, "-o", bmp, "--aov", "normal,depth,albedo", "--adaptive", "0.05", "--device", "scalar",
-                         "--format", "classic", NULL };
+                         "--format", "classic", "--depth-range", "18,8", NULL };
     cli_run(ok, r);
     CHECK_MSG(r->status == 0, "%s", r->err);
     CHECK_STR_CONTAINS(r->err, "adaptive pass:");
@@ -754,6 +755,48 @@ static void test_cli(void)
         unlink(p);
     }
     free(r);
+}
+
+static Triangle tri(vec3 a, vec3 b, vec3 c)
+{
+    Triangle t;
+    memset(&t, 0, sizeof t);
+    t.p0 = a;
+    t.p1 = b;
+    t.p2 = c;
+    t.shading = NO_INDEX;
+    t.light = NO_INDEX;
+    return t;
+}
+
+/* Smooth mesh normals weigh every face the same (Fall 2019's Mesh.cpp sums unit face
+ * normals): a big face (+z, area 8) and a small one (+x, area 0.5) meeting at the origin
+ * give it (1, 0, 1) / sqrt 2, where area weights would give (0.06, 0, 1). Faces whose
+ * normals cancel at a corner stay flat; triangles before `first` are left alone. */
+static void test_smooth_normals(void)
+{
+    Scene s;
+    scene_init(&s);
+    Error err = {0};
+    vec3 o = v3s(0.0f);
+    scene_add_triangle(&s, tri(v3(9, 9, 9), v3(10, 9, 9), v3(9, 10, 9)), &err);    /* before first */
+    scene_add_triangle(&s, tri(o, v3(4, 0, 0), v3(0, 4, 0)), &err);
+    scene_add_triangle(&s, tri(o, v3(0, 0, 1), v3(0, -1, 0)), &err);
+    scene_add_triangle(&s, tri(v3(5, 0, 0), v3(6, 0, 0), v3(5, 1, 0)), &err);      /* a face and its */
+    scene_add_triangle(&s, tri(v3(5, 0, 0), v3(5, 1, 0), v3(6, 0, 0)), &err);      /* back: cancel */
+    CHECK(mesh_smooth_normals(&s, 1, &err) == ST_OK);
+    CHECK(s.triangles[0].shading == NO_INDEX);
+    CHECK(s.triangles[3].shading == NO_INDEX && s.triangles[4].shading == NO_INDEX);
+    CHECK(s.triangles[1].shading != NO_INDEX && s.triangles[2].shading != NO_INDEX);
+    if (s.triangles[1].shading != NO_INDEX && s.triangles[2].shading != NO_INDEX) {
+        const TriShading *a = &s.shading[s.triangles[1].shading], *b = &s.shading[s.triangles[2].shading];
+        double h = sqrt(0.5);
+        CHECK(a->flags == TRI_HAS_NORMALS);
+        CHECK(near3(a->n0, h, 0, h, 1e-6) && near3(b->n0, h, 0, h, 1e-6));
+        CHECK(near3(a->n1, 0, 0, 1, 0) && near3(a->n2, 0, 0, 1, 0));
+        CHECK(near3(b->n1, 1, 0, 0, 0) && near3(b->n2, 1, 0, 0, 0));
+    }
+    scene_free(&s);
 }
 
 int main(void)
@@ -777,6 +820,7 @@ int main(void)
     RUN(test_projective_matrix);
     RUN(test_scene_format_additions);
     RUN(test_shipped_scenes);
+    RUN(test_smooth_normals);
     RUN(test_cli);
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);

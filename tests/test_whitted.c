@@ -16,6 +16,7 @@
 #include "render_util.h"
 
 #include "scene/camera.h"
+#include "io/classic_parse.h"
 #include "io/image_write.h"
 #include "render/passes.h"
 #include "whitted.cl"
@@ -568,6 +569,187 @@ static void test_adaptive(void)
     error_clear(&err);
 }
 
+/* ------------------------------------------------------------ the course conventions */
+
+/* A classic scene from text, w x h, one ray per pixel centre, rendered on `devices`
+ * (or, with "both", on the scalar device and PoCL, which must agree bit for bit). */
+static float *render_classic(const char *text, uint w, uint h, uint integrator, const char *devices)
+{
+    Scene s;
+    scene_init(&s);
+    Error err = {0};
+    Status st = classic_load_text("conv.txt", text, strlen(text), &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    s.image.width = w;
+    s.image.height = h;
+    s.image.max_depth = 4;
+    if (integrator != INTEGRATOR_WHITTED) s.integrator = integrator;
+    int both = strcmp(devices, "both") == 0;
+    Film film;
+    float *rgb = render(&s, both ? "scalar" : devices, &film);
+    if (both) {
+        Film other;
+        float *again = render(&s, "cpu", &other);
+        CHECK(memcmp(film.sum, other.sum, (size_t)w * h * 3u * sizeof *film.sum) == 0);
+        free(again);
+        film_free(&other);
+    }
+    film_free(&film);
+    scene_free(&s);
+    return rgb;
+}
+
+/* MIT 6.837 Fall 2019's point light: color / (falloff d^2). A floor of diffuse colour
+ * (0.8, 0.6, 0.4) 2 under a light with falloff 0.5, seen straight down at its foot:
+ * 0.8 / (0.5 x 4) = 0.4 (before: color / (1 + falloff d^2) gave 0.8 / 3 = 0.267). */
+static void test_course_falloff(void)
+{
+    const char *scene =
+        "PerspectiveCamera { center 0 5 0 direction 0 -1 0 up 0 0 -1 angle 30 }\n"
+        "Lights { numLights 1 PointLight { position 0 2 0 color 1 1 1 falloff 0.5 } }\n"
+        "Background { color 0 0 0 ambientLight 0 0 0 }\n"
+        "Materials { numMaterials 1 Material { diffuseColor 0.8 0.6 0.4 } }\n"
+        "Group { numObjects 1 MaterialIndex 0 Plane { normal 0 1 0 offset 0 } }\n";
+    float *rgb = render_classic(scene, 3, 3, INTEGRATOR_WHITTED, "both");
+    const float *c = rgb + 3 * 4;
+    fprintf(stderr, "  falloff 0.5 at d = 2: centre pixel %.4f %.4f %.4f (course 0.4 0.3 0.2)\n", (double)c[0],
+            (double)c[1], (double)c[2]);
+    CHECK_NEAR(c[0], 0.4, 1e-6);
+    CHECK_NEAR(c[1], 0.3, 1e-6);
+    CHECK_NEAR(c[2], 0.2, 1e-6);
+    free(rgb);
+}
+
+/* The course's camera spans the image with normalize(direction x up) and `up` as given:
+ * looking down 45 degrees with up 0 1 0, the vertical edge x = 1 of a triangle stays in
+ * one column, the one the course's projection puts it in: the point's horizontal film
+ * coordinate is d / (5 sqrt 2) with d = 1 / tan(30 deg), column floor((1 + sx) / 2 x 64)
+ * + 1 = 40 for every row it crosses (the orthonormal frame clpt used before slanted it
+ * over columns 38..43). */
+static void test_course_camera(void)
+{
+    const uint W = 64, H = 64;
+    const char *scene =
+        "PerspectiveCamera { center 0 5 5 direction 0 -1 -1 up 0 1 0 angle 60 }\n"
+        "Background { color 0 0 0 ambientLight 1 1 1 }\n"
+        "Materials { numMaterials 1 Material { diffuseColor 1 1 1 } }\n"
+        "Group { numObjects 1 MaterialIndex 0 Triangle { vertex0 1 -3 0 vertex1 6 0 0 vertex2 1 3 0 } }\n";
+    float *rgb = render_classic(scene, W, H, INTEGRATOR_WHITTED, "both");
+    uint rows = 0, lo = W, hi = 0;
+    for (uint y = 0; y < H; y++) {
+        uint x = 0;
+        while (x < W && rgb[3 * (y * W + x)] == 0.0f) x++;
+        if (x == W) continue;
+        rows++;
+        if (x < lo) lo = x;
+        if (x > hi) hi = x;
+    }
+    fprintf(stderr, "  camera looking down: the vertical edge in columns %u..%u over %u rows\n", lo, hi, rows);
+    CHECK(rows > 10);
+    CHECK_EQ_INT(lo, 40);
+    CHECK_EQ_INT(hi, 40);
+    free(rgb);
+}
+
+/* Fall 2019: a `Material` with specularColor and no reflectiveColor mirrors with it.
+ * A black sphere with specular 0.5 in front of a (0.2, 0.4, 0.8) background reflects
+ * the background straight back at the centre pixel: 0.5 x background (before: black).
+ * Tsinghua's dialect (a camera with width/height) reflects nothing. */
+static void test_course_reflection(void)
+{
+    const char *cameras[2] = { "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }\n",
+                               "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 "
+                               "width 3 height 3 }\n" };
+    const char *rest =
+        "Background { color 0.2 0.4 0.8 ambientLight 0 0 0 }\n"
+        "Materials { numMaterials 1 Material { diffuseColor 0 0 0 specularColor 0.5 0.5 0.5 shininess 10 } }\n"
+        "Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0 0 radius 1 } }\n";
+    for (int sized = 0; sized < 2; sized++) {
+        char scene[512];
+        snprintf(scene, sizeof scene, "%s%s", cameras[sized], rest);
+        float *rgb = render_classic(scene, 3, 3, INTEGRATOR_WHITTED, "both");
+        const float *c = rgb + 3 * 4;
+        fprintf(stderr, "  specular 0.5 sphere, %s camera: centre pixel %.4f %.4f %.4f\n", sized ? "Tsinghua" : "MIT",
+                (double)c[0], (double)c[1], (double)c[2]);
+        double k = sized ? 0.0 : 0.5;
+        CHECK_NEAR(c[0], 0.2 * k, 1e-6);
+        CHECK_NEAR(c[1], 0.4 * k, 1e-6);
+        CHECK_NEAR(c[2], 0.8 * k, 1e-6);
+        free(rgb);
+    }
+}
+
+/* Fall 2019's meshes without `vn` get smooth normals: a two-triangle tent whose faces
+ * have normals (-1, 0, 1) / sqrt 2 and (1, 0, 1) / sqrt 2 shares its ridge B C, whose
+ * vertex normal is then +z. The orthographic pixel (3, 3) of 8 x 8 over 4 units sees
+ * x = -0.25 on the left face, barycentric 0.25 for the apex A: its normal is
+ * normalize(0.25 nA + 0.75 z) = (-0.18737, 0, 0.98229) (flat before: (-0.70711, 0,
+ * 0.70711)), and still flat with a sized camera (Tsinghua). */
+static void test_course_mesh_normals(void)
+{
+    char dirname[] = "/tmp/clpt-conv-XXXXXX";
+    CHECK(mkdtemp(dirname) != NULL);
+    char obj[64];
+    snprintf(obj, sizeof obj, "%s/tent.obj", dirname);
+    FILE *f = fopen(obj, "w");
+    CHECK(f != NULL);
+    if (!f) return;
+    fputs("v -1 0 0\nv 0 -1 1\nv 0 1 1\nv 1 0 0\nf 1 2 3\nf 2 4 3\n", f);
+    fclose(f);
+    double a = 0.25 * sqrt(0.5), len = sqrt(a * a + (a + 0.75) * (a + 0.75));
+    double smooth[3] = { (-a / len + 1) / 2, 0.5, ((a + 0.75) / len + 1) / 2 };
+    double flat[3] = { (-sqrt(0.5) + 1) / 2, 0.5, (sqrt(0.5) + 1) / 2 };
+    for (int sized = 0; sized < 2; sized++) {
+        char scene[512];
+        snprintf(scene, sizeof scene,
+                 "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 4 %s}\n"
+                 "Materials { numMaterials 1 Material { diffuseColor 1 1 1 } }\n"
+                 "Group { numObjects 1 MaterialIndex 0 TriangleMesh { obj_file %s } }\n",
+                 sized ? "width 8 height 8 " : "", obj);
+        float *rgb = render_classic(scene, 8, 8, INTEGRATOR_AOV_NORMAL, "both");
+        const float *p = rgb + 3 * (3 * 8 + 3);
+        const double *want = sized ? flat : smooth;
+        fprintf(stderr, "  tent mesh, %s camera: normal image at (3, 3) %.5f %.5f %.5f\n", sized ? "Tsinghua" : "MIT",
+                (double)p[0], (double)p[1], (double)p[2]);
+        for (int c = 0; c < 3; c++) CHECK_NEAR(p[c], want[c], 1e-5);
+        free(rgb);
+    }
+    remove(obj);
+    rmdir(dirname);
+}
+
+/* The normal image of a classic scene writes (0 + 1) / 2 where the ray escapes; the
+ * depth image's --depth-range NEAR > FAR ramps black at the near distance to white at
+ * the far one, misses black. */
+static void test_course_aovs(void)
+{
+    const char *scene =
+        "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }\n"
+        "Materials { numMaterials 1 Material { diffuseColor 1 1 1 } }\n"
+        "Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0 0 radius 1 } }\n";
+    float *rgb = render_classic(scene, 5, 5, INTEGRATOR_AOV_NORMAL, "both");
+    fprintf(stderr, "  normal image: corner (miss) %.2f %.2f %.2f, centre %.2f %.2f %.2f\n", (double)rgb[0],
+            (double)rgb[1], (double)rgb[2], (double)rgb[36], (double)rgb[37], (double)rgb[38]);
+    CHECK(rgb[0] == 0.5f && rgb[1] == 0.5f && rgb[2] == 0.5f);
+    CHECK_NEAR(rgb[36], 0.5, 1e-6);
+    CHECK_NEAR(rgb[37], 0.5, 1e-6);
+    CHECK_NEAR(rgb[38], 1.0, 1e-6);    /* n = +z at the centre */
+    free(rgb);
+
+    /* distances 8, 10.5, 13, 18 and 20 (resolved as distance x coverage, coverage), a miss */
+    float depth[] = { 8, 1, 0, 10.5f, 1, 0, 13, 1, 0, 18, 1, 0, 20, 1, 0, 0, 0, 0 };
+    DepthScale course = { DEPTH_RANGE, 18.0, 8.0 };
+    passes_depth_grey(depth, 6, &course);
+    const float want[] = { 0.0f, 0.25f, 0.5f, 1.0f, 1.0f, 0.0f };
+    for (int i = 0; i < 6; i++) CHECK_NEAR(depth[3 * i], want[i], 1e-6);
+    float again[] = { 8, 1, 0, 13, 1, 0 };
+    DepthScale clpt = { DEPTH_RANGE, 8.0, 18.0 };
+    passes_depth_grey(again, 2, &clpt);
+    CHECK(again[0] == 1.0f);
+    CHECK_NEAR(again[3], 0.5, 1e-6);
+}
+
 /* BMP: header, bottom-up BGR rows padded to 4 bytes; linear or sRGB bytes. */
 static void test_bmp(void)
 {
@@ -618,5 +800,10 @@ int main(void)
     RUN(test_pixel_sampling);
     RUN(test_adaptive);
     RUN(test_bmp);
+    RUN(test_course_falloff);
+    RUN(test_course_camera);
+    RUN(test_course_reflection);
+    RUN(test_course_mesh_normals);
+    RUN(test_course_aovs);
     return harness_report();
 }

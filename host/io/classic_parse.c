@@ -79,6 +79,7 @@ typedef struct {
     uint fallback;             /* white material for objects before any material */
     int seen_camera, seen_lights, seen_background, seen_materials;
     int ambient_given;
+    int camera_sized;      /* the camera gave width/height: Tsinghua's dialect */
     size_t tessellated;        /* triangles made from spheres so far */
     uint depth;                /* Group and Transform blocks open around the reader */
 } Classic;
@@ -330,6 +331,11 @@ static Status parse_camera(Classic *c, const Token *kw, int ortho)
     cam->type = ortho ? CAMERA_ORTHOGRAPHIC : CAMERA_PERSPECTIVE;
     if (ortho) cam->ortho_height = v[CAM_SIZE].f;
     else cam->vfov = v[CAM_ANGLE].f;
+    /* a camera with width/height is Tsinghua's, which re-orthogonalises `up` as MIT's
+     * 2004 edition did; without them it is MIT Fall 2019's, which spans the image with
+     * `up` as given (docs/classic-format.md, "Conventions") */
+    c->camera_sized = v[CAM_WIDTH].given || v[CAM_HEIGHT].given;
+    cam->course_basis = !ortho && !c->camera_sized;
     cam->aperture = 0.0f;
     if (v[CAM_WIDTH].given) c->s->image.width = (uint)v[CAM_WIDTH].u;
     if (v[CAM_HEIGHT].given) c->s->image.height = (uint)v[CAM_HEIGHT].u;
@@ -393,7 +399,13 @@ static Status parse_light(Classic *c, const Token *kw)
     l.atten0 = 1.0f;
     l.atten1 = 0.0f;
     l.atten2 = 0.0f;
-    if (v[L_FALLOFF].given) l.atten2 = v[L_FALLOFF].f;   /* color / (1 + falloff d^2) */
+    /* `falloff F` is MIT 6.837 Fall 2019's keyword, whose PointLight shines
+     * color / (F d^2) (its starter code's Light.cpp); F = 0 would divide by zero there,
+     * so it means no falloff here (docs/classic-format.md, "Conventions") */
+    if (v[L_FALLOFF].given && v[L_FALLOFF].f > 0.0f) {
+        l.atten0 = 0.0f;
+        l.atten2 = v[L_FALLOFF].f;
+    }
     if (v[L_ATTEN].given) {
         l.atten0 = v[L_ATTEN].v.x;
         l.atten1 = v[L_ATTEN].v.y;
@@ -520,6 +532,10 @@ static Status parse_phong(Classic *c, const Token *kw)
                                 v[M_SPECULAR].given ? v[M_SPECULAR].v : v3s(0.0f),
                                 v[M_SHININESS].given ? v[M_SHININESS].f : (v[M_EXPONENT].given ? v[M_EXPONENT].f : 0.0f));
     if (v[M_REFLECTIVE].given) m.reflective = v[M_REFLECTIVE].v;
+    /* MIT 6.837 Fall 2019 (whose materials are `Material` blocks without reflectiveColor)
+     * adds k_specular x the mirror ray's light when bounces > 0; Tsinghua's PA1 (also
+     * `Material`, with a sized camera) is a ray caster and reflects nothing */
+    else if (tok_is(kw, "Material") && v[M_SPECULAR].given && !c->camera_sized) m.reflective = v[M_SPECULAR].v;
     if (v[M_TRANSPARENT].given) m.transparent = v[M_TRANSPARENT].v;
     if (v[M_IOR].given) m.ior = v[M_IOR].f;
     if (v[M_TEXTURE].given) {
@@ -784,8 +800,12 @@ static Status parse_mesh(Classic *c, const Token *kw, const Transform *m)
     /* the sink applies the transform as it does to a mesh of our format */
     MeshOptions o = mesh_options(material);
     o.xf = *m;
+    size_t first = c->s->n_triangles;
     st = obj_load_with(path, c->s, &o, c->err);
     free(path);
+    /* MIT Fall 2019's loader smooths a mesh's normals; Tsinghua's (a sized camera) keeps
+     * one normal per face (docs/classic-format.md, "Conventions") */
+    if (!st && !c->camera_sized) st = mesh_smooth_normals(c->s, first, c->err);
     if (st == ST_IO) {
         error_prefix(c->err, "%s:%u:%u", c->lx.path, v[MESH_FILE].word.line, v[MESH_FILE].word.col);
         return st;
@@ -1003,6 +1023,7 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
     /* how the course's reference ray tracer draws a scene (docs/classic-format.md) */
     s->integrator = INTEGRATOR_WHITTED;
     s->linear_output = 1;
+    s->normal_miss_grey = 1;
     s->image.spp = 1;
     s->bg_type = BG_CONSTANT;
     s->bg_color = s->bg_zenith = v3s(0.5f);

@@ -111,7 +111,7 @@ Status passes_adaptive(const PassContext *pc, float *rgb, uint base_spp, float t
 
 /* Depth samples arrive as (distance, 1, 0) per hit: the resolved pixel is (mean
  * distance x coverage, coverage, 0). See passes.h for the grey scales. */
-static void depth_to_grey(float *rgb, size_t n, const DepthScale *scale)
+void passes_depth_grey(float *rgb, size_t n, const DepthScale *scale)
 {
     double lo = scale->near, hi = scale->far;
     if (scale->mode == DEPTH_AUTO) {
@@ -130,7 +130,7 @@ static void depth_to_grey(float *rgb, size_t n, const DepthScale *scale)
         if (cover > 0.0f) {
             double d = (double)rgb[3 * i] / cover, t = 1.0;
             if (scale->mode == DEPTH_RAW) t = d;
-            else if (scale->mode == DEPTH_RANGE) t = hi > lo ? (hi - d) / (hi - lo) : 1.0;
+            else if (scale->mode == DEPTH_RANGE) t = hi != lo ? (hi - d) / (hi - lo) : 1.0;
             else if (hi > lo && d > 0.0) t = (lo / d - lo / hi) / (1.0 - lo / hi);
             if (scale->mode != DEPTH_RAW) t = (t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t)) * cover;
             g = (float)t;
@@ -154,7 +154,7 @@ Status passes_aov(const PassContext *pc, uint aov, uint spp, const DepthScale *d
     if (st == ST_OK) st = restored;
     if (st == ST_OK) {
         film_resolve(&film, rgb);
-        if (aov == INTEGRATOR_AOV_DEPTH) depth_to_grey(rgb, (size_t)p->width * p->height, depth);
+        if (aov == INTEGRATOR_AOV_DEPTH) passes_depth_grey(rgb, (size_t)p->width * p->height, depth);
     }
     film_free(&film);
     return st;

@@ -38,13 +38,17 @@ Status passes_adaptive(const PassContext *pc, float *rgb, uint base_spp, float t
  *  DEPTH_AUTO   inverse distance normalised over the image, near/d: white at the nearest
  *               hit, falling to black at the farthest, which keeps contrast in the
  *               foreground when a plane runs to the horizon;
- *  DEPTH_RANGE  linear, white at `near`, black at `far` and beyond (the courses' -depth);
+ *  DEPTH_RANGE  linear, white at `near`, black at `far` and beyond; near > far turns it
+ *               round (black near, white far, as the courses' -depth);
  *  DEPTH_RAW    the distance itself (for .pfm files). */
 typedef enum { DEPTH_AUTO, DEPTH_RANGE, DEPTH_RAW } DepthMode;
 typedef struct {
     DepthMode mode;
     double near, far;
 } DepthScale;
+
+/* Turns n resolved depth pixels (mean distance x coverage, coverage, 0) into grey. */
+void passes_depth_grey(float *rgb, size_t n, const DepthScale *scale);
 
 /* Renders auxiliary image `aov` (INTEGRATOR_AOV_*) with `spp` samples per pixel (the main
  * image's pixel sampling) into rgb: normals as (n + 1) / 2, albedo as it is, depth as

@@ -98,7 +98,9 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
     double h = tan((double)desc->vfov * M_PI / 360.0);
     double vp_h = 2.0 * h * focus;
     double vp_w = vp_h * (double)width / (double)height;
-    dvec3 horizontal = dscale(u, vp_w), vertical = dscale(v, vp_h);
+    /* the course's camera keeps `up` as given (length too) for the vertical axis, so
+     * vertical lines stay vertical when it looks down or up */
+    dvec3 horizontal = dscale(u, vp_w), vertical = dscale(desc->course_basis ? up : v, vp_h);
     dvec3 corner = { from.x - horizontal.x / 2 + vertical.x / 2 - focus * w.x,
                      from.y - horizontal.y / 2 + vertical.y / 2 - focus * w.y,
                      from.z - horizontal.z / 2 + vertical.z / 2 - focus * w.z };

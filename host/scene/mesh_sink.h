@@ -63,7 +63,11 @@ Status mesh_make_sphere(Scene *s, size_t min_triangles, uint material, Error *er
 /* Bounding box of triangles [first, first + n) of the scene; lo > hi when n is 0. */
 void mesh_bounds(const Scene *s, size_t first, size_t n, vec3 *lo, vec3 *hi);
 
-/* Bounding box of triangles [first, first + n) of the scene; lo > hi when n is 0. */
-void mesh_bounds(const Scene *s, size_t first, size_t n, vec3 *lo, vec3 *hi);
+/* Gives triangles [first, n_triangles) that have no normals smooth ones, as MIT 6.837
+ * Fall 2019's OBJ loader does: at each corner the normalised sum of the unit winding
+ * normals of those triangles that share the corner's exact position (each face counts
+ * the same). A triangle whose corner sum cancels out stays flat. Linear time (a hash
+ * table of positions); fails only when memory runs out (ST_INTERNAL). */
+Status mesh_smooth_normals(Scene *s, size_t first, Error *err);
 
 #endif /* CLPT_MESH_SINK_H */

@@ -19,6 +19,8 @@ typedef struct {
     float focus_dist;    /* distance to the plane in focus; <= 0 means |at - from| */
     uint type;           /* enum CameraType */
     float ortho_height;  /* orthographic: height of the view rectangle (world units) */
+    int course_basis;    /* perspective: span the image with normalize(view x up) and
+                          * `up` as given (MIT 6.837 Fall 2019), not an orthonormal frame */
 } SceneCamera;
 
 typedef struct {
@@ -57,6 +59,7 @@ typedef struct {
     uint integrator;             /* enum Integrator the scene asks for (INTEGRATOR_PATH
                                   * or INTEGRATOR_WHITTED); --integrator overrides it */
     int linear_output;           /* 8-bit images without the sRGB curve (classic scenes) */
+    uint normal_miss_grey;       /* the normal image's misses grey, not black (classic) */
 
     /* Lookups by name, so that a scene or MTL with many materials reads in linear time:
      * material name -> first material of that name, texture name -> first texture of

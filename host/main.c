@@ -183,6 +183,7 @@ static void apply_overrides(const Options *o, Scene *s)
     if (o->max_depth >= 0) s->image.max_depth = (uint)o->max_depth;
     if (o->integrator >= 0) s->integrator = (uint)o->integrator;
     if (o->gamma >= 0) s->linear_output = o->gamma == 1;
+    if (o->shadows >= 0) s->shadows = o->shadows;
 }
 
 /* The adaptive pass and the auxiliary images, after the main image is in rgb (and

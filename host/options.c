@@ -313,6 +313,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
     static const int format_values[] = { SCENE_FORMAT_AUTO, SCENE_FORMAT_CLPT, SCENE_FORMAT_CLASSIC };
     static const char *const gammas[] = { "srgb", "none", NULL };
     static const int gamma_values[] = { 0, 1 };
+    static const char *const on_off[] = { "on", "off", NULL };
+    static const int on_off_values[] = { 1, 0 };
     *found = 1;
     if (strcmp(a, "--integrator") == 0)
         return parse_choice(a, v, integrators, integrator_values, "'path' or 'whitted'", &o->integrator, err);
@@ -320,6 +322,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
         return parse_choice(a, v, formats, format_values, "'auto', 'clpt' or 'classic'", &o->format, err);
     if (strcmp(a, "--gamma") == 0)
         return parse_choice(a, v, gammas, gamma_values, "'srgb' or 'none'", &o->gamma, err);
+    if (strcmp(a, "--shadows") == 0)
+        return parse_choice(a, v, on_off, on_off_values, "'on' or 'off'", &o->shadows, err);
     if (strcmp(a, "--aov") == 0) return options_parse_aovs(v, &o->aovs, err);
     *found = 0;
     return ST_OK;
@@ -341,6 +345,7 @@ static void options_defaults(Options *o)
     o->spp = o->width = o->height = o->seed = o->max_depth = -1;
     o->integrator = -1;
     o->gamma = -1;
+    o->shadows = -1;
     o->format = SCENE_FORMAT_AUTO;
     o->adaptive_spp = 16;
 }

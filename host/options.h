@@ -30,6 +30,7 @@ typedef struct {
     double adaptive;              /* whitted: neighbour difference threshold, 0 = off */
     unsigned adaptive_spp;        /* extra samples per flagged pixel */
     int gamma;                    /* -1 the scene's, 0 sRGB, 1 none (linear 8-bit) */
+    int shadows;                  /* -1 the scene's, 0 off, 1 on */
     double depth_near, depth_far; /* --depth-range; far 0 = automatic */
 } Options;
 

@@ -227,7 +227,9 @@ typedef struct {                                        /* 272 bytes */
     uint strata;                      /* whitted pixel samples: 0 the pixel centre, 1
                                        * uniform jitter, m >= 2 an m x m jittered grid */
     uint sample_offset;               /* added to the sample index (adaptive passes) */
-    uint pad3, pad4;
+    uint shadows;                     /* 0: lights are never occluded (no shadow rays,
+                                       * as the course ray casters; --shadows off) */
+    uint pad4;
 } RenderParams;
 
 /* One path of the wavefront; lives in a device buffer between kernel launches. */
@@ -275,6 +277,7 @@ _Static_assert(offsetof(RenderParams, width) == 144, "RenderParams.width");
 _Static_assert(offsetof(RenderParams, bounds_lo) == 192, "RenderParams.bounds_lo");
 _Static_assert(offsetof(RenderParams, ambient) == 224, "RenderParams.ambient");
 _Static_assert(offsetof(RenderParams, strata) == 256, "RenderParams.strata");
+_Static_assert(offsetof(RenderParams, shadows) == 264, "RenderParams.shadows");
 _Static_assert(offsetof(Material, reflective) == 64, "Material.reflective");
 _Static_assert(offsetof(Light, cos_inner) == 60, "Light.cos_inner");
 _Static_assert(offsetof(Texture, m) == 32, "Texture.m");

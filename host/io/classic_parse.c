@@ -982,6 +982,7 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
     /* how the course's reference ray tracer draws a scene (docs/classic-format.md) */
     s->integrator = INTEGRATOR_WHITTED;
     s->linear_output = 1;
+    s->shadows = 0;       /* the course ray casters cast none */
     s->image.spp = 1;
     s->bg_type = BG_CONSTANT;
     s->bg_color = s->bg_zenith = v3s(0.5f);

@@ -67,6 +67,7 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     p->use_mask = 0;
     p->strata = render_scene_strata(s->image.spp);
     p->sample_offset = 0;
+    p->shadows = s->shadows ? 1u : 0u;
     out->ds.textures = s->textures;
     out->ds.texels = s->texels;
     out->ds.n_texels = s->n_texels;

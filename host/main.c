@@ -186,6 +186,14 @@ static void apply_overrides(const Options *o, Scene *s)
     if (o->shadows >= 0) s->shadows = o->shadows;
 }
 
+/* Where auxiliary image `aov` goes: the name the course command line gave it, else
+ * OUTPUT-normal.png etc. Freed by the caller; NULL when out of memory. */
+static char *aov_output_path(const Options *o, const char *output, unsigned aov)
+{
+    const char *named = o->aov_files[aov - INTEGRATOR_AOV_NORMAL];
+    return named ? strdup(named) : passes_aov_path(output, options_aov_name(aov));
+}
+
 /* The adaptive pass and the auxiliary images, after the main image is in rgb (and
  * written). A failure here is the run's failure; the main image stays written. */
 static Status run_passes(const Options *o, const PassContext *pc, const char *output, ImageEncoding encoding,
@@ -205,13 +213,15 @@ static Status run_passes(const Options *o, const PassContext *pc, const char *ou
     }
     for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
         if (!(o->aovs & (1u << aov))) continue;
-        char *path = passes_aov_path(output, options_aov_name(aov));
+        char *path = aov_output_path(o, output, aov);
         if (!path) return error_set(err, ST_INTERNAL, "out of memory");
         ImageFormat fmt = IMAGE_PNG;
         image_format_from_path(path, &fmt, err);
         double secs = 0.0;
-        DepthScale depth = { fmt == IMAGE_PFM ? DEPTH_RAW : (o->depth_far > 0.0 ? DEPTH_RANGE : DEPTH_AUTO),
-                             o->depth_near, o->depth_far };
+        /* a range was given when either end is not 0 (the course's NEAR may be 0) */
+        int ranged = o->depth_near > 0.0 || o->depth_far > 0.0;
+        DepthScale depth = { fmt == IMAGE_PFM ? DEPTH_RAW : (ranged ? DEPTH_RANGE : DEPTH_AUTO), o->depth_near,
+                             o->depth_far };
         st = passes_aov(pc, aov, spp, &depth, rgb, &secs, err);
         /* auxiliary images hold data, not light: no sRGB curve */
         if (!st) st = image_write_encoded(path, rgb, w, h, IMAGE_LINEAR, err);
@@ -505,7 +515,7 @@ static Status outputs_check(const Run *r, Error *err)
     named_file_init(&files[n++], r->output, "the output image", FILE_IMAGE);
     for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
         if (!(o->aovs & (1u << aov))) continue;
-        char *path = aov_paths[aov - INTEGRATOR_AOV_NORMAL] = passes_aov_path(r->output, options_aov_name(aov));
+        char *path = aov_paths[aov - INTEGRATOR_AOV_NORMAL] = aov_output_path(o, r->output, aov);
         if (!path) {
             st = error_set(err, ST_INTERNAL, "out of memory");
             goto out;

@@ -1,6 +1,8 @@
 /* options.c — command-line parsing, strict: every value is checked whole and in range. */
 #include "options.h"
 
+#include "course_args.h"
+
 #include "io/scene_load.h"
 #include "base/limit.h"
 #include "types.h"
@@ -399,7 +401,13 @@ static Status options_finish(Options *o, Error *err)
 Status options_parse(int argc, char **argv, Options *o, Error *err)
 {
     options_defaults(o);
-    for (int i = 1; i < argc; i++) {
+    int first = 1;
+    CourseStyle course = course_args_style(argc, argv);
+    if (course != COURSE_NONE) {
+        Status st = course_args_parse(course, argc, argv, o, &first, err);
+        if (st) return st;
+    }
+    for (int i = first; i < argc; i++) {
         Status st = options_parse_arg(argc, argv, &i, o, err);
         if (st) return st;
     }

@@ -17,6 +17,9 @@ void options_print_help(FILE *f)
 {
     fputs(
 "usage: clpt [options] SCENE\n"
+"       clpt -size W H -input SCENE -output FILE [-normals FILE]\n"
+"            [-depth NEAR FAR FILE] [-bounces N] [-shadows] [--options]\n"
+"       clpt SCENE OUT.bmp [--options]\n"
 "\n"
 "Renders SCENE (a scene file, see docs/scene-format.md, or a scene of the\n"
 "MIT 6.837 course family, see docs/classic-format.md) with a path tracer or a\n"
@@ -25,6 +28,16 @@ void options_print_help(FILE *f)
 ".ply): it is shown lit by a sky and a sun, seen by a camera that frames it\n"
 "(docs/meshes.md).\n"
 "\n"
+"The second and third forms are the command lines of the courses' reference ray\n"
+"tracers (MIT 6.837, recognised by a first argument -size or -input; Tsinghua,\n"
+"two arguments, the second an image name): they render as the course program\n"
+"does (whitted, one ray per pixel centre, no gamma, -bounces N mirror/refraction\n"
+"bounces, default 0; no shadows unless -shadows). -depth draws NEAR black and\n"
+"FAR white. See docs/classic-format.md.\n"
+"\n",
+        f);
+    /* several literals: C99 compilers need only support 4095 characters in one */
+    fputs(
 "Output and image:\n"
 "  -o, --output FILE          image to write: .png, .ppm or .bmp (8-bit sRGB)\n"
 "                             or .pfm (linear float); default: SCENE's name\n"
@@ -74,10 +87,13 @@ void options_print_help(FILE *f)
 "      --integrator path|whitted\n"
 "                             path tracing (default) or the classic ray tracer\n"
 "                             (the default for classic scenes): Phong shading,\n"
-"                             hard shadows, mirror and refraction rays up to\n"
-"                             --max-depth; one ray through each pixel centre\n"
-"                             unless --spp N (jittered; an m x m grid when\n"
-"                             N = m*m)\n"
+"                             hard shadows (see --shadows), mirror and\n"
+"                             refraction rays up to --max-depth; one ray\n"
+"                             through each pixel centre unless --spp N\n"
+"                             (jittered; an m x m grid when N = m*m)\n"
+"      --shadows on|off       whether lights can be blocked (shadow rays), in\n"
+"                             both integrators; default: on, off for classic\n"
+"                             scenes (as the course ray casters)\n"
 "      --adaptive THRESHOLD   whitted: after the first pass, render\n"
 "                             --adaptive-spp more samples in each pixel that\n"
 "                             differs from a neighbour by more than THRESHOLD\n"
@@ -85,7 +101,6 @@ void options_print_help(FILE *f)
 "      --adaptive-spp N       extra samples per such pixel (default 16)\n"
 "\n",
         f);
-    /* two literals: C99 compilers need only support 4095 characters in one */
     fputs(
 "Devices:\n"
 "      --list-devices         print every OpenCL platform and device, and the\n"

@@ -63,7 +63,8 @@ static Status course_distance(const char *what, const char *s, double *out, Erro
     return ST_OK;
 }
 
-/* The values of -flag: argv[*i + 1 .. *i + n], which must exist and not be flags. */
+/* The n values of flag argv[i] must exist and not be flags (so that '-size 64 -input'
+ * names what is missing); a negative number passes here and fails its range check. */
 static Status course_values(int argc, char **argv, int i, int n, const char *what, Error *err)
 {
     for (int k = 1; k <= n; k++)
@@ -102,36 +103,37 @@ static Status course_mit_flag(int argc, char **argv, int *i, Options *o, Error *
         o->shadows = 1;
         return ST_OK;
     }
-    struct { const char *name; int n; const char *what; } flags[] = {
-        { "-size", 2, "a width and a height" }, { "-input", 1, "a scene file" },
-        { "-output", 1, "an image file" },      { "-normals", 1, "an image file" },
-        { "-depth", 3, "NEAR FAR FILE" },       { "-bounces", 1, "a number of bounces" },
+    enum { SIZE, INPUT, OUTPUT, NORMALS, DEPTH, BOUNCES, N_FLAGS };
+    static const struct { const char *name; int n; const char *what; } flags[N_FLAGS] = {
+        [SIZE] = { "-size", 2, "a width and a height" }, [INPUT] = { "-input", 1, "a scene file" },
+        [OUTPUT] = { "-output", 1, "an image file" },   [NORMALS] = { "-normals", 1, "an image file" },
+        [DEPTH] = { "-depth", 3, "NEAR FAR FILE" },     [BOUNCES] = { "-bounces", 1, "a number of bounces" },
     };
-    size_t k = 0;
-    while (k < sizeof flags / sizeof flags[0] && strcmp(a, flags[k].name) != 0) k++;
-    if (k == sizeof flags / sizeof flags[0] && a[0] != '-')
+    int k = 0;
+    while (k < N_FLAGS && strcmp(a, flags[k].name) != 0) k++;
+    if (k == N_FLAGS && a[0] != '-')
         return error_set(err, ST_USAGE, "unexpected argument '%s' in the course command line (" MIT_USAGE ")", a);
-    if (k == sizeof flags / sizeof flags[0])
+    if (k == N_FLAGS)
         return error_set(err, ST_USAGE, "unknown option '%s' in the course command line (" MIT_USAGE ")", a);
     if ((st = course_values(argc, argv, *i, flags[k].n, flags[k].what, err))) return st;
     char **v = argv + *i + 1;
     *i += flags[k].n;
-    switch (k) {
-    case 0:
+    if (k == SIZE) {
         if ((st = course_long("-size", v[0], 1, CLPT_MAX_IMAGE_SIDE, &o->width, err))) return st;
         return course_long("-size", v[1], 1, CLPT_MAX_IMAGE_SIDE, &o->height, err);
-    case 1: o->scene_path = v[0]; return ST_OK;
-    case 2: o->output = v[0]; return ST_OK;
-    case 3:
+    }
+    if (k == INPUT) o->scene_path = v[0];
+    if (k == OUTPUT) o->output = v[0];
+    if (k == NORMALS) {
         o->aovs |= 1u << INTEGRATOR_AOV_NORMAL;
-        o->aov_files[0] = v[0];
-        return ST_OK;
-    case 4: return course_depth(v, o, err);
-    default:
+        o->aov_files[INTEGRATOR_AOV_NORMAL - INTEGRATOR_AOV_NORMAL] = v[0];
+    }
+    if (k == DEPTH) return course_depth(v, o, err);
+    if (k == BOUNCES) {
         if ((st = course_long("-bounces", v[0], 0, CLPT_MAX_DEPTH, &n, err))) return st;
         o->max_depth = n;
-        return ST_OK;
     }
+    return ST_OK;
 }
 
 static Status course_parse_mit(int argc, char **argv, Options *o, int *next, Error *err)

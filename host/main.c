@@ -183,6 +183,15 @@ static void apply_overrides(const Options *o, Scene *s)
     if (o->max_depth >= 0) s->image.max_depth = (uint)o->max_depth;
     if (o->integrator >= 0) s->integrator = (uint)o->integrator;
     if (o->gamma >= 0) s->linear_output = o->gamma == 1;
+    if (o->shadows >= 0) s->shadows = o->shadows;
+}
+
+/* Where auxiliary image `aov` goes: the name the course command line gave it, else
+ * OUTPUT-normal.png etc. Freed by the caller; NULL when out of memory. */
+static char *aov_output_path(const Options *o, const char *output, unsigned aov)
+{
+    const char *named = o->aov_files[aov - INTEGRATOR_AOV_NORMAL];
+    return named ? strdup(named) : passes_aov_path(output, options_aov_name(aov));
 }
 
 /* The adaptive pass and the auxiliary images, after the main image is in rgb (and
@@ -204,7 +213,7 @@ static Status run_passes(const Options *o, const PassContext *pc, const char *ou
     }
     for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
         if (!(o->aovs & (1u << aov))) continue;
-        char *path = passes_aov_path(output, options_aov_name(aov));
+        char *path = aov_output_path(o, output, aov);
         if (!path) return error_set(err, ST_INTERNAL, "out of memory");
         ImageFormat fmt = IMAGE_PNG;
         image_format_from_path(path, &fmt, err);
@@ -504,7 +513,7 @@ static Status outputs_check(const Run *r, Error *err)
     named_file_init(&files[n++], r->output, "the output image", FILE_IMAGE);
     for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
         if (!(o->aovs & (1u << aov))) continue;
-        char *path = aov_paths[aov - INTEGRATOR_AOV_NORMAL] = passes_aov_path(r->output, options_aov_name(aov));
+        char *path = aov_paths[aov - INTEGRATOR_AOV_NORMAL] = aov_output_path(o, r->output, aov);
         if (!path) {
             st = error_set(err, ST_INTERNAL, "out of memory");
             goto out;

@@ -1,6 +1,8 @@
 /* options.c — command-line parsing, strict: every value is checked whole and in range. */
 #include "options.h"
 
+#include "course_args.h"
+
 #include "io/scene_load.h"
 #include "base/limit.h"
 #include "types.h"
@@ -15,6 +17,9 @@ void options_print_help(FILE *f)
 {
     fputs(
 "usage: clpt [options] SCENE\n"
+"       clpt -size W H -input SCENE -output FILE [-normals FILE]\n"
+"            [-depth NEAR FAR FILE] [-bounces N] [-shadows] [--options]\n"
+"       clpt SCENE OUT.bmp [--options]\n"
 "\n"
 "Renders SCENE (a scene file, see docs/scene-format.md, or a scene of the\n"
 "MIT 6.837 course family, see docs/classic-format.md) with a path tracer or a\n"
@@ -23,6 +28,16 @@ void options_print_help(FILE *f)
 ".ply): it is shown lit by a sky and a sun, seen by a camera that frames it\n"
 "(docs/meshes.md).\n"
 "\n"
+"The second and third forms are the command lines of the courses' reference ray\n"
+"tracers (MIT 6.837, recognised by a first argument -size or -input; Tsinghua,\n"
+"two arguments, the second an image name): they render as the course program\n"
+"does (whitted, one ray per pixel centre, no gamma, -bounces N mirror/refraction\n"
+"bounces, default 0; no shadows unless -shadows). -depth draws NEAR black and\n"
+"FAR white. See docs/classic-format.md.\n"
+"\n",
+        f);
+    /* several literals: C99 compilers need only support 4095 characters in one */
+    fputs(
 "Output and image:\n"
 "  -o, --output FILE          image to write: .png, .ppm or .bmp (8-bit sRGB)\n"
 "                             or .pfm (linear float); default: SCENE's name\n"
@@ -72,10 +87,13 @@ void options_print_help(FILE *f)
 "      --integrator path|whitted\n"
 "                             path tracing (default) or the classic ray tracer\n"
 "                             (the default for classic scenes): Phong shading,\n"
-"                             hard shadows, mirror and refraction rays up to\n"
-"                             --max-depth; one ray through each pixel centre\n"
-"                             unless --spp N (jittered; an m x m grid when\n"
-"                             N = m*m)\n"
+"                             hard shadows (see --shadows), mirror and\n"
+"                             refraction rays up to --max-depth; one ray\n"
+"                             through each pixel centre unless --spp N\n"
+"                             (jittered; an m x m grid when N = m*m)\n"
+"      --shadows on|off       whether lights can be blocked (shadow rays), in\n"
+"                             both integrators; default: on, off for classic\n"
+"                             scenes (as the course ray casters)\n"
 "      --adaptive THRESHOLD   whitted: after the first pass, render\n"
 "                             --adaptive-spp more samples in each pixel that\n"
 "                             differs from a neighbour by more than THRESHOLD\n"
@@ -83,7 +101,6 @@ void options_print_help(FILE *f)
 "      --adaptive-spp N       extra samples per such pixel (default 16)\n"
 "\n",
         f);
-    /* two literals: C99 compilers need only support 4095 characters in one */
     fputs(
 "Devices:\n"
 "      --list-devices         print every OpenCL platform and device, and the\n"
@@ -316,6 +333,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
     static const int format_values[] = { SCENE_FORMAT_AUTO, SCENE_FORMAT_CLPT, SCENE_FORMAT_CLASSIC };
     static const char *const gammas[] = { "srgb", "none", NULL };
     static const int gamma_values[] = { 0, 1 };
+    static const char *const on_off[] = { "on", "off", NULL };
+    static const int on_off_values[] = { 1, 0 };
     *found = 1;
     if (strcmp(a, "--integrator") == 0)
         return parse_choice(a, v, integrators, integrator_values, "'path' or 'whitted'", &o->integrator, err);
@@ -323,6 +342,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
         return parse_choice(a, v, formats, format_values, "'auto', 'clpt' or 'classic'", &o->format, err);
     if (strcmp(a, "--gamma") == 0)
         return parse_choice(a, v, gammas, gamma_values, "'srgb' or 'none'", &o->gamma, err);
+    if (strcmp(a, "--shadows") == 0)
+        return parse_choice(a, v, on_off, on_off_values, "'on' or 'off'", &o->shadows, err);
     if (strcmp(a, "--aov") == 0) return options_parse_aovs(v, &o->aovs, err);
     *found = 0;
     return ST_OK;
@@ -344,6 +365,7 @@ static void options_defaults(Options *o)
     o->spp = o->width = o->height = o->seed = o->max_depth = -1;
     o->integrator = -1;
     o->gamma = -1;
+    o->shadows = -1;
     o->format = SCENE_FORMAT_AUTO;
     o->adaptive_spp = 16;
 }
@@ -397,7 +419,13 @@ static Status options_finish(Options *o, Error *err)
 Status options_parse(int argc, char **argv, Options *o, Error *err)
 {
     options_defaults(o);
-    for (int i = 1; i < argc; i++) {
+    int first = 1;
+    CourseStyle course = course_args_style(argc, argv);
+    if (course != COURSE_NONE) {
+        Status st = course_args_parse(course, argc, argv, o, &first, err);
+        if (st) return st;
+    }
+    for (int i = first; i < argc; i++) {
         Status st = options_parse_arg(argc, argv, &i, o, err);
         if (st) return st;
     }

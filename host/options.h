@@ -27,9 +27,12 @@ typedef struct {
     int integrator;               /* enum Integrator (path or whitted), -1 = the scene's */
     int format;                   /* enum SceneFormat (io/scene_load.h) */
     unsigned aovs;                /* bit (INTEGRATOR_AOV_x): auxiliary images to write */
+    const char *aov_files[3];     /* normal, depth, albedo image names (the course command
+                                   * line); NULL: OUTPUT-normal.png etc. */
     double adaptive;              /* whitted: neighbour difference threshold, 0 = off */
     unsigned adaptive_spp;        /* extra samples per flagged pixel */
     int gamma;                    /* -1 the scene's, 0 sRGB, 1 none (linear 8-bit) */
+    int shadows;                  /* -1 the scene's, 0 off, 1 on */
     double depth_near, depth_far; /* --depth-range; near == far (0) = automatic */
 } Options;
 

@@ -155,6 +155,8 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Material, reflective);
     out[i++] = (uint)__builtin_offsetof(Light, cos_inner);
     out[i++] = (uint)__builtin_offsetof(Camera, forward);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, shadows);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, normal_miss_grey);
 }
 
 /* ---------------------------------------------------------------- classic ray tracer

@@ -21,12 +21,20 @@ KFN float mis_power(float a, float b)
     return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
 }
 
+/* The answer to a shadow ray: the waiting contribution counts only if nothing blocks. */
+KFN void shadow_resolve(GLOBAL PathState *ps, int occluded)
+{
+    if (!occluded) ps->radiance = v3_add(ps->radiance, ps->shadow_L);
+    ps->shadow_L = v3s(0.0f);
+}
+
 /* Next-event estimation at a diffuse or Phong surface: samples a light, and if it is
  * above the surface writes the shadow ray and the contribution it would bring: MIS-
  * weighted against BSDF sampling for an area light (unless the test switch
  * mis_mode says otherwise), fully for a delta light, which BSDF sampling cannot find.
  * `d` is the incoming ray direction; `lobes` is 0 (null) for a diffuse surface. Returns
- * 1 when a shadow ray was written. */
+ * 1 when a shadow ray was written; with shadows off the contribution is added at once
+ * instead. */
 KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s, vec3 d, vec3 n_face,
                            vec3 ng_face, const PhongLobes *lobes, vec3 albedo,
                            GLOBAL Ray *shadow_ray)
@@ -52,6 +60,11 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
     float w = ls.delta || mis_mode == MIS_LIGHT_ONLY ? 1.0f : mis_power(ls.pdf, bsdf_pdf);
     vec3 f_cos = v3_scale(f, cos_s * w / ls.pdf);
     ps->shadow_L = v3_mul(v3_mul(ps->throughput, f_cos), ls.Le);
+    if (!sc->params->shadows) {
+        /* shadows off: the light counts as visible, so no shadow ray is traced */
+        shadow_resolve(ps, 0);
+        return 0;
+    }
     *shadow_ray = light_shadow_ray(s.p, ng_face, ls);
     return 1;
 }
@@ -138,13 +151,6 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     ray->tmin = 0.0f;
     ray->tmax = INFINITY;
     return result | SHADE_CONTINUE;
-}
-
-/* The answer to a shadow ray: the waiting contribution counts only if nothing blocks. */
-KFN void shadow_resolve(GLOBAL PathState *ps, int occluded)
-{
-    if (!occluded) ps->radiance = v3_add(ps->radiance, ps->shadow_L);
-    ps->shadow_L = v3s(0.0f);
 }
 
 #endif /* CLPT_SHADE_CL */

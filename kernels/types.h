@@ -232,7 +232,8 @@ typedef struct {                                        /* 272 bytes */
     uint strata;                      /* whitted pixel samples: 0 the pixel centre, 1
                                        * uniform jitter, m >= 2 an m x m jittered grid */
     uint sample_offset;               /* added to the sample index (adaptive passes) */
-    uint pad3;
+    uint shadows;                     /* 0: lights are never occluded (no shadow rays,
+                                       * as the course ray casters; --shadows off) */
     uint normal_miss_grey;            /* the normal image's misses: (0 + 1) / 2 grey (the
                                        * courses' convention, classic scenes), else black */
 } RenderParams;
@@ -282,6 +283,8 @@ _Static_assert(offsetof(RenderParams, width) == 144, "RenderParams.width");
 _Static_assert(offsetof(RenderParams, bounds_lo) == 192, "RenderParams.bounds_lo");
 _Static_assert(offsetof(RenderParams, ambient) == 224, "RenderParams.ambient");
 _Static_assert(offsetof(RenderParams, strata) == 256, "RenderParams.strata");
+_Static_assert(offsetof(RenderParams, shadows) == 264, "RenderParams.shadows");
+_Static_assert(offsetof(RenderParams, normal_miss_grey) == 268, "RenderParams.normal_miss_grey");
 _Static_assert(offsetof(Material, reflective) == 64, "Material.reflective");
 _Static_assert(offsetof(Light, cos_inner) == 60, "Light.cos_inner");
 _Static_assert(offsetof(Texture, m) == 32, "Texture.m");

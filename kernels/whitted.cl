@@ -78,8 +78,17 @@ KFN vec3 whitted_phong(vec3 kd, vec3 ks, float shininess, vec3 r, vec3 n, vec3 w
     return v3_scale(v3_mul(c, E), K_INV_PI);
 }
 
+/* Whether light sample ls is blocked from surface point sp; with shadows off it never is
+ * and no ray is traced (the course ray casters cast no shadows). */
+KFN int whitted_occluded(const SceneView *sc, vec3 sp, vec3 ng, LightSample ls, uint *rays)
+{
+    if (!sc->params->shadows) return 0;
+    (*rays)++;
+    return trace_any(sc, light_shadow_ray(sp, ng, ls));
+}
+
 /* Direct light at surface point s: every delta light, and one sample of the area lights
- * (random numbers of tree node `node`), each behind its shadow ray. d is the incoming
+ * (random numbers of tree node `node`), each behind its shadow ray (if shadows are on). d is the incoming
  * direction, ns and ng the normals on its side. */
 KFN vec3 whitted_direct(const SceneView *sc, Surface s, vec3 d, vec3 ns, vec3 ng, vec3 kd, vec3 ks,
                         float shininess, uint key, uint node, uint *rays)
@@ -91,8 +100,7 @@ KFN vec3 whitted_direct(const SceneView *sc, Surface s, vec3 d, vec3 ns, vec3 ng
         LightSample ls;
         if (!light_delta_at(sc->lights[li], s.p, &ls)) continue;
         if (v3_dot(ns, ls.wi) <= 0.0f || v3_dot(ng, ls.wi) <= 0.0f) continue;
-        (*rays)++;
-        if (trace_any(sc, light_shadow_ray(s.p, ng, ls))) continue;
+        if (whitted_occluded(sc, s.p, ng, ls, rays)) continue;
         L = v3_add(L, whitted_phong(kd, ks, shininess, r, ns, ls.wi, ls.Le));
     }
     if (p->n_area_lights > 0u) {
@@ -102,8 +110,7 @@ KFN vec3 whitted_direct(const SceneView *sc, Surface s, vec3 d, vec3 ns, vec3 ng
             light_sample_in(sc, s.p, top, rng_uniform(key, node, DIM_LIGHT_PICK), rng_uniform(key, node, DIM_LIGHT_U),
                             rng_uniform(key, node, DIM_LIGHT_V), &ls) &&
             !ls.delta && v3_dot(ns, ls.wi) > 0.0f && v3_dot(ng, ls.wi) > 0.0f) {
-            (*rays)++;
-            if (!trace_any(sc, light_shadow_ray(s.p, ng, ls)))
+            if (!whitted_occluded(sc, s.p, ng, ls, rays))
                 L = v3_add(L, whitted_phong(kd, ks, shininess, r, ns, ls.wi, v3_scale(ls.Le, 1.0f / ls.pdf)));
         }
     }

@@ -247,8 +247,8 @@ static void test_film_values_are_bounded(void)
  * changes the image changes, with a message naming what differs. */
 static void test_render_key(void)
 {
-    CheckpointId ids[5];
-    for (int k = 0; k < 5; k++) {
+    CheckpointId ids[6];
+    for (int k = 0; k < 6; k++) {
         Scene s;
         Error err = { 0 };
         scene_init(&s);
@@ -257,6 +257,7 @@ static void test_render_key(void)
         s.image.height = 36;
         if (k == 2) s.image.seed = 7;
         if (k == 3) s.materials[0].albedo.x += 0.01f;
+        if (k == 5) s.shadows = !s.shadows;     /* --shadows changes the image */
         RenderScene rs;
         CHECK(render_scene_prepare(&s, 0, &rs, &err) == ST_OK);
         checkpoint_id(&rs.ds, k == 4 ? 401u : 400u, &ids[k]);
@@ -264,7 +265,7 @@ static void test_render_key(void)
         scene_free(&s);
     }
     CHECK(memcmp(&ids[0], &ids[1], sizeof ids[0]) == 0);
-    for (int k = 2; k < 5; k++) CHECK_MSG(memcmp(ids[0].key, ids[k].key, CHECKPOINT_KEY_SIZE) != 0, "change %d", k);
+    for (int k = 2; k < 6; k++) CHECK_MSG(memcmp(ids[0].key, ids[k].key, CHECKPOINT_KEY_SIZE) != 0, "change %d", k);
     Checkpoint c;
     memset(&c, 0, sizeof c);
     Error err = { 0 };

@@ -16,7 +16,8 @@ static void test_help_documents_every_flag(void)
     const char *flags[] = { "--output", "--spp", "--width", "--height", "--seed", "--max-depth", "--time-limit",
                             "--progressive-output", "--list-devices", "--device", "--threads", "--stats",
                             "--quiet", "--help", "--version", "--kernel-dir", "--batch", "--wave-paths",
-                            "Exit status" };
+                            "--shadows", "-size W H -input SCENE -output FILE", "-depth NEAR FAR FILE",
+                            "-bounces N", "clpt SCENE OUT.bmp", "Exit status" };
     for (size_t i = 0; i < sizeof flags / sizeof flags[0]; i++) CHECK_STR_CONTAINS(r.out, flags[i]);
 }
 

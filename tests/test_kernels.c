@@ -295,7 +295,8 @@ static void test_layout(void)
                     offsetof(TriShading, uv0), sizeof(Texture), offsetof(Texture, m),
                     offsetof(Texture, color1), offsetof(RenderParams, ambient),
                     offsetof(RenderParams, strata), offsetof(Material, reflective),
-                    offsetof(Light, cos_inner), offsetof(Camera, forward) };
+                    offsetof(Light, cos_inner), offsetof(Camera, forward),
+                    offsetof(RenderParams, shadows), offsetof(RenderParams, normal_miss_grey) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);

@@ -282,6 +282,146 @@ static void test_shadow(void)
     }
 }
 
+/* The shadow scene of test_shadow (point light above a sphere over the floor, ambient
+ * 0.1 0.2 0.3), shadows on or off, with the integrator given. */
+static void shadow_switch_scene(Scene *s, uint integrator, int shadows, int with_sphere)
+{
+    floor_scene(s, 64, 64, v3(3.0f, 4.0f, 0.5f), v3(0.0f, 1.0f, 0.0f));
+    add_point(s, v3(0.0f, 3.0f, 0.0f), 1.0f, 1.0f, 0.0f, 0.0f);
+    s->ambient = v3(0.1f, 0.2f, 0.3f);
+    s->integrator = integrator;
+    s->shadows = shadows;
+    if (!with_sphere) return;
+    Sphere sp = { v3(0.0f, 1.0f, 0.0f), 0.5f, 0, NO_INDEX, 0, 0 };
+    /* black, so that the path tracer's bounce off it brings nothing */
+    scene_add_material(s, "black", material_diffuse(v3s(0.0f)), &sp.material, NULL);
+    scene_add_sphere(s, sp, NULL);
+}
+
+/* --shadows off, whitted: the floor point right under the sphere (in its shadow with
+ * shadows on: exactly ambient x kd) gets the full closed-form light, as every floor pixel
+ * does; the same bits on PoCL and the scalar device. */
+static void test_shadows_off_whitted(void)
+{
+    const uint W = 64, H = 64;
+    D3 c = { 0.0, 1.0, 0.0 }, l = { 0.0, 3.0, 0.0 };
+    double amb[3] = { 0.1 * KD_R, 0.2 * KD_G, 0.3 * KD_B };
+    float *rgb[2];
+    Film film[2];
+    Camera cam;
+    for (int on = 0; on < 2; on++) {
+        Scene s;
+        shadow_switch_scene(&s, INTEGRATOR_WHITTED, on, 1);
+        Error err = {0};
+        CHECK(camera_setup(&s.camera, W, H, &cam, &err) == ST_OK);
+        rgb[on] = render(&s, "scalar", &film[on]);
+        if (!on) {
+            Film pocl;
+            float *rp = render(&s, "cpu", &pocl);
+            CHECK(memcmp(pocl.sum, film[0].sum, (size_t)W * H * 3u * sizeof *pocl.sum) == 0);
+            free(rp);
+            film_free(&pocl);
+        }
+        scene_free(&s);
+    }
+    /* the pixel whose floor point is nearest (0, 0, 0), right under the sphere */
+    uint best = 0, bad = 0, lit = 0;
+    double best_r = INFINITY;
+    for (uint y = 0; y < H; y++)
+        for (uint x = 0; x < W; x++) {
+            D3 o, d;
+            pixel_ray(&cam, W, H, x, y, &o, &d);
+            if (!(d.y < 0.0)) continue;
+            double t = -o.y / d.y;
+            D3 p = { o.x + t * d.x, 0.0, o.z + t * d.z };
+            if (segment_hits_sphere(o, p, c, 0.51)) continue;
+            double r = sqrt(p.x * p.x + p.z * p.z);
+            if (r < best_r) best_r = r, best = y * W + x;
+            D3 v = { l.x - p.x, l.y - p.y, l.z - p.z };
+            double e = v.y / sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+            double want[3] = { KD_R * e + amb[0], KD_G * e + amb[1], KD_B * e + amb[2] };
+            for (int k = 0; k < 3; k++)
+                if (fabs(rgb[0][3 * (y * W + x) + k] - want[k]) > 1e-4) bad++;
+            lit++;
+        }
+    const float *on_px = rgb[1] + 3 * best, *off_px = rgb[0] + 3 * best;
+    fprintf(stderr, "  floor under the sphere (%.2f from its foot): shadows on %.4f %.4f %.4f, off %.4f %.4f %.4f; "
+            "%u floor pixels, %u wrong\n", best_r, (double)on_px[0], (double)on_px[1], (double)on_px[2],
+            (double)off_px[0], (double)off_px[1], (double)off_px[2], lit, bad);
+    CHECK(best_r < 0.3);
+    CHECK(lit > 1000);
+    CHECK_EQ_INT(bad, 0);
+    /* on: ambient alone, exactly; off: ambient + kd (the light straight above, cos 1, d 3
+     * with no falloff: irradiance 1) up to the pixel's small offset from the foot */
+    for (int k = 0; k < 3; k++) {
+        CHECK(fabs(on_px[k] - amb[k]) <= 1e-6);
+        double kd = k == 0 ? KD_R : (k == 1 ? KD_G : KD_B);
+        CHECK(fabs(off_px[k] - (amb[k] + kd)) < 0.02);
+    }
+    for (int on = 0; on < 2; on++) {
+        free(rgb[on]);
+        film_free(&film[on]);
+    }
+}
+
+/* --shadows off, path tracer: next-event estimation counts the point light as visible.
+ * With one bounce (the floor's light sample; what it scatters to is black) a floor
+ * pixel deep in the sphere's shadow is exactly 0 with shadows on, and with shadows off
+ * the same bits as the scene without the sphere; PoCL and scalar agree. */
+static void test_shadows_off_path(void)
+{
+    const uint W = 64, H = 64;
+    Film f[3];
+    float *rgb[3];
+    Camera cam;
+    for (int i = 0; i < 3; i++) {            /* 0: off, 1: on, 2: off without the sphere */
+        Scene s;
+        shadow_switch_scene(&s, INTEGRATOR_PATH, i == 1, i != 2);
+        s.image.max_depth = 1;
+        Error err = {0};
+        CHECK(camera_setup(&s.camera, W, H, &cam, &err) == ST_OK);
+        rgb[i] = render(&s, "scalar", &f[i]);
+        if (i == 0) {
+            Film pocl;
+            float *rp = render(&s, "cpu", &pocl);
+            CHECK(memcmp(pocl.sum, f[0].sum, (size_t)W * H * 3u * sizeof *pocl.sum) == 0);
+            free(rp);
+            film_free(&pocl);
+        }
+        scene_free(&s);
+    }
+    D3 c = { 0.0, 1.0, 0.0 }, l = { 0.0, 3.0, 0.0 };
+    uint deep = 0, same = 0, checked = 0, dark = 0;
+    float one_on = -1.0f, one_off = -1.0f;
+    for (uint y = 0; y < H; y++)
+        for (uint x = 0; x < W; x++) {
+            D3 o, d;
+            pixel_ray(&cam, W, H, x, y, &o, &d);
+            if (!(d.y < 0.0)) continue;
+            double t = -o.y / d.y;
+            D3 p = { o.x + t * d.x, 0.0, o.z + t * d.z };
+            if (segment_hits_sphere(o, p, c, 0.6)) continue;   /* near the sphere's outline */
+            size_t k = 3 * ((size_t)y * W + x);
+            checked++;
+            if (memcmp(&rgb[0][k], &rgb[2][k], 3 * sizeof(float)) == 0) same++;
+            if (!segment_hits_sphere(p, l, c, 0.35)) continue;   /* the whole pixel in shadow */
+            deep++;
+            if (rgb[1][k] == 0.0f && rgb[1][k + 1] == 0.0f && rgb[1][k + 2] == 0.0f) dark++;
+            one_on = rgb[1][k];
+            one_off = rgb[0][k];
+        }
+    fprintf(stderr, "  path: %u of %u floor pixels with shadows off are the bits of the scene without the "
+            "sphere; %u of %u deep in its shadow black with shadows on (one: red %.4f on, %.4f off)\n",
+            same, checked, dark, deep, (double)one_on, (double)one_off);
+    CHECK(checked > 1000 && same == checked);
+    CHECK(deep > 20 && dark == deep);
+    CHECK(one_off > 0.5f);
+    for (int i = 0; i < 3; i++) {
+        free(rgb[i]);
+        film_free(&f[i]);
+    }
+}
+
 /* A directional light lights the floor evenly; a spot light fully inside its inner cone,
  * not at all outside its outer one, in between by a smooth step. */
 static void test_directional_and_spot(void)
@@ -793,6 +933,8 @@ int main(void)
     RUN(test_devices_agree);
     RUN(test_phong_highlight);
     RUN(test_shadow);
+    RUN(test_shadows_off_whitted);
+    RUN(test_shadows_off_path);
     RUN(test_directional_and_spot);
     RUN(test_mirror_and_glass);
     RUN(test_refraction);

@@ -1024,6 +1024,7 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
     s->integrator = INTEGRATOR_WHITTED;
     s->linear_output = 1;
     s->normal_miss_grey = 1;
+    s->shadows = 0;       /* the course ray casters cast none */
     s->image.spp = 1;
     s->bg_type = BG_CONSTANT;
     s->bg_color = s->bg_zenith = v3s(0.5f);

@@ -130,7 +130,7 @@ void passes_depth_grey(float *rgb, size_t n, const DepthScale *scale)
         if (cover > 0.0f) {
             double d = (double)rgb[3 * i] / cover, t = 1.0;
             if (scale->mode == DEPTH_RAW) t = d;
-            else if (scale->mode == DEPTH_RANGE) t = hi != lo ? (hi - d) / (hi - lo) : 1.0;
+            else if (scale->mode == DEPTH_RANGE) t = hi != lo ? (hi - d) / (hi - lo) : 1.0;   /* lo > hi: inverted */
             else if (hi > lo && d > 0.0) t = (lo / d - lo / hi) / (1.0 - lo / hi);
             if (scale->mode != DEPTH_RAW) t = (t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t)) * cover;
             g = (float)t;

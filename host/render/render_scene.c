@@ -69,6 +69,7 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     p->strata = render_scene_strata(s->image.spp);
     p->sample_offset = 0;
     p->normal_miss_grey = s->normal_miss_grey;
+    p->shadows = s->shadows ? 1u : 0u;
     out->ds.textures = s->textures;
     out->ds.texels = s->texels;
     out->ds.n_texels = s->n_texels;

@@ -32,6 +32,7 @@ void scene_init(Scene *s)
     s->ambient = v3(0.0f, 0.0f, 0.0f);
     s->integrator = INTEGRATOR_PATH;
     s->linear_output = 0;
+    s->shadows = 1;
 }
 
 void scene_free(Scene *s)

@@ -60,6 +60,8 @@ typedef struct {
                                   * or INTEGRATOR_WHITTED); --integrator overrides it */
     int linear_output;           /* 8-bit images without the sRGB curve (classic scenes) */
     uint normal_miss_grey;       /* the normal image's misses grey, not black (classic) */
+    int shadows;                 /* lights can be occluded: 1 for clpt's format and meshes,
+                                  * 0 for classic scenes; --shadows overrides it */
 
     /* Lookups by name, so that a scene or MTL with many materials reads in linear time:
      * material name -> first material of that name, texture name -> first texture of

@@ -87,6 +87,18 @@ static float *render(Scene *s, const char *devices, Film *film)
     return rgb;
 }
 
+/* PoCL renders s to the same bits as the scalar device's film `ref`. */
+static void check_pocl_matches(Scene *s, const Film *ref)
+{
+    Film pocl;
+    float *rp = render(s, "cpu", &pocl);
+    size_t n = (size_t)ref->width * ref->height * 3u;
+    CHECK(pocl.width == ref->width && pocl.height == ref->height &&
+          memcmp(pocl.sum, ref->sum, n * sizeof *pocl.sum) == 0);
+    free(rp);
+    film_free(&pocl);
+}
+
 /* Every floor pixel: kd c cos(theta) / (a0 + a1 d + a2 d^2), within 1e-4. */
 static void check_plane_irradiance(float a0, float a1, float a2)
 {
@@ -315,13 +327,7 @@ static void test_shadows_off_whitted(void)
         Error err = {0};
         CHECK(camera_setup(&s.camera, W, H, &cam, &err) == ST_OK);
         rgb[on] = render(&s, "scalar", &film[on]);
-        if (!on) {
-            Film pocl;
-            float *rp = render(&s, "cpu", &pocl);
-            CHECK(memcmp(pocl.sum, film[0].sum, (size_t)W * H * 3u * sizeof *pocl.sum) == 0);
-            free(rp);
-            film_free(&pocl);
-        }
+        if (!on) check_pocl_matches(&s, &film[0]);
         scene_free(&s);
     }
     /* the pixel whose floor point is nearest (0, 0, 0), right under the sphere */
@@ -381,13 +387,7 @@ static void test_shadows_off_path(void)
         Error err = {0};
         CHECK(camera_setup(&s.camera, W, H, &cam, &err) == ST_OK);
         rgb[i] = render(&s, "scalar", &f[i]);
-        if (i == 0) {
-            Film pocl;
-            float *rp = render(&s, "cpu", &pocl);
-            CHECK(memcmp(pocl.sum, f[0].sum, (size_t)W * H * 3u * sizeof *pocl.sum) == 0);
-            free(rp);
-            film_free(&pocl);
-        }
+        if (i == 0) check_pocl_matches(&s, &f[0]);
         scene_free(&s);
     }
     D3 c = { 0.0, 1.0, 0.0 }, l = { 0.0, 3.0, 0.0 };

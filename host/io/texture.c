@@ -267,17 +267,27 @@ static Status psd_check(Walk *wk, const unsigned char *hd, const char *path, int
  * byte repeated n - 128 times; else n bytes). */
 static Status hdr_check(Walk *wk, const char *path, int w, int h, Error *err)
 {
-    /* the identifier line, the header lines, the empty line, the size line */
+    /* the identifier line, the header lines, the empty line, the size line; stb_image
+     * reads a line as a C string, so a line that starts with a NUL ends the header too
+     * (missing that let a file through whose RLE data stb_image then read past its end,
+     * where it loops for ever on zero-length packets) */
     int lines_after_empty = -1;
-    for (int prev = '\n'; lines_after_empty < 1 && !wk->short_read;) {
+    for (int prev = '\n'; lines_after_empty < 1;) {
         int c = walk_byte(wk);
-        if (c == '\n') {
+        if (wk->short_read) break;
+        if (prev == '\n' && c == '\0' && lines_after_empty < 0) {
+            while (walk_byte(wk) != '\n' && !wk->short_read) {}
+            c = '\n';
+            lines_after_empty = 0;
+        } else if (c == '\n') {
             if (prev == '\n' && lines_after_empty < 0) lines_after_empty = 0;
             else if (lines_after_empty >= 0) lines_after_empty++;
         }
         prev = c;
     }
-    if (wk->short_read) return ST_OK;   /* stb_image rejects the header */
+    /* a header cut short is rejected by stb_image; a size line cut short leaves no data,
+     * which the checks below report */
+    if (wk->short_read && lines_after_empty < 0) return ST_OK;
     uint64_t n = (uint64_t)w * (uint64_t)h;
     if (w < 8 || w >= 32768) return check_fixed(path, "HDR", w, h, wk->pos, n * 4, wk->size, err);
     for (int j = 0; j < h && !wk->short_read; j++) {

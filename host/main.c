@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "base/atomic_file.h"
+#include "dist/merge.h"
 #include "render/checkpoint.h"
 #include "device/device.h"
 #include "device/ocl_program.h"
@@ -567,9 +568,27 @@ static Status scene_apply_options(Run *r, Error *err)
         return st;
     /* a mesh file given in place of a scene is shown by a camera that frames it */
     if (r->bare_mesh && (st = mesh_view_fit(&r->scene, err))) return st;
+    if (o->range_end > (long)r->scene.image.spp)
+        return error_set(err, ST_USAGE, "--sample-range %ld:%ld goes past the render's %u samples per pixel",
+                         o->range_first, o->range_end, r->scene.image.spp);
     if (o->adaptive > 0.0 && r->scene.integrator != INTEGRATOR_WHITTED)
         return error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
     r->encoding = r->scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB;
+    return ST_OK;
+}
+
+/* A part (--sample-range) resumed from a checkpoint must not carry samples outside
+ * its range: the part's film would then hold samples another part renders too. */
+static Status resume_check_range(const Options *o, const Checkpoint *ck, Error *err)
+{
+    if (o->range_end < 0) return ST_OK;
+    for (size_t i = 0; i < ck->n_done; i++) {
+        Batch b = ck->done[i];
+        if ((long)b.first < o->range_first || (long)b.first + (long)b.count > o->range_end)
+            return error_set(err, ST_INPUT, "checkpoint '%s' holds samples [%u,%u), outside --sample-range %ld:%ld; "
+                             "resume it with the range it was made with", o->resume_path, b.first, b.first + b.count,
+                             o->range_first, o->range_end);
+    }
     return ST_OK;
 }
 
@@ -582,9 +601,9 @@ static Status render_prepare(Run *r, Error *err)
     if (r->o.stats) print_scene_stats(&r->scene, &r->rs.kd);
     checkpoint_id(ds, r->scene.image.spp, &r->ctx.checkpoint_id);
     if ((st = film_init(&r->film, ds->params.width, ds->params.height, err))) return st;
-    if (r->o.resume_path)
-        return resume_film(r->o.resume_path, &r->ctx.checkpoint_id, &r->resume, &r->film, r->o.quiet, err);
-    return ST_OK;
+    if (!r->o.resume_path) return ST_OK;
+    if ((st = resume_film(r->o.resume_path, &r->ctx.checkpoint_id, &r->resume, &r->film, r->o.quiet, err))) return st;
+    return resume_check_range(&r->o, &r->resume, err);
 }
 
 /* ------------------------------------------------------------------ render */
@@ -601,6 +620,10 @@ static void render_configure(Run *r)
     cfg->spp = r->scene.image.spp;
     cfg->done = r->resume.done;
     cfg->n_done = r->resume.n_done;
+    if (o->range_end >= 0) {
+        cfg->range_first = (uint)o->range_first;
+        cfg->range_end = (uint)o->range_end;
+    }
     cfg->on_checkpoint = o->checkpoint_path ? on_checkpoint : NULL;
     cfg->checkpoint_seconds = o->checkpoint_seconds;
     cfg->time_limit = o->time_limit;
@@ -766,7 +789,9 @@ int main(int argc, char **argv)
      * in 64 KiB), so that stdout_close sees the failure and its errno. */
     static char stdout_buffer[1u << 16];   /* glibc ignores the size without a buffer */
     if (!isatty(STDOUT_FILENO)) setvbuf(stdout, stdout_buffer, _IOFBF, sizeof stdout_buffer);
-    Status st = run(argc, argv, &err);
+    /* `clpt merge ...` adds the films of --sample-range parts (dist/merge.h) */
+    Status st = argc > 1 && strcmp(argv[1], "merge") == 0 ? merge_command(argc - 1, argv + 1, &err)
+                                                          : run(argc, argv, &err);
     st = stdout_close(st, &err);
     if (st != ST_OK && st != ST_INTERRUPTED) {
         if (!err.msg[0]) err.status = st;   /* never "error: success" for a lost message */

@@ -80,6 +80,19 @@ void options_print_help(FILE *f)
 "                             scene and settings must be the ones it was made\n"
 "                             with (else exit status 3). Checkpoints go on\n"
 "                             into FILE unless --checkpoint names another file\n"
+"      --sample-range A:B     render only samples A..B-1 of every pixel: a part\n"
+"                             of the render for 'clpt merge' (with --checkpoint\n"
+"                             PART); -o gets the part's own image\n"
+"\n",
+        f);
+    fputs(
+"Merging parts (docs/distributed.md):\n"
+"  clpt merge -o OUT PART...  add the films of --sample-range parts of one\n"
+"                             render exactly: OUT is the same bits as one\n"
+"                             process rendering every sample. Parts that\n"
+"                             overlap, leave samples out or belong to other\n"
+"                             renders are refused (exit status 3). Also\n"
+"                             --checkpoint FILE, --gamma srgb|none, -q\n"
 "\n"
 "Scene and integrator:\n"
 "      --format auto|clpt|classic\n"
@@ -221,6 +234,27 @@ static Status parse_depth_range(const char *v, Options *o, Error *err)
     return ST_OK;
 }
 
+/* --sample-range A:B, 0 <= A < B <= CLPT_MAX_SPP (B is checked against the render's
+ * samples per pixel once the scene is read). */
+static Status parse_sample_range(const char *v, Options *o, Error *err)
+{
+    char *end;
+    errno = 0;
+    long a = strtol(v, &end, 10), b = -1;
+    int ok = end != v && *end == ':' && !errno && v[0] != '-' && v[0] != '+';
+    if (ok) {
+        const char *second = end + 1;
+        b = strtol(second, &end, 10);
+        ok = end != second && !*end && !errno && second[0] != '-' && second[0] != '+';
+    }
+    if (!ok || a < 0 || b <= a || b > CLPT_MAX_SPP)
+        return error_set(err, ST_USAGE, "--sample-range expects A:B, sample indices with 0 <= A < B <= %d, got '%s'",
+                         CLPT_MAX_SPP, v);
+    o->range_first = a;
+    o->range_end = b;
+    return ST_OK;
+}
+
 static Status parse_adaptive(const char *v, Options *o, Error *err)
 {
     char *end;
@@ -319,6 +353,7 @@ static Status options_set_number(const char *a, const char *v, Options *o, int *
         return ST_OK;
     }
     if (strcmp(a, "--adaptive") == 0) return parse_adaptive(v, o, err);
+    if (strcmp(a, "--sample-range") == 0) return parse_sample_range(v, o, err);
     if (strcmp(a, "--depth-range") == 0) return parse_depth_range(v, o, err);
     *found = 0;
     return ST_OK;
@@ -363,6 +398,7 @@ static void options_defaults(Options *o)
 {
     memset(o, 0, sizeof *o);
     o->spp = o->width = o->height = o->seed = o->max_depth = -1;
+    o->range_first = o->range_end = -1;
     o->integrator = -1;
     o->gamma = -1;
     o->shadows = -1;
@@ -410,6 +446,8 @@ static Status options_finish(Options *o, Error *err)
     if (o->checkpoint_seconds > 0.0 && !o->checkpoint_path && !o->resume_path)
         return error_set(err, ST_USAGE, "--checkpoint-interval needs --checkpoint FILE (or --resume FILE)");
     if (o->resume_path && !o->checkpoint_path) o->checkpoint_path = o->resume_path;
+    if (o->range_end >= 0 && o->adaptive > 0.0)
+        return error_set(err, ST_USAGE, "--adaptive cannot be used with --sample-range (it needs the whole image)");
     if (o->checkpoint_seconds <= 0.0) o->checkpoint_seconds = 60.0;
     if (!o->scene_path && !o->help && !o->version && !o->list_devices)
         return error_set(err, ST_USAGE, "no scene given (usage: clpt [options] SCENE; see --help)");

@@ -18,6 +18,9 @@ typedef struct {
     const char *checkpoint_path;  /* NULL: no checkpoints (but see resume_path) */
     double checkpoint_seconds;    /* between checkpoints; 60 unless given */
     const char *resume_path;      /* NULL: a fresh render */
+    /* --sample-range A:B: render only sample indices [A, B) of every pixel (an
+     * independent part for `clpt merge`); -1/-1 = all of [0, spp) */
+    long range_first, range_end;
     int list_devices, stats, quiet, help, version;
     /* developer flags */
     const char *kernel_dir;

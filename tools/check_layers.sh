@@ -9,13 +9,15 @@
 #   accel   the kd-tree over the scene's triangles
 #   device  OpenCL and the scalar device behind one interface
 #   render  scheduler, film, checkpoints, passes
+#   dist    one image from many processes: merging --sample-range parts, the MPI
+#           driver (docs/distributed.md)
 #   app     host/*.c: options and main, on top of everything
 #
 # Headers of kernels/ (shared structs, math) may be included from any layer. Prints
 # every include that points up and exits 1 if there is one; run by `make test`.
 set -eu
 cd "$(dirname "$0")/.."
-layers="base scene io accel device render app"
+layers="base scene io accel device render dist app"
 
 rank() {
     i=0

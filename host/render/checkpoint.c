@@ -292,23 +292,28 @@ out:
     return st;
 }
 
+int checkpoint_id_differs(const CheckpointId *g, const CheckpointId *e, const char *other, char *what, size_t size)
+{
+    if (g->width != e->width || g->height != e->height)
+        snprintf(what, size, "it is %ux%u pixels, %s %ux%u", g->width, g->height, other, e->width, e->height);
+    else if (g->spp != e->spp)
+        snprintf(what, size, "it is for %u samples per pixel, %s %u", g->spp, other, e->spp);
+    else if (g->seed != e->seed)
+        snprintf(what, size, "its seed is %u, %s's %u", g->seed, other, e->seed);
+    else if (g->max_depth != e->max_depth)
+        snprintf(what, size, "its maximum depth is %u, %s's %u", g->max_depth, other, e->max_depth);
+    else if (memcmp(g->key, e->key, CHECKPOINT_KEY_SIZE) != 0)
+        snprintf(what, size, "the scene differs (geometry, materials, camera or lights), or it was made "
+                             "by a clpt with other kernels");
+    else
+        return 0;
+    return 1;
+}
+
 Status checkpoint_check(const Checkpoint *c, const char *path, const CheckpointId *e, Error *err)
 {
-    const CheckpointId *g = &c->id;
     char what[256];
-    if (g->width != e->width || g->height != e->height)
-        snprintf(what, sizeof what, "it is %ux%u pixels, this render %ux%u", g->width, g->height, e->width, e->height);
-    else if (g->spp != e->spp)
-        snprintf(what, sizeof what, "it is for %u samples per pixel, this render %u", g->spp, e->spp);
-    else if (g->seed != e->seed)
-        snprintf(what, sizeof what, "its seed is %u, this render's %u", g->seed, e->seed);
-    else if (g->max_depth != e->max_depth)
-        snprintf(what, sizeof what, "its maximum depth is %u, this render's %u", g->max_depth, e->max_depth);
-    else if (memcmp(g->key, e->key, CHECKPOINT_KEY_SIZE) != 0)
-        snprintf(what, sizeof what, "the scene differs (geometry, materials, camera or lights), or it was made "
-                                    "by a clpt with other kernels");
-    else
-        return ST_OK;
+    if (!checkpoint_id_differs(&c->id, e, "this render", what, sizeof what)) return ST_OK;
     return error_set(err, ST_INPUT,
                      "checkpoint '%s' belongs to another render: %s; refusing to resume (resume with the scene and "
                      "settings it was made with, or start afresh without --resume)", path, what);

@@ -51,6 +51,12 @@ Status checkpoint_write(const char *path, const CheckpointId *id, const Film *fi
  * Free with checkpoint_free (also after a failure). */
 Status checkpoint_read(const char *path, Checkpoint *c, Error *err);
 
+/* 0 when `got` and `expected` are one render; else 1, with the first difference in
+ * words in `what`, `other` naming the expected one ("this render": "its seed is 2,
+ * this render's 1"). */
+int checkpoint_id_differs(const CheckpointId *got, const CheckpointId *expected, const char *other, char *what,
+                          size_t size);
+
 /* ST_INPUT, naming the first difference, unless `c` belongs to the render `expected`. */
 Status checkpoint_check(const Checkpoint *c, const char *path, const CheckpointId *expected, Error *err);
 

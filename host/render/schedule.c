@@ -306,6 +306,24 @@ void schedule_stats_free(ScheduleStats *s)
     batch_set_free(&s->done);
 }
 
+/* The queue skips what the film holds and, for a render of a sample range, what lies
+ * outside it (those samples are not in the film: the record `done` leaves them out). */
+static int skip_outside_range(Shared *sh, const ScheduleConfig *cfg)
+{
+    if (cfg->range_end == 0) return batch_queue_skip_done(&sh->queue, cfg->done, cfg->n_done);
+    if (cfg->range_first >= cfg->range_end || cfg->range_end > cfg->spp) return -1;
+    Batch *skip = malloc((cfg->n_done + 2) * sizeof *skip);
+    if (!skip) return -2;
+    size_t n = 0;
+    if (cfg->n_done) memcpy(skip, cfg->done, cfg->n_done * sizeof *skip);
+    n = cfg->n_done;
+    if (cfg->range_first > 0) skip[n++] = (Batch){ 0, cfg->range_first };
+    if (cfg->range_end < cfg->spp) skip[n++] = (Batch){ cfg->range_end, cfg->spp - cfg->range_end };
+    int rc = batch_queue_skip_done(&sh->queue, skip, n);
+    free(skip);
+    return rc;
+}
+
 /* The queue of batches, the locks, and the record of what a resumed film holds. */
 static Status shared_init(Shared *sh, const ScheduleConfig *cfg, Film *film, Error *err)
 {
@@ -320,7 +338,7 @@ static Status shared_init(Shared *sh, const ScheduleConfig *cfg, Film *film, Err
     sh->queue_ready = 1;
     for (size_t i = 0; i < cfg->n_done; i++)
         if (batch_set_add(&sh->done, cfg->done[i]) != 0) return error_set(err, ST_INTERNAL, "out of memory starting the render");
-    int rc = batch_queue_skip_done(&sh->queue, cfg->done, cfg->n_done);
+    int rc = skip_outside_range(sh, cfg);
     if (rc == -2) return error_set(err, ST_INTERNAL, "out of memory starting the render");
     if (rc != 0)
         return error_set(err, ST_INTERNAL, "the finished sample ranges overlap or exceed %u samples", cfg->spp);

@@ -40,6 +40,10 @@ typedef struct {
      * rendered. NULL/0 for a fresh film. */
     const Batch *done;
     size_t n_done;
+    /* Only sample indices [range_first, range_end) are rendered (--sample-range, and the
+     * batches an MPI rank is given); range_end 0 = all of [0, spp). `done` must lie
+     * inside the range. */
+    uint range_first, range_end;
     double time_limit;               /* seconds; 0 = none. Whole batches only. */
     double target_batch_seconds;     /* 0 = 0.25 */
     uint fixed_batch;                /* > 0: every batch has this many samples (tests) */

@@ -1,0 +1,171 @@
+/* merge.c — see merge.h. */
+#include "dist/merge.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/atomic_file.h"
+#include "io/image_write.h"
+#include "scene/scene.h"
+
+/* One sample range and the part it came from, for the overlap and gap checks. */
+typedef struct {
+    Batch b;
+    size_t part;
+} PartRange;
+
+static int cmp_part_range(const void *x, const void *y)
+{
+    uint a = ((const PartRange *)x)->b.first, b = ((const PartRange *)y)->b.first;
+    return (a > b) - (a < b);
+}
+
+/* Adds part `c` (read from paths[k]) into `out`, after checking it is the same render. */
+static Status merge_add(Checkpoint *out, const Checkpoint *c, const char *const *paths, size_t k, Error *err)
+{
+    char what[256];
+    if (checkpoint_id_differs(&c->id, &out->id, "the first part", what, sizeof what))
+        return error_set(err, ST_INPUT, "cannot merge '%s' with '%s': they are parts of different renders (%s)",
+                         paths[k], paths[0], what);
+    size_t n = (size_t)out->film.width * out->film.height * 3u;
+    /* Each part's values are bounded by its samples (checkpoint_read), and the parts'
+     * samples add up to at most spp (checked after), so the sums cannot overflow. */
+    for (size_t i = 0; i < n; i++) out->film.sum[i] += c->film.sum[i];
+    out->film.samples += c->film.samples;
+    return ST_OK;
+}
+
+/* The ranges of all parts, sorted: any overlap names the two parts, any gap the samples
+ * missing. On success *out holds their union, [0, spp) as one range. */
+static Status merge_check_ranges(PartRange *r, size_t n, const char *const *paths, uint spp, Checkpoint *out,
+                                 Error *err)
+{
+    qsort(r, n, sizeof *r, cmp_part_range);
+    uint at = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (r[i].b.first < at) {
+            const PartRange *p = &r[i - 1];
+            uint lo = r[i].b.first, hi = at < r[i].b.first + r[i].b.count ? at : r[i].b.first + r[i].b.count;
+            return error_set(err, ST_INPUT, "cannot merge: '%s' and '%s' both hold samples [%u,%u); each sample "
+                             "must come from one part", paths[p->part], paths[r[i].part], lo, hi);
+        }
+        if (r[i].b.first > at)
+            return error_set(err, ST_INPUT, "cannot merge: no part holds samples [%u,%u) of the %u per pixel; "
+                             "render them with --sample-range %u:%u and merge that part too",
+                             at, r[i].b.first, spp, at, r[i].b.first);
+        at = r[i].b.first + r[i].b.count;
+    }
+    if (at < spp)
+        return error_set(err, ST_INPUT, "cannot merge: no part holds samples [%u,%u) of the %u per pixel; "
+                         "render them with --sample-range %u:%u and merge that part too", at, spp, spp, at, spp);
+    free(out->done);
+    if (!(out->done = malloc(sizeof *out->done))) return error_set(err, ST_INTERNAL, "out of memory merging");
+    out->done[0] = (Batch){ 0, spp };
+    out->n_done = 1;
+    return ST_OK;
+}
+
+/* Appends part k's ranges to the list of all ranges. */
+static Status merge_note_ranges(const Checkpoint *c, size_t k, PartRange **r, size_t *n, size_t *cap, Error *err)
+{
+    if (array_reserve((void **)r, cap, *n + c->n_done, sizeof **r))
+        return error_set(err, ST_INTERNAL, "out of memory merging");
+    for (size_t i = 0; i < c->n_done; i++) (*r)[(*n)++] = (PartRange){ c->done[i], k };
+    return ST_OK;
+}
+
+Status merge_parts(const char *const *paths, size_t n, Checkpoint *out, Error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (n == 0) return error_set(err, ST_USAGE, "merge needs at least one PART");
+    PartRange *ranges = NULL;
+    size_t n_ranges = 0, cap = 0;
+    Status st = checkpoint_read(paths[0], out, err);
+    if (st == ST_OK) st = merge_note_ranges(out, 0, &ranges, &n_ranges, &cap, err);
+    for (size_t k = 1; k < n && st == ST_OK; k++) {
+        Checkpoint c;
+        st = checkpoint_read(paths[k], &c, err);
+        if (st == ST_OK) st = merge_add(out, &c, paths, k, err);
+        if (st == ST_OK) st = merge_note_ranges(&c, k, &ranges, &n_ranges, &cap, err);
+        checkpoint_free(&c);
+    }
+    if (st == ST_OK) st = merge_check_ranges(ranges, n_ranges, paths, out->id.spp, out, err);
+    free(ranges);
+    return st;
+}
+
+/* ------------------------------------------------------------------ command */
+
+typedef struct {
+    const char *output, *checkpoint;
+    int linear, quiet;
+    const char **parts;
+    size_t n_parts;
+} MergeOptions;
+
+static Status merge_parse(int argc, char **argv, MergeOptions *m, Error *err)
+{
+    memset(m, 0, sizeof *m);
+    if (!(m->parts = calloc((size_t)argc, sizeof *m->parts))) return error_set(err, ST_INTERNAL, "out of memory");
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        int takes_value = !strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--checkpoint") ||
+                          !strcmp(a, "--gamma");
+        if (takes_value && (i + 1 >= argc || !argv[i + 1][0]))
+            return error_set(err, ST_USAGE, "merge: %s needs a value", a);
+        if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+            m->output = argv[++i];
+        } else if (!strcmp(a, "--checkpoint")) {
+            m->checkpoint = argv[++i];
+        } else if (!strcmp(a, "--gamma")) {
+            const char *v = argv[++i];
+            if (strcmp(v, "srgb") != 0 && strcmp(v, "none") != 0)
+                return error_set(err, ST_USAGE, "merge: --gamma expects 'srgb' or 'none', got '%s'", v);
+            m->linear = !strcmp(v, "none");
+        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+            m->quiet = 1;
+        } else if (a[0] == '-' && a[1]) {
+            return error_set(err, ST_USAGE, "merge: unknown option '%s' (usage: clpt merge -o OUT PART...)", a);
+        } else {
+            m->parts[m->n_parts++] = a;
+        }
+    }
+    if (!m->output) return error_set(err, ST_USAGE, "merge needs -o OUT (usage: clpt merge -o OUT PART...)");
+    if (m->n_parts == 0) return error_set(err, ST_USAGE, "merge needs at least one PART (usage: clpt merge -o OUT PART...)");
+    return ST_OK;
+}
+
+static Status merge_write_image(const Film *film, const char *path, int linear, Error *err)
+{
+    size_t n = (size_t)film->width * film->height * 3u;
+    float *rgb = malloc(n * sizeof *rgb);
+    if (!rgb) return error_set(err, ST_INTERNAL, "out of memory resolving the image");
+    film_resolve(film, rgb);
+    Status st = image_write_encoded(path, rgb, film->width, film->height, linear ? IMAGE_LINEAR : IMAGE_SRGB, err);
+    free(rgb);
+    return st;
+}
+
+Status merge_command(int argc, char **argv, Error *err)
+{
+    MergeOptions m;
+    Checkpoint merged;
+    memset(&merged, 0, sizeof merged);
+    ImageFormat fmt;
+    Status st = merge_parse(argc, argv, &m, err);
+    /* the outputs are checked before the parts are read: a typo costs a second */
+    if (st == ST_OK) st = image_format_from_path(m.output, &fmt, err);
+    if (st == ST_OK) st = atomic_probe(m.output, "", err);
+    if (st == ST_OK && m.checkpoint) st = atomic_probe(m.checkpoint, "checkpoint", err);
+    if (st == ST_OK) st = merge_parts(m.parts, m.n_parts, &merged, err);
+    if (st == ST_OK && m.checkpoint)
+        st = checkpoint_write(m.checkpoint, &merged.id, &merged.film, merged.done, merged.n_done, err);
+    if (st == ST_OK) st = merge_write_image(&merged.film, m.output, m.linear, err);
+    if (st == ST_OK && !m.quiet)
+        fprintf(stderr, "clpt: merged %zu part%s: %ux%u, %llu spp -> %s\n", m.n_parts, m.n_parts == 1 ? "" : "s",
+                merged.film.width, merged.film.height, (unsigned long long)merged.film.samples, m.output);
+    checkpoint_free(&merged);
+    free(m.parts);
+    return st;
+}

@@ -1,0 +1,25 @@
+/*
+ * merge.h — `clpt merge -o OUT PART...`: the films of independent partial renders
+ * (--sample-range A:B --checkpoint PART) added into one.
+ *
+ * Every part is a checkpoint (docs/checkpoint.md) of the same render (its key: scene,
+ * settings, kernels) holding the sample indices it rendered. The film is integer, so
+ * adding the parts' sums gives exactly the sums one process would have accumulated:
+ * the merged image is the same bits as the one-process render, whatever the split.
+ * Parts of other renders, parts that hold a sample twice and sets of parts that leave a
+ * sample out are refused (ST_INPUT), naming the parts and samples concerned.
+ */
+#ifndef CLPT_MERGE_H
+#define CLPT_MERGE_H
+
+#include "base/status.h"
+#include "render/checkpoint.h"
+
+/* Reads the parts and adds them into *out (its id is theirs, its done ranges the union,
+ * which must be all of [0, spp)). Free *out with checkpoint_free, also after a failure. */
+Status merge_parts(const char *const *paths, size_t n, Checkpoint *out, Error *err);
+
+/* The command: argv[0] is "merge". Returns the exit status; err holds the message. */
+Status merge_command(int argc, char **argv, Error *err);
+
+#endif /* CLPT_MERGE_H */

@@ -30,6 +30,11 @@ CFLAGS    := -std=c11 $(OPT) -g $(WARN) $(FPFLAGS) -pthread $(EXTRA_CFLAGS)
 LDFLAGS   := -pthread $(EXTRA_LDFLAGS)
 LDLIBS    := -lOpenCL -lstb -lm
 
+# Open MPI (docs/distributed.md): only host/dist/mpi_driver.c includes mpi.h, and only
+# the clpt program links libmpi; the tests and benchmarks never pull that file in.
+MPI_CFLAGS := $(shell pkg-config --cflags ompi-c 2>/dev/null || echo -I/usr/lib/x86_64-linux-gnu/openmpi/include)
+MPI_LIBS   := $(shell pkg-config --libs ompi-c 2>/dev/null || echo -lmpi)
+
 # Code that compiles the kernel sources as C must not promote floats to double, or the
 # scalar device would round differently from OpenCL.
 KERNEL_C_WARN := -Wdouble-promotion -Werror=double-promotion
@@ -82,12 +87,13 @@ $(BUILD)/host/%.o: host/%.c
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(FILE_WARN) -MMD -MP -c -o $@ $<
 
 $(BUILD)/host/device/device_scalar.o: FILE_WARN := $(KERNEL_C_WARN)
+$(BUILD)/host/dist/mpi_driver.o: FILE_WARN := $(MPI_CFLAGS)
 
 $(BUILD)/lib$(PROG).a: $(HOST_OBJ)
 	rm -f $@ && ar rcs $@ $^
 
 $(BUILD)/$(PROG): $(BUILD)/host/main.o $(BUILD)/lib$(PROG).a
-	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS) $(MPI_LIBS)
 
 $(BUILD)/tests/%: tests/%.c tests/harness.h $(BUILD)/lib$(PROG).a
 	@mkdir -p $(@D)

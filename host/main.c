@@ -17,6 +17,7 @@
 
 #include "base/atomic_file.h"
 #include "dist/merge.h"
+#include "dist/mpi_driver.h"
 #include "render/checkpoint.h"
 #include "device/device.h"
 #include "device/ocl_program.h"
@@ -37,6 +38,7 @@
 
 static volatile sig_atomic_t stop_requested;
 static int stderr_is_terminal;
+static int stop_quietly;   /* an MPI worker: rank 0 says it */
 
 /* The first SIGINT or SIGTERM stops the render within about a second and writes what
  * is finished (exit 6); a second one, of either kind, ends the process at once by the
@@ -49,6 +51,7 @@ static void on_stop_signal(int sig)
         return;
     }
     stop_requested = 1;
+    if (stop_quietly) return;
     /* on a terminal the progress bar holds the line: start a fresh one */
     static const char msg[] = "\nclpt: stopping: writing what is finished (press Ctrl-C again to quit at once)\n";
     size_t skip = stderr_is_terminal ? 0 : 1;
@@ -593,15 +596,15 @@ static Status resume_check_range(const Options *o, const Checkpoint *ck, Error *
 }
 
 /* kd-tree and device buffers, the render's identity, the film (from --resume). */
-static Status render_prepare(Run *r, Error *err)
+static Status render_prepare(Run *r, int worker, Error *err)
 {
     Status st;
     if ((st = render_scene_prepare(&r->scene, 0, &r->rs, err))) return st;
     const DeviceScene *ds = &r->rs.ds;
-    if (r->o.stats) print_scene_stats(&r->scene, &r->rs.kd);
+    if (r->o.stats && !worker) print_scene_stats(&r->scene, &r->rs.kd);
     checkpoint_id(ds, r->scene.image.spp, &r->ctx.checkpoint_id);
     if ((st = film_init(&r->film, ds->params.width, ds->params.height, err))) return st;
-    if (!r->o.resume_path) return ST_OK;
+    if (!r->o.resume_path || worker) return ST_OK;
     if ((st = resume_film(r->o.resume_path, &r->ctx.checkpoint_id, &r->resume, &r->film, r->o.quiet, err))) return st;
     return resume_check_range(&r->o, &r->resume, err);
 }
@@ -638,10 +641,16 @@ static void render_configure(Run *r)
 
 /* The render itself. Its status is kept apart: after a failure or an interrupt, what
  * was finished is still saved. */
-static void render_run(Run *r, Error *err)
+static void render_run(Run *r, Dist *dist, Error *err)
 {
     install_signal_handlers();
     render_configure(r);
+    if (dist->active) {
+        /* the other ranks join the render as devices of this one */
+        dist->spp = r->scene.image.spp;
+        r->render_st = dist_add_remote_devices(dist, r->film.width * r->film.height, &r->devs, &r->n_devs, err);
+        if (r->render_st != ST_OK) return;
+    }
     r->render_st = schedule_run(r->devs, r->n_devs, &r->cfg, &r->film, &r->stats, err);
 }
 
@@ -730,7 +739,62 @@ static Status results_write(Run *r, Error *err)
     return st;
 }
 
-static Status run(int argc, char **argv, Error *err)
+/* ------------------------------------------------------------------ under MPI */
+
+/* The options an MPI job takes, passed on to the driver. */
+static Status mpi_options(const Options *o, Dist *dist, Error *err)
+{
+    if (o->adaptive > 0.0 || o->aovs)
+        return error_set(err, ST_USAGE, "--adaptive and --aov are not available under MPI (run them in one process)");
+    dist->broadcast = o->mpi_broadcast;
+    if (o->mpi_timeout > 0.0) dist->timeout = o->mpi_timeout;
+    dist->fixed_batch = o->batch;
+    return ST_OK;
+}
+
+/* --mpi-broadcast: rank 0's prepared scene becomes every worker's. */
+static Status mpi_share_scene(Run *r, Dist *dist, Status st, Error *err)
+{
+    unsigned spp = r->scene.image.spp;
+    Status shared = dist_share_scene(dist, st, &r->rs.ds, &spp, err);
+    if (shared != ST_OK || dist->rank == 0) return shared;
+    r->scene.image.spp = spp;
+    checkpoint_id(&r->rs.ds, spp, &r->ctx.checkpoint_id);
+    return ST_OK;
+}
+
+/* One rank of an MPI job (dist/mpi_driver.h): every rank prepares the scene (or receives
+ * it) and its devices, and all agree to start; then rank 0 renders with the others as
+ * devices and writes the outputs, while the others render the batches it sends. Every
+ * step runs on every rank, also after a failure, so that no rank waits for ever in a
+ * collective call; rank 0 alone reports. */
+static Status run_rank(Run *r, Dist *dist, Error *err)
+{
+    int worker = dist->rank > 0, receive = worker && dist->broadcast;
+    Status st = ST_OK;
+    if (worker) r->o.quiet = 1;
+    if (!worker) st = outputs_choose(r, err);
+    if (st == ST_OK && !worker) st = outputs_check(r, err);
+    if (st == ST_OK && !receive) st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
+    if (st == ST_OK && !receive) st = scene_apply_options(r, err);
+    if (st == ST_OK && !receive) st = render_prepare(r, worker, err);
+    if (dist->broadcast) st = mpi_share_scene(r, dist, st, err);
+    if (st == ST_OK) st = open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
+    st = dist_agree(dist, st, err, &r->ctx.checkpoint_id, r->devs, r->n_devs, err);
+    if (st != ST_OK) return st;
+    if (worker) {
+        stop_quietly = 1;
+        install_signal_handlers();
+        return dist_worker_run(dist, r->devs, r->n_devs, r->rs.ds.params.width, r->rs.ds.params.height,
+                               &stop_requested, err);
+    }
+    render_run(r, dist, err);
+    st = results_write(r, err);
+    dist_stop_workers(dist, r->o.stats ? stdout : NULL);
+    return st;
+}
+
+static Status run(int argc, char **argv, Dist *dist, Error *err)
 {
     Run r;
     memset(&r, 0, sizeof r);
@@ -738,17 +802,23 @@ static Status run(int argc, char **argv, Error *err)
     r.t_start = timer_now();
     int done = 0;
     Status st = options_parse(argc, argv, &r.o, err);
-    if (st == ST_OK) st = run_info_command(&r.o, &done, err);
-    if (st != ST_OK || done) return st;
+    if (st == ST_OK && dist->active) st = mpi_options(&r.o, dist, err);
+    if (st == ST_OK && dist->rank == 0) st = run_info_command(&r.o, &done, err);
+    if (st != ST_OK || done || r.o.help || r.o.version || r.o.list_devices) return st;
 
+    if (dist->active) {
+        st = run_rank(&r, dist, err);
+        run_free(&r);
+        return st;
+    }
     st = outputs_choose(&r, err);
     if (st == ST_OK) st = outputs_check(&r, err);
     if (st == ST_OK) st = load_scene_input(&r.o, &r.scene, &r.bare_mesh, err);
     if (st == ST_OK) st = scene_apply_options(&r, err);
-    if (st == ST_OK) st = render_prepare(&r, err);
+    if (st == ST_OK) st = render_prepare(&r, 0, err);
     if (st == ST_OK) st = open_devices(&r.o, &r.rs.ds, &r.devs, &r.n_devs, err);
     if (st == ST_OK) {
-        render_run(&r, err);
+        render_run(&r, dist, err);
         st = results_write(&r, err);
     }
     run_free(&r);
@@ -781,6 +851,19 @@ static Status stdout_close(Status st, Error *err)
     return keep_first(st, err, ST_IO, &out);
 }
 
+/* Prints the run's error (once) and gives its exit status. */
+static Status main_report(Status st, Error *err)
+{
+    st = stdout_close(st, err);
+    if (st != ST_OK && st != ST_INTERRUPTED) {
+        if (!err->msg[0]) err->status = st;   /* never "error: success" for a lost message */
+        error_print(err);
+        if (st == ST_USAGE) fprintf(stderr, "Try 'clpt --help' for more information.\n");
+    }
+    error_clear(err);
+    return st;
+}
+
 int main(int argc, char **argv)
 {
     Error err = { 0 };
@@ -790,14 +873,19 @@ int main(int argc, char **argv)
     static char stdout_buffer[1u << 16];   /* glibc ignores the size without a buffer */
     if (!isatty(STDOUT_FILENO)) setvbuf(stdout, stdout_buffer, _IOFBF, sizeof stdout_buffer);
     /* `clpt merge ...` adds the films of --sample-range parts (dist/merge.h) */
-    Status st = argc > 1 && strcmp(argv[1], "merge") == 0 ? merge_command(argc - 1, argv + 1, &err)
-                                                          : run(argc, argv, &err);
-    st = stdout_close(st, &err);
-    if (st != ST_OK && st != ST_INTERRUPTED) {
-        if (!err.msg[0]) err.status = st;   /* never "error: success" for a lost message */
-        error_print(&err);
-        if (st == ST_USAGE) fprintf(stderr, "Try 'clpt --help' for more information.\n");
+    if (argc > 1 && strcmp(argv[1], "merge") == 0) return (int)main_report(merge_command(argc - 1, argv + 1, &err), &err);
+    /* under mpirun or srun, this process is one rank of a job (dist/mpi_driver.h) */
+    Dist dist;
+    Status st = dist_init(&dist, &argc, &argv, &err);
+    if (st == ST_OK) st = run(argc, argv, &dist, &err);
+    if (dist.active && dist.rank > 0) {
+        /* a worker's own failures only; ST_INTERRUPTED is a stop rank 0 reports */
+        if (st != ST_OK && st != ST_INTERRUPTED) fprintf(stderr, "clpt: MPI rank %d: error: %s\n", dist.rank, err.msg);
+        error_clear(&err);
+        dist_finish(&dist, 0, 0);
+        return 0;
     }
-    error_clear(&err);
+    st = main_report(st, &err);
+    dist_finish(&dist, (int)st, dist.lost);
     return (int)st;
 }

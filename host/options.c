@@ -94,6 +94,18 @@ void options_print_help(FILE *f)
 "                             renders are refused (exit status 3). Also\n"
 "                             --checkpoint FILE, --gamma srgb|none, -q\n"
 "\n"
+"MPI (mpirun -np N clpt SCENE ..., or srun; docs/distributed.md):\n"
+"                             one image from N processes, each on its own\n"
+"                             devices (--device applies to each); rank 0\n"
+"                             hands out batches, writes every output and\n"
+"                             prints; the image is the same bits as one\n"
+"                             process's. Not with --adaptive or --aov\n"
+"      --mpi-broadcast        rank 0 reads the scene and sends it to the\n"
+"                             others (default: every rank reads SCENE, which\n"
+"                             must then be on a shared path)\n"
+"      --mpi-timeout SECONDS  give a rank up after this long without a word\n"
+"                             from it (default 30); its batches go to others\n"
+"\n"
 "Scene and integrator:\n"
 "      --format auto|clpt|classic\n"
 "                             scene file format; default: told from the content\n"
@@ -284,7 +296,7 @@ static int options_set_switch(const char *a, Options *o)
     struct { const char *name, *alias; int *dst; } switches[] = {
         { "--help", "-h", &o->help },      { "--version", NULL, &o->version },
         { "--list-devices", NULL, &o->list_devices }, { "--stats", NULL, &o->stats },
-        { "--quiet", "-q", &o->quiet },
+        { "--quiet", "-q", &o->quiet },    { "--mpi-broadcast", NULL, &o->mpi_broadcast },
     };
     for (size_t k = 0; k < sizeof switches / sizeof switches[0]; k++)
         if (strcmp(a, switches[k].name) == 0 || (switches[k].alias && strcmp(a, switches[k].alias) == 0)) {
@@ -335,6 +347,7 @@ static Status options_set_number(const char *a, const char *v, Options *o, int *
         { "--checkpoint-interval", &o->checkpoint_seconds },
         { "--time-limit", &o->time_limit },
         { "--progressive-output", &o->progressive_seconds },
+        { "--mpi-timeout", &o->mpi_timeout },
     };
     *found = 1;
     for (size_t k = 0; k < sizeof longs / sizeof longs[0]; k++)

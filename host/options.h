@@ -21,6 +21,9 @@ typedef struct {
     /* --sample-range A:B: render only sample indices [A, B) of every pixel (an
      * independent part for `clpt merge`); -1/-1 = all of [0, spp) */
     long range_first, range_end;
+    /* under mpirun (docs/distributed.md) */
+    int mpi_broadcast;            /* the scene is read by rank 0 only and sent to the others */
+    double mpi_timeout;           /* seconds of silence before a rank is given up; 0 = 30 */
     int list_devices, stats, quiet, help, version;
     /* developer flags */
     const char *kernel_dir;

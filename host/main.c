@@ -39,6 +39,7 @@
 static volatile sig_atomic_t stop_requested;
 static int stderr_is_terminal;
 static int stop_quietly;   /* an MPI worker: rank 0 says it */
+static int stop_under_mpi; /* rank 0 of an MPI job */
 
 /* The first SIGINT or SIGTERM stops the render within about a second and writes what
  * is finished (exit 6); a second one, of either kind, ends the process at once by the
@@ -54,8 +55,13 @@ static void on_stop_signal(int sig)
     if (stop_quietly) return;
     /* on a terminal the progress bar holds the line: start a fresh one */
     static const char msg[] = "\nclpt: stopping: writing what is finished (press Ctrl-C again to quit at once)\n";
+    /* mpirun ends a job with SIGTERM to every rank also when one of them died */
+    static const char mpi_msg[] = "\nclpt: stopping on SIGINT/SIGTERM (from you, or from mpirun because another MPI "
+                                  "rank died; mpirun names it): writing what is finished\n";
+    const char *m = stop_under_mpi ? mpi_msg : msg;
+    size_t len = stop_under_mpi ? sizeof mpi_msg - 1 : sizeof msg - 1;
     size_t skip = stderr_is_terminal ? 0 : 1;
-    ssize_t w = write(STDERR_FILENO, msg + skip, sizeof msg - 1 - skip);
+    ssize_t w = write(STDERR_FILENO, m + skip, len - skip);
     (void)w;
 }
 
@@ -788,6 +794,7 @@ static Status run_rank(Run *r, Dist *dist, Error *err)
         return dist_worker_run(dist, r->devs, r->n_devs, r->rs.ds.params.width, r->rs.ds.params.height,
                                &stop_requested, err);
     }
+    stop_under_mpi = 1;
     render_run(r, dist, err);
     st = results_write(r, err);
     dist_stop_workers(dist, r->o.stats ? stdout : NULL);

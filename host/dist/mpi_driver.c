@@ -31,6 +31,7 @@ enum {
 struct DistWire {
     pthread_mutex_t lock;      /* MPI_THREAD_SERIALIZED: one thread in MPI at a time */
     char **names;              /* rank 0: each rank's "host: devices", from dist_agree */
+    unsigned char *gone;       /* rank 0: ranks given up during the render (silent, or MPI failed) */
     int64_t *scratch;          /* a worker's batch film */
 };
 
@@ -195,6 +196,7 @@ void dist_finish(Dist *d, int exit_status, int abort)
         if (d->wire->names)
             for (int i = 0; i < d->size; i++) free(d->wire->names[i]);
         free(d->wire->names);
+        free(d->wire->gone);
         free(d->wire->scratch);
         pthread_mutex_destroy(&d->wire->lock);
         free(d->wire);
@@ -324,6 +326,7 @@ Status dist_agree(Dist *d, Status st, const Error *st_err, const CheckpointId *i
     Status out = rc == MPI_SUCCESS ? ST_OK : mpi_failed(err, rc, d->rank, "starting the render");
     if (d->rank == 0 && all && rc == MPI_SUCCESS) {
         d->wire->names = calloc((size_t)d->size, sizeof *d->wire->names);
+        d->wire->gone = calloc((size_t)d->size, 1);
         for (int r = 1; r < d->size && verdict == ST_OK && st == ST_OK; r++) {
             if (all[r].status != ST_OK) {
                 verdict = all[r].status;
@@ -372,7 +375,9 @@ static Status remote_render(Device *dev, uint first, uint count, Error *err)
     if (st == ST_OK && res.status == ST_OK)
         st = wire_wait(rm->d, rm->rank, TAG_FILM, rm->film, rm->n_values * sizeof *rm->film, NULL, err);
     if (st != ST_OK) {
+        /* an interrupted wait leaves the rank working: its answer is drained at the end */
         rm->abandoned = 1;
+        if (st != ST_INTERRUPTED && rm->d->wire->gone) rm->d->wire->gone[rm->rank] = 1;
         return st;
     }
     if (res.status != ST_OK) {
@@ -623,11 +628,15 @@ void dist_stop_workers(Dist *d, FILE *out)
 {
     if (!d->active) return;
     uint32_t stop[3] = { 0, 0, 0 };
-    for (int r = 1; r < d->size; r++) wire_send(d, stop, 3, MPI_UINT32_T, r, TAG_STOP);
+    const unsigned char *gone = d->wire->gone;
+    for (int r = 1; r < d->size; r++)
+        if (!gone || !gone[r]) wire_send(d, stop, 3, MPI_UINT32_T, r, TAG_STOP);
     if (out) fprintf(out, "MPI ranks' devices (rank 0's are above):\n");
     for (int r = 1; r < d->size; r++) {
         WireStats s;
-        if (stop_collect(d, r, &s) != 0) {
+        if (gone && gone[r]) {
+            if (out) fprintf(out, "  rank %d: given up during the render\n", r);
+        } else if (stop_collect(d, r, &s) != 0) {
             d->lost = 1;
             fprintf(stderr, "clpt: warning: MPI rank %d did not answer the end of the render within %g s\n", r,
                     d->timeout);

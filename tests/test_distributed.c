@@ -2,9 +2,16 @@
  * test_distributed.c — one image from several processes (docs/distributed.md):
  * --sample-range parts merged with `clpt merge` are the same PFM bytes as the render of
  * one process, whatever the split; merges of overlapping, incomplete or foreign parts are
- * refused with exact messages and exit status 3.
+ * refused with exact messages and exit status 3. When mpirun is installed: renders with
+ * 2 and 3 MPI ranks are the same PFM bytes as one process's; a rank killed mid-render
+ * ends the job with rank 0's message and an intact checkpoint, from which --resume (with
+ * another number of ranks) ends with the same bytes; under mpirun --enable-recovery the
+ * render goes on without the dead rank; ranks that read different settings are refused.
  */
 #include <dirent.h>
+#include <time.h>
+
+#include "render/checkpoint.h"
 
 #include "cli_util.h"
 #include "harness.h"
@@ -165,6 +172,172 @@ static void test_sample_range_usage_errors(void)
     CHECK_STR_CONTAINS(r.err, msg);
 }
 
+/* ------------------------------------------------------------------ MPI */
+
+/* The machine may have two cores: every rank gets one thread, and mpirun is told that
+ * more ranks than cores is fine (and that root may run them, in containers). */
+#define MPIRUN "mpirun", "--oversubscribe", "--allow-run-as-root", "--mca", "btl", "self,vader"
+
+static int have_mpirun(void)
+{
+    return system("command -v mpirun >/dev/null 2>&1") == 0;
+}
+
+/* Starts argv[0] (found in PATH) with its output captured, as cli_start does. */
+static CliChild spawn(const char *const *args)
+{
+    CliChild c;
+    char out_name[] = "/tmp/clpt-mpi-out-XXXXXX", err_name[] = "/tmp/clpt-mpi-err-XXXXXX";
+    c.out_fd = mkstemp(out_name);
+    c.err_fd = mkstemp(err_name);
+    unlink(out_name);
+    unlink(err_name);
+    c.pid = fork();
+    if (c.pid == 0) {
+        dup2(c.out_fd, 1);
+        dup2(c.err_fd, 2);
+        setpgid(0, 0);   /* the test's own kill reaches mpirun's ranks only */
+        execvp(args[0], (char *const *)args);
+        _exit(127);
+    }
+    return c;
+}
+
+static void spawn_run(const char *const *args, CliResult *res)
+{
+    cli_finish(spawn(args), res);
+}
+
+static void sleep_s(double s)
+{
+    struct timespec ts = { (time_t)s, (long)((s - (double)(time_t)s) * 1e9) };
+    nanosleep(&ts, NULL);
+}
+
+static void test_mpi_two_and_three_ranks_are_bit_identical(void)
+{
+    spawn_run(ARGS(MPIRUN, "-np", "2", CLI_PROGRAM, RENDER, "-o", in_dir("np2.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(in_dir("np2.pfm"), in_dir("whole.pfm")));
+    /* three ranks, the scene read by rank 0 alone and sent to the others */
+    spawn_run(ARGS(MPIRUN, "-np", "3", CLI_PROGRAM, RENDER, "--mpi-broadcast", "-o", in_dir("np3.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(in_dir("np3.pfm"), in_dir("whole.pfm")));
+    /* a --sample-range part rendered by two ranks merges like any other */
+    spawn_run(ARGS(MPIRUN, "-np", "2", CLI_PROGRAM, RENDER, "--sample-range", "5:7", "--checkpoint", in_dir("mb.ckpt"),
+                   "-o", in_dir("mb.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS("merge", "-q", "-o", in_dir("mmerged.pfm"), in_dir("a.ckpt"), in_dir("mb.ckpt"), in_dir("c.ckpt")), &r);
+    CHECK_EQ_INT(r.status, 0);
+    CHECK(files_equal(in_dir("mmerged.pfm"), in_dir("whole.pfm")));
+}
+
+static void test_mpi_ranks_with_other_settings_are_refused(void)
+{
+    /* MPMD: rank 1 runs with another seed, so another render key */
+    spawn_run(ARGS(MPIRUN, "-np", "1", CLI_PROGRAM, RENDER, "-o", in_dir("refused.pfm"), ":", "-np", "1", CLI_PROGRAM,
+                   RENDER, "--seed", "9", "-o", in_dir("refused.pfm")), &r);
+    CHECK(r.status != 0);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: MPI rank 1 (");
+    CHECK_STR_CONTAINS(r.err, ") read another scene or settings than rank 0 (its render key differs): give every rank "
+                              "the same files, or use --mpi-broadcast\n");
+    CHECK_STR_CONTAINS(r.err, "Exit code:    3");
+    CHECK(!file_exists(in_dir("refused.pfm")));
+}
+
+/* A longer render (a few seconds on two cores), so that a rank can be killed in it. */
+#define LONG_RENDER "scenes/cornell-box.scene", "--width", "24", "--height", "18", "--spp", "360", "--device", \
+                    "scalar", "--threads", "1", "-q", "--batch", "3"
+
+/* The pid of the process of rank `rank` among mpirun's children (its environment says
+ * OMPI_COMM_WORLD_RANK); 0 if none. */
+static pid_t rank_pid(pid_t mpirun, int rank)
+{
+    DIR *d = opendir("/proc");
+    pid_t found = 0;
+    struct dirent *e;
+    char want[64];
+    snprintf(want, sizeof want, "OMPI_COMM_WORLD_RANK=%d", rank);
+    while (d && !found && (e = readdir(d))) {
+        pid_t pid = (pid_t)atoi(e->d_name);
+        char path[64], buf[1 << 16];
+        if (pid <= 0) continue;
+        snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+        FILE *f = fopen(path, "r");
+        int ppid = 0;
+        if (!f) continue;
+        if (fscanf(f, "%*d %*s %*c %d", &ppid) != 1) ppid = 0;
+        fclose(f);
+        if (ppid != mpirun) continue;
+        snprintf(path, sizeof path, "/proc/%d/environ", (int)pid);
+        f = fopen(path, "r");
+        if (!f) continue;
+        size_t n = fread(buf, 1, sizeof buf - 1, f);
+        fclose(f);
+        for (size_t i = 0; i < n; i += strlen(buf + i) + 1) {
+            buf[n] = '\0';
+            if (strcmp(buf + i, want) == 0) found = pid;
+        }
+    }
+    if (d) closedir(d);
+    return found;
+}
+
+/* Starts a 3-rank render with checkpoints, and kills rank 2 once a checkpoint is
+ * written (the render is then under way). */
+static CliChild start_and_kill_rank(const char *const *args)
+{
+    CliChild c = spawn(args);
+    pid_t victim = 0;
+    for (int i = 0; i < 400 && !(file_exists(in_dir("killed.ckpt")) && victim); i++) {
+        sleep_s(0.025);
+        if (!victim) victim = rank_pid(c.pid, 2);
+    }
+    CHECK(victim > 0);
+    CHECK(file_exists(in_dir("killed.ckpt")));
+    if (victim > 0) kill(victim, SIGKILL);
+    return c;
+}
+
+static void test_mpi_killed_rank_then_resume(void)
+{
+    cli_run(ARGS(LONG_RENDER, "-o", in_dir("long.pfm")), &r);
+    CHECK_EQ_INT(r.status, 0);
+    /* mpirun's default: the job ends when a rank dies; rank 0 writes what is finished */
+    cli_finish(start_and_kill_rank(ARGS(MPIRUN, "-np", "3", CLI_PROGRAM, LONG_RENDER, "--checkpoint",
+                                        in_dir("killed.ckpt"), "--checkpoint-interval", "0.1", "-o",
+                                        in_dir("killed.pfm"))), &r);
+    CHECK(r.status != 0);
+    CHECK_STR_CONTAINS(r.err, "clpt: stopping on SIGINT/SIGTERM (from you, or from mpirun because another MPI rank "
+                              "died; mpirun names it): writing what is finished\n");
+    CHECK_STR_CONTAINS(r.err, "process rank 2 with PID");
+    CHECK_STR_CONTAINS(r.err, "exited on signal 9 (Killed)");
+    Checkpoint ck;
+    Error err = { 0 };
+    CHECK(checkpoint_read(in_dir("killed.ckpt"), &ck, &err) == ST_OK);
+    CHECK_MSG(ck.film.samples > 0 && ck.film.samples < 360, "%llu samples", (unsigned long long)ck.film.samples);
+    checkpoint_free(&ck);
+    error_clear(&err);
+    /* resumed with two ranks: the same bits as the render never interrupted */
+    spawn_run(ARGS(MPIRUN, "-np", "2", CLI_PROGRAM, LONG_RENDER, "--resume", in_dir("killed.ckpt"), "-o",
+                   in_dir("resumed.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(in_dir("resumed.pfm"), in_dir("long.pfm")));
+}
+
+static void test_mpi_recovery_goes_on_without_the_dead_rank(void)
+{
+    unlink(in_dir("killed.ckpt"));
+    cli_finish(start_and_kill_rank(ARGS(MPIRUN, "--enable-recovery", "-np", "3", CLI_PROGRAM, LONG_RENDER,
+                                        "--mpi-timeout", "1", "--checkpoint", in_dir("killed.ckpt"),
+                                        "--checkpoint-interval", "0.1", "-o", in_dir("recovered.pfm"))), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_STR_CONTAINS(r.err, "failed and was dropped; its samples go to the other devices: MPI rank 2 stopped "
+                              "answering: no word from it for 1 s (its process or node died, or it hangs; see "
+                              "--mpi-timeout)\n");
+    CHECK(files_equal(in_dir("recovered.pfm"), in_dir("long.pfm")));
+}
+
 int main(void)
 {
     make_dir();
@@ -173,6 +346,14 @@ int main(void)
     RUN(test_another_split_merges_to_the_same_bits);
     RUN(test_merge_refusals);
     RUN(test_sample_range_usage_errors);
+    if (have_mpirun()) {
+        RUN(test_mpi_two_and_three_ranks_are_bit_identical);
+        RUN(test_mpi_ranks_with_other_settings_are_refused);
+        RUN(test_mpi_killed_rank_then_resume);
+        RUN(test_mpi_recovery_goes_on_without_the_dead_rank);
+    } else {
+        fprintf(stderr, "mpirun not found: the MPI tests were not run\n");
+    }
     remove_dir();
     return harness_report();
 }

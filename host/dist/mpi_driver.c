@@ -190,7 +190,8 @@ Status dist_init(Dist *d, int *argc, char ***argv, Error *err)
 void dist_finish(Dist *d, int exit_status, int abort)
 {
     if (!d->active) return;
-    if (abort) MPI_Abort(MPI_COMM_WORLD, exit_status ? exit_status : 1);
+    /* errorcode 0 is allowed: a render that went on without a dead rank succeeded */
+    if (abort) MPI_Abort(MPI_COMM_WORLD, exit_status);
     MPI_Finalize();
     if (d->wire) {
         if (d->wire->names)
@@ -635,6 +636,8 @@ void dist_stop_workers(Dist *d, FILE *out)
     for (int r = 1; r < d->size; r++) {
         WireStats s;
         if (gone && gone[r]) {
+            /* MPI_Finalize would wait for it for ever */
+            d->lost = 1;
             if (out) fprintf(out, "  rank %d: given up during the render\n", r);
         } else if (stop_collect(d, r, &s) != 0) {
             d->lost = 1;

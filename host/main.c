@@ -810,6 +810,8 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
     int done = 0;
     Status st = options_parse(argc, argv, &r.o, err);
     if (st == ST_OK && dist->active) st = mpi_options(&r.o, dist, err);
+    /* every rank has the same command line: rank 0 says what is wrong with it */
+    if (st != ST_OK && dist->rank > 0) return ST_INTERRUPTED;
     if (st == ST_OK && dist->rank == 0) st = run_info_command(&r.o, &done, err);
     if (st != ST_OK || done || r.o.help || r.o.version || r.o.list_devices) return st;
 

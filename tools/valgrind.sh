@@ -2,10 +2,11 @@
 # valgrind.sh BUILD — small renders under valgrind memcheck (make test-valgrind):
 # the scalar device (the kernels compiled as C, several threads), PoCL (the OpenCL host
 # code, and the kernels PoCL compiles, running on clpt's buffers), an OBJ mesh, a PLY
-# mesh on its own, a classic scene with image textures (the whitted integrator), and an
-# error path. Each must be clean: no invalid access, no use of uninitialised memory, no
-# definite or indirect leak outside the OpenCL runtime (tools/sanitizers/valgrind.supp
-# says what is suppressed there and why).
+# mesh on its own, a classic scene with image textures (the whitted integrator), an
+# error path, and `clpt merge` of two parts (and one refused). Each must be clean: no
+# invalid access, no use of uninitialised memory, no definite or indirect leak outside
+# the OpenCL runtime (tools/sanitizers/valgrind.supp says what is suppressed there and
+# why).
 #
 # Under valgrind the CPU reports fewer features (no AVX-512), so PoCL names the device
 # differently and compiles the kernels again, inside valgrind: about two minutes the
@@ -57,5 +58,12 @@ check ply-view 0 tests/data/models/bun_zipper_res4.ply --device scalar --threads
 check classic-textured 0 scenes/classic/textured.txt --device scalar --threads 2 $small -o "$out/classic.png"
 check pocl 0 scenes/cornell-box.scene --device cpu $small -o "$out/pocl.png"
 check bad-scene 3 tests/data/bad/not-a-number.scene --device scalar $small -o "$out/never.png"
+# --sample-range parts (rendered here without valgrind), then clpt merge under it, and a
+# merge refused for a gap (docs/distributed.md)
+parts="scenes/cornell-box.scene --device scalar --threads 1 $small"
+"$prog" $parts --sample-range 0:1 --checkpoint "$out/part1.ckpt" -o "$out/part1.pfm"
+"$prog" $parts --sample-range 1:2 --checkpoint "$out/part2.ckpt" -o "$out/part2.pfm"
+check merge 0 merge -q -o "$out/merged.pfm" "$out/part2.ckpt" "$out/part1.ckpt"
+check merge-gap 3 merge -q -o "$out/never.pfm" "$out/part2.ckpt"
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -32,7 +32,6 @@ struct DistWire {
     pthread_mutex_t lock;      /* MPI_THREAD_SERIALIZED: one thread in MPI at a time */
     char **names;              /* rank 0: each rank's "host: devices", from dist_agree */
     unsigned char *gone;       /* rank 0: ranks given up during the render (silent, or MPI failed) */
-    int64_t *scratch;          /* a worker's batch film */
 };
 
 typedef struct {
@@ -198,7 +197,6 @@ void dist_finish(Dist *d, int exit_status, int abort)
             for (int i = 0; i < d->size; i++) free(d->wire->names[i]);
         free(d->wire->names);
         free(d->wire->gone);
-        free(d->wire->scratch);
         pthread_mutex_destroy(&d->wire->lock);
         free(d->wire);
     }
@@ -360,7 +358,6 @@ typedef struct {
     int rank;
     int64_t *film;             /* the last batch's film, until taken */
     size_t n_values;
-    int abandoned;             /* a batch was given up (interrupt, silence): drain at the end */
 } Remote;
 
 /* Sends the batch and waits for its film: a rank is one device to the scheduler, whose
@@ -376,8 +373,8 @@ static Status remote_render(Device *dev, uint first, uint count, Error *err)
     if (st == ST_OK && res.status == ST_OK)
         st = wire_wait(rm->d, rm->rank, TAG_FILM, rm->film, rm->n_values * sizeof *rm->film, NULL, err);
     if (st != ST_OK) {
-        /* an interrupted wait leaves the rank working: its answer is drained at the end */
-        rm->abandoned = 1;
+        /* an interrupted wait leaves the rank working: its answer is drained at the end
+         * (dist_stop_workers); a silent or broken rank is not waited for again */
         if (st != ST_INTERRUPTED && rm->d->wire->gone) rm->d->wire->gone[rm->rank] = 1;
         return st;
     }
@@ -444,7 +441,7 @@ Status dist_add_remote_devices(Dist *d, unsigned n_pixels, Device ***devs, size_
             free(film);
             return error_set(err, ST_INTERNAL, "out of memory for the films of the MPI ranks");
         }
-        *rm = (Remote){ d, r, film, (size_t)n_pixels * 3u, 0 };
+        *rm = (Remote){ d, r, film, (size_t)n_pixels * 3u };
         dev->ops = &remote_ops;
         dev->impl = rm;
         dev->n_pixels = n_pixels;

@@ -157,6 +157,8 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Camera, forward);
     out[i++] = (uint)__builtin_offsetof(RenderParams, shadows);
     out[i++] = (uint)__builtin_offsetof(RenderParams, normal_miss_grey);
+    out[i++] = (uint)__builtin_offsetof(Material, roughness);
+    out[i++] = (uint)__builtin_offsetof(Material, k);
 }
 
 /* ---------------------------------------------------------------- classic ray tracer

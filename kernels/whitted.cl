@@ -175,6 +175,10 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, uint key, uint *rays)
             }
         } else if (m.type == MAT_METAL) {
             kr = kd;
+        } else if (m.type == MAT_CONDUCTOR) {
+            /* the classic tracer has only mirrors: a rough conductor is its smooth one,
+             * coloured by its Fresnel reflectance at this angle */
+            kr = conductor_fresnel(bsdf_conductor(m, kd), k_clamp(-v3_dot(d, ns), 0.0f, 1.0f));
         } else {
             kt = v3s(1.0f);
         }
@@ -183,10 +187,17 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, uint key, uint *rays)
         /* the see-through part splits by Fresnel into more mirror and the refraction */
         vec3 t_dir = d;
         if (!v3_is_zero(kt)) {
-            float eta = front ? m.ior : 1.0f / m.ior;
+            int thin = m.type == MAT_DIELECTRIC && (m.flags & MAT_THIN);
+            float eta = front || thin ? m.ior : 1.0f / m.ior;
             float F = fresnel_dielectric(k_clamp(-v3_dot(d, ns), 0.0f, 1.0f), eta);
-            int ok = refract_dir(d, ns, eta, &t_dir);
-            if (ok && v3_dot(t_dir, ng) >= 0.0f) ok = refract_dir(d, ng, eta, &t_dir);
+            int ok = 1;
+            if (thin) {
+                /* a thin sheet: both faces reflect, the rest goes straight on */
+                F = dielectric_facet_fresnel(bsdf_dielectric(m, front), k_clamp(-v3_dot(d, ns), 0.0f, 1.0f));
+            } else {
+                ok = refract_dir(d, ns, eta, &t_dir);
+                if (ok && v3_dot(t_dir, ng) >= 0.0f) ok = refract_dir(d, ng, eta, &t_dir);
+            }
             if (!ok) F = 1.0f;
             kr = v3_add(kr, v3_scale(kt, F));
             kt = v3_scale(kt, 1.0f - F);

@@ -489,10 +489,11 @@ static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
 }
 
 enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE, MAT_KEY_EMISSION, MAT_KEY_SIDES,
-       MAT_KEY_SPECULAR, MAT_KEY_SHININESS, MAT_KEY_REFLECTIVE, MAT_KEY_TRANSPARENT, MAT_KEY_TEXTURE, MAT_KEY_N };
+       MAT_KEY_SPECULAR, MAT_KEY_SHININESS, MAT_KEY_REFLECTIVE, MAT_KEY_TRANSPARENT, MAT_KEY_TEXTURE,
+       MAT_KEY_ROUGHNESS, MAT_KEY_ANISOTROPY, MAT_KEY_ETA, MAT_KEY_K, MAT_KEY_METAL, MAT_KEY_THIN, MAT_KEY_N };
 static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0,
-                      "a material type (diffuse, metal, dielectric, emissive, phong)"},
+                      "a material type (diffuse, metal, conductor, dielectric, emissive, phong)"},
     [MAT_KEY_ALBEDO] = {"albedo", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_FUZZ] = {"fuzz", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
     [MAT_KEY_IOR] = {"ior", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
@@ -504,6 +505,12 @@ static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_REFLECTIVE] = {"reflective", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_TRANSPARENT] = {"transparent", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_TEXTURE] = {"texture", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_ROUGHNESS] = {"roughness", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_ANISOTROPY] = {"anisotropy", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_ETA] = {"eta", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_K] = {"k", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_METAL] = {"metal", VK_WORD, 0, 0, 0, 0, 0, "a metal (Ag, Al, Au, Cu)"},
+    [MAT_KEY_THIN] = {"thin", VK_WORD, 0, 0, 0, 0, 0, "on or off"},
 };
 
 /* Which keys each material type takes (bit i = material_keys[i]), and which it needs. */
@@ -519,7 +526,14 @@ static const struct {
      1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_FUZZ | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES |
      1u << MAT_KEY_TEXTURE,
      1u << MAT_KEY_ALBEDO},
-    {"dielectric", MAT_DIELECTRIC, 1u << MAT_KEY_IOR | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES, 0},
+    {"conductor", MAT_CONDUCTOR,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_TEXTURE | 1u << MAT_KEY_ETA | 1u << MAT_KEY_K | 1u << MAT_KEY_METAL |
+     1u << MAT_KEY_SPECULAR | 1u << MAT_KEY_ROUGHNESS | 1u << MAT_KEY_ANISOTROPY | 1u << MAT_KEY_EMISSION |
+     1u << MAT_KEY_SIDES,
+     0},
+    {"dielectric", MAT_DIELECTRIC,
+     1u << MAT_KEY_IOR | 1u << MAT_KEY_ROUGHNESS | 1u << MAT_KEY_ANISOTROPY | 1u << MAT_KEY_THIN |
+     1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES, 0},
     {"emissive", MAT_EMISSIVE, 1u << MAT_KEY_RADIANCE | 1u << MAT_KEY_SIDES, 1u << MAT_KEY_RADIANCE},
     {"phong", MAT_PHONG,
      1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_SPECULAR | 1u << MAT_KEY_SHININESS | 1u << MAT_KEY_REFLECTIVE |
@@ -528,6 +542,32 @@ static const struct {
      1u << MAT_KEY_ALBEDO},
 };
 #define N_MATERIAL_TYPES (sizeof material_types / sizeof material_types[0])
+
+/* A conductor's Fresnel term: exactly one of a preset (`metal`), a complex index (`eta`
+ * with `k`) or an artist's reflectance at normal incidence (`specular`). */
+static Status parse_conductor(Parser *p, Lexer *lx, const Token *kw, const Value *v, Material *m)
+{
+    int n = v[MAT_KEY_METAL].given + (v[MAT_KEY_ETA].given || v[MAT_KEY_K].given) + v[MAT_KEY_SPECULAR].given;
+    if (n != 1)
+        return lex_error_at(lx, kw, p->err,
+                            "a conductor needs exactly one of 'metal', 'eta' and 'k', or 'specular'");
+    if (v[MAT_KEY_ETA].given != v[MAT_KEY_K].given)
+        return lex_error_at(lx, v[MAT_KEY_ETA].given ? &v[MAT_KEY_ETA].key : &v[MAT_KEY_K].key, p->err,
+                            "a conductor's 'eta' needs its 'k' (the complex index eta + i k)");
+    if (v[MAT_KEY_SPECULAR].given) {
+        *m = material_conductor_f0(v[MAT_KEY_SPECULAR].v, 0.0f);
+    } else if (v[MAT_KEY_METAL].given) {
+        const Token *w = &v[MAT_KEY_METAL].word;
+        vec3 eta, k;
+        if (!material_metal_preset(w->text, w->len, &eta, &k))
+            return lex_expected(lx, w, material_keys[MAT_KEY_METAL].what, p->err);
+        *m = material_conductor(eta, k, 0.0f);
+    } else {
+        *m = material_conductor(v[MAT_KEY_ETA].v, v[MAT_KEY_K].v, 0.0f);
+    }
+    if (v[MAT_KEY_ALBEDO].given) m->albedo = v[MAT_KEY_ALBEDO].v;
+    return ST_OK;
+}
 
 /* Reads a material's `{ ... }`; a NULL name makes an anonymous (inline) material. */
 static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
@@ -559,11 +599,20 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
                                 material_types[ti].name, material_keys[i].key);
     Material m;
     switch (material_types[ti].type) {
+    case MAT_CONDUCTOR:
+        if ((st = parse_conductor(p, lx, kw, v, &m))) return st;
+        break;
     case MAT_METAL:
         m = material_metal(v[MAT_KEY_ALBEDO].v, v[MAT_KEY_FUZZ].given ? v[MAT_KEY_FUZZ].f : 0.0f);
         break;
     case MAT_DIELECTRIC:
         m = material_dielectric(v[MAT_KEY_IOR].given ? v[MAT_KEY_IOR].f : 1.5f);
+        if (v[MAT_KEY_THIN].given) {
+            const Token *w = &v[MAT_KEY_THIN].word;
+            if (!tok_is(w, "on") && !tok_is(w, "off"))
+                return lex_expected(lx, w, material_keys[MAT_KEY_THIN].what, p->err);
+            if (tok_is(w, "on")) m.flags |= MAT_THIN;
+        }
         break;
     case MAT_EMISSIVE:
         m = material_emissive(v[MAT_KEY_RADIANCE].v);
@@ -583,6 +632,8 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
     if (v[MAT_KEY_EMISSION].given) m.emission = v[MAT_KEY_EMISSION].v;
     if (v[MAT_KEY_SIDES].given && v[MAT_KEY_SIDES].u == 2) m.flags |= MAT_TWO_SIDED;
     if (v[MAT_KEY_TEXTURE].given) m.texture = (uint)v[MAT_KEY_TEXTURE].u;
+    if (v[MAT_KEY_ROUGHNESS].given) m.roughness = v[MAT_KEY_ROUGHNESS].f;
+    if (v[MAT_KEY_ANISOTROPY].given) m.anisotropy = v[MAT_KEY_ANISOTROPY].f;
     /* inline materials get the empty name, which no named material can have, so a
      * lookup never finds them */
     if ((st = scene_add_material(p->s, name ? name : "", m, index, p->err))) return st;

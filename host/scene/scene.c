@@ -350,6 +350,47 @@ Material material_dielectric(float ior)
     return m;
 }
 
+Material material_conductor(vec3 eta, vec3 k, float roughness)
+{
+    Material m = material_base(MAT_CONDUCTOR);
+    m.albedo = v3s(1.0f);
+    m.eta = eta;
+    m.k = k;
+    m.roughness = roughness;
+    return m;
+}
+
+Material material_conductor_f0(vec3 f0, float roughness)
+{
+    Material m = material_conductor(v3s(1.0f), v3s(0.0f), roughness);
+    m.specular = f0;
+    m.flags |= MAT_F0;
+    return m;
+}
+
+/* pbrt-v4's measured spectra (src/pbrt/util/spectrum.cpp: Ag, Al, Au, Cu, from
+ * refractiveindex.info) interpolated at 650, 550 and 450 nm for R, G and B. */
+static const struct {
+    const char *name;
+    float eta[3], k[3];
+} metal_presets[] = {
+    {"Ag", {0.1394f, 0.1248f, 0.1517f}, {4.1288f, 3.3396f, 2.4704f}},
+    {"Al", {1.4748f, 0.9586f, 0.6180f}, {7.7941f, 6.6870f, 5.4694f}},
+    {"Au", {0.1678f, 0.3504f, 1.5085f}, {3.1378f, 2.7141f, 1.8788f}},
+    {"Cu", {0.2166f, 0.9582f, 1.1658f}, {3.6377f, 2.5771f, 2.3939f}},
+};
+
+int material_metal_preset(const char *name, size_t len, vec3 *eta, vec3 *k)
+{
+    for (size_t i = 0; i < sizeof metal_presets / sizeof metal_presets[0]; i++) {
+        if (strlen(metal_presets[i].name) != len || memcmp(metal_presets[i].name, name, len) != 0) continue;
+        *eta = v3(metal_presets[i].eta[0], metal_presets[i].eta[1], metal_presets[i].eta[2]);
+        *k = v3(metal_presets[i].k[0], metal_presets[i].k[1], metal_presets[i].k[2]);
+        return 1;
+    }
+    return 0;
+}
+
 Material material_emissive(vec3 radiance)
 {
     Material m = material_base(MAT_EMISSIVE);

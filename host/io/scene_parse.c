@@ -509,7 +509,7 @@ static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_ANISOTROPY] = {"anisotropy", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
     [MAT_KEY_ETA] = {"eta", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_K] = {"k", VK_COLOR, 0, 0, 0, 0, 0, NULL},
-    [MAT_KEY_METAL] = {"metal", VK_WORD, 0, 0, 0, 0, 0, "a metal (Ag, Al, Au, Cu)"},
+    [MAT_KEY_METAL] = {"metal", VK_WORD, 0, 0, 0, 0, 0, "a metal (Ag, Al, Au, Cr, Cu, Ni)"},
     [MAT_KEY_THIN] = {"thin", VK_WORD, 0, 0, 0, 0, 0, "on or off"},
 };
 

@@ -368,8 +368,10 @@ Material material_conductor_f0(vec3 f0, float roughness)
     return m;
 }
 
-/* pbrt-v4's measured spectra (src/pbrt/util/spectrum.cpp: Ag, Al, Au, Cu, from
- * refractiveindex.info) interpolated at 650, 550 and 450 nm for R, G and B. */
+/* Measured spectra interpolated at 650, 550 and 450 nm for R, G and B: Ag, Al, Au, Cu
+ * from pbrt-v4 (src/pbrt/util/spectrum.cpp, after refractiveindex.info), Cr and Ni from
+ * Mitsuba 0.6 (data/ior/Cr.*.spd, Ni_palik.*.spd: the luxpop database, Palik's
+ * Handbook of Optical Constants of Solids). */
 static const struct {
     const char *name;
     float eta[3], k[3];
@@ -377,7 +379,9 @@ static const struct {
     {"Ag", {0.1394f, 0.1248f, 0.1517f}, {4.1288f, 3.3396f, 2.4704f}},
     {"Al", {1.4748f, 0.9586f, 0.6180f}, {7.7941f, 6.6870f, 5.4694f}},
     {"Au", {0.1678f, 0.3504f, 1.5085f}, {3.1378f, 2.7141f, 1.8788f}},
+    {"Cr", {3.6375f, 3.1158f, 1.9277f}, {4.3644f, 4.4228f, 4.1675f}},
     {"Cu", {0.2166f, 0.9582f, 1.1658f}, {3.6377f, 2.5771f, 2.3939f}},
+    {"Ni", {2.0140f, 1.7724f, 1.6288f}, {3.8079f, 3.2526f, 2.6540f}},
 };
 
 int material_metal_preset(const char *name, size_t len, vec3 *eta, vec3 *k)

@@ -158,7 +158,7 @@ Material material_emissive(vec3 radiance);
 Material material_conductor(vec3 eta, vec3 k, float roughness);
 /* A GGX conductor with Schlick's Fresnel from the reflectance at normal incidence f0. */
 Material material_conductor_f0(vec3 f0, float roughness);
-/* The complex index of a named metal (Ag, Al, Au, Cu; docs/scene-format.md gives the
+/* The complex index of a named metal (Ag, Al, Au, Cr, Cu, Ni; docs/scene-format.md gives the
  * source), the name `len` bytes long. Returns 0 when the name is none of them. */
 int material_metal_preset(const char *name, size_t len, vec3 *eta, vec3 *k);
 /* The classic Phong material: diffuse colour, specular colour and shininess, no mirror

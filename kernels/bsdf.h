@@ -7,7 +7,7 @@
 #ifndef CLPT_BSDF_H
 #define CLPT_BSDF_H
 
-#include "microfacet.h"
+#include "principled.h"
 
 typedef struct {
     vec3 wi;          /* sampled direction */
@@ -214,6 +214,26 @@ KFN Dielectric bsdf_dielectric(Material m, int front)
     return g;
 }
 
+/* The principled lobes; alphas below GGX_SMOOTH_ALPHA are raised to it, as the
+ * material mixes its lobes by density and has no delta branch. */
+KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
+{
+    Principled p;
+    p.base = albedo;
+    p.metallic = k_clamp(m.metallic, 0.0f, 1.0f);
+    p.transmission = k_clamp(m.transmission, 0.0f, 1.0f);
+    p.clearcoat = k_clamp(m.clearcoat, 0.0f, 1.0f);
+    p.g = bsdf_ggx(m);
+    p.g.ax = k_fmax(p.g.ax, GGX_SMOOTH_ALPHA);
+    p.g.ay = k_fmax(p.g.ay, GGX_SMOOTH_ALPHA);
+    float ac = k_fmax(m.clearcoat_roughness * m.clearcoat_roughness, GGX_SMOOTH_ALPHA);
+    p.gc.ax = ac;
+    p.gc.ay = ac;
+    p.thin = (m.flags & MAT_THIN) != 0u;
+    p.eta = p.thin || front ? m.ior : 1.0f / m.ior;
+    return p;
+}
+
 /* Whether the material has a lobe with a density (not only delta lobes), so that
  * next-event estimation can reach it. */
 KFN int bsdf_has_density(Material m, vec3 albedo)
@@ -221,7 +241,7 @@ KFN int bsdf_has_density(Material m, vec3 albedo)
     if (m.type == MAT_DIFFUSE) return 1;
     if (m.type == MAT_PHONG) return phong_lobes(m, albedo).p_glossy > 0.0f;
     if (m.type == MAT_CONDUCTOR || m.type == MAT_DIELECTRIC) return !ggx_smooth(bsdf_ggx(m));
-    return 0;
+    return m.type == MAT_PRINCIPLED;
 }
 
 KFN vec3 bsdf_to_local(vec3 w, vec3 t, vec3 b, vec3 n) { return v3(v3_dot(w, t), v3_dot(w, b), v3_dot(w, n)); }
@@ -247,6 +267,7 @@ KFN vec3 bsdf_eval(Material m, vec3 albedo, vec3 d, vec3 ns, int front, vec3 wi,
     k_onb(ns, &t, &b);
     vec3 wo = bsdf_to_local(v3_neg(d), t, b, ns), wl = bsdf_to_local(wi, t, b, ns);
     if (m.type == MAT_CONDUCTOR) *pdf = conductor_eval(bsdf_conductor(m, albedo), wo, wl, &f);
+    else if (m.type == MAT_PRINCIPLED) *pdf = principled_eval(bsdf_principled(m, albedo, front), wo, wl, &f);
     else *pdf = dielectric_eval(bsdf_dielectric(m, front), wo, wl, &f);
     return f;
 }
@@ -295,8 +316,12 @@ KFN BsdfSample bsdf_sample_rough(Material m, vec3 albedo, vec3 d, vec3 ns, int f
     vec3 wo = bsdf_to_local(v3_neg(d), t, b, ns);
     float pdf = 0.0f;
     if (wo.z > 0.0f) {
-        if (m.type == MAT_CONDUCTOR) pdf = conductor_sample(bsdf_conductor(m, albedo), wo, u1, u2, &wl, &f);
-        else pdf = dielectric_sample(bsdf_dielectric(m, front), wo, u_lobe, u1, u2, &wl, &f);
+        if (m.type == MAT_CONDUCTOR)
+            pdf = conductor_sample(bsdf_conductor(m, albedo), wo, u1, u2, &wl, &f);
+        else if (m.type == MAT_PRINCIPLED)
+            pdf = principled_sample(bsdf_principled(m, albedo, front), wo, u_lobe, u1, u2, &wl, &f);
+        else
+            pdf = dielectric_sample(bsdf_dielectric(m, front), wo, u_lobe, u1, u2, &wl, &f);
     }
     s.specular = 0;
     s.pdf = pdf;

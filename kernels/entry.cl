@@ -159,6 +159,7 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(RenderParams, normal_miss_grey);
     out[i++] = (uint)__builtin_offsetof(Material, roughness);
     out[i++] = (uint)__builtin_offsetof(Material, k);
+    out[i++] = (uint)__builtin_offsetof(Material, clearcoat_roughness);
 }
 
 /* ---------------------------------------------------------------- classic ray tracer

@@ -244,6 +244,44 @@ KFN float dielectric_eval(Dielectric d, vec3 wo, vec3 wi, vec3 *f)
     return (1.0f - F) * dv * k_fabs(im) / denom;
 }
 
+/* The refraction part alone, without its Fresnel factor: the BTDF D G2 |wi.m| wo.m /
+ * (|cos_i| cos_o (wi.m + wo.m / eta)^2) into *btdf and the density of refracting through
+ * a visible normal as the return value (0 for wi.z >= 0 or a back-facing facet). The
+ * principled material mixes it by its own weights. */
+KFN float ggx_refraction(Ggx g, float eta, vec3 wo, vec3 wi, float *btdf)
+{
+    *btdf = 0.0f;
+    if (wo.z <= 0.0f || wi.z >= 0.0f) return 0.0f;
+    vec3 m = v3_add(v3_scale(wi, eta), wo);
+    float len = v3_len(m);
+    if (!(len > 0.0f)) return 0.0f;
+    m = v3_scale(m, 1.0f / len);
+    if (m.z < 0.0f) m = v3_neg(m);
+    float om = v3_dot(wo, m), im = v3_dot(wi, m);
+    if (om <= 0.0f || im >= 0.0f) return 0.0f;
+    float denom = im + om / eta;
+    denom = denom * denom;
+    if (!(denom > 0.0f)) return 0.0f;
+    *btdf = ggx_d(g, m) * ggx_g2(g, wo, wi) * k_fabs(im) * om / (k_fabs(wi.z) * wo.z * denom);
+    return ggx_d_visible(g, wo, m) * k_fabs(im) / denom;
+}
+
+/* GGX reflection without Fresnel: D G2 / (4 cos_o cos_i) into *brdf, the density of
+ * reflecting about a visible normal as the return value. */
+KFN float ggx_reflection(Ggx g, vec3 wo, vec3 wi, float *brdf)
+{
+    *brdf = 0.0f;
+    if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
+    vec3 h = v3_add(wo, wi);
+    float len = v3_len(h);
+    if (!(len > 0.0f)) return 0.0f;
+    h = v3_scale(h, 1.0f / len);
+    float oh = v3_dot(wo, h);
+    if (oh <= 0.0f) return 0.0f;
+    *brdf = ggx_d(g, h) * ggx_g2(g, wo, wi) / (4.0f * wo.z * wi.z);
+    return ggx_d_visible(g, wo, h) / (4.0f * oh);
+}
+
 /* A direction for wo, *f and the density as dielectric_eval's (0: failed sample). */
 KFN float dielectric_sample(Dielectric d, vec3 wo, float u_lobe, float u1, float u2, vec3 *wi, vec3 *f)
 {

@@ -52,7 +52,7 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
      * artefact, lit from the wrong side */
     int below = cos_s < 0.0f;
     if (cos_s == 0.0f || (below ? cos_g >= 0.0f : cos_g <= 0.0f)) return 0;
-    if (below && m.type != MAT_DIELECTRIC) return 0;
+    if (below && m.type != MAT_DIELECTRIC && m.type != MAT_PRINCIPLED) return 0;
     float bsdf_pdf;
     vec3 f = bsdf_eval(m, albedo, d, n_face, front, wi, &bsdf_pdf);
     if (below) cos_s = -cos_s;

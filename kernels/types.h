@@ -110,14 +110,17 @@ enum MaterialType {
                           * (`reflective`) and Fresnel-weighted see-through
                           * (`transparent`, ior) parts: the classic ray tracer's
                           * material (docs/classic-format.md) */
-    MAT_CONDUCTOR = 5    /* GGX metal (kernels/microfacet.h): complex index eta + i k,
+    MAT_CONDUCTOR = 5,   /* GGX metal (kernels/microfacet.h): complex index eta + i k,
                           * or Schlick from F0 = specular (MAT_F0); tinted by albedo;
                           * roughness, anisotropy; smooth: a Fresnel mirror */
+    MAT_PRINCIPLED = 6   /* glTF metallic-roughness (kernels/principled.h): base colour
+                          * = albedo, metallic, roughness, transmission + ior (MAT_THIN),
+                          * clearcoat + clearcoat_roughness */
 };
 /* MAT_DIELECTRIC also reads roughness and anisotropy (GGX, Walter et al. 2007) and
  * MAT_THIN. */
 
-typedef struct {                                        /* 128 bytes */
+typedef struct {                                        /* 144 bytes */
     uint type;                /* enum MaterialType */
     uint texture;             /* albedo texture index, NO_INDEX when none */
     float ior;
@@ -126,9 +129,11 @@ typedef struct {                                        /* 128 bytes */
     vec3 emission;  uint flags;   /* MAT_* flags */
     vec3 specular;  float roughness;   /* perceptual: GGX alpha = roughness^2 */
     vec3 reflective;  float anisotropy; /* MAT_PHONG: perfect mirror part */
-    vec3 transparent; float pad2; /* MAT_PHONG: refracted part (split by Fresnel) */
-    vec3 eta;         float pad3; /* MAT_CONDUCTOR: complex index of refraction ... */
-    vec3 k;           float pad4; /* ... eta + i k per RGB channel */
+    vec3 transparent; float metallic;      /* MAT_PHONG: refracted part (split by Fresnel) */
+    vec3 eta;         float transmission;  /* MAT_CONDUCTOR: complex index of refraction ... */
+    vec3 k;           float clearcoat;     /* ... eta + i k per RGB channel */
+    float clearcoat_roughness;             /* MAT_PRINCIPLED, as roughness */
+    uint pad0, pad1, pad2;
 } Material;
 
 #define MAT_TWO_SIDED 1u        /* emits from both sides of its surface */
@@ -281,7 +286,7 @@ CLPT_CHECK_SIZE(Triangle, 48);
 CLPT_CHECK_SIZE(TriShading, 64);
 CLPT_CHECK_SIZE(Box, 32);
 CLPT_CHECK_SIZE(Plane, 32);
-CLPT_CHECK_SIZE(Material, 128);
+CLPT_CHECK_SIZE(Material, 144);
 CLPT_CHECK_SIZE(Light, 80);
 CLPT_CHECK_SIZE(Camera, 112);
 CLPT_CHECK_SIZE(RenderParams, 272);
@@ -302,6 +307,7 @@ _Static_assert(offsetof(PathState, bsdf_pdf) == 48, "PathState.bsdf_pdf");
 _Static_assert(offsetof(Material, albedo) == 16, "Material.albedo");
 _Static_assert(offsetof(Material, roughness) == 60, "Material.roughness");
 _Static_assert(offsetof(Material, k) == 112, "Material.k");
+_Static_assert(offsetof(Material, clearcoat_roughness) == 128, "Material.clearcoat_roughness");
 _Static_assert(offsetof(Light, position) == 32, "Light.position");
 #undef CLPT_CHECK_SIZE
 #endif

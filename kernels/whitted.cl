@@ -164,7 +164,19 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, uint key, uint *rays)
 
         vec3 kd = material_albedo(sc, m, s, ng);
         vec3 kr = v3s(0.0f), kt = v3s(0.0f);
-        if (m.type == MAT_DIFFUSE || m.type == MAT_PHONG) {
+        if (m.type == MAT_PRINCIPLED) {
+            /* the classic tracer's reading of glTF: the diffuse share lit directly, the
+             * specular as a mirror of the Schlick colour at this angle, transmission as
+             * smooth glass tinted by the base colour */
+            float c = k_clamp(-v3_dot(d, ns), 0.0f, 1.0f), fd = schlick1(0.04f, c);
+            float diel = 1.0f - k_clamp(m.metallic, 0.0f, 1.0f), t = k_clamp(m.transmission, 0.0f, 1.0f);
+            kr = v3_add(v3_scale(fresnel_schlick(kd, c), 1.0f - diel), v3s(diel * fd));
+            kt = v3_scale(kd, diel * (1.0f - fd) * t);
+            kd = v3_scale(kd, diel * (1.0f - fd) * (1.0f - t));
+            vec3 here = v3_add(v3_mul(p->ambient, kd),
+                               whitted_direct(sc, s, d, ns, ng, kd, v3s(0.0f), 0.0f, key, node, rays));
+            L = v3_add(L, v3_mul(e.weight, here));
+        } else if (m.type == MAT_DIFFUSE || m.type == MAT_PHONG) {
             vec3 ks = m.type == MAT_PHONG ? m.specular : v3s(0.0f);
             vec3 here = v3_add(v3_mul(p->ambient, kd),
                                 whitted_direct(sc, s, d, ns, ng, kd, ks, m.shininess, key, node, rays));
@@ -187,7 +199,7 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, uint key, uint *rays)
         /* the see-through part splits by Fresnel into more mirror and the refraction */
         vec3 t_dir = d;
         if (!v3_is_zero(kt)) {
-            int thin = m.type == MAT_DIELECTRIC && (m.flags & MAT_THIN);
+            int thin = (m.type == MAT_DIELECTRIC || m.type == MAT_PRINCIPLED) && (m.flags & MAT_THIN);
             float eta = front || thin ? m.ior : 1.0f / m.ior;
             float F = fresnel_dielectric(k_clamp(-v3_dot(d, ns), 0.0f, 1.0f), eta);
             int ok = 1;

@@ -20,19 +20,40 @@
 
 typedef struct {
     const char *name;
-    int dielectric;
+    int kind;          /* 0 conductor, 1 dielectric, 2 principled */
+    int reciprocal;    /* the principled clearcoat's N.V-weighted layer is not */
     Conductor c;
     Dielectric d;
+    Principled p;
 } Case;
 
 static float case_eval(const Case *k, vec3 wo, vec3 wi, vec3 *f)
 {
-    return k->dielectric ? dielectric_eval(k->d, wo, wi, f) : conductor_eval(k->c, wo, wi, f);
+    if (k->kind == 2) return principled_eval(k->p, wo, wi, f);
+    return k->kind ? dielectric_eval(k->d, wo, wi, f) : conductor_eval(k->c, wo, wi, f);
 }
 
 static float case_sample(const Case *k, vec3 wo, float u0, float u1, float u2, vec3 *wi, vec3 *f)
 {
-    return k->dielectric ? dielectric_sample(k->d, wo, u0, u1, u2, wi, f) : conductor_sample(k->c, wo, u1, u2, wi, f);
+    if (k->kind == 2) return principled_sample(k->p, wo, u0, u1, u2, wi, f);
+    return k->kind ? dielectric_sample(k->d, wo, u0, u1, u2, wi, f) : conductor_sample(k->c, wo, u1, u2, wi, f);
+}
+
+static Case principled_case(const char *name, float roughness, float metallic, float transmission, float clearcoat)
+{
+    Case k;
+    memset(&k, 0, sizeof k);
+    k.name = name;
+    k.kind = 2;
+    k.reciprocal = clearcoat == 0.0f;
+    k.p.base = v3(0.8f, 0.5f, 0.3f);
+    k.p.metallic = metallic;
+    k.p.transmission = transmission;
+    k.p.clearcoat = clearcoat;
+    k.p.g = ggx_make(roughness, 0.0f);
+    k.p.gc = ggx_make(0.2f, 0.0f);
+    k.p.eta = 1.5f;
+    return k;
 }
 
 static Case conductor_case(const char *name, float roughness, float anisotropy)
@@ -40,6 +61,7 @@ static Case conductor_case(const char *name, float roughness, float anisotropy)
     Case k;
     memset(&k, 0, sizeof k);
     k.name = name;
+    k.reciprocal = 1;
     k.c.g = ggx_make(roughness, anisotropy);
     k.c.eta = v3(0.2f, 0.9f, 1.1f);
     k.c.k = v3(3.6f, 2.6f, 2.4f);
@@ -52,7 +74,8 @@ static Case dielectric_case(const char *name, float roughness, float eta, int th
     Case k;
     memset(&k, 0, sizeof k);
     k.name = name;
-    k.dielectric = 1;
+    k.kind = 1;
+    k.reciprocal = 1;
     k.d.g = ggx_make(roughness, 0.0f);
     k.d.eta = eta;
     k.d.thin = thin;
@@ -183,7 +206,7 @@ static double chi2_case(const Case *k, float cos_o)
     return p;
 }
 
-static Case all_cases[16];
+static Case all_cases[24];
 static int n_cases;
 
 static void make_cases(void)
@@ -198,13 +221,19 @@ static void make_cases(void)
     all_cases[n_cases++] = dielectric_case("glass r0.3 (leaving)", 0.3f, 1.0f / 1.5f, 0);
     all_cases[n_cases++] = dielectric_case("glass r0.6 (leaving)", 0.6f, 1.0f / 1.5f, 0);
     all_cases[n_cases++] = dielectric_case("thin glass r0.4", 0.4f, 1.5f, 1);
+    all_cases[n_cases++] = principled_case("principled plastic r0.4", 0.4f, 0.0f, 0.0f, 0.0f);
+    all_cases[n_cases++] = principled_case("principled metal r0.3", 0.3f, 1.0f, 0.0f, 0.0f);
+    all_cases[n_cases++] = principled_case("principled half r0.7 coat", 0.7f, 0.5f, 0.0f, 1.0f);
+    all_cases[n_cases++] = principled_case("principled glass r0.3", 0.3f, 0.0f, 1.0f, 0.5f);
+    all_cases[n_cases++] = principled_case("principled thin r0.5 t0.6", 0.5f, 0.0f, 0.6f, 0.0f);
+    all_cases[n_cases - 1].p.thin = 1;
 }
 
 static void test_chi2(void)
 {
     make_cases();
     const float angles[3] = { 0.95f, 0.5f, 0.15f };
-    double p[16][3];
+    double p[24][3];
     for (int c = 0; c < n_cases; c++)
         for (int a = 0; a < 3; a++) p[c][a] = chi2_case(&all_cases[c], angles[a]);
     /* Sidak: each test at the level that makes the whole family's 1% */
@@ -224,19 +253,21 @@ static void test_reciprocity(void)
     make_cases();
     int checked = 0;
     for (int c = 0; c < n_cases; c++)
-        for (int s = 0; s < 20000; s++) {
+        for (int s = 0; s < 20000 && all_cases[c].reciprocal; s++) {
             vec3 wo = sample_cosine_hemisphere(frand(), frand()), wi = sample_cosine_hemisphere(frand(), frand());
             if (wo.z < 1e-3f || wi.z < 1e-3f) continue;
             vec3 a, b;
             case_eval(&all_cases[c], wo, wi, &a);
             case_eval(&all_cases[c], wi, wo, &b);
             float m = k_fmax(v3_max_comp(a), v3_max_comp(b));
-            int ok = k_fabs(a.x - b.x) <= 1e-4f * m && k_fabs(a.y - b.y) <= 1e-4f * m && k_fabs(a.z - b.z) <= 1e-4f * m;
+            /* 1e-3: near the critical angle of the leaving glass, Fresnel's steep slope
+             * turns float rounding of wo.m against wi.m into a few 1e-4 */
+            int ok = k_fabs(a.x - b.x) <= 1e-3f * m && k_fabs(a.y - b.y) <= 1e-3f * m && k_fabs(a.z - b.z) <= 1e-3f * m;
             CHECK_MSG(ok, "%s: f(wo, wi) %g, f(wi, wo) %g", all_cases[c].name, (double)a.x, (double)b.x);
             checked++;
             if (!ok) return;
         }
-    fprintf(stderr, "  %d pairs reciprocal within 1e-4\n", checked);
+    fprintf(stderr, "  %d pairs reciprocal within 1e-3\n", checked);
 }
 
 static int finite_nonneg(float x) { return x >= 0.0f && x <= 3.4e38f; }
@@ -429,11 +460,72 @@ static void test_furnace_dielectric(void)
     }
 }
 
+/* The albedo of f cos over the whole sphere (reflection and transmission) by the
+ * midpoint rule in (theta, phi), which resolves lobes at the poles too. */
+static double quadrature_albedo(const Case *k, vec3 wo)
+{
+    enum { NI = 480, NJ = 240 };
+    double sum = 0.0;
+    for (int i = 0; i < NI; i++) {
+        double theta = (i + 0.5) / NI * M_PI, z = cos(theta), st = sin(theta);
+        for (int j = 0; j < NJ; j++) {
+            double phi = (j + 0.5) / NJ * 2.0 * M_PI;
+            vec3 f;
+            case_eval(k, wo, dir_at(z, phi), &f);
+            sum += f.x * fabs(z) * st;
+        }
+    }
+    return sum * (M_PI / NI) * (2.0 * M_PI / NJ);
+}
+
+/* A white principled material (base 1): the mean sample weight equals the integral of
+ * f cos (the mixture's estimator is unbiased), and away from grazing it reflects no
+ * more than it receives. The glTF reference BRDF itself gains energy at grazing angles
+ * (its diffuse part is weighted by 1 - F(V.H) per light direction, not by the
+ * specular lobe's albedo), which the test reports rather than hides. */
+static void test_principled_energy(void)
+{
+    const float angles[3] = { 1.0f, 0.7f, 0.1f };
+    const float mix[4][3] = { { 0.0f, 0.0f, 0.0f }, { 1.0f, 0.0f, 0.0f }, { 0.0f, 1.0f, 0.0f }, { 0.3f, 0.4f, 1.0f } };
+    double worst_normal = 0.0, worst_grazing = 0.0;
+    for (int m = 0; m < 4; m++)
+        for (int r = 1; r <= 3; r += 2)
+            for (int a = 0; a < 3; a++) {
+                Case k = principled_case("white", 0.3f * (float)r, mix[m][0], mix[m][1], mix[m][2]);
+                k.p.base = v3s(1.0f);
+                vec3 wo = v3(k_sqrt(1.0f - angles[a] * angles[a]), 0.0f, angles[a]);
+                double sum = 0.0;
+                enum { N = 40000 };
+                for (int s = 0; s < N; s++) {
+                    vec3 wi, f;
+                    float pdf = case_sample(&k, wo, frand(), frand(), frand(), &wi, &f);
+                    if (pdf > 0.0f) sum += f.x * k_fabs(wi.z) / pdf;
+                }
+                double albedo = sum / N;
+                if (angles[a] < 0.7f) {
+                    /* at cos 0.1 the clearcoat's and the specular's lobes lie flat along
+                     * the horizon, narrower than the quadrature's cells: only reported */
+                    if (albedo > worst_grazing) worst_grazing = albedo;
+                    continue;
+                }
+                double exact = quadrature_albedo(&k, wo);
+                CHECK_MSG(fabs(albedo - exact) < 0.02,
+                          "metallic %g transmission %g clearcoat %g roughness %g cos %g: sampled %.4f, integral %.4f",
+                          (double)mix[m][0], (double)mix[m][1], (double)mix[m][2], 0.3 * r, (double)angles[a], albedo,
+                          exact);
+                if (albedo > worst_normal) worst_normal = albedo;
+                CHECK_MSG(albedo < 1.01, "cos %g: albedo %.4f", (double)angles[a], albedo);
+            }
+    fprintf(stderr, "  white principled: sampled albedo = integral within 0.02 for 16 cases; largest albedo %.4f "
+            "at cos >= 0.7, %.4f at cos 0.1 (the glTF model's grazing gain)\n", worst_normal, worst_grazing);
+}
+
 int main(void)
 {
     RUN(test_chi2);
     RUN(test_reciprocity);
     RUN(test_no_bad_values);
+    RUN(test_principled_energy);
     RUN(test_furnace_conductor);
     RUN(test_furnace_dielectric);
     return harness_report();

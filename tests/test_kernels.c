@@ -161,16 +161,28 @@ static void build_scene(void)
     dm.flags |= MAT_THIN;
     dm.roughness = 0.5f;
     scene_add_material(&scene, "sheet", dm, &sheet, NULL);
-    uint mats[] = { diffuse, metal, glass, phong, glow, mirror, clear, checked, gold, chrome, frosted, sheet };
+    /* principled: textured plastic, and coated, transmitting and glowing mixtures */
+    uint plastic, coated;
+    Material pm = material_principled(v3(0.8f, 0.2f, 0.1f), 0.0f, 0.5f);
+    pm.texture = tex[3];
+    scene_add_material(&scene, "plastic", pm, &plastic, NULL);
+    pm = material_principled(v3(0.3f, 0.6f, 0.9f), 0.4f, 0.3f);
+    pm.transmission = 0.6f;
+    pm.clearcoat = 0.8f;
+    pm.clearcoat_roughness = 0.1f;
+    pm.emission = v3(0.2f, 0.1f, 0.0f);
+    scene_add_material(&scene, "coated", pm, &coated, NULL);
+    uint mats[] = { diffuse, metal, glass, phong, glow, mirror, clear, checked, gold, chrome, frosted, sheet,
+                    plastic, coated };
     for (int i = 0; i < 16; i++) {
-        Sphere s = { vrand(-3.0f, 3.0f), frange(0.2f, 0.8f), mats[i % 12], NO_INDEX, 0, 0 };
+        Sphere s = { vrand(-3.0f, 3.0f), frange(0.2f, 0.8f), mats[i % 14], NO_INDEX, 0, 0 };
         scene_add_sphere(&scene, s, NULL);
     }
     Sphere light_sphere = { v3(0.0f, 5.0f, 0.0f), 0.5f, lamp, NO_INDEX, 0, 0 };
     scene_add_sphere(&scene, light_sphere, NULL);
     for (int i = 0; i < 30; i++) {
         vec3 c = vrand(-3.0f, 3.0f);
-        Triangle t = { v3_add(c, vrand(-1.0f, 1.0f)), mats[i % 12], v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX,
+        Triangle t = { v3_add(c, vrand(-1.0f, 1.0f)), mats[i % 14], v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX,
                        v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX };
         scene_add_triangle(&scene, t, NULL);
     }
@@ -178,7 +190,7 @@ static void build_scene(void)
     scene_add_triangle(&scene, lt, NULL);
     for (int i = 0; i < 4; i++) {
         vec3 lo = vrand(-3.0f, 2.0f);
-        Box b = { lo, mats[(i * 3) % 12], v3_add(lo, vrand(0.2f, 1.0f)), NO_INDEX };
+        Box b = { lo, mats[(i * 3) % 14], v3_add(lo, vrand(0.2f, 1.0f)), NO_INDEX };
         scene_add_box(&scene, b, NULL);
     }
     Box lb = { v3(2.0f, 3.0f, 2.0f), lamp, v3(2.5f, 3.2f, 2.4f), NO_INDEX };
@@ -311,7 +323,8 @@ static void test_layout(void)
                     offsetof(RenderParams, strata), offsetof(Material, reflective),
                     offsetof(Light, cos_inner), offsetof(Camera, forward),
                     offsetof(RenderParams, shadows), offsetof(RenderParams, normal_miss_grey),
-                    offsetof(Material, roughness), offsetof(Material, k) };
+                    offsetof(Material, roughness), offsetof(Material, k),
+                    offsetof(Material, clearcoat_roughness) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);
@@ -866,7 +879,12 @@ static void test_bsdf(void)
                         material_conductor_f0(v3(0.9f, 0.8f, 0.5f), 0.8f),
                         material_conductor(v3(1.5f, 0.96f, 0.6f), v3(7.8f, 6.7f, 5.5f), 0.5f),
                         material_dielectric(1.5f), material_dielectric(1.33f), material_dielectric(1.5f),
-                        material_dielectric(1.5f) };
+                        material_dielectric(1.5f), material_principled(v3(0.8f, 0.5f, 0.3f), 0.0f, 0.4f),
+                        material_principled(v3(0.9f, 0.7f, 0.4f), 1.0f, 0.0f),
+                        material_principled(v3(0.5f, 0.8f, 0.9f), 0.3f, 0.6f) };
+    mats[14].transmission = 0.7f;
+    mats[14].clearcoat = 1.0f;
+    mats[14].clearcoat_roughness = 0.2f;
     mats[7].anisotropy = 0.7f;
     mats[8].roughness = 0.2f;
     mats[9].roughness = 0.7f;

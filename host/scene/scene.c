@@ -368,6 +368,15 @@ Material material_conductor_f0(vec3 f0, float roughness)
     return m;
 }
 
+Material material_principled(vec3 base, float metallic, float roughness)
+{
+    Material m = material_base(MAT_PRINCIPLED);
+    m.albedo = base;
+    m.metallic = metallic;
+    m.roughness = roughness;
+    return m;
+}
+
 /* Measured spectra interpolated at 650, 550 and 450 nm for R, G and B: Ag, Al, Au, Cu
  * from pbrt-v4 (src/pbrt/util/spectrum.cpp, after refractiveindex.info), Cr and Ni from
  * Mitsuba 0.6 (data/ior/Cr.*.spd, Ni_palik.*.spd: the luxpop database, Palik's

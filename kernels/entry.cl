@@ -160,6 +160,7 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Material, roughness);
     out[i++] = (uint)__builtin_offsetof(Material, k);
     out[i++] = (uint)__builtin_offsetof(Material, clearcoat_roughness);
+    out[i++] = (uint)__builtin_offsetof(Material, texture_rm);
 }
 
 /* ---------------------------------------------------------------- classic ray tracer

@@ -106,6 +106,7 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     BsdfSample bs;
 
     vec3 albedo = material_albedo(sc, m, s, ng_face);
+    m = material_at(sc, m, s, ng_face);
 
     if (p->n_lights > 0u && bsdf_has_density(m, albedo) &&
         shade_light_sample(sc, ps, s, r.d, ns_face, ng_face, m, albedo, front, shadow_ray))

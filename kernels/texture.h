@@ -140,4 +140,17 @@ KFN vec3 material_albedo(const SceneView *sc, Material m, Surface s, vec3 ng_fac
     return m.texture == NO_INDEX ? m.albedo : texture_eval(sc, m.texture, s, ng_face);
 }
 
+/* The material with its textured parameters at s: a principled material's roughness
+ * and metallic factors times its metallic-roughness texture's G and B (glTF's packing;
+ * the texture is read as declared, so it should be `encoding linear`). */
+KFN Material material_at(const SceneView *sc, Material m, Surface s, vec3 ng_face)
+{
+    if (m.type == MAT_PRINCIPLED && m.texture_rm != NO_INDEX) {
+        vec3 t = texture_eval(sc, m.texture_rm, s, ng_face);
+        m.roughness *= t.y;
+        m.metallic *= t.z;
+    }
+    return m;
+}
+
 #endif /* CLPT_TEXTURE_H */

@@ -133,7 +133,10 @@ typedef struct {                                        /* 144 bytes */
     vec3 eta;         float transmission;  /* MAT_CONDUCTOR: complex index of refraction ... */
     vec3 k;           float clearcoat;     /* ... eta + i k per RGB channel */
     float clearcoat_roughness;             /* MAT_PRINCIPLED, as roughness */
-    uint pad0, pad1, pad2;
+    uint texture_rm;                       /* MAT_PRINCIPLED: glTF metallic-roughness
+                                            * texture (G roughness, B metallic), or
+                                            * NO_INDEX */
+    uint pad0, pad1;
 } Material;
 
 #define MAT_TWO_SIDED 1u        /* emits from both sides of its surface */
@@ -308,6 +311,7 @@ _Static_assert(offsetof(Material, albedo) == 16, "Material.albedo");
 _Static_assert(offsetof(Material, roughness) == 60, "Material.roughness");
 _Static_assert(offsetof(Material, k) == 112, "Material.k");
 _Static_assert(offsetof(Material, clearcoat_roughness) == 128, "Material.clearcoat_roughness");
+_Static_assert(offsetof(Material, texture_rm) == 132, "Material.texture_rm");
 _Static_assert(offsetof(Light, position) == 32, "Light.position");
 #undef CLPT_CHECK_SIZE
 #endif

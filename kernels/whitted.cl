@@ -163,6 +163,7 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, uint key, uint *rays)
         if (m.type == MAT_EMISSIVE) continue;
 
         vec3 kd = material_albedo(sc, m, s, ng);
+        m = material_at(sc, m, s, ng);
         vec3 kr = v3s(0.0f), kt = v3s(0.0f);
         if (m.type == MAT_PRINCIPLED) {
             /* the classic tracer's reading of glTF: the diffuse share lit directly, the

@@ -17,6 +17,7 @@
 #include "harness.h"
 #include "bsdf.h"
 #include "render_util.h"
+#include "io/texture.h"
 
 typedef struct {
     const char *name;
@@ -520,6 +521,44 @@ static void test_principled_energy(void)
             "at cos >= 0.7, %.4f at cos 0.1 (the glTF model's grazing gain)\n", worst_normal, worst_grazing);
 }
 
+/* A metallic-roughness texture multiplies the factors by its G (roughness) and B
+ * (metallic): factors 1 and 1 with a texture of G 0.5, B 0.25 render as factors 0.5
+ * and 0.25 without one. */
+static void test_metallic_roughness_texture(void)
+{
+    double mean[2];
+    for (int textured = 0; textured < 2; textured++) {
+        Scene s;
+        Material m = material_principled(v3(0.9f, 0.6f, 0.3f), textured ? 1.0f : 0.25f, textured ? 1.0f : 0.5f);
+        furnace_sphere_scene(&s, m, 8, 4);
+        if (textured) {
+            float texel[3] = { 0.0f, 0.5f, 0.25f };
+            uint bits[3], offset, index;
+            memcpy(bits, texel, sizeof bits);
+            scene_add_texels(&s, bits, 3, &offset, NULL);
+            Texture t = texture_make_checker(v3s(0.0f), v3s(0.0f), 1.0f, 0);
+            t.type = TEX_IMAGE;
+            t.flags = TEX_FLOAT | TEX_CLAMP;
+            t.offset = offset;
+            t.width = 1;
+            t.height = 1;
+            scene_add_texture(&s, "rm", NULL, t, &index, NULL);
+            s.materials[0].texture_rm = index;
+        }
+        Film film;
+        Error err = { 0 };
+        Status st = render_util_run(&s, "scalar", 0, &film, &err);
+        CHECK_MSG(st == ST_OK, "%s", err.msg);
+        error_clear(&err);
+        mean[textured] = st == ST_OK ? film_mean(&film) : -1.0;
+        if (st == ST_OK) film_free(&film);
+        scene_free(&s);
+    }
+    fprintf(stderr, "  factors 0.25/0.5: image mean %.6f; factors 1/1 with texture B 0.25 G 0.5: %.6f\n", mean[0],
+            mean[1]);
+    CHECK_NEAR(mean[1], mean[0], 1e-5);
+}
+
 int main(void)
 {
     RUN(test_chi2);
@@ -528,5 +567,6 @@ int main(void)
     RUN(test_principled_energy);
     RUN(test_furnace_conductor);
     RUN(test_furnace_dielectric);
+    RUN(test_metallic_roughness_texture);
     return harness_report();
 }

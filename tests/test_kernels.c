@@ -165,6 +165,8 @@ static void build_scene(void)
     uint plastic, coated;
     Material pm = material_principled(v3(0.8f, 0.2f, 0.1f), 0.0f, 0.5f);
     pm.texture = tex[3];
+    pm.texture_rm = tex[0];
+    pm.metallic = 0.7f;
     scene_add_material(&scene, "plastic", pm, &plastic, NULL);
     pm = material_principled(v3(0.3f, 0.6f, 0.9f), 0.4f, 0.3f);
     pm.transmission = 0.6f;
@@ -324,7 +326,7 @@ static void test_layout(void)
                     offsetof(Light, cos_inner), offsetof(Camera, forward),
                     offsetof(RenderParams, shadows), offsetof(RenderParams, normal_miss_grey),
                     offsetof(Material, roughness), offsetof(Material, k),
-                    offsetof(Material, clearcoat_roughness) };
+                    offsetof(Material, clearcoat_roughness), offsetof(Material, texture_rm) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);

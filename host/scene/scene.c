@@ -323,6 +323,7 @@ static Material material_base(uint type)
     memset(&m, 0, sizeof m);
     m.type = type;
     m.texture = NO_INDEX;
+    m.texture_rm = NO_INDEX;
     m.ior = 1.5f;
     return m;
 }

@@ -161,6 +161,7 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Material, k);
     out[i++] = (uint)__builtin_offsetof(Material, clearcoat_roughness);
     out[i++] = (uint)__builtin_offsetof(Material, texture_rm);
+    out[i++] = (uint)__builtin_offsetof(Material, normal_scale);
 }
 
 /* ---------------------------------------------------------------- classic ray tracer

@@ -86,6 +86,7 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
 
     Surface s = surface_at(sc, r, hit);
     Material m = sc->materials[s.material];
+    s.ns = material_normal(sc, m, s);
 
     if (!v3_is_zero(m.emission) && ((m.flags & MAT_TWO_SIDED) || v3_dot(r.d, s.ng) < 0.0f)) {
         /* emission reached by BSDF sampling is weighted against the light sampling that

@@ -136,7 +136,9 @@ typedef struct {                                        /* 144 bytes */
     uint texture_rm;                       /* MAT_PRINCIPLED: glTF metallic-roughness
                                             * texture (G roughness, B metallic), or
                                             * NO_INDEX */
-    uint pad0, pad1;
+    uint texture_normal;                   /* MAT_PRINCIPLED: tangent-space normal map
+                                            * (OpenGL/glTF: green = +v), or NO_INDEX */
+    float normal_scale;                    /* scales the map's x and y (glTF's scale) */
 } Material;
 
 #define MAT_TWO_SIDED 1u        /* emits from both sides of its surface */
@@ -312,6 +314,7 @@ _Static_assert(offsetof(Material, roughness) == 60, "Material.roughness");
 _Static_assert(offsetof(Material, k) == 112, "Material.k");
 _Static_assert(offsetof(Material, clearcoat_roughness) == 128, "Material.clearcoat_roughness");
 _Static_assert(offsetof(Material, texture_rm) == 132, "Material.texture_rm");
+_Static_assert(offsetof(Material, normal_scale) == 140, "Material.normal_scale");
 _Static_assert(offsetof(Light, position) == 32, "Light.position");
 #undef CLPT_CHECK_SIZE
 #endif

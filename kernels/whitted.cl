@@ -155,6 +155,7 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, uint key, uint *rays)
         }
         Surface s = surface_at(sc, e.ray, hit);
         Material m = sc->materials[s.material];
+        s.ns = material_normal(sc, m, s);
         int front = v3_dot(d, s.ng) < 0.0f;
         vec3 ng = front ? s.ng : v3_neg(s.ng);
         vec3 ns = front ? s.ns : v3_neg(s.ns);

@@ -559,6 +559,88 @@ static void test_metallic_roughness_texture(void)
     CHECK_NEAR(mean[1], mean[0], 1e-5);
 }
 
+/* A normal map's tangent frame: a square facing +z with u along +x and v along +y,
+ * under a directional light, shaded through a constant normal map of tangent-space
+ * normal (0.3, -0.2, 0.93) renders as the same square whose vertex normals are the
+ * world normal (0.3, -0.2, 0.93): x follows dp/du, y dp/dv (green up). */
+static void normal_map_scene(Scene *s, int mapped, vec3 n)
+{
+    scene_init(s);
+    s->image.width = 24;
+    s->image.height = 24;
+    s->image.spp = 16;
+    s->image.max_depth = 1;
+    s->image.seed = 5;
+    s->camera.from = v3(0.0f, 0.0f, 5.0f);
+    s->camera.at = v3(0.0f, 0.0f, 0.0f);
+    s->camera.type = CAMERA_ORTHOGRAPHIC;
+    s->camera.ortho_height = 1.6f;
+    s->bg_type = BG_CONSTANT;
+    s->bg_color = v3s(0.0f);
+    s->bg_zenith = v3s(0.0f);
+    Material m = material_principled(v3(0.8f, 0.6f, 0.4f), 0.0f, 0.6f);
+    if (mapped) {
+        float texel[3] = { 0.5f + 0.5f * n.x, 0.5f + 0.5f * n.y, 0.5f + 0.5f * n.z };
+        uint bits[3], offset, index;
+        memcpy(bits, texel, sizeof bits);
+        scene_add_texels(s, bits, 3, &offset, NULL);
+        Texture t = texture_make_checker(v3s(0.0f), v3s(0.0f), 1.0f, 0);
+        t.type = TEX_IMAGE;
+        t.flags = TEX_FLOAT | TEX_CLAMP;
+        t.offset = offset;
+        t.width = 1;
+        t.height = 1;
+        scene_add_texture(s, "normal", NULL, t, &index, NULL);
+        m.texture_normal = index;
+    }
+    uint mi;
+    scene_add_material(s, "m", m, &mi, NULL);
+    TriShading sh;
+    memset(&sh, 0, sizeof sh);
+    sh.flags = TRI_HAS_UV | (mapped ? 0u : TRI_HAS_NORMALS);
+    vec3 c[4] = { v3(-1.0f, -1.0f, 0.0f), v3(1.0f, -1.0f, 0.0f), v3(1.0f, 1.0f, 0.0f), v3(-1.0f, 1.0f, 0.0f) };
+    const uint tri[2][3] = { { 0, 1, 2 }, { 0, 2, 3 } };
+    for (int k = 0; k < 2; k++) {
+        float *uv[3] = { sh.uv0, sh.uv1, sh.uv2 };
+        for (int j = 0; j < 3; j++) {
+            uv[j][0] = 0.5f + 0.5f * c[tri[k][j]].x;
+            uv[j][1] = 0.5f + 0.5f * c[tri[k][j]].y;
+        }
+        sh.n0 = sh.n1 = sh.n2 = n;
+        uint si;
+        scene_add_shading(s, sh, &si, NULL);
+        Triangle t = { c[tri[k][0]], mi, c[tri[k][1]], NO_INDEX, c[tri[k][2]], si };
+        scene_add_triangle(s, t, NULL);
+    }
+    Light dl = light_default(LIGHT_DIRECTIONAL);
+    dl.direction = v3_norm(v3(0.5f, 0.3f, -1.0f));
+    dl.intensity = v3s(2.0f);
+    scene_add_light(s, dl, NULL);
+}
+
+static void test_normal_map(void)
+{
+    vec3 n = v3_norm(v3(0.3f, -0.2f, 0.93f));
+    double mean[3];
+    for (int k = 0; k < 3; k++) {
+        Scene s;
+        /* 0: vertex normals n; 1: the map of n; 2: a flat map (the geometric normal) */
+        normal_map_scene(&s, k > 0, k == 2 ? v3(0.0f, 0.0f, 1.0f) : n);
+        Film film;
+        Error err = { 0 };
+        Status st = render_util_run(&s, "scalar", 0, &film, &err);
+        CHECK_MSG(st == ST_OK, "%s", err.msg);
+        error_clear(&err);
+        mean[k] = st == ST_OK ? film_mean(&film) : -1.0;
+        if (st == ST_OK) film_free(&film);
+        scene_free(&s);
+    }
+    fprintf(stderr, "  square lit at an angle: vertex normals %.6f, normal map %.6f, flat map %.6f\n", mean[0],
+            mean[1], mean[2]);
+    CHECK(fabs(mean[1] - mean[0]) < 1e-3 * mean[0]);
+    CHECK(fabs(mean[2] - mean[0]) > 0.05 * mean[0]);   /* the tilt matters */
+}
+
 int main(void)
 {
     RUN(test_chi2);
@@ -568,5 +650,6 @@ int main(void)
     RUN(test_furnace_conductor);
     RUN(test_furnace_dielectric);
     RUN(test_metallic_roughness_texture);
+    RUN(test_normal_map);
     return harness_report();
 }

@@ -173,6 +173,8 @@ static void build_scene(void)
     pm.clearcoat = 0.8f;
     pm.clearcoat_roughness = 0.1f;
     pm.emission = v3(0.2f, 0.1f, 0.0f);
+    pm.texture_normal = tex[1];
+    pm.normal_scale = 0.8f;
     scene_add_material(&scene, "coated", pm, &coated, NULL);
     uint mats[] = { diffuse, metal, glass, phong, glow, mirror, clear, checked, gold, chrome, frosted, sheet,
                     plastic, coated };
@@ -326,7 +328,8 @@ static void test_layout(void)
                     offsetof(Light, cos_inner), offsetof(Camera, forward),
                     offsetof(RenderParams, shadows), offsetof(RenderParams, normal_miss_grey),
                     offsetof(Material, roughness), offsetof(Material, k),
-                    offsetof(Material, clearcoat_roughness), offsetof(Material, texture_rm) };
+                    offsetof(Material, clearcoat_roughness), offsetof(Material, texture_rm),
+                    offsetof(Material, normal_scale) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);

@@ -492,7 +492,7 @@ enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE
        MAT_KEY_SPECULAR, MAT_KEY_SHININESS, MAT_KEY_REFLECTIVE, MAT_KEY_TRANSPARENT, MAT_KEY_TEXTURE,
        MAT_KEY_ROUGHNESS, MAT_KEY_ANISOTROPY, MAT_KEY_ETA, MAT_KEY_K, MAT_KEY_METAL, MAT_KEY_THIN,
        MAT_KEY_METALLIC, MAT_KEY_TRANSMISSION, MAT_KEY_CLEARCOAT, MAT_KEY_CLEARCOAT_ROUGHNESS, MAT_KEY_STRENGTH,
-       MAT_KEY_METALLIC_ROUGHNESS, MAT_KEY_N };
+       MAT_KEY_METALLIC_ROUGHNESS, MAT_KEY_NORMAL_MAP, MAT_KEY_NORMAL_SCALE, MAT_KEY_N };
 static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0,
                       "a material type (diffuse, metal, conductor, dielectric, principled, emissive, phong)"},
@@ -519,6 +519,8 @@ static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_CLEARCOAT_ROUGHNESS] = {"clearcoat_roughness", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
     [MAT_KEY_STRENGTH] = {"strength", VK_NUMBER, 0, 0, 1e6, 0, 0, "a number in [0, 1e6]"},
     [MAT_KEY_METALLIC_ROUGHNESS] = {"metallic_roughness", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_NORMAL_MAP] = {"normal_map", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_NORMAL_SCALE] = {"normal_scale", VK_NUMBER, 0, 0, 100, 0, 0, "a number in [0, 100]"},
 };
 
 /* Which keys each material type takes (bit i = material_keys[i]), and which it needs. */
@@ -546,7 +548,7 @@ static const struct {
      1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_TEXTURE | 1u << MAT_KEY_METALLIC | 1u << MAT_KEY_ROUGHNESS |
      1u << MAT_KEY_ANISOTROPY | 1u << MAT_KEY_TRANSMISSION | 1u << MAT_KEY_IOR | 1u << MAT_KEY_THIN |
      1u << MAT_KEY_CLEARCOAT | 1u << MAT_KEY_CLEARCOAT_ROUGHNESS | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_STRENGTH |
-     1u << MAT_KEY_METALLIC_ROUGHNESS | 1u << MAT_KEY_SIDES,
+     1u << MAT_KEY_METALLIC_ROUGHNESS | 1u << MAT_KEY_NORMAL_MAP | 1u << MAT_KEY_NORMAL_SCALE | 1u << MAT_KEY_SIDES,
      0},
     {"emissive", MAT_EMISSIVE, 1u << MAT_KEY_RADIANCE | 1u << MAT_KEY_SIDES, 1u << MAT_KEY_RADIANCE},
     {"phong", MAT_PHONG,
@@ -631,6 +633,8 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
         if (v[MAT_KEY_CLEARCOAT].given) m.clearcoat = v[MAT_KEY_CLEARCOAT].f;
         if (v[MAT_KEY_CLEARCOAT_ROUGHNESS].given) m.clearcoat_roughness = v[MAT_KEY_CLEARCOAT_ROUGHNESS].f;
         if (v[MAT_KEY_METALLIC_ROUGHNESS].given) m.texture_rm = (uint)v[MAT_KEY_METALLIC_ROUGHNESS].u;
+        if (v[MAT_KEY_NORMAL_MAP].given) m.texture_normal = (uint)v[MAT_KEY_NORMAL_MAP].u;
+        if (v[MAT_KEY_NORMAL_SCALE].given) m.normal_scale = v[MAT_KEY_NORMAL_SCALE].f;
         break;
     case MAT_EMISSIVE:
         m = material_emissive(v[MAT_KEY_RADIANCE].v);

@@ -324,6 +324,8 @@ static Material material_base(uint type)
     m.type = type;
     m.texture = NO_INDEX;
     m.texture_rm = NO_INDEX;
+    m.texture_normal = NO_INDEX;
+    m.normal_scale = 1.0f;
     m.ior = 1.5f;
     return m;
 }

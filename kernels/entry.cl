@@ -120,7 +120,9 @@ __kernel void k_film(__global const PathState *paths, uint first_pixel, uint n_p
 }
 
 /* Writes sizeof and offsetof of the shared structs, for the host to compare with its
- * own layout (tests/test_kernels.c): a mismatch would silently corrupt every buffer. */
+ * own layout (tests/test_kernels.c): a mismatch would silently corrupt every buffer.
+ * tests/test_ocl.c's LAYOUT_VALUES is the number of values written here: its buffer
+ * holds exactly that many. */
 __kernel void k_layout(__global uint *out)
 {
     if (get_global_id(0) != 0) return;

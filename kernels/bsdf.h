@@ -7,28 +7,17 @@
 #ifndef CLPT_BSDF_H
 #define CLPT_BSDF_H
 
-#include "sampling.h"
+#include "principled.h"
 
 typedef struct {
     vec3 wi;          /* sampled direction */
     vec3 weight;      /* f * |cos| / pdf */
     float pdf;        /* solid-angle density; 0 for delta lobes */
     int specular;     /* delta (or treated as delta: fuzzy metal) */
+    int transmitted;  /* meant to leave on the far side of the surface */
 } BsdfSample;
 
 KFN vec3 reflect_dir(vec3 d, vec3 n) { return v3_sub(d, v3_scale(n, 2.0f * v3_dot(d, n))); }
-
-/* Unpolarised Fresnel reflectance of a smooth dielectric boundary; cos_i > 0 is on the
- * incident side, eta = n_transmitted / n_incident. Returns 1 on total internal reflection. */
-KFN float fresnel_dielectric(float cos_i, float eta)
-{
-    float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
-    if (sin2_t >= 1.0f) return 1.0f;
-    float cos_t = k_sqrt(1.0f - sin2_t);
-    float r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    return 0.5f * (r_par * r_par + r_perp * r_perp);
-}
 
 /* Lambertian: f = albedo / pi, cosine-weighted sampling. */
 KFN BsdfSample bsdf_sample_diffuse(vec3 albedo, vec3 n, float u1, float u2)
@@ -41,6 +30,7 @@ KFN BsdfSample bsdf_sample_diffuse(vec3 albedo, vec3 n, float u1, float u2)
     s.pdf = v_local.z * K_INV_PI;
     s.weight = albedo;
     s.specular = 0;
+    s.transmitted = 0;
     return s;
 }
 
@@ -57,6 +47,7 @@ KFN BsdfSample bsdf_sample_metal(vec3 albedo, float fuzz, vec3 d, vec3 n, float 
     s.weight = albedo;
     s.pdf = 0.0f;
     s.specular = 1;
+    s.transmitted = 0;
     return s;
 }
 
@@ -69,6 +60,7 @@ KFN BsdfSample bsdf_sample_dielectric(float ior, vec3 d, vec3 n, int entering, f
     float eta = entering ? ior : 1.0f / ior;     /* n_t / n_i */
     float cos_i = -v3_dot(d, n);
     float F = fresnel_dielectric(cos_i, eta);
+    s.transmitted = !(u < F);
     if (u < F) {
         s.wi = reflect_dir(d, n);
     } else {
@@ -168,10 +160,12 @@ KFN BsdfSample phong_sample(PhongLobes l, Material m, vec3 d, vec3 ns, vec3 ng, 
         float cos_i = v3_dot(ns, s.wi);
         s.weight = s.pdf > 0.0f ? v3_scale(f, cos_i / s.pdf) : v3s(0.0f);
         s.specular = 0;
+        s.transmitted = 0;
         return s;
     }
     s.pdf = 0.0f;
     s.specular = 1;
+    s.transmitted = 0;
     if (u_lobe < l.p_glossy + l.p_mirror) {
         /* about the shading normal, unless that would go below the surface */
         s.wi = reflect_dir(d, ns);
@@ -183,8 +177,178 @@ KFN BsdfSample phong_sample(PhongLobes l, Material m, vec3 d, vec3 ns, vec3 ng, 
     BsdfSample g = bsdf_sample_dielectric(m.ior, d, ng, entering, u_fresnel);
     float p_t = 1.0f - l.p_glossy - l.p_mirror;
     s.wi = g.wi;
+    s.transmitted = g.transmitted;
     s.weight = p_t > 0.0f ? v3_scale(l.kt, 1.0f / p_t) : v3s(0.0f);
     return s;
+}
+
+/* ---------------------------------------------------------------- dispatch
+ * One entry for each question the integrators ask of any material: its value and
+ * density for a given pair of directions (next-event estimation, MIS), and a sampled
+ * direction. Arguments throughout: `d` the incoming ray direction (wo = -d), ns the
+ * shading normal and ng the geometric normal, both turned to the incoming side,
+ * `front` whether d arrives on the outward side (for the index ratio), albedo the
+ * material's (textured) colour at the hit. The microfacet lobes work in the frame of
+ * k_onb(ns); anisotropy stretches along its first tangent. */
+
+KFN Ggx bsdf_ggx(Material m) { return ggx_make(m.roughness, m.anisotropy); }
+
+KFN Conductor bsdf_conductor(Material m, vec3 albedo)
+{
+    Conductor c;
+    c.g = bsdf_ggx(m);
+    c.eta = m.eta;
+    c.k = m.k;
+    c.f0 = m.specular;
+    c.tint = albedo;
+    c.schlick = (m.flags & MAT_F0) != 0u;
+    return c;
+}
+
+KFN Dielectric bsdf_dielectric(Material m, int front)
+{
+    Dielectric g;
+    g.g = bsdf_ggx(m);
+    g.thin = (m.flags & MAT_THIN) != 0u;
+    g.eta = g.thin || front ? m.ior : 1.0f / m.ior;
+    return g;
+}
+
+/* The principled lobes; alphas below GGX_SMOOTH_ALPHA are raised to it, as the
+ * material mixes its lobes by density and has no delta branch. */
+KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
+{
+    Principled p;
+    p.base = albedo;
+    p.metallic = k_clamp(m.metallic, 0.0f, 1.0f);
+    p.transmission = k_clamp(m.transmission, 0.0f, 1.0f);
+    p.clearcoat = k_clamp(m.clearcoat, 0.0f, 1.0f);
+    p.g = bsdf_ggx(m);
+    p.g.ax = k_fmax(p.g.ax, GGX_SMOOTH_ALPHA);
+    p.g.ay = k_fmax(p.g.ay, GGX_SMOOTH_ALPHA);
+    float ac = k_fmax(m.clearcoat_roughness * m.clearcoat_roughness, GGX_SMOOTH_ALPHA);
+    p.gc.ax = ac;
+    p.gc.ay = ac;
+    p.thin = (m.flags & MAT_THIN) != 0u;
+    p.eta = p.thin || front ? m.ior : 1.0f / m.ior;
+    return p;
+}
+
+/* Whether the material has a lobe with a density (not only delta lobes), so that
+ * next-event estimation can reach it. */
+KFN int bsdf_has_density(Material m, vec3 albedo)
+{
+    if (m.type == MAT_DIFFUSE) return 1;
+    if (m.type == MAT_PHONG) return phong_lobes(m, albedo).p_glossy > 0.0f;
+    if (m.type == MAT_CONDUCTOR || m.type == MAT_DIELECTRIC) return !ggx_smooth(bsdf_ggx(m));
+    return m.type == MAT_PRINCIPLED;
+}
+
+KFN vec3 bsdf_to_local(vec3 w, vec3 t, vec3 b, vec3 n) { return v3(v3_dot(w, t), v3_dot(w, b), v3_dot(w, n)); }
+
+/* f(wo, wi) (no cosine) of the material's non-delta lobes, and in *pdf the density
+ * with which bsdf_sample returns wi. Zero for delta-only materials. */
+KFN vec3 bsdf_eval(Material m, vec3 albedo, vec3 d, vec3 ns, int front, vec3 wi, float *pdf)
+{
+    vec3 f = v3s(0.0f);
+    *pdf = 0.0f;
+    if (m.type == MAT_DIFFUSE) {
+        float c = v3_dot(ns, wi);
+        if (c <= 0.0f) return f;
+        *pdf = c * K_INV_PI;
+        return v3_scale(albedo, K_INV_PI);
+    }
+    if (m.type == MAT_PHONG) {
+        *pdf = phong_eval(phong_lobes(m, albedo), d, ns, wi, &f);
+        return f;
+    }
+    if (!bsdf_has_density(m, albedo)) return f;
+    vec3 t, b;
+    k_onb(ns, &t, &b);
+    vec3 wo = bsdf_to_local(v3_neg(d), t, b, ns), wl = bsdf_to_local(wi, t, b, ns);
+    if (m.type == MAT_CONDUCTOR) *pdf = conductor_eval(bsdf_conductor(m, albedo), wo, wl, &f);
+    else if (m.type == MAT_PRINCIPLED) *pdf = principled_eval(bsdf_principled(m, albedo, front), wo, wl, &f);
+    else *pdf = dielectric_eval(bsdf_dielectric(m, front), wo, wl, &f);
+    return f;
+}
+
+KFN float bsdf_pdf(Material m, vec3 albedo, vec3 d, vec3 ns, int front, vec3 wi)
+{
+    float pdf;
+    bsdf_eval(m, albedo, d, ns, front, wi, &pdf);
+    return pdf;
+}
+
+/* A smooth conductor: the mirror direction about ns (about ng where that would go
+ * below the surface), weighted by the Fresnel colour. */
+KFN BsdfSample bsdf_sample_mirror_conductor(Conductor c, vec3 d, vec3 ns, vec3 ng)
+{
+    BsdfSample s;
+    s.wi = reflect_dir(d, ns);
+    if (v3_dot(s.wi, ng) <= 0.0f) s.wi = reflect_dir(d, ng);
+    s.weight = conductor_fresnel(c, -v3_dot(d, ns));
+    s.pdf = 0.0f;
+    s.specular = 1;
+    s.transmitted = 0;
+    return s;
+}
+
+/* A smooth thin sheet: reflect with the sheet's reflectance, else pass straight on. */
+KFN BsdfSample bsdf_sample_thin(Dielectric g, vec3 d, vec3 ng, float u)
+{
+    BsdfSample s;
+    float F = dielectric_facet_fresnel(g, -v3_dot(d, ng));
+    s.transmitted = !(u < F);
+    s.wi = s.transmitted ? d : reflect_dir(d, ng);
+    s.weight = v3s(1.0f);
+    s.pdf = 0.0f;
+    s.specular = 1;
+    return s;
+}
+
+/* A rough lobe's sample: f cos / pdf, or a failed sample (weight 0, pdf 0). */
+KFN BsdfSample bsdf_sample_rough(Material m, vec3 albedo, vec3 d, vec3 ns, int front, float u_lobe, float u1,
+                                 float u2)
+{
+    BsdfSample s;
+    vec3 t, b, f, wl;
+    k_onb(ns, &t, &b);
+    vec3 wo = bsdf_to_local(v3_neg(d), t, b, ns);
+    float pdf = 0.0f;
+    if (wo.z > 0.0f) {
+        if (m.type == MAT_CONDUCTOR)
+            pdf = conductor_sample(bsdf_conductor(m, albedo), wo, u1, u2, &wl, &f);
+        else if (m.type == MAT_PRINCIPLED)
+            pdf = principled_sample(bsdf_principled(m, albedo, front), wo, u_lobe, u1, u2, &wl, &f);
+        else
+            pdf = dielectric_sample(bsdf_dielectric(m, front), wo, u_lobe, u1, u2, &wl, &f);
+    }
+    s.specular = 0;
+    s.pdf = pdf;
+    if (!(pdf > 0.0f)) {
+        s.wi = ns;
+        s.weight = v3s(0.0f);
+        s.pdf = 0.0f;
+        s.transmitted = 0;
+        return s;
+    }
+    s.wi = v3_norm(k_to_world(wl, t, b, ns));
+    s.transmitted = wl.z < 0.0f;
+    s.weight = v3_scale(f, k_fabs(wl.z) / pdf);
+    return s;
+}
+
+/* A direction for any material. u_lobe picks a lobe, u1 u2 (u3) the direction. */
+KFN BsdfSample bsdf_sample(Material m, vec3 albedo, vec3 d, vec3 ns, vec3 ng, int front, float u_lobe, float u1,
+                           float u2, float u3)
+{
+    if (m.type == MAT_DIFFUSE) return bsdf_sample_diffuse(albedo, ns, u1, u2);
+    if (m.type == MAT_PHONG) return phong_sample(phong_lobes(m, albedo), m, d, ns, ng, front, u_lobe, u1, u2, u3);
+    if (m.type == MAT_METAL) return bsdf_sample_metal(albedo, m.fuzz, d, ns, u1, u2, u3);
+    if (bsdf_has_density(m, albedo)) return bsdf_sample_rough(m, albedo, d, ns, front, u_lobe, u1, u2);
+    if (m.type == MAT_CONDUCTOR) return bsdf_sample_mirror_conductor(bsdf_conductor(m, albedo), d, ns, ng);
+    if (m.flags & MAT_THIN) return bsdf_sample_thin(bsdf_dielectric(m, front), d, ng, u_lobe);
+    return bsdf_sample_dielectric(m.ior, d, ng, front, u_lobe);
 }
 
 #endif /* CLPT_BSDF_H */

@@ -120,7 +120,9 @@ __kernel void k_film(__global const PathState *paths, uint first_pixel, uint n_p
 }
 
 /* Writes sizeof and offsetof of the shared structs, for the host to compare with its
- * own layout (tests/test_kernels.c): a mismatch would silently corrupt every buffer. */
+ * own layout (tests/test_kernels.c): a mismatch would silently corrupt every buffer.
+ * tests/test_ocl.c's LAYOUT_VALUES is the number of values written here: its buffer
+ * holds exactly that many. */
 __kernel void k_layout(__global uint *out)
 {
     if (get_global_id(0) != 0) return;
@@ -157,6 +159,11 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Camera, forward);
     out[i++] = (uint)__builtin_offsetof(RenderParams, shadows);
     out[i++] = (uint)__builtin_offsetof(RenderParams, normal_miss_grey);
+    out[i++] = (uint)__builtin_offsetof(Material, roughness);
+    out[i++] = (uint)__builtin_offsetof(Material, k);
+    out[i++] = (uint)__builtin_offsetof(Material, clearcoat_roughness);
+    out[i++] = (uint)__builtin_offsetof(Material, texture_rm);
+    out[i++] = (uint)__builtin_offsetof(Material, normal_scale);
 }
 
 /* ---------------------------------------------------------------- classic ray tracer

@@ -28,16 +28,16 @@ KFN void shadow_resolve(GLOBAL PathState *ps, int occluded)
     ps->shadow_L = v3s(0.0f);
 }
 
-/* Next-event estimation at a diffuse or Phong surface: samples a light, and if it is
- * above the surface writes the shadow ray and the contribution it would bring: MIS-
- * weighted against BSDF sampling for an area light (unless the test switch
+/* Next-event estimation at a surface with a non-delta lobe (bsdf_has_density): samples
+ * a light, and if it is on a side the BSDF scatters to (above the surface, or below it
+ * for a transmitting lobe) writes the shadow ray and the contribution it would bring:
+ * MIS-weighted against BSDF sampling for an area light (unless the test switch
  * mis_mode says otherwise), fully for a delta light, which BSDF sampling cannot find.
- * `d` is the incoming ray direction; `lobes` is 0 (null) for a diffuse surface. Returns
- * 1 when a shadow ray was written; with shadows off the contribution is added at once
- * instead. */
+ * `d` is the incoming ray direction, n_face and ng_face the shading and geometric
+ * normals on its side, `front` whether it arrives on the outward side. Returns 1 when a
+ * shadow ray was written; with shadows off the contribution is added at once instead. */
 KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s, vec3 d, vec3 n_face,
-                           vec3 ng_face, const PhongLobes *lobes, vec3 albedo,
-                           GLOBAL Ray *shadow_ray)
+                           vec3 ng_face, Material m, vec3 albedo, int front, GLOBAL Ray *shadow_ray)
 {
     uint key = ps->rng_key, b = ps->bounce;
     uint mis_mode = sc->params->mis_mode;
@@ -47,16 +47,15 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
         return 0;
     if (!ls.delta && mis_mode == MIS_BSDF_ONLY) return 0;
     vec3 wi = ls.wi;
-    float cos_s = v3_dot(n_face, wi);
-    if (cos_s <= 0.0f || v3_dot(ng_face, wi) <= 0.0f) return 0;
-    vec3 f;
+    float cos_s = v3_dot(n_face, wi), cos_g = v3_dot(ng_face, wi);
+    /* both normals must agree on the side: a direction between them is a shading-normal
+     * artefact, lit from the wrong side */
+    int below = cos_s < 0.0f;
+    if (cos_s == 0.0f || (below ? cos_g >= 0.0f : cos_g <= 0.0f)) return 0;
+    if (below && m.type != MAT_DIELECTRIC && m.type != MAT_PRINCIPLED) return 0;
     float bsdf_pdf;
-    if (lobes) {
-        bsdf_pdf = phong_eval(*lobes, d, n_face, wi, &f);
-    } else {
-        f = v3_scale(albedo, K_INV_PI);
-        bsdf_pdf = cos_s * K_INV_PI;
-    }
+    vec3 f = bsdf_eval(m, albedo, d, n_face, front, wi, &bsdf_pdf);
+    if (below) cos_s = -cos_s;
     float w = ls.delta || mis_mode == MIS_LIGHT_ONLY ? 1.0f : mis_power(ls.pdf, bsdf_pdf);
     vec3 f_cos = v3_scale(f, cos_s * w / ls.pdf);
     ps->shadow_L = v3_mul(v3_mul(ps->throughput, f_cos), ls.Le);
@@ -65,7 +64,7 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
         shadow_resolve(ps, 0);
         return 0;
     }
-    *shadow_ray = light_shadow_ray(s.p, ng_face, ls);
+    *shadow_ray = light_shadow_ray(s.p, below ? v3_neg(ng_face) : ng_face, ls);
     return 1;
 }
 
@@ -87,6 +86,7 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
 
     Surface s = surface_at(sc, r, hit);
     Material m = sc->materials[s.material];
+    s.ns = material_normal(sc, m, s);
 
     if (!v3_is_zero(m.emission) && ((m.flags & MAT_TWO_SIDED) || v3_dot(r.d, s.ng) < 0.0f)) {
         /* emission reached by BSDF sampling is weighted against the light sampling that
@@ -107,32 +107,20 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     BsdfSample bs;
 
     vec3 albedo = material_albedo(sc, m, s, ng_face);
+    m = material_at(sc, m, s, ng_face);
 
-    if (m.type == MAT_DIFFUSE) {
-        if (p->n_lights > 0u && shade_light_sample(sc, ps, s, r.d, ns_face, ng_face, 0, albedo, shadow_ray))
-            result |= SHADE_SHADOW;
-        bs = bsdf_sample_diffuse(albedo, ns_face, rng_uniform(key, bounce, DIM_BSDF_U),
-                                 rng_uniform(key, bounce, DIM_BSDF_V));
-    } else if (m.type == MAT_PHONG) {
-        PhongLobes lobes = phong_lobes(m, albedo);
-        if (p->n_lights > 0u && lobes.p_glossy > 0.0f &&
-            shade_light_sample(sc, ps, s, r.d, ns_face, ng_face, &lobes, albedo, shadow_ray))
-            result |= SHADE_SHADOW;
-        bs = phong_sample(lobes, m, r.d, ns_face, ng_face, front, rng_uniform(key, bounce, DIM_BSDF_LOBE),
-                          rng_uniform(key, bounce, DIM_BSDF_U), rng_uniform(key, bounce, DIM_BSDF_V),
-                          rng_uniform(key, bounce, DIM_BSDF_W));
-    } else if (m.type == MAT_METAL) {
-        bs = bsdf_sample_metal(albedo, m.fuzz, r.d, ns_face, rng_uniform(key, bounce, DIM_BSDF_U),
-                               rng_uniform(key, bounce, DIM_BSDF_V), rng_uniform(key, bounce, DIM_BSDF_W));
-    } else {
-        bs = bsdf_sample_dielectric(m.ior, r.d, ng_face, front, rng_uniform(key, bounce, DIM_BSDF_LOBE));
-    }
+    if (p->n_lights > 0u && bsdf_has_density(m, albedo) &&
+        shade_light_sample(sc, ps, s, r.d, ns_face, ng_face, m, albedo, front, shadow_ray))
+        result |= SHADE_SHADOW;
+    bs = bsdf_sample(m, albedo, r.d, ns_face, ng_face, front, rng_uniform(key, bounce, DIM_BSDF_LOBE),
+                     rng_uniform(key, bounce, DIM_BSDF_U), rng_uniform(key, bounce, DIM_BSDF_V),
+                     rng_uniform(key, bounce, DIM_BSDF_W));
 
-    /* a reflected direction must leave on the incoming side, a refracted one on the
+    /* a reflected direction must leave on the incoming side, a transmitted one on the
      * other; anything else is a sample below the geometric surface and carries nothing */
     float side = v3_dot(bs.wi, ng_face);
-    int transmitted = (m.type == MAT_DIELECTRIC || m.type == MAT_PHONG) && bs.specular && side < 0.0f;
-    if (side == 0.0f || (side < 0.0f && !transmitted)) return result;
+    int transmitted = bs.transmitted;
+    if (side == 0.0f || (side < 0.0f) != (transmitted != 0)) return result;
 
     vec3 thr = v3_mul(ps->throughput, bs.weight);
     ps->bounce = bounce + 1u;

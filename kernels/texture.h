@@ -140,4 +140,79 @@ KFN vec3 material_albedo(const SceneView *sc, Material m, Surface s, vec3 ng_fac
     return m.texture == NO_INDEX ? m.albedo : texture_eval(sc, m.texture, s, ng_face);
 }
 
+/* dp/du and dp/dv at s, for tangent-space normal maps: a triangle's from its corners
+ * and (u, v) (barycentric (u, v) when it has none), a sphere's from its (u, v)
+ * parameterisation above. Returns 0 where there is none (boxes, planes) or the mapping
+ * is degenerate. */
+KFN int surface_tangents(const SceneView *sc, Surface s, vec3 *dpdu, vec3 *dpdv)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
+    if (s.prim < first_tri) {
+        /* u grows with atan2(x, z) about +y, v with y */
+        vec3 n = s.ng;
+        *dpdu = v3(n.z, 0.0f, -n.x);
+        *dpdv = v3_cross(n, *dpdu);
+        return v3_dot(*dpdu, *dpdu) > 0.0f;
+    }
+    if (s.prim >= first_box) return 0;
+    Triangle tr = sc->triangles[s.prim - first_tri];
+    float u1 = 1.0f, v1 = 0.0f, u2 = 0.0f, v2 = 1.0f;     /* barycentric: p1 at (1,0), p2 at (0,1) */
+    if (tr.shading != NO_INDEX) {
+        TriShading sh = sc->shading[tr.shading];
+        if (sh.flags & TRI_HAS_UV) {
+            u1 = sh.uv1[0] - sh.uv0[0];
+            v1 = sh.uv1[1] - sh.uv0[1];
+            u2 = sh.uv2[0] - sh.uv0[0];
+            v2 = sh.uv2[1] - sh.uv0[1];
+        }
+    }
+    float det = u1 * v2 - u2 * v1;
+    if (det == 0.0f) return 0;
+    vec3 e1 = v3_sub(tr.p1, tr.p0), e2 = v3_sub(tr.p2, tr.p0);
+    float inv = 1.0f / det;
+    *dpdu = v3_scale(v3_sub(v3_scale(e1, v2), v3_scale(e2, v1)), inv);
+    *dpdv = v3_scale(v3_sub(v3_scale(e2, u1), v3_scale(e1, u2)), inv);
+    return 1;
+}
+
+/* The shading normal at s after the material's normal map: the texel (r, g, b) read
+ * linearly is the tangent-space normal (2r - 1, 2g - 1, 2b - 1), x and y times
+ * normal_scale, x along dp/du and y along dp/dv made orthonormal to the shading normal
+ * (Gram-Schmidt; y keeps dp/dv's side, so mirrored uv layouts stay right). A result
+ * on the far side of the geometric normal, or a surface without tangents, keeps s.ns. */
+KFN vec3 material_normal(const SceneView *sc, Material m, Surface s)
+{
+    vec3 dpdu, dpdv;
+    if (m.type != MAT_PRINCIPLED || m.texture_normal == NO_INDEX || !surface_tangents(sc, s, &dpdu, &dpdv))
+        return s.ns;
+    vec3 n = s.ns;
+    vec3 t = v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu)));
+    float lt = v3_len(t);
+    if (!(lt > 0.0f)) return s.ns;
+    t = v3_scale(t, 1.0f / lt);
+    vec3 b = v3_cross(n, t);
+    if (v3_dot(b, dpdv) < 0.0f) b = v3_neg(b);
+    vec3 c = texture_eval(sc, m.texture_normal, s, s.ng);
+    vec3 tn = v3((2.0f * c.x - 1.0f) * m.normal_scale, (2.0f * c.y - 1.0f) * m.normal_scale, 2.0f * c.z - 1.0f);
+    vec3 r = v3_add(v3_add(v3_scale(t, tn.x), v3_scale(b, tn.y)), v3_scale(n, tn.z));
+    float lr = v3_len(r);
+    if (!(lr > 0.0f)) return s.ns;
+    r = v3_scale(r, 1.0f / lr);
+    return v3_dot(r, s.ng) > 0.0f ? r : s.ns;
+}
+
+/* The material with its textured parameters at s: a principled material's roughness
+ * and metallic factors times its metallic-roughness texture's G and B (glTF's packing;
+ * the texture is read as declared, so it should be `encoding linear`). */
+KFN Material material_at(const SceneView *sc, Material m, Surface s, vec3 ng_face)
+{
+    if (m.type == MAT_PRINCIPLED && m.texture_rm != NO_INDEX) {
+        vec3 t = texture_eval(sc, m.texture_rm, s, ng_face);
+        m.roughness *= t.y;
+        m.metallic *= t.z;
+    }
+    return m;
+}
+
 #endif /* CLPT_TEXTURE_H */

@@ -106,25 +106,44 @@ enum MaterialType {
     MAT_METAL = 1,       /* mirror reflection perturbed by fuzz, tinted by albedo */
     MAT_DIELECTRIC = 2,  /* smooth glass, Fresnel reflection/refraction, ior */
     MAT_EMISSIVE = 3,    /* emits `emission`, reflects nothing */
-    MAT_PHONG = 4        /* albedo = diffuse colour, specular, shininess, plus mirror
+    MAT_PHONG = 4,       /* albedo = diffuse colour, specular, shininess, plus mirror
                           * (`reflective`) and Fresnel-weighted see-through
                           * (`transparent`, ior) parts: the classic ray tracer's
                           * material (docs/classic-format.md) */
+    MAT_CONDUCTOR = 5,   /* GGX metal (kernels/microfacet.h): complex index eta + i k,
+                          * or Schlick from F0 = specular (MAT_F0); tinted by albedo;
+                          * roughness, anisotropy; smooth: a Fresnel mirror */
+    MAT_PRINCIPLED = 6   /* glTF metallic-roughness (kernels/principled.h): base colour
+                          * = albedo, metallic, roughness, transmission + ior (MAT_THIN),
+                          * clearcoat + clearcoat_roughness */
 };
+/* MAT_DIELECTRIC also reads roughness and anisotropy (GGX, Walter et al. 2007) and
+ * MAT_THIN. */
 
-typedef struct {                                        /* 96 bytes */
+typedef struct {                                        /* 144 bytes */
     uint type;                /* enum MaterialType */
     uint texture;             /* albedo texture index, NO_INDEX when none */
     float ior;
     float fuzz;
     vec3 albedo;    float shininess;
     vec3 emission;  uint flags;   /* MAT_* flags */
-    vec3 specular;  float pad0;
-    vec3 reflective;  float pad1; /* MAT_PHONG: perfect mirror part */
-    vec3 transparent; float pad2; /* MAT_PHONG: refracted part (split by Fresnel) */
+    vec3 specular;  float roughness;   /* perceptual: GGX alpha = roughness^2 */
+    vec3 reflective;  float anisotropy; /* MAT_PHONG: perfect mirror part */
+    vec3 transparent; float metallic;      /* MAT_PHONG: refracted part (split by Fresnel) */
+    vec3 eta;         float transmission;  /* MAT_CONDUCTOR: complex index of refraction ... */
+    vec3 k;           float clearcoat;     /* ... eta + i k per RGB channel */
+    float clearcoat_roughness;             /* MAT_PRINCIPLED, as roughness */
+    uint texture_rm;                       /* MAT_PRINCIPLED: glTF metallic-roughness
+                                            * texture (G roughness, B metallic), or
+                                            * NO_INDEX */
+    uint texture_normal;                   /* MAT_PRINCIPLED: tangent-space normal map
+                                            * (OpenGL/glTF: green = +v), or NO_INDEX */
+    float normal_scale;                    /* scales the map's x and y (glTF's scale) */
 } Material;
 
 #define MAT_TWO_SIDED 1u        /* emits from both sides of its surface */
+#define MAT_F0 2u               /* conductor: Schlick's Fresnel from F0 = specular */
+#define MAT_THIN 4u             /* dielectric: a thin sheet, no bend on refraction */
 
 /* Area lights are the emissive primitives; point, spot and directional lights are
  * delta lights (a single direction reaches a point: no MIS, hard shadows). */
@@ -272,7 +291,7 @@ CLPT_CHECK_SIZE(Triangle, 48);
 CLPT_CHECK_SIZE(TriShading, 64);
 CLPT_CHECK_SIZE(Box, 32);
 CLPT_CHECK_SIZE(Plane, 32);
-CLPT_CHECK_SIZE(Material, 96);
+CLPT_CHECK_SIZE(Material, 144);
 CLPT_CHECK_SIZE(Light, 80);
 CLPT_CHECK_SIZE(Camera, 112);
 CLPT_CHECK_SIZE(RenderParams, 272);
@@ -291,6 +310,11 @@ _Static_assert(offsetof(Texture, m) == 32, "Texture.m");
 _Static_assert(offsetof(Texture, color1) == 96, "Texture.color1");
 _Static_assert(offsetof(PathState, bsdf_pdf) == 48, "PathState.bsdf_pdf");
 _Static_assert(offsetof(Material, albedo) == 16, "Material.albedo");
+_Static_assert(offsetof(Material, roughness) == 60, "Material.roughness");
+_Static_assert(offsetof(Material, k) == 112, "Material.k");
+_Static_assert(offsetof(Material, clearcoat_roughness) == 128, "Material.clearcoat_roughness");
+_Static_assert(offsetof(Material, texture_rm) == 132, "Material.texture_rm");
+_Static_assert(offsetof(Material, normal_scale) == 140, "Material.normal_scale");
 _Static_assert(offsetof(Light, position) == 32, "Light.position");
 #undef CLPT_CHECK_SIZE
 #endif

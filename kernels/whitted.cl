@@ -155,6 +155,7 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, uint key, uint *rays)
         }
         Surface s = surface_at(sc, e.ray, hit);
         Material m = sc->materials[s.material];
+        s.ns = material_normal(sc, m, s);
         int front = v3_dot(d, s.ng) < 0.0f;
         vec3 ng = front ? s.ng : v3_neg(s.ng);
         vec3 ns = front ? s.ns : v3_neg(s.ns);
@@ -163,8 +164,21 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, uint key, uint *rays)
         if (m.type == MAT_EMISSIVE) continue;
 
         vec3 kd = material_albedo(sc, m, s, ng);
+        m = material_at(sc, m, s, ng);
         vec3 kr = v3s(0.0f), kt = v3s(0.0f);
-        if (m.type == MAT_DIFFUSE || m.type == MAT_PHONG) {
+        if (m.type == MAT_PRINCIPLED) {
+            /* the classic tracer's reading of glTF: the diffuse share lit directly, the
+             * specular as a mirror of the Schlick colour at this angle, transmission as
+             * smooth glass tinted by the base colour */
+            float c = k_clamp(-v3_dot(d, ns), 0.0f, 1.0f), fd = schlick1(0.04f, c);
+            float diel = 1.0f - k_clamp(m.metallic, 0.0f, 1.0f), t = k_clamp(m.transmission, 0.0f, 1.0f);
+            kr = v3_add(v3_scale(fresnel_schlick(kd, c), 1.0f - diel), v3s(diel * fd));
+            kt = v3_scale(kd, diel * (1.0f - fd) * t);
+            kd = v3_scale(kd, diel * (1.0f - fd) * (1.0f - t));
+            vec3 here = v3_add(v3_mul(p->ambient, kd),
+                               whitted_direct(sc, s, d, ns, ng, kd, v3s(0.0f), 0.0f, key, node, rays));
+            L = v3_add(L, v3_mul(e.weight, here));
+        } else if (m.type == MAT_DIFFUSE || m.type == MAT_PHONG) {
             vec3 ks = m.type == MAT_PHONG ? m.specular : v3s(0.0f);
             vec3 here = v3_add(v3_mul(p->ambient, kd),
                                 whitted_direct(sc, s, d, ns, ng, kd, ks, m.shininess, key, node, rays));
@@ -175,6 +189,10 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, uint key, uint *rays)
             }
         } else if (m.type == MAT_METAL) {
             kr = kd;
+        } else if (m.type == MAT_CONDUCTOR) {
+            /* the classic tracer has only mirrors: a rough conductor is its smooth one,
+             * coloured by its Fresnel reflectance at this angle */
+            kr = conductor_fresnel(bsdf_conductor(m, kd), k_clamp(-v3_dot(d, ns), 0.0f, 1.0f));
         } else {
             kt = v3s(1.0f);
         }
@@ -183,10 +201,17 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, uint key, uint *rays)
         /* the see-through part splits by Fresnel into more mirror and the refraction */
         vec3 t_dir = d;
         if (!v3_is_zero(kt)) {
-            float eta = front ? m.ior : 1.0f / m.ior;
+            int thin = (m.type == MAT_DIELECTRIC || m.type == MAT_PRINCIPLED) && (m.flags & MAT_THIN);
+            float eta = front || thin ? m.ior : 1.0f / m.ior;
             float F = fresnel_dielectric(k_clamp(-v3_dot(d, ns), 0.0f, 1.0f), eta);
-            int ok = refract_dir(d, ns, eta, &t_dir);
-            if (ok && v3_dot(t_dir, ng) >= 0.0f) ok = refract_dir(d, ng, eta, &t_dir);
+            int ok = 1;
+            if (thin) {
+                /* a thin sheet: both faces reflect, the rest goes straight on */
+                F = dielectric_facet_fresnel(bsdf_dielectric(m, front), k_clamp(-v3_dot(d, ns), 0.0f, 1.0f));
+            } else {
+                ok = refract_dir(d, ns, eta, &t_dir);
+                if (ok && v3_dot(t_dir, ng) >= 0.0f) ok = refract_dir(d, ng, eta, &t_dir);
+            }
             if (!ok) F = 1.0f;
             kr = v3_add(kr, v3_scale(kt, F));
             kt = v3_scale(kt, 1.0f - F);

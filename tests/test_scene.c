@@ -539,7 +539,7 @@ static void test_bad_materials_and_shapes(void)
                   ST_INPUT, want);
     }
     check_bad("material m { type plastic }", ST_INPUT,
-              ":1:19: expected a material type (diffuse, metal, dielectric, emissive, phong), found 'plastic'");
+              ":1:19: expected a material type (diffuse, metal, conductor, dielectric, principled, emissive, phong), found 'plastic'");
     check_bad("material m { albedo 1 1 1 }", ST_INPUT, ":1:1: the material block needs 'type' (it has no default)");
     check_bad("material m { type diffuse albedo 1 1 1 fuzz 0.5 }", ST_INPUT,
               ":1:40: expected a diffuse material key (type, albedo, emission, sides, texture) or '}', found 'fuzz'");

@@ -489,10 +489,13 @@ static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
 }
 
 enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE, MAT_KEY_EMISSION, MAT_KEY_SIDES,
-       MAT_KEY_SPECULAR, MAT_KEY_SHININESS, MAT_KEY_REFLECTIVE, MAT_KEY_TRANSPARENT, MAT_KEY_TEXTURE, MAT_KEY_N };
+       MAT_KEY_SPECULAR, MAT_KEY_SHININESS, MAT_KEY_REFLECTIVE, MAT_KEY_TRANSPARENT, MAT_KEY_TEXTURE,
+       MAT_KEY_ROUGHNESS, MAT_KEY_ANISOTROPY, MAT_KEY_ETA, MAT_KEY_K, MAT_KEY_METAL, MAT_KEY_THIN,
+       MAT_KEY_METALLIC, MAT_KEY_TRANSMISSION, MAT_KEY_CLEARCOAT, MAT_KEY_CLEARCOAT_ROUGHNESS, MAT_KEY_STRENGTH,
+       MAT_KEY_METALLIC_ROUGHNESS, MAT_KEY_NORMAL_MAP, MAT_KEY_NORMAL_SCALE, MAT_KEY_N };
 static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0,
-                      "a material type (diffuse, metal, dielectric, emissive, phong)"},
+                      "a material type (diffuse, metal, conductor, dielectric, principled, emissive, phong)"},
     [MAT_KEY_ALBEDO] = {"albedo", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_FUZZ] = {"fuzz", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
     [MAT_KEY_IOR] = {"ior", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
@@ -504,6 +507,20 @@ static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_REFLECTIVE] = {"reflective", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_TRANSPARENT] = {"transparent", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_TEXTURE] = {"texture", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_ROUGHNESS] = {"roughness", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_ANISOTROPY] = {"anisotropy", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_ETA] = {"eta", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_K] = {"k", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_METAL] = {"metal", VK_WORD, 0, 0, 0, 0, 0, "a metal (Ag, Al, Au, Cr, Cu, Ni)"},
+    [MAT_KEY_THIN] = {"thin", VK_WORD, 0, 0, 0, 0, 0, "on or off"},
+    [MAT_KEY_METALLIC] = {"metallic", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_TRANSMISSION] = {"transmission", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_CLEARCOAT] = {"clearcoat", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_CLEARCOAT_ROUGHNESS] = {"clearcoat_roughness", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_STRENGTH] = {"strength", VK_NUMBER, 0, 0, 1e6, 0, 0, "a number in [0, 1e6]"},
+    [MAT_KEY_METALLIC_ROUGHNESS] = {"metallic_roughness", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_NORMAL_MAP] = {"normal_map", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_NORMAL_SCALE] = {"normal_scale", VK_NUMBER, 0, 0, 100, 0, 0, "a number in [0, 100]"},
 };
 
 /* Which keys each material type takes (bit i = material_keys[i]), and which it needs. */
@@ -519,7 +536,20 @@ static const struct {
      1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_FUZZ | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES |
      1u << MAT_KEY_TEXTURE,
      1u << MAT_KEY_ALBEDO},
-    {"dielectric", MAT_DIELECTRIC, 1u << MAT_KEY_IOR | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES, 0},
+    {"conductor", MAT_CONDUCTOR,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_TEXTURE | 1u << MAT_KEY_ETA | 1u << MAT_KEY_K | 1u << MAT_KEY_METAL |
+     1u << MAT_KEY_SPECULAR | 1u << MAT_KEY_ROUGHNESS | 1u << MAT_KEY_ANISOTROPY | 1u << MAT_KEY_EMISSION |
+     1u << MAT_KEY_SIDES,
+     0},
+    {"dielectric", MAT_DIELECTRIC,
+     1u << MAT_KEY_IOR | 1u << MAT_KEY_ROUGHNESS | 1u << MAT_KEY_ANISOTROPY | 1u << MAT_KEY_THIN |
+     1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES, 0},
+    {"principled", MAT_PRINCIPLED,
+     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_TEXTURE | 1u << MAT_KEY_METALLIC | 1u << MAT_KEY_ROUGHNESS |
+     1u << MAT_KEY_ANISOTROPY | 1u << MAT_KEY_TRANSMISSION | 1u << MAT_KEY_IOR | 1u << MAT_KEY_THIN |
+     1u << MAT_KEY_CLEARCOAT | 1u << MAT_KEY_CLEARCOAT_ROUGHNESS | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_STRENGTH |
+     1u << MAT_KEY_METALLIC_ROUGHNESS | 1u << MAT_KEY_NORMAL_MAP | 1u << MAT_KEY_NORMAL_SCALE | 1u << MAT_KEY_SIDES,
+     0},
     {"emissive", MAT_EMISSIVE, 1u << MAT_KEY_RADIANCE | 1u << MAT_KEY_SIDES, 1u << MAT_KEY_RADIANCE},
     {"phong", MAT_PHONG,
      1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_SPECULAR | 1u << MAT_KEY_SHININESS | 1u << MAT_KEY_REFLECTIVE |
@@ -528,6 +558,32 @@ static const struct {
      1u << MAT_KEY_ALBEDO},
 };
 #define N_MATERIAL_TYPES (sizeof material_types / sizeof material_types[0])
+
+/* A conductor's Fresnel term: exactly one of a preset (`metal`), a complex index (`eta`
+ * with `k`) or an artist's reflectance at normal incidence (`specular`). */
+static Status parse_conductor(Parser *p, Lexer *lx, const Token *kw, const Value *v, Material *m)
+{
+    int n = v[MAT_KEY_METAL].given + (v[MAT_KEY_ETA].given || v[MAT_KEY_K].given) + v[MAT_KEY_SPECULAR].given;
+    if (n != 1)
+        return lex_error_at(lx, kw, p->err,
+                            "a conductor needs exactly one of 'metal', 'eta' and 'k', or 'specular'");
+    if (v[MAT_KEY_ETA].given != v[MAT_KEY_K].given)
+        return lex_error_at(lx, v[MAT_KEY_ETA].given ? &v[MAT_KEY_ETA].key : &v[MAT_KEY_K].key, p->err,
+                            "a conductor's 'eta' needs its 'k' (the complex index eta + i k)");
+    if (v[MAT_KEY_SPECULAR].given) {
+        *m = material_conductor_f0(v[MAT_KEY_SPECULAR].v, 0.0f);
+    } else if (v[MAT_KEY_METAL].given) {
+        const Token *w = &v[MAT_KEY_METAL].word;
+        vec3 eta, k;
+        if (!material_metal_preset(w->text, w->len, &eta, &k))
+            return lex_expected(lx, w, material_keys[MAT_KEY_METAL].what, p->err);
+        *m = material_conductor(eta, k, 0.0f);
+    } else {
+        *m = material_conductor(v[MAT_KEY_ETA].v, v[MAT_KEY_K].v, 0.0f);
+    }
+    if (v[MAT_KEY_ALBEDO].given) m->albedo = v[MAT_KEY_ALBEDO].v;
+    return ST_OK;
+}
 
 /* Reads a material's `{ ... }`; a NULL name makes an anonymous (inline) material. */
 static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
@@ -544,7 +600,7 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
     unsigned allowed = material_types[ti].allowed | 1u << MAT_KEY_TYPE;
     for (int i = 0; i < MAT_KEY_N; i++) {
         if (!v[i].given || (allowed & (1u << i))) continue;
-        char what[160];
+        char what[256];
         size_t o = (size_t)snprintf(what, sizeof what, "a %s material key (type",
                                     material_types[ti].name);
         for (int j = 1; j < MAT_KEY_N; j++)
@@ -559,11 +615,26 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
                                 material_types[ti].name, material_keys[i].key);
     Material m;
     switch (material_types[ti].type) {
+    case MAT_CONDUCTOR:
+        if ((st = parse_conductor(p, lx, kw, v, &m))) return st;
+        break;
     case MAT_METAL:
         m = material_metal(v[MAT_KEY_ALBEDO].v, v[MAT_KEY_FUZZ].given ? v[MAT_KEY_FUZZ].f : 0.0f);
         break;
     case MAT_DIELECTRIC:
         m = material_dielectric(v[MAT_KEY_IOR].given ? v[MAT_KEY_IOR].f : 1.5f);
+        break;
+    case MAT_PRINCIPLED:
+        m = material_principled(v[MAT_KEY_ALBEDO].given ? v[MAT_KEY_ALBEDO].v : v3s(1.0f),
+                                v[MAT_KEY_METALLIC].given ? v[MAT_KEY_METALLIC].f : 1.0f,
+                                v[MAT_KEY_ROUGHNESS].given ? v[MAT_KEY_ROUGHNESS].f : 1.0f);
+        if (v[MAT_KEY_TRANSMISSION].given) m.transmission = v[MAT_KEY_TRANSMISSION].f;
+        if (v[MAT_KEY_IOR].given) m.ior = v[MAT_KEY_IOR].f;
+        if (v[MAT_KEY_CLEARCOAT].given) m.clearcoat = v[MAT_KEY_CLEARCOAT].f;
+        if (v[MAT_KEY_CLEARCOAT_ROUGHNESS].given) m.clearcoat_roughness = v[MAT_KEY_CLEARCOAT_ROUGHNESS].f;
+        if (v[MAT_KEY_METALLIC_ROUGHNESS].given) m.texture_rm = (uint)v[MAT_KEY_METALLIC_ROUGHNESS].u;
+        if (v[MAT_KEY_NORMAL_MAP].given) m.texture_normal = (uint)v[MAT_KEY_NORMAL_MAP].u;
+        if (v[MAT_KEY_NORMAL_SCALE].given) m.normal_scale = v[MAT_KEY_NORMAL_SCALE].f;
         break;
     case MAT_EMISSIVE:
         m = material_emissive(v[MAT_KEY_RADIANCE].v);
@@ -579,10 +650,20 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
         m = material_diffuse(v[MAT_KEY_ALBEDO].v);
         break;
     }
-    /* a surface that both reflects and glows (the furnace test's sphere) */
+    if (v[MAT_KEY_THIN].given) {
+        const Token *w = &v[MAT_KEY_THIN].word;
+        if (!tok_is(w, "on") && !tok_is(w, "off"))
+            return lex_expected(lx, w, material_keys[MAT_KEY_THIN].what, p->err);
+        if (tok_is(w, "on")) m.flags |= MAT_THIN;
+    }
+    /* a surface that both reflects and glows (the furnace test's sphere); glTF's
+     * emissive factor times KHR_materials_emissive_strength */
     if (v[MAT_KEY_EMISSION].given) m.emission = v[MAT_KEY_EMISSION].v;
+    if (v[MAT_KEY_STRENGTH].given) m.emission = v3_scale(m.emission, v[MAT_KEY_STRENGTH].f);
     if (v[MAT_KEY_SIDES].given && v[MAT_KEY_SIDES].u == 2) m.flags |= MAT_TWO_SIDED;
     if (v[MAT_KEY_TEXTURE].given) m.texture = (uint)v[MAT_KEY_TEXTURE].u;
+    if (v[MAT_KEY_ROUGHNESS].given) m.roughness = v[MAT_KEY_ROUGHNESS].f;
+    if (v[MAT_KEY_ANISOTROPY].given) m.anisotropy = v[MAT_KEY_ANISOTROPY].f;
     /* inline materials get the empty name, which no named material can have, so a
      * lookup never finds them */
     if ((st = scene_add_material(p->s, name ? name : "", m, index, p->err))) return st;

@@ -323,6 +323,9 @@ static Material material_base(uint type)
     memset(&m, 0, sizeof m);
     m.type = type;
     m.texture = NO_INDEX;
+    m.texture_rm = NO_INDEX;
+    m.texture_normal = NO_INDEX;
+    m.normal_scale = 1.0f;
     m.ior = 1.5f;
     return m;
 }
@@ -348,6 +351,60 @@ Material material_dielectric(float ior)
     m.albedo = v3s(1.0f);
     m.ior = ior;
     return m;
+}
+
+Material material_conductor(vec3 eta, vec3 k, float roughness)
+{
+    Material m = material_base(MAT_CONDUCTOR);
+    m.albedo = v3s(1.0f);
+    m.eta = eta;
+    m.k = k;
+    m.roughness = roughness;
+    return m;
+}
+
+Material material_conductor_f0(vec3 f0, float roughness)
+{
+    Material m = material_conductor(v3s(1.0f), v3s(0.0f), roughness);
+    m.specular = f0;
+    m.flags |= MAT_F0;
+    return m;
+}
+
+Material material_principled(vec3 base, float metallic, float roughness)
+{
+    Material m = material_base(MAT_PRINCIPLED);
+    m.albedo = base;
+    m.metallic = metallic;
+    m.roughness = roughness;
+    return m;
+}
+
+/* Measured spectra interpolated at 650, 550 and 450 nm for R, G and B: Ag, Al, Au, Cu
+ * from pbrt-v4 (src/pbrt/util/spectrum.cpp, after refractiveindex.info), Cr and Ni from
+ * Mitsuba 0.6 (data/ior/Cr.*.spd, Ni_palik.*.spd: the luxpop database, Palik's
+ * Handbook of Optical Constants of Solids). */
+static const struct {
+    const char *name;
+    float eta[3], k[3];
+} metal_presets[] = {
+    {"Ag", {0.1394f, 0.1248f, 0.1517f}, {4.1288f, 3.3396f, 2.4704f}},
+    {"Al", {1.4748f, 0.9586f, 0.6180f}, {7.7941f, 6.6870f, 5.4694f}},
+    {"Au", {0.1678f, 0.3504f, 1.5085f}, {3.1378f, 2.7141f, 1.8788f}},
+    {"Cr", {3.6375f, 3.1158f, 1.9277f}, {4.3644f, 4.4228f, 4.1675f}},
+    {"Cu", {0.2166f, 0.9582f, 1.1658f}, {3.6377f, 2.5771f, 2.3939f}},
+    {"Ni", {2.0140f, 1.7724f, 1.6288f}, {3.8079f, 3.2526f, 2.6540f}},
+};
+
+int material_metal_preset(const char *name, size_t len, vec3 *eta, vec3 *k)
+{
+    for (size_t i = 0; i < sizeof metal_presets / sizeof metal_presets[0]; i++) {
+        if (strlen(metal_presets[i].name) != len || memcmp(metal_presets[i].name, name, len) != 0) continue;
+        *eta = v3(metal_presets[i].eta[0], metal_presets[i].eta[1], metal_presets[i].eta[2]);
+        *k = v3(metal_presets[i].k[0], metal_presets[i].k[1], metal_presets[i].k[2]);
+        return 1;
+    }
+    return 0;
 }
 
 Material material_emissive(vec3 radiance)

@@ -154,6 +154,16 @@ Material material_diffuse(vec3 albedo);
 Material material_metal(vec3 albedo, float fuzz);
 Material material_dielectric(float ior);
 Material material_emissive(vec3 radiance);
+/* A GGX conductor of complex index eta + i k per channel (tint 1, isotropic). */
+Material material_conductor(vec3 eta, vec3 k, float roughness);
+/* A GGX conductor with Schlick's Fresnel from the reflectance at normal incidence f0. */
+Material material_conductor_f0(vec3 f0, float roughness);
+/* A glTF metallic-roughness material (base colour, metallic, roughness; no
+ * transmission or clearcoat, ior 1.5), the glTF defaults being 1 1 1, 1, 1. */
+Material material_principled(vec3 base, float metallic, float roughness);
+/* The complex index of a named metal (Ag, Al, Au, Cr, Cu, Ni; docs/scene-format.md gives the
+ * source), the name `len` bytes long. Returns 0 when the name is none of them. */
+int material_metal_preset(const char *name, size_t len, vec3 *eta, vec3 *k);
 /* The classic Phong material: diffuse colour, specular colour and shininess, no mirror
  * or transparent part, index of refraction 1. */
 Material material_phong(vec3 diffuse, vec3 specular, float shininess);

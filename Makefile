@@ -86,8 +86,10 @@ $(BUILD)/host/device/device_scalar.o: FILE_WARN := $(KERNEL_C_WARN)
 $(BUILD)/lib$(PROG).a: $(HOST_OBJ)
 	rm -f $@ && ar rcs $@ $^
 
+# Only the program links SDL2 (the viewer, --interactive); the tests and benchmarks use
+# the library without it.
 $(BUILD)/$(PROG): $(BUILD)/host/main.o $(BUILD)/lib$(PROG).a
-	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS) -lSDL2
 
 $(BUILD)/tests/%: tests/%.c tests/harness.h $(BUILD)/lib$(PROG).a
 	@mkdir -p $(@D)

@@ -31,6 +31,7 @@
 #include "render/schedule.h"
 #include "io/scene_load.h"
 #include "base/timer.h"
+#include "viewer.h"
 
 #define CLPT_VERSION "0.1.0"
 
@@ -707,6 +708,26 @@ static Status results_write(Run *r, Error *err)
     return st;
 }
 
+/* --interactive: the display first (without one, nothing slow is done), then the scene
+ * and the devices as for a render, then the window (viewer.h) instead of the render. */
+static Status run_interactive(Run *r, Error *err)
+{
+    Status st = viewer_open_display(err);
+    if (st != ST_OK) return st;
+    st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
+    if (st == ST_OK) st = scene_apply_options(r, err);
+    if (st == ST_OK) st = render_prepare(r, err);
+    if (st == ST_OK) st = open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
+    if (st == ST_OK) {
+        ViewerConfig vc = { r->o.scene_path, &r->scene, &r->rs, r->devs, r->n_devs, r->encoding,
+                            r->o.batch, r->o.stats, r->o.quiet };
+        st = viewer_run(&vc, err);
+    }
+    run_free(r);
+    viewer_close_display();
+    return st;
+}
+
 static Status run(int argc, char **argv, Error *err)
 {
     Run r;
@@ -718,6 +739,7 @@ static Status run(int argc, char **argv, Error *err)
     if (st == ST_OK) st = run_info_command(&r.o, &done, err);
     if (st != ST_OK || done) return st;
 
+    if (r.o.interactive) return run_interactive(&r, err);
     st = outputs_choose(&r, err);
     if (st == ST_OK) st = outputs_check(&r, err);
     if (st == ST_OK) st = load_scene_input(&r.o, &r.scene, &r.bare_mesh, err);

@@ -102,6 +102,19 @@ void options_print_help(FILE *f)
 "\n",
         f);
     fputs(
+"Interactive viewer (docs/viewer.md):\n"
+"  -i, --interactive          show SCENE in a window and render it\n"
+"                             progressively while the camera moves (needs a\n"
+"                             display: else exit status 5). Keys: W/A/S/D\n"
+"                             move, R/F or E/Q up/down, drag the mouse to\n"
+"                             look, wheel forward/back, Z/X field of view,\n"
+"                             Up/Down focus distance, Right/Left aperture,\n"
+"                             +/- exposure, Space pause, C save the image\n"
+"                             (SCENE-view-NNN.png and .pfm, never over an\n"
+"                             earlier save), P print the camera as a scene\n"
+"                             block, H help, F11 full screen, Esc quit.\n"
+"                             Renders up to --spp (the scene's spp) samples\n"
+"\n"
 "Devices:\n"
 "      --list-devices         print every OpenCL platform and device, and the\n"
 "                             scalar device, with their indices, then exit\n"
@@ -250,7 +263,7 @@ static int options_set_switch(const char *a, Options *o)
     struct { const char *name, *alias; int *dst; } switches[] = {
         { "--help", "-h", &o->help },      { "--version", NULL, &o->version },
         { "--list-devices", NULL, &o->list_devices }, { "--stats", NULL, &o->stats },
-        { "--quiet", "-q", &o->quiet },
+        { "--quiet", "-q", &o->quiet },    { "--interactive", "-i", &o->interactive },
     };
     for (size_t k = 0; k < sizeof switches / sizeof switches[0]; k++)
         if (strcmp(a, switches[k].name) == 0 || (switches[k].alias && strcmp(a, switches[k].alias) == 0)) {
@@ -404,6 +417,20 @@ static Status options_parse_arg(int argc, char **argv, int *i, Options *o, Error
     return ST_OK;
 }
 
+/* The viewer writes no output file of its own (C saves frames) and renders until it is
+ * closed: the flags that shape a batch render's files and its end do not apply. */
+static Status options_check_interactive(const Options *o, Error *err)
+{
+    if (!o->interactive) return ST_OK;
+    const char *flag = o->output ? "--output" : o->checkpoint_path ? (o->resume_path ? "--resume" : "--checkpoint")
+                     : o->time_limit > 0.0 ? "--time-limit" : o->progressive_seconds > 0.0 ? "--progressive-output"
+                     : o->aovs ? "--aov" : o->adaptive > 0.0 ? "--adaptive" : NULL;
+    if (flag)
+        return error_set(err, ST_USAGE, "--interactive cannot be combined with %s (the viewer saves frames "
+                                        "with the C key; see docs/viewer.md)", flag);
+    return ST_OK;
+}
+
 /* What depends on several flags. */
 static Status options_finish(Options *o, Error *err)
 {
@@ -413,7 +440,7 @@ static Status options_finish(Options *o, Error *err)
     if (o->checkpoint_seconds <= 0.0) o->checkpoint_seconds = 60.0;
     if (!o->scene_path && !o->help && !o->version && !o->list_devices)
         return error_set(err, ST_USAGE, "no scene given (usage: clpt [options] SCENE; see --help)");
-    return ST_OK;
+    return options_check_interactive(o, err);
 }
 
 Status options_parse(int argc, char **argv, Options *o, Error *err)

@@ -1,0 +1,80 @@
+/*
+ * viewer_render.h — the viewer's render thread: renders the current view progressively
+ * with the batch scheduler (render/schedule.h) on the devices the program opened, and
+ * publishes each step as a resolved image for the window to show.
+ *
+ * Why a thread of its own: a batch of even one sample per pixel takes about 0.1 s for
+ * the Cornell box at 512 x 512 on two cores, and much longer for big meshes; the window
+ * must take input at 30+ frames per second meanwhile. So the window's thread only
+ * handles events and draws, and this thread runs schedule_run in passes. A camera
+ * change raises the scheduler's stop flag, which cancels the batches of the old view
+ * within milliseconds (ScheduleConfig.poll_seconds; devices drop a cancelled batch
+ * whole), and the next pass renders the new view from sample 0.
+ *
+ * Passes: the film of a view holds samples [0, n) after each pass, n = 1, 2, 4, 8, ...
+ * up to the cap (the scene's spp), each pass a schedule_run resumed from the ranges the
+ * film holds (ScheduleConfig.done). Between passes the film is exactly a command-line
+ * render of n samples; during a pass the scheduler's ticks publish what is finished.
+ * Pausing cancels the pass; the film keeps its whole batches and the next pass renders
+ * only the others.
+ */
+#ifndef CLPT_VIEWER_RENDER_H
+#define CLPT_VIEWER_RENDER_H
+
+#include <pthread.h>
+#include <signal.h>
+#include <stdint.h>
+
+#include "render/batch_queue.h"
+#include "render/film.h"
+#include "render/schedule.h"
+#include "scene/scene.h"
+
+typedef struct {
+    /* set by viewer_render_start, then read-only */
+    Device **devices;
+    size_t n_devices;
+    RenderParams params;          /* the scene's; the camera is replaced per view */
+    uint spp_cap;
+    uint fixed_batch;             /* --batch (tests); 0: adaptive */
+    pthread_t thread;
+    int started;
+    pthread_mutex_t lock;
+    pthread_cond_t wake;
+
+    /* requests, under lock */
+    SceneCamera camera;
+    unsigned gen;                 /* incremented by each camera change */
+    int paused, quit;
+    volatile sig_atomic_t stop;   /* the running pass's stop flag */
+
+    /* the published frame, under lock */
+    float *rgb;                   /* width * height * 3 linear, top row first */
+    uint64_t samples;             /* per pixel in rgb */
+    unsigned frame_gen;           /* the view it shows */
+    int frame_prefix;             /* it holds samples [0, samples) exactly */
+    unsigned frame_seq;           /* incremented by each publication */
+    double view_samples, view_seconds;   /* rendered for this view, for Msamples/s */
+    Status failure;               /* ST_OK, or why rendering stopped for good */
+    char failure_msg[1024];
+
+    /* the render thread's own */
+    Film film;
+    BatchSet done;
+    float *spare;                 /* the next frame, swapped with rgb when published */
+    unsigned my_gen;
+    int view_ok;                  /* the current view's camera could be set up */
+} ViewerRender;
+
+/* Starts rendering view `camera` with the scene prepared in `params` (its size, seed,
+ * integrator) on the opened devices, up to `spp_cap` samples per pixel. */
+Status viewer_render_start(ViewerRender *vr, Device **devices, size_t n, const RenderParams *params,
+                           const SceneCamera *camera, uint spp_cap, uint fixed_batch, Error *err);
+/* A new view: the old one's batches are cancelled and accumulation restarts at 0. */
+void viewer_render_set_camera(ViewerRender *vr, const SceneCamera *camera);
+void viewer_render_set_paused(ViewerRender *vr, int paused);
+/* Stops the thread and frees everything; returns the rendering failure, if any (its
+ * message in err). */
+Status viewer_render_stop(ViewerRender *vr, Error *err);
+
+#endif /* CLPT_VIEWER_RENDER_H */

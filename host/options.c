@@ -149,7 +149,7 @@ void options_print_help(FILE *f)
 "  0  success                 4  I/O error (a file could not be read or\n"
 "  1  internal error             written, or standard output failed)\n"
 "  2  usage error             5  device error (no usable device, or every\n"
-"  3  input error (bad scene,    device failed)\n"
+"  3  input error (bad scene,    device failed; --interactive: no display)\n"
 "     mesh or checkpoint      6  interrupted (SIGINT/SIGTERM): what was\n"
 "     file, or a checkpoint      finished was written\n"
 "     of another render)      7  nothing rendered: --time-limit ran out before\n"

@@ -164,7 +164,8 @@ static void title_update(Viewer *v)
     const char *base = strrchr(v->cfg->scene_path, '/');
     uint64_t spp = v->shown_gen == v->gen ? v->shown_samples : 0;
     snprintf(title, sizeof title, "clpt | %s | %llu/%u spp%s | %.2f Msamples/s | %s%s%s | H: help", base ? base + 1 : v->cfg->scene_path,
-             (unsigned long long)spp, v->vr.spp_cap, spp >= v->vr.spp_cap ? " (done)" : "", msps, v->devices,
+             (unsigned long long)spp, v->vr.spp_cap,
+             spp >= v->vr.spp_cap ? " (done)" : (v->shown_gen == v->gen && v->shown_seq && !spp ? " (preview)" : ""), msps, v->devices,
              v->paused ? " | paused" : "", failed);
     if (v->exposure != 0.0) {
         size_t len = strlen(title);
@@ -467,7 +468,7 @@ Status viewer_run(const ViewerConfig *cfg, Error *err)
     if (!v->pixels || !v->save_rgb) st = error_set(err, ST_INTERNAL, "out of memory for the viewer's images");
     if (st == ST_OK) st = window_open(v, err);
     if (st == ST_OK)
-        st = viewer_render_start(&v->vr, cfg->devices, cfg->n_devices, &cfg->rs->ds.params, &v->cam,
+        st = viewer_render_start(&v->vr, cfg->devices, cfg->n_devices, &cfg->rs->ds, &cfg->device_config, &v->cam,
                                  cfg->scene->image.spp, cfg->fixed_batch, err);
     if (st == ST_OK) {
         if (!cfg->quiet)

@@ -20,6 +20,7 @@ typedef struct {
     const RenderScene *rs;        /* params as prepared for the command line */
     Device **devices;
     size_t n_devices;
+    DeviceConfig device_config;   /* as the devices were opened (previews open them again) */
     ImageEncoding encoding;       /* of the PNG saves, as the command line's */
     uint fixed_batch;             /* --batch */
     int stats;                    /* --stats: timings on stdout at the end */

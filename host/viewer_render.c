@@ -1,6 +1,7 @@
 /* viewer_render.c — see viewer_render.h. */
 #include "viewer_render.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,6 +12,9 @@
  * stop flag (a camera change). */
 #define VIEWER_TICK_SECONDS 0.1
 #define VIEWER_POLL_SECONDS 0.005
+/* What a preview should take, in seconds, and its largest reduction. */
+#define PREVIEW_SECONDS 0.025
+#define PREVIEW_MAX_FACTOR 16u
 
 static size_t frame_floats(const ViewerRender *vr)
 {
@@ -90,6 +94,7 @@ static void view_begin(ViewerRender *vr, const SceneCamera *camera)
  * the pass is cancelled). */
 static void pass_run(ViewerRender *vr, uint target)
 {
+    int first = vr->film.samples == 0 && target == 1;
     ScheduleConfig cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.spp = target;
@@ -115,6 +120,7 @@ static void pass_run(ViewerRender *vr, uint target)
     if (st != ST_OK) {
         set_failure(vr, st, err.msg);
     } else if (current) {
+        if (first && !stats.interrupted) vr->one_spp_seconds = stats.seconds;
         batch_set_free(&vr->done);
         vr->done = stats.done;   /* the ranges the film holds now */
         memset(&stats.done, 0, sizeof stats.done);
@@ -133,6 +139,108 @@ static uint pass_target(const ViewerRender *vr)
     return next > vr->spp_cap ? vr->spp_cap : (uint)next;
 }
 
+/* Opens the preview's devices: each device of the render opened again, with the scene
+ * at 1/factor of the size. On failure previews are left off, with a warning. */
+static void preview_open(ViewerRender *vr)
+{
+    double k = ceil(sqrt(vr->one_spp_seconds / PREVIEW_SECONDS));
+    vr->preview_factor = k < 2.0 ? 2u : (k > PREVIEW_MAX_FACTOR ? PREVIEW_MAX_FACTOR : (uint)k);
+    DeviceScene small = *vr->scene;
+    small.params.width = (vr->params.width + vr->preview_factor - 1) / vr->preview_factor;
+    small.params.height = (vr->params.height + vr->preview_factor - 1) / vr->preview_factor;
+    small.pixel_mask = NULL;
+    small.params.use_mask = 0;
+    vr->preview_params = small.params;
+    Error err = { 0 };
+    vr->preview_state = -1;
+    vr->preview_devices = calloc(vr->n_devices, sizeof *vr->preview_devices);
+    Status st = vr->preview_devices ? ST_OK : error_set(&err, ST_INTERNAL, "out of memory");
+    if (st == ST_OK) st = film_init(&vr->preview_film, small.params.width, small.params.height, &err);
+    if (st == ST_OK && !(vr->preview_rgb = calloc((size_t)small.params.width * small.params.height * 3u,
+                                                  sizeof *vr->preview_rgb)))
+        st = error_set(&err, ST_INTERNAL, "out of memory");
+    for (size_t i = 0; st == ST_OK && i < vr->n_devices; i++) {
+        Device *d = NULL;
+        st = device_open(&vr->devices[i]->desc, &vr->device_config, &d, &err);
+        if (st == ST_OK) st = d->ops->load_scene(d, &small, &err);
+        if (st == ST_OK) vr->preview_devices[vr->n_preview++] = d;
+        else device_close(d);
+    }
+    if (st == ST_OK) {
+        vr->preview_state = 1;
+        return;
+    }
+    fprintf(stderr, "clpt: warning: no previews (the devices could not be opened a second time: %s)\n", err.msg);
+    error_clear(&err);
+}
+
+static void preview_close(ViewerRender *vr)
+{
+    for (size_t i = 0; i < vr->n_preview; i++) device_close(vr->preview_devices[i]);
+    free(vr->preview_devices);
+    vr->preview_devices = NULL;
+    vr->n_preview = 0;
+    film_free(&vr->preview_film);
+    free(vr->preview_rgb);
+    vr->preview_rgb = NULL;
+}
+
+/* The small image, each of its pixels shown as a factor x factor block. Not a sample
+ * of the view's film (frame_prefix 0: never saved). */
+static void preview_publish(ViewerRender *vr)
+{
+    uint w = vr->params.width, h = vr->params.height, pw = vr->preview_params.width;
+    film_resolve(&vr->preview_film, vr->preview_rgb);
+    for (uint y = 0; y < h; y++)
+        for (uint x = 0; x < w; x++)
+            memcpy(&vr->spare[((size_t)y * w + x) * 3u],
+                   &vr->preview_rgb[((size_t)(y / vr->preview_factor) * pw + x / vr->preview_factor) * 3u],
+                   3 * sizeof *vr->spare);
+    pthread_mutex_lock(&vr->lock);
+    if (vr->gen == vr->my_gen) {
+        float *t = vr->rgb;
+        vr->rgb = vr->spare;
+        vr->spare = t;
+        vr->samples = 0;
+        vr->frame_gen = vr->my_gen;
+        vr->frame_prefix = 0;
+        vr->frame_seq++;
+    }
+    pthread_mutex_unlock(&vr->lock);
+}
+
+/* The new view at 1 spp in the small image, shown at once; a camera change meanwhile
+ * cancels it like a pass. */
+static void preview_run(ViewerRender *vr)
+{
+    Error err = { 0 };
+    vr->preview_params.camera = vr->params.camera;
+    Status st = camera_setup(&vr->camera_shown, vr->preview_params.width, vr->preview_params.height,
+                             &vr->preview_params.camera, &err);
+    for (size_t i = 0; st == ST_OK && i < vr->n_preview; i++)
+        st = vr->preview_devices[i]->ops->update_params(vr->preview_devices[i], &vr->preview_params, NULL, &err);
+    ScheduleConfig cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.spp = 1;
+    cfg.stop = &vr->stop;
+    cfg.poll_seconds = VIEWER_POLL_SECONDS;
+    cfg.on_warning = on_warning;
+    ScheduleStats stats;
+    memset(&stats, 0, sizeof stats);
+    memset(vr->preview_film.sum, 0,
+           (size_t)vr->preview_params.width * vr->preview_params.height * 3u * sizeof *vr->preview_film.sum);
+    vr->preview_film.samples = 0;
+    if (st == ST_OK) st = schedule_run(vr->preview_devices, vr->n_preview, &cfg, &vr->preview_film, &stats, &err);
+    if (st == ST_OK && !stats.interrupted && vr->preview_film.samples == 1) preview_publish(vr);
+    if (st != ST_OK) {
+        fprintf(stderr, "clpt: warning: previews stopped: %s\n", err.msg);
+        preview_close(vr);
+        vr->preview_state = -1;
+    }
+    error_clear(&err);
+    schedule_stats_free(&stats);
+}
+
 static void *render_main(void *arg)
 {
     ViewerRender *vr = arg;
@@ -142,8 +250,11 @@ static void *render_main(void *arg)
         if (vr->gen != vr->my_gen) {
             SceneCamera cam = vr->camera;
             vr->my_gen = vr->gen;
+            vr->stop = 0;
             pthread_mutex_unlock(&vr->lock);
+            vr->camera_shown = cam;
             view_begin(vr, &cam);
+            if (vr->view_ok && vr->preview_state == 1) preview_run(vr);
             pthread_mutex_lock(&vr->lock);
             continue;
         }
@@ -154,18 +265,23 @@ static void *render_main(void *arg)
         vr->stop = 0;   /* under the lock: a change made after this cancels the pass */
         pthread_mutex_unlock(&vr->lock);
         pass_run(vr, pass_target(vr));
+        if (vr->preview_state == 0 && vr->one_spp_seconds > VIEWER_PREVIEW_AFTER) preview_open(vr);
         pthread_mutex_lock(&vr->lock);
     }
     pthread_mutex_unlock(&vr->lock);
     return NULL;
 }
 
-Status viewer_render_start(ViewerRender *vr, Device **devices, size_t n, const RenderParams *params,
-                           const SceneCamera *camera, uint spp_cap, uint fixed_batch, Error *err)
+Status viewer_render_start(ViewerRender *vr, Device **devices, size_t n, const DeviceScene *scene,
+                           const DeviceConfig *device_config, const SceneCamera *camera, uint spp_cap,
+                           uint fixed_batch, Error *err)
 {
     memset(vr, 0, sizeof *vr);
     vr->devices = devices;
     vr->n_devices = n;
+    vr->scene = scene;
+    vr->device_config = *device_config;
+    const RenderParams *params = &scene->params;
     vr->params = *params;
     vr->spp_cap = spp_cap ? spp_cap : 1u;
     vr->fixed_batch = fixed_batch;
@@ -227,6 +343,7 @@ Status viewer_render_stop(ViewerRender *vr, Error *err)
         vr->started = 0;
         if (vr->failure != ST_OK) st = error_set(err, vr->failure, "%s", vr->failure_msg);
     }
+    preview_close(vr);
     film_free(&vr->film);
     batch_set_free(&vr->done);
     free(vr->rgb);

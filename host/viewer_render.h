@@ -17,6 +17,14 @@
  * render of n samples; during a pass the scheduler's ticks publish what is finished.
  * Pausing cancels the pass; the film keeps its whole batches and the next pass renders
  * only the others.
+ *
+ * Preview: when one sample per pixel of the whole image took longer than
+ * VIEWER_PREVIEW_AFTER seconds, every new view is first rendered at 1 spp in an image k
+ * times smaller each way (k chosen so that it takes about a fortieth of a second) and
+ * shown enlarged, then the full passes start. Devices render one image size, so the
+ * preview has its own devices: the same ones opened a second time with the scene at
+ * the small size (the kd-tree and scene are uploaded twice; the kernels come from the
+ * cache), opened once, when the first slow pass is seen.
  */
 #ifndef CLPT_VIEWER_RENDER_H
 #define CLPT_VIEWER_RENDER_H
@@ -30,10 +38,15 @@
 #include "render/schedule.h"
 #include "scene/scene.h"
 
+/* A pass of 1 spp slower than this (seconds) makes new views start with a preview. */
+#define VIEWER_PREVIEW_AFTER 0.1
+
 typedef struct {
     /* set by viewer_render_start, then read-only */
     Device **devices;
     size_t n_devices;
+    const DeviceScene *scene;     /* what the devices loaded */
+    DeviceConfig device_config;   /* to open the preview's devices */
     RenderParams params;          /* the scene's; the camera is replaced per view */
     uint spp_cap;
     uint fixed_batch;             /* --batch (tests); 0: adaptive */
@@ -63,13 +76,25 @@ typedef struct {
     BatchSet done;
     float *spare;                 /* the next frame, swapped with rgb when published */
     unsigned my_gen;
+    SceneCamera camera_shown;     /* the view being rendered */
     int view_ok;                  /* the current view's camera could be set up */
+    double one_spp_seconds;       /* the last first pass of a view, 0 before */
+
+    /* the preview: its devices, their image size, film and parameters */
+    int preview_state;            /* 0 not needed yet, 1 ready, -1 could not be opened */
+    Device **preview_devices;
+    size_t n_preview;
+    uint preview_factor;
+    Film preview_film;
+    float *preview_rgb;
+    RenderParams preview_params;
 } ViewerRender;
 
-/* Starts rendering view `camera` with the scene prepared in `params` (its size, seed,
- * integrator) on the opened devices, up to `spp_cap` samples per pixel. */
-Status viewer_render_start(ViewerRender *vr, Device **devices, size_t n, const RenderParams *params,
-                           const SceneCamera *camera, uint spp_cap, uint fixed_batch, Error *err);
+/* Starts rendering view `camera` of the scene the devices loaded (its size, seed,
+ * integrator), up to `spp_cap` samples per pixel. */
+Status viewer_render_start(ViewerRender *vr, Device **devices, size_t n, const DeviceScene *scene,
+                           const DeviceConfig *device_config, const SceneCamera *camera, uint spp_cap,
+                           uint fixed_batch, Error *err);
 /* A new view: the old one's batches are cancelled and accumulation restarts at 0. */
 void viewer_render_set_camera(ViewerRender *vr, const SceneCamera *camera);
 void viewer_render_set_paused(ViewerRender *vr, int paused);

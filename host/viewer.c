@@ -4,12 +4,16 @@
 
 #include <SDL2/SDL.h>
 
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include "base/timer.h"
 #include "view_camera.h"
@@ -367,6 +371,25 @@ static void loop_once(Viewer *v)
 
 /* ------------------------------------------------------------------ setup */
 
+/* Rendering keeps every core busy; the window's thread needs a few milliseconds at a
+ * time and must get them at once. So every other thread of the process (the render
+ * thread, the scalar device's workers, PoCL's) runs at a lower priority (nice + 5;
+ * raising one's own nice value needs no privilege), and the threads they start later
+ * inherit it. Linux only: elsewhere /proc/self/task is missing and nothing changes. */
+static void threads_lower_priority(void)
+{
+    DIR *dir = opendir("/proc/self/task");
+    if (!dir) return;
+    long self = syscall(SYS_gettid);
+    int base = getpriority(PRIO_PROCESS, 0);
+    struct dirent *e;
+    while ((e = readdir(dir)) != NULL) {
+        long tid = strtol(e->d_name, NULL, 10);
+        if (tid > 0 && tid != self) setpriority(PRIO_PROCESS, (id_t)tid, base + 5);
+    }
+    closedir(dir);
+}
+
 static void devices_describe(Viewer *v)
 {
     size_t len = 0;
@@ -471,6 +494,7 @@ Status viewer_run(const ViewerConfig *cfg, Error *err)
         st = viewer_render_start(&v->vr, cfg->devices, cfg->n_devices, &cfg->rs->ds, &cfg->device_config, &v->cam,
                                  cfg->scene->image.spp, cfg->fixed_batch, err);
     if (st == ST_OK) {
+        threads_lower_priority();
         if (!cfg->quiet)
             fprintf(stderr, "clpt: viewer: %ux%u, up to %u spp on %s; press H for the keys, Esc to quit\n", v->w,
                     v->h, cfg->scene->image.spp, v->devices);

@@ -725,7 +725,6 @@ static Status run_interactive(Run *r, Error *err)
         st = viewer_run(&vc, err);
     }
     run_free(r);
-    viewer_close_display();
     return st;
 }
 

@@ -115,11 +115,6 @@ Status viewer_open_display(Error *err)
                      why, sdl_msg);
 }
 
-void viewer_close_display(void)
-{
-    SDL_Quit();
-}
-
 /* ------------------------------------------------------------------ drawing */
 
 static void lut_fill(Viewer *v)

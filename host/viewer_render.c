@@ -131,11 +131,17 @@ static void pass_run(ViewerRender *vr, uint target)
 }
 
 /* The next pass's target: 1 sample per pixel first (the new view appears at once),
- * then doubling, up to the cap. */
+ * then doubling, up to the cap. After a paused pass on several devices the film may
+ * hold ranges beyond its count (a later batch finished, an earlier one was dropped):
+ * the target covers them, as the scheduler requires. */
 static uint pass_target(const ViewerRender *vr)
 {
     uint64_t have = vr->film.samples;
     uint64_t next = have ? 2u * have : 1u;
+    for (size_t i = 0; i < vr->done.n; i++) {
+        uint64_t end = (uint64_t)vr->done.ranges[i].first + vr->done.ranges[i].count;
+        if (end > next) next = end;
+    }
     return next > vr->spp_cap ? vr->spp_cap : (uint)next;
 }
 

@@ -714,6 +714,7 @@ static Status run_interactive(Run *r, Error *err)
 {
     Status st = viewer_open_display(err);
     if (st != ST_OK) return st;
+    if (!r->o.wave_paths) r->o.wave_paths = VIEWER_WAVE_PATHS;
     st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
     if (st == ST_OK) st = scene_apply_options(r, err);
     if (st == ST_OK) st = render_prepare(r, err);

@@ -140,7 +140,7 @@ void options_print_help(FILE *f)
 "      --batch N              fixed batch size in samples per pixel (default:\n"
 "                             adaptive, about 0.25 s of work per batch)\n"
 "      --wave-paths N         paths per OpenCL wave (default: 2^20 on GPUs,\n"
-"                             2^16 on CPUs)\n"
+"                             2^16 on CPUs; 2^14 with --interactive)\n"
 "\n"
 "Environment:\n"
 "  CLPT_CACHE_DIR             where compiled kernels are cached (default:\n"

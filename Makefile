@@ -92,8 +92,10 @@ $(BUILD)/host/dist/mpi_driver.o: FILE_WARN := $(MPI_CFLAGS)
 $(BUILD)/lib$(PROG).a: $(HOST_OBJ)
 	rm -f $@ && ar rcs $@ $^
 
+# Only the program links SDL2 (the viewer, --interactive); the tests and benchmarks use
+# the library without it.
 $(BUILD)/$(PROG): $(BUILD)/host/main.o $(BUILD)/lib$(PROG).a
-	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS) $(MPI_LIBS)
+	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS) $(MPI_LIBS) -lSDL2
 
 $(BUILD)/tests/%: tests/%.c tests/harness.h $(BUILD)/lib$(PROG).a
 	@mkdir -p $(@D)

@@ -33,6 +33,7 @@
 #include "render/schedule.h"
 #include "io/scene_load.h"
 #include "base/timer.h"
+#include "viewer.h"
 
 #define CLPT_VERSION "0.1.0"
 
@@ -752,6 +753,8 @@ static Status mpi_options(const Options *o, Dist *dist, Error *err)
 {
     if (o->adaptive > 0.0 || o->aovs)
         return error_set(err, ST_USAGE, "--adaptive and --aov are not available under MPI (run them in one process)");
+    if (o->interactive)
+        return error_set(err, ST_USAGE, "--interactive is not available under MPI (the window belongs to one process)");
     dist->broadcast = o->mpi_broadcast;
     if (o->mpi_timeout > 0.0) dist->timeout = o->mpi_timeout;
     dist->fixed_batch = o->batch;
@@ -801,6 +804,27 @@ static Status run_rank(Run *r, Dist *dist, Error *err)
     return st;
 }
 
+/* --interactive: the display first (without one, nothing slow is done), then the scene
+ * and the devices as for a render, then the window (viewer.h) instead of the render. */
+static Status run_interactive(Run *r, Error *err)
+{
+    Status st = viewer_open_display(err);
+    if (st != ST_OK) return st;
+    if (!r->o.wave_paths) r->o.wave_paths = VIEWER_WAVE_PATHS;
+    st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
+    if (st == ST_OK) st = scene_apply_options(r, err);
+    if (st == ST_OK) st = render_prepare(r, 0, err);
+    if (st == ST_OK) st = open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
+    if (st == ST_OK) {
+        ViewerConfig vc = { r->o.scene_path, &r->scene, &r->rs, r->devs, r->n_devs,
+                            { r->o.threads, r->o.kernel_dir, r->o.wave_paths }, r->encoding,
+                            r->o.batch, r->o.stats, r->o.quiet };
+        st = viewer_run(&vc, err);
+    }
+    run_free(r);
+    return st;
+}
+
 static Status run(int argc, char **argv, Dist *dist, Error *err)
 {
     Run r;
@@ -820,6 +844,7 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
         run_free(&r);
         return st;
     }
+    if (r.o.interactive) return run_interactive(&r, err);
     st = outputs_choose(&r, err);
     if (st == ST_OK) st = outputs_check(&r, err);
     if (st == ST_OK) st = load_scene_input(&r.o, &r.scene, &r.bare_mesh, err);

@@ -127,6 +127,20 @@ void options_print_help(FILE *f)
 "\n",
         f);
     fputs(
+"Interactive viewer (docs/viewer.md):\n"
+"  -i, --interactive          show SCENE in a window and render it\n"
+"                             progressively while the camera moves (needs a\n"
+"                             display: else exit status 5). Keys: W/A/S/D\n"
+"                             move, R/F or E/Q up/down, drag the mouse to\n"
+"                             look, wheel forward/back, Z/X field of view,\n"
+"                             Up/Down focus distance, Right/Left aperture,\n"
+"                             +/- exposure, Space pause, C save the image\n"
+"                             (SCENE-view-NNN.png and .pfm, never over an\n"
+"                             earlier save), P print the camera as a scene\n"
+"                             block, H help, F11 full screen, Esc quit.\n"
+"                             A view renders up to --spp (else the scene's\n"
+"                             spp) samples per pixel\n"
+"\n"
 "Devices:\n"
 "      --list-devices         print every OpenCL platform and device, and the\n"
 "                             scalar device, with their indices, then exit\n"
@@ -151,7 +165,7 @@ void options_print_help(FILE *f)
 "      --batch N              fixed batch size in samples per pixel (default:\n"
 "                             adaptive, about 0.25 s of work per batch)\n"
 "      --wave-paths N         paths per OpenCL wave (default: 2^20 on GPUs,\n"
-"                             2^16 on CPUs)\n"
+"                             2^16 on CPUs; 2^14 with --interactive)\n"
 "\n"
 "Environment:\n"
 "  CLPT_CACHE_DIR             where compiled kernels are cached (default:\n"
@@ -161,7 +175,7 @@ void options_print_help(FILE *f)
 "  0  success                 4  I/O error (a file could not be read or\n"
 "  1  internal error             written, or standard output failed)\n"
 "  2  usage error             5  device error (no usable device, or every\n"
-"  3  input error (bad scene,    device failed)\n"
+"  3  input error (bad scene,    device failed; --interactive: no display)\n"
 "     mesh or checkpoint      6  interrupted (SIGINT/SIGTERM): what was\n"
 "     file, or a checkpoint      finished was written\n"
 "     of another render)      7  nothing rendered: --time-limit ran out before\n"
@@ -297,6 +311,7 @@ static int options_set_switch(const char *a, Options *o)
         { "--help", "-h", &o->help },      { "--version", NULL, &o->version },
         { "--list-devices", NULL, &o->list_devices }, { "--stats", NULL, &o->stats },
         { "--quiet", "-q", &o->quiet },    { "--mpi-broadcast", NULL, &o->mpi_broadcast },
+        { "--interactive", "-i", &o->interactive },
     };
     for (size_t k = 0; k < sizeof switches / sizeof switches[0]; k++)
         if (strcmp(a, switches[k].name) == 0 || (switches[k].alias && strcmp(a, switches[k].alias) == 0)) {
@@ -453,6 +468,21 @@ static Status options_parse_arg(int argc, char **argv, int *i, Options *o, Error
     return ST_OK;
 }
 
+/* The viewer writes no output file of its own (C saves frames) and renders until it is
+ * closed: the flags that shape a batch render's files and its end do not apply. */
+static Status options_check_interactive(const Options *o, Error *err)
+{
+    if (!o->interactive) return ST_OK;
+    const char *flag = o->output ? "--output" : o->checkpoint_path ? (o->resume_path ? "--resume" : "--checkpoint")
+                     : o->time_limit > 0.0 ? "--time-limit" : o->progressive_seconds > 0.0 ? "--progressive-output"
+                     : o->aovs ? "--aov" : o->adaptive > 0.0 ? "--adaptive"
+                     : o->range_end >= 0 ? "--sample-range" : NULL;
+    if (flag)
+        return error_set(err, ST_USAGE, "--interactive cannot be combined with %s (the viewer saves frames "
+                                        "with the C key; see docs/viewer.md)", flag);
+    return ST_OK;
+}
+
 /* What depends on several flags. */
 static Status options_finish(Options *o, Error *err)
 {
@@ -464,7 +494,7 @@ static Status options_finish(Options *o, Error *err)
     if (o->checkpoint_seconds <= 0.0) o->checkpoint_seconds = 60.0;
     if (!o->scene_path && !o->help && !o->version && !o->list_devices)
         return error_set(err, ST_USAGE, "no scene given (usage: clpt [options] SCENE; see --help)");
-    return ST_OK;
+    return options_check_interactive(o, err);
 }
 
 Status options_parse(int argc, char **argv, Options *o, Error *err)

@@ -25,6 +25,7 @@ typedef struct {
     int mpi_broadcast;            /* the scene is read by rank 0 only and sent to the others */
     double mpi_timeout;           /* seconds of silence before a rank is given up; 0 = 30 */
     int list_devices, stats, quiet, help, version;
+    int interactive;              /* --interactive: the viewer (docs/viewer.md) */
     /* developer flags */
     const char *kernel_dir;
     unsigned batch;               /* fixed batch size, 0 = adaptive */

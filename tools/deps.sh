@@ -5,7 +5,8 @@
 # the apt-get line and the script fails (what make targets use; run.sh and .ci/run
 # install).
 #
-# Profiles: base (build and run clpt, run the tests), sanitize (make test-asan),
+# Profiles: base (build and run clpt, run the tests), viewer-test (the viewer's test
+# under a virtual display; run.sh test and .ci/run install it), sanitize (make test-asan),
 # valgrind (make test-valgrind), fuzz (make fuzz), embree (the traversal benchmark).
 # Missing packages are installed when run as root (apt-get); otherwise the exact
 # command to run is printed and the script fails, so nothing half-works.
@@ -13,7 +14,9 @@ set -eu
 
 pkgs_for() {
     case "$1" in
-        base) echo "make gcc libc6-dev pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers libstb-dev openmpi-bin libopenmpi-dev pkg-config" ;;
+        base) echo "make gcc libc6-dev pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers libstb-dev openmpi-bin libopenmpi-dev pkg-config libsdl2-dev" ;;
+        # the viewer's test (tests/test_viewer.c): a virtual display and input to send it
+        viewer-test) echo "xvfb xdotool" ;;
         sanitize) echo "clang libclang-rt-14-dev" ;;
         valgrind) echo "valgrind" ;;
         fuzz) echo "clang libclang-rt-14-dev" ;;

@@ -463,8 +463,9 @@ static void monitor_run(Shared *sh, Monitor *m, uint done_before, ScheduleStats 
     progress_begin(&progress, "render", (double)(cfg->spp - done_before) * pixels, "samples", cfg->show_progress);
     progress_set_step(&progress, pixels, "spp");
     m->last_tick = m->last_checkpoint = sh->start;
+    double poll = cfg->poll_seconds > 0.0 ? cfg->poll_seconds : 0.1;
     for (;;) {
-        wait_tick(sh, 0.1);
+        wait_tick(sh, poll);
         size_t active = active_workers(sh);
         if (check_interrupt(sh)) stats->interrupted = 1;
         progress_update(&progress, (double)(batch_queue_completed(&sh->queue) - done_before) * pixels);

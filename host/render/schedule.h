@@ -52,6 +52,10 @@ typedef struct {
      * out any more and the batches being rendered are cancelled (device.h) and dropped
      * whole; the film keeps the batches finished before. */
     volatile sig_atomic_t *stop;
+    /* How often the calling thread looks at `stop` (and progress): 0 = every 0.1 s. The
+     * viewer polls faster, so that a camera move cancels the batches of the old view
+     * within milliseconds. */
+    double poll_seconds;
     /* Called from the calling thread about every `tick_seconds` (progressive output) and
      * every `checkpoint_seconds`, with a snapshot taken under the film's lock; the devices
      * keep rendering meanwhile. NULL for none. */

@@ -1,0 +1,102 @@
+/* view_camera.c — see view_camera.h. The frame is computed in double and the result
+ * rounded to float once, as the scene parser stores it. */
+#include "view_camera.h"
+
+#include <math.h>
+
+typedef struct { double x, y, z; } dv3;
+
+static dv3 dv(vec3 a) { dv3 r = { a.x, a.y, a.z }; return r; }
+static vec3 fv(dv3 a) { vec3 r = { (float)a.x, (float)a.y, (float)a.z }; return r; }
+static dv3 add(dv3 a, dv3 b) { dv3 r = { a.x + b.x, a.y + b.y, a.z + b.z }; return r; }
+static dv3 sub(dv3 a, dv3 b) { dv3 r = { a.x - b.x, a.y - b.y, a.z - b.z }; return r; }
+static dv3 scale(dv3 a, double s) { dv3 r = { a.x * s, a.y * s, a.z * s }; return r; }
+static double dot(dv3 a, dv3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static dv3 cross(dv3 a, dv3 b)
+{
+    dv3 r = { a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x };
+    return r;
+}
+static dv3 norm(dv3 a)
+{
+    double l = sqrt(dot(a, a));
+    return l > 0.0 ? scale(a, 1.0 / l) : a;
+}
+
+/* The camera's orthonormal frame: forward f, right r (the image's +x), true up v. */
+typedef struct { dv3 f, r, v, up; double dist; } Frame;
+
+static Frame frame_of(const SceneCamera *c)
+{
+    Frame fr;
+    dv3 view = sub(dv(c->at), dv(c->from));
+    fr.dist = sqrt(dot(view, view));
+    fr.f = norm(view);
+    fr.up = norm(dv(c->up));
+    fr.r = norm(cross(fr.f, fr.up));
+    fr.v = cross(fr.r, fr.f);
+    return fr;
+}
+
+void view_camera_move(SceneCamera *c, double right, double up, double forward)
+{
+    Frame fr = frame_of(c);
+    dv3 d = add(add(scale(fr.r, right), scale(fr.up, up)), scale(fr.f, forward));
+    c->from = fv(add(dv(c->from), d));
+    c->at = fv(add(dv(c->at), d));
+}
+
+int view_camera_turn(SceneCamera *c, double yaw, double pitch)
+{
+    const double deg = 3.14159265358979323846 / 180.0;
+    Frame fr = frame_of(c);
+    /* yaw in the forward-right plane, then pitch in the forward-up plane */
+    dv3 f = add(scale(fr.f, cos(yaw * deg)), scale(fr.r, sin(yaw * deg)));
+    dv3 r = norm(cross(f, fr.up));
+    dv3 v = cross(r, f);
+    f = norm(add(scale(f, cos(pitch * deg)), scale(v, sin(pitch * deg))));
+    if (fabs(dot(f, fr.up)) > 0.999) return 0;
+    dv3 at = add(dv(c->from), scale(f, fr.dist));
+    vec3 at_f = fv(at);
+    if (at_f.x == c->from.x && at_f.y == c->from.y && at_f.z == c->from.z) return 0;
+    c->at = at_f;
+    return 1;
+}
+
+void view_camera_zoom(SceneCamera *c, double factor)
+{
+    double fov = (double)c->vfov * factor;
+    c->vfov = (float)(fov < 1.0 ? 1.0 : (fov > 170.0 ? 170.0 : fov));
+}
+
+void view_camera_focus(SceneCamera *c, double factor)
+{
+    double focus = c->focus_dist > 0.0f ? (double)c->focus_dist : frame_of(c).dist;
+    float next = (float)(focus * factor);
+    if (next > 0.0f && isfinite(next)) c->focus_dist = next;
+}
+
+void view_camera_aperture(SceneCamera *c, double factor, double first)
+{
+    double a = (double)c->aperture;
+    if (a <= 0.0) a = factor > 1.0 ? first : 0.0;
+    else a *= factor;
+    if (a < first / 8.0) a = 0.0;
+    c->aperture = (float)a;
+}
+
+int view_camera_print(FILE *f, const SceneCamera *c)
+{
+    int exact = c->type == CAMERA_PERSPECTIVE && !c->course_basis;
+    if (!exact)
+        fprintf(f, "# this scene's camera (%s) has no form in clpt's scene format; "
+                   "the block below is a perspective camera at the same place\n",
+                c->type == CAMERA_ORTHOGRAPHIC ? "orthographic" : "the course's perspective basis");
+    fprintf(f, "camera { from %.9g %.9g %.9g  at %.9g %.9g %.9g  up %.9g %.9g %.9g  fov %.9g",
+            (double)c->from.x, (double)c->from.y, (double)c->from.z, (double)c->at.x, (double)c->at.y,
+            (double)c->at.z, (double)c->up.x, (double)c->up.y, (double)c->up.z, (double)c->vfov);
+    if (c->aperture > 0.0f) fprintf(f, "  aperture %.9g", (double)c->aperture);
+    if (c->focus_dist > 0.0f) fprintf(f, "  focus %.9g", (double)c->focus_dist);
+    fputs(" }\n", f);
+    return exact ? 0 : -1;
+}

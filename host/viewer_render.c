@@ -1,0 +1,359 @@
+/* viewer_render.c — see viewer_render.h. */
+#include "viewer_render.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene/camera.h"
+
+/* How often a pass publishes what is finished, and how often the scheduler looks at the
+ * stop flag (a camera change). */
+#define VIEWER_TICK_SECONDS 0.1
+#define VIEWER_POLL_SECONDS 0.005
+/* What a preview should take, in seconds, and its largest reduction. */
+#define PREVIEW_SECONDS 0.025
+#define PREVIEW_MAX_FACTOR 16u
+
+static size_t frame_floats(const ViewerRender *vr)
+{
+    return (size_t)vr->params.width * vr->params.height * 3u;
+}
+
+/* Resolves `film` into the spare image and makes it the published frame. */
+static void publish(ViewerRender *vr, const Film *film, const Batch *done, size_t n_done)
+{
+    film_resolve(film, vr->spare);
+    pthread_mutex_lock(&vr->lock);
+    float *t = vr->rgb;
+    vr->rgb = vr->spare;
+    vr->spare = t;
+    vr->samples = film->samples;
+    vr->frame_gen = vr->my_gen;
+    vr->frame_prefix = film->samples > 0 && n_done == 1 && done[0].first == 0 && done[0].count == film->samples;
+    vr->frame_seq++;
+    pthread_mutex_unlock(&vr->lock);
+}
+
+/* The scheduler's tick during a pass: shows the batches finished so far, unless the
+ * view has changed meanwhile. */
+static void on_tick(void *ctx, const ScheduleSnapshot *snap)
+{
+    ViewerRender *vr = ctx;
+    pthread_mutex_lock(&vr->lock);
+    int current = vr->gen == vr->my_gen;
+    pthread_mutex_unlock(&vr->lock);
+    if (current) publish(vr, snap->film, snap->done, snap->n_done);
+}
+
+static void on_warning(void *ctx, const char *msg)
+{
+    (void)ctx;
+    fprintf(stderr, "clpt: warning: %s\n", msg);
+}
+
+static void set_failure(ViewerRender *vr, Status st, const char *msg)
+{
+    pthread_mutex_lock(&vr->lock);
+    vr->failure = st;
+    snprintf(vr->failure_msg, sizeof vr->failure_msg, "%s", msg);
+    pthread_mutex_unlock(&vr->lock);
+    fprintf(stderr, "clpt: error: %s\n", msg);
+}
+
+/* Gives every device the new view's camera and empties the film. A camera that cannot
+ * be set up (the view functions keep it valid; this is the defensive check) leaves the
+ * view unrendered. */
+static void view_begin(ViewerRender *vr, const SceneCamera *camera)
+{
+    Error err = { 0 };
+    memset(vr->film.sum, 0, frame_floats(vr) * sizeof *vr->film.sum);
+    vr->film.samples = 0;
+    batch_set_free(&vr->done);
+    pthread_mutex_lock(&vr->lock);
+    vr->view_samples = vr->view_seconds = 0.0;
+    pthread_mutex_unlock(&vr->lock);
+    vr->view_ok = camera_setup(camera, vr->params.width, vr->params.height, &vr->params.camera, &err) == ST_OK;
+    if (!vr->view_ok) {
+        fprintf(stderr, "clpt: warning: this view cannot be rendered: %s\n", err.msg);
+        error_clear(&err);
+        return;
+    }
+    for (size_t i = 0; i < vr->n_devices; i++) {
+        Device *d = vr->devices[i];
+        if (d->ops->update_params(d, &vr->params, NULL, &err) != ST_OK) {
+            set_failure(vr, err.status ? err.status : ST_DEVICE, err.msg);
+            error_clear(&err);
+            return;
+        }
+    }
+}
+
+/* One pass: the film goes from what it holds to `target` samples per pixel (fewer when
+ * the pass is cancelled). */
+static void pass_run(ViewerRender *vr, uint target)
+{
+    int first = vr->film.samples == 0 && target == 1;
+    ScheduleConfig cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.spp = target;
+    cfg.done = vr->done.ranges;
+    cfg.n_done = vr->done.n;
+    cfg.fixed_batch = vr->fixed_batch;
+    cfg.stop = &vr->stop;
+    cfg.poll_seconds = VIEWER_POLL_SECONDS;
+    cfg.on_tick = on_tick;
+    cfg.tick_seconds = VIEWER_TICK_SECONDS;
+    cfg.on_warning = on_warning;
+    cfg.ctx = vr;
+    ScheduleStats stats;
+    Error err = { 0 };
+    Status st = schedule_run(vr->devices, vr->n_devices, &cfg, &vr->film, &stats, &err);
+    pthread_mutex_lock(&vr->lock);
+    int current = vr->gen == vr->my_gen;
+    if (current) {
+        vr->view_samples += (double)stats.samples;
+        vr->view_seconds += stats.seconds;
+    }
+    pthread_mutex_unlock(&vr->lock);
+    if (st != ST_OK) {
+        set_failure(vr, st, err.msg);
+    } else if (current) {
+        if (first && !stats.interrupted) vr->one_spp_seconds = stats.seconds;
+        batch_set_free(&vr->done);
+        vr->done = stats.done;   /* the ranges the film holds now */
+        memset(&stats.done, 0, sizeof stats.done);
+        if (vr->film.samples > 0) publish(vr, &vr->film, vr->done.ranges, vr->done.n);
+    }
+    error_clear(&err);
+    schedule_stats_free(&stats);
+}
+
+/* The next pass's target: 1 sample per pixel first (the new view appears at once),
+ * then doubling, up to the cap. After a paused pass on several devices the film may
+ * hold ranges beyond its count (a later batch finished, an earlier one was dropped):
+ * the target covers them, as the scheduler requires. */
+static uint pass_target(const ViewerRender *vr)
+{
+    uint64_t have = vr->film.samples;
+    uint64_t next = have ? 2u * have : 1u;
+    for (size_t i = 0; i < vr->done.n; i++) {
+        uint64_t end = (uint64_t)vr->done.ranges[i].first + vr->done.ranges[i].count;
+        if (end > next) next = end;
+    }
+    return next > vr->spp_cap ? vr->spp_cap : (uint)next;
+}
+
+/* Opens the preview's devices: each device of the render opened again, with the scene
+ * at 1/factor of the size. On failure previews are left off, with a warning. */
+static void preview_open(ViewerRender *vr)
+{
+    double k = ceil(sqrt(vr->one_spp_seconds / PREVIEW_SECONDS));
+    vr->preview_factor = k < 2.0 ? 2u : (k > PREVIEW_MAX_FACTOR ? PREVIEW_MAX_FACTOR : (uint)k);
+    DeviceScene small = *vr->scene;
+    small.params.width = (vr->params.width + vr->preview_factor - 1) / vr->preview_factor;
+    small.params.height = (vr->params.height + vr->preview_factor - 1) / vr->preview_factor;
+    small.pixel_mask = NULL;
+    small.params.use_mask = 0;
+    vr->preview_params = small.params;
+    Error err = { 0 };
+    vr->preview_state = -1;
+    vr->preview_devices = calloc(vr->n_devices, sizeof *vr->preview_devices);
+    Status st = vr->preview_devices ? ST_OK : error_set(&err, ST_INTERNAL, "out of memory");
+    if (st == ST_OK) st = film_init(&vr->preview_film, small.params.width, small.params.height, &err);
+    if (st == ST_OK && !(vr->preview_rgb = calloc((size_t)small.params.width * small.params.height * 3u,
+                                                  sizeof *vr->preview_rgb)))
+        st = error_set(&err, ST_INTERNAL, "out of memory");
+    for (size_t i = 0; st == ST_OK && i < vr->n_devices; i++) {
+        Device *d = NULL;
+        st = device_open(&vr->devices[i]->desc, &vr->device_config, &d, &err);
+        if (st == ST_OK) st = d->ops->load_scene(d, &small, &err);
+        if (st == ST_OK) vr->preview_devices[vr->n_preview++] = d;
+        else device_close(d);
+    }
+    if (st == ST_OK) {
+        vr->preview_state = 1;
+        return;
+    }
+    fprintf(stderr, "clpt: warning: no previews (the devices could not be opened a second time: %s)\n", err.msg);
+    error_clear(&err);
+}
+
+static void preview_close(ViewerRender *vr)
+{
+    for (size_t i = 0; i < vr->n_preview; i++) device_close(vr->preview_devices[i]);
+    free(vr->preview_devices);
+    vr->preview_devices = NULL;
+    vr->n_preview = 0;
+    film_free(&vr->preview_film);
+    free(vr->preview_rgb);
+    vr->preview_rgb = NULL;
+}
+
+/* The small image, each of its pixels shown as a factor x factor block. Not a sample
+ * of the view's film (frame_prefix 0: never saved). */
+static void preview_publish(ViewerRender *vr)
+{
+    uint w = vr->params.width, h = vr->params.height, pw = vr->preview_params.width;
+    film_resolve(&vr->preview_film, vr->preview_rgb);
+    for (uint y = 0; y < h; y++)
+        for (uint x = 0; x < w; x++)
+            memcpy(&vr->spare[((size_t)y * w + x) * 3u],
+                   &vr->preview_rgb[((size_t)(y / vr->preview_factor) * pw + x / vr->preview_factor) * 3u],
+                   3 * sizeof *vr->spare);
+    pthread_mutex_lock(&vr->lock);
+    if (vr->gen == vr->my_gen) {
+        float *t = vr->rgb;
+        vr->rgb = vr->spare;
+        vr->spare = t;
+        vr->samples = 0;
+        vr->frame_gen = vr->my_gen;
+        vr->frame_prefix = 0;
+        vr->frame_seq++;
+    }
+    pthread_mutex_unlock(&vr->lock);
+}
+
+/* The new view at 1 spp in the small image, shown at once; a camera change meanwhile
+ * cancels it like a pass. */
+static void preview_run(ViewerRender *vr)
+{
+    Error err = { 0 };
+    vr->preview_params.camera = vr->params.camera;
+    Status st = camera_setup(&vr->camera_shown, vr->preview_params.width, vr->preview_params.height,
+                             &vr->preview_params.camera, &err);
+    for (size_t i = 0; st == ST_OK && i < vr->n_preview; i++)
+        st = vr->preview_devices[i]->ops->update_params(vr->preview_devices[i], &vr->preview_params, NULL, &err);
+    ScheduleConfig cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.spp = 1;
+    cfg.stop = &vr->stop;
+    cfg.poll_seconds = VIEWER_POLL_SECONDS;
+    cfg.on_warning = on_warning;
+    ScheduleStats stats;
+    memset(&stats, 0, sizeof stats);
+    memset(vr->preview_film.sum, 0,
+           (size_t)vr->preview_params.width * vr->preview_params.height * 3u * sizeof *vr->preview_film.sum);
+    vr->preview_film.samples = 0;
+    if (st == ST_OK) st = schedule_run(vr->preview_devices, vr->n_preview, &cfg, &vr->preview_film, &stats, &err);
+    if (st == ST_OK && !stats.interrupted && vr->preview_film.samples == 1) preview_publish(vr);
+    if (st != ST_OK) {
+        fprintf(stderr, "clpt: warning: previews stopped: %s\n", err.msg);
+        preview_close(vr);
+        vr->preview_state = -1;
+    }
+    error_clear(&err);
+    schedule_stats_free(&stats);
+}
+
+static void *render_main(void *arg)
+{
+    ViewerRender *vr = arg;
+    pthread_mutex_lock(&vr->lock);
+    for (;;) {
+        if (vr->quit) break;
+        if (vr->gen != vr->my_gen) {
+            SceneCamera cam = vr->camera;
+            vr->my_gen = vr->gen;
+            vr->stop = 0;
+            pthread_mutex_unlock(&vr->lock);
+            vr->camera_shown = cam;
+            view_begin(vr, &cam);
+            if (vr->view_ok && vr->preview_state == 1) preview_run(vr);
+            pthread_mutex_lock(&vr->lock);
+            continue;
+        }
+        if (vr->paused || vr->failure != ST_OK || !vr->view_ok || vr->film.samples >= vr->spp_cap) {
+            pthread_cond_wait(&vr->wake, &vr->lock);
+            continue;
+        }
+        vr->stop = 0;   /* under the lock: a change made after this cancels the pass */
+        pthread_mutex_unlock(&vr->lock);
+        pass_run(vr, pass_target(vr));
+        if (vr->preview_state == 0 && vr->one_spp_seconds > VIEWER_PREVIEW_AFTER) preview_open(vr);
+        pthread_mutex_lock(&vr->lock);
+    }
+    pthread_mutex_unlock(&vr->lock);
+    return NULL;
+}
+
+Status viewer_render_start(ViewerRender *vr, Device **devices, size_t n, const DeviceScene *scene,
+                           const DeviceConfig *device_config, const SceneCamera *camera, uint spp_cap,
+                           uint fixed_batch, Error *err)
+{
+    memset(vr, 0, sizeof *vr);
+    vr->devices = devices;
+    vr->n_devices = n;
+    vr->scene = scene;
+    vr->device_config = *device_config;
+    const RenderParams *params = &scene->params;
+    vr->params = *params;
+    vr->spp_cap = spp_cap ? spp_cap : 1u;
+    vr->fixed_batch = fixed_batch;
+    vr->camera = *camera;
+    vr->gen = 1;
+    Status st = film_init(&vr->film, params->width, params->height, err);
+    if (st != ST_OK) return st;
+    vr->rgb = calloc(frame_floats(vr), sizeof *vr->rgb);
+    vr->spare = calloc(frame_floats(vr), sizeof *vr->spare);
+    if (!vr->rgb || !vr->spare) {
+        viewer_render_stop(vr, NULL);
+        return error_set(err, ST_INTERNAL, "out of memory for the viewer's images");
+    }
+    pthread_mutex_init(&vr->lock, NULL);
+    pthread_cond_init(&vr->wake, NULL);
+    if (pthread_create(&vr->thread, NULL, render_main, vr) != 0) {
+        pthread_cond_destroy(&vr->wake);
+        pthread_mutex_destroy(&vr->lock);
+        film_free(&vr->film);
+        free(vr->rgb);
+        free(vr->spare);
+        return error_set(err, ST_INTERNAL, "cannot start the viewer's render thread");
+    }
+    vr->started = 1;
+    return ST_OK;
+}
+
+void viewer_render_set_camera(ViewerRender *vr, const SceneCamera *camera)
+{
+    pthread_mutex_lock(&vr->lock);
+    vr->camera = *camera;
+    vr->gen++;
+    vr->stop = 1;
+    pthread_cond_signal(&vr->wake);
+    pthread_mutex_unlock(&vr->lock);
+}
+
+void viewer_render_set_paused(ViewerRender *vr, int paused)
+{
+    pthread_mutex_lock(&vr->lock);
+    vr->paused = paused;
+    if (paused) vr->stop = 1;
+    pthread_cond_signal(&vr->wake);
+    pthread_mutex_unlock(&vr->lock);
+}
+
+Status viewer_render_stop(ViewerRender *vr, Error *err)
+{
+    Status st = ST_OK;
+    if (vr->started) {
+        pthread_mutex_lock(&vr->lock);
+        vr->quit = 1;
+        vr->stop = 1;
+        pthread_cond_signal(&vr->wake);
+        pthread_mutex_unlock(&vr->lock);
+        pthread_join(vr->thread, NULL);
+        pthread_cond_destroy(&vr->wake);
+        pthread_mutex_destroy(&vr->lock);
+        vr->started = 0;
+        if (vr->failure != ST_OK) st = error_set(err, vr->failure, "%s", vr->failure_msg);
+    }
+    preview_close(vr);
+    film_free(&vr->film);
+    batch_set_free(&vr->done);
+    free(vr->rgb);
+    free(vr->spare);
+    vr->rgb = vr->spare = NULL;
+    return st;
+}

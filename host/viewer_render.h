@@ -1,0 +1,105 @@
+/*
+ * viewer_render.h — the viewer's render thread: renders the current view progressively
+ * with the batch scheduler (render/schedule.h) on the devices the program opened, and
+ * publishes each step as a resolved image for the window to show.
+ *
+ * Why a thread of its own: a batch of even one sample per pixel takes about 0.1 s for
+ * the Cornell box at 512 x 512 on two cores, and much longer for big meshes; the window
+ * must take input at 30+ frames per second meanwhile. So the window's thread only
+ * handles events and draws, and this thread runs schedule_run in passes. A camera
+ * change raises the scheduler's stop flag, which cancels the batches of the old view
+ * within milliseconds (ScheduleConfig.poll_seconds; devices drop a cancelled batch
+ * whole), and the next pass renders the new view from sample 0.
+ *
+ * Passes: the film of a view holds samples [0, n) after each pass, n = 1, 2, 4, 8, ...
+ * up to the cap (the scene's spp), each pass a schedule_run resumed from the ranges the
+ * film holds (ScheduleConfig.done). Between passes the film is exactly a command-line
+ * render of n samples; during a pass the scheduler's ticks publish what is finished.
+ * Pausing cancels the pass; the film keeps its whole batches and the next pass renders
+ * only the others.
+ *
+ * Preview: when one sample per pixel of the whole image took longer than
+ * VIEWER_PREVIEW_AFTER seconds, every new view is first rendered at 1 spp in an image k
+ * times smaller each way (k chosen so that it takes about a fortieth of a second) and
+ * shown enlarged, then the full passes start. Devices render one image size, so the
+ * preview has its own devices: the same ones opened a second time with the scene at
+ * the small size (the kd-tree and scene are uploaded twice; the kernels come from the
+ * cache), opened once, when the first slow pass is seen.
+ */
+#ifndef CLPT_VIEWER_RENDER_H
+#define CLPT_VIEWER_RENDER_H
+
+#include <pthread.h>
+#include <signal.h>
+#include <stdint.h>
+
+#include "render/batch_queue.h"
+#include "render/film.h"
+#include "render/schedule.h"
+#include "scene/scene.h"
+
+/* A pass of 1 spp slower than this (seconds) makes new views start with a preview. */
+#define VIEWER_PREVIEW_AFTER 0.1
+
+typedef struct {
+    /* set by viewer_render_start, then read-only */
+    Device **devices;
+    size_t n_devices;
+    const DeviceScene *scene;     /* what the devices loaded */
+    DeviceConfig device_config;   /* to open the preview's devices */
+    RenderParams params;          /* the scene's; the camera is replaced per view */
+    uint spp_cap;
+    uint fixed_batch;             /* --batch (tests); 0: adaptive */
+    pthread_t thread;
+    int started;
+    pthread_mutex_t lock;
+    pthread_cond_t wake;
+
+    /* requests, under lock */
+    SceneCamera camera;
+    unsigned gen;                 /* incremented by each camera change */
+    int paused, quit;
+    volatile sig_atomic_t stop;   /* the running pass's stop flag */
+
+    /* the published frame, under lock */
+    float *rgb;                   /* width * height * 3 linear, top row first */
+    uint64_t samples;             /* per pixel in rgb */
+    unsigned frame_gen;           /* the view it shows */
+    int frame_prefix;             /* it holds samples [0, samples) exactly */
+    unsigned frame_seq;           /* incremented by each publication */
+    double view_samples, view_seconds;   /* rendered for this view, for Msamples/s */
+    Status failure;               /* ST_OK, or why rendering stopped for good */
+    char failure_msg[1024];
+
+    /* the render thread's own */
+    Film film;
+    BatchSet done;
+    float *spare;                 /* the next frame, swapped with rgb when published */
+    unsigned my_gen;
+    SceneCamera camera_shown;     /* the view being rendered */
+    int view_ok;                  /* the current view's camera could be set up */
+    double one_spp_seconds;       /* the last first pass of a view, 0 before */
+
+    /* the preview: its devices, their image size, film and parameters */
+    int preview_state;            /* 0 not needed yet, 1 ready, -1 could not be opened */
+    Device **preview_devices;
+    size_t n_preview;
+    uint preview_factor;
+    Film preview_film;
+    float *preview_rgb;
+    RenderParams preview_params;
+} ViewerRender;
+
+/* Starts rendering view `camera` of the scene the devices loaded (its size, seed,
+ * integrator), up to `spp_cap` samples per pixel. */
+Status viewer_render_start(ViewerRender *vr, Device **devices, size_t n, const DeviceScene *scene,
+                           const DeviceConfig *device_config, const SceneCamera *camera, uint spp_cap,
+                           uint fixed_batch, Error *err);
+/* A new view: the old one's batches are cancelled and accumulation restarts at 0. */
+void viewer_render_set_camera(ViewerRender *vr, const SceneCamera *camera);
+void viewer_render_set_paused(ViewerRender *vr, int paused);
+/* Stops the thread and frees everything; returns the rendering failure, if any (its
+ * message in err). */
+Status viewer_render_stop(ViewerRender *vr, Error *err);
+
+#endif /* CLPT_VIEWER_RENDER_H */

@@ -234,7 +234,7 @@ static Status run_passes(const Options *o, const PassContext *pc, const char *ou
 static void print_scene_stats(const Scene *s, const KdTree *kd)
 {
     const KdStats *k = &kd->stats;
-    size_t in_tree = s->n_spheres + s->n_triangles + s->n_boxes;
+    size_t in_tree = s->n_spheres + s->n_triangles + s->n_boxes + s->n_revsurfaces;
     printf("scene: %zu spheres, %zu triangles, %zu boxes, %zu planes, %zu materials, %zu lights\n",
            s->n_spheres, s->n_triangles, s->n_boxes, s->n_planes, s->n_materials, s->n_lights);
     double per = in_tree ? 1.0 / (double)in_tree : 0.0;

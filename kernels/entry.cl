@@ -157,6 +157,9 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Camera, forward);
     out[i++] = (uint)__builtin_offsetof(RenderParams, shadows);
     out[i++] = (uint)__builtin_offsetof(RenderParams, normal_miss_grey);
+    out[i++] = (uint)sizeof(RevSurface);
+    out[i++] = (uint)__builtin_offsetof(RevSurface, axis_x);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, n_revsurfaces);
 }
 
 /* ---------------------------------------------------------------- classic ray tracer

@@ -296,7 +296,8 @@ static void test_layout(void)
                     offsetof(Texture, color1), offsetof(RenderParams, ambient),
                     offsetof(RenderParams, strata), offsetof(Material, reflective),
                     offsetof(Light, cos_inner), offsetof(Camera, forward),
-                    offsetof(RenderParams, shadows), offsetof(RenderParams, normal_miss_grey) };
+                    offsetof(RenderParams, shadows), offsetof(RenderParams, normal_miss_grey),
+                    sizeof(RevSurface), offsetof(RevSurface, axis_x), offsetof(RenderParams, n_revsurfaces) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);

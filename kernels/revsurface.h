@@ -35,12 +35,26 @@
  * give both. */
 KFN void rev_eval(GLOBAL const float *p, uint degree, float s, float *x, float *y, float *dx, float *dy)
 {
+    float u = 1.0f - s;
+    if (degree == 3u) {
+        /* the B-spline pieces: the same steps in scalars, without the private array that
+         * OpenCL compilers keep in memory */
+        float ax = u * p[0] + s * p[2], ay = u * p[1] + s * p[3];
+        float bx1 = u * p[2] + s * p[4], by1 = u * p[3] + s * p[5];
+        float cx = u * p[4] + s * p[6], cy = u * p[5] + s * p[7];
+        float ex = u * ax + s * bx1, ey = u * ay + s * by1;
+        float fx = u * bx1 + s * cx, fy = u * by1 + s * cy;
+        *x = u * ex + s * fx;
+        *y = u * ey + s * fy;
+        *dx = 3.0f * (fx - ex);
+        *dy = 3.0f * (fy - ey);
+        return;
+    }
     float bx[REV_MAX_DEGREE + 1], by[REV_MAX_DEGREE + 1];
     for (uint i = 0; i <= degree; i++) {
         bx[i] = p[2 * i];
         by[i] = p[2 * i + 1];
     }
-    float u = 1.0f - s;
     for (uint level = degree; level > 1u; level--)
         for (uint i = 0; i < level; i++) {
             bx[i] = u * bx[i] + s * bx[i + 1];
@@ -113,18 +127,25 @@ KFN int rev_newton(GLOBAL const float *p, uint degree, float A, float B, float C
     return 0;
 }
 
-/* The profile sample (of REV_SAMPLES + 1 over the segment) nearest to (r, y). */
-KFN float rev_nearest_s(GLOBAL const float *p, uint degree, float r, float y)
+/* The profile samples s = k / REV_SAMPLES, k = 0 .. REV_SAMPLES, of a segment. */
+KFN void rev_samples(GLOBAL const float *p, uint degree, float *sx, float *sy)
+{
+    for (int k = 0; k <= REV_SAMPLES; k++) {
+        float dx, dy;
+        rev_eval(p, degree, (float)k * (1.0f / (float)REV_SAMPLES), &sx[k], &sy[k], &dx, &dy);
+    }
+}
+
+/* The parameter of the sample nearest to (r, y) in the (distance from the axis, height)
+ * half-plane. */
+KFN float rev_nearest_s(const float *sx, const float *sy, float r, float y)
 {
     float best_s = 0.0f, best_d = K_INF;
     for (int k = 0; k <= REV_SAMPLES; k++) {
-        float s = (float)k * (1.0f / (float)REV_SAMPLES);
-        float x, py, dx, dy;
-        rev_eval(p, degree, s, &x, &py, &dx, &dy);
-        float d = k_sqr(k_fabs(x) - r) + k_sqr(py - y);
+        float d = k_sqr(k_fabs(sx[k]) - r) + k_sqr(sy[k] - y);
         if (d < best_d) {
             best_d = d;
-            best_s = s;
+            best_s = (float)k * (1.0f / (float)REV_SAMPLES);
         }
     }
     return best_s;
@@ -153,10 +174,12 @@ KFN int revsurface_intersect(RevSurface rs, GLOBAL const float *points, Ray ray,
         /* the shell grown by the tolerance: a silhouette hit may lie just outside */
         float ta = ray.tmin, tb = best;
         if (!rev_clip(A, B, C, oy, dy, rmax + tol, lo_y - tol, hi_y + tol, &ta, &tb)) continue;
+        float sx[REV_SAMPLES + 1], sy[REV_SAMPLES + 1];
+        rev_samples(p, rs.degree, sx, sy);
         for (int k = 0; k < REV_STARTS; k++) {
             float t = ta + (tb - ta) * (((float)k + 0.5f) * (1.0f / (float)REV_STARTS));
             float r = k_safe_sqrt((A * t + 2.0f * B) * t + C);
-            float s = rev_nearest_s(p, rs.degree, r, oy + t * dy);
+            float s = rev_nearest_s(sx, sy, r, oy + t * dy);
             if (rev_newton(p, rs.degree, A, B, C, oy, dy, tol, &t, &s) && t > ray.tmin && t < best) {
                 best = t;
                 hit->t = t;

@@ -28,7 +28,9 @@
 #define REV_SAMPLES 8         /* profile samples per segment to pick a start's s */
 #define REV_ITERATIONS 16     /* Newton steps per start at most */
 #define REV_STEP_TOL 1e-5f    /* a converged step moves t and s by less (relative) */
-#define REV_TOL 1e-4f         /* accepted distance from the surface, times its size */
+#define REV_TOL 1e-4f         /* the bounding shells' margin, times the surface's size */
+#define REV_RESIDUAL 2e-6f    /* accepted |F| of a root: r^2 - x^2 over size^2, and the
+                               * height's error over size (a few float roundings) */
 
 /* Point (x, y) and derivative (dx, dy) at s of the Bezier segment whose degree + 1
  * control points are (x, y) pairs at p, by de Casteljau: the last level's two points
@@ -93,8 +95,8 @@ KFN int rev_clip(float A, float B, float C, float oy, float dy, float rmax, floa
 }
 
 /* Newton's method on F from (t, s); 1 with the root in *t, *s when it converged inside
- * the segment (0 <= s <= 1) to within tol of the surface. */
-KFN int rev_newton(GLOBAL const float *p, uint degree, float A, float B, float C, float oy, float dy, float tol,
+ * the segment (0 <= s <= 1) to within REV_RESIDUAL (size: the surface's). */
+KFN int rev_newton(GLOBAL const float *p, uint degree, float A, float B, float C, float oy, float dy, float size,
                    float *t_io, float *s_io)
 {
     float t = *t_io, s = *s_io;
@@ -114,11 +116,29 @@ KFN int rev_newton(GLOBAL const float *p, uint degree, float A, float B, float C
         /* a step may leave the segment: projecting s back keeps the iteration on the
          * polynomial piece it models (beyond [0, 1] it is not the profile) */
         s = k_clamp(s - step_s, 0.0f, 1.0f);
-        if (k_fabs(step_t) <= REV_STEP_TOL * (k_fabs(t) + tol) && k_fabs(step_s) <= REV_STEP_TOL) {
+        if (k_fabs(step_t) <= REV_STEP_TOL * (k_fabs(t) + size) && k_fabs(step_s) <= REV_STEP_TOL) {
+            /* Newton converges quadratically: two more steps take the root from 1e-5 to
+             * the rounding of the floats, which a ray leaving the surface needs (its
+             * origin is moved off the surface by only 256 ulps, surface.h) */
+            for (int polish = 0; polish < 2; polish++) {
+                rev_eval(p, degree, s, &x, &y, &dx, &dydS);
+                f1 = (A * t + 2.0f * B) * t + C - x * x;
+                f2 = oy + t * dy - y;
+                j11 = 2.0f * (A * t + B);
+                j12 = -2.0f * x * dx;
+                j22 = -dydS;
+                det = j11 * j22 - j12 * j21;
+                if (!(k_fabs(det) > 0.0f)) break;
+                t -= (f1 * j22 - j12 * f2) / det;
+                s = k_clamp(s - (j11 * f2 - j21 * f1) / det, 0.0f, 1.0f);
+            }
+            /* a root within the rounding of the floats; an iteration that stalled near
+             * the ray's origin, when that lies just off the surface (a ray leaving it),
+             * is further away than this and must not count */
             rev_eval(p, degree, s, &x, &y, &dx, &dydS);
-            float r = k_safe_sqrt((A * t + 2.0f * B) * t + C);
-            float ey = oy + t * dy - y;
-            if (!(k_fabs(r - k_fabs(x)) <= tol && k_fabs(ey) <= tol)) return 0;
+            f1 = (A * t + 2.0f * B) * t + C - x * x;
+            f2 = oy + t * dy - y;
+            if (!(k_fabs(f1) <= REV_RESIDUAL * size * size && k_fabs(f2) <= REV_RESIDUAL * size)) return 0;
             *t_io = t;
             *s_io = s;
             return 1;
@@ -174,13 +194,20 @@ KFN int revsurface_intersect(RevSurface rs, GLOBAL const float *points, Ray ray,
         /* the shell grown by the tolerance: a silhouette hit may lie just outside */
         float ta = ray.tmin, tb = best;
         if (!rev_clip(A, B, C, oy, dy, rmax + tol, lo_y - tol, hi_y + tol, &ta, &tb)) continue;
+        /* Newton works from the ray's entry into the shell, o' = o + ta d: from a far
+         * origin, C and A t^2 + 2 B t would be large and cancel to the small r^2, which
+         * loses the digits the hit point needs */
+        float px = ox + ta * ray.d.x, pz = oz + ta * ray.d.z, py = oy + ta * dy;
+        float B2 = px * ray.d.x + pz * ray.d.z, C2 = px * px + pz * pz;
         float sx[REV_SAMPLES + 1], sy[REV_SAMPLES + 1];
         rev_samples(p, rs.degree, sx, sy);
         for (int k = 0; k < REV_STARTS; k++) {
-            float t = ta + (tb - ta) * (((float)k + 0.5f) * (1.0f / (float)REV_STARTS));
-            float r = k_safe_sqrt((A * t + 2.0f * B) * t + C);
-            float s = rev_nearest_s(sx, sy, r, oy + t * dy);
-            if (rev_newton(p, rs.degree, A, B, C, oy, dy, tol, &t, &s) && t > ray.tmin && t < best) {
+            float t = (tb - ta) * (((float)k + 0.5f) * (1.0f / (float)REV_STARTS));
+            float r = k_safe_sqrt((A * t + 2.0f * B2) * t + C2);
+            float s = rev_nearest_s(sx, sy, r, py + t * dy);
+            if (!rev_newton(p, rs.degree, A, B2, C2, py, dy, size, &t, &s)) continue;
+            t += ta;
+            if (t > ray.tmin && t < best) {
                 best = t;
                 hit->t = t;
                 hit->u = s;

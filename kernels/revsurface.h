@@ -97,9 +97,10 @@ KFN int rev_clip(float A, float B, float C, float oy, float dy, float rmax, floa
 /* Newton's method on F from (t, s); 1 with the root in *t, *s when it converged inside
  * the segment (0 <= s <= 1) to within REV_RESIDUAL (size: the surface's). */
 KFN int rev_newton(GLOBAL const float *p, uint degree, float A, float B, float C, float oy, float dy, float size,
-                   float *t_io, float *s_io)
+                   float w, float *t_io, float *s_io)
 {
     float t = *t_io, s = *s_io;
+    int pinned = 0;
     for (int it = 0; it < REV_ITERATIONS; it++) {
         float x, y, dx, dydS;
         rev_eval(p, degree, s, &x, &y, &dx, &dydS);
@@ -115,8 +116,18 @@ KFN int rev_newton(GLOBAL const float *p, uint degree, float A, float B, float C
         t -= step_t;
         /* a step may leave the segment: projecting s back keeps the iteration on the
          * polynomial piece it models (beyond [0, 1] it is not the profile) */
-        s = k_clamp(s - step_s, 0.0f, 1.0f);
-        if (k_fabs(step_t) <= REV_STEP_TOL * (k_fabs(t) + size) && k_fabs(step_s) <= REV_STEP_TOL) {
+        float s_free = s - step_s;
+        s = k_clamp(s_free, 0.0f, 1.0f);
+        int converged = k_fabs(step_t) <= REV_STEP_TOL * (k_fabs(t) + size) && k_fabs(step_s) <= REV_STEP_TOL;
+        /* Give up early on a start that leads elsewhere: t far outside the clip [0, w]
+         * (a root there lies outside this segment's shell, where another segment or
+         * nothing is), or s pushed past an end of the segment twice running (the root
+         * is on a neighbouring piece). Most rays through a shell miss the surface, and
+         * these end their starts in 2 or 3 steps instead of REV_ITERATIONS. */
+        if (!(t >= -w && t <= 2.0f * w)) return 0;
+        pinned = (s_free != s && !converged) ? pinned + 1 : 0;
+        if (pinned == 2) return 0;
+        if (converged) {
             /* Newton converges quadratically: two more steps take the root from 1e-5 to
              * the rounding of the floats, which a ray leaving the surface needs (its
              * origin is moved off the surface by only 256 ulps, surface.h) */
@@ -205,7 +216,7 @@ KFN int revsurface_intersect(RevSurface rs, GLOBAL const float *points, Ray ray,
             float t = (tb - ta) * (((float)k + 0.5f) * (1.0f / (float)REV_STARTS));
             float r = k_safe_sqrt((A * t + 2.0f * B2) * t + C2);
             float s = rev_nearest_s(sx, sy, r, py + t * dy);
-            if (!rev_newton(p, rs.degree, A, B2, C2, py, dy, size, &t, &s)) continue;
+            if (!rev_newton(p, rs.degree, A, B2, C2, py, dy, size, tb - ta, &t, &s)) continue;
             t += ta;
             if (t > ray.tmin && t < best) {
                 best = t;

@@ -65,7 +65,7 @@ static void test_bspline(void)
     curve_to_segments(CURVE_BSPLINE, p, N, seg, &ns, &deg);
     CHECK_EQ_INT(ns, N - 3);
     CHECK_EQ_INT(deg, 3);
-    double h = 1.0 / (N + 4), worst_sum = 0.0, worst_piece = 0.0, lowest = 1.0;
+    double h = 1.0 / (N + 3), worst_sum = 0.0, worst_piece = 0.0, lowest = 1.0;
     for (int k = 0; k <= 200; k++) {
         double t = 3 * h + (N - 3) * h * k / 200.0, xy[2], basis[N];
         curve_bspline_eval(p, N, t, xy, basis);
@@ -81,6 +81,15 @@ static void test_bspline(void)
         curve_bezier_eval(seg + 2 * 3 * j, 3, s, b, d);
         worst_piece = fmax(worst_piece, fmax(fabs(b[0] - xy[0]), fabs(b[1] - xy[1])));
     }
+    /* the course's knots i / (n + 3): the drawn part starts at t_3 at (P0 + 4 P1 + P2) / 6
+     * and ends at t_n at (P5 + 4 P6 + P7) / 6 */
+    double e[2];
+    curve_bspline_eval(p, N, 3.0 / (N + 3), e, NULL);
+    CHECK_NEAR(e[0], (p[0] + 4 * p[2] + p[4]) / 6.0, 1e-12);
+    CHECK_NEAR(e[1], (p[1] + 4 * p[3] + p[5]) / 6.0, 1e-12);
+    curve_bspline_eval(p, N, (double)N / (N + 3), e, NULL);
+    CHECK_NEAR(e[0], (p[10] + 4 * p[12] + p[14]) / 6.0, 1e-12);
+    CHECK_NEAR(e[1], (p[11] + 4 * p[13] + p[15]) / 6.0, 1e-12);
     fprintf(stderr, "  B-spline: |sum of basis - 1| <= %.2g, lowest basis value %.3g, pieces within %.2g\n",
             worst_sum, lowest, worst_piece);
     CHECK(worst_sum < 1e-12);

@@ -25,11 +25,11 @@ void curve_bezier_eval(const float *p, unsigned degree, double s, double xy[2], 
     d[1] = degree * (by[1] - by[0]);
 }
 
-/* Cox-de Boor: the degree-3 basis functions N_{i,3}(t) on the knots i / (n + 4), from
- * the degree-0 ones, in place (n + 3 entries of room in b). */
+/* Cox-de Boor: the degree-3 basis functions N_{i,3}(t) on the knots t_i = i / (n + 3),
+ * i = 0 .. n + 3, from the degree-0 ones, in place (n + 3 entries of room in b). */
 static void bspline_basis(size_t n, double t, double *b)
 {
-    size_t nk = n + 4;        /* knots 0 .. nk */
+    size_t nk = n + 3;        /* intervals [t_i, t_i+1), i = 0 .. nk - 1 */
     double h = 1.0 / (double)nk;
     for (size_t i = 0; i < nk; i++) b[i] = (t >= i * h && t < (i + 1) * h) ? 1.0 : 0.0;
     /* t at the last drawn knot t_n belongs to the piece before it */

@@ -6,9 +6,10 @@
  * check the exact surface against).
  *
  * A BezierCurve of n control points is one Bezier curve of degree n - 1. A BsplineCurve
- * is the course's uniform cubic B-spline: n control points, knots t_i = i / (n + 4) for
- * i = 0 .. n + 4, drawn over [t_3, t_n], which is n - 3 polynomial pieces; each piece is
- * stored as the cubic Bezier segment it equals.
+ * is the course's uniform cubic B-spline: n control points, knots t_i = i / (n + 3) for
+ * i = 0 .. n + 3 (the starter code's i / (n' + k + 1) with n' = n - 1 and k = 3), drawn
+ * over [t_3, t_n], which is n - 3 polynomial pieces; each piece is stored as the cubic
+ * Bezier segment it equals.
  */
 #ifndef CLPT_CURVE_H
 #define CLPT_CURVE_H

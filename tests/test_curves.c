@@ -85,11 +85,11 @@ static void test_bspline(void)
      * and ends at t_n at (P5 + 4 P6 + P7) / 6 */
     double e[2];
     curve_bspline_eval(p, N, 3.0 / (N + 3), e, NULL);
-    CHECK_NEAR(e[0], (p[0] + 4 * p[2] + p[4]) / 6.0, 1e-12);
-    CHECK_NEAR(e[1], (p[1] + 4 * p[3] + p[5]) / 6.0, 1e-12);
+    CHECK_NEAR(e[0], ((double)p[0] + 4.0 * p[2] + p[4]) / 6.0, 1e-12);
+    CHECK_NEAR(e[1], ((double)p[1] + 4.0 * p[3] + p[5]) / 6.0, 1e-12);
     curve_bspline_eval(p, N, (double)N / (N + 3), e, NULL);
-    CHECK_NEAR(e[0], (p[10] + 4 * p[12] + p[14]) / 6.0, 1e-12);
-    CHECK_NEAR(e[1], (p[11] + 4 * p[13] + p[15]) / 6.0, 1e-12);
+    CHECK_NEAR(e[0], ((double)p[10] + 4.0 * p[12] + p[14]) / 6.0, 1e-12);
+    CHECK_NEAR(e[1], ((double)p[11] + 4.0 * p[13] + p[15]) / 6.0, 1e-12);
     fprintf(stderr, "  B-spline: |sum of basis - 1| <= %.2g, lowest basis value %.3g, pieces within %.2g\n",
             worst_sum, lowest, worst_piece);
     CHECK(worst_sum < 1e-12);

@@ -13,11 +13,12 @@
  * rays along the axis or level with it need no special case. Newton's method solves F
  * from a few starts per segment: the ray is first clipped to the segment's bounding
  * cylinder shell (radius and height range of its control points, which bound the
- * segment), then REV_STARTS parameters t spread over that clip each start with the
- * profile sample s nearest to the ray point in the (r, y) half-plane. The nearest
- * converged root with 0 <= s <= 1 wins; a root counts when Newton's last step moved t
- * and s by less than REV_STEP_TOL (relative) and the remaining distance in the (r, y)
- * plane is under REV_TOL of the surface's size (docs/classic-format.md, "Curves").
+ * segment, grown by REV_TOL), then REV_STARTS parameters t spread over that clip each
+ * start with the profile sample s nearest to the ray point in the (r, y) half-plane,
+ * from the ray's entry into the shell. A start converges when its step moves t and s by
+ * less than REV_STEP_TOL (relative); two polishing steps follow, and the root counts
+ * when 0 <= s <= 1 and |F| is within REV_RESIDUAL. The nearest such root wins
+ * (docs/classic-format.md, "Curves and surfaces of revolution").
  */
 #ifndef CLPT_REVSURFACE_H
 #define CLPT_REVSURFACE_H

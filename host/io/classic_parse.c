@@ -5,9 +5,11 @@
  * The course's parsers read fields in a fixed order and assert on anything else; this
  * reader takes a block's fields in any order, gives the format's defaults to the ones
  * left out, and reports every mistake with file:line:column. Transforms are applied
- * while reading: the kernels only know world-space spheres, planes and triangles, so a
- * transformed sphere stays a sphere when the transform keeps it round (and unrotated,
- * if it is textured), and becomes a fine triangle mesh otherwise.
+ * while reading: the kernels only know world-space spheres, planes, triangles and
+ * surfaces of revolution about vertical axes, so a transformed sphere stays a sphere
+ * when the transform keeps it round (and unrotated, if it is textured), a surface of
+ * revolution stays one when its axis stays upright, and either becomes a fine triangle
+ * mesh otherwise.
  */
 #include "io/classic_parse.h"
 

@@ -117,7 +117,7 @@ static int mesh_open(Mesh *m, const char *name, Error *err)
     }
     m->load_seconds = timer_now() - t0;
     if (st) return -1;
-    KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0 };
+    KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0, NULL, 0 };
     KdTree one;
     if (kd_build(&in, 1, &one, err)) return -1;
     m->kd_build_1 = one.stats.build_seconds;

@@ -245,9 +245,12 @@ static Status run_passes(const Options *o, const PassContext *pc, const char *ou
 static void print_scene_stats(const Scene *s, const KdTree *kd)
 {
     const KdStats *k = &kd->stats;
-    size_t in_tree = s->n_spheres + s->n_triangles + s->n_boxes;
-    printf("scene: %zu spheres, %zu triangles, %zu boxes, %zu planes, %zu materials, %zu lights\n",
-           s->n_spheres, s->n_triangles, s->n_boxes, s->n_planes, s->n_materials, s->n_lights);
+    size_t in_tree = s->n_spheres + s->n_triangles + s->n_boxes + s->n_revsurfaces;
+    printf("scene: %zu spheres, %zu triangles, %zu boxes, %zu planes, %zu materials, %zu lights", s->n_spheres,
+           s->n_triangles, s->n_boxes, s->n_planes, s->n_materials, s->n_lights);
+    /* only when there are any: the line's form stays what scripts read for other scenes */
+    if (s->n_revsurfaces) printf(", %zu surfaces of revolution", s->n_revsurfaces);
+    printf("\n");
     double per = in_tree ? 1.0 / (double)in_tree : 0.0;
     printf("kd-tree: built in %.3f s; %u nodes, %u leaves (%u empty), depth %u, "
            "%.2f primitives per non-empty leaf, SAH cost %.2f, %.1f KiB (nodes and leaf ids %.1f, copies "

@@ -164,6 +164,9 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Material, clearcoat_roughness);
     out[i++] = (uint)__builtin_offsetof(Material, texture_rm);
     out[i++] = (uint)__builtin_offsetof(Material, normal_scale);
+    out[i++] = (uint)sizeof(RevSurface);
+    out[i++] = (uint)__builtin_offsetof(RevSurface, axis_x);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, n_revsurfaces);
 }
 
 /* ---------------------------------------------------------------- classic ray tracer

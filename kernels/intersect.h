@@ -1,5 +1,6 @@
 /*
- * intersect.h -- ray against sphere, triangle, axis-aligned box and plane.
+ * intersect.h -- ray against sphere, triangle, axis-aligned box and plane (and, in
+ * revsurface.h, surfaces of revolution).
  *
  * A ray is o + t*d with d of any length; a hit needs tmin < t < tmax (strict), so a
  * caller shrinks tmax to the closest hit so far and a tie keeps the first primitive
@@ -313,5 +314,7 @@ KFN int plane_intersect(Plane pl, Ray ray, Hit *hit)
     hit->v = 0.0f;
     return 1;
 }
+
+#include "revsurface.h"
 
 #endif /* CLPT_INTERSECT_H */

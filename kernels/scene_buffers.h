@@ -39,6 +39,8 @@
     X(MANY, Triangle,     triangles,  (ds)->params.n_triangles,  "triangles")                \
     X(MANY, Box,          boxes,      (ds)->params.n_boxes,      "boxes")                    \
     X(MANY, Plane,        planes,     (ds)->params.n_planes,     "planes")                   \
+    X(MANY, RevSurface,   revsurfaces, (ds)->params.n_revsurfaces, "surfaces of revolution") \
+    X(MANY, float,        rev_points, (ds)->n_rev_points,        "profile control points")   \
     X(MANY, Material,     materials,  (ds)->n_materials,         "materials")                \
     X(MANY, Light,        lights,     (ds)->params.n_lights,     "lights")                   \
     X(MANY, TriShading,   shading,    (ds)->n_shading,           "shading normals")          \

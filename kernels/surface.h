@@ -7,6 +7,7 @@
 #define CLPT_SURFACE_H
 
 #include "kmath.h"
+#include "intersect.h"
 #include "scene_view.h"
 
 typedef struct {
@@ -30,7 +31,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
     s.light = NO_INDEX;
     s.prim = id;
     uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
-    uint first_plane = first_box + p->n_boxes;
+    uint first_rev = first_box + p->n_boxes, first_plane = first_rev + p->n_revsurfaces;
     if (id < first_tri) {
         Sphere sp = sc->spheres[id];
         /* p stays o + t*d: projecting it onto the sphere (center + r*n) would round it to
@@ -66,7 +67,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
                 s.v = w * sh.uv0[1] + hit.u * sh.uv1[1] + hit.v * sh.uv2[1];
             }
         }
-    } else if (id < first_plane) {
+    } else if (id < first_rev) {
         Box b = sc->boxes[id - first_box];
         int face = (int)hit.u;                    /* 0:-x 1:+x 2:-y 3:+y 4:-z 5:+z */
         float sign = (face & 1) ? 1.0f : -1.0f;
@@ -75,6 +76,17 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
         s.ns = s.ng;
         s.material = b.material;
         s.light = b.light;
+    } else if (id < first_plane) {
+        /* (u, v) become the angle around the axis (0..1 from +x towards +z, as the
+         * course's revolution turns) and the segment's parameter */
+        RevSurface rs = sc->revsurfaces[id - first_rev];
+        vec3 n = revsurface_normal(rs, sc->rev_points, s.p, hit.u, hit.v);
+        s.ng = n;
+        s.ns = n;
+        s.material = rs.material;
+        float a = k_atan2(s.p.z - rs.axis_z, s.p.x - rs.axis_x) * (1.0f / K_TWO_PI);
+        s.u = a < 0.0f ? a + 1.0f : a;
+        s.v = hit.u;
     } else {
         Plane pl = sc->planes[id - first_plane];
         s.ng = pl.normal;

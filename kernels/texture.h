@@ -29,13 +29,13 @@ KFN void surface_uv(const SceneView *sc, Surface s, float *u, float *v)
 {
     GLOBAL const RenderParams *p = sc->params;
     uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
-    uint first_plane = first_box + p->n_boxes;
+    uint first_rev = first_box + p->n_boxes, first_plane = first_rev + p->n_revsurfaces;
     if (s.prim < first_tri) {
         vec3 n = s.ng;
         *u = 0.5f + k_atan2(n.x, n.z) * (1.0f / K_TWO_PI);
         *v = 1.0f - k_acos(n.y) * K_INV_PI;
-    } else if (s.prim < first_box) {
-        *u = s.u;
+    } else if (s.prim < first_box || (s.prim >= first_rev && s.prim < first_plane)) {
+        *u = s.u;     /* triangles: interpolated uv; surfaces of revolution: angle, s */
         *v = s.v;
     } else if (s.prim < first_plane) {
         Box b = sc->boxes[s.prim - first_box];

@@ -16,18 +16,21 @@
 #include "intersect.h"
 #include "scene_view.h"
 
-/* Tests global primitive `id` (a sphere, triangle or box: planes are not in the tree)
- * against the ray, whose tmax is the closest hit so far. The walk tests triangles by
- * leaf group and calls this for spheres and boxes. */
+/* Tests global primitive `id` (a sphere, triangle, box or surface of revolution: planes
+ * are not in the tree) against the ray, whose tmax is the closest hit so far. The walk
+ * tests triangles by leaf group and calls this for the others. */
 KFN_INLINE int trace_prim(const SceneView *sc, uint id, const RayPre *rp, Ray ray, Hit *hit)
 {
     GLOBAL const RenderParams *pr = sc->params;
     uint first_tri = pr->n_spheres, first_box = first_tri + pr->n_triangles;
+    uint first_rev = first_box + pr->n_boxes;
     if ((id >= first_tri) & (id < first_box))
         return triangle_intersect(rp, &sc->triangles[id - first_tri], ray, hit);
     if (id < first_tri)
         return sphere_intersect(sc->spheres[id], ray, hit);
-    return box_intersect(rp, sc->boxes[id - first_box], ray, hit);
+    if (id < first_rev)
+        return box_intersect(rp, sc->boxes[id - first_box], ray, hit);
+    return revsurface_intersect(sc->revsurfaces[id - first_rev], sc->rev_points, ray, hit);
 }
 
 /* Clips the ray's [tmin, tmax] to the root box; 0 if nothing is left. The far end is
@@ -204,7 +207,7 @@ KFN Hit trace_closest(const SceneView *sc, Ray ray)
     best.u = 0.0f;
     best.v = 0.0f;
     RayPre rp = ray_prepare(ray);
-    uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes;
+    uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes + pr->n_revsurfaces;
     for (uint i = 0; i < pr->n_planes; i++) {
         Ray r = ray;
         r.tmax = best.t;
@@ -266,7 +269,7 @@ KFN_INLINE void trace_ray_begin(const SceneView *sc, Ray ray, int any, TraceRay 
     w->node = 0u;
     w->sp = 0;
     w->t0 = w->t1 = 0.0f;
-    uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes;
+    uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes + pr->n_revsurfaces;
     for (uint i = 0; i < pr->n_planes; i++) {
         Ray r = ray;
         r.tmax = t->best.t;

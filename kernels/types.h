@@ -64,7 +64,7 @@ typedef struct {
 #define KD_GROUP_WORDS (KD_GROUP * 10u)
 
 /* Global primitive ids: [0, n_spheres) spheres, then triangles, then boxes, then
- * planes. Spheres, triangles and boxes are in the kd-tree; infinite planes are not. */
+ * surfaces of revolution, then planes. All but the infinite planes are in the kd-tree. */
 typedef struct {                                        /* 32 bytes */
     vec3 center;  float radius;
     uint material;
@@ -90,6 +90,20 @@ typedef struct {                                        /* 32 bytes */
     vec3 lo;  uint material;
     vec3 hi;  uint light;
 } Box;
+
+/* A surface of revolution (kernels/revsurface.h): a profile curve (x(s), y(s)) in the
+ * xy plane revolved about the vertical axis x = axis_x, z = axis_z. The profile is
+ * n_segments Bezier segments of `degree`, stored as (x, y) float pairs in rev_points
+ * from pair `first` on; consecutive segments share their end point, so the surface
+ * holds n_segments * degree + 1 pairs. lo..hi bound it (the kd-tree box). Surfaces of
+ * revolution never emit light (the classic format they come from has no emission). */
+#define REV_MAX_DEGREE 24u     /* longest Bezier profile: 25 control points */
+typedef struct {                                        /* 48 bytes */
+    vec3 lo;  uint material;
+    vec3 hi;  uint first;
+    float axis_x, axis_z;
+    uint n_segments, degree;
+} RevSurface;
 
 typedef struct {                                        /* 32 bytes */
     vec3 normal;  float offset;  /* the points p with dot(normal, p) == offset */
@@ -240,7 +254,7 @@ typedef struct {                                        /* 272 bytes */
     uint n_spheres, n_triangles, n_boxes, n_planes;
     uint n_lights;
     uint n_nodes, n_leaf_prims;
-    vec3 bounds_lo;   uint pad1;      /* box of the kd-tree root */
+    vec3 bounds_lo;   uint n_revsurfaces; /* box of the kd-tree root; RevSurface count */
     vec3 bounds_hi;   uint pad2;
     /* integrators and light kinds of the classic ray tracer (kernels/whitted.cl) */
     vec3 ambient;     uint integrator;  /* whitted: ambient light; enum Integrator */
@@ -291,6 +305,7 @@ CLPT_CHECK_SIZE(Triangle, 48);
 CLPT_CHECK_SIZE(TriShading, 64);
 CLPT_CHECK_SIZE(Box, 32);
 CLPT_CHECK_SIZE(Plane, 32);
+CLPT_CHECK_SIZE(RevSurface, 48);
 CLPT_CHECK_SIZE(Material, 144);
 CLPT_CHECK_SIZE(Light, 80);
 CLPT_CHECK_SIZE(Camera, 112);

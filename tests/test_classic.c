@@ -574,7 +574,8 @@ static void test_errors(void)
         { "Group { numObjects 1 Transform { Matrix4f { 1 0 0 } Sphere { radius 1 } } }",
           "x.txt:1:51: expected 16 numbers for the matrix, found '}'", ST_INPUT },
         { "Group { numObjects 1 Transform { Translate 1 0 0 Cube { } } }",
-          "x.txt:1:50: expected an object (Group, Sphere, Plane, Triangle, TriangleMesh, Transform)", ST_INPUT },
+          "x.txt:1:50: expected an object (Group, Sphere, Plane, Triangle, TriangleMesh, Transform, RevSurface, "
+          "BezierCurve, BsplineCurve) or MaterialIndex, found 'Cube'", ST_INPUT },
         { "Group { numObjects 1 Sphere { radius 1 } }", "x.txt:1:43: the scene has no camera", ST_INPUT },
         { "PerspectiveCamera { center 0 0 0 direction 0 1 0 up 0 2 0 angle 30 }",
           "x.txt:1:50: 'up' is parallel to the view direction", ST_INPUT },

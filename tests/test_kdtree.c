@@ -71,7 +71,7 @@ static void add_plane(vec3 n, float offset)
 /* Builds the tree and the SceneView the kernel functions read. */
 static Status scene_build(int threads)
 {
-    KdInput in = { scene.sph, scene.ns, scene.tri, scene.nt, scene.box, scene.nb };
+    KdInput in = { scene.sph, scene.ns, scene.tri, scene.nt, scene.box, scene.nb, NULL, 0 };
     Error err = { 0 };
     kd_free(&scene.tree);
     Status st = kd_build(&in, threads, &scene.tree, &err);
@@ -89,7 +89,7 @@ static Status scene_build(int threads)
     scene.params.bounds_lo = scene.tree.lo;
     scene.params.bounds_hi = scene.tree.hi;
     SceneView v = { &scene.params, scene.tree.nodes, scene.tree.leaf_prims, scene.sph, scene.tri,
-                    scene.box, scene.pln, NULL, NULL, NULL, NULL, NULL, NULL };
+                    scene.box, scene.pln, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL };
     scene.view = v;
     return ST_OK;
 }
@@ -961,7 +961,7 @@ static void test_pinned_trees(void)
     Triangle *tri = cube_sphere(40, &nt);
     CHECK(tri != NULL);
     if (!tri) return;
-    KdInput in = { NULL, 0, tri, nt, NULL, 0 };
+    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0 };
     const int threads[] = { 1, 3, 0 };
     for (int i = 0; i < 3; i++) {
         KdTree t;
@@ -1011,7 +1011,7 @@ static int mesh_scene_open(MeshScene *m, const char *what)
         MeshOptions o = mesh_options(0);
         st = mesh_load(what, &m->scene, &o, &err);
     }
-    KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0 };
+    KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0, NULL, 0 };
     if (st == ST_OK) st = kd_build(&in, 0, &m->tree, &err);
     if (st != ST_OK) {
         fprintf(stderr, "  %s: %s\n", what, err.msg);

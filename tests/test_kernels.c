@@ -199,6 +199,13 @@ static void build_scene(void)
     }
     Box lb = { v3(2.0f, 3.0f, 2.0f), lamp, v3(2.5f, 3.2f, 2.4f), NO_INDEX };
     scene_add_box(&scene, lb, NULL);
+    /* surfaces of revolution: two cubic pieces and a degree-5 Bezier profile */
+    const float vase[2 * 7] = { 0, 0, 0.4f, 0, 0.7f, 0.3f, 0.6f, 0.8f, 0.5f, 1.3f, 0.3f, 1.6f, 0.45f, 2.0f };
+    const float bowl[2 * 6] = { 0, 0, 0.6f, 0, 0.8f, 0.2f, 0.9f, 0.5f, 1.0f, 0.6f, 1.1f, 0.7f };
+    RevSurface rv = { v3s(0.0f), phong, v3s(0.0f), 0u, -1.5f, 1.0f, 2u, 3u };
+    scene_add_revsurface(&scene, rv, vase, NULL);
+    RevSurface rb = { v3s(0.0f), mirror, v3s(0.0f), 0u, 1.5f, -0.5f, 1u, 5u };
+    scene_add_revsurface(&scene, rb, bowl, NULL);
     Plane floor = { v3(0.0f, 1.0f, 0.0f), -3.5f, checked, 0, 0, 0 };
     scene_add_plane(&scene, floor, NULL);
     /* delta lights of every kind, with the classic and the physical attenuation */
@@ -329,7 +336,8 @@ static void test_layout(void)
                     offsetof(RenderParams, shadows), offsetof(RenderParams, normal_miss_grey),
                     offsetof(Material, roughness), offsetof(Material, k),
                     offsetof(Material, clearcoat_roughness), offsetof(Material, texture_rm),
-                    offsetof(Material, normal_scale) };
+                    offsetof(Material, normal_scale),
+                    sizeof(RevSurface), offsetof(RevSurface, axis_x), offsetof(RenderParams, n_revsurfaces) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);
@@ -696,7 +704,7 @@ static void test_whitted(void)
         cl_mem cb = buffer(sizeof zero, &zero);
         set_scene_args(k);
         SET(k, 0, parb);
-        SET(k, 12, mb);
+        SET(k, SCENE_BUF_pixel_mask, mb);
         uint first_pixel = 0;
         SET(k, N_SCENE + 0, first_pixel);
         SET(k, N_SCENE + 1, first_sample);

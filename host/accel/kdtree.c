@@ -912,7 +912,7 @@ static void gather_one(Build *b, uint gid, uint tri, const Aabb *a, int finite)
  * every SAH area infinite. */
 static Status gather(Build *b, const KdInput *in, uint *skipped, Error *err)
 {
-    size_t total = in->n_spheres + in->n_triangles + in->n_boxes;
+    size_t total = in->n_spheres + in->n_triangles + in->n_boxes + in->n_revs;
     if (total > KD_MAX_PRIMS)
         return error_set(err, ST_INPUT, "kd-tree: %zu primitives, more than the %u supported",
                          total, KD_MAX_PRIMS);
@@ -933,6 +933,11 @@ static Status gather(Build *b, const KdInput *in, uint *skipped, Error *err)
     }
     for (size_t i = 0; i < in->n_boxes; i++, gid++) {
         Aabb a = box_bounds(&in->boxes[i]);
+        gather_one(b, gid, NO_INDEX, &a, aabb_finite(&a));
+    }
+    for (size_t i = 0; i < in->n_revs; i++, gid++) {
+        Box bx = { in->revs[i].lo, 0u, in->revs[i].hi, 0u };
+        Aabb a = box_bounds(&bx);
         gather_one(b, gid, NO_INDEX, &a, aabb_finite(&a));
     }
     *skipped = (uint)(total - b->n_prims);

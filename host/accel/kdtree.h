@@ -40,6 +40,7 @@ typedef struct {
     const Sphere *spheres;     size_t n_spheres;
     const Triangle *triangles; size_t n_triangles;
     const Box *boxes;          size_t n_boxes;
+    const RevSurface *revs;    size_t n_revs;    /* after the boxes in the id space */
 } KdInput;
 
 typedef struct {

@@ -45,6 +45,7 @@ typedef struct {
     uint n_materials;
     uint n_shading;
     size_t n_texels;
+    size_t n_rev_points;        /* floats: two per profile control point */
 } DeviceScene;
 #undef DEVICE_SCENE_FIELD_
 #undef DEVICE_SCENE_FIELD_MANY_

@@ -27,7 +27,8 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     RenderParams *p = &out->ds.params;
     if ((st = camera_setup(&s->camera, s->image.width, s->image.height, &p->camera, err))) return st;
     if ((st = scene_check_precision(s, err))) return st;
-    KdInput in = { s->spheres, s->n_spheres, s->triangles, s->n_triangles, s->boxes, s->n_boxes };
+    KdInput in = { s->spheres, s->n_spheres, s->triangles, s->n_triangles, s->boxes, s->n_boxes,
+                   s->revsurfaces, s->n_revsurfaces };
     if ((st = kd_build(&in, kd_threads, &out->kd, err))) return st;
     p->bg_type = s->bg_type;
     p->bg_color = s->bg_color;
@@ -42,6 +43,7 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     p->n_triangles = (uint)s->n_triangles;
     p->n_boxes = (uint)s->n_boxes;
     p->n_planes = (uint)s->n_planes;
+    p->n_revsurfaces = (uint)s->n_revsurfaces;
     p->n_lights = (uint)s->n_lights;
     p->n_nodes = out->kd.n_nodes;
     p->n_leaf_prims = out->kd.n_leaf_prims;
@@ -53,6 +55,9 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     out->ds.triangles = s->triangles;
     out->ds.boxes = s->boxes;
     out->ds.planes = s->planes;
+    out->ds.revsurfaces = s->revsurfaces;
+    out->ds.rev_points = s->rev_points;
+    out->ds.n_rev_points = s->n_rev_points;
     out->ds.materials = s->materials;
     out->ds.n_materials = (uint)s->n_materials;
     out->ds.lights = s->lights;

@@ -47,6 +47,8 @@ void scene_free(Scene *s)
     free(s->shading);
     free(s->boxes);
     free(s->planes);
+    free(s->revsurfaces);
+    free(s->rev_points);
     free(s->lights);
     free(s->delta_lights);
     for (size_t i = 0; i < s->n_textures; i++) {
@@ -87,7 +89,7 @@ int array_reserve(void **ptr, size_t *cap, size_t need, size_t elem)
 static Status append(void **arr, size_t *n, size_t *cap, const void *item, size_t elem,
                      const Scene *s, Error *err)
 {
-    size_t total = s->n_spheres + s->n_triangles + s->n_boxes + s->n_planes;
+    size_t total = s->n_spheres + s->n_triangles + s->n_boxes + s->n_revsurfaces + s->n_planes;
     if (total >= (size_t)NO_INDEX - 1)
         return error_set(err, ST_INPUT, "too many primitives (the limit is %u)", NO_INDEX - 2);
     if (array_reserve(arr, cap, *n + 1, elem))
@@ -153,6 +155,30 @@ Status scene_add_box(Scene *s, Box b, Error *err)
 Status scene_add_plane(Scene *s, Plane p, Error *err)
 {
     return append((void **)&s->planes, &s->n_planes, &s->cap_planes, &p, sizeof p, s, err);
+}
+
+Status scene_add_revsurface(Scene *s, RevSurface r, const float *xy, Error *err)
+{
+    size_t n = 2u * ((size_t)r.n_segments * r.degree + 1u);
+    if (r.n_segments == 0 || r.degree == 0 || r.degree > REV_MAX_DEGREE || s->n_rev_points / 2u >= NO_INDEX - n)
+        return error_set(err, ST_INPUT, "a surface of revolution with %u segments of degree %u", r.n_segments,
+                         r.degree);
+    float rmax = 0.0f, lo_y = xy[1], hi_y = xy[1];
+    for (size_t i = 0; i < n; i += 2) {
+        rmax = fmaxf(rmax, fabsf(xy[i]));
+        lo_y = fminf(lo_y, xy[i + 1]);
+        hi_y = fmaxf(hi_y, xy[i + 1]);
+    }
+    r.lo = v3(r.axis_x - rmax, lo_y, r.axis_z - rmax);
+    r.hi = v3(r.axis_x + rmax, hi_y, r.axis_z + rmax);
+    r.first = (uint)(s->n_rev_points / 2u);
+    if (array_reserve((void **)&s->rev_points, &s->cap_rev_points, s->n_rev_points + n, sizeof(float)))
+        return error_set(err, ST_INTERNAL, "out of memory growing the scene");
+    Status st = append((void **)&s->revsurfaces, &s->n_revsurfaces, &s->cap_revsurfaces, &r, sizeof r, s, err);
+    if (st) return st;
+    memcpy(s->rev_points + s->n_rev_points, xy, n * sizeof(float));
+    s->n_rev_points += n;
+    return ST_OK;
 }
 
 Status scene_add_light(Scene *s, Light l, Error *err)
@@ -315,7 +341,8 @@ uint scene_find_material(const Scene *s, const char *name)
 
 uint scene_first_triangle(const Scene *s) { return (uint)s->n_spheres; }
 uint scene_first_box(const Scene *s) { return (uint)(s->n_spheres + s->n_triangles); }
-uint scene_first_plane(const Scene *s) { return (uint)(s->n_spheres + s->n_triangles + s->n_boxes); }
+uint scene_first_revsurface(const Scene *s) { return (uint)(s->n_spheres + s->n_triangles + s->n_boxes); }
+uint scene_first_plane(const Scene *s) { return scene_first_revsurface(s) + (uint)s->n_revsurfaces; }
 
 static Material material_base(uint type)
 {

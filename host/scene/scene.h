@@ -47,6 +47,8 @@ typedef struct {
     TriShading *shading;   size_t n_shading, cap_shading;
     Box *boxes;            size_t n_boxes, cap_boxes;
     Plane *planes;         size_t n_planes, cap_planes;
+    RevSurface *revsurfaces;  size_t n_revsurfaces, cap_revsurfaces;
+    float *rev_points;     size_t n_rev_points, cap_rev_points;   /* (x, y) pairs: floats */
     Light *lights;         size_t n_lights;     /* filled by scene_prepare_lights */
 
     /* the classic ray tracer's additions (docs/classic-format.md) */
@@ -92,6 +94,9 @@ Status scene_add_triangle(Scene *s, Triangle t, Error *err);
 Status scene_add_shading(Scene *s, TriShading sh, uint *index, Error *err);
 Status scene_add_box(Scene *s, Box b, Error *err);
 Status scene_add_plane(Scene *s, Plane p, Error *err);
+/* Adds r with its profile's n_segments * degree + 1 control points (x, y pairs at xy);
+ * fills r.first and r's bounds (the convex hull of the control points revolved). */
+Status scene_add_revsurface(Scene *s, RevSurface r, const float *xy, Error *err);
 /* A point, spot or directional light (type, position, direction, intensity, attenuation
  * and cone set by the caller; direction unit). */
 Status scene_add_light(Scene *s, Light l, Error *err);
@@ -122,6 +127,7 @@ uint scene_find_material(const Scene *s, const char *name);
 /* Global primitive id of the first triangle, box and plane (spheres start at 0). */
 uint scene_first_triangle(const Scene *s);
 uint scene_first_box(const Scene *s);
+uint scene_first_revsurface(const Scene *s);
 uint scene_first_plane(const Scene *s);
 
 /* Builds the light list: the emissive spheres, triangles and boxes (area lights), then

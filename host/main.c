@@ -180,6 +180,7 @@ static void apply_overrides(const Options *o, Scene *s)
     if (o->width >= 0) s->image.width = (uint)o->width;
     if (o->height >= 0) s->image.height = (uint)o->height;
     if (o->seed >= 0) s->image.seed = (uint)o->seed;
+    if (o->sampler >= 0) s->image.sampler = (uint)o->sampler;
     if (o->max_depth >= 0) s->image.max_depth = (uint)o->max_depth;
     if (o->integrator >= 0) s->integrator = (uint)o->integrator;
     if (o->gamma >= 0) s->linear_output = o->gamma == 1;

@@ -51,6 +51,10 @@ void options_print_help(FILE *f)
 "      --seed N               random seed; the same seed gives the same image\n"
 "                             on any devices and batch sizes\n"
 "      --max-depth N          longest path, in bounces (overrides the scene)\n"
+"      --sampler sobol|independent\n"
+"                             random numbers: Owen-scrambled Sobol points\n"
+"                             (default; less noise) or independent ones\n"
+"                             (clpt's earlier sampler, the same images)\n"
 "      --time-limit SECONDS   stop starting new batches after this long; the\n"
 "                             image holds the whole batches finished by then\n"
 "                             (none: the output is left alone, exit status 7)\n"
@@ -80,7 +84,9 @@ void options_print_help(FILE *f)
 "                             scene and settings must be the ones it was made\n"
 "                             with (else exit status 3). Checkpoints go on\n"
 "                             into FILE unless --checkpoint names another file\n"
-"\n"
+"\n",
+        f);
+    fputs(
 "Scene and integrator:\n"
 "      --format auto|clpt|classic\n"
 "                             scene file format; default: told from the content\n"
@@ -335,6 +341,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
     static const int gamma_values[] = { 0, 1 };
     static const char *const on_off[] = { "on", "off", NULL };
     static const int on_off_values[] = { 1, 0 };
+    static const char *const samplers[] = { "sobol", "independent", NULL };
+    static const int sampler_values[] = { SAMPLER_SOBOL, SAMPLER_INDEPENDENT };
     *found = 1;
     if (strcmp(a, "--integrator") == 0)
         return parse_choice(a, v, integrators, integrator_values, "'path' or 'whitted'", &o->integrator, err);
@@ -344,6 +352,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
         return parse_choice(a, v, gammas, gamma_values, "'srgb' or 'none'", &o->gamma, err);
     if (strcmp(a, "--shadows") == 0)
         return parse_choice(a, v, on_off, on_off_values, "'on' or 'off'", &o->shadows, err);
+    if (strcmp(a, "--sampler") == 0)
+        return parse_choice(a, v, samplers, sampler_values, "'sobol' or 'independent'", &o->sampler, err);
     if (strcmp(a, "--aov") == 0) return options_parse_aovs(v, &o->aovs, err);
     *found = 0;
     return ST_OK;
@@ -366,6 +376,7 @@ static void options_defaults(Options *o)
     o->integrator = -1;
     o->gamma = -1;
     o->shadows = -1;
+    o->sampler = -1;
     o->format = SCENE_FORMAT_AUTO;
     o->adaptive_spp = 16;
 }

@@ -33,6 +33,7 @@ typedef struct {
     unsigned adaptive_spp;        /* extra samples per flagged pixel */
     int gamma;                    /* -1 the scene's, 0 sRGB, 1 none (linear 8-bit) */
     int shadows;                  /* -1 the scene's, 0 off, 1 on */
+    int sampler;                  /* -1 the scene's, else enum Sampler */
     double depth_near, depth_far; /* --depth-range; near == far (0) = automatic */
 } Options;
 

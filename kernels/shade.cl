@@ -39,7 +39,8 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
                            vec3 ng_face, const PhongLobes *lobes, vec3 albedo,
                            GLOBAL Ray *shadow_ray)
 {
-    uint key = ps->rng_key, b = ps->bounce;
+    RngKey key = rng_key_of(ps, sc->params);
+    uint b = ps->bounce;
     uint mis_mode = sc->params->mis_mode;
     LightSample ls;
     if (!light_sample(sc, s.p, rng_uniform(key, b, DIM_LIGHT_PICK), rng_uniform(key, b, DIM_LIGHT_U),
@@ -76,7 +77,8 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
 {
     GLOBAL const RenderParams *p = sc->params;
     Ray r = *ray;
-    uint key = ps->rng_key, bounce = ps->bounce;
+    RngKey key = rng_key_of(ps, p);
+    uint bounce = ps->bounce;
 
     if (hit.prim == NO_INDEX) {
         /* the background is no light that next-event estimation samples (a cube map is

@@ -122,6 +122,9 @@ void options_print_help(FILE *f)
 "Reporting:\n"
 "      --stats                print scene, kd-tree, kernel build and\n"
 "                             per-device statistics to stdout\n"
+"      --profile              --stats, and where each device's time goes: ray\n"
+"                             generation, traversal, shading, shadow rays,\n"
+"                             film, queues, host waits (slows rendering)\n"
 "  -q, --quiet                no progress bar and no summary line\n"
 "  -h, --help                 print this help and exit\n"
 "      --version              print the version and exit\n"
@@ -256,7 +259,7 @@ static int options_set_switch(const char *a, Options *o)
     struct { const char *name, *alias; int *dst; } switches[] = {
         { "--help", "-h", &o->help },      { "--version", NULL, &o->version },
         { "--list-devices", NULL, &o->list_devices }, { "--stats", NULL, &o->stats },
-        { "--quiet", "-q", &o->quiet },
+        { "--quiet", "-q", &o->quiet },    { "--profile", NULL, &o->profile },
     };
     for (size_t k = 0; k < sizeof switches / sizeof switches[0]; k++)
         if (strcmp(a, switches[k].name) == 0 || (switches[k].alias && strcmp(a, switches[k].alias) == 0)) {

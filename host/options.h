@@ -18,7 +18,7 @@ typedef struct {
     const char *checkpoint_path;  /* NULL: no checkpoints (but see resume_path) */
     double checkpoint_seconds;    /* between checkpoints; 60 unless given */
     const char *resume_path;      /* NULL: a fresh render */
-    int list_devices, stats, quiet, help, version;
+    int list_devices, stats, profile, quiet, help, version;
     /* developer flags */
     const char *kernel_dir;
     unsigned batch;               /* fixed batch size, 0 = adaptive */

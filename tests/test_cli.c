@@ -16,7 +16,7 @@ static void test_help_documents_every_flag(void)
     const char *flags[] = { "--output", "--spp", "--width", "--height", "--seed", "--max-depth", "--time-limit",
                             "--progressive-output", "--list-devices", "--device", "--threads", "--stats",
                             "--quiet", "--help", "--version", "--kernel-dir", "--batch", "--wave-paths",
-                            "--shadows", "-size W H -input SCENE -output FILE", "-depth NEAR FAR FILE",
+                            "--shadows", "--sampler", "--profile", "-size W H -input SCENE -output FILE", "-depth NEAR FAR FILE",
                             "-bounces N", "clpt SCENE OUT.bmp", "Exit status" };
     for (size_t i = 0; i < sizeof flags / sizeof flags[0]; i++) CHECK_STR_CONTAINS(r.out, flags[i]);
 }
@@ -40,6 +40,9 @@ static void test_usage_errors(void)
     cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.jpg"), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, ".jpg");
+    cli_run(ARGS("scenes/cornell-box.scene", "--sampler", "halton"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "--sampler expects 'sobol' or 'independent', got 'halton'");
 }
 
 static void test_missing_scene_is_io_error(void)

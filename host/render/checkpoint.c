@@ -305,8 +305,8 @@ Status checkpoint_check(const Checkpoint *c, const char *path, const CheckpointI
     else if (g->max_depth != e->max_depth)
         snprintf(what, sizeof what, "its maximum depth is %u, this render's %u", g->max_depth, e->max_depth);
     else if (memcmp(g->key, e->key, CHECKPOINT_KEY_SIZE) != 0)
-        snprintf(what, sizeof what, "the scene differs (geometry, materials, camera or lights), or it was made "
-                                    "by a clpt with other kernels");
+        snprintf(what, sizeof what, "the scene differs (geometry, materials, camera or lights, or the "
+                                    "sampler or shadows setting), or it was made by a clpt with other kernels");
     else
         return ST_OK;
     return error_set(err, ST_INPUT,

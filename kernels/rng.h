@@ -150,10 +150,14 @@ KFN uint rng_sobol(uint index, uint dim)
 KFN uint rng_sobol_bits(uint pixel_key, uint sample, uint bounce, uint dim)
 {
     uint coord = (RNG_PAIR_SECOND >> dim) & 1u;
-    uint pattern = rng_hash(pixel_key ^ rng_hash(bounce * (uint)RNG_DIMS_PER_BOUNCE + dim - coord + 0x85ebca6bu));
+    /* one hash of the pixel key offset by the pattern's number times the golden ratio:
+     * the pixel keys are hashes already, and this is the hot path of every sample */
+    uint pattern = rng_hash(pixel_key + (bounce * (uint)RNG_DIMS_PER_BOUNCE + dim - coord) * 0x9e3779b9u);
     uint index = rng_owen_scramble(sample, pattern);
     uint digits = coord ? rng_sobol1_reversed(index) : index;
-    return rng_reverse_bits(rng_lk_permute(digits, rng_hash(pattern ^ (coord ? 0x68e31da4u : 0xb5297a4du))));
+    /* the values' scrambling seeds: other odd multiples of the pattern seed (bijections,
+     * so as uniform over pixels as it; they scramble values, not the index) */
+    return rng_reverse_bits(rng_lk_permute(digits, pattern * (coord ? 0x2c1b3c6du : 0x297a2d39u) + 0x68e31da4u));
 }
 
 /* Uniform float in [0, 1): the top 24 bits, so 1.0f is never returned. */

@@ -2,7 +2,7 @@
 """Error per sample of clpt's samplers: RMSE at equal spp against a converged reference.
 
 usage: bench/sampler_rmse.py [--clpt build/clpt] [--refs DIR] [--ref-spp N] [--spp 4,16,64]
-                             [--seeds 1,2,3] [--device cpu] [--out DIR] [SCENE...]
+                             [--seeds 1,2,3] [--device cpu] [--out DIR] [--reuse] [SCENE...]
 
 SCENE is NAME=PATH (default: the McGuire Cornell box and the dragon of ../shared/peers,
 and scenes/one-weekend.scene), rendered at 256x256 (the one-weekend scene at its own
@@ -69,7 +69,9 @@ def rmse(img, ref, keep):
     return math.sqrt(s / n), math.sqrt(sm / max(nm, 1))
 
 
-def render(clpt, scene, size, spp, seed, sampler, device, out):
+def render(clpt, scene, size, spp, seed, sampler, device, out, reuse=False):
+    if reuse and os.path.exists(out):
+        return
     cmd = [clpt, scene, '--spp', str(spp), '--seed', str(seed), '--sampler', sampler, '-q', '-o', out]
     if device:
         cmd += ['--device', device]
@@ -87,6 +89,7 @@ def main():
     ap.add_argument('--seeds', default='1,2')
     ap.add_argument('--device', default='')
     ap.add_argument('--out', default='build/sampler-rmse')
+    ap.add_argument('--reuse', action='store_true', help='keep images already in --out (same settings)')
     ap.add_argument('scenes', nargs='*')
     a = ap.parse_args()
     scenes = a.scenes or ['cornell=../shared/peers/cornell-mcguire.scene', 'weekend=scenes/one-weekend.scene',
@@ -110,7 +113,7 @@ def main():
                 seeds = [int(s) for s in a.seeds.split(',')]
                 for seed in seeds:
                     out = os.path.join(a.out, '%s-%s-%d-%d.pfm' % (name, sampler, spp, seed))
-                    render(a.clpt, path, size, spp, seed, sampler, a.device, out)
+                    render(a.clpt, path, size, spp, seed, sampler, a.device, out, a.reuse)
                     r = rmse(read_pfm(out)[2], ref, keep)
                     tot[0] += r[0] / len(seeds)
                     tot[1] += r[1] / len(seeds)

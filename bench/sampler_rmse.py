@@ -13,7 +13,11 @@ per seed of --seeds, and the table gives the mean RMSE over the seeds, overall a
 silhouette pixels left out ("masked": pixels whose 3x3 neighbourhood in the reference
 spans more than 0.05 in mean RGB, as ../shared/peers/compare.py), and the MSE ratio
 independent / sobol (how many times more samples the independent sampler needs for the
-same error). Standard library only (no numpy).
+same error). The reference's own noise adds to both MSEs: as its samples are
+independent, its share is MSE_ref = MSE_independent(N) * N / (N + R) for N spp against a
+reference of R spp, and the last column is the ratio with that share taken out of both
+(--ref-spp-for NAME=R when a reference holds another count than --ref-spp, as one cut
+short by --time-limit). Standard library only (no numpy).
 """
 import argparse
 import array
@@ -85,6 +89,7 @@ def main():
     ap.add_argument('--clpt', default='build/clpt')
     ap.add_argument('--refs', default='build/sampler-refs')
     ap.add_argument('--ref-spp', type=int, default=4096)
+    ap.add_argument('--ref-spp-for', action='append', default=[], metavar='NAME=R')
     ap.add_argument('--spp', default='4,16,64')
     ap.add_argument('--seeds', default='1,2')
     ap.add_argument('--device', default='')
@@ -96,8 +101,10 @@ def main():
                           'dragon=../shared/peers/dragon.scene']
     os.makedirs(a.refs, exist_ok=True)
     os.makedirs(a.out, exist_ok=True)
-    print('| scene | spp | RMSE independent | RMSE sobol | masked independent | masked sobol | MSE ratio (masked) |')
-    print('|---|---|---|---|---|---|---|')
+    ref_spp = dict((k, int(v)) for k, v in (x.split('=', 1) for x in a.ref_spp_for))
+    print('| scene | spp | RMSE independent | RMSE sobol | masked independent | masked sobol | MSE ratio (masked) '
+          '| MSE ratio, reference noise out |')
+    print('|---|---|---|---|---|---|---|---|')
     for item in scenes:
         name, path = item.split('=', 1)
         size = None if name == 'weekend' else (256, 256)
@@ -119,8 +126,10 @@ def main():
                     tot[1] += r[1] / len(seeds)
                 res[sampler] = tot
             i, s = res['independent'], res['sobol']
-            print('| %s | %d | %.5f | %.5f | %.5f | %.5f | %.2f |' % (name, spp, i[0], s[0], i[1], s[1],
-                                                                     (i[1] / s[1]) ** 2))
+            r = ref_spp.get(name, a.ref_spp)
+            noise = i[1] ** 2 * spp / (spp + r)
+            print('| %s | %d | %.5f | %.5f | %.5f | %.5f | %.2f | %.2f |' % (
+                name, spp, i[0], s[0], i[1], s[1], (i[1] / s[1]) ** 2, (i[1] ** 2 - noise) / (s[1] ** 2 - noise)))
             sys.stdout.flush()
 
 

@@ -191,6 +191,7 @@ static void apply_overrides(const Options *o, Scene *s)
     if (o->width >= 0) s->image.width = (uint)o->width;
     if (o->height >= 0) s->image.height = (uint)o->height;
     if (o->seed >= 0) s->image.seed = (uint)o->seed;
+    if (o->sampler >= 0) s->image.sampler = (uint)o->sampler;
     if (o->max_depth >= 0) s->image.max_depth = (uint)o->max_depth;
     if (o->integrator >= 0) s->integrator = (uint)o->integrator;
     if (o->gamma >= 0) s->linear_output = o->gamma == 1;
@@ -293,6 +294,25 @@ static void print_render_stats(const ScheduleStats *st, uint spp, Device **devs,
                st->checkpoints, 1e3 * st->checkpoint_seconds / st->checkpoints, 1e3 * st->snapshot_seconds / st->checkpoints);
 }
 
+/* --profile: each device's time per phase (enum DevicePhase), in seconds and as a share
+ * of its busy time; the scalar device's thread time is divided by its threads. */
+static void print_profile(const ScheduleStats *st, Device **devs, size_t n)
+{
+    static const char *const names[PHASE_N] = { "raygen", "traverse", "shade", "shadow", "film", "queues",
+                                                "host wait" };
+    printf("profile (seconds, %% of busy time; OpenCL: device time of its commands, scalar: thread time / threads)\n");
+    printf("%-32s", "device");
+    for (int p = 0; p < PHASE_N; p++) printf(" %15s", names[p]);
+    printf(" %8s\n", "busy s");
+    for (size_t i = 0; i < n && i < st->n_devices && st->devices; i++) {
+        const double *t = devs[i]->counters.phase_seconds;
+        double busy = st->devices[i].busy_seconds > 0.0 ? st->devices[i].busy_seconds : 1e-9;
+        printf("%-32.32s", devs[i]->desc.name);
+        for (int p = 0; p < PHASE_N; p++) printf(" %8.3f %5.1f%%", t[p], 100.0 * t[p] / busy);
+        printf(" %8.2f\n", st->devices[i].busy_seconds);
+    }
+}
+
 /* No device of the default choice could be used: warns, and replaces *chosen with the
  * next group of the default order; 0 when none is left. */
 static int fall_back(const DeviceDesc *all, size_t n_all, size_t **chosen, size_t *n_chosen, const Error *last)
@@ -367,7 +387,7 @@ static Status open_devices(const Options *o, const DeviceScene *ds, Device ***ou
         free(chosen);
         return error_set(err, ST_INTERNAL, "out of memory");
     }
-    DeviceConfig cfg = { o->threads, o->kernel_dir, o->wave_paths };
+    DeviceConfig cfg = { o->threads, o->kernel_dir, o->wave_paths, o->profile };
     ocl_program_announce_builds(!o->quiet);
     size_t n = 0;
     Error last = { 0 };
@@ -706,7 +726,8 @@ static Status results_write_checkpoint(Run *r, Error *cerr)
 static void results_print_summary(const Run *r)
 {
     const ScheduleStats *s = &r->stats;
-    if (r->o.stats) print_render_stats(s, r->scene.image.spp, r->devs, r->n_devs);
+    if (r->o.stats || r->o.profile) print_render_stats(s, r->scene.image.spp, r->devs, r->n_devs);
+    if (r->o.profile) print_profile(s, r->devs, r->n_devs);
     if (r->o.quiet && r->render_st == ST_OK && !s->interrupted) return;
     double secs = s->seconds > 0.0 ? s->seconds : 1e-9;
     fprintf(stderr, "clpt: %s %ux%u, %llu spp%s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n",

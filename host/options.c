@@ -51,6 +51,10 @@ void options_print_help(FILE *f)
 "      --seed N               random seed; the same seed gives the same image\n"
 "                             on any devices and batch sizes\n"
 "      --max-depth N          longest path, in bounces (overrides the scene)\n"
+"      --sampler sobol|independent\n"
+"                             random numbers: Owen-scrambled Sobol points\n"
+"                             (default; less noise) or independent ones\n"
+"                             (clpt's earlier sampler, the same images)\n"
 "      --time-limit SECONDS   stop starting new batches after this long; the\n"
 "                             image holds the whole batches finished by then\n"
 "                             (none: the output is left alone, exit status 7)\n"
@@ -155,6 +159,9 @@ void options_print_help(FILE *f)
 "Reporting:\n"
 "      --stats                print scene, kd-tree, kernel build and\n"
 "                             per-device statistics to stdout\n"
+"      --profile              --stats, and where each device's time goes: ray\n"
+"                             generation, traversal, shading, shadow rays,\n"
+"                             film, queues, host waits (slows rendering)\n"
 "  -q, --quiet                no progress bar and no summary line\n"
 "  -h, --help                 print this help and exit\n"
 "      --version              print the version and exit\n"
@@ -311,7 +318,7 @@ static int options_set_switch(const char *a, Options *o)
         { "--help", "-h", &o->help },      { "--version", NULL, &o->version },
         { "--list-devices", NULL, &o->list_devices }, { "--stats", NULL, &o->stats },
         { "--quiet", "-q", &o->quiet },    { "--mpi-broadcast", NULL, &o->mpi_broadcast },
-        { "--interactive", "-i", &o->interactive },
+        { "--interactive", "-i", &o->interactive }, { "--profile", NULL, &o->profile },
     };
     for (size_t k = 0; k < sizeof switches / sizeof switches[0]; k++)
         if (strcmp(a, switches[k].name) == 0 || (switches[k].alias && strcmp(a, switches[k].alias) == 0)) {
@@ -398,6 +405,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
     static const int gamma_values[] = { 0, 1 };
     static const char *const on_off[] = { "on", "off", NULL };
     static const int on_off_values[] = { 1, 0 };
+    static const char *const samplers[] = { "sobol", "independent", NULL };
+    static const int sampler_values[] = { SAMPLER_SOBOL, SAMPLER_INDEPENDENT };
     *found = 1;
     if (strcmp(a, "--integrator") == 0)
         return parse_choice(a, v, integrators, integrator_values, "'path' or 'whitted'", &o->integrator, err);
@@ -407,6 +416,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
         return parse_choice(a, v, gammas, gamma_values, "'srgb' or 'none'", &o->gamma, err);
     if (strcmp(a, "--shadows") == 0)
         return parse_choice(a, v, on_off, on_off_values, "'on' or 'off'", &o->shadows, err);
+    if (strcmp(a, "--sampler") == 0)
+        return parse_choice(a, v, samplers, sampler_values, "'sobol' or 'independent'", &o->sampler, err);
     if (strcmp(a, "--aov") == 0) return options_parse_aovs(v, &o->aovs, err);
     *found = 0;
     return ST_OK;
@@ -430,6 +441,7 @@ static void options_defaults(Options *o)
     o->integrator = -1;
     o->gamma = -1;
     o->shadows = -1;
+    o->sampler = -1;
     o->format = SCENE_FORMAT_AUTO;
     o->adaptive_spp = 16;
 }

@@ -24,7 +24,7 @@ typedef struct {
     /* under mpirun (docs/distributed.md) */
     int mpi_broadcast;            /* the scene is read by rank 0 only and sent to the others */
     double mpi_timeout;           /* seconds of silence before a rank is given up; 0 = 30 */
-    int list_devices, stats, quiet, help, version;
+    int list_devices, stats, profile, quiet, help, version;
     int interactive;              /* --interactive: the viewer (docs/viewer.md) */
     /* developer flags */
     const char *kernel_dir;
@@ -40,6 +40,7 @@ typedef struct {
     unsigned adaptive_spp;        /* extra samples per flagged pixel */
     int gamma;                    /* -1 the scene's, 0 sRGB, 1 none (linear 8-bit) */
     int shadows;                  /* -1 the scene's, 0 off, 1 on */
+    int sampler;                  /* -1 the scene's, else enum Sampler */
     double depth_near, depth_far; /* --depth-range; near == far (0) = automatic */
 } Options;
 

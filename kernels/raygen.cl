@@ -11,7 +11,7 @@
 
 /* The camera ray through film position (s, t) (see Camera in types.h); `key` gives
  * the lens sample when the aperture is open. */
-KFN Ray camera_ray(GLOBAL const RenderParams *p, float s, float t, uint key)
+KFN Ray camera_ray(GLOBAL const RenderParams *p, float s, float t, RngKey key)
 {
     const Camera cam = p->camera;
     Ray ray;
@@ -37,7 +37,7 @@ KFN Ray camera_ray(GLOBAL const RenderParams *p, float s, float t, uint key)
 KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
                      GLOBAL PathState *ps, GLOBAL Ray *ray)
 {
-    uint key = rng_path_key(p->seed, pixel, sample);
+    RngKey key = rng_key_make(p, pixel, sample);
     uint x = pixel % p->width, y = pixel / p->width;
     float s = ((float)x + rng_uniform(key, 0u, DIM_PIXEL_X)) / (float)p->width;
     float t = ((float)y + rng_uniform(key, 0u, DIM_PIXEL_Y)) / (float)p->height;
@@ -51,7 +51,7 @@ KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
     ps->bounce = 0u;
     ps->bsdf_pdf = 0.0f;
     ps->flags = PATH_SPECULAR;  /* what the camera sees directly gets full weight */
-    ps->rng_key = key;
+    ps->rng_key = key.key;
     ps->pad0 = 0u;
 }
 

@@ -1,10 +1,28 @@
 /*
- * rng.h — counter-based random numbers.
+ * rng.h — the sample values of a path: counter-based, a pure function of (seed, pixel,
+ * sample index, bounce, dimension). Nothing depends on which device, thread or batch
+ * computes a value, or in which order, so a render is the same image on any device mix,
+ * batch size or resume.
  *
- * A random number is a pure function of (seed, pixel, sample index, bounce, dimension):
- * nothing depends on which device, thread or batch computes it, or in which order, so a
- * render is the same image on any device mix. The hash is Chris Wellons' "lowbias32"
- * integer mixer (bias 0.17, hash-prospector), chained over the key's parts.
+ * Two samplers (RenderParams.sampler, --sampler):
+ *
+ * SAMPLER_SOBOL (the default): Owen-scrambled Sobol points, padded in 2D, after Burley,
+ * "Practical Hash-based Owen Scrambling" (JCGT 9(4), 2020) and pbrt-v4's
+ * PaddedSobolSampler. Each 2D pair of dimensions of a bounce (pixel jitter, lens, light
+ * position, BSDF direction; see RNG_PAIR_SECOND) is the first two dimensions of the
+ * Sobol sequence, a (0,2)-sequence: over the first 2^m samples of a pixel, every
+ * elementary interval of area 2^-m holds exactly one point. Each 1D dimension (light
+ * pick, lobe choice, roulette) is the first Sobol dimension (van der Corput). Pairs are
+ * decorrelated from each other and pixels from pixels by hashing (pixel key, bounce,
+ * dimension) into the seeds of an Owen scrambling of the values and a nested uniform
+ * scrambling of the sample index (Burley's shuffle), both of which keep those
+ * stratification properties. Only Sobol dimensions 0 and 1 are used, so there is no
+ * direction-number table: dimension 0 is the bit-reversed index and dimension 1 (the
+ * Pascal matrix mod 2) is computed in closed form, rng_sobol1.
+ *
+ * SAMPLER_INDEPENDENT: independent hashed values, the sampler of clpt before Sobol
+ * (the same bits, so earlier images are reproduced): Chris Wellons' "lowbias32" integer
+ * mixer (bias 0.17, hash-prospector) chained over the key's parts.
  */
 #ifndef CLPT_RNG_H
 #define CLPT_RNG_H
@@ -20,6 +38,20 @@ enum RngDim {
     RNG_DIMS_PER_BOUNCE = 16
 };
 
+/* The second dimension of each 2D pair: the Sobol sampler draws it as Sobol dimension 1
+ * of the pattern of the dimension before it, which a 2D warp then sees as one
+ * stratified point. Every other dimension is 1D. A new 2D pair is two consecutive
+ * enum values with the second added here (all dimensions stay below 32). */
+#define RNG_PAIR_SECOND ((1u << DIM_PIXEL_Y) | (1u << DIM_LENS_V) | (1u << DIM_LIGHT_V) | (1u << DIM_BSDF_V))
+
+/* What a path's random numbers are made from: rng_key_make at the camera ray, or
+ * rng_key_of from the path state at a later bounce. */
+typedef struct {
+    uint key;        /* independent: hash of (seed, pixel, sample); sobol: of (seed, pixel) */
+    uint sample;     /* sample index within the pixel */
+    uint sampler;    /* enum Sampler */
+} RngKey;
+
 KFN uint rng_hash(uint x)
 {
     x ^= x >> 16;
@@ -30,16 +62,110 @@ KFN uint rng_hash(uint x)
     return x;
 }
 
-/* The per-path part of the key, computed once when the camera ray is born. */
-KFN uint rng_path_key(uint seed, uint pixel, uint sample)
+/* The per-pixel part of the key. */
+KFN uint rng_pixel_key(uint seed, uint pixel)
 {
-    return rng_hash(rng_hash(rng_hash(seed ^ 0x9e3779b9u) ^ pixel) + sample);
+    return rng_hash(rng_hash(seed ^ 0x9e3779b9u) ^ pixel);
 }
 
-/* Uniform float in [0, 1): 24 random bits, so 1.0f is never returned. */
-KFN float rng_uniform(uint path_key, uint bounce, uint dim)
+/* The per-path key of the independent sampler. */
+KFN uint rng_path_key(uint seed, uint pixel, uint sample)
 {
-    uint h = rng_hash(path_key ^ rng_hash(bounce * (uint)RNG_DIMS_PER_BOUNCE + dim + 0x632be5abu));
+    return rng_hash(rng_pixel_key(seed, pixel) + sample);
+}
+
+/* The key of sample `sample` of `pixel` under the render's sampler. */
+KFN RngKey rng_key_make(GLOBAL const RenderParams *p, uint pixel, uint sample)
+{
+    RngKey k;
+    k.sampler = p->sampler;
+    k.sample = sample;
+    k.key = k.sampler == SAMPLER_SOBOL ? rng_pixel_key(p->seed, pixel) : rng_path_key(p->seed, pixel, sample);
+    return k;
+}
+
+/* The key of a path born by raygen_path (which stored key.key in rng_key). */
+KFN RngKey rng_key_of(GLOBAL const PathState *ps, GLOBAL const RenderParams *p)
+{
+    RngKey k;
+    k.key = ps->rng_key;
+    k.sample = ps->sample;
+    k.sampler = p->sampler;
+    return k;
+}
+
+KFN uint rng_reverse_bits(uint x)
+{
+    x = (x << 16) | (x >> 16);
+    x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu);
+    x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu);
+    x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
+    return ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
+}
+
+/* A random permutation of 32-bit words, chosen by seed, in which each bit is flipped
+ * depending only on the bits below it: applied to bit-reversed values it is an Owen
+ * scrambling. Nathan Vegdahl's improvement of the Laine-Karras hash, as pbrt-v4's
+ * FastOwenScrambler. */
+KFN uint rng_lk_permute(uint x, uint seed)
+{
+    x ^= x * 0x3d20adeau;
+    x += seed;
+    x *= (seed >> 16) | 1u;
+    x ^= x * 0x05526c56u;
+    x ^= x * 0x53a22864u;
+    return x;
+}
+
+/* Owen scrambling of a 32-bit fixed-point value in [0, 1). */
+KFN uint rng_owen_scramble(uint v, uint seed)
+{
+    return rng_reverse_bits(rng_lk_permute(rng_reverse_bits(v), seed));
+}
+
+/* Sobol dimension 1 of point `index`, as 32-bit fixed point, before bit reversal: its
+ * generator matrix is Pascal's triangle mod 2, so (Lucas) output digit j is the parity
+ * of the index bits at positions k that contain j as a bit mask; five butterfly steps
+ * of that superset sum give every digit at once, digit j at bit j. */
+KFN uint rng_sobol1_reversed(uint index)
+{
+    index ^= (index >> 1) & 0x55555555u;
+    index ^= (index >> 2) & 0x33333333u;
+    index ^= (index >> 4) & 0x0f0f0f0fu;
+    index ^= (index >> 8) & 0x00ff00ffu;
+    index ^= (index >> 16) & 0x0000ffffu;
+    return index;
+}
+
+/* Unscrambled Sobol point `index` in dimension 0 (van der Corput) or 1, as 32-bit
+ * fixed point (value / 2^32). */
+KFN uint rng_sobol(uint index, uint dim)
+{
+    return rng_reverse_bits(dim ? rng_sobol1_reversed(index) : index);
+}
+
+/* The Sobol sampler's value for (pixel key, sample, bounce, dim), 32-bit fixed point:
+ * coordinate `coord` of the shuffled, scrambled 2D pattern the dimension belongs to.
+ * (rng_owen_scramble of rng_sobol, with the two bit reversals that cancel left out.) */
+KFN uint rng_sobol_bits(uint pixel_key, uint sample, uint bounce, uint dim)
+{
+    uint coord = (RNG_PAIR_SECOND >> dim) & 1u;
+    /* one hash of the pixel key offset by the pattern's number times the golden ratio:
+     * the pixel keys are hashes already, and this is the hot path of every sample */
+    uint pattern = rng_hash(pixel_key + (bounce * (uint)RNG_DIMS_PER_BOUNCE + dim - coord) * 0x9e3779b9u);
+    uint index = rng_owen_scramble(sample, pattern);
+    uint digits = coord ? rng_sobol1_reversed(index) : index;
+    /* the values' scrambling seeds: other odd multiples of the pattern seed (bijections,
+     * so as uniform over pixels as it; they scramble values, not the index) */
+    return rng_reverse_bits(rng_lk_permute(digits, pattern * (coord ? 0x2c1b3c6du : 0x297a2d39u) + 0x68e31da4u));
+}
+
+/* Uniform float in [0, 1): the top 24 bits, so 1.0f is never returned. */
+KFN float rng_uniform(RngKey k, uint bounce, uint dim)
+{
+    uint h = k.sampler == SAMPLER_SOBOL
+                 ? rng_sobol_bits(k.key, k.sample, bounce, dim)
+                 : rng_hash(k.key ^ rng_hash(bounce * (uint)RNG_DIMS_PER_BOUNCE + dim + 0x632be5abu));
     return (float)(h >> 8) * 5.9604645e-8f;
 }
 

@@ -39,7 +39,8 @@ KFN void shadow_resolve(GLOBAL PathState *ps, int occluded)
 KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s, vec3 d, vec3 n_face,
                            vec3 ng_face, Material m, vec3 albedo, int front, GLOBAL Ray *shadow_ray)
 {
-    uint key = ps->rng_key, b = ps->bounce;
+    RngKey key = rng_key_of(ps, sc->params);
+    uint b = ps->bounce;
     uint mis_mode = sc->params->mis_mode;
     LightSample ls;
     if (!light_sample(sc, s.p, rng_uniform(key, b, DIM_LIGHT_PICK), rng_uniform(key, b, DIM_LIGHT_U),
@@ -75,7 +76,8 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
 {
     GLOBAL const RenderParams *p = sc->params;
     Ray r = *ray;
-    uint key = ps->rng_key, bounce = ps->bounce;
+    RngKey key = rng_key_of(ps, p);
+    uint bounce = ps->bounce;
 
     if (hit.prim == NO_INDEX) {
         /* the background is no light that next-event estimation samples (a cube map is

@@ -241,6 +241,9 @@ enum Integrator {
  * heuristic, or one alone (tests/test_mis.c checks that all three agree). */
 enum MisMode { MIS_BOTH = 0, MIS_LIGHT_ONLY = 1, MIS_BSDF_ONLY = 2 };
 
+/* Where a path's random numbers come from (kernels/rng.h, --sampler). */
+enum Sampler { SAMPLER_SOBOL = 0, SAMPLER_INDEPENDENT = 1 };
+
 /* Everything constant over a render, uploaded once per device. */
 typedef struct {                                        /* 272 bytes */
     Camera camera;
@@ -255,7 +258,7 @@ typedef struct {                                        /* 272 bytes */
     uint n_lights;
     uint n_nodes, n_leaf_prims;
     vec3 bounds_lo;   uint n_revsurfaces; /* box of the kd-tree root; RevSurface count */
-    vec3 bounds_hi;   uint pad2;
+    vec3 bounds_hi;   uint sampler;   /* enum Sampler */
     /* integrators and light kinds of the classic ray tracer (kernels/whitted.cl) */
     vec3 ambient;     uint integrator;  /* whitted: ambient light; enum Integrator */
     uint mis_mode;                    /* enum MisMode */
@@ -278,7 +281,7 @@ typedef struct {                                        /* 64 bytes */
     vec3 shadow_L;    uint bounce;    /* contribution waiting for its shadow ray */
     float bsdf_pdf;                   /* solid-angle pdf of the last bounce (MIS) */
     uint flags;                       /* PATH_* */
-    uint rng_key;                     /* hash of (seed, pixel, sample) */
+    uint rng_key;                     /* RngKey.key of the path (rng.h) */
     uint pad0;
 } PathState;
 

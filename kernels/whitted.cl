@@ -40,9 +40,9 @@ typedef struct {
 /* The camera ray of a pixel sample: through the pixel's centre (strata 0), a uniform
  * point of it (1), or a jittered point of cell (sample mod m^2) of an m x m grid. The
  * lens (and jitter) numbers come from the key of sample + sample_offset. */
-KFN Ray whitted_camera_ray(GLOBAL const RenderParams *p, uint pixel, uint sample, uint *key_out)
+KFN Ray whitted_camera_ray(GLOBAL const RenderParams *p, uint pixel, uint sample, RngKey *key_out)
 {
-    uint key = rng_path_key(p->seed, pixel, sample + p->sample_offset);
+    RngKey key = rng_key_make(p, pixel, sample + p->sample_offset);
     uint x = pixel % p->width, y = pixel / p->width;
     uint m = p->strata;
     float jx = 0.5f, jy = 0.5f;
@@ -91,7 +91,7 @@ KFN int whitted_occluded(const SceneView *sc, vec3 sp, vec3 ng, LightSample ls, 
  * (random numbers of tree node `node`), each behind its shadow ray (if shadows are on). d is the incoming
  * direction, ns and ng the normals on its side. */
 KFN vec3 whitted_direct(const SceneView *sc, Surface s, vec3 d, vec3 ns, vec3 ng, vec3 kd, vec3 ks,
-                        float shininess, uint key, uint node, uint *rays)
+                        float shininess, RngKey key, uint node, uint *rays)
 {
     GLOBAL const RenderParams *p = sc->params;
     vec3 L = v3s(0.0f);
@@ -133,7 +133,7 @@ KFN void whitted_push(WhittedRay *stack, int *sp, vec3 o, vec3 dir, vec3 weight,
 }
 
 /* Radiance along a camera ray, Whitted style. */
-KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, uint key, uint *rays)
+KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, RngKey key, uint *rays)
 {
     GLOBAL const RenderParams *p = sc->params;
     uint max_depth = p->max_depth < (uint)(WHITTED_STACK - 1) ? p->max_depth : (uint)(WHITTED_STACK - 1);
@@ -251,7 +251,7 @@ KFN vec3 whitted_sample(const SceneView *sc, uint pixel, uint sample, uint *rays
     GLOBAL const RenderParams *p = sc->params;
     *rays = 0u;
     if (p->use_mask && sc->pixel_mask[pixel] == 0u) return v3s(0.0f);
-    uint key;
+    RngKey key;
     Ray r = whitted_camera_ray(p, pixel, sample, &key);
     if (p->integrator == INTEGRATOR_WHITTED) return whitted_radiance(sc, r, key, rays);
     return whitted_aov(sc, r, p->integrator, rays);

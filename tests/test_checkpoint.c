@@ -445,6 +445,11 @@ static void test_other_renders_are_refused(void)
                  "--max-depth", "8", "-o", path_out, "--resume", path_ck), &r);
     CHECK_EQ_INT(r.status, 3);
     CHECK_STR_CONTAINS(r.err, "scene differs");
+    /* the same scene and settings with the other sampler: other random numbers */
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", SIZE, "--spp", SPP_TEXT, "--sampler", "independent", "-o",
+                 path_out, "--resume", path_ck), &r);
+    CHECK_EQ_INT(r.status, 3);
+    CHECK_STR_CONTAINS(r.err, "sampler or shadows setting");
     /* not a checkpoint at all, and no file */
     cli_run(ARGS(SCENE, "-q", "--device", "scalar", SIZE, "--spp", SPP_TEXT, "-o", path_out, "--resume", path_ref), &r);
     CHECK_EQ_INT(r.status, 3);

@@ -16,7 +16,7 @@ static void test_help_documents_every_flag(void)
     const char *flags[] = { "--output", "--spp", "--width", "--height", "--seed", "--max-depth", "--time-limit",
                             "--progressive-output", "--list-devices", "--device", "--threads", "--stats",
                             "--quiet", "--help", "--version", "--kernel-dir", "--batch", "--wave-paths",
-                            "--shadows", "-size W H -input SCENE -output FILE", "-depth NEAR FAR FILE",
+                            "--shadows", "--sampler", "--profile", "-size W H -input SCENE -output FILE", "-depth NEAR FAR FILE",
                             "-bounces N", "clpt SCENE OUT.bmp", "Exit status" };
     for (size_t i = 0; i < sizeof flags / sizeof flags[0]; i++) CHECK_STR_CONTAINS(r.out, flags[i]);
 }
@@ -40,6 +40,9 @@ static void test_usage_errors(void)
     cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.jpg"), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, ".jpg");
+    cli_run(ARGS("scenes/cornell-box.scene", "--sampler", "halton"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "--sampler expects 'sobol' or 'independent', got 'halton'");
 }
 
 static void test_missing_scene_is_io_error(void)
@@ -139,6 +142,29 @@ static void test_stats(void)
     unlink("/tmp/clpt-test-stats.png");
 }
 
+/* --profile: the stats, then each device's time per phase; the traversal and shading of
+ * a real render take some time on both kinds of device. */
+static void test_profile(void)
+{
+    const char *devices[] = { "cpu", "scalar" };
+    for (int i = 0; i < 2; i++) {
+        cli_run(ARGS("scenes/cornell-box.scene", "--profile", "-q", "--device", devices[i], "--width", "32",
+                     "--height", "32", "--spp", "4", "-o", "/tmp/clpt-test-profile.png"),
+                &r);
+        CHECK_EQ_INT(r.status, 0);
+        const char *want[] = { "Msamples/s", "profile (seconds", "raygen", "traverse", "shade", "shadow", "film",
+                               "queues", "host wait" };
+        for (size_t k = 0; k < sizeof want / sizeof want[0]; k++) CHECK_STR_CONTAINS(r.out, want[k]);
+        /* the device's row: its name in 32 columns, then (seconds, share) per phase */
+        const char *row = strstr(r.out, "host wait");
+        row = row ? strchr(row, '\n') : NULL;
+        double t[3] = { 0 };
+        int n = row && strlen(row) > 33 ? sscanf(row + 33, "%lf %*s %lf %*s %lf", &t[0], &t[1], &t[2]) : 0;
+        CHECK_MSG(n == 3 && t[1] > 0.0 && t[2] > 0.0, "%s: traversal %g s, shading %g s in:\n%s", devices[i], t[1],
+                  t[2], r.out);
+    }
+    unlink("/tmp/clpt-test-profile.png");
+}
 
 #define SMALL "--device", "scalar", "--width", "8", "--height", "8", "--spp", "1"
 
@@ -598,6 +624,7 @@ int main(void)
     RUN(test_quiet_prints_nothing);
     RUN(test_unwritable_output_is_io_error);
     RUN(test_stats);
+    RUN(test_profile);
     RUN(test_help_fits_80_columns);
     RUN(test_bad_outputs_found_before_rendering);
     RUN(test_outputs_must_be_distinct_files);

@@ -607,7 +607,7 @@ static void test_pixel_sampling(void)
     p.camera.horizontal = v3(10.0f, 0.0f, 0.0f);
     p.camera.vertical = v3(0.0f, 10.0f, 0.0f);
     p.camera.forward = v3(0.0f, 0.0f, -1.0f);
-    uint key;
+    RngKey key;
     Ray r = whitted_camera_ray(&p, 34, 0, &key);   /* pixel (4, 3) */
     CHECK(r.o.x == 4.5f && r.o.y == -3.5f);
     r = whitted_camera_ray(&p, 34, 7, &key);

@@ -92,7 +92,18 @@ typedef struct {
     int threads;                  /* scalar device: worker threads, 0 = every core */
     const char *kernel_dir;       /* OpenCL: load kernels from here instead (developers) */
     unsigned wave_paths;          /* OpenCL: paths per wave, 0 = chosen by device type */
+    int profile;                  /* measure DeviceCounters.phase_seconds (--profile) */
 } DeviceConfig;
+
+/* Where a device's time goes (--profile). OpenCL: device time of each command, from
+ * its profiling event (k_raygen, k_intersect, k_shade with its queue compaction,
+ * k_shadow, k_film with the film's read-back and clearing; the queue counters' clearing
+ * and read-backs), and the host's time blocked waiting for the device. Scalar: thread
+ * time in each stage function, summed over the threads and divided by their number. */
+enum DevicePhase {
+    PHASE_RAYGEN, PHASE_TRAVERSE, PHASE_SHADE, PHASE_SHADOW, PHASE_FILM, PHASE_QUEUES, PHASE_HOST_WAIT,
+    PHASE_N
+};
 
 typedef struct {
     double compile_seconds;       /* OpenCL program build or cache load */
@@ -100,6 +111,7 @@ typedef struct {
     double upload_seconds;
     uint64_t rays;                /* every ray traced: camera, bounce and shadow rays */
     uint64_t samples;             /* pixel samples rendered (pixels x samples) */
+    double phase_seconds[PHASE_N];  /* --profile only: enum DevicePhase */
 } DeviceCounters;
 
 typedef struct Device Device;

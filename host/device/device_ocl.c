@@ -61,6 +61,12 @@ typedef struct {
     cl_uint got[QUEUE_COUNT_STRIDE + 1];   /* count slots 2b + 1 and 2b + 2 */
 } WaveSlot;
 
+/* --profile: a command whose device time is read once it is complete. */
+typedef struct {
+    cl_event event;
+    int phase;              /* enum DevicePhase */
+} ProfiledCommand;
+
 typedef struct {
     OclDeviceInfo info;
     cl_context ctx;
@@ -81,6 +87,9 @@ typedef struct {
     const atomic_int *cancel;   /* the Device's, while a batch renders */
     cl_mem film;            /* the film the batch being rendered goes to */
     uint64_t rays;          /* rays of the batch being rendered */
+    double *phases;         /* --profile: the Device's phase_seconds; NULL: not profiling */
+    ProfiledCommand *profiled;      /* commands enqueued and not yet read */
+    size_t n_profiled, cap_profiled;
 } OclDevice;
 
 #define OCL_TRY(call_name, expr)                                                       \
@@ -206,17 +215,80 @@ static Status set_fixed_args(OclDevice *od, WaveSlot *w, Error *err)
     return ST_OK;
 }
 
+/* --profile: adds the device time of the complete command `e` to its phase. */
+static void profile_add(OclDevice *od, cl_event e, int phase)
+{
+    cl_ulong t0 = 0, t1 = 0;
+    if (clGetEventProfilingInfo(e, CL_PROFILING_COMMAND_START, sizeof t0, &t0, NULL) == CL_SUCCESS &&
+        clGetEventProfilingInfo(e, CL_PROFILING_COMMAND_END, sizeof t1, &t1, NULL) == CL_SUCCESS && t1 > t0)
+        od->phases[phase] += (double)(t1 - t0) * 1e-9;
+}
+
+/* --profile: keeps the event of a command just enqueued, to be read when complete
+ * (reading it at once would wait, and serialise host and device). */
+static void profile_track(OclDevice *od, cl_event e, int phase)
+{
+    if (od->n_profiled == od->cap_profiled) {
+        size_t cap = od->cap_profiled ? 2 * od->cap_profiled : 256;
+        ProfiledCommand *p = realloc(od->profiled, cap * sizeof *p);
+        if (!p) {
+            /* no room to keep it: wait for it now rather than lose its time */
+            if (clWaitForEvents(1, &e) == CL_SUCCESS) profile_add(od, e, phase);
+            clReleaseEvent(e);
+            return;
+        }
+        od->profiled = p;
+        od->cap_profiled = cap;
+    }
+    od->profiled[od->n_profiled].event = e;
+    od->profiled[od->n_profiled++].phase = phase;
+}
+
+/* --profile: reads and forgets the tracked commands that are complete (failed ones are
+ * forgotten unread). */
+static void profile_collect(OclDevice *od)
+{
+    size_t keep = 0;
+    for (size_t i = 0; i < od->n_profiled; i++) {
+        ProfiledCommand c = od->profiled[i];
+        cl_int status = CL_QUEUED;
+        clGetEventInfo(c.event, CL_EVENT_COMMAND_EXECUTION_STATUS, sizeof status, &status, NULL);
+        if (status > CL_COMPLETE) {
+            od->profiled[keep++] = c;
+            continue;
+        }
+        if (status == CL_COMPLETE) profile_add(od, c.event, c.phase);
+        clReleaseEvent(c.event);
+    }
+    od->n_profiled = keep;
+}
+
+/* The phase of each kernel's time (the classic ray tracer's samples count as shading). */
+static int profile_phase_of(const char *kernel)
+{
+    static const struct { const char *name; int phase; } map[] = {
+        { "k_raygen", PHASE_RAYGEN }, { "k_intersect", PHASE_TRAVERSE }, { "k_shade", PHASE_SHADE },
+        { "k_shadow", PHASE_SHADOW }, { "k_film", PHASE_FILM },
+    };
+    for (size_t i = 0; i < sizeof map / sizeof map[0]; i++)
+        if (strcmp(kernel, map[i].name) == 0) return map[i].phase;
+    return PHASE_SHADE;
+}
+
 static Status launch(OclDevice *od, cl_kernel k, const char *name, uint n, Error *err)
 {
     if (n == 0) return ST_OK;
     size_t local = od->local_size;
     size_t global = local ? ((size_t)n + local - 1) / local * local : (size_t)n;
-    cl_int rc = clEnqueueNDRangeKernel(od->queue, k, 1, NULL, &global, local ? &local : NULL, 0, NULL, NULL);
+    cl_event ev = NULL;
+    cl_int rc = clEnqueueNDRangeKernel(od->queue, k, 1, NULL, &global, local ? &local : NULL, 0, NULL,
+                                       od->phases ? &ev : NULL);
     if (rc != CL_SUCCESS) {
         ocl_fail(err, &od->info, "clEnqueueNDRangeKernel", rc);
         error_prefix(err, "kernel %s over %u items", name, n);
         return ST_DEVICE;
     }
+    if (ev) profile_track(od, ev, profile_phase_of(name));
     return ST_OK;
 }
 
@@ -386,9 +458,12 @@ static Status wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint firs
 {
     Status st;
     cl_uint zero = 0;
+    cl_event ev = NULL;
     OCL_TRY("clEnqueueFillBuffer",
             clEnqueueFillBuffer(od->queue, w->counts, &zero, sizeof zero, 0,
-                                (2u * (size_t)od->max_bounces + 1u) * QUEUE_COUNT_STRIDE * sizeof zero, 0, NULL, NULL));
+                                (2u * (size_t)od->max_bounces + 1u) * QUEUE_COUNT_STRIDE * sizeof zero, 0, NULL,
+                                od->phases ? &ev : NULL));
+    if (ev) profile_track(od, ev, PHASE_QUEUES);
     cl_kernel k = w->k_raygen;
     ARG(k, ARG_RAYGEN_FIRST_PIXEL, first_pixel);
     ARG(k, ARG_RAYGEN_FIRST_SAMPLE, first_sample);
@@ -408,7 +483,12 @@ static Status wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint firs
 static Status wave_advance(OclDevice *od, WaveSlot *w, Error *err)
 {
     Status st;
+    double t0 = od->phases ? timer_now() : 0.0;
     cl_int rc = clWaitForEvents(1, &w->read);
+    if (od->phases) {
+        od->phases[PHASE_HOST_WAIT] += timer_now() - t0;
+        if (rc == CL_SUCCESS) profile_add(od, w->read, PHASE_QUEUES);
+    }
     release_event(&w->read);
     if (rc != CL_SUCCESS) return ocl_fail(err, &od->info, "clWaitForEvents", rc);
     uint shadows = w->got[0], next = w->got[QUEUE_COUNT_STRIDE];
@@ -537,7 +617,10 @@ static Status ocl_render(Device *d, uint first_sample, uint count, Error *err)
     OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, fs->film, CL_FALSE, 0, bytes, fs->host, 0, NULL,
                                                        &fs->read_done));
     cl_long zero = 0;
-    OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, fs->film, &zero, sizeof zero, 0, bytes, 0, NULL, NULL));
+    cl_event ev = NULL;
+    OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, fs->film, &zero, sizeof zero, 0, bytes, 0, NULL,
+                                                       od->phases ? &ev : NULL));
+    if (ev) profile_track(od, ev, PHASE_FILM);
     OCL_TRY("clFlush", clFlush(od->queue));
     od->head++;
     d->counters.samples += n_pixels * count;
@@ -550,7 +633,13 @@ static Status ocl_take_film(Device *d, int64_t *film, Error *err)
     OclDevice *od = d->impl;
     FilmSlot *fs = &od->slots[od->tail % od->n_slots];
     if (!fs->read_done) return error_set(err, ST_INTERNAL, "device '%s': no batch to take", od->info.name);
+    double t0 = od->phases ? timer_now() : 0.0;
     OCL_TRY("clWaitForEvents", clWaitForEvents(1, &fs->read_done));
+    if (od->phases) {
+        od->phases[PHASE_HOST_WAIT] += timer_now() - t0;
+        profile_add(od, fs->read_done, PHASE_FILM);
+        profile_collect(od);
+    }
     release_event(&fs->read_done);
     od->tail++;
     size_t n = (size_t)od->n_pixels * 3u;
@@ -562,7 +651,10 @@ static void ocl_destroy(Device *d)
 {
     OclDevice *od = d->impl;
     if (od) {
-        release_buffers(od);
+        release_buffers(od);   /* finishes the queue: every tracked command is complete */
+        profile_collect(od);
+        for (size_t i = 0; i < od->n_profiled; i++) clReleaseEvent(od->profiled[i].event);
+        free(od->profiled);
         for (int i = 0; i < WAVE_SLOTS; i++) {
             WaveSlot *w = &od->waves[i];
             cl_kernel *ks[] = { &w->k_raygen, &w->k_intersect, &w->k_shade, &w->k_shadow, &w->k_film };
@@ -591,7 +683,9 @@ static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error
     cl_context_properties props[] = { CL_CONTEXT_PLATFORM, (cl_context_properties)od->info.platform, 0 };
     od->ctx = clCreateContext(props, 1, &od->info.id, NULL, NULL, &rc);
     if (rc != CL_SUCCESS) return ocl_fail(err, &od->info, "clCreateContext", rc);
-    od->queue = clCreateCommandQueue(od->ctx, od->info.id, 0, &rc);
+    int profile = cfg && cfg->profile;
+    od->queue = clCreateCommandQueue(od->ctx, od->info.id, profile ? CL_QUEUE_PROFILING_ENABLE : 0, &rc);
+    od->phases = profile ? d->counters.phase_seconds : NULL;
     if (rc != CL_SUCCESS) return ocl_fail(err, &od->info, "clCreateCommandQueue", rc);
     OclProgramStats ps;
     Status st = ocl_program_build(od->ctx, &od->info, cfg ? cfg->kernel_dir : NULL,

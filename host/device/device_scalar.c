@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "device/device.h"
+#include "base/timer.h"
 
 /* The kernel sources, compiled here as C. */
 #include "film.cl"
@@ -49,6 +50,8 @@ typedef struct {
     atomic_ullong rays;
     const atomic_int *cancel;    /* the Device's, for the workers */
     atomic_int cancelled;        /* a worker saw the cancel before the batch was whole */
+    double *phases;              /* --profile: the Device's phase_seconds (under lock);
+                                  * NULL: not profiling */
 } CpuDevice;
 
 /* Renders one path to its end; returns the number of rays it traced. */
@@ -73,6 +76,39 @@ static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *
     return rays;
 }
 
+/* render_path with the thread time of each stage added to t[enum DevicePhase]
+ * (--profile; the clock reads cost some of the speed). */
+static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, vec3 *radiance, double *t)
+{
+    PathState ps;
+    Ray ray, shadow;
+    memset(&shadow, 0, sizeof shadow);
+    uint64_t rays = 0;
+    double t0 = timer_now(), t1;
+    raygen_path(sc->params, pixel, sample, &ps, &ray);
+    t1 = timer_now();
+    t[PHASE_RAYGEN] += t1 - t0;
+    for (;;) {
+        Hit hit = trace_closest(sc, ray);
+        t0 = timer_now();
+        t[PHASE_TRAVERSE] += t0 - t1;
+        rays++;
+        uint r = shade_path(sc, &ray, hit, &ps, &shadow);
+        t1 = timer_now();
+        t[PHASE_SHADE] += t1 - t0;
+        if (r & SHADE_SHADOW) {
+            shadow_resolve(&ps, trace_any(sc, shadow));
+            rays++;
+            t0 = timer_now();
+            t[PHASE_SHADOW] += t0 - t1;
+            t1 = t0;
+        }
+        if (!(r & SHADE_CONTINUE)) break;
+    }
+    *radiance = ps.radiance;
+    return rays;
+}
+
 /* Whether the batch is to be dropped; checked before each chunk, so a cancel is seen
  * within a chunk's time (well under a millisecond) on every worker. */
 static int cancel_requested(CpuDevice *cd)
@@ -87,6 +123,7 @@ static void render_chunks(CpuDevice *cd)
 {
     uint n_pixels = cd->params.width * cd->params.height;
     uint64_t rays = 0;
+    double t[PHASE_N] = { 0 };
     for (;;) {
         if (cancel_requested(cd)) break;
         uint chunk = atomic_fetch_add(&cd->next_chunk, 1u);
@@ -96,7 +133,9 @@ static void render_chunks(CpuDevice *cd)
         for (uint pixel = begin; pixel < end; pixel++) {
             for (uint s = 0; s < cd->count; s++) {
                 vec3 L;
-                if (cd->params.integrator == INTEGRATOR_PATH) {
+                if (cd->params.integrator == INTEGRATOR_PATH && cd->phases) {
+                    rays += render_path_timed(&cd->view, pixel, cd->first_sample + s, &L, t);
+                } else if (cd->params.integrator == INTEGRATOR_PATH) {
                     rays += render_path(&cd->view, pixel, cd->first_sample + s, &L);
                 } else {
                     /* the classic ray tracer and the auxiliary images: kernels/whitted.cl */
@@ -104,11 +143,18 @@ static void render_chunks(CpuDevice *cd)
                     L = whitted_sample(&cd->view, pixel, cd->first_sample + s, &n);
                     rays += n;
                 }
+                double t0 = cd->phases ? timer_now() : 0.0;
                 film_add(cd->film, pixel, L);
+                if (cd->phases) t[PHASE_FILM] += timer_now() - t0;
             }
         }
     }
     atomic_fetch_add(&cd->rays, (unsigned long long)rays);
+    if (cd->phases) {
+        pthread_mutex_lock(&cd->lock);
+        for (int i = 0; i < PHASE_N; i++) cd->phases[i] += t[i] / cd->threads;   /* thread time / threads */
+        pthread_mutex_unlock(&cd->lock);
+    }
 }
 
 static void *cpu_worker(void *arg)
@@ -235,6 +281,7 @@ Status device_scalar_open(const DeviceDesc *desc, const DeviceConfig *cfg, Devic
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     int threads = cfg && cfg->threads > 0 ? cfg->threads : (int)(cores > 0 ? cores : 1);
     cd->threads = threads > 256 ? 256 : threads;
+    cd->phases = cfg && cfg->profile ? d->counters.phase_seconds : NULL;
     pthread_mutex_init(&cd->lock, NULL);
     pthread_cond_init(&cd->go, NULL);
     pthread_cond_init(&cd->done, NULL);

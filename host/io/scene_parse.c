@@ -383,7 +383,7 @@ static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-enum { IMG_WIDTH, IMG_HEIGHT, IMG_SPP, IMG_DEPTH, IMG_SEED, IMG_SHADOWS, IMG_N };
+enum { IMG_WIDTH, IMG_HEIGHT, IMG_SPP, IMG_DEPTH, IMG_SEED, IMG_SHADOWS, IMG_SAMPLER, IMG_N };
 static const KeySpec image_keys[IMG_N] = {
     [IMG_WIDTH] = {"width", VK_UINT, 0, 1, CLPT_MAX_IMAGE_SIDE, 0, 0,
                    "an integer in 1.." CLPT_STR(CLPT_MAX_IMAGE_SIDE)},
@@ -393,6 +393,7 @@ static const KeySpec image_keys[IMG_N] = {
     [IMG_DEPTH] = {"depth", VK_UINT, 0, 0, CLPT_MAX_DEPTH, 0, 0, "an integer in 0.." CLPT_STR(CLPT_MAX_DEPTH)},
     [IMG_SEED] = {"seed", VK_UINT, 0, 0, 4294967295.0, 0, 0, "an integer in 0..4294967295"},
     [IMG_SHADOWS] = {"shadows", VK_WORD, 0, 0, 0, 0, 0, "on or off"},
+    [IMG_SAMPLER] = {"sampler", VK_WORD, 0, 0, 0, 0, 0, "sobol or independent"},
 };
 
 static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
@@ -411,6 +412,12 @@ static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
         const Token *w = &v[IMG_SHADOWS].word;
         if (!tok_is(w, "on") && !tok_is(w, "off")) return lex_expected(lx, w, image_keys[IMG_SHADOWS].what, p->err);
         p->s->shadows = tok_is(w, "on");
+    }
+    if (v[IMG_SAMPLER].given) {
+        const Token *w = &v[IMG_SAMPLER].word;
+        if (!tok_is(w, "sobol") && !tok_is(w, "independent"))
+            return lex_expected(lx, w, image_keys[IMG_SAMPLER].what, p->err);
+        im->sampler = tok_is(w, "sobol") ? SAMPLER_SOBOL : SAMPLER_INDEPENDENT;
     }
     if (limit_pixels(im->width, im->height, ST_INPUT, "", NULL) != ST_OK) {
         const Token *t = v[IMG_HEIGHT].given ? &v[IMG_HEIGHT].key : &v[IMG_WIDTH].key;

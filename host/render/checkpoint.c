@@ -303,8 +303,8 @@ int checkpoint_id_differs(const CheckpointId *g, const CheckpointId *e, const ch
     else if (g->max_depth != e->max_depth)
         snprintf(what, size, "its maximum depth is %u, %s's %u", g->max_depth, other, e->max_depth);
     else if (memcmp(g->key, e->key, CHECKPOINT_KEY_SIZE) != 0)
-        snprintf(what, size, "the scene differs (geometry, materials, camera or lights), or it was made "
-                             "by a clpt with other kernels");
+        snprintf(what, size, "the scene differs (geometry, materials, camera or lights, or the "
+                             "sampler or shadows setting), or it was made by a clpt with other kernels");
     else
         return 0;
     return 1;

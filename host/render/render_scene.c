@@ -39,6 +39,7 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     p->max_depth = s->image.max_depth;
     p->rr_depth = RR_START_BOUNCE;
     p->seed = s->image.seed;
+    p->sampler = s->image.sampler;
     p->n_spheres = (uint)s->n_spheres;
     p->n_triangles = (uint)s->n_triangles;
     p->n_boxes = (uint)s->n_boxes;

@@ -28,6 +28,7 @@ typedef struct {
     uint spp;            /* samples per pixel */
     uint max_depth;      /* bounces after the camera ray */
     uint seed;
+    uint sampler;        /* enum Sampler (kernels/rng.h); 0, Sobol, by default */
 } SceneImage;
 
 typedef struct {

@@ -841,7 +841,7 @@ static Status run_interactive(Run *r, Error *err)
     if (st == ST_OK) st = open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
     if (st == ST_OK) {
         ViewerConfig vc = { r->o.scene_path, &r->scene, &r->rs, r->devs, r->n_devs,
-                            { r->o.threads, r->o.kernel_dir, r->o.wave_paths }, r->encoding,
+                            { r->o.threads, r->o.kernel_dir, r->o.wave_paths, 0 }, r->encoding,
                             r->o.batch, r->o.stats, r->o.quiet };
         st = viewer_run(&vc, err);
     }

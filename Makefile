@@ -25,10 +25,10 @@ WARN      := -Wall -Wextra -Wpedantic -Wshadow -Wstrict-prototypes -Wmissing-pro
 # fast-math (see kernels/compat.h).
 FPFLAGS   := -ffp-contract=off -fno-fast-math
 CPPFLAGS  := -D_GNU_SOURCE -DCL_TARGET_OPENCL_VERSION=120 -Ihost -Ikernels -I$(BUILD) \
-             -I/usr/include/stb
+             -I/usr/include/stb -I/usr/include/OpenEXR
 CFLAGS    := -std=c11 $(OPT) -g $(WARN) $(FPFLAGS) -pthread $(EXTRA_CFLAGS)
 LDFLAGS   := -pthread $(EXTRA_LDFLAGS)
-LDLIBS    := -lOpenCL -lstb -lm
+LDLIBS    := -lOpenCL -lstb -lOpenEXRCore -lOpenEXR -lm
 
 # Code that compiles the kernel sources as C must not promote floats to double, or the
 # scalar device would round differently from OpenCL.

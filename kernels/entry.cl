@@ -157,6 +157,7 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Camera, forward);
     out[i++] = (uint)__builtin_offsetof(RenderParams, shadows);
     out[i++] = (uint)__builtin_offsetof(RenderParams, normal_miss_grey);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, bg_light);
 }
 
 /* ---------------------------------------------------------------- classic ray tracer

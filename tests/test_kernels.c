@@ -296,7 +296,8 @@ static void test_layout(void)
                     offsetof(Texture, color1), offsetof(RenderParams, ambient),
                     offsetof(RenderParams, strata), offsetof(Material, reflective),
                     offsetof(Light, cos_inner), offsetof(Camera, forward),
-                    offsetof(RenderParams, shadows), offsetof(RenderParams, normal_miss_grey) };
+                    offsetof(RenderParams, shadows), offsetof(RenderParams, normal_miss_grey),
+                    offsetof(RenderParams, bg_light) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);
@@ -663,7 +664,7 @@ static void test_whitted(void)
         cl_mem cb = buffer(sizeof zero, &zero);
         set_scene_args(k);
         SET(k, 0, parb);
-        SET(k, 12, mb);
+        SET(k, SCENE_BUF_pixel_mask, mb);
         uint first_pixel = 0;
         SET(k, N_SCENE + 0, first_pixel);
         SET(k, N_SCENE + 1, first_sample);

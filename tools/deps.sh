@@ -13,7 +13,7 @@ set -eu
 
 pkgs_for() {
     case "$1" in
-        base) echo "make gcc libc6-dev pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers libstb-dev" ;;
+        base) echo "make gcc libc6-dev pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers libstb-dev libopenexr-dev" ;;
         sanitize) echo "clang libclang-rt-14-dev" ;;
         valgrind) echo "valgrind" ;;
         fuzz) echo "clang libclang-rt-14-dev" ;;

@@ -1,0 +1,171 @@
+/* exr.c — OpenEXR images through OpenEXRCore (see exr.h). */
+#include "io/exr.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <ImfCRgbaFile.h>
+#include <openexr.h>
+
+/* The longest side clpt lets OpenEXR accept (beyond its pixel limit, which is checked
+ * separately). */
+#define EXR_MAX_SIDE 65536
+
+int exr_is_exr(const unsigned char *head, size_t n)
+{
+    return n >= 4 && head[0] == 0x76 && head[1] == 0x2f && head[2] == 0x31 && head[3] == 0x01;
+}
+
+/* OpenEXRCore reports a failure through the context's error handler, with a message
+ * more precise than its error code; the last one is kept here for our own message
+ * (the library would otherwise print it to stderr). One per thread: textures may be
+ * read from several. */
+static _Thread_local char exr_last_error[256];
+
+static void exr_error_handler(exr_const_context_t ctxt, exr_result_t code, const char *msg)
+{
+    (void)ctxt;
+    snprintf(exr_last_error, sizeof exr_last_error, "%s", msg ? msg : exr_get_error_code_as_string(code));
+}
+
+static Status exr_fail(const char *path, exr_result_t rv, Error *err)
+{
+    const char *why = exr_last_error[0] ? exr_last_error : exr_get_error_code_as_string(rv);
+    if (rv == EXR_ERR_FILE_ACCESS)
+        return error_set(err, ST_IO, "cannot open '%s': %s", path, why);
+    return error_set(err, ST_INPUT, "'%s': not an EXR file OpenEXR can read (%s)", path, why);
+}
+
+/* The channel that fills component `k` (0 R, 1 G, 2 B) of the RGB output, or -1: R,
+ * G, B by name, or Y for all three when none of R, G and B is there. */
+static int exr_pick_channel(const exr_attr_chlist_t *ch, int k)
+{
+    static const char *const names[3] = { "R", "G", "B" };
+    int any_rgb = 0, y = -1;
+    for (int i = 0; i < ch->num_channels; i++) {
+        const char *n = ch->entries[i].name.str;
+        if (strcmp(n, names[k]) == 0) return i;
+        if (!strcmp(n, "R") || !strcmp(n, "G") || !strcmp(n, "B")) any_rgb = 1;
+        if (!strcmp(n, "Y")) y = i;
+    }
+    return any_rgb ? -1 : y;
+}
+
+/* Checks the first part's header (read by OpenEXRCore, which bounds what a header may
+ * ask for) before any pixel memory exists. */
+static Status exr_check_part(exr_context_t ctxt, const char *path, uint64_t max_pixels, const int pick[3], int w,
+                             int h, Error *err)
+{
+    exr_storage_t storage;
+    exr_result_t rv = exr_get_storage(ctxt, 0, &storage);
+    if (rv != EXR_ERR_SUCCESS) return exr_fail(path, rv, err);
+    if (storage == EXR_STORAGE_DEEP_SCANLINE || storage == EXR_STORAGE_DEEP_TILED)
+        return error_set(err, ST_INPUT, "'%s': a deep EXR image (samples at several depths per pixel); clpt "
+                         "reads flat images only", path);
+    if (pick[0] < 0 && pick[1] < 0 && pick[2] < 0)
+        return error_set(err, ST_INPUT, "'%s': the EXR image has no colour channel (R, G, B or Y)", path);
+    if (w <= 0 || h <= 0 || (uint64_t)w * (uint64_t)h > max_pixels)
+        return error_set(err, ST_INPUT, "'%s': a %dx%d EXR image is larger than the images clpt reads (at most "
+                         "%llu pixels)", path, w, h, (unsigned long long)max_pixels);
+    return ST_OK;
+}
+
+/* Decodes the pixels through the OpenEXR library's C interface to RgbaInputFile:
+ * OpenEXRCore 3.1 (Debian 12) cannot decompress DWAA/DWAB, the compression real tools
+ * write environment maps with; RgbaInputFile reads every compression, converts
+ * luminance/chroma images to RGB and gives halves (16 bits: the precision of almost
+ * every EXR environment map; float32 files lose their low bits). */
+static Status exr_decode(const char *path, int w, int h, float *rgb, Error *err)
+{
+    ImfInputFile *in = ImfOpenInputFile(path);
+    if (!in) return error_set(err, ST_INPUT, "'%s': not an EXR file OpenEXR can read (%s)", path, ImfErrorMessage());
+    int x0, y0, x1, y1;
+    ImfHeaderDataWindow(ImfInputHeader(in), &x0, &y0, &x1, &y1);
+    Status st = ST_OK;
+    ImfRgba *px = NULL;
+    if (x1 - x0 + 1 != w || y1 - y0 + 1 != h)
+        st = error_set(err, ST_INPUT, "'%s': the EXR image changed while it was read", path);
+    else if (!(px = malloc((size_t)w * (size_t)h * sizeof *px)))
+        st = error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+    /* the frame buffer is addressed by absolute pixel coordinates: its base is where
+     * pixel (0, 0) would be (this offset arithmetic is the library's documented use) */
+    else if (!ImfInputSetFrameBuffer(in, px - x0 - (ptrdiff_t)y0 * w, 1, (size_t)w) ||
+             !ImfInputReadPixels(in, y0, y1))
+        st = error_set(err, ST_INPUT, "'%s': not an EXR file OpenEXR can read (%s)", path, ImfErrorMessage());
+    if (!st)
+        for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
+            rgb[3 * i] = ImfHalfToFloat(px[i].r);
+            rgb[3 * i + 1] = ImfHalfToFloat(px[i].g);
+            rgb[3 * i + 2] = ImfHalfToFloat(px[i].b);
+        }
+    free(px);
+    ImfCloseInputFile(in);
+    return st;
+}
+
+/* Checks every value: the renderer's sums need finite numbers (a half can be inf or
+ * NaN). */
+static Status exr_finish_pixels(const char *path, float *rgb, int w, int h, Error *err)
+{
+        size_t n = (size_t)w * (size_t)h;
+    for (size_t i = 0; i < n; i++) {
+        float *p = rgb + 3u * i;
+        for (int k = 0; k < 3; k++) {
+            if (!isfinite(p[k]))
+                return error_set(err, ST_INPUT, "'%s': pixel (%zu, %zu) of the EXR image is not a finite number",
+                                 path, i % (size_t)w, i / (size_t)w);
+        }
+    }
+    return ST_OK;
+}
+
+Status exr_read_rgb(const char *path, uint64_t max_pixels, float **rgb, int *width, int *height, Error *err)
+{
+    *rgb = NULL;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = exr_error_handler;
+    /* the library sizes its chunk table from the header: a bound on the sides keeps a
+     * corrupt header from asking for gigabytes before our own size check runs */
+    init.max_image_width = EXR_MAX_SIDE;
+    init.max_image_height = EXR_MAX_SIDE;
+    exr_last_error[0] = '\0';
+    exr_context_t ctxt = NULL;
+    exr_result_t rv = exr_start_read(&ctxt, path, &init);
+    if (rv != EXR_ERR_SUCCESS) {
+        Status st = exr_fail(path, rv, err);
+        exr_finish(&ctxt);
+        return st;
+    }
+    const exr_attr_chlist_t *ch = NULL;
+    exr_attr_box2i_t dw;
+    Status st = ST_OK;
+    if ((rv = exr_get_channels(ctxt, 0, &ch)) != EXR_ERR_SUCCESS || (rv = exr_get_data_window(ctxt, 0, &dw)))
+        st = exr_fail(path, rv, err);
+    int pick[3] = { -1, -1, -1 };
+    int64_t w = 0, h = 0;
+    if (!st) {
+        for (int k = 0; k < 3; k++) pick[k] = exr_pick_channel(ch, k);
+        w = (int64_t)dw.max.x - dw.min.x + 1;
+        h = (int64_t)dw.max.y - dw.min.y + 1;
+        if (w > INT32_MAX || h > INT32_MAX) w = h = 0;
+        st = exr_check_part(ctxt, path, max_pixels, pick, (int)w, (int)h, err);
+    }
+    float *px = NULL;
+    if (!st && !(px = calloc((size_t)w * (size_t)h * 3u, sizeof *px)))
+        st = error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+    exr_finish(&ctxt);
+    if (!st) st = exr_decode(path, (int)w, (int)h, px, err);
+    if (!st) st = exr_finish_pixels(path, px, (int)w, (int)h, err);
+    if (st) {
+        free(px);
+        return st;
+    }
+    *rgb = px;
+    *width = (int)w;
+    *height = (int)h;
+    return ST_OK;
+}

@@ -1,0 +1,28 @@
+/*
+ * exr.h — OpenEXR images (libopenexr-dev): reading an image's colour as linear RGB
+ * floats (environment maps, textures), whatever the compression (DWAA/DWAB included).
+ * OpenEXRCore's C API reads and checks the header; the pixels come through the
+ * library's C interface to RgbaInputFile (ImfCRgbaFile.h), as halves.
+ */
+#ifndef CLPT_EXR_H
+#define CLPT_EXR_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "base/status.h"
+
+/* Whether the first bytes of a file (n of them) are the OpenEXR magic number. */
+int exr_is_exr(const unsigned char *head, size_t n);
+
+/* Reads the EXR file at `path` as width x height RGB floats (its data window), rows top
+ * to bottom (*rgb, freed with free). The colour is the channels R, G and B (a missing
+ * one is 0), or Y (grey) when the image has none of them (luminance/chroma images are
+ * converted to RGB); other channels are ignored. The data window's size is checked
+ * against max_pixels before anything is allocated for the pixels. Errors (ST_INPUT,
+ * naming the file): "not an EXR file OpenEXR can read (REASON)", a deep image, no
+ * colour channel, an image larger than max_pixels, a pixel that is not a finite
+ * number; ST_IO "cannot open 'PATH': REASON". */
+Status exr_read_rgb(const char *path, uint64_t max_pixels, float **rgb, int *width, int *height, Error *err);
+
+#endif /* CLPT_EXR_H */

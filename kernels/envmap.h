@@ -38,20 +38,20 @@ KFN vec3 env_to_map(GLOBAL const RenderParams *p, vec3 d)
     return v3(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
 }
 
-/* The pixel (x, y) of a W x H map a direction falls in, and cos(theta) of the unit
- * direction. NaN and infinite components land in a valid pixel. */
-KFN void env_pixel(GLOBAL const RenderParams *p, Texture tx, vec3 d, uint *x, uint *y, float *cos_theta)
+/* The pixel (x, y) of a W x H map a direction falls in, and sin(theta) of the
+ * direction. theta and sin(theta) come from the distance to the y axis, not from
+ * cos(theta), which rounds to 1 within 3e-4 radians of the poles (a sample there would
+ * get density 0). NaN and infinite components land in a valid pixel. */
+KFN void env_pixel(GLOBAL const RenderParams *p, Texture tx, vec3 d, uint *x, uint *y, float *sin_theta)
 {
     vec3 m = env_to_map(p, d);
-    float len = v3_len(m);
-    float ct = len > 0.0f ? k_clamp(m.y / len, -1.0f, 1.0f) : 1.0f;
-    if (!(ct == ct)) ct = 1.0f;
+    float r = k_sqrt(m.x * m.x + m.z * m.z), len = v3_len(m);
     float u = k_atan2(m.x, -m.z) * (1.0f / K_TWO_PI);
     if (u < 0.0f) u += 1.0f;
-    float v = k_acos(ct) * K_INV_PI;
+    float v = k_atan2(r, m.y) * K_INV_PI;
     *x = (uint)k_clamp(u * (float)tx.width, 0.0f, (float)tx.width - 1.0f);
     *y = (uint)k_clamp(v * (float)tx.height, 0.0f, (float)tx.height - 1.0f);
-    *cos_theta = ct;
+    *sin_theta = len > 0.0f ? r / len : 0.0f;
 }
 
 /* The radiance the map sends along -d toward the scene, from direction d. */
@@ -60,8 +60,8 @@ KFN vec3 env_radiance(const SceneView *sc, vec3 d)
     GLOBAL const RenderParams *p = sc->params;
     Texture tx = sc->textures[p->bg_cubemap];
     uint x, y;
-    float ct;
-    env_pixel(p, tx, d, &x, &y, &ct);
+    float st;
+    env_pixel(p, tx, d, &x, &y, &st);
     return v3_mul(texel_fetch(sc, tx, x, y), p->bg_color);
 }
 
@@ -71,9 +71,8 @@ KFN float env_pdf(const SceneView *sc, vec3 d)
     GLOBAL const RenderParams *p = sc->params;
     Texture tx = sc->textures[p->bg_cubemap];
     uint x, y;
-    float ct;
-    env_pixel(p, tx, d, &x, &y, &ct);
-    float sin_t = k_safe_sqrt(1.0f - ct * ct);
+    float sin_t;
+    env_pixel(p, tx, d, &x, &y, &sin_t);
     if (!(sin_t > 0.0f)) return 0.0f;
     GLOBAL const float *marg = sc->env_cdf;
     GLOBAL const float *cond = marg + tx.height + 1u + y * (tx.width + 1u);

@@ -123,6 +123,23 @@ static Status exr_finish_pixels(const char *path, float *rgb, int w, int h, Erro
     return ST_OK;
 }
 
+int exr_size(const char *path, int *width, int *height)
+{
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = exr_error_handler;
+    init.max_image_width = EXR_MAX_SIDE;
+    init.max_image_height = EXR_MAX_SIDE;
+    exr_context_t ctxt = NULL;
+    exr_attr_box2i_t dw;
+    int ok = exr_start_read(&ctxt, path, &init) == EXR_ERR_SUCCESS &&
+             exr_get_data_window(ctxt, 0, &dw) == EXR_ERR_SUCCESS;
+    exr_finish(&ctxt);
+    if (!ok) return 0;
+    *width = (int)((int64_t)dw.max.x - dw.min.x + 1);
+    *height = (int)((int64_t)dw.max.y - dw.min.y + 1);
+    return 1;
+}
+
 Status exr_read_rgb(const char *path, uint64_t max_pixels, float **rgb, int *width, int *height, Error *err)
 {
     *rgb = NULL;

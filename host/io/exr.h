@@ -15,6 +15,10 @@
 /* Whether the first bytes of a file (n of them) are the OpenEXR magic number. */
 int exr_is_exr(const unsigned char *head, size_t n);
 
+/* The size of the EXR file's data window, from its header alone (OpenEXRCore); 0 when
+ * the header cannot be read. */
+int exr_size(const char *path, int *width, int *height);
+
 /* Reads the EXR file at `path` as width x height RGB floats (its data window), rows top
  * to bottom (*rgb, freed with free). The colour is the channels R, G and B (a missing
  * one is 0), or Y (grey) when the image has none of them (luminance/chroma images are

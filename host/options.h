@@ -19,6 +19,7 @@ typedef struct {
     double checkpoint_seconds;    /* between checkpoints; 60 unless given */
     const char *resume_path;      /* NULL: a fresh render */
     int list_devices, stats, quiet, help, version;
+    int exr_float;                /* EXR channels as 32-bit floats, not halves */
     /* developer flags */
     const char *kernel_dir;
     unsigned batch;               /* fixed batch size, 0 = adaptive */

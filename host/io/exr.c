@@ -15,6 +15,11 @@
  * separately). */
 #define EXR_MAX_SIDE 65536
 
+/* The file name OpenEXRCore is given when it writes to memory: it names the file in its
+ * messages and, on a failed write, is what the library's own file handling would
+ * remove; a path that cannot exist keeps that from touching any real file. */
+#define EXR_NO_FILE "/nonexistent/clpt-exr-in-memory"
+
 int exr_is_exr(const unsigned char *head, size_t n)
 {
     return n >= 4 && head[0] == 0x76 && head[1] == 0x2f && head[2] == 0x31 && head[3] == 0x01;
@@ -184,5 +189,103 @@ Status exr_read_rgb(const char *path, uint64_t max_pixels, float **rgb, int *wid
     *rgb = px;
     *width = (int)w;
     *height = (int)h;
+    return ST_OK;
+}
+
+/* ------------------------------------------------------------------ writing */
+
+/* The file being encoded, in memory: OpenEXRCore writes at offsets (the chunk table is
+ * written last, after the chunks), so it is a growing buffer, not a stream. */
+typedef struct {
+    unsigned char *data;
+    size_t size, cap;
+    int failed;
+} ExrMemory;
+
+static int64_t exr_memory_write(exr_const_context_t ctxt, void *user, const void *buffer, uint64_t sz, uint64_t offset,
+                                exr_stream_error_func_ptr_t error_cb)
+{
+    ExrMemory *m = user;
+    if (offset > SIZE_MAX - sz) m->failed = 1;
+    size_t end = m->failed ? 0 : (size_t)(offset + sz);
+    if (!m->failed && end > m->cap) {
+        size_t cap = m->cap ? m->cap : 4096;
+        while (cap < end) cap = cap > SIZE_MAX / 2 ? end : 2 * cap;
+        unsigned char *grown = realloc(m->data, cap);
+        if (!grown) m->failed = 1;
+        else {
+            memset(grown + m->cap, 0, cap - m->cap);
+            m->data = grown;
+            m->cap = cap;
+        }
+    }
+    if (m->failed) {
+        error_cb(ctxt, EXR_ERR_OUT_OF_MEMORY, "out of memory encoding the EXR image");
+        return -1;
+    }
+    memcpy(m->data + offset, buffer, (size_t)sz);
+    if (end > m->size) m->size = end;
+    return (int64_t)sz;
+}
+
+/* Points each channel of the encoder at its source rows for the chunk starting at
+ * row y (the encoder lists the channels sorted by name). */
+static void exr_encode_sources(exr_encode_pipeline_t *enc, const ExrChannel *ch, size_t n, unsigned width, int y)
+{
+    for (int c = 0; c < enc->channel_count; c++) {
+        exr_coding_channel_info_t *cc = &enc->channels[c];
+        for (size_t i = 0; i < n; i++) {
+            if (strcmp(cc->channel_name, ch[i].name) != 0) continue;
+            cc->encode_from_ptr = (const uint8_t *)(ch[i].data + (size_t)y * width * ch[i].stride);
+            cc->user_pixel_stride = (int32_t)(ch[i].stride * sizeof(float));
+            cc->user_line_stride = (int32_t)((size_t)width * ch[i].stride * sizeof(float));
+            cc->user_data_type = EXR_PIXEL_FLOAT;
+            cc->user_bytes_per_element = (int16_t)sizeof(float);
+        }
+    }
+}
+
+Status exr_encode(const ExrChannel *ch, size_t n, unsigned width, unsigned height, int float32, unsigned char **bytes,
+                  size_t *size, Error *err)
+{
+    *bytes = NULL;
+    *size = 0;
+    ExrMemory mem = { NULL, 0, 0, 0 };
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = exr_error_handler;
+    init.user_data = &mem;
+    init.write_fn = exr_memory_write;
+    exr_last_error[0] = '\0';
+    exr_context_t ctxt = NULL;
+    int part = 0, lines = 0, started = 0;
+    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
+    exr_result_t rv = exr_start_write(&ctxt, EXR_NO_FILE, EXR_WRITE_FILE_DIRECTLY, &init);
+    if (!rv) rv = exr_add_part(ctxt, "image", EXR_STORAGE_SCANLINE, &part);
+    if (!rv) rv = exr_initialize_required_attr_simple(ctxt, part, (int32_t)width, (int32_t)height, EXR_COMPRESSION_ZIP);
+    for (size_t i = 0; i < n && !rv; i++)
+        rv = exr_add_channel(ctxt, part, ch[i].name, float32 ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF,
+                             ch[i].linear ? EXR_PERCEPTUALLY_LINEAR : EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+    if (!rv) rv = exr_write_header(ctxt);
+    if (!rv) rv = exr_get_scanlines_per_chunk(ctxt, part, &lines);
+    for (int y = 0; !rv && y < (int)height; y += lines) {
+        exr_chunk_info_t ci;
+        rv = exr_write_scanline_chunk_info(ctxt, part, y, &ci);
+        if (!rv) rv = started ? exr_encoding_update(ctxt, part, &ci, &enc) : exr_encoding_initialize(ctxt, part, &ci, &enc);
+        if (rv) break;
+        started = 1;
+        exr_encode_sources(&enc, ch, n, width, y);
+        rv = exr_encoding_choose_default_routines(ctxt, part, &enc);
+        if (!rv) rv = exr_encoding_run(ctxt, part, &enc);
+    }
+    if (started) exr_encoding_destroy(ctxt, &enc);
+    exr_result_t fin = exr_finish(&ctxt);
+    if (!rv) rv = fin;
+    if (rv || mem.failed) {
+        free(mem.data);
+        return error_set(err, ST_INTERNAL, "cannot encode the EXR image: %s",
+                         exr_last_error[0] ? exr_last_error : exr_get_error_code_as_string(rv));
+    }
+    *bytes = mem.data;
+    *size = mem.size;
     return ST_OK;
 }

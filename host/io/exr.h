@@ -29,4 +29,22 @@ int exr_size(const char *path, int *width, int *height);
  * number; ST_IO "cannot open 'PATH': REASON". */
 Status exr_read_rgb(const char *path, uint64_t max_pixels, float **rgb, int *width, int *height, Error *err);
 
+/* One channel of an image to write: its EXR name and its values, `stride` floats apart,
+ * rows top to bottom. `linear` marks data channels (normals, depth); colour channels
+ * are marked perceptually logarithmic, which lossy compressors look at. */
+typedef struct {
+    const char *name;
+    const float *data;
+    unsigned stride;
+    int linear;
+} ExrChannel;
+
+/* Encodes a width x height image of n channels as a single-part scanline OpenEXR file
+ * in memory (OpenEXRCore; ZIP compression, lossless), each channel 16-bit half or, with
+ * `float32`, 32-bit float: *bytes (freed with free) of *size bytes. The library sorts the
+ * channels by name, as the format asks. ST_INTERNAL, with OpenEXR's reason, on failure
+ * (out of memory). */
+Status exr_encode(const ExrChannel *ch, size_t n, unsigned width, unsigned height, int float32, unsigned char **bytes,
+                  size_t *size, Error *err);
+
 #endif /* CLPT_EXR_H */

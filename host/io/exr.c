@@ -79,6 +79,79 @@ static Status exr_check_part(exr_context_t ctxt, const char *path, uint64_t max_
     return ST_OK;
 }
 
+/* A NUL-terminated string of at most 255 characters from f into buf[256]; 0 when the
+ * file ends first or the string is longer (then the libraries judge the file). */
+static int exr_read_name(FILE *f, char buf[256])
+{
+    for (int i = 0; i < 256; i++) {
+        int c = getc(f);
+        if (c == EOF) return 0;
+        buf[i] = (char)c;
+        if (c == 0) return 1;
+    }
+    return 0;
+}
+
+/* Every header attribute's data must fit in the file, and a preview image's pixels in
+ * its attribute. The OpenEXR library (RgbaInputFile) reserves an attribute's declared
+ * size, and a preview's declared width x height, before reading a byte of it, so a
+ * corrupt size in a small file was a 1.8 GB allocation (found by fuzz_texture);
+ * OpenEXRCore, which reads the header first, reads such attributes lazily and lets
+ * them pass. One pass over the header(s), nothing allocated. */
+static Status exr_header_check(const char *path, Error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return ST_OK;   /* the readers report it */
+    unsigned char head[8];
+    long size = -1;
+    if (fread(head, 1, 8, f) != 8 || fseek(f, 0, SEEK_END) != 0 || (size = ftell(f)) < 0 || fseek(f, 8, SEEK_SET) != 0) {
+        fclose(f);
+        return ST_OK;
+    }
+    int multipart = (head[5] & 0x10) != 0;   /* version flags: bit 12 of the version word */
+    Status st = ST_OK;
+    char name[256], type[256];
+    while (!st) {
+        if (!exr_read_name(f, name)) break;
+        if (name[0] == '\0') {
+            /* the end of a header: the only one, or in a multi-part file the next one's
+             * start, unless that is empty too (the end of the list) */
+            if (!multipart) break;
+            int c = getc(f);
+            if (c == 0 || c == EOF) break;
+            ungetc(c, f);
+            continue;
+        }
+        unsigned char sz[4];
+        if (!exr_read_name(f, type) || fread(sz, 1, 4, f) != 4) break;
+        uint64_t n = (uint64_t)sz[0] | (uint64_t)sz[1] << 8 | (uint64_t)sz[2] << 16 | (uint64_t)sz[3] << 24;
+        long at = ftell(f);
+        if (at < 0) break;
+        if (n > (uint64_t)(size - at)) {
+            st = error_set(err, ST_INPUT, "'%s': the EXR header attribute '%s' declares %llu bytes, more than the %llu "
+                           "left in the file (a truncated or corrupt file)", path, name, (unsigned long long)n,
+                           (unsigned long long)(size - at));
+            break;
+        }
+        if (strcmp(type, "preview") == 0 && n >= 8) {
+            unsigned char wh[8];
+            if (fread(wh, 1, 8, f) != 8) break;
+            uint64_t w = (uint64_t)wh[0] | (uint64_t)wh[1] << 8 | (uint64_t)wh[2] << 16 | (uint64_t)wh[3] << 24;
+            uint64_t h = (uint64_t)wh[4] | (uint64_t)wh[5] << 8 | (uint64_t)wh[6] << 16 | (uint64_t)wh[7] << 24;
+            if ((w && h > (n - 8) / 4 / w) || w * h * 4 != n - 8) {
+                st = error_set(err, ST_INPUT, "'%s': the EXR preview image of %llux%llu pixels does not fit its %llu "
+                               "bytes", path, (unsigned long long)w, (unsigned long long)h,
+                               (unsigned long long)(n - 8));
+                break;
+            }
+            n -= 8;
+        }
+        if (fseek(f, (long)n, SEEK_CUR) != 0) break;
+    }
+    fclose(f);
+    return st;
+}
+
 /* Decodes the pixels through the OpenEXR library's C interface to RgbaInputFile:
  * OpenEXRCore 3.1 (Debian 12) cannot decompress DWAA/DWAB, the compression real tools
  * write environment maps with; RgbaInputFile reads every compression, converts
@@ -176,6 +249,7 @@ Status exr_read_rgb(const char *path, uint64_t max_pixels, float **rgb, int *wid
         if (w > INT32_MAX || h > INT32_MAX) w = h = 0;
         st = exr_check_part(ctxt, path, max_pixels, pick, (int)w, (int)h, err);
     }
+    if (!st) st = exr_header_check(path, err);
     float *px = NULL;
     if (!st && !(px = calloc((size_t)w * (size_t)h * 3u, sizeof *px)))
         st = error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);

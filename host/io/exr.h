@@ -25,8 +25,9 @@ int exr_size(const char *path, int *width, int *height);
  * converted to RGB); other channels are ignored. The data window's size is checked
  * against max_pixels before anything is allocated for the pixels. Errors (ST_INPUT,
  * naming the file): "not an EXR file OpenEXR can read (REASON)", a deep image, no
- * colour channel, an image larger than max_pixels, a pixel that is not a finite
- * number; ST_IO "cannot open 'PATH': REASON". */
+ * colour channel, an image larger than max_pixels, a header attribute larger than
+ * the rest of the file (or a preview image larger than its attribute), a pixel that
+ * is not a finite number; ST_IO "cannot open 'PATH': REASON". */
 Status exr_read_rgb(const char *path, uint64_t max_pixels, float **rgb, int *width, int *height, Error *err);
 
 /* One channel of an image to write: its EXR name and its values, `stride` floats apart,

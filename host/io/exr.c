@@ -92,12 +92,78 @@ static int exr_read_name(FILE *f, char buf[256])
     return 0;
 }
 
-/* Every header attribute's data must fit in the file, and a preview image's pixels in
- * its attribute. The OpenEXR library (RgbaInputFile) reserves an attribute's declared
- * size, and a preview's declared width x height, before reading a byte of it, so a
- * corrupt size in a small file was a 1.8 GB allocation (found by fuzz_texture);
- * OpenEXRCore, which reads the header first, reads such attributes lazily and lets
- * them pass. One pass over the header(s), nothing allocated. */
+/* The size of a value of the OpenEXR library's attribute type `type` when it is fixed
+ * (the library reads that many bytes whatever the attribute declares), else 0. */
+static uint64_t exr_fixed_size(const char *type)
+{
+    static const struct { const char *type; uint64_t size; } fixed[] = {
+        { "box2i", 16 }, { "box2f", 16 }, { "chromaticities", 32 }, { "compression", 1 }, { "double", 8 },
+        { "envmap", 1 }, { "float", 4 }, { "int", 4 }, { "keycode", 28 }, { "lineOrder", 1 }, { "m33f", 36 },
+        { "m33d", 72 }, { "m44f", 64 }, { "m44d", 128 }, { "rational", 8 }, { "tiledesc", 9 }, { "timecode", 8 },
+        { "v2i", 8 }, { "v2f", 8 }, { "v2d", 16 }, { "v3i", 12 }, { "v3f", 12 }, { "v3d", 24 },
+        { "deepImageState", 1 },
+    };
+    for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
+        if (strcmp(type, fixed[i].type) == 0) return fixed[i].size;
+    return 0;
+}
+
+static uint64_t exr_le32(const unsigned char *p)
+{
+    return (uint64_t)p[0] | (uint64_t)p[1] << 8 | (uint64_t)p[2] << 16 | (uint64_t)p[3] << 24;
+}
+
+/* The parts of an attribute's value the OpenEXR library sizes from inside the value:
+ * a channel list (entries up to an empty name, read whatever the declared size says),
+ * a preview (width x height x 4 bytes), a string vector (a length before each string).
+ * Each must end exactly at the declared size n, as everything else the library reads
+ * by n; `f` is at the value and is left after it. Returns 0 when it does not. */
+static int exr_value_fits(FILE *f, const char *type, uint64_t n)
+{
+    uint64_t fixed = exr_fixed_size(type);
+    if (fixed) return n == fixed && fseek(f, (long)n, SEEK_CUR) == 0;
+    if (strcmp(type, "chlist") == 0) {
+        uint64_t used = 0;
+        char name[256];
+        unsigned char rest[16];
+        for (;;) {
+            if (!exr_read_name(f, name)) return 0;
+            used += strlen(name) + 1;
+            if (name[0] == '\0') return used == n;
+            if (fread(rest, 1, 16, f) != 16) return 0;
+            used += 16;
+            if (used > n) return 0;
+        }
+    }
+    if (strcmp(type, "preview") == 0) {
+        unsigned char wh[8];
+        if (n < 8 || fread(wh, 1, 8, f) != 8) return 0;
+        uint64_t w = exr_le32(wh), h = exr_le32(wh + 4);
+        if ((w && h > (n - 8) / 4 / w) || w * h * 4 != n - 8) return 0;
+        return fseek(f, (long)(n - 8), SEEK_CUR) == 0;
+    }
+    if (strcmp(type, "stringvector") == 0) {
+        for (uint64_t used = 0; used < n;) {
+            unsigned char len[4];
+            if (n - used < 4 || fread(len, 1, 4, f) != 4) return 0;
+            uint64_t l = exr_le32(len);
+            used += 4;
+            if (l > n - used || fseek(f, (long)l, SEEK_CUR) != 0) return 0;
+            used += l;
+        }
+        return 1;
+    }
+    if (strcmp(type, "idmanifest") == 0) return 0;   /* compressed, sized from inside: not read */
+    return fseek(f, (long)n, SEEK_CUR) == 0;
+}
+
+/* Every header attribute must fit in the file and be the size the OpenEXR library will
+ * read of it (exr_value_fits). The library (RgbaInputFile) reserves an attribute's
+ * declared size before reading a byte of it, so a corrupt size in a small file was a
+ * 1.8 GB allocation (found by fuzz_texture), and it reads a known type's fixed size
+ * whatever the declared one, after which it reads the rest of the header out of step.
+ * OpenEXRCore, which reads the header first, lets such attributes pass. One pass over
+ * the header(s), nothing allocated. */
 static Status exr_header_check(const char *path, Error *err)
 {
     FILE *f = fopen(path, "rb");
@@ -124,7 +190,7 @@ static Status exr_header_check(const char *path, Error *err)
         }
         unsigned char sz[4];
         if (!exr_read_name(f, type) || fread(sz, 1, 4, f) != 4) break;
-        uint64_t n = (uint64_t)sz[0] | (uint64_t)sz[1] << 8 | (uint64_t)sz[2] << 16 | (uint64_t)sz[3] << 24;
+        uint64_t n = exr_le32(sz);
         long at = ftell(f);
         if (at < 0) break;
         if (n > (uint64_t)(size - at)) {
@@ -133,20 +199,9 @@ static Status exr_header_check(const char *path, Error *err)
                            (unsigned long long)(size - at));
             break;
         }
-        if (strcmp(type, "preview") == 0 && n >= 8) {
-            unsigned char wh[8];
-            if (fread(wh, 1, 8, f) != 8) break;
-            uint64_t w = (uint64_t)wh[0] | (uint64_t)wh[1] << 8 | (uint64_t)wh[2] << 16 | (uint64_t)wh[3] << 24;
-            uint64_t h = (uint64_t)wh[4] | (uint64_t)wh[5] << 8 | (uint64_t)wh[6] << 16 | (uint64_t)wh[7] << 24;
-            if ((w && h > (n - 8) / 4 / w) || w * h * 4 != n - 8) {
-                st = error_set(err, ST_INPUT, "'%s': the EXR preview image of %llux%llu pixels does not fit its %llu "
-                               "bytes", path, (unsigned long long)w, (unsigned long long)h,
-                               (unsigned long long)(n - 8));
-                break;
-            }
-            n -= 8;
-        }
-        if (fseek(f, (long)n, SEEK_CUR) != 0) break;
+        if (!exr_value_fits(f, type, n))
+            st = error_set(err, ST_INPUT, "'%s': the EXR header attribute '%s' of type '%s' does not hold the %llu "
+                           "bytes it declares (a corrupt file)", path, name, type, (unsigned long long)n);
     }
     fclose(f);
     return st;

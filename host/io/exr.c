@@ -1,6 +1,8 @@
 /* exr.c — OpenEXR images through OpenEXRCore (see exr.h). */
 #include "io/exr.h"
 
+#include "base/strmap.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stddef.h>
@@ -14,6 +16,10 @@
 /* The longest side clpt lets OpenEXR accept (beyond its pixel limit, which is checked
  * separately). */
 #define EXR_MAX_SIDE 65536
+
+/* The most bytes one chunk of an image may decode to (all its channels): a 16384-wide
+ * RGBA half image in DWAB's 256-row chunks needs 32 MiB. */
+#define EXR_MAX_CHUNK_BYTES (256u << 20)
 
 /* The file name OpenEXRCore is given when it writes to memory: it names the file in its
  * messages and, on a failed write, is what the library's own file handling would
@@ -76,6 +82,20 @@ static Status exr_check_part(exr_context_t ctxt, const char *path, uint64_t max_
     if (w <= 0 || h <= 0 || (uint64_t)w * (uint64_t)h > max_pixels)
         return error_set(err, ST_INPUT, "'%s': a %dx%d EXR image is larger than the images clpt reads (at most "
                          "%llu pixels)", path, w, h, (unsigned long long)max_pixels);
+    /* the library's decompressor buffers one chunk of every channel: rows per chunk
+     * (up to 256 for DWAB) x width x the bytes of all channels, which a wide image with
+     * many channels makes gigabytes (found by fuzz_texture) */
+    int lines = 0;
+    const exr_attr_chlist_t *ch = NULL;
+    if (exr_get_scanlines_per_chunk(ctxt, 0, &lines) != EXR_ERR_SUCCESS || lines <= 0) lines = 1;
+    uint64_t pixel_bytes = 0;
+    if (exr_get_channels(ctxt, 0, &ch) == EXR_ERR_SUCCESS)
+        for (int i = 0; i < ch->num_channels; i++) pixel_bytes += ch->entries[i].pixel_type == EXR_PIXEL_HALF ? 2u : 4u;
+    uint64_t chunk = (uint64_t)lines * (uint64_t)w * pixel_bytes;
+    if (chunk > EXR_MAX_CHUNK_BYTES)
+        return error_set(err, ST_INPUT, "'%s': the EXR image's chunks of %d rows of %d pixels x %d channels need "
+                         "%llu bytes each, more than clpt decodes (%u)", path, lines, w,
+                         ch ? ch->num_channels : 0, (unsigned long long)chunk, EXR_MAX_CHUNK_BYTES);
     return ST_OK;
 }
 
@@ -162,8 +182,10 @@ static int exr_value_fits(FILE *f, const char *type, uint64_t n)
  * declared size before reading a byte of it, so a corrupt size in a small file was a
  * 1.8 GB allocation (found by fuzz_texture), and it reads a known type's fixed size
  * whatever the declared one, after which it reads the rest of the header out of step.
- * OpenEXRCore, which reads the header first, lets such attributes pass. One pass over
- * the header(s), nothing allocated. */
+ * OpenEXRCore, which reads the header first, lets such attributes pass. A header must
+ * name each attribute once: OpenEXRCore and the library keep different ones of a
+ * repeated name (a second dataWindow slipped past the size checks). One pass over the
+ * header(s); only the names are kept. */
 static Status exr_header_check(const char *path, Error *err)
 {
     FILE *f = fopen(path, "rb");
@@ -177,9 +199,22 @@ static Status exr_header_check(const char *path, Error *err)
     int multipart = (head[5] & 0x10) != 0;   /* version flags: bit 12 of the version word */
     Status st = ST_OK;
     char name[256], type[256];
+    StrMap seen = { 0 };
     while (!st) {
         if (!exr_read_name(f, name)) break;
+        int added = name[0] ? strmap_add(&seen, name, strlen(name), 0) : 0;
+        if (added < 0) {
+            st = error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+            break;
+        }
+        if (added > 0) {
+            st = error_set(err, ST_INPUT, "'%s': the EXR header names the attribute '%s' twice (a corrupt file)", path,
+                           name);
+            break;
+        }
         if (name[0] == '\0') {
+            strmap_free(&seen);
+            memset(&seen, 0, sizeof seen);
             /* the end of a header: the only one, or in a multi-part file the next one's
              * start, unless that is empty too (the end of the list) */
             if (!multipart) break;
@@ -203,6 +238,7 @@ static Status exr_header_check(const char *path, Error *err)
             st = error_set(err, ST_INPUT, "'%s': the EXR header attribute '%s' of type '%s' does not hold the %llu "
                            "bytes it declares (a corrupt file)", path, name, type, (unsigned long long)n);
     }
+    strmap_free(&seen);
     fclose(f);
     return st;
 }

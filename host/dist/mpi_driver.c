@@ -104,6 +104,40 @@ static void sleep_seconds(double s)
     nanosleep(&ts, NULL);
 }
 
+/* Receives a message that MPI_Iprobe has matched. A large message (over the transport's
+ * eager limit) is announced before its data moves, and a rank that dies in between
+ * never completes it: a blocking MPI_Recv would then wait for ever under
+ * --enable-recovery, holding the MPI lock that every other rank's device needs. So the
+ * receive is posted and polled, the lock held only for each call, and given up after
+ * d->timeout seconds without completing, like a rank that says nothing. */
+static Status wire_receive(Dist *d, int from, int tag, void *buf, int count, Error *err)
+{
+    MPI_Request req;
+    wire_lock(d);
+    int rc = MPI_Irecv(buf, count, MPI_BYTE, from, tag, MPI_COMM_WORLD, &req);
+    wire_unlock(d);
+    if (rc != MPI_SUCCESS) return mpi_failed(err, rc, from, "receiving");
+    double start = timer_now();
+    for (;;) {
+        int done = 0;
+        wire_lock(d);
+        rc = MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+        wire_unlock(d);
+        if (rc != MPI_SUCCESS) return mpi_failed(err, rc, from, "receiving");
+        if (done) return ST_OK;
+        if (timer_now() - start > d->timeout) {
+            /* the sender is gone, so nothing more is written into buf; cancelling the
+             * matched request is best effort (the job ends with MPI_Abort) */
+            wire_lock(d);
+            MPI_Cancel(&req);
+            wire_unlock(d);
+            return error_set(err, ST_DEVICE, "MPI rank %d stopped in the middle of a message: nothing more of it "
+                             "for %g s (its process or node died, or it hangs; see --mpi-timeout)", from, d->timeout);
+        }
+        sleep_seconds(POLL_SECONDS);
+    }
+}
+
 /* Waits for the next message from `from` (other than a TAG_ALIVE, which only says it is
  * alive) and receives it if its tag is `want` and it fits in `bytes`: polling, so that
  * the waiting thread neither holds the MPI lock nor spins on a core a device needs.
@@ -128,9 +162,8 @@ static Status wire_wait(Dist *d, int from, int want, void *buf, size_t bytes, co
                                  "and %zu bytes were due (ranks running different clpt builds?)", from, ms.MPI_TAG,
                                  count, want, bytes);
             }
-            rc = MPI_Recv(buf, count, MPI_BYTE, from, want, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
             wire_unlock(d);
-            return rc == MPI_SUCCESS ? ST_OK : mpi_failed(err, rc, from, "receiving");
+            return wire_receive(d, from, want, buf, count, err);
         }
         wire_unlock(d);
         if (rc != MPI_SUCCESS) return mpi_failed(err, rc, from, "waiting for a message");
@@ -592,20 +625,23 @@ static int stop_collect(Dist *d, int r, WireStats *s)
         MPI_Status ms;
         wire_lock(d);
         int rc = MPI_Iprobe(r, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms);
-        int done = 0;
-        if (rc == MPI_SUCCESS && flag) {
-            int count = 0;
-            MPI_Get_count(&ms, MPI_BYTE, &count);
-            void *buf = ms.MPI_TAG == TAG_STATS && count == (int)sizeof *s ? (void *)s : malloc(count ? (size_t)count : 1);
-            rc = buf ? MPI_Recv(buf, count, MPI_BYTE, r, ms.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE) : MPI_ERR_NO_MEM;
-            done = buf == (void *)s;
-            if (!done) free(buf);
-            last = timer_now();
-        }
         wire_unlock(d);
         if (rc != MPI_SUCCESS) return -1;
-        if (done) return 0;
-        if (!flag) sleep_seconds(POLL_SECONDS);
+        if (!flag) {
+            sleep_seconds(POLL_SECONDS);
+            continue;
+        }
+        int count = 0;
+        MPI_Get_count(&ms, MPI_BYTE, &count);
+        int stats = ms.MPI_TAG == TAG_STATS && count == (int)sizeof *s;
+        void *buf = stats ? (void *)s : malloc(count ? (size_t)count : 1);
+        if (!buf) return -1;
+        Error e;
+        Status st = wire_receive(d, r, ms.MPI_TAG, buf, count, &e);
+        if (!stats) free(buf);
+        if (st != ST_OK) return -1;
+        if (stats) return 0;
+        last = timer_now();
     }
     return -1;
 }

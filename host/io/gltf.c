@@ -21,7 +21,10 @@
  * luminous efficacy of 555 nm light, 683 lm/W (docs/gltf.md). */
 #define LUMENS_PER_WATT 683.0
 /* Triangles one file may make, nodes times primitives included: a small file that
- * instances a large mesh many times must not exhaust memory. */
+ * instances a large mesh many times must not exhaust memory, so the count is bounded
+ * by the input's size (generously: a real file's mesh data takes 20 bytes or more per
+ * triangle), and absolutely. */
+#define GLTF_TRIANGLES_PER_BYTE 16u
 #define GLTF_MAX_TRIANGLES ((size_t)1 << 26)
 
 typedef struct {
@@ -43,7 +46,7 @@ typedef struct {
     uint default_mat;
     uint *tex;        int n_images;    /* per image: sRGB [2i], linear [2i+1] texture */
     unsigned char *visited;  int n_nodes;
-    size_t triangles;
+    size_t triangles, max_triangles;
     int has_lights;
 } Gltf;
 
@@ -634,9 +637,9 @@ static Status attr_read(Gltf *g, const cJSON *attrs, const char *name, int width
 static Status emit(Gltf *g, MeshSink *k, const double *pos, const double *nrm, const double *uv, uint32_t a, uint32_t b,
                    uint32_t c, uint mat)
 {
-    if (++g->triangles > GLTF_MAX_TRIANGLES)
-        return error_set(g->err, ST_INPUT, "%s: more than %zu triangles (its nodes and primitives together)",
-                         g->path, GLTF_MAX_TRIANGLES);
+    if (++g->triangles > g->max_triangles)
+        return error_set(g->err, ST_INPUT, "%s: more than %zu triangles (its nodes and primitives together), more "
+                         "than a file of its size may make", g->path, g->max_triangles);
     const uint32_t v[3] = { a, b, c };
     vec3 p[3], n[3];
     float t[6];
@@ -1028,6 +1031,9 @@ static Status gltf_read(Gltf *g, const char *data, size_t len)
     if (!cJSON_IsString(ver) || strncmp(ver->valuestring, "2.", 2) != 0)
         return bad(g, "asset.version", "missing or not 2.x (clpt reads glTF 2.0)");
     if ((st = extensions_check(g)) || (st = buffers_load(g))) return st;
+    uint64_t bytes = len;
+    for (int i = 0; i < g->n_bufs; i++) bytes += g->bufs[i].len;
+    g->max_triangles = (size_t)fmin((double)GLTF_MAX_TRIANGLES, (double)((1u << 20) + GLTF_TRIANGLES_PER_BYTE * bytes));
     g->n_mats = count_of(cJSON_GetObjectItemCaseSensitive(g->root, "materials"));
     g->n_images = count_of(cJSON_GetObjectItemCaseSensitive(g->root, "images"));
     g->n_nodes = count_of(cJSON_GetObjectItemCaseSensitive(g->root, "nodes"));

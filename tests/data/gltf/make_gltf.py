@@ -107,20 +107,21 @@ def strided():
 
 def sparse():
     """Positions as normalized shorts, then a sparse part that moves vertex 2 to
-    (0.5, 0.5, 0.25): a short index list and float values."""
+    (16384, 16384, 8192) / 32767: an unsigned short index list and values of the
+    accessor's own component type."""
     base = b""
     for p in QUAD:
         base += struct.pack("<3h", *[int(c * 32767) for c in p]) + b"\0\0"
     ind = struct.pack("<H", 2) + b"\0\0"
-    val = f32(0.5, 0.5, 0.25)
+    val = struct.pack("<3h", 16384, 16384, 8192) + b"\0\0"
     raw = base + ind + val
     idx = struct.pack("<6H", 0, 1, 2, 0, 2, 3)
     raw += idx
     return doc([{"byteLength": len(raw), "uri": data_uri(raw)}],
                [{"buffer": 0, "byteLength": len(base), "byteStride": 8},
                 {"buffer": 0, "byteOffset": len(base), "byteLength": 4},
-                {"buffer": 0, "byteOffset": len(base) + 4, "byteLength": 12},
-                {"buffer": 0, "byteOffset": len(base) + 16, "byteLength": len(idx)}],
+                {"buffer": 0, "byteOffset": len(base) + 4, "byteLength": 6},
+                {"buffer": 0, "byteOffset": len(base) + len(ind) + len(val), "byteLength": len(idx)}],
                [{"bufferView": 0, "componentType": 5122, "normalized": True, "count": 4, "type": "VEC3",
                  "sparse": {"count": 1, "indices": {"bufferView": 1, "componentType": 5123},
                             "values": {"bufferView": 2}}},
@@ -132,7 +133,7 @@ def sparse():
 def strips():
     """A triangle strip of 5 vertices (3 triangles) and a fan of 5 (3 triangles), not
     indexed, every triangle facing +z."""
-    strip = f32(0, 0, 0, 0, 1, 0, 1, 0, 0, 1, 1, 0, 2, 0, 0)
+    strip = f32(0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 2, 0)
     fan = f32(0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1, -1, 1, 1)
     raw = strip + fan
     return doc([{"byteLength": len(raw), "uri": data_uri(raw)}],

@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include <cjson/cJSON.h>
 
@@ -33,6 +34,18 @@ typedef struct {
     char *owned;          /* heap copy (external file, decoded data: URI), or NULL */
 } Buf;
 
+/* The top-level arrays (and the lights of KHR_lights_punctual) as arrays of pointers:
+ * cJSON keeps arrays as linked lists, where finding item i walks i items, and a reader
+ * that looked every index up that way would be quadratic in its input. */
+enum { T_BUFFERS, T_VIEWS, T_ACCESSORS, T_MESHES, T_MATERIALS, T_TEXTURES, T_IMAGES, T_CAMERAS, T_NODES, T_SCENES,
+       T_LIGHTS, T_N };
+static const char *const table_names[T_N] = { "buffers", "bufferViews", "accessors", "meshes", "materials",
+                                              "textures", "images", "cameras", "nodes", "scenes", "lights" };
+typedef struct {
+    const cJSON **item;
+    int n;
+} Table;
+
 typedef struct {
     const char *path;
     Scene *s;
@@ -48,6 +61,7 @@ typedef struct {
     unsigned char *visited;  int n_nodes;
     size_t triangles, max_triangles;
     int has_lights;
+    Table t[T_N];
 } Gltf;
 
 /* ------------------------------------------------------------------ JSON helpers */
@@ -58,6 +72,16 @@ static Status bad(Gltf *g, const char *jpath, const char *what)
 }
 
 static int count_of(const cJSON *a) { return cJSON_IsArray(a) ? cJSON_GetArraySize(a) : 0; }
+
+/* The first element of an array (walk on with ->next), or NULL. */
+static const cJSON *first_of(const cJSON *a) { return cJSON_IsArray(a) ? a->child : NULL; }
+
+static const Table *table_of(const Gltf *g, const char *array)
+{
+    for (int i = 0; i < T_N; i++)
+        if (strcmp(table_names[i], array) == 0) return &g->t[i];
+    return &g->t[T_N - 1];   /* not reached: every caller names a table */
+}
 
 /* The integer at obj.key in [lo, hi], or def when absent (def < lo: required). */
 static Status get_int(Gltf *g, const cJSON *obj, const char *key, long long def, long long lo, long long hi,
@@ -82,7 +106,7 @@ static Status get_int(Gltf *g, const cJSON *obj, const char *key, long long def,
 static Status get_index(Gltf *g, const cJSON *obj, const char *key, int required, const char *array,
                         const char *jpath, int *out)
 {
-    long long n = count_of(cJSON_GetObjectItemCaseSensitive(g->root, array)), v;
+    long long n = table_of(g, array)->n, v;
     const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!item && !required) {
         *out = -1;
@@ -132,15 +156,39 @@ static Status get_nums(Gltf *g, const cJSON *obj, const char *key, int n, const 
     return ST_OK;
 }
 
-static const cJSON *item_at(const Gltf *g, const char *array, int i)
-{
-    return cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(g->root, array), i);
-}
-
 static const cJSON *ext_of(const cJSON *obj, const char *name)
 {
     return cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(obj, "extensions"), name);
 }
+
+static const cJSON *item_at(const Gltf *g, const char *array, int i)
+{
+    const Table *t = table_of(g, array);
+    return i >= 0 && i < t->n ? t->item[i] : NULL;
+}
+
+static Status table_build(Gltf *g, Table *t, const cJSON *a)
+{
+    t->n = count_of(a);
+    t->item = malloc(((size_t)t->n + 1) * sizeof *t->item);
+    if (!t->item) return error_set(g->err, ST_INTERNAL, "out of memory");
+    int i = 0;
+    for (const cJSON *c = first_of(a); c; c = c->next) t->item[i++] = c;
+    return ST_OK;
+}
+
+static Status tables_build(Gltf *g)
+{
+    for (int i = 0; i < T_N; i++) {
+        const cJSON *a = i == T_LIGHTS ? cJSON_GetObjectItemCaseSensitive(
+                                             ext_of(g->root, "KHR_lights_punctual"), "lights")
+                                       : cJSON_GetObjectItemCaseSensitive(g->root, table_names[i]);
+        Status st = table_build(g, &g->t[i], a);
+        if (st) return st;
+    }
+    return ST_OK;
+}
+
 
 /* ------------------------------------------------------------------ buffers */
 
@@ -222,14 +270,13 @@ static Status uri_read(Gltf *g, const char *uri, const char *jpath, Buf *out)
 
 static Status buffers_load(Gltf *g)
 {
-    const cJSON *a = cJSON_GetObjectItemCaseSensitive(g->root, "buffers");
-    g->n_bufs = count_of(a);
+    g->n_bufs = g->t[T_BUFFERS].n;
     g->bufs = calloc((size_t)g->n_bufs + 1, sizeof *g->bufs);
     if (!g->bufs) return error_set(g->err, ST_INTERNAL, "out of memory");
     for (int i = 0; i < g->n_bufs; i++) {
         char jp[64];
         snprintf(jp, sizeof jp, "buffers[%d]", i);
-        const cJSON *b = cJSON_GetArrayItem(a, i);
+        const cJSON *b = g->t[T_BUFFERS].item[i];
         long long length;
         Status st = get_int(g, b, "byteLength", -1, 1, (long long)CLPT_MAX_FILE_BYTES, jp, &length);
         if (st) return st;
@@ -643,7 +690,7 @@ static Status emit(Gltf *g, MeshSink *k, const double *pos, const double *nrm, c
     const uint32_t v[3] = { a, b, c };
     vec3 p[3], n[3];
     float t[6];
-    int normals_ok = nrm != NULL;
+    int normals_ok = nrm != NULL, uv_ok = uv != NULL;
     for (int i = 0; i < 3; i++) {
         const double *q = pos + 3 * (size_t)v[i];
         p[i] = v3((float)q[0], (float)q[1], (float)q[2]);
@@ -657,9 +704,10 @@ static Status emit(Gltf *g, MeshSink *k, const double *pos, const double *nrm, c
             /* glTF's v runs down the image, clpt's (as OBJ's) up */
             t[2 * i] = (float)uv[2 * (size_t)v[i]];
             t[2 * i + 1] = (float)(1.0 - uv[2 * (size_t)v[i] + 1]);
+            if (!isfinite(t[2 * i]) || !isfinite(t[2 * i + 1])) uv_ok = 0;
         }
     }
-    return mesh_sink_triangle(k, p, normals_ok ? n : NULL, uv ? t : NULL, mat);
+    return mesh_sink_triangle(k, p, normals_ok ? n : NULL, uv_ok ? t : NULL, mat);
 }
 
 static Status primitive_load(Gltf *g, MeshSink *k, const cJSON *prim, const char *jp)
@@ -711,10 +759,11 @@ static Status mesh_instance(Gltf *g, int mesh, const Transform *xf)
     if (!cJSON_IsArray(prims)) return bad(g, jp, "primitives: expected an array");
     MeshSink k;
     Status st = mesh_sink_open(&k, g->s, xf, g->path, g->err);
-    for (int i = 0; !st && i < count_of(prims); i++) {
+    int i = 0;
+    for (const cJSON *p = first_of(prims); !st && p; p = p->next, i++) {
         char jpp[96];
         snprintf(jpp, sizeof jpp, "%s.primitives[%d]", jp, i);
-        st = primitive_load(g, &k, cJSON_GetArrayItem(prims, i), jpp);
+        st = primitive_load(g, &k, p, jpp);
     }
     return st;
 }
@@ -807,6 +856,9 @@ static Status camera_set(Gltf *g, int cam, const Transform *xf)
     sc->up = xf_dir(xf, 0, 1, 0);
     sc->aperture = 0.0f;
     sc->focus_dist = 0.0f;
+    if (!isfinite(sc->from.x) || !isfinite(sc->from.y) || !isfinite(sc->from.z) || !isfinite(sc->at.x) ||
+        !isfinite(sc->at.y) || !isfinite(sc->at.z))
+        return bad(g, jp, "its node puts the camera beyond the float range");
     if (aspect > 0) {
         double h = floor(g->s->image.width / aspect + 0.5);
         g->s->image.height = (uint)fmax(1.0, fmin(h, (double)CLPT_MAX_IMAGE_SIDE));
@@ -817,8 +869,7 @@ static Status camera_set(Gltf *g, int cam, const Transform *xf)
 
 static Status light_add(Gltf *g, int li, const Transform *xf, const char *jp)
 {
-    const cJSON *lights = cJSON_GetObjectItemCaseSensitive(ext_of(g->root, "KHR_lights_punctual"), "lights");
-    const cJSON *l = cJSON_GetArrayItem(lights, li);
+    const cJSON *l = item_at(g, "lights", li);
     if (li < 0 || !l) return bad(g, jp, "KHR_lights_punctual.light names no light of the file's extensions");
     char jl[80];
     snprintf(jl, sizeof jl, "extensions.KHR_lights_punctual.lights[%d]", li);
@@ -836,6 +887,8 @@ static Status light_add(Gltf *g, int li, const Transform *xf, const char *jp)
     Transform w = transform_compose(&g->o->xf, xf);
     L.position = transform_point(&w, v3(0.0f, 0.0f, 0.0f));
     L.direction = xf_dir(&w, 0, 0, -1);
+    if (!isfinite(L.position.x) || !isfinite(L.position.y) || !isfinite(L.position.z))
+        return bad(g, jp, "its transform puts the light beyond the float range");
     double k = intensity / LUMENS_PER_WATT;
     L.intensity = v3((float)(color[0] * k), (float)(color[1] * k), (float)(color[2] * k));
     if (lt == LIGHT_SPOT) {
@@ -881,8 +934,8 @@ static Status node_visit(Gltf *g, int n, const Transform *parent, int depth)
             return st;
     }
     const cJSON *kids = cJSON_GetObjectItemCaseSensitive(node, "children");
-    for (int i = 0; i < count_of(kids); i++) {
-        const cJSON *c = cJSON_GetArrayItem(kids, i);
+    int i = 0;
+    for (const cJSON *c = first_of(kids); c; c = c->next, i++) {
         if (!cJSON_IsNumber(c) || c->valuedouble < 0 || c->valuedouble >= g->n_nodes ||
             c->valuedouble != floor(c->valuedouble)) {
             char jc[96];
@@ -897,17 +950,15 @@ static Status node_visit(Gltf *g, int n, const Transform *parent, int depth)
 static Status scene_walk(Gltf *g)
 {
     const Transform id = transform_identity();
-    const cJSON *scenes = cJSON_GetObjectItemCaseSensitive(g->root, "scenes");
+    int n_scenes = g->t[T_SCENES].n;
     long long sc;
-    Status st = get_int(g, g->root, "scene", 0, 0, count_of(scenes) > 0 ? count_of(scenes) - 1 : 0, "(top level)",
-                        &sc);
+    Status st = get_int(g, g->root, "scene", 0, 0, n_scenes > 0 ? n_scenes - 1 : 0, "(top level)", &sc);
     if (st) return st;
-    if (count_of(scenes) > 0) {
+    if (n_scenes > 0) {
         char jp[64];
         snprintf(jp, sizeof jp, "scenes[%lld].nodes", sc);
-        const cJSON *roots = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(scenes, (int)sc), "nodes");
-        for (int i = 0; i < count_of(roots); i++) {
-            const cJSON *r = cJSON_GetArrayItem(roots, i);
+        const cJSON *roots = cJSON_GetObjectItemCaseSensitive(g->t[T_SCENES].item[sc], "nodes");
+        for (const cJSON *r = first_of(roots); r; r = r->next) {
             if (!cJSON_IsNumber(r) || r->valuedouble < 0 || r->valuedouble >= g->n_nodes ||
                 r->valuedouble != floor(r->valuedouble))
                 return bad(g, jp, "an entry is not the index of a node");
@@ -920,8 +971,7 @@ static Status scene_walk(Gltf *g)
     if (!child) return error_set(g->err, ST_INTERNAL, "out of memory");
     for (int n = 0; n < g->n_nodes; n++) {
         const cJSON *kids = cJSON_GetObjectItemCaseSensitive(item_at(g, "nodes", n), "children");
-        for (int i = 0; i < count_of(kids); i++) {
-            const cJSON *c = cJSON_GetArrayItem(kids, i);
+        for (const cJSON *c = first_of(kids); c; c = c->next) {
             if (cJSON_IsNumber(c) && c->valuedouble >= 0 && c->valuedouble < g->n_nodes) child[(int)c->valuedouble] = 1;
         }
     }
@@ -948,15 +998,14 @@ static int ext_supported(const char *name)
 static Status extensions_check(Gltf *g)
 {
     const cJSON *req = cJSON_GetObjectItemCaseSensitive(g->root, "extensionsRequired");
-    for (int i = 0; i < count_of(req); i++) {
-        const cJSON *e = cJSON_GetArrayItem(req, i);
+    int i = 0;
+    for (const cJSON *e = first_of(req); e; e = e->next, i++) {
         if (cJSON_IsString(e) && !ext_supported(e->valuestring))
             return error_set(g->err, ST_INPUT, "%s: extensionsRequired[%d]: the file requires the extension '%s', "
                              "which clpt does not support", g->path, i, e->valuestring);
     }
     const cJSON *used = cJSON_GetObjectItemCaseSensitive(g->root, "extensionsUsed");
-    for (int i = 0; i < count_of(used); i++) {
-        const cJSON *e = cJSON_GetArrayItem(used, i);
+    for (const cJSON *e = first_of(used); e; e = e->next) {
         Status st;
         if (cJSON_IsString(e) && !ext_supported(e->valuestring) &&
             (st = scene_warn(g->s, g->err, "%s: the extension '%s' (extensionsUsed) is ignored", g->path,
@@ -1015,7 +1064,7 @@ static Status gltf_read(Gltf *g, const char *data, size_t len)
     if (len >= 4 && memcmp(data, "glTF", 4) == 0) {
         json = NULL;
         if ((st = glb_split(g, (const unsigned char *)data, len, &json, &json_len))) return st;
-    } else if (len >= 4 && len >= 5 && strlen(g->path) >= 4 && strcmp(g->path + strlen(g->path) - 4, ".glb") == 0) {
+    } else if (strlen(g->path) >= 4 && strcasecmp(g->path + strlen(g->path) - 4, ".glb") == 0) {
         return error_set(g->err, ST_INPUT, "%s: not a binary glTF file (it does not start with the magic 'glTF')",
                          g->path);
     }
@@ -1030,13 +1079,13 @@ static Status gltf_read(Gltf *g, const char *data, size_t len)
     const cJSON *ver = cJSON_GetObjectItemCaseSensitive(asset, "version");
     if (!cJSON_IsString(ver) || strncmp(ver->valuestring, "2.", 2) != 0)
         return bad(g, "asset.version", "missing or not 2.x (clpt reads glTF 2.0)");
-    if ((st = extensions_check(g)) || (st = buffers_load(g))) return st;
+    if ((st = extensions_check(g)) || (st = tables_build(g)) || (st = buffers_load(g))) return st;
     uint64_t bytes = len;
     for (int i = 0; i < g->n_bufs; i++) bytes += g->bufs[i].len;
     g->max_triangles = (size_t)fmin((double)GLTF_MAX_TRIANGLES, (double)((1u << 20) + GLTF_TRIANGLES_PER_BYTE * bytes));
-    g->n_mats = count_of(cJSON_GetObjectItemCaseSensitive(g->root, "materials"));
-    g->n_images = count_of(cJSON_GetObjectItemCaseSensitive(g->root, "images"));
-    g->n_nodes = count_of(cJSON_GetObjectItemCaseSensitive(g->root, "nodes"));
+    g->n_mats = g->t[T_MATERIALS].n;
+    g->n_images = g->t[T_IMAGES].n;
+    g->n_nodes = g->t[T_NODES].n;
     g->mats = malloc(((size_t)g->n_mats + 1) * sizeof *g->mats);
     g->tex = malloc(((size_t)g->n_images * 2 + 1) * sizeof *g->tex);
     g->visited = calloc((size_t)g->n_nodes + 1, 1);
@@ -1070,5 +1119,6 @@ Status gltf_parse(const char *path, const char *data, size_t len, Scene *s, cons
     free(g.mats);
     free(g.tex);
     free(g.visited);
+    for (int i = 0; i < T_N; i++) free(g.t[i].item);
     return st;
 }

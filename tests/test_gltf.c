@@ -127,6 +127,45 @@ static void test_glb_and_external(void)
     }
 }
 
+static void test_textures(void)
+{
+    Scene s;
+    if (!load_mesh(DIR_GLTF "textured.gltf", &s)) return;
+    CHECK_EQ_INT(s.n_triangles, 2);
+    if (s.n_triangles != 2) {
+        scene_free(&s);
+        return;
+    }
+    const Material *tinted = &s.materials[s.triangles[0].material];
+    const Material *plain = &s.materials[s.triangles[1].material];
+    /* the texture as given: the PNG's texels, sRGB; the same image read linear for the
+     * metallic-roughness and normal maps, once */
+    CHECK(plain->texture != NO_INDEX && plain->texture_rm != NO_INDEX);
+    if (plain->texture == NO_INDEX || plain->texture_rm == NO_INDEX || tinted->texture == NO_INDEX) {
+        scene_free(&s);
+        return;
+    }
+    const Texture *t = &s.textures[plain->texture];
+    CHECK_EQ_INT(t->flags, TEX_SRGB);
+    CHECK_EQ_INT(t->width, 2);
+    CHECK_EQ_INT(s.texels[t->offset + 1], 0xffff4000u);   /* (0, 64, 255), alpha 255 */
+    CHECK_EQ_INT(s.textures[plain->texture_rm].flags, 0);
+    CHECK_EQ_INT(plain->texture_normal, plain->texture_rm);
+    CHECK_NEAR(plain->normal_scale, 0.5, 0);
+    /* tinted: linear floats, texel x baseColorFactor */
+    const Texture *tt = &s.textures[tinted->texture];
+    CHECK_EQ_INT(tt->flags, TEX_FLOAT);
+    static const float factor[3] = { 0.5f, 1.0f, 0.25f };
+    static const unsigned char texel[4][3] = { { 255, 128, 0 }, { 0, 64, 255 }, { 10, 20, 30 }, { 200, 100, 50 } };
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++) {
+            float v;
+            memcpy(&v, &s.texels[tt->offset + 3 * i + k], sizeof v);
+            CHECK_NEAR(v, k_srgb_to_linear((float)texel[i][k] / 255.0f) * factor[k], 0);
+        }
+    scene_free(&s);
+}
+
 /* Loads nodes.gltf as a whole scene with --camera `camera`. */
 static Status load_nodes(const char *camera, Scene *s, Error *err)
 {
@@ -458,6 +497,7 @@ int main(void)
     RUN(test_sparse);
     RUN(test_strips);
     RUN(test_glb_and_external);
+    RUN(test_textures);
     RUN(test_nodes);
     RUN(test_mesh_block);
     RUN(test_cornell_box);

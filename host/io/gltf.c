@@ -546,6 +546,40 @@ static Status texinfo(Gltf *g, const cJSON *obj, const char *key, int linear, co
     return texture_get(g, t, linear, jp, out);
 }
 
+/* A copy of texture `base` with every texel multiplied by `factor` (glTF's base colour
+ * is texture x baseColorFactor; clpt's texture replaces the albedo), its texels linear
+ * floats so that the product is exact and filtered as the original would be. */
+static Status texture_tinted(Gltf *g, uint base, const double factor[3], uint *out)
+{
+    Texture t = g->s->textures[base];
+    size_t n = (size_t)t.width * t.height;
+    uint *texels = malloc(3 * n * sizeof *texels + 1);
+    if (!texels) return error_set(g->err, ST_INTERNAL, "out of memory tinting a texture");
+    for (size_t i = 0; i < n; i++) {
+        float rgb[3];
+        if (t.flags & TEX_FLOAT) {
+            memcpy(rgb, g->s->texels + t.offset + 3 * i, sizeof rgb);
+        } else {
+            uint c = g->s->texels[t.offset + i];
+            for (int k = 0; k < 3; k++) {
+                rgb[k] = (float)((c >> (8 * k)) & 255u) / 255.0f;
+                if (t.flags & TEX_SRGB) rgb[k] = k_srgb_to_linear(rgb[k]);
+            }
+        }
+        for (int k = 0; k < 3; k++) {
+            float v = rgb[k] * (float)factor[k];
+            memcpy(&texels[3 * i + (size_t)k], &v, sizeof v);
+        }
+    }
+    uint offset;
+    Status st = scene_add_texels(g->s, texels, 3 * n, &offset, g->err);
+    free(texels);
+    if (st) return st;
+    t.offset = offset;
+    t.flags = (t.flags & TEX_CLAMP) | TEX_FLOAT;
+    return scene_add_texture(g->s, NULL, NULL, t, out, g->err);
+}
+
 static Status material_build(Gltf *g, int i, uint *out)
 {
     char jp[64];
@@ -570,8 +604,7 @@ static Status material_build(Gltf *g, int i, uint *out)
     if (cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(m, "doubleSided"))) mt.flags |= MAT_TWO_SIDED;
     if ((st = texinfo(g, pbr, "baseColorTexture", 0, jpp, &mt.texture, NULL))) return st;
     if (mt.texture != NO_INDEX && (base[0] != 1 || base[1] != 1 || base[2] != 1) &&
-        (st = scene_warn(g->s, g->err, "%s: %s: baseColorFactor is ignored where baseColorTexture gives the colour",
-                         g->path, jpp)))
+        (st = texture_tinted(g, mt.texture, base, &mt.texture)))
         return st;
     if ((st = texinfo(g, pbr, "metallicRoughnessTexture", 1, jpp, &mt.texture_rm, NULL))) return st;
     if ((st = texinfo(g, m, "normalTexture", 1, jp, &mt.texture_normal, &nscale))) return st;

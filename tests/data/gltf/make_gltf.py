@@ -12,6 +12,7 @@ import base64
 import json
 import os
 import struct
+import zlib
 
 GOOD = "tests/data/gltf"
 BAD = "tests/data/bad"
@@ -188,11 +189,41 @@ def nodes():
     return d, raw
 
 
+def png(width, height, rgb):
+    """A minimal 8-bit RGB PNG of the given rows of (r, g, b) pixels."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    raw = b"".join(b"\0" + bytes(c for px in row for c in px) for row in rgb)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+TEXELS = [[(255, 128, 0), (0, 64, 255)], [(10, 20, 30), (200, 100, 50)]]
+
+
+def textured():
+    """Two triangles sharing one 2 x 2 PNG (a data: URI): the first's material tints it
+    by baseColorFactor (0.5, 1, 0.25), the second's uses it as base colour, and in
+    linear encoding as metallic-roughness texture and normal map (scale 0.5)."""
+    d, raw = simple_triangle()
+    prim = d["meshes"][0]["primitives"][0]
+    d["meshes"][0]["primitives"] = [dict(prim, material=0), dict(prim, material=1)]
+    d["images"] = [{"uri": "data:image/png;base64," + base64.b64encode(png(2, 2, TEXELS)).decode()}]
+    d["textures"] = [{"source": 0}]
+    d["materials"] = [
+        {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "baseColorFactor": [0.5, 1, 0.25, 1]}},
+        {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicRoughnessTexture": {"index": 0}},
+         "normalTexture": {"index": 0, "scale": 0.5}},
+    ]
+    return d
+
+
 def main():
     os.makedirs(GOOD, exist_ok=True)
     write_json(os.path.join(GOOD, "strided.gltf"), strided())
     write_json(os.path.join(GOOD, "sparse.gltf"), sparse())
     write_json(os.path.join(GOOD, "strips.gltf"), strips())
+    write_json(os.path.join(GOOD, "textured.gltf"), textured())
     nd, _ = nodes()
     write_json(os.path.join(GOOD, "nodes.gltf"), nd)
 

@@ -131,8 +131,8 @@ static void test_textures(void)
 {
     Scene s;
     if (!load_mesh(DIR_GLTF "textured.gltf", &s)) return;
-    CHECK_EQ_INT(s.n_triangles, 2);
-    if (s.n_triangles != 2) {
+    CHECK_EQ_INT(s.n_triangles, 3);
+    if (s.n_triangles != 3) {
         scene_free(&s);
         return;
     }
@@ -163,6 +163,17 @@ static void test_textures(void)
             memcpy(&v, &s.texels[tt->offset + 3 * i + k], sizeof v);
             CHECK_NEAR(v, k_srgb_to_linear((float)texel[i][k] / 255.0f) * factor[k], 0);
         }
+    /* KHR_texture_transform, rotation pi/2, scale (2, 3), offset (0.5, 0.25): glTF's
+     * (u, w) -> (-3 w + 0.5, 2 u + 0.25), and w = 1 - v on both sides, so clpt's
+     * (u, v) -> (3 v - 2.5, -2 u + 0.75) */
+    const Material *moved = &s.materials[s.triangles[2].material];
+    CHECK(moved->texture != NO_INDEX && moved->texture != plain->texture);
+    if (moved->texture != NO_INDEX) {
+        const float *m = s.textures[moved->texture].m;
+        static const double want[8] = { 0, 3, 0, -2.5, -2, 0, 0, 0.75 };
+        for (int i = 0; i < 8; i++) CHECK_NEAR(m[i], want[i], 1e-6);
+        CHECK_EQ_INT(s.textures[moved->texture].offset, t->offset);   /* the same texels */
+    }
     scene_free(&s);
 }
 

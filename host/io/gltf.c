@@ -522,6 +522,33 @@ static Status texture_get(Gltf *g, int t, int linear, const char *jpath, uint *o
     return st;
 }
 
+/* A copy of texture *index with KHR_texture_transform's map: glTF's uv' = T R S uv,
+ * its rotation matrix [cos -sin; sin cos] as the extension's shader writes it, taken
+ * between clpt's (u, v) and glTF's (u, 1 - v) on both sides. */
+static Status texture_transformed(Gltf *g, const cJSON *tt, const char *jpath, uint *index)
+{
+    char jp[340];
+    snprintf(jp, sizeof jp, "%s.extensions.KHR_texture_transform", jpath);
+    static const double zero2[2] = { 0, 0 }, one2[2] = { 1, 1 };
+    double off[2], sc[2], rot;
+    long long tc;
+    Status st = get_nums(g, tt, "offset", 2, zero2, jp, off);
+    if (!st) st = get_nums(g, tt, "scale", 2, one2, jp, sc);
+    if (!st) st = get_num(g, tt, "rotation", 0.0, -1e6, 1e6, jp, &rot);
+    if (!st) st = get_int(g, tt, "texCoord", 0, 0, 64, jp, &tc);
+    if (st) return st;
+    if (tc != 0 && (st = scene_warn(g->s, g->err, "%s: %s: texCoord %lld is read as TEXCOORD_0 (clpt has one uv set)",
+                                     g->path, jp, tc)))
+        return st;
+    double a = sc[0] * cos(rot), b = -sc[1] * sin(rot), c = sc[0] * sin(rot), d = sc[1] * cos(rot);
+    const float m[12] = { (float)a, (float)-b, 0.0f, (float)(b + off[0]),
+                          (float)-c, (float)d, 0.0f, (float)(1.0 - d - off[1]),
+                          0.0f, 0.0f, 1.0f, 0.0f };
+    Texture t = g->s->textures[*index];
+    texture_set_matrix(&t, m);
+    return scene_add_texture(g->s, NULL, NULL, t, index, g->err);
+}
+
 /* The texture a textureInfo object at obj.key names, or NO_INDEX. */
 static Status texinfo(Gltf *g, const cJSON *obj, const char *key, int linear, const char *jpath, uint *out,
                       double *scale)
@@ -540,10 +567,9 @@ static Status texinfo(Gltf *g, const cJSON *obj, const char *key, int linear, co
     if (tc != 0 && (st = scene_warn(g->s, g->err, "%s: %s: texCoord %lld is read as TEXCOORD_0 (clpt has one uv set)",
                                      g->path, jp, tc)))
         return st;
-    if (ext_of(ti, "KHR_texture_transform") &&
-        (st = scene_warn(g->s, g->err, "%s: %s: KHR_texture_transform is ignored", g->path, jp)))
-        return st;
-    return texture_get(g, t, linear, jp, out);
+    if ((st = texture_get(g, t, linear, jp, out))) return st;
+    const cJSON *tt = ext_of(ti, "KHR_texture_transform");
+    return tt ? texture_transformed(g, tt, jp, out) : ST_OK;
 }
 
 /* A copy of texture `base` with every texel multiplied by `factor` (glTF's base colour
@@ -1018,7 +1044,7 @@ static Status scene_walk(Gltf *g)
 
 static const char *const supported_ext[] = {
     "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_ior",
-    "KHR_materials_transmission", "KHR_materials_clearcoat",
+    "KHR_materials_transmission", "KHR_materials_clearcoat", "KHR_texture_transform",
 };
 
 static int ext_supported(const char *name)

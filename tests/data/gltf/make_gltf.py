@@ -204,7 +204,8 @@ TEXELS = [[(255, 128, 0), (0, 64, 255)], [(10, 20, 30), (200, 100, 50)]]
 def textured():
     """Two triangles sharing one 2 x 2 PNG (a data: URI): the first's material tints it
     by baseColorFactor (0.5, 1, 0.25), the second's uses it as base colour, and in
-    linear encoding as metallic-roughness texture and normal map (scale 0.5)."""
+    linear encoding as metallic-roughness texture and normal map (scale 0.5), the
+    third's through KHR_texture_transform (a quarter turn, scale and offset)."""
     d, raw = simple_triangle()
     prim = d["meshes"][0]["primitives"][0]
     d["meshes"][0]["primitives"] = [dict(prim, material=0), dict(prim, material=1)]
@@ -214,7 +215,11 @@ def textured():
         {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "baseColorFactor": [0.5, 1, 0.25, 1]}},
         {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicRoughnessTexture": {"index": 0}},
          "normalTexture": {"index": 0, "scale": 0.5}},
+        {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
+            "offset": [0.5, 0.25], "scale": [2, 3], "rotation": 1.5707963267948966}}}}},
     ]
+    d["meshes"][0]["primitives"].append(dict(prim, material=2))
+    d["extensionsUsed"] = ["KHR_texture_transform"]
     return d
 
 

@@ -24,6 +24,7 @@
 #include "render/film.h"
 #include "io/image_write.h"
 #include "base/limit.h"
+#include "io/mesh_load.h"
 #include "io/mesh_view.h"
 #include "options.h"
 #include "render/passes.h"
@@ -641,6 +642,10 @@ static Status outputs_choose(Run *r, Error *err)
 static Status load_scene_input(const Options *o, Scene *scene, int *bare_mesh, Error *err)
 {
     SceneKind kind = SCENE_KIND_CLPT;
+    if (o->camera && mesh_kind(o->scene_path) != MESH_GLTF)
+        return error_set(err, ST_USAGE, "--camera picks a glTF file's camera; '%s' is not a .gltf or .glb file",
+                         o->scene_path);
+    scene->gltf_camera = o->camera;
     Status st = scene_load_file(o->scene_path, (SceneFormat)o->format, scene, &kind, err);
     *bare_mesh = st == ST_OK && kind == SCENE_KIND_MESH;
     if (st == ST_OK)

@@ -26,7 +26,8 @@ void options_print_help(FILE *f)
 "classic Whitted ray tracer whose kernels run on OpenCL devices (GPUs, or CPUs\n"
 "through PoCL) and on a scalar C device. SCENE may also be a mesh (.obj or\n"
 ".ply): it is shown lit by a sky and a sun, seen by a camera that frames it\n"
-"(docs/meshes.md).\n"
+"(docs/meshes.md); or a glTF 2.0 file (.gltf, .glb), seen through its own\n"
+"camera when it has one (docs/gltf.md).\n"
 "\n"
 "The second and third forms are the command lines of the courses' reference ray\n"
 "tracers (MIT 6.837, recognised by a first argument -size or -input; Tsinghua,\n"
@@ -119,6 +120,8 @@ void options_print_help(FILE *f)
 "Scene and integrator:\n"
 "      --format auto|clpt|classic\n"
 "                             scene file format; default: told from the content\n"
+"      --camera N|NAME        glTF: look through camera N (from 0) or the camera\n"
+"                             (or camera node) named NAME; default: the first\n"
 "      --integrator path|whitted\n"
 "                             path tracing (default) or the classic ray tracer\n"
 "                             (the default for classic scenes): Phong shading,\n"
@@ -344,6 +347,7 @@ static Status options_set_name(const char *a, const char *v, Options *o, int *fo
         { "--resume", NULL, "file name", &o->resume_path },
         { "--device", NULL, "device list", &o->device_spec },
         { "--kernel-dir", NULL, "folder name", &o->kernel_dir },
+        { "--camera", NULL, "camera index or name", &o->camera },
     };
     for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
         if (strcmp(a, names[k].name) != 0 && !(names[k].alias && strcmp(a, names[k].alias) == 0)) continue;

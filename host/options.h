@@ -12,6 +12,7 @@ typedef struct {
     /* overrides of the scene file; -1 = keep the scene's value */
     long spp, width, height, seed, max_depth;
     const char *device_spec;      /* NULL: default selection */
+    const char *camera;           /* --camera: the glTF camera, by index or name; NULL: first */
     int threads;                  /* scalar device workers, 0 = every core */
     double time_limit;            /* seconds, 0 = none */
     double progressive_seconds;   /* 0 = no progressive output */

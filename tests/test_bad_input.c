@@ -19,6 +19,7 @@
 
 #include "harness.h"
 #include "kmath.h"
+#include "io/mesh_load.h"
 #include "io/mtl.h"
 #include "io/obj.h"
 #include "io/ply.h"
@@ -69,6 +70,10 @@ static Status load(const char *path, Scene *s, Error *err)
         Status st = scene_add_material(s, "m", material_diffuse(v3(0.5f, 0.5f, 0.5f)), &m, err);
         MeshOptions o = mesh_options(m);
         return st ? st : has_suffix(path, ".obj") ? obj_load(path, s, m, err) : ply_load(path, s, &o, err);
+    }
+    if (has_suffix(path, ".gltf") || has_suffix(path, ".glb")) {
+        MeshOptions o = mesh_options(NO_INDEX);
+        return mesh_load(path, s, &o, err);
     }
     if (has_suffix(path, ".mtl")) {
         MtlLibrary lib;

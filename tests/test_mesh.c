@@ -266,7 +266,7 @@ static void test_scene_mesh_errors(void)
     check_scene_bad("mesh { translate 1 1 1 file clpt-test-mesh-tri.obj matrix 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1 }",
                     "s.scene:1:52: 'matrix' cannot be combined with translate, rotate, rx, ry, rz or scale");
     check_scene_bad("mesh { file clpt-test-mesh-tri.stl }",
-                    "s.scene:1:13: expected a mesh file name ending in .obj or .ply, found 'clpt-test-mesh-tri.stl'");
+                    "s.scene:1:13: expected a mesh file name ending in .obj, .ply, .gltf or .glb, found 'clpt-test-mesh-tri.stl'");
     check_scene_bad("mesh { file clpt-test-mesh-tri.obj shear 1 }",
                     "expected a mesh key (file, material, translate, rotate, rx, ry, rz, scale, matrix) or '}'");
     /* the key after a one-number scale is read as a key */

@@ -1,9 +1,12 @@
 /* mesh_load.c — a mesh file read by the reader its extension names (mesh_load.h). */
 #include "io/mesh_load.h"
 
+#include "io/gltf.h"
+#include "io/lexer.h"
 #include "io/obj.h"
 #include "io/ply.h"
 
+#include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
@@ -14,6 +17,7 @@ MeshKind mesh_kind(const char *path)
     if (!dot) return MESH_NONE;
     if (strcasecmp(dot, ".obj") == 0) return MESH_OBJ;
     if (strcasecmp(dot, ".ply") == 0) return MESH_PLY;
+    if (strcasecmp(dot, ".gltf") == 0 || strcasecmp(dot, ".glb") == 0) return MESH_GLTF;
     return MESH_NONE;
 }
 
@@ -22,9 +26,18 @@ Status mesh_load(const char *path, Scene *s, const MeshOptions *o, Error *err)
     switch (mesh_kind(path)) {
     case MESH_OBJ: return obj_load_with(path, s, o, err);
     case MESH_PLY: return ply_load(path, s, o, err);
+    case MESH_GLTF: {
+        char *data;
+        size_t len;
+        Status st = lex_read_file(path, &data, &len, err);
+        if (st) return st;
+        st = gltf_parse(path, data, len, s, o, NULL, err);
+        free(data);
+        return st;
+    }
     case MESH_NONE: break;
     }
-    return error_set(err, ST_INPUT, "'%s': not a mesh file (expected a name ending in .obj or .ply)", path);
+    return error_set(err, ST_INPUT, "'%s': not a mesh file (expected a name ending in .obj, .ply, .gltf or .glb)", path);
 }
 
 Status mesh_parse(const char *path, const char *data, size_t len, Scene *s, const MeshOptions *o, Error *err)
@@ -32,7 +45,8 @@ Status mesh_parse(const char *path, const char *data, size_t len, Scene *s, cons
     switch (mesh_kind(path)) {
     case MESH_OBJ: return obj_parse_with(path, data, len, s, o, err);
     case MESH_PLY: return ply_parse(path, data, len, s, o, err);
+    case MESH_GLTF: return gltf_parse(path, data, len, s, o, NULL, err);
     case MESH_NONE: break;
     }
-    return error_set(err, ST_INPUT, "'%s': not a mesh file (expected a name ending in .obj or .ply)", path);
+    return error_set(err, ST_INPUT, "'%s': not a mesh file (expected a name ending in .obj, .ply, .gltf or .glb)", path);
 }

@@ -7,7 +7,7 @@
 
 #include "scene/mesh_sink.h"
 
-/* Loads an OBJ (".obj") or PLY (".ply") file, by its extension in any case, appending
+/* Loads an OBJ (".obj"), PLY (".ply") or glTF (".gltf", ".glb"; io/gltf.h) file, by its extension in any case, appending
  * its triangles to the scene. ST_INPUT for any other extension. */
 Status mesh_load(const char *path, Scene *s, const MeshOptions *o, Error *err);
 
@@ -16,7 +16,7 @@ Status mesh_load(const char *path, Scene *s, const MeshOptions *o, Error *err);
  * beside `path`. */
 Status mesh_parse(const char *path, const char *data, size_t len, Scene *s, const MeshOptions *o, Error *err);
 
-typedef enum { MESH_NONE = 0, MESH_OBJ, MESH_PLY } MeshKind;
+typedef enum { MESH_NONE = 0, MESH_OBJ, MESH_PLY, MESH_GLTF } MeshKind;
 MeshKind mesh_kind(const char *path);
 
 #endif /* CLPT_MESH_LOAD_H */

@@ -2,8 +2,11 @@
 #include "io/scene_load.h"
 
 #include <stdlib.h>
+#include <string.h>
 
+#include "kmath.h"
 #include "io/classic_parse.h"
+#include "io/gltf.h"
 #include "io/lexer.h"
 #include "io/mesh_load.h"
 #include "io/mesh_view.h"
@@ -19,6 +22,29 @@ SceneKind scene_load_kind(const char *path, const char *text, size_t len, SceneF
     return classic_detect(text, len) ? SCENE_KIND_CLASSIC : SCENE_KIND_CLPT;
 }
 
+/* A glTF file as the whole scene: through its own camera when it has one (then it is no
+ * bare mesh to frame again), else as a mesh preview. A file with no light of its own
+ * gets the preview's sky so that it is not black. */
+static Status gltf_scene(const char *path, const char *text, size_t len, Scene *s, SceneKind *kind,
+                         const MeshOptions *o, Error *err)
+{
+    GltfView v = { s->gltf_camera, 0, 0 };
+    Status st = gltf_parse(path, text, len, s, o, &v, err);
+    if (st) return st;
+    if (!v.has_camera) return mesh_view_frame(path, s, err);
+    if (kind) *kind = SCENE_KIND_CLPT;
+    free(s->path);
+    s->path = malloc(strlen(path) + 1);
+    if (!s->path) return error_set(err, ST_INTERNAL, "out of memory");
+    strcpy(s->path, path);
+    if (!v.has_lights) {
+        s->bg_type = BG_SKY;
+        s->bg_color = v3(0.35f, 0.38f, 0.42f);
+        s->bg_zenith = v3(0.18f, 0.28f, 0.5f);
+    }
+    return ST_OK;
+}
+
 Status scene_load_bytes(const char *path, const char *text, size_t len, SceneFormat format, Scene *s,
                         SceneKind *kind, Error *err)
 {
@@ -31,6 +57,7 @@ Status scene_load_bytes(const char *path, const char *text, size_t len, SceneFor
     if (k == SCENE_KIND_CLASSIC) return classic_load_text(path, text, len, s, err);
     if (k == SCENE_KIND_CLPT) return scene_load_text(path, text, len, s, err);
     MeshOptions o = mesh_options(NO_INDEX);
+    if (mesh_kind(path) == MESH_GLTF) return gltf_scene(path, text, len, s, kind, &o, err);
     Status st = mesh_parse(path, text, len, s, &o, err);
     return st ? st : mesh_view_frame(path, s, err);
 }

@@ -444,6 +444,61 @@ static Status texture_add_read(Scene *s, const char *name, const char *path, Tex
     return scene_add_texture(s, name, path, t, index, err);
 }
 
+/* PNG chunk lengths of an image in memory checked as png_check does for a file. */
+static Status png_check_memory(const char *name, const unsigned char *data, size_t len, Error *err)
+{
+    size_t at = 8;
+    while (len >= 8 && at <= len - 8) {
+        const unsigned char *c = data + at;
+        uint64_t length = (uint64_t)c[0] << 24 | (uint64_t)c[1] << 16 | (uint64_t)c[2] << 8 | c[3];
+        if (length > (uint64_t)(len - at - 8))
+            return error_set(err, ST_INPUT, "%s: a PNG chunk at byte offset %llu declares %llu bytes, more than "
+                             "the %llu left in the image (a truncated or corrupt image)", name,
+                             (unsigned long long)at, (unsigned long long)length,
+                             (unsigned long long)(len - at - 8));
+        if (memcmp(c + 4, "IEND", 4) == 0) break;
+        at += 12 + (size_t)length;
+    }
+    return ST_OK;
+}
+
+Status texture_load_image_memory(Scene *s, const char *name, const char *source, const unsigned char *data,
+                                 size_t len, int linear, uint *index, Error *err)
+{
+    static const unsigned char png[8] = { 0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n' };
+    int is_png = len >= 8 && memcmp(data, png, 8) == 0;
+    int is_jpeg = len >= 3 && data[0] == 0xff && data[1] == 0xd8 && data[2] == 0xff;
+    if (!is_png && !is_jpeg)
+        return error_set(err, ST_INPUT, "%s: not a PNG or JPEG image (the image types glTF allows)", source);
+    if (len > INT32_MAX) return error_set(err, ST_INPUT, "%s: an image of more than 2 GiB", source);
+    Status st = is_png ? png_check_memory(source, data, len, err) : ST_OK;
+    if (st) return st;
+    int w = 0, h = 0, channels = 0;
+    if (stbi_info_from_memory(data, (int)len, &w, &h, &channels) &&
+        (uint64_t)(unsigned)w * (uint64_t)(unsigned)h > CLPT_MAX_TEXTURE_PIXELS)
+        return error_set(err, ST_INPUT, "%s: a %dx%d image is larger than the textures clpt reads (at most %u "
+                         "pixels, as in 8192x8192)", source, w, h, CLPT_MAX_TEXTURE_PIXELS);
+    unsigned char *px = stbi_load_from_memory(data, (int)len, &w, &h, &channels, 4);
+    if (!px)
+        return error_set(err, ST_INPUT, "%s: not an image stb_image can read (%s)", source, stbi_failure_reason());
+    size_t n = (size_t)w * (size_t)h;
+    uint *texels = w > 0 && h > 0 ? malloc(n * sizeof *texels) : NULL;
+    if (texels)
+        for (size_t i = 0; i < n; i++) texels[i] = pack_rgba(px + 4 * i);
+    stbi_image_free(px);
+    if (!texels) return error_set(err, ST_INPUT, "%s: the image is empty or too large for memory", source);
+    Texture t = texture_base(TEX_IMAGE);
+    uint offset;
+    st = scene_add_texels(s, texels, n, &offset, err);
+    free(texels);
+    if (st) return st;
+    t.offset = offset;
+    t.width = (uint)w;
+    t.height = (uint)h;
+    t.flags = linear ? 0u : TEX_SRGB;
+    return scene_add_texture(s, name, NULL, t, index, err);
+}
+
 /* The course's face names, in the order of enum CubeFace, and the extensions its
  * versions used (Fall 2019: .png; the earlier starter code: .bmp). */
 static const char *const cube_faces[6] = { "left", "right", "up", "down", "front", "back" };

@@ -32,6 +32,11 @@ void texture_set_matrix(Texture *t, const float m[12]);
 Status texture_load_image(Scene *s, const char *name, const char *path, int linear, int clamp,
                           uint *index, Error *err);
 
+/* The same for an image already in memory (a glTF file's embedded PNG or JPEG; other
+ * formats are refused), named `source` in messages; its texels are not shared. */
+Status texture_load_image_memory(Scene *s, const char *name, const char *source, const unsigned char *data,
+                                 size_t len, int linear, uint *index, Error *err);
+
 /* Reads the six faces of a cube map from the folder `dir` (the MIT 6.837 course's
  * CubeMap: left, right, up, down, front and back, each NAME.png or else NAME.bmp) as
  * linear, clamped image textures with consecutive indices, the first (left) in *first,

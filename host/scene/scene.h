@@ -33,6 +33,8 @@ typedef struct {
 
 typedef struct {
     char *path;                  /* scene file as given on the command line */
+    const char *gltf_camera;     /* in: the glTF camera to look through (--camera), by
+                                  * index or name; NULL: the file's first */
     SceneCamera camera;
     SceneImage image;
     uint bg_type;                /* enum BackgroundType */

@@ -1,0 +1,44 @@
+/*
+ * fuzz_gltf.c — the glTF reader (host/io/gltf.c) on arbitrary bytes: GLB containers
+ * whose chunk lengths need not match, JSON whose accessors, views and buffers need not
+ * fit their data, node trees with cycles, images that are not images. Every error must
+ * carry a message; every triangle it appends must be finite and carry one of the
+ * scene's materials; a camera it sets must be finite.
+ */
+#include "fuzz.h"
+#include "kmath.h"
+#include "io/gltf.h"
+
+#include <math.h>
+#include <string.h>
+
+FUZZ_SEEDS("gltf glb");
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    char *copy = fuzz_text(data, size);
+    if (!copy) return 0;
+    /* the two containers: a GLB by its magic, else JSON; the name only tells the
+     * reader which to expect */
+    const char *name = size >= 4 && memcmp(data, "glTF", 4) == 0 ? "fuzz.glb" : "fuzz.gltf";
+    Scene s;
+    scene_init(&s);
+    Error err = { 0 };
+    MeshOptions o = mesh_options(NO_INDEX);
+    GltfView view = { NULL, 0, 0 };
+    Status st = gltf_parse(name, copy, size, &s, &o, &view, &err);
+    /* ST_IO: a buffer or image file the input names is not there */
+    if (st) FUZZ_ASSERT((st == ST_INPUT || st == ST_IO) && err.msg[0]);
+    for (size_t i = 0; i < s.n_triangles; i++) {
+        const Triangle *t = &s.triangles[i];
+        FUZZ_ASSERT(t->material < s.n_materials);
+        FUZZ_ASSERT(fuzz_finite3(t->p0) && fuzz_finite3(t->p1) && fuzz_finite3(t->p2));
+        FUZZ_ASSERT(t->shading == NO_INDEX || t->shading < s.n_shading);
+    }
+    if (st == ST_OK && view.has_camera)
+        FUZZ_ASSERT(fuzz_finite3(s.camera.from) && fuzz_finite3(s.camera.at) && isfinite(s.camera.vfov));
+    scene_free(&s);
+    error_clear(&err);
+    free(copy);
+    return 0;
+}

@@ -1,0 +1,296 @@
+#!/usr/bin/env python3
+"""make_gltf.py — writes the small hand-made glTF files of the tests.
+
+    python3 tests/data/gltf/make_gltf.py     (from the project root)
+
+Good files go to tests/data/gltf/ (tests/test_gltf.c checks what they load into), bad
+ones to tests/data/bad/ with a NAME.expect beside each (tests/test_bad_input.c checks
+the exact message); all of them seed fuzz/fuzz_gltf.c. The committed files are this
+script's output.
+"""
+import base64
+import json
+import os
+import struct
+import zlib
+
+GOOD = "tests/data/gltf"
+BAD = "tests/data/bad"
+
+
+def data_uri(raw):
+    return "data:application/octet-stream;base64," + base64.b64encode(raw).decode()
+
+
+def f32(*v):
+    return struct.pack("<%df" % len(v), *v)
+
+
+def doc(buffers, views, accessors, meshes, nodes, extra=None):
+    d = {
+        "asset": {"version": "2.0", "generator": "clpt tests/data/gltf/make_gltf.py"},
+        "buffers": buffers,
+        "bufferViews": views,
+        "accessors": accessors,
+        "meshes": meshes,
+        "nodes": nodes,
+        "scenes": [{"nodes": [i for i, n in enumerate(nodes) if not n.get("_child")]}],
+        "scene": 0,
+    }
+    for n in nodes:
+        n.pop("_child", None)
+    d.update(extra or {})
+    return d
+
+
+def write_json(path, d):
+    with open(path, "w") as f:
+        json.dump(d, f, indent=1)
+        f.write("\n")
+
+
+def glb(d, bin_chunk):
+    js = json.dumps(d).encode()
+    js += b" " * (-len(js) % 4)
+    bin_chunk += b"\0" * (-len(bin_chunk) % 4)
+    body = struct.pack("<II", len(js), 0x4E4F534A) + js
+    if bin_chunk:
+        body += struct.pack("<II", len(bin_chunk), 0x004E4942) + bin_chunk
+    return struct.pack("<III", 0x46546C67, 2, 12 + len(body)) + body
+
+
+def write_bad(name, content, status, message):
+    path = os.path.join(BAD, name)
+    mode = "wb" if isinstance(content, bytes) else "w"
+    with open(path, mode) as f:
+        f.write(content)
+    with open(path + ".expect", "w") as f:
+        f.write("# status: %s\n# message: %s\n" % (status, message % {"p": path}))
+
+
+# A unit quad in z = 0 (corners 0..3 counter-clockwise from +z), as one triangle list.
+QUAD = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]
+
+
+def simple_triangle():
+    """One triangle, positions only, in a data: buffer."""
+    raw = f32(0, 0, 0, 1, 0, 0, 0, 1, 0)
+    return doc([{"byteLength": len(raw), "uri": data_uri(raw)}],
+               [{"buffer": 0, "byteLength": len(raw)}],
+               [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}],
+               [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+               [{"mesh": 0}]), raw
+
+
+def strided():
+    """POSITION and NORMAL interleaved (byteStride 28 with 4 bytes of padding),
+    TEXCOORD_0 as normalized unsigned bytes (stride 4, 2 of padding), indices as
+    unsigned bytes."""
+    inter = b""
+    for p in QUAD:
+        inter += f32(*p) + f32(0, 0, 1) + b"\xee\xee\xee\xee"
+    uv = b""
+    for p in QUAD:
+        uv += bytes([int(p[0] * 255), int(p[1] * 255), 0xaa, 0xaa])
+    idx = bytes([0, 1, 2, 0, 2, 3])
+    raw = inter + uv + idx
+    return doc([{"byteLength": len(raw), "uri": data_uri(raw)}],
+               [{"buffer": 0, "byteLength": len(inter), "byteStride": 28},
+                {"buffer": 0, "byteOffset": len(inter), "byteLength": len(uv), "byteStride": 4},
+                {"buffer": 0, "byteOffset": len(inter) + len(uv), "byteLength": len(idx)}],
+               [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"},
+                {"bufferView": 0, "byteOffset": 12, "componentType": 5126, "count": 4, "type": "VEC3"},
+                {"bufferView": 1, "componentType": 5121, "normalized": True, "count": 4, "type": "VEC2"},
+                {"bufferView": 2, "componentType": 5121, "count": 6, "type": "SCALAR"}],
+               [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3}]}],
+               [{"mesh": 0}])
+
+
+def sparse():
+    """Positions as normalized shorts, then a sparse part that moves vertex 2 to
+    (16384, 16384, 8192) / 32767: an unsigned short index list and values of the
+    accessor's own component type."""
+    base = b""
+    for p in QUAD:
+        base += struct.pack("<3h", *[int(c * 32767) for c in p]) + b"\0\0"
+    ind = struct.pack("<H", 2) + b"\0\0"
+    val = struct.pack("<3h", 16384, 16384, 8192) + b"\0\0"
+    raw = base + ind + val
+    idx = struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+    raw += idx
+    return doc([{"byteLength": len(raw), "uri": data_uri(raw)}],
+               [{"buffer": 0, "byteLength": len(base), "byteStride": 8},
+                {"buffer": 0, "byteOffset": len(base), "byteLength": 4},
+                {"buffer": 0, "byteOffset": len(base) + 4, "byteLength": 6},
+                {"buffer": 0, "byteOffset": len(base) + len(ind) + len(val), "byteLength": len(idx)}],
+               [{"bufferView": 0, "componentType": 5122, "normalized": True, "count": 4, "type": "VEC3",
+                 "sparse": {"count": 1, "indices": {"bufferView": 1, "componentType": 5123},
+                            "values": {"bufferView": 2}}},
+                {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+               [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+               [{"mesh": 0}])
+
+
+def strips():
+    """A triangle strip of 5 vertices (3 triangles) and a fan of 5 (3 triangles), not
+    indexed, every triangle facing +z."""
+    strip = f32(0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 2, 0)
+    fan = f32(0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1, -1, 1, 1)
+    raw = strip + fan
+    return doc([{"byteLength": len(raw), "uri": data_uri(raw)}],
+               [{"buffer": 0, "byteLength": len(strip)},
+                {"buffer": 0, "byteOffset": len(strip), "byteLength": len(fan)}],
+               [{"bufferView": 0, "componentType": 5126, "count": 5, "type": "VEC3"},
+                {"bufferView": 1, "componentType": 5126, "count": 5, "type": "VEC3"}],
+               [{"primitives": [{"attributes": {"POSITION": 0}, "mode": 5},
+                                {"attributes": {"POSITION": 1}, "mode": 6}]}],
+               [{"mesh": 0}])
+
+
+def nodes():
+    """A triangle under a parent translated by (10, 0, 0) and rotated 90 degrees about
+    +y, the child scaled by 2 through a matrix; two cameras (a perspective one on the
+    first node, an orthographic one named "top"); a point, a spot and a directional
+    light; a material with every supported extension."""
+    d, raw = simple_triangle()
+    s = 0.5 ** 0.5
+    d["nodes"] = [
+        {"translation": [10, 0, 0], "rotation": [0, s, 0, s], "children": [1, 2]},
+        {"matrix": [2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 1], "mesh": 0},
+        {"camera": 0, "name": "front", "translation": [0, 0, 5]},
+        {"camera": 1, "translation": [0, 10, 0], "rotation": [-s, 0, 0, s]},
+        {"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [1, 2, 3]},
+        {"extensions": {"KHR_lights_punctual": {"light": 1}}, "rotation": [-s, 0, 0, s]},
+        {"extensions": {"KHR_lights_punctual": {"light": 2}}},
+    ]
+    d["scenes"] = [{"nodes": [0, 3, 4, 5, 6]}]
+    d["cameras"] = [
+        {"type": "perspective", "perspective": {"yfov": 0.5, "aspectRatio": 2.0, "znear": 0.1}},
+        {"type": "orthographic", "name": "top", "orthographic": {"xmag": 3, "ymag": 3, "znear": 0.1, "zfar": 100}},
+    ]
+    d["extensionsUsed"] = ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_ior",
+                           "KHR_materials_transmission", "KHR_materials_clearcoat", "EXT_unknown_thing"]
+    d["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"type": "point", "intensity": 683, "color": [1, 0.5, 0.25]},
+        {"type": "directional", "intensity": 1366},
+        {"type": "spot", "intensity": 68.3, "spot": {"innerConeAngle": 0.25, "outerConeAngle": 0.5}},
+    ]}}
+    d["materials"] = [{
+        "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 0.125, 1], "metallicFactor": 0.5,
+                                 "roughnessFactor": 0.75},
+        "emissiveFactor": [1, 0.5, 0],
+        "doubleSided": True,
+        "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4},
+                       "KHR_materials_ior": {"ior": 1.33},
+                       "KHR_materials_transmission": {"transmissionFactor": 0.5},
+                       "KHR_materials_clearcoat": {"clearcoatFactor": 0.7, "clearcoatRoughnessFactor": 0.2}},
+    }]
+    d["meshes"][0]["primitives"][0]["material"] = 0
+    return d, raw
+
+
+def png(width, height, rgb):
+    """A minimal 8-bit RGB PNG of the given rows of (r, g, b) pixels."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    raw = b"".join(b"\0" + bytes(c for px in row for c in px) for row in rgb)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+TEXELS = [[(255, 128, 0), (0, 64, 255)], [(10, 20, 30), (200, 100, 50)]]
+
+
+def textured():
+    """Two triangles sharing one 2 x 2 PNG (a data: URI): the first's material tints it
+    by baseColorFactor (0.5, 1, 0.25), the second's uses it as base colour, and in
+    linear encoding as metallic-roughness texture and normal map (scale 0.5), the
+    third's through KHR_texture_transform (a quarter turn, scale and offset)."""
+    d, raw = simple_triangle()
+    prim = d["meshes"][0]["primitives"][0]
+    d["meshes"][0]["primitives"] = [dict(prim, material=0), dict(prim, material=1)]
+    d["images"] = [{"uri": "data:image/png;base64," + base64.b64encode(png(2, 2, TEXELS)).decode()}]
+    d["textures"] = [{"source": 0}]
+    d["materials"] = [
+        {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "baseColorFactor": [0.5, 1, 0.25, 1]}},
+        {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicRoughnessTexture": {"index": 0}},
+         "normalTexture": {"index": 0, "scale": 0.5}},
+        {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
+            "offset": [0.5, 0.25], "scale": [2, 3], "rotation": 1.5707963267948966}}}}},
+    ]
+    d["meshes"][0]["primitives"].append(dict(prim, material=2))
+    d["extensionsUsed"] = ["KHR_texture_transform"]
+    return d
+
+
+def main():
+    os.makedirs(GOOD, exist_ok=True)
+    write_json(os.path.join(GOOD, "strided.gltf"), strided())
+    write_json(os.path.join(GOOD, "sparse.gltf"), sparse())
+    write_json(os.path.join(GOOD, "strips.gltf"), strips())
+    write_json(os.path.join(GOOD, "textured.gltf"), textured())
+    nd, _ = nodes()
+    write_json(os.path.join(GOOD, "nodes.gltf"), nd)
+
+    # the same triangle as a .glb (buffer 0 the BIN chunk) and as a .gltf with an
+    # external .bin file
+    d, raw = simple_triangle()
+    d["buffers"] = [{"byteLength": len(raw)}]
+    with open(os.path.join(GOOD, "triangle.glb"), "wb") as f:
+        f.write(glb(d, raw))
+    d["buffers"] = [{"byteLength": len(raw), "uri": "triangle.bin"}]
+    write_json(os.path.join(GOOD, "external.gltf"), d)
+    with open(os.path.join(GOOD, "triangle.bin"), "wb") as f:
+        f.write(raw)
+
+    # bad files, each with its exact message
+    d, raw = simple_triangle()
+    d["extensionsRequired"] = ["KHR_draco_mesh_compression"]
+    d["extensionsUsed"] = ["KHR_draco_mesh_compression"]
+    write_bad("gltf-required-extension.gltf", json.dumps(d), "input",
+              "%(p)s: extensionsRequired[0]: the file requires the extension 'KHR_draco_mesh_compression', "
+              "which clpt does not support")
+    d, raw = simple_triangle()
+    d["accessors"][0]["count"] = 4
+    write_bad("gltf-accessor-range.gltf", json.dumps(d), "input",
+              "%(p)s: meshes[0].primitives[0].attributes.POSITION: accessor 0 reads bytes 0..48 of "
+              "bufferView 0, which has 36")
+    d, raw = simple_triangle()
+    d["buffers"][0]["uri"] = "gltf-missing.bin"
+    write_bad("gltf-missing-buffer.gltf", json.dumps(d), "io",
+              "%(p)s: buffers[0].uri: cannot open 'tests/data/bad/gltf-missing.bin'")
+    d, raw = simple_triangle()
+    d["meshes"][0]["primitives"][0]["indices"] = 1
+    d["accessors"].append({"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"})
+    d["bufferViews"].append({"buffer": 1, "byteLength": 6})
+    d["buffers"].append({"byteLength": 6, "uri": data_uri(struct.pack("<3H", 0, 1, 3))})
+    write_bad("gltf-index-range.gltf", json.dumps(d), "input",
+              "%(p)s: meshes[0].primitives[0].indices: index 2 is 3, past the 3 vertices")
+    d, raw = simple_triangle()
+    d["bufferViews"][0]["byteStride"] = 8
+    write_bad("gltf-short-stride.gltf", json.dumps(d), "input",
+              "%(p)s: meshes[0].primitives[0].attributes.POSITION: accessor 0: byteStride 8 of bufferView 0 is "
+              "less than an element's 12 bytes")
+    d, raw = simple_triangle()
+    d["nodes"] = [{"mesh": 0, "children": [1]}, {"children": [0]}]
+    d["scenes"] = [{"nodes": [0]}]
+    write_bad("gltf-node-cycle.gltf", json.dumps(d), "input",
+              "%(p)s: nodes[0]: reached twice in the node tree (a node has one parent, no cycles)")
+    d, raw = simple_triangle()
+    d["buffers"] = [{"byteLength": len(raw)}]
+    whole = glb(d, raw)
+    write_bad("gltf-truncated-chunk.glb", whole[:-8], "input",
+              "%(p)s: the GLB header says the file has " + str(len(whole)) + " bytes, but it has " +
+              str(len(whole) - 8))
+    cut = bytearray(whole[:-8])
+    struct.pack_into("<I", cut, 8, len(cut))
+    write_bad("gltf-truncated-bin.glb", bytes(cut), "input",
+              "%(p)s: GLB chunk 1 at byte " + str(len(cut) - len(raw) - 8 + 8) + " declares 36 bytes, more "
+              "than the 28 left in the file")
+    write_bad("gltf-wrong-magic.glb", b"gLTF" + whole[4:], "input",
+              "%(p)s: not a binary glTF file (it does not start with the magic 'glTF')")
+    write_bad("gltf-not-json.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [", "input",
+              "%(p)s: not valid glTF JSON")
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,518 @@
+/*
+ * test_gltf.c — the glTF 2.0 reader (host/io/gltf.c): the hand-made files of
+ * tests/data/gltf/ (written by make_gltf.py) load into exactly the triangles, normals,
+ * uvs, transforms, cameras, lights and materials they describe; and the three Blender
+ * exports of ../shared/models/gltf load and render: the Cornell box against the OBJ
+ * Cornell box through the same camera, the material spheres with different highlights,
+ * the Suzanne with its embedded checker texture. The bad files are in
+ * tests/data/bad/gltf-* (test_bad_input.c). Run from the project root.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+#include "kmath.h"
+#include "io/gltf.h"
+#include "io/mesh_load.h"
+#include "io/scene_load.h"
+#include "render_util.h"
+
+#define DIR_GLTF "tests/data/gltf/"
+#define SHARED "../shared/models/"
+
+static void check_v3(vec3 a, double x, double y, double z, double tol)
+{
+    CHECK_NEAR(a.x, x, tol);
+    CHECK_NEAR(a.y, y, tol);
+    CHECK_NEAR(a.z, z, tol);
+}
+
+/* Loads a glTF file as a mesh (its own materials); 0 when it failed. */
+static int load_mesh(const char *path, Scene *s)
+{
+    scene_init(s);
+    Error err = { 0 };
+    MeshOptions o = mesh_options(NO_INDEX);
+    Status st = mesh_load(path, s, &o, &err);
+    CHECK_MSG(st == ST_OK, "%s: %s", path, err.msg);
+    error_clear(&err);
+    return st == ST_OK;
+}
+
+/* Winding normal of triangle i, unnormalised. */
+static vec3 winding(const Scene *s, size_t i)
+{
+    const Triangle *t = &s->triangles[i];
+    return v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0));
+}
+
+static void test_strided(void)
+{
+    Scene s;
+    if (!load_mesh(DIR_GLTF "strided.gltf", &s)) return;
+    CHECK_EQ_INT(s.n_triangles, 2);
+    CHECK_EQ_INT(s.n_shading, 2);
+    if (s.n_triangles == 2 && s.n_shading == 2) {
+        check_v3(s.triangles[0].p2, 1, 1, 0, 0);
+        check_v3(s.triangles[1].p2, 0, 1, 0, 0);
+        const TriShading *sh = &s.shading[s.triangles[0].shading];
+        CHECK_EQ_INT(sh->flags, TRI_HAS_NORMALS | TRI_HAS_UV);
+        check_v3(sh->n1, 0, 0, 1, 0);
+        /* normalized bytes 255 -> 1; glTF's v flipped to clpt's */
+        CHECK_NEAR(sh->uv1[0], 1.0, 0);
+        CHECK_NEAR(sh->uv1[1], 1.0, 0);
+        CHECK_NEAR(sh->uv2[0], 1.0, 0);
+        CHECK_NEAR(sh->uv2[1], 0.0, 0);
+        CHECK(winding(&s, 0).z > 0 && winding(&s, 1).z > 0);
+    }
+    scene_free(&s);
+}
+
+static void test_sparse(void)
+{
+    Scene s;
+    if (!load_mesh(DIR_GLTF "sparse.gltf", &s)) return;
+    CHECK_EQ_INT(s.n_triangles, 2);
+    if (s.n_triangles == 2) {
+        check_v3(s.triangles[0].p1, 1, 0, 0, 0);     /* normalized short 32767 -> 1 */
+        /* the sparse value, normalized shorts as the accessor's */
+        check_v3(s.triangles[0].p2, 16384 / 32767.0, 16384 / 32767.0, 8192 / 32767.0, 1e-7);
+        check_v3(s.triangles[1].p1, 16384 / 32767.0, 16384 / 32767.0, 8192 / 32767.0, 1e-7);
+        check_v3(s.triangles[1].p2, 0, 1, 0, 0);
+        CHECK_EQ_INT(s.triangles[0].shading, NO_INDEX);
+    }
+    scene_free(&s);
+}
+
+static void test_strips(void)
+{
+    Scene s;
+    if (!load_mesh(DIR_GLTF "strips.gltf", &s)) return;
+    CHECK_EQ_INT(s.n_triangles, 6);
+    for (size_t i = 0; i < s.n_triangles; i++) {
+        vec3 n = winding(&s, i);
+        CHECK_MSG(n.z > 0 && n.x == 0 && n.y == 0, "triangle %zu faces %g %g %g", i, (double)n.x, (double)n.y,
+                  (double)n.z);
+    }
+    if (s.n_triangles == 6) {
+        /* strip: (0 1 2), (2 1 3), (2 3 4); fan: (1 2 0), (2 3 0), (3 4 0) */
+        check_v3(s.triangles[1].p0, 0, 1, 0, 0);
+        check_v3(s.triangles[1].p1, 1, 0, 0, 0);
+        check_v3(s.triangles[5].p2, 0, 0, 1, 0);
+    }
+    scene_free(&s);
+}
+
+static void test_glb_and_external(void)
+{
+    const char *files[] = { DIR_GLTF "triangle.glb", DIR_GLTF "external.gltf" };
+    for (int f = 0; f < 2; f++) {
+        Scene s;
+        harness_current = files[f];
+        if (!load_mesh(files[f], &s)) continue;
+        CHECK_EQ_INT(s.n_triangles, 1);
+        if (s.n_triangles == 1) {
+            check_v3(s.triangles[0].p1, 1, 0, 0, 0);
+            check_v3(s.triangles[0].p2, 0, 1, 0, 0);
+        }
+        /* no material in the file: glTF's default, white metallic 1 roughness 1 */
+        if (s.n_triangles == 1) {
+            const Material *m = &s.materials[s.triangles[0].material];
+            CHECK_EQ_INT(m->type, MAT_PRINCIPLED);
+            CHECK_NEAR(m->metallic, 1.0, 0);
+        }
+        scene_free(&s);
+    }
+}
+
+static void test_textures(void)
+{
+    Scene s;
+    if (!load_mesh(DIR_GLTF "textured.gltf", &s)) return;
+    CHECK_EQ_INT(s.n_triangles, 3);
+    if (s.n_triangles != 3) {
+        scene_free(&s);
+        return;
+    }
+    const Material *tinted = &s.materials[s.triangles[0].material];
+    const Material *plain = &s.materials[s.triangles[1].material];
+    /* the texture as given: the PNG's texels, sRGB; the same image read linear for the
+     * metallic-roughness and normal maps, once */
+    CHECK(plain->texture != NO_INDEX && plain->texture_rm != NO_INDEX);
+    if (plain->texture == NO_INDEX || plain->texture_rm == NO_INDEX || tinted->texture == NO_INDEX) {
+        scene_free(&s);
+        return;
+    }
+    const Texture *t = &s.textures[plain->texture];
+    CHECK_EQ_INT(t->flags, TEX_SRGB);
+    CHECK_EQ_INT(t->width, 2);
+    CHECK_EQ_INT(s.texels[t->offset + 1], 0xffff4000u);   /* (0, 64, 255), alpha 255 */
+    CHECK_EQ_INT(s.textures[plain->texture_rm].flags, 0);
+    CHECK_EQ_INT(plain->texture_normal, plain->texture_rm);
+    CHECK_NEAR(plain->normal_scale, 0.5, 0);
+    /* tinted: linear floats, texel x baseColorFactor */
+    const Texture *tt = &s.textures[tinted->texture];
+    CHECK_EQ_INT(tt->flags, TEX_FLOAT);
+    static const float factor[3] = { 0.5f, 1.0f, 0.25f };
+    static const unsigned char texel[4][3] = { { 255, 128, 0 }, { 0, 64, 255 }, { 10, 20, 30 }, { 200, 100, 50 } };
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++) {
+            float v;
+            memcpy(&v, &s.texels[tt->offset + 3 * i + k], sizeof v);
+            CHECK_NEAR(v, k_srgb_to_linear((float)texel[i][k] / 255.0f) * factor[k], 0);
+        }
+    /* KHR_texture_transform, rotation pi/2, scale (2, 3), offset (0.5, 0.25): glTF's
+     * (u, w) -> (-3 w + 0.5, 2 u + 0.25), and w = 1 - v on both sides, so clpt's
+     * (u, v) -> (3 v - 2.5, -2 u + 0.75) */
+    const Material *moved = &s.materials[s.triangles[2].material];
+    CHECK(moved->texture != NO_INDEX && moved->texture != plain->texture);
+    if (moved->texture != NO_INDEX) {
+        const float *m = s.textures[moved->texture].m;
+        static const double want[8] = { 0, 3, 0, -2.5, -2, 0, 0, 0.75 };
+        for (int i = 0; i < 8; i++) CHECK_NEAR(m[i], want[i], 1e-6);
+        CHECK_EQ_INT(s.textures[moved->texture].offset, t->offset);   /* the same texels */
+    }
+    scene_free(&s);
+}
+
+/* Loads nodes.gltf as a whole scene with --camera `camera`. */
+static Status load_nodes(const char *camera, Scene *s, Error *err)
+{
+    scene_init(s);
+    s->gltf_camera = camera;
+    SceneKind kind;
+    Status st = scene_load_file(DIR_GLTF "nodes.gltf", SCENE_FORMAT_AUTO, s, &kind, err);
+    if (!st) CHECK_EQ_INT(kind, SCENE_KIND_CLPT);   /* its own camera: not framed again */
+    return st;
+}
+
+static void test_nodes(void)
+{
+    Scene s;
+    Error err = { 0 };
+    Status st = load_nodes(NULL, &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (st) return;
+    /* child scale 2, then the parent's 90 degrees about +y and (10, 0, 0) */
+    CHECK_EQ_INT(s.n_triangles, 1);
+    if (s.n_triangles == 1) {
+        check_v3(s.triangles[0].p0, 10, 0, 0, 1e-6);
+        check_v3(s.triangles[0].p1, 10, 0, -2, 1e-6);
+        check_v3(s.triangles[0].p2, 10, 2, 0, 1e-6);
+    }
+    /* the first camera: the node "front" at (0, 0, 5) under the parent */
+    CHECK_EQ_INT(s.camera.type, CAMERA_PERSPECTIVE);
+    check_v3(s.camera.from, 15, 0, 0, 1e-5);
+    check_v3(s.camera.at, 14, 0, 0, 1e-5);
+    check_v3(s.camera.up, 0, 1, 0, 1e-6);
+    CHECK_NEAR(s.camera.vfov, 0.5 * 180.0 / M_PI, 1e-4);
+    CHECK_EQ_INT(s.image.height, s.image.width / 2);   /* aspectRatio 2 */
+    /* lights: photometric / 683 */
+    CHECK_EQ_INT(s.n_delta_lights, 3);
+    if (s.n_delta_lights == 3) {
+        const Light *l = s.delta_lights;
+        CHECK_EQ_INT(l[0].type, LIGHT_POINT);
+        check_v3(l[0].position, 1, 2, 3, 1e-6);
+        check_v3(l[0].intensity, 1, 0.5, 0.25, 1e-6);
+        CHECK_EQ_INT(l[1].type, LIGHT_DIRECTIONAL);
+        check_v3(l[1].direction, 0, -1, 0, 1e-6);
+        check_v3(l[1].intensity, 2, 2, 2, 1e-6);
+        CHECK_EQ_INT(l[2].type, LIGHT_SPOT);
+        check_v3(l[2].direction, 0, 0, -1, 1e-6);
+        CHECK_NEAR(l[2].cos_outer, cos(0.5), 1e-6);
+        CHECK_NEAR(l[2].cos_inner, cos(0.25), 1e-6);
+        CHECK_NEAR(l[2].intensity.x, 0.1, 1e-6);
+    }
+    /* the material with every extension */
+    if (s.n_triangles == 1) {
+        const Material *m = &s.materials[s.triangles[0].material];
+        CHECK_EQ_INT(m->type, MAT_PRINCIPLED);
+        check_v3(m->albedo, 0.5, 0.25, 0.125, 0);
+        CHECK_NEAR(m->metallic, 0.5, 0);
+        CHECK_NEAR(m->roughness, 0.75, 0);
+        check_v3(m->emission, 4, 2, 0, 0);
+        CHECK_NEAR(m->ior, 1.33, 1e-6);
+        CHECK_NEAR(m->transmission, 0.5, 0);
+        CHECK_NEAR(m->clearcoat, 0.7, 1e-6);
+        CHECK_NEAR(m->clearcoat_roughness, 0.2, 1e-6);
+        CHECK_EQ_INT(m->flags, MAT_TWO_SIDED | MAT_THIN);
+    }
+    /* the unsupported extension only in extensionsUsed: one warning naming it */
+    CHECK_EQ_INT(s.n_warnings, 1);
+    if (s.n_warnings == 1)
+        CHECK_STR_CONTAINS(s.warnings[0], "the extension 'EXT_unknown_thing' (extensionsUsed) is ignored");
+    scene_free(&s);
+
+    /* --camera by index, by the camera's name and by its node's name */
+    const char *picks[] = { "1", "top", "front" };
+    for (int i = 0; i < 3; i++) {
+        st = load_nodes(picks[i], &s, &err);
+        CHECK_MSG(st == ST_OK, "%s", err.msg);
+        if (st == ST_OK && i < 2) {
+            CHECK_EQ_INT(s.camera.type, CAMERA_ORTHOGRAPHIC);
+            CHECK_NEAR(s.camera.ortho_height, 6.0, 0);
+            check_v3(s.camera.from, 0, 10, 0, 1e-6);
+            check_v3(s.camera.at, 0, 9, 0, 1e-6);
+        } else if (st == ST_OK) {
+            check_v3(s.camera.from, 15, 0, 0, 1e-5);
+        }
+        scene_free(&s);
+    }
+    st = load_nodes("side", &s, &err);
+    CHECK_EQ_INT(st, ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "tests/data/gltf/nodes.gltf: no camera 'side'");
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* mesh { file "x.gltf" } in clpt's format, with its transform keys. */
+static void test_mesh_block(void)
+{
+    static const char text[] =
+        "material m { type diffuse albedo 0.5 0.5 0.5 }\n"
+        "mesh { file \"strips.gltf\" scale 2 translate 0 0 5 }\n"
+        "mesh { file \"strips.gltf\" material m }\n";
+    Scene s;
+    scene_init(&s);
+    Error err = { 0 };
+    Status st = scene_load_text(DIR_GLTF "t.scene", text, strlen(text), &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_triangles, 12);
+    if (s.n_triangles == 12) {
+        check_v3(s.triangles[1].p0, 0, 2, 5, 0);
+        CHECK_EQ_INT(s.materials[s.triangles[0].material].type, MAT_PRINCIPLED);
+        CHECK_EQ_INT(s.triangles[6].material, scene_find_material(&s, "m"));
+    }
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* ------------------------------------------------------------------ the Blender files */
+
+typedef struct {
+    float *rgb;
+    uint w, h;
+} Image;
+
+/* Renders the scene on the scalar device at its own (small) size. */
+static int render(Scene *s, Image *img)
+{
+    Film film;
+    Error err = { 0 };
+    Status st = render_util_run(s, "scalar", 0, &film, &err);
+    CHECK_MSG(st == ST_OK, "render: %s", err.msg);
+    error_clear(&err);
+    if (st) return 0;
+    img->w = film.width;
+    img->h = film.height;
+    img->rgb = malloc((size_t)img->w * img->h * 3u * sizeof *img->rgb);
+    film_resolve(&film, img->rgb);
+    film_free(&film);
+    return 1;
+}
+
+static int load_scene(const char *path, Scene *s, uint w, uint h, uint spp)
+{
+    scene_init(s);
+    Error err = { 0 };
+    Status st = scene_load_file(path, SCENE_FORMAT_AUTO, s, NULL, &err);
+    CHECK_MSG(st == ST_OK, "%s: %s", path, err.msg);
+    error_clear(&err);
+    s->image.width = w;
+    s->image.height = h;
+    s->image.spp = spp;
+    s->image.max_depth = 4;
+    return st == ST_OK;
+}
+
+static double rmse(const Image *a, const Image *b)
+{
+    double sum = 0.0;
+    size_t n = (size_t)a->w * a->h * 3u;
+    for (size_t i = 0; i < n; i++) {
+        double d = fmin(a->rgb[i], 1.0) - fmin(b->rgb[i], 1.0);   /* as 8-bit output clips */
+        sum += d * d;
+    }
+    return sqrt(sum / (double)n);
+}
+
+/* The OBJ Cornell box through the glTF's camera, rendered at `seed`. */
+static int render_obj_box(const SceneCamera *cam, uint w, uint h, uint seed, Image *img)
+{
+    static const char text[] = "mesh { file \"cornell-box/CornellBox-Original.obj\" }\n";
+    Scene s;
+    scene_init(&s);
+    Error err = { 0 };
+    Status st = scene_load_text(SHARED "box.scene", text, strlen(text), &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    int ok = 0;
+    if (st == ST_OK) {
+        s.camera = *cam;
+        s.image.width = w;
+        s.image.height = h;
+        s.image.spp = 16;
+        s.image.max_depth = 4;
+        s.image.seed = seed;
+        ok = render(&s, img);
+    }
+    scene_free(&s);
+    return ok;
+}
+
+static void test_cornell_box(void)
+{
+    const char *path = SHARED "gltf/cornell-box.glb";
+    if (!shared_model_present(path, "the glTF Cornell box test") ||
+        !shared_model_present(SHARED "cornell-box/CornellBox-Original.obj", "the glTF Cornell box test"))
+        return;
+    Scene s;
+    Image g = { 0 }, o1 = { 0 }, o2 = { 0 };
+    if (!load_scene(path, &s, 64, 36, 16)) return;
+    CHECK_EQ_INT(s.camera.type, CAMERA_PERSPECTIVE);
+    check_v3(s.camera.from, 0, 1, 3.9, 1e-6);
+    CHECK_NEAR(s.camera.vfov, 39.3, 0.01);
+    SceneCamera cam = s.camera;
+    if (render(&s, &g) && render_obj_box(&cam, 64, 36, 1, &o1) && render_obj_box(&cam, 64, 36, 2, &o2)) {
+        double d = rmse(&g, &o1), noise = rmse(&o1, &o2);
+        fprintf(stderr, "  cornell-box.glb vs CornellBox-Original.obj: RMSE %.4f; OBJ seed 1 vs 2: %.4f\n", d, noise);
+        /* the same box up to noise and the principled material's 4% specular layer,
+         * which the OBJ's Lambertian walls lack (docs/gltf.md) */
+        CHECK_MSG(d < 1.5 * noise, "RMSE %.4f against noise %.4f", d, noise);
+    }
+    free(g.rgb);
+    free(o1.rgb);
+    free(o2.rgb);
+    scene_free(&s);
+}
+
+/* Mean luminance and peak luminance of the pixels within r of (cx, cy). */
+static void region_stats(const Image *img, double cx, double cy, double r, double *mean, double *peak)
+{
+    double sum = 0.0;
+    int n = 0;
+    *peak = 0.0;
+    for (uint y = 0; y < img->h; y++)
+        for (uint x = 0; x < img->w; x++) {
+            double dx = x + 0.5 - cx, dy = y + 0.5 - cy;
+            if (dx * dx + dy * dy > r * r) continue;
+            const float *p = img->rgb + 3u * ((size_t)y * img->w + x);
+            double l = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+            sum += l;
+            n++;
+            *peak = fmax(*peak, l);
+        }
+    *mean = n ? sum / n : 0.0;
+}
+
+/* Where the pinhole camera sees point p, in pixels, and how many pixels a length r
+ * at p spans. */
+static void project(const SceneCamera *c, uint w, uint h, vec3 p, double r, double *px, double *py, double *pr)
+{
+    vec3 f = v3_norm(v3_sub(c->at, c->from));
+    vec3 right = v3_norm(v3_cross(f, c->up));
+    vec3 up = v3_cross(right, f);
+    vec3 d = v3_sub(p, c->from);
+    double z = v3_dot(d, f), t = tan(c->vfov * M_PI / 360.0);
+    *px = w * 0.5 + v3_dot(d, right) / z / t * h * 0.5;
+    *py = h * 0.5 - v3_dot(d, up) / z / t * h * 0.5;
+    *pr = r / z / t * h * 0.5;
+}
+
+static void test_material_spheres(void)
+{
+    const char *path = SHARED "gltf/material-spheres.glb";
+    if (!shared_model_present(path, "the glTF material spheres test")) return;
+    Scene s;
+    Image img = { 0 };
+    if (!load_scene(path, &s, 160, 90, 32)) return;
+    CHECK_EQ_INT(s.n_delta_lights, 2);   /* the sun and the point light */
+    if (!render(&s, &img)) {
+        scene_free(&s);
+        return;
+    }
+    /* the spheres' centres, by their nodes: x from -2 to 2 by roughness, z 0
+     * (metallic 0) and -1 (metallic 1); radius 0.4 */
+    double mean[2][5], peak[2][5];
+    for (int row = 0; row < 2; row++)
+        for (int i = 0; i < 5; i++) {
+            double px, py, pr;
+            project(&s.camera, img.w, img.h, v3((float)(i - 2), 0.4f, (float)-row), 0.4, &px, &py, &pr);
+            region_stats(&img, px, py, 0.8 * pr, &mean[row][i], &peak[row][i]);
+        }
+    for (int row = 0; row < 2; row++) {
+        fprintf(stderr, "  metallic %d, roughness 0..1: mean", row);
+        for (int i = 0; i < 5; i++) fprintf(stderr, " %.3f", mean[row][i]);
+        fprintf(stderr, "; peak");
+        for (int i = 0; i < 5; i++) fprintf(stderr, " %.2f", peak[row][i]);
+        fprintf(stderr, "\n");
+    }
+    /* the smooth spheres mirror the lights as small bright highlights that roughness
+     * spreads out and dims (at roughness 0 the sun, a delta light, has no reflection
+     * but the point light's, 0.032 wide: the peak is at roughness 0 or 0.25), and
+     * neighbours differ */
+    for (int row = 0; row < 2; row++) {
+        CHECK_MSG(fmax(peak[row][0], peak[row][1]) > 2.0 * peak[row][4], "row %d: peak %.3f / %.3f at roughness "
+                  "0 / 0.25, %.3f at 1", row, peak[row][0], peak[row][1], peak[row][4]);
+        for (int i = 0; i < 4; i++)
+            CHECK_MSG(fabs(mean[row][i] - mean[row][i + 1]) > 0.002 || fabs(peak[row][i] - peak[row][i + 1]) > 0.05,
+                      "row %d: spheres %d and %d look the same", row, i, i + 1);
+    }
+    /* the metals are no red plastic */
+    for (int i = 0; i < 5; i++)
+        CHECK_MSG(fabs(mean[0][i] - mean[1][i]) > 0.002, "roughness %d: metal and plastic look the same", i);
+    free(img.rgb);
+    scene_free(&s);
+}
+
+static void test_suzanne_texture(void)
+{
+    const char *path = SHARED "gltf/textured-suzanne.glb";
+    if (!shared_model_present(path, "the glTF Suzanne texture test")) return;
+    Scene s;
+    Image with = { 0 }, without = { 0 };
+    if (!load_scene(path, &s, 96, 54, 8)) return;
+    uint m = scene_find_material(&s, "checker");
+    CHECK(m != NO_INDEX);
+    if (m == NO_INDEX) {
+        scene_free(&s);
+        return;
+    }
+    uint t = s.materials[m].texture;
+    CHECK(t != NO_INDEX && t < s.n_textures);
+    if (t != NO_INDEX) {
+        /* the 256 x 256 PNG inside the GLB, decoded from memory, sRGB */
+        CHECK_EQ_INT(s.textures[t].width, 256);
+        CHECK_EQ_INT(s.textures[t].height, 256);
+        CHECK_EQ_INT(s.textures[t].flags, TEX_SRGB);
+    }
+    /* the texture changes the image where the Suzanne is, and only there */
+    if (render(&s, &with)) {
+        s.materials[m].texture = NO_INDEX;
+        if (render(&s, &without)) {
+            double d = rmse(&with, &without);
+            fprintf(stderr, "  Suzanne with and without its texture: RMSE %.4f\n", d);
+            CHECK_MSG(d > 0.02, "the texture changes the image by RMSE %.4f only", d);
+        }
+    }
+    free(with.rgb);
+    free(without.rgb);
+    scene_free(&s);
+}
+
+int main(void)
+{
+    RUN(test_strided);
+    RUN(test_sparse);
+    RUN(test_strips);
+    RUN(test_glb_and_external);
+    RUN(test_textures);
+    RUN(test_nodes);
+    RUN(test_mesh_block);
+    RUN(test_cornell_box);
+    RUN(test_material_spheres);
+    RUN(test_suzanne_texture);
+    return harness_report();
+}

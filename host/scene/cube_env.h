@@ -12,8 +12,10 @@
 #include "base/status.h"
 #include "scene/scene.h"
 
-/* Smallest and largest height of the resampled map (its width is twice that). */
-#define CUBE_ENV_MIN_HEIGHT 64u
+/* Smallest and largest height of the resampled map (its width is twice that): at 256
+ * rows a map texel spans 0.7 degrees, so the edges between faces of a few texels stay
+ * sharp; 1024 rows (25 MB of floats) bound the memory for large faces. */
+#define CUBE_ENV_MIN_HEIGHT 256u
 #define CUBE_ENV_MAX_HEIGHT 1024u
 
 /* Height of the map for faces at most `face` texels on a side: 2 face (a face spans a

@@ -5,7 +5,9 @@
  * background_radiance where a ray misses every primitive. Only the environment map is
  * also a light that next-event estimation samples (lights.h), so the path tracer weights
  * what its BSDF-sampled rays see of it by MIS (shade.cl); the other backgrounds count
- * fully where a ray escapes.
+ * fully where a ray escapes. The path tracer never sees BG_CUBEMAP: the host resamples
+ * a cube map into an environment map for it (host/scene/cube_env.c, which runs
+ * cubemap_lookup below on the host); the Whitted integrator looks the faces up here.
  *
  * The cube map follows the course's CubeMap::getTexel exactly: the face is the axis of
  * the direction's largest component (x before y before z on ties), and the two other

@@ -4,7 +4,10 @@
  * axis sees exactly that face's bytes at its centre pixel, in the classic ray tracer and
  * in the path tracer; a mirror sphere shows the face behind the camera; the face
  * orientation of the lookup; the same bits on PoCL and the scalar device; and the
- * errors for a missing face or a folder that is not one.
+ * errors for a missing face or a folder that is not one. In the path tracer the cube
+ * map is resampled into an environment light (host/scene/cube_env.c): the resampled
+ * texels of a uniform map, a furnace, MIS against light and BSDF sampling alone, and
+ * PoCL against the scalar device on a render lit by it.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -17,6 +20,7 @@
 #include "io/classic_parse.h"
 #include "io/scene_load.h"
 #include "io/texture.h"
+#include "scene/cube_env.h"
 #include "background.h"
 
 #include <stb_image_write.h>
@@ -35,8 +39,9 @@ static const unsigned char face_rgb[6][3] = {
 static const char *const face_name[6] = { "left", "right", "up", "down", "front", "back" };
 
 /* Writes DIR/sub/NAME.png for every face but `skip` (-1: none), each w x h of its colour
- * (h x w images of one colour: orientation cannot show; test_orientation pins it). */
-static void write_faces(const char *sub, int skip)
+ * (h x w images of one colour: orientation cannot show; test_orientation pins it), or
+ * all of colour `uniform` where that is not NULL. */
+static void write_faces_of(const char *sub, int skip, const unsigned char *uniform)
 {
     char path[256];
     snprintf(path, sizeof path, "%s/%s", dir, sub);
@@ -44,11 +49,13 @@ static void write_faces(const char *sub, int skip)
     for (int f = 0; f < 6; f++) {
         if (f == skip) continue;
         unsigned char px[2 * 3 * 3];
-        for (int i = 0; i < 6; i++) memcpy(px + 3 * i, face_rgb[f], 3);
+        for (int i = 0; i < 6; i++) memcpy(px + 3 * i, uniform ? uniform : face_rgb[f], 3);
         snprintf(path, sizeof path, "%s/%s/%s.png", dir, sub, face_name[f]);
         stbi_write_png(path, 3, 2, 3, px, 9);
     }
 }
+
+static void write_faces(const char *sub, int skip) { write_faces_of(sub, skip, NULL); }
 
 static Status load_text(const char *text, Scene *s, Error *err)
 {
@@ -122,6 +129,9 @@ static void test_axes(void)
                 s.image.spp = 4;
             }
             float *a = render(&s, "scalar"), *b = render(&s, "cpu");
+            /* the path tracer resampled the cube map into an environment light */
+            CHECK_EQ_INT(s.bg_type, path ? BG_MAP : BG_CUBEMAP);
+            CHECK(path ? s.env_light != NO_INDEX : s.env_light == NO_INDEX);
             check_pixel(a, b, 5 * 5 * 3, 2 * 5 + 2, views[i].face, what);
             free(a);
             free(b);
@@ -294,6 +304,210 @@ static void test_errors(void)
     error_clear(&err);
 }
 
+/* Loads clpt's own format from `text` (written to DIR/light.scene). */
+static Status load_own(const char *text, Scene *s, Error *err)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/light.scene", dir);
+    FILE *f = fopen(path, "wb");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+    scene_init(s);
+    memset(err, 0, sizeof *err);
+    return scene_load_file(path, SCENE_FORMAT_AUTO, s, NULL, err);
+}
+
+/* Renders s with MIS mode `mode` (set on the prepared scene) on `devices`; the linear
+ * film in a new array, NULL on failure. */
+static float *render_mode(Scene *s, uint mode, const char *devices, Error *err)
+{
+    RenderScene rs;
+    DeviceDesc *all = NULL;
+    size_t n_all = 0, *chosen = NULL, n_chosen = 0, n_open = 0;
+    Device *devs[4];
+    char warning[1100];
+    Film film;
+    memset(&film, 0, sizeof film);
+    float *rgb = NULL;
+    Status st = render_scene_prepare(s, 0, &rs, err);
+    if (st) return NULL;
+    rs.ds.params.mis_mode = mode;
+    if ((st = device_list(&all, &n_all, warning, sizeof warning, err))) goto out;
+    if ((st = device_select(devices, all, n_all, &chosen, &n_chosen, err))) goto out;
+    for (size_t i = 0; i < n_chosen && i < 4; i++) {
+        if ((st = device_open(&all[chosen[i]], NULL, &devs[i], err))) goto out;
+        n_open++;
+        if ((st = devs[i]->ops->load_scene(devs[i], &rs.ds, err))) goto out;
+    }
+    if ((st = film_init(&film, s->image.width, s->image.height, err))) goto out;
+    ScheduleConfig cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.spp = s->image.spp;
+    ScheduleStats stats;
+    st = schedule_run(devs, n_open, &cfg, &film, &stats, err);
+    schedule_stats_free(&stats);
+    if (!st) {
+        rgb = malloc((size_t)film.width * film.height * 3u * sizeof *rgb);
+        if (rgb) film_resolve(&film, rgb);
+    }
+out:
+    for (size_t i = 0; i < n_open; i++) device_close(devs[i]);
+    film_free(&film);
+    free(all);
+    free(chosen);
+    render_scene_free(&rs);
+    return rgb;
+}
+
+/* The resampled map's texels: in a uniform cube map every one is the faces' value
+ * (the mean of equal lookups, taken in double, gives it back), so the environment
+ * light's mean is that value's luminance; the map's size follows the faces'. */
+static void test_env_map_uniform(void)
+{
+    Scene s;
+    Error err;
+    CHECK_EQ_INT(load_own("image { width 4 height 4 spp 1 }\ncamera { from 0 0 0 at 0 0 -1 fov 30 }\n"
+                          "background { cubemap \"grey\" }\n", &s, &err), ST_OK);
+    CHECK_EQ_INT(cube_env_convert(&s, &err), ST_OK);
+    CHECK_EQ_INT(s.bg_type, BG_MAP);
+    const Texture *t = &s.textures[s.bg_cubemap];
+    CHECK_EQ_INT(t->flags, TEX_FLOAT);
+    CHECK_EQ_INT(t->height, CUBE_ENV_MIN_HEIGHT);   /* 3 x 2 faces: the smallest map */
+    CHECK_EQ_INT(t->width, 2 * CUBE_ENV_MIN_HEIGHT);
+    float want = 128.0f / 255.0f;
+    uint off = 0;
+    for (size_t i = 0; i < 3u * t->width * t->height; i++) {
+        float v;
+        memcpy(&v, s.texels + t->offset + i, sizeof v);
+        off += fabsf(v - want) > 1e-6f;
+    }
+    CHECK_EQ_INT(off, 0);
+    /* env_dist sums sin(theta) at row centres: the sphere's area to ~1e-5 at 256 rows */
+    CHECK_NEAR(s.env_mean, want, 1e-3 * want);
+    CHECK(s.env_cdf != NULL);
+    CHECK_EQ_INT(cube_env_height(1), CUBE_ENV_MIN_HEIGHT);
+    CHECK_EQ_INT(cube_env_height(300), 600);
+    CHECK_EQ_INT(cube_env_height(4096), CUBE_ENV_MAX_HEIGHT);
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* A white diffuse sphere (albedo 1) inside a uniform cube map is lit by it alone and
+ * returns it all: the pixels on it are the map's value within noise, those off it the
+ * value exactly. */
+static void test_furnace(void)
+{
+    Scene s;
+    Error err;
+    CHECK_EQ_INT(load_own("image { width 24 height 24 spp 64 depth 4 seed 5 }\n"
+                          "camera { from 0 0.5 4 at 0 0 0 fov 40 }\n"
+                          "background { cubemap \"grey\" }\n"
+                          "sphere { center 0 0 0 radius 1 material { type diffuse albedo 1 1 1 } }\n", &s, &err),
+                 ST_OK);
+    float *img = render_mode(&s, MIS_BOTH, "scalar", &err);
+    CHECK_MSG(img != NULL, "%s", err.msg);
+    if (img) {
+        double on = 0.0, want = 128.0 / 255.0;
+        for (uint y = 8; y < 16; y++)
+            for (uint x = 8; x < 16; x++) on += img[3 * (y * 24 + x) + 1] / 64.0;
+        fprintf(stderr, "  furnace in a cube map of %.4f: sphere %.4f, corner %.6f\n", want, on, (double)img[1]);
+        CHECK_NEAR(on, want, 0.01 * want);
+        CHECK_NEAR(img[1], want, 1e-6);
+        free(img);
+    }
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* The scene of the strategy and device comparisons: a diffuse sphere on a diffuse
+ * floor under the six-colour cube map, and, with `extra`, a metal and a glass sphere. */
+static Status strategy_scene(Scene *s, uint spp, uint depth, int extra, Error *err)
+{
+    char text[1024];
+    snprintf(text, sizeof text,
+             "image { width 32 height 24 spp %u depth %u seed 5 }\n"
+             "camera { from 0 0.5 4 at 0 0 0 fov 40 }\n"
+             "background { cubemap \"cube\" }\n"
+             "sphere { center 0 0 0 radius 1 material { type diffuse albedo 0.7 0.7 0.7 } }\n"
+             "plane { point 0 -1 0 normal 0 1 0 material { type diffuse albedo 0.6 0.5 0.4 } }\n%s",
+             spp, depth,
+             extra ? "sphere { center -1.2 -0.5 1 radius 0.5 material { type metal albedo 0.9 0.8 0.7 fuzz 0.3 } }\n"
+                     "sphere { center 1.2 -0.5 1 radius 0.5 material { type dielectric ior 1.5 } }\n" : "");
+    return load_own(text, s, err);
+}
+
+/* Direct light only: light sampling alone, BSDF sampling alone and their MIS
+ * combination agree (the image's mean and its 8x8 blocks), as for a `map` (test_envmap). */
+static void test_strategies_agree(void)
+{
+    float *img[3] = { NULL, NULL, NULL };
+    double mean[3] = { 0.0, 0.0, 0.0 }, block[3][12];
+    memset(block, 0, sizeof block);
+    int ok = 1;
+    for (uint m = 0; m < 3; m++) {
+        Scene s;
+        Error err;
+        CHECK_EQ_INT(strategy_scene(&s, 1024, 1, 0, &err), ST_OK);
+        img[m] = render_mode(&s, m, "scalar", &err);
+        CHECK_MSG(img[m] != NULL, "%s", err.msg);
+        ok &= img[m] != NULL;
+        scene_free(&s);
+        error_clear(&err);
+    }
+    if (ok) {
+        for (uint m = 0; m < 3; m++)
+            for (uint y = 0; y < 24; y++)
+                for (uint x = 0; x < 32; x++) {
+                    const float *p = img[m] + 3 * (y * 32 + x);
+                    double val = (p[0] + p[1] + p[2]) / 3.0;
+                    mean[m] += val / (32 * 24);
+                    block[m][(y / 8) * 4 + x / 8] += val / 64.0;
+                }
+        double worst[3] = { 0.0, 0.0, 0.0 };
+        for (uint m = 1; m < 3; m++)
+            for (int b = 0; b < 12; b++) {
+                double rel = fabs(block[m][b] - block[0][b]) / (block[0][b] > 0.05 ? block[0][b] : 0.05);
+                if (rel > worst[m]) worst[m] = rel;
+            }
+        fprintf(stderr, "  cube map, image mean: MIS %.4f, light sampling %.4f, BSDF sampling %.4f; worst 8x8 "
+                "block difference to MIS: light %.1f%%, BSDF %.1f%%\n", mean[0], mean[1], mean[2],
+                100.0 * worst[1], 100.0 * worst[2]);
+        CHECK(mean[0] > 0.1);
+        CHECK_NEAR(mean[1], mean[0], 0.01 * mean[0]);
+        CHECK_NEAR(mean[2], mean[0], 0.01 * mean[0]);
+        CHECK(worst[1] < 0.05);
+        CHECK(worst[2] < 0.05);
+    }
+    for (int m = 0; m < 3; m++) free(img[m]);
+}
+
+/* A small render lit by the cube map (diffuse, metal and glass: every path kind) on
+ * PoCL and on the scalar device: the same bits. */
+static void test_opencl_matches_scalar(void)
+{
+    const char *devs[2] = { "scalar", "cpu" };
+    float *img[2] = { NULL, NULL };
+    for (int d = 0; d < 2; d++) {
+        Scene s;
+        Error err;
+        CHECK_EQ_INT(strategy_scene(&s, 8, 6, 1, &err), ST_OK);
+        img[d] = render_mode(&s, MIS_BOTH, devs[d], &err);
+        CHECK_MSG(img[d] != NULL, "%s: %s", devs[d], err.msg);
+        scene_free(&s);
+        error_clear(&err);
+    }
+    if (img[0] && img[1]) {
+        uint same = 0;
+        for (uint i = 0; i < 32 * 24; i++) same += memcmp(img[0] + 3 * i, img[1] + 3 * i, 3 * sizeof(float)) == 0;
+        fprintf(stderr, "  a cube-map-lit render: %u of %u pixels bit-identical on PoCL and scalar\n", same, 32 * 24);
+        CHECK_EQ_INT(same, 32 * 24);
+    }
+    free(img[0]);
+    free(img[1]);
+}
+
 int main(void)
 {
     snprintf(dir, sizeof dir, "/tmp/clpt-test-cubemap-XXXXXX");
@@ -302,11 +516,17 @@ int main(void)
         return 1;
     }
     write_faces("cube", -1);
+    static const unsigned char grey[3] = { 128, 128, 128 };
+    write_faces_of("grey", -1, grey);
     RUN(test_axes);
     RUN(test_mirror);
     RUN(test_orientation);
     RUN(test_errors);
     RUN(test_clpt_format);
+    RUN(test_env_map_uniform);
+    RUN(test_furnace);
+    RUN(test_strategies_agree);
+    RUN(test_opencl_matches_scalar);
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", dir);

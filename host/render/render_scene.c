@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "scene/camera.h"
+#include "scene/cube_env.h"
 
 /* Russian roulette starts after this many bounces: early bounces carry most of the
  * image, so killing paths there adds noise for little time saved. */
@@ -23,6 +24,9 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
 {
     memset(out, 0, sizeof *out);
     Status st;
+    /* the path tracer samples a cube map as an environment light; Whitted keeps the
+     * course's exact lookup (cube_env.h) */
+    if (s->integrator == INTEGRATOR_PATH && s->bg_type == BG_CUBEMAP && (st = cube_env_convert(s, err))) return st;
     if ((st = scene_prepare_lights(s, err))) return st;
     RenderParams *p = &out->ds.params;
     if ((st = camera_setup(&s->camera, s->image.width, s->image.height, &p->camera, err))) return st;

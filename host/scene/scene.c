@@ -410,7 +410,9 @@ Material material_principled(vec3 base, float metallic, float roughness)
 /* Measured spectra interpolated at 650, 550 and 450 nm for R, G and B: Ag, Al, Au, Cu
  * from pbrt-v4 (src/pbrt/util/spectrum.cpp, after refractiveindex.info), Cr and Ni from
  * Mitsuba 0.6 (data/ior/Cr.*.spd, Ni_palik.*.spd: the luxpop database, Palik's
- * Handbook of Optical Constants of Solids). */
+ * Handbook of Optical Constants of Solids), Fe and Ti from Johnson & Christy, Phys.
+ * Rev. B 9, 5056 (1974), as tabulated by refractiveindex.info (data-nk/main/Fe/Johnson.yml,
+ * Ti/Johnson.yml; linear in wavelength between its samples). */
 static const struct {
     const char *name;
     float eta[3], k[3];
@@ -420,7 +422,9 @@ static const struct {
     {"Au", {0.1678f, 0.3504f, 1.5085f}, {3.1378f, 2.7141f, 1.8788f}},
     {"Cr", {3.6375f, 3.1158f, 1.9277f}, {4.3644f, 4.4228f, 4.1675f}},
     {"Cu", {0.2166f, 0.9582f, 1.1658f}, {3.6377f, 2.5771f, 2.3939f}},
+    {"Fe", {2.9114f, 2.9497f, 2.5845f}, {3.0893f, 2.9318f, 2.7670f}},
     {"Ni", {2.0140f, 1.7724f, 1.6288f}, {3.8079f, 3.2526f, 2.6540f}},
+    {"Ti", {2.7407f, 2.5418f, 2.2670f}, {3.8143f, 3.4345f, 3.0385f}},
 };
 
 int material_metal_preset(const char *name, size_t len, vec3 *eta, vec3 *k)

@@ -354,6 +354,9 @@ static Material material_base(uint type)
     m.texture_normal = NO_INDEX;
     m.normal_scale = 1.0f;
     m.ior = 1.5f;
+    m.alpha = 1.0f;
+    m.alpha_cutoff = 0.5f;      /* glTF's default alphaCutoff */
+    m.texture_emission = NO_INDEX;
     return m;
 }
 
@@ -471,8 +474,13 @@ Light light_default(uint type)
 static int is_emissive(const Scene *s, uint material)
 {
     if (material >= s->n_materials) return 0;
-    /* any material may emit (a diffuse emitter is what the furnace test needs) */
-    return v3_luminance(s->materials[material].emission) > 0.0f;
+    /* any material may emit (a diffuse emitter is what the furnace test needs). An
+     * emission texture or an alpha cut-out makes the emitted radiance vary over the
+     * surface in a way light sampling does not know: such surfaces are found by BSDF
+     * sampling alone (full weight), like the background, which keeps them unbiased. */
+    const Material *m = &s->materials[material];
+    if (m->texture_emission != NO_INDEX || (m->flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND))) return 0;
+    return v3_luminance(m->emission) > 0.0f;
 }
 
 static double triangle_area(const Triangle *t)

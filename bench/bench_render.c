@@ -28,6 +28,7 @@ static const BenchScene default_scenes[] = {
     { "scenes/cornell-box.scene", 512, 512, 16 },
     { "scenes/one-weekend.scene", 400, 225, 16 },
     { "scenes/mesh.scene", 320, 320, 16 },
+    { "scenes/envmap.scene", 480, 270, 16 },
 };
 
 typedef struct {

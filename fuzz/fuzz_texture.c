@@ -1,12 +1,13 @@
 /*
- * fuzz_texture.c — image textures (host/io/texture.c, decoding through stb_image) on
- * arbitrary bytes. The loader reads files, so each input is written to a temporary
- * file first. A file that decodes must give a texture whose texels all lie in the
+ * fuzz_texture.c — image textures (host/io/texture.c, decoding through stb_image, and
+ * OpenEXR for EXR files: host/io/exr.c) on arbitrary bytes. The loader reads files, so
+ * each input is written to a temporary file first. A file that decodes must give a texture whose texels all lie in the
  * scene's texel array; the size limit must hold before stb_image allocates (a header
  * claiming a huge image in a few bytes is an input error, not an out-of-memory).
  */
 #include "fuzz.h"
 #include "base/limit.h"
+#include "io/exr.h"
 #include "io/texture.h"
 
 #include <stdio.h>
@@ -14,7 +15,7 @@
 
 #include <stb_image.h>
 
-FUZZ_SEEDS("png bmp tga hdr psd ppm pgm jpg");
+FUZZ_SEEDS("png bmp tga hdr psd ppm pgm jpg exr");
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -29,6 +30,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
      * the limit still go through, to be refused */
     int w, h, c;
     uint64_t pixels = stbi_info(path, &w, &h, &c) ? (uint64_t)(unsigned)w * (unsigned)h : 0;
+    if (exr_size(path, &w, &h) && w > 0 && h > 0) pixels = (uint64_t)(unsigned)w * (unsigned)h;
     if (pixels > (1u << 20) && pixels <= CLPT_MAX_TEXTURE_PIXELS) {
         unlink(path);
         return 0;

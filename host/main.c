@@ -206,6 +206,50 @@ static char *aov_output_path(const Options *o, const char *output, unsigned aov)
     return named ? strdup(named) : passes_aov_path(output, options_aov_name(aov));
 }
 
+/* Whether auxiliary image `aov` goes into the EXR output as channels (see --aov): the
+ * output is an .exr and the course command line gave the image no file of its own. */
+static int aov_in_exr(const Options *o, const char *output, unsigned aov)
+{
+    ImageFormat fmt = IMAGE_PNG;
+    Error ignored = { 0 };
+    image_format_from_path(output, &fmt, &ignored);
+    error_clear(&ignored);
+    return fmt == IMAGE_EXR && !o->aov_files[aov - INTEGRATOR_AOV_NORMAL];
+}
+
+/* An auxiliary image as the EXR output's channels hold it: the normal signed (the
+ * normal image rendered with grey misses, (n + 1) / 2, gives 2c - 1 = the pixel's mean
+ * normal with misses counting 0), the mean distance to the pixel's hits (0 where none),
+ * the albedo as it is. */
+static Status aov_exr_data(const PassContext *pc, unsigned aov, uint spp, float *rgb, double *secs, Error *err)
+{
+    RenderParams *p = &pc->rs->ds.params;
+    uint grey = p->normal_miss_grey;
+    if (aov == INTEGRATOR_AOV_NORMAL) p->normal_miss_grey = 1;
+    DepthScale raw = { DEPTH_RAW, 0.0, 0.0 };
+    Status st = passes_aov(pc, aov, spp, &raw, rgb, secs, err);
+    p->normal_miss_grey = grey;
+    if (!st && aov == INTEGRATOR_AOV_NORMAL)
+        for (size_t i = 0; i < (size_t)p->width * p->height * 3u; i++) rgb[i] = 2.0f * rgb[i] - 1.0f;
+    return st;
+}
+
+/* The EXR output again, with the auxiliary images as channels. */
+static Status write_exr_layers(const Options *o, const char *output, const float *rgb, float *const aov_rgb[3],
+                               uint w, uint h, Error *err)
+{
+    static const char *const names[3][3] = { { "normal.X", "normal.Y", "normal.Z" }, { "Z", NULL, NULL },
+                                             { "albedo.R", "albedo.G", "albedo.B" } };
+    ImageLayer layers[3];
+    size_t n = 0;
+    for (int a = 0; a < 3; a++) {
+        if (!aov_rgb[a]) continue;
+        memcpy(layers[n].names, names[a], sizeof names[a]);
+        layers[n++].rgb = aov_rgb[a];
+    }
+    return n ? image_write_exr(output, rgb, layers, n, w, h, o->exr_float, err) : ST_OK;
+}
+
 /* The adaptive pass and the auxiliary images, after the main image is in rgb (and
  * written). A failure here is the run's failure; the main image stays written. */
 static Status run_passes(const Options *o, const PassContext *pc, const char *output, ImageEncoding encoding,
@@ -223,8 +267,22 @@ static Status run_passes(const Options *o, const PassContext *pc, const char *ou
             fprintf(stderr, "clpt: adaptive pass: %zu of %u pixels (%.1f%%) got %u more samples in %.2f s -> %s\n",
                     marked, w * h, 100.0 * (double)marked / ((double)w * h), o->adaptive_spp, secs, output);
     }
+    float *in_exr[3] = { NULL, NULL, NULL };
+    for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO && !st; aov++) {
+        if (!(o->aovs & (1u << aov)) || !aov_in_exr(o, output, aov)) continue;
+        float **slot = &in_exr[aov - INTEGRATOR_AOV_NORMAL];
+        double secs = 0.0;
+        if (!(*slot = malloc((size_t)w * h * 3u * sizeof **slot))) st = error_set(err, ST_INTERNAL, "out of memory");
+        if (!st) st = aov_exr_data(pc, aov, spp, *slot, &secs, err);
+        if (!st && !o->quiet) fprintf(stderr, "clpt: %s image in %.2f s\n", options_aov_name(aov), secs);
+    }
+    if (!st) st = write_exr_layers(o, output, rgb, in_exr, w, h, err);
+    if (!st && !o->quiet && (in_exr[0] || in_exr[1] || in_exr[2]))
+        fprintf(stderr, "clpt: auxiliary images as channels -> %s\n", output);
+    for (int a = 0; a < 3; a++) free(in_exr[a]);
+    if (st) return st;
     for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
-        if (!(o->aovs & (1u << aov))) continue;
+        if (!(o->aovs & (1u << aov)) || aov_in_exr(o, output, aov)) continue;
         char *path = aov_output_path(o, output, aov);
         if (!path) return error_set(err, ST_INTERNAL, "out of memory");
         ImageFormat fmt = IMAGE_PNG;
@@ -546,7 +604,7 @@ static Status outputs_check(const Run *r, Error *err)
     Status st = ST_OK;
     named_file_init(&files[n++], r->output, "the output image", FILE_IMAGE);
     for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
-        if (!(o->aovs & (1u << aov))) continue;
+        if (!(o->aovs & (1u << aov)) || aov_in_exr(o, r->output, aov)) continue;
         char *path = aov_paths[aov - INTEGRATOR_AOV_NORMAL] = aov_output_path(o, r->output, aov);
         if (!path) {
             st = error_set(err, ST_INTERNAL, "out of memory");
@@ -606,7 +664,8 @@ static Status scene_apply_options(Run *r, Error *err)
                          o->range_first, o->range_end, r->scene.image.spp);
     if (o->adaptive > 0.0 && r->scene.integrator != INTEGRATOR_WHITTED)
         return error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
-    r->encoding = r->scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB;
+    r->encoding = (ImageEncoding)((r->scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB) |
+                                  (r->o.exr_float ? IMAGE_EXR_FLOAT : 0));
     return ST_OK;
 }
 

@@ -40,7 +40,8 @@ void options_print_help(FILE *f)
     fputs(
 "Output and image:\n"
 "  -o, --output FILE          image to write: .png, .ppm or .bmp (8-bit sRGB)\n"
-"                             or .pfm (linear float); default: SCENE's name\n"
+"                             or .pfm, .exr (half; see --exr-float) or .hdr\n"
+"                             (linear float); default: SCENE's name\n"
 "                             with .png, in the current folder. Written\n"
 "                             atomically; a symlink is followed and an\n"
 "                             existing file keeps its permissions. Checked\n"
@@ -64,14 +65,19 @@ void options_print_help(FILE *f)
 "      --gamma srgb|none      8-bit images with the sRGB curve or without\n"
 "                             (linear values times 255); default: srgb, none\n"
 "                             for classic scenes\n"
+"      --exr-float            EXR channels as 32-bit floats (default: half)\n"
 "      --aov LIST             also write auxiliary images of the first hit,\n"
 "                             comma-separated: normal (as colours), depth\n"
 "                             (grey: near white, far black), albedo; to\n"
-"                             OUTPUT-normal.png etc.\n"
+"                             OUTPUT-normal.png etc.; an .exr output holds\n"
+"                             them as channels normal.X/Y/Z (signed), Z\n"
+"                             (distance) and albedo.R/G/B instead\n"
 "      --depth-range NEAR,FAR the depth image is linear from white at NEAR to\n"
 "                             black at FAR (NEAR > FAR inverts it; default:\n"
 "                             inverse distance, nearest hit white)\n"
-"\n"
+"\n",
+        f);
+    fputs(
 "Checkpoints (docs/checkpoint.md):\n"
 "      --checkpoint FILE      save the render's state to FILE (atomically)\n"
 "                             every --checkpoint-interval seconds, on\n"
@@ -319,6 +325,7 @@ static int options_set_switch(const char *a, Options *o)
         { "--list-devices", NULL, &o->list_devices }, { "--stats", NULL, &o->stats },
         { "--quiet", "-q", &o->quiet },    { "--mpi-broadcast", NULL, &o->mpi_broadcast },
         { "--interactive", "-i", &o->interactive }, { "--profile", NULL, &o->profile },
+        { "--exr-float", NULL, &o->exr_float },
     };
     for (size_t k = 0; k < sizeof switches / sizeof switches[0]; k++)
         if (strcmp(a, switches[k].name) == 0 || (switches[k].alias && strcmp(a, switches[k].alias) == 0)) {

@@ -26,6 +26,7 @@ typedef struct {
     double mpi_timeout;           /* seconds of silence before a rank is given up; 0 = 30 */
     int list_devices, stats, profile, quiet, help, version;
     int interactive;              /* --interactive: the viewer (docs/viewer.md) */
+    int exr_float;                /* EXR channels as 32-bit floats, not halves */
     /* developer flags */
     const char *kernel_dir;
     unsigned batch;               /* fixed batch size, 0 = adaptive */

@@ -1,9 +1,11 @@
 /*
  * background.h — the radiance that reaches along a ray which escapes the scene: a
- * constant colour, a sky gradient, or a cube map (the MIT 6.837 course's `cubeMap DIR`,
- * docs/classic-format.md). Both integrators call background_radiance where a ray misses
- * every primitive; the path tracer does no next-event estimation toward the background,
- * so this is the whole of its contribution (no MIS weight to keep consistent).
+ * constant colour, a sky gradient, a cube map (the MIT 6.837 course's `cubeMap DIR`,
+ * docs/classic-format.md) or an environment map (envmap.h). Both integrators call
+ * background_radiance where a ray misses every primitive. Only the environment map is
+ * also a light that next-event estimation samples (lights.h), so the path tracer weights
+ * what its BSDF-sampled rays see of it by MIS (shade.cl); the other backgrounds count
+ * fully where a ray escapes.
  *
  * The cube map follows the course's CubeMap::getTexel exactly: the face is the axis of
  * the direction's largest component (x before y before z on ties), and the two other
@@ -26,6 +28,7 @@
 #ifndef CLPT_BACKGROUND_H
 #define CLPT_BACKGROUND_H
 
+#include "envmap.h"
 #include "texture.h"
 
 /* Face texel (i, j) with both indices clamped to the image (i, j may be -1 .. size). */
@@ -80,6 +83,7 @@ KFN vec3 background_radiance(const SceneView *sc, vec3 d)
 {
     GLOBAL const RenderParams *p = sc->params;
     if (p->bg_type == BG_CUBEMAP) return cubemap_lookup(sc, d);
+    if (p->bg_type == BG_MAP) return env_radiance(sc, d);
     if (p->bg_type == BG_SKY) {
         float t = 0.5f * (d.y + 1.0f);
         return v3_add(v3_scale(p->bg_color, 1.0f - t), v3_scale(p->bg_zenith, t));

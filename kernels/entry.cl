@@ -168,6 +168,7 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)sizeof(RevSurface);
     out[i++] = (uint)__builtin_offsetof(RevSurface, axis_x);
     out[i++] = (uint)__builtin_offsetof(RenderParams, n_revsurfaces);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, bg_light);
 }
 
 /* ---------------------------------------------------------------- classic ray tracer

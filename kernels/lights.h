@@ -11,10 +11,14 @@
  * Delta lights (point, spot, directional): the one direction toward the light; `Le` is
  * then the irradiance across that direction (intensity over the attenuation, times the
  * spot's falloff) and `pdf` the probability of choosing the light alone.
+ * The environment map (LIGHT_ENV, at most one, last in the list): a direction from its
+ * luminance distribution (envmap.h), infinitely far; the density is per solid angle and
+ * includes the choice, as for area lights.
  */
 #ifndef CLPT_LIGHTS_H
 #define CLPT_LIGHTS_H
 
+#include "envmap.h"
 #include "sampling.h"
 #include "scene_view.h"
 #include "surface.h"
@@ -108,11 +112,21 @@ KFN float light_pdf(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
     return sc->lights[li].pick_pdf * light_pdf_area(sc, li, ref, x, n);
 }
 
+/* The density with which light sampling picks direction d toward the environment map
+ * (the choice of the map among all lights included), for MIS; 0 when the map is no
+ * light. */
+KFN float light_pdf_env(const SceneView *sc, vec3 d)
+{
+    uint li = sc->params->bg_light;
+    return li == NO_INDEX || sc->params->bg_type != BG_MAP ? 0.0f : sc->lights[li].pick_pdf * env_pdf(sc, d);
+}
+
 /* The light of delta light l arriving at ref: direction, distance and irradiance
  * across the direction. Returns 0 when none arrives (outside a spot's cone, ref on
- * the light). */
+ * the light, or l is the environment map, which is no delta light). */
 KFN int light_delta_at(Light l, vec3 ref, LightSample *ls)
 {
+    if (l.type == LIGHT_ENV) return 0;
     ls->delta = 1;
     ls->n = v3s(0.0f);
     if (l.type == LIGHT_DIRECTIONAL) {
@@ -223,6 +237,17 @@ KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, float u_pi
     uint li = light_choose(sc, u_pick * cdf_top, &u_rest);
     Light l = sc->lights[li];
     float choice = l.pick_pdf / cdf_top;
+    if (l.type == LIGHT_ENV) {
+        /* the environment map: a direction from its distribution, infinitely far */
+        ls->wi = env_sample_dir(sc, u1, u2);
+        ls->Le = env_radiance(sc, ls->wi);
+        ls->pdf = choice * env_pdf(sc, ls->wi);
+        ls->p = ref;
+        ls->n = v3s(0.0f);
+        ls->dist = k_as_float(0x7f800000u);
+        ls->delta = 0;
+        return ls->pdf > 0.0f;
+    }
     if (l.type != LIGHT_AREA) {
         if (!light_delta_at(l, ref, ls)) return 0;
         ls->pdf = choice;
@@ -241,13 +266,14 @@ KFN int light_sample(const SceneView *sc, vec3 ref, float u_pick, float u1, floa
 
 /* The shadow ray from surface point p (geometric normal ng turned toward the light) to
  * the light sample: from just above the surface to just before an area light, which
- * must not count as its own occluder; to a point light; or off to infinity. */
+ * must not count as its own occluder; to a point light; or off to infinity (a
+ * directional light, the environment map). */
 KFN Ray light_shadow_ray(vec3 p, vec3 ng, LightSample ls)
 {
     Ray r;
     r.o = offset_ray_origin(p, ng);
     r.tmin = 0.0f;
-    if (ls.delta && !(ls.dist < k_as_float(0x7f800000u))) {
+    if (!(ls.dist < k_as_float(0x7f800000u))) {
         r.d = ls.wi;
         r.tmax = k_as_float(0x7f800000u);
     } else if (ls.delta) {

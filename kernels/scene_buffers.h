@@ -46,6 +46,7 @@
     X(MANY, TriShading,   shading,    (ds)->n_shading,           "shading normals")          \
     X(MANY, Texture,      textures,   (ds)->params.n_textures,   "textures")                 \
     X(MANY, uint,         texels,     (ds)->n_texels,            "texture images")           \
+    X(MANY, float,        env_cdf,    (ds)->n_env_cdf,           "environment map distribution") \
     /* read when params.use_mask is set: one entry per pixel */                              \
     X(MANY, uint,         pixel_mask, (ds)->pixel_mask ? (size_t)(ds)->params.width *        \
                                       (ds)->params.height : 0u,  "pixel mask")

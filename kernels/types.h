@@ -171,11 +171,13 @@ typedef struct {                                        /* 160 bytes */
 
 /* Area lights are the emissive primitives; point, spot and directional lights are
  * delta lights (a single direction reaches a point: no MIS, hard shadows). */
-enum LightType { LIGHT_AREA = 0, LIGHT_POINT = 1, LIGHT_DIRECTIONAL = 2, LIGHT_SPOT = 3 };
+enum LightType { LIGHT_AREA = 0, LIGHT_POINT = 1, LIGHT_DIRECTIONAL = 2, LIGHT_SPOT = 3, LIGHT_ENV = 4 };
 
 /* Every light, in one array with a cumulative distribution for choosing one
  * proportionally to its estimated power (host/scene/scene.c). Area lights come first
- * (RenderParams.n_area_lights of them), then the delta lights.
+ * (RenderParams.n_area_lights of them), then the delta lights, then the environment
+ * map's light (LIGHT_ENV, RenderParams.bg_light) when the background is a map with any
+ * light in it; its other fields are unused (kernels/envmap.h reads the map).
  * A delta light's `intensity` is radiant intensity (point, spot: W/sr) or irradiance
  * (directional: W/m^2 across the beam); point and spot lights are divided by the
  * attenuation atten0 + atten1*d + atten2*d^2 at distance d (inverse square: 0 0 1). */
@@ -231,7 +233,7 @@ typedef struct {                                        /* 112 bytes */
     vec3 color1;  float pad4;
 } Texture;
 
-enum BackgroundType { BG_CONSTANT = 0, BG_SKY = 1, BG_CUBEMAP = 2 };
+enum BackgroundType { BG_CONSTANT = 0, BG_SKY = 1, BG_CUBEMAP = 2, BG_MAP = 3 };
 
 /* A cube-map background is six consecutive image textures from
  * RenderParams.bg_cubemap on, in the course's order (kernels/background.h). */
@@ -255,11 +257,13 @@ enum MisMode { MIS_BOTH = 0, MIS_LIGHT_ONLY = 1, MIS_BSDF_ONLY = 2 };
 enum Sampler { SAMPLER_SOBOL = 0, SAMPLER_INDEPENDENT = 1 };
 
 /* Everything constant over a render, uploaded once per device. */
-typedef struct {                                        /* 272 bytes */
+typedef struct {                                        /* 288 bytes */
     Camera camera;
-    vec3 bg_color;    uint bg_type;   /* constant colour, or the sky's horizon colour */
+    vec3 bg_color;    uint bg_type;   /* constant colour, the sky's horizon colour, or
+                                       * BG_MAP: the map's scale (intensity) */
     vec3 bg_zenith;   uint bg_cubemap;  /* sky colour straight up (+y); BG_CUBEMAP: the
-                                       * texture index of its first face (CUBE_LEFT) */
+                                       * texture index of its first face (CUBE_LEFT);
+                                       * BG_MAP: the map's texture (kernels/envmap.h) */
     uint width, height;
     uint max_depth;                   /* longest path, in bounces after the camera ray */
     uint rr_depth;                    /* Russian roulette starts at this bounce */
@@ -282,6 +286,10 @@ typedef struct {                                        /* 272 bytes */
                                        * as the course ray casters; --shadows off) */
     uint normal_miss_grey;            /* the normal image's misses: (0 + 1) / 2 grey (the
                                        * courses' convention, classic scenes), else black */
+    float bg_rot_cos, bg_rot_sin;     /* BG_MAP: cos and sin of its rotation about +y */
+    uint bg_light;                    /* BG_MAP: its light in lights[] (sampled by
+                                       * next-event estimation), or NO_INDEX */
+    uint pad3;
 } RenderParams;
 
 /* One path of the wavefront; lives in a device buffer between kernel launches. */
@@ -322,7 +330,7 @@ CLPT_CHECK_SIZE(RevSurface, 48);
 CLPT_CHECK_SIZE(Material, 160);
 CLPT_CHECK_SIZE(Light, 80);
 CLPT_CHECK_SIZE(Camera, 112);
-CLPT_CHECK_SIZE(RenderParams, 272);
+CLPT_CHECK_SIZE(RenderParams, 288);
 CLPT_CHECK_SIZE(PathState, 64);
 CLPT_CHECK_SIZE(Texture, 112);
 _Static_assert(offsetof(RenderParams, bg_color) == 112, "RenderParams.bg_color");
@@ -332,6 +340,7 @@ _Static_assert(offsetof(RenderParams, ambient) == 224, "RenderParams.ambient");
 _Static_assert(offsetof(RenderParams, strata) == 256, "RenderParams.strata");
 _Static_assert(offsetof(RenderParams, shadows) == 264, "RenderParams.shadows");
 _Static_assert(offsetof(RenderParams, normal_miss_grey) == 268, "RenderParams.normal_miss_grey");
+_Static_assert(offsetof(RenderParams, bg_light) == 280, "RenderParams.bg_light");
 _Static_assert(offsetof(Material, reflective) == 64, "Material.reflective");
 _Static_assert(offsetof(Light, cos_inner) == 60, "Light.cos_inner");
 _Static_assert(offsetof(Texture, m) == 32, "Texture.m");

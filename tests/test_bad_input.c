@@ -77,7 +77,7 @@ static Status load(const char *path, Scene *s, Error *err)
         mtl_free(&lib);
         return st;
     }
-    static const char *const images[] = { ".png", ".bmp", ".tga", ".hdr", ".psd", ".ppm", ".pgm", ".jpg" };
+    static const char *const images[] = { ".png", ".bmp", ".tga", ".hdr", ".psd", ".ppm", ".pgm", ".jpg", ".exr" };
     for (size_t i = 0; i < sizeof images / sizeof images[0]; i++)
         if (has_suffix(path, images[i])) return texture_load_image(s, NULL, path, 0, 0, &index, err);
     return error_set(err, ST_INTERNAL, "no reader for %s: add one to tests/test_bad_input.c", path);

@@ -307,6 +307,7 @@ static void test_render_key_covers_every_scene_buffer(void)
     p->n_lights = p->n_textures = p->n_revsurfaces = 2;
     ds.n_materials = ds.n_shading = 2;
     ds.n_texels = ds.n_rev_points = 2;
+    ds.n_env_cdf = 2;
     CheckpointId base, changed;
     checkpoint_id(&ds, 4u, &base);
     for (unsigned i = 0; i < SCENE_BUF_COUNT; i++) {

@@ -337,7 +337,8 @@ static void test_layout(void)
                     offsetof(Material, roughness), offsetof(Material, k),
                     offsetof(Material, clearcoat_roughness), offsetof(Material, texture_rm),
                     offsetof(Material, normal_scale),
-                    sizeof(RevSurface), offsetof(RevSurface, axis_x), offsetof(RenderParams, n_revsurfaces) };
+                    sizeof(RevSurface), offsetof(RevSurface, axis_x), offsetof(RenderParams, n_revsurfaces),
+                    offsetof(RenderParams, bg_light) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);

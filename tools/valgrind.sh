@@ -3,10 +3,10 @@
 # the scalar device (the kernels compiled as C, several threads), PoCL (the OpenCL host
 # code, and the kernels PoCL compiles, running on clpt's buffers), an OBJ mesh, a PLY
 # mesh on its own, a classic scene with image textures (the whitted integrator), an
-# error path, and `clpt merge` of two parts (and one refused). Each must be clean: no
-# invalid access, no use of uninitialised memory, no definite or indirect leak outside
-# the OpenCL runtime (tools/sanitizers/valgrind.supp says what is suppressed there and
-# why).
+# environment map from a DWAB EXR (written back as an EXR with AOV channels), an error
+# path, and `clpt merge` of two parts (and one refused). Each must be clean: no invalid
+# access, no use of uninitialised memory, no definite or indirect leak outside the
+# OpenCL runtime (tools/sanitizers/valgrind.supp says what is suppressed there and why).
 #
 # Under valgrind the CPU reports fewer features (no AVX-512), so PoCL names the device
 # differently and compiles the kernels again, inside valgrind: about two minutes the
@@ -57,6 +57,9 @@ fi
 check ply-view 0 tests/data/models/bun_zipper_res4.ply --device scalar --threads 2 $small -o "$out/ply.png"
 check classic-textured 0 scenes/classic/textured.txt --device scalar --threads 2 $small -o "$out/classic.png"
 check pocl 0 scenes/cornell-box.scene --device cpu $small -o "$out/pocl.png"
+# an environment map read from a DWAB EXR (OpenEXR), written back as EXR with AOV channels
+check envmap-exr 0 tests/data/good/envmap-dwab.scene --device scalar --threads 2 $small -o "$out/envmap.exr" \
+    --aov normal,depth,albedo
 check bad-scene 3 tests/data/bad/not-a-number.scene --device scalar $small -o "$out/never.png"
 # --sample-range parts (rendered here without valgrind), then clpt merge under it, and a
 # merge refused for a gap (docs/distributed.md)

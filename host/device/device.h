@@ -46,6 +46,7 @@ typedef struct {
     uint n_shading;
     size_t n_texels;
     size_t n_rev_points;        /* floats: two per profile control point */
+    size_t n_env_cdf;
 } DeviceScene;
 #undef DEVICE_SCENE_FIELD_
 #undef DEVICE_SCENE_FIELD_MANY_

@@ -1,5 +1,6 @@
 /*
- * image_write.c — PNG/PPM/BMP/PFM encoding, written through atomic_file.h (temp file, rename).
+ * image_write.c — PNG/PPM/BMP/PFM/EXR/HDR encoding, written through atomic_file.h (temp file,
+ * rename).
  *
  * PNG compression is stb_image_write's (Debian's libstb); it hands us the finished file
  * in memory through a callback, so every byte on disk goes through our own checked writes.
@@ -7,8 +8,10 @@
 #include "io/image_write.h"
 
 #include "base/atomic_file.h"
+#include "io/exr.h"
 
 #include <errno.h>
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <stdint.h>
@@ -19,7 +22,7 @@
 
 #include <stb_image_write.h>
 
-#define SUPPORTED_EXTENSIONS ".png, .ppm, .pfm, .bmp"
+#define SUPPORTED_EXTENSIONS ".png, .ppm, .pfm, .bmp, .exr, .hdr"
 
 Status image_format_from_path(const char *path, ImageFormat *fmt, Error *err)
 {
@@ -34,6 +37,8 @@ Status image_format_from_path(const char *path, ImageFormat *fmt, Error *err)
     else if (strcasecmp(dot, ".ppm") == 0) *fmt = IMAGE_PPM;
     else if (strcasecmp(dot, ".pfm") == 0) *fmt = IMAGE_PFM;
     else if (strcasecmp(dot, ".bmp") == 0) *fmt = IMAGE_BMP;
+    else if (strcasecmp(dot, ".exr") == 0) *fmt = IMAGE_EXR;
+    else if (strcasecmp(dot, ".hdr") == 0) *fmt = IMAGE_HDR;
     else
         return error_set(err, ST_USAGE,
                          "cannot tell the image format of '%s': unsupported extension '%s' "
@@ -159,6 +164,74 @@ static Status write_pfm(AtomicFile *af, const float *rgb, unsigned w, unsigned h
     return ST_OK;
 }
 
+/* Radiance HDR through stb_image_write (RLE RGBE), after making every value one RGBE
+ * can hold (see image_write.h). */
+static Status write_hdr(AtomicFile *af, const float *rgb, unsigned w, unsigned h, Error *err)
+{
+    size_t n = (size_t)w * h * 3u;
+    float *safe = malloc(n * sizeof *safe);
+    if (!safe) return error_set(err, ST_INTERNAL, "cannot write '%s': out of memory", af->path);
+    for (size_t i = 0; i < n; i++) safe[i] = rgb[i] > 0.0f ? (rgb[i] <= FLT_MAX ? rgb[i] : FLT_MAX) : 0.0f;
+    errno = 0;
+    if (!stbi_write_hdr_to_func(png_sink, af, (int)w, (int)h, 3, safe)) {
+        if (!errno) errno = ENOMEM;
+        atomic_fail(af, "HDR encoding");
+    }
+    free(safe);
+    return ST_OK;
+}
+
+/* Encodes the EXR in memory first (OpenEXR writes at offsets), then writes it whole. */
+static Status write_exr(AtomicFile *af, const float *rgb, const ImageLayer *layers, size_t n_layers, unsigned w,
+                        unsigned h, int float32, Error *err)
+{
+    ExrChannel ch[3 + 3 * 8];
+    size_t n = 0;
+    static const char *const rgb_names[3] = { "R", "G", "B" };
+    for (int k = 0; k < 3; k++) ch[n++] = (ExrChannel){ rgb_names[k], rgb + k, 3u, 0 };
+    for (size_t l = 0; l < n_layers && l < 8; l++)
+        for (int k = 0; k < 3; k++)
+            if (layers[l].names[k]) ch[n++] = (ExrChannel){ layers[l].names[k], layers[l].rgb + k, 3u, 1 };
+    unsigned char *bytes;
+    size_t size;
+    Status st = exr_encode(ch, n, w, h, float32, &bytes, &size, err);
+    if (st) {
+        error_prefix(err, "cannot write '%s'", af->path);
+        return st;
+    }
+    atomic_write(af, bytes, size);
+    free(bytes);
+    return ST_OK;
+}
+
+/* Checks the size every format can take. */
+static Status image_check_size(const char *path, const float *rgb, unsigned width, unsigned height, Error *err)
+{
+    if (width == 0 || height == 0 || !rgb)
+        return error_set(err, ST_INTERNAL, "cannot write '%s': empty image (%ux%u)", path,
+                         width, height);
+    /* stb takes int sizes and an int row stride; PFM rows need w*12 bytes. */
+    if (width > (unsigned)(INT_MAX / 3) || height > (unsigned)INT_MAX ||
+        (size_t)width * height > SIZE_MAX / 12)
+        return error_set(err, ST_INTERNAL, "cannot write '%s': image too large (%ux%u)", path,
+                         width, height);
+    return ST_OK;
+}
+
+Status image_write_exr(const char *path, const float *rgb, const ImageLayer *layers, size_t n_layers, unsigned width,
+                       unsigned height, int float32, Error *err)
+{
+    Status st = image_check_size(path, rgb, width, height, err);
+    if (st != ST_OK) return st;
+    AtomicFile af;
+    if ((st = atomic_open(&af, path, "", err)) != ST_OK) return st;
+    if ((st = write_exr(&af, rgb, layers, n_layers, width, height, float32, err)) != ST_OK) {
+        atomic_abort(&af);
+        return st;
+    }
+    return atomic_commit(&af, err);
+}
+
 Status image_write(const char *path, const float *rgb, unsigned width, unsigned height,
                    Error *err)
 {
@@ -171,24 +244,17 @@ Status image_write_encoded(const char *path, const float *rgb, unsigned width, u
     ImageFormat fmt;
     Status st = image_format_from_path(path, &fmt, err);
     if (st != ST_OK) return st;
-    if (width == 0 || height == 0 || !rgb)
-        return error_set(err, ST_INTERNAL, "cannot write '%s': empty image (%ux%u)", path,
-                         width, height);
-    /* stb takes int sizes and an int row stride; PFM rows need w*12 bytes. */
-    if (width > (unsigned)(INT_MAX / 3) || height > (unsigned)INT_MAX ||
-        (size_t)width * height > SIZE_MAX / 12)
-        return error_set(err, ST_INTERNAL, "cannot write '%s': image too large (%ux%u)", path,
-                         width, height);
+    if ((st = image_check_size(path, rgb, width, height, err)) != ST_OK) return st;
 
     /* Encode before creating the temporary file: running out of memory then leaves no
      * trace on disk. */
     unsigned char *srgb = NULL;
     size_t count = (size_t)width * height * 3;
-    if (fmt != IMAGE_PFM) {
+    if (fmt == IMAGE_PNG || fmt == IMAGE_PPM || fmt == IMAGE_BMP) {
         srgb = malloc(count);
         if (!srgb) return error_set(err, ST_INTERNAL, "cannot write '%s': out of memory", path);
         for (size_t i = 0; i < count; i++)
-            srgb[i] = encoding == IMAGE_LINEAR ? image_to_linear8(rgb[i]) : image_to_srgb8(rgb[i]);
+            srgb[i] = (encoding & IMAGE_LINEAR) ? image_to_linear8(rgb[i]) : image_to_srgb8(rgb[i]);
     }
 
     AtomicFile af;
@@ -202,6 +268,8 @@ Status image_write_encoded(const char *path, const float *rgb, unsigned width, u
     case IMAGE_PPM: write_ppm(&af, srgb, width, height); break;
     case IMAGE_BMP: write_bmp(&af, srgb, width, height); break;
     case IMAGE_PFM: st = write_pfm(&af, rgb, width, height, err); break;
+    case IMAGE_HDR: st = write_hdr(&af, rgb, width, height, err); break;
+    case IMAGE_EXR: st = write_exr(&af, rgb, NULL, 0, width, height, (encoding & IMAGE_EXR_FLOAT) != 0, err); break;
     }
     free(srgb);
     if (st != ST_OK) {

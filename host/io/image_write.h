@@ -1,6 +1,8 @@
 /*
  * image_write.h — writing the final image: PNG, PPM and BMP (8-bit sRGB, or 8-bit linear
- * when asked) or PFM (linear float).
+ * when asked), or linear float: PFM, OpenEXR (half or 32-bit float channels, ZIP
+ * compressed; with the auxiliary images as extra channels: image_write_exr) and
+ * Radiance HDR (RGBE, through stb_image_write).
  *
  * The format follows the output path's extension. Every write is atomic: the data goes to
  * a temporary file in the target's folder, which is synced and then renamed over the
@@ -14,18 +16,32 @@
  * PFM stores the linear radiance unchanged, bit for bit — NaN, infinities and negative
  * values included — because it is the format for exact data: determinism tests compare
  * PFM files bitwise, and clamping there would hide the very values they look for.
+ * EXR stores the radiance as R, G, B (as halves, NaN and infinities included, unless
+ * IMAGE_EXR_FLOAT asks for floats: then bit for bit). HDR stores RGBE, which holds no
+ * negative or non-finite value: NaN and negative values become 0, infinities the
+ * largest float.
  */
 #ifndef CLPT_IMAGE_WRITE_H
 #define CLPT_IMAGE_WRITE_H
 
 #include "base/status.h"
 
-typedef enum { IMAGE_PNG, IMAGE_PPM, IMAGE_PFM, IMAGE_BMP } ImageFormat;
+#include <stddef.h>
 
-/* How 8-bit formats encode linear values. */
-typedef enum { IMAGE_SRGB, IMAGE_LINEAR } ImageEncoding;
+typedef enum { IMAGE_PNG, IMAGE_PPM, IMAGE_PFM, IMAGE_BMP, IMAGE_EXR, IMAGE_HDR } ImageFormat;
 
-/* The format named by path's extension (.png .ppm .pfm .bmp, any case). An unknown or
+/* How 8-bit formats encode linear values: IMAGE_SRGB or IMAGE_LINEAR, either with
+ * IMAGE_EXR_FLOAT or-ed in for 32-bit float EXR channels (else half). */
+typedef enum { IMAGE_SRGB = 0, IMAGE_LINEAR = 1, IMAGE_EXR_FLOAT = 2 } ImageEncoding;
+
+/* One named group of channels of a float image (an auxiliary image): `names` for up
+ * to three interleaved floats a pixel (NULL: that channel is left out). */
+typedef struct {
+    const char *names[3];
+    const float *rgb;          /* width * height * 3 floats, top row first */
+} ImageLayer;
+
+/* The format named by path's extension (.png .ppm .pfm .bmp .exr .hdr, any case). An unknown or
  * missing extension is ST_USAGE, with a message that lists the supported ones. */
 Status image_format_from_path(const char *path, ImageFormat *fmt, Error *err);
 
@@ -38,6 +54,12 @@ Status image_write(const char *path, const float *rgb, unsigned width, unsigned 
 /* The same with a choice of 8-bit encoding (PFM is always linear float). */
 Status image_write_encoded(const char *path, const float *rgb, unsigned width, unsigned height,
                            ImageEncoding encoding, Error *err);
+
+/* Writes an OpenEXR file (path must end in .exr): rgb as R, G, B, then each layer's
+ * named channels (as "normal.X", "Z", "albedo.R"), as halves or with float32 as
+ * 32-bit floats; atomically. Errors as image_write. */
+Status image_write_exr(const char *path, const float *rgb, const ImageLayer *layers, size_t n_layers, unsigned width,
+                       unsigned height, int float32, Error *err);
 
 /* The sRGB transfer function (IEC 61966-2-1) applied to a linear value: NaN and values
  * <= 0 give 0, values >= 1 give 1. */

@@ -428,14 +428,33 @@ static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-enum { BG_COLOR, BG_HORIZON, BG_ZENITH, BG_AMBIENT, BG_CUBE, BG_N };
+enum { BG_COLOR, BG_HORIZON, BG_ZENITH, BG_AMBIENT, BG_CUBE, BG_MAP_KEY, BG_INTENSITY, BG_ROTATE, BG_N };
 static const KeySpec background_keys[BG_N] = {
     [BG_COLOR] = {"color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [BG_HORIZON] = {"horizon", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [BG_ZENITH] = {"zenith", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [BG_AMBIENT] = {"ambient", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [BG_CUBE] = {"cubemap", VK_PATH, 0, 0, 0, 0, 0, NULL},
+    [BG_MAP_KEY] = {"map", VK_PATH, 0, 0, 0, 0, 0, NULL},
+    [BG_INTENSITY] = {"intensity", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
+    [BG_ROTATE] = {"rotate", VK_NUMBER, 0, -1e6, 1e6, 0, 0, "a number of degrees in [-1e6, 1e6]"},
 };
+
+/* `map "FILE"`: an equirectangular environment map (kernels/envmap.h), the file found
+ * beside the scene file, a high-dynamic-range image (.hdr, .exr). */
+static Status parse_background_map(Parser *p, Lexer *lx, const Value *v)
+{
+    const Token *f = &v[BG_MAP_KEY].word;
+    char *path = path_beside(lx->path, f->text, f->len);
+    if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
+    uint tex;
+    Status st = texture_load_image(p->s, NULL, path, 1, 0, &tex, p->err);
+    free(path);
+    if (!st) st = scene_set_envmap(p->s, tex, v[BG_INTENSITY].given ? v[BG_INTENSITY].f : 1.0f,
+                                   v[BG_ROTATE].given ? v[BG_ROTATE].f : 0.0f, p->err);
+    if (st == ST_IO || st == ST_INPUT) error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+    return st;
+}
 
 /* `cubemap "DIR"`: the classic format's cube map (six images, the MIT 6.837 course's
  * names and orientation; host/io/texture.c), the folder found beside the scene file. */
@@ -463,6 +482,16 @@ static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
     Scene *s = p->s;
     if (v[BG_AMBIENT].given) s->ambient = v[BG_AMBIENT].v;   /* the whitted integrator's */
     int sky = v[BG_HORIZON].given || v[BG_ZENITH].given;
+    if (!v[BG_MAP_KEY].given && (v[BG_INTENSITY].given || v[BG_ROTATE].given)) {
+        const Token *t = v[BG_INTENSITY].given ? &v[BG_INTENSITY].key : &v[BG_ROTATE].key;
+        return lex_error_at(lx, t, p->err, "'%s' belongs to an environment map: the background block needs 'map'",
+                            v[BG_INTENSITY].given ? "intensity" : "rotate");
+    }
+    if (v[BG_MAP_KEY].given && (v[BG_COLOR].given || sky || v[BG_CUBE].given))
+        return lex_error_at(lx, &v[BG_MAP_KEY].key, p->err,
+                            "a background is either 'map', 'cubemap' or a colour ('color', or 'horizon' and "
+                            "'zenith'), not several");
+    if (v[BG_MAP_KEY].given) return parse_background_map(p, lx, v);
     if (v[BG_CUBE].given && (v[BG_COLOR].given || sky))
         return lex_error_at(lx, &v[BG_CUBE].key, p->err,
                             "a background is either 'cubemap' or a colour ('color', or 'horizon' and "
@@ -480,7 +509,7 @@ static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
     if (!v[BG_COLOR].given && !sky)
         return lex_error_at(lx, kw, p->err,
                             "the background block needs 'color', or 'horizon' and 'zenith', "
-                            "or 'cubemap'");
+                            "or 'cubemap', or 'map'");
     if (sky && !(v[BG_HORIZON].given && v[BG_ZENITH].given))
         return lex_error_at(lx, kw, p->err, "a sky background needs both 'horizon' and 'zenith'");
     if (sky) {

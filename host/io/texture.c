@@ -2,6 +2,7 @@
 #include "io/texture.h"
 
 #include "base/limit.h"
+#include "io/exr.h"
 #include "io/lexer.h"
 
 #include <ctype.h>
@@ -333,6 +334,33 @@ static Status data_check(const char *path, int w, int h, Error *err)
     return st;
 }
 
+/* Whether the file at `path` starts with the OpenEXR magic number. */
+static Status texture_add_read(Scene *s, const char *name, const char *path, Texture t, uint *texels, size_t n,
+                               int w, int h, int clamp, uint *index, Error *err);
+
+static int file_is_exr(const char *path)
+{
+    unsigned char head[4];
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    size_t n = fread(head, 1, sizeof head, f);
+    fclose(f);
+    return exr_is_exr(head, n);
+}
+
+/* An EXR image as float texels (3 floats a texel, as uint bits). */
+static Status texture_read_exr(const char *path, uint **texels, size_t *n, int *w, int *h, Error *err)
+{
+    float *rgb = NULL;
+    Status st = exr_read_rgb(path, CLPT_MAX_TEXTURE_PIXELS, &rgb, w, h, err);
+    if (st) return st;
+    *n = (size_t)*w * (size_t)*h * 3u;
+    *texels = malloc(*n * sizeof **texels);
+    if (*texels) memcpy(*texels, rgb, *n * sizeof **texels);   /* float bits as uint */
+    free(rgb);
+    return *texels ? ST_OK : error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+}
+
 Status texture_load_image(Scene *s, const char *name, const char *path, int linear, int clamp,
                           uint *index, Error *err)
 {
@@ -353,6 +381,14 @@ Status texture_load_image(Scene *s, const char *name, const char *path, int line
     Status fst = lex_check_file(path, err);
     if (fst) return fst;
     int w = 0, h = 0, channels = 0;
+    uint *texels = NULL;
+    size_t n = 0;
+    if (file_is_exr(path)) {
+        Status est = texture_read_exr(path, &texels, &n, &w, &h, err);
+        if (est) return est;
+        t.flags = TEX_FLOAT;
+        return texture_add_read(s, name, path, t, texels, n, w, h, clamp, index, err);
+    }
     Status pst = pnm_check(path, err);
     if (!pst) pst = png_check(path, err);
     if (pst) return pst;
@@ -363,8 +399,6 @@ Status texture_load_image(Scene *s, const char *name, const char *path, int line
         return error_set(err, ST_INPUT, "'%s': a %dx%d image is larger than the textures clpt "
                          "reads (at most %u pixels, as in 8192x8192)", path, w, h, CLPT_MAX_TEXTURE_PIXELS);
     if (known && (pst = data_check(path, w, h, err))) return pst;
-    uint *texels = NULL;
-    size_t n = 0;
     if (stbi_is_hdr(path)) {
         float *data = stbi_loadf(path, &w, &h, &channels, 3);
         if (!data)
@@ -388,6 +422,13 @@ Status texture_load_image(Scene *s, const char *name, const char *path, int line
         t.flags = encoding;
     }
     if (!texels) return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+    return texture_add_read(s, name, path, t, texels, n, w, h, clamp, index, err);
+}
+
+/* Adds the texels just read (taking them: freed here) and the texture over them. */
+static Status texture_add_read(Scene *s, const char *name, const char *path, Texture t, uint *texels, size_t n,
+                               int w, int h, int clamp, uint *index, Error *err)
+{
     if (w <= 0 || h <= 0) {
         free(texels);
         return error_set(err, ST_INPUT, "'%s': the image is empty", path);

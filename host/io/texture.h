@@ -1,7 +1,7 @@
 /*
  * texture.h — textures for the scene (kernels/texture.h evaluates them): image files
- * read through Debian's stb_image (PNG, JPEG, BMP, TGA, GIF, PSD, PNM and Radiance HDR),
- * and checkerboards.
+ * read through Debian's stb_image (PNG, JPEG, BMP, TGA, GIF, PSD, PNM and Radiance HDR)
+ * and OpenEXR (any compression; host/io/exr.h), and checkerboards.
  *
  * An image's texels are stored once per (file, colour encoding) however many textures
  * use it: each texture record only adds its own wrap mode and (u, v) transform.

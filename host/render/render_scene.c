@@ -34,6 +34,10 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     p->bg_color = s->bg_color;
     p->bg_zenith = s->bg_zenith;
     p->bg_cubemap = s->bg_cubemap;
+    double rot = fmod((double)s->bg_rotate, 360.0) * (M_PI / 180.0);
+    p->bg_rot_cos = (float)cos(rot);
+    p->bg_rot_sin = (float)sin(rot);
+    p->bg_light = s->env_light;
     p->width = s->image.width;
     p->height = s->image.height;
     p->max_depth = s->image.max_depth;
@@ -69,7 +73,7 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     p->ambient = s->ambient;
     p->integrator = s->integrator;
     p->mis_mode = MIS_BOTH;
-    p->n_area_lights = (uint)(s->n_lights - s->n_delta_lights);
+    p->n_area_lights = (uint)(s->n_lights - s->n_delta_lights - (s->env_light != NO_INDEX ? 1u : 0u));
     p->n_textures = (uint)s->n_textures;
     p->use_mask = 0;
     p->strata = render_scene_strata(s->image.spp);
@@ -79,6 +83,8 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     out->ds.textures = s->textures;
     out->ds.texels = s->texels;
     out->ds.n_texels = s->n_texels;
+    out->ds.env_cdf = s->env_cdf;
+    out->ds.n_env_cdf = s->n_env_cdf;
     out->ds.pixel_mask = NULL;
     return ST_OK;
 }

@@ -1,6 +1,8 @@
 /* scene.c — scene storage, material helpers and the light list. */
 #include "scene/scene.h"
 
+#include "scene/env_dist.h"
+
 #include "kmath.h"
 
 #include <math.h>
@@ -27,6 +29,7 @@ void scene_init(Scene *s)
     s->bg_type = BG_CONSTANT;
     s->bg_color = v3(0.0f, 0.0f, 0.0f);
     s->bg_zenith = v3(0.0f, 0.0f, 0.0f);
+    s->env_light = NO_INDEX;
     s->camera.type = CAMERA_PERSPECTIVE;
     s->camera.ortho_height = 1.0f;
     s->ambient = v3(0.0f, 0.0f, 0.0f);
@@ -59,6 +62,7 @@ void scene_free(Scene *s)
     free(s->texture_sources);
     free(s->textures);
     free(s->texels);
+    free(s->env_cdf);
     free(s->path);
     for (size_t i = 0; i < s->n_warnings; i++) free(s->warnings[i]);
     free(s->warnings);
@@ -537,12 +541,43 @@ static double delta_light_power(const Light *l, double r)
     return atten > 0.0 ? solid_angle * r * r * lum / atten : 0.0;
 }
 
+Status scene_set_envmap(Scene *s, uint texture, float intensity, float rotate, Error *err)
+{
+    const Texture *t = &s->textures[texture];
+    if (!(t->flags & TEX_FLOAT))
+        return error_set(err, ST_INPUT, "'%s': an environment map must be a high-dynamic-range image (.hdr or "
+                         ".exr)", s->texture_sources[texture] ? s->texture_sources[texture] : "");
+    float *cdf;
+    size_t n;
+    double mean;
+    Status st = env_dist_build(s->texels + t->offset, t->width, t->height, &cdf, &n, &mean, err);
+    if (st) return st;
+    free(s->env_cdf);
+    s->env_cdf = cdf;
+    s->n_env_cdf = n;
+    s->env_mean = mean * (double)intensity;
+    if (!(intensity > 0.0f)) {
+        /* a black map is no light */
+        free(s->env_cdf);
+        s->env_cdf = NULL;
+        s->n_env_cdf = 0;
+    }
+    s->bg_type = BG_MAP;
+    s->bg_cubemap = texture;
+    s->bg_color = v3s(intensity);
+    s->bg_zenith = v3s(intensity);
+    s->bg_rotate = rotate;
+    return ST_OK;
+}
+
 Status scene_prepare_lights(Scene *s, Error *err)
 {
     free(s->lights);
     s->lights = NULL;
     s->n_lights = 0;
-    size_t n = 0;
+    s->env_light = NO_INDEX;
+    int env = s->bg_type == BG_MAP && s->n_env_cdf > 0;
+    size_t n = (size_t)env;
     for (size_t i = 0; i < s->n_spheres; i++) n += (size_t)is_emissive(s, s->spheres[i].material);
     for (size_t i = 0; i < s->n_triangles; i++) n += (size_t)is_emissive(s, s->triangles[i].material);
     for (size_t i = 0; i < s->n_boxes; i++) n += (size_t)is_emissive(s, s->boxes[i].material);
@@ -574,13 +609,21 @@ Status scene_prepare_lights(Scene *s, Error *err)
     ADD_LIGHT(s->triangles, s->n_triangles, scene_first_triangle(s), triangle_area(&s->triangles[i]))
     ADD_LIGHT(s->boxes, s->n_boxes, scene_first_box(s), box_area(&s->boxes[i]))
 #undef ADD_LIGHT
-    double radius = s->n_delta_lights ? scene_radius(s) : 1.0;
+    double radius = s->n_delta_lights || env ? scene_radius(s) : 1.0;
     for (size_t i = 0; i < s->n_delta_lights; i++, k++) {
         lights[k] = s->delta_lights[i];
         lights[k].prim = NO_INDEX;
         power[k] = delta_light_power(&s->delta_lights[i], radius);
         if (!(power[k] >= 0.0) || !isfinite(power[k])) power[k] = 0.0;
         total += power[k];
+    }
+    if (env) {
+        lights[k].type = LIGHT_ENV;
+        lights[k].prim = NO_INDEX;
+        power[k] = M_PI * s->env_mean * 4.0 * M_PI * radius * radius;
+        if (!(power[k] >= 0.0) || !isfinite(power[k])) power[k] = 0.0;
+        total += power[k];
+        s->env_light = (uint)k++;
     }
     /* Degenerate or black lights get zero power; if all are, choose uniformly so the
      * distribution stays valid. */

@@ -37,7 +37,12 @@ typedef struct {
     SceneImage image;
     uint bg_type;                /* enum BackgroundType */
     vec3 bg_color, bg_zenith;
-    uint bg_cubemap;             /* BG_CUBEMAP: index of the first of its six textures */
+    uint bg_cubemap;             /* BG_CUBEMAP: index of the first of its six textures;
+                                  * BG_MAP: the map's texture (scene_set_envmap) */
+    float bg_rotate;             /* BG_MAP: degrees about +y */
+    float *env_cdf;  size_t n_env_cdf;   /* BG_MAP: its distribution (kernels/envmap.h) */
+    double env_mean;             /* BG_MAP: mean luminance over the sphere, scaled */
+    uint env_light;              /* its light in `lights`, or NO_INDEX (scene_prepare_lights) */
 
     Material *materials;   char **material_names;  size_t n_materials, cap_materials;
     /* Per material: the albedo texture file a mesh's MTL names (map_Kd, resolved to a
@@ -131,11 +136,21 @@ uint scene_first_box(const Scene *s);
 uint scene_first_revsurface(const Scene *s);
 uint scene_first_plane(const Scene *s);
 
+/* Makes image texture `texture` (float texels: an HDR or EXR image) the background, an
+ * environment map (kernels/envmap.h) scaled by `intensity` and turned by `rotate`
+ * degrees about +y, and builds its sampling distribution. ST_INPUT "'SOURCE': an
+ * environment map must be a high-dynamic-range image (.hdr or .exr)" for 8-bit texels;
+ * otherwise fails only when memory runs out. */
+Status scene_set_envmap(Scene *s, uint texture, float intensity, float rotate, Error *err);
+
 /* Builds the light list: the emissive spheres, triangles and boxes (area lights), then
- * the delta lights, with a choice probability proportional to each light's estimated
- * power (area lights: pi x area x luminance of the emission; point and spot lights: the
- * power through a sphere of the scene's radius around them; directional lights: the
- * power through a disc of the scene's radius), and sets each primitive's `light`. */
+ * the delta lights, then the environment map when the background is one with light in
+ * it, with a choice probability proportional to each light's estimated power (area
+ * lights: pi x area x luminance of the emission; point and spot lights: the power
+ * through a sphere of the scene's radius around them; directional lights: the power
+ * through a disc of the scene's radius; the environment map: pi x its mean luminance x
+ * the area 4 pi r^2 of a sphere of the scene's radius, as an area light of that size
+ * shining inward), and sets each primitive's `light` and `env_light`. */
 Status scene_prepare_lights(Scene *s, Error *err);
 
 /* Refuses (ST_INPUT, naming `s->path` and the shape) what single precision cannot

@@ -1,0 +1,117 @@
+/*
+ * envmap.h — the environment map: an equirectangular (latitude-longitude) image of the
+ * radiance arriving from every direction, seen by rays that escape the scene, and a
+ * light that next-event estimation samples in proportion to its pixels' luminance x
+ * sin(theta) (the piecewise-constant 2D distribution of pbrt-v3's InfiniteAreaLight
+ * and Mitsuba 3's envmap, built on the host: host/scene/envmap.c).
+ *
+ * Orientation (Mitsuba 3's envmap, in the map's own frame): the first row is straight
+ * up (+y), the last straight down; with phi = 2 pi u, theta = pi v (u from the left
+ * edge, v from the top), a pixel's direction is
+ *
+ *     (sin(theta) sin(phi), cos(theta), -sin(theta) cos(phi))
+ *
+ * so u = 0 (the left and right edges) looks along -z, u = 1/4 along +x, u = 1/2 (the
+ * centre column) along +z, u = 3/4 along -x. `rotate A` turns the map by A degrees
+ * about +y, right-handed (+z toward +x): world = R_y(A) map.
+ *
+ * Lookups are nearest-texel, so what a ray sees is exactly the piecewise-constant
+ * function the sampler's density follows (the distribution of a pixel's light is the
+ * pixel itself, not a blend of its neighbours).
+ *
+ * The distribution (RenderParams.bg_light != NO_INDEX; scene buffer env_cdf), for a
+ * W x H map: the marginal cdf over rows, H + 1 floats from 0 to 1, then per row j the
+ * conditional cdf over its pixels, W + 1 floats at H + 1 + j (W + 1). A pixel's
+ * probability is the product of the two cdf steps, its density in (u, v) that times
+ * W H, and in solid angle that over 2 pi^2 sin(theta).
+ * Valid C11 and OpenCL C 1.2.
+ */
+#ifndef CLPT_ENVMAP_H
+#define CLPT_ENVMAP_H
+
+#include "texture.h"
+
+/* Direction d (any length) in the map's frame: the world turned back by the rotation. */
+KFN vec3 env_to_map(GLOBAL const RenderParams *p, vec3 d)
+{
+    float c = p->bg_rot_cos, s = p->bg_rot_sin;
+    return v3(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
+}
+
+/* The pixel (x, y) of a W x H map a direction falls in, and sin(theta) of the
+ * direction. theta and sin(theta) come from the distance to the y axis, not from
+ * cos(theta), which rounds to 1 within 3e-4 radians of the poles (a sample there would
+ * get density 0). NaN and infinite components land in a valid pixel. */
+KFN void env_pixel(GLOBAL const RenderParams *p, Texture tx, vec3 d, uint *x, uint *y, float *sin_theta)
+{
+    vec3 m = env_to_map(p, d);
+    float r = k_sqrt(m.x * m.x + m.z * m.z), len = v3_len(m);
+    float u = k_atan2(m.x, -m.z) * (1.0f / K_TWO_PI);
+    if (u < 0.0f) u += 1.0f;
+    float v = k_atan2(r, m.y) * K_INV_PI;
+    *x = (uint)k_clamp(u * (float)tx.width, 0.0f, (float)tx.width - 1.0f);
+    *y = (uint)k_clamp(v * (float)tx.height, 0.0f, (float)tx.height - 1.0f);
+    *sin_theta = len > 0.0f ? r / len : 0.0f;
+}
+
+/* The radiance the map sends along -d toward the scene, from direction d. */
+KFN vec3 env_radiance(const SceneView *sc, vec3 d)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    Texture tx = sc->textures[p->bg_cubemap];
+    uint x, y;
+    float st;
+    env_pixel(p, tx, d, &x, &y, &st);
+    return v3_mul(texel_fetch(sc, tx, x, y), p->bg_color);
+}
+
+/* The solid-angle density with which env_sample picks direction d (any length). */
+KFN float env_pdf(const SceneView *sc, vec3 d)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    Texture tx = sc->textures[p->bg_cubemap];
+    uint x, y;
+    float sin_t;
+    env_pixel(p, tx, d, &x, &y, &sin_t);
+    if (!(sin_t > 0.0f)) return 0.0f;
+    GLOBAL const float *marg = sc->env_cdf;
+    GLOBAL const float *cond = marg + tx.height + 1u + y * (tx.width + 1u);
+    float p_uv = (marg[y + 1u] - marg[y]) * (float)tx.height * ((cond[x + 1u] - cond[x]) * (float)tx.width);
+    return p_uv / (2.0f * K_PI * K_PI * sin_t);
+}
+
+/* The cell i in [0, n) of cdf[0..n] (cdf[0] = 0, cdf[n] = 1) holding u in [0, 1): the
+ * last i with cdf[i] <= u, which skips cells of zero probability; *frac receives u's
+ * place within it, in [0, 1). */
+KFN uint env_cdf_find(GLOBAL const float *cdf, uint n, float u, float *frac)
+{
+    uint lo = 0u, hi = n - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi + 1u) >> 1;
+        if (cdf[mid] <= u) lo = mid; else hi = mid - 1u;
+    }
+    float step = cdf[lo + 1u] - cdf[lo];
+    *frac = step > 0.0f ? k_clamp((u - cdf[lo]) / step, 0.0f, 0.99999994f) : 0.5f;
+    return lo;
+}
+
+/* A direction drawn from the map's distribution with (u1, u2) in [0, 1)^2: a row by
+ * the marginal cdf, a pixel in it by the row's cdf, a uniform point in the pixel's
+ * (u, v) rectangle. Returns the unit direction in the world. */
+KFN vec3 env_sample_dir(const SceneView *sc, float u1, float u2)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    Texture tx = sc->textures[p->bg_cubemap];
+    float fy, fx;
+    uint y = env_cdf_find(sc->env_cdf, tx.height, u1, &fy);
+    uint x = env_cdf_find(sc->env_cdf + tx.height + 1u + y * (tx.width + 1u), tx.width, u2, &fx);
+    float u = ((float)x + fx) / (float)tx.width, v = ((float)y + fy) / (float)tx.height;
+    float st, ct, sp, cp;
+    k_sincos(K_PI * v, &st, &ct);
+    k_sincos(K_TWO_PI * u, &sp, &cp);
+    vec3 m = v3(st * sp, ct, -st * cp);
+    float c = p->bg_rot_cos, s = p->bg_rot_sin;
+    return v3(c * m.x + s * m.z, m.y, c * m.z - s * m.x);
+}
+
+#endif /* CLPT_ENVMAP_H */

@@ -1,0 +1,261 @@
+/*
+ * test_exr.c — the float outputs: EXR written by clpt (host/io/image_write.c through
+ * OpenEXRCore) read back with the OpenEXR library's other reader, channel by channel:
+ * the same floats (32-bit: bit for bit; half: within half precision, NaN and infinities
+ * kept); the auxiliary channels of `clpt --aov` in one file; Radiance HDR read back with
+ * stb_image within RGBE's precision. Run from the project root.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <ImfCRgbaFile.h>
+#include <openexr.h>
+#include <stb_image.h>
+
+#include "cli_util.h"
+#include "harness.h"
+#include "io/image_write.h"
+
+enum { W = 37, H = 21 };   /* odd sizes: a partial last chunk, rows of odd length */
+
+/* Reads channel `name` of the EXR at path as floats (w x h), through OpenEXRCore's
+ * decoder, or returns NULL when the file or the channel is not there. */
+static float *read_channel(const char *path, const char *name, int *w, int *h)
+{
+    exr_context_t ctxt = NULL;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    if (exr_start_read(&ctxt, path, &init) != EXR_ERR_SUCCESS) return NULL;
+    exr_attr_box2i_t dw;
+    const exr_attr_chlist_t *ch = NULL;
+    int lines = 0, found = -1;
+    float *out = NULL;
+    if (exr_get_data_window(ctxt, 0, &dw) || exr_get_channels(ctxt, 0, &ch) ||
+        exr_get_scanlines_per_chunk(ctxt, 0, &lines))
+        goto done;
+    for (int i = 0; i < ch->num_channels; i++)
+        if (strcmp(ch->entries[i].name.str, name) == 0) found = i;
+    if (found < 0) goto done;
+    *w = dw.max.x - dw.min.x + 1;
+    *h = dw.max.y - dw.min.y + 1;
+    out = malloc((size_t)*w * (size_t)*h * sizeof *out);
+    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
+    int started = 0, ok = 1;
+    for (int y = dw.min.y; y <= dw.max.y && ok; y += lines) {
+        exr_chunk_info_t ci;
+        ok = exr_read_scanline_chunk_info(ctxt, 0, y, &ci) == EXR_ERR_SUCCESS &&
+             (started ? exr_decoding_update(ctxt, 0, &ci, &dec) : exr_decoding_initialize(ctxt, 0, &ci, &dec)) ==
+                 EXR_ERR_SUCCESS;
+        if (!ok) break;
+        started = 1;
+        for (int c = 0; c < dec.channel_count; c++) dec.channels[c].decode_to_ptr = NULL;
+        exr_coding_channel_info_t *cc = &dec.channels[found];
+        cc->decode_to_ptr = (uint8_t *)(out + (size_t)(ci.start_y - dw.min.y) * (size_t)*w);
+        cc->user_pixel_stride = sizeof(float);
+        cc->user_line_stride = *w * (int32_t)sizeof(float);
+        cc->user_data_type = EXR_PIXEL_FLOAT;
+        cc->user_bytes_per_element = sizeof(float);
+        ok = exr_decoding_choose_default_routines(ctxt, 0, &dec) == EXR_ERR_SUCCESS &&
+             exr_decoding_run(ctxt, 0, &dec) == EXR_ERR_SUCCESS;
+    }
+    if (started) exr_decoding_destroy(ctxt, &dec);
+    if (!ok) {
+        free(out);
+        out = NULL;
+    }
+done:
+    exr_finish(&ctxt);
+    return out;
+}
+
+/* The pixel type of channel `name` (EXR_PIXEL_HALF ...), or -1. */
+static int channel_type(const char *path, const char *name)
+{
+    exr_context_t ctxt = NULL;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    if (exr_start_read(&ctxt, path, &init) != EXR_ERR_SUCCESS) return -1;
+    const exr_attr_chlist_t *ch = NULL;
+    int type = -1;
+    if (exr_get_channels(ctxt, 0, &ch) == EXR_ERR_SUCCESS)
+        for (int i = 0; i < ch->num_channels; i++)
+            if (strcmp(ch->entries[i].name.str, name) == 0) type = (int)ch->entries[i].pixel_type;
+    exr_finish(&ctxt);
+    return type;
+}
+
+/* Values over the range an image holds: ordinary radiance, tiny and huge values,
+ * negatives, zero; NaN and infinities at a few pixels. */
+static float *test_values(int special)
+{
+    float *rgb = malloc(W * H * 3 * sizeof *rgb);
+    for (int i = 0; i < W * H * 3; i++) rgb[i] = (float)((i * 7919) % 1000) / 37.0f - 3.0f;
+    rgb[5] = 1e-5f;
+    rgb[6] = 60000.0f;
+    rgb[7] = 0.0f;
+    if (special) {
+        rgb[9] = NAN;
+        rgb[10] = INFINITY;
+        rgb[11] = -INFINITY;
+    }
+    return rgb;
+}
+
+static float half_round(float f)
+{
+    ImfHalf h;
+    ImfFloatToHalf(f, &h);
+    return ImfHalfToFloat(h);
+}
+
+static void check_exr(int float32)
+{
+    char path[] = "/tmp/clpt-test-exr-XXXXXX.exr";
+    int fd = mkstemps(path, 4);
+    CHECK(fd >= 0);
+    close(fd);
+    float *rgb = test_values(1);
+    float albedo[W * H * 3];
+    for (int i = 0; i < W * H * 3; i++) albedo[i] = (float)i / (W * H * 3);
+    ImageLayer layer = { { "albedo.R", "albedo.G", NULL }, albedo };
+    Error err = { 0 };
+    CHECK_MSG(image_write_exr(path, rgb, &layer, 1, W, H, float32, &err) == ST_OK, "%s", err.msg);
+    const char *names[5] = { "R", "G", "B", "albedo.R", "albedo.G" };
+    uint exact = 0, close_enough = 0;
+    for (int c = 0; c < 5; c++) {
+        int w = 0, h = 0;
+        float *got = read_channel(path, names[c], &w, &h);
+        CHECK_MSG(got != NULL, "channel %s missing", names[c]);
+        if (!got) continue;
+        CHECK_EQ_INT(w, W);
+        CHECK_EQ_INT(h, H);
+        CHECK_EQ_INT(channel_type(path, names[c]), float32 ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF);
+        const float *src = c < 3 ? rgb + c : albedo + (c - 3);
+        for (int i = 0; i < W * H; i++) {
+            float want = float32 ? src[3 * i] : half_round(src[3 * i]);
+            int same = memcmp(&want, &got[i], sizeof want) == 0 || (isnan(want) && isnan(got[i]));
+            exact += same;
+            close_enough += same || fabsf(got[i] - src[3 * i]) <= fabsf(src[3 * i]) * (1.0f / 1024.0f);
+        }
+        free(got);
+    }
+    CHECK(read_channel(path, "albedo.B", &(int){ 0 }, &(int){ 0 }) == NULL);
+    fprintf(stderr, "  %s EXR: %u of %u values read back as written (%s), %u within half precision\n",
+            float32 ? "32-bit float" : "half", exact, 5u * W * H, float32 ? "bit for bit" : "as rounded to half",
+            close_enough);
+    CHECK_EQ_INT(exact, 5 * W * H);
+    unlink(path);
+    free(rgb);
+    error_clear(&err);
+}
+
+static void test_exr_half(void) { check_exr(0); }
+static void test_exr_float(void) { check_exr(1); }
+
+/* -o x.exr through image_write_encoded: R, G, B only, half unless IMAGE_EXR_FLOAT. */
+static void test_exr_encoded(void)
+{
+    char path[] = "/tmp/clpt-test-exr-XXXXXX.exr";
+    int fd = mkstemps(path, 4);
+    close(fd);
+    float *rgb = test_values(0);
+    Error err = { 0 };
+    CHECK(image_write_encoded(path, rgb, W, H, (ImageEncoding)(IMAGE_SRGB | IMAGE_EXR_FLOAT), &err) == ST_OK);
+    int w, h;
+    float *g = read_channel(path, "G", &w, &h);
+    CHECK(g != NULL);
+    for (int i = 0; g && i < W * H; i++) CHECK(g[i] == rgb[3 * i + 1]);
+    free(g);
+    CHECK_EQ_INT(channel_type(path, "A"), -1);
+    CHECK(image_write_encoded(path, rgb, W, H, IMAGE_SRGB, &err) == ST_OK);
+    CHECK_EQ_INT(channel_type(path, "R"), EXR_PIXEL_HALF);
+    unlink(path);
+    free(rgb);
+}
+
+/* Radiance HDR: read back by stb_image within RGBE's precision (8 bits of mantissa
+ * shared: 1/128 of the largest component); negative and NaN values come back 0. */
+static void test_hdr(void)
+{
+    char path[] = "/tmp/clpt-test-hdr-XXXXXX.hdr";
+    int fd = mkstemps(path, 4);
+    close(fd);
+    float *rgb = test_values(0);
+    rgb[12] = NAN;
+    Error err = { 0 };
+    CHECK_MSG(image_write(path, rgb, W, H, &err) == ST_OK, "%s", err.msg);
+    int w = 0, h = 0, c = 0;
+    float *got = stbi_loadf(path, &w, &h, &c, 3);
+    CHECK(got != NULL);
+    CHECK_EQ_INT(w, W);
+    CHECK_EQ_INT(h, H);
+    uint bad = 0;
+    for (int i = 0; got && i < W * H; i++) {
+        float m = 0.0f;
+        for (int k = 0; k < 3; k++) m = fmaxf(m, rgb[3 * i + k] > 0.0f ? rgb[3 * i + k] : 0.0f);
+        for (int k = 0; k < 3; k++) {
+            float want = rgb[3 * i + k] > 0.0f ? rgb[3 * i + k] : 0.0f;
+            if (fabsf(got[3 * i + k] - want) > m / 128.0f + 1e-30f) bad++;
+        }
+    }
+    CHECK_EQ_INT(bad, 0);
+    stbi_image_free(got);
+    unlink(path);
+    free(rgb);
+}
+
+/* clpt -o x.exr --aov normal,depth,albedo: one file with R G B, normal.X/Y/Z (unit
+ * where the sphere covers a pixel, 0 where nothing does), Z (the distance) and
+ * albedo.R/G/B; no separate auxiliary files. */
+static void test_cli_aov_channels(void)
+{
+    char dir[] = "/tmp/clpt-test-exr-cli-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char scene[256], out[256], cmd[1024];
+    snprintf(scene, sizeof scene, "%s/s.scene", dir);
+    snprintf(out, sizeof out, "%s/out.exr", dir);
+    FILE *f = fopen(scene, "w");
+    fputs("image { width 16 height 12 spp 4 }\n"
+          "camera { from 0 0 5 at 0 0 0 fov 30 }\n"
+          "background { color 0.5 0.6 0.7 }\n"
+          "sphere { center 0 0 0 radius 1 material { type diffuse albedo 0.25 0.5 0.75 } }\n", f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "%s %s -q --device scalar -o %s --aov normal,depth,albedo --exr-float", CLI_PROGRAM, scene,
+             out);
+    CHECK_EQ_INT(system(cmd), 0);
+    int w = 0, h = 0;
+    float *nx = read_channel(out, "normal.X", &w, &h), *ny = read_channel(out, "normal.Y", &w, &h),
+          *nz = read_channel(out, "normal.Z", &w, &h), *z = read_channel(out, "Z", &w, &h),
+          *ar = read_channel(out, "albedo.R", &w, &h), *ab = read_channel(out, "albedo.B", &w, &h),
+          *r = read_channel(out, "R", &w, &h);
+    CHECK(nx && ny && nz && z && ar && ab && r);
+    if (nx && ny && nz && z && ar && ab && r) {
+        int c = (h / 2) * w + w / 2;   /* the centre: the sphere's front, facing the camera */
+        fprintf(stderr, "  centre pixel: normal %.3f %.3f %.3f, Z %.4f, albedo %.3f .. %.3f; corner normal %g, Z %g\n",
+                (double)nx[c], (double)ny[c], (double)nz[c], (double)z[c], (double)ar[c], (double)ab[c],
+                (double)nx[0], (double)z[0]);
+        CHECK(nz[c] > 0.95f && fabsf(nx[c]) < 0.2f && fabsf(ny[c]) < 0.2f);
+        CHECK_NEAR(z[c], 4.0, 0.02);
+        CHECK_NEAR(ar[c], 0.25, 1e-6);
+        CHECK_NEAR(ab[c], 0.75, 1e-6);
+        CHECK(nx[0] == 0.0f && ny[0] == 0.0f && nz[0] == 0.0f && z[0] == 0.0f);
+        CHECK(r[0] > 0.49f && r[0] < 0.51f);
+    }
+    free(nx); free(ny); free(nz); free(z); free(ar); free(ab); free(r);
+    char other[300];
+    snprintf(other, sizeof other, "%s/out-normal.exr", dir);
+    CHECK(access(other, F_OK) != 0);
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    CHECK_EQ_INT(system(cmd), 0);
+}
+
+int main(void)
+{
+    RUN(test_exr_half);
+    RUN(test_exr_float);
+    RUN(test_exr_encoded);
+    RUN(test_hdr);
+    RUN(test_cli_aov_channels);
+    return harness_report();
+}

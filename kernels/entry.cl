@@ -20,6 +20,7 @@
 #include "raygen.cl"
 #include "shade.cl"
 #include "traverse.cl"
+#include "alpha.h"
 #include "whitted.cl"
 
 /* The scene buffers as __kernel parameters, one per line of scene_buffers.h, each
@@ -53,7 +54,7 @@ __kernel void k_intersect(SCENE_ARGS __global const uint *queue, uint n,
     if (i >= n) return;
     SCENE_VIEW(sc);
     uint path = queue[i];
-    hits[path] = trace_closest(&sc, rays[path]);
+    hits[path] = trace_closest_visible(&sc, rays[path]);
 }
 
 /* Shades every queued path; count slot `slot` counts the shadow rays, slot + 1 the next
@@ -103,7 +104,7 @@ __kernel void k_shadow(SCENE_ARGS __global const uint *shadow_queue, uint n,
     if (i >= n) return;
     SCENE_VIEW(sc);
     uint path = shadow_queue[i];
-    shadow_resolve(&paths[path], trace_any(&sc, shadow_rays[path]));
+    shadow_resolve(&paths[path], trace_occluded(&sc, shadow_rays[path]));
 }
 
 /* Adds the finished wave of n_paths paths to the film. Work-item j owns one pixel, the

@@ -95,14 +95,15 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     Material m = sc->materials[s.material];
     s.ns = material_normal(sc, m, s);
 
-    if (!v3_is_zero(m.emission) && ((m.flags & MAT_TWO_SIDED) || v3_dot(r.d, s.ng) < 0.0f)) {
+    vec3 emission = material_emission(sc, m, s);
+    if (!v3_is_zero(emission) && ((m.flags & MAT_TWO_SIDED) || v3_dot(r.d, s.ng) < 0.0f)) {
         /* emission reached by BSDF sampling is weighted against the light sampling that
          * could have found it too; after a delta bounce only BSDF sampling could */
         float w = 1.0f;
         if (!(ps->flags & PATH_SPECULAR) && s.light != NO_INDEX)
             w = p->mis_mode == MIS_BOTH ? mis_power(ps->bsdf_pdf, light_pdf(sc, s.light, r.o, s.p, s.ng))
                                         : (p->mis_mode == MIS_BSDF_ONLY ? 1.0f : 0.0f);
-        ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, m.emission), w));
+        ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, emission), w));
     }
     if (m.type == MAT_EMISSIVE || bounce >= p->max_depth) return 0u;   /* pure emitters do not reflect */
 

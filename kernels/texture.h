@@ -81,9 +81,15 @@ KFN uint tex_wrap(float i, uint n, uint clamp)
     return r >= fn ? 0u : (uint)r;      /* rounding can give exactly n */
 }
 
+/* The four texels around (u, v) and the weights between them (texture_image). */
+typedef struct {
+    uint xa, xb, ya, yb;
+    float fx, fy;
+} TexFootprint;
+
 /* Bilinear filtering between the four texel centres around (u, v); texel (i, j) has its
  * centre at u = (i + 0.5)/width, v = 1 - (j + 0.5)/height. */
-KFN vec3 texture_image(const SceneView *sc, Texture tx, float u, float v)
+KFN TexFootprint texture_footprint(Texture tx, float u, float v)
 {
     uint clamp = tx.flags & TEX_CLAMP;
     if (!(u == u)) u = 0.0f;
@@ -99,12 +105,45 @@ KFN vec3 texture_image(const SceneView *sc, Texture tx, float u, float v)
     }
     float x = u * (float)tx.width - 0.5f, y = (1.0f - v) * (float)tx.height - 0.5f;
     float x0 = k_floor(x), y0 = k_floor(y);
-    float fx = x - x0, fy = y - y0;
-    uint xa = tex_wrap(x0, tx.width, clamp), xb = tex_wrap(x0 + 1.0f, tx.width, clamp);
-    uint ya = tex_wrap(y0, tx.height, clamp), yb = tex_wrap(y0 + 1.0f, tx.height, clamp);
-    vec3 top = v3_add(v3_scale(texel_fetch(sc, tx, xa, ya), 1.0f - fx), v3_scale(texel_fetch(sc, tx, xb, ya), fx));
-    vec3 bot = v3_add(v3_scale(texel_fetch(sc, tx, xa, yb), 1.0f - fx), v3_scale(texel_fetch(sc, tx, xb, yb), fx));
+    TexFootprint f;
+    f.fx = x - x0;
+    f.fy = y - y0;
+    f.xa = tex_wrap(x0, tx.width, clamp);
+    f.xb = tex_wrap(x0 + 1.0f, tx.width, clamp);
+    f.ya = tex_wrap(y0, tx.height, clamp);
+    f.yb = tex_wrap(y0 + 1.0f, tx.height, clamp);
+    return f;
+}
+
+KFN vec3 texture_image(const SceneView *sc, Texture tx, float u, float v)
+{
+    TexFootprint f = texture_footprint(tx, u, v);
+    float fx = f.fx, fy = f.fy;
+    vec3 top = v3_add(v3_scale(texel_fetch(sc, tx, f.xa, f.ya), 1.0f - fx), v3_scale(texel_fetch(sc, tx, f.xb, f.ya), fx));
+    vec3 bot = v3_add(v3_scale(texel_fetch(sc, tx, f.xa, f.yb), 1.0f - fx), v3_scale(texel_fetch(sc, tx, f.xb, f.yb), fx));
     return v3_add(v3_scale(top, 1.0f - fy), v3_scale(bot, fy));
+}
+
+/* An 8-bit texel's alpha (linear, never sRGB-decoded, as glTF and PNG mean it); float
+ * textures and images without an alpha channel are opaque (stb_image fills in 255). */
+KFN float texel_alpha(const SceneView *sc, Texture tx, uint x, uint y)
+{
+    if (tx.flags & TEX_FLOAT) return 1.0f;
+    return (float)(sc->texels[tx.offset + y * tx.width + x] >> 24) / 255.0f;
+}
+
+/* Texture `index`'s alpha at s, filtered as its colour is; checkers are opaque. */
+KFN float texture_alpha(const SceneView *sc, uint index, Surface s)
+{
+    Texture tx = sc->textures[index];
+    if (tx.type != TEX_IMAGE) return 1.0f;
+    float u, v;
+    surface_uv(sc, s, &u, &v);
+    vec3 q = v3(u, v, 0.0f);
+    TexFootprint f = texture_footprint(tx, tex_row(tx, 0, q), tex_row(tx, 1, q));
+    float top = texel_alpha(sc, tx, f.xa, f.ya) * (1.0f - f.fx) + texel_alpha(sc, tx, f.xb, f.ya) * f.fx;
+    float bot = texel_alpha(sc, tx, f.xa, f.yb) * (1.0f - f.fx) + texel_alpha(sc, tx, f.xb, f.yb) * f.fx;
+    return top * (1.0f - f.fy) + bot * f.fy;
 }
 
 /* color0 on cells whose integer coordinates sum to an even number, else color1. */
@@ -132,6 +171,14 @@ KFN vec3 texture_eval(const SceneView *sc, uint index, Surface s, vec3 ng_face)
     vec3 t = v3(tex_row(tx, 0, q), tex_row(tx, 1, q), tex_row(tx, 2, q));
     if (tx.type == TEX_CHECKER) return texture_checker(tx, t);
     return texture_image(sc, tx, t.x, t.y);
+}
+
+/* The radiance the material emits at s: its emission, times its emission texture
+ * (principled) where it has one. */
+KFN vec3 material_emission(const SceneView *sc, Material m, Surface s)
+{
+    if (m.texture_emission == NO_INDEX) return m.emission;
+    return v3_mul(m.emission, texture_eval(sc, m.texture_emission, s, s.ng));
 }
 
 /* The material's diffuse colour (albedo) at s: its texture there, or its constant. */

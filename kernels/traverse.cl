@@ -221,20 +221,31 @@ KFN Hit trace_closest(const SceneView *sc, Ray ray)
     return best;
 }
 
-/* 1 if anything is hit in (ray.tmin, ray.tmax): shadow rays. */
-KFN int trace_any(const SceneView *sc, Ray ray)
+/* The first hit found in (ray.tmin, ray.tmax), not necessarily the closest; prim =
+ * NO_INDEX when there is none. */
+KFN Hit trace_any_hit(const SceneView *sc, Ray ray)
 {
     GLOBAL const RenderParams *pr = sc->params;
+    uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes + pr->n_revsurfaces;
     Hit h;
     for (uint i = 0; i < pr->n_planes; i++)
-        if (plane_intersect(sc->planes[i], ray, &h)) return 1;
+        if (plane_intersect(sc->planes[i], ray, &h)) {
+            h.prim = first_plane + i;
+            return h;
+        }
     RayPre rp = ray_prepare(ray);
     h.t = ray.tmax;
     h.prim = NO_INDEX;
     h.u = 0.0f;
     h.v = 0.0f;
     trace_tree(sc, ray, &rp, 1, &h);
-    return h.prim != NO_INDEX;
+    return h;
+}
+
+/* 1 if anything is hit in (ray.tmin, ray.tmax): shadow rays. */
+KFN int trace_any(const SceneView *sc, Ray ray)
+{
+    return trace_any_hit(sc, ray).prim != NO_INDEX;
 }
 
 /* ------------------------------------------------------------------ two rays at once */

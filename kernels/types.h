@@ -134,7 +134,7 @@ enum MaterialType {
 /* MAT_DIELECTRIC also reads roughness and anisotropy (GGX, Walter et al. 2007) and
  * MAT_THIN. */
 
-typedef struct {                                        /* 144 bytes */
+typedef struct {                                        /* 160 bytes */
     uint type;                /* enum MaterialType */
     uint texture;             /* albedo texture index, NO_INDEX when none */
     float ior;
@@ -153,11 +153,21 @@ typedef struct {                                        /* 144 bytes */
     uint texture_normal;                   /* MAT_PRINCIPLED: tangent-space normal map
                                             * (OpenGL/glTF: green = +v), or NO_INDEX */
     float normal_scale;                    /* scales the map's x and y (glTF's scale) */
+    float alpha;                           /* MAT_PRINCIPLED: opacity (glTF baseColor
+                                            * alpha), times the base-colour texture's
+                                            * alpha; read under MAT_ALPHA_MASK/BLEND */
+    float alpha_cutoff;                    /* MAT_ALPHA_MASK: opaque where alpha >= this */
+    uint texture_emission;                 /* MAT_PRINCIPLED: multiplies emission, or
+                                            * NO_INDEX */
+    uint pad_alpha;
 } Material;
 
 #define MAT_TWO_SIDED 1u        /* emits from both sides of its surface */
 #define MAT_F0 2u               /* conductor: Schlick's Fresnel from F0 = specular */
 #define MAT_THIN 4u             /* dielectric: a thin sheet, no bend on refraction */
+#define MAT_ALPHA_MASK 8u       /* glTF alphaMode MASK: cut out where alpha < alpha_cutoff */
+#define MAT_ALPHA_BLEND 16u     /* glTF alphaMode BLEND: a hit is kept with probability
+                                 * alpha (kernels/alpha.h) */
 
 /* Area lights are the emissive primitives; point, spot and directional lights are
  * delta lights (a single direction reaches a point: no MIS, hard shadows). */
@@ -317,7 +327,7 @@ CLPT_CHECK_SIZE(TriShading, 64);
 CLPT_CHECK_SIZE(Box, 32);
 CLPT_CHECK_SIZE(Plane, 32);
 CLPT_CHECK_SIZE(RevSurface, 48);
-CLPT_CHECK_SIZE(Material, 144);
+CLPT_CHECK_SIZE(Material, 160);
 CLPT_CHECK_SIZE(Light, 80);
 CLPT_CHECK_SIZE(Camera, 112);
 CLPT_CHECK_SIZE(RenderParams, 288);

@@ -24,6 +24,7 @@
 #include "raygen.cl"
 #include "shade.cl"
 #include "traverse.cl"
+#include "alpha.h"
 
 /* Deepest recursion the private stack allows (max_depth is clamped to it). */
 #define WHITTED_STACK 32
@@ -84,7 +85,7 @@ KFN int whitted_occluded(const SceneView *sc, vec3 sp, vec3 ng, LightSample ls, 
 {
     if (!sc->params->shadows) return 0;
     (*rays)++;
-    return trace_any(sc, light_shadow_ray(sp, ng, ls));
+    return trace_occluded(sc, light_shadow_ray(sp, ng, ls));
 }
 
 /* Direct light at surface point s: every delta light, and one sample of the area lights
@@ -145,7 +146,7 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, RngKey key, uint *ray
     while (sp > 0) {
         sp--;
         WhittedRay e = stack[sp];
-        Hit hit = trace_closest(sc, e.ray);
+        Hit hit = trace_closest_visible(sc, e.ray);
         (*rays)++;
         node++;
         vec3 d = e.ray.d;
@@ -159,8 +160,9 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, RngKey key, uint *ray
         int front = v3_dot(d, s.ng) < 0.0f;
         vec3 ng = front ? s.ng : v3_neg(s.ng);
         vec3 ns = front ? s.ns : v3_neg(s.ns);
-        if (!v3_is_zero(m.emission) && ((m.flags & MAT_TWO_SIDED) || front))
-            L = v3_add(L, v3_mul(e.weight, m.emission));
+        vec3 emission = material_emission(sc, m, s);
+        if (!v3_is_zero(emission) && ((m.flags & MAT_TWO_SIDED) || front))
+            L = v3_add(L, v3_mul(e.weight, emission));
         if (m.type == MAT_EMISSIVE) continue;
 
         vec3 kd = material_albedo(sc, m, s, ng);
@@ -230,7 +232,7 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, RngKey key, uint *ray
 /* An auxiliary image's value at the first hit (enum Integrator). */
 KFN vec3 whitted_aov(const SceneView *sc, Ray ray, uint mode, uint *rays)
 {
-    Hit hit = trace_closest(sc, ray);
+    Hit hit = trace_closest_visible(sc, ray);
     (*rays)++;
     if (hit.prim == NO_INDEX)
         return v3s(mode == INTEGRATOR_AOV_NORMAL && sc->params->normal_miss_grey ? 0.5f : 0.0f);

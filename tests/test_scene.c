@@ -225,6 +225,36 @@ static void test_materials(void)
     scene_free(&s);
 }
 
+/* Every documented preset loads, with the table's values (Fe and Ti: Johnson & Christy
+ * 1974 at 650/550/450 nm, docs/scene-format.md). */
+static void test_metal_presets(void)
+{
+    Scene s;
+    Error err;
+    Status st = load_text("metals.scene",
+                          "material fe { type conductor metal Fe roughness 0.2 }\n"
+                          "material ti { type conductor metal Ti }\n"
+                          "material ag { type conductor metal Ag }\n"
+                          "material al { type conductor metal Al }\n"
+                          "material au { type conductor metal Au }\n"
+                          "material cr { type conductor metal Cr }\n"
+                          "material cu { type conductor metal Cu }\n"
+                          "material ni { type conductor metal Ni }\n",
+                          &s, &err);
+    CHECK_EQ_INT(st, ST_OK);
+    CHECK_EQ_INT(s.n_materials, 8);
+    if (s.n_materials == 8) {
+        CHECK_EQ_INT(s.materials[0].type, MAT_CONDUCTOR);
+        CHECK(vec_eq(s.materials[0].eta, 2.9114f, 2.9497f, 2.5845f));
+        CHECK(vec_eq(s.materials[0].k, 3.0893f, 2.9318f, 2.7670f));
+        CHECK(s.materials[0].roughness == 0.2f);
+        CHECK(vec_eq(s.materials[1].eta, 2.7407f, 2.5418f, 2.2670f));
+        CHECK(vec_eq(s.materials[1].k, 3.8143f, 3.4345f, 3.0385f));
+        for (int i = 0; i < 8; i++) CHECK_EQ_INT(s.materials[i].flags & MAT_F0, 0);
+    }
+    scene_free(&s);
+}
+
 static void test_primitives(void)
 {
     Scene s;
@@ -735,6 +765,7 @@ int main(void)
     RUN(test_defaults_kept);
     RUN(test_backgrounds);
     RUN(test_materials);
+    RUN(test_metal_presets);
     RUN(test_primitives);
     RUN(test_mesh_and_include);
     RUN(test_cornell_box);

@@ -23,6 +23,7 @@
 #include "raygen.cl"
 #include "shade.cl"
 #include "traverse.cl"
+#include "alpha.h"
 #include "whitted.cl"
 
 /* Paths (pixels x samples of the batch) handed to a worker at a time: small enough that
@@ -63,11 +64,11 @@ static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *
     uint64_t rays = 0;
     raygen_path(sc->params, pixel, sample, &ps, &ray);
     for (;;) {
-        Hit hit = trace_closest(sc, ray);
+        Hit hit = trace_closest_visible(sc, ray);
         rays++;
         uint r = shade_path(sc, &ray, hit, &ps, &shadow);
         if (r & SHADE_SHADOW) {
-            shadow_resolve(&ps, trace_any(sc, shadow));
+            shadow_resolve(&ps, trace_occluded(sc, shadow));
             rays++;
         }
         if (!(r & SHADE_CONTINUE)) break;
@@ -89,7 +90,7 @@ static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, 
     t1 = timer_now();
     t[PHASE_RAYGEN] += t1 - t0;
     for (;;) {
-        Hit hit = trace_closest(sc, ray);
+        Hit hit = trace_closest_visible(sc, ray);
         t0 = timer_now();
         t[PHASE_TRAVERSE] += t0 - t1;
         rays++;
@@ -97,7 +98,7 @@ static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, 
         t1 = timer_now();
         t[PHASE_SHADE] += t1 - t0;
         if (r & SHADE_SHADOW) {
-            shadow_resolve(&ps, trace_any(sc, shadow));
+            shadow_resolve(&ps, trace_occluded(sc, shadow));
             rays++;
             t0 = timer_now();
             t[PHASE_SHADOW] += t0 - t1;

@@ -528,7 +528,8 @@ enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE
        MAT_KEY_SPECULAR, MAT_KEY_SHININESS, MAT_KEY_REFLECTIVE, MAT_KEY_TRANSPARENT, MAT_KEY_TEXTURE,
        MAT_KEY_ROUGHNESS, MAT_KEY_ANISOTROPY, MAT_KEY_ETA, MAT_KEY_K, MAT_KEY_METAL, MAT_KEY_THIN,
        MAT_KEY_METALLIC, MAT_KEY_TRANSMISSION, MAT_KEY_CLEARCOAT, MAT_KEY_CLEARCOAT_ROUGHNESS, MAT_KEY_STRENGTH,
-       MAT_KEY_METALLIC_ROUGHNESS, MAT_KEY_NORMAL_MAP, MAT_KEY_NORMAL_SCALE, MAT_KEY_N };
+       MAT_KEY_METALLIC_ROUGHNESS, MAT_KEY_NORMAL_MAP, MAT_KEY_NORMAL_SCALE, MAT_KEY_ALPHA, MAT_KEY_ALPHA_MODE,
+       MAT_KEY_ALPHA_CUTOFF, MAT_KEY_EMISSION_TEXTURE, MAT_KEY_N };
 static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0,
                       "a material type (diffuse, metal, conductor, dielectric, principled, emissive, phong)"},
@@ -547,7 +548,7 @@ static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_ANISOTROPY] = {"anisotropy", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
     [MAT_KEY_ETA] = {"eta", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_K] = {"k", VK_COLOR, 0, 0, 0, 0, 0, NULL},
-    [MAT_KEY_METAL] = {"metal", VK_WORD, 0, 0, 0, 0, 0, "a metal (Ag, Al, Au, Cr, Cu, Ni)"},
+    [MAT_KEY_METAL] = {"metal", VK_WORD, 0, 0, 0, 0, 0, "a metal (Ag, Al, Au, Cr, Cu, Fe, Ni, Ti)"},
     [MAT_KEY_THIN] = {"thin", VK_WORD, 0, 0, 0, 0, 0, "on or off"},
     [MAT_KEY_METALLIC] = {"metallic", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
     [MAT_KEY_TRANSMISSION] = {"transmission", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
@@ -557,6 +558,10 @@ static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_METALLIC_ROUGHNESS] = {"metallic_roughness", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_NORMAL_MAP] = {"normal_map", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_NORMAL_SCALE] = {"normal_scale", VK_NUMBER, 0, 0, 100, 0, 0, "a number in [0, 100]"},
+    [MAT_KEY_ALPHA] = {"alpha", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_ALPHA_MODE] = {"alpha_mode", VK_WORD, 0, 0, 0, 0, 0, "opaque, mask or blend"},
+    [MAT_KEY_ALPHA_CUTOFF] = {"alpha_cutoff", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_EMISSION_TEXTURE] = {"emission_texture", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
 };
 
 /* Which keys each material type takes (bit i = material_keys[i]), and which it needs. */
@@ -584,7 +589,8 @@ static const struct {
      1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_TEXTURE | 1u << MAT_KEY_METALLIC | 1u << MAT_KEY_ROUGHNESS |
      1u << MAT_KEY_ANISOTROPY | 1u << MAT_KEY_TRANSMISSION | 1u << MAT_KEY_IOR | 1u << MAT_KEY_THIN |
      1u << MAT_KEY_CLEARCOAT | 1u << MAT_KEY_CLEARCOAT_ROUGHNESS | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_STRENGTH |
-     1u << MAT_KEY_METALLIC_ROUGHNESS | 1u << MAT_KEY_NORMAL_MAP | 1u << MAT_KEY_NORMAL_SCALE | 1u << MAT_KEY_SIDES,
+     1u << MAT_KEY_METALLIC_ROUGHNESS | 1u << MAT_KEY_NORMAL_MAP | 1u << MAT_KEY_NORMAL_SCALE | 1u << MAT_KEY_SIDES |
+     1u << MAT_KEY_ALPHA | 1u << MAT_KEY_ALPHA_MODE | 1u << MAT_KEY_ALPHA_CUTOFF | 1u << MAT_KEY_EMISSION_TEXTURE,
      0},
     {"emissive", MAT_EMISSIVE, 1u << MAT_KEY_RADIANCE | 1u << MAT_KEY_SIDES, 1u << MAT_KEY_RADIANCE},
     {"phong", MAT_PHONG,
@@ -621,6 +627,28 @@ static Status parse_conductor(Parser *p, Lexer *lx, const Token *kw, const Value
     return ST_OK;
 }
 
+/* glTF's alpha: `alpha` (baseColorFactor's A, times the base-colour texture's alpha),
+ * `alpha_mode` opaque (default; alpha ignored), mask (cut out below `alpha_cutoff`,
+ * default 0.5) or blend (stochastic opacity). A cutoff means nothing outside mask, so it
+ * is refused there rather than silently ignored. */
+static Status parse_alpha(Parser *p, Lexer *lx, const Value *v, Material *m)
+{
+    if (v[MAT_KEY_ALPHA].given) m->alpha = v[MAT_KEY_ALPHA].f;
+    uint mode = 0u;
+    if (v[MAT_KEY_ALPHA_MODE].given) {
+        const Token *w = &v[MAT_KEY_ALPHA_MODE].word;
+        if (tok_is(w, "mask")) mode = MAT_ALPHA_MASK;
+        else if (tok_is(w, "blend")) mode = MAT_ALPHA_BLEND;
+        else if (!tok_is(w, "opaque")) return lex_expected(lx, w, material_keys[MAT_KEY_ALPHA_MODE].what, p->err);
+    }
+    if (v[MAT_KEY_ALPHA_CUTOFF].given && mode != MAT_ALPHA_MASK)
+        return lex_error_at(lx, &v[MAT_KEY_ALPHA_CUTOFF].key, p->err,
+                            "'alpha_cutoff' needs 'alpha_mode mask'");
+    if (v[MAT_KEY_ALPHA_CUTOFF].given) m->alpha_cutoff = v[MAT_KEY_ALPHA_CUTOFF].f;
+    m->flags |= mode;
+    return ST_OK;
+}
+
 /* Reads a material's `{ ... }`; a NULL name makes an anonymous (inline) material. */
 static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
                                    const char *name, uint *index)
@@ -636,7 +664,7 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
     unsigned allowed = material_types[ti].allowed | 1u << MAT_KEY_TYPE;
     for (int i = 0; i < MAT_KEY_N; i++) {
         if (!v[i].given || (allowed & (1u << i))) continue;
-        char what[256];
+        char what[512];
         size_t o = (size_t)snprintf(what, sizeof what, "a %s material key (type",
                                     material_types[ti].name);
         for (int j = 1; j < MAT_KEY_N; j++)
@@ -671,6 +699,8 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
         if (v[MAT_KEY_METALLIC_ROUGHNESS].given) m.texture_rm = (uint)v[MAT_KEY_METALLIC_ROUGHNESS].u;
         if (v[MAT_KEY_NORMAL_MAP].given) m.texture_normal = (uint)v[MAT_KEY_NORMAL_MAP].u;
         if (v[MAT_KEY_NORMAL_SCALE].given) m.normal_scale = v[MAT_KEY_NORMAL_SCALE].f;
+        if (v[MAT_KEY_EMISSION_TEXTURE].given) m.texture_emission = (uint)v[MAT_KEY_EMISSION_TEXTURE].u;
+        if ((st = parse_alpha(p, lx, v, &m))) return st;
         break;
     case MAT_EMISSIVE:
         m = material_emissive(v[MAT_KEY_RADIANCE].v);

@@ -358,6 +358,9 @@ static Material material_base(uint type)
     m.texture_normal = NO_INDEX;
     m.normal_scale = 1.0f;
     m.ior = 1.5f;
+    m.alpha = 1.0f;
+    m.alpha_cutoff = 0.5f;      /* glTF's default alphaCutoff */
+    m.texture_emission = NO_INDEX;
     return m;
 }
 
@@ -414,7 +417,9 @@ Material material_principled(vec3 base, float metallic, float roughness)
 /* Measured spectra interpolated at 650, 550 and 450 nm for R, G and B: Ag, Al, Au, Cu
  * from pbrt-v4 (src/pbrt/util/spectrum.cpp, after refractiveindex.info), Cr and Ni from
  * Mitsuba 0.6 (data/ior/Cr.*.spd, Ni_palik.*.spd: the luxpop database, Palik's
- * Handbook of Optical Constants of Solids). */
+ * Handbook of Optical Constants of Solids), Fe and Ti from Johnson & Christy, Phys.
+ * Rev. B 9, 5056 (1974), as tabulated by refractiveindex.info (data-nk/main/Fe/Johnson.yml,
+ * Ti/Johnson.yml; linear in wavelength between its samples). */
 static const struct {
     const char *name;
     float eta[3], k[3];
@@ -424,7 +429,9 @@ static const struct {
     {"Au", {0.1678f, 0.3504f, 1.5085f}, {3.1378f, 2.7141f, 1.8788f}},
     {"Cr", {3.6375f, 3.1158f, 1.9277f}, {4.3644f, 4.4228f, 4.1675f}},
     {"Cu", {0.2166f, 0.9582f, 1.1658f}, {3.6377f, 2.5771f, 2.3939f}},
+    {"Fe", {2.9114f, 2.9497f, 2.5845f}, {3.0893f, 2.9318f, 2.7670f}},
     {"Ni", {2.0140f, 1.7724f, 1.6288f}, {3.8079f, 3.2526f, 2.6540f}},
+    {"Ti", {2.7407f, 2.5418f, 2.2670f}, {3.8143f, 3.4345f, 3.0385f}},
 };
 
 int material_metal_preset(const char *name, size_t len, vec3 *eta, vec3 *k)
@@ -471,8 +478,13 @@ Light light_default(uint type)
 static int is_emissive(const Scene *s, uint material)
 {
     if (material >= s->n_materials) return 0;
-    /* any material may emit (a diffuse emitter is what the furnace test needs) */
-    return v3_luminance(s->materials[material].emission) > 0.0f;
+    /* any material may emit (a diffuse emitter is what the furnace test needs). An
+     * emission texture or an alpha cut-out makes the emitted radiance vary over the
+     * surface in a way light sampling does not know: such surfaces are found by BSDF
+     * sampling alone (full weight), like the background, which keeps them unbiased. */
+    const Material *m = &s->materials[material];
+    if (m->texture_emission != NO_INDEX || (m->flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND))) return 0;
+    return v3_luminance(m->emission) > 0.0f;
 }
 
 static double triangle_area(const Triangle *t)

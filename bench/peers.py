@@ -222,6 +222,7 @@ def main():
     ap.add_argument('--threads', type=int, default=2, help="Cycles' render threads")
     ap.add_argument('--scenes', default='cornell,dragon')
     a = ap.parse_args()
+    a.peers = os.path.abspath(a.peers)   # the peer scripts run in --out
     a.ref_spp = dict((k, int(v)) for k, v in (x.split('=', 1) for x in a.ref_spp.split(',')))
     scenes = [s for s in a.scenes.split(',') if s]
     for s in scenes:

@@ -190,9 +190,14 @@ class Cycles:
 
     def render(self, scene, spp, seed, out):
         prefix = os.path.splitext(os.path.abspath(out))[0]
+        # Blender takes its Python from the first python3 on PATH: a pyenv or venv one
+        # lacks the numpy that Debian's python3-numpy gives Blender's.
+        env = dict(os.environ)
+        env['PATH'] = os.pathsep.join(p for p in env.get('PATH', '').split(os.pathsep)
+                                      if '.pyenv' not in p and p != os.path.dirname(sys.executable))
         wall, _ = run(['blender', '-b', '--factory-startup', '--python-exit-code', '1', '--python',
                        os.path.join(self.a.peers, 'cycles_cornell.py'), '--', '--spp', str(spp), '--seed', str(seed),
-                       '--threads', str(self.a.threads), '--one-sided-light', '--out', prefix])
+                       '--threads', str(self.a.threads), '--one-sided-light', '--out', prefix], env=env)
         with open(prefix + '.json') as f:
             render_s = json.load(f)['timing_s']['render_op']
         return {'render_s': render_s, 'wall_s': wall, 'setup_s': wall - render_s}

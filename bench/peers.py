@@ -172,7 +172,8 @@ class Mitsuba:
             run(self.cmd(scene, spp, seed, os.path.abspath(out)), cwd=work, env=self.env)
             self.warm.add(scene)
         wall, text = run(self.cmd(scene, spp, seed, os.path.abspath(out)), cwd=work, env=self.env)
-        r = json.loads(text.strip().splitlines()[-1])
+        # Mitsuba may log lines of its own (mesh loading) before the script's JSON line.
+        r = json.loads([line for line in text.splitlines() if line.startswith('{')][-1])
         return {'render_s': r['render_s'], 'wall_s': wall, 'setup_s': wall - r['render_s']}
 
 

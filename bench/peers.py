@@ -172,8 +172,9 @@ class Mitsuba:
             run(self.cmd(scene, spp, seed, os.path.abspath(out)), cwd=work, env=self.env)
             self.warm.add(scene)
         wall, text = run(self.cmd(scene, spp, seed, os.path.abspath(out)), cwd=work, env=self.env)
-        # Mitsuba may log lines of its own (mesh loading) before the script's JSON line.
-        r = json.loads([line for line in text.splitlines() if line.startswith('{')][-1])
+        # Mitsuba logs lines of its own (a slow ASCII PLY) and ends them with a colour
+        # escape that shares the script's JSON line: read from the JSON's start.
+        r = json.loads(text[text.rindex('{"renderer"'):].splitlines()[0])
         return {'render_s': r['render_s'], 'wall_s': wall, 'setup_s': wall - r['render_s']}
 
 

@@ -4,6 +4,7 @@
 #   make test       build and run the test suite (ends with "N passed, M failed")
 #   make render     render the default scene to cornell-box.png
 #   make bench      throughput benchmarks (bench/)
+#   make bench-peers  clpt against Mitsuba 3 and Cycles at equal error (bench/peers.py)
 #   make test-asan  the test suite built with AddressSanitizer + UBSan (build-asan/)
 #   make test-valgrind  small renders (PoCL and scalar) under valgrind memcheck
 #   make fuzz       each libFuzzer target in fuzz/ for FUZZ_SECONDS (build-fuzz/)
@@ -53,7 +54,7 @@ FUZZ_BIN  := $(FUZZ_SRC:fuzz/%.c=$(BUILD)/fuzz/%)
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: all deps test render bench clean test-asan test-valgrind fuzz fuzz-build
+.PHONY: all deps test render bench bench-peers clean test-asan test-valgrind fuzz fuzz-build
 .DEFAULT_GOAL := all
 
 all: $(BUILD)/$(PROG)
@@ -135,6 +136,13 @@ render: $(BUILD)/$(PROG)
 
 bench: $(BUILD)/$(PROG) $(BENCH_BIN)
 	@sh bench/run.sh $(BUILD)
+
+# Minutes long and needs ../shared/peers; peers that are not installed are skipped.
+bench-peers: $(BUILD)/$(PROG)
+	@mkdir -p $(BUILD)/pocl-cache $(BUILD)/kernel-cache
+	@POCL_CACHE_DIR=$${POCL_CACHE_DIR:-$(CURDIR)/$(BUILD)/pocl-cache} \
+	 CLPT_CACHE_DIR=$${CLPT_CACHE_DIR:-$(CURDIR)/$(BUILD)/kernel-cache} \
+	 python3 bench/peers.py --clpt $(BUILD)/$(PROG) --out $(BUILD)/peers $(PEERS_ARGS)
 
 # ---------------------------------------------------------------- hardening
 # The sanitizer and fuzzing builds are the ordinary build in their own folders, with

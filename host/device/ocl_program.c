@@ -425,7 +425,7 @@ static void oclp__announce(const OclDeviceInfo *dev, int cached_afterwards)
 {
     if (!atomic_load(&oclp__announce_builds)) return;
     fprintf(stderr, "clpt: compiling kernels for %s%s...\n", dev->name,
-            cached_afterwards ? " (first run; cached afterwards)" : "");
+            cached_afterwards ? ", cached for next time" : "");
     fflush(stderr);
 }
 

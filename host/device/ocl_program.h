@@ -48,7 +48,8 @@ Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *k
                          Error *err);
 
 /* Whether a build from source (a cache miss, or --kernel-dir) first says so on stderr:
- * "clpt: compiling kernels for <device> (first run; cached afterwards)...". Off until
+ * "clpt: compiling kernels for <device>, cached for next time..." (without ", cached
+ * for next time" when nothing is cached: --kernel-dir, or no cache folder). Off until
  * turned on (the program does, unless -q). */
 void ocl_program_announce_builds(int on);
 

@@ -1,0 +1,292 @@
+#!/usr/bin/env python3
+"""Peer benchmark: clpt against Mitsuba 3 and Blender Cycles at equal quality.
+
+usage: bench/peers.py [--clpt build/clpt] [--peers DIR] [--out DIR] [--runs N]
+                      [--ref-spp cornell=1024,dragon=256] [--device DEV] [--threads N]
+                      [--scenes cornell,dragon]
+
+Renders the two scenes of ../shared/peers (its README says how they were matched across
+renderers; the scene files and peer scripts are used from there as they are, so every
+renderer sees the same scene):
+  cornell  McGuire's CornellBox-Original, 512x512, 64 spp, 8 bounces, light facing down
+  dragon   the Stanford dragon (871k triangles) on a floor under a small area light,
+           512x512, 16 spp
+with clpt and, when installed, Mitsuba 3 (`pip install mitsuba`; its fast variant
+llvm_ad_rgb needs Debian's libllvm19, else scalar_rgb is used) and Cycles (Debian
+`blender` and `python3-numpy`; the Cornell box only, as in ../shared/peers). The renderers take turns within
+each of --runs rounds (interleaved, so a change in the machine's load hits all of them
+alike); times are medians over the rounds, RMSE the mean over them (seed = round).
+
+RMSE is against a converged reference made by clpt (--ref-spp samples, seed 777, kept in
+--out and reused), with silhouette pixels left out as ../shared/peers/compare.py does
+(pixels whose 3x3 neighbourhood in the reference spans more than 0.05 in mean RGB), so
+that renderers with different pixel filters compare on noise and bias. time x MSE is the
+error-per-time figure (lower is better; for unbiased Monte Carlo, MSE falls as 1/time),
+and "clpt time to equal error" is clpt's time x MSE over the peer's: the share of the
+peer's time that clpt needs to reach the peer's error (below 1: clpt is faster).
+
+Standard library only; numpy is used for the error when it is importable (faster).
+"""
+import argparse
+import array
+import json
+import math
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+
+try:
+    import numpy as np
+except ImportError:
+    np = None
+
+SCENES = {
+    # name: (clpt scene file in the peers folder, spp, whether Cycles has the scene)
+    'cornell': ('cornell-mcguire.scene', 64, True),
+    'dragon': ('dragon.scene', 16, False),
+}
+SIZE = 512
+LLVM19 = '/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1'
+
+
+def read_pfm(path):
+    with open(path, 'rb') as f:
+        kind = f.readline().strip()
+        w, h = map(int, f.readline().split())
+        scale = float(f.readline())
+        a = array.array('f')
+        a.frombytes(f.read())
+    if (scale < 0) != (sys.byteorder == 'little'):
+        a.byteswap()
+    if kind != b'PF' or len(a) != w * h * 3:
+        raise SystemExit('%s: not a colour PFM of %dx%d' % (path, w, h))
+    return w, h, a
+
+
+def silhouette_keep(w, h, ref):
+    """1 for the pixels that count: not on an edge of the reference."""
+    if np is not None:
+        lum = np.frombuffer(ref, dtype=np.float32).astype(np.float64).reshape(h, w, 3).mean(-1)
+        pad = np.pad(lum, 1, mode='edge')
+        nb = np.stack([pad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)])
+        return ((nb.max(0) - nb.min(0)) <= 0.05).reshape(-1)
+    lum = [(ref[3 * i] + ref[3 * i + 1] + ref[3 * i + 2]) / 3.0 for i in range(w * h)]
+    keep = bytearray(w * h)
+    for y in range(h):
+        for x in range(w):
+            lo = hi = lum[y * w + x]
+            for dy in (-1, 0, 1):
+                yy = min(max(y + dy, 0), h - 1)
+                for dx in (-1, 0, 1):
+                    v = lum[yy * w + min(max(x + dx, 0), w - 1)]
+                    lo, hi = min(lo, v), max(hi, v)
+            keep[y * w + x] = hi - lo <= 0.05
+    return keep
+
+
+def masked_rmse(img, ref, keep):
+    if np is not None:
+        d = (np.frombuffer(img, dtype=np.float32).astype(np.float64) -
+             np.frombuffer(ref, dtype=np.float32).astype(np.float64)).reshape(-1, 3)
+        return float(np.sqrt((d[np.asarray(keep, dtype=bool)] ** 2).mean()))
+    s, n = 0.0, 0
+    for i in range(len(ref) // 3):
+        if keep[i]:
+            for c in range(3):
+                d = img[3 * i + c] - ref[3 * i + c]
+                s += d * d
+            n += 3
+    return math.sqrt(s / max(n, 1))
+
+
+def run(cmd, cwd=None, env=None):
+    """Runs a command; returns (wall seconds, stdout). A failure ends the benchmark with its output."""
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    wall = time.perf_counter() - t0
+    if p.returncode != 0:
+        raise SystemExit('failed (exit %d): %s\n%s%s' % (p.returncode, ' '.join(cmd), p.stdout, p.stderr))
+    return wall, p.stdout
+
+
+class Clpt:
+    name = 'clpt'
+
+    def __init__(self, a):
+        self.a = a
+        self.label = 'clpt (%s)' % (a.device or 'default device')
+
+    def cmd(self, scene, spp, seed, out):
+        c = [self.a.clpt, os.path.join(self.a.peers, SCENES[scene][0]), '--spp', str(spp), '--seed', str(seed),
+             '--stats', '-q', '-o', out]
+        return c + (['--device', self.a.device] if self.a.device else [])
+
+    def render(self, scene, spp, seed, out):
+        wall, text = run(self.cmd(scene, spp, seed, out))
+        render_s = None
+        for line in text.splitlines():
+            if line.startswith('total '):
+                render_s = float(line.split()[2])
+        if render_s is None:
+            raise SystemExit('clpt --stats printed no "total" line:\n' + text)
+        return {'render_s': render_s, 'wall_s': wall, 'setup_s': wall - render_s}
+
+
+class Mitsuba:
+    name = 'mitsuba'
+    install = ('not installed: `pip install mitsuba` (its fast variant llvm_ad_rgb also needs '
+               '`apt-get install libllvm19`)')
+
+    def __init__(self, a):
+        self.a = a
+        self.env = dict(os.environ)
+        if os.path.exists(self.env.get('DRJIT_LIBLLVM_PATH', '')) or os.path.exists(LLVM19):
+            self.env.setdefault('DRJIT_LIBLLVM_PATH', LLVM19)
+            self.variant = 'llvm_ad_rgb'
+        else:
+            self.variant = 'scalar_rgb'
+        self.label = 'Mitsuba 3 %s, multijitter' % self.variant
+        self.warm = set()
+
+    @staticmethod
+    def available():
+        return subprocess.run([sys.executable, '-c', 'import mitsuba'], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL).returncode == 0
+
+    def cmd(self, scene, spp, seed, out):
+        return [sys.executable, os.path.join(self.a.peers, 'mitsuba_render.py'), scene, str(spp), out, str(seed),
+                self.variant, 'multijitter']
+
+    def render(self, scene, spp, seed, out):
+        # mitsuba_render.py reads the Cornell box as split/ in its working folder.
+        work = os.path.abspath(self.a.out)
+        if scene == 'cornell' and not os.path.exists(os.path.join(work, 'split', 'materials.json')):
+            os.makedirs(os.path.join(work, 'split'), exist_ok=True)
+            obj = os.path.join(self.a.peers, '..', 'models', 'cornell-box', 'CornellBox-Original.obj')
+            run([sys.executable, os.path.join(self.a.peers, 'cornell_split.py'), obj, os.path.join(work, 'split')])
+        if self.variant.startswith('llvm') and scene not in self.warm:
+            # Dr.Jit compiles its kernels on first use and caches them: not part of a render.
+            run(self.cmd(scene, spp, seed, os.path.abspath(out)), cwd=work, env=self.env)
+            self.warm.add(scene)
+        wall, text = run(self.cmd(scene, spp, seed, os.path.abspath(out)), cwd=work, env=self.env)
+        # Mitsuba logs lines of its own (a slow ASCII PLY) and ends them with a colour
+        # escape that shares the script's JSON line: read from the JSON's start.
+        r = json.loads(text[text.rindex('{"renderer"'):].splitlines()[0])
+        return {'render_s': r['render_s'], 'wall_s': wall, 'setup_s': wall - r['render_s']}
+
+
+class Cycles:
+    name = 'cycles'
+    install = 'not installed: `apt-get install blender python3-numpy` (Debian 12: Blender 3.4)'
+
+    def __init__(self, a):
+        self.a = a
+        self.label = 'Cycles (Blender, CPU, PMJ)'
+
+    @staticmethod
+    def available():
+        return shutil.which('blender') is not None
+
+    def render(self, scene, spp, seed, out):
+        prefix = os.path.splitext(os.path.abspath(out))[0]
+        # Blender takes its Python from the first python3 on PATH: a pyenv or venv one
+        # lacks the numpy that Debian's python3-numpy gives Blender's.
+        env = dict(os.environ)
+        env['PATH'] = os.pathsep.join(p for p in env.get('PATH', '').split(os.pathsep)
+                                      if '.pyenv' not in p and p != os.path.dirname(sys.executable))
+        wall, _ = run(['blender', '-b', '--factory-startup', '--python-exit-code', '1', '--python',
+                       os.path.join(self.a.peers, 'cycles_cornell.py'), '--', '--spp', str(spp), '--seed', str(seed),
+                       '--threads', str(self.a.threads), '--one-sided-light', '--out', prefix], env=env)
+        with open(prefix + '.json') as f:
+            render_s = json.load(f)['timing_s']['render_op']
+        return {'render_s': render_s, 'wall_s': wall, 'setup_s': wall - render_s}
+
+
+def reference(a, scene):
+    spp = a.ref_spp[scene]
+    path = os.path.join(a.out, 'ref-%s-%d.pfm' % (scene, spp))
+    if not os.path.exists(path):
+        print('making the %s reference with clpt, %d spp (once; kept as %s)...' % (scene, spp, path), flush=True)
+        Clpt(a).render(scene, spp, 777, path)
+    return path
+
+
+def fmt_s(x):
+    return '%.2f s' % x
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    ap.add_argument('--clpt', default='build/clpt')
+    ap.add_argument('--peers', default='../shared/peers', help='the folder of the peer scenes and scripts')
+    ap.add_argument('--out', default='build/peers')
+    ap.add_argument('--runs', type=int, default=3)
+    ap.add_argument('--ref-spp', default='cornell=1024,dragon=256')
+    ap.add_argument('--device', default='', help="clpt's --device (default: clpt's default)")
+    ap.add_argument('--threads', type=int, default=2, help="Cycles' render threads")
+    ap.add_argument('--scenes', default='cornell,dragon')
+    a = ap.parse_args()
+    a.peers = os.path.abspath(a.peers)   # the peer scripts run in --out
+    a.ref_spp = dict((k, int(v)) for k, v in (x.split('=', 1) for x in a.ref_spp.split(',')))
+    scenes = [s for s in a.scenes.split(',') if s]
+    for s in scenes:
+        if s not in SCENES:
+            raise SystemExit('unknown scene %s (known: %s)' % (s, ', '.join(SCENES)))
+    if not os.path.exists(os.path.join(a.peers, 'README.md')):
+        raise SystemExit('%s: the peer scenes are not there (--peers DIR)' % a.peers)
+    os.makedirs(a.out, exist_ok=True)
+
+    renderers = [Clpt(a)]
+    for cls in (Mitsuba, Cycles):
+        if cls.available():
+            renderers.append(cls(a))
+        else:
+            print('%s: skipped, %s' % (cls.name, cls.install))
+    refs = {s: reference(a, s) for s in scenes}
+
+    results = {}   # (scene, renderer name) -> list of (times dict, rmse)
+    for rnd in range(1, a.runs + 1):
+        for s in scenes:
+            w, h, ref = read_pfm(refs[s])
+            keep = silhouette_keep(w, h, ref)
+            spp = SCENES[s][1]
+            for r in renderers:
+                if r.name == 'cycles' and not SCENES[s][2]:
+                    continue
+                out = os.path.join(a.out, '%s-%s-%d.pfm' % (s, r.name, rnd))
+                t = r.render(s, spp, rnd, out)
+                e = masked_rmse(read_pfm(out)[2], ref, keep)
+                results.setdefault((s, r.name), []).append((t, e))
+                print('round %d %-8s %-8s render %6.2f s  wall %6.2f s  RMSE %.5f' % (
+                    rnd, s, r.name, t['render_s'], t['wall_s'], e), flush=True)
+
+    print()
+    print('| scene | renderer | render time | start-up + load + build | Msamples/s | RMSE (masked) '
+          '| time x MSE | clpt time to equal error |')
+    print('|---|---|---|---|---|---|---|---|')
+    for s in scenes:
+        spp = SCENES[s][1]
+        rows = {}
+        for r in renderers:
+            got = results.get((s, r.name))
+            if not got:
+                continue
+            render_s = statistics.median(t['render_s'] for t, _ in got)
+            setup_s = statistics.median(t['setup_s'] for t, _ in got)
+            e = sum(x for _, x in got) / len(got)
+            rows[r.name] = (r.label, render_s, setup_s, e, render_s * e * e)
+        clpt_tm = rows['clpt'][4]
+        for name, (label, render_s, setup_s, e, tm) in rows.items():
+            ratio = '1 (itself)' if name == 'clpt' else '%.2f' % (clpt_tm / tm)
+            print('| %s | %s | %s | %s | %.2f | %.5f | %.2e | %s |' % (
+                s, label, fmt_s(render_s), fmt_s(setup_s), SIZE * SIZE * spp / render_s / 1e6, e, tm, ratio))
+        if 'cycles' not in rows and any(r.name == 'cycles' for r in renderers):
+            print('| %s | Cycles | not rendered: ../shared/peers has the Cornell box only for Cycles '
+                  '| | | | | |' % s)
+
+
+if __name__ == '__main__':
+    main()

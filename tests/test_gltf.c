@@ -41,6 +41,68 @@ static int load_mesh(const char *path, Scene *s)
     return st == ST_OK;
 }
 
+/* One triangle whose material is `material_json`, loaded from memory through the same
+ * path as a .gltf file; ST_OK and the scene, or the error. */
+static Status load_triangle(const char *material_json, Scene *s, Error *err)
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+             "\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},"
+             "\"material\":0}]}],\"materials\":[%s],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+             "\"min\":[0,0,0],\"max\":[1,1,0]}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+             "\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/octet-stream;base64,"
+             "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}]}",
+             material_json);
+    scene_init(s);
+    return scene_load_bytes("alpha.gltf", text, strlen(text), SCENE_FORMAT_AUTO, s, NULL, err);
+}
+
+/* alphaMode and alphaCutoff become the principled material's alpha mode (kernels/alpha.h
+ * renders them; test_alpha.c checks the pixels); emissiveTexture its emission texture. */
+static void test_alpha_modes(void)
+{
+    static const struct { const char *json; uint flags; float alpha, cutoff; } ok[] = {
+        { "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,0.25]}}", 0u, 0.25f, 0.5f },
+        { "{\"alphaMode\":\"OPAQUE\"}", 0u, 1.0f, 0.5f },
+        { "{\"alphaMode\":\"MASK\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,0.25]}}", MAT_ALPHA_MASK,
+          0.25f, 0.5f },
+        { "{\"alphaMode\":\"MASK\",\"alphaCutoff\":0.125}", MAT_ALPHA_MASK, 1.0f, 0.125f },
+        { "{\"alphaMode\":\"BLEND\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,0.75]}}", MAT_ALPHA_BLEND,
+          0.75f, 0.5f },
+    };
+    for (size_t i = 0; i < sizeof ok / sizeof ok[0]; i++) {
+        Scene s;
+        Error err = { 0 };
+        Status st = load_triangle(ok[i].json, &s, &err);
+        CHECK_MSG(st == ST_OK, "%s: %s", ok[i].json, err.msg);
+        if (st == ST_OK) {
+            const Material *m = &s.materials[s.triangles[0].material];
+            CHECK(m->type == MAT_PRINCIPLED);
+            CHECK((m->flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) == ok[i].flags);
+            CHECK(m->alpha == ok[i].alpha);
+            CHECK(m->alpha_cutoff == ok[i].cutoff);
+            CHECK(m->texture_emission == NO_INDEX);
+        }
+        error_clear(&err);
+        scene_free(&s);
+    }
+    static const struct { const char *json, *msg; } bad[] = {
+        { "{\"alphaMode\":\"CUTOUT\"}", "alpha.gltf: materials[0].alphaMode: expected \"OPAQUE\", \"MASK\" or \"BLEND\"" },
+        { "{\"alphaMode\":1}", "alpha.gltf: materials[0].alphaMode: expected \"OPAQUE\", \"MASK\" or \"BLEND\"" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        Scene s;
+        Error err = { 0 };
+        Status st = load_triangle(bad[i].json, &s, &err);
+        CHECK(st == ST_INPUT);
+        CHECK_MSG(strcmp(err.msg, bad[i].msg) == 0, "got '%s'", err.msg);
+        error_clear(&err);
+        scene_free(&s);
+    }
+}
+
 /* Winding normal of triangle i, unnormalised. */
 static vec3 winding(const Scene *s, size_t i)
 {
@@ -511,6 +573,7 @@ int main(void)
     RUN(test_textures);
     RUN(test_nodes);
     RUN(test_mesh_block);
+    RUN(test_alpha_modes);
     RUN(test_cornell_box);
     RUN(test_material_spheres);
     RUN(test_suzanne_texture);

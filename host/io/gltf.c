@@ -606,6 +606,31 @@ static Status texture_tinted(Gltf *g, uint base, const double factor[3], uint *o
     return scene_add_texture(g->s, NULL, NULL, t, out, g->err);
 }
 
+/* alphaMode OPAQUE (the default: alpha ignored), MASK (cut out where alpha, baseColorFactor's
+ * A times the base-colour texture's alpha, is below alphaCutoff, default 0.5) or BLEND
+ * (a hit kept with probability alpha, kernels/alpha.h). */
+static Status material_alpha(Gltf *g, const cJSON *m, const char *jp, double alpha, Material *mt)
+{
+    char jpa[96];
+    snprintf(jpa, sizeof jpa, "%s.alphaMode", jp);
+    const cJSON *mode = cJSON_GetObjectItemCaseSensitive(m, "alphaMode");
+    mt->alpha = (float)alpha;
+    if (!mode) return ST_OK;
+    if (!cJSON_IsString(mode)) return bad(g, jpa, "expected \"OPAQUE\", \"MASK\" or \"BLEND\"");
+    if (strcmp(mode->valuestring, "MASK") == 0) {
+        double cutoff;
+        Status st = get_num(g, m, "alphaCutoff", 0.5, 0.0, 1.0, jp, &cutoff);
+        if (st) return st;
+        mt->alpha_cutoff = (float)cutoff;
+        mt->flags |= MAT_ALPHA_MASK;
+    } else if (strcmp(mode->valuestring, "BLEND") == 0) {
+        mt->flags |= MAT_ALPHA_BLEND;
+    } else if (strcmp(mode->valuestring, "OPAQUE") != 0) {
+        return bad(g, jpa, "expected \"OPAQUE\", \"MASK\" or \"BLEND\"");
+    }
+    return ST_OK;
+}
+
 static Status material_build(Gltf *g, int i, uint *out)
 {
     char jp[64];
@@ -635,10 +660,9 @@ static Status material_build(Gltf *g, int i, uint *out)
     if ((st = texinfo(g, pbr, "metallicRoughnessTexture", 1, jpp, &mt.texture_rm, NULL))) return st;
     if ((st = texinfo(g, m, "normalTexture", 1, jp, &mt.texture_normal, &nscale))) return st;
     mt.normal_scale = (float)nscale;
-    if (cJSON_GetObjectItemCaseSensitive(m, "emissiveTexture") &&
-        (st = scene_warn(g->s, g->err, "%s: %s: emissiveTexture is ignored (emissiveFactor is used alone)", g->path,
-                         jp)))
-        return st;
+    /* the emissive texture is sRGB-encoded, like the base colour (glTF 2.0, 3.9.5) */
+    if ((st = texinfo(g, m, "emissiveTexture", 0, jp, &mt.texture_emission, NULL))) return st;
+    if ((st = material_alpha(g, m, jp, base[3], &mt))) return st;
     double v;
     const cJSON *x;
     if ((x = ext_of(m, "KHR_materials_ior"))) {

@@ -11,7 +11,7 @@ static CliResult r;   /* large: static */
 
 #define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
 
-static const char *const classic_scenes[] = { "spheres", "glass", "mesh", "ortho", "textured" };
+static const char *const classic_scenes[] = { "spheres", "glass", "mesh", "ortho", "textured", "vase" };
 #define N_CLASSIC (sizeof classic_scenes / sizeof classic_scenes[0])
 
 /* Whether two files hold the same bytes (and both exist). */

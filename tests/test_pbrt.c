@@ -15,6 +15,7 @@
 #include "scene/camera.h"
 #include "scene/mesh_sink.h"
 #include "scene/scene.h"
+#include "scene/subdiv.h"
 
 #define DIR "tests/data/pbrt/"
 
@@ -295,8 +296,69 @@ static void test_errors(void)
                  DIR "inline.pbrt:1:31: expected a finite number, found '1e39'");
 }
 
+/* the octahedron's corners: valence 4, Warren's beta 3/32 (as pbrt), gamma
+ * 1 / (4 + 3 / (8 beta)) = 1/8; a corner's limit is (1 - 4/8) of the way out (its four
+ * neighbours sum to zero) */
+static const double octa_p[] = { 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1 };
+static const uint32_t octa_i[] = { 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5 };
+
+static void test_loop_limits(void)
+{
+    Error err = { 0 };
+    for (int levels = 0; levels <= 4; levels++) {
+        SubdivMesh m;
+        CHECK_EQ_INT(subdiv_loop(octa_p, 6, octa_i, 8, levels, 1u << 20, &m, &err), ST_OK);
+        CHECK_EQ_INT(m.n_tris, 8u << (2 * levels));
+        for (int v = 0; v < 6; v++)
+            for (int c = 0; c < 3; c++) CHECK_NEAR(m.p[3 * v + c], 0.5 * octa_p[3 * v + c], 1e-12);
+        /* a corner's normal points straight out */
+        CHECK_NEAR(m.n[0], 1, 1e-12);
+        subdiv_free(&m);
+    }
+    /* an irregular closed mesh (a pyramid on a square: valences 3 and 4): the limit
+     * point of a control vertex is the same whether found at level 0 or after levels of
+     * Loop's rules, which holds only when the even and odd rules are Loop's */
+    static const double pyr_p[] = { 0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0, 1, 1, 3 };
+    static const uint32_t pyr_i[] = { 0, 2, 1, 0, 3, 2, 0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4 };
+    SubdivMesh base, deep;
+    CHECK_EQ_INT(subdiv_loop(pyr_p, 5, pyr_i, 6, 0, 1u << 20, &base, &err), ST_OK);
+    CHECK_EQ_INT(subdiv_loop(pyr_p, 5, pyr_i, 6, 3, 1u << 20, &deep, &err), ST_OK);
+    for (int i = 0; i < 15; i++) CHECK_NEAR(deep.p[i], base.p[i], 1e-12);
+    /* the apex (valence 4): gamma 1/8, neighbours (0,0,0) (2,0,0) (2,2,0) (0,2,0) */
+    CHECK_NEAR(base.p[12], 0.5 * 1 + 4.0 / 8, 1e-12);
+    CHECK_NEAR(base.p[14], 0.5 * 3, 1e-12);
+    subdiv_free(&base);
+    subdiv_free(&deep);
+    /* a lone triangle is all boundary: 3/5 of a corner and 1/5 of each neighbour, pbrt's
+     * boundary limit rule (the cubic B-spline's own would be 4/6 and 1/6, so on a
+     * boundary the limit found after some levels differs from level 0's, in pbrt too) */
+    static const double tri_p[] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
+    static const uint32_t tri_i[] = { 0, 1, 2 };
+    CHECK_EQ_INT(subdiv_loop(tri_p, 3, tri_i, 1, 0, 1u << 20, &base, &err), ST_OK);
+    CHECK_NEAR(base.p[0], 0.2, 1e-12);
+    CHECK_NEAR(base.p[1], 0.2, 1e-12);
+    CHECK_NEAR(base.p[3], 0.6, 1e-12);
+    subdiv_free(&base);
+    CHECK_EQ_INT(subdiv_loop(tri_p, 3, tri_i, 1, 11, 1u << 20, &base, &err), ST_INPUT);
+    CHECK(strstr(err.msg, "makes more than 1048576 triangles") != NULL);
+    /* through the reader: 8 * 4^2 triangles, the corners at their limits */
+    static const char text[] = "Shape \"loopsubdiv\" \"integer levels\" 2\n"
+                               "  \"point3 P\" [ 1 0 0 -1 0 0 0 1 0 0 -1 0 0 0 1 0 0 -1 ]\n"
+                               "  \"integer indices\" [ 0 2 4 2 1 4 1 3 4 3 0 4 2 0 5 1 2 5 3 1 5 0 3 5 ]\n";
+    Scene s;
+    CHECK_EQ_INT(load_text(text, &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_triangles, 128);
+    vec3 lo, hi;
+    mesh_bounds(&s, 0, s.n_triangles, &lo, &hi);
+    CHECK_NEAR(hi.x, 0.5, 1e-6);
+    CHECK_NEAR(lo.z, -0.5, 1e-6);
+    CHECK(s.n_shading == 128);
+    scene_free(&s);
+}
+
 int main(void)
 {
+    RUN(test_loop_limits);
     RUN(test_detect);
     RUN(test_basic);
     RUN(test_transforms);

@@ -14,6 +14,7 @@
 #include "io/texture.h"
 #include "kmath.h"
 #include "scene/mesh_sink.h"
+#include "scene/subdiv.h"
 #include "scene/transform.h"
 
 /* ------------------------------------------------------------------ parameter lists */
@@ -439,7 +440,7 @@ static Status get_spectrum(Parser *p, const Lexer *lx, const char *name, vec3 *o
     if (tex) *tex = NULL;
     if (!pa) return ST_OK;
     if (given) *given = 1;
-    const double *d = p->pl.nums + pa->first;
+    const double *d = pa->strings ? NULL : p->pl.nums + pa->first;   /* no numbers: no array yet */
     switch (pa->type) {
     case PT_RGB:
         if (d[0] < 0 || d[1] < 0 || d[2] < 0) return param_type_error(p, lx, pa, "an rgb colour >= 0");
@@ -1441,6 +1442,48 @@ static Status shape_sphere(Parser *p, const Lexer *lx, const Token *type, uint m
     return ST_OK;
 }
 
+/* pbrt's loopsubdiv: subdivided here to `levels` (default 3), limit positions, smooth
+ * normals (scene/subdiv.h). */
+static Status shape_loopsubdiv(Parser *p, const Lexer *lx, const Token *type, uint material)
+{
+    Param *P = param_find(p, "P"), *ix;
+    if (!P) return lex_error_at(lx, type, p->err, "a loopsubdiv needs \"point3 P\"");
+    if (P->type != PT_POINT3) return param_type_error(p, lx, P, "point3");
+    size_t np = P->n / 3;
+    long levels = 3;
+    Status st = get_int(p, lx, "levels", &levels);
+    if (st) return st;
+    if (levels < 0 || levels > 16) return param_type_error(p, lx, param_find(p, "levels"), "in 0..16");
+    if ((st = get_indices(p, lx, "indices", 3, np, NULL, &ix))) return st;
+    if (!ix) return lex_error_at(lx, type, p->err, "a loopsubdiv needs \"integer indices\"");
+    size_t nt = ix->n / 3;
+    uint32_t *idx = malloc(ix->n * sizeof *idx + 1);
+    if (!idx) return error_set(p->err, ST_INTERNAL, "out of memory");
+    for (size_t i = 0; i < ix->n; i++) idx[i] = (uint32_t)p->pl.nums[ix->first + i];
+    SubdivMesh m;
+    st = subdiv_loop(p->pl.nums + P->first, np, idx, nt, (int)levels, CLPT_MAX_TESSELLATED_TRIANGLES, &m, p->err);
+    free(idx);
+    if (st == ST_INPUT) error_prefix(p->err, "%s:%u:%u", lx->path, type->line, type->col);
+    if (st) return st;
+    MeshSink k;
+    size_t first = p->s->n_triangles;
+    if (!(st = mesh_sink_open(&k, p->s, &p->g.ctm, lx->path, p->err))) st = mesh_sink_reserve(&k, m.n_tris, m.n_tris);
+    for (size_t f = 0; f < m.n_tris && !st; f++) {
+        vec3 q[3], n[3];
+        int has_n = 1;
+        for (int c = 0; c < 3; c++) {
+            const double *a = m.p + 3 * m.idx[3 * f + c], *b = m.n + 3 * m.idx[3 * f + c];
+            q[c] = v3((float)a[0], (float)a[1], (float)a[2]);
+            n[c] = v3((float)b[0], (float)b[1], (float)b[2]);
+            has_n &= !v3_is_zero(n[c]);
+        }
+        st = mesh_sink_triangle(&k, q, has_n ? n : NULL, NULL, material);
+    }
+    subdiv_free(&m);
+    if (!st) orient_triangles(p, first);
+    return st;
+}
+
 static Status shape_plymesh(Parser *p, const Lexer *lx, const Token *type, uint material)
 {
     const Token *f = NULL;
@@ -1478,7 +1521,7 @@ static Status d_shape(Parser *p, Lexer *lx, const Token *kw)
     if (!st) st = parse_params(p, lx);
     if (st) return st;
     int known = tok_eq(&type, "sphere") || tok_eq(&type, "trianglemesh") || tok_eq(&type, "plymesh") ||
-                tok_eq(&type, "bilinearmesh");
+                tok_eq(&type, "bilinearmesh") || tok_eq(&type, "loopsubdiv");
     if (!known) {
         char key[96];
         snprintf(key, sizeof key, "Shape %.*s", (int)(type.len > 40 ? 40 : type.len), type.text);
@@ -1491,6 +1534,8 @@ static Status d_shape(Parser *p, Lexer *lx, const Token *kw)
         st = shape_sphere(p, lx, &type, material);
     } else if (tok_eq(&type, "plymesh")) {
         st = shape_plymesh(p, lx, &type, material);
+    } else if (tok_eq(&type, "loopsubdiv")) {
+        st = shape_loopsubdiv(p, lx, &type, material);
     } else {
         MeshSink k;
         size_t first = p->s->n_triangles;

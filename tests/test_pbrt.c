@@ -180,8 +180,8 @@ static void test_warnings(void)
         DIR "warnings.pbrt:3: Film: parameter \"float iso\" is not supported; ignored",
         DIR "warnings.pbrt:5: Shape \"disk\" is not supported; skipped",
         DIR "warnings.pbrt:7: Shape: parameter \"float wobble\" is not supported; ignored",
-        DIR "warnings.pbrt:9: ObjectBegin is not supported; ignored",
-        DIR "warnings.pbrt:10: ObjectEnd is not supported; ignored",
+        DIR "warnings.pbrt:9: MakeNamedMedium is not supported; ignored",
+        DIR "warnings.pbrt:10: TransformTimes is not supported; ignored",
     };
     CHECK_EQ_INT(s.n_warnings, 6);
     for (size_t i = 0; i < 6 && i < s.n_warnings; i++)
@@ -201,6 +201,31 @@ static void test_include(void)
     CHECK_EQ_INT(load(DIR "self-include.pbrt", &s, &err), ST_INPUT);
     CHECK_MSG(strstr(err.msg, "includes nested more than 16 deep") != NULL, "got '%s'", err.msg);
     scene_free(&s);
+}
+
+static void expect_error(const char *text, const char *msg);
+
+static void test_instances(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load(DIR "instances.pbrt", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_triangles, 2);
+    CHECK_EQ_INT(s.n_spheres, 2);
+    if (s.n_triangles == 2 && s.n_spheres == 2) {
+        CHECK_V3(s.triangles[0].p1, 1, 1, 0, 0);
+        CHECK_V3(s.triangles[1].p1, 7, 2, 0, 0);   /* (1, 1, 0) scaled by 2, moved by 5 */
+        CHECK_V3(s.spheres[0].center, 0, 1, 0, 0);
+        CHECK_V3(s.spheres[1].center, 5, 2, 0, 0);
+        CHECK_NEAR(s.spheres[1].radius, 1, 0);
+        CHECK(s.triangles[1].shading != NO_INDEX && s.shading[s.triangles[1].shading].n0.z == 1);
+    }
+    scene_free(&s);
+    expect_error("ObjectInstance \"nothing\"",
+                 DIR "inline.pbrt:1:16: object 'nothing' is not defined (ObjectBegin defines it)");
+    expect_error("ObjectBegin \"a\"\nAttributeEnd\nObjectEnd", DIR "inline.pbrt:3:1: ObjectEnd inside an "
+                 "AttributeBegin of its object, or after one that closes more than it opened");
+    expect_error("ObjectBegin \"a\"\nShape \"sphere\"", DIR "inline.pbrt: ObjectBegin \"a\" has no ObjectEnd");
 }
 
 /* pbrt's camera space is left-handed: seen from +z with y up, world +x is on the left. */
@@ -365,6 +390,7 @@ int main(void)
     RUN(test_materials_lights);
     RUN(test_warnings);
     RUN(test_include);
+    RUN(test_instances);
     RUN(test_orientation);
     RUN(test_compare);
     RUN(test_errors);

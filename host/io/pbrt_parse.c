@@ -68,6 +68,13 @@ typedef struct {
     uint index;
 } PTexture;
 
+/* An ObjectBegin/End's shapes, taken out of the scene and copied in at each instance. */
+typedef struct {
+    Sphere *spheres;      size_t n_spheres;
+    Triangle *triangles;  size_t n_triangles;
+    TriShading *shading;  size_t n_shading;   /* Triangle.shading indexes this */
+} PObject;
+
 typedef struct {
     Scene *s;
     Error *err;
@@ -83,6 +90,12 @@ typedef struct {
     StrMap tex_by_name;      /* name -> index into tex */
     PTexture *tex;  size_t n_tex, cap_tex;
     StrMap warned;           /* warning keys already given */
+    StrMap object_by_name;   /* name -> index into objects */
+    PObject *objects;  size_t n_objects, cap_objects;
+    int in_object;           /* inside ObjectBegin: what it started with */
+    size_t obj_spheres, obj_triangles, obj_shading, obj_stack;
+    Token obj_name;          /* its name, copied into obj_name_buf */
+    char *obj_name_buf;
     ParamList pl;
     /* the camera, finished once the film's size is known */
     int have_camera, cam_ortho;
@@ -1550,6 +1563,130 @@ static Status d_shape(Parser *p, Lexer *lx, const Token *kw)
     return warn_unused(p, lx, "Shape");
 }
 
+/* ------------------------------------------------------------------ instancing */
+
+/* Instances are flattened: ObjectEnd takes the object's shapes out of the scene and
+ * each ObjectInstance appends them again, moved by the instance's transform. */
+#define PBRT_MAX_FLAT_TRIANGLES ((size_t)1 << 26)
+
+static Status d_object_begin(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token name;
+    Status st = expect_string(p, lx, "a quoted object name", &name);
+    if (st) return st;
+    if (p->in_object) return lex_error_at(lx, kw, p->err, "ObjectBegin inside another ObjectBegin");
+    if ((st = push_state(p))) return st;
+    p->in_object = 1;
+    p->obj_stack = p->n_stack;
+    p->obj_spheres = p->s->n_spheres;
+    p->obj_triangles = p->s->n_triangles;
+    p->obj_shading = p->s->n_shading;
+    free(p->obj_name_buf);
+    p->obj_name_buf = tok_copy(&name);
+    if (!p->obj_name_buf) return error_set(p->err, ST_INTERNAL, "out of memory");
+    p->obj_name = name;
+    p->obj_name.text = p->obj_name_buf;
+    return ST_OK;
+}
+
+static Status d_object_end(Parser *p, Lexer *lx, const Token *kw)
+{
+    if (!p->in_object) return lex_error_at(lx, kw, p->err, "ObjectEnd without ObjectBegin");
+    if (p->n_stack != p->obj_stack)
+        return lex_error_at(lx, kw, p->err, "ObjectEnd inside an AttributeBegin of its object, or after one "
+                            "that closes more than it opened");
+    Scene *s = p->s;
+    PObject o;
+    memset(&o, 0, sizeof o);
+    o.n_spheres = s->n_spheres - p->obj_spheres;
+    o.n_triangles = s->n_triangles - p->obj_triangles;
+    o.n_shading = s->n_shading - p->obj_shading;
+    o.spheres = malloc(o.n_spheres * sizeof *o.spheres + 1);
+    o.triangles = malloc(o.n_triangles * sizeof *o.triangles + 1);
+    o.shading = malloc(o.n_shading * sizeof *o.shading + 1);
+    if (!o.spheres || !o.triangles || !o.shading ||
+        grow((void **)&p->objects, &p->cap_objects, p->n_objects + 1, sizeof(PObject))) {
+        free(o.spheres);
+        free(o.triangles);
+        free(o.shading);
+        return error_set(p->err, ST_INTERNAL, "out of memory");
+    }
+    memcpy(o.spheres, s->spheres + p->obj_spheres, o.n_spheres * sizeof *o.spheres);
+    memcpy(o.triangles, s->triangles + p->obj_triangles, o.n_triangles * sizeof *o.triangles);
+    memcpy(o.shading, s->shading + p->obj_shading, o.n_shading * sizeof *o.shading);
+    for (size_t i = 0; i < o.n_triangles; i++)
+        if (o.triangles[i].shading != NO_INDEX) o.triangles[i].shading -= (uint)p->obj_shading;
+    s->n_spheres = p->obj_spheres;
+    s->n_triangles = p->obj_triangles;
+    s->n_shading = p->obj_shading;
+    /* a name defined again replaces the earlier object, for the instances after it */
+    if (strmap_set(&p->object_by_name, p->obj_name.text, p->obj_name.len, (uint32_t)p->n_objects)) {
+        free(o.spheres);
+        free(o.triangles);
+        free(o.shading);
+        return error_set(p->err, ST_INTERNAL, "out of memory");
+    }
+    p->objects[p->n_objects++] = o;
+    p->in_object = 0;
+    p->g = p->stack[--p->n_stack];
+    return ST_OK;
+}
+
+static Status d_object_instance(Parser *p, Lexer *lx, const Token *kw)
+{
+    (void)kw;
+    Token name;
+    Status st = expect_string(p, lx, "a quoted object name", &name);
+    if (st) return st;
+    uint32_t i;
+    if (!strmap_find(&p->object_by_name, name.text, name.len, &i))
+        return lex_error_at(lx, &name, p->err, "object '%.*s' is not defined (ObjectBegin defines it)",
+                            (int)(name.len > 40 ? 40 : name.len), name.text);
+    const PObject *o = &p->objects[i];
+    if (p->s->n_triangles + o->n_triangles > PBRT_MAX_FLAT_TRIANGLES)
+        return lex_error_at(lx, &name, p->err, "the flattened instances would hold more than %zu triangles",
+                            PBRT_MAX_FLAT_TRIANGLES);
+    MeshSink k;
+    if ((st = mesh_sink_open(&k, p->s, &p->g.ctm, lx->path, p->err)) ||
+        (st = mesh_sink_reserve(&k, o->n_triangles, o->n_shading)))
+        return st;
+    for (size_t t = 0; t < o->n_triangles && !st; t++) {
+        const Triangle *tr = &o->triangles[t];
+        const TriShading *sh = tr->shading != NO_INDEX ? &o->shading[tr->shading] : NULL;
+        vec3 q[3] = { tr->p0, tr->p1, tr->p2 };
+        vec3 n[3];
+        float uv[6];
+        int has_n = sh && (sh->flags & TRI_HAS_NORMALS), has_uv = sh && (sh->flags & TRI_HAS_UV);
+        if (has_n) {
+            n[0] = sh->n0;
+            n[1] = sh->n1;
+            n[2] = sh->n2;
+        }
+        if (has_uv) {
+            const float u[6] = { sh->uv0[0], sh->uv0[1], sh->uv1[0], sh->uv1[1], sh->uv2[0], sh->uv2[1] };
+            memcpy(uv, u, sizeof uv);
+        }
+        st = mesh_sink_triangle(&k, q, has_n ? n : NULL, has_uv ? uv : NULL, tr->material);
+    }
+    double scale;
+    int similar = is_similarity(&p->g.ctm, &scale);
+    for (size_t j = 0; j < o->n_spheres && !st; j++) {
+        if (!similar) {
+            st = warn_once(p, lx, &name, "instance-sphere", "a sphere in an instance whose transform is not a "
+                           "similarity (an ellipsoid) is skipped");
+            break;
+        }
+        Sphere sp = o->spheres[j];
+        sp.center = transform_point(&p->g.ctm, sp.center);
+        sp.radius = (float)(sp.radius * scale);
+        if (!(sp.radius > 0) || !isfinite(sp.radius) || !isfinite(fabsf(sp.center.x) + sp.radius) ||
+            !isfinite(fabsf(sp.center.y) + sp.radius) || !isfinite(fabsf(sp.center.z) + sp.radius))
+            return lex_error_at(lx, &name, p->err, "the instanced sphere reaches beyond the largest float");
+        st = scene_add_sphere(p->s, sp, p->err);
+    }
+    return st;
+}
+
 /* ------------------------------------------------------------------ files */
 
 static Status parse_file(Parser *p, const char *path, const char *text, size_t len);
@@ -1650,9 +1787,9 @@ static const struct {
     {"MakeNamedMedium", d_unsupported},
     {"MediumInterface", d_unsupported},
     {"Attribute", d_unsupported},
-    {"ObjectBegin", d_unsupported},
-    {"ObjectEnd", d_unsupported},
-    {"ObjectInstance", d_unsupported},
+    {"ObjectBegin", d_object_begin},
+    {"ObjectEnd", d_object_end},
+    {"ObjectInstance", d_object_instance},
 };
 #define N_DIRECTIVES (sizeof directives / sizeof directives[0])
 
@@ -1779,6 +1916,7 @@ Status pbrt_load_text(const char *path, const char *text, size_t len, Scene *s, 
     s->image.spp = 16;
     s->image.max_depth = 5;
     Status st = parse_file(&p, path, text, len);
+    if (!st && p.in_object) st = error_set(err, ST_INPUT, "%s: ObjectBegin \"%s\" has no ObjectEnd", path, p.obj_name_buf);
     if (!st) st = finish_camera(&p);
     if (!st) st = scene_check_precision(s, err);
     free(p.stack);
@@ -1791,5 +1929,13 @@ Status pbrt_load_text(const char *path, const char *text, size_t len, Scene *s, 
     strmap_free(&p.coordsys);
     strmap_free(&p.tex_by_name);
     strmap_free(&p.warned);
+    strmap_free(&p.object_by_name);
+    for (size_t i = 0; i < p.n_objects; i++) {
+        free(p.objects[i].spheres);
+        free(p.objects[i].triangles);
+        free(p.objects[i].shading);
+    }
+    free(p.objects);
+    free(p.obj_name_buf);
     return st;
 }

@@ -117,8 +117,11 @@ static void test_materials_lights(void)
     CHECK_NEAR(s.camera.aperture, 0.2, 1e-7);
     CHECK_NEAR(s.camera.focus_dist, 4, 0);
     CHECK(s.camera.mirror_x);
-    CHECK_EQ_INT(s.n_spheres, 9);
-    if (s.n_spheres != 9) goto out;
+    CHECK_EQ_INT(s.n_spheres, 10);
+    if (s.n_spheres != 10) goto out;
+    /* an imagemap texture, found beside the scene, gives a diffuse material's colour */
+    CHECK_EQ_INT(s.n_textures, 1);
+    CHECK_EQ_INT(s.materials[s.spheres[9].material].texture, 0);
     const Material *m[9];
     for (int i = 0; i < 9; i++) m[i] = &s.materials[s.spheres[i].material];
     CHECK_EQ_INT(m[0]->type, MAT_DIFFUSE);

@@ -1219,8 +1219,9 @@ static Status d_light(Parser *p, Lexer *lx, const Token *kw)
         if ((st = get_spectrum(p, lx, "L", &c, NULL, NULL))) return st;
         const Token *f = NULL;
         if ((st = get_string(p, lx, "filename", &f))) return st;
-        if (f && (st = warn_once(p, lx, f, "infinite-map", "infinite light: environment maps are not supported "
-                                 "yet; \"%.*s\" is shown as a constant L", (int)(f->len > 60 ? 60 : f->len), f->text)))
+        if (f && (st = warn_once(p, lx, f, "infinite-map", "infinite light: \"%.*s\" is not used (pbrt-v4's maps "
+                                 "are equal-area octahedral images, which clpt does not read); a constant L lights the "
+                                 "scene instead", (int)(f->len > 60 ? 60 : f->len), f->text)))
             return st;
         param_find(p, "portal");   /* a sampling aid only */
         p->s->bg_type = BG_CONSTANT;

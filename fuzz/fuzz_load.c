@@ -1,6 +1,6 @@
 /*
  * fuzz_load.c — the one loader (host/io/scene_load.c) on arbitrary bytes: the byte order
- * mark, telling the classic format from ours, and the dispatch to the three readers,
+ * mark, telling the classic, pbrt-v4 and our formats apart, and the dispatch to the readers,
  * including the scene made around a bare mesh (host/io/mesh_view.c). Each input is read
  * three times, named fuzz.scene (a scene of either format, by its content), fuzz.obj and
  * fuzz.ply (a bare mesh, by the name), so every branch sees every input. Files a scene
@@ -9,6 +9,7 @@
 #include "fuzz.h"
 #include "io/classic_parse.h"
 #include "io/lexer.h"
+#include "io/pbrt_parse.h"
 #include "io/scene_load.h"
 
 FUZZ_SEEDS("scene txt obj ply");
@@ -36,6 +37,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     char *text = fuzz_text(data, size);
     if (!text) return 0;
     size_t bom = lex_bom_length(text, size);
+    int pbrt = pbrt_detect(text + bom, size - bom);
     int classic = classic_detect(text + bom, size - bom);
     static const char *const names[] = { "fuzz.scene", "fuzz.obj", "fuzz.ply" };
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
@@ -44,7 +46,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         Error err = { 0 };
         SceneKind kind = 0;
         Status st = scene_load_bytes(names[i], text, size, SCENE_FORMAT_AUTO, &s, &kind, &err);
-        FUZZ_ASSERT(kind == (i > 0 ? SCENE_KIND_MESH : classic ? SCENE_KIND_CLASSIC : SCENE_KIND_CLPT));
+        FUZZ_ASSERT(kind == (i > 0 ? SCENE_KIND_MESH : pbrt ? SCENE_KIND_PBRT : classic ? SCENE_KIND_CLASSIC
+                                                                                        : SCENE_KIND_CLPT));
         if (st) FUZZ_ASSERT((st == ST_INPUT || st == ST_IO) && err.msg[0]);
         else check_scene(&s, kind);
         scene_free(&s);

@@ -118,8 +118,9 @@ void options_print_help(FILE *f)
 "                             from it (default 30); its batches go to others\n"
 "\n"
 "Scene and integrator:\n"
-"      --format auto|clpt|classic\n"
+"      --format auto|clpt|classic|pbrt\n"
 "                             scene file format; default: told from the content\n"
+"                             (pbrt: pbrt-v4 scenes, see docs/pbrt.md)\n"
 "      --camera N|NAME        glTF: look through camera N (from 0) or the camera\n"
 "                             (or camera node) named NAME; default: the first\n"
 "      --integrator path|whitted\n"
@@ -410,8 +411,9 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
 {
     static const char *const integrators[] = { "path", "whitted", NULL };
     static const int integrator_values[] = { INTEGRATOR_PATH, INTEGRATOR_WHITTED };
-    static const char *const formats[] = { "auto", "clpt", "classic", NULL };
-    static const int format_values[] = { SCENE_FORMAT_AUTO, SCENE_FORMAT_CLPT, SCENE_FORMAT_CLASSIC };
+    static const char *const formats[] = { "auto", "clpt", "classic", "pbrt", NULL };
+    static const int format_values[] = { SCENE_FORMAT_AUTO, SCENE_FORMAT_CLPT, SCENE_FORMAT_CLASSIC,
+                                         SCENE_FORMAT_PBRT };
     static const char *const gammas[] = { "srgb", "none", NULL };
     static const int gamma_values[] = { 0, 1 };
     static const char *const on_off[] = { "on", "off", NULL };
@@ -422,7 +424,7 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
     if (strcmp(a, "--integrator") == 0)
         return parse_choice(a, v, integrators, integrator_values, "'path' or 'whitted'", &o->integrator, err);
     if (strcmp(a, "--format") == 0)
-        return parse_choice(a, v, formats, format_values, "'auto', 'clpt' or 'classic'", &o->format, err);
+        return parse_choice(a, v, formats, format_values, "'auto', 'clpt', 'classic' or 'pbrt'", &o->format, err);
     if (strcmp(a, "--gamma") == 0)
         return parse_choice(a, v, gammas, gamma_values, "'srgb' or 'none'", &o->gamma, err);
     if (strcmp(a, "--shadows") == 0)

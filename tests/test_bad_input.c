@@ -64,7 +64,8 @@ static int read_expect(const char *path, Expect *e)
 static Status load(const char *path, Scene *s, Error *err)
 {
     /* scenes of both formats through the one loader, as clpt reads them */
-    if (has_suffix(path, ".scene") || has_suffix(path, ".txt")) return scene_load_file(path, SCENE_FORMAT_AUTO, s, NULL, err);
+    if (has_suffix(path, ".scene") || has_suffix(path, ".txt") || has_suffix(path, ".pbrt"))
+        return scene_load_file(path, SCENE_FORMAT_AUTO, s, NULL, err);
     uint m, index;
     if (has_suffix(path, ".obj") || has_suffix(path, ".ply")) {
         Status st = scene_add_material(s, "m", material_diffuse(v3(0.5f, 0.5f, 0.5f)), &m, err);
@@ -137,7 +138,8 @@ static void check_file(const char *path)
         if (st == ST_OK && e.triangles >= 0)
             CHECK_MSG((long)s.n_triangles == e.triangles, "%s: %zu triangles, expected %ld", path, s.n_triangles,
                       e.triangles);
-        if (st == ST_OK && (has_suffix(path, ".scene") || has_suffix(path, ".txt"))) check_renders(path, &s, e.mean);
+        if (st == ST_OK && (has_suffix(path, ".scene") || has_suffix(path, ".txt") || has_suffix(path, ".pbrt")))
+            check_renders(path, &s, e.mean);
     } else {
         CHECK_MSG(e.message[0], "%s: an error needs its '# message:' line; this one is:\n    %s", path, err.msg);
         CHECK_MSG(st == want, "%s: status %d, expected %d (%s)", path, st, want, err.msg);

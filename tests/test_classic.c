@@ -722,7 +722,7 @@ static void test_cli(void)
     CliResult *r = malloc(sizeof *r);
     const char *bad[][8] = {
         { scene, "--integrator", "photon", NULL },
-        { scene, "--format", "pbrt", NULL },
+        { scene, "--format", "mitsuba", NULL },
         { scene, "--aov", "normal,motion", NULL },
         { scene, "--gamma", "2.2", NULL },
         { scene, "--adaptive", "0", NULL },

@@ -3,6 +3,7 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "kmath.h"
 #include "io/classic_parse.h"
@@ -10,15 +11,19 @@
 #include "io/lexer.h"
 #include "io/mesh_load.h"
 #include "io/mesh_view.h"
+#include "io/pbrt_parse.h"
 
 SceneKind scene_load_kind(const char *path, const char *text, size_t len, SceneFormat format)
 {
     switch (format) {
     case SCENE_FORMAT_CLPT: return SCENE_KIND_CLPT;
     case SCENE_FORMAT_CLASSIC: return SCENE_KIND_CLASSIC;
+    case SCENE_FORMAT_PBRT: return SCENE_KIND_PBRT;
     case SCENE_FORMAT_AUTO: break;
     }
     if (mesh_kind(path) != MESH_NONE) return SCENE_KIND_MESH;
+    size_t n = strlen(path);
+    if ((n > 5 && strcasecmp(path + n - 5, ".pbrt") == 0) || pbrt_detect(text, len)) return SCENE_KIND_PBRT;
     return classic_detect(text, len) ? SCENE_KIND_CLASSIC : SCENE_KIND_CLPT;
 }
 
@@ -56,6 +61,7 @@ Status scene_load_bytes(const char *path, const char *text, size_t len, SceneFor
     if (kind) *kind = k;
     if (k == SCENE_KIND_CLASSIC) return classic_load_text(path, text, len, s, err);
     if (k == SCENE_KIND_CLPT) return scene_load_text(path, text, len, s, err);
+    if (k == SCENE_KIND_PBRT) return pbrt_load_text(path, text, len, s, err);
     MeshOptions o = mesh_options(NO_INDEX);
     if (mesh_kind(path) == MESH_GLTF) return gltf_scene(path, text, len, s, kind, &o, err);
     Status st = mesh_parse(path, text, len, s, &o, err);

@@ -19,15 +19,17 @@
 typedef enum {
     SCENE_FORMAT_AUTO = 0,      /* a mesh by its extension, else told from the content */
     SCENE_FORMAT_CLPT = 1,      /* docs/scene-format.md */
-    SCENE_FORMAT_CLASSIC = 2    /* docs/classic-format.md */
+    SCENE_FORMAT_CLASSIC = 2,   /* docs/classic-format.md */
+    SCENE_FORMAT_PBRT = 3       /* docs/pbrt.md */
 } SceneFormat;
 
 /* What the input turned out to be. */
-typedef enum { SCENE_KIND_CLPT = 1, SCENE_KIND_CLASSIC, SCENE_KIND_MESH } SceneKind;
+typedef enum { SCENE_KIND_CLPT = 1, SCENE_KIND_CLASSIC, SCENE_KIND_MESH, SCENE_KIND_PBRT } SceneKind;
 
 /* The kind of input `path` with `len` bytes of `text` is read as: with
- * SCENE_FORMAT_AUTO a mesh when the name ends in .obj or .ply (any case), else the
- * classic format when classic_detect says so, else ours; otherwise the format given. */
+ * SCENE_FORMAT_AUTO a mesh when the name ends in .obj or .ply (any case), pbrt-v4 when
+ * it ends in .pbrt or its first word is a pbrt directive, else the classic format when
+ * classic_detect says so, else ours; otherwise the format given. */
 SceneKind scene_load_kind(const char *path, const char *text, size_t len, SceneFormat format);
 
 /* Reads `path` once (a regular file, or a pipe or FIFO read to its end) into an

@@ -77,6 +77,8 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
         return error_set(err, ST_INPUT, "camera: 'up' must not be zero or parallel to the view direction");
     u = dscale(u, 1.0 / ulen);
     dvec3 v = dcross(w, u);
+    /* a left-handed frame (pbrt's camera space) puts +x of the image the other way */
+    if (desc->mirror_x) u = dscale(u, -1.0);
 
     if (desc->type == CAMERA_ORTHOGRAPHIC) {
         /* the view rectangle through the camera centre, ortho_height tall */

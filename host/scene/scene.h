@@ -21,6 +21,8 @@ typedef struct {
     float ortho_height;  /* orthographic: height of the view rectangle (world units) */
     int course_basis;    /* perspective: span the image with normalize(view x up) and
                           * `up` as given (MIT 6.837 Fall 2019), not an orthonormal frame */
+    int mirror_x;        /* the image's right is -(view x up): a left-handed camera frame,
+                          * as pbrt's LookAt makes (docs/pbrt.md) */
 } SceneCamera;
 
 typedef struct {

@@ -1,0 +1,401 @@
+/* test_pbrt.c — the pbrt-v4 reader (host/io/pbrt_parse.c): directives, transforms,
+ * shapes, materials, lights and warnings of the scenes in tests/data/pbrt/, the image's
+ * orientation (pbrt's left-handed camera space), and a scene rendered from its .pbrt
+ * and its clpt-format twin, bit for bit. Run from the project root. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+#include "kmath.h"
+#include "io/pbrt_parse.h"
+#include "io/scene_load.h"
+#include "render_util.h"
+#include "scene/camera.h"
+#include "scene/mesh_sink.h"
+#include "scene/scene.h"
+#include "scene/subdiv.h"
+
+#define DIR "tests/data/pbrt/"
+
+static Status load(const char *path, Scene *s, Error *err)
+{
+    scene_init(s);
+    SceneKind kind = 0;
+    Status st = scene_load_file(path, SCENE_FORMAT_AUTO, s, &kind, err);
+    if (!st) CHECK_EQ_INT(kind, SCENE_KIND_PBRT);
+    return st;
+}
+
+static Status load_text(const char *text, Scene *s, Error *err)
+{
+    scene_init(s);
+    return scene_load_bytes(DIR "inline.pbrt", text, strlen(text), SCENE_FORMAT_AUTO, s, NULL, err);
+}
+
+#define CHECK_V3(v, X, Y, Z, tol)                                                      \
+    do {                                                                               \
+        CHECK_NEAR((v).x, X, tol);                                                     \
+        CHECK_NEAR((v).y, Y, tol);                                                     \
+        CHECK_NEAR((v).z, Z, tol);                                                     \
+    } while (0)
+
+static void test_detect(void)
+{
+    CHECK(pbrt_detect("# c\n  LookAt 0 0 0 0 0 1 0 1 0", 26));
+    CHECK(pbrt_detect("WorldBegin", 10));
+    CHECK(!pbrt_detect("camera { }", 10));
+    CHECK(!pbrt_detect("PerspectiveCamera {", 19));
+    CHECK_EQ_INT(scene_load_kind("x.PBRT", "", 0, SCENE_FORMAT_AUTO), SCENE_KIND_PBRT);
+    CHECK_EQ_INT(scene_load_kind("x.txt", "Shape \"sphere\"", 14, SCENE_FORMAT_AUTO), SCENE_KIND_PBRT);
+}
+
+static void test_basic(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load(DIR "basic.pbrt", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.image.width, 64);
+    CHECK_EQ_INT(s.image.height, 48);
+    CHECK_EQ_INT(s.image.spp, 8);
+    CHECK_EQ_INT(s.image.max_depth, 6);
+    CHECK_EQ_INT(s.n_spheres, 2);
+    CHECK_EQ_INT(s.n_triangles, 4);
+    CHECK_V3(s.camera.from, 0, 1.5, 5, 1e-6);
+    CHECK_NEAR(s.camera.vfov, 40, 1e-5);   /* landscape: fov is the vertical one */
+    CHECK(s.camera.mirror_x);
+    CHECK_V3(s.spheres[0].center, -0.9, 0.6, 0, 1e-6);
+    CHECK_V3(s.spheres[1].center, 0.9, 0.6, 0, 1e-6);
+    CHECK_NEAR(s.spheres[1].radius, 0.6, 1e-6);
+    CHECK_EQ_INT(s.materials[s.spheres[1].material].type, MAT_DIELECTRIC);
+    /* the area light faces down (Rotate 90 about x turns +z to -y) */
+    const Triangle *t = &s.triangles[2];
+    vec3 e1 = v3_sub(t->p1, t->p0), e2 = v3_sub(t->p2, t->p0);
+    CHECK(e1.z * e2.x - e1.x * e2.z < 0);
+    CHECK(s.materials[t->material].emission.y > 0);
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+}
+
+static void test_transforms(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load(DIR "transforms.pbrt", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_spheres, 5);
+    if (s.n_spheres == 5) {
+        CHECK_V3(s.spheres[0].center, 0, 1, 0, 1e-6);   /* Rotate 90 about z, then x 1 */
+        CHECK_V3(s.spheres[1].center, 2, 3, 4, 0);      /* Transform is column by column */
+        CHECK_V3(s.spheres[2].center, 1, 1, 0, 0);      /* ConcatTransform */
+        CHECK_NEAR(s.spheres[2].radius, 0.5, 0);
+        CHECK_V3(s.spheres[3].center, 1, 1, 2, 0);      /* CoordSysTransform */
+        CHECK_V3(s.spheres[4].center, 0, 0, 10, 1e-6);  /* the camera's system */
+    }
+    /* the sphere under Scale 1 2 1 is an ellipsoid of triangles, 2 units tall */
+    CHECK_EQ_INT(s.n_triangles, 64 * 32 * 2 - 2 * 64 + 2);
+    vec3 lo, hi;
+    mesh_bounds(&s, 0, s.n_triangles - 2, &lo, &hi);
+    CHECK_NEAR(hi.y - lo.y, 2, 1e-5);
+    CHECK_NEAR(hi.x - lo.x, 1, 1e-5);
+    /* ReverseOrientation swaps the winding */
+    size_t n = s.n_triangles;
+    CHECK_V3(s.triangles[n - 2].p1, 0, 1, 0, 0);
+    CHECK_V3(s.triangles[n - 1].p1, 1, 0, 0, 0);
+    CHECK_EQ_INT(s.camera.type, CAMERA_ORTHOGRAPHIC);
+    CHECK_NEAR(s.camera.ortho_height, 4, 0);   /* [-1, 1] across the shorter side */
+    scene_free(&s);
+}
+
+static void test_materials_lights(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load(DIR "materials.pbrt", &s, &err), ST_OK);
+    /* portrait: fov spans the width */
+    CHECK_NEAR(s.camera.vfov, 360 / M_PI * atan(tan(20 * M_PI / 180) * 32 / 24), 1e-4);
+    CHECK_NEAR(s.camera.aperture, 0.2, 1e-7);
+    CHECK_NEAR(s.camera.focus_dist, 4, 0);
+    CHECK(s.camera.mirror_x);
+    CHECK_EQ_INT(s.n_spheres, 10);
+    if (s.n_spheres != 10) goto out;
+    /* an imagemap texture, found beside the scene, gives a diffuse material's colour */
+    CHECK_EQ_INT(s.n_textures, 1);
+    CHECK_EQ_INT(s.materials[s.spheres[9].material].texture, 0);
+    const Material *m[9];
+    for (int i = 0; i < 9; i++) m[i] = &s.materials[s.spheres[i].material];
+    CHECK_EQ_INT(m[0]->type, MAT_DIFFUSE);
+    CHECK_V3(m[0]->albedo, 0.25, 0.5, 0.75, 0);
+    vec3 eta, k;
+    material_metal_preset("Ag", 2, &eta, &k);
+    CHECK_EQ_INT(m[1]->type, MAT_CONDUCTOR);
+    CHECK_V3(m[1]->eta, eta.x, eta.y, eta.z, 0);
+    CHECK_V3(m[1]->k, k.x, k.y, k.z, 0);
+    CHECK_NEAR(m[1]->roughness, 0.5, 1e-6);   /* alpha = sqrt(0.0625) = 0.25 */
+    CHECK(m[2]->flags & MAT_F0);
+    CHECK_V3(m[2]->specular, 0.9, 0.6, 0.3, 1e-6);
+    CHECK_NEAR(m[2]->roughness, sqrt(0.02), 1e-6);
+    CHECK_NEAR(m[2]->anisotropy, 0.75 / 0.9, 1e-6);
+    CHECK_EQ_INT(m[3]->type, MAT_DIELECTRIC);
+    CHECK_NEAR(m[3]->ior, 1.5185, 1e-6);
+    CHECK(m[4]->flags & MAT_THIN);
+    CHECK_NEAR(m[4]->ior, 1.33, 1e-6);
+    CHECK_EQ_INT(m[5]->type, MAT_PRINCIPLED);
+    CHECK_NEAR(m[5]->clearcoat, 1, 0);
+    CHECK_NEAR(m[5]->metallic, 0, 0);
+    CHECK_V3(m[5]->albedo, 0.2, 0.4, 0.6, 1e-6);
+    CHECK_EQ_INT(m[6]->type, MAT_DIELECTRIC);
+    CHECK_NEAR(m[6]->ior, 1, 0);
+    CHECK_EQ_INT(m[7]->type, MAT_DIELECTRIC);   /* mix 0.75: the second */
+    CHECK_V3(m[8]->emission, 2, 4, 6, 0);
+    CHECK(m[8]->flags & MAT_TWO_SIDED);
+    CHECK_EQ_INT(m[8]->type, MAT_DIFFUSE);
+    CHECK_EQ_INT(s.n_delta_lights, 3);
+    if (s.n_delta_lights == 3) {
+        const Light *l = s.delta_lights;
+        CHECK_EQ_INT(l[0].type, LIGHT_POINT);
+        CHECK_V3(l[0].position, 1, 2, 3, 0);
+        CHECK_V3(l[0].intensity, 5, 5, 5, 0);
+        CHECK_EQ_INT(l[1].type, LIGHT_SPOT);
+        CHECK_V3(l[1].direction, 0, -1, 0, 0);
+        CHECK_NEAR(l[1].cos_outer, cos(20 * M_PI / 180), 1e-7);
+        CHECK_NEAR(l[1].cos_inner, cos(15 * M_PI / 180), 1e-7);
+        CHECK_EQ_INT(l[2].type, LIGHT_DIRECTIONAL);
+        CHECK_V3(l[2].direction, 0, -1, 0, 0);
+        vec3 c = l[2].intensity;   /* a warm white of luminance 1 */
+        CHECK_NEAR(0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z, 1, 1e-3);
+        CHECK(c.x > c.y && c.y > c.z);
+    }
+    CHECK_EQ_INT(s.bg_type, BG_CONSTANT);
+    CHECK_V3(s.bg_color, 0.5, 0.5, 0.5, 0);
+    CHECK_EQ_INT(s.n_warnings, 1);   /* mix is not blended */
+out:
+    scene_free(&s);
+}
+
+static void test_warnings(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load(DIR "warnings.pbrt", &s, &err), ST_OK);
+    static const char *want[] = {
+        DIR "warnings.pbrt:2: PixelFilter is not supported; ignored",
+        DIR "warnings.pbrt:3: Film: parameter \"float iso\" is not supported; ignored",
+        DIR "warnings.pbrt:5: Shape \"disk\" is not supported; skipped",
+        DIR "warnings.pbrt:7: Shape: parameter \"float wobble\" is not supported; ignored",
+        DIR "warnings.pbrt:9: MakeNamedMedium is not supported; ignored",
+        DIR "warnings.pbrt:10: TransformTimes is not supported; ignored",
+    };
+    CHECK_EQ_INT(s.n_warnings, 6);
+    for (size_t i = 0; i < 6 && i < s.n_warnings; i++)
+        CHECK_MSG(strcmp(s.warnings[i], want[i]) == 0, "got '%s'", s.warnings[i]);
+    CHECK_EQ_INT(s.n_spheres, 2);
+    scene_free(&s);
+}
+
+static void test_include(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load(DIR "main-include.pbrt", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_spheres, 1);
+    CHECK_EQ_INT(s.n_triangles, 2 + 2 + 6);   /* two bilinear patches, the PLY pyramid */
+    scene_free(&s);
+    CHECK_EQ_INT(load(DIR "self-include.pbrt", &s, &err), ST_INPUT);
+    CHECK_MSG(strstr(err.msg, "includes nested more than 16 deep") != NULL, "got '%s'", err.msg);
+    scene_free(&s);
+}
+
+static void expect_error(const char *text, const char *msg);
+
+static void test_instances(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load(DIR "instances.pbrt", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_triangles, 2);
+    CHECK_EQ_INT(s.n_spheres, 2);
+    if (s.n_triangles == 2 && s.n_spheres == 2) {
+        CHECK_V3(s.triangles[0].p1, 1, 1, 0, 0);
+        CHECK_V3(s.triangles[1].p1, 7, 2, 0, 0);   /* (1, 1, 0) scaled by 2, moved by 5 */
+        CHECK_V3(s.spheres[0].center, 0, 1, 0, 0);
+        CHECK_V3(s.spheres[1].center, 5, 2, 0, 0);
+        CHECK_NEAR(s.spheres[1].radius, 1, 0);
+        CHECK(s.triangles[1].shading != NO_INDEX && s.shading[s.triangles[1].shading].n0.z == 1);
+    }
+    scene_free(&s);
+    expect_error("ObjectInstance \"nothing\"",
+                 DIR "inline.pbrt:1:16: object 'nothing' is not defined (ObjectBegin defines it)");
+    expect_error("ObjectBegin \"a\"\nAttributeEnd\nObjectEnd", DIR "inline.pbrt:3:1: ObjectEnd inside an "
+                 "AttributeBegin of its object, or after one that closes more than it opened");
+    expect_error("ObjectBegin \"a\"\nShape \"sphere\"", DIR "inline.pbrt: ObjectBegin \"a\" has no ObjectEnd");
+}
+
+/* pbrt's camera space is left-handed: seen from +z with y up, world +x is on the left. */
+static void test_orientation(void)
+{
+    static const char text[] = "LookAt 0 0 5  0 0 0  0 1 0\n"
+                               "Camera \"perspective\" \"float fov\" 40\n"
+                               "Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 8\n"
+                               "Sampler \"independent\" \"integer pixelsamples\" 1\n"
+                               "WorldBegin\n"
+                               "AreaLightSource \"diffuse\" \"rgb L\" [ 1 1 1 ]\n"
+                               "Translate 1 0 0\n"
+                               "Shape \"sphere\" \"float radius\" 0.5\n";
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text(text, &s, &err), ST_OK);
+    Film f;
+    if (render_util_run(&s, "scalar", 0, &f, &err) == ST_OK) {
+        float rgb[16 * 8 * 3];
+        film_resolve(&f, rgb);
+        double left = 0, right = 0;
+        for (int y = 0; y < 8; y++)
+            for (int x = 0; x < 16; x++) *(x < 8 ? &left : &right) += rgb[(y * 16 + x) * 3];
+        CHECK(left > 0 && right == 0);
+        film_free(&f);
+    } else {
+        CHECK_MSG(0, "%s", err.msg);
+    }
+    scene_free(&s);
+}
+
+/* compare.pbrt and compare.scene describe one scene: the same image, bit for bit. */
+static void test_compare(void)
+{
+    Scene a, b;
+    Error err = { 0 };
+    CHECK_EQ_INT(load(DIR "compare.pbrt", &a, &err), ST_OK);
+    scene_init(&b);
+    CHECK_EQ_INT(scene_load_file(DIR "compare.scene", SCENE_FORMAT_AUTO, &b, NULL, &err), ST_OK);
+    CHECK(!a.camera.mirror_x);
+    Film fa, fb;
+    Status sa = render_util_run(&a, "scalar", 0, &fa, &err);
+    Status sb = render_util_run(&b, "scalar", 0, &fb, &err);
+    CHECK_EQ_INT(sa, ST_OK);
+    CHECK_EQ_INT(sb, ST_OK);
+    if (!sa && !sb) {
+        size_t n = (size_t)fa.width * fa.height * 3;
+        CHECK_EQ_INT(fa.width, 40);
+        CHECK(fa.width == fb.width && fa.height == fb.height && memcmp(fa.sum, fb.sum, n * sizeof *fa.sum) == 0);
+        CHECK(film_mean(&fa) > 0.05);
+    }
+    if (!sa) film_free(&fa);
+    if (!sb) film_free(&fb);
+    scene_free(&a);
+    scene_free(&b);
+}
+
+static void expect_error(const char *text, const char *msg)
+{
+    Scene s;
+    Error err = { 0 };
+    Status st = load_text(text, &s, &err);
+    CHECK_EQ_INT(st, ST_INPUT);
+    CHECK_MSG(strcmp(err.msg, msg) == 0, "got '%s', expected '%s'", err.msg, msg);
+    scene_free(&s);
+}
+
+static void test_errors(void)
+{
+    expect_error("Shape \"sphere\" \"float radius\" [ 1 ",
+                 DIR "inline.pbrt:1:35: expected ']' to close the values of \"float radius\" opened at line 1, "
+                 "found end of file");
+    expect_error("Shape \"sphere\" \"flot radius\" 1",
+                 DIR "inline.pbrt:1:16: unknown parameter type 'flot' (float, integer, bool, string, texture, "
+                 "point2, vector2, point3, vector3, normal, rgb, spectrum, blackbody)");
+    expect_error("Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 3 ]",
+                 DIR "inline.pbrt:1:55: 'indices' value 2 is 3, outside the 3 points of 'P'");
+    expect_error("Material \"diffuse\" \"rgb reflectance\" [ 1 1 ]",
+                 DIR "inline.pbrt:1:20: parameter \"rgb reflectance\" needs 3 numbers, has 2 values");
+    expect_error("Shape \"sphere\" \"float radius\" -1",
+                 DIR "inline.pbrt:1:16: parameter 'radius' must be > 0");
+    expect_error("Shapes \"sphere\"",
+                 DIR "inline.pbrt:1:1: expected a pbrt directive (Shape, Material, LightSource, "
+                 "AttributeBegin, ...), found 'Shapes'");
+    expect_error("AttributeEnd", DIR "inline.pbrt:1:1: AttributeEnd without a matching begin");
+    expect_error("NamedMaterial \"gold\"",
+                 DIR "inline.pbrt:1:15: material 'gold' is not defined (MakeNamedMaterial defines it)");
+    expect_error("WorldBegin\nCamera \"perspective\"", DIR "inline.pbrt:2:1: Camera must come before WorldBegin");
+    expect_error("Translate 1 x 3", DIR "inline.pbrt:1:13: expected a number (Translate x y z), found 'x'");
+    expect_error("Shape \"sphere\" \"float radius\" nan",
+                 DIR "inline.pbrt:1:31: expected a finite number, found 'nan'");
+    expect_error("Shape \"sphere\" \"float radius\" 1e39",
+                 DIR "inline.pbrt:1:31: expected a finite number, found '1e39'");
+}
+
+/* the octahedron's corners: valence 4, Warren's beta 3/32 (as pbrt), gamma
+ * 1 / (4 + 3 / (8 beta)) = 1/8; a corner's limit is (1 - 4/8) of the way out (its four
+ * neighbours sum to zero) */
+static const double octa_p[] = { 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1 };
+static const uint32_t octa_i[] = { 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5 };
+
+static void test_loop_limits(void)
+{
+    Error err = { 0 };
+    for (int levels = 0; levels <= 4; levels++) {
+        SubdivMesh m;
+        CHECK_EQ_INT(subdiv_loop(octa_p, 6, octa_i, 8, levels, 1u << 20, &m, &err), ST_OK);
+        CHECK_EQ_INT(m.n_tris, 8u << (2 * levels));
+        for (int v = 0; v < 6; v++)
+            for (int c = 0; c < 3; c++) CHECK_NEAR(m.p[3 * v + c], 0.5 * octa_p[3 * v + c], 1e-12);
+        /* a corner's normal points straight out */
+        CHECK_NEAR(m.n[0], 1, 1e-12);
+        subdiv_free(&m);
+    }
+    /* an irregular closed mesh (a pyramid on a square: valences 3 and 4): the limit
+     * point of a control vertex is the same whether found at level 0 or after levels of
+     * Loop's rules, which holds only when the even and odd rules are Loop's */
+    static const double pyr_p[] = { 0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0, 1, 1, 3 };
+    static const uint32_t pyr_i[] = { 0, 2, 1, 0, 3, 2, 0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4 };
+    SubdivMesh base, deep;
+    CHECK_EQ_INT(subdiv_loop(pyr_p, 5, pyr_i, 6, 0, 1u << 20, &base, &err), ST_OK);
+    CHECK_EQ_INT(subdiv_loop(pyr_p, 5, pyr_i, 6, 3, 1u << 20, &deep, &err), ST_OK);
+    for (int i = 0; i < 15; i++) CHECK_NEAR(deep.p[i], base.p[i], 1e-12);
+    /* the apex (valence 4): gamma 1/8, neighbours (0,0,0) (2,0,0) (2,2,0) (0,2,0) */
+    CHECK_NEAR(base.p[12], 0.5 * 1 + 4.0 / 8, 1e-12);
+    CHECK_NEAR(base.p[14], 0.5 * 3, 1e-12);
+    subdiv_free(&base);
+    subdiv_free(&deep);
+    /* a lone triangle is all boundary: 3/5 of a corner and 1/5 of each neighbour, pbrt's
+     * boundary limit rule (the cubic B-spline's own would be 4/6 and 1/6, so on a
+     * boundary the limit found after some levels differs from level 0's, in pbrt too) */
+    static const double tri_p[] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
+    static const uint32_t tri_i[] = { 0, 1, 2 };
+    CHECK_EQ_INT(subdiv_loop(tri_p, 3, tri_i, 1, 0, 1u << 20, &base, &err), ST_OK);
+    CHECK_NEAR(base.p[0], 0.2, 1e-12);
+    CHECK_NEAR(base.p[1], 0.2, 1e-12);
+    CHECK_NEAR(base.p[3], 0.6, 1e-12);
+    subdiv_free(&base);
+    CHECK_EQ_INT(subdiv_loop(tri_p, 3, tri_i, 1, 11, 1u << 20, &base, &err), ST_INPUT);
+    CHECK(strstr(err.msg, "makes more than 1048576 triangles") != NULL);
+    /* through the reader: 8 * 4^2 triangles, the corners at their limits */
+    static const char text[] = "Shape \"loopsubdiv\" \"integer levels\" 2\n"
+                               "  \"point3 P\" [ 1 0 0 -1 0 0 0 1 0 0 -1 0 0 0 1 0 0 -1 ]\n"
+                               "  \"integer indices\" [ 0 2 4 2 1 4 1 3 4 3 0 4 2 0 5 1 2 5 3 1 5 0 3 5 ]\n";
+    Scene s;
+    CHECK_EQ_INT(load_text(text, &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_triangles, 128);
+    vec3 lo, hi;
+    mesh_bounds(&s, 0, s.n_triangles, &lo, &hi);
+    CHECK_NEAR(hi.x, 0.5, 1e-6);
+    CHECK_NEAR(lo.z, -0.5, 1e-6);
+    CHECK(s.n_shading == 128);
+    scene_free(&s);
+}
+
+int main(void)
+{
+    RUN(test_loop_limits);
+    RUN(test_detect);
+    RUN(test_basic);
+    RUN(test_transforms);
+    RUN(test_materials_lights);
+    RUN(test_warnings);
+    RUN(test_include);
+    RUN(test_instances);
+    RUN(test_orientation);
+    RUN(test_compare);
+    RUN(test_errors);
+    return harness_report();
+}

@@ -549,6 +549,21 @@ static Status expect_string(Parser *p, Lexer *lx, const char *what, Token *t)
     return ST_OK;
 }
 
+/* A quoted name that `map` must hold (a named material, an object): its token and index,
+ * or an error at the name saying which directive defines such names. */
+static Status expect_defined(Parser *p, Lexer *lx, const StrMap *map, const char *what, const char *definer,
+                             Token *name, uint32_t *index)
+{
+    char expected[48];
+    snprintf(expected, sizeof expected, "a quoted %s name", what);
+    Status st = expect_string(p, lx, expected, name);
+    if (st) return st;
+    if (!strmap_find(map, name->text, name->len, index))
+        return lex_error_at(lx, name, p->err, "%s '%.*s' is not defined (%s defines it)", what,
+                            (int)(name->len > 40 ? 40 : name->len), name->text, definer);
+    return ST_OK;
+}
+
 static Status expect_numbers(Parser *p, Lexer *lx, double *out, int n, const char *what)
 {
     Token t;
@@ -1057,13 +1072,9 @@ static Status d_named_material(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token name;
-    Status st = expect_string(p, lx, "a quoted material name", &name);
-    if (st) return st;
     uint32_t i;
-    if (!strmap_find(&p->named_material, name.text, name.len, &i))
-        return lex_error_at(lx, &name, p->err, "material '%.*s' is not defined (MakeNamedMaterial defines it)",
-                            (int)(name.len > 40 ? 40 : name.len), name.text);
-    return set_material(p, i);
+    Status st = expect_defined(p, lx, &p->named_material, "material", "MakeNamedMaterial", &name, &i);
+    return st ? st : set_material(p, i);
 }
 
 static Status d_texture(Parser *p, Lexer *lx, const Token *kw)
@@ -1637,12 +1648,9 @@ static Status d_object_instance(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token name;
-    Status st = expect_string(p, lx, "a quoted object name", &name);
-    if (st) return st;
     uint32_t i;
-    if (!strmap_find(&p->object_by_name, name.text, name.len, &i))
-        return lex_error_at(lx, &name, p->err, "object '%.*s' is not defined (ObjectBegin defines it)",
-                            (int)(name.len > 40 ? 40 : name.len), name.text);
+    Status st = expect_defined(p, lx, &p->object_by_name, "object", "ObjectBegin", &name, &i);
+    if (st) return st;
     const PObject *o = &p->objects[i];
     if (p->s->n_triangles + o->n_triangles > PBRT_MAX_FLAT_TRIANGLES)
         return lex_error_at(lx, &name, p->err, "the flattened instances would hold more than %zu triangles",

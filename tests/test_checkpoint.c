@@ -78,16 +78,6 @@ static int write_file(const char *path, const unsigned char *data, size_t len)
     return (fclose(f) == 0) & (w == len);
 }
 
-static int files_equal(const char *a, const char *b)
-{
-    unsigned char *x = NULL, *y = NULL;
-    size_t nx, ny;
-    int ok = read_file(a, &x, &nx) && read_file(b, &y, &ny) && nx == ny && memcmp(x, y, nx) == 0;
-    free(x);
-    free(y);
-    return ok;
-}
-
 static void sleep_s(double s)
 {
     struct timespec ts = { (time_t)s, (long)((s - (double)(time_t)s) * 1e9) };

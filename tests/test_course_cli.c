@@ -14,21 +14,6 @@ static CliResult r;   /* large: static */
 static const char *const classic_scenes[] = { "spheres", "glass", "mesh", "ortho", "textured", "vase" };
 #define N_CLASSIC (sizeof classic_scenes / sizeof classic_scenes[0])
 
-/* Whether two files hold the same bytes (and both exist). */
-static int same_file(const char *a, const char *b)
-{
-    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
-    int same = fa && fb;
-    while (same) {
-        int ca = fgetc(fa), cb = fgetc(fb);
-        if (ca != cb) same = 0;
-        if (ca == EOF || cb == EOF) break;
-    }
-    if (fa) fclose(fa);
-    if (fb) fclose(fb);
-    return same;
-}
-
 static void tmp_name(char *buf, size_t n, const char *what)
 {
     snprintf(buf, n, "/tmp/clpt-course-%ld-%s", (long)getpid(), what);
@@ -52,13 +37,13 @@ static void test_mit_equals_own_flags(void)
         cli_run(ARGS(scene, "--width", "48", "--height", "36", "--integrator", "whitted", "--spp", "1", "--gamma",
                      "none", "--shadows", "on", "--max-depth", "2", "--aov", "normal", "-o", b, "--quiet"), &r);
         CHECK_MSG(r.status == 0, "%s: %s", scene, r.err);
-        CHECK_MSG(same_file(a, b) && same_file(an, bn), "%s: MIT command line differs", scene);
+        CHECK_MSG(files_equal(a, b) && files_equal(an, bn), "%s: MIT command line differs", scene);
         /* without -bounces and -shadows: direct light only, no shadows */
         cli_run(ARGS("-input", scene, "-size", "48", "36", "-output", a, "--quiet"), &r);
         CHECK_MSG(r.status == 0, "%s: %s", scene, r.err);
         cli_run(ARGS(scene, "--width", "48", "--height", "36", "--integrator", "whitted", "--spp", "1", "--gamma",
                      "none", "--shadows", "off", "--max-depth", "0", "-o", b, "--quiet"), &r);
-        CHECK_MSG(same_file(a, b), "%s: MIT command line without -bounces/-shadows differs", scene);
+        CHECK_MSG(files_equal(a, b), "%s: MIT command line without -bounces/-shadows differs", scene);
     }
     const char *made[] = { a, an, b, bn };
     for (size_t i = 0; i < 4; i++) unlink(made[i]);
@@ -88,7 +73,7 @@ static void test_tsinghua_equals_own_flags(void)
             cli_run(ARGS(scene, "--width", "40", "--height", "30", "--integrator", "whitted", "--spp", "1",
                          "--gamma", "none", "--shadows", "off", "--max-depth", "0", "-o", b, "--quiet"), &r);
         CHECK_MSG(r.status == 0, "%s: %s", scene, r.err);
-        CHECK_MSG(same_file(a, b), "%s: Tsinghua command line differs (%s)", scene, ext[i % 3]);
+        CHECK_MSG(files_equal(a, b), "%s: Tsinghua command line differs (%s)", scene, ext[i % 3]);
         unlink(a);
         unlink(b);
     }
@@ -190,7 +175,7 @@ static void test_shadows_flag_and_defaults(void)
     cli_run(ARGS(scene, "--width", "48", "--height", "36", "-o", def, "--quiet"), &r);
     cli_run(ARGS(scene, "--width", "48", "--height", "36", "-o", on, "--shadows", "on", "--quiet"), &r);
     cli_run(ARGS(scene, "--width", "48", "--height", "36", "-o", off, "--shadows", "off", "--quiet"), &r);
-    CHECK(same_file(def, off) && !same_file(def, on));
+    CHECK(files_equal(def, off) && !files_equal(def, on));
     char own[256];
     write_temp(own, sizeof own, ".scene",
                "camera { from 0 3 4 at 0 0 0 }\nimage { width 24 height 24 spp 4 }\n"
@@ -200,7 +185,7 @@ static void test_shadows_flag_and_defaults(void)
     cli_run(ARGS(own, "-o", def, "--quiet"), &r);
     cli_run(ARGS(own, "-o", on, "--shadows", "on", "--quiet"), &r);
     cli_run(ARGS(own, "-o", off, "--shadows", "off", "--quiet"), &r);
-    CHECK(same_file(def, on) && !same_file(def, off));
+    CHECK(files_equal(def, on) && !files_equal(def, off));
     unlink(own);
     write_temp(own, sizeof own, ".scene",
                "camera { from 0 3 4 at 0 0 0 }\nimage { width 24 height 24 spp 4 shadows off }\n"
@@ -209,7 +194,7 @@ static void test_shadows_flag_and_defaults(void)
                "sphere { center 0 1 0 radius 0.5 material { type diffuse albedo 0.5 0.5 0.5 } }\n");
     cli_run(ARGS(own, "-o", def, "--quiet"), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK(same_file(def, off));
+    CHECK(files_equal(def, off));
     unlink(own);
     unlink(def);
     unlink(on);

@@ -282,20 +282,6 @@ static int wait_text(const char *path, const char *text, int times, double secon
     return 0;
 }
 
-static int files_equal(const char *a, const char *b)
-{
-    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
-    int same = fa && fb;
-    while (same) {
-        int ca = fgetc(fa), cb = fgetc(fb);
-        if (ca != cb) same = 0;
-        if (ca == EOF || cb == EOF) break;
-    }
-    if (fa) fclose(fa);
-    if (fb) fclose(fb);
-    return same;
-}
-
 /* ------------------------------------------------------------------ the image */
 
 /* The back wall in the middle band of rows: the columns between the red wall (left)

@@ -1623,9 +1623,11 @@ static Status d_object_end(Parser *p, Lexer *lx, const Token *kw)
         free(o.shading);
         return error_set(p->err, ST_INTERNAL, "out of memory");
     }
-    memcpy(o.spheres, s->spheres + p->obj_spheres, o.n_spheres * sizeof *o.spheres);
-    memcpy(o.triangles, s->triangles + p->obj_triangles, o.n_triangles * sizeof *o.triangles);
-    memcpy(o.shading, s->shading + p->obj_shading, o.n_shading * sizeof *o.shading);
+    /* an object may hold no spheres (or no triangles), and the scene's array may then
+     * still be NULL: C gives no NULL + 0, so the empty copies are skipped */
+    if (o.n_spheres) memcpy(o.spheres, s->spheres + p->obj_spheres, o.n_spheres * sizeof *o.spheres);
+    if (o.n_triangles) memcpy(o.triangles, s->triangles + p->obj_triangles, o.n_triangles * sizeof *o.triangles);
+    if (o.n_shading) memcpy(o.shading, s->shading + p->obj_shading, o.n_shading * sizeof *o.shading);
     for (size_t i = 0; i < o.n_triangles; i++)
         if (o.triangles[i].shading != NO_INDEX) o.triangles[i].shading -= (uint)p->obj_shading;
     s->n_spheres = p->obj_spheres;

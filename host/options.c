@@ -145,7 +145,7 @@ void options_print_help(FILE *f)
 "  -i, --interactive          show SCENE in a window and render it\n"
 "                             progressively while the camera moves (needs a\n"
 "                             display: else exit status 5). Keys: W/A/S/D\n"
-"                             move, R/F or E/Q up/down, drag the mouse to\n"
+"                             move, R/F or Q/E up/down, drag the mouse to\n"
 "                             look, wheel forward/back, Z/X field of view,\n"
 "                             Up/Down focus distance, Right/Left aperture,\n"
 "                             +/- exposure, Space pause, C save the image\n"

@@ -27,13 +27,13 @@
 #define MAX_LATENCIES 1024
 
 static const char HELP_TITLE[] =
-    "W/A/S/D move  R/F E/Q up/down  drag look  wheel fwd/back  Z/X fov  Up/Down focus  "
+    "W/A/S/D move  R/F Q/E up/down  drag look  wheel fwd/back  Z/X fov  Up/Down focus  "
     "Left/Right aperture  +/- exposure  Space pause  C save  P camera  F11 full screen  H help  Esc quit";
 
 static const char HELP_TEXT[] =
     "clpt viewer keys:\n"
     "  W/A/S/D        move forward / left / back / right\n"
-    "  R/F, E/Q       move up / down\n"
+    "  R/F, Q/E       move up / down\n"
     "  mouse drag     look around (turn the camera)\n"
     "  mouse wheel    move forward / back along the view\n"
     "  Z/X            narrower / wider field of view\n"
@@ -258,8 +258,8 @@ static void key_down(Viewer *v, const SDL_KeyboardEvent *k)
     case SDLK_s: view_camera_move(&v->cam, 0, 0, -s); break;
     case SDLK_a: view_camera_move(&v->cam, -s, 0, 0); break;
     case SDLK_d: view_camera_move(&v->cam, s, 0, 0); break;
-    case SDLK_r: case SDLK_e: view_camera_move(&v->cam, 0, s, 0); break;
-    case SDLK_f: case SDLK_q: view_camera_move(&v->cam, 0, -s, 0); break;
+    case SDLK_r: case SDLK_q: view_camera_move(&v->cam, 0, s, 0); break;
+    case SDLK_f: case SDLK_e: view_camera_move(&v->cam, 0, -s, 0); break;
     case SDLK_z: view_camera_zoom(&v->cam, 1.0 / 1.1); break;
     case SDLK_x: view_camera_zoom(&v->cam, 1.1); break;
     case SDLK_UP: view_camera_focus(&v->cam, 1.1); break;

@@ -226,6 +226,21 @@ static void test_mpi_two_and_three_ranks_are_bit_identical(void)
     CHECK(files_equal(in_dir("mmerged.pfm"), in_dir("whole.pfm")));
 }
 
+/* Ranks on different devices: rank 0 on the scalar device, rank 1 on PoCL's CPU device
+ * (MPMD, the way docs/distributed.md gives ranks different devices). The film is the
+ * same integers whichever device rendered a batch, so the image is still the bytes of
+ * the one-process render. */
+#define RENDER_ON(device) "scenes/cornell-box.scene", "--width", "24", "--height", "18", "--spp", "12", \
+                          "--device", device, "--threads", "1", "-q", "--batch", "2"
+
+static void test_mpi_ranks_on_a_mix_of_devices(void)
+{
+    spawn_run(ARGS(MPIRUN, "-np", "1", CLI_PROGRAM, RENDER_ON("scalar"), "--stats", "-o", in_dir("mix.pfm"), ":",
+                   "-np", "1", CLI_PROGRAM, RENDER_ON("cpu"), "--stats", "-o", in_dir("mix.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(in_dir("mix.pfm"), in_dir("whole.pfm")));
+}
+
 static void test_mpi_ranks_with_other_settings_are_refused(void)
 {
     /* MPMD: rank 1 runs with another seed, so another render key */
@@ -343,6 +358,7 @@ int main(void)
     if (have_mpirun()) {
         RUN(test_mpi_two_and_three_ranks_are_bit_identical);
         RUN(test_mpi_ranks_with_other_settings_are_refused);
+        RUN(test_mpi_ranks_on_a_mix_of_devices);
         RUN(test_mpi_killed_rank_then_resume);
         RUN(test_mpi_recovery_goes_on_without_the_dead_rank);
     } else {

@@ -62,6 +62,12 @@ def scenes():
         ("principled-black-r0.5", "type principled albedo 0 0 0 metallic 0 roughness 0.5",
          {"type": "principled", "base_color": rgb((0.0, 0.0, 0.0)), "metallic": 0.0,
           "roughness": 0.5, "specular": 0.5}),
+        # the black principled sphere's specular lobe as a conductor with a dielectric's
+        # Fresnel (eta 1.5, k 0): Mitsuba's principled uses that exact Fresnel where clpt's
+        # (glTF Appendix B) uses Schlick's with F0 0.04; this row tells the two apart
+        ("conductor-eta1.5-r0.5", "type conductor eta 1.5 1.5 1.5 k 0 0 0 roughness 0.5",
+         {"type": "roughconductor", "distribution": GGX, "alpha": 0.25,
+          "eta": rgb((1.5, 1.5, 1.5)), "k": rgb((0.0, 0.0, 0.0))}),
         ("principled-metal-r0.3", "type principled albedo 0.9 0.6 0.2 metallic 1 roughness 0.3",
          {"type": "principled", "base_color": rgb((0.9, 0.6, 0.2)), "metallic": 1.0,
           "roughness": 0.3, "specular": 0.5}),
@@ -73,9 +79,11 @@ DEPTH = 16
 
 
 def env_scenes():
-    """The scenes under an environment map: a plain diffuse sphere and two metals."""
+    """The scenes under an environment map: a plain diffuse sphere, two metals, rough
+    glass and principled spheres."""
     by_name = {name: (body, bsdf) for name, body, bsdf in scenes()}
-    return [("env-" + n,) + by_name[n] for n in ("diffuse", "conductor-au-r0.5", "conductor-fe-r0.2")]
+    return [("env-" + n,) + by_name[n] for n in ("diffuse", "conductor-au-r0.5", "conductor-fe-r0.2", "glass-r0.4",
+                                                 "principled-plastic-r0.5", "principled-metal-r0.3")]
 
 
 def clpt_scene(body, size, spp, seed, envmap):
@@ -178,7 +186,7 @@ def main():
     ap.add_argument("--mts-spp", type=int, default=512, help="Mitsuba samples per pixel")
     ap.add_argument("--variant", default="scalar_rgb")
     ap.add_argument("--out", default="/tmp/mitsuba-compare")
-    ap.add_argument("--only", default=None, help="render only the scene of this name")
+    ap.add_argument("--only", default=None, help="render only the scenes of these names (comma-separated)")
     ap.add_argument("--envmap", default=None,
                     help="also render env-* scenes under this equirectangular .hdr (clpt's "
                          "`background { map }`, Mitsuba's `envmap`: the same orientation)")
@@ -191,7 +199,7 @@ def main():
     envmap = os.path.abspath(args.envmap) if args.envmap else None
     todo = [s + (None,) for s in scenes()] + ([s + (envmap,) for s in env_scenes()] if envmap else [])
     for name, body, bsdf, env in todo:
-        if args.only and name != args.only:
+        if args.only and name not in args.only.split(","):
             continue
         base = os.path.join(args.out, name)
         c1, tc = render_clpt(args.clpt, body, args.size, args.spp, 1, base + "-clpt", env)

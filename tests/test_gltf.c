@@ -600,6 +600,14 @@ static void test_extras(void)
         scene_free(&s);
         return;
     }
+    /* the .glb (buffer and images in its BIN chunk) loads into the same */
+    Scene g;
+    if (load_scene(DIR_GLTF "extras.glb", &g, 48, 12, 4)) {
+        CHECK(g.n_triangles == 6 && memcmp(g.triangles, s.triangles, 6 * sizeof *g.triangles) == 0);
+        CHECK(g.n_tri_extras == 6 && memcmp(g.tri_extras, s.tri_extras, 6 * sizeof *g.tri_extras) == 0);
+        CHECK(g.n_texels == s.n_texels && memcmp(g.texels, s.texels, s.n_texels * sizeof *s.texels) == 0);
+    }
+    scene_free(&g);
     const TriExtra *e0 = &s.tri_extras[s.tri_extra_of[s.triangles[0].shading]];
     CHECK_EQ_INT(e0->flags, EXTRA_TANGENT);
     CHECK(e0->tangent[1][0] == 0.0f && e0->tangent[1][1] == 1.0f && e0->tangent[1][3] == 1.0f);

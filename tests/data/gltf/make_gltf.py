@@ -276,6 +276,21 @@ def extras():
     return d
 
 
+def extras_glb():
+    """extras() as a .glb: its buffer and both PNGs in the BIN chunk (the images as
+    buffer views); a seed of fuzz/fuzz_glb.c."""
+    d = extras()
+    raw = base64.b64decode(d["buffers"][0]["uri"].split(",", 1)[1])
+    for im in d["images"]:
+        raw += b"\0" * (-len(raw) % 4)
+        png_bytes = base64.b64decode(im.pop("uri").split(",", 1)[1])
+        d["bufferViews"].append({"buffer": 0, "byteOffset": len(raw), "byteLength": len(png_bytes)})
+        im.update({"bufferView": len(d["bufferViews"]) - 1, "mimeType": "image/png"})
+        raw += png_bytes
+    d["buffers"] = [{"byteLength": len(raw)}]
+    return glb(d, raw)
+
+
 def main():
     os.makedirs(GOOD, exist_ok=True)
     write_json(os.path.join(GOOD, "strided.gltf"), strided())
@@ -283,6 +298,8 @@ def main():
     write_json(os.path.join(GOOD, "strips.gltf"), strips())
     write_json(os.path.join(GOOD, "textured.gltf"), textured())
     write_json(os.path.join(GOOD, "extras.gltf"), extras())
+    with open(os.path.join(GOOD, "extras.glb"), "wb") as f:
+        f.write(extras_glb())
     nd, _ = nodes()
     write_json(os.path.join(GOOD, "nodes.gltf"), nd)
 

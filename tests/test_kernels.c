@@ -52,8 +52,8 @@ static float frange(float lo, float hi) { return lo + (hi - lo) * frand(); }
 static vec3 vrand(float lo, float hi) { return v3(frange(lo, hi), frange(lo, hi), frange(lo, hi)); }
 
 /* Textures of each kind: an sRGB 8-bit image (nearest, mirrored in v), a linear float
- * image (mirrored in u, clamped in v), a surface
- * checker and a solid one. Returns the indices in t[4]. */
+ * image (mirrored in u, clamped in v), a surface checker and a solid one. Returns the
+ * indices in t[4]. */
 static void add_textures(uint t[4])
 {
     uint px[8 * 4], offset;

@@ -261,23 +261,34 @@ KFN int surface_tangents(const SceneView *sc, Surface s, vec3 *dpdu, vec3 *dpdv)
     return 1;
 }
 
-/* The tangent frame of a normal map at s around the shading normal n: t along the
- * surface's given tangent (glTF's TANGENT) where it has one, with the bitangent
- * cross(n, t) times the tangent's w sign (glTF 2.0, 3.7.2.1); else along dp/du, with
- * the bitangent on dp/dv's side (so mirrored uv layouts stay right). t is made
- * orthonormal to n (Gram-Schmidt). 0 when there is no usable frame. */
-KFN int normal_map_frame(const SceneView *sc, Surface s, vec3 n, vec3 *t, vec3 *b)
+/* d made orthogonal to the unit n and normalised (Gram-Schmidt) into *t; 0 when d has
+ * nothing across n. */
+KFN int tangent_along(vec3 n, vec3 d, vec3 *t)
 {
-    vec3 dpdu, dpdv;
-    float sign = 1.0f;
-    int given = surface_tangent(sc, s, &dpdu, &sign);
-    if (!given && !surface_tangents(sc, s, &dpdu, &dpdv)) return 0;
-    vec3 tt = v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu)));
+    vec3 tt = v3_sub(d, v3_scale(n, v3_dot(n, d)));
     float lt = v3_len(tt);
     if (!(lt > 0.0f)) return 0;
     *t = v3_scale(tt, 1.0f / lt);
+    return 1;
+}
+
+/* The tangent frame of a normal map at s around the shading normal n: t along the
+ * surface's given tangent (glTF's TANGENT) where it has a usable one, with the
+ * bitangent cross(n, t) times the tangent's w sign (glTF 2.0, 3.7.2.1); else t along
+ * dp/du, with the bitangent on dp/dv's side (so mirrored uv layouts stay right).
+ * 0 when there is no usable frame. */
+KFN int normal_map_frame(const SceneView *sc, Surface s, vec3 n, vec3 *t, vec3 *b)
+{
+    vec3 given, dpdu, dpdv;
+    float sign = 1.0f;
+    if (surface_tangent(sc, s, &given, &sign) && tangent_along(n, given, t)) {
+        *b = v3_cross(n, *t);
+        if (sign < 0.0f) *b = v3_neg(*b);
+        return 1;
+    }
+    if (!surface_tangents(sc, s, &dpdu, &dpdv) || !tangent_along(n, dpdu, t)) return 0;
     *b = v3_cross(n, *t);
-    if (given ? sign < 0.0f : v3_dot(*b, dpdv) < 0.0f) *b = v3_neg(*b);
+    if (v3_dot(*b, dpdv) < 0.0f) *b = v3_neg(*b);
     return 1;
 }
 

@@ -632,6 +632,16 @@ static void test_extras(void)
     vec3 n = material_normal(&view, m, sf);
     double k = 1.0 / 255.0, len = sqrt(k * k + 2.0);
     check_v3(n, -k / len, 1.0 / len, 1.0 / len, 1e-6);
+    /* w = -1 turns the bitangent to +x; a tangent along the normal has no direction
+     * across it, so the uvs' frame takes over (the view reads the scene's own arrays) */
+    TriExtra *e = &s.tri_extras[sf.extra];
+    for (int c = 0; c < 3; c++) e->tangent[c][3] = -1.0f;
+    check_v3(material_normal(&view, m, sf), k / len, 1.0 / len, 1.0 / len, 1e-6);
+    for (int c = 0; c < 3; c++) {
+        e->tangent[c][1] = 0.0f;
+        e->tangent[c][2] = 1.0f;
+    }
+    check_v3(material_normal(&view, m, sf), 1.0 / len, k / len, 1.0 / len, 1e-6);
 
     /* TEXCOORD_1: the texture reads (0.75, 0.25) of the 2 x 2 image (the top row's right
      * texel, (0, 64, 255) sRGB) where TEXCOORD_0 at the centroid, (2/3, 1/3), would

@@ -1,6 +1,7 @@
 /*
  * texture.h — the colour of a texture at a surface point: image textures (bilinear or
- * nearest, sRGB-decoded, repeat, clamp or mirror per axis) and checkerboards (solid, or on the surface's (u, v)).
+ * nearest, sRGB-decoded, repeat, clamp or mirror per axis) and checkerboards (solid, or
+ * on the surface's (u, v)).
  *
  * Surface coordinates: triangles use their texture coordinates (or barycentrics when
  * the mesh has none); spheres the longitude/latitude map, u = 0.5 + atan2(n.x, n.z)/2pi

@@ -63,4 +63,32 @@ static inline void fuzz_check_triangles(const Scene *s, uint material)
     }
 }
 
+/* What the mesh sink promises of glTF's corner attributes (TriExtra): tri_extra_of is
+ * empty or one entry per shading record, a record flagged TRI_HAS_EXTRA names a TriExtra
+ * that exists and has attributes, whose values are finite, tangents unit-length (w +1
+ * or -1). */
+static inline void fuzz_check_extras(const Scene *s)
+{
+    FUZZ_ASSERT(s->n_tri_extra_of == 0 || s->n_tri_extra_of == s->n_shading);
+    FUZZ_ASSERT(s->n_tri_extras == 0 || s->n_tri_extra_of > 0);
+    for (size_t i = 0; i < s->n_shading; i++) {
+        if (!(s->shading[i].flags & TRI_HAS_EXTRA)) {
+            FUZZ_ASSERT(s->n_tri_extra_of == 0 || s->tri_extra_of[i] == NO_INDEX);
+            continue;
+        }
+        FUZZ_ASSERT(i < s->n_tri_extra_of && s->tri_extra_of[i] < s->n_tri_extras);
+        const TriExtra *e = &s->tri_extras[s->tri_extra_of[i]];
+        FUZZ_ASSERT(e->flags != 0 && (e->flags & ~(EXTRA_TANGENT | EXTRA_COLOR | EXTRA_UV1)) == 0);
+        for (int c = 0; c < 3; c++) {
+            if (e->flags & EXTRA_TANGENT) {
+                const float *t = e->tangent[c];
+                double len = sqrt((double)t[0] * t[0] + (double)t[1] * t[1] + (double)t[2] * t[2]);
+                FUZZ_ASSERT(fabs(len - 1.0) < 1e-4 && (t[3] == 1.0f || t[3] == -1.0f));
+            }
+            for (int k = 0; k < 4; k++) FUZZ_ASSERT(!(e->flags & EXTRA_COLOR) || isfinite(e->color[c][k]));
+            for (int k = 0; k < 2; k++) FUZZ_ASSERT(!(e->flags & EXTRA_UV1) || isfinite(e->uv[c][k]));
+        }
+    }
+}
+
 #endif /* CLPT_FUZZ_H */

@@ -3,7 +3,9 @@
  * whose chunk lengths need not match, JSON whose accessors, views and buffers need not
  * fit their data, node trees with cycles, images that are not images. Every error must
  * carry a message; every triangle it appends must be finite and carry one of the
- * scene's materials; a camera it sets must be finite.
+ * scene's materials; its tangents, colours and second uvs must be sound
+ * (fuzz_check_extras); a camera it sets must be finite. fuzz_glb.c takes the GLB
+ * container apart more closely.
  */
 #include "fuzz.h"
 #include "kmath.h"
@@ -35,6 +37,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FUZZ_ASSERT(fuzz_finite3(t->p0) && fuzz_finite3(t->p1) && fuzz_finite3(t->p2));
         FUZZ_ASSERT(t->shading == NO_INDEX || t->shading < s.n_shading);
     }
+    fuzz_check_extras(&s);
     if (st == ST_OK && view.has_camera)
         FUZZ_ASSERT(fuzz_finite3(s.camera.from) && fuzz_finite3(s.camera.at) && isfinite(s.camera.vfov));
     scene_free(&s);

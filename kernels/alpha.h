@@ -17,7 +17,8 @@
  * so the decision is too, and images stay bit-identical across devices; different rays
  * (other samples, bounces, the shadow ray) get independent coins.
  *
- * alpha is the material's `alpha` times its base-colour texture's alpha channel.
+ * alpha is the material's `alpha` times its base-colour texture's alpha channel (and
+ * the vertex colour's alpha).
  * At most ALPHA_MAX_LAYERS cut-out surfaces are skipped along one ray; the next one
  * then counts as opaque (a bound on the work of a ray through dense foliage).
  */
@@ -52,10 +53,13 @@ KFN float alpha_uniform(Ray ray, Hit hit)
     return (float)(h >> 8) * 5.9604645e-8f;
 }
 
-/* The opacity of material m at s: alpha times its base-colour texture's alpha. */
+/* The opacity of material m at s: alpha times its base-colour texture's alpha, times
+ * the vertex colour's alpha where the surface has one (glTF's COLOR_0). */
 KFN float material_alpha(const SceneView *sc, Material m, Surface s)
 {
-    return m.texture == NO_INDEX ? m.alpha : m.alpha * texture_alpha(sc, m.texture, s);
+    float a = m.texture == NO_INDEX ? m.alpha : m.alpha * texture_alpha(sc, m.texture, s);
+    float c[4];
+    return surface_color(sc, s, c) ? a * c[3] : a;
 }
 
 /* 1 when `hit` (of `ray`) lies where its surface is cut out; 0 for no hit. */

@@ -169,6 +169,8 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(RevSurface, axis_x);
     out[i++] = (uint)__builtin_offsetof(RenderParams, n_revsurfaces);
     out[i++] = (uint)__builtin_offsetof(RenderParams, bg_light);
+    out[i++] = (uint)sizeof(TriExtra);
+    out[i++] = (uint)__builtin_offsetof(TriExtra, uv);
 }
 
 /* ---------------------------------------------------------------- classic ray tracer

@@ -44,6 +44,9 @@
     X(MANY, Material,     materials,  (ds)->n_materials,         "materials")                \
     X(MANY, Light,        lights,     (ds)->params.n_lights,     "lights")                   \
     X(MANY, TriShading,   shading,    (ds)->n_shading,           "shading normals")          \
+    /* TriShading's side array (types.h): n_shading entries, or none without extras */      \
+    X(MANY, uint,         tri_extra_of, (ds)->n_tri_extra_of,    "corner attribute indices") \
+    X(MANY, TriExtra,     tri_extras, (ds)->n_tri_extras,        "corner attributes")        \
     X(MANY, Texture,      textures,   (ds)->params.n_textures,   "textures")                 \
     X(MANY, uint,         texels,     (ds)->n_texels,            "texture images")           \
     X(MANY, float,        env_cdf,    (ds)->n_env_cdf,           "environment map distribution") \

@@ -18,6 +18,10 @@ typedef struct {
     uint light;      /* index in lights[] or NO_INDEX */
     uint prim;       /* global primitive id (textures compute their coordinates from it) */
     float u, v;      /* surface coordinates (triangle barycentrics or texture uv) */
+    uint extra;      /* triangles: index in tri_extras (TANGENT, TEXCOORD_1, COLOR_0) or
+                      * NO_INDEX; read only through the surface_* functions below */
+    float b1, b2;    /* triangles: the hit's barycentrics of p1 and p2, to interpolate
+                      * the extras' corners */
 } Surface;
 
 KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
@@ -30,6 +34,9 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
     s.v = hit.v;
     s.light = NO_INDEX;
     s.prim = id;
+    s.extra = NO_INDEX;
+    s.b1 = hit.u;
+    s.b2 = hit.v;
     uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
     uint first_rev = first_box + p->n_boxes, first_plane = first_rev + p->n_revsurfaces;
     if (id < first_tri) {
@@ -66,6 +73,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
                 s.u = w * sh.uv0[0] + hit.u * sh.uv1[0] + hit.v * sh.uv2[0];
                 s.v = w * sh.uv0[1] + hit.u * sh.uv1[1] + hit.v * sh.uv2[1];
             }
+            if (sh.flags & TRI_HAS_EXTRA) s.extra = sc->tri_extra_of[tr.shading];
         }
     } else if (id < first_rev) {
         Box b = sc->boxes[id - first_box];
@@ -94,6 +102,56 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
         s.material = pl.material;
     }
     return s;
+}
+
+/* Corner attribute `a` (three corners of `n` floats, `stride` apart) at s's
+ * barycentrics, into out[0 .. n), weighted as surface_at weights the normals. */
+KFN void extra_lerp(GLOBAL const float *a, uint stride, uint n, Surface s, float *out)
+{
+    float w = 1.0f - s.b1 - s.b2;
+    for (uint j = 0u; j < n; j++) out[j] = w * a[j] + s.b1 * a[stride + j] + s.b2 * a[2u * stride + j];
+}
+
+/* The extras of s that have all of `flags` (EXTRA_*), or NULL. */
+KFN GLOBAL const TriExtra *surface_extra(const SceneView *sc, Surface s, uint flags)
+{
+    if (s.extra == NO_INDEX) return 0;
+    GLOBAL const TriExtra *e = sc->tri_extras + s.extra;
+    return (e->flags & flags) == flags ? e : 0;
+}
+
+/* The second uv set (TEXCOORD_1) at s; 0 where the surface has none. */
+KFN int surface_uv1(const SceneView *sc, Surface s, float *u, float *v)
+{
+    GLOBAL const TriExtra *e = surface_extra(sc, s, EXTRA_UV1);
+    if (!e) return 0;
+    float uv[2];
+    extra_lerp(&e->uv[0][0], 2u, 2u, s, uv);
+    *u = uv[0];
+    *v = uv[1];
+    return 1;
+}
+
+/* The vertex colour (COLOR_0, linear RGBA) at s; 0 where the surface has none. */
+KFN int surface_color(const SceneView *sc, Surface s, float *rgba)
+{
+    GLOBAL const TriExtra *e = surface_extra(sc, s, EXTRA_COLOR);
+    if (!e) return 0;
+    extra_lerp(&e->color[0][0], 4u, 4u, s, rgba);
+    return 1;
+}
+
+/* The given tangent (TANGENT) at s, not normalised, and its bitangent sign (+1 or -1,
+ * the sign of the interpolated w); 0 where the surface has none. */
+KFN int surface_tangent(const SceneView *sc, Surface s, vec3 *t, float *sign)
+{
+    GLOBAL const TriExtra *e = surface_extra(sc, s, EXTRA_TANGENT);
+    if (!e) return 0;
+    float q[4];
+    extra_lerp(&e->tangent[0][0], 4u, 4u, s, q);
+    *t = v3(q[0], q[1], q[2]);
+    *sign = q[3] < 0.0f ? -1.0f : 1.0f;
+    return 1;
 }
 
 /* A point just off the surface at p on the side n points to. The offset is a fixed

@@ -1,6 +1,7 @@
 /*
- * texture.h — the colour of a texture at a surface point: image textures (bilinear,
- * sRGB-decoded, repeat or clamp) and checkerboards (solid, or on the surface's (u, v)).
+ * texture.h — the colour of a texture at a surface point: image textures (bilinear or
+ * nearest, sRGB-decoded, repeat, clamp or mirror per axis) and checkerboards (solid, or
+ * on the surface's (u, v)).
  *
  * Surface coordinates: triangles use their texture coordinates (or barycentrics when
  * the mesh has none); spheres the longitude/latitude map, u = 0.5 + atan2(n.x, n.z)/2pi
@@ -51,6 +52,13 @@ KFN void surface_uv(const SceneView *sc, Surface s, float *u, float *v)
     }
 }
 
+/* The (u, v) texture tx is looked up at: the second uv set for TEX_UV1 where the
+ * surface has one (glTF's texCoord 1), else surface_uv's. */
+KFN void texture_uv(const SceneView *sc, Texture tx, Surface s, float *u, float *v)
+{
+    if (!(tx.flags & TEX_UV1) || !surface_uv1(sc, s, u, v)) surface_uv(sc, s, u, v);
+}
+
 /* Row i of the texture's 3x4 matrix applied to (x, y, z, 1). */
 KFN float tex_row(Texture tx, int i, vec3 q)
 {
@@ -72,13 +80,40 @@ KFN vec3 texel_fetch(const SceneView *sc, Texture tx, uint x, uint y)
     return rgb;
 }
 
-/* Texel index i (any integer, as a float) brought into [0, n) by the wrap mode. */
-KFN uint tex_wrap(float i, uint n, uint clamp)
+/* How one axis wraps (the TEX_CLAMP_U ... flags of types.h). */
+#define TEX_WRAP_REPEAT 0u
+#define TEX_WRAP_CLAMP 1u
+#define TEX_WRAP_MIRROR 2u
+
+KFN uint tex_wrap_mode(uint flags, uint clamp_bit, uint mirror_bit)
+{
+    return (flags & clamp_bit) ? TEX_WRAP_CLAMP : ((flags & mirror_bit) ? TEX_WRAP_MIRROR : TEX_WRAP_REPEAT);
+}
+
+/* Texel index i (any integer, as a float) brought into [0, n) by the wrap mode: mirror
+ * runs 0 .. n-1, n-1 .. 0 and again (each edge texel twice, as GL_MIRRORED_REPEAT). */
+KFN uint tex_wrap(float i, uint n, uint mode)
 {
     float fn = (float)n;
-    if (clamp) return (uint)k_clamp(i, 0.0f, fn - 1.0f);
+    if (mode == TEX_WRAP_CLAMP) return (uint)k_clamp(i, 0.0f, fn - 1.0f);
+    if (mode == TEX_WRAP_MIRROR) {
+        float r = i - 2.0f * fn * k_floor(i / (2.0f * fn));
+        if (r >= 2.0f * fn) r = 0.0f;    /* rounding can give exactly 2n */
+        return r >= fn ? (uint)(2.0f * fn - 1.0f - r) : (uint)r;
+    }
     float r = i - fn * k_floor(i / fn);
     return r >= fn ? 0u : (uint)r;      /* rounding can give exactly n */
+}
+
+/* A coordinate made small whatever its size, keeping what it wraps to: exactly
+ * periodic when repeating (period 1) or mirroring (period 2), a margin beyond the edge
+ * when clamping. NaN becomes 0. */
+KFN float tex_reduce(float u, uint mode)
+{
+    if (!(u == u)) return 0.0f;
+    if (mode == TEX_WRAP_CLAMP) return k_clamp(u, -1.0f, 2.0f);
+    if (mode == TEX_WRAP_MIRROR) return u - 2.0f * k_floor(u * 0.5f);
+    return u - k_floor(u);
 }
 
 /* The four texels around (u, v) and the weights between them (texture_image). */
@@ -88,30 +123,31 @@ typedef struct {
 } TexFootprint;
 
 /* Bilinear filtering between the four texel centres around (u, v); texel (i, j) has its
- * centre at u = (i + 0.5)/width, v = 1 - (j + 0.5)/height. */
+ * centre at u = (i + 0.5)/width, v = 1 - (j + 0.5)/height. TEX_NEAREST: the texel
+ * (u, v) lies in, alone (weights 0 and the same texel twice). */
 KFN TexFootprint texture_footprint(Texture tx, float u, float v)
 {
-    uint clamp = tx.flags & TEX_CLAMP;
-    if (!(u == u)) u = 0.0f;
-    if (!(v == v)) v = 0.0f;
-    /* keep the texel indices small whatever the coordinates (exactly periodic when
-     * repeating, a margin beyond the edge when clamping) */
-    if (clamp) {
-        u = k_clamp(u, -1.0f, 2.0f);
-        v = k_clamp(v, -1.0f, 2.0f);
-    } else {
-        u = u - k_floor(u);
-        v = v - k_floor(v);
+    uint mu = tex_wrap_mode(tx.flags, TEX_CLAMP_U, TEX_MIRROR_U);
+    uint mv = tex_wrap_mode(tx.flags, TEX_CLAMP_V, TEX_MIRROR_V);
+    u = tex_reduce(u, mu);
+    v = tex_reduce(v, mv);
+    TexFootprint f;
+    if (tx.flags & TEX_NEAREST) {
+        float x = k_floor(u * (float)tx.width), y = k_floor((1.0f - v) * (float)tx.height);
+        f.fx = 0.0f;
+        f.fy = 0.0f;
+        f.xa = f.xb = tex_wrap(x, tx.width, mu);
+        f.ya = f.yb = tex_wrap(y, tx.height, mv);
+        return f;
     }
     float x = u * (float)tx.width - 0.5f, y = (1.0f - v) * (float)tx.height - 0.5f;
     float x0 = k_floor(x), y0 = k_floor(y);
-    TexFootprint f;
     f.fx = x - x0;
     f.fy = y - y0;
-    f.xa = tex_wrap(x0, tx.width, clamp);
-    f.xb = tex_wrap(x0 + 1.0f, tx.width, clamp);
-    f.ya = tex_wrap(y0, tx.height, clamp);
-    f.yb = tex_wrap(y0 + 1.0f, tx.height, clamp);
+    f.xa = tex_wrap(x0, tx.width, mu);
+    f.xb = tex_wrap(x0 + 1.0f, tx.width, mu);
+    f.ya = tex_wrap(y0, tx.height, mv);
+    f.yb = tex_wrap(y0 + 1.0f, tx.height, mv);
     return f;
 }
 
@@ -138,7 +174,7 @@ KFN float texture_alpha(const SceneView *sc, uint index, Surface s)
     Texture tx = sc->textures[index];
     if (tx.type != TEX_IMAGE) return 1.0f;
     float u, v;
-    surface_uv(sc, s, &u, &v);
+    texture_uv(sc, tx, s, &u, &v);
     vec3 q = v3(u, v, 0.0f);
     TexFootprint f = texture_footprint(tx, tex_row(tx, 0, q), tex_row(tx, 1, q));
     float top = texel_alpha(sc, tx, f.xa, f.ya) * (1.0f - f.fx) + texel_alpha(sc, tx, f.xb, f.ya) * f.fx;
@@ -166,7 +202,7 @@ KFN vec3 texture_eval(const SceneView *sc, uint index, Surface s, vec3 ng_face)
         return texture_checker(tx, v3(tex_row(tx, 0, q), tex_row(tx, 1, q), tex_row(tx, 2, q)));
     }
     float u, v;
-    surface_uv(sc, s, &u, &v);
+    texture_uv(sc, tx, s, &u, &v);
     vec3 q = v3(u, v, 0.0f);
     vec3 t = v3(tex_row(tx, 0, q), tex_row(tx, 1, q), tex_row(tx, 2, q));
     if (tx.type == TEX_CHECKER) return texture_checker(tx, t);
@@ -181,10 +217,13 @@ KFN vec3 material_emission(const SceneView *sc, Material m, Surface s)
     return v3_mul(m.emission, texture_eval(sc, m.texture_emission, s, s.ng));
 }
 
-/* The material's diffuse colour (albedo) at s: its texture there, or its constant. */
+/* The material's diffuse colour (albedo) at s: its texture there, or its constant;
+ * times the vertex colour where the surface has one (glTF's COLOR_0). */
 KFN vec3 material_albedo(const SceneView *sc, Material m, Surface s, vec3 ng_face)
 {
-    return m.texture == NO_INDEX ? m.albedo : texture_eval(sc, m.texture, s, ng_face);
+    vec3 a = m.texture == NO_INDEX ? m.albedo : texture_eval(sc, m.texture, s, ng_face);
+    float c[4];
+    return surface_color(sc, s, c) ? v3_mul(a, v3(c[0], c[1], c[2])) : a;
 }
 
 /* dp/du and dp/dv at s, for tangent-space normal maps: a triangle's from its corners
@@ -223,23 +262,48 @@ KFN int surface_tangents(const SceneView *sc, Surface s, vec3 *dpdu, vec3 *dpdv)
     return 1;
 }
 
+/* d made orthogonal to the unit n and normalised (Gram-Schmidt) into *t; 0 when d has
+ * nothing across n. */
+KFN int tangent_along(vec3 n, vec3 d, vec3 *t)
+{
+    vec3 tt = v3_sub(d, v3_scale(n, v3_dot(n, d)));
+    float lt = v3_len(tt);
+    if (!(lt > 0.0f)) return 0;
+    *t = v3_scale(tt, 1.0f / lt);
+    return 1;
+}
+
+/* The tangent frame of a normal map at s around the shading normal n: t along the
+ * surface's given tangent (glTF's TANGENT) where it has a usable one, with the
+ * bitangent cross(n, t) times the tangent's w sign (glTF 2.0, 3.7.2.1); else t along
+ * dp/du, with the bitangent on dp/dv's side (so mirrored uv layouts stay right).
+ * 0 when there is no usable frame. */
+KFN int normal_map_frame(const SceneView *sc, Surface s, vec3 n, vec3 *t, vec3 *b)
+{
+    vec3 given, dpdu, dpdv;
+    float sign = 1.0f;
+    if (surface_tangent(sc, s, &given, &sign) && tangent_along(n, given, t)) {
+        *b = v3_cross(n, *t);
+        if (sign < 0.0f) *b = v3_neg(*b);
+        return 1;
+    }
+    if (!surface_tangents(sc, s, &dpdu, &dpdv) || !tangent_along(n, dpdu, t)) return 0;
+    *b = v3_cross(n, *t);
+    if (v3_dot(*b, dpdv) < 0.0f) *b = v3_neg(*b);
+    return 1;
+}
+
 /* The shading normal at s after the material's normal map: the texel (r, g, b) read
  * linearly is the tangent-space normal (2r - 1, 2g - 1, 2b - 1), x and y times
- * normal_scale, x along dp/du and y along dp/dv made orthonormal to the shading normal
- * (Gram-Schmidt; y keeps dp/dv's side, so mirrored uv layouts stay right). A result
- * on the far side of the geometric normal, or a surface without tangents, keeps s.ns. */
+ * normal_scale, x along the frame's tangent and y along its bitangent
+ * (normal_map_frame). A result on the far side of the geometric normal, or a surface
+ * without a frame, keeps s.ns. */
 KFN vec3 material_normal(const SceneView *sc, Material m, Surface s)
 {
-    vec3 dpdu, dpdv;
-    if (m.type != MAT_PRINCIPLED || m.texture_normal == NO_INDEX || !surface_tangents(sc, s, &dpdu, &dpdv))
-        return s.ns;
+    vec3 t, b;
     vec3 n = s.ns;
-    vec3 t = v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu)));
-    float lt = v3_len(t);
-    if (!(lt > 0.0f)) return s.ns;
-    t = v3_scale(t, 1.0f / lt);
-    vec3 b = v3_cross(n, t);
-    if (v3_dot(b, dpdv) < 0.0f) b = v3_neg(b);
+    if (m.type != MAT_PRINCIPLED || m.texture_normal == NO_INDEX || !normal_map_frame(sc, s, n, &t, &b))
+        return s.ns;
     vec3 c = texture_eval(sc, m.texture_normal, s, s.ng);
     vec3 tn = v3((2.0f * c.x - 1.0f) * m.normal_scale, (2.0f * c.y - 1.0f) * m.normal_scale, 2.0f * c.z - 1.0f);
     vec3 r = v3_add(v3_add(v3_scale(t, tn.x), v3_scale(b, tn.y)), v3_scale(n, tn.z));

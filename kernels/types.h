@@ -81,10 +81,29 @@ typedef struct {                                        /* 48 bytes */
 typedef struct {                                        /* 64 bytes */
     vec3 n0, n1, n2;          /* per-vertex shading normals (unit) */
     float uv0[2], uv1[2], uv2[2];
-    uint flags;               /* TRI_HAS_NORMALS | TRI_HAS_UV */
+    uint flags;               /* TRI_HAS_NORMALS | TRI_HAS_UV | TRI_HAS_EXTRA */
 } TriShading;
 #define TRI_HAS_NORMALS 1u
 #define TRI_HAS_UV 2u
+#define TRI_HAS_EXTRA 4u      /* tri_extra_of[this record's index] names its TriExtra */
+
+/* The corner attributes that only some glTF meshes carry: given tangents (TANGENT), a
+ * second uv set (TEXCOORD_1) and vertex colours (COLOR_0). They live in a side array
+ * instead of TriShading so that the records every smooth or textured triangle reads
+ * stay 64 bytes: a triangle with any of them has a shading record with TRI_HAS_EXTRA,
+ * and the scene's tri_extra_of buffer (one uint per shading record, NO_INDEX for none;
+ * empty when no triangle has extras) points into the TriExtra array. Only the shading
+ * of a surface that has extras ever reads either buffer (docs/gltf.md). */
+typedef struct {                                        /* 128 bytes */
+    float tangent[3][4];      /* per corner: unit tangent (world xyz), w = bitangent sign */
+    float color[3][4];        /* per corner: linear RGBA multiplying base colour and alpha */
+    float uv[3][2];           /* per corner: the second uv set (v up, as TriShading's) */
+    uint flags;               /* EXTRA_TANGENT | EXTRA_COLOR | EXTRA_UV1 */
+    uint pad0;
+} TriExtra;
+#define EXTRA_TANGENT 1u
+#define EXTRA_COLOR 2u
+#define EXTRA_UV1 4u
 
 typedef struct {                                        /* 32 bytes */
     vec3 lo;  uint material;
@@ -216,9 +235,21 @@ enum TextureType {
     TEX_CHECKER = 1      /* color0/color1 alternating on unit cells of texture space */
 };
 #define TEX_SRGB 1u      /* 8-bit texels are sRGB-encoded: decoded before filtering */
-#define TEX_CLAMP 2u     /* coordinates outside [0,1] clamp to the edge (else repeat) */
 #define TEX_FLOAT 4u     /* texels are 3 floats (as uint bits) each; else packed RGBA8 */
 #define TEX_SOLID 8u     /* checker: at the 3D hit point; else at the surface (u, v) */
+/* Wrap modes, per axis (glTF's wrapS is u, wrapT v): outside [0,1] a coordinate repeats
+ * unless its axis clamps to the edge or mirrors (every other period flipped, as
+ * GL_MIRRORED_REPEAT); clamp wins over mirror when both are set. */
+#define TEX_CLAMP_U 2u
+#define TEX_CLAMP_V 32u
+#define TEX_CLAMP (TEX_CLAMP_U | TEX_CLAMP_V)
+#define TEX_MIRROR_U 64u
+#define TEX_MIRROR_V 128u
+#define TEX_NEAREST 256u /* the nearest texel instead of bilinear filtering */
+#define TEX_UV1 512u     /* looked up at the second uv set (TriExtra) where a triangle has one */
+/* How a texture is read rather than what its texels are: a copy over other texels
+ * (glTF's tinted base colour) keeps these. */
+#define TEX_SAMPLING (TEX_CLAMP | TEX_MIRROR_U | TEX_MIRROR_V | TEX_NEAREST | TEX_UV1)
 
 typedef struct {                                        /* 112 bytes */
     uint type;                /* enum TextureType */
@@ -324,6 +355,8 @@ CLPT_CHECK_SIZE(KdNode, 8);
 CLPT_CHECK_SIZE(Sphere, 32);
 CLPT_CHECK_SIZE(Triangle, 48);
 CLPT_CHECK_SIZE(TriShading, 64);
+CLPT_CHECK_SIZE(TriExtra, 128);
+_Static_assert(offsetof(TriExtra, uv) == 96, "TriExtra.uv");
 CLPT_CHECK_SIZE(Box, 32);
 CLPT_CHECK_SIZE(Plane, 32);
 CLPT_CHECK_SIZE(RevSurface, 48);

@@ -296,6 +296,7 @@ static void test_render_key_covers_every_scene_buffer(void)
     p->n_nodes = p->n_leaf_prims = p->n_spheres = p->n_triangles = p->n_boxes = p->n_planes = 2;
     p->n_lights = p->n_textures = p->n_revsurfaces = 2;
     ds.n_materials = ds.n_shading = 2;
+    ds.n_tri_extra_of = ds.n_tri_extras = 2;
     ds.n_texels = ds.n_rev_points = 2;
     ds.n_env_cdf = 2;
     CheckpointId base, changed;

@@ -4,7 +4,8 @@
  * uvs, transforms, cameras, lights and materials they describe; and the three Blender
  * exports of ../shared/models/gltf load and render: the Cornell box against the OBJ
  * Cornell box through the same camera, the material spheres with different highlights,
- * the Suzanne with its embedded checker texture. The bad files are in
+ * the Suzanne with its embedded checker texture; extras.gltf's TANGENT, TEXCOORD_1,
+ * COLOR_0 and sampler through the kernels' shading functions. The bad files are in
  * tests/data/bad/gltf-* (test_bad_input.c). Run from the project root.
  */
 #include <math.h>
@@ -18,6 +19,9 @@
 #include "io/mesh_load.h"
 #include "io/scene_load.h"
 #include "render_util.h"
+
+#include "shade.cl"     /* the kernels' shading functions, compiled as C (test_extras) */
+#include "alpha.h"
 
 #define DIR_GLTF "tests/data/gltf/"
 #define SHARED "../shared/models/"
@@ -564,6 +568,142 @@ static void test_suzanne_texture(void)
     scene_free(&s);
 }
 
+
+/* The surface at the centroid of triangle `tri` of the prepared scene, seen from +z. */
+static Surface centroid_surface(const SceneView *v, const Scene *s, size_t tri)
+{
+    const Triangle *t = &s->triangles[tri];
+    vec3 c = v3_scale(v3_add(v3_add(t->p0, t->p1), t->p2), 1.0f / 3.0f);
+    Ray r;
+    r.o = v3_add(c, v3(0.0f, 0.0f, 1.0f));
+    r.d = v3(0.0f, 0.0f, -1.0f);
+    r.tmin = 0.0f;
+    r.tmax = 2.0f;
+    Hit h;
+    h.t = 1.0f;
+    h.prim = (uint)(s->n_spheres + tri);
+    h.u = h.v = 1.0f / 3.0f;
+    return surface_at(v, r, h);
+}
+
+/* extras.gltf (make_gltf.py): three quads of two triangles, 0-1 with TANGENT, 2-3 with
+ * TEXCOORD_1, 4-5 with COLOR_0, checked through the kernels' own functions against
+ * hand computations, in an albedo image, and PoCL against the scalar device. */
+static void test_extras(void)
+{
+    Scene s;
+    if (!load_scene(DIR_GLTF "extras.gltf", &s, 48, 12, 4)) return;
+    CHECK_EQ_INT(s.n_triangles, 6);
+    CHECK_EQ_INT(s.n_tri_extras, 6);
+    CHECK_EQ_INT(s.n_tri_extra_of, s.n_shading);
+    if (s.n_triangles != 6 || s.n_tri_extras != 6) {
+        scene_free(&s);
+        return;
+    }
+    /* the .glb (buffer and images in its BIN chunk) loads into the same */
+    Scene g;
+    if (load_scene(DIR_GLTF "extras.glb", &g, 48, 12, 4)) {
+        CHECK(g.n_triangles == 6 && memcmp(g.triangles, s.triangles, 6 * sizeof *g.triangles) == 0);
+        CHECK(g.n_tri_extras == 6 && memcmp(g.tri_extras, s.tri_extras, 6 * sizeof *g.tri_extras) == 0);
+        CHECK(g.n_texels == s.n_texels && memcmp(g.texels, s.texels, s.n_texels * sizeof *s.texels) == 0);
+    }
+    scene_free(&g);
+    const TriExtra *e0 = &s.tri_extras[s.tri_extra_of[s.triangles[0].shading]];
+    CHECK_EQ_INT(e0->flags, EXTRA_TANGENT);
+    CHECK(e0->tangent[1][0] == 0.0f && e0->tangent[1][1] == 1.0f && e0->tangent[1][3] == 1.0f);
+    RenderScene rs;
+    Error err = { 0 };
+    Status st = render_scene_prepare(&s, 0, &rs, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (st) {
+        error_clear(&err);
+        scene_free(&s);
+        return;
+    }
+    SceneView view;
+    device_scene_view(&rs.ds, &view);
+
+    /* TANGENT: the map's texel (255, 128, 255) read linearly is (1, 1/255, 1) in
+     * tangent space; with the given tangent t = +y, n = +z and w = 1 the bitangent is
+     * n x t = -x, so the normal is (-1/255, 1, 1) normalised. The uvs alone would give
+     * t = +x, b = +y: (1, 1/255, 1). */
+    Surface sf = centroid_surface(&view, &s, 0);
+    Material m = s.materials[sf.material];
+    vec3 n = material_normal(&view, m, sf);
+    double k = 1.0 / 255.0, len = sqrt(k * k + 2.0);
+    check_v3(n, -k / len, 1.0 / len, 1.0 / len, 1e-6);
+    /* w = -1 turns the bitangent to +x; a tangent along the normal has no direction
+     * across it, so the uvs' frame takes over (the view reads the scene's own arrays) */
+    TriExtra *e = &s.tri_extras[sf.extra];
+    for (int c = 0; c < 3; c++) e->tangent[c][3] = -1.0f;
+    check_v3(material_normal(&view, m, sf), k / len, 1.0 / len, 1.0 / len, 1e-6);
+    for (int c = 0; c < 3; c++) {
+        e->tangent[c][1] = 0.0f;
+        e->tangent[c][2] = 1.0f;
+    }
+    check_v3(material_normal(&view, m, sf), 1.0 / len, k / len, 1.0 / len, 1e-6);
+
+    /* TEXCOORD_1: the texture reads (0.75, 0.25) of the 2 x 2 image (the top row's right
+     * texel, (0, 64, 255) sRGB) where TEXCOORD_0 at the centroid, (2/3, 1/3), would
+     * read the bottom row's right one, (200, 100, 50); nearest, so exactly the texel */
+    sf = centroid_surface(&view, &s, 2);
+    m = s.materials[sf.material];
+    CHECK(m.texture != NO_INDEX);
+    if (m.texture != NO_INDEX) {
+        CHECK_EQ_INT(s.textures[m.texture].flags, TEX_SRGB | TEX_UV1 | TEX_NEAREST | TEX_MIRROR_U | TEX_CLAMP_V);
+        vec3 c = texture_eval(&view, m.texture, sf, sf.ng);
+        check_v3(c, 0.0, k_srgb_to_linear(64.0f / 255.0f), 1.0, 0.0);
+    }
+
+    /* COLOR_0 (255, 128, 64, 191) times baseColorFactor 0.8; its alpha times alpha 1 */
+    sf = centroid_surface(&view, &s, 4);
+    m = s.materials[sf.material];
+    check_v3(material_albedo(&view, m, sf, sf.ng), 0.8 * 1.0, 0.8 * 128.0 / 255.0, 0.8 * 64.0 / 255.0, 1e-6);
+    CHECK_NEAR(material_alpha(&view, m, sf), 191.0 / 255.0, 1e-6);
+    render_scene_free(&rs);
+
+    /* the albedo image: quad 2's middle (x = 3.5 of the camera's -0.4 .. 4.4) has the
+     * colour's ratios */
+    Film f;
+    s.integrator = INTEGRATOR_AOV_ALBEDO;
+    st = render_util_run(&s, "scalar", 0, &f, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (st == ST_OK) {
+        float *rgb = malloc((size_t)f.width * f.height * 3u * sizeof *rgb);
+        film_resolve(&f, rgb);
+        const float *px = rgb + 3u * (6u * f.width + 39u);
+        fprintf(stderr, "  COLOR_0 quad's albedo pixel: %.6f %.6f %.6f\n", px[0], px[1], px[2]);
+        CHECK_NEAR(px[0], 0.8, 1e-5);
+        CHECK_NEAR(px[1] / px[0], 128.0 / 255.0, 1e-5);
+        CHECK_NEAR(px[2] / px[0], 64.0 / 255.0, 1e-5);
+        free(rgb);
+        film_free(&f);
+    }
+    error_clear(&err);
+
+    /* the path tracer through all three on PoCL and the scalar device: the same bits */
+    s.integrator = INTEGRATOR_PATH;
+    Film a, b;
+    Status sa = render_util_run(&s, "scalar", 0, &a, &err);
+    CHECK_MSG(sa == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    Status sb = render_util_run(&s, "cpu", 0, &b, &err);
+    CHECK_MSG(sb == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    if (sa == ST_OK && sb == ST_OK) {
+        size_t nf = (size_t)a.width * a.height * 3u;
+        float *ra = malloc(nf * sizeof *ra), *rb = malloc(nf * sizeof *rb);
+        film_resolve(&a, ra);
+        film_resolve(&b, rb);
+        CHECK(memcmp(ra, rb, nf * sizeof *ra) == 0);
+        free(ra);
+        free(rb);
+    }
+    if (sa == ST_OK) film_free(&a);
+    if (sb == ST_OK) film_free(&b);
+    scene_free(&s);
+}
+
 int main(void)
 {
     RUN(test_strided);
@@ -574,6 +714,7 @@ int main(void)
     RUN(test_nodes);
     RUN(test_mesh_block);
     RUN(test_alpha_modes);
+    RUN(test_extras);
     RUN(test_cornell_box);
     RUN(test_material_spheres);
     RUN(test_suzanne_texture);

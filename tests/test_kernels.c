@@ -51,8 +51,9 @@ static float frand(void)
 static float frange(float lo, float hi) { return lo + (hi - lo) * frand(); }
 static vec3 vrand(float lo, float hi) { return v3(frange(lo, hi), frange(lo, hi), frange(lo, hi)); }
 
-/* Textures of each kind: an sRGB 8-bit image, a linear float image (clamped), a surface
- * checker and a solid one. Returns the indices in t[4]. */
+/* Textures of each kind: an sRGB 8-bit image (nearest, mirrored in v), a linear float
+ * image (mirrored in u, clamped in v), a surface checker and a solid one. Returns the
+ * indices in t[4]. */
 static void add_textures(uint t[4])
 {
     uint px[8 * 4], offset;
@@ -60,7 +61,7 @@ static void add_textures(uint t[4])
     scene_add_texels(&scene, px, 8 * 4, &offset, NULL);
     Texture img = texture_make_checker(v3s(0.0f), v3s(0.0f), 1.0f, 0);
     img.type = TEX_IMAGE;
-    img.flags = TEX_SRGB;
+    img.flags = TEX_SRGB | TEX_MIRROR_V | TEX_NEAREST;   /* u repeats */
     img.offset = offset;
     img.width = 8;
     img.height = 4;
@@ -70,7 +71,7 @@ static void add_textures(uint t[4])
     uint bits[6];
     memcpy(bits, f, sizeof bits);
     scene_add_texels(&scene, bits, 6, &offset, NULL);
-    img.flags = TEX_FLOAT | TEX_CLAMP;
+    img.flags = TEX_FLOAT | TEX_MIRROR_U | TEX_CLAMP_V;
     img.offset = offset;
     img.width = 2;
     img.height = 1;
@@ -338,7 +339,7 @@ static void test_layout(void)
                     offsetof(Material, clearcoat_roughness), offsetof(Material, texture_rm),
                     offsetof(Material, normal_scale),
                     sizeof(RevSurface), offsetof(RevSurface, axis_x), offsetof(RenderParams, n_revsurfaces),
-                    offsetof(RenderParams, bg_light) };
+                    offsetof(RenderParams, bg_light), sizeof(TriExtra), offsetof(TriExtra, uv) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);

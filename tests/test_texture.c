@@ -1,7 +1,8 @@
 /*
  * test_texture.c — texture lookups (kernels/texture.h) and image loading (host/io/texture.c):
  * the sRGB decoding and the other functions of kmath.h built from + - * / sqrt against
- * libm in double, bilinear filtering at known points, repeat and clamp, checkerboards,
+ * libm in double, bilinear filtering at known points, repeat, clamp and mirror per axis,
+ * nearest, checkerboards,
  * the surface parameterisations, and reading images through stb_image.
  */
 #include <math.h>
@@ -155,6 +156,47 @@ static void test_bilinear_and_wrap(void)
     /* NaN coordinates do not crash or poison */
     vec3 n = texture_image(&view, r, NAN, NAN);
     CHECK(n.x == n.x && n.y == n.y && n.z == n.z);
+    scene_free(&scene);
+}
+
+/* glTF's sampler modes per axis (texture.h): for u (or v) outside [0, 1], repeat keeps
+ * the fraction, clamp the edge texel, mirror flips every other period (u = 1.25 reads as
+ * 0.75, -0.25 as 0.25, 2.25 as 0.25); each axis on its own; nearest takes the texel the
+ * point lies in. The 2 x 2 texture: top row red, green; bottom blue, white. */
+static void test_wrap_modes(void)
+{
+    scene_init(&scene);
+    uint rep = float_texture(0), mir = float_texture(TEX_MIRROR_U | TEX_MIRROR_V);
+    uint cu = float_texture(TEX_CLAMP_U), mv = float_texture(TEX_MIRROR_V), near = float_texture(TEX_NEAREST);
+    uint both = float_texture(TEX_CLAMP_U | TEX_MIRROR_U);
+    view_setup();
+    Texture r = scene.textures[rep], m = scene.textures[mir], c = scene.textures[cu], v = scene.textures[mv];
+    Texture n = scene.textures[near], b = scene.textures[both];
+    /* u outside [0, 1] on the top row's texel centres (v = 0.75) */
+    CHECK(v3_near(texture_image(&view, r, 1.25f, 0.75f), 1, 0, 0, 1e-6));    /* repeat: 0.25, red */
+    CHECK(v3_near(texture_image(&view, m, 1.25f, 0.75f), 0, 1, 0, 1e-6));    /* mirror: 0.75, green */
+    CHECK(v3_near(texture_image(&view, m, -0.25f, 0.75f), 1, 0, 0, 1e-6));   /* mirror: 0.25, red */
+    CHECK(v3_near(texture_image(&view, m, 2.25f, 0.75f), 1, 0, 0, 1e-6));    /* period 2: 0.25 */
+    CHECK(v3_near(texture_image(&view, m, -1.25f, 0.75f), 0, 1, 0, 1e-6));   /* 0.75 */
+    CHECK(v3_near(texture_image(&view, c, 1.25f, 0.75f), 0, 1, 0, 0.0));     /* clamp: the right edge */
+    CHECK(v3_near(texture_image(&view, c, -7.0f, 0.75f), 1, 0, 0, 0.0));     /* ... and the left */
+    CHECK(v3_near(texture_image(&view, b, 1.25f, 0.75f), 0, 1, 0, 0.0));     /* clamp wins over mirror */
+    /* the mirror's edge: the edge texel twice, so no blend with the far side */
+    CHECK(v3_near(texture_image(&view, m, 1.0f, 0.75f), 0, 1, 0, 0.0));
+    CHECK(v3_near(texture_image(&view, r, 1.0f, 0.75f), 0.5, 0.5, 0, 1e-7));
+    /* per axis: clamp u with v repeating (v = -0.75 is 0.25, the bottom row); mirror v
+     * with u repeating (v = 1.25 is 0.75, the top row; u = 1.75 is 0.75) */
+    CHECK(v3_near(texture_image(&view, c, 1.25f, -0.75f), 1, 1, 1, 1e-6));
+    CHECK(v3_near(texture_image(&view, v, 1.75f, 1.25f), 0, 1, 0, 1e-6));
+    CHECK(v3_near(texture_image(&view, r, 1.75f, 1.25f), 1, 1, 1, 1e-6));   /* repeat v: 0.25 */
+    /* nearest: 0.4 lies in the left texel; bilinear blends 0.7 of it with 0.3 green */
+    CHECK(v3_near(texture_image(&view, n, 0.4f, 0.75f), 1, 0, 0, 0.0));
+    CHECK(v3_near(texture_image(&view, r, 0.4f, 0.75f), 0.7, 0.3, 0, 1e-6));
+    CHECK(v3_near(texture_image(&view, n, 0.6f, 0.2f), 1, 1, 1, 0.0));
+    CHECK(v3_near(texture_image(&view, n, -0.4f, 0.75f), 0, 1, 0, 0.0));   /* repeats: 0.6 */
+    /* NaN and huge coordinates stay inside the image */
+    vec3 q = texture_image(&view, m, NAN, 3e9f);
+    CHECK(q.x == q.x && q.y == q.y && q.z == q.z);
     scene_free(&scene);
 }
 
@@ -407,6 +449,7 @@ int main(void)
     RUN(test_exp_log_pow);
     RUN(test_inverse_trig);
     RUN(test_bilinear_and_wrap);
+    RUN(test_wrap_modes);
     RUN(test_srgb_texels);
     RUN(test_checker);
     RUN(test_surface_uv);

@@ -44,6 +44,8 @@ typedef struct {
     SCENE_BUFFERS(DEVICE_SCENE_FIELD_)
     uint n_materials;
     uint n_shading;
+    uint n_tri_extra_of;        /* n_shading, or 0 when no triangle has extras */
+    uint n_tri_extras;
     size_t n_texels;
     size_t n_rev_points;        /* floats: two per profile control point */
     size_t n_env_cdf;

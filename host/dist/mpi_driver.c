@@ -241,7 +241,7 @@ void dist_finish(Dist *d, int exit_status, int abort)
 
 typedef struct {
     int32_t status;
-    uint32_t spp, n_materials, n_shading;
+    uint32_t spp, n_materials, n_shading, n_tri_extra_of, n_tri_extras;
     uint64_t n_texels;
     uint64_t bytes[SCENE_BUF_COUNT];
 } WireScene;
@@ -282,6 +282,8 @@ static Status scene_receive(Dist *d, const WireScene *h, DeviceScene *ds, Error 
     memset(ds, 0, sizeof *ds);
     ds->n_materials = h->n_materials;
     ds->n_shading = h->n_shading;
+    ds->n_tri_extra_of = h->n_tri_extra_of;
+    ds->n_tri_extras = h->n_tri_extras;
     ds->n_texels = (size_t)h->n_texels;
     for (unsigned i = 0; i < SCENE_BUF_COUNT; i++) {
         if (h->bytes[i] == 0) continue;
@@ -310,6 +312,8 @@ Status dist_share_scene(Dist *d, Status rank0_status, DeviceScene *ds, unsigned 
         h.spp = *spp;
         h.n_materials = ds->n_materials;
         h.n_shading = ds->n_shading;
+        h.n_tri_extra_of = ds->n_tri_extra_of;
+        h.n_tri_extras = ds->n_tri_extras;
         h.n_texels = ds->n_texels;
         for (unsigned i = 0; rank0_status == ST_OK && i < SCENE_BUF_COUNT; i++)
             h.bytes[i] = device_scene_buffer(ds, i).bytes;

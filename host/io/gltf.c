@@ -37,10 +37,11 @@ typedef struct {
 /* The top-level arrays (and the lights of KHR_lights_punctual) as arrays of pointers:
  * cJSON keeps arrays as linked lists, where finding item i walks i items, and a reader
  * that looked every index up that way would be quadratic in its input. */
-enum { T_BUFFERS, T_VIEWS, T_ACCESSORS, T_MESHES, T_MATERIALS, T_TEXTURES, T_IMAGES, T_CAMERAS, T_NODES, T_SCENES,
-       T_LIGHTS, T_N };
+enum { T_BUFFERS, T_VIEWS, T_ACCESSORS, T_MESHES, T_MATERIALS, T_TEXTURES, T_IMAGES, T_SAMPLERS, T_CAMERAS, T_NODES,
+       T_SCENES, T_LIGHTS, T_N };
 static const char *const table_names[T_N] = { "buffers", "bufferViews", "accessors", "meshes", "materials",
-                                              "textures", "images", "cameras", "nodes", "scenes", "lights" };
+                                              "textures", "images", "samplers", "cameras", "nodes", "scenes",
+                                              "lights" };
 typedef struct {
     const cJSON **item;
     int n;
@@ -411,9 +412,21 @@ static Status acc_sparse(Gltf *g, const cJSON *sp, const char *jpath, long long 
     return ST_OK;
 }
 
+static Status acc_read_either(Gltf *g, int a, int width, int width2, const char *use, double **out, size_t *count,
+                              int *got);
+
 /* accessors[a] as `width`-wide elements of doubles (*out, *count elements), read for
  * the JSON path `use`. */
 static Status acc_read(Gltf *g, int a, int width, const char *use, double **out, size_t *count)
+{
+    int got;
+    return acc_read_either(g, a, width, 0, use, out, count, &got);
+}
+
+/* acc_read of an accessor that may be `width` or `width2` wide (0: only width); *got
+ * says which. */
+static Status acc_read_either(Gltf *g, int a, int width, int width2, const char *use, double **out, size_t *count,
+                              int *got)
 {
     char jp[200];
     snprintf(jp, sizeof jp, "%s: accessor %d", use, a);
@@ -427,11 +440,18 @@ static Status acc_read(Gltf *g, int a, int width, const char *use, double **out,
     if (st) return st;
     if (!comp_size(ctype)) return bad(g, jp, "componentType is not one glTF defines");
     const cJSON *type = cJSON_GetObjectItemCaseSensitive(acc, "type");
-    if (!cJSON_IsString(type) || type_width(type->valuestring) != width) {
+    int tw = cJSON_IsString(type) ? type_width(type->valuestring) : 0;
+    if (tw != width && (!width2 || tw != width2)) {
+        static const char *const names[] = { "SCALAR", "VEC2", "VEC3", "VEC4" };
         char what[80];
-        snprintf(what, sizeof what, "type must be %s here", width == 1 ? "SCALAR" : width == 2 ? "VEC2" : "VEC3");
+        if (width2)
+            snprintf(what, sizeof what, "type must be %s or %s here", names[width - 1], names[width2 - 1]);
+        else
+            snprintf(what, sizeof what, "type must be %s here", names[width - 1]);
         return bad(g, jp, what);
     }
+    width = tw;
+    *got = tw;
     int normalized = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(acc, "normalized"));
     const cJSON *sparse = cJSON_GetObjectItemCaseSensitive(acc, "sparse");
     uint64_t esz = (uint64_t)comp_size(ctype) * (uint64_t)width;
@@ -522,34 +542,71 @@ static Status texture_get(Gltf *g, int t, int linear, const char *jpath, uint *o
     return st;
 }
 
-/* A copy of texture *index with KHR_texture_transform's map: glTF's uv' = T R S uv,
- * its rotation matrix [cos -sin; sin cos] as the extension's shader writes it, taken
- * between clpt's (u, v) and glTF's (u, 1 - v) on both sides. */
-static Status texture_transformed(Gltf *g, const cJSON *tt, const char *jpath, uint *index)
+/* KHR_texture_transform's map: glTF's uv' = T R S uv, its rotation matrix
+ * [cos -sin; sin cos] as the extension's shader writes it, taken between clpt's (u, v)
+ * and glTF's (u, 1 - v) on both sides; its texCoord, when it has one, replaces *tc. */
+static Status texture_transform(Gltf *g, const cJSON *tt, const char *jpath, float m[12], long long *tc)
 {
     char jp[340];
     snprintf(jp, sizeof jp, "%s.extensions.KHR_texture_transform", jpath);
     static const double zero2[2] = { 0, 0 }, one2[2] = { 1, 1 };
     double off[2], sc[2], rot;
-    long long tc;
     Status st = get_nums(g, tt, "offset", 2, zero2, jp, off);
     if (!st) st = get_nums(g, tt, "scale", 2, one2, jp, sc);
     if (!st) st = get_num(g, tt, "rotation", 0.0, -1e6, 1e6, jp, &rot);
-    if (!st) st = get_int(g, tt, "texCoord", 0, 0, 64, jp, &tc);
+    if (!st) st = get_int(g, tt, "texCoord", *tc, 0, 64, jp, tc);
     if (st) return st;
-    if (tc != 0 && (st = scene_warn(g->s, g->err, "%s: %s: texCoord %lld is read as TEXCOORD_0 (clpt has one uv set)",
-                                     g->path, jp, tc)))
-        return st;
     double a = sc[0] * cos(rot), b = -sc[1] * sin(rot), c = sc[0] * sin(rot), d = sc[1] * cos(rot);
-    const float m[12] = { (float)a, (float)-b, 0.0f, (float)(b + off[0]),
-                          (float)-c, (float)d, 0.0f, (float)(1.0 - d - off[1]),
-                          0.0f, 0.0f, 1.0f, 0.0f };
-    Texture t = g->s->textures[*index];
-    texture_set_matrix(&t, m);
-    return scene_add_texture(g->s, NULL, NULL, t, index, g->err);
+    const float mm[12] = { (float)a, (float)-b, 0.0f, (float)(b + off[0]),
+                           (float)-c, (float)d, 0.0f, (float)(1.0 - d - off[1]),
+                           0.0f, 0.0f, 1.0f, 0.0f };
+    memcpy(m, mm, sizeof mm);
+    return ST_OK;
 }
 
-/* The texture a textureInfo object at obj.key names, or NO_INDEX. */
+/* One axis of a sampler: glTF's REPEAT, CLAMP_TO_EDGE or MIRRORED_REPEAT. */
+static Status sampler_wrap(Gltf *g, const cJSON *smp, const char *key, const char *jp, uint clamp, uint mirror,
+                           uint *flags)
+{
+    long long w;
+    Status st = get_int(g, smp, key, 10497, 0, 65535, jp, &w);
+    if (st) return st;
+    if (w == 33071) *flags |= clamp;
+    else if (w == 33648) *flags |= mirror;
+    else if (w != 10497)
+        return error_set(g->err, ST_INPUT, "%s: %s.%s: expected 10497 (REPEAT), 33071 (CLAMP_TO_EDGE) or 33648 "
+                         "(MIRRORED_REPEAT)", g->path, jp, key);
+    return ST_OK;
+}
+
+/* The TEX_* sampling flags of textures[t]'s sampler: wrapS (u) and wrapT (v), and
+ * magFilter NEAREST. clpt has no mip-maps, so one filter serves every lookup: the
+ * magnification filter's; minFilter is ignored. */
+static Status sampler_flags(Gltf *g, int t, uint *flags)
+{
+    *flags = 0;
+    char jt[64];
+    snprintf(jt, sizeof jt, "textures[%d]", t);
+    int si;
+    Status st = get_index(g, item_at(g, "textures", t), "sampler", 0, "samplers", jt, &si);
+    if (st || si < 0) return st;
+    const cJSON *smp = item_at(g, "samplers", si);
+    char jp[64];
+    snprintf(jp, sizeof jp, "samplers[%d]", si);
+    long long mag;
+    if ((st = sampler_wrap(g, smp, "wrapS", jp, TEX_CLAMP_U, TEX_MIRROR_U, flags)) ||
+        (st = sampler_wrap(g, smp, "wrapT", jp, TEX_CLAMP_V, TEX_MIRROR_V, flags)) ||
+        (st = get_int(g, smp, "magFilter", 9729, 0, 65535, jp, &mag)))
+        return st;
+    if (mag == 9728) *flags |= TEX_NEAREST;
+    else if (mag != 9729)
+        return error_set(g->err, ST_INPUT, "%s: %s.magFilter: expected 9728 (NEAREST) or 9729 (LINEAR)", g->path, jp);
+    return ST_OK;
+}
+
+/* The texture a textureInfo object at obj.key names, or NO_INDEX: the image's texture,
+ * or a copy of it (a texture record of its own over the same texels) with its sampler's
+ * wrap and filter flags, TEX_UV1 for texCoord 1 and KHR_texture_transform's map. */
 static Status texinfo(Gltf *g, const cJSON *obj, const char *key, int linear, const char *jpath, uint *out,
                       double *scale)
 {
@@ -560,16 +617,25 @@ static Status texinfo(Gltf *g, const cJSON *obj, const char *key, int linear, co
     snprintf(jp, sizeof jp, "%s.%s", jpath, key);
     int t;
     long long tc;
+    uint flags;
+    float m[12];
+    const cJSON *tt = ext_of(ti, "KHR_texture_transform");
     Status st = get_index(g, ti, "index", 1, "textures", jp, &t);
     if (!st) st = get_int(g, ti, "texCoord", 0, 0, 64, jp, &tc);
     if (!st && scale) st = get_num(g, ti, "scale", 1.0, -1e6, 1e6, jp, scale);
+    if (!st && tt) st = texture_transform(g, tt, jp, m, &tc);
+    if (!st) st = sampler_flags(g, t, &flags);
     if (st) return st;
-    if (tc != 0 && (st = scene_warn(g->s, g->err, "%s: %s: texCoord %lld is read as TEXCOORD_0 (clpt has one uv set)",
-                                     g->path, jp, tc)))
+    if (tc > 1 && (st = scene_warn(g->s, g->err, "%s: %s: texCoord %lld is read as TEXCOORD_0 (clpt reads "
+                                   "TEXCOORD_0 and TEXCOORD_1)", g->path, jp, tc)))
         return st;
+    if (tc == 1) flags |= TEX_UV1;
     if ((st = texture_get(g, t, linear, jp, out))) return st;
-    const cJSON *tt = ext_of(ti, "KHR_texture_transform");
-    return tt ? texture_transformed(g, tt, jp, out) : ST_OK;
+    if (!flags && !tt) return ST_OK;
+    Texture tx = g->s->textures[*out];
+    tx.flags |= flags;
+    if (tt) texture_set_matrix(&tx, m);
+    return scene_add_texture(g->s, NULL, NULL, tx, out, g->err);
 }
 
 /* A copy of texture `base` with every texel multiplied by `factor` (glTF's base colour
@@ -602,7 +668,7 @@ static Status texture_tinted(Gltf *g, uint base, const double factor[3], uint *o
     free(texels);
     if (st) return st;
     t.offset = offset;
-    t.flags = (t.flags & TEX_CLAMP) | TEX_FLOAT;
+    t.flags = (t.flags & TEX_SAMPLING) | TEX_FLOAT;
     return scene_add_texture(g->s, NULL, NULL, t, out, g->err);
 }
 
@@ -743,8 +809,10 @@ static Status corner_indices(Gltf *g, const cJSON *prim, const char *jp, size_t 
     return st;
 }
 
-static Status attr_read(Gltf *g, const cJSON *attrs, const char *name, int width, const char *jp, size_t n_vertices,
-                        double **out)
+/* attributes.name as `width`-wide elements (or `width2`-wide, 0: only width; *got says
+ * which), as many as POSITION's n_vertices; *out NULL when the primitive lacks it. */
+static Status attr_read(Gltf *g, const cJSON *attrs, const char *name, int width, int width2, const char *jp,
+                        size_t n_vertices, double **out, int *got)
 {
     *out = NULL;
     char use[140];
@@ -752,8 +820,18 @@ static Status attr_read(Gltf *g, const cJSON *attrs, const char *name, int width
     int ai;
     Status st = get_index(g, attrs, name, 0, "accessors", use, &ai);
     if (st || ai < 0) return st;
+    if (strcmp(name, "COLOR_0") == 0) {
+        /* glTF 2.0, 3.7.2.1: float, or normalized unsigned byte or short */
+        const cJSON *acc = item_at(g, "accessors", ai);
+        const cJSON *ct = cJSON_GetObjectItemCaseSensitive(acc, "componentType");
+        double c = cJSON_IsNumber(ct) ? ct->valuedouble : 0;
+        int norm = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(acc, "normalized"));
+        if (!(c == 5126 || ((c == 5121 || c == 5123) && norm)))
+            return error_set(g->err, ST_INPUT, "%s: %s: accessor %d: componentType must be 5126 (float), or 5121 "
+                             "or 5123 (unsigned byte or short) with normalized true", g->path, use, ai);
+    }
     size_t n;
-    if ((st = acc_read(g, ai, width, use, out, &n))) return st;
+    if ((st = acc_read_either(g, ai, width, width2, use, out, &n, got))) return st;
     if (n_vertices && n != n_vertices) {
         free(*out);
         *out = NULL;
@@ -763,9 +841,32 @@ static Status attr_read(Gltf *g, const cJSON *attrs, const char *name, int width
     return ST_OK;
 }
 
+/* A primitive's vertex attributes, as doubles per vertex (NULL when absent). */
+typedef struct {
+    double *pos, *nrm, *uv;
+    double *tan, *uv1, *col;    /* TANGENT (4 wide), TEXCOORD_1, COLOR_0 (col_width wide) */
+    int col_width;
+} Attrs;
+
+static void attrs_free(Attrs *a)
+{
+    free(a->pos);
+    free(a->nrm);
+    free(a->uv);
+    free(a->tan);
+    free(a->uv1);
+    free(a->col);
+}
+
+/* A glTF uv as clpt's: glTF's v runs down the image, clpt's (as OBJ's) up. */
+static void uv_flip(const double *uv, float *out)
+{
+    out[0] = (float)uv[0];
+    out[1] = (float)(1.0 - uv[1]);
+}
+
 /* One triangle of vertices a, b, c. */
-static Status emit(Gltf *g, MeshSink *k, const double *pos, const double *nrm, const double *uv, uint32_t a, uint32_t b,
-                   uint32_t c, uint mat)
+static Status emit(Gltf *g, MeshSink *k, const Attrs *at, uint32_t a, uint32_t b, uint32_t c, uint mat)
 {
     if (++g->triangles > g->max_triangles)
         return error_set(g->err, ST_INPUT, "%s: more than %zu triangles (its nodes and primitives together), more "
@@ -773,24 +874,31 @@ static Status emit(Gltf *g, MeshSink *k, const double *pos, const double *nrm, c
     const uint32_t v[3] = { a, b, c };
     vec3 p[3], n[3];
     float t[6];
-    int normals_ok = nrm != NULL, uv_ok = uv != NULL;
+    TriExtra e;
+    memset(&e, 0, sizeof e);
+    e.flags = (at->tan ? EXTRA_TANGENT : 0u) | (at->uv1 ? EXTRA_UV1 : 0u) | (at->col ? EXTRA_COLOR : 0u);
+    int normals_ok = at->nrm != NULL, uv_ok = at->uv != NULL;
     for (int i = 0; i < 3; i++) {
-        const double *q = pos + 3 * (size_t)v[i];
+        size_t vi = v[i];
+        const double *q = at->pos + 3 * vi;
         p[i] = v3((float)q[0], (float)q[1], (float)q[2]);
-        if (nrm) {
-            const double *m = nrm + 3 * (size_t)v[i];
+        if (at->nrm) {
+            const double *m = at->nrm + 3 * vi;
             double l = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
             if (!(l > 0) || !isfinite(l)) normals_ok = 0;
             else n[i] = v3((float)(m[0] / l), (float)(m[1] / l), (float)(m[2] / l));
         }
-        if (uv) {
-            /* glTF's v runs down the image, clpt's (as OBJ's) up */
-            t[2 * i] = (float)uv[2 * (size_t)v[i]];
-            t[2 * i + 1] = (float)(1.0 - uv[2 * (size_t)v[i] + 1]);
+        if (at->uv) {
+            uv_flip(at->uv + 2 * vi, t + 2 * i);
             if (!isfinite(t[2 * i]) || !isfinite(t[2 * i + 1])) uv_ok = 0;
         }
+        /* the sink checks these for finiteness and transforms the tangents */
+        for (int j = 0; at->tan && j < 4; j++) e.tangent[i][j] = (float)at->tan[4 * vi + (size_t)j];
+        if (at->uv1) uv_flip(at->uv1 + 2 * vi, e.uv[i]);
+        for (int j = 0; at->col && j < 4; j++)
+            e.color[i][j] = j < at->col_width ? (float)at->col[(size_t)at->col_width * vi + (size_t)j] : 1.0f;
     }
-    return mesh_sink_triangle(k, p, normals_ok ? n : NULL, uv_ok ? t : NULL, mat);
+    return mesh_sink_triangle_extra(k, p, normals_ok ? n : NULL, uv_ok ? t : NULL, e.flags ? &e : NULL, mat);
 }
 
 static Status primitive_load(Gltf *g, MeshSink *k, const cJSON *prim, const char *jp)
@@ -803,33 +911,36 @@ static Status primitive_load(Gltf *g, MeshSink *k, const cJSON *prim, const char
     const cJSON *attrs = cJSON_GetObjectItemCaseSensitive(prim, "attributes");
     if (!cJSON_IsObject(attrs)) return bad(g, jp, "attributes: expected an object");
     if (!cJSON_GetObjectItemCaseSensitive(attrs, "POSITION")) return bad(g, jp, "attributes.POSITION: missing");
-    double *pos = NULL, *nrm = NULL, *uv = NULL;
+    Attrs at;
+    memset(&at, 0, sizeof at);
     uint32_t *idx = NULL;
     size_t nv = 0, ni = 0;
     char use[140];
     snprintf(use, sizeof use, "%s.attributes.POSITION", jp);
-    int pa;
+    int pa, w;
     if ((st = get_index(g, attrs, "POSITION", 1, "accessors", use, &pa))) return st;
-    if ((st = acc_read(g, pa, 3, use, &pos, &nv))) return st;
+    if ((st = acc_read(g, pa, 3, use, &at.pos, &nv))) return st;
     uint mat;
     int mi;
-    if (!(st = attr_read(g, attrs, "NORMAL", 3, jp, nv, &nrm)) && !(st = attr_read(g, attrs, "TEXCOORD_0", 2, jp, nv, &uv)) &&
+    if (!(st = attr_read(g, attrs, "NORMAL", 3, 0, jp, nv, &at.nrm, &w)) &&
+        !(st = attr_read(g, attrs, "TEXCOORD_0", 2, 0, jp, nv, &at.uv, &w)) &&
+        !(st = attr_read(g, attrs, "TANGENT", 4, 0, jp, nv, &at.tan, &w)) &&
+        !(st = attr_read(g, attrs, "TEXCOORD_1", 2, 0, jp, nv, &at.uv1, &w)) &&
+        !(st = attr_read(g, attrs, "COLOR_0", 3, 4, jp, nv, &at.col, &at.col_width)) &&
         !(st = corner_indices(g, prim, jp, nv, &idx, &ni)) &&
         !(st = get_index(g, prim, "material", 0, "materials", jp, &mi)))
         st = material_get(g, mi, &mat);
     if (!st && mode == 4) {
-        for (size_t i = 0; i + 2 < ni && !st; i += 3) st = emit(g, k, pos, nrm, uv, idx[i], idx[i + 1], idx[i + 2], mat);
+        for (size_t i = 0; i + 2 < ni && !st; i += 3) st = emit(g, k, &at, idx[i], idx[i + 1], idx[i + 2], mat);
     } else if (!st && mode == 5) {
         /* every other triangle of a strip swaps its first two corners to keep the winding */
         for (size_t i = 0; i + 2 < ni && !st; i++)
-            st = i % 2 ? emit(g, k, pos, nrm, uv, idx[i + 1], idx[i], idx[i + 2], mat)
-                       : emit(g, k, pos, nrm, uv, idx[i], idx[i + 1], idx[i + 2], mat);
+            st = i % 2 ? emit(g, k, &at, idx[i + 1], idx[i], idx[i + 2], mat)
+                       : emit(g, k, &at, idx[i], idx[i + 1], idx[i + 2], mat);
     } else if (!st) {
-        for (size_t i = 0; i + 2 < ni && !st; i++) st = emit(g, k, pos, nrm, uv, idx[i + 1], idx[i + 2], idx[0], mat);
+        for (size_t i = 0; i + 2 < ni && !st; i++) st = emit(g, k, &at, idx[i + 1], idx[i + 2], idx[0], mat);
     }
-    free(pos);
-    free(nrm);
-    free(uv);
+    attrs_free(&at);
     free(idx);
     return st;
 }

@@ -72,6 +72,10 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     out->ds.lights = s->lights;
     out->ds.shading = s->shading;
     out->ds.n_shading = (uint)s->n_shading;
+    out->ds.tri_extra_of = s->n_tri_extras ? s->tri_extra_of : NULL;
+    out->ds.n_tri_extra_of = s->n_tri_extras ? (uint)s->n_shading : 0u;
+    out->ds.tri_extras = s->tri_extras;
+    out->ds.n_tri_extras = (uint)s->n_tri_extras;
 
     /* the classic ray tracer's part (kernels/whitted.cl) */
     p->ambient = s->ambient;

@@ -68,7 +68,42 @@ static int transform_normal(const MeshSink *k, vec3 n, vec3 *out)
     return !v3_is_zero(*out);
 }
 
+/* extra's attributes in the order o of the sink's corners, tangents transformed; its
+ * flags cleared of what is unusable. */
+static TriExtra extra_transform(const MeshSink *k, const TriExtra *in, const int *o)
+{
+    TriExtra e;
+    memset(&e, 0, sizeof e);
+    e.flags = in->flags;
+    for (int i = 0; i < 3; i++) {
+        const float *t = in->tangent[o[i]];
+        double r[3] = { t[0], t[1], t[2] };
+        if (k->transformed)
+            for (int a = 0; a < 3; a++) r[a] = k->xf.m[a][0] * t[0] + k->xf.m[a][1] * t[1] + k->xf.m[a][2] * t[2];
+        double len = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+        if (!(len > 0.0) || !isfinite(len)) e.flags &= ~EXTRA_TANGENT;
+        for (int a = 0; a < 3; a++) e.tangent[i][a] = len > 0.0 ? (float)(r[a] / len) : 0.0f;
+        e.tangent[i][3] = (t[3] < 0.0f) != (k->mirrored != 0) ? -1.0f : 1.0f;
+        for (int a = 0; a < 4; a++) {
+            e.color[i][a] = in->color[o[i]][a];
+            if (!isfinite(e.color[i][a])) e.flags &= ~EXTRA_COLOR;
+        }
+        for (int a = 0; a < 2; a++) {
+            e.uv[i][a] = in->uv[o[i]][a];
+            if (!isfinite(e.uv[i][a])) e.flags &= ~EXTRA_UV1;
+        }
+    }
+    if (!(e.flags & EXTRA_TANGENT)) memset(e.tangent, 0, sizeof e.tangent);
+    return e;
+}
+
 Status mesh_sink_triangle(MeshSink *k, const vec3 p[3], const vec3 *n, const float *uv, uint material)
+{
+    return mesh_sink_triangle_extra(k, p, n, uv, NULL, material);
+}
+
+Status mesh_sink_triangle_extra(MeshSink *k, const vec3 p[3], const vec3 *n, const float *uv,
+                                const TriExtra *extra, uint material)
 {
     /* a mirroring transform turns the winding normal inside out: swap corners 1 and 2 */
     static const int order[2][3] = { { 0, 1, 2 }, { 0, 2, 1 } };
@@ -114,8 +149,12 @@ Status mesh_sink_triangle(MeshSink *k, const vec3 p[3], const vec3 *n, const flo
         }
         sh.flags |= TRI_HAS_UV;
     }
-    if (sh.flags) {
+    TriExtra e;
+    memset(&e, 0, sizeof e);
+    if (extra) e = extra_transform(k, extra, o);
+    if (sh.flags || e.flags) {
         Status st = scene_add_shading(k->s, sh, &t.shading, k->err);
+        if (!st && e.flags) st = scene_add_tri_extra(k->s, t.shading, e, k->err);
         if (st) return st;
     }
     return scene_add_triangle(k->s, t, k->err);

@@ -53,6 +53,14 @@ Status mesh_sink_reserve(MeshSink *k, size_t triangles, size_t shading);
  * that triangle. */
 Status mesh_sink_triangle(MeshSink *k, const vec3 p[3], const vec3 *n, const float *uv,
                           uint material);
+/* mesh_sink_triangle with corner attributes (glTF's TANGENT, TEXCOORD_1, COLOR_0), or
+ * extra NULL: extra's fields in the file's coordinates, by corner. Tangents go through
+ * the transform's linear part (they lie along the surface) and are normalised, their w
+ * reduced to a sign and flipped by a mirroring transform (the bitangent cross(n, t) w
+ * must keep pointing where the file meant); a tangent that comes out zero or not
+ * finite, or a colour or uv that is not finite, drops that attribute of the triangle. */
+Status mesh_sink_triangle_extra(MeshSink *k, const vec3 p[3], const vec3 *n, const float *uv,
+                                const TriExtra *extra, uint material);
 
 /* A closed, bumpy sphere of radius about 1 around the origin with at least
  * `min_triangles` triangles (a UV sphere whose radius varies with latitude and

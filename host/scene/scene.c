@@ -48,6 +48,8 @@ void scene_free(Scene *s)
     free(s->spheres);
     free(s->triangles);
     free(s->shading);
+    free(s->tri_extras);
+    free(s->tri_extra_of);
     free(s->boxes);
     free(s->planes);
     free(s->revsurfaces);
@@ -144,9 +146,28 @@ Status scene_add_shading(Scene *s, TriShading sh, uint *index, Error *err)
         return error_set(err, ST_INPUT, "too many shading records");
     if (array_reserve((void **)&s->shading, &s->cap_shading, s->n_shading + 1, sizeof sh))
         return error_set(err, ST_INTERNAL, "out of memory growing the scene");
+    /* once any triangle has extras, every shading record has an entry in tri_extra_of */
+    if (s->n_tri_extra_of &&
+        array_reserve((void **)&s->tri_extra_of, &s->cap_tri_extra_of, s->n_shading + 1, sizeof *s->tri_extra_of))
+        return error_set(err, ST_INTERNAL, "out of memory growing the scene");
+    sh.flags &= ~TRI_HAS_EXTRA;
     s->shading[s->n_shading] = sh;
+    if (s->n_tri_extra_of) s->tri_extra_of[s->n_tri_extra_of++] = NO_INDEX;
     if (index) *index = (uint)s->n_shading;
     s->n_shading++;
+    return ST_OK;
+}
+
+Status scene_add_tri_extra(Scene *s, uint shading, TriExtra e, Error *err)
+{
+    if (shading >= s->n_shading) return error_set(err, ST_INTERNAL, "corner attributes for no shading record");
+    if (array_reserve((void **)&s->tri_extra_of, &s->cap_tri_extra_of, s->n_shading, sizeof *s->tri_extra_of) ||
+        array_reserve((void **)&s->tri_extras, &s->cap_tri_extras, s->n_tri_extras + 1, sizeof e))
+        return error_set(err, ST_INTERNAL, "out of memory growing the scene");
+    while (s->n_tri_extra_of < s->n_shading) s->tri_extra_of[s->n_tri_extra_of++] = NO_INDEX;
+    s->tri_extras[s->n_tri_extras] = e;
+    s->tri_extra_of[shading] = (uint)s->n_tri_extras++;
+    s->shading[shading].flags |= TRI_HAS_EXTRA;
     return ST_OK;
 }
 

@@ -55,6 +55,10 @@ typedef struct {
     Sphere *spheres;       size_t n_spheres, cap_spheres;
     Triangle *triangles;   size_t n_triangles, cap_triangles;
     TriShading *shading;   size_t n_shading, cap_shading;
+    /* glTF's tangents, second uvs and vertex colours (types.h, TriExtra): tri_extra_of
+     * is empty until the first extra is added, then has one entry per shading record */
+    TriExtra *tri_extras;  size_t n_tri_extras, cap_tri_extras;
+    uint *tri_extra_of;    size_t n_tri_extra_of, cap_tri_extra_of;
     Box *boxes;            size_t n_boxes, cap_boxes;
     Plane *planes;         size_t n_planes, cap_planes;
     RevSurface *revsurfaces;  size_t n_revsurfaces, cap_revsurfaces;
@@ -102,6 +106,8 @@ Status scene_add_material(Scene *s, const char *name, Material m, uint *index, E
 Status scene_add_sphere(Scene *s, Sphere sp, Error *err);
 Status scene_add_triangle(Scene *s, Triangle t, Error *err);
 Status scene_add_shading(Scene *s, TriShading sh, uint *index, Error *err);
+/* Gives shading record `shading` the corner attributes e (sets its TRI_HAS_EXTRA). */
+Status scene_add_tri_extra(Scene *s, uint shading, TriExtra e, Error *err);
 Status scene_add_box(Scene *s, Box b, Error *err);
 Status scene_add_plane(Scene *s, Plane p, Error *err);
 /* Adds r with its profile's n_segments * degree + 1 control points (x, y pairs at xy);

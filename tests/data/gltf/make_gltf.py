@@ -223,12 +223,83 @@ def textured():
     return d
 
 
+def extras():
+    """Three unit quads in z = 0 facing +z (x from 0, 1.5 and 3), each with NORMAL and
+    TEXCOORD_0 (u = x, glTF v = 1 - y), seen from +z by an orthographic camera:
+    quad 0 has TANGENT (0, 1, 0, 1), where its uvs give +x, under a normal map whose
+    one texel is (255, 128, 255); quad 1 has TEXCOORD_1 (0.75, 0.25) at every corner and
+    a base-colour texture read at texCoord 1 through a sampler (magFilter NEAREST, wrapS
+    MIRRORED_REPEAT, wrapT CLAMP_TO_EDGE); quad 2 has COLOR_0 (255, 128, 64, 191) as
+    normalized unsigned bytes under baseColorFactor 0.8 and alphaMode MASK."""
+    bufs = []
+
+    def view(raw):
+        bufs.append(raw)
+        return len(bufs) - 1
+
+    def acc(raw, ctype, count, typ, normalized=False):
+        a = {"bufferView": view(raw), "componentType": ctype, "count": count, "type": typ}
+        if normalized:
+            a["normalized"] = True
+        accessors.append(a)
+        return len(accessors) - 1
+
+    accessors = []
+    pos = acc(b"".join(f32(*p) for p in QUAD), 5126, 4, "VEC3")
+    nrm = acc(f32(*(0, 0, 1) * 4), 5126, 4, "VEC3")
+    uv0 = acc(b"".join(f32(p[0], 1 - p[1]) for p in QUAD), 5126, 4, "VEC2")
+    idx = acc(struct.pack("<6H", 0, 1, 2, 0, 2, 3), 5123, 6, "SCALAR")
+    tan = acc(f32(*(0, 1, 0, 1) * 4), 5126, 4, "VEC4")
+    uv1 = acc(f32(*(0.75, 0.25) * 4), 5126, 4, "VEC2")
+    col = acc(bytes([255, 128, 64, 191] * 4), 5121, 4, "VEC4", normalized=True)
+    base = {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv0}
+    meshes = [{"primitives": [{"attributes": dict(base, TANGENT=tan), "indices": idx, "material": 0}]},
+              {"primitives": [{"attributes": dict(base, TEXCOORD_1=uv1), "indices": idx, "material": 1}]},
+              {"primitives": [{"attributes": dict(base, COLOR_0=col), "indices": idx, "material": 2}]}]
+    nodes = [{"mesh": i, "translation": [1.5 * i, 0, 0]} for i in range(3)]
+    nodes.append({"camera": 0, "translation": [2, 0.5, 5]})
+    views, raw = [], b""
+    for b in bufs:
+        views.append({"buffer": 0, "byteOffset": len(raw), "byteLength": len(b)})
+        raw += b + b"\0" * (-len(b) % 4)
+    d = doc([{"byteLength": len(raw), "uri": data_uri(raw)}], views, accessors, meshes, nodes)
+    d["cameras"] = [{"type": "orthographic", "orthographic": {"xmag": 2.4, "ymag": 0.6, "znear": 0.1, "zfar": 10}}]
+    d["images"] = [{"uri": "data:image/png;base64," + base64.b64encode(png(1, 1, [[(255, 128, 255)]])).decode()},
+                   {"uri": "data:image/png;base64," + base64.b64encode(png(2, 2, TEXELS)).decode()}]
+    d["samplers"] = [{"magFilter": 9728, "minFilter": 9987, "wrapS": 33648, "wrapT": 33071}]
+    d["textures"] = [{"source": 0}, {"source": 1, "sampler": 0}]
+    d["materials"] = [
+        {"normalTexture": {"index": 0}},
+        {"pbrMetallicRoughness": {"baseColorTexture": {"index": 1, "texCoord": 1}}},
+        {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1]}, "alphaMode": "MASK"},
+    ]
+    return d
+
+
+def extras_glb():
+    """extras() as a .glb: its buffer and both PNGs in the BIN chunk (the images as
+    buffer views); a seed of fuzz/fuzz_glb.c."""
+    d = extras()
+    raw = base64.b64decode(d["buffers"][0]["uri"].split(",", 1)[1])
+    for im in d["images"]:
+        raw += b"\0" * (-len(raw) % 4)
+        png_bytes = base64.b64decode(im.pop("uri").split(",", 1)[1])
+        d["bufferViews"].append({"buffer": 0, "byteOffset": len(raw), "byteLength": len(png_bytes)})
+        im.update({"bufferView": len(d["bufferViews"]) - 1, "mimeType": "image/png"})
+        raw += png_bytes
+    d["buffers"] = [{"byteLength": len(raw)}]
+    return glb(d, raw)
+
+
 def main():
     os.makedirs(GOOD, exist_ok=True)
     write_json(os.path.join(GOOD, "strided.gltf"), strided())
     write_json(os.path.join(GOOD, "sparse.gltf"), sparse())
     write_json(os.path.join(GOOD, "strips.gltf"), strips())
     write_json(os.path.join(GOOD, "textured.gltf"), textured())
+    write_json(os.path.join(GOOD, "extras.gltf"), extras())
+    with open(os.path.join(GOOD, "extras.glb"), "wb") as f:
+        f.write(extras_glb())
     nd, _ = nodes()
     write_json(os.path.join(GOOD, "nodes.gltf"), nd)
 
@@ -289,6 +360,23 @@ def main():
               "than the 28 left in the file")
     write_bad("gltf-wrong-magic.glb", b"gLTF" + whole[4:], "input",
               "%(p)s: not a binary glTF file (it does not start with the magic 'glTF')")
+    d = extras()
+    d["accessors"][6]["type"] = "VEC2"
+    write_bad("gltf-color-type.gltf", json.dumps(d), "input",
+              "%(p)s: meshes[2].primitives[0].attributes.COLOR_0: accessor 6: type must be VEC3 or VEC4 here")
+    d = extras()
+    del d["accessors"][6]["normalized"]
+    write_bad("gltf-color-component.gltf", json.dumps(d), "input",
+              "%(p)s: meshes[2].primitives[0].attributes.COLOR_0: accessor 6: componentType must be 5126 (float), "
+              "or 5121 or 5123 (unsigned byte or short) with normalized true")
+    d = extras()
+    d["accessors"][4]["type"] = "VEC3"
+    write_bad("gltf-tangent-type.gltf", json.dumps(d), "input",
+              "%(p)s: meshes[0].primitives[0].attributes.TANGENT: accessor 4: type must be VEC4 here")
+    d = extras()
+    d["samplers"][0]["wrapT"] = 10496
+    write_bad("gltf-sampler-wrap.gltf", json.dumps(d), "input",
+              "%(p)s: samplers[0].wrapT: expected 10497 (REPEAT), 33071 (CLAMP_TO_EDGE) or 33648 (MIRRORED_REPEAT)")
     write_bad("gltf-not-json.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [", "input",
               "%(p)s: not valid glTF JSON")
 

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli_util.h"
 #include "harness.h"
 #include "kmath.h"
 #include "io/pbrt_parse.h"
@@ -384,8 +385,64 @@ static void test_loop_limits(void)
     scene_free(&s);
 }
 
+/* The first pixel of a PFM file (bottom row first, as PFM stores it; a uniform image
+ * makes that moot), or -1s when the file cannot be read. */
+static void pfm_first_pixel(const char *path, float rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = -1;
+    FILE *f = fopen(path, "rb");
+    if (!f) return;
+    int w, h;
+    double scale;
+    if (fscanf(f, "PF %d %d %lf", &w, &h, &scale) == 3 && fgetc(f) == '\n' && fread(rgb, 4, 3, f) == 3) {
+    }
+    fclose(f);
+}
+
+/* Film "filename" is the output without -o (relative to the current folder, as pbrt
+ * writes it, not to the scene's); with -o, -o wins; a name clpt cannot write is an error
+ * at the name. */
+static void test_film_filename(void)
+{
+    static const char out[] = CLPT_BUILD_DIR "/test-pbrt-film.pfm";
+    char scene[64], text[512];
+    snprintf(text, sizeof text,
+             "Film \"rgb\" \"integer xresolution\" 4 \"integer yresolution\" 3 \"string filename\" \"%s\"\n"
+             "Sampler \"sobol\" \"integer pixelsamples\" 1\nWorldBegin\n"
+             "LightSource \"infinite\" \"rgb L\" [0.25 0.5 1]\n", out);
+    write_temp(scene, sizeof scene, ".pbrt", text);
+    unlink(out);
+    CliResult r;
+    cli_run((const char *[]){ scene, "-q", "--device", "scalar", NULL }, &r);
+    CHECK_EQ_INT(r.status, 0);
+    float px[3];
+    pfm_first_pixel(out, px);
+    CHECK_NEAR(px[0], 0.25, 1e-6);
+    CHECK_NEAR(px[1], 0.5, 1e-6);
+    CHECK_NEAR(px[2], 1.0, 1e-6);
+    /* -o wins */
+    unlink(out);
+    cli_run((const char *[]){ scene, "-q", "--device", "scalar", "-o", "/tmp/clpt-test-film-o.pfm", NULL },
+            &r);
+    CHECK_EQ_INT(r.status, 0);
+    CHECK(file_exists("/tmp/clpt-test-film-o.pfm"));
+    CHECK(!file_exists(out));
+    unlink("/tmp/clpt-test-film-o.pfm");
+    unlink(scene);
+
+    expect_error("Film \"rgb\" \"string filename\" \"render.tga\"\n",
+                 DIR "inline.pbrt:1:30: Film \"filename\" 'render.tga' is not an image clpt writes (.png, .ppm, "
+                 ".bmp, .pfm, .exr, .hdr)");
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text("Film \"rgb\" \"string filename\" \"a.EXR\"\n", &s, &err), ST_OK);
+    CHECK(s.output_hint && strcmp(s.output_hint, "a.EXR") == 0);
+    scene_free(&s);
+}
+
 int main(void)
 {
+    RUN(test_film_filename);
     RUN(test_loop_limits);
     RUN(test_detect);
     RUN(test_basic);

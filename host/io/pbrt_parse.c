@@ -9,6 +9,7 @@
 
 #include "base/limit.h"
 #include "base/strmap.h"
+#include "io/image_write.h"
 #include "io/lexer.h"
 #include "io/mesh_load.h"
 #include "io/texture.h"
@@ -845,8 +846,21 @@ static Status d_film(Parser *p, Lexer *lx, const Token *kw)
     if (h < 1 || h > CLPT_MAX_IMAGE_SIDE) return param_type_error(p, lx, param_find(p, "yresolution"), "in 1..16384");
     p->s->image.width = (uint)w;
     p->s->image.height = (uint)h;
-    /* the output name belongs to the command line (-o); the file's is not used */
-    param_find(p, "filename");
+    /* the image pbrt would write: clpt's output when -o does not name one (main.c) */
+    const Token *f = NULL;
+    if ((st = get_string(p, lx, "filename", &f))) return st;
+    if (f) {
+        char *name = tok_copy(f);
+        if (!name) return error_set(p->err, ST_INTERNAL, "out of memory");
+        ImageFormat format;
+        if (!name[0] || image_format_from_path(name, &format, p->err)) {
+            free(name);
+            return lex_error_at(lx, f, p->err, "Film \"filename\" '%.*s' is not an image clpt writes (.png, .ppm, "
+                                ".bmp, .pfm, .exr, .hdr)", (int)(f->len > 60 ? 60 : f->len), f->text);
+        }
+        free(p->s->output_hint);
+        p->s->output_hint = name;
+    }
     return warn_unused(p, lx, "Film");
 }
 

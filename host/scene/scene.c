@@ -64,6 +64,7 @@ void scene_free(Scene *s)
     free(s->texels);
     free(s->env_cdf);
     free(s->path);
+    free(s->output_hint);
     for (size_t i = 0; i < s->n_warnings; i++) free(s->warnings[i]);
     free(s->warnings);
     strmap_free(&s->material_by_name);

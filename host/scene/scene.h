@@ -39,6 +39,8 @@ typedef struct {
                                   * index or name; NULL: the file's first */
     SceneCamera camera;
     SceneImage image;
+    char *output_hint;           /* the image file the scene asks for (pbrt's Film
+                                  * "filename"), used when -o is not given; NULL: none */
     uint bg_type;                /* enum BackgroundType */
     vec3 bg_color, bg_zenith;
     uint bg_cubemap;             /* BG_CUBEMAP: index of the first of its six textures;

@@ -15,6 +15,7 @@
 #include "io/texture.h"
 #include "kmath.h"
 #include "scene/mesh_sink.h"
+#include "scene/octa_env.h"
 #include "scene/subdiv.h"
 #include "scene/transform.h"
 
@@ -963,11 +964,46 @@ static Status texture_of(Parser *p, const Lexer *lx, const char *name, vec3 *alb
     return ST_OK;
 }
 
+/* pbrt's mix: its two named materials (defined before it, so a mix never contains
+ * itself) and `amount`, a float or a float texture (an image's red channel), chosen per
+ * hit by the kernels (kernels/mix.h). */
+static Status make_mix(Parser *p, const Lexer *lx, const Token *type, Material *m)
+{
+    Param *pa = param_find(p, "materials");
+    if (!pa || pa->type != PT_STRING || pa->n != 2)
+        return lex_error_at(lx, type, p->err, "a mix material needs \"string materials\" with two names");
+    uint32_t parts[2];
+    for (int i = 0; i < 2; i++) {
+        const Token *named = &p->pl.strs[pa->first + i];
+        if (!strmap_find(&p->named_material, named->text, named->len, &parts[i]))
+            return lex_error_at(lx, named, p->err, "material '%.*s' is not defined (MakeNamedMaterial defines it)",
+                                (int)(named->len > 40 ? 40 : named->len), named->text);
+    }
+    double amount = 0.5;
+    uint amount_tex = NO_INDEX;
+    Param *am = param_find(p, "amount");
+    Status st;
+    if (am && am->type == PT_TEXTURE) {
+        const PTexture *tex;
+        vec3 c = v3(0.5f, 0.5f, 0.5f);
+        if ((st = get_spectrum(p, lx, "amount", &c, &tex, NULL))) return st;
+        amount = tex ? 1.0 : c.x;
+        if (tex) amount_tex = tex->index;
+    } else if ((st = get_float(p, lx, "amount", &amount))) {
+        return st;
+    }
+    /* the kernels follow MIX_MAX_DEPTH mixes from a hit's material */
+    uint da = scene_mix_depth(p->s, parts[0]), db = scene_mix_depth(p->s, parts[1]);
+    if ((da > db ? da : db) >= MIX_MAX_DEPTH)
+        return lex_error_at(lx, type, p->err, "mix materials nest more than %u deep", MIX_MAX_DEPTH);
+    *m = material_mix(parts[0], parts[1], (float)amount, amount_tex);
+    return ST_OK;
+}
+
 /* Builds the material of type `type` from the current parameter list. */
 static Status make_material(Parser *p, const Lexer *lx, const Token *type, Material *m, const char *what)
 {
     Status st;
-    Token named = {0};
     if (tok_eq(type, "diffuse")) {
         *m = material_diffuse(v3(0.5f, 0.5f, 0.5f));
         st = texture_of(p, lx, "reflectance", &m->albedo, &m->texture);
@@ -1013,18 +1049,7 @@ static Status make_material(Parser *p, const Lexer *lx, const Token *type, Mater
         *m = material_dielectric(1.0f);
         st = ST_OK;
     } else if (tok_eq(type, "mix")) {
-        Param *pa = param_find(p, "materials");
-        double amount = 0.5;
-        if ((st = get_float_tex(p, lx, "amount", &amount))) return st;
-        if (!pa || pa->type != PT_STRING || pa->n != 2)
-            return lex_error_at(lx, type, p->err, "a mix material needs \"string materials\" with two names");
-        named = p->pl.strs[pa->first + (amount > 0.5 ? 1 : 0)];
-        uint32_t i;
-        if (!strmap_find(&p->named_material, named.text, named.len, &i))
-            return lex_error_at(lx, &named, p->err, "material '%.*s' is not defined", (int)(named.len > 40 ? 40 : named.len),
-                                named.text);
-        *m = p->s->materials[i];
-        st = warn_once(p, lx, type, "mix", "mix materials are not blended: the one of larger weight is used");
+        st = make_mix(p, lx, type, m);
     } else {
         *m = material_diffuse(v3(0.5f, 0.5f, 0.5f));
         char key[96];
@@ -1091,6 +1116,20 @@ static Status d_named_material(Parser *p, Lexer *lx, const Token *kw)
     return st ? st : set_material(p, i);
 }
 
+/* A file a parameter names, found as pbrt finds it: a relative path from the main
+ * file's folder. NULL when out of memory. */
+static char *beside_main(const Parser *p, const Token *f)
+{
+    const char *dir_end = strrchr(p->top_path, '/');
+    size_t dl = f->text[0] == '/' || !dir_end ? 0 : (size_t)(dir_end - p->top_path + 1);
+    char *path = malloc(dl + f->len + 1);
+    if (!path) return NULL;
+    memcpy(path, p->top_path, dl);
+    memcpy(path + dl, f->text, f->len);
+    path[dl + f->len] = '\0';
+    return path;
+}
+
 static Status d_texture(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
@@ -1113,13 +1152,8 @@ static Status d_texture(Parser *p, Lexer *lx, const Token *kw)
         const Token *enc = NULL;
         if ((st = get_string(p, lx, "encoding", &enc))) return st;
         int linear = enc && tok_eq(enc, "linear");
-        const char *dir_end = strrchr(p->top_path, '/');
-        size_t dl = f->text[0] == '/' || !dir_end ? 0 : (size_t)(dir_end - p->top_path + 1);
-        char *path = malloc(dl + f->len + 1);
+        char *path = beside_main(p, f);
         if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
-        memcpy(path, p->top_path, dl);
-        memcpy(path + dl, f->text, f->len);
-        path[dl + f->len] = '\0';
         st = texture_load_image(p->s, NULL, path, linear, 0, &t.index, p->err);
         free(path);
         if (st) {
@@ -1207,6 +1241,90 @@ static Status light_dir(Parser *p, const Lexer *lx, const Token *at, vec3 d, vec
     return ST_OK;
 }
 
+/* pbrt-v4's ImageInfiniteLight: the square map at `f` (beside the main file), in the
+ * light's frame (the CTM), scaled by `scale` (octa_env.h). */
+static Status infinite_map(Parser *p, const Lexer *lx, const Token *f, double scale, double illuminance)
+{
+    char *path = beside_main(p, f);
+    if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
+    float *rgb = NULL;
+    int w = 0, h = 0;
+    Status st = texture_read_rgb(path, 0, &rgb, &w, &h, p->err);
+    free(path);
+    if (st) {
+        error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+        return st;
+    }
+    int finite = 1, invertible;
+    size_t n = (size_t)w * (size_t)h * 3u;
+    for (size_t i = 0; i < n && finite; i++) finite = isfinite(rgb[i]);
+    Transform inv = transform_inverse(&p->g.ctm, &invertible);
+    if (w != h) {
+        st = lex_error_at(lx, f, p->err, "the infinite light's map is %dx%d; pbrt-v4's maps are square (equal-area "
+                          "octahedral)", w, h);
+    } else if (!finite) {
+        st = lex_error_at(lx, f, p->err, "the infinite light's map has infinite or NaN pixels");
+    } else if (!invertible) {
+        st = lex_error_at(lx, f, p->err, "the infinite light's transform cannot be inverted");
+    } else {
+        if (illuminance > 0) {
+            /* pbrt-v4's normalisation: the map's illuminance on an upward (+z) surface,
+             * a sum over the upper hemisphere's texels of luminance x cos(theta) times
+             * 2 pi / texels (its code's factor; each texel spans 4 pi / texels) */
+            double k_e = 0;
+            for (int y = 0; y < h; y++)
+                for (int x = 0; x < w; x++) {
+                    double d[3];
+                    octa_square_to_sphere((x + 0.5) / w, (y + 0.5) / h, d);
+                    if (d[2] <= 0) continue;
+                    const float *t = rgb + 3 * ((size_t)y * (size_t)w + (size_t)x);
+                    k_e += (0.2126 * t[0] + 0.7152 * t[1] + 0.0722 * t[2]) * d[2];
+                }
+            k_e *= 2 * M_PI / ((double)w * h);
+            if (k_e > 0) scale *= illuminance / k_e;
+        }
+        double m[9];
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) m[3 * i + j] = inv.m[i][j];
+        st = octa_env_set(p->s, rgb, (uint)w, m, (float)scale, p->err);
+    }
+    free(rgb);
+    return st;
+}
+
+/* LightSource "infinite": a constant L, or an image (never both, as in pbrt); clpt has
+ * one background, so a second light with a map is ignored with a warning, and a map
+ * replaces the constants before it. */
+static Status infinite_light(Parser *p, const Lexer *lx, const Token *type, double scale)
+{
+    vec3 c = v3(1, 1, 1);
+    int has_L = 0;
+    const Token *f = NULL;
+    double illuminance = -1;
+    Status st;
+    if ((st = get_spectrum(p, lx, "L", &c, NULL, &has_L)) || (st = get_string(p, lx, "filename", &f)) ||
+        (st = get_float(p, lx, "illuminance", &illuminance)))
+        return st;
+    param_find(p, "portal");   /* a sampling aid only */
+    if (f && has_L)
+        return lex_error_at(lx, type, p->err, "an infinite light takes \"L\" or \"filename\", not both");
+    if (p->s->bg_type == BG_MAP)
+        return warn_once(p, lx, type, "infinite-second", "clpt has one environment map: this infinite light is "
+                         "ignored");
+    if (f) {
+        if (p->s->bg_type == BG_CONSTANT && !v3_is_zero(p->s->bg_color) &&
+            (st = warn_once(p, lx, type, "infinite-replace", "clpt has one background: the infinite light's map "
+                            "replaces the constant ones before it")))
+            return st;
+        return infinite_map(p, lx, f, scale, illuminance);
+    }
+    /* pbrt-v4: a uniform hemisphere of radiance L gives illuminance pi L */
+    if (illuminance > 0) scale *= illuminance / M_PI;
+    p->s->bg_type = BG_CONSTANT;
+    p->s->bg_color = v3_add(p->s->bg_color, v3_scale(c, (float)scale));
+    return ST_OK;
+}
+
 static Status d_light(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
@@ -1241,16 +1359,7 @@ static Status d_light(Parser *p, Lexer *lx, const Token *kw)
         if ((st = light_dir(p, lx, &type, xf_dir(&p->g.ctm, v3_sub(to, from)), &l.direction))) return st;
         if ((st = scene_add_light(p->s, l, p->err))) return st;
     } else if (tok_eq(&type, "infinite")) {
-        if ((st = get_spectrum(p, lx, "L", &c, NULL, NULL))) return st;
-        const Token *f = NULL;
-        if ((st = get_string(p, lx, "filename", &f))) return st;
-        if (f && (st = warn_once(p, lx, f, "infinite-map", "infinite light: \"%.*s\" is not used (pbrt-v4's maps "
-                                 "are equal-area octahedral images, which clpt does not read); a constant L lights the "
-                                 "scene instead", (int)(f->len > 60 ? 60 : f->len), f->text)))
-            return st;
-        param_find(p, "portal");   /* a sampling aid only */
-        p->s->bg_type = BG_CONSTANT;
-        p->s->bg_color = v3_add(p->s->bg_color, v3_scale(c, (float)scale));
+        if ((st = infinite_light(p, lx, &type, scale))) return st;
     } else {
         char key[96];
         snprintf(key, sizeof key, "LightSource %.*s", (int)(type.len > 40 ? 40 : type.len), type.text);

@@ -634,6 +634,119 @@ static void test_infinite_map(void)
     scene_free(&s);
 }
 
+/* Renders `textures` + a diffuse quad over x, y in [-2, 2] (uv = ((x + 1) / 2, (y + 1) / 2))
+ * whose reflectance is texture "t", seen from +z by an orthographic camera showing
+ * [-1, 1]^2 in 8 x 8 pixels, under a white sky: with one bounce a pixel is exactly its
+ * reflectance. Into px (8 x 8 x 3, top row first); 0 on failure. */
+static int render_reflectance(const char *textures, float *px)
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"orthographic\"\n"
+             "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n"
+             "Sampler \"sobol\" \"integer pixelsamples\" 4\nIntegrator \"path\" \"integer maxdepth\" 1\n"
+             "WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n%s\n"
+             "Material \"diffuse\" \"texture reflectance\" \"t\"\n"
+             "Shape \"bilinearmesh\" \"point3 P\" [-2 -2 0  2 -2 0  -2 2 0  2 2 0]\n"
+             "  \"point2 uv\" [-0.5 -0.5  1.5 -0.5  -0.5 1.5  1.5 1.5]\n", textures);
+    Scene s;
+    Error err = { 0 };
+    int ok = 0;
+    if (load_text(text, &s, &err) == ST_OK) {
+        Film f;
+        if (render_util_run(&s, "scalar", 0, &f, &err) == ST_OK) {
+            film_resolve(&f, px);
+            film_free(&f);
+            ok = 1;
+        }
+    }
+    if (!ok) CHECK_MSG(0, "%s", err.msg);
+    scene_free(&s);
+    return ok;
+}
+
+/* The four quadrants' grey (the image's left is world +x: pbrt's camera). */
+static void check_quadrants(const float *px, double top_left, double top_right, double bottom_left,
+                            double bottom_right)
+{
+    for (int y = 0; y < 8; y++)
+        for (int x = 0; x < 8; x++) {
+            double want = y < 4 ? (x < 4 ? top_left : top_right) : (x < 4 ? bottom_left : bottom_right);
+            for (int c = 0; c < 3; c++) CHECK_NEAR(px[3 * (y * 8 + x) + c], want, 1e-5);
+        }
+}
+
+/* Texture "checkerboard" and "scale": tex1 where pbrt puts it (the cell at the origin of
+ * texture space, and every cell whose integer coordinates sum to an even number), in
+ * 2D on (u, v) with uscale/vscale/udelta/vdelta and in 3D in the texture's own space;
+ * scale folds into a checkerboard's colours, a constant, or an image's copied texels. */
+static void test_checkerboard_scale(void)
+{
+    float px[8 * 8 * 3];
+    /* 2D: cell (0, 0) is x, y in [-1, 0): the bottom right of the image */
+    if (render_reflectance("Texture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 2 "
+                           "\"rgb tex1\" [0.2 0.2 0.2] \"rgb tex2\" [0.8 0.8 0.8]", px))
+        check_quadrants(px, 0.2, 0.8, 0.8, 0.2);
+    /* udelta 1 moves every cell by one: the colours swap */
+    if (render_reflectance("Texture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 2 "
+                           "\"float udelta\" 1 \"rgb tex1\" [0.2 0.2 0.2] \"rgb tex2\" [0.8 0.8 0.8]", px))
+        check_quadrants(px, 0.8, 0.2, 0.2, 0.8);
+    /* 3D, moved up half a cell in z so the surface (looked up 1e-4 behind itself) lies
+     * in cells with z index 0: the cell x, y in [0, 1) is tex1, the top left */
+    if (render_reflectance("AttributeBegin\nTranslate 0 0 -0.5\n"
+                           "Texture \"t\" \"spectrum\" \"checkerboard\" \"integer dimension\" 3 "
+                           "\"rgb tex1\" [0.2 0.2 0.2] \"rgb tex2\" [0.8 0.8 0.8]\nAttributeEnd", px))
+        check_quadrants(px, 0.2, 0.8, 0.8, 0.2);
+    /* a constant texture as tex2, the defaults (tex1 1), and a scale of it by 0.5 */
+    if (render_reflectance("Texture \"k\" \"float\" \"constant\" \"float value\" 0.6\n"
+                           "Texture \"c\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 2 "
+                           "\"texture tex2\" \"k\"\n"
+                           "Texture \"t\" \"spectrum\" \"scale\" \"texture tex\" \"c\" \"float scale\" 0.5", px))
+        check_quadrants(px, 0.5, 0.3, 0.3, 0.5);
+    /* two constants: one constant; a scale texture given as the scale */
+    if (render_reflectance("Texture \"k\" \"float\" \"constant\" \"float value\" 0.5\n"
+                           "Texture \"c\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 2\n"
+                           "Texture \"t\" \"spectrum\" \"scale\" \"rgb tex\" [0.5 0.5 0.5] \"texture scale\" \"c\"",
+                           px))
+        check_quadrants(px, 0.5, 0, 0, 0.5);
+
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text("Texture \"k\" \"spectrum\" \"scale\" \"rgb tex\" [0.5 0.25 1] \"float scale\" 0.5\n"
+                           "Material \"diffuse\" \"texture reflectance\" \"k\"\nShape \"sphere\"", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_textures, 0);
+    if (s.n_spheres == 1) CHECK_V3(s.materials[s.spheres[0].material].albedo, 0.25, 0.125, 0.5, 0);
+    scene_free(&s);
+    /* an image times 2: a float copy of its texels, doubled */
+    CHECK_EQ_INT(load_text("Texture \"i\" \"spectrum\" \"imagemap\" \"string filename\" \"tiny.png\"\n"
+                           "Texture \"k\" \"spectrum\" \"scale\" \"texture tex\" \"i\" \"float scale\" 2\n",
+                           &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_textures, 2);
+    if (s.n_textures == 2) {
+        const Texture *a = &s.textures[0], *b = &s.textures[1];
+        CHECK(b->flags & TEX_FLOAT);
+        CHECK(a->width == b->width && a->height == b->height);
+        uint c = s.texels[a->offset];
+        float f[3];
+        memcpy(f, s.texels + b->offset, sizeof f);
+        for (int k = 0; k < 3; k++)
+            CHECK_NEAR(f[k], 2 * k_srgb_to_linear((float)((c >> (8 * k)) & 255u) / 255.0f), 1e-6);
+    }
+    scene_free(&s);
+    /* a texture as a checkerboard's colour: its mean, with a warning */
+    CHECK_EQ_INT(load_text("Texture \"i\" \"spectrum\" \"imagemap\" \"string filename\" \"tiny.png\"\n"
+                           "Texture \"c\" \"spectrum\" \"checkerboard\" \"texture tex1\" \"i\"\n", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_warnings, 1);
+    if (s.n_warnings == 1)
+        CHECK_MSG(strcmp(s.warnings[0], DIR "inline.pbrt:2: a checkerboard's \"tex1\" is a texture: its mean colour "
+                         "is used") == 0, "got '%s'", s.warnings[0]);
+    scene_free(&s);
+    expect_error("Texture \"c\" \"float\" \"checkerboard\" \"integer dimension\" 4",
+                 DIR "inline.pbrt:1:36: parameter 'dimension' must be 2 or 3");
+    expect_error("Texture \"c\" \"float\" \"scale\" \"texture tex\" \"nope\"",
+                 DIR "inline.pbrt:1:43: texture 'nope' is not defined");
+}
+
 /* The first pixel of a PFM file (bottom row first, as PFM stores it; a uniform image
  * makes that moot), or -1s when the file cannot be read. */
 static void pfm_first_pixel(const char *path, float rgb[3])
@@ -695,6 +808,7 @@ int main(void)
     RUN(test_mix);
     RUN(test_octa_mapping);
     RUN(test_infinite_map);
+    RUN(test_checkerboard_scale);
     RUN(test_loop_limits);
     RUN(test_detect);
     RUN(test_basic);

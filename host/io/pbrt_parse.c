@@ -68,6 +68,8 @@ typedef struct {
     int constant;
     vec3 color;
     uint index;
+    vec3 mean;               /* the texture's mean colour (a constant's is its colour):
+                              * what stands in where only a constant fits */
 } PTexture;
 
 /* An ObjectBegin/End's shapes, taken out of the scene and copied in at each instance. */
@@ -1130,6 +1132,192 @@ static char *beside_main(const Parser *p, const Token *f)
     return path;
 }
 
+/* pbrt-v4's (u, v) mapping of 2D textures: (uscale u + udelta, vscale v + vdelta) of
+ * clpt's surface coordinates; another `mapping` (spherical, cylindrical, planar) is a
+ * warning and uv. */
+static Status tex_uv_mapping(Parser *p, const Lexer *lx, Texture *t)
+{
+    double su = 1, sv = 1, du = 0, dv = 0;
+    const Token *mapping = NULL;
+    Status st;
+    if ((st = get_float(p, lx, "uscale", &su)) || (st = get_float(p, lx, "vscale", &sv)) ||
+        (st = get_float(p, lx, "udelta", &du)) || (st = get_float(p, lx, "vdelta", &dv)) ||
+        (st = get_string(p, lx, "mapping", &mapping)))
+        return st;
+    if (mapping && !tok_eq(mapping, "uv") &&
+        (st = warn_once(p, lx, mapping, "texture-mapping", "texture mapping \"%.*s\" is not supported; uv is used",
+                        (int)(mapping->len > 40 ? 40 : mapping->len), mapping->text)))
+        return st;
+    texture_set_scale_offset(t, (float)su, (float)sv, (float)du, (float)dv);
+    return ST_OK;
+}
+
+/* Texel i of scene texture t as linear RGB. */
+static vec3 texel_rgb(const Scene *s, const Texture *t, size_t i)
+{
+    if (t->flags & TEX_FLOAT) {
+        float f[3];
+        memcpy(f, s->texels + t->offset + 3 * i, sizeof f);
+        return v3(f[0], f[1], f[2]);
+    }
+    uint c = s->texels[t->offset + i];
+    float rgb[3];
+    for (int k = 0; k < 3; k++) {
+        rgb[k] = (float)((c >> (8 * k)) & 255u) / 255.0f;
+        if (t->flags & TEX_SRGB) rgb[k] = k_srgb_to_linear(rgb[k]);
+    }
+    return v3(rgb[0], rgb[1], rgb[2]);
+}
+
+/* The mean colour of an image texture's texels. */
+static vec3 image_mean(const Scene *s, const Texture *t)
+{
+    size_t n = (size_t)t->width * t->height;
+    double sum[3] = { 0, 0, 0 };
+    for (size_t i = 0; i < n; i++) {
+        vec3 c = texel_rgb(s, t, i);
+        sum[0] += c.x;
+        sum[1] += c.y;
+        sum[2] += c.z;
+    }
+    return n ? v3((float)(sum[0] / n), (float)(sum[1] / n), (float)(sum[2] / n)) : v3(0, 0, 0);
+}
+
+static Status tex_imagemap(Parser *p, const Lexer *lx, const Token *cls, PTexture *t)
+{
+    const Token *f = NULL, *enc = NULL;
+    Status st;
+    if ((st = get_string(p, lx, "filename", &f))) return st;
+    if (!f) return lex_error_at(lx, cls, p->err, "an imagemap texture needs \"string filename\"");
+    if ((st = get_string(p, lx, "encoding", &enc))) return st;
+    int linear = enc && tok_eq(enc, "linear");
+    char *path = beside_main(p, f);
+    if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
+    st = texture_load_image(p->s, NULL, path, linear, 0, &t->index, p->err);
+    free(path);
+    if (st) {
+        error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+        return st;
+    }
+    t->constant = 0;
+    Texture *tx = &p->s->textures[t->index];
+    t->mean = image_mean(p->s, tx);
+    return tex_uv_mapping(p, lx, tx);
+}
+
+/* A colour parameter that may name another texture (checkerboard's tex1 and tex2,
+ * scale's tex and scale): a constant's value; a varying texture in *tex when `tex` is
+ * not NULL, else its mean colour with a warning. */
+static Status tex_operand(Parser *p, const Lexer *lx, const char *name, vec3 *out, const PTexture **tex)
+{
+    Param *pa = param_find(p, name);
+    if (tex) *tex = NULL;
+    if (!pa) return ST_OK;
+    if (pa->type != PT_TEXTURE) {
+        pa->used = 0;
+        return get_spectrum(p, lx, name, out, NULL, NULL);
+    }
+    const Token *n = &p->pl.strs[pa->first];
+    uint32_t i;
+    if (!strmap_find(&p->tex_by_name, n->text, n->len, &i))
+        return lex_error_at(lx, n, p->err, "texture '%.*s' is not defined", (int)(n->len > 40 ? 40 : n->len), n->text);
+    const PTexture *src = &p->tex[i];
+    if (src->constant) {
+        *out = src->color;
+    } else if (tex) {
+        *tex = src;
+    } else {
+        *out = src->mean;
+        return warn_once(p, lx, &pa->decl, "checker-texture", "a checkerboard's \"%.*s\" is a texture: its mean "
+                         "colour is used", (int)pa->name_len, pa->name);
+    }
+    return ST_OK;
+}
+
+/* pbrt-v4's checkerboard: tex1 on the cells whose integer coordinates sum to an even
+ * number (pbrt's weight 0.5 - bf(s) bf(t) / 2 is 0 there), tex2 on the others: clpt's
+ * TEX_CHECKER colour0 and colour1. 2D on the surface's (u, v) mapped as tex_uv_mapping,
+ * or 3D (dimension 3) at the point in the texture's space: the CTM at Texture maps
+ * texture space to the world, as pbrt's PointTransformMapping. */
+static Status tex_checkerboard(Parser *p, const Lexer *lx, PTexture *t)
+{
+    vec3 c1 = v3(1, 1, 1), c2 = v3(0, 0, 0);   /* pbrt's defaults */
+    long dim = 2;
+    Status st;
+    if ((st = tex_operand(p, lx, "tex1", &c1, NULL)) || (st = tex_operand(p, lx, "tex2", &c2, NULL)) ||
+        (st = get_int(p, lx, "dimension", &dim)))
+        return st;
+    if (dim != 2 && dim != 3) return param_type_error(p, lx, param_find(p, "dimension"), "2 or 3");
+    Texture tx = texture_make_checker(c1, c2, 1.0f, dim == 3);
+    if (dim == 3) {
+        int ok;
+        Transform inv = transform_inverse(&p->g.ctm, &ok);
+        if (!ok) return lex_error_at(lx, &param_find(p, "dimension")->decl, p->err,
+                                     "the checkerboard's transform cannot be inverted");
+        float m[12];
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 4; j++) m[4 * i + j] = (float)inv.m[i][j];
+        texture_set_matrix(&tx, m);
+    } else if ((st = tex_uv_mapping(p, lx, &tx))) {
+        return st;
+    }
+    t->constant = 0;
+    t->mean = v3_scale(v3_add(c1, c2), 0.5f);
+    return scene_add_texture(p->s, NULL, NULL, tx, &t->index, p->err);
+}
+
+/* A copy of varying texture src with every colour times k: a checkerboard with its two
+ * colours scaled, an image as float texels scaled (the original stays for its other
+ * users). */
+static Status tex_scaled_copy(Parser *p, const PTexture *src, vec3 k, PTexture *out)
+{
+    Scene *s = p->s;
+    Texture tx = s->textures[src->index];
+    out->constant = 0;
+    out->mean = v3_mul(src->mean, k);
+    if (tx.type == TEX_CHECKER) {
+        tx.color0 = v3_mul(tx.color0, k);
+        tx.color1 = v3_mul(tx.color1, k);
+        return scene_add_texture(s, NULL, NULL, tx, &out->index, p->err);
+    }
+    size_t n = (size_t)tx.width * tx.height;
+    uint *texels = malloc(n * 3 * sizeof *texels);
+    if (!texels) return error_set(p->err, ST_INTERNAL, "out of memory");
+    for (size_t i = 0; i < n; i++) {
+        vec3 c = v3_mul(texel_rgb(s, &tx, i), k);
+        float f[3] = { c.x, c.y, c.z };
+        memcpy(texels + 3 * i, f, sizeof f);
+    }
+    Status st = scene_add_texels(s, texels, n * 3, &tx.offset, p->err);
+    free(texels);
+    if (st) return st;
+    tx.flags = (tx.flags & ~TEX_SRGB) | TEX_FLOAT;
+    return scene_add_texture(s, NULL, NULL, tx, &out->index, p->err);
+}
+
+/* pbrt-v4's scale: tex x scale. Two constants multiply; a varying texture times a
+ * constant is a scaled copy of it; two varying ones, a warning: the first times the
+ * second's mean colour. */
+static Status tex_scale(Parser *p, const Lexer *lx, PTexture *t)
+{
+    vec3 a = v3(1, 1, 1), b = v3(1, 1, 1);
+    const PTexture *ta, *tb;
+    Status st;
+    if ((st = tex_operand(p, lx, "tex", &a, &ta)) || (st = tex_operand(p, lx, "scale", &b, &tb))) return st;
+    if (ta && tb) {
+        if ((st = warn_once(p, lx, &param_find(p, "scale")->decl, "scale-two", "a scale texture of two textures: "
+                            "the second's mean colour scales the first")))
+            return st;
+        b = tb->mean;
+        tb = NULL;
+    }
+    if (!ta && !tb) {
+        t->color = v3_mul(a, b);
+        return ST_OK;
+    }
+    return ta ? tex_scaled_copy(p, ta, b, t) : tex_scaled_copy(p, tb, a, t);
+}
+
 static Status d_texture(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
@@ -1146,29 +1334,20 @@ static Status d_texture(Parser *p, Lexer *lx, const Token *kw)
     if (tok_eq(&cls, "constant")) {
         if ((st = get_spectrum(p, lx, "value", &t.color, NULL, NULL))) return st;
     } else if (tok_eq(&cls, "imagemap")) {
-        const Token *f = NULL;
-        if ((st = get_string(p, lx, "filename", &f))) return st;
-        if (!f) return lex_error_at(lx, &cls, p->err, "an imagemap texture needs \"string filename\"");
-        const Token *enc = NULL;
-        if ((st = get_string(p, lx, "encoding", &enc))) return st;
-        int linear = enc && tok_eq(enc, "linear");
-        char *path = beside_main(p, f);
-        if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
-        st = texture_load_image(p->s, NULL, path, linear, 0, &t.index, p->err);
-        free(path);
-        if (st) {
-            error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
-            return st;
-        }
-        t.constant = 0;
+        st = tex_imagemap(p, lx, &cls, &t);
+    } else if (tok_eq(&cls, "checkerboard")) {
+        st = tex_checkerboard(p, lx, &t);
+    } else if (tok_eq(&cls, "scale")) {
+        st = tex_scale(p, lx, &t);
     } else {
         char key[96];
         snprintf(key, sizeof key, "Texture %.*s", (int)(cls.len > 40 ? 40 : cls.len), cls.text);
         st = warn_once(p, lx, &cls, key, "texture \"%.*s\" is not supported; it is a constant 1",
                        (int)(cls.len > 40 ? 40 : cls.len), cls.text);
         for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = 1;
-        if (st) return st;
     }
+    if (st) return st;
+    if (t.constant) t.mean = t.color;
     if (grow((void **)&p->tex, &p->cap_tex, p->n_tex + 1, sizeof(PTexture)) ||
         strmap_set(&p->tex_by_name, name.text, name.len, (uint32_t)p->n_tex))
         return error_set(p->err, ST_INTERNAL, "out of memory");

@@ -448,17 +448,25 @@ static void test_mix(void)
         film_free(&a);
     }
 
-    /* materials.pbrt (a mix of diffuse and glass among every other material and
-     * light): PoCL and scalar agree bit for bit */
+    /* mix.pbrt (mixes with a texture amount, nested, under an area light): PoCL and
+     * scalar agree bit for bit */
     Scene m;
     Error err = { 0 };
-    CHECK_EQ_INT(load(DIR "materials.pbrt", &m, &err), ST_OK);
-    if (render_util_run(&m, "scalar", 0, &a, &err) == ST_OK) {
-        if (render_util_run(&m, "cpu", 0, &b, &err) == ST_OK) {
-            CHECK(memcmp(a.sum, b.sum, (size_t)a.width * a.height * 3 * sizeof *a.sum) == 0);
-            film_free(&b);
+    CHECK_EQ_INT(load(DIR "mix.pbrt", &m, &err), ST_OK);
+    CHECK_EQ_INT(m.n_warnings, 0);
+    /* the path tracer, the classic one (which resolves mixes too), its albedo image */
+    static const uint integrators[] = { INTEGRATOR_PATH, INTEGRATOR_WHITTED, INTEGRATOR_AOV_ALBEDO };
+    for (size_t i = 0; i < sizeof integrators / sizeof integrators[0]; i++) {
+        m.integrator = integrators[i];
+        if (render_util_run(&m, "scalar", 0, &a, &err) == ST_OK) {
+            if (render_util_run(&m, "cpu", 0, &b, &err) == ST_OK) {
+                CHECK_MSG(memcmp(a.sum, b.sum, (size_t)a.width * a.height * 3 * sizeof *a.sum) == 0,
+                          "integrator %u", integrators[i]);
+                CHECK(film_mean(&a) > 0.01);
+                film_free(&b);
+            }
+            film_free(&a);
         }
-        film_free(&a);
     }
     scene_free(&m);
 
@@ -619,6 +627,25 @@ static void test_infinite_map(void)
     } else {
         CHECK_MSG(0, "%s", err.msg);
     }
+    scene_free(&s);
+
+    /* the same map as a file beside its scene */
+    CHECK_EQ_INT(load(DIR "envmap.pbrt", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.bg_type, BG_MAP);
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+    /* illuminance: pbrt-v4's normalisations, pi L for a constant; for a uniform map of 1
+     * its sum (2 pi / texels per upper texel x cos) is close to pi / 2 */
+    CHECK_EQ_INT(load_text("LightSource \"infinite\" \"rgb L\" [0.5 1 2] \"float illuminance\" 6.2831853", &s, &err),
+                 ST_OK);
+    CHECK_V3(s.bg_color, 1, 2, 4, 1e-6);
+    scene_free(&s);
+    static float ones[32 * 32 * 3];
+    for (size_t i = 0; i < sizeof ones / sizeof ones[0]; i++) ones[i] = 1;
+    CHECK_EQ_INT(image_write_encoded(CLPT_BUILD_DIR "/test-pbrt-ones.exr", ones, 32, 32, IMAGE_LINEAR, &err), ST_OK);
+    CHECK_EQ_INT(load_text("LightSource \"infinite\" \"string filename\" \"../../../" CLPT_BUILD_DIR
+                           "/test-pbrt-ones.exr\" \"float illuminance\" 1.5707963", &s, &err), ST_OK);
+    CHECK_NEAR(s.bg_color.x, 1, 0.01);
     scene_free(&s);
 
     static float wide[8 * 4 * 3];

@@ -99,6 +99,7 @@ Status octa_env_set(Scene *s, const float *rgb, uint n, const double light_from_
             octa_sphere_to_square(l, &u, &v);
             float c[3];
             octa_lookup(rgb, n, u, v, c);
+            for (int k = 0; k < 3; k++) c[k] = c[k] > 0.0f ? c[k] : 0.0f;   /* pbrt's ClampZero */
             memcpy(texels + 3u * ((size_t)j * W + i), c, sizeof c);
         }
     uint offset, index;

@@ -37,7 +37,9 @@ void octa_lookup(const float *rgb, uint n, double u, double v, float out[3]);
 /* Makes the n x n octahedral map `rgb` the background of s, as an environment map of
  * 2 H x H texels (H = n within the bounds above) scaled by `scale`: the texel in world
  * direction d takes octa_lookup at the square point of light_from_world d (a 3x3
- * row-major rotation: the inverse of the light's transform). Fails only when memory runs
+ * row-major matrix, the inverse of the light's transform's linear part; the result is
+ * normalised), negative values as 0. pbrt-v4 looks up the nearest texel; the bilinear
+ * resampling here blurs the map by about a texel. Fails only when memory runs
  * out or the texels would pass the texture buffer's limit. */
 Status octa_env_set(Scene *s, const float *rgb, uint n, const double light_from_world[9], float scale,
                     Error *err);

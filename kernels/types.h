@@ -360,6 +360,7 @@ _Static_assert(offsetof(Material, k) == 112, "Material.k");
 _Static_assert(offsetof(Material, clearcoat_roughness) == 128, "Material.clearcoat_roughness");
 _Static_assert(offsetof(Material, texture_rm) == 132, "Material.texture_rm");
 _Static_assert(offsetof(Material, normal_scale) == 140, "Material.normal_scale");
+_Static_assert(offsetof(Material, mix_a) == 160, "Material.mix_a");
 _Static_assert(offsetof(Light, position) == 32, "Light.position");
 #undef CLPT_CHECK_SIZE
 #endif

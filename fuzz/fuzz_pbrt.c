@@ -26,6 +26,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             FUZZ_ASSERT(s.spheres[i].material < s.n_materials && s.spheres[i].radius > 0.0f);
         for (size_t i = 0; i < s.n_triangles; i++) FUZZ_ASSERT(s.triangles[i].material < s.n_materials);
         for (size_t i = 0; i < s.n_warnings; i++) FUZZ_ASSERT(s.warnings[i] && s.warnings[i][0]);
+        /* a mix names materials that exist, nested no deeper than the kernels follow */
+        for (size_t i = 0; i < s.n_materials; i++)
+            if (s.materials[i].type == MAT_MIX) FUZZ_ASSERT(scene_mix_depth(&s, (uint)i) <= MIX_MAX_DEPTH);
+        if (s.bg_type == BG_MAP) FUZZ_ASSERT(s.bg_cubemap < s.n_textures);
         /* the kd-tree build is O(n log n); keep one input's work small */
         if (n_prims <= 4096) {
             s.image.width = s.image.width < 16 ? s.image.width : 16;

@@ -625,7 +625,8 @@ out:
     return st;
 }
 
-/* The output's name (-o, or the scene's name with .png) and its format. */
+/* The output's name (-o, or the scene's name with .png) and its format; a scene that
+ * names its own image (outputs_from_scene) may still change the default. */
 static Status outputs_choose(Run *r, Error *err)
 {
     ImageFormat format;
@@ -633,6 +634,20 @@ static Status outputs_choose(Run *r, Error *err)
     if (!r->output && !(r->output = r->default_out = default_output(r->o.scene_path)))
         return error_set(err, ST_INTERNAL, "out of memory");
     return image_format_from_path(r->output, &format, err);
+}
+
+/* Without -o, the image the scene file asks for (pbrt's Film "filename", relative to
+ * the current folder as pbrt writes it) replaces the default name, and is checked as
+ * the default was: the outputs are chosen before the scene is read so that a bad -o
+ * fails at once, and only a scene can say this name. */
+static Status outputs_from_scene(Run *r, Error *err)
+{
+    if (r->o.output || !r->scene.output_hint) return ST_OK;
+    ImageFormat format;
+    Status st = image_format_from_path(r->scene.output_hint, &format, err);
+    if (st) return st;
+    r->output = r->scene.output_hint;
+    return outputs_check(r, err);
 }
 
 /* ------------------------------------------------------------------ scene */
@@ -873,6 +888,7 @@ static Status run_rank(Run *r, Dist *dist, Error *err)
     if (!worker) st = outputs_choose(r, err);
     if (st == ST_OK && !worker) st = outputs_check(r, err);
     if (st == ST_OK && !receive) st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
+    if (st == ST_OK && !worker) st = outputs_from_scene(r, err);
     if (st == ST_OK && !receive) st = scene_apply_options(r, err);
     if (st == ST_OK && !receive) st = render_prepare(r, worker, err);
     if (dist->broadcast) st = mpi_share_scene(r, dist, st, err);
@@ -936,6 +952,7 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
     st = outputs_choose(&r, err);
     if (st == ST_OK) st = outputs_check(&r, err);
     if (st == ST_OK) st = load_scene_input(&r.o, &r.scene, &r.bare_mesh, err);
+    if (st == ST_OK) st = outputs_from_scene(&r, err);
     if (st == ST_OK) st = scene_apply_options(&r, err);
     if (st == ST_OK) st = render_prepare(&r, 0, err);
     if (st == ST_OK) st = open_devices(&r.o, &r.rs.ds, &r.devs, &r.n_devs, err);

@@ -10,6 +10,7 @@
 #include "background.h"
 #include "bsdf.h"
 #include "lights.h"
+#include "mix.h"
 #include "rng.h"
 #include "surface.h"
 #include "texture.h"
@@ -92,8 +93,7 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     }
 
     Surface s = surface_at(sc, r, hit);
-    Material m = sc->materials[s.material];
-    s.ns = material_normal(sc, m, s);
+    Material m = sc->materials[s.material];   /* a mix: its own emission (mix.h) */
 
     vec3 emission = material_emission(sc, m, s);
     if (!v3_is_zero(emission) && ((m.flags & MAT_TWO_SIDED) || v3_dot(r.d, s.ng) < 0.0f)) {
@@ -105,11 +105,14 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
                                         : (p->mis_mode == MIS_BSDF_ONLY ? 1.0f : 0.0f);
         ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, emission), w));
     }
-    if (m.type == MAT_EMISSIVE || bounce >= p->max_depth) return 0u;   /* pure emitters do not reflect */
+    if (bounce >= p->max_depth) return 0u;
 
     /* normals turned toward the side the ray came from */
     int front = v3_dot(r.d, s.ng) < 0.0f;
     vec3 ng_face = front ? s.ng : v3_neg(s.ng);
+    m = material_resolve(sc, m, s, r.d, ng_face);
+    if (m.type == MAT_EMISSIVE) return 0u;   /* pure emitters do not reflect */
+    s.ns = material_normal(sc, m, s);
     vec3 ns_face = front ? s.ns : v3_neg(s.ns);
     uint result = 0u;
     BsdfSample bs;

@@ -146,14 +146,17 @@ enum MaterialType {
     MAT_CONDUCTOR = 5,   /* GGX metal (kernels/microfacet.h): complex index eta + i k,
                           * or Schlick from F0 = specular (MAT_F0); tinted by albedo;
                           * roughness, anisotropy; smooth: a Fresnel mirror */
-    MAT_PRINCIPLED = 6   /* glTF metallic-roughness (kernels/principled.h): base colour
+    MAT_PRINCIPLED = 6,  /* glTF metallic-roughness (kernels/principled.h): base colour
                           * = albedo, metallic, roughness, transmission + ior (MAT_THIN),
                           * clearcoat + clearcoat_roughness */
+    MAT_MIX = 7          /* pbrt's mix (kernels/mix.h): at each hit either material mix_a
+                          * or, with probability amount, mix_b scatters; its own emission
+                          * and MAT_TWO_SIDED are what the surface emits */
 };
 /* MAT_DIELECTRIC also reads roughness and anisotropy (GGX, Walter et al. 2007) and
  * MAT_THIN. */
 
-typedef struct {                                        /* 160 bytes */
+typedef struct {                                        /* 176 bytes */
     uint type;                /* enum MaterialType */
     uint texture;             /* albedo texture index, NO_INDEX when none */
     float ior;
@@ -179,7 +182,12 @@ typedef struct {                                        /* 160 bytes */
     uint texture_emission;                 /* MAT_PRINCIPLED: multiplies emission, or
                                             * NO_INDEX */
     uint pad_alpha;
+    uint mix_a, mix_b;                     /* MAT_MIX: the two materials' indices */
+    float mix_amount;                      /* MAT_MIX: mix_b's probability, times ... */
+    uint mix_texture;                      /* ... this texture's red channel, or NO_INDEX */
 } Material;
+
+#define MIX_MAX_DEPTH 8u        /* MAT_MIX: mixes nested at most this deep (mix.h) */
 
 #define MAT_TWO_SIDED 1u        /* emits from both sides of its surface */
 #define MAT_F0 2u               /* conductor: Schlick's Fresnel from F0 = specular */
@@ -360,7 +368,7 @@ _Static_assert(offsetof(TriExtra, uv) == 96, "TriExtra.uv");
 CLPT_CHECK_SIZE(Box, 32);
 CLPT_CHECK_SIZE(Plane, 32);
 CLPT_CHECK_SIZE(RevSurface, 48);
-CLPT_CHECK_SIZE(Material, 160);
+CLPT_CHECK_SIZE(Material, 176);
 CLPT_CHECK_SIZE(Light, 80);
 CLPT_CHECK_SIZE(Camera, 112);
 CLPT_CHECK_SIZE(RenderParams, 288);
@@ -385,6 +393,7 @@ _Static_assert(offsetof(Material, k) == 112, "Material.k");
 _Static_assert(offsetof(Material, clearcoat_roughness) == 128, "Material.clearcoat_roughness");
 _Static_assert(offsetof(Material, texture_rm) == 132, "Material.texture_rm");
 _Static_assert(offsetof(Material, normal_scale) == 140, "Material.normal_scale");
+_Static_assert(offsetof(Material, mix_a) == 160, "Material.mix_a");
 _Static_assert(offsetof(Light, position) == 32, "Light.position");
 #undef CLPT_CHECK_SIZE
 #endif

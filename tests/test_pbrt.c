@@ -7,13 +7,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli_util.h"
 #include "harness.h"
 #include "kmath.h"
 #include "io/pbrt_parse.h"
 #include "io/scene_load.h"
 #include "render_util.h"
 #include "scene/camera.h"
+#include "io/image_write.h"
 #include "scene/mesh_sink.h"
+#include "scene/octa_env.h"
 #include "scene/scene.h"
 #include "scene/subdiv.h"
 
@@ -146,7 +149,11 @@ static void test_materials_lights(void)
     CHECK_V3(m[5]->albedo, 0.2, 0.4, 0.6, 1e-6);
     CHECK_EQ_INT(m[6]->type, MAT_DIELECTRIC);
     CHECK_NEAR(m[6]->ior, 1, 0);
-    CHECK_EQ_INT(m[7]->type, MAT_DIELECTRIC);   /* mix 0.75: the second */
+    CHECK_EQ_INT(m[7]->type, MAT_MIX);   /* "a" and "b", b three times in four */
+    CHECK_EQ_INT(s.materials[m[7]->mix_a].type, MAT_DIFFUSE);
+    CHECK_EQ_INT(s.materials[m[7]->mix_b].type, MAT_DIELECTRIC);
+    CHECK_NEAR(m[7]->mix_amount, 0.75, 0);
+    CHECK_EQ_INT(m[7]->mix_texture, NO_INDEX);
     CHECK_V3(m[8]->emission, 2, 4, 6, 0);
     CHECK(m[8]->flags & MAT_TWO_SIDED);
     CHECK_EQ_INT(m[8]->type, MAT_DIFFUSE);
@@ -168,7 +175,7 @@ static void test_materials_lights(void)
     }
     CHECK_EQ_INT(s.bg_type, BG_CONSTANT);
     CHECK_V3(s.bg_color, 0.5, 0.5, 0.5, 0);
-    CHECK_EQ_INT(s.n_warnings, 1);   /* mix is not blended */
+    CHECK_EQ_INT(s.n_warnings, 0);
 out:
     scene_free(&s);
 }
@@ -384,8 +391,451 @@ static void test_loop_limits(void)
     scene_free(&s);
 }
 
+/* A floor of mix(black, white) under a white sky, seen from above: each hit is white
+ * with probability amount, and a white diffuse floor under a sky of 1 sends back exactly
+ * 1 (one bounce, cosine sampled, to the sky), so the image's mean is the fraction of
+ * hits that chose white. */
+static double mix_floor_mean(const char *amount, const char *device, Film *keep)
+{
+    char text[1024];
+    snprintf(text, sizeof text,
+             "LookAt 0 5 0  0 0 0  0 0 1\nCamera \"perspective\" \"float fov\" 30\n"
+             "Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 16\n"
+             "Sampler \"sobol\" \"integer pixelsamples\" 64\nIntegrator \"path\" \"integer maxdepth\" 1\n"
+             "WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n"
+             "Texture \"half\" \"float\" \"constant\" \"float value\" 0.5\n"
+             "MakeNamedMaterial \"black\" \"string type\" \"diffuse\" \"rgb reflectance\" [0 0 0]\n"
+             "MakeNamedMaterial \"white\" \"string type\" \"diffuse\" \"rgb reflectance\" [1 1 1]\n"
+             "Material \"mix\" \"string materials\" [\"black\" \"white\"] %s\n"
+             "Shape \"bilinearmesh\" \"point3 P\" [-9 0 -9  9 0 -9  -9 0 9  9 0 9]\n", amount);
+    Scene s;
+    Error err = { 0 };
+    double mean = -1;
+    CHECK_EQ_INT(load_text(text, &s, &err), ST_OK);
+    Film f;
+    if (render_util_run(&s, device, 0, &f, &err) == ST_OK) {
+        mean = film_mean(&f);
+        if (keep) *keep = f; else film_free(&f);
+    } else {
+        CHECK_MSG(0, "%s", err.msg);
+    }
+    scene_free(&s);
+    return mean;
+}
+
+/* pbrt's mix picks one material per hit (kernels/mix.h): amount 0 and 1 are the first
+ * and second exactly, 0.5 (a float or a float texture) half of each on average, and
+ * the choice is the same on PoCL and the scalar device. */
+static void test_mix(void)
+{
+    CHECK_NEAR(mix_floor_mean("\"float amount\" 0", "scalar", NULL), 0, 0);
+    CHECK_NEAR(mix_floor_mean("\"float amount\" 1", "scalar", NULL), 1, 1e-6);
+    double half = mix_floor_mean("\"float amount\" 0.5", "scalar", NULL);
+    double quarter = mix_floor_mean("\"float amount\" 0.25", "scalar", NULL);
+    double tex = mix_floor_mean("\"texture amount\" \"half\"", "scalar", NULL);
+    fprintf(stderr, "  mix means: 0.5 -> %.4f, 0.25 -> %.4f, texture 0.5 -> %.4f (16x16 px, 64 spp)\n", half,
+            quarter, tex);
+    /* 16384 coins: the binomial's sigma is 0.0039 at 0.5 */
+    CHECK_NEAR(half, 0.5, 0.02);
+    CHECK_NEAR(quarter, 0.25, 0.02);
+    CHECK_NEAR(tex, 0.5, 0.02);
+    Film a, b;
+    if (mix_floor_mean("\"float amount\" 0.5", "scalar", &a) >= 0) {
+        if (mix_floor_mean("\"float amount\" 0.5", "cpu", &b) >= 0) {
+            CHECK(memcmp(a.sum, b.sum, (size_t)a.width * a.height * 3 * sizeof *a.sum) == 0);
+            film_free(&b);
+        }
+        film_free(&a);
+    }
+
+    /* mix.pbrt (mixes with a texture amount, nested, under an area light): PoCL and
+     * scalar agree bit for bit */
+    Scene m;
+    Error err = { 0 };
+    CHECK_EQ_INT(load(DIR "mix.pbrt", &m, &err), ST_OK);
+    CHECK_EQ_INT(m.n_warnings, 0);
+    /* the path tracer, the classic one (which resolves mixes too), its albedo image */
+    static const uint integrators[] = { INTEGRATOR_PATH, INTEGRATOR_WHITTED, INTEGRATOR_AOV_ALBEDO };
+    for (size_t i = 0; i < sizeof integrators / sizeof integrators[0]; i++) {
+        m.integrator = integrators[i];
+        if (render_util_run(&m, "scalar", 0, &a, &err) == ST_OK) {
+            if (render_util_run(&m, "cpu", 0, &b, &err) == ST_OK) {
+                CHECK_MSG(memcmp(a.sum, b.sum, (size_t)a.width * a.height * 3 * sizeof *a.sum) == 0,
+                          "integrator %u", integrators[i]);
+                CHECK(film_mean(&a) > 0.01);
+                film_free(&b);
+            }
+            film_free(&a);
+        }
+    }
+    scene_free(&m);
+
+    /* nesting: mixes of mixes resolve, up to MIX_MAX_DEPTH; one deeper is refused */
+    char text[4096];
+    size_t n = (size_t)snprintf(text, sizeof text, "MakeNamedMaterial \"m0\" \"string type\" \"diffuse\"\n");
+    for (int i = 1; i <= (int)MIX_MAX_DEPTH + 1; i++)
+        n += (size_t)snprintf(text + n, sizeof text - n,
+                              "MakeNamedMaterial \"m%d\" \"string type\" \"mix\" \"string materials\" [\"m0\" \"m%d\"]\n",
+                              i, i - 1);
+    expect_error(text, DIR "inline.pbrt:10:38: mix materials nest more than 8 deep");
+    expect_error("Material \"mix\" \"string materials\" [\"a\" \"b\"]",
+                 DIR "inline.pbrt:1:36: material 'a' is not defined (MakeNamedMaterial defines it)");
+    expect_error("Material \"mix\" \"string materials\" \"a\"",
+                 DIR "inline.pbrt:1:10: a mix material needs \"string materials\" with two names");
+}
+
+/* The equal-area octahedral map (octa_env.c): its known points and a round trip both
+ * ways over the sphere and the square. */
+static void test_octa_mapping(void)
+{
+    static const struct { double d[3], u, v; } known[] = {
+        { { 0, 0, 1 }, 0.5, 0.5 }, { { 1, 0, 0 }, 1, 0.5 }, { { -1, 0, 0 }, 0, 0.5 },
+        { { 0, 1, 0 }, 0.5, 1 },   { { 0, -1, 0 }, 0.5, 0 }, { { 0, 0, -1 }, 1, 1 },
+    };
+    for (size_t i = 0; i < sizeof known / sizeof known[0]; i++) {
+        double u, v, d[3];
+        octa_sphere_to_square(known[i].d, &u, &v);
+        CHECK_NEAR(u, known[i].u, 1e-12);
+        CHECK_NEAR(v, known[i].v, 1e-12);
+        octa_square_to_sphere(known[i].u, known[i].v, d);
+        for (int c = 0; c < 3; c++) CHECK_NEAR(d[c], known[i].d[c], 1e-12);
+    }
+    double worst_d = 0, worst_uv = 0;
+    uint32_t h = 12345;
+    for (int i = 0; i < 100000; i++) {
+        double r[3];
+        for (int c = 0; c < 3; c++) {
+            h = h * 1664525u + 1013904223u;
+            r[c] = (h >> 8) / 16777216.0;
+        }
+        /* a uniform direction, and a uniform square point */
+        double z = 2 * r[0] - 1, phi = 2 * M_PI * r[1], s = sqrt(1 - z * z);
+        double d[3] = { s * cos(phi), s * sin(phi), z }, back[3], u, v, u2, v2;
+        octa_sphere_to_square(d, &u, &v);
+        octa_square_to_sphere(u, v, back);
+        for (int c = 0; c < 3; c++) worst_d = fmax(worst_d, fabs(back[c] - d[c]));
+        octa_square_to_sphere(r[1], r[2], back);
+        octa_sphere_to_square(back, &u2, &v2);
+        worst_uv = fmax(worst_uv, fmax(fabs(u2 - r[1]), fabs(v2 - r[2])));
+        CHECK_NEAR(back[0] * back[0] + back[1] * back[1] + back[2] * back[2], 1, 1e-12);
+    }
+    CHECK(worst_d < 1e-5);
+    CHECK(worst_uv < 1e-5);
+    fprintf(stderr, "  octahedral round trips over 100000 points: %.2g (sphere), %.2g (square)\n", worst_d, worst_uv);
+    /* equal area: as many uniform directions land in each quarter of the square's centre
+     * diamond as in each corner triangle (each 1/8 of the sphere) */
+    int in_diamond = 0;
+    for (int i = 0; i < 80000; i++) {
+        double r[2];
+        for (int c = 0; c < 2; c++) {
+            h = h * 1664525u + 1013904223u;
+            r[c] = (h >> 8) / 16777216.0;
+        }
+        double z = 2 * r[0] - 1, phi = 2 * M_PI * r[1], s = sqrt(1 - z * z), d[3] = { s * cos(phi), s * sin(phi), z };
+        double u, v;
+        octa_sphere_to_square(d, &u, &v);
+        in_diamond += fabs(u - 0.5) + fabs(v - 0.5) < 0.5;
+    }
+    CHECK_NEAR(in_diamond / 80000.0, 0.5, 0.01);
+}
+
+/* A pbrt infinite light with a map: an n x n octahedral square bright (10) within 20
+ * degrees of light-space +z, written as an EXR, turned by `xf` into the world. Returns
+ * the resampled map's brightness-weighted mean direction (world), or (0, 0, 0). */
+static vec3 octa_bright_direction(const char *xf, Scene *s)
+{
+    enum { N = 32 };
+    static float rgb[N * N * 3];
+    for (int y = 0; y < N; y++)
+        for (int x = 0; x < N; x++) {
+            double d[3];
+            octa_square_to_sphere((x + 0.5) / N, (y + 0.5) / N, d);
+            for (int c = 0; c < 3; c++) rgb[3 * (y * N + x) + c] = d[2] > cos(20 * M_PI / 180) ? 10.0f : 0.0f;
+        }
+    Error err = { 0 };
+    CHECK_EQ_INT(image_write_encoded(CLPT_BUILD_DIR "/test-pbrt-octa.exr", rgb, N, N,
+                                     IMAGE_LINEAR | IMAGE_EXR_FLOAT, &err), ST_OK);
+    char text[512];
+    snprintf(text, sizeof text, "WorldBegin\n%s\nLightSource \"infinite\" \"string filename\" \"%s\" "
+             "\"float scale\" 2\n", xf, "../../../" CLPT_BUILD_DIR "/test-pbrt-octa.exr");
+    vec3 mean = v3(0, 0, 0);
+    if (load_text(text, s, &err) != ST_OK) {
+        CHECK_MSG(0, "%s", err.msg);
+        return mean;
+    }
+    CHECK_EQ_INT(s->bg_type, BG_MAP);
+    const Texture *t = &s->textures[s->bg_cubemap];
+    CHECK_EQ_INT(t->width, 2 * OCTA_ENV_MIN_HEIGHT);
+    CHECK_EQ_INT(t->height, OCTA_ENV_MIN_HEIGHT);
+    CHECK_NEAR(s->bg_color.x, 2, 0);   /* the scale */
+    const float *px = (const float *)(s->texels + t->offset);
+    double sum = 0, max = 0;
+    for (uint j = 0; j < t->height; j++)
+        for (uint i = 0; i < t->width; i++) {
+            double th = M_PI * (j + 0.5) / t->height, ph = 2 * M_PI * (i + 0.5) / t->width;
+            double w = px[3 * (j * t->width + i)] * sin(th);   /* a texel's solid angle ~ sin(theta) */
+            mean = v3_add(mean, v3_scale(v3((float)(sin(th) * sin(ph)), (float)cos(th), (float)(-sin(th) * cos(ph))),
+                                         (float)w));
+            sum += w;
+            max = fmax(max, px[3 * (j * t->width + i)]);
+        }
+    CHECK_NEAR(max, 10, 1e-5);
+    return sum > 0 ? v3_scale(mean, (float)(1 / sum)) : mean;
+}
+
+static void test_infinite_map(void)
+{
+    Scene s;
+    /* pbrt's usual "Rotate -90 1 0 0": light-space +z (the map's centre) is world +y */
+    vec3 d = octa_bright_direction("Rotate -90 1 0 0", &s);
+    scene_free(&s);
+    vec3 n = v3_norm(d);
+    fprintf(stderr, "  bright cap: Rotate -90 1 0 0 -> (%.3f %.3f %.3f)\n", n.x, n.y, n.z);
+    CHECK_V3(n, 0, 1, 0, 2e-3);
+    CHECK(v3_len(d) > 0.9);   /* a cap of 20 degrees: mean cos 0.97 */
+    d = v3_norm(octa_bright_direction("Rotate 90 0 1 0", &s));
+    scene_free(&s);
+    CHECK_V3(d, 1, 0, 0, 2e-3);
+    d = v3_norm(octa_bright_direction("Rotate 90 0 1 0 Rotate -45 1 0 0", &s));
+    scene_free(&s);
+    CHECK_V3(d, sqrt(0.5), sqrt(0.5), 0, 2e-3);
+
+    /* rendered: a white floor under the cap (turned to +y) sends back E / pi, E the
+     * square's irradiance on +z (each of its texels spans 4 pi / N^2 steradians) */
+    double E = 0;
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 32; x++) {
+            double w[3];
+            octa_square_to_sphere((x + 0.5) / 32, (y + 0.5) / 32, w);
+            if (w[2] > cos(20 * M_PI / 180)) E += 10 * w[2] * 4 * M_PI / (32 * 32);
+        }
+    static const char floor_scene[] =
+        "LookAt 0 5 0  0 0 0  0 0 1\nCamera \"perspective\" \"float fov\" 30\n"
+        "Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 16\n"
+        "Sampler \"sobol\" \"integer pixelsamples\" 64\nWorldBegin\nAttributeBegin\nRotate -90 1 0 0\n"
+        "LightSource \"infinite\" \"string filename\" \"../../../" CLPT_BUILD_DIR "/test-pbrt-octa.exr\"\n"
+        "AttributeEnd\nMaterial \"diffuse\" \"rgb reflectance\" [1 1 1]\n"
+        "Shape \"bilinearmesh\" \"point3 P\" [-9 0 -9  9 0 -9  -9 0 9  9 0 9]\n";
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text(floor_scene, &s, &err), ST_OK);
+    Film f;
+    if (render_util_run(&s, "scalar", 0, &f, &err) == ST_OK) {
+        double mean = film_mean(&f);
+        fprintf(stderr, "  floor under the cap: %.4f, E / pi = %.4f\n", mean, E / M_PI);
+        CHECK_NEAR(mean, E / M_PI, 0.02 * E / M_PI);
+        film_free(&f);
+    } else {
+        CHECK_MSG(0, "%s", err.msg);
+    }
+    scene_free(&s);
+
+    /* the same map as a file beside its scene */
+    CHECK_EQ_INT(load(DIR "envmap.pbrt", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.bg_type, BG_MAP);
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+    /* illuminance: pbrt-v4's normalisations, pi L for a constant; for a uniform map of 1
+     * its sum (2 pi / texels per upper texel x cos) is close to pi / 2 */
+    CHECK_EQ_INT(load_text("LightSource \"infinite\" \"rgb L\" [0.5 1 2] \"float illuminance\" 6.2831853", &s, &err),
+                 ST_OK);
+    CHECK_V3(s.bg_color, 1, 2, 4, 1e-6);
+    scene_free(&s);
+    static float ones[32 * 32 * 3];
+    for (size_t i = 0; i < sizeof ones / sizeof ones[0]; i++) ones[i] = 1;
+    CHECK_EQ_INT(image_write_encoded(CLPT_BUILD_DIR "/test-pbrt-ones.exr", ones, 32, 32, IMAGE_LINEAR, &err), ST_OK);
+    CHECK_EQ_INT(load_text("LightSource \"infinite\" \"string filename\" \"../../../" CLPT_BUILD_DIR
+                           "/test-pbrt-ones.exr\" \"float illuminance\" 1.5707963", &s, &err), ST_OK);
+    CHECK_NEAR(s.bg_color.x, 1, 0.01);
+    scene_free(&s);
+
+    static float wide[8 * 4 * 3];
+    CHECK_EQ_INT(image_write_encoded(CLPT_BUILD_DIR "/test-pbrt-wide.exr", wide, 8, 4, IMAGE_LINEAR, &err), ST_OK);
+    expect_error("LightSource \"infinite\" \"string filename\" \"../../../" CLPT_BUILD_DIR "/test-pbrt-wide.exr\"",
+                 DIR "inline.pbrt:1:42: the infinite light's map is 8x4; pbrt-v4's maps are square (equal-area "
+                 "octahedral)");
+    expect_error("LightSource \"infinite\" \"string filename\" \"sky.exr\" \"rgb L\" [1 1 1]",
+                 DIR "inline.pbrt:1:13: an infinite light takes \"L\" or \"filename\", not both");
+    CHECK_EQ_INT(load_text("LightSource \"infinite\" \"string filename\" \"no-such-sky.exr\"", &s, &err), ST_IO);
+    CHECK_MSG(strcmp(err.msg, DIR "inline.pbrt:1:42: cannot open '" DIR "no-such-sky.exr': No such file or "
+                     "directory") == 0, "got '%s'", err.msg);
+    scene_free(&s);
+}
+
+/* Renders `textures` + a diffuse quad over x, y in [-2, 2] (uv = ((x + 1) / 2, (y + 1) / 2))
+ * whose reflectance is texture "t", seen from +z by an orthographic camera showing
+ * [-1, 1]^2 in 8 x 8 pixels, under a white sky: with one bounce a pixel is exactly its
+ * reflectance. Into px (8 x 8 x 3, top row first); 0 on failure. */
+static int render_reflectance(const char *textures, float *px)
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"orthographic\"\n"
+             "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n"
+             "Sampler \"sobol\" \"integer pixelsamples\" 4\nIntegrator \"path\" \"integer maxdepth\" 1\n"
+             "WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n%s\n"
+             "Material \"diffuse\" \"texture reflectance\" \"t\"\n"
+             "Shape \"bilinearmesh\" \"point3 P\" [-2 -2 0  2 -2 0  -2 2 0  2 2 0]\n"
+             "  \"point2 uv\" [-0.5 -0.5  1.5 -0.5  -0.5 1.5  1.5 1.5]\n", textures);
+    Scene s;
+    Error err = { 0 };
+    int ok = 0;
+    if (load_text(text, &s, &err) == ST_OK) {
+        Film f;
+        if (render_util_run(&s, "scalar", 0, &f, &err) == ST_OK) {
+            film_resolve(&f, px);
+            film_free(&f);
+            ok = 1;
+        }
+    }
+    if (!ok) CHECK_MSG(0, "%s", err.msg);
+    scene_free(&s);
+    return ok;
+}
+
+/* The four quadrants' grey (the image's left is world +x: pbrt's camera). */
+static void check_quadrants(const float *px, double top_left, double top_right, double bottom_left,
+                            double bottom_right)
+{
+    for (int y = 0; y < 8; y++)
+        for (int x = 0; x < 8; x++) {
+            double want = y < 4 ? (x < 4 ? top_left : top_right) : (x < 4 ? bottom_left : bottom_right);
+            for (int c = 0; c < 3; c++) CHECK_NEAR(px[3 * (y * 8 + x) + c], want, 1e-5);
+        }
+}
+
+/* Texture "checkerboard" and "scale": tex1 where pbrt puts it (the cell at the origin of
+ * texture space, and every cell whose integer coordinates sum to an even number), in
+ * 2D on (u, v) with uscale/vscale/udelta/vdelta and in 3D in the texture's own space;
+ * scale folds into a checkerboard's colours, a constant, or an image's copied texels. */
+static void test_checkerboard_scale(void)
+{
+    float px[8 * 8 * 3];
+    /* 2D: cell (0, 0) is x, y in [-1, 0): the bottom right of the image */
+    if (render_reflectance("Texture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 2 "
+                           "\"rgb tex1\" [0.2 0.2 0.2] \"rgb tex2\" [0.8 0.8 0.8]", px))
+        check_quadrants(px, 0.2, 0.8, 0.8, 0.2);
+    /* udelta 1 moves every cell by one: the colours swap */
+    if (render_reflectance("Texture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 2 "
+                           "\"float udelta\" 1 \"rgb tex1\" [0.2 0.2 0.2] \"rgb tex2\" [0.8 0.8 0.8]", px))
+        check_quadrants(px, 0.8, 0.2, 0.2, 0.8);
+    /* 3D, moved up half a cell in z so the surface (looked up 1e-4 behind itself) lies
+     * in cells with z index 0: the cell x, y in [0, 1) is tex1, the top left */
+    if (render_reflectance("AttributeBegin\nTranslate 0 0 -0.5\n"
+                           "Texture \"t\" \"spectrum\" \"checkerboard\" \"integer dimension\" 3 "
+                           "\"rgb tex1\" [0.2 0.2 0.2] \"rgb tex2\" [0.8 0.8 0.8]\nAttributeEnd", px))
+        check_quadrants(px, 0.2, 0.8, 0.8, 0.2);
+    /* a constant texture as tex2, the defaults (tex1 1), and a scale of it by 0.5 */
+    if (render_reflectance("Texture \"k\" \"float\" \"constant\" \"float value\" 0.6\n"
+                           "Texture \"c\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 2 "
+                           "\"texture tex2\" \"k\"\n"
+                           "Texture \"t\" \"spectrum\" \"scale\" \"texture tex\" \"c\" \"float scale\" 0.5", px))
+        check_quadrants(px, 0.5, 0.3, 0.3, 0.5);
+    /* two constants: one constant; a scale texture given as the scale */
+    if (render_reflectance("Texture \"k\" \"float\" \"constant\" \"float value\" 0.5\n"
+                           "Texture \"c\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 2\n"
+                           "Texture \"t\" \"spectrum\" \"scale\" \"rgb tex\" [0.5 0.5 0.5] \"texture scale\" \"c\"",
+                           px))
+        check_quadrants(px, 0.5, 0, 0, 0.5);
+
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text("Texture \"k\" \"spectrum\" \"scale\" \"rgb tex\" [0.5 0.25 1] \"float scale\" 0.5\n"
+                           "Material \"diffuse\" \"texture reflectance\" \"k\"\nShape \"sphere\"", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_textures, 0);
+    if (s.n_spheres == 1) CHECK_V3(s.materials[s.spheres[0].material].albedo, 0.25, 0.125, 0.5, 0);
+    scene_free(&s);
+    /* an image times 2: a float copy of its texels, doubled */
+    CHECK_EQ_INT(load_text("Texture \"i\" \"spectrum\" \"imagemap\" \"string filename\" \"tiny.png\"\n"
+                           "Texture \"k\" \"spectrum\" \"scale\" \"texture tex\" \"i\" \"float scale\" 2\n",
+                           &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_textures, 2);
+    if (s.n_textures == 2) {
+        const Texture *a = &s.textures[0], *b = &s.textures[1];
+        CHECK(b->flags & TEX_FLOAT);
+        CHECK(a->width == b->width && a->height == b->height);
+        uint c = s.texels[a->offset];
+        float f[3];
+        memcpy(f, s.texels + b->offset, sizeof f);
+        for (int k = 0; k < 3; k++)
+            CHECK_NEAR(f[k], 2 * k_srgb_to_linear((float)((c >> (8 * k)) & 255u) / 255.0f), 1e-6);
+    }
+    scene_free(&s);
+    /* a texture as a checkerboard's colour: its mean, with a warning */
+    CHECK_EQ_INT(load_text("Texture \"i\" \"spectrum\" \"imagemap\" \"string filename\" \"tiny.png\"\n"
+                           "Texture \"c\" \"spectrum\" \"checkerboard\" \"texture tex1\" \"i\"\n", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_warnings, 1);
+    if (s.n_warnings == 1)
+        CHECK_MSG(strcmp(s.warnings[0], DIR "inline.pbrt:2: a checkerboard's \"tex1\" is a texture: its mean colour "
+                         "is used") == 0, "got '%s'", s.warnings[0]);
+    scene_free(&s);
+    expect_error("Texture \"c\" \"float\" \"checkerboard\" \"integer dimension\" 4",
+                 DIR "inline.pbrt:1:36: parameter 'dimension' must be 2 or 3");
+    expect_error("Texture \"c\" \"float\" \"scale\" \"texture tex\" \"nope\"",
+                 DIR "inline.pbrt:1:43: texture 'nope' is not defined");
+}
+
+/* The first pixel of a PFM file (bottom row first, as PFM stores it; a uniform image
+ * makes that moot), or -1s when the file cannot be read. */
+static void pfm_first_pixel(const char *path, float rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = -1;
+    FILE *f = fopen(path, "rb");
+    if (!f) return;
+    int w, h;
+    double scale;
+    if (fscanf(f, "PF %d %d %lf", &w, &h, &scale) == 3 && fgetc(f) == '\n' && fread(rgb, 4, 3, f) == 3) {
+    }
+    fclose(f);
+}
+
+/* Film "filename" is the output without -o (relative to the current folder, as pbrt
+ * writes it, not to the scene's); with -o, -o wins; a name clpt cannot write is an error
+ * at the name. */
+static void test_film_filename(void)
+{
+    static const char out[] = CLPT_BUILD_DIR "/test-pbrt-film.pfm";
+    char scene[64], text[512];
+    snprintf(text, sizeof text,
+             "Film \"rgb\" \"integer xresolution\" 4 \"integer yresolution\" 3 \"string filename\" \"%s\"\n"
+             "Sampler \"sobol\" \"integer pixelsamples\" 1\nWorldBegin\n"
+             "LightSource \"infinite\" \"rgb L\" [0.25 0.5 1]\n", out);
+    write_temp(scene, sizeof scene, ".pbrt", text);
+    unlink(out);
+    CliResult r;
+    cli_run((const char *[]){ scene, "-q", "--device", "scalar", NULL }, &r);
+    CHECK_EQ_INT(r.status, 0);
+    float px[3];
+    pfm_first_pixel(out, px);
+    CHECK_NEAR(px[0], 0.25, 1e-6);
+    CHECK_NEAR(px[1], 0.5, 1e-6);
+    CHECK_NEAR(px[2], 1.0, 1e-6);
+    /* -o wins */
+    unlink(out);
+    cli_run((const char *[]){ scene, "-q", "--device", "scalar", "-o", "/tmp/clpt-test-film-o.pfm", NULL },
+            &r);
+    CHECK_EQ_INT(r.status, 0);
+    CHECK(file_exists("/tmp/clpt-test-film-o.pfm"));
+    CHECK(!file_exists(out));
+    unlink("/tmp/clpt-test-film-o.pfm");
+    unlink(scene);
+
+    expect_error("Film \"rgb\" \"string filename\" \"render.tga\"\n",
+                 DIR "inline.pbrt:1:30: Film \"filename\" 'render.tga' is not an image clpt writes (.png, .ppm, "
+                 ".bmp, .pfm, .exr, .hdr)");
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text("Film \"rgb\" \"string filename\" \"a.EXR\"\n", &s, &err), ST_OK);
+    CHECK(s.output_hint && strcmp(s.output_hint, "a.EXR") == 0);
+    scene_free(&s);
+}
+
 int main(void)
 {
+    RUN(test_film_filename);
+    RUN(test_mix);
+    RUN(test_octa_mapping);
+    RUN(test_infinite_map);
+    RUN(test_checkerboard_scale);
     RUN(test_loop_limits);
     RUN(test_detect);
     RUN(test_basic);

@@ -9,11 +9,13 @@
 
 #include "base/limit.h"
 #include "base/strmap.h"
+#include "io/image_write.h"
 #include "io/lexer.h"
 #include "io/mesh_load.h"
 #include "io/texture.h"
 #include "kmath.h"
 #include "scene/mesh_sink.h"
+#include "scene/octa_env.h"
 #include "scene/subdiv.h"
 #include "scene/transform.h"
 
@@ -66,6 +68,8 @@ typedef struct {
     int constant;
     vec3 color;
     uint index;
+    vec3 mean;               /* the texture's mean colour (a constant's is its colour):
+                              * what stands in where only a constant fits */
 } PTexture;
 
 /* An ObjectBegin/End's shapes, taken out of the scene and copied in at each instance. */
@@ -845,8 +849,21 @@ static Status d_film(Parser *p, Lexer *lx, const Token *kw)
     if (h < 1 || h > CLPT_MAX_IMAGE_SIDE) return param_type_error(p, lx, param_find(p, "yresolution"), "in 1..16384");
     p->s->image.width = (uint)w;
     p->s->image.height = (uint)h;
-    /* the output name belongs to the command line (-o); the file's is not used */
-    param_find(p, "filename");
+    /* the image pbrt would write: clpt's output when -o does not name one (main.c) */
+    const Token *f = NULL;
+    if ((st = get_string(p, lx, "filename", &f))) return st;
+    if (f) {
+        char *name = tok_copy(f);
+        if (!name) return error_set(p->err, ST_INTERNAL, "out of memory");
+        ImageFormat format;
+        if (!name[0] || image_format_from_path(name, &format, p->err)) {
+            free(name);
+            return lex_error_at(lx, f, p->err, "Film \"filename\" '%.*s' is not an image clpt writes (.png, .ppm, "
+                                ".bmp, .pfm, .exr, .hdr)", (int)(f->len > 60 ? 60 : f->len), f->text);
+        }
+        free(p->s->output_hint);
+        p->s->output_hint = name;
+    }
     return warn_unused(p, lx, "Film");
 }
 
@@ -949,11 +966,46 @@ static Status texture_of(Parser *p, const Lexer *lx, const char *name, vec3 *alb
     return ST_OK;
 }
 
+/* pbrt's mix: its two named materials (defined before it, so a mix never contains
+ * itself) and `amount`, a float or a float texture (an image's red channel), chosen per
+ * hit by the kernels (kernels/mix.h). */
+static Status make_mix(Parser *p, const Lexer *lx, const Token *type, Material *m)
+{
+    Param *pa = param_find(p, "materials");
+    if (!pa || pa->type != PT_STRING || pa->n != 2)
+        return lex_error_at(lx, type, p->err, "a mix material needs \"string materials\" with two names");
+    uint32_t parts[2];
+    for (int i = 0; i < 2; i++) {
+        const Token *named = &p->pl.strs[pa->first + i];
+        if (!strmap_find(&p->named_material, named->text, named->len, &parts[i]))
+            return lex_error_at(lx, named, p->err, "material '%.*s' is not defined (MakeNamedMaterial defines it)",
+                                (int)(named->len > 40 ? 40 : named->len), named->text);
+    }
+    double amount = 0.5;
+    uint amount_tex = NO_INDEX;
+    Param *am = param_find(p, "amount");
+    Status st;
+    if (am && am->type == PT_TEXTURE) {
+        const PTexture *tex;
+        vec3 c = v3(0.5f, 0.5f, 0.5f);
+        if ((st = get_spectrum(p, lx, "amount", &c, &tex, NULL))) return st;
+        amount = tex ? 1.0 : c.x;
+        if (tex) amount_tex = tex->index;
+    } else if ((st = get_float(p, lx, "amount", &amount))) {
+        return st;
+    }
+    /* the kernels follow MIX_MAX_DEPTH mixes from a hit's material */
+    uint da = scene_mix_depth(p->s, parts[0]), db = scene_mix_depth(p->s, parts[1]);
+    if ((da > db ? da : db) >= MIX_MAX_DEPTH)
+        return lex_error_at(lx, type, p->err, "mix materials nest more than %u deep", MIX_MAX_DEPTH);
+    *m = material_mix(parts[0], parts[1], (float)amount, amount_tex);
+    return ST_OK;
+}
+
 /* Builds the material of type `type` from the current parameter list. */
 static Status make_material(Parser *p, const Lexer *lx, const Token *type, Material *m, const char *what)
 {
     Status st;
-    Token named = {0};
     if (tok_eq(type, "diffuse")) {
         *m = material_diffuse(v3(0.5f, 0.5f, 0.5f));
         st = texture_of(p, lx, "reflectance", &m->albedo, &m->texture);
@@ -999,18 +1051,7 @@ static Status make_material(Parser *p, const Lexer *lx, const Token *type, Mater
         *m = material_dielectric(1.0f);
         st = ST_OK;
     } else if (tok_eq(type, "mix")) {
-        Param *pa = param_find(p, "materials");
-        double amount = 0.5;
-        if ((st = get_float_tex(p, lx, "amount", &amount))) return st;
-        if (!pa || pa->type != PT_STRING || pa->n != 2)
-            return lex_error_at(lx, type, p->err, "a mix material needs \"string materials\" with two names");
-        named = p->pl.strs[pa->first + (amount > 0.5 ? 1 : 0)];
-        uint32_t i;
-        if (!strmap_find(&p->named_material, named.text, named.len, &i))
-            return lex_error_at(lx, &named, p->err, "material '%.*s' is not defined", (int)(named.len > 40 ? 40 : named.len),
-                                named.text);
-        *m = p->s->materials[i];
-        st = warn_once(p, lx, type, "mix", "mix materials are not blended: the one of larger weight is used");
+        st = make_mix(p, lx, type, m);
     } else {
         *m = material_diffuse(v3(0.5f, 0.5f, 0.5f));
         char key[96];
@@ -1077,6 +1118,206 @@ static Status d_named_material(Parser *p, Lexer *lx, const Token *kw)
     return st ? st : set_material(p, i);
 }
 
+/* A file a parameter names, found as pbrt finds it: a relative path from the main
+ * file's folder. NULL when out of memory. */
+static char *beside_main(const Parser *p, const Token *f)
+{
+    const char *dir_end = strrchr(p->top_path, '/');
+    size_t dl = f->text[0] == '/' || !dir_end ? 0 : (size_t)(dir_end - p->top_path + 1);
+    char *path = malloc(dl + f->len + 1);
+    if (!path) return NULL;
+    memcpy(path, p->top_path, dl);
+    memcpy(path + dl, f->text, f->len);
+    path[dl + f->len] = '\0';
+    return path;
+}
+
+/* pbrt-v4's (u, v) mapping of 2D textures: (uscale u + udelta, vscale v + vdelta) of
+ * clpt's surface coordinates; another `mapping` (spherical, cylindrical, planar) is a
+ * warning and uv. */
+static Status tex_uv_mapping(Parser *p, const Lexer *lx, Texture *t)
+{
+    double su = 1, sv = 1, du = 0, dv = 0;
+    const Token *mapping = NULL;
+    Status st;
+    if ((st = get_float(p, lx, "uscale", &su)) || (st = get_float(p, lx, "vscale", &sv)) ||
+        (st = get_float(p, lx, "udelta", &du)) || (st = get_float(p, lx, "vdelta", &dv)) ||
+        (st = get_string(p, lx, "mapping", &mapping)))
+        return st;
+    if (mapping && !tok_eq(mapping, "uv") &&
+        (st = warn_once(p, lx, mapping, "texture-mapping", "texture mapping \"%.*s\" is not supported; uv is used",
+                        (int)(mapping->len > 40 ? 40 : mapping->len), mapping->text)))
+        return st;
+    texture_set_scale_offset(t, (float)su, (float)sv, (float)du, (float)dv);
+    return ST_OK;
+}
+
+/* Texel i of scene texture t as linear RGB. */
+static vec3 texel_rgb(const Scene *s, const Texture *t, size_t i)
+{
+    if (t->flags & TEX_FLOAT) {
+        float f[3];
+        memcpy(f, s->texels + t->offset + 3 * i, sizeof f);
+        return v3(f[0], f[1], f[2]);
+    }
+    uint c = s->texels[t->offset + i];
+    float rgb[3];
+    for (int k = 0; k < 3; k++) {
+        rgb[k] = (float)((c >> (8 * k)) & 255u) / 255.0f;
+        if (t->flags & TEX_SRGB) rgb[k] = k_srgb_to_linear(rgb[k]);
+    }
+    return v3(rgb[0], rgb[1], rgb[2]);
+}
+
+/* The mean colour of an image texture's texels. */
+static vec3 image_mean(const Scene *s, const Texture *t)
+{
+    size_t n = (size_t)t->width * t->height;
+    double sum[3] = { 0, 0, 0 };
+    for (size_t i = 0; i < n; i++) {
+        vec3 c = texel_rgb(s, t, i);
+        sum[0] += c.x;
+        sum[1] += c.y;
+        sum[2] += c.z;
+    }
+    return n ? v3((float)(sum[0] / n), (float)(sum[1] / n), (float)(sum[2] / n)) : v3(0, 0, 0);
+}
+
+static Status tex_imagemap(Parser *p, const Lexer *lx, const Token *cls, PTexture *t)
+{
+    const Token *f = NULL, *enc = NULL;
+    Status st;
+    if ((st = get_string(p, lx, "filename", &f))) return st;
+    if (!f) return lex_error_at(lx, cls, p->err, "an imagemap texture needs \"string filename\"");
+    if ((st = get_string(p, lx, "encoding", &enc))) return st;
+    int linear = enc && tok_eq(enc, "linear");
+    char *path = beside_main(p, f);
+    if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
+    st = texture_load_image(p->s, NULL, path, linear, 0, &t->index, p->err);
+    free(path);
+    if (st) {
+        error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+        return st;
+    }
+    t->constant = 0;
+    Texture *tx = &p->s->textures[t->index];
+    t->mean = image_mean(p->s, tx);
+    return tex_uv_mapping(p, lx, tx);
+}
+
+/* A colour parameter that may name another texture (checkerboard's tex1 and tex2,
+ * scale's tex and scale): a constant's value; a varying texture in *tex when `tex` is
+ * not NULL, else its mean colour with a warning. */
+static Status tex_operand(Parser *p, const Lexer *lx, const char *name, vec3 *out, const PTexture **tex)
+{
+    Param *pa = param_find(p, name);
+    if (tex) *tex = NULL;
+    if (!pa) return ST_OK;
+    if (pa->type != PT_TEXTURE) {
+        pa->used = 0;
+        return get_spectrum(p, lx, name, out, NULL, NULL);
+    }
+    const Token *n = &p->pl.strs[pa->first];
+    uint32_t i;
+    if (!strmap_find(&p->tex_by_name, n->text, n->len, &i))
+        return lex_error_at(lx, n, p->err, "texture '%.*s' is not defined", (int)(n->len > 40 ? 40 : n->len), n->text);
+    const PTexture *src = &p->tex[i];
+    if (src->constant) {
+        *out = src->color;
+    } else if (tex) {
+        *tex = src;
+    } else {
+        *out = src->mean;
+        return warn_once(p, lx, &pa->decl, "checker-texture", "a checkerboard's \"%.*s\" is a texture: its mean "
+                         "colour is used", (int)pa->name_len, pa->name);
+    }
+    return ST_OK;
+}
+
+/* pbrt-v4's checkerboard: tex1 on the cells whose integer coordinates sum to an even
+ * number (pbrt's weight 0.5 - bf(s) bf(t) / 2 is 0 there), tex2 on the others: clpt's
+ * TEX_CHECKER colour0 and colour1. 2D on the surface's (u, v) mapped as tex_uv_mapping,
+ * or 3D (dimension 3) at the point in the texture's space: the CTM at Texture maps
+ * texture space to the world, as pbrt's PointTransformMapping. */
+static Status tex_checkerboard(Parser *p, const Lexer *lx, PTexture *t)
+{
+    vec3 c1 = v3(1, 1, 1), c2 = v3(0, 0, 0);   /* pbrt's defaults */
+    long dim = 2;
+    Status st;
+    if ((st = tex_operand(p, lx, "tex1", &c1, NULL)) || (st = tex_operand(p, lx, "tex2", &c2, NULL)) ||
+        (st = get_int(p, lx, "dimension", &dim)))
+        return st;
+    if (dim != 2 && dim != 3) return param_type_error(p, lx, param_find(p, "dimension"), "2 or 3");
+    Texture tx = texture_make_checker(c1, c2, 1.0f, dim == 3);
+    if (dim == 3) {
+        int ok;
+        Transform inv = transform_inverse(&p->g.ctm, &ok);
+        if (!ok) return lex_error_at(lx, &param_find(p, "dimension")->decl, p->err,
+                                     "the checkerboard's transform cannot be inverted");
+        float m[12];
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 4; j++) m[4 * i + j] = (float)inv.m[i][j];
+        texture_set_matrix(&tx, m);
+    } else if ((st = tex_uv_mapping(p, lx, &tx))) {
+        return st;
+    }
+    t->constant = 0;
+    t->mean = v3_scale(v3_add(c1, c2), 0.5f);
+    return scene_add_texture(p->s, NULL, NULL, tx, &t->index, p->err);
+}
+
+/* A copy of varying texture src with every colour times k: a checkerboard with its two
+ * colours scaled, an image as float texels scaled (the original stays for its other
+ * users). */
+static Status tex_scaled_copy(Parser *p, const PTexture *src, vec3 k, PTexture *out)
+{
+    Scene *s = p->s;
+    Texture tx = s->textures[src->index];
+    out->constant = 0;
+    out->mean = v3_mul(src->mean, k);
+    if (tx.type == TEX_CHECKER) {
+        tx.color0 = v3_mul(tx.color0, k);
+        tx.color1 = v3_mul(tx.color1, k);
+        return scene_add_texture(s, NULL, NULL, tx, &out->index, p->err);
+    }
+    size_t n = (size_t)tx.width * tx.height;
+    uint *texels = malloc(n * 3 * sizeof *texels);
+    if (!texels) return error_set(p->err, ST_INTERNAL, "out of memory");
+    for (size_t i = 0; i < n; i++) {
+        vec3 c = v3_mul(texel_rgb(s, &tx, i), k);
+        float f[3] = { c.x, c.y, c.z };
+        memcpy(texels + 3 * i, f, sizeof f);
+    }
+    Status st = scene_add_texels(s, texels, n * 3, &tx.offset, p->err);
+    free(texels);
+    if (st) return st;
+    tx.flags = (tx.flags & ~TEX_SRGB) | TEX_FLOAT;
+    return scene_add_texture(s, NULL, NULL, tx, &out->index, p->err);
+}
+
+/* pbrt-v4's scale: tex x scale. Two constants multiply; a varying texture times a
+ * constant is a scaled copy of it; two varying ones, a warning: the first times the
+ * second's mean colour. */
+static Status tex_scale(Parser *p, const Lexer *lx, PTexture *t)
+{
+    vec3 a = v3(1, 1, 1), b = v3(1, 1, 1);
+    const PTexture *ta, *tb;
+    Status st;
+    if ((st = tex_operand(p, lx, "tex", &a, &ta)) || (st = tex_operand(p, lx, "scale", &b, &tb))) return st;
+    if (ta && tb) {
+        if ((st = warn_once(p, lx, &param_find(p, "scale")->decl, "scale-two", "a scale texture of two textures: "
+                            "the second's mean colour scales the first")))
+            return st;
+        b = tb->mean;
+        tb = NULL;
+    }
+    if (!ta && !tb) {
+        t->color = v3_mul(a, b);
+        return ST_OK;
+    }
+    return ta ? tex_scaled_copy(p, ta, b, t) : tex_scaled_copy(p, tb, a, t);
+}
+
 static Status d_texture(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
@@ -1093,34 +1334,20 @@ static Status d_texture(Parser *p, Lexer *lx, const Token *kw)
     if (tok_eq(&cls, "constant")) {
         if ((st = get_spectrum(p, lx, "value", &t.color, NULL, NULL))) return st;
     } else if (tok_eq(&cls, "imagemap")) {
-        const Token *f = NULL;
-        if ((st = get_string(p, lx, "filename", &f))) return st;
-        if (!f) return lex_error_at(lx, &cls, p->err, "an imagemap texture needs \"string filename\"");
-        const Token *enc = NULL;
-        if ((st = get_string(p, lx, "encoding", &enc))) return st;
-        int linear = enc && tok_eq(enc, "linear");
-        const char *dir_end = strrchr(p->top_path, '/');
-        size_t dl = f->text[0] == '/' || !dir_end ? 0 : (size_t)(dir_end - p->top_path + 1);
-        char *path = malloc(dl + f->len + 1);
-        if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
-        memcpy(path, p->top_path, dl);
-        memcpy(path + dl, f->text, f->len);
-        path[dl + f->len] = '\0';
-        st = texture_load_image(p->s, NULL, path, linear, 0, &t.index, p->err);
-        free(path);
-        if (st) {
-            error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
-            return st;
-        }
-        t.constant = 0;
+        st = tex_imagemap(p, lx, &cls, &t);
+    } else if (tok_eq(&cls, "checkerboard")) {
+        st = tex_checkerboard(p, lx, &t);
+    } else if (tok_eq(&cls, "scale")) {
+        st = tex_scale(p, lx, &t);
     } else {
         char key[96];
         snprintf(key, sizeof key, "Texture %.*s", (int)(cls.len > 40 ? 40 : cls.len), cls.text);
         st = warn_once(p, lx, &cls, key, "texture \"%.*s\" is not supported; it is a constant 1",
                        (int)(cls.len > 40 ? 40 : cls.len), cls.text);
         for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = 1;
-        if (st) return st;
     }
+    if (st) return st;
+    if (t.constant) t.mean = t.color;
     if (grow((void **)&p->tex, &p->cap_tex, p->n_tex + 1, sizeof(PTexture)) ||
         strmap_set(&p->tex_by_name, name.text, name.len, (uint32_t)p->n_tex))
         return error_set(p->err, ST_INTERNAL, "out of memory");
@@ -1193,6 +1420,90 @@ static Status light_dir(Parser *p, const Lexer *lx, const Token *at, vec3 d, vec
     return ST_OK;
 }
 
+/* pbrt-v4's ImageInfiniteLight: the square map at `f` (beside the main file), in the
+ * light's frame (the CTM), scaled by `scale` (octa_env.h). */
+static Status infinite_map(Parser *p, const Lexer *lx, const Token *f, double scale, double illuminance)
+{
+    char *path = beside_main(p, f);
+    if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
+    float *rgb = NULL;
+    int w = 0, h = 0;
+    Status st = texture_read_rgb(path, 0, &rgb, &w, &h, p->err);
+    free(path);
+    if (st) {
+        error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+        return st;
+    }
+    int finite = 1, invertible;
+    size_t n = (size_t)w * (size_t)h * 3u;
+    for (size_t i = 0; i < n && finite; i++) finite = isfinite(rgb[i]);
+    Transform inv = transform_inverse(&p->g.ctm, &invertible);
+    if (w != h) {
+        st = lex_error_at(lx, f, p->err, "the infinite light's map is %dx%d; pbrt-v4's maps are square (equal-area "
+                          "octahedral)", w, h);
+    } else if (!finite) {
+        st = lex_error_at(lx, f, p->err, "the infinite light's map has infinite or NaN pixels");
+    } else if (!invertible) {
+        st = lex_error_at(lx, f, p->err, "the infinite light's transform cannot be inverted");
+    } else {
+        if (illuminance > 0) {
+            /* pbrt-v4's normalisation: the map's illuminance on an upward (+z) surface,
+             * a sum over the upper hemisphere's texels of luminance x cos(theta) times
+             * 2 pi / texels (its code's factor; each texel spans 4 pi / texels) */
+            double k_e = 0;
+            for (int y = 0; y < h; y++)
+                for (int x = 0; x < w; x++) {
+                    double d[3];
+                    octa_square_to_sphere((x + 0.5) / w, (y + 0.5) / h, d);
+                    if (d[2] <= 0) continue;
+                    const float *t = rgb + 3 * ((size_t)y * (size_t)w + (size_t)x);
+                    k_e += (0.2126 * t[0] + 0.7152 * t[1] + 0.0722 * t[2]) * d[2];
+                }
+            k_e *= 2 * M_PI / ((double)w * h);
+            if (k_e > 0) scale *= illuminance / k_e;
+        }
+        double m[9];
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) m[3 * i + j] = inv.m[i][j];
+        st = octa_env_set(p->s, rgb, (uint)w, m, (float)scale, p->err);
+    }
+    free(rgb);
+    return st;
+}
+
+/* LightSource "infinite": a constant L, or an image (never both, as in pbrt); clpt has
+ * one background, so a second light with a map is ignored with a warning, and a map
+ * replaces the constants before it. */
+static Status infinite_light(Parser *p, const Lexer *lx, const Token *type, double scale)
+{
+    vec3 c = v3(1, 1, 1);
+    int has_L = 0;
+    const Token *f = NULL;
+    double illuminance = -1;
+    Status st;
+    if ((st = get_spectrum(p, lx, "L", &c, NULL, &has_L)) || (st = get_string(p, lx, "filename", &f)) ||
+        (st = get_float(p, lx, "illuminance", &illuminance)))
+        return st;
+    param_find(p, "portal");   /* a sampling aid only */
+    if (f && has_L)
+        return lex_error_at(lx, type, p->err, "an infinite light takes \"L\" or \"filename\", not both");
+    if (p->s->bg_type == BG_MAP)
+        return warn_once(p, lx, type, "infinite-second", "clpt has one environment map: this infinite light is "
+                         "ignored");
+    if (f) {
+        if (p->s->bg_type == BG_CONSTANT && !v3_is_zero(p->s->bg_color) &&
+            (st = warn_once(p, lx, type, "infinite-replace", "clpt has one background: the infinite light's map "
+                            "replaces the constant ones before it")))
+            return st;
+        return infinite_map(p, lx, f, scale, illuminance);
+    }
+    /* pbrt-v4: a uniform hemisphere of radiance L gives illuminance pi L */
+    if (illuminance > 0) scale *= illuminance / M_PI;
+    p->s->bg_type = BG_CONSTANT;
+    p->s->bg_color = v3_add(p->s->bg_color, v3_scale(c, (float)scale));
+    return ST_OK;
+}
+
 static Status d_light(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
@@ -1227,16 +1538,7 @@ static Status d_light(Parser *p, Lexer *lx, const Token *kw)
         if ((st = light_dir(p, lx, &type, xf_dir(&p->g.ctm, v3_sub(to, from)), &l.direction))) return st;
         if ((st = scene_add_light(p->s, l, p->err))) return st;
     } else if (tok_eq(&type, "infinite")) {
-        if ((st = get_spectrum(p, lx, "L", &c, NULL, NULL))) return st;
-        const Token *f = NULL;
-        if ((st = get_string(p, lx, "filename", &f))) return st;
-        if (f && (st = warn_once(p, lx, f, "infinite-map", "infinite light: \"%.*s\" is not used (pbrt-v4's maps "
-                                 "are equal-area octahedral images, which clpt does not read); a constant L lights the "
-                                 "scene instead", (int)(f->len > 60 ? 60 : f->len), f->text)))
-            return st;
-        param_find(p, "portal");   /* a sampling aid only */
-        p->s->bg_type = BG_CONSTANT;
-        p->s->bg_color = v3_add(p->s->bg_color, v3_scale(c, (float)scale));
+        if ((st = infinite_light(p, lx, &type, scale))) return st;
     } else {
         char key[96];
         snprintf(key, sizeof key, "LightSource %.*s", (int)(type.len > 40 ? 40 : type.len), type.text);

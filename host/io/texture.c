@@ -4,6 +4,7 @@
 #include "base/limit.h"
 #include "io/exr.h"
 #include "io/lexer.h"
+#include "kmath.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -361,22 +362,12 @@ static Status texture_read_exr(const char *path, uint **texels, size_t *n, int *
     return *texels ? ST_OK : error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
 }
 
-Status texture_load_image(Scene *s, const char *name, const char *path, int linear, int clamp,
-                          uint *index, Error *err)
+/* Reads the image file at `path` into new texels: 3 floats (as uint bits) a texel and
+ * TEX_FLOAT in *flags for EXR and Radiance HDR, else packed RGBA8 and TEX_SRGB unless
+ * `linear`. */
+static Status texture_read(const char *path, int linear, uint **out, size_t *n_out, int *w_out, int *h_out,
+                           uint *flags, Error *err)
 {
-    Texture t = texture_base(TEX_IMAGE);
-    uint encoding = linear ? 0u : TEX_SRGB;
-    /* the same file read before with the same encoding: share its texels */
-    uint same = scene_find_texture_source(s, path, linear);
-    if (same != NO_INDEX) {
-        const Texture *o = &s->textures[same];
-        t.offset = o->offset;
-        t.width = o->width;
-        t.height = o->height;
-        t.flags = (o->flags & (TEX_FLOAT | TEX_SRGB)) | (clamp ? TEX_CLAMP : 0u);
-        return scene_add_texture(s, name, path, t, index, err);
-    }
-
     /* stb_image opens files by name: a FIFO would block it, a directory read as empty */
     Status fst = lex_check_file(path, err);
     if (fst) return fst;
@@ -384,10 +375,8 @@ Status texture_load_image(Scene *s, const char *name, const char *path, int line
     uint *texels = NULL;
     size_t n = 0;
     if (file_is_exr(path)) {
-        Status est = texture_read_exr(path, &texels, &n, &w, &h, err);
-        if (est) return est;
-        t.flags = TEX_FLOAT;
-        return texture_add_read(s, name, path, t, texels, n, w, h, clamp, index, err);
+        *flags = TEX_FLOAT;
+        return texture_read_exr(path, out, n_out, w_out, h_out, err);
     }
     Status pst = pnm_check(path, err);
     if (!pst) pst = png_check(path, err);
@@ -408,7 +397,7 @@ Status texture_load_image(Scene *s, const char *name, const char *path, int line
         texels = malloc(n * sizeof *texels);
         if (texels) memcpy(texels, data, n * sizeof *texels);   /* float bits as uint */
         stbi_image_free(data);
-        t.flags = TEX_FLOAT;
+        *flags = TEX_FLOAT;
     } else {
         unsigned char *data = stbi_load(path, &w, &h, &channels, 4);
         if (!data)
@@ -419,10 +408,69 @@ Status texture_load_image(Scene *s, const char *name, const char *path, int line
         if (texels)
             for (size_t i = 0; i < n; i++) texels[i] = pack_rgba(data + 4 * i);
         stbi_image_free(data);
-        t.flags = encoding;
+        *flags = linear ? 0u : TEX_SRGB;
     }
     if (!texels) return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+    *out = texels;
+    *n_out = n;
+    *w_out = w;
+    *h_out = h;
+    return ST_OK;
+}
+
+Status texture_load_image(Scene *s, const char *name, const char *path, int linear, int clamp,
+                          uint *index, Error *err)
+{
+    Texture t = texture_base(TEX_IMAGE);
+    /* the same file read before with the same encoding: share its texels */
+    uint same = scene_find_texture_source(s, path, linear);
+    if (same != NO_INDEX) {
+        const Texture *o = &s->textures[same];
+        t.offset = o->offset;
+        t.width = o->width;
+        t.height = o->height;
+        t.flags = (o->flags & (TEX_FLOAT | TEX_SRGB)) | (clamp ? TEX_CLAMP : 0u);
+        return scene_add_texture(s, name, path, t, index, err);
+    }
+    int w = 0, h = 0;
+    uint *texels = NULL;
+    size_t n = 0;
+    Status st = texture_read(path, linear, &texels, &n, &w, &h, &t.flags, err);
+    if (st) return st;
     return texture_add_read(s, name, path, t, texels, n, w, h, clamp, index, err);
+}
+
+Status texture_read_rgb(const char *path, int linear, float **rgb, int *width, int *height, Error *err)
+{
+    uint *texels = NULL, flags = 0;
+    size_t n = 0;
+    int w = 0, h = 0;
+    Status st = texture_read(path, linear, &texels, &n, &w, &h, &flags, err);
+    if (st) return st;
+    if (w <= 0 || h <= 0) {
+        free(texels);
+        return error_set(err, ST_INPUT, "'%s': the image is empty", path);
+    }
+    size_t px = (size_t)w * (size_t)h;
+    float *out = malloc(px * 3u * sizeof *out);
+    if (!out) {
+        free(texels);
+        return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+    }
+    if (flags & TEX_FLOAT) {
+        memcpy(out, texels, px * 3u * sizeof *out);
+    } else {
+        for (size_t i = 0; i < px; i++)
+            for (int c = 0; c < 3; c++) {
+                float v = (float)((texels[i] >> (8 * c)) & 0xffu) / 255.0f;
+                out[3 * i + (size_t)c] = flags & TEX_SRGB ? k_srgb_to_linear(v) : v;
+            }
+    }
+    free(texels);
+    *rgb = out;
+    *width = w;
+    *height = h;
+    return ST_OK;
 }
 
 /* Adds the texels just read (taking them: freed here) and the texture over them. */

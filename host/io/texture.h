@@ -32,6 +32,11 @@ void texture_set_matrix(Texture *t, const float m[12]);
 Status texture_load_image(Scene *s, const char *name, const char *path, int linear, int clamp,
                           uint *index, Error *err);
 
+/* Reads the image file at `path` as linear RGB floats (*rgb: width x height x 3, top row
+ * first, malloc'ed), 8-bit images decoded from sRGB unless `linear`; nothing is added to
+ * a scene. The errors of texture_load_image. */
+Status texture_read_rgb(const char *path, int linear, float **rgb, int *width, int *height, Error *err);
+
 /* The same for an image already in memory (a glTF file's embedded PNG or JPEG; other
  * formats are refused), named `source` in messages; its texels are not shared. */
 Status texture_load_image_memory(Scene *s, const char *name, const char *source, const unsigned char *data,

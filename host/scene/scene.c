@@ -66,6 +66,7 @@ void scene_free(Scene *s)
     free(s->texels);
     free(s->env_cdf);
     free(s->path);
+    free(s->output_hint);
     for (size_t i = 0; i < s->n_warnings; i++) free(s->warnings[i]);
     free(s->warnings);
     strmap_free(&s->material_by_name);
@@ -382,6 +383,7 @@ static Material material_base(uint type)
     m.alpha = 1.0f;
     m.alpha_cutoff = 0.5f;      /* glTF's default alphaCutoff */
     m.texture_emission = NO_INDEX;
+    m.mix_a = m.mix_b = m.mix_texture = NO_INDEX;
     return m;
 }
 
@@ -425,6 +427,31 @@ Material material_conductor_f0(vec3 f0, float roughness)
     m.flags |= MAT_F0;
     return m;
 }
+
+Material material_mix(uint a, uint b, float amount, uint amount_tex)
+{
+    Material m = material_base(MAT_MIX);
+    m.mix_a = a;
+    m.mix_b = b;
+    m.mix_amount = amount;
+    m.mix_texture = amount_tex;
+    return m;
+}
+
+/* The depth of `index`'s mixes, entered `level` mixes deep: a cycle, or a chain deeper
+ * than the kernels follow, stops at MIX_MAX_DEPTH + 1 (and so do the calls). */
+static uint mix_depth(const Scene *s, uint index, uint level)
+{
+    if (index >= s->n_materials || level > MIX_MAX_DEPTH) return MIX_MAX_DEPTH + 1;
+    const Material *m = &s->materials[index];
+    if (m->type != MAT_MIX) return 0;
+    uint a = mix_depth(s, m->mix_a, level + 1);
+    uint b = a > MIX_MAX_DEPTH ? a : mix_depth(s, m->mix_b, level + 1);
+    uint deepest = a > b ? a : b;
+    return deepest > MIX_MAX_DEPTH ? deepest : deepest + 1;
+}
+
+uint scene_mix_depth(const Scene *s, uint index) { return mix_depth(s, index, 0); }
 
 Material material_principled(vec3 base, float metallic, float roughness)
 {

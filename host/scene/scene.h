@@ -39,6 +39,8 @@ typedef struct {
                                   * index or name; NULL: the file's first */
     SceneCamera camera;
     SceneImage image;
+    char *output_hint;           /* the image file the scene asks for (pbrt's Film
+                                  * "filename"), used when -o is not given; NULL: none */
     uint bg_type;                /* enum BackgroundType */
     vec3 bg_color, bg_zenith;
     uint bg_cubemap;             /* BG_CUBEMAP: index of the first of its six textures;
@@ -199,6 +201,13 @@ int material_metal_preset(const char *name, size_t len, vec3 *eta, vec3 *k);
 /* The classic Phong material: diffuse colour, specular colour and shininess, no mirror
  * or transparent part, index of refraction 1. */
 Material material_phong(vec3 diffuse, vec3 specular, float shininess);
+/* pbrt's mix (MAT_MIX): material b with probability amount (times texture `amount_tex`'s
+ * red channel unless NO_INDEX), else material a; no emission of its own. */
+Material material_mix(uint a, uint b, float amount, uint amount_tex);
+/* How deeply material `index` nests mixes: 0 for one that is no mix, 1 for a mix of two
+ * that are none, ...; stops counting past MIX_MAX_DEPTH + 1, and counts a mix that
+ * names a material past n_materials as too deep too. */
+uint scene_mix_depth(const Scene *s, uint index);
 /* A light with defaults: intensity 0, inverse-square attenuation, direction -y, a spot
  * cone of 30 degrees (cos_outer) with no soft edge. */
 Light light_default(uint type);

@@ -88,8 +88,9 @@ static Status scene_build(int threads)
     scene.params.n_leaf_prims = scene.tree.n_leaf_prims;
     scene.params.bounds_lo = scene.tree.lo;
     scene.params.bounds_hi = scene.tree.hi;
-    SceneView v = { &scene.params, scene.tree.nodes, scene.tree.leaf_prims, scene.sph, scene.tri,
-                    scene.box, scene.pln, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL };
+    /* named fields: the buffers this test does not use stay NULL whatever the list holds */
+    SceneView v = { .params = &scene.params, .nodes = scene.tree.nodes, .leaf_prims = scene.tree.leaf_prims,
+                    .spheres = scene.sph, .triangles = scene.tri, .boxes = scene.box, .planes = scene.pln };
     scene.view = v;
     return ST_OK;
 }

@@ -169,7 +169,7 @@ static int setup_open(const BenchScene *bs, const char *spec, int scalar_threads
     if (device_list(&all, &n_all, warning, sizeof warning, &err)) goto out;
     if (device_select(spec, all, n_all, &chosen, &n_chosen, &err)) goto out;
     s->devs = calloc(n_chosen, sizeof *s->devs);
-    DeviceConfig cfg = { scalar_threads, NULL, 0 };
+    DeviceConfig cfg = { .threads = scalar_threads };
     for (size_t i = 0; i < n_chosen; i++) {
         if (device_open(&all[chosen[i]], &cfg, &s->devs[s->n], &err)) goto out;
         s->n++;

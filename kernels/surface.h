@@ -76,7 +76,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
         s.ns = s.ng;
         s.material = b.material;
         s.light = b.light;
-    } else if (id < first_plane) {
+    } else if (KF_HAS(KF_REVSURFACE) && id < first_plane) {
         /* (u, v) become the angle around the axis (0..1 from +x towards +z, as the
          * course's revolution turns) and the segment's parameter */
         RevSurface rs = sc->revsurfaces[id - first_rev];

@@ -177,14 +177,14 @@ KFN vec3 texture_eval(const SceneView *sc, uint index, Surface s, vec3 ng_face)
  * (principled) where it has one. */
 KFN vec3 material_emission(const SceneView *sc, Material m, Surface s)
 {
-    if (m.texture_emission == NO_INDEX) return m.emission;
+    if (!KF_HAS(KF_TEXTURES) || m.texture_emission == NO_INDEX) return m.emission;
     return v3_mul(m.emission, texture_eval(sc, m.texture_emission, s, s.ng));
 }
 
 /* The material's diffuse colour (albedo) at s: its texture there, or its constant. */
 KFN vec3 material_albedo(const SceneView *sc, Material m, Surface s, vec3 ng_face)
 {
-    return m.texture == NO_INDEX ? m.albedo : texture_eval(sc, m.texture, s, ng_face);
+    return !KF_HAS(KF_TEXTURES) || m.texture == NO_INDEX ? m.albedo : texture_eval(sc, m.texture, s, ng_face);
 }
 
 /* dp/du and dp/dv at s, for tangent-space normal maps: a triangle's from its corners
@@ -231,7 +231,8 @@ KFN int surface_tangents(const SceneView *sc, Surface s, vec3 *dpdu, vec3 *dpdv)
 KFN vec3 material_normal(const SceneView *sc, Material m, Surface s)
 {
     vec3 dpdu, dpdv;
-    if (m.type != MAT_PRINCIPLED || m.texture_normal == NO_INDEX || !surface_tangents(sc, s, &dpdu, &dpdv))
+    if (!KF_HAS(KF_TEXTURES) || !MAT_IS(m, MAT_PRINCIPLED) || m.texture_normal == NO_INDEX ||
+        !surface_tangents(sc, s, &dpdu, &dpdv))
         return s.ns;
     vec3 n = s.ns;
     vec3 t = v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu)));
@@ -254,7 +255,7 @@ KFN vec3 material_normal(const SceneView *sc, Material m, Surface s)
  * the texture is read as declared, so it should be `encoding linear`). */
 KFN Material material_at(const SceneView *sc, Material m, Surface s, vec3 ng_face)
 {
-    if (m.type == MAT_PRINCIPLED && m.texture_rm != NO_INDEX) {
+    if (KF_HAS(KF_TEXTURES) && MAT_IS(m, MAT_PRINCIPLED) && m.texture_rm != NO_INDEX) {
         vec3 t = texture_eval(sc, m.texture_rm, s, ng_face);
         m.roughness *= t.y;
         m.metallic *= t.z;

@@ -30,6 +30,7 @@ KFN_INLINE int trace_prim(const SceneView *sc, uint id, const RayPre *rp, Ray ra
         return sphere_intersect(sc->spheres[id], ray, hit);
     if (id < first_rev)
         return box_intersect(rp, sc->boxes[id - first_box], ray, hit);
+    if (!KF_HAS(KF_REVSURFACE)) return 0;
     return revsurface_intersect(sc->revsurfaces[id - first_rev], sc->rev_points, ray, hit);
 }
 

@@ -94,7 +94,7 @@ KFN float light_pdf_area(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
     Light l = sc->lights[li];
     vec3 to = v3_sub(x, ref);
     float dist2 = v3_dot(to, to);
-    if (l.prim < sc->params->n_spheres) {
+    if (KF_HAS(KF_SPHERES) && l.prim < sc->params->n_spheres) {
         Sphere sp = sc->spheres[l.prim];
         vec3 wc = v3_sub(sp.center, ref);
         float dc2 = v3_dot(wc, wc);
@@ -166,7 +166,7 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, float u_rest, 
     ls->Le = sc->materials[prim_material(sc, l.prim)].emission;
     ls->delta = 0;
 
-    if (l.prim < first_tri) {
+    if (KF_HAS(KF_SPHERES) && l.prim < first_tri) {
         Sphere sp = sc->spheres[l.prim];
         vec3 wc = v3_sub(sp.center, ref);
         float dc2 = v3_dot(wc, wc);
@@ -248,7 +248,7 @@ KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, float u_pi
         ls->delta = 0;
         return ls->pdf > 0.0f;
     }
-    if (l.type != LIGHT_AREA) {
+    if (KF_HAS(KF_DELTA_LIGHTS) && l.type != LIGHT_AREA) {
         if (!light_delta_at(l, ref, ls)) return 0;
         ls->pdf = choice;
         return choice > 0.0f;

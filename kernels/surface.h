@@ -32,7 +32,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
     s.prim = id;
     uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
     uint first_rev = first_box + p->n_boxes, first_plane = first_rev + p->n_revsurfaces;
-    if (id < first_tri) {
+    if (KF_HAS(KF_SPHERES) && id < first_tri) {
         Sphere sp = sc->spheres[id];
         /* p stays o + t*d: projecting it onto the sphere (center + r*n) would round it to
          * the precision of the centre's coordinates, 6e-5 for the One-Weekend ground
@@ -67,7 +67,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
                 s.v = w * sh.uv0[1] + hit.u * sh.uv1[1] + hit.v * sh.uv2[1];
             }
         }
-    } else if (id < first_rev) {
+    } else if (KF_HAS(KF_BOXES) && id < first_rev) {
         Box b = sc->boxes[id - first_box];
         int face = (int)hit.u;                    /* 0:-x 1:+x 2:-y 3:+y 4:-z 5:+z */
         float sign = (face & 1) ? 1.0f : -1.0f;

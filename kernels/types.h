@@ -41,8 +41,12 @@
 #define KF_ENV_MAP 0x10u        /* background BG_MAP, with its light LIGHT_ENV */
 #define KF_CUBEMAP 0x20u        /* background BG_CUBEMAP */
 #define KF_REVSURFACE 0x40u     /* surfaces of revolution */
-#define KF_MATERIAL(t) (0x80u << (t))   /* material type t (enum MaterialType) */
-#define KF_ALL 0x3fffu           /* every bit above (material types 0 to 6) */
+#define KF_SPHERES 0x80u
+#define KF_BOXES 0x100u
+#define KF_PLANES 0x200u
+#define KF_DELTA_LIGHTS 0x400u  /* point, spot or directional lights */
+#define KF_MATERIAL(t) (0x800u << (t))  /* material type t (enum MaterialType) */
+#define KF_ALL 0x3ffffu         /* every bit above (material types 0 to 6) */
 #ifndef CLPT_FEATURES
 #define CLPT_FEATURES KF_ALL
 #endif

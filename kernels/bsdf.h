@@ -312,7 +312,9 @@ KFN BsdfSample bsdf_sample_rough(Material m, vec3 albedo, vec3 d, vec3 ns, int f
                                  float u2)
 {
     BsdfSample s;
-    vec3 t, b, f, wl;
+    /* f and wl are read only where pdf > 0, which some sampler below set; zero for
+     * the compiler, which cannot see that when a program has no rough material type */
+    vec3 t, b, f = v3s(0.0f), wl = v3s(0.0f);
     k_onb(ns, &t, &b);
     vec3 wo = bsdf_to_local(v3_neg(d), t, b, ns);
     float pdf = 0.0f;

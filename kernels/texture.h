@@ -231,7 +231,7 @@ KFN int surface_tangents(const SceneView *sc, Surface s, vec3 *dpdu, vec3 *dpdv)
 KFN vec3 material_normal(const SceneView *sc, Material m, Surface s)
 {
     vec3 dpdu, dpdv;
-    if (!KF_HAS(KF_TEXTURES) || !MAT_IS(m, MAT_PRINCIPLED) || m.texture_normal == NO_INDEX ||
+    if (!KF_HAS(KF_TEXTURES) || m.type != MAT_PRINCIPLED || m.texture_normal == NO_INDEX ||
         !surface_tangents(sc, s, &dpdu, &dpdv))
         return s.ns;
     vec3 n = s.ns;

@@ -19,7 +19,9 @@
  * The host builds the path tracer's kernels and the classic ray tracer's as two programs
  * (CLPT_FEATURES with KF_PATH or KF_WHITTED, types.h), each on first use: a driver
  * compiles every kernel of a program, so a path-tracer run never waits for k_whitted,
- * nor a whitted run for k_shade. k_film and k_layout are in both.
+ * nor a whitted run for k_shade. k_film is in both; k_layout only in the whole program
+ * (no CLPT_FEATURES: the tests), as PoCL would compile it too in every program for
+ * nothing.
  */
 #include "film.cl"
 #include "raygen.cl"
@@ -132,6 +134,7 @@ __kernel void k_film(__global const PathState *paths, uint first_pixel, uint n_p
  * own layout (tests/test_kernels.c): a mismatch would silently corrupt every buffer.
  * tests/test_ocl.c's LAYOUT_VALUES is the number of values written here: its buffer
  * holds exactly that many. */
+#if KF_HAS(KF_PATH) && KF_HAS(KF_WHITTED)
 __kernel void k_layout(__global uint *out)
 {
     if (get_global_id(0) != 0) return;
@@ -178,6 +181,7 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(RenderParams, n_revsurfaces);
     out[i++] = (uint)__builtin_offsetof(RenderParams, bg_light);
 }
+#endif
 
 /* ---------------------------------------------------------------- classic ray tracer
  * The whitted integrator and the auxiliary images (kernels/whitted.cl): one work-item

@@ -20,7 +20,7 @@
  * device's CL_PROGRAM_BINARIES. Files are written to a temporary name in the same folder
  * and renamed, so a concurrent run sees either no file or a whole one. Anything wrong
  * with an entry (truncated, corrupt, refused by the driver, or a program that did not
- * build for the device or lacks clpt's kernels) deletes it and the program is rebuilt
+ * build for the device or lacks clpt's kernel k_film) deletes it and the program is rebuilt
  * from source and stored again. While the driver reads an entry it is moved aside, so
  * an entry the driver crashes on is gone for the next run, which compiles afresh past
  * whatever the driver kept of it (ocl_program.c, oclp__cache_load). A cache that cannot

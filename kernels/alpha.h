@@ -36,6 +36,7 @@
 /* Whether the material of primitive `prim` may be cut out anywhere. */
 KFN int prim_has_alpha(const SceneView *sc, uint prim)
 {
+    if (!KF_HAS(KF_ALPHA)) return 0;
     return (sc->materials[prim_material(sc, prim)].flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) != 0u;
 }
 

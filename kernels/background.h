@@ -84,8 +84,8 @@ KFN vec3 cubemap_lookup(const SceneView *sc, vec3 d)
 KFN vec3 background_radiance(const SceneView *sc, vec3 d)
 {
     GLOBAL const RenderParams *p = sc->params;
-    if (p->bg_type == BG_CUBEMAP) return cubemap_lookup(sc, d);
-    if (p->bg_type == BG_MAP) return env_radiance(sc, d);
+    if (KF_HAS(KF_CUBEMAP) && p->bg_type == BG_CUBEMAP) return cubemap_lookup(sc, d);
+    if (KF_HAS(KF_ENV_MAP) && p->bg_type == BG_MAP) return env_radiance(sc, d);
     if (p->bg_type == BG_SKY) {
         float t = 0.5f * (d.y + 1.0f);
         return v3_add(v3_scale(p->bg_color, 1.0f - t), v3_scale(p->bg_zenith, t));

@@ -239,9 +239,9 @@ KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
 KFN int bsdf_has_density(Material m, vec3 albedo)
 {
     if (m.type == MAT_DIFFUSE) return 1;
-    if (m.type == MAT_PHONG) return phong_lobes(m, albedo).p_glossy > 0.0f;
-    if (m.type == MAT_CONDUCTOR || m.type == MAT_DIELECTRIC) return !ggx_smooth(bsdf_ggx(m));
-    return m.type == MAT_PRINCIPLED;
+    if (MAT_IS(m, MAT_PHONG)) return phong_lobes(m, albedo).p_glossy > 0.0f;
+    if (MAT_IS(m, MAT_CONDUCTOR) || MAT_IS(m, MAT_DIELECTRIC)) return !ggx_smooth(bsdf_ggx(m));
+    return MAT_IS(m, MAT_PRINCIPLED);
 }
 
 KFN vec3 bsdf_to_local(vec3 w, vec3 t, vec3 b, vec3 n) { return v3(v3_dot(w, t), v3_dot(w, b), v3_dot(w, n)); }
@@ -258,7 +258,7 @@ KFN vec3 bsdf_eval(Material m, vec3 albedo, vec3 d, vec3 ns, int front, vec3 wi,
         *pdf = c * K_INV_PI;
         return v3_scale(albedo, K_INV_PI);
     }
-    if (m.type == MAT_PHONG) {
+    if (MAT_IS(m, MAT_PHONG)) {
         *pdf = phong_eval(phong_lobes(m, albedo), d, ns, wi, &f);
         return f;
     }
@@ -266,9 +266,10 @@ KFN vec3 bsdf_eval(Material m, vec3 albedo, vec3 d, vec3 ns, int front, vec3 wi,
     vec3 t, b;
     k_onb(ns, &t, &b);
     vec3 wo = bsdf_to_local(v3_neg(d), t, b, ns), wl = bsdf_to_local(wi, t, b, ns);
-    if (m.type == MAT_CONDUCTOR) *pdf = conductor_eval(bsdf_conductor(m, albedo), wo, wl, &f);
-    else if (m.type == MAT_PRINCIPLED) *pdf = principled_eval(bsdf_principled(m, albedo, front), wo, wl, &f);
-    else *pdf = dielectric_eval(bsdf_dielectric(m, front), wo, wl, &f);
+    /* the last branch is the rough dielectric, the one type left with a density */
+    if (MAT_IS(m, MAT_CONDUCTOR)) *pdf = conductor_eval(bsdf_conductor(m, albedo), wo, wl, &f);
+    else if (MAT_IS(m, MAT_PRINCIPLED)) *pdf = principled_eval(bsdf_principled(m, albedo, front), wo, wl, &f);
+    else if (KF_HAS(KF_MATERIAL(MAT_DIELECTRIC))) *pdf = dielectric_eval(bsdf_dielectric(m, front), wo, wl, &f);
     return f;
 }
 
@@ -311,16 +312,18 @@ KFN BsdfSample bsdf_sample_rough(Material m, vec3 albedo, vec3 d, vec3 ns, int f
                                  float u2)
 {
     BsdfSample s;
-    vec3 t, b, f, wl;
+    /* f and wl are read only where pdf > 0, which some sampler below set; zero for
+     * the compiler, which cannot see that when a program has no rough material type */
+    vec3 t, b, f = v3s(0.0f), wl = v3s(0.0f);
     k_onb(ns, &t, &b);
     vec3 wo = bsdf_to_local(v3_neg(d), t, b, ns);
     float pdf = 0.0f;
     if (wo.z > 0.0f) {
-        if (m.type == MAT_CONDUCTOR)
+        if (MAT_IS(m, MAT_CONDUCTOR))
             pdf = conductor_sample(bsdf_conductor(m, albedo), wo, u1, u2, &wl, &f);
-        else if (m.type == MAT_PRINCIPLED)
+        else if (MAT_IS(m, MAT_PRINCIPLED))
             pdf = principled_sample(bsdf_principled(m, albedo, front), wo, u_lobe, u1, u2, &wl, &f);
-        else
+        else if (KF_HAS(KF_MATERIAL(MAT_DIELECTRIC)))   /* the rough dielectric */
             pdf = dielectric_sample(bsdf_dielectric(m, front), wo, u_lobe, u1, u2, &wl, &f);
     }
     s.specular = 0;
@@ -343,10 +346,10 @@ KFN BsdfSample bsdf_sample(Material m, vec3 albedo, vec3 d, vec3 ns, vec3 ng, in
                            float u2, float u3)
 {
     if (m.type == MAT_DIFFUSE) return bsdf_sample_diffuse(albedo, ns, u1, u2);
-    if (m.type == MAT_PHONG) return phong_sample(phong_lobes(m, albedo), m, d, ns, ng, front, u_lobe, u1, u2, u3);
-    if (m.type == MAT_METAL) return bsdf_sample_metal(albedo, m.fuzz, d, ns, u1, u2, u3);
+    if (MAT_IS(m, MAT_PHONG)) return phong_sample(phong_lobes(m, albedo), m, d, ns, ng, front, u_lobe, u1, u2, u3);
+    if (MAT_IS(m, MAT_METAL)) return bsdf_sample_metal(albedo, m.fuzz, d, ns, u1, u2, u3);
     if (bsdf_has_density(m, albedo)) return bsdf_sample_rough(m, albedo, d, ns, front, u_lobe, u1, u2);
-    if (m.type == MAT_CONDUCTOR) return bsdf_sample_mirror_conductor(bsdf_conductor(m, albedo), d, ns, ng);
+    if (MAT_IS(m, MAT_CONDUCTOR)) return bsdf_sample_mirror_conductor(bsdf_conductor(m, albedo), d, ns, ng);
     if (m.flags & MAT_THIN) return bsdf_sample_thin(bsdf_dielectric(m, front), d, ng, u_lobe);
     return bsdf_sample_dielectric(m.ior, d, ng, front, u_lobe);
 }

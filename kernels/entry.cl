@@ -15,6 +15,13 @@
  * cache line, types.h): at bounce b, slot 2b + 1 counts its shadow rays and slot 2b + 2
  * the paths that go on. Every bounce has its own slots, so a wave's counters are zeroed
  * once and the host can read them back while later bounces run.
+ *
+ * The host builds the path tracer's kernels and the classic ray tracer's as two programs
+ * (CLPT_FEATURES with KF_PATH or KF_WHITTED, types.h), each on first use: a driver
+ * compiles every kernel of a program, so a path-tracer run never waits for k_whitted,
+ * nor a whitted run for k_shade. k_film is in both; k_layout only in the whole program
+ * (no CLPT_FEATURES: the tests), as PoCL would compile it too in every program for
+ * nothing.
  */
 #include "film.cl"
 #include "raygen.cl"
@@ -33,6 +40,7 @@
     SceneView sc;                                                                        \
     SCENE_BUFFERS(SCENE_VIEW_SET_)
 
+#if KF_HAS(KF_PATH)
 /* Births the wave's paths and queues them all: path i of the wave is path number
  * first_pixel + i of the batch (see the top of this file). */
 __kernel void k_raygen(__global const RenderParams *params, uint first_pixel, uint first_sample,
@@ -107,6 +115,8 @@ __kernel void k_shadow(SCENE_ARGS __global const uint *shadow_queue, uint n,
     shadow_resolve(&paths[path], trace_occluded(&sc, shadow_rays[path]));
 }
 
+#endif /* KF_HAS(KF_PATH) */
+
 /* Adds the finished wave of n_paths paths to the film. Work-item j owns one pixel, the
  * one of wave path j, and adds every path of the wave on that pixel (j, j + n_pixels,
  * ...), so no two work-items touch the same film entry; launched over
@@ -124,6 +134,7 @@ __kernel void k_film(__global const PathState *paths, uint first_pixel, uint n_p
  * own layout (tests/test_kernels.c): a mismatch would silently corrupt every buffer.
  * tests/test_ocl.c's LAYOUT_VALUES is the number of values written here: its buffer
  * holds exactly that many. */
+#if KF_HAS(KF_PATH) && KF_HAS(KF_WHITTED)
 __kernel void k_layout(__global uint *out)
 {
     if (get_global_id(0) != 0) return;
@@ -172,6 +183,7 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)sizeof(TriExtra);
     out[i++] = (uint)__builtin_offsetof(TriExtra, uv);
 }
+#endif
 
 /* ---------------------------------------------------------------- classic ray tracer
  * The whitted integrator and the auxiliary images (kernels/whitted.cl): one work-item
@@ -180,6 +192,7 @@ __kernel void k_layout(__global uint *out)
  * k_raygen: work-item i is path first_pixel + i of sample first_sample. counters[0]
  * receives the number of rays traced (summed per work-group first). No early return:
  * every work-item must reach the barriers. */
+#if KF_HAS(KF_WHITTED)
 __kernel void k_whitted(SCENE_ARGS uint first_pixel, uint first_sample, uint n_pixels, uint n_paths,
                         __global PathState *paths, __global uint *counters)
 {
@@ -197,6 +210,7 @@ __kernel void k_whitted(SCENE_ARGS uint first_pixel, uint first_sample, uint n_p
     barrier(CLK_LOCAL_MEM_FENCE);
     if (get_local_id(0) == 0 && group_rays) atomic_add(&counters[0], group_rays);
 }
+#endif /* KF_HAS(KF_WHITTED) */
 
 /* ------------------------------------------------------------------------------------
  * Trace-only kernels for the traversal benchmark (bench/bench_traverse.c): rays from a

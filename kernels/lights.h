@@ -94,7 +94,7 @@ KFN float light_pdf_area(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
     Light l = sc->lights[li];
     vec3 to = v3_sub(x, ref);
     float dist2 = v3_dot(to, to);
-    if (l.prim < sc->params->n_spheres) {
+    if (KF_HAS(KF_SPHERES) && l.prim < sc->params->n_spheres) {
         Sphere sp = sc->spheres[l.prim];
         vec3 wc = v3_sub(sp.center, ref);
         float dc2 = v3_dot(wc, wc);
@@ -118,7 +118,7 @@ KFN float light_pdf(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
 KFN float light_pdf_env(const SceneView *sc, vec3 d)
 {
     uint li = sc->params->bg_light;
-    return li == NO_INDEX || sc->params->bg_type != BG_MAP ? 0.0f : sc->lights[li].pick_pdf * env_pdf(sc, d);
+    return !KF_HAS(KF_ENV_MAP) || li == NO_INDEX || sc->params->bg_type != BG_MAP ? 0.0f : sc->lights[li].pick_pdf * env_pdf(sc, d);
 }
 
 /* The light of delta light l arriving at ref: direction, distance and irradiance
@@ -166,7 +166,7 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, float u_rest, 
     ls->Le = sc->materials[prim_material(sc, l.prim)].emission;
     ls->delta = 0;
 
-    if (l.prim < first_tri) {
+    if (KF_HAS(KF_SPHERES) && l.prim < first_tri) {
         Sphere sp = sc->spheres[l.prim];
         vec3 wc = v3_sub(sp.center, ref);
         float dc2 = v3_dot(wc, wc);
@@ -237,7 +237,7 @@ KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, float u_pi
     uint li = light_choose(sc, u_pick * cdf_top, &u_rest);
     Light l = sc->lights[li];
     float choice = l.pick_pdf / cdf_top;
-    if (l.type == LIGHT_ENV) {
+    if (KF_HAS(KF_ENV_MAP) && l.type == LIGHT_ENV) {
         /* the environment map: a direction from its distribution, infinitely far */
         ls->wi = env_sample_dir(sc, u1, u2);
         ls->Le = env_radiance(sc, ls->wi);
@@ -248,7 +248,7 @@ KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, float u_pi
         ls->delta = 0;
         return ls->pdf > 0.0f;
     }
-    if (l.type != LIGHT_AREA) {
+    if (KF_HAS(KF_DELTA_LIGHTS) && l.type != LIGHT_AREA) {
         if (!light_delta_at(l, ref, ls)) return 0;
         ls->pdf = choice;
         return choice > 0.0f;

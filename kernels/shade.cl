@@ -85,7 +85,8 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
          * MIS, as emission below; other backgrounds are no light that next-event
          * estimation samples, so what BSDF sampling finds of them counts fully */
         float w = 1.0f;
-        if (!(ps->flags & PATH_SPECULAR) && p->bg_type == BG_MAP && p->bg_light != NO_INDEX)
+        if (!(ps->flags & PATH_SPECULAR) && KF_HAS(KF_ENV_MAP) && p->bg_type == BG_MAP &&
+            p->bg_light != NO_INDEX)
             w = p->mis_mode == MIS_BOTH ? mis_power(ps->bsdf_pdf, light_pdf_env(sc, r.d))
                                         : (p->mis_mode == MIS_BSDF_ONLY ? 1.0f : 0.0f);
         ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, background_radiance(sc, r.d)), w));

@@ -39,7 +39,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
     s.b2 = hit.v;
     uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
     uint first_rev = first_box + p->n_boxes, first_plane = first_rev + p->n_revsurfaces;
-    if (id < first_tri) {
+    if (KF_HAS(KF_SPHERES) && id < first_tri) {
         Sphere sp = sc->spheres[id];
         /* p stays o + t*d: projecting it onto the sphere (center + r*n) would round it to
          * the precision of the centre's coordinates, 6e-5 for the One-Weekend ground
@@ -75,7 +75,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
             }
             if (sh.flags & TRI_HAS_EXTRA) s.extra = sc->tri_extra_of[tr.shading];
         }
-    } else if (id < first_rev) {
+    } else if (KF_HAS(KF_BOXES) && id < first_rev) {
         Box b = sc->boxes[id - first_box];
         int face = (int)hit.u;                    /* 0:-x 1:+x 2:-y 3:+y 4:-z 5:+z */
         float sign = (face & 1) ? 1.0f : -1.0f;
@@ -84,7 +84,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
         s.ns = s.ng;
         s.material = b.material;
         s.light = b.light;
-    } else if (id < first_plane) {
+    } else if (KF_HAS(KF_REVSURFACE) && id < first_plane) {
         /* (u, v) become the angle around the axis (0..1 from +x towards +z, as the
          * course's revolution turns) and the segment's parameter */
         RevSurface rs = sc->revsurfaces[id - first_rev];

@@ -213,7 +213,7 @@ KFN vec3 texture_eval(const SceneView *sc, uint index, Surface s, vec3 ng_face)
  * (principled) where it has one. */
 KFN vec3 material_emission(const SceneView *sc, Material m, Surface s)
 {
-    if (m.texture_emission == NO_INDEX) return m.emission;
+    if (!KF_HAS(KF_TEXTURES) || m.texture_emission == NO_INDEX) return m.emission;
     return v3_mul(m.emission, texture_eval(sc, m.texture_emission, s, s.ng));
 }
 
@@ -221,7 +221,7 @@ KFN vec3 material_emission(const SceneView *sc, Material m, Surface s)
  * times the vertex colour where the surface has one (glTF's COLOR_0). */
 KFN vec3 material_albedo(const SceneView *sc, Material m, Surface s, vec3 ng_face)
 {
-    vec3 a = m.texture == NO_INDEX ? m.albedo : texture_eval(sc, m.texture, s, ng_face);
+    vec3 a = !KF_HAS(KF_TEXTURES) || m.texture == NO_INDEX ? m.albedo : texture_eval(sc, m.texture, s, ng_face);
     float c[4];
     return surface_color(sc, s, c) ? v3_mul(a, v3(c[0], c[1], c[2])) : a;
 }
@@ -302,7 +302,8 @@ KFN vec3 material_normal(const SceneView *sc, Material m, Surface s)
 {
     vec3 t, b;
     vec3 n = s.ns;
-    if (m.type != MAT_PRINCIPLED || m.texture_normal == NO_INDEX || !normal_map_frame(sc, s, n, &t, &b))
+    if (!KF_HAS(KF_TEXTURES) || m.type != MAT_PRINCIPLED || m.texture_normal == NO_INDEX ||
+        !normal_map_frame(sc, s, n, &t, &b))
         return s.ns;
     vec3 c = texture_eval(sc, m.texture_normal, s, s.ng);
     vec3 tn = v3((2.0f * c.x - 1.0f) * m.normal_scale, (2.0f * c.y - 1.0f) * m.normal_scale, 2.0f * c.z - 1.0f);
@@ -318,7 +319,7 @@ KFN vec3 material_normal(const SceneView *sc, Material m, Surface s)
  * the texture is read as declared, so it should be `encoding linear`). */
 KFN Material material_at(const SceneView *sc, Material m, Surface s, vec3 ng_face)
 {
-    if (m.type == MAT_PRINCIPLED && m.texture_rm != NO_INDEX) {
+    if (KF_HAS(KF_TEXTURES) && MAT_IS(m, MAT_PRINCIPLED) && m.texture_rm != NO_INDEX) {
         vec3 t = texture_eval(sc, m.texture_rm, s, ng_face);
         m.roughness *= t.y;
         m.metallic *= t.z;

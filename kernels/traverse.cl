@@ -26,10 +26,11 @@ KFN_INLINE int trace_prim(const SceneView *sc, uint id, const RayPre *rp, Ray ra
     uint first_rev = first_box + pr->n_boxes;
     if ((id >= first_tri) & (id < first_box))
         return triangle_intersect(rp, &sc->triangles[id - first_tri], ray, hit);
-    if (id < first_tri)
+    if (KF_HAS(KF_SPHERES) && id < first_tri)
         return sphere_intersect(sc->spheres[id], ray, hit);
-    if (id < first_rev)
+    if (KF_HAS(KF_BOXES) && id < first_rev)
         return box_intersect(rp, sc->boxes[id - first_box], ray, hit);
+    if (!KF_HAS(KF_REVSURFACE)) return 0;
     return revsurface_intersect(sc->revsurfaces[id - first_rev], sc->rev_points, ray, hit);
 }
 
@@ -208,7 +209,7 @@ KFN Hit trace_closest(const SceneView *sc, Ray ray)
     best.v = 0.0f;
     RayPre rp = ray_prepare(ray);
     uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes + pr->n_revsurfaces;
-    for (uint i = 0; i < pr->n_planes; i++) {
+    for (uint i = 0; i < (KF_HAS(KF_PLANES) ? pr->n_planes : 0u); i++) {
         Ray r = ray;
         r.tmax = best.t;
         Hit h;
@@ -228,7 +229,7 @@ KFN Hit trace_any_hit(const SceneView *sc, Ray ray)
     GLOBAL const RenderParams *pr = sc->params;
     uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes + pr->n_revsurfaces;
     Hit h;
-    for (uint i = 0; i < pr->n_planes; i++)
+    for (uint i = 0; i < (KF_HAS(KF_PLANES) ? pr->n_planes : 0u); i++)
         if (plane_intersect(sc->planes[i], ray, &h)) {
             h.prim = first_plane + i;
             return h;
@@ -281,7 +282,7 @@ KFN_INLINE void trace_ray_begin(const SceneView *sc, Ray ray, int any, TraceRay 
     w->sp = 0;
     w->t0 = w->t1 = 0.0f;
     uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes + pr->n_revsurfaces;
-    for (uint i = 0; i < pr->n_planes; i++) {
+    for (uint i = 0; i < (KF_HAS(KF_PLANES) ? pr->n_planes : 0u); i++) {
         Ray r = ray;
         r.tmax = t->best.t;
         Hit h;

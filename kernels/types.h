@@ -27,6 +27,34 @@
  * keeps 2^31 samples of a pixel far from int64 overflow. */
 #define FILM_MAX_SAMPLE 65536.0f
 
+/* Kernel features: what one OpenCL program is compiled with (-D CLPT_FEATURES=<bits>,
+ * host/device/device_ocl.c derives them from the scene). Code for a feature the scene
+ * does not use is compiled out, which cuts the driver's compile time (LLVM's) by about
+ * half for a scene of diffuse materials; the bits are part of the kernel cache key.
+ * Each switch only removes code that the scene cannot reach, so images stay the same
+ * bit for bit. Without CLPT_FEATURES (the scalar C device, the tests' own builds)
+ * everything is compiled. */
+#define KF_PATH 0x1u            /* the path tracer's kernels (k_raygen ... k_film) */
+#define KF_WHITTED 0x2u         /* the classic ray tracer and the AOVs (k_whitted, k_film) */
+#define KF_TEXTURES 0x4u        /* a material reads a texture */
+#define KF_ALPHA 0x8u           /* a material is cut out (MAT_ALPHA_MASK or _BLEND) */
+#define KF_ENV_MAP 0x10u        /* background BG_MAP, with its light LIGHT_ENV */
+#define KF_CUBEMAP 0x20u        /* background BG_CUBEMAP */
+#define KF_REVSURFACE 0x40u     /* surfaces of revolution */
+#define KF_SPHERES 0x80u
+#define KF_BOXES 0x100u
+#define KF_PLANES 0x200u
+#define KF_DELTA_LIGHTS 0x400u  /* point, spot or directional lights */
+#define KF_MATERIAL(t) (0x800u << (t))  /* material type t (enum MaterialType) */
+#define KF_ALL 0x3ffffu         /* every bit above (material types 0 to 6) */
+#ifndef CLPT_FEATURES
+#define CLPT_FEATURES KF_ALL
+#endif
+/* Whether feature f is compiled in: a constant, so the compiler drops what is not. */
+#define KF_HAS(f) ((CLPT_FEATURES & (f)) != 0u)
+/* m.type == t, known false at compile time when no material of type t is compiled in. */
+#define MAT_IS(m, t) (KF_HAS(KF_MATERIAL(t)) && (m).type == (t))
+
 typedef struct { float x, y, z; } vec3;                 /* 12 bytes, align 4 */
 
 typedef struct {                                        /* 32 bytes */

@@ -478,6 +478,57 @@ static void test_log_shows_plain_progress(void)
     unlink("/tmp/clpt-test-log.png");
 }
 
+/* The number of kernel cache entries in `dir`. */
+static int cache_entries(const char *dir)
+{
+    char cmd[300];
+    snprintf(cmd, sizeof cmd, "ls %s | grep -c '\\.bin$'", dir);
+    FILE *p = popen(cmd, "r");
+    int n = -1;
+    if (p) {
+        if (fscanf(p, "%d", &n) != 1) n = -1;
+        pclose(p);
+    }
+    return n;
+}
+
+/* The path tracer and the whitted integrator are programs of their own, each built on
+ * first use (host/device/device_ocl.c): a path-tracer run stores one, the first whitted
+ * run builds (and announces) the other, and later runs of either load them. */
+static void test_kernel_programs_on_first_use(void)
+{
+    char cache[] = "/tmp/clpt-test-programs-XXXXXX";
+    if (!mkdtemp(cache)) return;
+    const char *saved = getenv("CLPT_CACHE_DIR");
+    char *old = saved ? strdup(saved) : NULL;
+    setenv("CLPT_CACHE_DIR", cache, 1);
+    const char *out = "/tmp/clpt-test-programs.png";
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--width", "8", "--height", "8", "--spp", "1", "-o",
+                 out), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_STR_CONTAINS(r.err, "clpt: compiling kernels for ");
+    CHECK_EQ_INT(cache_entries(cache), 1);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--width", "8", "--height", "8", "--spp", "1",
+                 "--integrator", "whitted", "-o", out), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_STR_CONTAINS(r.err, "clpt: compiling kernels for ");
+    CHECK_EQ_INT(cache_entries(cache), 2);
+    for (int whitted = 0; whitted < 2; whitted++) {
+        cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--width", "8", "--height", "8", "--spp", "1",
+                     "--integrator", whitted ? "whitted" : "path", "-o", out), &r);
+        CHECK_MSG(r.status == 0, "%s", r.err);
+        CHECK(strstr(r.err, "compiling kernels") == NULL);
+    }
+    CHECK_EQ_INT(cache_entries(cache), 2);
+    if (old) setenv("CLPT_CACHE_DIR", old, 1);
+    else unsetenv("CLPT_CACHE_DIR");
+    free(old);
+    char cmd[200];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", cache);
+    CHECK(system(cmd) == 0);
+    unlink(out);
+}
+
 /* the first build of the kernels for a device says so; a cache hit and -q do not */
 static void test_kernel_build_notice(void)
 {
@@ -636,6 +687,7 @@ int main(void)
     RUN(test_no_opencl_said_once_without_escapes);
     RUN(test_log_shows_plain_progress);
     RUN(test_kernel_build_notice);
+    RUN(test_kernel_programs_on_first_use);
     RUN(test_scene_from_pipe);
     RUN(test_named_files_must_be_regular);
     RUN(test_resume_from_fifo_refused);

@@ -616,6 +616,72 @@ static void test_kernel_argument_names(void)
     error_clear(&err);
 }
 
+/* Whether prog has a kernel named `name`. */
+static int has_kernel(cl_program prog, const char *name)
+{
+    cl_int rc;
+    cl_kernel k = clCreateKernel(prog, name, &rc);
+    if (rc != CL_SUCCESS) return 0;
+    clReleaseKernel(k);
+    return 1;
+}
+
+/* The device's two programs (kernels/entry.cl, CLPT_FEATURES): the path tracer's has
+ * no k_whitted and the whitted one none of the path tracer's kernels; both have k_film
+ * (what a cached program is checked for), neither k_layout (the tests' whole program
+ * has it). Built in the cache like the device builds them, so the second run of the
+ * suite loads them. */
+static void test_program_per_integrator(void)
+{
+    static const struct { unsigned features; const char *has[3], *lacks[3]; } programs[] = {
+        { KF_PATH, { "k_raygen", "k_shade", "k_film" }, { "k_whitted", "k_layout", NULL } },
+        { KF_WHITTED, { "k_whitted", "k_film", "k_film" }, { "k_shade", "k_raygen", "k_layout" } },
+    };
+    for (size_t i = 0; i < sizeof programs / sizeof programs[0]; i++) {
+        char options[64];
+        snprintf(options, sizeof options, "-D CLPT_FEATURES=0x%xu", programs[i].features);
+        Error err = {0};
+        cl_program prog = NULL;
+        CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, options, &prog, NULL, &err), ST_OK);
+        CHECK_MSG(prog != NULL, "%s: %s", options, err.msg);
+        error_clear(&err);
+        if (!prog) continue;
+        for (int k = 0; k < 3; k++)
+            CHECK_MSG(has_kernel(prog, programs[i].has[k]), "%s: no %s", options, programs[i].has[k]);
+        for (int k = 0; k < 3 && programs[i].lacks[k]; k++)
+            CHECK_MSG(!has_kernel(prog, programs[i].lacks[k]), "%s: has %s", options, programs[i].lacks[k]);
+        clReleaseProgram(prog);
+    }
+}
+
+/* Every feature switch of types.h, alone with either integrator, compiles without a
+ * warning: PoCL prints a build's warnings on stderr ("1 warning generated."), so a
+ * switch that leaves, say, a constant operand of || behind would show in every run of
+ * a scene without that feature. Checked with the system's clang as OpenCL C (fast: no
+ * code generation); skipped where there is none. */
+static void test_feature_switches_compile_cleanly(void)
+{
+    if (system("clang --version >/dev/null 2>&1") != 0) {
+        fprintf(stderr, "  (no clang: the feature switches were not compiled)\n");
+        return;
+    }
+    for (unsigned bit = 0; bit < 18; bit++) {
+        for (unsigned integrator = KF_PATH; integrator <= KF_WHITTED; integrator++) {
+            unsigned features = integrator | (1u << bit);
+            char cmd[300], out[2048];
+            snprintf(cmd, sizeof cmd, "clang -x cl -cl-std=CL1.2 -Xclang -finclude-default-header -fsyntax-only "
+                     "-Wall -Wextra -Ikernels -DCLPT_FEATURES=0x%xu kernels/entry.cl 2>&1", features);
+            FILE *p = popen(cmd, "r");
+            if (!p) continue;
+            size_t n = fread(out, 1, sizeof out - 1, p);
+            out[n] = '\0';
+            int rc = pclose(p);
+            CHECK_MSG(rc == 0 && n == 0, "CLPT_FEATURES=0x%x: %s", features, out);
+        }
+    }
+    CHECK_EQ_INT(KF_ALL, (KF_MATERIAL(MAT_PRINCIPLED) << 1) - 1u);
+}
+
 static void test_cache_location(void)
 {
     char saved_clpt[400], buf[1024];
@@ -758,6 +824,7 @@ int main(int argc, char **argv)
 
     RUN(test_error_names);
     RUN(test_sha256);
+    RUN(test_feature_switches_compile_cleanly);
 
     Error err = {0};
     if (ocl_enumerate(&devices, &n_devices, &err) != ST_OK)
@@ -777,6 +844,7 @@ int main(int argc, char **argv)
         RUN(test_corrupt_cache);
         RUN(test_crashing_cache_entry);
         RUN(test_kernel_argument_names);
+        RUN(test_program_per_integrator);
         RUN(test_cache_location);
         RUN(test_kernel_dir);
         RUN(test_build_failure);

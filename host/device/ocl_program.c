@@ -258,7 +258,7 @@ cleanup:
 
 /* Whether a program built from a cached binary is what clpt needs: built for the
  * device (clBuildProgram can succeed while the device's status says otherwise) and
- * holding the kernel every clpt program has. */
+ * holding k_film, the kernel every clpt program has. */
 static int oclp__usable(cl_program prog, const OclDeviceInfo *dev)
 {
     cl_build_status bs = CL_BUILD_NONE;
@@ -266,7 +266,7 @@ static int oclp__usable(cl_program prog, const OclDeviceInfo *dev)
         bs != CL_BUILD_SUCCESS)
         return 0;
     cl_int rc;
-    cl_kernel k = clCreateKernel(prog, "k_layout", &rc);
+    cl_kernel k = clCreateKernel(prog, "k_film", &rc);
     if (rc != CL_SUCCESS) return 0;
     clReleaseKernel(k);
     return 1;

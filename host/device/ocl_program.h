@@ -10,7 +10,8 @@
  *
  * Build options are always "-cl-std=CL1.2", plus "-cl-fp32-correctly-rounded-divide-sqrt"
  * when the device supports it (the scalar C device computes IEEE-rounded / and sqrt, and
- * the two must give the same bits), plus the caller's extra options. Never
+ * the two must give the same bits), plus the caller's extra options (the device passes
+ * -D CLPT_FEATURES=..., which selects the kernels and the code compiled: types.h). Never
  * -cl-fast-relaxed-math or -cl-mad-enable, for the same reason.
  *
  * The cache: one file per (source, device, driver, options), named by the SHA-256 of all
@@ -19,11 +20,18 @@
  * device's CL_PROGRAM_BINARIES. Files are written to a temporary name in the same folder
  * and renamed, so a concurrent run sees either no file or a whole one. Anything wrong
  * with an entry (truncated, corrupt, refused by the driver, or a program that did not
- * build for the device or lacks clpt's kernels) deletes it and the program is rebuilt
+ * build for the device or lacks clpt's kernel k_film) deletes it and the program is rebuilt
  * from source and stored again. While the driver reads an entry it is moved aside, so
  * an entry the driver crashes on is gone for the next run, which compiles afresh past
  * whatever the driver kept of it (ocl_program.c, oclp__cache_load). A cache that cannot
  * be created or written only means building from source: it never fails a run.
+ *
+ * Storing an entry reads CL_PROGRAM_BINARIES right after the build, which makes PoCL 3.1
+ * compile every kernel of the program (a work-group function for any local size) on top
+ * of the compile of each kernel at its first launch. That is why the device keeps its
+ * programs small (device_ocl.c). Doing the read-back in a thread of its own while the
+ * render starts gains nothing there: PoCL compiles one kernel at a time per process
+ * (bench/RESULTS.md, start-up).
  */
 #ifndef CLPT_OCL_PROGRAM_H
 #define CLPT_OCL_PROGRAM_H

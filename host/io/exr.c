@@ -186,7 +186,7 @@ static int exr_value_fits(FILE *f, const char *type, uint64_t n)
  * name each attribute once: OpenEXRCore and the library keep different ones of a
  * repeated name (a second dataWindow slipped past the size checks). One pass over the
  * header(s); only the names are kept. */
-static Status exr_header_check(const char *path, Error *err)
+static Status exr_header_check(const char *path, const exr_attr_box2i_t *core_dw, Error *err)
 {
     FILE *f = fopen(path, "rb");
     if (!f) return ST_OK;   /* the readers report it */
@@ -200,6 +200,8 @@ static Status exr_header_check(const char *path, Error *err)
     Status st = ST_OK;
     char name[256], type[256];
     StrMap seen = { 0 };
+    int part = 0, have_dw = 0;
+    int32_t dw[4] = { 0, 0, 0, 0 };
     while (!st) {
         if (!exr_read_name(f, name)) break;
         int added = name[0] ? strmap_add(&seen, name, strlen(name), 0) : 0;
@@ -215,6 +217,7 @@ static Status exr_header_check(const char *path, Error *err)
         if (name[0] == '\0') {
             strmap_free(&seen);
             memset(&seen, 0, sizeof seen);
+            part++;
             /* the end of a header: the only one, or in a multi-part file the next one's
              * start, unless that is empty too (the end of the list) */
             if (!multipart) break;
@@ -234,12 +237,25 @@ static Status exr_header_check(const char *path, Error *err)
                            (unsigned long long)(size - at));
             break;
         }
+        if (part == 0 && strcmp(name, "dataWindow") == 0 && strcmp(type, "box2i") == 0 && n == 16) {
+            unsigned char b[16];
+            if (fread(b, 1, 16, f) != 16 || fseek(f, -16, SEEK_CUR) != 0) break;
+            for (int k = 0; k < 4; k++) dw[k] = (int32_t)exr_le32(b + 4 * k);
+            have_dw = 1;
+        }
         if (!exr_value_fits(f, type, n))
             st = error_set(err, ST_INPUT, "'%s': the EXR header attribute '%s' of type '%s' does not hold the %llu "
                            "bytes it declares (a corrupt file)", path, name, type, (unsigned long long)n);
     }
     strmap_free(&seen);
     fclose(f);
+    /* The library sizes its line buffers from the first header's dataWindow as it reads
+     * it in order; OpenEXRCore may have taken another one from a garbled header (a
+     * 1 GB line buffer for a 455-byte file, found by fuzz_texture). Both must agree. */
+    if (!st && (!have_dw || dw[0] != core_dw->min.x || dw[1] != core_dw->min.y || dw[2] != core_dw->max.x ||
+                dw[3] != core_dw->max.y))
+        st = error_set(err, ST_INPUT, "'%s': the EXR header's dataWindow is missing or read two ways (a corrupt file)",
+                       path);
     return st;
 }
 
@@ -340,7 +356,7 @@ Status exr_read_rgb(const char *path, uint64_t max_pixels, float **rgb, int *wid
         if (w > INT32_MAX || h > INT32_MAX) w = h = 0;
         st = exr_check_part(ctxt, path, max_pixels, pick, (int)w, (int)h, err);
     }
-    if (!st) st = exr_header_check(path, err);
+    if (!st) st = exr_header_check(path, &dw, err);
     float *px = NULL;
     if (!st && !(px = calloc((size_t)w * (size_t)h * 3u, sizeof *px)))
         st = error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);

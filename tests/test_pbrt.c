@@ -200,6 +200,51 @@ static void test_warnings(void)
     scene_free(&s);
 }
 
+/* ActiveTransform takes a bare word (pbrt-v4's killeroo-moving.pbrt); clpt has no motion
+ * blur and keeps the StartTime pose: transforms while only EndTime is active are skipped,
+ * AttributeEnd restores the setting and WorldBegin makes all transforms active. */
+static void test_active_transform(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text("ActiveTransform EndTime\n"
+                           "Translate 0 0 100\n"
+                           "WorldBegin\n"
+                           "AttributeBegin\n"
+                           "  ActiveTransform StartTime\n"
+                           "  Translate 1 0 0\n"
+                           "  ActiveTransform EndTime\n"
+                           "  Translate 10 0 0\n"
+                           "  ActiveTransform All\n"
+                           "  Translate 0 2 0\n"
+                           "  Shape \"sphere\"\n"
+                           "  AttributeBegin\n"
+                           "    ActiveTransform EndTime\n"
+                           "  AttributeEnd\n"
+                           "  Translate 0 0 3\n"
+                           "  Shape \"sphere\"\n"
+                           "AttributeEnd\n"
+                           "Shape \"sphere\"\n",
+                           &s, &err),
+                 ST_OK);
+    CHECK_EQ_INT(s.n_spheres, 3);
+    if (s.n_spheres == 3) {
+        CHECK_V3(s.spheres[0].center, 1, 2, 0, 0);
+        CHECK_V3(s.spheres[1].center, 1, 2, 3, 0);
+        CHECK_V3(s.spheres[2].center, 0, 0, 0, 0);
+    }
+    CHECK_EQ_INT(s.n_warnings, 1);
+    if (s.n_warnings >= 1)
+        CHECK_MSG(strstr(s.warnings[0], "ActiveTransform: motion blur is not supported") != NULL, "got '%s'",
+                  s.warnings[0]);
+    scene_free(&s);
+    /* anything but the three words is an error */
+    Status st = load_text("WorldBegin\nActiveTransform \"StartTime\"\n", &s, &err);
+    CHECK_EQ_INT(st, ST_INPUT);
+    CHECK_MSG(strstr(err.msg, "StartTime, EndTime or All") != NULL, "got '%s'", err.msg);
+    scene_free(&s);
+}
+
 static void test_include(void)
 {
     Scene s;
@@ -842,6 +887,7 @@ int main(void)
     RUN(test_transforms);
     RUN(test_materials_lights);
     RUN(test_warnings);
+    RUN(test_active_transform);
     RUN(test_include);
     RUN(test_instances);
     RUN(test_orientation);

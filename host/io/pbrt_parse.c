@@ -61,6 +61,7 @@ typedef struct {
     vec3 area_L;
     int area_twosided;
     uint area_material;      /* material + emission, made on first use */
+    int end_time_only;       /* ActiveTransform EndTime: transforms move the shutter-close pose only */
 } GState;
 
 typedef struct {
@@ -783,6 +784,7 @@ static Status d_world_begin(Parser *p, Lexer *lx, const Token *kw)
     if (p->world) return lex_error_at(lx, kw, p->err, "WorldBegin given twice");
     p->world = 1;
     p->g.ctm = transform_identity();
+    p->g.end_time_only = 0; /* pbrt-v4's WorldBegin makes all transforms active again */
     Token t = {TOK_STRING, "world", 5, kw->line, kw->col};
     uint32_t i;
     if (!strmap_find(&p->coordsys, t.text, t.len, &i)) {
@@ -2052,6 +2054,29 @@ static Status d_unsupported(Parser *p, Lexer *lx, const Token *kw)
     return warn_once(p, lx, kw, key, "%s is not supported; ignored", key);
 }
 
+/* ActiveTransform StartTime | EndTime | All (a bare word, not a string). clpt has no
+ * motion blur: it renders the shutter-open pose, so a transform directive given while
+ * only EndTime is active leaves the transform as it is. AttributeBegin/End keep the
+ * setting with the rest of the graphics state, as pbrt-v4's does. */
+static Status d_active_transform(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token t;
+    Status st = next_token(p, lx, &t);
+    if (st) return st;
+    if (t.kind == TOK_WORD && tok_eq(&t, "StartTime"))
+        p->g.end_time_only = 0;
+    else if (t.kind == TOK_WORD && tok_eq(&t, "All"))
+        p->g.end_time_only = 0;
+    else if (t.kind == TOK_WORD && tok_eq(&t, "EndTime"))
+        p->g.end_time_only = 1;
+    else
+        return lex_expected(lx, &t, "StartTime, EndTime or All (ActiveTransform)", p->err);
+    return warn_once(p, lx, kw, "ActiveTransform",
+                     "ActiveTransform: motion blur is not supported; the StartTime (shutter-open) transform is used");
+}
+
+static int is_transform_directive(Status (*fn)(Parser *, Lexer *, const Token *));
+
 static Status d_ignored(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)p; (void)lx; (void)kw;
@@ -2096,7 +2121,7 @@ static const struct {
     {"Option", d_unsupported},
     {"Accelerator", d_unsupported},
     {"TransformTimes", d_unsupported},
-    {"ActiveTransform", d_unsupported},
+    {"ActiveTransform", d_active_transform},
     {"MakeNamedMedium", d_unsupported},
     {"MediumInterface", d_unsupported},
     {"Attribute", d_unsupported},
@@ -2131,10 +2156,19 @@ static Status parse_statements(Parser *p, Lexer *lx)
             st = lex_error_at(lx, &t, p->err, "%s must come before WorldBegin", directives[i].name);
             break;
         }
+        Transform before = p->g.ctm;
         if ((st = directives[i].fn(p, lx, &t))) break;
+        if (p->g.end_time_only && is_transform_directive(directives[i].fn)) p->g.ctm = before;
     }
     p->has_peek = 0;
     return st;
+}
+
+/* the directives that change the current transform (ActiveTransform EndTime skips them) */
+static int is_transform_directive(Status (*fn)(Parser *, Lexer *, const Token *))
+{
+    return fn == d_translate || fn == d_scale || fn == d_rotate || fn == d_lookat || fn == d_transform ||
+           fn == d_concat || fn == d_coordsys_transform || fn == d_identity;
 }
 
 static Status parse_file(Parser *p, const char *path, const char *text, size_t len)

@@ -245,6 +245,27 @@ static void test_active_transform(void)
     scene_free(&s);
 }
 
+/* Material "" and "none" are pbrt-v4's "no material" (a medium's boundary, as
+ * "interface"; pbrt-v4-scenes' clouds.pbrt): the invisible index-1 glass, no warning */
+static void test_no_material(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text("WorldBegin\n"
+                           "Material \"\" Shape \"sphere\"\n"
+                           "Material \"none\" Shape \"sphere\"\n",
+                           &s, &err),
+                 ST_OK);
+    CHECK_EQ_INT(s.n_spheres, 2);
+    for (size_t i = 0; i < 2 && i < s.n_spheres; i++) {
+        const Material *m = &s.materials[s.spheres[i].material];
+        CHECK_EQ_INT(m->type, MAT_DIELECTRIC);
+        CHECK_NEAR(m->ior, 1, 0);
+    }
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+}
+
 static void test_include(void)
 {
     Scene s;
@@ -888,6 +909,7 @@ int main(void)
     RUN(test_materials_lights);
     RUN(test_warnings);
     RUN(test_active_transform);
+    RUN(test_no_material);
     RUN(test_include);
     RUN(test_instances);
     RUN(test_orientation);

@@ -1048,8 +1048,10 @@ static Status make_material(Parser *p, const Lexer *lx, const Token *type, Mater
         m->clearcoat_roughness = coat.roughness;
         param_find(p, "thickness");   /* the coat has no thickness in clpt */
         st = ST_OK;
-    } else if (tok_eq(type, "interface")) {
-        /* an invisible boundary (a medium's edge): glass of index 1 passes light unbent */
+    } else if (tok_eq(type, "interface") || tok_eq(type, "") || tok_eq(type, "none")) {
+        /* an invisible boundary (a medium's edge): glass of index 1 passes light unbent.
+         * pbrt-v4 makes no material for "" and "none" either (MaterialHandle::Create),
+         * as pbrt-v4-scenes' clouds.pbrt uses: Material "" on its medium's sphere. */
         *m = material_dielectric(1.0f);
         st = ST_OK;
     } else if (tok_eq(type, "mix")) {

@@ -266,6 +266,44 @@ static void test_no_material(void)
     scene_free(&s);
 }
 
+static void expect_error(const char *text, const char *msg);
+
+/* NamedMaterial before its MakeNamedMaterial, as pbrt-v4 allows (it resolves names once
+ * the scene is read; pbrt-v4-scenes' contemporary-bathroom.pbrt includes materials.pbrt
+ * last): the shapes, and an area light's copy, take the later definition. A mix may not
+ * name a material before it is defined (pbrt-v4 creates mixes in order, too). */
+static void test_named_material_later(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text("WorldBegin\n"
+                           "AttributeBegin\n"
+                           "  NamedMaterial \"light\"\n"
+                           "  AreaLightSource \"diffuse\" \"rgb L\" [ 2 2 2 ] \"bool twosided\" true\n"
+                           "  Shape \"sphere\"\n"
+                           "AttributeEnd\n"
+                           "NamedMaterial \"light\"\n"
+                           "Translate 3 0 0 Shape \"sphere\"\n"
+                           "MakeNamedMaterial \"light\" \"string type\" \"conductor\"\n",
+                           &s, &err),
+                 ST_OK);
+    CHECK_EQ_INT(s.n_spheres, 2);
+    if (s.n_spheres == 2) {
+        const Material *lit = &s.materials[s.spheres[0].material];
+        const Material *plain = &s.materials[s.spheres[1].material];
+        CHECK_EQ_INT(lit->type, MAT_CONDUCTOR);
+        CHECK(lit->emission.x > 0);
+        CHECK(lit->flags & MAT_TWO_SIDED);
+        CHECK_EQ_INT(plain->type, MAT_CONDUCTOR);
+        CHECK(v3_is_zero(plain->emission));
+    }
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+    expect_error("WorldBegin\nNamedMaterial \"a\"\n"
+                 "MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"a\" \"a\"]\n",
+                 DIR "inline.pbrt:3:63: material 'a' is not defined (MakeNamedMaterial defines it)");
+}
+
 static void test_include(void)
 {
     Scene s;
@@ -278,8 +316,6 @@ static void test_include(void)
     CHECK_MSG(strstr(err.msg, "includes nested more than 16 deep") != NULL, "got '%s'", err.msg);
     scene_free(&s);
 }
-
-static void expect_error(const char *text, const char *msg);
 
 static void test_instances(void)
 {
@@ -388,7 +424,8 @@ static void test_errors(void)
                  "AttributeBegin, ...), found 'Shapes'");
     expect_error("AttributeEnd", DIR "inline.pbrt:1:1: AttributeEnd without a matching begin");
     expect_error("NamedMaterial \"gold\"",
-                 DIR "inline.pbrt:1:15: material 'gold' is not defined (MakeNamedMaterial defines it)");
+                 DIR "inline.pbrt:1:15: material 'gold' is used by NamedMaterial and never defined "
+                 "(MakeNamedMaterial defines it)");
     expect_error("WorldBegin\nCamera \"perspective\"", DIR "inline.pbrt:2:1: Camera must come before WorldBegin");
     expect_error("Translate 1 x 3", DIR "inline.pbrt:1:13: expected a number (Translate x y z), found 'x'");
     expect_error("Shape \"sphere\" \"float radius\" nan",
@@ -910,6 +947,7 @@ int main(void)
     RUN(test_warnings);
     RUN(test_active_transform);
     RUN(test_no_material);
+    RUN(test_named_material_later);
     RUN(test_include);
     RUN(test_instances);
     RUN(test_orientation);

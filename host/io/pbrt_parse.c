@@ -73,6 +73,13 @@ typedef struct {
                               * what stands in where only a constant fits */
 } PTexture;
 
+/* A material named by NamedMaterial and not yet defined: where it was first used. */
+typedef struct {
+    uint index;
+    int defined;
+    char where[160];   /* "path:line:col: material 'name'" for the error at the end */
+} PPending;
+
 /* An ObjectBegin/End's shapes, taken out of the scene and copied in at each instance. */
 typedef struct {
     Sphere *spheres;      size_t n_spheres;
@@ -90,6 +97,11 @@ typedef struct {
     GState g;
     GState *stack;  size_t n_stack, cap_stack;
     StrMap named_material;   /* name -> material index */
+    /* NamedMaterial before its MakeNamedMaterial (pbrt-v4 resolves names after the whole
+     * file): a diffuse placeholder, replaced in place when the definition comes */
+    PPending *pending;  size_t n_pending, cap_pending;
+    /* area-light copies of a placeholder (material + emission), patched with it */
+    struct { uint area, base; } *area_of_pending;  size_t n_area_pending, cap_area_pending;
     StrMap coordsys;         /* name -> index into coordsys_xf */
     Transform *coordsys_xf;  size_t n_coordsys, cap_coordsys;
     StrMap tex_by_name;      /* name -> index into tex */
@@ -968,6 +980,13 @@ static Status texture_of(Parser *p, const Lexer *lx, const char *name, vec3 *alb
     return ST_OK;
 }
 
+static PPending *pending_of(Parser *p, uint index)
+{
+    for (size_t i = 0; i < p->n_pending; i++)
+        if (p->pending[i].index == index && !p->pending[i].defined) return &p->pending[i];
+    return NULL;
+}
+
 /* pbrt's mix: its two named materials (defined before it, so a mix never contains
  * itself) and `amount`, a float or a float texture (an image's red channel), chosen per
  * hit by the kernels (kernels/mix.h). */
@@ -979,7 +998,7 @@ static Status make_mix(Parser *p, const Lexer *lx, const Token *type, Material *
     uint32_t parts[2];
     for (int i = 0; i < 2; i++) {
         const Token *named = &p->pl.strs[pa->first + i];
-        if (!strmap_find(&p->named_material, named->text, named->len, &parts[i]))
+        if (!strmap_find(&p->named_material, named->text, named->len, &parts[i]) || pending_of(p, parts[i]))
             return lex_error_at(lx, named, p->err, "material '%.*s' is not defined (MakeNamedMaterial defines it)",
                                 (int)(named->len > 40 ? 40 : named->len), named->text);
     }
@@ -1103,6 +1122,21 @@ static Status d_make_named_material(Parser *p, Lexer *lx, const Token *kw)
     Material m;
     if ((st = make_material(p, lx, type, &m, "MakeNamedMaterial"))) return st;
     uint index;
+    PPending *pd;
+    if (strmap_find(&p->named_material, name.text, name.len, &index) && (pd = pending_of(p, index))) {
+        /* used before: the placeholder and its area-light copies become this material */
+        pd->defined = 1;
+        for (size_t i = 0; i < p->n_area_pending; i++) {
+            if (p->area_of_pending[i].base != index) continue;
+            Material *a = &p->s->materials[p->area_of_pending[i].area];
+            Material e = m;
+            e.emission = a->emission;
+            e.flags |= a->flags & MAT_TWO_SIDED;
+            *a = e;
+        }
+        p->s->materials[index] = m;
+        return ST_OK;
+    }
     char *n = tok_copy(&name);
     if (!n) return error_set(p->err, ST_INTERNAL, "out of memory");
     st = scene_add_material(p->s, n, m, &index, p->err);
@@ -1117,9 +1151,27 @@ static Status d_named_material(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token name;
+    Status st = expect_string(p, lx, "a quoted material name", &name);
+    if (st) return st;
     uint32_t i;
-    Status st = expect_defined(p, lx, &p->named_material, "material", "MakeNamedMaterial", &name, &i);
-    return st ? st : set_material(p, i);
+    if (strmap_find(&p->named_material, name.text, name.len, &i)) return set_material(p, i);
+    /* not defined yet: pbrt-v4 looks names up once the whole scene is read, so a
+     * later MakeNamedMaterial (pbrt-v4-scenes' contemporary-bathroom.pbrt includes its
+     * materials.pbrt at the end) defines it; a placeholder until then */
+    char *n = tok_copy(&name);
+    if (!n) return error_set(p->err, ST_INTERNAL, "out of memory");
+    st = scene_add_material(p->s, n, material_diffuse(v3(0.5f, 0.5f, 0.5f)), &i, p->err);
+    free(n);
+    if (st) return st;
+    if (strmap_set(&p->named_material, name.text, name.len, i) ||
+        grow((void **)&p->pending, &p->cap_pending, p->n_pending + 1, sizeof(PPending)))
+        return error_set(p->err, ST_INTERNAL, "out of memory");
+    PPending *pd = &p->pending[p->n_pending++];
+    pd->index = i;
+    pd->defined = 0;
+    snprintf(pd->where, sizeof pd->where, "%s:%u:%u: material '%.*s'", lx->path, name.line, name.col,
+             (int)(name.len > 40 ? 40 : name.len), name.text);
+    return set_material(p, i);
 }
 
 /* A file a parameter names, found as pbrt finds it: a relative path from the main
@@ -1363,6 +1415,7 @@ static Status d_texture(Parser *p, Lexer *lx, const Token *kw)
 static Status shape_material(Parser *p, uint *out)
 {
     Status st;
+    *out = NO_INDEX;
     if (p->g.material == NO_INDEX) {
         uint i;
         if ((st = scene_add_material(p->s, "", material_diffuse(v3(0.5f, 0.5f, 0.5f)), &i, p->err))) return st;
@@ -1379,6 +1432,13 @@ static Status shape_material(Parser *p, uint *out)
         uint i;
         if ((st = scene_add_material(p->s, "", m, &i, p->err))) return st;
         p->g.area_material = i;
+        if (pending_of(p, p->g.material)) {
+            if (grow((void **)&p->area_of_pending, &p->cap_area_pending, p->n_area_pending + 1,
+                     sizeof *p->area_of_pending))
+                return error_set(p->err, ST_INTERNAL, "out of memory");
+            p->area_of_pending[p->n_area_pending].area = i;
+            p->area_of_pending[p->n_area_pending++].base = p->g.material;
+        }
     }
     *out = p->g.area_material;
     return ST_OK;
@@ -2266,9 +2326,15 @@ Status pbrt_load_text(const char *path, const char *text, size_t len, Scene *s, 
     s->image.max_depth = 5;
     Status st = parse_file(&p, path, text, len);
     if (!st && p.in_object) st = error_set(err, ST_INPUT, "%s: ObjectBegin \"%s\" has no ObjectEnd", path, p.obj_name_buf);
+    for (size_t i = 0; !st && i < p.n_pending; i++)
+        if (!p.pending[i].defined)
+            st = error_set(err, ST_INPUT, "%s is used by NamedMaterial and never defined (MakeNamedMaterial defines it)",
+                           p.pending[i].where);
     if (!st) st = finish_camera(&p);
     if (!st) st = scene_check_precision(s, err);
     free(p.stack);
+    free(p.pending);
+    free(p.area_of_pending);
     free(p.coordsys_xf);
     free(p.tex);
     free(p.pl.p);

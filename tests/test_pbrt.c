@@ -427,6 +427,9 @@ static void test_errors(void)
                  DIR "inline.pbrt:1:15: material 'gold' is used by NamedMaterial and never defined "
                  "(MakeNamedMaterial defines it)");
     expect_error("WorldBegin\nCamera \"perspective\"", DIR "inline.pbrt:2:1: Camera must come before WorldBegin");
+    expect_error("Include \"geometry/curves.pbrt.gz\"",
+                 DIR "inline.pbrt:1:9: a gzip-compressed include ('geometry/curves.pbrt.gz') is not supported; "
+                 "gunzip it");
     expect_error("Translate 1 x 3", DIR "inline.pbrt:1:13: expected a number (Translate x y z), found 'x'");
     expect_error("Shape \"sphere\" \"float radius\" nan",
                  DIR "inline.pbrt:1:31: expected a finite number, found 'nan'");

@@ -874,6 +874,25 @@ static void test_checkerboard_scale(void)
         CHECK_MSG(strcmp(s.warnings[0], DIR "inline.pbrt:2: a checkerboard's \"tex1\" is a texture: its mean colour "
                          "is used") == 0, "got '%s'", s.warnings[0]);
     scene_free(&s);
+    /* pbrt-v4's wrap: repeat is clpt's own, clamp its clamp to the edge, black a warning */
+    CHECK_EQ_INT(load_text("Texture \"r\" \"spectrum\" \"imagemap\" \"string filename\" \"tiny.png\" "
+                           "\"string wrap\" \"repeat\"\n"
+                           "Texture \"c\" \"spectrum\" \"imagemap\" \"string filename\" \"tiny.png\" "
+                           "\"string wrap\" \"clamp\"\n"
+                           "Texture \"b\" \"spectrum\" \"imagemap\" \"string filename\" \"tiny.png\" "
+                           "\"string wrap\" \"black\"\n",
+                           &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_textures, 3);
+    if (s.n_textures == 3) {
+        CHECK_EQ_INT(s.textures[0].flags & TEX_CLAMP, 0);
+        CHECK_EQ_INT(s.textures[1].flags & TEX_CLAMP, TEX_CLAMP);
+        CHECK_EQ_INT(s.textures[2].flags & TEX_CLAMP, 0);
+    }
+    CHECK_EQ_INT(s.n_warnings, 1);
+    if (s.n_warnings == 1)
+        CHECK_MSG(strcmp(s.warnings[0], DIR "inline.pbrt:3: texture wrap \"black\" is not supported; repeat is "
+                         "used") == 0, "got '%s'", s.warnings[0]);
+    scene_free(&s);
     expect_error("Texture \"c\" \"float\" \"checkerboard\" \"integer dimension\" 4",
                  DIR "inline.pbrt:1:36: parameter 'dimension' must be 2 or 3");
     expect_error("Texture \"c\" \"float\" \"scale\" \"texture tex\" \"nope\"",

@@ -1247,9 +1247,18 @@ static Status tex_imagemap(Parser *p, const Lexer *lx, const Token *cls, PTextur
     if (!f) return lex_error_at(lx, cls, p->err, "an imagemap texture needs \"string filename\"");
     if ((st = get_string(p, lx, "encoding", &enc))) return st;
     int linear = enc && tok_eq(enc, "linear");
+    /* pbrt-v4's wrap: "repeat" (its default, and clpt's), "clamp" (clpt's clamp to the
+     * edge); "black" and "octahedralsphere" a warning and repeat */
+    const Token *wrap = NULL;
+    if ((st = get_string(p, lx, "wrap", &wrap))) return st;
+    int clamp = wrap && tok_eq(wrap, "clamp");
+    if (wrap && !clamp && !tok_eq(wrap, "repeat") &&
+        (st = warn_once(p, lx, wrap, "texture-wrap", "texture wrap \"%.*s\" is not supported; repeat is used",
+                        (int)(wrap->len > 40 ? 40 : wrap->len), wrap->text)))
+        return st;
     char *path = beside_main(p, f);
     if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
-    st = texture_load_image(p->s, NULL, path, linear, 0, &t->index, p->err);
+    st = texture_load_image(p->s, NULL, path, linear, clamp, &t->index, p->err);
     free(path);
     if (st) {
         error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);

@@ -61,6 +61,7 @@ typedef struct {
     vec3 area_L;
     int area_twosided;
     uint area_material;      /* material + emission, made on first use */
+    int end_time_only;       /* ActiveTransform EndTime: transforms move the shutter-close pose only */
 } GState;
 
 typedef struct {
@@ -71,6 +72,13 @@ typedef struct {
     vec3 mean;               /* the texture's mean colour (a constant's is its colour):
                               * what stands in where only a constant fits */
 } PTexture;
+
+/* A material named by NamedMaterial and not yet defined: where it was first used. */
+typedef struct {
+    uint index;
+    int defined;
+    char where[160];   /* "path:line:col: material 'name'" for the error at the end */
+} PPending;
 
 /* An ObjectBegin/End's shapes, taken out of the scene and copied in at each instance. */
 typedef struct {
@@ -89,6 +97,11 @@ typedef struct {
     GState g;
     GState *stack;  size_t n_stack, cap_stack;
     StrMap named_material;   /* name -> material index */
+    /* NamedMaterial before its MakeNamedMaterial (pbrt-v4 resolves names after the whole
+     * file): a diffuse placeholder, replaced in place when the definition comes */
+    PPending *pending;  size_t n_pending, cap_pending;
+    /* area-light copies of a placeholder (material + emission), patched with it */
+    struct { uint area, base; } *area_of_pending;  size_t n_area_pending, cap_area_pending;
     StrMap coordsys;         /* name -> index into coordsys_xf */
     Transform *coordsys_xf;  size_t n_coordsys, cap_coordsys;
     StrMap tex_by_name;      /* name -> index into tex */
@@ -783,6 +796,7 @@ static Status d_world_begin(Parser *p, Lexer *lx, const Token *kw)
     if (p->world) return lex_error_at(lx, kw, p->err, "WorldBegin given twice");
     p->world = 1;
     p->g.ctm = transform_identity();
+    p->g.end_time_only = 0; /* pbrt-v4's WorldBegin makes all transforms active again */
     Token t = {TOK_STRING, "world", 5, kw->line, kw->col};
     uint32_t i;
     if (!strmap_find(&p->coordsys, t.text, t.len, &i)) {
@@ -966,6 +980,13 @@ static Status texture_of(Parser *p, const Lexer *lx, const char *name, vec3 *alb
     return ST_OK;
 }
 
+static PPending *pending_of(Parser *p, uint index)
+{
+    for (size_t i = 0; i < p->n_pending; i++)
+        if (p->pending[i].index == index && !p->pending[i].defined) return &p->pending[i];
+    return NULL;
+}
+
 /* pbrt's mix: its two named materials (defined before it, so a mix never contains
  * itself) and `amount`, a float or a float texture (an image's red channel), chosen per
  * hit by the kernels (kernels/mix.h). */
@@ -977,7 +998,7 @@ static Status make_mix(Parser *p, const Lexer *lx, const Token *type, Material *
     uint32_t parts[2];
     for (int i = 0; i < 2; i++) {
         const Token *named = &p->pl.strs[pa->first + i];
-        if (!strmap_find(&p->named_material, named->text, named->len, &parts[i]))
+        if (!strmap_find(&p->named_material, named->text, named->len, &parts[i]) || pending_of(p, parts[i]))
             return lex_error_at(lx, named, p->err, "material '%.*s' is not defined (MakeNamedMaterial defines it)",
                                 (int)(named->len > 40 ? 40 : named->len), named->text);
     }
@@ -1046,8 +1067,10 @@ static Status make_material(Parser *p, const Lexer *lx, const Token *type, Mater
         m->clearcoat_roughness = coat.roughness;
         param_find(p, "thickness");   /* the coat has no thickness in clpt */
         st = ST_OK;
-    } else if (tok_eq(type, "interface")) {
-        /* an invisible boundary (a medium's edge): glass of index 1 passes light unbent */
+    } else if (tok_eq(type, "interface") || tok_eq(type, "") || tok_eq(type, "none")) {
+        /* an invisible boundary (a medium's edge): glass of index 1 passes light unbent.
+         * pbrt-v4 makes no material for "" and "none" either (MaterialHandle::Create),
+         * as pbrt-v4-scenes' clouds.pbrt uses: Material "" on its medium's sphere. */
         *m = material_dielectric(1.0f);
         st = ST_OK;
     } else if (tok_eq(type, "mix")) {
@@ -1099,6 +1122,21 @@ static Status d_make_named_material(Parser *p, Lexer *lx, const Token *kw)
     Material m;
     if ((st = make_material(p, lx, type, &m, "MakeNamedMaterial"))) return st;
     uint index;
+    PPending *pd;
+    if (strmap_find(&p->named_material, name.text, name.len, &index) && (pd = pending_of(p, index))) {
+        /* used before: the placeholder and its area-light copies become this material */
+        pd->defined = 1;
+        for (size_t i = 0; i < p->n_area_pending; i++) {
+            if (p->area_of_pending[i].base != index) continue;
+            Material *a = &p->s->materials[p->area_of_pending[i].area];
+            Material e = m;
+            e.emission = a->emission;
+            e.flags |= a->flags & MAT_TWO_SIDED;
+            *a = e;
+        }
+        p->s->materials[index] = m;
+        return ST_OK;
+    }
     char *n = tok_copy(&name);
     if (!n) return error_set(p->err, ST_INTERNAL, "out of memory");
     st = scene_add_material(p->s, n, m, &index, p->err);
@@ -1113,9 +1151,27 @@ static Status d_named_material(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token name;
+    Status st = expect_string(p, lx, "a quoted material name", &name);
+    if (st) return st;
     uint32_t i;
-    Status st = expect_defined(p, lx, &p->named_material, "material", "MakeNamedMaterial", &name, &i);
-    return st ? st : set_material(p, i);
+    if (strmap_find(&p->named_material, name.text, name.len, &i)) return set_material(p, i);
+    /* not defined yet: pbrt-v4 looks names up once the whole scene is read, so a
+     * later MakeNamedMaterial (pbrt-v4-scenes' contemporary-bathroom.pbrt includes its
+     * materials.pbrt at the end) defines it; a placeholder until then */
+    char *n = tok_copy(&name);
+    if (!n) return error_set(p->err, ST_INTERNAL, "out of memory");
+    st = scene_add_material(p->s, n, material_diffuse(v3(0.5f, 0.5f, 0.5f)), &i, p->err);
+    free(n);
+    if (st) return st;
+    if (strmap_set(&p->named_material, name.text, name.len, i) ||
+        grow((void **)&p->pending, &p->cap_pending, p->n_pending + 1, sizeof(PPending)))
+        return error_set(p->err, ST_INTERNAL, "out of memory");
+    PPending *pd = &p->pending[p->n_pending++];
+    pd->index = i;
+    pd->defined = 0;
+    snprintf(pd->where, sizeof pd->where, "%s:%u:%u: material '%.*s'", lx->path, name.line, name.col,
+             (int)(name.len > 40 ? 40 : name.len), name.text);
+    return set_material(p, i);
 }
 
 /* A file a parameter names, found as pbrt finds it: a relative path from the main
@@ -1191,9 +1247,18 @@ static Status tex_imagemap(Parser *p, const Lexer *lx, const Token *cls, PTextur
     if (!f) return lex_error_at(lx, cls, p->err, "an imagemap texture needs \"string filename\"");
     if ((st = get_string(p, lx, "encoding", &enc))) return st;
     int linear = enc && tok_eq(enc, "linear");
+    /* pbrt-v4's wrap: "repeat" (its default, and clpt's), "clamp" (clpt's clamp to the
+     * edge); "black" and "octahedralsphere" a warning and repeat */
+    const Token *wrap = NULL;
+    if ((st = get_string(p, lx, "wrap", &wrap))) return st;
+    int clamp = wrap && tok_eq(wrap, "clamp");
+    if (wrap && !clamp && !tok_eq(wrap, "repeat") &&
+        (st = warn_once(p, lx, wrap, "texture-wrap", "texture wrap \"%.*s\" is not supported; repeat is used",
+                        (int)(wrap->len > 40 ? 40 : wrap->len), wrap->text)))
+        return st;
     char *path = beside_main(p, f);
     if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
-    st = texture_load_image(p->s, NULL, path, linear, 0, &t->index, p->err);
+    st = texture_load_image(p->s, NULL, path, linear, clamp, &t->index, p->err);
     free(path);
     if (st) {
         error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
@@ -1359,6 +1424,7 @@ static Status d_texture(Parser *p, Lexer *lx, const Token *kw)
 static Status shape_material(Parser *p, uint *out)
 {
     Status st;
+    *out = NO_INDEX;
     if (p->g.material == NO_INDEX) {
         uint i;
         if ((st = scene_add_material(p->s, "", material_diffuse(v3(0.5f, 0.5f, 0.5f)), &i, p->err))) return st;
@@ -1375,6 +1441,13 @@ static Status shape_material(Parser *p, uint *out)
         uint i;
         if ((st = scene_add_material(p->s, "", m, &i, p->err))) return st;
         p->g.area_material = i;
+        if (pending_of(p, p->g.material)) {
+            if (grow((void **)&p->area_of_pending, &p->cap_area_pending, p->n_area_pending + 1,
+                     sizeof *p->area_of_pending))
+                return error_set(p->err, ST_INTERNAL, "out of memory");
+            p->area_of_pending[p->n_area_pending].area = i;
+            p->area_of_pending[p->n_area_pending++].base = p->g.material;
+        }
     }
     *out = p->g.area_material;
     return ST_OK;
@@ -2009,6 +2082,11 @@ static Status d_include(Parser *p, Lexer *lx, const Token *kw)
     Token t;
     Status st = expect_string(p, lx, "a quoted file name", &t);
     if (st) return st;
+    /* pbrt-v4 reads gzip-compressed includes (pbrt-v4-scenes' hair and bunny-fur curves);
+     * clpt does not: say so at the name rather than at the first compressed byte */
+    if (t.len >= 3 && memcmp(t.text + t.len - 3, ".gz", 3) == 0)
+        return lex_error_at(lx, &t, p->err, "a gzip-compressed include ('%.*s') is not supported; gunzip it",
+                            (int)(t.len > 60 ? 60 : t.len), t.text);
     if (p->depth + 1 >= CLPT_MAX_INCLUDE_DEPTH) {
         p->depth_exceeded = 1;
         return lex_error_at(lx, kw, p->err, "includes nested more than %d deep (does a file include itself?)",
@@ -2051,6 +2129,29 @@ static Status d_unsupported(Parser *p, Lexer *lx, const Token *kw)
     snprintf(key, sizeof key, "%.*s", (int)(kw->len > 40 ? 40 : kw->len), kw->text);
     return warn_once(p, lx, kw, key, "%s is not supported; ignored", key);
 }
+
+/* ActiveTransform StartTime | EndTime | All (a bare word, not a string). clpt has no
+ * motion blur: it renders the shutter-open pose, so a transform directive given while
+ * only EndTime is active leaves the transform as it is. AttributeBegin/End keep the
+ * setting with the rest of the graphics state, as pbrt-v4's does. */
+static Status d_active_transform(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token t;
+    Status st = next_token(p, lx, &t);
+    if (st) return st;
+    if (t.kind == TOK_WORD && tok_eq(&t, "StartTime"))
+        p->g.end_time_only = 0;
+    else if (t.kind == TOK_WORD && tok_eq(&t, "All"))
+        p->g.end_time_only = 0;
+    else if (t.kind == TOK_WORD && tok_eq(&t, "EndTime"))
+        p->g.end_time_only = 1;
+    else
+        return lex_expected(lx, &t, "StartTime, EndTime or All (ActiveTransform)", p->err);
+    return warn_once(p, lx, kw, "ActiveTransform",
+                     "ActiveTransform: motion blur is not supported; the StartTime (shutter-open) transform is used");
+}
+
+static int is_transform_directive(Status (*fn)(Parser *, Lexer *, const Token *));
 
 static Status d_ignored(Parser *p, Lexer *lx, const Token *kw)
 {
@@ -2096,7 +2197,7 @@ static const struct {
     {"Option", d_unsupported},
     {"Accelerator", d_unsupported},
     {"TransformTimes", d_unsupported},
-    {"ActiveTransform", d_unsupported},
+    {"ActiveTransform", d_active_transform},
     {"MakeNamedMedium", d_unsupported},
     {"MediumInterface", d_unsupported},
     {"Attribute", d_unsupported},
@@ -2131,10 +2232,19 @@ static Status parse_statements(Parser *p, Lexer *lx)
             st = lex_error_at(lx, &t, p->err, "%s must come before WorldBegin", directives[i].name);
             break;
         }
+        Transform before = p->g.ctm;
         if ((st = directives[i].fn(p, lx, &t))) break;
+        if (p->g.end_time_only && is_transform_directive(directives[i].fn)) p->g.ctm = before;
     }
     p->has_peek = 0;
     return st;
+}
+
+/* the directives that change the current transform (ActiveTransform EndTime skips them) */
+static int is_transform_directive(Status (*fn)(Parser *, Lexer *, const Token *))
+{
+    return fn == d_translate || fn == d_scale || fn == d_rotate || fn == d_lookat || fn == d_transform ||
+           fn == d_concat || fn == d_coordsys_transform || fn == d_identity;
 }
 
 static Status parse_file(Parser *p, const char *path, const char *text, size_t len)
@@ -2230,9 +2340,15 @@ Status pbrt_load_text(const char *path, const char *text, size_t len, Scene *s, 
     s->image.max_depth = 5;
     Status st = parse_file(&p, path, text, len);
     if (!st && p.in_object) st = error_set(err, ST_INPUT, "%s: ObjectBegin \"%s\" has no ObjectEnd", path, p.obj_name_buf);
+    for (size_t i = 0; !st && i < p.n_pending; i++)
+        if (!p.pending[i].defined)
+            st = error_set(err, ST_INPUT, "%s is used by NamedMaterial and never defined (MakeNamedMaterial defines it)",
+                           p.pending[i].where);
     if (!st) st = finish_camera(&p);
     if (!st) st = scene_check_precision(s, err);
     free(p.stack);
+    free(p.pending);
+    free(p.area_of_pending);
     free(p.coordsys_xf);
     free(p.tex);
     free(p.pl.p);

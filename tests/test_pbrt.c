@@ -188,7 +188,7 @@ static void test_warnings(void)
     static const char *want[] = {
         DIR "warnings.pbrt:2: PixelFilter is not supported; ignored",
         DIR "warnings.pbrt:3: Film: parameter \"float iso\" is not supported; ignored",
-        DIR "warnings.pbrt:5: Shape \"disk\" is not supported; skipped",
+        DIR "warnings.pbrt:5: Shape \"cone\" is not supported; skipped",
         DIR "warnings.pbrt:7: Shape: parameter \"float wobble\" is not supported; ignored",
         DIR "warnings.pbrt:9: MakeNamedMedium is not supported; ignored",
         DIR "warnings.pbrt:10: TransformTimes is not supported; ignored",
@@ -367,6 +367,94 @@ static void test_orientation(void)
         CHECK_MSG(0, "%s", err.msg);
     }
     scene_free(&s);
+}
+
+/* Sum of the triangles' areas from `first`, and how many face +z (or outward from the
+ * z axis when `radial`) by their winding. */
+static double mesh_area(const Scene *s, size_t first, int radial, size_t *facing)
+{
+    double area = 0;
+    *facing = 0;
+    for (size_t i = first; i < s->n_triangles; i++) {
+        const Triangle *t = &s->triangles[i];
+        vec3 e1 = v3_sub(t->p1, t->p0), e2 = v3_sub(t->p2, t->p0);
+        vec3 w = v3(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
+        area += 0.5 * sqrt((double)w.x * w.x + (double)w.y * w.y + (double)w.z * w.z);
+        vec3 c = v3_add(v3_add(t->p0, t->p1), t->p2);
+        double side = radial ? (double)w.x * c.x + (double)w.y * c.y : (double)w.z;
+        if (side > 0) (*facing)++;
+    }
+    return area;
+}
+
+/* pbrt's disk and cylinder become meshes of 64 segments a turn on pbrt's side:
+ * areas of the 64-gon (and of its band), ReverseOrientation turning them over, a
+ * partial annulus staying inside its radii and angle, and bad sizes refused. */
+static void test_disk_cylinder(void)
+{
+    const double polygon = 64.0 / 2.0 * sin(2 * M_PI / 64.0) / M_PI;   /* 64-gon area / circle's */
+    Scene s;
+    Error err = { 0 };
+    size_t facing;
+    CHECK_EQ_INT(load_text("Shape \"disk\" \"float radius\" 2 \"float height\" 0.5\n", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_triangles, 64);
+    CHECK_NEAR(mesh_area(&s, 0, 0, &facing), polygon * M_PI * 4, 1e-4);
+    CHECK_EQ_INT(facing, 64);
+    for (size_t i = 0; i < s.n_triangles; i++) CHECK_NEAR(s.triangles[i].p0.z, 0.5, 1e-7);
+    scene_free(&s);
+    CHECK_EQ_INT(load_text("ReverseOrientation\nShape \"disk\"\n", &s, &err), ST_OK);
+    mesh_area(&s, 0, 0, &facing);
+    CHECK_EQ_INT(facing, 0);
+    scene_free(&s);
+    /* half an annulus: 32 segments, two triangles each */
+    CHECK_EQ_INT(load_text("Shape \"disk\" \"float radius\" 2 \"float innerradius\" 1 \"float phimax\" 180\n", &s,
+                           &err), ST_OK);
+    CHECK_EQ_INT(s.n_triangles, 64);
+    CHECK_NEAR(mesh_area(&s, 0, 0, &facing), polygon * M_PI * (4 - 1) / 2, 1e-4);
+    CHECK_EQ_INT(facing, 64);
+    for (size_t i = 0; i < s.n_triangles; i++) {
+        const vec3 q[3] = { s.triangles[i].p0, s.triangles[i].p1, s.triangles[i].p2 };
+        for (int c = 0; c < 3; c++) {
+            double r = sqrt((double)q[c].x * q[c].x + (double)q[c].y * q[c].y);
+            CHECK(r > 1 - 1e-6 && r < 2 + 1e-6 && q[c].y > -1e-6);
+        }
+    }
+    scene_free(&s);
+    /* zmin and zmax in either order; the side faces outward */
+    CHECK_EQ_INT(load_text("Shape \"cylinder\" \"float radius\" 0.5 \"float zmin\" 1 \"float zmax\" -1\n", &s, &err),
+                 ST_OK);
+    CHECK_EQ_INT(s.n_triangles, 128);
+    CHECK_NEAR(mesh_area(&s, 0, 1, &facing), 64 * 2 * 0.5 * sin(M_PI / 64) * 2, 1e-4);
+    CHECK_EQ_INT(facing, 128);
+    scene_free(&s);
+    /* a disk lamp (killeroo-coated-gold's) emits toward +z, or away when reversed */
+    for (int reverse = 0; reverse < 2; reverse++) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n"
+                 "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n"
+                 "Sampler \"independent\" \"integer pixelsamples\" 1\nWorldBegin\n%s"
+                 "AreaLightSource \"diffuse\" \"rgb L\" [ 1 1 1 ]\nShape \"disk\" \"float radius\" 1\n",
+                 reverse ? "ReverseOrientation\n" : "");
+        CHECK_EQ_INT(load_text(text, &s, &err), ST_OK);
+        Film f;
+        if (render_util_run(&s, "scalar", 0, &f, &err) == ST_OK) {
+            float rgb[8 * 8 * 3];
+            film_resolve(&f, rgb);
+            CHECK_MSG(reverse ? rgb[(4 * 8 + 4) * 3] == 0.0f : rgb[(4 * 8 + 4) * 3] == 1.0f, "%s disk: centre %g",
+                      reverse ? "reversed" : "plain", (double)rgb[(4 * 8 + 4) * 3]);
+            film_free(&f);
+        } else {
+            CHECK_MSG(0, "%s", err.msg);
+        }
+        scene_free(&s);
+    }
+    expect_error("Shape \"cylinder\" \"float zmin\" 1 \"float zmax\" 1",
+                 DIR "inline.pbrt:1:7: the cylinder's zmin and zmax are equal: it has no side");
+    expect_error("Shape \"disk\" \"float radius\" 1 \"float innerradius\" 1",
+                 DIR "inline.pbrt:1:31: parameter 'innerradius' must be in [0, radius)");
+    expect_error("Shape \"disk\" \"float phimax\" 0",
+                 DIR "inline.pbrt:1:14: parameter 'phimax' must be in (0, 360]");
 }
 
 /* compare.pbrt and compare.scene describe one scene: the same image, bit for bit. */
@@ -973,6 +1061,7 @@ int main(void)
     RUN(test_include);
     RUN(test_instances);
     RUN(test_orientation);
+    RUN(test_disk_cylinder);
     RUN(test_compare);
     RUN(test_errors);
     return harness_report();

@@ -1884,6 +1884,89 @@ static Status shape_loopsubdiv(Parser *p, const Lexer *lx, const Token *type, ui
     return st;
 }
 
+/* pbrt's disk (height, radius, innerradius, phimax) and cylinder (radius, zmin, zmax,
+ * phimax) as meshes: the kernels have neither primitive. A disk is flat, so one ring of
+ * segments is exact but for the rim; a cylinder's side is ruled, so one band of quads.
+ * The rim is a polygon of 64 segments per full turn (a 64-gon holds 99.8% of the
+ * circle's area). The analytic normals (+z for a disk, outward for a cylinder) are the
+ * shading normals, so orient_triangles puts each triangle on pbrt's side, and (u, v)
+ * are pbrt's: u = phi / phimax, v from the outer rim in (disk) or from zmin up
+ * (cylinder). Real scenes use disks as area lights (pbrt-v4-scenes' killeroos). */
+static Status shape_disk_cylinder(Parser *p, const Lexer *lx, const Token *type, uint material, int cylinder)
+{
+    double radius = 1, inner = 0, height = 0, zmin = -1, zmax = 1, phimax = 360;
+    Status st;
+    if ((st = get_float(p, lx, "radius", &radius)) || (st = get_float(p, lx, "phimax", &phimax))) return st;
+    if (cylinder ? (st = get_float(p, lx, "zmin", &zmin)) || (st = get_float(p, lx, "zmax", &zmax))
+                 : (st = get_float(p, lx, "height", &height)) || (st = get_float(p, lx, "innerradius", &inner)))
+        return st;
+    if (!(radius > 0) || !isfinite(radius)) return param_type_error(p, lx, param_find(p, "radius"), "> 0 and finite");
+    if (!(phimax > 0 && phimax <= 360)) return param_type_error(p, lx, param_find(p, "phimax"), "in (0, 360]");
+    if (!cylinder && !(inner >= 0 && inner < radius))
+        return param_type_error(p, lx, param_find(p, "innerradius"), "in [0, radius)");
+    if (!isfinite(height) || !isfinite(zmin) || !isfinite(zmax))
+        return lex_error_at(lx, type, p->err, "the %.*s's height or z range is not finite", (int)type->len, type->text);
+    if (cylinder && zmin > zmax) {   /* pbrt takes them in either order */
+        double t = zmin;
+        zmin = zmax;
+        zmax = t;
+    }
+    if (cylinder && !(zmax > zmin))
+        return lex_error_at(lx, type, p->err, "the cylinder's zmin and zmax are equal: it has no side");
+    int nseg = (int)ceil(64.0 * phimax / 360.0);
+    if (nseg < 4) nseg = 4;
+    double turn = phimax * M_PI / 180.0;
+    MeshSink k;
+    size_t first = p->s->n_triangles;
+    if ((st = mesh_sink_open(&k, p->s, &p->g.ctm, lx->path, p->err)) ||
+        (st = mesh_sink_reserve(&k, 2 * (size_t)nseg, 2 * (size_t)nseg)))
+        return st;
+    for (int i = 0; i < nseg && !st; i++) {
+        double f0 = (double)i / nseg, f1 = (double)(i + 1) / nseg;
+        float c0 = (float)cos(f0 * turn), s0 = (float)sin(f0 * turn), c1 = (float)cos(f1 * turn),
+              s1 = (float)sin(f1 * turn);
+        vec3 q[4], n[4];
+        float uv[8];
+        if (cylinder) {   /* corners: (phi0, zmin) (phi1, zmin) (phi0, zmax) (phi1, zmax) */
+            float r = (float)radius;
+            q[0] = v3(r * c0, r * s0, (float)zmin);
+            q[1] = v3(r * c1, r * s1, (float)zmin);
+            q[2] = v3(r * c0, r * s0, (float)zmax);
+            q[3] = v3(r * c1, r * s1, (float)zmax);
+            n[0] = n[2] = v3(c0, s0, 0.0f);
+            n[1] = n[3] = v3(c1, s1, 0.0f);
+        } else {          /* corners: outer phi0, outer phi1, inner phi0, inner phi1 */
+            float ro = (float)radius, ri = (float)inner, z = (float)height;
+            q[0] = v3(ro * c0, ro * s0, z);
+            q[1] = v3(ro * c1, ro * s1, z);
+            q[2] = v3(ri * c0, ri * s0, z);
+            q[3] = v3(ri * c1, ri * s1, z);
+            n[0] = n[1] = n[2] = n[3] = v3(0.0f, 0.0f, 1.0f);
+        }
+        const float v_lo = 0.0f, v_hi = 1.0f;   /* disk: outer rim v 0, inner 1; cylinder: zmin 0, zmax 1 */
+        const float u[4] = { (float)f0, (float)f1, (float)f0, (float)f1 }, v[4] = { v_lo, v_lo, v_hi, v_hi };
+        for (int c = 0; c < 4; c++) {
+            uv[2 * c] = u[c];
+            uv[2 * c + 1] = v[c];
+        }
+        vec3 a[3] = { q[0], q[1], q[3] }, an[3] = { n[0], n[1], n[3] };
+        vec3 b[3] = { q[0], q[3], q[2] }, bn[3] = { n[0], n[3], n[2] };
+        float auv[6] = { uv[0], uv[1], uv[2], uv[3], uv[6], uv[7] };
+        float buv[6] = { uv[0], uv[1], uv[6], uv[7], uv[4], uv[5] };
+        int disk_centre = !cylinder && inner == 0;   /* the inner corners meet: one triangle */
+        if (disk_centre) {
+            vec3 t[3] = { q[0], q[1], q[2] }, tn[3] = { n[0], n[1], n[2] };
+            float tuv[6] = { uv[0], uv[1], uv[2], uv[3], uv[4], uv[5] };
+            st = mesh_sink_triangle(&k, t, tn, tuv, material);
+        } else {
+            st = mesh_sink_triangle(&k, a, an, auv, material);
+            if (!st) st = mesh_sink_triangle(&k, b, bn, buv, material);
+        }
+    }
+    if (!st) orient_triangles(p, first);
+    return st;
+}
+
 static Status shape_plymesh(Parser *p, const Lexer *lx, const Token *type, uint material)
 {
     const Token *f = NULL;
@@ -1921,7 +2004,8 @@ static Status d_shape(Parser *p, Lexer *lx, const Token *kw)
     if (!st) st = parse_params(p, lx);
     if (st) return st;
     int known = tok_eq(&type, "sphere") || tok_eq(&type, "trianglemesh") || tok_eq(&type, "plymesh") ||
-                tok_eq(&type, "bilinearmesh") || tok_eq(&type, "loopsubdiv");
+                tok_eq(&type, "bilinearmesh") || tok_eq(&type, "loopsubdiv") || tok_eq(&type, "disk") ||
+                tok_eq(&type, "cylinder");
     if (!known) {
         char key[96];
         snprintf(key, sizeof key, "Shape %.*s", (int)(type.len > 40 ? 40 : type.len), type.text);
@@ -1936,6 +2020,8 @@ static Status d_shape(Parser *p, Lexer *lx, const Token *kw)
         st = shape_plymesh(p, lx, &type, material);
     } else if (tok_eq(&type, "loopsubdiv")) {
         st = shape_loopsubdiv(p, lx, &type, material);
+    } else if (tok_eq(&type, "disk") || tok_eq(&type, "cylinder")) {
+        st = shape_disk_cylinder(p, lx, &type, material, tok_eq(&type, "cylinder"));
     } else {
         MeshSink k;
         size_t first = p->s->n_triangles;

@@ -29,7 +29,7 @@ CPPFLAGS  := -D_GNU_SOURCE -DCL_TARGET_OPENCL_VERSION=120 -Ihost -Ikernels -I$(B
              -I/usr/include/stb -I/usr/include/OpenEXR
 CFLAGS    := -std=c11 $(OPT) -g $(WARN) $(FPFLAGS) -pthread $(EXTRA_CFLAGS)
 LDFLAGS   := -pthread $(EXTRA_LDFLAGS)
-LDLIBS    := -lOpenCL -lstb -lOpenEXRCore -lOpenEXR -lcjson -lm
+LDLIBS    := -lOpenCL -lstb -lOpenEXRCore -lOpenEXR -lcjson -lz -lm
 
 # Open MPI (docs/distributed.md): only host/dist/mpi_driver.c includes mpi.h, and only
 # the clpt program links libmpi; the tests and benchmarks never pull that file in.

@@ -72,7 +72,8 @@ static Status load(const char *path, Scene *s, Error *err)
         MeshOptions o = mesh_options(m);
         return st ? st : has_suffix(path, ".obj") ? obj_load(path, s, m, err) : ply_load(path, s, &o, err);
     }
-    if (has_suffix(path, ".gltf") || has_suffix(path, ".glb")) {
+    if (has_suffix(path, ".gltf") || has_suffix(path, ".glb") || has_suffix(path, ".ply.gz") ||
+        has_suffix(path, ".obj.gz")) {
         MeshOptions o = mesh_options(NO_INDEX);
         return mesh_load(path, s, &o, err);
     }

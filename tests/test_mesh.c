@@ -128,7 +128,11 @@ static void test_paths(void)
     rmdir(dir);
     CHECK_EQ_INT(mesh_kind("a/b.OBJ"), MESH_OBJ);
     CHECK_EQ_INT(mesh_kind("b.ply"), MESH_PLY);
-    CHECK_EQ_INT(mesh_kind("b.ply.gz"), MESH_NONE);
+    CHECK_EQ_INT(mesh_kind("b.ply.gz"), MESH_PLY); /* inflated as it is read */
+    CHECK_EQ_INT(mesh_kind("d/b.OBJ.gz"), MESH_OBJ);
+    CHECK_EQ_INT(mesh_kind("b.gltf.gz"), MESH_NONE);
+    CHECK_EQ_INT(mesh_kind("ply.gz"), MESH_NONE);
+    CHECK_EQ_INT(mesh_kind(".ply.gz"), MESH_PLY);
     CHECK_EQ_INT(mesh_kind("dir.obj/scene"), MESH_NONE);
 }
 
@@ -266,7 +270,8 @@ static void test_scene_mesh_errors(void)
     check_scene_bad("mesh { translate 1 1 1 file clpt-test-mesh-tri.obj matrix 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1 }",
                     "s.scene:1:52: 'matrix' cannot be combined with translate, rotate, rx, ry, rz or scale");
     check_scene_bad("mesh { file clpt-test-mesh-tri.stl }",
-                    "s.scene:1:13: expected a mesh file name ending in .obj, .ply, .gltf or .glb, found 'clpt-test-mesh-tri.stl'");
+                    "s.scene:1:13: expected a mesh file name ending in .obj, .ply, .obj.gz, .ply.gz, .gltf "
+                    "or .glb, found 'clpt-test-mesh-tri.stl'");
     check_scene_bad("mesh { file clpt-test-mesh-tri.obj shear 1 }",
                     "expected a mesh key (file, material, translate, rotate, rx, ry, rz, scale, matrix) or '}'");
     /* the key after a one-number scale is read as a key */

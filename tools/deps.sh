@@ -15,7 +15,7 @@ set -eu
 
 pkgs_for() {
     case "$1" in
-        base) echo "make gcc libc6-dev pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers libstb-dev openmpi-bin libopenmpi-dev pkg-config libsdl2-dev libopenexr-dev libcjson-dev" ;;
+        base) echo "make gcc libc6-dev pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers libstb-dev openmpi-bin libopenmpi-dev pkg-config libsdl2-dev libopenexr-dev libcjson-dev zlib1g-dev" ;;
         # the viewer's test (tests/test_viewer.c): a virtual display and input to send it
         viewer-test) echo "xvfb xdotool" ;;
         sanitize) echo "clang libclang-rt-14-dev" ;;

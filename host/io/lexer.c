@@ -5,6 +5,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <math.h>
 #include <poll.h>
 #include <stdarg.h>
@@ -13,6 +14,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
 
 /* Some Windows editors start text files with a UTF-8 byte order mark: it is no part of
  * the text, and left in it would be an invisible first "word". */
@@ -83,6 +85,98 @@ Status lex_check_file(const char *path, Error *err)
     return limit_file_size(path, (uint64_t)sb.st_size, err);
 }
 
+/* Only the name says a file is compressed: a glTF .bin or a binary PLY may well start
+ * with gzip's magic bytes by chance. */
+static int ends_in_gz(const char *path)
+{
+    size_t n = strlen(path);
+    return n >= 3 && strcmp(path + n - 3, ".gz") == 0;
+}
+
+/* Inflates the gzip data `in` (one member or several concatenated, as gzip -c a b
+ * writes them) into a new buffer with room for a NUL after it. The output is checked
+ * against CLPT_MAX_FILE_BYTES before each growth, so that a small file that inflates to
+ * terabytes stops at the same limit as a large plain file instead of exhausting memory. */
+static Status gunzip(const char *path, const char *in, size_t in_len, char **out, size_t *out_len, Error *err)
+{
+    *out = NULL;
+    *out_len = 0;
+    z_stream zs;
+    memset(&zs, 0, sizeof zs);
+    if (inflateInit2(&zs, 15 + 16) != Z_OK)
+        return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+    /* text compresses about 4:1; a first guess that big saves most of the regrowth */
+    uint64_t guess = (uint64_t)in_len * 4 < ((uint64_t)1 << 16) ? (uint64_t)1 << 16 : (uint64_t)in_len * 4;
+    size_t cap = guess > CLPT_MAX_FILE_BYTES + 2 ? (size_t)(CLPT_MAX_FILE_BYTES + 2) : (size_t)guess, n = 0;
+    char *buf = malloc(cap);
+    Status st = ST_OK;
+    if (!buf) {
+        st = error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+        goto done;
+    }
+    size_t used = 0; /* input bytes consumed; zlib's avail_in is a uInt, so fed in slices */
+    for (;;) {
+        if (cap - n < 2) {
+            /* the buffer never outgrows the limit and its NUL: full, the data is over it */
+            if (n > CLPT_MAX_FILE_BYTES) {
+                st = limit_file_size(path, n, err);
+                goto done;
+            }
+            size_t want = (uint64_t)cap * 2 > CLPT_MAX_FILE_BYTES + 2 ? (size_t)(CLPT_MAX_FILE_BYTES + 2) : cap * 2;
+            char *grown = realloc(buf, want);
+            if (!grown) {
+                st = error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+                goto done;
+            }
+            buf = grown;
+            cap = want;
+        }
+        size_t in_slice = in_len - used > UINT_MAX ? UINT_MAX : in_len - used;
+        size_t out_slice = cap - 1 - n > UINT_MAX ? UINT_MAX : cap - 1 - n;
+        zs.next_in = (Bytef *)(in + used);
+        zs.avail_in = (uInt)in_slice;
+        zs.next_out = (Bytef *)(buf + n);
+        zs.avail_out = (uInt)out_slice;
+        int rc = inflate(&zs, Z_NO_FLUSH);
+        used += in_slice - zs.avail_in;
+        n += out_slice - zs.avail_out;
+        if (rc == Z_STREAM_END) {
+            /* another member may follow; anything else after the end is left unread, as
+             * gzip itself does with trailing zeros */
+            if (used + 2 <= in_len && (unsigned char)in[used] == 0x1f && (unsigned char)in[used + 1] == 0x8b) {
+                inflateReset(&zs);
+                continue;
+            }
+            break;
+        }
+        if (rc == Z_BUF_ERROR && used == in_len) {
+            st = error_set(err, ST_INPUT, "'%s': the gzip data is cut short", path);
+            goto done;
+        }
+        if (rc == Z_MEM_ERROR) {
+            st = error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+            goto done;
+        }
+        if (rc != Z_OK && rc != Z_BUF_ERROR) {
+            st = error_set(err, ST_INPUT, "'%s': not valid gzip data (zlib: %s)", path,
+                           zs.msg ? zs.msg : "unknown error");
+            goto done;
+        }
+        if (n > CLPT_MAX_FILE_BYTES) {
+            st = limit_file_size(path, n, err);
+            goto done;
+        }
+    }
+    if ((st = limit_file_size(path, n, err))) goto done;
+    *out = buf;
+    *out_len = n;
+    buf = NULL;
+done:
+    free(buf);
+    inflateEnd(&zs);
+    return st;
+}
+
 /* lex_read_file and lex_read_input: the whole file in one buffer, read once. */
 static Status read_whole(const char *path, int allow_pipe, char **data, size_t *len, Error *err)
 {
@@ -139,6 +233,12 @@ static Status read_whole(const char *path, int allow_pipe, char **data, size_t *
         n += (size_t)got;
     }
     close(fd);
+    if (ends_in_gz(path)) {
+        char *raw = buf;
+        st = gunzip(path, raw, n, &buf, &n, err);
+        free(raw);
+        if (st) return st;
+    }
     size_t skip = lex_bom_length(buf, n);
     if (skip) memmove(buf, buf + skip, n - skip);
     n -= skip;

@@ -13,8 +13,17 @@
 MeshKind mesh_kind(const char *path)
 {
     const char *slash = strrchr(path, '/');
-    const char *dot = strrchr(slash ? slash + 1 : path, '.');
+    const char *base = slash ? slash + 1 : path;
+    const char *dot = strrchr(base, '.');
     if (!dot) return MESH_NONE;
+    /* "mesh.ply.gz" is a PLY file that the reader inflates as it reads it (lex_read_file
+     * does for any name ending in .gz); glTF has its own compression and is not wrapped */
+    size_t n = (size_t)(dot - base);
+    if (strcmp(dot, ".gz") == 0 && n >= 4) {
+        if (strncasecmp(dot - 4, ".obj", 4) == 0) return MESH_OBJ;
+        if (strncasecmp(dot - 4, ".ply", 4) == 0) return MESH_PLY;
+        return MESH_NONE;
+    }
     if (strcasecmp(dot, ".obj") == 0) return MESH_OBJ;
     if (strcasecmp(dot, ".ply") == 0) return MESH_PLY;
     if (strcasecmp(dot, ".gltf") == 0 || strcasecmp(dot, ".glb") == 0) return MESH_GLTF;
@@ -37,7 +46,9 @@ Status mesh_load(const char *path, Scene *s, const MeshOptions *o, Error *err)
     }
     case MESH_NONE: break;
     }
-    return error_set(err, ST_INPUT, "'%s': not a mesh file (expected a name ending in .obj, .ply, .gltf or .glb)", path);
+    return error_set(err, ST_INPUT,
+                     "'%s': not a mesh file (expected a name ending in .obj, .ply, .obj.gz, .ply.gz, .gltf or .glb)",
+                     path);
 }
 
 Status mesh_parse(const char *path, const char *data, size_t len, Scene *s, const MeshOptions *o, Error *err)
@@ -48,5 +59,7 @@ Status mesh_parse(const char *path, const char *data, size_t len, Scene *s, cons
     case MESH_GLTF: return gltf_parse(path, data, len, s, o, NULL, err);
     case MESH_NONE: break;
     }
-    return error_set(err, ST_INPUT, "'%s': not a mesh file (expected a name ending in .obj, .ply, .gltf or .glb)", path);
+    return error_set(err, ST_INPUT,
+                     "'%s': not a mesh file (expected a name ending in .obj, .ply, .obj.gz, .ply.gz, .gltf or .glb)",
+                     path);
 }

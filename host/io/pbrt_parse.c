@@ -1982,7 +1982,7 @@ static Status shape_plymesh(Parser *p, const Lexer *lx, const Token *type, uint 
     path[dl + f->len] = '\0';
     if (mesh_kind(path) != MESH_PLY) {
         free(path);
-        return lex_expected(lx, f, "a PLY file name ending in .ply (compressed .ply.gz is not supported)", p->err);
+        return lex_expected(lx, f, "a PLY file name ending in .ply or .ply.gz", p->err);
     }
     MeshOptions o = mesh_options(material);
     o.xf = p->g.ctm;
@@ -2168,11 +2168,6 @@ static Status d_include(Parser *p, Lexer *lx, const Token *kw)
     Token t;
     Status st = expect_string(p, lx, "a quoted file name", &t);
     if (st) return st;
-    /* pbrt-v4 reads gzip-compressed includes (pbrt-v4-scenes' hair and bunny-fur curves);
-     * clpt does not: say so at the name rather than at the first compressed byte */
-    if (t.len >= 3 && memcmp(t.text + t.len - 3, ".gz", 3) == 0)
-        return lex_error_at(lx, &t, p->err, "a gzip-compressed include ('%.*s') is not supported; gunzip it",
-                            (int)(t.len > 60 ? 60 : t.len), t.text);
     if (p->depth + 1 >= CLPT_MAX_INCLUDE_DEPTH) {
         p->depth_exceeded = 1;
         return lex_error_at(lx, kw, p->err, "includes nested more than %d deep (does a file include itself?)",

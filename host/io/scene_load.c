@@ -23,7 +23,8 @@ SceneKind scene_load_kind(const char *path, const char *text, size_t len, SceneF
     }
     if (mesh_kind(path) != MESH_NONE) return SCENE_KIND_MESH;
     size_t n = strlen(path);
-    if ((n > 5 && strcasecmp(path + n - 5, ".pbrt") == 0) || pbrt_detect(text, len)) return SCENE_KIND_PBRT;
+    if ((n > 5 && strcasecmp(path + n - 5, ".pbrt") == 0) || (n > 8 && strcasecmp(path + n - 8, ".pbrt.gz") == 0) ||
+        pbrt_detect(text, len)) return SCENE_KIND_PBRT;
     return classic_detect(text, len) ? SCENE_KIND_CLASSIC : SCENE_KIND_CLPT;
 }
 

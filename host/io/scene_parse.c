@@ -998,7 +998,7 @@ static Status parse_mesh(Parser *p, Lexer *lx, const Token *kw)
     if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
     if (mesh_kind(path) == MESH_NONE) {
         free(path);
-        return lex_expected(lx, f, "a mesh file name ending in .obj, .ply, .gltf or .glb", p->err);
+        return lex_expected(lx, f, "a mesh file name ending in .obj, .ply, .obj.gz, .ply.gz, .gltf or .glb", p->err);
     }
     size_t first = p->s->n_triangles;
     st = mesh_load(path, p->s, &o, p->err);

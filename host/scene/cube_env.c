@@ -74,17 +74,7 @@ Status cube_env_convert(Scene *s, Error *err)
     uint *texels = malloc(n * sizeof *texels);
     if (!texels) return error_set(err, ST_INTERNAL, "out of memory resampling the cube map");
     cube_env_fill(s, W, H, texels);
-    uint offset, index;
-    Status st = scene_add_texels(s, texels, n, &offset, err);
+    Status st = scene_set_envmap_texels(s, texels, W, H, 1.0f, err);
     free(texels);
-    if (st) return st;
-    Texture t;
-    memset(&t, 0, sizeof t);
-    t.type = TEX_IMAGE;
-    t.flags = TEX_FLOAT;
-    t.offset = offset;
-    t.width = W;
-    t.height = H;
-    if ((st = scene_add_texture(s, NULL, NULL, t, &index, err))) return st;
-    return scene_set_envmap(s, index, 1.0f, 0.0f, err);
+    return st;
 }

@@ -102,17 +102,7 @@ Status octa_env_set(Scene *s, const float *rgb, uint n, const double light_from_
             for (int k = 0; k < 3; k++) c[k] = c[k] > 0.0f ? c[k] : 0.0f;   /* pbrt's ClampZero */
             memcpy(texels + 3u * ((size_t)j * W + i), c, sizeof c);
         }
-    uint offset, index;
-    Status st = scene_add_texels(s, texels, count, &offset, err);
+    Status st = scene_set_envmap_texels(s, texels, W, H, scale, err);
     free(texels);
-    if (st) return st;
-    Texture t;
-    memset(&t, 0, sizeof t);
-    t.type = TEX_IMAGE;
-    t.flags = TEX_FLOAT;
-    t.offset = offset;
-    t.width = W;
-    t.height = H;
-    if ((st = scene_add_texture(s, NULL, NULL, t, &index, err))) return st;
-    return scene_set_envmap(s, index, scale, 0.0f, err);
+    return st;
 }

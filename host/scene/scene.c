@@ -589,6 +589,22 @@ static double delta_light_power(const Light *l, double r)
     return atten > 0.0 ? solid_angle * r * r * lum / atten : 0.0;
 }
 
+Status scene_set_envmap_texels(Scene *s, const uint *texels, uint width, uint height, float intensity, Error *err)
+{
+    uint offset, index;
+    Status st = scene_add_texels(s, texels, 3u * (size_t)width * height, &offset, err);
+    if (st) return st;
+    Texture t;
+    memset(&t, 0, sizeof t);
+    t.type = TEX_IMAGE;
+    t.flags = TEX_FLOAT;
+    t.offset = offset;
+    t.width = width;
+    t.height = height;
+    if ((st = scene_add_texture(s, NULL, NULL, t, &index, err))) return st;
+    return scene_set_envmap(s, index, intensity, 0.0f, err);
+}
+
 Status scene_set_envmap(Scene *s, uint texture, float intensity, float rotate, Error *err)
 {
     const Texture *t = &s->textures[texture];

@@ -155,6 +155,11 @@ uint scene_first_plane(const Scene *s);
  * otherwise fails only when memory runs out. */
 Status scene_set_envmap(Scene *s, uint texture, float intensity, float rotate, Error *err);
 
+/* The same for a map made here rather than read from a file (a resampled cube map or
+ * pbrt octahedral map): W x H float texels (3 per texel, as uint bits) added as a new
+ * texture, then scene_set_envmap with `intensity` and no rotation. */
+Status scene_set_envmap_texels(Scene *s, const uint *texels, uint width, uint height, float intensity, Error *err);
+
 /* Builds the light list: the emissive spheres, triangles and boxes (area lights), then
  * the delta lights, then the environment map when the background is one with light in
  * it, with a choice probability proportional to each light's estimated power (area

@@ -347,17 +347,18 @@ static void test_mpi_recovery_goes_on_without_the_dead_rank(void)
                                         "--mpi-timeout", "4", "--checkpoint", in_dir("killed.ckpt"),
                                         "--checkpoint-interval", "0.1", "-o", in_dir("recovered.pfm"))), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    /* the kill lands between messages or in the middle of one (a film on its way): rank
-     * 0 says which, and either way drops the rank and finishes the image */
-    static const char dropped[] = "failed and was dropped; its samples go to the other devices: MPI rank 2 stopped ";
-    static const char between[] = "answering: no word from it for 4 s (its process or node died, or it hangs; see "
-                                  "--mpi-timeout)\n";
-    static const char within[] = "in the middle of a message: nothing more of it for 4 s (its process or node died, "
-                                 "or it hangs; see --mpi-timeout)\n";
-    char want_between[512], want_within[512];
-    snprintf(want_between, sizeof want_between, "%s%s", dropped, between);
-    snprintf(want_within, sizeof want_within, "%s%s", dropped, within);
-    CHECK_MSG(strstr(r.err, want_between) || strstr(r.err, want_within), "no drop message in: %s", r.err);
+    /* The kill lands between messages or in the middle of one (a film on its way), or
+     * MPI itself reports the dead peer: rank 0 names rank 2 and drops it in every case,
+     * with the wording of what it saw (host/dist/mpi_driver.c), and finishes the image.
+     * The usual case, its exact message: */
+    static const char dropped[] = "failed and was dropped; its samples go to the other devices: MPI rank 2 ";
+    static const char between[] = "stopped answering: no word from it for 4 s (its process or node died, or it "
+                                  "hangs; see --mpi-timeout)\n";
+    char want[512];
+    snprintf(want, sizeof want, "%s%s", dropped, between);
+    const char *drop = strstr(r.err, dropped);
+    CHECK_MSG(drop != NULL, "no drop message in: %s", r.err);
+    if (drop && !strstr(r.err, want)) fprintf(stderr, "  rank 2 dropped with another message: %s\n", drop);
     CHECK(files_equal(in_dir("recovered.pfm"), in_dir("long.pfm")));
 }
 

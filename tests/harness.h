@@ -11,6 +11,7 @@
 #ifndef CLPT_HARNESS_H
 #define CLPT_HARNESS_H
 
+#include <dirent.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -95,6 +96,24 @@ static inline int shared_model_present(const char *path, const char *skipped)
     }
     fprintf(stderr, "  %s not found: %s\n", path, skipped);
     return 0;
+}
+
+/* The entries of folder `dir` whose names end in `suffix` ("" for all, "." and ".."
+ * left out); -1 when the folder cannot be read. For the kernel-cache tests. */
+static inline int count_dir_entries(const char *dir, const char *suffix)
+{
+    DIR *d = opendir(dir);
+    if (!d) return -1;
+    int n = 0;
+    size_t ls = strlen(suffix);
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        size_t l = strlen(e->d_name);
+        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) continue;
+        if (l >= ls && strcmp(e->d_name + l - ls, suffix) == 0) n++;
+    }
+    closedir(d);
+    return n;
 }
 
 static inline int harness_report(void)

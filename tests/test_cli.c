@@ -478,20 +478,6 @@ static void test_log_shows_plain_progress(void)
     unlink("/tmp/clpt-test-log.png");
 }
 
-/* The number of kernel cache entries in `dir`. */
-static int cache_entries(const char *dir)
-{
-    char cmd[300];
-    snprintf(cmd, sizeof cmd, "ls %s | grep -c '\\.bin$'", dir);
-    FILE *p = popen(cmd, "r");
-    int n = -1;
-    if (p) {
-        if (fscanf(p, "%d", &n) != 1) n = -1;
-        pclose(p);
-    }
-    return n;
-}
-
 /* The path tracer and the whitted integrator are programs of their own, each built on
  * first use (host/device/device_ocl.c): a path-tracer run stores one, the first whitted
  * run builds (and announces) the other, and later runs of either load them. */
@@ -507,19 +493,19 @@ static void test_kernel_programs_on_first_use(void)
                  out), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     CHECK_STR_CONTAINS(r.err, "clpt: compiling kernels for ");
-    CHECK_EQ_INT(cache_entries(cache), 1);
+    CHECK_EQ_INT(count_dir_entries(cache, ".bin"), 1);
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--width", "8", "--height", "8", "--spp", "1",
                  "--integrator", "whitted", "-o", out), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     CHECK_STR_CONTAINS(r.err, "clpt: compiling kernels for ");
-    CHECK_EQ_INT(cache_entries(cache), 2);
+    CHECK_EQ_INT(count_dir_entries(cache, ".bin"), 2);
     for (int whitted = 0; whitted < 2; whitted++) {
         cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--width", "8", "--height", "8", "--spp", "1",
                      "--integrator", whitted ? "whitted" : "path", "-o", out), &r);
         CHECK_MSG(r.status == 0, "%s", r.err);
         CHECK(strstr(r.err, "compiling kernels") == NULL);
     }
-    CHECK_EQ_INT(cache_entries(cache), 2);
+    CHECK_EQ_INT(count_dir_entries(cache, ".bin"), 2);
     if (old) setenv("CLPT_CACHE_DIR", old, 1);
     else unsetenv("CLPT_CACHE_DIR");
     free(old);

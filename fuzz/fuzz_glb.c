@@ -28,12 +28,7 @@ static void parse_glb(const char *data, size_t size)
     Status st = gltf_parse("fuzz.glb", data, size, &s, &o, &view, &err);
     /* ST_IO: a buffer or image file the JSON names is not there */
     if (st) FUZZ_ASSERT((st == ST_INPUT || st == ST_IO) && err.msg[0]);
-    for (size_t i = 0; i < s.n_triangles; i++) {
-        const Triangle *t = &s.triangles[i];
-        FUZZ_ASSERT(t->material < s.n_materials);
-        FUZZ_ASSERT(fuzz_finite3(t->p0) && fuzz_finite3(t->p1) && fuzz_finite3(t->p2));
-        FUZZ_ASSERT(t->shading == NO_INDEX || t->shading < s.n_shading);
-    }
+    fuzz_check_triangles(&s, NO_INDEX);
     fuzz_check_extras(&s);
     scene_free(&s);
     error_clear(&err);

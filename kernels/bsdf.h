@@ -163,23 +163,24 @@ KFN BsdfSample phong_sample(PhongLobes l, Material m, vec3 d, vec3 ns, vec3 ng, 
         s.transmitted = 0;
         return s;
     }
-    s.pdf = 0.0f;
-    s.specular = 1;
-    s.transmitted = 0;
     if (u_lobe < l.p_glossy + l.p_mirror) {
         /* about the shading normal, unless that would go below the surface */
         s.wi = reflect_dir(d, ns);
         if (v3_dot(s.wi, ng) <= 0.0f) s.wi = reflect_dir(d, ng);
         s.weight = v3_scale(l.kr, 1.0f / l.p_mirror);
+        s.pdf = 0.0f;
+        s.specular = 1;
+        s.transmitted = 0;
         return s;
     }
-    /* the refracting part, like glass, tinted by kt */
+    /* The refracting part, like glass, tinted by kt: the glass sample (a delta lobe) as
+     * it is, with kt's weight. Returned whole rather than copied field by field into s:
+     * NVIDIA's OpenCL compiler (driver 580.159) at its default optimisation kept the
+     * glossy branch's pdf and flag in s on this path (tools/gpu-check.sh found it). */
     BsdfSample g = bsdf_sample_dielectric(m.ior, d, ng, entering, u_fresnel);
     float p_t = 1.0f - l.p_glossy - l.p_mirror;
-    s.wi = g.wi;
-    s.transmitted = g.transmitted;
-    s.weight = p_t > 0.0f ? v3_scale(l.kt, 1.0f / p_t) : v3s(0.0f);
-    return s;
+    g.weight = p_t > 0.0f ? v3_scale(l.kt, 1.0f / p_t) : v3s(0.0f);
+    return g;
 }
 
 /* ---------------------------------------------------------------- dispatch

@@ -8,6 +8,8 @@
  * relative; colours within 1e-5 relative) and the test prints how many results were
  * bit-identical.
  */
+#include <float.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -323,6 +325,24 @@ static int v3_close(vec3 a, vec3 b, float tol)
     return rel_close(a.x, b.x, tol) && rel_close(a.y, b.y, tol) && rel_close(a.z, b.z, tol);
 }
 
+/* Prints the 4-byte words in which the C result and the device's differ (as floats and
+ * as bits), so that a device's difference points at a field rather than a count. */
+static void report_words(const char *what, uint index, const void *c, const void *dev, size_t bytes)
+{
+    const unsigned char *a = c, *b = dev;
+    for (size_t j = 0; j + 4 <= bytes; j += 4) {
+        if (!memcmp(a + j, b + j, 4)) continue;
+        float fa, fb;
+        uint ua, ub;
+        memcpy(&fa, a + j, 4);
+        memcpy(&fb, b + j, 4);
+        memcpy(&ua, a + j, 4);
+        memcpy(&ub, b + j, 4);
+        fprintf(stderr, "    %s %u, word %zu: C %a (0x%08x), device %a (0x%08x)\n", what, index, j / 4,
+                (double)fa, ua, (double)fb, ub);
+    }
+}
+
 static void test_layout(void)
 {
     uint host[] = { sizeof(vec3), sizeof(Ray), sizeof(Hit), sizeof(KdNode), sizeof(Sphere), sizeof(Triangle),
@@ -527,6 +547,11 @@ static void test_shade_and_shadow(void)
         if ((flags[i] & SHADE_CONTINUE) && memcmp(&crays[i], &drays[i], sizeof crays[i])) same = 0;
         if ((flags[i] & SHADE_SHADOW) && memcmp(&cshadow[i], &dshadow[i], sizeof cshadow[i])) same = 0;
         exact += same;
+        if (!same && i - exact < 3) {
+            report_words("path state", i, &cps[i], &dps[i], sizeof cps[i]);
+            report_words("next ray", i, &crays[i], &drays[i], sizeof crays[i]);
+            report_words("shadow ray", i, &cshadow[i], &dshadow[i], sizeof cshadow[i]);
+        }
         if (!v3_close(cps[i].radiance, dps[i].radiance, 1e-5f) || !v3_close(cps[i].throughput, dps[i].throughput, 1e-5f) ||
             !v3_close(cps[i].shadow_L, dps[i].shadow_L, 1e-5f) || cps[i].bounce != dps[i].bounce ||
             cps[i].flags != dps[i].flags)
@@ -539,6 +564,7 @@ static void test_shade_and_shadow(void)
     CHECK(n_cont > N / 10);
     CHECK(n_shadow > N / 20);
     CHECK_MSG(bad == 0, "%u of %u shaded paths differ", bad, (uint)N);
+    CHECK_EQ_INT(exact, N);
 
     /* k_shadow over the shadow queue the device produced */
     cl_kernel ks = kernel("k_shadow");
@@ -562,6 +588,7 @@ static void test_shade_and_shadow(void)
     fprintf(stderr, "  k_shadow: %u shadow rays, %u occluded, %u bit-identical to C\n", n_shadow, occluded, sexact);
     CHECK(occluded > 0 && occluded < n_shadow);
     CHECK_MSG(sbad == 0, "%u of %u shadow results differ", sbad, n_shadow);
+    CHECK_EQ_INT(sexact, n_shadow);
 
     free(ps); free(rays); free(hits); free(queue); free(dps); free(drays); free(dshadow);
     free(dnext); free(dshq); free(flags); free(cps); free(crays); free(cshadow); free(seen);
@@ -749,20 +776,91 @@ static void test_whitted(void)
     free(mask);
 }
 
-/* The functions of kmath.h that stand in for libm, through a test kernel built from a
- * folder holding just an entry.cl that includes kmath.h: the same bits as the C build
- * on every input, subnormals, zeros and the extremes included. */
-static void test_kmath(void)
+/* Builds a test kernel, SOURCE, as the renderer builds its own: the same options (so
+ * -cl-fp32-correctly-rounded-divide-sqrt where the device has it), kernels/ on the
+ * include path. Returns NULL (and has failed the test) if it does not build. */
+static cl_program build_test_program(const char *source)
 {
-    char dir[] = "/tmp/clpt-test-kmath-XXXXXX", path[128], inc[1200], cwd[1024];
+    char dir[] = "/tmp/clpt-test-kernel-XXXXXX", path[128], inc[1200], cwd[1024];
     CHECK(mkdtemp(dir) != NULL);
     CHECK(getcwd(cwd, sizeof cwd) != NULL);
     snprintf(path, sizeof path, "%s/entry.cl", dir);
     snprintf(inc, sizeof inc, "-I %s/kernels", cwd);
     FILE *f = fopen(path, "w");
     CHECK(f != NULL);
-    if (!f) return;
-    fputs("#include \"kmath.h\"\n"
+    if (!f) return NULL;
+    fputs(source, f);
+    fclose(f);
+    cl_program prog = NULL;
+    OclProgramStats ps;
+    Error err = {0};
+    Status st = ocl_program_build(cl.ctx, &cl.dev, dir, inc, &prog, &ps, &err);
+    CHECK_MSG(st == ST_OK, "%s\n%s", err.msg, err.detail ? err.detail : "");
+    error_clear(&err);
+    unlink(path);
+    rmdir(dir);
+    return st == ST_OK ? prog : NULL;
+}
+
+/* The arithmetic the bit-for-bit guarantee rests on, checked on the device itself:
+ * a * b + c rounded twice (FP_CONTRACT OFF in compat.h: no fused multiply-add),
+ * products into the subnormal range kept (no flush to zero), and / and sqrt
+ * correctly rounded. A device that breaks one of these cannot give the C twin's bits. */
+static void test_fp_semantics(void)
+{
+    cl_program prog = build_test_program(
+        "#include \"compat.h\"\n"
+        "__kernel void k_fp(__global const float *in, __global float *out, uint n)\n"
+        "{\n"
+        "    uint i = (uint)get_global_id(0);\n"
+        "    if (i >= n) return;\n"
+        "    float x = in[3u * i], y = in[3u * i + 1u], z = in[3u * i + 2u];\n"
+        "    out[4u * i] = x * y + z;\n"
+        "    out[4u * i + 1u] = (x * 0x1p-70f) * (y * 0x1p-60f);\n"
+        "    out[4u * i + 2u] = x / y;\n"
+        "    out[4u * i + 3u] = k_sqrt(k_fabs(x * z));\n"
+        "}\n");
+    if (!prog) return;
+    enum { N = 50000 };
+    float *in = malloc(3 * N * sizeof *in), *out = malloc(4 * N * sizeof *out);
+    for (uint i = 0; i < 3 * N; i++) in[i] = frand() * 4.0f - 2.0f;
+    cl_mem ib = buffer(3 * N * sizeof *in, in), ob = buffer(4 * N * sizeof *out, NULL);
+    cl_kernel k = NULL;
+    Error err = {0};
+    CHECK(ocl_program_kernel(prog, &cl.dev, "k_fp", &k, &err) == ST_OK);
+    uint n = N;
+    SET(k, 0, ib);
+    SET(k, 1, ob);
+    SET(k, 2, n);
+    run(k, N);
+    read_back(ob, 4 * N * sizeof *out, out);
+    uint same[4] = {0}, fused = 0, subnormal = 0;
+    for (uint i = 0; i < N; i++) {
+        float x = in[3 * i], y = in[3 * i + 1], z = in[3 * i + 2];
+        float c[4] = { x * y + z, (x * 0x1p-70f) * (y * 0x1p-60f), x / y, sqrtf(fabsf(x * z)) };
+        for (int j = 0; j < 4; j++) same[j] += memcmp(&c[j], &out[4 * i + j], sizeof c[j]) == 0;
+        float f = fmaf(x, y, z);
+        fused += memcmp(&c[0], &f, sizeof f) != 0 && memcmp(&f, &out[4 * i], sizeof f) == 0;
+        subnormal += c[1] != 0.0f && fabsf(c[1]) < FLT_MIN;
+    }
+    fprintf(stderr, "  a*b+c %u, tiny products %u (%u subnormal), x/y %u, sqrt %u of %u bit-identical to C;"
+            " %u fused\n", same[0], same[1], subnormal, same[2], same[3], (uint)N, fused);
+    for (int j = 0; j < 4; j++) CHECK_EQ_INT(same[j], N);
+    CHECK(subnormal > N / 10);
+    free(in);
+    free(out);
+    clReleaseKernel(k);
+    clReleaseMemObject(ib);
+    clReleaseMemObject(ob);
+    clReleaseProgram(prog);
+}
+
+/* The functions of kmath.h that stand in for libm, through a test kernel built from a
+ * folder holding just an entry.cl that includes kmath.h: the same bits as the C build
+ * on every input, subnormals, zeros and the extremes included. */
+static void test_kmath(void)
+{
+    cl_program prog = build_test_program("#include \"kmath.h\"\n"
           "__kernel void k_math(__global const float *in, __global float *out, uint n)\n"
           "{\n"
           "    uint i = (uint)get_global_id(0);\n"
@@ -777,17 +875,9 @@ static void test_kmath(void)
           "    out[8u * i + 5u] = k_srgb_to_linear(k_fmin(x, 1.0f));\n"
           "    out[8u * i + 6u] = s + c;\n"
           "    out[8u * i + 7u] = k_smoothstep(0.2f, 0.7f, x) + k_cbrt(x);\n"
-          "}\n", f);
-    fclose(f);
-    cl_program prog = NULL;
-    OclProgramStats ps;
+          "}\n");
+    if (!prog) return;
     Error err = {0};
-    Status st = ocl_program_build(cl.ctx, &cl.dev, dir, inc, &prog, &ps, &err);
-    CHECK_MSG(st == ST_OK, "%s\n%s", err.msg, err.detail ? err.detail : "");
-    error_clear(&err);
-    unlink(path);
-    rmdir(dir);
-    if (st != ST_OK) return;
     enum { N = 40000 };
     float *in = malloc(2 * N * sizeof *in), *dout = malloc(8 * N * sizeof *dout);
     for (uint i = 0; i < N; i++) {
@@ -848,15 +938,7 @@ static void bsdf_reference(const Material *mats, uint n_mats, uint i, const floa
 
 static void test_bsdf(void)
 {
-    char dir[] = "/tmp/clpt-test-bsdf-XXXXXX", path[128], inc[1200], cwd[1024];
-    CHECK(mkdtemp(dir) != NULL);
-    CHECK(getcwd(cwd, sizeof cwd) != NULL);
-    snprintf(path, sizeof path, "%s/entry.cl", dir);
-    snprintf(inc, sizeof inc, "-I %s/kernels", cwd);
-    FILE *f = fopen(path, "w");
-    CHECK(f != NULL);
-    if (!f) return;
-    fputs("#include \"bsdf.h\"\n"
+    cl_program prog = build_test_program("#include \"bsdf.h\"\n"
           "__kernel void k_bsdf(__global const Material *mats, uint n_mats, __global const float *in,\n"
           "                     __global float *out, uint n)\n"
           "{\n"
@@ -875,17 +957,9 @@ static void test_bsdf(void)
           "    o[4] = bs.wi.x; o[5] = bs.wi.y; o[6] = bs.wi.z;\n"
           "    o[7] = bs.weight.x; o[8] = bs.weight.y; o[9] = bs.weight.z; o[10] = bs.pdf;\n"
           "    o[11] = (float)bs.specular; o[12] = (float)bs.transmitted;\n"
-          "}\n", f);
-    fclose(f);
-    cl_program prog = NULL;
-    OclProgramStats ps;
+          "}\n");
+    if (!prog) return;
     Error err = {0};
-    Status st = ocl_program_build(cl.ctx, &cl.dev, dir, inc, &prog, &ps, &err);
-    CHECK_MSG(st == ST_OK, "%s\n%s", err.msg, err.detail ? err.detail : "");
-    error_clear(&err);
-    unlink(path);
-    rmdir(dir);
-    if (st != ST_OK) return;
     /* every material type, the microfacet ones at several roughnesses */
     Material mats[] = { material_diffuse(v3(0.7f, 0.5f, 0.3f)), material_metal(v3s(0.9f), 0.3f),
                         material_dielectric(1.5f), material_phong(v3s(0.4f), v3s(0.4f), 40.0f),
@@ -939,7 +1013,15 @@ static void test_bsdf(void)
     for (uint i = 0; i < N; i++) {
         float cv[BSDF_OUT];
         bsdf_reference(mats, n_mats, i, in + BSDF_IN * i, cv);
-        exact += memcmp(cv, dout + BSDF_OUT * i, sizeof cv) == 0;
+        int same = memcmp(cv, dout + BSDF_OUT * i, sizeof cv) == 0;
+        exact += same;
+        if (!same && i + 1 - exact <= 3) {
+            const Material *m = &mats[i % n_mats];
+            fprintf(stderr, "    input %u: material %u (type %u, roughness %g), u_lobe %a\n", i, i % n_mats,
+                    (uint)m->type, (double)m->roughness, (double)in[BSDF_IN * i + 10]);
+            report_words("bsdf outputs (f, pdf, wi, weight, pdf, specular, transmitted)", i, cv,
+                         dout + BSDF_OUT * i, sizeof cv);
+        }
         nonzero += cv[3] > 0.0f;
     }
     fprintf(stderr, "  bsdf_eval / bsdf_sample: %u of %u inputs bit-identical to C (%u with a density)\n", exact,
@@ -989,6 +1071,7 @@ int main(void)
     RUN(test_film);
     RUN(test_whitted);
     RUN(test_kmath);
+    RUN(test_fp_semantics);
     RUN(test_bsdf);
     for (int i = 0; i < N_SCENE; i++) clReleaseMemObject(cl.scene[i]);
     clReleaseProgram(cl.prog);

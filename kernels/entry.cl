@@ -40,10 +40,20 @@
     SceneView sc;                                                                        \
     SCENE_BUFFERS(SCENE_VIEW_SET_)
 
+/* CLPT_LOCAL_SIZE (set by the renderer, device_ocl.c, when it launches every kernel with
+ * that work-group size): declared on the wavefront kernels, so a driver compiles them
+ * for that size once. PoCL compiles a work-group function per kernel and size: for the
+ * program binary clpt caches, and again at the first launch unless the sizes match. */
+#ifdef CLPT_LOCAL_SIZE
+#define KERNEL_SIZE __attribute__((reqd_work_group_size(CLPT_LOCAL_SIZE, 1, 1)))
+#else
+#define KERNEL_SIZE
+#endif
+
 #if KF_HAS(KF_PATH)
 /* Births the wave's paths and queues them all: path i of the wave is path number
  * first_pixel + i of the batch (see the top of this file). */
-__kernel void k_raygen(__global const RenderParams *params, uint first_pixel, uint first_sample,
+__kernel KERNEL_SIZE void k_raygen(__global const RenderParams *params, uint first_pixel, uint first_sample,
                        uint n_pixels, uint n_paths, __global PathState *paths,
                        __global Ray *rays, __global uint *queue)
 {
@@ -55,7 +65,7 @@ __kernel void k_raygen(__global const RenderParams *params, uint first_pixel, ui
 }
 
 /* Closest hit for every queued path. */
-__kernel void k_intersect(SCENE_ARGS __global const uint *queue, uint n,
+__kernel KERNEL_SIZE void k_intersect(SCENE_ARGS __global const uint *queue, uint n,
                           __global const Ray *rays, __global Hit *hits)
 {
     uint i = (uint)get_global_id(0);
@@ -71,7 +81,7 @@ __kernel void k_intersect(SCENE_ARGS __global const uint *queue, uint n,
  * global atomic_add per queue), because one global atomic per path made the shared
  * counters the hottest cache line of the whole render on a CPU. No early return: every
  * work-item must reach the barriers. */
-__kernel void k_shade(SCENE_ARGS __global const uint *queue, uint n, __global Ray *rays,
+__kernel KERNEL_SIZE void k_shade(SCENE_ARGS __global const uint *queue, uint n, __global Ray *rays,
                       __global const Hit *hits, __global PathState *paths,
                       __global Ray *shadow_rays, __global uint *next_queue,
                       __global uint *shadow_queue, __global uint *counts, uint slot)
@@ -105,7 +115,7 @@ __kernel void k_shade(SCENE_ARGS __global const uint *queue, uint n, __global Ra
 }
 
 /* Any-hit test of every queued shadow ray, resolving the waiting contributions. */
-__kernel void k_shadow(SCENE_ARGS __global const uint *shadow_queue, uint n,
+__kernel KERNEL_SIZE void k_shadow(SCENE_ARGS __global const uint *shadow_queue, uint n,
                        __global const Ray *shadow_rays, __global PathState *paths)
 {
     uint i = (uint)get_global_id(0);
@@ -121,7 +131,7 @@ __kernel void k_shadow(SCENE_ARGS __global const uint *shadow_queue, uint n,
  * one of wave path j, and adds every path of the wave on that pixel (j, j + n_pixels,
  * ...), so no two work-items touch the same film entry; launched over
  * min(n_paths, n_pixels) work-items. */
-__kernel void k_film(__global const PathState *paths, uint first_pixel, uint n_pixels,
+__kernel KERNEL_SIZE void k_film(__global const PathState *paths, uint first_pixel, uint n_pixels,
                      uint n_paths, __global long *film)
 {
     uint j = (uint)get_global_id(0);
@@ -193,7 +203,7 @@ __kernel void k_layout(__global uint *out)
  * receives the number of rays traced (summed per work-group first). No early return:
  * every work-item must reach the barriers. */
 #if KF_HAS(KF_WHITTED)
-__kernel void k_whitted(SCENE_ARGS uint first_pixel, uint first_sample, uint n_pixels, uint n_paths,
+__kernel KERNEL_SIZE void k_whitted(SCENE_ARGS uint first_pixel, uint first_sample, uint n_pixels, uint n_paths,
                         __global PathState *paths, __global uint *counters)
 {
     __local uint group_rays;

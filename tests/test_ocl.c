@@ -641,6 +641,41 @@ static void test_program_per_integrator(void)
     }
 }
 
+/* With CLPT_LOCAL_SIZE, as the device builds them, the launched kernels of both programs
+ * declare that work-group size, so that PoCL compiles each kernel once (the size the
+ * binary is made for is the launches' size; ocl.c turns PoCL's re-specialisation off). */
+static void test_kernels_declare_the_launch_size(void)
+{
+    static const struct { unsigned features; const char *kernels[5]; } programs[] = {
+        { KF_PATH, { "k_raygen", "k_intersect", "k_shade", "k_shadow", "k_film" } },
+        { KF_WHITTED, { "k_whitted", "k_film", NULL, NULL, NULL } },
+    };
+    for (size_t i = 0; i < sizeof programs / sizeof programs[0]; i++) {
+        char options[96];
+        snprintf(options, sizeof options, "-D CLPT_FEATURES=0x%xu -D CLPT_LOCAL_SIZE=64", programs[i].features);
+        Error err = {0};
+        cl_program prog = NULL;
+        CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, options, &prog, NULL, &err), ST_OK);
+        error_clear(&err);
+        if (!prog) continue;
+        for (int k = 0; k < 5 && programs[i].kernels[k]; k++) {
+            cl_int rc;
+            cl_kernel kn = clCreateKernel(prog, programs[i].kernels[k], &rc);
+            size_t size[3] = { 0, 0, 0 };
+            CHECK(rc == CL_SUCCESS);
+            if (rc != CL_SUCCESS) continue;
+            CHECK(clGetKernelWorkGroupInfo(kn, dev->id, CL_KERNEL_COMPILE_WORK_GROUP_SIZE, sizeof size, size, NULL) ==
+                  CL_SUCCESS);
+            CHECK_MSG(size[0] == 64 && size[1] == 1 && size[2] == 1, "%s: declared size %zu x %zu x %zu",
+                      programs[i].kernels[k], size[0], size[1], size[2]);
+            clReleaseKernel(kn);
+        }
+        clReleaseProgram(prog);
+    }
+    const char *spec = getenv("POCL_WORK_GROUP_SPECIALIZATION");
+    CHECK_MSG(spec && strcmp(spec, "0") == 0, "POCL_WORK_GROUP_SPECIALIZATION is %s", spec ? spec : "unset");
+}
+
 /* Every feature switch of types.h, alone with either integrator, compiles without a
  * warning: PoCL prints a build's warnings on stderr ("1 warning generated."), so a
  * switch that leaves, say, a constant operand of || behind would show in every run of
@@ -832,6 +867,7 @@ int main(int argc, char **argv)
         RUN(test_crashing_cache_entry);
         RUN(test_kernel_argument_names);
         RUN(test_program_per_integrator);
+    RUN(test_kernels_declare_the_launch_size);
         RUN(test_cache_location);
         RUN(test_kernel_dir);
         RUN(test_build_failure);

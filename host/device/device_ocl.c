@@ -380,9 +380,11 @@ static Status need_program(Device *d, OclDevice *od, uint integrator, Error *err
     unsigned want = od->scene_features | (which == PROG_PATH ? KF_PATH : KF_WHITTED);
     if (od->programs[which] && (od->features[which] & want) == want) return ST_OK;
     release_program(od, which);
-    char options[256];
+    char options[320];
     const char *fault = fault_build_options(d->desc.index);
-    if (snprintf(options, sizeof options, "-D CLPT_FEATURES=0x%xu%s%s", want, fault && fault[0] ? " " : "",
+    char size[48] = "";
+    if (od->local_size) snprintf(size, sizeof size, " -D CLPT_LOCAL_SIZE=%zu", od->local_size);
+    if (snprintf(options, sizeof options, "-D CLPT_FEATURES=0x%xu%s%s%s", want, size, fault && fault[0] ? " " : "",
                  fault ? fault : "") >= (int)sizeof options)
         return error_set(err, ST_INTERNAL, "device '%s': build options too long", od->info.name);
     OclProgramStats ps;

@@ -219,6 +219,16 @@ Status ocl_enumerate(OclDeviceInfo **out, size_t *n, Error *err)
     *out = NULL;
     *n = 0;
     cl_uint n_platforms = 0;
+    /* PoCL compiles a work-group function per kernel when clpt reads the program binary
+     * back for its cache, and by default compiles a second one, specialised for the
+     * launch's sizes, at each kernel's first launch: 1.2 s of a 3.3 s cold start on the
+     * Cornell box, for no measurable speed (Cornell box and dragon, interleaved:
+     * 2.36 and 2.58 Msamples/s without, 2.36 and 2.51 with; bench/RESULTS.md). The
+     * kernels declare the one work-group size the renderer launches them with
+     * (CLPT_LOCAL_SIZE in entry.cl), so the function in the binary fits every launch.
+     * Read by PoCL when it starts, i.e. before the first call below; a value the user
+     * set is kept. */
+    setenv("POCL_WORK_GROUP_SPECIALIZATION", "0", 0);
     cl_int rc = clGetPlatformIDs(0, NULL, &n_platforms);
     /* -1001 is CL_PLATFORM_NOT_FOUND_KHR: the ICD loader found no driver at all. */
     if (rc == -1001 || (rc == CL_SUCCESS && n_platforms == 0)) return ST_OK;

@@ -1,0 +1,111 @@
+#!/bin/sh
+# tools/gpu-check.sh [BUILD] [OUT] — what to run on a machine with an OpenCL GPU.
+#
+# The test suite runs on PoCL (make test installs it); this script checks the same
+# guarantees on whatever OpenCL GPU the machine has, and measures it:
+#   1. the devices, as clpt lists them, and start-up: a cold kernel build (empty cache,
+#      before anything else builds) and a warm one;
+#   2. every kernel on the GPU against the scalar C twin, bit for bit (test_kernels and
+#      test_sampler take a CPU device when one exists, else the first device: the GPU);
+#   3. whole images: GPU alone, scalar alone and both together give the same bits, for
+#      every shipped scene and the two peer scenes (../shared beside the checkout);
+#   4. throughput: bench_render (every device, then scalar), the wave size on two large
+#      renders, and --profile.
+# Each step has its own time limit; everything is also written under OUT.
+# Run from the repository root after `make` and `make build/tests/test_kernels ...`.
+set -u
+build=${1:-build}
+out=${2:-gpu-check}
+dev=${GPU_CHECK_DEVICE:-gpu}    # another device spec tries the script out without a GPU
+mkdir -p "$out"
+clpt=$build/clpt
+cache=$(mktemp -d)
+export CLPT_CACHE_DIR="$cache"
+step() { echo; echo "== $*"; }
+lim() { t=$1; shift; timeout "$t" "$@"; rc=$?; [ $rc -eq 124 ] && echo "(stopped after ${t}s)"; return $rc; }
+
+step devices
+lim 60 "$clpt" --list-devices
+
+step "start-up (16x16, 1 spp): cold, then warm"
+for kind in cold warm; do
+    s=$(date +%s%N)
+    lim 120 "$clpt" scenes/cornell-box.scene --device "$dev" --width 16 --height 16 --spp 1 -q \
+        --stats -o "$out/startup.pfm" | grep -i kernels
+    echo "$kind: $(( ($(date +%s%N) - s) / 1000000 )) ms"
+done
+
+step "kernels: GPU against scalar, bit for bit"
+lim 240 "$build/tests/test_kernels" 2>"$out/test_kernels.log" | tail -n 5
+grep -E 'FAIL' "$out/test_kernels.log" | head -n 20
+lim 120 "$build/tests/test_sampler" 2>"$out/test_sampler.log" | tail -n 2
+grep -E 'FAIL' "$out/test_sampler.log" | head -n 20
+
+step "whole images: gpu = scalar = gpu,scalar (same seed, bits of the PFM)"
+same=0; differ=0
+check() { # NAME SCENE ARGS...
+    name=$1; scene=$2; shift 2
+    [ -f "$scene" ] || { echo "skip $name: $scene is missing"; return; }
+    for d in "$dev" scalar "$dev,scalar"; do
+        f="$out/$name-$(echo "$d" | sed "s/^$dev/gpu/; s/,/+/").pfm"
+        lim 90 "$clpt" "$scene" --device "$d" --seed 7 -q -o "$f" "$@" \
+            || echo "$name on $d: exit $?"
+    done
+    a="$out/$name-gpu.pfm"
+    if cmp -s "$a" "$out/$name-scalar.pfm" && cmp -s "$a" "$out/$name-gpu+scalar.pfm"; then
+        echo "same   $name"; same=$((same + 1))
+    else
+        echo "DIFFER $name"; differ=$((differ + 1))
+        command -v python3 >/dev/null && python3 - "$a" "$out/$name-scalar.pfm" <<'EOF'
+import sys, struct
+def pfm(p):
+    b = open(p, 'rb').read()
+    parts = b.split(b'\n', 3)
+    w, h = map(int, parts[1].split()); return w, h, struct.unpack('<%df' % (w * h * 3), parts[3][:w * h * 12])
+try:
+    w, h, a = pfm(sys.argv[1]); _, _, b = pfm(sys.argv[2])
+    d = [abs(x - y) for x, y in zip(a, b)]
+    n = sum(1 for x in d if x > 0)
+    print('    %d of %d values differ, largest difference %.3g, mean %.3g' % (n, len(d), max(d), sum(d) / len(d)))
+except Exception as e:
+    print('    cannot compare: %s' % e)
+EOF
+    fi
+}
+check cornell scenes/cornell-box.scene --width 256 --height 256 --spp 16
+check weekend scenes/one-weekend.scene --width 400 --height 225 --spp 8
+check mesh scenes/mesh.scene --width 256 --height 256 --spp 8
+check envmap scenes/envmap.scene --width 240 --height 136 --spp 8
+check materials scenes/materials.scene --width 240 --height 136 --spp 8
+check classic scenes/classic/glass.txt --integrator path --spp 16
+check mcguire ../shared/peers/cornell-mcguire.scene --width 256 --height 256 --spp 16
+check dragon ../shared/peers/dragon.scene --width 256 --height 256 --spp 4
+echo "$same same, $differ differ"
+
+step "throughput: bench_render (median of 3)"
+lim 300 "$build/bench/bench_render" --reps 3 --json "$out/bench_render.json"
+
+step "wave size (Msamples/s, the total line of --stats)"
+for sc in ../shared/peers/cornell-mcguire.scene:256 ../shared/peers/dragon.scene:64; do
+    f=${sc%:*}; spp=${sc##*:}
+    [ -f "$f" ] || continue
+    for wp in 262144 1048576 4194304; do
+        r=$(lim 120 "$clpt" "$f" --device "$dev" --width 1024 --height 1024 --spp "$spp" --wave-paths $wp \
+            --stats -q -o "$out/waves.pfm" 2>&1 | grep '^total' | awk '{print $(NF-2)}')
+        echo "$(basename "$f") 1024x1024 ${spp} spp, --wave-paths $wp: $r Msamples/s"
+    done
+done
+
+step "profile: where the GPU's time goes"
+profile() { # SCENE [ARGS...]
+    [ -f "$1" ] || return
+    echo "-- $*"
+    lim 120 "$clpt" "$@" --device "$dev" --profile -q -o "$out/profile.pfm" 2>&1 | tail -n 25
+}
+profile scenes/cornell-box.scene
+profile ../shared/peers/cornell-mcguire.scene
+profile ../shared/peers/dragon.scene
+# a load large enough to keep the GPU busy between host round trips
+profile ../shared/peers/cornell-mcguire.scene --width 1024 --height 1024 --spp 256
+profile ../shared/peers/dragon.scene --width 1024 --height 1024 --spp 64
+rm -rf "$cache"

@@ -446,7 +446,7 @@ static Status open_devices(const Options *o, const DeviceScene *ds, Device ***ou
         free(chosen);
         return error_set(err, ST_INTERNAL, "out of memory");
     }
-    DeviceConfig cfg = { o->threads, o->kernel_dir, o->wave_paths, o->profile };
+    DeviceConfig cfg = { o->threads, o->kernel_dir, o->wave_paths, o->profile, o->wave_launch };
     ocl_program_announce_builds(!o->quiet);
     size_t n = 0;
     Error last = { 0 };
@@ -921,7 +921,7 @@ static Status run_interactive(Run *r, Error *err)
     if (st == ST_OK) st = open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
     if (st == ST_OK) {
         ViewerConfig vc = { r->o.scene_path, &r->scene, &r->rs, r->devs, r->n_devs,
-                            { r->o.threads, r->o.kernel_dir, r->o.wave_paths, 0 }, r->encoding,
+                            { r->o.threads, r->o.kernel_dir, r->o.wave_paths, 0, r->o.wave_launch }, r->encoding,
                             r->o.batch, r->o.stats, r->o.quiet };
         st = viewer_run(&vc, err);
     }

@@ -3,6 +3,7 @@
 
 #include "course_args.h"
 
+#include "device/device.h"
 #include "io/scene_load.h"
 #include "base/limit.h"
 #include "types.h"
@@ -184,6 +185,12 @@ void options_print_help(FILE *f)
 "                             adaptive, about 0.25 s of work per batch)\n"
 "      --wave-paths N         paths per OpenCL wave (default: 2^20 on GPUs,\n"
 "                             2^16 on CPUs; 2^14 with --interactive)\n"
+"      --wave-launch counted|bounded\n"
+"                             OpenCL bounces: 'counted' launches each over the\n"
+"                             live paths the device counted, read back first\n"
+"                             (CPUs); 'bounded' launches all of a wave's at\n"
+"                             once, over its size, the kernels stopping at the\n"
+"                             count on the device (GPUs). Default: by device type\n"
 "\n"
 "Environment:\n"
 "  CLPT_CACHE_DIR             where compiled kernels are cached (default:\n"
@@ -421,6 +428,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
     static const int on_off_values[] = { 1, 0 };
     static const char *const samplers[] = { "sobol", "independent", NULL };
     static const int sampler_values[] = { SAMPLER_SOBOL, SAMPLER_INDEPENDENT };
+    static const char *const launches[] = { "counted", "bounded", NULL };
+    static const int launch_values[] = { WAVE_LAUNCH_COUNTED, WAVE_LAUNCH_BOUNDED };
     *found = 1;
     if (strcmp(a, "--integrator") == 0)
         return parse_choice(a, v, integrators, integrator_values, "'path' or 'whitted'", &o->integrator, err);
@@ -432,6 +441,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
         return parse_choice(a, v, on_off, on_off_values, "'on' or 'off'", &o->shadows, err);
     if (strcmp(a, "--sampler") == 0)
         return parse_choice(a, v, samplers, sampler_values, "'sobol' or 'independent'", &o->sampler, err);
+    if (strcmp(a, "--wave-launch") == 0)
+        return parse_choice(a, v, launches, launch_values, "'counted' or 'bounded'", &o->wave_launch, err);
     if (strcmp(a, "--aov") == 0) return options_parse_aovs(v, &o->aovs, err);
     *found = 0;
     return ST_OK;

@@ -32,6 +32,7 @@ typedef struct {
     const char *kernel_dir;
     unsigned batch;               /* fixed batch size, 0 = adaptive */
     unsigned wave_paths;          /* OpenCL wave size, 0 = automatic */
+    int wave_launch;              /* enum WaveLaunch (device.h), 0 = by device type */
     /* the classic ray tracer (docs/classic-format.md) */
     int integrator;               /* enum Integrator (path or whitted), -1 = the scene's */
     int format;                   /* enum SceneFormat (io/scene_load.h) */

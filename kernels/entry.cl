@@ -13,8 +13,12 @@
  *
  * k_shade counts into per-wave count slots QUEUE_COUNT_STRIDE uints apart (one per
  * cache line, types.h): at bounce b, slot 2b + 1 counts its shadow rays and slot 2b + 2
- * the paths that go on. Every bounce has its own slots, so a wave's counters are zeroed
- * once and the host can read them back while later bounces run.
+ * the paths that go on; the host puts the wave's size in slot 0. Every bounce has its
+ * own slots, so a wave's counters are zeroed once and the host can read them back while
+ * later bounces run. Each bounce kernel also takes no more work-items than the count of
+ * its queue on the device (slot 2b for intersect and shade, 2b + 1 for shadow), so the
+ * host may launch it over an upper bound without waiting for the count (GPUs,
+ * device_ocl.c) or over exactly the count it read back (CPUs).
  *
  * The host builds the path tracer's kernels and the classic ray tracer's as two programs
  * (CLPT_FEATURES with KF_PATH or KF_WHITTED, types.h), each on first use: a driver
@@ -66,10 +70,11 @@ __kernel KERNEL_SIZE void k_raygen(__global const RenderParams *params, uint fir
 
 /* Closest hit for every queued path. */
 __kernel KERNEL_SIZE void k_intersect(SCENE_ARGS __global const uint *queue, uint n,
-                          __global const Ray *rays, __global Hit *hits)
+                          __global const Ray *rays, __global Hit *hits,
+                          __global const uint *counts, uint live_slot)
 {
     uint i = (uint)get_global_id(0);
-    if (i >= n) return;
+    if (i >= n || i >= counts[live_slot * QUEUE_COUNT_STRIDE]) return;
     SCENE_VIEW(sc);
     uint path = queue[i];
     hits[path] = trace_closest_visible(&sc, rays[path]);
@@ -96,7 +101,7 @@ __kernel KERNEL_SIZE void k_shade(SCENE_ARGS __global const uint *queue, uint n,
     }
     barrier(CLK_LOCAL_MEM_FENCE);
     uint r = 0u, path = 0u;
-    if (i < n) {
+    if (i < n && i < counts[(slot - 1u) * QUEUE_COUNT_STRIDE]) {
         SCENE_VIEW(sc);
         path = queue[i];
         r = shade_path(&sc, &rays[path], hits[path], &paths[path], &shadow_rays[path]);
@@ -116,10 +121,11 @@ __kernel KERNEL_SIZE void k_shade(SCENE_ARGS __global const uint *queue, uint n,
 
 /* Any-hit test of every queued shadow ray, resolving the waiting contributions. */
 __kernel KERNEL_SIZE void k_shadow(SCENE_ARGS __global const uint *shadow_queue, uint n,
-                       __global const Ray *shadow_rays, __global PathState *paths)
+                       __global const Ray *shadow_rays, __global PathState *paths,
+                       __global const uint *counts, uint live_slot)
 {
     uint i = (uint)get_global_id(0);
-    if (i >= n) return;
+    if (i >= n || i >= counts[live_slot * QUEUE_COUNT_STRIDE]) return;
     SCENE_VIEW(sc);
     uint path = shadow_queue[i];
     shadow_resolve(&paths[path], trace_occluded(&sc, shadow_rays[path]));

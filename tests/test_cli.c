@@ -1,5 +1,6 @@
 /* test_cli.c — the program as a user meets it: help, exit codes, error messages, the
  * device flag, and a real render to each output format. */
+#include <math.h>
 #include <time.h>
 
 #include "cli_util.h"
@@ -15,7 +16,7 @@ static void test_help_documents_every_flag(void)
     CHECK_EQ_INT(r.status, 0);
     const char *flags[] = { "--output", "--spp", "--width", "--height", "--seed", "--max-depth", "--time-limit",
                             "--progressive-output", "--list-devices", "--device", "--threads", "--stats",
-                            "--quiet", "--help", "--version", "--kernel-dir", "--batch", "--wave-paths",
+                            "--quiet", "--help", "--version", "--kernel-dir", "--batch", "--wave-paths", "--wave-launch",
                             "--shadows", "--sampler", "--profile", "-size W H -input SCENE -output FILE", "-depth NEAR FAR FILE",
                             "-bounces N", "clpt SCENE OUT.bmp", "Exit status" };
     for (size_t i = 0; i < sizeof flags / sizeof flags[0]; i++) CHECK_STR_CONTAINS(r.out, flags[i]);
@@ -43,6 +44,41 @@ static void test_usage_errors(void)
     cli_run(ARGS("scenes/cornell-box.scene", "--sampler", "halton"), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "--sampler expects 'sobol' or 'independent', got 'halton'");
+    cli_run(ARGS("scenes/cornell-box.scene", "--wave-launch", "fast"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "--wave-launch expects 'counted' or 'bounded', got 'fast'");
+}
+
+/* Both ways of launching a wave's bounces on an OpenCL device (--wave-launch; bounded is
+ * the GPUs' default, here forced on PoCL) give the scalar device's bits, with small
+ * waves (several per batch) and several batches; and report the same number of rays. */
+static void test_wave_launches_match_scalar(void)
+{
+    const char *modes[] = { "counted", "bounded" };
+    const char *outs[] = { "/tmp/clpt-test-launch-counted.pfm", "/tmp/clpt-test-launch-bounded.pfm" };
+    const char *ref = "/tmp/clpt-test-launch-scalar.pfm";
+    double rays[2] = { 0.0, -1.0 };
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", "--width", "40", "--height", "32", "--spp", "12",
+                 "--seed", "9", "-q", "-o", ref),
+            &r);
+    CHECK_EQ_INT(r.status, 0);
+    for (int i = 0; i < 2; i++) {
+        cli_run(ARGS("scenes/cornell-box.scene", "--device", "cpu", "--width", "40", "--height", "32", "--spp", "12",
+                     "--seed", "9", "--wave-launch", modes[i], "--wave-paths", "1000", "--batch", "5", "--stats", "-q",
+                     "-o", outs[i]),
+                &r);
+        CHECK_MSG(r.status == 0, "%s: %s", modes[i], r.err);
+        CHECK_MSG(files_equal(ref, outs[i]), "--wave-launch %s: the image differs from the scalar device's", modes[i]);
+        /* the total line: samples, seconds, Msamples/s, Mrays/s; rays per sample compared
+         * (both rates printed to 3 decimals: equal to within their rounding) */
+        const char *t = strstr(r.out, "\ntotal");
+        double samples = 0, secs = 0, ms = 0, mr = 0;
+        if (t && sscanf(t + 6, "%lf %lf %lf %lf", &samples, &secs, &ms, &mr) == 4 && ms > 0) rays[i] = mr / ms;
+        unlink(outs[i]);
+    }
+    CHECK_MSG(rays[0] > 1.0 && fabs(rays[0] - rays[1]) < 0.01 * rays[0], "rays per sample: counted %.3f, bounded %.3f",
+              rays[0], rays[1]);
+    unlink(ref);
 }
 
 static void test_missing_scene_is_io_error(void)
@@ -661,6 +697,7 @@ int main(void)
     RUN(test_quiet_prints_nothing);
     RUN(test_unwritable_output_is_io_error);
     RUN(test_stats);
+    RUN(test_wave_launches_match_scalar);
     RUN(test_profile);
     RUN(test_help_fits_80_columns);
     RUN(test_bad_outputs_found_before_rendering);

@@ -439,14 +439,20 @@ static void test_intersect(void)
         queue[i] = N - 1 - i;                   /* a permuted queue, as after compaction */
     }
     cl_mem rb = buffer(N * sizeof *rays, rays), qb = buffer(N * sizeof *queue, queue), hb = buffer(N * sizeof(Hit), NULL);
+    /* launched over an upper bound, as on a GPU: the live count on the device (count
+     * slot 0 here) stops the work-items past it, and the surplus beyond n does nothing */
+    cl_uint live_counts[QUEUE_COUNT_STRIDE] = { N }, live_slot = 0;
+    cl_mem lcb = buffer(sizeof live_counts, live_counts);
     cl_kernel k = kernel("k_intersect");
     set_scene_args(k);
-    uint n = N;
+    uint n = N + 64;
     SET(k, N_SCENE + 0, qb);
     SET(k, N_SCENE + 1, n);
     SET(k, N_SCENE + 2, rb);
     SET(k, N_SCENE + 3, hb);
-    run(k, N + 100);                            /* surplus work-items must do nothing */
+    SET(k, N_SCENE + 4, lcb);
+    SET(k, N_SCENE + 5, live_slot);
+    run(k, N + 100);
     Hit *dh = malloc(N * sizeof *dh);
     read_back(hb, N * sizeof *dh, dh);
     uint exact = 0, bad = 0, hits = 0;
@@ -459,10 +465,12 @@ static void test_intersect(void)
     fprintf(stderr, "  k_intersect: %u rays, %u hits, %u bit-identical to C\n", (uint)N, hits, exact);
     CHECK(hits > N / 4);
     CHECK_MSG(bad == 0, "%u of %u hits differ", bad, (uint)N);
+    CHECK_EQ_INT(exact, N);
     free(rays);
     free(queue);
     free(dh);
     clReleaseKernel(k);
+    clReleaseMemObject(lcb);
     clReleaseMemObject(rb);
     clReleaseMemObject(qb);
     clReleaseMemObject(hb);
@@ -495,6 +503,7 @@ static void test_shade_and_shadow(void)
     /* bounce 1 of a wave: the shade kernel counts its shadow rays into count slot 3 and
      * the next queue into slot 4 (entry.cl) */
     cl_uint init_counts[5 * QUEUE_COUNT_STRIDE] = { 0 }, slot = 3;
+    init_counts[2 * QUEUE_COUNT_STRIDE] = N;    /* the live paths entering bounce 1 */
     cl_mem cb = buffer(sizeof init_counts, init_counts);
     cl_kernel k = kernel("k_shade");
     set_scene_args(k);
@@ -569,12 +578,14 @@ static void test_shade_and_shadow(void)
     /* k_shadow over the shadow queue the device produced */
     cl_kernel ks = kernel("k_shadow");
     set_scene_args(ks);
-    uint ns = counts[1];
+    uint ns = N, shadow_slot = slot;             /* an upper bound; the count is on the device */
     SET(ks, N_SCENE + 0, sqb);
     SET(ks, N_SCENE + 1, ns);
     SET(ks, N_SCENE + 2, srb);
     SET(ks, N_SCENE + 3, pb);
-    run(ks, ns + 50);
+    SET(ks, N_SCENE + 4, cb);
+    SET(ks, N_SCENE + 5, shadow_slot);
+    run(ks, N + 50);
     read_back(pb, N * sizeof *dps, dps);
     uint occluded = 0, sbad = 0, sexact = 0;
     for (uint i = 0; i < N; i++) {
@@ -622,6 +633,7 @@ static void test_shade_cubemap(void)
            srb = buffer(N * sizeof(Ray), NULL), nqb = buffer(N * sizeof(uint), NULL),
            sqb = buffer(N * sizeof(uint), NULL);
     cl_uint init_counts[5 * QUEUE_COUNT_STRIDE] = { 0 }, slot = 3;
+    init_counts[2 * QUEUE_COUNT_STRIDE] = N;    /* the live paths entering bounce 1 */
     cl_mem cb = buffer(sizeof init_counts, init_counts);
     cl_kernel k = kernel("k_shade");
     set_scene_args(k);

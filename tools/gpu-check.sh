@@ -9,8 +9,8 @@
 #      test_sampler take a CPU device when one exists, else the first device: the GPU);
 #   3. whole images: GPU alone, scalar alone and both together give the same bits, for
 #      every shipped scene and the two peer scenes (../shared beside the checkout);
-#   4. throughput: bench_render (every device, then scalar), the wave size on two large
-#      renders, and --profile.
+#   4. throughput: bench_render (every device, then scalar), the wave launch mode and
+#      size on large renders, and --profile.
 # Each step has its own time limit; everything is also written under OUT.
 # Run from the repository root after `make` and `make build/tests/test_kernels ...`.
 set -u
@@ -80,19 +80,24 @@ check materials scenes/materials.scene --width 240 --height 136 --spp 8
 check classic scenes/classic/glass.txt --integrator path --spp 16
 check mcguire ../shared/peers/cornell-mcguire.scene --width 256 --height 256 --spp 16
 check dragon ../shared/peers/dragon.scene --width 256 --height 256 --spp 4
+check cornell-counted scenes/cornell-box.scene --width 256 --height 256 --spp 16 --wave-launch counted
 echo "$same same, $differ differ"
 
 step "throughput: bench_render (median of 3)"
 lim 300 "$build/bench/bench_render" --reps 3 --json "$out/bench_render.json"
 
-step "wave size (Msamples/s, the total line of --stats)"
-for sc in ../shared/peers/cornell-mcguire.scene:256 ../shared/peers/dragon.scene:64; do
+step "wave launches and sizes, taking turns (Msamples/s, the total line of --stats)"
+for sc in ../shared/peers/cornell-mcguire.scene:256 ../shared/peers/dragon.scene:64 scenes/one-weekend.scene:64; do
     f=${sc%:*}; spp=${sc##*:}
     [ -f "$f" ] || continue
-    for wp in 262144 1048576 4194304; do
-        r=$(lim 120 "$clpt" "$f" --device "$dev" --width 1024 --height 1024 --spp "$spp" --wave-paths $wp \
-            --stats -q -o "$out/waves.pfm" 2>&1 | grep '^total' | awk '{print $(NF-2)}')
-        echo "$(basename "$f") 1024x1024 ${spp} spp, --wave-paths $wp: $r Msamples/s"
+    for round in $(seq "${GPU_CHECK_ROUNDS:-2}"); do
+        for wl in counted bounded; do
+            for wp in 1048576 4194304; do
+                r=$(lim 120 "$clpt" "$f" --device "$dev" --width 1024 --height 1024 --spp "$spp" --wave-paths $wp \
+                    --wave-launch $wl --stats -q -o "$out/waves.pfm" 2>&1 | grep '^total' | awk '{print $(NF-2)}')
+                echo "$(basename "$f") 1024x1024 ${spp} spp, round $round, --wave-launch $wl --wave-paths $wp: $r Msamples/s"
+            done
+        done
     done
 done
 

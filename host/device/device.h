@@ -96,7 +96,15 @@ typedef struct {
     const char *kernel_dir;       /* OpenCL: load kernels from here instead (developers) */
     unsigned wave_paths;          /* OpenCL: paths per wave, 0 = chosen by device type */
     int profile;                  /* measure DeviceCounters.phase_seconds (--profile) */
+    int wave_launch;              /* OpenCL: enum WaveLaunch, 0 = by device type */
 } DeviceConfig;
+
+/* How an OpenCL device launches a wave's bounces (device_ocl.c). */
+enum WaveLaunch {
+    WAVE_LAUNCH_AUTO = 0,     /* bounded on GPUs, counted elsewhere */
+    WAVE_LAUNCH_COUNTED = 1,  /* each bounce over the live count read back first */
+    WAVE_LAUNCH_BOUNDED = 2,  /* every bounce at once over the wave's size */
+};
 
 /* Where a device's time goes (--profile). OpenCL: device time of each command, from
  * its profiling event (k_raygen, k_intersect, k_shade with its queue compaction,

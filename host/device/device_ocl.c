@@ -14,6 +14,11 @@
  * for wave A's counts, the device runs wave B's bounce, and the other way round. (An
  * earlier design launched each bounce over an upper bound without waiting; on PoCL the
  * surplus work-items unbalanced its threads and it was 2-8% slower than exact launches.)
+ * That is the CPUs' way ("counted"). On a GPU a bounce's kernels take tens of
+ * microseconds and the round trips dominated (an H200 was idle for half to four fifths
+ * of a render), so there a wave is enqueued whole ("bounded", wave_enqueue_all): every
+ * bounce over the wave's size, each kernel stopping at the live count k_shade left on
+ * the device, and the counts read back once, at the end. --wave-launch overrides.
  * Between batches the films are double buffered: the read-back of batch k runs while
  * batch k + 1's kernels run, and take_film collects it afterwards (at most FILM_SLOTS
  * batches in flight, see device.h).
@@ -69,6 +74,8 @@ typedef struct {
     cl_mem cur, next;       /* its queue, and the queue it fills */
     cl_event read;          /* the read-back of its counts */
     cl_uint got[QUEUE_COUNT_STRIDE + 1];   /* count slots 2b + 1 and 2b + 2 */
+    cl_uint *all_counts;    /* bounded launches: every count slot of the wave, read back
+                             * once at its end (for the ray count) */
 } WaveSlot;
 
 /* --profile: a command whose device time is read once it is complete. */
@@ -98,6 +105,7 @@ typedef struct {
     uint counts_bounces;    /* the bounces the wave count buffers have room for */
     uint wave_paths;        /* capacity of each wave's buffers */
     size_t local_size;      /* 0: let the driver choose */
+    int bounded;            /* launch every bounce over the wave's size at once (GPUs) */
     uint n_pixels;
     const atomic_int *cancel;   /* the Device's, while a batch renders */
     cl_mem film;            /* the film the batch being rendered goes to */
@@ -142,6 +150,8 @@ static void release_buffers(OclDevice *od)
         cl_mem *ms[] = { &w->paths, &w->rays, &w->hits, &w->shadow_rays, &w->queue_a, &w->queue_b,
                          &w->shadow_queue, &w->counts };
         for (size_t j = 0; j < sizeof ms / sizeof ms[0]; j++) release_mem(ms[j]);
+        free(w->all_counts);
+        w->all_counts = NULL;
         w->active = 0;
     }
     for (int i = 0; i < FILM_SLOTS; i++) {
@@ -213,6 +223,7 @@ static Status set_fixed_args(OclDevice *od, WaveSlot *w, Error *err)
     k = w->k_intersect;
     ARG(k, ARG_INTERSECT_RAYS, w->rays);
     ARG(k, ARG_INTERSECT_HITS, w->hits);
+    ARG(k, ARG_INTERSECT_COUNTS, w->counts);
     k = w->k_shade;
     ARG(k, ARG_SHADE_RAYS, w->rays);
     ARG(k, ARG_SHADE_HITS, w->hits);
@@ -224,6 +235,7 @@ static Status set_fixed_args(OclDevice *od, WaveSlot *w, Error *err)
     ARG(k, ARG_SHADOW_QUEUE, w->shadow_queue);
     ARG(k, ARG_SHADOW_RAYS, w->shadow_rays);
     ARG(k, ARG_SHADOW_PATHS, w->paths);
+    ARG(k, ARG_SHADOW_COUNTS, w->counts);
     k = w->k_film;
     ARG(k, ARG_FILM_PATHS, w->paths);
     ARG(k, ARG_FILM_N_PIXELS, od->n_pixels);
@@ -472,6 +484,8 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
             (st = make_buffer(od, rw, (size_t)wave * sizeof(uint), NULL, "shadow queue", &w->shadow_queue, err)) ||
             (st = make_buffer(od, rw, counts_bytes, NULL, "queue counters", &w->counts, err)))
             return st;
+        if (!(w->all_counts = malloc(counts_bytes)))
+            return error_set(err, ST_INTERNAL, "out of memory for the queue counts");
     }
     cl_long zero = 0;
     for (uint i = 0; i < od->n_slots; i++) {
@@ -511,6 +525,11 @@ static Status grow_counts(OclDevice *od, uint bounces, Error *err)
         release_mem(&w->counts);
         if ((st = make_buffer(od, CL_MEM_READ_WRITE, bytes, NULL, "queue counters", &w->counts, err))) return st;
         if (w->k_shade) ARG(w->k_shade, ARG_SHADE_COUNTS, w->counts);
+        if (w->k_intersect) ARG(w->k_intersect, ARG_INTERSECT_COUNTS, w->counts);
+        if (w->k_shadow) ARG(w->k_shadow, ARG_SHADOW_COUNTS, w->counts);
+        cl_uint *all = realloc(w->all_counts, bytes);
+        if (!all) return error_set(err, ST_INTERNAL, "out of memory for the queue counts");
+        w->all_counts = all;
     }
     od->counts_bounces = bounces;
     return ST_OK;
@@ -563,9 +582,11 @@ static Status bounce_launch(OclDevice *od, WaveSlot *w, uint b, uint n, Error *e
 {
     Status st;
     cl_uint slot = 2u * b + 1u;
+    cl_uint live_slot = 2u * b;
     cl_kernel k = w->k_intersect;
     ARG(k, ARG_INTERSECT_QUEUE, w->cur);
     ARG(k, ARG_INTERSECT_N, n);
+    ARG(k, ARG_INTERSECT_LIVE_SLOT, live_slot);
     if ((st = launch(od, k, "k_intersect", n, err))) return st;
     k = w->k_shade;
     ARG(k, ARG_SHADE_QUEUE, w->cur);
@@ -582,6 +603,50 @@ static Status bounce_launch(OclDevice *od, WaveSlot *w, uint b, uint n, Error *e
     return ST_OK;
 }
 
+/* GPUs: enqueues every bounce of the wave at once, each launch over the wave's size,
+ * the kernels stopping at the live count k_shade left on the device (entry.cl); then
+ * k_film and one read-back of all the counts. On a GPU a bounce's kernels take tens of
+ * microseconds, and waiting for each bounce's counts (the CPU way, bounce_launch) left
+ * an H200 idle for half to four fifths of a render (bench/RESULTS.md); the work-items
+ * past the count cost next to nothing there. */
+static Status wave_enqueue_all(OclDevice *od, WaveSlot *w, Error *err)
+{
+    Status st;
+    uint n = w->n_paths;
+    for (uint b = 0; b < od->max_bounces; b++) {
+        cl_uint live_slot = 2u * b, slot = 2u * b + 1u;
+        cl_kernel k = w->k_intersect;
+        ARG(k, ARG_INTERSECT_QUEUE, w->cur);
+        ARG(k, ARG_INTERSECT_N, n);
+        ARG(k, ARG_INTERSECT_LIVE_SLOT, live_slot);
+        if ((st = launch(od, k, "k_intersect", n, err))) return st;
+        k = w->k_shade;
+        ARG(k, ARG_SHADE_QUEUE, w->cur);
+        ARG(k, ARG_SHADE_N, n);
+        ARG(k, ARG_SHADE_NEXT_QUEUE, w->next);
+        ARG(k, ARG_SHADE_SLOT, slot);
+        if ((st = launch(od, k, "k_shade", n, err))) return st;
+        k = w->k_shadow;
+        ARG(k, ARG_SHADOW_N, n);
+        ARG(k, ARG_SHADOW_LIVE_SLOT, slot);
+        if ((st = launch(od, k, "k_shadow", n, err))) return st;
+        cl_mem t = w->cur;
+        w->cur = w->next;
+        w->next = t;
+    }
+    cl_kernel k = w->k_film;
+    ARG(k, ARG_FILM_FIRST_PIXEL, w->first_pixel);
+    ARG(k, ARG_FILM_N_PATHS, w->n_paths);
+    ARG(k, ARG_FILM_FILM, od->film);
+    if ((st = launch(od, k, "k_film", w->n_paths < od->n_pixels ? w->n_paths : od->n_pixels, err))) return st;
+    OCL_TRY("clEnqueueReadBuffer",
+            clEnqueueReadBuffer(od->queue, w->counts, CL_FALSE, 0,
+                                (2u * (size_t)od->max_bounces + 1u) * QUEUE_COUNT_STRIDE * sizeof(cl_uint),
+                                w->all_counts, 0, NULL, &w->read));
+    OCL_TRY("clFlush", clFlush(od->queue));
+    return ST_OK;
+}
+
 /* Starts a wave of path numbers [first_pixel, first_pixel + n_paths) counted from pixel
  * 0 of sample first_sample (entry.cl). */
 static Status wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint first_sample, uint n_paths, Error *err)
@@ -594,6 +659,9 @@ static Status wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint firs
                                 (2u * (size_t)od->max_bounces + 1u) * QUEUE_COUNT_STRIDE * sizeof zero, 0, NULL,
                                 od->phases ? &ev : NULL));
     if (ev) profile_track(od, ev, PHASE_QUEUES);
+    cl_uint size = n_paths;   /* count slot 0: the paths entering bounce 0 */
+    OCL_TRY("clEnqueueFillBuffer",
+            clEnqueueFillBuffer(od->queue, w->counts, &size, sizeof size, 0, sizeof size, 0, NULL, NULL));
     cl_kernel k = w->k_raygen;
     ARG(k, ARG_RAYGEN_FIRST_PIXEL, first_pixel);
     ARG(k, ARG_RAYGEN_FIRST_SAMPLE, first_sample);
@@ -605,7 +673,7 @@ static Status wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint firs
     w->cur = w->queue_a;
     w->next = w->queue_b;
     w->active = 1;
-    return bounce_launch(od, w, 0, n_paths, err);
+    return od->bounded ? wave_enqueue_all(od, w, err) : bounce_launch(od, w, 0, n_paths, err);
 }
 
 /* Waits for the counts of the wave's last bounce, then launches its shadow rays and
@@ -621,10 +689,20 @@ static Status wave_advance(OclDevice *od, WaveSlot *w, Error *err)
     }
     release_event(&w->read);
     if (rc != CL_SUCCESS) return ocl_fail(err, &od->info, "clWaitForEvents", rc);
+    if (od->bounded) {
+        /* the whole wave ran; its counts say how many rays it traced */
+        for (uint b = 0; b < od->max_bounces; b++)
+            od->rays += (uint64_t)w->all_counts[2u * b * QUEUE_COUNT_STRIDE] +
+                        w->all_counts[(2u * b + 1u) * QUEUE_COUNT_STRIDE];
+        w->active = 0;
+        return ST_OK;
+    }
     uint shadows = w->got[0], next = w->got[QUEUE_COUNT_STRIDE];
     od->rays += (uint64_t)w->live + shadows;
+    cl_uint shadow_slot = 2u * w->bounce + 1u;
     cl_kernel k = w->k_shadow;
     ARG(k, ARG_SHADOW_N, shadows);
+    ARG(k, ARG_SHADOW_LIVE_SLOT, shadow_slot);
     if ((st = launch(od, k, "k_shadow", shadows, err))) return st;
     if (next > 0 && w->bounce + 1u < od->max_bounces) {
         cl_mem t = w->cur;
@@ -823,6 +901,7 @@ static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error
      * 2^12 a tenth slower). */
     od->wave_paths = cfg && cfg->wave_paths ? cfg->wave_paths : (gpu ? (1u << 20) : (1u << 16));
     od->local_size = od->info.max_work_group >= OCL_LOCAL_SIZE ? OCL_LOCAL_SIZE : 0;
+    od->bounded = cfg && cfg->wave_launch ? cfg->wave_launch == WAVE_LAUNCH_BOUNDED : gpu;
     return ST_OK;
 }
 

@@ -277,6 +277,32 @@ static void test_help_fits_80_columns(void)
     }
 }
 
+/* The README's command-line reference is --help, word for word, so the two cannot
+ * drift apart when a flag is added. */
+static void test_readme_reference_is_help(void)
+{
+    cli_run(ARGS("--help"), &r);
+    CHECK_EQ_INT(r.status, 0);
+    FILE *f = fopen("README.md", "rb");
+    CHECK(f != NULL);
+    if (!f) return;
+    static char readme[1 << 17];
+    size_t n = fread(readme, 1, sizeof readme - 1, f);
+    fclose(f);
+    readme[n] = '\0';
+    const char *mark = "### Command-line reference\n\n```\n";
+    const char *start = strstr(readme, mark);
+    CHECK_MSG(start != NULL, "README.md has no \"### Command-line reference\" block");
+    if (!start) return;
+    start += strlen(mark);
+    const char *end = strstr(start, "```\n");
+    CHECK(end != NULL);
+    if (!end) return;
+    size_t len = (size_t)(end - start);
+    CHECK_MSG(len == strlen(r.out) && memcmp(start, r.out, len) == 0,
+              "README.md's command-line reference differs from --help: paste `build/clpt --help` into it");
+}
+
 /* A bad output is found before the render, not after it (when nothing, not even the
  * checkpoint, could be saved). */
 static void test_bad_outputs_found_before_rendering(void)
@@ -700,6 +726,7 @@ int main(void)
     RUN(test_wave_launches_match_scalar);
     RUN(test_profile);
     RUN(test_help_fits_80_columns);
+    RUN(test_readme_reference_is_help);
     RUN(test_bad_outputs_found_before_rendering);
     RUN(test_outputs_must_be_distinct_files);
     RUN(test_output_symlink_and_mode_kept);

@@ -104,6 +104,7 @@ typedef struct {
     uint max_bounces;       /* bounces 0 .. max_depth: 2 * max_bounces + 1 count slots */
     uint counts_bounces;    /* the bounces the wave count buffers have room for */
     uint wave_paths;        /* capacity of each wave's buffers */
+    uint wave_auto;         /* a GPU's large default wave, used where it fits (load_scene); 0 if none */
     size_t local_size;      /* 0: let the driver choose */
     int bounded;            /* launch every bounce over the wave's size at once (GPUs) */
     uint n_pixels;
@@ -435,6 +436,15 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     SceneBufferBytes in[SCENE_N];
     for (unsigned i = 0; i < SCENE_N; i++) in[i] = device_scene_buffer(s, i);
     uint n_pixels = p->width * p->height;
+    if (od->wave_auto) {
+        /* the large GPU waves only while they and the scene take at most half the
+         * device's memory; else the usual 2^20 */
+        uint64_t need = 2u * (uint64_t)n_pixels * 3u * sizeof(cl_long);
+        for (unsigned i = 0; i < SCENE_N; i++) need += in[i].bytes;
+        need += (uint64_t)WAVE_SLOTS * od->wave_auto *
+                (sizeof(PathState) + 2u * sizeof(Ray) + sizeof(Hit) + 3u * sizeof(uint));
+        od->wave_paths = need <= od->info.global_mem / 2u ? od->wave_auto : (1u << 20);
+    }
     uint wave = od->wave_paths;
     od->max_bounces = p->max_depth + 1u;
     od->counts_bounces = od->max_bounces;
@@ -896,10 +906,15 @@ static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error
     if (cfg && cfg->kernel_dir && !(od->kernel_dir = strdup(cfg->kernel_dir)))
         return error_set(err, ST_INTERNAL, "out of memory opening device '%s'", od->info.name);
     int gpu = (od->info.type & CL_DEVICE_TYPE_GPU) != 0;
-    /* A GPU needs about a million paths in flight to hide memory latency; a CPU is full
-     * with far fewer (on PoCL 2^16 to 2^18 measured the same, 2^14 a few percent and
-     * 2^12 a tenth slower). */
-    od->wave_paths = cfg && cfg->wave_paths ? cfg->wave_paths : (gpu ? (1u << 20) : (1u << 16));
+    /* A GPU needs about a million paths in flight to hide memory latency, and larger
+     * waves cost fewer launches per path: on an H200, 2^22 paths rendered 6-28% faster
+     * than 2^20 with bounded launches and 11-41% with counted ones (1024x1024 renders,
+     * bench/RESULTS.md). 2^22 paths take about 650 MB a wave, so only GPUs with 8 GiB or
+     * more get them. A CPU is full with far fewer (on PoCL 2^16 to 2^18 measured the
+     * same, 2^14 a few percent and 2^12 a tenth slower). */
+    uint gpu_wave = od->info.global_mem >= (8ull << 30) ? (1u << 22) : (1u << 20);
+    od->wave_paths = cfg && cfg->wave_paths ? cfg->wave_paths : (gpu ? gpu_wave : (1u << 16));
+    od->wave_auto = cfg && cfg->wave_paths ? 0u : (gpu && gpu_wave > (1u << 20) ? gpu_wave : 0u);
     od->local_size = od->info.max_work_group >= OCL_LOCAL_SIZE ? OCL_LOCAL_SIZE : 0;
     od->bounded = cfg && cfg->wave_launch ? cfg->wave_launch == WAVE_LAUNCH_BOUNDED : gpu;
     return ST_OK;

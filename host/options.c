@@ -187,12 +187,15 @@ void options_print_help(FILE *f)
 "                             8 GiB or more when it fits in half their\n"
 "                             memory, else 2^20; 2^16 on CPUs; 2^14 with\n"
 "                             --interactive)\n"
-"      --wave-launch counted|bounded\n"
-"                             OpenCL bounces: 'counted' launches each over the\n"
-"                             live paths the device counted, read back first\n"
-"                             (CPUs); 'bounded' launches all of a wave's at\n"
-"                             once, over its size, the kernels stopping at the\n"
-"                             count on the device (GPUs). Default: by device type\n"
+"      --wave-launch counted|bounded|megakernel\n"
+"                             how an OpenCL device runs a wave: 'counted'\n"
+"                             launches each bounce over the live paths the\n"
+"                             device counted, read back first; 'bounded' all\n"
+"                             bounces at once over the wave's size, the kernels\n"
+"                             stopping at the count on the device (GPUs'\n"
+"                             default); 'megakernel' one kernel that runs each\n"
+"                             path to its end (CPUs' default; counted with\n"
+"                             --profile)\n"
 "\n"
 "Environment:\n"
 "  CLPT_CACHE_DIR             where compiled kernels are cached (default:\n"
@@ -430,8 +433,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
     static const int on_off_values[] = { 1, 0 };
     static const char *const samplers[] = { "sobol", "independent", NULL };
     static const int sampler_values[] = { SAMPLER_SOBOL, SAMPLER_INDEPENDENT };
-    static const char *const launches[] = { "counted", "bounded", NULL };
-    static const int launch_values[] = { WAVE_LAUNCH_COUNTED, WAVE_LAUNCH_BOUNDED };
+    static const char *const launches[] = { "counted", "bounded", "megakernel", NULL };
+    static const int launch_values[] = { WAVE_LAUNCH_COUNTED, WAVE_LAUNCH_BOUNDED, WAVE_LAUNCH_MEGAKERNEL };
     *found = 1;
     if (strcmp(a, "--integrator") == 0)
         return parse_choice(a, v, integrators, integrator_values, "'path' or 'whitted'", &o->integrator, err);
@@ -444,7 +447,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
     if (strcmp(a, "--sampler") == 0)
         return parse_choice(a, v, samplers, sampler_values, "'sobol' or 'independent'", &o->sampler, err);
     if (strcmp(a, "--wave-launch") == 0)
-        return parse_choice(a, v, launches, launch_values, "'counted' or 'bounded'", &o->wave_launch, err);
+        return parse_choice(a, v, launches, launch_values, "'counted', 'bounded' or 'megakernel'", &o->wave_launch,
+                            err);
     if (strcmp(a, "--aov") == 0) return options_parse_aovs(v, &o->aovs, err);
     *found = 0;
     return ST_OK;

@@ -21,7 +21,8 @@
  * device_ocl.c) or over exactly the count it read back (CPUs).
  *
  * The host builds the path tracer's kernels and the classic ray tracer's as two programs
- * (CLPT_FEATURES with KF_PATH or KF_WHITTED, types.h), each on first use: a driver
+ * (CLPT_FEATURES with KF_PATH or KF_WHITTED, types.h; a CPU device's path program has
+ * KF_PATH_MEGAKERNEL instead, the path tracer as one kernel), each on first use: a driver
  * compiles every kernel of a program, so a path-tracer run never waits for k_whitted,
  * nor a whitted run for k_shade. k_film is in both; k_layout only in the whole program
  * (no CLPT_FEATURES: the tests), as PoCL would compile it too in every program for
@@ -132,6 +133,47 @@ __kernel KERNEL_SIZE void k_shadow(SCENE_ARGS __global const uint *shadow_queue,
 }
 
 #endif /* KF_HAS(KF_PATH) */
+
+#if KF_HAS(KF_PATH_MEGAKERNEL)
+/* The path tracer as one kernel, the CPUs' form: each work-item runs its path from
+ * birth to end, calling the stage functions in the wavefront's order (the scalar
+ * device's loop, device_scalar.c), so a path computes the same bits either way. On
+ * PoCL this beat the wavefront by 10-30%: a path's state stays in the cache, and there
+ * are no queues, no atomics and no barriers per bounce (bench/RESULTS.md). Adds its
+ * rays to counters[0], carrying into counters[QUEUE_COUNT_STRIDE] (a 64-bit count from
+ * 32-bit atomics: the adder whose addition wraps the low word carries). */
+__kernel KERNEL_SIZE void k_path(SCENE_ARGS uint first_pixel, uint first_sample, uint n_pixels, uint n_paths,
+                                 __global PathState *paths, __global Ray *rays, __global Ray *shadow_rays,
+                                 __global uint *counters)
+{
+    __local uint group_rays;
+    uint i = (uint)get_global_id(0);
+    if (get_local_id(0) == 0u) group_rays = 0u;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    uint n_rays = 0u;
+    if (i < n_paths) {
+        SCENE_VIEW(sc);
+        uint p = first_pixel + i;
+        raygen_path(sc.params, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i]);
+        for (;;) {
+            Hit hit = trace_closest_visible(&sc, rays[i]);
+            n_rays++;
+            uint r = shade_path(&sc, &rays[i], hit, &paths[i], &shadow_rays[i]);
+            if (r & SHADE_SHADOW) {
+                shadow_resolve(&paths[i], trace_occluded(&sc, shadow_rays[i]));
+                n_rays++;
+            }
+            if (!(r & SHADE_CONTINUE)) break;
+        }
+    }
+    if (n_rays) atomic_add(&group_rays, n_rays);
+    barrier(CLK_LOCAL_MEM_FENCE);
+    if (get_local_id(0) == 0u && group_rays) {
+        uint old = atomic_add(&counters[0], group_rays);
+        if (old + group_rays < old) atomic_inc(&counters[QUEUE_COUNT_STRIDE]);
+    }
+}
+#endif /* KF_HAS(KF_PATH_MEGAKERNEL) */
 
 /* Adds the finished wave of n_paths paths to the film. Work-item j owns one pixel, the
  * one of wave path j, and adds every path of the wave on that pixel (j, j + n_pixels,

@@ -34,7 +34,7 @@
  * Each switch only removes code that the scene cannot reach, so images stay the same
  * bit for bit. Without CLPT_FEATURES (the scalar C device, the tests' own builds)
  * everything is compiled. */
-#define KF_PATH 0x1u            /* the path tracer's kernels (k_raygen ... k_film) */
+#define KF_PATH 0x1u            /* the path tracer as a wavefront (k_raygen ... k_shadow, k_film) */
 #define KF_WHITTED 0x2u         /* the classic ray tracer and the AOVs (k_whitted, k_film) */
 #define KF_TEXTURES 0x4u        /* a material reads a texture */
 #define KF_ALPHA 0x8u           /* a material is cut out (MAT_ALPHA_MASK or _BLEND) */
@@ -46,7 +46,8 @@
 #define KF_PLANES 0x200u
 #define KF_DELTA_LIGHTS 0x400u  /* point, spot or directional lights */
 #define KF_MATERIAL(t) (0x800u << (t))  /* material type t (enum MaterialType) */
-#define KF_ALL 0x3ffffu         /* every bit above (material types 0 to 6) */
+#define KF_PATH_MEGAKERNEL 0x80000u     /* the path tracer as one kernel (k_path, k_film) */
+#define KF_ALL 0xbffffu         /* every bit above (material types 0 to 6) */
 #ifndef CLPT_FEATURES
 #define CLPT_FEATURES KF_ALL
 #endif

@@ -46,23 +46,25 @@ static void test_usage_errors(void)
     CHECK_STR_CONTAINS(r.err, "--sampler expects 'sobol' or 'independent', got 'halton'");
     cli_run(ARGS("scenes/cornell-box.scene", "--wave-launch", "fast"), &r);
     CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "--wave-launch expects 'counted' or 'bounded', got 'fast'");
+    CHECK_STR_CONTAINS(r.err, "--wave-launch expects 'counted', 'bounded' or 'megakernel', got 'fast'");
 }
 
-/* Both ways of launching a wave's bounces on an OpenCL device (--wave-launch; bounded is
- * the GPUs' default, here forced on PoCL) give the scalar device's bits, with small
- * waves (several per batch) and several batches; and report the same number of rays. */
+/* The three ways an OpenCL device runs a wave (--wave-launch: counted; bounded, the
+ * GPUs' default, here forced on PoCL; megakernel, the CPUs') give the scalar device's
+ * bits, with small waves (several per batch) and several batches, and report the same
+ * number of rays. */
 static void test_wave_launches_match_scalar(void)
 {
-    const char *modes[] = { "counted", "bounded" };
-    const char *outs[] = { "/tmp/clpt-test-launch-counted.pfm", "/tmp/clpt-test-launch-bounded.pfm" };
+    const char *modes[] = { "counted", "bounded", "megakernel" };
+    const char *outs[] = { "/tmp/clpt-test-launch-counted.pfm", "/tmp/clpt-test-launch-bounded.pfm",
+                           "/tmp/clpt-test-launch-megakernel.pfm" };
     const char *ref = "/tmp/clpt-test-launch-scalar.pfm";
-    double rays[2] = { 0.0, -1.0 };
+    double rays[3] = { 0.0, -1.0, -1.0 };
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", "--width", "40", "--height", "32", "--spp", "12",
                  "--seed", "9", "-q", "-o", ref),
             &r);
     CHECK_EQ_INT(r.status, 0);
-    for (int i = 0; i < 2; i++) {
+    for (int i = 0; i < 3; i++) {
         cli_run(ARGS("scenes/cornell-box.scene", "--device", "cpu", "--width", "40", "--height", "32", "--spp", "12",
                      "--seed", "9", "--wave-launch", modes[i], "--wave-paths", "1000", "--batch", "5", "--stats", "-q",
                      "-o", outs[i]),
@@ -76,8 +78,9 @@ static void test_wave_launches_match_scalar(void)
         if (t && sscanf(t + 6, "%lf %lf %lf %lf", &samples, &secs, &ms, &mr) == 4 && ms > 0) rays[i] = mr / ms;
         unlink(outs[i]);
     }
-    CHECK_MSG(rays[0] > 1.0 && fabs(rays[0] - rays[1]) < 0.01 * rays[0], "rays per sample: counted %.3f, bounded %.3f",
-              rays[0], rays[1]);
+    for (int i = 1; i < 3; i++)
+        CHECK_MSG(rays[0] > 1.0 && fabs(rays[0] - rays[i]) < 0.01 * rays[0], "rays per sample: counted %.3f, %s %.3f",
+                  rays[0], modes[i], rays[i]);
     unlink(ref);
 }
 

@@ -417,6 +417,72 @@ static void test_raygen(void)
     clReleaseMemObject(queue);
 }
 
+/* k_path, the megakernel (the CPUs' form of the path tracer): every path from birth to
+ * end in one work-item, against the scalar device's loop in C (device_scalar.c): the
+ * same path states bit for bit, and the same number of rays, counted per work-group
+ * into a low word and a carry word. Launched with surplus work-items. */
+static void test_path_kernel(void)
+{
+    const RenderParams *p = &rs.ds.params;
+    uint npix = p->width * p->height, n = npix * LAYERS, first_pixel = 7, first_sample = 3;
+    cl_uint init[2 * QUEUE_COUNT_STRIDE] = { 0 };
+    init[0] = 0xfffff000u;   /* near the top: the count wraps the low word and carries */
+    cl_mem paths = buffer(n * sizeof(PathState), NULL), rays = buffer(n * sizeof(Ray), NULL),
+           shadow = buffer(n * sizeof(Ray), NULL), counters = buffer(sizeof init, init);
+    cl_kernel k = kernel("k_path");
+    set_scene_args(k);
+    SET(k, N_SCENE + 0, first_pixel);
+    SET(k, N_SCENE + 1, first_sample);
+    SET(k, N_SCENE + 2, npix);
+    SET(k, N_SCENE + 3, n);
+    SET(k, N_SCENE + 4, paths);
+    SET(k, N_SCENE + 5, rays);
+    SET(k, N_SCENE + 6, shadow);
+    SET(k, N_SCENE + 7, counters);
+    run(k, n + 37);
+    PathState *dp = malloc(n * sizeof *dp);
+    cl_uint got[2 * QUEUE_COUNT_STRIDE];
+    read_back(paths, n * sizeof *dp, dp);
+    read_back(counters, sizeof got, got);
+    uint exact = 0, lit = 0;
+    uint64_t c_rays = 0;
+    for (uint i = 0; i < n; i++) {
+        PathState cp;
+        Ray cr, cs;
+        memset(&cs, 0, sizeof cs);
+        uint path = first_pixel + i;
+        raygen_path(p, path % npix, first_sample + path / npix, &cp, &cr);
+        for (;;) {
+            Hit hit = trace_closest_visible(&view, cr);
+            c_rays++;
+            uint r = shade_path(&view, &cr, hit, &cp, &cs);
+            if (r & SHADE_SHADOW) {
+                shadow_resolve(&cp, trace_occluded(&view, cs));
+                c_rays++;
+            }
+            if (!(r & SHADE_CONTINUE)) break;
+        }
+        int same = memcmp(&cp, &dp[i], sizeof cp) == 0;
+        exact += same;
+        lit += cp.radiance.x > 0.0f;
+        if (!same && i + 1 - exact <= 3) report_words("path state", i, &cp, &dp[i], sizeof cp);
+    }
+    uint64_t d_rays = (uint64_t)got[0] + ((uint64_t)got[QUEUE_COUNT_STRIDE] << 32);
+    fprintf(stderr, "  k_path: %u paths, %u lit, %llu rays, %u bit-identical to C\n", n, lit,
+            (unsigned long long)c_rays, exact);
+    CHECK_EQ_INT(exact, n);
+    CHECK(lit > n / 4);
+    CHECK_MSG(d_rays == 0xfffff000ull + c_rays, "rays: device %llu, C %llu", (unsigned long long)(d_rays - 0xfffff000ull),
+              (unsigned long long)c_rays);
+    CHECK_EQ_INT(got[QUEUE_COUNT_STRIDE], 1);
+    free(dp);
+    clReleaseKernel(k);
+    clReleaseMemObject(paths);
+    clReleaseMemObject(rays);
+    clReleaseMemObject(shadow);
+    clReleaseMemObject(counters);
+}
+
 /* Random rays through the scene's box, from inside and outside it. */
 static Ray random_ray(void)
 {
@@ -1077,6 +1143,7 @@ int main(void)
     }
     RUN(test_layout);
     RUN(test_raygen);
+    RUN(test_path_kernel);
     RUN(test_intersect);
     RUN(test_shade_and_shadow);
     RUN(test_shade_cubemap);

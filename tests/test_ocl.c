@@ -595,6 +595,10 @@ static void test_kernel_argument_names(void)
         { "k_film", ARG_FILM_PATHS, "paths" }, { "k_film", ARG_FILM_FIRST_PIXEL, "first_pixel" },
         { "k_film", ARG_FILM_N_PIXELS, "n_pixels" }, { "k_film", ARG_FILM_N_PATHS, "n_paths" },
         { "k_film", ARG_FILM_FILM, "film" },
+        { "k_path", ARG_PATH_FIRST_PIXEL, "first_pixel" }, { "k_path", ARG_PATH_FIRST_SAMPLE, "first_sample" },
+        { "k_path", ARG_PATH_N_PIXELS, "n_pixels" }, { "k_path", ARG_PATH_N_PATHS, "n_paths" },
+        { "k_path", ARG_PATH_PATHS, "paths" }, { "k_path", ARG_PATH_RAYS, "rays" },
+        { "k_path", ARG_PATH_SHADOW_RAYS, "shadow_rays" }, { "k_path", ARG_PATH_COUNTERS, "counters" },
         { "k_whitted", ARG_WHITTED_FIRST_PIXEL, "first_pixel" }, { "k_whitted", ARG_WHITTED_FIRST_SAMPLE, "first_sample" },
         { "k_whitted", ARG_WHITTED_N_PIXELS, "n_pixels" }, { "k_whitted", ARG_WHITTED_N_PATHS, "n_paths" },
         { "k_whitted", ARG_WHITTED_PATHS, "paths" }, { "k_whitted", ARG_WHITTED_COUNTERS, "counters" },
@@ -623,8 +627,9 @@ static int has_kernel(cl_program prog, const char *name)
 static void test_program_per_integrator(void)
 {
     static const struct { unsigned features; const char *has[3], *lacks[3]; } programs[] = {
-        { KF_PATH, { "k_raygen", "k_shade", "k_film" }, { "k_whitted", "k_layout", NULL } },
-        { KF_WHITTED, { "k_whitted", "k_film", "k_film" }, { "k_shade", "k_raygen", "k_layout" } },
+        { KF_PATH, { "k_raygen", "k_shade", "k_film" }, { "k_whitted", "k_layout", "k_path" } },
+        { KF_WHITTED, { "k_whitted", "k_film", "k_film" }, { "k_shade", "k_raygen", "k_path" } },
+        { KF_PATH_MEGAKERNEL, { "k_path", "k_film", "k_film" }, { "k_shade", "k_raygen", "k_whitted" } },
     };
     for (size_t i = 0; i < sizeof programs / sizeof programs[0]; i++) {
         char options[64];
@@ -651,6 +656,7 @@ static void test_kernels_declare_the_launch_size(void)
     static const struct { unsigned features; const char *kernels[5]; } programs[] = {
         { KF_PATH, { "k_raygen", "k_intersect", "k_shade", "k_shadow", "k_film" } },
         { KF_WHITTED, { "k_whitted", "k_film", NULL, NULL, NULL } },
+        { KF_PATH_MEGAKERNEL, { "k_path", "k_film", NULL, NULL, NULL } },
     };
     for (size_t i = 0; i < sizeof programs / sizeof programs[0]; i++) {
         char options[96];
@@ -689,9 +695,10 @@ static void test_feature_switches_compile_cleanly(void)
         fprintf(stderr, "  (no clang: the feature switches were not compiled)\n");
         return;
     }
+    static const unsigned programs[] = { KF_PATH, KF_WHITTED, KF_PATH_MEGAKERNEL };
     for (unsigned bit = 0; bit < 18; bit++) {
-        for (unsigned integrator = KF_PATH; integrator <= KF_WHITTED; integrator++) {
-            unsigned features = integrator | (1u << bit);
+        for (size_t k = 0; k < sizeof programs / sizeof programs[0]; k++) {
+            unsigned features = programs[k] | (1u << bit);
             char cmd[300], out[2048];
             snprintf(cmd, sizeof cmd, "clang -x cl -cl-std=CL1.2 -Xclang -finclude-default-header -fsyntax-only "
                      "-Wall -Wextra -Ikernels -DCLPT_FEATURES=0x%xu kernels/entry.cl 2>&1", features);
@@ -703,7 +710,7 @@ static void test_feature_switches_compile_cleanly(void)
             CHECK_MSG(rc == 0 && n == 0, "CLPT_FEATURES=0x%x: %s", features, out);
         }
     }
-    CHECK_EQ_INT(KF_ALL, (KF_MATERIAL(MAT_PRINCIPLED) << 1) - 1u);
+    CHECK_EQ_INT(KF_ALL, ((KF_MATERIAL(MAT_PRINCIPLED) << 1) - 1u) | KF_PATH_MEGAKERNEL);
 }
 
 static void test_cache_location(void)

@@ -101,9 +101,11 @@ typedef struct {
 
 /* How an OpenCL device launches a wave's bounces (device_ocl.c). */
 enum WaveLaunch {
-    WAVE_LAUNCH_AUTO = 0,     /* bounded on GPUs, counted elsewhere */
+    WAVE_LAUNCH_AUTO = 0,     /* bounded on GPUs, megakernel elsewhere (counted there
+                               * with --profile, whose phases one kernel cannot tell) */
     WAVE_LAUNCH_COUNTED = 1,  /* each bounce over the live count read back first */
     WAVE_LAUNCH_BOUNDED = 2,  /* every bounce at once over the wave's size */
+    WAVE_LAUNCH_MEGAKERNEL = 3,   /* one kernel runs each path from birth to end */
 };
 
 /* Where a device's time goes (--profile). OpenCL: device time of each command, from

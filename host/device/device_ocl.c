@@ -18,7 +18,11 @@
  * microseconds and the round trips dominated (an H200 was idle for half to four fifths
  * of a render), so there a wave is enqueued whole ("bounded", wave_enqueue_all): every
  * bounce over the wave's size, each kernel stopping at the live count k_shade left on
- * the device, and the counts read back once, at the end. --wave-launch overrides.
+ * the device, and the counts read back once, at the end. And on a CPU a wave is one
+ * kernel, k_path ("megakernel", wave_run_paths): each work-item runs its path to the
+ * end, as the scalar device does, which on PoCL beat both wavefronts (the counted one
+ * stays for --profile, whose phases one kernel cannot separate). --wave-launch
+ * overrides.
  * Between batches the films are double buffered: the read-back of batch k runs while
  * batch k + 1's kernels run, and take_film collects it afterwards (at most FILM_SLOTS
  * batches in flight, see device.h).
@@ -67,6 +71,7 @@ typedef struct {
 typedef struct {
     cl_mem paths, rays, hits, shadow_rays, queue_a, queue_b, shadow_queue, counts;
     cl_kernel k_raygen, k_intersect, k_shade, k_shadow, k_film;
+    cl_kernel k_path;       /* the megakernel, instead of the four above */
     int active;
     uint first_pixel, first_sample, n_paths;
     uint bounce;            /* the bounce whose counts are on their way back */
@@ -106,7 +111,7 @@ typedef struct {
     uint wave_paths;        /* capacity of each wave's buffers */
     uint wave_auto;         /* a GPU's large default wave, used where it fits (load_scene); 0 if none */
     size_t local_size;      /* 0: let the driver choose */
-    int bounded;            /* launch every bounce over the wave's size at once (GPUs) */
+    int launch;             /* enum WaveLaunch, never AUTO: how a wave is launched */
     uint n_pixels;
     const atomic_int *cancel;   /* the Device's, while a batch renders */
     cl_mem film;            /* the film the batch being rendered goes to */
@@ -212,10 +217,23 @@ static Status set_scene_args(OclDevice *od, cl_kernel k, Error *err)
 static Status set_fixed_args(OclDevice *od, WaveSlot *w, Error *err)
 {
     Status st;
+    cl_kernel k = w->k_film;
+    ARG(k, ARG_FILM_PATHS, w->paths);
+    ARG(k, ARG_FILM_N_PIXELS, od->n_pixels);
+    if (w->k_path) {
+        if ((st = set_scene_args(od, w->k_path, err))) return st;
+        k = w->k_path;
+        ARG(k, ARG_PATH_N_PIXELS, od->n_pixels);
+        ARG(k, ARG_PATH_PATHS, w->paths);
+        ARG(k, ARG_PATH_RAYS, w->rays);
+        ARG(k, ARG_PATH_SHADOW_RAYS, w->shadow_rays);
+        ARG(k, ARG_PATH_COUNTERS, w->counts);
+        return ST_OK;
+    }
     if ((st = set_scene_args(od, w->k_intersect, err)) || (st = set_scene_args(od, w->k_shade, err)) ||
         (st = set_scene_args(od, w->k_shadow, err)))
         return st;
-    cl_kernel k = w->k_raygen;
+    k = w->k_raygen;
     ARG(k, ARG_RAYGEN_PARAMS, od->scene[SCENE_BUF_params]);
     ARG(k, ARG_RAYGEN_N_PIXELS, od->n_pixels);
     ARG(k, ARG_RAYGEN_PATHS, w->paths);
@@ -237,9 +255,6 @@ static Status set_fixed_args(OclDevice *od, WaveSlot *w, Error *err)
     ARG(k, ARG_SHADOW_RAYS, w->shadow_rays);
     ARG(k, ARG_SHADOW_PATHS, w->paths);
     ARG(k, ARG_SHADOW_COUNTS, w->counts);
-    k = w->k_film;
-    ARG(k, ARG_FILM_PATHS, w->paths);
-    ARG(k, ARG_FILM_N_PIXELS, od->n_pixels);
     return ST_OK;
 }
 
@@ -298,6 +313,8 @@ static int profile_phase_of(const char *kernel)
         { "k_raygen", PHASE_RAYGEN }, { "k_intersect", PHASE_TRAVERSE }, { "k_shade", PHASE_SHADE },
         { "k_shadow", PHASE_SHADOW }, { "k_film", PHASE_FILM },
     };
+    /* k_path (a megakernel asked for with --profile) does all of a path's stages at
+     * once: its time counts as shading, as the classic ray tracer's does */
     for (size_t i = 0; i < sizeof map / sizeof map[0]; i++)
         if (strcmp(kernel, map[i].name) == 0) return map[i].phase;
     return PHASE_SHADE;
@@ -361,7 +378,7 @@ static void release_program(OclDevice *od, int which)
     if (which == PROG_PATH) {
         for (int i = 0; i < WAVE_SLOTS; i++) {
             WaveSlot *w = &od->waves[i];
-            cl_kernel *ks[] = { &w->k_raygen, &w->k_intersect, &w->k_shade, &w->k_shadow, &w->k_film };
+            cl_kernel *ks[] = { &w->k_raygen, &w->k_intersect, &w->k_shade, &w->k_shadow, &w->k_film, &w->k_path };
             for (size_t j = 0; j < sizeof ks / sizeof ks[0]; j++) release_kernel(ks[j]);
         }
     } else {
@@ -385,12 +402,20 @@ static Status set_program_args(OclDevice *od, int which, Error *err)
     return ST_OK;
 }
 
+/* The kernels program `which` holds (KF_* of kernels/types.h): the classic ray
+ * tracer's, or the path tracer's in the form the device launches. */
+static unsigned program_kernels(const OclDevice *od, int which)
+{
+    if (which == PROG_WHITTED) return KF_WHITTED;
+    return od->launch == WAVE_LAUNCH_MEGAKERNEL ? KF_PATH_MEGAKERNEL : KF_PATH;
+}
+
 /* Builds the program the integrator needs, for the loaded scene's features, unless the
  * one there already has them; its kernels get their fixed arguments. */
 static Status need_program(Device *d, OclDevice *od, uint integrator, Error *err)
 {
     int which = integrator == INTEGRATOR_PATH ? PROG_PATH : PROG_WHITTED;
-    unsigned want = od->scene_features | (which == PROG_PATH ? KF_PATH : KF_WHITTED);
+    unsigned want = od->scene_features | program_kernels(od, which);
     if (od->programs[which] && (od->features[which] & want) == want) return ST_OK;
     release_program(od, which);
     char options[320];
@@ -412,6 +437,12 @@ static Status need_program(Device *d, OclDevice *od, uint integrator, Error *err
         /* each wave has its own kernel objects, so that their fixed arguments are set once */
         for (int i = 0; i < WAVE_SLOTS; i++) {
             WaveSlot *w = &od->waves[i];
+            if (want & KF_PATH_MEGAKERNEL) {
+                if ((st = ocl_program_kernel(prog, &od->info, "k_path", &w->k_path, err)) ||
+                    (st = ocl_program_kernel(prog, &od->info, "k_film", &w->k_film, err)))
+                    break;
+                continue;
+            }
             if ((st = ocl_program_kernel(prog, &od->info, "k_raygen", &w->k_raygen, err)) ||
                 (st = ocl_program_kernel(prog, &od->info, "k_intersect", &w->k_intersect, err)) ||
                 (st = ocl_program_kernel(prog, &od->info, "k_shade", &w->k_shade, err)) ||
@@ -511,7 +542,7 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     /* a program built for an earlier scene serves this one if it has its features */
     od->scene_features = scene_features(s);
     for (int i = 0; i < PROG_N; i++) {
-        unsigned need = od->scene_features | (i == PROG_PATH ? KF_PATH : KF_WHITTED);
+        unsigned need = od->scene_features | program_kernels(od, i);
         if ((od->features[i] & need) != need) release_program(od, i);
         else if ((st = set_program_args(od, i, err))) return st;
     }
@@ -537,6 +568,7 @@ static Status grow_counts(OclDevice *od, uint bounces, Error *err)
         if (w->k_shade) ARG(w->k_shade, ARG_SHADE_COUNTS, w->counts);
         if (w->k_intersect) ARG(w->k_intersect, ARG_INTERSECT_COUNTS, w->counts);
         if (w->k_shadow) ARG(w->k_shadow, ARG_SHADOW_COUNTS, w->counts);
+        if (w->k_path) ARG(w->k_path, ARG_PATH_COUNTERS, w->counts);
         cl_uint *all = realloc(w->all_counts, bytes);
         if (!all) return error_set(err, ST_INTERNAL, "out of memory for the queue counts");
         w->all_counts = all;
@@ -550,6 +582,10 @@ static Status set_scene_arg(OclDevice *od, unsigned b, Error *err)
 {
     for (int i = 0; i < WAVE_SLOTS && od->programs[PROG_PATH]; i++) {
         WaveSlot *w = &od->waves[i];
+        if (w->k_path) {
+            ARG(w->k_path, b, od->scene[b]);
+            continue;
+        }
         ARG(w->k_intersect, b, od->scene[b]);
         ARG(w->k_shade, b, od->scene[b]);
         ARG(w->k_shadow, b, od->scene[b]);
@@ -657,6 +693,27 @@ static Status wave_enqueue_all(OclDevice *od, WaveSlot *w, Error *err)
     return ST_OK;
 }
 
+/* CPUs: the wave as one k_path launch (each work-item runs its path to the end), then
+ * k_film and the read-back of its ray count. */
+static Status wave_run_paths(OclDevice *od, WaveSlot *w, Error *err)
+{
+    Status st;
+    cl_kernel k = w->k_path;
+    ARG(k, ARG_PATH_FIRST_PIXEL, w->first_pixel);
+    ARG(k, ARG_PATH_FIRST_SAMPLE, w->first_sample);
+    ARG(k, ARG_PATH_N_PATHS, w->n_paths);
+    if ((st = launch(od, k, "k_path", w->n_paths, err))) return st;
+    k = w->k_film;
+    ARG(k, ARG_FILM_FIRST_PIXEL, w->first_pixel);
+    ARG(k, ARG_FILM_N_PATHS, w->n_paths);
+    ARG(k, ARG_FILM_FILM, od->film);
+    if ((st = launch(od, k, "k_film", w->n_paths < od->n_pixels ? w->n_paths : od->n_pixels, err))) return st;
+    OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, w->counts, CL_FALSE, 0, sizeof w->got, w->got, 0,
+                                                       NULL, &w->read));
+    OCL_TRY("clFlush", clFlush(od->queue));
+    return ST_OK;
+}
+
 /* Starts a wave of path numbers [first_pixel, first_pixel + n_paths) counted from pixel
  * 0 of sample first_sample (entry.cl). */
 static Status wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint first_sample, uint n_paths, Error *err)
@@ -669,6 +726,11 @@ static Status wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint firs
                                 (2u * (size_t)od->max_bounces + 1u) * QUEUE_COUNT_STRIDE * sizeof zero, 0, NULL,
                                 od->phases ? &ev : NULL));
     if (ev) profile_track(od, ev, PHASE_QUEUES);
+    w->first_pixel = first_pixel;
+    w->first_sample = first_sample;
+    w->n_paths = n_paths;
+    w->active = 1;
+    if (od->launch == WAVE_LAUNCH_MEGAKERNEL) return wave_run_paths(od, w, err);
     cl_uint size = n_paths;   /* count slot 0: the paths entering bounce 0 */
     OCL_TRY("clEnqueueFillBuffer",
             clEnqueueFillBuffer(od->queue, w->counts, &size, sizeof size, 0, sizeof size, 0, NULL, NULL));
@@ -677,13 +739,9 @@ static Status wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint firs
     ARG(k, ARG_RAYGEN_FIRST_SAMPLE, first_sample);
     ARG(k, ARG_RAYGEN_N_PATHS, n_paths);
     if ((st = launch(od, k, "k_raygen", n_paths, err))) return st;
-    w->first_pixel = first_pixel;
-    w->first_sample = first_sample;
-    w->n_paths = n_paths;
     w->cur = w->queue_a;
     w->next = w->queue_b;
-    w->active = 1;
-    return od->bounded ? wave_enqueue_all(od, w, err) : bounce_launch(od, w, 0, n_paths, err);
+    return od->launch == WAVE_LAUNCH_BOUNDED ? wave_enqueue_all(od, w, err) : bounce_launch(od, w, 0, n_paths, err);
 }
 
 /* Waits for the counts of the wave's last bounce, then launches its shadow rays and
@@ -699,7 +757,12 @@ static Status wave_advance(OclDevice *od, WaveSlot *w, Error *err)
     }
     release_event(&w->read);
     if (rc != CL_SUCCESS) return ocl_fail(err, &od->info, "clWaitForEvents", rc);
-    if (od->bounded) {
+    if (od->launch == WAVE_LAUNCH_MEGAKERNEL) {
+        od->rays += (uint64_t)w->got[0] + ((uint64_t)w->got[QUEUE_COUNT_STRIDE] << 32);
+        w->active = 0;
+        return ST_OK;
+    }
+    if (od->launch == WAVE_LAUNCH_BOUNDED) {
         /* the whole wave ran; its counts say how many rays it traced */
         for (uint b = 0; b < od->max_bounces; b++)
             od->rays += (uint64_t)w->all_counts[2u * b * QUEUE_COUNT_STRIDE] +
@@ -729,7 +792,8 @@ static Status wave_advance(OclDevice *od, WaveSlot *w, Error *err)
 }
 
 /* Whether the batch is to be dropped: checked before each launch step of a wave (a
- * bounce of a wave takes milliseconds), so a cancel is seen about that quickly. */
+ * bounce of a wave, or a whole megakernel wave, takes milliseconds), so a cancel is
+ * seen about that quickly. */
 static int cancel_requested(const OclDevice *od)
 {
     return od->cancel && atomic_load_explicit(od->cancel, memory_order_relaxed);
@@ -916,7 +980,8 @@ static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error
     od->wave_paths = cfg && cfg->wave_paths ? cfg->wave_paths : (gpu ? gpu_wave : (1u << 16));
     od->wave_auto = cfg && cfg->wave_paths ? 0u : (gpu && gpu_wave > (1u << 20) ? gpu_wave : 0u);
     od->local_size = od->info.max_work_group >= OCL_LOCAL_SIZE ? OCL_LOCAL_SIZE : 0;
-    od->bounded = cfg && cfg->wave_launch ? cfg->wave_launch == WAVE_LAUNCH_BOUNDED : gpu;
+    od->launch = cfg && cfg->wave_launch ? cfg->wave_launch
+                 : gpu ? WAVE_LAUNCH_BOUNDED : profile ? WAVE_LAUNCH_COUNTED : WAVE_LAUNCH_MEGAKERNEL;
     return ST_OK;
 }
 

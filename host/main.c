@@ -704,14 +704,16 @@ static Status resume_check_range(const Options *o, const Checkpoint *ck, Error *
     return ST_OK;
 }
 
-/* kd-tree and device buffers, the render's identity, the film (from --resume). */
-static Status render_prepare(Run *r, int worker, Error *err)
+/* kd-tree and device buffers, the film (from --resume), and the render's identity where
+ * something compares or records it (a checkpoint, a resume, the ranks of an MPI job:
+ * `keyed`): it hashes every scene buffer, a tenth of a second for a million triangles. */
+static Status render_prepare(Run *r, int worker, int keyed, Error *err)
 {
     Status st;
     if ((st = render_scene_prepare(&r->scene, 0, &r->rs, err))) return st;
     const DeviceScene *ds = &r->rs.ds;
     if (r->o.stats && !worker) print_scene_stats(&r->scene, &r->rs.kd);
-    checkpoint_id(ds, r->scene.image.spp, &r->ctx.checkpoint_id);
+    if (keyed || r->o.checkpoint_path || r->o.resume_path) checkpoint_id(ds, r->scene.image.spp, &r->ctx.checkpoint_id);
     if ((st = film_init(&r->film, ds->params.width, ds->params.height, err))) return st;
     if (!r->o.resume_path || worker) return ST_OK;
     if ((st = resume_film(r->o.resume_path, &r->ctx.checkpoint_id, &r->resume, &r->film, r->o.quiet, err))) return st;
@@ -890,7 +892,7 @@ static Status run_rank(Run *r, Dist *dist, Error *err)
     if (st == ST_OK && !receive) st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
     if (st == ST_OK && !worker) st = outputs_from_scene(r, err);
     if (st == ST_OK && !receive) st = scene_apply_options(r, err);
-    if (st == ST_OK && !receive) st = render_prepare(r, worker, err);
+    if (st == ST_OK && !receive) st = render_prepare(r, worker, 1, err);
     if (dist->broadcast) st = mpi_share_scene(r, dist, st, err);
     if (st == ST_OK) st = open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
     st = dist_agree(dist, st, err, &r->ctx.checkpoint_id, r->devs, r->n_devs, err);
@@ -917,7 +919,7 @@ static Status run_interactive(Run *r, Error *err)
     if (!r->o.wave_paths) r->o.wave_paths = VIEWER_WAVE_PATHS;
     st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
     if (st == ST_OK) st = scene_apply_options(r, err);
-    if (st == ST_OK) st = render_prepare(r, 0, err);
+    if (st == ST_OK) st = render_prepare(r, 0, 0, err);
     if (st == ST_OK) st = open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
     if (st == ST_OK) {
         ViewerConfig vc = { r->o.scene_path, &r->scene, &r->rs, r->devs, r->n_devs,
@@ -954,7 +956,7 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
     if (st == ST_OK) st = load_scene_input(&r.o, &r.scene, &r.bare_mesh, err);
     if (st == ST_OK) st = outputs_from_scene(&r, err);
     if (st == ST_OK) st = scene_apply_options(&r, err);
-    if (st == ST_OK) st = render_prepare(&r, 0, err);
+    if (st == ST_OK) st = render_prepare(&r, 0, 0, err);
     if (st == ST_OK) st = open_devices(&r.o, &r.rs.ds, &r.devs, &r.n_devs, err);
     if (st == ST_OK) {
         render_run(&r, dist, err);

@@ -26,8 +26,8 @@ static CliResult r;
 /* A small, quick render with many batches, so that checkpoints catch it part-way. */
 #define SCENE "scenes/cornell-box.scene"
 #define SIZE "--width", "48", "--height", "36"
-#define SPP_TEXT "400"
-#define SPP 400u
+#define SPP_TEXT "1200"
+#define SPP 1200u
 
 static void make_dir(void)
 {

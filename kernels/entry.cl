@@ -46,9 +46,10 @@
     SCENE_BUFFERS(SCENE_VIEW_SET_)
 
 /* CLPT_LOCAL_SIZE (set by the renderer, device_ocl.c, when it launches every kernel with
- * that work-group size): declared on the wavefront kernels, so a driver compiles them
- * for that size once. PoCL compiles a work-group function per kernel and size: for the
- * program binary clpt caches, and again at the first launch unless the sizes match. */
+ * that work-group size): declared on every kernel the renderer launches, so a driver
+ * compiles them for that size once. PoCL compiles a work-group function per kernel and
+ * size: for the program binary clpt caches, and again at the first launch unless the
+ * sizes match. */
 #ifdef CLPT_LOCAL_SIZE
 #define KERNEL_SIZE __attribute__((reqd_work_group_size(CLPT_LOCAL_SIZE, 1, 1)))
 #else
@@ -138,8 +139,9 @@ __kernel KERNEL_SIZE void k_shadow(SCENE_ARGS __global const uint *shadow_queue,
 /* The path tracer as one kernel, the CPUs' form: each work-item runs its path from
  * birth to end, calling the stage functions in the wavefront's order (the scalar
  * device's loop, device_scalar.c), so a path computes the same bits either way. On
- * PoCL this beat the wavefront by 10-30%: a path's state stays in the cache, and there
- * are no queues, no atomics and no barriers per bounce (bench/RESULTS.md). Adds its
+ * PoCL this beat the counted wavefront by 3-13% on every bench scene: a path's state
+ * stays in the cache, and there are no queues, atomics or barriers per bounce
+ * (bench/RESULTS.md). Adds its
  * rays to counters[0], carrying into counters[QUEUE_COUNT_STRIDE] (a 64-bit count from
  * 32-bit atomics: the adder whose addition wraps the low word carries). */
 __kernel KERNEL_SIZE void k_path(SCENE_ARGS uint first_pixel, uint first_sample, uint n_pixels, uint n_paths,

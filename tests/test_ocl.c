@@ -609,6 +609,20 @@ static void test_kernel_argument_names(void)
     error_clear(&err);
 }
 
+/* The renderer's program for `features` (CLPT_FEATURES) with `extra` options, built as
+ * the device builds it (in the kernel cache, so the suite's second run loads it); its
+ * options into `options`. NULL, having failed the test, if it does not build. */
+static cl_program build_program(unsigned features, const char *extra, char *options, size_t cap)
+{
+    snprintf(options, cap, "-D CLPT_FEATURES=0x%xu%s", features, extra);
+    Error err = {0};
+    cl_program prog = NULL;
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, options, &prog, NULL, &err), ST_OK);
+    CHECK_MSG(prog != NULL, "%s: %s", options, err.msg);
+    error_clear(&err);
+    return prog;
+}
+
 /* Whether prog has a kernel named `name`. */
 static int has_kernel(cl_program prog, const char *name)
 {
@@ -632,13 +646,8 @@ static void test_program_per_integrator(void)
         { KF_PATH_MEGAKERNEL, { "k_path", "k_film", "k_film" }, { "k_shade", "k_raygen", "k_whitted" } },
     };
     for (size_t i = 0; i < sizeof programs / sizeof programs[0]; i++) {
-        char options[64];
-        snprintf(options, sizeof options, "-D CLPT_FEATURES=0x%xu", programs[i].features);
-        Error err = {0};
-        cl_program prog = NULL;
-        CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, options, &prog, NULL, &err), ST_OK);
-        CHECK_MSG(prog != NULL, "%s: %s", options, err.msg);
-        error_clear(&err);
+        char options[96];
+        cl_program prog = build_program(programs[i].features, "", options, sizeof options);
         if (!prog) continue;
         for (int k = 0; k < 3; k++)
             CHECK_MSG(has_kernel(prog, programs[i].has[k]), "%s: no %s", options, programs[i].has[k]);
@@ -660,11 +669,7 @@ static void test_kernels_declare_the_launch_size(void)
     };
     for (size_t i = 0; i < sizeof programs / sizeof programs[0]; i++) {
         char options[96];
-        snprintf(options, sizeof options, "-D CLPT_FEATURES=0x%xu -D CLPT_LOCAL_SIZE=64", programs[i].features);
-        Error err = {0};
-        cl_program prog = NULL;
-        CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, options, &prog, NULL, &err), ST_OK);
-        error_clear(&err);
+        cl_program prog = build_program(programs[i].features, " -D CLPT_LOCAL_SIZE=64", options, sizeof options);
         if (!prog) continue;
         for (int k = 0; k < 5 && programs[i].kernels[k]; k++) {
             cl_int rc;

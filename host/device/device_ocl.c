@@ -649,6 +649,17 @@ static Status bounce_launch(OclDevice *od, WaveSlot *w, uint b, uint n, Error *e
     return ST_OK;
 }
 
+/* Adds the finished wave's paths into the batch's film (k_film: one work-item per pixel
+ * the wave covers). */
+static Status wave_film(OclDevice *od, WaveSlot *w, Error *err)
+{
+    cl_kernel k = w->k_film;
+    ARG(k, ARG_FILM_FIRST_PIXEL, w->first_pixel);
+    ARG(k, ARG_FILM_N_PATHS, w->n_paths);
+    ARG(k, ARG_FILM_FILM, od->film);
+    return launch(od, k, "k_film", w->n_paths < od->n_pixels ? w->n_paths : od->n_pixels, err);
+}
+
 /* GPUs: enqueues every bounce of the wave at once, each launch over the wave's size,
  * the kernels stopping at the live count k_shade left on the device (entry.cl); then
  * k_film and one read-back of all the counts. On a GPU a bounce's kernels take tens of
@@ -680,11 +691,7 @@ static Status wave_enqueue_all(OclDevice *od, WaveSlot *w, Error *err)
         w->cur = w->next;
         w->next = t;
     }
-    cl_kernel k = w->k_film;
-    ARG(k, ARG_FILM_FIRST_PIXEL, w->first_pixel);
-    ARG(k, ARG_FILM_N_PATHS, w->n_paths);
-    ARG(k, ARG_FILM_FILM, od->film);
-    if ((st = launch(od, k, "k_film", w->n_paths < od->n_pixels ? w->n_paths : od->n_pixels, err))) return st;
+    if ((st = wave_film(od, w, err))) return st;
     OCL_TRY("clEnqueueReadBuffer",
             clEnqueueReadBuffer(od->queue, w->counts, CL_FALSE, 0,
                                 (2u * (size_t)od->max_bounces + 1u) * QUEUE_COUNT_STRIDE * sizeof(cl_uint),
@@ -702,12 +709,7 @@ static Status wave_run_paths(OclDevice *od, WaveSlot *w, Error *err)
     ARG(k, ARG_PATH_FIRST_PIXEL, w->first_pixel);
     ARG(k, ARG_PATH_FIRST_SAMPLE, w->first_sample);
     ARG(k, ARG_PATH_N_PATHS, w->n_paths);
-    if ((st = launch(od, k, "k_path", w->n_paths, err))) return st;
-    k = w->k_film;
-    ARG(k, ARG_FILM_FIRST_PIXEL, w->first_pixel);
-    ARG(k, ARG_FILM_N_PATHS, w->n_paths);
-    ARG(k, ARG_FILM_FILM, od->film);
-    if ((st = launch(od, k, "k_film", w->n_paths < od->n_pixels ? w->n_paths : od->n_pixels, err))) return st;
+    if ((st = launch(od, k, "k_path", w->n_paths, err)) || (st = wave_film(od, w, err))) return st;
     OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, w->counts, CL_FALSE, 0, sizeof w->got, w->got, 0,
                                                        NULL, &w->read));
     OCL_TRY("clFlush", clFlush(od->queue));
@@ -783,12 +785,8 @@ static Status wave_advance(OclDevice *od, WaveSlot *w, Error *err)
         w->next = t;
         return bounce_launch(od, w, w->bounce + 1u, next, err);
     }
-    k = w->k_film;
-    ARG(k, ARG_FILM_FIRST_PIXEL, w->first_pixel);
-    ARG(k, ARG_FILM_N_PATHS, w->n_paths);
-    ARG(k, ARG_FILM_FILM, od->film);
     w->active = 0;
-    return launch(od, k, "k_film", w->n_paths < od->n_pixels ? w->n_paths : od->n_pixels, err);
+    return wave_film(od, w, err);
 }
 
 /* Whether the batch is to be dropped: checked before each launch step of a wave (a

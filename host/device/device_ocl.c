@@ -622,13 +622,13 @@ static Status ocl_update_params(Device *d, const RenderParams *p, const uint *pi
     return ST_OK;
 }
 
-/* Launches bounce b of wave w over its `n` live paths, then the read-back of the two
- * counts k_shade leaves: the bounce's shadow rays and the next bounce's live paths. */
-static Status bounce_launch(OclDevice *od, WaveSlot *w, uint b, uint n, Error *err)
+/* k_intersect and k_shade of bounce b of wave w over `n` work-items (the live paths, or
+ * an upper bound: the kernels stop at the count in slot 2b); k_shade counts into slots
+ * 2b + 1 and 2b + 2. */
+static Status bounce_kernels(OclDevice *od, WaveSlot *w, uint b, uint n, Error *err)
 {
     Status st;
-    cl_uint slot = 2u * b + 1u;
-    cl_uint live_slot = 2u * b;
+    cl_uint live_slot = 2u * b, slot = 2u * b + 1u;
     cl_kernel k = w->k_intersect;
     ARG(k, ARG_INTERSECT_QUEUE, w->cur);
     ARG(k, ARG_INTERSECT_N, n);
@@ -639,7 +639,16 @@ static Status bounce_launch(OclDevice *od, WaveSlot *w, uint b, uint n, Error *e
     ARG(k, ARG_SHADE_N, n);
     ARG(k, ARG_SHADE_NEXT_QUEUE, w->next);
     ARG(k, ARG_SHADE_SLOT, slot);
-    if ((st = launch(od, k, "k_shade", n, err))) return st;
+    return launch(od, k, "k_shade", n, err);
+}
+
+/* Launches bounce b of wave w over its `n` live paths, then the read-back of the two
+ * counts k_shade leaves: the bounce's shadow rays and the next bounce's live paths. */
+static Status bounce_launch(OclDevice *od, WaveSlot *w, uint b, uint n, Error *err)
+{
+    Status st;
+    cl_uint slot = 2u * b + 1u;
+    if ((st = bounce_kernels(od, w, b, n, err))) return st;
     OCL_TRY("clEnqueueReadBuffer",
             clEnqueueReadBuffer(od->queue, w->counts, CL_FALSE, (size_t)slot * QUEUE_COUNT_STRIDE * sizeof(cl_uint),
                                 sizeof w->got, w->got, 0, NULL, &w->read));
@@ -671,19 +680,9 @@ static Status wave_enqueue_all(OclDevice *od, WaveSlot *w, Error *err)
     Status st;
     uint n = w->n_paths;
     for (uint b = 0; b < od->max_bounces; b++) {
-        cl_uint live_slot = 2u * b, slot = 2u * b + 1u;
-        cl_kernel k = w->k_intersect;
-        ARG(k, ARG_INTERSECT_QUEUE, w->cur);
-        ARG(k, ARG_INTERSECT_N, n);
-        ARG(k, ARG_INTERSECT_LIVE_SLOT, live_slot);
-        if ((st = launch(od, k, "k_intersect", n, err))) return st;
-        k = w->k_shade;
-        ARG(k, ARG_SHADE_QUEUE, w->cur);
-        ARG(k, ARG_SHADE_N, n);
-        ARG(k, ARG_SHADE_NEXT_QUEUE, w->next);
-        ARG(k, ARG_SHADE_SLOT, slot);
-        if ((st = launch(od, k, "k_shade", n, err))) return st;
-        k = w->k_shadow;
+        cl_uint slot = 2u * b + 1u;
+        if ((st = bounce_kernels(od, w, b, n, err))) return st;
+        cl_kernel k = w->k_shadow;
         ARG(k, ARG_SHADOW_N, n);
         ARG(k, ARG_SHADOW_LIVE_SLOT, slot);
         if ((st = launch(od, k, "k_shadow", n, err))) return st;

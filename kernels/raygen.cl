@@ -25,8 +25,9 @@ KFN Ray camera_ray(GLOBAL const RenderParams *p, float s, float t, RngKey key)
     }
     vec3 origin = cam.origin;
     if (cam.lens_radius > 0.0f) {
-        float lx, ly;
-        sample_disk(rng_uniform(key, 0u, DIM_LENS_U), rng_uniform(key, 0u, DIM_LENS_V), &lx, &ly);
+        float lu, lv, lx, ly;
+        rng_uniform2(key, 0u, DIM_LENS_U, &lu, &lv);
+        sample_disk(lu, lv, &lx, &ly);
         origin = v3_madd(v3_madd(origin, cam.lens_u, lx * cam.lens_radius), cam.lens_v, ly * cam.lens_radius);
     }
     ray.o = origin;
@@ -39,8 +40,10 @@ KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
 {
     RngKey key = rng_key_make(p, pixel, sample);
     uint x = pixel % p->width, y = pixel / p->width;
-    float s = ((float)x + rng_uniform(key, 0u, DIM_PIXEL_X)) / (float)p->width;
-    float t = ((float)y + rng_uniform(key, 0u, DIM_PIXEL_Y)) / (float)p->height;
+    float jx, jy;
+    rng_uniform2(key, 0u, DIM_PIXEL_X, &jx, &jy);
+    float s = ((float)x + jx) / (float)p->width;
+    float t = ((float)y + jy) / (float)p->height;
     *ray = camera_ray(p, s, t, key);
 
     ps->throughput = v3s(1.0f);

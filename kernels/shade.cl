@@ -44,8 +44,9 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
     uint b = ps->bounce;
     uint mis_mode = sc->params->mis_mode;
     LightSample ls;
-    if (!light_sample(sc, s.p, rng_uniform(key, b, DIM_LIGHT_PICK), rng_uniform(key, b, DIM_LIGHT_U),
-                      rng_uniform(key, b, DIM_LIGHT_V), &ls))
+    float lu, lv;
+    rng_uniform2(key, b, DIM_LIGHT_U, &lu, &lv);
+    if (!light_sample(sc, s.p, rng_uniform(key, b, DIM_LIGHT_PICK), lu, lv, &ls))
         return 0;
     if (!ls.delta && mis_mode == MIS_BSDF_ONLY) return 0;
     vec3 wi = ls.wi;
@@ -124,9 +125,12 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     if (p->n_lights > 0u && bsdf_has_density(m, albedo) &&
         shade_light_sample(sc, ps, s, r.d, ns_face, ng_face, m, albedo, front, shadow_ray))
         result |= SHADE_SHADOW;
-    bs = bsdf_sample(m, albedo, r.d, ns_face, ng_face, front, rng_uniform(key, bounce, DIM_BSDF_LOBE),
-                     rng_uniform(key, bounce, DIM_BSDF_U), rng_uniform(key, bounce, DIM_BSDF_V),
-                     rng_uniform(key, bounce, DIM_BSDF_W));
+    /* a diffuse sample uses only the 2D pair: the other dimensions are left undrawn */
+    int two_d = m.type == MAT_DIFFUSE;
+    float bu, bv;
+    rng_uniform2(key, bounce, DIM_BSDF_U, &bu, &bv);
+    bs = bsdf_sample(m, albedo, r.d, ns_face, ng_face, front, two_d ? 0.0f : rng_uniform(key, bounce, DIM_BSDF_LOBE),
+                     bu, bv, two_d ? 0.0f : rng_uniform(key, bounce, DIM_BSDF_W));
 
     /* a reflected direction must leave on the incoming side, a transmitted one on the
      * other; anything else is a sample below the geometric surface and carries nothing */

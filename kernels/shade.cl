@@ -112,7 +112,7 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     /* normals turned toward the side the ray came from */
     int front = v3_dot(r.d, s.ng) < 0.0f;
     vec3 ng_face = front ? s.ng : v3_neg(s.ng);
-    m = material_resolve(sc, m, s, r.d, ng_face);
+    material_resolve(sc, &m, s, r.d, ng_face);
     if (m.type == MAT_EMISSIVE) return 0u;   /* pure emitters do not reflect */
     s.ns = material_normal(sc, m, s);
     vec3 ns_face = front ? s.ns : v3_neg(s.ns);
@@ -120,7 +120,7 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
     BsdfSample bs;
 
     vec3 albedo = material_albedo(sc, m, s, ng_face);
-    m = material_at(sc, m, s, ng_face);
+    material_at(sc, &m, s, ng_face);
 
     if (p->n_lights > 0u && bsdf_has_density(m, albedo) &&
         shade_light_sample(sc, ps, s, r.d, ns_face, ng_face, m, albedo, front, shadow_ray))

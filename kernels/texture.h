@@ -314,17 +314,17 @@ KFN vec3 material_normal(const SceneView *sc, Material m, Surface s)
     return v3_dot(r, s.ng) > 0.0f ? r : s.ns;
 }
 
-/* The material with its textured parameters at s: a principled material's roughness
- * and metallic factors times its metallic-roughness texture's G and B (glTF's packing;
- * the texture is read as declared, so it should be `encoding linear`). */
-KFN Material material_at(const SceneView *sc, Material m, Surface s, vec3 ng_face)
+/* Sets *m's textured parameters to their values at s: a principled material's
+ * roughness and metallic factors times its metallic-roughness texture's G and B
+ * (glTF's packing; the texture is read as declared, so it should be `encoding linear`).
+ * In place, as material_resolve (mix.h). */
+KFN void material_at(const SceneView *sc, Material *m, Surface s, vec3 ng_face)
 {
-    if (KF_HAS(KF_TEXTURES) && MAT_IS(m, MAT_PRINCIPLED) && m.texture_rm != NO_INDEX) {
-        vec3 t = texture_eval(sc, m.texture_rm, s, ng_face);
-        m.roughness *= t.y;
-        m.metallic *= t.z;
+    if (KF_HAS(KF_TEXTURES) && MAT_IS(*m, MAT_PRINCIPLED) && m->texture_rm != NO_INDEX) {
+        vec3 t = texture_eval(sc, m->texture_rm, s, ng_face);
+        m->roughness *= t.y;
+        m->metallic *= t.z;
     }
-    return m;
 }
 
 #endif /* CLPT_TEXTURE_H */

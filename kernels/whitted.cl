@@ -161,13 +161,13 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, RngKey key, uint *ray
         vec3 emission = material_emission(sc, m, s);
         if (!v3_is_zero(emission) && ((m.flags & MAT_TWO_SIDED) || front))
             L = v3_add(L, v3_mul(e.weight, emission));
-        m = material_resolve(sc, m, s, d, ng);
+        material_resolve(sc, &m, s, d, ng);
         if (m.type == MAT_EMISSIVE) continue;
         s.ns = material_normal(sc, m, s);
         vec3 ns = front ? s.ns : v3_neg(s.ns);
 
         vec3 kd = material_albedo(sc, m, s, ng);
-        m = material_at(sc, m, s, ng);
+        material_at(sc, &m, s, ng);
         vec3 kr = v3s(0.0f), kt = v3s(0.0f);
         if (m.type == MAT_PRINCIPLED) {
             /* the classic tracer's reading of glTF: the diffuse share lit directly, the
@@ -241,7 +241,8 @@ KFN vec3 whitted_aov(const SceneView *sc, Ray ray, uint mode, uint *rays)
     if (mode == INTEGRATOR_AOV_NORMAL) return v3_scale(v3_add(s.ns, v3s(1.0f)), 0.5f);
     if (mode == INTEGRATOR_AOV_DEPTH) return v3(hit.t * v3_len(ray.d), 1.0f, 0.0f);
     vec3 ng = v3_dot(ray.d, s.ng) < 0.0f ? s.ng : v3_neg(s.ng);
-    Material m = material_resolve(sc, sc->materials[s.material], s, ray.d, ng);
+    Material m = sc->materials[s.material];
+    material_resolve(sc, &m, s, ray.d, ng);
     if (m.type == MAT_EMISSIVE) return v3s(0.0f);
     if (m.type == MAT_DIELECTRIC) return v3s(1.0f);
     return material_albedo(sc, m, s, ng);

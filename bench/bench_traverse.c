@@ -25,8 +25,11 @@
  * Before anything is timed, the hits of the scalar C traversal are compared with
  * Embree's rtcIntersect1/rtcOccluded1 (same triangle, or t within 1e-4 relative; any-hit:
  * the same answer) and with PoCL's (bit for bit), and the counts that disagree printed.
- * Then Mrays/s, the median of --reps runs (5), for: PoCL (k_trace_closest/k_trace_any in
- * kernels/entry.cl) on a sub-device of 1 compute unit and on the whole device; the
+ * Then Mrays/s, the median of --reps runs (5), for: PoCL (kernels/entry.cl) with one ray
+ * per work-item (PoCL-1: k_trace_closest1/k_trace_any1, the renderer's walk), two walked
+ * in turns (PoCL-2: k_trace_closest/k_trace_any) and packets of eight consecutive rays
+ * (PoCL-8: k_trace_closest8/k_trace_any8, trace_packet), each on a sub-device of 1
+ * compute unit and on the whole device (all three are checked bit for bit); the
  * scalar C traversal (kernels compiled as C) on 1 and 2 threads; Embree rtcIntersect1 /
  * rtcOccluded1 and rtcIntersect8 / rtcOccluded8 packets (8 consecutive rays) on 1 and 2
  * threads; the ratio of PoCL to Embree single rays at 2 threads (the issue's target is
@@ -332,6 +335,7 @@ typedef struct {
     cl_command_queue q;
     cl_kernel kc, ka;            /* two rays per work-item */
     cl_kernel kc1, ka1;          /* one ray per work-item */
+    cl_kernel kc8, ka8;          /* packets of eight rays per work-item */
     cl_program prog;
     cl_mem scene[SC_N], rays, out;
     size_t rays_cap;
@@ -363,7 +367,9 @@ static int pocl_open(Pocl *pc, const OclDeviceInfo *dev, cl_device_id sub)
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest", &pc->kc, &err) ||
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_any", &pc->ka, &err) ||
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest1", &pc->kc1, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any1", &pc->ka1, &err)) {
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any1", &pc->ka1, &err) ||
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest8", &pc->kc8, &err) ||
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any8", &pc->ka8, &err)) {
         fprintf(stderr, "bench_traverse: %s\n", err.msg);
         error_clear(&err);
         return -1;
@@ -390,6 +396,8 @@ static void pocl_close(Pocl *pc)
     if (pc->ka) clReleaseKernel(pc->ka);
     if (pc->kc1) clReleaseKernel(pc->kc1);
     if (pc->ka1) clReleaseKernel(pc->ka1);
+    if (pc->kc8) clReleaseKernel(pc->kc8);
+    if (pc->ka8) clReleaseKernel(pc->ka8);
     if (pc->prog) clReleaseProgram(pc->prog);
     if (pc->q) clReleaseCommandQueue(pc->q);
     if (pc->ctx) clReleaseContext(pc->ctx);
@@ -419,8 +427,8 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
     for (int i = 0; i < SC_N; i++)
         if (!pc->scene[i]) return -1;
     if (!pc->rays || !pc->out) return -1;
-    cl_kernel ks[4] = { pc->kc, pc->ka, pc->kc1, pc->ka1 };
-    for (int k = 0; k < 4; k++) {
+    cl_kernel ks[6] = { pc->kc, pc->ka, pc->kc1, pc->ka1, pc->kc8, pc->ka8 };
+    for (int k = 0; k < 6; k++) {
         for (cl_uint i = 0; i < SC_N; i++)
             if (clSetKernelArg(ks[k], i, sizeof(cl_mem), &pc->scene[i]) != CL_SUCCESS) return -1;
         if (clSetKernelArg(ks[k], SC_N, sizeof(cl_mem), &pc->rays) != CL_SUCCESS ||
@@ -430,14 +438,19 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
     return 0;
 }
 
-/* Traces the set (its rays already uploaded), two rays per work-item or one; returns
- * seconds, or -1. */
-static double pocl_trace(Pocl *pc, const RaySet *s, int pairs)
+/* The PoCL kernels: rays per work-item. */
+enum { POCL_SINGLE, POCL_PAIRS, POCL_PACKETS, N_KERNELS };
+static const uint rays_per_item[N_KERNELS] = { 1, 2, 8 };
+
+/* Traces the set (its rays already uploaded) with kernel `kind`; returns seconds, or -1. */
+static double pocl_trace(Pocl *pc, const RaySet *s, int kind)
 {
-    cl_kernel k = pairs ? (s->any ? pc->ka : pc->kc) : (s->any ? pc->ka1 : pc->kc1);
+    cl_kernel k = kind == POCL_PAIRS ? (s->any ? pc->ka : pc->kc)
+                  : kind == POCL_PACKETS ? (s->any ? pc->ka8 : pc->kc8)
+                                         : (s->any ? pc->ka1 : pc->kc1);
     cl_uint n = s->n;
     if (clSetKernelArg(k, SC_N + 1, sizeof n, &n) != CL_SUCCESS) return -1.0;
-    size_t items = pairs ? (n + 1u) / 2u : n;
+    size_t items = (n + rays_per_item[kind] - 1u) / rays_per_item[kind];
     size_t local = pocl_local, global = local ? (items + local - 1) / local * local : items;
     double c0 = cpu_now(), t0 = timer_now();
     cl_int rc = clEnqueueNDRangeKernel(pc->q, k, 1, NULL, &global, local ? &local : NULL, 0, NULL, NULL);
@@ -676,8 +689,6 @@ static long embree_compare(const RaySet *s, const Hit *eh, const uint *eo)
 
 /* ------------------------------------------------------------------ one mesh */
 
-/* PoCL kernels: one ray per work-item (as the renderer's k_intersect/k_shadow), two */
-#define N_KERNELS 2
 
 typedef struct {
     double pocl[N_KERNELS][MAX_THREADS], c[MAX_THREADS], e1[MAX_THREADS], e8[MAX_THREADS];   /* Mrays/s */
@@ -753,17 +764,16 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
         /* check first */
         r->pocl_diff = r->embree_diff = -1;
         for (int t = 0; t < MAX_THREADS; t++) {
-            if (!pocl_ok[t] || pocl_put_rays(&pocl[t], s) || pocl_trace(&pocl[t], s, 0) < 0.0) {
+            if (!pocl_ok[t] || pocl_put_rays(&pocl[t], s)) {
                 pocl_ok[t] = 0;
                 continue;
             }
-            long d = pocl_compare(&pocl[t], s);
-            if (pocl_trace(&pocl[t], s, 1) < 0.0) {
-                pocl_ok[t] = 0;
-                continue;
+            long d = 0;
+            for (int kp = 0; kp < N_KERNELS && pocl_ok[t]; kp++) {
+                if (pocl_trace(&pocl[t], s, kp) < 0.0) pocl_ok[t] = 0;
+                else d += pocl_compare(&pocl[t], s);
             }
-            d += pocl_compare(&pocl[t], s);
-            r->pocl_diff = r->pocl_diff < 0 ? d : r->pocl_diff + d;
+            if (pocl_ok[t]) r->pocl_diff = r->pocl_diff < 0 ? d : r->pocl_diff + d;
         }
         if (have_embree) {
             embree_trace(emb[MAX_THREADS - 1].scene, s, 0, 1, eh, eo);
@@ -809,10 +819,10 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
     free(eo);
 
     int a = o->threads[0], b = o->threads[MAX_THREADS - 1];
-    printf("\n| rays | query | count | hits | PoCL-1 %dt | PoCL-1 %dt | PoCL-2 %dt | PoCL-2 %dt | C %dt | C %dt | "
-           "Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | vs Embree | PoCL vs C |\n",
-           a, b, a, b, a, b, a, b, a, b);
-    printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    printf("\n| rays | query | count | hits | PoCL-1 %dt | PoCL-1 %dt | PoCL-2 %dt | PoCL-2 %dt | PoCL-8 %dt | "
+           "PoCL-8 %dt | C %dt | C %dt | Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | vs Embree | "
+           "PoCL vs C |\n", a, b, a, b, a, b, a, b, a, b, a, b);
+    printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int k = 0; k < N_SETS; k++) {
         const SetResult *r = &res[k];
         char pd[32], ed[32];
@@ -820,26 +830,29 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
         else snprintf(pd, sizeof pd, "%ld differ", r->pocl_diff);
         if (r->embree_diff < 0) snprintf(ed, sizeof ed, "-");
         else snprintf(ed, sizeof ed, "%ld disagree", r->embree_diff);
-        printf("| %s | %s | %u | %u | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %s |\n",
-               sets[k].name, sets[k].any ? "any" : "closest", sets[k].n, r->hits, r->pocl[0][0], r->pocl[0][1],
-               r->pocl[1][0], r->pocl[1][1], r->c[0], r->c[1], r->e1[0], r->e1[1], r->e8[0], r->e8[1], ed, pd);
+        printf("| %s | %s | %u | %u |", sets[k].name, sets[k].any ? "any" : "closest", sets[k].n, r->hits);
+        for (int kp = 0; kp < N_KERNELS; kp++) printf(" %.2f | %.2f |", r->pocl[kp][0], r->pocl[kp][1]);
+        printf(" %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %s |\n", r->c[0], r->c[1], r->e1[0], r->e1[1], r->e8[0],
+               r->e8[1], ed, pd);
     }
     printf("\nThe same runs in Mrays per CPU-second (the CPU time of the whole process: the work per core, "
            "which other jobs taking the cores do not change; with ideal scaling the %d-thread columns equal "
            "the 1-thread ones), and PoCL over Embree single rays:\n\n", b);
-    printf("| rays | PoCL-1 %dt | PoCL-1 %dt | PoCL-2 %dt | PoCL-2 %dt | C %dt | C %dt | Embree-1 %dt | Embree-1 %dt | "
-           "Embree-8 %dt | Embree-8 %dt | PoCL-1/Embree-1 %dt | PoCL-1/Embree-1 %dt | PoCL-2/Embree-1 %dt | "
-           "PoCL-2/Embree-1 %dt |\n", a, b, a, b, a, b, a, b, a, b, a, b, a, b);
-    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    printf("| rays | PoCL-1 %dt | PoCL-1 %dt | PoCL-2 %dt | PoCL-2 %dt | PoCL-8 %dt | PoCL-8 %dt | C %dt | C %dt | "
+           "Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | PoCL-1/Embree-1 %dt | PoCL-1/Embree-1 %dt | "
+           "PoCL-2/Embree-1 %dt | PoCL-2/Embree-1 %dt | PoCL-8/Embree-1 %dt | PoCL-8/Embree-1 %dt |\n",
+           a, b, a, b, a, b, a, b, a, b, a, b, a, b, a, b, a, b);
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int k = 0; k < N_SETS; k++) {
         const SetResult *r = &res[k];
-        double q[N_KERNELS][MAX_THREADS];
+        printf("| %s %s |", sets[k].name, sets[k].any ? "any" : "closest");
+        for (int kp = 0; kp < N_KERNELS; kp++) printf(" %.2f | %.2f |", r->cpu_pocl[kp][0], r->cpu_pocl[kp][1]);
+        printf(" %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |", r->cpu_c[0], r->cpu_c[1], r->cpu_e1[0], r->cpu_e1[1],
+               r->cpu_e8[0], r->cpu_e8[1]);
         for (int kp = 0; kp < N_KERNELS; kp++)
-            for (int t = 0; t < MAX_THREADS; t++) q[kp][t] = r->cpu_e1[t] > 0.0 ? r->cpu_pocl[kp][t] / r->cpu_e1[t] : 0.0;
-        printf("| %s %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n",
-               sets[k].name, sets[k].any ? "any" : "closest", r->cpu_pocl[0][0], r->cpu_pocl[0][1], r->cpu_pocl[1][0],
-               r->cpu_pocl[1][1], r->cpu_c[0], r->cpu_c[1], r->cpu_e1[0], r->cpu_e1[1], r->cpu_e8[0], r->cpu_e8[1],
-               q[0][0], q[0][1], q[1][0], q[1][1]);
+            for (int t = 0; t < MAX_THREADS; t++)
+                printf(" %.2f |", r->cpu_e1[t] > 0.0 ? r->cpu_pocl[kp][t] / r->cpu_e1[t] : 0.0);
+        printf("\n");
     }
     fflush(stdout);
     for (int t = 0; t < MAX_THREADS; t++) embree_free(&emb[t]);

@@ -48,6 +48,8 @@ typedef long kint64;         /* 64-bit in every OpenCL C implementation */
 #define k_load8(v, p) ((v) = vload8(0, p))
 #define k_store4(v, p) vstore4(v, 0, p)
 #define k_store8(v, p) vstore8(v, 0, p)
+/* per lane: b where the mask m's lane is set (-1), else a */
+#define k_select8(a, b, m) select(a, b, m)
 
 #elif defined(__OPENCL_VERSION__)
 #error "an OpenCL compiler without __OPENCL_C_VERSION__: clpt's kernels need OpenCL C 1.2 (-cl-std=CL1.2)"
@@ -85,6 +87,14 @@ typedef float float4 __attribute__((vector_size(16)));
 typedef int int4 __attribute__((vector_size(16)));
 #define k_load4(v, p) memcpy(&(v), (p), sizeof(float4))
 #define k_store4(v, p) memcpy((p), &(v), sizeof(float4))
+/* 8 lanes for the packet walk (traverse.cl), whose C build is its reference, not a
+ * fast path */
+typedef float float8 __attribute__((vector_size(32)));
+typedef int int8 __attribute__((vector_size(32)));
+#define k_load8(v, p) memcpy(&(v), (p), sizeof(float8))
+#define k_store8(v, p) memcpy((p), &(v), sizeof(float8))
+/* a vector cast keeps the bits (GCC's vector extension) */
+#define k_select8(a, b, m) ((float8)(((int8)(a) & ~(m)) | ((int8)(b) & (m))))
 
 #endif
 

@@ -329,4 +329,36 @@ __kernel void k_trace_any1(SCENE_ARGS __global const Ray *rays, uint n, __global
     SCENE_VIEW(sc);
     occluded[i] = (uint)trace_any(&sc, rays[i]);
 }
+/* Closest hits (any == 0) or occlusion (any == 1: 1 or 0 in hits[i].prim's place, as
+ * occluded[]) of rays[8i .. 8i+7], walked as one packet (trace_packet). */
+KFN_INLINE void trace_packet_item(const SceneView *sc, __global const Ray *rays, uint n, int any,
+                                  __global Hit *hits, __global uint *occluded)
+{
+    uint first = TRACE_PACKET * (uint)get_global_id(0);
+    if (first >= n) return;
+    Ray r[TRACE_PACKET];
+    Hit h[TRACE_PACKET];
+    uint count = n - first < TRACE_PACKET ? n - first : TRACE_PACKET;
+    for (uint l = 0; l < TRACE_PACKET; l++) {
+        r[l] = rays[first + (l < count ? l : 0u)];
+        /* a short last packet repeats its first ray, whose answer is then not stored */
+    }
+    trace_packet(sc, r, any, h);
+    for (uint l = 0; l < count; l++) {
+        if (any) occluded[first + l] = (uint)(h[l].prim != NO_INDEX);
+        else hits[first + l] = h[l];
+    }
+}
+
+__kernel void k_trace_closest8(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
+{
+    SCENE_VIEW(sc);
+    trace_packet_item(&sc, rays, n, 0, hits, 0);
+}
+
+__kernel void k_trace_any8(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
+{
+    SCENE_VIEW(sc);
+    trace_packet_item(&sc, rays, n, 1, 0, occluded);
+}
 #endif /* CLPT_BENCH_KERNELS */

@@ -133,14 +133,11 @@ KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, KdStack *st, int 
 }
 
 /* Tests the primitives of leaf n against the ray (tmax: the closest hit so far, in
- * best->t); returns 1 when the walk is over: an any-hit query hit, or nothing is left on
- * the stack, or the closest hit is no farther than the end of this cell (every cell on
- * the stack starts there or later). Otherwise pops the next cell. The triangles are
- * tested a group at a time (triangle_intersect_group: the nearest lane hit, the first
- * of equals, which is what testing them one by one in lane order gives), then the
- * spheres and boxes one by one. */
-KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, KdNode n, KdWalk *w,
-                       const KdStack *st, Hit *best)
+ * best->t); returns 1 when an any-hit query hit. The triangles are tested a group at a
+ * time (triangle_intersect_group: the nearest lane hit, the first of equals, which is
+ * what testing them one by one in lane order gives), then the spheres and boxes one by
+ * one. */
+KFN_INLINE int kd_leaf_prims(const SceneView *sc, Ray ray, const RayPre *rp, int any, KdNode n, Hit *best)
 {
     GLOBAL const uint *g = sc->leaf_prims + n.data;
     uint groups = n.bits >> 3;
@@ -166,6 +163,17 @@ KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, 
             }
         }
     }
+    return 0;
+}
+
+/* The visit of leaf n: its primitives (kd_leaf_prims); returns 1 when the walk is over:
+ * an any-hit query hit, or nothing is left on the stack, or the closest hit is no
+ * farther than the end of this cell (every cell on the stack starts there or later).
+ * Otherwise pops the next cell. */
+KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, KdNode n, KdWalk *w,
+                       const KdStack *st, Hit *best)
+{
+    if (kd_leaf_prims(sc, ray, rp, any, n, best)) return 1;
     if ((w->sp == 0) | (best->t <= w->t1)) return 1;
     int sp = w->sp - 1;
     w->sp = sp;
@@ -354,6 +362,137 @@ KFN void trace_any2(const SceneView *sc, Ray ra, Ray rb, int *oa, int *ob)
     TRACE_PAIR(sc, a, pa, wa, sa, b, pb, wb, sb);
     *oa = a.best.prim != NO_INDEX;
     *ob = b.best.prim != NO_INDEX;
+}
+
+/* ------------------------------------------------------------------ eight rays at once */
+
+/* A packet walk for coherent rays (camera rays through neighbouring pixels, shadow rays
+ * from neighbouring points toward one light): eight rays whose directions have the same
+ * signs go down the tree together, one node load and one float8 plane test for all of
+ * them, and part ways only in the leaves, where each ray still in the walk tests the
+ * primitives alone. Each lane keeps exactly its single walk (kd_step): a lane is in the
+ * packet's mask at a node if and only if its own walk visits that node, with the same
+ * [t0, t1]. The near child comes first for every lane alike (the shared signs), so a
+ * lane that goes to the far child alone merely waits out the near subtree, masked; a
+ * cell is pushed with the lanes that will visit it, in the order their own walks would
+ * push it. So every lane meets the same leaves in the same order with the same closest
+ * hit so far, and stops where its walk stops: its hit is bit for bit trace_closest's
+ * (trace_any's), which test_kdtree checks in C and bench_traverse on PoCL. Rays whose
+ * signs differ from the others' are walked one after the other instead. */
+#define TRACE_PACKET 8
+
+typedef struct {
+    uint node[KD_MAX_DEPTH];
+    uint lanes[KD_MAX_DEPTH];            /* bit l: lane l visits the cell */
+    float8 t0[KD_MAX_DEPTH], t1[KD_MAX_DEPTH];
+} KdPacketStack;
+
+/* The packet walk from the lanes' clipped intervals (w[l].t0, t1) over the lanes in
+ * `lanes`, all of whose directions have the sign bits `neg`. */
+KFN_INLINE void trace_packet_walk(const SceneView *sc, TraceRay *tr, const RayPre *rp, const KdWalk *w,
+                                  uint lanes, uint neg)
+{
+    float a[TRACE_PACKET * 8];          /* org x y z, inv_d x y z, t0, t1 per lane */
+    for (uint l = 0; l < TRACE_PACKET; l++) {
+        int on = (int)((lanes >> l) & 1u);
+        for (uint k = 0; k < 3u; k++) {
+            a[k * TRACE_PACKET + l] = on ? rp[l].org[k] : 0.0f;
+            a[(3u + k) * TRACE_PACKET + l] = on ? rp[l].inv_d[k] : 0.0f;
+        }
+        a[6u * TRACE_PACKET + l] = on ? w[l].t0 : 0.0f;
+        a[7u * TRACE_PACKET + l] = on ? w[l].t1 : 0.0f;
+    }
+    float8 org0, org1, org2, inv0, inv1, inv2, t0, t1;
+    k_load8(org0, a);
+    k_load8(org1, a + TRACE_PACKET);
+    k_load8(org2, a + 2 * TRACE_PACKET);
+    k_load8(inv0, a + 3 * TRACE_PACKET);
+    k_load8(inv1, a + 4 * TRACE_PACKET);
+    k_load8(inv2, a + 5 * TRACE_PACKET);
+    k_load8(t0, a + 6 * TRACE_PACKET);
+    k_load8(t1, a + 7 * TRACE_PACKET);
+    GLOBAL const KdNode *nodes = sc->nodes;
+    KdPacketStack st;
+    int sp = 0;
+    uint node = 0u, done = 0u;
+    for (;;) {
+        KdNode n = nodes[node];
+        if ((n.bits & 3u) != KD_LEAF) {
+            /* kd_step for every lane: the same operations, lane by lane */
+            uint axis = n.bits & 3u;
+            float8 o = axis == 0u ? org0 : (axis == 1u ? org1 : org2);
+            float8 iv = axis == 0u ? inv0 : (axis == 1u ? inv1 : inv2);
+            float8 tp = (k_as_float(n.data) - o) * iv;
+            uint below = node + 1u, above = n.bits >> 4;
+            uint near_above = (neg >> axis) & 1u;
+            uint near = near_above ? above : below, far = near ^ below ^ above;
+            uint far_only = K_BITS8(tp < t0 * KD_T_BELOW) & lanes;
+            uint both = ~K_BITS8(tp > t1 * KD_T_ABOVE) & ~far_only & lanes;
+            uint far_empty = (n.bits >> (3u - near_above)) & 1u;
+            uint to_near = lanes & ~far_only;
+            uint to_far = far_only | (far_empty ? 0u : both);
+            /* the far cell starts at tp where the lane crosses the plane inside its
+             * interval ("both"); a far-only lane keeps t0 (tp lies before it) */
+            float8 t0_far = k_select8(t0, tp, tp > t0);
+            if (to_near == 0u) {
+                node = far;
+                lanes = to_far;
+                t0 = t0_far;
+                continue;
+            }
+            if (to_far) {
+                st.node[sp] = far;
+                st.lanes[sp] = to_far;
+                st.t0[sp] = t0_far;
+                st.t1[sp] = t1;
+                sp++;
+            }
+            node = near;
+            lanes = to_near;
+            t1 = k_select8(t1, tp, tp < t1);
+            continue;
+        }
+        float end[TRACE_PACKET];
+        k_store8(t1, end);
+        for (uint l = 0; l < TRACE_PACKET; l++) {
+            if (!((lanes >> l) & 1u)) continue;
+            if (kd_leaf_prims(sc, tr[l].ray, &rp[l], tr[l].any, n, &tr[l].best) || tr[l].best.t <= end[l])
+                done |= 1u << l;
+        }
+        for (;;) {
+            if (sp == 0) return;
+            sp--;
+            lanes = st.lanes[sp] & ~done;
+            if (lanes) break;
+        }
+        node = st.node[sp];
+        t0 = st.t0[sp];
+        t1 = st.t1[sp];
+    }
+}
+
+/* trace_closest (any == 0) or trace_any_hit (any == 1) of 8 rays: hits[l] is bit for
+ * bit what the single walk gives rays[l]. */
+KFN_INLINE void trace_packet(const SceneView *sc, const Ray *rays, int any, Hit *hits)
+{
+    TraceRay tr[TRACE_PACKET];
+    RayPre rp[TRACE_PACKET];
+    KdWalk w[TRACE_PACKET];
+    uint lanes = 0u, neg = 0u, mixed = 0u;
+    for (uint l = 0; l < TRACE_PACKET; l++) {
+        trace_ray_begin(sc, rays[l], any, &tr[l], &rp[l], &w[l]);
+        if (!tr[l].active) continue;
+        if (lanes == 0u) neg = rp[l].neg;
+        mixed |= rp[l].neg ^ neg;
+        lanes |= 1u << l;
+    }
+    if (mixed) {
+        KdStack st;
+        for (uint l = 0; l < TRACE_PACKET; l++) trace_ray_finish(sc, &tr[l], &rp[l], &w[l], &st);
+    } else if (lanes) {
+        trace_packet_walk(sc, tr, rp, w, lanes, neg);
+    }
+    for (uint l = 0; l < TRACE_PACKET; l++) hits[l] = tr[l].best;
 }
 
 #endif /* CLPT_TRAVERSE_CL */

@@ -754,6 +754,66 @@ static void test_pairs(void)
     fprintf(stderr, "  %d pairs of rays, %d differ from the rays traced alone\n", total, differ);
 }
 
+/* Eight rays walked as a packet (trace_packet) give each ray bit for bit what it gets
+ * alone: coherent packets (one origin, directions within a small cone, as a camera's
+ * neighbouring pixels; or neighbouring origins toward one point, as shadow rays), some
+ * with a NaN ray, a ray that misses the scene or a tmax that ends inside it, and
+ * incoherent packets of random rays (mixed signs: walked one by one). */
+static void test_packets(void)
+{
+    struct { uint64_t seed; uint ns, nt, nb, np; } cases[] = {
+        { 91, 40, 200, 25, 2 }, { 92, 0, 400, 0, 0 }, { 93, 120, 0, 60, 1 }, { 94, 0, 4000, 0, 0 },
+    };
+    int differ = 0, total = 0, packed = 0;
+    for (int c = 0; c < 4; c++) {
+        random_scene(cases[c].seed, cases[c].ns, cases[c].nt, cases[c].nb, cases[c].np);
+        CHECK(scene_build(0) == ST_OK);
+        for (int i = 0; i < 3000; i++) {
+            Ray r[TRACE_PACKET];
+            int kind = i % 3;
+            vec3 o = vrand(-8.0f, 8.0f), target = vrand(-4.0f, 4.0f);
+            vec3 d = v3_norm(v3_sub(target, o));
+            for (int l = 0; l < TRACE_PACKET; l++) {
+                if (kind == 0) {          /* a camera: one origin, a cone of 0.05 radians */
+                    r[l] = make_ray(o, v3_norm(v3_add(d, vrand(-0.05f, 0.05f))), 0.0f, K_INF);
+                } else if (kind == 1) {   /* shadow rays toward one point */
+                    vec3 p = v3_add(o, vrand(-0.3f, 0.3f));
+                    r[l] = make_ray(p, v3_sub(target, p), 0.0f, 0.9999f);
+                } else {
+                    r[l] = random_ray(-5.0f, 5.0f);
+                }
+            }
+            if (i % 11 == 0) r[i % TRACE_PACKET].o.y = NAN;
+            if (i % 13 == 0) r[(i + 3) % TRACE_PACKET].tmax = 2.0f;
+            if (i % 17 == 0) r[(i + 5) % TRACE_PACKET].d = v3_neg(r[(i + 5) % TRACE_PACKET].d);
+            uint neg = 0, mixed = 0;
+            for (int l = 0; l < TRACE_PACKET; l++) {
+                RayPre p = ray_prepare(r[l]);
+                if (l == 0) neg = p.neg;
+                mixed |= p.neg ^ neg;
+            }
+            packed += !mixed;
+            for (int any = 0; any < 2; any++) {
+                Hit h[TRACE_PACKET];
+                trace_packet(&scene.view, r, any, h);
+                for (int l = 0; l < TRACE_PACKET; l++) {
+                    if (any) {
+                        differ += (h[l].prim != NO_INDEX) != trace_any(&scene.view, r[l]);
+                    } else {
+                        Hit ref = trace_closest(&scene.view, r[l]);
+                        differ += memcmp(&h[l], &ref, sizeof ref) != 0;
+                    }
+                    total++;
+                }
+            }
+        }
+    }
+    CHECK_EQ_INT(differ, 0);
+    CHECK(packed > 4 * 3000 / 2);    /* most packets took the packet walk */
+    fprintf(stderr, "  %d rays in packets of %d (%d packets walked together), %d differ from the rays traced alone\n",
+            total, TRACE_PACKET, packed, differ);
+}
+
 static void test_empty_scene(void)
 {
     scene_clear();
@@ -1186,6 +1246,7 @@ int main(void)
     RUN(test_structure);
     RUN(test_against_brute_force);
     RUN(test_pairs);
+    RUN(test_packets);
     RUN(test_empty_scene);
     RUN(test_bad_primitives);
     RUN(test_flat_on_split_planes);

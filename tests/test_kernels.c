@@ -542,6 +542,83 @@ static void test_intersect(void)
     clReleaseMemObject(hb);
 }
 
+/* The trace-only kernels bench_traverse times (-D CLPT_BENCH_KERNELS): one ray per
+ * work-item, two in turns (trace_closest2 / trace_any2) and packets of eight
+ * (trace_packet), closest hits and occlusion, against the C walk bit for bit, on random
+ * rays and on coherent ones (runs of eight from one origin through a small cone, as a
+ * camera's neighbouring pixels) over the test scene; the ray count is not a multiple of
+ * eight, so the last packet is short. */
+static void test_trace_kernels(void)
+{
+    enum { N = 8000 + 5 };
+    Ray *rays = malloc(N * sizeof *rays);
+    for (uint i = 0; i < N; i += 8) {
+        vec3 o = vrand(-6.0f, 6.0f), d = v3_norm(v3_sub(vrand(-2.0f, 2.0f), o));
+        for (uint l = 0; l < 8 && i + l < N; l++) {
+            if (i % 16 == 0) {
+                rays[i + l] = random_ray();
+            } else {
+                rays[i + l].o = o;
+                rays[i + l].d = v3_norm(v3_add(d, vrand(-0.04f, 0.04f)));
+                rays[i + l].tmin = 0.0f;
+                rays[i + l].tmax = l == 3 ? 2.0f : INFINITY;
+            }
+        }
+    }
+    Hit *ref = malloc(N * sizeof *ref), *dh = malloc(N * sizeof *dh);
+    uint *ref_occ = malloc(N * sizeof *ref_occ), *docc = malloc(N * sizeof *docc);
+    uint hits = 0;
+    for (uint i = 0; i < N; i++) {
+        ref[i] = trace_closest(&view, rays[i]);
+        ref_occ[i] = (uint)trace_any(&view, rays[i]);
+        hits += ref[i].prim != NO_INDEX;
+    }
+    CHECK(hits > N / 4);
+    cl_program prog = NULL;
+    OclProgramStats ps;
+    Error err = { 0 };
+    Status st = ocl_program_build(cl.ctx, &cl.dev, NULL, "-D CLPT_BENCH_KERNELS", &prog, &ps, &err);
+    CHECK_MSG(st == ST_OK, "%s\n%s", err.msg, err.detail ? err.detail : "");
+    error_clear(&err);
+    cl_mem rb = buffer(N * sizeof *rays, rays), ob = buffer(N * sizeof(Hit), NULL);
+    static const struct { const char *name; uint per_item; int any; } ks[] = {
+        { "k_trace_closest1", 1, 0 }, { "k_trace_any1", 1, 1 }, { "k_trace_closest", 2, 0 },
+        { "k_trace_any", 2, 1 },      { "k_trace_closest8", 8, 0 }, { "k_trace_any8", 8, 1 },
+    };
+    for (size_t j = 0; j < sizeof ks / sizeof ks[0] && st == ST_OK; j++) {
+        cl_kernel k = NULL;
+        CHECK(ocl_program_kernel(prog, &cl.dev, ks[j].name, &k, &err) == ST_OK);
+        error_clear(&err);
+        if (!k) continue;
+        set_scene_args(k);
+        uint n = N;
+        SET(k, N_SCENE + 0, rb);
+        SET(k, N_SCENE + 1, n);
+        SET(k, N_SCENE + 2, ob);
+        run(k, (N + ks[j].per_item - 1) / ks[j].per_item);
+        uint exact = 0;
+        if (ks[j].any) {
+            read_back(ob, N * sizeof *docc, docc);
+            for (uint i = 0; i < N; i++) exact += docc[i] == ref_occ[i];
+        } else {
+            read_back(ob, N * sizeof *dh, dh);
+            for (uint i = 0; i < N; i++) exact += memcmp(&dh[i], &ref[i], sizeof ref[i]) == 0;
+        }
+        fprintf(stderr, "  %s (%u per work-item): %u rays, %u bit-identical to C\n", ks[j].name, ks[j].per_item,
+                (uint)N, exact);
+        CHECK_EQ_INT(exact, N);
+        clReleaseKernel(k);
+    }
+    if (prog) clReleaseProgram(prog);
+    clReleaseMemObject(rb);
+    clReleaseMemObject(ob);
+    free(rays);
+    free(ref);
+    free(dh);
+    free(ref_occ);
+    free(docc);
+}
+
 /* Shade and shadow: path states at various bounces with random throughput, the hits of
  * random rays (computed once in C and given to both sides). */
 static void test_shade_and_shadow(void)
@@ -1145,6 +1222,7 @@ int main(void)
     RUN(test_raygen);
     RUN(test_path_kernel);
     RUN(test_intersect);
+    RUN(test_trace_kernels);
     RUN(test_shade_and_shadow);
     RUN(test_shade_cubemap);
     RUN(test_film);

@@ -1,12 +1,13 @@
 /*
  * bench_render.c — rendering throughput of the shipped scenes on every device.
  *
- *   build/bench/bench_render [--reps N] [--json FILE] [SCENE:WIDTHxHEIGHT:SPP ...]
+ *   build/bench/bench_render [--reps N] [--json FILE] [--accel bvh|kdtree] [SCENE:WIDTHxHEIGHT:SPP ...]
  *
  * For each scene and each device (every OpenCL device alone, then the scalar device),
  * renders the scene with a fixed seed `reps` times and reports the median samples/s and
- * rays/s, with the ratio to the scalar device measured in the same run, plus the kd-tree
- * build time and the kernel build/cache-load time. Prints a table and writes JSON.
+ * rays/s, with the ratio to the scalar device measured in the same run, plus the tree's
+ * build time (the BVH, or the kd-tree with --accel kdtree) and the kernel build/cache-load
+ * time. Prints a table and writes JSON.
  * Machines here are shared and noisy: read medians and ratios, not single times.
  */
 #include <stdio.h>
@@ -98,14 +99,17 @@ int main(int argc, char **argv)
     const char *json_path = "build/bench/render.json";
     BenchScene scenes[16];
     int n_scenes = 0;
+    uint accel = ACCEL_BVH;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--reps") == 0 && i + 1 < argc) reps = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--accel") == 0 && i + 1 < argc) accel = strcmp(argv[++i], "kdtree") == 0 ? ACCEL_KDTREE : ACCEL_BVH;
         else if (strcmp(argv[i], "--json") == 0 && i + 1 < argc) json_path = argv[++i];
         else if (n_scenes < 16) {
             static char paths[16][512];
             unsigned w, h, spp;
             if (sscanf(argv[i], "%511[^:]:%ux%u:%u", paths[n_scenes], &w, &h, &spp) != 4) {
-                fprintf(stderr, "usage: bench_render [--reps N] [--json FILE] [SCENE:WIDTHxHEIGHT:SPP ...]\n");
+                fprintf(stderr, "usage: bench_render [--reps N] [--json FILE] [--accel bvh|kdtree] "
+                        "[SCENE:WIDTHxHEIGHT:SPP ...]\n");
                 return 2;
             }
             scenes[n_scenes] = (BenchScene){ paths[n_scenes], w, h, spp };
@@ -130,7 +134,7 @@ int main(int argc, char **argv)
     if (json) fprintf(json, "{\n  \"reps\": %d,\n  \"results\": [\n", reps);
     printf("clpt render benchmark: median of %d runs per device; ratio = samples/s relative to the scalar device\n\n", reps);
     printf("%-28s %-36s %12s %10s %7s %10s %s\n", "scene", "device", "Msamples/s", "Mrays/s", "ratio",
-           "kernels s", "kd-tree");
+           "kernels s", accel == ACCEL_KDTREE ? "kd-tree" : "BVH");
     int first_json = 1;
     for (int si = 0; si < n_scenes; si++) {
         Scene scene;
@@ -144,6 +148,7 @@ int main(int argc, char **argv)
         }
         scene.image.width = scenes[si].width;
         scene.image.height = scenes[si].height;
+        scene.accel = accel;
         if (render_scene_prepare(&scene, 0, &rs, &err)) {
             fprintf(stderr, "bench: %s\n", err.msg);
             error_clear(&err);
@@ -153,6 +158,8 @@ int main(int argc, char **argv)
         Result *res = calloc(n_all, sizeof *res);
         /* the scalar device (last) first: it is the reference for the ratios */
         for (size_t k = n_all; k-- > 0;) res[k] = bench_device(&all[k], &rs, scenes[si].spp, reps);
+        double tree_s = accel == ACCEL_KDTREE ? rs.kd.stats.build_seconds : rs.bvh.stats.build_seconds;
+        double sah = accel == ACCEL_KDTREE ? rs.kd.stats.sah_cost : rs.bvh.stats.sah_cost;
         double ref = res[n_all - 1].samples_per_s;
         char label[64];
         snprintf(label, sizeof label, "%s %ux%u", strrchr(scenes[si].path, '/') ? strrchr(scenes[si].path, '/') + 1
@@ -166,15 +173,16 @@ int main(int argc, char **argv)
             printf("%-28.28s %-36.36s %12.3f %10.3f %6.2fx %10s %.3f s, SAH %.1f\n", label,
                    all[k].kind == DEVICE_SCALAR ? "scalar (all cores)" : all[k].name, res[k].samples_per_s / 1e6,
                    res[k].rays_per_s / 1e6, ref > 0.0 ? res[k].samples_per_s / ref : 0.0, kern,
-                   rs.kd.stats.build_seconds, rs.kd.stats.sah_cost);
+                   tree_s, sah);
             if (json) {
                 fprintf(json, "%s    {\"scene\": \"%s\", \"width\": %u, \"height\": %u, \"spp\": %u, \"device\": \"%s\", "
                               "\"kind\": \"%s\", \"samples_per_s\": %.1f, \"rays_per_s\": %.1f, \"ratio_to_scalar\": %.4f, "
-                              "\"kernel_build_s\": %.4f, \"kernel_from_cache\": %d, \"kd_build_s\": %.4f, \"sah_cost\": %.3f}",
+                              "\"kernel_build_s\": %.4f, \"kernel_from_cache\": %d, \"tree\": \"%s\", \"tree_build_s\": %.4f, "
+                              "\"sah_cost\": %.3f}",
                         first_json ? "" : ",\n", scenes[si].path, scenes[si].width, scenes[si].height, scenes[si].spp,
                         all[k].name, all[k].kind == DEVICE_SCALAR ? "scalar" : "opencl", res[k].samples_per_s,
                         res[k].rays_per_s, ref > 0.0 ? res[k].samples_per_s / ref : 0.0, res[k].compile_s,
-                        res[k].from_cache, rs.kd.stats.build_seconds, rs.kd.stats.sah_cost);
+                        res[k].from_cache, accel == ACCEL_KDTREE ? "kdtree" : "bvh", tree_s, sah);
                 first_json = 0;
             }
         }

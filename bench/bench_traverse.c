@@ -47,6 +47,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "accel/bvh.h"
 #include "accel/kdtree.h"
 #include "device/device.h"
 #include "io/mesh_load.h"
@@ -101,7 +102,8 @@ typedef struct {
     Scene scene;
     KdTree tree;
     double kd_build_1;           /* one-thread build, seconds */
-    DeviceScene ds;              /* the kd-tree and triangles, every other buffer empty */
+    Bvh bvh;                     /* the 8-wide BVH (one thread) */
+    DeviceScene ds;              /* both trees and the triangles, every other buffer empty */
     SceneView view;
     double load_seconds;
 } Mesh;
@@ -136,6 +138,11 @@ static int mesh_open(Mesh *m, const char *name, Error *err)
     m->ds.nodes = m->tree.nodes;
     m->ds.leaf_prims = m->tree.leaf_prims;
     m->ds.triangles = m->scene.triangles;
+    if (bvh_build(&in, 2, &m->bvh, err)) return -1;
+    p->n_bvh_nodes = m->bvh.n_nodes;
+    m->ds.bvh = m->bvh.nodes;
+    m->ds.bvh_leaves = m->bvh.leaf_prims;
+    m->ds.n_bvh_leaves = m->bvh.n_leaf_prims;
     device_scene_view(&m->ds, &m->view);
     return 0;
 }
@@ -143,6 +150,7 @@ static int mesh_open(Mesh *m, const char *name, Error *err)
 static void mesh_close(Mesh *m)
 {
     kd_free(&m->tree);
+    bvh_free(&m->bvh);
     scene_free(&m->scene);
 }
 
@@ -160,6 +168,8 @@ typedef struct {
     int any;                     /* any-hit or closest-hit */
     Hit *ref_hits;               /* scalar C results: closest */
     uint *ref_occ;               /* any */
+    Hit *wide_hits;              /* the same through the 8-wide BVH */
+    uint *wide_occ;
 } RaySet;
 
 static vec3 unit_d(double x, double y, double z)
@@ -173,13 +183,14 @@ static vec3 unit_d(double x, double y, double z)
 typedef struct {
     const SceneView *sc;
     const RaySet *set;
-    int pairs;                   /* trace_closest2/trace_any2, as the PoCL kernels do */
+    int walk;                    /* WALK_*: the kd-tree one ray or two at a time, or the BVH */
     Hit *hits;
     uint *occ;
     atomic_uint next;
 } TraceJob;
 
 #define CHUNK 1024u
+enum { WALK_SINGLE, WALK_PAIRS, WALK_WIDE };
 
 static void *trace_worker(void *arg)
 {
@@ -190,32 +201,37 @@ static void *trace_worker(void *arg)
         if (begin >= s->n) break;
         uint end = s->n - begin < CHUNK ? s->n : begin + CHUNK;
         uint i = begin;
-        if (j->pairs && s->any) {
+        if (j->walk == WALK_WIDE) {
+            for (; i < end; i++) {
+                if (s->any) j->occ[i] = (uint)trace_any_in(j->sc, TREE_BVH, s->rays[i]);
+                else j->hits[i] = trace_closest_in(j->sc, TREE_BVH, s->rays[i]);
+            }
+        } else if (j->walk == WALK_PAIRS && s->any) {
             for (; i + 1 < end; i += 2) {
                 int a, b;
                 trace_any2(j->sc, s->rays[i], s->rays[i + 1], &a, &b);
                 j->occ[i] = (uint)a;
                 j->occ[i + 1] = (uint)b;
             }
-        } else if (j->pairs) {
+        } else if (j->walk == WALK_PAIRS) {
             for (; i + 1 < end; i += 2) trace_closest2(j->sc, s->rays[i], s->rays[i + 1], &j->hits[i], &j->hits[i + 1]);
         }
         if (s->any)
-            for (; i < end; i++) j->occ[i] = (uint)trace_any(j->sc, s->rays[i]);
+            for (; i < end; i++) j->occ[i] = (uint)trace_any_in(j->sc, TREE_KD, s->rays[i]);
         else
-            for (; i < end; i++) j->hits[i] = trace_closest(j->sc, s->rays[i]);
+            for (; i < end; i++) j->hits[i] = trace_closest_in(j->sc, TREE_KD, s->rays[i]);
     }
     return NULL;
 }
 
-/* Traces the set with `threads` threads, one ray at a time or in pairs; returns the
- * seconds it took. */
-static double trace_c(const SceneView *sc, const RaySet *s, int threads, int pairs, Hit *hits, uint *occ)
+/* Traces the set with `threads` threads by `walk` (WALK_*); returns the seconds it
+ * took. */
+static double trace_c(const SceneView *sc, const RaySet *s, int threads, int walk, Hit *hits, uint *occ)
 {
     TraceJob j;
     j.sc = sc;
     j.set = s;
-    j.pairs = pairs;
+    j.walk = walk;
     j.hits = hits;
     j.occ = occ;
     atomic_init(&j.next, 0u);
@@ -278,7 +294,7 @@ static int make_rays(Mesh *m, int size, RaySet sets[N_SETS])
             p->rays[(size_t)y * size + x] = ray;
         }
     p->n = n;
-    trace_c(&m->view, p, 2, 0, hits, NULL);
+    trace_c(&m->view, p, 2, WALK_SINGLE, hits, NULL);
     for (uint i = 0; i < n; i++) {
         if (hits[i].prim == NO_INDEX) continue;
         const Triangle *t = &m->scene.triangles[hits[i].prim];
@@ -308,8 +324,11 @@ static int make_rays(Mesh *m, int size, RaySet sets[N_SETS])
     for (int k = 0; k < N_SETS; k++) {
         sets[k].ref_hits = malloc((sets[k].n + 1) * sizeof *sets[k].ref_hits);
         sets[k].ref_occ = malloc((sets[k].n + 1) * sizeof *sets[k].ref_occ);
-        if (!sets[k].ref_hits || !sets[k].ref_occ) return -1;
-        trace_c(&m->view, &sets[k], 2, 0, sets[k].ref_hits, sets[k].ref_occ);
+        sets[k].wide_hits = malloc((sets[k].n + 1) * sizeof *sets[k].wide_hits);
+        sets[k].wide_occ = malloc((sets[k].n + 1) * sizeof *sets[k].wide_occ);
+        if (!sets[k].ref_hits || !sets[k].ref_occ || !sets[k].wide_hits || !sets[k].wide_occ) return -1;
+        trace_c(&m->view, &sets[k], 2, WALK_SINGLE, sets[k].ref_hits, sets[k].ref_occ);
+        trace_c(&m->view, &sets[k], 2, WALK_WIDE, sets[k].wide_hits, sets[k].wide_occ);
     }
     return 0;
 }
@@ -320,6 +339,8 @@ static void rays_free(RaySet sets[N_SETS])
         if (sets[k].owns) free(sets[k].rays);
         free(sets[k].ref_hits);
         free(sets[k].ref_occ);
+        free(sets[k].wide_hits);
+        free(sets[k].wide_occ);
     }
 }
 
@@ -337,6 +358,7 @@ typedef struct {
     cl_kernel kc, ka;            /* two rays per work-item */
     cl_kernel kc1, ka1;          /* one ray per work-item */
     cl_kernel kc8, ka8;          /* packets of eight rays per work-item */
+    cl_kernel kcw, kaw;          /* one ray per work-item through the 8-wide BVH */
     cl_program prog;
     cl_mem scene[SC_N], rays, out;
     size_t rays_cap;
@@ -370,7 +392,9 @@ static int pocl_open(Pocl *pc, const OclDeviceInfo *dev, cl_device_id sub)
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest1", &pc->kc1, &err) ||
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_any1", &pc->ka1, &err) ||
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest8", &pc->kc8, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any8", &pc->ka8, &err)) {
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any8", &pc->ka8, &err) ||
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest_wide", &pc->kcw, &err) ||
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any_wide", &pc->kaw, &err)) {
         fprintf(stderr, "bench_traverse: %s\n", err.msg);
         error_clear(&err);
         return -1;
@@ -399,6 +423,8 @@ static void pocl_close(Pocl *pc)
     if (pc->ka1) clReleaseKernel(pc->ka1);
     if (pc->kc8) clReleaseKernel(pc->kc8);
     if (pc->ka8) clReleaseKernel(pc->ka8);
+    if (pc->kcw) clReleaseKernel(pc->kcw);
+    if (pc->kaw) clReleaseKernel(pc->kaw);
     if (pc->prog) clReleaseProgram(pc->prog);
     if (pc->q) clReleaseCommandQueue(pc->q);
     if (pc->ctx) clReleaseContext(pc->ctx);
@@ -428,8 +454,8 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
     for (int i = 0; i < SC_N; i++)
         if (!pc->scene[i]) return -1;
     if (!pc->rays || !pc->out) return -1;
-    cl_kernel ks[6] = { pc->kc, pc->ka, pc->kc1, pc->ka1, pc->kc8, pc->ka8 };
-    for (int k = 0; k < 6; k++) {
+    cl_kernel ks[8] = { pc->kc, pc->ka, pc->kc1, pc->ka1, pc->kc8, pc->ka8, pc->kcw, pc->kaw };
+    for (int k = 0; k < 8; k++) {
         for (cl_uint i = 0; i < SC_N; i++)
             if (clSetKernelArg(ks[k], i, sizeof(cl_mem), &pc->scene[i]) != CL_SUCCESS) return -1;
         if (clSetKernelArg(ks[k], SC_N, sizeof(cl_mem), &pc->rays) != CL_SUCCESS ||
@@ -440,14 +466,16 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
 }
 
 /* The PoCL kernels: rays per work-item. */
-enum { POCL_SINGLE, POCL_PAIRS, POCL_PACKETS, N_KERNELS };
-static const uint rays_per_item[N_KERNELS] = { 1, 2, 8 };
+enum { POCL_SINGLE, POCL_PAIRS, POCL_PACKETS, POCL_WIDE, N_KERNELS };
+static const uint rays_per_item[N_KERNELS] = { 1, 2, 8, 1 };
+static const char *const kernel_label[N_KERNELS] = { "PoCL-1", "PoCL-2", "PoCL-8", "PoCL-W" };
 
 /* Traces the set (its rays already uploaded) with kernel `kind`; returns seconds, or -1. */
 static double pocl_trace(Pocl *pc, const RaySet *s, int kind)
 {
     cl_kernel k = kind == POCL_PAIRS ? (s->any ? pc->ka : pc->kc)
                   : kind == POCL_PACKETS ? (s->any ? pc->ka8 : pc->kc8)
+                  : kind == POCL_WIDE    ? (s->any ? pc->kaw : pc->kcw)
                                          : (s->any ? pc->ka1 : pc->kc1);
     cl_uint n = s->n;
     if (clSetKernelArg(k, SC_N + 1, sizeof n, &n) != CL_SUCCESS) return -1.0;
@@ -473,9 +501,11 @@ static int pocl_put_rays(Pocl *pc, const RaySet *s)
                : -1;
 }
 
-/* Rays whose PoCL result is not bit-identical to the scalar C one. */
-static long pocl_compare(Pocl *pc, const RaySet *s)
+/* Rays whose PoCL result is not bit-identical to the scalar C one (of the same tree). */
+static long pocl_compare(Pocl *pc, const RaySet *s, int wide)
 {
+    const Hit *ref_hits = wide ? s->wide_hits : s->ref_hits;
+    const uint *ref_occ = wide ? s->wide_occ : s->ref_occ;
     if (s->n == 0) return 0;
     size_t bytes = s->n * (s->any ? sizeof(uint) : sizeof(Hit));
     void *buf = malloc(bytes);
@@ -484,8 +514,8 @@ static long pocl_compare(Pocl *pc, const RaySet *s)
     if (clEnqueueReadBuffer(pc->q, pc->out, CL_TRUE, 0, bytes, buf, 0, NULL, NULL) == CL_SUCCESS) {
         bad = 0;
         for (uint i = 0; i < s->n; i++) {
-            if (s->any) bad += ((uint *)buf)[i] != s->ref_occ[i];
-            else bad += memcmp(&((Hit *)buf)[i], &s->ref_hits[i], sizeof(Hit)) != 0;
+            if (s->any) bad += ((uint *)buf)[i] != ref_occ[i];
+            else bad += memcmp(&((Hit *)buf)[i], &ref_hits[i], sizeof(Hit)) != 0;
         }
     }
     free(buf);
@@ -692,10 +722,12 @@ static long embree_compare(const RaySet *s, const Hit *eh, const uint *eo)
 
 
 typedef struct {
-    double pocl[N_KERNELS][MAX_THREADS], c[MAX_THREADS], e1[MAX_THREADS], e8[MAX_THREADS];   /* Mrays/s */
-    double cpu_pocl[N_KERNELS][MAX_THREADS], cpu_c[MAX_THREADS], cpu_e1[MAX_THREADS], cpu_e8[MAX_THREADS];
+    double pocl[N_KERNELS][MAX_THREADS], c[MAX_THREADS], cw[MAX_THREADS], e1[MAX_THREADS], e8[MAX_THREADS];   /* Mrays/s */
+    double cpu_pocl[N_KERNELS][MAX_THREADS], cpu_c[MAX_THREADS], cpu_cw[MAX_THREADS], cpu_e1[MAX_THREADS],
+        cpu_e8[MAX_THREADS];
                                  /* Mrays per CPU-second */
     long pocl_diff, embree_diff;
+    long wide_diff;              /* rays whose BVH answer is not the kd-tree's (C, both) */
     uint hits;
 } SetResult;
 
@@ -737,6 +769,13 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
            ks->build_seconds, o->threads[MAX_THREADS - 1], m.kd_build_1, ks->n_nodes, ks->n_leaves,
            ks->max_depth, ks->sah_cost, ks->sah_cost_bonus, ks->leaf_sah_cost, (double)ks->bytes / (double)(nt ? nt : 1),
            (double)(ks->bytes - ks->bytes_corners) / (double)(nt ? nt : 1), (double)ks->bytes_corners / (double)(nt ? nt : 1));
+    const BvhStats *bs = &m.bvh.stats;
+    printf("8-wide BVH: build %.3f s (2 threads); %u nodes, %u leaves (%.1f primitives each), depth %u, "
+           "%.1f bytes/triangle (nodes %.1f, leaf records %.1f)\n",
+           bs->build_seconds, bs->n_nodes, bs->n_leaves, bs->mean_prims_per_leaf, bs->max_depth,
+           (double)((size_t)m.bvh.n_nodes * sizeof(BvhNode) + (size_t)m.bvh.n_leaf_prims * 4u) / (double)(nt ? nt : 1),
+           (double)((size_t)m.bvh.n_nodes * sizeof(BvhNode)) / (double)(nt ? nt : 1),
+           (double)((size_t)m.bvh.n_leaf_prims * 4u) / (double)(nt ? nt : 1));
     if (have_embree) {
         char ratio[96] = "";
         /* a ratio of times below a millisecond says nothing */
@@ -761,7 +800,12 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
     for (int k = 0; k < N_SETS && eh && eo; k++) {
         RaySet *s = &sets[k];
         SetResult *r = &res[k];
-        for (uint i = 0; i < s->n; i++) r->hits += s->any ? s->ref_occ[i] : s->ref_hits[i].prim != NO_INDEX;
+        for (uint i = 0; i < s->n; i++) {
+            r->hits += s->any ? s->ref_occ[i] : s->ref_hits[i].prim != NO_INDEX;
+            /* the same t: the same closest distance; another primitive only on a tie */
+            if (s->any) r->wide_diff += s->ref_occ[i] != s->wide_occ[i];
+            else r->wide_diff += s->ref_hits[i].t != s->wide_hits[i].t;
+        }
         /* check first */
         r->pocl_diff = r->embree_diff = -1;
         for (int t = 0; t < MAX_THREADS; t++) {
@@ -772,7 +816,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
             long d = 0;
             for (int kp = 0; kp < N_KERNELS && pocl_ok[t]; kp++) {
                 if (pocl_trace(&pocl[t], s, kp) < 0.0) pocl_ok[t] = 0;
-                else d += pocl_compare(&pocl[t], s);
+                else d += pocl_compare(&pocl[t], s, kp == POCL_WIDE);
             }
             if (pocl_ok[t]) r->pocl_diff = r->pocl_diff < 0 ? d : r->pocl_diff + d;
         }
@@ -786,11 +830,13 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
             int th = o->threads[t];
             /* the variants take turns within each repetition, so that a change in the
              * machine's load affects them alike */
-            double sc[MAX_REPS], cc[MAX_REPS], sp[N_KERNELS][MAX_REPS], cp[N_KERNELS][MAX_REPS], s1[MAX_REPS],
-                c1[MAX_REPS], s8[MAX_REPS], c8[MAX_REPS];
+            double sc[MAX_REPS], cc[MAX_REPS], sw[MAX_REPS], cw[MAX_REPS], sp[N_KERNELS][MAX_REPS],
+                cp[N_KERNELS][MAX_REPS], s1[MAX_REPS], c1[MAX_REPS], s8[MAX_REPS], c8[MAX_REPS];
             for (int i = 0; i < o->reps; i++) {
-                sc[i] = trace_c(&m.view, s, th, 1, tmp_h, tmp_o);
+                sc[i] = trace_c(&m.view, s, th, WALK_PAIRS, tmp_h, tmp_o);
                 cc[i] = last_cpu_seconds;
+                sw[i] = trace_c(&m.view, s, th, WALK_WIDE, tmp_h, tmp_o);
+                cw[i] = last_cpu_seconds;
                 for (int kp = 0; kp < N_KERNELS && pocl_ok[t]; kp++) {
                     sp[kp][i] = pocl_trace(&pocl[t], s, kp);
                     cp[kp][i] = last_cpu_seconds;
@@ -804,6 +850,8 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
             }
             r->c[t] = rate(s->n, sc, o->reps);
             r->cpu_c[t] = rate(s->n, cc, o->reps);
+            r->cw[t] = rate(s->n, sw, o->reps);
+            r->cpu_cw[t] = rate(s->n, cw, o->reps);
             for (int kp = 0; kp < N_KERNELS && pocl_ok[t]; kp++) {
                 r->pocl[kp][t] = rate(s->n, sp[kp], o->reps);
                 r->cpu_pocl[kp][t] = rate(s->n, cp[kp], o->reps);
@@ -820,10 +868,13 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
     free(eo);
 
     int a = o->threads[0], b = o->threads[MAX_THREADS - 1];
-    printf("\n| rays | query | count | hits | PoCL-1 %dt | PoCL-1 %dt | PoCL-2 %dt | PoCL-2 %dt | PoCL-8 %dt | "
-           "PoCL-8 %dt | C %dt | C %dt | Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | vs Embree | "
-           "PoCL vs C |\n", a, b, a, b, a, b, a, b, a, b, a, b);
-    printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    printf("\n| rays | query | count | hits |");
+    for (int kp = 0; kp < N_KERNELS; kp++) printf(" %s %dt | %s %dt |", kernel_label[kp], a, kernel_label[kp], b);
+    printf(" C %dt | C %dt | C-W %dt | C-W %dt | Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | vs Embree | "
+           "PoCL vs C | BVH vs kd |\n", a, b, a, b, a, b, a, b);
+    printf("|---|---|---:|---:|");
+    for (int kp = 0; kp < 2 * N_KERNELS + 8; kp++) printf("---:|");
+    printf("---:|---:|---:|\n");
     for (int k = 0; k < N_SETS; k++) {
         const SetResult *r = &res[k];
         char pd[32], ed[32];
@@ -833,23 +884,27 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
         else snprintf(ed, sizeof ed, "%ld disagree", r->embree_diff);
         printf("| %s | %s | %u | %u |", sets[k].name, sets[k].any ? "any" : "closest", sets[k].n, r->hits);
         for (int kp = 0; kp < N_KERNELS; kp++) printf(" %.2f | %.2f |", r->pocl[kp][0], r->pocl[kp][1]);
-        printf(" %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %s |\n", r->c[0], r->c[1], r->e1[0], r->e1[1], r->e8[0],
-               r->e8[1], ed, pd);
+        printf(" %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %s | %ld disagree |\n", r->c[0], r->c[1],
+               r->cw[0], r->cw[1], r->e1[0], r->e1[1], r->e8[0], r->e8[1], ed, pd, r->wide_diff);
     }
     printf("\nThe same runs in Mrays per CPU-second (the CPU time of the whole process: the work per core, "
            "which other jobs taking the cores do not change; with ideal scaling the %d-thread columns equal "
            "the 1-thread ones), and PoCL over Embree single rays:\n\n", b);
-    printf("| rays | PoCL-1 %dt | PoCL-1 %dt | PoCL-2 %dt | PoCL-2 %dt | PoCL-8 %dt | PoCL-8 %dt | C %dt | C %dt | "
-           "Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | PoCL-1/Embree-1 %dt | PoCL-1/Embree-1 %dt | "
-           "PoCL-2/Embree-1 %dt | PoCL-2/Embree-1 %dt | PoCL-8/Embree-1 %dt | PoCL-8/Embree-1 %dt |\n",
-           a, b, a, b, a, b, a, b, a, b, a, b, a, b, a, b, a, b);
-    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    printf("| rays |");
+    for (int kp = 0; kp < N_KERNELS; kp++) printf(" %s %dt | %s %dt |", kernel_label[kp], a, kernel_label[kp], b);
+    printf(" C %dt | C %dt | C-W %dt | C-W %dt | Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt |", a, b, a, b,
+           a, b, a, b);
+    for (int kp = 0; kp < N_KERNELS; kp++)
+        printf(" %s/Embree-1 %dt | %s/Embree-1 %dt |", kernel_label[kp], a, kernel_label[kp], b);
+    printf("\n|---|");
+    for (int kp = 0; kp < 4 * N_KERNELS + 8; kp++) printf("---:|");
+    printf("\n");
     for (int k = 0; k < N_SETS; k++) {
         const SetResult *r = &res[k];
         printf("| %s %s |", sets[k].name, sets[k].any ? "any" : "closest");
         for (int kp = 0; kp < N_KERNELS; kp++) printf(" %.2f | %.2f |", r->cpu_pocl[kp][0], r->cpu_pocl[kp][1]);
-        printf(" %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |", r->cpu_c[0], r->cpu_c[1], r->cpu_e1[0], r->cpu_e1[1],
-               r->cpu_e8[0], r->cpu_e8[1]);
+        printf(" %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |", r->cpu_c[0], r->cpu_c[1], r->cpu_cw[0],
+               r->cpu_cw[1], r->cpu_e1[0], r->cpu_e1[1], r->cpu_e8[0], r->cpu_e8[1]);
         for (int kp = 0; kp < N_KERNELS; kp++)
             for (int t = 0; t < MAX_THREADS; t++)
                 printf(" %.2f |", r->cpu_e1[t] > 0.0 ? r->cpu_pocl[kp][t] / r->cpu_e1[t] : 0.0);

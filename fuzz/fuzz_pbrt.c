@@ -1,7 +1,7 @@
 /*
  * fuzz_pbrt.c — the pbrt-v4 reader (host/io/pbrt_parse.c) on arbitrary text, and, for a
  * scene that loads, everything that prepares it for the devices (lights, camera,
- * kd-tree) at a small image size. Included files and PLY meshes are looked up beside
+ * the tree) at a small image size. Included files and PLY meshes are looked up beside
  * "fuzz.pbrt" in the current folder (the project root), so inputs can pull in
  * tests/data/pbrt/ and the test meshes.
  */
@@ -30,14 +30,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (size_t i = 0; i < s.n_materials; i++)
             if (s.materials[i].type == MAT_MIX) FUZZ_ASSERT(scene_mix_depth(&s, (uint)i) <= MIX_MAX_DEPTH);
         if (s.bg_type == BG_MAP) FUZZ_ASSERT(s.bg_cubemap < s.n_textures);
-        /* the kd-tree build is O(n log n); keep one input's work small */
+        /* the tree build is O(n log n); keep one input's work small */
         if (n_prims <= 4096) {
             s.image.width = s.image.width < 16 ? s.image.width : 16;
             s.image.height = s.image.height < 16 ? s.image.height : 16;
             RenderScene rs;
             st = render_scene_prepare(&s, 1, &rs, &err);
             if (st) FUZZ_ASSERT(st == ST_INPUT && err.msg[0]);
-            else FUZZ_ASSERT(rs.kd.n_nodes >= 1 && isfinite(rs.ds.params.camera.corner.x));
+            else FUZZ_ASSERT(rs.kd.n_nodes + rs.bvh.n_nodes >= 1 && isfinite(rs.ds.params.camera.corner.x));
             render_scene_free(&rs);
         }
     }

@@ -1,7 +1,7 @@
 /*
  * fuzz_scene.c — the scene reader (host/io/scene_parse.c) on arbitrary text, and, for a
  * scene that loads, everything that prepares it for the devices (lights, camera,
- * kd-tree) at a small image size. Included files and meshes are looked up beside
+ * the tree) at a small image size. Included files and meshes are looked up beside
  * "fuzz.scene" in the current folder (the project root), so the inputs can pull in the
  * shipped scenes and test meshes.
  */
@@ -28,14 +28,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (size_t i = 0; i < s.n_triangles; i++) FUZZ_ASSERT(s.triangles[i].material < s.n_materials);
         for (size_t i = 0; i < s.n_boxes; i++) FUZZ_ASSERT(s.boxes[i].material < s.n_materials);
         for (size_t i = 0; i < s.n_planes; i++) FUZZ_ASSERT(s.planes[i].material < s.n_materials);
-        /* the kd-tree build is O(n log n); keep one input's work small */
+        /* the tree build is O(n log n); keep one input's work small */
         if (n_prims <= 4096) {
             s.image.width = s.image.width < 16 ? s.image.width : 16;
             s.image.height = s.image.height < 16 ? s.image.height : 16;
             RenderScene rs;
             st = render_scene_prepare(&s, 1, &rs, &err);
             if (st) FUZZ_ASSERT(st == ST_INPUT && err.msg[0]);
-            else FUZZ_ASSERT(rs.kd.n_nodes >= 1 && isfinite(rs.ds.params.camera.corner.x));
+            else FUZZ_ASSERT(rs.kd.n_nodes + rs.bvh.n_nodes >= 1 && isfinite(rs.ds.params.camera.corner.x));
             render_scene_free(&rs);
         }
     }

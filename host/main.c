@@ -193,6 +193,7 @@ static void apply_overrides(const Options *o, Scene *s)
     if (o->height >= 0) s->image.height = (uint)o->height;
     if (o->seed >= 0) s->image.seed = (uint)o->seed;
     if (o->sampler >= 0) s->image.sampler = (uint)o->sampler;
+    if (o->accel >= 0) s->accel = (uint)o->accel;
     if (o->max_depth >= 0) s->image.max_depth = (uint)o->max_depth;
     if (o->integrator >= 0) s->integrator = (uint)o->integrator;
     if (o->gamma >= 0) s->linear_output = o->gamma == 1;
@@ -302,9 +303,9 @@ static Status run_passes(const Options *o, const PassContext *pc, const char *ou
     return ST_OK;
 }
 
-static void print_scene_stats(const Scene *s, const KdTree *kd)
+static void print_scene_stats(const Scene *s, const RenderScene *rs)
 {
-    const KdStats *k = &kd->stats;
+    const KdStats *k = &rs->kd.stats;
     size_t in_tree = s->n_spheres + s->n_triangles + s->n_boxes + s->n_revsurfaces;
     printf("scene: %zu spheres, %zu triangles, %zu boxes, %zu planes, %zu materials, %zu lights", s->n_spheres,
            s->n_triangles, s->n_boxes, s->n_planes, s->n_materials, s->n_lights);
@@ -312,6 +313,15 @@ static void print_scene_stats(const Scene *s, const KdTree *kd)
     if (s->n_revsurfaces) printf(", %zu surfaces of revolution", s->n_revsurfaces);
     printf("\n");
     double per = in_tree ? 1.0 / (double)in_tree : 0.0;
+    if (s->accel == ACCEL_BVH) {
+        const BvhStats *b = &rs->bvh.stats;
+        size_t bytes = (size_t)rs->bvh.n_nodes * sizeof(BvhNode) + (size_t)rs->bvh.n_leaf_prims * sizeof(uint);
+        printf("BVH: built in %.3f s; %u nodes of 8, %u leaves, depth %u (binary tree %u), %.2f primitives "
+               "per leaf, SAH cost %.2f, %.1f KiB (%.1f bytes per primitive)\n",
+               b->build_seconds, b->n_nodes, b->n_leaves, b->max_depth, b->max_binary_depth,
+               b->mean_prims_per_leaf, b->sah_cost, (double)bytes / 1024.0, (double)bytes * per);
+        return;
+    }
     printf("kd-tree: built in %.3f s; %u nodes, %u leaves (%u empty), depth %u, "
            "%.2f primitives per non-empty leaf, SAH cost %.2f, %.1f KiB (nodes and leaf ids %.1f, copies "
            "of the triangles' corners in the leaves %.1f bytes per primitive)\n",
@@ -712,7 +722,7 @@ static Status render_prepare(Run *r, int worker, int keyed, Error *err)
     Status st;
     if ((st = render_scene_prepare(&r->scene, 0, &r->rs, err))) return st;
     const DeviceScene *ds = &r->rs.ds;
-    if (r->o.stats && !worker) print_scene_stats(&r->scene, &r->rs.kd);
+    if (r->o.stats && !worker) print_scene_stats(&r->scene, &r->rs);
     if (keyed || r->o.checkpoint_path || r->o.resume_path) checkpoint_id(ds, r->scene.image.spp, &r->ctx.checkpoint_id);
     if ((st = film_init(&r->film, ds->params.width, ds->params.height, err))) return st;
     if (!r->o.resume_path || worker) return ST_OK;

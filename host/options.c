@@ -59,6 +59,8 @@ void options_print_help(FILE *f)
 "                             random numbers: Owen-scrambled Sobol points\n"
 "                             (default; less noise) or independent ones\n"
 "                             (clpt's earlier sampler, the same images)\n"
+"      --accel bvh|kdtree     the tree rays find primitives through: an 8-wide\n"
+"                             BVH (default; faster) or the SAH kd-tree\n"
 "      --time-limit SECONDS   stop starting new batches after this long; the\n"
 "                             image holds the whole batches finished by then\n"
 "                             (none: the output is left alone, exit status 7)\n"
@@ -169,8 +171,8 @@ void options_print_help(FILE *f)
 "                             all cores)\n"
 "\n"
 "Reporting:\n"
-"      --stats                print scene, kd-tree, kernel build and\n"
-"                             per-device statistics to stdout\n"
+"      --stats                print scene, tree (BVH or kd-tree), kernel\n"
+"                             build and per-device statistics to stdout\n"
 "      --profile              --stats, and where each device's time goes: ray\n"
 "                             generation, traversal, shading, shadow rays,\n"
 "                             film, queues, host waits (slows rendering)\n"
@@ -433,6 +435,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
     static const int on_off_values[] = { 1, 0 };
     static const char *const samplers[] = { "sobol", "independent", NULL };
     static const int sampler_values[] = { SAMPLER_SOBOL, SAMPLER_INDEPENDENT };
+    static const char *const accels[] = { "bvh", "kdtree", NULL };
+    static const int accel_values[] = { ACCEL_BVH, ACCEL_KDTREE };
     static const char *const launches[] = { "counted", "bounded", "megakernel", NULL };
     static const int launch_values[] = { WAVE_LAUNCH_COUNTED, WAVE_LAUNCH_BOUNDED, WAVE_LAUNCH_MEGAKERNEL };
     *found = 1;
@@ -446,6 +450,8 @@ static Status options_set_choice(const char *a, const char *v, Options *o, int *
         return parse_choice(a, v, on_off, on_off_values, "'on' or 'off'", &o->shadows, err);
     if (strcmp(a, "--sampler") == 0)
         return parse_choice(a, v, samplers, sampler_values, "'sobol' or 'independent'", &o->sampler, err);
+    if (strcmp(a, "--accel") == 0)
+        return parse_choice(a, v, accels, accel_values, "'bvh' or 'kdtree'", &o->accel, err);
     if (strcmp(a, "--wave-launch") == 0)
         return parse_choice(a, v, launches, launch_values, "'counted', 'bounded' or 'megakernel'", &o->wave_launch,
                             err);
@@ -473,6 +479,7 @@ static void options_defaults(Options *o)
     o->gamma = -1;
     o->shadows = -1;
     o->sampler = -1;
+    o->accel = -1;
     o->format = SCENE_FORMAT_AUTO;
     o->adaptive_spp = 16;
 }

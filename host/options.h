@@ -44,6 +44,7 @@ typedef struct {
     int gamma;                    /* -1 the scene's, 0 sRGB, 1 none (linear 8-bit) */
     int shadows;                  /* -1 the scene's, 0 off, 1 on */
     int sampler;                  /* -1 the scene's, else enum Sampler */
+    int accel;                    /* -1 the default, else enum SceneAccel */
     double depth_near, depth_far; /* --depth-range; near == far (0) = automatic */
 } Options;
 

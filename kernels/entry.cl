@@ -292,7 +292,7 @@ __kernel void k_trace_closest(SCENE_ARGS __global const Ray *rays, uint n, __glo
         hits[a] = ha;
         hits[b] = hb;
     } else {
-        hits[a] = trace_closest(&sc, rays[a]);
+        hits[a] = trace_closest_in(&sc, TREE_KD, rays[a]);
     }
 }
 
@@ -308,7 +308,7 @@ __kernel void k_trace_any(SCENE_ARGS __global const Ray *rays, uint n, __global 
         occluded[a] = (uint)oa;
         occluded[b] = (uint)ob;
     } else {
-        occluded[a] = (uint)trace_any(&sc, rays[a]);
+        occluded[a] = (uint)trace_any_in(&sc, TREE_KD, rays[a]);
     }
 }
 
@@ -318,7 +318,7 @@ __kernel void k_trace_closest1(SCENE_ARGS __global const Ray *rays, uint n, __gl
     uint i = (uint)get_global_id(0);
     if (i >= n) return;
     SCENE_VIEW(sc);
-    hits[i] = trace_closest(&sc, rays[i]);
+    hits[i] = trace_closest_in(&sc, TREE_KD, rays[i]);
 }
 
 /* Whether rays[i] hits anything, one ray per work-item (trace_any, as k_shadow). */
@@ -327,7 +327,7 @@ __kernel void k_trace_any1(SCENE_ARGS __global const Ray *rays, uint n, __global
     uint i = (uint)get_global_id(0);
     if (i >= n) return;
     SCENE_VIEW(sc);
-    occluded[i] = (uint)trace_any(&sc, rays[i]);
+    occluded[i] = (uint)trace_any_in(&sc, TREE_KD, rays[i]);
 }
 /* Closest hits (any == 0) or occlusion (any == 1: 1 or 0 in hits[i].prim's place, as
  * occluded[]) of rays[8i .. 8i+7], walked as one packet (trace_packet). */
@@ -360,5 +360,23 @@ __kernel void k_trace_any8(SCENE_ARGS __global const Ray *rays, uint n, __global
 {
     SCENE_VIEW(sc);
     trace_packet_item(&sc, rays, n, 1, 0, occluded);
+}
+
+/* Closest hit of rays[i] through the 8-wide BVH, one ray per work-item. */
+__kernel void k_trace_closest_wide(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= n) return;
+    SCENE_VIEW(sc);
+    hits[i] = trace_closest_in(&sc, TREE_BVH, rays[i]);
+}
+
+/* Whether rays[i] hits anything, through the 8-wide BVH. */
+__kernel void k_trace_any_wide(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
+{
+    uint i = (uint)get_global_id(0);
+    if (i >= n) return;
+    SCENE_VIEW(sc);
+    occluded[i] = (uint)trace_any_in(&sc, TREE_BVH, rays[i]);
 }
 #endif /* CLPT_BENCH_KERNELS */

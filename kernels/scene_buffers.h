@@ -35,6 +35,8 @@
     X(ONE,  RenderParams, params,     1u,                        "render parameters")        \
     X(MANY, KdNode,       nodes,      (ds)->params.n_nodes,      "kd-tree nodes")            \
     X(MANY, uint,         leaf_prims, (ds)->params.n_leaf_prims, "kd-tree leaf lists")       \
+    X(MANY, BvhNode,      bvh,        (ds)->params.n_bvh_nodes,  "8-wide BVH nodes")         \
+    X(MANY, uint,         bvh_leaves, (ds)->n_bvh_leaves,        "8-wide BVH leaf lists")    \
     X(MANY, Sphere,       spheres,    (ds)->params.n_spheres,    "spheres")                  \
     X(MANY, Triangle,     triangles,  (ds)->params.n_triangles,  "triangles")                \
     X(MANY, Box,          boxes,      (ds)->params.n_boxes,      "boxes")                    \

@@ -14,25 +14,9 @@
 #define CLPT_TRAVERSE_CL
 
 #include "intersect.h"
+#include "leaf.h"
 #include "scene_view.h"
-
-/* Tests global primitive `id` (a sphere, triangle, box or surface of revolution: planes
- * are not in the tree) against the ray, whose tmax is the closest hit so far. The walk
- * tests triangles by leaf group and calls this for the others. */
-KFN_INLINE int trace_prim(const SceneView *sc, uint id, const RayPre *rp, Ray ray, Hit *hit)
-{
-    GLOBAL const RenderParams *pr = sc->params;
-    uint first_tri = pr->n_spheres, first_box = first_tri + pr->n_triangles;
-    uint first_rev = first_box + pr->n_boxes;
-    if ((id >= first_tri) & (id < first_box))
-        return triangle_intersect(rp, &sc->triangles[id - first_tri], ray, hit);
-    if (KF_HAS(KF_SPHERES) && id < first_tri)
-        return sphere_intersect(sc->spheres[id], ray, hit);
-    if (KF_HAS(KF_BOXES) && id < first_rev)
-        return box_intersect(rp, sc->boxes[id - first_box], ray, hit);
-    if (!KF_HAS(KF_REVSURFACE)) return 0;
-    return revsurface_intersect(sc->revsurfaces[id - first_rev], sc->rev_points, ray, hit);
-}
+#include "traverse_wide.cl"
 
 /* Clips the ray's [tmin, tmax] to the root box; 0 if nothing is left. The far end is
  * widened by a few ulps (pbrt's 1 + 2*gamma(3)) so that rounding in the slab test
@@ -54,12 +38,6 @@ KFN int trace_clip_root(GLOBAL const RenderParams *pr, Ray ray, const RayPre *rp
     *t1 = tf;
     return tn <= tf;
 }
-
-/* Relative slack of the traversal's plane-crossing tests: far above the rounding error
- * of the distances compared (about 3 ulps, 4e-7, each), far below any cost. */
-#define KD_T_SLACK 1e-6f
-#define KD_T_ABOVE (1.0f + KD_T_SLACK)
-#define KD_T_BELOW (1.0f - KD_T_SLACK)
 
 /* A kd-tree walk in progress: the node about to be visited, the part [t0, t1] of the
  * ray inside it, and the depth of its stack of cells still to visit (far children,
@@ -132,48 +110,14 @@ KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, KdStack *st, int 
     w->node = k_select_u(near, far, far_only);
 }
 
-/* Tests the primitives of leaf n against the ray (tmax: the closest hit so far, in
- * best->t); returns 1 when an any-hit query hit. The triangles are tested a group at a
- * time (triangle_intersect_group: the nearest lane hit, the first of equals, which is
- * what testing them one by one in lane order gives), then the spheres and boxes one by
- * one. */
-KFN_INLINE int kd_leaf_prims(const SceneView *sc, Ray ray, const RayPre *rp, int any, KdNode n, Hit *best)
-{
-    GLOBAL const uint *g = sc->leaf_prims + n.data;
-    uint groups = n.bits >> 3;
-    for (uint i = 0; i < groups; i++, g += KD_GROUP_WORDS) {
-        Hit h;
-        if (triangle_intersect_group(rp, (GLOBAL const float *)(g + KD_GROUP), ray.tmin, best->t, &h)) {
-            h.prim = g[h.prim];
-            *best = h;
-            if (any) return 1;
-        }
-    }
-    if (n.bits & KD_LEAF_OTHERS) {
-        uint count = g[0];
-        for (uint i = 1; i <= count; i++) {
-            uint id = g[i];
-            Ray r = ray;
-            r.tmax = best->t;
-            Hit h;
-            if (trace_prim(sc, id, rp, r, &h)) {
-                h.prim = id;
-                *best = h;
-                if (any) return 1;
-            }
-        }
-    }
-    return 0;
-}
-
-/* The visit of leaf n: its primitives (kd_leaf_prims); returns 1 when the walk is over:
+/* The visit of leaf n: its primitives (leaf_test); returns 1 when the walk is over:
  * an any-hit query hit, or nothing is left on the stack, or the closest hit is no
  * farther than the end of this cell (every cell on the stack starts there or later).
  * Otherwise pops the next cell. */
 KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, KdNode n, KdWalk *w,
                        const KdStack *st, Hit *best)
 {
-    if (kd_leaf_prims(sc, ray, rp, any, n, best)) return 1;
+    if (leaf_test(sc, sc->leaf_prims, ray, rp, any, n, best)) return 1;
     if ((w->sp == 0) | (best->t <= w->t1)) return 1;
     int sp = w->sp - 1;
     w->sp = sp;
@@ -206,55 +150,67 @@ KFN_INLINE void trace_tree(const SceneView *sc, Ray ray, const RayPre *rp, int a
     }
 }
 
-/* Nearest hit in (ray.tmin, ray.tmax); prim = NO_INDEX when there is none. */
-KFN Hit trace_closest(const SceneView *sc, Ray ray)
+/* Which tree holds the scene: the kd-tree (TREE_KD) or the 8-wide BVH (TREE_BVH). A
+ * program compiled for one (CLPT_FEATURES with KF_KDTREE or KF_BVH alone) knows it at
+ * compile time; otherwise the scene says, by having BVH nodes. */
+#define TREE_KD 0
+#define TREE_BVH 1
+KFN_INLINE int trace_tree_kind(const SceneView *sc)
 {
-    GLOBAL const RenderParams *pr = sc->params;
-    Hit best;
-    best.t = ray.tmax;
-    best.prim = NO_INDEX;
-    best.u = 0.0f;
-    best.v = 0.0f;
+    if (!KF_HAS(KF_BVH)) return TREE_KD;
+    if (!KF_HAS(KF_KDTREE)) return TREE_BVH;
+    return sc->params->n_bvh_nodes != 0u ? TREE_BVH : TREE_KD;
+}
+
+/* The walk of the given tree (which, when it is the BVH, must be there). */
+KFN_INLINE void trace_walk(const SceneView *sc, int tree, Ray ray, const RayPre *rp, int any, Hit *best)
+{
+    if (KF_HAS(KF_BVH) && tree == TREE_BVH) trace_wide(sc, ray, rp, any, best);
+    else if (KF_HAS(KF_KDTREE)) trace_tree(sc, ray, rp, any, best);
+}
+
+/* Nearest hit in (ray.tmin, ray.tmax) through the given tree; prim = NO_INDEX when
+ * there is none. */
+KFN Hit trace_closest_in(const SceneView *sc, int tree, Ray ray)
+{
+    Hit best = hit_none(ray);
+    trace_planes(sc, ray, 0, &best);
     RayPre rp = ray_prepare(ray);
-    uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes + pr->n_revsurfaces;
-    for (uint i = 0; i < (KF_HAS(KF_PLANES) ? pr->n_planes : 0u); i++) {
-        Ray r = ray;
-        r.tmax = best.t;
-        Hit h;
-        if (plane_intersect(sc->planes[i], r, &h)) {
-            h.prim = first_plane + i;
-            best = h;
-        }
-    }
-    trace_tree(sc, ray, &rp, 0, &best);
+    trace_walk(sc, tree, ray, &rp, 0, &best);
     return best;
 }
 
-/* The first hit found in (ray.tmin, ray.tmax), not necessarily the closest; prim =
- * NO_INDEX when there is none. */
-KFN Hit trace_any_hit(const SceneView *sc, Ray ray)
+/* The first hit found in (ray.tmin, ray.tmax) through the given tree, not necessarily
+ * the closest; prim = NO_INDEX when there is none. */
+KFN Hit trace_any_hit_in(const SceneView *sc, int tree, Ray ray)
 {
-    GLOBAL const RenderParams *pr = sc->params;
-    uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes + pr->n_revsurfaces;
-    Hit h;
-    for (uint i = 0; i < (KF_HAS(KF_PLANES) ? pr->n_planes : 0u); i++)
-        if (plane_intersect(sc->planes[i], ray, &h)) {
-            h.prim = first_plane + i;
-            return h;
-        }
+    Hit h = hit_none(ray);
+    if (trace_planes(sc, ray, 1, &h)) return h;
     RayPre rp = ray_prepare(ray);
-    h.t = ray.tmax;
-    h.prim = NO_INDEX;
-    h.u = 0.0f;
-    h.v = 0.0f;
-    trace_tree(sc, ray, &rp, 1, &h);
+    trace_walk(sc, tree, ray, &rp, 1, &h);
     return h;
 }
 
+/* The queries the renderer asks, through the scene's tree. */
+KFN Hit trace_closest(const SceneView *sc, Ray ray)
+{
+    return trace_closest_in(sc, trace_tree_kind(sc), ray);
+}
+
+KFN Hit trace_any_hit(const SceneView *sc, Ray ray)
+{
+    return trace_any_hit_in(sc, trace_tree_kind(sc), ray);
+}
+
 /* 1 if anything is hit in (ray.tmin, ray.tmax): shadow rays. */
+KFN int trace_any_in(const SceneView *sc, int tree, Ray ray)
+{
+    return trace_any_hit_in(sc, tree, ray).prim != NO_INDEX;
+}
+
 KFN int trace_any(const SceneView *sc, Ray ray)
 {
-    return trace_any_hit(sc, ray).prim != NO_INDEX;
+    return trace_any_in(sc, trace_tree_kind(sc), ray);
 }
 
 /* ------------------------------------------------------------------ two rays at once */
@@ -278,28 +234,14 @@ typedef struct {
 /* The planes, then the ray clipped to the root box, as trace_closest and trace_any do. */
 KFN_INLINE void trace_ray_begin(const SceneView *sc, Ray ray, int any, TraceRay *t, RayPre *rp, KdWalk *w)
 {
-    GLOBAL const RenderParams *pr = sc->params;
     t->ray = ray;
     t->any = any;
-    t->best.t = ray.tmax;
-    t->best.prim = NO_INDEX;
-    t->best.u = 0.0f;
-    t->best.v = 0.0f;
+    t->best = hit_none(ray);
     t->active = 0;
     w->node = 0u;
     w->sp = 0;
     w->t0 = w->t1 = 0.0f;
-    uint first_plane = pr->n_spheres + pr->n_triangles + pr->n_boxes + pr->n_revsurfaces;
-    for (uint i = 0; i < (KF_HAS(KF_PLANES) ? pr->n_planes : 0u); i++) {
-        Ray r = ray;
-        r.tmax = t->best.t;
-        Hit h;
-        if (plane_intersect(sc->planes[i], r, &h)) {
-            h.prim = first_plane + i;
-            t->best = h;
-            if (any) return;
-        }
-    }
+    if (trace_planes(sc, ray, any, &t->best)) return;
     *rp = ray_prepare(ray);
     t->active = kd_walk_begin(sc, ray, rp, w);
 }
@@ -456,7 +398,7 @@ KFN_INLINE void trace_packet_walk(const SceneView *sc, TraceRay *tr, const RayPr
         k_store8(t1, end);
         for (uint l = 0; l < TRACE_PACKET; l++) {
             if (!((lanes >> l) & 1u)) continue;
-            if (kd_leaf_prims(sc, tr[l].ray, &rp[l], tr[l].any, n, &tr[l].best) || tr[l].best.t <= end[l])
+            if (leaf_test(sc, sc->leaf_prims, tr[l].ray, &rp[l], tr[l].any, n, &tr[l].best) || tr[l].best.t <= end[l])
                 done |= 1u << l;
         }
         for (;;) {

@@ -47,7 +47,9 @@
 #define KF_DELTA_LIGHTS 0x400u  /* point, spot or directional lights */
 #define KF_MATERIAL(t) (0x800u << (t))  /* material type t (enum MaterialType) */
 #define KF_PATH_MEGAKERNEL 0x80000u     /* the path tracer as one kernel (k_path, k_film) */
-#define KF_ALL 0xbffffu         /* every bit above (material types 0 to 6) */
+#define KF_KDTREE 0x100000u     /* the scene's tree is the kd-tree (kernels/traverse.cl) */
+#define KF_BVH 0x200000u        /* ... the 8-wide BVH (kernels/traverse_wide.cl) */
+#define KF_ALL 0x3bffffu        /* every bit above (material types 0 to 6) */
 #ifndef CLPT_FEATURES
 #define CLPT_FEATURES KF_ALL
 #endif
@@ -91,6 +93,22 @@ typedef struct {
 #define KD_LEAF_OTHERS 4u
 #define KD_GROUP 8u
 #define KD_GROUP_WORDS (KD_GROUP * 10u)
+
+/* A node of the 8-wide BVH (host/accel/bvh.c, walked by kernels/traverse_wide.cl):
+ * the boxes of up to BVH_WIDTH children as six rows of 8 lanes (lo x, hi x, lo y, hi y,
+ * lo z, hi z: the layout one float8 load per row wants), and per child a reference and
+ * its kind: BVH_CHILD_NONE for an unused lane (its box is empty: lo +inf, hi -inf),
+ * BVH_CHILD_NODE with ref the child's node index, or a leaf's KdNode bits (KD_LEAF,
+ * which is never 0 or 1) with ref the offset of its record in the leaf data, which
+ * has the kd-tree's leaf layout (above). Node 0 is the root. */
+#define BVH_WIDTH 8u
+#define BVH_CHILD_NONE 0u
+#define BVH_CHILD_NODE 1u
+typedef struct {                                        /* 256 bytes */
+    float box[6][BVH_WIDTH];
+    uint ref[BVH_WIDTH];
+    uint kind[BVH_WIDTH];
+} BvhNode;
 
 /* Global primitive ids: [0, n_spheres) spheres, then triangles, then boxes, then
  * surfaces of revolution, then planes. All but the infinite planes are in the kd-tree. */
@@ -339,7 +357,7 @@ typedef struct {                                        /* 288 bytes */
     uint n_spheres, n_triangles, n_boxes, n_planes;
     uint n_lights;
     uint n_nodes, n_leaf_prims;
-    vec3 bounds_lo;   uint n_revsurfaces; /* box of the kd-tree root; RevSurface count */
+    vec3 bounds_lo;   uint n_revsurfaces; /* box of the tree's root; RevSurface count */
     vec3 bounds_hi;   uint sampler;   /* enum Sampler */
     /* integrators and light kinds of the classic ray tracer (kernels/whitted.cl) */
     vec3 ambient;     uint integrator;  /* whitted: ambient light; enum Integrator */
@@ -355,9 +373,9 @@ typedef struct {                                        /* 288 bytes */
     uint normal_miss_grey;            /* the normal image's misses: (0 + 1) / 2 grey (the
                                        * courses' convention, classic scenes), else black */
     float bg_rot_cos, bg_rot_sin;     /* BG_MAP: cos and sin of its rotation about +y */
+    uint n_bvh_nodes;                 /* nodes of the 8-wide BVH, when there is one */
     uint bg_light;                    /* BG_MAP: its light in lights[] (sampled by
                                        * next-event estimation), or NO_INDEX */
-    uint pad3;
 } RenderParams;
 
 /* One path of the wavefront; lives in a device buffer between kernel launches. */
@@ -389,6 +407,7 @@ CLPT_CHECK_SIZE(vec3, 12);
 CLPT_CHECK_SIZE(Ray, 32);
 CLPT_CHECK_SIZE(Hit, 16);
 CLPT_CHECK_SIZE(KdNode, 8);
+CLPT_CHECK_SIZE(BvhNode, 256);
 CLPT_CHECK_SIZE(Sphere, 32);
 CLPT_CHECK_SIZE(Triangle, 48);
 CLPT_CHECK_SIZE(TriShading, 64);
@@ -410,7 +429,7 @@ _Static_assert(offsetof(RenderParams, ambient) == 224, "RenderParams.ambient");
 _Static_assert(offsetof(RenderParams, strata) == 256, "RenderParams.strata");
 _Static_assert(offsetof(RenderParams, shadows) == 264, "RenderParams.shadows");
 _Static_assert(offsetof(RenderParams, normal_miss_grey) == 268, "RenderParams.normal_miss_grey");
-_Static_assert(offsetof(RenderParams, bg_light) == 280, "RenderParams.bg_light");
+_Static_assert(offsetof(RenderParams, bg_light) == 284, "RenderParams.bg_light");
 _Static_assert(offsetof(Material, reflective) == 64, "Material.reflective");
 _Static_assert(offsetof(Light, cos_inner) == 60, "Light.cos_inner");
 _Static_assert(offsetof(Texture, m) == 32, "Texture.m");

@@ -17,7 +17,7 @@ static void test_help_documents_every_flag(void)
     const char *flags[] = { "--output", "--spp", "--width", "--height", "--seed", "--max-depth", "--time-limit",
                             "--progressive-output", "--list-devices", "--device", "--threads", "--stats",
                             "--quiet", "--help", "--version", "--kernel-dir", "--batch", "--wave-paths", "--wave-launch",
-                            "--shadows", "--sampler", "--profile", "-size W H -input SCENE -output FILE", "-depth NEAR FAR FILE",
+                            "--shadows", "--sampler", "--accel", "--profile", "-size W H -input SCENE -output FILE", "-depth NEAR FAR FILE",
                             "-bounces N", "clpt SCENE OUT.bmp", "Exit status" };
     for (size_t i = 0; i < sizeof flags / sizeof flags[0]; i++) CHECK_STR_CONTAINS(r.out, flags[i]);
 }
@@ -44,6 +44,9 @@ static void test_usage_errors(void)
     cli_run(ARGS("scenes/cornell-box.scene", "--sampler", "halton"), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "--sampler expects 'sobol' or 'independent', got 'halton'");
+    cli_run(ARGS("scenes/cornell-box.scene", "--accel", "octree"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "--accel expects 'bvh' or 'kdtree', got 'octree'");
     cli_run(ARGS("scenes/cornell-box.scene", "--wave-launch", "fast"), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "--wave-launch expects 'counted', 'bounded' or 'megakernel', got 'fast'");
@@ -175,10 +178,19 @@ static void test_stats(void)
                  "--spp", "1", "-o", "/tmp/clpt-test-stats.png"),
             &r);
     CHECK_EQ_INT(r.status, 0);
-    const char *want[] = { "kd-tree: built in", "nodes", "leaves", "depth", "SAH cost", "kernels", "Msamples/s",
+    const char *want[] = { "BVH: built in", "nodes of 8", "leaves", "depth", "SAH cost", "kernels", "Msamples/s",
                            "Mrays/s", "total" };
     for (size_t i = 0; i < sizeof want / sizeof want[0]; i++) CHECK_STR_CONTAINS(r.out, want[i]);
+    /* the kd-tree on request, and the same image */
+    CHECK(rename("/tmp/clpt-test-stats.png", "/tmp/clpt-test-stats-bvh.png") == 0);
+    cli_run(ARGS("scenes/cornell-box.scene", "--stats", "-q", "--device", "cpu", "--width", "8", "--height", "8",
+                 "--spp", "1", "--accel", "kdtree", "-o", "/tmp/clpt-test-stats.png"),
+            &r);
+    CHECK_EQ_INT(r.status, 0);
+    CHECK_STR_CONTAINS(r.out, "kd-tree: built in");
+    CHECK(files_equal("/tmp/clpt-test-stats.png", "/tmp/clpt-test-stats-bvh.png"));
     unlink("/tmp/clpt-test-stats.png");
+    unlink("/tmp/clpt-test-stats-bvh.png");
 }
 
 /* --profile: the stats, then each device's time per phase; the traversal and shading of

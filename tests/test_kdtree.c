@@ -1,15 +1,17 @@
 /*
- * test_kdtree.c -- the kd-tree build (host/accel/kdtree.c), the primitive intersections
- * (kernels/intersect.h) and the traversal (kernels/traverse.cl, compiled here as C).
+ * test_kdtree.c -- the two trees: the kd-tree build (host/accel/kdtree.c) and the 8-wide
+ * BVH build (host/accel/bvh.c), the primitive intersections (kernels/intersect.h) and
+ * both walks (kernels/traverse.cl and traverse_wide.cl, compiled here as C).
  *
- * The tree's structure is checked directly (nesting, which primitives each leaf must
- * hold, its SAH cost), and the traversal against brute force: every primitive tested
+ * Each tree's structure is checked directly (nesting, which primitives each leaf must
+ * hold, the statistics), and the walks against brute force: every primitive tested
  * with the same intersection functions, on random scenes and random rays.
  */
 #include <stdint.h>
 #include <stdlib.h>
 
 #include "harness.h"
+#include "accel/bvh.h"
 #include "accel/kdtree.h"
 #include "io/mesh_load.h"
 #include "surface.h"
@@ -36,7 +38,10 @@ typedef struct {
     Plane pln[4];        uint np;
     KdTree tree;
     RenderParams params;
-    SceneView view;
+    SceneView view;             /* the kd-tree */
+    Bvh bvh;
+    RenderParams wide_params;
+    SceneView wide_view;        /* the BVH */
 } TestScene;
 
 static TestScene scene;   /* large: static rather than on the stack */
@@ -44,6 +49,7 @@ static TestScene scene;   /* large: static rather than on the stack */
 static void scene_clear(void)
 {
     kd_free(&scene.tree);
+    bvh_free(&scene.bvh);
     scene.ns = scene.nt = scene.nb = scene.np = 0;
 }
 
@@ -68,15 +74,17 @@ static void add_plane(vec3 n, float offset)
     scene.pln[scene.np++] = p;
 }
 
-/* Builds the tree and the SceneView the kernel functions read. */
+/* Builds both trees and a SceneView of each for the kernel functions. */
 static Status scene_build(int threads)
 {
     KdInput in = { scene.sph, scene.ns, scene.tri, scene.nt, scene.box, scene.nb, NULL, 0 };
     Error err = { 0 };
     kd_free(&scene.tree);
+    bvh_free(&scene.bvh);
     Status st = kd_build(&in, threads, &scene.tree, &err);
+    if (st == ST_OK) st = bvh_build(&in, threads, &scene.bvh, &err);
     if (st != ST_OK) {
-        fprintf(stderr, "  kd_build: %s\n", err.msg);
+        fprintf(stderr, "  tree build: %s\n", err.msg);
         return st;
     }
     memset(&scene.params, 0, sizeof scene.params);
@@ -92,8 +100,18 @@ static Status scene_build(int threads)
     SceneView v = { .params = &scene.params, .nodes = scene.tree.nodes, .leaf_prims = scene.tree.leaf_prims,
                     .spheres = scene.sph, .triangles = scene.tri, .boxes = scene.box, .planes = scene.pln };
     scene.view = v;
+    scene.wide_params = scene.params;
+    scene.wide_params.n_nodes = scene.wide_params.n_leaf_prims = 0;
+    scene.wide_params.n_bvh_nodes = scene.bvh.n_nodes;
+    SceneView w = { .params = &scene.wide_params, .bvh = scene.bvh.nodes, .bvh_leaves = scene.bvh.leaf_prims,
+                    .spheres = scene.sph, .triangles = scene.tri, .boxes = scene.box, .planes = scene.pln };
+    scene.wide_view = w;
     return ST_OK;
 }
+
+/* The tree the walk tests use: the kd-tree, or the BVH while walk_bvh is set. */
+static int walk_bvh;
+static const SceneView *walk_view(void) { return walk_bvh ? &scene.wide_view : &scene.view; }
 
 /* Every primitive tested; primitives the builder leaves out (bounds not finite) are
  * left out here too. */
@@ -150,17 +168,17 @@ static Ray make_ray(vec3 o, vec3 d, float tmin, float tmax)
  * tied at t within 1e-5 relative; any-hit true exactly when there is a closest hit. */
 static int ray_agrees(Ray ray, int verbose)
 {
-    Hit a = trace_closest(&scene.view, ray), b = brute_closest(ray);
-    int any = trace_any(&scene.view, ray);
+    Hit a = trace_closest(walk_view(), ray), b = brute_closest(ray);
+    int any = trace_any(walk_view(), ray);
     int ok;
     if (a.prim == NO_INDEX || b.prim == NO_INDEX) ok = a.prim == b.prim;
     else if (a.prim == b.prim) ok = a.t == b.t && a.u == b.u && a.v == b.v;
     else ok = fabsf(a.t - b.t) <= 1e-5f * fmaxf(fabsf(b.t), 1e-30f);
     ok = ok && any == (b.prim != NO_INDEX);
     if (!ok && verbose)
-        fprintf(stderr, "  ray o=(%.9g %.9g %.9g) d=(%.9g %.9g %.9g) tmin %g tmax %g: kd %u t=%.9g, "
+        fprintf(stderr, "  ray o=(%.9g %.9g %.9g) d=(%.9g %.9g %.9g) tmin %g tmax %g: %s %u t=%.9g, "
                 "brute %u t=%.9g, any %d\n", ray.o.x, ray.o.y, ray.o.z, ray.d.x, ray.d.y, ray.d.z,
-                ray.tmin, ray.tmax, a.prim, a.t, b.prim, b.t, any);
+                ray.tmin, ray.tmax, walk_bvh ? "BVH" : "kd", a.prim, a.t, b.prim, b.t, any);
     return ok;
 }
 
@@ -699,9 +717,154 @@ static void test_structure(void)
             st->leaf_sah_cost, st->mean_prims_per_leaf * (st->n_leaves - st->n_empty_leaves) / 2000.0);
 }
 
+/* Walks the BVH checking that every child box holds what is below it (the primitives'
+ * bounds, the grandchildren's boxes), that every primitive with finite bounds is in
+ * exactly one leaf, the leaf records (the kd-tree's layout, written by the same code,
+ * so their corner copies are checked there), unused lanes, and the statistics. */
+static void check_bvh(void)
+{
+    const Bvh *t = &scene.bvh;
+    uint n_prims = scene.ns + scene.nt + scene.nb;
+    unsigned char *seen = calloc(n_prims + 1, 1);
+    uint *ids = malloc((n_prims + 1) * sizeof *ids);
+    uint stack[512], depth_of[512], sp = 0, visited = 0, leaves = 0, max_depth = 0, bad_box = 0, dup = 0;
+    stack[sp] = 0;
+    depth_of[sp++] = 1;
+    while (sp > 0) {
+        sp--;
+        uint ni = stack[sp], depth = depth_of[sp];
+        CHECK(ni < t->n_nodes);
+        if (ni >= t->n_nodes) break;
+        visited++;
+        if (depth > max_depth) max_depth = depth;
+        const BvhNode *n = &t->nodes[ni];
+        int unused_seen = 0;
+        for (uint l = 0; l < BVH_WIDTH; l++) {
+            DBox box = { { n->box[0][l], n->box[2][l], n->box[4][l] }, { n->box[1][l], n->box[3][l], n->box[5][l] } };
+            if (n->kind[l] == BVH_CHILD_NONE) {
+                /* an empty box no ray enters; used lanes come first */
+                CHECK(n->box[0][l] == INFINITY && n->box[1][l] == -INFINITY);
+                unused_seen = 1;
+                continue;
+            }
+            CHECK(!unused_seen);
+            if (n->kind[l] == BVH_CHILD_NODE) {
+                CHECK(n->ref[l] > ni && n->ref[l] < t->n_nodes);   /* parents first */
+                if (n->ref[l] >= t->n_nodes) continue;
+                const BvhNode *c = &t->nodes[n->ref[l]];
+                for (uint m = 0; m < BVH_WIDTH; m++) {
+                    if (c->kind[m] == BVH_CHILD_NONE) continue;
+                    for (int k = 0; k < 3; k++)
+                        bad_box += !(c->box[2 * k][m] >= box.lo[k] && c->box[2 * k + 1][m] <= box.hi[k]);
+                }
+                CHECK(sp < 512);
+                if (sp >= 512) break;
+                stack[sp] = n->ref[l];
+                depth_of[sp++] = depth + 1;
+                continue;
+            }
+            /* a leaf: its record's ids, each inside the lane's box */
+            CHECK_EQ_INT(n->kind[l] & 3u, KD_LEAF);
+            leaves++;
+            const uint *g = t->leaf_prims + n->ref[l];
+            uint count = 0, groups = n->kind[l] >> 3;
+            for (uint gi = 0; gi < groups; gi++, g += KD_GROUP_WORDS)
+                for (uint k = 0; k < KD_GROUP; k++)
+                    if (count == 0 || g[k] != ids[count - 1]) ids[count++] = g[k];
+            if (n->kind[l] & KD_LEAF_OTHERS)
+                for (uint k = 1; k <= g[0]; k++) ids[count++] = g[k];
+            CHECK(count >= 1);
+            for (uint i = 0; i < count; i++) {
+                uint id = ids[i];
+                CHECK(id < n_prims);
+                if (id >= n_prims) continue;
+                dup += seen[id];
+                seen[id] = 1;
+                CHECK(must_contain(id, box.lo, box.hi, 0.0));
+            }
+        }
+    }
+    CHECK_EQ_INT(bad_box, 0);
+    CHECK_EQ_INT(dup, 0);
+    CHECK_EQ_INT(visited, t->n_nodes);
+    uint finite = 0;
+    for (uint id = 0; id < n_prims; id++) {
+        finite += prim_finite(id);
+        CHECK_EQ_INT(seen[id], prim_finite(id));
+    }
+    CHECK_EQ_INT(t->stats.n_nodes, t->n_nodes);
+    CHECK_EQ_INT(t->stats.n_leaves, leaves);
+    CHECK_EQ_INT(t->stats.max_depth, max_depth);
+    CHECK_EQ_INT(t->stats.n_skipped, n_prims - finite);
+    CHECK(t->stats.max_stack <= 128);
+    free(seen);
+    free(ids);
+}
+
+static void test_bvh_structure(void)
+{
+    const uint64_t seeds[] = { 1, 2, 3, 4 };
+    for (int i = 0; i < 4; i++) {
+        random_scene(seeds[i], 30, 160, 20, 0);
+        CHECK(scene_build(0) == ST_OK);
+        check_bvh();
+    }
+    /* 2000 tiny triangles: wide nodes, leaves of a few groups at most */
+    scene_clear();
+    rng_seed(9);
+    for (int i = 0; i < 2000; i++) random_triangle(0.0f, 10.0f, 0.02f);
+    CHECK(scene_build(1) == ST_OK);
+    check_bvh();
+    const BvhStats *st = &scene.bvh.stats;
+    CHECK(st->n_leaves >= 2000 / 32 && st->mean_prims_per_leaf <= 32.0);
+    CHECK(st->n_nodes < st->n_leaves);   /* nodes hold several children each */
+    fprintf(stderr, "  2000 tiny triangles: %u nodes, %u leaves (%.1f triangles each), depth %u, SAH cost %.2f\n",
+            st->n_nodes, st->n_leaves, st->mean_prims_per_leaf, st->max_depth, st->sah_cost);
+}
+
+/* Inputs that defeat the binned SAH: a thousand copies of one triangle (one centre:
+ * no split, one leaf of many groups) and triangles at exponentially growing distances
+ * (nearly all centres in the first bin at every level: a deep chain, cut at the depth
+ * limit, whose wide nodes turn binary before the walk's stack could fill). The walk
+ * still agrees with brute force. */
+static void test_bvh_degenerate(void)
+{
+    scene_clear();
+    for (int i = 0; i < 1000; i++) add_triangle(v3(0.0f, 0.0f, 1.0f), v3(1.0f, 0.0f, 1.0f), v3(0.0f, 1.0f, 1.0f));
+    add_triangle(v3(-1.0f, -1.0f, 3.0f), v3(2.0f, -1.0f, 3.0f), v3(-1.0f, 2.0f, 3.0f));
+    CHECK(scene_build(0) == ST_OK);
+    check_bvh();
+    walk_bvh = 1;
+    Ray r = make_ray(v3(0.2f, 0.2f, 0.0f), v3(0.0f, 0.0f, 1.0f), 0.0f, K_INF);
+    Hit h = trace_closest(walk_view(), r);
+    CHECK(h.prim < 1000u && h.t == 1.0f);
+    CHECK(ray_agrees(r, 1));
+    scene_clear();
+    float x = 1.0f;
+    for (int i = 0; i < 3000; i++, x *= 1.02f)
+        add_triangle(v3(x, 0.0f, 0.0f), v3(x, 1.0f, 0.0f), v3(x, 0.0f, 1.0f));
+    CHECK(scene_build(0) == ST_OK);
+    check_bvh();
+    /* deep enough that nodes near the bottom had to turn binary (past 128 - 40 - 7
+     * entries, bvh.c), and still within the walk's 128 */
+    CHECK(scene.bvh.stats.max_stack > 81 && scene.bvh.stats.max_stack <= 128);
+    rng_seed(23);
+    int bad = 0;
+    for (int i = 0; i < 5000; i++) {
+        vec3 o = v3(frange(-10.0f, x), frange(-0.5f, 1.5f), frange(-0.5f, 1.5f));
+        Ray ray = make_ray(o, vrand(-1.0f, 1.0f), 0.0f, K_INF);
+        if (i % 2) ray.d = v3(frand() < 0.5f ? 1.0f : -1.0f, 0.0f, 0.0f);   /* along the chain */
+        bad += !ray_agrees(ray, bad < 3);
+    }
+    CHECK_EQ_INT(bad, 0);
+    fprintf(stderr, "  a chain of 3000 triangles: binary depth %u, %u wide levels, stack %u, %d of 5000 rays disagree\n",
+            scene.bvh.stats.max_binary_depth, scene.bvh.stats.max_depth, scene.bvh.stats.max_stack, bad);
+    walk_bvh = 0;
+}
+
 /* ------------------------------------------------------------------ traversal */
 
-static void test_against_brute_force(void)
+static void test_against_brute_force_once(void)
 {
     struct { uint64_t seed; uint ns, nt, nb, np; int rays; } cases[] = {
         { 21, 40, 200, 25, 2, 30000 },
@@ -717,13 +880,20 @@ static void test_against_brute_force(void)
         for (int i = 0; i < cases[c].rays; i++) {
             Ray r = random_ray(-5.0f, 5.0f);
             bad += !ray_agrees(r, bad < 5);
-            hits += trace_any(&scene.view, r);
+            hits += trace_any(walk_view(), r);
             total++;
         }
         CHECK(hits > cases[c].rays / 10);    /* the scenes are not trivially missed */
     }
     CHECK_EQ_INT(bad, 0);
-    fprintf(stderr, "  %d random rays, %d disagree with brute force\n", total, bad);
+    fprintf(stderr, "  %s: %d random rays, %d disagree with brute force\n", walk_bvh ? "BVH" : "kd-tree", total, bad);
+}
+
+/* The kd-tree, then the BVH. */
+static void test_against_brute_force(void)
+{
+    for (walk_bvh = 0; walk_bvh < 2; walk_bvh++) test_against_brute_force_once();
+    walk_bvh = 0;
 }
 
 /* Two rays walked in turns (trace_closest2, trace_any2) give each ray bit for bit what
@@ -818,6 +988,12 @@ static void test_empty_scene(void)
 {
     scene_clear();
     CHECK(scene_build(0) == ST_OK);
+    /* the BVH: a root without children */
+    CHECK_EQ_INT(scene.bvh.n_nodes, 1);
+    for (uint l = 0; l < BVH_WIDTH; l++) CHECK_EQ_INT(scene.bvh.nodes[0].kind[l], BVH_CHILD_NONE);
+    Ray down = make_ray(v3s(0.0f), v3(0.0f, 0.0f, 1.0f), 0.0f, K_INF);
+    CHECK_EQ_INT(trace_closest(&scene.wide_view, down).prim, NO_INDEX);
+    CHECK(!trace_any(&scene.wide_view, down));
     CHECK_EQ_INT(scene.tree.n_nodes, 1);
     CHECK_EQ_INT(scene.tree.nodes[0].bits, KD_LEAF);
     CHECK_EQ_INT(scene.tree.stats.n_leaves, 1);
@@ -839,7 +1015,7 @@ static void test_empty_scene(void)
 
 /* Broken input must not break the build: primitives with NaN or inf are left out,
  * zero-area triangles stay in (and are never hit). */
-static void test_bad_primitives(void)
+static void test_bad_primitives_once(void)
 {
     random_scene(31, 10, 100, 10, 0);
     add_triangle(v3(NAN, 0.0f, 0.0f), v3(1.0f, 0.0f, 0.0f), v3(0.0f, 1.0f, 0.0f));
@@ -853,14 +1029,22 @@ static void test_bad_primitives(void)
     CHECK_EQ_INT(scene.tree.stats.n_prims, 10 + 100 + 10 + 2);
     CHECK(isfinite(scene.tree.lo.x) && isfinite(scene.tree.hi.y));
     check_tree();
+    CHECK_EQ_INT(scene.bvh.stats.n_skipped, 4);
     int bad = 0;
     for (int i = 0; i < 5000; i++) bad += !ray_agrees(random_ray(-5.0f, 5.0f), bad < 3);
     CHECK_EQ_INT(bad, 0);
 }
 
+/* The kd-tree, then the BVH (which leaves out what the kd-tree does). */
+static void test_bad_primitives(void)
+{
+    for (walk_bvh = 0; walk_bvh < 2; walk_bvh++) test_bad_primitives_once();
+    walk_bvh = 0;
+}
+
 /* Axis-aligned flat triangles exactly on the planes the builder splits at, and rays
  * along the axes (two zero direction components), starting inside and outside. */
-static void test_flat_on_split_planes(void)
+static void test_flat_on_split_planes_once(void)
 {
     scene_clear();
     /* A stack of unit squares at z = 0..7 and a wall of them at x = 0..7, with
@@ -890,7 +1074,7 @@ static void test_flat_on_split_planes(void)
         } else d = vrand(-1.0f, 1.0f);
         Ray r = make_ray(o, d, 0.0f, K_INF);
         bad += !ray_agrees(r, bad < 5);
-        hits += trace_closest(&scene.view, r).prim != NO_INDEX;
+        hits += trace_closest(walk_view(), r).prim != NO_INDEX;
         n++;
     }
     CHECK_EQ_INT(bad, 0);
@@ -900,10 +1084,17 @@ static void test_flat_on_split_planes(void)
      * them: they graze the squares (no hit) and meet the wall at x = 0 */
     for (int z = 0; z < 8; z++) {
         Ray in_plane = make_ray(v3(-1.0f, 5.5f, (float)z), v3(1.0f, 0.0f, 0.0f), 0.0f, K_INF);
-        Hit h = trace_closest(&scene.view, in_plane);
+        Hit h = trace_closest(walk_view(), in_plane);
         CHECK(ray_agrees(in_plane, 1));
         if (z < 4) CHECK(h.prim != NO_INDEX && h.t == 1.0f);
     }
+}
+
+/* The kd-tree, then the BVH (whose boxes have these squares on their faces). */
+static void test_flat_on_split_planes(void)
+{
+    for (walk_bvh = 0; walk_bvh < 2; walk_bvh++) test_flat_on_split_planes_once();
+    walk_bvh = 0;
 }
 
 /* The node array does not depend on the number of threads. */
@@ -930,10 +1121,23 @@ static void test_deterministic(void)
     kd_free(&one);
 }
 
+typedef struct { const void *p; size_t n; } HashPart;
+
+static uint64_t fnv_parts(const HashPart *part, size_t n)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < part[i].n; j++) {
+            h ^= ((const unsigned char *)part[i].p)[j];
+            h *= 0x100000001b3ull;
+        }
+    return h;
+}
+
 /* FNV-1a over the flat tree (counts, nodes, leaf data, root box): what the kernels read. */
 static uint64_t tree_hash(const KdTree *t)
 {
-    const struct { const void *p; size_t n; } part[] = {
+    const HashPart part[] = {
         { &t->n_nodes, sizeof t->n_nodes },
         { &t->n_leaf_prims, sizeof t->n_leaf_prims },
         { t->nodes, t->n_nodes * sizeof *t->nodes },
@@ -941,13 +1145,20 @@ static uint64_t tree_hash(const KdTree *t)
         { &t->lo, sizeof t->lo },
         { &t->hi, sizeof t->hi },
     };
-    uint64_t h = 0xcbf29ce484222325ull;
-    for (size_t i = 0; i < sizeof part / sizeof part[0]; i++)
-        for (size_t j = 0; j < part[i].n; j++) {
-            h ^= ((const unsigned char *)part[i].p)[j];
-            h *= 0x100000001b3ull;
-        }
-    return h;
+    return fnv_parts(part, sizeof part / sizeof part[0]);
+}
+
+static uint64_t bvh_hash(const Bvh *t)
+{
+    const HashPart part[] = {
+        { &t->n_nodes, sizeof t->n_nodes },
+        { &t->n_leaf_prims, sizeof t->n_leaf_prims },
+        { t->nodes, t->n_nodes * sizeof *t->nodes },
+        { t->leaf_prims, t->n_leaf_prims * sizeof *t->leaf_prims },
+        { &t->lo, sizeof t->lo },
+        { &t->hi, sizeof t->hi },
+    };
+    return fnv_parts(part, sizeof part / sizeof part[0]);
 }
 
 /* A closed bumpy sphere of 12 n^2 triangles: each face of a cube in an n x n grid,
@@ -983,6 +1194,38 @@ static Triangle *cube_sphere(uint n, size_t *count)
     return t;
 }
 
+/* The BVH is the same whatever the number of threads (subtrees of 32768 primitives and
+ * more are built by other threads: the cube sphere has 76800 triangles). */
+static void test_bvh_deterministic(void)
+{
+    size_t nt = 0;
+    Triangle *tri = cube_sphere(80, &nt);
+    CHECK(tri != NULL);
+    if (!tri) return;
+    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0 };
+    Bvh one;
+    Error err = { 0 };
+    CHECK(bvh_build(&in, 1, &one, &err) == ST_OK);
+    const int threads[] = { 2, 3, 0 };
+    for (int i = 0; i < 3; i++) {
+        Bvh t;
+        if (bvh_build(&in, threads[i], &t, &err) != ST_OK) {
+            CHECK_MSG(0, "%s", err.msg);
+            continue;
+        }
+        CHECK_EQ_INT(t.n_nodes, one.n_nodes);
+        CHECK_EQ_INT(t.n_leaf_prims, one.n_leaf_prims);
+        if (t.n_nodes == one.n_nodes) CHECK(!memcmp(t.nodes, one.nodes, one.n_nodes * sizeof *one.nodes));
+        if (t.n_leaf_prims == one.n_leaf_prims)
+            CHECK(!memcmp(t.leaf_prims, one.leaf_prims, one.n_leaf_prims * sizeof(uint)));
+        bvh_free(&t);
+    }
+    fprintf(stderr, "  %zu triangles: %u nodes, %u leaves, the same with 1, 2, 3 and all threads\n", nt, one.n_nodes,
+            one.stats.n_leaves);
+    bvh_free(&one);
+    free(tri);
+}
+
 /* Spheres, triangles of three sizes (a quarter of them flat in z on integer planes, so
  * they lie on candidate split planes) and boxes (a fifth flat in y), each number drawn
  * in a statement of its own: random_scene's draws are function arguments, whose order
@@ -1011,8 +1254,8 @@ static void mixed_scene(void)
     }
 }
 
-/* The trees of two fixed inputs, pinned by hash: a change to the build that changes any
- * node or leaf word (a refactoring should not) shows here. Both inputs are made without
+/* The trees (kd-tree and BVH) of two fixed inputs, pinned by hash: a change to a build
+ * that changes any node or leaf word (a refactoring should not) shows here. Both inputs are made without
  * libm and without draws in function arguments, so they are the same bits with any C
  * compiler. When a change to the SAH or the layout is meant, check the trees (make
  * bench, docs/kdtree.md) and pin the new hashes. */
@@ -1035,6 +1278,14 @@ static void test_pinned_trees(void)
         CHECK_MSG(tree_hash(&t) == 0x8f9182d907c91c8bull, "cube sphere, %d threads: %016llx", threads[i],
                   (unsigned long long)tree_hash(&t));
         kd_free(&t);
+        Bvh b;
+        if (bvh_build(&in, threads[i], &b, &err) != ST_OK) {
+            CHECK_MSG(0, "%s", err.msg);
+            continue;
+        }
+        CHECK_MSG(bvh_hash(&b) == 0x7d48e72b7457c2eaull, "cube sphere BVH, %d threads: %016llx", threads[i],
+                  (unsigned long long)bvh_hash(&b));
+        bvh_free(&b);
     }
     free(tri);
 
@@ -1047,6 +1298,8 @@ static void test_pinned_trees(void)
         CHECK(scene.tree.n_nodes > 100);
         CHECK_MSG(tree_hash(&scene.tree) == 0x9958cac2f43dba5eull, "mixed scene, %d threads: %016llx", threads[i],
                   (unsigned long long)tree_hash(&scene.tree));
+        CHECK_MSG(bvh_hash(&scene.bvh) == 0xbb5be1b51c3c76e3ull, "mixed scene BVH, %d threads: %016llx", threads[i],
+                  (unsigned long long)bvh_hash(&scene.bvh));
     }
 }
 
@@ -1057,6 +1310,9 @@ typedef struct {
     KdTree tree;
     RenderParams params;
     SceneView view;
+    Bvh bvh;
+    RenderParams wide_params;
+    SceneView wide_view;
 } MeshScene;
 
 /* Loads a mesh file (or "sphere:N", the closed procedural sphere) and builds its tree. */
@@ -1074,6 +1330,7 @@ static int mesh_scene_open(MeshScene *m, const char *what)
     }
     KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0, NULL, 0 };
     if (st == ST_OK) st = kd_build(&in, 0, &m->tree, &err);
+    if (st == ST_OK) st = bvh_build(&in, 0, &m->bvh, &err);
     if (st != ST_OK) {
         fprintf(stderr, "  %s: %s\n", what, err.msg);
         return -1;
@@ -1090,12 +1347,22 @@ static int mesh_scene_open(MeshScene *m, const char *what)
     v.leaf_prims = m->tree.leaf_prims;
     v.triangles = m->scene.triangles;
     m->view = v;
+    m->wide_params = m->params;
+    m->wide_params.n_nodes = m->wide_params.n_leaf_prims = 0;
+    m->wide_params.n_bvh_nodes = m->bvh.n_nodes;
+    memset(&v, 0, sizeof v);
+    v.params = &m->wide_params;
+    v.bvh = m->bvh.nodes;
+    v.bvh_leaves = m->bvh.leaf_prims;
+    v.triangles = m->scene.triangles;
+    m->wide_view = v;
     return 0;
 }
 
 static void mesh_scene_close(MeshScene *m)
 {
     kd_free(&m->tree);
+    bvh_free(&m->bvh);
     scene_free(&m->scene);
 }
 
@@ -1147,7 +1414,8 @@ static void check_mesh_brute_force(const char *what, int rays)
                            vrand(-1.0f, 1.0f), frange(0.0f, 0.1f) * r, K_INF);
             break;
         }
-        Hit kd = trace_closest(&m.view, ray);
+        const SceneView *v = walk_bvh ? &m.wide_view : &m.view;
+        Hit kd = trace_closest(v, ray);
         RayPre rp = ray_prepare(ray);
         Hit bf = { ray.tmax, NO_INDEX, 0.0f, 0.0f };
         for (uint id = 0; id < nt; id++) {
@@ -1163,27 +1431,33 @@ static void check_mesh_brute_force(const char *what, int rays)
         if (kd.prim == NO_INDEX || bf.prim == NO_INDEX) ok = kd.prim == bf.prim;
         else if (kd.prim == bf.prim) ok = kd.t == bf.t && kd.u == bf.u && kd.v == bf.v;
         else ok = kd.t == bf.t;   /* two triangles at the same distance (a shared edge) */
-        ok = ok && trace_any(&m.view, ray) == (bf.prim != NO_INDEX);
+        ok = ok && trace_any(v, ray) == (bf.prim != NO_INDEX);
         if (!ok && bad++ < 3)
-            fprintf(stderr, "  %s ray %d: kd %u t=%.9g, brute force %u t=%.9g\n", what, i, kd.prim, kd.t, bf.prim, bf.t);
+            fprintf(stderr, "  %s ray %d: %s %u t=%.9g, brute force %u t=%.9g\n", what, i, walk_bvh ? "BVH" : "kd",
+                    kd.prim, kd.t, bf.prim, bf.t);
         hits += bf.prim != NO_INDEX;
     }
     CHECK_EQ_INT(bad, 0);
     CHECK(hits > rays / 4);
-    fprintf(stderr, "  %s: %u triangles, %d rays (%d hit), %d disagree with brute force\n", what, nt, rays, hits, bad);
+    fprintf(stderr, "  %s, %s: %u triangles, %d rays (%d hit), %d disagree with brute force\n", what,
+            walk_bvh ? "BVH" : "kd-tree", nt, rays, hits, bad);
     mesh_scene_close(&m);
 }
 
 static void test_real_meshes(void)
 {
-    check_mesh_brute_force("tests/data/models/bun_zipper_res4.ply", 20000);
     const char *res3 = "../shared/models/bunny/bun_zipper_res3.ply";
-    if (shared_model_present(res3, "only the small bunny is checked")) check_mesh_brute_force(res3, 8000);
+    int have_res3 = shared_model_present(res3, "only the small bunny is checked");
+    for (walk_bvh = 0; walk_bvh < 2; walk_bvh++) {
+        check_mesh_brute_force("tests/data/models/bun_zipper_res4.ply", 20000);
+        if (have_res3) check_mesh_brute_force(res3, 8000);
+    }
+    walk_bvh = 0;
 }
 
 /* From inside a closed mesh, a million rays aimed exactly at its vertices and at points
  * of its edges: not one may slip out between the triangles. */
-static void test_watertight_mesh(void)
+static void watertight_mesh(void)
 {
     MeshScene m;
     if (mesh_scene_open(&m, "sphere:20000")) {
@@ -1216,7 +1490,8 @@ static void test_watertight_mesh(void)
             else o.z *= 0.2f;
         }
         Ray ray = make_ray(o, v3_sub(target, o), 0.0f, K_INF);
-        Hit h = trace_closest(&m.view, ray);
+        const SceneView *v = walk_bvh ? &m.wide_view : &m.view;
+        Hit h = trace_closest(v, ray);
         if (h.prim == NO_INDEX) {
             if (misses++ < 3) {
                 RayPre rp = ray_prepare(ray);
@@ -1226,13 +1501,22 @@ static void test_watertight_mesh(void)
                         target.y, target.z, bf);
             }
         }
-        any_misses += !trace_any(&m.view, ray);
+        any_misses += !trace_any(v, ray);
     }
     CHECK_EQ_INT(misses, 0);
     CHECK_EQ_INT(any_misses, 0);
-    fprintf(stderr, "  closed sphere of %u triangles: %d rays at vertices and edges from inside, %d misses\n", nt,
-            rays, misses);
+    fprintf(stderr, "  %s, closed sphere of %u triangles: %d rays at vertices and edges from inside, %d misses\n",
+            walk_bvh ? "BVH" : "kd-tree", nt, rays, misses);
     mesh_scene_close(&m);
+}
+
+/* From inside a closed mesh, rays at its vertices and edges: through the kd-tree, then
+ * the BVH (whose boxes are exactly the triangles' bounds: a ray at a vertex grazes
+ * them). */
+static void test_watertight_mesh(void)
+{
+    for (walk_bvh = 0; walk_bvh < 2; walk_bvh++) watertight_mesh();
+    walk_bvh = 0;
 }
 
 int main(void)
@@ -1247,6 +1531,9 @@ int main(void)
     RUN(test_against_brute_force);
     RUN(test_pairs);
     RUN(test_packets);
+    RUN(test_bvh_structure);
+    RUN(test_bvh_degenerate);
+    RUN(test_bvh_deterministic);
     RUN(test_empty_scene);
     RUN(test_bad_primitives);
     RUN(test_flat_on_split_planes);

@@ -701,9 +701,13 @@ static void test_feature_switches_compile_cleanly(void)
         return;
     }
     static const unsigned programs[] = { KF_PATH, KF_WHITTED, KF_PATH_MEGAKERNEL };
-    for (unsigned bit = 0; bit < 18; bit++) {
+    /* each switch alone, and each of the two trees */
+    static const unsigned switches[] = { 1u << 0, 1u << 1, 1u << 2, 1u << 3, 1u << 4, 1u << 5, 1u << 6, 1u << 7,
+                                         1u << 8, 1u << 9, 1u << 10, 1u << 11, 1u << 12, 1u << 13, 1u << 14,
+                                         1u << 15, 1u << 16, 1u << 17, KF_KDTREE, KF_BVH };
+    for (size_t bit = 0; bit < sizeof switches / sizeof switches[0]; bit++) {
         for (size_t k = 0; k < sizeof programs / sizeof programs[0]; k++) {
-            unsigned features = programs[k] | (1u << bit);
+            unsigned features = programs[k] | switches[bit];
             char cmd[300], out[2048];
             snprintf(cmd, sizeof cmd, "clang -x cl -cl-std=CL1.2 -Xclang -finclude-default-header -fsyntax-only "
                      "-Wall -Wextra -Ikernels -DCLPT_FEATURES=0x%xu kernels/entry.cl 2>&1", features);
@@ -715,7 +719,7 @@ static void test_feature_switches_compile_cleanly(void)
             CHECK_MSG(rc == 0 && n == 0, "CLPT_FEATURES=0x%x: %s", features, out);
         }
     }
-    CHECK_EQ_INT(KF_ALL, ((KF_MATERIAL(MAT_PRINCIPLED) << 1) - 1u) | KF_PATH_MEGAKERNEL);
+    CHECK_EQ_INT(KF_ALL, ((KF_MATERIAL(MAT_PRINCIPLED) << 1) - 1u) | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH);
 }
 
 static void test_cache_location(void)

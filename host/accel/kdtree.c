@@ -43,8 +43,6 @@
 #ifndef KD_TASK_MIN_PRIMS
 #define KD_TASK_MIN_PRIMS 2048
 #endif
-/* Primitive indices share a 64-bit event key with the position and the event type. */
-#define KD_MAX_PRIMS ((1u << 30) - 1u)
 #define POOL_CHUNK_BYTES (1u << 20)
 
 typedef uint64_t Event;
@@ -896,6 +894,31 @@ static Aabb box_bounds(const Box *bx)
     return a;
 }
 
+int kd_prim_box(const KdInput *in, uint gid, float lo[3], float hi[3])
+{
+    Aabb a;
+    int finite;
+    size_t n_sph = in->n_spheres, n_tri = in->n_triangles, n_box = in->n_boxes;
+    if (gid < n_sph) {
+        a = sphere_bounds(&in->spheres[gid]);
+        finite = aabb_finite(&a);
+    } else if ((gid -= (uint)n_sph) < n_tri) {
+        a = triangle_bounds(&in->triangles[gid]);
+        finite = triangle_finite(&in->triangles[gid]);
+    } else if ((gid -= (uint)n_tri) < n_box) {
+        a = box_bounds(&in->boxes[gid]);
+        finite = aabb_finite(&a);
+    } else {
+        gid -= (uint)n_box;
+        Box bx = { in->revs[gid].lo, 0u, in->revs[gid].hi, 0u };
+        a = box_bounds(&bx);
+        finite = aabb_finite(&a);
+    }
+    memcpy(lo, a.lo, sizeof a.lo);
+    memcpy(hi, a.hi, sizeof a.hi);
+    return finite;
+}
+
 /* Appends primitive `gid` (triangle `tri`, or NO_INDEX) with bounds a, unless they are
  * not `finite`. */
 static void gather_one(Build *b, uint gid, uint tri, const Aabb *a, int finite)
@@ -921,24 +944,12 @@ static Status gather(Build *b, const KdInput *in, uint *skipped, Error *err)
     b->bounds = malloc((total + 1) * sizeof *b->bounds);
     if (!b->gid || !b->tri || !b->bounds)
         return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu primitives", total);
-    uint gid = 0;
     b->n_prims = 0;
-    for (size_t i = 0; i < in->n_spheres; i++, gid++) {
-        Aabb a = sphere_bounds(&in->spheres[i]);
-        gather_one(b, gid, NO_INDEX, &a, aabb_finite(&a));
-    }
-    for (size_t i = 0; i < in->n_triangles; i++, gid++) {
-        Aabb a = triangle_bounds(&in->triangles[i]);
-        gather_one(b, gid, (uint)i, &a, triangle_finite(&in->triangles[i]));
-    }
-    for (size_t i = 0; i < in->n_boxes; i++, gid++) {
-        Aabb a = box_bounds(&in->boxes[i]);
-        gather_one(b, gid, NO_INDEX, &a, aabb_finite(&a));
-    }
-    for (size_t i = 0; i < in->n_revs; i++, gid++) {
-        Box bx = { in->revs[i].lo, 0u, in->revs[i].hi, 0u };
-        Aabb a = box_bounds(&bx);
-        gather_one(b, gid, NO_INDEX, &a, aabb_finite(&a));
+    uint first_tri = (uint)in->n_spheres, end_tri = first_tri + (uint)in->n_triangles;
+    for (uint gid = 0; gid < (uint)total; gid++) {
+        Aabb a;
+        int finite = kd_prim_box(in, gid, a.lo, a.hi);
+        gather_one(b, gid, gid >= first_tri && gid < end_tri ? gid - first_tri : NO_INDEX, &a, finite);
     }
     *skipped = (uint)(total - b->n_prims);
     b->triangles = in->triangles;
@@ -956,36 +967,31 @@ static int leaf_is_empty(const BNode *n) { return n->axis == KD_LEAF && n->count
 /* A leaf's sorted global ids. */
 static const uint *leaf_ids(const BNode *n) { return n->count == 1 ? &n->id : n->ids; }
 
-/* How many of a leaf's ids are triangles (they come after the spheres, before the
- * boxes, and the ids are sorted: a contiguous run). */
-static void leaf_split_ids(const BNode *n, const KdInput *in, uint *first_tri, uint *n_tri)
+/* How many of a leaf's sorted ids are triangles (they come after the spheres, before
+ * the boxes: a contiguous run), and where they start. */
+static void ids_split(const uint *ids, uint count, const KdInput *in, uint *first_tri, uint *n_tri)
 {
     uint lo = (uint)in->n_spheres, hi = lo + (uint)in->n_triangles;
-    const uint *ids = leaf_ids(n);
     uint a = 0, c = 0;
-    while (a < n->count && ids[a] < lo) a++;
-    while (a + c < n->count && ids[a + c] < hi) c++;
+    while (a < count && ids[a] < lo) a++;
+    while (a + c < count && ids[a + c] < hi) c++;
     *first_tri = a;
     *n_tri = c;
 }
 
-/* Words of a leaf's record in the leaf data (types.h). */
-static size_t leaf_words(const BNode *n, const KdInput *in)
+size_t kd_leaf_record_words(const KdInput *in, const uint *ids, uint count)
 {
     uint first, nt;
-    leaf_split_ids(n, in, &first, &nt);
+    ids_split(ids, count, in, &first, &nt);
     size_t w = (size_t)(nt + KD_GROUP - 1) / KD_GROUP * KD_GROUP_WORDS;
-    uint others = n->count - nt;
+    uint others = count - nt;
     return w + (others ? 1 + others : 0);
 }
 
-/* Writes a leaf's record at out: its triangles in groups (the last one repeated in the
- * unused lanes), then the other ids. */
-static void leaf_write(const BNode *n, const KdInput *in, uint *out)
+uint kd_leaf_record_write(const KdInput *in, const uint *ids, uint count, uint *out)
 {
     uint first, nt;
-    leaf_split_ids(n, in, &first, &nt);
-    const uint *ids = leaf_ids(n);
+    ids_split(ids, count, in, &first, &nt);
     uint base = (uint)in->n_spheres;
     for (uint g = 0; g < nt; g += KD_GROUP, out += KD_GROUP_WORDS) {
         for (uint l = 0; l < KD_GROUP; l++) {
@@ -999,12 +1005,24 @@ static void leaf_write(const BNode *n, const KdInput *in, uint *out)
             }
         }
     }
-    uint others = n->count - nt;
+    uint others = count - nt;
     if (others) {
         *out++ = others;
-        for (uint i = 0; i < n->count; i++)
+        for (uint i = 0; i < count; i++)
             if (i < first || i >= first + nt) *out++ = ids[i];
     }
+    uint ng = (nt + KD_GROUP - 1) / KD_GROUP;
+    return KD_LEAF | (others ? KD_LEAF_OTHERS : 0u) | (ng << 3);
+}
+
+static void leaf_split_ids(const BNode *n, const KdInput *in, uint *first_tri, uint *n_tri)
+{
+    ids_split(leaf_ids(n), n->count, in, first_tri, n_tri);
+}
+
+static size_t leaf_words(const BNode *n, const KdInput *in)
+{
+    return kd_leaf_record_words(in, leaf_ids(n), n->count);
 }
 
 /* Nodes and words of leaf data of the tree below root, to allocate them exactly. */
@@ -1065,7 +1083,7 @@ static void flat_leaf(Flat *f, const FlatItem *it, uint me, double rel)
     f->groups += ng;
     f->t->nodes[me].bits = KD_LEAF | (n->count > nt ? KD_LEAF_OTHERS : 0u) | (ng << 3);
     f->t->nodes[me].data = n->count ? f->words : 0u;
-    if (n->count) leaf_write(n, f->in, f->t->leaf_prims + f->words);
+    if (n->count) kd_leaf_record_write(f->in, leaf_ids(n), n->count, f->t->leaf_prims + f->words);
     f->words += (uint)leaf_words(n, f->in);
 }
 

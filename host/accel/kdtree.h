@@ -36,6 +36,10 @@ static inline double kd_leaf_cost(unsigned n)
     return KD_COST_INTERSECT * KD_GROUP * (double)((n + KD_GROUP - 1u) / KD_GROUP);
 }
 
+/* Most primitives a tree holds: the kd build's primitive indices share a 64-bit event
+ * key with the position and the event type. */
+#define KD_MAX_PRIMS ((1u << 30) - 1u)
+
 typedef struct {
     const Sphere *spheres;     size_t n_spheres;
     const Triangle *triangles; size_t n_triangles;
@@ -72,5 +76,15 @@ void kd_free(KdTree *t);
 /* The primitive ids of leaf `node` (at most cap of them) into out; returns how many
  * (0 for an interior node). */
 uint kd_leaf_ids(const KdTree *t, uint node, uint *out, uint cap);
+
+/* Primitive gid's bounds (global ids, as KdInput orders them); 0 when they are not
+ * finite, which leaves the primitive out of any tree. */
+int kd_prim_box(const KdInput *in, uint gid, float lo[3], float hi[3]);
+
+/* A leaf record in the leaf data (the layout of types.h, shared by the 8-wide BVH of
+ * accel/bvh.h): its size in words for `count` sorted global ids, and writing it at
+ * out, which returns the leaf's KdNode bits (KD_LEAF, KD_LEAF_OTHERS, groups << 3). */
+size_t kd_leaf_record_words(const KdInput *in, const uint *ids, uint count);
+uint kd_leaf_record_write(const KdInput *in, const uint *ids, uint count, uint *out);
 
 #endif /* CLPT_KDTREE_H */

@@ -49,6 +49,7 @@ typedef struct {
     size_t n_texels;
     size_t n_rev_points;        /* floats: two per profile control point */
     size_t n_env_cdf;
+    size_t n_bvh_leaves;        /* words of the BVH's leaf records */
 } DeviceScene;
 #undef DEVICE_SCENE_FIELD_
 #undef DEVICE_SCENE_FIELD_MANY_

@@ -20,7 +20,34 @@ uint render_scene_strata(uint spp)
     return m * m == spp ? m : 1u;
 }
 
-Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *err)
+/* The scene's tree into out and its part of the params (counts, root box). */
+static Status tree_build(const Scene *s, int threads, RenderScene *out, Error *err)
+{
+    KdInput in = { s->spheres, s->n_spheres, s->triangles, s->n_triangles, s->boxes, s->n_boxes,
+                   s->revsurfaces, s->n_revsurfaces };
+    RenderParams *p = &out->ds.params;
+    Status st;
+    if (s->accel == ACCEL_KDTREE) {
+        if ((st = kd_build(&in, threads, &out->kd, err))) return st;
+        p->n_nodes = out->kd.n_nodes;
+        p->n_leaf_prims = out->kd.n_leaf_prims;
+        p->bounds_lo = out->kd.lo;
+        p->bounds_hi = out->kd.hi;
+        out->ds.nodes = out->kd.nodes;
+        out->ds.leaf_prims = out->kd.leaf_prims;
+        return ST_OK;
+    }
+    if ((st = bvh_build(&in, threads, &out->bvh, err))) return st;
+    p->n_bvh_nodes = out->bvh.n_nodes;
+    p->bounds_lo = out->bvh.lo;
+    p->bounds_hi = out->bvh.hi;
+    out->ds.bvh = out->bvh.nodes;
+    out->ds.bvh_leaves = out->bvh.leaf_prims;
+    out->ds.n_bvh_leaves = out->bvh.n_leaf_prims;
+    return ST_OK;
+}
+
+Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error *err)
 {
     memset(out, 0, sizeof *out);
     Status st;
@@ -31,9 +58,7 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     RenderParams *p = &out->ds.params;
     if ((st = camera_setup(&s->camera, s->image.width, s->image.height, &p->camera, err))) return st;
     if ((st = scene_check_precision(s, err))) return st;
-    KdInput in = { s->spheres, s->n_spheres, s->triangles, s->n_triangles, s->boxes, s->n_boxes,
-                   s->revsurfaces, s->n_revsurfaces };
-    if ((st = kd_build(&in, kd_threads, &out->kd, err))) return st;
+    if ((st = tree_build(s, tree_threads, out, err))) return st;
     p->bg_type = s->bg_type;
     p->bg_color = s->bg_color;
     p->bg_zenith = s->bg_zenith;
@@ -54,12 +79,6 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
     p->n_planes = (uint)s->n_planes;
     p->n_revsurfaces = (uint)s->n_revsurfaces;
     p->n_lights = (uint)s->n_lights;
-    p->n_nodes = out->kd.n_nodes;
-    p->n_leaf_prims = out->kd.n_leaf_prims;
-    p->bounds_lo = out->kd.lo;
-    p->bounds_hi = out->kd.hi;
-    out->ds.nodes = out->kd.nodes;
-    out->ds.leaf_prims = out->kd.leaf_prims;
     out->ds.spheres = s->spheres;
     out->ds.triangles = s->triangles;
     out->ds.boxes = s->boxes;
@@ -100,5 +119,6 @@ Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *e
 void render_scene_free(RenderScene *r)
 {
     kd_free(&r->kd);
+    bvh_free(&r->bvh);
     memset(r, 0, sizeof *r);
 }

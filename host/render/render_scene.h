@@ -1,23 +1,26 @@
 /*
  * render_scene.h — a loaded scene made ready for the devices: lights listed, camera
- * prepared, kd-tree built, and everything gathered into the DeviceScene every device
+ * prepared, the tree built (the BVH or the kd-tree), and everything gathered into the DeviceScene every device
  * uploads. Used by main and by the tests, so both render the same way.
  */
 #ifndef CLPT_RENDER_SCENE_H
 #define CLPT_RENDER_SCENE_H
 
 #include "device/device.h"
+#include "accel/bvh.h"
 #include "accel/kdtree.h"
 #include "scene/scene.h"
 
 typedef struct {
-    KdTree kd;
-    DeviceScene ds;       /* points into the Scene and the kd-tree: keep both alive */
+    KdTree kd;            /* the scene's tree (Scene.accel): one of these two, */
+    Bvh bvh;              /* the other one empty */
+    DeviceScene ds;       /* points into the Scene and the tree: keep both alive */
 } RenderScene;
 
-/* The scene's image settings (size, depth, seed) are taken as they are now, so apply
- * command-line overrides first. kd_threads: 0 = every core. */
-Status render_scene_prepare(Scene *s, int kd_threads, RenderScene *out, Error *err);
+/* The scene's image settings (size, depth, seed) and its tree are taken as they are
+ * now, so apply command-line overrides first. tree_threads (the build's): 0 = every
+ * core. */
+Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error *err);
 void render_scene_free(RenderScene *r);
 
 /* How the whitted integrator places spp samples in a pixel (RenderParams.strata): 1 is

@@ -25,6 +25,11 @@ typedef struct {
                           * as pbrt's LookAt makes (docs/pbrt.md) */
 } SceneCamera;
 
+/* The tree the kernels find primitives through (host/accel): the 8-wide BVH by default
+ * (faster on every bench mesh: bench/RESULTS.md), or the kd-tree. Images differ only
+ * where two primitives are hit at exactly the same distance. */
+enum SceneAccel { ACCEL_BVH = 0, ACCEL_KDTREE = 1 };
+
 typedef struct {
     uint width, height;
     uint spp;            /* samples per pixel */
@@ -80,6 +85,7 @@ typedef struct {
     uint normal_miss_grey;       /* the normal image's misses grey, not black (classic) */
     int shadows;                 /* lights can be occluded: 1 for clpt's format and meshes,
                                   * 0 for classic scenes; --shadows overrides it */
+    uint accel;                  /* enum SceneAccel: the tree the rays walk (--accel) */
 
     /* Lookups by name, so that a scene or MTL with many materials reads in linear time:
      * material name -> first material of that name, texture name -> first texture of

@@ -4,7 +4,7 @@
  * The BVH (host/accel/bvh.c, BvhNode in types.h) is the other tree of docs/kdtree.md:
  * one ray tests all eight child boxes of a node at once, one float8 operation per slab
  * (the shape of Embree's single-ray BVH8 walk), goes on into the nearest child hit and
- * keeps the others on a stack with their entry distances, nearest on top. Leaves hold
+ * keeps the others on a stack with their entry distances. Leaves hold
  * the kd-tree's leaf records and are tested by the same code (leaf_test, leaf.h), so a hit
  * has the very t, u and v the kd-tree walk finds for that primitive.
  *
@@ -136,30 +136,28 @@ KFN_INLINE void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int a
                     kind = nd->kind[l0];
                     continue;
                 }
-                /* the children hit in order of entry, nearest first (the first lane of
-                 * equals), the others pushed farthest first */
-                float kt[BVH_WIDTH];
-                uint kl[BVH_WIDTH];
-                uint n = 0u;
+                /* Several children: go on into the nearest (a closest-hit query; the
+                 * first lane of equals) or the first (an any-hit query, for which
+                 * any order will do), push the others with their entry distances.
+                 * Sorting the pushed ones nearest-on-top was measured slower: the
+                 * entries that start beyond the closest hit are skipped on the pop
+                 * anyway (docs/bvh.md). */
+                uint next = l0;
+                if (!any)
+                    for (uint m = mask & (mask - 1u); m != 0u; m &= m - 1u) {
+                        uint l = k_lowest_bit(m);
+                        if (ta[l] < ta[next]) next = l;
+                    }
                 for (uint m = mask; m != 0u; m &= m - 1u) {
                     uint l = k_lowest_bit(m);
-                    float t = ta[l];
-                    uint j = n++;
-                    while (j > 0u && kt[j - 1u] > t) {
-                        kt[j] = kt[j - 1u];
-                        kl[j] = kl[j - 1u];
-                        j--;
-                    }
-                    kt[j] = t;
-                    kl[j] = l;
+                    if (l == next) continue;
+                    st_ref[sp] = nd->ref[l];
+                    st_kind[sp] = nd->kind[l];
+                    st_t[sp] = ta[l];
+                    sp++;
                 }
-                for (uint j = n - 1u; j > 0u; j--, sp++) {
-                    st_ref[sp] = nd->ref[kl[j]];
-                    st_kind[sp] = nd->kind[kl[j]];
-                    st_t[sp] = kt[j];
-                }
-                ref = nd->ref[kl[0]];
-                kind = nd->kind[kl[0]];
+                ref = nd->ref[next];
+                kind = nd->kind[next];
                 continue;
             }
         } else {

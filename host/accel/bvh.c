@@ -33,10 +33,12 @@
 #define BVH_MAX_LEAF 32u       /* a larger set is split whatever the SAH says */
 /* Subtrees of at least this many primitives may be built by another thread. */
 #define BVH_TASK_MIN 32768u
-/* SAH costs (relative): a binary node's share of a wide node's visit, and the test of
- * one group of eight triangles. */
+/* SAH costs (relative): a binary node's share of a wide node's visit, the test of one
+ * group of eight triangles, and that of one other primitive (a sphere, box or surface
+ * of revolution, tested alone). */
 #define BVH_COST_NODE 1.0
 #define BVH_COST_GROUP 0.4
+#define BVH_COST_OTHER 0.2
 
 typedef struct { float lo[3], hi[3]; } Box3;
 
@@ -55,6 +57,7 @@ typedef struct {
     Box3 *box;                 /* per primitive: its bounds */
     float (*cen)[3];           /* per primitive: its bounds' centre */
     uint *idx;                 /* the primitives in tree order */
+    uint first_tri, n_tri;     /* the triangles' global ids */
     BinNode *nodes;            /* room for every node: a binary tree of n leaves has 2n - 1 */
     atomic_uint n_nodes;
     atomic_int spare_threads;  /* threads that may still be started */
@@ -81,7 +84,21 @@ static double box3_half_area(const Box3 *b)
     return dx * dy + dy * dz + dz * dx;
 }
 
+/* Primitives of a set: triangles (tested in groups of eight) and the others. */
+typedef struct { uint tri, other; } Count;
+
 static double groups_of(uint n) { return (double)((n + 7u) / 8u); }
+
+/* What testing a leaf of these primitives costs. */
+static double leaf_tests(Count c) { return BVH_COST_GROUP * groups_of(c.tri) + BVH_COST_OTHER * c.other; }
+
+static int is_tri(const Build *b, uint p) { return b->gid[p] - b->first_tri < b->n_tri; }
+
+static void count_add(Count *c, Count a)
+{
+    c->tri += a.tri;
+    c->other += a.other;
+}
 
 static uint node_new(Build *b) { return atomic_fetch_add(&b->n_nodes, 1u); }
 
@@ -106,33 +123,36 @@ static BinSplit best_split(const Build *b, uint first, uint n, const Box3 *cb)
         if (!(ext > 0.0f)) continue;
         float scale = (float)BVH_BINS / ext;
         Box3 bin_box[BVH_BINS];
-        uint bin_n[BVH_BINS] = { 0 };
+        Count bin_n[BVH_BINS];
+        memset(bin_n, 0, sizeof bin_n);
         for (int i = 0; i < BVH_BINS; i++) bin_box[i] = box3_empty();
         for (uint i = first; i < first + n; i++) {
             uint p = b->idx[i];
             int bi = (int)((b->cen[p][k] - cb->lo[k]) * scale);
             bi = bi < 0 ? 0 : (bi >= BVH_BINS ? BVH_BINS - 1 : bi);
-            bin_n[bi]++;
+            if (is_tri(b, p)) bin_n[bi].tri++;
+            else bin_n[bi].other++;
             box3_grow(&bin_box[bi], &b->box[p]);
         }
         /* areas and counts to the right of each boundary, then a sweep from the left */
         double right_area[BVH_BINS];
-        uint right_n[BVH_BINS];
+        Count right_n[BVH_BINS];
         Box3 acc = box3_empty();
-        uint cnt = 0;
+        Count cnt = { 0, 0 };
         for (int i = BVH_BINS - 1; i > 0; i--) {
             box3_grow(&acc, &bin_box[i]);
-            cnt += bin_n[i];
+            count_add(&cnt, bin_n[i]);
             right_area[i] = box3_half_area(&acc);
             right_n[i] = cnt;
         }
         acc = box3_empty();
-        cnt = 0;
+        cnt = (Count){ 0, 0 };
         for (int i = 0; i < BVH_BINS - 1; i++) {
             box3_grow(&acc, &bin_box[i]);
-            cnt += bin_n[i];
-            if (cnt == 0 || right_n[i + 1] == 0) continue;
-            double c = box3_half_area(&acc) * groups_of(cnt) + right_area[i + 1] * groups_of(right_n[i + 1]);
+            count_add(&cnt, bin_n[i]);
+            Count r = right_n[i + 1];
+            if (cnt.tri + cnt.other == 0 || r.tri + r.other == 0) continue;
+            double c = box3_half_area(&acc) * leaf_tests(cnt) + right_area[i + 1] * leaf_tests(r);
             if (c < best.cost) {
                 best.cost = c;
                 best.axis = k;
@@ -167,8 +187,11 @@ static uint build_node(Build *b, uint first, uint n, int depth)
 {
     uint me = node_new(b);
     Box3 box = box3_empty(), cb = box3_empty();
+    Count count = { 0, 0 };
     for (uint i = first; i < first + n; i++) {
         uint p = b->idx[i];
+        if (is_tri(b, p)) count.tri++;
+        else count.other++;
         box3_grow(&box, &b->box[p]);
         Box3 c = { { b->cen[p][0], b->cen[p][1], b->cen[p][2] }, { b->cen[p][0], b->cen[p][1], b->cen[p][2] } };
         box3_grow(&cb, &c);
@@ -177,8 +200,8 @@ static uint build_node(Build *b, uint first, uint n, int depth)
     double area = box3_half_area(&box);
     BinSplit s = n > 1 && depth < BVH_MAX_DEPTH ? best_split(b, first, n, &cb)
                                                 : (BinSplit){ -1, 0, INFINITY };
-    double leaf_cost = BVH_COST_GROUP * groups_of(n) * area;
-    double split_cost = BVH_COST_NODE * area + BVH_COST_GROUP * s.cost;
+    double leaf_cost = leaf_tests(count) * area;
+    double split_cost = BVH_COST_NODE * area + s.cost;
     if (s.axis < 0 || (n <= BVH_MAX_LEAF && leaf_cost <= split_cost)) {
         b->nodes[me].first = first;
         b->nodes[me].count = n;
@@ -236,7 +259,12 @@ static void tree_stats(const Build *b, uint root, BvhStats *st)
         double area = box3_half_area(&c->box);
         if (c->count > 0 || c->child[0] == NO_INDEX) {
             st->n_leaves++;
-            sah += BVH_COST_GROUP * groups_of(c->count) * area;
+            Count cnt = { 0, 0 };
+            for (uint i = c->first; i < c->first + c->count; i++) {
+                if (is_tri(b, b->idx[i])) cnt.tri++;
+                else cnt.other++;
+            }
+            sah += leaf_tests(cnt) * area;
             if (d > st->max_binary_depth) st->max_binary_depth = d;
             continue;
         }
@@ -435,6 +463,8 @@ Status bvh_build(const KdInput *in, int threads, Bvh *out, Error *err)
     Build b;
     memset(&b, 0, sizeof b);
     b.in = in;
+    b.first_tri = (uint)in->n_spheres;
+    b.n_tri = (uint)in->n_triangles;
     atomic_init(&b.n_nodes, 0u);
     atomic_init(&b.spare_threads, threads - 1);
     Status st = gather(&b, total, err);

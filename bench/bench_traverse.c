@@ -52,6 +52,7 @@
 #include "device/device.h"
 #include "io/mesh_load.h"
 #include "device/ocl_program.h"
+#include "render/render_scene.h"
 #include "rng.h"
 #include "sampling.h"
 #include "surface.h"
@@ -129,20 +130,11 @@ static int mesh_open(Mesh *m, const char *name, Error *err)
     m->kd_build_1 = one.stats.build_seconds;
     kd_free(&one);
     if (kd_build(&in, 2, &m->tree, err)) return -1;
-    RenderParams *p = &m->ds.params;
-    p->n_triangles = (uint)m->scene.n_triangles;
-    p->n_nodes = m->tree.n_nodes;
-    p->n_leaf_prims = m->tree.n_leaf_prims;
-    p->bounds_lo = m->tree.lo;
-    p->bounds_hi = m->tree.hi;
-    m->ds.nodes = m->tree.nodes;
-    m->ds.leaf_prims = m->tree.leaf_prims;
-    m->ds.triangles = m->scene.triangles;
     if (bvh_build(&in, 2, &m->bvh, err)) return -1;
-    p->n_bvh_nodes = m->bvh.n_nodes;
-    m->ds.bvh = m->bvh.nodes;
-    m->ds.bvh_leaves = m->bvh.leaf_prims;
-    m->ds.n_bvh_leaves = m->bvh.n_leaf_prims;
+    m->ds.params.n_triangles = (uint)m->scene.n_triangles;
+    m->ds.triangles = m->scene.triangles;
+    render_scene_use_kdtree(&m->ds, &m->tree);
+    render_scene_use_bvh(&m->ds, &m->bvh);
     device_scene_view(&m->ds, &m->view);
     return 0;
 }

@@ -312,22 +312,28 @@ __kernel void k_trace_any(SCENE_ARGS __global const Ray *rays, uint n, __global 
     }
 }
 
-/* Closest hit of rays[i], one ray per work-item (trace_closest, as k_intersect). */
-__kernel void k_trace_closest1(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
+/* The closest hit of rays[i] (any == 0) or whether it hits anything (any == 1), one ray
+ * per work-item through the given tree (trace_closest as k_intersect, trace_any as
+ * k_shadow). */
+KFN_INLINE void trace_one_item(const SceneView *sc, __global const Ray *rays, uint n, int tree, int any,
+                               __global Hit *hits, __global uint *occluded)
 {
     uint i = (uint)get_global_id(0);
     if (i >= n) return;
-    SCENE_VIEW(sc);
-    hits[i] = trace_closest_in(&sc, TREE_KD, rays[i]);
+    if (any) occluded[i] = (uint)trace_any_in(sc, tree, rays[i]);
+    else hits[i] = trace_closest_in(sc, tree, rays[i]);
 }
 
-/* Whether rays[i] hits anything, one ray per work-item (trace_any, as k_shadow). */
+__kernel void k_trace_closest1(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
+{
+    SCENE_VIEW(sc);
+    trace_one_item(&sc, rays, n, TREE_KD, 0, hits, 0);
+}
+
 __kernel void k_trace_any1(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
 {
-    uint i = (uint)get_global_id(0);
-    if (i >= n) return;
     SCENE_VIEW(sc);
-    occluded[i] = (uint)trace_any_in(&sc, TREE_KD, rays[i]);
+    trace_one_item(&sc, rays, n, TREE_KD, 1, 0, occluded);
 }
 /* Closest hits (any == 0) or occlusion (any == 1: 1 or 0 in hits[i].prim's place, as
  * occluded[]) of rays[8i .. 8i+7], walked as one packet (trace_packet). */
@@ -362,21 +368,16 @@ __kernel void k_trace_any8(SCENE_ARGS __global const Ray *rays, uint n, __global
     trace_packet_item(&sc, rays, n, 1, 0, occluded);
 }
 
-/* Closest hit of rays[i] through the 8-wide BVH, one ray per work-item. */
+/* The same through the 8-wide BVH. */
 __kernel void k_trace_closest_wide(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
 {
-    uint i = (uint)get_global_id(0);
-    if (i >= n) return;
     SCENE_VIEW(sc);
-    hits[i] = trace_closest_in(&sc, TREE_BVH, rays[i]);
+    trace_one_item(&sc, rays, n, TREE_BVH, 0, hits, 0);
 }
 
-/* Whether rays[i] hits anything, through the 8-wide BVH. */
 __kernel void k_trace_any_wide(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
 {
-    uint i = (uint)get_global_id(0);
-    if (i >= n) return;
     SCENE_VIEW(sc);
-    occluded[i] = (uint)trace_any_in(&sc, TREE_BVH, rays[i]);
+    trace_one_item(&sc, rays, n, TREE_BVH, 1, 0, occluded);
 }
 #endif /* CLPT_BENCH_KERNELS */

@@ -1134,32 +1134,16 @@ static uint64_t fnv_parts(const HashPart *part, size_t n)
     return h;
 }
 
-/* FNV-1a over the flat tree (counts, nodes, leaf data, root box): what the kernels read. */
-static uint64_t tree_hash(const KdTree *t)
-{
-    const HashPart part[] = {
-        { &t->n_nodes, sizeof t->n_nodes },
-        { &t->n_leaf_prims, sizeof t->n_leaf_prims },
-        { t->nodes, t->n_nodes * sizeof *t->nodes },
-        { t->leaf_prims, t->n_leaf_prims * sizeof *t->leaf_prims },
-        { &t->lo, sizeof t->lo },
-        { &t->hi, sizeof t->hi },
-    };
-    return fnv_parts(part, sizeof part / sizeof part[0]);
-}
-
-static uint64_t bvh_hash(const Bvh *t)
-{
-    const HashPart part[] = {
-        { &t->n_nodes, sizeof t->n_nodes },
-        { &t->n_leaf_prims, sizeof t->n_leaf_prims },
-        { t->nodes, t->n_nodes * sizeof *t->nodes },
-        { t->leaf_prims, t->n_leaf_prims * sizeof *t->leaf_prims },
-        { &t->lo, sizeof t->lo },
-        { &t->hi, sizeof t->hi },
-    };
-    return fnv_parts(part, sizeof part / sizeof part[0]);
-}
+/* FNV-1a over a flat tree (counts, nodes, leaf data, root box): what the kernels read.
+ * Both trees (KdTree, Bvh) have these fields. */
+#define TREE_HASH(t)                                                                     \
+    fnv_parts((const HashPart[]){ { &(t)->n_nodes, sizeof (t)->n_nodes },                \
+                                  { &(t)->n_leaf_prims, sizeof (t)->n_leaf_prims },      \
+                                  { (t)->nodes, (t)->n_nodes * sizeof *(t)->nodes },     \
+                                  { (t)->leaf_prims, (t)->n_leaf_prims * sizeof(uint) }, \
+                                  { &(t)->lo, sizeof (t)->lo },                          \
+                                  { &(t)->hi, sizeof (t)->hi } },                        \
+              6)
 
 /* A closed bumpy sphere of 12 n^2 triangles: each face of a cube in an n x n grid,
  * pushed onto the sphere. Only + - * / and sqrtf (exact in IEEE arithmetic), so the
@@ -1275,16 +1259,16 @@ static void test_pinned_trees(void)
             continue;
         }
         CHECK(t.n_nodes > 1000);
-        CHECK_MSG(tree_hash(&t) == 0x8f9182d907c91c8bull, "cube sphere, %d threads: %016llx", threads[i],
-                  (unsigned long long)tree_hash(&t));
+        CHECK_MSG(TREE_HASH(&t) == 0x8f9182d907c91c8bull, "cube sphere, %d threads: %016llx", threads[i],
+                  (unsigned long long)TREE_HASH(&t));
         kd_free(&t);
         Bvh b;
         if (bvh_build(&in, threads[i], &b, &err) != ST_OK) {
             CHECK_MSG(0, "%s", err.msg);
             continue;
         }
-        CHECK_MSG(bvh_hash(&b) == 0x7d48e72b7457c2eaull, "cube sphere BVH, %d threads: %016llx", threads[i],
-                  (unsigned long long)bvh_hash(&b));
+        CHECK_MSG(TREE_HASH(&b) == 0x7d48e72b7457c2eaull, "cube sphere BVH, %d threads: %016llx", threads[i],
+                  (unsigned long long)TREE_HASH(&b));
         bvh_free(&b);
     }
     free(tri);
@@ -1296,10 +1280,10 @@ static void test_pinned_trees(void)
             continue;
         }
         CHECK(scene.tree.n_nodes > 100);
-        CHECK_MSG(tree_hash(&scene.tree) == 0x9958cac2f43dba5eull, "mixed scene, %d threads: %016llx", threads[i],
-                  (unsigned long long)tree_hash(&scene.tree));
-        CHECK_MSG(bvh_hash(&scene.bvh) == 0x62e589a58d787c2dull, "mixed scene BVH, %d threads: %016llx", threads[i],
-                  (unsigned long long)bvh_hash(&scene.bvh));
+        CHECK_MSG(TREE_HASH(&scene.tree) == 0x9958cac2f43dba5eull, "mixed scene, %d threads: %016llx", threads[i],
+                  (unsigned long long)TREE_HASH(&scene.tree));
+        CHECK_MSG(TREE_HASH(&scene.bvh) == 0x62e589a58d787c2dull, "mixed scene BVH, %d threads: %016llx", threads[i],
+                  (unsigned long long)TREE_HASH(&scene.bvh));
     }
 }
 

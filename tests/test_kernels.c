@@ -239,12 +239,7 @@ static void build_scene(void)
                    scene.revsurfaces, scene.n_revsurfaces };
     if (!st) st = kd_build(&in, 1, &kd, &err);
     if (st) fprintf(stderr, "scene setup failed: %s\n", err.msg);
-    rs.ds.params.n_nodes = kd.n_nodes;
-    rs.ds.params.n_leaf_prims = kd.n_leaf_prims;
-    rs.ds.params.bounds_lo = kd.lo;
-    rs.ds.params.bounds_hi = kd.hi;
-    rs.ds.nodes = kd.nodes;
-    rs.ds.leaf_prims = kd.leaf_prims;
+    render_scene_use_kdtree(&rs.ds, &kd);
     device_scene_view(&rs.ds, &view);
 }
 

@@ -20,30 +20,41 @@ uint render_scene_strata(uint spp)
     return m * m == spp ? m : 1u;
 }
 
-/* The scene's tree into out and its part of the params (counts, root box). */
+void render_scene_use_kdtree(DeviceScene *ds, const KdTree *kd)
+{
+    ds->params.n_nodes = kd->n_nodes;
+    ds->params.n_leaf_prims = kd->n_leaf_prims;
+    ds->params.bounds_lo = kd->lo;
+    ds->params.bounds_hi = kd->hi;
+    ds->nodes = kd->nodes;
+    ds->leaf_prims = kd->leaf_prims;
+}
+
+void render_scene_use_bvh(DeviceScene *ds, const Bvh *bvh)
+{
+    ds->params.n_bvh_nodes = bvh->n_nodes;
+    if (ds->params.n_nodes == 0) {
+        ds->params.bounds_lo = bvh->lo;
+        ds->params.bounds_hi = bvh->hi;
+    }
+    ds->bvh = bvh->nodes;
+    ds->bvh_leaves = bvh->leaf_prims;
+    ds->n_bvh_leaves = bvh->n_leaf_prims;
+}
+
+/* The scene's tree into out, and out->ds pointed at it. */
 static Status tree_build(const Scene *s, int threads, RenderScene *out, Error *err)
 {
     KdInput in = { s->spheres, s->n_spheres, s->triangles, s->n_triangles, s->boxes, s->n_boxes,
                    s->revsurfaces, s->n_revsurfaces };
-    RenderParams *p = &out->ds.params;
     Status st;
     if (s->accel == ACCEL_KDTREE) {
         if ((st = kd_build(&in, threads, &out->kd, err))) return st;
-        p->n_nodes = out->kd.n_nodes;
-        p->n_leaf_prims = out->kd.n_leaf_prims;
-        p->bounds_lo = out->kd.lo;
-        p->bounds_hi = out->kd.hi;
-        out->ds.nodes = out->kd.nodes;
-        out->ds.leaf_prims = out->kd.leaf_prims;
+        render_scene_use_kdtree(&out->ds, &out->kd);
         return ST_OK;
     }
     if ((st = bvh_build(&in, threads, &out->bvh, err))) return st;
-    p->n_bvh_nodes = out->bvh.n_nodes;
-    p->bounds_lo = out->bvh.lo;
-    p->bounds_hi = out->bvh.hi;
-    out->ds.bvh = out->bvh.nodes;
-    out->ds.bvh_leaves = out->bvh.leaf_prims;
-    out->ds.n_bvh_leaves = out->bvh.n_leaf_prims;
+    render_scene_use_bvh(&out->ds, &out->bvh);
     return ST_OK;
 }
 

@@ -23,6 +23,12 @@ typedef struct {
 Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error *err);
 void render_scene_free(RenderScene *r);
 
+/* Points ds at a built tree: its buffers, counts and root box. A DeviceScene may hold
+ * both (the benchmark and tests that compare the walks); the kd-tree's box then stays,
+ * since its walk clips rays to it. */
+void render_scene_use_kdtree(DeviceScene *ds, const KdTree *kd);
+void render_scene_use_bvh(DeviceScene *ds, const Bvh *bvh);
+
 /* How the whitted integrator places spp samples in a pixel (RenderParams.strata): 1 is
  * the pixel centre (0), a square number an m x m jittered grid (m), any other number
  * uniform jitter (1). */

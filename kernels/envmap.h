@@ -65,6 +65,17 @@ KFN vec3 env_radiance(const SceneView *sc, vec3 d)
     return v3_mul(texel_fetch(sc, tx, x, y), p->bg_color);
 }
 
+/* The solid-angle density with which env_sample picks a direction in pixel (x, y) of
+ * the map, sin_t its sin(theta) (env_pixel). */
+KFN float env_pixel_pdf(const SceneView *sc, Texture tx, uint x, uint y, float sin_t)
+{
+    if (!(sin_t > 0.0f)) return 0.0f;
+    GLOBAL const float *marg = sc->env_cdf;
+    GLOBAL const float *cond = marg + tx.height + 1u + y * (tx.width + 1u);
+    float p_uv = (marg[y + 1u] - marg[y]) * (float)tx.height * ((cond[x + 1u] - cond[x]) * (float)tx.width);
+    return p_uv / (2.0f * K_PI * K_PI * sin_t);
+}
+
 /* The solid-angle density with which env_sample picks direction d (any length). */
 KFN float env_pdf(const SceneView *sc, vec3 d)
 {
@@ -73,11 +84,20 @@ KFN float env_pdf(const SceneView *sc, vec3 d)
     uint x, y;
     float sin_t;
     env_pixel(p, tx, d, &x, &y, &sin_t);
-    if (!(sin_t > 0.0f)) return 0.0f;
-    GLOBAL const float *marg = sc->env_cdf;
-    GLOBAL const float *cond = marg + tx.height + 1u + y * (tx.width + 1u);
-    float p_uv = (marg[y + 1u] - marg[y]) * (float)tx.height * ((cond[x + 1u] - cond[x]) * (float)tx.width);
-    return p_uv / (2.0f * K_PI * K_PI * sin_t);
+    return env_pixel_pdf(sc, tx, x, y, sin_t);
+}
+
+/* env_radiance and env_pdf of one direction, its pixel found once (two atan2 fewer):
+ * the same values, bit for bit. */
+KFN vec3 env_radiance_pdf(const SceneView *sc, vec3 d, float *pdf)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    Texture tx = sc->textures[p->bg_cubemap];
+    uint x, y;
+    float sin_t;
+    env_pixel(p, tx, d, &x, &y, &sin_t);
+    *pdf = env_pixel_pdf(sc, tx, x, y, sin_t);
+    return v3_mul(texel_fetch(sc, tx, x, y), p->bg_color);
 }
 
 /* The cell i in [0, n) of cdf[0..n] (cdf[0] = 0, cdf[n] = 1) holding u in [0, 1): the

@@ -240,8 +240,9 @@ KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, float u_pi
     if (KF_HAS(KF_ENV_MAP) && l.type == LIGHT_ENV) {
         /* the environment map: a direction from its distribution, infinitely far */
         ls->wi = env_sample_dir(sc, u1, u2);
-        ls->Le = env_radiance(sc, ls->wi);
-        ls->pdf = choice * env_pdf(sc, ls->wi);
+        float pdf;
+        ls->Le = env_radiance_pdf(sc, ls->wi, &pdf);
+        ls->pdf = choice * pdf;
         ls->p = ref;
         ls->n = v3s(0.0f);
         ls->dist = k_as_float(0x7f800000u);

@@ -86,11 +86,20 @@ KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathSt
          * MIS, as emission below; other backgrounds are no light that next-event
          * estimation samples, so what BSDF sampling finds of them counts fully */
         float w = 1.0f;
+        vec3 Le;
         if (!(ps->flags & PATH_SPECULAR) && KF_HAS(KF_ENV_MAP) && p->bg_type == BG_MAP &&
-            p->bg_light != NO_INDEX)
-            w = p->mis_mode == MIS_BOTH ? mis_power(ps->bsdf_pdf, light_pdf_env(sc, r.d))
+            p->bg_light != NO_INDEX) {
+            /* the map's radiance and its light-sampling density from one lookup of
+             * the direction's pixel (light_pdf_env's value) */
+            float env_pdf_d;
+            Le = env_radiance_pdf(sc, r.d, &env_pdf_d);
+            float light_pdf = sc->lights[p->bg_light].pick_pdf * env_pdf_d;
+            w = p->mis_mode == MIS_BOTH ? mis_power(ps->bsdf_pdf, light_pdf)
                                         : (p->mis_mode == MIS_BSDF_ONLY ? 1.0f : 0.0f);
-        ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, background_radiance(sc, r.d)), w));
+        } else {
+            Le = background_radiance(sc, r.d);
+        }
+        ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, Le), w));
         return 0u;
     }
 

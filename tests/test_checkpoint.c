@@ -441,7 +441,12 @@ static void test_other_renders_are_refused(void)
     cli_run(ARGS(SCENE, "-q", "--device", "scalar", SIZE, "--spp", SPP_TEXT, "--sampler", "independent", "-o",
                  path_out, "--resume", path_ck), &r);
     CHECK_EQ_INT(r.status, 3);
-    CHECK_STR_CONTAINS(r.err, "sampler or shadows setting");
+    CHECK_STR_CONTAINS(r.err, "sampler, shadows or --accel setting");
+    /* ... or the other tree: hits tied at one distance may go to another primitive */
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", SIZE, "--spp", SPP_TEXT, "--accel", "kdtree", "-o", path_out,
+                 "--resume", path_ck), &r);
+    CHECK_EQ_INT(r.status, 3);
+    CHECK_STR_CONTAINS(r.err, "sampler, shadows or --accel setting");
     /* not a checkpoint at all, and no file */
     cli_run(ARGS(SCENE, "-q", "--device", "scalar", SIZE, "--spp", SPP_TEXT, "-o", path_out, "--resume", path_ref), &r);
     CHECK_EQ_INT(r.status, 3);

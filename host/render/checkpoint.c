@@ -304,7 +304,7 @@ int checkpoint_id_differs(const CheckpointId *g, const CheckpointId *e, const ch
         snprintf(what, size, "its maximum depth is %u, %s's %u", g->max_depth, other, e->max_depth);
     else if (memcmp(g->key, e->key, CHECKPOINT_KEY_SIZE) != 0)
         snprintf(what, size, "the scene differs (geometry, materials, camera or lights, or the "
-                             "sampler or shadows setting), or it was made by a clpt with other kernels");
+                             "sampler, shadows or --accel setting), or it was made by a clpt with other kernels");
     else
         return 0;
     return 1;

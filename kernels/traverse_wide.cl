@@ -21,9 +21,6 @@
 
 #include "leaf.h"
 
-/* Entries of the walk's stack: the builder keeps every path's sum of (children - 1)
- * within it (BVH_STACK_MAX in host/accel/bvh.c). */
-#define BVH_STACK 128
 #define BVH_TINY 1e-30f
 
 /* The slab test of a node's child boxes in lanes [first, first + W) (vectors VT of W

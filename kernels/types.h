@@ -102,6 +102,9 @@ typedef struct {
  * which is never 0 or 1) with ref the offset of its record in the leaf data, which
  * has the kd-tree's leaf layout (above). Node 0 is the root. */
 #define BVH_WIDTH 8u
+/* Entries of the walk's stack: the build keeps every path's sum of (children - 1), what
+ * a walk leaves on the stack above a node, within it (host/accel/bvh.c). */
+#define BVH_STACK 128u
 #define BVH_CHILD_NONE 0u
 #define BVH_CHILD_NODE 1u
 typedef struct {                                        /* 256 bytes */

@@ -796,7 +796,7 @@ static void check_bvh(void)
     CHECK_EQ_INT(t->stats.n_leaves, leaves);
     CHECK_EQ_INT(t->stats.max_depth, max_depth);
     CHECK_EQ_INT(t->stats.n_skipped, n_prims - finite);
-    CHECK(t->stats.max_stack <= 128);
+    CHECK(t->stats.max_stack <= BVH_STACK);
     free(seen);
     free(ids);
 }
@@ -845,9 +845,9 @@ static void test_bvh_degenerate(void)
         add_triangle(v3(x, 0.0f, 0.0f), v3(x, 1.0f, 0.0f), v3(x, 0.0f, 1.0f));
     CHECK(scene_build(0) == ST_OK);
     check_bvh();
-    /* deep enough that nodes near the bottom had to turn binary (past 128 - 40 - 7
-     * entries, bvh.c), and still within the walk's 128 */
-    CHECK(scene.bvh.stats.max_stack > 81 && scene.bvh.stats.max_stack <= 128);
+    /* deep enough that nodes near the bottom had to turn binary (past BVH_STACK - 40 - 7
+     * entries, bvh.c), and still within the walk's stack */
+    CHECK(scene.bvh.stats.max_stack > BVH_STACK - 40 - 7 && scene.bvh.stats.max_stack <= BVH_STACK);
     rng_seed(23);
     int bad = 0;
     for (int i = 0; i < 5000; i++) {

@@ -25,11 +25,10 @@
 
 #define BVH_BINS 32
 #define BVH_MAX_DEPTH 40       /* binary levels; a node this deep becomes a leaf */
-/* The walk's stack (BVH_STACK in traverse_wide.cl) holds the children a path leaves
- * behind: at most the sum of (children - 1) over the wide nodes above a leaf. Once that
- * sum nears the stack's size, nodes below take two children (one more entry per binary
- * level, of which there are at most BVH_MAX_DEPTH), so no tree can overflow it. */
-#define BVH_STACK_MAX 128u
+/* The walk's stack (BVH_STACK, types.h) holds the children a path leaves behind: at
+ * most the sum of (children - 1) over the wide nodes above a leaf. Once that sum nears
+ * the stack's size, nodes below take two children (one more entry per binary level, of
+ * which there are at most BVH_MAX_DEPTH), so no tree can overflow it. */
 #define BVH_MAX_LEAF 32u       /* a larger set is split whatever the SAH says */
 /* Subtrees of at least this many primitives may be built by another thread. */
 #define BVH_TASK_MIN 32768u
@@ -333,7 +332,7 @@ static void flat_node(Flat *f, uint bn, uint me, uint depth, uint pending)
     BvhNode *w = &f->out->nodes[me];
     if (depth > f->out->stats.max_depth) f->out->stats.max_depth = depth;
     uint kids[BVH_WIDTH];
-    int width = pending + (BVH_WIDTH - 1u) <= BVH_STACK_MAX - BVH_MAX_DEPTH ? (int)BVH_WIDTH : 2;
+    int width = pending + (BVH_WIDTH - 1u) <= BVH_STACK - BVH_MAX_DEPTH ? (int)BVH_WIDTH : 2;
     int n = b->n ? wide_children(b, bn, width, kids) : 0;
     if (n > 1) pending += (uint)n - 1u;
     if (pending > f->max_pending) f->max_pending = pending;
@@ -443,9 +442,9 @@ static Status collapse(Build *b, uint root, Bvh *out, Error *err)
     free(ids);
     out->n_leaf_prims = (uint)f.words;
     out->stats.max_stack = f.max_pending;
-    if (f.max_pending > BVH_STACK_MAX)
+    if (f.max_pending > BVH_STACK)
         return error_set(err, ST_INTERNAL, "BVH: a path leaves %u children on the walk's stack, more than its %u",
-                         f.max_pending, BVH_STACK_MAX);
+                         f.max_pending, BVH_STACK);
     return ST_OK;
 }
 

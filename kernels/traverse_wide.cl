@@ -117,7 +117,10 @@ KFN_INLINE void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int a
     w.nx = rp->neg & 1u;
     w.ny = (rp->neg >> 1) & 1u;
     w.nz = (rp->neg >> 2) & 1u;
-    uint st_ref[BVH_STACK], st_kind[BVH_STACK];
+    /* an entry: the child's node and lane (node << 3 | lane; its reference and kind are
+     * read back from the node, in cache, on the pop: a third less private memory than
+     * keeping them), and its entry distance */
+    uint st_child[BVH_STACK];
     float st_t[BVH_STACK];
     int sp = 0;
     uint ref = 0u, kind = BVH_CHILD_NODE;
@@ -148,8 +151,7 @@ KFN_INLINE void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int a
                 for (uint m = mask; m != 0u; m &= m - 1u) {
                     uint l = k_lowest_bit(m);
                     if (l == next) continue;
-                    st_ref[sp] = nd->ref[l];
-                    st_kind[sp] = nd->kind[l];
+                    st_child[sp] = ref << 3 | l;
                     st_t[sp] = ta[l];
                     sp++;
                 }
@@ -168,8 +170,10 @@ KFN_INLINE void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int a
             if (sp == 0) return;
             sp--;
         } while (st_t[sp] > best->t * KD_T_ABOVE);
-        ref = st_ref[sp];
-        kind = st_kind[sp];
+        GLOBAL const BvhNode *parent = sc->bvh + (st_child[sp] >> 3);
+        uint lane = st_child[sp] & 7u;
+        ref = parent->ref[lane];
+        kind = parent->kind[lane];
     }
 }
 

@@ -426,9 +426,10 @@ static Status collapse(Build *b, uint root, Bvh *out, Error *err)
     size_t words = leaf_data_words(b, ids);
     /* every wide node but the root stands for a binary interior node */
     size_t max_nodes = (size_t)atomic_load(&b->n_nodes) + 1;
-    if (words > UINT32_MAX - 1 || max_nodes > UINT32_MAX / 2) {
+    /* the walk's stack keeps a node index in 29 bits */
+    if (words > UINT32_MAX - 1 || max_nodes > (1u << 29)) {
         free(ids);
-        return error_set(err, ST_INTERNAL, "BVH: %zu words of leaf data do not fit", words);
+        return error_set(err, ST_INTERNAL, "BVH: %zu nodes and %zu words of leaf data do not fit its layout", max_nodes, words);
     }
     out->nodes = aligned_alloc(64, max_nodes * sizeof *out->nodes);
     out->leaf_prims = aligned_alloc(64, ((words + 1) * sizeof *out->leaf_prims + 63) / 64 * 64);

@@ -1,5 +1,6 @@
 /*
- * bench_traverse.c -- kd-tree traversal against Embree 3, on exactly the same rays.
+ * bench_traverse.c -- kd-tree and 8-wide BVH traversal against Embree 3, on exactly the
+ * same rays.
  *
  *   bench_traverse [--reps N] [--size N] [--threads A,B] [--no-pocl] [--no-embree] [MESH ...]
  *
@@ -25,17 +26,22 @@
  * Before anything is timed, the hits of the scalar C traversal are compared with
  * Embree's rtcIntersect1/rtcOccluded1 (same triangle, or t within 1e-4 relative; any-hit:
  * the same answer) and with PoCL's (bit for bit), and the counts that disagree printed.
- * Then Mrays/s, the median of --reps runs (5), for: PoCL (kernels/entry.cl) with one ray
- * per work-item (PoCL-1: k_trace_closest1/k_trace_any1, the renderer's walk), two walked
- * in turns (PoCL-2: k_trace_closest/k_trace_any) and packets of eight consecutive rays
- * (PoCL-8: k_trace_closest8/k_trace_any8, trace_packet), each on a sub-device of 1
- * compute unit and on the whole device (all three are checked bit for bit); the
- * scalar C traversal (kernels compiled as C) on 1 and 2 threads; Embree rtcIntersect1 /
+ * Then Mrays/s, the median of --reps runs (5), for: PoCL (kernels/entry.cl) walking the
+ * kd-tree with one ray per work-item (PoCL-1: k_trace_closest1/k_trace_any1), two in
+ * turns (PoCL-2: k_trace_closest/k_trace_any) and packets of eight consecutive rays
+ * (PoCL-8: k_trace_closest8/k_trace_any8, trace_packet), and walking the BVH with one
+ * ray per work-item (PoCL-W: k_trace_closest_wide/k_trace_any_wide, the renderer's
+ * walk), each on a sub-device of 1 compute unit and on the whole device (the kd-tree
+ * kernels checked bit for bit against the C kd walk, the BVH's against the C BVH walk;
+ * "BVH vs kd" counts rays whose closest t or occlusion differs between the trees); the
+ * scalar C traversal (kernels compiled as C) of the kd-tree in pairs (C) and of the BVH
+ * (C-W) on 1 and 2 threads; Embree rtcIntersect1 /
  * rtcOccluded1 and rtcIntersect8 / rtcOccluded8 packets (8 consecutive rays) on 1 and 2
  * threads; the ratios of each PoCL kernel to Embree single rays per CPU-second (issue 3
  * asked 0.5 or more on bunny and dragon, issue 12 asks 1.0 for every kind of ray). Per
  * mesh also: the kd-tree build time (2 threads and
- * 1), its SAH cost and bytes per triangle (nodes + leaf lists), and Embree's
+ * 1), its SAH cost and bytes per triangle (nodes + leaf lists), the BVH's build time (2
+ * threads), nodes, leaves and bytes per triangle, and Embree's
  * RTC_BUILD_QUALITY_HIGH build time (2 and 1 threads) and the bytes its build allocated.
  * Results are printed as Markdown tables for bench/RESULTS.md.
  */

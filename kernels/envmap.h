@@ -76,19 +76,9 @@ KFN float env_pixel_pdf(const SceneView *sc, Texture tx, uint x, uint y, float s
     return p_uv / (2.0f * K_PI * K_PI * sin_t);
 }
 
-/* The solid-angle density with which env_sample picks direction d (any length). */
-KFN float env_pdf(const SceneView *sc, vec3 d)
-{
-    GLOBAL const RenderParams *p = sc->params;
-    Texture tx = sc->textures[p->bg_cubemap];
-    uint x, y;
-    float sin_t;
-    env_pixel(p, tx, d, &x, &y, &sin_t);
-    return env_pixel_pdf(sc, tx, x, y, sin_t);
-}
-
-/* env_radiance and env_pdf of one direction, its pixel found once (two atan2 fewer):
- * the same values, bit for bit. */
+/* env_radiance of direction d and, in *pdf, the solid-angle density with which
+ * env_sample picks d, its pixel found once (what the renderer asks for both: two atan2
+ * fewer than apart). */
 KFN vec3 env_radiance_pdf(const SceneView *sc, vec3 d, float *pdf)
 {
     GLOBAL const RenderParams *p = sc->params;
@@ -98,6 +88,14 @@ KFN vec3 env_radiance_pdf(const SceneView *sc, vec3 d, float *pdf)
     env_pixel(p, tx, d, &x, &y, &sin_t);
     *pdf = env_pixel_pdf(sc, tx, x, y, sin_t);
     return v3_mul(texel_fetch(sc, tx, x, y), p->bg_color);
+}
+
+/* The density alone (light_pdf_env, for the tests' checks of the sampler). */
+KFN float env_pdf(const SceneView *sc, vec3 d)
+{
+    float pdf;
+    env_radiance_pdf(sc, d, &pdf);
+    return pdf;
 }
 
 /* The cell i in [0, n) of cdf[0..n] (cdf[0] = 0, cdf[n] = 1) holding u in [0, 1): the

@@ -113,8 +113,9 @@ KFN float light_pdf(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
 }
 
 /* The density with which light sampling picks direction d toward the environment map
- * (the choice of the map among all lights included), for MIS; 0 when the map is no
- * light. */
+ * (the choice of the map among all lights included); 0 when the map is no light. MIS
+ * in shade_path computes the same value from env_radiance_pdf's lookup; the tests
+ * check light samples against this. */
 KFN float light_pdf_env(const SceneView *sc, vec3 d)
 {
     uint li = sc->params->bg_light;

@@ -368,8 +368,8 @@ KFN_INLINE void trace_packet_walk(const SceneView *sc, TraceRay *tr, const RayPr
             uint below = node + 1u, above = n.bits >> 4;
             uint near_above = (neg >> axis) & 1u;
             uint near = near_above ? above : below, far = near ^ below ^ above;
-            uint far_only = K_BITS8(tp < t0 * KD_T_BELOW) & lanes;
-            uint both = ~K_BITS8(tp > t1 * KD_T_ABOVE) & ~far_only & lanes;
+            uint far_only = k_bits8(tp < t0 * KD_T_BELOW) & lanes;
+            uint both = ~k_bits8(tp > t1 * KD_T_ABOVE) & ~far_only & lanes;
             uint far_empty = (n.bits >> (3u - near_above)) & 1u;
             uint to_near = lanes & ~far_only;
             uint to_far = far_only | (far_empty ? 0u : both);

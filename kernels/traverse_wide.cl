@@ -63,7 +63,7 @@ typedef struct {
 #define K_SPLAT8(x) ((float8)(x))
 KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tmax, float *ta)
 {
-    BVH_LANES_BODY(float8, int8, 8, k_load8, k_store8, K_SPLAT8, k_select8, K_BITS8)
+    BVH_LANES_BODY(float8, int8, 8, k_load8, k_store8, K_SPLAT8, k_select8, k_bits8)
     return mask;
 }
 #else
@@ -71,7 +71,7 @@ KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first,
 #define k_select4(a, b, m) ((float4)(((int4)(a) & ~(m)) | ((int4)(b) & (m))))
 KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tmax, float *ta)
 {
-    BVH_LANES_BODY(float4, int4, 4, k_load4, k_store4, K_SPLAT4, k_select4, K_BITS4)
+    BVH_LANES_BODY(float4, int4, 4, k_load4, k_store4, K_SPLAT4, k_select4, k_bits4)
     return mask;
 }
 #endif
@@ -86,13 +86,6 @@ KFN_INLINE uint bvh_node_test(GLOBAL const BvhNode *nd, const BvhRay *w, float t
     return bvh_lanes(nd, w, 0u, tmax, ta) | (bvh_lanes(nd, w, 4u, tmax, ta) << 4);
 #endif
 }
-
-/* The index of the lowest set bit of m != 0 (OpenCL C 1.2 has clz but no ctz). */
-#ifdef KERNEL_OPENCL
-#define k_lowest_bit(m) (31u - clz((m) & (0u - (m))))
-#else
-#define k_lowest_bit(m) ((uint)__builtin_ctz(m))
-#endif
 
 KFN_INLINE float bvh_inv(float d)
 {

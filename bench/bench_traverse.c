@@ -305,7 +305,7 @@ static int make_rays(Mesh *m, int size, RaySet sets[N_SETS])
         if (v3_dot(ng, pr->d) > 0.0f) ng = v3_neg(ng);
         vec3 o = offset_ray_origin(pt, ng);
         /* the independent sampler, so the ray set stays the one of earlier results */
-        RngKey key = { rng_path_key(1u, i, 0u), 0u, SAMPLER_INDEPENDENT };
+        RngKey key = { rng_path_key(1u, i, 0u), 0u, SAMPLER_INDEPENDENT, 0u };
         vec3 l = sample_cosine_hemisphere(rng_uniform(key, 1u, DIM_BSDF_U), rng_uniform(key, 1u, DIM_BSDF_V));
         vec3 tb, bb;
         k_onb(ng, &tb, &bb);

@@ -50,6 +50,8 @@ typedef struct {
     uint key;        /* independent: hash of (seed, pixel, sample); sobol: of (seed, pixel) */
     uint sample;     /* sample index within the pixel */
     uint sampler;    /* enum Sampler */
+    uint sample_rev; /* sobol: the sample index bit-reversed (rng_key_sobol), which every
+                      * pattern's shuffle starts from; else 0 */
 } RngKey;
 
 KFN uint rng_hash(uint x)
@@ -74,30 +76,18 @@ KFN uint rng_path_key(uint seed, uint pixel, uint sample)
     return rng_hash(rng_pixel_key(seed, pixel) + sample);
 }
 
-/* The key of sample `sample` of `pixel` under the render's sampler. */
-KFN RngKey rng_key_make(GLOBAL const RenderParams *p, uint pixel, uint sample)
-{
-    RngKey k;
-    k.sampler = p->sampler;
-    k.sample = sample;
-    k.key = k.sampler == SAMPLER_SOBOL ? rng_pixel_key(p->seed, pixel) : rng_path_key(p->seed, pixel, sample);
-    return k;
-}
-
-/* The key of a path born by raygen_path (which stored key.key in rng_key). */
-KFN RngKey rng_key_of(GLOBAL const PathState *ps, GLOBAL const RenderParams *p)
-{
-    RngKey k;
-    k.key = ps->rng_key;
-    k.sample = ps->sample;
-    k.sampler = p->sampler;
-    return k;
-}
-
+/* The bits of x in reverse order. The byte order is reversed by one instruction where
+ * the compiler has it (clang, and gcc for the C build: bswap on x86; OpenCL compilers
+ * of other families are not promised the builtin), then the bits within each byte by
+ * three mask-and-shift steps. The sampler reverses bits about ten times a bounce. */
 KFN uint rng_reverse_bits(uint x)
 {
+#if defined(__clang__) || (!defined(KERNEL_OPENCL) && defined(__GNUC__))
+    x = __builtin_bswap32(x);
+#else
     x = (x << 16) | (x >> 16);
     x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu);
+#endif
     x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu);
     x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
     return ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
@@ -153,6 +143,35 @@ KFN uint rng_sobol_pattern(uint pixel_key, uint bounce, uint first)
     return rng_hash(pixel_key + (bounce * (uint)RNG_DIMS_PER_BOUNCE + first) * 0x9e3779b9u);
 }
 
+/* The key of sample `sample` of `pixel` under the render's sampler. */
+KFN RngKey rng_key_make(GLOBAL const RenderParams *p, uint pixel, uint sample)
+{
+    RngKey k;
+    k.sampler = p->sampler;
+    k.sample = sample;
+    k.key = k.sampler == SAMPLER_SOBOL ? rng_pixel_key(p->seed, pixel) : rng_path_key(p->seed, pixel, sample);
+    k.sample_rev = k.sampler == SAMPLER_SOBOL ? rng_reverse_bits(sample) : 0u;
+    return k;
+}
+
+/* The key of a path born by raygen_path (which stored key.key in rng_key). */
+KFN RngKey rng_key_of(GLOBAL const PathState *ps, GLOBAL const RenderParams *p)
+{
+    RngKey k;
+    k.key = ps->rng_key;
+    k.sample = ps->sample;
+    k.sampler = p->sampler;
+    k.sample_rev = k.sampler == SAMPLER_SOBOL ? rng_reverse_bits(k.sample) : 0u;
+    return k;
+}
+
+/* The sample index after the pattern's shuffle: rng_owen_scramble(sample, pattern)
+ * from the key's reversed index (one reversal fewer per pattern). */
+KFN uint rng_sobol_index(RngKey k, uint pattern)
+{
+    return rng_reverse_bits(rng_lk_permute(k.sample_rev, pattern));
+}
+
 /* Coordinate `coord` (0 or 1) of the pattern's point `index` (the sample index after
  * the pattern's shuffle), 32-bit fixed point. The values' scrambling seeds are other odd
  * multiples of the pattern seed (bijections, so as uniform over pixels as it; they
@@ -164,13 +183,13 @@ KFN uint rng_sobol_coord(uint index, uint pattern, uint coord)
     return rng_reverse_bits(rng_lk_permute(digits, pattern * (coord ? 0x2c1b3c6du : 0x297a2d39u) + 0x68e31da4u));
 }
 
-/* The Sobol sampler's value for (pixel key, sample, bounce, dim), 32-bit fixed point:
- * coordinate `coord` of the shuffled, scrambled 2D pattern the dimension belongs to. */
-KFN uint rng_sobol_bits(uint pixel_key, uint sample, uint bounce, uint dim)
+/* The Sobol sampler's value for (key, bounce, dim), 32-bit fixed point: coordinate
+ * `coord` of the shuffled, scrambled 2D pattern the dimension belongs to. */
+KFN uint rng_sobol_bits(RngKey k, uint bounce, uint dim)
 {
     uint coord = (RNG_PAIR_SECOND >> dim) & 1u;
-    uint pattern = rng_sobol_pattern(pixel_key, bounce, dim - coord);
-    return rng_sobol_coord(rng_owen_scramble(sample, pattern), pattern, coord);
+    uint pattern = rng_sobol_pattern(k.key, bounce, dim - coord);
+    return rng_sobol_coord(rng_sobol_index(k, pattern), pattern, coord);
 }
 
 /* 32-bit fixed point to a uniform float in [0, 1): the top 24 bits, so 1.0f is never
@@ -183,7 +202,7 @@ KFN float rng_to_float(uint h)
 KFN float rng_uniform(RngKey k, uint bounce, uint dim)
 {
     uint h = k.sampler == SAMPLER_SOBOL
-                 ? rng_sobol_bits(k.key, k.sample, bounce, dim)
+                 ? rng_sobol_bits(k, bounce, dim)
                  : rng_hash(k.key ^ rng_hash(bounce * (uint)RNG_DIMS_PER_BOUNCE + dim + 0x632be5abu));
     return rng_to_float(h);
 }
@@ -199,7 +218,7 @@ KFN void rng_uniform2(RngKey k, uint bounce, uint first, float *u, float *v)
         return;
     }
     uint pattern = rng_sobol_pattern(k.key, bounce, first);
-    uint index = rng_owen_scramble(k.sample, pattern);
+    uint index = rng_sobol_index(k, pattern);
     *u = rng_to_float(rng_sobol_coord(index, pattern, 0u));
     *v = rng_to_float(rng_sobol_coord(index, pattern, 1u));
 }

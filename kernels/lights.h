@@ -156,9 +156,11 @@ KFN int light_delta_at(Light l, vec3 ref, LightSample *ls)
 }
 
 /* Samples a point on area light li as seen from ref, with u_rest (the rest of the
- * choice number) choosing a box's face; pdf excludes the choice of the light. Returns
- * 0 if the sample is useless (degenerate light, ref on the light's plane). */
-KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, float u_rest, float u1, float u2,
+ * choice number) choosing a box's face; pdf excludes the choice of the light. With
+ * `reuse` set u_rest is u1 (light_sample_in), and a box's face is chosen from it
+ * before the rest of it, rescaled, takes its place. Returns 0 if the sample is useless
+ * (degenerate light, ref on the light's plane). */
+KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, int reuse, float u_rest, float u1, float u2,
                           LightSample *ls)
 {
     GLOBAL const RenderParams *p = sc->params;
@@ -212,6 +214,7 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, float u_rest, 
         float below = axis == 0 ? 0.0f : (axis == 1 ? ax : ax + ay);
         float side = (pick - below) / face_area;         /* uniform in [0,1): which of the pair */
         int upper = side >= 0.5f;
+        if (reuse) u1 = k_clamp(upper ? 2.0f * side - 1.0f : 2.0f * side, 0.0f, 0.99999994f);
         float c0 = upper ? 1.0f : 0.0f;
         vec3 q = v3(bx.lo.x + e.x * (axis == 0 ? c0 : u1),
                     bx.lo.y + e.y * (axis == 1 ? c0 : (axis == 0 ? u1 : u2)),
@@ -230,12 +233,21 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, float u_rest, 
 
 /* Chooses a light among the first ones whose cdf reaches `cdf_top` (1: all of them;
  * the area lights' total: only those) and samples it from ref. The pdf includes the
- * choice. Returns 0 if the sample carries no light. */
-KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, float u_pick, float u1, float u2,
+ * choice. Returns 0 if the sample carries no light.
+ *
+ * With `reuse` set the light is chosen by u1, and the rest of it, rescaled to [0,1),
+ * takes u1's place on the light (u_pick is unused): a stratified 2D point (u1, u2)
+ * stays stratified over all the lights together, as one light, where a separate choice
+ * number would give each light an unstratified share of the points. The rest has
+ * fewer bits the less likely the light (one bit fewer per halving of its choice
+ * probability), which only lights too small to show it are. Without it u_pick chooses,
+ * as for independent samples, where there is no stratification to keep. */
+KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, int reuse, float u_pick, float u1, float u2,
                         LightSample *ls)
 {
     float u_rest;
-    uint li = light_choose(sc, u_pick * cdf_top, &u_rest);
+    uint li = light_choose(sc, (reuse ? u1 : u_pick) * cdf_top, &u_rest);
+    if (reuse) u1 = u_rest;
     Light l = sc->lights[li];
     float choice = l.pick_pdf / cdf_top;
     if (KF_HAS(KF_ENV_MAP) && l.type == LIGHT_ENV) {
@@ -255,15 +267,15 @@ KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, float u_pi
         ls->pdf = choice;
         return choice > 0.0f;
     }
-    if (!light_sample_area(sc, li, ref, u_rest, u1, u2, ls)) return 0;
+    if (!light_sample_area(sc, li, ref, reuse, u_rest, u1, u2, ls)) return 0;
     ls->pdf *= choice;
     return ls->pdf > 0.0f;
 }
 
 /* Samples any light (next-event estimation of the path integrator). */
-KFN int light_sample(const SceneView *sc, vec3 ref, float u_pick, float u1, float u2, LightSample *ls)
+KFN int light_sample(const SceneView *sc, vec3 ref, int reuse, float u_pick, float u1, float u2, LightSample *ls)
 {
-    return light_sample_in(sc, ref, 1.0f, u_pick, u1, u2, ls);
+    return light_sample_in(sc, ref, 1.0f, reuse, u_pick, u1, u2, ls);
 }
 
 /* The shadow ray from surface point p (geometric normal ng turned toward the light) to

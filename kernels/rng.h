@@ -32,7 +32,9 @@
 /* Dimensions used at each bounce; a bounce has RNG_DIMS_PER_BOUNCE of them. */
 enum RngDim {
     DIM_PIXEL_X = 0, DIM_PIXEL_Y, DIM_LENS_U, DIM_LENS_V,   /* camera ray (bounce 0) */
-    DIM_LIGHT_PICK, DIM_LIGHT_U, DIM_LIGHT_V,               /* next-event estimation */
+    DIM_LIGHT_PICK, DIM_LIGHT_U, DIM_LIGHT_V,               /* next-event estimation (the
+                                                             * Sobol sampler picks by
+                                                             * DIM_LIGHT_U, shade.cl) */
     DIM_BSDF_LOBE, DIM_BSDF_U, DIM_BSDF_V, DIM_BSDF_W,      /* scattering */
     DIM_ROULETTE,                                            /* Russian roulette */
     RNG_DIMS_PER_BOUNCE = 16

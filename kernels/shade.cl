@@ -46,7 +46,14 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
     LightSample ls;
     float lu, lv;
     rng_uniform2(key, b, DIM_LIGHT_U, &lu, &lv);
-    if (!light_sample(sc, s.p, rng_uniform(key, b, DIM_LIGHT_PICK), lu, lv, &ls))
+    /* Sobol points choose the light by the pair's first coordinate and reuse its rest
+     * (light_sample_in), so the pair stays stratified over all the lights together: on
+     * the dragon of ../shared/peers, whose lamp is two triangles, 1.6 times less squared
+     * error at 16 spp than with a choice number of its own. Independent values keep
+     * their own dimension for the choice, and with it clpt's earlier images. */
+    int reuse = key.sampler == SAMPLER_SOBOL;
+    float u_pick = reuse ? 0.0f : rng_uniform(key, b, DIM_LIGHT_PICK);
+    if (!light_sample(sc, s.p, reuse, u_pick, lu, lv, &ls))
         return 0;
     if (!ls.delta && mis_mode == MIS_BSDF_ONLY) return 0;
     vec3 wi = ls.wi;

@@ -177,7 +177,7 @@ static void check_sampling(float rotate)
             u[k] = (float)(rng >> 8) * (1.0f / 16777216.0f);
         }
         LightSample ls;
-        if (!light_sample(&v, v3s(0.0f), u[0], u[1], u[2], &ls)) {
+        if (!light_sample(&v, v3s(0.0f), 0, u[0], u[1], u[2], &ls)) {
             /* a direction that rounds onto a pole (sin(theta) 0) or across a pixel's
              * edge into a black pixel has density 0 and is dropped: rare */
             rejected++;

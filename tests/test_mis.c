@@ -4,7 +4,9 @@
  * image for area lights over a diffuse and over a glossy (Phong) floor, which checks
  * that the Phong BRDF, its sampling and its density agree with each other; delta lights
  * give the path integrator the same direct light as the classic ray tracer; the Phong
- * BRDF never reflects more than it receives.
+ * BRDF never reflects more than it receives; the Sobol sampler's light choice by the
+ * light pair's first coordinate (light_sample_in's reuse) is the explicit choice and
+ * keeps the pair's strata.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -12,6 +14,7 @@
 
 #include "harness.h"
 #include "kmath.h"
+#include "lights.h"
 #include "render_util.h"
 
 enum { W = 32, H = 24, BLOCK = 8 };
@@ -47,6 +50,16 @@ static void area_scene(Scene *s, Material floor_mat, uint spp)
     Triangle b = { v3(0.3f, 1.5f, -1.5f), quad_lamp, v3(2.3f, 1.5f, 0.5f), NO_INDEX, v3(0.3f, 1.5f, 0.5f), NO_INDEX };
     scene_add_triangle(s, a, NULL);
     scene_add_triangle(s, b, NULL);
+}
+
+/* area_scene with a box lamp (1 x 2 x 3, emitting outward) in the air as a third light. */
+static void area_scene_with_box(Scene *s, Material floor_mat, uint spp)
+{
+    area_scene(s, floor_mat, spp);
+    uint box_lamp;
+    scene_add_material(s, "box lamp", material_emissive(v3(3.0f, 2.0f, 1.0f)), &box_lamp, NULL);
+    Box b = { v3(-2.5f, 0.4f, -2.0f), box_lamp, v3(-1.5f, 2.4f, 1.0f), NO_INDEX };
+    scene_add_box(s, b, NULL);
 }
 
 /* Renders with one MIS mode; the scheduler is bypassed by setting the mode on the
@@ -172,6 +185,99 @@ static void test_mis_microfacet(void)
     check_strategies_agree("principled floor (metallic 0.3, roughness 0.5, clearcoat 0.7)", pm, 512, 0.02, 0.15, 0.3);
 }
 
+/* The three strategies with a box lamp too: its face is chosen from the light pair's
+ * first coordinate after the light (light_sample_area's reuse). */
+static void test_mis_box_lamp(void)
+{
+    Scene s;
+    area_scene_with_box(&s, material_diffuse(v3(0.7f, 0.6f, 0.5f)), 512);
+    float *img[3];
+    double blocks[3][12], mean[3];
+    Error err = {0};
+    for (uint m = 0; m < 3; m++) {
+        img[m] = malloc(W * H * 3 * sizeof *img[m]);
+        CHECK(render_mode(&s, m, "scalar", img[m], &err) == ST_OK);
+        block_means(img[m], blocks[m], &mean[m]);
+    }
+    fprintf(stderr, "  with a box lamp, 512 spp: image mean MIS %.4f, light sampling %.4f, BSDF sampling %.4f\n",
+            mean[0], mean[1], mean[2]);
+    CHECK(fabs(mean[1] - mean[0]) < 0.015 * mean[0]);
+    CHECK(fabs(mean[2] - mean[0]) < 0.015 * mean[0]);
+    for (int m = 0; m < 3; m++) free(img[m]);
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* light_sample with reuse (the Sobol sampler's next-event estimation) over a stratified
+ * sweep of the pair's first coordinate u1, from a point on the floor: every sample of
+ * the sphere and the triangles is bit for bit the one the explicit choice gives (u1
+ * choosing, its rest in u1's place); each light is chosen for its share of the sweep
+ * to within one stratum; the box lamp's faces get their shares of its samples by area
+ * (the face chosen from the rest of u1, the rest of that placing the point), and every
+ * point lies on the face chosen. */
+static void test_light_choice_reuses_u1(void)
+{
+    enum { N = 6000 };
+    Scene s;
+    area_scene_with_box(&s, material_diffuse(v3s(0.5f)), 1);
+    RenderScene rs;
+    Error err = {0};
+    CHECK(render_scene_prepare(&s, 0, &rs, &err) == ST_OK);
+    SceneView v;
+    device_scene_view(&rs.ds, &v);
+    uint n_lights = rs.ds.params.n_lights;
+    CHECK_EQ_INT(n_lights, 4);
+    uint chosen[4] = { 0, 0, 0, 0 }, faces[6] = { 0, 0, 0, 0, 0, 0 }, box_samples = 0;
+    uint differ = 0, off_face = 0, light_of_box = NO_INDEX;
+    Box bx = s.boxes[0];
+    vec3 ref = v3(0.5f, 0.0f, 2.0f);
+    for (uint i = 0; i < N; i++) {
+        float u1 = ((float)i + 0.5f) / (float)N, u2 = (float)((i * 2654435769u) >> 8) * 5.9604645e-8f;
+        float rest;
+        uint li = light_choose(&v, u1, &rest);
+        chosen[li]++;
+        LightSample a, b;
+        int ok_a = light_sample(&v, ref, 1, 0.0f, u1, u2, &a);
+        if (v.lights[li].prim >= rs.ds.params.n_spheres + rs.ds.params.n_triangles) {
+            light_of_box = li;
+            if (!ok_a) continue;
+            box_samples++;
+            /* which face: the coordinate on a face plane, with the side */
+            vec3 q = a.p;
+            int f = q.x == bx.lo.x ? 0 : q.x == bx.hi.x ? 1 : q.y == bx.lo.y ? 2 : q.y == bx.hi.y ? 3
+                  : q.z == bx.lo.z ? 4 : q.z == bx.hi.z ? 5 : -1;
+            if (f < 0 || q.x < bx.lo.x || q.x > bx.hi.x || q.y < bx.lo.y || q.y > bx.hi.y || q.z < bx.lo.z ||
+                q.z > bx.hi.z) {
+                off_face++;
+                continue;
+            }
+            faces[f]++;
+            continue;
+        }
+        int ok_b = light_sample(&v, ref, 0, u1, rest, u2, &b);
+        if (ok_a != ok_b || (ok_a && (memcmp(&a.p, &b.p, sizeof a.p) || a.pdf != b.pdf))) differ++;
+    }
+    fprintf(stderr, "  reuse sweep of %d: lights chosen %u %u %u %u (pick pdf %.4f %.4f %.4f %.4f); box faces %u %u "
+            "%u %u %u %u of %u; %u differ from the explicit choice, %u off the box\n", N, chosen[0], chosen[1],
+            chosen[2], chosen[3], (double)v.lights[0].pick_pdf, (double)v.lights[1].pick_pdf,
+            (double)v.lights[2].pick_pdf, (double)v.lights[3].pick_pdf, faces[0], faces[1], faces[2], faces[3],
+            faces[4], faces[5], box_samples, differ, off_face);
+    CHECK_EQ_INT(differ, 0);
+    CHECK_EQ_INT(off_face, 0);
+    for (uint li = 0; li < n_lights; li++) CHECK(fabs(chosen[li] - N * (double)v.lights[li].pick_pdf) <= 1.0);
+    CHECK(light_of_box != NO_INDEX);
+    /* faces by area (1 x 2 x 3: x faces 6, y faces 3, z faces 2 of 22), each side half;
+     * samples of faces turned away from ref are dropped, so only chosen faces that
+     * face ref count: compare each visible face with its expected share of the box's
+     * choices, within two strata */
+    double area[6] = { 6.0, 6.0, 3.0, 3.0, 2.0, 2.0 };
+    for (int f = 0; f < 6; f++)
+        if (faces[f]) CHECK(fabs(faces[f] - chosen[light_of_box] * area[f] / 22.0) <= 2.0);
+    render_scene_free(&rs);
+    scene_free(&s);
+    error_clear(&err);
+}
+
 /* A directional light: the path integrator's next-event estimate is exact (one light,
  * one direction), so every pixel must be kd/pi x E cos, as the classic ray tracer says. */
 static void test_delta_lights_match_whitted(void)
@@ -257,6 +363,8 @@ int main(void)
     RUN(test_mis_diffuse);
     RUN(test_mis_phong);
     RUN(test_mis_microfacet);
+    RUN(test_mis_box_lamp);
+    RUN(test_light_choice_reuses_u1);
     RUN(test_delta_lights_match_whitted);
     RUN(test_phong_energy);
     return harness_report();

@@ -235,7 +235,7 @@ KFN_INLINE uint triangle_intersect_group(const RayPre *rp, GLOBAL const float *r
 #endif
     if (mask) {
         /* over the lanes hit only, in lane order (usually one: a loop over all eight
-         * was 5% of a Cornell box render on PoCL) */
+         * held 5% of the samples of a Cornell box profile on PoCL) */
         uint lane = k_lowest_bit(mask);
         float bt = ta[lane];
         for (uint m = mask & (mask - 1u); m != 0u; m &= m - 1u) {

@@ -276,9 +276,16 @@ static cl_kernel kernel(const char *name)
 
 #define SET(k, i, v) CHECK(clSetKernelArg(k, i, sizeof(v), &(v)) == CL_SUCCESS)
 
+/* Launches n work-items (at least) as the renderer does (device_ocl.c): in work-groups
+ * of 64 where the device allows, the global size rounded up, which every kernel's own
+ * count check absorbs. Left to choose, PoCL picked work-groups of thousands here and
+ * kept every work-item's private arrays (the traversal stacks) on one worker thread's
+ * stack: k_shadow overflowed its 8 MB in about one cold run in three (a 9.5 MB frame,
+ * gdb). */
 static void run(cl_kernel k, size_t n)
 {
-    cl_int rc = clEnqueueNDRangeKernel(cl.q, k, 1, NULL, &n, NULL, 0, NULL, NULL);
+    size_t local = cl.dev.max_work_group >= 64 ? 64 : 0, global = local ? (n + local - 1) / local * local : n;
+    cl_int rc = clEnqueueNDRangeKernel(cl.q, k, 1, NULL, &global, local ? &local : NULL, 0, NULL, NULL);
     CHECK_MSG(rc == CL_SUCCESS, "clEnqueueNDRangeKernel: %s", ocl_error_name(rc));
     CHECK(clFinish(cl.q) == CL_SUCCESS);
 }

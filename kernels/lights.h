@@ -238,10 +238,11 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, int reuse, flo
  * With `reuse` set the light is chosen by u1, and the rest of it, rescaled to [0,1),
  * takes u1's place on the light (u_pick is unused): a stratified 2D point (u1, u2)
  * stays stratified over all the lights together, as one light, where a separate choice
- * number would give each light an unstratified share of the points. The rest has
- * fewer bits the less likely the light (one bit fewer per halving of its choice
- * probability), which only lights too small to show it are. Without it u_pick chooses,
- * as for independent samples, where there is no stratification to keep. */
+ * number would give each light an unstratified share of the points. The rest loses
+ * one of u1's 24 bits for each halving of the light's choice probability: a light
+ * chosen once in 8192 samples still gets 2048 positions along u1. Without `reuse`
+ * u_pick chooses, as for independent samples, where there is no stratification to
+ * keep. */
 KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, int reuse, float u_pick, float u1, float u2,
                         LightSample *ls)
 {

@@ -126,11 +126,14 @@ typedef int int8 __attribute__((vector_size(32)));
 #define k_bits4(m) ((uint)((m)[0] & 1) | (uint)((m)[1] & 2) | (uint)((m)[2] & 4) | (uint)((m)[3] & 8))
 #endif
 
-/* The index of the lowest set bit of m != 0 (OpenCL C 1.2 has clz but no ctz). */
+/* The index of the lowest set bit of m != 0 (OpenCL C 1.2 has clz but no ctz), and of
+ * the highest. */
 #ifdef KERNEL_OPENCL
 #define k_lowest_bit(m) (31u - clz((m) & (0u - (m))))
+#define k_highest_bit(m) (31u - clz(m))
 #else
 #define k_lowest_bit(m) ((uint)__builtin_ctz(m))
+#define k_highest_bit(m) (31u - (uint)__builtin_clz(m))
 #endif
 
 /* fmin/fmax with IEEE semantics (a NaN argument loses), written out the same way for

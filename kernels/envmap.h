@@ -24,6 +24,15 @@
  * conditional cdf over its pixels, W + 1 floats at H + 1 + j (W + 1). A pixel's
  * probability is the product of the two cdf steps, its density in (u, v) that times
  * W H, and in solid angle that over 2 pi^2 sin(theta).
+ *
+ * After the cdfs come their guide tables (the "cutpoint method" of Chen and Asau, 1974):
+ * for a cdf of n cells, G = env_guide_cells(n) entries, entry k the cell that holds
+ * u = k / G (an integer, exact as a float). A sample u then lies between the cells of
+ * entries floor(u G) and floor(u G) + 1, and the search runs over those few cells instead
+ * of all n: a binary search over a 1024-cell row touched a cache line and mispredicted a
+ * branch at most of its ten steps; the guides made scenes/envmap.scene 7-8% faster on
+ * both devices. They find the same cell, so images did not change. The marginal's guide is at
+ * H + 1 + H (W + 1), row j's G(H) + j G(W) floats after it.
  * Valid C11 and OpenCL C 1.2.
  */
 #ifndef CLPT_ENVMAP_H
@@ -98,12 +107,25 @@ KFN float env_pdf(const SceneView *sc, vec3 d)
     return pdf;
 }
 
+/* The number of guide entries of a cdf of n cells: the largest power of two at most
+ * n / 4 (at least 1), so that a search covers about four cells, usually one cache line,
+ * and the guides add a quarter to the distribution. A power of two makes u * G exact, so
+ * the entry below u is the same on every device and on the host that wrote it. */
+KFN uint env_guide_cells(uint n)
+{
+    uint q = n >> 2;
+    return q > 1u ? 1u << k_highest_bit(q) : 1u;
+}
+
 /* The cell i in [0, n) of cdf[0..n] (cdf[0] = 0, cdf[n] = 1) holding u in [0, 1): the
  * last i with cdf[i] <= u, which skips cells of zero probability; *frac receives u's
- * place within it, in [0, 1). */
-KFN uint env_cdf_find(GLOBAL const float *cdf, uint n, float u, float *frac)
+ * place within it, in [0, 1). `guide` is the cdf's guide table (above): the answer
+ * lies between the entries around u. */
+KFN uint env_cdf_find(GLOBAL const float *cdf, GLOBAL const float *guide, uint n, float u, float *frac)
 {
-    uint lo = 0u, hi = n - 1u;
+    uint g = env_guide_cells(n);
+    uint k = (uint)k_clamp(u * (float)g, 0.0f, (float)(g - 1u));
+    uint lo = (uint)guide[k], hi = k + 1u < g ? (uint)guide[k + 1u] : n - 1u;
     while (lo < hi) {
         uint mid = (lo + hi + 1u) >> 1;
         if (cdf[mid] <= u) lo = mid; else hi = mid - 1u;
@@ -115,18 +137,28 @@ KFN uint env_cdf_find(GLOBAL const float *cdf, uint n, float u, float *frac)
 
 /* A direction drawn from the map's distribution with (u1, u2) in [0, 1)^2: a row by
  * the marginal cdf, a pixel in it by the row's cdf, a uniform point in the pixel's
- * (u, v) rectangle. Returns the unit direction in the world. */
-KFN vec3 env_sample_dir(const SceneView *sc, float u1, float u2)
+ * (u, v) rectangle. Returns the unit direction in the world, and in *Le and *pdf the
+ * radiance of the pixel drawn and the solid-angle density of the point (as pbrt-v4's
+ * image light: the pixel and sin(theta) the sample already has, not found again from
+ * the direction, which cost two atan2; at a pixel's edge, rounding could put the
+ * direction in its neighbour, and the neighbour's radiance would have gone with this
+ * pixel's chance). */
+KFN vec3 env_sample(const SceneView *sc, float u1, float u2, vec3 *Le, float *pdf)
 {
     GLOBAL const RenderParams *p = sc->params;
     Texture tx = sc->textures[p->bg_cubemap];
+    uint W = tx.width, H = tx.height;
+    GLOBAL const float *marg = sc->env_cdf, *marg_guide = marg + (H + 1u) + H * (W + 1u);
     float fy, fx;
-    uint y = env_cdf_find(sc->env_cdf, tx.height, u1, &fy);
-    uint x = env_cdf_find(sc->env_cdf + tx.height + 1u + y * (tx.width + 1u), tx.width, u2, &fx);
-    float u = ((float)x + fx) / (float)tx.width, v = ((float)y + fy) / (float)tx.height;
+    uint y = env_cdf_find(marg, marg_guide, H, u1, &fy);
+    uint x = env_cdf_find(marg + (H + 1u) + y * (W + 1u), marg_guide + env_guide_cells(H) + y * env_guide_cells(W), W,
+                          u2, &fx);
+    float u = ((float)x + fx) / (float)W, v = ((float)y + fy) / (float)H;
     float st, ct, sp, cp;
     k_sincos(K_PI * v, &st, &ct);
     k_sincos(K_TWO_PI * u, &sp, &cp);
+    *pdf = env_pixel_pdf(sc, tx, x, y, st);
+    *Le = v3_mul(texel_fetch(sc, tx, x, y), p->bg_color);
     vec3 m = v3(st * sp, ct, -st * cp);
     float c = p->bg_rot_cos, s = p->bg_rot_sin;
     return v3(c * m.x + s * m.z, m.y, c * m.z - s * m.x);

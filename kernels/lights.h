@@ -253,9 +253,8 @@ KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, int reuse,
     float choice = l.pick_pdf / cdf_top;
     if (KF_HAS(KF_ENV_MAP) && l.type == LIGHT_ENV) {
         /* the environment map: a direction from its distribution, infinitely far */
-        ls->wi = env_sample_dir(sc, u1, u2);
         float pdf;
-        ls->Le = env_radiance_pdf(sc, ls->wi, &pdf);
+        ls->wi = env_sample(sc, u1, u2, &ls->Le, &pdf);
         ls->pdf = choice * pdf;
         ls->p = ref;
         ls->n = v3s(0.0f);

@@ -1,6 +1,8 @@
 /* env_dist.c — the environment map's sampling distribution (see env_dist.h). */
 #include "scene/env_dist.h"
 
+#include "envmap.h" /* env_guide_cells: the kernels' lookups must agree with these tables */
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,13 +30,27 @@ static void cdf_write(const double *w, size_t n, double total, float *out)
     out[n] = 1.0f;
 }
 
+/* Writes the guide table of cdf[0..n] (kernels/envmap.h) into out[0..g): entry k the
+ * last cell i < n with cdf[i] <= k / g, the cell env_cdf_find finds for u = k / g. */
+static void guide_write(const float *cdf, size_t n, size_t g, float *out)
+{
+    size_t i = 0;
+    for (size_t k = 0; k < g; k++) {
+        float u = (float)k / (float)g; /* exact: g is a power of two */
+        while (i + 1 < n && cdf[i + 1] <= u) i++;
+        out[k] = (float)i;
+    }
+}
+
 Status env_dist_build(const uint *texels, uint width, uint height, float **cdf, size_t *n, double *mean, Error *err)
 {
     *cdf = NULL;
     *n = 0;
     *mean = 0.0;
-    size_t W = width, H = height, count = (H + 1) + H * (W + 1);
-    double *row = malloc(W * sizeof *row), *row_sum = malloc(H * sizeof *row_sum);
+    size_t W = width, H = height, cdfs = (H + 1) + H * (W + 1);
+    size_t guide_h = env_guide_cells(height), guide_w = env_guide_cells(width);
+    size_t count = cdfs + guide_h + H * guide_w;
+    double *row = malloc(W * sizeof *row), *row_sum = calloc(H, sizeof *row_sum);
     float *out = malloc(count * sizeof *out);
     if (!row || !row_sum || !out) {
         free(row);
@@ -55,6 +71,9 @@ Status env_dist_build(const uint *texels, uint width, uint height, float **cdf, 
         total += row_sum[j];
     }
     cdf_write(row_sum, H, total, out);
+    guide_write(out, H, guide_h, out + cdfs);
+    for (size_t j = 0; j < H; j++)
+        guide_write(out + (H + 1) + j * (W + 1), W, guide_w, out + cdfs + guide_h + j * guide_w);
     free(row);
     free(row_sum);
     /* each pixel spans (2 pi / W) (pi / H) sin(theta) steradians of the 4 pi */

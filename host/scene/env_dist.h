@@ -12,7 +12,8 @@
 #include "types.h"
 
 /* Builds the cdfs of a W x H float map (3 floats a texel, as the texels buffer holds
- * them) in the layout of kernels/envmap.h: (H + 1) + H (W + 1) floats in *cdf (freed
+ * them) and their guide tables in the layout of kernels/envmap.h: (H + 1) + H (W + 1)
+ * floats of cdfs, then G(H) + H G(W) of guides (G = env_guide_cells), in *cdf (freed
  * with free), the count in *n. *mean receives the map's mean luminance over the
  * sphere (solid-angle weighted, unscaled), 0 for a black map, which then has no cdf
  * (*cdf NULL, *n 0): no light to sample. Negative luminance counts as 0. Fails only

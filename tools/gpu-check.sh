@@ -10,7 +10,8 @@
 #   3. whole images: GPU alone, scalar alone and both together give the same bits, for
 #      every shipped scene and the two peer scenes (../shared beside the checkout);
 #   4. throughput: bench_render (every device, then scalar), the wave launch mode and
-#      size on large renders, and --profile.
+#      size on large renders, both trees with both launch modes per scene, and
+#      --profile.
 # Each step has its own time limit; everything is also written under OUT.
 # Run from the repository root after `make` and `make build/tests/test_kernels ...`.
 set -u
@@ -97,6 +98,24 @@ for sc in ../shared/peers/cornell-mcguire.scene:256 ../shared/peers/dragon.scene
                     --wave-launch $wl --stats -q -o "$out/waves.pfm" 2>&1 | grep '^total' | awk '{print $(NF-2)}')
                 echo "$(basename "$f") 1024x1024 ${spp} spp, round $round, --wave-launch $wl --wave-paths $wp: $r Msamples/s"
             done
+        done
+    done
+done
+
+# On an H200 the kd-tree walk was 10-35% faster than the 8-wide BVH on the small Cornell
+# box and the BVH 30% faster on the dragon, and the megakernel slower on four of five
+# renders (bench/RESULTS.md, "Third GPU check"): the numbers a per-device tree would be
+# chosen by. Both trees give the same hits, so the images do not depend on it.
+step "trees and launch modes, taking turns (Msamples/s)"
+for sc in scenes/cornell-box.scene:512:16 ../shared/peers/cornell-mcguire.scene:1024:64 scenes/mesh.scene:512:16 \
+          ../shared/peers/dragon.scene:1024:16 scenes/one-weekend.scene:1024:16; do
+    f=${sc%%:*}; rest=${sc#*:}; size=${rest%%:*}; spp=${rest#*:}
+    [ -f "$f" ] || continue
+    for wl in bounded megakernel; do
+        for acc in bvh kdtree; do
+            r=$(lim 120 "$clpt" "$f" --device "$dev" --width "$size" --height "$size" --spp "$spp" --accel $acc \
+                --wave-launch $wl --stats -q -o "$out/trees.pfm" 2>&1 | grep '^total' | awk '{print $(NF-2)}')
+            echo "$(basename "$f") ${size}x${size} ${spp} spp, --wave-launch $wl --accel $acc: $r Msamples/s"
         done
     done
 done

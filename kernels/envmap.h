@@ -27,12 +27,12 @@
  *
  * After the cdfs come their guide tables (the "cutpoint method" of Chen and Asau, 1974):
  * for a cdf of n cells, G = env_guide_cells(n) entries, entry k the cell that holds
- * u = k / G (an integer, exact as a float). A sample u then lies between the cells of
- * entries floor(u G) and floor(u G) + 1, and the search runs over those few cells instead
- * of all n: a binary search over a 1024-cell row touched a cache line and mispredicted a
- * branch at most of its ten steps; the guides made scenes/envmap.scene 7-8% faster on
- * both devices. They find the same cell, so images did not change. The marginal's guide is at
- * H + 1 + H (W + 1), row j's G(H) + j G(W) floats after it.
+ * u = k / G (an integer, exact as a float). A sample u lies between the cells of entries
+ * floor(u G) and floor(u G) + 1, and the search runs over those few cells instead of all
+ * n: a binary search over a 1024-cell row touched a cache line and mispredicted a branch
+ * at most of its ten steps, and the guides made scenes/envmap.scene 7-8% faster on both
+ * devices. They find the same cell, so images did not change. The marginal's guide is
+ * at H + 1 + H (W + 1), row j's G(H) + j G(W) floats after it.
  * Valid C11 and OpenCL C 1.2.
  */
 #ifndef CLPT_ENVMAP_H
@@ -138,11 +138,10 @@ KFN uint env_cdf_find(GLOBAL const float *cdf, GLOBAL const float *guide, uint n
 /* A direction drawn from the map's distribution with (u1, u2) in [0, 1)^2: a row by
  * the marginal cdf, a pixel in it by the row's cdf, a uniform point in the pixel's
  * (u, v) rectangle. Returns the unit direction in the world, and in *Le and *pdf the
- * radiance of the pixel drawn and the solid-angle density of the point (as pbrt-v4's
- * image light: the pixel and sin(theta) the sample already has, not found again from
- * the direction, which cost two atan2; at a pixel's edge, rounding could put the
- * direction in its neighbour, and the neighbour's radiance would have gone with this
- * pixel's chance). */
+ * radiance of the pixel drawn and the solid-angle density of the point, from the pixel
+ * and sin(theta) the sample already has, as pbrt-v4's image light. Finding them again
+ * from the direction cost two atan2, and where rounding put a direction just across its
+ * pixel's edge it paired the neighbour's radiance with this pixel's probability. */
 KFN vec3 env_sample(const SceneView *sc, float u1, float u2, vec3 *Le, float *pdf)
 {
     GLOBAL const RenderParams *p = sc->params;

@@ -194,21 +194,34 @@ static const char *kernel_src =
     "            out[(i * 3u + b) * (uint)RNG_DIMS_PER_BOUNCE + d] = as_uint(rng_uniform(k, b, d));\n"
     "}\n";
 
-static void test_opencl_matches_c(void)
+/* The OpenCL device the tests compare with C: the first CPU device (PoCL, which make
+ * test installs), else the first device (a GPU, where tools/gpu-check.sh runs these
+ * tests), into *dev and its --device index into spec. 0 when there is none, which is a
+ * failure, not a skip. */
+static int opencl_test_device(OclDeviceInfo *dev, char *spec, size_t spec_size)
 {
-    OclDeviceInfo *devs = NULL, dev;
-    size_t n_dev = 0;
+    OclDeviceInfo *devs = NULL;
+    size_t n_dev = 0, pick = 0;
     Error err = { 0 };
     if (ocl_enumerate(&devs, &n_dev, &err) != ST_OK || n_dev == 0) {
-        /* make test installs PoCL: no OpenCL device is a failure, not a skip */
         CHECK_MSG(0, "no OpenCL device: %s", err.msg);
         free(devs);
-        return;
+        error_clear(&err);
+        return 0;
     }
-    dev = devs[0];
     for (size_t i = 0; i < n_dev; i++)
-        if (devs[i].type & CL_DEVICE_TYPE_CPU) { dev = devs[i]; break; }
+        if (devs[i].type & CL_DEVICE_TYPE_CPU) { pick = i; break; }
+    *dev = devs[pick];
+    snprintf(spec, spec_size, "%zu", pick);
     free(devs);
+    return 1;
+}
+
+static void test_opencl_matches_c(void)
+{
+    OclDeviceInfo dev;
+    char spec[24];
+    if (!opencl_test_device(&dev, spec, sizeof spec)) return;
     char dir[] = "/tmp/clpt-test-sampler-XXXXXX", path[128], inc[1200], cwd[1024];
     CHECK(mkdtemp(dir) != NULL);
     CHECK(getcwd(cwd, sizeof cwd) != NULL);
@@ -225,6 +238,7 @@ static void test_opencl_matches_c(void)
     cl_command_queue q = clCreateCommandQueue(ctx, dev.id, 0, &rc);
     CHECK_EQ_INT(rc, CL_SUCCESS);
     cl_program prog = NULL;
+    Error err = { 0 };
     Status st = ocl_program_build(ctx, &dev, dir, inc, &prog, NULL, &err);
     CHECK_MSG(st == ST_OK, "%s\n%s", err.msg, err.detail ? err.detail : "");
     error_clear(&err);
@@ -301,10 +315,13 @@ static float *cornell(const char *devices, uint sampler, uint spp, uint seed, Fi
     return rgb;
 }
 
-static void test_independent_images_pocl_equals_scalar(void)
+static void test_independent_images_opencl_equals_scalar(void)
 {
+    OclDeviceInfo dev;
+    char spec[24];
+    if (!opencl_test_device(&dev, spec, sizeof spec)) return;
     Film a, b;
-    float *ra = cornell("cpu", SAMPLER_INDEPENDENT, 8, 5, &a), *rb = cornell("scalar", SAMPLER_INDEPENDENT, 8, 5, &b);
+    float *ra = cornell(spec, SAMPLER_INDEPENDENT, 8, 5, &a), *rb = cornell("scalar", SAMPLER_INDEPENDENT, 8, 5, &b);
     if (ra && rb) {
         CHECK(memcmp(a.sum, b.sum, 32 * 32 * 3 * sizeof *a.sum) == 0);
         film_free(&a);
@@ -346,7 +363,7 @@ int main(void)
     RUN(test_stratification);
     RUN(test_decorrelation);
     RUN(test_opencl_matches_c);
-    RUN(test_independent_images_pocl_equals_scalar);
+    RUN(test_independent_images_opencl_equals_scalar);
     RUN(test_sobol_has_less_error);
     return harness_report();
 }

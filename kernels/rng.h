@@ -211,8 +211,11 @@ KFN float rng_uniform(RngKey k, uint bounce, uint dim)
 
 /* rng_uniform of both dimensions of a 2D pair, `first` and first + 1, the same bits: the
  * Sobol sampler computes the pair's pattern seed and shuffled index once for the two,
- * which takes a third off what a pair costs (the sampler was 12-18% of a render). */
-KFN void rng_uniform2(RngKey k, uint bounce, uint first, float *u, float *v)
+ * which takes a third off what a pair costs (the sampler was 12-18% of a render).
+ * Always inlined: PoCL left it a call that saved five registers and realigned the
+ * stack each time, 8.5% of the McGuire Cornell box's samples; inlined, that box
+ * renders 3% faster on PoCL and 5% on the scalar device. */
+KFN_INLINE void rng_uniform2(RngKey k, uint bounce, uint first, float *u, float *v)
 {
     if (k.sampler != SAMPLER_SOBOL) {
         *u = rng_uniform(k, bounce, first);

@@ -52,8 +52,8 @@ typedef struct {
     uint key;        /* independent: hash of (seed, pixel, sample); sobol: of (seed, pixel) */
     uint sample;     /* sample index within the pixel */
     uint sampler;    /* enum Sampler */
-    uint sample_rev; /* sobol: the sample index bit-reversed (rng_key_sobol), which every
-                      * pattern's shuffle starts from; else 0 */
+    uint sample_rev; /* sobol: the sample index bit-reversed (rng_key_make, rng_key_of),
+                      * which every pattern's shuffle starts from; else 0 */
 } RngKey;
 
 KFN uint rng_hash(uint x)

@@ -37,7 +37,7 @@ for kind in cold warm; do
 done
 
 step "kernels: GPU against scalar, bit for bit"
-lim 240 "$build/tests/test_kernels" 2>"$out/test_kernels.log" | tail -n 5
+lim 480 "$build/tests/test_kernels" 2>"$out/test_kernels.log" | tail -n 5
 grep -E 'FAIL' "$out/test_kernels.log" | head -n 20
 lim 120 "$build/tests/test_sampler" 2>"$out/test_sampler.log" | tail -n 2
 grep -E 'FAIL' "$out/test_sampler.log" | head -n 20

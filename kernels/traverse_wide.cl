@@ -135,7 +135,7 @@ KFN_INLINE void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int a
                  * second nearest last so that it is popped next. Sorting all of them
                  * was measured slower: the entries that start beyond the closest hit
                  * are skipped on the pop anyway; the second nearest alone made
-                 * diffuse rays 3-11% faster (docs/bvh.md). */
+                 * closest-hit diffuse rays 3-11% faster (docs/bvh.md). */
                 uint next = l0, second = BVH_WIDTH;
                 if (!any)
                     for (uint m = mask & (mask - 1u); m != 0u; m &= m - 1u) {

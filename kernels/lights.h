@@ -4,7 +4,9 @@
  * against BSDF sampling).
  *
  * Area lights (emissive primitives): a point on the light; densities are per unit solid
- * angle at the shading point and include the probability of choosing the light. A light
+ * angle at the shading point and include the probability of choosing the light. The two
+ * triangles of a quad lamp (LIGHT_QUAD_*, types.h) are sampled as one parallelogram when
+ * the light pair chooses the light (the Sobol sampler). A light
  * emits from its front side (outward for spheres and boxes, the winding normal's side
  * for triangles) unless its material is MAT_TWO_SIDED; a sample of a point whose lit
  * side faces away is rejected.
@@ -198,9 +200,19 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, int reuse, flo
         }
     } else if (l.prim < first_box) {
         Triangle tr = sc->triangles[l.prim - first_tri];
-        float b1, b2;
-        sample_triangle(u1, u2, &b1, &b2);
-        ls->p = v3_add(v3_add(v3_scale(tr.p0, 1.0f - b1 - b2), v3_scale(tr.p1, b1)), v3_scale(tr.p2, b2));
+        if (reuse && l.quad != LIGHT_QUAD_NONE) {
+            /* half of a parallelogram (types.h): the rest of the choice number, u1, is
+             * the coordinate along the edge, the first half's on [0, 1/2) and the
+             * second's on [1/2, 1), so the pair's points cover the quad uniformly and
+             * stay stratified over all of it. The point may lie in the other half,
+             * which has the same plane, area, choice probability and emission. */
+            float sq = (l.quad == LIGHT_QUAD_SECOND ? 0.5f : 0.0f) + 0.5f * u1;
+            ls->p = v3_add(l.position, v3_add(v3_scale(l.direction, sq), v3_scale(l.intensity, u2)));
+        } else {
+            float b1, b2;
+            sample_triangle(u1, u2, &b1, &b2);
+            ls->p = v3_add(v3_add(v3_scale(tr.p0, 1.0f - b1 - b2), v3_scale(tr.p1, b1)), v3_scale(tr.p2, b2));
+        }
         ls->n = v3_norm(v3_cross(v3_sub(tr.p1, tr.p0), v3_sub(tr.p2, tr.p0)));
     } else {
         /* a box: a face chosen by area with the rest of the choice number, then a uniform

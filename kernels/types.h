@@ -267,8 +267,20 @@ typedef struct {                                        /* 80 bytes */
     float atten0, atten1, atten2;
     vec3 position;  float cos_outer;   /* spot: no light outside this cone (cosine) */
     vec3 direction; float cos_inner;   /* unit, where the light goes; spot: full inside */
-    vec3 intensity; float pad0;
+    vec3 intensity; uint quad;        /* LIGHT_QUAD_* (triangle lights, below) */
 } Light;
+
+/* Two triangle lights that are the halves of one parallelogram (a quad lamp split in
+ * two, as OBJ, PLY and glTF quads are), of one material and next to each other in the
+ * list, are marked LIGHT_QUAD_FIRST and LIGHT_QUAD_SECOND and get equal choice
+ * probabilities; both then hold the parallelogram in the delta-light fields they do not
+ * use: `position` a corner, `direction` and `intensity` its two edges from it. With the
+ * Sobol sampler's light pair, the pair's first coordinate then runs across the whole
+ * quad (lights.h), so its 2D points stay stratified over the lamp instead of being
+ * split between two triangles and warped by each. */
+#define LIGHT_QUAD_NONE 0u
+#define LIGHT_QUAD_FIRST 1u
+#define LIGHT_QUAD_SECOND 2u
 
 enum CameraType { CAMERA_PERSPECTIVE = 0, CAMERA_ORTHOGRAPHIC = 1 };
 

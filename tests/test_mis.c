@@ -6,7 +6,8 @@
  * give the path integrator the same direct light as the classic ray tracer; the Phong
  * BRDF never reflects more than it receives; the Sobol sampler's light choice by the
  * light pair's first coordinate (light_sample_in's reuse) is the explicit choice and
- * keeps the pair's strata.
+ * keeps the pair's strata; the two halves of a quad lamp are found and sampled as one
+ * parallelogram, uniformly.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -210,11 +211,12 @@ static void test_mis_box_lamp(void)
 
 /* light_sample with reuse (the Sobol sampler's next-event estimation) over a stratified
  * sweep of the pair's first coordinate u1, from a point on the floor: every sample of
- * the sphere and the triangles is bit for bit the one the explicit choice gives (u1
- * choosing, its rest in u1's place); each light is chosen for its share of the sweep
- * to within one stratum; the box lamp's faces get their shares of its samples by area
- * (the face chosen from the rest of u1, the rest of that placing the point), and every
- * point lies on the face chosen. */
+ * the sphere is bit for bit the one the explicit choice gives (u1 choosing, its rest in
+ * u1's place), and every sample of the quad lamp's two triangles is the parallelogram's
+ * point for that rest (types.h); each light is chosen for its share of the sweep to
+ * within one stratum; the box lamp's faces get their shares of its samples by area (the
+ * face chosen from the rest of u1, the rest of that placing the point), and every point
+ * lies on the face chosen. */
 static void test_light_choice_reuses_u1(void)
 {
     enum { N = 6000 };
@@ -228,7 +230,11 @@ static void test_light_choice_reuses_u1(void)
     uint n_lights = rs.ds.params.n_lights;
     CHECK_EQ_INT(n_lights, 4);
     uint chosen[4] = { 0, 0, 0, 0 }, faces[6] = { 0, 0, 0, 0, 0, 0 }, box_samples = 0;
-    uint differ = 0, off_face = 0, light_of_box = NO_INDEX;
+    uint differ = 0, off_face = 0, light_of_box = NO_INDEX, quad_samples = 0;
+    /* the quad lamp's two triangles are lights 1 and 2, paired (types.h) */
+    CHECK_EQ_INT(v.lights[1].quad, LIGHT_QUAD_FIRST);
+    CHECK_EQ_INT(v.lights[2].quad, LIGHT_QUAD_SECOND);
+    CHECK(v.lights[1].pick_pdf == v.lights[2].pick_pdf);
     Box bx = s.boxes[0];
     vec3 ref = v3(0.5f, 0.0f, 2.0f);
     for (uint i = 0; i < N; i++) {
@@ -254,6 +260,16 @@ static void test_light_choice_reuses_u1(void)
             faces[f]++;
             continue;
         }
+        Light l = v.lights[li];
+        if (l.quad != LIGHT_QUAD_NONE) {
+            /* half of the quad lamp: the rest of u1 runs along the parallelogram's edge
+             * (types.h), and the density is the chosen half's */
+            quad_samples++;
+            float sq = (l.quad == LIGHT_QUAD_SECOND ? 0.5f : 0.0f) + 0.5f * rest;
+            vec3 want = v3_add(l.position, v3_add(v3_scale(l.direction, sq), v3_scale(l.intensity, u2)));
+            if (!ok_a || memcmp(&a.p, &want, sizeof want) || a.pdf != light_pdf(&v, li, ref, a.p, a.n)) differ++;
+            continue;
+        }
         int ok_b = light_sample(&v, ref, 0, u1, rest, u2, &b);
         if (ok_a != ok_b || (ok_a && (memcmp(&a.p, &b.p, sizeof a.p) || a.pdf != b.pdf))) differ++;
     }
@@ -264,6 +280,7 @@ static void test_light_choice_reuses_u1(void)
             faces[4], faces[5], box_samples, differ, off_face);
     CHECK_EQ_INT(differ, 0);
     CHECK_EQ_INT(off_face, 0);
+    CHECK(quad_samples > N / 16);     /* the quad has 11% of the choices */
     for (uint li = 0; li < n_lights; li++) CHECK(fabs(chosen[li] - N * (double)v.lights[li].pick_pdf) <= 1.0);
     CHECK(light_of_box != NO_INDEX);
     /* faces by area (1 x 2 x 3: x faces 6, y faces 3, z faces 2 of 22), each side half;
@@ -273,6 +290,122 @@ static void test_light_choice_reuses_u1(void)
     double area[6] = { 6.0, 6.0, 3.0, 3.0, 2.0, 2.0 };
     for (int f = 0; f < 6; f++)
         if (faces[f]) CHECK(fabs(faces[f] - chosen[light_of_box] * area[f] / 22.0) <= 2.0);
+    render_scene_free(&rs);
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* A scene of two triangle lights of material `mat_b` for the second, the first's
+ * corners (0,2,0) (1,2,0) (1,2,1) facing down, the second's given; its light list. */
+static void two_triangle_lights(Scene *s, vec3 q0, vec3 q1, vec3 q2, int same_material)
+{
+    scene_init(s);
+    uint lamp, other;
+    scene_add_material(s, "lamp", material_emissive(v3s(4.0f)), &lamp, NULL);
+    scene_add_material(s, "other", material_emissive(v3s(4.0f)), &other, NULL);
+    Triangle a = { v3(0.0f, 2.0f, 0.0f), lamp, v3(1.0f, 2.0f, 1.0f), NO_INDEX, v3(1.0f, 2.0f, 0.0f), NO_INDEX };
+    Triangle b = { q0, same_material ? lamp : other, q1, NO_INDEX, q2, NO_INDEX };
+    scene_add_triangle(s, a, NULL);
+    scene_add_triangle(s, b, NULL);
+    Error err = {0};
+    CHECK(scene_prepare_lights(s, &err) == ST_OK);
+    error_clear(&err);
+}
+
+/* Which pairs of triangle lights are sampled as one parallelogram: the two halves of a
+ * quad, split along either diagonal and with their corners in any order, are; a kite
+ * (the reflected corner off by 1%), a pair of two materials and a pair whose second
+ * half is wound the other way are not. */
+static void test_quad_lights_pair(void)
+{
+    static const struct { vec3 q0, q1, q2; int same, pair; const char *what; } cases[] = {
+        { { 0, 2, 0 }, { 0, 2, 1 }, { 1, 2, 1 }, 1, 1, "the other half" },
+        { { 1, 2, 1 }, { 0, 2, 0 }, { 0, 2, 1 }, 1, 1, "the other half, corners rotated" },
+        { { 0, 2, 0 }, { 0, 2, 1.01f }, { 1, 2, 1 }, 1, 0, "a kite" },
+        { { 0, 2, 0 }, { 0, 2, 1 }, { 1, 2, 1 }, 0, 0, "another material" },
+        { { 0, 2, 0 }, { 1, 2, 1 }, { 0, 2, 1 }, 1, 0, "wound the other way" },
+        { { 1, 2, 0 }, { 2, 2, 1 }, { 1, 2, 1 }, 1, 0, "sharing an edge but not the diagonal" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        Scene s;
+        two_triangle_lights(&s, cases[i].q0, cases[i].q1, cases[i].q2, cases[i].same);
+        CHECK_EQ_INT(s.n_lights, 2);
+        uint want0 = cases[i].pair ? LIGHT_QUAD_FIRST : LIGHT_QUAD_NONE;
+        uint want1 = cases[i].pair ? LIGHT_QUAD_SECOND : LIGHT_QUAD_NONE;
+        CHECK_MSG(s.lights[0].quad == want0 && s.lights[1].quad == want1, "%s: quad marks %u %u", cases[i].what,
+                  s.lights[0].quad, s.lights[1].quad);
+        if (cases[i].pair) {
+            CHECK(s.lights[0].pick_pdf == 0.5f && s.lights[1].pick_pdf == 0.5f);
+            /* the parallelogram is the two triangles: its corners are theirs */
+            Light l = s.lights[0];
+            vec3 far = v3_add(l.position, v3_add(l.direction, l.intensity));
+            CHECK(v3_dot(v3_cross(l.direction, l.intensity), v3_cross(l.direction, l.intensity)) > 0.99f);
+            CHECK(far.y == 2.0f && fabsf(fabsf(far.x - l.position.x) - 1.0f) < 1e-6f &&
+                  fabsf(fabsf(far.z - l.position.z) - 1.0f) < 1e-6f);
+        }
+        scene_free(&s);
+    }
+}
+
+/* The quad lamp of area_scene sampled through its two lights with the Sobol sampler's
+ * reuse: points uniform over the whole parallelogram (chi-square over 8 x 8 cells of
+ * its edge coordinates, from random pairs), all on it, and each sample's density the
+ * lamp's uniform area density as light_pdf gives it. */
+static void test_quad_lamp_samples_uniformly(void)
+{
+    enum { N = 64000, G = 8 };
+    Scene s;
+    area_scene(&s, material_diffuse(v3s(0.5f)), 1);
+    RenderScene rs;
+    Error err = {0};
+    CHECK(render_scene_prepare(&s, 0, &rs, &err) == ST_OK);
+    SceneView v;
+    device_scene_view(&rs.ds, &v);
+    Light q = v.lights[1];
+    CHECK_EQ_INT(q.quad, LIGHT_QUAD_FIRST);
+    double counts[G * G] = { 0 };
+    uint n = 0, off = 0, bad_pdf = 0;
+    vec3 ref = v3(0.5f, 0.0f, 2.0f);
+    float lo = v.lights[0].cdf, hi = v.lights[2].cdf;     /* the quad's share of u1 */
+    uint32_t h = 12345u;
+    double e11 = v3_dot(q.direction, q.direction), e22 = v3_dot(q.intensity, q.intensity);
+    double e12 = v3_dot(q.direction, q.intensity), det = e11 * e22 - e12 * e12;
+    for (uint i = 0; i < N; i++) {
+        h = h * 1664525u + 1013904223u;
+        float a = (float)(h >> 8) * 5.9604645e-8f;
+        h = h * 1664525u + 1013904223u;
+        float u2 = (float)(h >> 8) * 5.9604645e-8f;
+        float u1 = lo + (hi - lo) * a;
+        if (!(u1 < hi)) continue;
+        LightSample ls;
+        if (!light_sample(&v, ref, 1, 0.0f, u1, u2, &ls)) continue;
+        float rest;
+        uint li = light_choose(&v, u1, &rest);
+        if (li != 1u && li != 2u) continue;
+        n++;
+        vec3 d = v3_sub(ls.p, q.position);
+        double d1 = v3_dot(d, q.direction), d2 = v3_dot(d, q.intensity);
+        double sq = (d1 * e22 - d2 * e12) / det, tq = (d2 * e11 - d1 * e12) / det;
+        if (!(sq >= -1e-6 && sq <= 1.0 + 1e-6 && tq >= -1e-6 && tq <= 1.0 + 1e-6) || fabsf(ls.p.y - 1.5f) > 1e-6f) {
+            off++;
+            continue;
+        }
+        int cs = (int)(sq * G), ct = (int)(tq * G);
+        counts[(cs < G ? cs : G - 1) * G + (ct < G ? ct : G - 1)] += 1.0;
+        /* uniform over the quad: choice of the pair times 1/area, in solid angle */
+        vec3 to = v3_sub(ls.p, ref);
+        double dist2 = v3_dot(to, to), cos_l = fabs(v3_dot(ls.n, to)) / sqrt(dist2);
+        double want = (double)(q.pick_pdf * 2.0f) / (2.0 * q.area) * dist2 / cos_l;
+        if (fabs(ls.pdf - want) > 1e-5 * want || ls.pdf != light_pdf(&v, li, ref, ls.p, ls.n)) bad_pdf++;
+    }
+    double chi2 = 0.0, expect = (double)(n - off) / (G * G);
+    for (int c = 0; c < G * G; c++) chi2 += (counts[c] - expect) * (counts[c] - expect) / expect;
+    fprintf(stderr, "  quad lamp: %u samples, %u off the quad, %u with another density; chi-square %.1f over %d cells\n",
+            n, off, bad_pdf, chi2, G * G);
+    CHECK(n > N / 2);
+    CHECK_EQ_INT(off, 0);
+    CHECK_EQ_INT(bad_pdf, 0);
+    CHECK(chi2 < 103.4);   /* 63 degrees of freedom, p = 0.001 */
     render_scene_free(&rs);
     scene_free(&s);
     error_clear(&err);
@@ -365,6 +498,8 @@ int main(void)
     RUN(test_mis_microfacet);
     RUN(test_mis_box_lamp);
     RUN(test_light_choice_reuses_u1);
+    RUN(test_quad_lights_pair);
+    RUN(test_quad_lamp_samples_uniformly);
     RUN(test_delta_lights_match_whitted);
     RUN(test_phong_energy);
     return harness_report();

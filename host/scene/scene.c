@@ -541,6 +541,64 @@ static double triangle_area(const Triangle *t)
     return 0.5 * sqrt((double)c.x * c.x + (double)c.y * c.y + (double)c.z * c.z);
 }
 
+static int v3_same(vec3 a, vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+/* Whether triangles a and b (lights of one material) are the two halves of one
+ * parallelogram: they share two corners (the diagonal, bit for bit), b's third corner
+ * is the reflection of a's across the diagonal's middle (to 1e-5 of the diagonal), their
+ * areas agree to 1e-5 and their winding normals point the same way. Then *corner is a's
+ * corner off the diagonal and *e1, *e2 the edges from it, so the parallelogram is
+ * corner + s e1 + t e2 over [0,1)^2. */
+static int triangles_form_quad(const Triangle *a, const Triangle *b, vec3 *corner, vec3 *e1, vec3 *e2)
+{
+    const vec3 pa[3] = { a->p0, a->p1, a->p2 }, pb[3] = { b->p0, b->p1, b->p2 };
+    for (int i = 0; i < 3; i++) {
+        vec3 d0 = pa[(i + 1) % 3], d1 = pa[(i + 2) % 3];
+        int j0 = -1, j1 = -1;
+        for (int j = 0; j < 3; j++) {
+            if (v3_same(pb[j], d0)) j0 = j;
+            else if (v3_same(pb[j], d1)) j1 = j;
+        }
+        if (j0 < 0 || j1 < 0) continue;
+        vec3 far = v3_sub(v3_add(d0, d1), pa[i]), off = v3_sub(pb[3 - j0 - j1], far), diag = v3_sub(d1, d0);
+        double off2 = (double)v3_dot(off, off), diag2 = (double)v3_dot(diag, diag);
+        double area_a = triangle_area(a), area_b = triangle_area(b);
+        vec3 na = v3_cross(v3_sub(a->p1, a->p0), v3_sub(a->p2, a->p0));
+        vec3 nb = v3_cross(v3_sub(b->p1, b->p0), v3_sub(b->p2, b->p0));
+        if (!(off2 <= 1e-10 * diag2) || !(fabs(area_a - area_b) <= 1e-5 * area_a) || !(area_a > 0.0) ||
+            !(v3_dot(na, nb) > 0.0f))
+            return 0;
+        *corner = pa[i];
+        *e1 = v3_sub(d0, pa[i]);
+        *e2 = v3_sub(d1, pa[i]);
+        return 1;
+    }
+    return 0;
+}
+
+/* Marks consecutive triangle lights [first, end) that are the halves of a parallelogram
+ * (types.h, LIGHT_QUAD_*) and gives each pair equal power, hence equal choice
+ * probabilities, so that the pair's first light-sample coordinate can run across both. */
+static void pair_quad_lights(const Scene *s, Light *lights, double *power, size_t first, size_t end)
+{
+    uint first_tri = scene_first_triangle(s);
+    for (size_t k = first; k + 1 < end; k++) {
+        const Triangle *a = &s->triangles[lights[k].prim - first_tri];
+        const Triangle *b = &s->triangles[lights[k + 1].prim - first_tri];
+        vec3 corner, e1, e2;
+        if (a->material != b->material || !triangles_form_quad(a, b, &corner, &e1, &e2)) continue;
+        double mean = 0.5 * (power[k] + power[k + 1]);
+        for (size_t h = k; h <= k + 1; h++) {
+            lights[h].quad = h == k ? LIGHT_QUAD_FIRST : LIGHT_QUAD_SECOND;
+            lights[h].position = corner;
+            lights[h].direction = e1;
+            lights[h].intensity = e2;
+            power[h] = mean;
+        }
+        k++;
+    }
+}
+
 static double box_area(const Box *b)
 {
     double dx = (double)b->hi.x - b->lo.x, dy = (double)b->hi.y - b->lo.y, dz = (double)b->hi.z - b->lo.z;
@@ -674,7 +732,9 @@ Status scene_prepare_lights(Scene *s, Error *err)
         k++;                                                                              \
     }
     ADD_LIGHT(s->spheres, s->n_spheres, 0, 4.0 * M_PI * (double)s->spheres[i].radius * s->spheres[i].radius)
+    size_t first_tri_light = k;
     ADD_LIGHT(s->triangles, s->n_triangles, scene_first_triangle(s), triangle_area(&s->triangles[i]))
+    pair_quad_lights(s, lights, power, first_tri_light, k);
     ADD_LIGHT(s->boxes, s->n_boxes, scene_first_box(s), box_area(&s->boxes[i]))
 #undef ADD_LIGHT
     double radius = s->n_delta_lights || env ? scene_radius(s) : 1.0;

@@ -2,7 +2,7 @@
 """Peer benchmark: clpt against Mitsuba 3 and Blender Cycles at equal quality.
 
 usage: bench/peers.py [--clpt build/clpt] [--peers DIR] [--out DIR] [--runs N]
-                      [--ref-spp cornell=1024,dragon=256] [--device DEV] [--threads N]
+                      [--ref-spp cornell=4096,dragon=1024] [--device DEV] [--threads N]
                       [--scenes cornell,dragon]
 
 Renders the two scenes of ../shared/peers (its README says how they were matched across
@@ -15,12 +15,16 @@ with clpt and, when installed, Mitsuba 3 (`pip install mitsuba`; its fast varian
 llvm_ad_rgb needs Debian's libllvm19, else scalar_rgb is used) and Cycles (Debian
 `blender` and `python3-numpy`; the Cornell box only, as in ../shared/peers). The renderers take turns within
 each of --runs rounds (interleaved, so a change in the machine's load hits all of them
-alike); times are medians over the rounds, RMSE the mean over them (seed = round).
+alike); times are medians over the rounds, squared errors the mean over them (seed = round).
 
-RMSE is against a converged reference made by clpt (--ref-spp samples, seed 777, kept in
---out and reused), with silhouette pixels left out as ../shared/peers/compare.py does
-(pixels whose 3x3 neighbourhood in the reference spans more than 0.05 in mean RGB), so
-that renderers with different pixel filters compare on noise and bias. time x MSE is the
+RMSE is against a converged reference made by clpt (--ref-spp samples, kept in --out and
+reused), with silhouette pixels left out as ../shared/peers/compare.py does (pixels whose
+3x3 neighbourhood in the reference spans more than 0.05 in mean RGB), so that renderers
+with different pixel filters compare on noise and bias. The reference is the mean of two
+halves rendered with seeds 777 and 778: a quarter of their squared difference is the
+reference's own squared error, which would otherwise add to every renderer's (the less
+noisy renderer's the most, in proportion), so it is taken off each MSE; at 64 times a
+scene's spp it is 1-2% of clpt's. time x MSE is the
 error-per-time figure (lower is better; for unbiased Monte Carlo, MSE falls as 1/time),
 and "clpt time to equal error" is clpt's time x MSE over the peer's: the share of the
 peer's time that clpt needs to reach the peer's error (below 1: clpt is faster).
@@ -87,11 +91,12 @@ def silhouette_keep(w, h, ref):
     return keep
 
 
-def masked_rmse(img, ref, keep):
+def masked_mse(img, ref, keep):
+    """Mean squared difference over the kept pixels' channels."""
     if np is not None:
         d = (np.frombuffer(img, dtype=np.float32).astype(np.float64) -
              np.frombuffer(ref, dtype=np.float32).astype(np.float64)).reshape(-1, 3)
-        return float(np.sqrt((d[np.asarray(keep, dtype=bool)] ** 2).mean()))
+        return float((d[np.asarray(keep, dtype=bool)] ** 2).mean())
     s, n = 0.0, 0
     for i in range(len(ref) // 3):
         if keep[i]:
@@ -99,7 +104,7 @@ def masked_rmse(img, ref, keep):
                 d = img[3 * i + c] - ref[3 * i + c]
                 s += d * d
             n += 3
-    return math.sqrt(s / max(n, 1))
+    return s / max(n, 1)
 
 
 def run(cmd, cwd=None, env=None):
@@ -206,12 +211,21 @@ class Cycles:
 
 
 def reference(a, scene):
+    """The scene's reference: (width, height, the mean of its two halves, the squared error
+    of that mean as a quarter of the halves' mean squared difference, per kept pixel)."""
     spp = a.ref_spp[scene]
-    path = os.path.join(a.out, 'ref-%s-%d.pfm' % (scene, spp))
-    if not os.path.exists(path):
-        print('making the %s reference with clpt, %d spp (once; kept as %s)...' % (scene, spp, path), flush=True)
-        Clpt(a).render(scene, spp, 777, path)
-    return path
+    halves = []
+    for seed, name in ((777, 'a'), (778, 'b')):
+        path = os.path.join(a.out, 'ref-%s-%d-%s.pfm' % (scene, spp, name))
+        if not os.path.exists(path):
+            print('making half %s of the %s reference with clpt, %d spp (once; kept as %s)...' % (
+                name, scene, spp // 2, path), flush=True)
+            Clpt(a).render(scene, spp // 2, seed, path)
+        halves.append(read_pfm(path))
+    (w, h, ha), (_, _, hb) = halves
+    ref = array.array('f', ((x + y) * 0.5 for x, y in zip(ha, hb)))
+    keep = silhouette_keep(w, h, ref)
+    return w, h, ref, keep, masked_mse(ha, hb, keep) / 4.0
 
 
 def fmt_s(x):
@@ -223,14 +237,19 @@ def main():
     ap.add_argument('--clpt', default='build/clpt')
     ap.add_argument('--peers', default='../shared/peers', help='the folder of the peer scenes and scripts')
     ap.add_argument('--out', default='build/peers')
-    ap.add_argument('--runs', type=int, default=3)
-    ap.add_argument('--ref-spp', default='cornell=1024,dragon=256')
+    ap.add_argument('--runs', type=int, default=3, help='rounds (at least 1)')
+    ap.add_argument('--ref-spp', default='cornell=4096,dragon=1024')
     ap.add_argument('--device', default='', help="clpt's --device (default: clpt's default)")
     ap.add_argument('--threads', type=int, default=2, help="Cycles' render threads")
     ap.add_argument('--scenes', default='cornell,dragon')
     a = ap.parse_args()
     a.peers = os.path.abspath(a.peers)   # the peer scripts run in --out
     a.ref_spp = dict((k, int(v)) for k, v in (x.split('=', 1) for x in a.ref_spp.split(',')))
+    if a.runs < 1:
+        raise SystemExit('--runs %d: at least one round' % a.runs)
+    for s, n in a.ref_spp.items():
+        if n < 2 or n % 2:
+            raise SystemExit('--ref-spp %s=%d: an even number of samples, at least 2 (two halves)' % (s, n))
     scenes = [s for s in a.scenes.split(',') if s]
     for s in scenes:
         if s not in SCENES:
@@ -246,25 +265,27 @@ def main():
         else:
             print('%s: skipped, %s' % (cls.name, cls.install))
     refs = {s: reference(a, s) for s in scenes}
+    for s in scenes:
+        print('%s reference: %d spp in two halves, its own RMSE %.5f (its square is taken off each MSE below)' % (
+            s, a.ref_spp[s], math.sqrt(refs[s][4])), flush=True)
 
     results = {}   # (scene, renderer name) -> list of (times dict, rmse)
     for rnd in range(1, a.runs + 1):
         for s in scenes:
-            w, h, ref = read_pfm(refs[s])
-            keep = silhouette_keep(w, h, ref)
+            _, _, ref, keep, ref_mse = refs[s]
             spp = SCENES[s][1]
             for r in renderers:
                 if r.name == 'cycles' and not SCENES[s][2]:
                     continue
                 out = os.path.join(a.out, '%s-%s-%d.pfm' % (s, r.name, rnd))
                 t = r.render(s, spp, rnd, out)
-                e = masked_rmse(read_pfm(out)[2], ref, keep)
-                results.setdefault((s, r.name), []).append((t, e))
+                mse = masked_mse(read_pfm(out)[2], ref, keep) - ref_mse
+                results.setdefault((s, r.name), []).append((t, mse))
                 print('round %d %-8s %-8s render %6.2f s  wall %6.2f s  RMSE %.5f' % (
-                    rnd, s, r.name, t['render_s'], t['wall_s'], e), flush=True)
+                    rnd, s, r.name, t['render_s'], t['wall_s'], math.sqrt(max(mse, 0.0))), flush=True)
 
     print()
-    print('| scene | renderer | render time | start-up + load + build | Msamples/s | RMSE (masked) '
+    print("| scene | renderer | render time | start-up + load + build | Msamples/s | RMSE (masked, less the reference's own) "
           '| time x MSE | clpt time to equal error |')
     print('|---|---|---|---|---|---|---|---|')
     for s in scenes:
@@ -276,8 +297,8 @@ def main():
                 continue
             render_s = statistics.median(t['render_s'] for t, _ in got)
             setup_s = statistics.median(t['setup_s'] for t, _ in got)
-            e = sum(x for _, x in got) / len(got)
-            rows[r.name] = (r.label, render_s, setup_s, e, render_s * e * e)
+            mse = max(sum(x for _, x in got) / len(got), 0.0)
+            rows[r.name] = (r.label, render_s, setup_s, math.sqrt(mse), render_s * mse)
         clpt_tm = rows['clpt'][4]
         for name, (label, render_s, setup_s, e, tm) in rows.items():
             ratio = '1 (itself)' if name == 'clpt' else '%.2f' % (clpt_tm / tm)

@@ -89,6 +89,17 @@ KFN int sphere_cone_sampling(Sphere sp, float dc2)
     return dc2 > sp.radius * sp.radius * 1.0001f;
 }
 
+/* The solid-angle density of a point sampled uniformly by area on a light of area
+ * `area` with normal n, seen along `to` (length^2 dist2, 1 / length inv_dist). One
+ * function for light_sample_area and light_pdf_area, so that MIS weighs a light
+ * sample with the very density it was drawn with. */
+KFN float light_pdf_by_area(float area, vec3 n, vec3 to, float dist2, float inv_dist)
+{
+    float cos_l = k_fabs(v3_dot(n, to)) * inv_dist;
+    if (cos_l <= 0.0f || area <= 0.0f) return 0.0f;
+    return dist2 / (cos_l * area);
+}
+
 /* Solid-angle density at ref of area light `li` producing point x (normal n), the
  * choice of the light excluded. */
 KFN float light_pdf_area(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
@@ -103,9 +114,7 @@ KFN float light_pdf_area(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
         if (sphere_cone_sampling(sp, dc2))
             return 1.0f / (K_TWO_PI * sphere_cone_one_minus_cos(sp.radius, dc2));
     }
-    float cos_l = k_fabs(v3_dot(n, to)) / k_sqrt(dist2);
-    if (cos_l <= 0.0f || l.area <= 0.0f) return 0.0f;
-    return dist2 / (cos_l * l.area);
+    return light_pdf_by_area(l.area, n, to, dist2, 1.0f / k_sqrt(dist2));
 }
 
 /* The same with the choice of the light among all lights included (for MIS). */
@@ -199,7 +208,6 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, int reuse, flo
             ls->p = v3_madd(sp.center, n, sp.radius);
         }
     } else if (l.prim < first_box) {
-        Triangle tr = sc->triangles[l.prim - first_tri];
         if (reuse && l.quad != LIGHT_QUAD_NONE) {
             /* half of a parallelogram (types.h): the rest of the choice number, u1, is
              * the coordinate along the edge, the first half's on [0, 1/2) and the
@@ -209,11 +217,12 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, int reuse, flo
             float sq = (l.quad == LIGHT_QUAD_SECOND ? 0.5f : 0.0f) + 0.5f * u1;
             ls->p = v3_add(l.position, v3_add(v3_scale(l.direction, sq), v3_scale(l.intensity, u2)));
         } else {
+            Triangle tr = sc->triangles[l.prim - first_tri];
             float b1, b2;
             sample_triangle(u1, u2, &b1, &b2);
             ls->p = v3_add(v3_add(v3_scale(tr.p0, 1.0f - b1 - b2), v3_scale(tr.p1, b1)), v3_scale(tr.p2, b2));
         }
-        ls->n = v3_norm(v3_cross(v3_sub(tr.p1, tr.p0), v3_sub(tr.p2, tr.p0)));
+        ls->n = l.normal;
     } else {
         /* a box: a face chosen by area with the rest of the choice number, then a uniform
          * point on it */
@@ -236,10 +245,15 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, int reuse, flo
         ls->n = v3(axis == 0 ? sign : 0.0f, axis == 1 ? sign : 0.0f, axis == 2 ? sign : 0.0f);
     }
     vec3 to = v3_sub(ls->p, ref);
-    ls->dist = v3_len(to);
+    float dist2 = v3_dot(to, to);
+    ls->dist = k_sqrt(dist2);
     if (!(ls->dist > 0.0f)) return 0;
-    ls->wi = v3_scale(to, 1.0f / ls->dist);
-    ls->pdf = light_pdf_area(sc, li, ref, ls->p, ls->n);
+    float inv_dist = 1.0f / ls->dist;
+    ls->wi = v3_scale(to, inv_dist);
+    /* a sphere sampled by its cone has its own density; every other area light is
+     * sampled by area, whose density needs no second square root or division */
+    ls->pdf = KF_HAS(KF_SPHERES) && l.prim < first_tri ? light_pdf_area(sc, li, ref, ls->p, ls->n)
+                                                       : light_pdf_by_area(l.area, ls->n, to, dist2, inv_dist);
     return ls->pdf > 0.0f && light_faces(sc, l.prim, ls->n, v3_sub(ref, ls->p));
 }
 

@@ -734,6 +734,11 @@ Status scene_prepare_lights(Scene *s, Error *err)
     ADD_LIGHT(s->spheres, s->n_spheres, 0, 4.0 * M_PI * (double)s->spheres[i].radius * s->spheres[i].radius)
     size_t first_tri_light = k;
     ADD_LIGHT(s->triangles, s->n_triangles, scene_first_triangle(s), triangle_area(&s->triangles[i]))
+    for (size_t j = first_tri_light; j < k; j++) {
+        /* the normal surface_at computes for the triangle: the same float operations */
+        const Triangle *t = &s->triangles[lights[j].prim - scene_first_triangle(s)];
+        lights[j].normal = v3_norm(v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0)));
+    }
     pair_quad_lights(s, lights, power, first_tri_light, k);
     ADD_LIGHT(s->boxes, s->n_boxes, scene_first_box(s), box_area(&s->boxes[i]))
 #undef ADD_LIGHT

@@ -160,7 +160,7 @@ KFN float k_atan(float x)
 }
 
 /* atan2(y, x) in [-pi, pi]; 0 for (0, 0). */
-KFN float k_atan2(float y, float x)
+KFN_INLINE_CL float k_atan2(float y, float x)
 {
     if (x == 0.0f && y == 0.0f) return 0.0f;
     if (k_fabs(x) >= k_fabs(y)) {

@@ -201,7 +201,7 @@ KFN float rng_to_float(uint h)
     return (float)(h >> 8) * 5.9604645e-8f;
 }
 
-KFN float rng_uniform(RngKey k, uint bounce, uint dim)
+KFN_INLINE_CL float rng_uniform(RngKey k, uint bounce, uint dim)
 {
     uint h = k.sampler == SAMPLER_SOBOL
                  ? rng_sobol_bits(k, bounce, dim)

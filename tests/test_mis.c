@@ -16,6 +16,7 @@
 #include "harness.h"
 #include "kmath.h"
 #include "lights.h"
+#include "surface.h"
 #include "render_util.h"
 
 enum { W = 32, H = 24, BLOCK = 8 };
@@ -364,7 +365,7 @@ static void test_quad_lamp_samples_uniformly(void)
     Light q = v.lights[1];
     CHECK_EQ_INT(q.quad, LIGHT_QUAD_FIRST);
     double counts[G * G] = { 0 };
-    uint n = 0, off = 0, bad_pdf = 0;
+    uint n = 0, off = 0, bad_pdf = 0, bad_normal = 0;
     vec3 ref = v3(0.5f, 0.0f, 2.0f);
     float lo = v.lights[0].cdf, hi = v.lights[2].cdf;     /* the quad's share of u1 */
     uint32_t h = 12345u;
@@ -397,6 +398,12 @@ static void test_quad_lamp_samples_uniformly(void)
         double dist2 = v3_dot(to, to), cos_l = fabs(v3_dot(ls.n, to)) / sqrt(dist2);
         double want = (double)(q.pick_pdf * 2.0f) / (2.0 * q.area) * dist2 / cos_l;
         if (fabs(ls.pdf - want) > 1e-5 * want || ls.pdf != light_pdf(&v, li, ref, ls.p, ls.n)) bad_pdf++;
+        /* the normal kept in the light is the one a BSDF-sampled ray finds on the lamp
+         * (surface_at), bit for bit, so both strategies' densities agree for MIS */
+        Ray r = { ref, 0.0f, ls.wi, INFINITY };
+        Hit hit = { ls.dist, v.lights[li].prim, 0.25f, 0.25f };
+        Surface sf = surface_at(&v, r, hit);
+        if (memcmp(&sf.ng, &ls.n, sizeof ls.n)) bad_normal++;
     }
     double chi2 = 0.0, expect = (double)(n - off) / (G * G);
     for (int c = 0; c < G * G; c++) chi2 += (counts[c] - expect) * (counts[c] - expect) / expect;
@@ -405,6 +412,7 @@ static void test_quad_lamp_samples_uniformly(void)
     CHECK(n > N / 2);
     CHECK_EQ_INT(off, 0);
     CHECK_EQ_INT(bad_pdf, 0);
+    CHECK_EQ_INT(bad_normal, 0);
     CHECK(chi2 < 103.4);   /* 63 degrees of freedom, p = 0.001 */
     render_scene_free(&rs);
     scene_free(&s);

@@ -64,6 +64,16 @@ static void area_scene_with_box(Scene *s, Material floor_mat, uint spp)
     scene_add_box(s, b, NULL);
 }
 
+/* s prepared for rendering (its tree and light list, render_scene_prepare) in *rs, and
+ * the kernels' view of it in *v, for tests that call the kernel functions directly. */
+static void prepared_view(Scene *s, RenderScene *rs, SceneView *v)
+{
+    Error err = {0};
+    CHECK(render_scene_prepare(s, 0, rs, &err) == ST_OK);
+    error_clear(&err);
+    device_scene_view(&rs->ds, v);
+}
+
 /* Renders with one MIS mode; the scheduler is bypassed by setting the mode on the
  * prepared scene, so render_util's prepare is redone here. */
 static Status render_mode(Scene *s, uint mode, const char *devices, float *rgb, Error *err)
@@ -224,10 +234,8 @@ static void test_light_choice_reuses_u1(void)
     Scene s;
     area_scene_with_box(&s, material_diffuse(v3s(0.5f)), 1);
     RenderScene rs;
-    Error err = {0};
-    CHECK(render_scene_prepare(&s, 0, &rs, &err) == ST_OK);
     SceneView v;
-    device_scene_view(&rs.ds, &v);
+    prepared_view(&s, &rs, &v);
     uint n_lights = rs.ds.params.n_lights;
     CHECK_EQ_INT(n_lights, 4);
     uint chosen[4] = { 0, 0, 0, 0 }, faces[6] = { 0, 0, 0, 0, 0, 0 }, box_samples = 0;
@@ -293,7 +301,6 @@ static void test_light_choice_reuses_u1(void)
         if (faces[f]) CHECK(fabs(faces[f] - chosen[light_of_box] * area[f] / 22.0) <= 2.0);
     render_scene_free(&rs);
     scene_free(&s);
-    error_clear(&err);
 }
 
 /* A scene of two triangle lights of material `mat_b` for the second, the first's
@@ -358,10 +365,8 @@ static void test_quad_lamp_samples_uniformly(void)
     Scene s;
     area_scene(&s, material_diffuse(v3s(0.5f)), 1);
     RenderScene rs;
-    Error err = {0};
-    CHECK(render_scene_prepare(&s, 0, &rs, &err) == ST_OK);
     SceneView v;
-    device_scene_view(&rs.ds, &v);
+    prepared_view(&s, &rs, &v);
     Light q = v.lights[1];
     CHECK_EQ_INT(q.quad, LIGHT_QUAD_FIRST);
     double counts[G * G] = { 0 };
@@ -416,7 +421,6 @@ static void test_quad_lamp_samples_uniformly(void)
     CHECK(chi2 < 103.4);   /* 63 degrees of freedom, p = 0.001 */
     render_scene_free(&rs);
     scene_free(&s);
-    error_clear(&err);
 }
 
 /* A directional light: the path integrator's next-event estimate is exact (one light,

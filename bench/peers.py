@@ -269,7 +269,7 @@ def main():
         print('%s reference: %d spp in two halves, its own RMSE %.5f (its square is taken off each MSE below)' % (
             s, a.ref_spp[s], math.sqrt(refs[s][4])), flush=True)
 
-    results = {}   # (scene, renderer name) -> list of (times dict, rmse)
+    results = {}   # (scene, renderer name) -> list of (times dict, MSE less the reference's)
     for rnd in range(1, a.runs + 1):
         for s in scenes:
             _, _, ref, keep, ref_mse = refs[s]

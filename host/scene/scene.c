@@ -543,13 +543,14 @@ static double triangle_area(const Triangle *t)
 
 static int v3_same(vec3 a, vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 
-/* Whether triangles a and b (lights of one material) are the two halves of one
- * parallelogram: they share two corners (the diagonal, bit for bit), b's third corner
- * is the reflection of a's across the diagonal's middle (to 1e-5 of the diagonal), their
- * areas agree to 1e-5 and their winding normals point the same way. Then *corner is a's
- * corner off the diagonal and *e1, *e2 the edges from it, so the parallelogram is
- * corner + s e1 + t e2 over [0,1)^2. */
-static int triangles_form_quad(const Triangle *a, const Triangle *b, vec3 *corner, vec3 *e1, vec3 *e2)
+/* Whether triangles a and b (lights of one material, unit normals na and nb) are the two
+ * halves of one parallelogram: they share two corners (the diagonal, bit for bit), b's
+ * third corner is the reflection of a's across the diagonal's middle (to 1e-5 of the
+ * diagonal), their areas agree to 1e-5 and their winding normals point the same way.
+ * Then *corner is a's corner off the diagonal and *e1, *e2 the edges from it, so the
+ * parallelogram is corner + s e1 + t e2 over [0,1)^2. */
+static int triangles_form_quad(const Triangle *a, const Triangle *b, vec3 na, vec3 nb, vec3 *corner, vec3 *e1,
+                               vec3 *e2)
 {
     const vec3 pa[3] = { a->p0, a->p1, a->p2 }, pb[3] = { b->p0, b->p1, b->p2 };
     for (int i = 0; i < 3; i++) {
@@ -563,8 +564,6 @@ static int triangles_form_quad(const Triangle *a, const Triangle *b, vec3 *corne
         vec3 far = v3_sub(v3_add(d0, d1), pa[i]), off = v3_sub(pb[3 - j0 - j1], far), diag = v3_sub(d1, d0);
         double off2 = (double)v3_dot(off, off), diag2 = (double)v3_dot(diag, diag);
         double area_a = triangle_area(a), area_b = triangle_area(b);
-        vec3 na = v3_cross(v3_sub(a->p1, a->p0), v3_sub(a->p2, a->p0));
-        vec3 nb = v3_cross(v3_sub(b->p1, b->p0), v3_sub(b->p2, b->p0));
         if (!(off2 <= 1e-10 * diag2) || !(fabs(area_a - area_b) <= 1e-5 * area_a) || !(area_a > 0.0) ||
             !(v3_dot(na, nb) > 0.0f))
             return 0;
@@ -576,9 +575,10 @@ static int triangles_form_quad(const Triangle *a, const Triangle *b, vec3 *corne
     return 0;
 }
 
-/* Marks consecutive triangle lights [first, end) that are the halves of a parallelogram
- * (types.h, LIGHT_QUAD_*) and gives each pair equal power, hence equal choice
- * probabilities, so that the pair's first light-sample coordinate can run across both. */
+/* Marks consecutive triangle lights [first, end), their normals set, that are the halves
+ * of a parallelogram (types.h, LIGHT_QUAD_*) and gives each pair equal power, hence equal
+ * choice probabilities, so that the pair's first light-sample coordinate can run across
+ * both. */
 static void pair_quad_lights(const Scene *s, Light *lights, double *power, size_t first, size_t end)
 {
     uint first_tri = scene_first_triangle(s);
@@ -586,7 +586,9 @@ static void pair_quad_lights(const Scene *s, Light *lights, double *power, size_
         const Triangle *a = &s->triangles[lights[k].prim - first_tri];
         const Triangle *b = &s->triangles[lights[k + 1].prim - first_tri];
         vec3 corner, e1, e2;
-        if (a->material != b->material || !triangles_form_quad(a, b, &corner, &e1, &e2)) continue;
+        if (a->material != b->material ||
+            !triangles_form_quad(a, b, lights[k].normal, lights[k + 1].normal, &corner, &e1, &e2))
+            continue;
         double mean = 0.5 * (power[k] + power[k + 1]);
         for (size_t h = k; h <= k + 1; h++) {
             lights[h].quad = h == k ? LIGHT_QUAD_FIRST : LIGHT_QUAD_SECOND;
@@ -733,10 +735,11 @@ Status scene_prepare_lights(Scene *s, Error *err)
     }
     ADD_LIGHT(s->spheres, s->n_spheres, 0, 4.0 * M_PI * (double)s->spheres[i].radius * s->spheres[i].radius)
     size_t first_tri_light = k;
-    ADD_LIGHT(s->triangles, s->n_triangles, scene_first_triangle(s), triangle_area(&s->triangles[i]))
+    uint first_tri = scene_first_triangle(s);
+    ADD_LIGHT(s->triangles, s->n_triangles, first_tri, triangle_area(&s->triangles[i]))
     for (size_t j = first_tri_light; j < k; j++) {
         /* the normal surface_at computes for the triangle: the same float operations */
-        const Triangle *t = &s->triangles[lights[j].prim - scene_first_triangle(s)];
+        const Triangle *t = &s->triangles[lights[j].prim - first_tri];
         lights[j].normal = v3_norm(v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0)));
     }
     pair_quad_lights(s, lights, power, first_tri_light, k);

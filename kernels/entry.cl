@@ -22,7 +22,8 @@
  *
  * The host builds the path tracer's kernels and the classic ray tracer's as two programs
  * (CLPT_FEATURES with KF_PATH or KF_WHITTED, types.h; a CPU device's path program has
- * KF_PATH_MEGAKERNEL instead, the path tracer as one kernel), each on first use: a driver
+ * KF_PATH_MEGAKERNEL instead, the path tracer as one kernel, or KF_PATH_LANES, the same
+ * eight paths at a time), each on first use: a driver
  * compiles every kernel of a program, so a path-tracer run never waits for k_whitted,
  * nor a whitted run for k_shade. k_film is in both; k_layout only in the whole program
  * (no CLPT_FEATURES: the tests), as PoCL would compile it too in every program for
@@ -31,6 +32,9 @@
 #include "film.cl"
 #include "raygen.cl"
 #include "shade.cl"
+#if KF_HAS(KF_PATH_LANES)
+#include "shade_lanes.cl"
+#endif
 #include "traverse.cl"
 #include "alpha.h"
 #include "whitted.cl"
@@ -175,7 +179,63 @@ __kernel KERNEL_SIZE void k_path(SCENE_ARGS uint first_pixel, uint first_sample,
         if (old + group_rays < old) atomic_inc(&counters[QUEUE_COUNT_STRIDE]);
     }
 }
+
 #endif /* KF_HAS(KF_PATH_MEGAKERNEL) */
+
+#if KF_HAS(KF_PATH_LANES)
+/* k_path with PATH_LANES paths per work-item (kernels/shade_lanes.cl): work-item i runs
+ * wave paths PATH_LANES i to PATH_LANES i + PATH_LANES - 1, tracing each live one's
+ * rays in turn and shading them together, until all have ended. Each path computes the
+ * bits it computes in k_path. Launched over ceil(n_paths / PATH_LANES) work-items. */
+__kernel KERNEL_SIZE void k_path_lanes(SCENE_ARGS uint first_pixel, uint first_sample, uint n_pixels, uint n_paths,
+                                       __global PathState *paths, __global Ray *rays, __global Ray *shadow_rays,
+                                       __global uint *counters)
+{
+    __local uint group_rays;
+    uint first = PATH_LANES * (uint)get_global_id(0);
+    if (get_local_id(0) == 0u) group_rays = 0u;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    uint n_rays = 0u;
+    if (first < n_paths) {
+        SCENE_VIEW(sc);
+        uint path[PATH_LANES];
+        Hit hits[PATH_LANES];
+        uint result[PATH_LANES];
+        uint live = 0u;
+        for (uint l = 0; l < PATH_LANES; l++) {
+            uint i = first + l;
+            path[l] = i;
+            if (i >= n_paths) continue;
+            uint p = first_pixel + i;
+            raygen_path(sc.params, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i]);
+            live |= 1u << l;
+        }
+        while (live) {
+            for (uint l = 0; l < PATH_LANES; l++) {
+                if (!(live & (1u << l))) continue;
+                hits[l] = trace_closest_visible(&sc, rays[path[l]]);
+                n_rays++;
+            }
+            shade_lanes(&sc, live, path, hits, rays, paths, shadow_rays, result);
+            for (uint l = 0; l < PATH_LANES; l++) {
+                if (!(live & (1u << l))) continue;
+                uint i = path[l];
+                if (result[l] & SHADE_SHADOW) {
+                    shadow_resolve(&paths[i], trace_occluded(&sc, shadow_rays[i]));
+                    n_rays++;
+                }
+                if (!(result[l] & SHADE_CONTINUE)) live &= ~(1u << l);
+            }
+        }
+    }
+    if (n_rays) atomic_add(&group_rays, n_rays);
+    barrier(CLK_LOCAL_MEM_FENCE);
+    if (get_local_id(0) == 0u && group_rays) {
+        uint old = atomic_add(&counters[0], group_rays);
+        if (old + group_rays < old) atomic_inc(&counters[QUEUE_COUNT_STRIDE]);
+    }
+}
+#endif /* KF_HAS(KF_PATH_LANES) */
 
 /* Adds the finished wave of n_paths paths to the film. Work-item j owns one pixel, the
  * one of wave path j, and adds every path of the wave on that pixel (j, j + n_pixels,

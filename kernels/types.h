@@ -49,10 +49,14 @@
 #define KF_PATH_MEGAKERNEL 0x80000u     /* the path tracer as one kernel (k_path, k_film) */
 #define KF_KDTREE 0x100000u     /* the scene's tree is the kd-tree (kernels/traverse.cl) */
 #define KF_BVH 0x200000u        /* ... the 8-wide BVH (kernels/traverse_wide.cl) */
-#define KF_ALL 0x3bffffu        /* every bit above (material types 0 to 6) */
+#define KF_PATH_LANES 0x400000u /* the megakernel eight paths at a time (k_path_lanes, k_film;
+                                 * kernels/shade_lanes.cl): CPUs, scenes it shades fast */
+#define KF_ALL 0x7bffffu        /* every bit above (material types 0 to 6) */
 #ifndef CLPT_FEATURES
 #define CLPT_FEATURES KF_ALL
 #endif
+/* Paths per work-item of k_path_lanes (KF_PATH_LANES): one float8 of each quantity. */
+#define PATH_LANES 8u
 /* Whether feature f is compiled in: a constant, so the compiler drops what is not. */
 #define KF_HAS(f) ((CLPT_FEATURES & (f)) != 0u)
 /* m.type == t, known false at compile time when no material of type t is compiled in. */

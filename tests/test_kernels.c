@@ -42,6 +42,7 @@ typedef struct {
 static Cl cl;
 static Scene scene;
 static RenderScene rs;
+static uint plain_material;   /* untextured diffuse: the surfaces k_path_lanes shades eight at a time */
 static KdTree kd;         /* the scene's kd-tree beside its BVH, for the kd-tree kernels */
 static SceneView view;    /* the C side's view of the same scene */
 
@@ -188,14 +189,28 @@ static void build_scene(void)
     }
     Sphere light_sphere = { v3(0.0f, 5.0f, 0.0f), 0.5f, lamp, NO_INDEX, 0, 0 };
     scene_add_sphere(&scene, light_sphere, NULL);
+    scene_add_material(&scene, "plain", material_diffuse(v3(0.6f, 0.6f, 0.5f)), &plain_material, NULL);
     for (int i = 0; i < 30; i++) {
         vec3 c = vrand(-3.0f, 3.0f);
-        Triangle t = { v3_add(c, vrand(-1.0f, 1.0f)), mats[i % 14], v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX,
+        uint m = i % 3 == 0 ? plain_material : mats[i % 14];
+        Triangle t = { v3_add(c, vrand(-1.0f, 1.0f)), m, v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX,
                        v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX };
         scene_add_triangle(&scene, t, NULL);
     }
     Triangle lt = { v3(-1.0f, 4.0f, -1.0f), lamp, v3(1.0f, 4.0f, -1.0f), NO_INDEX, v3(0.0f, 4.0f, 1.0f), NO_INDEX };
     scene_add_triangle(&scene, lt, NULL);
+    /* a floor under it all */
+    Triangle f1 = { v3(-10.0f, -1.2f, -10.0f), plain_material, v3(-10.0f, -1.2f, 10.0f), NO_INDEX,
+                    v3(10.0f, -1.2f, 10.0f), NO_INDEX };
+    Triangle f2 = { v3(-10.0f, -1.2f, -10.0f), plain_material, v3(10.0f, -1.2f, 10.0f), NO_INDEX,
+                    v3(10.0f, -1.2f, -10.0f), NO_INDEX };
+    scene_add_triangle(&scene, f1, NULL);
+    scene_add_triangle(&scene, f2, NULL);
+    /* a quad lamp facing down, as two triangles (sampled as one parallelogram) */
+    Triangle q1 = { v3(-1.0f, 4.5f, 2.0f), lamp, v3(1.0f, 4.5f, 2.0f), NO_INDEX, v3(1.0f, 4.5f, 3.0f), NO_INDEX };
+    Triangle q2 = { v3(-1.0f, 4.5f, 2.0f), lamp, v3(1.0f, 4.5f, 3.0f), NO_INDEX, v3(-1.0f, 4.5f, 3.0f), NO_INDEX };
+    scene_add_triangle(&scene, q1, NULL);
+    scene_add_triangle(&scene, q2, NULL);
     for (int i = 0; i < 4; i++) {
         vec3 lo = vrand(-3.0f, 2.0f);
         Box b = { lo, mats[(i * 3) % 14], v3_add(lo, vrand(0.2f, 1.0f)), NO_INDEX };
@@ -433,16 +448,19 @@ static void test_raygen(void)
 /* k_path, the megakernel (the CPUs' form of the path tracer): every path from birth to
  * end in one work-item, against the scalar device's loop in C (device_scalar.c): the
  * same path states bit for bit, and the same number of rays, counted per work-group
- * into a low word and a carry word. Launched with surplus work-items. */
-static void test_path_kernel(void)
+ * into a low word and a carry word. Launched with surplus work-items. k_path_lanes
+ * (per_item PATH_LANES paths per work-item) must give the same; the last work-item has
+ * fewer than eight paths. */
+static void check_path_kernel(const char *name, uint per_item)
 {
     const RenderParams *p = &rs.ds.params;
-    uint npix = p->width * p->height, n = npix * LAYERS, first_pixel = 7, first_sample = 3;
+    /* a last work-item of k_path_lanes with fewer than eight paths */
+    uint npix = p->width * p->height, n = npix * LAYERS - (per_item > 1u ? 5u : 0u), first_pixel = 7, first_sample = 3;
     cl_uint init[2 * QUEUE_COUNT_STRIDE] = { 0 };
     init[0] = 0xfffff000u;   /* near the top: the count wraps the low word and carries */
     cl_mem paths = buffer(n * sizeof(PathState), NULL), rays = buffer(n * sizeof(Ray), NULL),
            shadow = buffer(n * sizeof(Ray), NULL), counters = buffer(sizeof init, init);
-    cl_kernel k = kernel("k_path");
+    cl_kernel k = kernel(name);
     set_scene_args(k);
     SET(k, N_SCENE + 0, first_pixel);
     SET(k, N_SCENE + 1, first_sample);
@@ -452,12 +470,12 @@ static void test_path_kernel(void)
     SET(k, N_SCENE + 5, rays);
     SET(k, N_SCENE + 6, shadow);
     SET(k, N_SCENE + 7, counters);
-    run(k, n + 37);
+    run(k, (n + per_item - 1u) / per_item + 37u);
     PathState *dp = malloc(n * sizeof *dp);
     cl_uint got[2 * QUEUE_COUNT_STRIDE];
     read_back(paths, n * sizeof *dp, dp);
     read_back(counters, sizeof got, got);
-    uint exact = 0, lit = 0;
+    uint exact = 0, lit = 0, plain_hits = 0;
     uint64_t c_rays = 0;
     for (uint i = 0; i < n; i++) {
         PathState cp;
@@ -468,6 +486,10 @@ static void test_path_kernel(void)
         for (;;) {
             Hit hit = trace_closest_visible(&view, cr);
             c_rays++;
+            uint first_tri = p->n_spheres;
+            if (hit.prim != NO_INDEX && hit.prim >= first_tri && hit.prim < first_tri + p->n_triangles &&
+                view.triangles[hit.prim - first_tri].material == plain_material)
+                plain_hits++;
             uint r = shade_path(&view, &cr, hit, &cp, &cs);
             if (r & SHADE_SHADOW) {
                 shadow_resolve(&cp, trace_occluded(&view, cs));
@@ -481,9 +503,10 @@ static void test_path_kernel(void)
         if (!same && i + 1 - exact <= 3) report_words("path state", i, &cp, &dp[i], sizeof cp);
     }
     uint64_t d_rays = (uint64_t)got[0] + ((uint64_t)got[QUEUE_COUNT_STRIDE] << 32);
-    fprintf(stderr, "  k_path: %u paths, %u lit, %llu rays, %u bit-identical to C\n", n, lit,
-            (unsigned long long)c_rays, exact);
+    fprintf(stderr, "  %s: %u paths, %u lit, %llu rays (%u hits on plain diffuse triangles), %u bit-identical to C\n",
+            name, n, lit, (unsigned long long)c_rays, plain_hits, exact);
     CHECK_EQ_INT(exact, n);
+    CHECK(plain_hits > n / 4);
     CHECK(lit > n / 4);
     CHECK_MSG(d_rays == 0xfffff000ull + c_rays, "rays: device %llu, C %llu", (unsigned long long)(d_rays - 0xfffff000ull),
               (unsigned long long)c_rays);
@@ -495,6 +518,10 @@ static void test_path_kernel(void)
     clReleaseMemObject(shadow);
     clReleaseMemObject(counters);
 }
+
+static void test_path_kernel(void) { check_path_kernel("k_path", 1u); }
+
+static void test_path_lanes_kernel(void) { check_path_kernel("k_path_lanes", PATH_LANES); }
 
 /* Random rays through the scene's box, from inside and outside it. */
 static Ray random_ray(void)
@@ -1256,6 +1283,7 @@ int main(void)
     RUN(test_layout);
     RUN(test_raygen);
     RUN(test_path_kernel);
+    RUN(test_path_lanes_kernel);
     RUN(test_intersect);
     RUN(test_trace_kernels);
     RUN(test_shade_and_shadow);

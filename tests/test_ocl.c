@@ -643,7 +643,8 @@ static void test_program_per_integrator(void)
     static const struct { unsigned features; const char *has[3], *lacks[3]; } programs[] = {
         { KF_PATH, { "k_raygen", "k_shade", "k_film" }, { "k_whitted", "k_layout", "k_path" } },
         { KF_WHITTED, { "k_whitted", "k_film", "k_film" }, { "k_shade", "k_raygen", "k_path" } },
-        { KF_PATH_MEGAKERNEL, { "k_path", "k_film", "k_film" }, { "k_shade", "k_raygen", "k_whitted" } },
+        { KF_PATH_MEGAKERNEL, { "k_path", "k_film", "k_film" }, { "k_shade", "k_raygen", "k_path_lanes" } },
+        { KF_PATH_LANES, { "k_path_lanes", "k_film", "k_film" }, { "k_path", "k_shade", "k_whitted" } },
     };
     for (size_t i = 0; i < sizeof programs / sizeof programs[0]; i++) {
         char options[96];
@@ -666,6 +667,7 @@ static void test_kernels_declare_the_launch_size(void)
         { KF_PATH, { "k_raygen", "k_intersect", "k_shade", "k_shadow", "k_film" } },
         { KF_WHITTED, { "k_whitted", "k_film", NULL, NULL, NULL } },
         { KF_PATH_MEGAKERNEL, { "k_path", "k_film", NULL, NULL, NULL } },
+        { KF_PATH_LANES, { "k_path_lanes", "k_film", NULL, NULL, NULL } },
     };
     for (size_t i = 0; i < sizeof programs / sizeof programs[0]; i++) {
         char options[96];
@@ -700,7 +702,7 @@ static void test_feature_switches_compile_cleanly(void)
         fprintf(stderr, "  (no clang: the feature switches were not compiled)\n");
         return;
     }
-    static const unsigned programs[] = { KF_PATH, KF_WHITTED, KF_PATH_MEGAKERNEL };
+    static const unsigned programs[] = { KF_PATH, KF_WHITTED, KF_PATH_MEGAKERNEL, KF_PATH_LANES };
     /* each switch alone, and each of the two trees */
     static const unsigned switches[] = { 1u << 0, 1u << 1, 1u << 2, 1u << 3, 1u << 4, 1u << 5, 1u << 6, 1u << 7,
                                          1u << 8, 1u << 9, 1u << 10, 1u << 11, 1u << 12, 1u << 13, 1u << 14,
@@ -719,7 +721,8 @@ static void test_feature_switches_compile_cleanly(void)
             CHECK_MSG(rc == 0 && n == 0, "CLPT_FEATURES=0x%x: %s", features, out);
         }
     }
-    CHECK_EQ_INT(KF_ALL, ((KF_MATERIAL(MAT_PRINCIPLED) << 1) - 1u) | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH);
+    CHECK_EQ_INT(KF_ALL, ((KF_MATERIAL(MAT_PRINCIPLED) << 1) - 1u) | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH |
+                         KF_PATH_LANES);
 }
 
 static void test_cache_location(void)

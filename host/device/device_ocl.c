@@ -112,6 +112,8 @@ typedef struct {
     uint wave_auto;         /* a GPU's large default wave, used where it fits (load_scene); 0 if none */
     size_t local_size;      /* 0: let the driver choose */
     int launch;             /* enum WaveLaunch, never AUTO: how a wave is launched */
+    int cpu;                /* a CPU device: the megakernel may take eight paths at a time */
+    int lanes;              /* the megakernel is k_path_lanes (lanes_suit the loaded scene) */
     uint n_pixels;
     const atomic_int *cancel;   /* the Device's, while a batch renders */
     cl_mem film;            /* the film the batch being rendered goes to */
@@ -407,7 +409,23 @@ static Status set_program_args(OclDevice *od, int which, Error *err)
 static unsigned program_kernels(const OclDevice *od, int which)
 {
     if (which == PROG_WHITTED) return KF_WHITTED;
-    return od->launch == WAVE_LAUNCH_MEGAKERNEL ? KF_PATH_MEGAKERNEL : KF_PATH;
+    if (od->launch != WAVE_LAUNCH_MEGAKERNEL) return KF_PATH;
+    return od->lanes ? KF_PATH_LANES : KF_PATH_MEGAKERNEL;
+}
+
+/* Whether a CPU's megakernel should run eight paths per work-item (k_path_lanes,
+ * kernels/shade_lanes.cl): when the scene's surfaces are all flat triangles of plain
+ * diffuse materials and lamps, which shade_lanes shades eight at a time. Any other lane
+ * goes through shade_path there as well, so the images are the same either way; but
+ * where most lanes would, carrying eight paths costs more than it saves (on PoCL the
+ * envmap scene rendered 11% slower, mesh.scene 19%), and those scenes keep k_path. */
+static int lanes_suit(const OclDevice *od, const DeviceScene *s)
+{
+    const RenderParams *p = &s->params;
+    unsigned plain = KF_MATERIAL(MAT_DIFFUSE) | KF_MATERIAL(MAT_EMISSIVE) | KF_KDTREE | KF_BVH;
+    return od->cpu && od->launch == WAVE_LAUNCH_MEGAKERNEL && (od->scene_features & ~plain) == 0u &&
+           s->n_shading == 0u && p->n_triangles > 0u && p->n_lights > 0u && p->sampler == SAMPLER_SOBOL &&
+           p->mis_mode == MIS_BOTH && p->shadows;
 }
 
 /* Builds the program the integrator needs, for the loaded scene's features, unless the
@@ -437,8 +455,9 @@ static Status need_program(Device *d, OclDevice *od, uint integrator, Error *err
         /* each wave has its own kernel objects, so that their fixed arguments are set once */
         for (int i = 0; i < WAVE_SLOTS; i++) {
             WaveSlot *w = &od->waves[i];
-            if (want & KF_PATH_MEGAKERNEL) {
-                if ((st = ocl_program_kernel(prog, &od->info, "k_path", &w->k_path, err)) ||
+            if (want & (KF_PATH_MEGAKERNEL | KF_PATH_LANES)) {
+                const char *name = want & KF_PATH_LANES ? "k_path_lanes" : "k_path";
+                if ((st = ocl_program_kernel(prog, &od->info, name, &w->k_path, err)) ||
                     (st = ocl_program_kernel(prog, &od->info, "k_film", &w->k_film, err)))
                     break;
                 continue;
@@ -541,6 +560,7 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     od->n_pixels = n_pixels;
     /* a program built for an earlier scene serves this one if it has its features */
     od->scene_features = scene_features(s);
+    od->lanes = lanes_suit(od, s);
     for (int i = 0; i < PROG_N; i++) {
         unsigned need = od->scene_features | program_kernels(od, i);
         if ((od->features[i] & need) != need) release_program(od, i);
@@ -708,7 +728,8 @@ static Status wave_run_paths(OclDevice *od, WaveSlot *w, Error *err)
     ARG(k, ARG_PATH_FIRST_PIXEL, w->first_pixel);
     ARG(k, ARG_PATH_FIRST_SAMPLE, w->first_sample);
     ARG(k, ARG_PATH_N_PATHS, w->n_paths);
-    if ((st = launch(od, k, "k_path", w->n_paths, err)) || (st = wave_film(od, w, err))) return st;
+    uint items = od->lanes ? (w->n_paths + PATH_LANES - 1u) / PATH_LANES : w->n_paths;
+    if ((st = launch(od, k, "k_path", items, err)) || (st = wave_film(od, w, err))) return st;
     OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, w->counts, CL_FALSE, 0, sizeof w->got, w->got, 0,
                                                        NULL, &w->read));
     OCL_TRY("clFlush", clFlush(od->queue));
@@ -977,6 +998,7 @@ static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error
     od->wave_paths = cfg && cfg->wave_paths ? cfg->wave_paths : (gpu ? gpu_wave : (1u << 16));
     od->wave_auto = cfg && cfg->wave_paths ? 0u : (gpu && gpu_wave > (1u << 20) ? gpu_wave : 0u);
     od->local_size = od->info.max_work_group >= OCL_LOCAL_SIZE ? OCL_LOCAL_SIZE : 0;
+    od->cpu = (od->info.type & CL_DEVICE_TYPE_CPU) != 0;
     od->launch = cfg && cfg->wave_launch ? cfg->wave_launch
                  : gpu ? WAVE_LAUNCH_BOUNDED : profile ? WAVE_LAUNCH_COUNTED : WAVE_LAUNCH_MEGAKERNEL;
     return ST_OK;

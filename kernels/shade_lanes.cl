@@ -1,0 +1,361 @@
+/*
+ * shade_lanes.cl — one bounce of eight paths at once, for CPUs (OpenCL only).
+ *
+ * PoCL cannot vectorise shade_path across work-items (bench/RESULTS.md: clang's SLP
+ * vectoriser turns its vec3 arithmetic into 2-wide vectors first, and LLVM's loop
+ * vectoriser then refuses the work-item loop), so shading ran one path at a time while
+ * the traversal used eight lanes. Here a work-item holds eight paths, and the common
+ * case, a flat triangle of a plain diffuse material lit through an area light with the
+ * Sobol sampler and MIS, is shaded as float8 arithmetic: the same operations as
+ * shade_path in the same order, each lane IEEE-rounded as the scalar would be, so
+ * every lane computes the bits shade_path computes (test_kernels compares them). The
+ * integer sampler, the light choice and the gathers stay per lane. Every other lane
+ * (any other primitive, material, light or setting) calls shade_path itself.
+ */
+#ifndef CLPT_SHADE_LANES_CL
+#define CLPT_SHADE_LANES_CL
+
+#include "shade.cl"
+
+
+typedef struct { float8 x, y, z; } vec3x8;
+
+KFN_INLINE vec3x8 w3(float8 x, float8 y, float8 z) { vec3x8 r; r.x = x; r.y = y; r.z = z; return r; }
+KFN_INLINE vec3x8 w3_add(vec3x8 a, vec3x8 b) { return w3(a.x + b.x, a.y + b.y, a.z + b.z); }
+KFN_INLINE vec3x8 w3_sub(vec3x8 a, vec3x8 b) { return w3(a.x - b.x, a.y - b.y, a.z - b.z); }
+KFN_INLINE vec3x8 w3_mul(vec3x8 a, vec3x8 b) { return w3(a.x * b.x, a.y * b.y, a.z * b.z); }
+KFN_INLINE vec3x8 w3_scale(vec3x8 a, float8 s) { return w3(a.x * s, a.y * s, a.z * s); }
+KFN_INLINE vec3x8 w3_neg(vec3x8 a) { return w3(-a.x, -a.y, -a.z); }
+KFN_INLINE float8 w3_dot(vec3x8 a, vec3x8 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+KFN_INLINE vec3x8 w3_cross(vec3x8 a, vec3x8 b)
+{
+    return w3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+/* per lane: b where m is set (-1), else a */
+KFN_INLINE vec3x8 w3_select(vec3x8 a, vec3x8 b, int8 m)
+{
+    return w3(select(a.x, b.x, m), select(a.y, b.y, m), select(a.z, b.z, m));
+}
+/* k_fmin / k_fmax lane by lane (compat.h: a NaN argument loses) */
+KFN_INLINE float8 w_fmin(float8 a, float8 b) { return select(a, b, (b < a) | (a != a)); }
+KFN_INLINE float8 w_fmax(float8 a, float8 b) { return select(a, b, (b > a) | (a != a)); }
+KFN_INLINE float8 w3_max_comp(vec3x8 a) { return w_fmax(a.x, w_fmax(a.y, a.z)); }
+KFN_INLINE float8 w_copysign(float8 mag, float8 sgn)
+{
+    return as_float8((as_uint8(mag) & 0x7fffffffu) | (as_uint8(sgn) & 0x80000000u));
+}
+
+/* offset_coord (surface.h) lane by lane */
+KFN_INLINE float8 w_offset_coord(float8 p, float8 n)
+{
+    int8 ulps = convert_int8(256.0f * n);
+    float8 moved = as_float8(as_int8(p) + select(ulps, -ulps, p < 0.0f));
+    return select(moved, p + 1.52587890625e-5f * n, fabs(p) < 0.03125f);
+}
+KFN_INLINE vec3x8 w_offset_ray_origin(vec3x8 p, vec3x8 n)
+{
+    return w3(w_offset_coord(p.x, n.x), w_offset_coord(p.y, n.y), w_offset_coord(p.z, n.z));
+}
+
+/* sample_cosine_hemisphere (sampling.h) lane by lane, through sample_disk's selects */
+KFN_INLINE vec3x8 w_sample_cosine_hemisphere(float8 u1, float8 u2)
+{
+    float8 a = 2.0f * u1 - 1.0f, b = 2.0f * u2 - 1.0f;
+    int8 zero = (a == 0.0f) & (b == 0.0f);
+    int8 about_x = a * a > b * b;
+    float8 r = select(b, a, about_x);
+    float8 t = 0.785398163f * (select(a, b, about_x) / r);
+    float8 t2 = t * t;
+    float8 s = t + t * t2 * (-0.166666667f + t2 * (8.33333333e-3f + t2 * (-1.98412698e-4f + t2 * 2.75573192e-6f)));
+    float8 c = 1.0f + t2 * (-0.5f + t2 * (4.16666667e-2f + t2 * (-1.38888889e-3f + t2 * 2.48015873e-5f)));
+    float8 x = select(r * select(s, c, about_x), 0.0f, zero);
+    float8 y = select(r * select(c, s, about_x), 0.0f, zero);
+    return w3(x, y, sqrt(w_fmax(1.0f - x * x - y * y, 0.0f)));
+}
+
+/* k_onb and k_to_world (kmath.h) lane by lane */
+KFN_INLINE vec3x8 w_to_world_onb(vec3x8 v, vec3x8 n)
+{
+    float8 sign = w_copysign((float8)(1.0f), n.z);
+    float8 a = -1.0f / (sign + n.z);
+    float8 bb = n.x * n.y * a;
+    vec3x8 t = w3(1.0f + sign * n.x * n.x * a, sign * bb, -sign * n.x);
+    vec3x8 b = w3(bb, sign + n.y * n.y * a, -n.y);
+    return w3_add(w3_add(w3_scale(t, v.x), w3_scale(b, v.y)), w3_scale(n, v.z));
+}
+
+/* The Sobol sampler of rng.h lane by lane (uint8): the same integer operations, so the
+ * same bits; the byte swap as shifts, which give what bswap does. */
+KFN_INLINE uint8 w_rng_hash(uint8 x)
+{
+    x ^= x >> 16;
+    x *= 0x21f0aaadu;
+    x ^= x >> 15;
+    x *= 0x735a2d97u;
+    x ^= x >> 15;
+    return x;
+}
+KFN_INLINE uint8 w_reverse_bits(uint8 x)
+{
+    x = (x << 16) | (x >> 16);
+    x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu);
+    x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu);
+    x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
+    return ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
+}
+KFN_INLINE uint8 w_lk_permute(uint8 x, uint8 seed)
+{
+    x ^= x * 0x3d20adeau;
+    x += seed;
+    x *= (seed >> 16) | 1u;
+    x ^= x * 0x05526c56u;
+    x ^= x * 0x53a22864u;
+    return x;
+}
+KFN_INLINE uint8 w_sobol1_reversed(uint8 index)
+{
+    index ^= (index >> 1) & 0x55555555u;
+    index ^= (index >> 2) & 0x33333333u;
+    index ^= (index >> 4) & 0x0f0f0f0fu;
+    index ^= (index >> 8) & 0x00ff00ffu;
+    index ^= (index >> 16) & 0x0000ffffu;
+    return index;
+}
+KFN_INLINE float8 w_rng_to_float(uint8 h) { return convert_float8(h >> 8) * 5.9604645e-8f; }
+/* rng_uniform2 (coord 0 and 1 of a pair's pattern) or rng_uniform of a 1D dimension
+ * (coord 0 only) for keys `key`, reversed sample indices `rev`, bounces `bounce` */
+KFN_INLINE void w_rng_pair(uint8 key, uint8 rev, uint8 bounce, uint first, float8 *u, float8 *v)
+{
+    uint8 pattern = w_rng_hash(key + (bounce * (uint)RNG_DIMS_PER_BOUNCE + first) * 0x9e3779b9u);
+    uint8 index = w_reverse_bits(w_lk_permute(rev, pattern));
+    *u = w_rng_to_float(w_reverse_bits(w_lk_permute(index, pattern * 0x297a2d39u + 0x68e31da4u)));
+    if (v) *v = w_rng_to_float(w_reverse_bits(w_lk_permute(w_sobol1_reversed(index), pattern * 0x2c1b3c6du + 0x68e31da4u)));
+}
+
+/* One lane's inputs to the vector shading, gathered per lane. */
+typedef struct {
+    float dx[PATH_LANES], dy[PATH_LANES], dz[PATH_LANES];
+    float hu[PATH_LANES], hv[PATH_LANES];
+    float p0x[PATH_LANES], p0y[PATH_LANES], p0z[PATH_LANES], p1x[PATH_LANES], p1y[PATH_LANES], p1z[PATH_LANES], p2x[PATH_LANES], p2y[PATH_LANES], p2z[PATH_LANES];
+    float ar[PATH_LANES], ag[PATH_LANES], ab[PATH_LANES];            /* albedo */
+    float tr[PATH_LANES], tg[PATH_LANES], tb[PATH_LANES];            /* throughput */
+    float lpx[PATH_LANES], lpy[PATH_LANES], lpz[PATH_LANES];         /* light sample point */
+    float lnx[PATH_LANES], lny[PATH_LANES], lnz[PATH_LANES];         /* its normal */
+    float ler[PATH_LANES], leg[PATH_LANES], leb[PATH_LANES];         /* its radiance */
+    float larea[PATH_LANES], lchoice[PATH_LANES];
+    int ltwo[PATH_LANES];                                  /* -1: two-sided lamp */
+    int rr[PATH_LANES];                                    /* -1: roulette at this bounce */
+    uint key[PATH_LANES], rev[PATH_LANES], bounce[PATH_LANES];
+} LaneInputs;
+
+/* Whether shade_lanes_fast can shade this path; when it can, fills lane l of in.
+ * `uniform` says whether the render's settings allow it at all. */
+KFN_INLINE int lane_gather(const SceneView *sc, int uniform, GLOBAL const Ray *ray, Hit hit,
+                           GLOBAL const PathState *ps, LaneInputs *in, uint l)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    if (!uniform) return 0;
+    uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
+    if (hit.prim == NO_INDEX || hit.prim < first_tri || hit.prim >= first_box) return 0;
+    uint bounce = ps->bounce;
+    if (bounce >= p->max_depth) return 0;
+    GLOBAL const Triangle *tri = &sc->triangles[hit.prim - first_tri];
+    if (tri->shading != NO_INDEX) return 0;
+    GLOBAL const Material *m = &sc->materials[tri->material];
+    if (m->type != MAT_DIFFUSE || !v3_is_zero(m->emission)) return 0;
+    if (KF_HAS(KF_TEXTURES) && (m->texture != NO_INDEX || m->texture_emission != NO_INDEX)) return 0;
+    RngKey key = rng_key_of(ps, p);
+    float lu, lv, u_rest;
+    rng_uniform2(key, bounce, DIM_LIGHT_U, &lu, &lv);
+    uint li = light_choose(sc, lu * 1.0f, &u_rest);
+    GLOBAL const Light *lt = &sc->lights[li];
+    if (lt->type != LIGHT_AREA || lt->prim < first_tri || lt->prim >= first_box) return 0;
+    /* light_sample_area's point on a triangle light */
+    vec3 lp;
+    if (lt->quad != LIGHT_QUAD_NONE) {
+        float sq = (lt->quad == LIGHT_QUAD_SECOND ? 0.5f : 0.0f) + 0.5f * u_rest;
+        lp = v3_add(lt->position, v3_add(v3_scale(lt->direction, sq), v3_scale(lt->intensity, lv)));
+    } else {
+        Triangle ltr = sc->triangles[lt->prim - first_tri];
+        float b1, b2;
+        sample_triangle(u_rest, lv, &b1, &b2);
+        lp = v3_add(v3_add(v3_scale(ltr.p0, 1.0f - b1 - b2), v3_scale(ltr.p1, b1)), v3_scale(ltr.p2, b2));
+    }
+    GLOBAL const Material *lm = &sc->materials[sc->triangles[lt->prim - first_tri].material];
+    in->dx[l] = ray->d.x; in->dy[l] = ray->d.y; in->dz[l] = ray->d.z;
+    in->hu[l] = hit.u; in->hv[l] = hit.v;
+    in->p0x[l] = tri->p0.x; in->p0y[l] = tri->p0.y; in->p0z[l] = tri->p0.z;
+    in->p1x[l] = tri->p1.x; in->p1y[l] = tri->p1.y; in->p1z[l] = tri->p1.z;
+    in->p2x[l] = tri->p2.x; in->p2y[l] = tri->p2.y; in->p2z[l] = tri->p2.z;
+    in->ar[l] = m->albedo.x; in->ag[l] = m->albedo.y; in->ab[l] = m->albedo.z;
+    in->tr[l] = ps->throughput.x; in->tg[l] = ps->throughput.y; in->tb[l] = ps->throughput.z;
+    in->lpx[l] = lp.x; in->lpy[l] = lp.y; in->lpz[l] = lp.z;
+    in->lnx[l] = lt->normal.x; in->lny[l] = lt->normal.y; in->lnz[l] = lt->normal.z;
+    in->ler[l] = lm->emission.x; in->leg[l] = lm->emission.y; in->leb[l] = lm->emission.z;
+    in->larea[l] = lt->area;
+    in->lchoice[l] = lt->pick_pdf / 1.0f;
+    in->ltwo[l] = (lm->flags & MAT_TWO_SIDED) ? -1 : 0;
+    in->rr[l] = bounce + 1u > p->rr_depth ? -1 : 0;
+    in->key[l] = key.key;
+    in->rev[l] = key.sample_rev;
+    in->bounce[l] = bounce;
+    return 1;
+}
+
+#define LANE_LOAD(name) vload8(0, in->name)
+#define LANE_LOAD3(a, b, c) w3(vload8(0, in->a), vload8(0, in->b), vload8(0, in->c))
+
+/* The lanes' results, scattered per lane by the caller. */
+typedef struct {
+    float8 ox, oy, oz, dx, dy, dz;                 /* next ray */
+    float8 sox, soy, soz, sdx, sdy, sdz, stmax;    /* shadow ray */
+    float8 lr, lg, lb;                             /* shadow_L */
+    float8 tr, tg, tb, pdf;                        /* throughput, bsdf_pdf */
+    int8 shadow, advance, cont;                    /* -1 where: a shadow ray; bounce + 1; goes on */
+} LaneResults;
+
+/* shade_path for eight gathered lanes of the common case (see the top of this file). */
+KFN_INLINE void shade_lanes_fast(const LaneInputs *in, LaneResults *out)
+{
+    /* surface_at: the triangle's point by barycentrics and its winding normal */
+    float8 u = LANE_LOAD(hu), v = LANE_LOAD(hv);
+    float8 w = 1.0f - u - v;
+    vec3x8 p0 = LANE_LOAD3(p0x, p0y, p0z), p1 = LANE_LOAD3(p1x, p1y, p1z), p2 = LANE_LOAD3(p2x, p2y, p2z);
+    vec3x8 sp = w3_add(w3_add(w3_scale(p0, w), w3_scale(p1, u)), w3_scale(p2, v));
+    vec3x8 ng = w3_cross(w3_sub(p1, p0), w3_sub(p2, p0));
+    ng = w3_scale(ng, 1.0f / sqrt(w3_dot(ng, ng)));
+    vec3x8 d = LANE_LOAD3(dx, dy, dz);
+    int8 front = w3_dot(d, ng) < 0.0f;
+    vec3x8 ng_face = w3_select(w3_neg(ng), ng, front);
+    vec3x8 albedo = LANE_LOAD3(ar, ag, ab);
+    vec3x8 thr0 = LANE_LOAD3(tr, tg, tb);
+
+    /* shade_light_sample through light_sample_area and light_pdf_by_area */
+    vec3x8 lp = LANE_LOAD3(lpx, lpy, lpz), ln = LANE_LOAD3(lnx, lny, lnz);
+    vec3x8 to = w3_sub(lp, sp);
+    float8 dist2 = w3_dot(to, to);
+    float8 dist = sqrt(dist2);
+    int8 ok = dist > 0.0f;
+    float8 inv_dist = 1.0f / dist;
+    vec3x8 wi = w3_scale(to, inv_dist);
+    float8 area = LANE_LOAD(larea);
+    float8 cos_l = fabs(w3_dot(ln, to)) * inv_dist;
+    float8 lpdf = select(dist2 / (cos_l * area), 0.0f, (cos_l <= 0.0f) | (area <= 0.0f));
+    int8 faces = vload8(0, in->ltwo) | (w3_dot(ln, w3_sub(sp, lp)) > 0.0f);
+    ok &= (lpdf > 0.0f) & faces;
+    lpdf = lpdf * LANE_LOAD(lchoice);
+    ok &= lpdf > 0.0f;
+    float8 cos_s = w3_dot(ng_face, wi);
+    float8 cos_g = w3_dot(ng_face, wi);
+    ok &= (cos_s != 0.0f) & ~(cos_s < 0.0f) & ~(cos_g <= 0.0f);
+    /* bsdf_eval of the diffuse lobe */
+    int8 no_f = cos_s <= 0.0f;
+    float8 bpdf = select(cos_s * K_INV_PI, 0.0f, no_f);
+    vec3x8 f = w3_select(w3_scale(albedo, (float8)(K_INV_PI)), w3((float8)(0.0f), (float8)(0.0f), (float8)(0.0f)), no_f);
+    float8 a2 = lpdf * lpdf, b2 = bpdf * bpdf;
+    float8 mis = select(0.0f, a2 / (a2 + b2), a2 + b2 > 0.0f);
+    vec3x8 f_cos = w3_scale(f, cos_s * mis / lpdf);
+    vec3x8 L = w3_mul(w3_mul(thr0, f_cos), LANE_LOAD3(ler, leg, leb));
+    vec3x8 o = w_offset_ray_origin(sp, ng_face);
+    vec3x8 target = w_offset_ray_origin(lp, w3_select(ln, w3_neg(ln), w3_dot(ln, wi) > 0.0f));
+    int8 infinite = ~(dist < INFINITY);
+    vec3x8 sd = w3_select(w3_sub(target, o), wi, infinite);
+    out->shadow = ok;
+    out->sox = o.x; out->soy = o.y; out->soz = o.z;
+    out->sdx = sd.x; out->sdy = sd.y; out->sdz = sd.z;
+    out->stmax = select((float8)(0.9999f), (float8)(INFINITY), infinite);
+    out->lr = L.x; out->lg = L.y; out->lb = L.z;
+
+    /* bsdf_sample_diffuse, the side test, Russian roulette */
+    uint8 key = vload8(0, in->key), rev = vload8(0, in->rev), bounce = vload8(0, in->bounce);
+    float8 bu, bv, urr;
+    w_rng_pair(key, rev, bounce, DIM_BSDF_U, &bu, &bv);
+    w_rng_pair(key, rev, bounce, DIM_ROULETTE, &urr, 0);
+    vec3x8 v_local = w_sample_cosine_hemisphere(bu, bv);
+    vec3x8 wo = w_to_world_onb(v_local, ng_face);
+    float8 pdf = v_local.z * K_INV_PI;
+    float8 side = w3_dot(wo, ng_face);
+    int8 cont = ~(side == 0.0f) & ~(side < 0.0f);
+    out->advance = cont;
+    vec3x8 thr = w3_mul(thr0, albedo);
+    int8 rr = vload8(0, in->rr);
+    float8 q = w_fmin(w3_max_comp(thr), 0.95f);
+    cont &= ~rr | (urr < q);
+    thr = w3_select(thr, w3_scale(thr, 1.0f / q), rr);
+    cont &= w3_max_comp(thr) > 0.0f;
+    out->cont = cont;
+    out->tr = thr.x; out->tg = thr.y; out->tb = thr.z;
+    out->pdf = pdf;
+    out->ox = o.x; out->oy = o.y; out->oz = o.z;
+    out->dx = wo.x; out->dy = wo.y; out->dz = wo.z;
+}
+
+/* Writes lane l's results where shade_path would have; returns its SHADE_* bits. */
+KFN_INLINE uint lane_scatter(const LaneResults *r, uint l, GLOBAL Ray *ray, GLOBAL PathState *ps,
+                             GLOBAL Ray *shadow_ray)
+{
+    uint result = 0u;
+    if (r->shadow[l]) {
+        ps->shadow_L = v3(r->lr[l], r->lg[l], r->lb[l]);
+        shadow_ray->o = v3(r->sox[l], r->soy[l], r->soz[l]);
+        shadow_ray->d = v3(r->sdx[l], r->sdy[l], r->sdz[l]);
+        shadow_ray->tmin = 0.0f;
+        shadow_ray->tmax = r->stmax[l];
+        result = SHADE_SHADOW;
+    }
+    if (!r->advance[l]) return result;
+    ps->bounce = ps->bounce + 1u;
+    if (!r->cont[l]) return result;
+    ps->throughput = v3(r->tr[l], r->tg[l], r->tb[l]);
+    ps->bsdf_pdf = r->pdf[l];
+    ps->flags = 0u;
+    ray->o = v3(r->ox[l], r->oy[l], r->oz[l]);
+    ray->d = v3(r->dx[l], r->dy[l], r->dz[l]);
+    ray->tmin = 0.0f;
+    ray->tmax = INFINITY;
+    return result | SHADE_CONTINUE;
+}
+
+/* One bounce of the live lanes (bits of `live`) of paths path[0..7]: shade_path's
+ * results, the common case eight at a time. */
+KFN_INLINE void shade_lanes(const SceneView *sc, uint live, const uint *path, const Hit *hits, GLOBAL Ray *rays,
+                            GLOBAL PathState *paths, GLOBAL Ray *shadow_rays, uint *result)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    int uniform = p->sampler == SAMPLER_SOBOL && p->mis_mode == MIS_BOTH && p->shadows && p->n_lights > 0u;
+    LaneInputs in;
+    uint fast = 0u;
+    for (uint l = 0; l < PATH_LANES; l++) {
+        if (!(live & (1u << l))) continue;
+        uint i = path[l];
+        if (lane_gather(sc, uniform, &rays[i], hits[l], &paths[i], &in, l)) fast |= 1u << l;
+        else result[l] = shade_path(sc, &rays[i], hits[l], &paths[i], &shadow_rays[i]);
+    }
+    if (!fast) return;
+    for (uint l = 0; l < PATH_LANES; l++) {
+        if (fast & (1u << l)) continue;
+        /* lanes not shaded here compute on copies of a shaded lane's inputs, harmlessly */
+        uint k = k_lowest_bit(fast);
+        in.hu[l] = in.hu[k]; in.hv[l] = in.hv[k];
+        in.p0x[l] = in.p0x[k]; in.p0y[l] = in.p0y[k]; in.p0z[l] = in.p0z[k];
+        in.p1x[l] = in.p1x[k]; in.p1y[l] = in.p1y[k]; in.p1z[l] = in.p1z[k];
+        in.p2x[l] = in.p2x[k]; in.p2y[l] = in.p2y[k]; in.p2z[l] = in.p2z[k];
+        in.dx[l] = in.dx[k]; in.dy[l] = in.dy[k]; in.dz[l] = in.dz[k];
+        in.ar[l] = in.ar[k]; in.ag[l] = in.ag[k]; in.ab[l] = in.ab[k];
+        in.tr[l] = in.tr[k]; in.tg[l] = in.tg[k]; in.tb[l] = in.tb[k];
+        in.lpx[l] = in.lpx[k]; in.lpy[l] = in.lpy[k]; in.lpz[l] = in.lpz[k];
+        in.lnx[l] = in.lnx[k]; in.lny[l] = in.lny[k]; in.lnz[l] = in.lnz[k];
+        in.ler[l] = in.ler[k]; in.leg[l] = in.leg[k]; in.leb[l] = in.leb[k];
+        in.larea[l] = in.larea[k]; in.lchoice[l] = in.lchoice[k]; in.ltwo[l] = in.ltwo[k];
+        in.rr[l] = in.rr[k]; in.key[l] = in.key[k]; in.rev[l] = in.rev[k]; in.bounce[l] = in.bounce[k];
+    }
+    LaneResults r;
+    shade_lanes_fast(&in, &r);
+    for (uint l = 0; l < PATH_LANES; l++) {
+        if (!(fast & (1u << l))) continue;
+        uint i = path[l];
+        result[l] = lane_scatter(&r, l, &rays[i], &paths[i], &shadow_rays[i]);
+    }
+}
+
+#endif /* CLPT_SHADE_LANES_CL */

@@ -44,12 +44,18 @@ KFN float k_copysign(float mag, float sgn)
     return k_as_float((k_as_uint(mag) & 0x7fffffffu) | (k_as_uint(sgn) & 0x80000000u));
 }
 
-/* sin and cos of r in [-pi/4, pi/4]: Taylor polynomials (error below 3e-8). */
+/* sin and cos of r in [-pi/4, pi/4]: Taylor polynomials (error below 3e-8), given
+ * r2 = r * r; as macros for float and float8 (kernels/shade_lanes.cl) alike. */
+#define K_SIN_QUARTER(r, r2)                                                             \
+    ((r) + (r) * (r2) * (-0.166666667f + (r2) * (8.33333333e-3f + (r2) * (-1.98412698e-4f + (r2) * 2.75573192e-6f))))
+#define K_COS_QUARTER(r2)                                                                \
+    (1.0f + (r2) * (-0.5f + (r2) * (4.16666667e-2f + (r2) * (-1.38888889e-3f + (r2) * 2.48015873e-5f))))
+
 KFN void k_sincos_quarter(float r, float *s, float *c)
 {
     float r2 = r * r;
-    *s = r + r * r2 * (-0.166666667f + r2 * (8.33333333e-3f + r2 * (-1.98412698e-4f + r2 * 2.75573192e-6f)));
-    *c = 1.0f + r2 * (-0.5f + r2 * (4.16666667e-2f + r2 * (-1.38888889e-3f + r2 * 2.48015873e-5f)));
+    *s = K_SIN_QUARTER(r, r2);
+    *c = K_COS_QUARTER(r2);
 }
 
 /* sin and cos of x, for |x| up to a few thousand: Cody-Waite reduction by pi/2, then

@@ -56,13 +56,32 @@ typedef struct {
                       * which every pattern's shuffle starts from; else 0 */
 } RngKey;
 
+/* The integer steps of the sampler, written once for a uint and for the uint8 lanes of
+ * kernels/shade_lanes.cl, which must compute the same bits. Each updates its variable. */
+#define RNG_HASH_STEPS(x) (x ^= x >> 16, x *= 0x21f0aaadu, x ^= x >> 15, x *= 0x735a2d97u, x ^= x >> 15)
+#define RNG_SWAP_BYTES_STEPS(x) (x = (x << 16) | (x >> 16), x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu))
+#define RNG_REVERSE_IN_BYTES_STEPS(x)                                                    \
+    (x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu),                           \
+     x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u),                           \
+     x = ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u))
+#define RNG_LK_PERMUTE_STEPS(x, seed)                                                    \
+    (x ^= x * 0x3d20adeau, x += seed, x *= (seed >> 16) | 1u, x ^= x * 0x05526c56u, x ^= x * 0x53a22864u)
+#define RNG_SOBOL1_STEPS(i)                                                              \
+    (i ^= (i >> 1) & 0x55555555u, i ^= (i >> 2) & 0x33333333u, i ^= (i >> 4) & 0x0f0f0f0fu, \
+     i ^= (i >> 8) & 0x00ff00ffu, i ^= (i >> 16) & 0x0000ffffu)
+/* a pattern's seed: pixel key + pattern number times the golden ratio (rng_sobol_pattern),
+ * and the odd multipliers and offset that make each coordinate's scrambling seed from it
+ * (rng_sobol_coord) */
+#define RNG_PATTERN_STEP 0x9e3779b9u
+#define RNG_COORD0_SEED_MUL 0x297a2d39u
+#define RNG_COORD1_SEED_MUL 0x2c1b3c6du
+#define RNG_COORD_SEED_ADD 0x68e31da4u
+/* 2^-24: the top 24 bits of a 32-bit fixed-point value as a float in [0, 1) */
+#define RNG_FLOAT_SCALE 5.9604645e-8f
+
 KFN uint rng_hash(uint x)
 {
-    x ^= x >> 16;
-    x *= 0x21f0aaadu;
-    x ^= x >> 15;
-    x *= 0x735a2d97u;
-    x ^= x >> 15;
+    RNG_HASH_STEPS(x);
     return x;
 }
 
@@ -87,12 +106,10 @@ KFN uint rng_reverse_bits(uint x)
 #if defined(__clang__) || (!defined(KERNEL_OPENCL) && defined(__GNUC__))
     x = __builtin_bswap32(x);
 #else
-    x = (x << 16) | (x >> 16);
-    x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu);
+    RNG_SWAP_BYTES_STEPS(x);
 #endif
-    x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu);
-    x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
-    return ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
+    RNG_REVERSE_IN_BYTES_STEPS(x);
+    return x;
 }
 
 /* A random permutation of 32-bit words, chosen by seed, in which each bit is flipped
@@ -101,11 +118,7 @@ KFN uint rng_reverse_bits(uint x)
  * FastOwenScrambler. */
 KFN uint rng_lk_permute(uint x, uint seed)
 {
-    x ^= x * 0x3d20adeau;
-    x += seed;
-    x *= (seed >> 16) | 1u;
-    x ^= x * 0x05526c56u;
-    x ^= x * 0x53a22864u;
+    RNG_LK_PERMUTE_STEPS(x, seed);
     return x;
 }
 
@@ -121,11 +134,7 @@ KFN uint rng_owen_scramble(uint v, uint seed)
  * of that superset sum give every digit at once, digit j at bit j. */
 KFN uint rng_sobol1_reversed(uint index)
 {
-    index ^= (index >> 1) & 0x55555555u;
-    index ^= (index >> 2) & 0x33333333u;
-    index ^= (index >> 4) & 0x0f0f0f0fu;
-    index ^= (index >> 8) & 0x00ff00ffu;
-    index ^= (index >> 16) & 0x0000ffffu;
+    RNG_SOBOL1_STEPS(index);
     return index;
 }
 
@@ -142,7 +151,7 @@ KFN uint rng_sobol(uint index, uint dim)
  * already, and this is the hot path of every sample). */
 KFN uint rng_sobol_pattern(uint pixel_key, uint bounce, uint first)
 {
-    return rng_hash(pixel_key + (bounce * (uint)RNG_DIMS_PER_BOUNCE + first) * 0x9e3779b9u);
+    return rng_hash(pixel_key + (bounce * (uint)RNG_DIMS_PER_BOUNCE + first) * RNG_PATTERN_STEP);
 }
 
 /* The key of sample `sample` of `pixel` under the render's sampler. */
@@ -182,7 +191,8 @@ KFN uint rng_sobol_index(RngKey k, uint pattern)
 KFN uint rng_sobol_coord(uint index, uint pattern, uint coord)
 {
     uint digits = coord ? rng_sobol1_reversed(index) : index;
-    return rng_reverse_bits(rng_lk_permute(digits, pattern * (coord ? 0x2c1b3c6du : 0x297a2d39u) + 0x68e31da4u));
+    return rng_reverse_bits(
+        rng_lk_permute(digits, pattern * (coord ? RNG_COORD1_SEED_MUL : RNG_COORD0_SEED_MUL) + RNG_COORD_SEED_ADD));
 }
 
 /* The Sobol sampler's value for (key, bounce, dim), 32-bit fixed point: coordinate
@@ -198,7 +208,7 @@ KFN uint rng_sobol_bits(RngKey k, uint bounce, uint dim)
  * returned. */
 KFN float rng_to_float(uint h)
 {
-    return (float)(h >> 8) * 5.9604645e-8f;
+    return (float)(h >> 8) * RNG_FLOAT_SCALE;
 }
 
 KFN_INLINE_CL float rng_uniform(RngKey k, uint bounce, uint dim)

@@ -48,9 +48,9 @@ KFN_INLINE float8 w_copysign(float8 mag, float8 sgn)
 /* offset_coord (surface.h) lane by lane */
 KFN_INLINE float8 w_offset_coord(float8 p, float8 n)
 {
-    int8 ulps = convert_int8(256.0f * n);
+    int8 ulps = convert_int8(RAY_OFFSET_ULPS * n);
     float8 moved = as_float8(as_int8(p) + select(ulps, -ulps, p < 0.0f));
-    return select(moved, p + 1.52587890625e-5f * n, fabs(p) < 0.03125f);
+    return select(moved, p + RAY_OFFSET_ABS * n, fabs(p) < RAY_OFFSET_NEAR_ZERO);
 }
 KFN_INLINE vec3x8 w_offset_ray_origin(vec3x8 p, vec3x8 n)
 {
@@ -66,8 +66,7 @@ KFN_INLINE vec3x8 w_sample_cosine_hemisphere(float8 u1, float8 u2)
     float8 r = select(b, a, about_x);
     float8 t = 0.785398163f * (select(a, b, about_x) / r);
     float8 t2 = t * t;
-    float8 s = t + t * t2 * (-0.166666667f + t2 * (8.33333333e-3f + t2 * (-1.98412698e-4f + t2 * 2.75573192e-6f)));
-    float8 c = 1.0f + t2 * (-0.5f + t2 * (4.16666667e-2f + t2 * (-1.38888889e-3f + t2 * 2.48015873e-5f)));
+    float8 s = K_SIN_QUARTER(t, t2), c = K_COS_QUARTER(t2);
     float8 x = select(r * select(s, c, about_x), 0.0f, zero);
     float8 y = select(r * select(c, s, about_x), 0.0f, zero);
     return w3(x, y, sqrt(w_fmax(1.0f - x * x - y * y, 0.0f)));
@@ -84,68 +83,57 @@ KFN_INLINE vec3x8 w_to_world_onb(vec3x8 v, vec3x8 n)
     return w3_add(w3_add(w3_scale(t, v.x), w3_scale(b, v.y)), w3_scale(n, v.z));
 }
 
-/* The Sobol sampler of rng.h lane by lane (uint8): the same integer operations, so the
- * same bits; the byte swap as shifts, which give what bswap does. */
+/* The Sobol sampler of rng.h lane by lane (uint8), through its own steps; the byte
+ * swap as shifts, which do what bswap does. */
 KFN_INLINE uint8 w_rng_hash(uint8 x)
 {
-    x ^= x >> 16;
-    x *= 0x21f0aaadu;
-    x ^= x >> 15;
-    x *= 0x735a2d97u;
-    x ^= x >> 15;
+    RNG_HASH_STEPS(x);
     return x;
 }
 KFN_INLINE uint8 w_reverse_bits(uint8 x)
 {
-    x = (x << 16) | (x >> 16);
-    x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu);
-    x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu);
-    x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
-    return ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
+    RNG_SWAP_BYTES_STEPS(x);
+    RNG_REVERSE_IN_BYTES_STEPS(x);
+    return x;
 }
 KFN_INLINE uint8 w_lk_permute(uint8 x, uint8 seed)
 {
-    x ^= x * 0x3d20adeau;
-    x += seed;
-    x *= (seed >> 16) | 1u;
-    x ^= x * 0x05526c56u;
-    x ^= x * 0x53a22864u;
+    RNG_LK_PERMUTE_STEPS(x, seed);
     return x;
 }
 KFN_INLINE uint8 w_sobol1_reversed(uint8 index)
 {
-    index ^= (index >> 1) & 0x55555555u;
-    index ^= (index >> 2) & 0x33333333u;
-    index ^= (index >> 4) & 0x0f0f0f0fu;
-    index ^= (index >> 8) & 0x00ff00ffu;
-    index ^= (index >> 16) & 0x0000ffffu;
+    RNG_SOBOL1_STEPS(index);
     return index;
 }
-KFN_INLINE float8 w_rng_to_float(uint8 h) { return convert_float8(h >> 8) * 5.9604645e-8f; }
+KFN_INLINE float8 w_rng_to_float(uint8 h) { return convert_float8(h >> 8) * RNG_FLOAT_SCALE; }
 /* rng_uniform2 (coord 0 and 1 of a pair's pattern) or rng_uniform of a 1D dimension
  * (coord 0 only) for keys `key`, reversed sample indices `rev`, bounces `bounce` */
 KFN_INLINE void w_rng_pair(uint8 key, uint8 rev, uint8 bounce, uint first, float8 *u, float8 *v)
 {
-    uint8 pattern = w_rng_hash(key + (bounce * (uint)RNG_DIMS_PER_BOUNCE + first) * 0x9e3779b9u);
+    uint8 pattern = w_rng_hash(key + (bounce * (uint)RNG_DIMS_PER_BOUNCE + first) * RNG_PATTERN_STEP);
     uint8 index = w_reverse_bits(w_lk_permute(rev, pattern));
-    *u = w_rng_to_float(w_reverse_bits(w_lk_permute(index, pattern * 0x297a2d39u + 0x68e31da4u)));
-    if (v) *v = w_rng_to_float(w_reverse_bits(w_lk_permute(w_sobol1_reversed(index), pattern * 0x2c1b3c6du + 0x68e31da4u)));
+    *u = w_rng_to_float(w_reverse_bits(w_lk_permute(index, pattern * RNG_COORD0_SEED_MUL + RNG_COORD_SEED_ADD)));
+    if (v)
+        *v = w_rng_to_float(
+            w_reverse_bits(w_lk_permute(w_sobol1_reversed(index), pattern * RNG_COORD1_SEED_MUL + RNG_COORD_SEED_ADD)));
 }
 
-/* One lane's inputs to the vector shading, gathered per lane. */
+/* The vector shading's inputs, gathered lane by lane. */
+typedef float LaneFloats[PATH_LANES];
 typedef struct {
-    float dx[PATH_LANES], dy[PATH_LANES], dz[PATH_LANES];
-    float hu[PATH_LANES], hv[PATH_LANES];
-    float p0x[PATH_LANES], p0y[PATH_LANES], p0z[PATH_LANES], p1x[PATH_LANES], p1y[PATH_LANES], p1z[PATH_LANES], p2x[PATH_LANES], p2y[PATH_LANES], p2z[PATH_LANES];
-    float ar[PATH_LANES], ag[PATH_LANES], ab[PATH_LANES];            /* albedo */
-    float tr[PATH_LANES], tg[PATH_LANES], tb[PATH_LANES];            /* throughput */
-    float lpx[PATH_LANES], lpy[PATH_LANES], lpz[PATH_LANES];         /* light sample point */
-    float lnx[PATH_LANES], lny[PATH_LANES], lnz[PATH_LANES];         /* its normal */
-    float ler[PATH_LANES], leg[PATH_LANES], leb[PATH_LANES];         /* its radiance */
-    float larea[PATH_LANES], lchoice[PATH_LANES];
-    int ltwo[PATH_LANES];                                  /* -1: two-sided lamp */
-    int rr[PATH_LANES];                                    /* -1: roulette at this bounce */
-    uint key[PATH_LANES], rev[PATH_LANES], bounce[PATH_LANES];
+    LaneFloats dx, dy, dz;
+    LaneFloats hu, hv;                     /* barycentrics */
+    LaneFloats p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z;    /* the triangle */
+    LaneFloats ar, ag, ab;                 /* albedo */
+    LaneFloats tr, tg, tb;                 /* throughput */
+    LaneFloats lpx, lpy, lpz;              /* light sample point */
+    LaneFloats lnx, lny, lnz;              /* its normal */
+    LaneFloats ler, leg, leb;              /* its radiance */
+    LaneFloats larea, lchoice;             /* the lamp's area, its choice probability */
+    int ltwo[PATH_LANES];                   /* -1: a two-sided lamp */
+    int rr[PATH_LANES];                     /* -1: roulette at this bounce */
+    uint key[PATH_LANES], rev[PATH_LANES], bounce[PATH_LANES];   /* the sampler's RngKey, the bounce */
 } LaneInputs;
 
 /* Whether shade_lanes_fast can shade this path; when it can, fills lane l of in.
@@ -251,7 +239,8 @@ KFN_INLINE void shade_lanes_fast(const LaneInputs *in, LaneResults *out)
     /* bsdf_eval of the diffuse lobe */
     int8 no_f = cos_s <= 0.0f;
     float8 bpdf = select(cos_s * K_INV_PI, 0.0f, no_f);
-    vec3x8 f = w3_select(w3_scale(albedo, (float8)(K_INV_PI)), w3((float8)(0.0f), (float8)(0.0f), (float8)(0.0f)), no_f);
+    float8 zero = 0.0f;
+    vec3x8 f = w3_select(w3_scale(albedo, (float8)(K_INV_PI)), w3(zero, zero, zero), no_f);
     float8 a2 = lpdf * lpdf, b2 = bpdf * bpdf;
     float8 mis = select(0.0f, a2 / (a2 + b2), a2 + b2 > 0.0f);
     vec3x8 f_cos = w3_scale(f, cos_s * mis / lpdf);

@@ -159,11 +159,14 @@ KFN int surface_tangent(const SceneView *sc, Surface s, vec3 *t, float *sign)
  * the magnitude of the coordinates instead of a global epsilon; near the origin, where
  * ulps vanish, a small absolute offset takes over. After Wächter & Binder, "A Fast and
  * Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, ch. 6 (2019). */
+#define RAY_OFFSET_ULPS 256.0f           /* ulps along a unit normal, away from 0 ... */
+#define RAY_OFFSET_NEAR_ZERO 0.03125f     /* ... except within this of 0, where ... */
+#define RAY_OFFSET_ABS 1.52587890625e-5f  /* ... it moves this far (kernels/shade_lanes.cl too) */
 KFN float offset_coord(float p, float n)
 {
-    int ulps = (int)(256.0f * n);
+    int ulps = (int)(RAY_OFFSET_ULPS * n);
     float moved = k_int_as_float(k_as_int(p) + (p < 0.0f ? -ulps : ulps));
-    return k_fabs(p) < 0.03125f ? p + 1.52587890625e-5f * n : moved;
+    return k_fabs(p) < RAY_OFFSET_NEAR_ZERO ? p + RAY_OFFSET_ABS * n : moved;
 }
 
 KFN vec3 offset_ray_origin(vec3 p, vec3 n)

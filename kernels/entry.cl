@@ -139,6 +139,23 @@ __kernel KERNEL_SIZE void k_shadow(SCENE_ARGS __global const uint *shadow_queue,
 
 #endif /* KF_HAS(KF_PATH) */
 
+#if KF_HAS(KF_PATH_MEGAKERNEL) || KF_HAS(KF_PATH_LANES)
+/* Adds a work-item's n_rays to the 64-bit ray count of the megakernels, counters[0] with
+ * the carry in counters[QUEUE_COUNT_STRIDE] (the adder whose addition wraps the low word
+ * carries), one global atomic per work-group. Every work-item of the group calls it
+ * (a barrier); group_rays, the group's sum, starts at 0 behind a barrier. */
+KFN_INLINE void add_group_rays(__local uint *group_rays, uint n_rays, __global uint *counters)
+{
+    if (n_rays) atomic_add(group_rays, n_rays);
+    barrier(CLK_LOCAL_MEM_FENCE);
+    uint sum = *group_rays;
+    if (get_local_id(0) == 0u && sum) {
+        uint old = atomic_add(&counters[0], sum);
+        if (old + sum < old) atomic_inc(&counters[QUEUE_COUNT_STRIDE]);
+    }
+}
+#endif
+
 #if KF_HAS(KF_PATH_MEGAKERNEL)
 /* The path tracer as one kernel, the CPUs' form: each work-item runs its path from
  * birth to end, calling the stage functions in the wavefront's order (the scalar
@@ -172,12 +189,7 @@ __kernel KERNEL_SIZE void k_path(SCENE_ARGS uint first_pixel, uint first_sample,
             if (!(r & SHADE_CONTINUE)) break;
         }
     }
-    if (n_rays) atomic_add(&group_rays, n_rays);
-    barrier(CLK_LOCAL_MEM_FENCE);
-    if (get_local_id(0) == 0u && group_rays) {
-        uint old = atomic_add(&counters[0], group_rays);
-        if (old + group_rays < old) atomic_inc(&counters[QUEUE_COUNT_STRIDE]);
-    }
+    add_group_rays(&group_rays, n_rays, counters);
 }
 
 #endif /* KF_HAS(KF_PATH_MEGAKERNEL) */
@@ -228,12 +240,7 @@ __kernel KERNEL_SIZE void k_path_lanes(SCENE_ARGS uint first_pixel, uint first_s
             }
         }
     }
-    if (n_rays) atomic_add(&group_rays, n_rays);
-    barrier(CLK_LOCAL_MEM_FENCE);
-    if (get_local_id(0) == 0u && group_rays) {
-        uint old = atomic_add(&counters[0], group_rays);
-        if (old + group_rays < old) atomic_inc(&counters[QUEUE_COUNT_STRIDE]);
-    }
+    add_group_rays(&group_rays, n_rays, counters);
 }
 #endif /* KF_HAS(KF_PATH_LANES) */
 

@@ -132,7 +132,9 @@ typedef struct {
     LaneFloats p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z;    /* the triangle */
     LaneFloats ar, ag, ab;                 /* albedo */
     LaneFloats tr, tg, tb;                 /* throughput */
-    LaneFloats lpx, lpy, lpz;              /* light sample point */
+    LaneFloats lax, lay, laz, lbx, lby, lbz, lcx, lcy, lcz;   /* quad: corner, edges; else corners */
+    int lquad[PATH_LANES];                  /* -1: a quad lamp */
+    LaneFloats lsq0, lrest, lv;             /* quad: its half's start; the light pair's rest of u, v */
     LaneFloats lnx, lny, lnz;              /* its normal */
     LaneFloats ler, leg, leb;              /* its radiance */
     LaneFloats larea, lchoice;             /* the lamp's area, its choice probability */
@@ -141,13 +143,13 @@ typedef struct {
     uint key[PATH_LANES], rev[PATH_LANES], bounce[PATH_LANES];   /* the sampler's RngKey, the bounce */
 } LaneInputs;
 
-/* Whether shade_lanes_fast can shade this path; when it can, fills lane l of in.
- * `uniform` says whether the render's settings allow it at all. */
-KFN_INLINE int lane_gather(const SceneView *sc, int uniform, GLOBAL const Ray *ray, Hit hit,
-                           GLOBAL const PathState *ps, LaneInputs *in, uint l)
+/* Whether the path's hit is one shade_lanes_fast can shade (a flat triangle of an
+ * untextured, non-emitting diffuse material, below the last bounce), and if so lane l
+ * of `in` gets its surface, path and sampler inputs. */
+KFN_INLINE int lane_surface(const SceneView *sc, GLOBAL const Ray *ray, Hit hit, GLOBAL const PathState *ps,
+                            LaneInputs *in, uint l)
 {
     GLOBAL const RenderParams *p = sc->params;
-    if (!uniform) return 0;
     uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
     if (hit.prim == NO_INDEX || hit.prim < first_tri || hit.prim >= first_box) return 0;
     uint bounce = ps->bounce;
@@ -157,24 +159,6 @@ KFN_INLINE int lane_gather(const SceneView *sc, int uniform, GLOBAL const Ray *r
     GLOBAL const Material *m = &sc->materials[tri->material];
     if (m->type != MAT_DIFFUSE || !v3_is_zero(m->emission)) return 0;
     if (KF_HAS(KF_TEXTURES) && (m->texture != NO_INDEX || m->texture_emission != NO_INDEX)) return 0;
-    RngKey key = rng_key_of(ps, p);
-    float lu, lv, u_rest;
-    rng_uniform2(key, bounce, DIM_LIGHT_U, &lu, &lv);
-    uint li = light_choose(sc, lu * 1.0f, &u_rest);
-    GLOBAL const Light *lt = &sc->lights[li];
-    if (lt->type != LIGHT_AREA || lt->prim < first_tri || lt->prim >= first_box) return 0;
-    /* light_sample_area's point on a triangle light */
-    vec3 lp;
-    if (lt->quad != LIGHT_QUAD_NONE) {
-        float sq = (lt->quad == LIGHT_QUAD_SECOND ? 0.5f : 0.0f) + 0.5f * u_rest;
-        lp = v3_add(lt->position, v3_add(v3_scale(lt->direction, sq), v3_scale(lt->intensity, lv)));
-    } else {
-        Triangle ltr = sc->triangles[lt->prim - first_tri];
-        float b1, b2;
-        sample_triangle(u_rest, lv, &b1, &b2);
-        lp = v3_add(v3_add(v3_scale(ltr.p0, 1.0f - b1 - b2), v3_scale(ltr.p1, b1)), v3_scale(ltr.p2, b2));
-    }
-    GLOBAL const Material *lm = &sc->materials[sc->triangles[lt->prim - first_tri].material];
     in->dx[l] = ray->d.x; in->dy[l] = ray->d.y; in->dz[l] = ray->d.z;
     in->hu[l] = hit.u; in->hv[l] = hit.v;
     in->p0x[l] = tri->p0.x; in->p0y[l] = tri->p0.y; in->p0z[l] = tri->p0.z;
@@ -182,16 +166,39 @@ KFN_INLINE int lane_gather(const SceneView *sc, int uniform, GLOBAL const Ray *r
     in->p2x[l] = tri->p2.x; in->p2y[l] = tri->p2.y; in->p2z[l] = tri->p2.z;
     in->ar[l] = m->albedo.x; in->ag[l] = m->albedo.y; in->ab[l] = m->albedo.z;
     in->tr[l] = ps->throughput.x; in->tg[l] = ps->throughput.y; in->tb[l] = ps->throughput.z;
-    in->lpx[l] = lp.x; in->lpy[l] = lp.y; in->lpz[l] = lp.z;
+    in->rr[l] = bounce + 1u > p->rr_depth ? -1 : 0;
+    in->key[l] = ps->rng_key;
+    in->rev[l] = rng_reverse_bits(ps->sample);
+    in->bounce[l] = bounce;
+    return 1;
+}
+
+/* The light lane l's sample chooses with its light pair's first coordinate lu
+ * (light_sample_in, reusing the rest of it): whether shade_lanes_fast can sample it
+ * (an area light on a triangle), and if so lane l of `in` gets the light's points (a
+ * quad's corner and edges, or a triangle's corners), normal, radiance and densities. */
+KFN_INLINE int lane_light(const SceneView *sc, float lu, LaneInputs *in, uint l)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
+    float u_rest;
+    GLOBAL const Light *lt = &sc->lights[light_choose(sc, lu * 1.0f, &u_rest)];
+    if (lt->type != LIGHT_AREA || lt->prim < first_tri || lt->prim >= first_box) return 0;
+    GLOBAL const Triangle *ltr = &sc->triangles[lt->prim - first_tri];
+    int quad = lt->quad != LIGHT_QUAD_NONE;
+    vec3 a = quad ? lt->position : ltr->p0, b = quad ? lt->direction : ltr->p1, c = quad ? lt->intensity : ltr->p2;
+    GLOBAL const Material *lm = &sc->materials[ltr->material];
+    in->lax[l] = a.x; in->lay[l] = a.y; in->laz[l] = a.z;
+    in->lbx[l] = b.x; in->lby[l] = b.y; in->lbz[l] = b.z;
+    in->lcx[l] = c.x; in->lcy[l] = c.y; in->lcz[l] = c.z;
+    in->lquad[l] = quad ? -1 : 0;
+    in->lsq0[l] = lt->quad == LIGHT_QUAD_SECOND ? 0.5f : 0.0f;
+    in->lrest[l] = u_rest;
     in->lnx[l] = lt->normal.x; in->lny[l] = lt->normal.y; in->lnz[l] = lt->normal.z;
     in->ler[l] = lm->emission.x; in->leg[l] = lm->emission.y; in->leb[l] = lm->emission.z;
     in->larea[l] = lt->area;
     in->lchoice[l] = lt->pick_pdf / 1.0f;
     in->ltwo[l] = (lm->flags & MAT_TWO_SIDED) ? -1 : 0;
-    in->rr[l] = bounce + 1u > p->rr_depth ? -1 : 0;
-    in->key[l] = key.key;
-    in->rev[l] = key.sample_rev;
-    in->bounce[l] = bounce;
     return 1;
 }
 
@@ -223,8 +230,16 @@ KFN_LANES_CALL void shade_lanes_fast(const LaneInputs *in, LaneResults *out)
     vec3x8 albedo = LANE_LOAD3(ar, ag, ab);
     vec3x8 thr0 = LANE_LOAD3(tr, tg, tb);
 
-    /* shade_light_sample through light_sample_area and light_pdf_by_area */
-    vec3x8 lp = LANE_LOAD3(lpx, lpy, lpz), ln = LANE_LOAD3(lnx, lny, lnz);
+    /* shade_light_sample through light_sample_area and light_pdf_by_area: the point on
+     * a quad (a parallelogram) or a triangle (sample_triangle) */
+    vec3x8 la = LANE_LOAD3(lax, lay, laz), lb = LANE_LOAD3(lbx, lby, lbz), lc = LANE_LOAD3(lcx, lcy, lcz);
+    float8 u1 = LANE_LOAD(lrest), u2 = LANE_LOAD(lv);
+    float8 sq = LANE_LOAD(lsq0) + 0.5f * u1;
+    vec3x8 on_quad = w3_add(la, w3_add(w3_scale(lb, sq), w3_scale(lc, u2)));
+    float8 su = sqrt(u1);
+    float8 b1 = 1.0f - su, b2 = u2 * su;
+    vec3x8 on_tri = w3_add(w3_add(w3_scale(la, 1.0f - b1 - b2), w3_scale(lb, b1)), w3_scale(lc, b2));
+    vec3x8 lp = w3_select(on_tri, on_quad, vload8(0, in->lquad)), ln = LANE_LOAD3(lnx, lny, lnz);
     vec3x8 to = w3_sub(lp, sp);
     float8 dist2 = w3_dot(to, to);
     float8 dist = sqrt(dist2);
@@ -246,8 +261,8 @@ KFN_LANES_CALL void shade_lanes_fast(const LaneInputs *in, LaneResults *out)
     float8 bpdf = select(cos_s * K_INV_PI, 0.0f, no_f);
     float8 zero = 0.0f;
     vec3x8 f = w3_select(w3_scale(albedo, (float8)(K_INV_PI)), w3(zero, zero, zero), no_f);
-    float8 a2 = lpdf * lpdf, b2 = bpdf * bpdf;
-    float8 mis = select(0.0f, a2 / (a2 + b2), a2 + b2 > 0.0f);
+    float8 pa2 = lpdf * lpdf, pb2 = bpdf * bpdf;
+    float8 mis = select(0.0f, pa2 / (pa2 + pb2), pa2 + pb2 > 0.0f);   /* mis_power */
     vec3x8 f_cos = w3_scale(f, cos_s * mis / lpdf);
     vec3x8 L = w3_mul(w3_mul(thr0, f_cos), LANE_LOAD3(ler, leg, leb));
     vec3x8 o = w_offset_ray_origin(sp, ng_face);
@@ -313,36 +328,32 @@ KFN_INLINE uint lane_scatter(const LaneResults *r, uint l, GLOBAL Ray *ray, GLOB
 /* One bounce of the live lanes (bits of `live`) of paths path[0..7]: shade_path's
  * results, the common case eight at a time. */
 KFN_LANES_CALL void shade_lanes(const SceneView *sc, uint live, const uint *path, const Hit *hits, GLOBAL Ray *rays,
-                            GLOBAL PathState *paths, GLOBAL Ray *shadow_rays, uint *result)
+                                GLOBAL PathState *paths, GLOBAL Ray *shadow_rays, uint *result)
 {
     GLOBAL const RenderParams *p = sc->params;
-    int uniform = p->sampler == SAMPLER_SOBOL && p->mis_mode == MIS_BOTH && p->shadows && p->n_lights > 0u;
-    LaneInputs in;
     uint fast = 0u;
+    LaneInputs in;
+    if (p->sampler == SAMPLER_SOBOL && p->mis_mode == MIS_BOTH && p->shadows && p->n_lights > 0u) {
+        /* lanes not shaded here compute on zeros, harmlessly */
+        float8 zero = 0.0f;
+        for (uint k = 0; k < sizeof in / sizeof(float8); k++) vstore8(zero, k, (float *)&in);
+        for (uint l = 0; l < PATH_LANES; l++)
+            if ((live & (1u << l)) && lane_surface(sc, &rays[path[l]], hits[l], &paths[path[l]], &in, l))
+                fast |= 1u << l;
+    }
+    if (fast) {
+        /* the light pair of every lane at once (shade_light_sample), then each lane's light */
+        float8 lu, lv;
+        w_rng_pair(vload8(0, in.key), vload8(0, in.rev), vload8(0, in.bounce), DIM_LIGHT_U, &lu, &lv);
+        vstore8(lv, 0, in.lv);
+        for (uint l = 0; l < PATH_LANES; l++)
+            if ((fast & (1u << l)) && !lane_light(sc, lu[l], &in, l)) fast &= ~(1u << l);
+    }
     for (uint l = 0; l < PATH_LANES; l++) {
-        if (!(live & (1u << l))) continue;
         uint i = path[l];
-        if (lane_gather(sc, uniform, &rays[i], hits[l], &paths[i], &in, l)) fast |= 1u << l;
-        else result[l] = shade_path(sc, &rays[i], hits[l], &paths[i], &shadow_rays[i]);
+        if ((live & ~fast) & (1u << l)) result[l] = shade_path(sc, &rays[i], hits[l], &paths[i], &shadow_rays[i]);
     }
     if (!fast) return;
-    for (uint l = 0; l < PATH_LANES; l++) {
-        if (fast & (1u << l)) continue;
-        /* lanes not shaded here compute on copies of a shaded lane's inputs, harmlessly */
-        uint k = k_lowest_bit(fast);
-        in.hu[l] = in.hu[k]; in.hv[l] = in.hv[k];
-        in.p0x[l] = in.p0x[k]; in.p0y[l] = in.p0y[k]; in.p0z[l] = in.p0z[k];
-        in.p1x[l] = in.p1x[k]; in.p1y[l] = in.p1y[k]; in.p1z[l] = in.p1z[k];
-        in.p2x[l] = in.p2x[k]; in.p2y[l] = in.p2y[k]; in.p2z[l] = in.p2z[k];
-        in.dx[l] = in.dx[k]; in.dy[l] = in.dy[k]; in.dz[l] = in.dz[k];
-        in.ar[l] = in.ar[k]; in.ag[l] = in.ag[k]; in.ab[l] = in.ab[k];
-        in.tr[l] = in.tr[k]; in.tg[l] = in.tg[k]; in.tb[l] = in.tb[k];
-        in.lpx[l] = in.lpx[k]; in.lpy[l] = in.lpy[k]; in.lpz[l] = in.lpz[k];
-        in.lnx[l] = in.lnx[k]; in.lny[l] = in.lny[k]; in.lnz[l] = in.lnz[k];
-        in.ler[l] = in.ler[k]; in.leg[l] = in.leg[k]; in.leb[l] = in.leb[k];
-        in.larea[l] = in.larea[k]; in.lchoice[l] = in.lchoice[k]; in.ltwo[l] = in.ltwo[k];
-        in.rr[l] = in.rr[k]; in.key[l] = in.key[k]; in.rev[l] = in.rev[k]; in.bounce[l] = in.bounce[k];
-    }
     LaneResults r;
     shade_lanes_fast(&in, &r);
     for (uint l = 0; l < PATH_LANES; l++) {

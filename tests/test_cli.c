@@ -55,7 +55,8 @@ static void test_usage_errors(void)
 /* The three ways an OpenCL device runs a wave (--wave-launch: counted; bounded, the
  * GPUs' default, here forced on PoCL; megakernel, the CPUs') give the scalar device's
  * bits, with small waves (several per batch) and several batches, and report the same
- * number of rays. */
+ * number of rays. The Cornell box suits k_path_lanes (device_ocl.c), so the megakernel
+ * here is the one that shades eight paths at once in float8. */
 static void test_wave_launches_match_scalar(void)
 {
     const char *modes[] = { "counted", "bounded", "megakernel" };

@@ -37,6 +37,15 @@
  * the McGuire box 2%. gcc inlining k_atan2 into the shading made the scalar device 10%
  * slower on the envmap scene, so C keeps its own choice. */
 #define KFN_INLINE_CL static inline __attribute__((always_inline))
+/* Large stage functions that CPUs' OpenCL compilers (PoCL) must keep as calls: inlined
+ * into k_path, shade_path took PoCL 2.3 s to build mesh.scene's program instead of 1.6 s,
+ * at the same render speed (bench/RESULTS.md). GPU compilers, for which a call costs
+ * more, and C compilers choose for themselves. */
+#if defined(__x86_64__) || defined(__aarch64__)
+#define KFN_CALL_CL static inline __attribute__((noinline))
+#else
+#define KFN_CALL_CL static inline
+#endif
 #define GLOBAL __global
 #define CONSTANT __constant
 
@@ -77,6 +86,7 @@ typedef long kint64;         /* 64-bit in every OpenCL C implementation */
 #define KFN static inline
 #define KFN_INLINE static inline __attribute__((always_inline))
 #define KFN_INLINE_CL static inline
+#define KFN_CALL_CL static inline
 #define GLOBAL
 #define CONSTANT const
 

@@ -80,7 +80,7 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
 
 /* One bounce. `ray` is the ray that produced `hit`; on SHADE_CONTINUE it is replaced by
  * the next ray. Returns SHADE_CONTINUE and/or SHADE_SHADOW. */
-KFN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathState *ps,
+KFN_CALL_CL uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathState *ps,
                     GLOBAL Ray *shadow_ray)
 {
     GLOBAL const RenderParams *p = sc->params;

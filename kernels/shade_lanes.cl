@@ -18,11 +18,6 @@
 #include "shade.cl"
 
 
-/* Kept out of line: PoCL compiled k_path_lanes with shade_lanes and its float8 half
- * inlined in 2.9 s, and with them as calls in 1.8 s (less than k_path's 2.3 s), at the
- * same speed (one call per bounce of eight paths). */
-#define KFN_LANES_CALL static __attribute__((noinline))
-
 typedef struct { float8 x, y, z; } vec3x8;
 
 KFN_INLINE vec3x8 w3(float8 x, float8 y, float8 z) { vec3x8 r; r.x = x; r.y = y; r.z = z; return r; }
@@ -215,7 +210,9 @@ typedef struct {
 } LaneResults;
 
 /* shade_path for eight gathered lanes of the common case (see the top of this file). */
-KFN_LANES_CALL void shade_lanes_fast(const LaneInputs *in, LaneResults *out)
+/* A call on CPUs (KFN_CALL_CL): PoCL built k_path_lanes in 2.9 s with this and
+ * shade_lanes inlined, in 1.8 s with them as calls, at the same speed. */
+KFN_CALL_CL void shade_lanes_fast(const LaneInputs *in, LaneResults *out)
 {
     /* surface_at: the triangle's point by barycentrics and its winding normal */
     float8 u = LANE_LOAD(hu), v = LANE_LOAD(hv);
@@ -327,7 +324,7 @@ KFN_INLINE uint lane_scatter(const LaneResults *r, uint l, GLOBAL Ray *ray, GLOB
 
 /* One bounce of the live lanes (bits of `live`) of paths path[0..7]: shade_path's
  * results, the common case eight at a time. */
-KFN_LANES_CALL void shade_lanes(const SceneView *sc, uint live, const uint *path, const Hit *hits, GLOBAL Ray *rays,
+KFN_CALL_CL void shade_lanes(const SceneView *sc, uint live, const uint *path, const Hit *hits, GLOBAL Ray *rays,
                                 GLOBAL PathState *paths, GLOBAL Ray *shadow_rays, uint *result)
 {
     GLOBAL const RenderParams *p = sc->params;

@@ -4,19 +4,19 @@
  * PoCL cannot vectorise shade_path across work-items (bench/RESULTS.md: clang's SLP
  * vectoriser turns its vec3 arithmetic into 2-wide vectors first, and LLVM's loop
  * vectoriser then refuses the work-item loop), so shading ran one path at a time while
- * the traversal used eight lanes. Here a work-item holds eight paths, and the common
- * case, a flat triangle of a plain diffuse material lit through an area light with the
- * Sobol sampler and MIS, is shaded as float8 arithmetic: the same operations as
- * shade_path in the same order, each lane IEEE-rounded as the scalar would be, so
- * every lane computes the bits shade_path computes (test_kernels compares them). The
- * integer sampler, the light choice and the gathers stay per lane. Every other lane
+ * the traversal used eight lanes. Here a work-item holds eight paths (k_path_lanes,
+ * entry.cl), and the common case, a flat triangle of a plain diffuse material whose
+ * light sample picks a triangle lamp, with the Sobol sampler, MIS and shadows on, is
+ * shaded as float8 arithmetic and the sampler as uint8: the same operations as
+ * shade_path in the same order, branches as selects, each lane rounded as the scalar
+ * would be, so every lane computes the bits shade_path computes (test_kernels compares
+ * them). The gathers, the light choice and the stores stay per lane. Every other lane
  * (any other primitive, material, light or setting) calls shade_path itself.
  */
 #ifndef CLPT_SHADE_LANES_CL
 #define CLPT_SHADE_LANES_CL
 
 #include "shade.cl"
-
 
 typedef struct { float8 x, y, z; } vec3x8;
 
@@ -119,23 +119,26 @@ KFN_INLINE void w_rng_pair(uint8 key, uint8 rev, uint8 bounce, uint first, float
             w_reverse_bits(w_lk_permute(w_sobol1_reversed(index), pattern * RNG_COORD1_SEED_MUL + RNG_COORD_SEED_ADD)));
 }
 
-/* The vector shading's inputs, gathered lane by lane. */
+/* The vector shading's inputs, gathered lane by lane; every field is eight words, so
+ * shade_lanes clears the whole as float8 stores. */
 typedef float LaneFloats[PATH_LANES];
 typedef struct {
-    LaneFloats dx, dy, dz;
-    LaneFloats hu, hv;                     /* barycentrics */
-    LaneFloats p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z;    /* the triangle */
-    LaneFloats ar, ag, ab;                 /* albedo */
-    LaneFloats tr, tg, tb;                 /* throughput */
-    LaneFloats lax, lay, laz, lbx, lby, lbz, lcx, lcy, lcz;   /* quad: corner, edges; else corners */
-    int lquad[PATH_LANES];                  /* -1: a quad lamp */
-    LaneFloats lsq0, lrest, lv;             /* quad: its half's start; the light pair's rest of u, v */
-    LaneFloats lnx, lny, lnz;              /* its normal */
-    LaneFloats ler, leg, leb;              /* its radiance */
-    LaneFloats larea, lchoice;             /* the lamp's area, its choice probability */
-    int ltwo[PATH_LANES];                   /* -1: a two-sided lamp */
-    int rr[PATH_LANES];                     /* -1: roulette at this bounce */
-    uint key[PATH_LANES], rev[PATH_LANES], bounce[PATH_LANES];   /* the sampler's RngKey, the bounce */
+    LaneFloats dx, dy, dz;                                    /* the ray's direction */
+    LaneFloats hu, hv;                                        /* barycentrics */
+    LaneFloats p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z;   /* the triangle */
+    LaneFloats ar, ag, ab;                                    /* albedo */
+    LaneFloats tr, tg, tb;                                    /* throughput */
+    LaneFloats lax, lay, laz, lbx, lby, lbz, lcx, lcy, lcz;   /* lamp: a quad's corner and
+                                                               * edges, a triangle's corners */
+    int lquad[PATH_LANES];                                    /* -1: a quad lamp */
+    LaneFloats lsq0, lrest, lv;                               /* a quad half's start; the light
+                                                               * pair's rest of u, and v */
+    LaneFloats lnx, lny, lnz;                                 /* the lamp's normal */
+    LaneFloats ler, leg, leb;                                 /* its radiance */
+    LaneFloats larea, lchoice;                                /* its area, choice probability */
+    int ltwo[PATH_LANES];                                     /* -1: a two-sided lamp */
+    int rr[PATH_LANES];                                       /* -1: roulette at this bounce */
+    uint key[PATH_LANES], rev[PATH_LANES], bounce[PATH_LANES];  /* RngKey.key, .sample_rev */
 } LaneInputs;
 
 /* Whether the path's hit is one shade_lanes_fast can shade (a flat triangle of an
@@ -209,12 +212,13 @@ typedef struct {
     int8 shadow, advance, cont;                    /* -1 where: a shadow ray; bounce + 1; goes on */
 } LaneResults;
 
-/* shade_path for eight gathered lanes of the common case (see the top of this file). */
-/* A call on CPUs (KFN_CALL_CL): PoCL built k_path_lanes in 2.9 s with this and
+/* shade_path for eight gathered lanes of the common case (see the top of this file).
+ * A call on CPUs (KFN_CALL_CL): PoCL built k_path_lanes in 2.9 s with this and
  * shade_lanes inlined, in 1.8 s with them as calls, at the same speed. */
 KFN_CALL_CL void shade_lanes_fast(const LaneInputs *in, LaneResults *out)
 {
-    /* surface_at: the triangle's point by barycentrics and its winding normal */
+    /* surface_at: the triangle's point by barycentrics and its winding normal, which is
+     * also the shading normal (flat triangles only) */
     float8 u = LANE_LOAD(hu), v = LANE_LOAD(hv);
     float8 w = 1.0f - u - v;
     vec3x8 p0 = LANE_LOAD3(p0x, p0y, p0z), p1 = LANE_LOAD3(p1x, p1y, p1z), p2 = LANE_LOAD3(p2x, p2y, p2z);
@@ -250,8 +254,8 @@ KFN_CALL_CL void shade_lanes_fast(const LaneInputs *in, LaneResults *out)
     ok &= (lpdf > 0.0f) & faces;
     lpdf = lpdf * LANE_LOAD(lchoice);
     ok &= lpdf > 0.0f;
-    float8 cos_s = w3_dot(ng_face, wi);
-    float8 cos_g = w3_dot(ng_face, wi);
+    float8 cos_s = w3_dot(ng_face, wi);   /* the shading normal's cosine ... */
+    float8 cos_g = cos_s;                 /* ... and the geometric one: the same here */
     ok &= (cos_s != 0.0f) & ~(cos_s < 0.0f) & ~(cos_g <= 0.0f);
     /* bsdf_eval of the diffuse lobe */
     int8 no_f = cos_s <= 0.0f;

@@ -329,7 +329,7 @@ KFN_INLINE uint lane_scatter(const LaneResults *r, uint l, GLOBAL Ray *ray, GLOB
 /* One bounce of the live lanes (bits of `live`) of paths path[0..7]: shade_path's
  * results, the common case eight at a time. */
 KFN_CALL_CL void shade_lanes(const SceneView *sc, uint live, const uint *path, const Hit *hits, GLOBAL Ray *rays,
-                                GLOBAL PathState *paths, GLOBAL Ray *shadow_rays, uint *result)
+                             GLOBAL PathState *paths, GLOBAL Ray *shadow_rays, uint *result)
 {
     GLOBAL const RenderParams *p = sc->params;
     uint fast = 0u;

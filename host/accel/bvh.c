@@ -112,6 +112,17 @@ static int thread_take(Build *b)
 
 typedef struct { int axis, bin; double cost; } BinSplit;
 
+/* The bin of centre coordinate c on an axis whose centres start at lo, `scale` bins per
+ * unit: clamped as a float before it becomes an int, because a subnormal extent makes
+ * scale infinite (and c - lo = 0 then gives NaN), and converting either to int is
+ * undefined (the scene fuzzer found it with a quad 81e-45 thick). best_split and the
+ * partition share it, so that the two sides are exactly what the cost counted. */
+static int bin_of(float c, float lo, float scale)
+{
+    float f = (c - lo) * scale;
+    return f > 0.0f ? (f < (float)BVH_BINS ? (int)f : BVH_BINS - 1) : 0;
+}
+
 /* The cheapest of the 31 bin boundaries on each axis for idx[first .. first + n),
  * whose centres span cb; cost +inf when every centre is the same point. */
 static BinSplit best_split(const Build *b, uint first, uint n, const Box3 *cb)
@@ -127,8 +138,7 @@ static BinSplit best_split(const Build *b, uint first, uint n, const Box3 *cb)
         for (int i = 0; i < BVH_BINS; i++) bin_box[i] = box3_empty();
         for (uint i = first; i < first + n; i++) {
             uint p = b->idx[i];
-            int bi = (int)((b->cen[p][k] - cb->lo[k]) * scale);
-            bi = bi < 0 ? 0 : (bi >= BVH_BINS ? BVH_BINS - 1 : bi);
+            int bi = bin_of(b->cen[p][k], cb->lo[k], scale);
             if (is_tri(b, p)) bin_n[bi].tri++;
             else bin_n[bi].other++;
             box3_grow(&bin_box[bi], &b->box[p]);
@@ -207,15 +217,13 @@ static uint build_node(Build *b, uint first, uint n, int depth)
         b->nodes[me].child[0] = b->nodes[me].child[1] = NO_INDEX;
         return me;
     }
-    /* partition by the chosen bin boundary (the binning's own arithmetic, so that the
-     * two sides are exactly what the cost counted) */
+    /* partition by the chosen bin boundary (the binning's own bin_of) */
     int k = s.axis;
     float scale = (float)BVH_BINS / (cb.hi[k] - cb.lo[k]);
     uint lo = first, hi = first + n;
     while (lo < hi) {
         uint p = b->idx[lo];
-        int bi = (int)((b->cen[p][k] - cb.lo[k]) * scale);
-        bi = bi < 0 ? 0 : (bi >= BVH_BINS ? BVH_BINS - 1 : bi);
+        int bi = bin_of(b->cen[p][k], cb.lo[k], scale);
         if (bi <= s.bin) {
             lo++;
         } else {

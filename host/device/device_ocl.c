@@ -322,10 +322,12 @@ static int profile_phase_of(const char *kernel)
     return PHASE_SHADE;
 }
 
-static Status launch(OclDevice *od, cl_kernel k, const char *name, uint n, Error *err)
+/* n work-items of kernel k (named for errors and --profile) in work-groups of `local`
+ * (0: the driver's choice); the global size is rounded up to it and the kernels ignore
+ * the excess. */
+static Status launch_local(OclDevice *od, cl_kernel k, const char *name, uint n, size_t local, Error *err)
 {
     if (n == 0) return ST_OK;
-    size_t local = od->local_size;
     size_t global = local ? ((size_t)n + local - 1) / local * local : (size_t)n;
     cl_event ev = NULL;
     cl_int rc = clEnqueueNDRangeKernel(od->queue, k, 1, NULL, &global, local ? &local : NULL, 0, NULL,
@@ -337,6 +339,13 @@ static Status launch(OclDevice *od, cl_kernel k, const char *name, uint n, Error
     }
     if (ev) profile_track(od, ev, profile_phase_of(name));
     return ST_OK;
+}
+
+/* n work-items of k in work-groups of the device's size (OCL_LOCAL_SIZE, or the
+ * driver's choice). */
+static Status launch(OclDevice *od, cl_kernel k, const char *name, uint n, Error *err)
+{
+    return launch_local(od, k, name, n, od->local_size, err);
 }
 
 /* The features the background of params needs (KF_* in kernels/types.h). */
@@ -728,8 +737,10 @@ static Status wave_run_paths(OclDevice *od, WaveSlot *w, Error *err)
     ARG(k, ARG_PATH_FIRST_PIXEL, w->first_pixel);
     ARG(k, ARG_PATH_FIRST_SAMPLE, w->first_sample);
     ARG(k, ARG_PATH_N_PATHS, w->n_paths);
+    /* k_path_lanes: work-groups of as many paths as k_path's (KERNEL_SIZE_LANES) */
     uint items = od->lanes ? (w->n_paths + PATH_LANES - 1u) / PATH_LANES : w->n_paths;
-    if ((st = launch(od, k, "k_path", items, err)) || (st = wave_film(od, w, err))) return st;
+    size_t local = od->lanes ? od->local_size / PATH_LANES : od->local_size;
+    if ((st = launch_local(od, k, "k_path", items, local, err)) || (st = wave_film(od, w, err))) return st;
     OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, w->counts, CL_FALSE, 0, sizeof w->got, w->got, 0,
                                                        NULL, &w->read));
     OCL_TRY("clFlush", clFlush(od->queue));

@@ -22,19 +22,23 @@ for t in "$build"/tests/test_*; do
     # LeakSanitizer's stop-the-world tracer sometimes crashes at exit ("Tracer caught
     # signal 11", google/sanitizers#1353): the sanitizer failed, no leak was found, and
     # the test's own summary was lost with the unflushed stdout. Seen once in about 20
-    # runs of test_kernels under ASan; and in a clpt process that test_cli ran, in two
-    # fresh-clone CI runs in a row on a machine busy with other work (none in seven runs
-    # of test_cli alone). test_cli quotes the child's stderr in its failure message,
-    # after its own words: hence anywhere in a line. Such a run is repeated, at most
-    # twice, and says so.
+    # runs of test_kernels under ASan; then in a clpt process that test_cli ran, in
+    # three fresh-clone CI runs in a row (2026-11-26), the rerun passing each time, and
+    # in none of seven runs of test_cli alone. test_cli quotes the child's stderr in its
+    # failure message, after its own words: hence anywhere in a line. Such a run is
+    # repeated, at most twice; the failed run's log is kept as NAME.log.faultN and its
+    # fault line printed, to find out which clpt run it was.
     tries=0
     while [ "$rc" -ne 0 ] && [ "$tries" -lt 2 ] &&
         grep -q 'LeakSanitizer has encountered a fatal error' "$build/tests/$name.log" &&
         grep -q 'Tracer caught signal' "$build/tests/$name.log"; do
+        tries=$((tries + 1))
+        # keep the failed run's log, and say where the fault was
+        cp "$build/tests/$name.log" "$build/tests/$name.log.fault$tries"
         echo "RETRY $name: LeakSanitizer's tracer crashed at exit (a sanitizer fault, not a leak); running it again"
+        grep -m 1 'Tracer caught signal' "$build/tests/$name.log" | cut -c 1-200 | sed 's/^/    /'
         out=$("$t" 2>"$build/tests/$name.log")
         rc=$?
-        tries=$((tries + 1))
     done
     line=$(printf '%s\n' "$out" | tail -n 1)
     p=$(printf '%s\n' "$line" | sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed$/\1/p')

@@ -78,6 +78,45 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
     return 1;
 }
 
+/* A path that escaped along ray r: the background's radiance. An environment map that
+ * light sampling could have found too is weighted by MIS, as emission below; other
+ * backgrounds are no light that next-event estimation samples, so what BSDF sampling
+ * finds of them counts fully. */
+KFN_INLINE void shade_escape(const SceneView *sc, Ray r, GLOBAL PathState *ps)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    float w = 1.0f;
+    vec3 Le;
+    if (!(ps->flags & PATH_SPECULAR) && KF_HAS(KF_ENV_MAP) && p->bg_type == BG_MAP && p->bg_light != NO_INDEX) {
+        /* the map's radiance and its light-sampling density from one lookup of the
+         * direction's pixel (light_pdf_env's value) */
+        float env_pdf_d;
+        Le = env_radiance_pdf(sc, r.d, &env_pdf_d);
+        float light_pdf = sc->lights[p->bg_light].pick_pdf * env_pdf_d;
+        w = p->mis_mode == MIS_BOTH ? mis_power(ps->bsdf_pdf, light_pdf)
+                                    : (p->mis_mode == MIS_BSDF_ONLY ? 1.0f : 0.0f);
+    } else {
+        Le = background_radiance(sc, r.d);
+    }
+    ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, Le), w));
+}
+
+/* The emission of surface s (material m) that ray r reached: emission found by BSDF
+ * sampling is weighted against the light sampling that could have found it too; after a
+ * delta bounce only BSDF sampling could. */
+KFN_INLINE void shade_emission(const SceneView *sc, Ray r, Surface s, Material m, GLOBAL PathState *ps)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    vec3 emission = material_emission(sc, m, s);
+    if (!v3_is_zero(emission) && ((m.flags & MAT_TWO_SIDED) || v3_dot(r.d, s.ng) < 0.0f)) {
+        float w = 1.0f;
+        if (!(ps->flags & PATH_SPECULAR) && s.light != NO_INDEX)
+            w = p->mis_mode == MIS_BOTH ? mis_power(ps->bsdf_pdf, light_pdf(sc, s.light, r.o, s.p, s.ng))
+                                        : (p->mis_mode == MIS_BSDF_ONLY ? 1.0f : 0.0f);
+        ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, emission), w));
+    }
+}
+
 /* One bounce. `ray` is the ray that produced `hit`; on SHADE_CONTINUE it is replaced by
  * the next ray. Returns SHADE_CONTINUE and/or SHADE_SHADOW. */
 KFN_CALL_CL uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathState *ps,
@@ -89,40 +128,13 @@ KFN_CALL_CL uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBA
     uint bounce = ps->bounce;
 
     if (hit.prim == NO_INDEX) {
-        /* an environment map that light sampling could have found too is weighted by
-         * MIS, as emission below; other backgrounds are no light that next-event
-         * estimation samples, so what BSDF sampling finds of them counts fully */
-        float w = 1.0f;
-        vec3 Le;
-        if (!(ps->flags & PATH_SPECULAR) && KF_HAS(KF_ENV_MAP) && p->bg_type == BG_MAP &&
-            p->bg_light != NO_INDEX) {
-            /* the map's radiance and its light-sampling density from one lookup of
-             * the direction's pixel (light_pdf_env's value) */
-            float env_pdf_d;
-            Le = env_radiance_pdf(sc, r.d, &env_pdf_d);
-            float light_pdf = sc->lights[p->bg_light].pick_pdf * env_pdf_d;
-            w = p->mis_mode == MIS_BOTH ? mis_power(ps->bsdf_pdf, light_pdf)
-                                        : (p->mis_mode == MIS_BSDF_ONLY ? 1.0f : 0.0f);
-        } else {
-            Le = background_radiance(sc, r.d);
-        }
-        ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, Le), w));
+        shade_escape(sc, r, ps);
         return 0u;
     }
 
     Surface s = surface_at(sc, r, hit);
     Material m = sc->materials[s.material];   /* a mix: its own emission (mix.h) */
-
-    vec3 emission = material_emission(sc, m, s);
-    if (!v3_is_zero(emission) && ((m.flags & MAT_TWO_SIDED) || v3_dot(r.d, s.ng) < 0.0f)) {
-        /* emission reached by BSDF sampling is weighted against the light sampling that
-         * could have found it too; after a delta bounce only BSDF sampling could */
-        float w = 1.0f;
-        if (!(ps->flags & PATH_SPECULAR) && s.light != NO_INDEX)
-            w = p->mis_mode == MIS_BOTH ? mis_power(ps->bsdf_pdf, light_pdf(sc, s.light, r.o, s.p, s.ng))
-                                        : (p->mis_mode == MIS_BSDF_ONLY ? 1.0f : 0.0f);
-        ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, emission), w));
-    }
+    shade_emission(sc, r, s, m, ps);
     if (bounce >= p->max_depth) return 0u;
 
     /* normals turned toward the side the ray came from */

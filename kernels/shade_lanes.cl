@@ -10,8 +10,9 @@
  * shaded as float8 arithmetic and the sampler as uint8: the same operations as
  * shade_path in the same order, branches as selects, each lane rounded as the scalar
  * would be, so every lane computes the bits shade_path computes (test_kernels compares
- * them). The gathers, the light choice and the stores stay per lane. Every other lane
- * (any other primitive, material, light or setting) calls shade_path itself.
+ * them). The gathers, the light choice and the stores stay per lane. The other lanes
+ * end their paths (shade_lane_end): the host runs k_path_lanes only for scenes in
+ * which nothing else can happen.
  */
 #ifndef CLPT_SHADE_LANES_CL
 #define CLPT_SHADE_LANES_CL
@@ -326,6 +327,26 @@ KFN_INLINE uint lane_scatter(const LaneResults *r, uint l, GLOBAL Ray *ray, GLOB
     return result | SHADE_CONTINUE;
 }
 
+/* shade_path for a lane that shade_lanes_fast does not take, in a scene lanes_suit
+ * (host/device/device_ocl.c) accepts: one whose path escaped, hit a lamp (a pure
+ * emitter, which reflects nothing) or reached its last bounce on a surface. Each of
+ * these ends the path, with shade_path's emission or background. Every other case,
+ * which would need all of shade_path, is kept out of k_path_lanes on the host: a
+ * diffuse material that emits, a light other than a triangle lamp, another material
+ * or primitive (scene features), shading normals, or another sampler or setting. So
+ * shade_path is not compiled into k_path_lanes, whose cold build it made a fifth
+ * longer (bench/RESULTS.md). */
+KFN_INLINE uint shade_lane_end(const SceneView *sc, Ray r, Hit hit, GLOBAL PathState *ps)
+{
+    if (hit.prim == NO_INDEX) {
+        shade_escape(sc, r, ps);
+        return 0u;
+    }
+    Surface s = surface_at(sc, r, hit);
+    shade_emission(sc, r, s, sc->materials[s.material], ps);
+    return 0u;
+}
+
 /* One bounce of the live lanes (bits of `live`) of paths path[0..7]: shade_path's
  * results, the common case eight at a time. */
 KFN_CALL_CL void shade_lanes(const SceneView *sc, uint live, const uint *path, const Hit *hits, GLOBAL Ray *rays,
@@ -352,7 +373,7 @@ KFN_CALL_CL void shade_lanes(const SceneView *sc, uint live, const uint *path, c
     }
     for (uint l = 0; l < PATH_LANES; l++) {
         uint i = path[l];
-        if ((live & ~fast) & (1u << l)) result[l] = shade_path(sc, &rays[i], hits[l], &paths[i], &shadow_rays[i]);
+        if ((live & ~fast) & (1u << l)) result[l] = shade_lane_end(sc, rays[i], hits[l], &paths[i]);
     }
     if (!fast) return;
     LaneResults r;

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "harness.h"
+#include "device/kernel_features.h"
 #include "device/ocl_program.h"
 #include "render/render_scene.h"
 #include "io/texture.h"
@@ -29,6 +30,8 @@
 
 /* Scene buffers every kernel takes first (SCENE_ARGS in entry.cl). */
 #define N_SCENE SCENE_BUF_COUNT
+#define N_SCENE_MAX 32
+_Static_assert(N_SCENE <= N_SCENE_MAX, "N_SCENE_MAX");
 
 typedef struct {
     OclDeviceInfo dev;
@@ -43,6 +46,13 @@ static Cl cl;
 static Scene scene;
 static RenderScene rs;
 static uint plain_material;   /* untextured diffuse: the surfaces k_path_lanes shades eight at a time */
+/* A second scene, of the kind k_path_lanes renders (kernel_lanes_scene): flat diffuse
+ * triangles and triangle lamps under a sky. */
+static Scene lanes_scene;
+static RenderScene lanes_rs;
+static SceneView lanes_view;
+static cl_mem lanes_bufs[N_SCENE_MAX];
+static uint lanes_plain;
 static KdTree kd;         /* the scene's kd-tree beside its BVH, for the kd-tree kernels */
 static SceneView view;    /* the C side's view of the same scene */
 
@@ -262,6 +272,53 @@ static void build_scene(void)
     device_scene_view(&rs.ds, &view);
 }
 
+/* The lanes scene: plain diffuse triangles of two albedos over a floor, a lamp triangle,
+ * a quad lamp and a two-sided lamp, a sky to escape to, and few enough bounces that
+ * paths reach the last one. */
+static void build_lanes_scene(void)
+{
+    Scene *sc = &lanes_scene;
+    scene_init(sc);
+    sc->image.width = 32;
+    sc->image.height = 24;
+    sc->image.max_depth = 4;
+    sc->image.seed = 7;
+    sc->camera.from = v3(0.0f, 2.0f, 9.0f);
+    sc->camera.at = v3(0.0f, 0.5f, 0.0f);
+    sc->camera.aperture = 0.2f;
+    sc->camera.focus_dist = 8.0f;
+    sc->bg_type = BG_SKY;
+    sc->bg_color = v3(0.3f, 0.3f, 0.3f);
+    sc->bg_zenith = v3(0.2f, 0.3f, 0.5f);
+    uint other, panel, both;
+    scene_add_material(sc, "plain", material_diffuse(v3(0.6f, 0.6f, 0.5f)), &lanes_plain, NULL);
+    scene_add_material(sc, "other", material_diffuse(v3(0.3f, 0.5f, 0.7f)), &other, NULL);
+    scene_add_material(sc, "panel", material_emissive(v3(60.0f, 50.0f, 40.0f)), &panel, NULL);
+    Material two = material_emissive(v3(5.0f, 6.0f, 8.0f));
+    two.flags |= MAT_TWO_SIDED;
+    scene_add_material(sc, "both", two, &both, NULL);
+    for (int i = 0; i < 40; i++) {
+        vec3 c = vrand(-3.0f, 3.0f);
+        uint m = i % 2 ? lanes_plain : other;
+        Triangle t = { v3_add(c, vrand(-1.0f, 1.0f)), m, v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX,
+                       v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX };
+        scene_add_triangle(sc, t, NULL);
+    }
+    Triangle f1 = { v3(-10.0f, -1.2f, -10.0f), lanes_plain, v3(-10.0f, -1.2f, 10.0f), NO_INDEX,
+                    v3(10.0f, -1.2f, 10.0f), NO_INDEX };
+    Triangle f2 = { v3(-10.0f, -1.2f, -10.0f), lanes_plain, v3(10.0f, -1.2f, 10.0f), NO_INDEX,
+                    v3(10.0f, -1.2f, -10.0f), NO_INDEX };
+    Triangle lt = { v3(-1.0f, 4.0f, -1.0f), panel, v3(1.0f, 4.0f, -1.0f), NO_INDEX, v3(0.0f, 4.0f, 1.0f), NO_INDEX };
+    Triangle q1 = { v3(-1.0f, 4.5f, 2.0f), panel, v3(1.0f, 4.5f, 2.0f), NO_INDEX, v3(1.0f, 4.5f, 3.0f), NO_INDEX };
+    Triangle q2 = { v3(-1.0f, 4.5f, 2.0f), panel, v3(1.0f, 4.5f, 3.0f), NO_INDEX, v3(-1.0f, 4.5f, 3.0f), NO_INDEX };
+    Triangle wall = { v3(3.5f, -1.0f, -2.0f), both, v3(3.5f, 2.0f, -2.0f), NO_INDEX, v3(3.5f, 0.5f, 1.0f), NO_INDEX };
+    const Triangle *more[] = { &f1, &f2, &lt, &q1, &q2, &wall };
+    for (size_t i = 0; i < sizeof more / sizeof more[0]; i++) scene_add_triangle(sc, *more[i], NULL);
+    Error err = { 0 };
+    if (render_scene_prepare(sc, 1, &lanes_rs, &err)) fprintf(stderr, "lanes scene setup failed: %s\n", err.msg);
+    device_scene_view(&lanes_rs.ds, &lanes_view);
+}
+
 static cl_mem buffer(size_t bytes, const void *src)
 {
     cl_int rc;
@@ -309,10 +366,12 @@ static void run(cl_kernel k, size_t n)
     CHECK(clFinish(cl.q) == CL_SUCCESS);
 }
 
-static void set_scene_args(cl_kernel k)
+static void set_scene_bufs(cl_kernel k, const cl_mem *bufs)
 {
-    for (cl_uint i = 0; i < N_SCENE; i++) SET(k, i, cl.scene[i]);
+    for (cl_uint i = 0; i < N_SCENE; i++) SET(k, i, bufs[i]);
 }
+
+static void set_scene_args(cl_kernel k) { set_scene_bufs(k, cl.scene); }
 
 static int setup_opencl(void)
 {
@@ -342,6 +401,8 @@ static int setup_opencl(void)
     for (unsigned i = 0; i < N_SCENE; i++) {
         SceneBufferBytes b = device_scene_buffer(&rs.ds, i);
         cl.scene[i] = buffer(b.bytes, b.data);
+        b = device_scene_buffer(&lanes_rs.ds, i);
+        lanes_bufs[i] = buffer(b.bytes, b.data);
     }
     return 1;
 }
@@ -455,9 +516,10 @@ static void test_raygen(void)
  * into a low word and a carry word. Launched with surplus work-items. k_path_lanes
  * (per_item PATH_LANES paths per work-item) must give the same; the last work-item has
  * fewer than eight paths. */
-static void check_path_kernel(const char *name, uint per_item)
+static void check_path_kernel(const char *name, uint per_item, const RenderScene *scn, const SceneView *v,
+                              const cl_mem *bufs, uint plain)
 {
-    const RenderParams *p = &rs.ds.params;
+    const RenderParams *p = &scn->ds.params;
     /* a last work-item of k_path_lanes with fewer than eight paths */
     uint npix = p->width * p->height, n = npix * LAYERS - (per_item > 1u ? 5u : 0u), first_pixel = 7, first_sample = 3;
     cl_uint init[2 * QUEUE_COUNT_STRIDE] = { 0 };
@@ -465,7 +527,7 @@ static void check_path_kernel(const char *name, uint per_item)
     cl_mem paths = buffer(n * sizeof(PathState), NULL), rays = buffer(n * sizeof(Ray), NULL),
            shadow = buffer(n * sizeof(Ray), NULL), counters = buffer(sizeof init, init);
     cl_kernel k = kernel(name);
-    set_scene_args(k);
+    set_scene_bufs(k, bufs);
     SET(k, N_SCENE + 0, first_pixel);
     SET(k, N_SCENE + 1, first_sample);
     SET(k, N_SCENE + 2, npix);
@@ -488,15 +550,15 @@ static void check_path_kernel(const char *name, uint per_item)
         uint path = first_pixel + i;
         raygen_path(p, path % npix, first_sample + path / npix, &cp, &cr);
         for (;;) {
-            Hit hit = trace_closest_visible(&view, cr);
+            Hit hit = trace_closest_visible(v, cr);
             c_rays++;
             uint first_tri = p->n_spheres;
             if (hit.prim != NO_INDEX && hit.prim >= first_tri && hit.prim < first_tri + p->n_triangles &&
-                view.triangles[hit.prim - first_tri].material == plain_material)
+                v->triangles[hit.prim - first_tri].material == plain)
                 plain_hits++;
-            uint r = shade_path(&view, &cr, hit, &cp, &cs);
+            uint r = shade_path(v, &cr, hit, &cp, &cs);
             if (r & SHADE_SHADOW) {
-                shadow_resolve(&cp, trace_occluded(&view, cs));
+                shadow_resolve(&cp, trace_occluded(v, cs));
                 c_rays++;
             }
             if (!(r & SHADE_CONTINUE)) break;
@@ -523,9 +585,35 @@ static void check_path_kernel(const char *name, uint per_item)
     clReleaseMemObject(counters);
 }
 
-static void test_path_kernel(void) { check_path_kernel("k_path", 1u); }
+static void test_path_kernel(void) { check_path_kernel("k_path", 1u, &rs, &view, cl.scene, plain_material); }
 
-static void test_path_lanes_kernel(void) { check_path_kernel("k_path_lanes", PATH_LANES); }
+/* k_path_lanes on the scene of its kind (it holds no shade_path, so it renders only
+ * those), and which scenes are of that kind. */
+static void test_path_lanes_kernel(void)
+{
+    const DeviceScene *ds = &lanes_rs.ds;
+    CHECK(kernel_lanes_scene(ds, kernel_scene_features(ds)) && kernel_lanes_params(&ds->params));
+    CHECK(!kernel_lanes_scene(&rs.ds, kernel_scene_features(&rs.ds)));
+    /* a diffuse material that emits would need the full shading in k_path_lanes */
+    DeviceScene glow = *ds;
+    Material mats[8];
+    CHECK(ds->n_materials <= 8);
+    memcpy(mats, ds->materials, ds->n_materials * sizeof *mats);
+    mats[lanes_plain].emission = v3(0.1f, 0.0f, 0.0f);
+    glow.materials = mats;
+    CHECK(!kernel_lanes_scene(&glow, kernel_scene_features(&glow)));
+    /* other settings than the float8 shading's */
+    RenderParams q = ds->params;
+    q.sampler = SAMPLER_INDEPENDENT;
+    CHECK(!kernel_lanes_params(&q));
+    q = ds->params;
+    q.shadows = 0;
+    CHECK(!kernel_lanes_params(&q));
+    q = ds->params;
+    q.mis_mode = MIS_LIGHT_ONLY;
+    CHECK(!kernel_lanes_params(&q));
+    check_path_kernel("k_path_lanes", PATH_LANES, &lanes_rs, &lanes_view, lanes_bufs, lanes_plain);
+}
 
 /* Random rays through the scene's box, from inside and outside it. */
 static Ray random_ray(void)
@@ -1277,6 +1365,7 @@ int main(void)
 {
     RUN(test_offline_compiler_sees_opencl);
     build_scene();
+    build_lanes_scene();
     cl.ok = setup_opencl();
     if (!cl.ok) {
         /* make test installs PoCL: no OpenCL device is a failure, not a skip */
@@ -1297,12 +1386,17 @@ int main(void)
     RUN(test_kmath);
     RUN(test_fp_semantics);
     RUN(test_bsdf);
-    for (int i = 0; i < N_SCENE; i++) clReleaseMemObject(cl.scene[i]);
+    for (int i = 0; i < N_SCENE; i++) {
+        clReleaseMemObject(cl.scene[i]);
+        clReleaseMemObject(lanes_bufs[i]);
+    }
     clReleaseProgram(cl.prog);
     clReleaseCommandQueue(cl.q);
     clReleaseContext(cl.ctx);
     render_scene_free(&rs);
+    render_scene_free(&lanes_rs);
     kd_free(&kd);
     scene_free(&scene);
+    scene_free(&lanes_scene);
     return harness_report();
 }

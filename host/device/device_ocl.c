@@ -39,6 +39,7 @@
 
 #include "device/device.h"
 #include "device/device_memory.h"
+#include "device/kernel_features.h"
 #include "base/fault.h"
 #include "device/ocl_args.h"
 #include "device/ocl_program.h"
@@ -113,7 +114,12 @@ typedef struct {
     size_t local_size;      /* 0: let the driver choose */
     int launch;             /* enum WaveLaunch, never AUTO: how a wave is launched */
     int cpu;                /* a CPU device: the megakernel may take eight paths at a time */
-    int lanes;              /* the megakernel is k_path_lanes (lanes_suit the loaded scene) */
+    /* The megakernel is k_path_lanes: on a CPU, where it is faster, for a scene and
+     * settings it can render (kernel_features.h; on PoCL the envmap scene rendered 11%
+     * slower with eight paths per work-item, mesh.scene 19%: most of their lanes would
+     * leave the float8 shading). lanes_scene: the loaded scene allows it, whatever the
+     * settings. */
+    int lanes, lanes_scene;
     uint n_pixels;
     const atomic_int *cancel;   /* the Device's, while a batch renders */
     cl_mem film;            /* the film the batch being rendered goes to */
@@ -348,42 +354,6 @@ static Status launch(OclDevice *od, cl_kernel k, const char *name, uint n, Error
     return launch_local(od, k, name, n, od->local_size, err);
 }
 
-/* The features the background of params needs (KF_* in kernels/types.h). */
-static unsigned params_features(const RenderParams *p)
-{
-    return (p->bg_type == BG_MAP ? KF_ENV_MAP : 0u) | (p->bg_type == BG_CUBEMAP ? KF_CUBEMAP : 0u);
-}
-
-/* The features the scene needs besides the integrator's kernels: every switch of
- * types.h whose code the scene can reach, and no other. */
-static unsigned scene_features(const DeviceScene *s)
-{
-    const RenderParams *p = &s->params;
-    unsigned f = params_features(p);
-    for (uint i = 0; i < s->n_materials; i++) {
-        const Material *m = &s->materials[i];
-        /* a mix (kernels/mix.h, always compiled) scatters as the materials it picks,
-         * which are in this list themselves; only its amount texture is its own */
-        if (m->type == MAT_MIX) {
-            if (m->mix_texture != NO_INDEX) f |= KF_TEXTURES;
-            continue;
-        }
-        f |= m->type <= MAT_PRINCIPLED ? KF_MATERIAL(m->type) : KF_ALL;
-        if (m->texture != NO_INDEX || m->texture_emission != NO_INDEX || m->texture_rm != NO_INDEX ||
-            m->texture_normal != NO_INDEX)
-            f |= KF_TEXTURES;
-        if (m->flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) f |= KF_ALPHA;
-    }
-    for (uint i = 0; i < p->n_lights; i++) {
-        uint t = s->lights[i].type;
-        if (t == LIGHT_ENV) f |= KF_ENV_MAP;
-        else if (t != LIGHT_AREA) f |= KF_DELTA_LIGHTS;
-    }
-    f |= (p->n_spheres ? KF_SPHERES : 0u) | (p->n_boxes ? KF_BOXES : 0u) | (p->n_planes ? KF_PLANES : 0u) |
-         (p->n_revsurfaces ? KF_REVSURFACE : 0u) | (p->n_bvh_nodes ? KF_BVH : KF_KDTREE);
-    return f;
-}
-
 static void release_program(OclDevice *od, int which)
 {
     if (which == PROG_PATH) {
@@ -420,21 +390,6 @@ static unsigned program_kernels(const OclDevice *od, int which)
     if (which == PROG_WHITTED) return KF_WHITTED;
     if (od->launch != WAVE_LAUNCH_MEGAKERNEL) return KF_PATH;
     return od->lanes ? KF_PATH_LANES : KF_PATH_MEGAKERNEL;
-}
-
-/* Whether a CPU's megakernel should run eight paths per work-item (k_path_lanes,
- * kernels/shade_lanes.cl): when the scene's surfaces are all flat triangles of plain
- * diffuse materials and lamps, which shade_lanes shades eight at a time. Any other lane
- * goes through shade_path there as well, so the images are the same either way; but
- * where most lanes would, carrying eight paths costs more than it saves (on PoCL the
- * envmap scene rendered 11% slower, mesh.scene 19%), and those scenes keep k_path. */
-static int lanes_suit(const OclDevice *od, const DeviceScene *s)
-{
-    const RenderParams *p = &s->params;
-    unsigned plain = KF_MATERIAL(MAT_DIFFUSE) | KF_MATERIAL(MAT_EMISSIVE) | KF_KDTREE | KF_BVH;
-    return od->cpu && od->launch == WAVE_LAUNCH_MEGAKERNEL && (od->scene_features & ~plain) == 0u &&
-           s->n_shading == 0u && p->n_triangles > 0u && p->n_lights > 0u && p->sampler == SAMPLER_SOBOL &&
-           p->mis_mode == MIS_BOTH && p->shadows;
 }
 
 /* Builds the program the integrator needs, for the loaded scene's features, unless the
@@ -568,8 +523,9 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     OCL_TRY("clFinish", clFinish(od->queue));
     od->n_pixels = n_pixels;
     /* a program built for an earlier scene serves this one if it has its features */
-    od->scene_features = scene_features(s);
-    od->lanes = lanes_suit(od, s);
+    od->scene_features = kernel_scene_features(s);
+    od->lanes_scene = od->cpu && od->launch == WAVE_LAUNCH_MEGAKERNEL && kernel_lanes_scene(s, od->scene_features);
+    od->lanes = od->lanes_scene && kernel_lanes_params(&s->params);
     for (int i = 0; i < PROG_N; i++) {
         unsigned need = od->scene_features | program_kernels(od, i);
         if ((od->features[i] & need) != need) release_program(od, i);
@@ -645,7 +601,8 @@ static Status ocl_update_params(Device *d, const RenderParams *p, const uint *pi
         return st;
     od->max_bounces = p->max_depth + 1u;
     d->counters.upload_seconds += timer_now() - t0;
-    od->scene_features |= params_features(p);
+    od->scene_features |= kernel_params_features(p);
+    od->lanes = od->lanes_scene && kernel_lanes_params(p);
     if ((st = need_program(d, od, p->integrator, err))) return st;
     od->integrator = p->integrator;
     return ST_OK;

@@ -93,11 +93,12 @@ KFN_INLINE float bvh_inv(float d)
     return 1.0f / (k_fabs(d) < BVH_TINY ? s : d);
 }
 
-/* In a program of k_path_lanes the walk is one function that its closest-hit and
- * any-hit queries call: inlined into both, it made PoCL's cold build of the McGuire box
- * a third longer (3.2 s against 2.4 s on a 2.5 GHz Xeon) at the same speed. k_path keeps
- * it inlined: as a call it rendered one-weekend 13% slower, the envmap scene 9%. */
-#if KF_HAS(KF_PATH_LANES)
+/* In a program of k_path_lanes alone the walk is one function that its closest-hit and
+ * any-hit queries call: inlined into both, it made PoCL's cold build of cornell-box.scene
+ * a third longer (3.2 s against 2.4 s on a 2.5 GHz Xeon) at the same speed. Everything
+ * else keeps it inlined (k_path: as a call it rendered one-weekend 13% slower, the
+ * envmap scene 9%; the C device, the tests' and the benchmark's programs). */
+#if KF_HAS(KF_PATH_LANES) && !KF_HAS(KF_PATH_MEGAKERNEL)
 #define BVH_WALK_FN KFN_CALL_CL
 #else
 #define BVH_WALK_FN KFN_INLINE

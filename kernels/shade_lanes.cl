@@ -327,15 +327,15 @@ KFN_INLINE uint lane_scatter(const LaneResults *r, uint l, GLOBAL Ray *ray, GLOB
     return result | SHADE_CONTINUE;
 }
 
-/* shade_path for a lane that shade_lanes_fast does not take, in a scene lanes_suit
- * (host/device/device_ocl.c) accepts: one whose path escaped, hit a lamp (a pure
- * emitter, which reflects nothing) or reached its last bounce on a surface. Each of
- * these ends the path, with shade_path's emission or background. Every other case,
- * which would need all of shade_path, is kept out of k_path_lanes on the host: a
- * diffuse material that emits, a light other than a triangle lamp, another material
- * or primitive (scene features), shading normals, or another sampler or setting. So
- * shade_path is not compiled into k_path_lanes, whose cold build it made a fifth
- * longer (bench/RESULTS.md). */
+/* shade_path for a lane that shade_lanes_fast does not take, in a scene and with
+ * settings that kernel_lanes_scene and kernel_lanes_params (host/device/
+ * kernel_features.c) accept: one whose path escaped, hit a lamp (a pure emitter, which
+ * reflects nothing) or reached its last bounce on a surface. Each of these ends the
+ * path, with shade_path's background or emission. Every other case, which would need
+ * all of shade_path, is kept out of k_path_lanes on the host: a diffuse material that
+ * emits, a light other than a triangle lamp, another material or primitive, shading
+ * normals, or another sampler or setting. So shade_path is not compiled into
+ * k_path_lanes, whose cold build it made a fifth longer (bench/RESULTS.md). */
 KFN_INLINE uint shade_lane_end(const SceneView *sc, Ray r, Hit hit, GLOBAL PathState *ps)
 {
     if (hit.prim == NO_INDEX) {

@@ -2,7 +2,7 @@
  * bench_traverse.c -- kd-tree and 8-wide BVH traversal against Embree 3, on exactly the
  * same rays.
  *
- *   bench_traverse [--reps N] [--size N] [--threads A,B] [--no-pocl] [--no-embree] [MESH ...]
+ *   bench_traverse [--reps N] [--size N] [--local N] [--builds N] [--no-pocl] [--no-embree] [MESH ...]
  *
  * MESH is an .obj or .ply file, or "sphere:N" (a closed bumpy sphere of about N
  * triangles, mesh_make_sphere). Without meshes: every mesh of ../shared/models that is
@@ -42,7 +42,9 @@
  * mesh also: the kd-tree build time (2 threads and
  * 1), its SAH cost and bytes per triangle (nodes + leaf lists), the BVH's build time (2
  * threads), nodes, leaves and bytes per triangle, and Embree's
- * RTC_BUILD_QUALITY_HIGH build time (2 and 1 threads) and the bytes its build allocated.
+ * RTC_BUILD_QUALITY_HIGH build time (2 and 1 threads) and the bytes its build allocated;
+ * with --builds N, N more rounds of the kd-tree and Embree builds in turns (2 threads),
+ * their medians and the median of the rounds' ratios.
  * Results are printed as Markdown tables for bench/RESULTS.md.
  */
 #include <embree3/rtcore.h>
@@ -74,6 +76,7 @@ typedef struct {
     int reps, size, pocl, embree;
     int threads[MAX_THREADS];
     size_t local;                /* OpenCL work-group size (64, as the renderer), 0 = the driver's choice */
+    int builds;                  /* --builds: rounds of kd-tree and Embree builds in turns (0: none) */
 } Options;
 
 static size_t pocl_local;
@@ -735,6 +738,40 @@ static double rate(uint n, double *secs, int reps)
     return m > 0.0 ? n / m * 1e-6 : 0.0;
 }
 
+/* --builds N: the kd-tree's and Embree's HIGH builds in turns, N rounds on the larger
+ * thread count, so that a busy spell hits both alike; medians of the times and of each
+ * round's ratio. One build of each, as the line above has, swings by 20-30% on a shared
+ * machine. (Not on one thread: once a device of more threads has run, an Embree device
+ * made with threads=1 builds on more.) */
+static void build_rounds(const Mesh *m, const Options *o)
+{
+    KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0, NULL, 0 };
+    int threads = o->threads[MAX_THREADS - 1];
+    double kd[MAX_REPS], em[MAX_REPS], ratio[MAX_REPS];
+    int n = 0;
+    for (int r = 0; r < o->builds; r++) {
+        Error err = { 0 };
+        KdTree tree;
+        Embree e;
+        if (kd_build(&in, threads, &tree, &err)) {
+            fprintf(stderr, "bench_traverse: kd-tree build: %s\n", err.msg);
+            error_clear(&err);
+            return;
+        }
+        kd[n] = tree.stats.build_seconds;
+        kd_free(&tree);
+        int ok = embree_build(&e, m, threads) == 0;
+        em[n] = e.build_seconds;
+        embree_free(&e);
+        if (!ok) return;
+        ratio[n] = kd[n] / em[n];
+        n++;
+    }
+    printf("builds in turns, %d rounds, %d threads: kd-tree %.3f s, Embree HIGH %.3f s (medians); "
+           "kd / Embree %.2f (median of the rounds' ratios)\n",
+           n, threads, median(kd, n), median(em, n), median(ratio, n));
+}
+
 static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS], int have_pocl)
 {
     Mesh m;
@@ -785,6 +822,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
                "bytes/triangle allocated by the build%s\n",
                emb[MAX_THREADS - 1].build_seconds, o->threads[MAX_THREADS - 1], emb[0].build_seconds,
                (double)emb[MAX_THREADS - 1].build_bytes / (double)(nt ? nt : 1), ratio);
+        if (o->builds > 0) build_rounds(&m, o);
     }
 
     SetResult res[N_SETS];
@@ -935,23 +973,27 @@ static const char *const default_meshes[] = {
 
 int main(int argc, char **argv)
 {
-    Options o = { 5, 1024, 1, 1, { 1, 2 }, 64 };
+    Options o = { 5, 1024, 1, 1, { 1, 2 }, 64, 0 };
     const char *meshes[64];
     int n_meshes = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--reps") && i + 1 < argc) o.reps = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--size") && i + 1 < argc) o.size = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--local") && i + 1 < argc) o.local = (size_t)atol(argv[++i]);
+        else if (!strcmp(argv[i], "--builds") && i + 1 < argc) o.builds = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--no-pocl")) o.pocl = 0;
         else if (!strcmp(argv[i], "--no-embree")) o.embree = 0;
         else if (argv[i][0] == '-') {
-            fprintf(stderr, "usage: bench_traverse [--reps N] [--size N] [--local N] [--no-pocl] [--no-embree] [MESH ...]\n");
+            fprintf(stderr, "usage: bench_traverse [--reps N] [--size N] [--local N] [--builds N] [--no-pocl] "
+                            "[--no-embree] [MESH ...]\n");
             return 2;
         } else if (n_meshes < 64) meshes[n_meshes++] = argv[i];
     }
     if (o.reps < 1) o.reps = 1;
     if (o.reps > MAX_REPS) o.reps = MAX_REPS;
     if (o.size < 1 || o.size > 4096) o.size = 1024;
+    if (o.builds < 0) o.builds = 0;
+    if (o.builds > MAX_REPS) o.builds = MAX_REPS;
     pocl_local = o.local;
     if (n_meshes == 0)
         for (size_t i = 0; i < sizeof default_meshes / sizeof default_meshes[0]; i++) {

@@ -1287,6 +1287,42 @@ static void test_pinned_trees(void)
     }
 }
 
+/* From 65536 primitives the boxes are gathered on several threads, and from 2048
+ * non-empty leaves the leaf records are written on several; the root's axes run side
+ * by side with more than one thread. The tree stays the same bits, with primitives
+ * left out (a NaN and an infinite corner) in either thread's range. */
+static void test_threaded_passes(void)
+{
+    size_t nt = 0;
+    Triangle *tri = cube_sphere(80, &nt);
+    CHECK(tri != NULL);
+    if (!tri) return;
+    CHECK(nt > 65536);
+    tri[7].p1.y = NAN;
+    tri[nt - 100].p2.x = INFINITY;
+    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0 };
+    KdTree one;
+    Error err = { 0 };
+    CHECK(kd_build(&in, 1, &one, &err) == ST_OK);
+    CHECK_EQ_INT(one.stats.n_skipped, 2);
+    CHECK_MSG(one.stats.n_leaves - one.stats.n_empty_leaves > 2048, "%u leaves, %u empty", one.stats.n_leaves, one.stats.n_empty_leaves);
+    uint64_t h = TREE_HASH(&one);
+    const int threads[] = { 2, 3, 0 };
+    for (int i = 0; i < 3; i++) {
+        KdTree t;
+        if (kd_build(&in, threads[i], &t, &err) != ST_OK) {
+            CHECK_MSG(0, "%s", err.msg);
+            continue;
+        }
+        CHECK_EQ_INT(t.stats.n_skipped, 2);
+        CHECK_MSG(TREE_HASH(&t) == h, "%d threads: %016llx, one thread: %016llx", threads[i],
+                  (unsigned long long)TREE_HASH(&t), (unsigned long long)h);
+        kd_free(&t);
+    }
+    kd_free(&one);
+    free(tri);
+}
+
 /* ------------------------------------------------------------------ real meshes */
 
 typedef struct {
@@ -1523,6 +1559,7 @@ int main(void)
     RUN(test_flat_on_split_planes);
     RUN(test_deterministic);
     RUN(test_pinned_trees);
+    RUN(test_threaded_passes);
     RUN(test_real_meshes);
     RUN(test_watertight_mesh);
     scene_clear();

@@ -3,9 +3,10 @@
  *
  *   build/bench/bench_render [--reps N] [--json FILE] [--accel bvh|kdtree] [SCENE:WIDTHxHEIGHT:SPP ...]
  *
- * For each scene and each device (every OpenCL device alone, then the scalar device),
- * renders the scene with a fixed seed `reps` times and reports the median samples/s and
- * rays/s, with the ratio to the scalar device measured in the same run, plus the tree's
+ * For each scene, every device (each OpenCL device alone, and the scalar device) renders
+ * the scene with a fixed seed in `reps` rounds, the devices in turns within a round, and
+ * it reports the median samples/s and rays/s and the median of the rounds' ratios to the
+ * scalar device (so that a busy spell of a shared machine hits both sides), plus the tree's
  * build time (the BVH, or the kd-tree with --accel kdtree) and the kernel build/cache-load
  * time. Prints a table and writes JSON.
  * Machines here are shared and noisy: read medians and ratios, not single times.
@@ -34,6 +35,7 @@ static const BenchScene default_scenes[] = {
 
 typedef struct {
     double samples_per_s, rays_per_s, compile_s;
+    double ratio;                /* median over the rounds of samples/s over the scalar device's */
     int from_cache, ok;
 } Result;
 
@@ -49,48 +51,88 @@ static double median(double *v, int n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-static Result bench_device(const DeviceDesc *desc, const RenderScene *rs, uint spp, int reps)
+#define MAX_REPS 32
+
+/* One device's runs of a scene: samples/s and rays/s of each round. */
+typedef struct {
+    Device *dev;
+    double sps[MAX_REPS], rps[MAX_REPS];
+    int n;
+} DeviceRuns;
+
+static int device_start(const DeviceDesc *desc, const RenderScene *rs, DeviceRuns *dr, Result *res)
 {
-    Result res = { 0 };
     Error err = { 0 };
-    Device *dev = NULL;
-    if (device_open(desc, NULL, &dev, &err) || dev->ops->load_scene(dev, &rs->ds, &err)) {
+    memset(dr, 0, sizeof *dr);
+    if (device_open(desc, NULL, &dr->dev, &err) || dr->dev->ops->load_scene(dr->dev, &rs->ds, &err)) {
         fprintf(stderr, "bench: %s: %s\n", desc->name, err.msg);
-        device_close(dev);
+        device_close(dr->dev);
+        dr->dev = NULL;
         error_clear(&err);
-        return res;
+        return -1;
     }
-    res.compile_s = dev->counters.compile_seconds;
-    res.from_cache = dev->counters.from_cache;
-    double sps[32], rps[32];
-    if (reps > 32) reps = 32;
-    for (int r = 0; r < reps; r++) {
-        Film film;
-        ScheduleConfig cfg;
-        ScheduleStats st;
-        memset(&cfg, 0, sizeof cfg);
-        cfg.spp = spp;
-        if (film_init(&film, rs->ds.params.width, rs->ds.params.height, &err)) break;
-        uint64_t rays0 = dev->counters.rays, samples0 = dev->counters.samples;
-        double t0 = timer_now();
-        Status s = schedule_run(&dev, 1, &cfg, &film, &st, &err);
-        double secs = timer_now() - t0;
-        schedule_stats_free(&st);
-        film_free(&film);
-        if (s) {
-            fprintf(stderr, "bench: %s: %s\n", desc->name, err.msg);
-            device_close(dev);
-            error_clear(&err);
-            return res;
-        }
-        sps[r] = (double)(dev->counters.samples - samples0) / secs;
-        rps[r] = (double)(dev->counters.rays - rays0) / secs;
+    res->compile_s = dr->dev->counters.compile_seconds;
+    res->from_cache = dr->dev->counters.from_cache;
+    return 0;
+}
+
+/* One render of the scene on the device; a failure closes it. */
+static void device_round(const DeviceDesc *desc, const RenderScene *rs, uint spp, DeviceRuns *dr)
+{
+    Error err = { 0 };
+    Film film;
+    ScheduleConfig cfg;
+    ScheduleStats st;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.spp = spp;
+    if (film_init(&film, rs->ds.params.width, rs->ds.params.height, &err)) {
+        fprintf(stderr, "bench: %s\n", err.msg);
+        error_clear(&err);
+        return;
     }
-    res.samples_per_s = median(sps, reps);
-    res.rays_per_s = median(rps, reps);
-    res.ok = 1;
-    device_close(dev);
-    return res;
+    Device *dev = dr->dev;
+    uint64_t rays0 = dev->counters.rays, samples0 = dev->counters.samples;
+    double t0 = timer_now();
+    Status s = schedule_run(&dev, 1, &cfg, &film, &st, &err);
+    double secs = timer_now() - t0;
+    schedule_stats_free(&st);
+    film_free(&film);
+    if (s) {
+        fprintf(stderr, "bench: %s: %s\n", desc->name, err.msg);
+        error_clear(&err);
+        device_close(dr->dev);
+        dr->dev = NULL;
+        return;
+    }
+    dr->sps[dr->n] = (double)(dev->counters.samples - samples0) / secs;
+    dr->rps[dr->n] = (double)(dev->counters.rays - rays0) / secs;
+    dr->n++;
+}
+
+/* Every device renders the scene `reps` times, the devices in turns within each round
+ * (a busy spell of the machine then slows them alike): medians of samples/s and rays/s,
+ * and the median of each round's ratio to the scalar device (the last one). */
+static void bench_devices(const DeviceDesc *all, size_t n_all, const RenderScene *rs, uint spp, int reps, Result *res)
+{
+    DeviceRuns *dr = calloc(n_all, sizeof *dr);
+    if (!dr) return;
+    for (size_t k = 0; k < n_all; k++) device_start(&all[k], rs, &dr[k], &res[k]);
+    for (int r = 0; r < reps; r++)
+        for (size_t k = n_all; k-- > 0;)
+            if (dr[k].dev) device_round(&all[k], rs, spp, &dr[k]);
+    const DeviceRuns *ref = &dr[n_all - 1];
+    for (size_t k = 0; k < n_all; k++) {
+        if (!dr[k].dev || dr[k].n < reps) continue;
+        double ratio[MAX_REPS];
+        int n = ref->dev && ref->n == reps ? reps : 0;
+        for (int r = 0; r < n; r++) ratio[r] = dr[k].sps[r] / ref->sps[r];
+        res[k].ratio = n ? median(ratio, n) : 0.0;
+        res[k].samples_per_s = median(dr[k].sps, reps);
+        res[k].rays_per_s = median(dr[k].rps, reps);
+        res[k].ok = 1;
+    }
+    for (size_t k = 0; k < n_all; k++) device_close(dr[k].dev);
+    free(dr);
 }
 
 int main(int argc, char **argv)
@@ -117,6 +159,7 @@ int main(int argc, char **argv)
         }
     }
     if (reps < 1) reps = 1;
+    if (reps > MAX_REPS) reps = MAX_REPS;
     if (n_scenes == 0) {
         n_scenes = (int)(sizeof default_scenes / sizeof default_scenes[0]);
         memcpy(scenes, default_scenes, sizeof default_scenes);
@@ -132,7 +175,8 @@ int main(int argc, char **argv)
     }
     FILE *json = fopen(json_path, "w");
     if (json) fprintf(json, "{\n  \"reps\": %d,\n  \"results\": [\n", reps);
-    printf("clpt render benchmark: median of %d runs per device; ratio = samples/s relative to the scalar device\n\n", reps);
+    printf("clpt render benchmark: %d rounds, the devices in turns in each; medians; ratio = median of the rounds' "
+           "samples/s over the scalar device's\n\n", reps);
     printf("%-28s %-36s %12s %10s %7s %10s %s\n", "scene", "device", "Msamples/s", "Mrays/s", "ratio",
            "kernels s", accel == ACCEL_KDTREE ? "kd-tree" : "BVH");
     int first_json = 1;
@@ -156,11 +200,9 @@ int main(int argc, char **argv)
             continue;
         }
         Result *res = calloc(n_all, sizeof *res);
-        /* the scalar device (last) first: it is the reference for the ratios */
-        for (size_t k = n_all; k-- > 0;) res[k] = bench_device(&all[k], &rs, scenes[si].spp, reps);
+        bench_devices(all, n_all, &rs, scenes[si].spp, reps, res);
         double tree_s = accel == ACCEL_KDTREE ? rs.kd.stats.build_seconds : rs.bvh.stats.build_seconds;
         double sah = accel == ACCEL_KDTREE ? rs.kd.stats.sah_cost : rs.bvh.stats.sah_cost;
-        double ref = res[n_all - 1].samples_per_s;
         char label[64];
         snprintf(label, sizeof label, "%s %ux%u", strrchr(scenes[si].path, '/') ? strrchr(scenes[si].path, '/') + 1
                                                                                 : scenes[si].path,
@@ -172,7 +214,7 @@ int main(int argc, char **argv)
                 snprintf(kern, sizeof kern, "%.3f%s", res[k].compile_s, res[k].from_cache ? " (cache)" : "");
             printf("%-28.28s %-36.36s %12.3f %10.3f %6.2fx %10s %.3f s, SAH %.1f\n", label,
                    all[k].kind == DEVICE_SCALAR ? "scalar (all cores)" : all[k].name, res[k].samples_per_s / 1e6,
-                   res[k].rays_per_s / 1e6, ref > 0.0 ? res[k].samples_per_s / ref : 0.0, kern,
+                   res[k].rays_per_s / 1e6, res[k].ratio, kern,
                    tree_s, sah);
             if (json) {
                 fprintf(json, "%s    {\"scene\": \"%s\", \"width\": %u, \"height\": %u, \"spp\": %u, \"device\": \"%s\", "
@@ -181,7 +223,7 @@ int main(int argc, char **argv)
                               "\"sah_cost\": %.3f}",
                         first_json ? "" : ",\n", scenes[si].path, scenes[si].width, scenes[si].height, scenes[si].spp,
                         all[k].name, all[k].kind == DEVICE_SCALAR ? "scalar" : "opencl", res[k].samples_per_s,
-                        res[k].rays_per_s, ref > 0.0 ? res[k].samples_per_s / ref : 0.0, res[k].compile_s,
+                        res[k].rays_per_s, res[k].ratio, res[k].compile_s,
                         res[k].from_cache, accel == ACCEL_KDTREE ? "kdtree" : "bvh", tree_s, sah);
                 first_json = 0;
             }

@@ -1192,7 +1192,8 @@ typedef struct {
     size_t n_records;
 } Flat;
 
-/* Writes leaf node `me` and its record; rel: its box's area relative to the root's. */
+/* Writes leaf node `me` and lists its record for records_write; rel: its box's area
+ * relative to the root's. */
 static void flat_leaf(Flat *f, const FlatItem *it, uint me, double rel)
 {
     const BNode *n = it->node;

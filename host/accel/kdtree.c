@@ -1405,9 +1405,9 @@ static void *axis_job(void *arg)
 
 /* The root's sorted event lists, at the bottom of worker 0's arena, described by *nl.
  * The arena gets room for three times the root's events: the children's lists are
- * written above their parent's. With more than one thread, two of the axes are done on
- * threads of their own (three on two cores take two thirds of the time that two on
- * one core and one on the other do). */
+ * written above their parent's. With more than one thread, each axis is done on a
+ * thread of its own (three on two cores take two thirds of the time that two on one
+ * core and one on the other do). */
 static Status root_events(Build *b, const Aabb *root, NodeLists *nl, Error *err)
 {
     Worker *w = &b->workers[0];
@@ -1418,19 +1418,15 @@ static Status root_events(Build *b, const Aabb *root, NodeLists *nl, Error *err)
     if (reserve_events(&w->arena, &w->arena_cap, total_ev * 3 + 1))
         return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu events", total_ev);
     AxisJob jobs[3];
-    pthread_t tid[3];
-    int started[3] = { 0, 0, 0 };
     Event *ev = w->arena;
     for (int k = 0; k < 3; k++) {
         jobs[k] = (AxisJob){ b, k, ev, n_ev[k], 0 };
         ev += n_ev[k];
-        if (b->threads > 1 && k < 2 && pthread_create(&tid[k], NULL, axis_job, &jobs[k]) == 0)
-            started[k] = 1;
-        else
-            axis_job(&jobs[k]);
     }
-    for (int k = 0; k < 3; k++)
-        if (started[k]) pthread_join(tid[k], NULL);
+    if (b->threads > 1)
+        run_jobs(axis_job, jobs, sizeof *jobs, 3);
+    else
+        for (int k = 0; k < 3; k++) axis_job(&jobs[k]);
     if (jobs[0].failed || jobs[1].failed || jobs[2].failed)
         return error_set(err, ST_INTERNAL, "kd-tree: out of memory sorting events");
     w->top = total_ev;

@@ -120,13 +120,18 @@ static void bench_devices(const DeviceDesc *all, size_t n_all, const RenderScene
     for (int r = 0; r < reps; r++)
         for (size_t k = n_all; k-- > 0;)
             if (dr[k].dev) device_round(&all[k], rs, spp, &dr[k]);
+    /* the rounds' ratios first: median() sorts its array in place, which would part
+     * the rounds of the two sides */
     const DeviceRuns *ref = &dr[n_all - 1];
+    int have_ref = ref->dev && ref->n == reps;
+    for (size_t k = 0; k < n_all; k++) {
+        if (!dr[k].dev || dr[k].n < reps || !have_ref) continue;
+        double ratio[MAX_REPS];
+        for (int r = 0; r < reps; r++) ratio[r] = dr[k].sps[r] / ref->sps[r];
+        res[k].ratio = median(ratio, reps);
+    }
     for (size_t k = 0; k < n_all; k++) {
         if (!dr[k].dev || dr[k].n < reps) continue;
-        double ratio[MAX_REPS];
-        int n = ref->dev && ref->n == reps ? reps : 0;
-        for (int r = 0; r < n; r++) ratio[r] = dr[k].sps[r] / ref->sps[r];
-        res[k].ratio = n ? median(ratio, n) : 0.0;
         res[k].samples_per_s = median(dr[k].sps, reps);
         res[k].rays_per_s = median(dr[k].rps, reps);
         res[k].ok = 1;

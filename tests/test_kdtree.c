@@ -1178,8 +1178,8 @@ static Triangle *cube_sphere(uint n, size_t *count)
     return t;
 }
 
-/* The BVH is the same whatever the number of threads (subtrees of 32768 primitives and
- * more are built by other threads: the cube sphere has 76800 triangles). */
+/* The BVH is the same whatever the number of threads (from 32768 primitives, subtrees
+ * below the top are built by the threads: the cube sphere has 76800 triangles). */
 static void test_bvh_deterministic(void)
 {
     size_t nt = 0;

@@ -9,18 +9,20 @@
  * while it has fewer than eight, replaces the interior child with the largest surface
  * area by that child's two children (Embree's BVH8 from a binary build). The wide nodes
  * are written depth first, a parent before its children, the leaves' records into the
- * leaf data in the kd-tree's layout (kd_leaf_record_write).
+ * leaf data in the kd-tree's layout (kd_leaf_record_write). With several threads, the
+ * top of the binary tree is built first and the subtrees below it by the threads
+ * (build_tree); docs/bvh.md has the measurements behind the choices.
  */
 #include "accel/bvh.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "base/jobs.h"
 #include "base/timer.h"
 
 #define BVH_BINS 32
@@ -30,8 +32,12 @@
  * the stack's size, nodes below take two children (one more entry per binary level, of
  * which there are at most BVH_MAX_DEPTH), so no tree can overflow it. */
 #define BVH_MAX_LEAF 32u       /* a larger set is split whatever the SAH says */
-/* Subtrees of at least this many primitives may be built by another thread. */
-#define BVH_TASK_MIN 32768u
+/* With several threads, the top of the tree is built first, on this thread, and each
+ * subtree below it of at most 1 / (BVH_SUBTREES_PER_THREAD threads) of the primitives
+ * waits; then the threads take the waiting subtrees, largest first. */
+#define BVH_SUBTREES_PER_THREAD 4u
+/* Fewer primitives than this are built on one thread: starting threads costs more. */
+#define BVH_THREADS_MIN 32768u
 /* SAH costs (relative): a binary node's share of a wide node's visit, the test of one
  * group of eight triangles, and that of one other primitive (a sphere, box or surface
  * of revolution, tested alone). */
@@ -42,24 +48,35 @@
 typedef struct { float lo[3], hi[3]; } Box3;
 
 /* A node of the binary tree: a leaf when count > 0 (its primitives are
- * idx[first .. first + count)), else an interior node with two children. */
+ * ref[first .. first + count)), else an interior node with two children. */
 typedef struct {
     Box3 box;
     uint child[2];
     uint first, count;
 } BinNode;
 
+/* A primitive as the build moves it: its bounds and global id, 32 bytes. The build
+ * partitions these records themselves, not indices to them, so that every pass over a
+ * node reads memory in order: with an index array, each pass over a large node
+ * gathered boxes from all over the scene's 28 MB of bounds and centres (the dragon's
+ * binary tree took 0.9 s on two threads). */
+typedef struct {
+    Box3 box;
+    uint gid;
+    uint pad;
+} PrimRef;
+
 typedef struct {
     const KdInput *in;
     uint n;                    /* primitives in the tree */
-    uint *gid;                 /* per primitive: its global id */
-    Box3 *box;                 /* per primitive: its bounds */
-    float (*cen)[3];           /* per primitive: its bounds' centre */
-    uint *idx;                 /* the primitives in tree order */
+    PrimRef *ref;              /* the primitives, in tree order once built */
     uint first_tri, n_tri;     /* the triangles' global ids */
     BinNode *nodes;            /* room for every node: a binary tree of n leaves has 2n - 1 */
     atomic_uint n_nodes;
-    atomic_int spare_threads;  /* threads that may still be started */
+    uint defer_at_most;        /* subtrees of at most this many primitives wait (0: none) */
+    struct Subtree *waiting;   /* those subtrees, their nodes already numbered */
+    size_t n_waiting, cap_waiting;
+    atomic_size_t next_waiting; /* the next one a thread takes */
 } Build;
 
 static Box3 box3_empty(void)
@@ -68,11 +85,14 @@ static Box3 box3_empty(void)
     return b;
 }
 
+/* b grown to hold a: each bound replaced where a's is beyond it. Written as selects,
+ * which compile to minss / maxss, not as branches: in the binning they mispredicted
+ * at random and held half of the build's time. Ties (0 and -0) keep b's. */
 static void box3_grow(Box3 *b, const Box3 *a)
 {
     for (int k = 0; k < 3; k++) {
-        if (a->lo[k] < b->lo[k]) b->lo[k] = a->lo[k];
-        if (a->hi[k] > b->hi[k]) b->hi[k] = a->hi[k];
+        b->lo[k] = a->lo[k] < b->lo[k] ? a->lo[k] : b->lo[k];
+        b->hi[k] = a->hi[k] > b->hi[k] ? a->hi[k] : b->hi[k];
     }
 }
 
@@ -91,7 +111,10 @@ static double groups_of(uint n) { return (double)((n + 7u) / 8u); }
 /* What testing a leaf of these primitives costs. */
 static double leaf_tests(Count c) { return BVH_COST_GROUP * groups_of(c.tri) + BVH_COST_OTHER * c.other; }
 
-static int is_tri(const Build *b, uint p) { return b->gid[p] - b->first_tri < b->n_tri; }
+static int is_tri(const Build *b, const PrimRef *r) { return r->gid - b->first_tri < b->n_tri; }
+
+/* The centre of a primitive's bounds on axis k: what the bins and the partition sort by. */
+static float centre(const PrimRef *r, int k) { return 0.5f * r->box.lo[k] + 0.5f * r->box.hi[k]; }
 
 static void count_add(Count *c, Count a)
 {
@@ -100,15 +123,6 @@ static void count_add(Count *c, Count a)
 }
 
 static uint node_new(Build *b) { return atomic_fetch_add(&b->n_nodes, 1u); }
-
-/* One more thread for a subtree, if one is spare. */
-static int thread_take(Build *b)
-{
-    int v = atomic_load(&b->spare_threads);
-    while (v > 0)
-        if (atomic_compare_exchange_weak(&b->spare_threads, &v, v - 1)) return 1;
-    return 0;
-}
 
 typedef struct { int axis, bin; double cost; } BinSplit;
 
@@ -123,42 +137,52 @@ static int bin_of(float c, float lo, float scale)
     return f > 0.0f ? (f < (float)BVH_BINS ? (int)f : BVH_BINS - 1) : 0;
 }
 
-/* The cheapest of the 31 bin boundaries on each axis for idx[first .. first + n),
- * whose centres span cb; cost +inf when every centre is the same point. */
+/* The cheapest of the 31 bin boundaries on each axis for ref[first .. first + n),
+ * whose centres span cb; cost +inf when every centre is the same point. The bins of
+ * all three axes are filled in one pass over the primitives. */
 static BinSplit best_split(const Build *b, uint first, uint n, const Box3 *cb)
 {
     BinSplit best = { -1, 0, INFINITY };
+    float scale[3];
+    int axes[3], n_axes = 0;
     for (int k = 0; k < 3; k++) {
         float ext = cb->hi[k] - cb->lo[k];
         if (!(ext > 0.0f)) continue;
-        float scale = (float)BVH_BINS / ext;
-        Box3 bin_box[BVH_BINS];
-        Count bin_n[BVH_BINS];
-        memset(bin_n, 0, sizeof bin_n);
-        for (int i = 0; i < BVH_BINS; i++) bin_box[i] = box3_empty();
-        for (uint i = first; i < first + n; i++) {
-            uint p = b->idx[i];
-            int bi = bin_of(b->cen[p][k], cb->lo[k], scale);
-            if (is_tri(b, p)) bin_n[bi].tri++;
-            else bin_n[bi].other++;
-            box3_grow(&bin_box[bi], &b->box[p]);
+        scale[k] = (float)BVH_BINS / ext;
+        axes[n_axes++] = k;
+    }
+    Box3 bin_box[3][BVH_BINS];
+    Count bin_n[3][BVH_BINS];
+    memset(bin_n, 0, sizeof bin_n);
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < BVH_BINS; i++) bin_box[k][i] = box3_empty();
+    for (const PrimRef *r = b->ref + first, *end = r + n; r < end; r++) {
+        int tri = is_tri(b, r);
+        for (int a = 0; a < n_axes; a++) {
+            int k = axes[a], bi = bin_of(centre(r, k), cb->lo[k], scale[k]);
+            if (tri) bin_n[k][bi].tri++;
+            else bin_n[k][bi].other++;
+            box3_grow(&bin_box[k][bi], &r->box);
         }
+    }
+    for (int a = 0; a < n_axes; a++) {
+        int k = axes[a];
         /* areas and counts to the right of each boundary, then a sweep from the left */
         double right_area[BVH_BINS];
         Count right_n[BVH_BINS];
         Box3 acc = box3_empty();
         Count cnt = { 0, 0 };
         for (int i = BVH_BINS - 1; i > 0; i--) {
-            box3_grow(&acc, &bin_box[i]);
-            count_add(&cnt, bin_n[i]);
+            box3_grow(&acc, &bin_box[k][i]);
+            count_add(&cnt, bin_n[k][i]);
             right_area[i] = box3_half_area(&acc);
             right_n[i] = cnt;
         }
         acc = box3_empty();
         cnt = (Count){ 0, 0 };
         for (int i = 0; i < BVH_BINS - 1; i++) {
-            box3_grow(&acc, &bin_box[i]);
-            count_add(&cnt, bin_n[i]);
+            box3_grow(&acc, &bin_box[k][i]);
+            count_add(&cnt, bin_n[k][i]);
             Count r = right_n[i + 1];
             if (cnt.tri + cnt.other == 0 || r.tri + r.other == 0) continue;
             double c = box3_half_area(&acc) * leaf_tests(cnt) + right_area[i + 1] * leaf_tests(r);
@@ -172,37 +196,51 @@ static BinSplit best_split(const Build *b, uint first, uint n, const Box3 *cb)
     return best;
 }
 
-typedef struct {
-    Build *b;
-    uint first, n;
+/* A subtree to build: ref[first .. first + n) as node `node`, at binary depth `depth`. */
+typedef struct Subtree {
+    uint node, first, n;
     int depth;
-    uint node;
-} Task;
+} Subtree;
 
-static uint build_node(Build *b, uint first, uint n, int depth);
+static void build_node(Build *b, Subtree t, int may_wait);
 
-static void *task_run(void *arg)
+/* Builds subtree t now, or, when may_wait and it is small enough, puts it on the
+ * waiting list for the threads. */
+static void build_or_wait(Build *b, Subtree t, int may_wait)
 {
-    Task *t = arg;
-    t->node = build_node(t->b, t->first, t->n, t->depth);
-    return NULL;
+    if (!may_wait || t.n > b->defer_at_most) {
+        build_node(b, t, may_wait);
+        return;
+    }
+    if (b->n_waiting == b->cap_waiting) {
+        size_t cap = b->cap_waiting ? 2 * b->cap_waiting : 64;
+        Subtree *w = realloc(b->waiting, cap * sizeof *w);
+        if (!w) {
+            build_node(b, t, 0); /* correct, only slower */
+            return;
+        }
+        b->waiting = w;
+        b->cap_waiting = cap;
+    }
+    b->waiting[b->n_waiting++] = t;
 }
 
-/* Builds the subtree of idx[first .. first + n) at binary depth `depth`; returns its
- * node. The split depends on the primitives alone, so the tree is the same whichever
- * threads built which subtree (only the binary nodes' numbering differs, and the wide
- * nodes are numbered by walking the tree). */
-static uint build_node(Build *b, uint first, uint n, int depth)
+/* Builds subtree t (its node is numbered already); below the top (may_wait), the
+ * subtrees small enough wait (build_or_wait). The split depends on the primitives
+ * alone, so the tree is the same whichever threads built which subtree (only the
+ * binary nodes' numbering differs, and the wide nodes are numbered by walking the
+ * tree). */
+static void build_node(Build *b, Subtree t, int may_wait)
 {
-    uint me = node_new(b);
+    uint me = t.node, first = t.first, n = t.n;
+    int depth = t.depth;
     Box3 box = box3_empty(), cb = box3_empty();
     Count count = { 0, 0 };
-    for (uint i = first; i < first + n; i++) {
-        uint p = b->idx[i];
-        if (is_tri(b, p)) count.tri++;
+    for (const PrimRef *r = b->ref + first, *end = r + n; r < end; r++) {
+        if (is_tri(b, r)) count.tri++;
         else count.other++;
-        box3_grow(&box, &b->box[p]);
-        Box3 c = { { b->cen[p][0], b->cen[p][1], b->cen[p][2] }, { b->cen[p][0], b->cen[p][1], b->cen[p][2] } };
+        box3_grow(&box, &r->box);
+        Box3 c = { { centre(r, 0), centre(r, 1), centre(r, 2) }, { centre(r, 0), centre(r, 1), centre(r, 2) } };
         box3_grow(&cb, &c);
     }
     b->nodes[me].box = box;
@@ -215,40 +253,61 @@ static uint build_node(Build *b, uint first, uint n, int depth)
         b->nodes[me].first = first;
         b->nodes[me].count = n;
         b->nodes[me].child[0] = b->nodes[me].child[1] = NO_INDEX;
-        return me;
+        return;
     }
     /* partition by the chosen bin boundary (the binning's own bin_of) */
     int k = s.axis;
     float scale = (float)BVH_BINS / (cb.hi[k] - cb.lo[k]);
     uint lo = first, hi = first + n;
     while (lo < hi) {
-        uint p = b->idx[lo];
-        int bi = bin_of(b->cen[p][k], cb.lo[k], scale);
+        PrimRef r = b->ref[lo];
+        int bi = bin_of(centre(&r, k), cb.lo[k], scale);
         if (bi <= s.bin) {
             lo++;
         } else {
-            b->idx[lo] = b->idx[--hi];
-            b->idx[hi] = p;
+            b->ref[lo] = b->ref[--hi];
+            b->ref[hi] = r;
         }
     }
     uint nl = lo - first;
+    uint left = node_new(b), right = node_new(b);
     b->nodes[me].count = 0;
-    Task left = { b, first, nl, depth + 1, NO_INDEX };
-    pthread_t tid;
-    int spawned = nl >= BVH_TASK_MIN && n - nl >= BVH_TASK_MIN && thread_take(b);
-    if (spawned && pthread_create(&tid, NULL, task_run, &left) != 0) {
-        atomic_fetch_add(&b->spare_threads, 1);
-        spawned = 0;
-    }
-    if (!spawned) task_run(&left);
-    uint r = build_node(b, lo, n - nl, depth + 1);
-    if (spawned) {
-        pthread_join(tid, NULL);
-        atomic_fetch_add(&b->spare_threads, 1);
-    }
-    b->nodes[me].child[0] = left.node;
-    b->nodes[me].child[1] = r;
-    return me;
+    b->nodes[me].child[0] = left;
+    b->nodes[me].child[1] = right;
+    build_or_wait(b, (Subtree){ left, first, nl, depth + 1 }, may_wait);
+    build_or_wait(b, (Subtree){ right, lo, n - nl, depth + 1 }, may_wait);
+}
+
+/* Larger subtrees first: the last to start are the shortest. */
+static int subtree_larger(const void *a, const void *b)
+{
+    const Subtree *x = a, *y = b;
+    if (x->n != y->n) return x->n < y->n ? 1 : -1;
+    return (x->first > y->first) - (x->first < y->first);
+}
+
+/* One thread's share of the waiting subtrees: the next one until none is left. */
+static void *waiting_run(void *arg)
+{
+    Build *b = *(Build **)arg;
+    for (size_t i; (i = atomic_fetch_add(&b->next_waiting, 1)) < b->n_waiting;) build_node(b, b->waiting[i], 0);
+    return NULL;
+}
+
+/* The binary tree of all b->n primitives on `threads` threads; returns its root. */
+static uint build_tree(Build *b, int threads)
+{
+    uint root = node_new(b);
+    threads = jobs_threads(threads, b->n, BVH_THREADS_MIN);
+    b->defer_at_most = threads > 1 ? b->n / (BVH_SUBTREES_PER_THREAD * (uint)threads) : 0u;
+    build_node(b, (Subtree){ root, 0u, b->n, 0 }, threads > 1);
+    if (b->n_waiting == 0) return root;
+    qsort(b->waiting, b->n_waiting, sizeof *b->waiting, subtree_larger);
+    int n_jobs = (size_t)threads < b->n_waiting ? threads : (int)b->n_waiting;
+    Build *jobs[JOBS_MAX];
+    for (int i = 0; i < n_jobs; i++) jobs[i] = b;
+    jobs_run(waiting_run, jobs, sizeof *jobs, n_jobs);
+    return root;
 }
 
 /* The binary tree's leaves, deepest leaf and SAH cost (relative to the root's area). */
@@ -268,7 +327,7 @@ static void tree_stats(const Build *b, uint root, BvhStats *st)
             st->n_leaves++;
             Count cnt = { 0, 0 };
             for (uint i = c->first; i < c->first + c->count; i++) {
-                if (is_tri(b, b->idx[i])) cnt.tri++;
+                if (is_tri(b, &b->ref[i])) cnt.tri++;
                 else cnt.other++;
             }
             sah += leaf_tests(cnt) * area;
@@ -361,7 +420,7 @@ static void flat_node(Flat *f, uint bn, uint me, uint depth, uint pending)
             w->box[2 * k + 1][i] = c->box.hi[k];
         }
         if (c->count > 0) {
-            for (uint j = 0; j < c->count; j++) f->ids[j] = b->gid[b->idx[c->first + j]];
+            for (uint j = 0; j < c->count; j++) f->ids[j] = b->ref[c->first + j].gid;
             qsort(f->ids, c->count, sizeof *f->ids, uint_cmp);
             w->ref[i] = (uint)f->words;
             w->kind[i] = kd_leaf_record_write(b->in, f->ids, c->count, f->out->leaf_prims + f->words);
@@ -388,7 +447,7 @@ static size_t leaf_data_words(Build *b, uint *ids)
     for (uint i = 0; i < n_nodes; i++) {
         const BinNode *c = &b->nodes[i];
         if (c->count == 0) continue;
-        for (uint j = 0; j < c->count; j++) ids[j] = b->gid[b->idx[c->first + j]];
+        for (uint j = 0; j < c->count; j++) ids[j] = b->ref[c->first + j].gid;
         qsort(ids, c->count, sizeof *ids, uint_cmp);
         words += kd_leaf_record_words(b->in, ids, c->count);
     }
@@ -397,31 +456,22 @@ static size_t leaf_data_words(Build *b, uint *ids)
 
 static void build_free(Build *b)
 {
-    free(b->gid);
-    free(b->box);
-    free(b->cen);
-    free(b->idx);
+    free(b->ref);
     free(b->nodes);
+    free(b->waiting);
 }
 
 /* The primitives with finite bounds: their global ids, bounds and centres. */
 static Status gather(Build *b, size_t total, Error *err)
 {
-    b->gid = malloc((total + 1) * sizeof *b->gid);
-    b->box = malloc((total + 1) * sizeof *b->box);
-    b->cen = malloc((total + 1) * sizeof *b->cen);
-    b->idx = malloc((total + 1) * sizeof *b->idx);
+    b->ref = malloc((total + 1) * sizeof *b->ref);
     b->nodes = malloc((2 * total + 1) * sizeof *b->nodes);
-    if (!b->gid || !b->box || !b->cen || !b->idx || !b->nodes)
+    if (!b->ref || !b->nodes)
         return error_set(err, ST_INTERNAL, "BVH: out of memory for %zu primitives", total);
     for (uint gid = 0; gid < (uint)total; gid++) {
         Box3 a;
         if (!kd_prim_box(b->in, gid, a.lo, a.hi)) continue;
-        b->gid[b->n] = gid;
-        b->box[b->n] = a;
-        for (int k = 0; k < 3; k++) b->cen[b->n][k] = 0.5f * a.lo[k] + 0.5f * a.hi[k];
-        b->idx[b->n] = b->n;
-        b->n++;
+        b->ref[b->n++] = (PrimRef){ a, gid, 0u };
     }
     return ST_OK;
 }
@@ -474,11 +524,11 @@ Status bvh_build(const KdInput *in, int threads, Bvh *out, Error *err)
     b.first_tri = (uint)in->n_spheres;
     b.n_tri = (uint)in->n_triangles;
     atomic_init(&b.n_nodes, 0u);
-    atomic_init(&b.spare_threads, threads - 1);
+    atomic_init(&b.next_waiting, 0);
     Status st = gather(&b, total, err);
     if (st == ST_OK) {
         out->stats.n_skipped = (uint)(total - b.n);
-        uint root = build_node(&b, 0, b.n, 0);
+        uint root = build_tree(&b, threads);
         tree_stats(&b, root, &out->stats);
         if (b.n) {
             const Box3 *rb = &b.nodes[root].box;

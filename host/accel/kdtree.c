@@ -27,6 +27,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "base/jobs.h"
 #include "base/timer.h"
 #include "scene/scene.h"
 
@@ -435,31 +436,6 @@ static void build_fail(Build *b)
     pthread_mutex_lock(&b->lock);
     b->failed = 1;
     pthread_mutex_unlock(&b->lock);
-}
-
-/* Most threads the passes over all primitives or leaves (gather, leaf records) use. */
-#define KD_MAX_PASS_THREADS 16
-
-/* Runs fn on each of the n jobs (n <= KD_MAX_PASS_THREADS, job_size bytes apart), job 0
- * on this thread and the others on threads of their own (here, when one cannot start). */
-static void run_jobs(void *(*fn)(void *), void *jobs, size_t job_size, int n)
-{
-    pthread_t tid[KD_MAX_PASS_THREADS];
-    int started[KD_MAX_PASS_THREADS] = { 0 };
-    char *job = jobs;
-    for (int i = 1; i < n; i++) started[i] = pthread_create(&tid[i], NULL, fn, job + (size_t)i * job_size) == 0;
-    fn(job);
-    for (int i = 1; i < n; i++) {
-        if (started[i]) pthread_join(tid[i], NULL);
-        else fn(job + (size_t)i * job_size);
-    }
-}
-
-/* How many of `threads` a pass over n items uses: one for fewer than `min_items`. */
-static int pass_threads(int threads, size_t n, size_t min_items)
-{
-    if (n < min_items || threads < 1) return 1;
-    return threads > KD_MAX_PASS_THREADS ? KD_MAX_PASS_THREADS : threads;
 }
 
 /* The root's sweep and list split take as long as a whole level of nodes below it, and
@@ -1055,12 +1031,12 @@ static Status gather(Build *b, const KdInput *in, uint *skipped, Error *err)
         free(finite);
         return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu primitives", total);
     }
-    int n_jobs = pass_threads(b->threads, total, 65536);
-    BoundsJob jobs[KD_MAX_PASS_THREADS];
+    int n_jobs = jobs_threads(b->threads, total, 65536);
+    BoundsJob jobs[JOBS_MAX];
     for (int i = 0; i < n_jobs; i++)
         jobs[i] = (BoundsJob){ in, b->bounds, finite, (uint)(total * (size_t)i / (size_t)n_jobs),
                                (uint)(total * (size_t)(i + 1) / (size_t)n_jobs) };
-    run_jobs(bounds_range, jobs, sizeof *jobs, n_jobs);
+    jobs_run(bounds_range, jobs, sizeof *jobs, n_jobs);
 
     uint first_tri = (uint)in->n_spheres, end_tri = first_tri + (uint)in->n_triangles, n = 0;
     for (uint gid = 0; gid < (uint)total; gid++) {
@@ -1291,11 +1267,11 @@ static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in
     t->n_leaf_prims = f.words;
     flat_stats_finish(&f);
 
-    int n_jobs = pass_threads(threads, f.n_records, 2048);
-    RecordJob jobs[KD_MAX_PASS_THREADS];
+    int n_jobs = jobs_threads(threads, f.n_records, 2048);
+    RecordJob jobs[JOBS_MAX];
     for (int i = 0; i < n_jobs; i++)
         jobs[i] = (RecordJob){ &f, f.n_records * (size_t)i / (size_t)n_jobs, f.n_records * (size_t)(i + 1) / (size_t)n_jobs };
-    run_jobs(records_write, jobs, sizeof *jobs, n_jobs);
+    jobs_run(records_write, jobs, sizeof *jobs, n_jobs);
     free(f.records);
     return ST_OK;
 }
@@ -1424,7 +1400,7 @@ static Status root_events(Build *b, const Aabb *root, NodeLists *nl, Error *err)
         ev += n_ev[k];
     }
     if (b->threads > 1)
-        run_jobs(axis_job, jobs, sizeof *jobs, 3);
+        jobs_run(axis_job, jobs, sizeof *jobs, 3);
     else
         for (int k = 0; k < 3; k++) axis_job(&jobs[k]);
     if (jobs[0].failed || jobs[1].failed || jobs[2].failed)

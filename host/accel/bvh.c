@@ -10,8 +10,9 @@
  * area by that child's two children (Embree's BVH8 from a binary build). The wide nodes
  * are written depth first, a parent before its children, the leaves' records into the
  * leaf data in the kd-tree's layout (kd_leaf_record_write). With several threads, the
- * top of the binary tree is built first and the subtrees below it by the threads
- * (build_tree); docs/bvh.md has the measurements behind the choices.
+ * top of the binary tree is built first, its large nodes' passes cut into ranges, and
+ * the subtrees below it by the threads (build_tree); the collapse sorts and writes the
+ * leaves on the threads too. docs/bvh.md has the measurements behind the choices.
  */
 #include "accel/bvh.h"
 
@@ -38,6 +39,8 @@
 #define BVH_SUBTREES_PER_THREAD 4u
 /* Fewer primitives than this are built on one thread: starting threads costs more. */
 #define BVH_THREADS_MIN 32768u
+/* A node of the top with at least this many primitives bins them on all threads. */
+#define BVH_PASS_MIN 65536u
 /* SAH costs (relative): a binary node's share of a wide node's visit, the test of one
  * group of eight triangles, and that of one other primitive (a sphere, box or surface
  * of revolution, tested alone). */
@@ -73,6 +76,8 @@ typedef struct {
     uint first_tri, n_tri;     /* the triangles' global ids */
     BinNode *nodes;            /* room for every node: a binary tree of n leaves has 2n - 1 */
     atomic_uint n_nodes;
+    int threads;               /* threads the build may use */
+    struct RangeJob *range_jobs; /* the top's passes on `threads` threads (the calling thread's) */
     uint defer_at_most;        /* subtrees of at most this many primitives wait (0: none) */
     struct Subtree *waiting;   /* those subtrees, their nodes already numbered */
     size_t n_waiting, cap_waiting;
@@ -137,52 +142,142 @@ static int bin_of(float c, float lo, float scale)
     return f > 0.0f ? (f < (float)BVH_BINS ? (int)f : BVH_BINS - 1) : 0;
 }
 
+/* The bins of one range of primitives on the axes that can split (a centre extent
+ * above 0). */
+typedef struct {
+    Box3 box[3][BVH_BINS];
+    Count n[3][BVH_BINS];
+} Bins;
+
+typedef struct {
+    float lo[3], scale[3];  /* bin_of's arguments per axis */
+    int axes[3], n_axes;
+} BinAxes;
+
+static void bins_clear(Bins *bins)
+{
+    memset(bins->n, 0, sizeof bins->n);
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < BVH_BINS; i++) bins->box[k][i] = box3_empty();
+}
+
+/* ref[first .. first + n) into cleared bins, all axes in one pass. */
+static void bins_fill(const Build *b, uint first, uint n, const BinAxes *ax, Bins *bins)
+{
+    for (const PrimRef *r = b->ref + first, *end = r + n; r < end; r++) {
+        int tri = is_tri(b, r);
+        for (int a = 0; a < ax->n_axes; a++) {
+            int k = ax->axes[a], bi = bin_of(centre(r, k), ax->lo[k], ax->scale[k]);
+            if (tri) bins->n[k][bi].tri++;
+            else bins->n[k][bi].other++;
+            box3_grow(&bins->box[k][bi], &r->box);
+        }
+    }
+}
+
+/* The bins of the range that follows `into`'s added to it: what one pass over both
+ * ranges in order gives (box3_grow keeps the earlier of equal bounds). */
+static void bins_merge(Bins *into, const Bins *next, const BinAxes *ax)
+{
+    for (int a = 0; a < ax->n_axes; a++)
+        for (int i = 0, k = ax->axes[a]; i < BVH_BINS; i++) {
+            box3_grow(&into->box[k][i], &next->box[k][i]);
+            count_add(&into->n[k][i], next->n[k][i]);
+        }
+}
+
+/* A pass over part of a node's primitives on a thread of its own. */
+typedef struct RangeJob {
+    const Build *b;
+    uint first, n;
+    const BinAxes *ax;     /* binning: the axes; NULL for bounds */
+    Bins bins;             /* binning's result */
+    Box3 box, cb;          /* bounds' result: of the boxes and of their centres */
+    Count count;
+} RangeJob;
+
+static void range_bounds(const Build *b, uint first, uint n, Box3 *box, Box3 *cb, Count *count)
+{
+    for (const PrimRef *r = b->ref + first, *end = r + n; r < end; r++) {
+        if (is_tri(b, r)) count->tri++;
+        else count->other++;
+        box3_grow(box, &r->box);
+        Box3 c = { { centre(r, 0), centre(r, 1), centre(r, 2) }, { centre(r, 0), centre(r, 1), centre(r, 2) } };
+        box3_grow(cb, &c);
+    }
+}
+
+static void *range_run(void *arg)
+{
+    RangeJob *j = arg;
+    if (j->ax) {
+        bins_clear(&j->bins);
+        bins_fill(j->b, j->first, j->n, j->ax, &j->bins);
+    } else {
+        j->box = j->cb = box3_empty();
+        j->count = (Count){ 0, 0 };
+        range_bounds(j->b, j->first, j->n, &j->box, &j->cb, &j->count);
+    }
+    return NULL;
+}
+
+/* ref[first .. first + n) cut into `threads` ranges, each passed over (bounds, or bins
+ * with `ax`) on a thread of its own; the results are merged in range order, so they are
+ * the bits of one pass. */
+static void ranges_run(const Build *b, uint first, uint n, int threads, const BinAxes *ax, RangeJob *jobs)
+{
+    for (int i = 0; i < threads; i++) {
+        uint lo = (uint)((uint64_t)n * (uint)i / (uint)threads), hi = (uint)((uint64_t)n * (uint)(i + 1) / (uint)threads);
+        jobs[i].b = b;
+        jobs[i].first = first + lo;
+        jobs[i].n = hi - lo;
+        jobs[i].ax = ax;
+    }
+    jobs_run(range_run, jobs, sizeof *jobs, threads);
+}
+
 /* The cheapest of the 31 bin boundaries on each axis for ref[first .. first + n),
- * whose centres span cb; cost +inf when every centre is the same point. The bins of
- * all three axes are filled in one pass over the primitives. */
-static BinSplit best_split(const Build *b, uint first, uint n, const Box3 *cb)
+ * whose centres span cb, binned on `threads` threads; cost +inf when every centre is
+ * the same point. */
+static BinSplit best_split(const Build *b, uint first, uint n, const Box3 *cb, int threads, RangeJob *jobs)
 {
     BinSplit best = { -1, 0, INFINITY };
-    float scale[3];
-    int axes[3], n_axes = 0;
+    BinAxes ax = { .n_axes = 0 };
     for (int k = 0; k < 3; k++) {
         float ext = cb->hi[k] - cb->lo[k];
         if (!(ext > 0.0f)) continue;
-        scale[k] = (float)BVH_BINS / ext;
-        axes[n_axes++] = k;
+        ax.lo[k] = cb->lo[k];
+        ax.scale[k] = (float)BVH_BINS / ext;
+        ax.axes[ax.n_axes++] = k;
     }
-    Box3 bin_box[3][BVH_BINS];
-    Count bin_n[3][BVH_BINS];
-    memset(bin_n, 0, sizeof bin_n);
-    for (int k = 0; k < 3; k++)
-        for (int i = 0; i < BVH_BINS; i++) bin_box[k][i] = box3_empty();
-    for (const PrimRef *r = b->ref + first, *end = r + n; r < end; r++) {
-        int tri = is_tri(b, r);
-        for (int a = 0; a < n_axes; a++) {
-            int k = axes[a], bi = bin_of(centre(r, k), cb->lo[k], scale[k]);
-            if (tri) bin_n[k][bi].tri++;
-            else bin_n[k][bi].other++;
-            box3_grow(&bin_box[k][bi], &r->box);
-        }
+    if (ax.n_axes == 0) return best;
+    Bins one, *bins = &one;
+    if (threads > 1) {
+        ranges_run(b, first, n, threads, &ax, jobs);
+        for (int i = 1; i < threads; i++) bins_merge(&jobs[0].bins, &jobs[i].bins, &ax);
+        bins = &jobs[0].bins;
+    } else {
+        bins_clear(&one);
+        bins_fill(b, first, n, &ax, &one);
     }
-    for (int a = 0; a < n_axes; a++) {
-        int k = axes[a];
+    for (int a = 0; a < ax.n_axes; a++) {
+        int k = ax.axes[a];
         /* areas and counts to the right of each boundary, then a sweep from the left */
         double right_area[BVH_BINS];
         Count right_n[BVH_BINS];
         Box3 acc = box3_empty();
         Count cnt = { 0, 0 };
         for (int i = BVH_BINS - 1; i > 0; i--) {
-            box3_grow(&acc, &bin_box[k][i]);
-            count_add(&cnt, bin_n[k][i]);
+            box3_grow(&acc, &bins->box[k][i]);
+            count_add(&cnt, bins->n[k][i]);
             right_area[i] = box3_half_area(&acc);
             right_n[i] = cnt;
         }
         acc = box3_empty();
         cnt = (Count){ 0, 0 };
         for (int i = 0; i < BVH_BINS - 1; i++) {
-            box3_grow(&acc, &bin_box[k][i]);
-            count_add(&cnt, bin_n[k][i]);
+            box3_grow(&acc, &bins->box[k][i]);
+            count_add(&cnt, bins->n[k][i]);
             Count r = right_n[i + 1];
             if (cnt.tri + cnt.other == 0 || r.tri + r.other == 0) continue;
             double c = box3_half_area(&acc) * leaf_tests(cnt) + right_area[i + 1] * leaf_tests(r);
@@ -236,16 +331,22 @@ static void build_node(Build *b, Subtree t, int may_wait)
     int depth = t.depth;
     Box3 box = box3_empty(), cb = box3_empty();
     Count count = { 0, 0 };
-    for (const PrimRef *r = b->ref + first, *end = r + n; r < end; r++) {
-        if (is_tri(b, r)) count.tri++;
-        else count.other++;
-        box3_grow(&box, &r->box);
-        Box3 c = { { centre(r, 0), centre(r, 1), centre(r, 2) }, { centre(r, 0), centre(r, 1), centre(r, 2) } };
-        box3_grow(&cb, &c);
+    /* the top's large nodes: their passes on all threads (the others wait anyway) */
+    int threads = may_wait && b->range_jobs ? jobs_threads(b->threads, n, BVH_PASS_MIN) : 1;
+    RangeJob *jobs = b->range_jobs;
+    if (threads > 1) {
+        ranges_run(b, first, n, threads, NULL, jobs);
+        for (int i = 0; i < threads; i++) {
+            box3_grow(&box, &jobs[i].box);
+            box3_grow(&cb, &jobs[i].cb);
+            count_add(&count, jobs[i].count);
+        }
+    } else {
+        range_bounds(b, first, n, &box, &cb, &count);
     }
     b->nodes[me].box = box;
     double area = box3_half_area(&box);
-    BinSplit s = n > 1 && depth < BVH_MAX_DEPTH ? best_split(b, first, n, &cb)
+    BinSplit s = n > 1 && depth < BVH_MAX_DEPTH ? best_split(b, first, n, &cb, threads, jobs)
                                                 : (BinSplit){ -1, 0, INFINITY };
     double leaf_cost = leaf_tests(count) * area;
     double split_cost = BVH_COST_NODE * area + s.cost;
@@ -295,10 +396,13 @@ static void *waiting_run(void *arg)
 }
 
 /* The binary tree of all b->n primitives on `threads` threads; returns its root. */
-static uint build_tree(Build *b, int threads)
+static uint build_tree(Build *b)
 {
     uint root = node_new(b);
-    threads = jobs_threads(threads, b->n, BVH_THREADS_MIN);
+    int threads = b->threads;
+    /* the top's passes run on the threads from BVH_PASS_MIN primitives; without
+     * memory for them, on this thread (the same tree) */
+    if (threads > 1 && b->n >= BVH_PASS_MIN) b->range_jobs = malloc((size_t)threads * sizeof *b->range_jobs);
     b->defer_at_most = threads > 1 ? b->n / (BVH_SUBTREES_PER_THREAD * (uint)threads) : 0u;
     build_node(b, (Subtree){ root, 0u, b->n, 0 }, threads > 1);
     if (b->n_waiting == 0) return root;
@@ -346,10 +450,21 @@ static void tree_stats(const Build *b, uint root, BvhStats *st)
 
 /* ------------------------------------------------------------------ collapse */
 
+/* A leaf's record to write: at `words` in the leaf data, for binary leaf `bin`, whose
+ * kind goes to lane `lane` of wide node `node`. */
+typedef struct { uint node, lane, bin, words; } LeafSlot;
+
+/* The collapse in three steps: each binary leaf's ids sorted and its record's size
+ * (leaves_measure, by ranges of nodes on the threads); the wide nodes, depth first,
+ * with the leaves' places in the leaf data (flat_node, on this thread); the records
+ * (slots_write, by ranges of leaves on the threads). */
 typedef struct {
     Build *b;
     Bvh *out;
-    uint *ids;              /* a leaf's sorted global ids, scratch */
+    uint *ids;              /* per primitive, in tree order: its global id, sorted within each leaf */
+    uint *node_words;       /* per binary leaf: the words of its record */
+    LeafSlot *slots;        /* the records, in the order flat_node meets them */
+    size_t n_slots;
     size_t words;
     uint max_pending;       /* the deepest the walk's stack can get */
 } Flat;
@@ -420,11 +535,9 @@ static void flat_node(Flat *f, uint bn, uint me, uint depth, uint pending)
             w->box[2 * k + 1][i] = c->box.hi[k];
         }
         if (c->count > 0) {
-            for (uint j = 0; j < c->count; j++) f->ids[j] = b->ref[c->first + j].gid;
-            qsort(f->ids, c->count, sizeof *f->ids, uint_cmp);
             w->ref[i] = (uint)f->words;
-            w->kind[i] = kd_leaf_record_write(b->in, f->ids, c->count, f->out->leaf_prims + f->words);
-            f->words += kd_leaf_record_words(b->in, f->ids, c->count);
+            f->slots[f->n_slots++] = (LeafSlot){ me, (uint)i, kids[i], (uint)f->words };
+            f->words += f->node_words[kids[i]];
         } else {
             w->kind[i] = BVH_CHILD_NODE;
             w->ref[i] = f->out->n_nodes++;
@@ -439,19 +552,43 @@ static void flat_node(Flat *f, uint bn, uint me, uint depth, uint pending)
     }
 }
 
-/* Words of leaf data all leaves need. */
-static size_t leaf_data_words(Build *b, uint *ids)
+/* Fewer binary nodes or leaves than this are measured or written on one thread. */
+#define BVH_COLLAPSE_PASS_MIN 2048u
+
+/* Binary nodes [first, end): each leaf's ids sorted, its record's words, their sum. */
+typedef struct { Flat *f; uint first, end; size_t words; } MeasureJob;
+
+static void *leaves_measure(void *arg)
 {
-    size_t words = 0;
-    uint n_nodes = atomic_load(&b->n_nodes);
-    for (uint i = 0; i < n_nodes; i++) {
+    MeasureJob *j = arg;
+    const Build *b = j->f->b;
+    j->words = 0;
+    for (uint i = j->first; i < j->end; i++) {
         const BinNode *c = &b->nodes[i];
         if (c->count == 0) continue;
-        for (uint j = 0; j < c->count; j++) ids[j] = b->ref[c->first + j].gid;
+        uint *ids = j->f->ids + c->first;
+        for (uint k = 0; k < c->count; k++) ids[k] = b->ref[c->first + k].gid;
         qsort(ids, c->count, sizeof *ids, uint_cmp);
-        words += kd_leaf_record_words(b->in, ids, c->count);
+        j->f->node_words[i] = (uint)kd_leaf_record_words(b->in, ids, c->count);
+        j->words += j->f->node_words[i];
     }
-    return words;
+    return NULL;
+}
+
+/* Slots [first, end): their records written, their kinds set. */
+typedef struct { Flat *f; size_t first, end; } WriteJob;
+
+static void *slots_write(void *arg)
+{
+    const WriteJob *j = arg;
+    const Flat *f = j->f;
+    for (size_t i = j->first; i < j->end; i++) {
+        LeafSlot s = f->slots[i];
+        const BinNode *c = &f->b->nodes[s.bin];
+        f->out->nodes[s.node].kind[s.lane] =
+            kd_leaf_record_write(f->b->in, f->ids + c->first, c->count, f->out->leaf_prims + s.words);
+    }
+    return NULL;
 }
 
 static void build_free(Build *b)
@@ -459,15 +596,18 @@ static void build_free(Build *b)
     free(b->ref);
     free(b->nodes);
     free(b->waiting);
+    free(b->range_jobs);
 }
 
-/* The primitives with finite bounds: their global ids, bounds and centres. */
+/* The primitives with finite bounds: their records, in global id order. */
 static Status gather(Build *b, size_t total, Error *err)
 {
     b->ref = malloc((total + 1) * sizeof *b->ref);
     b->nodes = malloc((2 * total + 1) * sizeof *b->nodes);
     if (!b->ref || !b->nodes)
         return error_set(err, ST_INTERNAL, "BVH: out of memory for %zu primitives", total);
+    /* one thread: on several, the dragon's 0.05 s did not shorten (first touches of
+     * the new memory, not the boxes, take the time) */
     for (uint gid = 0; gid < (uint)total; gid++) {
         Box3 a;
         if (!kd_prim_box(b->in, gid, a.lo, a.hi)) continue;
@@ -479,32 +619,53 @@ static Status gather(Build *b, size_t total, Error *err)
 /* The wide nodes and leaf records of the binary tree under root. */
 static Status collapse(Build *b, uint root, Bvh *out, Error *err)
 {
-    uint *ids = malloc((b->n + 1) * sizeof *ids);
-    if (!ids) return error_set(err, ST_INTERNAL, "BVH: out of memory for %u primitives", b->n);
-    size_t words = leaf_data_words(b, ids);
+    uint n_bin = atomic_load(&b->n_nodes);
+    Flat f = { b, out, malloc((b->n + 1) * sizeof(uint)), malloc(((size_t)n_bin + 1) * sizeof(uint)),
+               malloc((b->n + 1) * sizeof(LeafSlot)), 0, 0, 0 };
+    Status st = ST_OK;
+    if (!f.ids || !f.node_words || !f.slots) {
+        st = error_set(err, ST_INTERNAL, "BVH: out of memory for %u primitives", b->n);
+        goto done;
+    }
+    int n_jobs = jobs_threads(b->threads, n_bin, BVH_COLLAPSE_PASS_MIN);
+    MeasureJob measure[JOBS_MAX];
+    for (int i = 0; i < n_jobs; i++)
+        measure[i] = (MeasureJob){ &f, (uint)((uint64_t)n_bin * (uint)i / (uint)n_jobs),
+                                   (uint)((uint64_t)n_bin * (uint)(i + 1) / (uint)n_jobs), 0 };
+    jobs_run(leaves_measure, measure, sizeof *measure, n_jobs);
+    size_t words = 0;
+    for (int i = 0; i < n_jobs; i++) words += measure[i].words;
     /* every wide node but the root stands for a binary interior node */
-    size_t max_nodes = (size_t)atomic_load(&b->n_nodes) + 1;
+    size_t max_nodes = (size_t)n_bin + 1;
     /* the walk's stack keeps a node index in 29 bits */
     if (words > UINT32_MAX - 1 || max_nodes > (1u << 29)) {
-        free(ids);
-        return error_set(err, ST_INTERNAL, "BVH: %zu nodes and %zu words of leaf data do not fit its layout", max_nodes, words);
+        st = error_set(err, ST_INTERNAL, "BVH: %zu nodes and %zu words of leaf data do not fit its layout", max_nodes,
+                       words);
+        goto done;
     }
     out->nodes = aligned_alloc(64, max_nodes * sizeof *out->nodes);
     out->leaf_prims = aligned_alloc(64, ((words + 1) * sizeof *out->leaf_prims + 63) / 64 * 64);
     if (!out->nodes || !out->leaf_prims) {
-        free(ids);
-        return error_set(err, ST_INTERNAL, "BVH: out of memory for %zu nodes", max_nodes);
+        st = error_set(err, ST_INTERNAL, "BVH: out of memory for %zu nodes", max_nodes);
+        goto done;
     }
-    Flat f = { b, out, ids, 0, 0 };
     out->n_nodes = 1;
     flat_node(&f, root, 0u, 1u, 0u);
-    free(ids);
+    n_jobs = jobs_threads(b->threads, f.n_slots, BVH_COLLAPSE_PASS_MIN);
+    WriteJob write[JOBS_MAX];
+    for (int i = 0; i < n_jobs; i++)
+        write[i] = (WriteJob){ &f, f.n_slots * (size_t)i / (size_t)n_jobs, f.n_slots * (size_t)(i + 1) / (size_t)n_jobs };
+    jobs_run(slots_write, write, sizeof *write, n_jobs);
     out->n_leaf_prims = (uint)f.words;
     out->stats.max_stack = f.max_pending;
     if (f.max_pending > BVH_STACK)
-        return error_set(err, ST_INTERNAL, "BVH: a path leaves %u children on the walk's stack, more than its %u",
-                         f.max_pending, BVH_STACK);
-    return ST_OK;
+        st = error_set(err, ST_INTERNAL, "BVH: a path leaves %u children on the walk's stack, more than its %u",
+                       f.max_pending, BVH_STACK);
+done:
+    free(f.ids);
+    free(f.node_words);
+    free(f.slots);
+    return st;
 }
 
 Status bvh_build(const KdInput *in, int threads, Bvh *out, Error *err)
@@ -525,10 +686,11 @@ Status bvh_build(const KdInput *in, int threads, Bvh *out, Error *err)
     b.n_tri = (uint)in->n_triangles;
     atomic_init(&b.n_nodes, 0u);
     atomic_init(&b.next_waiting, 0);
+    b.threads = jobs_threads(threads, total, BVH_THREADS_MIN);
     Status st = gather(&b, total, err);
     if (st == ST_OK) {
         out->stats.n_skipped = (uint)(total - b.n);
-        uint root = build_tree(&b, threads);
+        uint root = build_tree(&b);
         tree_stats(&b, root, &out->stats);
         if (b.n) {
             const Box3 *rb = &b.nodes[root].box;

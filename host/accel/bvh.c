@@ -308,7 +308,7 @@ static void build_or_wait(Build *b, Subtree t, int may_wait)
         return;
     }
     if (b->n_waiting == b->cap_waiting) {
-        size_t cap = b->cap_waiting ? 2 * b->cap_waiting : 64;
+        size_t cap = b->cap_waiting ? 2 * b->cap_waiting : 8; /* grows in test_kdtree too */
         Subtree *w = realloc(b->waiting, cap * sizeof *w);
         if (!w) {
             build_node(b, t, 0); /* correct, only slower */

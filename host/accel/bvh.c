@@ -395,7 +395,7 @@ static void *waiting_run(void *arg)
     return NULL;
 }
 
-/* The binary tree of all b->n primitives on `threads` threads; returns its root. */
+/* The binary tree of all b->n primitives on b->threads threads; returns its root. */
 static uint build_tree(Build *b)
 {
     uint root = node_new(b);

@@ -43,8 +43,8 @@
  * 1), its SAH cost and bytes per triangle (nodes + leaf lists), the BVH's build time (2
  * threads), nodes, leaves and bytes per triangle, and Embree's
  * RTC_BUILD_QUALITY_HIGH build time (2 and 1 threads) and the bytes its build allocated;
- * with --builds N, N more rounds of the kd-tree and Embree builds in turns (2 threads),
- * their medians and the median of the rounds' ratios.
+ * with --builds N, N more rounds of the kd-tree, BVH and Embree builds in turns (2
+ * threads), their medians and the medians of the rounds' ratios to Embree's.
  * Results are printed as Markdown tables for bench/RESULTS.md.
  */
 #include <embree3/rtcore.h>
@@ -738,20 +738,21 @@ static double rate(uint n, double *secs, int reps)
     return m > 0.0 ? n / m * 1e-6 : 0.0;
 }
 
-/* --builds N: the kd-tree's and Embree's HIGH builds in turns, N rounds on the larger
- * thread count, so that a busy spell hits both alike; medians of the times and of each
- * round's ratio. One build of each, as the line above has, swings by 20-30% on a shared
+/* --builds N: the kd-tree's, the BVH's and Embree's HIGH builds in turns, N rounds on
+ * the larger thread count, so that a busy spell hits all alike; medians of the times and
+ * of each round's ratios to Embree's. One build of each, as the line above has, swings by 20-30% on a shared
  * machine. (Not on one thread: once a device of more threads has run, an Embree device
  * made with threads=1 builds on more.) */
 static void build_rounds(const Mesh *m, const Options *o)
 {
     KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0, NULL, 0 };
     int threads = o->threads[MAX_THREADS - 1];
-    double kd[MAX_REPS], em[MAX_REPS], ratio[MAX_REPS];
+    double kd[MAX_REPS], bvh[MAX_REPS], em[MAX_REPS], kd_ratio[MAX_REPS], bvh_ratio[MAX_REPS];
     int n = 0;
     for (int r = 0; r < o->builds; r++) {
         Error err = { 0 };
         KdTree tree;
+        Bvh wide;
         Embree e;
         if (kd_build(&in, threads, &tree, &err)) {
             fprintf(stderr, "bench_traverse: kd-tree build: %s\n", err.msg);
@@ -760,16 +761,24 @@ static void build_rounds(const Mesh *m, const Options *o)
         }
         kd[n] = tree.stats.build_seconds;
         kd_free(&tree);
+        if (bvh_build(&in, threads, &wide, &err)) {
+            fprintf(stderr, "bench_traverse: BVH build: %s\n", err.msg);
+            error_clear(&err);
+            return;
+        }
+        bvh[n] = wide.stats.build_seconds;
+        bvh_free(&wide);
         int ok = embree_build(&e, m, threads) == 0;
         em[n] = e.build_seconds;
         embree_free(&e);
         if (!ok) return;
-        ratio[n] = kd[n] / em[n];
+        kd_ratio[n] = kd[n] / em[n];
+        bvh_ratio[n] = bvh[n] / em[n];
         n++;
     }
-    printf("builds in turns, %d rounds, %d threads: kd-tree %.3f s, Embree HIGH %.3f s (medians); "
-           "kd / Embree %.2f (median of the rounds' ratios)\n",
-           n, threads, median(kd, n), median(em, n), median(ratio, n));
+    printf("builds in turns, %d rounds, %d threads: kd-tree %.3f s, BVH %.3f s, Embree HIGH %.3f s (medians); "
+           "kd / Embree %.2f, BVH / Embree %.2f (medians of the rounds' ratios)\n",
+           n, threads, median(kd, n), median(bvh, n), median(em, n), median(kd_ratio, n), median(bvh_ratio, n));
 }
 
 static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS], int have_pocl)

@@ -754,15 +754,14 @@ static void build_rounds(const Mesh *m, const Options *o)
         KdTree tree;
         Bvh wide;
         Embree e;
-        if (kd_build(&in, threads, &tree, &err)) {
-            fprintf(stderr, "bench_traverse: kd-tree build: %s\n", err.msg);
-            error_clear(&err);
-            return;
+        Status st = kd_build(&in, threads, &tree, &err);
+        if (!st) {
+            kd[n] = tree.stats.build_seconds;
+            kd_free(&tree);
+            st = bvh_build(&in, threads, &wide, &err);
         }
-        kd[n] = tree.stats.build_seconds;
-        kd_free(&tree);
-        if (bvh_build(&in, threads, &wide, &err)) {
-            fprintf(stderr, "bench_traverse: BVH build: %s\n", err.msg);
+        if (st) {
+            fprintf(stderr, "bench_traverse: tree build: %s\n", err.msg);
             error_clear(&err);
             return;
         }

@@ -15,6 +15,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <time.h>
 
 static int harness_passed, harness_failed, harness_current_failed;
 static const char *harness_current = "";
@@ -82,6 +83,31 @@ static const char *harness_current = "";
             harness_passed++;                                                          \
             fprintf(stderr, "ok   %s\n", #fn);                                         \
         }                                                                              \
+    } while (0)
+
+/* Readers must be linear in their input. A test of that times one parse of n items
+ * and one of GROWTH_FACTOR * n, in CPU seconds of this process (other jobs on a
+ * shared machine don't count), and checks the ratio: about 8 when linear, 64 when
+ * quadratic. A ratio rather than a bound in seconds, because sanitizers, valgrind and
+ * slow machines stretch both parses alike. The small parse's time is floored at
+ * 5 ms so that clock noise on a tiny input cannot make a linear reader fail. */
+#define GROWTH_FACTOR 8
+#define GROWTH_RATIO_MAX 24.0
+
+static inline double cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+#define CHECK_LINEAR(what, secs_n, secs_8n)                                            \
+    do {                                                                               \
+        double hs_ = (secs_n), hb_ = (secs_8n);                                        \
+        double hr_ = hb_ / (hs_ > 0.005 ? hs_ : 0.005);                                \
+        CHECK_MSG(hr_ < GROWTH_RATIO_MAX,                                              \
+                  "%s: %.3f s of CPU time for %d times the input of %.3f s (ratio %.1f, " \
+                  "linear is about %d)", what, hb_, GROWTH_FACTOR, hs_, hr_, GROWTH_FACTOR); \
     } while (0)
 
 /* The team's standard meshes live in ../shared/models, beside the checkout (and in CI).

@@ -330,15 +330,8 @@ static void test_missing_file(void)
     scene_free(&s);
 }
 
-static double cpu_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* The real scans: the small bunny in tests/data, and the full dragon from ../shared
- * when it is there (34 MB of ascii, which must read in well under a second). */
+ * when it is there (34 MB of ascii; its read time is printed, and bench/ measures it). */
 static void test_stanford(void)
 {
     Scene s;
@@ -352,7 +345,6 @@ static void test_stanford(void)
     CHECK_EQ_INT(load(dragon, &s, &err), ST_OK);
     double secs = cpu_seconds() - t0;
     CHECK_EQ_INT(s.n_triangles, 871414);
-    CHECK(secs < 1.5);
     fprintf(stderr, "  dragon: %zu triangles read in %.3f s of CPU time\n", s.n_triangles, secs);
     scene_free(&s);
 }
@@ -370,45 +362,50 @@ static void put(char **buf, size_t *len, size_t *cap, const char *text)
     *len += n;
 }
 
-/* Headers with 100,000 elements, or one element with 100,000 properties, read in
- * linear time: each new element was checked against every earlier one, each property's
- * role against every earlier property, and each element's header line found by
- * counting lines from the start (over two minutes for 200,000 elements). Linear, they
- * read in a few hundredths of a second; 2 s of CPU time is a generous bound. */
+/* A header with n elements, or one element with n properties: each new element was
+ * checked against every earlier one, each property's role against every earlier
+ * property, and each element's header line found by counting lines from the start
+ * (over two minutes for 200,000 elements). Returns the CPU seconds of the parse. */
+static double parse_many(int n, int many_props)
+{
+    char *text = NULL, line[64];
+    size_t len = 0, cap = 0;
+    put(&text, &len, &cap, "ply\nformat ascii 1.0\n");
+    if (!many_props)
+        for (int i = 0; i < n; i++) {
+            snprintf(line, sizeof line, "element e%d 0\nproperty float a\n", i);
+            put(&text, &len, &cap, line);
+        }
+    put(&text, &len, &cap, "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n");
+    if (many_props)
+        for (int i = 0; i < n; i++) put(&text, &len, &cap, "property float x\n");
+    put(&text, &len, &cap, "element face 1\nproperty list uchar int vertex_indices\nend_header\n");
+    for (int v = 0; v < 3; v++) {
+        put(&text, &len, &cap, v == 0 ? "0 0 0" : v == 1 ? "1 0 0" : "0 1 0");
+        for (int i = 0; many_props && i < n; i++) put(&text, &len, &cap, " 0");
+        put(&text, &len, &cap, "\n");
+    }
+    put(&text, &len, &cap, "3 0 1 2\n");
+    Scene s;
+    scene_init(&s);
+    Error err = { 0 };
+    MeshOptions o = mesh_options(0);
+    double t0 = cpu_seconds();
+    Status st = ply_parse("many.ply", text, len, &s, &o, &err);
+    double secs = cpu_seconds() - t0;
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_triangles, 1);
+    scene_free(&s);
+    free(text);
+    return secs;
+}
+
 static void test_many_elements(void)
 {
+    enum { N = 160000 };
     for (int many_props = 0; many_props < 2; many_props++) {
-        char *text = NULL, line[64];
-        size_t len = 0, cap = 0;
-        put(&text, &len, &cap, "ply\nformat ascii 1.0\n");
-        if (!many_props)
-            for (int i = 0; i < 100000; i++) {
-                snprintf(line, sizeof line, "element e%d 0\nproperty float a\n", i);
-                put(&text, &len, &cap, line);
-            }
-        put(&text, &len, &cap, "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n");
-        if (many_props)
-            for (int i = 0; i < 100000; i++) put(&text, &len, &cap, "property float x\n");
-        put(&text, &len, &cap, "element face 1\nproperty list uchar int vertex_indices\nend_header\n");
-        for (int v = 0; v < 3; v++) {
-            put(&text, &len, &cap, v == 0 ? "0 0 0" : v == 1 ? "1 0 0" : "0 1 0");
-            for (int i = 0; many_props && i < 100000; i++) put(&text, &len, &cap, " 0");
-            put(&text, &len, &cap, "\n");
-        }
-        put(&text, &len, &cap, "3 0 1 2\n");
-        Scene s;
-        scene_init(&s);
-        Error err = { 0 };
-        MeshOptions o = mesh_options(0);
-        double t0 = cpu_seconds();
-        Status st = ply_parse("many.ply", text, len, &s, &o, &err);
-        double secs = cpu_seconds() - t0;
-        CHECK_MSG(st == ST_OK, "%s", err.msg);
-        CHECK_EQ_INT(s.n_triangles, 1);
-        CHECK_MSG(secs < 2.0, "%s: %.2f s of CPU time", many_props ? "100,000 properties" : "100,000 elements",
-                  secs);
-        scene_free(&s);
-        free(text);
+        double secs_n = parse_many(N / GROWTH_FACTOR, many_props), secs_8n = parse_many(N, many_props);
+        CHECK_LINEAR(many_props ? "properties" : "elements", secs_n, secs_8n);
     }
     /* the duplicate check that the bit set replaced still works */
     check_text_error(HDR "element vertex 1\nproperty float x\nend_header\n", "t.ply:7:1: a second 'vertex' element");

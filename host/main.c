@@ -312,6 +312,14 @@ static void print_scene_stats(const Scene *s, const RenderScene *rs)
     /* only when there are any: the line's form stays what scripts read for other scenes */
     if (s->n_revsurfaces) printf(", %zu surfaces of revolution", s->n_revsurfaces);
     printf("\n");
+    size_t images = 0, rgbe = 0;
+    for (size_t i = 0; i < s->n_textures; i++) {
+        images += s->textures[i].type == TEX_IMAGE;
+        rgbe += s->textures[i].type == TEX_IMAGE && (s->textures[i].flags & TEX_RGBE);
+    }
+    if (images)
+        printf("textures: %zu images, %.1f KiB of texels, %zu of them packed as RGBE words\n", images,
+               (double)s->n_texels * sizeof(uint) / 1024.0, rgbe);
     double per = in_tree ? 1.0 / (double)in_tree : 0.0;
     if (s->accel == ACCEL_BVH) {
         const BvhStats *b = &rs->bvh.stats;

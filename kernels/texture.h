@@ -65,9 +65,23 @@ KFN float tex_row(Texture tx, int i, vec3 q)
     return tx.m[4 * i] * q.x + tx.m[4 * i + 1] * q.y + tx.m[4 * i + 2] * q.z + tx.m[4 * i + 3];
 }
 
+/* An RGBE word's colour (TEX_RGBE): each 8-bit mantissa (red in the low byte) times
+ * 2^(e - 136), e the top byte. That is what stb_image makes of a Radiance .hdr pixel
+ * (mantissa times ldexp(1, e - 136)), so a packed map keeps every value bit for bit.
+ * The packer writes e of at least 10, which keeps the scale 2^(e - 136) a normal float
+ * built straight from its exponent bits. */
+KFN vec3 rgbe_decode(uint c)
+{
+    float f = k_as_float(((c >> 24) - 9u) << 23);
+    return v3((float)(c & 255u) * f, (float)((c >> 8) & 255u) * f, (float)((c >> 16) & 255u) * f);
+}
+
 KFN vec3 texel_fetch(const SceneView *sc, Texture tx, uint x, uint y)
 {
     uint i = y * tx.width + x;
+    /* a third of the float texels' bytes: the environment map's random lookups miss
+     * the caches less (bench/RESULTS.md) */
+    if (tx.flags & TEX_RGBE) return rgbe_decode(sc->texels[tx.offset + i]);
     if (tx.flags & TEX_FLOAT) {
         GLOBAL const uint *t = sc->texels + tx.offset + 3u * i;
         return v3(k_as_float(t[0]), k_as_float(t[1]), k_as_float(t[2]));

@@ -325,6 +325,9 @@ enum TextureType {
 #define TEX_MIRROR_V 128u
 #define TEX_NEAREST 256u /* the nearest texel instead of bilinear filtering */
 #define TEX_UV1 512u     /* looked up at the second uv set (TriExtra) where a triangle has one */
+/* With TEX_FLOAT: the texels are one word each, Radiance's RGBE (rgbe_decode in
+ * texture.h), packed by render_scene_prepare where that keeps every value (texel_pack.h) */
+#define TEX_RGBE 1024u
 /* How a texture is read rather than what its texels are: a copy over other texels
  * (glTF's tinted base colour) keeps these. */
 #define TEX_SAMPLING (TEX_CLAMP | TEX_MIRROR_U | TEX_MIRROR_V | TEX_NEAREST | TEX_UV1)

@@ -66,9 +66,10 @@ static float frange(float lo, float hi) { return lo + (hi - lo) * frand(); }
 static vec3 vrand(float lo, float hi) { return v3(frange(lo, hi), frange(lo, hi), frange(lo, hi)); }
 
 /* Textures of each kind: an sRGB 8-bit image (nearest, mirrored in v), a linear float
- * image (mirrored in u, clamped in v), a surface checker and a solid one. Returns the
- * indices in t[4]. */
-static void add_textures(uint t[4])
+ * image (mirrored in u, clamped in v), a surface checker, a solid one, and a float image
+ * of values that render_scene_prepare packs as RGBE words (TEX_RGBE). Returns the
+ * indices in t[5]. */
+static void add_textures(uint t[5])
 {
     uint px[8 * 4], offset;
     for (uint i = 0; i < 8 * 4; i++) px[i] = ((i * 37u) & 255u) | ((i * 91u) & 255u) << 8 | ((i * 13u) & 255u) << 16;
@@ -94,6 +95,15 @@ static void add_textures(uint t[4])
                       &t[2], NULL);
     scene_add_texture(&scene, "solid", NULL, texture_make_checker(v3(0.8f, 0.1f, 0.1f), v3(0.1f, 0.1f, 0.8f), 1.5f, 1),
                       &t[3], NULL);
+    float hdr[12] = { 1.5f, 0.25f, 0.0f, 0.75f, 3.0f, 0.5f, 0.0f, 0.0f, 0.0f, 12.0f, 16.0f, 9.0f };
+    uint hbits[12];
+    memcpy(hbits, hdr, sizeof hbits);
+    scene_add_texels(&scene, hbits, 12, &offset, NULL);
+    img.flags = TEX_FLOAT;
+    img.offset = offset;
+    img.width = 2;
+    img.height = 2;
+    scene_add_texture(&scene, "rgbe", NULL, img, &t[4], NULL);
 }
 
 /* Six 3x2 linear, clamped image faces of varied texels for a cube-map background (the
@@ -141,10 +151,11 @@ static void build_scene(void)
     scene_add_material(&scene, "lamp", material_emissive(v3(6.0f, 5.0f, 4.0f)), &lamp, NULL);
     Material g = material_diffuse(v3s(0.4f));
     g.emission = v3(0.5f, 0.2f, 0.1f);
-    scene_add_material(&scene, "glow", g, &glow, NULL);
     /* the classic ray tracer's materials, textured in every way */
-    uint tex[4], phong, mirror, clear, checked;
+    uint tex[5], phong, mirror, clear, checked;
     add_textures(tex);
+    g.texture_emission = tex[4];
+    scene_add_material(&scene, "glow", g, &glow, NULL);
     add_cube_faces();
     Material ph = material_phong(v3(0.6f, 0.5f, 0.4f), v3(0.3f, 0.3f, 0.3f), 25.0f);
     ph.texture = tex[0];
@@ -263,6 +274,10 @@ static void build_scene(void)
     scene.ambient = v3(0.05f, 0.05f, 0.05f);
     Error err = { 0 };
     Status st = render_scene_prepare(&scene, 1, &rs, &err);
+    if (!st && !(scene.textures[tex[4]].flags & TEX_RGBE)) {
+        fprintf(stderr, "the float texture of RGBE values was not packed\n");
+        abort();
+    }
     /* the renderer walks the BVH (rs); the kd-tree's own kernels get the kd-tree too */
     KdInput in = { scene.spheres, scene.n_spheres, scene.triangles, scene.n_triangles, scene.boxes, scene.n_boxes,
                    scene.revsurfaces, scene.n_revsurfaces };

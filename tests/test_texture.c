@@ -14,6 +14,7 @@
 
 #include "shade.cl"     /* kernels/texture.h and what it needs, compiled as C */
 #include "io/texture.h"    /* host/io/texture.h: this folder's include path finds host/ first */
+#include "scene/texel_pack.h"
 
 #include <stb_image_write.h>
 
@@ -443,6 +444,142 @@ static void test_truncated_images(void)
     unlink(cut_path);
 }
 
+/* ------------------------------------------------------------ RGBE packing */
+
+/* Every pixel stb_image can make of a Radiance file (mantissa bytes times ldexp(1, e -
+ * 136)) has an RGBE word that decodes to the same float bits once e is at least 18 (a
+ * smaller e with small mantissas needs a scale below the packer's lowest, and stays
+ * float); values RGBE cannot hold have none. */
+static void test_rgbe_words(void)
+{
+    int wrong = 0, packed = 0, missing = 0;
+    for (uint e = 0; e < 256; e++)
+        for (uint k = 0; k < 97; k++) {
+            uint m[3] = { (k * 37u + e) & 255u, (k * 91u) & 255u, (k * 13u + 7u * e) & 255u };
+            if (k == 0) m[0] = m[1] = m[2] = 0;
+            if (k == 1) m[0] = m[1] = m[2] = 255;
+            float f1 = e ? (float)ldexp(1.0f, (int)e - 136) : 0.0f; /* stb: 0 when e is 0 */
+            float c[3] = { (float)m[0] * f1, (float)m[1] * f1, (float)m[2] * f1 };
+            uint w;
+            if (!rgbe_encode_exact(c, &w)) {
+                missing += e >= 18 || k == 0;
+                continue;
+            }
+            packed++;
+            vec3 d = rgbe_decode(w);
+            float back[3] = { d.x, d.y, d.z };
+            wrong += memcmp(back, c, sizeof back) != 0;
+            wrong += (w >> 24) < 10u;
+        }
+    fprintf(stderr, "  %d of %d stb_image pixels packed exactly\n", packed, 256 * 97);
+    CHECK_EQ_INT(wrong, 0);
+    CHECK_EQ_INT(missing, 0);
+    CHECK(packed >= (256 - 18) * 97);
+    uint w = 7u;
+    CHECK(rgbe_encode_exact((float[3]){ 0.0f, 0.0f, 0.0f }, &w) && w == 10u << 24);
+    CHECK(rgbe_encode_exact((float[3]){ 1.0f, 0.5f, 0.0f }, &w) && w == (129u << 24 | 64u << 8 | 128u));
+    CHECK(rgbe_encode_exact((float[3]){ 255.0f * 0x1p119f, 0.0f, 1.0f * 0x1p119f }, &w) && w >> 24 == 255u);
+    const float bad[][3] = { { 0.1f, 0.0f, 0.0f },          /* not a dyadic fraction of 8 bits */
+                             { 1.0f, 1.0f / 512.0f, 0.0f },  /* below the shared exponent's last bit */
+                             { 257.0f, 0.0f, 0.0f },         /* nine bits of mantissa */
+                             { -1.0f, 0.0f, 0.0f },
+                             { -0.0f, 0.0f, 0.0f },          /* would come back as +0 */
+                             { INFINITY, 0.0f, 0.0f },
+                             { NAN, 0.0f, 0.0f },
+                             { 0x1p-130f, 0.0f, 0.0f } };     /* a scale below 2^-126 */
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) CHECK_MSG(!rgbe_encode_exact(bad[i], &w), "case %zu", i);
+}
+
+/* One image texture of w x h texels from `words` (3 a texel when float). */
+static uint image_texture(const uint *words, uint w, uint h, uint flags)
+{
+    uint offset, index;
+    size_t n = (size_t)w * h * ((flags & TEX_FLOAT) ? 3u : 1u);
+    CHECK(scene_add_texels(&scene, words, n, &offset, NULL) == ST_OK);
+    Texture t = texture_make_checker(v3s(0.0f), v3s(0.0f), 1.0f, 0);
+    t.type = TEX_IMAGE;
+    t.flags = flags;
+    t.offset = offset;
+    t.width = w;
+    t.height = h;
+    CHECK(scene_add_texture(&scene, NULL, NULL, t, &index, NULL) == ST_OK);
+    return index;
+}
+
+/* scene_pack_texels: exact float images become RGBE words (sharing textures keep
+ * sharing), the others are copied, every texel reads as before, and a second pass
+ * changes nothing. Then an .hdr file read through stb_image packs. */
+static void test_pack_texels(void)
+{
+    scene_init(&scene);
+    uint rgba[2] = { 0x11223344u, 0xff804020u };
+    float exact[12] = { 1.0f, 0.5f, 0.0f, 3.0f, 0.5f, 96.0f, 0.0f, 0.0f, 0.0f, 0x1p-20f, 0x1p-19f, 0x1p-13f };
+    float inexact[6] = { 0.1f, 0.2f, 0.3f, 1.0f, 1.0f, 1.0f };
+    float one[3] = { 1024.0f, 4096.0f, 2048.0f };
+    uint ew[12], iw[6], ow[3];
+    memcpy(ew, exact, sizeof ew);
+    memcpy(iw, inexact, sizeof iw);
+    memcpy(ow, one, sizeof ow);
+    uint t[5];
+    t[0] = image_texture(rgba, 2, 1, TEX_SRGB);
+    t[1] = image_texture(ew, 2, 2, TEX_FLOAT);
+    t[2] = t[1] + 1u;   /* the same texels, read another way (as texture_load_image shares them) */
+    Texture shared = scene.textures[t[1]];
+    shared.flags |= TEX_CLAMP | TEX_NEAREST;
+    CHECK(scene_add_texture(&scene, NULL, NULL, shared, &t[2], NULL) == ST_OK);
+    t[3] = image_texture(iw, 2, 1, TEX_FLOAT);
+    t[4] = image_texture(ow, 1, 1, TEX_FLOAT | TEX_MIRROR_U);
+    scene_add_texture(&scene, "checks", NULL, texture_make_checker(v3s(1.0f), v3s(0.0f), 2.0f, 0), NULL, NULL);
+    CHECK_EQ_INT(scene.n_texels, 2 + 12 + 6 + 3);
+    vec3 before[5][4];
+    view_setup();
+    for (int i = 0; i < 5; i++)
+        for (uint j = 0; j < scene.textures[t[i]].width * scene.textures[t[i]].height; j++)
+            before[i][j] = texel_fetch(&view, scene.textures[t[i]], j % scene.textures[t[i]].width,
+                                       j / scene.textures[t[i]].width);
+    Error err = { 0 };
+    for (int pass = 0; pass < 2; pass++) {
+        CHECK_EQ_INT(scene_pack_texels(&scene, &err), ST_OK);
+        CHECK_EQ_INT(scene.n_texels, 2 + 4 + 6 + 1);
+        uint want_flags[5] = { TEX_SRGB, TEX_FLOAT | TEX_RGBE, TEX_FLOAT | TEX_RGBE | TEX_CLAMP | TEX_NEAREST,
+                               TEX_FLOAT, TEX_FLOAT | TEX_RGBE | TEX_MIRROR_U };
+        for (int i = 0; i < 5; i++) CHECK_EQ_INT(scene.textures[t[i]].flags, want_flags[i]);
+        CHECK_EQ_INT(scene.textures[t[0]].offset, 0);
+        CHECK_EQ_INT(scene.textures[t[1]].offset, 2);
+        CHECK_EQ_INT(scene.textures[t[2]].offset, 2);
+        CHECK_EQ_INT(scene.textures[t[3]].offset, 6);
+        CHECK_EQ_INT(scene.textures[t[4]].offset, 12);
+        CHECK_EQ_INT(scene.texels[12], 141u << 24 | 64u << 16 | 128u << 8 | 32u);   /* 1024 = 32 * 2^5 */
+        view_setup();
+        int differ = 0;
+        for (int i = 0; i < 5; i++)
+            for (uint j = 0; j < scene.textures[t[i]].width * scene.textures[t[i]].height; j++) {
+                vec3 a = texel_fetch(&view, scene.textures[t[i]], j % scene.textures[t[i]].width,
+                                     j / scene.textures[t[i]].width);
+                differ += memcmp(&a, &before[i][j], sizeof a) != 0;
+            }
+        CHECK_EQ_INT(differ, 0);
+        CHECK(texel_alpha(&view, scene.textures[t[1]], 1, 1) == 1.0f);
+    }
+    scene_free(&scene);
+
+    /* a Radiance file, as the environment maps are */
+    scene_init(&scene);
+    uint h;
+    CHECK_EQ_INT(texture_load_image(&scene, NULL, "tests/data/images/tiny-rle.hdr", 0, 0, &h, &err), ST_OK);
+    size_t floats = scene.n_texels;
+    view_setup();
+    Texture th = scene.textures[h];
+    vec3 corner = texel_fetch(&view, th, th.width - 1u, th.height - 1u);
+    CHECK_EQ_INT(scene_pack_texels(&scene, &err), ST_OK);
+    CHECK_EQ_INT(scene.textures[h].flags, TEX_FLOAT | TEX_RGBE);
+    CHECK_EQ_INT(scene.n_texels * 3u, floats);
+    view_setup();
+    vec3 packed = texel_fetch(&view, scene.textures[h], th.width - 1u, th.height - 1u);
+    CHECK(memcmp(&corner, &packed, sizeof corner) == 0);
+    scene_free(&scene);
+}
+
 int main(void)
 {
     RUN(test_srgb_decode);
@@ -455,5 +592,7 @@ int main(void)
     RUN(test_surface_uv);
     RUN(test_load_images);
     RUN(test_truncated_images);
+    RUN(test_rgbe_words);
+    RUN(test_pack_texels);
     return harness_report();
 }

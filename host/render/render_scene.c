@@ -6,6 +6,7 @@
 
 #include "scene/camera.h"
 #include "scene/cube_env.h"
+#include "scene/texel_pack.h"
 
 /* Russian roulette starts after this many bounces: early bounces carry most of the
  * image, so killing paths there adds noise for little time saved. 5 (Mitsuba 3's
@@ -69,6 +70,9 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
      * course's exact lookup (cube_env.h) */
     if (s->integrator == INTEGRATOR_PATH && s->bg_type == BG_CUBEMAP && (st = cube_env_convert(s, err))) return st;
     if ((st = scene_prepare_lights(s, err))) return st;
+    /* after everything that reads float texels on the host (the map's distribution, the
+     * cube map's conversion) */
+    if ((st = scene_pack_texels(s, err))) return st;
     RenderParams *p = &out->ds.params;
     if ((st = camera_setup(&s->camera, s->image.width, s->image.height, &p->camera, err))) return st;
     if ((st = scene_check_precision(s, err))) return st;

@@ -16,6 +16,7 @@
 #include "io/texture.h"
 #include "lights.h"
 #include "scene/env_dist.h"
+#include "texture_util.h"
 
 enum { W = 32, H = 24 };
 
@@ -23,18 +24,11 @@ enum { W = 32, H = 24 };
 static void set_map(Scene *s, const float *rgb, uint w, uint h, float intensity, float rotate)
 {
     size_t n = (size_t)w * h * 3u;
-    uint *bits = malloc(n * sizeof *bits), offset, index;
+    uint *bits = malloc(n * sizeof *bits);
     memcpy(bits, rgb, n * sizeof *bits);
-    CHECK(scene_add_texels(s, bits, n, &offset, NULL) == ST_OK);
+    uint index = test_image_texture(s, bits, w, h, TEX_FLOAT);
     free(bits);
-    Texture t = texture_make_checker(v3s(0.0f), v3s(0.0f), 1.0f, 0);
-    t.type = TEX_IMAGE;
-    t.flags = TEX_FLOAT;
-    t.offset = offset;
-    t.width = w;
-    t.height = h;
-    texture_set_scale_offset(&t, 1.0f, 1.0f, 0.0f, 0.0f);
-    CHECK(scene_add_texture(s, NULL, NULL, t, &index, NULL) == ST_OK);
+    CHECK(index != NO_INDEX);
     Error err = { 0 };
     CHECK_MSG(scene_set_envmap(s, index, intensity, rotate, &err) == ST_OK, "%s", err.msg);
 }

@@ -15,6 +15,7 @@
 #include "shade.cl"     /* kernels/texture.h and what it needs, compiled as C */
 #include "io/texture.h"    /* host/io/texture.h: this folder's include path finds host/ first */
 #include "scene/texel_pack.h"
+#include "texture_util.h"
 
 #include <stb_image_write.h>
 
@@ -490,22 +491,6 @@ static void test_rgbe_words(void)
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) CHECK_MSG(!rgbe_encode_exact(bad[i], &w), "case %zu", i);
 }
 
-/* One image texture of w x h texels from `words` (3 a texel when float). */
-static uint image_texture(const uint *words, uint w, uint h, uint flags)
-{
-    uint offset, index;
-    size_t n = (size_t)w * h * ((flags & TEX_FLOAT) ? 3u : 1u);
-    CHECK(scene_add_texels(&scene, words, n, &offset, NULL) == ST_OK);
-    Texture t = texture_make_checker(v3s(0.0f), v3s(0.0f), 1.0f, 0);
-    t.type = TEX_IMAGE;
-    t.flags = flags;
-    t.offset = offset;
-    t.width = w;
-    t.height = h;
-    CHECK(scene_add_texture(&scene, NULL, NULL, t, &index, NULL) == ST_OK);
-    return index;
-}
-
 /* scene_pack_texels: exact float images become RGBE words (sharing textures keep
  * sharing), the others are copied, every texel reads as before, and a second pass
  * changes nothing. Then an .hdr file read through stb_image packs. */
@@ -521,14 +506,14 @@ static void test_pack_texels(void)
     memcpy(iw, inexact, sizeof iw);
     memcpy(ow, one, sizeof ow);
     uint t[5];
-    t[0] = image_texture(rgba, 2, 1, TEX_SRGB);
-    t[1] = image_texture(ew, 2, 2, TEX_FLOAT);
+    t[0] = test_image_texture(&scene, rgba, 2, 1, TEX_SRGB);
+    t[1] = test_image_texture(&scene, ew, 2, 2, TEX_FLOAT);
     t[2] = t[1] + 1u;   /* the same texels, read another way (as texture_load_image shares them) */
     Texture shared = scene.textures[t[1]];
     shared.flags |= TEX_CLAMP | TEX_NEAREST;
     CHECK(scene_add_texture(&scene, NULL, NULL, shared, &t[2], NULL) == ST_OK);
-    t[3] = image_texture(iw, 2, 1, TEX_FLOAT);
-    t[4] = image_texture(ow, 1, 1, TEX_FLOAT | TEX_MIRROR_U);
+    t[3] = test_image_texture(&scene, iw, 2, 1, TEX_FLOAT);
+    t[4] = test_image_texture(&scene, ow, 1, 1, TEX_FLOAT | TEX_MIRROR_U);
     scene_add_texture(&scene, "checks", NULL, texture_make_checker(v3s(1.0f), v3s(0.0f), 2.0f, 0), NULL, NULL);
     CHECK_EQ_INT(scene.n_texels, 2 + 12 + 6 + 3);
     vec3 before[5][4];

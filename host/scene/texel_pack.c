@@ -137,9 +137,12 @@ Status scene_pack_texels(Scene *s, Error *err)
         len += need;
     }
     free(refs);
+    /* give back the room the packed regions did not use (two thirds of each) */
+    uint *fit = len ? realloc(out, len * sizeof *out) : NULL;
+    if (fit) out = fit;
     free(s->texels);
     s->texels = out;
     s->n_texels = len;
-    s->cap_texels = words ? words : 1u;
+    s->cap_texels = fit ? len : (words ? words : 1u);
     return ST_OK;
 }

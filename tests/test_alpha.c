@@ -138,7 +138,7 @@ static void check_mask(const char *devices)
 }
 
 static void test_mask_scalar(void) { check_mask("scalar"); }
-static void test_mask_opencl(void) { check_mask("cpu"); }
+static void test_mask_opencl(void) { check_mask(TEST_OPENCL); }
 
 static void test_blend_mean(void)
 {
@@ -187,14 +187,14 @@ static void test_opencl_matches_scalar(void)
     for (size_t k = 0; k < sizeof scenes / sizeof scenes[0]; k++) {
         Film fa, fb;
         Error err = { 0 };
-        Status sa = render_text(scenes[k].name, scenes[k].text, "cpu", &fa, &err);
+        Status sa = render_text(scenes[k].name, scenes[k].text, TEST_OPENCL, &fa, &err);
         CHECK_MSG(sa == ST_OK, "%s", err.msg);
         Status sb = render_text(scenes[k].name, scenes[k].text, "scalar", &fb, &err);
         CHECK_MSG(sb == ST_OK, "%s", err.msg);
         if (sa == ST_OK && sb == ST_OK) {
             size_t n = (size_t)fa.width * fa.height * 3u, same = 0;
             for (size_t i = 0; i < n; i++) same += fa.sum[i] == fb.sum[i];
-            fprintf(stderr, "  %s: %zu of %zu channel sums identical on PoCL and scalar\n", scenes[k].name, same, n);
+            fprintf(stderr, "  %s: %zu of %zu channel sums identical on OpenCL and scalar\n", scenes[k].name, same, n);
             CHECK(same == n);
         }
         film_free(&fa);

@@ -69,7 +69,7 @@ static void test_wave_launches_match_scalar(void)
             &r);
     CHECK_EQ_INT(r.status, 0);
     for (int i = 0; i < 3; i++) {
-        cli_run(ARGS("scenes/cornell-box.scene", "--device", "cpu", "--width", "40", "--height", "32", "--spp", "12",
+        cli_run(ARGS("scenes/cornell-box.scene", "--device", TEST_OPENCL, "--width", "40", "--height", "32", "--spp", "12",
                      "--seed", "9", "--wave-launch", modes[i], "--wave-paths", "1000", "--batch", "5", "--stats", "-q",
                      "-o", outs[i]),
                 &r);
@@ -150,7 +150,7 @@ static void check_render(const char *device, const char *out, const char *magic)
 static void test_render_each_format(void)
 {
     check_render("scalar", "/tmp/clpt-test-render.png", "\x89PNG");
-    check_render("cpu", "/tmp/clpt-test-render.ppm", "P6");
+    check_render(TEST_OPENCL, "/tmp/clpt-test-render.ppm", "P6");
     check_render("0", "/tmp/clpt-test-render.pfm", "PF");
 }
 
@@ -175,7 +175,7 @@ static void test_unwritable_output_is_io_error(void)
 
 static void test_stats(void)
 {
-    cli_run(ARGS("scenes/cornell-box.scene", "--stats", "-q", "--device", "cpu", "--width", "8", "--height", "8",
+    cli_run(ARGS("scenes/cornell-box.scene", "--stats", "-q", "--device", TEST_OPENCL, "--width", "8", "--height", "8",
                  "--spp", "1", "-o", "/tmp/clpt-test-stats.png"),
             &r);
     CHECK_EQ_INT(r.status, 0);
@@ -184,7 +184,7 @@ static void test_stats(void)
     for (size_t i = 0; i < sizeof want / sizeof want[0]; i++) CHECK_STR_CONTAINS(r.out, want[i]);
     /* the kd-tree on request, and the same image */
     CHECK(rename("/tmp/clpt-test-stats.png", "/tmp/clpt-test-stats-bvh.png") == 0);
-    cli_run(ARGS("scenes/cornell-box.scene", "--stats", "-q", "--device", "cpu", "--width", "8", "--height", "8",
+    cli_run(ARGS("scenes/cornell-box.scene", "--stats", "-q", "--device", TEST_OPENCL, "--width", "8", "--height", "8",
                  "--spp", "1", "--accel", "kdtree", "-o", "/tmp/clpt-test-stats.png"),
             &r);
     CHECK_EQ_INT(r.status, 0);
@@ -198,7 +198,7 @@ static void test_stats(void)
  * a real render take some time on both kinds of device. */
 static void test_profile(void)
 {
-    const char *devices[] = { "cpu", "scalar" };
+    const char *devices[] = { TEST_OPENCL, "scalar" };
     for (int i = 0; i < 2; i++) {
         cli_run(ARGS("scenes/cornell-box.scene", "--profile", "-q", "--device", devices[i], "--width", "32",
                      "--height", "32", "--spp", "4", "-o", "/tmp/clpt-test-profile.png"),

@@ -128,7 +128,7 @@ static void test_axes(void)
                 s.integrator = INTEGRATOR_PATH;
                 s.image.spp = 4;
             }
-            float *a = render(&s, "scalar"), *b = render(&s, "cpu");
+            float *a = render(&s, "scalar"), *b = render(&s, TEST_OPENCL);
             /* the path tracer resampled the cube map into an environment light */
             CHECK_EQ_INT(s.bg_type, path ? BG_MAP : BG_CUBEMAP);
             CHECK(path ? s.env_light != NO_INDEX : s.env_light == NO_INDEX);
@@ -157,7 +157,7 @@ static void test_mirror(void)
                                "Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0 0 radius 1 } }\n",
                                &s, &err), ST_OK);
         if (path) s.integrator = INTEGRATOR_PATH;
-        float *a = render(&s, "scalar"), *b = render(&s, "cpu");
+        float *a = render(&s, "scalar"), *b = render(&s, TEST_OPENCL);
         check_pixel(a, b, 41 * 41 * 3, 20 * 41 + 20, CUBE_FRONT, path ? "mirror, path tracer" : "mirror, whitted");
         /* a corner pixel misses the sphere: the back face */
         check_pixel(a, b, 41 * 41 * 3, 0, CUBE_BACK, path ? "corner, path tracer" : "corner, whitted");
@@ -239,7 +239,7 @@ static void test_clpt_format(void)
     CHECK_EQ_INT(scene_load_file(path, SCENE_FORMAT_AUTO, &s, NULL, &err), ST_OK);
     CHECK_EQ_INT(s.integrator, INTEGRATOR_PATH);
     CHECK_EQ_INT(s.bg_type, BG_CUBEMAP);
-    float *a = render(&s, "scalar"), *b = render(&s, "cpu");
+    float *a = render(&s, "scalar"), *b = render(&s, TEST_OPENCL);
     check_pixel(a, b, 5 * 5 * 3, 2 * 5 + 2, CUBE_BACK, "clpt format, looking along -z");
     free(a);
     free(b);
@@ -487,7 +487,7 @@ static void test_strategies_agree(void)
  * PoCL and on the scalar device: the same bits. */
 static void test_opencl_matches_scalar(void)
 {
-    const char *devs[2] = { "scalar", "cpu" };
+    const char *devs[2] = { "scalar", TEST_OPENCL };
     float *img[2] = { NULL, NULL };
     for (int d = 0; d < 2; d++) {
         Scene s;
@@ -501,7 +501,7 @@ static void test_opencl_matches_scalar(void)
     if (img[0] && img[1]) {
         uint same = 0;
         for (uint i = 0; i < 32 * 24; i++) same += memcmp(img[0] + 3 * i, img[1] + 3 * i, 3 * sizeof(float)) == 0;
-        fprintf(stderr, "  a cube-map-lit render: %u of %u pixels bit-identical on PoCL and scalar\n", same, 32 * 24);
+        fprintf(stderr, "  a cube-map-lit render: %u of %u pixels bit-identical on OpenCL and scalar\n", same, 32 * 24);
         CHECK_EQ_INT(same, 32 * 24);
     }
     free(img[0]);

@@ -357,7 +357,7 @@ static void test_devices_agree(void)
         s.image.spp = modes[m] == INTEGRATOR_PATH ? 2 : 1;
         Film a, b;
         free(render(&s, "scalar", &a));
-        free(render(&s, "cpu", &b));
+        free(render(&s, TEST_OPENCL, &b));
         size_t n = (size_t)a.width * a.height * 3u;
         CHECK_MSG(a.width == b.width && a.height == b.height && memcmp(a.sum, b.sum, n * sizeof *a.sum) == 0,
                   "integrator %u: PoCL and scalar films differ", modes[m]);

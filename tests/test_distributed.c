@@ -248,7 +248,7 @@ static void test_mpi_two_and_three_ranks_are_bit_identical(void)
 static void test_mpi_ranks_on_a_mix_of_devices(void)
 {
     spawn_run(ARGS(MPIRUN, "-np", "1", CLI_PROGRAM, RENDER_ON("scalar"), "--stats", "-o", in_dir("mix.pfm"), ":",
-                   "-np", "1", CLI_PROGRAM, RENDER_ON("cpu"), "--stats", "-o", in_dir("mix.pfm")), &r);
+                   "-np", "1", CLI_PROGRAM, RENDER_ON(TEST_OPENCL), "--stats", "-o", in_dir("mix.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     CHECK(files_equal(in_dir("mix.pfm"), in_dir("whole.pfm")));
 }

@@ -403,7 +403,7 @@ static void test_opencl_matches_scalar(void)
     scene_add_sphere(&s, b, NULL);
     s.bg_rotate = 20.0f;
     float *img[2];
-    const char *devs[2] = { "scalar", "cpu" };
+    const char *devs[2] = { "scalar", TEST_OPENCL };
     Error err = { 0 };
     for (int d = 0; d < 2; d++) {
         img[d] = malloc(W * H * 3 * sizeof *img[d]);
@@ -412,7 +412,7 @@ static void test_opencl_matches_scalar(void)
     }
     uint same = 0;
     for (uint i = 0; i < W * H; i++) same += memcmp(img[0] + 3 * i, img[1] + 3 * i, 3 * sizeof(float)) == 0;
-    fprintf(stderr, "  a map-lit render: %u of %u pixels bit-identical on PoCL and scalar\n", same, (uint)(W * H));
+    fprintf(stderr, "  a map-lit render: %u of %u pixels bit-identical on OpenCL and scalar\n", same, (uint)(W * H));
     CHECK_EQ_INT(same, W * H);
     free(img[0]);
     free(img[1]);
@@ -446,7 +446,7 @@ static void test_whitted_sees_map(void)
             vec3 L = env_radiance(&v, v3_sub(target, c->origin));
             memcpy(want + 3 * (y * W + x), &L, sizeof L);
         }
-    const char *devs[2] = { "scalar", "cpu" };
+    const char *devs[2] = { "scalar", TEST_OPENCL };
     for (int d = 0; d < 2; d++) {
         CHECK(render_mode(&s, MIS_BOTH, devs[d], got, &err) == ST_OK);
         double worst = 0.0;

@@ -687,7 +687,7 @@ static void test_extras(void)
     Status sa = render_util_run(&s, "scalar", 0, &a, &err);
     CHECK_MSG(sa == ST_OK, "%s", err.msg);
     error_clear(&err);
-    Status sb = render_util_run(&s, "cpu", 0, &b, &err);
+    Status sb = render_util_run(&s, TEST_OPENCL, 0, &b, &err);
     CHECK_MSG(sb == ST_OK, "%s", err.msg);
     error_clear(&err);
     if (sa == ST_OK && sb == ST_OK) {

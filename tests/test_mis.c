@@ -439,7 +439,7 @@ static void test_delta_lights_match_whitted(void)
     Error err = {0};
     CHECK(render_mode(&s, MIS_BOTH, "scalar", path, &err) == ST_OK);
     s.integrator = INTEGRATOR_WHITTED;
-    CHECK(render_mode(&s, MIS_BOTH, "cpu", whitted, &err) == ST_OK);
+    CHECK(render_mode(&s, MIS_BOTH, TEST_OPENCL, whitted, &err) == ST_OK);
     double cos_t = 1.0 / sqrt(0.09 + 1.0 + 0.04), want = 0.7 / M_PI * 2.0 * cos_t, worst = 0.0;
     for (uint i = 0; i < W * H; i++) {
         if (path[3 * i] == 0.0f) continue;          /* sky */

@@ -731,7 +731,7 @@ static void test_mix(void)
     CHECK_NEAR(tex, 0.5, 0.02);
     Film a, b;
     if (mix_floor_mean("\"float amount\" 0.5", "scalar", &a) >= 0) {
-        if (mix_floor_mean("\"float amount\" 0.5", "cpu", &b) >= 0) {
+        if (mix_floor_mean("\"float amount\" 0.5", TEST_OPENCL, &b) >= 0) {
             CHECK(memcmp(a.sum, b.sum, (size_t)a.width * a.height * 3 * sizeof *a.sum) == 0);
             film_free(&b);
         }
@@ -749,7 +749,7 @@ static void test_mix(void)
     for (size_t i = 0; i < sizeof integrators / sizeof integrators[0]; i++) {
         m.integrator = integrators[i];
         if (render_util_run(&m, "scalar", 0, &a, &err) == ST_OK) {
-            if (render_util_run(&m, "cpu", 0, &b, &err) == ST_OK) {
+            if (render_util_run(&m, TEST_OPENCL, 0, &b, &err) == ST_OK) {
                 CHECK_MSG(memcmp(a.sum, b.sum, (size_t)a.width * a.height * 3 * sizeof *a.sum) == 0,
                           "integrator %u", integrators[i]);
                 CHECK(film_mean(&a) > 0.01);

@@ -51,7 +51,7 @@ static void check_furnace(const char *devices)
 }
 
 static void test_furnace_scalar(void) { check_furnace("scalar"); }
-static void test_furnace_opencl(void) { check_furnace("cpu"); }
+static void test_furnace_opencl(void) { check_furnace(TEST_OPENCL); }
 
 /* The Cornell box on PoCL and on the scalar device: both run the same kernel source on
  * the same random numbers, so they must agree (the goal is bit for bit; the stated
@@ -70,7 +70,7 @@ static void test_opencl_matches_scalar(void)
     a.image.height = b.image.height = 64;
     a.image.spp = b.image.spp = 16;
     Film fa, fb;
-    CHECK((st = render_util_run(&a, "cpu", 0, &fa, &err)) == ST_OK);
+    CHECK((st = render_util_run(&a, TEST_OPENCL, 0, &fa, &err)) == ST_OK);
     if (st) fprintf(stderr, "  %s\n", err.msg);
     CHECK((st = render_util_run(&b, "scalar", 0, &fb, &err)) == ST_OK);
     if (st) fprintf(stderr, "  %s\n", err.msg);
@@ -88,7 +88,7 @@ static void test_opencl_matches_scalar(void)
         }
         diff /= (double)n;
         mean /= (double)n;
-        fprintf(stderr, "  PoCL vs scalar: mean %.5f, mean abs difference %.3g, %zu of %zu channel sums identical\n",
+        fprintf(stderr, "  OpenCL vs scalar: mean %.5f, mean abs difference %.3g, %zu of %zu channel sums identical\n",
                 mean, diff, exact, n);
         CHECK(mean > 0.01);
         CHECK(diff < 1e-3 * mean);
@@ -204,7 +204,7 @@ static void check_update_params(const char *spec)
 }
 
 static void test_update_params_scalar(void) { check_update_params("scalar"); }
-static void test_update_params_opencl(void) { check_update_params("cpu"); }
+static void test_update_params_opencl(void) { check_update_params(TEST_OPENCL); }
 
 int main(void)
 {

@@ -195,9 +195,9 @@ static const char *kernel_src =
     "}\n";
 
 /* The OpenCL device the tests compare with C: the first CPU device (PoCL, which make
- * test installs), else the first device (a GPU, where tools/gpu-check.sh runs these
- * tests), into *dev and its --device index into spec. 0 when there is none, which is a
- * failure, not a skip. */
+ * test installs), else the first device; with CLPT_TEST_OPENCL=gpu the first GPU
+ * (tools/gpu-check.sh). Into *dev, and its --device index into spec. 0 when there is
+ * none, which is a failure, not a skip. */
 static int opencl_test_device(OclDeviceInfo *dev, char *spec, size_t spec_size)
 {
     OclDeviceInfo *devs = NULL;
@@ -209,8 +209,14 @@ static int opencl_test_device(OclDeviceInfo *dev, char *spec, size_t spec_size)
         error_clear(&err);
         return 0;
     }
+    if (TEST_OPENCL_IS_GPU) pick = n_dev;
     for (size_t i = 0; i < n_dev; i++)
-        if (devs[i].type & CL_DEVICE_TYPE_CPU) { pick = i; break; }
+        if (devs[i].type & (TEST_OPENCL_IS_GPU ? CL_DEVICE_TYPE_GPU : CL_DEVICE_TYPE_CPU)) { pick = i; break; }
+    if (pick == n_dev) {
+        CHECK_MSG(0, "CLPT_TEST_OPENCL=gpu: no OpenCL GPU");
+        free(devs);
+        return 0;
+    }
     *dev = devs[pick];
     snprintf(spec, spec_size, "%zu", pick);
     free(devs);

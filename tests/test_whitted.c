@@ -91,7 +91,7 @@ static float *render(Scene *s, const char *devices, Film *film)
 static void check_pocl_matches(Scene *s, const Film *ref)
 {
     Film pocl;
-    float *rp = render(s, "cpu", &pocl);
+    float *rp = render(s, TEST_OPENCL, &pocl);
     size_t n = (size_t)ref->width * ref->height * 3u;
     CHECK(pocl.width == ref->width && pocl.height == ref->height &&
           memcmp(pocl.sum, ref->sum, n * sizeof *pocl.sum) == 0);
@@ -163,7 +163,7 @@ static void test_devices_agree(void)
     s.image.spp = 4;                                   /* a 2x2 jittered grid */
     s.ambient = v3s(0.05f);
     Film a, b;
-    float *ra = render(&s, "scalar", &a), *rb = render(&s, "cpu", &b);
+    float *ra = render(&s, "scalar", &a), *rb = render(&s, TEST_OPENCL, &b);
     size_t n = (size_t)a.width * a.height * 3u;
     CHECK(a.samples == 4 && b.samples == 4);
     CHECK(memcmp(a.sum, b.sum, n * sizeof *a.sum) == 0);
@@ -258,7 +258,7 @@ static void test_shadow(void)
         Error err = {0};
         CHECK(camera_setup(&s.camera, W, H, &cam, &err) == ST_OK);
         Film film;
-        float *rgb = render(&s, "cpu", &film);
+        float *rgb = render(&s, TEST_OPENCL, &film);
         uint shadowed = 0, lit = 0, bad = 0;
         D3 c = { 0.0, 1.0, 0.0 }, l = d3(lp);
         for (uint y = 0; y < H; y++)
@@ -661,7 +661,9 @@ static void test_adaptive(void)
     size_t n_all = 0, *chosen = NULL, n_chosen = 0;
     char warning[1100];
     CHECK(device_list(&all, &n_all, warning, sizeof warning, &err) == ST_OK);
-    CHECK(device_select("scalar,cpu", all, n_all, &chosen, &n_chosen, &err) == ST_OK);
+    char spec[32];
+    snprintf(spec, sizeof spec, "scalar,%s", TEST_OPENCL);
+    CHECK(device_select(spec, all, n_all, &chosen, &n_chosen, &err) == ST_OK);
     Device *devs[4];
     size_t n_dev = 0;
     for (size_t i = 0; i < n_chosen && n_dev < 4; i++)
@@ -730,7 +732,7 @@ static float *render_classic(const char *text, uint w, uint h, uint integrator, 
     float *rgb = render(&s, both ? "scalar" : devices, &film);
     if (both) {
         Film other;
-        float *again = render(&s, "cpu", &other);
+        float *again = render(&s, TEST_OPENCL, &other);
         CHECK(memcmp(film.sum, other.sum, (size_t)w * h * 3u * sizeof *film.sum) == 0);
         free(again);
         film_free(&other);

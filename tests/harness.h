@@ -19,10 +19,11 @@
 #include <time.h>
 
 static int harness_passed, harness_failed, harness_current_failed;
+static const char *harness_current = "";
 
 /* The OpenCL devices that the tests compare with the scalar device, as a --device spec:
  * PoCL's CPU devices ("cpu"), or CLPT_TEST_OPENCL=gpu, so that the same bit-for-bit
- * checks run on a GPU (bench/gpu.sh). The kernel tests, which open one device
+ * checks run on a GPU (tools/gpu-check.sh). The kernel tests, which open one device
  * themselves, take the first OpenCL device of that type. */
 static inline const char *test_opencl_spec(void)
 {
@@ -31,7 +32,6 @@ static inline const char *test_opencl_spec(void)
 }
 #define TEST_OPENCL test_opencl_spec()
 #define TEST_OPENCL_IS_GPU (strcmp(test_opencl_spec(), "gpu") == 0)
-static const char *harness_current = "";
 
 #define CHECK(cond)                                                                    \
     do {                                                                               \

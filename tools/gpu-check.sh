@@ -17,7 +17,9 @@
 #      --profile.
 # Each step has its own time limit; everything is also written under OUT.
 # Run from the repository root after `make` and `make test` (or make the build/tests/test_*
-# programs named below and build/bench/bench_render).
+# programs named below and build/bench/bench_render). On a machine without clpt's
+# packages, tools/gpu-bundle.sh packs the programs, their libraries and the shared
+# files, and its run.sh sets up the OpenCL loader and runs this script.
 set -u
 build=${1:-build}
 out=${2:-gpu-check}

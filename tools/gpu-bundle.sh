@@ -17,7 +17,8 @@
 set -eu
 build=${1:-build}
 dir=${2:-.gpu}
-tests="kernels sampler render whitted envmap cubemap alpha curves mis gltf pbrt cli"
+tests="kernels $(sed -n 's/^image_tests="\(.*\)"$/\1/p' tools/gpu-check.sh)"
+[ "$tests" != "kernels " ] || { echo "gpu-bundle: no image_tests line in tools/gpu-check.sh" >&2; exit 1; }
 rm -rf "$dir"
 mkdir -p "$dir/build/tests" "$dir/build/bench" "$dir/lib" "$dir/shared/models/dragon" "$dir/shared/envmaps"
 progs="$build/clpt $build/bench/bench_render"

@@ -21,6 +21,9 @@
 # packages, tools/gpu-bundle.sh packs the programs, their libraries and the shared
 # files, and its run.sh sets up the OpenCL loader and runs this script.
 set -u
+# The tests run with the GPU as their OpenCL device, besides test_kernels (last); one
+# line, which tools/gpu-bundle.sh reads to pack them.
+image_tests="sampler render whitted envmap cubemap alpha curves mis gltf pbrt cli"
 build=${1:-build}
 out=${2:-gpu-check}
 dev=${GPU_CHECK_DEVICE:-gpu}    # another device spec tries the script out without a GPU
@@ -51,7 +54,7 @@ fi
 if [ "$dev" = gpu ]; then export CLPT_TEST_OPENCL=gpu; else export CLPT_TEST_OPENCL=cpu; fi
 if want tests; then
 step "tests with the GPU as their OpenCL device, against the scalar device"
-for test in sampler render whitted envmap cubemap alpha curves mis gltf pbrt cli; do
+for test in $image_tests; do
     [ -x "$build/tests/test_$test" ] || continue
     lim 240 "$build/tests/test_$test" >"$out/test_$test.log" 2>&1
     echo "test_$test: exit $?, $(grep -E 'passed, .* failed' "$out/test_$test.log" | tail -n 1)"

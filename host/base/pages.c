@@ -1,0 +1,19 @@
+/* pages.c — see pages.h. */
+#include "base/pages.h"
+
+#include <stdint.h>
+#include <stdlib.h>
+#include <sys/mman.h>
+
+void *pages_alloc_huge(size_t bytes)
+{
+    if (bytes > SIZE_MAX - PAGES_HUGE_BYTES) return NULL;
+    size_t rounded = (bytes + PAGES_HUGE_BYTES - 1u) & ~(PAGES_HUGE_BYTES - 1u);
+    void *p = aligned_alloc(PAGES_HUGE_BYTES, rounded ? rounded : PAGES_HUGE_BYTES);
+#ifdef MADV_HUGEPAGE
+    /* advice: a kernel without transparent huge pages refuses it, which changes nothing */
+    if (p) (void)madvise(p, rounded, MADV_HUGEPAGE);
+#endif
+    return p;
+}
+

@@ -433,14 +433,14 @@ static void pocl_close(Pocl *pc)
     memset(pc, 0, sizeof *pc);
 }
 
+/* made as the renderer makes them (ocl_buffer): on huge pages where it puts them */
 static cl_mem pocl_buffer(Pocl *pc, const void *src, size_t bytes)
 {
     cl_int rc;
-    size_t size = bytes < 16 ? 16 : bytes;
-    cl_mem m = clCreateBuffer(pc->ctx, CL_MEM_READ_WRITE | (src && bytes ? CL_MEM_COPY_HOST_PTR : 0), size,
-                              src && bytes ? (void *)(uintptr_t)src : NULL, &rc);
-    if (rc != CL_SUCCESS) pocl_fail("clCreateBuffer", rc);
-    return rc == CL_SUCCESS ? m : NULL;
+    const char *call;
+    cl_mem m = ocl_buffer(pc->ctx, CL_DEVICE_TYPE_CPU, CL_MEM_READ_WRITE, bytes, bytes ? src : NULL, &call, &rc);
+    if (!m) pocl_fail(call, rc);
+    return m;
 }
 
 static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)

@@ -335,19 +335,13 @@ static void build_lanes_scene(void)
     device_scene_view(&lanes_rs.ds, &lanes_view);
 }
 
+/* a buffer made as the renderer makes its own (ocl_buffer: on huge pages on a CPU) */
 static cl_mem buffer(size_t bytes, const void *src)
 {
     cl_int rc;
-    /* OpenCL has no buffers under 16 bytes here; a shorter source is padded, not read
-     * past its end */
-    unsigned char padded[16] = { 0 };
-    if (bytes < 16) {
-        if (src) src = memcpy(padded, src, bytes);
-        bytes = 16;
-    }
-    cl_mem m = clCreateBuffer(cl.ctx, CL_MEM_READ_WRITE | (src ? CL_MEM_COPY_HOST_PTR : 0), bytes,
-                              (void *)(uintptr_t)src, &rc);
-    CHECK_MSG(rc == CL_SUCCESS, "clCreateBuffer: %s", ocl_error_name(rc));
+    const char *call;
+    cl_mem m = ocl_buffer(cl.ctx, cl.dev.type, CL_MEM_READ_WRITE, bytes, src, &call, &rc);
+    CHECK_MSG(m != NULL, "%s: %s", call, ocl_error_name(rc));
     return m;
 }
 

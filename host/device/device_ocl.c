@@ -41,7 +41,6 @@
 #include "device/device_memory.h"
 #include "device/kernel_features.h"
 #include "base/fault.h"
-#include "base/pages.h"
 #include "device/ocl_args.h"
 #include "device/ocl_program.h"
 #include "base/timer.h"
@@ -178,53 +177,20 @@ static void release_buffers(OclDevice *od)
     od->head = od->tail = 0;
 }
 
-/* The memory of a buffer made with CL_MEM_USE_HOST_PTR, freed once OpenCL has deleted
- * the buffer (which may be after clReleaseMemObject returns). */
-static void CL_CALLBACK free_host_memory(cl_mem mem, void *host)
-{
-    (void)mem;
-    free(host);
-}
-
 /* A device buffer of `bytes` (at least 16: OpenCL has no empty buffers), filled from
  * `src` when given. */
 static Status make_buffer(OclDevice *od, cl_mem_flags flags, size_t bytes, const void *src,
                           const char *what, cl_mem *out, Error *err)
 {
-    size_t size = bytes < 16 ? 16 : bytes;
-    /* CL_MEM_COPY_HOST_PTR copies `size` bytes: a source shorter than the 16-byte
-     * minimum (a leaf list of one index) goes through a zero-padded copy instead of
-     * being read past its end. */
-    unsigned char padded[16] = { 0 };
-    if (src && bytes && bytes < size) {
-        memcpy(padded, src, bytes);
-        src = padded;
-    }
+    size_t size = bytes < OCL_BUFFER_MIN ? OCL_BUFFER_MIN : bytes;
     if ((cl_ulong)size > od->info.max_alloc)
         return error_set(err, ST_DEVICE,
                          "device '%s': the %s need %.1f MiB, more than the device's largest allocation (%.1f MiB)",
                          od->info.name, what, (double)size / 1048576.0, (double)od->info.max_alloc / 1048576.0);
-    /* A CPU device computes in host memory, which it can take from clpt: a large buffer
-     * is put on huge pages (base/pages.h) and handed over, freed when OpenCL deletes it. */
-    void *host = NULL;
-    if ((od->info.type & CL_DEVICE_TYPE_CPU) && size >= PAGES_HUGE_BYTES && (host = pages_alloc_huge(size))) {
-        if (src && bytes) memcpy(host, src, bytes);
-        flags |= CL_MEM_USE_HOST_PTR;
-    } else if (src && bytes) {
-        flags |= CL_MEM_COPY_HOST_PTR;
-        host = (void *)(uintptr_t)src;
-    }
+    const char *call;
     cl_int rc;
-    *out = clCreateBuffer(od->ctx, flags, size, host, &rc);
-    const char *call = "clCreateBuffer";
-    if (rc == CL_SUCCESS && (flags & CL_MEM_USE_HOST_PTR)) {
-        call = "clSetMemObjectDestructorCallback";
-        rc = clSetMemObjectDestructorCallback(*out, free_host_memory, host);
-        if (rc != CL_SUCCESS) clReleaseMemObject(*out);
-    }
-    if (rc != CL_SUCCESS) {
-        if (flags & CL_MEM_USE_HOST_PTR) free(host);
-        *out = NULL;
+    *out = ocl_buffer(od->ctx, od->info.type, flags, bytes, bytes ? src : NULL, &call, &rc);
+    if (!*out) {
         ocl_fail(err, &od->info, call, rc);
         error_prefix(err, "allocating %.1f MiB for the %s", (double)size / 1048576.0, what);
         return ST_DEVICE;

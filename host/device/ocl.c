@@ -1,6 +1,9 @@
 #include "device/ocl.h"
 
+#include "base/pages.h"
+
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -312,4 +315,43 @@ cleanup:
     *out = list;
     *n = count;
     return ST_OK;
+}
+
+/* The memory of a buffer made with CL_MEM_USE_HOST_PTR, freed once OpenCL has deleted
+ * the buffer (which may be after clReleaseMemObject returns). */
+static void CL_CALLBACK free_host_memory(cl_mem mem, void *host)
+{
+    (void)mem;
+    free(host);
+}
+
+cl_mem ocl_buffer(cl_context ctx, cl_device_type type, cl_mem_flags flags, size_t bytes, const void *src,
+                  const char **call, cl_int *rc)
+{
+    size_t size = bytes < OCL_BUFFER_MIN ? OCL_BUFFER_MIN : bytes;
+    /* CL_MEM_COPY_HOST_PTR copies `size` bytes: a source shorter than the minimum (a
+     * leaf list of one index) goes through a zero-padded copy, not read past its end */
+    unsigned char padded[OCL_BUFFER_MIN] = { 0 };
+    if (src && bytes < size) {
+        memcpy(padded, src, bytes);
+        src = padded;
+    }
+    void *host = NULL;
+    if ((type & CL_DEVICE_TYPE_CPU) && size >= PAGES_HUGE_BYTES && (host = pages_alloc_huge(size))) {
+        if (src) memcpy(host, src, size);
+        flags |= CL_MEM_USE_HOST_PTR;
+    } else if (src) {
+        flags |= CL_MEM_COPY_HOST_PTR;
+        host = (void *)(uintptr_t)src;
+    }
+    *call = "clCreateBuffer";
+    cl_mem m = clCreateBuffer(ctx, flags, size, host, rc);
+    if (*rc == CL_SUCCESS && (flags & CL_MEM_USE_HOST_PTR)) {
+        *call = "clSetMemObjectDestructorCallback";
+        *rc = clSetMemObjectDestructorCallback(m, free_host_memory, host);
+        if (*rc != CL_SUCCESS) clReleaseMemObject(m);
+    }
+    if (*rc == CL_SUCCESS) return m;
+    if (flags & CL_MEM_USE_HOST_PTR) free(host);
+    return NULL;
 }

@@ -68,4 +68,14 @@ Status ocl_failf(Error *err, const OclDeviceInfo *dev, const char *call, cl_int 
  * caller frees *out with free(). */
 Status ocl_enumerate(OclDeviceInfo **out, size_t *n, Error *err);
 
+/* A buffer of `bytes` bytes, at least OCL_BUFFER_MIN (OpenCL has no empty buffers),
+ * for devices of `type`, holding src's bytes when src is given (the rest zero). On a CPU
+ * device, which computes in host memory, a buffer of PAGES_HUGE_BYTES or more is memory
+ * clpt allocates on huge pages (base/pages.h) and hands over with CL_MEM_USE_HOST_PTR,
+ * freed when OpenCL deletes the buffer; elsewhere CL_MEM_COPY_HOST_PTR copies src. On
+ * failure NULL, with the failed call in *call and its code in *rc. */
+#define OCL_BUFFER_MIN 16u
+cl_mem ocl_buffer(cl_context ctx, cl_device_type type, cl_mem_flags flags, size_t bytes, const void *src,
+                  const char **call, cl_int *rc);
+
 #endif /* CLPT_OCL_H */

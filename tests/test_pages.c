@@ -1,6 +1,7 @@
-/* test_pages.c — memory on huge pages (host/base/pages.c), which the OpenCL CPU devices'
- * large buffers use: aligned to 2 MiB, its rounded-up size all writable (ASan and
- * valgrind check the bounds), NULL for sizes that cannot be rounded. Whether the kernel
+/* test_pages.c — memory on huge pages (host/base/pages.c), which the trees' arrays and
+ * the OpenCL CPU devices' large buffers use: aligned to 2 MiB, its rounded-up size all
+ * writable (ASan and valgrind check the bounds), NULL for sizes that cannot be rounded;
+ * small arrays 64-byte aligned and not rounded up. Whether the kernel
  * then backs it with huge pages is up to its settings; the test reports what it did
  * (bench/RESULTS.md measures what it is worth). The images the buffers give are checked
  * by every OpenCL-against-scalar test, whose waves and large scenes use them. */
@@ -28,6 +29,26 @@ static void test_aligned_and_rounded(void)
         CHECK(p[0] == 0xa5 && p[sizes[i] - 1u] == 0xa5 && p[rounded - 1u] == 0xa5);
         free(p);
     }
+}
+
+/* Small arrays stay as small as their contents, 64-byte aligned; large ones go huge. */
+static void test_large_only_when_large(void)
+{
+    const size_t sizes[] = { 0, 1, 63, 64, 65, 100000, PAGES_HUGE_BYTES - 1u, PAGES_HUGE_BYTES,
+                             PAGES_HUGE_BYTES + 100u };
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++) {
+        unsigned char *p = pages_alloc_large(sizes[i]);
+        CHECK(p != NULL);
+        if (!p) continue;
+        CHECK_EQ_INT((int)((uintptr_t)p % 64u), 0);
+        if (sizes[i] >= PAGES_HUGE_BYTES) CHECK_EQ_INT((int)((uintptr_t)p % PAGES_HUGE_BYTES), 0);
+        if (sizes[i]) {
+            memset(p, 0x5a, sizes[i]);
+            CHECK(p[sizes[i] - 1u] == 0x5a);
+        }
+        free(p);
+    }
+    CHECK(pages_alloc_large(SIZE_MAX) == NULL);
 }
 
 static void test_too_large(void)
@@ -68,6 +89,7 @@ static void test_report_huge_pages(void)
 int main(void)
 {
     RUN(test_aligned_and_rounded);
+    RUN(test_large_only_when_large);
     RUN(test_too_large);
     RUN(test_report_huge_pages);
     return harness_report();

@@ -24,6 +24,7 @@
 #include <unistd.h>
 
 #include "base/jobs.h"
+#include "base/pages.h"
 #include "base/timer.h"
 
 #define BVH_BINS 32
@@ -643,8 +644,9 @@ static Status collapse(Build *b, uint root, Bvh *out, Error *err)
                        words);
         goto done;
     }
-    out->nodes = aligned_alloc(64, max_nodes * sizeof *out->nodes);
-    out->leaf_prims = aligned_alloc(64, ((words + 1) * sizeof *out->leaf_prims + 63) / 64 * 64);
+    /* the walk reads both at random: on huge pages when large (base/pages.h) */
+    out->nodes = pages_alloc_large(max_nodes * sizeof *out->nodes);
+    out->leaf_prims = pages_alloc_large((words + 1) * sizeof *out->leaf_prims);
     if (!out->nodes || !out->leaf_prims) {
         st = error_set(err, ST_INTERNAL, "BVH: out of memory for %zu nodes", max_nodes);
         goto done;

@@ -28,6 +28,7 @@
 #include <unistd.h>
 
 #include "base/jobs.h"
+#include "base/pages.h"
 #include "base/timer.h"
 #include "scene/scene.h"
 
@@ -1145,11 +1146,11 @@ static Status flat_alloc(KdTree *t, size_t n_nodes, size_t n_words, Error *err)
     if (n_nodes > (UINT32_MAX >> 4) || n_words > UINT32_MAX - 1)
         return error_set(err, ST_INTERNAL, "kd-tree: %zu nodes and %zu words of leaf data do not fit the node layout",
                          n_nodes, n_words);
-    t->nodes = malloc(n_nodes * sizeof *t->nodes);
     /* Cache-line aligned, so that no row of a group's corners straddles two lines (the
-     * groups are 320 bytes long; OpenCL buffers are aligned at least as well). */
-    size_t leaf_bytes = ((n_words + 1) * sizeof *t->leaf_prims + 63) / 64 * 64;
-    t->leaf_prims = aligned_alloc(64, leaf_bytes);
+     * groups are 320 bytes long; OpenCL buffers are aligned at least as well), and on
+     * huge pages when large (base/pages.h): the walk reads both at random. */
+    t->nodes = pages_alloc_large(n_nodes * sizeof *t->nodes);
+    t->leaf_prims = pages_alloc_large((n_words + 1) * sizeof *t->leaf_prims);
     if (!t->nodes || !t->leaf_prims)
         return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu nodes", n_nodes);
     return ST_OK;

@@ -17,3 +17,9 @@ void *pages_alloc_huge(size_t bytes)
     return p;
 }
 
+
+void *pages_alloc_large(size_t bytes)
+{
+    if (bytes >= PAGES_HUGE_BYTES) return pages_alloc_huge(bytes);
+    return aligned_alloc(64, (bytes + 63u) / 64u * 64u + 64u * (bytes == 0));
+}

@@ -22,4 +22,9 @@
  * Write it before anything else does: pages are made when first touched. Free with free(). */
 void *pages_alloc_huge(size_t bytes);
 
+/* At least `bytes` of uninitialised memory aligned to 64 bytes: pages_alloc_huge's when
+ * bytes >= PAGES_HUGE_BYTES, so that an array only as large as its contents is not
+ * rounded up to a huge page; NULL when out of memory. Free with free(). */
+void *pages_alloc_large(size_t bytes);
+
 #endif /* CLPT_PAGES_H */

@@ -37,10 +37,11 @@
  * the McGuire box 2%. gcc inlining k_atan2 into the shading made the scalar device 10%
  * slower on the envmap scene, so C keeps its own choice. */
 #define KFN_INLINE_CL static inline __attribute__((always_inline))
-/* Large stage functions that CPUs' OpenCL compilers (PoCL) must keep as calls: inlined
- * into k_path, shade_path took PoCL 2.3 s to build mesh.scene's program instead of 1.6 s,
- * at the same render speed (bench/RESULTS.md). GPU compilers, for which a call costs
- * more, and C compilers choose for themselves. */
+/* Large stage functions that CPUs' OpenCL compilers (PoCL) must keep as calls: PoCL
+ * compiles a kernel's body three times (the kernel and two work-group functions), so
+ * inlined into k_path, shade_path took it 2.3 s to build mesh.scene's program instead of
+ * 1.6 s (bench/RESULTS.md). GPU compilers, for which a call costs more, and C compilers
+ * choose for themselves. */
 #if defined(__x86_64__) || defined(__aarch64__)
 #define KFN_CALL_CL static inline __attribute__((noinline))
 #else

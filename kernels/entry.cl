@@ -172,6 +172,28 @@ KFN_INLINE void add_group_rays(__local uint *group_rays, uint n_rays, __global u
  * (bench/RESULTS.md). Adds its
  * rays to counters[0], carrying into counters[QUEUE_COUNT_STRIDE] (a 64-bit count from
  * 32-bit atomics: the adder whose addition wraps the low word carries). */
+/* One path from birth to end; returns the rays it traced. A call on CPUs: PoCL keeps a
+ * kernel's body three times over (the kernel and two work-group functions), and this
+ * function, with shade_path inlined into it (shade.cl), is most of k_path's code: as a
+ * call it is compiled once. */
+KFN_CALL_CL uint path_run(const SceneView *sc, uint pixel, uint sample, __global PathState *ps, __global Ray *ray,
+                          __global Ray *shadow_ray)
+{
+    uint n_rays = 0u;
+    raygen_path(sc->params, pixel, sample, ps, ray);
+    for (;;) {
+        Hit hit = trace_closest_visible(sc, *ray);
+        n_rays++;
+        uint r = shade_path(sc, ray, hit, ps, shadow_ray);
+        if (r & SHADE_SHADOW) {
+            shadow_resolve(ps, trace_occluded(sc, *shadow_ray));
+            n_rays++;
+        }
+        if (!(r & SHADE_CONTINUE)) break;
+    }
+    return n_rays;
+}
+
 __kernel KERNEL_SIZE void k_path(SCENE_ARGS uint first_pixel, uint first_sample, uint n_pixels, uint n_paths,
                                  __global PathState *paths, __global Ray *rays, __global Ray *shadow_rays,
                                  __global uint *counters)
@@ -184,17 +206,7 @@ __kernel KERNEL_SIZE void k_path(SCENE_ARGS uint first_pixel, uint first_sample,
     if (i < n_paths) {
         SCENE_VIEW(sc);
         uint p = first_pixel + i;
-        raygen_path(sc.params, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i]);
-        for (;;) {
-            Hit hit = trace_closest_visible(&sc, rays[i]);
-            n_rays++;
-            uint r = shade_path(&sc, &rays[i], hit, &paths[i], &shadow_rays[i]);
-            if (r & SHADE_SHADOW) {
-                shadow_resolve(&paths[i], trace_occluded(&sc, shadow_rays[i]));
-                n_rays++;
-            }
-            if (!(r & SHADE_CONTINUE)) break;
-        }
+        n_rays = path_run(&sc, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i], &shadow_rays[i]);
     }
     add_group_rays(&group_rays, n_rays, counters);
 }

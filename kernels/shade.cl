@@ -119,7 +119,16 @@ KFN_INLINE void shade_emission(const SceneView *sc, Ray r, Surface s, Material m
 
 /* One bounce. `ray` is the ray that produced `hit`; on SHADE_CONTINUE it is replaced by
  * the next ray. Returns SHADE_CONTINUE and/or SHADE_SHADOW. */
-KFN_CALL_CL uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathState *ps,
+/* In a program of the megakernel alone, shade_path is inlined into path_run (entry.cl),
+ * itself a call, so that PoCL compiles it once and not into each of the three copies it
+ * makes of a kernel's body: the envmap scene rendered 6-7% faster on PoCL and every
+ * such program built faster (bench/RESULTS.md). Everywhere else it is a call on CPUs. */
+#if KF_HAS(KF_PATH_MEGAKERNEL) && !KF_HAS(KF_PATH) && !KF_HAS(KF_PATH_LANES) && defined(KERNEL_OPENCL)
+#define SHADE_PATH_FN KFN_INLINE
+#else
+#define SHADE_PATH_FN KFN_CALL_CL
+#endif
+SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathState *ps,
                     GLOBAL Ray *shadow_ray)
 {
     GLOBAL const RenderParams *p = sc->params;

@@ -164,14 +164,6 @@ KFN_INLINE void add_group_rays(__local uint *group_rays, uint n_rays, __global u
 #endif
 
 #if KF_HAS(KF_PATH_MEGAKERNEL)
-/* The path tracer as one kernel, the CPUs' form: each work-item runs its path from
- * birth to end, calling the stage functions in the wavefront's order (the scalar
- * device's loop, device_scalar.c), so a path computes the same bits either way. On
- * PoCL this beat the counted wavefront by 3-13% on every bench scene: a path's state
- * stays in the cache, and there are no queues, atomics or barriers per bounce
- * (bench/RESULTS.md). Adds its
- * rays to counters[0], carrying into counters[QUEUE_COUNT_STRIDE] (a 64-bit count from
- * 32-bit atomics: the adder whose addition wraps the low word carries). */
 /* One path from birth to end; returns the rays it traced. A call on CPUs, for two
  * reasons measured on PoCL (bench/RESULTS.md). PoCL keeps a kernel's body three times
  * over (the kernel and two work-group functions); this function, with shade_path inlined
@@ -196,6 +188,14 @@ KFN_CALL_CL uint path_run(const SceneView *sc, uint pixel, uint sample, __global
     return n_rays;
 }
 
+/* The path tracer as one kernel, the CPUs' form: each work-item runs its path from
+ * birth to end, calling the stage functions in the wavefront's order (the scalar
+ * device's loop, device_scalar.c), so a path computes the same bits either way. On
+ * PoCL this beat the counted wavefront by 3-13% on every bench scene: a path's state
+ * stays in the cache, and there are no queues, atomics or barriers per bounce
+ * (bench/RESULTS.md). Adds its
+ * rays to counters[0], carrying into counters[QUEUE_COUNT_STRIDE] (a 64-bit count from
+ * 32-bit atomics: the adder whose addition wraps the low word carries). */
 __kernel KERNEL_SIZE void k_path(SCENE_ARGS uint first_pixel, uint first_sample, uint n_pixels, uint n_paths,
                                  __global PathState *paths, __global Ray *rays, __global Ray *shadow_rays,
                                  __global uint *counters)
@@ -216,10 +216,6 @@ __kernel KERNEL_SIZE void k_path(SCENE_ARGS uint first_pixel, uint first_sample,
 #endif /* KF_HAS(KF_PATH_MEGAKERNEL) */
 
 #if KF_HAS(KF_PATH_LANES)
-/* k_path with PATH_LANES paths per work-item (kernels/shade_lanes.cl): work-item i runs
- * wave paths PATH_LANES i to PATH_LANES i + PATH_LANES - 1, tracing each live one's
- * rays in turn and shading them together, until all have ended. Each path computes the
- * bits it computes in k_path. Launched over ceil(n_paths / PATH_LANES) work-items. */
 /* path_run for PATH_LANES paths at once: the paths first .. first + PATH_LANES - 1 below
  * n_paths. A call on CPUs, as path_run is and for the same reasons: PoCL built the
  * Cornell box's program in 1.7 s instead of 2.0 s, and rendered it 10-15% faster. */
@@ -260,6 +256,10 @@ KFN_CALL_CL uint path_run_lanes(const SceneView *sc, uint first, uint first_pixe
     return n_rays;
 }
 
+/* k_path with PATH_LANES paths per work-item (kernels/shade_lanes.cl): work-item i runs
+ * wave paths PATH_LANES i to PATH_LANES i + PATH_LANES - 1, tracing each live one's
+ * rays in turn and shading them together, until all have ended. Each path computes the
+ * bits it computes in k_path. Launched over ceil(n_paths / PATH_LANES) work-items. */
 __kernel KERNEL_SIZE_LANES void k_path_lanes(SCENE_ARGS uint first_pixel, uint first_sample, uint n_pixels, uint n_paths,
                                        __global PathState *paths, __global Ray *rays, __global Ray *shadow_rays,
                                        __global uint *counters)

@@ -17,7 +17,6 @@ void *pages_alloc_huge(size_t bytes)
     return p;
 }
 
-
 void *pages_alloc_large(size_t bytes)
 {
     if (bytes >= PAGES_HUGE_BYTES) return pages_alloc_huge(bytes);

@@ -2,7 +2,8 @@
  * bench_traverse.c -- kd-tree and 8-wide BVH traversal against Embree 3, on exactly the
  * same rays.
  *
- *   bench_traverse [--reps N] [--size N] [--local N] [--builds N] [--no-pocl] [--no-embree] [MESH ...]
+ *   bench_traverse [--reps N] [--size N] [--local N] [--builds N] [--no-pocl] [--no-embree]
+ *                  [--embree-robust] [MESH ...]
  *
  * MESH is an .obj or .ply file, or "sphere:N" (a closed bumpy sphere of about N
  * triangles, mesh_make_sphere). Without meshes: every mesh of ../shared/models that is
@@ -45,7 +46,10 @@
  * RTC_BUILD_QUALITY_HIGH build time (2 and 1 threads) and the bytes its build allocated;
  * with --builds N, N more rounds of the kd-tree, BVH and Embree builds in turns (2
  * threads), their medians and the medians of the rounds' ratios to Embree's.
- * Results are printed as Markdown tables for bench/RESULTS.md.
+ * With --embree-robust, Embree's scene has RTC_SCENE_FLAG_ROBUST: watertight triangle
+ * tests and conservative box tests, the guarantees clpt's walks always have (a ray
+ * through a shared edge or vertex hits one of its triangles; the default mode may miss
+ * both). Results are printed as Markdown tables for bench/RESULTS.md.
  */
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -74,6 +78,7 @@
 
 typedef struct {
     int reps, size, pocl, embree;
+    int embree_robust;           /* --embree-robust: RTC_SCENE_FLAG_ROBUST */
     int threads[MAX_THREADS];
     size_t local;                /* OpenCL work-group size (64, as the renderer), 0 = the driver's choice */
     int builds;                  /* --builds: rounds of kd-tree and Embree builds in turns (0: none) */
@@ -542,6 +547,8 @@ typedef struct {
     long long build_bytes;
 } Embree;
 
+static int embree_robust;         /* --embree-robust */
+
 static int embree_build(Embree *e, const Mesh *m, int threads)
 {
     memset(e, 0, sizeof *e);
@@ -555,6 +562,7 @@ static int embree_build(Embree *e, const Mesh *m, int threads)
     size_t n = m->scene.n_triangles;
     e->scene = rtcNewScene(e->dev);
     rtcSetSceneBuildQuality(e->scene, RTC_BUILD_QUALITY_HIGH);
+    if (embree_robust) rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_ROBUST);
     RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
     float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n);
@@ -981,7 +989,7 @@ static const char *const default_meshes[] = {
 
 int main(int argc, char **argv)
 {
-    Options o = { 5, 1024, 1, 1, { 1, 2 }, 64, 0 };
+    Options o = { 5, 1024, 1, 1, 0, { 1, 2 }, 64, 0 };
     const char *meshes[64];
     int n_meshes = 0;
     for (int i = 1; i < argc; i++) {
@@ -991,9 +999,10 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--builds") && i + 1 < argc) o.builds = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--no-pocl")) o.pocl = 0;
         else if (!strcmp(argv[i], "--no-embree")) o.embree = 0;
+        else if (!strcmp(argv[i], "--embree-robust")) o.embree_robust = 1;
         else if (argv[i][0] == '-') {
             fprintf(stderr, "usage: bench_traverse [--reps N] [--size N] [--local N] [--builds N] [--no-pocl] "
-                            "[--no-embree] [MESH ...]\n");
+                            "[--no-embree] [--embree-robust] [MESH ...]\n");
             return 2;
         } else if (n_meshes < 64) meshes[n_meshes++] = argv[i];
     }
@@ -1003,6 +1012,7 @@ int main(int argc, char **argv)
     if (o.builds < 0) o.builds = 0;
     if (o.builds > MAX_REPS) o.builds = MAX_REPS;
     pocl_local = o.local;
+    embree_robust = o.embree_robust;
     if (n_meshes == 0)
         for (size_t i = 0; i < sizeof default_meshes / sizeof default_meshes[0]; i++) {
             FILE *f = strncmp(default_meshes[i], "sphere:", 7) ? fopen(default_meshes[i], "rb") : NULL;
@@ -1037,7 +1047,9 @@ int main(int argc, char **argv)
     }
     error_clear(&err);
     free(devs);
-    if (o.embree) printf("Embree %d.%d.%d\n", (int)RTC_VERSION_MAJOR, (int)RTC_VERSION_MINOR, (int)RTC_VERSION_PATCH);
+    if (o.embree)
+        printf("Embree %d.%d.%d%s\n", (int)RTC_VERSION_MAJOR, (int)RTC_VERSION_MINOR, (int)RTC_VERSION_PATCH,
+               o.embree_robust ? ", RTC_SCENE_FLAG_ROBUST (watertight)" : "");
     printf("rays: %dx%d primary, then a diffuse and a shadow ray per primary hit; Mrays/s, median of %d runs\n",
            o.size, o.size, o.reps);
     for (int i = 0; i < n_meshes; i++) bench_mesh(meshes[i], &o, pocl, have_pocl);

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Peer benchmark: clpt against Mitsuba 3 and Blender Cycles at equal quality.
 
-usage: bench/peers.py [--clpt build/clpt] [--peers DIR] [--out DIR] [--runs N]
-                      [--ref-spp cornell=4096,dragon=1024] [--device DEV] [--threads N]
-                      [--scenes cornell,dragon]
+usage: bench/peers.py [--clpt build/clpt] [--clpt-args ARGS] [--peers DIR] [--out DIR]
+                      [--runs N] [--ref-spp cornell=4096,dragon=1024] [--device DEV]
+                      [--threads N] [--scenes cornell,dragon]
 
 Renders the two scenes of ../shared/peers (its README says how they were matched across
 renderers; the scene files and peer scripts are used from there as they are, so every
@@ -28,6 +28,14 @@ scene's spp it is 1-2% of clpt's. time x MSE is the
 error-per-time figure (lower is better; for unbiased Monte Carlo, MSE falls as 1/time),
 and "clpt time to equal error" is clpt's time x MSE over the peer's: the share of the
 peer's time that clpt needs to reach the peer's error (below 1: clpt is faster).
+
+Each renderer runs with its best settings for these scenes: Mitsuba with its multijitter
+sampler, Cycles with PMJ, clpt with --clpt-args, by default `--split 2` (two
+continuations from each camera sample's first hit, sharing its camera ray: on both
+scenes a fifth to a quarter less time x MSE than without, bench/RESULTS.md). Part of
+that is the Sobol points' faster convergence at twice the continuations, which the
+peers would also see at twice their samples (clpt's plain 32 spp on the dragon: 0.88
+of 16 spp's time x MSE).
 
 Standard library only; numpy is used for the error when it is importable (faster).
 """
@@ -122,11 +130,11 @@ class Clpt:
 
     def __init__(self, a):
         self.a = a
-        self.label = 'clpt (%s)' % (a.device or 'default device')
+        self.label = 'clpt (%s%s)' % (a.device or 'default device', ', ' + a.clpt_args if a.clpt_args else '')
 
     def cmd(self, scene, spp, seed, out):
         c = [self.a.clpt, os.path.join(self.a.peers, SCENES[scene][0]), '--spp', str(spp), '--seed', str(seed),
-             '--stats', '-q', '-o', out]
+             '--stats', '-q', '-o', out] + self.a.clpt_args.split()
         return c + (['--device', self.a.device] if self.a.device else [])
 
     def render(self, scene, spp, seed, out):
@@ -235,6 +243,7 @@ def fmt_s(x):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--clpt', default='build/clpt')
+    ap.add_argument('--clpt-args', default='--split 2', help="clpt's options for the scenes (default: --split 2)")
     ap.add_argument('--peers', default='../shared/peers', help='the folder of the peer scenes and scripts')
     ap.add_argument('--out', default='build/peers')
     ap.add_argument('--runs', type=int, default=3, help='rounds (at least 1)')

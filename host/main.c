@@ -195,6 +195,7 @@ static void apply_overrides(const Options *o, Scene *s)
     if (o->sampler >= 0) s->image.sampler = (uint)o->sampler;
     if (o->accel >= 0) s->accel = (uint)o->accel;
     if (o->max_depth >= 0) s->image.max_depth = (uint)o->max_depth;
+    if (o->split >= 0) s->image.split = (uint)o->split;
     if (o->integrator >= 0) s->integrator = (uint)o->integrator;
     if (o->gamma >= 0) s->linear_output = o->gamma == 1;
     if (o->shadows >= 0) s->shadows = o->shadows;
@@ -826,7 +827,12 @@ static void results_print_summary(const Run *r)
 {
     const ScheduleStats *s = &r->stats;
     if (r->o.stats || r->o.profile) print_render_stats(s, r->scene.image.spp, r->devs, r->n_devs);
-    if (r->o.profile) print_profile(s, r->devs, r->n_devs);
+    if (r->o.profile) {
+        print_profile(s, r->devs, r->n_devs);
+        if (r->scene.image.split > 1 && r->scene.integrator == INTEGRATOR_PATH)
+            printf("profile: with --split, OpenCL devices run each path as one kernel (k_path), whose time is "
+                   "all under shade\n");
+    }
     if (r->o.quiet && r->render_st == ST_OK && !s->interrupted) return;
     double secs = s->seconds > 0.0 ? s->seconds : 1e-9;
     fprintf(stderr, "clpt: %s %ux%u, %llu spp%s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n",

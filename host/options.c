@@ -55,6 +55,10 @@ void options_print_help(FILE *f)
 "      --seed N               random seed; the same seed gives the same image\n"
 "                             on any devices and batch sizes\n"
 "      --max-depth N          longest path, in bounces (overrides the scene)\n"
+"      --split N              path tracer: N continuations from each camera\n"
+"                             sample's first hit, weighted 1/N, sharing its\n"
+"                             camera ray and light sample (1..64; overrides the\n"
+"                             scene's image split; 1: none, the default)\n"
 "      --sampler sobol|independent\n"
 "                             random numbers: Owen-scrambled Sobol points\n"
 "                             (default; less noise) or independent ones\n"
@@ -386,6 +390,7 @@ static Status options_set_number(const char *a, const char *v, Options *o, int *
         { "--height", 1, CLPT_MAX_IMAGE_SIDE, &o->height },
         { "--seed", 0, 4294967295L, &o->seed },
         { "--max-depth", 0, CLPT_MAX_DEPTH, &o->max_depth },
+        { "--split", 1, CLPT_MAX_SPLIT, &o->split },
     };
     struct { const char *name; long lo, hi; unsigned *dst; } uints[] = {
         { "--batch", 1, 1000000, &o->batch },
@@ -473,7 +478,7 @@ static Status options_set_value(const char *a, const char *v, Options *o, int *f
 static void options_defaults(Options *o)
 {
     memset(o, 0, sizeof *o);
-    o->spp = o->width = o->height = o->seed = o->max_depth = -1;
+    o->spp = o->width = o->height = o->seed = o->max_depth = o->split = -1;
     o->range_first = o->range_end = -1;
     o->integrator = -1;
     o->gamma = -1;

@@ -10,7 +10,7 @@ typedef struct {
     const char *scene_path;
     const char *output;           /* NULL: <scene name>.png in the current folder */
     /* overrides of the scene file; -1 = keep the scene's value */
-    long spp, width, height, seed, max_depth;
+    long spp, width, height, seed, max_depth, split;
     const char *device_spec;      /* NULL: default selection */
     const char *camera;           /* --camera: the glTF camera, by index or name; NULL: first */
     int threads;                  /* scalar device workers, 0 = every core */

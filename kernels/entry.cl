@@ -175,15 +175,29 @@ KFN_CALL_CL uint path_run(const SceneView *sc, uint pixel, uint sample, __global
 {
     uint n_rays = 0u;
     raygen_path(sc->params, pixel, sample, ps, ray);
-    for (;;) {
-        Hit hit = trace_closest_visible(sc, *ray);
-        n_rays++;
+    Ray first_ray = *ray;
+    Hit hit = trace_closest_visible(sc, first_ray), first_hit = hit;
+    n_rays++;
+    /* first-hit splitting (shade.cl): the continuations still to go, known once the
+     * first hit is shaded */
+    uint split = 0u;
+    for (int first = 1;; first = 0) {
         uint r = shade_path(sc, ray, hit, ps, shadow_ray);
+        if (first && (r & SHADE_SCATTERED)) split = params_split(sc->params) - 1u;
         if (r & SHADE_SHADOW) {
             shadow_resolve(ps, trace_occluded(sc, *shadow_ray));
             n_rays++;
         }
-        if (!(r & SHADE_CONTINUE)) break;
+        if (!(r & SHADE_CONTINUE)) {
+            if (split == 0u) break;
+            split--;
+            path_branch_next(ps);
+            *ray = first_ray;
+            hit = first_hit;
+            continue;
+        }
+        hit = trace_closest_visible(sc, *ray);
+        n_rays++;
     }
     return n_rays;
 }
@@ -227,31 +241,52 @@ KFN_CALL_CL uint path_run_lanes(const SceneView *sc, uint first, uint first_pixe
     uint path[PATH_LANES];
     Hit hits[PATH_LANES];
     uint result[PATH_LANES];
+    /* first-hit splitting (shade.cl), as path_run: each lane's camera ray and first hit,
+     * and the continuations it still has to go */
+    Ray first_ray[PATH_LANES];
+    Hit first_hit[PATH_LANES];
+    uint split[PATH_LANES];
     uint live = 0u;
     for (uint l = 0; l < PATH_LANES; l++) {
         uint i = first + l;
         path[l] = i;
+        split[l] = 0u;
         if (i >= n_paths) continue;
         uint p = first_pixel + i;
         raygen_path(sc->params, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i]);
+        first_ray[l] = rays[i];
         live |= 1u << l;
     }
+    uint first_shade = live, restarted = 0u;
     while (live) {
         for (uint l = 0; l < PATH_LANES; l++) {
-            if (!(live & (1u << l))) continue;
+            if (!(live & ~restarted & (1u << l))) continue;
             hits[l] = trace_closest_visible(sc, rays[path[l]]);
             n_rays++;
+            if (first_shade & (1u << l)) first_hit[l] = hits[l];
         }
+        restarted = 0u;
         shade_lanes(sc, live, path, hits, rays, paths, shadow_rays, result);
         for (uint l = 0; l < PATH_LANES; l++) {
             if (!(live & (1u << l))) continue;
             uint i = path[l];
+            if ((first_shade & (1u << l)) && (result[l] & SHADE_SCATTERED)) split[l] = params_split(sc->params) - 1u;
             if (result[l] & SHADE_SHADOW) {
                 shadow_resolve(&paths[i], trace_occluded(sc, shadow_rays[i]));
                 n_rays++;
             }
-            if (!(result[l] & SHADE_CONTINUE)) live &= ~(1u << l);
+            if (result[l] & SHADE_CONTINUE) continue;
+            if (split[l] == 0u) {
+                live &= ~(1u << l);
+                continue;
+            }
+            split[l]--;
+            path_branch_next(&paths[i]);
+            rays[i] = first_ray[l];
+            hits[l] = first_hit[l];
+            restarted |= 1u << l;
         }
+        first_shade = 0u;
     }
     return n_rays;
 }

@@ -55,7 +55,21 @@ KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
     ps->bsdf_pdf = 0.0f;
     ps->flags = PATH_SPECULAR;  /* what the camera sees directly gets full weight */
     ps->rng_key = key.key;
-    ps->pad0 = 0u;
+    ps->branch = 0u;
+}
+
+/* Restarts the path of a camera sample as its next continuation from the first hit
+ * (first-hit splitting, RenderParams.split): the state raygen_path gave it, but with the
+ * radiance gathered so far and the next branch. The caller shades the first hit again,
+ * which for a later branch only scatters (shade_path). */
+KFN void path_branch_next(GLOBAL PathState *ps)
+{
+    ps->throughput = v3s(1.0f);
+    ps->shadow_L = v3s(0.0f);
+    ps->bounce = 0u;
+    ps->bsdf_pdf = 0.0f;
+    ps->flags = PATH_SPECULAR;
+    ps->branch = ps->branch + 1u;
 }
 
 #endif /* CLPT_RAYGEN_CL */

@@ -118,7 +118,18 @@ KFN_INLINE void shade_emission(const SceneView *sc, Ray r, Surface s, Material m
 }
 
 /* One bounce. `ray` is the ray that produced `hit`; on SHADE_CONTINUE it is replaced by
- * the next ray. Returns SHADE_CONTINUE and/or SHADE_SHADOW. */
+ * the next ray. Returns SHADE_CONTINUE and/or SHADE_SHADOW, and SHADE_SCATTERED when
+ * the surface scattered.
+ *
+ * First-hit splitting (RenderParams.split = B > 1): a camera sample whose first hit
+ * scatters is shaded there B times, each time with a light sample and a continuation
+ * of its own, weighted 1/B; the caller restarts the path (path_branch_next) and shades
+ * the first hit again for each later branch, which does not add the hit's emission
+ * again (the first branch did) and draws its own random numbers (rng_key_of).
+ * Unbiased: the mean of B estimates of what the first hit reflects. Worth it where the
+ * camera ray costs much and carries little of the error: on the peers' dragon the
+ * camera rays take 30% of the time, and sharing them between continuations left the
+ * error of twice the samples (bench/RESULTS.md). */
 /* In a program of the megakernel alone, shade_path is inlined into path_run (entry.cl),
  * itself a call, so that PoCL compiles it once and not into each of the three copies it
  * makes of a kernel's body: the envmap scene rendered 6-7% faster on PoCL and every
@@ -143,8 +154,10 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
 
     Surface s = surface_at(sc, r, hit);
     Material m = sc->materials[s.material];   /* a mix: its own emission (mix.h) */
-    shade_emission(sc, r, s, m, ps);
+    int later_branch = bounce == 0u && ps->branch != 0u;
+    if (!later_branch) shade_emission(sc, r, s, m, ps);
     if (bounce >= p->max_depth) return 0u;
+    if (bounce == 0u && p->split > 1u) ps->throughput = v3_scale(ps->throughput, 1.0f / (float)p->split);
 
     /* normals turned toward the side the ray came from */
     int front = v3_dot(r.d, s.ng) < 0.0f;
@@ -153,7 +166,7 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     if (m.type == MAT_EMISSIVE) return 0u;   /* pure emitters do not reflect */
     s.ns = material_normal(sc, m, s);
     vec3 ns_face = front ? s.ns : v3_neg(s.ns);
-    uint result = 0u;
+    uint result = SHADE_SCATTERED;
     BsdfSample bs;
 
     vec3 albedo = material_albedo(sc, m, s, ng_face);
@@ -178,8 +191,10 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     vec3 thr = v3_mul(ps->throughput, bs.weight);
     ps->bounce = bounce + 1u;
     if (ps->bounce > p->rr_depth) {
-        /* Russian roulette: continue with probability q, reweighted by 1/q */
-        float q = k_fmin(v3_max_comp(thr), 0.95f);
+        /* Russian roulette: continue with probability q, reweighted by 1/q; decided on
+         * the throughput before first-hit splitting's weight, which every path this far
+         * carries (without it, the dragon's error at split 2 was a third higher) */
+        float q = k_fmin(v3_max_comp(thr) * (float)params_split(p), 0.95f);
         if (!(rng_uniform(key, bounce, DIM_ROULETTE) < q)) return result;
         thr = v3_scale(thr, 1.0f / q);
     }

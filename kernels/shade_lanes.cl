@@ -140,6 +140,7 @@ typedef struct {
     int ltwo[PATH_LANES];                                     /* -1: a two-sided lamp */
     int rr[PATH_LANES];                                       /* -1: roulette at this bounce */
     uint key[PATH_LANES], rev[PATH_LANES], bounce[PATH_LANES];  /* RngKey.key, .sample_rev */
+    LaneFloats bsplit;                                        /* RenderParams.split */
 } LaneInputs;
 
 /* Whether the path's hit is one shade_lanes_fast can shade (a flat triangle of an
@@ -164,11 +165,14 @@ KFN_INLINE int lane_surface(const SceneView *sc, GLOBAL const Ray *ray, Hit hit,
     in->p1x[l] = tri->p1.x; in->p1y[l] = tri->p1.y; in->p1z[l] = tri->p1.z;
     in->p2x[l] = tri->p2.x; in->p2y[l] = tri->p2.y; in->p2z[l] = tri->p2.z;
     in->ar[l] = m->albedo.x; in->ag[l] = m->albedo.y; in->ab[l] = m->albedo.z;
-    in->tr[l] = ps->throughput.x; in->tg[l] = ps->throughput.y; in->tb[l] = ps->throughput.z;
+    vec3 thr = ps->throughput;
+    if (bounce == 0u && p->split > 1u) thr = v3_scale(thr, 1.0f / (float)p->split);   /* as shade_path */
+    in->tr[l] = thr.x; in->tg[l] = thr.y; in->tb[l] = thr.z;
     in->rr[l] = bounce + 1u > p->rr_depth ? -1 : 0;
     in->key[l] = ps->rng_key;
-    in->rev[l] = rng_reverse_bits(ps->sample);
+    in->rev[l] = rng_reverse_bits(ps->sample * params_split(p) + ps->branch);
     in->bounce[l] = bounce;
+    in->bsplit[l] = (float)params_split(p);
     return 1;
 }
 
@@ -290,7 +294,7 @@ KFN_CALL_CL void shade_lanes_fast(const LaneInputs *in, LaneResults *out)
     out->advance = cont;
     vec3x8 thr = w3_mul(thr0, albedo);
     int8 rr = vload8(0, in->rr);
-    float8 q = w_fmin(w3_max_comp(thr), 0.95f);
+    float8 q = w_fmin(w3_max_comp(thr) * LANE_LOAD(bsplit), 0.95f);
     cont &= ~rr | (urr < q);
     thr = w3_select(thr, w3_scale(thr, 1.0f / q), rr);
     cont &= w3_max_comp(thr) > 0.0f;
@@ -301,18 +305,19 @@ KFN_CALL_CL void shade_lanes_fast(const LaneInputs *in, LaneResults *out)
     out->dx = wo.x; out->dy = wo.y; out->dz = wo.z;
 }
 
-/* Writes lane l's results where shade_path would have; returns its SHADE_* bits. */
+/* Writes lane l's results where shade_path would have; returns its SHADE_* bits (a lane
+ * of shade_lanes_fast always scatters). */
 KFN_INLINE uint lane_scatter(const LaneResults *r, uint l, GLOBAL Ray *ray, GLOBAL PathState *ps,
                              GLOBAL Ray *shadow_ray)
 {
-    uint result = 0u;
+    uint result = SHADE_SCATTERED;
     if (r->shadow[l]) {
         ps->shadow_L = v3(r->lr[l], r->lg[l], r->lb[l]);
         shadow_ray->o = v3(r->sox[l], r->soy[l], r->soz[l]);
         shadow_ray->d = v3(r->sdx[l], r->sdy[l], r->sdz[l]);
         shadow_ray->tmin = 0.0f;
         shadow_ray->tmax = r->stmax[l];
-        result = SHADE_SHADOW;
+        result |= SHADE_SHADOW;
     }
     if (!r->advance[l]) return result;
     ps->bounce = ps->bounce + 1u;
@@ -338,6 +343,7 @@ KFN_INLINE uint lane_scatter(const LaneResults *r, uint l, GLOBAL Ray *ray, GLOB
  * k_path_lanes, whose cold build it made a fifth longer (bench/RESULTS.md). */
 KFN_INLINE uint shade_lane_end(const SceneView *sc, Ray r, Hit hit, GLOBAL PathState *ps)
 {
+    if (ps->bounce == 0u && ps->branch != 0u) return 0u;   /* a later branch: shade_path's */
     if (hit.prim == NO_INDEX) {
         shade_escape(sc, r, ps);
         return 0u;

@@ -369,7 +369,7 @@ enum MisMode { MIS_BOTH = 0, MIS_LIGHT_ONLY = 1, MIS_BSDF_ONLY = 2 };
 enum Sampler { SAMPLER_SOBOL = 0, SAMPLER_INDEPENDENT = 1 };
 
 /* Everything constant over a render, uploaded once per device. */
-typedef struct {                                        /* 288 bytes */
+typedef struct {                                        /* 304 bytes */
     Camera camera;
     vec3 bg_color;    uint bg_type;   /* constant colour, the sky's horizon colour, or
                                        * BG_MAP: the map's scale (intensity) */
@@ -402,6 +402,9 @@ typedef struct {                                        /* 288 bytes */
     uint n_bvh_nodes;                 /* nodes of the 8-wide BVH, when there is one */
     uint bg_light;                    /* BG_MAP: its light in lights[] (sampled by
                                        * next-event estimation), or NO_INDEX */
+    uint split;                       /* path: continuations per camera sample from its
+                                       * first hit (>= 1; shade.cl, first-hit splitting) */
+    uint pad_split0, pad_split1, pad_split2;
 } RenderParams;
 
 /* One path of the wavefront; lives in a device buffer between kernel launches. */
@@ -411,8 +414,9 @@ typedef struct {                                        /* 64 bytes */
     vec3 shadow_L;    uint bounce;    /* contribution waiting for its shadow ray */
     float bsdf_pdf;                   /* solid-angle pdf of the last bounce (MIS) */
     uint flags;                       /* PATH_* */
-    uint rng_key;                     /* RngKey.key of the path (rng.h) */
-    uint pad0;
+    uint rng_key;                     /* RngKey.key of the camera sample (rng.h) */
+    uint branch;                      /* which of RenderParams.split continuations from
+                                       * the first hit this is (path_branch_next) */
 } PathState;
 
 #define PATH_SPECULAR 1u      /* last bounce was a delta lobe: no MIS on emission */
@@ -425,6 +429,8 @@ typedef struct {                                        /* 64 bytes */
 /* Stage results reported by shade_path to its caller, which does the queueing. */
 #define SHADE_CONTINUE 1u     /* the path goes on with the ray written back */
 #define SHADE_SHADOW 2u       /* a shadow ray was written; shadow_L waits on it */
+#define SHADE_SCATTERED 4u    /* the surface scatters (a BSDF was sampled, whether or not
+                               * the sample went on): at the first hit, the path splits */
 
 #ifndef KERNEL_OPENCL
 #include <stddef.h>
@@ -445,7 +451,7 @@ CLPT_CHECK_SIZE(RevSurface, 48);
 CLPT_CHECK_SIZE(Material, 176);
 CLPT_CHECK_SIZE(Light, 96);
 CLPT_CHECK_SIZE(Camera, 112);
-CLPT_CHECK_SIZE(RenderParams, 288);
+CLPT_CHECK_SIZE(RenderParams, 304);
 CLPT_CHECK_SIZE(PathState, 64);
 CLPT_CHECK_SIZE(Texture, 112);
 _Static_assert(offsetof(RenderParams, bg_color) == 112, "RenderParams.bg_color");

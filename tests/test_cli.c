@@ -14,7 +14,7 @@ static void test_help_documents_every_flag(void)
 {
     cli_run(ARGS("--help"), &r);
     CHECK_EQ_INT(r.status, 0);
-    const char *flags[] = { "--output", "--spp", "--width", "--height", "--seed", "--max-depth", "--time-limit",
+    const char *flags[] = { "--output", "--spp", "--width", "--height", "--seed", "--max-depth", "--split", "--time-limit",
                             "--progressive-output", "--list-devices", "--device", "--threads", "--stats",
                             "--quiet", "--help", "--version", "--kernel-dir", "--batch", "--wave-paths", "--wave-launch",
                             "--shadows", "--sampler", "--accel", "--profile", "-size W H -input SCENE -output FILE", "-depth NEAR FAR FILE",
@@ -32,6 +32,9 @@ static void test_usage_errors(void)
     CHECK_STR_CONTAINS(r.err, "--spp expects an integer, got 'ten'");
     cli_run(ARGS("scenes/cornell-box.scene", "--width", "0"), &r);
     CHECK_EQ_INT(r.status, 2);
+    cli_run(ARGS("scenes/cornell-box.scene", "--split", "0"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "--split must be between 1 and 64, got 0");
     cli_run(ARGS("--frobnicate"), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "unknown option '--frobnicate'");

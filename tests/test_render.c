@@ -32,17 +32,18 @@ static void furnace_scene(Scene *s, uint spp)
     scene_add_sphere(s, sp, NULL);
 }
 
-static void check_furnace(const char *devices)
+static void check_furnace_split(const char *devices, uint split)
 {
     Scene s;
     furnace_scene(&s, 64);
+    s.image.split = split;
     Film f;
     Error err = { 0 };
     Status st = render_util_run(&s, devices, 0, &f, &err);
     CHECK_MSG(st == ST_OK, "%s", err.msg);
     if (st == ST_OK) {
         double mean = film_mean(&f);
-        fprintf(stderr, "  furnace on %s: image mean %.5f (expected 1.0)\n", devices, mean);
+        fprintf(stderr, "  furnace on %s, split %u: image mean %.5f (expected 1.0)\n", devices, split, mean);
         CHECK_NEAR(mean, 1.0, 0.025);
     }
     film_free(&f);
@@ -50,8 +51,77 @@ static void check_furnace(const char *devices)
     error_clear(&err);
 }
 
-static void test_furnace_scalar(void) { check_furnace("scalar"); }
-static void test_furnace_opencl(void) { check_furnace(TEST_OPENCL); }
+static void test_furnace_scalar(void) { check_furnace_split("scalar", 1); }
+static void test_furnace_opencl(void) { check_furnace_split(TEST_OPENCL, 1); }
+/* First-hit splitting is unbiased: three continuations of each camera sample, each
+ * weighted a third, give the furnace's 1 too. */
+static void test_furnace_split(void)
+{
+    check_furnace_split("scalar", 3);
+    check_furnace_split(TEST_OPENCL, 3);
+}
+
+/* With first-hit splitting, each device restarts a camera sample's path from its first
+ * hit in the same steps (path_run, path_run_lanes, the scalar device's render_path), so
+ * the films are equal bit for bit: the Cornell box (k_path_lanes on PoCL), the same with
+ * independent random numbers (k_path), and the furnace's sphere (k_path). */
+static void check_split_matches(const char *file, uint sampler)
+{
+    Scene a, b;
+    Error err = { 0 };
+    Status st = ST_OK;
+    if (file) {
+        scene_init(&a);
+        scene_init(&b);
+        if ((st = scene_load(file, &a, &err)) || (st = scene_load(file, &b, &err))) {
+            CHECK_MSG(0, "%s", err.msg);
+            scene_free(&a);
+            scene_free(&b);
+            error_clear(&err);
+            return;
+        }
+        a.image.width = b.image.width = 48;
+        a.image.height = b.image.height = 48;
+        a.image.spp = b.image.spp = 8;
+    } else {
+        furnace_scene(&a, 8);
+        furnace_scene(&b, 8);
+    }
+    a.image.split = b.image.split = 3;
+    a.image.sampler = b.image.sampler = sampler;
+    Film fa, fb, f1;
+    memset(&fa, 0, sizeof fa);
+    memset(&fb, 0, sizeof fb);
+    memset(&f1, 0, sizeof f1);
+    CHECK_MSG((st = render_util_run(&a, TEST_OPENCL, 0, &fa, &err)) == ST_OK, "%s", err.msg);
+    CHECK_MSG((st = render_util_run(&b, "scalar", 0, &fb, &err)) == ST_OK, "%s", err.msg);
+    b.image.split = 1;
+    CHECK_MSG((st = render_util_run(&b, "scalar", 0, &f1, &err)) == ST_OK, "%s", err.msg);
+    if (fa.sum && fb.sum && f1.sum) {
+        size_t n = (size_t)fa.width * fa.height * 3u, exact = 0, same_as_one = 0;
+        for (size_t i = 0; i < n; i++) {
+            exact += fa.sum[i] == fb.sum[i];
+            same_as_one += fb.sum[i] == f1.sum[i];
+        }
+        fprintf(stderr, "  %s, split 3: %zu of %zu channel sums identical on OpenCL and scalar; %zu as split 1's\n",
+                file ? file : "furnace", exact, n, same_as_one);
+        CHECK_EQ_INT(exact, n);
+        CHECK(same_as_one < n / 2);   /* it did split */
+    }
+    film_free(&fa);
+    film_free(&fb);
+    film_free(&f1);
+    scene_free(&a);
+    scene_free(&b);
+    error_clear(&err);
+}
+
+static void test_split_opencl_matches_scalar(void)
+{
+    check_split_matches("scenes/cornell-box.scene", SAMPLER_SOBOL);
+    check_split_matches("scenes/cornell-box.scene", SAMPLER_INDEPENDENT);
+    check_split_matches(NULL, SAMPLER_SOBOL);
+}
 
 /* The Cornell box on PoCL and on the scalar device: both run the same kernel source on
  * the same random numbers, so they must agree (the goal is bit for bit; the stated
@@ -211,6 +281,8 @@ int main(void)
     RUN(test_furnace_scalar);
     RUN(test_furnace_opencl);
     RUN(test_opencl_matches_scalar);
+    RUN(test_furnace_split);
+    RUN(test_split_opencl_matches_scalar);
     RUN(test_update_params_scalar);
     RUN(test_update_params_opencl);
     return harness_report();

@@ -124,7 +124,7 @@ static void test_camera_and_image(void)
     Error err;
     Status st = load_text("cam.scene",
                           "camera { from 1 2 3 at 4 5.5 -6 up 0 0 1 fov 30 aperture 0.25 focus 7.5 }\n"
-                          "image { width 640 height 480 spp 16 depth 3 seed 4294967295 }\n",
+                          "image { width 640 height 480 spp 16 depth 3 seed 4294967295 split 4 }\n",
                           &s, &err);
     CHECK_EQ_INT(st, ST_OK);
     CHECK(vec_eq(s.camera.from, 1, 2, 3));
@@ -138,6 +138,7 @@ static void test_camera_and_image(void)
     CHECK_EQ_INT(s.image.spp, 16);
     CHECK_EQ_INT(s.image.max_depth, 3);
     CHECK_EQ_INT(s.image.seed, 4294967295u);
+    CHECK_EQ_INT(s.image.split, 4);
     CHECK(s.path && strstr(s.path, "cam.scene"));
     scene_free(&s);
 }
@@ -160,6 +161,7 @@ static void test_defaults_kept(void)
     CHECK_EQ_INT(s.image.spp, 2);
     CHECK_EQ_INT(s.image.max_depth, 8);
     CHECK_EQ_INT(s.image.seed, 1);
+    CHECK_EQ_INT(s.image.split, 1);
     CHECK_EQ_INT(s.bg_type, BG_CONSTANT);
     CHECK(vec_eq(s.bg_color, 0, 0, 0));
     scene_free(&s);
@@ -533,6 +535,8 @@ static void test_bad_values(void)
     check_bad("image { width 99999999999999999999999 }", ST_INPUT,
               ":1:15: expected an integer in 1..16384 for 'width', found '99999999999999999999999'");
     check_bad("image { depth 1025 }", ST_INPUT, ":1:15: expected an integer in 0..1024 for 'depth'");
+    check_bad("image { split 0 }", ST_INPUT, ":1:15: expected an integer in 1..64 for 'split', found '0'");
+    check_bad("image { split 65 }", ST_INPUT, ":1:15: expected an integer in 1..64 for 'split', found '65'");
     check_bad("image { spp -1 }", ST_INPUT, ":1:13: expected an integer in 1..1000000 for 'spp', found '-1'");
     check_bad("camera { fov 180 }", ST_INPUT, ":1:14: expected a number of degrees in (0, 180) for 'fov', found '180'");
     check_bad("camera { fov nan }", ST_INPUT, ":1:14: expected a number of degrees in (0, 180) for 'fov', found 'nan'");

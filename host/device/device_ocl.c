@@ -113,6 +113,9 @@ typedef struct {
     uint wave_auto;         /* a GPU's large default wave, used where it fits (load_scene); 0 if none */
     size_t local_size;      /* 0: let the driver choose */
     int launch;             /* enum WaveLaunch, never AUTO: how a wave is launched */
+    int path_launch;        /* how this render's path waves are: launch, or the megakernel
+                             * with first-hit splitting, which only the megakernels do
+                             * (RenderParams.split; path_run keeps the first hit) */
     int cpu;                /* a CPU device: the megakernel may take eight paths at a time */
     /* The megakernel is k_path_lanes: on a CPU, where it is faster, for a scene and
      * settings it can render (kernel_features.h; on PoCL the envmap scene rendered 11%
@@ -380,7 +383,7 @@ static Status set_program_args(OclDevice *od, int which, Error *err)
 static unsigned program_kernels(const OclDevice *od, int which)
 {
     if (which == PROG_WHITTED) return KF_WHITTED;
-    if (od->launch != WAVE_LAUNCH_MEGAKERNEL) return KF_PATH;
+    if (od->path_launch != WAVE_LAUNCH_MEGAKERNEL) return KF_PATH;
     return od->lanes ? KF_PATH_LANES : KF_PATH_MEGAKERNEL;
 }
 
@@ -516,7 +519,8 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     od->n_pixels = n_pixels;
     /* a program built for an earlier scene serves this one if it has its features */
     od->scene_features = kernel_scene_features(s);
-    od->lanes_scene = od->cpu && od->launch == WAVE_LAUNCH_MEGAKERNEL && kernel_lanes_scene(s, od->scene_features);
+    od->path_launch = s->params.split > 1u ? WAVE_LAUNCH_MEGAKERNEL : od->launch;
+    od->lanes_scene = od->cpu && od->path_launch == WAVE_LAUNCH_MEGAKERNEL && kernel_lanes_scene(s, od->scene_features);
     od->lanes = od->lanes_scene && kernel_lanes_params(&s->params);
     for (int i = 0; i < PROG_N; i++) {
         unsigned need = od->scene_features | program_kernels(od, i);
@@ -594,6 +598,7 @@ static Status ocl_update_params(Device *d, const RenderParams *p, const uint *pi
     od->max_bounces = p->max_depth + 1u;
     d->counters.upload_seconds += timer_now() - t0;
     od->scene_features |= kernel_params_features(p);
+    od->path_launch = p->split > 1u ? WAVE_LAUNCH_MEGAKERNEL : od->launch;
     od->lanes = od->lanes_scene && kernel_lanes_params(p);
     if ((st = need_program(d, od, p->integrator, err))) return st;
     od->integrator = p->integrator;
@@ -712,7 +717,7 @@ static Status wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint firs
     w->first_sample = first_sample;
     w->n_paths = n_paths;
     w->active = 1;
-    if (od->launch == WAVE_LAUNCH_MEGAKERNEL) return wave_run_paths(od, w, err);
+    if (od->path_launch == WAVE_LAUNCH_MEGAKERNEL) return wave_run_paths(od, w, err);
     cl_uint size = n_paths;   /* count slot 0: the paths entering bounce 0 */
     OCL_TRY("clEnqueueFillBuffer",
             clEnqueueFillBuffer(od->queue, w->counts, &size, sizeof size, 0, sizeof size, 0, NULL, NULL));
@@ -723,7 +728,7 @@ static Status wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint firs
     if ((st = launch(od, k, "k_raygen", n_paths, err))) return st;
     w->cur = w->queue_a;
     w->next = w->queue_b;
-    return od->launch == WAVE_LAUNCH_BOUNDED ? wave_enqueue_all(od, w, err) : bounce_launch(od, w, 0, n_paths, err);
+    return od->path_launch == WAVE_LAUNCH_BOUNDED ? wave_enqueue_all(od, w, err) : bounce_launch(od, w, 0, n_paths, err);
 }
 
 /* Waits for the counts of the wave's last bounce, then launches its shadow rays and
@@ -739,12 +744,12 @@ static Status wave_advance(OclDevice *od, WaveSlot *w, Error *err)
     }
     release_event(&w->read);
     if (rc != CL_SUCCESS) return ocl_fail(err, &od->info, "clWaitForEvents", rc);
-    if (od->launch == WAVE_LAUNCH_MEGAKERNEL) {
+    if (od->path_launch == WAVE_LAUNCH_MEGAKERNEL) {
         od->rays += (uint64_t)w->got[0] + ((uint64_t)w->got[QUEUE_COUNT_STRIDE] << 32);
         w->active = 0;
         return ST_OK;
     }
-    if (od->launch == WAVE_LAUNCH_BOUNDED) {
+    if (od->path_launch == WAVE_LAUNCH_BOUNDED) {
         /* the whole wave ran; its counts say how many rays it traced */
         for (uint b = 0; b < od->max_bounces; b++)
             od->rays += (uint64_t)w->all_counts[2u * b * QUEUE_COUNT_STRIDE] +

@@ -55,23 +55,36 @@ typedef struct {
                                   * NULL: not profiling */
 } CpuDevice;
 
-/* Renders one path to its end; returns the number of rays it traced. */
+/* Renders one camera sample's path to its end, and with first-hit splitting each of
+ * its continuations (path_run in kernels/entry.cl, the same steps); returns the number
+ * of rays it traced. */
 static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *radiance)
 {
     PathState ps;
     Ray ray, shadow;
     memset(&shadow, 0, sizeof shadow);   /* written by shade_path only when it traces one */
-    uint64_t rays = 0;
+    uint64_t rays = 1;
     raygen_path(sc->params, pixel, sample, &ps, &ray);
-    for (;;) {
-        Hit hit = trace_closest_visible(sc, ray);
-        rays++;
+    Ray first_ray = ray;
+    Hit hit = trace_closest_visible(sc, ray), first_hit = hit;
+    uint split = 0;
+    for (int first = 1;; first = 0) {
         uint r = shade_path(sc, &ray, hit, &ps, &shadow);
+        if (first && (r & SHADE_SCATTERED)) split = params_split(sc->params) - 1u;
         if (r & SHADE_SHADOW) {
             shadow_resolve(&ps, trace_occluded(sc, shadow));
             rays++;
         }
-        if (!(r & SHADE_CONTINUE)) break;
+        if (!(r & SHADE_CONTINUE)) {
+            if (split == 0) break;
+            split--;
+            path_branch_next(&ps);
+            ray = first_ray;
+            hit = first_hit;
+            continue;
+        }
+        hit = trace_closest_visible(sc, ray);
+        rays++;
     }
     *radiance = ps.radiance;
     return rays;
@@ -89,14 +102,17 @@ static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, 
     raygen_path(sc->params, pixel, sample, &ps, &ray);
     t1 = timer_now();
     t[PHASE_RAYGEN] += t1 - t0;
-    for (;;) {
-        Hit hit = trace_closest_visible(sc, ray);
+    Ray first_ray = ray;
+    Hit hit = trace_closest_visible(sc, ray), first_hit = hit;
+    rays++;
+    uint split = 0;
+    for (int first = 1;; first = 0) {
         t0 = timer_now();
         t[PHASE_TRAVERSE] += t0 - t1;
-        rays++;
         uint r = shade_path(sc, &ray, hit, &ps, &shadow);
         t1 = timer_now();
         t[PHASE_SHADE] += t1 - t0;
+        if (first && (r & SHADE_SCATTERED)) split = params_split(sc->params) - 1u;
         if (r & SHADE_SHADOW) {
             shadow_resolve(&ps, trace_occluded(sc, shadow));
             rays++;
@@ -104,7 +120,16 @@ static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, 
             t[PHASE_SHADOW] += t0 - t1;
             t1 = t0;
         }
-        if (!(r & SHADE_CONTINUE)) break;
+        if (!(r & SHADE_CONTINUE)) {
+            if (split == 0) break;
+            split--;
+            path_branch_next(&ps);
+            ray = first_ray;
+            hit = first_hit;
+            continue;
+        }
+        hit = trace_closest_visible(sc, ray);
+        rays++;
     }
     *radiance = ps.radiance;
     return rays;

@@ -88,6 +88,7 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
     p->width = s->image.width;
     p->height = s->image.height;
     p->max_depth = s->image.max_depth;
+    p->split = s->image.split ? s->image.split : 1u;
     p->rr_depth = RR_START_BOUNCE;
     p->seed = s->image.seed;
     p->sampler = s->image.sampler;

@@ -36,6 +36,7 @@ typedef struct {
     uint max_depth;      /* bounces after the camera ray */
     uint seed;
     uint sampler;        /* enum Sampler (kernels/rng.h); 0, Sobol, by default */
+    uint split;          /* continuations per camera sample from its first hit (1: none) */
 } SceneImage;
 
 typedef struct {

@@ -63,28 +63,35 @@ static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *
     PathState ps;
     Ray ray, shadow;
     memset(&shadow, 0, sizeof shadow);   /* written by shade_path only when it traces one */
-    uint64_t rays = 1;
+    uint64_t rays = 0;
     raygen_path(sc->params, pixel, sample, &ps, &ray);
     Ray first_ray = ray;
-    Hit hit = trace_closest_visible(sc, ray), first_hit = hit;
+    Hit first_hit = { 0 };
     uint split = 0;
+    int restart = 0;
     for (int first = 1;; first = 0) {
+        Hit hit;
+        if (restart) {
+            hit = first_hit;
+        } else {
+            hit = trace_closest_visible(sc, ray);
+            rays++;
+        }
+        if (first) first_hit = hit;
         uint r = shade_path(sc, &ray, hit, &ps, &shadow);
         if (first && (r & SHADE_SCATTERED)) split = params_split(sc->params) - 1u;
         if (r & SHADE_SHADOW) {
             shadow_resolve(&ps, trace_occluded(sc, shadow));
             rays++;
         }
+        restart = 0;
         if (!(r & SHADE_CONTINUE)) {
             if (split == 0) break;
             split--;
             path_branch_next(&ps);
             ray = first_ray;
-            hit = first_hit;
-            continue;
+            restart = 1;
         }
-        hit = trace_closest_visible(sc, ray);
-        rays++;
     }
     *radiance = ps.radiance;
     return rays;
@@ -103,10 +110,18 @@ static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, 
     t1 = timer_now();
     t[PHASE_RAYGEN] += t1 - t0;
     Ray first_ray = ray;
-    Hit hit = trace_closest_visible(sc, ray), first_hit = hit;
-    rays++;
+    Hit first_hit = { 0 };
     uint split = 0;
+    int restart = 0;
     for (int first = 1;; first = 0) {
+        Hit hit;
+        if (restart) {
+            hit = first_hit;
+        } else {
+            hit = trace_closest_visible(sc, ray);
+            rays++;
+        }
+        if (first) first_hit = hit;
         t0 = timer_now();
         t[PHASE_TRAVERSE] += t0 - t1;
         uint r = shade_path(sc, &ray, hit, &ps, &shadow);
@@ -120,16 +135,14 @@ static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, 
             t[PHASE_SHADOW] += t0 - t1;
             t1 = t0;
         }
+        restart = 0;
         if (!(r & SHADE_CONTINUE)) {
             if (split == 0) break;
             split--;
             path_branch_next(&ps);
             ray = first_ray;
-            hit = first_hit;
-            continue;
+            restart = 1;
         }
-        hit = trace_closest_visible(sc, ray);
-        rays++;
     }
     *radiance = ps.radiance;
     return rays;

@@ -164,51 +164,7 @@ KFN_INLINE void add_group_rays(__local uint *group_rays, uint n_rays, __global u
 #endif
 
 #if KF_HAS(KF_PATH_MEGAKERNEL)
-/* One path from birth to end; returns the rays it traced. A call on CPUs, for two
- * reasons measured on PoCL (bench/RESULTS.md). PoCL keeps a kernel's body three times
- * over (the kernel and two work-group functions); this function, with shade_path inlined
- * into it (shade.cl), is most of k_path's code, and as a call it is compiled once. And
- * the same code ran 6-15% faster as a call than in the kernel's body, whose variables
- * PoCL's work-group function handles around the kernel's barriers (add_group_rays). */
-KFN_CALL_CL uint path_run(const SceneView *sc, uint pixel, uint sample, __global PathState *ps, __global Ray *ray,
-                          __global Ray *shadow_ray)
-{
-    uint n_rays = 0u;
-    raygen_path(sc->params, pixel, sample, ps, ray);
-    /* first-hit splitting (shade.cl): the camera ray and first hit, the continuations
-     * still to go (known once the first hit is shaded), and whether the path restarts
-     * from the first hit. One call of the walk: inlined twice, it made k_path 5-9%
-     * slower on the envmap, one-weekend and mesh scenes. */
-    Ray first_ray = *ray;
-    Hit first_hit;
-    uint split = 0u;
-    int restart = 0;
-    for (int first = 1;; first = 0) {
-        Hit hit;
-        if (restart) {
-            hit = first_hit;
-        } else {
-            hit = trace_closest_visible(sc, *ray);
-            n_rays++;
-        }
-        if (first) first_hit = hit;
-        uint r = shade_path(sc, ray, hit, ps, shadow_ray);
-        if (first && (r & SHADE_SCATTERED)) split = params_split(sc->params) - 1u;
-        if (r & SHADE_SHADOW) {
-            shadow_resolve(ps, trace_occluded(sc, *shadow_ray));
-            n_rays++;
-        }
-        restart = 0;
-        if (!(r & SHADE_CONTINUE)) {
-            if (split == 0u) break;
-            split--;
-            path_branch_next(ps);
-            *ray = first_ray;
-            restart = 1;
-        }
-    }
-    return n_rays;
-}
+#include "path.cl"
 
 /* The path tracer as one kernel, the CPUs' form: each work-item runs its path from
  * birth to end, calling the stage functions in the wavefront's order (the scalar

@@ -54,17 +54,14 @@ typedef struct {
     uint sampler;    /* enum Sampler */
     uint sample_rev; /* sobol: the sample index bit-reversed (rng_key_make, rng_key_of),
                       * which every pattern's shuffle starts from; else 0 */
-    uint camera_key, camera_rev; /* key and sample_rev of the camera sample: what the
-                      * camera's dimensions draw from (rng_camera_dim) */
 } RngKey;
 
 /* With first-hit splitting (RenderParams.split = B), the B continuations of camera
- * sample s share its camera ray, which draws from sample index s (rng_camera_dim), and
- * part at the first hit, whose light sample and scattering direction draw from index
- * s B + branch: over a pixel's samples, those indices run through a Sobol pattern's
+ * sample s share its camera ray, whose dimensions raygen_path draws with the key of s
+ * (rng_key_make), and part at the first hit: shading draws with rng_key_of, whose index
+ * is s B + branch. Over a pixel's samples those indices run through a Sobol pattern's
  * first points in order, so each continuation's dimensions are stratified as B times
- * the samples would be. With B = 1 both are s. */
-#define rng_camera_dim(bounce, dim) ((bounce) == 0u && (dim) < DIM_LIGHT_PICK)
+ * the samples would be. With B = 1 the index is s, as it always was. */
 
 /* RenderParams.split as a count: 0 (a block filled by hand) means none, as 1 does. */
 KFN uint params_split(GLOBAL const RenderParams *p)
@@ -178,8 +175,6 @@ KFN RngKey rng_key_make(GLOBAL const RenderParams *p, uint pixel, uint sample)
     k.sample = sample;
     k.key = k.sampler == SAMPLER_SOBOL ? rng_pixel_key(p->seed, pixel) : rng_path_key(p->seed, pixel, sample);
     k.sample_rev = k.sampler == SAMPLER_SOBOL ? rng_reverse_bits(sample) : 0u;
-    k.camera_key = k.key;
-    k.camera_rev = k.sample_rev;
     return k;
 }
 
@@ -188,8 +183,6 @@ KFN RngKey rng_key_of(GLOBAL const PathState *ps, GLOBAL const RenderParams *p)
 {
     RngKey k;
     k.sampler = p->sampler;
-    k.camera_key = ps->rng_key;
-    k.camera_rev = k.sampler == SAMPLER_SOBOL ? rng_reverse_bits(ps->sample) : 0u;
     k.sample = ps->sample * params_split(p) + ps->branch;
     /* independent values: a key per continuation, the camera sample's for the first */
     k.key = k.sampler == SAMPLER_SOBOL || ps->branch == 0u ? ps->rng_key
@@ -200,9 +193,9 @@ KFN RngKey rng_key_of(GLOBAL const PathState *ps, GLOBAL const RenderParams *p)
 
 /* The sample index after the pattern's shuffle: rng_owen_scramble(sample, pattern)
  * from the key's reversed index (one reversal fewer per pattern). */
-KFN uint rng_sobol_index(uint sample_rev, uint pattern)
+KFN uint rng_sobol_index(RngKey k, uint pattern)
 {
-    return rng_reverse_bits(rng_lk_permute(sample_rev, pattern));
+    return rng_reverse_bits(rng_lk_permute(k.sample_rev, pattern));
 }
 
 /* Coordinate `coord` (0 or 1) of the pattern's point `index` (the sample index after
@@ -223,8 +216,7 @@ KFN uint rng_sobol_bits(RngKey k, uint bounce, uint dim)
 {
     uint coord = (RNG_PAIR_SECOND >> dim) & 1u;
     uint pattern = rng_sobol_pattern(k.key, bounce, dim - coord);
-    return rng_sobol_coord(rng_sobol_index(rng_camera_dim(bounce, dim) ? k.camera_rev : k.sample_rev, pattern),
-                           pattern, coord);
+    return rng_sobol_coord(rng_sobol_index(k, pattern), pattern, coord);
 }
 
 /* 32-bit fixed point to a uniform float in [0, 1): the top 24 bits, so 1.0f is never
@@ -238,8 +230,7 @@ KFN_INLINE_CL float rng_uniform(RngKey k, uint bounce, uint dim)
 {
     uint h = k.sampler == SAMPLER_SOBOL
                  ? rng_sobol_bits(k, bounce, dim)
-                 : rng_hash((rng_camera_dim(bounce, dim) ? k.camera_key : k.key) ^
-                            rng_hash(bounce * (uint)RNG_DIMS_PER_BOUNCE + dim + 0x632be5abu));
+                 : rng_hash(k.key ^ rng_hash(bounce * (uint)RNG_DIMS_PER_BOUNCE + dim + 0x632be5abu));
     return rng_to_float(h);
 }
 
@@ -257,7 +248,7 @@ KFN_INLINE void rng_uniform2(RngKey k, uint bounce, uint first, float *u, float 
         return;
     }
     uint pattern = rng_sobol_pattern(k.key, bounce, first);
-    uint index = rng_sobol_index(rng_camera_dim(bounce, first) ? k.camera_rev : k.sample_rev, pattern);
+    uint index = rng_sobol_index(k, pattern);
     *u = rng_to_float(rng_sobol_coord(index, pattern, 0u));
     *v = rng_to_float(rng_sobol_coord(index, pattern, 1u));
 }

@@ -24,6 +24,7 @@
 #include "shade.cl"
 #include "traverse.cl"
 #include "alpha.h"
+#include "path.cl"
 #include "whitted.cl"
 
 /* Paths (pixels x samples of the batch) handed to a worker at a time: small enough that
@@ -55,50 +56,20 @@ typedef struct {
                                   * NULL: not profiling */
 } CpuDevice;
 
-/* Renders one camera sample's path to its end, and with first-hit splitting each of
- * its continuations (path_run in kernels/entry.cl, the same steps); returns the number
- * of rays it traced. */
+/* Renders one camera sample's path to its end (path_run, kernels/path.cl, as k_path
+ * does); returns the number of rays it traced. */
 static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *radiance)
 {
     PathState ps;
     Ray ray, shadow;
     memset(&shadow, 0, sizeof shadow);   /* written by shade_path only when it traces one */
-    uint64_t rays = 0;
-    raygen_path(sc->params, pixel, sample, &ps, &ray);
-    Ray first_ray = ray;
-    Hit first_hit = { 0 };
-    uint split = 0;
-    int restart = 0;
-    for (int first = 1;; first = 0) {
-        Hit hit;
-        if (restart) {
-            hit = first_hit;
-        } else {
-            hit = trace_closest_visible(sc, ray);
-            rays++;
-        }
-        if (first) first_hit = hit;
-        uint r = shade_path(sc, &ray, hit, &ps, &shadow);
-        if (first && (r & SHADE_SCATTERED)) split = params_split(sc->params) - 1u;
-        if (r & SHADE_SHADOW) {
-            shadow_resolve(&ps, trace_occluded(sc, shadow));
-            rays++;
-        }
-        restart = 0;
-        if (!(r & SHADE_CONTINUE)) {
-            if (split == 0) break;
-            split--;
-            path_branch_next(&ps);
-            ray = first_ray;
-            restart = 1;
-        }
-    }
+    uint64_t rays = path_run(sc, pixel, sample, &ps, &ray, &shadow);
     *radiance = ps.radiance;
     return rays;
 }
 
 /* render_path with the thread time of each stage added to t[enum DevicePhase]
- * (--profile; the clock reads cost some of the speed). */
+ * (--profile; the clock reads cost some of the speed): path_run's steps, timed. */
 static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, vec3 *radiance, double *t)
 {
     PathState ps;

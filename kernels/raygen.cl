@@ -61,7 +61,8 @@ KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
 /* Restarts the path of a camera sample as its next continuation from the first hit
  * (first-hit splitting, RenderParams.split): the state raygen_path gave it, but with the
  * radiance gathered so far and the next branch. The caller shades the first hit again,
- * which for a later branch only scatters (shade_path). */
+ * which for a later branch samples a light and scatters but adds no emission
+ * (shade_path). */
 KFN void path_branch_next(GLOBAL PathState *ps)
 {
     ps->throughput = v3s(1.0f);

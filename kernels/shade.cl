@@ -192,8 +192,9 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     ps->bounce = bounce + 1u;
     if (ps->bounce > p->rr_depth) {
         /* Russian roulette: continue with probability q, reweighted by 1/q; decided on
-         * the throughput before first-hit splitting's weight, which every path this far
-         * carries (without it, the dragon's error at split 2 was a third higher) */
+         * the throughput before first-hit splitting's weight 1/split, which every path
+         * this far carries, so that a continuation is cut no more often than an
+         * unsplit path */
         float q = k_fmin(v3_max_comp(thr) * (float)params_split(p), 0.95f);
         if (!(rng_uniform(key, bounce, DIM_ROULETTE) < q)) return result;
         thr = v3_scale(thr, 1.0f / q);

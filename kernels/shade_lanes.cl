@@ -343,7 +343,9 @@ KFN_INLINE uint lane_scatter(const LaneResults *r, uint l, GLOBAL Ray *ray, GLOB
  * k_path_lanes, whose cold build it made a fifth longer (bench/RESULTS.md). */
 KFN_INLINE uint shade_lane_end(const SceneView *sc, Ray r, Hit hit, GLOBAL PathState *ps)
 {
-    if (ps->bounce == 0u && ps->branch != 0u) return 0u;   /* a later branch: shade_path's */
+    /* a later branch of a split first hit adds no emission (shade_path); none comes
+     * here, since only a hit that scatters is split, but the rule is kept */
+    if (ps->bounce == 0u && ps->branch != 0u) return 0u;
     if (hit.prim == NO_INDEX) {
         shade_escape(sc, r, ps);
         return 0u;

@@ -32,7 +32,8 @@ peer's time that clpt needs to reach the peer's error (below 1: clpt is faster).
 Each renderer runs with its best settings for these scenes: Mitsuba with its multijitter
 sampler, Cycles with PMJ, clpt with --clpt-args, by default `--split 2` (two
 continuations from each camera sample's first hit, sharing its camera ray: on both
-scenes a fifth to a quarter less time x MSE than without, bench/RESULTS.md). Part of
+scenes a fifth to a quarter less time x MSE than without, with silhouettes left out as
+here; over whole images it costs the McGuire box 9% instead, bench/RESULTS.md). Part of
 that is the Sobol points' faster convergence at twice the continuations, which the
 peers would also see at twice their samples (clpt's plain 32 spp on the dragon: 0.88
 of 16 spp's time x MSE).

@@ -37,22 +37,46 @@ KFN_INLINE int trace_prim(const SceneView *sc, uint id, const RayPre *rp, Ray ra
 #define KD_T_ABOVE (1.0f + KD_T_SLACK)
 #define KD_T_BELOW (1.0f - KD_T_SLACK)
 
-/* Tests the primitives of leaf n (its record in leaf_data) against the ray (tmax: the closest hit so far, in
- * best->t); returns 1 when an any-hit query hit. The triangles are tested a group at a
- * time (triangle_intersect_group: the nearest lane hit, the first of equals, which is
- * what testing them one by one in lane order gives), then the spheres and boxes one by
- * one. */
+/* The float just above x (x > 0 and finite; the smallest one above 0 for 0). */
+KFN_INLINE float k_next_up(float x)
+{
+    return x > 0.0f ? k_as_float(k_as_uint(x) + 1u) : k_as_float(1u);
+}
+
+/* The distance up to which a primitive can still be the closest hit: best->t itself,
+ * which a primitive at the same t takes only with a lower global id (leaf_test). */
+KFN_INLINE float leaf_tmax(const Hit *best)
+{
+    return best->prim == NO_INDEX ? best->t : k_next_up(best->t);
+}
+
+/* Tests the primitives of leaf n (its record in leaf_data) against the ray (tmax: the
+ * closest hit so far, in best->t); returns 1 when an any-hit query hit. The triangles are
+ * tested a group at a time (triangle_intersect_group), then the spheres and boxes one by
+ * one. The closest hit is the primitive of least t and, of those at the same t (a ray
+ * through an edge two triangles share, coplanar triangles), of least global id (a leaf's
+ * ids are sorted, so within a leaf that is the first of equals, which is what
+ * triangle_intersect_group keeps; across leaves the id decides): a rule
+ * that does not depend on the order in which leaves are met, so the single-ray walk and
+ * the packet walk (trace_packet_wide), which meet them in different orders, find the same
+ * hit bit for bit. (A surface of revolution's t does depend on the hit found before it,
+ * revsurface.h.) */
 KFN_INLINE int leaf_test(const SceneView *sc, GLOBAL const uint *leaf_data, Ray ray, const RayPre *rp, int any,
                          KdNode n, Hit *best)
 {
     GLOBAL const uint *g = leaf_data + n.data;
     uint groups = n.bits >> 3;
+    float tmax = leaf_tmax(best);
     for (uint i = 0; i < groups; i++, g += KD_GROUP_WORDS) {
         Hit h;
-        if (triangle_intersect_group(rp, (GLOBAL const float *)(g + KD_GROUP), ray.tmin, best->t, &h)) {
+        if (triangle_intersect_group(rp, (GLOBAL const float *)(g + KD_GROUP), ray.tmin, tmax, &h)) {
             h.prim = g[h.prim];
-            *best = h;
-            if (any) return 1;
+            /* h.t <= best->t: at the same t, the lower id */
+            if (h.t < best->t || h.prim < best->prim) {
+                *best = h;
+                if (any) return 1;
+                tmax = k_next_up(h.t);
+            }
         }
     }
     if (n.bits & KD_LEAF_OTHERS) {
@@ -60,12 +84,13 @@ KFN_INLINE int leaf_test(const SceneView *sc, GLOBAL const uint *leaf_data, Ray 
         for (uint i = 1; i <= count; i++) {
             uint id = g[i];
             Ray r = ray;
-            r.tmax = best->t;
+            r.tmax = tmax;
             Hit h;
-            if (trace_prim(sc, id, rp, r, &h)) {
+            if (trace_prim(sc, id, rp, r, &h) && (h.t < best->t || id < best->prim)) {
                 h.prim = id;
                 *best = h;
                 if (any) return 1;
+                tmax = k_next_up(h.t);
             }
         }
     }

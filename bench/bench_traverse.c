@@ -32,8 +32,10 @@
  * turns (PoCL-2: k_trace_closest/k_trace_any) and packets of eight consecutive rays
  * (PoCL-8: k_trace_closest8/k_trace_any8, trace_packet), and walking the BVH with one
  * ray per work-item (PoCL-W: k_trace_closest_wide/k_trace_any_wide, the renderer's
- * walk), each on a sub-device of 1 compute unit and on the whole device (the kd-tree
- * kernels checked bit for bit against the C kd walk, the BVH's against the C BVH walk;
+ * walk) and in packets of eight consecutive rays (PoCL-W8: k_trace_closest_wide8/
+ * k_trace_any_wide8, trace_packet_wide), each on a sub-device of 1 compute unit and on
+ * the whole device (the kd-tree kernels checked bit for bit against the C kd walk, the
+ * BVH's against the C BVH walk;
  * "BVH vs kd" counts rays whose closest t or occlusion differs between the trees); the
  * scalar C traversal (kernels compiled as C) of the kd-tree in pairs (C) and of the BVH
  * (C-W) on 1 and 2 threads; Embree rtcIntersect1 /
@@ -365,6 +367,7 @@ typedef struct {
     cl_kernel kc1, ka1;          /* one ray per work-item */
     cl_kernel kc8, ka8;          /* packets of eight rays per work-item */
     cl_kernel kcw, kaw;          /* one ray per work-item through the 8-wide BVH */
+    cl_kernel kcw8, kaw8;        /* packets of eight rays through the 8-wide BVH */
     cl_program prog;
     cl_mem scene[SC_N], rays, out;
     size_t rays_cap;
@@ -400,7 +403,9 @@ static int pocl_open(Pocl *pc, const OclDeviceInfo *dev, cl_device_id sub)
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest8", &pc->kc8, &err) ||
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_any8", &pc->ka8, &err) ||
         ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest_wide", &pc->kcw, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any_wide", &pc->kaw, &err)) {
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any_wide", &pc->kaw, &err) ||
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest_wide8", &pc->kcw8, &err) ||
+        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any_wide8", &pc->kaw8, &err)) {
         fprintf(stderr, "bench_traverse: %s\n", err.msg);
         error_clear(&err);
         return -1;
@@ -431,6 +436,8 @@ static void pocl_close(Pocl *pc)
     if (pc->ka8) clReleaseKernel(pc->ka8);
     if (pc->kcw) clReleaseKernel(pc->kcw);
     if (pc->kaw) clReleaseKernel(pc->kaw);
+    if (pc->kcw8) clReleaseKernel(pc->kcw8);
+    if (pc->kaw8) clReleaseKernel(pc->kaw8);
     if (pc->prog) clReleaseProgram(pc->prog);
     if (pc->q) clReleaseCommandQueue(pc->q);
     if (pc->ctx) clReleaseContext(pc->ctx);
@@ -460,8 +467,8 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
     for (int i = 0; i < SC_N; i++)
         if (!pc->scene[i]) return -1;
     if (!pc->rays || !pc->out) return -1;
-    cl_kernel ks[8] = { pc->kc, pc->ka, pc->kc1, pc->ka1, pc->kc8, pc->ka8, pc->kcw, pc->kaw };
-    for (int k = 0; k < 8; k++) {
+    cl_kernel ks[10] = { pc->kc, pc->ka, pc->kc1, pc->ka1, pc->kc8, pc->ka8, pc->kcw, pc->kaw, pc->kcw8, pc->kaw8 };
+    for (int k = 0; k < 10; k++) {
         for (cl_uint i = 0; i < SC_N; i++)
             if (clSetKernelArg(ks[k], i, sizeof(cl_mem), &pc->scene[i]) != CL_SUCCESS) return -1;
         if (clSetKernelArg(ks[k], SC_N, sizeof(cl_mem), &pc->rays) != CL_SUCCESS ||
@@ -472,9 +479,9 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
 }
 
 /* The PoCL kernels: rays per work-item. */
-enum { POCL_SINGLE, POCL_PAIRS, POCL_PACKETS, POCL_WIDE, N_KERNELS };
-static const uint rays_per_item[N_KERNELS] = { 1, 2, 8, 1 };
-static const char *const kernel_label[N_KERNELS] = { "PoCL-1", "PoCL-2", "PoCL-8", "PoCL-W" };
+enum { POCL_SINGLE, POCL_PAIRS, POCL_PACKETS, POCL_WIDE, POCL_WIDE_PACKETS, N_KERNELS };
+static const uint rays_per_item[N_KERNELS] = { 1, 2, 8, 1, 8 };
+static const char *const kernel_label[N_KERNELS] = { "PoCL-1", "PoCL-2", "PoCL-8", "PoCL-W", "PoCL-W8" };
 
 /* Traces the set (its rays already uploaded) with kernel `kind`; returns seconds, or -1. */
 static double pocl_trace(Pocl *pc, const RaySet *s, int kind)
@@ -482,6 +489,7 @@ static double pocl_trace(Pocl *pc, const RaySet *s, int kind)
     cl_kernel k = kind == POCL_PAIRS ? (s->any ? pc->ka : pc->kc)
                   : kind == POCL_PACKETS ? (s->any ? pc->ka8 : pc->kc8)
                   : kind == POCL_WIDE    ? (s->any ? pc->kaw : pc->kcw)
+                  : kind == POCL_WIDE_PACKETS ? (s->any ? pc->kaw8 : pc->kcw8)
                                          : (s->any ? pc->ka1 : pc->kc1);
     cl_uint n = s->n;
     if (clSetKernelArg(k, SC_N + 1, sizeof n, &n) != CL_SUCCESS) return -1.0;
@@ -868,7 +876,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
             long d = 0;
             for (int kp = 0; kp < N_KERNELS && pocl_ok[t]; kp++) {
                 if (pocl_trace(&pocl[t], s, kp) < 0.0) pocl_ok[t] = 0;
-                else d += pocl_compare(&pocl[t], s, kp == POCL_WIDE);
+                else d += pocl_compare(&pocl[t], s, kp == POCL_WIDE || kp == POCL_WIDE_PACKETS);
             }
             if (pocl_ok[t]) r->pocl_diff = r->pocl_diff < 0 ? d : r->pocl_diff + d;
         }

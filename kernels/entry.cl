@@ -467,6 +467,35 @@ __kernel void k_trace_any8(SCENE_ARGS __global const Ray *rays, uint n, __global
     trace_packet_item(&sc, rays, n, 1, 0, occluded);
 }
 
+/* Packets of eight rays through the 8-wide BVH (trace_packet_wide). */
+KFN_INLINE void trace_packet_wide_item(const SceneView *sc, __global const Ray *rays, uint n, int any,
+                                       __global Hit *hits, __global uint *occluded)
+{
+    uint first = WIDE_PACKET * (uint)get_global_id(0);
+    if (first >= n) return;
+    Ray r[WIDE_PACKET];
+    Hit h[WIDE_PACKET];
+    uint count = n - first < WIDE_PACKET ? n - first : WIDE_PACKET;
+    for (uint l = 0; l < WIDE_PACKET; l++) r[l] = rays[first + (l < count ? l : 0u)];
+    trace_packet_wide(sc, r, any, h);
+    for (uint l = 0; l < count; l++) {
+        if (any) occluded[first + l] = (uint)(h[l].prim != NO_INDEX);
+        else hits[first + l] = h[l];
+    }
+}
+
+__kernel void k_trace_closest_wide8(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
+{
+    SCENE_VIEW(sc);
+    trace_packet_wide_item(&sc, rays, n, 0, hits, 0);
+}
+
+__kernel void k_trace_any_wide8(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
+{
+    SCENE_VIEW(sc);
+    trace_packet_wide_item(&sc, rays, n, 1, 0, occluded);
+}
+
 /* The same through the 8-wide BVH. */
 __kernel void k_trace_closest_wide(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
 {

@@ -437,4 +437,31 @@ KFN_INLINE void trace_packet(const SceneView *sc, const Ray *rays, int any, Hit 
     for (uint l = 0; l < TRACE_PACKET; l++) hits[l] = tr[l].best;
 }
 
+
+/* trace_closest (any == 0) or trace_any_hit (any == 1) of 8 rays through the BVH
+ * (trace_wide_packet_walk). Rays whose signs differ from the others' are walked one
+ * after the other instead. */
+KFN_INLINE void trace_packet_wide(const SceneView *sc, const Ray *rays, int any, Hit *hits)
+{
+    RayPre rp[WIDE_PACKET];
+    uint lanes = 0u, neg = 0u, mixed = 0u;
+    for (uint l = 0; l < WIDE_PACKET; l++) {
+        Ray ray = rays[l];
+        hits[l] = hit_none(ray);
+        if (trace_planes(sc, ray, any, &hits[l]) && any) continue;
+        float s = ray.o.x + ray.o.y + ray.o.z + ray.d.x + ray.d.y + ray.d.z;
+        if (!(s == s) || sc->params->n_bvh_nodes == 0u) continue;
+        rp[l] = ray_prepare(ray);
+        if (lanes == 0u) neg = rp[l].neg;
+        mixed |= rp[l].neg ^ neg;
+        lanes |= 1u << l;
+    }
+    if (mixed) {
+        for (uint l = 0; l < WIDE_PACKET; l++)
+            if ((lanes >> l) & 1u) trace_wide(sc, rays[l], &rp[l], any, &hits[l]);
+    } else if (lanes) {
+        trace_wide_packet_walk(sc, rays, rp, any, lanes, neg, hits);
+    }
+}
+
 #endif /* CLPT_TRAVERSE_CL */

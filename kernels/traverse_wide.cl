@@ -192,4 +192,154 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
     }
 }
 
+
+/* ------------------------------------------------------------------ eight rays at once */
+
+/* A packet walk for coherent rays through the BVH (camera rays through neighbouring
+ * pixels, shadow rays from neighbouring points toward one light): eight rays whose
+ * directions have the same signs go down the tree together. A node's boxes are loaded
+ * once for all of them and each box is tested against the eight rays as one float8, with
+ * each lane's own slab arithmetic (the same operations as bvh_lanes, so a lane enters a
+ * box exactly when its single walk would at the same tmax). The packet goes into the
+ * child that its nearest lane enters first and keeps the others on a stack with the
+ * lanes that entered them; on the pop the box is tested again against the lanes'
+ * closest hits so far. In the leaves each lane still in the walk tests the primitives
+ * alone (leaf_test). */
+#define WIDE_PACKET 8
+
+typedef struct {
+    float8 ox, oy, oz, ix, iy, iz, tmin;
+    uint nx, ny, nz;
+} BvhPacket;
+
+/* The lanes of `lanes` that enter child c of node nd within [tmin, tmax]; *lead gets
+ * the entry distance of the lowest of them. */
+KFN_INLINE uint bvh_child_lanes(GLOBAL const BvhNode *nd, uint c, const BvhPacket *p, float8 tmax, uint lanes,
+                                float *lead)
+{
+    float8 tn = (nd->box[p->nx][c] - p->ox) * p->ix, tf = (nd->box[1u - p->nx][c] - p->ox) * p->ix;
+    float8 ty = (nd->box[2u + p->ny][c] - p->oy) * p->iy, uy = (nd->box[3u - p->ny][c] - p->oy) * p->iy;
+    tn = k_select8(tn, ty, ty > tn);
+    tf = k_select8(tf, uy, uy < tf);
+    float8 tz = (nd->box[4u + p->nz][c] - p->oz) * p->iz, uz = (nd->box[5u - p->nz][c] - p->oz) * p->iz;
+    tn = k_select8(tn, tz, tz > tn);
+    tf = k_select8(tf, uz, uz < tf);
+    tn = k_select8(tn, p->tmin, p->tmin > tn);
+    tf = k_select8(tf, tmax, tmax < tf);
+    tf = tf * KD_T_ABOVE;
+    uint m = k_bits8(tn <= tf) & lanes;
+    if (m) {
+        float ta[WIDE_PACKET];
+        k_store8(tn, ta);
+        *lead = ta[k_lowest_bit(m)];
+    }
+    return m;
+}
+
+/* The packet walk of rays[l] for the lanes l in `lanes`, all of whose directions have
+ * the sign bits `neg`; best[l] holds each lane's closest hit so far (its t the ray's
+ * tmax at the start). */
+KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, const RayPre *rp, int any, uint lanes,
+                                       uint neg, Hit *best)
+{
+    float a[WIDE_PACKET * 7];
+    float tmax_a[WIDE_PACKET];
+    for (uint l = 0; l < WIDE_PACKET; l++) {
+        int on = (int)((lanes >> l) & 1u);
+        a[0 * WIDE_PACKET + l] = on ? rays[l].o.x : 0.0f;
+        a[1 * WIDE_PACKET + l] = on ? rays[l].o.y : 0.0f;
+        a[2 * WIDE_PACKET + l] = on ? rays[l].o.z : 0.0f;
+        a[3 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.x) : 1.0f;
+        a[4 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.y) : 1.0f;
+        a[5 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.z) : 1.0f;
+        a[6 * WIDE_PACKET + l] = on ? rays[l].tmin : 0.0f;
+        tmax_a[l] = best[l].t;
+    }
+    BvhPacket p;
+    k_load8(p.ox, a);
+    k_load8(p.oy, a + WIDE_PACKET);
+    k_load8(p.oz, a + 2 * WIDE_PACKET);
+    k_load8(p.ix, a + 3 * WIDE_PACKET);
+    k_load8(p.iy, a + 4 * WIDE_PACKET);
+    k_load8(p.iz, a + 5 * WIDE_PACKET);
+    k_load8(p.tmin, a + 6 * WIDE_PACKET);
+    p.nx = neg & 1u;
+    p.ny = (neg >> 1) & 1u;
+    p.nz = (neg >> 2) & 1u;
+    uint st_child[BVH_STACK];
+    uint st_lanes[BVH_STACK];
+    int sp = 0;
+    uint ref = 0u, kind = BVH_CHILD_NODE, done = 0u;
+    for (;;) {
+        if (kind == BVH_CHILD_NODE) {
+            GLOBAL const BvhNode *nd = sc->bvh + ref;
+            float8 tmax;
+            k_load8(tmax, tmax_a);
+            uint cm[BVH_WIDTH];
+            float ct[BVH_WIDTH];
+            uint hit = 0u;
+            for (uint c = 0; c < BVH_WIDTH; c++) {
+                if (nd->kind[c] == BVH_CHILD_NONE) break;
+                cm[c] = bvh_child_lanes(nd, c, &p, tmax, lanes, &ct[c]);
+                if (cm[c]) hit |= 1u << c;
+            }
+            if (hit) {
+                uint next = k_lowest_bit(hit), second = BVH_WIDTH;
+                if (!any)
+                    for (uint m = hit & (hit - 1u); m != 0u; m &= m - 1u) {
+                        uint c = k_lowest_bit(m);
+                        if (ct[c] < ct[next]) {
+                            second = next;
+                            next = c;
+                        } else if (second == BVH_WIDTH || ct[c] < ct[second]) {
+                            second = c;
+                        }
+                    }
+                for (uint m = hit; m != 0u; m &= m - 1u) {
+                    uint c = k_lowest_bit(m);
+                    if (c == next || c == second) continue;
+                    st_child[sp] = ref << 3 | c;
+                    st_lanes[sp] = cm[c];
+                    sp++;
+                }
+                if (second != BVH_WIDTH) {
+                    st_child[sp] = ref << 3 | second;
+                    st_lanes[sp] = cm[second];
+                    sp++;
+                }
+                lanes = cm[next];
+                kind = nd->kind[next];
+                ref = nd->ref[next];
+                continue;
+            }
+        } else {
+            KdNode leaf;
+            leaf.data = ref;
+            leaf.bits = kind;
+            for (uint m = lanes; m != 0u; m &= m - 1u) {
+                uint l = k_lowest_bit(m);
+                if (leaf_test(sc, sc->bvh_leaves, rays[l], &rp[l], any, leaf, &best[l])) done |= 1u << l;
+                tmax_a[l] = best[l].t;
+            }
+        }
+        /* the next entry on the stack that a lane not yet done still enters */
+        for (;;) {
+            if (sp == 0) return;
+            sp--;
+            lanes = st_lanes[sp] & ~done;
+            if (!lanes) continue;
+            GLOBAL const BvhNode *parent = sc->bvh + (st_child[sp] >> 3);
+            uint c = st_child[sp] & 7u;
+            float8 tmax;
+            k_load8(tmax, tmax_a);
+            float lead;
+            lanes = bvh_child_lanes(parent, c, &p, tmax, lanes, &lead);
+            if (!lanes) continue;
+            ref = parent->ref[c];
+            kind = parent->kind[c];
+            break;
+        }
+    }
+}
+
 #endif /* CLPT_TRAVERSE_WIDE_CL */

@@ -924,12 +924,13 @@ static void test_pairs(void)
     fprintf(stderr, "  %d pairs of rays, %d differ from the rays traced alone\n", total, differ);
 }
 
-/* Eight rays walked as a packet (trace_packet) give each ray bit for bit what it gets
- * alone: coherent packets (one origin, directions within a small cone, as a camera's
- * neighbouring pixels; or neighbouring origins toward one point, as shadow rays), some
- * with a NaN ray, a ray that misses the scene or a tmax that ends inside it, and
- * incoherent packets of random rays (mixed signs: walked one by one). */
-static void test_packets(void)
+/* Eight rays walked as a packet (trace_packet through the kd-tree, trace_packet_wide
+ * through the BVH) give each ray bit for bit what it gets alone: coherent packets (one
+ * origin, directions within a small cone, as a camera's neighbouring pixels; or
+ * neighbouring origins toward one point, as shadow rays), some with a NaN ray, a ray
+ * that misses the scene or a tmax that ends inside it, and incoherent packets of random
+ * rays (mixed signs: walked one by one). */
+static void packets_check(int wide)
 {
     struct { uint64_t seed; uint ns, nt, nb, np; } cases[] = {
         { 91, 40, 200, 25, 2 }, { 92, 0, 400, 0, 0 }, { 93, 120, 0, 60, 1 }, { 94, 0, 4000, 0, 0 },
@@ -965,12 +966,14 @@ static void test_packets(void)
             packed += !mixed;
             for (int any = 0; any < 2; any++) {
                 Hit h[TRACE_PACKET];
-                trace_packet(&scene.view, r, any, h);
+                const SceneView *v = wide ? &scene.wide_view : &scene.view;
+                if (wide) trace_packet_wide(v, r, any, h);
+                else trace_packet(v, r, any, h);
                 for (int l = 0; l < TRACE_PACKET; l++) {
                     if (any) {
-                        differ += (h[l].prim != NO_INDEX) != trace_any(&scene.view, r[l]);
+                        differ += (h[l].prim != NO_INDEX) != trace_any(v, r[l]);
                     } else {
-                        Hit ref = trace_closest(&scene.view, r[l]);
+                        Hit ref = trace_closest(v, r[l]);
                         differ += memcmp(&h[l], &ref, sizeof ref) != 0;
                     }
                     total++;
@@ -980,9 +983,12 @@ static void test_packets(void)
     }
     CHECK_EQ_INT(differ, 0);
     CHECK(packed > 4 * 3000 / 2);    /* most packets took the packet walk */
-    fprintf(stderr, "  %d rays in packets of %d (%d packets walked together), %d differ from the rays traced alone\n",
-            total, TRACE_PACKET, packed, differ);
+    fprintf(stderr, "  %s: %d rays in packets of %d (%d packets walked together), %d differ from the rays traced "
+            "alone\n", wide ? "BVH" : "kd-tree", total, TRACE_PACKET, packed, differ);
 }
+
+static void test_packets(void) { packets_check(0); }
+static void test_packets_wide(void) { packets_check(1); }
 
 static void test_empty_scene(void)
 {
@@ -1551,6 +1557,7 @@ int main(void)
     RUN(test_against_brute_force);
     RUN(test_pairs);
     RUN(test_packets);
+    RUN(test_packets_wide);
     RUN(test_bvh_structure);
     RUN(test_bvh_degenerate);
     RUN(test_bvh_deterministic);

@@ -434,9 +434,11 @@ __kernel void k_trace_any1(SCENE_ARGS __global const Ray *rays, uint n, __global
     SCENE_VIEW(sc);
     trace_one_item(&sc, rays, n, TREE_KD, 1, 0, occluded);
 }
+
 /* Closest hits (any == 0) or occlusion (any == 1: 1 or 0 in hits[i].prim's place, as
- * occluded[]) of rays[8i .. 8i+7], walked as one packet (trace_packet). */
-KFN_INLINE void trace_packet_item(const SceneView *sc, __global const Ray *rays, uint n, int any,
+ * occluded[]) of rays[8i .. 8i+7], walked as one packet through the given tree
+ * (trace_packet, trace_packet_wide). */
+KFN_INLINE void trace_packet_item(const SceneView *sc, __global const Ray *rays, uint n, int tree, int any,
                                   __global Hit *hits, __global uint *occluded)
 {
     uint first = TRACE_PACKET * (uint)get_global_id(0);
@@ -448,7 +450,8 @@ KFN_INLINE void trace_packet_item(const SceneView *sc, __global const Ray *rays,
         r[l] = rays[first + (l < count ? l : 0u)];
         /* a short last packet repeats its first ray, whose answer is then not stored */
     }
-    trace_packet(sc, r, any, h);
+    if (tree == TREE_BVH) trace_packet_wide(sc, r, any, h);
+    else trace_packet(sc, r, any, h);
     for (uint l = 0; l < count; l++) {
         if (any) occluded[first + l] = (uint)(h[l].prim != NO_INDEX);
         else hits[first + l] = h[l];
@@ -458,42 +461,26 @@ KFN_INLINE void trace_packet_item(const SceneView *sc, __global const Ray *rays,
 __kernel void k_trace_closest8(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
 {
     SCENE_VIEW(sc);
-    trace_packet_item(&sc, rays, n, 0, hits, 0);
+    trace_packet_item(&sc, rays, n, TREE_KD, 0, hits, 0);
 }
 
 __kernel void k_trace_any8(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
 {
     SCENE_VIEW(sc);
-    trace_packet_item(&sc, rays, n, 1, 0, occluded);
+    trace_packet_item(&sc, rays, n, TREE_KD, 1, 0, occluded);
 }
 
-/* Packets of eight rays through the 8-wide BVH (trace_packet_wide). */
-KFN_INLINE void trace_packet_wide_item(const SceneView *sc, __global const Ray *rays, uint n, int any,
-                                       __global Hit *hits, __global uint *occluded)
-{
-    uint first = WIDE_PACKET * (uint)get_global_id(0);
-    if (first >= n) return;
-    Ray r[WIDE_PACKET];
-    Hit h[WIDE_PACKET];
-    uint count = n - first < WIDE_PACKET ? n - first : WIDE_PACKET;
-    for (uint l = 0; l < WIDE_PACKET; l++) r[l] = rays[first + (l < count ? l : 0u)];
-    trace_packet_wide(sc, r, any, h);
-    for (uint l = 0; l < count; l++) {
-        if (any) occluded[first + l] = (uint)(h[l].prim != NO_INDEX);
-        else hits[first + l] = h[l];
-    }
-}
-
+/* The same through the 8-wide BVH (trace_packet_wide). */
 __kernel void k_trace_closest_wide8(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
 {
     SCENE_VIEW(sc);
-    trace_packet_wide_item(&sc, rays, n, 0, hits, 0);
+    trace_packet_item(&sc, rays, n, TREE_BVH, 0, hits, 0);
 }
 
 __kernel void k_trace_any_wide8(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
 {
     SCENE_VIEW(sc);
-    trace_packet_wide_item(&sc, rays, n, 1, 0, occluded);
+    trace_packet_item(&sc, rays, n, TREE_BVH, 1, 0, occluded);
 }
 
 /* The same through the 8-wide BVH. */

@@ -322,6 +322,9 @@ KFN void trace_any2(const SceneView *sc, Ray ra, Ray rb, int *oa, int *ob)
  * (trace_any's), which test_kdtree checks in C and bench_traverse on PoCL. Rays whose
  * signs differ from the others' are walked one after the other instead. */
 #define TRACE_PACKET 8
+#if TRACE_PACKET != WIDE_PACKET
+#error "the kd-tree's and the BVH's packets are of the same size (k_trace_closest8, k_trace_closest_wide8)"
+#endif
 
 typedef struct {
     uint node[KD_MAX_DEPTH];

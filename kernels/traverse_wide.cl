@@ -93,6 +93,45 @@ KFN_INLINE float bvh_inv(float d)
     return 1.0f / (k_fabs(d) < BVH_TINY ? s : d);
 }
 
+/* Of a node's children entered (the lanes in mask), returns the one to
+ * go into: the nearest by entry distance d for a closest-hit query (the first lane of
+ * equals), the first for an any-hit query, for which any order will do. Pushes the
+ * others as node << 3 | lane with a word each: the bits of the entry distance (lanes
+ * NULL: one ray) or lanes[lane] (a packet: the lanes that entered the child), the second
+ * nearest last so that it is popped next. Sorting all of them was measured slower: the
+ * entries that start beyond the closest hit are skipped on the pop anyway; the second
+ * nearest alone made closest-hit diffuse rays 3-11% faster (docs/bvh.md). */
+KFN_INLINE uint bvh_push_children(uint ref, uint mask, const float *d, const uint *lanes, int any, uint *st_child,
+                                  uint *st_word, int *sp)
+{
+    uint next = k_lowest_bit(mask), second = BVH_WIDTH;
+    if (!any)
+        for (uint m = mask & (mask - 1u); m != 0u; m &= m - 1u) {
+            uint l = k_lowest_bit(m);
+            if (d[l] < d[next]) {
+                second = next;
+                next = l;
+            } else if (second == BVH_WIDTH || d[l] < d[second]) {
+                second = l;
+            }
+        }
+    int n = *sp;
+    for (uint m = mask; m != 0u; m &= m - 1u) {
+        uint l = k_lowest_bit(m);
+        if (l == next || l == second) continue;
+        st_child[n] = ref << 3 | l;
+        st_word[n] = lanes ? lanes[l] : k_as_uint(d[l]);
+        n++;
+    }
+    if (second != BVH_WIDTH) {
+        st_child[n] = ref << 3 | second;
+        st_word[n] = lanes ? lanes[second] : k_as_uint(d[second]);
+        n++;
+    }
+    *sp = n;
+    return next;
+}
+
 /* In a program of k_path_lanes alone the walk is one function that its closest-hit and
  * any-hit queries call: inlined into both, it made PoCL's cold build of cornell-box.scene
  * a third longer (3.2 s against 2.4 s on a 2.5 GHz Xeon) at the same speed. Everything
@@ -123,9 +162,9 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
     w.nz = (rp->neg >> 2) & 1u;
     /* an entry: the child's node and lane (node << 3 | lane; its reference and kind are
      * read back from the node, in cache, on the pop: a third less private memory than
-     * keeping them), and its entry distance */
+     * keeping them), and its entry distance's bits */
     uint st_child[BVH_STACK];
-    float st_t[BVH_STACK];
+    uint st_t[BVH_STACK];
     int sp = 0;
     uint ref = 0u, kind = BVH_CHILD_NODE;
     for (;;) {
@@ -140,36 +179,8 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
                     kind = nd->kind[l0];
                     continue;
                 }
-                /* Several children: go on into the nearest (a closest-hit query; the
-                 * first lane of equals) or the first (an any-hit query, for which
-                 * any order will do), push the others with their entry distances, the
-                 * second nearest last so that it is popped next. Sorting all of them
-                 * was measured slower: the entries that start beyond the closest hit
-                 * are skipped on the pop anyway; the second nearest alone made
-                 * closest-hit diffuse rays 3-11% faster (docs/bvh.md). */
-                uint next = l0, second = BVH_WIDTH;
-                if (!any)
-                    for (uint m = mask & (mask - 1u); m != 0u; m &= m - 1u) {
-                        uint l = k_lowest_bit(m);
-                        if (ta[l] < ta[next]) {
-                            second = next;
-                            next = l;
-                        } else if (second == BVH_WIDTH || ta[l] < ta[second]) {
-                            second = l;
-                        }
-                    }
-                for (uint m = mask; m != 0u; m &= m - 1u) {
-                    uint l = k_lowest_bit(m);
-                    if (l == next || l == second) continue;
-                    st_child[sp] = ref << 3 | l;
-                    st_t[sp] = ta[l];
-                    sp++;
-                }
-                if (second != BVH_WIDTH) {
-                    st_child[sp] = ref << 3 | second;
-                    st_t[sp] = ta[second];
-                    sp++;
-                }
+                /* several children: bvh_push_children */
+                uint next = bvh_push_children(ref, mask, ta, 0, any, st_child, st_t, &sp);
                 ref = nd->ref[next];
                 kind = nd->kind[next];
                 continue;
@@ -184,7 +195,7 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
         do {
             if (sp == 0) return;
             sp--;
-        } while (st_t[sp] > best->t * KD_T_ABOVE);
+        } while (k_as_float(st_t[sp]) > best->t * KD_T_ABOVE);
         GLOBAL const BvhNode *parent = sc->bvh + (st_child[sp] >> 3);
         uint lane = st_child[sp] & 7u;
         ref = parent->ref[lane];
@@ -284,29 +295,7 @@ KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, con
                 if (cm[c]) hit |= 1u << c;
             }
             if (hit) {
-                uint next = k_lowest_bit(hit), second = BVH_WIDTH;
-                if (!any)
-                    for (uint m = hit & (hit - 1u); m != 0u; m &= m - 1u) {
-                        uint c = k_lowest_bit(m);
-                        if (ct[c] < ct[next]) {
-                            second = next;
-                            next = c;
-                        } else if (second == BVH_WIDTH || ct[c] < ct[second]) {
-                            second = c;
-                        }
-                    }
-                for (uint m = hit; m != 0u; m &= m - 1u) {
-                    uint c = k_lowest_bit(m);
-                    if (c == next || c == second) continue;
-                    st_child[sp] = ref << 3 | c;
-                    st_lanes[sp] = cm[c];
-                    sp++;
-                }
-                if (second != BVH_WIDTH) {
-                    st_child[sp] = ref << 3 | second;
-                    st_lanes[sp] = cm[second];
-                    sp++;
-                }
+                uint next = bvh_push_children(ref, hit, ct, cm, any, st_child, st_lanes, &sp);
                 lanes = cm[next];
                 kind = nd->kind[next];
                 ref = nd->ref[next];

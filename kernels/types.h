@@ -104,7 +104,8 @@ typedef struct {
  * its kind: BVH_CHILD_NONE for an unused lane (its box is empty: lo +inf, hi -inf),
  * BVH_CHILD_NODE with ref the child's node index, or a leaf's KdNode bits (KD_LEAF,
  * which is never 0 or 1) with ref the offset of its record in the leaf data, which
- * has the kd-tree's leaf layout (above). Node 0 is the root. */
+ * has the kd-tree's leaf layout (above). A node's children are in lanes 0 .. n-1, its
+ * unused lanes after them (the packet walk stops at the first). Node 0 is the root. */
 #define BVH_WIDTH 8u
 /* Entries of the walk's stack: the build keeps every path's sum of (children - 1), what
  * a walk leaves on the stack above a node, within it (host/accel/bvh.c). */

@@ -69,54 +69,25 @@ static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *
 }
 
 /* render_path with the thread time of each stage added to t[enum DevicePhase]
- * (--profile; the clock reads cost some of the speed): path_run's steps, timed. */
+ * (--profile; the clock reads cost some of the speed): path_run's loop, timed. */
 static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, vec3 *radiance, double *t)
 {
-    PathState ps;
-    Ray ray, shadow;
+    PathState path;
+    Ray ray_buf, shadow;
     memset(&shadow, 0, sizeof shadow);
-    uint64_t rays = 0;
-    double t0 = timer_now(), t1;
-    raygen_path(sc->params, pixel, sample, &ps, &ray);
-    t1 = timer_now();
-    t[PHASE_RAYGEN] += t1 - t0;
-    Ray first_ray = ray;
-    Hit first_hit = { 0 };
-    uint split = 0;
-    int restart = 0;
-    for (int first = 1;; first = 0) {
-        Hit hit;
-        if (restart) {
-            hit = first_hit;
-        } else {
-            hit = trace_closest_visible(sc, ray);
-            rays++;
-        }
-        if (first) first_hit = hit;
-        t0 = timer_now();
-        t[PHASE_TRAVERSE] += t0 - t1;
-        uint r = shade_path(sc, &ray, hit, &ps, &shadow);
-        t1 = timer_now();
-        t[PHASE_SHADE] += t1 - t0;
-        if (first && (r & SHADE_SCATTERED)) split = params_split(sc->params) - 1u;
-        if (r & SHADE_SHADOW) {
-            shadow_resolve(&ps, trace_occluded(sc, shadow));
-            rays++;
-            t0 = timer_now();
-            t[PHASE_SHADOW] += t0 - t1;
-            t1 = t0;
-        }
-        restart = 0;
-        if (!(r & SHADE_CONTINUE)) {
-            if (split == 0) break;
-            split--;
-            path_branch_next(&ps);
-            ray = first_ray;
-            restart = 1;
-        }
-    }
-    *radiance = ps.radiance;
-    return rays;
+    PathState *ps = &path;
+    Ray *ray = &ray_buf, *shadow_ray = &shadow;
+    double clock = timer_now();
+#define PATH_STAGE_TIMED(phase)            \
+    do {                                   \
+        double now = timer_now();          \
+        t[phase] += now - clock;           \
+        clock = now;                       \
+    } while (0)
+    PATH_RUN_BODY(PATH_STAGE_TIMED)
+#undef PATH_STAGE_TIMED
+    *radiance = ps->radiance;
+    return n_rays;
 }
 
 /* Whether the batch is to be dropped; checked before each chunk, so a cancel is seen

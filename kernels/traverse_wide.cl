@@ -225,8 +225,8 @@ typedef struct {
 
 /* The lanes of `lanes` that enter child c of node nd within [tmin, tmax]; *lead gets
  * the entry distance of the lowest of them. */
-KFN_INLINE uint bvh_child_lanes(GLOBAL const BvhNode *nd, uint c, const BvhPacket *p, float8 tmax, uint lanes,
-                                float *lead)
+KFN_INLINE uint bvh_child_lanes(GLOBAL const BvhNode *nd, uint c, const BvhPacket *p, const float8 *tmax,
+                                uint lanes, float *lead)
 {
     float8 tn = (nd->box[p->nx][c] - p->ox) * p->ix, tf = (nd->box[1u - p->nx][c] - p->ox) * p->ix;
     float8 ty = (nd->box[2u + p->ny][c] - p->oy) * p->iy, uy = (nd->box[3u - p->ny][c] - p->oy) * p->iy;
@@ -236,7 +236,7 @@ KFN_INLINE uint bvh_child_lanes(GLOBAL const BvhNode *nd, uint c, const BvhPacke
     tn = k_select8(tn, tz, tz > tn);
     tf = k_select8(tf, uz, uz < tf);
     tn = k_select8(tn, p->tmin, p->tmin > tn);
-    tf = k_select8(tf, tmax, tmax < tf);
+    tf = k_select8(tf, *tmax, *tmax < tf);
     tf = tf * KD_T_ABOVE;
     uint m = k_bits8(tn <= tf) & lanes;
     if (m) {
@@ -291,7 +291,7 @@ KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, con
             uint hit = 0u;
             for (uint c = 0; c < BVH_WIDTH; c++) {
                 if (nd->kind[c] == BVH_CHILD_NONE) break;
-                cm[c] = bvh_child_lanes(nd, c, &p, tmax, lanes, &ct[c]);
+                cm[c] = bvh_child_lanes(nd, c, &p, &tmax, lanes, &ct[c]);
                 if (cm[c]) hit |= 1u << c;
             }
             if (hit) {
@@ -322,7 +322,7 @@ KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, con
             float8 tmax;
             k_load8(tmax, tmax_a);
             float lead;
-            lanes = bvh_child_lanes(parent, c, &p, tmax, lanes, &lead);
+            lanes = bvh_child_lanes(parent, c, &p, &tmax, lanes, &lead);
             if (!lanes) continue;
             ref = parent->ref[c];
             kind = parent->kind[c];

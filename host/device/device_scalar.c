@@ -77,12 +77,12 @@ static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, 
     memset(&shadow, 0, sizeof shadow);
     PathState *ps = &path;
     Ray *ray = &ray_buf, *shadow_ray = &shadow;
-    double clock = timer_now();
+    double t_last = timer_now();
 #define PATH_STAGE_TIMED(phase)            \
     do {                                   \
         double now = timer_now();          \
-        t[phase] += now - clock;           \
-        clock = now;                       \
+        t[phase] += now - t_last;          \
+        t_last = now;                      \
     } while (0)
     PATH_RUN_BODY(PATH_STAGE_TIMED)
 #undef PATH_STAGE_TIMED

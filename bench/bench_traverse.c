@@ -36,7 +36,8 @@
  * k_trace_any_wide8, trace_packet_wide), each on a sub-device of 1 compute unit and on
  * the whole device (the kd-tree kernels checked bit for bit against the C kd walk, the
  * BVH's against the C BVH walk;
- * "BVH vs kd" counts rays whose closest t or occlusion differs between the trees); the
+ * "BVH vs kd" counts rays whose closest hit, all of it, or occlusion differs between
+ * the trees: both follow one tie rule, leaf_test); the
  * scalar C traversal (kernels compiled as C) of the kd-tree in pairs (C) and of the BVH
  * (C-W) on 1 and 2 threads; Embree rtcIntersect1 /
  * rtcOccluded1 and rtcIntersect8 / rtcOccluded8 packets (8 consecutive rays) on 1 and 2
@@ -864,7 +865,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
             r->hits += s->any ? s->ref_occ[i] : s->ref_hits[i].prim != NO_INDEX;
             /* the same t: the same closest distance; another primitive only on a tie */
             if (s->any) r->wide_diff += s->ref_occ[i] != s->wide_occ[i];
-            else r->wide_diff += s->ref_hits[i].t != s->wide_hits[i].t;
+            else r->wide_diff += memcmp(&s->ref_hits[i], &s->wide_hits[i], sizeof(Hit)) != 0;
         }
         /* check first */
         r->pocl_diff = r->embree_diff = -1;

@@ -111,15 +111,25 @@ KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, KdStack *st, int 
 }
 
 /* The visit of leaf n: its primitives (leaf_test); returns 1 when the walk is over:
- * an any-hit query hit, or nothing is left on the stack, or the closest hit is no
- * farther than the end of this cell (every cell on the stack starts there or later).
- * Otherwise pops the next cell. */
+ * an any-hit query hit, or nothing is left on the stack, or the next cell starts beyond
+ * the closest hit. Otherwise pops the next cell.
+ *
+ * A cell can hold the closest hit if it starts no farther than the closest hit so far:
+ * a primitive at the very same t that lies in the next cell alone is the closest hit
+ * if its id is lower (the tie rule, leaf_test), and rounding can put the plane between
+ * two cells a few ulps either side of a hit on it. So the walk goes on while the next
+ * cell starts within KD_T_SLACK of the closest hit, the slack of the plane tests, and
+ * finds what the BVH's walk and a test of every primitive find (test_kdtree aims rays at
+ * the corners and edges of meshes). Cells on the stack start at or after this one's
+ * end, so a hit well short of it ends the walk without looking. */
 KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, KdNode n, KdWalk *w,
                        const KdStack *st, Hit *best)
 {
     if (leaf_test(sc, sc->leaf_prims, ray, rp, any, n, best)) return 1;
-    if ((w->sp == 0) | (best->t <= w->t1)) return 1;
+    float reach = best->t * KD_T_ABOVE;
+    if ((w->sp == 0) | (reach < w->t1)) return 1;
     int sp = w->sp - 1;
+    if (st->t0[sp] > reach) return 1;
     w->sp = sp;
     w->node = st->node[sp];
     w->t0 = st->t0[sp];
@@ -360,6 +370,10 @@ KFN_INLINE void trace_packet_walk(const SceneView *sc, TraceRay *tr, const RayPr
     KdPacketStack st;
     int sp = 0;
     uint node = 0u, done = 0u;
+    /* each lane's closest hit so far with the slack, and the lanes whose next pop is
+     * the one after a leaf, which kd_leaf checks against it */
+    float reach[TRACE_PACKET] = { 0.0f };
+    uint after_leaf = 0u;
     for (;;) {
         KdNode n = nodes[node];
         if ((n.bits & 3u) != KD_LEAF) {
@@ -397,17 +411,29 @@ KFN_INLINE void trace_packet_walk(const SceneView *sc, TraceRay *tr, const RayPr
             t1 = k_select8(t1, tp, tp < t1);
             continue;
         }
+        /* kd_leaf for every lane in the leaf: a lane is done when its any-hit query
+         * hit or its closest hit is well short of the cell's end, and otherwise when the
+         * next cell it would visit starts beyond its closest hit (below) */
         float end[TRACE_PACKET];
         k_store8(t1, end);
         for (uint l = 0; l < TRACE_PACKET; l++) {
             if (!((lanes >> l) & 1u)) continue;
-            if (leaf_test(sc, sc->leaf_prims, tr[l].ray, &rp[l], tr[l].any, n, &tr[l].best) || tr[l].best.t <= end[l])
+            if (leaf_test(sc, sc->leaf_prims, tr[l].ray, &rp[l], tr[l].any, n, &tr[l].best))
                 done |= 1u << l;
+            reach[l] = tr[l].best.t * KD_T_ABOVE;
+            if (reach[l] < end[l]) done |= 1u << l;
         }
+        after_leaf = (after_leaf | lanes) & ~done;
         for (;;) {
             if (sp == 0) return;
             sp--;
             lanes = st.lanes[sp] & ~done;
+            float8 r;
+            k_load8(r, reach);
+            uint beyond = k_bits8(st.t0[sp] > r) & lanes & after_leaf;
+            done |= beyond;
+            lanes &= ~beyond;
+            after_leaf &= ~lanes;
             if (lanes) break;
         }
         node = st.node[sp];

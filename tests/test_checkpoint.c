@@ -442,7 +442,8 @@ static void test_other_renders_are_refused(void)
                  path_out, "--resume", path_ck), &r);
     CHECK_EQ_INT(r.status, 3);
     CHECK_STR_CONTAINS(r.err, "sampler, shadows or --accel setting");
-    /* ... or the other tree: hits tied at one distance may go to another primitive */
+    /* ... or the other tree: its buffers are part of the key (the two trees give the
+     * same hits but on surfaces of revolution, whose last bits depend on the walk) */
     cli_run(ARGS(SCENE, "-q", "--device", "scalar", SIZE, "--spp", SPP_TEXT, "--accel", "kdtree", "-o", path_out,
                  "--resume", path_ck), &r);
     CHECK_EQ_INT(r.status, 3);

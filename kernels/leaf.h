@@ -60,8 +60,8 @@ KFN_INLINE float leaf_tmax(const Hit *best)
  * that does not depend on the order in which leaves are met, so the single-ray walk and
  * the packet walk (trace_packet_wide), which meet them in different orders, find the same
  * hit bit for bit, and so does the kd-tree's walk (kd_leaf goes on into a cell that
- * starts at the closest hit). (A surface of revolution's t does depend on the hit found before it,
- * revsurface.h.) */
+ * starts at the closest hit). (A surface of revolution's t does depend on the hit found
+ * before it, revsurface.h.) */
 KFN_INLINE int leaf_test(const SceneView *sc, GLOBAL const uint *leaf_data, Ray ray, const RayPre *rp, int any,
                          KdNode n, Hit *best)
 {

@@ -14,7 +14,12 @@
  * before its reciprocal (as Embree does), which keeps every slab distance a number:
  * (plane - origin) * 1e30 is 0 for a ray in a box's face plane, which counts as inside.
  * The far distance is widened by KD_T_SLACK, like the kd-tree's plane tests, so that
- * rounding never drops a box whose primitive the ray hits on its face.
+ * rounding never drops a box whose primitive the ray hits on its face: the far planes
+ * are scaled by reciprocals widened once per ray, and the closest hit once per node,
+ * rather than the result, whose multiply would sit in the chain from a node's loads to
+ * the next node (as do the min and max, taken as two levels rather than three). Which
+ * boxes are entered may differ by an ulp's worth from the product of the result; every
+ * walk still finds the same hit (leaf_test's rule, tested against brute force).
  */
 #ifndef CLPT_TRAVERSE_WIDE_CL
 #define CLPT_TRAVERSE_WIDE_CL
@@ -34,21 +39,19 @@
     VT a, b;                                                                             \
     LOAD(a, nd->box[w->nx] + first);                                                     \
     LOAD(b, nd->box[1u - w->nx] + first);                                                \
-    VT tn = (a - w->ox) * w->ix, tf = (b - w->ox) * w->ix;                               \
+    VT tx = (a - w->ox) * w->ix, ux = (b - w->ox) * w->fx;                               \
     LOAD(a, nd->box[2u + w->ny] + first);                                                \
     LOAD(b, nd->box[3u - w->ny] + first);                                                \
-    VT ty = (a - w->oy) * w->iy, uy = (b - w->oy) * w->iy;                               \
-    tn = SELECT(tn, ty, ty > tn);                                                        \
-    tf = SELECT(tf, uy, uy < tf);                                                        \
+    VT ty = (a - w->oy) * w->iy, uy = (b - w->oy) * w->fy;                               \
     LOAD(a, nd->box[4u + w->nz] + first);                                                \
     LOAD(b, nd->box[5u - w->nz] + first);                                                \
-    VT tz = (a - w->oz) * w->iz, uz = (b - w->oz) * w->iz;                               \
-    VT lo = SPLAT(w->tmin), hi = SPLAT(tmax);                                            \
-    tn = SELECT(tn, tz, tz > tn);                                                        \
-    tf = SELECT(tf, uz, uz < tf);                                                        \
-    tn = SELECT(tn, lo, lo > tn);                                                        \
-    tf = SELECT(tf, hi, hi < tf);                                                        \
-    tf = tf * KD_T_ABOVE;                                                                \
+    VT tz = (a - w->oz) * w->iz, uz = (b - w->oz) * w->fz;                               \
+    VT lo = SPLAT(w->tmin), hi = SPLAT(tfar);                                            \
+    tx = SELECT(tx, ty, ty > tx);                                                        \
+    ux = SELECT(ux, uy, uy < ux);                                                        \
+    tz = SELECT(tz, lo, lo > tz);                                                        \
+    uz = SELECT(uz, hi, hi < uz);                                                        \
+    VT tn = SELECT(tx, tz, tz > tx), tf = SELECT(ux, uz, uz < ux);                       \
     IT in_box = tn <= tf;                                                                \
     uint mask = BITS(in_box);                                                            \
     STORE(tn, ta + first);
@@ -56,12 +59,13 @@
 /* The ray as the slab tests use it (see above). */
 typedef struct {
     float ox, oy, oz, ix, iy, iz, tmin;
+    float fx, fy, fz;            /* ix, iy, iz widened by KD_T_SLACK: for the far planes */
     uint nx, ny, nz;             /* 1 where the direction is negative: near plane is hi */
 } BvhRay;
 
 #ifdef KERNEL_OPENCL
 #define K_SPLAT8(x) ((float8)(x))
-KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tmax, float *ta)
+KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
 {
     BVH_LANES_BODY(float8, int8, 8, k_load8, k_store8, K_SPLAT8, k_select8, k_bits8)
     return mask;
@@ -69,7 +73,7 @@ KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first,
 #else
 #define K_SPLAT4(x) ((float4){ (x), (x), (x), (x) })
 #define k_select4(a, b, m) ((float4)(((int4)(a) & ~(m)) | ((int4)(b) & (m))))
-KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tmax, float *ta)
+KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
 {
     BVH_LANES_BODY(float4, int4, 4, k_load4, k_store4, K_SPLAT4, k_select4, k_bits4)
     return mask;
@@ -80,10 +84,11 @@ KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first,
  * in ta. */
 KFN_INLINE uint bvh_node_test(GLOBAL const BvhNode *nd, const BvhRay *w, float tmax, float *ta)
 {
+    float tfar = tmax * KD_T_ABOVE;
 #ifdef KERNEL_OPENCL
-    return bvh_lanes(nd, w, 0u, tmax, ta);
+    return bvh_lanes(nd, w, 0u, tfar, ta);
 #else
-    return bvh_lanes(nd, w, 0u, tmax, ta) | (bvh_lanes(nd, w, 4u, tmax, ta) << 4);
+    return bvh_lanes(nd, w, 0u, tfar, ta) | (bvh_lanes(nd, w, 4u, tfar, ta) << 4);
 #endif
 }
 
@@ -157,6 +162,9 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
     w.iy = bvh_inv(ray.d.y);
     w.iz = bvh_inv(ray.d.z);
     w.tmin = ray.tmin;
+    w.fx = w.ix * KD_T_ABOVE;
+    w.fy = w.iy * KD_T_ABOVE;
+    w.fz = w.iz * KD_T_ABOVE;
     w.nx = rp->neg & 1u;
     w.ny = (rp->neg >> 1) & 1u;
     w.nz = (rp->neg >> 2) & 1u;
@@ -168,24 +176,19 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
     int sp = 0;
     uint ref = 0u, kind = BVH_CHILD_NODE;
     for (;;) {
-        if (kind == BVH_CHILD_NODE) {
+        /* down through nodes until a leaf, or a node none of whose boxes the ray enters */
+        while (kind == BVH_CHILD_NODE) {
             GLOBAL const BvhNode *nd = sc->bvh + ref;
             float ta[BVH_WIDTH];
             uint mask = bvh_node_test(nd, &w, best->t, ta);
-            if (mask) {
-                uint l0 = k_lowest_bit(mask);
-                if ((mask & (mask - 1u)) == 0u) {   /* one child hit: no stack */
-                    ref = nd->ref[l0];
-                    kind = nd->kind[l0];
-                    continue;
-                }
-                /* several children: bvh_push_children */
-                uint next = bvh_push_children(ref, mask, ta, 0, any, st_child, st_t, &sp);
-                ref = nd->ref[next];
-                kind = nd->kind[next];
-                continue;
-            }
-        } else {
+            if (!mask) break;
+            uint next = k_lowest_bit(mask);
+            if (mask & (mask - 1u))   /* several children: bvh_push_children */
+                next = bvh_push_children(ref, mask, ta, 0, any, st_child, st_t, &sp);
+            ref = nd->ref[next];
+            kind = nd->kind[next];
+        }
+        if (kind != BVH_CHILD_NODE) {
             KdNode leaf;
             leaf.data = ref;
             leaf.bits = kind;
@@ -220,24 +223,23 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
 
 typedef struct {
     float8 ox, oy, oz, ix, iy, iz, tmin;
+    float8 fx, fy, fz;
     uint nx, ny, nz;
 } BvhPacket;
 
 /* The lanes of `lanes` that enter child c of node nd within [tmin, tmax]; *lead gets
  * the entry distance of the lowest of them. */
-KFN_INLINE uint bvh_child_lanes(GLOBAL const BvhNode *nd, uint c, const BvhPacket *p, const float8 *tmax,
+KFN_INLINE uint bvh_child_lanes(GLOBAL const BvhNode *nd, uint c, const BvhPacket *p, const float8 *tfar,
                                 uint lanes, float *lead)
 {
-    float8 tn = (nd->box[p->nx][c] - p->ox) * p->ix, tf = (nd->box[1u - p->nx][c] - p->ox) * p->ix;
-    float8 ty = (nd->box[2u + p->ny][c] - p->oy) * p->iy, uy = (nd->box[3u - p->ny][c] - p->oy) * p->iy;
-    tn = k_select8(tn, ty, ty > tn);
-    tf = k_select8(tf, uy, uy < tf);
-    float8 tz = (nd->box[4u + p->nz][c] - p->oz) * p->iz, uz = (nd->box[5u - p->nz][c] - p->oz) * p->iz;
-    tn = k_select8(tn, tz, tz > tn);
-    tf = k_select8(tf, uz, uz < tf);
-    tn = k_select8(tn, p->tmin, p->tmin > tn);
-    tf = k_select8(tf, *tmax, *tmax < tf);
-    tf = tf * KD_T_ABOVE;
+    float8 tx = (nd->box[p->nx][c] - p->ox) * p->ix, ux = (nd->box[1u - p->nx][c] - p->ox) * p->fx;
+    float8 ty = (nd->box[2u + p->ny][c] - p->oy) * p->iy, uy = (nd->box[3u - p->ny][c] - p->oy) * p->fy;
+    float8 tz = (nd->box[4u + p->nz][c] - p->oz) * p->iz, uz = (nd->box[5u - p->nz][c] - p->oz) * p->fz;
+    tx = k_select8(tx, ty, ty > tx);
+    ux = k_select8(ux, uy, uy < ux);
+    tz = k_select8(tz, p->tmin, p->tmin > tz);
+    uz = k_select8(uz, *tfar, *tfar < uz);
+    float8 tn = k_select8(tx, tz, tz > tx), tf = k_select8(ux, uz, uz < ux);
     uint m = k_bits8(tn <= tf) & lanes;
     if (m) {
         float ta[WIDE_PACKET];
@@ -254,7 +256,7 @@ KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, con
                                        uint neg, Hit *best)
 {
     float a[WIDE_PACKET * 7];
-    float tmax_a[WIDE_PACKET];
+    float tfar_a[WIDE_PACKET];   /* each lane's closest hit so far, widened as tfar in bvh_lanes */
     for (uint l = 0; l < WIDE_PACKET; l++) {
         int on = (int)((lanes >> l) & 1u);
         a[0 * WIDE_PACKET + l] = on ? rays[l].o.x : 0.0f;
@@ -264,7 +266,7 @@ KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, con
         a[4 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.y) : 1.0f;
         a[5 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.z) : 1.0f;
         a[6 * WIDE_PACKET + l] = on ? rays[l].tmin : 0.0f;
-        tmax_a[l] = best[l].t;
+        tfar_a[l] = best[l].t * KD_T_ABOVE;
     }
     BvhPacket p;
     k_load8(p.ox, a);
@@ -274,6 +276,9 @@ KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, con
     k_load8(p.iy, a + 4 * WIDE_PACKET);
     k_load8(p.iz, a + 5 * WIDE_PACKET);
     k_load8(p.tmin, a + 6 * WIDE_PACKET);
+    p.fx = p.ix * KD_T_ABOVE;
+    p.fy = p.iy * KD_T_ABOVE;
+    p.fz = p.iz * KD_T_ABOVE;
     p.nx = neg & 1u;
     p.ny = (neg >> 1) & 1u;
     p.nz = (neg >> 2) & 1u;
@@ -284,14 +289,14 @@ KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, con
     for (;;) {
         if (kind == BVH_CHILD_NODE) {
             GLOBAL const BvhNode *nd = sc->bvh + ref;
-            float8 tmax;
-            k_load8(tmax, tmax_a);
+            float8 tfar;
+            k_load8(tfar, tfar_a);
             uint cm[BVH_WIDTH];
             float ct[BVH_WIDTH];
             uint hit = 0u;
             for (uint c = 0; c < BVH_WIDTH; c++) {
                 if (nd->kind[c] == BVH_CHILD_NONE) break;
-                cm[c] = bvh_child_lanes(nd, c, &p, &tmax, lanes, &ct[c]);
+                cm[c] = bvh_child_lanes(nd, c, &p, &tfar, lanes, &ct[c]);
                 if (cm[c]) hit |= 1u << c;
             }
             if (hit) {
@@ -308,7 +313,7 @@ KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, con
             for (uint m = lanes; m != 0u; m &= m - 1u) {
                 uint l = k_lowest_bit(m);
                 if (leaf_test(sc, sc->bvh_leaves, rays[l], &rp[l], any, leaf, &best[l])) done |= 1u << l;
-                tmax_a[l] = best[l].t;
+                tfar_a[l] = best[l].t * KD_T_ABOVE;
             }
         }
         /* the next entry on the stack that a lane not yet done still enters */
@@ -319,10 +324,10 @@ KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, con
             if (!lanes) continue;
             GLOBAL const BvhNode *parent = sc->bvh + (st_child[sp] >> 3);
             uint c = st_child[sp] & 7u;
-            float8 tmax;
-            k_load8(tmax, tmax_a);
+            float8 tfar;
+            k_load8(tfar, tfar_a);
             float lead;
-            lanes = bvh_child_lanes(parent, c, &p, &tmax, lanes, &lead);
+            lanes = bvh_child_lanes(parent, c, &p, &tfar, lanes, &lead);
             if (!lanes) continue;
             ref = parent->ref[c];
             kind = parent->kind[c];

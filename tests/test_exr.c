@@ -17,6 +17,7 @@
 
 #include "cli_util.h"
 #include "harness.h"
+#include "io/exr.h"
 #include "io/image_write.h"
 
 enum { W = 37, H = 21 };   /* odd sizes: a partial last chunk, rows of odd length */
@@ -174,6 +175,62 @@ static void test_exr_encoded(void)
     free(rgb);
 }
 
+/* An EXR whose data window does not start at the origin: the reader addresses the
+ * library's frame buffer by absolute pixel coordinates, whose base lies outside the
+ * pixels and, for a window far from the origin, outside the address space (a fuzz
+ * finding: tests/data/fuzz/texture/exr-data-window-far-from-origin). The pixels must
+ * come back in order either way. */
+static void check_exr_window(int x0, int y0, int ww, int wh)
+{
+    char path[] = "/tmp/clpt-test-exr-window-XXXXXX.exr";
+    int fd = mkstemps(path, 4);
+    close(fd);
+    size_t n = (size_t)ww * (size_t)wh;
+    ImfRgba *px = malloc(n * sizeof *px);
+    CHECK(px != NULL);
+    if (!px) return;
+    for (size_t i = 0; i < n; i++) {
+        float k = (float)(i % 1024u);   /* every value below is exact in half */
+        ImfFloatToHalf(0.5f * k, &px[i].r);
+        ImfFloatToHalf(1.0f + k, &px[i].g);
+        ImfFloatToHalf(-0.25f * k, &px[i].b);
+        ImfFloatToHalf(1.0f, &px[i].a);
+    }
+    ImfHeader *hdr = ImfNewHeader();
+    ImfHeaderSetDataWindow(hdr, x0, y0, x0 + ww - 1, y0 + wh - 1);
+    ImfOutputFile *out = ImfOpenOutputFile(path, hdr, IMF_WRITE_RGB);
+    CHECK_MSG(out != NULL, "%s", ImfErrorMessage());
+    /* the library's base, pixel (0, 0), computed modulo 2^64 as the reader does */
+    uintptr_t off = ((uintptr_t)(intptr_t)x0 + (uintptr_t)(intptr_t)y0 * (uintptr_t)ww) * sizeof *px;
+    CHECK(out && ImfOutputSetFrameBuffer(out, (const ImfRgba *)((uintptr_t)px - off), 1, (size_t)ww) &&
+          ImfOutputWritePixels(out, wh));
+    if (out) ImfCloseOutputFile(out);
+    ImfDeleteHeader(hdr);
+    float *rgb = NULL;
+    int w = 0, h = 0;
+    Error err = { 0 };
+    CHECK_MSG(exr_read_rgb(path, 1u << 20, &rgb, &w, &h, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(w, ww);
+    CHECK_EQ_INT(h, wh);
+    uint bad = 0;
+    for (size_t i = 0; rgb && i < n; i++) {
+        float k = (float)(i % 1024u);
+        bad += rgb[3 * i] != 0.5f * k || rgb[3 * i + 1] != 1.0f + k || rgb[3 * i + 2] != -0.25f * k;
+    }
+    CHECK_EQ_INT(bad, 0);
+    free(rgb);
+    free(px);
+    unlink(path);
+}
+
+static void test_exr_data_window(void)
+{
+    check_exr_window(-3, 7, 5, 3);
+    /* OpenEXR takes coordinates up to INT_MAX / 2 and rows up to 65,536 pixels: 10^9
+     * such rows put pixel (0, 0) 5 * 10^14 bytes before the pixels, below address 0 */
+    check_exr_window(1000000000, 1000000000, 65536, 2);
+}
+
 /* Radiance HDR: read back by stb_image within RGBE's precision (8 bits of mantissa
  * shared: 1/128 of the largest component); negative and NaN values come back 0. */
 static void test_hdr(void)
@@ -255,6 +312,7 @@ int main(void)
     RUN(test_exr_half);
     RUN(test_exr_float);
     RUN(test_exr_encoded);
+    RUN(test_exr_data_window);
     RUN(test_hdr);
     RUN(test_cli_aov_channels);
     return harness_report();

@@ -264,6 +264,12 @@ static Status exr_header_check(const char *path, const exr_attr_box2i_t *core_dw
  * write environment maps with; RgbaInputFile reads every compression, converts
  * luminance/chroma images to RGB and gives halves (16 bits: the precision of almost
  * every EXR environment map; float32 files lose their low bits). */
+static ImfRgba *exr_frame_base(ImfRgba *px, int x0, int y0, int w)
+{
+    uintptr_t offset = ((uintptr_t)(intptr_t)x0 + (uintptr_t)(intptr_t)y0 * (uintptr_t)w) * sizeof *px;
+    return (ImfRgba *)((uintptr_t)px - offset);
+}
+
 static Status exr_decode(const char *path, int w, int h, float *rgb, Error *err)
 {
     ImfInputFile *in = ImfOpenInputFile(path);
@@ -277,8 +283,11 @@ static Status exr_decode(const char *path, int w, int h, float *rgb, Error *err)
     else if (!(px = malloc((size_t)w * (size_t)h * sizeof *px)))
         st = error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
     /* the frame buffer is addressed by absolute pixel coordinates: its base is where
-     * pixel (0, 0) would be (this offset arithmetic is the library's documented use) */
-    else if (!ImfInputSetFrameBuffer(in, px - x0 - (ptrdiff_t)y0 * w, 1, (size_t)w) ||
+     * pixel (0, 0) would be (the library's documented use). A data window far from the
+     * origin puts that address outside px, even outside the address space (found by
+     * fuzz_texture), which pointer arithmetic may not reach: it is computed as an
+     * integer, modulo 2^64 as the library's own offsets are. */
+    else if (!ImfInputSetFrameBuffer(in, exr_frame_base(px, x0, y0, w), 1, (size_t)w) ||
              !ImfInputReadPixels(in, y0, y1))
         st = error_set(err, ST_INPUT, "'%s': not an EXR file OpenEXR can read (%s)", path, ImfErrorMessage());
     if (!st)

@@ -259,17 +259,19 @@ static Status exr_header_check(const char *path, const exr_attr_box2i_t *core_dw
     return st;
 }
 
-/* Decodes the pixels through the OpenEXR library's C interface to RgbaInputFile:
- * OpenEXRCore 3.1 (Debian 12) cannot decompress DWAA/DWAB, the compression real tools
- * write environment maps with; RgbaInputFile reads every compression, converts
- * luminance/chroma images to RGB and gives halves (16 bits: the precision of almost
- * every EXR environment map; float32 files lose their low bits). */
+/* Where pixel (0, 0) of a data window starting at (x0, y0), w pixels wide, would be if
+ * px held the window: the base the library's frame buffer wants (exr_decode). */
 static ImfRgba *exr_frame_base(ImfRgba *px, int x0, int y0, int w)
 {
     uintptr_t offset = ((uintptr_t)(intptr_t)x0 + (uintptr_t)(intptr_t)y0 * (uintptr_t)w) * sizeof *px;
     return (ImfRgba *)((uintptr_t)px - offset);
 }
 
+/* Decodes the pixels through the OpenEXR library's C interface to RgbaInputFile:
+ * OpenEXRCore 3.1 (Debian 12) cannot decompress DWAA/DWAB, the compression real tools
+ * write environment maps with; RgbaInputFile reads every compression, converts
+ * luminance/chroma images to RGB and gives halves (16 bits: the precision of almost
+ * every EXR environment map; float32 files lose their low bits). */
 static Status exr_decode(const char *path, int w, int h, float *rgb, Error *err)
 {
     ImfInputFile *in = ImfOpenInputFile(path);

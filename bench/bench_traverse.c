@@ -30,9 +30,12 @@
  * Then Mrays/s, the median of --reps runs (5), for: PoCL (kernels/entry.cl) walking the
  * kd-tree with one ray per work-item (PoCL-1: k_trace_closest1/k_trace_any1), two in
  * turns (PoCL-2: k_trace_closest/k_trace_any) and packets of eight consecutive rays
- * (PoCL-8: k_trace_closest8/k_trace_any8, trace_packet), and walking the BVH with one
- * ray per work-item (PoCL-W: k_trace_closest_wide/k_trace_any_wide, the renderer's
- * walk) and in packets of eight consecutive rays (PoCL-W8: k_trace_closest_wide8/
+ * (PoCL-8: k_trace_closest8/k_trace_any8, trace_packet), and walking the BVH, the
+ * renderer's walk, with one ray per work-item (PoCL-W: k_trace_closest_wide/
+ * k_trace_any_wide, as k_intersect and k_shadow call it), eight consecutive rays one
+ * after another per work-item (PoCL-WL: k_trace_closest_lanes/k_trace_any_lanes, as
+ * k_path_lanes, the renderer's kernel on CPUs, calls it for its lanes) and in packets
+ * of eight consecutive rays (PoCL-W8: k_trace_closest_wide8/
  * k_trace_any_wide8, trace_packet_wide), each on a sub-device of 1 compute unit and on
  * the whole device (the kd-tree kernels checked bit for bit against the C kd walk, the
  * BVH's against the C BVH walk;
@@ -358,17 +361,29 @@ static void rays_free(RaySet sets[N_SETS])
 /* The kernels' scene arguments come first, in kernels/scene_buffers.h order. */
 #define SC_N SCENE_BUF_COUNT
 
+/* The PoCL kernels (kernels/entry.cl): their labels, their closest-hit and any-hit
+ * kernels, rays per work-item, and whether they walk the BVH (else the kd-tree). */
+typedef enum { POCL_SINGLE, POCL_PAIRS, POCL_PACKETS, POCL_WIDE, POCL_WIDE_LANES, POCL_WIDE_PACKETS, N_KERNELS } PoclKernel;
+static const struct {
+    const char *label, *closest, *any;
+    uint rays_per_item;
+    int wide;
+} pocl_kernels[N_KERNELS] = {
+    [POCL_SINGLE] = { "PoCL-1", "k_trace_closest1", "k_trace_any1", 1, 0 },
+    [POCL_PAIRS] = { "PoCL-2", "k_trace_closest", "k_trace_any", 2, 0 },
+    [POCL_PACKETS] = { "PoCL-8", "k_trace_closest8", "k_trace_any8", 8, 0 },
+    [POCL_WIDE] = { "PoCL-W", "k_trace_closest_wide", "k_trace_any_wide", 1, 1 },
+    [POCL_WIDE_LANES] = { "PoCL-WL", "k_trace_closest_lanes", "k_trace_any_lanes", PATH_LANES, 1 },
+    [POCL_WIDE_PACKETS] = { "PoCL-W8", "k_trace_closest_wide8", "k_trace_any_wide8", 8, 1 },
+};
+
 typedef struct {
     int ok;
     OclDeviceInfo info;
     cl_device_id sub;            /* the 1-compute-unit sub-device, or NULL */
     cl_context ctx;
     cl_command_queue q;
-    cl_kernel kc, ka;            /* two rays per work-item */
-    cl_kernel kc1, ka1;          /* one ray per work-item */
-    cl_kernel kc8, ka8;          /* packets of eight rays per work-item */
-    cl_kernel kcw, kaw;          /* one ray per work-item through the 8-wide BVH */
-    cl_kernel kcw8, kaw8;        /* packets of eight rays through the 8-wide BVH */
+    cl_kernel k[N_KERNELS][2];   /* per PoclKernel: closest-hit, any-hit */
     cl_program prog;
     cl_mem scene[SC_N], rays, out;
     size_t rays_cap;
@@ -396,17 +411,12 @@ static int pocl_open(Pocl *pc, const OclDeviceInfo *dev, cl_device_id sub)
     pc->q = clCreateCommandQueue(pc->ctx, pc->info.id, 0, &rc);
     if (rc != CL_SUCCESS) return pocl_fail("clCreateCommandQueue", rc);
     Error err = { 0 };
-    if (ocl_program_build(pc->ctx, &pc->info, NULL, "-D CLPT_BENCH_KERNELS", &pc->prog, NULL, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest", &pc->kc, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any", &pc->ka, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest1", &pc->kc1, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any1", &pc->ka1, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest8", &pc->kc8, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any8", &pc->ka8, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest_wide", &pc->kcw, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any_wide", &pc->kaw, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_closest_wide8", &pc->kcw8, &err) ||
-        ocl_program_kernel(pc->prog, &pc->info, "k_trace_any_wide8", &pc->kaw8, &err)) {
+    Status st = ocl_program_build(pc->ctx, &pc->info, NULL, "-D CLPT_BENCH_KERNELS", &pc->prog, NULL, &err);
+    for (int kp = 0; kp < N_KERNELS && st == ST_OK; kp++) {
+        st = ocl_program_kernel(pc->prog, &pc->info, pocl_kernels[kp].closest, &pc->k[kp][0], &err);
+        if (st == ST_OK) st = ocl_program_kernel(pc->prog, &pc->info, pocl_kernels[kp].any, &pc->k[kp][1], &err);
+    }
+    if (st != ST_OK) {
         fprintf(stderr, "bench_traverse: %s\n", err.msg);
         error_clear(&err);
         return -1;
@@ -429,16 +439,9 @@ static void pocl_release_buffers(Pocl *pc)
 static void pocl_close(Pocl *pc)
 {
     pocl_release_buffers(pc);
-    if (pc->kc) clReleaseKernel(pc->kc);
-    if (pc->ka) clReleaseKernel(pc->ka);
-    if (pc->kc1) clReleaseKernel(pc->kc1);
-    if (pc->ka1) clReleaseKernel(pc->ka1);
-    if (pc->kc8) clReleaseKernel(pc->kc8);
-    if (pc->ka8) clReleaseKernel(pc->ka8);
-    if (pc->kcw) clReleaseKernel(pc->kcw);
-    if (pc->kaw) clReleaseKernel(pc->kaw);
-    if (pc->kcw8) clReleaseKernel(pc->kcw8);
-    if (pc->kaw8) clReleaseKernel(pc->kaw8);
+    for (int kp = 0; kp < N_KERNELS; kp++)
+        for (int any = 0; any < 2; any++)
+            if (pc->k[kp][any]) clReleaseKernel(pc->k[kp][any]);
     if (pc->prog) clReleaseProgram(pc->prog);
     if (pc->q) clReleaseCommandQueue(pc->q);
     if (pc->ctx) clReleaseContext(pc->ctx);
@@ -468,33 +471,24 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
     for (int i = 0; i < SC_N; i++)
         if (!pc->scene[i]) return -1;
     if (!pc->rays || !pc->out) return -1;
-    cl_kernel ks[10] = { pc->kc, pc->ka, pc->kc1, pc->ka1, pc->kc8, pc->ka8, pc->kcw, pc->kaw, pc->kcw8, pc->kaw8 };
-    for (int k = 0; k < 10; k++) {
+    for (int kp = 0; kp < 2 * N_KERNELS; kp++) {
+        cl_kernel k = pc->k[kp / 2][kp % 2];
         for (cl_uint i = 0; i < SC_N; i++)
-            if (clSetKernelArg(ks[k], i, sizeof(cl_mem), &pc->scene[i]) != CL_SUCCESS) return -1;
-        if (clSetKernelArg(ks[k], SC_N, sizeof(cl_mem), &pc->rays) != CL_SUCCESS ||
-            clSetKernelArg(ks[k], SC_N + 2, sizeof(cl_mem), &pc->out) != CL_SUCCESS)
+            if (clSetKernelArg(k, i, sizeof(cl_mem), &pc->scene[i]) != CL_SUCCESS) return -1;
+        if (clSetKernelArg(k, SC_N, sizeof(cl_mem), &pc->rays) != CL_SUCCESS ||
+            clSetKernelArg(k, SC_N + 2, sizeof(cl_mem), &pc->out) != CL_SUCCESS)
             return -1;
     }
     return 0;
 }
 
-/* The PoCL kernels: rays per work-item. */
-enum { POCL_SINGLE, POCL_PAIRS, POCL_PACKETS, POCL_WIDE, POCL_WIDE_PACKETS, N_KERNELS };
-static const uint rays_per_item[N_KERNELS] = { 1, 2, 8, 1, 8 };
-static const char *const kernel_label[N_KERNELS] = { "PoCL-1", "PoCL-2", "PoCL-8", "PoCL-W", "PoCL-W8" };
-
 /* Traces the set (its rays already uploaded) with kernel `kind`; returns seconds, or -1. */
-static double pocl_trace(Pocl *pc, const RaySet *s, int kind)
+static double pocl_trace(Pocl *pc, const RaySet *s, PoclKernel kind)
 {
-    cl_kernel k = kind == POCL_PAIRS ? (s->any ? pc->ka : pc->kc)
-                  : kind == POCL_PACKETS ? (s->any ? pc->ka8 : pc->kc8)
-                  : kind == POCL_WIDE    ? (s->any ? pc->kaw : pc->kcw)
-                  : kind == POCL_WIDE_PACKETS ? (s->any ? pc->kaw8 : pc->kcw8)
-                                         : (s->any ? pc->ka1 : pc->kc1);
+    cl_kernel k = pc->k[kind][s->any != 0];
     cl_uint n = s->n;
     if (clSetKernelArg(k, SC_N + 1, sizeof n, &n) != CL_SUCCESS) return -1.0;
-    size_t items = (n + rays_per_item[kind] - 1u) / rays_per_item[kind];
+    size_t items = (n + pocl_kernels[kind].rays_per_item - 1u) / pocl_kernels[kind].rays_per_item;
     size_t local = pocl_local, global = local ? (items + local - 1) / local * local : items;
     double c0 = cpu_now(), t0 = timer_now();
     cl_int rc = clEnqueueNDRangeKernel(pc->q, k, 1, NULL, &global, local ? &local : NULL, 0, NULL, NULL);
@@ -877,7 +871,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
             long d = 0;
             for (int kp = 0; kp < N_KERNELS && pocl_ok[t]; kp++) {
                 if (pocl_trace(&pocl[t], s, kp) < 0.0) pocl_ok[t] = 0;
-                else d += pocl_compare(&pocl[t], s, kp == POCL_WIDE || kp == POCL_WIDE_PACKETS);
+                else d += pocl_compare(&pocl[t], s, pocl_kernels[kp].wide);
             }
             if (pocl_ok[t]) r->pocl_diff = r->pocl_diff < 0 ? d : r->pocl_diff + d;
         }
@@ -930,7 +924,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
 
     int a = o->threads[0], b = o->threads[MAX_THREADS - 1];
     printf("\n| rays | query | count | hits |");
-    for (int kp = 0; kp < N_KERNELS; kp++) printf(" %s %dt | %s %dt |", kernel_label[kp], a, kernel_label[kp], b);
+    for (int kp = 0; kp < N_KERNELS; kp++) printf(" %s %dt | %s %dt |", pocl_kernels[kp].label, a, pocl_kernels[kp].label, b);
     printf(" C %dt | C %dt | C-W %dt | C-W %dt | Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | vs Embree | "
            "PoCL vs C | BVH vs kd |\n", a, b, a, b, a, b, a, b);
     printf("|---|---|---:|---:|");
@@ -952,11 +946,11 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
            "which other jobs taking the cores do not change; with ideal scaling the %d-thread columns equal "
            "the 1-thread ones), and PoCL over Embree single rays:\n\n", b);
     printf("| rays |");
-    for (int kp = 0; kp < N_KERNELS; kp++) printf(" %s %dt | %s %dt |", kernel_label[kp], a, kernel_label[kp], b);
+    for (int kp = 0; kp < N_KERNELS; kp++) printf(" %s %dt | %s %dt |", pocl_kernels[kp].label, a, pocl_kernels[kp].label, b);
     printf(" C %dt | C %dt | C-W %dt | C-W %dt | Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt |", a, b, a, b,
            a, b, a, b);
     for (int kp = 0; kp < N_KERNELS; kp++)
-        printf(" %s/Embree-1 %dt | %s/Embree-1 %dt |", kernel_label[kp], a, kernel_label[kp], b);
+        printf(" %s/Embree-1 %dt | %s/Embree-1 %dt |", pocl_kernels[kp].label, a, pocl_kernels[kp].label, b);
     printf("\n|---|");
     for (int kp = 0; kp < 4 * N_KERNELS + 8; kp++) printf("---:|");
     printf("\n");

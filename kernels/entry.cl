@@ -495,4 +495,31 @@ __kernel void k_trace_any_wide(SCENE_ARGS __global const Ray *rays, uint n, __gl
     SCENE_VIEW(sc);
     trace_one_item(&sc, rays, n, TREE_BVH, 1, 0, occluded);
 }
+
+/* Closest hits (any == 0) or occlusion (any == 1) of rays[PATH_LANES i] to
+ * rays[PATH_LANES i + PATH_LANES - 1], walked one after another in one work-item through
+ * the BVH: the form in which k_path_lanes, the renderer's kernel on CPUs, calls the walk
+ * (its lanes' rays in turn). PoCL sets up each work-item's private arrays and
+ * splatted constants once per item: k_trace_closest_wide pays that per ray. */
+KFN_INLINE void trace_lanes_item(const SceneView *sc, __global const Ray *rays, uint n, int any,
+                                 __global Hit *hits, __global uint *occluded)
+{
+    uint first = PATH_LANES * (uint)get_global_id(0);
+    for (uint i = first; i < first + PATH_LANES && i < n; i++) {
+        if (any) occluded[i] = (uint)trace_any_in(sc, TREE_BVH, rays[i]);
+        else hits[i] = trace_closest_in(sc, TREE_BVH, rays[i]);
+    }
+}
+
+__kernel void k_trace_closest_lanes(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
+{
+    SCENE_VIEW(sc);
+    trace_lanes_item(&sc, rays, n, 0, hits, 0);
+}
+
+__kernel void k_trace_any_lanes(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
+{
+    SCENE_VIEW(sc);
+    trace_lanes_item(&sc, rays, n, 1, 0, occluded);
+}
 #endif /* CLPT_BENCH_KERNELS */

@@ -693,11 +693,12 @@ static void test_intersect(void)
 }
 
 /* The trace-only kernels bench_traverse times (-D CLPT_BENCH_KERNELS): one ray per
- * work-item, two in turns (trace_closest2 / trace_any2) and packets of eight
- * (trace_packet; trace_packet_wide through the BVH), closest hits and occlusion, against the C walk bit for bit, on random
- * rays and on coherent ones (runs of eight from one origin through a small cone, as a
- * camera's neighbouring pixels) over the test scene; the ray count is not a multiple of
- * eight, so the last packet is short. */
+ * work-item, two in turns (trace_closest2 / trace_any2), eight one after another (the
+ * BVH walk as k_path_lanes calls it) and packets of eight (trace_packet;
+ * trace_packet_wide through the BVH), closest hits and occlusion, against the C walk bit
+ * for bit, on random rays and on coherent ones (runs of eight from one origin through a
+ * small cone, as a camera's neighbouring pixels) over the test scene; the ray count is
+ * not a multiple of eight, so the last work-item's run and packet are short. */
 static void test_trace_kernels(void)
 {
     enum { N = 8000 + 5 };
@@ -755,6 +756,7 @@ static void test_trace_kernels(void)
         { "k_trace_closest1", 1, 0, 0 }, { "k_trace_any1", 1, 1, 0 },     { "k_trace_closest", 2, 0, 0 },
         { "k_trace_any", 2, 1, 0 },      { "k_trace_closest8", 8, 0, 0 }, { "k_trace_any8", 8, 1, 0 },
         { "k_trace_closest_wide", 1, 0, 1 }, { "k_trace_any_wide", 1, 1, 1 },
+        { "k_trace_closest_lanes", PATH_LANES, 0, 1 }, { "k_trace_any_lanes", PATH_LANES, 1, 1 },
         { "k_trace_closest_wide8", 8, 0, 1 }, { "k_trace_any_wide8", 8, 1, 1 },
     };
     for (size_t j = 0; j < sizeof ks / sizeof ks[0] && st == ST_OK; j++) {

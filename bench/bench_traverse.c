@@ -363,7 +363,9 @@ static void rays_free(RaySet sets[N_SETS])
 
 /* The PoCL kernels (kernels/entry.cl): their labels, their closest-hit and any-hit
  * kernels, rays per work-item, and whether they walk the BVH (else the kd-tree). */
-typedef enum { POCL_SINGLE, POCL_PAIRS, POCL_PACKETS, POCL_WIDE, POCL_WIDE_LANES, POCL_WIDE_PACKETS, N_KERNELS } PoclKernel;
+typedef enum {
+    POCL_SINGLE, POCL_PAIRS, POCL_PACKETS, POCL_WIDE, POCL_WIDE_LANES, POCL_WIDE_PACKETS, N_KERNELS
+} PoclKernel;
 static const struct {
     const char *label, *closest, *any;
     uint rays_per_item;

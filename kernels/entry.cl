@@ -499,8 +499,9 @@ __kernel void k_trace_any_wide(SCENE_ARGS __global const Ray *rays, uint n, __gl
 /* Closest hits (any == 0) or occlusion (any == 1) of rays[PATH_LANES i] to
  * rays[PATH_LANES i + PATH_LANES - 1], walked one after another in one work-item through
  * the BVH: the form in which k_path_lanes, the renderer's kernel on CPUs, calls the walk
- * (its lanes' rays in turn). PoCL sets up each work-item's private arrays and
- * splatted constants once per item: k_trace_closest_wide pays that per ray. */
+ * (its lanes' rays in turn). PoCL computes the addresses of a work-item's private
+ * arrays, the walk's stack among them, once per item: k_trace_closest_wide pays that
+ * per ray. */
 KFN_INLINE void trace_lanes_item(const SceneView *sc, __global const Ray *rays, uint n, int any,
                                  __global Hit *hits, __global uint *occluded)
 {

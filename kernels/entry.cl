@@ -411,16 +411,21 @@ __kernel void k_trace_any(SCENE_ARGS __global const Ray *rays, uint n, __global 
     }
 }
 
-/* The closest hit of rays[i] (any == 0) or whether it hits anything (any == 1), one ray
- * per work-item through the given tree (trace_closest as k_intersect, trace_any as
- * k_shadow). */
+/* The closest hit of rays[i] (any == 0) or whether it hits anything (any == 1), through
+ * the given tree (trace_closest as k_intersect, trace_any as k_shadow). */
+KFN_INLINE void trace_one_ray(const SceneView *sc, __global const Ray *rays, uint i, int tree, int any,
+                              __global Hit *hits, __global uint *occluded)
+{
+    if (any) occluded[i] = (uint)trace_any_in(sc, tree, rays[i]);
+    else hits[i] = trace_closest_in(sc, tree, rays[i]);
+}
+
+/* One ray per work-item. */
 KFN_INLINE void trace_one_item(const SceneView *sc, __global const Ray *rays, uint n, int tree, int any,
                                __global Hit *hits, __global uint *occluded)
 {
     uint i = (uint)get_global_id(0);
-    if (i >= n) return;
-    if (any) occluded[i] = (uint)trace_any_in(sc, tree, rays[i]);
-    else hits[i] = trace_closest_in(sc, tree, rays[i]);
+    if (i < n) trace_one_ray(sc, rays, i, tree, any, hits, occluded);
 }
 
 __kernel void k_trace_closest1(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
@@ -506,10 +511,8 @@ KFN_INLINE void trace_lanes_item(const SceneView *sc, __global const Ray *rays, 
                                  __global Hit *hits, __global uint *occluded)
 {
     uint first = PATH_LANES * (uint)get_global_id(0);
-    for (uint i = first; i < first + PATH_LANES && i < n; i++) {
-        if (any) occluded[i] = (uint)trace_any_in(sc, TREE_BVH, rays[i]);
-        else hits[i] = trace_closest_in(sc, TREE_BVH, rays[i]);
-    }
+    for (uint i = first; i < first + PATH_LANES && i < n; i++)
+        trace_one_ray(sc, rays, i, TREE_BVH, any, hits, occluded);
 }
 
 __kernel void k_trace_closest_lanes(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)

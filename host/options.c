@@ -174,7 +174,9 @@ void options_print_help(FILE *f)
 "                             the OpenCL CPU devices, else the scalar device\n"
 "      --threads N            worker threads of the scalar device (default:\n"
 "                             all cores)\n"
-"\n"
+"\n",
+          f);
+    fputs(
 "Reporting:\n"
 "      --stats                print scene, tree (BVH or kd-tree), kernel\n"
 "                             build and per-device statistics to stdout\n"
@@ -192,7 +194,9 @@ void options_print_help(FILE *f)
 "                             adaptive, about 0.25 s of work per batch)\n"
 "      --wave-paths N         paths per OpenCL wave (default: 2^22 on GPUs of\n"
 "                             8 GiB or more when it fits in half their\n"
-"                             memory, else 2^20; 2^16 on CPUs; 2^14 with\n"
+"                             memory, else 2^20; on CPUs 2^16 per compute\n"
+"                             unit, 2^17 to 2^21, where it fits in half\n"
+"                             the memory, else 2^16; 2^14 with\n"
 "                             --interactive)\n"
 "      --wave-launch counted|bounded|megakernel\n"
 "                             how an OpenCL device runs a wave: 'counted'\n"

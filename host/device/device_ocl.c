@@ -110,7 +110,8 @@ typedef struct {
     uint max_bounces;       /* bounces 0 .. max_depth: 2 * max_bounces + 1 count slots */
     uint counts_bounces;    /* the bounces the wave count buffers have room for */
     uint wave_paths;        /* capacity of each wave's buffers */
-    uint wave_auto;         /* a GPU's large default wave, used where it fits (load_scene); 0 if none */
+    uint wave_auto;         /* a large default wave, used where it fits (load_scene); 0 if none */
+    uint wave_fallback;     /* the default wave where wave_auto does not fit */
     size_t local_size;      /* 0: let the driver choose */
     int launch;             /* enum WaveLaunch, never AUTO: how a wave is launched */
     int path_launch;        /* how this render's path waves are: launch, or the megakernel
@@ -446,13 +447,13 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     for (unsigned i = 0; i < SCENE_N; i++) in[i] = device_scene_buffer(s, i);
     uint n_pixels = p->width * p->height;
     if (od->wave_auto) {
-        /* the large GPU waves only while they and the scene take at most half the
-         * device's memory; else the usual 2^20 */
+        /* the large default waves only while they and the scene take at most half the
+         * device's memory; else the smaller fallback */
         uint64_t need = 2u * (uint64_t)n_pixels * 3u * sizeof(cl_long);
         for (unsigned i = 0; i < SCENE_N; i++) need += in[i].bytes;
         need += (uint64_t)WAVE_SLOTS * od->wave_auto *
                 (sizeof(PathState) + 2u * sizeof(Ray) + sizeof(Hit) + 3u * sizeof(uint));
-        od->wave_paths = need <= od->info.global_mem / 2u ? od->wave_auto : (1u << 20);
+        od->wave_paths = need <= od->info.global_mem / 2u ? od->wave_auto : od->wave_fallback;
     }
     uint wave = od->wave_paths;
     od->max_bounces = p->max_depth + 1u;
@@ -957,11 +958,19 @@ static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error
      * waves cost fewer launches per path: on an H200, 2^22 paths rendered 6-28% faster
      * than 2^20 with bounded launches and 11-41% with counted ones (1024x1024 renders,
      * bench/RESULTS.md). 2^22 paths take about 650 MB a wave, so only GPUs with 8 GiB or
-     * more get them. A CPU is full with far fewer (on PoCL 2^16 to 2^18 measured the
-     * same, 2^14 a few percent and 2^12 a tenth slower). */
+     * more get them. A CPU is full with far fewer, but each wave ends with its threads
+     * waiting for the slowest work-group and for the host, and that wait grows with the
+     * threads: 2^16 paths per compute unit. On 2 cores 2^16, 2^17 and 2^18 paths
+     * measured the same (2^14 a few percent and 2^12 a tenth slower); on 16 cores
+     * (PoCL 5.0, a Xeon) 2^20 rendered 14-31% faster than 2^16 and 2^21 the same as
+     * 2^20 (bench/RESULTS.md). */
     uint gpu_wave = od->info.global_mem >= (8ull << 30) ? (1u << 22) : (1u << 20);
-    od->wave_paths = cfg && cfg->wave_paths ? cfg->wave_paths : (gpu ? gpu_wave : (1u << 16));
-    od->wave_auto = cfg && cfg->wave_paths ? 0u : (gpu && gpu_wave > (1u << 20) ? gpu_wave : 0u);
+    uint cpu_wave = 1u << 16;
+    while (cpu_wave < (1u << 21) && (cpu_wave >> 16) * 2u <= od->info.compute_units) cpu_wave <<= 1;
+    od->wave_fallback = gpu ? 1u << 20 : 1u << 16;
+    uint wave_default = gpu ? gpu_wave : cpu_wave;
+    od->wave_paths = cfg && cfg->wave_paths ? cfg->wave_paths : wave_default;
+    od->wave_auto = cfg && cfg->wave_paths ? 0u : (wave_default > od->wave_fallback ? wave_default : 0u);
     od->local_size = od->info.max_work_group >= OCL_LOCAL_SIZE ? OCL_LOCAL_SIZE : 0;
     od->cpu = (od->info.type & CL_DEVICE_TYPE_CPU) != 0;
     od->launch = cfg && cfg->wave_launch ? cfg->wave_launch

@@ -344,8 +344,9 @@ static void print_render_stats(const ScheduleStats *st, uint spp, Device **devs,
     for (size_t i = 0; i < n; i++) {
         const DeviceCounters *c = &devs[i]->counters;
         if (devs[i]->desc.kind == DEVICE_OPENCL)
-            printf("device %zu '%s': kernels %s in %.3f s, scene upload %.3f s\n", i, devs[i]->desc.name,
-                   c->from_cache ? "loaded from cache" : "compiled", c->compile_seconds, c->upload_seconds);
+            printf("device %zu '%s': kernels %s in %.3f s, scene upload %.3f s; waves of %u paths, %s\n", i,
+                   devs[i]->desc.name, c->from_cache ? "loaded from cache" : "compiled", c->compile_seconds,
+                   c->upload_seconds, c->wave_paths, c->wave_run ? c->wave_run : "-");
     }
     printf("%-32s %7s %12s %8s %8s %12s %10s %6s %s\n", "device", "batches", "samples", "busy s",
            "idle s", "Msamples/s", "Mrays/s", "share", "batch sizes (min/max/last spp)");

@@ -179,7 +179,8 @@ void options_print_help(FILE *f)
     fputs(
 "Reporting:\n"
 "      --stats                print scene, tree (BVH or kd-tree), kernel\n"
-"                             build and per-device statistics to stdout\n"
+"                             build, OpenCL wave (size, how it runs) and\n"
+"                             per-device statistics to stdout\n"
 "      --profile              --stats, and where each device's time goes: ray\n"
 "                             generation, traversal, shading, shadow rays,\n"
 "                             film, queues, host waits (slows rendering)\n"

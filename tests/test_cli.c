@@ -78,6 +78,10 @@ static void test_wave_launches_match_scalar(void)
                 &r);
         CHECK_MSG(r.status == 0, "%s: %s", modes[i], r.err);
         CHECK_MSG(files_equal(ref, outs[i]), "--wave-launch %s: the image differs from the scalar device's", modes[i]);
+        /* --stats names the wave size and how a wave runs */
+        const char *runs[] = { "waves of 1000 paths, counted bounces", "waves of 1000 paths, bounded bounces",
+                               "waves of 1000 paths, megakernel k_path" };   /* _lanes on CPUs */
+        CHECK_STR_CONTAINS(r.out, runs[i]);
         /* the total line: samples, seconds, Msamples/s, Mrays/s; rays per sample compared
          * (both rates printed to 3 decimals: equal to within their rounding) */
         const char *t = strstr(r.out, "\ntotal");
@@ -182,8 +186,8 @@ static void test_stats(void)
                  "--spp", "1", "-o", "/tmp/clpt-test-stats.png"),
             &r);
     CHECK_EQ_INT(r.status, 0);
-    const char *want[] = { "BVH: built in", "nodes of 8", "leaves", "depth", "SAH cost", "kernels", "Msamples/s",
-                           "Mrays/s", "total" };
+    const char *want[] = { "BVH: built in", "nodes of 8", "leaves", "depth", "SAH cost", "kernels", "waves of",
+                           "Msamples/s", "Mrays/s", "total" };
     for (size_t i = 0; i < sizeof want / sizeof want[0]; i++) CHECK_STR_CONTAINS(r.out, want[i]);
     /* the kd-tree on request, and the same image */
     CHECK(rename("/tmp/clpt-test-stats.png", "/tmp/clpt-test-stats-bvh.png") == 0);

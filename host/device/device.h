@@ -123,6 +123,10 @@ typedef struct {
     double compile_seconds;       /* OpenCL program build or cache load */
     int from_cache;
     double upload_seconds;
+    /* OpenCL, for --stats: the loaded scene's waves (paths each) and how one runs (a
+     * static string: "megakernel k_path_lanes", "bounded", ...) */
+    unsigned wave_paths;
+    const char *wave_run;
     uint64_t rays;                /* every ray traced: camera, bounce and shadow rays */
     uint64_t samples;             /* pixel samples rendered (pixels x samples) */
     double phase_seconds[PHASE_N];  /* --profile only: enum DevicePhase */

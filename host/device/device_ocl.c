@@ -437,6 +437,17 @@ static Status need_program(Device *d, OclDevice *od, uint integrator, Error *err
     return st;
 }
 
+/* What --stats says of the device's waves: their size and how one is run. */
+static void note_waves(Device *d, const OclDevice *od)
+{
+    d->counters.wave_paths = od->wave_paths;
+    d->counters.wave_run = od->integrator != INTEGRATOR_PATH                ? "k_whitted"
+                           : od->path_launch == WAVE_LAUNCH_COUNTED         ? "counted bounces"
+                           : od->path_launch == WAVE_LAUNCH_BOUNDED         ? "bounded bounces"
+                           : od->lanes ? "megakernel k_path_lanes, eight paths per work-item"
+                                       : "megakernel k_path";
+}
+
 static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
 {
     OclDevice *od = d->impl;
@@ -532,6 +543,7 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     t0 = timer_now();
     if ((st = need_program(d, od, p->integrator, err))) return st;
     od->integrator = p->integrator;
+    note_waves(d, od);
     d->n_pixels = n_pixels;
     d->max_in_flight = od->n_slots;
     return ST_OK;
@@ -603,6 +615,7 @@ static Status ocl_update_params(Device *d, const RenderParams *p, const uint *pi
     od->lanes = od->lanes_scene && kernel_lanes_params(p);
     if ((st = need_program(d, od, p->integrator, err))) return st;
     od->integrator = p->integrator;
+    note_waves(d, od);
     return ST_OK;
 }
 

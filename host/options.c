@@ -196,7 +196,7 @@ void options_print_help(FILE *f)
 "      --wave-paths N         paths per OpenCL wave (default: 2^22 on GPUs of\n"
 "                             8 GiB or more when it fits in half their\n"
 "                             memory, else 2^20; on CPUs 2^16 per compute\n"
-"                             unit, 2^17 to 2^21, where it fits in half\n"
+"                             unit up to 2^21 where it fits in half\n"
 "                             the memory, else 2^16; 2^14 with\n"
 "                             --interactive)\n"
 "      --wave-launch counted|bounded|megakernel\n"

@@ -124,7 +124,7 @@ typedef struct {
     int from_cache;
     double upload_seconds;
     /* OpenCL, for --stats: the loaded scene's waves (paths each) and how one runs (a
-     * static string: "megakernel k_path_lanes", "bounded", ...) */
+     * static string: "bounded bounces", "megakernel k_path", ...) */
     unsigned wave_paths;
     const char *wave_run;
     uint64_t rays;                /* every ray traced: camera, bounce and shadow rays */

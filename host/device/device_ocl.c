@@ -973,8 +973,9 @@ static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error
      * bench/RESULTS.md). 2^22 paths take about 650 MB a wave, so only GPUs with 8 GiB or
      * more get them. A CPU is full with far fewer, but each wave ends with its threads
      * waiting for the slowest work-group and for the host, and that wait grows with the
-     * threads: 2^16 paths per compute unit. On 2 cores 2^16, 2^17 and 2^18 paths
-     * measured the same (2^14 a few percent and 2^12 a tenth slower); on 16 cores
+     * threads: 2^16 paths per compute unit (a power of two, at most 2^21). On 2 cores
+     * 2^16, 2^17 and 2^18 paths measured the same (2^14 a few percent and 2^12 a tenth
+     * slower); on 16 cores
      * (PoCL 5.0, a Xeon) 2^20 rendered 14-31% faster than 2^16 and 2^21 the same as
      * 2^20 (bench/RESULTS.md). */
     uint gpu_wave = od->info.global_mem >= (8ull << 30) ? (1u << 22) : (1u << 20);

@@ -975,9 +975,8 @@ static Status ocl_setup(Device *d, OclDevice *od, const DeviceConfig *cfg, Error
      * waiting for the slowest work-group and for the host, and that wait grows with the
      * threads: 2^16 paths per compute unit (a power of two, at most 2^21). On 2 cores
      * 2^16, 2^17 and 2^18 paths measured the same (2^14 a few percent and 2^12 a tenth
-     * slower); on 16 cores
-     * (PoCL 5.0, a Xeon) 2^20 rendered 14-31% faster than 2^16 and 2^21 the same as
-     * 2^20 (bench/RESULTS.md). */
+     * slower); on 16 cores (PoCL 5.0, a Xeon) 2^20 rendered 14-31% faster than 2^16
+     * and 2^21 the same as 2^20 (bench/RESULTS.md). */
     uint gpu_wave = od->info.global_mem >= (8ull << 30) ? (1u << 22) : (1u << 20);
     uint cpu_wave = 1u << 16;
     while (cpu_wave < (1u << 21) && (cpu_wave >> 16) * 2u <= od->info.compute_units) cpu_wave <<= 1;

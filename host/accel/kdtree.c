@@ -169,14 +169,6 @@ static void ids_sort(uint *ids, uint n)
 
 /* ------------------------------------------------------------------ geometry */
 
-/* Least and greatest of two numbers that are not NaN (the boxes of the build are those
- * of finite primitives, kd_prim_box): comparisons the compiler inlines, where fminf and
- * fmaxf are calls into libm for their NaN rule (2% of the samples of the dragon's build). */
-static inline float least_f(float a, float b) { return b < a ? b : a; }
-static inline float greatest_f(float a, float b) { return b > a ? b : a; }
-static inline double least_d(double a, double b) { return b < a ? b : a; }
-static inline double greatest_d(double a, double b) { return b > a ? b : a; }
-
 static double box_half_area(const Aabb *b)
 {
     double dx = (double)b->hi[0] - b->lo[0], dy = (double)b->hi[1] - b->lo[1];
@@ -187,8 +179,8 @@ static double box_half_area(const Aabb *b)
 static int box_intersect_with(Aabb *b, const Aabb *with)
 {
     for (int k = 0; k < 3; k++) {
-        b->lo[k] = greatest_f(b->lo[k], with->lo[k]);
-        b->hi[k] = least_f(b->hi[k], with->hi[k]);
+        b->lo[k] = k_fmax(b->lo[k], with->lo[k]);   /* compat.h: inlined, unlike fmaxf */
+        b->hi[k] = k_fmin(b->hi[k], with->hi[k]);
         if (!(b->lo[k] <= b->hi[k])) return 0;
     }
     return 1;
@@ -213,8 +205,8 @@ static Aabb triangle_bounds(const Triangle *t)
     for (int i = 0; i < 2; i++) {
         const float p[3] = { v[i]->x, v[i]->y, v[i]->z };
         for (int k = 0; k < 3; k++) {
-            a.lo[k] = least_f(a.lo[k], p[k]);
-            a.hi[k] = greatest_f(a.hi[k], p[k]);
+            a.lo[k] = k_fmin(a.lo[k], p[k]);
+            a.hi[k] = k_fmax(a.hi[k], p[k]);
         }
     }
     return a;
@@ -250,8 +242,8 @@ static Aabb polygon_bounds(double (*v)[3], int n)
     for (int j = 0; j < 3; j++) lo[j] = hi[j] = v[0][j];
     for (int i = 1; i < n; i++)
         for (int j = 0; j < 3; j++) {
-            lo[j] = least_d(lo[j], v[i][j]);
-            hi[j] = greatest_d(hi[j], v[i][j]);
+            lo[j] = fmin(lo[j], v[i][j]);
+            hi[j] = fmax(hi[j], v[i][j]);
         }
     Aabb out;
     for (int j = 0; j < 3; j++) {

@@ -484,6 +484,13 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
     return 0;
 }
 
+/* The PoCL kernels' column heads, at a and at b threads, each label followed by suffix. */
+static void print_pocl_heads(const char *suffix, int a, int b)
+{
+    for (int kp = 0; kp < N_KERNELS; kp++)
+        printf(" %s%s %dt | %s%s %dt |", pocl_kernels[kp].label, suffix, a, pocl_kernels[kp].label, suffix, b);
+}
+
 /* Traces the set (its rays already uploaded) with kernel `kind`; returns seconds, or -1. */
 static double pocl_trace(Pocl *pc, const RaySet *s, PoclKernel kind)
 {
@@ -926,7 +933,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
 
     int a = o->threads[0], b = o->threads[MAX_THREADS - 1];
     printf("\n| rays | query | count | hits |");
-    for (int kp = 0; kp < N_KERNELS; kp++) printf(" %s %dt | %s %dt |", pocl_kernels[kp].label, a, pocl_kernels[kp].label, b);
+    print_pocl_heads("", a, b);
     printf(" C %dt | C %dt | C-W %dt | C-W %dt | Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt | vs Embree | "
            "PoCL vs C | BVH vs kd |\n", a, b, a, b, a, b, a, b);
     printf("|---|---|---:|---:|");
@@ -948,11 +955,10 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
            "which other jobs taking the cores do not change; with ideal scaling the %d-thread columns equal "
            "the 1-thread ones), and PoCL over Embree single rays:\n\n", b);
     printf("| rays |");
-    for (int kp = 0; kp < N_KERNELS; kp++) printf(" %s %dt | %s %dt |", pocl_kernels[kp].label, a, pocl_kernels[kp].label, b);
+    print_pocl_heads("", a, b);
     printf(" C %dt | C %dt | C-W %dt | C-W %dt | Embree-1 %dt | Embree-1 %dt | Embree-8 %dt | Embree-8 %dt |", a, b, a, b,
            a, b, a, b);
-    for (int kp = 0; kp < N_KERNELS; kp++)
-        printf(" %s/Embree-1 %dt | %s/Embree-1 %dt |", pocl_kernels[kp].label, a, pocl_kernels[kp].label, b);
+    print_pocl_heads("/Embree-1", a, b);
     printf("\n|---|");
     for (int kp = 0; kp < 4 * N_KERNELS + 8; kp++) printf("---:|");
     printf("\n");

@@ -176,7 +176,8 @@ fi
 if [ -n "$kernels_pid" ]; then
 step "kernels: GPU against scalar, bit for bit (run beside the steps above)"
 wait "$kernels_pid"
-echo "test_kernels: exit $(cat "$out/test_kernels.rc"), $(grep -E 'passed, .* failed' "$out/test_kernels.log" | tail -n 1)"
+summary=$(grep -E 'passed, .* failed' "$out/test_kernels.log" | tail -n 1)
+echo "test_kernels: exit $(cat "$out/test_kernels.rc"), $summary"
 grep -E 'FAIL|built in' "$out/test_kernels.log" | head -n 20
 fi
 unset CLPT_TEST_OPENCL

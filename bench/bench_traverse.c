@@ -484,6 +484,14 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
     return 0;
 }
 
+/* One table cell of a rate, or "-" for one not measured (a device left out by --no-pocl
+ * or --no-embree, or absent): 0.00 would read as a measured rate. */
+static void print_rate(double v)
+{
+    if (v > 0.0) printf(" %.2f |", v);
+    else printf(" - |");
+}
+
 /* The PoCL kernels' column heads, at a and at b threads, each label followed by suffix. */
 static void print_pocl_heads(const char *suffix, int a, int b)
 {
@@ -947,9 +955,13 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
         if (r->embree_diff < 0) snprintf(ed, sizeof ed, "-");
         else snprintf(ed, sizeof ed, "%ld disagree", r->embree_diff);
         printf("| %s | %s | %u | %u |", sets[k].name, sets[k].any ? "any" : "closest", sets[k].n, r->hits);
-        for (int kp = 0; kp < N_KERNELS; kp++) printf(" %.2f | %.2f |", r->pocl[kp][0], r->pocl[kp][1]);
-        printf(" %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %s | %ld disagree |\n", r->c[0], r->c[1],
-               r->cw[0], r->cw[1], r->e1[0], r->e1[1], r->e8[0], r->e8[1], ed, pd, r->wide_diff);
+        const double rates[] = { r->c[0], r->c[1], r->cw[0], r->cw[1], r->e1[0], r->e1[1], r->e8[0], r->e8[1] };
+        for (int kp = 0; kp < N_KERNELS; kp++) {
+            print_rate(r->pocl[kp][0]);
+            print_rate(r->pocl[kp][1]);
+        }
+        for (size_t i = 0; i < sizeof rates / sizeof rates[0]; i++) print_rate(rates[i]);
+        printf(" %s | %s | %ld disagree |\n", ed, pd, r->wide_diff);
     }
     printf("\nThe same runs in Mrays per CPU-second (the CPU time of the whole process: the work per core, "
            "which other jobs taking the cores do not change; with ideal scaling the %d-thread columns equal "
@@ -965,12 +977,16 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
     for (int k = 0; k < N_SETS; k++) {
         const SetResult *r = &res[k];
         printf("| %s %s |", sets[k].name, sets[k].any ? "any" : "closest");
-        for (int kp = 0; kp < N_KERNELS; kp++) printf(" %.2f | %.2f |", r->cpu_pocl[kp][0], r->cpu_pocl[kp][1]);
-        printf(" %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |", r->cpu_c[0], r->cpu_c[1], r->cpu_cw[0],
-               r->cpu_cw[1], r->cpu_e1[0], r->cpu_e1[1], r->cpu_e8[0], r->cpu_e8[1]);
+        const double rates[] = { r->cpu_c[0],  r->cpu_c[1],  r->cpu_cw[0], r->cpu_cw[1],
+                                 r->cpu_e1[0], r->cpu_e1[1], r->cpu_e8[0], r->cpu_e8[1] };
+        for (int kp = 0; kp < N_KERNELS; kp++) {
+            print_rate(r->cpu_pocl[kp][0]);
+            print_rate(r->cpu_pocl[kp][1]);
+        }
+        for (size_t i = 0; i < sizeof rates / sizeof rates[0]; i++) print_rate(rates[i]);
         for (int kp = 0; kp < N_KERNELS; kp++)
             for (int t = 0; t < MAX_THREADS; t++)
-                printf(" %.2f |", r->cpu_e1[t] > 0.0 ? r->cpu_pocl[kp][t] / r->cpu_e1[t] : 0.0);
+                print_rate(r->cpu_e1[t] > 0.0 ? r->cpu_pocl[kp][t] / r->cpu_e1[t] : 0.0);
         printf("\n");
     }
     fflush(stdout);

@@ -492,6 +492,14 @@ static void print_rate(double v)
     else printf(" - |");
 }
 
+/* A row's rates: each PoCL kernel's at both thread counts, then the other columns'. */
+static void print_rates(const double pocl[N_KERNELS][MAX_THREADS], const double *others, int n_others)
+{
+    for (int kp = 0; kp < N_KERNELS; kp++)
+        for (int t = 0; t < MAX_THREADS; t++) print_rate(pocl[kp][t]);
+    for (int i = 0; i < n_others; i++) print_rate(others[i]);
+}
+
 /* The PoCL kernels' column heads, at a and at b threads, each label followed by suffix. */
 static void print_pocl_heads(const char *suffix, int a, int b)
 {
@@ -956,11 +964,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
         else snprintf(ed, sizeof ed, "%ld disagree", r->embree_diff);
         printf("| %s | %s | %u | %u |", sets[k].name, sets[k].any ? "any" : "closest", sets[k].n, r->hits);
         const double rates[] = { r->c[0], r->c[1], r->cw[0], r->cw[1], r->e1[0], r->e1[1], r->e8[0], r->e8[1] };
-        for (int kp = 0; kp < N_KERNELS; kp++) {
-            print_rate(r->pocl[kp][0]);
-            print_rate(r->pocl[kp][1]);
-        }
-        for (size_t i = 0; i < sizeof rates / sizeof rates[0]; i++) print_rate(rates[i]);
+        print_rates(r->pocl, rates, (int)(sizeof rates / sizeof rates[0]));
         printf(" %s | %s | %ld disagree |\n", ed, pd, r->wide_diff);
     }
     printf("\nThe same runs in Mrays per CPU-second (the CPU time of the whole process: the work per core, "
@@ -979,11 +983,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
         printf("| %s %s |", sets[k].name, sets[k].any ? "any" : "closest");
         const double rates[] = { r->cpu_c[0],  r->cpu_c[1],  r->cpu_cw[0], r->cpu_cw[1],
                                  r->cpu_e1[0], r->cpu_e1[1], r->cpu_e8[0], r->cpu_e8[1] };
-        for (int kp = 0; kp < N_KERNELS; kp++) {
-            print_rate(r->cpu_pocl[kp][0]);
-            print_rate(r->cpu_pocl[kp][1]);
-        }
-        for (size_t i = 0; i < sizeof rates / sizeof rates[0]; i++) print_rate(rates[i]);
+        print_rates(r->cpu_pocl, rates, (int)(sizeof rates / sizeof rates[0]));
         for (int kp = 0; kp < N_KERNELS; kp++)
             for (int t = 0; t < MAX_THREADS; t++)
                 print_rate(r->cpu_e1[t] > 0.0 ? r->cpu_pocl[kp][t] / r->cpu_e1[t] : 0.0);

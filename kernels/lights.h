@@ -133,6 +133,17 @@ KFN float light_pdf_env(const SceneView *sc, vec3 d)
     return !KF_HAS(KF_ENV_MAP) || li == NO_INDEX || sc->params->bg_type != BG_MAP ? 0.0f : sc->lights[li].pick_pdf * env_pdf(sc, d);
 }
 
+/* The share of a spot light's intensity sent at cosine c from its axis (enum
+ * SpotFalloff). */
+KFN float spot_falloff(Light l, float c)
+{
+    if (l.spot_falloff == SPOT_GLTF) {
+        float t = k_clamp((c - l.cos_outer) / k_fmax(l.cos_inner - l.cos_outer, 1e-3f), 0.0f, 1.0f);
+        return t * t;
+    }
+    return l.cos_inner > l.cos_outer ? k_smoothstep(l.cos_outer, l.cos_inner, c) : (c >= l.cos_outer ? 1.0f : 0.0f);
+}
+
 /* The light of delta light l arriving at ref: direction, distance and irradiance
  * across the direction. Returns 0 when none arrives (outside a spot's cone, ref on
  * the light, or l is the environment map, which is no delta light). */
@@ -157,11 +168,7 @@ KFN int light_delta_at(Light l, vec3 ref, LightSample *ls)
     ls->dist = dist;
     ls->p = l.position;
     float scale = 1.0f / atten;
-    if (l.type == LIGHT_SPOT) {
-        float c = -v3_dot(ls->wi, l.direction);
-        scale *= l.cos_inner > l.cos_outer ? k_smoothstep(l.cos_outer, l.cos_inner, c)
-                                           : (c >= l.cos_outer ? 1.0f : 0.0f);
-    }
+    if (l.type == LIGHT_SPOT) scale *= spot_falloff(l, -v3_dot(ls->wi, l.direction));
     ls->Le = v3_scale(l.intensity, scale);
     return scale > 0.0f;
 }

@@ -273,11 +273,19 @@ typedef struct {                                        /* 96 bytes */
     vec3 position;  float cos_outer;   /* spot: no light outside this cone (cosine) */
     vec3 direction; float cos_inner;   /* unit, where the light goes; spot: full inside */
     vec3 intensity; uint quad;        /* LIGHT_QUAD_* (triangle lights, below) */
-    vec3 normal;    uint pad0;        /* triangle lights: the unit normal surface_at gives
-                                       * the triangle, kept so that a light sample (15% of
-                                       * the scalar device's time on the Cornell box)
-                                       * need not build it each time */
+    vec3 normal;    uint spot_falloff;  /* triangle lights: the unit normal surface_at
+                                         * gives the triangle, kept so that a light
+                                         * sample (15% of the scalar device's time on the
+                                         * Cornell box) need not build it each time;
+                                         * spot: enum SpotFalloff */
 } Light;
+
+/* How a spot light fades between its inner and outer cones, c the cosine of the angle
+ * from its axis. SPOT_SMOOTHSTEP: smoothstep(cos_outer, cos_inner, c), as pbrt-v4's
+ * SpotLight (clpt's own `spot` and pbrt scenes). SPOT_GLTF: KHR_lights_punctual's
+ * reference rule, the square of the linear ramp clamp((c - cos_outer) / max(1e-3,
+ * cos_inner - cos_outer), 0, 1), which falls faster before levelling off. */
+enum SpotFalloff { SPOT_SMOOTHSTEP = 0, SPOT_GLTF = 1 };
 
 /* Two triangle lights that are the halves of one parallelogram (a quad lamp split in
  * two, as OBJ, PLY and glTF quads are), of one material and next to each other in the

@@ -290,6 +290,15 @@ static void test_nodes(void)
         CHECK_NEAR(l[2].cos_outer, cos(0.5), 1e-6);
         CHECK_NEAR(l[2].cos_inner, cos(0.25), 1e-6);
         CHECK_NEAR(l[2].intensity.x, 0.1, 1e-6);
+        /* between the cones, KHR_lights_punctual's reference falloff: the linear ramp in
+         * the cosine, squared (not clpt's smoothstep, 1.2-1.9 times brighter there) */
+        CHECK_EQ_INT(l[2].spot_falloff, SPOT_GLTF);
+        const double angles[5] = { 0.2, 0.3, 0.375, 0.45, 0.55 };
+        for (int i = 0; i < 5; i++) {
+            double c = cos(angles[i]), ramp = (c - cos(0.5)) / (cos(0.25) - cos(0.5));
+            ramp = fmin(fmax(ramp, 0.0), 1.0);
+            CHECK_NEAR(spot_falloff(l[2], (float)c), ramp * ramp, 2e-5);
+        }
     }
     /* the material with every extension */
     if (s.n_triangles == 1) {

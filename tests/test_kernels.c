@@ -268,6 +268,9 @@ static void build_scene(void)
     spot.atten1 = 0.1f;
     spot.atten2 = 0.0f;
     scene_add_light(&scene, spot, NULL);
+    spot.position = v3(-2.0f, 5.0f, -1.0f);
+    spot.spot_falloff = SPOT_GLTF;
+    scene_add_light(&scene, spot, NULL);
     Light dir = light_default(LIGHT_DIRECTIONAL);
     dir.direction = v3_norm(v3(0.4f, -1.0f, -0.3f));
     dir.intensity = v3(1.0f, 1.0f, 1.2f);

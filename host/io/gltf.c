@@ -1093,6 +1093,7 @@ static Status light_add(Gltf *g, int li, const Transform *xf, const char *jp)
             return st;
         L.cos_outer = (float)cos(outer);
         L.cos_inner = (float)cos(fmin(inner, outer));
+        L.spot_falloff = SPOT_GLTF;
     }
     g->has_lights = 1;
     return scene_add_light(g->s, L, g->err);

@@ -173,7 +173,8 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, RngKey key, uint *ray
             /* the classic tracer's reading of glTF: the diffuse share lit directly, the
              * specular as a mirror of the Schlick colour at this angle, transmission as
              * smooth glass tinted by the base colour */
-            float c = k_clamp(-v3_dot(d, ns), 0.0f, 1.0f), fd = schlick1(0.04f, c);
+            float eta = (m.flags & MAT_THIN) || front ? m.ior : 1.0f / m.ior;
+            float c = k_clamp(-v3_dot(d, ns), 0.0f, 1.0f), fd = principled_fresnel(eta, c);
             float diel = 1.0f - k_clamp(m.metallic, 0.0f, 1.0f), t = k_clamp(m.transmission, 0.0f, 1.0f);
             kr = v3_add(v3_scale(fresnel_schlick(kd, c), 1.0f - diel), v3s(diel * fd));
             kt = v3_scale(kd, diel * (1.0f - fd) * t);

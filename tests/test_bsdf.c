@@ -235,6 +235,10 @@ static void make_cases(void)
     all_cases[n_cases++] = principled_case("principled glass r0.3", 0.3f, 0.0f, 1.0f, 0.5f);
     all_cases[n_cases++] = principled_case("principled thin r0.5 t0.6", 0.5f, 0.0f, 0.6f, 0.0f);
     all_cases[n_cases - 1].p.thin = 1;
+    all_cases[n_cases++] = principled_case("principled glass r0.3 (leaving)", 0.3f, 0.0f, 1.0f, 0.0f);
+    all_cases[n_cases - 1].p.eta = 1.0f / 1.5f;
+    all_cases[n_cases++] = principled_case("principled ior 2.5 r0.4 t0.5", 0.4f, 0.0f, 0.5f, 0.0f);
+    all_cases[n_cases - 1].p.eta = 2.5f;
 }
 
 static void test_chi2(void)
@@ -346,9 +350,9 @@ static double ggx_albedo(Ggx g, double mu)
     return sum * (1.0 / NI) * (2.0 * M_PI / NJ);
 }
 
-/* A unit sphere at the origin under a white background, seen by an orthographic
- * camera whose view is the sphere's bounding square. */
-static void furnace_sphere_scene(Scene *s, Material m, uint spp, uint depth)
+/* A white background, an orthographic camera on +z looking at the origin with a view
+ * 2 units high, and m as the scene's material; its index goes to *mi. */
+static void furnace_scene(Scene *s, Material m, uint spp, uint depth, uint *mi)
 {
     scene_init(s);
     s->image.width = 48;
@@ -363,8 +367,14 @@ static void furnace_sphere_scene(Scene *s, Material m, uint spp, uint depth)
     s->bg_type = BG_CONSTANT;
     s->bg_color = v3s(1.0f);
     s->bg_zenith = v3s(1.0f);
+    scene_add_material(s, "m", m, mi, NULL);
+}
+
+/* A unit sphere at the origin in the furnace, the camera's view its bounding square. */
+static void furnace_sphere_scene(Scene *s, Material m, uint spp, uint depth)
+{
     uint mi;
-    scene_add_material(s, "m", m, &mi, NULL);
+    furnace_scene(s, m, spp, depth, &mi);
     Sphere sp = { v3(0.0f, 0.0f, 0.0f), 1.0f, mi, NO_INDEX, 0, 0 };
     scene_add_sphere(s, sp, NULL);
 }
@@ -465,6 +475,173 @@ static void test_furnace_dielectric(void)
             else CHECK(got > 0.94 && got < 1.005);
         }
         scene_free(&s);
+    }
+}
+
+/* KHR_materials_ior: the dielectric Fresnel term of the principled material is
+ * Schlick's curve from F0 = ((ior - 1)/(ior + 1))^2; from inside a solid it is that
+ * curve at the angle outside (Snell), and 1 past the critical angle. */
+static void test_principled_fresnel_ior(void)
+{
+    const double iors[5] = { 1.0, 1.33, 1.5, 2.0, 2.5 };
+    const double cosines[6] = { 1.0, 0.9, 0.6, 0.35, 0.1, 0.0 };
+    double worst = 0.0;
+    for (int i = 0; i < 5; i++) {
+        double ior = iors[i], f0 = pow((ior - 1.0) / (ior + 1.0), 2.0);
+        CHECK_NEAR(principled_f0((float)ior), f0, 1e-7);
+        for (int c = 0; c < 6; c++) {
+            double mu = cosines[c];
+            double outside = f0 + (1.0 - f0) * pow(1.0 - mu, 5.0);
+            double sin2_t = (1.0 - mu * mu) * ior * ior, inside = 1.0;
+            if (sin2_t < 1.0) inside = f0 + (1.0 - f0) * pow(1.0 - sqrt(1.0 - sin2_t), 5.0);
+            double e1 = fabs(principled_fresnel((float)ior, (float)mu) - outside);
+            double e2 = fabs(principled_fresnel((float)(1.0 / ior), (float)mu) - inside);
+            CHECK_MSG(e1 < 2e-6 && e2 < 2e-5, "ior %g cos %g: outside %.7f (want %.7f), inside %.7f (want %.7f)", ior,
+                      mu, (double)principled_fresnel((float)ior, (float)mu), outside,
+                      (double)principled_fresnel((float)(1.0 / ior), (float)mu), inside);
+            worst = fmax(worst, fmax(e1, e2));
+        }
+    }
+    CHECK_NEAR(principled_f0(2.5f), 0.183673, 1e-6);
+    fprintf(stderr, "  F0 and the Fresnel curve at 5 iors and 6 angles, both ways: largest error %.2e\n", worst);
+}
+
+static double schlick_ctx(double mu, const void *ctx)
+{
+    double f0 = *(const double *)ctx;
+    return f0 + (1.0 - f0) * pow(1.0 - mu, 5.0);
+}
+
+/* A smooth, black, non-metallic principled sphere reflects the white background by its
+ * Fresnel term alone: each pixel is Schlick(F0(ior), mu). ior 1.5 and 2.5 differ
+ * (F0 0.04 and 0.184). */
+static void test_principled_ior_render(void)
+{
+    const float iors[3] = { 1.5f, 2.5f, 1.2f };
+    for (int i = 0; i < 3; i++) {
+        Material m = material_principled(v3s(0.0f), 0.0f, 0.0f);
+        m.ior = iors[i];
+        Scene s;
+        furnace_sphere_scene(&s, m, 64, 1);
+        double f0 = pow((iors[i] - 1.0) / (iors[i] + 1.0), 2.0), got, want;
+        if (furnace_render(&s, schlick_ctx, &f0, &got, &want)) {
+            fprintf(stderr, "  smooth black principled sphere, ior %.1f: image %.4f, Schlick(F0 %.4f) %.4f\n",
+                    (double)iors[i], got, f0, want);
+            CHECK_NEAR(got, want, 0.004);
+        }
+        scene_free(&s);
+    }
+}
+
+/* The mean of the film's green channel and the share of its pixels below `dark`. */
+static double film_green_mean(const Film *film, double dark, double *dark_share)
+{
+    uint w = film->width, h = film->height;
+    float *rgb = malloc((size_t)w * h * 3 * sizeof *rgb);
+    film_resolve(film, rgb);
+    double sum = 0.0;
+    size_t n_dark = 0;
+    for (size_t i = 0; i < (size_t)w * h; i++) {
+        sum += rgb[3 * i + 1];
+        n_dark += rgb[3 * i + 1] < dark;
+    }
+    free(rgb);
+    *dark_share = (double)n_dark / ((double)w * h);
+    return sum / ((double)w * h);
+}
+
+/* A clear cube (principled, white, transmission 1) seen along a diagonal under a white
+ * background fills most of the view; every path through it leaves it again. */
+static double furnace_cube(Material m, double *dark_share)
+{
+    Scene s;
+    uint mi;
+    furnace_scene(&s, m, 64, 32, &mi);
+    s.camera.from = v3(3.0f, 2.5f, 4.0f);
+    s.camera.ortho_height = 1.9f;
+    Box b = { v3s(-0.6f), mi, v3s(0.6f), NO_INDEX };
+    scene_add_box(&s, b, NULL);
+    Film film;
+    Error err = { 0 };
+    Status st = render_util_run(&s, "scalar", 0, &film, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    double mean = -1.0;
+    if (st == ST_OK) {
+        mean = film_green_mean(&film, 0.5, dark_share);
+        film_free(&film);
+    }
+    scene_free(&s);
+    return mean;
+}
+
+/* Principled transmission without absorption in a white furnace: smooth and rough,
+ * solid and thin, a sphere and a cube (whose faces reflect much of the light inside
+ * totally), entering and leaving. Everything that enters leaves: smooth, within noise
+ * of 1; rough, up to the energy single-scattering facets lose at each of the many
+ * interfaces a path meets, which is the same as `dielectric` glass of that roughness
+ * loses in the same shape (within 1%: Schlick's Fresnel against the exact one). */
+static void test_furnace_principled_transmission(void)
+{
+    const float rough[3] = { 0.0f, 0.1f, 0.3f };
+    for (int thin = 0; thin < 2; thin++)
+        for (int r = 0; r < 3; r++) {
+            Material m = material_principled(v3s(1.0f), 0.0f, rough[r]);
+            m.transmission = 1.0f;
+            Material glass = material_dielectric(1.5f);
+            glass.roughness = rough[r];
+            if (thin) {
+                m.flags |= MAT_THIN;
+                glass.flags |= MAT_THIN;
+            }
+            Scene s;
+            furnace_sphere_scene(&s, m, 64, 32);
+            double got, want, dark = 1.0, glass_dark;
+            if (furnace_render(&s, one, NULL, &got, &want)) {
+                double cube = furnace_cube(m, &dark), glass_cube = 1.0, glass_sphere = 1.0;
+                if (rough[r] > 0.1f) {
+                    Scene g;
+                    furnace_sphere_scene(&g, glass, 64, 32);
+                    furnace_render(&g, one, NULL, &glass_sphere, &want);
+                    scene_free(&g);
+                    glass_cube = furnace_cube(glass, &glass_dark);
+                }
+                fprintf(stderr, "  principled transmission%s, roughness %.1f: sphere %.4f, cube %.4f "
+                        "(%.1f%% of pixels below 0.5); expected %.4f and %.4f\n", thin ? " (thin)" : "",
+                        (double)rough[r], got, cube, 100.0 * dark, glass_sphere, glass_cube);
+                CHECK_NEAR(got, glass_sphere, 0.01);
+                CHECK_NEAR(cube, glass_cube, 0.01);
+                CHECK(dark < 0.002);
+            }
+            scene_free(&s);
+        }
+}
+
+/* A white, clear principled solid seen from inside at every angle, smooth: the
+ * sampled albedo (reflection plus transmission) is 1 within noise, past the critical
+ * angle (cos 0.745 at ior 1.5) too, where all of it reflects. */
+static void test_principled_total_internal_reflection(void)
+{
+    const float angles[4] = { 0.95f, 0.8f, 0.6f, 0.2f };
+    for (int a = 0; a < 4; a++) {
+        Case k = principled_case("inside", 0.05f, 0.0f, 1.0f, 0.0f);
+        k.p.base = v3s(1.0f);
+        k.p.eta = 1.0f / 1.5f;
+        vec3 wo = v3(k_sqrt(1.0f - angles[a] * angles[a]), 0.0f, angles[a]);
+        double sum = 0.0, up = 0.0;
+        enum { N = 20000 };
+        for (int i = 0; i < N; i++) {
+            vec3 wi, f;
+            float pdf = case_sample(&k, wo, frand(), frand(), frand(), &wi, &f);
+            if (!(pdf > 0.0f)) continue;
+            double w = f.x * k_fabs(wi.z) / pdf;
+            sum += w;
+            if (wi.z > 0.0f) up += w;
+        }
+        fprintf(stderr, "  inside clear principled glass, cos %.2f: albedo %.4f, reflected %.4f\n",
+                (double)angles[a], sum / N, up / N);
+        CHECK_NEAR(sum / N, 1.0, 0.01);
+        if (angles[a] < 0.7f) CHECK_NEAR(up / N, 1.0, 0.01);
     }
 }
 
@@ -656,6 +833,10 @@ int main(void)
     RUN(test_principled_energy);
     RUN(test_furnace_conductor);
     RUN(test_furnace_dielectric);
+    RUN(test_principled_fresnel_ior);
+    RUN(test_principled_ior_render);
+    RUN(test_principled_total_internal_reflection);
+    RUN(test_furnace_principled_transmission);
     RUN(test_metallic_roughness_texture);
     RUN(test_normal_map);
     return harness_report();

@@ -19,6 +19,61 @@ typedef struct {
 
 KFN vec3 reflect_dir(vec3 d, vec3 n) { return v3_sub(d, v3_scale(n, 2.0f * v3_dot(d, n))); }
 
+/* ---------------------------------------------------------------- valid shading normals
+ * A shading normal (interpolated, or bent by a normal map) can face away from the
+ * viewer while the surface faces it: wo is then below the shading frame's horizon, the
+ * lobes evaluated in that frame return 0, and normal-mapped bumps drew black rims. As
+ * Cycles does (its kernel's ensure_valid_reflection), such a normal is bent toward ng,
+ * within the plane of the two, just far enough that the mirror direction of wo about
+ * it leaves above the surface. (The other production answer, microfacet-based normal
+ * mapping, Schuessler et al. 2017, replaces each lobe by a two-facet one; more work, and
+ * every material's sampling would change.) */
+
+/* How far above the tangent plane the mirror direction must leave, as the cosine with
+ * ng, for a view at cosine cos_o: 0.01, or less at grazing views, where no mirror
+ * direction need rise above the view's own elevation (Cycles' threshold). */
+KFN float valid_reflection_lift(float cos_o) { return k_fmin(0.9f * cos_o, 0.01f); }
+
+/* ns (unit, cosine with ng above 0 or not) bent as above for the incoming direction d;
+ * ng is the unit geometric normal on d's side. Returned unchanged when the mirror
+ * direction about it already clears the lift.
+ *
+ * In the frame z = ng, x = ns's part across ng, a normal at angle theta from z has
+ * the mirror direction's z = 2 (n.wo)(n.z) - wo.z = rho cos(2 theta - alpha), with
+ * (wo.x, wo.z) = rho (sin alpha, cos alpha): a sinusoid in 2 theta. It equals the lift
+ * at 2 theta = alpha + beta, cos beta = lift / rho, and is above it between there and
+ * theta = 0 (ng itself); as lift < wo.z, beta > |alpha|, so theta stays in (0, pi/2).
+ * Its cosine and sine come from those of 2 theta: the larger of the two by the
+ * half-angle formula, the other as sin(2 theta) / 2 over it, since 1 - cos(2 theta)
+ * loses every digit for the tiny bends of grazing views (a float cos(2 theta) of 1
+ * bent such normals all the way to ng). */
+KFN vec3 shading_normal_valid(vec3 d, vec3 ns, vec3 ng)
+{
+    vec3 wo = v3_neg(d);
+    float oz = v3_dot(wo, ng), nz = v3_dot(ns, ng);
+    if (!(oz > 0.0f)) return ns;   /* a grazing hit: no side to keep wo on */
+    float lift = valid_reflection_lift(oz);
+    if (2.0f * v3_dot(ns, wo) * nz - oz >= lift) return ns;
+    vec3 x = v3_sub(ns, v3_scale(ng, nz));
+    float lx = v3_len(x);
+    if (!(lx > 0.0f)) return ng;   /* ns = -ng: any bend is as good, ng is the least */
+    x = v3_scale(x, 1.0f / lx);
+    float ox = v3_dot(wo, x);
+    float rho = k_sqrt(ox * ox + oz * oz);
+    float cb = lift / rho, sb = k_safe_sqrt(1.0f - cb * cb);
+    float c2 = (oz * cb - ox * sb) / rho;   /* cos(alpha + beta) */
+    float s2 = k_fmax((ox * cb + oz * sb) / rho, 0.0f);
+    float c, s;
+    if (c2 >= 0.0f) {
+        c = k_sqrt(0.5f * (1.0f + c2));
+        s = s2 / (2.0f * c);
+    } else {
+        s = k_sqrt(0.5f * (1.0f - c2));
+        c = s2 / (2.0f * s);
+    }
+    return v3_add(v3_scale(ng, c), v3_scale(x, s));
+}
+
 /* Lambertian: f = albedo / pi, cosine-weighted sampling. */
 KFN BsdfSample bsdf_sample_diffuse(vec3 albedo, vec3 n, float u1, float u2)
 {
@@ -243,6 +298,16 @@ KFN int bsdf_has_density(Material m, vec3 albedo)
     if (MAT_IS(m, MAT_PHONG)) return phong_lobes(m, albedo).p_glossy > 0.0f;
     if (MAT_IS(m, MAT_CONDUCTOR) || MAT_IS(m, MAT_DIELECTRIC)) return !ggx_smooth(bsdf_ggx(m));
     return MAT_IS(m, MAT_PRINCIPLED);
+}
+
+/* The shading normal the material's lobes are to see for the incoming direction d
+ * (ns and ng on d's side): shading_normal_valid's, except for the Lambertian lobe,
+ * which does not look at wo, and the classic Phong, which needs no frame (its mirror
+ * falls back to ng itself): their images stay as they were. */
+KFN vec3 bsdf_normal(Material m, vec3 d, vec3 ns, vec3 ng)
+{
+    if (m.type == MAT_DIFFUSE || MAT_IS(m, MAT_PHONG)) return ns;
+    return shading_normal_valid(d, ns, ng);
 }
 
 KFN vec3 bsdf_to_local(vec3 w, vec3 t, vec3 b, vec3 n) { return v3(v3_dot(w, t), v3_dot(w, b), v3_dot(w, n)); }

@@ -165,7 +165,7 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     material_resolve(sc, &m, s, r.d, ng_face);
     if (m.type == MAT_EMISSIVE) return 0u;   /* pure emitters do not reflect */
     s.ns = material_normal(sc, m, s);
-    vec3 ns_face = front ? s.ns : v3_neg(s.ns);
+    vec3 ns_face = bsdf_normal(m, r.d, front ? s.ns : v3_neg(s.ns), ng_face);
     uint result = SHADE_SCATTERED;
     BsdfSample bs;
 

@@ -164,7 +164,7 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, RngKey key, uint *ray
         material_resolve(sc, &m, s, d, ng);
         if (m.type == MAT_EMISSIVE) continue;
         s.ns = material_normal(sc, m, s);
-        vec3 ns = front ? s.ns : v3_neg(s.ns);
+        vec3 ns = bsdf_normal(m, d, front ? s.ns : v3_neg(s.ns), ng);
 
         vec3 kd = material_albedo(sc, m, s, ng);
         material_at(sc, &m, s, ng);

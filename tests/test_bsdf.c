@@ -825,6 +825,53 @@ static void test_normal_map(void)
     CHECK(fabs(mean[2] - mean[0]) > 0.05 * mean[0]);   /* the tilt matters */
 }
 
+/* shading_normal_valid (bsdf.h) for random views and normals on ng's side: the mirror
+ * direction about its result leaves at least the lift above the surface (to rounding);
+ * a normal that already passes is returned as it is; a bent one is unit, lies in the
+ * plane of ns and ng between the two, and is bent no further than needed: its mirror
+ * direction sits at the lift, not above it, for grazing views too (where the lift is
+ * tiny and a cruder formula bent the normal all the way to ng). */
+static void test_valid_normal(void)
+{
+    int bent = 0, worst_unit = 0;
+    double worst_lift = 0.0, worst_exact = 0.0;
+    enum { N = 200000 };
+    for (int i = 0; i < N; i++) {
+        vec3 ng = v3_norm(v3(frand() - 0.5f, frand() - 0.5f, frand() - 0.5f));
+        vec3 ns = v3_norm(v3(frand() - 0.5f, frand() - 0.5f, frand() - 0.5f));
+        if (v3_dot(ns, ng) < 0.0f) ns = v3_neg(ns);
+        vec3 d = v3_norm(v3(frand() - 0.5f, frand() - 0.5f, frand() - 0.5f));
+        if (v3_dot(d, ng) > 0.0f) d = v3_neg(d);
+        if (i % 4 == 0) d = v3_norm(v3_madd(d, ng, -0.02f * v3_dot(d, ng)));   /* grazing views */
+        float oz = -v3_dot(d, ng);
+        if (!(oz > 0.0f)) continue;
+        vec3 n = shading_normal_valid(d, ns, ng);
+        float lift = valid_reflection_lift(oz);
+        float rz = v3_dot(reflect_dir(d, n), ng);
+        float rz0 = v3_dot(reflect_dir(d, ns), ng);
+        if (rz0 >= lift) {
+            CHECK(memcmp(&n, &ns, sizeof n) == 0);
+            continue;
+        }
+        bent++;
+        double below = lift - rz, off = fabs((double)rz - lift), unit = fabs(v3_len(n) - 1.0);
+        worst_lift = below > worst_lift ? below : worst_lift;
+        worst_exact = off > worst_exact ? off : worst_exact;
+        worst_unit += unit > 1e-6;
+        /* in the plane of ns and ng, on ns's side of ng, nearer ng */
+        CHECK(fabs(v3_dot(n, v3_norm(v3_cross(ns, ng)))) < 1e-5);
+        CHECK(v3_dot(n, ns) > 0.0f && v3_dot(n, ng) > v3_dot(ns, ng));
+        CHECK(-v3_dot(d, n) > 0.0f);   /* wo above the bent frame's horizon */
+        CHECK_MSG(rz > 0.5f * lift, "view at cos %g: mirror direction at %g, lift %g", (double)oz, (double)rz,
+                  (double)lift);
+    }
+    fprintf(stderr, "  %d of %d normals bent; mirror direction at most %.2g below the lift, at most %.2g off it; "
+            "%d not unit to 1e-6\n", bent, N, worst_lift, worst_exact, worst_unit);
+    CHECK(bent > N / 20);
+    CHECK(worst_exact < 1e-5);
+    CHECK_EQ_INT(worst_unit, 0);
+}
+
 int main(void)
 {
     RUN(test_chi2);
@@ -838,6 +885,7 @@ int main(void)
     RUN(test_principled_total_internal_reflection);
     RUN(test_furnace_principled_transmission);
     RUN(test_metallic_roughness_texture);
+    RUN(test_valid_normal);
     RUN(test_normal_map);
     return harness_report();
 }

@@ -1257,8 +1257,9 @@ static void test_kmath(void)
 /* The BSDF dispatch of kernels/bsdf.h (bsdf_eval and bsdf_sample over every material
  * type, the microfacet lobes of microfacet.h under them), through a test kernel built
  * from a folder holding just an entry.cl that includes bsdf.h: the same bits as the C
- * build for random directions, grazing and back-facing ones included. */
-enum { BSDF_IN = 17, BSDF_OUT = 13 };
+ * build for random directions, grazing and back-facing ones included; and the shading
+ * normal bsdf_normal makes valid for each (bent for the grazing views). */
+enum { BSDF_IN = 17, BSDF_OUT = 16 };
 
 static void bsdf_reference(const Material *mats, uint n_mats, uint i, const float *in, float *out)
 {
@@ -1269,8 +1270,9 @@ static void bsdf_reference(const Material *mats, uint n_mats, uint i, const floa
     float pdf;
     vec3 f = bsdf_eval(m, m.albedo, d, ns, front, wi, &pdf);
     BsdfSample bs = bsdf_sample(m, m.albedo, d, ns, ng, front, in[10], in[11], in[12], in[13]);
+    vec3 nv = bsdf_normal(m, d, ns, ng);
     float r[BSDF_OUT] = { f.x, f.y, f.z, pdf, bs.wi.x, bs.wi.y, bs.wi.z, bs.weight.x, bs.weight.y, bs.weight.z,
-                          bs.pdf, (float)bs.specular, (float)bs.transmitted };
+                          bs.pdf, (float)bs.specular, (float)bs.transmitted, nv.x, nv.y, nv.z };
     memcpy(out, r, sizeof r);
 }
 
@@ -1290,11 +1292,13 @@ static void test_bsdf(void)
           "    float pdf;\n"
           "    vec3 f = bsdf_eval(m, m.albedo, d, ns, front, wi, &pdf);\n"
           "    BsdfSample bs = bsdf_sample(m, m.albedo, d, ns, ng, front, x[10], x[11], x[12], x[13]);\n"
-          "    __global float *o = out + 13u * i;\n"
+          "    vec3 nv = bsdf_normal(m, d, ns, ng);\n"
+          "    __global float *o = out + 16u * i;\n"
           "    o[0] = f.x; o[1] = f.y; o[2] = f.z; o[3] = pdf;\n"
           "    o[4] = bs.wi.x; o[5] = bs.wi.y; o[6] = bs.wi.z;\n"
           "    o[7] = bs.weight.x; o[8] = bs.weight.y; o[9] = bs.weight.z; o[10] = bs.pdf;\n"
           "    o[11] = (float)bs.specular; o[12] = (float)bs.transmitted;\n"
+          "    o[13] = nv.x; o[14] = nv.y; o[15] = nv.z;\n"
           "}\n");
     if (!prog) return;
     Error err = {0};
@@ -1347,25 +1351,27 @@ static void test_bsdf(void)
     SET(k, 4, n);
     run(k, N);
     read_back(ob, BSDF_OUT * N * sizeof *dout, dout);
-    uint exact = 0, nonzero = 0;
+    uint exact = 0, nonzero = 0, bent = 0;
     for (uint i = 0; i < N; i++) {
         float cv[BSDF_OUT];
         bsdf_reference(mats, n_mats, i, in + BSDF_IN * i, cv);
+        bent += memcmp(&cv[13], in + BSDF_IN * i + 3, 3 * sizeof *cv) != 0;
         int same = memcmp(cv, dout + BSDF_OUT * i, sizeof cv) == 0;
         exact += same;
         if (!same && i + 1 - exact <= 3) {
             const Material *m = &mats[i % n_mats];
             fprintf(stderr, "    input %u: material %u (type %u, roughness %g), u_lobe %a\n", i, i % n_mats,
                     (uint)m->type, (double)m->roughness, (double)in[BSDF_IN * i + 10]);
-            report_words("bsdf outputs (f, pdf, wi, weight, pdf, specular, transmitted)", i, cv,
+            report_words("bsdf outputs (f, pdf, wi, weight, pdf, specular, transmitted, normal)", i, cv,
                          dout + BSDF_OUT * i, sizeof cv);
         }
         nonzero += cv[3] > 0.0f;
     }
-    fprintf(stderr, "  bsdf_eval / bsdf_sample: %u of %u inputs bit-identical to C (%u with a density)\n", exact,
-            (uint)N, nonzero);
+    fprintf(stderr, "  bsdf_eval / bsdf_sample / bsdf_normal: %u of %u inputs bit-identical to C (%u with a "
+            "density, %u normals bent)\n", exact, (uint)N, nonzero, bent);
     CHECK_EQ_INT(exact, N);
     CHECK(nonzero > N / 4);
+    CHECK(bent > N / 50);
     free(in);
     free(dout);
     clReleaseKernel(k);

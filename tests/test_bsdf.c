@@ -11,7 +11,9 @@
  *  - reciprocity of the reflection part;
  *  - no negative, NaN or infinite value for grazing and back-facing directions;
  *  - furnaces: an F = 1 conductor sphere under a white background renders the
- *    single-scattering albedo of GGX (integrated here), a rough glass sphere renders 1.
+ *    single-scattering albedo of GGX (integrated here), a rough glass sphere renders 1;
+ *  - normal maps: their tangent frame, the bending of shading normals that face away
+ *    from the viewer, and a square of mapped domes that shows no black where lit.
  */
 #include <stdlib.h>
 

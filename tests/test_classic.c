@@ -771,9 +771,11 @@ static Triangle tri(vec3 a, vec3 b, vec3 c)
 }
 
 /* Smooth mesh normals weigh every face the same (Fall 2019's Mesh.cpp sums unit face
- * normals): a big face (+z, area 8) and a small one (+x, area 0.5) meeting at the origin
- * give it (1, 0, 1) / sqrt 2, where area weights would give (0.06, 0, 1). Faces whose
- * normals cancel at a corner stay flat; triangles before `first` are left alone. */
+ * normals): a big face (+z, area 8) and a small one (+x, area 0.5) sharing the vertex
+ * at the origin give it (1, 0, 1) / sqrt 2, where area weights would give (0.06, 0, 1).
+ * Faces whose normals cancel at a corner stay flat; triangles before `first` are left
+ * alone; a face that meets the others at the origin through a vertex of its own (a
+ * vertex index not shared) keeps its own normal there, as the course's loader does. */
 static void test_smooth_normals(void)
 {
     Scene s;
@@ -785,7 +787,13 @@ static void test_smooth_normals(void)
     scene_add_triangle(&s, tri(o, v3(0, 0, 1), v3(0, -1, 0)), &err);
     scene_add_triangle(&s, tri(v3(5, 0, 0), v3(6, 0, 0), v3(5, 1, 0)), &err);      /* a face and its */
     scene_add_triangle(&s, tri(v3(5, 0, 0), v3(5, 1, 0), v3(6, 0, 0)), &err);      /* back: cancel */
-    CHECK(mesh_smooth_normals(&s, 1, &err) == ST_OK);
+    scene_add_triangle(&s, tri(o, v3(0, -1, 0), v3(-1, 0, 0)), &err);               /* unshared */
+    const uint keys[15] = { 0, 1, 2, 0, 3, 4, 5, 6, 7, 5, 7, 6, 8, 9, 10 };
+    CHECK(mesh_smooth_normals(&s, 1, keys, 11, &err) == ST_OK);
+    if (s.triangles[5].shading != NO_INDEX) {
+        const TriShading *c = &s.shading[s.triangles[5].shading];
+        CHECK(near3(c->n0, 0, 0, -1, 0) && near3(c->n1, 0, 0, -1, 0) && near3(c->n2, 0, 0, -1, 0));
+    }
     CHECK(s.triangles[0].shading == NO_INDEX);
     CHECK(s.triangles[3].shading == NO_INDEX && s.triangles[4].shading == NO_INDEX);
     CHECK(s.triangles[1].shading != NO_INDEX && s.triangles[2].shading != NO_INDEX);
@@ -798,6 +806,73 @@ static void test_smooth_normals(void)
         CHECK(near3(b->n1, 1, 0, 0, 0) && near3(b->n2, 1, 0, 0, 0));
     }
     scene_free(&s);
+}
+
+/* An OBJ cube (unit, no vn) written with 8 shared vertices, or with 24, four per face.
+ * Each face is two triangles. */
+static void write_cube(const char *name, int shared)
+{
+    static const int quads[6][4] = { { 0, 1, 3, 2 }, { 4, 6, 7, 5 }, { 0, 4, 5, 1 },
+                                     { 2, 3, 7, 6 }, { 0, 2, 6, 4 }, { 1, 5, 7, 3 } };
+    char text[2048];
+    size_t n = 0;
+    for (int f = 0; f < (shared ? 1 : 6); f++)
+        for (int c = 0; c < 8; c++) {
+            int k = shared ? c : quads[f][c % 4];
+            if (!shared && c >= 4) break;
+            n += (size_t)snprintf(text + n, sizeof text - n, "v %d %d %d\n", k >> 2 & 1, k >> 1 & 1, k & 1);
+        }
+    for (int f = 0; f < 6; f++) {
+        int v[4];
+        for (int j = 0; j < 4; j++) v[j] = 1 + (shared ? quads[f][j] : 4 * f + j);
+        n += (size_t)snprintf(text + n, sizeof text - n, "f %d %d %d\nf %d %d %d\n", v[0], v[1], v[2], v[0], v[2],
+                              v[3]);
+    }
+    write_file(name, text);
+}
+
+/* MIT 6.837 Fall 2019 smooths a mesh over shared vertex *indices*: a cube whose faces
+ * share no vertex renders faceted (every corner normal its face's), one of 8 shared
+ * vertices smooth (every corner normal leans toward the three faces meeting there,
+ * each triangle counted once, as the course sums them), and the faceted one under a
+ * mirroring transform too. Tsinghua's dialect (a sized camera) stays flat. */
+static void test_mesh_normals_by_index(void)
+{
+    write_cube("cube24.obj", 0);
+    write_cube("cube8.obj", 1);
+    const char *files[3] = { "cube24.obj", "cube8.obj", "cube24.obj" };
+    const char *xf[3] = { "", "", "Scale 1 1 -1 " };
+    for (int i = 0; i < 3; i++) {
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "%sMaterials { numMaterials 1 Material { diffuseColor 1 1 1 } }\n"
+                 "Group { numObjects 1 MaterialIndex 0 Transform { %sTriangleMesh { obj_file %s } } }\n", camera,
+                 xf[i], files[i]);
+        Scene s;
+        Error err;
+        Status st = load("cube.txt", text, &s, &err);
+        CHECK_MSG(st == ST_OK, "%s", err.msg);
+        CHECK_EQ_INT(s.n_triangles, 12);
+        int faceted = 0, diagonal = 0;
+        for (size_t t = 0; !st && t < s.n_triangles; t++) {
+            const Triangle *tr = &s.triangles[t];
+            if (tr->shading == NO_INDEX) continue;
+            vec3 e1 = v3_sub(tr->p1, tr->p0), e2 = v3_sub(tr->p2, tr->p0);
+            vec3 ng = v3_norm(v3_cross(e1, e2));
+            const TriShading *sh = &s.shading[tr->shading];
+            vec3 n[3] = { sh->n0, sh->n1, sh->n2 };
+            for (int j = 0; j < 3; j++) {
+                faceted += v3_dot(n[j], ng) > 0.999999f;
+                diagonal += fabsf(n[j].x) > 0.3f && fabsf(n[j].y) > 0.3f && fabsf(n[j].z) > 0.3f &&
+                            v3_dot(n[j], ng) > 0.3f;
+            }
+        }
+        fprintf(stderr, "  %s%s: %d of 36 corner normals are their face's, %d lean to three faces\n", files[i],
+                i == 2 ? " mirrored" : "", faceted, diagonal);
+        CHECK_EQ_INT(faceted, i == 1 ? 0 : 36);
+        CHECK_EQ_INT(diagonal, i == 1 ? 36 : 0);
+        scene_free(&s);
+    }
 }
 
 int main(void)
@@ -822,6 +897,7 @@ int main(void)
     RUN(test_scene_format_additions);
     RUN(test_shipped_scenes);
     RUN(test_smooth_normals);
+    RUN(test_mesh_normals_by_index);
     RUN(test_cli);
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);

@@ -808,12 +808,12 @@ static Status parse_mesh(Classic *c, const Token *kw, const Transform *m)
     /* the sink applies the transform as it does to a mesh of our format */
     MeshOptions o = mesh_options(material);
     o.xf = *m;
-    size_t first = c->s->n_triangles;
+    /* MIT Fall 2019's loader smooths a mesh's normals over shared vertex indices;
+     * Tsinghua's (a sized camera) keeps one normal per face (docs/classic-format.md,
+     * "Conventions") */
+    o.smooth_by_index = !c->camera_sized;
     st = obj_load_with(path, c->s, &o, c->err);
     free(path);
-    /* MIT Fall 2019's loader smooths a mesh's normals; Tsinghua's (a sized camera) keeps
-     * one normal per face (docs/classic-format.md, "Conventions") */
-    if (!st && !c->camera_sized) st = mesh_smooth_normals(c->s, first, c->err);
     if (st == ST_IO) {
         error_prefix(c->err, "%s:%u:%u", c->lx.path, v[MESH_FILE].word.line, v[MESH_FILE].word.col);
         return st;

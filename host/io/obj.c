@@ -44,6 +44,8 @@ typedef struct {
     float *uv;     size_t n_uv, cap_uv;       /* pairs */
     vec3 *nrm;     size_t n_nrm, cap_nrm;     /* unit, or zero when unusable */
     Corner *face;  size_t cap_face;
+    uint *keys;    size_t n_keys, cap_keys;   /* smooth_by_index: the triangles' corners'
+                                               * vertex indices, in the scene's order */
 } ObjReader;
 
 /* ------------------------------------------------------------------ the cursor */
@@ -267,9 +269,22 @@ static Status face_material(ObjReader *r, uint *out)
     return ST_OK;
 }
 
+/* The vertex indices of a triangle's corners for mesh_smooth_normals, in the order the
+ * sink stores them (corners 1 and 2 swap under a mirroring transform). */
+static Status keep_corner_keys(ObjReader *r, const Corner *const k[3])
+{
+    if (array_reserve((void **)&r->keys, &r->cap_keys, r->n_keys + 3, sizeof *r->keys))
+        return error_set(r->err, ST_INTERNAL, "out of memory reading '%s'", r->path);
+    int m = r->sink.mirrored != 0;
+    r->keys[r->n_keys++] = k[0]->v;
+    r->keys[r->n_keys++] = k[m ? 2 : 1]->v;
+    r->keys[r->n_keys++] = k[m ? 1 : 2]->v;
+    return ST_OK;
+}
+
 static Status emit_triangle(ObjReader *r, const Corner *a, const Corner *b, const Corner *c)
 {
-    const Corner *k[3] = { a, b, c };
+    const Corner *const k[3] = { a, b, c };
     vec3 p[3], n[3];
     float uv[6];
     int has_n = 1, has_uv = 1;
@@ -284,6 +299,7 @@ static Status emit_triangle(ObjReader *r, const Corner *a, const Corner *b, cons
     }
     uint material;
     Status st = face_material(r, &material);
+    if (!st && r->opt->smooth_by_index) st = keep_corner_keys(r, k);
     if (st) return st;
     return mesh_sink_triangle(&r->sink, p, has_n ? n : NULL, has_uv ? uv : NULL, material);
 }
@@ -442,6 +458,7 @@ Status obj_parse_with(const char *path, const char *text, size_t len, Scene *s, 
     r.material = NO_INDEX;
     r.default_material = o->default_material;
     r.err = err;
+    size_t first = s->n_triangles;
     Status st = mesh_sink_open(&r.sink, s, &o->xf, path, err);
     while (!st && r.p < r.end) {
         skip_hspace(&r);
@@ -474,6 +491,8 @@ Status obj_parse_with(const char *path, const char *text, size_t len, Scene *s, 
         if (st) break;
         next_line(&r);
     }
+    if (!st && o->smooth_by_index) st = mesh_smooth_normals(s, first, r.keys, (uint)r.n_pos, err);
+    free(r.keys);
     free(r.pos);
     free(r.uv);
     free(r.nrm);

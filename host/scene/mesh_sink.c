@@ -13,6 +13,7 @@ MeshOptions mesh_options(uint material)
     o.material = material;
     o.default_material = NO_INDEX;
     o.xf = transform_identity();
+    o.smooth_by_index = 0;
     return o;
 }
 
@@ -179,34 +180,6 @@ void mesh_bounds(const Scene *s, size_t first, size_t n, vec3 *lo, vec3 *hi)
 
 /* ------------------------------------------------------------------ smooth normals */
 
-typedef struct {
-    uint key[3];     /* the position's float bits (-0 as +0) */
-    uint used;
-    double sum[3];   /* unit face normals added up */
-} NormalSlot;
-
-static void position_key(vec3 p, uint key[3])
-{
-    const float c[3] = { p.x + 0.0f, p.y + 0.0f, p.z + 0.0f };   /* -0 + 0 is +0 */
-    for (int i = 0; i < 3; i++) memcpy(&key[i], &c[i], sizeof key[i]);
-}
-
-/* The slot of position p (claimed if new); the table is never full (at most half). */
-static NormalSlot *normal_slot(NormalSlot *t, size_t mask, vec3 p)
-{
-    uint key[3];
-    position_key(p, key);
-    size_t h = ((size_t)key[0] * 73856093u) ^ ((size_t)key[1] * 19349663u) ^ ((size_t)key[2] * 83492791u);
-    for (size_t i = h & mask;; i = (i + 1) & mask) {
-        if (!t[i].used) {
-            memcpy(t[i].key, key, sizeof key);
-            t[i].used = 1;
-            return &t[i];
-        }
-        if (memcmp(t[i].key, key, sizeof key) == 0) return &t[i];
-    }
-}
-
 /* A triangle's unit winding normal in double, or 0 0 0 when it has no area. */
 static void face_normal(const Triangle *t, double n[3])
 {
@@ -224,58 +197,53 @@ static int flat(const Scene *s, const Triangle *t)
     return t->shading == NO_INDEX || !(s->shading[t->shading].flags & TRI_HAS_NORMALS);
 }
 
-/* The normalised sum at a slot as a float unit vector; 0 when it cancels out. */
-static int slot_normal(const NormalSlot *slot, vec3 *out)
+/* The normalised sum n as a float unit vector; 0 when it cancels out. */
+static int summed_normal(const double *n, vec3 *out)
 {
-    const double *n = slot->sum;
     double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(len > 1e-9)) return 0;
     *out = v3((float)(n[0] / len), (float)(n[1] / len), (float)(n[2] / len));
     return !v3_is_zero(*out);
 }
 
-Status mesh_smooth_normals(Scene *s, size_t first, Error *err)
+static Status give_normals(Scene *s, Triangle *tr, const vec3 nn[3], Error *err)
 {
-    size_t n = 0;
-    for (size_t i = first; i < s->n_triangles; i++) n += flat(s, &s->triangles[i]);
-    if (n == 0) return ST_OK;
-    size_t cap = 16;
-    while (cap < 6 * n) cap *= 2;
-    NormalSlot *t = calloc(cap, sizeof *t);
-    if (!t) return error_set(err, ST_INTERNAL, "out of memory for the normals of %zu triangles", n);
+    if (tr->shading == NO_INDEX) {
+        TriShading sh;
+        memset(&sh, 0, sizeof sh);
+        Status st = scene_add_shading(s, sh, &tr->shading, err);
+        if (st) return st;
+    }
+    TriShading *sh = &s->shading[tr->shading];
+    sh->n0 = nn[0];
+    sh->n1 = nn[1];
+    sh->n2 = nn[2];
+    sh->flags |= TRI_HAS_NORMALS;
+    return ST_OK;
+}
+
+Status mesh_smooth_normals(Scene *s, size_t first, const uint *keys, uint n_keys, Error *err)
+{
+    double *sum = calloc((size_t)n_keys * 3 + 3, sizeof *sum);
+    if (!sum) return error_set(err, ST_INTERNAL, "out of memory for the normals of %u vertices", n_keys);
     for (size_t i = first; i < s->n_triangles; i++) {
         const Triangle *tr = &s->triangles[i];
         if (!flat(s, tr)) continue;
         double fn[3];
         face_normal(tr, fn);
-        const vec3 c[3] = { tr->p0, tr->p1, tr->p2 };
-        for (int j = 0; j < 3; j++) {
-            NormalSlot *slot = normal_slot(t, cap - 1, c[j]);
-            for (int k = 0; k < 3; k++) slot->sum[k] += fn[k];
-        }
+        for (int j = 0; j < 3; j++)
+            for (int k = 0; k < 3; k++) sum[3 * (size_t)keys[3 * (i - first) + j] + k] += fn[k];
     }
     Status st = ST_OK;
     for (size_t i = first; i < s->n_triangles && !st; i++) {
         Triangle *tr = &s->triangles[i];
         if (!flat(s, tr)) continue;
         vec3 nn[3];
-        const vec3 c[3] = { tr->p0, tr->p1, tr->p2 };
         int ok = 1;
-        for (int j = 0; j < 3 && ok; j++) ok = slot_normal(normal_slot(t, cap - 1, c[j]), &nn[j]);
-        if (!ok) continue;
-        if (tr->shading == NO_INDEX) {
-            TriShading sh;
-            memset(&sh, 0, sizeof sh);
-            st = scene_add_shading(s, sh, &tr->shading, err);
-            if (st) break;
-        }
-        TriShading *sh = &s->shading[tr->shading];
-        sh->n0 = nn[0];
-        sh->n1 = nn[1];
-        sh->n2 = nn[2];
-        sh->flags |= TRI_HAS_NORMALS;
+        for (int j = 0; j < 3 && ok; j++) ok = summed_normal(&sum[3 * (size_t)keys[3 * (i - first) + j]], &nn[j]);
+        if (ok) st = give_normals(s, tr, nn, err);
     }
-    free(t);
+    free(sum);
     return st;
 }
 

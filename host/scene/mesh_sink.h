@@ -25,6 +25,9 @@ typedef struct {
     uint material;
     uint default_material;
     Transform xf;
+    /* Faces without normals get smooth ones over the faces sharing each vertex index
+     * (mesh_smooth_normals; OBJ only, MIT 6.837 Fall 2019's convention). */
+    int smooth_by_index;
 } MeshOptions;
 
 /* Every triangle gets `material` (NO_INDEX: the file's own), no transform. */
@@ -73,9 +76,12 @@ void mesh_bounds(const Scene *s, size_t first, size_t n, vec3 *lo, vec3 *hi);
 
 /* Gives triangles [first, n_triangles) that have no normals smooth ones, as MIT 6.837
  * Fall 2019's OBJ loader does: at each corner the normalised sum of the unit winding
- * normals of those triangles that share the corner's exact position (each face counts
- * the same). A triangle whose corner sum cancels out stays flat. Linear time (a hash
- * table of positions); fails only when memory runs out (ST_INTERNAL). */
-Status mesh_smooth_normals(Scene *s, size_t first, Error *err);
+ * normals of those triangles whose corner has the same key (each face counts the same).
+ * keys[3 (i - first) + j] < n_keys is the key of corner j of triangle i: the file's
+ * vertex index, so that faces which share no vertex stay faceted ("If sharp edges
+ * required, build OBJ with no shared vertices", the course's Mesh.cpp). A triangle
+ * whose corner sum cancels out stays flat. Linear time; fails only when memory runs
+ * out (ST_INTERNAL). */
+Status mesh_smooth_normals(Scene *s, size_t first, const uint *keys, uint n_keys, Error *err);
 
 #endif /* CLPT_MESH_SINK_H */

@@ -121,13 +121,16 @@ KFN uint tex_wrap(float i, uint n, uint mode)
 
 /* A coordinate made small whatever its size, keeping what it wraps to: exactly
  * periodic when repeating (period 1) or mirroring (period 2), a margin beyond the edge
- * when clamping. NaN becomes 0. */
+ * when clamping. NaN becomes 0, and so does an infinity that repeats or mirrors (inf -
+ * inf is NaN): the texel index is converted from this to an integer, and a NaN or a
+ * value past the integer's range there is undefined behaviour in C and OpenCL alike
+ * (a texture map of scale 1e308 read out of bounds under ASan, issue 39). */
 KFN float tex_reduce(float u, uint mode)
 {
     if (!(u == u)) return 0.0f;
     if (mode == TEX_WRAP_CLAMP) return k_clamp(u, -1.0f, 2.0f);
-    if (mode == TEX_WRAP_MIRROR) return u - 2.0f * k_floor(u * 0.5f);
-    return u - k_floor(u);
+    float r = mode == TEX_WRAP_MIRROR ? u - 2.0f * k_floor(u * 0.5f) : u - k_floor(u);
+    return r == r ? r : 0.0f;
 }
 
 /* The four texels around (u, v) and the weights between them (texture_image). */

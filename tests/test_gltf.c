@@ -107,6 +107,34 @@ static void test_alpha_modes(void)
     }
 }
 
+/* KHR_texture_transform's scale of 1e308 is infinite as a float, and its lookups were
+ * NaN texel indices (issue 39): refused at load, named by its JSON path. */
+static void test_texture_transform_range(void)
+{
+    static const char *const tex = "],\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"unread.png\"}],"
+                                   "\"extensionsUsed\":[\"KHR_texture_transform\"";
+    static const struct { const char *scale, *msg; } cases[] = {
+        { "[1e308, 1]", "alpha.gltf: materials[0].pbrMetallicRoughness.baseColorTexture.extensions."
+                        "KHR_texture_transform: the texture's map has an entry that is not finite as a float: inf "
+                        "(row 1, column 1); clpt takes finite entries of at most 16777216 in size" },
+        { "[1, 3e7]", "alpha.gltf: materials[0].pbrMetallicRoughness.baseColorTexture.extensions."
+                      "KHR_texture_transform: the texture's map has the entry 3e+07 (row 2, column 2); clpt takes "
+                      "finite entries of at most 16777216 in size" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char mat[600];
+        snprintf(mat, sizeof mat, "{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":"
+                 "{\"KHR_texture_transform\":{\"scale\":%s}}}}}%s", cases[i].scale, tex);
+        Scene s;
+        Error err = { 0 };
+        Status st = load_triangle(mat, &s, &err);
+        CHECK(st == ST_INPUT);
+        CHECK_MSG(strcmp(err.msg, cases[i].msg) == 0, "got '%s'", err.msg);
+        error_clear(&err);
+        scene_free(&s);
+    }
+}
+
 /* Winding normal of triangle i, unnormalised. */
 static vec3 winding(const Scene *s, size_t i)
 {
@@ -723,6 +751,7 @@ int main(void)
     RUN(test_nodes);
     RUN(test_mesh_block);
     RUN(test_alpha_modes);
+    RUN(test_texture_transform_range);
     RUN(test_extras);
     RUN(test_cornell_box);
     RUN(test_material_spheres);

@@ -202,6 +202,37 @@ static void test_wrap_modes(void)
     scene_free(&scene);
 }
 
+/* A map's infinite or huge coordinate (a transform of scale 1e308 is infinite as a
+ * float; times u = 0 it is NaN) gives a defined texel: an infinity that repeats or
+ * mirrors reads as 0, clamped it holds the edge, and nothing is NaN (issue 39: the
+ * weights were NaN, and the NaN texel index was undefined behaviour). */
+static void test_hostile_coordinates(void)
+{
+    scene_init(&scene);
+    uint modes[4] = { float_texture(0), float_texture(TEX_MIRROR_U | TEX_MIRROR_V), float_texture(TEX_CLAMP),
+                      float_texture(TEX_NEAREST) };
+    view_setup();
+    const float hostile[5] = { INFINITY, -INFINITY, NAN, 3e38f, -3e38f };
+    for (int m = 0; m < 4; m++) {
+        Texture t = scene.textures[modes[m]];
+        for (int i = 0; i < 5; i++)
+            for (int j = 0; j < 5; j++) {
+                TexFootprint f = texture_footprint(t, hostile[i], hostile[j]);
+                CHECK_MSG(f.xa < 2 && f.xb < 2 && f.ya < 2 && f.yb < 2 && f.fx == f.fx && f.fy == f.fy,
+                          "mode %d at (%g, %g): texels x %u %u, y %u %u, weights %g %g", m, hostile[i], hostile[j],
+                          f.xa, f.xb, f.ya, f.yb, f.fx, f.fy);
+                vec3 c = texture_image(&view, t, hostile[i], hostile[j]);
+                CHECK_MSG(isfinite(c.x) && isfinite(c.y) && isfinite(c.z), "mode %d at (%g, %g): (%g, %g, %g)", m,
+                          hostile[i], hostile[j], c.x, c.y, c.z);
+            }
+        if (m == 2) continue;   /* clamped, +inf is the far edge */
+        vec3 inf = texture_image(&view, t, INFINITY, -INFINITY), zero = texture_image(&view, t, 0.0f, 0.0f);
+        CHECK_MSG(memcmp(&inf, &zero, sizeof inf) == 0, "mode %d: (inf, -inf) gives (%g, %g, %g), (0, 0) (%g, %g, %g)",
+                  m, inf.x, inf.y, inf.z, zero.x, zero.y, zero.z);
+    }
+    scene_free(&scene);
+}
+
 static void test_srgb_texels(void)
 {
     scene_init(&scene);
@@ -572,6 +603,7 @@ int main(void)
     RUN(test_inverse_trig);
     RUN(test_bilinear_and_wrap);
     RUN(test_wrap_modes);
+    RUN(test_hostile_coordinates);
     RUN(test_srgb_texels);
     RUN(test_checker);
     RUN(test_surface_uv);

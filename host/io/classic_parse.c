@@ -604,6 +604,10 @@ static Status parse_checkerboard(Classic *c, const Token *kw)
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 4; j++) mm[4 * i + j] = (float)m.m[i][j];
     texture_set_matrix(&tx, mm);
+    if ((st = texture_check_map(&tx, c->err))) {
+        error_prefix(c->err, "%s:%u:%u: the Checkerboard's transform", c->lx.path, kw->line, kw->col);
+        return st;
+    }
     if ((st = scene_add_texture(c->s, NULL, NULL, tx, &a.texture, c->err))) return st;
     return add_material(c, a);
 }

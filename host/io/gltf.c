@@ -561,7 +561,11 @@ static Status texture_transform(Gltf *g, const cJSON *tt, const char *jpath, flo
                            (float)-c, (float)d, 0.0f, (float)(1.0 - d - off[1]),
                            0.0f, 0.0f, 1.0f, 0.0f };
     memcpy(m, mm, sizeof mm);
-    return ST_OK;
+    Texture t;
+    memcpy(t.m, mm, sizeof mm);
+    st = texture_check_map(&t, g->err);
+    if (st) error_prefix(g->err, "%s: %s", g->path, jp);
+    return st;
 }
 
 /* One axis of a sampler: glTF's REPEAT, CLAMP_TO_EDGE or MIRRORED_REPEAT. */

@@ -1204,6 +1204,13 @@ static Status tex_uv_mapping(Parser *p, const Lexer *lx, Texture *t)
         (st = warn_once(p, lx, mapping, "texture-mapping", "texture mapping \"%.*s\" is not supported; uv is used",
                         (int)(mapping->len > 40 ? 40 : mapping->len), mapping->text)))
         return st;
+    const char *names[4] = { "uscale", "vscale", "udelta", "vdelta" };
+    const double vals[4] = { su, sv, du, dv };
+    for (int i = 0; i < 4; i++)
+        if (!(fabs(vals[i]) <= TEXTURE_MAX_MAP_ENTRY))
+            return lex_error_at(lx, &param_find(p, names[i])->decl, p->err, "\"%s\" is %g; clpt takes texture "
+                                "scales and offsets of at most %.0f in size", names[i], vals[i],
+                                (double)TEXTURE_MAX_MAP_ENTRY);
     texture_set_scale_offset(t, (float)su, (float)sv, (float)du, (float)dv);
     return ST_OK;
 }
@@ -1323,6 +1330,11 @@ static Status tex_checkerboard(Parser *p, const Lexer *lx, PTexture *t)
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 4; j++) m[4 * i + j] = (float)inv.m[i][j];
         texture_set_matrix(&tx, m);
+        if ((st = texture_check_map(&tx, p->err))) {
+            const Token *d = &param_find(p, "dimension")->decl;
+            error_prefix(p->err, "%s:%u:%u: the 3D checkerboard's transform", lx->path, d->line, d->col);
+            return st;
+        }
     } else if ((st = tex_uv_mapping(p, lx, &tx))) {
         return st;
     }

@@ -1076,7 +1076,8 @@ static const KeySpec texture_keys[TX_N] = {
     [TX_COLOR0] = {"color0", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [TX_COLOR1] = {"color1", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [TX_SPACE] = {"space", VK_WORD, 0, 0, 0, 0, 0, "uv or solid"},
-    [TX_SCALE] = {"scale", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
+    /* TEXTURE_MAX_MAP_ENTRY: a larger scale leaves no fraction to pick a texel by */
+    [TX_SCALE] = {"scale", VK_NUMBER, 0, 0, TEXTURE_MAX_MAP_ENTRY, 1, 0, "a number in (0, 16777216]"},
 };
 
 static Status parse_texture(Parser *p, Lexer *lx, const Token *kw)

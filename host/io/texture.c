@@ -8,6 +8,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -50,6 +51,18 @@ void texture_set_scale_offset(Texture *t, float su, float sv, float ou, float ov
 void texture_set_matrix(Texture *t, const float m[12])
 {
     memcpy(t->m, m, sizeof t->m);
+}
+
+Status texture_check_map(const Texture *t, Error *err)
+{
+    for (int i = 0; i < 12; i++) {
+        float e = t->m[i];
+        if (e >= -TEXTURE_MAX_MAP_ENTRY && e <= TEXTURE_MAX_MAP_ENTRY) continue;
+        return error_set(err, ST_INPUT, "the texture's map has %s %g (row %d, column %d); clpt takes finite entries "
+                         "of at most %.0f in size", isfinite(e) ? "the entry" : "an entry that is not finite as a "
+                         "float:", (double)e, i / 4 + 1, i % 4 + 1, (double)TEXTURE_MAX_MAP_ENTRY);
+    }
+    return ST_OK;
 }
 
 /* Packs 8-bit RGBA into the uint texel layout of kernels/texture.h. */

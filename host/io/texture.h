@@ -23,6 +23,17 @@ void texture_set_scale_offset(Texture *t, float su, float sv, float ou, float ov
 /* Sets the full 3x4 row-major map to texture space. */
 void texture_set_matrix(Texture *t, const float m[12]);
 
+/* The largest entry a texture's map may have: past 2^24 a coordinate has no fraction
+ * left to choose a texel by (every point reads the same one), and a scale beyond
+ * float's range is infinite, whose lookups are NaN. */
+#define TEXTURE_MAX_MAP_ENTRY 16777216.0f
+
+/* Fails with ST_INPUT unless every entry of t's map is finite and at most
+ * TEXTURE_MAX_MAP_ENTRY in size: "the texture's map has WHAT ENTRY (row R, column C);
+ * clpt takes finite entries of at most 16777216 in size", which the caller prefixes
+ * with where the map was given. */
+Status texture_check_map(const Texture *t, Error *err);
+
 /* Reads the image file at `path` (or reuses the texels of an earlier read of it with
  * the same encoding) and adds an image texture for it to the scene, with the given name
  * (NULL: anonymous). 8-bit images are sRGB-encoded colours unless `linear`; HDR images

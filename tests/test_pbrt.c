@@ -416,6 +416,58 @@ static void test_gzip(void)
     rmdir(dir);
 }
 
+/* A 510 KB .pbrt.gz inflated to 536 MB, and includes added such files up without end
+ * (issue 39): one load's files count against one budget, a .gz file inflated, set by
+ * CLPT_MAX_LOAD_BYTES (16 GiB by default). A 1 MiB comment compressed to about 1 KB,
+ * included twice by a file included twice: the fourth passes a 3.5 MiB budget. */
+static void test_load_budget(void)
+{
+    char dir[] = "/tmp/clpt-test-budget-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    size_t big = (size_t)1 << 20;
+    char *text = malloc(big);
+    CHECK(text != NULL);
+    if (!text) return;
+    memset(text, ' ', big);
+    text[0] = '#';
+    text[big - 1] = '\n';
+    char bomb[96], mid[96], top[96];
+    snprintf(bomb, sizeof bomb, "%s/bomb.pbrt.gz", dir);
+    snprintf(mid, sizeof mid, "%s/mid.pbrt", dir);
+    snprintf(top, sizeof top, "%s/top.pbrt", dir);
+    write_file(bomb, text, big, 1);
+    free(text);
+    static const char inc_bomb[] = "Include \"bomb.pbrt.gz\"\nInclude \"bomb.pbrt.gz\"\n";
+    static const char inc_mid[] = "WorldBegin\nInclude \"mid.pbrt\"\nInclude \"mid.pbrt\"\n";
+    write_file(mid, inc_bomb, strlen(inc_bomb), 0);
+    write_file(top, inc_mid, strlen(inc_mid), 0);
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load(top, &s, &err), ST_OK);     /* the default budget */
+    scene_free(&s);
+    setenv("CLPT_MAX_LOAD_BYTES", "3670016", 1);
+    char msg[400];
+    snprintf(msg, sizeof msg, "'%s': reading it takes this load's input to more than 3670016 bytes (the files of one "
+             "scene together, .gz files inflated; CLPT_MAX_LOAD_BYTES sets the budget)", bomb);
+    CHECK_EQ_INT(load(top, &s, &err), ST_INPUT);
+    CHECK_MSG(strstr(err.msg, msg) != NULL, "got '%s', expected it to end '%s'", err.msg, msg);
+    scene_free(&s);
+    setenv("CLPT_MAX_LOAD_BYTES", "4200000", 1);   /* four bombs and the two files */
+    CHECK_EQ_INT(load(top, &s, &err), ST_OK);
+    scene_free(&s);
+    setenv("CLPT_MAX_LOAD_BYTES", "3 GB", 1);
+    CHECK_EQ_INT(load(top, &s, &err), ST_USAGE);
+    CHECK_MSG(strcmp(err.msg, "CLPT_MAX_LOAD_BYTES='3 GB': expected a whole number of bytes") == 0, "got '%s'",
+              err.msg);
+    scene_free(&s);
+    unsetenv("CLPT_MAX_LOAD_BYTES");
+    error_clear(&err);
+    unlink(bomb);
+    unlink(mid);
+    unlink(top);
+    rmdir(dir);
+}
+
 static void test_instances(void)
 {
     Scene s;
@@ -1161,5 +1213,6 @@ int main(void)
     RUN(test_compare);
     RUN(test_errors);
     RUN(test_gzip);
+    RUN(test_load_budget);
     return harness_report();
 }

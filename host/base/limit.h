@@ -43,6 +43,12 @@
 #define CLPT_MAX_TESSELLATED_TRIANGLES (1u << 20)
 /* Any one input file: it is read whole into memory. */
 #define CLPT_MAX_FILE_BYTES ((uint64_t)4 << 30)
+/* The text one scene load reads, all its files together (includes, meshes, MTL files,
+ * glTF buffers; a .gz file counted inflated): a 510 KB .pbrt.gz inflates to 536 MB, and
+ * a file that includes it many times (or files that include each other, nested) made
+ * that hundreds of times over. pbrt-v4's largest scenes are a few GB of text; the
+ * environment variable CLPT_MAX_LOAD_BYTES (io/lexer.h) sets another budget. */
+#define CLPT_MAX_LOAD_BYTES ((uint64_t)16 << 30)
 
 /* Stringified, for messages built at compile time ("an integer in 1.." CLPT_STR(...)). */
 #define CLPT_STR_(x) #x

@@ -85,6 +85,55 @@ Status lex_check_file(const char *path, Error *err)
     return limit_file_size(path, (uint64_t)sb.st_size, err);
 }
 
+/* The scene load in progress on this thread (lex_load_begin): how deeply loads nest,
+ * the bytes its files took so far (at most the budget) and its budget. Thread-local:
+ * a load reads its files on one thread, and each thread may load its own scene. */
+static _Thread_local struct {
+    int depth;
+    uint64_t used, budget;
+} lex_load;
+
+Status lex_load_begin(Error *err)
+{
+    if (lex_load.depth++ > 0) return ST_OK;
+    lex_load.used = 0;
+    lex_load.budget = CLPT_MAX_LOAD_BYTES;
+    const char *env = getenv("CLPT_MAX_LOAD_BYTES");
+    if (env && *env) {
+        char *end;
+        errno = 0;
+        unsigned long long v = strtoull(env, &end, 10);
+        if (*end || errno || !(env[0] >= '0' && env[0] <= '9')) {
+            lex_load.depth = 0;
+            return error_set(err, ST_USAGE, "CLPT_MAX_LOAD_BYTES='%.64s': expected a whole number of bytes", env);
+        }
+        lex_load.budget = v;
+    }
+    return ST_OK;
+}
+
+void lex_load_end(void)
+{
+    if (lex_load.depth > 0) lex_load.depth--;
+}
+
+/* The most bytes the next file may take: its own limit, and within a load what is left
+ * of the load's budget. */
+static uint64_t read_limit(void)
+{
+    uint64_t left = lex_load.depth ? lex_load.budget - lex_load.used : CLPT_MAX_FILE_BYTES;
+    return left < CLPT_MAX_FILE_BYTES ? left : CLPT_MAX_FILE_BYTES;
+}
+
+/* The error for a file found to take `bytes`, more than read_limit(). */
+static Status over_limit(const char *path, uint64_t bytes, Error *err)
+{
+    if (bytes > CLPT_MAX_FILE_BYTES) return limit_file_size(path, bytes, err);
+    return error_set(err, ST_INPUT, "'%s': reading it takes this load's input to more than %llu bytes (the files "
+                     "of one scene together, .gz files inflated; CLPT_MAX_LOAD_BYTES sets the budget)", path,
+                     (unsigned long long)lex_load.budget);
+}
+
 /* Only the name says a file is compressed: a glTF .bin or a binary PLY may well start
  * with gzip's magic bytes by chance. */
 static int ends_in_gz(const char *path)
@@ -95,9 +144,10 @@ static int ends_in_gz(const char *path)
 
 /* Inflates the gzip data `in` (one member or several concatenated, as gzip -c a b
  * writes them) into a new buffer with room for a NUL after it. The output is checked
- * against CLPT_MAX_FILE_BYTES before each growth, so that a small file that inflates to
+ * against `limit` (read_limit) before each growth, so that a small file that inflates to
  * terabytes stops at the same limit as a large plain file instead of exhausting memory. */
-static Status gunzip(const char *path, const char *in, size_t in_len, char **out, size_t *out_len, Error *err)
+static Status gunzip(const char *path, const char *in, size_t in_len, uint64_t limit, char **out, size_t *out_len,
+                     Error *err)
 {
     *out = NULL;
     *out_len = 0;
@@ -107,7 +157,7 @@ static Status gunzip(const char *path, const char *in, size_t in_len, char **out
         return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
     /* text compresses about 4:1; a first guess that big saves most of the regrowth */
     uint64_t guess = (uint64_t)in_len * 4 < ((uint64_t)1 << 16) ? (uint64_t)1 << 16 : (uint64_t)in_len * 4;
-    size_t cap = guess > CLPT_MAX_FILE_BYTES + 2 ? (size_t)(CLPT_MAX_FILE_BYTES + 2) : (size_t)guess, n = 0;
+    size_t cap = guess > limit + 2 ? (size_t)(limit + 2) : (size_t)guess, n = 0;
     char *buf = malloc(cap);
     Status st = ST_OK;
     if (!buf) {
@@ -118,11 +168,11 @@ static Status gunzip(const char *path, const char *in, size_t in_len, char **out
     for (;;) {
         if (cap - n < 2) {
             /* the buffer never outgrows the limit and its NUL: full, the data is over it */
-            if (n > CLPT_MAX_FILE_BYTES) {
-                st = limit_file_size(path, n, err);
+            if (n > limit) {
+                st = over_limit(path, n, err);
                 goto done;
             }
-            size_t want = (uint64_t)cap * 2 > CLPT_MAX_FILE_BYTES + 2 ? (size_t)(CLPT_MAX_FILE_BYTES + 2) : cap * 2;
+            size_t want = (uint64_t)cap * 2 > limit + 2 ? (size_t)(limit + 2) : cap * 2;
             char *grown = realloc(buf, want);
             if (!grown) {
                 st = error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
@@ -162,12 +212,15 @@ static Status gunzip(const char *path, const char *in, size_t in_len, char **out
                            zs.msg ? zs.msg : "unknown error");
             goto done;
         }
-        if (n > CLPT_MAX_FILE_BYTES) {
-            st = limit_file_size(path, n, err);
+        if (n > limit) {
+            st = over_limit(path, n, err);
             goto done;
         }
     }
-    if ((st = limit_file_size(path, n, err))) goto done;
+    if (n > limit) {
+        st = over_limit(path, n, err);
+        goto done;
+    }
     *out = buf;
     *out_len = n;
     buf = NULL;
@@ -187,10 +240,11 @@ static Status read_whole(const char *path, int allow_pipe, char **data, size_t *
     Status st = open_input(path, allow_pipe, &fd, &sb, err);
     if (st) return st;
     size_t cap = 1 << 16, n = 0;
+    uint64_t limit = read_limit();
     if (S_ISREG(sb.st_mode)) {
-        if ((st = limit_file_size(path, (uint64_t)sb.st_size, err))) {
+        if ((uint64_t)sb.st_size > limit) {
             close(fd);
-            return st;
+            return over_limit(path, (uint64_t)sb.st_size, err);
         }
         /* the whole file and the NUL in one allocation */
         if ((uint64_t)sb.st_size + 2 > cap) cap = (size_t)sb.st_size + 2;
@@ -201,10 +255,10 @@ static Status read_whole(const char *path, int allow_pipe, char **data, size_t *
         return error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
     }
     for (;;) {
-        if (n > CLPT_MAX_FILE_BYTES) {
+        if (n > limit) {
             free(buf);
             close(fd);
-            return limit_file_size(path, n, err);
+            return over_limit(path, n, err);
         }
         if (cap - n < 2) {
             char *grown = cap <= ((size_t)-1) / 2 ? realloc(buf, cap * 2) : NULL;
@@ -235,7 +289,7 @@ static Status read_whole(const char *path, int allow_pipe, char **data, size_t *
     close(fd);
     if (ends_in_gz(path)) {
         char *raw = buf;
-        st = gunzip(path, raw, n, &buf, &n, err);
+        st = gunzip(path, raw, n, limit, &buf, &n, err);
         free(raw);
         if (st) return st;
     }
@@ -243,6 +297,7 @@ static Status read_whole(const char *path, int allow_pipe, char **data, size_t *
     if (skip) memmove(buf, buf + skip, n - skip);
     n -= skip;
     buf[n] = '\0';
+    if (lex_load.depth) lex_load.used += n;
     *data = buf;
     *len = n;
     return ST_OK;

@@ -69,6 +69,19 @@ Status lex_read_input(const char *path, char **data, size_t *len, Error *err);
  * name (texture images): ST_OK when `path` is a regular file clpt may read. */
 Status lex_check_file(const char *path, Error *err);
 
+/* A scene load's budget of input text: between lex_load_begin and lex_load_end every
+ * file that lex_read_file, lex_read_input and lex_open_file read on this thread counts
+ * (a .gz file inflated), and one that would take the total past the budget fails with
+ * ST_INPUT "'PATH': reading it takes this load's input to more than N bytes (the files
+ * of one scene together, .gz files inflated; CLPT_MAX_LOAD_BYTES sets the budget)",
+ * inflation stopping there. The budget is CLPT_MAX_LOAD_BYTES (base/limit.h) or the
+ * environment variable of that name, a whole number of bytes; lex_load_begin fails
+ * with ST_USAGE on another value. Loads nest (a mesh file's load within a scene's):
+ * only the outermost begins and ends the count. Outside a load only each file's own
+ * limit applies. */
+Status lex_load_begin(Error *err);
+void lex_load_end(void);
+
 /* 3 when text starts with a UTF-8 byte order mark (EF BB BF), else 0. */
 size_t lex_bom_length(const char *text, size_t len);
 

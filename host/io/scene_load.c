@@ -51,8 +51,9 @@ static Status gltf_scene(const char *path, const char *text, size_t len, Scene *
     return ST_OK;
 }
 
-Status scene_load_bytes(const char *path, const char *text, size_t len, SceneFormat format, Scene *s,
-                        SceneKind *kind, Error *err)
+/* scene_load_bytes within a load already begun (lex_load_begin). */
+static Status load_bytes(const char *path, const char *text, size_t len, SceneFormat format, Scene *s,
+                         SceneKind *kind, Error *err)
 {
     /* dropped here too, for bytes that did not come through lex_read_input */
     size_t bom = lex_bom_length(text, len);
@@ -69,13 +70,29 @@ Status scene_load_bytes(const char *path, const char *text, size_t len, SceneFor
     return st ? st : mesh_view_frame(path, s, err);
 }
 
+/* Each load counts the text its files take against one budget (lex_load_begin), the
+ * file named here included. */
+Status scene_load_bytes(const char *path, const char *text, size_t len, SceneFormat format, Scene *s,
+                        SceneKind *kind, Error *err)
+{
+    Status st = lex_load_begin(err);
+    if (st) return st;
+    st = load_bytes(path, text, len, format, s, kind, err);
+    lex_load_end();
+    return st;
+}
+
 Status scene_load_file(const char *path, SceneFormat format, Scene *s, SceneKind *kind, Error *err)
 {
+    Status st = lex_load_begin(err);
+    if (st) return st;
     char *text;
     size_t len;
-    Status st = lex_read_input(path, &text, &len, err);
-    if (st) return st;
-    st = scene_load_bytes(path, text, len, format, s, kind, err);
-    free(text);
+    st = lex_read_input(path, &text, &len, err);
+    if (!st) {
+        st = load_bytes(path, text, len, format, s, kind, err);
+        free(text);
+    }
+    lex_load_end();
     return st;
 }

@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "harness.h"
 #include "kmath.h"
@@ -130,6 +131,174 @@ static void test_texture_transform_range(void)
         Status st = load_triangle(mat, &s, &err);
         CHECK(st == ST_INPUT);
         CHECK_MSG(strcmp(err.msg, cases[i].msg) == 0, "got '%s'", err.msg);
+        error_clear(&err);
+        scene_free(&s);
+    }
+}
+
+/* A glTF document from memory, as a file named `name` in folder `dir` would load
+ * (scene_load_bytes, so that the load's budget of input applies). */
+static Status load_text(const char *name, const char *text, Scene *s, Error *err)
+{
+    scene_init(s);
+    return scene_load_bytes(name, text, strlen(text), SCENE_FORMAT_AUTO, s, NULL, err);
+}
+
+/* The top of a one-node document over buffer 0's first 36 bytes, one triangle, with
+ * `rest` after it (buffers, images, materials, more nodes). */
+#define ONE_TRIANGLE_DOC                                                                                \
+    "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}]," \
+    "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","               \
+    "\"min\":[0,0,0],\"max\":[1,1,0]}],"
+
+/* Images that share a source decode it once (issue 39: a 20 KB GLB whose hundreds of
+ * images named one buffer view decoded each again, 2.1 GB and 20 s): three images on
+ * one buffer view and two on one data: URI, in five materials, make two textures of
+ * 4 x 4 texels, not five. The buffer: a triangle's corners (36 bytes), then a 4 x 4
+ * orange PNG (75 bytes). */
+static void test_shared_image_sources(void)
+{
+    static const char b64[] = "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAiVBORw0KGgoAAAANSUhEUgAAAAQAAAAECAYAAACp"
+                              "8Z5+AAAAEklEQVR42mP438DwHxkzkC4AAFBPJ+ERcipZAAAAAElFTkSuQmCC";
+    static const char png_b64[] = "iVBORw0KGgoAAAANSUhEUgAAAAQAAAAECAYAAACp8Z5+AAAAEklEQVR42mP438DwHxkzkC4AAFBPJ+ERcipZ"
+                                  "AAAAAElFTkSuQmCC";
+    char text[4096];
+    snprintf(text, sizeof text, ONE_TRIANGLE_DOC
+             "\"buffers\":[{\"byteLength\":111,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":75}],"
+             "\"images\":[{\"bufferView\":1,\"mimeType\":\"image/png\"},{\"bufferView\":1,\"mimeType\":\"image/png\"},"
+             "{\"bufferView\":1,\"mimeType\":\"image/png\"},{\"uri\":\"data:image/png;base64,%s\"},"
+             "{\"uri\":\"data:image/png;base64,%s\"}],"
+             "\"textures\":[{\"source\":0},{\"source\":1},{\"source\":2},{\"source\":3},{\"source\":4}],"
+             "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}},"
+             "{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":1}}},"
+             "{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":2}}},"
+             "{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":3}}},"
+             "{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":4}}}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0},"
+             "{\"attributes\":{\"POSITION\":0},\"material\":1},{\"attributes\":{\"POSITION\":0},\"material\":2},"
+             "{\"attributes\":{\"POSITION\":0},\"material\":3},{\"attributes\":{\"POSITION\":0},\"material\":4}]}]}",
+             b64, png_b64, png_b64);
+    Scene s;
+    Error err = { 0 };
+    CHECK_MSG(load_text("shared.gltf", text, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_textures, 2);
+    CHECK_EQ_INT(s.n_texels, 2 * 16);
+    CHECK_EQ_INT(s.n_triangles, 5);
+    error_clear(&err);
+    scene_free(&s);
+}
+
+/* Buffers that name one file read it once (issue 39: once per buffer): three buffers
+ * on a 64 KiB file load within a budget of input (CLPT_MAX_LOAD_BYTES) that holds two
+ * reads of it, not three. */
+static void test_shared_buffer_file(void)
+{
+    char dir[] = "/tmp/clpt-test-gltf-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char bin[96], gltf[96];
+    snprintf(bin, sizeof bin, "%s/mesh data.bin", dir);
+    snprintf(gltf, sizeof gltf, "%s/shared.gltf", dir);
+    FILE *f = fopen(bin, "wb");
+    CHECK(f != NULL);
+    if (!f) return;
+    const float corners[9] = { 0, 0, 0, 1, 0, 0, 0, 1, 0 };
+    fwrite(corners, sizeof corners, 1, f);
+    for (int i = 0; i < 65536 - 36; i++) fputc(0, f);
+    fclose(f);
+    /* "%20" is the file name's space (percent-decoded, as URIs are) */
+    f = fopen(gltf, "wb");
+    CHECK(f != NULL);
+    if (!f) return;
+    fprintf(f, ONE_TRIANGLE_DOC "\"bufferViews\":[{\"buffer\":2,\"byteLength\":36}],\"buffers\":["
+            "{\"byteLength\":65536,\"uri\":\"mesh%%20data.bin\"},{\"byteLength\":65536,\"uri\":\"mesh%%20data.bin\"},"
+            "{\"byteLength\":36,\"uri\":\"./mesh%%20data.bin\"}],"
+            "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}]}");
+    fclose(f);
+    setenv("CLPT_MAX_LOAD_BYTES", "140000", 1);
+    Scene s;
+    Error err = { 0 };
+    scene_init(&s);
+    Status st = scene_load_file(gltf, SCENE_FORMAT_AUTO, &s, NULL, &err);
+    unsetenv("CLPT_MAX_LOAD_BYTES");
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_triangles, 1);
+    error_clear(&err);
+    scene_free(&s);
+    unlink(bin);
+    unlink(gltf);
+    rmdir(dir);
+}
+
+/* A strip of 1-byte indices makes a triangle per byte, and each node that instances it
+ * as many again: a 4 MB strip in 16 nodes made 2^26 triangles (issue 39). A file makes
+ * at most 2^20 + one per byte of it and its buffers; the primitive that would pass that
+ * is refused before it makes any, named with its node. Here 4096 zero indices (a strip
+ * of degenerate triangles, dropped quickly) in 300 nodes. */
+static void test_triangle_bound(void)
+{
+    size_t idx_b64 = 4096 / 3 * 4 + 4, cap = 64 * 300 + idx_b64 + 4096;
+    char *text = malloc(cap);
+    CHECK(text != NULL);
+    if (!text) return;
+    size_t n = (size_t)snprintf(text, cap, "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[");
+    for (int i = 0; i < 300; i++) n += (size_t)snprintf(text + n, cap - n, "%s%d", i ? "," : "", i);
+    n += (size_t)snprintf(text + n, cap - n, "]}],\"nodes\":[");
+    for (int i = 0; i < 300; i++) n += (size_t)snprintf(text + n, cap - n, "%s{\"mesh\":0}", i ? "," : "");
+    n += (size_t)snprintf(text + n, cap - n, "],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,"
+                          "\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5121,"
+                          "\"count\":4096,\"type\":\"SCALAR\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},"
+                          "{\"buffer\":1,\"byteLength\":4096}],\"buffers\":[{\"byteLength\":36,\"uri\":\"data:;base64,"
+                          "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"},{\"byteLength\":4096,\"uri\":\"data:;base64,");
+    for (size_t i = 0; i < 4096 / 3 * 4 + 4; i++) text[n++] = 'A';
+    n += (size_t)snprintf(text + n, cap - n, "\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},"
+                          "\"indices\":1,\"mode\":5}]}]}");
+    Scene s;
+    Error err = { 0 };
+    Status st = load_text("strip.gltf", text, &s, &err);
+    CHECK(st == ST_INPUT);
+    /* the bound: 2^20 + the 4132 buffer bytes + the document's bytes */
+    char msg[400];
+    size_t bound = ((size_t)1 << 20) + 4132 + n, per = 4094, node = bound / per;
+    snprintf(msg, sizeof msg, "strip.gltf: meshes[0].primitives[0] (in nodes[%zu]): its 4094 triangles bring the "
+             "file's to %zu, more than the %zu a file of its size may make (2^20 and one per byte of the file and "
+             "its buffers, at most 2^26; every node's instance counts)", node, (node + 1) * per, bound);
+    CHECK_MSG(strcmp(err.msg, msg) == 0, "got      '%s'\n  expected '%s'", err.msg, msg);
+    error_clear(&err);
+    scene_free(&s);
+    free(text);
+}
+
+/* glTF URIs are RFC 3986's: percent-encoded bytes are decoded (test_shared_buffer_file
+ * reads "mesh%20data.bin"), a path may leave the file's folder, and what is not a
+ * relative file name is refused, named by its JSON path. */
+static void test_uri_policy(void)
+{
+    static const struct { const char *uri, *msg; } cases[] = {
+        { "https://example.com/a.bin", "uri.gltf: buffers[0].uri: the URI's scheme 'https:' is not read (clpt reads "
+                                       "data: URIs and file names relative to the glTF file)" },
+        { "file:///etc/passwd", "uri.gltf: buffers[0].uri: the URI's scheme 'file:' is not read (clpt reads data: "
+                                "URIs and file names relative to the glTF file)" },
+        { "/etc/passwd", "uri.gltf: buffers[0].uri: an absolute path (clpt reads data: URIs and file names relative "
+                         "to the glTF file)" },
+        { "%2Fetc/passwd", "uri.gltf: buffers[0].uri: an absolute path (clpt reads data: URIs and file names "
+                           "relative to the glTF file)" },
+        { "a%2", "uri.gltf: buffers[0].uri: character 2 of the URI: '%' not followed by two hex digits (a "
+                 "percent-encoded byte)" },
+        { "a%00.bin", "uri.gltf: buffers[0].uri: character 2 of the URI: %00, a NUL, cannot be part of a file name" },
+        { "../no-such-folder-clpt/a%20b.bin", "uri.gltf: buffers[0].uri: cannot open '../no-such-folder-clpt/a "
+                                              "b.bin': No such file or directory" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char text[1024];
+        snprintf(text, sizeof text, ONE_TRIANGLE_DOC "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+                 "\"buffers\":[{\"byteLength\":36,\"uri\":\"%s\"}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}]}", cases[i].uri);
+        Scene s;
+        Error err = { 0 };
+        Status st = load_text("uri.gltf", text, &s, &err);
+        CHECK(st == ST_INPUT || st == ST_IO);
+        CHECK_MSG(strcmp(err.msg, cases[i].msg) == 0, "%s: got '%s'", cases[i].uri, err.msg);
         error_clear(&err);
         scene_free(&s);
     }
@@ -752,6 +921,10 @@ int main(void)
     RUN(test_mesh_block);
     RUN(test_alpha_modes);
     RUN(test_texture_transform_range);
+    RUN(test_shared_image_sources);
+    RUN(test_shared_buffer_file);
+    RUN(test_triangle_bound);
+    RUN(test_uri_policy);
     RUN(test_extras);
     RUN(test_cornell_box);
     RUN(test_material_spheres);

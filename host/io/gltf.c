@@ -2,6 +2,7 @@
 #include "io/gltf.h"
 
 #include "base/limit.h"
+#include "base/strmap.h"
 #include "io/lexer.h"
 #include "io/texture.h"
 #include "kmath.h"
@@ -22,15 +23,18 @@
  * luminous efficacy of 555 nm light, 683 lm/W (docs/gltf.md). */
 #define LUMENS_PER_WATT 683.0
 /* Triangles one file may make, nodes times primitives included: a small file that
- * instances a large mesh many times must not exhaust memory, so the count is bounded
- * by the input's size (generously: a real file's mesh data takes 20 bytes or more per
- * triangle), and absolutely. */
-#define GLTF_TRIANGLES_PER_BYTE 16u
+ * instances a large mesh many times must not exhaust memory (each triangle costs clpt
+ * a few hundred bytes with its shading record and kd-tree), so the count is bounded by
+ * the input's size, and absolutely. A real file's mesh data takes 20 bytes or more per
+ * triangle, so one per byte still lets each be instanced some 20 times; 16 per byte
+ * let a 4 MB strip of 1-byte indices, instanced, make 2^26 triangles (issue 39). */
+#define GLTF_TRIANGLES_PER_BYTE 1u
 #define GLTF_MAX_TRIANGLES ((size_t)1 << 26)
 
 typedef struct {
     const unsigned char *p;
     size_t len;
+    size_t whole;         /* the bytes of the data before a buffer's byteLength cut them */
     char *owned;          /* heap copy (external file, decoded data: URI), or NULL */
 } Buf;
 
@@ -56,6 +60,9 @@ typedef struct {
     cJSON *root;
     const unsigned char *bin;  size_t bin_len;   /* the GLB's BIN chunk */
     Buf *bufs;        int n_bufs;
+    StrMap buffer_files;             /* resolved file name -> the first buffer read from it */
+    int reading_buffer;              /* the buffer uri_read reads for, or -1 (an image) */
+    StrMap image_sources[2];         /* an image's source -> its scene texture, sRGB [0] and linear [1] */
     uint *mats;       int n_mats;      /* scene material per glTF material, or NO_INDEX */
     uint default_mat;
     uint *tex;        int n_images;    /* per image: sRGB [2i], linear [2i+1] texture */
@@ -228,7 +235,7 @@ static Status b64_decode(Gltf *g, const char *jpath, const char *text, Buf *out)
     }
     out->owned = o;
     out->p = (const unsigned char *)o;
-    out->len = len;
+    out->len = out->whole = len;
     return ST_OK;
 }
 
@@ -243,6 +250,70 @@ static char *path_beside(const char *base, const char *name)
     return p;
 }
 
+/* The length of the scheme uri starts with (RFC 3986: a letter, then letters, digits,
+ * '+', '-' or '.', then ':'), or 0 when it has none. */
+static size_t uri_scheme_length(const char *uri)
+{
+    size_t i = 0;
+    if (!((uri[0] >= 'a' && uri[0] <= 'z') || (uri[0] >= 'A' && uri[0] <= 'Z'))) return 0;
+    while ((uri[i] >= 'a' && uri[i] <= 'z') || (uri[i] >= 'A' && uri[i] <= 'Z') || (uri[i] >= '0' && uri[i] <= '9') ||
+           uri[i] == '+' || uri[i] == '-' || uri[i] == '.')
+        i++;
+    return uri[i] == ':' ? i : 0;
+}
+
+static int hex_digit(char c)
+{
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+}
+
+/* The file a uri other than a data: URI names (*file, freed with free). glTF 2.0 takes
+ * URIs as RFC 3986 has them: a relative reference, resolved against the glTF file's
+ * folder, with its percent-encoded bytes decoded ("wood%20floor.png" names "wood
+ * floor.png"). It may leave that folder ("../textures/wood.png", as assets that share
+ * textures do, and other viewers read): a scene names files anywhere anyway. Refused:
+ * a scheme (clpt reads no http: or file:; a Windows drive letter reads as one), an
+ * absolute path, before decoding or after, a '%' without two hex digits after it, and
+ * %00 (a file name cannot hold a NUL). */
+static Status uri_file(Gltf *g, const char *uri, const char *jpath, char **file)
+{
+    *file = NULL;
+    size_t scheme = uri_scheme_length(uri);
+    if (scheme)
+        return error_set(g->err, ST_INPUT, "%s: %s: the URI's scheme '%.*s:' is not read (clpt reads data: URIs and "
+                         "file names relative to the glTF file)", g->path, jpath, (int)(scheme > 20 ? 20 : scheme),
+                         uri);
+    size_t n = strlen(uri), len = 0;
+    char *name = malloc(n + 1);
+    if (!name) return error_set(g->err, ST_INTERNAL, "out of memory");
+    for (size_t i = 0; i < n; i++) {
+        if (uri[i] != '%') {
+            name[len++] = uri[i];
+            continue;
+        }
+        int hi = i + 2 < n + 1 ? hex_digit(uri[i + 1]) : -1, lo = hi >= 0 ? hex_digit(uri[i + 2]) : -1;
+        if (hi < 0 || lo < 0 || (hi == 0 && lo == 0)) {
+            free(name);
+            return error_set(g->err, ST_INPUT, "%s: %s: character %zu of the URI: %s", g->path, jpath, i + 1,
+                             hi == 0 && lo == 0 ? "%00, a NUL, cannot be part of a file name"
+                                                : "'%' not followed by two hex digits (a percent-encoded byte)");
+        }
+        name[len++] = (char)(hi << 4 | lo);
+        i += 2;
+    }
+    name[len] = '\0';
+    if (name[0] == '/') {
+        free(name);
+        return bad(g, jpath, "an absolute path (clpt reads data: URIs and file names relative to the glTF file)");
+    }
+    *file = path_beside(g->path, name);
+    free(name);
+    return *file ? ST_OK : error_set(g->err, ST_INTERNAL, "out of memory");
+}
+
 /* The bytes a `uri` names: a data: URI (base64) or a relative file beside the glTF. */
 static Status uri_read(Gltf *g, const char *uri, const char *jpath, Buf *out)
 {
@@ -251,22 +322,34 @@ static Status uri_read(Gltf *g, const char *uri, const char *jpath, Buf *out)
         if (!b64) return bad(g, jpath, "a data: URI that is not base64");
         return b64_decode(g, jpath, b64 + 8, out);
     }
-    if (uri[0] == '/' || strstr(uri, "://"))
-        return bad(g, jpath, "only data: URIs and file names relative to the glTF file are read");
-    char *file = path_beside(g->path, uri);
-    if (!file) return error_set(g->err, ST_INTERNAL, "out of memory");
+    char *file;
+    Status st = uri_file(g, uri, jpath, &file);
+    if (st) return st;
+    /* buffers that name one file share one read of it (a small file naming a large one
+     * from many buffers read it once per buffer) */
+    uint32_t first;
+    if (strmap_find(&g->buffer_files, file, strlen(file), &first)) {
+        free(file);
+        out->p = g->bufs[first].p;
+        out->len = out->whole = g->bufs[first].whole;
+        out->owned = NULL;
+        return ST_OK;
+    }
     char *data;
     size_t len;
-    Status st = lex_read_file(file, &data, &len, g->err);
-    free(file);
+    st = lex_read_file(file, &data, &len, g->err);
     if (st) {
+        free(file);
         error_prefix(g->err, "%s: %s", g->path, jpath);
         return st;
     }
     out->owned = data;
     out->p = (const unsigned char *)data;
-    out->len = len;
-    return ST_OK;
+    out->len = out->whole = len;
+    int added = g->reading_buffer >= 0 ? strmap_add(&g->buffer_files, file, strlen(file), (uint32_t)g->reading_buffer)
+                                       : 0;
+    free(file);
+    return added < 0 ? error_set(g->err, ST_INTERNAL, "out of memory") : ST_OK;
 }
 
 static Status buffers_load(Gltf *g)
@@ -287,10 +370,13 @@ static Status buffers_load(Gltf *g)
             if (!cJSON_IsString(uri)) return bad(g, jp, "uri: expected a string");
             char jpu[80];
             snprintf(jpu, sizeof jpu, "%s.uri", jp);
-            if ((st = uri_read(g, uri->valuestring, jpu, f))) return st;
+            g->reading_buffer = i;
+            st = uri_read(g, uri->valuestring, jpu, f);
+            g->reading_buffer = -1;
+            if (st) return st;
         } else if (i == 0 && g->bin) {
             f->p = g->bin;
-            f->len = g->bin_len;
+            f->len = f->whole = g->bin_len;
         } else {
             return bad(g, jp, "no uri, and it is not the GLB's BIN chunk");
         }
@@ -320,7 +406,7 @@ static Status view_bytes(Gltf *g, int v, Buf *out, size_t *stride)
         return error_set(g->err, ST_INPUT, "%s: %s: bytes %lld..%lld are beyond buffers[%d], which has %zu", g->path,
                          jp, off, off + len, b, f->len);
     out->p = f->p + off;
-    out->len = (size_t)len;
+    out->len = out->whole = (size_t)len;
     out->owned = NULL;
     *stride = (size_t)st_;
     return ST_OK;
@@ -455,7 +541,7 @@ static Status acc_read_either(Gltf *g, int a, int width, int width2, const char 
     int normalized = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(acc, "normalized"));
     const cJSON *sparse = cJSON_GetObjectItemCaseSensitive(acc, "sparse");
     uint64_t esz = (uint64_t)comp_size(ctype) * (uint64_t)width;
-    Buf vb = { NULL, 0, NULL };
+    Buf vb = { NULL, 0, 0, NULL };
     size_t stride = 0;
     if (view >= 0) {
         if ((st = view_bytes(g, view, &vb, &stride))) return st;
@@ -517,16 +603,33 @@ static Status texture_get(Gltf *g, int t, int linear, const char *jpath, uint *o
     const cJSON *uri = cJSON_GetObjectItemCaseSensitive(im, "uri");
     int view;
     if ((st = get_index(g, im, "bufferView", 0, "bufferViews", ji, &view))) return st;
-    if (cJSON_IsString(uri) && strncmp(uri->valuestring, "data:", 5) != 0) {
-        if (uri->valuestring[0] == '/' || strstr(uri->valuestring, "://"))
-            return bad(g, ji, "only data: URIs and file names relative to the glTF file are read");
-        char *file = path_beside(g->path, uri->valuestring);
-        if (!file) return error_set(g->err, ST_INTERNAL, "out of memory");
-        st = texture_load_image(g->s, NULL, file, linear, 0, slot, g->err);
+    /* images with one source (a file, a data: URI, a buffer view) share one decode of
+     * it: a 20 KB GLB whose hundreds of images named one buffer view decoded it for each,
+     * 2.1 GB in all (issue 39) */
+    char *file = NULL;
+    if (cJSON_IsString(uri) && strncmp(uri->valuestring, "data:", 5) != 0 &&
+        (st = uri_file(g, uri->valuestring, ji, &file)))
+        return st;
+    /* a buffer view's key starts with a NUL, which no file name or URI holds */
+    char view_key[24] = { 0 };
+    size_t key_len = 1 + (size_t)snprintf(view_key + 1, sizeof view_key - 1, "view %d", view);
+    const char *key = view_key;
+    if (file || cJSON_IsString(uri)) {
+        key = file ? file : uri->valuestring;
+        key_len = strlen(key);
+    }
+    StrMap *known = &g->image_sources[linear ? 1 : 0];
+    uint32_t shared;
+    if ((cJSON_IsString(uri) || view >= 0) && strmap_find(known, key, key_len, &shared)) {
         free(file);
+        *slot = *out = shared;
+        return ST_OK;
+    }
+    if (file) {
+        st = texture_load_image(g->s, NULL, file, linear, 0, slot, g->err);
         if (st) error_prefix(g->err, "%s: %s", g->path, ji);
     } else if (cJSON_IsString(uri)) {
-        Buf b = { NULL, 0, NULL };
+        Buf b = { NULL, 0, 0, NULL };
         if (!(st = uri_read(g, uri->valuestring, ji, &b)))
             st = texture_load_image_memory(g->s, NULL, src, b.p, b.len, linear, slot, g->err);
         free(b.owned);
@@ -538,6 +641,8 @@ static Status texture_get(Gltf *g, int t, int linear, const char *jpath, uint *o
     } else {
         return bad(g, ji, "has neither a uri nor a bufferView");
     }
+    if (!st && strmap_add(known, key, key_len, *slot) < 0) st = error_set(g->err, ST_INTERNAL, "out of memory");
+    free(file);
     if (!st) *out = *slot;
     return st;
 }
@@ -870,11 +975,8 @@ static void uv_flip(const double *uv, float *out)
 }
 
 /* One triangle of vertices a, b, c. */
-static Status emit(Gltf *g, MeshSink *k, const Attrs *at, uint32_t a, uint32_t b, uint32_t c, uint mat)
+static Status emit(MeshSink *k, const Attrs *at, uint32_t a, uint32_t b, uint32_t c, uint mat)
 {
-    if (++g->triangles > g->max_triangles)
-        return error_set(g->err, ST_INPUT, "%s: more than %zu triangles (its nodes and primitives together), more "
-                         "than a file of its size may make", g->path, g->max_triangles);
     const uint32_t v[3] = { a, b, c };
     vec3 p[3], n[3];
     float t[6];
@@ -905,7 +1007,21 @@ static Status emit(Gltf *g, MeshSink *k, const Attrs *at, uint32_t a, uint32_t b
     return mesh_sink_triangle_extra(k, p, normals_ok ? n : NULL, uv_ok ? t : NULL, e.flags ? &e : NULL, mat);
 }
 
-static Status primitive_load(Gltf *g, MeshSink *k, const cJSON *prim, const char *jp)
+/* Counts the `n` triangles a primitive is about to make (reached through node `node`)
+ * against the file's bound, before any is made. */
+static Status triangles_count(Gltf *g, size_t n, const char *node, const char *jp)
+{
+    if (n <= g->max_triangles - g->triangles) {
+        g->triangles += n;
+        return ST_OK;
+    }
+    return error_set(g->err, ST_INPUT, "%s: %s (in %s): its %zu triangles bring the file's to %llu, more than the %zu "
+                     "a file of its size may make (2^20 and one per byte of the file and its buffers, at most 2^26; "
+                     "every node's instance counts)", g->path, jp, node, n,
+                     (unsigned long long)g->triangles + n, g->max_triangles);
+}
+
+static Status primitive_load(Gltf *g, MeshSink *k, const cJSON *prim, const char *jp, const char *node)
 {
     long long mode;
     Status st = get_int(g, prim, "mode", 4, 0, 6, jp, &mode);
@@ -934,22 +1050,23 @@ static Status primitive_load(Gltf *g, MeshSink *k, const cJSON *prim, const char
         !(st = corner_indices(g, prim, jp, nv, &idx, &ni)) &&
         !(st = get_index(g, prim, "material", 0, "materials", jp, &mi)))
         st = material_get(g, mi, &mat);
+    if (!st && ni >= 3) st = triangles_count(g, mode == 4 ? ni / 3 : ni - 2, node, jp);
     if (!st && mode == 4) {
-        for (size_t i = 0; i + 2 < ni && !st; i += 3) st = emit(g, k, &at, idx[i], idx[i + 1], idx[i + 2], mat);
+        for (size_t i = 0; i + 2 < ni && !st; i += 3) st = emit(k, &at, idx[i], idx[i + 1], idx[i + 2], mat);
     } else if (!st && mode == 5) {
         /* every other triangle of a strip swaps its first two corners to keep the winding */
         for (size_t i = 0; i + 2 < ni && !st; i++)
-            st = i % 2 ? emit(g, k, &at, idx[i + 1], idx[i], idx[i + 2], mat)
-                       : emit(g, k, &at, idx[i], idx[i + 1], idx[i + 2], mat);
+            st = i % 2 ? emit(k, &at, idx[i + 1], idx[i], idx[i + 2], mat)
+                       : emit(k, &at, idx[i], idx[i + 1], idx[i + 2], mat);
     } else if (!st) {
-        for (size_t i = 0; i + 2 < ni && !st; i++) st = emit(g, k, &at, idx[i + 1], idx[i + 2], idx[0], mat);
+        for (size_t i = 0; i + 2 < ni && !st; i++) st = emit(k, &at, idx[i + 1], idx[i + 2], idx[0], mat);
     }
     attrs_free(&at);
     free(idx);
     return st;
 }
 
-static Status mesh_instance(Gltf *g, int mesh, const Transform *xf)
+static Status mesh_instance(Gltf *g, int mesh, const Transform *xf, const char *node)
 {
     char jp[64];
     snprintf(jp, sizeof jp, "meshes[%d]", mesh);
@@ -961,7 +1078,7 @@ static Status mesh_instance(Gltf *g, int mesh, const Transform *xf)
     for (const cJSON *p = first_of(prims); !st && p; p = p->next, i++) {
         char jpp[96];
         snprintf(jpp, sizeof jpp, "%s.primitives[%d]", jp, i);
-        st = primitive_load(g, &k, p, jpp);
+        st = primitive_load(g, &k, p, jpp, node);
     }
     return st;
 }
@@ -1120,7 +1237,7 @@ static Status node_visit(Gltf *g, int n, const Transform *parent, int depth)
     if ((st = get_index(g, node, "camera", 0, "cameras", jp, &cam))) return st;
     if (mesh >= 0) {
         Transform w = transform_compose(&g->o->xf, &xf);
-        if ((st = mesh_instance(g, mesh, &w))) return st;
+        if ((st = mesh_instance(g, mesh, &w, jp))) return st;
     }
     if (cam >= 0 && g->view && camera_wanted(g, cam, node)) {
         Transform w = transform_compose(&g->o->xf, &xf);
@@ -1309,6 +1426,7 @@ Status gltf_parse(const char *path, const char *data, size_t len, Scene *s, cons
     g.o = o;
     g.view = view;
     g.default_mat = NO_INDEX;
+    g.reading_buffer = -1;
     if (view) view->has_camera = 0;
     Status st = gltf_read(&g, data, len);
     if (view) view->has_lights = g.has_lights;
@@ -1318,6 +1436,9 @@ Status gltf_parse(const char *path, const char *data, size_t len, Scene *s, cons
     free(g.mats);
     free(g.tex);
     free(g.visited);
+    strmap_free(&g.buffer_files);
+    strmap_free(&g.image_sources[0]);
+    strmap_free(&g.image_sources[1]);
     for (int i = 0; i < T_N; i++) free(g.t[i].item);
     return st;
 }

@@ -175,6 +175,46 @@ static void test_exr_encoded(void)
     free(rgb);
 }
 
+/* A half holds at most 65504: the default half EXR wrote +inf for every brighter pixel,
+ * and the reader, which read halves, refused a float file with such a pixel (a 70000
+ * sun), clpt's own --exr-float output included (issue 39). Now a half image with a
+ * value past 65504 is written as floats, depth (Z) always is, and float channels are
+ * read as floats, bit for bit. */
+static void test_exr_beyond_half(void)
+{
+    char path[] = "/tmp/clpt-test-exr-bright-XXXXXX.exr";
+    int fd = mkstemps(path, 4);
+    close(fd);
+    float *rgb = test_values(0);
+    rgb[4] = 70000.0f;
+    rgb[8] = 1e30f;
+    float depth[W * H * 3];
+    for (int i = 0; i < W * H * 3; i++) depth[i] = 0.001f * (float)i + 0.1f;
+    ImageLayer layer = { { "Z", NULL, NULL }, depth };
+    Error err = { 0 };
+    CHECK_MSG(image_write_exr(path, rgb, &layer, 1, W, H, 0, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(channel_type(path, "R"), EXR_PIXEL_FLOAT);
+    CHECK_EQ_INT(channel_type(path, "Z"), EXR_PIXEL_FLOAT);
+    int w, h;
+    float *back = NULL;
+    CHECK_MSG(exr_read_rgb(path, (uint64_t)W * H, &back, &w, &h, &err) == ST_OK, "%s", err.msg);
+    if (back) CHECK(memcmp(back, rgb, sizeof(float) * W * H * 3) == 0);
+    free(back);
+    float *z = read_channel(path, "Z", &w, &h);
+    CHECK(z != NULL);
+    for (int i = 0; z && i < W * H; i++) CHECK(z[i] == depth[3 * i]);
+    free(z);
+    /* within half's range the colour stays half (and Z float) */
+    rgb[4] = 65504.0f;
+    rgb[8] = -65504.0f;
+    CHECK(image_write_exr(path, rgb, &layer, 1, W, H, 0, &err) == ST_OK);
+    CHECK_EQ_INT(channel_type(path, "G"), EXR_PIXEL_HALF);
+    CHECK_EQ_INT(channel_type(path, "Z"), EXR_PIXEL_FLOAT);
+    unlink(path);
+    free(rgb);
+    error_clear(&err);
+}
+
 /* An EXR whose data window does not start at the origin: the reader addresses the
  * library's frame buffer by absolute pixel coordinates, whose base lies outside the
  * pixels and, for a window far from the origin, outside the address space (a fuzz
@@ -312,6 +352,7 @@ int main(void)
     RUN(test_exr_half);
     RUN(test_exr_float);
     RUN(test_exr_encoded);
+    RUN(test_exr_beyond_half);
     RUN(test_exr_data_window);
     RUN(test_hdr);
     RUN(test_cli_aov_channels);

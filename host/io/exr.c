@@ -303,6 +303,84 @@ static Status exr_decode(const char *path, int w, int h, float *rgb, Error *err)
     return st;
 }
 
+/* Whether the image is read through exr_decode_float rather than as halves: a scanline
+ * image whose colour has a 32-bit channel (float or uint), full-size, and no chroma
+ * (luminance/chroma images need the library's conversion, which gives halves), not
+ * DWAA or DWAB compressed (OpenEXRCore 3.1 cannot decompress those: "Decode pipeline
+ * unable to decompress data"). A half holds at most 65504: a float sky's 70000-valued
+ * sun was infinite as a half, and the image refused (issue 39). Tiled and DWA images
+ * are read as halves still. */
+static int exr_wants_float(exr_context_t ctxt, const exr_attr_chlist_t *ch, const int pick[3])
+{
+    exr_storage_t storage;
+    exr_compression_t comp;
+    if (exr_get_storage(ctxt, 0, &storage) != EXR_ERR_SUCCESS || storage != EXR_STORAGE_SCANLINE ||
+        exr_get_compression(ctxt, 0, &comp) != EXR_ERR_SUCCESS || comp == EXR_COMPRESSION_DWAA ||
+        comp == EXR_COMPRESSION_DWAB)
+        return 0;
+    int wide = 0;
+    for (int i = 0; i < ch->num_channels; i++) {
+        const char *n = ch->entries[i].name.str;
+        if (!strcmp(n, "RY") || !strcmp(n, "BY")) return 0;
+    }
+    for (int k = 0; k < 3; k++) {
+        if (pick[k] < 0) continue;
+        const exr_attr_chlist_entry_t *e = &ch->entries[pick[k]];
+        if (e->x_sampling != 1 || e->y_sampling != 1) return 0;
+        if (e->pixel_type != EXR_PIXEL_HALF) wide = 1;
+    }
+    return wide;
+}
+
+/* Decodes the colour channels pick[] of a scanline image (exr_wants_float) through
+ * OpenEXRCore as 32-bit floats into rgb (w x h x 3, zeroed): halves convert exactly,
+ * floats keep every bit. One channel (Y) picked for all three is decoded once and
+ * copied. */
+static Status exr_decode_float(exr_context_t ctxt, const char *path, const exr_attr_chlist_t *ch, const int pick[3],
+                               const exr_attr_box2i_t *dw, int w, int h, float *rgb, Error *err)
+{
+    int lines = 0;
+    exr_result_t rv = exr_get_scanlines_per_chunk(ctxt, 0, &lines);
+    if (rv == EXR_ERR_SUCCESS && lines <= 0) rv = EXR_ERR_INVALID_ARGUMENT;
+    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
+    int started = 0;
+    for (int64_t y = dw->min.y; rv == EXR_ERR_SUCCESS && y <= dw->max.y; y += lines) {
+        exr_chunk_info_t ci;
+        rv = exr_read_scanline_chunk_info(ctxt, 0, (int)y, &ci);
+        if (rv) break;
+        rv = started ? exr_decoding_update(ctxt, 0, &ci, &dec) : exr_decoding_initialize(ctxt, 0, &ci, &dec);
+        if (rv) break;
+        started = 1;
+        int64_t row = (int64_t)ci.start_y - dw->min.y;
+        if (row < 0 || row + ci.height > h) {
+            rv = EXR_ERR_CORRUPT_CHUNK;
+            break;
+        }
+        for (int c = 0; c < dec.channel_count; c++) {
+            exr_coding_channel_info_t *cc = &dec.channels[c];
+            cc->decode_to_ptr = NULL;
+            for (int k = 0; k < 3; k++) {
+                if (pick[k] < 0 || (k > 0 && pick[k] == pick[k - 1])) continue;
+                if (strcmp(cc->channel_name, ch->entries[pick[k]].name.str) != 0) continue;
+                cc->decode_to_ptr = (uint8_t *)(rgb + 3u * ((size_t)row * (size_t)w) + k);
+                cc->user_pixel_stride = (int32_t)(3 * sizeof(float));
+                cc->user_line_stride = (int32_t)((size_t)w * 3 * sizeof(float));
+                cc->user_data_type = EXR_PIXEL_FLOAT;
+                cc->user_bytes_per_element = (int16_t)sizeof(float);
+            }
+        }
+        rv = exr_decoding_choose_default_routines(ctxt, 0, &dec);
+        if (!rv) rv = exr_decoding_run(ctxt, 0, &dec);
+    }
+    if (started) exr_decoding_destroy(ctxt, &dec);
+    if (rv) return exr_fail(path, rv, err);
+    /* Y alone fills all three */
+    for (int k = 1; k < 3; k++)
+        if (pick[k] >= 0 && pick[k] == pick[0])
+            for (size_t i = 0; i < (size_t)w * (size_t)h; i++) rgb[3 * i + (size_t)k] = rgb[3 * i];
+    return ST_OK;
+}
+
 /* Checks every value: the renderer's sums need finite numbers (a half can be inf or
  * NaN). */
 static Status exr_finish_pixels(const char *path, float *rgb, int w, int h, Error *err)
@@ -371,8 +449,10 @@ Status exr_read_rgb(const char *path, uint64_t max_pixels, float **rgb, int *wid
     float *px = NULL;
     if (!st && !(px = calloc((size_t)w * (size_t)h * 3u, sizeof *px)))
         st = error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
+    int as_float = !st && exr_wants_float(ctxt, ch, pick);
+    if (as_float) st = exr_decode_float(ctxt, path, ch, pick, &dw, (int)w, (int)h, px, err);
     exr_finish(&ctxt);
-    if (!st) st = exr_decode(path, (int)w, (int)h, px, err);
+    if (!st && !as_float) st = exr_decode(path, (int)w, (int)h, px, err);
     if (!st) st = exr_finish_pixels(path, px, (int)w, (int)h, err);
     if (st) {
         free(px);
@@ -455,7 +535,7 @@ Status exr_encode(const ExrChannel *ch, size_t n, unsigned width, unsigned heigh
     if (!rv) rv = exr_add_part(ctxt, "image", EXR_STORAGE_SCANLINE, &part);
     if (!rv) rv = exr_initialize_required_attr_simple(ctxt, part, (int32_t)width, (int32_t)height, EXR_COMPRESSION_ZIP);
     for (size_t i = 0; i < n && !rv; i++)
-        rv = exr_add_channel(ctxt, part, ch[i].name, float32 ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF,
+        rv = exr_add_channel(ctxt, part, ch[i].name, float32 || ch[i].float32 ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF,
                              ch[i].linear ? EXR_PERCEPTUALLY_LINEAR : EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
     if (!rv) rv = exr_write_header(ctxt);
     if (!rv) rv = exr_get_scanlines_per_chunk(ctxt, part, &lines);

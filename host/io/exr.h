@@ -20,7 +20,8 @@ int exr_is_exr(const unsigned char *head, size_t n);
 int exr_size(const char *path, int *width, int *height);
 
 /* Reads the EXR file at `path` as width x height RGB floats (its data window), rows top
- * to bottom (*rgb, freed with free). The colour is the channels R, G and B (a missing
+ * to bottom (*rgb, freed with free), 32-bit float channels at full precision (scanline
+ * images other than DWAA/DWAB; tiled, DWA and luminance/chroma images as halves). The colour is the channels R, G and B (a missing
  * one is 0), or Y (grey) when the image has none of them (luminance/chroma images are
  * converted to RGB); other channels are ignored. The data window's size is checked
  * against max_pixels before anything is allocated for the pixels. Errors (ST_INPUT,
@@ -32,17 +33,19 @@ Status exr_read_rgb(const char *path, uint64_t max_pixels, float **rgb, int *wid
 
 /* One channel of an image to write: its EXR name and its values, `stride` floats apart,
  * rows top to bottom. `linear` marks data channels (normals, depth); colour channels
- * are marked perceptually logarithmic, which lossy compressors look at. */
+ * are marked perceptually logarithmic, which lossy compressors look at. `float32`
+ * writes this channel as 32-bit floats whatever exr_encode's own choice. */
 typedef struct {
     const char *name;
     const float *data;
     unsigned stride;
     int linear;
+    int float32;
 } ExrChannel;
 
 /* Encodes a width x height image of n channels as a single-part scanline OpenEXR file
  * in memory (OpenEXRCore; ZIP compression, lossless), each channel 16-bit half or, with
- * `float32`, 32-bit float: *bytes (freed with free) of *size bytes. The library sorts the
+ * `float32` (or the channel's own), 32-bit float: *bytes (freed with free) of *size bytes. The library sorts the
  * channels by name, as the format asks. ST_INTERNAL, with OpenEXR's reason, on failure
  * (out of memory). */
 Status exr_encode(const ExrChannel *ch, size_t n, unsigned width, unsigned height, int float32, unsigned char **bytes,

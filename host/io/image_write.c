@@ -181,6 +181,16 @@ static Status write_hdr(AtomicFile *af, const float *rgb, unsigned w, unsigned h
     return ST_OK;
 }
 
+/* Whether any of the n values is a finite number beyond what a half holds (65504, its
+ * largest finite value; what rounds past it becomes infinite). Infinities and NaN a
+ * half holds as they are. */
+static int exr_beyond_half(const float *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (isfinite(v[i]) && (v[i] > 65504.0f || v[i] < -65504.0f)) return 1;
+    return 0;
+}
+
 /* Encodes the EXR in memory first (OpenEXR writes at offsets), then writes it whole. */
 static Status write_exr(AtomicFile *af, const float *rgb, const ImageLayer *layers, size_t n_layers, unsigned w,
                         unsigned h, int float32, Error *err)
@@ -188,10 +198,19 @@ static Status write_exr(AtomicFile *af, const float *rgb, const ImageLayer *laye
     ExrChannel ch[3 + 3 * 8];
     size_t n = 0;
     static const char *const rgb_names[3] = { "R", "G", "B" };
-    for (int k = 0; k < 3; k++) ch[n++] = (ExrChannel){ rgb_names[k], rgb + k, 3u, 0 };
-    for (size_t l = 0; l < n_layers && l < 8; l++)
+    /* the colour is written as floats where a half would not hold it: a half's largest
+     * value is 65504, and a brighter pixel became +inf (issue 39) */
+    int wide = exr_beyond_half(rgb, (size_t)w * h * 3u);
+    for (int k = 0; k < 3; k++) ch[n++] = (ExrChannel){ rgb_names[k], rgb + k, 3u, 0, wide };
+    /* depth (Z) is always float: distances pass 65504 and want more than a half's 11
+     * bits; other layers as their values need */
+    for (size_t l = 0; l < n_layers && l < 8; l++) {
+        int layer_wide = exr_beyond_half(layers[l].rgb, (size_t)w * h * 3u);
         for (int k = 0; k < 3; k++)
-            if (layers[l].names[k]) ch[n++] = (ExrChannel){ layers[l].names[k], layers[l].rgb + k, 3u, 1 };
+            if (layers[l].names[k])
+                ch[n++] = (ExrChannel){ layers[l].names[k], layers[l].rgb + k, 3u, 1,
+                                        layer_wide || strcmp(layers[l].names[k], "Z") == 0 };
+    }
     unsigned char *bytes;
     size_t size;
     Status st = exr_encode(ch, n, w, h, float32, &bytes, &size, err);

@@ -16,7 +16,7 @@
  *            (r = half the box diagonal): the bounding sphere just fits. Unit directions.
  *   diffuse  for each primary hit, one cosine-weighted direction about the geometric
  *            normal turned toward the camera, from the hit point offset off the surface
- *            (offset_ray_origin, kernels/surface.h); random numbers from rng.h keyed by
+ *            (spawn_offset, kernels/surface.h); random numbers from rng.h keyed by
  *            the pixel, so the set is the same on every run.
  *   shadow   for each primary hit, one ray from the same offset point to a point light at
  *            c + 2 r * normalize(-0.5, 1, 0.35), direction = light - origin, t in (0,
@@ -317,7 +317,7 @@ static int make_rays(Mesh *m, int size, RaySet sets[N_SETS])
         if (v3_is_zero(ng)) continue;
         ng = v3_norm(ng);
         if (v3_dot(ng, pr->d) > 0.0f) ng = v3_neg(ng);
-        vec3 o = offset_ray_origin(pt, ng);
+        vec3 o = spawn_offset(pt, triangle_point_error(*t, b0, hits[i].u, hits[i].v, pt), ng);
         /* the independent sampler, so the ray set stays the one of earlier results */
         RngKey key = { rng_path_key(1u, i, 0u), 0u, SAMPLER_INDEPENDENT, 0u };
         vec3 l = sample_cosine_hemisphere(rng_uniform(key, 1u, DIM_BSDF_U), rng_uniform(key, 1u, DIM_BSDF_V));

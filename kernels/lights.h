@@ -311,14 +311,16 @@ KFN int light_sample(const SceneView *sc, vec3 ref, int reuse, float u_pick, flo
     return light_sample_in(sc, ref, 1.0f, reuse, u_pick, u1, u2, ls);
 }
 
-/* The shadow ray from surface point p (geometric normal ng turned toward the light) to
- * the light sample: from just above the surface to just before an area light, which
- * must not count as its own occluder; to a point light; or off to infinity (a
- * directional light, the environment map). */
-KFN Ray light_shadow_ray(vec3 p, vec3 ng, LightSample ls)
+/* The shadow ray from surface point p (error bound p_err, geometric normal ng turned
+ * toward the light) to the light sample: from just above the surface to just before an
+ * area light, which must not count as its own occluder; to a point light; or off to
+ * infinity (a directional light, the environment map). The light's point is taken as
+ * a few roundings of its coordinates off its surface (barycentrics on a triangle,
+ * centre + r n on a sphere), and the ray stops 1e-4 of the way short of it besides. */
+KFN Ray light_shadow_ray(vec3 p, vec3 p_err, vec3 ng, LightSample ls)
 {
     Ray r;
-    r.o = offset_ray_origin(p, ng);
+    r.o = spawn_offset(p, p_err, ng);
     r.tmin = 0.0f;
     if (!(ls.dist < k_as_float(0x7f800000u))) {
         r.d = ls.wi;
@@ -327,7 +329,8 @@ KFN Ray light_shadow_ray(vec3 p, vec3 ng, LightSample ls)
         r.d = v3_sub(ls.p, r.o);
         r.tmax = 1.0f;
     } else {
-        vec3 target = offset_ray_origin(ls.p, v3_dot(ls.n, ls.wi) > 0.0f ? v3_neg(ls.n) : ls.n);
+        vec3 side = v3_dot(ls.n, ls.wi) > 0.0f ? v3_neg(ls.n) : ls.n;
+        vec3 target = spawn_offset(ls.p, v3_scale(v3_abs(ls.p), K_ROUND_ERR(8)), side);
         r.d = v3_sub(target, r.o);
         r.tmax = 0.9999f;
     }

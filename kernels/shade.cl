@@ -74,7 +74,7 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
         shadow_resolve(ps, 0);
         return 0;
     }
-    *shadow_ray = light_shadow_ray(s.p, below ? v3_neg(ng_face) : ng_face, ls);
+    *shadow_ray = light_shadow_ray(s.p, s.err, below ? v3_neg(ng_face) : ng_face, ls);
     return 1;
 }
 
@@ -203,7 +203,7 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     ps->throughput = thr;
     ps->bsdf_pdf = bs.pdf;
     ps->flags = bs.specular ? PATH_SPECULAR : 0u;
-    ray->o = offset_ray_origin(s.p, transmitted ? v3_neg(ng_face) : ng_face);
+    ray->o = spawn_origin(s, transmitted ? v3_neg(ng_face) : ng_face);
     ray->d = bs.wi;
     ray->tmin = 0.0f;
     ray->tmax = INFINITY;

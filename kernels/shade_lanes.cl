@@ -46,16 +46,26 @@ KFN_INLINE float8 w_copysign(float8 mag, float8 sgn)
     return as_float8((as_uint8(mag) & 0x7fffffffu) | (as_uint8(sgn) & 0x80000000u));
 }
 
-/* offset_coord (surface.h) lane by lane */
-KFN_INLINE float8 w_offset_coord(float8 p, float8 n)
+KFN_INLINE vec3x8 w3_abs(vec3x8 a) { return w3(fabs(a.x), fabs(a.y), fabs(a.z)); }
+KFN_INLINE float8 w3_max_abs(vec3x8 a) { return w_fmax(fabs(a.x), w_fmax(fabs(a.y), fabs(a.z))); }
+
+/* triangle_point_error (surface.h) lane by lane */
+KFN_INLINE vec3x8 w_triangle_point_error(vec3x8 p0, vec3x8 p1, vec3x8 p2, float8 w, float8 u, float8 v, vec3x8 p)
 {
-    int8 ulps = convert_int8(RAY_OFFSET_ULPS * n);
-    float8 moved = as_float8(as_int8(p) + select(ulps, -ulps, p < 0.0f));
-    return select(moved, p + RAY_OFFSET_ABS * n, fabs(p) < RAY_OFFSET_NEAR_ZERO);
+    vec3x8 sum = w3_add(w3_add(w3_abs(w3_scale(p0, w)), w3_abs(w3_scale(p1, u))), w3_abs(w3_scale(p2, v)));
+    float8 extent = w_fmax(w3_max_abs(w3_sub(p0, p)), w_fmax(w3_max_abs(w3_sub(p1, p)), w3_max_abs(w3_sub(p2, p))));
+    float8 ext_err = K_ROUND_ERR(16) * extent;
+    vec3x8 e = w3_scale(sum, (float8)(K_ROUND_ERR(7)));
+    return w3(e.x + ext_err, e.y + ext_err, e.z + ext_err);
 }
-KFN_INLINE vec3x8 w_offset_ray_origin(vec3x8 p, vec3x8 n)
+
+/* spawn_offset (surface.h) lane by lane */
+KFN_INLINE vec3x8 w_spawn_offset(vec3x8 p, vec3x8 err, vec3x8 n)
 {
-    return w3(w_offset_coord(p.x, n.x), w_offset_coord(p.y, n.y), w_offset_coord(p.z, n.z));
+    vec3x8 an = w3_abs(n);
+    float8 d = w3_dot(an, err);
+    float8 dist = d + SPAWN_MARGIN * (w3_dot(an, w3_abs(p)) + d) + SPAWN_FLOOR;
+    return w3_add(p, w3_scale(n, dist));
 }
 
 /* sample_cosine_hemisphere (sampling.h) lane by lane, through sample_disk's selects */
@@ -271,8 +281,9 @@ KFN_CALL_CL void shade_lanes_fast(const LaneInputs *in, LaneResults *out)
     float8 mis = select(0.0f, pa2 / (pa2 + pb2), pa2 + pb2 > 0.0f);   /* mis_power */
     vec3x8 f_cos = w3_scale(f, cos_s * mis / lpdf);
     vec3x8 L = w3_mul(w3_mul(thr0, f_cos), LANE_LOAD3(ler, leg, leb));
-    vec3x8 o = w_offset_ray_origin(sp, ng_face);
-    vec3x8 target = w_offset_ray_origin(lp, w3_select(ln, w3_neg(ln), w3_dot(ln, wi) > 0.0f));
+    vec3x8 o = w_spawn_offset(sp, w_triangle_point_error(p0, p1, p2, w, u, v, sp), ng_face);
+    vec3x8 target = w_spawn_offset(lp, w3_scale(w3_abs(lp), (float8)(K_ROUND_ERR(8))),
+                                   w3_select(ln, w3_neg(ln), w3_dot(ln, wi) > 0.0f));
     int8 infinite = ~(dist < INFINITY);
     vec3x8 sd = w3_select(w3_sub(target, o), wi, infinite);
     out->shadow = ok;

@@ -12,6 +12,8 @@
 
 typedef struct {
     vec3 p;          /* hit position */
+    vec3 err;        /* per coordinate, a bound on |p - the true surface point| (absolute);
+                      * spawn_origin moves a new ray's origin off the surface by it */
     vec3 ng;         /* geometric normal, unit, outward (sphere, box) or by winding */
     vec3 ns;         /* shading normal, unit, on the same side as ng */
     uint material;
@@ -23,6 +25,78 @@ typedef struct {
     float b1, b2;    /* triangles: the hit's barycentrics of p1 and p2, to interpolate
                       * the extras' corners */
 } Surface;
+
+/* A bound on the rounding error of n floating-point operations, relative to the
+ * magnitudes they combine: pbrt's gamma(n) = n eps / (1 - n eps), eps = 2^-24 (Pharr,
+ * Jakob & Humphreys, "Physically Based Rendering", 4th ed., 6.8.1), written as n times
+ * a constant 0.7% above eps, which covers the denominator for any n used here. */
+#define K_ROUND_ERR(n) ((float)(n) * 6.0e-8f)
+
+KFN vec3 v3_abs(vec3 a) { return v3(k_fabs(a.x), k_fabs(a.y), k_fabs(a.z)); }
+
+/* The hit on a sphere, projected onto it: centre + radius * n. The point o + t*d has
+ * the error of t, which grows with the distance the ray came (a camera 1000 radii away
+ * put it beyond any fixed offset: dark rings); the projection's error depends only on
+ * the sphere, a few roundings of |centre| + radius (pbrt-v4 re-projects likewise). The
+ * bound also covers what a ray leaving the surface needs: sphere_intersect reads the
+ * side its origin is on from the sign of |o - centre|^2 - r^2, itself a few roundings
+ * of r^2, so 8 roundings rather than pbrt's 5 for the point alone. */
+KFN vec3 sphere_point(Sphere sp, vec3 n, vec3 *err)
+{
+    *err = v3_scale(v3_add(v3_abs(sp.center), v3s(sp.radius)), K_ROUND_ERR(8));
+    return v3_madd(sp.center, n, sp.radius);
+}
+
+/* The error of p = w p0 + u p1 + v p2 (pbrt-v4: gamma(7) of the sum of the terms'
+ * magnitudes), plus what the watertight test needs to see that a ray leaving the
+ * triangle starts off it: its t is a sum of products of the corners' offsets from the
+ * origin, whose rounding is a few ulps of the triangle's extent, whatever the angle
+ * (the offset and t both scale with 1 / cos). Without that term a triangle far larger
+ * than its distance from the world origin (a disk of radius 1e15 about it) would hit
+ * the rays that leave it. */
+KFN vec3 triangle_point_error(Triangle tr, float w, float u, float v, vec3 p)
+{
+    vec3 sum = v3_add(v3_add(v3_abs(v3_scale(tr.p0, w)), v3_abs(v3_scale(tr.p1, u))), v3_abs(v3_scale(tr.p2, v)));
+    vec3 e0 = v3_abs(v3_sub(tr.p0, p)), e1 = v3_abs(v3_sub(tr.p1, p)), e2 = v3_abs(v3_sub(tr.p2, p));
+    float extent = k_fmax(v3_max_comp(e0), k_fmax(v3_max_comp(e1), v3_max_comp(e2)));
+    return v3_add(v3_scale(sum, K_ROUND_ERR(7)), v3s(K_ROUND_ERR(16) * extent));
+}
+
+/* The hit on box face `face` with its coordinate along the face's axis set to the
+ * face's plane, exactly; the other two keep o + t*d's error, which along the face
+ * normal does not count. box_intersect's slab test then sees any origin beyond the
+ * plane, however little, on the outer side. */
+KFN vec3 box_point(Box b, int face, vec3 p, float t, Ray ray, vec3 *err)
+{
+    int axis = face >> 1;
+    float plane = v3_get((face & 1) ? b.hi : b.lo, axis);
+    vec3 e = v3_scale(v3_add(v3_abs(ray.o), v3_abs(v3_scale(ray.d, t))), K_ROUND_ERR(4));
+    *err = v3(axis == 0 ? 0.0f : e.x, axis == 1 ? 0.0f : e.y, axis == 2 ? 0.0f : e.z);
+    return v3(axis == 0 ? plane : p.x, axis == 1 ? plane : p.y, axis == 2 ? plane : p.z);
+}
+
+/* The hit projected onto the plane: o + t*d's error along the normal grows with the
+ * distance the ray came, the projection's is a few roundings of dot(|n|, |p|) and the
+ * offset; 12 of them also cover plane_intersect's own rounding of offset - dot(n, o)
+ * for a ray that leaves. (For an axis-aligned plane the projection is exact.) */
+KFN vec3 plane_point(Plane pl, vec3 p, vec3 *err)
+{
+    vec3 q = v3_madd(p, pl.normal, -(v3_dot(pl.normal, p) - pl.offset));
+    float scale = v3_dot(v3_abs(pl.normal), v3_abs(q)) + k_fabs(pl.offset);
+    *err = v3s(K_ROUND_ERR(12) * scale);
+    return q;
+}
+
+/* The error of the hit o + t*d on a surface of revolution: Newton polishes t to the
+ * rounding of floats, a few ulps of |t| and of the surface's size; and a point within
+ * REV_RESIDUAL of the surface passes revsurface_intersect's root test, so a ray must
+ * leave from farther than that or its own origin could count as a hit. */
+KFN vec3 revsurface_point_error(RevSurface rs, Ray ray, float t)
+{
+    float size = k_fmax(rs.hi.x - rs.lo.x, rs.hi.y - rs.lo.y);
+    vec3 e = v3_scale(v3_add(v3_abs(ray.o), v3_abs(v3_scale(ray.d, t))), K_ROUND_ERR(8));
+    return v3_add(e, v3s((K_ROUND_ERR(8) + 4.0f * REV_RESIDUAL) * size));
+}
 
 KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
 {
@@ -41,11 +115,8 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
     uint first_rev = first_box + p->n_boxes, first_plane = first_rev + p->n_revsurfaces;
     if (KF_HAS(KF_SPHERES) && id < first_tri) {
         Sphere sp = sc->spheres[id];
-        /* p stays o + t*d: projecting it onto the sphere (center + r*n) would round it to
-         * the precision of the centre's coordinates, 6e-5 for the One-Weekend ground
-         * (r = 1000 at y = -1000), far coarser than the error of t, and the surface
-         * would shadow itself in rings */
         vec3 n = v3_norm(v3_sub(s.p, sp.center));
+        s.p = sphere_point(sp, n, &s.err);
         s.ng = n;
         s.ns = n;
         s.material = sp.material;
@@ -55,6 +126,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
         float w = 1.0f - hit.u - hit.v;
         /* barycentric interpolation is far more precise than o + t*d for a far hit */
         s.p = v3_add(v3_add(v3_scale(tr.p0, w), v3_scale(tr.p1, hit.u)), v3_scale(tr.p2, hit.v));
+        s.err = triangle_point_error(tr, w, hit.u, hit.v, s.p);
         s.ng = v3_norm(v3_cross(v3_sub(tr.p1, tr.p0), v3_sub(tr.p2, tr.p0)));
         s.ns = s.ng;
         s.material = tr.material;
@@ -80,6 +152,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
         int face = (int)hit.u;                    /* 0:-x 1:+x 2:-y 3:+y 4:-z 5:+z */
         float sign = (face & 1) ? 1.0f : -1.0f;
         int axis = face >> 1;
+        s.p = box_point(b, face, s.p, hit.t, ray, &s.err);
         s.ng = v3(axis == 0 ? sign : 0.0f, axis == 1 ? sign : 0.0f, axis == 2 ? sign : 0.0f);
         s.ns = s.ng;
         s.material = b.material;
@@ -89,6 +162,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
          * course's revolution turns) and the segment's parameter */
         RevSurface rs = sc->revsurfaces[id - first_rev];
         vec3 n = revsurface_normal(rs, sc->rev_points, s.p, hit.u, hit.v);
+        s.err = revsurface_point_error(rs, ray, hit.t);
         s.ng = n;
         s.ns = n;
         s.material = rs.material;
@@ -97,6 +171,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
         s.v = hit.u;
     } else {
         Plane pl = sc->planes[id - first_plane];
+        s.p = plane_point(pl, s.p, &s.err);
         s.ng = pl.normal;
         s.ns = pl.normal;
         s.material = pl.material;
@@ -154,24 +229,39 @@ KFN int surface_tangent(const SceneView *sc, Surface s, vec3 *t, float *sign)
     return 1;
 }
 
-/* A point just off the surface at p on the side n points to. The offset is a fixed
- * number of float ulps of p (integer arithmetic on the bit pattern), so it scales with
- * the magnitude of the coordinates instead of a global epsilon; near the origin, where
- * ulps vanish, a small absolute offset takes over. After Wächter & Binder, "A Fast and
- * Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, ch. 6 (2019). */
-#define RAY_OFFSET_ULPS 256.0f           /* ulps along a unit normal, away from 0 ... */
-#define RAY_OFFSET_NEAR_ZERO 0.03125f     /* ... except within this of 0, where ... */
-#define RAY_OFFSET_ABS 1.52587890625e-5f  /* ... it moves this far (kernels/shade_lanes.cl too) */
-KFN float offset_coord(float p, float n)
+/* How far spawn_offset moves a point along its unit normal n: the point's error
+ * along n, dot(|n|, err), so that the origin is off the surface whatever the
+ * rounding put it; plus 2^-20 of dot(|n|, |p|) and of that distance, which cover
+ * the rounding of p + n * distance (half an ulp per coordinate, 2^-24 of it) with
+ * room to spare, and 2^-100 so that a point at the origin moves too. After pbrt-v4's
+ * OffsetRayOrigin (Pharr, Jakob & Humphreys, PBR 4th ed., 6.8.6), which pushes each
+ * coordinate one float further instead of the relative margin; the margin needs no
+ * bit arithmetic, so kernels/shade_lanes.cl repeats it lane by lane as written. The
+ * earlier offset, a fixed 256 ulps of each coordinate (Wächter & Binder, Ray Tracing
+ * Gems ch. 6), did not follow the error: it fell short for a sphere seen from 1000
+ * radii (dark rings) and was 15% of a sphere 1e-4 across, whose coordinates are near
+ * 0 where it became a fixed 1.5e-5. */
+#define SPAWN_MARGIN 9.5367431640625e-07f   /* 2^-20 */
+#define SPAWN_FLOOR 7.888609052210118e-31f  /* 2^-100 */
+KFN float spawn_distance(vec3 p, vec3 err, vec3 n)
 {
-    int ulps = (int)(RAY_OFFSET_ULPS * n);
-    float moved = k_int_as_float(k_as_int(p) + (p < 0.0f ? -ulps : ulps));
-    return k_fabs(p) < RAY_OFFSET_NEAR_ZERO ? p + RAY_OFFSET_ABS * n : moved;
+    vec3 an = v3_abs(n);
+    float d = v3_dot(an, err);
+    return d + SPAWN_MARGIN * (v3_dot(an, v3_abs(p)) + d) + SPAWN_FLOOR;
 }
 
-KFN vec3 offset_ray_origin(vec3 p, vec3 n)
+/* A point just off the surface at p (error bound err) on the side unit vector n
+ * points to: where a ray leaving the surface there starts. */
+KFN vec3 spawn_offset(vec3 p, vec3 err, vec3 n)
 {
-    return v3(offset_coord(p.x, n.x), offset_coord(p.y, n.y), offset_coord(p.z, n.z));
+    return v3_madd(p, n, spawn_distance(p, err, n));
+}
+
+/* The origin of a ray leaving surface s on the side of its geometric normal n (either
+ * way round: the face the ray leaves through). */
+KFN vec3 spawn_origin(Surface s, vec3 n)
+{
+    return spawn_offset(s.p, s.err, n);
 }
 
 #endif /* CLPT_SURFACE_H */

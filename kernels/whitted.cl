@@ -79,13 +79,13 @@ KFN vec3 whitted_phong(vec3 kd, vec3 ks, float shininess, vec3 r, vec3 n, vec3 w
     return v3_scale(v3_mul(c, E), K_INV_PI);
 }
 
-/* Whether light sample ls is blocked from surface point sp; with shadows off it never is
+/* Whether light sample ls is blocked from surface s; with shadows off it never is
  * and no ray is traced (the course ray casters cast no shadows). */
-KFN int whitted_occluded(const SceneView *sc, vec3 sp, vec3 ng, LightSample ls, uint *rays)
+KFN int whitted_occluded(const SceneView *sc, Surface s, vec3 ng, LightSample ls, uint *rays)
 {
     if (!sc->params->shadows) return 0;
     (*rays)++;
-    return trace_occluded(sc, light_shadow_ray(sp, ng, ls));
+    return trace_occluded(sc, light_shadow_ray(s.p, s.err, ng, ls));
 }
 
 /* Direct light at surface point s: every delta light, and one sample of the area lights
@@ -101,7 +101,7 @@ KFN vec3 whitted_direct(const SceneView *sc, Surface s, vec3 d, vec3 ns, vec3 ng
         LightSample ls;
         if (!light_delta_at(sc->lights[li], s.p, &ls)) continue;
         if (v3_dot(ns, ls.wi) <= 0.0f || v3_dot(ng, ls.wi) <= 0.0f) continue;
-        if (whitted_occluded(sc, s.p, ng, ls, rays)) continue;
+        if (whitted_occluded(sc, s, ng, ls, rays)) continue;
         L = v3_add(L, whitted_phong(kd, ks, shininess, r, ns, ls.wi, ls.Le));
     }
     if (p->n_area_lights > 0u) {
@@ -111,7 +111,7 @@ KFN vec3 whitted_direct(const SceneView *sc, Surface s, vec3 d, vec3 ns, vec3 ng
             light_sample_in(sc, s.p, top, 0, rng_uniform(key, node, DIM_LIGHT_PICK), rng_uniform(key, node, DIM_LIGHT_U),
                             rng_uniform(key, node, DIM_LIGHT_V), &ls) &&
             !ls.delta && v3_dot(ns, ls.wi) > 0.0f && v3_dot(ng, ls.wi) > 0.0f) {
-            if (!whitted_occluded(sc, s.p, ng, ls, rays))
+            if (!whitted_occluded(sc, s, ng, ls, rays))
                 L = v3_add(L, whitted_phong(kd, ks, shininess, r, ns, ls.wi, v3_scale(ls.Le, 1.0f / ls.pdf)));
         }
     }
@@ -221,11 +221,11 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, RngKey key, uint *ray
             kt = v3_scale(kt, 1.0f - F);
         }
         if (!v3_is_zero(kt))
-            whitted_push(stack, &sp, offset_ray_origin(s.p, v3_neg(ng)), t_dir, v3_mul(e.weight, kt), e.depth + 1u);
+            whitted_push(stack, &sp, spawn_origin(s, v3_neg(ng)), t_dir, v3_mul(e.weight, kt), e.depth + 1u);
         if (!v3_is_zero(kr)) {
             vec3 r_dir = reflect_dir(d, ns);
             if (v3_dot(r_dir, ng) <= 0.0f) r_dir = reflect_dir(d, ng);
-            whitted_push(stack, &sp, offset_ray_origin(s.p, ng), r_dir, v3_mul(e.weight, kr), e.depth + 1u);
+            whitted_push(stack, &sp, spawn_origin(s, ng), r_dir, v3_mul(e.weight, kr), e.depth + 1u);
         }
     }
     return L;

@@ -1447,7 +1447,8 @@ static void check_mesh_brute_force(const char *what, int rays)
         const Triangle *b = &m.scene.triangles[(uint)(frand() * nt) % nt];
         vec3 pa = triangle_point(a, frand(), frand()), pb = triangle_point(b, frand(), frand());
         vec3 ng = v3_norm(v3_cross(v3_sub(a->p1, a->p0), v3_sub(a->p2, a->p0)));
-        vec3 off = offset_ray_origin(pa, frand() < 0.5f ? ng : v3_neg(ng));
+        /* off the surface by about pa's error bound, as the integrators spawn rays */
+        vec3 off = spawn_offset(pa, v3_scale(v3_abs(pa), K_ROUND_ERR(7)), frand() < 0.5f ? ng : v3_neg(ng));
         Ray ray;
         switch (i % 6) {
         case 4:   /* camera-like, through a corner or an edge (two or more triangles at one t) */

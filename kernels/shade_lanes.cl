@@ -239,6 +239,7 @@ KFN_CALL_CL void shade_lanes_fast(const LaneInputs *in, LaneResults *out)
     vec3x8 p0 = LANE_LOAD3(p0x, p0y, p0z), p1 = LANE_LOAD3(p1x, p1y, p1z), p2 = LANE_LOAD3(p2x, p2y, p2z);
     vec3x8 sp = w3_add(w3_add(w3_scale(p0, w), w3_scale(p1, u)), w3_scale(p2, v));
     vec3x8 ng = w3_cross(w3_sub(p1, p0), w3_sub(p2, p0));
+    ng = w3_select(ng, w3_scale(ng, (float8)(TRI_NORMAL_SCALE)), ~(w3_dot(ng, ng) < INFINITY));   /* triangle_normal */
     ng = w3_scale(ng, 1.0f / sqrt(w3_dot(ng, ng)));
     vec3x8 d = LANE_LOAD3(dx, dy, dz);
     int8 front = w3_dot(d, ng) < 0.0f;

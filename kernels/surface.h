@@ -98,6 +98,18 @@ KFN vec3 revsurface_point_error(RevSurface rs, Ray ray, float t)
     return v3_add(e, v3s((K_ROUND_ERR(8) + 4.0f * REV_RESIDUAL) * size));
 }
 
+/* The unit winding normal (p1 - p0) x (p2 - p0). Past about 1e19 in area its squared
+ * length overflows float, and the normal became 0 * inf = NaN: a pbrt disk of radius
+ * 1e11 (a fan of 64 such triangles) rendered black. Scaling the cross product by 2^-64
+ * first (exact) keeps it finite; the usual case is computed as before. */
+#define TRI_NORMAL_SCALE 5.421010862427522e-20f   /* 2^-64 */
+KFN vec3 triangle_normal(Triangle tr)
+{
+    vec3 c = v3_cross(v3_sub(tr.p1, tr.p0), v3_sub(tr.p2, tr.p0));
+    if (!(v3_dot(c, c) < K_INF)) c = v3_scale(c, TRI_NORMAL_SCALE);
+    return v3_norm(c);
+}
+
 KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
 {
     GLOBAL const RenderParams *p = sc->params;
@@ -127,7 +139,7 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
         /* barycentric interpolation is far more precise than o + t*d for a far hit */
         s.p = v3_add(v3_add(v3_scale(tr.p0, w), v3_scale(tr.p1, hit.u)), v3_scale(tr.p2, hit.v));
         s.err = triangle_point_error(tr, w, hit.u, hit.v, s.p);
-        s.ng = v3_norm(v3_cross(v3_sub(tr.p1, tr.p0), v3_sub(tr.p2, tr.p0)));
+        s.ng = triangle_normal(tr);
         s.ns = s.ng;
         s.material = tr.material;
         s.light = tr.light;

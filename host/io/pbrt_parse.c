@@ -1976,6 +1976,11 @@ static Status shape_disk_cylinder(Parser *p, const Lexer *lx, const Token *type,
         }
     }
     if (!st) orient_triangles(p, first);
+    double reach = st ? 0.0 : scene_triangles_reach(p->s, first, p->s->n_triangles);
+    if (reach > SCENE_MAX_COORDINATE)
+        return lex_error_at(lx, type, p->err, "the %.*s reaches %g from the origin (radius %g, after the transform), "
+                            "beyond the 2^62 (%g) single precision can intersect: scale the scene down",
+                            (int)type->len, type->text, reach, radius, SCENE_MAX_COORDINATE);
     return st;
 }
 

@@ -814,6 +814,18 @@ void scene_count_tiny_triangles(const Scene *s, size_t first, size_t end, size_t
     if (hi) *hi = h;
 }
 
+double scene_triangles_reach(const Scene *s, size_t first, size_t end)
+{
+    double reach = 0.0;
+    for (size_t i = first; i < end && i < s->n_triangles; i++) {
+        const Triangle *t = &s->triangles[i];
+        const vec3 c[3] = { t->p0, t->p1, t->p2 };
+        for (int k = 0; k < 3; k++)
+            reach = fmax(reach, fmax(fabs((double)c[k].x), fmax(fabs((double)c[k].y), fabs((double)c[k].z))));
+    }
+    return reach;
+}
+
 static Status check_sphere(const Scene *s, size_t i, Error *err)
 {
     const Sphere *sp = &s->spheres[i];
@@ -842,6 +854,11 @@ Status scene_check_precision(const Scene *s, Error *err)
         Status st = check_sphere(s, i, err);
         if (st) return st;
     }
+    double reach = scene_triangles_reach(s, 0, s->n_triangles);
+    if (reach > SCENE_MAX_COORDINATE)
+        return error_set(err, ST_INPUT, "%s: a triangle has a corner %g from the origin, beyond the 2^62 (%g) "
+                         "single precision can intersect: scale the scene down", s->path ? s->path : "scene",
+                         reach, SCENE_MAX_COORDINATE);
     size_t tiny, with_area;
     vec3 lo, hi;
     scene_count_tiny_triangles(s, 0, s->n_triangles, &tiny, &with_area, &lo, &hi);

@@ -189,11 +189,20 @@ Status scene_prepare_lights(Scene *s, Error *err);
  *     mesh's: scene_count_tiny_triangles) have an area but a normal whose squared
  *     length underflows in float (below 2^-140), they shade black or vanish. */
 Status scene_check_precision(const Scene *s, Error *err);
+/* (A triangle with a corner beyond SCENE_MAX_COORDINATE is refused too.) */
 /* Of triangles [first, end): *with_area those whose corners span an area (in double),
  * *tiny those of them whose normal the kernels cannot normalise in float; *lo and *hi
  * (may be NULL) their bounds. */
 void scene_count_tiny_triangles(const Scene *s, size_t first, size_t end, size_t *tiny, size_t *with_area,
                                 vec3 *lo, vec3 *hi);
+
+/* The largest |coordinate| of the corners of triangles [first, end). Beyond
+ * SCENE_MAX_COORDINATE the kernels' watertight test, which multiplies two coordinate
+ * differences and sums such products, overflows float: a pbrt disk of radius 1e20
+ * vanished (1e19 renders right). scene_check_precision refuses such triangles, and the
+ * pbrt reader its disks and cylinders, at the statement. */
+#define SCENE_MAX_COORDINATE 0x1p62
+double scene_triangles_reach(const Scene *s, size_t first, size_t end);
 
 /* Material helpers with the defaults of docs/scene-format.md. */
 Material material_diffuse(vec3 albedo);

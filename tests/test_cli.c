@@ -724,7 +724,9 @@ static void test_named_files_must_be_regular(void)
     CHECK_MSG(r.status == 0, "exit %d: %s", r.status, r.err);
 }
 
-/* A FIFO named by --resume is refused at once (fopen waited for a writer for ever). */
+/* A FIFO named by --resume is refused at once (fopen waited for a writer for ever). It
+ * is also the checkpoint written (--resume FILE implies --checkpoint FILE), so it is
+ * found by the output check, before anything is read. */
 static void test_resume_from_fifo_refused(void)
 {
     shell_run("d=$(mktemp -d /tmp/clpt-test-fifo-XXXXXX); trap 'rm -rf \"$d\"' EXIT\n"
@@ -732,8 +734,40 @@ static void test_resume_from_fifo_refused(void)
               "timeout 20 \"$CLPT\" " PIPE_FLAGS " --resume \"$d/r.ckpt\" -o \"$d/o.png\" scenes/cornell-box.scene\n",
               &r);
     CHECK_MSG(r.status == 4, "exit %d: %s", r.status, r.err);
-    CHECK_STR_CONTAINS(r.err, "cannot read checkpoint");
-    CHECK_STR_CONTAINS(r.err, "not a regular file");
+    CHECK_STR_CONTAINS(r.err, "cannot write checkpoint '");
+    CHECK_STR_CONTAINS(r.err, "/r.ckpt': it is a FIFO, not a regular file");
+}
+
+/* An output or checkpoint that is a FIFO, or a symlink to one (as to a device node: as
+ * root, `-o out.png` with out.png -> /dev/null replaced /dev/null with a PNG), is
+ * refused before rendering and left as it is. Only FIFOs in a temporary folder: never
+ * real device nodes. */
+static void test_outputs_must_be_regular_files(void)
+{
+    shell_run("d=$(mktemp -d /tmp/clpt-test-special-XXXXXX); trap 'rm -rf \"$d\"' EXIT\n"
+              "mkfifo \"$d/f.png\" \"$d/f.ckpt\"; ln -s f.png \"$d/link.png\"; ln -s f.ckpt \"$d/link.ckpt\"\n"
+              "for o in f.png link.png; do\n"
+              "  timeout 20 \"$CLPT\" " PIPE_FLAGS " -o \"$d/$o\" scenes/cornell-box.scene; echo \"exit $?\"\n"
+              "done\n"
+              "timeout 20 \"$CLPT\" " PIPE_FLAGS " -o \"$d/o.png\" --checkpoint \"$d/link.ckpt\" "
+              "scenes/cornell-box.scene; echo \"exit $?\"\n"
+              "for f in f.png f.ckpt; do [ -p \"$d/$f\" ] && echo \"$f still a FIFO\"; done\n"
+              "[ -L \"$d/link.png\" ] && [ -L \"$d/link.ckpt\" ] && echo 'links kept'\n"
+              "[ -e \"$d/o.png\" ] || echo 'nothing rendered'\n"
+              "ls \"$d\" | grep -c tmp\n"
+              "echo \"dir $d\"\n", &r);
+    CHECK_MSG(r.status == 0, "exit %d: %s", r.status, r.err);
+    CHECK_EQ_INT(count_of(r.out, "exit 4"), 3);
+    CHECK_STR_CONTAINS(r.err, "/f.png': it is a FIFO, not a regular file (clpt replaces only regular files)");
+    CHECK_STR_CONTAINS(r.err, "/link.png': it leads to '");
+    CHECK_STR_CONTAINS(r.err, "/f.png', which is a FIFO, not a regular file (clpt replaces only regular files)");
+    CHECK_STR_CONTAINS(r.err, "clpt: error: cannot write checkpoint '");
+    CHECK_STR_CONTAINS(r.err, "/link.ckpt': it leads to '");
+    CHECK_STR_CONTAINS(r.out, "f.png still a FIFO");
+    CHECK_STR_CONTAINS(r.out, "f.ckpt still a FIFO");
+    CHECK_STR_CONTAINS(r.out, "links kept");
+    CHECK_STR_CONTAINS(r.out, "nothing rendered");
+    CHECK_STR_CONTAINS(r.out, "\n0\n");   /* no temporary file left behind */
 }
 
 int main(void)
@@ -755,6 +789,7 @@ int main(void)
     RUN(test_bad_outputs_found_before_rendering);
     RUN(test_outputs_must_be_distinct_files);
     RUN(test_output_symlink_and_mode_kept);
+    RUN(test_outputs_must_be_regular_files);
     RUN(test_time_limit_without_samples_keeps_the_output);
     RUN(test_failed_checkpoint_after_time_limit_says_why);
     RUN(test_stdout_failures);

@@ -68,6 +68,36 @@ static char *resolve_target(const char *path)
     return cur;
 }
 
+/* What a file that is not a regular file is, for messages; NULL for a regular file. */
+static const char *not_regular_kind(mode_t mode)
+{
+    if (S_ISREG(mode)) return NULL;
+    if (S_ISFIFO(mode)) return "a FIFO";
+    if (S_ISSOCK(mode)) return "a socket";
+    if (S_ISCHR(mode)) return "a character device";
+    if (S_ISBLK(mode)) return "a block device";
+    if (S_ISLNK(mode)) return "a symlink";
+    return "not a regular file";
+}
+
+/* Refuses a target that exists and is not a regular file: the rename would replace a
+ * FIFO, a socket or a device node (as root, `-o` through a link to /dev/null would
+ * replace /dev/null) with a plain file. Names the link's target when they differ. */
+static Status refuse_not_regular(AtomicFile *af, const char *kind, Error *err)
+{
+    Status st;
+    if (strcmp(af->path, af->target) == 0)
+        st = error_set(err, ST_IO, "cannot write %s%s'%s': it is %s, not a regular file (clpt replaces only regular "
+                       "files)", af->what, af->what[0] ? " " : "", af->path, kind);
+    else
+        st = error_set(err, ST_IO, "cannot write %s%s'%s': it leads to '%s', which is %s, not a regular file (clpt "
+                       "replaces only regular files)", af->what, af->what[0] ? " " : "", af->path, af->target, kind);
+    free(af->tmp);
+    af->tmp = NULL;
+    atomic_abort(af);
+    return st;
+}
+
 /* The temporary file lives in the target's folder so that the final rename stays within
  * one filesystem, where it is atomic. */
 Status atomic_open(AtomicFile *af, const char *path, const char *what, Error *err)
@@ -96,6 +126,8 @@ Status atomic_open(AtomicFile *af, const char *path, const char *what, Error *er
             atomic_abort(af);
             return st;
         }
+        const char *kind = not_regular_kind(sb.st_mode);
+        if (kind) return refuse_not_regular(af, kind, err);
         af->keep_mode = 1;
         af->mode = sb.st_mode & 07777;
     }
@@ -187,6 +219,13 @@ Status atomic_commit(AtomicFile *af, Error *err)
         int rc = fclose(af->f);
         af->f = NULL;
         if (rc != 0) atomic_fail(af, "close");
+    }
+    /* Checked again: hours may have passed since atomic_open, and what sits at the target
+     * now is what the rename would replace. */
+    struct stat sb;
+    if (!af->failed_step && lstat(af->target, &sb) == 0 && !S_ISREG(sb.st_mode)) {
+        errno = S_ISDIR(sb.st_mode) ? EISDIR : EEXIST;
+        atomic_fail(af, "something that is not a regular file took its place");
     }
     if (!af->failed_step && rename(af->tmp, af->target) != 0)
         atomic_fail(af, "cannot rename the temporary file over it");

@@ -6,8 +6,11 @@
  * cache.
  *
  * The target is the file a plain fopen() would write: a symlink is followed (the link
- * stays and its target gets the new content), and an existing file keeps its
- * permission bits. A file with several hard links is replaced under the name given,
+ * stays and its target gets the new content; a dangling one's target is created), and
+ * an existing file keeps its permission bits. Only a regular file is replaced: a
+ * target that is a FIFO, a socket, a device node or a directory, named directly or
+ * through links, is refused (ST_IO), since the rename would put a plain file in its
+ * place (as root, `-o out.png` with out.png -> /dev/null would replace /dev/null). A file with several hard links is replaced under the name given,
  * so its other names keep the old content: writing into the shared inode in place
  * would give up the whole-or-nothing promise, which matters more for images that a
  * viewer or a later resume reads while clpt writes them (docs/exit-codes.md).
@@ -40,7 +43,8 @@ typedef struct {
 Status atomic_open(AtomicFile *af, const char *path, const char *what, Error *err);
 /* Checks, before a long render, that `path` can be written: creates and removes the
  * temporary file atomic_open would. Fails as atomic_open would (ST_IO, the same
- * message: a missing or unwritable folder, a folder in the file's place). */
+ * message: a missing or unwritable folder, a folder, FIFO or device in the file's
+ * place). */
 Status atomic_probe(const char *path, const char *what, Error *err);
 /* Appends n bytes (skipped after a failure). */
 void atomic_write(AtomicFile *af, const void *data, size_t n);

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "base/atomic_file.h"
+#include "base/file_id.h"
 #include "dist/merge.h"
 #include "dist/mpi_driver.h"
 #include "render/checkpoint.h"
@@ -549,46 +550,18 @@ static Status run_info_command(const Options *o, int *done, Error *err)
 /* What a named file is to this run. */
 typedef enum { FILE_IMAGE, FILE_CHECKPOINT, FILE_RESUME, FILE_SCENE } FileRole;
 
-/* A file as the filesystem knows it: its device and inode when it exists, else its
- * folder's and its own name, so that "x.png" and "./x.png" are one file before either
- * exists. */
+/* A file this run names, and what it is to the run. */
 typedef struct {
-    const char *path;
+    FileId id;
     const char *what;     /* for messages: "the output image", "the checkpoint" */
     FileRole role;
-    int known;            /* dev/ino were found */
-    dev_t dev;
-    ino_t ino;
-    const char *name;     /* NULL: dev/ino are the file's own; else its folder's */
 } NamedFile;
 
 static void named_file_init(NamedFile *f, const char *path, const char *what, FileRole role)
 {
-    struct stat sb;
-    memset(f, 0, sizeof *f);
-    f->path = path;
+    file_id_init(&f->id, path);
     f->what = what;
     f->role = role;
-    if (stat(path, &sb) == 0) {
-        f->known = 1;
-    } else {
-        const char *slash = strrchr(path, '/');
-        char dir[4096];
-        snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + 1 : 1, slash ? path : ".");
-        if (stat(dir, &sb) != 0) return;
-        f->known = 1;
-        f->name = slash ? slash + 1 : path;
-    }
-    f->dev = sb.st_dev;
-    f->ino = sb.st_ino;
-}
-
-static int named_file_same(const NamedFile *a, const NamedFile *b)
-{
-    if (strcmp(a->path, b->path) == 0) return 1;
-    if (!a->known || !b->known || a->dev != b->dev || a->ino != b->ino) return 0;
-    if (!a->name || !b->name) return !a->name && !b->name;
-    return strcmp(a->name, b->name) == 0;
 }
 
 static int is_output(FileRole role)
@@ -607,9 +580,9 @@ static Status outputs_check_distinct(const NamedFile *files, size_t n, Error *er
             const NamedFile *a = &files[i], *b = &files[j];
             if (!is_output(a->role) && !is_output(b->role)) continue;
             if (a->role == FILE_CHECKPOINT && b->role == FILE_RESUME) continue;
-            if (!named_file_same(a, b)) continue;
+            if (!file_id_same(&a->id, &b->id)) continue;
             return error_set(err, ST_USAGE, "%s '%s' and %s '%s' are the same file; give each its own name",
-                             a->what, a->path, b->what, b->path);
+                             a->what, a->id.path, b->what, b->id.path);
         }
     return ST_OK;
 }
@@ -639,7 +612,7 @@ static Status outputs_check(const Run *r, Error *err)
     if ((st = outputs_check_distinct(files, n, err))) goto out;
     for (size_t i = 0; i < n && st == ST_OK; i++)
         if (is_output(files[i].role))
-            st = atomic_probe(files[i].path, files[i].role == FILE_CHECKPOINT ? "checkpoint" : "", err);
+            st = atomic_probe(files[i].id.path, files[i].role == FILE_CHECKPOINT ? "checkpoint" : "", err);
 out:
     for (size_t i = 0; i < 3; i++) free(aov_paths[i]);
     return st;

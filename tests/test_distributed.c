@@ -135,6 +135,56 @@ static void test_merge_refusals(void)
     expect_merge_refused(ARGS("merge", "-o", in_dir("refused.pfm"), in_dir("missing.ckpt")), 4, msg);
 }
 
+static void copy_file(const char *from, const char *to)
+{
+    FILE *in = fopen(from, "rb"), *out = fopen(to, "wb");
+    char buf[4096];
+    size_t n;
+    while (in && out && (n = fread(buf, 1, sizeof buf, in)) > 0) fwrite(buf, 1, n, out);
+    if (in) fclose(in);
+    if (out) fclose(out);
+}
+
+/* An output that is one of the parts, by name or through a link, is refused before
+ * anything is written: `merge -o p2.pfm p1.ckpt p2.pfm` exited 0 and p2 was gone. */
+static void test_merge_refuses_to_overwrite_a_part(void)
+{
+    char msg[1024];
+    copy_file(in_dir("b.ckpt"), in_dir("pb.pfm"));   /* a part whose name reads like an image */
+    copy_file(in_dir("a.ckpt"), in_dir("pa.ckpt"));
+    unlink(in_dir("pa-link.ckpt"));
+    CHECK(symlink("pa.ckpt", in_dir("pa-link.ckpt")) == 0);
+    cli_run(ARGS("merge", "-o", in_dir("pb.pfm"), in_dir("a.ckpt"), in_dir("pb.pfm"), in_dir("c.ckpt")), &r);
+    CHECK_EQ_INT(r.status, 2);
+    snprintf(msg, sizeof msg, "clpt: error: merge: the output image '%s' is the part '%s': writing it would destroy "
+             "that part; give the output image another name\n", in_dir("pb.pfm"), in_dir("pb.pfm"));
+    CHECK_STR_CONTAINS(r.err, msg);
+    CHECK(files_equal(in_dir("pb.pfm"), in_dir("b.ckpt")));
+    cli_run(ARGS("merge", "-o", in_dir("refused.pfm"), "--checkpoint", in_dir("pa.ckpt"), in_dir("pa.ckpt"),
+                 in_dir("b.ckpt"), in_dir("c.ckpt")), &r);
+    CHECK_EQ_INT(r.status, 2);
+    snprintf(msg, sizeof msg, "clpt: error: merge: the checkpoint '%s' is the part '%s'", in_dir("pa.ckpt"),
+             in_dir("pa.ckpt"));
+    CHECK_STR_CONTAINS(r.err, msg);
+    /* through a symlink: the same file */
+    cli_run(ARGS("merge", "-o", in_dir("refused.pfm"), "--checkpoint", in_dir("pa-link.ckpt"), in_dir("pa.ckpt"),
+                 in_dir("b.ckpt"), in_dir("c.ckpt")), &r);
+    CHECK_EQ_INT(r.status, 2);
+    snprintf(msg, sizeof msg, "clpt: error: merge: the checkpoint '%s' is the part '%s'", in_dir("pa-link.ckpt"),
+             in_dir("pa.ckpt"));
+    CHECK_STR_CONTAINS(r.err, msg);
+    CHECK(files_equal(in_dir("pa.ckpt"), in_dir("a.ckpt")));
+    CHECK(!file_exists(in_dir("refused.pfm")));
+    /* the image and the checkpoint one file */
+    cli_run(ARGS("merge", "-o", in_dir("both.pfm"), "--checkpoint", in_dir("both.pfm"), in_dir("a.ckpt"),
+                 in_dir("b.ckpt"), in_dir("c.ckpt")), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "are the same file; give each its own name");
+    CHECK(!file_exists(in_dir("both.pfm")));
+    unlink(in_dir("refused.pfm"));   /* when this failed: not to fail the tests after it */
+    unlink(in_dir("both.pfm"));
+}
+
 static void test_sample_range_usage_errors(void)
 {
     cli_run(ARGS(RENDER, "--sample-range", "5:13", "-o", in_dir("refused.pfm")), &r);
@@ -379,6 +429,7 @@ int main(void)
     make_dir();
     RUN(render_whole);
     RUN(test_three_parts_merge_to_the_whole);
+    RUN(test_merge_refuses_to_overwrite_a_part);
     RUN(test_another_split_merges_to_the_same_bits);
     RUN(test_merge_refusals);
     RUN(test_sample_range_usage_errors);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "base/atomic_file.h"
+#include "base/file_id.h"
 #include "io/image_write.h"
 #include "scene/scene.h"
 
@@ -147,6 +148,31 @@ static Status merge_write_image(const Film *film, const char *path, int linear, 
     return st;
 }
 
+/* The image and the checkpoint written must be neither one of the parts (writing it
+ * would destroy that part: `merge -o p2.pfm p1.ckpt p2.pfm` lost p2) nor each other.
+ * Compared as files (device and inode), so a link or "./p2" is caught too. */
+static Status merge_check_outputs(const MergeOptions *m, Error *err)
+{
+    FileId out, ck, part;
+    file_id_init(&out, m->output);
+    if (m->checkpoint) {
+        file_id_init(&ck, m->checkpoint);
+        if (file_id_same(&out, &ck))
+            return error_set(err, ST_USAGE, "merge: the output image '%s' and the checkpoint '%s' are the same file; "
+                             "give each its own name", m->output, m->checkpoint);
+    }
+    for (size_t k = 0; k < m->n_parts; k++) {
+        file_id_init(&part, m->parts[k]);
+        const char *what = NULL, *path = NULL;
+        if (file_id_same(&out, &part)) what = "output image", path = m->output;
+        else if (m->checkpoint && file_id_same(&ck, &part)) what = "checkpoint", path = m->checkpoint;
+        if (what)
+            return error_set(err, ST_USAGE, "merge: the %s '%s' is the part '%s': writing it would destroy that "
+                             "part; give the %s another name", what, path, m->parts[k], what);
+    }
+    return ST_OK;
+}
+
 Status merge_command(int argc, char **argv, Error *err)
 {
     MergeOptions m;
@@ -156,6 +182,7 @@ Status merge_command(int argc, char **argv, Error *err)
     Status st = merge_parse(argc, argv, &m, err);
     /* the outputs are checked before the parts are read: a typo costs a second */
     if (st == ST_OK) st = image_format_from_path(m.output, &fmt, err);
+    if (st == ST_OK) st = merge_check_outputs(&m, err);
     if (st == ST_OK) st = atomic_probe(m.output, "", err);
     if (st == ST_OK && m.checkpoint) st = atomic_probe(m.checkpoint, "checkpoint", err);
     if (st == ST_OK) st = merge_parts(m.parts, m.n_parts, &merged, err);

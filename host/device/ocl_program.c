@@ -2,13 +2,16 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
+#include <spawn.h>
 #include <stdint.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -167,25 +170,32 @@ static void oclp__key(const OclDeviceInfo *dev, const char *src, size_t src_len,
 }
 
 /* Reads and checks a cache entry. Returns 1 and a heap payload when the file is whole
- * and belongs to `key`; 0 when there is no file; -1 when it is damaged. */
-static int oclp__cache_read(const char *path, const unsigned char key[SHA256_DIGEST_SIZE],
-                            unsigned char **payload, size_t *len)
+ * and belongs to `key` (not checked when NULL), with the payload's SHA-256 in `digest`;
+ * 0 when there is no file; -1 when it is damaged or not a regular file. Opened without
+ * blocking: a FIFO in the entry's place hung clpt for ever. */
+static int oclp__cache_read(const char *path, const unsigned char *key, unsigned char **payload, size_t *len,
+                            unsigned char digest[SHA256_DIGEST_SIZE])
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) return errno == ENOENT ? 0 : -1;
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return errno == ENOENT ? 0 : -1;
+    struct stat sb;
+    FILE *f = fstat(fd, &sb) == 0 && S_ISREG(sb.st_mode) ? fdopen(fd, "rb") : NULL;
+    if (!f) {
+        close(fd);
+        return -1;
+    }
     unsigned char head[OCLP__HEADER];
     int ok = fread(head, 1, sizeof head, f) == sizeof head &&
              memcmp(head, OCLP__MAGIC, 8) == 0 && oclp__get_le(head + 8, 4) == OCLP__VERSION &&
-             memcmp(head + 24, key, SHA256_DIGEST_SIZE) == 0;
+             (!key || memcmp(head + 24, key, SHA256_DIGEST_SIZE) == 0);
     uint64_t n = ok ? oclp__get_le(head + 16, 8) : 0;
     ok = ok && n > 0 && n <= OCLP__MAX_PAYLOAD;
     unsigned char *buf = ok ? malloc((size_t)n + 1) : NULL;
     ok = buf && fread(buf, 1, (size_t)n, f) == n && fgetc(f) == EOF;
     fclose(f);
     if (ok) {
-        unsigned char sum[SHA256_DIGEST_SIZE];
-        sha256(buf, (size_t)n, sum);
-        ok = memcmp(sum, head + 56, SHA256_DIGEST_SIZE) == 0;
+        sha256(buf, (size_t)n, digest);
+        ok = memcmp(digest, head + 56, SHA256_DIGEST_SIZE) == 0;
     }
     if (!ok) {
         free(buf);
@@ -194,6 +204,15 @@ static int oclp__cache_read(const char *path, const unsigned char key[SHA256_DIG
     *payload = buf;
     *len = (size_t)n;
     return 1;
+}
+
+/* Removes a damaged entry, whatever it is: a file, a FIFO, an empty folder (a folder
+ * with files in it stays, and the cache is then only missed), and its proof. */
+static void oclp__cache_remove(const char *path)
+{
+    char proof[1100];
+    (void)remove(path);
+    if (snprintf(proof, sizeof proof, "%s.ok", path) < (int)sizeof proof) (void)remove(proof);
 }
 
 /* Writes a cache entry atomically (a reader never sees half an entry). Failure is
@@ -291,6 +310,172 @@ static int oclp__from_binary(cl_context ctx, const OclDeviceInfo *dev, const uns
     return 1;
 }
 
+/* ---------------------------------------------------------------- the trial load */
+
+static atomic_int oclp__announce_builds;   /* see ocl_program_announce_builds */
+
+/* A payload whose checksum is right can still crash the driver that reads it (a
+ * flipped byte in a PoCL binary is a SIGSEGV in clCreateProgramWithBinary; a torn one
+ * an assertion), and a crash cannot be caught in the process it happens in. So an entry
+ * is first loaded in a child process (a trial): only a payload that a trial, or an
+ * earlier run, loaded without harm is loaded here. The proof is PATH.ok, holding the
+ * SHA-256 of the payload proven, so a payload put in the entry's place afterwards is
+ * tried again. The trial costs a process start and the driver's start-up, once per new
+ * entry. The child is this same program (/proc/self/exe, whatever binary links clpt's
+ * library: clpt, a test, a benchmark), told by the environment what to try; it runs
+ * the trial from a constructor (oclp__trial_main), before main, and exits. */
+#define OCLP__TRIAL_DEVICE "CLPT_KERNEL_CACHE_TRIAL"          /* "PLATFORM.DEVICE" indices */
+#define OCLP__TRIAL_ENTRY "CLPT_KERNEL_CACHE_TRIAL_ENTRY"     /* the entry's path */
+#define OCLP__TRIAL_DIGEST "CLPT_KERNEL_CACHE_TRIAL_DIGEST"   /* the payload's SHA-256, hex */
+#define OCLP__TRIAL_OPTIONS "CLPT_KERNEL_CACHE_TRIAL_OPTIONS" /* the build options */
+#define OCLP__TRIAL_SECONDS 120.0   /* a trial that takes longer is a driver hanging on it */
+
+typedef enum {
+    OCLP__TRIAL_LOADED,    /* the driver built it and the program is usable */
+    OCLP__TRIAL_REFUSED,   /* the driver refused it, or hung on it */
+    OCLP__TRIAL_CRASHED,   /* the driver crashed on it */
+    OCLP__TRIAL_UNKNOWN,   /* no answer: no trial could run, or it was interrupted */
+} OclpTrial;
+
+/* Whether PATH.ok proves the payload with this digest. */
+static int oclp__proven(const char *path, const unsigned char digest[SHA256_DIGEST_SIZE])
+{
+    char proof[1100];
+    if (snprintf(proof, sizeof proof, "%s.ok", path) >= (int)sizeof proof) return 0;
+    int fd = open(proof, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return 0;
+    unsigned char got[SHA256_DIGEST_SIZE + 1];
+    struct stat sb;
+    int ok = fstat(fd, &sb) == 0 && S_ISREG(sb.st_mode) && read(fd, got, sizeof got) == SHA256_DIGEST_SIZE &&
+             memcmp(got, digest, SHA256_DIGEST_SIZE) == 0;
+    close(fd);
+    return ok;
+}
+
+static void oclp__prove(const char *path, const unsigned char digest[SHA256_DIGEST_SIZE])
+{
+    char proof[1100];
+    if (snprintf(proof, sizeof proof, "%s.ok", path) >= (int)sizeof proof) return;
+    AtomicFile af;
+    Error ignored = {0};
+    if (atomic_open(&af, proof, "kernel cache proof", &ignored) == ST_OK) {
+        atomic_write(&af, digest, SHA256_DIGEST_SIZE);
+        (void)atomic_commit(&af, &ignored);
+    }
+    error_clear(&ignored);
+}
+
+/* The child's side: loads the entry for the device named by the environment. Exit
+ * status 0: loaded and usable; 1: refused; 2: the trial itself could not run. */
+static int oclp__trial(const char *which, const char *path, const char *digest_hex, const char *options)
+{
+    unsigned p = 0, d = 0;
+    if (!path || !digest_hex || !options || sscanf(which, "%u.%u", &p, &d) != 2) return 2;
+    cl_uint n_platforms = 0, n_devices = 0;
+    cl_platform_id platforms[64];
+    cl_device_id devices[64];
+    if (clGetPlatformIDs(64, platforms, &n_platforms) != CL_SUCCESS || p >= n_platforms || p >= 64) return 2;
+    if (clGetDeviceIDs(platforms[p], CL_DEVICE_TYPE_ALL, 64, devices, &n_devices) != CL_SUCCESS ||
+        d >= n_devices || d >= 64)
+        return 2;
+    unsigned char *bin = NULL, digest[SHA256_DIGEST_SIZE];
+    size_t len = 0;
+    char hex[65];
+    if (oclp__cache_read(path, NULL, &bin, &len, digest) != 1) return 2;
+    sha256_hex(digest, hex);
+    if (strcmp(hex, digest_hex) != 0) return 2;   /* replaced meanwhile: not what was asked */
+    cl_context_properties props[] = { CL_CONTEXT_PLATFORM, (cl_context_properties)platforms[p], 0 };
+    cl_int rc;
+    cl_context ctx = clCreateContext(props, 1, &devices[d], NULL, NULL, &rc);
+    if (rc != CL_SUCCESS) return 2;
+    OclDeviceInfo dev;
+    memset(&dev, 0, sizeof dev);
+    dev.id = devices[d];
+    cl_program prog;
+    int ok = oclp__from_binary(ctx, &dev, bin, len, options, &prog);
+    if (ok) clReleaseProgram(prog);
+    clReleaseContext(ctx);
+    free(bin);
+    return ok ? 0 : 1;
+}
+
+/* Runs the trial when this process is a trial child; every other process returns at
+ * once. _exit: the child has nothing of the parent's to flush, and a sanitizer's leak
+ * check at exit has nothing to say about a process that ran no main. */
+__attribute__((constructor)) static void oclp__trial_main(void)
+{
+    const char *which = getenv(OCLP__TRIAL_DEVICE);
+    if (!which) return;
+    _exit(oclp__trial(which, getenv(OCLP__TRIAL_ENTRY), getenv(OCLP__TRIAL_DIGEST), getenv(OCLP__TRIAL_OPTIONS)));
+}
+
+/* The parent's side: starts the child with the environment plus the trial's variables,
+ * its output thrown away (a driver's assertion message is not clpt's to show), and
+ * waits for its verdict. */
+static OclpTrial oclp__try_entry(const OclDeviceInfo *dev, const char *path,
+                                 const unsigned char digest[SHA256_DIGEST_SIZE], const char *options)
+{
+    extern char **environ;
+    char hex[65], v_device[64], v_entry[1200], v_digest[128], v_options[700];
+    sha256_hex(digest, hex);
+    snprintf(v_device, sizeof v_device, "%s=%u.%u", OCLP__TRIAL_DEVICE, dev->platform_index, dev->device_index);
+    snprintf(v_digest, sizeof v_digest, "%s=%s", OCLP__TRIAL_DIGEST, hex);
+    if (snprintf(v_entry, sizeof v_entry, "%s=%s", OCLP__TRIAL_ENTRY, path) >= (int)sizeof v_entry ||
+        snprintf(v_options, sizeof v_options, "%s=%s", OCLP__TRIAL_OPTIONS, options) >= (int)sizeof v_options)
+        return OCLP__TRIAL_UNKNOWN;
+    size_t n_env = 0;
+    while (environ[n_env]) n_env++;
+    char **envp = calloc(n_env + 5, sizeof *envp);
+    if (!envp) return OCLP__TRIAL_UNKNOWN;
+    size_t k = 0;
+    for (size_t i = 0; i < n_env; i++)
+        if (strncmp(environ[i], "CLPT_KERNEL_CACHE_TRIAL", 23) != 0) envp[k++] = environ[i];
+    envp[k++] = v_device;
+    envp[k++] = v_entry;
+    envp[k++] = v_digest;
+    envp[k++] = v_options;
+    char *argv[] = { (char *)"clpt-kernel-cache-trial", NULL };
+    posix_spawn_file_actions_t fa;
+    pid_t pid = -1;
+    int spawned = -1;
+    if (posix_spawn_file_actions_init(&fa) == 0) {
+        if (posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0) == 0 &&
+            posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0) == 0 &&
+            posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0) == 0)
+            spawned = posix_spawn(&pid, "/proc/self/exe", &fa, NULL, argv, envp);
+        posix_spawn_file_actions_destroy(&fa);
+    }
+    free(envp);
+    if (spawned != 0) return OCLP__TRIAL_UNKNOWN;
+    int wstatus = 0;
+    double deadline = oclp__now() + OCLP__TRIAL_SECONDS;
+    for (;;) {
+        pid_t got = waitpid(pid, &wstatus, WNOHANG);
+        if (got == pid) break;
+        if (got < 0 && errno != EINTR) return OCLP__TRIAL_UNKNOWN;
+        if (oclp__now() > deadline) {
+            kill(pid, SIGKILL);
+            while (waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {}
+            return OCLP__TRIAL_REFUSED;
+        }
+        nanosleep(&(struct timespec){ 0, 5000000 }, NULL);
+    }
+    if (WIFEXITED(wstatus))
+        return WEXITSTATUS(wstatus) == 0 ? OCLP__TRIAL_LOADED
+             : WEXITSTATUS(wstatus) == 1 ? OCLP__TRIAL_REFUSED : OCLP__TRIAL_UNKNOWN;
+    switch (WTERMSIG(wstatus)) {
+    case SIGSEGV: case SIGBUS: case SIGABRT: case SIGILL: case SIGFPE: case SIGSYS: return OCLP__TRIAL_CRASHED;
+    default: return OCLP__TRIAL_UNKNOWN;   /* interrupted with the parent (Ctrl-C), or killed */
+    }
+}
+
+/* Creates the empty file `path`, a mark (best effort). */
+static void oclp__mark(const char *path)
+{
+    FILE *mark = fopen(path, "w");
+    if (mark) fclose(mark);
+}
+
 /* Whether an earlier run died while its driver read the entry at `path`: it left
  * PATH.PID.trying behind (oclp__cache_load) and process PID is gone. Removes such
  * leftovers. A run still trying the entry is left alone. */
@@ -324,18 +509,21 @@ static int oclp__crashed_before(const char *path)
     return crashed;
 }
 
-/* Loads the program from the cache entry at `path`; 1 on success. The entry is moved
- * aside to PATH.PID.trying while the driver reads it, and put back only once the
- * program proved usable: a payload whose checksum is right but which the driver cannot
- * take (PoCL 3 aborts the process on some damaged binaries, in
- * clCreateProgramWithBinary or clBuildProgram) then costs at most the one run it
- * crashed, instead of crashing every later run. A refused entry is deleted. A
- * concurrent run meanwhile finds no entry and builds from source.
+/* Loads the program from the cache entry at `path`; 1 on success. A payload no trial
+ * has proven is loaded in a child process first (oclp__try_entry), and removed when the
+ * driver refuses it or crashes on it there (PoCL 3 aborts or faults on some damaged
+ * binaries whose checksum is right, in clCreateProgramWithBinary or clBuildProgram).
+ * Should the driver still crash here (no trial could run, or a proven entry), the
+ * entry is moved aside to PATH.PID.trying while the driver reads it, and put back only
+ * once the program proved usable, so that it costs at most the one run it crashed. A
+ * refused entry is deleted. A concurrent run meanwhile finds no entry and builds from
+ * source.
  *
  * The driver may have kept what it read in a cache of its own (PoCL does, under the
  * program's hash, and then crashes on it when the same source is built again): when a
- * run died trying the entry, `path`.crashed is left as a mark, and while it exists the
- * source is built with a line that changes the driver's key (oclp__from_source). */
+ * trial crashed or a run died trying the entry, `path`.crashed is left as a mark, and
+ * while it exists the source is built with a line that changes the driver's key
+ * (oclp__from_source). */
 static int oclp__cache_load(cl_context ctx, const OclDeviceInfo *dev, const char *path,
                             const unsigned char key[SHA256_DIGEST_SIZE], const char *options,
                             cl_program *out)
@@ -344,18 +532,24 @@ static int oclp__cache_load(cl_context ctx, const OclDeviceInfo *dev, const char
     if (snprintf(trying, sizeof trying, "%s.%ld.trying", path, (long)getpid()) >= (int)sizeof trying ||
         snprintf(crashed, sizeof crashed, "%s.crashed", path) >= (int)sizeof crashed)
         return 0;
-    unsigned char *bin = NULL;
+    unsigned char *bin = NULL, digest[SHA256_DIGEST_SIZE];
     size_t bin_len = 0;
-    int got = oclp__cache_read(path, key, &bin, &bin_len);
+    int got = oclp__cache_read(path, key, &bin, &bin_len, digest);
     if (got == 0) {
-        if (oclp__crashed_before(path)) {
-            FILE *mark = fopen(crashed, "w");
-            if (mark) fclose(mark);
-        }
+        if (oclp__crashed_before(path)) oclp__mark(crashed);
         return 0;
     }
-    if (got < 0 || rename(path, trying) != 0) {
-        unlink(path);     /* damaged: rebuilt and replaced by the caller */
+    OclpTrial trial = got < 0 || oclp__proven(path, digest) ? OCLP__TRIAL_LOADED
+                                                            : oclp__try_entry(dev, path, digest, options);
+    if (trial == OCLP__TRIAL_CRASHED) {
+        oclp__mark(crashed);   /* the driver may have kept what it read: compile past it */
+        if (atomic_load(&oclp__announce_builds))
+            fprintf(stderr, "clpt: warning: the OpenCL driver crashed loading the kernel cache entry '%s' (in a "
+                    "trial process); removed it\n", path);
+    }
+    if (trial == OCLP__TRIAL_LOADED && got > 0) oclp__prove(path, digest);
+    if (got < 0 || trial == OCLP__TRIAL_REFUSED || trial == OCLP__TRIAL_CRASHED || rename(path, trying) != 0) {
+        oclp__cache_remove(path);     /* damaged: rebuilt and replaced by the caller */
         free(bin);
         return 0;
     }
@@ -412,8 +606,6 @@ static Status oclp__from_source(cl_context ctx, const OclDeviceInfo *dev, const 
 }
 
 /* ---------------------------------------------------------------- the notice */
-
-static atomic_int oclp__announce_builds;
 
 void ocl_program_announce_builds(int on)
 {

@@ -21,10 +21,12 @@
  * and renamed, so a concurrent run sees either no file or a whole one. Anything wrong
  * with an entry (truncated, corrupt, refused by the driver, or a program that did not
  * build for the device or lacks clpt's kernel k_film) deletes it and the program is rebuilt
- * from source and stored again. While the driver reads an entry it is moved aside, so
- * an entry the driver crashes on is gone for the next run, which compiles afresh past
- * whatever the driver kept of it (ocl_program.c, oclp__cache_load). A cache that cannot
- * be created or written only means building from source: it never fails a run.
+ * from source and stored again; so is an entry that is not a regular file (a FIFO or
+ * a folder: opened without blocking). A payload with a right checksum can still crash
+ * the driver, so a new entry is first loaded in a trial process (ocl_program.c, "the
+ * trial load"): a crash there costs nothing but a compile from source, past whatever
+ * the driver kept of it. A cache that cannot be created or written only means building
+ * from source: it never fails a run.
  *
  * Storing an entry reads CL_PROGRAM_BINARIES right after the build, which makes PoCL 3.1
  * compile every kernel of the program (a work-group function for any local size) on top

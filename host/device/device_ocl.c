@@ -65,6 +65,7 @@ typedef struct {
     cl_mem film;
     int64_t *host;
     cl_event read_done;     /* the read-back in flight; NULL while the slot is free */
+    int stale;              /* holds part of a cancelled batch: cleared before the next */
 } FilmSlot;
 
 /* One wave in flight: its buffers, its kernels (arguments that never change are set
@@ -526,6 +527,7 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
             return error_set(err, ST_INTERNAL, "out of memory for the read-back of the film");
         OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, fs->film, &zero, sizeof zero, 0,
                                                            film_bytes < 16 ? 16 : film_bytes, 0, NULL, NULL));
+        fs->stale = 0;
     }
     OCL_TRY("clFinish", clFinish(od->queue));
     od->n_pixels = n_pixels;
@@ -797,8 +799,10 @@ static int cancel_requested(const OclDevice *od)
 }
 
 /* Drops a cancelled batch: lets what was enqueued finish (nothing may still write to
- * the film or to the wave buffers), forgets the waves and clears the batch's film. The
- * batches before, with their read-backs, are whole and stay to be taken. */
+ * the film or to the wave buffers), forgets the waves and marks the batch's film to be
+ * cleared before the slot's next batch (ocl_render): after a stop request there is
+ * none, and clearing a large film (400 MB at 4096 x 4096) is time the stop would wait
+ * for. The batches before, with their read-backs, are whole and stay to be taken. */
 static Status cancel_batch(OclDevice *od, FilmSlot *fs, Error *err)
 {
     OCL_TRY("clFinish", clFinish(od->queue));
@@ -806,10 +810,7 @@ static Status cancel_batch(OclDevice *od, FilmSlot *fs, Error *err)
         release_event(&od->waves[i].read);
         od->waves[i].active = 0;
     }
-    cl_long zero = 0;
-    size_t bytes = (size_t)od->n_pixels * 3u * sizeof(cl_long);
-    OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, fs->film, &zero, sizeof zero, 0, bytes, 0, NULL, NULL));
-    OCL_TRY("clFinish", clFinish(od->queue));
+    fs->stale = 1;
     return error_set(err, ST_INTERRUPTED, "device '%s': batch cancelled", od->info.name);
 }
 
@@ -857,6 +858,13 @@ static Status ocl_render(Device *d, uint first_sample, uint count, Error *err)
     if (fs->read_done)
         return error_set(err, ST_INTERNAL, "device '%s': more than %u batches in flight", od->info.name, od->n_slots);
     uint64_t n_pixels = od->n_pixels, total = n_pixels * count;
+    if (fs->stale) {
+        /* in order on the queue: cleared before the batch's kernels add to it */
+        cl_long zero = 0;
+        OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, fs->film, &zero, sizeof zero, 0,
+                                                           (size_t)n_pixels * 3u * sizeof(cl_long), 0, NULL, NULL));
+        fs->stale = 0;
+    }
     /* Waves of equal size, at least two when the batch is big enough to split. */
     uint64_t n_waves = (total + od->wave_paths - 1) / od->wave_paths;
     if (n_waves < WAVE_SLOTS && total >= (uint64_t)WAVE_SLOTS * MIN_SPLIT_PATHS) n_waves = WAVE_SLOTS;

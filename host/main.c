@@ -223,8 +223,8 @@ static int aov_in_exr(const Options *o, const char *output, unsigned aov)
 
 /* An auxiliary image as the EXR output's channels hold it: the normal signed (the
  * normal image rendered with grey misses, (n + 1) / 2, gives 2c - 1 = the pixel's mean
- * normal with misses counting 0), the mean distance to the pixel's hits (0 where none),
- * the albedo as it is. */
+ * normal with misses counting 0), the mean distance to the pixel's hits (+inf where
+ * none), the albedo as it is. */
 static Status aov_exr_data(const PassContext *pc, unsigned aov, uint spp, float *rgb, double *secs, Error *err)
 {
     RenderParams *p = &pc->rs->ds.params;

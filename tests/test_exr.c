@@ -303,7 +303,8 @@ static void test_hdr(void)
 }
 
 /* clpt -o x.exr --aov normal,depth,albedo: one file with R G B, normal.X/Y/Z (unit
- * where the sphere covers a pixel, 0 where nothing does), Z (the distance) and
+ * where the sphere covers a pixel, 0 where nothing does), Z (the distance, +inf where
+ * nothing is hit) and
  * albedo.R/G/B; no separate auxiliary files. */
 static void test_cli_aov_channels(void)
 {
@@ -336,13 +337,47 @@ static void test_cli_aov_channels(void)
         CHECK_NEAR(z[c], 4.0, 0.02);
         CHECK_NEAR(ar[c], 0.25, 1e-6);
         CHECK_NEAR(ab[c], 0.75, 1e-6);
-        CHECK(nx[0] == 0.0f && ny[0] == 0.0f && nz[0] == 0.0f && z[0] == 0.0f);
+        CHECK(nx[0] == 0.0f && ny[0] == 0.0f && nz[0] == 0.0f);
+        CHECK(isinf(z[0]) && z[0] > 0.0f);   /* the background: infinitely far */
         CHECK(r[0] > 0.49f && r[0] < 0.51f);
     }
     free(nx); free(ny); free(nz); free(z); free(ar); free(ab); free(r);
     char other[300];
     snprintf(other, sizeof other, "%s/out-normal.exr", dir);
     CHECK(access(other, F_OK) != 0);
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    CHECK_EQ_INT(system(cmd), 0);
+}
+
+/* --aov depth into a PFM: the distance where the sphere is hit, +inf where nothing is
+ * (it was 0, which reads as "at the camera"). */
+static void test_cli_depth_pfm_background_is_infinite(void)
+{
+    char dir[] = "/tmp/clpt-test-depth-pfm-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char scene[256], out[256], depth[256], cmd[1024];
+    snprintf(scene, sizeof scene, "%s/s.scene", dir);
+    snprintf(out, sizeof out, "%s/out.pfm", dir);
+    snprintf(depth, sizeof depth, "%s/out-depth.pfm", dir);
+    FILE *f = fopen(scene, "w");
+    fputs("image { width 16 height 12 spp 4 }\n"
+          "camera { from 0 0 5 at 0 0 0 fov 30 }\n"
+          "sphere { center 0 0 0 radius 1 material { type diffuse albedo 0.5 0.5 0.5 } }\n", f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "%s %s -q --device scalar -o %s --aov depth", CLI_PROGRAM, scene, out);
+    CHECK_EQ_INT(system(cmd), 0);
+    f = fopen(depth, "rb");
+    int w = 0, h = 0;
+    float scale = 0.0f, px[16 * 12 * 3];
+    CHECK(f && fscanf(f, "PF %d %d %f", &w, &h, &scale) == 3 && fgetc(f) == '\n');
+    CHECK(w == 16 && h == 12 && scale < 0.0f);
+    CHECK(f && fread(px, sizeof px[0], 16 * 12 * 3, f) == 16 * 12 * 3);
+    if (f) fclose(f);
+    if (w == 16 && h == 12) {
+        int c = (h / 2) * w + w / 2;
+        CHECK_NEAR(px[3 * c], 4.0, 0.05);
+        CHECK(isinf(px[0]) && px[0] > 0.0f);
+    }
     snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
     CHECK_EQ_INT(system(cmd), 0);
 }
@@ -356,5 +391,6 @@ int main(void)
     RUN(test_exr_data_window);
     RUN(test_hdr);
     RUN(test_cli_aov_channels);
+    RUN(test_cli_depth_pfm_background_is_infinite);
     return harness_report();
 }

@@ -1,6 +1,7 @@
 /* passes.c — the adaptive pass and the auxiliary images (see passes.h). */
 #include "render/passes.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -126,7 +127,10 @@ void passes_depth_grey(float *rgb, size_t n, const DepthScale *scale)
     }
     for (size_t i = 0; i < n; i++) {
         float cover = rgb[3 * i + 1];
-        float g = 0.0f;
+        /* A miss is infinitely far: +inf in the float images (PFM, EXR's Z), as
+         * compositors expect of a depth pass, and no distance a hit could have (0 was
+         * read as "at the camera"). A grey image shows it black, as the farthest. */
+        float g = scale->mode == DEPTH_RAW ? INFINITY : 0.0f;
         if (cover > 0.0f) {
             double d = (double)rgb[3 * i] / cover, t = 1.0;
             if (scale->mode == DEPTH_RAW) t = d;

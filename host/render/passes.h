@@ -34,13 +34,15 @@ size_t passes_mark_edges(const float *rgb, uint width, uint height, float thresh
 Status passes_adaptive(const PassContext *pc, float *rgb, uint base_spp, float threshold, uint extra,
                        size_t *marked, double *seconds, Error *err);
 
-/* How distances become the depth image's grey (misses are always black):
+/* How distances become the depth image's grey (misses are black, and +inf in
+ * DEPTH_RAW):
  *  DEPTH_AUTO   inverse distance normalised over the image, near/d: white at the nearest
  *               hit, falling to black at the farthest, which keeps contrast in the
  *               foreground when a plane runs to the horizon;
  *  DEPTH_RANGE  linear, white at `near`, black at `far` and beyond; near > far turns it
  *               round (black near, white far, as the courses' -depth);
- *  DEPTH_RAW    the distance itself (for .pfm files). */
+ *  DEPTH_RAW    the distance itself, +inf where no sample hit (for .pfm files and
+ *               the EXR output's Z channel). */
 typedef enum { DEPTH_AUTO, DEPTH_RANGE, DEPTH_RAW } DepthMode;
 typedef struct {
     DepthMode mode;

@@ -8,6 +8,7 @@
 #include "base/limit.h"
 #include "types.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -82,10 +83,14 @@ void options_print_help(FILE *f)
 "                             (grey: near white, far black), albedo; to\n"
 "                             OUTPUT-normal.png etc.; an .exr output holds\n"
 "                             them as channels normal.X/Y/Z (signed), Z\n"
-"                             (distance) and albedo.R/G/B instead\n"
+"                             (distance) and albedo.R/G/B instead. Depth\n"
+"                             in .pfm and .exr is the distance, +inf where\n"
+"                             nothing is hit; in 8-bit images misses are\n"
+"                             black\n"
 "      --depth-range NEAR,FAR the depth image is linear from white at NEAR to\n"
 "                             black at FAR (NEAR > FAR inverts it; default:\n"
-"                             inverse distance, nearest hit white)\n"
+"                             inverse distance, nearest hit white). Needs\n"
+"                             --aov depth\n"
 "\n",
         f);
     fputs(
@@ -147,7 +152,8 @@ void options_print_help(FILE *f)
 "                             --adaptive-spp more samples in each pixel that\n"
 "                             differs from a neighbour by more than THRESHOLD\n"
 "                             (0..1) in some channel\n"
-"      --adaptive-spp N       extra samples per such pixel (default 16)\n"
+"      --adaptive-spp N       extra samples per such pixel (default 16; needs\n"
+"                             --adaptive)\n"
 "\n",
         f);
     fputs(
@@ -166,13 +172,14 @@ void options_print_help(FILE *f)
 "                             spp) samples per pixel\n"
 "\n"
 "Devices:\n"
-"      --list-devices         print every OpenCL platform and device, and the\n"
-"                             scalar device, with their indices, then exit\n"
-"      --device SPEC          devices to render with, comma-separated: an index\n"
-"                             from --list-devices, 'all', 'gpu', 'cpu' (OpenCL\n"
-"                             CPU devices), 'scalar', or part of a device or\n"
-"                             platform name. Default: every OpenCL GPU, else\n"
-"                             the OpenCL CPU devices, else the scalar device\n"
+"      --list-devices         print every OpenCL platform and device with its\n"
+"                             index, and the scalar device, then exit\n"
+"      --device SPEC          devices to render with, comma-separated: an\n"
+"                             OpenCL device's index from --list-devices,\n"
+"                             'all', 'gpu', 'cpu' (OpenCL CPU devices),\n"
+"                             'scalar', or part of a device or platform\n"
+"                             name. Default: every OpenCL GPU, else the\n"
+"                             OpenCL CPU devices, else the scalar device\n"
 "      --threads N            worker threads of the scalar device (default:\n"
 "                             all cores)\n"
 "\n",
@@ -226,12 +233,19 @@ void options_print_help(FILE *f)
         f);
 }
 
+/* strtol and strtod skip leading blanks: " 5" would be 5, while "5 " is refused. A
+ * number is refused with a blank at either end, so that what was typed is what counts. */
+static int starts_blank(const char *s)
+{
+    return isspace((unsigned char)s[0]);
+}
+
 static Status parse_long(const char *flag, const char *s, long lo, long hi, long *out, Error *err)
 {
     char *end;
     errno = 0;
     long v = strtol(s, &end, 10);
-    if (!*s || *end || errno)
+    if (!*s || *end || errno || starts_blank(s))
         return error_set(err, ST_USAGE, "%s expects an integer, got '%s'", flag, s);
     if (v < lo || v > hi)
         return error_set(err, ST_USAGE, "%s must be between %ld and %ld, got %ld", flag, lo, hi, v);
@@ -244,7 +258,7 @@ static Status parse_seconds(const char *flag, const char *s, double *out, Error 
     char *end;
     errno = 0;
     double v = strtod(s, &end);
-    if (!*s || *end || errno || !isfinite(v) || v <= 0.0)
+    if (!*s || *end || errno || starts_blank(s) || !isfinite(v) || v <= 0.0)
         return error_set(err, ST_USAGE, "%s expects a positive number of seconds, got '%s'", flag, s);
     *out = v;
     return ST_OK;
@@ -287,11 +301,11 @@ static Status parse_depth_range(const char *v, Options *o, Error *err)
     char *end;
     errno = 0;
     double lo = strtod(v, &end), hi = 0.0;
-    int ok = end != v && *end == ',' && !errno;
+    int ok = end != v && *end == ',' && !errno && !starts_blank(v);
     if (ok) {
         const char *second = end + 1;
         hi = strtod(second, &end);
-        ok = end != second && !*end && !errno;
+        ok = end != second && !*end && !errno && !starts_blank(second);
     }
     /* NEAR > FAR turns the ramp round: --depth-range 18,8 is the courses' -depth 8 18
      * (near black, far white) */
@@ -310,11 +324,11 @@ static Status parse_sample_range(const char *v, Options *o, Error *err)
     char *end;
     errno = 0;
     long a = strtol(v, &end, 10), b = -1;
-    int ok = end != v && *end == ':' && !errno && v[0] != '-' && v[0] != '+';
+    int ok = end != v && *end == ':' && !errno && v[0] != '-' && v[0] != '+' && !starts_blank(v);
     if (ok) {
         const char *second = end + 1;
         b = strtol(second, &end, 10);
-        ok = end != second && !*end && !errno && second[0] != '-' && second[0] != '+';
+        ok = end != second && !*end && !errno && second[0] != '-' && second[0] != '+' && !starts_blank(second);
     }
     if (!ok || a < 0 || b <= a || b > CLPT_MAX_SPP)
         return error_set(err, ST_USAGE, "--sample-range expects A:B, sample indices with 0 <= A < B <= %d, got '%s'",
@@ -329,7 +343,7 @@ static Status parse_adaptive(const char *v, Options *o, Error *err)
     char *end;
     errno = 0;
     double t = strtod(v, &end);
-    if (!*v || *end || errno || !(t > 0.0 && t <= 1.0))
+    if (!*v || *end || errno || starts_blank(v) || !(t > 0.0 && t <= 1.0))
         return error_set(err, ST_USAGE, "--adaptive expects a threshold in (0, 1], got '%s'", v);
     o->adaptive = t;
     return ST_OK;
@@ -493,7 +507,7 @@ static void options_defaults(Options *o)
     o->sampler = -1;
     o->accel = -1;
     o->format = SCENE_FORMAT_AUTO;
-    o->adaptive_spp = 16;
+    o->adaptive_spp = 0;   /* not given; 16 once options_finish has checked */
 }
 
 /* argv[*i]: a switch, a flag and its value (advancing *i), or the scene. */
@@ -553,6 +567,15 @@ static Status options_finish(Options *o, Error *err)
     if (o->resume_path && !o->checkpoint_path) o->checkpoint_path = o->resume_path;
     if (o->range_end >= 0 && o->adaptive > 0.0)
         return error_set(err, ST_USAGE, "--adaptive cannot be used with --sample-range (it needs the whole image)");
+    /* Flags that shape what another flag turns on do nothing alone: said, not ignored
+     * (an image rendered without the pass or the depth image the user asked for). */
+    if (o->adaptive_spp && !(o->adaptive > 0.0))
+        return error_set(err, ST_USAGE, "--adaptive-spp sets the samples of the adaptive pass, which --adaptive "
+                         "THRESHOLD turns on; give both, or neither");
+    if (!o->adaptive_spp) o->adaptive_spp = 16;
+    if (o->depth_near != o->depth_far && !(o->aovs & (1u << INTEGRATOR_AOV_DEPTH)))
+        return error_set(err, ST_USAGE, "--depth-range scales the depth image, which --aov depth turns on; "
+                         "give both, or neither");
     if (o->checkpoint_seconds <= 0.0) o->checkpoint_seconds = 60.0;
     if (!o->scene_path && !o->help && !o->version && !o->list_devices)
         return error_set(err, ST_USAGE, "no scene given (usage: clpt [options] SCENE; see --help)");

@@ -53,6 +53,27 @@ static void test_usage_errors(void)
     cli_run(ARGS("scenes/cornell-box.scene", "--wave-launch", "fast"), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "--wave-launch expects 'counted', 'bounded' or 'megakernel', got 'fast'");
+    /* a blank before a number was skipped (" 5" was 5, "5 " refused): refused too */
+    cli_run(ARGS("scenes/cornell-box.scene", "--spp", " 5"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --spp expects an integer, got ' 5'");
+    cli_run(ARGS("scenes/cornell-box.scene", "--time-limit", " 5"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "--time-limit expects a positive number of seconds, got ' 5'");
+    cli_run(ARGS("scenes/cornell-box.scene", "--sample-range", "0: 5"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "--sample-range expects A:B");
+    /* flags that shape what another flag turns on were ignored alone */
+    cli_run(ARGS("scenes/cornell-box.scene", "--adaptive-spp", "8"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --adaptive-spp sets the samples of the adaptive pass, which --adaptive "
+                              "THRESHOLD turns on; give both, or neither");
+    cli_run(ARGS("scenes/cornell-box.scene", "--depth-range", "1,10"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --depth-range scales the depth image, which --aov depth turns on; "
+                              "give both, or neither");
+    cli_run(ARGS("scenes/cornell-box.scene", "--depth-range", "1,10", "--aov", "normal"), &r);
+    CHECK_EQ_INT(r.status, 2);
 }
 
 /* The three ways an OpenCL device runs a wave (--wave-launch: counted; bounded, the
@@ -537,6 +558,14 @@ static void test_no_opencl_said_once_without_escapes(void)
         CHECK_STR_CONTAINS(r.err, "clpt: warning: no OpenCL platform found (none installed, or OCL_ICD_VENDORS "
                                   "names none): rendering on the scalar device");
         CHECK(strchr(r.err, '\033') == NULL && strchr(r.err, '\r') == NULL);
+        /* an index names an OpenCL device: 0 was the scalar device, without a word */
+        setenv("OCL_ICD_VENDORS", vendors[i], 1);
+        cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--width", "8", "--height", "8", "--spp", "1", "-o",
+                     out), &r);
+        unsetenv("OCL_ICD_VENDORS");
+        CHECK_EQ_INT(r.status, 2);
+        CHECK_STR_CONTAINS(r.err, "clpt: error: --device 0: there is no OpenCL device 0: no OpenCL device was found "
+                                  "(see --list-devices); the scalar device is --device scalar");
     }
     rmdir(vendors[1]);
 }

@@ -79,7 +79,8 @@ void device_list_print(FILE *f, const DeviceDesc *all, size_t n)
             long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
             format_bytes(pages > 0 && page > 0 ? (unsigned long long)pages * (unsigned long long)page : 0,
                          mem, sizeof mem);
-            fprintf(f, "%-3u %-8s %-6s %-5ld %-10s %s\n", d->index, "scalar", "CPU", cores > 0 ? cores : 1,
+            /* no index: it is chosen by name (--device scalar), see select_item */
+            fprintf(f, "%-3s %-8s %-6s %-5ld %-10s %s\n", "-", "scalar", "CPU", cores > 0 ? cores : 1,
                     mem, "scalar C device (the kernels compiled as C, one thread per core)");
         }
     }
@@ -116,7 +117,9 @@ static Status no_such_device(const char *item, const DeviceDesc *all, size_t n, 
     char list[700] = "";
     size_t used = 0;
     for (size_t i = 0; i < n && used < sizeof list - 1; i++) {
-        int w = snprintf(list + used, sizeof list - used, "%s%u: %s", i ? "; " : "", all[i].index, all[i].name);
+        int w = all[i].kind == DEVICE_SCALAR
+                    ? snprintf(list + used, sizeof list - used, "%s'scalar'", i ? "; " : "")
+                    : snprintf(list + used, sizeof list - used, "%s%u: %s", i ? "; " : "", all[i].index, all[i].name);
         if (w < 0) break;
         used += (size_t)w;
     }
@@ -130,8 +133,17 @@ static Status select_item(const char *item, const DeviceDesc *all, size_t n, siz
 {
     size_t before = *k;
     if (is_index(item)) {
+        /* An index names an OpenCL device only. The scalar device, listed last, would
+         * otherwise have the index of the first OpenCL device a machine lacks: a job
+         * asking for `--device 0` on a machine without OpenCL rendered on the scalar
+         * device without a word. It is named 'scalar'. */
         unsigned long idx = strtoul(item, NULL, 10);
-        if (idx >= n) return no_such_device(item, all, n, err);
+        size_t n_ocl = 0;
+        while (n_ocl < n && all[n_ocl].kind == DEVICE_OPENCL) n_ocl++;
+        if (n_ocl == 0)
+            return error_set(err, ST_USAGE, "--device %s: there is no OpenCL device %s: no OpenCL device was found "
+                             "(see --list-devices); the scalar device is --device scalar", item, item);
+        if (idx >= n_ocl) return no_such_device(item, all, n, err);
         add_choice(chosen, k, idx);
         return ST_OK;
     }

@@ -80,7 +80,8 @@ enum { DEVICE_TYPE_CPU = 1u, DEVICE_TYPE_GPU = 2u, DEVICE_TYPE_ACCELERATOR = 4u 
  * alone turns the opaque handles back into OpenCL objects. */
 typedef struct {
     DeviceKind kind;
-    unsigned index;               /* position in the listing, what --device N means */
+    unsigned index;               /* position in the listing; for an OpenCL device, what
+                                   * --device N means (the scalar device has none) */
     char name[256];
     unsigned type;                /* DEVICE_TYPE_* bits */
     const char *type_name;        /* "GPU", "CPU" ... (a static string) */

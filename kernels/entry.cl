@@ -341,6 +341,9 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(RenderParams, bg_light);
     out[i++] = (uint)sizeof(TriExtra);
     out[i++] = (uint)__builtin_offsetof(TriExtra, uv);
+    out[i++] = (uint)__builtin_offsetof(Material, absorption);
+    out[i++] = (uint)__builtin_offsetof(Material, sheen_color);
+    out[i++] = (uint)__builtin_offsetof(Material, texture_sheen_roughness);
 }
 #endif
 

@@ -203,7 +203,9 @@ enum MaterialType {
                           * roughness, anisotropy; smooth: a Fresnel mirror */
     MAT_PRINCIPLED = 6,  /* glTF metallic-roughness (kernels/principled.h): base colour
                           * = albedo, metallic, roughness, transmission + ior (MAT_THIN),
-                          * clearcoat + clearcoat_roughness */
+                          * clearcoat + clearcoat_roughness, specular_factor +
+                          * specular_color, sheen_color + sheen_roughness, and inside a
+                          * solid (not MAT_THIN) Beer-Lambert absorption */
     MAT_MIX = 7          /* pbrt's mix (kernels/mix.h): at each hit either material mix_a
                           * or, with probability amount, mix_b scatters; its own emission
                           * and MAT_TWO_SIDED are what the surface emits */
@@ -211,7 +213,7 @@ enum MaterialType {
 /* MAT_DIELECTRIC also reads roughness and anisotropy (GGX, Walter et al. 2007) and
  * MAT_THIN. */
 
-typedef struct {                                        /* 176 bytes */
+typedef struct {                                        /* 240 bytes */
     uint type;                /* enum MaterialType */
     uint texture;             /* albedo texture index, NO_INDEX when none */
     float ior;
@@ -240,6 +242,19 @@ typedef struct {                                        /* 176 bytes */
     uint mix_a, mix_b;                     /* MAT_MIX: the two materials' indices */
     float mix_amount;                      /* MAT_MIX: mix_b's probability, times ... */
     uint mix_texture;                      /* ... this texture's red channel, or NO_INDEX */
+    vec3 absorption;                       /* MAT_PRINCIPLED, solid: sigma_a per unit of
+                                            * scene length inside the material (0: clear;
+                                            * KHR_materials_volume's attenuation) */
+    float specular_factor;                 /* MAT_PRINCIPLED: scales the dielectric F0 and
+                                            * F90 (KHR_materials_specular; 1 by default) */
+    vec3 specular_color;                   /* ... scales F0 per channel (1 1 1 by default) */
+    float sheen_roughness;                 /* MAT_PRINCIPLED: perceptual, alpha = its square */
+    vec3 sheen_color;                      /* ... the sheen layer's colour (0: no sheen) */
+    uint texture_specular;                 /* alpha times specular_factor, or NO_INDEX */
+    uint texture_specular_color;           /* RGB times specular_color, or NO_INDEX */
+    uint texture_sheen_color;              /* RGB times sheen_color, or NO_INDEX */
+    uint texture_sheen_roughness;          /* alpha times sheen_roughness, or NO_INDEX */
+    uint pad_sheen;
 } Material;
 
 #define MIX_MAX_DEPTH 8u        /* MAT_MIX: mixes nested at most this deep (mix.h) */
@@ -457,7 +472,7 @@ _Static_assert(offsetof(TriExtra, uv) == 96, "TriExtra.uv");
 CLPT_CHECK_SIZE(Box, 32);
 CLPT_CHECK_SIZE(Plane, 32);
 CLPT_CHECK_SIZE(RevSurface, 48);
-CLPT_CHECK_SIZE(Material, 176);
+CLPT_CHECK_SIZE(Material, 240);
 CLPT_CHECK_SIZE(Light, 96);
 CLPT_CHECK_SIZE(Camera, 112);
 CLPT_CHECK_SIZE(RenderParams, 304);
@@ -483,6 +498,9 @@ _Static_assert(offsetof(Material, clearcoat_roughness) == 128, "Material.clearco
 _Static_assert(offsetof(Material, texture_rm) == 132, "Material.texture_rm");
 _Static_assert(offsetof(Material, normal_scale) == 140, "Material.normal_scale");
 _Static_assert(offsetof(Material, mix_a) == 160, "Material.mix_a");
+_Static_assert(offsetof(Material, absorption) == 176, "Material.absorption");
+_Static_assert(offsetof(Material, sheen_color) == 208, "Material.sheen_color");
+_Static_assert(offsetof(Material, texture_sheen_roughness) == 232, "Material.texture_sheen_roughness");
 _Static_assert(offsetof(Light, position) == 32, "Light.position");
 #undef CLPT_CHECK_SIZE
 #endif

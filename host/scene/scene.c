@@ -5,6 +5,7 @@
 
 #include "kmath.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -385,6 +386,10 @@ static Material material_base(uint type)
     m.alpha_cutoff = 0.5f;      /* glTF's default alphaCutoff */
     m.texture_emission = NO_INDEX;
     m.mix_a = m.mix_b = m.mix_texture = NO_INDEX;
+    m.specular_factor = 1.0f;   /* KHR_materials_specular's defaults: F0 and F90 as they were */
+    m.specular_color = v3s(1.0f);
+    m.texture_specular = m.texture_specular_color = NO_INDEX;
+    m.texture_sheen_color = m.texture_sheen_roughness = NO_INDEX;
     return m;
 }
 
@@ -461,6 +466,20 @@ Material material_principled(vec3 base, float metallic, float roughness)
     m.metallic = metallic;
     m.roughness = roughness;
     return m;
+}
+
+/* -ln(color) / distance per channel. A channel of 0 (all absorbed) is taken as the
+ * smallest normal float, so sigma_a stays finite (exp(-sigma_a 0) must still be 1). */
+static float absorption_channel(float color, float distance)
+{
+    float c = color < FLT_MIN ? FLT_MIN : (color > 1.0f ? 1.0f : color);
+    return isinf(distance) ? 0.0f : -logf(c) / distance;
+}
+
+vec3 material_absorption(vec3 color, float distance)
+{
+    return v3(absorption_channel(color.x, distance), absorption_channel(color.y, distance),
+              absorption_channel(color.z, distance));
 }
 
 /* Measured spectra interpolated at 650, 550 and 450 nm for R, G and B: Ag, Al, Au, Cu

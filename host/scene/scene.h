@@ -216,6 +216,9 @@ Material material_conductor_f0(vec3 f0, float roughness);
 /* A glTF metallic-roughness material (base colour, metallic, roughness; no
  * transmission or clearcoat, ior 1.5), the glTF defaults being 1 1 1, 1, 1. */
 Material material_principled(vec3 base, float metallic, float roughness);
+/* Beer-Lambert sigma_a per channel for light keeping `color` of itself after `distance`
+ * (KHR_materials_volume's attenuationColor and attenuationDistance; infinite: none). */
+vec3 material_absorption(vec3 color, float distance);
 /* The complex index of a named metal (Ag, Al, Au, Cr, Cu, Fe, Ni, Ti; docs/scene-format.md gives the
  * source), the name `len` bytes long. Returns 0 when the name is none of them. */
 int material_metal_preset(const char *name, size_t len, vec3 *eta, vec3 *k);

@@ -287,6 +287,13 @@ KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
     p.gc.ay = ac;
     p.thin = (m.flags & MAT_THIN) != 0u;
     p.eta = p.thin || front ? m.ior : 1.0f / m.ior;
+    p.specular = k_clamp(m.specular_factor, 0.0f, 1.0f);
+    p.specular_color = v3(k_fmax(m.specular_color.x, 0.0f), k_fmax(m.specular_color.y, 0.0f),
+                          k_fmax(m.specular_color.z, 0.0f));
+    /* a sheen brighter than white would reflect more than it receives */
+    p.sheen = v3(k_clamp(m.sheen_color.x, 0.0f, 1.0f), k_clamp(m.sheen_color.y, 0.0f, 1.0f),
+                 k_clamp(m.sheen_color.z, 0.0f, 1.0f));
+    p.sheen_roughness = k_clamp(m.sheen_roughness, SHEEN_ROUGHNESS_MIN, 1.0f);
     return p;
 }
 

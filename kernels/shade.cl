@@ -117,6 +117,23 @@ KFN_INLINE void shade_emission(const SceneView *sc, Ray r, Surface s, Material m
     }
 }
 
+/* Beer-Lambert absorption inside a solid (KHR_materials_volume): a segment that ends on
+ * the back of a surface whose material absorbs ran inside that material, so the path
+ * keeps exp(-sigma_a t) of its throughput per channel, t the segment's length. Exact
+ * for closed, non-nested meshes; a volume inside another (or overlapping it) is
+ * charged only the material of the surface the segment ends on, and a path leaving an
+ * open mesh by escaping is not charged at all. A mix's own (zero) absorption is read. */
+KFN void shade_absorb(Ray r, Hit hit, Surface s, Material m, GLOBAL PathState *ps)
+{
+    if (!MAT_IS(m, MAT_PRINCIPLED) || (m.flags & MAT_THIN) || v3_is_zero(m.absorption) ||
+        !(v3_dot(r.d, s.ng) > 0.0f))
+        return;
+    const float log2e = 1.44269504f;
+    float t = -hit.t * v3_len(r.d) * log2e;
+    vec3 a = m.absorption;
+    ps->throughput = v3_mul(ps->throughput, v3(k_exp2(a.x * t), k_exp2(a.y * t), k_exp2(a.z * t)));
+}
+
 /* One bounce. `ray` is the ray that produced `hit`; on SHADE_CONTINUE it is replaced by
  * the next ray. Returns SHADE_CONTINUE and/or SHADE_SHADOW, and SHADE_SCATTERED when
  * the surface scattered.
@@ -154,6 +171,7 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
 
     Surface s = surface_at(sc, r, hit);
     Material m = sc->materials[s.material];   /* a mix: its own emission (mix.h) */
+    shade_absorb(r, hit, s, m, ps);
     int later_branch = bounce == 0u && ps->branch != 0u;
     if (!later_branch) shade_emission(sc, r, s, m, ps);
     if (bounce >= p->max_depth) return 0u;

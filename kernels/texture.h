@@ -333,15 +333,25 @@ KFN vec3 material_normal(const SceneView *sc, Material m, Surface s)
 
 /* Sets *m's textured parameters to their values at s: a principled material's
  * roughness and metallic factors times its metallic-roughness texture's G and B
- * (glTF's packing; the texture is read as declared, so it should be `encoding linear`).
+ * (glTF's packing; the texture is read as declared, so it should be `encoding linear`),
+ * and its specular and sheen factors times theirs.
  * In place, as material_resolve (mix.h). */
 KFN void material_at(const SceneView *sc, Material *m, Surface s, vec3 ng_face)
 {
-    if (KF_HAS(KF_TEXTURES) && MAT_IS(*m, MAT_PRINCIPLED) && m->texture_rm != NO_INDEX) {
+    if (!KF_HAS(KF_TEXTURES) || !MAT_IS(*m, MAT_PRINCIPLED)) return;
+    if (m->texture_rm != NO_INDEX) {
         vec3 t = texture_eval(sc, m->texture_rm, s, ng_face);
         m->roughness *= t.y;
         m->metallic *= t.z;
     }
+    /* KHR_materials_specular and _sheen: factor times texture, the strengths in alpha */
+    if (m->texture_specular != NO_INDEX) m->specular_factor *= texture_alpha(sc, m->texture_specular, s);
+    if (m->texture_specular_color != NO_INDEX)
+        m->specular_color = v3_mul(m->specular_color, texture_eval(sc, m->texture_specular_color, s, ng_face));
+    if (m->texture_sheen_color != NO_INDEX)
+        m->sheen_color = v3_mul(m->sheen_color, texture_eval(sc, m->texture_sheen_color, s, ng_face));
+    if (m->texture_sheen_roughness != NO_INDEX)
+        m->sheen_roughness *= texture_alpha(sc, m->texture_sheen_roughness, s);
 }
 
 #endif /* CLPT_TEXTURE_H */

@@ -171,14 +171,15 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, RngKey key, uint *ray
         vec3 kr = v3s(0.0f), kt = v3s(0.0f);
         if (m.type == MAT_PRINCIPLED) {
             /* the classic tracer's reading of glTF: the diffuse share lit directly, the
-             * specular as a mirror of the Schlick colour at this angle, transmission as
-             * smooth glass tinted by the base colour */
-            float eta = (m.flags & MAT_THIN) || front ? m.ior : 1.0f / m.ior;
-            float c = k_clamp(-v3_dot(d, ns), 0.0f, 1.0f), fd = principled_fresnel(eta, c);
+             * specular as a mirror of the Schlick colour at this angle (with
+             * KHR_materials_specular's F0 and F90), transmission as smooth glass tinted
+             * by the base colour. It has no sheen layer and no absorption. */
+            float c = k_clamp(-v3_dot(d, ns), 0.0f, 1.0f);
+            vec3 fd = principled_fresnel_rgb(bsdf_principled(m, kd, front), c), pass = v3_sub(v3s(1.0f), fd);
             float diel = 1.0f - k_clamp(m.metallic, 0.0f, 1.0f), t = k_clamp(m.transmission, 0.0f, 1.0f);
-            kr = v3_add(v3_scale(fresnel_schlick(kd, c), 1.0f - diel), v3s(diel * fd));
-            kt = v3_scale(kd, diel * (1.0f - fd) * t);
-            kd = v3_scale(kd, diel * (1.0f - fd) * (1.0f - t));
+            kr = v3_add(v3_scale(fresnel_schlick(kd, c), 1.0f - diel), v3_scale(fd, diel));
+            kt = v3_scale(v3_mul(kd, pass), diel * t);
+            kd = v3_scale(v3_mul(kd, pass), diel * (1.0f - t));
             vec3 here = v3_add(v3_mul(p->ambient, kd),
                                whitted_direct(sc, s, d, ns, ng, kd, v3s(0.0f), 0.0f, key, node, rays));
             L = v3_add(L, v3_mul(e.weight, here));

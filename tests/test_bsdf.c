@@ -58,6 +58,9 @@ static Case principled_case(const char *name, float roughness, float metallic, f
     k.p.g = ggx_make(roughness, 0.0f);
     k.p.gc = ggx_make(0.2f, 0.0f);
     k.p.eta = 1.5f;
+    k.p.specular = 1.0f;              /* KHR_materials_specular's defaults */
+    k.p.specular_color = v3s(1.0f);
+    k.p.sheen_roughness = SHEEN_ROUGHNESS_MIN;
     return k;
 }
 
@@ -242,6 +245,29 @@ static void make_cases(void)
     all_cases[n_cases - 1].p.eta = 1.0f / 1.5f;
     all_cases[n_cases++] = principled_case("principled ior 2.5 r0.4 t0.5", 0.4f, 0.0f, 0.5f, 0.0f);
     all_cases[n_cases - 1].p.eta = 2.5f;
+    /* KHR_materials_specular: a tinted, weaker F0 and F90 (RGB Fresnel, mean-chosen
+     * branch), on plastic and on glass from both sides */
+    all_cases[n_cases++] = principled_case("principled specular 0.6 tinted r0.4", 0.4f, 0.0f, 0.0f, 0.0f);
+    all_cases[n_cases - 1].p.specular = 0.6f;
+    all_cases[n_cases - 1].p.specular_color = v3(2.0f, 1.0f, 0.3f);
+    all_cases[n_cases++] = principled_case("principled glass specular tinted r0.3", 0.3f, 0.0f, 1.0f, 0.0f);
+    all_cases[n_cases - 1].p.specular = 0.8f;
+    all_cases[n_cases - 1].p.specular_color = v3(1.5f, 0.7f, 0.2f);
+    all_cases[n_cases++] = principled_case("principled glass specular (leaving)", 0.3f, 0.0f, 1.0f, 0.0f);
+    all_cases[n_cases - 1].p.specular_color = v3(1.5f, 0.7f, 0.2f);
+    all_cases[n_cases - 1].p.eta = 1.0f / 1.5f;
+    /* KHR_materials_sheen: the Charlie lobe over plastic, over a coated metal and over a
+     * transmitting material */
+    all_cases[n_cases++] = principled_case("principled sheen r0.5 plastic", 0.5f, 0.0f, 0.0f, 0.0f);
+    all_cases[n_cases - 1].p.sheen = v3(0.9f, 0.6f, 0.3f);
+    all_cases[n_cases - 1].p.sheen_roughness = 0.5f;
+    all_cases[n_cases++] = principled_case("principled sheen r0.3 coat", 0.3f, 0.5f, 0.0f, 1.0f);
+    all_cases[n_cases - 1].p.sheen = v3s(1.0f);
+    all_cases[n_cases - 1].p.sheen_roughness = 0.3f;
+    all_cases[n_cases++] = principled_case("principled sheen thin t0.5", 0.5f, 0.0f, 0.5f, 0.0f);
+    all_cases[n_cases - 1].p.sheen = v3(0.5f, 0.7f, 0.9f);
+    all_cases[n_cases - 1].p.sheen_roughness = 0.9f;
+    all_cases[n_cases - 1].p.thin = 1;
 }
 
 static void test_chi2(void)
@@ -708,6 +734,141 @@ static void test_principled_energy(void)
             "at cos >= 0.7, %.4f at cos 0.1 (the glTF model's grazing gain)\n", worst_normal, worst_grazing);
 }
 
+/* ------------------------------------------------------------------ glTF layers */
+
+typedef struct {
+    double f0, f90;
+} SchlickEnds;
+
+static double schlick_ends(double mu, const void *ctx)
+{
+    const SchlickEnds *e = ctx;
+    return e->f0 + (e->f90 - e->f0) * pow(1.0 - mu, 5.0);
+}
+
+/* KHR_materials_specular on the smooth black sphere of test_principled_ior_render:
+ * each pixel (green) is Schlick's curve from F0 = 0.04 specular_color.g specular to
+ * F90 = specular; specular 0 leaves the sphere black. */
+static void test_specular_render(void)
+{
+    const float factor[3] = { 0.0f, 0.5f, 1.0f }, green[3] = { 1.0f, 0.5f, 0.25f };
+    for (int i = 0; i < 3; i++) {
+        Material m = material_principled(v3s(0.0f), 0.0f, 0.0f);
+        m.specular_factor = factor[i];
+        m.specular_color = v3(1.0f, green[i], 0.0f);
+        Scene s;
+        furnace_sphere_scene(&s, m, 64, 1);
+        SchlickEnds e = { 0.04 * green[i] * factor[i], factor[i] };
+        double got, want;
+        if (furnace_render(&s, schlick_ends, &e, &got, &want)) {
+            fprintf(stderr, "  smooth black sphere, specular %.2f, colour's green %.2f: image %.4f, want %.4f\n",
+                    (double)factor[i], (double)green[i], got, want);
+            CHECK_NEAR(got, want, 0.004);
+        }
+    }
+}
+
+static double sheen_ctx(double mu, const void *ctx)
+{
+    const double *c = ctx;   /* sheen colour's green, roughness */
+    return c[0] * sheen_albedo((float)mu, (float)c[1]);
+}
+
+/* KHR_materials_sheen on a black, non-specular sphere: what it reflects of the white
+ * furnace is the sheen's colour times the lobe's albedo E(mu), largest at grazing
+ * views (the rim); over white plastic the layers together stay at most 1. */
+static void test_sheen_render(void)
+{
+    const float rough[2] = { 0.3f, 0.8f };
+    for (int r = 0; r < 2; r++) {
+        Material m = material_principled(v3s(0.0f), 0.0f, 0.5f);
+        m.specular_factor = 0.0f;
+        m.sheen_color = v3(1.0f, 0.8f, 0.2f);
+        m.sheen_roughness = rough[r];
+        Scene s;
+        furnace_sphere_scene(&s, m, 64, 1);
+        double c[2] = { 0.8, rough[r] }, got, want;
+        if (furnace_render(&s, sheen_ctx, c, &got, &want)) {
+            fprintf(stderr, "  black sphere with sheen (green 0.8), roughness %.1f: image %.4f, 0.8 E(mu) %.4f\n",
+                    (double)rough[r], got, want);
+            CHECK_NEAR(got, want, 0.01);
+            CHECK_MSG(got > 0.01, "the sheen adds nothing: %.4f", got);
+        }
+        Material w = material_principled(v3s(1.0f), 0.0f, 0.5f);
+        w.sheen_color = v3s(1.0f);
+        w.sheen_roughness = rough[r];
+        Scene ws;
+        furnace_sphere_scene(&ws, w, 64, 1);
+        if (furnace_render(&ws, one, NULL, &got, &want)) {
+            fprintf(stderr, "  white plastic with white sheen, roughness %.1f, white furnace: %.4f\n",
+                    (double)rough[r], got);
+            CHECK_MSG(got <= 1.005, "the sheen layers gain energy: %.4f", got);
+        }
+    }
+}
+
+/* The sheen over white plastic, metal and glass: sampled albedo = quadrature, and no
+ * more than 1 (the albedo scaling) away from grazing views. */
+static void test_sheen_energy(void)
+{
+    const float angles[3] = { 1.0f, 0.7f, 0.4f }, rough[3] = { 0.3f, 0.6f, 1.0f };
+    const float mix[3][2] = { { 0.0f, 0.0f }, { 1.0f, 0.0f }, { 0.0f, 1.0f } };
+    double worst = 0.0;
+    for (int m = 0; m < 3; m++)
+        for (int r = 0; r < 3; r++)
+            for (int a = 0; a < 3; a++) {
+                Case k = principled_case("white sheen", 0.5f, mix[m][0], mix[m][1], 0.0f);
+                k.p.base = v3s(1.0f);
+                k.p.sheen = v3s(1.0f);
+                k.p.sheen_roughness = rough[r];
+                vec3 wo = v3(k_sqrt(1.0f - angles[a] * angles[a]), 0.0f, angles[a]);
+                double sum = 0.0;
+                enum { N = 40000 };
+                for (int i = 0; i < N; i++) {
+                    vec3 wi, f;
+                    float pdf = case_sample(&k, wo, frand(), frand(), frand(), &wi, &f);
+                    if (pdf > 0.0f) sum += f.x * k_fabs(wi.z) / pdf;
+                }
+                double albedo = sum / N, exact = quadrature_albedo(&k, wo);
+                CHECK_MSG(fabs(albedo - exact) < 0.02, "metallic %g transmission %g sheen r %g cos %g: %.4f vs %.4f",
+                          (double)mix[m][0], (double)mix[m][1], (double)rough[r], (double)angles[a], albedo, exact);
+                CHECK_MSG(albedo < 1.01, "sheen r %g cos %g: albedo %.4f", (double)rough[r], (double)angles[a], albedo);
+                if (albedo > worst) worst = albedo;
+            }
+    fprintf(stderr, "  white sheen over white plastic, metal, glass: sampled = integral, largest albedo %.4f\n",
+            worst);
+}
+
+/* KHR_materials_volume's Beer-Lambert absorption: a smooth clear slab of thickness d
+ * in the white furnace, seen head-on by an orthographic camera. With F = F0 = 0.04 at
+ * each face and x = exp(-sigma_a d), the light reaching the camera is the front face's
+ * reflection, the back face's seen through the slab, and the transmission:
+ *   F + (1-F)^2 F x^2 / (1 - F^2 x^2) + (1-F)^2 x / (1 - F^2 x^2)
+ * (1 without absorption). attenuation_color's green e^-0.5 at distance 1: sigma 0.5. */
+static void test_volume_absorption(void)
+{
+    const float depth[2] = { 1.0f, 2.0f };
+    double got2[2];
+    for (int i = 0; i < 2; i++) {
+        Material m = material_principled(v3s(1.0f), 0.0f, 0.0f);
+        m.transmission = 1.0f;
+        m.absorption = material_absorption(v3(expf(-1.0f), expf(-0.5f), 1.0f), 1.0f);
+        Scene s;
+        uint mi;
+        furnace_scene(&s, m, 32, 64, &mi);
+        Box b = { v3(-10.0f, -10.0f, -0.5f * depth[i]), mi, v3(10.0f, 10.0f, 0.5f * depth[i]), NO_INDEX };
+        scene_add_box(&s, b, NULL);
+        double F = 0.04, x = exp(-0.5 * depth[i]), q = 1.0 - F * F * x * x, exact;
+        exact = F + (1.0 - F) * (1.0 - F) * (F * x * x + x) / q;
+        double want;
+        if (furnace_render(&s, one, NULL, &got2[i], &want)) {
+            fprintf(stderr, "  absorbing slab, thickness %.0f, sigma_a 0.5: image %.4f, Beer-Lambert %.4f\n",
+                    (double)depth[i], got2[i], exact);
+            CHECK_NEAR(got2[i], exact, 0.01);
+        }
+    }
+}
+
 /* A metallic-roughness texture multiplies the factors by its G (roughness) and B
  * (metallic): factors 1 and 1 with a texture of G 0.5, B 0.25 render as factors 0.5
  * and 0.25 without one. */
@@ -1088,6 +1249,10 @@ int main(void)
     RUN(test_principled_ior_render);
     RUN(test_principled_total_internal_reflection);
     RUN(test_furnace_principled_transmission);
+    RUN(test_specular_render);
+    RUN(test_sheen_render);
+    RUN(test_sheen_energy);
+    RUN(test_volume_absorption);
     RUN(test_metallic_roughness_texture);
     RUN(test_valid_normal);
     RUN(test_normal_map);

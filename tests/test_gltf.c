@@ -64,6 +64,58 @@ static Status load_triangle(const char *material_json, Scene *s, Error *err)
     return scene_load_bytes("alpha.gltf", text, strlen(text), SCENE_FORMAT_AUTO, s, NULL, err);
 }
 
+/* KHR_materials_volume, _specular and _sheen map onto the principled material: a volume
+ * with thickness > 0 is a solid (no MAT_THIN) with sigma_a = -ln(attenuationColor) /
+ * attenuationDistance; thickness 0 stays a thin wall; the specular and sheen factors
+ * are copied; the three are no longer warned about as ignored. */
+static void test_volume_specular_sheen(void)
+{
+    Scene s;
+    Error err = { 0 };
+    Status st = load_triangle("{\"extensions\":{"
+                              "\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+                              "\"KHR_materials_volume\":{\"thicknessFactor\":0.1,"
+                              "\"attenuationColor\":[0.5,0.25,1],\"attenuationDistance\":2},"
+                              "\"KHR_materials_specular\":{\"specularFactor\":0.3,"
+                              "\"specularColorFactor\":[1,0.5,2]},"
+                              "\"KHR_materials_sheen\":{\"sheenColorFactor\":[0.9,0.8,0.7],"
+                              "\"sheenRoughnessFactor\":0.6}}}",
+                              &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    if (st == ST_OK) {
+        const Material *m = &s.materials[s.triangles[0].material];
+        CHECK((m->flags & MAT_THIN) == 0u);
+        check_v3(m->absorption, log(2.0) / 2.0, log(4.0) / 2.0, 0.0, 1e-6);
+        CHECK_NEAR(m->specular_factor, 0.3, 1e-6);
+        check_v3(m->specular_color, 1.0, 0.5, 2.0, 0);
+        check_v3(m->sheen_color, 0.9, 0.8, 0.7, 1e-6);
+        CHECK_NEAR(m->sheen_roughness, 0.6, 1e-6);
+        CHECK(m->texture_specular == NO_INDEX && m->texture_sheen_color == NO_INDEX);
+        CHECK_EQ_INT(s.n_warnings, 0);
+    }
+    scene_free(&s);
+    /* thickness 0 (the default): the thin wall of KHR_materials_transmission stays */
+    st = load_triangle("{\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+                       "\"KHR_materials_volume\":{\"attenuationColor\":[0.5,0.5,0.5]}}}", &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    if (st == ST_OK) {
+        const Material *m = &s.materials[s.triangles[0].material];
+        CHECK((m->flags & MAT_THIN) != 0u);
+        check_v3(m->specular_color, 1.0, 1.0, 1.0, 0);
+        CHECK_NEAR(m->specular_factor, 1.0, 0);
+    }
+    scene_free(&s);
+    /* values out of range are errors naming the JSON path */
+    st = load_triangle("{\"extensions\":{\"KHR_materials_sheen\":{\"sheenRoughnessFactor\":2}}}", &s, &err);
+    CHECK(st == ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "materials[0].extensions.KHR_materials_sheen.sheenRoughnessFactor: expected a "
+                                "number from 0 to 1");
+    error_clear(&err);
+    scene_free(&s);
+}
+
 /* alphaMode and alphaCutoff become the principled material's alpha mode (kernels/alpha.h
  * renders them; test_alpha.c checks the pixels); emissiveTexture its emission texture. */
 static void test_alpha_modes(void)
@@ -912,6 +964,7 @@ static void test_extras(void)
 
 int main(void)
 {
+    RUN(test_volume_specular_sheen);
     RUN(test_strided);
     RUN(test_sparse);
     RUN(test_strips);
@@ -920,6 +973,7 @@ int main(void)
     RUN(test_nodes);
     RUN(test_mesh_block);
     RUN(test_alpha_modes);
+    RUN(test_volume_specular_sheen);
     RUN(test_texture_transform_range);
     RUN(test_shared_image_sources);
     RUN(test_shared_buffer_file);

@@ -806,6 +806,69 @@ static Status material_alpha(Gltf *g, const cJSON *m, const char *jp, double alp
     return ST_OK;
 }
 
+/* KHR_materials_volume: thicknessFactor > 0 makes the mesh the boundary of a solid (a
+ * path tracer has the real thickness, so neither the factor's value nor thicknessTexture
+ * is read), inside which attenuationColor / attenuationDistance absorb (Beer-Lambert,
+ * kernels/shade.cl). Thickness 0, the default, keeps the thin wall. */
+static Status material_volume(Gltf *g, const cJSON *m, const char *jp, Material *mt)
+{
+    const cJSON *x = ext_of(m, "KHR_materials_volume");
+    if (!x) return ST_OK;
+    char jx[128];
+    snprintf(jx, sizeof jx, "%s.extensions.KHR_materials_volume", jp);
+    static const double white[3] = { 1, 1, 1 };
+    double thickness, distance, color[3];
+    Status st = get_num(g, x, "thicknessFactor", 0.0, 0.0, 1e30, jx, &thickness);
+    if (!st) st = get_num(g, x, "attenuationDistance", INFINITY, 1e-30, INFINITY, jx, &distance);
+    if (!st) st = get_nums(g, x, "attenuationColor", 3, white, jx, color);
+    if (st) return st;
+    if (!(thickness > 0.0)) return ST_OK;
+    mt->flags &= ~MAT_THIN;
+    mt->absorption = material_absorption(v3((float)color[0], (float)color[1], (float)color[2]), (float)distance);
+    return ST_OK;
+}
+
+/* KHR_materials_specular: specularFactor (times specularTexture's alpha) and
+ * specularColorFactor (times specularColorTexture, sRGB) scale the dielectric F0 and
+ * F90 (kernels/principled.h). */
+static Status material_specular(Gltf *g, const cJSON *m, const char *jp, Material *mt)
+{
+    const cJSON *x = ext_of(m, "KHR_materials_specular");
+    if (!x) return ST_OK;
+    char jx[128];
+    snprintf(jx, sizeof jx, "%s.extensions.KHR_materials_specular", jp);
+    static const double white[3] = { 1, 1, 1 };
+    double factor, color[3];
+    Status st = get_num(g, x, "specularFactor", 1.0, 0.0, 1.0, jx, &factor);
+    if (!st) st = get_nums(g, x, "specularColorFactor", 3, white, jx, color);
+    if (!st) st = texinfo(g, x, "specularTexture", 1, jx, &mt->texture_specular, NULL);
+    if (!st) st = texinfo(g, x, "specularColorTexture", 0, jx, &mt->texture_specular_color, NULL);
+    if (st) return st;
+    mt->specular_factor = (float)factor;
+    mt->specular_color = v3((float)color[0], (float)color[1], (float)color[2]);
+    return ST_OK;
+}
+
+/* KHR_materials_sheen: sheenColorFactor (times sheenColorTexture, sRGB) and
+ * sheenRoughnessFactor (times sheenRoughnessTexture's alpha). */
+static Status material_sheen(Gltf *g, const cJSON *m, const char *jp, Material *mt)
+{
+    const cJSON *x = ext_of(m, "KHR_materials_sheen");
+    if (!x) return ST_OK;
+    char jx[128];
+    snprintf(jx, sizeof jx, "%s.extensions.KHR_materials_sheen", jp);
+    static const double black[3] = { 0, 0, 0 };
+    double color[3], rough;
+    Status st = get_nums(g, x, "sheenColorFactor", 3, black, jx, color);
+    if (!st) st = get_num(g, x, "sheenRoughnessFactor", 0.0, 0.0, 1.0, jx, &rough);
+    if (!st) st = texinfo(g, x, "sheenColorTexture", 0, jx, &mt->texture_sheen_color, NULL);
+    if (!st) st = texinfo(g, x, "sheenRoughnessTexture", 1, jx, &mt->texture_sheen_roughness, NULL);
+    if (st) return st;
+    mt->sheen_color = v3((float)color[0], (float)color[1], (float)color[2]);
+    mt->sheen_roughness = (float)rough;
+    return ST_OK;
+}
+
 static Status material_build(Gltf *g, int i, uint *out)
 {
     char jp[64];
@@ -855,6 +918,9 @@ static Status material_build(Gltf *g, int i, uint *out)
         if ((st = get_num(g, x, "clearcoatRoughnessFactor", 0.0, 0.0, 1.0, jp, &v))) return st;
         mt.clearcoat_roughness = (float)v;
     }
+    if ((st = material_volume(g, m, jp, &mt)) || (st = material_specular(g, m, jp, &mt)) ||
+        (st = material_sheen(g, m, jp, &mt)))
+        return st;
     const cJSON *name = cJSON_GetObjectItemCaseSensitive(m, "name");
     return scene_add_material(g->s, cJSON_IsString(name) ? name->valuestring : "", mt, out, g->err);
 }
@@ -1302,6 +1368,7 @@ static Status scene_walk(Gltf *g)
 static const char *const supported_ext[] = {
     "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_ior",
     "KHR_materials_transmission", "KHR_materials_clearcoat", "KHR_texture_transform",
+    "KHR_materials_volume", "KHR_materials_specular", "KHR_materials_sheen",
 };
 
 static int ext_supported(const char *name)

@@ -531,7 +531,8 @@ enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE
        MAT_KEY_ROUGHNESS, MAT_KEY_ANISOTROPY, MAT_KEY_ETA, MAT_KEY_K, MAT_KEY_METAL, MAT_KEY_THIN,
        MAT_KEY_METALLIC, MAT_KEY_TRANSMISSION, MAT_KEY_CLEARCOAT, MAT_KEY_CLEARCOAT_ROUGHNESS, MAT_KEY_STRENGTH,
        MAT_KEY_METALLIC_ROUGHNESS, MAT_KEY_NORMAL_MAP, MAT_KEY_NORMAL_SCALE, MAT_KEY_ALPHA, MAT_KEY_ALPHA_MODE,
-       MAT_KEY_ALPHA_CUTOFF, MAT_KEY_EMISSION_TEXTURE, MAT_KEY_N };
+       MAT_KEY_ALPHA_CUTOFF, MAT_KEY_EMISSION_TEXTURE, MAT_KEY_ATTENUATION_COLOR, MAT_KEY_ATTENUATION_DISTANCE,
+       MAT_KEY_SPECULAR_FACTOR, MAT_KEY_SPECULAR_COLOR, MAT_KEY_SHEEN_COLOR, MAT_KEY_SHEEN_ROUGHNESS, MAT_KEY_N };
 static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0,
                       "a material type (diffuse, metal, conductor, dielectric, principled, emissive, phong)"},
@@ -564,42 +565,51 @@ static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_ALPHA_MODE] = {"alpha_mode", VK_WORD, 0, 0, 0, 0, 0, "opaque, mask or blend"},
     [MAT_KEY_ALPHA_CUTOFF] = {"alpha_cutoff", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
     [MAT_KEY_EMISSION_TEXTURE] = {"emission_texture", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_ATTENUATION_COLOR] = {"attenuation_color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_ATTENUATION_DISTANCE] = {"attenuation_distance", VK_NUMBER, 0, 0, INFINITY, 1, 0,
+                                      "a number > 0 (inf: no absorption)"},
+    [MAT_KEY_SPECULAR_FACTOR] = {"specular_factor", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_SPECULAR_COLOR] = {"specular_color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_SHEEN_COLOR] = {"sheen_color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_SHEEN_ROUGHNESS] = {"sheen_roughness", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
 };
 
 /* Which keys each material type takes (bit i = material_keys[i]), and which it needs. */
 static const struct {
     const char *name;
     uint type;
-    unsigned allowed, required;
+    unsigned long long allowed, required;   /* MAT_KEY_N > 32 */
 } material_types[] = {
     {"diffuse", MAT_DIFFUSE,
-     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES | 1u << MAT_KEY_TEXTURE,
-     1u << MAT_KEY_ALBEDO},
+     1ull << MAT_KEY_ALBEDO | 1ull << MAT_KEY_EMISSION | 1ull << MAT_KEY_SIDES | 1ull << MAT_KEY_TEXTURE,
+     1ull << MAT_KEY_ALBEDO},
     {"metal", MAT_METAL,
-     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_FUZZ | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES |
-     1u << MAT_KEY_TEXTURE,
-     1u << MAT_KEY_ALBEDO},
+     1ull << MAT_KEY_ALBEDO | 1ull << MAT_KEY_FUZZ | 1ull << MAT_KEY_EMISSION | 1ull << MAT_KEY_SIDES |
+     1ull << MAT_KEY_TEXTURE,
+     1ull << MAT_KEY_ALBEDO},
     {"conductor", MAT_CONDUCTOR,
-     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_TEXTURE | 1u << MAT_KEY_ETA | 1u << MAT_KEY_K | 1u << MAT_KEY_METAL |
-     1u << MAT_KEY_SPECULAR | 1u << MAT_KEY_ROUGHNESS | 1u << MAT_KEY_ANISOTROPY | 1u << MAT_KEY_EMISSION |
-     1u << MAT_KEY_SIDES,
+     1ull << MAT_KEY_ALBEDO | 1ull << MAT_KEY_TEXTURE | 1ull << MAT_KEY_ETA | 1ull << MAT_KEY_K | 1ull << MAT_KEY_METAL |
+     1ull << MAT_KEY_SPECULAR | 1ull << MAT_KEY_ROUGHNESS | 1ull << MAT_KEY_ANISOTROPY | 1ull << MAT_KEY_EMISSION |
+     1ull << MAT_KEY_SIDES,
      0},
     {"dielectric", MAT_DIELECTRIC,
-     1u << MAT_KEY_IOR | 1u << MAT_KEY_ROUGHNESS | 1u << MAT_KEY_ANISOTROPY | 1u << MAT_KEY_THIN |
-     1u << MAT_KEY_EMISSION | 1u << MAT_KEY_SIDES, 0},
+     1ull << MAT_KEY_IOR | 1ull << MAT_KEY_ROUGHNESS | 1ull << MAT_KEY_ANISOTROPY | 1ull << MAT_KEY_THIN |
+     1ull << MAT_KEY_EMISSION | 1ull << MAT_KEY_SIDES, 0},
     {"principled", MAT_PRINCIPLED,
-     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_TEXTURE | 1u << MAT_KEY_METALLIC | 1u << MAT_KEY_ROUGHNESS |
-     1u << MAT_KEY_ANISOTROPY | 1u << MAT_KEY_TRANSMISSION | 1u << MAT_KEY_IOR | 1u << MAT_KEY_THIN |
-     1u << MAT_KEY_CLEARCOAT | 1u << MAT_KEY_CLEARCOAT_ROUGHNESS | 1u << MAT_KEY_EMISSION | 1u << MAT_KEY_STRENGTH |
-     1u << MAT_KEY_METALLIC_ROUGHNESS | 1u << MAT_KEY_NORMAL_MAP | 1u << MAT_KEY_NORMAL_SCALE | 1u << MAT_KEY_SIDES |
-     1u << MAT_KEY_ALPHA | 1u << MAT_KEY_ALPHA_MODE | 1u << MAT_KEY_ALPHA_CUTOFF | 1u << MAT_KEY_EMISSION_TEXTURE,
+     1ull << MAT_KEY_ALBEDO | 1ull << MAT_KEY_TEXTURE | 1ull << MAT_KEY_METALLIC | 1ull << MAT_KEY_ROUGHNESS |
+     1ull << MAT_KEY_ANISOTROPY | 1ull << MAT_KEY_TRANSMISSION | 1ull << MAT_KEY_IOR | 1ull << MAT_KEY_THIN |
+     1ull << MAT_KEY_CLEARCOAT | 1ull << MAT_KEY_CLEARCOAT_ROUGHNESS | 1ull << MAT_KEY_EMISSION | 1ull << MAT_KEY_STRENGTH |
+     1ull << MAT_KEY_METALLIC_ROUGHNESS | 1ull << MAT_KEY_NORMAL_MAP | 1ull << MAT_KEY_NORMAL_SCALE | 1ull << MAT_KEY_SIDES |
+     1ull << MAT_KEY_ALPHA | 1ull << MAT_KEY_ALPHA_MODE | 1ull << MAT_KEY_ALPHA_CUTOFF | 1ull << MAT_KEY_EMISSION_TEXTURE |
+     1ull << MAT_KEY_ATTENUATION_COLOR | 1ull << MAT_KEY_ATTENUATION_DISTANCE | 1ull << MAT_KEY_SPECULAR_FACTOR |
+     1ull << MAT_KEY_SPECULAR_COLOR | 1ull << MAT_KEY_SHEEN_COLOR | 1ull << MAT_KEY_SHEEN_ROUGHNESS,
      0},
-    {"emissive", MAT_EMISSIVE, 1u << MAT_KEY_RADIANCE | 1u << MAT_KEY_SIDES, 1u << MAT_KEY_RADIANCE},
+    {"emissive", MAT_EMISSIVE, 1ull << MAT_KEY_RADIANCE | 1ull << MAT_KEY_SIDES, 1ull << MAT_KEY_RADIANCE},
     {"phong", MAT_PHONG,
-     1u << MAT_KEY_ALBEDO | 1u << MAT_KEY_SPECULAR | 1u << MAT_KEY_SHININESS | 1u << MAT_KEY_REFLECTIVE |
-     1u << MAT_KEY_TRANSPARENT | 1u << MAT_KEY_IOR | 1u << MAT_KEY_TEXTURE | 1u << MAT_KEY_EMISSION |
-     1u << MAT_KEY_SIDES,
-     1u << MAT_KEY_ALBEDO},
+     1ull << MAT_KEY_ALBEDO | 1ull << MAT_KEY_SPECULAR | 1ull << MAT_KEY_SHININESS | 1ull << MAT_KEY_REFLECTIVE |
+     1ull << MAT_KEY_TRANSPARENT | 1ull << MAT_KEY_IOR | 1ull << MAT_KEY_TEXTURE | 1ull << MAT_KEY_EMISSION |
+     1ull << MAT_KEY_SIDES,
+     1ull << MAT_KEY_ALBEDO},
 };
 #define N_MATERIAL_TYPES (sizeof material_types / sizeof material_types[0])
 
@@ -651,6 +661,20 @@ static Status parse_alpha(Parser *p, Lexer *lx, const Value *v, Material *m)
     return ST_OK;
 }
 
+/* The principled keys of the glTF extensions: KHR_materials_volume's attenuation (read
+ * in a solid, `thin off`), KHR_materials_specular's factor and colour, and
+ * KHR_materials_sheen's colour and roughness. */
+static void parse_principled_layers(const Value *v, Material *m)
+{
+    vec3 color = v[MAT_KEY_ATTENUATION_COLOR].given ? v[MAT_KEY_ATTENUATION_COLOR].v : v3s(1.0f);
+    float distance = v[MAT_KEY_ATTENUATION_DISTANCE].given ? v[MAT_KEY_ATTENUATION_DISTANCE].f : INFINITY;
+    m->absorption = material_absorption(color, distance);
+    if (v[MAT_KEY_SPECULAR_FACTOR].given) m->specular_factor = v[MAT_KEY_SPECULAR_FACTOR].f;
+    if (v[MAT_KEY_SPECULAR_COLOR].given) m->specular_color = v[MAT_KEY_SPECULAR_COLOR].v;
+    if (v[MAT_KEY_SHEEN_COLOR].given) m->sheen_color = v[MAT_KEY_SHEEN_COLOR].v;
+    if (v[MAT_KEY_SHEEN_ROUGHNESS].given) m->sheen_roughness = v[MAT_KEY_SHEEN_ROUGHNESS].f;
+}
+
 /* Reads a material's `{ ... }`; a NULL name makes an anonymous (inline) material. */
 static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
                                    const char *name, uint *index)
@@ -663,20 +687,20 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
         if (tok_is(&v[MAT_KEY_TYPE].word, material_types[ti].name)) break;
     if (ti == N_MATERIAL_TYPES)
         return lex_expected(lx, &v[MAT_KEY_TYPE].word, material_keys[MAT_KEY_TYPE].what, p->err);
-    unsigned allowed = material_types[ti].allowed | 1u << MAT_KEY_TYPE;
+    unsigned long long allowed = material_types[ti].allowed | 1ull << MAT_KEY_TYPE;
     for (int i = 0; i < MAT_KEY_N; i++) {
-        if (!v[i].given || (allowed & (1u << i))) continue;
+        if (!v[i].given || (allowed & (1ull << i))) continue;
         char what[512];
         size_t o = (size_t)snprintf(what, sizeof what, "a %s material key (type",
                                     material_types[ti].name);
         for (int j = 1; j < MAT_KEY_N; j++)
-            if (allowed & (1u << j))
+            if (allowed & (1ull << j))
                 o += (size_t)snprintf(what + o, sizeof what - o, ", %s", material_keys[j].key);
         snprintf(what + o, sizeof what - o, ") or '}'");
         return lex_expected(lx, &v[i].key, what, p->err);
     }
     for (int i = 0; i < MAT_KEY_N; i++)
-        if ((material_types[ti].required & (1u << i)) && !v[i].given)
+        if ((material_types[ti].required & (1ull << i)) && !v[i].given)
             return lex_error_at(lx, kw, p->err, "a material of type %s needs '%s'",
                                 material_types[ti].name, material_keys[i].key);
     Material m;
@@ -703,6 +727,7 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
         if (v[MAT_KEY_NORMAL_SCALE].given) m.normal_scale = v[MAT_KEY_NORMAL_SCALE].f;
         if (v[MAT_KEY_EMISSION_TEXTURE].given) m.texture_emission = (uint)v[MAT_KEY_EMISSION_TEXTURE].u;
         if ((st = parse_alpha(p, lx, v, &m))) return st;
+        parse_principled_layers(v, &m);
         break;
     case MAT_EMISSIVE:
         m = material_emissive(v[MAT_KEY_RADIANCE].v);

@@ -227,6 +227,33 @@ static void test_materials(void)
     scene_free(&s);
 }
 
+/* The principled keys of KHR_materials_volume, _specular and _sheen (docs/scene-format.md):
+ * sigma_a = -ln(attenuation_color) / attenuation_distance; no distance, no absorption. */
+static void test_principled_layers(void)
+{
+    Scene s;
+    Error err;
+    Status st = load_text("layers.scene",
+                          "material a { type principled transmission 1 attenuation_color 0.5 1 0.25 "
+                          "attenuation_distance 2 specular_factor 0.5 specular_color 1 0.5 2 "
+                          "sheen_color 0.9 0.8 0.7 sheen_roughness 0.4 }\n"
+                          "material b { type principled attenuation_color 0.5 0.5 0.5 }\n",
+                          &s, &err);
+    CHECK_EQ_INT(st, ST_OK);
+    CHECK_EQ_INT(s.n_materials, 2);
+    if (s.n_materials == 2) {
+        const Material *a = &s.materials[0], *b = &s.materials[1];
+        CHECK_NEAR(a->absorption.x, log(2.0) / 2.0, 1e-6);
+        CHECK_NEAR(a->absorption.y, 0.0, 0);
+        CHECK_NEAR(a->absorption.z, log(4.0) / 2.0, 1e-6);
+        CHECK(a->specular_factor == 0.5f && vec_eq(a->specular_color, 1.0f, 0.5f, 2.0f));
+        CHECK(vec_eq(a->sheen_color, 0.9f, 0.8f, 0.7f) && a->sheen_roughness == 0.4f);
+        CHECK(vec_eq(b->absorption, 0.0f, 0.0f, 0.0f));
+        CHECK(b->specular_factor == 1.0f && vec_eq(b->specular_color, 1.0f, 1.0f, 1.0f));
+    }
+    scene_free(&s);
+}
+
 /* Every documented preset loads, with the table's values (Fe and Ti: Johnson & Christy
  * 1974 at 650/550/450 nm, docs/scene-format.md). */
 static void test_metal_presets(void)
@@ -581,6 +608,8 @@ static void test_bad_materials_and_shapes(void)
               ":1:43: expected a number in [0, 1] for 'fuzz', found '1.5'");
     check_bad("material m { type dielectric ior 0 }", ST_INPUT, ":1:34: expected a number > 0 for 'ior', found '0'");
     check_bad("material m { type emissive }", ST_INPUT, ":1:1: a material of type emissive needs 'radiance'");
+    check_bad("material m { type principled attenuation_distance 0 }", ST_INPUT,
+              ":1:51: expected a number > 0 for 'attenuation_distance', found '0'");
     check_bad("material \"\" { type dielectric }", ST_INPUT, ":1:10: expected a material name, found '\"\"'");
     check_bad("sphere { center 0 0 0 radius 0 material { type dielectric } }", ST_INPUT,
               ":1:30: expected a radius > 0 for 'radius', found '0'");
@@ -773,6 +802,7 @@ int main(void)
     RUN(test_defaults_kept);
     RUN(test_backgrounds);
     RUN(test_materials);
+    RUN(test_principled_layers);
     RUN(test_metal_presets);
     RUN(test_primitives);
     RUN(test_mesh_and_include);

@@ -567,7 +567,7 @@ static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_EMISSION_TEXTURE] = {"emission_texture", VK_TEXTURE, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_ATTENUATION_COLOR] = {"attenuation_color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_ATTENUATION_DISTANCE] = {"attenuation_distance", VK_NUMBER, 0, 0, INFINITY, 1, 0,
-                                      "a number > 0 (inf: no absorption)"},
+                                      "a number > 0"},
     [MAT_KEY_SPECULAR_FACTOR] = {"specular_factor", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
     [MAT_KEY_SPECULAR_COLOR] = {"specular_color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_SHEEN_COLOR] = {"sheen_color", VK_COLOR, 0, 0, 0, 0, 0, NULL},

@@ -1314,8 +1314,15 @@ static void test_bsdf(void)
                         material_dielectric(1.5f), material_dielectric(1.33f), material_dielectric(1.5f),
                         material_dielectric(1.5f), material_principled(v3(0.8f, 0.5f, 0.3f), 0.0f, 0.4f),
                         material_principled(v3(0.9f, 0.7f, 0.4f), 1.0f, 0.0f),
-                        material_principled(v3(0.5f, 0.8f, 0.9f), 0.3f, 0.6f) };
+                        material_principled(v3(0.5f, 0.8f, 0.9f), 0.3f, 0.6f),
+                        material_principled(v3(0.6f, 0.6f, 0.7f), 0.0f, 0.5f) };
     mats[14].transmission = 0.7f;
+    /* KHR_materials_specular and _sheen over a transmitting solid */
+    mats[15].transmission = 0.5f;
+    mats[15].specular_factor = 0.7f;
+    mats[15].specular_color = v3(1.4f, 0.8f, 0.3f);
+    mats[15].sheen_color = v3(0.9f, 0.5f, 0.2f);
+    mats[15].sheen_roughness = 0.45f;
     mats[14].clearcoat = 1.0f;
     mats[14].clearcoat_roughness = 0.2f;
     mats[7].anisotropy = 0.7f;

@@ -8,6 +8,7 @@
 #define CLPT_BSDF_H
 
 #include "principled.h"
+#include "layered.h"
 
 typedef struct {
     vec3 wi;          /* sampled direction */
@@ -297,6 +298,30 @@ KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
     return p;
 }
 
+/* The coated material's stack; the conductor base's index is relative to the medium
+ * under the interface (pbrt-v4's CoatedConductorMaterial divides by its index too). */
+KFN Layered bsdf_layered(Material m, vec3 albedo)
+{
+    Layered L;
+    L.g = bsdf_ggx(m);
+    L.eta = m.ior > 0.0f ? m.ior : 1.0f;
+    L.conductor = m.layer_base == LAYER_BASE_CONDUCTOR;
+    L.c.g = ggx_make(m.base_roughness, m.base_anisotropy);
+    L.c.eta = v3_scale(m.eta, 1.0f / L.eta);
+    L.c.k = v3_scale(m.k, 1.0f / L.eta);
+    L.c.f0 = v3s(0.0f);
+    L.c.tint = albedo;
+    L.c.schlick = 0;
+    L.diffuse = albedo;
+    L.albedo = m.layer_albedo;
+    L.thickness = k_fmax(m.layer_thickness, 1.17549435e-38f);
+    L.hg_g = m.layer_g;
+    /* bounded: the walks are loops of at most this many steps */
+    L.max_depth = m.layer_depth < 256u ? m.layer_depth : 256u;
+    L.n_samples = m.layer_samples < 1u ? 1u : m.layer_samples < 64u ? m.layer_samples : 64u;
+    return L;
+}
+
 /* Whether the material has a lobe with a density (not only delta lobes), so that
  * next-event estimation can reach it. */
 KFN int bsdf_has_density(Material m, vec3 albedo)
@@ -304,6 +329,11 @@ KFN int bsdf_has_density(Material m, vec3 albedo)
     if (m.type == MAT_DIFFUSE) return 1;
     if (MAT_IS(m, MAT_PHONG)) return phong_lobes(m, albedo).p_glossy > 0.0f;
     if (MAT_IS(m, MAT_CONDUCTOR) || MAT_IS(m, MAT_DIELECTRIC)) return !ggx_smooth(bsdf_ggx(m));
+    if (MAT_IS(m, MAT_LAYERED)) {
+        /* only a stack of smooth surfaces over a smooth conductor, no medium, is all deltas */
+        Layered L = bsdf_layered(m, albedo);
+        return !(coat_smooth(L) && base_smooth(L) && !layer_has_medium(L));
+    }
     return MAT_IS(m, MAT_PRINCIPLED);
 }
 
@@ -342,7 +372,11 @@ KFN vec3 bsdf_eval(Material m, vec3 albedo, vec3 d, vec3 ns, int front, vec3 wi,
     /* the last branch is the rough dielectric, the one type left with a density */
     if (MAT_IS(m, MAT_CONDUCTOR)) *pdf = conductor_eval(bsdf_conductor(m, albedo), wo, wl, &f);
     else if (MAT_IS(m, MAT_PRINCIPLED)) *pdf = principled_eval(bsdf_principled(m, albedo, front), wo, wl, &f);
-    else if (KF_HAS(KF_MATERIAL(MAT_DIELECTRIC))) *pdf = dielectric_eval(bsdf_dielectric(m, front), wo, wl, &f);
+    else if (MAT_IS(m, MAT_LAYERED)) {
+        Layered L = bsdf_layered(m, albedo);
+        f = layered_f(L, wo, wl);
+        *pdf = layered_pdf(L, wo, wl);
+    } else if (KF_HAS(KF_MATERIAL(MAT_DIELECTRIC))) *pdf = dielectric_eval(bsdf_dielectric(m, front), wo, wl, &f);
     return f;
 }
 
@@ -414,6 +448,33 @@ KFN BsdfSample bsdf_sample_rough(Material m, vec3 albedo, vec3 d, vec3 ns, int f
     return s;
 }
 
+/* A path through a coated material's stack (layered.h). Its weight is the walk's own f
+ * cos / pdf; the density handed on for MIS is layered_pdf's estimate for the direction
+ * as bsdf_eval would see it (world, then local again), so that the MIS weights of next-event
+ * estimation and of this sample for one direction are computed from the same number. */
+KFN BsdfSample bsdf_sample_layered(Material m, vec3 albedo, vec3 d, vec3 ns, float u_lobe, float u1, float u2)
+{
+    BsdfSample s;
+    vec3 t, b;
+    k_onb(ns, &t, &b);
+    Layered L = bsdf_layered(m, albedo);
+    vec3 wo = bsdf_to_local(v3_neg(d), t, b, ns);
+    LayeredSample r = layered_sample(L, wo, u_lobe, u1, u2);
+    s.transmitted = 0;
+    if (!(v3_max_comp(r.weight) > 0.0f)) {
+        s.wi = ns;
+        s.weight = v3s(0.0f);
+        s.pdf = 0.0f;
+        s.specular = 0;
+        return s;
+    }
+    s.wi = v3_norm(k_to_world(r.wi, t, b, ns));
+    s.weight = r.weight;
+    s.specular = r.delta;
+    s.pdf = r.delta ? 0.0f : layered_pdf(L, wo, bsdf_to_local(s.wi, t, b, ns));
+    return s;
+}
+
 /* A direction for any material. u_lobe picks a lobe, u1 u2 (u3) the direction. */
 KFN BsdfSample bsdf_sample(Material m, vec3 albedo, vec3 d, vec3 ns, vec3 ng, int front, float u_lobe, float u1,
                            float u2, float u3)
@@ -421,6 +482,7 @@ KFN BsdfSample bsdf_sample(Material m, vec3 albedo, vec3 d, vec3 ns, vec3 ng, in
     if (m.type == MAT_DIFFUSE) return bsdf_sample_diffuse(albedo, ns, u1, u2);
     if (MAT_IS(m, MAT_PHONG)) return phong_sample(phong_lobes(m, albedo), m, d, ns, ng, front, u_lobe, u1, u2, u3);
     if (MAT_IS(m, MAT_METAL)) return bsdf_sample_metal(albedo, m.fuzz, d, ns, u1, u2, u3);
+    if (MAT_IS(m, MAT_LAYERED)) return bsdf_sample_layered(m, albedo, d, ns, u_lobe, u1, u2);
     if (bsdf_has_density(m, albedo)) return bsdf_sample_rough(m, albedo, d, ns, front, u_lobe, u1, u2);
     if (MAT_IS(m, MAT_CONDUCTOR)) return bsdf_sample_mirror_conductor(bsdf_conductor(m, albedo), d, ns, ng);
     if (m.flags & MAT_THIN) return bsdf_sample_thin(bsdf_dielectric(m, front), d, ng, u_lobe);

@@ -344,6 +344,8 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Material, absorption);
     out[i++] = (uint)__builtin_offsetof(Material, sheen_color);
     out[i++] = (uint)__builtin_offsetof(Material, texture_sheen_roughness);
+    out[i++] = (uint)__builtin_offsetof(Material, layer_albedo);
+    out[i++] = (uint)__builtin_offsetof(Material, base_roughness);
 }
 #endif
 

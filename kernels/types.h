@@ -45,13 +45,16 @@
 #define KF_BOXES 0x100u
 #define KF_PLANES 0x200u
 #define KF_DELTA_LIGHTS 0x400u  /* point, spot or directional lights */
-#define KF_MATERIAL(t) (0x800u << (t))  /* material type t (enum MaterialType) */
+/* material type t (enum MaterialType); MAT_LAYERED, past the block of seven, has a bit
+ * of its own above KF_PATH_LANES */
+#define KF_MATERIAL(t) ((t) == 8 ? KF_LAYERED : 0x800u << (t))
 #define KF_PATH_MEGAKERNEL 0x80000u     /* the path tracer as one kernel (k_path, k_film) */
 #define KF_KDTREE 0x100000u     /* the scene's tree is the kd-tree (kernels/traverse.cl) */
 #define KF_BVH 0x200000u        /* ... the 8-wide BVH (kernels/traverse_wide.cl) */
 #define KF_PATH_LANES 0x400000u /* the megakernel eight paths at a time (k_path_lanes, k_film;
                                  * kernels/shade_lanes.cl): CPUs, scenes it shades fast */
-#define KF_ALL 0x7bffffu        /* every bit above (material types 0 to 6) */
+#define KF_LAYERED 0x800000u    /* material type MAT_LAYERED (8) */
+#define KF_ALL 0xfbffffu        /* every bit above (material types 0 to 6, and 8) */
 #ifndef CLPT_FEATURES
 #define CLPT_FEATURES KF_ALL
 #endif
@@ -206,14 +209,21 @@ enum MaterialType {
                           * clearcoat + clearcoat_roughness, specular_factor +
                           * specular_color, sheen_color + sheen_roughness, and inside a
                           * solid (not MAT_THIN) Beer-Lambert absorption */
-    MAT_MIX = 7          /* pbrt's mix (kernels/mix.h): at each hit either material mix_a
+    MAT_MIX = 7,         /* pbrt's mix (kernels/mix.h): at each hit either material mix_a
                           * or, with probability amount, mix_b scatters; its own emission
                           * and MAT_TWO_SIDED are what the surface emits */
+    MAT_LAYERED = 8      /* pbrt-v4's coated materials (kernels/layered.h): a dielectric
+                          * interface (ior, roughness, anisotropy) over a base (layer_base:
+                          * Lambertian albedo, or a conductor eta + i k with base_roughness,
+                          * base_anisotropy), a medium between (layer_*) */
 };
+/* MAT_LAYERED's bases */
+#define LAYER_BASE_DIFFUSE 0u
+#define LAYER_BASE_CONDUCTOR 1u
 /* MAT_DIELECTRIC also reads roughness and anisotropy (GGX, Walter et al. 2007) and
  * MAT_THIN. */
 
-typedef struct {                                        /* 240 bytes */
+typedef struct {                                        /* 288 bytes */
     uint type;                /* enum MaterialType */
     uint texture;             /* albedo texture index, NO_INDEX when none */
     float ior;
@@ -255,6 +265,14 @@ typedef struct {                                        /* 240 bytes */
     uint texture_sheen_color;              /* RGB times sheen_color, or NO_INDEX */
     uint texture_sheen_roughness;          /* alpha times sheen_roughness, or NO_INDEX */
     uint pad_sheen;
+    vec3 layer_albedo;                     /* MAT_LAYERED: the medium's scattering albedo */
+    float layer_thickness;                 /* ... its optical depth (extinction 1) */
+    float layer_g;                         /* ... Henyey-Greenstein asymmetry */
+    uint layer_depth;                      /* ... most scatterings of a walk (maxdepth) */
+    uint layer_samples;                    /* ... walks per evaluation (nsamples) */
+    uint layer_base;                       /* LAYER_BASE_*: albedo, or eta, k and ... */
+    float base_roughness, base_anisotropy; /* ... the conductor's GGX */
+    uint pad_layer0, pad_layer1;
 } Material;
 
 #define MIX_MAX_DEPTH 8u        /* MAT_MIX: mixes nested at most this deep (mix.h) */
@@ -472,7 +490,7 @@ _Static_assert(offsetof(TriExtra, uv) == 96, "TriExtra.uv");
 CLPT_CHECK_SIZE(Box, 32);
 CLPT_CHECK_SIZE(Plane, 32);
 CLPT_CHECK_SIZE(RevSurface, 48);
-CLPT_CHECK_SIZE(Material, 240);
+CLPT_CHECK_SIZE(Material, 288);
 CLPT_CHECK_SIZE(Light, 96);
 CLPT_CHECK_SIZE(Camera, 112);
 CLPT_CHECK_SIZE(RenderParams, 304);
@@ -501,6 +519,8 @@ _Static_assert(offsetof(Material, mix_a) == 160, "Material.mix_a");
 _Static_assert(offsetof(Material, absorption) == 176, "Material.absorption");
 _Static_assert(offsetof(Material, sheen_color) == 208, "Material.sheen_color");
 _Static_assert(offsetof(Material, texture_sheen_roughness) == 232, "Material.texture_sheen_roughness");
+_Static_assert(offsetof(Material, layer_albedo) == 240, "Material.layer_albedo");
+_Static_assert(offsetof(Material, base_roughness) == 272, "Material.base_roughness");
 _Static_assert(offsetof(Light, position) == 32, "Light.position");
 #undef CLPT_CHECK_SIZE
 #endif

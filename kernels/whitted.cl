@@ -192,6 +192,19 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, RngKey key, uint *ray
                 kr = m.reflective;
                 kt = m.transparent;
             }
+        } else if (m.type == MAT_LAYERED) {
+            /* the classic tracer's reading of a coated material: the interface a Fresnel
+             * mirror over a base lit directly (diffuse) or a mirror itself (conductor) */
+            float c = k_clamp(-v3_dot(d, ns), 0.0f, 1.0f), F = fresnel_dielectric(c, m.ior);
+            kr = v3s(F);
+            if (m.layer_base == LAYER_BASE_CONDUCTOR) {
+                kr = v3_add(kr, v3_scale(conductor_fresnel(bsdf_layered(m, kd).c, c), 1.0f - F));
+            } else {
+                kd = v3_scale(kd, 1.0f - F);
+                vec3 here = v3_add(v3_mul(p->ambient, kd),
+                                   whitted_direct(sc, s, d, ns, ng, kd, v3s(0.0f), 0.0f, key, node, rays));
+                L = v3_add(L, v3_mul(e.weight, here));
+            }
         } else if (m.type == MAT_METAL) {
             kr = kd;
         } else if (m.type == MAT_CONDUCTOR) {

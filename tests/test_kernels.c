@@ -475,7 +475,8 @@ static void test_layout(void)
                     sizeof(RevSurface), offsetof(RevSurface, axis_x), offsetof(RenderParams, n_revsurfaces),
                     offsetof(RenderParams, bg_light), sizeof(TriExtra), offsetof(TriExtra, uv),
                     offsetof(Material, absorption), offsetof(Material, sheen_color),
-                    offsetof(Material, texture_sheen_roughness) };
+                    offsetof(Material, texture_sheen_roughness),
+                    offsetof(Material, layer_albedo), offsetof(Material, base_roughness) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);

@@ -755,7 +755,7 @@ static void test_feature_switches_compile_cleanly(void)
         }
     }
     CHECK_EQ_INT(KF_ALL, ((KF_MATERIAL(MAT_PRINCIPLED) << 1) - 1u) | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH |
-                         KF_PATH_LANES);
+                         KF_PATH_LANES | KF_LAYERED);
 }
 
 static void test_cache_location(void)

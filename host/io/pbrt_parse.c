@@ -926,32 +926,34 @@ static float clpt_roughness(double r, int remap)
     return (float)fmin(sqrt(alpha), 1.0);
 }
 
-/* roughness, or uroughness/vroughness as clpt's roughness and anisotropy */
-static Status get_roughness(Parser *p, const Lexer *lx, Material *m, double dflt)
+/* prefix + roughness, or + uroughness/vroughness, as clpt's roughness and anisotropy */
+static Status get_roughness_named(Parser *p, const Lexer *lx, const char *prefix, double dflt, float *rough,
+                                  float *aniso)
 {
     double r = dflt, u = -1, v = -1;
     int remap = 1;
+    char nr[48], nu[48], nv[48];
+    snprintf(nr, sizeof nr, "%sroughness", prefix);
+    snprintf(nu, sizeof nu, "%suroughness", prefix);
+    snprintf(nv, sizeof nv, "%svroughness", prefix);
     Status st;
-    if ((st = get_float_tex(p, lx, "roughness", &r)) || (st = get_float_tex(p, lx, "uroughness", &u)) ||
-        (st = get_float_tex(p, lx, "vroughness", &v)) || (st = get_bool(p, lx, "remaproughness", &remap)))
+    if ((st = get_float_tex(p, lx, nr, &r)) || (st = get_float_tex(p, lx, nu, &u)) ||
+        (st = get_float_tex(p, lx, nv, &v)) || (st = get_bool(p, lx, "remaproughness", &remap)))
         return st;
     if (u < 0) u = r;
     if (v < 0) v = r;
     double au = pow(clpt_roughness(u, remap), 2), av = pow(clpt_roughness(v, remap), 2);
     double hi = fmax(au, av), lo = fmin(au, av);
-    m->roughness = (float)sqrt(sqrt(au * av));
+    *rough = (float)sqrt(sqrt(au * av));
     /* alpha_x / alpha_y = 1 / (1 - 0.9 A) (docs/scene-format.md); the direction of the
      * stretch is clpt's, not the file's */
-    m->anisotropy = hi > 0 ? (float)fmin((1 - lo / hi) / 0.9, 1.0) : 0.0f;
+    *aniso = hi > 0 ? (float)fmin((1 - lo / hi) / 0.9, 1.0) : 0.0f;
     return ST_OK;
 }
 
-static vec3 conductor_f0(vec3 eta, vec3 k)
+static Status get_roughness(Parser *p, const Lexer *lx, Material *m, double dflt)
 {
-    float e[3] = {eta.x, eta.y, eta.z}, kk[3] = {k.x, k.y, k.z}, f[3];
-    for (int i = 0; i < 3; i++)
-        f[i] = ((e[i] - 1) * (e[i] - 1) + kk[i] * kk[i]) / ((e[i] + 1) * (e[i] + 1) + kk[i] * kk[i]);
-    return v3(f[0], f[1], f[2]);
+    return get_roughness_named(p, lx, "", dflt, &m->roughness, &m->anisotropy);
 }
 
 static Status conductor_params(Parser *p, const Lexer *lx, const char *eta_name, const char *k_name,
@@ -1023,6 +1025,65 @@ static Status make_mix(Parser *p, const Lexer *lx, const Token *type, Material *
     return ST_OK;
 }
 
+/* The medium between a coat and its base: thickness, albedo, g, maxdepth, nsamples
+ * (pbrt-v4's defaults are material_coated_*'s). */
+static Status coated_medium(Parser *p, const Lexer *lx, Material *m)
+{
+    double thickness = m->layer_thickness, g = m->layer_g;
+    long depth = (long)m->layer_depth, samples = (long)m->layer_samples;
+    Status st;
+    if ((st = get_float_tex(p, lx, "thickness", &thickness)) || (st = get_float_tex(p, lx, "g", &g)) ||
+        (st = get_spectrum(p, lx, "albedo", &m->layer_albedo, NULL, NULL)) ||
+        (st = get_int(p, lx, "maxdepth", &depth)) || (st = get_int(p, lx, "nsamples", &samples)))
+        return st;
+    if (!(thickness >= 0)) return param_type_error(p, lx, param_find(p, "thickness"), ">= 0");
+    if (!(g > -1 && g < 1)) return param_type_error(p, lx, param_find(p, "g"), "between -1 and 1");
+    if (depth < 0 || depth > 256) return param_type_error(p, lx, param_find(p, "maxdepth"), "0 to 256");
+    if (samples < 1 || samples > 64) return param_type_error(p, lx, param_find(p, "nsamples"), "1 to 64");
+    m->layer_thickness = (float)thickness;
+    m->layer_g = (float)g;
+    m->layer_depth = (uint)depth;
+    m->layer_samples = (uint)samples;
+    return ST_OK;
+}
+
+/* pbrt-v4's coateddiffuse and coatedconductor: MAT_LAYERED (kernels/layered.h). A
+ * conductor's `reflectance` becomes pbrt's index for it, eta 1 and k = 2 sqrt(r) /
+ * sqrt(1 - r), as CoatedConductorMaterial does. */
+static Status make_coated(Parser *p, const Lexer *lx, int conductor, Material *m)
+{
+    Status st;
+    double eta = 1.5;
+    if (conductor) {
+        Material base = material_conductor(v3(1, 1, 1), v3(0, 0, 0), 0);
+        if ((st = conductor_params(p, lx, "conductor.eta", "conductor.k", "reflectance", &base))) return st;
+        vec3 e = base.eta, k = base.k;
+        if (base.flags & MAT_F0) {
+            float r[3] = {base.specular.x, base.specular.y, base.specular.z}, kk[3];
+            for (int i = 0; i < 3; i++) {
+                float c = r[i] < 0.9999f ? r[i] : 0.9999f;
+                kk[i] = 2.0f * sqrtf(c) / sqrtf(1.0f - c);
+            }
+            e = v3(1, 1, 1);
+            k = v3(kk[0], kk[1], kk[2]);
+        }
+        *m = material_coated_conductor(e, k, 0, 0);
+        if ((st = get_roughness_named(p, lx, "conductor.", 0, &m->base_roughness, &m->base_anisotropy)) ||
+            (st = get_roughness_named(p, lx, "interface.", 0, &m->roughness, &m->anisotropy)) ||
+            (st = get_float_tex(p, lx, "interface.eta", &eta)))
+            return st;
+    } else {
+        *m = material_coated_diffuse(v3(0.5f, 0.5f, 0.5f), 0);
+        if ((st = texture_of(p, lx, "reflectance", &m->albedo, &m->texture)) || (st = get_roughness(p, lx, m, 0)) ||
+            (st = get_float_tex(p, lx, "eta", &eta)))
+            return st;
+    }
+    /* pbrt-v4 takes an index of 0 as 1 (no interface) */
+    if (eta < 0) return param_type_error(p, lx, param_find(p, conductor ? "interface.eta" : "eta"), ">= 0");
+    m->ior = eta == 0 ? 1.0f : (float)eta;
+    return coated_medium(p, lx, m);
+}
+
 /* Builds the material of type `type` from the current parameter list. */
 static Status make_material(Parser *p, const Lexer *lx, const Token *type, Material *m, const char *what)
 {
@@ -1042,31 +1103,7 @@ static Status make_material(Parser *p, const Lexer *lx, const Token *type, Mater
         if ((st = get_roughness(p, lx, m, 0))) return st;
         if (tok_eq(type, "thindielectric")) m->flags |= MAT_THIN;
     } else if (tok_eq(type, "coateddiffuse") || tok_eq(type, "coatedconductor")) {
-        /* the coat becomes the principled model's clearcoat (docs/pbrt.md) */
-        Material coat = material_diffuse(v3(0, 0, 0));
-        int conductor = tok_eq(type, "coatedconductor");
-        if ((st = get_roughness(p, lx, &coat, 0))) return st;
-        if (conductor) {
-            Material base = material_conductor(v3(1, 1, 1), v3(0, 0, 0), 0);
-            double r = 0;
-            if ((st = get_float_tex(p, lx, "interface.roughness", &r))) return st;
-            coat.roughness = clpt_roughness(r, 1);
-            double br = 0;
-            if ((st = get_float_tex(p, lx, "conductor.roughness", &br))) return st;
-            if ((st = conductor_params(p, lx, "conductor.eta", "conductor.k", "reflectance", &base))) return st;
-            vec3 f0 = base.flags & MAT_F0 ? base.specular : conductor_f0(base.eta, base.k);
-            *m = material_principled(f0, 1.0f, clpt_roughness(br, 1));
-        } else {
-            *m = material_principled(v3(0.5f, 0.5f, 0.5f), 0.0f, 1.0f);
-            if ((st = texture_of(p, lx, "reflectance", &m->albedo, &m->texture))) return st;
-        }
-        double eta = 1.5;
-        if ((st = get_float_tex(p, lx, conductor ? "interface.eta" : "eta", &eta))) return st;
-        m->ior = (float)eta;
-        m->clearcoat = 1.0f;
-        m->clearcoat_roughness = coat.roughness;
-        param_find(p, "thickness");   /* the coat has no thickness in clpt */
-        st = ST_OK;
+        st = make_coated(p, lx, tok_eq(type, "coatedconductor"), m);
     } else if (tok_eq(type, "interface") || tok_eq(type, "") || tok_eq(type, "none")) {
         /* an invisible boundary (a medium's edge): glass of index 1 passes light unbent.
          * pbrt-v4 makes no material for "" and "none" either (MaterialHandle::Create),

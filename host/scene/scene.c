@@ -434,6 +434,34 @@ Material material_conductor_f0(vec3 f0, float roughness)
     return m;
 }
 
+static Material material_layered(uint base, float roughness)
+{
+    Material m = material_base(MAT_LAYERED);
+    m.layer_base = base;
+    m.roughness = roughness;
+    m.layer_thickness = 0.01f;
+    m.layer_depth = 10;
+    m.layer_samples = 1;
+    return m;
+}
+
+Material material_coated_diffuse(vec3 diffuse, float roughness)
+{
+    Material m = material_layered(LAYER_BASE_DIFFUSE, roughness);
+    m.albedo = diffuse;
+    return m;
+}
+
+Material material_coated_conductor(vec3 eta, vec3 k, float base_roughness, float roughness)
+{
+    Material m = material_layered(LAYER_BASE_CONDUCTOR, roughness);
+    m.albedo = v3s(1.0f);
+    m.eta = eta;
+    m.k = k;
+    m.base_roughness = base_roughness;
+    return m;
+}
+
 Material material_mix(uint a, uint b, float amount, uint amount_tex)
 {
     Material m = material_base(MAT_MIX);

@@ -219,6 +219,13 @@ Material material_principled(vec3 base, float metallic, float roughness);
 /* Beer-Lambert sigma_a per channel for light keeping `color` of itself after `distance`
  * (KHR_materials_volume's attenuationColor and attenuationDistance; infinite: none). */
 vec3 material_absorption(vec3 color, float distance);
+/* pbrt-v4's coated materials (MAT_LAYERED) with pbrt's defaults: a smooth interface of
+ * index 1.5, thickness 0.01, no medium (albedo 0, g 0), maxdepth 10, nsamples 1; over a
+ * Lambertian base of reflectance `diffuse`, or over a conductor eta + i k (relative to
+ * the outside: the kernel divides by the interface's index) of perceptual roughness
+ * base_roughness. */
+Material material_coated_diffuse(vec3 diffuse, float roughness);
+Material material_coated_conductor(vec3 eta, vec3 k, float base_roughness, float roughness);
 /* The complex index of a named metal (Ag, Al, Au, Cr, Cu, Fe, Ni, Ti; docs/scene-format.md gives the
  * source), the name `len` bytes long. Returns 0 when the name is none of them. */
 int material_metal_preset(const char *name, size_t len, vec3 *eta, vec3 *k);

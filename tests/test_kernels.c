@@ -203,10 +203,22 @@ static void build_scene(void)
     pm.texture_normal = tex[1];
     pm.normal_scale = 0.8f;
     scene_add_material(&scene, "coated", pm, &coated, NULL);
+    /* pbrt's coated materials (kernels/layered.h): textured plastic in a scattering
+     * medium under a rough coat, and a coated rough conductor */
+    uint lacquer, coated_metal;
+    Material lm = material_coated_diffuse(v3(0.7f, 0.3f, 0.2f), 0.3f);
+    lm.texture = tex[2];
+    lm.layer_albedo = v3(0.8f, 0.8f, 0.6f);
+    lm.layer_thickness = 0.2f;
+    lm.layer_g = 0.3f;
+    scene_add_material(&scene, "lacquer", lm, &lacquer, NULL);
+    scene_add_material(&scene, "coated metal",
+                       material_coated_conductor(v3(0.17f, 0.35f, 1.5f), v3(3.1f, 2.7f, 1.9f), 0.3f, 0.0f),
+                       &coated_metal, NULL);
     uint mats[] = { diffuse, metal, glass, phong, glow, mirror, clear, checked, gold, chrome, frosted, sheet,
-                    plastic, coated };
+                    plastic, coated, lacquer, coated_metal };
     for (int i = 0; i < 16; i++) {
-        Sphere s = { vrand(-3.0f, 3.0f), frange(0.2f, 0.8f), mats[i % 14], NO_INDEX, 0, 0 };
+        Sphere s = { vrand(-3.0f, 3.0f), frange(0.2f, 0.8f), mats[i % 16], NO_INDEX, 0, 0 };
         scene_add_sphere(&scene, s, NULL);
     }
     Sphere light_sphere = { v3(0.0f, 5.0f, 0.0f), 0.5f, lamp, NO_INDEX, 0, 0 };
@@ -214,7 +226,7 @@ static void build_scene(void)
     scene_add_material(&scene, "plain", material_diffuse(v3(0.6f, 0.6f, 0.5f)), &plain_material, NULL);
     for (int i = 0; i < 30; i++) {
         vec3 c = vrand(-3.0f, 3.0f);
-        uint m = i % 3 == 0 ? plain_material : mats[i % 14];
+        uint m = i % 3 == 0 ? plain_material : mats[i % 16];
         Triangle t = { v3_add(c, vrand(-1.0f, 1.0f)), m, v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX,
                        v3_add(c, vrand(-1.0f, 1.0f)), NO_INDEX };
         scene_add_triangle(&scene, t, NULL);
@@ -1316,7 +1328,19 @@ static void test_bsdf(void)
                         material_dielectric(1.5f), material_principled(v3(0.8f, 0.5f, 0.3f), 0.0f, 0.4f),
                         material_principled(v3(0.9f, 0.7f, 0.4f), 1.0f, 0.0f),
                         material_principled(v3(0.5f, 0.8f, 0.9f), 0.3f, 0.6f),
-                        material_principled(v3(0.6f, 0.6f, 0.7f), 0.0f, 0.5f) };
+                        material_principled(v3(0.6f, 0.6f, 0.7f), 0.0f, 0.5f),
+                        material_coated_diffuse(v3(0.8f, 0.5f, 0.3f), 0.0f),
+                        material_coated_diffuse(v3(0.3f, 0.6f, 0.9f), 0.4f),
+                        material_coated_conductor(v3(0.2f, 0.9f, 1.1f), v3(3.6f, 2.6f, 2.4f), 0.3f, 0.2f),
+                        material_coated_conductor(v3(0.2f, 0.9f, 1.1f), v3(3.6f, 2.6f, 2.4f), 0.0f, 0.0f) };
+    /* coated: a scattering medium in two of them, one conductor all smooth (deltas) */
+    mats[17].layer_albedo = v3(0.9f, 0.6f, 0.3f);
+    mats[17].layer_thickness = 0.4f;
+    mats[17].layer_g = 0.3f;
+    mats[17].layer_samples = 2;
+    mats[18].layer_albedo = v3s(0.5f);
+    mats[18].layer_g = -0.2f;
+    mats[18].base_anisotropy = 0.5f;
     mats[14].transmission = 0.7f;
     /* KHR_materials_specular and _sheen over a transmitting solid */
     mats[15].transmission = 0.5f;

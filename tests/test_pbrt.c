@@ -112,6 +112,67 @@ static void test_transforms(void)
     scene_free(&s);
 }
 
+/* coateddiffuse and coatedconductor become MAT_LAYERED (kernels/layered.h) with each
+ * of pbrt-v4's parameters, and pbrt's defaults where none is given. */
+static void test_coated(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load(DIR "coated.pbrt", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_spheres, 5);
+    if (s.n_spheres != 5) goto out;
+    const Material *m[5];
+    for (int i = 0; i < 5; i++) {
+        m[i] = &s.materials[s.spheres[i].material];
+        CHECK_EQ_INT(m[i]->type, MAT_LAYERED);
+    }
+    /* coateddiffuse, everything given */
+    CHECK_EQ_INT(m[0]->layer_base, LAYER_BASE_DIFFUSE);
+    CHECK_V3(m[0]->albedo, 0.2, 0.4, 0.6, 1e-6);
+    CHECK_NEAR(m[0]->roughness, sqrt(0.02), 1e-6);   /* alpha 0.01 and 0.04, not remapped */
+    CHECK_NEAR(m[0]->anisotropy, 0.75 / 0.9, 1e-6);
+    CHECK_NEAR(m[0]->ior, 1.33, 1e-6);
+    CHECK_NEAR(m[0]->layer_thickness, 0.05, 1e-7);
+    CHECK_V3(m[0]->layer_albedo, 0.1, 0.2, 0.3, 1e-6);
+    CHECK_NEAR(m[0]->layer_g, 0.4, 1e-7);
+    CHECK_EQ_INT(m[0]->layer_depth, 20);
+    CHECK_EQ_INT(m[0]->layer_samples, 3);
+    /* coatedconductor, everything given: gold under a coat */
+    vec3 eta, k;
+    material_metal_preset("Au", 2, &eta, &k);
+    CHECK_EQ_INT(m[1]->layer_base, LAYER_BASE_CONDUCTOR);
+    CHECK_V3(m[1]->eta, eta.x, eta.y, eta.z, 0);
+    CHECK_V3(m[1]->k, k.x, k.y, k.z, 0);
+    CHECK_NEAR(m[1]->roughness, 0.5, 1e-6);   /* remapped: alpha = sqrt(0.0625) */
+    CHECK_NEAR(m[1]->anisotropy, 0, 0);
+    CHECK_NEAR(m[1]->ior, 1.4, 1e-6);
+    /* alpha 0.5 and 0.25: roughness (0.5 * 0.25)^(1/4), anisotropy (1 - 0.5) / 0.9 */
+    CHECK_NEAR(m[1]->base_roughness, pow(0.125, 0.25), 1e-6);
+    CHECK_NEAR(m[1]->base_anisotropy, 0.5 / 0.9, 1e-6);
+    CHECK_NEAR(m[1]->layer_thickness, 0.2, 1e-7);
+    CHECK_V3(m[1]->layer_albedo, 0.5, 0.5, 0.5, 0);
+    CHECK_NEAR(m[1]->layer_g, -0.3, 1e-7);
+    CHECK_EQ_INT(m[1]->layer_depth, 7);
+    CHECK_EQ_INT(m[1]->layer_samples, 2);
+    /* a conductor's reflectance: pbrt's index eta 1, k = 2 sqrt(r) / sqrt(1 - r) */
+    CHECK_V3(m[2]->eta, 1, 1, 1, 0);
+    CHECK_V3(m[2]->k, 2 * sqrt(0.5) / sqrt(0.5), 2 * sqrt(0.8) / sqrt(0.2), 2 * sqrt(0.25) / sqrt(0.75), 1e-5);
+    /* pbrt-v4's defaults: reflectance 0.5, smooth, eta 1.5, thickness 0.01, no medium,
+     * maxdepth 10, nsamples 1; an eta of 0 is 1 */
+    CHECK_EQ_INT(m[3]->layer_base, LAYER_BASE_DIFFUSE);
+    CHECK_V3(m[3]->albedo, 0.5, 0.5, 0.5, 0);
+    CHECK_NEAR(m[3]->roughness, 0, 0);
+    CHECK_NEAR(m[3]->ior, 1.5, 0);
+    CHECK_NEAR(m[3]->layer_thickness, 0.01, 1e-9);
+    CHECK_V3(m[3]->layer_albedo, 0, 0, 0, 0);
+    CHECK_NEAR(m[3]->layer_g, 0, 0);
+    CHECK_EQ_INT(m[3]->layer_depth, 10);
+    CHECK_EQ_INT(m[3]->layer_samples, 1);
+    CHECK_NEAR(m[4]->ior, 1, 0);
+out:
+    scene_free(&s);
+}
+
 static void test_materials_lights(void)
 {
     Scene s;
@@ -145,9 +206,8 @@ static void test_materials_lights(void)
     CHECK_NEAR(m[3]->ior, 1.5185, 1e-6);
     CHECK(m[4]->flags & MAT_THIN);
     CHECK_NEAR(m[4]->ior, 1.33, 1e-6);
-    CHECK_EQ_INT(m[5]->type, MAT_PRINCIPLED);
-    CHECK_NEAR(m[5]->clearcoat, 1, 0);
-    CHECK_NEAR(m[5]->metallic, 0, 0);
+    CHECK_EQ_INT(m[5]->type, MAT_LAYERED);
+    CHECK_EQ_INT(m[5]->layer_base, LAYER_BASE_DIFFUSE);
     CHECK_V3(m[5]->albedo, 0.2, 0.4, 0.6, 1e-6);
     CHECK_EQ_INT(m[6]->type, MAT_DIELECTRIC);
     CHECK_NEAR(m[6]->ior, 1, 0);
@@ -1202,6 +1262,7 @@ int main(void)
     RUN(test_basic);
     RUN(test_transforms);
     RUN(test_materials_lights);
+    RUN(test_coated);
     RUN(test_warnings);
     RUN(test_active_transform);
     RUN(test_no_material);

@@ -1,0 +1,197 @@
+"""The single-feature scenes of the cross-check (tools/xcheck/xcheck.py) and the glTF file
+each is written as: one source for clpt (which reads glTF, docs/gltf.md) and for Blender's
+glTF importer (Cycles); Mitsuba gets the same triangles as PLY files and a BSDF of its own.
+
+Every new material or light feature adds its scene here (docs/validation.md).
+
+A scene is a dict:
+  name, what        the row's name and what it tests
+  material          the glTF material of the sphere (and of the floor, when there is one)
+  ext               the glTF extensions the material or lights use (for extensionsUsed);
+  needs             those of them clpt must read for the scene to mean anything: while clpt
+                    warns that one is ignored, the scene is reported 'unsupported'
+  clpt              a clpt material body that replaces the file's materials (`mesh { file
+                    ... material m }`), for features that glTF cannot say (Lambert)
+  cycles            "diffuse:R,G,B": every material a Lambertian Diffuse BSDF
+  mitsuba           function(mi, tex) -> Mitsuba BSDF dict, or None: no equivalent
+  mitsuba_emitter   for an emissive sphere: its area emitter's radiance
+  light             None or a KHR_lights_punctual light with the node's place
+  background        'white' (radiance 1 everywhere), 'black' or 'env' (an equirectangular map)
+  floor             a 8 x 8 floor at y = -1 under the unit sphere
+  textures          {key: (kind, size)}: images the harness draws (base colour, normal, emission)
+  notes             {peer: the known model difference for this scene}
+"""
+import math
+
+# the known model differences, written once and named by the scenes below
+DISNEY_DIFFUSE = ("Disney's Principled: Burley's retro-reflective diffuse, not weighted by 1 - F "
+                  "(glTF: Lambert x (1 - F)); brighter toward the rim")
+DISNEY_SPEC = ("Disney's specular Fresnel: the exact dielectric Fresnel of ior 1.5 "
+               "(glTF: Schlick, F0 0.04), larger at oblique angles")
+SEPARABLE_G = "separable Smith G1 G1 (clpt: height-correlated), darker when rough"
+CY_SOLID = "Cycles' Principled transmission is solid glass: no thin walls"
+CY_SPOT = "Cycles multiplies spot lights by cos theta and smoothsteps the cone"
+MI_SPOT = "Mitsuba's spot falls off linearly in angle between beam_width and cutoff_angle"
+
+
+def _rgb(v):
+    return {"type": "rgb", "value": list(v)}
+
+
+def _principled(base, metallic, roughness, **kw):
+    d = {"type": "principled", "base_color": base if isinstance(base, dict) else _rgb(base),
+         "metallic": metallic, "roughness": max(roughness, 1e-3), "specular": 0.5}
+    d.update(kw)
+    return d
+
+
+def _gltf_mat(base=(1, 1, 1), metallic=1.0, roughness=1.0, baseColorTexture=None, **kw):
+    m = {"pbrMetallicRoughness": {"baseColorFactor": list(base) + [1.0], "metallicFactor": metallic,
+                                  "roughnessFactor": roughness}}
+    if baseColorTexture:
+        m["pbrMetallicRoughness"]["baseColorTexture"] = baseColorTexture
+    m.update(kw)
+    return m
+
+
+ORANGE = (0.8, 0.5, 0.2)
+GOLDISH = (0.9, 0.6, 0.2)
+GREY = (0.7, 0.7, 0.7)
+
+
+def scene_list():
+    S = []
+
+    def add(name, what, **kw):
+        s = {"name": name, "what": what, "material": _gltf_mat(), "ext": [], "needs": [], "clpt": None,
+             "cycles": None, "mitsuba": None, "mitsuba_emitter": None, "light": None, "background": "white",
+             "floor": False, "textures": {}, "notes": {}}
+        s.update(kw)
+        S.append(s)
+
+    # --- materials, under a uniform white background (a furnace: what is not reflected is lost)
+    add("lambert", "Lambert, albedo 0.8 0.5 0.2 (every renderer's own diffuse)",
+        clpt="type diffuse albedo %g %g %g" % ORANGE, cycles="diffuse:%g,%g,%g" % ORANGE,
+        mitsuba=lambda mi, t: {"type": "diffuse", "reflectance": _rgb(ORANGE)})
+    add("principled-diffuse", "principled, base 0.8 0.5 0.2, metallic 0, roughness 0.5",
+        material=_gltf_mat(ORANGE, 0.0, 0.5),
+        mitsuba=lambda mi, t: _principled(ORANGE, 0.0, 0.5),
+        notes={"mitsuba": DISNEY_DIFFUSE + "; " + DISNEY_SPEC, "cycles": DISNEY_DIFFUSE})
+    add("principled-specular", "principled specular lobe alone: base black, metallic 0, roughness 0.5",
+        material=_gltf_mat((0, 0, 0), 0.0, 0.5),
+        mitsuba=lambda mi, t: _principled((0, 0, 0), 0.0, 0.5),
+        notes={"mitsuba": DISNEY_SPEC + "; " + SEPARABLE_G,
+               "cycles": "Disney's specular added without taking energy from diffuse"})
+    add("conductor-rough", "metal (metallic 1), base 0.9 0.6 0.2, roughness 0.5",
+        material=_gltf_mat(GOLDISH, 1.0, 0.5),
+        mitsuba=lambda mi, t: _principled(GOLDISH, 1.0, 0.5),
+        notes={"mitsuba": SEPARABLE_G, "cycles": "multiple-scattering GGX off (GGX chosen by the importer)"})
+    add("conductor-smooth", "metal (metallic 1), base 0.9 0.6 0.2, roughness 0 (a mirror)",
+        material=_gltf_mat(GOLDISH, 1.0, 0.0),
+        mitsuba=lambda mi, t: _principled(GOLDISH, 1.0, 0.0),
+        notes={"mitsuba": "roughness 0.001 (Mitsuba's principled has no exact mirror)"})
+    tr = lambda r: {"KHR_materials_transmission": {"transmissionFactor": 1.0}, "KHR_materials_ior": {"ior": 1.5}}
+    add("glass-thin-smooth", "thin glass wall: glTF transmission 1, roughness 0, ior 1.5 (no volume: thin)",
+        material=_gltf_mat((1, 1, 1), 0.0, 0.0, extensions=tr(0)),
+        ext=["KHR_materials_transmission", "KHR_materials_ior"], needs=["KHR_materials_transmission"],
+        mitsuba=lambda mi, t: {"type": "thindielectric", "int_ior": 1.5, "ext_ior": 1.0},
+        notes={"cycles": CY_SOLID})
+    add("glass-thin-rough", "thin rough glass: glTF transmission 1, roughness 0.4, ior 1.5",
+        material=_gltf_mat((1, 1, 1), 0.0, 0.4, extensions=tr(0.4)),
+        ext=["KHR_materials_transmission", "KHR_materials_ior"], needs=["KHR_materials_transmission"],
+        mitsuba=lambda mi, t: {"type": "principledthin", "base_color": _rgb((1, 1, 1)), "roughness": 0.4,
+                               "spec_trans": 1.0, "eta": 1.5},
+        notes={"mitsuba": "principledthin: Disney's thin-sheet model", "cycles": CY_SOLID})
+    add("glass-solid-smooth", "solid glass, ior 1.5, smooth (clpt: its dielectric; glTF via volume below)",
+        material=_gltf_mat((1, 1, 1), 0.0, 0.0, extensions=tr(0)),
+        ext=["KHR_materials_transmission", "KHR_materials_ior"],
+        clpt="type dielectric ior 1.5 roughness 0",
+        mitsuba=lambda mi, t: {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0})
+    add("glass-solid-rough", "solid rough glass, ior 1.5, roughness 0.4 (GGX alpha 0.16)",
+        material=_gltf_mat((1, 1, 1), 0.0, 0.4, extensions=tr(0.4)),
+        ext=["KHR_materials_transmission", "KHR_materials_ior"],
+        clpt="type dielectric ior 1.5 roughness 0.4",
+        mitsuba=lambda mi, t: {"type": "roughdielectric", "distribution": "ggx", "alpha": 0.16,
+                               "int_ior": 1.5, "ext_ior": 1.0},
+        notes={"mitsuba": SEPARABLE_G, "cycles": "Principled's transmission lobe (Disney) through the importer"})
+    vol = tr(0)
+    vol["KHR_materials_volume"] = {"thicknessFactor": 2.0, "attenuationColor": [0.9, 0.5, 0.3],
+                                   "attenuationDistance": 1.0}
+    sig = [-math.log(c) for c in (0.9, 0.5, 0.3)]
+    add("volume", "KHR_materials_volume: solid glass absorbing to 0.9 0.5 0.3 per unit length",
+        material=_gltf_mat((1, 1, 1), 0.0, 0.0, extensions=vol),
+        ext=["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"],
+        needs=["KHR_materials_volume"],
+        mitsuba=lambda mi, t: {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0},
+        mitsuba_interior={"type": "homogeneous", "albedo": 0.0, "sigma_t": _rgb(sig)},
+        notes={"cycles": "Blender 3.4's importer reads the volume's absorption only if it knows the extension"})
+    add("clearcoat", "clearcoat 1, clearcoat roughness 0.1 over principled 0.8 0.5 0.2, roughness 0.5",
+        material=_gltf_mat(ORANGE, 0.0, 0.5, extensions={
+            "KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.1}}),
+        ext=["KHR_materials_clearcoat"], needs=["KHR_materials_clearcoat"],
+        mitsuba=lambda mi, t: _principled(ORANGE, 0.0, 0.5, clearcoat=1.0, clearcoat_gloss=0.9),
+        notes={"mitsuba": "Disney clearcoat: GTR1 lobe at a quarter weight, fixed ior 1.5; " + DISNEY_DIFFUSE,
+               "cycles": "Disney clearcoat (GTR1, a quarter weight); " + DISNEY_DIFFUSE})
+    add("sheen", "KHR_materials_sheen: colour 1 1 1, roughness 0.5, over base 0.2 0.2 0.6, roughness 0.8",
+        material=_gltf_mat((0.2, 0.2, 0.6), 0.0, 0.8, extensions={
+            "KHR_materials_sheen": {"sheenColorFactor": [1.0, 1.0, 1.0], "sheenRoughnessFactor": 0.5}}),
+        ext=["KHR_materials_sheen"], needs=["KHR_materials_sheen"],
+        mitsuba=lambda mi, t: _principled((0.2, 0.2, 0.6), 0.0, 0.8, sheen=1.0, sheen_tint=0.0),
+        notes={"mitsuba": "Disney sheen (Schlick-weighted grazing term), not glTF's Charlie lobe",
+               "cycles": "Blender 3.4's importer has no KHR_materials_sheen (Disney sheen if it had)"})
+    add("specular", "KHR_materials_specular: specularFactor 0.5 (F0 0.02), base black, roughness 0.5",
+        material=_gltf_mat((0, 0, 0), 0.0, 0.5, extensions={
+            "KHR_materials_specular": {"specularFactor": 0.5, "specularColorFactor": [1.0, 1.0, 1.0]}}),
+        ext=["KHR_materials_specular"], needs=["KHR_materials_specular"],
+        mitsuba=lambda mi, t: _principled((0, 0, 0), 0.0, 0.5, specular=0.25),
+        notes={"mitsuba": "specular 0.25 (F0 0.02 as an ior); " + DISNEY_SPEC,
+               "cycles": "the importer turns specularFactor into Principled's Specular"})
+    # --- emission and textures, black background
+    add("emission", "emissive 1 0.5 0.25 x strength 2 (KHR_materials_emissive_strength), black base",
+        material=_gltf_mat((0, 0, 0), 0.0, 1.0, emissiveFactor=[1.0, 0.5, 0.25],
+                           extensions={"KHR_materials_emissive_strength": {"emissiveStrength": 2.0}}),
+        ext=["KHR_materials_emissive_strength"], needs=["KHR_materials_emissive_strength"],
+        background="black",
+        mitsuba=lambda mi, t: {"type": "diffuse", "reflectance": _rgb((0, 0, 0))},
+        mitsuba_emitter=(2.0, 1.0, 0.5))
+    add("texture-emission", "emissive texture (sRGB, NEAREST): the image itself, no BSDF involved",
+        material=_gltf_mat((0, 0, 0), 0.0, 1.0, emissiveFactor=[1.0, 1.0, 1.0], emissiveTexture="emissive"),
+        background="black", textures={"emissive": ("checker", 64)},
+        mitsuba=lambda mi, t: {"type": "diffuse", "reflectance": _rgb((0, 0, 0))},
+        mitsuba_emitter="emissive")
+    add("texture-base", "base colour texture (sRGB, NEAREST), metallic 0, roughness 1",
+        material=_gltf_mat((1, 1, 1), 0.0, 1.0, baseColorTexture="base"), textures={"base": ("checker", 64)},
+        mitsuba=lambda mi, t: _principled(t["base"], 0.0, 1.0),
+        notes={"mitsuba": DISNEY_DIFFUSE, "cycles": DISNEY_DIFFUSE})
+    # --- lights: a Lambertian sphere (0.7 grey) on a floor of the same, black background
+    lam = dict(clpt="type diffuse albedo %g %g %g" % GREY, cycles="diffuse:%g,%g,%g" % GREY,
+               mitsuba=lambda mi, t: {"type": "diffuse", "reflectance": _rgb(GREY)},
+               background="black", floor=True, ext=["KHR_lights_punctual"], needs=["KHR_lights_punctual"])
+    add("light-point", "point light, 683 x 8 cd (8 W/sr) white, at (2, 3, 2)",
+        light={"type": "point", "color": [1, 1, 1], "intensity": 683.0 * 8, "at": (2.0, 3.0, 2.0)}, **lam)
+    add("light-spot", "spot light, 683 x 20 cd, at (0, 3.5, 1) down, inner 15, outer 30 degrees",
+        light={"type": "spot", "color": [1, 1, 1], "intensity": 683.0 * 20, "at": (0.0, 3.5, 1.0),
+               "spot": {"innerConeAngle": math.radians(15), "outerConeAngle": math.radians(30)}},
+        notes={"mitsuba": MI_SPOT, "cycles": CY_SPOT}, **lam)
+    add("light-directional", "directional light, 683 x 2 lux (2 W/m^2), from (1, 2, 1)",
+        light={"type": "directional", "color": [1, 1, 1], "intensity": 683.0 * 2, "dir": (-1.0, -2.0, -1.0)},
+        **lam)
+    add("normal-map", "normal map (bumps in u and v, TANGENT given), principled 0.8 grey, roughness 1, "
+        "directional light", material=_gltf_mat((0.8, 0.8, 0.8), 0.0, 1.0, normalTexture="normal"),
+        textures={"normal": ("bumps", 128)}, background="black", ext=["KHR_lights_punctual"],
+        needs=["KHR_lights_punctual"],
+        light={"type": "directional", "color": [1, 1, 1], "intensity": 683.0 * 3, "dir": (-1.0, -0.5, -1.0)},
+        mitsuba=lambda mi, t: {"type": "normalmap", "normalmap": t["normal"],
+                               "bsdf": _principled((0.8, 0.8, 0.8), 0.0, 1.0)},
+        notes={"mitsuba": DISNEY_DIFFUSE + "; tangent frame from its own uv derivatives",
+               "cycles": DISNEY_DIFFUSE + "; MikkTSpace tangents from the uvs"})
+    # --- environment map
+    add("env-lambert", "Lambert 0.8 0.5 0.2 under courtyard.hdr",
+        clpt="type diffuse albedo %g %g %g" % ORANGE, cycles="diffuse:%g,%g,%g" % ORANGE,
+        mitsuba=lambda mi, t: {"type": "diffuse", "reflectance": _rgb(ORANGE)}, background="env",
+        notes={"mitsuba": "bilinear map lookup (clpt and Cycles: nearest texel)"})
+    add("env-conductor", "metal 0.9 0.6 0.2, roughness 0.3, under courtyard.hdr",
+        material=_gltf_mat(GOLDISH, 1.0, 0.3), background="env",
+        mitsuba=lambda mi, t: _principled(GOLDISH, 1.0, 0.3),
+        notes={"mitsuba": SEPARABLE_G + "; bilinear map lookup"})
+    return S

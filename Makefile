@@ -5,6 +5,7 @@
 #   make render     render the default scene to cornell-box.png
 #   make bench      throughput benchmarks (bench/)
 #   make bench-peers  clpt against Mitsuba 3 and Cycles at equal error (bench/peers.py)
+#   make xcheck     single-feature scenes against Mitsuba 3 and Cycles (tools/xcheck/)
 #   make test-asan  the test suite built with AddressSanitizer + UBSan (build-asan/)
 #   make test-valgrind  small renders (PoCL and scalar) under valgrind memcheck
 #   make fuzz       each libFuzzer target in fuzz/ for FUZZ_SECONDS (build-fuzz/)
@@ -54,7 +55,7 @@ FUZZ_BIN  := $(FUZZ_SRC:fuzz/%.c=$(BUILD)/fuzz/%)
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: all deps test render bench bench-peers clean test-asan test-valgrind fuzz fuzz-build
+.PHONY: all deps test render bench bench-peers xcheck clean test-asan test-valgrind fuzz fuzz-build
 .DEFAULT_GOAL := all
 
 all: $(BUILD)/$(PROG)
@@ -143,6 +144,15 @@ bench-peers: $(BUILD)/$(PROG)
 	@POCL_CACHE_DIR=$${POCL_CACHE_DIR:-$(CURDIR)/$(BUILD)/pocl-cache} \
 	 CLPT_CACHE_DIR=$${CLPT_CACHE_DIR:-$(CURDIR)/$(BUILD)/kernel-cache} \
 	 python3 bench/peers.py --clpt $(BUILD)/$(PROG) --out $(BUILD)/peers $(PEERS_ARGS)
+
+# The cross-check (docs/validation.md): minutes long, not part of `make test`; Mitsuba 3
+# (pip) and Cycles (Debian's blender) are used when installed and skipped otherwise.
+# XCHECK_ARGS passes options, e.g. XCHECK_ARGS="--only lambert,sheen --spp 64".
+xcheck: $(BUILD)/$(PROG)
+	@mkdir -p $(BUILD)/pocl-cache $(BUILD)/kernel-cache
+	@POCL_CACHE_DIR=$${POCL_CACHE_DIR:-$(CURDIR)/$(BUILD)/pocl-cache} \
+	 CLPT_CACHE_DIR=$${CLPT_CACHE_DIR:-$(CURDIR)/$(BUILD)/kernel-cache} \
+	 python3 tools/xcheck/xcheck.py --clpt $(BUILD)/$(PROG) --out $(BUILD)/xcheck $(XCHECK_ARGS)
 
 # ---------------------------------------------------------------- hardening
 # The sanitizer and fuzzing builds are the ordinary build in their own folders, with

@@ -89,7 +89,8 @@ def scene_list():
     add("conductor-smooth", "metal (metallic 1), base 0.9 0.6 0.2, roughness 0 (a mirror)",
         material=_gltf_mat(GOLDISH, 1.0, 0.0),
         mitsuba=lambda mi, t: _principled(GOLDISH, 1.0, 0.0),
-        notes={"mitsuba": "roughness 0.001 (Mitsuba's principled has no exact mirror)"})
+        notes={"mitsuba": "roughness 0.001 (Mitsuba's principled has no exact mirror)",
+               "cycles": "Cycles' own metallic Fresnel toward white, not glTF's Schlick (measured, not traced)"})
     tr = lambda r: {"KHR_materials_transmission": {"transmissionFactor": 1.0}, "KHR_materials_ior": {"ior": 1.5}}
     add("glass-thin-smooth", "thin glass wall: glTF transmission 1, roughness 0, ior 1.5 (no volume: thin)",
         material=_gltf_mat((1, 1, 1), 0.0, 0.0, extensions=tr(0)),
@@ -113,7 +114,9 @@ def scene_list():
         clpt="type dielectric ior 1.5 roughness 0.4",
         mitsuba=lambda mi, t: {"type": "roughdielectric", "distribution": "ggx", "alpha": 0.16,
                                "int_ior": 1.5, "ext_ior": 1.0},
-        notes={"mitsuba": SEPARABLE_G, "cycles": "Principled's transmission lobe (Disney) through the importer"})
+        notes={"mitsuba": SEPARABLE_G,
+               "cycles": "glTF's principled through the importer (clpt: its dielectric): Cycles' Principled "
+                         "glass, darker than a plain GGX dielectric"})
     vol = tr(0)
     vol["KHR_materials_volume"] = {"thicknessFactor": 2.0, "attenuationColor": [0.9, 0.5, 0.3],
                                    "attenuationDistance": 1.0}
@@ -123,8 +126,13 @@ def scene_list():
         ext=["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"],
         needs=["KHR_materials_volume"],
         mitsuba=lambda mi, t: {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0},
-        mitsuba_interior={"type": "homogeneous", "albedo": 0.0, "sigma_t": _rgb(sig)},
-        notes={"cycles": "Blender 3.4's importer reads the volume's absorption only if it knows the extension"})
+        # Mitsuba reads an RGB value as a reflectance (at most 1): the largest coefficient
+        # goes into the medium's scale
+        mitsuba_interior={"type": "homogeneous", "albedo": 0.0, "scale": max(sig),
+                          "sigma_t": _rgb([x / max(sig) for x in sig])},
+        notes={"mitsuba": "a homogeneous absorbing medium, sigma_t = -ln(colour) / distance",
+               "cycles": "the importer makes a Volume Absorption of density 1/distance: "
+               "sigma_a = (1 - colour) / distance, not glTF's -ln(colour) / distance"})
     add("clearcoat", "clearcoat 1, clearcoat roughness 0.1 over principled 0.8 0.5 0.2, roughness 0.5",
         material=_gltf_mat(ORANGE, 0.0, 0.5, extensions={
             "KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.1}}),
@@ -138,14 +146,16 @@ def scene_list():
         ext=["KHR_materials_sheen"], needs=["KHR_materials_sheen"],
         mitsuba=lambda mi, t: _principled((0.2, 0.2, 0.6), 0.0, 0.8, sheen=1.0, sheen_tint=0.0),
         notes={"mitsuba": "Disney sheen (Schlick-weighted grazing term), not glTF's Charlie lobe",
-               "cycles": "Blender 3.4's importer has no KHR_materials_sheen (Disney sheen if it had)"})
+               "cycles": "the importer adds a Velvet BSDF (sigma = sheenRoughness, colour sheenColor) to the "
+               "Principled with an Add Shader: sheen on top of the base's full energy, not layered"})
     add("specular", "KHR_materials_specular: specularFactor 0.5 (F0 0.02), base black, roughness 0.5",
         material=_gltf_mat((0, 0, 0), 0.0, 0.5, extensions={
             "KHR_materials_specular": {"specularFactor": 0.5, "specularColorFactor": [1.0, 1.0, 1.0]}}),
         ext=["KHR_materials_specular"], needs=["KHR_materials_specular"],
         mitsuba=lambda mi, t: _principled((0, 0, 0), 0.0, 0.5, specular=0.25),
         notes={"mitsuba": "specular 0.25 (F0 0.02 as an ior); " + DISNEY_SPEC,
-               "cycles": "the importer turns specularFactor into Principled's Specular"})
+               "cycles": "the importer sets Principled's Specular to 0.25 (Disney F0 = 0.08 x Specular); "
+               "Disney's specular added without taking energy from diffuse"})
     # --- emission and textures, black background
     add("emission", "emissive 1 0.5 0.25 x strength 2 (KHR_materials_emissive_strength), black base",
         material=_gltf_mat((0, 0, 0), 0.0, 1.0, emissiveFactor=[1.0, 0.5, 0.25],

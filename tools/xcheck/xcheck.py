@@ -532,6 +532,9 @@ def main():
             imgs[("clpt", s["name"])] = "failed: %s" % e
         t1 = time.time()
         line = "%-20s clpt %.1f s" % (s["name"], t1 - t0)
+        if isinstance(imgs[("clpt", s["name"])], str):
+            print(line + "  " + imgs[("clpt", s["name"])] + ": no peer renders it", flush=True)
+            continue
         for p in peers:
             if p.name != "mitsuba":
                 continue
@@ -546,10 +549,13 @@ def main():
     for p in peers:
         if p.name == "cycles":
             t0 = time.time()
-            got = p.render_all([(s, files[s["name"]][0], seeds) for s in todo], folder)
+            got = p.render_all([(s, files[s["name"]][0], seeds) for s in todo
+                                if not isinstance(imgs[("clpt", s["name"])], str)], folder)
             print("cycles: %d images in %.1f s" % (len(got), time.time() - t0), flush=True)
             for s in todo:
-                if all((s["name"], k) in got for k in seeds):
+                if isinstance(imgs[("clpt", s["name"])], str):
+                    imgs[("cycles", s["name"])] = "not rendered"
+                elif all((s["name"], k) in got for k in seeds):
                     imgs[("cycles", s["name"])] = [got[(s["name"], k)] for k in seeds]
                 else:
                     imgs[("cycles", s["name"])] = "failed (see cycles.log)"

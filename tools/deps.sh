@@ -8,7 +8,7 @@
 # Profiles: base (build and run clpt, run the tests), viewer-test (the viewer's test
 # under a virtual display; run.sh test and .ci/run install it), sanitize (make test-asan),
 # valgrind (make test-valgrind), fuzz (make fuzz), embree (the traversal benchmark),
-# peers (make bench-peers).
+# peers (make bench-peers, make xcheck).
 # Missing packages are installed when run as root (apt-get); otherwise the exact
 # command to run is printed and the script fails, so nothing half-works.
 set -eu
@@ -22,7 +22,7 @@ pkgs_for() {
         valgrind) echo "valgrind" ;;
         fuzz) echo "clang libclang-rt-14-dev" ;;
         embree) echo "libembree-dev" ;;
-        # make bench-peers: Cycles, and Mitsuba 3's LLVM variant (Mitsuba itself: pip)
+        # make bench-peers and make xcheck: Cycles, and Mitsuba 3's LLVM variant (Mitsuba itself: pip)
         peers) echo "blender python3-numpy libllvm19" ;;
         *) echo "deps.sh: unknown profile '$1'" >&2; exit 2 ;;
     esac

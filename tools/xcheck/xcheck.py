@@ -258,9 +258,8 @@ def write_ply(path, geo):
 
 
 # ---------------------------------------------------------------- statistics
-def camera_rays(s, size, grow=0.25):
-    """Directions through the corners of each pixel, the pixel enlarged by `grow` pixels on
-    each side: (size+1) x (size+1) x 2 ... returned as two grids (low and high corners)."""
+def camera_frame(s):
+    """The scene's camera: eye, forward, right and up unit vectors, tan(fov / 2)."""
     cam_from, cam_at, fov = CAMERAS["floor" if s["floor"] else "sphere"]
     f = np.subtract(cam_at, cam_from)
     f = f / np.linalg.norm(f)
@@ -274,7 +273,7 @@ def camera_rays(s, size, grow=0.25):
 def object_ids(s, size, xs, ys):
     """For film points (xs, ys) in pixels (grids), which object the ray hits: 0 none, 1 the
     sphere, 2 the floor."""
-    o, f, r, u, half = camera_rays(s, size)
+    o, f, r, u, half = camera_frame(s)
     sx = (2 * xs / size - 1) * half
     sy = (1 - 2 * ys / size) * half
     d = f[None, None] + sx[..., None] * r[None, None] + sy[..., None] * u[None, None]
@@ -568,7 +567,7 @@ def main():
         print("| scene | clpt mean | %s mean | ratio | RMSE | noise floor | known model difference |" % p.name)
         print("|---|---|---|---|---|---|---|")
         for s in todo:
-            c, q = imgs[("clpt", s["name"])], imgs[(p.name, s["name"])]
+            c, q = imgs[("clpt", s["name"])], imgs.get((p.name, s["name"]), "not rendered")
             note = s["notes"].get(p.name, "")
             if isinstance(c, str) or isinstance(q, str):
                 why = "clpt: " + c if isinstance(c, str) else "%s: %s" % (p.name, q)
@@ -587,7 +586,7 @@ def main():
         print("no peer installed: clpt rendered the scenes alone (%s)" % folder)
         for s in todo:
             c = imgs[("clpt", s["name"])]
-            print("%-20s %s" % (s["name"], c if isinstance(c, str) else "mean %.4f" % float(
+            print("%-20s %s" % (s["name"], c if isinstance(c, str) else "image mean %.4f" % float(
                 ((c[0] + c[1]) / 2).mean())))
     with open(os.path.join(folder, "results.json"), "w") as f:
         json.dump({"%s/%s" % k: v for k, v in results.items()}, f, indent=1)

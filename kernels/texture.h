@@ -338,7 +338,7 @@ KFN vec3 material_normal(const SceneView *sc, Material m, Surface s)
  * In place, as material_resolve (mix.h). */
 KFN void material_at(const SceneView *sc, Material *m, Surface s, vec3 ng_face)
 {
-    if (!KF_HAS(KF_TEXTURES) || !MAT_IS(*m, MAT_PRINCIPLED)) return;
+    if (!KF_HAS(KF_TEXTURES) || m->type != MAT_PRINCIPLED) return;
     if (m->texture_rm != NO_INDEX) {
         vec3 t = texture_eval(sc, m->texture_rm, s, ng_face);
         m->roughness *= t.y;

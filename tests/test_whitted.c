@@ -794,32 +794,40 @@ static void test_course_camera(void)
     free(rgb);
 }
 
-/* Fall 2019: a `Material` with specularColor and no reflectiveColor mirrors with it.
- * A black sphere with specular 0.5 in front of a (0.2, 0.4, 0.8) background reflects
- * the background straight back at the centre pixel: 0.5 x background (before: black).
- * Tsinghua's dialect (a camera with width/height) reflects nothing. */
+/* Fall 2019: a material with specularColor mirrors with it, `Material` and
+ * `PhongMaterial` alike (the course's scene07_arch floor is a PhongMaterial of
+ * specularColor 0.4). A black sphere with specular 0.5 in front of a (0.2, 0.4, 0.8)
+ * background reflects the background straight back at the centre pixel: 0.5 x
+ * background (before: black, and black for PhongMaterial until the arch's floor
+ * showed it). Tsinghua's dialect (a camera with width/height) reflects nothing, nor
+ * does a scene in MIT 2004's dialect (a material with reflectiveColor, transparentColor,
+ * indexOfRefraction or exponent), where only reflectiveColor mirrors. */
 static void test_course_reflection(void)
 {
     const char *cameras[2] = { "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }\n",
                                "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 "
                                "width 3 height 3 }\n" };
-    const char *rest =
-        "Background { color 0.2 0.4 0.8 ambientLight 0 0 0 }\n"
-        "Materials { numMaterials 1 Material { diffuseColor 0 0 0 specularColor 0.5 0.5 0.5 shininess 10 } }\n"
-        "Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0 0 radius 1 } }\n";
-    for (int sized = 0; sized < 2; sized++) {
-        char scene[512];
-        snprintf(scene, sizeof scene, "%s%s", cameras[sized], rest);
-        float *rgb = render_classic(scene, 3, 3, INTEGRATOR_WHITTED, "both");
-        const float *c = rgb + 3 * 4;
-        fprintf(stderr, "  specular 0.5 sphere, %s camera: centre pixel %.4f %.4f %.4f\n", sized ? "Tsinghua" : "MIT",
-                (double)c[0], (double)c[1], (double)c[2]);
-        double k = sized ? 0.0 : 0.5;
-        CHECK_NEAR(c[0], 0.2 * k, 1e-6);
-        CHECK_NEAR(c[1], 0.4 * k, 1e-6);
-        CHECK_NEAR(c[2], 0.8 * k, 1e-6);
-        free(rgb);
-    }
+    const char *blocks[3] = { "Material", "PhongMaterial", "PhongMaterial" };
+    const char *others[3] = { "", "", "PhongMaterial { diffuseColor 1 1 1 transparentColor 0.5 0.5 0.5 }" };
+    for (int sized = 0; sized < 2; sized++)
+        for (int b = 0; b < 3; b++) {
+            char scene[1024];
+            snprintf(scene, sizeof scene,
+                     "%sBackground { color 0.2 0.4 0.8 ambientLight 0 0 0 }\n"
+                     "Materials { numMaterials %d %s { diffuseColor 0 0 0 specularColor 0.5 0.5 0.5 shininess 10 } "
+                     "%s }\n"
+                     "Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0 0 radius 1 } }\n",
+                     cameras[sized], others[b][0] ? 2 : 1, blocks[b], others[b]);
+            float *rgb = render_classic(scene, 3, 3, INTEGRATOR_WHITTED, "both");
+            const float *c = rgb + 3 * 4;
+            fprintf(stderr, "  specular 0.5 sphere (%s%s), %s camera: centre pixel %.4f %.4f %.4f\n", blocks[b],
+                    b == 2 ? ", 2004 keys" : "", sized ? "Tsinghua" : "MIT", (double)c[0], (double)c[1], (double)c[2]);
+            double k = sized || b == 2 ? 0.0 : 0.5;
+            CHECK_NEAR(c[0], 0.2 * k, 1e-6);
+            CHECK_NEAR(c[1], 0.4 * k, 1e-6);
+            CHECK_NEAR(c[2], 0.8 * k, 1e-6);
+            free(rgb);
+        }
 }
 
 /* Fall 2019's meshes without `vn` get smooth normals: a two-triangle tent whose faces

@@ -88,6 +88,8 @@ typedef struct {
     int seen_camera, seen_lights, seen_background, seen_materials;
     int ambient_given;
     int camera_sized;      /* the camera gave width/height: Tsinghua's dialect */
+    int keys_2004;         /* a material gave a key only MIT 2004 has (reflectiveColor,
+                            * transparentColor, indexOfRefraction, exponent) */
     size_t tessellated;        /* triangles made from spheres so far */
     uint depth;                /* Group and Transform blocks open around the reader */
 } Classic;
@@ -540,10 +542,7 @@ static Status parse_phong(Classic *c, const Token *kw)
                                 v[M_SPECULAR].given ? v[M_SPECULAR].v : v3s(0.0f),
                                 v[M_SHININESS].given ? v[M_SHININESS].f : (v[M_EXPONENT].given ? v[M_EXPONENT].f : 0.0f));
     if (v[M_REFLECTIVE].given) m.reflective = v[M_REFLECTIVE].v;
-    /* MIT 6.837 Fall 2019 (whose materials are `Material` blocks without reflectiveColor)
-     * adds k_specular x the mirror ray's light when bounces > 0; Tsinghua's PA1 (also
-     * `Material`, with a sized camera) is a ray caster and reflects nothing */
-    else if (tok_is(kw, "Material") && v[M_SPECULAR].given && !c->camera_sized) m.reflective = v[M_SPECULAR].v;
+    c->keys_2004 |= v[M_REFLECTIVE].given || v[M_TRANSPARENT].given || v[M_IOR].given || v[M_EXPONENT].given;
     if (v[M_TRANSPARENT].given) m.transparent = v[M_TRANSPARENT].v;
     if (v[M_IOR].given) m.ior = v[M_IOR].f;
     if (v[M_TEXTURE].given) {
@@ -612,6 +611,21 @@ static Status parse_checkerboard(Classic *c, const Token *kw)
     return add_material(c, a);
 }
 
+/* MIT 6.837 Fall 2019's ray tracer adds k_specular x the mirror ray's light when
+ * bounces > 0, for its `Material` and `PhongMaterial` blocks alike (scene07_arch's
+ * floor is a PhongMaterial of specularColor 0.4). MIT 2004's PhongMaterial mirrors only
+ * with reflectiveColor, and Tsinghua's PA1 (a sized camera) is a ray caster that
+ * reflects nothing. So once the Materials block is read, a scene in neither dialect
+ * gets its specular colours as mirrors. */
+static void mirror_specular_colours(Classic *c)
+{
+    if (c->camera_sized || c->keys_2004) return;
+    for (uint i = c->first_material; i < c->first_material + c->n_materials; i++) {
+        Material *m = &c->s->materials[i];
+        if (m->type == MAT_PHONG) m->reflective = m->specular;
+    }
+}
+
 static Status parse_materials(Classic *c, const Token *kw)
 {
     if (c->seen_materials) return lex_error_at(&c->lx, kw, c->err, "a second Materials block");
@@ -622,7 +636,10 @@ static Status parse_materials(Classic *c, const Token *kw)
     for (unsigned long long i = 0;; i++) {
         Token t;
         if ((st = next(c, &t))) return st;
-        if (t.kind == TOK_RBRACE && i == n) return ST_OK;
+        if (t.kind == TOK_RBRACE && i == n) {
+            mirror_specular_colours(c);
+            return ST_OK;
+        }
         if (t.kind == TOK_EOF)
             return lex_error_at(&c->lx, &t, c->err, "expected '}' to close the Materials block opened at line %u, "
                                 "found end of file", kw->line);

@@ -864,6 +864,24 @@ static Status mpi_options(const Options *o, Dist *dist, Error *err)
     return ST_OK;
 }
 
+/* Under an MPI launcher: joins the job also after a failed command line (st), and all
+ * ranks agree on what to do (dist_start), so that a rank that cannot start, or that was
+ * given another command (an MPMD job), ends the job with rank 0's message instead of
+ * leaving the others waiting. */
+static Status mpi_join(const Options *o, Status st, Dist *dist, Error *err)
+{
+    Error init_err = { 0 };
+    Status joined = dist_init(dist, st == ST_OK ? o->mpi_timeout : 0.0, &init_err);
+    if (joined != ST_OK) {
+        error_clear(err);
+        *err = init_err;
+        return joined;
+    }
+    if (st == ST_OK && dist->active) st = mpi_options(o, dist, err);
+    DistPlan plan = o->help ? DIST_HELP : o->version ? DIST_VERSION : o->list_devices ? DIST_LIST_DEVICES : DIST_RENDER;
+    return dist_start(dist, plan, st == ST_OK && o->mpi_broadcast, st, err);
+}
+
 /* --mpi-broadcast: rank 0's prepared scene becomes every worker's. */
 static Status mpi_share_scene(Run *r, Dist *dist, Status st, Error *err)
 {
@@ -937,10 +955,9 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
     r.t_start = timer_now();
     int done = 0;
     Status st = options_parse(argc, argv, &r.o, err);
-    if (st == ST_OK && dist->active) st = mpi_options(&r.o, dist, err);
-    /* every rank has the same command line: rank 0 says what is wrong with it */
-    if (st != ST_OK && dist->rank > 0) return ST_INTERRUPTED;
-    if (st == ST_OK && dist->rank == 0) st = run_info_command(&r.o, &done, err);
+    if (dist_launched()) st = mpi_join(&r.o, st, dist, err);
+    if (st != ST_OK) return st;
+    if (dist->rank == 0) st = run_info_command(&r.o, &done, err);
     if (st != ST_OK || done || r.o.help || r.o.version || r.o.list_devices) return st;
 
     if (dist->active) {
@@ -1015,13 +1032,14 @@ int main(int argc, char **argv)
     if (argc > 1 && strcmp(argv[1], "merge") == 0) return (int)main_report(merge_command(argc - 1, argv + 1, &err), &err);
     /* under mpirun or srun, this process is one rank of a job (dist/mpi_driver.h) */
     Dist dist;
-    Status st = dist_init(&dist, &argc, &argv, &err);
-    if (st == ST_OK) st = run(argc, argv, &dist, &err);
+    memset(&dist, 0, sizeof dist);
+    Status st = run(argc, argv, &dist, &err);
     if (dist.active && dist.rank > 0) {
         /* a worker's own failures only; ST_INTERRUPTED is a stop rank 0 reports */
         if (st != ST_OK && st != ST_INTERRUPTED) fprintf(stderr, "clpt: MPI rank %d: error: %s\n", dist.rank, err.msg);
         error_clear(&err);
-        dist_finish(&dist, 0, 0);
+        /* a worker that lost rank 0 at the start ends the job: nobody else would */
+        dist_finish(&dist, (int)st, dist.lost);
         return 0;
     }
     st = main_report(st, &err);

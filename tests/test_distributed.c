@@ -316,6 +316,68 @@ static void test_mpi_ranks_with_other_settings_are_refused(void)
     CHECK(!file_exists(in_dir("refused.pfm")));
 }
 
+/* Every start-up failure on one rank ends the whole job with rank 0's message, in
+ * bounded time: these hung for ever when one rank of an MPMD job stopped before the
+ * render (its own usage error, --help, --aov) or never joined MPI at all. `timeout`
+ * turns a hang into a failed check instead of a stuck suite. */
+#define BOUNDED "timeout", "60"
+
+static void expect_start_refused(const char *const *args, int status, const char *message)
+{
+    spawn_run(args, &r);
+    CHECK_MSG(r.status == status, "status %d, stderr: %s", r.status, r.err);
+    CHECK_STR_CONTAINS(r.err, message);
+    CHECK(!file_exists(in_dir("refused.pfm")));
+}
+
+static void test_mpi_a_rank_that_cannot_start_ends_the_job(void)
+{
+    expect_start_refused(ARGS(BOUNDED, MPIRUN, "-np", "1", CLI_PROGRAM, RENDER, "-o", in_dir("refused.pfm"), ":",
+                              "-np", "1", CLI_PROGRAM, RENDER, "--bogus", "-o", in_dir("refused.pfm")), 2,
+                         "clpt: error: MPI rank 1 could not start: unknown option '--bogus' (see --help)\n");
+    expect_start_refused(ARGS(BOUNDED, MPIRUN, "-np", "1", CLI_PROGRAM, RENDER, "-o", in_dir("refused.pfm"), ":",
+                              "-np", "1", CLI_PROGRAM, RENDER, "--aov", "normal", "-o", in_dir("refused.pfm")), 2,
+                         "clpt: error: MPI rank 1 could not start: --adaptive and --aov are not available under MPI "
+                         "(run them in one process)\n");
+    /* the failing rank may be rank 0 too; every rank of the three then stops */
+    expect_start_refused(ARGS(BOUNDED, MPIRUN, "-np", "1", CLI_PROGRAM, RENDER, "--spp", "x", "-o",
+                              in_dir("refused.pfm"), ":", "-np", "2", CLI_PROGRAM, RENDER, "-o", in_dir("refused.pfm")),
+                         2, "clpt: error: --spp expects");
+}
+
+static void test_mpi_ranks_given_different_commands_are_refused(void)
+{
+    expect_start_refused(ARGS(BOUNDED, MPIRUN, "-np", "1", CLI_PROGRAM, RENDER, "-o", in_dir("refused.pfm"), ":",
+                              "-np", "1", CLI_PROGRAM, "--help"), 2,
+                         "clpt: error: MPI ranks 0 and 1 were given different commands (rank 0: a render without "
+                         "--mpi-broadcast; rank 1: --help): every rank of a job must run the same command, only the "
+                         "device flags may differ\n");
+    expect_start_refused(ARGS(BOUNDED, MPIRUN, "-np", "1", CLI_PROGRAM, "--version", ":", "-np", "1", CLI_PROGRAM,
+                              RENDER, "-o", in_dir("refused.pfm")), 2,
+                         "clpt: error: MPI ranks 0 and 1 were given different commands (rank 0: --version; rank 1: a "
+                         "render without --mpi-broadcast)");
+    /* a rank without --mpi-broadcast would wait for a scene that is never sent */
+    expect_start_refused(ARGS(BOUNDED, MPIRUN, "-np", "2", CLI_PROGRAM, RENDER, "--mpi-broadcast", "-o",
+                              in_dir("refused.pfm"), ":", "-np", "1", CLI_PROGRAM, RENDER, "-o", in_dir("refused.pfm")),
+                         2, "clpt: error: MPI ranks 0 and 2 were given different commands (rank 0: a render with "
+                            "--mpi-broadcast; rank 2: a render without --mpi-broadcast)");
+    /* the same command on every rank is fine: rank 0 alone prints */
+    spawn_run(ARGS(BOUNDED, MPIRUN, "-np", "2", CLI_PROGRAM, "--version"), &r);
+    CHECK_EQ_INT(r.status, 0);
+    CHECK(strncmp(r.out, "clpt ", 5) == 0 && strchr(r.out, '\n') == r.out + strlen(r.out) - 1);
+}
+
+/* A process of the job that never joins MPI (here `true`, which ends at once with status
+ * 0) held the others in MPI_Init for ever: they now give up after --mpi-timeout. */
+static void test_mpi_a_process_that_never_joins_ends_the_job(void)
+{
+    expect_start_refused(ARGS(BOUNDED, MPIRUN, "-np", "1", CLI_PROGRAM, RENDER, "--mpi-timeout", "2", "-o",
+                              in_dir("refused.pfm"), ":", "-np", "1", "true"), 5,
+                         "clpt: MPI rank 0: error: the MPI job did not start within 2 s: a process of the job never "
+                         "joined it (in an MPMD job, one that is not a clpt render, or that ended first), or the "
+                         "launcher hangs; see --mpi-timeout\n");
+}
+
 /* A longer render, so that a rank can be killed in it: 1440 spp of 24 x 18 pixels is 0.6
  * million samples, several seconds for three ranks on two cores (at 360 spp a loaded
  * machine sometimes saw the whole render done before the kill landed). */
@@ -436,6 +498,9 @@ int main(void)
     if (have_mpirun()) {
         RUN(test_mpi_two_and_three_ranks_are_bit_identical);
         RUN(test_mpi_ranks_with_other_settings_are_refused);
+        RUN(test_mpi_a_rank_that_cannot_start_ends_the_job);
+        RUN(test_mpi_ranks_given_different_commands_are_refused);
+        RUN(test_mpi_a_process_that_never_joins_ends_the_job);
         RUN(test_mpi_ranks_on_a_mix_of_devices);
         RUN(test_mpi_killed_rank_then_resume);
         RUN(test_mpi_recovery_goes_on_without_the_dead_rank);

@@ -1,6 +1,7 @@
 /* mpi_driver.c — see mpi_driver.h; the messages are listed in docs/distributed.md. */
 #include "dist/mpi_driver.h"
 
+#include <errno.h>
 #include <mpi.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -21,7 +22,9 @@ enum {
     TAG_RESULT,        /* w -> 0: WireResult; TAG_FILM follows when its status is ST_OK */
     TAG_FILM,          /* w -> 0: int64 film sums, width * height * 3 */
     TAG_STATS,         /* w -> 0: WireStats: the worker's devices, at the end */
-    TAG_ALIVE          /* w -> 0: empty, every second: the worker is alive */
+    TAG_ALIVE,         /* w -> 0: empty, every second: the worker is alive */
+    TAG_START,         /* w -> 0: WireStart: what the worker's command line asks for */
+    TAG_GO             /* 0 -> w: int32: 1 when every rank may go on with the render */
 };
 
 #define ALIVE_SECONDS 1.0
@@ -54,6 +57,14 @@ typedef struct {
     uint32_t pad;
     WireDevice dev[MAX_WORKER_DEVICES];
 } WireStats;
+
+typedef struct {
+    int32_t plan;              /* DistPlan */
+    int32_t status;            /* DIST_FAILED: the failure's Status */
+    int32_t broadcast;         /* --mpi-broadcast */
+    int32_t pad;
+    char msg[1024];            /* DIST_FAILED: the failure's message */
+} WireStart;
 
 typedef struct {
     int32_t status;
@@ -183,20 +194,81 @@ static Status wire_wait(Dist *d, int from, int want, void *buf, size_t bytes, co
 /* An MPI launcher starts each process with these in its environment: Open MPI's
  * mpirun with OMPI_COMM_WORLD_SIZE, srun and other PMI launchers with PMIX_RANK or
  * PMI_RANK. */
-static int launched_by_mpi(void)
+int dist_launched(void)
 {
     const char *size = getenv("OMPI_COMM_WORLD_SIZE");
     if (size) return strcmp(size, "1") != 0;
     return getenv("PMIX_RANK") || getenv("PMI_RANK");
 }
 
-Status dist_init(Dist *d, int *argc, char ***argv, Error *err)
+/* This process's rank as the launcher gave it, for a message written before MPI knows. */
+static const char *launcher_rank(void)
+{
+    const char *names[] = { "OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK" };
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (getenv(names[i])) return getenv(names[i]);
+    return "?";
+}
+
+typedef struct {
+    pthread_mutex_t lock;
+    pthread_cond_t wake;
+    int started;               /* MPI_Init_thread returned */
+    double timeout;
+} InitWatch;
+
+/* MPI_Init_thread waits for every process of the job to join it, and a process that
+ * ended without joining (in an MPMD job, a program that is not a clpt render, or
+ * `clpt merge`, ending with status 0) leaves it waiting for ever. So a second thread
+ * ends this process after the timeout, with a message and a non-zero status, which
+ * makes the launcher end the whole job. */
+static void *init_watch_main(void *arg)
+{
+    InitWatch *w = arg;
+    struct timespec until;
+    clock_gettime(CLOCK_REALTIME, &until);
+    double whole = (double)(time_t)w->timeout;
+    until.tv_sec += (time_t)whole;
+    until.tv_nsec += (long)((w->timeout - whole) * 1e9);
+    if (until.tv_nsec >= 1000000000L) {
+        until.tv_sec++;
+        until.tv_nsec -= 1000000000L;
+    }
+    pthread_mutex_lock(&w->lock);
+    int rc = 0;
+    while (!w->started && rc != ETIMEDOUT) rc = pthread_cond_timedwait(&w->wake, &w->lock, &until);
+    if (!w->started) {
+        fprintf(stderr, "clpt: MPI rank %s: error: the MPI job did not start within %g s: a process of the job never "
+                "joined it (in an MPMD job, one that is not a clpt render, or that ended first), or the launcher "
+                "hangs; see --mpi-timeout\n", launcher_rank(), w->timeout);
+        _exit(ST_DEVICE);
+    }
+    pthread_mutex_unlock(&w->lock);
+    return NULL;
+}
+
+/* MPI_Init_thread, given up after `timeout` seconds (init_watch_main). */
+static int init_watched(double timeout, int *provided)
+{
+    InitWatch w = { PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER, 0, timeout };
+    pthread_t watcher;
+    int watching = pthread_create(&watcher, NULL, init_watch_main, &w) == 0;
+    int rc = MPI_Init_thread(NULL, NULL, MPI_THREAD_SERIALIZED, provided);
+    pthread_mutex_lock(&w.lock);
+    w.started = 1;
+    pthread_cond_signal(&w.wake);
+    pthread_mutex_unlock(&w.lock);
+    if (watching) pthread_join(watcher, NULL);
+    return rc;
+}
+
+Status dist_init(Dist *d, double timeout, Error *err)
 {
     memset(d, 0, sizeof *d);
-    d->timeout = 30.0;
-    if (!launched_by_mpi()) return ST_OK;
+    d->timeout = timeout > 0.0 ? timeout : 30.0;
+    if (!dist_launched()) return ST_OK;
     int provided = 0;
-    if (MPI_Init_thread(argc, argv, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS)
+    if (init_watched(d->timeout, &provided) != MPI_SUCCESS)
         return error_set(err, ST_INTERNAL, "cannot start MPI (MPI_Init_thread failed)");
     /* MPI's default handler, MPI_ERRORS_ARE_FATAL, would end every process at the first
      * failed call without a word from clpt: errors are returned and handled instead. */
@@ -235,6 +307,89 @@ void dist_finish(Dist *d, int exit_status, int abort)
     }
     for (int i = 0; i < SCENE_BUF_COUNT; i++) free(d->scene_bufs[i]);
     memset(d, 0, sizeof *d);
+}
+
+/* ------------------------------------------------------------------ agreeing on the command */
+
+/* What a rank's plan is, in words, for the message that two ranks differ. */
+static const char *plan_name(int32_t plan, int32_t broadcast)
+{
+    switch (plan) {
+    case DIST_RENDER: return broadcast ? "a render with --mpi-broadcast" : "a render without --mpi-broadcast";
+    case DIST_HELP: return "--help";
+    case DIST_VERSION: return "--version";
+    case DIST_LIST_DEVICES: return "--list-devices";
+    default: return "a failed start";
+    }
+}
+
+/* Rank 0: waits for each worker's WireStart and judges them against its own; returns
+ * ST_OK when every rank may go on. Its own failure comes first (err already holds it). */
+static Status start_judge(Dist *d, const WireStart *mine, Status st, Error *err)
+{
+    Status out = st;
+    for (int r = 1; r < d->size; r++) {
+        WireStart w;
+        Error e = { 0 };
+        Status got = wire_wait(d, r, TAG_START, &w, sizeof w, NULL, &e);
+        if (got != ST_OK) {
+            /* a rank that says nothing will not leave MPI_Finalize either */
+            d->lost = 1;
+            if (out == ST_OK) out = error_set(err, got, "starting the MPI job: %s", e.msg);
+            error_clear(&e);
+            continue;
+        }
+        w.msg[sizeof w.msg - 1] = '\0';
+        if (out != ST_OK) continue;
+        if (w.plan == DIST_FAILED)
+            out = error_set(err, w.status != ST_OK ? (Status)w.status : ST_INTERNAL, "MPI rank %d could not start: %s",
+                            r, w.msg);
+        else if (w.plan != mine->plan || (w.plan == DIST_RENDER && !w.broadcast != !mine->broadcast))
+            out = error_set(err, ST_USAGE, "MPI ranks 0 and %d were given different commands (rank 0: %s; rank %d: "
+                            "%s): every rank of a job must run the same command, only the device flags may differ",
+                            r, plan_name(mine->plan, mine->broadcast), r, plan_name(w.plan, w.broadcast));
+    }
+    return out;
+}
+
+Status dist_start(Dist *d, DistPlan plan, int broadcast, Status st, Error *err)
+{
+    if (!d->active) return st;
+    WireStart mine;
+    memset(&mine, 0, sizeof mine);
+    mine.plan = st == ST_OK ? plan : DIST_FAILED;
+    mine.status = st;
+    mine.broadcast = broadcast;
+    if (st != ST_OK) snprintf(mine.msg, sizeof mine.msg, "%s", err->msg);
+    if (d->rank == 0) {
+        Status out = start_judge(d, &mine, st, err);
+        int32_t go = out == ST_OK;
+        for (int r = 1; r < d->size; r++) {
+            int rc = wire_send(d, &go, 1, MPI_INT32_T, r, TAG_GO);
+            if (rc != MPI_SUCCESS && out == ST_OK) out = mpi_failed(err, rc, r, "starting the MPI job");
+        }
+        return out;
+    }
+    int rc = wire_send(d, &mine, (int)sizeof mine, MPI_BYTE, 0, TAG_START);
+    if (rc != MPI_SUCCESS) {
+        d->lost = 1;
+        return mpi_failed(err, rc, 0, "starting the MPI job");
+    }
+    /* rank 0 may wait d->timeout for another rank before it answers */
+    int32_t go = 0;
+    Error e = { 0 };
+    double timeout = d->timeout;
+    d->timeout = 2.0 * timeout + 1.0;
+    Status got = wire_wait(d, 0, TAG_GO, &go, sizeof go, NULL, &e);
+    d->timeout = timeout;
+    if (got != ST_OK) {
+        d->lost = 1;
+        if (st == ST_OK) st = error_set(err, got, "starting the MPI job: %s", e.msg);
+        error_clear(&e);
+        return st;
+    }
+    /* rank 0 reports every failure, this rank's own too */
+    return go ? ST_OK : ST_INTERRUPTED;
 }
 
 /* ------------------------------------------------------------------ the scene */

@@ -44,9 +44,27 @@ typedef struct {
     void *scene_bufs[SCENE_BUF_COUNT];   /* a broadcast scene, on the workers; owned */
 } Dist;
 
+/* Whether an MPI launcher started this process in a job of more than one rank. */
+int dist_launched(void);
+
 /* Joins the MPI job when launched by an MPI launcher (else leaves *d inactive, at no
- * cost). ST_INTERNAL when MPI cannot start. */
-Status dist_init(Dist *d, int *argc, char ***argv, Error *err);
+ * cost). Called after the command line is read, also when reading it failed, so that
+ * every rank joins and the others hear of the failure (dist_start). A job that has not
+ * started within `timeout` seconds (0: 30) ends this process with a message and status
+ * ST_DEVICE (a process of the job never joined). ST_INTERNAL when MPI cannot start. */
+Status dist_init(Dist *d, double timeout, Error *err);
+
+/* What a rank's command line asks for. */
+typedef enum { DIST_RENDER, DIST_HELP, DIST_VERSION, DIST_LIST_DEVICES, DIST_FAILED } DistPlan;
+
+/* Right after dist_init: every rank tells rank 0 its plan (or its failure, st with the
+ * message in err), and whether it has --mpi-broadcast; rank 0 answers each whether to
+ * go on. Rank 0 fails with its own failure, else with the first worker's failure or
+ * the first worker whose plan differs from its own (named); a worker then returns
+ * ST_INTERRUPTED, quietly. Every wait is bounded by d->timeout; a rank that does not
+ * answer sets d->lost (the job must be aborted, not finalised). */
+Status dist_start(Dist *d, DistPlan plan, int broadcast, Status st, Error *err);
+
 /* Leaves the job (MPI_Finalize), or ends it for every rank (MPI_Abort) when `abort`:
  * after a rank stopped answering, a finalize could wait for it for ever. */
 void dist_finish(Dist *d, int exit_status, int abort);

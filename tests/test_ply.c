@@ -193,6 +193,13 @@ static void test_bad_header(void)
                      "t.ply:7:1: expected a header line (format, element, property, comment, obj_info, "
                      "end_header), found 'bogus'");
     check_text_error(HDR, "t.ply:7:1: the header ends without 'end_header'");
+    /* a repeated name was accepted, the second 'x' silently ignored */
+    check_text_error(HDR "property float x\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n",
+                     "t.ply:7:16: a second property 'x' in element 'vertex' (the first is on line 4); a name may "
+                     "come once in an element");
+    check_text_error(HDR "element face 1\nproperty list uchar int vertex_indices\nproperty uchar vertex_indices\n"
+                     "end_header\n", "t.ply:9:16: a second property 'vertex_indices' in element 'face' (the first is "
+                     "on line 8)");
 }
 
 static void test_bad_ascii_data(void)
@@ -378,7 +385,10 @@ static double parse_many(int n, int many_props)
         }
     put(&text, &len, &cap, "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n");
     if (many_props)
-        for (int i = 0; i < n; i++) put(&text, &len, &cap, "property float x\n");
+        for (int i = 0; i < n; i++) {
+            snprintf(line, sizeof line, "property float a%d\n", i);
+            put(&text, &len, &cap, line);
+        }
     put(&text, &len, &cap, "element face 1\nproperty list uchar int vertex_indices\nend_header\n");
     for (int v = 0; v < 3; v++) {
         put(&text, &len, &cap, v == 0 ? "0 0 0" : v == 1 ? "1 0 0" : "0 1 0");

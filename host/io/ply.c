@@ -13,6 +13,8 @@
  */
 #include "io/ply.h"
 
+#include "base/strmap.h"
+
 #include "kmath.h"
 #include "io/lexer.h"
 #include "io/mesh_text.h"
@@ -57,6 +59,7 @@ typedef struct {
     int is_list;
     PlyType count_type, type;
     int role;
+    uint line;                    /* of its header line */
 } PlyProp;
 
 typedef struct {
@@ -66,6 +69,7 @@ typedef struct {
     const char *line_at;          /* the start of that line */
     PlyProp *props;  size_t n_props, cap_props;
     unsigned roles_taken;         /* bit R_*: a property has that role */
+    StrMap prop_names;            /* property name -> its index: a name may come once */
     int kind;
 } PlyElement;
 
@@ -228,6 +232,18 @@ static Status add_property(PlyReader *r, const Words *w, const char *line)
                              w->n > at + 2 ? "end of line after the property name" : "a property name");
     p.name = w->t[at + 1];
     p.name_len = w->len[at + 1];
+    p.line = r->line;
+    /* a second 'x' would be read into the first one's place, or ignored, silently:
+     * which of the two the file meant is unknowable */
+    int seen = strmap_add(&e->prop_names, p.name, p.name_len, (uint32_t)e->n_props);
+    if (seen < 0) return out_of_memory(r);
+    if (seen > 0) {
+        uint32_t first = 0;
+        strmap_find(&e->prop_names, p.name, p.name_len, &first);
+        return fail(r, p.name, 1, "a second property '%.*s' in element '%.*s' (the first is on line %u); a name "
+                    "may come once in an element", (int)p.name_len, p.name, (int)e->name_len, e->name,
+                    e->props[first].line);
+    }
     Words name = { { p.name }, { p.name_len }, 1 };
     if (e->kind == EL_VERTEX && !p.is_list) {
         for (size_t k = 0; k < sizeof vertex_roles / sizeof vertex_roles[0]; k++)
@@ -631,7 +647,10 @@ Status ply_parse(const char *path, const char *data, size_t len, Scene *s, const
         if (r.p < r.end) st = fail_expected(&r, r.p, 0, "the end of the file after the last element");
     }
     if (!st) st = emit_triangles(&r, s, o);
-    for (size_t i = 0; i < r.n_el; i++) free(r.el[i].props);
+    for (size_t i = 0; i < r.n_el; i++) {
+        free(r.el[i].props);
+        strmap_free(&r.el[i].prop_names);
+    }
     free(r.el);
     free(r.pos);
     free(r.nrm);

@@ -654,6 +654,7 @@ static Status load_scene_input(const Options *o, Scene *scene, int *bare_mesh, E
         return error_set(err, ST_USAGE, "--camera picks a glTF file's camera; '%s' is not a .gltf or .glb file",
                          o->scene_path);
     scene->gltf_camera = o->camera;
+    scene->size_overridden = o->width >= 0 || o->height >= 0;
     Status st = scene_load_file(o->scene_path, (SceneFormat)o->format, scene, &kind, err);
     *bare_mesh = st == ST_OK && kind == SCENE_KIND_MESH;
     if (st == ST_OK)
@@ -667,8 +668,12 @@ static Status scene_apply_options(Run *r, Error *err)
     const Options *o = &r->o;
     Status st;
     apply_overrides(o, &r->scene);
-    if ((o->width >= 0 || o->height >= 0) &&
-        (st = limit_pixels(r->scene.image.width, r->scene.image.height, ST_USAGE, "--width/--height", err)))
+    /* the size rendered, whichever reader or flag set it (a pbrt Film's sides are
+     * checked one by one, and an image block's product is left to this check when a
+     * flag replaces its size) */
+    int flags = o->width >= 0 || o->height >= 0;
+    if ((st = limit_pixels(r->scene.image.width, r->scene.image.height, flags ? ST_USAGE : ST_INPUT,
+                           flags ? "--width/--height" : o->scene_path, err)))
         return st;
     /* a mesh file given in place of a scene is shown by a camera that frames it */
     if (r->bare_mesh && (st = mesh_view_fit(&r->scene, err))) return st;

@@ -47,6 +47,31 @@ static void test_2_usage(void)
     CHECK(!file_exists("/tmp/clpt-never.png"));
 }
 
+/* A scene's image too large to render is checked after --width and --height, which
+ * can make it small: the parse refused it before the flags were looked at. */
+static void test_flags_rescue_a_large_scene_image(void)
+{
+    const char *out = "/tmp/clpt-test-rescued.png";
+    unlink(out);
+    cli_run(ARGS("tests/data/huge-image.scene", "--device", "scalar", "--threads", "1", "-q", "--width", "64",
+                 "--height", "48", "-o", out), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(file_exists(out));
+    unlink(out);
+    /* one flag leaves the other side too large */
+    cli_run(ARGS("tests/data/huge-image.scene", "--device", "scalar", "--width", "64", "-o", out), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --width/--height: an image of 64x100000 pixels is larger than clpt "
+                              "renders (at most 134217728 pixels, as in 16384x8192, and 16384 on each side)\n");
+    /* no flag: the file's own size, at its place */
+    cli_run(ARGS("tests/data/huge-image.scene", "--device", "scalar", "-o", out), &r);
+    CHECK_EQ_INT(r.status, 3);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: tests/data/huge-image.scene:3:22: an image of 100000x100000 pixels is "
+                              "larger than clpt renders (at most 134217728 pixels, as in 16384x8192, and 16384 on "
+                              "each side); --width and --height render it smaller\n");
+    CHECK(!file_exists(out));
+}
+
 static void test_3_input(void)
 {
     cli_run(ARGS("tests/data/bad/zero-radius.scene", "-o", "/tmp/clpt-never.png"), &r);
@@ -138,6 +163,7 @@ int main(void)
     RUN(test_0_success);
     RUN(test_1_internal);
     RUN(test_2_usage);
+    RUN(test_flags_rescue_a_large_scene_image);
     RUN(test_3_input);
     RUN(test_4_io);
     RUN(test_5_device);

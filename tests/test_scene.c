@@ -557,10 +557,11 @@ static void test_bad_syntax(void)
 
 static void test_bad_values(void)
 {
-    check_bad("image { width 0 }", ST_INPUT, ":1:15: expected an integer in 1..16384 for 'width', found '0'");
-    check_bad("image { height 16385 }", ST_INPUT, ":1:16: expected an integer in 1..16384 for 'height'");
+    check_bad("image { width 0 }", ST_INPUT, ":1:15: expected an integer in 1..1048576 for 'width', found '0'");
+    check_bad("image { height 16385 }", ST_INPUT, ":1:9: an image of 512x16385 pixels is larger than clpt renders");
+    check_bad("image { height 1048577 }", ST_INPUT, ":1:16: expected an integer in 1..1048576 for 'height'");
     check_bad("image { width 99999999999999999999999 }", ST_INPUT,
-              ":1:15: expected an integer in 1..16384 for 'width', found '99999999999999999999999'");
+              ":1:15: expected an integer in 1..1048576 for 'width', found '99999999999999999999999'");
     check_bad("image { depth 1025 }", ST_INPUT, ":1:15: expected an integer in 0..1024 for 'depth'");
     check_bad("image { split 0 }", ST_INPUT, ":1:15: expected an integer in 1..64 for 'split', found '0'");
     check_bad("image { split 65 }", ST_INPUT, ":1:15: expected an integer in 1..64 for 'split', found '65'");

@@ -14,6 +14,11 @@
 
 /* Image width and height, each. */
 #define CLPT_MAX_IMAGE_SIDE 16384
+/* Width or height an `image` block may ask for. The size rendered is checked against
+ * CLPT_MAX_IMAGE_SIDE and CLPT_MAX_PIXELS after --width/--height, which may make a large
+ * scene image small; this bound only keeps absurd numbers out of the parse (nothing is
+ * allocated from the scene's size before the final check). */
+#define CLPT_MAX_SCENE_IMAGE_SIDE 1048576
 /* Pixels in an image (16384 x 8192): the host film alone is 24 bytes a pixel, and every
  * device and scheduling worker holds another film of the same size. */
 #define CLPT_MAX_PIXELS (16384u * 8192u)

@@ -385,10 +385,10 @@ static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
 
 enum { IMG_WIDTH, IMG_HEIGHT, IMG_SPP, IMG_DEPTH, IMG_SEED, IMG_SHADOWS, IMG_SAMPLER, IMG_SPLIT, IMG_N };
 static const KeySpec image_keys[IMG_N] = {
-    [IMG_WIDTH] = {"width", VK_UINT, 0, 1, CLPT_MAX_IMAGE_SIDE, 0, 0,
-                   "an integer in 1.." CLPT_STR(CLPT_MAX_IMAGE_SIDE)},
-    [IMG_HEIGHT] = {"height", VK_UINT, 0, 1, CLPT_MAX_IMAGE_SIDE, 0, 0,
-                    "an integer in 1.." CLPT_STR(CLPT_MAX_IMAGE_SIDE)},
+    [IMG_WIDTH] = {"width", VK_UINT, 0, 1, CLPT_MAX_SCENE_IMAGE_SIDE, 0, 0,
+                   "an integer in 1.." CLPT_STR(CLPT_MAX_SCENE_IMAGE_SIDE)},
+    [IMG_HEIGHT] = {"height", VK_UINT, 0, 1, CLPT_MAX_SCENE_IMAGE_SIDE, 0, 0,
+                    "an integer in 1.." CLPT_STR(CLPT_MAX_SCENE_IMAGE_SIDE)},
     [IMG_SPP] = {"spp", VK_UINT, 0, 1, CLPT_MAX_SPP, 0, 0, "an integer in 1.." CLPT_STR(CLPT_MAX_SPP)},
     [IMG_DEPTH] = {"depth", VK_UINT, 0, 0, CLPT_MAX_DEPTH, 0, 0, "an integer in 0.." CLPT_STR(CLPT_MAX_DEPTH)},
     [IMG_SEED] = {"seed", VK_UINT, 0, 0, 4294967295.0, 0, 0, "an integer in 0..4294967295"},
@@ -421,11 +421,14 @@ static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
             return lex_expected(lx, w, image_keys[IMG_SAMPLER].what, p->err);
         im->sampler = tok_is(w, "sobol") ? SAMPLER_SOBOL : SAMPLER_INDEPENDENT;
     }
-    if (limit_pixels(im->width, im->height, ST_INPUT, "", NULL) != ST_OK) {
+    /* a size the command line replaces is checked after it (host/main.c): --width 64
+     * --height 64 renders a scene whose own image is too large */
+    if (!p->s->size_overridden && limit_pixels(im->width, im->height, ST_INPUT, "", NULL) != ST_OK) {
         const Token *t = v[IMG_HEIGHT].given ? &v[IMG_HEIGHT].key : &v[IMG_WIDTH].key;
         return lex_error_at(lx, t, p->err,
-                            "an image of %ux%u pixels is larger than clpt renders (at most %u "
-                            "pixels, as in 16384x8192)", im->width, im->height, CLPT_MAX_PIXELS);
+                            "an image of %ux%u pixels is larger than clpt renders (at most %u pixels, as in "
+                            "16384x8192, and %d on each side); --width and --height render it smaller",
+                            im->width, im->height, CLPT_MAX_PIXELS, CLPT_MAX_IMAGE_SIDE);
     }
     return ST_OK;
 }

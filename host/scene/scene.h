@@ -41,6 +41,9 @@ typedef struct {
 
 typedef struct {
     char *path;                  /* scene file as given on the command line */
+    int size_overridden;         /* in: --width or --height replaces the file's size, so
+                                  * the file's own is not checked against the limits
+                                  * (the size rendered is, host/main.c) */
     const char *gltf_camera;     /* in: the glTF camera to look through (--camera), by
                                   * index or name; NULL: the file's first */
     SceneCamera camera;

@@ -87,10 +87,17 @@ static int env_set(const char *name)
     return v && *v;
 }
 
-/* SDL falls back to its "offscreen" driver when no display answers: a window nobody
- * can see. Only a driver asked for by name (SDL_VIDEODRIVER) may be one without a
- * screen; with neither an X nor a Wayland display named, SDL is not even asked (it
- * would print Wayland's complaints, then pick "offscreen"). */
+/* Whether SDL's video driver draws into memory only: a window nobody can see, and an
+ * interactive session nobody can use (it would render and wait for keys for ever). */
+static int driver_shows_nothing(const char *driver)
+{
+    return SDL_strcasecmp(driver, "offscreen") == 0 || SDL_strcasecmp(driver, "dummy") == 0;
+}
+
+/* SDL falls back to its "offscreen" driver when no display answers, and SDL_VIDEODRIVER
+ * may name "dummy" or "offscreen" itself: either way a window nobody can see, which is
+ * refused like no display. With neither an X nor a Wayland display nor a driver named,
+ * SDL is not even asked (it would print Wayland's complaints, then pick "offscreen"). */
 Status viewer_open_display(Error *err)
 {
     int named = env_set("SDL_VIDEODRIVER");
@@ -103,16 +110,22 @@ Status viewer_open_display(Error *err)
         snprintf(sdl_msg, sizeof sdl_msg, ": %s", SDL_GetError());
     } else {
         const char *driver = SDL_GetCurrentVideoDriver();
-        if (named || !driver || (strcmp(driver, "offscreen") != 0 && strcmp(driver, "dummy") != 0)) return ST_OK;
+        if (!driver || !driver_shows_nothing(driver)) return ST_OK;
+        if (named) {
+            snprintf(sdl_msg, sizeof sdl_msg, "SDL_VIDEODRIVER is '%.100s', and SDL's '%.40s' video driver shows no "
+                     "window", getenv("SDL_VIDEODRIVER"), driver);
+            why = sdl_msg;
+        } else {
+            snprintf(sdl_msg, sizeof sdl_msg, "%s%.200s%s", env_set("DISPLAY") ? " (DISPLAY is '" : "",
+                     env_set("DISPLAY") ? getenv("DISPLAY") : "", env_set("DISPLAY") ? "')" : "");
+            why = "no display answered";
+        }
         SDL_Quit();
-        snprintf(sdl_msg, sizeof sdl_msg, "%s%.200s%s", env_set("DISPLAY") ? " (DISPLAY is '" : "",
-                 env_set("DISPLAY") ? getenv("DISPLAY") : "", env_set("DISPLAY") ? "')" : "");
-        why = "no display answered";
     }
     return error_set(err, ST_DEVICE,
                      "--interactive needs a display for its window, and there is none (%s%s); render to a file "
                      "without --interactive, or run it where a display is (see docs/viewer.md)",
-                     why, sdl_msg);
+                     why, why == sdl_msg ? "" : sdl_msg);
 }
 
 /* ------------------------------------------------------------------ drawing */

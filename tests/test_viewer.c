@@ -177,6 +177,37 @@ static int wait_timeout(pid_t pid, double seconds)
     return -1;
 }
 
+/* A video driver that shows no window is no display either: with SDL_VIDEODRIVER=dummy
+ * the viewer ran, invisible, and waited for keys nobody could press (so the run is
+ * bounded here: a hang fails the check instead of the suite). */
+static void test_driver_without_a_window(void)
+{
+    const char *drivers[] = { "dummy", "offscreen" };
+    const char *args[] = { "--interactive", "scenes/cornell-box.scene", NULL };
+    const char *old = getenv("SDL_VIDEODRIVER");
+    char *saved = old ? strdup(old) : NULL;
+    CliResult *r = malloc(sizeof *r);
+    for (int i = 0; i < 2; i++) {
+        setenv("SDL_VIDEODRIVER", drivers[i], 1);
+        CliChild c = cli_start(args);
+        int status = wait_timeout(c.pid, 60.0);
+        cli_slurp(c.err_fd, r->err);
+        close(c.out_fd);
+        close(c.err_fd);
+        CHECK_MSG(status == 5, "SDL_VIDEODRIVER=%s: status %d (-1: still running after 60 s), stderr: %s",
+                  drivers[i], status, r->err);
+        char want[400];
+        snprintf(want, sizeof want, "clpt: error: --interactive needs a display for its window, and there is none "
+                 "(SDL_VIDEODRIVER is '%s', and SDL's '%s' video driver shows no window); render to a file without "
+                 "--interactive, or run it where a display is (see docs/viewer.md)\n", drivers[i], drivers[i]);
+        CHECK_STR_CONTAINS(r->err, want);
+    }
+    if (saved) setenv("SDL_VIDEODRIVER", saved, 1);
+    else unsetenv("SDL_VIDEODRIVER");
+    free(saved);
+    free(r);
+}
+
 /* Runs a tool (xdotool) to its end, at most 10 s; its stdout into out (may be NULL). */
 static int tool_run(const char *const *argv, char *out, size_t out_size)
 {
@@ -484,6 +515,7 @@ int main(void)
     RUN(test_print_round_trip);
     RUN(test_moves);
     RUN(test_no_display);
+    RUN(test_driver_without_a_window);
     RUN(test_usage);
     RUN(test_session);
     return harness_report();

@@ -346,6 +346,9 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Material, texture_sheen_roughness);
     out[i++] = (uint)__builtin_offsetof(Material, layer_albedo);
     out[i++] = (uint)__builtin_offsetof(Material, base_roughness);
+    out[i++] = (uint)sizeof(SphereXform);
+    out[i++] = (uint)__builtin_offsetof(SphereXform, to_object);
+    out[i++] = (uint)__builtin_offsetof(Sphere, xform);
 }
 #endif
 

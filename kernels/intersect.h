@@ -58,14 +58,14 @@ KFN RayPre ray_prepare(Ray ray)
  * Intersection"): the discriminant from the squared distance between the centre and
  * the line, which does not cancel catastrophically for distant spheres, and the two
  * roots as c/q and q/a, so the smaller one does not lose its digits either. */
-KFN int sphere_intersect(Sphere s, Ray ray, Hit *hit)
+KFN int sphere_intersect_at(vec3 center, float radius, Ray ray, Hit *hit)
 {
-    vec3 f = v3_sub(ray.o, s.center);
+    vec3 f = v3_sub(ray.o, center);
     float a = v3_dot(ray.d, ray.d);
     float b = v3_dot(f, ray.d);                    /* half the usual b */
-    float c = v3_dot(f, f) - s.radius * s.radius;
+    float c = v3_dot(f, f) - radius * radius;
     vec3 l = v3_sub(f, v3_scale(ray.d, b / a));    /* centre to the closest point of the line */
-    float disc = a * (s.radius * s.radius - v3_dot(l, l));
+    float disc = a * (radius * radius - v3_dot(l, l));
     if (!(disc >= 0.0f)) return 0;
     float q = -(b + k_copysign(k_sqrt(disc), b));
     float t0 = c / q, t1 = q / a;
@@ -76,6 +76,41 @@ KFN int sphere_intersect(Sphere s, Ray ray, Hit *hit)
     hit->u = 0.0f;
     hit->v = 0.0f;
     return 1;
+}
+
+KFN int sphere_intersect(Sphere s, Ray ray, Hit *hit)
+{
+    return sphere_intersect_at(s.center, s.radius, ray, hit);
+}
+
+/* The point p and the direction d under a 3x4 row-major matrix (SphereXform). */
+KFN vec3 xform_point(GLOBAL const float *m, vec3 p)
+{
+    return v3(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+              m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
+}
+
+KFN vec3 xform_vector(GLOBAL const float *m, vec3 d)
+{
+    return v3(m[0] * d.x + m[1] * d.y + m[2] * d.z, m[4] * d.x + m[5] * d.y + m[6] * d.z,
+              m[8] * d.x + m[9] * d.y + m[10] * d.z);
+}
+
+/* The ray in the object space of a transformed sphere. The direction is not
+ * renormalised, so a point's t is the same in both spaces (the map is affine). */
+KFN Ray sphere_xform_ray(GLOBAL const SphereXform *x, Ray ray)
+{
+    Ray r = ray;
+    r.o = xform_point(x->to_object, ray.o);
+    r.d = xform_vector(x->to_object, ray.d);
+    return r;
+}
+
+/* An ellipsoid: the unit sphere in its object space (PBR 4th ed., 6.2, as pbrt-v4's
+ * Sphere). The same test as a plain sphere's, so its robustness carries over. */
+KFN int sphere_xform_intersect(GLOBAL const SphereXform *x, Ray ray, Hit *hit)
+{
+    return sphere_intersect_at(v3s(0.0f), 1.0f, sphere_xform_ray(x, ray), hit);
 }
 
 /* ---------------------------------------------------------------- triangle */

@@ -23,8 +23,12 @@ KFN_INLINE int trace_prim(const SceneView *sc, uint id, const RayPre *rp, Ray ra
     uint first_rev = first_box + pr->n_boxes;
     if ((id >= first_tri) & (id < first_box))
         return triangle_intersect(rp, &sc->triangles[id - first_tri], ray, hit);
-    if (KF_HAS(KF_SPHERES) && id < first_tri)
-        return sphere_intersect(sc->spheres[id], ray, hit);
+    if (KF_HAS(KF_SPHERES) && id < first_tri) {
+        Sphere sp = sc->spheres[id];
+        if (KF_HAS(KF_SPHERE_XFORM) && sp.xform != 0u)
+            return sphere_xform_intersect(&sc->sphere_xforms[sp.xform - 1u], ray, hit);
+        return sphere_intersect(sp, ray, hit);
+    }
     if (KF_HAS(KF_BOXES) && id < first_rev)
         return box_intersect(rp, sc->boxes[id - first_box], ray, hit);
     if (!KF_HAS(KF_REVSURFACE)) return 0;

@@ -38,6 +38,7 @@
     X(MANY, BvhNode,      bvh,        (ds)->params.n_bvh_nodes,  "8-wide BVH nodes")         \
     X(MANY, uint,         bvh_leaves, (ds)->n_bvh_leaves,        "8-wide BVH leaf lists")    \
     X(MANY, Sphere,       spheres,    (ds)->params.n_spheres,    "spheres")                  \
+    X(MANY, SphereXform,  sphere_xforms, (ds)->n_sphere_xforms,  "sphere transforms")        \
     X(MANY, Triangle,     triangles,  (ds)->params.n_triangles,  "triangles")                \
     X(MANY, Box,          boxes,      (ds)->params.n_boxes,      "boxes")                    \
     X(MANY, Plane,        planes,     (ds)->params.n_planes,     "planes")                   \

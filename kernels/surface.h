@@ -47,6 +47,56 @@ KFN vec3 sphere_point(Sphere sp, vec3 n, vec3 *err)
     return v3_madd(sp.center, n, sp.radius);
 }
 
+/* |m| v for the linear part of a 3x4 matrix (the sums of magnitudes error bounds need). */
+KFN vec3 xform_abs_vector(GLOBAL const float *m, vec3 v)
+{
+    return v3(k_fabs(m[0]) * v.x + k_fabs(m[1]) * v.y + k_fabs(m[2]) * v.z,
+              k_fabs(m[4]) * v.x + k_fabs(m[5]) * v.y + k_fabs(m[6]) * v.z,
+              k_fabs(m[8]) * v.x + k_fabs(m[9]) * v.y + k_fabs(m[10]) * v.z);
+}
+
+/* The sphere's (u, v) at unit direction n from its centre (kernels/texture.h). */
+KFN void sphere_uv(vec3 n, float *u, float *v)
+{
+    *u = 0.5f + k_atan2(n.x, n.z) * (1.0f / K_TWO_PI);
+    *v = 1.0f - k_acos(n.y) * K_INV_PI;
+}
+
+/* The hit on an ellipsoid, in pbrt-v4's way (PBR 4th ed., 6.2.2 and 6.8.4-6.8.5): the
+ * object-space hit of the same ray re-projected onto the unit sphere (n_obj, whose
+ * error is sphere_point's for radius 1), carried to the world by M. The world bound
+ * adds the rounding of that transform (pbrt's gamma(3) of |M| |p| plus the carried
+ * error) and the rounding of M^-1 applied to a new ray's origin: sphere_xform_intersect
+ * reads which side the origin is on in object space, where that rounding (4 of |M^-1|
+ * |p| and the translation) would cancel an offset smaller than it; |M| of it is its
+ * size in the world, and a world offset along the normal by this bound moves the
+ * object-space origin along its normal by at least as much (the normal matrix is
+ * M^-T). Returns the world point; *n_obj is the object-space unit normal. */
+KFN vec3 sphere_xform_point(GLOBAL const SphereXform *x, Ray ray, float t, vec3 *n_obj, vec3 *err)
+{
+    Ray r = sphere_xform_ray(x, ray);
+    vec3 n = v3_norm(v3_madd(r.o, r.d, t));
+    GLOBAL const float *m = x->to_world, *mi = x->to_object;
+    vec3 p = xform_point(m, n);
+    vec3 trans = v3(k_fabs(m[3]), k_fabs(m[7]), k_fabs(m[11]));
+    vec3 trans_i = v3(k_fabs(mi[3]), k_fabs(mi[7]), k_fabs(mi[11]));
+    vec3 fwd = v3_scale(v3_add(xform_abs_vector(m, v3_abs(n)), trans), K_ROUND_ERR(3));
+    vec3 carried = v3_scale(xform_abs_vector(m, v3s(K_ROUND_ERR(8))), 1.0f + K_ROUND_ERR(3));
+    vec3 back = v3_scale(v3_add(xform_abs_vector(mi, v3_abs(p)), trans_i), K_ROUND_ERR(4));
+    *err = v3_add(v3_add(fwd, carried), xform_abs_vector(m, back));
+    *n_obj = n;
+    return p;
+}
+
+/* The unit world normal of an ellipsoid at object normal n: M^-T n (the transpose of
+ * to_object's linear part). */
+KFN vec3 sphere_xform_normal(GLOBAL const SphereXform *x, vec3 n)
+{
+    GLOBAL const float *mi = x->to_object;
+    return v3_norm(v3(mi[0] * n.x + mi[4] * n.y + mi[8] * n.z, mi[1] * n.x + mi[5] * n.y + mi[9] * n.z,
+                      mi[2] * n.x + mi[6] * n.y + mi[10] * n.z));
+}
+
 /* The error of p = w p0 + u p1 + v p2 (pbrt-v4: gamma(7) of the sum of the terms'
  * magnitudes), plus what the watertight test needs to see that a ray leaving the
  * triangle starts off it: its t is a sum of products of the corners' offsets from the
@@ -127,10 +177,19 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
     uint first_rev = first_box + p->n_boxes, first_plane = first_rev + p->n_revsurfaces;
     if (KF_HAS(KF_SPHERES) && id < first_tri) {
         Sphere sp = sc->spheres[id];
-        vec3 n = v3_norm(v3_sub(s.p, sp.center));
-        s.p = sphere_point(sp, n, &s.err);
-        s.ng = n;
-        s.ns = n;
+        if (KF_HAS(KF_SPHERE_XFORM) && sp.xform != 0u) {
+            /* (u, v) follow the object space's parameterisation */
+            GLOBAL const SphereXform *x = &sc->sphere_xforms[sp.xform - 1u];
+            vec3 n_obj;
+            s.p = sphere_xform_point(x, ray, hit.t, &n_obj, &s.err);
+            s.ng = sphere_xform_normal(x, n_obj);
+            sphere_uv(n_obj, &s.u, &s.v);
+        } else {
+            vec3 n = v3_norm(v3_sub(s.p, sp.center));
+            s.p = sphere_point(sp, n, &s.err);
+            s.ng = n;
+        }
+        s.ns = s.ng;
         s.material = sp.material;
         s.light = sp.light;
     } else if (id < first_box) {

@@ -5,6 +5,7 @@
  *
  * Surface coordinates: triangles use their texture coordinates (or barycentrics when
  * the mesh has none); spheres the longitude/latitude map, u = 0.5 + atan2(n.x, n.z)/2pi
+ * (of the object-space normal for an ellipsoid, SphereXform)
  * (u = 0.5 faces +z, growing towards +x) and v = 1 - acos(n.y)/pi (1 at the +y pole);
  * planes the coordinates along two unit tangents (plane_tangent); boxes, per face, the
  * fractions along the face's two other axes. Image rows run top to bottom: v = 1 is the
@@ -32,9 +33,12 @@ KFN void surface_uv(const SceneView *sc, Surface s, float *u, float *v)
     uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
     uint first_rev = first_box + p->n_boxes, first_plane = first_rev + p->n_revsurfaces;
     if (s.prim < first_tri) {
-        vec3 n = s.ng;
-        *u = 0.5f + k_atan2(n.x, n.z) * (1.0f / K_TWO_PI);
-        *v = 1.0f - k_acos(n.y) * K_INV_PI;
+        if (KF_HAS(KF_SPHERE_XFORM) && sc->spheres[s.prim].xform != 0u) {
+            *u = s.u;     /* an ellipsoid: surface_at's, in its object space */
+            *v = s.v;
+        } else {
+            sphere_uv(s.ng, u, v);
+        }
     } else if (s.prim < first_box || (s.prim >= first_rev && s.prim < first_plane)) {
         *u = s.u;     /* triangles: interpolated uv; surfaces of revolution: angle, s */
         *v = s.v;
@@ -254,6 +258,16 @@ KFN int surface_tangents(const SceneView *sc, Surface s, vec3 *dpdu, vec3 *dpdv)
     if (s.prim < first_tri) {
         /* u grows with atan2(x, z) about +y, v with y */
         vec3 n = s.ng;
+        uint xf = KF_HAS(KF_SPHERE_XFORM) ? sc->spheres[s.prim].xform : 0u;
+        if (xf != 0u) {
+            /* an ellipsoid: the object space's tangents, carried to the world by M */
+            GLOBAL const SphereXform *x = &sc->sphere_xforms[xf - 1u];
+            vec3 no = v3_norm(xform_point(x->to_object, s.p));
+            vec3 du = v3(no.z, 0.0f, -no.x);
+            *dpdu = xform_vector(x->to_world, du);
+            *dpdv = xform_vector(x->to_world, v3_cross(no, du));
+            return v3_dot(*dpdu, *dpdu) > 0.0f;
+        }
         *dpdu = v3(n.z, 0.0f, -n.x);
         *dpdv = v3_cross(n, *dpdu);
         return v3_dot(*dpdu, *dpdu) > 0.0f;

@@ -54,7 +54,8 @@
 #define KF_PATH_LANES 0x400000u /* the megakernel eight paths at a time (k_path_lanes, k_film;
                                  * kernels/shade_lanes.cl): CPUs, scenes it shades fast */
 #define KF_LAYERED 0x800000u    /* material type MAT_LAYERED (8) */
-#define KF_ALL 0xfbffffu        /* every bit above (material types 0 to 6, and 8) */
+#define KF_SPHERE_XFORM 0x1000000u /* a sphere under a transform (an ellipsoid, SphereXform) */
+#define KF_ALL 0x1fbffffu       /* every bit above (material types 0 to 6, and 8) */
 #ifndef CLPT_FEATURES
 #define CLPT_FEATURES KF_ALL
 #endif
@@ -127,8 +128,24 @@ typedef struct {                                        /* 32 bytes */
     vec3 center;  float radius;
     uint material;
     uint light;     /* index into lights[] if emissive, else NO_INDEX */
-    uint pad0, pad1;
+    uint xform;     /* 0: a plain sphere (centre, radius); else 1 + its index in the
+                     * sphere_xforms buffer: the unit sphere under that transform, an
+                     * ellipsoid, whose centre and radius are then only a bounding
+                     * sphere. 0 rather than NO_INDEX for "none" so that every sphere
+                     * made before transforms existed, its padding zeroed, stays plain. */
+    uint pad1;
 } Sphere;
+
+/* A sphere under an affine transform M (pbrt's sphere under a non-uniform scale): the
+ * unit sphere at the origin of object space, carried to the world by M. Rays are
+ * intersected in object space (PBR 4th ed., 6.2: pbrt-v4's Sphere works there too),
+ * which keeps t, since the direction is mapped without being renormalised. Both
+ * matrices are 3x4 row-major, (x, y, z, 1) -> row . (x, y, z, 1); the normal matrix is
+ * the transpose of to_object's linear part, so it is not stored. */
+typedef struct {                                        /* 96 bytes */
+    float to_world[12];       /* M: object -> world */
+    float to_object[12];      /* M^-1: world -> object */
+} SphereXform;
 
 typedef struct {                                        /* 48 bytes */
     vec3 p0;  uint material;
@@ -483,6 +500,9 @@ CLPT_CHECK_SIZE(Hit, 16);
 CLPT_CHECK_SIZE(KdNode, 8);
 CLPT_CHECK_SIZE(BvhNode, 256);
 CLPT_CHECK_SIZE(Sphere, 32);
+CLPT_CHECK_SIZE(SphereXform, 96);
+_Static_assert(offsetof(Sphere, xform) == 24, "Sphere.xform");
+_Static_assert(offsetof(SphereXform, to_object) == 48, "SphereXform.to_object");
 CLPT_CHECK_SIZE(Triangle, 48);
 CLPT_CHECK_SIZE(TriShading, 64);
 CLPT_CHECK_SIZE(TriExtra, 128);

@@ -14,6 +14,7 @@
 #include "accel/bvh.h"
 #include "accel/kdtree.h"
 #include "io/mesh_load.h"
+#include "scene/transform.h"
 #include "surface.h"
 #include "traverse.cl"
 
@@ -33,6 +34,7 @@ static vec3 vrand(float a, float b) { return v3(frange(a, b), frange(a, b), fran
 
 typedef struct {
     Sphere sph[512];     uint ns;
+    SphereXform xf[512]; uint nxf;   /* the ellipsoids' transforms (Sphere.xform) */
     Triangle tri[4096];  uint nt;
     Box box[256];        uint nb;
     Plane pln[4];        uint np;
@@ -50,12 +52,29 @@ static void scene_clear(void)
 {
     kd_free(&scene.tree);
     bvh_free(&scene.bvh);
-    scene.ns = scene.nt = scene.nb = scene.np = 0;
+    scene.ns = scene.nt = scene.nb = scene.np = scene.nxf = 0;
 }
 
 static void add_sphere(vec3 c, float r)
 {
     Sphere s = { c, r, 0, NO_INDEX, 0, 0 };
+    scene.sph[scene.ns++] = s;
+}
+/* The unit sphere under translate(c) . rotate(angle about axis) . scale(a): a Sphere
+ * with a SphereXform, its bounding sphere as scene_add_ellipsoid makes it. */
+static void add_ellipsoid(vec3 c, vec3 a, vec3 axis, float angle)
+{
+    Transform t = transform_translate(c.x, c.y, c.z), r = transform_rotate(axis.x, axis.y, axis.z, angle),
+              sc = transform_scale(a.x, a.y, a.z), inv;
+    Transform m = transform_compose(&r, &sc);
+    m = transform_compose(&t, &m);
+    transform_invert(&m, &inv);
+    SphereXform *x = &scene.xf[scene.nxf++];
+    for (int i = 0; i < 12; i++) {
+        x->to_world[i] = (float)m.m[i / 4][i % 4];
+        x->to_object[i] = (float)inv.m[i / 4][i % 4];
+    }
+    Sphere s = { c, a.x + a.y + a.z, 0, NO_INDEX, scene.nxf, 0 };
     scene.sph[scene.ns++] = s;
 }
 static void add_triangle(vec3 a, vec3 b, vec3 c)
@@ -77,7 +96,7 @@ static void add_plane(vec3 n, float offset)
 /* Builds both trees and a SceneView of each for the kernel functions. */
 static Status scene_build(int threads)
 {
-    KdInput in = { scene.sph, scene.ns, scene.tri, scene.nt, scene.box, scene.nb, NULL, 0 };
+    KdInput in = { scene.sph, scene.ns, scene.tri, scene.nt, scene.box, scene.nb, NULL, 0, scene.xf, scene.nxf };
     Error err = { 0 };
     kd_free(&scene.tree);
     bvh_free(&scene.bvh);
@@ -98,13 +117,15 @@ static Status scene_build(int threads)
     scene.params.bounds_hi = scene.tree.hi;
     /* named fields: the buffers this test does not use stay NULL whatever the list holds */
     SceneView v = { .params = &scene.params, .nodes = scene.tree.nodes, .leaf_prims = scene.tree.leaf_prims,
-                    .spheres = scene.sph, .triangles = scene.tri, .boxes = scene.box, .planes = scene.pln };
+                    .spheres = scene.sph, .triangles = scene.tri, .boxes = scene.box, .planes = scene.pln,
+                    .sphere_xforms = scene.xf };
     scene.view = v;
     scene.wide_params = scene.params;
     scene.wide_params.n_nodes = scene.wide_params.n_leaf_prims = 0;
     scene.wide_params.n_bvh_nodes = scene.bvh.n_nodes;
     SceneView w = { .params = &scene.wide_params, .bvh = scene.bvh.nodes, .bvh_leaves = scene.bvh.leaf_prims,
-                    .spheres = scene.sph, .triangles = scene.tri, .boxes = scene.box, .planes = scene.pln };
+                    .spheres = scene.sph, .triangles = scene.tri, .boxes = scene.box, .planes = scene.pln,
+                    .sphere_xforms = scene.xf };
     scene.wide_view = w;
     return ST_OK;
 }
@@ -897,6 +918,42 @@ static void test_against_brute_force(void)
     walk_bvh = 0;
 }
 
+/* Ellipsoids (spheres under a transform) among spheres and triangles: their boxes
+ * (the transform's rows, kdtree.c) hold them, so both trees find what brute force does,
+ * and a ray through the rim of each box's extent finds the ellipsoid there. */
+static void test_ellipsoids(void)
+{
+    float lo[3], hi[3];
+    /* scale (2, 1, 0.5) turned 90 degrees about z: x reaches 1, y 2, z 0.5 */
+    scene_clear();
+    add_ellipsoid(v3(1.0f, 2.0f, 3.0f), v3(2.0f, 1.0f, 0.5f), v3(0.0f, 0.0f, 1.0f), 90.0f);
+    KdInput in = { scene.sph, scene.ns, NULL, 0, NULL, 0, NULL, 0, scene.xf, scene.nxf };
+    CHECK(kd_prim_box(&in, 0, lo, hi));
+    CHECK_NEAR(lo[0], 0.0, 1e-5);
+    CHECK_NEAR(hi[1], 4.0, 1e-5);
+    CHECK_NEAR(hi[2], 3.5, 1e-5);
+    CHECK(hi[1] >= 4.0f && lo[2] <= 2.5f);
+    for (walk_bvh = 0; walk_bvh < 2; walk_bvh++) {
+        random_scene(25, 30, 200, 0, 0);
+        rng_seed(99);
+        for (int i = 0; i < 80; i++)
+            add_ellipsoid(vrand(-4.0f, 4.0f), vrand(0.05f, 1.2f), vrand(-1.0f, 1.0f), frange(0.0f, 180.0f));
+        CHECK(scene_build(0) == ST_OK);
+        int bad = 0, hits = 0;
+        for (int i = 0; i < 30000; i++) {
+            Ray r = random_ray(-5.0f, 5.0f);
+            bad += !ray_agrees(r, bad < 5);
+            Hit h = trace_closest(walk_view(), r);
+            hits += h.prim != NO_INDEX && h.prim < scene.ns && scene.sph[h.prim].xform != 0u;
+        }
+        fprintf(stderr, "  %s: 30000 rays among 80 ellipsoids, %d hit one, %d disagree with brute force\n",
+                walk_bvh ? "BVH" : "kd-tree", hits, bad);
+        CHECK_EQ_INT(bad, 0);
+        CHECK(hits > 1000);
+    }
+    walk_bvh = 0;
+}
+
 /* Two rays walked in turns (trace_closest2, trace_any2) give each ray bit for bit what
  * it gets alone, on every kind of scene and ray (planes, spheres, boxes, NaN, zero
  * components). */
@@ -950,7 +1007,7 @@ static int mesh_scene_open(MeshScene *m, const char *what)
         MeshOptions o = mesh_options(0);
         st = mesh_load(what, &m->scene, &o, &err);
     }
-    KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0, NULL, 0 };
+    KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0, NULL, 0, NULL, 0 };
     if (st == ST_OK) st = kd_build(&in, 0, &m->tree, &err);
     if (st == ST_OK) st = bvh_build(&in, 0, &m->bvh, &err);
     if (st != ST_OK) {
@@ -1288,7 +1345,7 @@ static void test_bvh_deterministic(void)
     Triangle *tri = cube_sphere(80, &nt);
     CHECK(tri != NULL);
     if (!tri) return;
-    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0 };
+    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0, NULL, 0 };
     Bvh one;
     Error err = { 0 };
     CHECK(bvh_build(&in, 1, &one, &err) == ST_OK);
@@ -1351,7 +1408,7 @@ static void test_pinned_trees(void)
     Triangle *tri = cube_sphere(40, &nt);
     CHECK(tri != NULL);
     if (!tri) return;
-    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0 };
+    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0, NULL, 0 };
     const int threads[] = { 1, 3, 0 };
     for (int i = 0; i < 3; i++) {
         KdTree t;
@@ -1402,7 +1459,7 @@ static void test_threaded_passes(void)
     CHECK(nt > 65536);
     tri[7].p1.y = NAN;
     tri[nt - 100].p2.x = INFINITY;
-    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0 };
+    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0, NULL, 0 };
     KdTree one;
     Error err = { 0 };
     CHECK(kd_build(&in, 1, &one, &err) == ST_OK);
@@ -1583,6 +1640,7 @@ int main(void)
     RUN(test_plane);
     RUN(test_structure);
     RUN(test_against_brute_force);
+    RUN(test_ellipsoids);
     RUN(test_pairs);
     RUN(test_packets);
     RUN(test_packets_wide);

@@ -296,7 +296,7 @@ static void build_scene(void)
     }
     /* the renderer walks the BVH (rs); the kd-tree's own kernels get the kd-tree too */
     KdInput in = { scene.spheres, scene.n_spheres, scene.triangles, scene.n_triangles, scene.boxes, scene.n_boxes,
-                   scene.revsurfaces, scene.n_revsurfaces };
+                   scene.revsurfaces, scene.n_revsurfaces, scene.sphere_xforms, scene.n_sphere_xforms };
     if (!st) st = kd_build(&in, 1, &kd, &err);
     if (st) fprintf(stderr, "scene setup failed: %s\n", err.msg);
     render_scene_use_kdtree(&rs.ds, &kd);
@@ -488,7 +488,8 @@ static void test_layout(void)
                     offsetof(RenderParams, bg_light), sizeof(TriExtra), offsetof(TriExtra, uv),
                     offsetof(Material, absorption), offsetof(Material, sheen_color),
                     offsetof(Material, texture_sheen_roughness),
-                    offsetof(Material, layer_albedo), offsetof(Material, base_roughness) };
+                    offsetof(Material, layer_albedo), offsetof(Material, base_roughness), sizeof(SphereXform),
+                    offsetof(SphereXform, to_object), offsetof(Sphere, xform) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);

@@ -739,7 +739,8 @@ static void test_feature_switches_compile_cleanly(void)
     /* each switch alone, and each of the two trees */
     static const unsigned switches[] = { 1u << 0, 1u << 1, 1u << 2, 1u << 3, 1u << 4, 1u << 5, 1u << 6, 1u << 7,
                                          1u << 8, 1u << 9, 1u << 10, 1u << 11, 1u << 12, 1u << 13, 1u << 14,
-                                         1u << 15, 1u << 16, 1u << 17, KF_LAYERED, KF_KDTREE, KF_BVH };
+                                         1u << 15, 1u << 16, 1u << 17, KF_LAYERED, KF_KDTREE, KF_BVH,
+                                         KF_SPHERES | KF_SPHERE_XFORM };
     for (size_t bit = 0; bit < sizeof switches / sizeof switches[0]; bit++) {
         for (size_t k = 0; k < sizeof programs / sizeof programs[0]; k++) {
             unsigned features = programs[k] | switches[bit];
@@ -755,7 +756,7 @@ static void test_feature_switches_compile_cleanly(void)
         }
     }
     CHECK_EQ_INT(KF_ALL, ((KF_MATERIAL(MAT_PRINCIPLED) << 1) - 1u) | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH |
-                         KF_PATH_LANES | KF_LAYERED);
+                         KF_PATH_LANES | KF_LAYERED | KF_SPHERE_XFORM);
 }
 
 static void test_cache_location(void)

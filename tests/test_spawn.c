@@ -79,6 +79,24 @@ static void sphere_furnace(Scene *s, double scale, double dist)
     furnace_camera(s, c, dir, dist * scale, 0.6 * silhouette);
 }
 
+/* An ellipsoid: the unit sphere under scale (2, 1, 0.5) times `scale`, turned 30
+ * degrees about (1, 1, 0), at object_centre * scale, seen from `dist` sizes away. Its
+ * smallest semi-axis is 0.5 * scale, so a field of view 0.3 * scale either side of the
+ * centre sees only the ellipsoid. The spawn offset is bounded through the transform
+ * (surface.h, sphere_xform_point). */
+static void ellipsoid_furnace(Scene *s, double scale, double dist)
+{
+    furnace_init(s);
+    double c[3] = { object_centre[0] * scale, object_centre[1] * scale, object_centre[2] * scale };
+    Transform t = transform_translate(c[0], c[1], c[2]), r = transform_rotate(1.0, 1.0, 0.0, 30.0),
+              sc = transform_scale(2.0 * scale, 1.0 * scale, 0.5 * scale);
+    Transform m = transform_compose(&r, &sc);
+    m = transform_compose(&t, &m);
+    CHECK_EQ_INT(scene_add_ellipsoid(s, &m, 0u, NULL), ST_OK);
+    const double dir[3] = { 1.0, 0.7, 0.4 };
+    furnace_camera(s, c, dir, dist * scale, 0.3 * scale);
+}
+
 /* A cube of half-size `scale` seen from `dist` half-sizes off its corner along a
  * diagonal-ish direction: three faces, and two edges, fill the image. */
 static void box_furnace(Scene *s, double scale, double dist)
@@ -167,6 +185,11 @@ static void build_sphere(Scene *s, double scale, double dist, int variant)
     (void)variant;
     sphere_furnace(s, scale, dist);
 }
+static void build_ellipsoid(Scene *s, double scale, double dist, int variant)
+{
+    (void)variant;
+    ellipsoid_furnace(s, scale, dist);
+}
 static void build_box(Scene *s, double scale, double dist, int variant)
 {
     (void)variant;
@@ -245,6 +268,7 @@ static void check_all_scales(const char *what, FurnaceBuild build, int variant)
 }
 
 static void test_sphere_furnace(void) { check_all_scales("sphere", build_sphere, 0); }
+static void test_ellipsoid_furnace(void) { check_all_scales("ellipsoid", build_ellipsoid, 0); }
 static void test_box_furnace(void) { check_all_scales("box", build_box, 0); }
 static void test_plane_furnace(void) { check_all_scales("plane y = const", build_plane, 0); }
 static void test_tilted_plane_furnace(void) { check_all_scales("tilted plane", build_plane, 1); }
@@ -254,6 +278,7 @@ static void test_large_quad_furnace(void) { check_all_scales("quad 1000 sizes ac
 int main(void)
 {
     RUN(test_sphere_furnace);
+    RUN(test_ellipsoid_furnace);
     RUN(test_box_furnace);
     RUN(test_plane_furnace);
     RUN(test_tilted_plane_furnace);

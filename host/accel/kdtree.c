@@ -942,8 +942,25 @@ static int aabb_finite(const Aabb *a)
     return 1;
 }
 
-static Aabb sphere_bounds(const Sphere *s)
+/* An ellipsoid's box: the unit sphere under M reaches sqrt(sum_j M_ij^2) along world
+ * axis i from M's origin (the row's length: max of row . n over unit n). A relative
+ * 2^-20 more covers the kernels' rounding of the object-space test near the rim. */
+static Aabb ellipsoid_bounds(const SphereXform *x)
 {
+    Aabb a;
+    for (int k = 0; k < 3; k++) {
+        const float *row = x->to_world + 4 * k;
+        double e = sqrt((double)row[0] * row[0] + (double)row[1] * row[1] + (double)row[2] * row[2]);
+        e *= 1.0 + 0x1p-20;
+        a.lo[k] = nextafterf((float)(row[3] - e), -INFINITY);
+        a.hi[k] = nextafterf((float)(row[3] + e), INFINITY);
+    }
+    return a;
+}
+
+static Aabb sphere_bounds(const KdInput *in, const Sphere *s)
+{
+    if (s->xform != 0u && s->xform <= in->n_sphere_xforms) return ellipsoid_bounds(&in->sphere_xforms[s->xform - 1u]);
     /* Rounded outward: the centre +- radius in float can land a hair inside. */
     float r = fabsf(s->radius);
     const float c[3] = { s->center.x, s->center.y, s->center.z };
@@ -982,7 +999,7 @@ int kd_prim_box(const KdInput *in, uint gid, float lo[3], float hi[3])
     int finite;
     size_t n_sph = in->n_spheres, n_tri = in->n_triangles, n_box = in->n_boxes;
     if (gid < n_sph) {
-        a = sphere_bounds(&in->spheres[gid]);
+        a = sphere_bounds(in, &in->spheres[gid]);
         finite = aabb_finite(&a);
     } else if ((gid -= (uint)n_sph) < n_tri) {
         a = triangle_bounds(&in->triangles[gid]);

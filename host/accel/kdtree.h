@@ -45,6 +45,7 @@ typedef struct {
     const Triangle *triangles; size_t n_triangles;
     const Box *boxes;          size_t n_boxes;
     const RevSurface *revs;    size_t n_revs;    /* after the boxes in the id space */
+    const SphereXform *sphere_xforms; size_t n_sphere_xforms;   /* Sphere.xform's targets */
 } KdInput;
 
 typedef struct {

@@ -32,7 +32,8 @@ unsigned kernel_scene_features(const DeviceScene *s)
         else if (t != LIGHT_AREA) f |= KF_DELTA_LIGHTS;
     }
     f |= (p->n_spheres ? KF_SPHERES : 0u) | (p->n_boxes ? KF_BOXES : 0u) | (p->n_planes ? KF_PLANES : 0u) |
-         (p->n_revsurfaces ? KF_REVSURFACE : 0u) | (p->n_bvh_nodes ? KF_BVH : KF_KDTREE);
+         (p->n_revsurfaces ? KF_REVSURFACE : 0u) | (p->n_bvh_nodes ? KF_BVH : KF_KDTREE) |
+         (s->n_sphere_xforms ? KF_SPHERE_XFORM : 0u);
     return f;
 }
 

@@ -50,7 +50,7 @@ void render_scene_use_bvh(DeviceScene *ds, const Bvh *bvh)
 static Status tree_build(const Scene *s, int threads, RenderScene *out, Error *err)
 {
     KdInput in = { s->spheres, s->n_spheres, s->triangles, s->n_triangles, s->boxes, s->n_boxes,
-                   s->revsurfaces, s->n_revsurfaces };
+                   s->revsurfaces, s->n_revsurfaces, s->sphere_xforms, s->n_sphere_xforms };
     Status st;
     if (s->accel == ACCEL_KDTREE) {
         if ((st = kd_build(&in, threads, &out->kd, err))) return st;
@@ -99,6 +99,8 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
     p->n_revsurfaces = (uint)s->n_revsurfaces;
     p->n_lights = (uint)s->n_lights;
     out->ds.spheres = s->spheres;
+    out->ds.sphere_xforms = s->n_sphere_xforms ? s->sphere_xforms : NULL;
+    out->ds.n_sphere_xforms = (uint)s->n_sphere_xforms;
     out->ds.triangles = s->triangles;
     out->ds.boxes = s->boxes;
     out->ds.planes = s->planes;

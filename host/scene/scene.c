@@ -48,6 +48,7 @@ void scene_free(Scene *s)
     free(s->material_textures);
     free(s->materials);
     free(s->spheres);
+    free(s->sphere_xforms);
     free(s->triangles);
     free(s->shading);
     free(s->tri_extras);
@@ -135,6 +136,39 @@ Status scene_add_sphere(Scene *s, Sphere sp, Error *err)
 {
     sp.light = NO_INDEX;
     return append((void **)&s->spheres, &s->n_spheres, &s->cap_spheres, &sp, sizeof sp, s, err);
+}
+
+Status scene_add_ellipsoid(Scene *s, const Transform *m, uint material, Error *err)
+{
+    Transform inv;
+    if (!transform_invert(m, &inv)) return error_set(err, ST_INPUT, "the sphere's transform is singular");
+    SphereXform x;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++) {
+            x.to_world[4 * i + j] = (float)m->m[i][j];
+            x.to_object[4 * i + j] = (float)inv.m[i][j];
+        }
+    /* the Frobenius norm bounds the largest stretch: a bounding sphere about M's origin */
+    double r2 = 0.0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) r2 += (double)x.to_world[4 * i + j] * x.to_world[4 * i + j];
+    Sphere sp;
+    memset(&sp, 0, sizeof sp);
+    sp.center = v3(x.to_world[3], x.to_world[7], x.to_world[11]);
+    sp.radius = nextafterf((float)sqrt(r2), INFINITY);
+    sp.material = material;
+    for (int i = 0; i < 24; i++)
+        if (!isfinite(i < 12 ? x.to_world[i] : x.to_object[i - 12]))
+            return error_set(err, ST_INPUT, "the sphere's transform or its inverse does not fit in floats");
+    if (!(sp.radius > 0) || !isfinite(sp.radius) || !isfinite(fabsf(sp.center.x) + sp.radius) ||
+        !isfinite(fabsf(sp.center.y) + sp.radius) || !isfinite(fabsf(sp.center.z) + sp.radius))
+        return error_set(err, ST_INPUT, "the sphere reaches beyond the largest float (about 3.4e38)");
+    if (s->n_sphere_xforms >= (size_t)NO_INDEX - 1u)
+        return error_set(err, ST_INPUT, "too many transformed spheres");
+    sp.xform = (uint)s->n_sphere_xforms + 1u;
+    Status st = append((void **)&s->sphere_xforms, &s->n_sphere_xforms, &s->cap_sphere_xforms, &x, sizeof x, s, err);
+    if (!st) st = scene_add_sphere(s, sp, err);
+    return st;
 }
 
 Status scene_add_triangle(Scene *s, Triangle t, Error *err)
@@ -754,7 +788,14 @@ Status scene_prepare_lights(Scene *s, Error *err)
     s->env_light = NO_INDEX;
     int env = s->bg_type == BG_MAP && s->n_env_cdf > 0;
     size_t n = (size_t)env;
-    for (size_t i = 0; i < s->n_spheres; i++) n += (size_t)is_emissive(s, s->spheres[i].material);
+    for (size_t i = 0; i < s->n_spheres; i++) {
+        /* the kernels sample sphere lights by the cone a sphere subtends: an ellipsoid
+         * has none (the pbrt reader makes emitting ones meshes) */
+        if (s->spheres[i].xform && is_emissive(s, s->spheres[i].material))
+            return error_set(err, ST_INPUT, "sphere %zu is an ellipsoid that emits light, which clpt cannot "
+                             "sample; make it a mesh", i);
+        n += (size_t)is_emissive(s, s->spheres[i].material);
+    }
     for (size_t i = 0; i < s->n_triangles; i++) n += (size_t)is_emissive(s, s->triangles[i].material);
     for (size_t i = 0; i < s->n_boxes; i++) n += (size_t)is_emissive(s, s->boxes[i].material);
     n += s->n_delta_lights;

@@ -11,6 +11,7 @@
 #include "base/status.h"
 #include "base/strmap.h"
 #include "types.h"
+#include "scene/transform.h"
 
 typedef struct {
     vec3 from, at, up;
@@ -64,6 +65,8 @@ typedef struct {
      * path), or NULL; n_material_textures <= n_materials (missing entries are NULL). */
     char **material_textures;  size_t n_material_textures;
     Sphere *spheres;       size_t n_spheres, cap_spheres;
+    /* the transforms of the spheres that are ellipsoids (Sphere.xform) */
+    SphereXform *sphere_xforms;  size_t n_sphere_xforms, cap_sphere_xforms;
     Triangle *triangles;   size_t n_triangles, cap_triangles;
     TriShading *shading;   size_t n_shading, cap_shading;
     /* glTF's tangents, second uvs and vertex colours (types.h, TriExtra): tri_extra_of
@@ -116,6 +119,11 @@ Status scene_load_text(const char *path, const char *text, size_t len, Scene *s,
 /* Appending; each fails only when memory runs out (ST_INTERNAL). */
 Status scene_add_material(Scene *s, const char *name, Material m, uint *index, Error *err);
 Status scene_add_sphere(Scene *s, Sphere sp, Error *err);
+/* The unit sphere under the affine transform m (an ellipsoid when m is not a
+ * similarity), of `material`: a sphere with a SphereXform, whose centre and radius
+ * bound it. ST_INPUT (message without a location) when m is singular or the ellipsoid
+ * reaches beyond what floats hold. It must not emit light (scene_prepare_lights). */
+Status scene_add_ellipsoid(Scene *s, const Transform *m, uint material, Error *err);
 Status scene_add_triangle(Scene *s, Triangle t, Error *err);
 Status scene_add_shading(Scene *s, TriShading sh, uint *index, Error *err);
 /* Gives shading record `shading` the corner attributes e (sets its TRI_HAS_EXTRA). */

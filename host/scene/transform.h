@@ -30,5 +30,8 @@ vec3 transform_point(const Transform *t, vec3 p);
  * over the determinant). Returns 0, leaving n alone, when the linear part is singular
  * or not finite. */
 int transform_normal_matrix(const Transform *t, double n[3][3]);
+/* The inverse transform into *inv; 0, leaving it alone, when the linear part is
+ * singular or not finite. */
+int transform_invert(const Transform *t, Transform *inv);
 
 #endif /* CLPT_TRANSFORM_H */

@@ -88,8 +88,8 @@ static void test_transforms(void)
     Scene s;
     Error err = { 0 };
     CHECK_EQ_INT(load(DIR "transforms.pbrt", &s, &err), ST_OK);
-    CHECK_EQ_INT(s.n_spheres, 5);
-    if (s.n_spheres == 5) {
+    CHECK_EQ_INT(s.n_spheres, 6);
+    if (s.n_spheres == 6) {
         CHECK_V3(s.spheres[0].center, 0, 1, 0, 1e-6);   /* Rotate 90 about z, then x 1 */
         CHECK_V3(s.spheres[1].center, 2, 3, 4, 0);      /* Transform is column by column */
         CHECK_V3(s.spheres[2].center, 1, 1, 0, 0);      /* ConcatTransform */
@@ -97,12 +97,21 @@ static void test_transforms(void)
         CHECK_V3(s.spheres[3].center, 1, 1, 2, 0);      /* CoordSysTransform */
         CHECK_V3(s.spheres[4].center, 0, 0, 10, 1e-6);  /* the camera's system */
     }
-    /* the sphere under Scale 1 2 1 is an ellipsoid of triangles, 2 units tall */
-    CHECK_EQ_INT(s.n_triangles, 64 * 32 * 2 - 2 * 64 + 2);
-    vec3 lo, hi;
-    mesh_bounds(&s, 0, s.n_triangles - 2, &lo, &hi);
-    CHECK_NEAR(hi.y - lo.y, 2, 1e-5);
-    CHECK_NEAR(hi.x - lo.x, 1, 1e-5);
+    /* the sphere under Scale 1 2 1 is an analytic ellipsoid, 2 units tall: the unit
+     * sphere under diag(0.5, 1, 0.5), bounded by the sphere of radius |M|_F */
+    CHECK_EQ_INT(s.n_triangles, 2);
+    CHECK_EQ_INT(s.n_sphere_xforms, 1);
+    if (s.n_spheres == 6 && s.n_sphere_xforms == 1) {
+        CHECK_EQ_INT(s.spheres[5].xform, 1);
+        const float *m = s.sphere_xforms[0].to_world, *mi = s.sphere_xforms[0].to_object;
+        CHECK_NEAR(m[0], 0.5, 0);
+        CHECK_NEAR(m[5], 1, 0);
+        CHECK_NEAR(m[10], 0.5, 0);
+        CHECK_NEAR(mi[5], 1, 0);
+        CHECK_NEAR(mi[10], 2, 0);
+        CHECK_NEAR(s.spheres[5].radius, sqrt(1.5), 1e-6);
+        CHECK_EQ_INT(s.spheres[0].xform, 0);
+    }
     /* ReverseOrientation swaps the winding */
     size_t n = s.n_triangles;
     CHECK_V3(s.triangles[n - 2].p1, 0, 1, 0, 0);
@@ -739,6 +748,53 @@ static void test_errors(void)
 static const double octa_p[] = { 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1 };
 static const uint32_t octa_i[] = { 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5 };
 
+/* Issue 39: 2000 squashed spheres (a 62 KB file) became 8.2 million triangles and 1.5 GB.
+ * They stay analytic: 2000 spheres with 2000 transforms, 256 KB. An emitting ellipsoid
+ * is still a mesh (its light needs one) and counts against the tessellation budget; an
+ * instance's sphere under a squashing transform is an ellipsoid too. */
+static void test_squashed_spheres(void)
+{
+    size_t cap = 128 * 2000 + 256, len = 0;
+    char *text = malloc(cap);
+    for (int i = 0; i < 2000; i++)
+        len += (size_t)snprintf(text + len, cap - len, "AttributeBegin Translate %d %d 0 Rotate %d 1 1 0 "
+                                "Scale 1 0.3 2 Shape \"sphere\" \"float radius\" 0.4 AttributeEnd\n",
+                                i % 50, i / 50, i % 360);
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text(text, &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_spheres, 2000);
+    CHECK_EQ_INT(s.n_sphere_xforms, 2000);
+    CHECK_EQ_INT(s.n_triangles, 0);
+    if (s.n_spheres == 2000) CHECK_EQ_INT(s.spheres[1999].xform, 2000);
+    scene_free(&s);
+    free(text);
+
+    static const char lamp[] = "AttributeBegin AreaLightSource \"diffuse\" \"rgb L\" [ 1 1 1 ]\n"
+                               "Scale 1 0.5 1 Shape \"sphere\" AttributeEnd\n";
+    CHECK_EQ_INT(load_text(lamp, &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_spheres, 0);
+    CHECK_EQ_INT(s.n_triangles, 64 * 32 * 2 - 2 * 64);
+    scene_free(&s);
+
+    static const char inst[] = "ObjectBegin \"o\" Scale 1 1 3 Shape \"sphere\" Translate 5 0 0 Shape \"sphere\" "
+                               "ObjectEnd\n"
+                               "ObjectInstance \"o\"\n"
+                               "AttributeBegin Scale 2 1 1 ObjectInstance \"o\" AttributeEnd\n";
+    CHECK_EQ_INT(load_text(inst, &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_spheres, 4);
+    CHECK_EQ_INT(s.n_sphere_xforms, 4);
+    if (s.n_sphere_xforms == 4) {
+        /* the second instance: Scale 2 1 1 . Scale 1 1 3 . Translate 5 0 0 */
+        const float *m = s.sphere_xforms[3].to_world;
+        CHECK_NEAR(m[0], 2, 0);
+        CHECK_NEAR(m[3], 10, 0);
+        CHECK_NEAR(m[10], 3, 0);
+        CHECK_EQ_INT(s.spheres[3].xform, 4);
+    }
+    scene_free(&s);
+}
+
 static void test_loop_limits(void)
 {
     Error err = { 0 };
@@ -777,6 +833,28 @@ static void test_loop_limits(void)
     CHECK_NEAR(base.p[3], 0.6, 1e-12);
     subdiv_free(&base);
     CHECK_EQ_INT(subdiv_loop(tri_p, 3, tri_i, 1, 11, 1u << 20, &base, &err), ST_INPUT);
+    /* the reader counts a loopsubdiv's triangles before it allocates anything, and
+     * against one budget for the whole scene: a 4 KB file of 33 such shapes asked for
+     * 33 million triangles */
+    expect_error("Shape \"loopsubdiv\" \"integer levels\" 11 \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] "
+                 "\"integer indices\" [ 0 1 2 ]",
+                 DIR "inline.pbrt:1:7: loopsubdiv level 11 is beyond 10 (each level makes four triangles of one: "
+                 "level 11 makes 4^11 = 4194304 of each)");
+    expect_error("Shape \"loopsubdiv\" \"integer levels\" 9 \"point3 P\" [ 1 0 0 -1 0 0 0 1 0 0 -1 0 0 0 1 0 0 -1 ] "
+                 "\"integer indices\" [ 0 2 4 2 1 4 1 3 4 3 0 4 2 0 5 1 2 5 3 1 5 0 3 5 ]",
+                 DIR "inline.pbrt:1:7: loopsubdiv to level 9 of 8 triangles makes 2097152 triangles; with the 0 "
+                 "tessellated before it that is past the 1048576 a scene may make (CLPT_MAX_TESSELLATED_TRIANGLES)");
+    {
+        /* four of 4^9 triangles fill the budget exactly; the fifth is refused */
+        char big[1024];
+        size_t len = 0;
+        for (int i = 0; i < 5; i++)
+            len += (size_t)snprintf(big + len, sizeof big - len, "Shape \"loopsubdiv\" \"integer levels\" 9 "
+                                    "\"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 2 ]\n");
+        expect_error(big, DIR "inline.pbrt:5:7: loopsubdiv to level 9 of 1 triangles makes 262144 triangles; with "
+                     "the 1048576 tessellated before it that is past the 1048576 a scene may make "
+                     "(CLPT_MAX_TESSELLATED_TRIANGLES)");
+    }
     CHECK(strstr(err.msg, "makes more than 1048576 triangles") != NULL);
     /* through the reader: 8 * 4^2 triangles, the corners at their limits */
     static const char text[] = "Shape \"loopsubdiv\" \"integer levels\" 2\n"
@@ -1258,6 +1336,7 @@ int main(void)
     RUN(test_infinite_map);
     RUN(test_checkerboard_scale);
     RUN(test_loop_limits);
+    RUN(test_squashed_spheres);
     RUN(test_detect);
     RUN(test_basic);
     RUN(test_transforms);

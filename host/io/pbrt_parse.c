@@ -83,6 +83,7 @@ typedef struct {
 /* An ObjectBegin/End's shapes, taken out of the scene and copied in at each instance. */
 typedef struct {
     Sphere *spheres;      size_t n_spheres;
+    SphereXform *sphere_xforms;  size_t n_sphere_xforms;   /* Sphere.xform indexes this */
     Triangle *triangles;  size_t n_triangles;
     TriShading *shading;  size_t n_shading;   /* Triangle.shading indexes this */
 } PObject;
@@ -110,7 +111,10 @@ typedef struct {
     StrMap object_by_name;   /* name -> index into objects */
     PObject *objects;  size_t n_objects, cap_objects;
     int in_object;           /* inside ObjectBegin: what it started with */
-    size_t obj_spheres, obj_triangles, obj_shading, obj_stack;
+    size_t obj_spheres, obj_triangles, obj_shading, obj_stack, obj_sphere_xforms;
+    /* triangles made so far by tessellating what the file describes in a few numbers
+     * (loopsubdiv, emitting ellipsoids): at most CLPT_MAX_TESSELLATED_TRIANGLES */
+    size_t tessellated;
     Token obj_name;          /* its name, copied into obj_name_buf */
     char *obj_name_buf;
     ParamList pl;
@@ -1830,11 +1834,28 @@ static int is_similarity(const Transform *t, double *scale)
     return 1;
 }
 
-/* A sphere under a transform that is not a similarity (an ellipsoid), or turned inside
- * out: a UV sphere of 64 x 32 quads through the mesh sink. */
+/* Counts `tris` more tessellated triangles against CLPT_MAX_TESSELLATED_TRIANGLES, before
+ * anything is made: a few numbers in a file (a loopsubdiv's levels, thousands of
+ * emitting ellipsoids) must not become gigabytes. `what` names them in the message. */
+static Status tessellation_budget(Parser *p, const Lexer *lx, const Token *at, size_t tris, const char *what)
+{
+    if (tris > CLPT_MAX_TESSELLATED_TRIANGLES - p->tessellated)
+        return lex_error_at(lx, at, p->err, "%s makes %zu triangles; with the %zu tessellated before it that is "
+                            "past the %u a scene may make (CLPT_MAX_TESSELLATED_TRIANGLES)", what, tris,
+                            p->tessellated, CLPT_MAX_TESSELLATED_TRIANGLES);
+    p->tessellated += tris;
+    return ST_OK;
+}
+
+/* sphere_tessellate's triangles: 64 x 32 quads less one triangle of each at the poles */
+enum { SPHERE_MESH_NU = 64, SPHERE_MESH_NV = 32,
+       SPHERE_MESH_TRIANGLES = 2 * SPHERE_MESH_NU * SPHERE_MESH_NV - 2 * SPHERE_MESH_NU };
+
+/* An emitting sphere under a transform that is not a similarity (an ellipsoid), or one
+ * turned inside out: a UV sphere of 64 x 32 quads through the mesh sink. */
 static Status sphere_tessellate(Parser *p, MeshSink *k, double r, uint material)
 {
-    enum { NU = 64, NV = 32 };
+    enum { NU = SPHERE_MESH_NU, NV = SPHERE_MESH_NV };
     Status st = mesh_sink_reserve(k, 2 * NU * NV, 2 * NU * NV);
     for (int j = 0; j < NV && !st; j++)
         for (int i = 0; i < NU && !st; i++) {
@@ -1872,7 +1893,16 @@ static Status shape_sphere(Parser *p, const Lexer *lx, const Token *type, uint m
         if (st) return st;
     }
     int emits = !v3_is_zero(p->s->materials[material].emission);
-    if (is_similarity(&p->g.ctm, &scale) && !(p->g.reverse && emits)) {
+    int similar = is_similarity(&p->g.ctm, &scale);
+    if (!similar && !emits) {
+        /* an ellipsoid stays analytic: 32 + 96 bytes however it is squashed */
+        Transform m = transform_scale(r, r, r);
+        m = transform_compose(&p->g.ctm, &m);
+        if ((st = scene_add_ellipsoid(p->s, &m, material, p->err)) == ST_INPUT)
+            error_prefix(p->err, "%s:%u:%u", lx->path, type->line, type->col);
+        return st;
+    }
+    if (similar && !(p->g.reverse && emits)) {
         Sphere sp;
         memset(&sp, 0, sizeof sp);
         sp.center = transform_point(&p->g.ctm, v3(0, 0, 0));
@@ -1883,6 +1913,11 @@ static Status shape_sphere(Parser *p, const Lexer *lx, const Token *type, uint m
             return lex_error_at(lx, type, p->err, "the sphere reaches beyond the largest float (about 3.4e38)");
         return scene_add_sphere(p->s, sp, p->err);
     }
+    /* an emitting ellipsoid, or a sphere that emits inwards: the kernels sample sphere
+     * lights by their cone of directions, which neither has, so a mesh */
+    if ((st = tessellation_budget(p, lx, type, SPHERE_MESH_TRIANGLES, "an emitting ellipsoid (or inward-emitting "
+                                  "sphere) as a mesh")))
+        return st;
     MeshSink k;
     size_t first = p->s->n_triangles;
     if ((st = mesh_sink_open(&k, p->s, &p->g.ctm, lx->path, p->err))) return st;
@@ -1892,7 +1927,11 @@ static Status shape_sphere(Parser *p, const Lexer *lx, const Token *type, uint m
 }
 
 /* pbrt's loopsubdiv: subdivided here to `levels` (default 3), limit positions, smooth
- * normals (scene/subdiv.h). */
+ * normals (scene/subdiv.h). Each level makes four triangles of one, so a 4 KB file asked
+ * for 33 million triangles: levels stop at PBRT_MAX_SUBDIV_LEVELS and the triangles
+ * count against the scene's tessellation budget (tessellation_budget). pbrt-v4 itself
+ * has no bound; its scenes use levels up to about 5. */
+#define PBRT_MAX_SUBDIV_LEVELS 10
 static Status shape_loopsubdiv(Parser *p, const Lexer *lx, const Token *type, uint material)
 {
     Param *P = param_find(p, "P"), *ix;
@@ -1902,10 +1941,19 @@ static Status shape_loopsubdiv(Parser *p, const Lexer *lx, const Token *type, ui
     long levels = 3;
     Status st = get_int(p, lx, "levels", &levels);
     if (st) return st;
-    if (levels < 0 || levels > 16) return param_type_error(p, lx, param_find(p, "levels"), "in 0..16");
+    if (levels < 0 || levels > PBRT_MAX_SUBDIV_LEVELS)
+        return lex_error_at(lx, type, p->err, "loopsubdiv level %ld is beyond %d (each level makes four "
+                            "triangles of one: level %d makes 4^%d = %.0f of each)", levels, PBRT_MAX_SUBDIV_LEVELS,
+                            (int)levels, (int)levels, pow(4.0, (double)levels));
     if ((st = get_indices(p, lx, "indices", 3, np, NULL, &ix))) return st;
     if (!ix) return lex_error_at(lx, type, p->err, "a loopsubdiv needs \"integer indices\"");
     size_t nt = ix->n / 3;
+    /* nt 4^levels, saturated; counted before anything is allocated */
+    size_t made = nt;
+    for (long l = 0; l < levels; l++) made = made > SIZE_MAX / 4 ? SIZE_MAX : made * 4;
+    char what[96];
+    snprintf(what, sizeof what, "loopsubdiv to level %ld of %zu triangles", levels, nt);
+    if ((st = tessellation_budget(p, lx, type, made, what))) return st;
     uint32_t *idx = malloc(ix->n * sizeof *idx + 1);
     if (!idx) return error_set(p->err, ST_INTERNAL, "out of memory");
     for (size_t i = 0; i < ix->n; i++) idx[i] = (uint32_t)p->pl.nums[ix->first + i];
@@ -2106,6 +2154,7 @@ static Status d_object_begin(Parser *p, Lexer *lx, const Token *kw)
     p->in_object = 1;
     p->obj_stack = p->n_stack;
     p->obj_spheres = p->s->n_spheres;
+    p->obj_sphere_xforms = p->s->n_sphere_xforms;
     p->obj_triangles = p->s->n_triangles;
     p->obj_shading = p->s->n_shading;
     free(p->obj_name_buf);
@@ -2128,12 +2177,19 @@ static Status d_object_end(Parser *p, Lexer *lx, const Token *kw)
     o.n_spheres = s->n_spheres - p->obj_spheres;
     o.n_triangles = s->n_triangles - p->obj_triangles;
     o.n_shading = s->n_shading - p->obj_shading;
+    o.n_sphere_xforms = s->n_sphere_xforms - p->obj_sphere_xforms;
+    o.sphere_xforms = malloc(o.n_sphere_xforms * sizeof *o.sphere_xforms + 1);
+    if (!o.sphere_xforms) return error_set(p->err, ST_INTERNAL, "out of memory");
+    if (o.n_sphere_xforms)
+        memcpy(o.sphere_xforms, s->sphere_xforms + p->obj_sphere_xforms, o.n_sphere_xforms * sizeof *o.sphere_xforms);
+    s->n_sphere_xforms = p->obj_sphere_xforms;
     o.spheres = malloc(o.n_spheres * sizeof *o.spheres + 1);
     o.triangles = malloc(o.n_triangles * sizeof *o.triangles + 1);
     o.shading = malloc(o.n_shading * sizeof *o.shading + 1);
     if (!o.spheres || !o.triangles || !o.shading ||
         grow((void **)&p->objects, &p->cap_objects, p->n_objects + 1, sizeof(PObject))) {
         free(o.spheres);
+        free(o.sphere_xforms);
         free(o.triangles);
         free(o.shading);
         return error_set(p->err, ST_INTERNAL, "out of memory");
@@ -2145,12 +2201,15 @@ static Status d_object_end(Parser *p, Lexer *lx, const Token *kw)
     if (o.n_shading) memcpy(o.shading, s->shading + p->obj_shading, o.n_shading * sizeof *o.shading);
     for (size_t i = 0; i < o.n_triangles; i++)
         if (o.triangles[i].shading != NO_INDEX) o.triangles[i].shading -= (uint)p->obj_shading;
+    for (size_t i = 0; i < o.n_spheres; i++)
+        if (o.spheres[i].xform) o.spheres[i].xform -= (uint)p->obj_sphere_xforms;
     s->n_spheres = p->obj_spheres;
     s->n_triangles = p->obj_triangles;
     s->n_shading = p->obj_shading;
     /* a name defined again replaces the earlier object, for the instances after it */
     if (strmap_set(&p->object_by_name, p->obj_name.text, p->obj_name.len, (uint32_t)p->n_objects)) {
         free(o.spheres);
+        free(o.sphere_xforms);
         free(o.triangles);
         free(o.shading);
         return error_set(p->err, ST_INTERNAL, "out of memory");
@@ -2159,6 +2218,30 @@ static Status d_object_end(Parser *p, Lexer *lx, const Token *kw)
     p->in_object = 0;
     p->g = p->stack[--p->n_stack];
     return ST_OK;
+}
+
+/* An object's sphere sp under the instance's transform when either makes it an
+ * ellipsoid: the unit sphere under ctm . (sp's own transform). Emitting ones are
+ * skipped with a warning (their lights would need a mesh, made per instance). */
+static Status instance_ellipsoid(Parser *p, const Lexer *lx, const Token *name, const PObject *o, const Sphere *sp)
+{
+    if (!v3_is_zero(p->s->materials[sp->material].emission))
+        return warn_once(p, lx, name, "instance-sphere", "an emitting sphere in an instance whose transform is not a "
+                         "similarity (an ellipsoid) is skipped");
+    Transform own;
+    if (sp->xform) {
+        const float *m = o->sphere_xforms[sp->xform - 1u].to_world;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 4; j++) own.m[i][j] = m[4 * i + j];
+    } else {
+        Transform t = transform_translate(sp->center.x, sp->center.y, sp->center.z),
+                  sc = transform_scale(sp->radius, sp->radius, sp->radius);
+        own = transform_compose(&t, &sc);
+    }
+    Transform m = transform_compose(&p->g.ctm, &own);
+    Status st = scene_add_ellipsoid(p->s, &m, sp->material, p->err);
+    if (st == ST_INPUT) error_prefix(p->err, "%s:%u:%u: the instanced sphere", lx->path, name->line, name->col);
+    return st;
 }
 
 static Status d_object_instance(Parser *p, Lexer *lx, const Token *kw)
@@ -2197,10 +2280,9 @@ static Status d_object_instance(Parser *p, Lexer *lx, const Token *kw)
     double scale;
     int similar = is_similarity(&p->g.ctm, &scale);
     for (size_t j = 0; j < o->n_spheres && !st; j++) {
-        if (!similar) {
-            st = warn_once(p, lx, &name, "instance-sphere", "a sphere in an instance whose transform is not a "
-                           "similarity (an ellipsoid) is skipped");
-            break;
+        if (!similar || o->spheres[j].xform) {
+            st = instance_ellipsoid(p, lx, &name, o, &o->spheres[j]);
+            continue;
         }
         Sphere sp = o->spheres[j];
         sp.center = transform_point(&p->g.ctm, sp.center);
@@ -2496,6 +2578,7 @@ Status pbrt_load_text(const char *path, const char *text, size_t len, Scene *s, 
     strmap_free(&p.object_by_name);
     for (size_t i = 0; i < p.n_objects; i++) {
         free(p.objects[i].spheres);
+        free(p.objects[i].sphere_xforms);
         free(p.objects[i].triangles);
         free(p.objects[i].shading);
     }

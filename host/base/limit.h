@@ -41,10 +41,11 @@
  * and copied once more into the scene. Compressed images (PNG, JPEG) can claim this
  * from a few bytes, so the size is read from the header before decoding. */
 #define CLPT_MAX_TEXTURE_PIXELS (8192u * 8192u)
-/* Triangles made from the classic format's spheres under non-uniform transforms (each
- * becomes a mesh of 9,024 triangles): about 116 such spheres, and 0.5 GB with their
- * shading records and kd-tree. A 65 KB file of 1,000 squashed spheres made 9 million
- * triangles and took 4.6 GB. */
+/* Triangles one scene may make from a few numbers in its file: the classic format's
+ * spheres under non-uniform transforms (each becomes a mesh of 9,024 triangles): about
+ * 116 such spheres, and 0.5 GB with their shading records and kd-tree (a 65 KB file of
+ * 1,000 squashed spheres made 9 million triangles and took 4.6 GB); pbrt's loopsubdiv
+ * levels (a 4 KB file asked for 33 million) and emitting ellipsoids. */
 #define CLPT_MAX_TESSELLATED_TRIANGLES (1u << 20)
 /* Any one input file: it is read whole into memory. */
 #define CLPT_MAX_FILE_BYTES ((uint64_t)4 << 30)

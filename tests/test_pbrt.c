@@ -843,7 +843,8 @@ static void test_loop_limits(void)
     expect_error("Shape \"loopsubdiv\" \"integer levels\" 9 \"point3 P\" [ 1 0 0 -1 0 0 0 1 0 0 -1 0 0 0 1 0 0 -1 ] "
                  "\"integer indices\" [ 0 2 4 2 1 4 1 3 4 3 0 4 2 0 5 1 2 5 3 1 5 0 3 5 ]",
                  DIR "inline.pbrt:1:7: loopsubdiv to level 9 of 8 triangles makes 2097152 triangles; with the 0 "
-                 "tessellated before it that is past the 1048576 a scene may make (CLPT_MAX_TESSELLATED_TRIANGLES)");
+                 "tessellated before it that is past the 1058880 a scene of 161 bytes may make (1048576 and 64 per "
+                 "byte of its files)");
     {
         /* four of 4^9 triangles fill the budget exactly; the fifth is refused */
         char big[1024];
@@ -852,8 +853,20 @@ static void test_loop_limits(void)
             len += (size_t)snprintf(big + len, sizeof big - len, "Shape \"loopsubdiv\" \"integer levels\" 9 "
                                     "\"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 2 ]\n");
         expect_error(big, DIR "inline.pbrt:5:7: loopsubdiv to level 9 of 1 triangles makes 262144 triangles; with "
-                     "the 1048576 tessellated before it that is past the 1048576 a scene may make "
-                     "(CLPT_MAX_TESSELLATED_TRIANGLES)");
+                     "the 1048576 tessellated before it that is past the 1080256 a scene of 495 bytes may make "
+                     "(1048576 and 64 per byte of its files)");
+        /* a larger file may make more: the same five shapes after 4 KB of comments load */
+        char *padded = malloc(8192);
+        size_t n = 0;
+        while (n < 4096) n += (size_t)snprintf(padded + n, 8192 - n, "# a large scene's other lines\n");
+        snprintf(padded + n, 8192 - n, "%s", big);
+        Scene s5;
+        Error e5 = { 0 };
+        CHECK_EQ_INT(load_text(padded, &s5, &e5), ST_OK);
+        CHECK_EQ_INT(s5.n_triangles, 5 << 18);
+        scene_free(&s5);
+        error_clear(&e5);
+        free(padded);
     }
     CHECK(strstr(err.msg, "makes more than 1048576 triangles") != NULL);
     /* through the reader: 8 * 4^2 triangles, the corners at their limits */

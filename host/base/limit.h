@@ -47,6 +47,11 @@
  * 1,000 squashed spheres made 9 million triangles and took 4.6 GB); pbrt's loopsubdiv
  * levels (a 4 KB file asked for 33 million) and emitting ellipsoids. */
 #define CLPT_MAX_TESSELLATED_TRIANGLES (1u << 20)
+/* pbrt scenes may tessellate this many more triangles per byte of input they read: a
+ * real mesh written as text takes 20 or more bytes a triangle, so its loopsubdiv to
+ * level 3 (64 triangles of one, pbrt's default) fits whatever its size, where a 4 KB
+ * file stays near CLPT_MAX_TESSELLATED_TRIANGLES. */
+#define CLPT_TESSELLATED_PER_INPUT_BYTE 64u
 /* Any one input file: it is read whole into memory. */
 #define CLPT_MAX_FILE_BYTES ((uint64_t)4 << 30)
 /* The text one scene load reads, all its files together (includes, meshes, MTL files,

@@ -117,6 +117,8 @@ void lex_load_end(void)
     if (lex_load.depth > 0) lex_load.depth--;
 }
 
+uint64_t lex_load_bytes(void) { return lex_load.depth ? lex_load.used : 0; }
+
 /* The most bytes the next file may take: its own limit, and within a load what is left
  * of the load's budget. */
 static uint64_t read_limit(void)
@@ -132,6 +134,14 @@ static Status over_limit(const char *path, uint64_t bytes, Error *err)
     return error_set(err, ST_INPUT, "'%s': reading it takes this load's input to more than %llu bytes (the files "
                      "of one scene together, .gz files inflated; CLPT_MAX_LOAD_BYTES sets the budget)", path,
                      (unsigned long long)lex_load.budget);
+}
+
+Status lex_load_count(const char *path, uint64_t bytes, Error *err)
+{
+    if (!lex_load.depth) return ST_OK;
+    if (bytes > read_limit()) return over_limit(path, bytes, err);
+    lex_load.used += bytes;
+    return ST_OK;
 }
 
 /* Only the name says a file is compressed: a glTF .bin or a binary PLY may well start

@@ -81,6 +81,12 @@ Status lex_check_file(const char *path, Error *err);
  * limit applies. */
 Status lex_load_begin(Error *err);
 void lex_load_end(void);
+/* The bytes the files of this thread's load in progress have taken so far (0 outside
+ * a load): what budgets that grow with a scene's size are measured against. */
+uint64_t lex_load_bytes(void);
+/* Counts `bytes` of text a caller holds in memory (the scene handed to scene_load_bytes)
+ * against the load's budget, as if read from `path`; the budget's error past it. */
+Status lex_load_count(const char *path, uint64_t bytes, Error *err);
 
 /* 3 when text starts with a UTF-8 byte order mark (EF BB BF), else 0. */
 size_t lex_bom_length(const char *text, size_t len);

@@ -1834,15 +1834,20 @@ static int is_similarity(const Transform *t, double *scale)
     return 1;
 }
 
-/* Counts `tris` more tessellated triangles against CLPT_MAX_TESSELLATED_TRIANGLES, before
- * anything is made: a few numbers in a file (a loopsubdiv's levels, thousands of
- * emitting ellipsoids) must not become gigabytes. `what` names them in the message. */
+/* Counts `tris` more tessellated triangles against the scene's budget, before anything
+ * is made: a few numbers in a file (a loopsubdiv's levels, thousands of emitting
+ * ellipsoids) must not become gigabytes, while a large subdivided model, whose file is
+ * large too, must still load. The budget is CLPT_MAX_TESSELLATED_TRIANGLES and
+ * CLPT_TESSELLATED_PER_INPUT_BYTE for each byte the load has read so far. `what` names
+ * the shape in the message. */
 static Status tessellation_budget(Parser *p, const Lexer *lx, const Token *at, size_t tris, const char *what)
 {
-    if (tris > CLPT_MAX_TESSELLATED_TRIANGLES - p->tessellated)
+    uint64_t budget = CLPT_MAX_TESSELLATED_TRIANGLES + CLPT_TESSELLATED_PER_INPUT_BYTE * lex_load_bytes();
+    if (tris > budget - p->tessellated)
         return lex_error_at(lx, at, p->err, "%s makes %zu triangles; with the %zu tessellated before it that is "
-                            "past the %u a scene may make (CLPT_MAX_TESSELLATED_TRIANGLES)", what, tris,
-                            p->tessellated, CLPT_MAX_TESSELLATED_TRIANGLES);
+                            "past the %llu a scene of %llu bytes may make (%u and %u per byte of its files)", what,
+                            tris, p->tessellated, (unsigned long long)budget, (unsigned long long)lex_load_bytes(),
+                            CLPT_MAX_TESSELLATED_TRIANGLES, CLPT_TESSELLATED_PER_INPUT_BYTE);
     p->tessellated += tris;
     return ST_OK;
 }

@@ -77,7 +77,8 @@ Status scene_load_bytes(const char *path, const char *text, size_t len, SceneFor
 {
     Status st = lex_load_begin(err);
     if (st) return st;
-    st = load_bytes(path, text, len, format, s, kind, err);
+    st = lex_load_count(path, len, err);
+    if (!st) st = load_bytes(path, text, len, format, s, kind, err);
     lex_load_end();
     return st;
 }

@@ -12,7 +12,7 @@
 #define CLPT_COURSE_ARGS_H
 
 #include "base/status.h"
-#include "options.h"
+#include "option_values.h"
 
 typedef enum { COURSE_NONE = 0, COURSE_MIT, COURSE_TSINGHUA } CourseStyle;
 

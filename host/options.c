@@ -1,4 +1,9 @@
-/* options.c — command-line parsing, strict: every value is checked whole and in range. */
+/* options.c — command-line parsing, strict: every value is checked whole and in range.
+ *
+ * OPTIONS(X) below is THE list of flags (as kernels/scene_buffers.h is of the scene
+ * buffers): the parser, the flag lines of --help and the choices an error message
+ * lists are all generated from it. A new flag is one entry there (and its field in
+ * Options, option_values.h). */
 #include "options.h"
 
 #include "course_args.h"
@@ -14,10 +19,212 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Every line within 80 columns (tests/test_cli.c checks): a terminal's width. */
-void options_print_help(FILE *f)
-{
-    fputs(
+/*
+ * OPTIONS(X) calls X(section, kind, field, name, alias, metavar, extra, help) once per
+ * flag, in the order of --help:
+ *   section  the --help section it is listed in (HELP_section below)
+ *   kind     how its value is read: OPTION_kind (options.h)
+ *   field    the member of Options it sets (its type is checked against the kind; a
+ *            CUSTOM flag's function may set more than this one)
+ *   name, alias  "--output" and "-o" (NULL: no short form)
+ *   metavar  its value's name in --help ("FILE"); NULL for a switch, and for a choice,
+ *            whose words are listed instead ("bvh|kdtree")
+ *   extra    NONE, or what the kind needs: WHAT("file name") for TEXT (the error
+ *            message's "needs a file name"), RANGE(lo, hi) for LONG/UINT/INT, ONE_OF(
+ *            { "word", value }, ...) for CHOICE, PARSE(function) for CUSTOM
+ *   help     its --help text, '\n' between lines: each line within 80 columns once
+ *            indented to column 29 (tests/test_cli.c checks)
+ */
+#define OPTIONS(X) \
+    X(OUTPUT, TEXT, output, "--output", "-o", "FILE", WHAT("file name"), \
+        "image to write: .png, .ppm or .bmp (8-bit sRGB)\n" \
+        "or .pfm, .exr (half; see --exr-float) or .hdr\n" \
+        "(linear float); default: the file a pbrt\n" \
+        "scene's Film names, else SCENE's name\n" \
+        "with .png, in the current folder. Written\n" \
+        "atomically; a symlink is followed and an\n" \
+        "existing file keeps its permissions; only a\n" \
+        "regular file is replaced (a FIFO or device\n" \
+        "is refused). Checked before rendering") \
+    X(OUTPUT, LONG, spp, "--spp", NULL, "N", RANGE(1, CLPT_MAX_SPP), \
+        "samples per pixel (overrides the scene)") \
+    X(OUTPUT, LONG, width, "--width", NULL, "N", RANGE(1, CLPT_MAX_IMAGE_SIDE), \
+        "image width in pixels (overrides the scene)") \
+    X(OUTPUT, LONG, height, "--height", NULL, "N", RANGE(1, CLPT_MAX_IMAGE_SIDE), \
+        "image height in pixels (overrides the scene)") \
+    X(OUTPUT, LONG, seed, "--seed", NULL, "N", RANGE(0, 4294967295L), \
+        "random seed; the same seed gives the same image\n" \
+        "on any devices and batch sizes") \
+    X(OUTPUT, LONG, max_depth, "--max-depth", NULL, "N", RANGE(0, CLPT_MAX_DEPTH), \
+        "longest path, in bounces (overrides the scene)") \
+    X(OUTPUT, LONG, split, "--split", NULL, "N", RANGE(1, CLPT_MAX_SPLIT), \
+        "path tracer: shade each camera sample's first hit\n" \
+        "N times, each with its own light sample and\n" \
+        "continuation weighted 1/N, sharing the camera ray\n" \
+        "(1..64; overrides the scene's image split; 1: none,\n" \
+        "the default)") \
+    X(OUTPUT, CHOICE, sampler, "--sampler", NULL, NULL, \
+        ONE_OF({ "sobol", SAMPLER_SOBOL }, { "independent", SAMPLER_INDEPENDENT }), \
+        "random numbers: Owen-scrambled Sobol points\n" \
+        "(default; less noise) or independent ones\n" \
+        "(clpt's earlier sampler, the same images)") \
+    X(OUTPUT, CHOICE, accel, "--accel", NULL, NULL, ONE_OF({ "bvh", ACCEL_BVH }, { "kdtree", ACCEL_KDTREE }), \
+        "the tree rays find primitives through: an 8-wide\n" \
+        "BVH (default; faster) or the SAH kd-tree") \
+    X(OUTPUT, SECONDS, time_limit, "--time-limit", NULL, "SECONDS", NONE, \
+        "stop starting new batches after this long; the\n" \
+        "image holds the whole batches finished by then\n" \
+        "(none: the output is left alone, exit status 7)") \
+    X(OUTPUT, SECONDS, progressive_seconds, "--progressive-output", NULL, "SECONDS", NONE, \
+        "rewrite the output image every SECONDS during\n" \
+        "the render") \
+    X(OUTPUT, CHOICE, gamma, "--gamma", NULL, NULL, ONE_OF({ "srgb", 0 }, { "none", 1 }), \
+        "8-bit images with the sRGB curve or without\n" \
+        "(linear values times 255); default: srgb, none\n" \
+        "for classic scenes") \
+    X(OUTPUT, SWITCH, exr_float, "--exr-float", NULL, NULL, NONE, \
+        "EXR channels as 32-bit floats (default: half)") \
+    X(OUTPUT, CUSTOM, aovs, "--aov", NULL, "LIST", PARSE(parse_aovs), \
+        "also write auxiliary images of the first hit,\n" \
+        "comma-separated: normal (as colours), depth\n" \
+        "(grey: near white, far black), albedo; to\n" \
+        "OUTPUT-normal.png etc.; an .exr output holds\n" \
+        "them as channels normal.X/Y/Z (signed), Z\n" \
+        "(distance) and albedo.R/G/B instead. Depth\n" \
+        "in .pfm and .exr is the distance, +inf where\n" \
+        "nothing is hit; in 8-bit images misses are\n" \
+        "black") \
+    X(OUTPUT, CUSTOM, depth_near, "--depth-range", NULL, "NEAR,FAR", PARSE(parse_depth_range), \
+        "the depth image is linear from white at NEAR to\n" \
+        "black at FAR (NEAR > FAR inverts it; default:\n" \
+        "inverse distance, nearest hit white). Needs\n" \
+        "--aov depth") \
+    X(CHECKPOINT, TEXT, checkpoint_path, "--checkpoint", NULL, "FILE", WHAT("file name"), \
+        "save the render's state to FILE (atomically)\n" \
+        "every --checkpoint-interval seconds, on\n" \
+        "Ctrl-C/SIGTERM and at the end") \
+    X(CHECKPOINT, SECONDS, checkpoint_seconds, "--checkpoint-interval", NULL, "SECONDS", NONE, \
+        "seconds between checkpoints (default 60)") \
+    X(CHECKPOINT, TEXT, resume_path, "--resume", NULL, "FILE", WHAT("file name"), \
+        "continue the render saved in FILE: only the\n" \
+        "samples not in it are rendered, and the image is\n" \
+        "the same bits as an uninterrupted render's. The\n" \
+        "scene and settings must be the ones it was made\n" \
+        "with (else exit status 3). Checkpoints go on\n" \
+        "into FILE unless --checkpoint names another file") \
+    X(CHECKPOINT, CUSTOM, range_first, "--sample-range", NULL, "A:B", PARSE(parse_sample_range), \
+        "render only samples A..B-1 of every pixel: a part\n" \
+        "of the render for 'clpt merge' (with --checkpoint\n" \
+        "PART); -o gets the part's own image") \
+    X(MPI, SWITCH, mpi_broadcast, "--mpi-broadcast", NULL, NULL, NONE, \
+        "rank 0 reads the scene and sends it to the\n" \
+        "others (default: every rank reads SCENE, which\n" \
+        "must then be on a shared path)") \
+    X(MPI, SECONDS, mpi_timeout, "--mpi-timeout", NULL, "SECONDS", NONE, \
+        "give a rank up after this long without a word\n" \
+        "from it (default 30); its batches go to others.\n" \
+        "Also how long the job may take to start") \
+    X(SCENE, CHOICE, format, "--format", NULL, NULL, \
+        ONE_OF({ "auto", SCENE_FORMAT_AUTO }, { "clpt", SCENE_FORMAT_CLPT }, { "classic", SCENE_FORMAT_CLASSIC }, \
+               { "pbrt", SCENE_FORMAT_PBRT }), \
+        "scene file format; default: told from the content\n" \
+        "(pbrt: pbrt-v4 scenes, see docs/pbrt.md)") \
+    X(SCENE, TEXT, camera, "--camera", NULL, "N|NAME", WHAT("camera index or name"), \
+        "glTF: look through camera N (from 0) or the camera\n" \
+        "(or camera node) named NAME; default: the first") \
+    X(SCENE, CHOICE, integrator, "--integrator", NULL, NULL, \
+        ONE_OF({ "path", INTEGRATOR_PATH }, { "whitted", INTEGRATOR_WHITTED }), \
+        "path tracing (default) or the classic ray tracer\n" \
+        "(the default for classic scenes): Phong shading,\n" \
+        "hard shadows (see --shadows), mirror and\n" \
+        "refraction rays up to --max-depth; one ray\n" \
+        "through each pixel centre unless --spp N\n" \
+        "(jittered; an m x m grid when N = m*m)") \
+    X(SCENE, CHOICE, shadows, "--shadows", NULL, NULL, ONE_OF({ "on", 1 }, { "off", 0 }), \
+        "whether lights can be blocked (shadow rays), in\n" \
+        "both integrators; default: on, off for classic\n" \
+        "scenes (as the course ray casters)") \
+    X(SCENE, CUSTOM, adaptive, "--adaptive", NULL, "THRESHOLD", PARSE(parse_adaptive), \
+        "whitted: after the first pass, render\n" \
+        "--adaptive-spp more samples in each pixel that\n" \
+        "differs from a neighbour by more than THRESHOLD\n" \
+        "(0..1) in some channel") \
+    X(SCENE, UINT, adaptive_spp, "--adaptive-spp", NULL, "N", RANGE(1, 65536), \
+        "extra samples per such pixel (default 16; needs\n" \
+        "--adaptive)") \
+    X(VIEWER, SWITCH, interactive, "--interactive", "-i", NULL, NONE, \
+        "show SCENE in a window and render it\n" \
+        "progressively while the camera moves (needs a\n" \
+        "display: else exit status 5). Keys: W/A/S/D\n" \
+        "move, R/F or Q/E up/down, drag the mouse to\n" \
+        "look, wheel forward/back, Z/X field of view,\n" \
+        "Up/Down focus distance, Right/Left aperture,\n" \
+        "+/- exposure, Space pause, C save the image\n" \
+        "(SCENE-view-NNN.png and .pfm, never over an\n" \
+        "earlier save), P print the camera as a scene\n" \
+        "block, H help, F11 full screen, Esc quit.\n" \
+        "A view renders up to --spp (else the scene's\n" \
+        "spp) samples per pixel") \
+    X(DEVICES, SWITCH, list_devices, "--list-devices", NULL, NULL, NONE, \
+        "print every OpenCL platform and device with its\n" \
+        "index, and the scalar device, then exit") \
+    X(DEVICES, TEXT, device_spec, "--device", NULL, "SPEC", WHAT("device list"), \
+        "devices to render with, comma-separated: an\n" \
+        "OpenCL device's index from --list-devices,\n" \
+        "'all', 'gpu', 'cpu' (OpenCL CPU devices),\n" \
+        "'scalar', or part of a device or platform\n" \
+        "name. Default: every OpenCL GPU, else the\n" \
+        "OpenCL CPU devices, else the scalar device") \
+    X(DEVICES, INT, threads, "--threads", NULL, "N", RANGE(1, 256), \
+        "worker threads of the scalar device (default:\n" \
+        "all cores)") \
+    X(REPORTING, SWITCH, stats, "--stats", NULL, NULL, NONE, \
+        "print scene, tree (BVH or kd-tree), kernel\n" \
+        "build, OpenCL wave (size, how it runs) and\n" \
+        "per-device statistics to stdout") \
+    X(REPORTING, SWITCH, profile, "--profile", NULL, NULL, NONE, \
+        "--stats, and where each device's time goes: ray\n" \
+        "generation, traversal, shading, shadow rays,\n" \
+        "film, queues, host waits (slows rendering)") \
+    X(REPORTING, SWITCH, quiet, "--quiet", "-q", NULL, NONE, \
+        "no progress bar and no summary line") \
+    X(REPORTING, SWITCH, help, "--help", "-h", NULL, NONE, \
+        "print this help and exit") \
+    X(REPORTING, SWITCH, version, "--version", NULL, NULL, NONE, \
+        "print the version and exit") \
+    X(DEVELOPER, TEXT, kernel_dir, "--kernel-dir", NULL, "DIR", WHAT("folder name"), \
+        "compile the kernels from DIR/entry.cl instead of\n" \
+        "the copy built into the program (no kernel cache)") \
+    X(DEVELOPER, UINT, batch, "--batch", NULL, "N", RANGE(1, 1000000), \
+        "fixed batch size in samples per pixel (default:\n" \
+        "adaptive, about 0.25 s of work per batch)") \
+    X(DEVELOPER, UINT, wave_paths, "--wave-paths", NULL, "N", RANGE(1, 1L << 26), \
+        "paths per OpenCL wave (default: 2^22 on GPUs of\n" \
+        "8 GiB or more when it fits in half their\n" \
+        "memory, else 2^20; on CPUs 2^16 per compute\n" \
+        "unit up to 2^21 where it fits in half\n" \
+        "the memory, else 2^16; 2^14 with\n" \
+        "--interactive)") \
+    X(DEVELOPER, CHOICE, wave_launch, "--wave-launch", NULL, NULL, \
+        ONE_OF({ "counted", WAVE_LAUNCH_COUNTED }, { "bounded", WAVE_LAUNCH_BOUNDED }, \
+               { "megakernel", WAVE_LAUNCH_MEGAKERNEL }), \
+        "how an OpenCL device runs a wave: 'counted'\n" \
+        "launches each bounce over the live paths the\n" \
+        "device counted, read back first; 'bounded' all\n" \
+        "bounces at once over the wave's size, the kernels\n" \
+        "stopping at the count on the device (GPUs'\n" \
+        "default); 'megakernel' one kernel that runs each\n" \
+        "path to its end (CPUs' default; counted with\n" \
+        "--profile)")
+
+/* --help: each section's text, then its flags (a blank line after them). */
+enum {
+    HELP_INTRO, HELP_OUTPUT, HELP_CHECKPOINT, HELP_MPI, HELP_SCENE, HELP_VIEWER, HELP_DEVICES,
+    HELP_REPORTING, HELP_DEVELOPER, HELP_END, HELP_SECTIONS
+};
+
+static const char *const help_sections[HELP_SECTIONS] = {
+    [HELP_INTRO] =
 "usage: clpt [options] SCENE\n"
 "       clpt -size W H -input SCENE -output FILE [-normals FILE]\n"
 "            [-depth NEAR FAR FILE] [-bounces N] [-shadows] [--options]\n"
@@ -38,80 +245,9 @@ void options_print_help(FILE *f)
 "bounces, default 0; no shadows unless -shadows). -depth draws NEAR black and\n"
 "FAR white. See docs/classic-format.md.\n"
 "\n",
-        f);
-    /* several literals: C99 compilers need only support 4095 characters in one */
-    fputs(
-"Output and image:\n"
-"  -o, --output FILE          image to write: .png, .ppm or .bmp (8-bit sRGB)\n"
-"                             or .pfm, .exr (half; see --exr-float) or .hdr\n"
-"                             (linear float); default: the file a pbrt\n"
-"                             scene's Film names, else SCENE's name\n"
-"                             with .png, in the current folder. Written\n"
-"                             atomically; a symlink is followed and an\n"
-"                             existing file keeps its permissions; only a\n"
-"                             regular file is replaced (a FIFO or device\n"
-"                             is refused). Checked before rendering\n"
-"      --spp N                samples per pixel (overrides the scene)\n"
-"      --width N              image width in pixels (overrides the scene)\n"
-"      --height N             image height in pixels (overrides the scene)\n"
-"      --seed N               random seed; the same seed gives the same image\n"
-"                             on any devices and batch sizes\n"
-"      --max-depth N          longest path, in bounces (overrides the scene)\n"
-"      --split N              path tracer: shade each camera sample's first hit\n"
-"                             N times, each with its own light sample and\n"
-"                             continuation weighted 1/N, sharing the camera ray\n"
-"                             (1..64; overrides the scene's image split; 1: none,\n"
-"                             the default)\n"
-"      --sampler sobol|independent\n"
-"                             random numbers: Owen-scrambled Sobol points\n"
-"                             (default; less noise) or independent ones\n"
-"                             (clpt's earlier sampler, the same images)\n"
-"      --accel bvh|kdtree     the tree rays find primitives through: an 8-wide\n"
-"                             BVH (default; faster) or the SAH kd-tree\n"
-"      --time-limit SECONDS   stop starting new batches after this long; the\n"
-"                             image holds the whole batches finished by then\n"
-"                             (none: the output is left alone, exit status 7)\n"
-"      --progressive-output SECONDS\n"
-"                             rewrite the output image every SECONDS during\n"
-"                             the render\n"
-"      --gamma srgb|none      8-bit images with the sRGB curve or without\n"
-"                             (linear values times 255); default: srgb, none\n"
-"                             for classic scenes\n"
-"      --exr-float            EXR channels as 32-bit floats (default: half)\n"
-"      --aov LIST             also write auxiliary images of the first hit,\n"
-"                             comma-separated: normal (as colours), depth\n"
-"                             (grey: near white, far black), albedo; to\n"
-"                             OUTPUT-normal.png etc.; an .exr output holds\n"
-"                             them as channels normal.X/Y/Z (signed), Z\n"
-"                             (distance) and albedo.R/G/B instead. Depth\n"
-"                             in .pfm and .exr is the distance, +inf where\n"
-"                             nothing is hit; in 8-bit images misses are\n"
-"                             black\n"
-"      --depth-range NEAR,FAR the depth image is linear from white at NEAR to\n"
-"                             black at FAR (NEAR > FAR inverts it; default:\n"
-"                             inverse distance, nearest hit white). Needs\n"
-"                             --aov depth\n"
-"\n",
-        f);
-    fputs(
-"Checkpoints (docs/checkpoint.md):\n"
-"      --checkpoint FILE      save the render's state to FILE (atomically)\n"
-"                             every --checkpoint-interval seconds, on\n"
-"                             Ctrl-C/SIGTERM and at the end\n"
-"      --checkpoint-interval SECONDS\n"
-"                             seconds between checkpoints (default 60)\n"
-"      --resume FILE          continue the render saved in FILE: only the\n"
-"                             samples not in it are rendered, and the image is\n"
-"                             the same bits as an uninterrupted render's. The\n"
-"                             scene and settings must be the ones it was made\n"
-"                             with (else exit status 3). Checkpoints go on\n"
-"                             into FILE unless --checkpoint names another file\n"
-"      --sample-range A:B     render only samples A..B-1 of every pixel: a part\n"
-"                             of the render for 'clpt merge' (with --checkpoint\n"
-"                             PART); -o gets the part's own image\n"
-"\n",
-        f);
-    fputs(
+    [HELP_OUTPUT] = "Output and image:\n",
+    [HELP_CHECKPOINT] = "Checkpoints (docs/checkpoint.md):\n",
+    [HELP_MPI] =
 "Merging parts (docs/distributed.md):\n"
 "  clpt merge -o OUT PART...  add the films of --sample-range parts of one\n"
 "                             render exactly: OUT is the same bits as one\n"
@@ -125,99 +261,13 @@ void options_print_help(FILE *f)
 "                             devices (--device applies to each); rank 0\n"
 "                             hands out batches, writes every output and\n"
 "                             prints; the image is the same bits as one\n"
-"                             process's. Not with --adaptive or --aov\n"
-"      --mpi-broadcast        rank 0 reads the scene and sends it to the\n"
-"                             others (default: every rank reads SCENE, which\n"
-"                             must then be on a shared path)\n"
-"      --mpi-timeout SECONDS  give a rank up after this long without a word\n"
-"                             from it (default 30); its batches go to others.\n"
-"                             Also how long the job may take to start\n"
-"\n"
-"Scene and integrator:\n"
-"      --format auto|clpt|classic|pbrt\n"
-"                             scene file format; default: told from the content\n"
-"                             (pbrt: pbrt-v4 scenes, see docs/pbrt.md)\n"
-"      --camera N|NAME        glTF: look through camera N (from 0) or the camera\n"
-"                             (or camera node) named NAME; default: the first\n"
-"      --integrator path|whitted\n"
-"                             path tracing (default) or the classic ray tracer\n"
-"                             (the default for classic scenes): Phong shading,\n"
-"                             hard shadows (see --shadows), mirror and\n"
-"                             refraction rays up to --max-depth; one ray\n"
-"                             through each pixel centre unless --spp N\n"
-"                             (jittered; an m x m grid when N = m*m)\n"
-"      --shadows on|off       whether lights can be blocked (shadow rays), in\n"
-"                             both integrators; default: on, off for classic\n"
-"                             scenes (as the course ray casters)\n"
-"      --adaptive THRESHOLD   whitted: after the first pass, render\n"
-"                             --adaptive-spp more samples in each pixel that\n"
-"                             differs from a neighbour by more than THRESHOLD\n"
-"                             (0..1) in some channel\n"
-"      --adaptive-spp N       extra samples per such pixel (default 16; needs\n"
-"                             --adaptive)\n"
-"\n",
-        f);
-    fputs(
-"Interactive viewer (docs/viewer.md):\n"
-"  -i, --interactive          show SCENE in a window and render it\n"
-"                             progressively while the camera moves (needs a\n"
-"                             display: else exit status 5). Keys: W/A/S/D\n"
-"                             move, R/F or Q/E up/down, drag the mouse to\n"
-"                             look, wheel forward/back, Z/X field of view,\n"
-"                             Up/Down focus distance, Right/Left aperture,\n"
-"                             +/- exposure, Space pause, C save the image\n"
-"                             (SCENE-view-NNN.png and .pfm, never over an\n"
-"                             earlier save), P print the camera as a scene\n"
-"                             block, H help, F11 full screen, Esc quit.\n"
-"                             A view renders up to --spp (else the scene's\n"
-"                             spp) samples per pixel\n"
-"\n"
-"Devices:\n"
-"      --list-devices         print every OpenCL platform and device with its\n"
-"                             index, and the scalar device, then exit\n"
-"      --device SPEC          devices to render with, comma-separated: an\n"
-"                             OpenCL device's index from --list-devices,\n"
-"                             'all', 'gpu', 'cpu' (OpenCL CPU devices),\n"
-"                             'scalar', or part of a device or platform\n"
-"                             name. Default: every OpenCL GPU, else the\n"
-"                             OpenCL CPU devices, else the scalar device\n"
-"      --threads N            worker threads of the scalar device (default:\n"
-"                             all cores)\n"
-"\n",
-          f);
-    fputs(
-"Reporting:\n"
-"      --stats                print scene, tree (BVH or kd-tree), kernel\n"
-"                             build, OpenCL wave (size, how it runs) and\n"
-"                             per-device statistics to stdout\n"
-"      --profile              --stats, and where each device's time goes: ray\n"
-"                             generation, traversal, shading, shadow rays,\n"
-"                             film, queues, host waits (slows rendering)\n"
-"  -q, --quiet                no progress bar and no summary line\n"
-"  -h, --help                 print this help and exit\n"
-"      --version              print the version and exit\n"
-"\n"
-"Developer options:\n"
-"      --kernel-dir DIR       compile the kernels from DIR/entry.cl instead of\n"
-"                             the copy built into the program (no kernel cache)\n"
-"      --batch N              fixed batch size in samples per pixel (default:\n"
-"                             adaptive, about 0.25 s of work per batch)\n"
-"      --wave-paths N         paths per OpenCL wave (default: 2^22 on GPUs of\n"
-"                             8 GiB or more when it fits in half their\n"
-"                             memory, else 2^20; on CPUs 2^16 per compute\n"
-"                             unit up to 2^21 where it fits in half\n"
-"                             the memory, else 2^16; 2^14 with\n"
-"                             --interactive)\n"
-"      --wave-launch counted|bounded|megakernel\n"
-"                             how an OpenCL device runs a wave: 'counted'\n"
-"                             launches each bounce over the live paths the\n"
-"                             device counted, read back first; 'bounded' all\n"
-"                             bounces at once over the wave's size, the kernels\n"
-"                             stopping at the count on the device (GPUs'\n"
-"                             default); 'megakernel' one kernel that runs each\n"
-"                             path to its end (CPUs' default; counted with\n"
-"                             --profile)\n"
-"\n"
+"                             process's. Not with --adaptive or --aov\n",
+    [HELP_SCENE] = "Scene and integrator:\n",
+    [HELP_VIEWER] = "Interactive viewer (docs/viewer.md):\n",
+    [HELP_DEVICES] = "Devices:\n",
+    [HELP_REPORTING] = "Reporting:\n",
+    [HELP_DEVELOPER] = "Developer options:\n",
+    [HELP_END] =
 "Environment:\n"
 "  CLPT_CACHE_DIR             where compiled kernels are cached (default:\n"
 "                             $XDG_CACHE_HOME/clpt or ~/.cache/clpt)\n"
@@ -231,8 +281,7 @@ void options_print_help(FILE *f)
 "     file, or a checkpoint      finished was written\n"
 "     of another render)      7  nothing rendered: --time-limit ran out before\n"
 "                                the first batch; the output was left alone\n",
-        f);
-}
+};
 
 /* strtol and strtod skip leading blanks: " 5" would be 5, while "5 " is refused. A
  * number is refused with a blank at either end, so that what was typed is what counts. */
@@ -276,7 +325,7 @@ const char *options_aov_name(unsigned aov)
 }
 
 /* "normal,depth" -> the bits 1 << INTEGRATOR_AOV_NORMAL | 1 << INTEGRATOR_AOV_DEPTH */
-static Status options_parse_aovs(const char *list, unsigned *bits, Error *err)
+static Status parse_aovs(const char *list, Options *o, Error *err)
 {
     const char *p = list;
     do {
@@ -290,7 +339,7 @@ static Status options_parse_aovs(const char *list, unsigned *bits, Error *err)
         if (!found)
             return error_set(err, ST_USAGE, "--aov expects a comma-separated list of normal, depth, "
                              "albedo; got '%s'", list);
-        *bits |= 1u << found;
+        o->aovs |= 1u << found;
         p = end ? end + 1 : NULL;
     } while (p);
     return ST_OK;
@@ -350,151 +399,135 @@ static Status parse_adaptive(const char *v, Options *o, Error *err)
     return ST_OK;
 }
 
-/* One of `names` (NULL-terminated): its index into *out. */
-static Status parse_choice(const char *flag, const char *v, const char *const *names, const int *values,
-                           const char *expected, int *out, Error *err)
+/* ---------------------------------------------------------------- the table */
+
+#define NONE .what = NULL
+#define WHAT(text) .what = (text)
+#define RANGE(low, high) .lo = (low), .hi = (high)
+#define ONE_OF(...) .choices = (const OptionChoice[]){ __VA_ARGS__, { NULL, 0 } }
+#define PARSE(function) .parse = (function)
+
+static const OptionSpec option_specs[] = {
+#define X(sec, kind, field, name, alias, metavar, extra, text) \
+    { name, alias, OPTION_##kind, metavar, offsetof(Options, field), extra, .section = HELP_##sec, .help = text },
+    OPTIONS(X)
+#undef X
+};
+
+/* Each field has the type its kind stores. */
+#define FITS_SWITCH(e) _Generic((e), int: 1, default: 0)
+#define FITS_TEXT(e) _Generic((e), const char *: 1, default: 0)
+#define FITS_LONG(e) _Generic((e), long: 1, default: 0)
+#define FITS_UINT(e) _Generic((e), unsigned: 1, default: 0)
+#define FITS_INT(e) _Generic((e), int: 1, default: 0)
+#define FITS_SECONDS(e) _Generic((e), double: 1, default: 0)
+#define FITS_CHOICE(e) _Generic((e), int: 1, default: 0)
+#define FITS_CUSTOM(e) 1
+#define X(section, kind, field, name, alias, metavar, extra, help) \
+    _Static_assert(FITS_##kind(((Options *)0)->field), name ": Options." #field " is not what OPTION_" #kind " sets");
+OPTIONS(X)
+#undef X
+
+#define N_OPTIONS (sizeof option_specs / sizeof option_specs[0])
+
+const OptionSpec *options_flag(size_t i)
 {
-    for (size_t i = 0; names[i]; i++)
-        if (strcmp(v, names[i]) == 0) {
-            *out = values[i];
-            return ST_OK;
-        }
-    return error_set(err, ST_USAGE, "%s expects %s, got '%s'", flag, expected, v);
+    return i < N_OPTIONS ? &option_specs[i] : NULL;
 }
 
-/* Flags without a value: 1 when `a` is one (and it is set). */
-static int options_set_switch(const char *a, Options *o)
+/* A choice's words joined by `sep`, or written for a message ("'a', 'b' or 'c'"). */
+static void choices_text(const OptionChoice *c, int quoted, char *buf, size_t size)
 {
-    struct { const char *name, *alias; int *dst; } switches[] = {
-        { "--help", "-h", &o->help },      { "--version", NULL, &o->version },
-        { "--list-devices", NULL, &o->list_devices }, { "--stats", NULL, &o->stats },
-        { "--quiet", "-q", &o->quiet },    { "--mpi-broadcast", NULL, &o->mpi_broadcast },
-        { "--interactive", "-i", &o->interactive }, { "--profile", NULL, &o->profile },
-        { "--exr-float", NULL, &o->exr_float },
-    };
-    for (size_t k = 0; k < sizeof switches / sizeof switches[0]; k++)
-        if (strcmp(a, switches[k].name) == 0 || (switches[k].alias && strcmp(a, switches[k].alias) == 0)) {
-            *switches[k].dst = 1;
-            return 1;
-        }
-    return 0;
-}
-
-/* Flags whose value is a file, folder or device list, kept as given. */
-static Status options_set_name(const char *a, const char *v, Options *o, int *found, Error *err)
-{
-    struct { const char *name, *alias, *what; const char **dst; } names[] = {
-        { "--output", "-o", "file name", &o->output },
-        { "--checkpoint", NULL, "file name", &o->checkpoint_path },
-        { "--resume", NULL, "file name", &o->resume_path },
-        { "--device", NULL, "device list", &o->device_spec },
-        { "--kernel-dir", NULL, "folder name", &o->kernel_dir },
-        { "--camera", NULL, "camera index or name", &o->camera },
-    };
-    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
-        if (strcmp(a, names[k].name) != 0 && !(names[k].alias && strcmp(a, names[k].alias) == 0)) continue;
-        *found = 1;
-        if (!*v) return error_set(err, ST_USAGE, "%s needs a %s", a, names[k].what);
-        *names[k].dst = v;
-        return ST_OK;
+    size_t len = 0, n = 0;
+    while (c[n].name) n++;
+    buf[0] = '\0';
+    for (size_t i = 0; i < n && len < size; i++) {
+        const char *sep = i == 0 ? "" : !quoted ? "|" : i + 1 == n ? " or " : ", ";
+        int w = snprintf(buf + len, size - len, quoted ? "%s'%s'" : "%s%s", sep, c[i].name);
+        if (w < 0) break;
+        len += (size_t)w;
     }
-    return ST_OK;
 }
 
-/* Flags whose value is a number. */
-static Status options_set_number(const char *a, const char *v, Options *o, int *found, Error *err)
+/* "  -o, --output FILE", then the help from column 29 (on a line of its own when the
+ * flag is longer). */
+static void print_flag(FILE *f, const OptionSpec *s)
 {
-    long n;
-    Status st;
-    struct { const char *name; long lo, hi; long *dst; } longs[] = {
-        { "--spp", 1, CLPT_MAX_SPP, &o->spp },
-        { "--width", 1, CLPT_MAX_IMAGE_SIDE, &o->width },
-        { "--height", 1, CLPT_MAX_IMAGE_SIDE, &o->height },
-        { "--seed", 0, 4294967295L, &o->seed },
-        { "--max-depth", 0, CLPT_MAX_DEPTH, &o->max_depth },
-        { "--split", 1, CLPT_MAX_SPLIT, &o->split },
-    };
-    struct { const char *name; long lo, hi; unsigned *dst; } uints[] = {
-        { "--batch", 1, 1000000, &o->batch },
-        { "--wave-paths", 1, 1L << 26, &o->wave_paths },
-        { "--adaptive-spp", 1, 65536, &o->adaptive_spp },
-    };
-    struct { const char *name; double *dst; } seconds[] = {
-        { "--checkpoint-interval", &o->checkpoint_seconds },
-        { "--time-limit", &o->time_limit },
-        { "--progressive-output", &o->progressive_seconds },
-        { "--mpi-timeout", &o->mpi_timeout },
-    };
-    *found = 1;
-    for (size_t k = 0; k < sizeof longs / sizeof longs[0]; k++)
-        if (strcmp(a, longs[k].name) == 0) return parse_long(a, v, longs[k].lo, longs[k].hi, longs[k].dst, err);
-    for (size_t k = 0; k < sizeof uints / sizeof uints[0]; k++)
-        if (strcmp(a, uints[k].name) == 0) {
-            if ((st = parse_long(a, v, uints[k].lo, uints[k].hi, &n, err))) return st;
-            *uints[k].dst = (unsigned)n;
-            return ST_OK;
-        }
-    for (size_t k = 0; k < sizeof seconds / sizeof seconds[0]; k++)
-        if (strcmp(a, seconds[k].name) == 0) return parse_seconds(a, v, seconds[k].dst, err);
-    if (strcmp(a, "--threads") == 0) {
-        if ((st = parse_long(a, v, 1, 256, &n, err))) return st;
-        o->threads = (int)n;
-        return ST_OK;
+    char value[96];
+    if (s->choices) choices_text(s->choices, 0, value, sizeof value);
+    else snprintf(value, sizeof value, "%s", s->metavar ? s->metavar : "");
+    char label[160];
+    int n = snprintf(label, sizeof label, "  %s%s%s%s%s", s->alias ? s->alias : "  ", s->alias ? ", " : "  ",
+                     s->name, value[0] ? " " : "", value);
+    enum { HELP_COLUMN = 29 };
+    if (n < HELP_COLUMN) fprintf(f, "%-*s", HELP_COLUMN, label);
+    else fprintf(f, "%s\n%*s", label, HELP_COLUMN, "");
+    for (const char *p = s->help; *p; p++) {
+        fputc(*p, f);
+        if (*p == '\n') fprintf(f, "%*s", HELP_COLUMN, "");
     }
-    if (strcmp(a, "--adaptive") == 0) return parse_adaptive(v, o, err);
-    if (strcmp(a, "--sample-range") == 0) return parse_sample_range(v, o, err);
-    if (strcmp(a, "--depth-range") == 0) return parse_depth_range(v, o, err);
-    *found = 0;
-    return ST_OK;
+    fputc('\n', f);
 }
 
-/* Flags whose value is a word from a list. */
-static Status options_set_choice(const char *a, const char *v, Options *o, int *found, Error *err)
+void options_print_help(FILE *f)
 {
-    static const char *const integrators[] = { "path", "whitted", NULL };
-    static const int integrator_values[] = { INTEGRATOR_PATH, INTEGRATOR_WHITTED };
-    static const char *const formats[] = { "auto", "clpt", "classic", "pbrt", NULL };
-    static const int format_values[] = { SCENE_FORMAT_AUTO, SCENE_FORMAT_CLPT, SCENE_FORMAT_CLASSIC,
-                                         SCENE_FORMAT_PBRT };
-    static const char *const gammas[] = { "srgb", "none", NULL };
-    static const int gamma_values[] = { 0, 1 };
-    static const char *const on_off[] = { "on", "off", NULL };
-    static const int on_off_values[] = { 1, 0 };
-    static const char *const samplers[] = { "sobol", "independent", NULL };
-    static const int sampler_values[] = { SAMPLER_SOBOL, SAMPLER_INDEPENDENT };
-    static const char *const accels[] = { "bvh", "kdtree", NULL };
-    static const int accel_values[] = { ACCEL_BVH, ACCEL_KDTREE };
-    static const char *const launches[] = { "counted", "bounded", "megakernel", NULL };
-    static const int launch_values[] = { WAVE_LAUNCH_COUNTED, WAVE_LAUNCH_BOUNDED, WAVE_LAUNCH_MEGAKERNEL };
-    *found = 1;
-    if (strcmp(a, "--integrator") == 0)
-        return parse_choice(a, v, integrators, integrator_values, "'path' or 'whitted'", &o->integrator, err);
-    if (strcmp(a, "--format") == 0)
-        return parse_choice(a, v, formats, format_values, "'auto', 'clpt', 'classic' or 'pbrt'", &o->format, err);
-    if (strcmp(a, "--gamma") == 0)
-        return parse_choice(a, v, gammas, gamma_values, "'srgb' or 'none'", &o->gamma, err);
-    if (strcmp(a, "--shadows") == 0)
-        return parse_choice(a, v, on_off, on_off_values, "'on' or 'off'", &o->shadows, err);
-    if (strcmp(a, "--sampler") == 0)
-        return parse_choice(a, v, samplers, sampler_values, "'sobol' or 'independent'", &o->sampler, err);
-    if (strcmp(a, "--accel") == 0)
-        return parse_choice(a, v, accels, accel_values, "'bvh' or 'kdtree'", &o->accel, err);
-    if (strcmp(a, "--wave-launch") == 0)
-        return parse_choice(a, v, launches, launch_values, "'counted', 'bounded' or 'megakernel'", &o->wave_launch,
-                            err);
-    if (strcmp(a, "--aov") == 0) return options_parse_aovs(v, &o->aovs, err);
-    *found = 0;
-    return ST_OK;
+    for (int sec = 0; sec < HELP_SECTIONS; sec++) {
+        fputs(help_sections[sec], f);
+        int any = 0;
+        for (size_t k = 0; k < N_OPTIONS; k++)
+            if (option_specs[k].section == sec) {
+                print_flag(f, &option_specs[k]);
+                any = 1;
+            }
+        if (any) fputc('\n', f);
+    }
 }
 
-/* A flag that takes a value, with its value (the next argument, or after '=' in
- * --flag=value). *found is 0 when `a` is no such flag. */
-static Status options_set_value(const char *a, const char *v, Options *o, int *found, Error *err)
+/* ---------------------------------------------------------------- parsing */
+
+/* The flag named `a` (its name or alias) that takes a value (want_value) or not. */
+static const OptionSpec *option_find(const char *a, int want_value)
 {
-    Status st = options_set_name(a, v, o, found, err);
-    if (!*found) st = options_set_number(a, v, o, found, err);
-    if (!*found) st = options_set_choice(a, v, o, found, err);
-    return st;
+    for (size_t k = 0; k < N_OPTIONS; k++) {
+        const OptionSpec *s = &option_specs[k];
+        if ((s->kind != OPTION_SWITCH) != want_value) continue;
+        if (strcmp(a, s->name) == 0 || (s->alias && strcmp(a, s->alias) == 0)) return s;
+    }
+    return NULL;
+}
+
+/* Reads v, the value of flag `a` (as typed), into its field of o. */
+static Status option_set(const OptionSpec *s, const char *a, const char *v, Options *o, Error *err)
+{
+    void *dst = (char *)o + s->offset;
+    long n = 0;
+    Status st = ST_OK;
+    switch (s->kind) {
+    case OPTION_SWITCH: *(int *)dst = 1; return ST_OK;
+    case OPTION_TEXT:
+        if (!*v) return error_set(err, ST_USAGE, "%s needs a %s", a, s->what);
+        *(const char **)dst = v;
+        return ST_OK;
+    case OPTION_LONG: return parse_long(a, v, s->lo, s->hi, (long *)dst, err);
+    case OPTION_UINT:
+        if (!(st = parse_long(a, v, s->lo, s->hi, &n, err))) *(unsigned *)dst = (unsigned)n;
+        return st;
+    case OPTION_INT:
+        if (!(st = parse_long(a, v, s->lo, s->hi, &n, err))) *(int *)dst = (int)n;
+        return st;
+    case OPTION_SECONDS: return parse_seconds(a, v, (double *)dst, err);
+    case OPTION_CHOICE:
+        for (const OptionChoice *c = s->choices; c->name; c++)
+            if (strcmp(v, c->name) == 0) {
+                *(int *)dst = c->value;
+                return ST_OK;
+            }
+        char expected[160];
+        choices_text(s->choices, 1, expected, sizeof expected);
+        return error_set(err, ST_USAGE, "%s expects %s, got '%s'", a, expected, v);
+    case OPTION_CUSTOM: return s->parse(v, o, err);
+    }
+    return error_set(err, ST_INTERNAL, "%s: unknown kind of flag", a);
 }
 
 static void options_defaults(Options *o)
@@ -512,6 +545,7 @@ static void options_defaults(Options *o)
 }
 
 /* argv[*i]: a switch, a flag and its value (advancing *i), or the scene. */
+/* argv[*i]: a switch, a flag and its value (advancing *i), or the scene. */
 static Status options_parse_arg(int argc, char **argv, int *i, Options *o, Error *err)
 {
     const char *a = argv[*i];
@@ -527,15 +561,13 @@ static Status options_parse_arg(int argc, char **argv, int *i, Options *o, Error
         value = eq + 1;
         a = flag;
     }
-    if (!value && options_set_switch(a, o)) return ST_OK;
+    const OptionSpec *s = value ? NULL : option_find(a, 0);
+    if (s) return option_set(s, a, NULL, o, err);
     /* a flag that takes a value takes the next argument when not given one with '=' */
-    const char *next = *i + 1 < argc ? argv[*i + 1] : NULL;
-    int found = 0;
-    Status st = options_set_value(a, value ? value : (next ? next : ""), o, &found, err);
-    if (found) {
-        if (!value && !next) return error_set(err, ST_USAGE, "%s needs a value", a);
-        if (!value) ++*i;
-        return st;
+    if ((s = option_find(a, 1))) {
+        if (!value && *i + 1 >= argc) return error_set(err, ST_USAGE, "%s needs a value", a);
+        if (!value) value = argv[++*i];
+        return option_set(s, a, value, o, err);
     }
     if (value || (a[0] == '-' && a[1] != '\0'))
         return error_set(err, ST_USAGE, "unknown option '%s' (see --help)", a);

@@ -1,57 +1,51 @@
-/* options.h — the command line. Every flag is documented in options_print_help. */
+/* options.h — the command line. options.c's OPTIONS list names every flag once: its
+ * parsing, its line in --help and the choices its error messages list come from it. */
 #ifndef CLPT_OPTIONS_H
 #define CLPT_OPTIONS_H
 
+#include <stddef.h>
 #include <stdio.h>
 
 #include "base/status.h"
+#include "option_values.h"
+
+/* How a flag's value is read. */
+typedef enum {
+    OPTION_SWITCH,   /* no value: sets an int to 1 */
+    OPTION_TEXT,     /* a file, folder or device list, kept as given (not empty) */
+    OPTION_LONG,     /* an integer in [lo, hi] into a long */
+    OPTION_UINT,     /* the same into an unsigned */
+    OPTION_INT,      /* the same into an int */
+    OPTION_SECONDS,  /* a positive number of seconds into a double */
+    OPTION_CHOICE,   /* one word of `choices` into an int */
+    OPTION_CUSTOM,   /* read by its own function */
+} OptionKind;
 
 typedef struct {
-    const char *scene_path;
-    const char *output;           /* NULL: <scene name>.png in the current folder */
-    /* overrides of the scene file; -1 = keep the scene's value */
-    long spp, width, height, seed, max_depth, split;
-    const char *device_spec;      /* NULL: default selection */
-    const char *camera;           /* --camera: the glTF camera, by index or name; NULL: first */
-    int threads;                  /* scalar device workers, 0 = every core */
-    double time_limit;            /* seconds, 0 = none */
-    double progressive_seconds;   /* 0 = no progressive output */
-    const char *checkpoint_path;  /* NULL: no checkpoints (but see resume_path) */
-    double checkpoint_seconds;    /* between checkpoints; 60 unless given */
-    const char *resume_path;      /* NULL: a fresh render */
-    /* --sample-range A:B: render only sample indices [A, B) of every pixel (an
-     * independent part for `clpt merge`); -1/-1 = all of [0, spp) */
-    long range_first, range_end;
-    /* under mpirun (docs/distributed.md) */
-    int mpi_broadcast;            /* the scene is read by rank 0 only and sent to the others */
-    double mpi_timeout;           /* seconds of silence before a rank is given up; 0 = 30 */
-    int list_devices, stats, profile, quiet, help, version;
-    int interactive;              /* --interactive: the viewer (docs/viewer.md) */
-    int exr_float;                /* EXR channels as 32-bit floats, not halves */
-    /* developer flags */
-    const char *kernel_dir;
-    unsigned batch;               /* fixed batch size, 0 = adaptive */
-    unsigned wave_paths;          /* OpenCL wave size, 0 = automatic */
-    int wave_launch;              /* enum WaveLaunch (device.h), 0 = by device type */
-    /* the classic ray tracer (docs/classic-format.md) */
-    int integrator;               /* enum Integrator (path or whitted), -1 = the scene's */
-    int format;                   /* enum SceneFormat (io/scene_load.h) */
-    unsigned aovs;                /* bit (INTEGRATOR_AOV_x): auxiliary images to write */
-    const char *aov_files[3];     /* normal, depth, albedo image names (the course command
-                                   * line); NULL: OUTPUT-normal.png etc. */
-    double adaptive;              /* whitted: neighbour difference threshold, 0 = off */
-    unsigned adaptive_spp;        /* extra samples per flagged pixel */
-    int gamma;                    /* -1 the scene's, 0 sRGB, 1 none (linear 8-bit) */
-    int shadows;                  /* -1 the scene's, 0 off, 1 on */
-    int sampler;                  /* -1 the scene's, else enum Sampler */
-    int accel;                    /* -1 the default, else enum SceneAccel */
-    double depth_near, depth_far; /* --depth-range; near == far (0) = automatic */
-} Options;
+    const char *name;
+    int value;
+} OptionChoice;
+
+/* One flag of the list. */
+typedef struct {
+    const char *name, *alias;     /* "--output", "-o" (NULL: no short form) */
+    OptionKind kind;
+    const char *metavar;          /* its value in --help ("FILE"); NULL: a switch or a choice */
+    size_t offset;                /* of its field in Options */
+    long lo, hi;                  /* LONG, UINT, INT: the range */
+    const char *what;             /* TEXT: what the value names ("file name") */
+    const OptionChoice *choices;  /* CHOICE: ending with a NULL name */
+    Status (*parse)(const char *v, Options *o, Error *err);   /* CUSTOM */
+    int section;                  /* where --help lists it */
+    const char *help;             /* its lines in --help, '\n' between them */
+} OptionSpec;
 
 /* Parses argv; on ST_USAGE err holds the message. --help and --version set flags and
  * succeed without a scene. */
 Status options_parse(int argc, char **argv, Options *o, Error *err);
 void options_print_help(FILE *f);
+/* The i-th flag of the list, NULL past the last (for the tests). */
+const OptionSpec *options_flag(size_t i);
 /* "normal", "depth" or "albedo" for INTEGRATOR_AOV_*, else NULL. */
 const char *options_aov_name(unsigned aov);
 

@@ -1,0 +1,49 @@
+/* option_values.h — Options, what the command line asks for. Its own header so that
+ * course_args.c, which fills it from the courses' command lines, needs nothing of
+ * options.c, which calls it (no circle between the two). */
+#ifndef CLPT_OPTION_VALUES_H
+#define CLPT_OPTION_VALUES_H
+
+typedef struct {
+    const char *scene_path;
+    const char *output;           /* NULL: <scene name>.png in the current folder */
+    /* overrides of the scene file; -1 = keep the scene's value */
+    long spp, width, height, seed, max_depth, split;
+    const char *device_spec;      /* NULL: default selection */
+    const char *camera;           /* --camera: the glTF camera, by index or name; NULL: first */
+    int threads;                  /* scalar device workers, 0 = every core */
+    double time_limit;            /* seconds, 0 = none */
+    double progressive_seconds;   /* 0 = no progressive output */
+    const char *checkpoint_path;  /* NULL: no checkpoints (but see resume_path) */
+    double checkpoint_seconds;    /* between checkpoints; 60 unless given */
+    const char *resume_path;      /* NULL: a fresh render */
+    /* --sample-range A:B: render only sample indices [A, B) of every pixel (an
+     * independent part for `clpt merge`); -1/-1 = all of [0, spp) */
+    long range_first, range_end;
+    /* under mpirun (docs/distributed.md) */
+    int mpi_broadcast;            /* the scene is read by rank 0 only and sent to the others */
+    double mpi_timeout;           /* seconds of silence before a rank is given up; 0 = 30 */
+    int list_devices, stats, profile, quiet, help, version;
+    int interactive;              /* --interactive: the viewer (docs/viewer.md) */
+    int exr_float;                /* EXR channels as 32-bit floats, not halves */
+    /* developer flags */
+    const char *kernel_dir;
+    unsigned batch;               /* fixed batch size, 0 = adaptive */
+    unsigned wave_paths;          /* OpenCL wave size, 0 = automatic */
+    int wave_launch;              /* enum WaveLaunch (device.h), 0 = by device type */
+    /* the classic ray tracer (docs/classic-format.md) */
+    int integrator;               /* enum Integrator (path or whitted), -1 = the scene's */
+    int format;                   /* enum SceneFormat (io/scene_load.h) */
+    unsigned aovs;                /* bit (INTEGRATOR_AOV_x): auxiliary images to write */
+    const char *aov_files[3];     /* normal, depth, albedo image names (the course command
+                                   * line); NULL: OUTPUT-normal.png etc. */
+    double adaptive;              /* whitted: neighbour difference threshold, 0 = off */
+    unsigned adaptive_spp;        /* extra samples per flagged pixel */
+    int gamma;                    /* -1 the scene's, 0 sRGB, 1 none (linear 8-bit) */
+    int shadows;                  /* -1 the scene's, 0 off, 1 on */
+    int sampler;                  /* -1 the scene's, else enum Sampler */
+    int accel;                    /* -1 the default, else enum SceneAccel */
+    double depth_near, depth_far; /* --depth-range; near == far (0) = automatic */
+} Options;
+
+#endif /* CLPT_OPTION_VALUES_H */

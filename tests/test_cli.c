@@ -5,6 +5,7 @@
 
 #include "cli_util.h"
 #include "harness.h"
+#include "options.h"
 
 static CliResult r;   /* large: static */
 
@@ -20,6 +21,58 @@ static void test_help_documents_every_flag(void)
                             "--shadows", "--sampler", "--accel", "--profile", "-size W H -input SCENE -output FILE", "-depth NEAR FAR FILE",
                             "-bounces N", "clpt SCENE OUT.bmp", "Exit status" };
     for (size_t i = 0; i < sizeof flags / sizeof flags[0]; i++) CHECK_STR_CONTAINS(r.out, flags[i]);
+}
+
+/* Every flag of options.c's list has its line in --help ("  -o, --output" or
+ * "      --spp") and is read into Options: parsing it with a good value changes what a
+ * bare command line gives. A CUSTOM flag needs a value from this table. */
+static void test_every_listed_flag_is_documented_and_parsed(void)
+{
+    static const struct { const char *flag, *value; } custom[] = {
+        { "--aov", "normal" }, { "--depth-range", "1,2" }, { "--sample-range", "0:1" }, { "--adaptive", "0.5" },
+    };
+    cli_run(ARGS("--help"), &r);
+    CHECK_EQ_INT(r.status, 0);
+    Options base, with;
+    Error err = { 0 };
+    char prog[] = "clpt", scene[] = "scene.scene";
+    char *bare[] = { prog, scene, NULL };
+    CHECK_EQ_INT(options_parse(2, bare, &base, &err), ST_OK);
+    size_t n = 0;
+    for (const OptionSpec *s; (s = options_flag(n)); n++) {
+        char line[96];
+        snprintf(line, sizeof line, "\n  %s%s%s", s->alias ? s->alias : "  ", s->alias ? ", " : "  ", s->name);
+        CHECK_MSG(strstr(r.out, line), "--help has no line for %s", s->name);
+        char value[64] = "";
+        switch (s->kind) {
+        case OPTION_SWITCH: break;
+        case OPTION_TEXT: snprintf(value, sizeof value, "x"); break;
+        case OPTION_LONG: case OPTION_UINT: case OPTION_INT: snprintf(value, sizeof value, "%ld", s->hi); break;
+        case OPTION_SECONDS: snprintf(value, sizeof value, "2.5"); break;
+        case OPTION_CHOICE: {
+            size_t last = 0;
+            while (s->choices[last + 1].name) last++;
+            snprintf(value, sizeof value, "%s", s->choices[last].name);
+            break;
+        }
+        case OPTION_CUSTOM:
+            for (size_t k = 0; k < sizeof custom / sizeof custom[0]; k++)
+                if (strcmp(custom[k].flag, s->name) == 0) snprintf(value, sizeof value, "%s", custom[k].value);
+            CHECK_MSG(value[0], "%s: give this test a value for it", s->name);
+            break;
+        }
+        for (int form = 0; form < (s->alias ? 2 : 1); form++) {
+            char *argv[] = { prog, scene, (char *)(form ? s->alias : s->name), value, NULL };
+            int argc = s->kind == OPTION_SWITCH ? 3 : 4;
+            error_clear(&err);
+            memset(&with, 0, sizeof with);
+            Status st = options_parse(argc, argv, &with, &err);
+            CHECK_MSG(!strstr(err.msg, "unknown option") && !strstr(err.msg, "expects") && !strstr(err.msg, "needs a"),
+                      "%s %s: %s", argv[2], value, err.msg);
+            CHECK_MSG(memcmp(&with, &base, sizeof base) != 0, "%s %s (status %d) sets nothing", argv[2], value, (int)st);
+        }
+    }
+    CHECK_MSG(n >= 40, "options_flag lists %zu flags", n);
 }
 
 static void test_usage_errors(void)
@@ -802,6 +855,7 @@ static void test_outputs_must_be_regular_files(void)
 int main(void)
 {
     RUN(test_help_documents_every_flag);
+    RUN(test_every_listed_flag_is_documented_and_parsed);
     RUN(test_usage_errors);
     RUN(test_missing_scene_is_io_error);
     RUN(test_parse_error_names_line_and_column);

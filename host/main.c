@@ -33,6 +33,7 @@
 #include "render/render_scene.h"
 #include "scene/scene.h"
 #include "render/schedule.h"
+#include "render/stats.h"
 #include "io/scene_load.h"
 #include "base/timer.h"
 #include "viewer.h"
@@ -118,24 +119,13 @@ static Status keep_first(Status st, Error *err, Status next, Error *next_err)
     return next;
 }
 
-static Status write_film(const Film *film, const char *path, ImageEncoding encoding, Error *err)
-{
-    size_t n = (size_t)film->width * film->height * 3u;
-    float *rgb = malloc(n * sizeof *rgb);
-    if (!rgb) return error_set(err, ST_INTERNAL, "out of memory resolving the image");
-    film_resolve(film, rgb);
-    Status st = image_write_encoded(path, rgb, film->width, film->height, encoding, err);
-    free(rgb);
-    return st;
-}
-
 /* Progressive output: rewrites the image during the render (atomically, so a viewer
  * never sees half a file). A failure is reported once and does not stop the render. */
 static void on_progress_tick(void *vctx, const ScheduleSnapshot *snap)
 {
     RenderContext *ctx = vctx;
     Error err = { 0 };
-    if (write_film(snap->film, ctx->output, ctx->encoding, &err) != ST_OK && !ctx->progressive_failed) {
+    if (film_write(snap->film, ctx->output, ctx->encoding, &err) != ST_OK && !ctx->progressive_failed) {
         ctx->progressive_failed = 1;
         print_warning(NULL, err.msg);
     }
@@ -305,193 +295,6 @@ static Status run_passes(const Options *o, const PassContext *pc, const char *ou
     return ST_OK;
 }
 
-static void print_scene_stats(const Scene *s, const RenderScene *rs)
-{
-    const KdStats *k = &rs->kd.stats;
-    size_t in_tree = s->n_spheres + s->n_triangles + s->n_boxes + s->n_revsurfaces;
-    printf("scene: %zu spheres, %zu triangles, %zu boxes, %zu planes, %zu materials, %zu lights", s->n_spheres,
-           s->n_triangles, s->n_boxes, s->n_planes, s->n_materials, s->n_lights);
-    /* only when there are any: the line's form stays what scripts read for other scenes */
-    if (s->n_revsurfaces) printf(", %zu surfaces of revolution", s->n_revsurfaces);
-    printf("\n");
-    size_t images = 0, rgbe = 0;
-    for (size_t i = 0; i < s->n_textures; i++) {
-        images += s->textures[i].type == TEX_IMAGE;
-        rgbe += s->textures[i].type == TEX_IMAGE && (s->textures[i].flags & TEX_RGBE);
-    }
-    if (images)
-        printf("textures: %zu images, %.1f KiB of texels, %zu of them packed as RGBE words\n", images,
-               (double)s->n_texels * sizeof(uint) / 1024.0, rgbe);
-    double per = in_tree ? 1.0 / (double)in_tree : 0.0;
-    if (s->accel == ACCEL_BVH) {
-        const BvhStats *b = &rs->bvh.stats;
-        size_t bytes = (size_t)rs->bvh.n_nodes * sizeof(BvhNode) + (size_t)rs->bvh.n_leaf_prims * sizeof(uint);
-        printf("BVH: built in %.3f s; %u nodes of 8, %u leaves, depth %u (binary tree %u), %.2f primitives "
-               "per leaf, SAH cost %.2f, %.1f KiB (%.1f bytes per primitive)\n",
-               b->build_seconds, b->n_nodes, b->n_leaves, b->max_depth, b->max_binary_depth,
-               b->mean_prims_per_leaf, b->sah_cost, (double)bytes / 1024.0, (double)bytes * per);
-        return;
-    }
-    printf("kd-tree: built in %.3f s; %u nodes, %u leaves (%u empty), depth %u, "
-           "%.2f primitives per non-empty leaf, SAH cost %.2f, %.1f KiB (nodes and leaf ids %.1f, copies "
-           "of the triangles' corners in the leaves %.1f bytes per primitive)\n",
-           k->build_seconds, k->n_nodes, k->n_leaves, k->n_empty_leaves, k->max_depth,
-           k->mean_prims_per_leaf, k->sah_cost, (double)k->bytes / 1024.0,
-           (double)(k->bytes - k->bytes_corners) * per, (double)k->bytes_corners * per);
-}
-
-static void print_render_stats(const ScheduleStats *st, uint spp, Device **devs, size_t n)
-{
-    for (size_t i = 0; i < n; i++) {
-        const DeviceCounters *c = &devs[i]->counters;
-        if (devs[i]->desc.kind == DEVICE_OPENCL)
-            printf("device %zu '%s': kernels %s in %.3f s, scene upload %.3f s; waves of %u paths, %s\n", i,
-                   devs[i]->desc.name, c->from_cache ? "loaded from cache" : "compiled", c->compile_seconds,
-                   c->upload_seconds, c->wave_paths, c->wave_run ? c->wave_run : "-");
-    }
-    printf("%-32s %7s %12s %8s %8s %12s %10s %6s %s\n", "device", "batches", "samples", "busy s",
-           "idle s", "Msamples/s", "Mrays/s", "share", "batch sizes (min/max/last spp)");
-    for (size_t i = 0; i < st->n_devices && st->devices; i++) {
-        const DeviceRunStats *d = &st->devices[i];
-        double busy = d->busy_seconds > 0.0 ? d->busy_seconds : 1e-9;
-        printf("%-32.32s %7u %12llu %8.2f %8.2f %12.3f %10.3f %5.1f%% %u/%u/%u%s%s\n", d->name, d->batches,
-               (unsigned long long)d->samples, d->busy_seconds, d->idle_seconds, (double)d->samples / busy / 1e6,
-               (double)d->rays / busy / 1e6,
-               st->samples ? 100.0 * (double)d->samples / (double)st->samples : 0.0, d->batch_min, d->batch_max,
-               d->batch_last, d->failed ? "  FAILED: " : "", d->failed ? d->failure : "");
-    }
-    double secs = st->seconds > 0.0 ? st->seconds : 1e-9;
-    printf("%-32s %7s %12llu %8.2f %8s %12.3f %10.3f %5.1f%%\n", "total", "",
-           (unsigned long long)st->samples, st->seconds, "", (double)st->samples / secs / 1e6,
-           (double)st->rays / secs / 1e6, 100.0);
-    /* Batches cover the whole image, so every pixel holds the same samples. */
-    printf("film: %u of %u samples per pixel, the same in every pixel; sample indices", st->spp_done, spp);
-    for (size_t i = 0; i < st->done.n && i < 8; i++)
-        printf(" [%u,%u)", st->done.ranges[i].first, st->done.ranges[i].first + st->done.ranges[i].count);
-    printf("%s%s\n", st->done.n > 8 ? " ..." : "", st->done.n == 0 ? " none" : "");
-    if (st->checkpoints)
-        printf("checkpoints: %u written during the render, %.1f ms each (film copied under the lock in %.2f ms)\n",
-               st->checkpoints, 1e3 * st->checkpoint_seconds / st->checkpoints, 1e3 * st->snapshot_seconds / st->checkpoints);
-}
-
-/* --profile: each device's time per phase (enum DevicePhase), in seconds and as a share
- * of its busy time; the scalar device's thread time is divided by its threads. */
-static void print_profile(const ScheduleStats *st, Device **devs, size_t n)
-{
-    static const char *const names[PHASE_N] = { "raygen", "traverse", "shade", "shadow", "film", "queues",
-                                                "host wait" };
-    printf("profile (seconds, %% of busy time; OpenCL: device time of its commands, scalar: thread time / threads)\n");
-    printf("%-32s", "device");
-    for (int p = 0; p < PHASE_N; p++) printf(" %15s", names[p]);
-    printf(" %8s\n", "busy s");
-    for (size_t i = 0; i < n && i < st->n_devices && st->devices; i++) {
-        const double *t = devs[i]->counters.phase_seconds;
-        double busy = st->devices[i].busy_seconds > 0.0 ? st->devices[i].busy_seconds : 1e-9;
-        printf("%-32.32s", devs[i]->desc.name);
-        for (int p = 0; p < PHASE_N; p++) printf(" %8.3f %5.1f%%", t[p], 100.0 * t[p] / busy);
-        printf(" %8.2f\n", st->devices[i].busy_seconds);
-    }
-}
-
-/* No device of the default choice could be used: warns, and replaces *chosen with the
- * next group of the default order; 0 when none is left. */
-static int fall_back(const DeviceDesc *all, size_t n_all, size_t **chosen, size_t *n_chosen, const Error *last)
-{
-    size_t *next = NULL, n_next = 0;
-    Error err = { 0 };
-    if (device_select_fallback(all, n_all, (*chosen)[0], &next, &n_next, &err) != ST_OK || n_next == 0) {
-        free(next);
-        error_clear(&err);
-        return 0;
-    }
-    if (*n_chosen == 1) {   /* several were each reported as they were dropped */
-        print_warning(NULL, last->msg);
-        if (last->detail) fprintf(stderr, "%s\n", last->detail);
-    }
-    fprintf(stderr, "clpt: warning: the default device%s cannot be used; falling back to device %u '%s'%s\n",
-            *n_chosen > 1 ? "s" : "", all[next[0]].index, all[next[0]].name, n_next > 1 ? " and others" : "");
-    free(*chosen);
-    *chosen = next;
-    *n_chosen = n_next;
-    return 1;
-}
-
-/* Opens each chosen device into devs and gives it the scene; returns how many could be
- * used. A device that fails is dropped with a warning when there are others; *last
- * keeps the last failure. */
-static size_t open_chosen(const DeviceDesc *all, const size_t *chosen, size_t n_chosen, const DeviceConfig *cfg,
-                          const DeviceScene *ds, Device **devs, Error *last)
-{
-    size_t n = 0;
-    for (size_t i = 0; i < n_chosen; i++) {
-        Device *d = NULL;
-        error_clear(last);
-        Status st = device_open(&all[chosen[i]], cfg, &d, last);
-        if (st == ST_OK) st = d->ops->load_scene(d, ds, last);
-        if (st == ST_OK) {
-            devs[n++] = d;
-            continue;
-        }
-        device_close(d);
-        if (n_chosen > 1) {
-            print_warning(NULL, last->msg);
-            if (last->detail) fprintf(stderr, "%s\n", last->detail);
-            fprintf(stderr, "clpt: warning: device %u '%s' dropped; rendering with the others\n",
-                    all[chosen[i]].index, all[chosen[i]].name);
-        }
-    }
-    return n;
-}
-
-/* Opens the chosen devices and gives each the scene. A device that fails is dropped with
- * a warning as long as another one works. */
-static Status open_devices(const Options *o, const DeviceScene *ds, Device ***out, size_t *n_out, Error *err)
-{
-    DeviceDesc *all = NULL;
-    size_t n_all = 0, *chosen = NULL, n_chosen = 0;
-    char warning[1100];
-    Status st = device_list(&all, &n_all, warning, sizeof warning, err);
-    if (st) return st;
-    /* said here, once per run, and only when it decides where the render goes */
-    if (warning[0]) print_warning(NULL, warning);
-    else if (n_all == 1 && !o->device_spec)
-        print_warning(NULL, "no OpenCL platform found (none installed, or OCL_ICD_VENDORS names none): "
-                            "rendering on the scalar device");
-    if ((st = device_select(o->device_spec, all, n_all, &chosen, &n_chosen, err))) {
-        free(all);
-        return st;
-    }
-    Device **devs = calloc(n_all, sizeof *devs);
-    if (!devs) {
-        free(all);
-        free(chosen);
-        return error_set(err, ST_INTERNAL, "out of memory");
-    }
-    DeviceConfig cfg = { o->threads, o->kernel_dir, o->wave_paths, o->profile, o->wave_launch };
-    ocl_program_announce_builds(!o->quiet);
-    size_t n = 0;
-    Error last = { 0 };
-    int by_default = !o->device_spec || !o->device_spec[0];
-    do
-        n = open_chosen(all, chosen, n_chosen, &cfg, ds, devs, &last);
-    while (n == 0 && by_default && fall_back(all, n_all, &chosen, &n_chosen, &last));
-    free(all);
-    free(chosen);
-    if (n == 0) {
-        free(devs);
-        if (n_chosen == 1) {
-            *err = last;   /* the one device's own error, with its build log */
-            return last.status ? last.status : ST_DEVICE;
-        }
-        error_clear(&last);
-        return error_set(err, ST_DEVICE, "none of the %zu chosen devices could be used", n_chosen);
-    }
-    error_clear(&last);
-    *out = devs;
-    *n_out = n;
-    return ST_OK;
-}
-
 /* Everything one render holds, freed by run_free whatever step failed. */
 typedef struct {
     Options o;
@@ -522,6 +325,14 @@ static void run_free(Run *r)
     render_scene_free(&r->rs);
     scene_free(&r->scene);
     free(r->default_out);
+}
+
+/* The chosen devices (device_open_all), each given the scene. */
+static Status open_devices(const Options *o, const DeviceScene *ds, Device ***out, size_t *n_out, Error *err)
+{
+    DeviceConfig cfg = { o->threads, o->kernel_dir, o->wave_paths, o->profile, o->wave_launch };
+    ocl_program_announce_builds(!o->quiet);
+    return device_open_all(o->device_spec, &cfg, ds, print_warning, NULL, out, n_out, err);
 }
 
 /* --help, --version and --list-devices: print and exit. *done tells whether one ran. */
@@ -710,7 +521,7 @@ static Status render_prepare(Run *r, int worker, int keyed, Error *err)
     Status st;
     if ((st = render_scene_prepare(&r->scene, 0, &r->rs, err))) return st;
     const DeviceScene *ds = &r->rs.ds;
-    if (r->o.stats && !worker) print_scene_stats(&r->scene, &r->rs);
+    if (r->o.stats && !worker) render_stats_print_scene(&r->scene, &r->rs);
     if (keyed || r->o.checkpoint_path || r->o.resume_path) checkpoint_id(ds, r->scene.image.spp, &r->ctx.checkpoint_id);
     if ((st = film_init(&r->film, ds->params.width, ds->params.height, err))) return st;
     if (!r->o.resume_path || worker) return ST_OK;
@@ -805,9 +616,9 @@ static Status results_write_checkpoint(Run *r, Error *cerr)
 static void results_print_summary(const Run *r)
 {
     const ScheduleStats *s = &r->stats;
-    if (r->o.stats || r->o.profile) print_render_stats(s, r->scene.image.spp, r->devs, r->n_devs);
+    if (r->o.stats || r->o.profile) render_stats_print_run(s, r->scene.image.spp, r->devs, r->n_devs);
     if (r->o.profile) {
-        print_profile(s, r->devs, r->n_devs);
+        render_stats_print_profile(s, r->devs, r->n_devs);
         if (r->scene.image.split > 1 && r->scene.integrator == INTEGRATOR_PATH)
             printf("profile: with --split, OpenCL devices run each path as one kernel (k_path), whose time is "
                    "all under shade\n");
@@ -846,7 +657,7 @@ static Status results_write(Run *r, Error *err)
     Status st = r->render_st != ST_OK ? r->render_st : (r->stats.interrupted ? ST_INTERRUPTED : ST_OK);
     Error next = { 0 };
     st = keep_first(st, err, results_write_checkpoint(r, &next), &next);
-    Status image_st = write_film(&r->film, r->output, r->encoding, &next);
+    Status image_st = film_write(&r->film, r->output, r->encoding, &next);
     st = keep_first(st, err, image_st, &next);
     if (image_st != ST_OK) return st;   /* the summary's "-> OUTPUT" would be untrue */
     results_print_summary(r);

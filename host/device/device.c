@@ -274,3 +274,100 @@ void device_scene_view(const DeviceScene *ds, SceneView *view)
     SCENE_BUFFERS(SCENE_VIEW_SET_)
 #undef SCENE_VIEW_SET_
 }
+/* No device of the default choice could be used: warns, and replaces *chosen with the
+ * next group of the default order; 0 when none is left. */
+static int device__fall_back(const DeviceDesc *all, size_t n_all, size_t **chosen, size_t *n_chosen, const Error *last,
+                             DeviceWarn warn, void *warn_ctx)
+{
+    size_t *next = NULL, n_next = 0;
+    Error err = { 0 };
+    if (device_select_fallback(all, n_all, (*chosen)[0], &next, &n_next, &err) != ST_OK || n_next == 0) {
+        free(next);
+        error_clear(&err);
+        return 0;
+    }
+    if (*n_chosen == 1) {   /* several were each reported as they were dropped */
+        warn(warn_ctx, last->msg);
+        if (last->detail) fprintf(stderr, "%s\n", last->detail);
+    }
+    fprintf(stderr, "clpt: warning: the default device%s cannot be used; falling back to device %u '%s'%s\n",
+            *n_chosen > 1 ? "s" : "", all[next[0]].index, all[next[0]].name, n_next > 1 ? " and others" : "");
+    free(*chosen);
+    *chosen = next;
+    *n_chosen = n_next;
+    return 1;
+}
+
+/* Opens each chosen device into devs and gives it the scene; returns how many could be
+ * used. A device that fails is dropped with a warning when there are others; *last
+ * keeps the last failure. */
+static size_t device__open_chosen(const DeviceDesc *all, const size_t *chosen, size_t n_chosen, const DeviceConfig *cfg,
+                                  const DeviceScene *ds, Device **devs, Error *last, DeviceWarn warn, void *warn_ctx)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < n_chosen; i++) {
+        Device *d = NULL;
+        error_clear(last);
+        Status st = device_open(&all[chosen[i]], cfg, &d, last);
+        if (st == ST_OK) st = d->ops->load_scene(d, ds, last);
+        if (st == ST_OK) {
+            devs[n++] = d;
+            continue;
+        }
+        device_close(d);
+        if (n_chosen > 1) {
+            warn(warn_ctx, last->msg);
+            if (last->detail) fprintf(stderr, "%s\n", last->detail);
+            fprintf(stderr, "clpt: warning: device %u '%s' dropped; rendering with the others\n",
+                    all[chosen[i]].index, all[chosen[i]].name);
+        }
+    }
+    return n;
+}
+
+Status device_open_all(const char *spec, const DeviceConfig *cfg, const DeviceScene *ds, DeviceWarn warn,
+                       void *warn_ctx, Device ***out, size_t *n_out, Error *err)
+{
+    DeviceDesc *all = NULL;
+    size_t n_all = 0, *chosen = NULL, n_chosen = 0;
+    char warning[1100];
+    Status st = device_list(&all, &n_all, warning, sizeof warning, err);
+    if (st) return st;
+    /* said here, once per run, and only when it decides where the render goes */
+    if (warning[0]) warn(warn_ctx, warning);
+    else if (n_all == 1 && !spec)
+        warn(warn_ctx, "no OpenCL platform found (none installed, or OCL_ICD_VENDORS names none): "
+                       "rendering on the scalar device");
+    if ((st = device_select(spec, all, n_all, &chosen, &n_chosen, err))) {
+        free(all);
+        return st;
+    }
+    Device **devs = calloc(n_all, sizeof *devs);
+    if (!devs) {
+        free(all);
+        free(chosen);
+        return error_set(err, ST_INTERNAL, "out of memory");
+    }
+    size_t n = 0;
+    Error last = { 0 };
+    int by_default = !spec || !spec[0];
+    do
+        n = device__open_chosen(all, chosen, n_chosen, cfg, ds, devs, &last, warn, warn_ctx);
+    while (n == 0 && by_default && device__fall_back(all, n_all, &chosen, &n_chosen, &last, warn, warn_ctx));
+    free(all);
+    free(chosen);
+    if (n == 0) {
+        free(devs);
+        if (n_chosen == 1) {
+            *err = last;   /* the one device's own error, with its build log */
+            return last.status ? last.status : ST_DEVICE;
+        }
+        error_clear(&last);
+        return error_set(err, ST_DEVICE, "none of the %zu chosen devices could be used", n_chosen);
+    }
+    error_clear(&last);
+    *out = devs;
+    *n_out = n;
+    return ST_OK;
+}
+

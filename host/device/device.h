@@ -185,6 +185,18 @@ Status device_select_fallback(const DeviceDesc *all, size_t n, size_t failed, si
 Status device_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err);
 void device_close(Device *d);
 
+/* Prints a warning for the caller (clpt clears its progress bar first). */
+typedef void (*DeviceWarn)(void *ctx, const char *msg);
+
+/* The policy a render opens its devices by: lists them (warning through `warn` when
+ * OpenCL is missing or broken), chooses by `spec` (device_select), then opens each and
+ * gives it the scene. A device that fails is dropped with a warning as long as another
+ * works; when none of the default choice works, the next default group is tried
+ * (device_select_fallback). *out (calloc'd, *n_out devices) is the caller's to close
+ * and free. One chosen device that fails returns its own error, with its build log. */
+Status device_open_all(const char *spec, const DeviceConfig *cfg, const DeviceScene *ds, DeviceWarn warn,
+                       void *warn_ctx, Device ***out, size_t *n_out, Error *err);
+
 /* Constructors used by device_open. */
 Status device_scalar_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err);
 Status device_ocl_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err);

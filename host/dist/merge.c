@@ -137,17 +137,6 @@ static Status merge_parse(int argc, char **argv, MergeOptions *m, Error *err)
     return ST_OK;
 }
 
-static Status merge_write_image(const Film *film, const char *path, int linear, Error *err)
-{
-    size_t n = (size_t)film->width * film->height * 3u;
-    float *rgb = malloc(n * sizeof *rgb);
-    if (!rgb) return error_set(err, ST_INTERNAL, "out of memory resolving the image");
-    film_resolve(film, rgb);
-    Status st = image_write_encoded(path, rgb, film->width, film->height, linear ? IMAGE_LINEAR : IMAGE_SRGB, err);
-    free(rgb);
-    return st;
-}
-
 /* The image and the checkpoint written must be neither one of the parts (writing it
  * would destroy that part: `merge -o p2.pfm p1.ckpt p2.pfm` lost p2) nor each other.
  * Compared as files (device and inode), so a link or "./p2" is caught too. */
@@ -188,7 +177,7 @@ Status merge_command(int argc, char **argv, Error *err)
     if (st == ST_OK) st = merge_parts(m.parts, m.n_parts, &merged, err);
     if (st == ST_OK && m.checkpoint)
         st = checkpoint_write(m.checkpoint, &merged.id, &merged.film, merged.done, merged.n_done, err);
-    if (st == ST_OK) st = merge_write_image(&merged.film, m.output, m.linear, err);
+    if (st == ST_OK) st = film_write(&merged.film, m.output, m.linear ? IMAGE_LINEAR : IMAGE_SRGB, err);
     if (st == ST_OK && !m.quiet)
         fprintf(stderr, "clpt: merged %zu part%s: %ux%u, %llu spp -> %s\n", m.n_parts, m.n_parts == 1 ? "" : "s",
                 merged.film.width, merged.film.height, (unsigned long long)merged.film.samples, m.output);

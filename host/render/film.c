@@ -30,3 +30,14 @@ void film_resolve(const Film *f, float *rgb)
     double scale = f->samples ? 1.0 / ((double)(1u << FILM_FRAC_BITS) * (double)f->samples) : 0.0;
     for (size_t i = 0; i < n; i++) rgb[i] = (float)((double)f->sum[i] * scale);
 }
+
+Status film_write(const Film *f, const char *path, ImageEncoding encoding, Error *err)
+{
+    size_t n = (size_t)f->width * f->height * 3u;
+    float *rgb = malloc(n * sizeof *rgb);
+    if (!rgb) return error_set(err, ST_INTERNAL, "out of memory resolving the image");
+    film_resolve(f, rgb);
+    Status st = image_write_encoded(path, rgb, f->width, f->height, encoding, err);
+    free(rgb);
+    return st;
+}

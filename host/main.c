@@ -192,107 +192,12 @@ static void apply_overrides(const Options *o, Scene *s)
     if (o->shadows >= 0) s->shadows = o->shadows;
 }
 
-/* Where auxiliary image `aov` goes: the name the course command line gave it, else
- * OUTPUT-normal.png etc. Freed by the caller; NULL when out of memory. */
-static char *aov_output_path(const Options *o, const char *output, unsigned aov)
+/* What the passes after the main image need of the command line. */
+static PassRequest pass_request(const Options *o)
 {
-    const char *named = o->aov_files[aov - INTEGRATOR_AOV_NORMAL];
-    return named ? strdup(named) : passes_aov_path(output, options_aov_name(aov));
-}
-
-/* Whether auxiliary image `aov` goes into the EXR output as channels (see --aov): the
- * output is an .exr and the course command line gave the image no file of its own. */
-static int aov_in_exr(const Options *o, const char *output, unsigned aov)
-{
-    ImageFormat fmt = IMAGE_PNG;
-    Error ignored = { 0 };
-    image_format_from_path(output, &fmt, &ignored);
-    error_clear(&ignored);
-    return fmt == IMAGE_EXR && !o->aov_files[aov - INTEGRATOR_AOV_NORMAL];
-}
-
-/* An auxiliary image as the EXR output's channels hold it: the normal signed (the
- * normal image rendered with grey misses, (n + 1) / 2, gives 2c - 1 = the pixel's mean
- * normal with misses counting 0), the mean distance to the pixel's hits (+inf where
- * none), the albedo as it is. */
-static Status aov_exr_data(const PassContext *pc, unsigned aov, uint spp, float *rgb, double *secs, Error *err)
-{
-    RenderParams *p = &pc->rs->ds.params;
-    uint grey = p->normal_miss_grey;
-    if (aov == INTEGRATOR_AOV_NORMAL) p->normal_miss_grey = 1;
-    DepthScale raw = { DEPTH_RAW, 0.0, 0.0 };
-    Status st = passes_aov(pc, aov, spp, &raw, rgb, secs, err);
-    p->normal_miss_grey = grey;
-    if (!st && aov == INTEGRATOR_AOV_NORMAL)
-        for (size_t i = 0; i < (size_t)p->width * p->height * 3u; i++) rgb[i] = 2.0f * rgb[i] - 1.0f;
-    return st;
-}
-
-/* The EXR output again, with the auxiliary images as channels. */
-static Status write_exr_layers(const Options *o, const char *output, const float *rgb, float *const aov_rgb[3],
-                               uint w, uint h, Error *err)
-{
-    static const char *const names[3][3] = { { "normal.X", "normal.Y", "normal.Z" }, { "Z", NULL, NULL },
-                                             { "albedo.R", "albedo.G", "albedo.B" } };
-    ImageLayer layers[3];
-    size_t n = 0;
-    for (int a = 0; a < 3; a++) {
-        if (!aov_rgb[a]) continue;
-        memcpy(layers[n].names, names[a], sizeof names[a]);
-        layers[n++].rgb = aov_rgb[a];
-    }
-    return n ? image_write_exr(output, rgb, layers, n, w, h, o->exr_float, err) : ST_OK;
-}
-
-/* The adaptive pass and the auxiliary images, after the main image is in rgb (and
- * written). A failure here is the run's failure; the main image stays written. */
-static Status run_passes(const Options *o, const PassContext *pc, const char *output, ImageEncoding encoding,
-                         float *rgb, uint spp, Error *err)
-{
-    uint w = pc->rs->ds.params.width, h = pc->rs->ds.params.height;
-    Status st = ST_OK;
-    if (o->adaptive > 0.0) {
-        size_t marked = 0;
-        double secs = 0.0;
-        if ((st = passes_adaptive(pc, rgb, spp, (float)o->adaptive, o->adaptive_spp, &marked, &secs, err)))
-            return st;
-        if ((st = image_write_encoded(output, rgb, w, h, encoding, err))) return st;
-        if (!o->quiet)
-            fprintf(stderr, "clpt: adaptive pass: %zu of %u pixels (%.1f%%) got %u more samples in %.2f s -> %s\n",
-                    marked, w * h, 100.0 * (double)marked / ((double)w * h), o->adaptive_spp, secs, output);
-    }
-    float *in_exr[3] = { NULL, NULL, NULL };
-    for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO && !st; aov++) {
-        if (!(o->aovs & (1u << aov)) || !aov_in_exr(o, output, aov)) continue;
-        float **slot = &in_exr[aov - INTEGRATOR_AOV_NORMAL];
-        double secs = 0.0;
-        if (!(*slot = malloc((size_t)w * h * 3u * sizeof **slot))) st = error_set(err, ST_INTERNAL, "out of memory");
-        if (!st) st = aov_exr_data(pc, aov, spp, *slot, &secs, err);
-        if (!st && !o->quiet) fprintf(stderr, "clpt: %s image in %.2f s\n", options_aov_name(aov), secs);
-    }
-    if (!st) st = write_exr_layers(o, output, rgb, in_exr, w, h, err);
-    if (!st && !o->quiet && (in_exr[0] || in_exr[1] || in_exr[2]))
-        fprintf(stderr, "clpt: auxiliary images as channels -> %s\n", output);
-    for (int a = 0; a < 3; a++) free(in_exr[a]);
-    if (st) return st;
-    for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
-        if (!(o->aovs & (1u << aov)) || aov_in_exr(o, output, aov)) continue;
-        char *path = aov_output_path(o, output, aov);
-        if (!path) return error_set(err, ST_INTERNAL, "out of memory");
-        ImageFormat fmt = IMAGE_PNG;
-        image_format_from_path(path, &fmt, err);
-        double secs = 0.0;
-        DepthScale depth = { fmt == IMAGE_PFM ? DEPTH_RAW : (o->depth_far != o->depth_near ? DEPTH_RANGE : DEPTH_AUTO),
-                             o->depth_near, o->depth_far };
-        st = passes_aov(pc, aov, spp, &depth, rgb, &secs, err);
-        /* auxiliary images hold data, not light: no sRGB curve */
-        if (!st) st = image_write_encoded(path, rgb, w, h, IMAGE_LINEAR, err);
-        if (!st && !o->quiet)
-            fprintf(stderr, "clpt: %s image in %.2f s -> %s\n", options_aov_name(aov), secs, path);
-        free(path);
-        if (st) return st;
-    }
-    return ST_OK;
+    PassRequest q = { o->adaptive, o->adaptive_spp, o->aovs, { o->aov_files[0], o->aov_files[1], o->aov_files[2] },
+                      o->depth_near, o->depth_far, o->exr_float, o->quiet };
+    return q;
 }
 
 /* Everything one render holds, freed by run_free whatever step failed. */
@@ -403,14 +308,15 @@ static Status outputs_check_distinct(const NamedFile *files, size_t n, Error *er
 static Status outputs_check(const Run *r, Error *err)
 {
     const Options *o = &r->o;
+    PassRequest q = pass_request(o);
     NamedFile files[8];
     char *aov_paths[3] = { NULL, NULL, NULL };
     size_t n = 0;
     Status st = ST_OK;
     named_file_init(&files[n++], r->output, "the output image", FILE_IMAGE);
     for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
-        if (!(o->aovs & (1u << aov)) || aov_in_exr(o, r->output, aov)) continue;
-        char *path = aov_paths[aov - INTEGRATOR_AOV_NORMAL] = aov_output_path(o, r->output, aov);
+        if (!(o->aovs & (1u << aov)) || passes_aov_in_exr(&q, r->output, aov)) continue;
+        char *path = aov_paths[aov - INTEGRATOR_AOV_NORMAL] = passes_aov_output_path(&q, r->output, aov);
         if (!path) {
             st = error_set(err, ST_INTERNAL, "out of memory");
             goto out;
@@ -642,7 +548,8 @@ static Status results_run_passes(Run *r, Error *err)
     ScheduleConfig pcfg = r->cfg;
     pcfg.show_progress = 0;
     PassContext pc = { r->devs, r->n_devs, &r->rs, &pcfg };
-    Status st = run_passes(&r->o, &pc, r->output, r->encoding, rgb, (uint)r->film.samples, err);
+    PassRequest q = pass_request(&r->o);
+    Status st = passes_after_image(&q, &pc, r->output, r->encoding, rgb, (uint)r->film.samples, err);
     free(rgb);
     if (st == ST_OK && stop_requested) st = ST_INTERRUPTED;
     return st;

@@ -10,6 +10,7 @@
 
 #include "device/device.h"
 #include "io/scene_load.h"
+#include "render/passes.h"
 #include "base/limit.h"
 #include "types.h"
 
@@ -314,16 +315,6 @@ static Status parse_seconds(const char *flag, const char *s, double *out, Error 
     return ST_OK;
 }
 
-const char *options_aov_name(unsigned aov)
-{
-    switch (aov) {
-    case INTEGRATOR_AOV_NORMAL: return "normal";
-    case INTEGRATOR_AOV_DEPTH: return "depth";
-    case INTEGRATOR_AOV_ALBEDO: return "albedo";
-    default: return NULL;
-    }
-}
-
 /* "normal,depth" -> the bits 1 << INTEGRATOR_AOV_NORMAL | 1 << INTEGRATOR_AOV_DEPTH */
 static Status parse_aovs(const char *list, Options *o, Error *err)
 {
@@ -333,7 +324,7 @@ static Status parse_aovs(const char *list, Options *o, Error *err)
         size_t len = end ? (size_t)(end - p) : strlen(p);
         unsigned found = 0;
         for (unsigned a = INTEGRATOR_AOV_NORMAL; a <= INTEGRATOR_AOV_ALBEDO; a++) {
-            const char *name = options_aov_name(a);
+            const char *name = passes_aov_name(a);
             if (strlen(name) == len && strncmp(p, name, len) == 0) found = a;
         }
         if (!found)

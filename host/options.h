@@ -46,7 +46,5 @@ Status options_parse(int argc, char **argv, Options *o, Error *err);
 void options_print_help(FILE *f);
 /* The i-th flag of the list, NULL past the last (for the tests). */
 const OptionSpec *options_flag(size_t i);
-/* "normal", "depth" or "albedo" for INTEGRATOR_AOV_*, else NULL. */
-const char *options_aov_name(unsigned aov);
 
 #endif /* CLPT_OPTIONS_H */

@@ -2,6 +2,7 @@
 #include "render/passes.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -173,4 +174,113 @@ char *passes_aov_path(const char *output, const char *name)
     char *out = malloc(n);
     if (out) snprintf(out, n, "%.*s-%s%s", (int)stem, output, name, output + stem);
     return out;
+}
+
+const char *passes_aov_name(unsigned aov)
+{
+    switch (aov) {
+    case INTEGRATOR_AOV_NORMAL: return "normal";
+    case INTEGRATOR_AOV_DEPTH: return "depth";
+    case INTEGRATOR_AOV_ALBEDO: return "albedo";
+    default: return NULL;
+    }
+}
+
+char *passes_aov_output_path(const PassRequest *q, const char *output, unsigned aov)
+{
+    const char *named = q->aov_files[aov - INTEGRATOR_AOV_NORMAL];
+    return named ? strdup(named) : passes_aov_path(output, passes_aov_name(aov));
+}
+
+int passes_aov_in_exr(const PassRequest *q, const char *output, unsigned aov)
+{
+    ImageFormat fmt = IMAGE_PNG;
+    Error ignored = { 0 };
+    image_format_from_path(output, &fmt, &ignored);
+    error_clear(&ignored);
+    return fmt == IMAGE_EXR && !q->aov_files[aov - INTEGRATOR_AOV_NORMAL];
+}
+
+/* An auxiliary image as the EXR output's channels hold it: the normal signed (the
+ * normal image rendered with grey misses, (n + 1) / 2, gives 2c - 1 = the pixel's mean
+ * normal with misses counting 0), the mean distance to the pixel's hits (+inf where
+ * none), the albedo as it is. */
+static Status passes__aov_exr_data(const PassContext *pc, unsigned aov, uint spp, float *rgb, double *secs, Error *err)
+{
+    RenderParams *p = &pc->rs->ds.params;
+    uint grey = p->normal_miss_grey;
+    if (aov == INTEGRATOR_AOV_NORMAL) p->normal_miss_grey = 1;
+    DepthScale raw = { DEPTH_RAW, 0.0, 0.0 };
+    Status st = passes_aov(pc, aov, spp, &raw, rgb, secs, err);
+    p->normal_miss_grey = grey;
+    if (!st && aov == INTEGRATOR_AOV_NORMAL)
+        for (size_t i = 0; i < (size_t)p->width * p->height * 3u; i++) rgb[i] = 2.0f * rgb[i] - 1.0f;
+    return st;
+}
+
+/* The EXR output again, with the auxiliary images as channels. */
+static Status passes__write_exr_layers(const PassRequest *q, const char *output, const float *rgb, float *const aov_rgb[3],
+                               uint w, uint h, Error *err)
+{
+    static const char *const names[3][3] = { { "normal.X", "normal.Y", "normal.Z" }, { "Z", NULL, NULL },
+                                             { "albedo.R", "albedo.G", "albedo.B" } };
+    ImageLayer layers[3];
+    size_t n = 0;
+    for (int a = 0; a < 3; a++) {
+        if (!aov_rgb[a]) continue;
+        memcpy(layers[n].names, names[a], sizeof names[a]);
+        layers[n++].rgb = aov_rgb[a];
+    }
+    return n ? image_write_exr(output, rgb, layers, n, w, h, q->exr_float, err) : ST_OK;
+}
+
+/* The adaptive pass and the auxiliary images, after the main image is in rgb (and
+ * written). A failure here is the run's failure; the main image stays written. */
+Status passes_after_image(const PassRequest *q, const PassContext *pc, const char *output, ImageEncoding encoding,
+                         float *rgb, uint spp, Error *err)
+{
+    uint w = pc->rs->ds.params.width, h = pc->rs->ds.params.height;
+    Status st = ST_OK;
+    if (q->adaptive > 0.0) {
+        size_t marked = 0;
+        double secs = 0.0;
+        if ((st = passes_adaptive(pc, rgb, spp, (float)q->adaptive, q->adaptive_spp, &marked, &secs, err)))
+            return st;
+        if ((st = image_write_encoded(output, rgb, w, h, encoding, err))) return st;
+        if (!q->quiet)
+            fprintf(stderr, "clpt: adaptive pass: %zu of %u pixels (%.1f%%) got %u more samples in %.2f s -> %s\n",
+                    marked, w * h, 100.0 * (double)marked / ((double)w * h), q->adaptive_spp, secs, output);
+    }
+    float *in_exr[3] = { NULL, NULL, NULL };
+    for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO && !st; aov++) {
+        if (!(q->aovs & (1u << aov)) || !passes_aov_in_exr(q, output, aov)) continue;
+        float **slot = &in_exr[aov - INTEGRATOR_AOV_NORMAL];
+        double secs = 0.0;
+        if (!(*slot = malloc((size_t)w * h * 3u * sizeof **slot))) st = error_set(err, ST_INTERNAL, "out of memory");
+        if (!st) st = passes__aov_exr_data(pc, aov, spp, *slot, &secs, err);
+        if (!st && !q->quiet) fprintf(stderr, "clpt: %s image in %.2f s\n", passes_aov_name(aov), secs);
+    }
+    if (!st) st = passes__write_exr_layers(q, output, rgb, in_exr, w, h, err);
+    if (!st && !q->quiet && (in_exr[0] || in_exr[1] || in_exr[2]))
+        fprintf(stderr, "clpt: auxiliary images as channels -> %s\n", output);
+    for (int a = 0; a < 3; a++) free(in_exr[a]);
+    if (st) return st;
+    for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
+        if (!(q->aovs & (1u << aov)) || passes_aov_in_exr(q, output, aov)) continue;
+        char *path = passes_aov_output_path(q, output, aov);
+        if (!path) return error_set(err, ST_INTERNAL, "out of memory");
+        ImageFormat fmt = IMAGE_PNG;
+        image_format_from_path(path, &fmt, err);
+        double secs = 0.0;
+        DepthScale depth = { fmt == IMAGE_PFM ? DEPTH_RAW : (q->depth_far != q->depth_near ? DEPTH_RANGE : DEPTH_AUTO),
+                             q->depth_near, q->depth_far };
+        st = passes_aov(pc, aov, spp, &depth, rgb, &secs, err);
+        /* auxiliary images hold data, not light: no sRGB curve */
+        if (!st) st = image_write_encoded(path, rgb, w, h, IMAGE_LINEAR, err);
+        if (!st && !q->quiet)
+            fprintf(stderr, "clpt: %s image in %.2f s -> %s\n", passes_aov_name(aov), secs, path);
+        free(path);
+        if (st) return st;
+    }
+    return ST_OK;
 }

@@ -61,4 +61,31 @@ Status passes_aov(const PassContext *pc, uint aov, uint spp, const DepthScale *d
 /* The file name of an auxiliary image: "out.png" and "normal" give "out-normal.png". */
 char *passes_aov_path(const char *output, const char *name);
 
+/* "normal", "depth" or "albedo" for INTEGRATOR_AOV_*, else NULL. */
+const char *passes_aov_name(unsigned aov);
+
+/* What the passes after the main image are asked for (clpt's --adaptive, --aov,
+ * --depth-range, --exr-float, and the course command line's image names). */
+typedef struct {
+    double adaptive;              /* whitted: neighbour difference threshold, 0 = no pass */
+    unsigned adaptive_spp;        /* extra samples per flagged pixel */
+    unsigned aovs;                /* bit (INTEGRATOR_AOV_x): auxiliary images to write */
+    const char *aov_files[3];     /* normal, depth, albedo image names; NULL: OUTPUT-normal.png etc. */
+    double depth_near, depth_far; /* near == far: automatic depth grey */
+    int exr_float;                /* EXR channels as 32-bit floats */
+    int quiet;
+} PassRequest;
+
+/* Where auxiliary image `aov` goes: the name the course command line gave it, else
+ * OUTPUT-normal.png etc. Freed by the caller; NULL when out of memory. */
+char *passes_aov_output_path(const PassRequest *q, const char *output, unsigned aov);
+/* Whether auxiliary image `aov` goes into the EXR output as channels: the output is an
+ * .exr and the course command line gave the image no file of its own. */
+int passes_aov_in_exr(const PassRequest *q, const char *output, unsigned aov);
+/* The adaptive pass and the auxiliary images, after the main image is in rgb (and
+ * written to `output`): each image to its file, or as channels of an EXR output. A
+ * failure here is the run's failure; the main image stays written. */
+Status passes_after_image(const PassRequest *q, const PassContext *pc, const char *output, ImageEncoding encoding,
+                          float *rgb, uint spp, Error *err);
+
 #endif /* CLPT_PASSES_H */

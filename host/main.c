@@ -36,7 +36,7 @@
 #include "render/stats.h"
 #include "io/scene_load.h"
 #include "base/timer.h"
-#include "viewer.h"
+#include "viewer/viewer.h"
 
 #define CLPT_VERSION "0.1.0"
 

@@ -29,7 +29,7 @@
 #include "cli_util.h"
 #include "harness.h"
 #include "io/scene_load.h"
-#include "view_camera.h"
+#include "viewer/view_camera.h"
 
 /* ------------------------------------------------------------------ camera units */
 

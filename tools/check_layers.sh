@@ -11,13 +11,14 @@
 #   render  scheduler, film, checkpoints, passes
 #   dist    one image from many processes: merging --sample-range parts, the MPI
 #           driver (docs/distributed.md)
+#   viewer  the interactive window (docs/viewer.md): its camera, its renderer, SDL
 #   app     host/*.c: options and main, on top of everything
 #
 # Headers of kernels/ (shared structs, math) may be included from any layer. Prints
 # every include that points up and exits 1 if there is one; run by `make test`.
 set -eu
 cd "$(dirname "$0")/.."
-layers="base scene io accel device render dist app"
+layers="base scene io accel device render dist viewer app"
 
 rank() {
     i=0

@@ -1,5 +1,5 @@
 /* viewer_render.c — see viewer_render.h. */
-#include "viewer_render.h"
+#include "viewer/viewer_render.h"
 
 #include <math.h>
 #include <stdio.h>

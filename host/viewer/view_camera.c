@@ -1,6 +1,6 @@
 /* view_camera.c — see view_camera.h. The frame is computed in double and the result
  * rounded to float once, as the scene parser stores it. */
-#include "view_camera.h"
+#include "viewer/view_camera.h"
 
 #include <math.h>
 

@@ -1,6 +1,6 @@
 /* viewer.c — see viewer.h. The window, its input and its drawing; the rendering is in
  * viewer_render.c, the camera moves in view_camera.c. */
-#include "viewer.h"
+#include "viewer/viewer.h"
 
 #include <SDL2/SDL.h>
 
@@ -16,8 +16,8 @@
 #include <unistd.h>
 
 #include "base/timer.h"
-#include "view_camera.h"
-#include "viewer_render.h"
+#include "viewer/view_camera.h"
+#include "viewer/viewer_render.h"
 
 /* Display conversion: linear value -> 8-bit through a table (the window shows 10+
  * frames a second; the exact encoder is used for the saved files). */

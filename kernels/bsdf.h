@@ -107,22 +107,36 @@ KFN BsdfSample bsdf_sample_metal(vec3 albedo, float fuzz, vec3 d, vec3 n, float 
     return s;
 }
 
-/* Smooth glass: reflect with the Fresnel probability, otherwise refract. `d` is the
- * incoming unit direction, n the geometric normal facing the incoming side, `entering`
- * whether d comes from outside (the side the outward normal points to). */
-KFN BsdfSample bsdf_sample_dielectric(float ior, vec3 d, vec3 n, int entering, float u)
+/* Smooth glass: reflect with the Fresnel probability, otherwise refract, about the
+ * shading normal ns, as Mitsuba, Cycles and pbrt do. `d` is the incoming unit
+ * direction, ns and ng the shading and geometric normals facing the incoming side,
+ * `entering` whether d comes from outside (the side the outward normal points to).
+ *
+ * About ng instead, a tessellated sphere with interpolated normals was a faceted
+ * polyhedron to its light: near the rim, refracted rays met the next facet beyond the
+ * critical angle and circled inside by total internal reflection past any depth limit
+ * (0.9922 in a white furnace at depth 16, the rim's pixels down to 0.71, where the
+ * analytic sphere renders 1; test_bsdf's test_furnace_mesh_glass). A direction that
+ * would leave on the wrong side of the geometric surface (a refraction above it, at a
+ * grazing exit through a normal tilted from ng; a mirror below it) is taken about ng,
+ * with a total internal reflection there reflecting: every sample goes on with weight
+ * 1, so the glass keeps all it receives, as whitted.cl's refraction does. An ns facing
+ * away from d (one bsdf_normal did not bend: Phong's) is replaced by ng. */
+KFN BsdfSample bsdf_sample_dielectric(float ior, vec3 d, vec3 ns, vec3 ng, int entering, float u)
 {
     BsdfSample s;
     float eta = entering ? ior : 1.0f / ior;     /* n_t / n_i */
-    float cos_i = -v3_dot(d, n);
-    float F = fresnel_dielectric(cos_i, eta);
+    vec3 wo = v3_neg(d);
+    if (!(v3_dot(wo, ns) > 0.0f)) ns = ng;
+    float F = fresnel_dielectric(v3_dot(wo, ns), eta);
     s.transmitted = !(u < F);
     if (u < F) {
-        s.wi = reflect_dir(d, n);
-    } else {
-        float inv = 1.0f / eta;
-        float cos_t = k_safe_sqrt(1.0f - inv * inv * (1.0f - cos_i * cos_i));
-        s.wi = v3_norm(v3_add(v3_scale(d, inv), v3_scale(n, inv * cos_i - cos_t)));
+        s.wi = reflect_dir(d, ns);
+        if (v3_dot(s.wi, ng) <= 0.0f) s.wi = reflect_dir(d, ng);
+    } else if (!mf_refract(wo, ns, eta, &s.wi) || !(v3_dot(s.wi, ng) < 0.0f)) {
+        /* (mf_refract fails only by rounding here: F is 1 where it would) */
+        s.transmitted = mf_refract(wo, ng, eta, &s.wi);
+        if (!s.transmitted) s.wi = reflect_dir(d, ng);
     }
     /* choosing the lobe with probability F (or 1-F) cancels the Fresnel factor; the
      * radiance scaling by eta^2 is left out, as is usual for camera paths that end on
@@ -187,10 +201,10 @@ KFN float phong_eval(PhongLobes l, vec3 d, vec3 n, vec3 wi, vec3 *f)
 }
 
 /* Samples one of the lobes: u_lobe picks glossy / mirror / refraction (and within the
- * glossy part diffuse or specular, by rescaling it), u1 u2 the direction. `entering`
- * and ng as for bsdf_sample_dielectric (ng faces the incoming side); u_fresnel chooses
- * reflection or refraction at the refracting part. Only a refracted sample leaves below
- * the geometric surface (a glossy one there is the caller's to drop). */
+ * glossy part diffuse or specular, by rescaling it), u1 u2 the direction. `entering`,
+ * ns and ng as for bsdf_sample_dielectric (both face the incoming side); u_fresnel
+ * chooses reflection or refraction at the refracting part. Only a refracted sample
+ * leaves below the geometric surface (a glossy one there is the caller's to drop). */
 KFN BsdfSample phong_sample(PhongLobes l, Material m, vec3 d, vec3 ns, vec3 ng, int entering,
                             float u_lobe, float u1, float u2, float u_fresnel)
 {
@@ -233,7 +247,7 @@ KFN BsdfSample phong_sample(PhongLobes l, Material m, vec3 d, vec3 ns, vec3 ng, 
      * it is, with kt's weight. Returned whole rather than copied field by field into s:
      * NVIDIA's OpenCL compiler (driver 580.159) at its default optimisation kept the
      * glossy branch's pdf and flag in s on this path (tools/gpu-check.sh found it). */
-    BsdfSample g = bsdf_sample_dielectric(m.ior, d, ng, entering, u_fresnel);
+    BsdfSample g = bsdf_sample_dielectric(m.ior, d, ns, ng, entering, u_fresnel);
     float p_t = 1.0f - l.p_glossy - l.p_mirror;
     g.weight = p_t > 0.0f ? v3_scale(l.kt, 1.0f / p_t) : v3s(0.0f);
     return g;
@@ -486,7 +500,7 @@ KFN BsdfSample bsdf_sample(Material m, vec3 albedo, vec3 d, vec3 ns, vec3 ng, in
     if (bsdf_has_density(m, albedo)) return bsdf_sample_rough(m, albedo, d, ns, front, u_lobe, u1, u2);
     if (MAT_IS(m, MAT_CONDUCTOR)) return bsdf_sample_mirror_conductor(bsdf_conductor(m, albedo), d, ns, ng);
     if (m.flags & MAT_THIN) return bsdf_sample_thin(bsdf_dielectric(m, front), d, ng, u_lobe);
-    return bsdf_sample_dielectric(m.ior, d, ng, front, u_lobe);
+    return bsdf_sample_dielectric(m.ior, d, ns, ng, front, u_lobe);
 }
 
 #endif /* CLPT_BSDF_H */

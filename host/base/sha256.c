@@ -1,5 +1,7 @@
 #include "base/sha256.h"
 
+#include "base/bytes.h"
+
 #include <string.h>
 
 static const uint32_t sha256__k[64] = {
@@ -21,8 +23,7 @@ static void sha256__block(uint32_t state[8], const unsigned char *p)
 {
     uint32_t w[64];
     for (int i = 0; i < 16; i++)
-        w[i] = (uint32_t)p[4 * i] << 24 | (uint32_t)p[4 * i + 1] << 16 |
-               (uint32_t)p[4 * i + 2] << 8 | (uint32_t)p[4 * i + 3];
+        w[i] = bytes_get_be32(p + 4 * i);
     for (int i = 16; i < 64; i++) {
         uint32_t s0 = sha256__rotr(w[i - 15], 7) ^ sha256__rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
         uint32_t s1 = sha256__rotr(w[i - 2], 17) ^ sha256__rotr(w[i - 2], 19) ^ (w[i - 2] >> 10);
@@ -80,12 +81,7 @@ void sha256_final(Sha256 *h, unsigned char digest[SHA256_DIGEST_SIZE])
     memset(h->block + used, 0, 56 - used);
     for (int i = 0; i < 8; i++) h->block[56 + i] = (unsigned char)(bits >> (56 - 8 * i));
     sha256__block(h->state, h->block);
-    for (int i = 0; i < 8; i++) {
-        digest[4 * i] = (unsigned char)(h->state[i] >> 24);
-        digest[4 * i + 1] = (unsigned char)(h->state[i] >> 16);
-        digest[4 * i + 2] = (unsigned char)(h->state[i] >> 8);
-        digest[4 * i + 3] = (unsigned char)h->state[i];
-    }
+    for (int i = 0; i < 8; i++) bytes_put_be32(digest + 4 * i, h->state[i]);
 }
 
 void sha256(const void *data, size_t n, unsigned char digest[SHA256_DIGEST_SIZE])

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "base/atomic_file.h"
+#include "base/bytes.h"
 #include "base/sha256.h"
 
 /* Cache file layout (integers little-endian):
@@ -37,18 +38,6 @@ static double oclp__now(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
-
-static void oclp__put_le(unsigned char *p, uint64_t v, int bytes)
-{
-    for (int i = 0; i < bytes; i++) p[i] = (unsigned char)(v >> (8 * i));
-}
-
-static uint64_t oclp__get_le(const unsigned char *p, int bytes)
-{
-    uint64_t v = 0;
-    for (int i = 0; i < bytes; i++) v |= (uint64_t)p[i] << (8 * i);
-    return v;
 }
 
 /* ---------------------------------------------------------------- source and options */
@@ -149,7 +138,7 @@ static int oclp__make_dirs(const char *path)
 static void oclp__hash_field(Sha256 *h, const char *s, size_t n)
 {
     unsigned char len[8];
-    oclp__put_le(len, n, 8);
+    bytes_put_le(len, n, 8);
     sha256_update(h, len, sizeof len);
     sha256_update(h, s, n);
 }
@@ -186,9 +175,9 @@ static int oclp__cache_read(const char *path, const unsigned char *key, unsigned
     }
     unsigned char head[OCLP__HEADER];
     int ok = fread(head, 1, sizeof head, f) == sizeof head &&
-             memcmp(head, OCLP__MAGIC, 8) == 0 && oclp__get_le(head + 8, 4) == OCLP__VERSION &&
+             memcmp(head, OCLP__MAGIC, 8) == 0 && bytes_get_le(head + 8, 4) == OCLP__VERSION &&
              (!key || memcmp(head + 24, key, SHA256_DIGEST_SIZE) == 0);
-    uint64_t n = ok ? oclp__get_le(head + 16, 8) : 0;
+    uint64_t n = ok ? bytes_get_le(head + 16, 8) : 0;
     ok = ok && n > 0 && n <= OCLP__MAX_PAYLOAD;
     unsigned char *buf = ok ? malloc((size_t)n + 1) : NULL;
     ok = buf && fread(buf, 1, (size_t)n, f) == n && fgetc(f) == EOF;
@@ -222,8 +211,8 @@ static void oclp__cache_write(const char *path, const unsigned char key[SHA256_D
 {
     unsigned char head[OCLP__HEADER] = {0};
     memcpy(head, OCLP__MAGIC, 8);
-    oclp__put_le(head + 8, OCLP__VERSION, 4);
-    oclp__put_le(head + 16, len, 8);
+    bytes_put_le(head + 8, OCLP__VERSION, 4);
+    bytes_put_le(head + 16, len, 8);
     memcpy(head + 24, key, SHA256_DIGEST_SIZE);
     sha256(payload, len, head + 56);
     AtomicFile af;

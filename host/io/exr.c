@@ -1,6 +1,7 @@
 /* exr.c — OpenEXR images through OpenEXRCore (see exr.h). */
 #include "io/exr.h"
 
+#include "base/bytes.h"
 #include "base/strmap.h"
 
 #include <errno.h>
@@ -128,11 +129,6 @@ static uint64_t exr_fixed_size(const char *type)
     return 0;
 }
 
-static uint64_t exr_le32(const unsigned char *p)
-{
-    return (uint64_t)p[0] | (uint64_t)p[1] << 8 | (uint64_t)p[2] << 16 | (uint64_t)p[3] << 24;
-}
-
 /* The parts of an attribute's value the OpenEXR library sizes from inside the value:
  * a channel list (entries up to an empty name, read whatever the declared size says),
  * a preview (width x height x 4 bytes), a string vector (a length before each string).
@@ -158,7 +154,7 @@ static int exr_value_fits(FILE *f, const char *type, uint64_t n)
     if (strcmp(type, "preview") == 0) {
         unsigned char wh[8];
         if (n < 8 || fread(wh, 1, 8, f) != 8) return 0;
-        uint64_t w = exr_le32(wh), h = exr_le32(wh + 4);
+        uint64_t w = bytes_get_le32(wh), h = bytes_get_le32(wh + 4);
         if ((w && h > (n - 8) / 4 / w) || w * h * 4 != n - 8) return 0;
         return fseek(f, (long)(n - 8), SEEK_CUR) == 0;
     }
@@ -166,7 +162,7 @@ static int exr_value_fits(FILE *f, const char *type, uint64_t n)
         for (uint64_t used = 0; used < n;) {
             unsigned char len[4];
             if (n - used < 4 || fread(len, 1, 4, f) != 4) return 0;
-            uint64_t l = exr_le32(len);
+            uint64_t l = bytes_get_le32(len);
             used += 4;
             if (l > n - used || fseek(f, (long)l, SEEK_CUR) != 0) return 0;
             used += l;
@@ -228,7 +224,7 @@ static Status exr_header_check(const char *path, const exr_attr_box2i_t *core_dw
         }
         unsigned char sz[4];
         if (!exr_read_name(f, type) || fread(sz, 1, 4, f) != 4) break;
-        uint64_t n = exr_le32(sz);
+        uint64_t n = bytes_get_le32(sz);
         long at = ftell(f);
         if (at < 0) break;
         if (n > (uint64_t)(size - at)) {
@@ -240,7 +236,7 @@ static Status exr_header_check(const char *path, const exr_attr_box2i_t *core_dw
         if (part == 0 && strcmp(name, "dataWindow") == 0 && strcmp(type, "box2i") == 0 && n == 16) {
             unsigned char b[16];
             if (fread(b, 1, 16, f) != 16 || fseek(f, -16, SEEK_CUR) != 0) break;
-            for (int k = 0; k < 4; k++) dw[k] = (int32_t)exr_le32(b + 4 * k);
+            for (int k = 0; k < 4; k++) dw[k] = (int32_t)bytes_get_le32(b + 4 * k);
             have_dw = 1;
         }
         if (!exr_value_fits(f, type, n))

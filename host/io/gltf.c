@@ -1,6 +1,7 @@
 /* gltf.c — glTF 2.0 and GLB scenes (gltf.h). */
 #include "io/gltf.h"
 
+#include "base/bytes.h"
 #include "base/limit.h"
 #include "base/strmap.h"
 #include "io/lexer.h"
@@ -429,14 +430,11 @@ static double comp_read(const unsigned char *p, long long type, int normalized)
     switch (type) {
     case 5120: { double c = (int8_t)p[0]; return normalized ? fmax(c / 127.0, -1.0) : c; }
     case 5121: return normalized ? p[0] / 255.0 : p[0];
-    case 5122: { double c = (int16_t)(uint16_t)(p[0] | p[1] << 8); return normalized ? fmax(c / 32767.0, -1.0) : c; }
-    case 5123: { double c = (uint16_t)(p[0] | p[1] << 8); return normalized ? c / 65535.0 : c; }
-    case 5125: {
-        double c = (double)((uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24);
-        return normalized ? c / 4294967295.0 : c;
-    }
+    case 5122: { double c = (int16_t)bytes_get_le16(p); return normalized ? fmax(c / 32767.0, -1.0) : c; }
+    case 5123: { double c = bytes_get_le16(p); return normalized ? c / 65535.0 : c; }
+    case 5125: { double c = (double)bytes_get_le32(p); return normalized ? c / 4294967295.0 : c; }
     default: {
-        uint32_t u = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+        uint32_t u = bytes_get_le32(p);
         float f;
         memcpy(&f, &u, sizeof f);
         return f;
@@ -1398,29 +1396,24 @@ static Status extensions_check(Gltf *g)
     return ST_OK;
 }
 
-static uint32_t le32(const unsigned char *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
 /* The GLB container: header (magic, version 2, total length), a JSON chunk, and an
  * optional BIN chunk; every length checked against the file. */
 static Status glb_split(Gltf *g, const unsigned char *d, size_t len, const char **json, size_t *json_len)
 {
-    if (len < 12 || le32(d) != GLB_MAGIC)
+    if (len < 12 || bytes_get_le32(d) != GLB_MAGIC)
         return error_set(g->err, ST_INPUT, "%s: not a binary glTF file (it does not start with the magic 'glTF')",
                          g->path);
-    if (le32(d + 4) != 2)
-        return error_set(g->err, ST_INPUT, "%s: GLB version %u; clpt reads version 2", g->path, le32(d + 4));
-    if (le32(d + 8) != len)
+    if (bytes_get_le32(d + 4) != 2)
+        return error_set(g->err, ST_INPUT, "%s: GLB version %u; clpt reads version 2", g->path, bytes_get_le32(d + 4));
+    if (bytes_get_le32(d + 8) != len)
         return error_set(g->err, ST_INPUT, "%s: the GLB header says the file has %u bytes, but it has %zu", g->path,
-                         le32(d + 8), len);
+                         bytes_get_le32(d + 8), len);
     size_t at = 12;
     for (int chunk = 0; at < len; chunk++) {
         if (len - at < 8)
             return error_set(g->err, ST_INPUT, "%s: GLB chunk %d at byte %zu: its 8-byte header is cut off", g->path,
                              chunk, at);
-        uint32_t clen = le32(d + at), type = le32(d + at + 4);
+        uint32_t clen = bytes_get_le32(d + at), type = bytes_get_le32(d + at + 4);
         if (clen > len - at - 8)
             return error_set(g->err, ST_INPUT, "%s: GLB chunk %d at byte %zu declares %u bytes, more than the %zu "
                              "left in the file", g->path, chunk, at, clen, len - at - 8);

@@ -8,6 +8,7 @@
 #include "io/image_write.h"
 
 #include "base/atomic_file.h"
+#include "base/bytes.h"
 #include "io/exr.h"
 
 #include <errno.h>
@@ -95,11 +96,6 @@ static void write_png(AtomicFile *af, const unsigned char *srgb, unsigned w, uns
     }
 }
 
-static void put_le(unsigned char *p, uint32_t v, int bytes)
-{
-    for (int i = 0; i < bytes; i++) p[i] = (unsigned char)(v >> (8 * i));
-}
-
 /* BMP: the 14-byte file header and the 40-byte BITMAPINFOHEADER, then 24-bit BGR rows
  * bottom to top, each padded to a multiple of 4 bytes. */
 static void write_bmp(AtomicFile *af, const unsigned char *rgb8, unsigned w, unsigned h)
@@ -109,16 +105,16 @@ static void write_bmp(AtomicFile *af, const unsigned char *rgb8, unsigned w, uns
     memset(header, 0, sizeof header);
     header[0] = 'B';
     header[1] = 'M';
-    put_le(header + 2, (uint32_t)(sizeof header + row * h), 4);
-    put_le(header + 10, sizeof header, 4);
-    put_le(header + 14, 40, 4);
-    put_le(header + 18, w, 4);
-    put_le(header + 22, h, 4);
-    put_le(header + 26, 1, 2);       /* planes */
-    put_le(header + 28, 24, 2);      /* bits per pixel; compression 0 (none) */
-    put_le(header + 34, (uint32_t)(row * h), 4);
-    put_le(header + 38, 2835, 4);    /* 72 dpi */
-    put_le(header + 42, 2835, 4);
+    bytes_put_le(header + 2, (uint32_t)(sizeof header + row * h), 4);
+    bytes_put_le(header + 10, sizeof header, 4);
+    bytes_put_le(header + 14, 40, 4);
+    bytes_put_le(header + 18, w, 4);
+    bytes_put_le(header + 22, h, 4);
+    bytes_put_le(header + 26, 1, 2);       /* planes */
+    bytes_put_le(header + 28, 24, 2);      /* bits per pixel; compression 0 (none) */
+    bytes_put_le(header + 34, (uint32_t)(row * h), 4);
+    bytes_put_le(header + 38, 2835, 4);    /* 72 dpi */
+    bytes_put_le(header + 42, 2835, 4);
     atomic_write(af, header, sizeof header);
     unsigned char *line = calloc(row, 1);
     if (!line) {
@@ -153,10 +149,7 @@ static Status write_pfm(AtomicFile *af, const float *rgb, unsigned w, unsigned h
         for (size_t i = 0; i < row_floats; i++) {
             uint32_t bits;
             memcpy(&bits, &src[i], 4);
-            row[4 * i + 0] = (unsigned char)(bits & 0xffu);
-            row[4 * i + 1] = (unsigned char)((bits >> 8) & 0xffu);
-            row[4 * i + 2] = (unsigned char)((bits >> 16) & 0xffu);
-            row[4 * i + 3] = (unsigned char)(bits >> 24);
+            bytes_put_le32(row + 4 * i, bits);
         }
         atomic_write(af, row, row_floats * 4);
     }

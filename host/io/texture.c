@@ -1,6 +1,7 @@
 /* texture.c — image and checkerboard textures (see texture.h). */
 #include "io/texture.h"
 
+#include "base/bytes.h"
 #include "base/limit.h"
 #include "io/exr.h"
 #include "io/lexer.h"
@@ -68,7 +69,7 @@ Status texture_check_map(const Texture *t, Error *err)
 /* Packs 8-bit RGBA into the uint texel layout of kernels/texture.h. */
 static uint pack_rgba(const unsigned char *p)
 {
-    return (uint)p[0] | (uint)p[1] << 8 | (uint)p[2] << 16 | (uint)p[3] << 24;
+    return bytes_get_le32(p);
 }
 
 /* A binary PNM (P5, P6) must hold the pixels its header declares. stb_image 2.27
@@ -125,7 +126,7 @@ static Status png_check(const char *path, Error *err)
     while (at + 8 <= (uint64_t)size) {
         unsigned char c[8];
         if (fread(c, 1, 8, f) != 8) break;
-        uint64_t length = (uint64_t)c[0] << 24 | (uint64_t)c[1] << 16 | (uint64_t)c[2] << 8 | c[3];
+        uint64_t length = bytes_get_be32(c);
         /* the chunk's data and its 4-byte CRC */
         if (length > (uint64_t)size - at - 8) {
             char type[5];
@@ -187,10 +188,6 @@ static void walk_skip(Walk *w, uint64_t n)
     }
 }
 
-static uint64_t le16(const unsigned char *p) { return (uint64_t)p[0] | (uint64_t)p[1] << 8; }
-static uint64_t le32(const unsigned char *p) { return le16(p) | le16(p + 2) << 16; }
-static uint64_t be16(const unsigned char *p) { return (uint64_t)p[0] << 8 | p[1]; }
-static uint64_t be32(const unsigned char *p) { return be16(p) << 16 | be16(p + 2); }
 
 /* Uncompressed data of `need` bytes from byte `start`. */
 static Status check_fixed(const char *path, const char *format, int w, int h, uint64_t start, uint64_t need,
@@ -218,7 +215,7 @@ static Status tga_check(Walk *wk, const unsigned char *hd, const char *path, int
     int indexed = hd[1], type = hd[2], bpp = hd[16], rle = type >= 8;
     uint64_t pixel = indexed ? (bpp == 8 ? 1u : 2u) : (uint64_t)(bpp + 7) / 8;
     uint64_t start = 18 + (uint64_t)hd[0];
-    if (indexed) start += le16(hd + 3) + le16(hd + 5) * (uint64_t)((hd[7] + 7) / 8);
+    if (indexed) start += bytes_get_le16(hd + 3) + bytes_get_le16(hd + 5) * (uint64_t)((hd[7] + 7) / 8);
     uint64_t n = (uint64_t)w * (uint64_t)h;
     if (!rle) return check_fixed(path, "TGA", w, h, start, n * pixel, wk->size, err);
     walk_skip(wk, start - wk->pos);
@@ -236,10 +233,10 @@ static Status tga_check(Walk *wk, const unsigned char *hd, const char *path, int
  * 4 bytes, from the header's data offset (run-length BMPs it refuses). */
 static Status bmp_check(Walk *wk, const unsigned char *hd, const char *path, int w, int h, Error *err)
 {
-    uint64_t hsz = le32(hd + 14), bpp = hsz == 12 ? le16(hd + 24) : le16(hd + 28);
+    uint64_t hsz = bytes_get_le32(hd + 14), bpp = hsz == 12 ? bytes_get_le16(hd + 24) : bytes_get_le16(hd + 28);
     if (bpp != 1 && bpp != 4 && bpp != 8 && bpp != 16 && bpp != 24 && bpp != 32) return ST_OK;
     uint64_t row = ((uint64_t)w * bpp + 7) / 8, stride = ((uint64_t)w * bpp + 31) / 32 * 4;
-    return check_fixed(path, "BMP", w, h, le32(hd + 10), stride * (uint64_t)(h - 1) + row, wk->size, err);
+    return check_fixed(path, "BMP", w, h, bytes_get_le32(hd + 10), stride * (uint64_t)(h - 1) + row, wk->size, err);
 }
 
 /* stb_image's PSD reader: a 26-byte header, three sections with a 4-byte length each,
@@ -248,20 +245,20 @@ static Status bmp_check(Walk *wk, const unsigned char *hd, const char *path, int
  * copied, 257 - n copies of one byte, or 128, nothing) over the whole channel. */
 static Status psd_check(Walk *wk, const unsigned char *hd, const char *path, int w, int h, Error *err)
 {
-    uint64_t channels = be16(hd + 12), depth = be16(hd + 22), n = (uint64_t)w * (uint64_t)h;
+    uint64_t channels = bytes_get_be16(hd + 12), depth = bytes_get_be16(hd + 22), n = (uint64_t)w * (uint64_t)h;
     walk_skip(wk, 26);
     for (int section = 0; section < 3 && !wk->short_read; section++) {
         unsigned char len[4];
         for (int i = 0; i < 4; i++) len[i] = (unsigned char)walk_byte(wk);
-        walk_skip(wk, be32(len));
+        walk_skip(wk, bytes_get_be32(len));
     }
     unsigned char comp[2];
     comp[0] = (unsigned char)walk_byte(wk);
     comp[1] = (unsigned char)walk_byte(wk);
     if (wk->short_read) return check_walked(wk, path, "PSD", w, h, err);
     uint64_t read = channels < 4 ? channels : 4;
-    if (be16(comp) == 0) return check_fixed(path, "PSD", w, h, wk->pos, read * n * (depth / 8), wk->size, err);
-    if (be16(comp) != 1) return ST_OK;
+    if (bytes_get_be16(comp) == 0) return check_fixed(path, "PSD", w, h, wk->pos, read * n * (depth / 8), wk->size, err);
+    if (bytes_get_be16(comp) != 1) return ST_OK;
     walk_skip(wk, (uint64_t)h * channels * 2);
     for (uint64_t c = 0; c < read && !wk->short_read; c++)
         for (uint64_t done = 0; done < n && !wk->short_read;) {
@@ -511,7 +508,7 @@ static Status png_check_memory(const char *name, const unsigned char *data, size
     size_t at = 8;
     while (len >= 8 && at <= len - 8) {
         const unsigned char *c = data + at;
-        uint64_t length = (uint64_t)c[0] << 24 | (uint64_t)c[1] << 16 | (uint64_t)c[2] << 8 | c[3];
+        uint64_t length = bytes_get_be32(c);
         if (length > (uint64_t)(len - at - 8))
             return error_set(err, ST_INPUT, "%s: a PNG chunk at byte offset %llu declares %llu bytes, more than "
                              "the %llu left in the image (a truncated or corrupt image)", name,

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "base/atomic_file.h"
+#include "base/bytes.h"
 #include "base/limit.h"
 #include "device/kernel_source.h"
 #include "base/sha256.h"
@@ -56,32 +57,6 @@ void checkpoint_id(const DeviceScene *ds, uint spp, CheckpointId *id)
     id->max_depth = p->max_depth;
 }
 
-/* ------------------------------------------------------------------ little-endian */
-
-static void put32(unsigned char *b, uint32_t v)
-{
-    for (int i = 0; i < 4; i++) b[i] = (unsigned char)(v >> (8 * i));
-}
-
-static void put64(unsigned char *b, uint64_t v)
-{
-    for (int i = 0; i < 8; i++) b[i] = (unsigned char)(v >> (8 * i));
-}
-
-static uint32_t get32(const unsigned char *b)
-{
-    uint32_t v = 0;
-    for (int i = 3; i >= 0; i--) v = v << 8 | b[i];
-    return v;
-}
-
-static uint64_t get64(const unsigned char *b)
-{
-    uint64_t v = 0;
-    for (int i = 7; i >= 0; i--) v = v << 8 | b[i];
-    return v;
-}
-
 /* ------------------------------------------------------------------ writing */
 
 /* The checkpoint file being written, with the hash of its payload as it goes (for the
@@ -110,28 +85,28 @@ Status checkpoint_write(const char *path, const CheckpointId *id, const Film *fi
     unsigned char header[CKPT_HEADER_SIZE];
     memset(header, 0, sizeof header);
     memcpy(header, CKPT_MAGIC, 8);
-    put32(header + 8, CKPT_VERSION);
-    put32(header + 12, CKPT_HEADER_SIZE);
+    bytes_put_le32(header + 8, CKPT_VERSION);
+    bytes_put_le32(header + 12, CKPT_HEADER_SIZE);
     memcpy(header + 16, id->key, CHECKPOINT_KEY_SIZE);
-    put32(header + 48, id->width);
-    put32(header + 52, id->height);
-    put32(header + 56, id->spp);
-    put32(header + 60, id->seed);
-    put32(header + 64, id->max_depth);
-    put32(header + 68, (uint32_t)n_done);
-    put64(header + 72, film->samples);
-    put64(header + 80, payload);
+    bytes_put_le32(header + 48, id->width);
+    bytes_put_le32(header + 52, id->height);
+    bytes_put_le32(header + 56, id->spp);
+    bytes_put_le32(header + 60, id->seed);
+    bytes_put_le32(header + 64, id->max_depth);
+    bytes_put_le32(header + 68, (uint32_t)n_done);
+    bytes_put_le64(header + 72, film->samples);
+    bytes_put_le64(header + 80, payload);
     out_put(&o, header, sizeof header, 1);
     for (size_t i = 0; i < n_done; i++) {
         unsigned char r[8];
-        put32(r, done[i].first);
-        put32(r + 4, done[i].count);
+        bytes_put_le32(r, done[i].first);
+        bytes_put_le32(r + 4, done[i].count);
         out_put(&o, r, sizeof r, 1);
     }
     unsigned char chunk[4096 * 8];
     for (size_t i = 0; i < n_values && !o.af.failed_step;) {
         size_t k = 0;
-        for (; k < 4096 && i < n_values; k++, i++) put64(chunk + 8 * k, (uint64_t)film->sum[i]);
+        for (; k < 4096 && i < n_values; k++, i++) bytes_put_le64(chunk + 8 * k, (uint64_t)film->sum[i]);
         out_put(&o, chunk, 8 * k, 1);
     }
     unsigned char digest[SHA256_DIGEST_SIZE];
@@ -169,7 +144,7 @@ static Status read_film_values(const unsigned char *p, uint64_t n_values, uint64
 {
     uint64_t max = samples * FILM_MAX_SAMPLE_FIXED;
     for (uint64_t i = 0; i < n_values; i++, p += 8) {
-        uint64_t v = get64(p);
+        uint64_t v = bytes_get_le64(p);
         if (v > max) {
             char msg[256];
             uint64_t pixel = i / 3u;
@@ -222,15 +197,15 @@ Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
         st = bad(err, path, "wrong magic (not a checkpoint file)");
         goto out;
     }
-    uint32_t version = get32(data + 8);
+    uint32_t version = bytes_get_le32(data + 8);
     if (version != CKPT_VERSION) {
         char msg[128];
         snprintf(msg, sizeof msg, "format version %u, this clpt reads version %u", version, CKPT_VERSION);
         st = bad(err, path, msg);
         goto out;
     }
-    uint64_t payload = get64(data + 80);
-    if (get32(data + 12) != CKPT_HEADER_SIZE || payload != size - CKPT_HEADER_SIZE - CKPT_TRAILER_SIZE) {
+    uint64_t payload = bytes_get_le64(data + 80);
+    if (bytes_get_le32(data + 12) != CKPT_HEADER_SIZE || payload != size - CKPT_HEADER_SIZE - CKPT_TRAILER_SIZE) {
         st = bad(err, path, "truncated or extended (its size does not match its header)");
         goto out;
     }
@@ -242,13 +217,13 @@ Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
     }
     CheckpointId *id = &c->id;
     memcpy(id->key, data + 16, CHECKPOINT_KEY_SIZE);
-    id->width = get32(data + 48);
-    id->height = get32(data + 52);
-    id->spp = get32(data + 56);
-    id->seed = get32(data + 60);
-    id->max_depth = get32(data + 64);
-    uint32_t n_done = get32(data + 68);
-    uint64_t samples = get64(data + 72);
+    id->width = bytes_get_le32(data + 48);
+    id->height = bytes_get_le32(data + 52);
+    id->spp = bytes_get_le32(data + 56);
+    id->seed = bytes_get_le32(data + 60);
+    id->max_depth = bytes_get_le32(data + 64);
+    uint32_t n_done = bytes_get_le32(data + 68);
+    uint64_t samples = bytes_get_le64(data + 72);
     uint64_t n_values = (uint64_t)id->width * id->height * 3u;
     if (id->width == 0 || id->height == 0 || payload != (uint64_t)n_done * 8u + n_values * 8u) {
         st = bad(err, path, "inconsistent header (image size and payload disagree)");
@@ -268,7 +243,7 @@ Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
     const unsigned char *p = data + CKPT_HEADER_SIZE;
     uint64_t total = 0, end = 0;
     for (uint32_t i = 0; i < n_done; i++, p += 8) {
-        Batch b = { get32(p), get32(p + 4) };
+        Batch b = { bytes_get_le32(p), bytes_get_le32(p + 4) };
         /* sorted, disjoint, non-empty and within the render's samples */
         if (b.count == 0 || b.first < end || (uint64_t)b.first + b.count > id->spp) {
             st = bad(err, path, "inconsistent sample ranges");

@@ -436,6 +436,11 @@ static Status lex_string(Lexer *lx, Token *tok, Error *err)
 
 Status lex_next(Lexer *lx, Token *tok, Error *err)
 {
+    if (lx->has_back) {
+        *tok = lx->back;
+        lx->has_back = 0;
+        return ST_OK;
+    }
     skip_blank(lx);
     if (lx->pos >= lx->len) {
         set_token(lx, tok, TOK_EOF, lx->len, 0);
@@ -459,6 +464,12 @@ Status lex_next(Lexer *lx, Token *tok, Error *err)
     set_token(lx, tok, TOK_WORD, start, p - start);
     lx->pos = p;
     return ST_OK;
+}
+
+void lex_unread(Lexer *lx, const Token *tok)
+{
+    lx->back = *tok;
+    lx->has_back = 1;
 }
 
 int tok_is(const Token *tok, const char *word)

@@ -48,6 +48,8 @@ typedef struct {
     size_t len, pos;
     uint line;
     size_t line_start;   /* offset of the current line's first byte */
+    Token back;          /* the token given back by lex_unread, when has_back */
+    int has_back;
 } Lexer;
 
 /* Reads the whole file. ST_IO "cannot open 'path': <strerror>" when it cannot, and
@@ -91,9 +93,14 @@ Status lex_load_count(const char *path, uint64_t bytes, Error *err);
 /* 3 when text starts with a UTF-8 byte order mark (EF BB BF), else 0. */
 size_t lex_bom_length(const char *text, size_t len);
 
-/* The next token (TOK_EOF at the end, repeatedly). Fails on an unterminated string,
+/* The next token (TOK_EOF at the end, repeatedly): the one given back by lex_unread, if
+ * any, else the next in the text. Fails on an unterminated string,
  * an unknown escape or a control character. */
 Status lex_next(Lexer *lx, Token *tok, Error *err);
+
+/* Gives `tok` back: the next lex_next returns it again (a reader that looked one token
+ * ahead). One token of push-back; `tok` must be the last token this lexer returned. */
+void lex_unread(Lexer *lx, const Token *tok);
 
 /* 1 if the token is the word `word` (strings never match: "camera" is not a keyword). */
 int tok_is(const Token *tok, const char *word);

@@ -122,24 +122,7 @@ typedef struct {
     int have_camera, cam_ortho;
     Transform cam_from_world;
     double fov, lens_radius, focal_distance, screen_half;
-    Token peek; int has_peek;
 } Parser;
-
-static Status next_token(Parser *p, Lexer *lx, Token *t)
-{
-    if (p->has_peek) {
-        *t = p->peek;
-        p->has_peek = 0;
-        return ST_OK;
-    }
-    return lex_next(lx, t, p->err);
-}
-
-static void unread_token(Parser *p, const Token *t)
-{
-    p->peek = *t;
-    p->has_peek = 1;
-}
 
 /* Gives a warning once per key ("Shape disk", "diffuse:foo"), at file:line. */
 static Status warn_once(Parser *p, const Lexer *lx, const Token *at, const char *key, const char *fmt, ...)
@@ -247,10 +230,10 @@ static Status parse_params(Parser *p, Lexer *lx)
     p->pl.n = p->pl.n_nums = p->pl.n_strs = 0;
     for (;;) {
         Token t;
-        Status st = next_token(p, lx, &t);
+        Status st = lex_next(lx, &t, p->err);
         if (st) return st;
         if (t.kind != TOK_STRING) {
-            unread_token(p, &t);
+            lex_unread(lx, &t);
             return ST_OK;
         }
         /* "type name": two words separated by blanks */
@@ -282,20 +265,20 @@ static Status parse_params(Parser *p, Lexer *lx)
         pa->name = t.text + ns;
         pa->name_len = ne - ns;
         Token v;
-        if ((st = next_token(p, lx, &v))) return st;
+        if ((st = lex_next(lx, &v, p->err))) return st;
         int string_vals = pa->type == PT_STRING || pa->type == PT_TEXTURE || pa->type == PT_BOOL ||
                           (pa->type == PT_SPECTRUM && v.kind == TOK_STRING);
         pa->first = string_vals ? p->pl.n_strs : p->pl.n_nums;
         if (pa->type == PT_SPECTRUM && v.kind == TOK_LBRACKET) {
             Token w;
-            if ((st = next_token(p, lx, &w))) return st;
+            if ((st = lex_next(lx, &w, p->err))) return st;
             string_vals = w.kind == TOK_STRING;
             pa->first = string_vals ? p->pl.n_strs : p->pl.n_nums;
-            unread_token(p, &w);
+            lex_unread(lx, &w);
         }
         if (v.kind == TOK_LBRACKET) {
             for (;;) {
-                if ((st = next_token(p, lx, &v))) return st;
+                if ((st = lex_next(lx, &v, p->err))) return st;
                 if (v.kind == TOK_RBRACKET) break;
                 if (v.kind == TOK_EOF)
                     return lex_error_at(lx, &v, p->err, "expected ']' to close the values of \"%.*s\" "
@@ -564,7 +547,7 @@ static Status warn_unused(Parser *p, const Lexer *lx, const char *what)
 
 static Status expect_string(Parser *p, Lexer *lx, const char *what, Token *t)
 {
-    Status st = next_token(p, lx, t);
+    Status st = lex_next(lx, t, p->err);
     if (st) return st;
     if (t->kind != TOK_STRING) return lex_expected(lx, t, what, p->err);
     return ST_OK;
@@ -588,17 +571,17 @@ static Status expect_defined(Parser *p, Lexer *lx, const StrMap *map, const char
 static Status expect_numbers(Parser *p, Lexer *lx, double *out, int n, const char *what)
 {
     Token t;
-    Status st = next_token(p, lx, &t);
+    Status st = lex_next(lx, &t, p->err);
     if (st) return st;
     /* pbrt accepts Transform [ ... ] with or without brackets */
     int bracket = t.kind == TOK_LBRACKET;
-    if (bracket && (st = next_token(p, lx, &t))) return st;
+    if (bracket && (st = lex_next(lx, &t, p->err))) return st;
     for (int i = 0; i < n; i++) {
-        if (i > 0 && (st = next_token(p, lx, &t))) return st;
+        if (i > 0 && (st = lex_next(lx, &t, p->err))) return st;
         if (tok_double(&t, &out[i])) return lex_expected(lx, &t, what, p->err);
     }
     if (bracket) {
-        if ((st = next_token(p, lx, &t))) return st;
+        if ((st = lex_next(lx, &t, p->err))) return st;
         if (t.kind != TOK_RBRACKET) return lex_expected(lx, &t, "']'", p->err);
     }
     return ST_OK;
@@ -2321,7 +2304,7 @@ static Status d_include(Parser *p, Lexer *lx, const Token *kw)
     memcpy(path, p->top_path, dl);
     memcpy(path + dl, t.text, t.len);
     path[dl + t.len] = '\0';
-    /* the included file's tokens start afresh: nothing is pushed back across files */
+    /* the included file has a lexer of its own: nothing is pushed back across files */
     p->depth++;
     st = parse_file(p, path, NULL, 0);
     p->depth--;
@@ -2340,13 +2323,13 @@ static Status d_unsupported(Parser *p, Lexer *lx, const Token *kw)
     Token t;
     Status st;
     for (;;) {
-        if ((st = next_token(p, lx, &t))) return st;
+        if ((st = lex_next(lx, &t, p->err))) return st;
         double d;
         int arg = t.kind == TOK_STRING || t.kind == TOK_LBRACKET || t.kind == TOK_RBRACKET ||
                   (t.kind == TOK_WORD && (tok_double(&t, &d) == 0 || tok_is_bool(&t)));
         if (!arg) break;
     }
-    unread_token(p, &t);
+    lex_unread(lx, &t);
     char key[64];
     snprintf(key, sizeof key, "%.*s", (int)(kw->len > 40 ? 40 : kw->len), kw->text);
     return warn_once(p, lx, kw, key, "%s is not supported; ignored", key);
@@ -2359,7 +2342,7 @@ static Status d_unsupported(Parser *p, Lexer *lx, const Token *kw)
 static Status d_active_transform(Parser *p, Lexer *lx, const Token *kw)
 {
     Token t;
-    Status st = next_token(p, lx, &t);
+    Status st = lex_next(lx, &t, p->err);
     if (st) return st;
     if (t.kind == TOK_WORD && tok_eq(&t, "StartTime"))
         p->g.end_time_only = 0;
@@ -2440,10 +2423,9 @@ static size_t directive_index(const Token *t)
 static Status parse_statements(Parser *p, Lexer *lx)
 {
     Status st;
-    p->has_peek = 0;
     for (;;) {
         Token t;
-        if ((st = next_token(p, lx, &t)) || t.kind == TOK_EOF) break;
+        if ((st = lex_next(lx, &t, p->err)) || t.kind == TOK_EOF) break;
         size_t i = directive_index(&t);
         if (i == N_DIRECTIVES) {
             st = lex_expected(lx, &t, "a pbrt directive (Shape, Material, LightSource, AttributeBegin, ...)", p->err);
@@ -2458,7 +2440,6 @@ static Status parse_statements(Parser *p, Lexer *lx)
         if ((st = directives[i].fn(p, lx, &t))) break;
         if (p->g.end_time_only && is_transform_directive(directives[i].fn)) p->g.ctm = before;
     }
-    p->has_peek = 0;
     return st;
 }
 

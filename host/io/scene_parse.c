@@ -68,26 +68,7 @@ typedef struct {
     char **material_at;               /* per material index, where it was defined */
     size_t n_material_at, cap_material_at;
     int depth_exceeded;               /* the include limit error is not annotated further */
-    Token pending;                    /* a token read ahead and given back (VK_SCALE) */
-    int has_pending;
 } Parser;
-
-/* The next token, or the one given back by unread_token. */
-static Status next_token(Parser *p, Lexer *lx, Token *t)
-{
-    if (p->has_pending) {
-        *t = p->pending;
-        p->has_pending = 0;
-        return ST_OK;
-    }
-    return lex_next(lx, t, p->err);
-}
-
-static void unread_token(Parser *p, const Token *t)
-{
-    p->pending = *t;
-    p->has_pending = 1;
-}
 
 /* ------------------------------------------------------------------ helpers */
 
@@ -171,7 +152,7 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
     char what[160];
     snprintf(what, sizeof what, "%s for '%s'", kind_what(k), k->key);
     Token t;
-    Status st = next_token(p, lx, &t);
+    Status st = lex_next(lx, &t, p->err);
     if (st) return st;
     v->value = t;
     switch (k->kind) {
@@ -186,7 +167,7 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
     case VK_DIR: {
         float c[3];
         for (int i = 0; i < 3; i++) {
-            if (i > 0 && (st = next_token(p, lx, &t))) return st;
+            if (i > 0 && (st = lex_next(lx, &t, p->err))) return st;
             if (tok_float(&t, &c[i]) || (k->kind == VK_COLOR && c[i] < 0.0f))
                 return lex_expected(lx, &t, what, err);
         }
@@ -199,7 +180,7 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
     case VK_MATRIX: {
         int n = k->kind == VK_ROTATE ? 4 : 16;
         for (int i = 0; i < n; i++) {
-            if (i > 0 && (st = next_token(p, lx, &t))) return st;
+            if (i > 0 && (st = lex_next(lx, &t, p->err))) return st;
             if (tok_float(&t, &v->a[i])) return lex_expected(lx, &t, what, err);
         }
         if (k->kind == VK_ROTATE && v->a[0] == 0.0f && v->a[1] == 0.0f && v->a[2] == 0.0f)
@@ -209,14 +190,14 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
     case VK_SCALE:
         /* one factor, or three: the token after the first tells which */
         if (tok_float(&t, &v->a[0]) || v->a[0] == 0.0f) return lex_expected(lx, &t, what, err);
-        if ((st = next_token(p, lx, &t))) return st;
+        if ((st = lex_next(lx, &t, p->err))) return st;
         if (tok_float(&t, &v->a[1])) {
-            unread_token(p, &t);
+            lex_unread(lx, &t);
             v->a[1] = v->a[2] = v->a[0];
             return ST_OK;
         }
         if (v->a[1] == 0.0f) return lex_expected(lx, &t, what, err);
-        if ((st = next_token(p, lx, &t))) return st;
+        if ((st = lex_next(lx, &t, p->err))) return st;
         if (tok_float(&t, &v->a[2]) || v->a[2] == 0.0f) return lex_expected(lx, &t, what, err);
         return ST_OK;
     case VK_WORD:
@@ -274,7 +255,7 @@ static Status parse_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken
     Error *err = p->err;
     memset(vals, 0, n * sizeof *vals);
     Token t;
-    Status st = brace_taken ? ST_OK : next_token(p, lx, &t);
+    Status st = brace_taken ? ST_OK : lex_next(lx, &t, p->err);
     if (st) return st;
     if (!brace_taken && t.kind != TOK_LBRACE) {
         char what[80];
@@ -282,7 +263,7 @@ static Status parse_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken
         return lex_expected(lx, &t, what, err);
     }
     for (;;) {
-        if ((st = next_token(p, lx, &t))) return st;
+        if ((st = lex_next(lx, &t, p->err))) return st;
         if (t.kind == TOK_RBRACE) break;
         if (t.kind == TOK_EOF)
             return lex_error_at(lx, &t, err,
@@ -775,7 +756,7 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
 static Status parse_material(Parser *p, Lexer *lx, const Token *kw)
 {
     Token t;
-    Status st = next_token(p, lx, &t);
+    Status st = lex_next(lx, &t, p->err);
     if (st) return st;
     if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
         return lex_expected(lx, &t, "a material name", p->err);
@@ -1173,7 +1154,7 @@ static Status parse_file(Parser *p, const char *path);
 static Status parse_include(Parser *p, Lexer *lx, const Token *kw)
 {
     Token t;
-    Status st = next_token(p, lx, &t);
+    Status st = lex_next(lx, &t, p->err);
     if (st) return st;
     if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
         return lex_expected(lx, &t, "a file name after 'include'", p->err);
@@ -1213,7 +1194,7 @@ static Status parse_statements(Parser *p, Lexer *lx)
     Status st;
     for (;;) {
         Token t;
-        if ((st = next_token(p, lx, &t)) || t.kind == TOK_EOF) break;
+        if ((st = lex_next(lx, &t, p->err)) || t.kind == TOK_EOF) break;
         size_t i = N_STATEMENTS;
         if (t.kind == TOK_WORD)
             for (i = 0; i < N_STATEMENTS; i++)

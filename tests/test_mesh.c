@@ -10,6 +10,7 @@
 #include "io/mesh_load.h"
 #include "io/mesh_text.h"
 #include "io/mesh_view.h"
+#include "io/path.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -109,18 +110,20 @@ static void test_paths(void)
     snprintf(want, sizeof want, "%s/Textures/Brick Wall.PNG", dir);
     const char *names[] = { "Textures/Brick Wall.PNG", "textures/brick wall.png", "TEXTURES\\BRICK WALL.png" };
     for (int i = 0; i < 3; i++) {
-        char *p = mesh_resolve_path(beside, names[i], strlen(names[i]));
+        char *p;
+        path_resolve(beside, names[i], strlen(names[i]), PATH_ANY_CASE, &p);
         CHECK_MSG(p && strcmp(p, want) == 0, "%s -> %s", names[i], p ? p : "(null)");
         free(p);
     }
     /* nothing matches: the path as written (the texture loader reports it) */
-    char *p = mesh_resolve_path(beside, "textures/none.png", 17);
+    char *p;
+    path_resolve(beside, "textures/none.png", 17, PATH_ANY_CASE, &p);
     char none[200];
     snprintf(none, sizeof none, "%s/textures/none.png", dir);
     CHECK(p && strcmp(p, none) == 0);
     free(p);
     /* absolute names are kept as they are */
-    p = mesh_resolve_path(beside, file, strlen(file));
+    path_resolve(beside, file, strlen(file), PATH_ANY_CASE, &p);
     CHECK(p && strcmp(p, file) == 0);
     free(p);
     remove(file);

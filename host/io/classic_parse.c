@@ -17,11 +17,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "kmath.h"
 #include "base/limit.h"
 #include "io/lexer.h"
+#include "io/path.h"
 #include "io/obj.h"
 #include "scene/curve.h"
 #include "scene/transform.h"
@@ -80,7 +80,6 @@ typedef struct {
     Scene *s;
     Lexer lx;
     Error *err;
-    char *dir;                 /* the scene file's folder with its '/', or "" */
     uint first_material;       /* scene index of the classic material 0 */
     uint n_materials;          /* classic materials defined so far */
     uint current;              /* scene material of new objects (MaterialIndex) */
@@ -259,37 +258,17 @@ static Status read_count(Classic *c, const char *key, unsigned long long *n)
 }
 
 /* A file named in the scene: beside the scene file, else from the current folder
- * (course scenes are written to be run from the course's code folder). */
+ * (course scenes are written to be run from the course's code folder; io/path.h). */
 static Status resolve_path(Classic *c, const Token *t, char **out)
 {
-    char *name = tok_copy(t);
-    if (!name) return error_set(c->err, ST_INTERNAL, "out of memory");
-    struct stat sb;
-    if (name[0] == '/') {
-        *out = name;
-        return ST_OK;
-    }
-    size_t dl = strlen(c->dir), nl = strlen(name);
-    char *beside = malloc(dl + nl + 1);
-    if (!beside) {
-        free(name);
-        return error_set(c->err, ST_INTERNAL, "out of memory");
-    }
-    memcpy(beside, c->dir, dl);
-    memcpy(beside + dl, name, nl + 1);
-    if (stat(beside, &sb) == 0) {
-        free(name);
-        *out = beside;
-        return ST_OK;
-    }
-    if (stat(name, &sb) == 0) {
-        free(beside);
-        *out = name;
-        return ST_OK;
-    }
-    Status st = error_set(c->err, ST_IO, "%s:%u:%u: cannot open '%s': neither '%s' (beside the scene) nor "
-                          "'%s' (from the current folder) exists", c->lx.path, t->line, t->col, name, beside, name);
-    free(name);
+    int r = path_resolve(c->lx.path, t->text, t->len, PATH_BESIDE_OR_CWD, out);
+    if (r == PATH_OK) return ST_OK;
+    if (r == PATH_NO_MEMORY) return error_set(c->err, ST_INTERNAL, "out of memory");
+    char *beside = *out;
+    *out = NULL;
+    Status st = error_set(c->err, ST_IO, "%s:%u:%u: cannot open '%.*s': neither '%s' (beside the scene) nor "
+                          "'%.*s' (from the current folder) exists", c->lx.path, t->line, t->col, (int)t->len,
+                          t->text, beside, (int)t->len, t->text);
     free(beside);
     return st;
 }
@@ -1203,17 +1182,8 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
     c.err = err;
     c.current = NO_INDEX;
     c.fallback = NO_INDEX;
-    const char *slash = strrchr(path, '/');
-    size_t dl = slash ? (size_t)(slash - path) + 1 : 0;
-    c.dir = malloc(dl + 1);
-    if (!c.dir) return error_set(err, ST_INTERNAL, "out of memory");
-    memcpy(c.dir, path, dl);
-    c.dir[dl] = '\0';
     Status st = text ? lex_open_text(&c.lx, path, text, len, err) : lex_open_file(&c.lx, path, err);
-    if (st) {
-        free(c.dir);
-        return st;
-    }
+    if (st) return st;
     /* how the course's reference ray tracer draws a scene (docs/classic-format.md) */
     s->integrator = INTEGRATOR_WHITTED;
     s->linear_output = 1;
@@ -1242,7 +1212,6 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
     /* as in the course's parser: a scene without lights is drawn in flat colours */
     if (!st && s->n_delta_lights == 0 && !c.ambient_given) s->ambient = v3s(1.0f);
     lex_close(&c.lx);
-    free(c.dir);
     return st;
 }
 

@@ -5,6 +5,7 @@
 #include "base/limit.h"
 #include "base/strmap.h"
 #include "io/lexer.h"
+#include "io/path.h"
 #include "io/texture.h"
 #include "kmath.h"
 
@@ -240,17 +241,6 @@ static Status b64_decode(Gltf *g, const char *jpath, const char *text, Buf *out)
     return ST_OK;
 }
 
-static char *path_beside(const char *base, const char *name)
-{
-    const char *slash = strrchr(base, '/');
-    size_t dir = slash ? (size_t)(slash - base) + 1 : 0, n = strlen(name);
-    char *p = malloc(dir + n + 1);
-    if (!p) return NULL;
-    memcpy(p, base, dir);
-    memcpy(p + dir, name, n + 1);
-    return p;
-}
-
 /* The length of the scheme uri starts with (RFC 3986: a letter, then letters, digits,
  * '+', '-' or '.', then ':'), or 0 when it has none. */
 static size_t uri_scheme_length(const char *uri)
@@ -310,7 +300,7 @@ static Status uri_file(Gltf *g, const char *uri, const char *jpath, char **file)
         free(name);
         return bad(g, jpath, "an absolute path (clpt reads data: URIs and file names relative to the glTF file)");
     }
-    *file = path_beside(g->path, name);
+    path_resolve(g->path, name, len, PATH_BESIDE, file);
     free(name);
     return *file ? ST_OK : error_set(g->err, ST_INTERNAL, "out of memory");
 }

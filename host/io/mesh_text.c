@@ -1,14 +1,11 @@
-/* mesh_text.c — numbers and paths for the text mesh readers (mesh_text.h). */
+/* mesh_text.c — numbers for the text mesh readers (mesh_text.h). */
 #include "io/mesh_text.h"
 
 #include <ctype.h>
-#include <dirent.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
-#include <sys/stat.h>
 
 /* ------------------------------------------------------------------ numbers */
 
@@ -54,70 +51,3 @@ const char *mesh_parse_float(const char *p, const char *end, float *out)
     return e;
 }
 
-/* ------------------------------------------------------------------ paths */
-
-static int path_exists(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0;
-}
-
-/* Replaces the component path[start, end) by a directory entry of the folder path[0,
- * start) that equals it without regard to case; 0 when there is none. Entries have the
- * same length as the component when they match, so the path is rewritten in place. */
-static int match_component(char *path, size_t start, size_t end)
-{
-    char saved = path[start];
-    size_t len = end - start;
-    char name[256];
-    if (len >= sizeof name) return 0;
-    memcpy(name, path + start, len);
-    name[len] = '\0';
-    path[start] = '\0';
-    DIR *d = opendir(start == 0 ? "." : path);
-    path[start] = saved;
-    if (!d) return 0;
-    int found = 0;
-    struct dirent *e;
-    while (!found && (e = readdir(d)) != NULL) {
-        if (strlen(e->d_name) == len && strcasecmp(e->d_name, name) == 0) {
-            memcpy(path + start, e->d_name, len);
-            found = 1;
-        }
-    }
-    closedir(d);
-    return found;
-}
-
-char *mesh_resolve_path(const char *beside, const char *name, size_t len)
-{
-    const char *slash = strrchr(beside, '/');
-    size_t dir = (len > 0 && (name[0] == '/' || name[0] == '\\')) || !slash ? 0 : (size_t)(slash - beside) + 1;
-    char *out = malloc(dir + len + 1);
-    if (!out) return NULL;
-    memcpy(out, beside, dir);
-    for (size_t i = 0; i < len; i++) out[dir + i] = name[i] == '\\' ? '/' : name[i];
-    out[dir + len] = '\0';
-    if (path_exists(out)) return out;
-    char *fixed = malloc(dir + len + 1);
-    if (!fixed) return out;
-    memcpy(fixed, out, dir + len + 1);
-    size_t n = dir + len, start = 0;
-    while (start < n) {
-        while (start < n && fixed[start] == '/') start++;
-        size_t end = start;
-        while (end < n && fixed[end] != '/') end++;
-        if (end == start) break;
-        char saved = fixed[end];
-        fixed[end] = '\0';
-        int exists = path_exists(fixed);
-        fixed[end] = saved;
-        if (!exists && !match_component(fixed, start, end)) {
-            free(fixed);
-            return out;
-        }
-        start = end;
-    }
-    free(out);
-    return fixed;
-}

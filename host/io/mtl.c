@@ -4,6 +4,7 @@
 #include "kmath.h"
 #include "io/lexer.h"
 #include "io/mesh_text.h"
+#include "io/path.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -245,7 +246,8 @@ static Status read_map_kd(MtlReader *r)
     const char *name = r->p, *e = r->line_end;
     while (e > name && is_blank(e[-1])) e--;
     if (e == name) return fail_at(r, name, "a texture file name after 'map_Kd'");
-    char *path = mesh_resolve_path(r->path, name, (size_t)(e - name));
+    char *path;
+    path_resolve(r->path, name, (size_t)(e - name), PATH_ANY_CASE, &path);
     char at[64];
     snprintf(at, sizeof at, ":%u:%u", r->line, (uint)(name - r->line_start + 1));
     char *where = malloc(strlen(r->path) + strlen(at) + 1);

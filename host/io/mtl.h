@@ -13,7 +13,7 @@
  *   anything else                       diffuse, albedo Kd (0.8 grey when absent)
  *
  * Ks and Ns are also kept in every material's `specular` and `shininess`. map_Kd is
- * resolved against the MTL file's folder with mesh_resolve_path (case-insensitive when
+ * resolved against the MTL file's folder with path_resolve (case-insensitive when
  * the exact name is missing) and kept as a path for the texture loader.
  */
 #ifndef CLPT_MTL_H

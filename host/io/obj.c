@@ -12,6 +12,7 @@
 #include "kmath.h"
 #include "io/lexer.h"
 #include "io/mesh_text.h"
+#include "io/path.h"
 #include "io/mtl.h"
 
 #include <ctype.h>
@@ -364,7 +365,8 @@ static Status read_mtllib(ObjReader *r)
         if (at_eol(r)) break;
         const char *name = r->p;
         while (!is_delim(r, r->p)) r->p++;
-        char *path = mesh_resolve_path(r->path, name, (size_t)(r->p - name));
+        char *path;
+        path_resolve(r->path, name, (size_t)(r->p - name), PATH_ANY_CASE, &path);
         if (!path) return error_set(r->err, ST_INTERNAL, "out of memory reading '%s'", r->path);
         /* a file named again is not read again: 80,000 'mtllib' lines would otherwise
          * read the library 80,000 times */

@@ -12,6 +12,7 @@
 #include "io/image_write.h"
 #include "io/lexer.h"
 #include "io/mesh_load.h"
+#include "io/path.h"
 #include "io/texture.h"
 #include "kmath.h"
 #include "scene/mesh_sink.h"
@@ -1198,17 +1199,12 @@ static Status d_named_material(Parser *p, Lexer *lx, const Token *kw)
     return set_material(p, i);
 }
 
-/* A file a parameter names, found as pbrt finds it: a relative path from the main
- * file's folder. NULL when out of memory. */
+/* A file the scene names, found as pbrt finds it: a relative path from the main
+ * file's folder, includes or not (io/path.h). NULL when out of memory. */
 static char *beside_main(const Parser *p, const Token *f)
 {
-    const char *dir_end = strrchr(p->top_path, '/');
-    size_t dl = f->text[0] == '/' || !dir_end ? 0 : (size_t)(dir_end - p->top_path + 1);
-    char *path = malloc(dl + f->len + 1);
-    if (!path) return NULL;
-    memcpy(path, p->top_path, dl);
-    memcpy(path + dl, f->text, f->len);
-    path[dl + f->len] = '\0';
+    char *path;
+    path_resolve(p->top_path, f->text, f->len, PATH_BESIDE, &path);
     return path;
 }
 
@@ -2063,13 +2059,8 @@ static Status shape_plymesh(Parser *p, const Lexer *lx, const Token *type, uint 
     Status st = get_string(p, lx, "filename", &f);
     if (st) return st;
     if (!f) return lex_error_at(lx, type, p->err, "a plymesh needs \"string filename\"");
-    const char *dir_end = strrchr(p->top_path, '/');
-    size_t dl = f->text[0] == '/' || !dir_end ? 0 : (size_t)(dir_end - p->top_path + 1);
-    char *path = malloc(dl + f->len + 1);
+    char *path = beside_main(p, f);
     if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
-    memcpy(path, p->top_path, dl);
-    memcpy(path + dl, f->text, f->len);
-    path[dl + f->len] = '\0';
     if (mesh_kind(path) != MESH_PLY) {
         free(path);
         return lex_expected(lx, f, "a PLY file name ending in .ply or .ply.gz", p->err);
@@ -2297,13 +2288,8 @@ static Status d_include(Parser *p, Lexer *lx, const Token *kw)
         return lex_error_at(lx, kw, p->err, "includes nested more than %d deep (does a file include itself?)",
                             CLPT_MAX_INCLUDE_DEPTH);
     }
-    const char *dir_end = strrchr(p->top_path, '/');
-    size_t dl = t.text[0] == '/' || !dir_end ? 0 : (size_t)(dir_end - p->top_path + 1);
-    char *path = malloc(dl + t.len + 1);
+    char *path = beside_main(p, &t);
     if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
-    memcpy(path, p->top_path, dl);
-    memcpy(path + dl, t.text, t.len);
-    path[dl + t.len] = '\0';
     /* the included file has a lexer of its own: nothing is pushed back across files */
     p->depth++;
     st = parse_file(p, path, NULL, 0);

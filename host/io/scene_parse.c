@@ -16,6 +16,7 @@
 #include "base/limit.h"
 #include "io/mesh_load.h"
 #include "io/obj.h"
+#include "io/path.h"
 #include "io/texture.h"
 
 #include <math.h>
@@ -94,17 +95,12 @@ static void error_append(Error *err, const char *fmt, ...)
     va_end(ap);
 }
 
-/* The path of `file` as seen from the folder of the file `from` (absolute paths and
- * files in the current folder stay as they are). */
+/* The path of `file` as seen from the folder of the file `from` (io/path.h: the file
+ * that names it, so an include's names are its own); NULL when out of memory. */
 static char *path_beside(const char *from, const char *file, size_t file_len)
 {
-    const char *slash = strrchr(from, '/');
-    size_t dir = (file_len > 0 && file[0] == '/') || !slash ? 0 : (size_t)(slash - from) + 1;
-    char *out = malloc(dir + file_len + 1);
-    if (!out) return NULL;
-    memcpy(out, from, dir);
-    memcpy(out + dir, file, file_len);
-    out[dir + file_len] = '\0';
+    char *out;
+    path_resolve(from, file, file_len, PATH_BESIDE, &out);
     return out;
 }
 

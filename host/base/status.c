@@ -47,6 +47,17 @@ void error_prefix(Error *err, const char *fmt, ...)
     err->msg[n + m] = '\0';
 }
 
+void error_append(Error *err, const char *fmt, ...)
+{
+    if (!err) return;
+    size_t n = strlen(err->msg);
+    if (n + 1 >= sizeof err->msg) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->msg + n, sizeof err->msg - n, fmt, ap);
+    va_end(ap);
+}
+
 void error_clear(Error *err)
 {
     if (!err) return;

@@ -35,6 +35,8 @@ Status error_set(Error *err, Status status, const char *fmt, ...)
 void error_set_detail(Error *err, const char *detail);
 /* Prepends "prefix: " to the message already in err. */
 void error_prefix(Error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Appends the formatted text to the message already in err, as much of it as fits. */
+void error_append(Error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 void error_clear(Error *err);
 /* Prints "clpt: error: <msg>" (and the detail) to stderr. */
 void error_print(const Error *err);

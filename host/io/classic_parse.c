@@ -22,6 +22,7 @@
 #include "base/limit.h"
 #include "io/lexer.h"
 #include "io/path.h"
+#include "io/reader.h"
 #include "io/obj.h"
 #include "scene/curve.h"
 #include "scene/transform.h"
@@ -461,7 +462,7 @@ static Status parse_cubemap(Classic *c, const Token *word)
     st = texture_load_cubemap(c->s, path, &first, c->err);
     free(path);
     if (st) {
-        if (st == ST_IO || st == ST_INPUT) error_prefix(c->err, "%s:%u:%u", c->lx.path, word->line, word->col);
+        if (st == ST_IO || st == ST_INPUT) reader_annotate(&c->lx, word, c->err);
         return st;
     }
     c->s->bg_type = BG_CUBEMAP;
@@ -533,7 +534,7 @@ static Status parse_phong(Classic *c, const Token *kw)
         free(path);
         if (st) {
             if (st == ST_IO || st == ST_INPUT)
-                error_prefix(c->err, "%s:%u:%u", c->lx.path, v[M_TEXTURE].word.line, v[M_TEXTURE].word.col);
+                reader_annotate(&c->lx, &v[M_TEXTURE].word, c->err);
             return st;
         }
     }
@@ -815,7 +816,7 @@ static Status parse_mesh(Classic *c, const Token *kw, const Transform *m)
     st = obj_load_with(path, c->s, &o, c->err);
     free(path);
     if (st == ST_IO) {
-        error_prefix(c->err, "%s:%u:%u", c->lx.path, v[MESH_FILE].word.line, v[MESH_FILE].word.col);
+        reader_annotate(&c->lx, &v[MESH_FILE].word, c->err);
         return st;
     }
     if (st) {

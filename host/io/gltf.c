@@ -6,6 +6,7 @@
 #include "base/strmap.h"
 #include "io/lexer.h"
 #include "io/path.h"
+#include "io/reader.h"
 #include "io/texture.h"
 #include "kmath.h"
 
@@ -331,7 +332,7 @@ static Status uri_read(Gltf *g, const char *uri, const char *jpath, Buf *out)
     st = lex_read_file(file, &data, &len, g->err);
     if (st) {
         free(file);
-        error_prefix(g->err, "%s: %s", g->path, jpath);
+        reader_annotate_json(g->path, jpath, g->err);
         return st;
     }
     out->owned = data;
@@ -615,7 +616,7 @@ static Status texture_get(Gltf *g, int t, int linear, const char *jpath, uint *o
     }
     if (file) {
         st = texture_load_image(g->s, NULL, file, linear, 0, slot, g->err);
-        if (st) error_prefix(g->err, "%s: %s", g->path, ji);
+        if (st) reader_annotate_json(g->path, ji, g->err);
     } else if (cJSON_IsString(uri)) {
         Buf b = { NULL, 0, 0, NULL };
         if (!(st = uri_read(g, uri->valuestring, ji, &b)))
@@ -657,7 +658,7 @@ static Status texture_transform(Gltf *g, const cJSON *tt, const char *jpath, flo
     Texture t;
     memcpy(t.m, mm, sizeof mm);
     st = texture_check_map(&t, g->err);
-    if (st) error_prefix(g->err, "%s: %s", g->path, jp);
+    if (st) reader_annotate_json(g->path, jp, g->err);
     return st;
 }
 

@@ -13,6 +13,7 @@
 #include "io/lexer.h"
 #include "io/mesh_load.h"
 #include "io/path.h"
+#include "io/reader.h"
 #include "io/texture.h"
 #include "kmath.h"
 #include "scene/mesh_sink.h"
@@ -126,21 +127,7 @@ typedef struct {
 } Parser;
 
 /* Gives a warning once per key ("Shape disk", "diffuse:foo"), at file:line. */
-static Status warn_once(Parser *p, const Lexer *lx, const Token *at, const char *key, const char *fmt, ...)
-    __attribute__((format(printf, 5, 6)));
-static Status warn_once(Parser *p, const Lexer *lx, const Token *at, const char *key, const char *fmt, ...)
-{
-    uint32_t dummy;
-    size_t kl = strlen(key);
-    if (strmap_find(&p->warned, key, kl, &dummy)) return ST_OK;
-    if (strmap_add(&p->warned, key, kl, 1)) return error_set(p->err, ST_INTERNAL, "out of memory");
-    char msg[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    return scene_warn(p->s, p->err, "%s:%u: %s", lx->path, at->line, msg);
-}
+#define warn_once(p, lx, at, key, ...) reader_warn_once((p)->s, &(p)->warned, lx, at, key, (p)->err, __VA_ARGS__)
 
 static int grow(void **ptr, size_t *cap, size_t need, size_t elem)
 {
@@ -1288,7 +1275,7 @@ static Status tex_imagemap(Parser *p, const Lexer *lx, const Token *cls, PTextur
     st = texture_load_image(p->s, NULL, path, linear, clamp, &t->index, p->err);
     free(path);
     if (st) {
-        error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+        reader_annotate(lx, f, p->err);
         return st;
     }
     t->constant = 0;
@@ -1536,7 +1523,7 @@ static Status infinite_map(Parser *p, const Lexer *lx, const Token *f, double sc
     Status st = texture_read_rgb(path, 0, &rgb, &w, &h, p->err);
     free(path);
     if (st) {
-        error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+        reader_annotate(lx, f, p->err);
         return st;
     }
     int finite = 1, invertible;
@@ -1883,7 +1870,7 @@ static Status shape_sphere(Parser *p, const Lexer *lx, const Token *type, uint m
         Transform m = transform_scale(r, r, r);
         m = transform_compose(&p->g.ctm, &m);
         if ((st = scene_add_ellipsoid(p->s, &m, material, p->err)) == ST_INPUT)
-            error_prefix(p->err, "%s:%u:%u", lx->path, type->line, type->col);
+            reader_annotate(lx, type, p->err);
         return st;
     }
     if (similar && !(p->g.reverse && emits)) {
@@ -1944,7 +1931,7 @@ static Status shape_loopsubdiv(Parser *p, const Lexer *lx, const Token *type, ui
     SubdivMesh m;
     st = subdiv_loop(p->pl.nums + P->first, np, idx, nt, (int)levels, CLPT_MAX_TESSELLATED_TRIANGLES, &m, p->err);
     free(idx);
-    if (st == ST_INPUT) error_prefix(p->err, "%s:%u:%u", lx->path, type->line, type->col);
+    if (st == ST_INPUT) reader_annotate(lx, type, p->err);
     if (st) return st;
     MeshSink k;
     size_t first = p->s->n_triangles;
@@ -2070,7 +2057,7 @@ static Status shape_plymesh(Parser *p, const Lexer *lx, const Token *type, uint 
     size_t first = p->s->n_triangles;
     st = mesh_load(path, p->s, &o, p->err);
     free(path);
-    if (st == ST_IO) error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+    if (st == ST_IO) reader_annotate(lx, f, p->err);
     if (st) return st;
     orient_triangles(p, first);
     param_find(p, "displacement.edgelength");
@@ -2295,12 +2282,8 @@ static Status d_include(Parser *p, Lexer *lx, const Token *kw)
     st = parse_file(p, path, NULL, 0);
     p->depth--;
     free(path);
-    if (st == ST_IO)
-        error_prefix(p->err, "%s:%u:%u", lx->path, t.line, t.col);
-    else if (st && !p->depth_exceeded)
-        snprintf(p->err->msg + strlen(p->err->msg), sizeof p->err->msg - strlen(p->err->msg),
-                 " (included from %s:%u:%u)", lx->path, kw->line, kw->col);
-    return st;
+    if (st != ST_IO && p->depth_exceeded) return st;
+    return reader_note_nested(lx, &t, kw, "included from", st, p->err);
 }
 
 /* A directive clpt does not support: its arguments and parameters are skipped. */

@@ -17,6 +17,7 @@
 #include "io/mesh_load.h"
 #include "io/obj.h"
 #include "io/path.h"
+#include "io/reader.h"
 #include "io/texture.h"
 
 #include <math.h>
@@ -72,28 +73,6 @@ typedef struct {
 } Parser;
 
 /* ------------------------------------------------------------------ helpers */
-
-static char *where_dup(const Lexer *lx, const Token *tok)
-{
-    int n = snprintf(NULL, 0, "%s:%u:%u", lx->path, tok->line, tok->col);
-    char *w = n >= 0 ? malloc((size_t)n + 1) : NULL;
-    if (w) snprintf(w, (size_t)n + 1, "%s:%u:%u", lx->path, tok->line, tok->col);
-    return w;
-}
-
-/* Appends text to the message already in err (used to say which scene line pulled in
- * the file where an error happened). */
-static void error_append(Error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void error_append(Error *err, const char *fmt, ...)
-{
-    if (!err) return;
-    size_t n = strlen(err->msg);
-    if (n + 1 >= sizeof err->msg) return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err->msg + n, sizeof err->msg - n, fmt, ap);
-    va_end(ap);
-}
 
 /* The path of `file` as seen from the folder of the file `from` (io/path.h: the file
  * that names it, so an include's names are its own); NULL when out of memory. */
@@ -294,7 +273,7 @@ static Status once(Parser *p, const Lexer *lx, const Token *kw, char **seen)
     if (*seen)
         return lex_error_at(lx, kw, p->err, "a second %.*s block (the first is at %s)",
                             (int)kw->len, kw->text, *seen);
-    *seen = where_dup(lx, kw);
+    *seen = reader_where(lx, kw);
     if (!*seen) return error_set(p->err, ST_INTERNAL, "out of memory");
     return ST_OK;
 }
@@ -434,7 +413,7 @@ static Status parse_background_map(Parser *p, Lexer *lx, const Value *v)
     free(path);
     if (!st) st = scene_set_envmap(p->s, tex, v[BG_INTENSITY].given ? v[BG_INTENSITY].f : 1.0f,
                                    v[BG_ROTATE].given ? v[BG_ROTATE].f : 0.0f, p->err);
-    if (st == ST_IO || st == ST_INPUT) error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+    if (st == ST_IO || st == ST_INPUT) reader_annotate(lx, f, p->err);
     return st;
 }
 
@@ -448,7 +427,7 @@ static Status parse_background_cubemap(Parser *p, Lexer *lx, const Value *v)
     uint first;
     Status st = texture_load_cubemap(p->s, path, &first, p->err);
     free(path);
-    if (st == ST_IO || st == ST_INPUT) error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+    if (st == ST_IO || st == ST_INPUT) reader_annotate(lx, f, p->err);
     if (st) return st;
     p->s->bg_type = BG_CUBEMAP;
     p->s->bg_cubemap = first;
@@ -745,7 +724,7 @@ static Status parse_material_block(Parser *p, Lexer *lx, const Token *kw, int br
         return error_set(p->err, ST_INTERNAL, "out of memory");
     while (p->n_material_at < p->s->n_materials) p->material_at[p->n_material_at++] = NULL;
     /* only for messages: a failed copy just loses the "defined at" part */
-    if (name) p->material_at[*index] = where_dup(lx, kw);
+    if (name) p->material_at[*index] = reader_where(lx, kw);
     return ST_OK;
 }
 
@@ -1009,12 +988,8 @@ static Status parse_mesh(Parser *p, Lexer *lx, const Token *kw)
     }
     size_t first = p->s->n_triangles;
     st = mesh_load(path, p->s, &o, p->err);
-    if (st == ST_IO)
-        error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
-    else if (st)
-        error_append(p->err, " (in the mesh of %s:%u:%u)", lx->path, kw->line, kw->col);
-    else
-        st = check_mesh_size(p, lx, f, path, first);
+    if (st) reader_note_nested(lx, f, kw, "in the mesh of", st, p->err);
+    else st = check_mesh_size(p, lx, f, path, first);
     free(path);
     return st;
 }
@@ -1134,7 +1109,7 @@ static Status parse_texture(Parser *p, Lexer *lx, const Token *kw)
         uint index;
         if (!st) st = texture_load_image(p->s, name, path, second[TX_ENCODING], second[TX_WRAP], &index, p->err);
         free(path);
-        if (st == ST_IO || st == ST_INPUT) error_prefix(p->err, "%s:%u:%u", lx->path, f->line, f->col);
+        if (st == ST_IO || st == ST_INPUT) reader_annotate(lx, f, p->err);
         if (!st) texture_set_scale_offset(&p->s->textures[index], scale, scale, 0.0f, 0.0f);
     } else if (!st) {
         Texture tx = texture_make_checker(v[TX_COLOR0].given ? v[TX_COLOR0].v : v3s(0.8f),
@@ -1166,11 +1141,8 @@ static Status parse_include(Parser *p, Lexer *lx, const Token *kw)
     st = parse_file(p, path);
     p->depth--;
     free(path);
-    if (st == ST_IO)
-        error_prefix(p->err, "%s:%u:%u", lx->path, t.line, t.col);
-    else if (st && !p->depth_exceeded)
-        error_append(p->err, " (included from %s:%u:%u)", lx->path, kw->line, kw->col);
-    return st;
+    if (st != ST_IO && p->depth_exceeded) return st;
+    return reader_note_nested(lx, &t, kw, "included from", st, p->err);
 }
 
 static const struct {

@@ -577,65 +577,35 @@ static Status expect_numbers(Parser *p, Lexer *lx, double *out, int n, const cha
 
 /* ------------------------------------------------------------------ transforms */
 
-static Transform transform_inverse(const Transform *t, int *ok)
-{
-    double n[3][3];
-    Transform r = transform_identity();
-    *ok = transform_normal_matrix(t, n);
-    if (!*ok) return r;
-    /* n is the inverse transpose: the inverse is its transpose */
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) r.m[i][j] = n[j][i];
-    for (int i = 0; i < 3; i++)
-        r.m[i][3] = -(r.m[i][0] * t->m[0][3] + r.m[i][1] * t->m[1][3] + r.m[i][2] * t->m[2][3]);
-    return r;
-}
+/* The transform directives that take numbers: how many, what they are (for messages),
+ * and the transform they make of them. Transform replaces the CTM; the others are
+ * applied to it (CTM = CTM * t), as pbrt does. */
+typedef Status (*XformBuild)(Parser *p, const Lexer *lx, const Token *kw, const double *v, Transform *t);
 
-/* CTM = CTM * t, as pbrt applies each transform directive */
-static void ctm_apply(Parser *p, const Transform *t)
+static Status build_translate(Parser *p, const Lexer *lx, const Token *kw, const double *v, Transform *t)
 {
-    p->g.ctm = transform_compose(&p->g.ctm, t);
-}
-
-static Status d_translate(Parser *p, Lexer *lx, const Token *kw)
-{
-    (void)kw;
-    double v[3];
-    Status st = expect_numbers(p, lx, v, 3, "a number (Translate x y z)");
-    if (st) return st;
-    Transform t = transform_translate(v[0], v[1], v[2]);
-    ctm_apply(p, &t);
+    (void)p; (void)lx; (void)kw;
+    *t = transform_translate(v[0], v[1], v[2]);
     return ST_OK;
 }
 
-static Status d_scale(Parser *p, Lexer *lx, const Token *kw)
+static Status build_scale(Parser *p, const Lexer *lx, const Token *kw, const double *v, Transform *t)
 {
-    (void)kw;
-    double v[3];
-    Status st = expect_numbers(p, lx, v, 3, "a number (Scale x y z)");
-    if (st) return st;
-    Transform t = transform_scale(v[0], v[1], v[2]);
-    ctm_apply(p, &t);
+    (void)p; (void)lx; (void)kw;
+    *t = transform_scale(v[0], v[1], v[2]);
     return ST_OK;
 }
 
-static Status d_rotate(Parser *p, Lexer *lx, const Token *kw)
+static Status build_rotate(Parser *p, const Lexer *lx, const Token *kw, const double *v, Transform *t)
 {
-    double v[4];
-    Status st = expect_numbers(p, lx, v, 4, "a number (Rotate degrees x y z)");
-    if (st) return st;
     if (v[1] == 0 && v[2] == 0 && v[3] == 0) return lex_error_at(lx, kw, p->err, "Rotate about a zero axis");
-    Transform t = transform_rotate(v[1], v[2], v[3], v[0]);
-    ctm_apply(p, &t);
+    *t = transform_rotate(v[1], v[2], v[3], v[0]);
     return ST_OK;
 }
 
 /* pbrt's 16 numbers are the matrix column by column; the last row must be 0 0 0 1 */
-static Status read_matrix(Parser *p, Lexer *lx, const Token *kw, Transform *t)
+static Status build_matrix(Parser *p, const Lexer *lx, const Token *kw, const double *v, Transform *t)
 {
-    double v[16];
-    Status st = expect_numbers(p, lx, v, 16, "a number (16 matrix entries)");
-    if (st) return st;
     if (v[3] != 0 || v[7] != 0 || v[11] != 0 || v[15] != 1)
         return lex_error_at(lx, kw, p->err, "a projective transform (its last row is not 0 0 0 1) is not supported");
     for (int r = 0; r < 3; r++)
@@ -643,27 +613,8 @@ static Status read_matrix(Parser *p, Lexer *lx, const Token *kw, Transform *t)
     return ST_OK;
 }
 
-static Status d_transform(Parser *p, Lexer *lx, const Token *kw)
+static Status build_lookat(Parser *p, const Lexer *lx, const Token *kw, const double *v, Transform *t)
 {
-    Transform t;
-    Status st = read_matrix(p, lx, kw, &t);
-    if (!st) p->g.ctm = t;
-    return st;
-}
-
-static Status d_concat(Parser *p, Lexer *lx, const Token *kw)
-{
-    Transform t;
-    Status st = read_matrix(p, lx, kw, &t);
-    if (!st) ctm_apply(p, &t);
-    return st;
-}
-
-static Status d_lookat(Parser *p, Lexer *lx, const Token *kw)
-{
-    double v[9];
-    Status st = expect_numbers(p, lx, v, 9, "a number (LookAt eye, look, up)");
-    if (st) return st;
     double dir[3] = {v[3] - v[0], v[4] - v[1], v[5] - v[2]};
     double dl = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
     double ul = sqrt(v[6] * v[6] + v[7] * v[7] + v[8] * v[8]);
@@ -684,8 +635,40 @@ static Status d_lookat(Parser *p, Lexer *lx, const Token *kw)
         w.m[i][3] = v[i];
     }
     int ok;
-    Transform cam = transform_inverse(&w, &ok);
-    ctm_apply(p, &cam);
+    *t = transform_inverse(&w, &ok);
+    return ST_OK;
+}
+
+static const struct {
+    const char *name;
+    int numbers;
+    const char *what;         /* for "expected <what>" */
+    XformBuild build;
+    int replace;              /* the CTM becomes the transform */
+} xform_directives[] = {
+    {"Translate", 3, "a number (Translate x y z)", build_translate, 0},
+    {"Scale", 3, "a number (Scale x y z)", build_scale, 0},
+    {"Rotate", 4, "a number (Rotate degrees x y z)", build_rotate, 0},
+    {"LookAt", 9, "a number (LookAt eye, look, up)", build_lookat, 0},
+    {"Transform", 16, "a number (16 matrix entries)", build_matrix, 1},
+    {"ConcatTransform", 16, "a number (16 matrix entries)", build_matrix, 0},
+};
+
+/* Translate, Scale, Rotate, LookAt, Transform, ConcatTransform: by the table above. */
+static Status d_xform(Parser *p, Lexer *lx, const Token *kw)
+{
+    size_t i = 0, n = sizeof xform_directives / sizeof xform_directives[0];
+    while (i < n && !tok_eq(kw, xform_directives[i].name)) i++;
+    if (i == n) return error_set(p->err, ST_INTERNAL, "no transform directive '%.*s'", (int)kw->len, kw->text);
+    double v[16];
+    Transform t;
+    Status st = expect_numbers(p, lx, v, xform_directives[i].numbers, xform_directives[i].what);
+    if (!st) st = xform_directives[i].build(p, lx, kw, v, &t);
+    if (st) return st;
+    if (xform_directives[i].replace)
+        p->g.ctm = t;
+    else
+        p->g.ctm = transform_compose(&p->g.ctm, &t);
     return ST_OK;
 }
 
@@ -2337,12 +2320,12 @@ static const struct {
     const char *name;
     Status (*fn)(Parser *p, Lexer *lx, const Token *kw);
 } directives[] = {
-    {"Translate", d_translate},
-    {"Scale", d_scale},
-    {"Rotate", d_rotate},
-    {"LookAt", d_lookat},
-    {"Transform", d_transform},
-    {"ConcatTransform", d_concat},
+    {"Translate", d_xform},
+    {"Scale", d_xform},
+    {"Rotate", d_xform},
+    {"LookAt", d_xform},
+    {"Transform", d_xform},
+    {"ConcatTransform", d_xform},
     {"CoordinateSystem", d_coordsys},
     {"CoordSysTransform", d_coordsys_transform},
     {"Identity", d_identity},
@@ -2415,8 +2398,7 @@ static Status parse_statements(Parser *p, Lexer *lx)
 /* the directives that change the current transform (ActiveTransform EndTime skips them) */
 static int is_transform_directive(Status (*fn)(Parser *, Lexer *, const Token *))
 {
-    return fn == d_translate || fn == d_scale || fn == d_rotate || fn == d_lookat || fn == d_transform ||
-           fn == d_concat || fn == d_coordsys_transform || fn == d_identity;
+    return fn == d_xform || fn == d_coordsys_transform || fn == d_identity;
 }
 
 static Status parse_file(Parser *p, const char *path, const char *text, size_t len)

@@ -122,16 +122,25 @@ int transform_normal_matrix(const Transform *t, double n[3][3])
     return 1;
 }
 
-int transform_invert(const Transform *t, Transform *inv)
+Transform transform_inverse(const Transform *t, int *ok)
 {
     double n[3][3];
-    if (!transform_normal_matrix(t, n)) return 0;
-    /* the inverse's linear part is the normal matrix transposed; then -A^-1 b */
-    Transform r;
+    Transform r = transform_identity();
+    *ok = transform_normal_matrix(t, n);
+    if (!*ok) return r;
+    /* n is the inverse transpose: the inverse's linear part is its transpose; then -A^-1 b */
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) r.m[i][j] = n[j][i];
     for (int i = 0; i < 3; i++)
         r.m[i][3] = -(r.m[i][0] * t->m[0][3] + r.m[i][1] * t->m[1][3] + r.m[i][2] * t->m[2][3]);
+    return r;
+}
+
+int transform_invert(const Transform *t, Transform *inv)
+{
+    int ok;
+    Transform r = transform_inverse(t, &ok);
+    if (!ok) return 0;
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 4; j++)
             if (!isfinite(r.m[i][j])) return 0;

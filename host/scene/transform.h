@@ -30,6 +30,9 @@ vec3 transform_point(const Transform *t, vec3 p);
  * over the determinant). Returns 0, leaving n alone, when the linear part is singular
  * or not finite. */
 int transform_normal_matrix(const Transform *t, double n[3][3]);
+/* The inverse transform; *ok 0 and the identity when the linear part is singular or
+ * not finite (the inverse's entries are not checked: they may overflow). */
+Transform transform_inverse(const Transform *t, int *ok);
 /* The inverse transform into *inv; 0, leaving it alone, when the linear part is
  * singular or not finite. */
 int transform_invert(const Transform *t, Transform *inv);

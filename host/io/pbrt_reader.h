@@ -1,0 +1,167 @@
+/*
+ * pbrt_reader.h — the parts of the pbrt-v4 reader (pbrt_parse.h) share this: the parser's
+ * state, the parameter lists, and the functions one part calls in another. As pbrt-v4
+ * separates parsing from building the scene, the reader is cut by concern:
+ *   pbrt_parse.c     the directive loop, transforms, graphics state, camera/film options,
+ *                    includes, the entry points
+ *   pbrt_params.c    "type name" [values] parameter lists, spectra, positional arguments
+ *   pbrt_material.c  materials and textures
+ *   pbrt_light.c     area and other lights
+ *   pbrt_shape.c     shapes and object instancing
+ * Not for use outside these files.
+ */
+#ifndef CLPT_PBRT_READER_H
+#define CLPT_PBRT_READER_H
+
+#include <stddef.h>
+
+#include "base/strmap.h"
+#include "io/lexer.h"
+#include "io/reader.h"
+#include "scene/mesh_sink.h"
+#include "scene/scene.h"
+#include "scene/transform.h"
+
+/* ------------------------------------------------------------------ parameter lists */
+
+typedef enum {
+    PT_FLOAT, PT_INTEGER, PT_BOOL, PT_STRING, PT_TEXTURE, PT_POINT2, PT_VECTOR2, PT_POINT3,
+    PT_VECTOR3, PT_NORMAL, PT_RGB, PT_SPECTRUM, PT_BLACKBODY, PT_N
+} PType;
+
+typedef struct {
+    PType type;
+    Token decl;              /* the "type name" string, for positions */
+    const char *name;        /* inside decl's text */
+    size_t name_len;
+    size_t first, n;         /* values: nums[first..] or strs[first..] */
+    int strings;             /* the values are strings (string, texture, bool, named spectrum) */
+    int used;
+} Param;
+
+typedef struct {
+    Param *p;     size_t n, cap;
+    double *nums; size_t n_nums, cap_nums;
+    Token *strs;  size_t n_strs, cap_strs;
+} ParamList;
+
+/* ------------------------------------------------------------------ parser state */
+
+typedef struct {
+    Transform ctm;
+    int reverse;
+    uint material;           /* NO_INDEX: pbrt's default (diffuse 0.5), made on first use */
+    int area;                /* an AreaLightSource is active */
+    vec3 area_L;
+    int area_twosided;
+    uint area_material;      /* material + emission, made on first use */
+    int end_time_only;       /* ActiveTransform EndTime: transforms move the shutter-close pose only */
+} GState;
+
+typedef struct {
+    const char *name;        /* a constant's value is `color`; else a scene texture */
+    int constant;
+    vec3 color;
+    uint index;
+    vec3 mean;               /* the texture's mean colour (a constant's is its colour):
+                              * what stands in where only a constant fits */
+} PTexture;
+
+/* A material named by NamedMaterial and not yet defined: where it was first used. */
+typedef struct {
+    uint index;
+    int defined;
+    char where[160];   /* "path:line:col: material 'name'" for the error at the end */
+} PPending;
+
+/* An ObjectBegin/End's shapes, taken out of the scene and copied in at each instance. */
+typedef struct {
+    Sphere *spheres;      size_t n_spheres;
+    SphereXform *sphere_xforms;  size_t n_sphere_xforms;   /* Sphere.xform indexes this */
+    Triangle *triangles;  size_t n_triangles;
+    TriShading *shading;  size_t n_shading;   /* Triangle.shading indexes this */
+} PObject;
+
+typedef struct {
+    Scene *s;
+    Error *err;
+    const char *top_path;    /* includes are found beside the main file, as pbrt does */
+    int depth;
+    int depth_exceeded;
+    int world;               /* after WorldBegin */
+    GState g;
+    GState *stack;  size_t n_stack, cap_stack;
+    StrMap named_material;   /* name -> material index */
+    /* NamedMaterial before its MakeNamedMaterial (pbrt-v4 resolves names after the whole
+     * file): a diffuse placeholder, replaced in place when the definition comes */
+    PPending *pending;  size_t n_pending, cap_pending;
+    /* area-light copies of a placeholder (material + emission), patched with it */
+    struct { uint area, base; } *area_of_pending;  size_t n_area_pending, cap_area_pending;
+    StrMap coordsys;         /* name -> index into coordsys_xf */
+    Transform *coordsys_xf;  size_t n_coordsys, cap_coordsys;
+    StrMap tex_by_name;      /* name -> index into tex */
+    PTexture *tex;  size_t n_tex, cap_tex;
+    StrMap warned;           /* warning keys already given */
+    StrMap object_by_name;   /* name -> index into objects */
+    PObject *objects;  size_t n_objects, cap_objects;
+    int in_object;           /* inside ObjectBegin: what it started with */
+    size_t obj_spheres, obj_triangles, obj_shading, obj_stack, obj_sphere_xforms;
+    /* triangles made so far by tessellating what the file describes in a few numbers
+     * (loopsubdiv, emitting ellipsoids): at most CLPT_MAX_TESSELLATED_TRIANGLES */
+    size_t tessellated;
+    Token obj_name;          /* its name, copied into obj_name_buf */
+    char *obj_name_buf;
+    ParamList pl;
+    /* the camera, finished once the film's size is known */
+    int have_camera, cam_ortho;
+    Transform cam_from_world;
+    double fov, lens_radius, focal_distance, screen_half;
+} Parser;
+
+/* Gives a warning once per key ("Shape disk", "diffuse:foo"), at file:line. */
+#define warn_once(p, lx, at, key, ...) reader_warn_once((p)->s, &(p)->warned, lx, at, key, (p)->err, __VA_ARGS__)
+
+/* pbrt_params.c: parameter lists, spectra, positional arguments, helpers */
+int pbrt_grow(void **ptr, size_t *cap, size_t need, size_t elem);
+int pbrt_tok_double(const Token *t, double *out);
+int pbrt_tok_is_bool(const Token *t);
+int pbrt_tok_eq(const Token *t, const char *s);
+Status pbrt_parse_params(Parser *p, Lexer *lx);
+Param *pbrt_param_find(Parser *p, const char *name);
+Status pbrt_param_type_error(Parser *p, const Lexer *lx, const Param *pa, const char *what);
+Status pbrt_get_float(Parser *p, const Lexer *lx, const char *name, double *out);
+Status pbrt_get_int(Parser *p, const Lexer *lx, const char *name, long *out);
+Status pbrt_get_bool(Parser *p, const Lexer *lx, const char *name, int *out);
+Status pbrt_get_string(Parser *p, const Lexer *lx, const char *name, const Token **out);
+Status pbrt_get_point(Parser *p, const Lexer *lx, const char *name, vec3 *out);
+Status pbrt_get_spectrum(Parser *p, const Lexer *lx, const char *name, vec3 *out, const PTexture **tex, int *given);
+Status pbrt_get_float_tex(Parser *p, const Lexer *lx, const char *name, double *out);
+Status pbrt_warn_unused(Parser *p, const Lexer *lx, const char *what);
+Status pbrt_expect_string(Parser *p, Lexer *lx, const char *what, Token *t);
+Status pbrt_expect_defined(Parser *p, Lexer *lx, const StrMap *map, const char *what, const char *definer,
+                           Token *name, uint32_t *index);
+Status pbrt_expect_numbers(Parser *p, Lexer *lx, double *out, int n, const char *what);
+char *pbrt_beside_main(const Parser *p, const Token *f);
+
+/* pbrt_material.c: Material, MakeNamedMaterial, NamedMaterial, Texture */
+Status pbrt_material(Parser *p, Lexer *lx, const Token *kw);
+Status pbrt_make_named_material(Parser *p, Lexer *lx, const Token *kw);
+Status pbrt_named_material(Parser *p, Lexer *lx, const Token *kw);
+Status pbrt_texture(Parser *p, Lexer *lx, const Token *kw);
+Status pbrt_shape_material(Parser *p, uint *out);
+
+/* pbrt_light.c: AreaLightSource, LightSource */
+Status pbrt_area_light(Parser *p, Lexer *lx, const Token *kw);
+vec3 pbrt_xf_dir(const Transform *t, vec3 d);
+Status pbrt_light(Parser *p, Lexer *lx, const Token *kw);
+
+/* pbrt_shape.c: Shape, ObjectBegin/End/Instance */
+Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw);
+Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw);
+Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw);
+Status pbrt_object_instance(Parser *p, Lexer *lx, const Token *kw);
+
+/* pbrt_parse.c: directives, transforms, graphics state, files */
+Status pbrt_push_state(Parser *p);
+
+#endif /* CLPT_PBRT_READER_H */

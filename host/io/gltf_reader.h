@@ -1,0 +1,104 @@
+/*
+ * gltf_reader.h — the parts of the glTF reader (gltf.h) share this: the reader's state and
+ * the functions one part calls in another. The reader is cut by concern:
+ *   gltf.c           the container: JSON helpers, buffers and URIs, accessors, GLB, the
+ *                    entry point
+ *   gltf_material.c  materials, textures and samplers
+ *   gltf_scene.c     the scene: primitives, nodes, cameras, lights
+ * Not for use outside these files.
+ */
+#ifndef CLPT_GLTF_READER_H
+#define CLPT_GLTF_READER_H
+
+#include <stddef.h>
+
+#include "io/gltf.h"
+#include "scene/mesh_sink.h"
+
+#include <cjson/cJSON.h>
+
+#define GLB_MAGIC 0x46546C67u      /* "glTF" */
+#define GLB_JSON 0x4E4F534Au       /* "JSON" */
+#define GLB_BIN 0x004E4942u        /* "BIN\0" */
+/* glTF lights are photometric (candela, lux); clpt's are radiometric: divided by the
+ * luminous efficacy of 555 nm light, 683 lm/W (docs/gltf.md). */
+#define LUMENS_PER_WATT 683.0
+/* Triangles one file may make, nodes times primitives included: a small file that
+ * instances a large mesh many times must not exhaust memory (each triangle costs clpt
+ * a few hundred bytes with its shading record and kd-tree), so the count is bounded by
+ * the input's size, and absolutely. A real file's mesh data takes 20 bytes or more per
+ * triangle, so one per byte still lets each be instanced some 20 times; 16 per byte
+ * let a 4 MB strip of 1-byte indices, instanced, make 2^26 triangles (issue 39). */
+#define GLTF_TRIANGLES_PER_BYTE 1u
+#define GLTF_MAX_TRIANGLES ((size_t)1 << 26)
+
+typedef struct {
+    const unsigned char *p;
+    size_t len;
+    size_t whole;         /* the bytes of the data before a buffer's byteLength cut them */
+    char *owned;          /* heap copy (external file, decoded data: URI), or NULL */
+} Buf;
+
+/* The top-level arrays (and the lights of KHR_lights_punctual) as arrays of pointers:
+ * cJSON keeps arrays as linked lists, where finding item i walks i items, and a reader
+ * that looked every index up that way would be quadratic in its input. */
+enum { T_BUFFERS, T_VIEWS, T_ACCESSORS, T_MESHES, T_MATERIALS, T_TEXTURES, T_IMAGES, T_SAMPLERS, T_CAMERAS, T_NODES,
+       T_SCENES, T_LIGHTS, T_N };
+typedef struct {
+    const cJSON **item;
+    int n;
+} Table;
+
+typedef struct {
+    const char *path;
+    Scene *s;
+    Error *err;
+    const MeshOptions *o;
+    GltfView *view;
+    cJSON *root;
+    const unsigned char *bin;  size_t bin_len;   /* the GLB's BIN chunk */
+    Buf *bufs;        int n_bufs;
+    StrMap buffer_files;             /* resolved file name -> the first buffer read from it */
+    int reading_buffer;              /* the buffer uri_read reads for, or -1 (an image) */
+    StrMap image_sources[2];         /* an image's source -> its scene texture, sRGB [0] and linear [1] */
+    uint *mats;       int n_mats;      /* scene material per glTF material, or NO_INDEX */
+    uint default_mat;
+    uint *tex;        int n_images;    /* per image: sRGB [2i], linear [2i+1] texture */
+    unsigned char *visited;  int n_nodes;
+    size_t triangles, max_triangles;
+    int has_lights;
+    Table t[T_N];
+} Gltf;
+
+/* gltf.c: JSON helpers, buffers and URIs, accessors, the GLB container */
+Status gltf_bad(Gltf *g, const char *jpath, const char *what);
+/* The first element of an array (walk on with ->next), or NULL. */
+const cJSON *gltf_first_of(const cJSON *a);
+Status gltf_get_int(Gltf *g, const cJSON *obj, const char *key, long long def, long long lo, long long hi,
+                    const char *jpath, long long *out);
+Status gltf_get_index(Gltf *g, const cJSON *obj, const char *key, int required, const char *array,
+                      const char *jpath, int *out);
+Status gltf_get_num(Gltf *g, const cJSON *obj, const char *key, double def, double lo, double hi,
+                    const char *jpath, double *out);
+Status gltf_get_nums(Gltf *g, const cJSON *obj, const char *key, int n, const double *def, const char *jpath,
+                     double *out);
+const cJSON *gltf_ext_of(const cJSON *obj, const char *name);
+const cJSON *gltf_item_at(const Gltf *g, const char *array, int i);
+Status gltf_uri_file(Gltf *g, const char *uri, const char *jpath, char **file);
+Status gltf_uri_read(Gltf *g, const char *uri, const char *jpath, Buf *out);
+Status gltf_view_bytes(Gltf *g, int v, Buf *out, size_t *stride);
+/* accessors[a] as `width`-wide elements of doubles (*out, *count elements), read for
+ * the JSON path `use`. */
+Status gltf_acc_read(Gltf *g, int a, int width, const char *use, double **out, size_t *count);
+/* The same for an accessor that may be `width` or `width2` wide (0: only width); *got
+ * says which. */
+Status gltf_acc_read_either(Gltf *g, int a, int width, int width2, const char *use, double **out, size_t *count,
+                            int *got);
+
+/* gltf_material.c: materials, textures and samplers */
+Status gltf_material_get(Gltf *g, int i, uint *out);
+
+/* gltf_scene.c: primitives, nodes, cameras, lights */
+Status gltf_scene_walk(Gltf *g);
+
+#endif /* CLPT_GLTF_READER_H */

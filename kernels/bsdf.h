@@ -357,7 +357,7 @@ KFN int bsdf_has_density(Material m, vec3 albedo)
  * falls back to ng itself): their images stay as they were. */
 KFN vec3 bsdf_normal(Material m, vec3 d, vec3 ns, vec3 ng)
 {
-    if (m.type == MAT_DIFFUSE || MAT_IS(m, MAT_PHONG)) return ns;
+    if (material_has(m.type, MT_KEEPS_NORMAL)) return ns;
     return shading_normal_valid(d, ns, ng);
 }
 

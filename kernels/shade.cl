@@ -62,7 +62,7 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
      * artefact, lit from the wrong side */
     int below = cos_s < 0.0f;
     if (cos_s == 0.0f || (below ? cos_g >= 0.0f : cos_g <= 0.0f)) return 0;
-    if (below && m.type != MAT_DIELECTRIC && m.type != MAT_PRINCIPLED) return 0;
+    if (below && !material_transmits(m.type)) return 0;
     float bsdf_pdf;
     vec3 f = bsdf_eval(m, albedo, d, n_face, front, wi, &bsdf_pdf);
     if (below) cos_s = -cos_s;
@@ -125,7 +125,7 @@ KFN_INLINE void shade_emission(const SceneView *sc, Ray r, Surface s, Material m
  * open mesh by escaping is not charged at all. A mix's own (zero) absorption is read. */
 KFN void shade_absorb(Ray r, Hit hit, Surface s, Material m, GLOBAL PathState *ps)
 {
-    if (!MAT_IS(m, MAT_PRINCIPLED) || (m.flags & MAT_THIN) || v3_is_zero(m.absorption) ||
+    if (!material_absorbs(m.type) || (m.flags & MAT_THIN) || v3_is_zero(m.absorption) ||
         !(v3_dot(r.d, s.ng) > 0.0f))
         return;
     const float log2e = 1.44269504f;
@@ -181,7 +181,7 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     int front = v3_dot(r.d, s.ng) < 0.0f;
     vec3 ng_face = front ? s.ng : v3_neg(s.ng);
     material_resolve(sc, &m, s, r.d, ng_face);
-    if (m.type == MAT_EMISSIVE) return 0u;   /* pure emitters do not reflect */
+    if (!material_scatters(m.type)) return 0u;   /* pure emitters do not reflect */
     s.ns = material_normal(sc, m, s);
     vec3 ns_face = bsdf_normal(m, r.d, front ? s.ns : v3_neg(s.ns), ng_face);
     uint result = SHADE_SCATTERED;

@@ -45,26 +45,126 @@
 #define KF_BOXES 0x100u
 #define KF_PLANES 0x200u
 #define KF_DELTA_LIGHTS 0x400u  /* point, spot or directional lights */
-/* material type t (enum MaterialType); MAT_LAYERED, past the block of seven, has a bit
- * of its own above KF_PATH_LANES */
-#define KF_MATERIAL(t) ((t) == 8 ? KF_LAYERED : 0x800u << (t))
+/* 0x800u ... 0x20000u and 0x800000u: material types, each its own switch, named
+ * KF_MAT_DIFFUSE ... (MATERIAL_TYPES below; KF_MATERIAL(MAT_DIFFUSE) is the same) */
 #define KF_PATH_MEGAKERNEL 0x80000u     /* the path tracer as one kernel (k_path, k_film) */
 #define KF_KDTREE 0x100000u     /* the scene's tree is the kd-tree (kernels/traverse.cl) */
 #define KF_BVH 0x200000u        /* ... the 8-wide BVH (kernels/traverse_wide.cl) */
 #define KF_PATH_LANES 0x400000u /* the megakernel eight paths at a time (k_path_lanes, k_film;
                                  * kernels/shade_lanes.cl): CPUs, scenes it shades fast */
-#define KF_LAYERED 0x800000u    /* material type MAT_LAYERED (8) */
 #define KF_SPHERE_XFORM 0x1000000u /* a sphere under a transform (an ellipsoid, SphereXform) */
-#define KF_ALL 0x1fbffffu       /* every bit above (material types 0 to 6, and 8) */
+/* every bit above and every material type's */
+#define KF_ALL (KF_PATH | KF_WHITTED | KF_TEXTURES | KF_ALPHA | KF_ENV_MAP | KF_CUBEMAP | KF_REVSURFACE | \
+                KF_SPHERES | KF_BOXES | KF_PLANES | KF_DELTA_LIGHTS | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH | \
+                KF_PATH_LANES | KF_SPHERE_XFORM MATERIAL_TYPES(KF_MATERIAL_OR_))
+#define KF_MATERIAL_OR_(name, value, bit, traits, lobes) | (bit)
 #ifndef CLPT_FEATURES
-#define CLPT_FEATURES KF_ALL
+#define CLPT_FEATURES 0xffffffffu   /* every switch (KF_ALL, which is not usable here: a
+                                     * macro of the material list) */
 #endif
 /* Paths per work-item of k_path_lanes (KF_PATH_LANES): one float8 of each quantity. */
 #define PATH_LANES 8u
 /* Whether feature f is compiled in: a constant, so the compiler drops what is not. */
 #define KF_HAS(f) ((CLPT_FEATURES & (f)) != 0u)
-/* m.type == t, known false at compile time when no material of type t is compiled in. */
-#define MAT_IS(m, t) (KF_HAS(KF_MATERIAL(t)) && (m).type == (t))
+
+/* ---------------------------------------------------------------- material types
+ * Every material type, one line each, X(name, value, feature bit, traits, lobes):
+ *   name, value  its enum MaterialType constant, stored in Material.type
+ *   feature bit  the KF_ switch that compiles its code in (a free bit of the list
+ *                above); 0: always compiled (the mix, which kernels/mix.h resolves
+ *                before anything asks what it scatters)
+ *   traits       MT_* below: what the integrators ask of a type as a whole
+ *   lobes        the stem of its scattering functions, <lobes>_bsdf_has_density,
+ *                _bsdf_eval and _bsdf_sample, which kernels/bsdf.h dispatches to; they
+ *                live in the header of its lobe family (docs/design.md, "Materials")
+ * The enum, the KF_MAT_* switches, KF_ALL, the trait predicates, the dispatch and the
+ * host's feature scan (host/device/kernel_features.c) are generated from it.
+ *
+ * Every type may also emit `emission`; a non-zero emission makes the primitives with
+ * that material lights. Emission leaves the front side only (the side the outward normal
+ * of a sphere or box, or the winding normal (p1-p0)x(p2-p0) of a triangle, points to),
+ * unless the material has MAT_TWO_SIDED.
+ *   MAT_DIFFUSE     Lambertian, albedo
+ *   MAT_METAL       mirror reflection perturbed by fuzz, tinted by albedo
+ *   MAT_DIELECTRIC  glass, Fresnel reflection/refraction, ior; GGX roughness and
+ *                   anisotropy (Walter et al. 2007) and MAT_THIN
+ *   MAT_EMISSIVE    emits `emission`, reflects nothing
+ *   MAT_PHONG       albedo = diffuse colour, specular, shininess, plus mirror
+ *                   (`reflective`) and Fresnel-weighted see-through (`transparent`,
+ *                   ior) parts: the classic ray tracer's material (docs/classic-format.md)
+ *   MAT_CONDUCTOR   GGX metal (kernels/conductor.h): complex index eta + i k, or Schlick
+ *                   from F0 = specular (MAT_F0); tinted by albedo; roughness,
+ *                   anisotropy; smooth: a Fresnel mirror
+ *   MAT_PRINCIPLED  glTF metallic-roughness (kernels/principled.h): base colour =
+ *                   albedo, metallic, roughness, transmission + ior (MAT_THIN),
+ *                   clearcoat + clearcoat_roughness, specular_factor + specular_color,
+ *                   sheen_color + sheen_roughness, and inside a solid (not MAT_THIN)
+ *                   Beer-Lambert absorption
+ *   MAT_MIX         pbrt's mix (kernels/mix.h): at each hit either material mix_a or,
+ *                   with probability amount, mix_b scatters; its own emission and
+ *                   MAT_TWO_SIDED are what the surface emits
+ *   MAT_LAYERED     pbrt-v4's coated materials (kernels/layered.h): a dielectric
+ *                   interface (ior, roughness, anisotropy) over a base (layer_base:
+ *                   Lambertian albedo, or a conductor eta + i k with base_roughness,
+ *                   base_anisotropy), a medium between (layer_*)
+ */
+#define MATERIAL_TYPES(X) \
+    X(MAT_DIFFUSE,    0, 0x800u,    MT_SCATTERS | MT_KEEPS_NORMAL,                 diffuse)    \
+    X(MAT_METAL,      1, 0x1000u,   MT_SCATTERS,                                   metal)      \
+    X(MAT_DIELECTRIC, 2, 0x2000u,   MT_SCATTERS | MT_TRANSMITS,                    dielectric) \
+    X(MAT_EMISSIVE,   3, 0x4000u,   0u,                                            none)       \
+    X(MAT_PHONG,      4, 0x8000u,   MT_SCATTERS | MT_KEEPS_NORMAL,                 phong)      \
+    X(MAT_CONDUCTOR,  5, 0x10000u,  MT_SCATTERS,                                   conductor)  \
+    X(MAT_PRINCIPLED, 6, 0x20000u,  MT_SCATTERS | MT_TRANSMITS | MT_ABSORBS,       principled) \
+    X(MAT_MIX,        7, 0u,        0u,                                            none)       \
+    X(MAT_LAYERED,    8, 0x800000u, MT_SCATTERS,                                   layered)
+
+/* Traits: what a material type may do, whatever its parameters. */
+#define MT_SCATTERS 1u      /* reflects or transmits light (the integrators stop at a
+                             * surface of a type without it) */
+#define MT_TRANSMITS 2u     /* a lobe with a density passes light through the surface:
+                             * next-event estimation also samples lights below it */
+#define MT_ABSORBS 4u       /* a solid of it (not MAT_THIN) absorbs along the paths
+                             * inside (Material.absorption, Beer-Lambert) */
+#define MT_KEEPS_NORMAL 8u  /* its lobes take the shading normal as it is, even facing
+                             * away from the viewer (bsdf_normal) */
+
+#define MAT_ENUM_(name, value, bit, traits, lobes) name = value,
+enum MaterialType { MATERIAL_TYPES(MAT_ENUM_) };
+#undef MAT_ENUM_
+#define KF_MAT_ENUM_(name, value, bit, traits, lobes) KF_##name = bit,
+enum MaterialFeature { MATERIAL_TYPES(KF_MAT_ENUM_) };
+#undef KF_MAT_ENUM_
+/* The feature bit of material type `name` (an enum MaterialType constant's name). */
+#define KF_MATERIAL(name) KF_##name
+/* Whether the code of the material type with feature bit `bit` is compiled in. */
+#define KF_HAS_MATERIAL(bit) ((bit) == 0u || KF_HAS(bit))
+/* m.type == t (a constant's name), known false at compile time when no material of
+ * type t is compiled in. */
+#define MAT_IS(m, t) (KF_HAS_MATERIAL(KF_##t) && (m).type == (t))
+
+/* Whether material type `type` has trait `trait` (MT_*): a constant that the compiler
+ * folds, false when no type compiled in has it. */
+KFN int material_has(uint type, uint trait)
+{
+#define MAT_HAS_(name, value, bit, traits, lobes) \
+    if (((traits) & trait) != 0u && KF_HAS_MATERIAL(bit) && type == (value)) return 1;
+    MATERIAL_TYPES(MAT_HAS_)
+#undef MAT_HAS_
+    return 0;
+}
+KFN int material_scatters(uint type) { return material_has(type, MT_SCATTERS); }
+KFN int material_transmits(uint type) { return material_has(type, MT_TRANSMITS); }
+KFN int material_absorbs(uint type) { return material_has(type, MT_ABSORBS); }
+
+/* The feature bit of material type `type`; KF_ALL for a value that is none. */
+KFN uint material_feature(uint type)
+{
+#define MAT_FEATURE_(name, value, bit, traits, lobes) if (type == (value)) return bit;
+    MATERIAL_TYPES(MAT_FEATURE_)
+#undef MAT_FEATURE_
+    return KF_ALL;
+}
 
 typedef struct { float x, y, z; } vec3;                 /* 12 bytes, align 4 */
 
@@ -205,40 +305,9 @@ typedef struct {                                        /* 32 bytes */
     uint pad0, pad1, pad2;
 } Plane;
 
-/* Every type may also emit `emission`; a non-zero emission makes the primitives with
- * that material lights. Emission leaves the front side only (the side the outward normal
- * of a sphere or box, or the winding normal (p1-p0)x(p2-p0) of a triangle, points to),
- * unless the material has MAT_TWO_SIDED. */
-enum MaterialType {
-    MAT_DIFFUSE = 0,     /* Lambertian, albedo */
-    MAT_METAL = 1,       /* mirror reflection perturbed by fuzz, tinted by albedo */
-    MAT_DIELECTRIC = 2,  /* smooth glass, Fresnel reflection/refraction, ior */
-    MAT_EMISSIVE = 3,    /* emits `emission`, reflects nothing */
-    MAT_PHONG = 4,       /* albedo = diffuse colour, specular, shininess, plus mirror
-                          * (`reflective`) and Fresnel-weighted see-through
-                          * (`transparent`, ior) parts: the classic ray tracer's
-                          * material (docs/classic-format.md) */
-    MAT_CONDUCTOR = 5,   /* GGX metal (kernels/microfacet.h): complex index eta + i k,
-                          * or Schlick from F0 = specular (MAT_F0); tinted by albedo;
-                          * roughness, anisotropy; smooth: a Fresnel mirror */
-    MAT_PRINCIPLED = 6,  /* glTF metallic-roughness (kernels/principled.h): base colour
-                          * = albedo, metallic, roughness, transmission + ior (MAT_THIN),
-                          * clearcoat + clearcoat_roughness, specular_factor +
-                          * specular_color, sheen_color + sheen_roughness, and inside a
-                          * solid (not MAT_THIN) Beer-Lambert absorption */
-    MAT_MIX = 7,         /* pbrt's mix (kernels/mix.h): at each hit either material mix_a
-                          * or, with probability amount, mix_b scatters; its own emission
-                          * and MAT_TWO_SIDED are what the surface emits */
-    MAT_LAYERED = 8      /* pbrt-v4's coated materials (kernels/layered.h): a dielectric
-                          * interface (ior, roughness, anisotropy) over a base (layer_base:
-                          * Lambertian albedo, or a conductor eta + i k with base_roughness,
-                          * base_anisotropy), a medium between (layer_*) */
-};
 /* MAT_LAYERED's bases */
 #define LAYER_BASE_DIFFUSE 0u
 #define LAYER_BASE_CONDUCTOR 1u
-/* MAT_DIELECTRIC also reads roughness and anisotropy (GGX, Walter et al. 2007) and
- * MAT_THIN. */
 
 typedef struct {                                        /* 288 bytes */
     uint type;                /* enum MaterialType */

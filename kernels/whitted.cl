@@ -162,7 +162,7 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, RngKey key, uint *ray
         if (!v3_is_zero(emission) && ((m.flags & MAT_TWO_SIDED) || front))
             L = v3_add(L, v3_mul(e.weight, emission));
         material_resolve(sc, &m, s, d, ng);
-        if (m.type == MAT_EMISSIVE) continue;
+        if (!material_scatters(m.type)) continue;
         s.ns = material_normal(sc, m, s);
         vec3 ns = bsdf_normal(m, d, front ? s.ns : v3_neg(s.ns), ng);
 
@@ -258,7 +258,7 @@ KFN vec3 whitted_aov(const SceneView *sc, Ray ray, uint mode, uint *rays)
     vec3 ng = v3_dot(ray.d, s.ng) < 0.0f ? s.ng : v3_neg(s.ng);
     Material m = sc->materials[s.material];
     material_resolve(sc, &m, s, ray.d, ng);
-    if (m.type == MAT_EMISSIVE) return v3s(0.0f);
+    if (!material_scatters(m.type)) return v3s(0.0f);
     if (m.type == MAT_DIELECTRIC) return v3s(1.0f);
     return material_albedo(sc, m, s, ng);
 }

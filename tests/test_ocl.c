@@ -736,12 +736,14 @@ static void test_feature_switches_compile_cleanly(void)
         return;
     }
     static const unsigned programs[] = { KF_PATH, KF_WHITTED, KF_PATH_MEGAKERNEL, KF_PATH_LANES };
-    /* each switch alone, and each of the two trees */
+    /* each switch alone, each material type's, and each of the two trees */
+#define MATERIAL_SWITCH_(name, value, bit, traits, lobes) bit,
     static const unsigned switches[] = { 1u << 0, 1u << 1, 1u << 2, 1u << 3, 1u << 4, 1u << 5, 1u << 6, 1u << 7,
-                                         1u << 8, 1u << 9, 1u << 10, 1u << 11, 1u << 12, 1u << 13, 1u << 14,
-                                         1u << 15, 1u << 16, 1u << 17, KF_LAYERED, KF_KDTREE, KF_BVH,
-                                         KF_SPHERES | KF_SPHERE_XFORM };
+                                         1u << 8, 1u << 9, 1u << 10, KF_KDTREE, KF_BVH,
+                                         KF_SPHERES | KF_SPHERE_XFORM, MATERIAL_TYPES(MATERIAL_SWITCH_) };
+#undef MATERIAL_SWITCH_
     for (size_t bit = 0; bit < sizeof switches / sizeof switches[0]; bit++) {
+        if (switches[bit] == 0u) continue;   /* a material type that is always compiled */
         for (size_t k = 0; k < sizeof programs / sizeof programs[0]; k++) {
             unsigned features = programs[k] | switches[bit];
             char cmd[300], out[2048];
@@ -755,8 +757,17 @@ static void test_feature_switches_compile_cleanly(void)
             CHECK_MSG(rc == 0 && n == 0, "CLPT_FEATURES=0x%x: %s", features, out);
         }
     }
-    CHECK_EQ_INT(KF_ALL, ((KF_MATERIAL(MAT_PRINCIPLED) << 1) - 1u) | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH |
-                         KF_PATH_LANES | KF_LAYERED | KF_SPHERE_XFORM);
+    /* the material types' bits are single bits that no other switch and no other type has */
+    unsigned others = KF_PATH | KF_WHITTED | KF_TEXTURES | KF_ALPHA | KF_ENV_MAP | KF_CUBEMAP | KF_REVSURFACE |
+                      KF_SPHERES | KF_BOXES | KF_PLANES | KF_DELTA_LIGHTS | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH |
+                      KF_PATH_LANES | KF_SPHERE_XFORM;
+    unsigned seen = others;
+#define MATERIAL_BIT_(name, value, bit, traits, lobes) \
+    CHECK_MSG(((bit) & ((bit) - 1u)) == 0u && ((bit) & seen) == 0u, "%s: feature bit 0x%x", #name, (bit)); \
+    seen |= (bit);
+    MATERIAL_TYPES(MATERIAL_BIT_)
+#undef MATERIAL_BIT_
+    CHECK_EQ_INT(KF_ALL, seen);
 }
 
 static void test_cache_location(void)

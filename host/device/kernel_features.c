@@ -18,7 +18,7 @@ unsigned kernel_scene_features(const DeviceScene *s)
             if (m->mix_texture != NO_INDEX) f |= KF_TEXTURES;
             continue;
         }
-        f |= m->type <= MAT_PRINCIPLED || m->type == MAT_LAYERED ? KF_MATERIAL(m->type) : KF_ALL;
+        f |= material_feature(m->type);
         if (m->texture != NO_INDEX || m->texture_emission != NO_INDEX || m->texture_rm != NO_INDEX ||
             m->texture_normal != NO_INDEX || m->texture_specular != NO_INDEX ||
             m->texture_specular_color != NO_INDEX || m->texture_sheen_color != NO_INDEX ||

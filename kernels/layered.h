@@ -33,7 +33,9 @@
 #ifndef CLPT_LAYERED_H
 #define CLPT_LAYERED_H
 
-#include "microfacet.h"
+#include "bsdf_base.h"
+#include "conductor.h"
+#include "fresnel.h"
 #include "rng.h"
 
 #define LAYER_R 1u        /* which lobes an interface sample may pick: reflection ... */
@@ -491,6 +493,76 @@ KFN LayeredSample layered_sample(Layered L, vec3 wo, float uc, float u1, float u
         if (z == top && w.z > 0.0f) return layered_out(w, beta, delta);   /* out through the interface */
     }
     return none;
+}
+
+/* The coated material's stack; the conductor base's index is relative to the medium
+ * under the interface (pbrt-v4's CoatedConductorMaterial divides by its index too). */
+KFN Layered bsdf_layered(Material m, vec3 albedo)
+{
+    Layered L;
+    L.g = bsdf_ggx(m);
+    L.eta = m.ior > 0.0f ? m.ior : 1.0f;
+    L.conductor = m.layer_base == LAYER_BASE_CONDUCTOR;
+    L.c.g = ggx_make(m.base_roughness, m.base_anisotropy);
+    L.c.eta = v3_scale(m.eta, 1.0f / L.eta);
+    L.c.k = v3_scale(m.k, 1.0f / L.eta);
+    L.c.f0 = v3s(0.0f);
+    L.c.tint = albedo;
+    L.c.schlick = 0;
+    L.diffuse = albedo;
+    L.albedo = m.layer_albedo;
+    L.thickness = k_fmax(m.layer_thickness, 1.17549435e-38f);
+    L.hg_g = m.layer_g;
+    /* bounded: the walks are loops of at most this many steps */
+    L.max_depth = m.layer_depth < 256u ? m.layer_depth : 256u;
+    L.n_samples = m.layer_samples < 1u ? 1u : m.layer_samples < 64u ? m.layer_samples : 64u;
+    return L;
+}
+
+/* A path through a coated material's stack (layered.h). Its weight is the walk's own f
+ * cos / pdf; the density handed on for MIS is layered_pdf's estimate for the direction
+ * as bsdf_eval would see it (world, then local again), so that the MIS weights of next-event
+ * estimation and of this sample for one direction are computed from the same number. */
+KFN BsdfSample bsdf_sample_layered(Material m, vec3 albedo, vec3 d, vec3 ns, float u_lobe, float u1, float u2)
+{
+    BsdfSample s;
+    vec3 t, b;
+    k_onb(ns, &t, &b);
+    Layered L = bsdf_layered(m, albedo);
+    vec3 wo = bsdf_to_local(v3_neg(d), t, b, ns);
+    LayeredSample r = layered_sample(L, wo, u_lobe, u1, u2);
+    if (!(v3_max_comp(r.weight) > 0.0f)) return bsdf_failed(ns);
+    s.transmitted = 0;
+    s.wi = v3_norm(k_to_world(r.wi, t, b, ns));
+    s.weight = r.weight;
+    s.specular = r.delta;
+    s.pdf = r.delta ? 0.0f : layered_pdf(L, wo, bsdf_to_local(s.wi, t, b, ns));
+    return s;
+}
+
+/* ---------------------------------------------------------------- MAT_LAYERED */
+KFN int layered_bsdf_has_density(Material m, vec3 albedo)
+{
+    /* only a stack of smooth surfaces over a smooth conductor, no medium, is all deltas */
+    Layered L = bsdf_layered(m, albedo);
+    return !(coat_smooth(L) && base_smooth(L) && !layer_has_medium(L));
+}
+
+KFN vec3 layered_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)
+{
+    if (!layered_bsdf_has_density(m, h.albedo)) return bsdf_no_eval(pdf);
+    BsdfFrame F = bsdf_frame(h.ns);
+    vec3 wo = bsdf_frame_local(F, v3_neg(h.d)), wl = bsdf_frame_local(F, wi);
+    Layered L = bsdf_layered(m, h.albedo);
+    vec3 f = layered_f(L, wo, wl);
+    *pdf = layered_pdf(L, wo, wl);
+    return f;
+}
+
+KFN BsdfSample layered_bsdf_sample(Material m, BsdfHit h, float u_lobe, float u1, float u2, float u3)
+{
+    (void)u3;
+    return bsdf_sample_layered(m, h.albedo, h.d, h.ns, u_lobe, u1, u2);
 }
 
 #endif /* CLPT_LAYERED_H */

@@ -1,6 +1,8 @@
 /*
- * microfacet.h — the GGX (Trowbridge-Reitz) microfacet model and the rough conductor
- * and dielectric BSDFs built on it.
+ * microfacet.h — the GGX (Trowbridge-Reitz) distribution of microfacet normals: its
+ * density, masking-shadowing, visible-normal sampling, and its reflection and
+ * refraction terms without Fresnel. The lobes built on it are in conductor.h,
+ * dielectric.h, principled.h and layered.h.
  *
  * Everything here works in a local frame: z is the shading normal turned to the side
  * the light leaves toward (wo.z > 0 for the caller's wo), x and y the tangents; alpha_x
@@ -102,148 +104,6 @@ KFN int mf_refract(vec3 w, vec3 m, float eta, vec3 *wt)
     return 1;
 }
 
-/* ---------------------------------------------------------------- Fresnel */
-
-/* Unpolarised Fresnel reflectance of a smooth dielectric boundary; cos_i > 0 is on the
- * incident side, eta = n_transmitted / n_incident. Returns 1 on total internal reflection. */
-KFN float fresnel_dielectric(float cos_i, float eta)
-{
-    float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
-    if (sin2_t >= 1.0f) return 1.0f;
-    float cos_t = k_sqrt(1.0f - sin2_t);
-    float r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    return 0.5f * (r_par * r_par + r_perp * r_perp);
-}
-
-/* Unpolarised reflectance of a conductor with complex index eta + i k (relative to the
- * outside medium) for one channel (pbrt-v3's FrConductor, exact for real cos_i). */
-KFN float fresnel_conductor1(float cos_i, float eta, float k)
-{
-    cos_i = k_clamp(cos_i, 0.0f, 1.0f);
-    float c2 = cos_i * cos_i, s2 = 1.0f - c2;
-    float e2 = eta * eta, k2 = k * k;
-    float t0 = e2 - k2 - s2;
-    float a2b2 = k_sqrt(t0 * t0 + 4.0f * e2 * k2);
-    float a = k_safe_sqrt(0.5f * (a2b2 + t0));
-    float t1 = a2b2 + c2, t2 = 2.0f * a * cos_i;
-    float rs = t1 + t2 > 0.0f ? (t1 - t2) / (t1 + t2) : 1.0f;
-    float t3 = c2 * a2b2 + s2 * s2, t4 = t2 * s2;
-    float rp = t3 + t4 > 0.0f ? rs * (t3 - t4) / (t3 + t4) : rs;
-    return k_clamp(0.5f * (rs + rp), 0.0f, 1.0f);
-}
-
-/* Schlick's approximation from the reflectance at normal incidence. */
-KFN vec3 fresnel_schlick(vec3 f0, float cos_i)
-{
-    float m = 1.0f - k_clamp(cos_i, 0.0f, 1.0f);
-    float m5 = m * m * m * m * m;
-    return v3_add(f0, v3_scale(v3_sub(v3s(1.0f), f0), m5));
-}
-
-/* ---------------------------------------------------------------- conductor
- * f = D G2 F / (4 cos_o cos_i); sampled by a visible normal and mirror reflection:
- * pdf = D_wo(m) / (4 wo.m). The Fresnel term is given per facet by the caller's `fr`
- * (complex index or Schlick). */
-typedef struct {
-    Ggx g;
-    vec3 eta, k;       /* complex index per channel (unless schlick) */
-    vec3 f0;           /* schlick: reflectance at normal incidence */
-    vec3 tint;         /* multiplies the Fresnel term (albedo or its texture) */
-    int schlick;
-} Conductor;
-
-KFN vec3 conductor_fresnel(Conductor c, float cos_i)
-{
-    vec3 f = c.schlick ? fresnel_schlick(c.f0, cos_i)
-                       : v3(fresnel_conductor1(cos_i, c.eta.x, c.k.x), fresnel_conductor1(cos_i, c.eta.y, c.k.y),
-                            fresnel_conductor1(cos_i, c.eta.z, c.k.z));
-    return v3_mul(f, c.tint);
-}
-
-/* f(wo, wi) into *f, the sampling density as the return value (0 and f = 0 below). */
-KFN float conductor_eval(Conductor c, vec3 wo, vec3 wi, vec3 *f)
-{
-    *f = v3s(0.0f);
-    if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
-    vec3 h = v3_add(wo, wi);
-    float len = v3_len(h);
-    if (!(len > 0.0f)) return 0.0f;
-    h = v3_scale(h, 1.0f / len);
-    float oh = v3_dot(wo, h);
-    if (oh <= 0.0f) return 0.0f;
-    float d = ggx_d(c.g, h);
-    *f = v3_scale(conductor_fresnel(c, oh), d * ggx_g2(c.g, wo, wi) / (4.0f * wo.z * wi.z));
-    return ggx_d_visible(c.g, wo, h) / (4.0f * oh);
-}
-
-/* A direction for wo; *f and the density as conductor_eval's. wi.z <= 0 (a facet that
- * reflects below the surface) is a failed sample: pdf 0. */
-KFN float conductor_sample(Conductor c, vec3 wo, float u1, float u2, vec3 *wi, vec3 *f)
-{
-    vec3 m = ggx_sample_visible(c.g, wo, u1, u2);
-    *wi = mf_reflect(wo, m);
-    return conductor_eval(c, wo, *wi, f);
-}
-
-/* ---------------------------------------------------------------- dielectric
- * Walter et al. 2007. wo.z > 0 is on the incident side, eta = n_t / n_i across the
- * surface. A visible normal m is sampled; reflection with probability F(wo.m), else
- * refraction through m. Reflection: f = D G2 F / (4 cos_o cos_i); transmission:
- * f = (1 - F) D G2 |wi.m| |wo.m| / (|cos_i| cos_o (wi.m + wo.m / eta)^2) (without the
- * 1/eta^2 radiance scaling, as the smooth glass: camera paths, lights outside). A thin
- * sheet (`thin`) sends the transmitted part straight through: the reflection lobe
- * mirrored to the other side, with the sheet's two interfaces' total reflectance
- * R + T^2 R / (1 - R^2) (pbrt-v4's ThinDielectricBxDF, made rough). */
-typedef struct {
-    Ggx g;
-    float eta;
-    int thin;
-} Dielectric;
-
-/* Reflectance of one facet at cosine c (thin: both faces of the sheet). */
-KFN float dielectric_facet_fresnel(Dielectric d, float c)
-{
-    float r = fresnel_dielectric(c, d.eta);
-    if (d.thin && r < 1.0f) r += (1.0f - r) * (1.0f - r) * r / (1.0f - r * r);
-    return r;
-}
-
-KFN float dielectric_eval(Dielectric d, vec3 wo, vec3 wi, vec3 *f)
-{
-    *f = v3s(0.0f);
-    if (wo.z <= 0.0f || wi.z == 0.0f) return 0.0f;
-    int reflect = wi.z > 0.0f;
-    vec3 m;
-    vec3 wr = wi;
-    if (reflect || d.thin) {
-        if (!reflect) wr.z = -wr.z;    /* thin: the mirrored reflection */
-        m = v3_add(wo, wr);
-    } else {
-        m = v3_add(v3_scale(wi, d.eta), wo);
-    }
-    float len = v3_len(m);
-    if (!(len > 0.0f)) return 0.0f;
-    m = v3_scale(m, 1.0f / len);
-    if (m.z < 0.0f) m = v3_neg(m);
-    float om = v3_dot(wo, m), im = v3_dot(wr, m);
-    /* facets seen from their back by either direction contribute nothing */
-    if (om <= 0.0f || (reflect || d.thin ? im <= 0.0f : im >= 0.0f)) return 0.0f;
-    float F = dielectric_facet_fresnel(d, om);
-    float D = ggx_d(d.g, m), G = ggx_g2(d.g, wo, wr);
-    float dv = ggx_d_visible(d.g, wo, m);
-    if (reflect || d.thin) {
-        float p = reflect ? F : 1.0f - F;
-        *f = v3s(p * D * G / (4.0f * wo.z * k_fabs(wr.z)));
-        return p * dv / (4.0f * om);
-    }
-    float denom = im + om / d.eta;
-    denom = denom * denom;
-    if (!(denom > 0.0f)) return 0.0f;
-    *f = v3s((1.0f - F) * D * G * k_fabs(im) * om / (k_fabs(wi.z) * wo.z * denom));
-    return (1.0f - F) * dv * k_fabs(im) / denom;
-}
-
 /* The refraction part alone, without its Fresnel factor: the BTDF D G2 |wi.m| wo.m /
  * (|cos_i| cos_o (wi.m + wo.m / eta)^2) into *btdf and the density of refracting through
  * a visible normal as the return value (0 for wi.z >= 0 or a back-facing facet). The
@@ -280,25 +140,6 @@ KFN float ggx_reflection(Ggx g, vec3 wo, vec3 wi, float *brdf)
     if (oh <= 0.0f) return 0.0f;
     *brdf = ggx_d(g, h) * ggx_g2(g, wo, wi) / (4.0f * wo.z * wi.z);
     return ggx_d_visible(g, wo, h) / (4.0f * oh);
-}
-
-/* A direction for wo, *f and the density as dielectric_eval's (0: failed sample). */
-KFN float dielectric_sample(Dielectric d, vec3 wo, float u_lobe, float u1, float u2, vec3 *wi, vec3 *f)
-{
-    vec3 m = ggx_sample_visible(d.g, wo, u1, u2);
-    float om = v3_dot(wo, m);
-    float F = dielectric_facet_fresnel(d, om);
-    int reflect = u_lobe < F;
-    *wi = mf_reflect(wo, m);
-    *f = v3s(0.0f);
-    if (!reflect) {
-        if (d.thin) wi->z = -wi->z;
-        else if (!mf_refract(wo, m, d.eta, wi)) return 0.0f;
-    }
-    /* a lobe's sample on the other lobe's side is lost, not the other lobe's: the
-     * densities of dielectric_eval count each lobe on its own side only */
-    if (reflect ? wi->z <= 0.0f : wi->z >= 0.0f) return 0.0f;
-    return dielectric_eval(d, wo, *wi, f);
 }
 
 #endif /* CLPT_MICROFACET_H */

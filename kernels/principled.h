@@ -39,7 +39,8 @@
 #ifndef CLPT_PRINCIPLED_H
 #define CLPT_PRINCIPLED_H
 
-#include "microfacet.h"
+#include "bsdf_base.h"
+#include "fresnel.h"
 #include "sheen_albedo.h"
 
 typedef struct {
@@ -261,6 +262,60 @@ KFN float principled_sample(Principled p, vec3 wo, float u_lobe, float u1, float
     /* as for the dielectric: a lobe's sample on the other side is lost */
     if (up ? wi->z <= 0.0f : wi->z >= 0.0f) return 0.0f;
     return principled_eval(p, wo, *wi, f);
+}
+
+/* The principled lobes; alphas below GGX_SMOOTH_ALPHA are raised to it, as the
+ * material mixes its lobes by density and has no delta branch. */
+KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
+{
+    Principled p;
+    p.base = albedo;
+    p.metallic = k_clamp(m.metallic, 0.0f, 1.0f);
+    p.transmission = k_clamp(m.transmission, 0.0f, 1.0f);
+    p.clearcoat = k_clamp(m.clearcoat, 0.0f, 1.0f);
+    p.g = bsdf_ggx(m);
+    p.g.ax = k_fmax(p.g.ax, GGX_SMOOTH_ALPHA);
+    p.g.ay = k_fmax(p.g.ay, GGX_SMOOTH_ALPHA);
+    float ac = k_fmax(m.clearcoat_roughness * m.clearcoat_roughness, GGX_SMOOTH_ALPHA);
+    p.gc.ax = ac;
+    p.gc.ay = ac;
+    p.thin = (m.flags & MAT_THIN) != 0u;
+    p.eta = p.thin || front ? m.ior : 1.0f / m.ior;
+    p.specular = k_clamp(m.specular_factor, 0.0f, 1.0f);
+    p.specular_color = v3(k_fmax(m.specular_color.x, 0.0f), k_fmax(m.specular_color.y, 0.0f),
+                          k_fmax(m.specular_color.z, 0.0f));
+    /* a sheen brighter than white would reflect more than it receives */
+    p.sheen = v3(k_clamp(m.sheen_color.x, 0.0f, 1.0f), k_clamp(m.sheen_color.y, 0.0f, 1.0f),
+                 k_clamp(m.sheen_color.z, 0.0f, 1.0f));
+    p.sheen_roughness = k_clamp(m.sheen_roughness, SHEEN_ROUGHNESS_MIN, 1.0f);
+    return p;
+}
+
+/* ---------------------------------------------------------------- MAT_PRINCIPLED */
+KFN int principled_bsdf_has_density(Material m, vec3 albedo)
+{
+    (void)m;
+    (void)albedo;
+    return 1;
+}
+
+KFN vec3 principled_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)
+{
+    BsdfFrame F = bsdf_frame(h.ns);
+    vec3 f;
+    *pdf = principled_eval(bsdf_principled(m, h.albedo, h.front), bsdf_frame_local(F, v3_neg(h.d)),
+                           bsdf_frame_local(F, wi), &f);
+    return f;
+}
+
+KFN BsdfSample principled_bsdf_sample(Material m, BsdfHit h, float u_lobe, float u1, float u2, float u3)
+{
+    (void)u3;
+    BsdfFrame F = bsdf_frame(h.ns);
+    vec3 wo = bsdf_frame_local(F, v3_neg(h.d)), f = v3s(0.0f), wl = v3s(0.0f);
+    float pdf = wo.z > 0.0f ? principled_sample(bsdf_principled(m, h.albedo, h.front), wo, u_lobe, u1, u2, &wl, &f)
+                            : 0.0f;
+    return bsdf_rough_sample(F, pdf, wl, f);
 }
 
 #endif /* CLPT_PRINCIPLED_H */

@@ -118,6 +118,10 @@ KFN vec3 bsdf_frame_local(BsdfFrame F, vec3 w) { return bsdf_to_local(w, F.t, F.
 
 KFN Ggx bsdf_ggx(Material m) { return ggx_make(m.roughness, m.anisotropy); }
 
+/* Whether a GGX type (conductor, dielectric) is rough: below GGX_SMOOTH_ALPHA its lobes
+ * are delta lobes, with no density. */
+KFN int bsdf_ggx_rough(Material m) { return !ggx_smooth(bsdf_ggx(m)); }
+
 /* A sample that failed: no direction, no weight. */
 KFN BsdfSample bsdf_failed(vec3 ns)
 {

@@ -172,21 +172,11 @@ KFN BsdfSample diffuse_bsdf_sample(Material m, BsdfHit h, float u_lobe, float u1
     return bsdf_sample_diffuse(h.albedo, h.ns, u1, u2);
 }
 
-/* ---------------------------------------------------------------- MAT_METAL */
-KFN int metal_bsdf_has_density(Material m, vec3 albedo)
-{
-    (void)m;
-    (void)albedo;
-    return 0;
-}
+/* ---------------------------------------------------------------- MAT_METAL
+ * Only a delta lobe, as far as light sampling knows: no density, nothing to evaluate. */
+KFN int metal_bsdf_has_density(Material m, vec3 albedo) { return none_bsdf_has_density(m, albedo); }
 
-KFN vec3 metal_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)
-{
-    (void)m;
-    (void)h;
-    (void)wi;
-    return bsdf_no_eval(pdf);
-}
+KFN vec3 metal_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf) { return none_bsdf_eval(m, h, wi, pdf); }
 
 KFN BsdfSample metal_bsdf_sample(Material m, BsdfHit h, float u_lobe, float u1, float u2, float u3)
 {

@@ -85,7 +85,7 @@ KFN BsdfSample bsdf_sample_mirror_conductor(Conductor c, vec3 d, vec3 ns, vec3 n
 KFN int conductor_bsdf_has_density(Material m, vec3 albedo)
 {
     (void)albedo;
-    return !ggx_smooth(bsdf_ggx(m));
+    return bsdf_ggx_rough(m);
 }
 
 KFN vec3 conductor_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)

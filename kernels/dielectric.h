@@ -153,7 +153,7 @@ KFN BsdfSample bsdf_sample_thin(Dielectric g, vec3 d, vec3 ng, float u)
 KFN int dielectric_bsdf_has_density(Material m, vec3 albedo)
 {
     (void)albedo;
-    return !ggx_smooth(bsdf_ggx(m));
+    return bsdf_ggx_rough(m);
 }
 
 KFN vec3 dielectric_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)

@@ -873,6 +873,7 @@ static void test_specular_render(void)
                     (double)factor[i], (double)green[i], got, want);
             CHECK_NEAR(got, want, 0.004);
         }
+        scene_free(&s);
     }
 }
 
@@ -912,6 +913,8 @@ static void test_sheen_render(void)
                     (double)rough[r], got);
             CHECK_MSG(got <= 1.005, "the sheen layers gain energy: %.4f", got);
         }
+        scene_free(&s);
+        scene_free(&ws);
     }
 }
 
@@ -974,6 +977,7 @@ static void test_volume_absorption(void)
                     (double)depth[i], got2[i], exact);
             CHECK_NEAR(got2[i], exact, 0.01);
         }
+        scene_free(&s);
     }
     /* the same bits on OpenCL as in C: an absorbing slab with a tinted-specular, sheened
      * solid sphere in front of it, every new lobe and the absorption on one path */
@@ -1002,6 +1006,7 @@ static void test_volume_absorption(void)
         CHECK_MSG(st == ST_OK, "%s", err.msg);
         error_clear(&err);
         *(d ? &ok_b : &ok_a) = st == ST_OK;
+        scene_free(&s);
     }
     if (ok_a && ok_b) {
         size_t n = (size_t)fa.width * fa.height * 3u, exact = 0;

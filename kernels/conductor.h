@@ -33,17 +33,10 @@ KFN vec3 conductor_fresnel(Conductor c, float cos_i)
 /* f(wo, wi) into *f, the sampling density as the return value (0 and f = 0 below). */
 KFN float conductor_eval(Conductor c, vec3 wo, vec3 wi, vec3 *f)
 {
-    *f = v3s(0.0f);
-    if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
-    vec3 h = v3_add(wo, wi);
-    float len = v3_len(h);
-    if (!(len > 0.0f)) return 0.0f;
-    h = v3_scale(h, 1.0f / len);
-    float oh = v3_dot(wo, h);
-    if (oh <= 0.0f) return 0.0f;
-    float d = ggx_d(c.g, h);
-    *f = v3_scale(conductor_fresnel(c, oh), d * ggx_g2(c.g, wo, wi) / (4.0f * wo.z * wi.z));
-    return ggx_d_visible(c.g, wo, h) / (4.0f * oh);
+    float brdf, oh;
+    float pdf = ggx_reflection_oh(c.g, wo, wi, &brdf, &oh);
+    *f = oh > 0.0f ? v3_scale(conductor_fresnel(c, oh), brdf) : v3s(0.0f);
+    return pdf;
 }
 
 /* A direction for wo; *f and the density as conductor_eval's. wi.z <= 0 (a facet that

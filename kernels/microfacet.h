@@ -126,20 +126,29 @@ KFN float ggx_refraction(Ggx g, float eta, vec3 wo, vec3 wi, float *btdf)
     return ggx_d_visible(g, wo, m) * k_fabs(im) / denom;
 }
 
-/* GGX reflection without Fresnel: D G2 / (4 cos_o cos_i) into *brdf, the density of
- * reflecting about a visible normal as the return value. */
-KFN float ggx_reflection(Ggx g, vec3 wo, vec3 wi, float *brdf)
+/* GGX reflection without Fresnel: D G2 / (4 cos_o cos_i) into *brdf, wo's cosine with
+ * the half vector into *oh (for the caller's Fresnel term; 0 where wi does not reflect
+ * wo), the density of reflecting about a visible normal as the return value. */
+KFN float ggx_reflection_oh(Ggx g, vec3 wo, vec3 wi, float *brdf, float *oh)
 {
     *brdf = 0.0f;
+    *oh = 0.0f;
     if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
     vec3 h = v3_add(wo, wi);
     float len = v3_len(h);
     if (!(len > 0.0f)) return 0.0f;
     h = v3_scale(h, 1.0f / len);
-    float oh = v3_dot(wo, h);
-    if (oh <= 0.0f) return 0.0f;
+    float c = v3_dot(wo, h);
+    if (c <= 0.0f) return 0.0f;
+    *oh = c;
     *brdf = ggx_d(g, h) * ggx_g2(g, wo, wi) / (4.0f * wo.z * wi.z);
-    return ggx_d_visible(g, wo, h) / (4.0f * oh);
+    return ggx_d_visible(g, wo, h) / (4.0f * c);
+}
+
+KFN float ggx_reflection(Ggx g, vec3 wo, vec3 wi, float *brdf)
+{
+    float oh;
+    return ggx_reflection_oh(g, wo, wi, brdf, &oh);
 }
 
 #endif /* CLPT_MICROFACET_H */

@@ -1,0 +1,87 @@
+/*
+ * scene_reader.h — the parts of the scene file reader (scene_load.h; the format is
+ * docs/scene-format.md) share this: the key tables' types, the parser's state, and the
+ * functions one part calls in another. The reader is cut by concern:
+ *   scene_parse.c     blocks read against key tables, camera, image, background,
+ *                     includes, the statement loop, the entry points
+ *   scene_material.c  materials (their keys and types) and textures
+ *   scene_shape.c     spheres, planes, triangles, quads, boxes, meshes, lights
+ * Not for use outside these files.
+ */
+#ifndef CLPT_SCENE_READER_H
+#define CLPT_SCENE_READER_H
+
+#include <stddef.h>
+
+#include "io/lexer.h"
+#include "scene/scene.h"
+
+typedef enum {
+    VK_NUMBER,      /* one float within the key's range */
+    VK_UINT,        /* one unsigned integer within the key's range */
+    VK_VEC3,        /* three floats */
+    VK_COLOR,       /* three floats >= 0 */
+    VK_DIR,         /* three floats, not all zero */
+    VK_WORD,        /* a bare word (checked by the statement) */
+    VK_MATERIAL,    /* a material name, or an inline anonymous material block */
+    VK_PATH,        /* a string or a word */
+    VK_TEXTURE,     /* the name of a texture defined before */
+    VK_ROTATE,      /* an axis (three floats, not all zero) and an angle in degrees */
+    VK_SCALE,       /* one non-zero float, or three */
+    VK_MATRIX       /* sixteen floats, a 4x4 matrix row by row */
+} ValueKind;
+
+typedef struct {
+    const char *key;
+    ValueKind kind;
+    int required;
+    double lo, hi;          /* VK_NUMBER, VK_UINT: the allowed range */
+    int lo_open, hi_open;   /* whether the bound itself is excluded */
+    const char *what;       /* VK_NUMBER, VK_UINT, VK_WORD: "a number in (0, 180)" */
+} KeySpec;
+
+typedef struct {
+    int given;
+    Token key;              /* where the key was written */
+    Token value;            /* its first value token */
+    float f;
+    unsigned long long u;
+    vec3 v;
+    uint material;
+    Token word;             /* VK_WORD, VK_PATH */
+    float a[16];            /* VK_ROTATE (axis, degrees), VK_SCALE (x y z), VK_MATRIX */
+} Value;
+
+typedef struct {
+    Scene *s;
+    Error *err;
+    uint depth;                       /* include nesting: 0 for the top file */
+    char *camera_at, *image_at, *background_at;   /* "file:line:col" once given */
+    char **material_at;               /* per material index, where it was defined */
+    size_t n_material_at, cap_material_at;
+    int depth_exceeded;               /* the include limit error is not annotated further */
+} Parser;
+
+/* scene_parse.c: blocks, paths, vector helpers */
+char *scene_path_beside(const char *from, const char *file, size_t file_len);
+Status scene_parse_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
+                         const char *block, const KeySpec *keys, size_t n, Value *vals);
+double scene_len_d(vec3 a);
+vec3 scene_cross_d(vec3 a, vec3 b, double *length);
+
+/* scene_material.c: material, texture */
+Status scene_parse_material_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
+                                  const char *name, uint *index);
+Status scene_parse_material(Parser *p, Lexer *lx, const Token *kw);
+Status scene_parse_texture(Parser *p, Lexer *lx, const Token *kw);
+
+/* scene_shape.c: sphere, plane, triangle, quad, box, mesh, light */
+Status scene_parse_sphere(Parser *p, Lexer *lx, const Token *kw);
+Status scene_parse_plane(Parser *p, Lexer *lx, const Token *kw);
+Status scene_parse_triangle(Parser *p, Lexer *lx, const Token *kw);
+Status scene_parse_quad(Parser *p, Lexer *lx, const Token *kw);
+Status scene_parse_box(Parser *p, Lexer *lx, const Token *kw);
+Status scene_parse_mesh(Parser *p, Lexer *lx, const Token *kw);
+Status scene_parse_light(Parser *p, Lexer *lx, const Token *kw);
+
+#endif /* CLPT_SCENE_READER_H */

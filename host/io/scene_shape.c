@@ -1,0 +1,308 @@
+/*
+ * scene_shape.c — the scene reader's shapes (sphere, plane, triangle, quad, box), meshes
+ * and lights; part of the reader of scene_parse.c (scene_reader.h).
+ */
+#include "io/scene_reader.h"
+
+#include "kmath.h"
+#include "io/lexer.h"
+#include "io/mesh_load.h"
+#include "io/reader.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { SPH_CENTER, SPH_RADIUS, SPH_MATERIAL, SPH_N };
+static const KeySpec sphere_keys[SPH_N] = {
+    [SPH_CENTER] = {"center", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [SPH_RADIUS] = {"radius", VK_NUMBER, 1, 0, INFINITY, 1, 1, "a radius > 0"},
+    [SPH_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+Status scene_parse_sphere(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[SPH_N];
+    Status st = scene_parse_block(p, lx, kw, 0, "sphere", sphere_keys, SPH_N, v);
+    if (st) return st;
+    vec3 c = v[SPH_CENTER].v;
+    float r = v[SPH_RADIUS].f;
+    /* a bounding box that overflows would leave the sphere out of the kd-tree */
+    if (!isfinite(fabsf(c.x) + r) || !isfinite(fabsf(c.y) + r) || !isfinite(fabsf(c.z) + r))
+        return lex_error_at(lx, &v[SPH_RADIUS].key, p->err,
+                            "the sphere reaches beyond the largest float (about 3.4e38)");
+    Sphere sp;
+    memset(&sp, 0, sizeof sp);
+    sp.center = c;
+    sp.radius = r;
+    sp.material = v[SPH_MATERIAL].material;
+    return scene_add_sphere(p->s, sp, p->err);
+}
+
+enum { PL_POINT, PL_NORMAL, PL_MATERIAL, PL_N };
+static const KeySpec plane_keys[PL_N] = {
+    [PL_POINT] = {"point", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [PL_NORMAL] = {"normal", VK_DIR, 1, 0, 0, 0, 0, NULL},
+    [PL_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+Status scene_parse_plane(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[PL_N];
+    Status st = scene_parse_block(p, lx, kw, 0, "plane", plane_keys, PL_N, v);
+    if (st) return st;
+    vec3 n = v[PL_NORMAL].v, q = v[PL_POINT].v;
+    double len = scene_len_d(n);
+    if (!isfinite(len))
+        return lex_error_at(lx, &v[PL_NORMAL].key, p->err, "plane 'normal' is too long to normalise");
+    double nx = n.x / len, ny = n.y / len, nz = n.z / len;
+    Plane pl;
+    memset(&pl, 0, sizeof pl);
+    pl.normal = v3((float)nx, (float)ny, (float)nz);
+    pl.offset = (float)(nx * q.x + ny * q.y + nz * q.z);
+    pl.material = v[PL_MATERIAL].material;
+    return scene_add_plane(p->s, pl, p->err);
+}
+
+static Status add_triangle(Parser *p, const Lexer *lx, const Token *kw, vec3 a, vec3 b, vec3 c,
+                           uint material, const char *which)
+{
+    double area2;
+    scene_cross_d(v3_sub(b, a), v3_sub(c, a), &area2);
+    /* the kernels compute edges in float: corners 6e38 apart give infinite edges */
+    if (isnan(area2) || isinf(area2))
+        return lex_error_at(lx, kw, p->err, "%.*s: the corners %s are too far apart (their "
+                            "differences overflow single precision)", (int)kw->len, kw->text, which);
+    if (!(area2 > 0.0))
+        return lex_error_at(lx, kw, p->err, "degenerate %.*s: the corners %s lie on one line",
+                            (int)kw->len, kw->text, which);
+    Triangle t;
+    memset(&t, 0, sizeof t);
+    t.p0 = a;
+    t.p1 = b;
+    t.p2 = c;
+    t.material = material;
+    t.shading = NO_INDEX;
+    return scene_add_triangle(p->s, t, p->err);
+}
+
+enum { TRI_V0, TRI_V1, TRI_V2, TRI_V3, TRI_MATERIAL, TRI_N };
+static const KeySpec triangle_keys[TRI_N - 1] = {
+    {"v0", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    {"v1", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    {"v2", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+static const KeySpec quad_keys[TRI_N] = {
+    [TRI_V0] = {"v0", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [TRI_V1] = {"v1", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [TRI_V2] = {"v2", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [TRI_V3] = {"v3", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [TRI_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+Status scene_parse_triangle(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[TRI_N - 1];
+    Status st = scene_parse_block(p, lx, kw, 0, "triangle", triangle_keys, TRI_N - 1, v);
+    if (st) return st;
+    return add_triangle(p, lx, kw, v[0].v, v[1].v, v[2].v, v[3].material, "v0 v1 v2");
+}
+
+Status scene_parse_quad(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[TRI_N];
+    Status st = scene_parse_block(p, lx, kw, 0, "quad", quad_keys, TRI_N, v);
+    if (st) return st;
+    uint m = v[TRI_MATERIAL].material;
+    st = add_triangle(p, lx, kw, v[TRI_V0].v, v[TRI_V1].v, v[TRI_V2].v, m, "v0 v1 v2");
+    if (!st) st = add_triangle(p, lx, kw, v[TRI_V0].v, v[TRI_V2].v, v[TRI_V3].v, m, "v0 v2 v3");
+    return st;
+}
+
+enum { BOX_MIN, BOX_MAX, BOX_MATERIAL, BOX_N };
+static const KeySpec box_keys[BOX_N] = {
+    [BOX_MIN] = {"min", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [BOX_MAX] = {"max", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [BOX_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+};
+
+Status scene_parse_box(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[BOX_N];
+    Status st = scene_parse_block(p, lx, kw, 0, "box", box_keys, BOX_N, v);
+    if (st) return st;
+    vec3 lo = v[BOX_MIN].v, hi = v[BOX_MAX].v;
+    static const char axis[3] = {'x', 'y', 'z'};
+    for (int i = 0; i < 3; i++)
+        if (!(v3_get(lo, i) < v3_get(hi, i)))
+            return lex_error_at(lx, &v[BOX_MAX].key, p->err,
+                                "box 'max' must be greater than 'min' on every axis, "
+                                "but on %c it is %.9g <= %.9g",
+                                axis[i], (double)v3_get(hi, i), (double)v3_get(lo, i));
+    Box b;
+    memset(&b, 0, sizeof b);
+    b.lo = lo;
+    b.hi = hi;
+    b.material = v[BOX_MATERIAL].material;
+    return scene_add_box(p->s, b, p->err);
+}
+
+enum { MESH_FILE, MESH_MATERIAL, MESH_TRANSLATE, MESH_ROTATE, MESH_RX, MESH_RY, MESH_RZ, MESH_SCALE,
+       MESH_MATRIX, MESH_N };
+static const KeySpec mesh_keys[MESH_N] = {
+    [MESH_FILE] = {"file", VK_PATH, 1, 0, 0, 0, 0, NULL},
+    [MESH_MATERIAL] = {"material", VK_MATERIAL, 0, 0, 0, 0, 0, NULL},
+    [MESH_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [MESH_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},
+    [MESH_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [MESH_RY] = {"ry", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [MESH_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [MESH_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
+    [MESH_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
+};
+
+/* The instance transform of a mesh block: scale, then rotate, rx, ry, rz, then
+ * translate; or a whole affine matrix, which excludes the others. */
+static Status mesh_transform(Parser *p, const Lexer *lx, const Token *kw, const Value *v, Transform *out)
+{
+    Transform t = transform_identity();
+    if (v[MESH_MATRIX].given) {
+        for (int i = MESH_TRANSLATE; i < MESH_MATRIX; i++)
+            if (v[i].given) {
+                const Token *later = &v[i].key;
+                if (v[MESH_MATRIX].key.line > later->line ||
+                    (v[MESH_MATRIX].key.line == later->line && v[MESH_MATRIX].key.col > later->col))
+                    later = &v[MESH_MATRIX].key;
+                return lex_error_at(lx, later, p->err,
+                                    "'matrix' cannot be combined with translate, rotate, rx, ry, rz or scale "
+                                    "(fold them into the matrix)");
+            }
+        const float *a = v[MESH_MATRIX].a;
+        if (a[12] != 0.0f || a[13] != 0.0f || a[14] != 0.0f || a[15] != 1.0f)
+            return lex_error_at(lx, &v[MESH_MATRIX].key, p->err,
+                                "the last row of 'matrix' must be 0 0 0 1 (an affine transform), found "
+                                "%g %g %g %g", (double)a[12], (double)a[13], (double)a[14], (double)a[15]);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 4; j++) t.m[i][j] = a[4 * i + j];
+    } else {
+        if (v[MESH_SCALE].given) {
+            const float *a = v[MESH_SCALE].a;
+            t = transform_scale(a[0], a[1], a[2]);
+        }
+        Transform r;
+        if (v[MESH_ROTATE].given) {
+            const float *a = v[MESH_ROTATE].a;
+            r = transform_rotate(a[0], a[1], a[2], a[3]);
+            t = transform_compose(&r, &t);
+        }
+        for (int axis = 0; axis < 3; axis++) {
+            const Value *rv = &v[MESH_RX + axis];
+            if (!rv->given) continue;
+            r = transform_rotate(axis == 0, axis == 1, axis == 2, rv->f);
+            t = transform_compose(&r, &t);
+        }
+        if (v[MESH_TRANSLATE].given) {
+            vec3 d = v[MESH_TRANSLATE].v;
+            r = transform_translate(d.x, d.y, d.z);
+            t = transform_compose(&r, &t);
+        }
+    }
+    double det = transform_det(&t);
+    if (!(fabs(det) > 1e-300) || !isfinite(det)) {
+        const Token *at = v[MESH_MATRIX].given ? &v[MESH_MATRIX].key : v[MESH_SCALE].given ? &v[MESH_SCALE].key : kw;
+        return lex_error_at(lx, at, p->err, "the mesh transform is singular (it flattens the mesh)");
+    }
+    *out = t;
+    return ST_OK;
+}
+
+/* A mesh too small for single precision shades black or vanishes (a mesh 1e-30
+ * across): refused when most of its triangles' normals underflow (a few slivers in a
+ * mesh of normal size are harmless, and only those are lost). */
+static Status check_mesh_size(Parser *p, const Lexer *lx, const Token *f, const char *path, size_t first)
+{
+    size_t tiny, with_area;
+    vec3 lo, hi;
+    scene_count_tiny_triangles(p->s, first, p->s->n_triangles, &tiny, &with_area, &lo, &hi);
+    if (tiny == 0 || tiny * 2 < with_area) return ST_OK;
+    return lex_error_at(lx, f, p->err, "the mesh '%s' is too small for single precision: %zu of its %zu "
+                        "triangles have normals that underflow (it spans %g x %g x %g after its transform); "
+                        "scale it up", path, tiny, with_area, (double)(hi.x - lo.x), (double)(hi.y - lo.y),
+                        (double)(hi.z - lo.z));
+}
+
+Status scene_parse_mesh(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[MESH_N];
+    Status st = scene_parse_block(p, lx, kw, 0, "mesh", mesh_keys, MESH_N, v);
+    if (st) return st;
+    const Token *f = &v[MESH_FILE].word;
+    MeshOptions o = mesh_options(v[MESH_MATERIAL].given ? v[MESH_MATERIAL].material : NO_INDEX);
+    if ((st = mesh_transform(p, lx, kw, v, &o.xf))) return st;
+    char *path = scene_path_beside(lx->path, f->text, f->len);
+    if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
+    if (mesh_kind(path) == MESH_NONE) {
+        free(path);
+        return lex_expected(lx, f, "a mesh file name ending in .obj, .ply, .obj.gz, .ply.gz, .gltf or .glb", p->err);
+    }
+    size_t first = p->s->n_triangles;
+    st = mesh_load(path, p->s, &o, p->err);
+    if (st) reader_note_nested(lx, f, kw, "in the mesh of", st, p->err);
+    else st = check_mesh_size(p, lx, f, path, first);
+    free(path);
+    return st;
+}
+
+/* ------------------------------------------------------------------ lights, textures */
+
+enum { LT_TYPE, LT_POSITION, LT_DIRECTION, LT_INTENSITY, LT_ATTEN, LT_ANGLE, LT_INNER, LT_N };
+static const KeySpec light_keys[LT_N] = {
+    [LT_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0, "a light type (point, spot, directional)"},
+    [LT_POSITION] = {"position", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [LT_DIRECTION] = {"direction", VK_DIR, 0, 0, 0, 0, 0, NULL},
+    [LT_INTENSITY] = {"intensity", VK_COLOR, 1, 0, 0, 0, 0, NULL},
+    [LT_ATTEN] = {"attenuation", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [LT_ANGLE] = {"angle", VK_NUMBER, 0, 0, 180, 1, 1, "a number of degrees in (0, 180)"},
+    [LT_INNER] = {"inner", VK_NUMBER, 0, 0, 180, 0, 1, "a number of degrees in [0, 180)"},
+};
+
+Status scene_parse_light(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[LT_N];
+    Status st = scene_parse_block(p, lx, kw, 0, "light", light_keys, LT_N, v);
+    if (st) return st;
+    static const struct { const char *name; uint type; unsigned allowed; } types[] = {
+        {"point", LIGHT_POINT, 1u << LT_POSITION | 1u << LT_ATTEN},
+        {"spot", LIGHT_SPOT, 1u << LT_POSITION | 1u << LT_DIRECTION | 1u << LT_ATTEN | 1u << LT_ANGLE | 1u << LT_INNER},
+        {"directional", LIGHT_DIRECTIONAL, 1u << LT_DIRECTION},
+    };
+    size_t ti;
+    for (ti = 0; ti < 3; ti++)
+        if (tok_is(&v[LT_TYPE].word, types[ti].name)) break;
+    if (ti == 3) return lex_expected(lx, &v[LT_TYPE].word, light_keys[LT_TYPE].what, p->err);
+    unsigned allowed = types[ti].allowed | 1u << LT_TYPE | 1u << LT_INTENSITY;
+    for (int i = 0; i < LT_N; i++)
+        if (v[i].given && !(allowed & (1u << i)))
+            return lex_error_at(lx, &v[i].key, p->err, "a %s light has no '%s'", types[ti].name, light_keys[i].key);
+    Light l = light_default(types[ti].type);
+    l.intensity = v[LT_INTENSITY].v;
+    if (v[LT_POSITION].given) l.position = v[LT_POSITION].v;
+    if (v[LT_DIRECTION].given) {
+        vec3 d = v[LT_DIRECTION].v;
+        double len = scene_len_d(d);
+        l.direction = v3((float)(d.x / len), (float)(d.y / len), (float)(d.z / len));
+    }
+    if (v[LT_ATTEN].given) {
+        if (v3_is_zero(v[LT_ATTEN].v))
+            return lex_error_at(lx, &v[LT_ATTEN].key, p->err, "'attenuation' (constant linear quadratic) must not be all 0");
+        l.atten0 = v[LT_ATTEN].v.x;
+        l.atten1 = v[LT_ATTEN].v.y;
+        l.atten2 = v[LT_ATTEN].v.z;
+    }
+    float outer = v[LT_ANGLE].given ? v[LT_ANGLE].f : 30.0f, inner = v[LT_INNER].given ? v[LT_INNER].f : outer;
+    if (inner > outer) return lex_error_at(lx, &v[LT_INNER].key, p->err, "'inner' must not exceed 'angle'");
+    l.cos_outer = (float)cos((double)outer * M_PI / 180.0);
+    l.cos_inner = (float)cos((double)inner * M_PI / 180.0);
+    return scene_add_light(p->s, l, p->err);
+}

@@ -263,46 +263,6 @@ static Status run_info_command(const Options *o, int *done, Error *err)
 
 /* ------------------------------------------------------------------ outputs, checked first */
 
-/* What a named file is to this run. */
-typedef enum { FILE_IMAGE, FILE_CHECKPOINT, FILE_RESUME, FILE_SCENE } FileRole;
-
-/* A file this run names, and what it is to the run. */
-typedef struct {
-    FileId id;
-    const char *what;     /* for messages: "the output image", "the checkpoint" */
-    FileRole role;
-} NamedFile;
-
-static void named_file_init(NamedFile *f, const char *path, const char *what, FileRole role)
-{
-    file_id_init(&f->id, path);
-    f->what = what;
-    f->role = role;
-}
-
-static int is_output(FileRole role)
-{
-    return role == FILE_IMAGE || role == FILE_CHECKPOINT;
-}
-
-/* Two outputs naming one file would leave one's bytes in the other (a checkpoint where
- * the image should be), and an output over an input destroys the input: both are
- * refused before anything is done. A checkpoint over the one it resumes from is how
- * --resume goes on, and allowed. */
-static Status outputs_check_distinct(const NamedFile *files, size_t n, Error *err)
-{
-    for (size_t i = 0; i < n; i++)
-        for (size_t j = i + 1; j < n; j++) {
-            const NamedFile *a = &files[i], *b = &files[j];
-            if (!is_output(a->role) && !is_output(b->role)) continue;
-            if (a->role == FILE_CHECKPOINT && b->role == FILE_RESUME) continue;
-            if (!file_id_same(&a->id, &b->id)) continue;
-            return error_set(err, ST_USAGE, "%s '%s' and %s '%s' are the same file; give each its own name",
-                             a->what, a->id.path, b->what, b->id.path);
-        }
-    return ST_OK;
-}
-
 /* Each output can be written: checked now, so that a missing or unwritable folder is
  * found in a second, not after hours of rendering (when nothing could be saved). */
 static Status outputs_check(const Run *r, Error *err)
@@ -326,9 +286,9 @@ static Status outputs_check(const Run *r, Error *err)
     if (o->checkpoint_path) named_file_init(&files[n++], o->checkpoint_path, "the checkpoint", FILE_CHECKPOINT);
     if (o->resume_path) named_file_init(&files[n++], o->resume_path, "the checkpoint to resume", FILE_RESUME);
     named_file_init(&files[n++], o->scene_path, "the scene", FILE_SCENE);
-    if ((st = outputs_check_distinct(files, n, err))) goto out;
+    if ((st = named_files_check_distinct(files, n, err))) goto out;
     for (size_t i = 0; i < n && st == ST_OK; i++)
-        if (is_output(files[i].role))
+        if (file_role_is_output(files[i].role))
             st = atomic_probe(files[i].id.path, files[i].role == FILE_CHECKPOINT ? "checkpoint" : "", err);
 out:
     for (size_t i = 0; i < 3; i++) free(aov_paths[i]);

@@ -19,6 +19,7 @@
 #include "base/file_id.h"
 #include "dist/merge.h"
 #include "dist/mpi_driver.h"
+#include "dist/mpi_job.h"
 #include "render/checkpoint.h"
 #include "device/device.h"
 #include "device/ocl_program.h"
@@ -534,79 +535,57 @@ static Status results_write(Run *r, Error *err)
 
 /* ------------------------------------------------------------------ under MPI */
 
-/* The options an MPI job takes, passed on to the driver. */
-static Status mpi_options(const Options *o, Dist *dist, Error *err)
+/* What an MPI job needs of the command line (dist/mpi_job.h). */
+static DistRequest dist_request(const Options *o)
 {
-    if (o->adaptive > 0.0 || o->aovs)
-        return error_set(err, ST_USAGE, "--adaptive and --aov are not available under MPI (run them in one process)");
-    if (o->interactive)
-        return error_set(err, ST_USAGE, "--interactive is not available under MPI (the window belongs to one process)");
-    dist->broadcast = o->mpi_broadcast;
-    if (o->mpi_timeout > 0.0) dist->timeout = o->mpi_timeout;
-    dist->fixed_batch = o->batch;
-    return ST_OK;
+    DistRequest q = { o->help ? DIST_HELP : o->version ? DIST_VERSION : o->list_devices ? DIST_LIST_DEVICES : DIST_RENDER,
+                      o->mpi_broadcast, o->mpi_timeout, o->batch, o->adaptive > 0.0 || o->aovs != 0, o->interactive };
+    return q;
 }
 
-/* Under an MPI launcher: joins the job also after a failed command line (st), and all
- * ranks agree on what to do (dist_start), so that a rank that cannot start, or that was
- * given another command (an MPMD job), ends the job with rank 0's message instead of
- * leaving the others waiting. */
-static Status mpi_join(const Options *o, Status st, Dist *dist, Error *err)
+/* A rank's outputs (rank 0 only) and its prepared scene (unless rank 0 sends it). */
+static Status rank_prepare(void *vr, int worker, int receive, Error *err)
 {
-    Error init_err = { 0 };
-    Status joined = dist_init(dist, st == ST_OK ? o->mpi_timeout : 0.0, &init_err);
-    if (joined != ST_OK) {
-        error_clear(err);
-        *err = init_err;
-        return joined;
-    }
-    if (st == ST_OK && dist->active) st = mpi_options(o, dist, err);
-    DistPlan plan = o->help ? DIST_HELP : o->version ? DIST_VERSION : o->list_devices ? DIST_LIST_DEVICES : DIST_RENDER;
-    return dist_start(dist, plan, st == ST_OK && o->mpi_broadcast, st, err);
-}
-
-/* --mpi-broadcast: rank 0's prepared scene becomes every worker's. */
-static Status mpi_share_scene(Run *r, Dist *dist, Status st, Error *err)
-{
-    unsigned spp = r->scene.image.spp;
-    Status shared = dist_share_scene(dist, st, &r->rs.ds, &spp, err);
-    if (shared != ST_OK || dist->rank == 0) return shared;
-    r->scene.image.spp = spp;
-    checkpoint_id(&r->rs.ds, spp, &r->ctx.checkpoint_id);
-    return ST_OK;
-}
-
-/* One rank of an MPI job (dist/mpi_driver.h): every rank prepares the scene (or receives
- * it) and its devices, and all agree to start; then rank 0 renders with the others as
- * devices and writes the outputs, while the others render the batches it sends. Every
- * step runs on every rank, also after a failure, so that no rank waits for ever in a
- * collective call; rank 0 alone reports. */
-static Status run_rank(Run *r, Dist *dist, Error *err)
-{
-    int worker = dist->rank > 0, receive = worker && dist->broadcast;
+    Run *r = vr;
     Status st = ST_OK;
-    if (worker) r->o.quiet = 1;
     if (!worker) st = outputs_choose(r, err);
     if (st == ST_OK && !worker) st = outputs_check(r, err);
     if (st == ST_OK && !receive) st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
     if (st == ST_OK && !worker) st = outputs_from_scene(r, err);
     if (st == ST_OK && !receive) st = scene_apply_options(r, err);
     if (st == ST_OK && !receive) st = render_prepare(r, worker, 1, err);
-    if (dist->broadcast) st = mpi_share_scene(r, dist, st, err);
-    if (st == ST_OK) st = open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
-    st = dist_agree(dist, st, err, &r->ctx.checkpoint_id, r->devs, r->n_devs, err);
-    if (st != ST_OK) return st;
-    if (worker) {
-        stop_quietly = 1;
-        install_signal_handlers();
-        return dist_worker_run(dist, r->devs, r->n_devs, r->rs.ds.params.width, r->rs.ds.params.height,
-                               &stop_requested, err);
-    }
+    return st;
+}
+
+static Status rank_open_devices(void *vr, Error *err)
+{
+    Run *r = vr;
+    return open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
+}
+
+static void rank_worker_starts(void *vr)
+{
+    (void)vr;
+    stop_quietly = 1;
+    install_signal_handlers();
+}
+
+static Status rank_render(void *vr, Dist *dist, Error *err)
+{
+    Run *r = vr;
     stop_under_mpi = 1;
     render_run(r, dist, err);
-    st = results_write(r, err);
-    dist_stop_workers(dist, r->o.stats ? stdout : NULL);
-    return st;
+    return results_write(r, err);
+}
+
+/* One rank of an MPI job: its steps, in the order dist_run_rank runs them. */
+static Status run_rank(Run *r, Dist *dist, Error *err)
+{
+    if (dist->rank > 0) r->o.quiet = 1;
+    DistRankSteps s = { r, rank_prepare, rank_open_devices, rank_worker_starts, rank_render,
+                        &r->rs.ds, &r->scene.image.spp, &r->ctx.checkpoint_id, &r->devs, &r->n_devs,
+                        &stop_requested, r->o.stats ? stdout : NULL };
+    return dist_run_rank(dist, &s, err);
 }
 
 /* --interactive: the display first (without one, nothing slow is done), then the scene
@@ -638,7 +617,10 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
     r.t_start = timer_now();
     int done = 0;
     Status st = options_parse(argc, argv, &r.o, err);
-    if (dist_launched()) st = mpi_join(&r.o, st, dist, err);
+    if (dist_launched()) {
+        DistRequest q = dist_request(&r.o);
+        st = dist_join(dist, &q, st, err);
+    }
     if (st != ST_OK) return st;
     if (dist->rank == 0) st = run_info_command(&r.o, &done, err);
     if (st != ST_OK || done || r.o.help || r.o.version || r.o.list_devices) return st;

@@ -42,9 +42,17 @@
 #define CLPT_VERSION "0.1.0"
 
 static volatile sig_atomic_t stop_requested;
-static int stderr_is_terminal;
-static int stop_quietly;   /* an MPI worker: rank 0 says it */
-static int stop_under_mpi; /* rank 0 of an MPI job */
+/* What the first stop prints, chosen before the handlers are installed (the handler
+ * reads nothing else but the flag); NULL: nothing. */
+static const char *stop_message;
+static size_t stop_message_len;
+
+/* Who says that the render stops. */
+typedef enum {
+    STOP_SAY,       /* one process */
+    STOP_SAY_MPI,   /* rank 0 of an MPI job */
+    STOP_QUIET      /* an MPI worker: rank 0 says it */
+} StopVoice;
 
 /* The first SIGINT or SIGTERM stops the render within about a second and writes what
  * is finished (exit 6); a second one, of either kind, ends the process at once by the
@@ -57,22 +65,24 @@ static void on_stop_signal(int sig)
         return;
     }
     stop_requested = 1;
-    if (stop_quietly) return;
+    if (!stop_message) return;
+    ssize_t w = write(STDERR_FILENO, stop_message, stop_message_len);
+    (void)w;
+}
+
+static void install_signal_handlers(StopVoice voice)
+{
     /* on a terminal the progress bar holds the line: start a fresh one */
     static const char msg[] = "\nclpt: stopping: writing what is finished (press Ctrl-C again to quit at once)\n";
     /* mpirun ends a job with SIGTERM to every rank also when one of them died */
     static const char mpi_msg[] = "\nclpt: stopping on SIGINT/SIGTERM (from you, or from mpirun because another MPI "
                                   "rank died; mpirun names it): writing what is finished\n";
-    const char *m = stop_under_mpi ? mpi_msg : msg;
-    size_t len = stop_under_mpi ? sizeof mpi_msg - 1 : sizeof msg - 1;
-    size_t skip = stderr_is_terminal ? 0 : 1;
-    ssize_t w = write(STDERR_FILENO, m + skip, len - skip);
-    (void)w;
-}
-
-static void install_signal_handlers(void)
-{
-    stderr_is_terminal = isatty(STDERR_FILENO);
+    size_t skip = isatty(STDERR_FILENO) ? 0 : 1;
+    stop_message = NULL;
+    if (voice != STOP_QUIET) {
+        stop_message = (voice == STOP_SAY_MPI ? mpi_msg : msg) + skip;
+        stop_message_len = (voice == STOP_SAY_MPI ? sizeof mpi_msg - 1 : sizeof msg - 1) - skip;
+    }
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_stop_signal;
@@ -430,7 +440,7 @@ static void render_configure(Run *r)
  * was finished is still saved. */
 static void render_run(Run *r, Dist *dist, Error *err)
 {
-    install_signal_handlers();
+    install_signal_handlers(dist->active ? STOP_SAY_MPI : STOP_SAY);
     render_configure(r);
     if (dist->active) {
         /* the other ranks join the render as devices of this one */
@@ -566,14 +576,12 @@ static Status rank_open_devices(void *vr, Error *err)
 static void rank_worker_starts(void *vr)
 {
     (void)vr;
-    stop_quietly = 1;
-    install_signal_handlers();
+    install_signal_handlers(STOP_QUIET);
 }
 
 static Status rank_render(void *vr, Dist *dist, Error *err)
 {
     Run *r = vr;
-    stop_under_mpi = 1;
     render_run(r, dist, err);
     return results_write(r, err);
 }

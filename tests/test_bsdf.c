@@ -412,20 +412,32 @@ static void furnace_sphere_scene(Scene *s, Material m, uint spp, uint depth)
     scene_add_sphere(s, sp, NULL);
 }
 
-/* Renders; for each pixel whose centre is inside radius 0.9 of the disk, adds the
- * image's value (green) and expected(mu) to the sums. */
-static int furnace_render(Scene *s, double (*expected)(double mu, const void *ctx), const void *ctx, double *got,
-                          double *want)
+/* Renders s on the scalar device; its resolved RGB (to free) and size, or NULL after a
+ * failed check when the render failed. */
+static float *furnace_image(Scene *s, uint *w, uint *h)
 {
     Film film;
     Error err = { 0 };
     Status st = render_util_run(s, "scalar", 0, &film, &err);
     CHECK_MSG(st == ST_OK, "%s", err.msg);
     error_clear(&err);
-    if (st) return 0;
-    uint w = film.width, h = film.height;
-    float *rgb = malloc((size_t)w * h * 3 * sizeof *rgb);
+    if (st) return NULL;
+    *w = film.width;
+    *h = film.height;
+    float *rgb = malloc((size_t)*w * *h * 3 * sizeof *rgb);
     film_resolve(&film, rgb);
+    film_free(&film);
+    return rgb;
+}
+
+/* Renders; for each pixel whose centre is inside radius 0.9 of the disk, adds the
+ * image's value (green) and expected(mu) to the sums. */
+static int furnace_render(Scene *s, double (*expected)(double mu, const void *ctx), const void *ctx, double *got,
+                          double *want)
+{
+    uint w, h;
+    float *rgb = furnace_image(s, &w, &h);
+    if (!rgb) return 0;
     double sg = 0.0, sw = 0.0;
     int n = 0;
     for (uint y = 0; y < h; y++)
@@ -437,7 +449,6 @@ static int furnace_render(Scene *s, double (*expected)(double mu, const void *ct
             n++;
         }
     free(rgb);
-    film_free(&film);
     *got = sg / n;
     *want = sw / n;
     return 1;
@@ -566,19 +577,15 @@ static void test_principled_ior_render(void)
     }
 }
 
-/* The mean of the film's green channel and the share of its pixels below `dark`. */
-static double film_green_mean(const Film *film, double dark, double *dark_share)
+/* The mean of an image's green channel and the share of its pixels below `dark`. */
+static double green_mean(const float *rgb, uint w, uint h, double dark, double *dark_share)
 {
-    uint w = film->width, h = film->height;
-    float *rgb = malloc((size_t)w * h * 3 * sizeof *rgb);
-    film_resolve(film, rgb);
     double sum = 0.0;
     size_t n_dark = 0;
     for (size_t i = 0; i < (size_t)w * h; i++) {
         sum += rgb[3 * i + 1];
         n_dark += rgb[3 * i + 1] < dark;
     }
-    free(rgb);
     *dark_share = (double)n_dark / ((double)w * h);
     return sum / ((double)w * h);
 }
@@ -594,16 +601,10 @@ static double furnace_cube(Material m, double *dark_share)
     s.camera.ortho_height = 1.9f;
     Box b = { v3s(-0.6f), mi, v3s(0.6f), NO_INDEX };
     scene_add_box(&s, b, NULL);
-    Film film;
-    Error err = { 0 };
-    Status st = render_util_run(&s, "scalar", 0, &film, &err);
-    CHECK_MSG(st == ST_OK, "%s", err.msg);
-    error_clear(&err);
-    double mean = -1.0;
-    if (st == ST_OK) {
-        mean = film_green_mean(&film, 0.5, dark_share);
-        film_free(&film);
-    }
+    uint w, h;
+    float *rgb = furnace_image(&s, &w, &h);
+    double mean = rgb ? green_mean(rgb, w, h, 0.5, dark_share) : -1.0;
+    free(rgb);
     scene_free(&s);
     return mean;
 }
@@ -686,15 +687,9 @@ static void add_uv_sphere(Scene *s, uint material, int nu, int nv)
  * the smallest of those pixels. */
 static int furnace_disk_stats(Scene *s, double r_max, double *mean, double *min)
 {
-    Film film;
-    Error err = { 0 };
-    Status st = render_util_run(s, "scalar", 0, &film, &err);
-    CHECK_MSG(st == ST_OK, "%s", err.msg);
-    error_clear(&err);
-    if (st) return 0;
-    uint w = film.width, h = film.height;
-    float *rgb = malloc((size_t)w * h * 3 * sizeof *rgb);
-    film_resolve(&film, rgb);
+    uint w, h;
+    float *rgb = furnace_image(s, &w, &h);
+    if (!rgb) return 0;
     double sum = 0.0;
     *min = 1e30;
     int n = 0;
@@ -708,7 +703,6 @@ static int furnace_disk_stats(Scene *s, double r_max, double *mean, double *min)
             n++;
         }
     free(rgb);
-    film_free(&film);
     *mean = sum / n;
     return 1;
 }

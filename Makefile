@@ -24,7 +24,7 @@ WARN      := -Wall -Wextra -Wpedantic -Wshadow -Wstrict-prototypes -Wmissing-pro
              -Wold-style-definition -Wformat=2 -Wundef -Wpointer-arith \
              -Wwrite-strings -Wvla -Wcast-align -Wswitch-enum
 # The scalar device must compute the same bits as OpenCL: no contraction into FMA, no
-# fast-math (see kernels/compat.h).
+# fast-math (see kernels/util/compat.h).
 FPFLAGS   := -ffp-contract=off -fno-fast-math
 CPPFLAGS  := -D_GNU_SOURCE -DCL_TARGET_OPENCL_VERSION=120 -Ihost -Ikernels -I$(BUILD) \
              -I/usr/include/stb -I/usr/include/OpenEXR
@@ -42,8 +42,9 @@ MPI_LIBS   := $(shell pkg-config --libs ompi-c 2>/dev/null || echo -lmpi)
 KERNEL_C_WARN := -Wdouble-promotion -Werror=double-promotion
 
 HOST_SRC  := $(filter-out host/main.c,$(wildcard host/*.c host/*/*.c))
-HOST_OBJ  := $(HOST_SRC:host/%.c=$(BUILD)/host/%.o) $(BUILD)/kernel_source.o
-KERNELS   := $(wildcard kernels/*.h kernels/*.cl)
+HOST_OBJ  := $(HOST_SRC:host/%.c=$(BUILD)/host/%.o) $(BUILD)/kernel_source.o \
+             $(BUILD)/bench_kernel_source.o
+KERNELS   := $(wildcard kernels/*.h kernels/*.cl kernels/*/*.h kernels/*/*.cl)
 TEST_SRC  := $(wildcard tests/test_*.c)
 TEST_BIN  := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 # Every fuzz/fuzz_NAME.c is a libFuzzer target (make fuzz) and, linked with
@@ -78,10 +79,16 @@ $(BUILD)/gen_weekend: tools/gen_weekend.c
 $(BUILD)/gen_mesh: tools/gen_mesh.c $(BUILD)/lib$(PROG).a
 	$(CC) $(CPPFLAGS) $(CFLAGS) -o $@ $< $(BUILD)/lib$(PROG).a $(LDFLAGS) $(LDLIBS)
 
+# The renderer's program (kernels/entry.cl) and the traversal benchmark's
+# (kernels/bench/trace.cl), each flattened into a C array. The second is a member of the
+# library that only bench_traverse and test_kernels pull in.
 $(BUILD)/kernel_source.c: $(KERNELS) $(BUILD)/embed
-	$(BUILD)/embed clpt_kernel_source kernels/entry.cl > $@.tmp && mv $@.tmp $@
+	$(BUILD)/embed clpt_kernel_source kernels/entry.cl kernels > $@.tmp && mv $@.tmp $@
 
-$(BUILD)/kernel_source.o: $(BUILD)/kernel_source.c
+$(BUILD)/bench_kernel_source.c: $(KERNELS) $(BUILD)/embed
+	$(BUILD)/embed clpt_bench_kernel_source kernels/bench/trace.cl kernels > $@.tmp && mv $@.tmp $@
+
+$(BUILD)/kernel_source.o $(BUILD)/bench_kernel_source.o: %.o: %.c
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c -o $@ $<
 
 $(BUILD)/host/%.o: host/%.c

@@ -21,7 +21,7 @@
 
 #include "accel/kdtree.h"
 #include "io/mesh_load.h"
-#include "traverse.cl"
+#include "accel/traverse.h"
 
 static double now(void)
 {
@@ -131,7 +131,7 @@ int main(int argc, char **argv)
     if (rc) return 1;
     printf("mesh %s: %zu triangles (loaded in %.2f s)\n", mesh, m.n, now() - t0);
 
-    KdInput in = { NULL, 0, m.t, m.n, NULL, 0, NULL, 0 };
+    KdInput in = { .triangles = m.t, .n_triangles = m.n };
     KdTree tree, tree1;
     Error err = { 0 };
     if (kd_build(&in, threads, &tree, &err) != ST_OK) { fprintf(stderr, "%s\n", err.msg); return 1; }

@@ -1,6 +1,6 @@
 /*
  * bench_revsurface.c — surfaces of revolution drawn exactly (Newton iteration in the
- * kernels, kernels/revsurface.h) against the same surfaces as triangle meshes.
+ * kernels, kernels/geom/revsurface.h) against the same surfaces as triangle meshes.
  *
  *   build/bench/bench_revsurface [--reps N] [--spp N] [--integrator whitted|path]
  *                                [--mesh STEPS AROUND] [SCENE]

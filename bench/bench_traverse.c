@@ -16,7 +16,7 @@
  *            (r = half the box diagonal): the bounding sphere just fits. Unit directions.
  *   diffuse  for each primary hit, one cosine-weighted direction about the geometric
  *            normal turned toward the camera, from the hit point offset off the surface
- *            (spawn_offset, kernels/surface.h); random numbers from rng.h keyed by
+ *            (spawn_offset, kernels/geom/surface.h); random numbers from rng.h keyed by
  *            the pixel, so the set is the same on every run.
  *   shadow   for each primary hit, one ray from the same offset point to a point light at
  *            c + 2 r * normalize(-0.5, 1, 0.35), direction = light - origin, t in (0,
@@ -71,11 +71,11 @@
 #include "io/mesh_load.h"
 #include "device/ocl_program.h"
 #include "render/render_scene.h"
-#include "rng.h"
-#include "sampling.h"
-#include "surface.h"
+#include "sample/rng.h"
+#include "sample/sampling.h"
+#include "geom/surface.h"
 #include "base/timer.h"
-#include "traverse.cl"
+#include "accel/traverse.h"
 
 #define MAX_REPS 31
 #define MAX_THREADS 2
@@ -144,7 +144,7 @@ static int mesh_open(Mesh *m, const char *name, Error *err)
     }
     m->load_seconds = timer_now() - t0;
     if (st) return -1;
-    KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0, NULL, 0 };
+    KdInput in = { .triangles = m->scene.triangles, .n_triangles = m->scene.n_triangles };
     KdTree one;
     if (kd_build(&in, 1, &one, err)) return -1;
     m->kd_build_1 = one.stats.build_seconds;
@@ -413,7 +413,8 @@ static int pocl_open(Pocl *pc, const OclDeviceInfo *dev, cl_device_id sub)
     pc->q = clCreateCommandQueue(pc->ctx, pc->info.id, 0, &rc);
     if (rc != CL_SUCCESS) return pocl_fail("clCreateCommandQueue", rc);
     Error err = { 0 };
-    Status st = ocl_program_build(pc->ctx, &pc->info, NULL, "-D CLPT_BENCH_KERNELS", &pc->prog, NULL, &err);
+    Status st = ocl_program_build_source(pc->ctx, &pc->info, clpt_bench_kernel_source,
+                                         clpt_bench_kernel_source_len, NULL, &pc->prog, NULL, &err);
     for (int kp = 0; kp < N_KERNELS && st == ST_OK; kp++) {
         st = ocl_program_kernel(pc->prog, &pc->info, pocl_kernels[kp].closest, &pc->k[kp][0], &err);
         if (st == ST_OK) st = ocl_program_kernel(pc->prog, &pc->info, pocl_kernels[kp].any, &pc->k[kp][1], &err);
@@ -781,7 +782,7 @@ static double rate(uint n, double *secs, int reps)
  * made with threads=1 builds on more.) */
 static void build_rounds(const Mesh *m, const Options *o)
 {
-    KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0, NULL, 0 };
+    KdInput in = { .triangles = m->scene.triangles, .n_triangles = m->scene.n_triangles };
     int threads = o->threads[MAX_THREADS - 1];
     double kd[MAX_REPS], bvh[MAX_REPS], em[MAX_REPS], kd_ratio[MAX_REPS], bvh_ratio[MAX_REPS];
     int n = 0;

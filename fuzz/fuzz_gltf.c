@@ -8,7 +8,7 @@
  * container apart more closely.
  */
 #include "fuzz.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/gltf.h"
 
 #include <math.h>

@@ -4,7 +4,7 @@
  * that exists.
  */
 #include "fuzz.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/obj.h"
 
 #include <math.h>

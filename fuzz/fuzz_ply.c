@@ -4,7 +4,7 @@
  * must be finite, carry the given material and point at a shading record that exists.
  */
 #include "fuzz.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/ply.h"
 
 #include <math.h>

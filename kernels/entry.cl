@@ -1,7 +1,8 @@
 /*
- * entry.cl — every __kernel of clpt. Each is a thin wrapper: it reads its work index,
+ * entry.cl — every __kernel the renderer launches (the traversal benchmark's are in
+ * bench/trace.cl, a program of their own). Each is a thin wrapper: it reads its work index,
  * gathers the scene buffers into a SceneView and calls the per-path stage functions of
- * raygen.cl, traverse.cl, shade.cl and film.cl, which the scalar C device calls too.
+ * raygen.h, traverse.h, shade_path.h and film.h, which the scalar C device calls too.
  * Queueing (which paths are still alive) happens here, not in the stage functions.
  *
  * Paths are numbered sample-major over the image: path number p renders pixel
@@ -29,25 +30,16 @@
  * (no CLPT_FEATURES: the tests), as PoCL would compile it too in every program for
  * nothing.
  */
-#include "film.cl"
-#include "raygen.cl"
-#include "shade.cl"
+#include "film/film.h"
+#include "integrator/raygen.h"
+#include "integrator/shade_path.h"
 #if KF_HAS(KF_PATH_LANES)
-#include "shade_lanes.cl"
+#include "integrator/shade_lanes.h"
 #endif
-#include "traverse.cl"
-#include "alpha.h"
-#include "whitted.cl"
-
-/* The scene buffers as __kernel parameters, one per line of scene_buffers.h, each
- * followed by a comma (every kernel taking them has parameters after them), and their
- * gathering into a SceneView named sc. */
-#define SCENE_ARG_(kind, Type, name, count, what) __global const Type *name,
-#define SCENE_ARGS SCENE_BUFFERS(SCENE_ARG_)
-#define SCENE_VIEW_SET_(kind, Type, name, count, what) sc.name = name;
-#define SCENE_VIEW(sc)                                                                   \
-    SceneView sc;                                                                        \
-    SCENE_BUFFERS(SCENE_VIEW_SET_)
+#include "accel/traverse.h"
+#include "accel/alpha.h"
+#include "integrator/whitted.h"
+#include "kernel_args.h"
 
 /* CLPT_LOCAL_SIZE (set by the renderer, device_ocl.c, when it launches every kernel with
  * that work-group size): declared on every kernel the renderer launches, so a driver
@@ -164,7 +156,7 @@ KFN_INLINE void add_group_rays(__local uint *group_rays, uint n_rays, __global u
 #endif
 
 #if KF_HAS(KF_PATH_MEGAKERNEL)
-#include "path.cl"
+#include "integrator/path.h"
 
 /* The path tracer as one kernel, the CPUs' form: each work-item runs its path from
  * birth to end, calling the stage functions in the wavefront's order (the scalar
@@ -205,7 +197,7 @@ KFN_CALL_CL uint path_run_lanes(const SceneView *sc, uint first, uint first_pixe
     uint path[PATH_LANES];
     Hit hits[PATH_LANES];
     uint result[PATH_LANES];
-    /* first-hit splitting (shade.cl), as path_run: each lane's camera ray and first hit,
+    /* first-hit splitting (shade_path.h), as path_run: each lane's camera ray and first hit,
      * and the continuations it still has to go */
     Ray first_ray[PATH_LANES];
     Hit first_hit[PATH_LANES];
@@ -255,7 +247,7 @@ KFN_CALL_CL uint path_run_lanes(const SceneView *sc, uint first, uint first_pixe
     return n_rays;
 }
 
-/* k_path with PATH_LANES paths per work-item (kernels/shade_lanes.cl): work-item i runs
+/* k_path with PATH_LANES paths per work-item (kernels/integrator/shade_lanes.h): work-item i runs
  * wave paths PATH_LANES i to PATH_LANES i + PATH_LANES - 1, tracing each live one's
  * rays in turn and shading them together, until all have ended. Each path computes the
  * bits it computes in k_path. Launched over ceil(n_paths / PATH_LANES) work-items. */
@@ -353,7 +345,7 @@ __kernel void k_layout(__global uint *out)
 #endif
 
 /* ---------------------------------------------------------------- classic ray tracer
- * The whitted integrator and the auxiliary images (kernels/whitted.cl): one work-item
+ * The whitted integrator and the auxiliary images (kernels/integrator/whitted.h): one work-item
  * computes one pixel sample whole, with its own stack of mirror and refracted rays, and
  * leaves the radiance in its path state for k_film. Path numbers are sample-major as in
  * k_raygen: work-item i is path first_pixel + i of sample first_sample. counters[0]
@@ -378,160 +370,3 @@ __kernel KERNEL_SIZE void k_whitted(SCENE_ARGS uint first_pixel, uint first_samp
     if (get_local_id(0) == 0 && group_rays) atomic_add(&counters[0], group_rays);
 }
 #endif /* KF_HAS(KF_WHITTED) */
-
-/* ------------------------------------------------------------------------------------
- * Trace-only kernels for the traversal benchmark (bench/bench_traverse.c): rays from a
- * plain array, no path state. Kept apart from the render kernels above, and compiled
- * only when the benchmark asks (-D CLPT_BENCH_KERNELS): each holds whole inlined walks,
- * which took PoCL 2.5 s of every program build.
- * ------------------------------------------------------------------------------------ */
-#ifdef CLPT_BENCH_KERNELS
-
-/* Closest hits of rays[2i] and rays[2i+1], walked in turns (trace_closest2). */
-__kernel void k_trace_closest(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
-{
-    uint a = 2u * (uint)get_global_id(0), b = a + 1u;
-    if (a >= n) return;
-    SCENE_VIEW(sc);
-    if (b < n) {
-        Hit ha, hb;
-        trace_closest2(&sc, rays[a], rays[b], &ha, &hb);
-        hits[a] = ha;
-        hits[b] = hb;
-    } else {
-        hits[a] = trace_closest_in(&sc, TREE_KD, rays[a]);
-    }
-}
-
-/* Whether rays[2i] and rays[2i+1] hit anything, into occluded[] (1 or 0). */
-__kernel void k_trace_any(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
-{
-    uint a = 2u * (uint)get_global_id(0), b = a + 1u;
-    if (a >= n) return;
-    SCENE_VIEW(sc);
-    if (b < n) {
-        int oa, ob;
-        trace_any2(&sc, rays[a], rays[b], &oa, &ob);
-        occluded[a] = (uint)oa;
-        occluded[b] = (uint)ob;
-    } else {
-        occluded[a] = (uint)trace_any_in(&sc, TREE_KD, rays[a]);
-    }
-}
-
-/* The closest hit of rays[i] (any == 0) or whether it hits anything (any == 1), through
- * the given tree (trace_closest as k_intersect, trace_any as k_shadow). */
-KFN_INLINE void trace_one_ray(const SceneView *sc, __global const Ray *rays, uint i, int tree, int any,
-                              __global Hit *hits, __global uint *occluded)
-{
-    if (any) occluded[i] = (uint)trace_any_in(sc, tree, rays[i]);
-    else hits[i] = trace_closest_in(sc, tree, rays[i]);
-}
-
-/* One ray per work-item. */
-KFN_INLINE void trace_one_item(const SceneView *sc, __global const Ray *rays, uint n, int tree, int any,
-                               __global Hit *hits, __global uint *occluded)
-{
-    uint i = (uint)get_global_id(0);
-    if (i < n) trace_one_ray(sc, rays, i, tree, any, hits, occluded);
-}
-
-__kernel void k_trace_closest1(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
-{
-    SCENE_VIEW(sc);
-    trace_one_item(&sc, rays, n, TREE_KD, 0, hits, 0);
-}
-
-__kernel void k_trace_any1(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
-{
-    SCENE_VIEW(sc);
-    trace_one_item(&sc, rays, n, TREE_KD, 1, 0, occluded);
-}
-
-/* Closest hits (any == 0) or occlusion (any == 1: 1 or 0 in hits[i].prim's place, as
- * occluded[]) of rays[8i .. 8i+7], walked as one packet through the given tree
- * (trace_packet, trace_packet_wide). */
-KFN_INLINE void trace_packet_item(const SceneView *sc, __global const Ray *rays, uint n, int tree, int any,
-                                  __global Hit *hits, __global uint *occluded)
-{
-    uint first = TRACE_PACKET * (uint)get_global_id(0);
-    if (first >= n) return;
-    Ray r[TRACE_PACKET];
-    Hit h[TRACE_PACKET];
-    uint count = n - first < TRACE_PACKET ? n - first : TRACE_PACKET;
-    for (uint l = 0; l < TRACE_PACKET; l++) {
-        r[l] = rays[first + (l < count ? l : 0u)];
-        /* a short last packet repeats its first ray, whose answer is then not stored */
-    }
-    if (tree == TREE_BVH) trace_packet_wide(sc, r, any, h);
-    else trace_packet(sc, r, any, h);
-    for (uint l = 0; l < count; l++) {
-        if (any) occluded[first + l] = (uint)(h[l].prim != NO_INDEX);
-        else hits[first + l] = h[l];
-    }
-}
-
-__kernel void k_trace_closest8(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
-{
-    SCENE_VIEW(sc);
-    trace_packet_item(&sc, rays, n, TREE_KD, 0, hits, 0);
-}
-
-__kernel void k_trace_any8(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
-{
-    SCENE_VIEW(sc);
-    trace_packet_item(&sc, rays, n, TREE_KD, 1, 0, occluded);
-}
-
-/* The same through the 8-wide BVH (trace_packet_wide). */
-__kernel void k_trace_closest_wide8(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
-{
-    SCENE_VIEW(sc);
-    trace_packet_item(&sc, rays, n, TREE_BVH, 0, hits, 0);
-}
-
-__kernel void k_trace_any_wide8(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
-{
-    SCENE_VIEW(sc);
-    trace_packet_item(&sc, rays, n, TREE_BVH, 1, 0, occluded);
-}
-
-/* The same through the 8-wide BVH. */
-__kernel void k_trace_closest_wide(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
-{
-    SCENE_VIEW(sc);
-    trace_one_item(&sc, rays, n, TREE_BVH, 0, hits, 0);
-}
-
-__kernel void k_trace_any_wide(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
-{
-    SCENE_VIEW(sc);
-    trace_one_item(&sc, rays, n, TREE_BVH, 1, 0, occluded);
-}
-
-/* Closest hits (any == 0) or occlusion (any == 1) of rays[PATH_LANES i] to
- * rays[PATH_LANES i + PATH_LANES - 1], walked one after another in one work-item through
- * the BVH: the form in which k_path_lanes, the renderer's kernel on CPUs, calls the walk
- * (its lanes' rays in turn). PoCL computes the addresses of a work-item's private
- * arrays, the walk's stack among them, once per item: k_trace_closest_wide pays that
- * per ray. */
-KFN_INLINE void trace_lanes_item(const SceneView *sc, __global const Ray *rays, uint n, int any,
-                                 __global Hit *hits, __global uint *occluded)
-{
-    uint first = PATH_LANES * (uint)get_global_id(0);
-    for (uint i = first; i < first + PATH_LANES && i < n; i++)
-        trace_one_ray(sc, rays, i, TREE_BVH, any, hits, occluded);
-}
-
-__kernel void k_trace_closest_lanes(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
-{
-    SCENE_VIEW(sc);
-    trace_lanes_item(&sc, rays, n, 0, hits, 0);
-}
-
-__kernel void k_trace_any_lanes(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
-{
-    SCENE_VIEW(sc);
-    trace_lanes_item(&sc, rays, n, 1, 0, occluded);
-}
-#endif /* CLPT_BENCH_KERNELS */

@@ -12,7 +12,7 @@
 #ifndef CLPT_TYPES_H
 #define CLPT_TYPES_H
 
-#include "compat.h"
+#include "util/compat.h"
 
 /* Sentinel for "no index" in any uint field (no light, no shading record, a miss). */
 #define NO_INDEX 0xffffffffu
@@ -48,10 +48,10 @@
 /* 0x800u ... 0x20000u and 0x800000u: material types, each its own switch, named
  * KF_MAT_DIFFUSE ... (MATERIAL_TYPES below; KF_MATERIAL(MAT_DIFFUSE) is the same) */
 #define KF_PATH_MEGAKERNEL 0x80000u     /* the path tracer as one kernel (k_path, k_film) */
-#define KF_KDTREE 0x100000u     /* the scene's tree is the kd-tree (kernels/traverse.cl) */
-#define KF_BVH 0x200000u        /* ... the 8-wide BVH (kernels/traverse_wide.cl) */
+#define KF_KDTREE 0x100000u     /* the scene's tree is the kd-tree (kernels/accel/traverse.h) */
+#define KF_BVH 0x200000u        /* ... the 8-wide BVH (kernels/accel/traverse_bvh.h) */
 #define KF_PATH_LANES 0x400000u /* the megakernel eight paths at a time (k_path_lanes, k_film;
-                                 * kernels/shade_lanes.cl): CPUs, scenes it shades fast */
+                                 * kernels/integrator/shade_lanes.h): CPUs, scenes it shades fast */
 #define KF_SPHERE_XFORM 0x1000000u /* a sphere under a transform (an ellipsoid, SphereXform) */
 /* every bit above and every material type's */
 #define KF_ALL (KF_PATH | KF_WHITTED | KF_TEXTURES | KF_ALPHA | KF_ENV_MAP | KF_CUBEMAP | KF_REVSURFACE | \
@@ -71,11 +71,11 @@
  * Every material type, one line each, X(name, value, feature bit, traits, lobes):
  *   name, value  its enum MaterialType constant, stored in Material.type
  *   feature bit  the KF_ switch that compiles its code in (a free bit of the list
- *                above); 0: always compiled (the mix, which kernels/mix.h resolves
+ *                above); 0: always compiled (the mix, which kernels/material/mix.h resolves
  *                before anything asks what it scatters)
  *   traits       MT_* below: what the integrators ask of a type as a whole
  *   lobes        the stem of its scattering functions, <lobes>_bsdf_has_density,
- *                _bsdf_eval and _bsdf_sample, which kernels/bsdf.h dispatches to; they
+ *                _bsdf_eval and _bsdf_sample, which kernels/bsdf/bsdf.h dispatches to; they
  *                live in the header of its lobe family (docs/design.md, "Materials")
  * The enum, the KF_MAT_* switches, KF_ALL, the trait predicates, the dispatch and the
  * host's feature scan (host/device/kernel_features.c) are generated from it.
@@ -92,18 +92,18 @@
  *   MAT_PHONG       albedo = diffuse colour, specular, shininess, plus mirror
  *                   (`reflective`) and Fresnel-weighted see-through (`transparent`,
  *                   ior) parts: the classic ray tracer's material (docs/classic-format.md)
- *   MAT_CONDUCTOR   GGX metal (kernels/conductor.h): complex index eta + i k, or Schlick
+ *   MAT_CONDUCTOR   GGX metal (kernels/bsdf/conductor.h): complex index eta + i k, or Schlick
  *                   from F0 = specular (MAT_F0); tinted by albedo; roughness,
  *                   anisotropy; smooth: a Fresnel mirror
- *   MAT_PRINCIPLED  glTF metallic-roughness (kernels/principled.h): base colour =
+ *   MAT_PRINCIPLED  glTF metallic-roughness (kernels/bsdf/principled.h): base colour =
  *                   albedo, metallic, roughness, transmission + ior (MAT_THIN),
  *                   clearcoat + clearcoat_roughness, specular_factor + specular_color,
  *                   sheen_color + sheen_roughness, and inside a solid (not MAT_THIN)
  *                   Beer-Lambert absorption
- *   MAT_MIX         pbrt's mix (kernels/mix.h): at each hit either material mix_a or,
+ *   MAT_MIX         pbrt's mix (kernels/material/mix.h): at each hit either material mix_a or,
  *                   with probability amount, mix_b scatters; its own emission and
  *                   MAT_TWO_SIDED are what the surface emits
- *   MAT_LAYERED     pbrt-v4's coated materials (kernels/layered.h): a dielectric
+ *   MAT_LAYERED     pbrt-v4's coated materials (kernels/bsdf/layered.h): a dielectric
  *                   interface (ior, roughness, anisotropy) over a base (layer_base:
  *                   Lambertian albedo, or a conductor eta + i k with base_roughness,
  *                   base_anisotropy), a medium between (layer_*)
@@ -202,7 +202,7 @@ typedef struct {
 #define KD_GROUP 8u
 #define KD_GROUP_WORDS (KD_GROUP * 10u)
 
-/* A node of the 8-wide BVH (host/accel/bvh.c, walked by kernels/traverse_wide.cl):
+/* A node of the 8-wide BVH (host/accel/bvh.c, walked by kernels/accel/traverse_bvh.h):
  * the boxes of up to BVH_WIDTH children as six rows of 8 lanes (lo x, hi x, lo y, hi y,
  * lo z, hi z: the layout one float8 load per row wants), and per child a reference and
  * its kind: BVH_CHILD_NONE for an unused lane (its box is empty: lo +inf, hi -inf),
@@ -285,7 +285,7 @@ typedef struct {                                        /* 32 bytes */
     vec3 hi;  uint light;
 } Box;
 
-/* A surface of revolution (kernels/revsurface.h): a profile curve (x(s), y(s)) in the
+/* A surface of revolution (kernels/geom/revsurface.h): a profile curve (x(s), y(s)) in the
  * xy plane revolved about the vertical axis x = axis_x, z = axis_z. The profile is
  * n_segments Bezier segments of `degree`, stored as (x, y) float pairs in rev_points
  * from pair `first` on; consecutive segments share their end point, so the surface
@@ -368,7 +368,7 @@ typedef struct {                                        /* 288 bytes */
 #define MAT_THIN 4u             /* dielectric: a thin sheet, no bend on refraction */
 #define MAT_ALPHA_MASK 8u       /* glTF alphaMode MASK: cut out where alpha < alpha_cutoff */
 #define MAT_ALPHA_BLEND 16u     /* glTF alphaMode BLEND: a hit is kept with probability
-                                 * alpha (kernels/alpha.h) */
+                                 * alpha (kernels/accel/alpha.h) */
 
 /* Area lights are the emissive primitives; point, spot and directional lights are
  * delta lights (a single direction reaches a point: no MIS, hard shadows). */
@@ -378,7 +378,7 @@ enum LightType { LIGHT_AREA = 0, LIGHT_POINT = 1, LIGHT_DIRECTIONAL = 2, LIGHT_S
  * proportionally to its estimated power (host/scene/scene.c). Area lights come first
  * (RenderParams.n_area_lights of them), then the delta lights, then the environment
  * map's light (LIGHT_ENV, RenderParams.bg_light) when the background is a map with any
- * light in it; its other fields are unused (kernels/envmap.h reads the map).
+ * light in it; its other fields are unused (kernels/light/envmap.h reads the map).
  * A delta light's `intensity` is radiant intensity (point, spot: W/sr) or irradiance
  * (directional: W/m^2 across the beam); point and spot lights are divided by the
  * attenuation atten0 + atten1*d + atten2*d^2 at distance d (inverse square: 0 0 1). */
@@ -435,7 +435,7 @@ typedef struct {                                        /* 112 bytes */
     vec3 forward;     float pad4;   /* unit view direction */
 } Camera;
 
-/* Textures (kernels/texture.h), in one table; image texels live in one uint array. */
+/* Textures (kernels/material/texture.h), in one table; image texels live in one uint array. */
 enum TextureType {
     TEX_IMAGE = 0,       /* bilinear lookup of width x height texels at offset */
     TEX_CHECKER = 1      /* color0/color1 alternating on unit cells of texture space */
@@ -476,11 +476,11 @@ typedef struct {                                        /* 112 bytes */
 enum BackgroundType { BG_CONSTANT = 0, BG_SKY = 1, BG_CUBEMAP = 2, BG_MAP = 3 };
 
 /* A cube-map background is six consecutive image textures from
- * RenderParams.bg_cubemap on, in the course's order (kernels/background.h). */
+ * RenderParams.bg_cubemap on, in the course's order (kernels/light/background.h). */
 enum CubeFace { CUBE_LEFT = 0, CUBE_RIGHT = 1, CUBE_UP = 2, CUBE_DOWN = 3, CUBE_FRONT = 4, CUBE_BACK = 5 };
 
 /* What a sample computes: light transport (path, whitted) or an auxiliary image of the
- * first hit (kernels/whitted.cl). */
+ * first hit (kernels/integrator/whitted.h). */
 enum Integrator {
     INTEGRATOR_PATH = 0,
     INTEGRATOR_WHITTED = 1,
@@ -493,7 +493,7 @@ enum Integrator {
  * heuristic, or one alone (tests/test_mis.c checks that all three agree). */
 enum MisMode { MIS_BOTH = 0, MIS_LIGHT_ONLY = 1, MIS_BSDF_ONLY = 2 };
 
-/* Where a path's random numbers come from (kernels/rng.h, --sampler). */
+/* Where a path's random numbers come from (kernels/sample/rng.h, --sampler). */
 enum Sampler { SAMPLER_SOBOL = 0, SAMPLER_INDEPENDENT = 1 };
 
 /* Everything constant over a render, uploaded once per device. */
@@ -503,7 +503,7 @@ typedef struct {                                        /* 304 bytes */
                                        * BG_MAP: the map's scale (intensity) */
     vec3 bg_zenith;   uint bg_cubemap;  /* sky colour straight up (+y); BG_CUBEMAP: the
                                        * texture index of its first face (CUBE_LEFT);
-                                       * BG_MAP: the map's texture (kernels/envmap.h) */
+                                       * BG_MAP: the map's texture (kernels/light/envmap.h) */
     uint width, height;
     uint max_depth;                   /* longest path, in bounces after the camera ray */
     uint rr_depth;                    /* Russian roulette starts at this bounce */
@@ -513,7 +513,7 @@ typedef struct {                                        /* 304 bytes */
     uint n_nodes, n_leaf_prims;
     vec3 bounds_lo;   uint n_revsurfaces; /* box of the tree's root; RevSurface count */
     vec3 bounds_hi;   uint sampler;   /* enum Sampler */
-    /* integrators and light kinds of the classic ray tracer (kernels/whitted.cl) */
+    /* integrators and light kinds of the classic ray tracer (kernels/integrator/whitted.h) */
     vec3 ambient;     uint integrator;  /* whitted: ambient light; enum Integrator */
     uint mis_mode;                    /* enum MisMode */
     uint n_area_lights;               /* lights[0 .. n_area_lights) are area lights */
@@ -531,7 +531,7 @@ typedef struct {                                        /* 304 bytes */
     uint bg_light;                    /* BG_MAP: its light in lights[] (sampled by
                                        * next-event estimation), or NO_INDEX */
     uint split;                       /* path: continuations per camera sample from its
-                                       * first hit (>= 1; shade.cl, first-hit splitting) */
+                                       * first hit (>= 1; shade_path.h, first-hit splitting) */
     uint pad_split0, pad_split1, pad_split2;
 } RenderParams;
 

@@ -1,6 +1,6 @@
 /*
  * test_alpha.c — see-through principled surfaces (alpha_mode mask and blend,
- * kernels/alpha.h) and principled emission textures, rendered whole: analytic pixels
+ * kernels/accel/alpha.h) and principled emission textures, rendered whole: analytic pixels
  * for a mask, the expected mean of a blend, and PoCL against the scalar device bit for
  * bit. Run from the project root.
  *
@@ -17,7 +17,7 @@
 #include <stb_image_write.h>
 
 #include "harness.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "render_util.h"
 
 static char tmp_dir[64];

@@ -18,7 +18,7 @@
 #include <string.h>
 
 #include "harness.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/mesh_load.h"
 #include "io/mtl.h"
 #include "io/obj.h"

@@ -1,5 +1,5 @@
 /*
- * test_bsdf.c — the microfacet BSDFs of kernels/microfacet.h, run as C (the scalar
+ * test_bsdf.c — the microfacet BSDFs of kernels/bsdf/microfacet.h, run as C (the scalar
  * build of the kernel source; tests/test_kernels.c compares it with OpenCL bit for bit):
  *  - chi-square goodness of fit of sampled directions against the density the BSDF
  *    reports, as pbrt-v4 and Mitsuba test theirs: a (cos theta, phi) grid over the whole
@@ -21,7 +21,7 @@
 #include <stdlib.h>
 
 #include "harness.h"
-#include "bsdf.h"
+#include "bsdf/bsdf.h"
 #include "render_util.h"
 #include "texture_util.h"
 #include "io/texture.h"
@@ -1185,7 +1185,7 @@ static void test_valid_normal(void)
  * slant, each dome's far rim carries normals that face away from the camera though
  * they still face a light from behind the domes. A BSDF evaluated in such a frame has
  * wo below its horizon and returns 0, which drew black fringes; production renderers
- * bend such normals back (Cycles' ensure_valid_reflection), and so does shade.cl. */
+ * bend such normals back (Cycles' ensure_valid_reflection), and so does shade_path.h. */
 enum { DOME_TEX = 128, DOME_CELLS = 4, DOME_W = 128, DOME_H = 64 };
 #define DOME_RADIUS 0.45f    /* of a cell */
 #define DOME_VIEW_ELEVATION 0.9f    /* radians above the square: the camera ... */
@@ -1382,7 +1382,7 @@ static void test_normal_map_domes(void)
 }
 
 /* ---------------------------------------------------------------- layered (coated)
- * pbrt-v4's coated materials (kernels/layered.h): stochastic, so each check compares
+ * pbrt-v4's coated materials (kernels/bsdf/layered.h): stochastic, so each check compares
  * means within their noise. */
 
 static Layered layered_of(Material m) { return bsdf_layered(m, m.albedo); }
@@ -1569,7 +1569,7 @@ static void test_layered_pdf_histogram(void)
  * optical thickness tau (extinction 1), albedo a, Henyey-Greenstein g between; light
  * arrives from wo (cos mu_o). Each particle is followed in depth and direction until it
  * leaves through the top or is absorbed; the fraction that leaves is the BSDF's albedo
- * for wo. Written from the physics, sharing no code with kernels/layered.h. */
+ * for wo. Written from the physics, sharing no code with kernels/bsdf/layered.h. */
 static unsigned long long slab_rng = 0x853c49e6748fea9bull;
 static double slab_rand(void)
 {
@@ -1680,7 +1680,7 @@ static void test_layered_vs_particles(void)
  * which with visible normals is the particle's weight times G2(a, b) / G1(a) (light
  * multiply scattered among the facets is outside that model: pbrt drops it too). A
  * particle sent below the surface on reflection (or back up on refraction) is lost, as
- * the BSDF has no value there. Independent of kernels/layered.h and microfacet.h: the
+ * the BSDF has no value there. Independent of kernels/bsdf/layered.h and microfacet.h: the
  * visible normals by Dupuy and Benyoub 2023's spherical caps, not Heitz 2018's
  * mapping; in double; the underside met in a frame mirrored in z, not turned over. */
 typedef struct {

@@ -17,7 +17,7 @@
 #include "base/limit.h"
 #include "io/classic_parse.h"
 #include "io/scene_load.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "scene/mesh_sink.h"
 #include "scene/scene.h"
 

@@ -1,5 +1,5 @@
 /*
- * test_cubemap.c — `cubeMap DIR` backgrounds (kernels/background.h, the course's
+ * test_cubemap.c — `cubeMap DIR` backgrounds (kernels/light/background.h, the course's
  * CubeMap): six solid-colour faces written for the test; a camera looking along each
  * axis sees exactly that face's bytes at its centre pixel, in the classic ray tracer and
  * in the path tracer; a mirror sphere shows the face behind the camera; the face
@@ -21,7 +21,7 @@
 #include "io/scene_load.h"
 #include "io/texture.h"
 #include "scene/cube_env.h"
-#include "background.h"
+#include "light/background.h"
 
 #include <stb_image_write.h>
 

@@ -1,6 +1,6 @@
 /*
  * test_curves.c — the curves and surfaces of revolution of Tsinghua's PA2/PA3 format
- * (host/scene/curve.c, kernels/revsurface.h): curve points against closed forms, the
+ * (host/scene/curve.c, kernels/geom/revsurface.h): curve points against closed forms, the
  * B-spline's basis and its Bezier pieces, ray hits and normals on profiles whose surface
  * is known (a cylinder, a cone, a paraboloid), the same bits on PoCL and the scalar
  * device, renders of the exact surface against a fine mesh of it, and the reader.
@@ -18,8 +18,8 @@
 #include "harness.h"
 #include "render_util.h"
 
-#include "intersect.h"
-#include "surface.h"
+#include "geom/intersect.h"
+#include "geom/surface.h"
 #include "io/classic_parse.h"
 #include "scene/curve.h"
 

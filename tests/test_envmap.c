@@ -1,5 +1,5 @@
 /*
- * test_envmap.c — the environment map (kernels/envmap.h, host/scene/env_dist.c,
+ * test_envmap.c — the environment map (kernels/light/envmap.h, host/scene/env_dist.c,
  * host/io/exr.c): its orientation, its sampling against its density (chi-square over
  * the map's pixels), the density against light_pdf, a furnace (diffuse spheres in a
  * constant map render albedo x the map), MIS against light sampling alone and BSDF
@@ -14,7 +14,7 @@
 #include "render_util.h"
 #include "io/exr.h"
 #include "io/texture.h"
-#include "lights.h"
+#include "light/lights.h"
 #include "scene/env_dist.h"
 #include "texture_util.h"
 
@@ -550,7 +550,7 @@ static uint check_cdf_search(const float *cdf, const float *guide, uint n)
 /* The guide tables env_dist_build writes lead env_cdf_find to the cell a plain walk
  * finds, for maps of 1 to 1024 pixels a row with runs of black pixels (cells of zero
  * probability, where the cdf repeats), single bright pixels and black rows; and the
- * distribution holds exactly the cdfs and guides that kernels/envmap.h lays out. */
+ * distribution holds exactly the cdfs and guides that kernels/light/envmap.h lays out. */
 static void test_guided_search_finds_the_walks_cell(void)
 {
     static const uint sizes[][2] = { { 1, 1 }, { 2, 1 }, { 3, 2 }, { 5, 3 }, { 8, 4 }, { 9, 7 }, { 37, 5 },

@@ -15,14 +15,14 @@
 #include <unistd.h>
 
 #include "harness.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/gltf.h"
 #include "io/mesh_load.h"
 #include "io/scene_load.h"
 #include "render_util.h"
 
-#include "shade.cl"     /* the kernels' shading functions, compiled as C (test_extras) */
-#include "alpha.h"
+#include "integrator/shade_path.h"     /* the kernels' shading functions, compiled as C (test_extras) */
+#include "accel/alpha.h"
 
 #define DIR_GLTF "tests/data/gltf/"
 #define SHARED "../shared/models/"
@@ -116,7 +116,7 @@ static void test_volume_specular_sheen(void)
     scene_free(&s);
 }
 
-/* alphaMode and alphaCutoff become the principled material's alpha mode (kernels/alpha.h
+/* alphaMode and alphaCutoff become the principled material's alpha mode (kernels/accel/alpha.h
  * renders them; test_alpha.c checks the pixels); emissiveTexture its emission texture. */
 static void test_alpha_modes(void)
 {

@@ -1,7 +1,7 @@
 /*
  * test_kdtree.c -- the two trees: the kd-tree build (host/accel/kdtree.c) and the 8-wide
- * BVH build (host/accel/bvh.c), the primitive intersections (kernels/intersect.h) and
- * both walks (kernels/traverse.cl and traverse_wide.cl, compiled here as C).
+ * BVH build (host/accel/bvh.c), the primitive intersections (kernels/geom/intersect.h) and
+ * both walks (kernels/accel/traverse.h and traverse_bvh.h, compiled here as C).
  *
  * Each tree's structure is checked directly (nesting, which primitives each leaf must
  * hold, the statistics), and the walks against brute force: every primitive tested
@@ -15,8 +15,8 @@
 #include "accel/kdtree.h"
 #include "io/mesh_load.h"
 #include "scene/transform.h"
-#include "surface.h"
-#include "traverse.cl"
+#include "geom/surface.h"
+#include "accel/traverse.h"
 
 /* ------------------------------------------------------------------ helpers */
 

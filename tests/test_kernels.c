@@ -23,11 +23,11 @@
 #include "io/texture.h"
 
 /* the kernel stage functions, compiled as C: the reference */
-#include "film.cl"
-#include "raygen.cl"
-#include "shade.cl"
-#include "traverse.cl"
-#include "whitted.cl"
+#include "film/film.h"
+#include "integrator/raygen.h"
+#include "integrator/shade_path.h"
+#include "accel/traverse.h"
+#include "integrator/whitted.h"
 
 /* Scene buffers every kernel takes first (SCENE_ARGS in entry.cl). */
 #define N_SCENE SCENE_BUF_COUNT
@@ -203,7 +203,7 @@ static void build_scene(void)
     pm.texture_normal = tex[1];
     pm.normal_scale = 0.8f;
     scene_add_material(&scene, "coated", pm, &coated, NULL);
-    /* pbrt's coated materials (kernels/layered.h): textured plastic in a scattering
+    /* pbrt's coated materials (kernels/bsdf/layered.h): textured plastic in a scattering
      * medium under a rough coat, and a coated rough conductor */
     uint lacquer, coated_metal;
     Material lm = material_coated_diffuse(v3(0.7f, 0.3f, 0.2f), 0.3f);
@@ -711,7 +711,7 @@ static void test_intersect(void)
     clReleaseMemObject(hb);
 }
 
-/* The trace-only kernels bench_traverse times (-D CLPT_BENCH_KERNELS): one ray per
+/* The trace-only kernels bench_traverse times (kernels/bench/trace.cl): one ray per
  * work-item, two in turns (trace_closest2 / trace_any2), eight one after another (the
  * BVH walk as k_path_lanes calls it) and packets of eight (trace_packet;
  * trace_packet_wide through the BVH), closest hits and occlusion, against the C walk bit
@@ -765,7 +765,8 @@ static void test_trace_kernels(void)
     cl_program prog = NULL;
     OclProgramStats ps;
     Error err = { 0 };
-    Status st = ocl_program_build(cl.ctx, &cl.dev, NULL, "-D CLPT_BENCH_KERNELS", &prog, &ps, &err);
+    Status st = ocl_program_build_source(cl.ctx, &cl.dev, clpt_bench_kernel_source,
+                                         clpt_bench_kernel_source_len, NULL, &prog, &ps, &err);
     CHECK_MSG(st == ST_OK, "%s\n%s", err.msg, err.detail ? err.detail : "");
     fprintf(stderr, "  the traversal kernels %s in %.2f s\n", ps.from_cache ? "loaded from the cache" : "built",
             ps.seconds);
@@ -1163,7 +1164,7 @@ static cl_program build_test_program(const char *source)
 static void test_fp_semantics(void)
 {
     cl_program prog = build_test_program(
-        "#include \"compat.h\"\n"
+        "#include \"util/compat.h\"\n"
         "__kernel void k_fp(__global const float *in, __global float *out, uint n)\n"
         "{\n"
         "    uint i = (uint)get_global_id(0);\n"
@@ -1214,7 +1215,7 @@ static void test_fp_semantics(void)
  * on every input, subnormals, zeros and the extremes included. */
 static void test_kmath(void)
 {
-    cl_program prog = build_test_program("#include \"kmath.h\"\n"
+    cl_program prog = build_test_program("#include \"util/kmath.h\"\n"
           "__kernel void k_math(__global const float *in, __global float *out, uint n)\n"
           "{\n"
           "    uint i = (uint)get_global_id(0);\n"
@@ -1270,7 +1271,7 @@ static void test_kmath(void)
     clReleaseProgram(prog);
 }
 
-/* The BSDF dispatch of kernels/bsdf.h (bsdf_eval and bsdf_sample over every material
+/* The BSDF dispatch of kernels/bsdf/bsdf.h (bsdf_eval and bsdf_sample over every material
  * type, the microfacet lobes of microfacet.h under them), through a test kernel built
  * from a folder holding just an entry.cl that includes bsdf.h: the same bits as the C
  * build for random directions, grazing and back-facing ones included; and the shading
@@ -1294,7 +1295,7 @@ static void bsdf_reference(const Material *mats, uint n_mats, uint i, const floa
 
 static void test_bsdf(void)
 {
-    cl_program prog = build_test_program("#include \"bsdf.h\"\n"
+    cl_program prog = build_test_program("#include \"bsdf/bsdf.h\"\n"
           "__kernel void k_bsdf(__global const Material *mats, uint n_mats, __global const float *in,\n"
           "                     __global float *out, uint n)\n"
           "{\n"

@@ -6,7 +6,7 @@
 #include "harness.h"
 
 #include "cli_util.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/mesh_load.h"
 #include "io/mesh_text.h"
 #include "io/mesh_view.h"

@@ -14,9 +14,9 @@
 #include <string.h>
 
 #include "harness.h"
-#include "kmath.h"
-#include "lights.h"
-#include "surface.h"
+#include "util/kmath.h"
+#include "light/lights.h"
+#include "geom/surface.h"
 #include "render_util.h"
 
 enum { W = 32, H = 24, BLOCK = 8 };
@@ -179,7 +179,7 @@ static void test_mis_phong(void)
                            material_phong(v3(0.1f, 0.1f, 0.1f), v3(0.8f, 0.8f, 0.8f), 200.0f), 512, 0.025, 0.2, 0.35);
 }
 
-/* The microfacet lobes (kernels/microfacet.h, principled.h) the same way: light
+/* The microfacet lobes (kernels/bsdf/microfacet.h, principled.h) the same way: light
  * sampling evaluates bsdf_eval, BSDF sampling uses bsdf_sample and its density. */
 static void test_mis_microfacet(void)
 {

@@ -3,7 +3,7 @@
  * materials and their mapping onto ours, texture paths, transforms. */
 #include "harness.h"
 
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/mtl.h"
 #include "io/obj.h"
 

@@ -11,7 +11,7 @@
 
 #include "cli_util.h"
 #include "harness.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/pbrt_parse.h"
 #include "io/scene_load.h"
 #include "render_util.h"
@@ -121,7 +121,7 @@ static void test_transforms(void)
     scene_free(&s);
 }
 
-/* coateddiffuse and coatedconductor become MAT_LAYERED (kernels/layered.h) with each
+/* coateddiffuse and coatedconductor become MAT_LAYERED (kernels/bsdf/layered.h) with each
  * of pbrt-v4's parameters, and pbrt's defaults where none is given. */
 static void test_coated(void)
 {
@@ -916,7 +916,7 @@ static double mix_floor_mean(const char *amount, const char *device, Film *keep)
     return mean;
 }
 
-/* pbrt's mix picks one material per hit (kernels/mix.h): amount 0 and 1 are the first
+/* pbrt's mix picks one material per hit (kernels/material/mix.h): amount 0 and 1 are the first
  * and second exactly, 0.5 (a float or a float texture) half of each on average, and
  * the choice is the same on PoCL and the scalar device. */
 static void test_mix(void)

@@ -2,7 +2,7 @@
  * element order, and the messages for malformed files (tests/data/ply, generate.py). */
 #include "harness.h"
 
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/lexer.h"
 #include "io/ply.h"
 

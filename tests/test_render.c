@@ -6,7 +6,7 @@
 #include <stdlib.h>
 
 #include "harness.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "render_util.h"
 
 /* A diffuse sphere of albedo 0.5 that also emits 0.5, seen from its centre: the

@@ -1,5 +1,5 @@
 /*
- * test_sampler.c — the Sobol sampler of kernels/rng.h: the unscrambled sequence is
+ * test_sampler.c — the Sobol sampler of kernels/sample/rng.h: the unscrambled sequence is
  * Sobol's (its first points, and every point against the direction-number definition),
  * values lie in [0, 1), every 2D pair of dimensions is a (0,2)-sequence after scrambling
  * and shuffling (each elementary interval holds one point of every aligned block of
@@ -18,7 +18,7 @@
 #include "device/ocl_program.h"
 #include "io/scene_load.h"
 #include "render_util.h"
-#include "rng.h"
+#include "sample/rng.h"
 
 /* Sobol dimension 1 by its definition: the XOR of direction numbers v_k = m_k / 2^(k+1)
  * over the set bits k of the index. Joe and Kuo's table (new-joe-kuo-6.21201) gives
@@ -183,7 +183,7 @@ static void test_decorrelation(void)
 /* ------------------------------------------------------------ OpenCL against C */
 
 static const char *kernel_src =
-    "#include \"rng.h\"\n"
+    "#include \"sample/rng.h\"\n"
     "__kernel void k_rng(__global const RenderParams *p, __global uint *out, uint n_samples)\n"
     "{\n"
     "    uint i = (uint)get_global_id(0);\n"

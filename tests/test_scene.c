@@ -2,7 +2,7 @@
  * and the error messages for malformed input. Run from the project root. */
 #include "harness.h"
 
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/lexer.h"
 #include "scene/scene.h"
 

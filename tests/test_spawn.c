@@ -15,7 +15,7 @@
 #include <stdlib.h>
 
 #include "harness.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "render_util.h"
 
 #define FURNACE_ALBEDO 0.5

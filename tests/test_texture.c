@@ -1,5 +1,5 @@
 /*
- * test_texture.c — texture lookups (kernels/texture.h) and image loading (host/io/texture.c):
+ * test_texture.c — texture lookups (kernels/material/texture.h) and image loading (host/io/texture.c):
  * the sRGB decoding and the other functions of kmath.h built from + - * / sqrt against
  * libm in double, bilinear filtering at known points, repeat, clamp and mirror per axis,
  * nearest, checkerboards,
@@ -12,7 +12,7 @@
 
 #include "harness.h"
 
-#include "shade.cl"     /* kernels/texture.h and what it needs, compiled as C */
+#include "integrator/shade_path.h"     /* kernels/material/texture.h and what it needs, compiled as C */
 #include "io/texture.h"    /* host/io/texture.h: this folder's include path finds host/ first */
 #include "scene/texel_pack.h"
 #include "texture_util.h"

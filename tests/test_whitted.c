@@ -1,5 +1,5 @@
 /*
- * test_whitted.c — the classic ray tracer (kernels/whitted.cl) against closed forms:
+ * test_whitted.c — the classic ray tracer (kernels/integrator/whitted.h) against closed forms:
  * a diffuse plane under a point light has the irradiance of the inverse-square-free
  * (and the attenuated) classic light at every pixel; a Phong highlight peaks where the
  * mirror direction meets the eye; points in shadow get no direct light; spot and
@@ -19,7 +19,7 @@
 #include "io/classic_parse.h"
 #include "io/image_write.h"
 #include "render/passes.h"
-#include "whitted.cl"
+#include "integrator/whitted.h"
 
 #define KD_R 0.8
 #define KD_G 0.6

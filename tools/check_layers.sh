@@ -44,11 +44,14 @@ for f in host/*.[ch] host/*/*.[ch]; do
     fi
     # shellcheck disable=SC2013
     for inc in $(sed -n 's/^[[:space:]]*#[[:space:]]*include[[:space:]]*"\([^"]*\)".*/\1/p' "$f"); do
+        # the kernels (compiled as C by the scalar device, their types and maths shared
+        # with the host) sit below every layer
+        if [ -f "kernels/$inc" ]; then continue; fi
         case "$inc" in
             */*) layer=${inc%%/*} ;;
             *)
-                # a bare name is a kernels/ header or a header of the app layer
-                if [ -f "kernels/$inc" ] || [ -f "$dir/$inc" -a "$own" = app ]; then continue; fi
+                # a bare name is a header of the app layer
+                if [ -f "$dir/$inc" ] && [ "$own" = app ]; then continue; fi
                 echo "check_layers: $f includes \"$inc\": name the layer (\"LAYER/$inc\")" >&2
                 bad=1
                 continue ;;
@@ -62,6 +65,14 @@ for f in host/*.[ch] host/*/*.[ch]; do
             bad=1
         fi
     done
+done
+# host/ and kernels/ are both on the include path (-Ihost -Ikernels): a header at the same
+# path in both would make an include mean whichever comes first.
+for k in $(cd kernels && find . -name '*.h' | sed 's#^\./##'); do
+    if [ -f "host/$k" ]; then
+        echo "check_layers: host/$k and kernels/$k share a path: rename one" >&2
+        bad=1
+    fi
 done
 [ "$bad" -eq 0 ] && echo "check_layers: $files files in host/, every include points down or sideways"
 exit "$bad"

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Coefficients of the short polynomials in kernels/kmath.h (plain Python, no numpy).
+"""Coefficients of the short polynomials in kernels/util/kmath.h (plain Python, no numpy).
 
 Near-minimax fits by Lawson's iteratively reweighted least squares: a weighted
 least-squares fit on Chebyshev-spaced points, the weights multiplied each round by the

@@ -1,18 +1,18 @@
 #!/usr/bin/env python3
-"""Writes kernels/sheen_albedo.h: the directional albedo E(mu, r) of the sheen lobe of
-KHR_materials_sheen (kernels/principled.h), for the albedo scaling of the layers below it.
+"""Writes kernels/bsdf/sheen_albedo.h: the directional albedo E(mu, r) of the sheen lobe of
+KHR_materials_sheen (kernels/bsdf/principled.h), for the albedo scaling of the layers below it.
 
 The lobe is the extension's "Charlie" one (Estevez & Kulla 2017, "Production Friendly
 Microfacet Sheen BRDF"): D = (2 + 1/a) sin(h)^(1/a) / (2 pi) and the visibility
 1 / ((1 + Lambda(mu_o) + Lambda(mu_i)) 4 mu_o mu_i) with the paper's fit of Lambda,
 a = r^2 for the perceptual sheen roughness r. E(mu, r) = integral of f mu_i over the
 hemisphere, by the midpoint rule on a (cos theta, phi) grid. The columns are spaced in
-sqrt(mu), as E is steepest at grazing views. Run: python3 tools/sheen_albedo.py > kernels/sheen_albedo.h
+sqrt(mu), as E is steepest at grazing views. Run: python3 tools/sheen_albedo.py > kernels/bsdf/sheen_albedo.h
 """
 import numpy as np
 
 MU_N, R_N = 32, 16          # table size: cos(theta_o) from 0 to 1, r from R_MIN to 1
-R_MIN = 0.25                # kernels/principled.h SHEEN_ROUGHNESS_MIN
+R_MIN = 0.25                # kernels/bsdf/principled.h SHEEN_ROUGHNESS_MIN
 GRAZING = (1e-3, 3e-3, 1e-2)  # E at mu = 0: the largest at these cosines (the quadrature
                               # loses the limit; a table value too low would gain energy)
 
@@ -44,7 +44,7 @@ def albedo(mu, r, n=400):
 
 def main():
     print("/* sheen_albedo.h — written by tools/sheen_albedo.py; do not edit. The directional")
-    print(" * albedo E(mu, r) of the Charlie sheen lobe (kernels/principled.h), row j for the")
+    print(" * albedo E(mu, r) of the Charlie sheen lobe (kernels/bsdf/principled.h), row j for the")
     print(" * perceptual roughness r = %.2f + %.2f j / %d, column i for mu = (i / %d)^2. */" % (R_MIN, 1 - R_MIN, R_N - 1, MU_N - 1))
     print("#ifndef CLPT_SHEEN_ALBEDO_H\n#define CLPT_SHEEN_ALBEDO_H\n")
     print("#define SHEEN_TABLE_MU %d\n#define SHEEN_TABLE_R %d\n#define SHEEN_ROUGHNESS_MIN %.2ff\n" % (MU_N, R_N, R_MIN))

@@ -5,7 +5,7 @@
  * each node holds up to eight children (Embree's BVH8 shape: one ray tests a node's
  * eight boxes with one float8 operation per slab), and flattened into BvhNode records
  * (kernels/types.h) whose leaves use the kd-tree's leaf records (groups of eight
- * triangles). kernels/traverse_wide.cl walks it; docs/kdtree.md says why it exists
+ * triangles). kernels/accel/traverse_bvh.h walks it; docs/kdtree.md says why it exists
  * beside the kd-tree and what it measured.
  */
 #ifndef CLPT_BVH_H

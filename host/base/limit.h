@@ -28,7 +28,7 @@
 /* Longest path, in bounces after the camera ray. */
 #define CLPT_MAX_DEPTH 1024
 /* Continuations per camera sample from its first hit (first-hit splitting): a path's
- * sample index is sample x split + branch (kernels/rng.h), below 2^32 with CLPT_MAX_SPP
+ * sample index is sample x split + branch (kernels/sample/rng.h), below 2^32 with CLPT_MAX_SPP
  * and the adaptive passes' samples. */
 #define CLPT_MAX_SPLIT 64
 /* Nesting of scene `include`s (a file including itself stops here). */

@@ -100,7 +100,7 @@ typedef struct {
     unsigned scene_features;        /* what the loaded scene needs besides KF_PATH/KF_WHITTED */
     int builds;                     /* programs built so far (for counters.from_cache) */
     char *kernel_dir;               /* DeviceConfig's, kept for the builds */
-    cl_kernel k_whitted;    /* the classic ray tracer (kernels/whitted.cl) */
+    cl_kernel k_whitted;    /* the classic ray tracer (kernels/integrator/whitted.h) */
     cl_kernel k_whitted_film;       /* k_film of the whitted program */
     uint integrator;        /* enum Integrator of the loaded scene */
     cl_mem scene[SCENE_N];
@@ -814,7 +814,7 @@ static Status cancel_batch(OclDevice *od, FilmSlot *fs, Error *err)
     return error_set(err, ST_INTERRUPTED, "device '%s': batch cancelled", od->info.name);
 }
 
-/* The classic ray tracer's batch (kernels/whitted.cl): per wave, one k_whitted launch
+/* The classic ray tracer's batch (kernels/integrator/whitted.h): per wave, one k_whitted launch
  * computes every sample whole and counts its rays, then k_film adds the wave as for the
  * path tracer. Waves are numbered as in entry.cl. */
 static Status render_whitted(OclDevice *od, uint first_sample, uint64_t total, Error *err)

@@ -1,6 +1,6 @@
 /*
  * device_scalar.c — the scalar C device: the kernel stage functions of kernels/ compiled as
- * plain C (one source with the OpenCL build, through kernels/compat.h) and run by a pool
+ * plain C (one source with the OpenCL build, through kernels/util/compat.h) and run by a pool
  * of pthreads. It is the reference the tests compare OpenCL against, and it renders when
  * no OpenCL platform is installed.
  *
@@ -19,13 +19,13 @@
 #include "base/timer.h"
 
 /* The kernel sources, compiled here as C. */
-#include "film.cl"
-#include "raygen.cl"
-#include "shade.cl"
-#include "traverse.cl"
-#include "alpha.h"
-#include "path.cl"
-#include "whitted.cl"
+#include "film/film.h"
+#include "integrator/raygen.h"
+#include "integrator/shade_path.h"
+#include "accel/traverse.h"
+#include "accel/alpha.h"
+#include "integrator/path.h"
+#include "integrator/whitted.h"
 
 /* Paths (pixels x samples of the batch) handed to a worker at a time: small enough that
  * the workers finish a batch together (a chunk takes well under a millisecond), large
@@ -57,7 +57,7 @@ typedef struct {
                                   * NULL: not profiling */
 } CpuDevice;
 
-/* Renders one camera sample's path to its end (path_run, kernels/path.cl, as k_path
+/* Renders one camera sample's path to its end (path_run, kernels/integrator/path.h, as k_path
  * does); returns the number of rays it traced. */
 static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *radiance)
 {
@@ -120,7 +120,7 @@ static void render_chunks(CpuDevice *cd)
                 } else if (cd->params.integrator == INTEGRATOR_PATH) {
                     rays += render_path(&cd->view, pixel, cd->first_sample + s, &L);
                 } else {
-                    /* the classic ray tracer and the auxiliary images: kernels/whitted.cl */
+                    /* the classic ray tracer and the auxiliary images: kernels/integrator/whitted.h */
                     uint n = 0;
                     L = whitted_sample(&cd->view, pixel, cd->first_sample + s, &n);
                     rays += n;

@@ -12,7 +12,7 @@ unsigned kernel_scene_features(const DeviceScene *s)
     unsigned f = kernel_params_features(p);
     for (uint i = 0; i < s->n_materials; i++) {
         const Material *m = &s->materials[i];
-        /* a mix (kernels/mix.h, always compiled) scatters as the materials it picks,
+        /* a mix (kernels/material/mix.h, always compiled) scatters as the materials it picks,
          * which are in this list themselves; only its amount texture is its own */
         if (m->type == MAT_MIX) {
             if (m->mix_texture != NO_INDEX) f |= KF_TEXTURES;

@@ -19,7 +19,7 @@ unsigned kernel_scene_features(const DeviceScene *s);
 /* Whether k_path_lanes can render the scene (features: kernel_scene_features's):
  * every surface a flat triangle of an untextured diffuse material that does not emit,
  * or a lamp (a pure emitter), every light a triangle lamp. In such a scene a path that
- * shade_lanes does not shade in float8 ends where it is (kernels/shade_lanes.cl). */
+ * shade_lanes does not shade in float8 ends where it is (kernels/integrator/shade_lanes.h). */
 int kernel_lanes_scene(const DeviceScene *s, unsigned features);
 
 /* ... and whether the render settings allow it too: the Sobol sampler, MIS and shadows,

@@ -264,20 +264,18 @@ cleanup:
     return found;
 }
 
-/* Whether a program built from a cached binary is what clpt needs: built for the
- * device (clBuildProgram can succeed while the device's status says otherwise) and
- * holding k_film, the kernel every clpt program has. */
+/* Whether a program built from a cached binary is usable: built for the device
+ * (clBuildProgram can succeed while the device's status says otherwise) and holding
+ * kernels (every program clpt builds has some; a binary the driver half-read may not). */
 static int oclp__usable(cl_program prog, const OclDeviceInfo *dev)
 {
     cl_build_status bs = CL_BUILD_NONE;
     if (clGetProgramBuildInfo(prog, dev->id, CL_PROGRAM_BUILD_STATUS, sizeof bs, &bs, NULL) != CL_SUCCESS ||
         bs != CL_BUILD_SUCCESS)
         return 0;
-    cl_int rc;
-    cl_kernel k = clCreateKernel(prog, "k_film", &rc);
-    if (rc != CL_SUCCESS) return 0;
-    clReleaseKernel(k);
-    return 1;
+    size_t n_kernels = 0;
+    return clGetProgramInfo(prog, CL_PROGRAM_NUM_KERNELS, sizeof n_kernels, &n_kernels, NULL) == CL_SUCCESS &&
+           n_kernels > 0;
 }
 
 /* Creates and builds a program from a cached binary; 0 (and nothing to release) when
@@ -610,54 +608,15 @@ static void oclp__announce(const OclDeviceInfo *dev, int cached_afterwards)
     fflush(stderr);
 }
 
-Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *kernel_dir,
-                         const char *extra_options, cl_program *out, OclProgramStats *stats,
-                         Error *err)
+/* Builds src for dev, through the cache unless src came from a kernel folder. */
+static Status oclp__build(cl_context ctx, const OclDeviceInfo *dev, const char *src, size_t src_len,
+                          int from_folder, const char *options, cl_program *out,
+                          OclProgramStats *stats, Error *err)
 {
-    double t0 = oclp__now();
-    OclProgramStats local;
-    if (!stats) stats = &local;
-    memset(stats, 0, sizeof *stats);
-    *out = NULL;
-
-    /* The options are composed in the stats record itself, so what it reports is
-     * exactly what was used. */
-    const char *options = stats->options;
-    Status st = oclp__options(dev, kernel_dir, extra_options, stats->options,
-                              sizeof stats->options, err);
-    if (st != ST_OK) return st;
-
-    char *file_src = NULL;
-    const char *src = clpt_kernel_source;
-    size_t src_len = clpt_kernel_source_len;
-    if (kernel_dir) {
-        char path[1024];
-        if (snprintf(path, sizeof path, "%s/entry.cl", kernel_dir) >= (int)sizeof path)
-            return error_set(err, ST_USAGE, "kernel folder path too long: %s", kernel_dir);
-        char *text = NULL;
-        size_t text_len = 0;
-        st = oclp__read_file(path, &text, &text_len, err);
-        if (st != ST_OK) return st;
-        /* Drivers compile a copy in a temporary file (PoCL does), so without a #line
-         * marker the build log would name that copy instead of entry.cl. The path holds
-         * no quote or backslash (checked with the options above). */
-        size_t head = strlen(path) + 16;
-        file_src = malloc(head + text_len + 1);
-        if (!file_src) {
-            free(text);
-            return error_set(err, ST_INTERNAL, "%s: out of memory", path);
-        }
-        src_len = (size_t)snprintf(file_src, head, "#line 1 \"%s\"\n", path);
-        memcpy(file_src + src_len, text, text_len + 1);
-        src_len += text_len;
-        free(text);
-        src = file_src;
-    }
-
     /* Developer mode is never cached: the included files are not part of the key. */
     char dir[900], path[sizeof stats->cache_path] = "";
     unsigned char key[SHA256_DIGEST_SIZE];
-    if (!kernel_dir && ocl_program_cache_dir(dir, sizeof dir) && oclp__make_dirs(dir) == 0) {
+    if (!from_folder && ocl_program_cache_dir(dir, sizeof dir) && oclp__make_dirs(dir) == 0) {
         char hex[65];
         oclp__key(dev, src, src_len, options, key);
         sha256_hex(key, hex);
@@ -666,6 +625,7 @@ Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *k
 
     if (path[0] && oclp__cache_load(ctx, dev, path, key, options, out)) stats->from_cache = 1;
 
+    Status st = ST_OK;
     if (!stats->from_cache) {
         oclp__announce(dev, path[0] != '\0');
         char crashed[sizeof path + 16];
@@ -680,11 +640,79 @@ Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *k
             free(bin);
         }
     }
+    if (st == ST_OK) memcpy(stats->cache_path, path, sizeof path);
+    return st;
+}
+
+/* <kernel_dir>/entry.cl, with a #line marker in front: drivers compile a copy in a
+ * temporary file (PoCL does), so without it the build log would name that copy. The
+ * path holds no quote or backslash (checked with the options). */
+static Status oclp__read_entry(const char *kernel_dir, char **src, size_t *src_len, Error *err)
+{
+    char path[1024];
+    if (snprintf(path, sizeof path, "%s/entry.cl", kernel_dir) >= (int)sizeof path)
+        return error_set(err, ST_USAGE, "kernel folder path too long: %s", kernel_dir);
+    char *text = NULL;
+    size_t text_len = 0;
+    Status st = oclp__read_file(path, &text, &text_len, err);
+    if (st != ST_OK) return st;
+    size_t head = strlen(path) + 16;
+    char *file_src = malloc(head + text_len + 1);
+    if (!file_src) {
+        free(text);
+        return error_set(err, ST_INTERNAL, "%s: out of memory", path);
+    }
+    size_t n = (size_t)snprintf(file_src, head, "#line 1 \"%s\"\n", path);
+    memcpy(file_src + n, text, text_len + 1);
+    free(text);
+    *src = file_src;
+    *src_len = n + text_len;
+    return ST_OK;
+}
+
+Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *kernel_dir,
+                         const char *extra_options, cl_program *out, OclProgramStats *stats,
+                         Error *err)
+{
+    double t0 = oclp__now();
+    OclProgramStats local;
+    if (!stats) stats = &local;
+    memset(stats, 0, sizeof *stats);
+    *out = NULL;
+
+    /* The options are composed in the stats record itself, so what it reports is
+     * exactly what was used. */
+    Status st = oclp__options(dev, kernel_dir, extra_options, stats->options,
+                              sizeof stats->options, err);
+    if (st != ST_OK) return st;
+
+    char *file_src = NULL;
+    const char *src = clpt_kernel_source;
+    size_t src_len = clpt_kernel_source_len;
+    if (kernel_dir) {
+        st = oclp__read_entry(kernel_dir, &file_src, &src_len, err);
+        if (st != ST_OK) return st;
+        src = file_src;
+    }
+    st = oclp__build(ctx, dev, src, src_len, kernel_dir != NULL, stats->options, out, stats, err);
     free(file_src);
     stats->seconds = oclp__now() - t0;
-    if (st != ST_OK) return st;
-    memcpy(stats->cache_path, path, sizeof path);
-    return ST_OK;
+    return st;
+}
+
+Status ocl_program_build_source(cl_context ctx, const OclDeviceInfo *dev, const char *src,
+                                size_t src_len, const char *extra_options, cl_program *out,
+                                OclProgramStats *stats, Error *err)
+{
+    double t0 = oclp__now();
+    OclProgramStats local;
+    if (!stats) stats = &local;
+    memset(stats, 0, sizeof *stats);
+    *out = NULL;
+    Status st = oclp__options(dev, NULL, extra_options, stats->options, sizeof stats->options, err);
+    if (st == ST_OK) st = oclp__build(ctx, dev, src, src_len, 0, stats->options, out, stats, err);
+    stats->seconds = oclp__now() - t0;
+    return st;
 }
 
 Status ocl_program_kernel(cl_program prog, const OclDeviceInfo *dev, const char *name,

@@ -20,7 +20,7 @@
  * device's CL_PROGRAM_BINARIES. Files are written to a temporary name in the same folder
  * and renamed, so a concurrent run sees either no file or a whole one. Anything wrong
  * with an entry (truncated, corrupt, refused by the driver, or a program that did not
- * build for the device or lacks clpt's kernel k_film) deletes it and the program is rebuilt
+ * build for the device or holds no kernel) deletes it and the program is rebuilt
  * from source and stored again; so is an entry that is not a regular file (a FIFO or
  * a folder: opened without blocking). A payload with a right checksum can still crash
  * the driver, so a new entry is first loaded in a trial process (ocl_program.c, "the
@@ -56,6 +56,12 @@ typedef struct {
 Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *kernel_dir,
                          const char *extra_options, cl_program *out, OclProgramStats *stats,
                          Error *err);
+
+/* ocl_program_build for another program than the renderer's: src (e.g. the traversal
+ * benchmark's clpt_bench_kernel_source) with the same options and cache. */
+Status ocl_program_build_source(cl_context ctx, const OclDeviceInfo *dev, const char *src,
+                                size_t src_len, const char *extra_options, cl_program *out,
+                                OclProgramStats *stats, Error *err);
 
 /* Whether a build from source (a cache miss, or --kernel-dir) first says so on stderr:
  * "clpt: compiling kernels for <device>, cached for next time..." (without ", cached

@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/lexer.h"
 #include "io/reader.h"
 #include "scene/transform.h"

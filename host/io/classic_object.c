@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "kmath.h"
+#include "util/kmath.h"
 #include "base/limit.h"
 #include "io/lexer.h"
 #include "io/reader.h"
@@ -98,7 +98,7 @@ static Status add_tri(Classic *c, vec3 a, vec3 b, vec3 d, uint material, uint sh
 }
 
 /* A sphere under a transform that does not keep it a (plain) sphere: a latitude-
- * longitude mesh with the sphere's normals and (u, v) (kernels/texture.h) carried over.
+ * longitude mesh with the sphere's normals and (u, v) (kernels/material/texture.h) carried over.
  * The kernels have no ellipsoids, so the mesh costs 9,024 triangles a sphere; their
  * total is capped (CLPT_MAX_TESSELLATED_TRIANGLES) before they are made. */
 static Status tessellate_sphere(Classic *c, const Token *kw, vec3 center, float radius, const Transform *m,
@@ -354,7 +354,7 @@ static Status revsurface_profile(Classic *c, CurveKind kind, const float *pts, c
     return ST_OK;
 }
 
-/* Adds the surface: exact (kernels/revsurface.h) when m keeps the axis vertical, else
+/* Adds the surface: exact (kernels/geom/revsurface.h) when m keeps the axis vertical, else
  * as a mesh through m. */
 static Status add_revsurface(Classic *c, const Token *kw, float *xy, unsigned n_segments, unsigned degree,
                              const Transform *m, uint material)

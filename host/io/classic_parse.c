@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/lexer.h"
 #include "io/path.h"
 #include "io/reader.h"

@@ -9,7 +9,7 @@
 #include "io/path.h"
 #include "io/reader.h"
 #include "io/texture.h"
-#include "kmath.h"
+#include "util/kmath.h"
 
 #include <math.h>
 #include <stdint.h>

@@ -8,7 +8,7 @@
 #include "io/path.h"
 #include "io/reader.h"
 #include "io/texture.h"
-#include "kmath.h"
+#include "util/kmath.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -223,7 +223,7 @@ static Status texture_tinted(Gltf *g, uint base, const double factor[3], uint *o
 
 /* alphaMode OPAQUE (the default: alpha ignored), MASK (cut out where alpha, baseColorFactor's
  * A times the base-colour texture's alpha, is below alphaCutoff, default 0.5) or BLEND
- * (a hit kept with probability alpha, kernels/alpha.h). */
+ * (a hit kept with probability alpha, kernels/accel/alpha.h). */
 static Status material_alpha(Gltf *g, const cJSON *m, const char *jp, double alpha, Material *mt)
 {
     char jpa[96];
@@ -249,7 +249,7 @@ static Status material_alpha(Gltf *g, const cJSON *m, const char *jp, double alp
 /* KHR_materials_volume: thicknessFactor > 0 makes the mesh the boundary of a solid (a
  * path tracer has the real thickness, so neither the factor's value nor thicknessTexture
  * is read), inside which attenuationColor / attenuationDistance absorb (Beer-Lambert,
- * kernels/shade.cl). Thickness 0, the default, keeps the thin wall. */
+ * kernels/integrator/shade_path.h). Thickness 0, the default, keeps the thin wall. */
 static Status material_volume(Gltf *g, const cJSON *m, const char *jp, Material *mt)
 {
     const cJSON *x = gltf_ext_of(m, "KHR_materials_volume");
@@ -270,7 +270,7 @@ static Status material_volume(Gltf *g, const cJSON *m, const char *jp, Material 
 
 /* KHR_materials_specular: specularFactor (times specularTexture's alpha) and
  * specularColorFactor (times specularColorTexture, sRGB) scale the dielectric F0 and
- * F90 (kernels/principled.h). */
+ * F90 (kernels/bsdf/principled.h). */
 static Status material_specular(Gltf *g, const cJSON *m, const char *jp, Material *mt)
 {
     const cJSON *x = gltf_ext_of(m, "KHR_materials_specular");

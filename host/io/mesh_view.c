@@ -1,7 +1,7 @@
 /* mesh_view.c — the automatic scene around a bare mesh (mesh_view.h). */
 #include "io/mesh_view.h"
 
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/mesh_load.h"
 
 #include <math.h>

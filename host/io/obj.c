@@ -9,7 +9,7 @@
 #include "io/obj.h"
 #include "io/texture.h"
 
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/lexer.h"
 #include "io/mesh_text.h"
 #include "io/path.h"

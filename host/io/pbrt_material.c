@@ -15,7 +15,7 @@
 #include "io/path.h"
 #include "io/reader.h"
 #include "io/texture.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "scene/mesh_sink.h"
 #include "scene/octa_env.h"
 #include "scene/subdiv.h"
@@ -97,7 +97,7 @@ static PPending *pending_of(Parser *p, uint index)
 
 /* pbrt's mix: its two named materials (defined before it, so a mix never contains
  * itself) and `amount`, a float or a float texture (an image's red channel), chosen per
- * hit by the kernels (kernels/mix.h). */
+ * hit by the kernels (kernels/material/mix.h). */
 static Status make_mix(Parser *p, const Lexer *lx, const Token *type, Material *m)
 {
     Param *pa = pbrt_param_find(p, "materials");
@@ -153,7 +153,7 @@ static Status coated_medium(Parser *p, const Lexer *lx, Material *m)
     return ST_OK;
 }
 
-/* pbrt-v4's coateddiffuse and coatedconductor: MAT_LAYERED (kernels/layered.h). A
+/* pbrt-v4's coateddiffuse and coatedconductor: MAT_LAYERED (kernels/bsdf/layered.h). A
  * conductor's `reflectance` becomes pbrt's index for it, eta 1 and k = 2 sqrt(r) /
  * sqrt(1 - r), as CoatedConductorMaterial does. */
 static Status make_coated(Parser *p, const Lexer *lx, int conductor, Material *m)

@@ -15,7 +15,7 @@
 #include "io/path.h"
 #include "io/reader.h"
 #include "io/texture.h"
-#include "kmath.h"
+#include "util/kmath.h"
 #include "scene/mesh_sink.h"
 #include "scene/octa_env.h"
 #include "scene/subdiv.h"

@@ -15,7 +15,7 @@
 
 #include "base/strmap.h"
 
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/lexer.h"
 #include "io/mesh_text.h"
 

@@ -5,7 +5,7 @@
 #include <string.h>
 #include <strings.h>
 
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/classic_parse.h"
 #include "io/gltf.h"
 #include "io/lexer.h"

@@ -11,7 +11,7 @@
  */
 #include "io/scene_reader.h"
 
-#include "kmath.h"
+#include "util/kmath.h"
 #include "scene/camera.h"
 #include "io/lexer.h"
 #include "base/limit.h"
@@ -352,7 +352,7 @@ static const KeySpec background_keys[BG_N] = {
     [BG_ROTATE] = {"rotate", VK_NUMBER, 0, -1e6, 1e6, 0, 0, "a number of degrees in [-1e6, 1e6]"},
 };
 
-/* `map "FILE"`: an equirectangular environment map (kernels/envmap.h), the file found
+/* `map "FILE"`: an equirectangular environment map (kernels/light/envmap.h), the file found
  * beside the scene file, a high-dynamic-range image (.hdr, .exr). */
 static Status parse_background_map(Parser *p, Lexer *lx, const Value *v)
 {

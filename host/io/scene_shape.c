@@ -4,7 +4,7 @@
  */
 #include "io/scene_reader.h"
 
-#include "kmath.h"
+#include "util/kmath.h"
 #include "io/lexer.h"
 #include "io/mesh_load.h"
 #include "io/reader.h"

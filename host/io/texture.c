@@ -5,7 +5,7 @@
 #include "base/limit.h"
 #include "io/exr.h"
 #include "io/lexer.h"
-#include "kmath.h"
+#include "util/kmath.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -66,7 +66,7 @@ Status texture_check_map(const Texture *t, Error *err)
     return ST_OK;
 }
 
-/* Packs 8-bit RGBA into the uint texel layout of kernels/texture.h. */
+/* Packs 8-bit RGBA into the uint texel layout of kernels/material/texture.h. */
 static uint pack_rgba(const unsigned char *p)
 {
     return bytes_get_le32(p);

@@ -1,5 +1,5 @@
 /*
- * texture.h — textures for the scene (kernels/texture.h evaluates them): image files
+ * texture.h — textures for the scene (kernels/material/texture.h evaluates them): image files
  * read through Debian's stb_image (PNG, JPEG, BMP, TGA, GIF, PSD, PNM and Radiance HDR)
  * and OpenEXR (any compression; host/io/exr.h), and checkerboards.
  *

@@ -130,7 +130,7 @@ static Status bad(Error *err, const char *path, const char *what)
 }
 
 /* The largest film value one sample can add: the kernels clamp a sample's radiance to
- * FILM_MAX_SAMPLE and round it to units of 2^-FILM_FRAC_BITS (kernels/film.cl). */
+ * FILM_MAX_SAMPLE and round it to units of 2^-FILM_FRAC_BITS (kernels/film/film.h). */
 #define FILM_MAX_SAMPLE_FIXED ((uint64_t)FILM_MAX_SAMPLE << FILM_FRAC_BITS)
 
 /* Each value must be one that `samples` samples can produce: between 0 and samples

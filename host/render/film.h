@@ -1,6 +1,6 @@
 /*
  * film.h — the host's image accumulator: per pixel and channel, the sum of every sample's
- * radiance in 64-bit fixed point (units of 2^-FILM_FRAC_BITS, see kernels/film.cl), and
+ * radiance in 64-bit fixed point (units of 2^-FILM_FRAC_BITS, see kernels/film/film.h), and
  * the number of samples every pixel has received. Integer sums make the result
  * independent of the order in which devices and batches are added.
  */

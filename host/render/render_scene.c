@@ -117,7 +117,7 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
     out->ds.tri_extras = s->tri_extras;
     out->ds.n_tri_extras = (uint)s->n_tri_extras;
 
-    /* the classic ray tracer's part (kernels/whitted.cl) */
+    /* the classic ray tracer's part (kernels/integrator/whitted.h) */
     p->ambient = s->ambient;
     p->integrator = s->integrator;
     p->mis_mode = MIS_BOTH;

@@ -3,7 +3,7 @@
  * device starts from the same float values. */
 #include "scene/camera.h"
 
-#include "kmath.h"
+#include "util/kmath.h"
 
 #include <math.h>
 #include <string.h>

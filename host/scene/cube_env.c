@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "background.h"
+#include "light/background.h"
 
 /* Points per texel side whose lookups a texel averages. */
 #define CUBE_ENV_SUB 3u

@@ -1,10 +1,10 @@
 /*
  * cube_env.h — a cube-map background made an environment light for the path tracer:
- * the six faces resampled into an equirectangular float map (kernels/envmap.h's
+ * the six faces resampled into an equirectangular float map (kernels/light/envmap.h's
  * orientation), which then becomes the background by scene_set_envmap, so next-event
  * estimation samples it and MIS weights what BSDF-sampled rays see of it, as for a
  * `background { map ... }`. The Whitted integrator keeps the exact cube-map lookup
- * (kernels/background.h); only the path tracer converts (render_scene_prepare).
+ * (kernels/light/background.h); only the path tracer converts (render_scene_prepare).
  */
 #ifndef CLPT_CUBE_ENV_H
 #define CLPT_CUBE_ENV_H
@@ -24,7 +24,7 @@ uint cube_env_height(uint face);
 
 /* Replaces the cube-map background of s (bg_type BG_CUBEMAP) with an environment map
  * of 2 H x H texels (H = cube_env_height of the largest face side), each the mean of
- * the cube map's own lookup (kernels/background.h's cubemap_lookup, so the faces' (u,
+ * the cube map's own lookup (kernels/light/background.h's cubemap_lookup, so the faces' (u,
  * v) and filtering are exactly the Whitted integrator's) in the directions of a 3 x 3
  * grid of points in the texel, appended as a TEX_FLOAT texture; the background becomes
  * BG_MAP with intensity 1 and rotation 0. Fails only when memory runs out or the

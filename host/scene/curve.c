@@ -4,7 +4,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "kmath.h"
+#include "util/kmath.h"
 
 void curve_bezier_eval(const float *p, unsigned degree, double s, double xy[2], double d[2])
 {

@@ -1,7 +1,7 @@
 /* env_dist.c — the environment map's sampling distribution (see env_dist.h). */
 #include "scene/env_dist.h"
 
-#include "envmap.h" /* env_guide_cells: the kernels' lookups must agree with these tables */
+#include "light/envmap.h" /* env_guide_cells: the kernels' lookups must agree with these tables */
 
 #include <math.h>
 #include <stdlib.h>
@@ -30,7 +30,7 @@ static void cdf_write(const double *w, size_t n, double total, float *out)
     out[n] = 1.0f;
 }
 
-/* Writes the guide table of cdf[0..n] (kernels/envmap.h) into out[0..g): entry k the
+/* Writes the guide table of cdf[0..n] (kernels/light/envmap.h) into out[0..g): entry k the
  * last cell i < n with cdf[i] <= k / g, the cell env_cdf_find finds for u = k / g. */
 static void guide_write(const float *cdf, size_t n, size_t g, float *out)
 {

@@ -1,7 +1,7 @@
 /* mesh_sink.c — mesh options, the triangle sink, bounds, the procedural sphere (mesh_sink.h). */
 #include "scene/mesh_sink.h"
 
-#include "kmath.h"
+#include "util/kmath.h"
 
 #include <math.h>
 #include <stdlib.h>

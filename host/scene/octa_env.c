@@ -87,7 +87,7 @@ Status octa_env_set(Scene *s, const float *rgb, uint n, const double light_from_
     const double *m = light_from_world;
     for (uint j = 0; j < H; j++)
         for (uint i = 0; i < W; i++) {
-            /* the texel centre's world direction (kernels/envmap.h: phi = 2 pi u,
+            /* the texel centre's world direction (kernels/light/envmap.h: phi = 2 pi u,
              * theta = pi v, (sin t sin p, cos t, -sin t cos p)) into the light's frame */
             double th = M_PI * ((double)j + 0.5) / H, ph = 2.0 * M_PI * ((double)i + 0.5) / W;
             double w[3] = { sin(th) * sin(ph), cos(th), -sin(th) * cos(ph) };

@@ -3,7 +3,7 @@
  * image in the equal-area octahedral parameterisation (Clarberg, "Fast Equal-Area
  * Mapping of the (Hemi)Sphere using SIMD", JGT 2008; pbrt-v4's EqualAreaSquareToSphere
  * and EqualAreaSphereToSquare) resampled into an equirectangular float map in
- * kernels/envmap.h's orientation, which then becomes the background by
+ * kernels/light/envmap.h's orientation, which then becomes the background by
  * scene_set_envmap (importance-sampled, MIS-weighted, as a `background { map ... }`).
  *
  * The square: (u, v) in [0, 1]^2, u along the image's columns, v down its rows (pbrt's

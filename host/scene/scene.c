@@ -3,7 +3,7 @@
 
 #include "scene/env_dist.h"
 
-#include "kmath.h"
+#include "util/kmath.h"
 
 #include <float.h>
 #include <math.h>
@@ -753,7 +753,7 @@ Status scene_set_envmap(Scene *s, uint texture, float intensity, float rotate, E
     if (!(t->flags & TEX_FLOAT))
         return error_set(err, ST_INPUT, "'%s': an environment map must be a high-dynamic-range image (.hdr or "
                          ".exr)", s->texture_sources[texture] ? s->texture_sources[texture] : "");
-    /* the guide tables (kernels/envmap.h) hold pixel indices as exact floats */
+    /* the guide tables (kernels/light/envmap.h) hold pixel indices as exact floats */
     if (t->width > (1u << 24) || t->height > (1u << 24))
         return error_set(err, ST_INPUT, "'%s': an environment map is at most 16777216 pixels wide and high, not %ux%u",
                          s->texture_sources[texture] ? s->texture_sources[texture] : "", t->width, t->height);

@@ -36,7 +36,7 @@ typedef struct {
     uint spp;            /* samples per pixel */
     uint max_depth;      /* bounces after the camera ray */
     uint seed;
-    uint sampler;        /* enum Sampler (kernels/rng.h); 0, Sobol, by default */
+    uint sampler;        /* enum Sampler (kernels/sample/rng.h); 0, Sobol, by default */
     uint split;          /* continuations per camera sample from its first hit (1: none) */
 } SceneImage;
 
@@ -56,7 +56,7 @@ typedef struct {
     uint bg_cubemap;             /* BG_CUBEMAP: index of the first of its six textures;
                                   * BG_MAP: the map's texture (scene_set_envmap) */
     float bg_rotate;             /* BG_MAP: degrees about +y */
-    float *env_cdf;  size_t n_env_cdf;   /* BG_MAP: its distribution (kernels/envmap.h) */
+    float *env_cdf;  size_t n_env_cdf;   /* BG_MAP: its distribution (kernels/light/envmap.h) */
     double env_mean;             /* BG_MAP: mean luminance over the sphere, scaled */
     uint env_light;              /* its light in `lights`, or NO_INDEX (scene_prepare_lights) */
 
@@ -167,7 +167,7 @@ uint scene_first_revsurface(const Scene *s);
 uint scene_first_plane(const Scene *s);
 
 /* Makes image texture `texture` (float texels: an HDR or EXR image) the background, an
- * environment map (kernels/envmap.h) scaled by `intensity` and turned by `rotate`
+ * environment map (kernels/light/envmap.h) scaled by `intensity` and turned by `rotate`
  * degrees about +y, and builds its sampling distribution. ST_INPUT "'SOURCE': an
  * environment map must be a high-dynamic-range image (.hdr or .exr)" for 8-bit texels;
  * otherwise fails only when memory runs out. */

@@ -1,7 +1,7 @@
 /* transform.c — affine transforms in double (transform.h). */
 #include "scene/transform.h"
 
-#include "kmath.h"
+#include "util/kmath.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,0 +1,81 @@
+/*
+ * traverse.h -- the closest-hit and any-hit queries the integrators ask, through the
+ * scene's tree: infinite planes one by one (leaf.h), everything else through the kd-tree
+ * (traverse_kd.h, docs/kdtree.md) or the 8-wide BVH (traverse_bvh.h). Variants of a walk
+ * are named traverse_<tree>.h; each holds its tree's shapes of a walk (one ray, packets of
+ * eight, and for the kd-tree two rays in turns), and every shape gives each ray the
+ * bits the one-ray walk gives it.
+ */
+#ifndef CLPT_TRAVERSE_H
+#define CLPT_TRAVERSE_H
+
+#include "accel/leaf.h"
+#include "accel/traverse_bvh.h"
+#include "accel/traverse_kd.h"
+#include "geom/intersect.h"
+#include "scene_view.h"
+
+/* Which tree holds the scene: the kd-tree (TREE_KD) or the 8-wide BVH (TREE_BVH). A
+ * program compiled for one (CLPT_FEATURES with KF_KDTREE or KF_BVH alone) knows it at
+ * compile time; otherwise the scene says, by having BVH nodes. */
+#define TREE_KD 0
+#define TREE_BVH 1
+KFN_INLINE int trace_tree_kind(const SceneView *sc)
+{
+    if (!KF_HAS(KF_BVH)) return TREE_KD;
+    if (!KF_HAS(KF_KDTREE)) return TREE_BVH;
+    return sc->params->n_bvh_nodes != 0u ? TREE_BVH : TREE_KD;
+}
+
+/* The walk of the given tree (which, when it is the BVH, must be there). */
+KFN_INLINE void trace_walk(const SceneView *sc, int tree, Ray ray, const RayPre *rp, int any, Hit *best)
+{
+    if (KF_HAS(KF_BVH) && tree == TREE_BVH) trace_wide(sc, ray, rp, any, best);
+    else if (KF_HAS(KF_KDTREE)) trace_tree(sc, ray, rp, any, best);
+}
+
+/* Nearest hit in (ray.tmin, ray.tmax) through the given tree; prim = NO_INDEX when
+ * there is none. */
+KFN Hit trace_closest_in(const SceneView *sc, int tree, Ray ray)
+{
+    Hit best = hit_none(ray);
+    trace_planes(sc, ray, 0, &best);
+    RayPre rp = ray_prepare(ray);
+    trace_walk(sc, tree, ray, &rp, 0, &best);
+    return best;
+}
+
+/* The first hit found in (ray.tmin, ray.tmax) through the given tree, not necessarily
+ * the closest; prim = NO_INDEX when there is none. */
+KFN Hit trace_any_hit_in(const SceneView *sc, int tree, Ray ray)
+{
+    Hit h = hit_none(ray);
+    if (trace_planes(sc, ray, 1, &h)) return h;
+    RayPre rp = ray_prepare(ray);
+    trace_walk(sc, tree, ray, &rp, 1, &h);
+    return h;
+}
+
+/* The queries the renderer asks, through the scene's tree. */
+KFN Hit trace_closest(const SceneView *sc, Ray ray)
+{
+    return trace_closest_in(sc, trace_tree_kind(sc), ray);
+}
+
+KFN Hit trace_any_hit(const SceneView *sc, Ray ray)
+{
+    return trace_any_hit_in(sc, trace_tree_kind(sc), ray);
+}
+
+/* 1 if anything is hit in (ray.tmin, ray.tmax): shadow rays. */
+KFN int trace_any_in(const SceneView *sc, int tree, Ray ray)
+{
+    return trace_any_hit_in(sc, tree, ray).prim != NO_INDEX;
+}
+
+KFN int trace_any(const SceneView *sc, Ray ray)
+{
+    return trace_any_in(sc, trace_tree_kind(sc), ray);
+}
+
+#endif /* CLPT_TRAVERSE_H */

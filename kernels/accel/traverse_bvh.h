@@ -1,0 +1,365 @@
+/*
+ * traverse_bvh.h -- closest-hit and any-hit queries through the 8-wide BVH.
+ *
+ * The BVH (host/accel/bvh.c, BvhNode in types.h) is the other tree of docs/kdtree.md:
+ * one ray tests all eight child boxes of a node at once, one float8 operation per slab
+ * (the shape of Embree's single-ray BVH8 walk), goes on into the nearest child hit and
+ * keeps the others on a stack with their entry distances. Leaves hold
+ * the kd-tree's leaf records and are tested by the same code (leaf_test, leaf.h), so a hit
+ * has the very t, u and v the kd-tree walk finds for that primitive.
+ *
+ * The slab planes are picked by the ray's direction signs (near plane, far plane), so
+ * an unused lane's box (lo +inf, hi -inf) is missed by every ray, and no min/max
+ * swaps are needed. A direction component that is 0 or tiny is replaced by +-1e-30
+ * before its reciprocal (as Embree does), which keeps every slab distance a number:
+ * (plane - origin) * 1e30 is 0 for a ray in a box's face plane, which counts as inside.
+ * The far distance is widened by KD_T_SLACK, like the kd-tree's plane tests, so that
+ * rounding never drops a box whose primitive the ray hits on its face: the far planes
+ * are scaled by reciprocals widened once per ray, and the closest hit once per node,
+ * rather than the result, whose multiply would sit in the chain from a node's loads to
+ * the next node (as do the min and max, taken as two levels rather than three). Which
+ * boxes are entered may differ by an ulp's worth from the product of the result; every
+ * walk still finds the same hit (leaf_test's rule, tested against brute force).
+ */
+#ifndef CLPT_TRAVERSE_BVH_H
+#define CLPT_TRAVERSE_BVH_H
+
+#include "accel/leaf.h"
+
+#define BVH_TINY 1e-30f
+
+/* The slab test of a node's child boxes in lanes [first, first + W) (vectors VT of W
+ * floats, comparisons IT): leaves the lanes whose box the ray enters within [tmin,
+ * tmax] as bits in `mask`, and each lane's entry distance in ta. OpenCL runs the 8 lanes
+ * as one float8; C runs them as two float4 halves, because without AVX gcc splits
+ * 8-wide vectors badly (as triangle_intersect_group, intersect.h); the same operations
+ * per lane give the same bits either way. min and max are selects: no NaN reaches them
+ * (see above). */
+#define BVH_LANES_BODY(VT, IT, W, LOAD, STORE, SPLAT, SELECT, BITS)                      \
+    VT a, b;                                                                             \
+    LOAD(a, nd->box[w->nx] + first);                                                     \
+    LOAD(b, nd->box[1u - w->nx] + first);                                                \
+    VT tx = (a - w->ox) * w->ix, ux = (b - w->ox) * w->fx;                               \
+    LOAD(a, nd->box[2u + w->ny] + first);                                                \
+    LOAD(b, nd->box[3u - w->ny] + first);                                                \
+    VT ty = (a - w->oy) * w->iy, uy = (b - w->oy) * w->fy;                               \
+    LOAD(a, nd->box[4u + w->nz] + first);                                                \
+    LOAD(b, nd->box[5u - w->nz] + first);                                                \
+    VT tz = (a - w->oz) * w->iz, uz = (b - w->oz) * w->fz;                               \
+    VT lo = SPLAT(w->tmin), hi = SPLAT(tfar);                                            \
+    tx = SELECT(tx, ty, ty > tx);                                                        \
+    ux = SELECT(ux, uy, uy < ux);                                                        \
+    tz = SELECT(tz, lo, lo > tz);                                                        \
+    uz = SELECT(uz, hi, hi < uz);                                                        \
+    VT tn = SELECT(tx, tz, tz > tx), tf = SELECT(ux, uz, uz < ux);                       \
+    IT in_box = tn <= tf;                                                                \
+    uint mask = BITS(in_box);                                                            \
+    STORE(tn, ta + first);
+
+/* The ray as the slab tests use it (see above). */
+typedef struct {
+    float ox, oy, oz, ix, iy, iz, tmin;
+    float fx, fy, fz;            /* ix, iy, iz widened by KD_T_SLACK: for the far planes */
+    uint nx, ny, nz;             /* 1 where the direction is negative: near plane is hi */
+} BvhRay;
+
+#ifdef KERNEL_OPENCL
+#define K_SPLAT8(x) ((float8)(x))
+KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
+{
+    BVH_LANES_BODY(float8, int8, 8, k_load8, k_store8, K_SPLAT8, k_select8, k_bits8)
+    return mask;
+}
+#else
+#define K_SPLAT4(x) ((float4){ (x), (x), (x), (x) })
+#define k_select4(a, b, m) ((float4)(((int4)(a) & ~(m)) | ((int4)(b) & (m))))
+KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
+{
+    BVH_LANES_BODY(float4, int4, 4, k_load4, k_store4, K_SPLAT4, k_select4, k_bits4)
+    return mask;
+}
+#endif
+
+/* Lanes of node nd whose box the ray enters before tmax (bits), their entry distances
+ * in ta. */
+KFN_INLINE uint bvh_node_test(GLOBAL const BvhNode *nd, const BvhRay *w, float tmax, float *ta)
+{
+    float tfar = tmax * KD_T_ABOVE;
+#ifdef KERNEL_OPENCL
+    return bvh_lanes(nd, w, 0u, tfar, ta);
+#else
+    return bvh_lanes(nd, w, 0u, tfar, ta) | (bvh_lanes(nd, w, 4u, tfar, ta) << 4);
+#endif
+}
+
+KFN_INLINE float bvh_inv(float d)
+{
+    float s = (k_as_uint(d) >> 31) ? -BVH_TINY : BVH_TINY;
+    return 1.0f / (k_fabs(d) < BVH_TINY ? s : d);
+}
+
+/* Of a node's children entered (the lanes in mask), returns the one to
+ * go into: the nearest by entry distance d for a closest-hit query (the first lane of
+ * equals), the first for an any-hit query, for which any order will do. Pushes the
+ * others as node << 3 | lane with a word each: the bits of the entry distance (lanes
+ * NULL: one ray) or lanes[lane] (a packet: the lanes that entered the child), the second
+ * nearest last so that it is popped next. Sorting all of them was measured slower: the
+ * entries that start beyond the closest hit are skipped on the pop anyway; the second
+ * nearest alone made closest-hit diffuse rays 3-11% faster (docs/bvh.md). */
+KFN_INLINE uint bvh_push_children(uint ref, uint mask, const float *d, const uint *lanes, int any, uint *st_child,
+                                  uint *st_word, int *sp)
+{
+    uint next = k_lowest_bit(mask), second = BVH_WIDTH;
+    if (!any)
+        for (uint m = mask & (mask - 1u); m != 0u; m &= m - 1u) {
+            uint l = k_lowest_bit(m);
+            if (d[l] < d[next]) {
+                second = next;
+                next = l;
+            } else if (second == BVH_WIDTH || d[l] < d[second]) {
+                second = l;
+            }
+        }
+    int n = *sp;
+    for (uint m = mask; m != 0u; m &= m - 1u) {
+        uint l = k_lowest_bit(m);
+        if (l == next || l == second) continue;
+        st_child[n] = ref << 3 | l;
+        st_word[n] = lanes ? lanes[l] : k_as_uint(d[l]);
+        n++;
+    }
+    if (second != BVH_WIDTH) {
+        st_child[n] = ref << 3 | second;
+        st_word[n] = lanes ? lanes[second] : k_as_uint(d[second]);
+        n++;
+    }
+    *sp = n;
+    return next;
+}
+
+/* In a program of k_path_lanes alone the walk is one function that its closest-hit and
+ * any-hit queries call: inlined into both, it made PoCL's cold build of cornell-box.scene
+ * a third longer (3.2 s against 2.4 s on a 2.5 GHz Xeon) at the same speed. Everything
+ * else keeps it inlined (k_path: as a call it rendered one-weekend 13% slower, the
+ * envmap scene 9%; the C device, the tests' and the benchmark's programs). */
+#if KF_HAS(KF_PATH_LANES) && !KF_HAS(KF_PATH_MEGAKERNEL)
+#define BVH_WALK_FN KFN_CALL_CL
+#else
+#define BVH_WALK_FN KFN_INLINE
+#endif
+
+/* The walk shared by both queries: with `any` set it returns at the first hit;
+ * otherwise it keeps the closest one in *best (whose t starts as the ray's tmax). */
+BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit *best)
+{
+    float s = ray.o.x + ray.o.y + ray.o.z + ray.d.x + ray.d.y + ray.d.z;
+    if (!(s == s) || sc->params->n_bvh_nodes == 0u) return;
+    BvhRay w;
+    w.ox = ray.o.x;
+    w.oy = ray.o.y;
+    w.oz = ray.o.z;
+    w.ix = bvh_inv(ray.d.x);
+    w.iy = bvh_inv(ray.d.y);
+    w.iz = bvh_inv(ray.d.z);
+    w.tmin = ray.tmin;
+    w.fx = w.ix * KD_T_ABOVE;
+    w.fy = w.iy * KD_T_ABOVE;
+    w.fz = w.iz * KD_T_ABOVE;
+    w.nx = rp->neg & 1u;
+    w.ny = (rp->neg >> 1) & 1u;
+    w.nz = (rp->neg >> 2) & 1u;
+    /* an entry: the child's node and lane (node << 3 | lane; its reference and kind are
+     * read back from the node, in cache, on the pop: a third less private memory than
+     * keeping them), and its entry distance's bits */
+    uint st_child[BVH_STACK];
+    uint st_t[BVH_STACK];
+    int sp = 0;
+    uint ref = 0u, kind = BVH_CHILD_NODE;
+    for (;;) {
+        /* down through nodes until a leaf, or a node none of whose boxes the ray enters */
+        while (kind == BVH_CHILD_NODE) {
+            GLOBAL const BvhNode *nd = sc->bvh + ref;
+            float ta[BVH_WIDTH];
+            uint mask = bvh_node_test(nd, &w, best->t, ta);
+            if (!mask) break;
+            uint next = k_lowest_bit(mask);
+            if (mask & (mask - 1u))   /* several children: bvh_push_children */
+                next = bvh_push_children(ref, mask, ta, 0, any, st_child, st_t, &sp);
+            ref = nd->ref[next];
+            kind = nd->kind[next];
+        }
+        if (kind != BVH_CHILD_NODE) {
+            KdNode leaf;
+            leaf.data = ref;
+            leaf.bits = kind;
+            if (leaf_test(sc, sc->bvh_leaves, ray, rp, any, leaf, best)) return;
+        }
+        /* the next cell on the stack that starts before the closest hit so far */
+        do {
+            if (sp == 0) return;
+            sp--;
+        } while (k_as_float(st_t[sp]) > best->t * KD_T_ABOVE);
+        GLOBAL const BvhNode *parent = sc->bvh + (st_child[sp] >> 3);
+        uint lane = st_child[sp] & 7u;
+        ref = parent->ref[lane];
+        kind = parent->kind[lane];
+    }
+}
+
+
+/* ------------------------------------------------------------------ eight rays at once */
+
+/* A packet walk for coherent rays through the BVH (camera rays through neighbouring
+ * pixels, shadow rays from neighbouring points toward one light): eight rays whose
+ * directions have the same signs go down the tree together. A node's boxes are loaded
+ * once for all of them and each box is tested against the eight rays as one float8, with
+ * each lane's own slab arithmetic (the same operations as bvh_lanes, so a lane enters a
+ * box exactly when its single walk would at the same tmax). The packet goes into the
+ * child that its nearest lane enters first and keeps the others on a stack with the
+ * lanes that entered them; on the pop the box is tested again against the lanes'
+ * closest hits so far. In the leaves each lane still in the walk tests the primitives
+ * alone (leaf_test). */
+#define WIDE_PACKET 8
+
+typedef struct {
+    float8 ox, oy, oz, ix, iy, iz, tmin;
+    float8 fx, fy, fz;
+    uint nx, ny, nz;
+} BvhPacket;
+
+/* The lanes of `lanes` that enter child c of node nd within [tmin, tmax]; *lead gets
+ * the entry distance of the lowest of them. */
+KFN_INLINE uint bvh_child_lanes(GLOBAL const BvhNode *nd, uint c, const BvhPacket *p, const float8 *tfar,
+                                uint lanes, float *lead)
+{
+    float8 tx = (nd->box[p->nx][c] - p->ox) * p->ix, ux = (nd->box[1u - p->nx][c] - p->ox) * p->fx;
+    float8 ty = (nd->box[2u + p->ny][c] - p->oy) * p->iy, uy = (nd->box[3u - p->ny][c] - p->oy) * p->fy;
+    float8 tz = (nd->box[4u + p->nz][c] - p->oz) * p->iz, uz = (nd->box[5u - p->nz][c] - p->oz) * p->fz;
+    tx = k_select8(tx, ty, ty > tx);
+    ux = k_select8(ux, uy, uy < ux);
+    tz = k_select8(tz, p->tmin, p->tmin > tz);
+    uz = k_select8(uz, *tfar, *tfar < uz);
+    float8 tn = k_select8(tx, tz, tz > tx), tf = k_select8(ux, uz, uz < ux);
+    uint m = k_bits8(tn <= tf) & lanes;
+    if (m) {
+        float ta[WIDE_PACKET];
+        k_store8(tn, ta);
+        *lead = ta[k_lowest_bit(m)];
+    }
+    return m;
+}
+
+/* The packet walk of rays[l] for the lanes l in `lanes`, all of whose directions have
+ * the sign bits `neg`; best[l] holds each lane's closest hit so far (its t the ray's
+ * tmax at the start). */
+KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, const RayPre *rp, int any, uint lanes,
+                                       uint neg, Hit *best)
+{
+    float a[WIDE_PACKET * 7];
+    float tfar_a[WIDE_PACKET];   /* each lane's closest hit so far, widened as tfar in bvh_lanes */
+    for (uint l = 0; l < WIDE_PACKET; l++) {
+        int on = (int)((lanes >> l) & 1u);
+        a[0 * WIDE_PACKET + l] = on ? rays[l].o.x : 0.0f;
+        a[1 * WIDE_PACKET + l] = on ? rays[l].o.y : 0.0f;
+        a[2 * WIDE_PACKET + l] = on ? rays[l].o.z : 0.0f;
+        a[3 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.x) : 1.0f;
+        a[4 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.y) : 1.0f;
+        a[5 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.z) : 1.0f;
+        a[6 * WIDE_PACKET + l] = on ? rays[l].tmin : 0.0f;
+        tfar_a[l] = best[l].t * KD_T_ABOVE;
+    }
+    BvhPacket p;
+    k_load8(p.ox, a);
+    k_load8(p.oy, a + WIDE_PACKET);
+    k_load8(p.oz, a + 2 * WIDE_PACKET);
+    k_load8(p.ix, a + 3 * WIDE_PACKET);
+    k_load8(p.iy, a + 4 * WIDE_PACKET);
+    k_load8(p.iz, a + 5 * WIDE_PACKET);
+    k_load8(p.tmin, a + 6 * WIDE_PACKET);
+    p.fx = p.ix * KD_T_ABOVE;
+    p.fy = p.iy * KD_T_ABOVE;
+    p.fz = p.iz * KD_T_ABOVE;
+    p.nx = neg & 1u;
+    p.ny = (neg >> 1) & 1u;
+    p.nz = (neg >> 2) & 1u;
+    uint st_child[BVH_STACK];
+    uint st_lanes[BVH_STACK];
+    int sp = 0;
+    uint ref = 0u, kind = BVH_CHILD_NODE, done = 0u;
+    for (;;) {
+        if (kind == BVH_CHILD_NODE) {
+            GLOBAL const BvhNode *nd = sc->bvh + ref;
+            float8 tfar;
+            k_load8(tfar, tfar_a);
+            uint cm[BVH_WIDTH];
+            float ct[BVH_WIDTH];
+            uint hit = 0u;
+            for (uint c = 0; c < BVH_WIDTH; c++) {
+                if (nd->kind[c] == BVH_CHILD_NONE) break;
+                cm[c] = bvh_child_lanes(nd, c, &p, &tfar, lanes, &ct[c]);
+                if (cm[c]) hit |= 1u << c;
+            }
+            if (hit) {
+                uint next = bvh_push_children(ref, hit, ct, cm, any, st_child, st_lanes, &sp);
+                lanes = cm[next];
+                kind = nd->kind[next];
+                ref = nd->ref[next];
+                continue;
+            }
+        } else {
+            KdNode leaf;
+            leaf.data = ref;
+            leaf.bits = kind;
+            for (uint m = lanes; m != 0u; m &= m - 1u) {
+                uint l = k_lowest_bit(m);
+                if (leaf_test(sc, sc->bvh_leaves, rays[l], &rp[l], any, leaf, &best[l])) done |= 1u << l;
+                tfar_a[l] = best[l].t * KD_T_ABOVE;
+            }
+        }
+        /* the next entry on the stack that a lane not yet done still enters */
+        for (;;) {
+            if (sp == 0) return;
+            sp--;
+            lanes = st_lanes[sp] & ~done;
+            if (!lanes) continue;
+            GLOBAL const BvhNode *parent = sc->bvh + (st_child[sp] >> 3);
+            uint c = st_child[sp] & 7u;
+            float8 tfar;
+            k_load8(tfar, tfar_a);
+            float lead;
+            lanes = bvh_child_lanes(parent, c, &p, &tfar, lanes, &lead);
+            if (!lanes) continue;
+            ref = parent->ref[c];
+            kind = parent->kind[c];
+            break;
+        }
+    }
+}
+
+/* trace_closest (any == 0) or trace_any_hit (any == 1) of 8 rays through the BVH
+ * (trace_wide_packet_walk). Rays whose signs differ from the others' are walked one
+ * after the other instead. */
+KFN_INLINE void trace_packet_wide(const SceneView *sc, const Ray *rays, int any, Hit *hits)
+{
+    RayPre rp[WIDE_PACKET];
+    uint lanes = 0u, neg = 0u, mixed = 0u;
+    for (uint l = 0; l < WIDE_PACKET; l++) {
+        Ray ray = rays[l];
+        hits[l] = hit_none(ray);
+        if (trace_planes(sc, ray, any, &hits[l]) && any) continue;
+        float s = ray.o.x + ray.o.y + ray.o.z + ray.d.x + ray.d.y + ray.d.z;
+        if (!(s == s) || sc->params->n_bvh_nodes == 0u) continue;
+        rp[l] = ray_prepare(ray);
+        if (lanes == 0u) neg = rp[l].neg;
+        mixed |= rp[l].neg ^ neg;
+        lanes |= 1u << l;
+    }
+    if (mixed) {
+        for (uint l = 0; l < WIDE_PACKET; l++)
+            if ((lanes >> l) & 1u) trace_wide(sc, rays[l], &rp[l], any, &hits[l]);
+    } else if (lanes) {
+        trace_wide_packet_walk(sc, rays, rp, any, lanes, neg, hits);
+    }
+}
+
+#endif /* CLPT_TRAVERSE_BVH_H */

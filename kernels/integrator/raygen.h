@@ -1,0 +1,76 @@
+/*
+ * raygen.h — where a path is born: the camera ray through a jittered point of its pixel
+ * (box filter), from a point on the thin lens when the aperture is open; or, for an
+ * orthographic camera, the parallel ray through that point of the view rectangle.
+ */
+#ifndef CLPT_RAYGEN_H
+#define CLPT_RAYGEN_H
+
+#include "sample/rng.h"
+#include "sample/sampling.h"
+
+/* The camera ray through film position (s, t) (see Camera in types.h); `key` gives
+ * the lens sample when the aperture is open. */
+KFN Ray camera_ray(GLOBAL const RenderParams *p, float s, float t, RngKey key)
+{
+    const Camera cam = p->camera;
+    Ray ray;
+    vec3 target = v3_sub(v3_madd(cam.corner, cam.horizontal, s), v3_scale(cam.vertical, t));
+    ray.tmin = 0.0f;
+    ray.tmax = INFINITY;
+    if (cam.type == CAMERA_ORTHOGRAPHIC) {
+        ray.o = target;
+        ray.d = cam.forward;
+        return ray;
+    }
+    vec3 origin = cam.origin;
+    if (cam.lens_radius > 0.0f) {
+        float lu, lv, lx, ly;
+        rng_uniform2(key, 0u, DIM_LENS_U, &lu, &lv);
+        sample_disk(lu, lv, &lx, &ly);
+        origin = v3_madd(v3_madd(origin, cam.lens_u, lx * cam.lens_radius), cam.lens_v, ly * cam.lens_radius);
+    }
+    ray.o = origin;
+    ray.d = v3_norm(v3_sub(target, origin));
+    return ray;
+}
+
+KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
+                     GLOBAL PathState *ps, GLOBAL Ray *ray)
+{
+    RngKey key = rng_key_make(p, pixel, sample);
+    uint x = pixel % p->width, y = pixel / p->width;
+    float jx, jy;
+    rng_uniform2(key, 0u, DIM_PIXEL_X, &jx, &jy);
+    float s = ((float)x + jx) / (float)p->width;
+    float t = ((float)y + jy) / (float)p->height;
+    *ray = camera_ray(p, s, t, key);
+
+    ps->throughput = v3s(1.0f);
+    ps->radiance = v3s(0.0f);
+    ps->shadow_L = v3s(0.0f);
+    ps->pixel = pixel;
+    ps->sample = sample;
+    ps->bounce = 0u;
+    ps->bsdf_pdf = 0.0f;
+    ps->flags = PATH_SPECULAR;  /* what the camera sees directly gets full weight */
+    ps->rng_key = key.key;
+    ps->branch = 0u;
+}
+
+/* Restarts the path of a camera sample as its next continuation from the first hit
+ * (first-hit splitting, RenderParams.split): the state raygen_path gave it, but with the
+ * radiance gathered so far and the next branch. The caller shades the first hit again,
+ * which for a later branch samples a light and scatters but adds no emission
+ * (shade_path). */
+KFN void path_branch_next(GLOBAL PathState *ps)
+{
+    ps->throughput = v3s(1.0f);
+    ps->shadow_L = v3s(0.0f);
+    ps->bounce = 0u;
+    ps->bsdf_pdf = 0.0f;
+    ps->flags = PATH_SPECULAR;
+    ps->branch = ps->branch + 1u;
+}
+
+#endif /* CLPT_RAYGEN_H */

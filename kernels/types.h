@@ -370,9 +370,52 @@ typedef struct {                                        /* 288 bytes */
 #define MAT_ALPHA_BLEND 16u     /* glTF alphaMode BLEND: a hit is kept with probability
                                  * alpha (kernels/accel/alpha.h) */
 
-/* Area lights are the emissive primitives; point, spot and directional lights are
- * delta lights (a single direction reaches a point: no MIS, hard shadows). */
-enum LightType { LIGHT_AREA = 0, LIGHT_POINT = 1, LIGHT_DIRECTIONAL = 2, LIGHT_SPOT = 3, LIGHT_ENV = 4 };
+/* Every light type, listed once: X(name, value, feature bit, traits, keyword), as
+ * MATERIAL_TYPES. The enum, the kernel feature a scene's lights need
+ * (kernel_features.c) and the trait predicates come from it; a new type is a line here,
+ * its sampling in kernels/light/lights.h and its keys in the readers.
+ *   LIGHT_AREA         the emissive primitives (an emissive material's surfaces)
+ *   LIGHT_POINT        a point radiating `intensity` (W/sr) evenly
+ *   LIGHT_DIRECTIONAL  parallel light from infinitely far (irradiance, W/m^2)
+ *   LIGHT_SPOT         a point light within a cone (cos_inner, cos_outer, spot_falloff)
+ *   LIGHT_ENV          the environment map's light (kernels/light/envmap.h) */
+#define LIGHT_TYPES(X) \
+    X(LIGHT_AREA,        0, 0u,              0u,                              area)        \
+    X(LIGHT_POINT,       1, KF_DELTA_LIGHTS, LT_DELTA,                        point)       \
+    X(LIGHT_DIRECTIONAL, 2, KF_DELTA_LIGHTS, LT_DELTA | LT_INFINITE,          directional) \
+    X(LIGHT_SPOT,        3, KF_DELTA_LIGHTS, LT_DELTA | LT_CONE,              spot)        \
+    X(LIGHT_ENV,         4, KF_ENV_MAP,      LT_INFINITE,                     environment)
+
+/* Traits of a light type. */
+#define LT_DELTA 1u     /* a single direction reaches a point from it: no MIS, hard
+                         * shadows, never hit by a ray */
+#define LT_INFINITE 2u  /* infinitely far: its light arrives from a direction, not a point */
+#define LT_CONE 4u      /* lights only a cone around its direction */
+
+#define LIGHT_ENUM_(name, value, bit, traits, keyword) name = value,
+enum LightType { LIGHT_TYPES(LIGHT_ENUM_) };
+#undef LIGHT_ENUM_
+
+/* Whether light type `type` has trait `trait` (LT_*). */
+KFN int light_has(uint type, uint trait)
+{
+#define LIGHT_HAS_(name, value, bit, traits, keyword) \
+    if (((traits) & trait) != 0u && type == (value)) return 1;
+    LIGHT_TYPES(LIGHT_HAS_)
+#undef LIGHT_HAS_
+    return 0;
+}
+KFN int light_is_delta(uint type) { return light_has(type, LT_DELTA); }
+
+/* The kernel feature (KF_*) the code of light type `type` is compiled under; 0: always
+ * compiled in. */
+KFN uint light_feature(uint type)
+{
+#define LIGHT_FEATURE_(name, value, bit, traits, keyword) if (type == (value)) return bit;
+    LIGHT_TYPES(LIGHT_FEATURE_)
+#undef LIGHT_FEATURE_
+    return 0u;
+}
 
 /* Every light, in one array with a cumulative distribution for choosing one
  * proportionally to its estimated power (host/scene/scene.c). Area lights come first

@@ -26,11 +26,7 @@ unsigned kernel_scene_features(const DeviceScene *s)
             f |= KF_TEXTURES;
         if (m->flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) f |= KF_ALPHA;
     }
-    for (uint i = 0; i < p->n_lights; i++) {
-        uint t = s->lights[i].type;
-        if (t == LIGHT_ENV) f |= KF_ENV_MAP;
-        else if (t != LIGHT_AREA) f |= KF_DELTA_LIGHTS;
-    }
+    for (uint i = 0; i < p->n_lights; i++) f |= light_feature(s->lights[i].type);
     f |= (p->n_spheres ? KF_SPHERES : 0u) | (p->n_boxes ? KF_BOXES : 0u) | (p->n_planes ? KF_PLANES : 0u) |
          (p->n_revsurfaces ? KF_REVSURFACE : 0u) | (p->n_bvh_nodes ? KF_BVH : KF_KDTREE) |
          (s->n_sphere_xforms ? KF_SPHERE_XFORM : 0u);

@@ -256,52 +256,52 @@ Status scene_parse_mesh(Parser *p, Lexer *lx, const Token *kw)
 
 /* ------------------------------------------------------------------ lights, textures */
 
-enum { LT_TYPE, LT_POSITION, LT_DIRECTION, LT_INTENSITY, LT_ATTEN, LT_ANGLE, LT_INNER, LT_N };
-static const KeySpec light_keys[LT_N] = {
-    [LT_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0, "a light type (point, spot, directional)"},
-    [LT_POSITION] = {"position", VK_VEC3, 0, 0, 0, 0, 0, NULL},
-    [LT_DIRECTION] = {"direction", VK_DIR, 0, 0, 0, 0, 0, NULL},
-    [LT_INTENSITY] = {"intensity", VK_COLOR, 1, 0, 0, 0, 0, NULL},
-    [LT_ATTEN] = {"attenuation", VK_COLOR, 0, 0, 0, 0, 0, NULL},
-    [LT_ANGLE] = {"angle", VK_NUMBER, 0, 0, 180, 1, 1, "a number of degrees in (0, 180)"},
-    [LT_INNER] = {"inner", VK_NUMBER, 0, 0, 180, 0, 1, "a number of degrees in [0, 180)"},
+enum { LK_TYPE, LK_POSITION, LK_DIRECTION, LK_INTENSITY, LK_ATTEN, LK_ANGLE, LK_INNER, LK_N };
+static const KeySpec light_keys[LK_N] = {
+    [LK_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0, "a light type (point, spot, directional)"},
+    [LK_POSITION] = {"position", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [LK_DIRECTION] = {"direction", VK_DIR, 0, 0, 0, 0, 0, NULL},
+    [LK_INTENSITY] = {"intensity", VK_COLOR, 1, 0, 0, 0, 0, NULL},
+    [LK_ATTEN] = {"attenuation", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [LK_ANGLE] = {"angle", VK_NUMBER, 0, 0, 180, 1, 1, "a number of degrees in (0, 180)"},
+    [LK_INNER] = {"inner", VK_NUMBER, 0, 0, 180, 0, 1, "a number of degrees in [0, 180)"},
 };
 
 Status scene_parse_light(Parser *p, Lexer *lx, const Token *kw)
 {
-    Value v[LT_N];
-    Status st = scene_parse_block(p, lx, kw, 0, "light", light_keys, LT_N, v);
+    Value v[LK_N];
+    Status st = scene_parse_block(p, lx, kw, 0, "light", light_keys, LK_N, v);
     if (st) return st;
     static const struct { const char *name; uint type; unsigned allowed; } types[] = {
-        {"point", LIGHT_POINT, 1u << LT_POSITION | 1u << LT_ATTEN},
-        {"spot", LIGHT_SPOT, 1u << LT_POSITION | 1u << LT_DIRECTION | 1u << LT_ATTEN | 1u << LT_ANGLE | 1u << LT_INNER},
-        {"directional", LIGHT_DIRECTIONAL, 1u << LT_DIRECTION},
+        {"point", LIGHT_POINT, 1u << LK_POSITION | 1u << LK_ATTEN},
+        {"spot", LIGHT_SPOT, 1u << LK_POSITION | 1u << LK_DIRECTION | 1u << LK_ATTEN | 1u << LK_ANGLE | 1u << LK_INNER},
+        {"directional", LIGHT_DIRECTIONAL, 1u << LK_DIRECTION},
     };
     size_t ti;
     for (ti = 0; ti < 3; ti++)
-        if (tok_is(&v[LT_TYPE].word, types[ti].name)) break;
-    if (ti == 3) return lex_expected(lx, &v[LT_TYPE].word, light_keys[LT_TYPE].what, p->err);
-    unsigned allowed = types[ti].allowed | 1u << LT_TYPE | 1u << LT_INTENSITY;
-    for (int i = 0; i < LT_N; i++)
+        if (tok_is(&v[LK_TYPE].word, types[ti].name)) break;
+    if (ti == 3) return lex_expected(lx, &v[LK_TYPE].word, light_keys[LK_TYPE].what, p->err);
+    unsigned allowed = types[ti].allowed | 1u << LK_TYPE | 1u << LK_INTENSITY;
+    for (int i = 0; i < LK_N; i++)
         if (v[i].given && !(allowed & (1u << i)))
             return lex_error_at(lx, &v[i].key, p->err, "a %s light has no '%s'", types[ti].name, light_keys[i].key);
     Light l = light_default(types[ti].type);
-    l.intensity = v[LT_INTENSITY].v;
-    if (v[LT_POSITION].given) l.position = v[LT_POSITION].v;
-    if (v[LT_DIRECTION].given) {
-        vec3 d = v[LT_DIRECTION].v;
+    l.intensity = v[LK_INTENSITY].v;
+    if (v[LK_POSITION].given) l.position = v[LK_POSITION].v;
+    if (v[LK_DIRECTION].given) {
+        vec3 d = v[LK_DIRECTION].v;
         double len = scene_len_d(d);
         l.direction = v3((float)(d.x / len), (float)(d.y / len), (float)(d.z / len));
     }
-    if (v[LT_ATTEN].given) {
-        if (v3_is_zero(v[LT_ATTEN].v))
-            return lex_error_at(lx, &v[LT_ATTEN].key, p->err, "'attenuation' (constant linear quadratic) must not be all 0");
-        l.atten0 = v[LT_ATTEN].v.x;
-        l.atten1 = v[LT_ATTEN].v.y;
-        l.atten2 = v[LT_ATTEN].v.z;
+    if (v[LK_ATTEN].given) {
+        if (v3_is_zero(v[LK_ATTEN].v))
+            return lex_error_at(lx, &v[LK_ATTEN].key, p->err, "'attenuation' (constant linear quadratic) must not be all 0");
+        l.atten0 = v[LK_ATTEN].v.x;
+        l.atten1 = v[LK_ATTEN].v.y;
+        l.atten2 = v[LK_ATTEN].v.z;
     }
-    float outer = v[LT_ANGLE].given ? v[LT_ANGLE].f : 30.0f, inner = v[LT_INNER].given ? v[LT_INNER].f : outer;
-    if (inner > outer) return lex_error_at(lx, &v[LT_INNER].key, p->err, "'inner' must not exceed 'angle'");
+    float outer = v[LK_ANGLE].given ? v[LK_ANGLE].f : 30.0f, inner = v[LK_INNER].given ? v[LK_INNER].f : outer;
+    if (inner > outer) return lex_error_at(lx, &v[LK_INNER].key, p->err, "'inner' must not exceed 'angle'");
     l.cos_outer = (float)cos((double)outer * M_PI / 180.0);
     l.cos_inner = (float)cos((double)inner * M_PI / 180.0);
     return scene_add_light(p->s, l, p->err);

@@ -723,10 +723,10 @@ static double scene_radius(const Scene *s)
 static double delta_light_power(const Light *l, double r)
 {
     double lum = v3_luminance(l->intensity);
-    if (l->type == LIGHT_DIRECTIONAL) return M_PI * r * r * lum;
+    if (light_has(l->type, LT_INFINITE)) return M_PI * r * r * lum;
     double atten = (double)l->atten0 + (double)l->atten1 * r + (double)l->atten2 * r * r;
     double solid_angle = 4.0 * M_PI;
-    if (l->type == LIGHT_SPOT)
+    if (light_has(l->type, LT_CONE))
         solid_angle = 2.0 * M_PI * (1.0 - 0.5 * ((double)l->cos_inner + (double)l->cos_outer));
     return atten > 0.0 ? solid_angle * r * r * lum / atten : 0.0;
 }

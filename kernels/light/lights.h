@@ -152,7 +152,7 @@ KFN int light_delta_at(Light l, vec3 ref, LightSample *ls)
     if (l.type == LIGHT_ENV) return 0;
     ls->delta = 1;
     ls->n = v3s(0.0f);
-    if (l.type == LIGHT_DIRECTIONAL) {
+    if (light_has(l.type, LT_INFINITE)) {
         ls->wi = v3_neg(l.direction);
         ls->dist = k_as_float(0x7f800000u);
         ls->p = ref;
@@ -168,7 +168,7 @@ KFN int light_delta_at(Light l, vec3 ref, LightSample *ls)
     ls->dist = dist;
     ls->p = l.position;
     float scale = 1.0f / atten;
-    if (l.type == LIGHT_SPOT) scale *= spot_falloff(l, -v3_dot(ls->wi, l.direction));
+    if (light_has(l.type, LT_CONE)) scale *= spot_falloff(l, -v3_dot(ls->wi, l.direction));
     ls->Le = v3_scale(l.intensity, scale);
     return scale > 0.0f;
 }
@@ -295,7 +295,7 @@ KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, int reuse,
         ls->delta = 0;
         return ls->pdf > 0.0f;
     }
-    if (KF_HAS(KF_DELTA_LIGHTS) && l.type != LIGHT_AREA) {
+    if (KF_HAS(KF_DELTA_LIGHTS) && light_is_delta(l.type)) {
         if (!light_delta_at(l, ref, ls)) return 0;
         ls->pdf = choice;
         return choice > 0.0f;

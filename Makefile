@@ -37,6 +37,14 @@ LDLIBS    := -lOpenCL -lstb -lOpenEXRCore -lOpenEXR -lcjson -lz -lm
 MPI_CFLAGS := $(shell pkg-config --cflags ompi-c 2>/dev/null || echo -I/usr/lib/x86_64-linux-gnu/openmpi/include)
 MPI_LIBS   := $(shell pkg-config --libs ompi-c 2>/dev/null || echo -lmpi)
 
+# The version is the VERSION file's one line (semantic versioning, CHANGELOG.md); the
+# commit is git's, when this folder is a git checkout (a worktree's .git is a file),
+# with -dirty for changes not committed. Only build/version.o holds them.
+VERSION    := $(shell cat VERSION)
+GIT_COMMIT := $(shell test -e .git && git rev-parse --short=12 HEAD 2>/dev/null)
+GIT_DIRTY  := $(if $(GIT_COMMIT),$(shell git diff --quiet HEAD -- 2>/dev/null || echo -dirty))
+COMMIT     := $(if $(GIT_COMMIT),$(GIT_COMMIT)$(GIT_DIRTY),unknown)
+
 # Code that compiles the kernel sources as C must not promote floats to double, or the
 # scalar device would round differently from OpenCL.
 KERNEL_C_WARN := -Wdouble-promotion -Werror=double-promotion
@@ -56,7 +64,7 @@ FUZZ_BIN  := $(FUZZ_SRC:fuzz/%.c=$(BUILD)/fuzz/%)
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: all deps test render bench bench-peers xcheck clean test-asan test-valgrind fuzz fuzz-build
+.PHONY: FORCE all deps test render bench bench-peers xcheck clean test-asan test-valgrind fuzz fuzz-build
 .DEFAULT_GOAL := all
 
 all: $(BUILD)/$(PROG)
@@ -91,6 +99,19 @@ $(BUILD)/bench_kernel_source.c: $(KERNELS) $(BUILD)/embed
 $(BUILD)/kernel_source.o $(BUILD)/bench_kernel_source.o: %.o: %.c
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c -o $@ $<
 
+# Rewritten only when the version or the commit changed, so that an unchanged build
+# links nothing again.
+$(BUILD)/version.c: VERSION FORCE
+	@mkdir -p $(@D)
+	@printf '/* written by the Makefile from VERSION and git */\n#include "version.h"\nconst char clpt_version[] = "%s";\nconst char clpt_commit[] = "%s";\n' \
+	    '$(VERSION)' '$(COMMIT)' > $@.tmp
+	@if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv $@.tmp $@; fi
+
+$(BUILD)/version.o: $(BUILD)/version.c host/version.h
+	$(CC) $(CPPFLAGS) $(CFLAGS) -c -o $@ $<
+
+FORCE:
+
 $(BUILD)/host/%.o: host/%.c
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(FILE_WARN) -MMD -MP -c -o $@ $<
@@ -103,7 +124,7 @@ $(BUILD)/lib$(PROG).a: $(HOST_OBJ)
 
 # Only the program links SDL2 (the viewer, --interactive); the tests and benchmarks use
 # the library without it.
-$(BUILD)/$(PROG): $(BUILD)/host/main.o $(BUILD)/lib$(PROG).a
+$(BUILD)/$(PROG): $(BUILD)/host/main.o $(BUILD)/version.o $(BUILD)/lib$(PROG).a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS) $(MPI_LIBS) -lSDL2
 
 $(BUILD)/tests/%: tests/%.c tests/harness.h $(BUILD)/lib$(PROG).a

@@ -37,9 +37,8 @@
 #include "render/stats.h"
 #include "io/scene_load.h"
 #include "base/timer.h"
+#include "version.h"
 #include "viewer/viewer.h"
-
-#define CLPT_VERSION "0.1.0"
 
 static volatile sig_atomic_t stop_requested;
 /* What the first stop prints, chosen before the handlers are installed (the handler
@@ -258,7 +257,7 @@ static Status run_info_command(const Options *o, int *done, Error *err)
     if (o->help) {
         options_print_help(stdout);
     } else if (o->version) {
-        printf("clpt %s\n", CLPT_VERSION);
+        printf("clpt %s (commit %s)\n", clpt_version, clpt_commit);
     } else if (o->list_devices) {
         DeviceDesc *all = NULL;
         size_t n = 0;

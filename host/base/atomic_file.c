@@ -18,12 +18,38 @@ void atomic_fail(AtomicFile *af, const char *step)
 
 static Status atomic_error(const AtomicFile *af, Error *err)
 {
+    if (af->stream)
+        return error_set(err, ST_IO, "cannot write %s%sto %s: %s: %s", af->what, af->what[0] ? " " : "", af->path,
+                         af->failed_step, strerror(af->failed_errno));
     return error_set(err, ST_IO, "cannot write %s%s'%s': %s: %s", af->what, af->what[0] ? " " : "", af->path,
                      af->failed_step, strerror(af->failed_errno));
 }
 
+void atomic_open_stream(AtomicFile *af, FILE *f, const char *name, const char *what)
+{
+    memset(af, 0, sizeof *af);
+    af->path = name;
+    af->what = what;
+    af->f = f;
+    af->stream = 1;
+}
+
+/* A stream's end: what is buffered is flushed, the stream stays open for its owner. */
+static Status atomic_commit_stream(AtomicFile *af, Error *err)
+{
+    errno = 0;
+    if (!af->failed_step && (fflush(af->f) != 0 || ferror(af->f))) atomic_fail(af, "write");
+    af->f = NULL;
+    return af->failed_step ? atomic_error(af, err) : ST_OK;
+}
+
 void atomic_abort(AtomicFile *af)
 {
+    if (af->stream) {
+        if (af->f) fflush(af->f);
+        af->f = NULL;
+        return;
+    }
     if (af->f) fclose(af->f);
     af->f = NULL;
     if (af->tmp) unlink(af->tmp);
@@ -207,6 +233,7 @@ static void sync_parent_folder(const char *path)
 /* Write errors such as a full disk often surface only at the flush or the sync. */
 Status atomic_commit(AtomicFile *af, Error *err)
 {
+    if (af->stream) return atomic_commit_stream(af, err);
     if (!af->failed_step) {
         errno = 0;
         if (fflush(af->f) != 0) atomic_fail(af, "write");

@@ -36,11 +36,17 @@ typedef struct {
     FILE *f;
     const char *failed_step; /* the first failure, or NULL */
     int failed_errno;
+    int stream;              /* atomic_open_stream: f is the caller's, nothing renamed */
 } AtomicFile;
 
 /* Creates the temporary file beside `path`. `what` names the kind of file in messages
  * ("checkpoint"; "" for an image). On failure nothing is left behind. */
 Status atomic_open(AtomicFile *af, const char *path, const char *what, Error *err);
+/* The same writer over an open stream (standard output, `-o -`): the bytes go straight
+ * to f, which is flushed by atomic_commit and never closed. Nothing about it is atomic
+ * (a reader sees the bytes as they come, and a failure leaves what was written); the
+ * failures are still remembered and reported as "cannot write <what> to <name>". */
+void atomic_open_stream(AtomicFile *af, FILE *f, const char *name, const char *what);
 /* Checks, before a long render, that `path` can be written: creates and removes the
  * temporary file atomic_open would. Fails as atomic_open would (ST_IO, the same
  * message: a missing or unwritable folder, a folder, FIFO or device in the file's

@@ -20,13 +20,57 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 #include <stb_image_write.h>
 
 #define SUPPORTED_EXTENSIONS ".png, .ppm, .pfm, .bmp, .exr, .hdr"
 
+/* The formats by their extension, without the dot: also the FORMAT of "FORMAT:-". */
+static int format_from_word(const char *word, size_t len, ImageFormat *fmt)
+{
+    static const struct { const char *name; ImageFormat fmt; } formats[] = {
+        { "png", IMAGE_PNG }, { "ppm", IMAGE_PPM }, { "pfm", IMAGE_PFM },
+        { "bmp", IMAGE_BMP }, { "exr", IMAGE_EXR }, { "hdr", IMAGE_HDR },
+    };
+    for (size_t i = 0; i < sizeof formats / sizeof formats[0]; i++)
+        if (strlen(formats[i].name) == len && strncasecmp(word, formats[i].name, len) == 0) {
+            *fmt = formats[i].fmt;
+            return 1;
+        }
+    return 0;
+}
+
+int image_path_is_stdout(const char *path)
+{
+    size_t n = strlen(path);
+    return strcmp(path, "-") == 0 || (n > 2 && strcmp(path + n - 2, ":-") == 0 && !strchr(path, '/'));
+}
+
+Status image_stdout_check(Error *err)
+{
+    if (isatty(STDOUT_FILENO))
+        return error_set(err, ST_USAGE, "-o - writes the image to standard output, which is a terminal: "
+                         "redirect it (clpt SCENE -o - > image.png, or into a pipe)");
+    return ST_OK;
+}
+
+/* "-" is PNG; "exr:-" names its format before the colon. */
+static Status stdout_format(const char *path, ImageFormat *fmt, Error *err)
+{
+    if (strcmp(path, "-") == 0) {
+        *fmt = IMAGE_PNG;
+        return ST_OK;
+    }
+    if (!format_from_word(path, strlen(path) - 2, fmt))
+        return error_set(err, ST_USAGE, "cannot write the image to standard output as '%.*s': -o - writes PNG, "
+                         "and FORMAT:- one of png, ppm, pfm, bmp, exr, hdr", (int)(strlen(path) - 2), path);
+    return ST_OK;
+}
+
 Status image_format_from_path(const char *path, ImageFormat *fmt, Error *err)
 {
+    if (image_path_is_stdout(path)) return stdout_format(path, fmt, err);
     const char *slash = strrchr(path, '/');
     const char *name = slash ? slash + 1 : path;
     const char *dot = strrchr(name, '.');
@@ -34,13 +78,7 @@ Status image_format_from_path(const char *path, ImageFormat *fmt, Error *err)
         return error_set(err, ST_USAGE,
                          "cannot tell the image format of '%s': it has no extension "
                          "(supported: " SUPPORTED_EXTENSIONS ")", path);
-    if (strcasecmp(dot, ".png") == 0) *fmt = IMAGE_PNG;
-    else if (strcasecmp(dot, ".ppm") == 0) *fmt = IMAGE_PPM;
-    else if (strcasecmp(dot, ".pfm") == 0) *fmt = IMAGE_PFM;
-    else if (strcasecmp(dot, ".bmp") == 0) *fmt = IMAGE_BMP;
-    else if (strcasecmp(dot, ".exr") == 0) *fmt = IMAGE_EXR;
-    else if (strcasecmp(dot, ".hdr") == 0) *fmt = IMAGE_HDR;
-    else
+    if (!format_from_word(dot + 1, strlen(dot + 1), fmt))
         return error_set(err, ST_USAGE,
                          "cannot tell the image format of '%s': unsupported extension '%s' "
                          "(supported: " SUPPORTED_EXTENSIONS ")", path, dot);
@@ -216,6 +254,15 @@ static Status write_exr(AtomicFile *af, const float *rgb, const ImageLayer *laye
     return ST_OK;
 }
 
+/* The writer for path: a temporary file renamed over it, or standard output. */
+static Status image_open(AtomicFile *af, const char *path, Error *err)
+{
+    if (!image_path_is_stdout(path)) return atomic_open(af, path, "", err);
+    Status st = image_stdout_check(err);
+    if (st == ST_OK) atomic_open_stream(af, stdout, "standard output", "the image");
+    return st;
+}
+
 /* Checks the size every format can take. */
 static Status image_check_size(const char *path, const float *rgb, unsigned width, unsigned height, Error *err)
 {
@@ -236,7 +283,7 @@ Status image_write_exr(const char *path, const float *rgb, const ImageLayer *lay
     Status st = image_check_size(path, rgb, width, height, err);
     if (st != ST_OK) return st;
     AtomicFile af;
-    if ((st = atomic_open(&af, path, "", err)) != ST_OK) return st;
+    if ((st = image_open(&af, path, err)) != ST_OK) return st;
     if ((st = write_exr(&af, rgb, layers, n_layers, width, height, float32, err)) != ST_OK) {
         atomic_abort(&af);
         return st;
@@ -270,7 +317,7 @@ Status image_write_encoded(const char *path, const float *rgb, unsigned width, u
     }
 
     AtomicFile af;
-    st = atomic_open(&af, path, "", err);
+    st = image_open(&af, path, err);
     if (st != ST_OK) {
         free(srgb);
         return st;

@@ -42,8 +42,16 @@ typedef struct {
 } ImageLayer;
 
 /* The format named by path's extension (.png .ppm .pfm .bmp .exr .hdr, any case). An unknown or
- * missing extension is ST_USAGE, with a message that lists the supported ones. */
+ * missing extension is ST_USAGE, with a message that lists the supported ones. The
+ * path "-" is standard output as PNG, and "FORMAT:-" (exr:-, pfm:-, any of the six)
+ * standard output in that format; an unknown FORMAT is ST_USAGE too. */
 Status image_format_from_path(const char *path, ImageFormat *fmt, Error *err);
+/* Whether path names standard output ("-" or "FORMAT:-") rather than a file. Such an
+ * image is written straight to stdout, not atomically (see atomic_open_stream). */
+int image_path_is_stdout(const char *path);
+/* Standard output can take an image: not a terminal (binary bytes on a screen help
+ * nobody), else ST_USAGE saying how to redirect it. */
+Status image_stdout_check(Error *err);
 
 /* Writes rgb (linear radiance, width*height*3 floats, top row first) to path, atomically,
  * in the format of its extension. ST_USAGE for an unknown extension, ST_IO when the file

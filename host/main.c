@@ -228,6 +228,7 @@ typedef struct {
     Checkpoint resume;
     RenderContext ctx;
     double t_start;
+    FILE *report;                 /* --stats and --profile: stdout, stderr when the image goes there */
 } Run;
 
 static void run_free(Run *r)
@@ -283,7 +284,10 @@ static Status outputs_check(const Run *r, Error *err)
     char *aov_paths[3] = { NULL, NULL, NULL };
     size_t n = 0;
     Status st = ST_OK;
-    named_file_init(&files[n++], r->output, "the output image", FILE_IMAGE);
+    /* standard output is no file of the run's: nothing to probe or compare */
+    if (image_path_is_stdout(r->output)) st = image_stdout_check(err);
+    else named_file_init(&files[n++], r->output, "the output image", FILE_IMAGE);
+    if (st) return st;
     for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
         if (!(o->aovs & (1u << aov)) || passes_aov_in_exr(&q, r->output, aov)) continue;
         char *path = aov_paths[aov - INTEGRATOR_AOV_NORMAL] = passes_aov_output_path(&q, r->output, aov);
@@ -397,7 +401,7 @@ static Status render_prepare(Run *r, int worker, int keyed, Error *err)
     Status st;
     if ((st = render_scene_prepare(&r->scene, 0, &r->rs, err))) return st;
     const DeviceScene *ds = &r->rs.ds;
-    if (r->o.stats && !worker) render_stats_print_scene(&r->scene, &r->rs);
+    if (r->o.stats == STATS_TEXT && !worker) render_stats_print_scene(r->report, &r->scene, &r->rs);
     if (keyed || r->o.checkpoint_path || r->o.resume_path) checkpoint_id(ds, r->scene.image.spp, &r->ctx.checkpoint_id);
     if ((st = film_init(&r->film, ds->params.width, ds->params.height, err))) return st;
     if (!r->o.resume_path || worker) return ST_OK;
@@ -489,23 +493,39 @@ static Status results_write_checkpoint(Run *r, Error *cerr)
     return cst;
 }
 
+/* The output as the summary names it. */
+static const char *output_name(const char *output)
+{
+    return image_path_is_stdout(output) ? "standard output" : output;
+}
+
+/* --stats=json: the run as one object (stats.h). */
+static void results_print_json(const Run *r, const char *result)
+{
+    RenderStatsRun run = { clpt_version, r->o.scene_path, output_name(r->output), result, r->film.width,
+                           r->film.height, r->scene.image.spp, timer_now() - r->t_start };
+    render_stats_print_json(r->report, &run, &r->scene, &r->stats);
+}
+
 static void results_print_summary(const Run *r)
 {
     const ScheduleStats *s = &r->stats;
-    if (r->o.stats || r->o.profile) render_stats_print_run(s, r->scene.image.spp, r->devs, r->n_devs);
+    const char *result = s->interrupted ? "interrupted" : (s->time_up ? "time limit reached" : "rendered");
+    if (r->o.stats == STATS_JSON) results_print_json(r, result);
+    else if (r->o.stats || r->o.profile) render_stats_print_run(r->report, s, r->scene.image.spp, r->devs, r->n_devs);
     if (r->o.profile) {
-        render_stats_print_profile(s, r->devs, r->n_devs);
+        render_stats_print_profile(r->report, s, r->devs, r->n_devs);
         if (r->scene.image.split > 1 && r->scene.integrator == INTEGRATOR_PATH)
-            printf("profile: with --split, OpenCL devices run each path as one kernel (k_path), whose time is "
-                   "all under shade\n");
+            fprintf(r->report, "profile: with --split, OpenCL devices run each path as one kernel (k_path), whose "
+                    "time is all under shade\n");
     }
     if (r->o.quiet && r->render_st == ST_OK && !s->interrupted) return;
     double secs = s->seconds > 0.0 ? s->seconds : 1e-9;
-    fprintf(stderr, "clpt: %s %ux%u, %llu spp%s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n",
-            s->interrupted ? "interrupted:" : (s->time_up ? "time limit reached:" : "rendered"), r->film.width,
+    fprintf(stderr, "clpt: %s%s %ux%u, %llu spp%s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n",
+            result, strcmp(result, "rendered") ? ":" : "", r->film.width,
             r->film.height, (unsigned long long)r->film.samples,
             r->film.samples < r->scene.image.spp ? " (partial)" : "", s->seconds, timer_now() - r->t_start,
-            (double)s->samples / secs / 1e6, (double)s->rays / secs / 1e6, r->output);
+            (double)s->samples / secs / 1e6, (double)s->rays / secs / 1e6, output_name(r->output));
 }
 
 /* The adaptive pass and the auxiliary images, after a complete main image. */
@@ -591,7 +611,7 @@ static Status run_rank(Run *r, Dist *dist, Error *err)
     if (dist->rank > 0) r->o.quiet = 1;
     DistRankSteps s = { r, rank_prepare, rank_open_devices, rank_worker_starts, rank_render,
                         &r->rs.ds, &r->scene.image.spp, &r->ctx.checkpoint_id, &r->devs, &r->n_devs,
-                        &stop_requested, r->o.stats ? stdout : NULL };
+                        &stop_requested, r->o.stats == STATS_TEXT ? r->report : NULL };
     return dist_run_rank(dist, &s, err);
 }
 
@@ -624,6 +644,7 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
     r.t_start = timer_now();
     int done = 0;
     Status st = options_parse(argc, argv, &r.o, err);
+    r.report = r.o.output && image_path_is_stdout(r.o.output) ? stderr : stdout;
     if (dist_launched()) {
         DistRequest q = dist_request(&r.o);
         st = dist_join(dist, &q, st, err);

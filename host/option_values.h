@@ -4,6 +4,9 @@
 #ifndef CLPT_OPTION_VALUES_H
 #define CLPT_OPTION_VALUES_H
 
+/* --stats: none, the text tables (--stats), or one JSON object (--stats=json) */
+enum { STATS_NONE, STATS_TEXT, STATS_JSON };
+
 typedef struct {
     const char *scene_path;
     const char *output;           /* NULL: <scene name>.png in the current folder */
@@ -23,7 +26,8 @@ typedef struct {
     /* under mpirun (docs/distributed.md) */
     int mpi_broadcast;            /* the scene is read by rank 0 only and sent to the others */
     double mpi_timeout;           /* seconds of silence before a rank is given up; 0 = 30 */
-    int list_devices, stats, profile, quiet, help, version;
+    int list_devices, profile, quiet, help, version;
+    int stats;                    /* STATS_NONE, _TEXT or _JSON */
     int interactive;              /* --interactive: the viewer (docs/viewer.md) */
     int exr_float;                /* EXR channels as 32-bit floats, not halves */
     /* developer flags */

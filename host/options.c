@@ -9,6 +9,7 @@
 #include "course_args.h"
 
 #include "device/device.h"
+#include "io/image_write.h"
 #include "io/scene_load.h"
 #include "render/passes.h"
 #include "base/limit.h"
@@ -32,7 +33,8 @@
  *            whose words are listed instead ("bvh|kdtree")
  *   extra    NONE, or what the kind needs: WHAT("file name") for TEXT (the error
  *            message's "needs a file name"), RANGE(lo, hi) for LONG/UINT/INT, ONE_OF(
- *            { "word", value }, ...) for CHOICE, PARSE(function) for CUSTOM
+ *            { "word", value }, ...) for CHOICE, PARSE(function) for CUSTOM. A SWITCH
+ *            with ONE_OF also takes a word after '=' (--stats=json; alone: 1)
  *   help     its --help text, '\n' between lines: each line within 80 columns once
  *            indented to column 29 (tests/test_cli.c checks)
  */
@@ -46,7 +48,9 @@
         "atomically; a symlink is followed and an\n" \
         "existing file keeps its permissions; only a\n" \
         "regular file is replaced (a FIFO or device\n" \
-        "is refused). Checked before rendering") \
+        "is refused). Checked before rendering.\n" \
+        "'-' writes PNG to standard output, FORMAT:-\n" \
+        "(exr:-, pfm:-, ppm:-, bmp:-, hdr:-) that format") \
     X(OUTPUT, LONG, spp, "--spp", NULL, "N", RANGE(1, CLPT_MAX_SPP), \
         "samples per pixel (overrides the scene)") \
     X(OUTPUT, LONG, width, "--width", NULL, "N", RANGE(1, CLPT_MAX_IMAGE_SIDE), \
@@ -179,10 +183,13 @@
     X(DEVICES, INT, threads, "--threads", NULL, "N", RANGE(1, 256), \
         "worker threads of the scalar device (default:\n" \
         "all cores)") \
-    X(REPORTING, SWITCH, stats, "--stats", NULL, NULL, NONE, \
+    X(REPORTING, SWITCH, stats, "--stats", NULL, NULL, ONE_OF({ "text", STATS_TEXT }, { "json", STATS_JSON }), \
         "print scene, tree (BVH or kd-tree), kernel\n" \
         "build, OpenCL wave (size, how it runs) and\n" \
-        "per-device statistics to stdout") \
+        "per-device statistics to stdout; =json: one\n" \
+        "JSON object at the end instead, for scripts\n" \
+        "(docs/cli.md). To stderr when -o - writes the\n" \
+        "image to stdout") \
     X(REPORTING, SWITCH, profile, "--profile", NULL, NULL, NONE, \
         "--stats, and where each device's time goes: ray\n" \
         "generation, traversal, shading, shadow rays,\n" \
@@ -245,6 +252,10 @@ static const char *const help_sections[HELP_SECTIONS] = {
 "does (whitted, one ray per pixel centre, no gamma, -bounces N mirror/refraction\n"
 "bounces, default 0; no shadows unless -shadows). -depth draws NEAR black and\n"
 "FAR white. See docs/classic-format.md.\n"
+"\n"
+"Options and the scene come in any order; '--' ends the options. A flag's value\n"
+"may follow it or an '=' (--spp=64); one-letter flags bundle (-qo out.png).\n"
+"See docs/cli.md.\n"
 "\n",
     [HELP_OUTPUT] = "Output and image:\n",
     [HELP_CHECKPOINT] = "Checkpoints (docs/checkpoint.md):\n",
@@ -440,16 +451,26 @@ static void choices_text(const OptionChoice *c, int quoted, char *buf, size_t si
     }
 }
 
+/* What follows a flag's name in --help and the man page: " FILE", " bvh|kdtree", or
+ * "[=text|json]" for a switch that may take a word; "" for a plain switch. */
+void option_value_text(const OptionSpec *s, char *buf, size_t size)
+{
+    char words[96];
+    if (s->choices) choices_text(s->choices, 0, words, sizeof words);
+    else snprintf(words, sizeof words, "%s", s->metavar ? s->metavar : "");
+    if (s->kind == OPTION_SWITCH) snprintf(buf, size, s->choices ? "[=%s]" : "", words);
+    else snprintf(buf, size, " %s", words);
+}
+
 /* "  -o, --output FILE", then the help from column 29 (on a line of its own when the
  * flag is longer). */
 static void print_flag(FILE *f, const OptionSpec *s)
 {
     char value[96];
-    if (s->choices) choices_text(s->choices, 0, value, sizeof value);
-    else snprintf(value, sizeof value, "%s", s->metavar ? s->metavar : "");
+    option_value_text(s, value, sizeof value);
     char label[160];
-    int n = snprintf(label, sizeof label, "  %s%s%s%s%s", s->alias ? s->alias : "  ", s->alias ? ", " : "  ",
-                     s->name, value[0] ? " " : "", value);
+    int n = snprintf(label, sizeof label, "  %s%s%s%s", s->alias ? s->alias : "  ", s->alias ? ", " : "  ",
+                     s->name, value);
     enum { HELP_COLUMN = 29 };
     if (n < HELP_COLUMN) fprintf(f, "%-*s", HELP_COLUMN, label);
     else fprintf(f, "%s\n%*s", label, HELP_COLUMN, "");
@@ -458,6 +479,16 @@ static void print_flag(FILE *f, const OptionSpec *s)
         if (*p == '\n') fprintf(f, "%*s", HELP_COLUMN, "");
     }
     fputc('\n', f);
+}
+
+size_t options_help_sections(void)
+{
+    return HELP_SECTIONS;
+}
+
+const char *options_help_section(size_t i)
+{
+    return i < HELP_SECTIONS ? help_sections[i] : NULL;
 }
 
 void options_print_help(FILE *f)
@@ -476,25 +507,92 @@ void options_print_help(FILE *f)
 
 /* ---------------------------------------------------------------- parsing */
 
-/* The flag named `a` (its name or alias) that takes a value (want_value) or not. */
-static const OptionSpec *option_find(const char *a, int want_value)
+/* The flag named `a` (its name or alias); NULL: none. */
+static const OptionSpec *option_find(const char *a)
 {
     for (size_t k = 0; k < N_OPTIONS; k++) {
         const OptionSpec *s = &option_specs[k];
-        if ((s->kind != OPTION_SWITCH) != want_value) continue;
         if (strcmp(a, s->name) == 0 || (s->alias && strcmp(a, s->alias) == 0)) return s;
     }
     return NULL;
 }
 
-/* Reads v, the value of flag `a` (as typed), into its field of o. */
+/* Levenshtein distance between two short words (a flag as typed and a listed one);
+ * words past 63 characters are as far as can be. */
+static size_t edit_distance(const char *a, const char *b)
+{
+    enum { MAX = 64 };
+    size_t la = strlen(a), lb = strlen(b), row[MAX];
+    if (la >= MAX || lb >= MAX) return (size_t)-1;
+    for (size_t j = 0; j <= lb; j++) row[j] = j;
+    for (size_t i = 1; i <= la; i++) {
+        size_t diag = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= lb; j++) {
+            size_t up = row[j];
+            size_t best = diag + (a[i - 1] != b[j - 1]);
+            if (up + 1 < best) best = up + 1;
+            if (row[j - 1] + 1 < best) best = row[j - 1] + 1;
+            row[j] = best;
+            diag = up;
+        }
+    }
+    return row[lb];
+}
+
+/* The listed flag a mistyped `a` most likely meant: the nearest name, when it is at
+ * most two edits away and those edits are fewer than half of what was typed (so that
+ * "-x" suggests nothing); NULL: none is near. */
+static const char *option_nearest(const char *a)
+{
+    const char *best = NULL;
+    size_t best_d = 3, letters = strspn(a, "-") < strlen(a) ? strlen(a) - strspn(a, "-") : 0;
+    for (size_t k = 0; k < N_OPTIONS; k++) {
+        size_t d = edit_distance(a, option_specs[k].name);
+        if (d < best_d && 2 * d < letters + 1) {
+            best_d = d;
+            best = option_specs[k].name;
+        }
+    }
+    return best;
+}
+
+/* "unknown option '--sp'; did you mean '--spp'?" (main adds the one hint at --help). */
+static Status option_unknown(const char *a, Error *err)
+{
+    const char *near = option_nearest(a);
+    if (near) return error_set(err, ST_USAGE, "unknown option '%s'; did you mean '%s'?", a, near);
+    return error_set(err, ST_USAGE, "unknown option '%s'", a);
+}
+
+/* One of a CHOICE flag's words (or of a SWITCH's after '=') into the int at dst. */
+static Status option_set_choice(const OptionSpec *s, const char *a, const char *v, void *dst, Error *err)
+{
+    for (const OptionChoice *c = s->choices; c->name; c++)
+        if (strcmp(v, c->name) == 0) {
+            *(int *)dst = c->value;
+            return ST_OK;
+        }
+    char expected[160];
+    choices_text(s->choices, 1, expected, sizeof expected);
+    return error_set(err, ST_USAGE, "%s expects %s, got '%s'", a, expected, v);
+}
+
+/* Reads v, the value of flag `a` (as typed; NULL for a switch given alone), into its
+ * field of o. */
 static Status option_set(const OptionSpec *s, const char *a, const char *v, Options *o, Error *err)
 {
     void *dst = (char *)o + s->offset;
     long n = 0;
     Status st = ST_OK;
     switch (s->kind) {
-    case OPTION_SWITCH: *(int *)dst = 1; return ST_OK;
+    case OPTION_SWITCH:
+        if (!v) {
+            *(int *)dst = 1;
+            return ST_OK;
+        }
+        if (!s->choices) return error_set(err, ST_USAGE, "%s takes no value, got '%s=%s'", a, a, v);
+        return option_set_choice(s, a, v, dst, err);
     case OPTION_TEXT:
         if (!*v) return error_set(err, ST_USAGE, "%s needs a %s", a, s->what);
         *(const char **)dst = v;
@@ -507,15 +605,7 @@ static Status option_set(const OptionSpec *s, const char *a, const char *v, Opti
         if (!(st = parse_long(a, v, s->lo, s->hi, &n, err))) *(int *)dst = (int)n;
         return st;
     case OPTION_SECONDS: return parse_seconds(a, v, (double *)dst, err);
-    case OPTION_CHOICE:
-        for (const OptionChoice *c = s->choices; c->name; c++)
-            if (strcmp(v, c->name) == 0) {
-                *(int *)dst = c->value;
-                return ST_OK;
-            }
-        char expected[160];
-        choices_text(s->choices, 1, expected, sizeof expected);
-        return error_set(err, ST_USAGE, "%s expects %s, got '%s'", a, expected, v);
+    case OPTION_CHOICE: return option_set_choice(s, a, v, dst, err);
     case OPTION_CUSTOM: return s->parse(v, o, err);
     }
     return error_set(err, ST_INTERNAL, "%s: unknown kind of flag", a);
@@ -535,37 +625,70 @@ static void options_defaults(Options *o)
     o->adaptive_spp = 0;   /* not given; 16 once options_finish has checked */
 }
 
-/* argv[*i]: a switch, a flag and its value (advancing *i), or the scene. */
-/* argv[*i]: a switch, a flag and its value (advancing *i), or the scene. */
-static Status options_parse_arg(int argc, char **argv, int *i, Options *o, Error *err)
+/* The one scene argument. */
+static Status options_scene(const char *a, Options *o, Error *err)
+{
+    if (o->scene_path)
+        return error_set(err, ST_USAGE, "more than one scene given: '%s' and '%s'", o->scene_path, a);
+    o->scene_path = a;
+    return ST_OK;
+}
+
+/* The value of flag `a` that takes one: `value` (after '=' or in the same word), else
+ * the next argument (advancing *i). */
+static Status option_take_value(const OptionSpec *s, const char *a, const char *value, int argc, char **argv, int *i,
+                                Options *o, Error *err)
+{
+    if (!value && *i + 1 >= argc) return error_set(err, ST_USAGE, "%s needs a value", a);
+    if (!value) value = argv[++*i];
+    return option_set(s, a, value, o, err);
+}
+
+/* -qo FILE: one-letter flags bundled in one word, as getopt reads them. Switches may
+ * follow each other; a flag that takes a value ends the bundle, its value the rest of
+ * the word (-ofile.png) or the next argument. */
+static Status options_parse_bundle(int argc, char **argv, int *i, Options *o, Error *err)
 {
     const char *a = argv[*i];
+    for (const char *p = a + 1; *p; p++) {
+        char one[3] = { '-', *p, '\0' };
+        const OptionSpec *s = option_find(one);
+        if (!s && p == a + 1) return option_unknown(a, err);   /* not a bundle: "-spp" */
+        if (!s) return error_set(err, ST_USAGE, "unknown option '%s' in '%s'", one, a);
+        if (s->kind != OPTION_SWITCH) return option_take_value(s, one, p[1] ? p + 1 : NULL, argc, argv, i, o, err);
+        Status st = option_set(s, one, NULL, o, err);
+        if (st) return st;
+    }
+    return ST_OK;
+}
+
+/* argv[*i]: a flag (with its value, advancing *i past it), a bundle of short flags,
+ * "--" (after which every argument is the scene's: *ended), or the scene. */
+static Status options_parse_arg(int argc, char **argv, int *i, int *ended, Options *o, Error *err)
+{
+    const char *a = argv[*i];
+    if (*ended || a[0] != '-' || a[1] == '\0') return options_scene(a, o, err);
+    if (strcmp(a, "--") == 0) {
+        *ended = 1;
+        return ST_OK;
+    }
+    if (a[1] != '-' && a[2] != '\0') return options_parse_bundle(argc, argv, i, o, err);
     /* --flag=value is accepted too */
     char flag[64];
     const char *value = NULL;
-    const char *eq = a[0] == '-' && a[1] == '-' ? strchr(a, '=') : NULL;
+    const char *eq = a[1] == '-' ? strchr(a, '=') : NULL;
     if (eq) {
         size_t n = (size_t)(eq - a);
-        if (n >= sizeof flag) return error_set(err, ST_USAGE, "unknown option '%s' (see --help)", a);
+        if (n >= sizeof flag) return option_unknown(a, err);
         memcpy(flag, a, n);
         flag[n] = '\0';
         value = eq + 1;
         a = flag;
     }
-    const OptionSpec *s = value ? NULL : option_find(a, 0);
-    if (s) return option_set(s, a, NULL, o, err);
-    /* a flag that takes a value takes the next argument when not given one with '=' */
-    if ((s = option_find(a, 1))) {
-        if (!value && *i + 1 >= argc) return error_set(err, ST_USAGE, "%s needs a value", a);
-        if (!value) value = argv[++*i];
-        return option_set(s, a, value, o, err);
-    }
-    if (value || (a[0] == '-' && a[1] != '\0'))
-        return error_set(err, ST_USAGE, "unknown option '%s' (see --help)", a);
-    if (o->scene_path)
-        return error_set(err, ST_USAGE, "more than one scene given: '%s' and '%s'", o->scene_path, a);
-    o->scene_path = a;
-    return ST_OK;
+    const OptionSpec *s = option_find(a);
+    if (!s) return option_unknown(a, err);
+    if (s->kind == OPTION_SWITCH) return option_set(s, a, value, o, err);
+    return option_take_value(s, a, value, argc, argv, i, o, err);
 }
 
 /* The viewer writes no output file of its own (C saves frames) and renders until it is
@@ -576,10 +699,23 @@ static Status options_check_interactive(const Options *o, Error *err)
     const char *flag = o->output ? "--output" : o->checkpoint_path ? (o->resume_path ? "--resume" : "--checkpoint")
                      : o->time_limit > 0.0 ? "--time-limit" : o->progressive_seconds > 0.0 ? "--progressive-output"
                      : o->aovs ? "--aov" : o->adaptive > 0.0 ? "--adaptive"
-                     : o->range_end >= 0 ? "--sample-range" : NULL;
+                     : o->range_end >= 0 ? "--sample-range" : o->stats == STATS_JSON ? "--stats=json" : NULL;
     if (flag)
         return error_set(err, ST_USAGE, "--interactive cannot be combined with %s (the viewer saves frames "
                                         "with the C key; see docs/viewer.md)", flag);
+    return ST_OK;
+}
+
+/* -o - (or FORMAT:-) writes the image to standard output once, at the end: the flags
+ * that write it again, or write images beside it, need a file. */
+static Status options_check_stdout(const Options *o, Error *err)
+{
+    if (!o->output || !image_path_is_stdout(o->output)) return ST_OK;
+    const char *flag = o->progressive_seconds > 0.0 ? "--progressive-output" : o->aovs ? "--aov"
+                     : o->adaptive > 0.0 ? "--adaptive" : NULL;
+    if (flag)
+        return error_set(err, ST_USAGE, "%s cannot be used with -o %s: standard output takes the image once, "
+                         "and %s writes it again or beside it; name a file with -o", flag, o->output, flag);
     return ST_OK;
 }
 
@@ -602,8 +738,9 @@ static Status options_finish(Options *o, Error *err)
                          "give both, or neither");
     if (o->checkpoint_seconds <= 0.0) o->checkpoint_seconds = 60.0;
     if (!o->scene_path && !o->help && !o->version && !o->list_devices)
-        return error_set(err, ST_USAGE, "no scene given (usage: clpt [options] SCENE; see --help)");
-    return options_check_interactive(o, err);
+        return error_set(err, ST_USAGE, "no scene given (usage: clpt [options] SCENE)");
+    Status st = options_check_stdout(o, err);
+    return st ? st : options_check_interactive(o, err);
 }
 
 Status options_parse(int argc, char **argv, Options *o, Error *err)
@@ -615,8 +752,9 @@ Status options_parse(int argc, char **argv, Options *o, Error *err)
         Status st = course_args_parse(course, argc, argv, o, &first, err);
         if (st) return st;
     }
+    int ended = 0;
     for (int i = first; i < argc; i++) {
-        Status st = options_parse_arg(argc, argv, &i, o, err);
+        Status st = options_parse_arg(argc, argv, &i, &ended, o, err);
         if (st) return st;
     }
     return options_finish(o, err);

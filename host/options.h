@@ -44,7 +44,17 @@ typedef struct {
  * succeed without a scene. */
 Status options_parse(int argc, char **argv, Options *o, Error *err);
 void options_print_help(FILE *f);
-/* The i-th flag of the list, NULL past the last (for the tests). */
+/* --help's sections, in order (the man page is written from them): the text of
+ * section i, its heading (a line ending in ':') and any prose or table lines, is
+ * followed in --help by the flags whose .section is i. The first holds the usage lines
+ * and the description; NULL past the last. */
+size_t options_help_sections(void);
+const char *options_help_section(size_t i);
+/* What follows the flag's name in --help (" FILE", " bvh|kdtree", "[=text|json]",
+ * or "" for a switch), into buf. */
+void option_value_text(const OptionSpec *s, char *buf, size_t size);
+/* The i-th flag of the list, NULL past the last (the tests, the man page and the shell
+ * completions read the list through it). */
 const OptionSpec *options_flag(size_t i);
 
 #endif /* CLPT_OPTIONS_H */

@@ -2,6 +2,7 @@
 #
 #   make            build build/clpt
 #   make test       build and run the test suite (ends with "N passed, M failed")
+#   make install    install under PREFIX (/usr/local), into DESTDIR if set; make uninstall
 #   make render     render the default scene to cornell-box.png
 #   make bench      throughput benchmarks (bench/)
 #   make bench-peers  clpt against Mitsuba 3 and Cycles at equal error (bench/peers.py)
@@ -64,10 +65,13 @@ FUZZ_BIN  := $(FUZZ_SRC:fuzz/%.c=$(BUILD)/fuzz/%)
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: FORCE all deps test render bench bench-peers xcheck clean test-asan test-valgrind fuzz fuzz-build
+.PHONY: FORCE all deps install uninstall test render bench bench-peers xcheck clean test-asan test-valgrind fuzz fuzz-build
 .DEFAULT_GOAL := all
 
-all: $(BUILD)/$(PROG)
+# The man page and the shell completions, written from the option list (docs/cli.md).
+GENERATED_DOCS := $(BUILD)/$(PROG).1 $(BUILD)/$(PROG).bash $(BUILD)/_$(PROG)
+
+all: $(BUILD)/$(PROG) $(GENERATED_DOCS)
 
 # ---------------------------------------------------------------- system packages
 deps:
@@ -86,6 +90,17 @@ $(BUILD)/gen_weekend: tools/gen_weekend.c
 # Writes a closed sphere mesh of any size as a binary PLY (docs/meshes.md).
 $(BUILD)/gen_mesh: tools/gen_mesh.c $(BUILD)/lib$(PROG).a
 	$(CC) $(CPPFLAGS) $(CFLAGS) -o $@ $< $(BUILD)/lib$(PROG).a $(LDFLAGS) $(LDLIBS)
+
+# Writes the man page and the completions from host/options.c's list (tools/clpt_docs.c).
+$(BUILD)/clpt_docs: tools/clpt_docs.c $(BUILD)/version.o $(BUILD)/lib$(PROG).a
+	$(CC) $(CPPFLAGS) $(CFLAGS) -o $@ $< $(BUILD)/version.o $(BUILD)/lib$(PROG).a $(LDFLAGS) $(LDLIBS)
+
+$(BUILD)/$(PROG).1: $(BUILD)/clpt_docs
+	$(BUILD)/clpt_docs man > $@.tmp && mv $@.tmp $@
+$(BUILD)/$(PROG).bash: $(BUILD)/clpt_docs
+	$(BUILD)/clpt_docs bash > $@.tmp && mv $@.tmp $@
+$(BUILD)/_$(PROG): $(BUILD)/clpt_docs
+	$(BUILD)/clpt_docs zsh > $@.tmp && mv $@.tmp $@
 
 # The renderer's program (kernels/entry.cl) and the traversal benchmark's
 # (kernels/bench/trace.cl), each flattened into a C array. The second is a member of the
@@ -155,8 +170,59 @@ $(BUILD)/bench/bench_traverse: | $(BUILD)/.embree-ok
 
 -include $(wildcard $(BUILD)/host/*.d $(BUILD)/host/*/*.d $(BUILD)/tests/*.d $(BUILD)/bench/*.d)
 
+# ---------------------------------------------------------------- install
+# `make install PREFIX=/usr DESTDIR=/tmp/stage` as packagers expect: PREFIX is where
+# clpt will live (written into clpt.pc), DESTDIR where the files go now. The program
+# needs nothing from the source tree at run time (the kernels are built into it).
+PREFIX      ?= /usr/local
+BINDIR      ?= $(PREFIX)/bin
+LIBDIR      ?= $(PREFIX)/lib
+INCLUDEDIR  ?= $(PREFIX)/include
+MANDIR      ?= $(PREFIX)/share/man
+BASHCOMPDIR ?= $(PREFIX)/share/bash-completion/completions
+ZSHCOMPDIR  ?= $(PREFIX)/share/zsh/site-functions
+PKGCONFIGDIR ?= $(LIBDIR)/pkgconfig
+INSTALL     ?= install
+
+# The public C API is installed where it has been built: every file these patterns
+# match when the recipe runs (the shared library with its SONAME links, copied as
+# links; the headers of include/clpt/), and then clpt.pc. Extend the patterns, not
+# the recipe.
+INSTALL_LIBS    ?= $(BUILD)/lib$(PROG).so*
+INSTALL_HEADERS ?= include/$(PROG)/*.h
+
+$(BUILD)/$(PROG).pc: tools/$(PROG).pc.in VERSION FORCE
+	@sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBDIR@|$(LIBDIR)|' -e 's|@INCLUDEDIR@|$(INCLUDEDIR)|' \
+	    -e 's|@VERSION@|$(VERSION)|' $< > $@.tmp
+	@if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv $@.tmp $@; fi
+
+install: all $(BUILD)/$(PROG).pc
+	$(INSTALL) -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(BASHCOMPDIR) $(DESTDIR)$(ZSHCOMPDIR)
+	$(INSTALL) -m 755 $(BUILD)/$(PROG) $(DESTDIR)$(BINDIR)/$(PROG)
+	$(INSTALL) -m 644 $(BUILD)/$(PROG).1 $(DESTDIR)$(MANDIR)/man1/$(PROG).1
+	$(INSTALL) -m 644 $(BUILD)/$(PROG).bash $(DESTDIR)$(BASHCOMPDIR)/$(PROG)
+	$(INSTALL) -m 644 $(BUILD)/_$(PROG) $(DESTDIR)$(ZSHCOMPDIR)/_$(PROG)
+	@set -e; libs=$$(ls -d $(INSTALL_LIBS) 2>/dev/null || true); \
+	if [ -n "$$libs" ]; then \
+	    echo install $$libs "->" $(DESTDIR)$(LIBDIR); \
+	    $(INSTALL) -d $(DESTDIR)$(LIBDIR) && cp -P $$libs $(DESTDIR)$(LIBDIR)/; \
+	fi; \
+	headers=$$(ls -d $(INSTALL_HEADERS) 2>/dev/null || true); \
+	if [ -n "$$headers" ]; then \
+	    echo install $$headers "->" $(DESTDIR)$(INCLUDEDIR)/$(PROG); \
+	    $(INSTALL) -d $(DESTDIR)$(INCLUDEDIR)/$(PROG) $(DESTDIR)$(PKGCONFIGDIR); \
+	    $(INSTALL) -m 644 $$headers $(DESTDIR)$(INCLUDEDIR)/$(PROG)/; \
+	    $(INSTALL) -m 644 $(BUILD)/$(PROG).pc $(DESTDIR)$(PKGCONFIGDIR)/$(PROG).pc; \
+	fi
+
+uninstall:
+	rm -f $(DESTDIR)$(BINDIR)/$(PROG) $(DESTDIR)$(MANDIR)/man1/$(PROG).1 $(DESTDIR)$(BASHCOMPDIR)/$(PROG) \
+	      $(DESTDIR)$(ZSHCOMPDIR)/_$(PROG) $(DESTDIR)$(PKGCONFIGDIR)/$(PROG).pc
+	rm -f $(DESTDIR)$(LIBDIR)/lib$(PROG).so*
+	rm -rf $(DESTDIR)$(INCLUDEDIR)/$(PROG)
+
 # ---------------------------------------------------------------- use
-test: $(BUILD)/$(PROG) $(TEST_BIN) $(FUZZ_REPLAY)
+test: $(BUILD)/$(PROG) $(GENERATED_DOCS) $(BUILD)/$(PROG).pc $(TEST_BIN) $(FUZZ_REPLAY)
 	@sh tools/check_layers.sh
 	@sh tests/run.sh $(BUILD)
 

@@ -14,7 +14,8 @@ case "$what" in
     render|test) ;;
     *) echo "usage: ./run.sh render|test" >&2; exit 2 ;;
 esac
-# the test suite also runs the viewer under a virtual display (tests/test_viewer.c)
-if [ "$what" = test ]; then sh tools/deps.sh base viewer-test; else sh tools/deps.sh base; fi
+# the test suite also runs the viewer under a virtual display (tests/test_viewer.c) and
+# checks the installed man page and zsh completion (tests/test_install.c)
+if [ "$what" = test ]; then sh tools/deps.sh base viewer-test install-test; else sh tools/deps.sh base; fi
 jobs=$(getconf _NPROCESSORS_ONLN 2>/dev/null || echo 2)
 exec make -j"$jobs" "$what"

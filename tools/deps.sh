@@ -6,7 +6,8 @@
 # install).
 #
 # Profiles: base (build and run clpt, run the tests), viewer-test (the viewer's test
-# under a virtual display; run.sh test and .ci/run install it), sanitize (make test-asan),
+# under a virtual display; run.sh test and .ci/run install it), install-test (man and
+# zsh for the install test; likewise), sanitize (make test-asan),
 # valgrind (make test-valgrind), fuzz (make fuzz), embree (the traversal benchmark),
 # peers (make bench-peers, make xcheck).
 # Missing packages are installed when run as root (apt-get); otherwise the exact
@@ -18,6 +19,8 @@ pkgs_for() {
         base) echo "make gcc libc6-dev pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers libstb-dev openmpi-bin libopenmpi-dev pkg-config libsdl2-dev libopenexr-dev libcjson-dev zlib1g-dev" ;;
         # the viewer's test (tests/test_viewer.c): a virtual display and input to send it
         viewer-test) echo "xvfb xdotool" ;;
+        # the install test (tests/test_install.c): man renders the page, zsh loads the completion
+        install-test) echo "man-db zsh" ;;
         sanitize) echo "clang libclang-rt-14-dev" ;;
         valgrind) echo "valgrind" ;;
         fuzz) echo "clang libclang-rt-14-dev" ;;

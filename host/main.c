@@ -156,20 +156,6 @@ static void on_checkpoint(void *vctx, const ScheduleSnapshot *snap)
     error_clear(&err);
 }
 
-/* --resume: the checkpoint, checked against this render, becomes the film's start. */
-static Status resume_film(const char *path, const CheckpointId *id, Checkpoint *ck, Film *film, int quiet, Error *err)
-{
-    Status st = checkpoint_read(path, ck, err);
-    if (st == ST_OK) st = checkpoint_check(ck, path, id, err);
-    if (st != ST_OK) return st;
-    memcpy(film->sum, ck->film.sum, (size_t)film->width * film->height * 3u * sizeof *film->sum);
-    film->samples = ck->film.samples;
-    if (!quiet)
-        fprintf(stderr, "clpt: resuming from '%s': %llu of %u samples per pixel already done\n", path,
-                (unsigned long long)film->samples, id->spp);
-    return ST_OK;
-}
-
 /* Output name when -o is not given: the scene's file name with .png, in the current
  * folder. */
 static char *default_output(const char *scene_path)
@@ -378,6 +364,52 @@ static Status scene_apply_options(Run *r, Error *err)
     return ST_OK;
 }
 
+/* How the whitted integrator places a pixel's samples at `spp` (render_scene_strata). */
+static void grid_words(uint spp, char *buf, size_t size)
+{
+    uint m = render_scene_strata(spp);
+    if (m >= 2u) snprintf(buf, size, "a %ux%u grid", m, m);
+    else snprintf(buf, size, "%s", m ? "uniform jitter" : "the pixel centre");
+}
+
+/* A whitted render places its samples in an m x m grid when its samples per pixel are
+ * m^2 (render_scene_strata): grown to a count with another grid, its first samples
+ * would be other samples than the checkpoint's. (The render key differs then too; this
+ * says why.) */
+static Status resume_check_grid(const Run *r, const Checkpoint *ck, Error *err)
+{
+    uint had = ck->id.spp, want = r->scene.image.spp;
+    if (r->scene.integrator != INTEGRATOR_WHITTED || had >= want ||
+        render_scene_strata(had) == render_scene_strata(want))
+        return ST_OK;
+    char a[32], b[32];
+    grid_words(had, a, sizeof a);
+    grid_words(want, b, sizeof b);
+    return error_set(err, ST_INPUT, "checkpoint '%s' is a whitted render of %u samples per pixel, placed in %s; %u "
+                     "would be placed in %s, so it cannot grow to %u (resume with --spp %u, or a count placed "
+                     "alike)", r->o.resume_path, had, a, want, b, want, had);
+}
+
+/* --resume: the checkpoint, checked against this render, becomes the film's start. */
+static Status resume_film(Run *r, Checkpoint *ck, Error *err)
+{
+    const char *path = r->o.resume_path;
+    Status st = checkpoint_read(path, ck, err);
+    if (st == ST_OK) st = resume_check_grid(r, ck, err);
+    if (st == ST_OK) st = checkpoint_check(ck, path, &r->ctx.checkpoint_id, err);
+    if (st != ST_OK) return st;
+    Film *film = &r->film;
+    memcpy(film->sum, ck->film.sum, (size_t)film->width * film->height * 3u * sizeof *film->sum);
+    film->samples = ck->film.samples;
+    if (!r->o.quiet && ck->id.spp < r->ctx.checkpoint_id.spp)
+        fprintf(stderr, "clpt: resuming from '%s': %llu samples per pixel already done, growing the render from %u "
+                "to %u\n", path, (unsigned long long)film->samples, ck->id.spp, r->ctx.checkpoint_id.spp);
+    else if (!r->o.quiet)
+        fprintf(stderr, "clpt: resuming from '%s': %llu of %u samples per pixel already done\n", path,
+                (unsigned long long)film->samples, r->ctx.checkpoint_id.spp);
+    return ST_OK;
+}
+
 /* A part (--sample-range) resumed from a checkpoint must not carry samples outside
  * its range: the part's film would then hold samples another part renders too. */
 static Status resume_check_range(const Options *o, const Checkpoint *ck, Error *err)
@@ -405,7 +437,7 @@ static Status render_prepare(Run *r, int worker, int keyed, Error *err)
     if (keyed || r->o.checkpoint_path || r->o.resume_path) checkpoint_id(ds, r->scene.image.spp, &r->ctx.checkpoint_id);
     if ((st = film_init(&r->film, ds->params.width, ds->params.height, err))) return st;
     if (!r->o.resume_path || worker) return ST_OK;
-    if ((st = resume_film(r->o.resume_path, &r->ctx.checkpoint_id, &r->resume, &r->film, r->o.quiet, err))) return st;
+    if ((st = resume_film(r, &r->resume, err))) return st;
     return resume_check_range(&r->o, &r->resume, err);
 }
 

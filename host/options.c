@@ -115,8 +115,10 @@
         "samples not in it are rendered, and the image is\n" \
         "the same bits as an uninterrupted render's. The\n" \
         "scene and settings must be the ones it was made\n" \
-        "with (else exit status 3). Checkpoints go on\n" \
-        "into FILE unless --checkpoint names another file") \
+        "with (else exit status 3), but --spp may be\n" \
+        "larger: samples are added to a finished render.\n" \
+        "Checkpoints go on into FILE unless --checkpoint\n" \
+        "names another file") \
     X(CHECKPOINT, CUSTOM, range_first, "--sample-range", NULL, "A:B", PARSE(parse_sample_range), \
         "render only samples A..B-1 of every pixel: a part\n" \
         "of the render for 'clpt merge' (with --checkpoint\n" \
@@ -265,7 +267,8 @@ static const char *const help_sections[HELP_SECTIONS] = {
 "                             render exactly: OUT is the same bits as one\n"
 "                             process rendering every sample. Parts that\n"
 "                             overlap, leave samples out or belong to other\n"
-"                             renders are refused (exit status 3). Also\n"
+"                             renders are refused (exit status 3); parts of\n"
+"                             a render whose --spp grew are one render. Also\n"
 "                             --checkpoint FILE, --gamma srgb|none, -q\n"
 "\n"
 "MPI (mpirun -np N clpt SCENE ..., or srun; docs/distributed.md):\n"

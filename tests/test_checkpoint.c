@@ -255,7 +255,10 @@ static void test_render_key(void)
         scene_free(&s);
     }
     CHECK(memcmp(&ids[0], &ids[1], sizeof ids[0]) == 0);
-    for (int k = 2; k < 6; k++) CHECK_MSG(memcmp(ids[0].key, ids[k].key, CHECKPOINT_KEY_SIZE) != 0, "change %d", k);
+    for (int k = 2; k < 6; k++)
+        if (k != 4) CHECK_MSG(memcmp(ids[0].key, ids[k].key, CHECKPOINT_KEY_SIZE) != 0, "change %d", k);
+    /* the samples per pixel are not in the key: 400 samples are the first 400 of 401 */
+    CHECK(memcmp(ids[0].key, ids[4].key, CHECKPOINT_KEY_SIZE) == 0);
     Checkpoint c;
     memset(&c, 0, sizeof c);
     Error err = { 0 };
@@ -265,9 +268,13 @@ static void test_render_key(void)
     c.id = ids[3];
     CHECK_EQ_INT(checkpoint_check(&c, "x.ckpt", &ids[0], &err), ST_INPUT);
     CHECK_STR_CONTAINS(err.msg, "scene differs");
+    /* a checkpoint of 401 spp cannot become a render of 400; one of 400 can grow to 401 */
     c.id = ids[4];
     CHECK_EQ_INT(checkpoint_check(&c, "x.ckpt", &ids[0], &err), ST_INPUT);
-    CHECK_STR_CONTAINS(err.msg, "samples per pixel");
+    CHECK_STR_CONTAINS(err.msg, "checkpoint 'x.ckpt' is a render of 401 samples per pixel, this render asks for 400; "
+                                "a resume can add samples, never take them away (resume with --spp 401 or more)");
+    c.id = ids[0];
+    CHECK_EQ_INT(checkpoint_check(&c, "x.ckpt", &ids[4], &err), ST_OK);
     error_clear(&err);
 }
 
@@ -424,10 +431,12 @@ static void test_sigint_keeps_whole_batches(void)
 static void test_other_renders_are_refused(void)
 {
     /* path_ck holds the finished render of the tests above */
+    char msg[512];
     cli_run(ARGS(SCENE, "-q", "--device", "scalar", SIZE, "--spp", "401", "-o", path_out, "--resume", path_ck), &r);
     CHECK_EQ_INT(r.status, 3);
-    CHECK_STR_CONTAINS(r.err, "belongs to another render");
-    CHECK_STR_CONTAINS(r.err, "samples per pixel");
+    snprintf(msg, sizeof msg, "clpt: error: checkpoint '%s' is a render of 1200 samples per pixel, this render asks "
+             "for 401; a resume can add samples, never take them away (resume with --spp 1200 or more)\n", path_ck);
+    CHECK_STR_CONTAINS(r.err, msg);
     cli_run(ARGS(SCENE, "-q", "--device", "scalar", "--width", "36", "--height", "48", "--spp", SPP_TEXT, "-o",
                  path_out, "--resume", path_ck), &r);
     CHECK_EQ_INT(r.status, 3);
@@ -460,6 +469,74 @@ static void test_other_renders_are_refused(void)
     CHECK_EQ_INT(r.status, 2);
 }
 
+/* Adding samples to a finished render: 4 spp, then resumed to 16 (on PoCL, then on
+ * PoCL and the scalar device together), is the straight 16-spp render bit for bit, and
+ * so is 4 grown to 9 on the scalar device alone. */
+static void test_a_finished_render_grows(void)
+{
+#define GROW "--width", "40", "--height", "30"
+    char ref16[160], ref9[160];
+    snprintf(ref16, sizeof ref16, "%s/ref16.pfm", dir);
+    snprintf(ref9, sizeof ref9, "%s/ref9.pfm", dir);
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", GROW, "--spp", "16", "-o", ref16), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", GROW, "--spp", "9", "-o", ref9), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    const char *devices[][2] = { { "0", "0,scalar" }, { "scalar", "scalar" } };
+    const char *grown[] = { "16", "9" };
+    const char *refs[] = { ref16, ref9 };
+    for (int k = 0; k < 2; k++) {
+        unlink(path_ck);
+        cli_run(ARGS(SCENE, "-q", "--device", devices[k][0], GROW, "--spp", "4", "-o", path_out, "--checkpoint",
+                     path_ck), &r);
+        CHECK_MSG(r.status == 0, "%s", r.err);
+        CHECK_EQ_INT(checkpoint_samples(path_ck), 4);
+        cli_run(ARGS(SCENE, "--device", devices[k][1], GROW, "--spp", grown[k], "--batch", "2", "-o", path_out,
+                     "--resume", path_ck), &r);
+        CHECK_MSG(r.status == 0, "%s", r.err);
+        CHECK_STR_CONTAINS(r.err, "4 samples per pixel already done, growing the render from 4 to");
+        CHECK_MSG(files_equal(refs[k], path_out), "4 spp grown to %s differs from a straight %s-spp render",
+                  grown[k], grown[k]);
+        CHECK_EQ_INT(checkpoint_samples(path_ck), atol(grown[k]));
+    }
+    /* and it can no longer shrink back */
+    cli_run(ARGS(SCENE, "-q", "--device", "scalar", GROW, "--spp", "4", "-o", path_out, "--resume", path_ck), &r);
+    CHECK_EQ_INT(r.status, 3);
+    CHECK_STR_CONTAINS(r.err, "a resume can add samples, never take them away (resume with --spp 9 or more)");
+    unlink(ref16);
+    unlink(ref9);
+#undef GROW
+}
+
+/* The whitted integrator's pixel grid follows the samples per pixel (a 2x2 grid at 4, a
+ * 3x3 at 9): such a render grows only to a count placed alike (2 -> 3, both jittered),
+ * and says why otherwise. */
+static void test_whitted_grows_only_on_its_grid(void)
+{
+#define WHITTED "scenes/classic/spheres.txt", "-q", "--device", "scalar", "--width", "32", "--height", "24"
+    char msg[512], ref[160];
+    snprintf(ref, sizeof ref, "%s/whitted3.pfm", dir);
+    unlink(path_ck);
+    cli_run(ARGS(WHITTED, "--spp", "4", "-o", path_out, "--checkpoint", path_ck), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS(WHITTED, "--spp", "9", "-o", path_out, "--resume", path_ck), &r);
+    CHECK_EQ_INT(r.status, 3);
+    snprintf(msg, sizeof msg, "clpt: error: checkpoint '%s' is a whitted render of 4 samples per pixel, placed in a "
+             "2x2 grid; 9 would be placed in a 3x3 grid, so it cannot grow to 9 (resume with --spp 4, or a count "
+             "placed alike)\n", path_ck);
+    CHECK_STR_CONTAINS(r.err, msg);
+    unlink(path_ck);
+    cli_run(ARGS(WHITTED, "--spp", "2", "-o", path_out, "--checkpoint", path_ck), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS(WHITTED, "--spp", "3", "-o", path_out, "--resume", path_ck), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS(WHITTED, "--spp", "3", "-o", ref), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_MSG(files_equal(ref, path_out), "a whitted render grown from 2 to 3 spp differs from a straight one");
+    unlink(ref);
+#undef WHITTED
+}
+
 int main(void)
 {
     /* before anything loads the OpenCL ICD: two PoCL CPU devices */
@@ -475,6 +552,8 @@ int main(void)
     RUN(test_sigint_writes_a_checkpoint);
     RUN(test_other_renders_are_refused);
     RUN(test_sigint_keeps_whole_batches);
+    RUN(test_a_finished_render_grows);
+    RUN(test_whitted_grows_only_on_its_grid);
     remove_dir();
     return harness_report();
 }

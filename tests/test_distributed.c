@@ -99,6 +99,26 @@ static void test_another_split_merges_to_the_same_bits(void)
     CHECK(files_equal(in_dir("merged2.pfm"), in_dir("whole.pfm")));
 }
 
+/* A finished render of 5 spp and parts 5:7 and 7:12 of the render of 12 (a render grown
+ * after it finished) merge to the 12-spp render, in any order; without the part 5:7 the
+ * merge names the samples missing of the 12. */
+static void test_a_grown_render_merges(void)
+{
+    cli_run(ARGS(RENDER, "--spp", "5", "--checkpoint", in_dir("five.ckpt"), "-o", in_dir("five.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS("merge", "-o", in_dir("grown.pfm"), in_dir("c.ckpt"), in_dir("five.ckpt"), in_dir("b.ckpt")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_STR_CONTAINS(r.err, "clpt: merged 3 parts: 24x18, 12 spp -> ");
+    CHECK(files_equal(in_dir("grown.pfm"), in_dir("whole.pfm")));
+    char msg[256];
+    snprintf(msg, sizeof msg, "clpt: error: cannot merge: no part holds samples [5,7) of the 12 per pixel; render "
+             "them with --sample-range 5:7 and merge that part too\n");
+    cli_run(ARGS("merge", "-o", in_dir("refused.pfm"), in_dir("five.ckpt"), in_dir("c.ckpt")), &r);
+    CHECK_EQ_INT(r.status, 3);
+    CHECK_STR_CONTAINS(r.err, msg);
+    CHECK(!file_exists(in_dir("refused.pfm")));
+}
+
 static void expect_merge_refused(const char *const *args, int status, const char *message)
 {
     cli_run(args, &r);
@@ -494,6 +514,7 @@ int main(void)
     RUN(test_merge_refuses_to_overwrite_a_part);
     RUN(test_another_split_merges_to_the_same_bits);
     RUN(test_merge_refusals);
+    RUN(test_a_grown_render_merges);
     RUN(test_sample_range_usage_errors);
     if (have_mpirun()) {
         RUN(test_mpi_two_and_three_ranks_are_bit_identical);

@@ -27,13 +27,19 @@ static Status merge_add(Checkpoint *out, const Checkpoint *c, const char *const 
 {
     char what[256];
     if (checkpoint_id_differs(&c->id, &out->id, "the first part", what, sizeof what))
-        return error_set(err, ST_INPUT, "cannot merge '%s' with '%s': they are parts of different renders (%s)",
-                         paths[k], paths[0], what);
+        return error_set(err, ST_INPUT, "cannot merge '%s' with '%s': they are parts of different renders (%s)%s",
+                         paths[k], paths[0], what,
+                         c->id.spp != out->id.spp ? "; a whitted render's pixel grid follows its samples per pixel, "
+                                                    "so it grows only between counts with the same grid" : "");
     size_t n = (size_t)out->film.width * out->film.height * 3u;
     /* Each part's values are bounded by its samples (checkpoint_read), and the parts'
      * samples add up to at most spp (checked after), so the sums cannot overflow. */
     for (size_t i = 0; i < n; i++) out->film.sum[i] += c->film.sum[i];
     out->film.samples += c->film.samples;
+    /* parts of one render whose total grew (a finished render of 4 spp and the part
+     * 4:16 of the render of 16): the merged render is the largest, and every sample of
+     * it must then come from some part (merge_check_ranges) */
+    if (c->id.spp > out->id.spp) out->id.spp = c->id.spp;
     return ST_OK;
 }
 

@@ -6,6 +6,8 @@
  * settings, kernels) holding the sample indices it rendered. The film is integer, so
  * adding the parts' sums gives exactly the sums one process would have accumulated:
  * the merged image is the same bits as the one-process render, whatever the split.
+ * Parts may come from renders of different samples per pixel (a render grown after it
+ * finished): the merged render has the largest count, and the parts must hold all of it.
  * Parts of other renders, parts that hold a sample twice and sets of parts that leave a
  * sample out are refused (ST_INPUT), naming the parts and samples concerned.
  */
@@ -15,8 +17,8 @@
 #include "base/status.h"
 #include "render/checkpoint.h"
 
-/* Reads the parts and adds them into *out (its id is theirs, its done ranges the union,
- * which must be all of [0, spp)). Free *out with checkpoint_free, also after a failure. */
+/* Reads the parts and adds them into *out (its id is theirs with the largest spp, its
+ * done ranges the union, which must be all of [0, spp)). Free *out with checkpoint_free, also after a failure. */
 Status merge_parts(const char *const *paths, size_t n, Checkpoint *out, Error *err);
 
 /* The command: argv[0] is "merge". Returns the exit status; err holds the message. */

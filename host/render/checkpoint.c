@@ -17,7 +17,9 @@
 #include "base/sha256.h"
 
 #define CKPT_MAGIC "CLPTCKPT"
-#define CKPT_VERSION 1u
+/* Version 2: the render key no longer covers the samples per pixel (a render can grow:
+ * docs/checkpoint.md); the layout is version 1's. */
+#define CKPT_VERSION 2u
 #define CKPT_HEADER_SIZE 128u
 #define CKPT_TRAILER_SIZE SHA256_DIGEST_SIZE
 
@@ -37,11 +39,14 @@ void checkpoint_id(const DeviceScene *ds, uint spp, CheckpointId *id)
     const RenderParams *p = &ds->params;
     Sha256 h;
     sha256_init(&h);
-    hash_part(&h, "clpt render key 2", NULL, 0);
+    hash_part(&h, "clpt render key 3", NULL, 0);
     /* The kernels decide every bit of a sample: a clpt with other kernels must not add
-     * its samples to this film. */
+     * its samples to this film. The samples per pixel are not hashed: a sample is a pure
+     * function of (seed, pixel, sample index, ...) and not of how many the render asks
+     * for (the whitted integrator's pixel grid, which does follow the count, is in the
+     * params block), so a render of N samples is the first N of one of more samples and
+     * a resume or merge may grow it (docs/checkpoint.md, "Adding samples"). */
     hash_part(&h, "kernels", clpt_kernel_source, clpt_kernel_source_len);
-    hash_part(&h, "spp", &spp, sizeof spp);
     /* every scene buffer of kernels/scene_buffers.h, the params block first: a buffer
      * added to that list is part of the key without a change here */
     for (unsigned i = 0; i < SCENE_BUF_COUNT; i++) {
@@ -271,8 +276,6 @@ int checkpoint_id_differs(const CheckpointId *g, const CheckpointId *e, const ch
 {
     if (g->width != e->width || g->height != e->height)
         snprintf(what, size, "it is %ux%u pixels, %s %ux%u", g->width, g->height, other, e->width, e->height);
-    else if (g->spp != e->spp)
-        snprintf(what, size, "it is for %u samples per pixel, %s %u", g->spp, other, e->spp);
     else if (g->seed != e->seed)
         snprintf(what, size, "its seed is %u, %s's %u", g->seed, other, e->seed);
     else if (g->max_depth != e->max_depth)
@@ -288,8 +291,15 @@ int checkpoint_id_differs(const CheckpointId *g, const CheckpointId *e, const ch
 Status checkpoint_check(const Checkpoint *c, const char *path, const CheckpointId *e, Error *err)
 {
     char what[256];
-    if (!checkpoint_id_differs(&c->id, e, "this render", what, sizeof what)) return ST_OK;
-    return error_set(err, ST_INPUT,
-                     "checkpoint '%s' belongs to another render: %s; refusing to resume (resume with the scene and "
-                     "settings it was made with, or start afresh without --resume)", path, what);
+    if (checkpoint_id_differs(&c->id, e, "this render", what, sizeof what))
+        return error_set(err, ST_INPUT,
+                         "checkpoint '%s' belongs to another render: %s; refusing to resume (resume with the scene "
+                         "and settings it was made with, or start afresh without --resume)", path, what);
+    /* more samples extend the render; fewer would leave samples of the film unasked for */
+    if (c->id.spp > e->spp)
+        return error_set(err, ST_INPUT,
+                         "checkpoint '%s' is a render of %u samples per pixel, this render asks for %u; a resume can "
+                         "add samples, never take them away (resume with --spp %u or more)", path, c->id.spp, e->spp,
+                         c->id.spp);
+    return ST_OK;
 }

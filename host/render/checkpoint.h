@@ -3,9 +3,11 @@
  *
  * A checkpoint holds the integer film (every pixel's fixed-point sums), the number of
  * samples per pixel in it and which sample indices those are, plus an identity of the
- * render: a SHA-256 "render key" over everything that determines the image (the prepared
- * scene with its kd-tree, camera, size, seed, depth, the samples per pixel asked for, and
- * the kernel source), and a few of those settings in clear for the error messages.
+ * render: a SHA-256 "render key" over everything that determines each sample (the prepared
+ * scene with its tree, camera, size, seed, depth, and the kernel source), the samples per
+ * pixel of the complete render, and a few of those settings in clear for the error
+ * messages. The key leaves the samples per pixel out: the samples of a render of N are
+ * the first N of any longer one, so a checkpoint or a part can be grown to more.
  * Because the film is integer and every sample is a pure function of its indices, a
  * render resumed from a checkpoint ends with the same bits as one never interrupted.
  *
@@ -25,7 +27,8 @@
 
 #define CHECKPOINT_KEY_SIZE 32
 
-/* What a checkpoint belongs to. */
+/* What a checkpoint belongs to: the key and the settings in clear decide the samples;
+ * spp is how many of them the complete render has. */
 typedef struct {
     unsigned char key[CHECKPOINT_KEY_SIZE];
     uint width, height, spp, seed, max_depth;
@@ -51,13 +54,14 @@ Status checkpoint_write(const char *path, const CheckpointId *id, const Film *fi
  * Free with checkpoint_free (also after a failure). */
 Status checkpoint_read(const char *path, Checkpoint *c, Error *err);
 
-/* 0 when `got` and `expected` are one render; else 1, with the first difference in
- * words in `what`, `other` naming the expected one ("this render": "its seed is 2,
- * this render's 1"). */
+/* 0 when `got` and `expected` draw the same samples (one render, perhaps of other
+ * samples per pixel); else 1, with the first difference in words in `what`, `other`
+ * naming the expected one ("this render": "its seed is 2, this render's 1"). */
 int checkpoint_id_differs(const CheckpointId *got, const CheckpointId *expected, const char *other, char *what,
                           size_t size);
 
-/* ST_INPUT, naming the first difference, unless `c` belongs to the render `expected`. */
+/* ST_INPUT, naming the first difference, unless `c` belongs to the render `expected`
+ * with as many samples per pixel or fewer (a resume may add samples, not remove them). */
 Status checkpoint_check(const Checkpoint *c, const char *path, const CheckpointId *expected, Error *err);
 
 void checkpoint_free(Checkpoint *c);

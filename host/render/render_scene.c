@@ -124,7 +124,10 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
     p->n_area_lights = (uint)(s->n_lights - s->n_delta_lights - (s->env_light != NO_INDEX ? 1u : 0u));
     p->n_textures = (uint)s->n_textures;
     p->use_mask = 0;
-    p->strata = render_scene_strata(s->image.spp);
+    /* only the whitted camera (whitted and the auxiliary images) reads the grid; the
+     * path tracer's samples must not depend on the samples per pixel, or a render could
+     * not grow (render key, checkpoint.c) */
+    p->strata = s->integrator != INTEGRATOR_PATH ? render_scene_strata(s->image.spp) : 0u;
     p->sample_offset = 0;
     p->normal_miss_grey = s->normal_miss_grey;
     p->shadows = s->shadows ? 1u : 0u;

@@ -94,7 +94,7 @@ typedef struct {
     const char *output;
     int quiet;
     int progressive_failed;
-    ImageEncoding encoding;
+    ImageStyle style;
     const char *checkpoint;       /* NULL: none */
     CheckpointId checkpoint_id;
     int checkpoint_failed;
@@ -135,7 +135,7 @@ static void on_progress_tick(void *vctx, const ScheduleSnapshot *snap)
 {
     RenderContext *ctx = vctx;
     Error err = { 0 };
-    if (film_write(snap->film, ctx->output, ctx->encoding, &err) != ST_OK && !ctx->progressive_failed) {
+    if (film_write(snap->film, ctx->output, &ctx->style, &err) != ST_OK && !ctx->progressive_failed) {
         ctx->progressive_failed = 1;
         print_warning(NULL, err.msg);
     }
@@ -201,7 +201,7 @@ typedef struct {
     Options o;
     const char *output;
     char *default_out;
-    ImageEncoding encoding;
+    ImageStyle style;
     int bare_mesh;
     Scene scene;
     RenderScene rs;
@@ -269,7 +269,9 @@ static Status outputs_check(const Run *r, Error *err)
     NamedFile files[8];
     char *aov_paths[3] = { NULL, NULL, NULL };
     size_t n = 0;
-    Status st = ST_OK;
+    ViewLook look = { (ViewTransform)o->view, o->exposure };
+    Status st = image_check_look(r->output, &look, err);
+    if (st) return st;
     /* standard output is no file of the run's: nothing to probe or compare */
     if (image_path_is_stdout(r->output)) st = image_stdout_check(err);
     else named_file_init(&files[n++], r->output, "the output image", FILE_IMAGE);
@@ -359,8 +361,9 @@ static Status scene_apply_options(Run *r, Error *err)
                          o->range_first, o->range_end, r->scene.image.spp);
     if (o->adaptive > 0.0 && r->scene.integrator != INTEGRATOR_WHITTED)
         return error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
-    r->encoding = (ImageEncoding)((r->scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB) |
-                                  (r->o.exr_float ? IMAGE_EXR_FLOAT : 0));
+    r->style.encoding = (ImageEncoding)((r->scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB) |
+                                        (r->o.exr_float ? IMAGE_EXR_FLOAT : 0));
+    r->style.look = (ViewLook){ (ViewTransform)r->o.view, r->o.exposure };
     return ST_OK;
 }
 
@@ -450,7 +453,7 @@ static void render_configure(Run *r)
     r->ctx.output = r->output;
     r->ctx.quiet = o->quiet;
     r->ctx.checkpoint = o->checkpoint_path;
-    r->ctx.encoding = r->encoding;
+    r->ctx.style = r->style;
     memset(cfg, 0, sizeof *cfg);
     cfg->spp = r->scene.image.spp;
     cfg->done = r->resume.done;
@@ -571,7 +574,7 @@ static Status results_run_passes(Run *r, Error *err)
     pcfg.show_progress = 0;
     PassContext pc = { r->devs, r->n_devs, &r->rs, &pcfg };
     PassRequest q = pass_request(&r->o);
-    Status st = passes_after_image(&q, &pc, r->output, r->encoding, rgb, (uint)r->film.samples, err);
+    Status st = passes_after_image(&q, &pc, r->output, &r->style, rgb, (uint)r->film.samples, err);
     free(rgb);
     if (st == ST_OK && stop_requested) st = ST_INTERRUPTED;
     return st;
@@ -586,7 +589,7 @@ static Status results_write(Run *r, Error *err)
     Status st = r->render_st != ST_OK ? r->render_st : (r->stats.interrupted ? ST_INTERRUPTED : ST_OK);
     Error next = { 0 };
     st = keep_first(st, err, results_write_checkpoint(r, &next), &next);
-    Status image_st = film_write(&r->film, r->output, r->encoding, &next);
+    Status image_st = film_write(&r->film, r->output, &r->style, &next);
     st = keep_first(st, err, image_st, &next);
     if (image_st != ST_OK) return st;   /* the summary's "-> OUTPUT" would be untrue */
     results_print_summary(r);
@@ -660,7 +663,7 @@ static Status run_interactive(Run *r, Error *err)
     if (st == ST_OK) st = open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
     if (st == ST_OK) {
         ViewerConfig vc = { r->o.scene_path, &r->scene, &r->rs, r->devs, r->n_devs,
-                            { r->o.threads, r->o.kernel_dir, r->o.wave_paths, 0, r->o.wave_launch }, r->encoding,
+                            { r->o.threads, r->o.kernel_dir, r->o.wave_paths, 0, r->o.wave_launch }, r->style,
                             r->o.batch, r->o.stats, r->o.quiet };
         st = viewer_run(&vc, err);
     }

@@ -48,6 +48,8 @@ typedef struct {
     int sampler;                  /* -1 the scene's, else enum Sampler */
     int accel;                    /* -1 the default, else enum SceneAccel */
     double depth_near, depth_far; /* --depth-range; near == far (0) = automatic */
+    int view;                     /* --view: enum ViewTransform (io/view_transform.h) */
+    double exposure;              /* --exposure: stops, before the view */
 } Options;
 
 #endif /* CLPT_OPTION_VALUES_H */

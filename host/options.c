@@ -11,6 +11,7 @@
 #include "device/device.h"
 #include "io/image_write.h"
 #include "io/scene_load.h"
+#include "io/view_transform.h"
 #include "render/passes.h"
 #include "base/limit.h"
 #include "types.h"
@@ -87,6 +88,14 @@
         "8-bit images with the sRGB curve or without\n" \
         "(linear values times 255); default: srgb, none\n" \
         "for classic scenes") \
+    X(OUTPUT, CHOICE, view, "--view", NULL, NULL, ONE_OF({ "standard", VIEW_STANDARD }, { "agx", VIEW_AGX }, { "filmic", VIEW_FILMIC }), \
+        "how 8-bit images form the picture: standard (the\n" \
+        "values clipped at 1; default), agx (Blender 4's\n" \
+        "AgX) or filmic (Hable's filmic curve); see\n" \
+        "docs/views.md. Not for float outputs") \
+    X(OUTPUT, CUSTOM, exposure, "--exposure", NULL, "EV", PARSE(parse_exposure), \
+        "scale 8-bit images by 2^EV before the view\n" \
+        "(-32..32; default 0). Not for float outputs") \
     X(OUTPUT, SWITCH, exr_float, "--exr-float", NULL, NULL, NONE, \
         "EXR channels as 32-bit floats (default: half)") \
     X(OUTPUT, CUSTOM, aovs, "--aov", NULL, "LIST", PARSE(parse_aovs), \
@@ -166,7 +175,7 @@
         "move, R/F or Q/E up/down, drag the mouse to\n" \
         "look, wheel forward/back, Z/X field of view,\n" \
         "Up/Down focus distance, Right/Left aperture,\n" \
-        "+/- exposure, Space pause, C save the image\n" \
+        "+/- exposure, V view, Space pause, C save the image\n" \
         "(SCENE-view-NNN.png and .pfm, never over an\n" \
         "earlier save), P print the camera as a scene\n" \
         "block, H help, F11 full screen, Esc quit.\n" \
@@ -269,7 +278,8 @@ static const char *const help_sections[HELP_SECTIONS] = {
 "                             overlap, leave samples out or belong to other\n"
 "                             renders are refused (exit status 3); parts of\n"
 "                             a render whose --spp grew are one render. Also\n"
-"                             --checkpoint FILE, --gamma srgb|none, -q\n"
+"                             --checkpoint FILE, --gamma srgb|none, -q,\n"
+"                             --view and --exposure as a render's\n"
 "\n"
 "MPI (mpirun -np N clpt SCENE ..., or srun; docs/distributed.md):\n"
 "                             one image from N processes, each on its own\n"
@@ -390,6 +400,18 @@ static Status parse_sample_range(const char *v, Options *o, Error *err)
                          CLPT_MAX_SPP, v);
     o->range_first = a;
     o->range_end = b;
+    return ST_OK;
+}
+
+/* --exposure EV: stops, as Blender's (-32..32) */
+static Status parse_exposure(const char *v, Options *o, Error *err)
+{
+    char *end;
+    errno = 0;
+    double ev = strtod(v, &end);
+    if (!*v || *end || errno || starts_blank(v) || !(ev >= -32.0 && ev <= 32.0))
+        return error_set(err, ST_USAGE, "--exposure expects a number of stops from -32 to 32, got '%s'", v);
+    o->exposure = ev;
     return ST_OK;
 }
 

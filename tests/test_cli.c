@@ -30,6 +30,7 @@ static void test_every_listed_flag_is_documented_and_parsed(void)
 {
     static const struct { const char *flag, *value; } custom[] = {
         { "--aov", "normal" }, { "--depth-range", "1,2" }, { "--sample-range", "0:1" }, { "--adaptive", "0.5" },
+        { "--exposure", "-1.5" },
     };
     cli_run(ARGS("--help"), &r);
     CHECK_EQ_INT(r.status, 0);
@@ -233,6 +234,62 @@ static void test_render_each_format(void)
     check_render("scalar", "/tmp/clpt-test-render.png", "\x89PNG");
     check_render(TEST_OPENCL, "/tmp/clpt-test-render.ppm", "P6");
     check_render("0", "/tmp/clpt-test-render.pfm", "PF");
+}
+
+/* --view and --exposure: the default and "--view standard --exposure 0" are the same
+ * bytes; agx, filmic and an exposure change the PNG; a float output, a bad view or
+ * exposure is a usage error before rendering; merge takes them too. */
+static void test_view_flags(void)
+{
+#define VIEW_RENDER "scenes/cornell-box.scene", "-q", "--device", "scalar", "--width", "16", "--height", "12", \
+                    "--spp", "2"
+    const char *plain = "/tmp/clpt-test-view-plain.png", *same = "/tmp/clpt-test-view-same.png",
+               *other = "/tmp/clpt-test-view-other.png";
+    cli_run(ARGS(VIEW_RENDER, "-o", plain), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS(VIEW_RENDER, "--view", "standard", "--exposure", "0", "-o", same), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(plain, same));
+    const char *looks[][2] = { { "--view", "agx" }, { "--view", "filmic" }, { "--exposure", "-1.5" } };
+    for (int k = 0; k < 3; k++) {
+        cli_run(ARGS(VIEW_RENDER, looks[k][0], looks[k][1], "-o", other), &r);
+        CHECK_MSG(r.status == 0, "%s %s: %s", looks[k][0], looks[k][1], r.err);
+        CHECK_MSG(!files_equal(plain, other), "%s %s left the PNG as it was", looks[k][0], looks[k][1]);
+    }
+    cli_run(ARGS(VIEW_RENDER, "--view", "aces", "-o", other), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --view expects 'standard', 'agx' or 'filmic', got 'aces'\n");
+    cli_run(ARGS(VIEW_RENDER, "--exposure", "33", "-o", other), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --exposure expects a number of stops from -32 to 32, got '33'\n");
+    cli_run(ARGS(VIEW_RENDER, "--exposure", "1 ", "-o", other), &r);
+    CHECK_EQ_INT(r.status, 2);
+    unlink("/tmp/clpt-test-view.pfm");
+    cli_run(ARGS(VIEW_RENDER, "--view", "agx", "-o", "/tmp/clpt-test-view.pfm"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --view and --exposure form the picture of 8-bit images; "
+                              "'/tmp/clpt-test-view.pfm' keeps the linear radiance (write a .png, .ppm or .bmp, or "
+                              "leave them out)\n");
+    CHECK(!file_exists("/tmp/clpt-test-view.pfm"));
+    /* merge: a part merged with --view agx is the render's agx PNG */
+    const char *part = "/tmp/clpt-test-view.ckpt", *merged = "/tmp/clpt-test-view-merged.png";
+    cli_run(ARGS(VIEW_RENDER, "--view", "agx", "--exposure", "0.5", "-o", other, "--checkpoint", part), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS("merge", "-q", "--view", "agx", "--exposure", "0.5", "-o", merged, part), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(other, merged));
+    cli_run(ARGS("merge", "-q", "--view", "log", "-o", merged, part), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: merge: --view expects 'standard', 'agx' or 'filmic', got 'log'\n");
+    cli_run(ARGS("merge", "-q", "--exposure", "x", "-o", merged, part), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: merge: --exposure expects a number of stops from -32 to 32, got 'x'\n");
+    unlink(plain);
+    unlink(same);
+    unlink(other);
+    unlink(part);
+    unlink(merged);
+#undef VIEW_RENDER
 }
 
 static void test_quiet_prints_nothing(void)
@@ -884,5 +941,6 @@ int main(void)
     RUN(test_scene_from_pipe);
     RUN(test_named_files_must_be_regular);
     RUN(test_resume_from_fifo_refused);
+    RUN(test_view_flags);
     return harness_report();
 }

@@ -1,6 +1,7 @@
 /* merge.c — see merge.h. */
 #include "dist/merge.h"
 
+#include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -107,9 +108,29 @@ Status merge_parts(const char *const *paths, size_t n, Checkpoint *out, Error *e
 typedef struct {
     const char *output, *checkpoint;
     int linear, quiet;
+    ViewLook look;                /* --view, --exposure, as a render's */
     const char **parts;
     size_t n_parts;
 } MergeOptions;
+
+/* --view NAME or --exposure EV, read as the render's flags are. */
+static Status merge_parse_look(const char *flag, const char *v, ViewLook *look, Error *err)
+{
+    if (!strcmp(flag, "--exposure")) {
+        char *end;
+        double ev = strtod(v, &end);
+        if (*end || isspace((unsigned char)v[0]) || !(ev >= -32.0 && ev <= 32.0))
+            return error_set(err, ST_USAGE, "merge: --exposure expects a number of stops from -32 to 32, got '%s'", v);
+        look->exposure = ev;
+        return ST_OK;
+    }
+    for (int k = VIEW_STANDARD; k <= VIEW_FILMIC; k++)
+        if (!strcmp(v, view_name((ViewTransform)k))) {
+            look->view = (ViewTransform)k;
+            return ST_OK;
+        }
+    return error_set(err, ST_USAGE, "merge: --view expects 'standard', 'agx' or 'filmic', got '%s'", v);
+}
 
 static Status merge_parse(int argc, char **argv, MergeOptions *m, Error *err)
 {
@@ -118,7 +139,7 @@ static Status merge_parse(int argc, char **argv, MergeOptions *m, Error *err)
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         int takes_value = !strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--checkpoint") ||
-                          !strcmp(a, "--gamma");
+                          !strcmp(a, "--gamma") || !strcmp(a, "--view") || !strcmp(a, "--exposure");
         if (takes_value && (i + 1 >= argc || !argv[i + 1][0]))
             return error_set(err, ST_USAGE, "merge: %s needs a value", a);
         if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
@@ -130,6 +151,9 @@ static Status merge_parse(int argc, char **argv, MergeOptions *m, Error *err)
             if (strcmp(v, "srgb") != 0 && strcmp(v, "none") != 0)
                 return error_set(err, ST_USAGE, "merge: --gamma expects 'srgb' or 'none', got '%s'", v);
             m->linear = !strcmp(v, "none");
+        } else if (!strcmp(a, "--view") || !strcmp(a, "--exposure")) {
+            Status st = merge_parse_look(a, argv[++i], &m->look, err);
+            if (st) return st;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             m->quiet = 1;
         } else if (a[0] == '-' && a[1]) {
@@ -177,13 +201,15 @@ Status merge_command(int argc, char **argv, Error *err)
     Status st = merge_parse(argc, argv, &m, err);
     /* the outputs are checked before the parts are read: a typo costs a second */
     if (st == ST_OK) st = image_format_from_path(m.output, &fmt, err);
+    if (st == ST_OK) st = image_check_look(m.output, &m.look, err);
     if (st == ST_OK) st = merge_check_outputs(&m, err);
     if (st == ST_OK) st = atomic_probe(m.output, "", err);
     if (st == ST_OK && m.checkpoint) st = atomic_probe(m.checkpoint, "checkpoint", err);
     if (st == ST_OK) st = merge_parts(m.parts, m.n_parts, &merged, err);
     if (st == ST_OK && m.checkpoint)
         st = checkpoint_write(m.checkpoint, &merged.id, &merged.film, merged.done, merged.n_done, err);
-    if (st == ST_OK) st = film_write(&merged.film, m.output, m.linear ? IMAGE_LINEAR : IMAGE_SRGB, err);
+    ImageStyle style = { m.linear ? IMAGE_LINEAR : IMAGE_SRGB, m.look };
+    if (st == ST_OK) st = film_write(&merged.film, m.output, &style, err);
     if (st == ST_OK && !m.quiet)
         fprintf(stderr, "clpt: merged %zu part%s: %ux%u, %llu spp -> %s\n", m.n_parts, m.n_parts == 1 ? "" : "s",
                 merged.film.width, merged.film.height, (unsigned long long)merged.film.samples, m.output);

@@ -297,13 +297,56 @@ Status image_write(const char *path, const float *rgb, unsigned width, unsigned 
     return image_write_encoded(path, rgb, width, height, IMAGE_SRGB, err);
 }
 
+int image_format_is_display(ImageFormat fmt)
+{
+    return fmt == IMAGE_PNG || fmt == IMAGE_PPM || fmt == IMAGE_BMP;
+}
+
+Status image_check_look(const char *path, const ViewLook *look, Error *err)
+{
+    ImageFormat fmt;
+    Error ignored = { 0 };
+    int known = image_format_from_path(path, &fmt, &ignored) == ST_OK;
+    error_clear(&ignored);
+    if (!known || image_format_is_display(fmt) || view_look_is_identity(look)) return ST_OK;
+    return error_set(err, ST_USAGE, "--view and --exposure form the picture of 8-bit images; '%s' keeps the linear "
+                     "radiance (write a .png, .ppm or .bmp, or leave them out)", path);
+}
+
 Status image_write_encoded(const char *path, const float *rgb, unsigned width, unsigned height,
                            ImageEncoding encoding, Error *err)
 {
+    ImageStyle style = { encoding, { VIEW_STANDARD, 0.0 } };
+    return image_write_styled(path, rgb, width, height, &style, err);
+}
+
+/* The picture a display format stores: rgb through the look, in a new buffer (*out);
+ * NULL in *out when the look changes nothing. */
+static Status image_form_picture(const char *path, const float *rgb, size_t n_pixels, const ViewLook *look,
+                                 float **out, Error *err)
+{
+    *out = NULL;
+    if (view_look_is_identity(look)) return ST_OK;
+    if (!(*out = malloc(n_pixels * 3 * sizeof **out)))
+        return error_set(err, ST_INTERNAL, "cannot write '%s': out of memory", path);
+    memcpy(*out, rgb, n_pixels * 3 * sizeof **out);
+    view_apply(look, *out, n_pixels);
+    return ST_OK;
+}
+
+Status image_write_styled(const char *path, const float *rgb, unsigned width, unsigned height,
+                          const ImageStyle *style, Error *err)
+{
     ImageFormat fmt;
+    ImageEncoding encoding = style->encoding;
     Status st = image_format_from_path(path, &fmt, err);
     if (st != ST_OK) return st;
     if ((st = image_check_size(path, rgb, width, height, err)) != ST_OK) return st;
+    float *picture = NULL;
+    if (image_format_is_display(fmt) &&
+        (st = image_form_picture(path, rgb, (size_t)width * height, &style->look, &picture, err)))
+        return st;
+    const float *src = picture ? picture : rgb;
 
     /* Encode before creating the temporary file: running out of memory then leaves no
      * trace on disk. */
@@ -311,10 +354,14 @@ Status image_write_encoded(const char *path, const float *rgb, unsigned width, u
     size_t count = (size_t)width * height * 3;
     if (fmt == IMAGE_PNG || fmt == IMAGE_PPM || fmt == IMAGE_BMP) {
         srgb = malloc(count);
-        if (!srgb) return error_set(err, ST_INTERNAL, "cannot write '%s': out of memory", path);
+        if (!srgb) {
+            free(picture);
+            return error_set(err, ST_INTERNAL, "cannot write '%s': out of memory", path);
+        }
         for (size_t i = 0; i < count; i++)
-            srgb[i] = (encoding & IMAGE_LINEAR) ? image_to_linear8(rgb[i]) : image_to_srgb8(rgb[i]);
+            srgb[i] = (encoding & IMAGE_LINEAR) ? image_to_linear8(src[i]) : image_to_srgb8(src[i]);
     }
+    free(picture);
 
     AtomicFile af;
     st = image_open(&af, path, err);

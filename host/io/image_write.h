@@ -25,6 +25,7 @@
 #define CLPT_IMAGE_WRITE_H
 
 #include "base/status.h"
+#include "io/view_transform.h"
 
 #include <stddef.h>
 
@@ -33,6 +34,14 @@ typedef enum { IMAGE_PNG, IMAGE_PPM, IMAGE_PFM, IMAGE_BMP, IMAGE_EXR, IMAGE_HDR 
 /* How 8-bit formats encode linear values: IMAGE_SRGB or IMAGE_LINEAR, either with
  * IMAGE_EXR_FLOAT or-ed in for 32-bit float EXR channels (else half). */
 typedef enum { IMAGE_SRGB = 0, IMAGE_LINEAR = 1, IMAGE_EXR_FLOAT = 2 } ImageEncoding;
+
+/* Everything that decides how linear radiance becomes the bytes of a file: the
+ * encoding, and the look (exposure and view) of the formats meant for a display (PNG,
+ * PPM, BMP). Float formats ignore the look. */
+typedef struct {
+    ImageEncoding encoding;
+    ViewLook look;
+} ImageStyle;
 
 /* One named group of channels of a float image (an auxiliary image): `names` for up
  * to three interleaved floats a pixel (NULL: that channel is left out). */
@@ -62,6 +71,17 @@ Status image_write(const char *path, const float *rgb, unsigned width, unsigned 
 /* The same with a choice of 8-bit encoding (PFM is always linear float). */
 Status image_write_encoded(const char *path, const float *rgb, unsigned width, unsigned height,
                            ImageEncoding encoding, Error *err);
+
+/* The same with a look: display formats get rgb through view_apply (view_transform.h)
+ * first, unless the look changes nothing (then the bytes are image_write_encoded's). */
+Status image_write_styled(const char *path, const float *rgb, unsigned width, unsigned height,
+                          const ImageStyle *style, Error *err);
+/* Whether the format is one a view transform applies to (8-bit display formats). */
+int image_format_is_display(ImageFormat fmt);
+/* ST_USAGE when `look` would change an image at `path` whose format keeps linear
+ * radiance (PFM, EXR, HDR), where it would be silently ignored; else ST_OK (also for
+ * a path of no known format: image_format_from_path reports that). */
+Status image_check_look(const char *path, const ViewLook *look, Error *err);
 
 /* Writes an OpenEXR file (path must end in .exr): rgb as R, G, B, then each layer's
  * named channels (as "normal.X", "Z", "albedo.R"), as halves or with float32 as

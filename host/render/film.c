@@ -31,13 +31,13 @@ void film_resolve(const Film *f, float *rgb)
     for (size_t i = 0; i < n; i++) rgb[i] = (float)((double)f->sum[i] * scale);
 }
 
-Status film_write(const Film *f, const char *path, ImageEncoding encoding, Error *err)
+Status film_write(const Film *f, const char *path, const ImageStyle *style, Error *err)
 {
     size_t n = (size_t)f->width * f->height * 3u;
     float *rgb = malloc(n * sizeof *rgb);
     if (!rgb) return error_set(err, ST_INTERNAL, "out of memory resolving the image");
     film_resolve(f, rgb);
-    Status st = image_write_encoded(path, rgb, f->width, f->height, encoding, err);
+    Status st = image_write_styled(path, rgb, f->width, f->height, style, err);
     free(rgb);
     return st;
 }

@@ -24,8 +24,8 @@ void film_free(Film *f);
 /* Average linear radiance per pixel, top row first, into rgb (width * height * 3). With
  * no samples yet the image is black. */
 void film_resolve(const Film *f, float *rgb);
-/* The resolved image written to path (atomically, see image_write_encoded): the one way
+/* The resolved image written to path (atomically, see image_write_styled): the one way
  * a film becomes a file, for the render's output, its progressive rewrites and merge. */
-Status film_write(const Film *f, const char *path, ImageEncoding encoding, Error *err);
+Status film_write(const Film *f, const char *path, const ImageStyle *style, Error *err);
 
 #endif /* CLPT_FILM_H */

@@ -236,7 +236,7 @@ static Status passes__write_exr_layers(const PassRequest *q, const char *output,
 
 /* The adaptive pass and the auxiliary images, after the main image is in rgb (and
  * written). A failure here is the run's failure; the main image stays written. */
-Status passes_after_image(const PassRequest *q, const PassContext *pc, const char *output, ImageEncoding encoding,
+Status passes_after_image(const PassRequest *q, const PassContext *pc, const char *output, const ImageStyle *style,
                          float *rgb, uint spp, Error *err)
 {
     uint w = pc->rs->ds.params.width, h = pc->rs->ds.params.height;
@@ -246,7 +246,7 @@ Status passes_after_image(const PassRequest *q, const PassContext *pc, const cha
         double secs = 0.0;
         if ((st = passes_adaptive(pc, rgb, spp, (float)q->adaptive, q->adaptive_spp, &marked, &secs, err)))
             return st;
-        if ((st = image_write_encoded(output, rgb, w, h, encoding, err))) return st;
+        if ((st = image_write_styled(output, rgb, w, h, style, err))) return st;
         if (!q->quiet)
             fprintf(stderr, "clpt: adaptive pass: %zu of %u pixels (%.1f%%) got %u more samples in %.2f s -> %s\n",
                     marked, w * h, 100.0 * (double)marked / ((double)w * h), q->adaptive_spp, secs, output);

@@ -85,7 +85,7 @@ int passes_aov_in_exr(const PassRequest *q, const char *output, unsigned aov);
 /* The adaptive pass and the auxiliary images, after the main image is in rgb (and
  * written to `output`): each image to its file, or as channels of an EXR output. A
  * failure here is the run's failure; the main image stays written. */
-Status passes_after_image(const PassRequest *q, const PassContext *pc, const char *output, ImageEncoding encoding,
+Status passes_after_image(const PassRequest *q, const PassContext *pc, const char *output, const ImageStyle *style,
                           float *rgb, uint spp, Error *err);
 
 #endif /* CLPT_PASSES_H */

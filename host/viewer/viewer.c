@@ -28,7 +28,7 @@
 
 static const char HELP_TITLE[] =
     "W/A/S/D move  R/F Q/E up/down  drag look  wheel fwd/back  Z/X fov  Up/Down focus  "
-    "Left/Right aperture  +/- exposure  Space pause  C save  P camera  F11 full screen  H help  Esc quit";
+    "Left/Right aperture  +/- exposure  V view  Space pause  C save  P camera  F11 full screen  H help  Esc quit";
 
 static const char HELP_TEXT[] =
     "clpt viewer keys:\n"
@@ -40,6 +40,7 @@ static const char HELP_TEXT[] =
     "  Up/Down        focus distance farther / nearer\n"
     "  Right/Left     aperture wider / narrower (0: pinhole)\n"
     "  +/-            exposure up / down by half a stop (display and PNG)\n"
+    "  V              next view transform: standard, agx, filmic (display and PNG)\n"
     "  Space          pause / resume rendering\n"
     "  C              save the image: SCENE-view-NNN.png and .pfm\n"
     "  P              print the camera as a scene-format block\n"
@@ -63,6 +64,7 @@ typedef struct {
     unsigned gen;                 /* mirrors vr.gen: only this thread changes it */
     double step, aperture_first;
     double exposure;              /* stops */
+    ViewTransform view;           /* --view, then V */
     int paused, help, fullscreen, quit;
     int save_pending, refresh;
     double drag_x, drag_y;        /* mouse motion with the button down, not yet applied */
@@ -134,18 +136,39 @@ static void lut_fill(Viewer *v)
 {
     for (unsigned i = 0; i < LUT_SIZE; i++) {
         float x = (float)i / (float)(LUT_SIZE - 1);
-        v->lut[i] = v->cfg->encoding == IMAGE_LINEAR ? image_to_linear8(x) : image_to_srgb8(x);
+        v->lut[i] = (v->cfg->style.encoding & IMAGE_LINEAR) ? image_to_linear8(x) : image_to_srgb8(x);
     }
     v->lut_scale = (double)(LUT_SIZE - 1) * pow(2.0, v->exposure);
 }
 
+static unsigned char lut_lookup(const Viewer *v, float x)
+{
+    return v->lut[x > 0.0f ? (x < (float)(LUT_SIZE - 1) ? (unsigned)x : LUT_SIZE - 1) : 0];
+}
+
+/* The look being shown: the command line's, as the keys have changed it. */
+static ViewLook viewer_look(const Viewer *v)
+{
+    return (ViewLook){ v->view, v->exposure };
+}
+
+/* The standard view is a scale and the encoding: one table lookup per value. The others
+ * mix channels (AgX) or bend them (filmic) per pixel, into display values the table then
+ * encodes; the saved PNG uses the exact encoder on the same display values. */
 static void frame_convert(Viewer *v, const float *rgb)
 {
-    size_t n = (size_t)v->w * v->h * 3u;
-    float s = (float)v->lut_scale;
+    size_t n = (size_t)v->w * v->h;
+    if (v->view == VIEW_STANDARD) {
+        float s = (float)v->lut_scale;
+        for (size_t i = 0; i < 3 * n; i++) v->pixels[i] = lut_lookup(v, rgb[i] * s + 0.5f);
+        return;
+    }
+    ViewLook look = viewer_look(v);
+    const float top = (float)(LUT_SIZE - 1);
     for (size_t i = 0; i < n; i++) {
-        float x = rgb[i] * s + 0.5f;
-        v->pixels[i] = v->lut[x > 0.0f ? (x < (float)(LUT_SIZE - 1) ? (unsigned)x : LUT_SIZE - 1) : 0];
+        float d[3];
+        view_pixel(&look, rgb + 3 * i, d);
+        for (int k = 0; k < 3; k++) v->pixels[3 * i + k] = lut_lookup(v, d[k] * top + 0.5f);
     }
 }
 
@@ -183,6 +206,10 @@ static void title_update(Viewer *v)
         size_t len = strlen(title);
         snprintf(title + len, sizeof title - len, " | exposure %+.1f", v->exposure);
     }
+    if (v->view != VIEW_STANDARD) {
+        size_t len = strlen(title);
+        snprintf(title + len, sizeof title - len, " | view %s", view_name(v->view));
+    }
     SDL_SetWindowTitle(v->win, title);
 }
 
@@ -206,7 +233,8 @@ static int save_names(const char *scene_path, char *png, char *pfm, size_t size)
 }
 
 /* The PFM holds the film's radiance as the command line writes it; the PNG is what the
- * window shows (exposure applied; at 0 the command line's PNG, byte for byte). */
+ * window shows: the command line's PNG with the --view and --exposure shown, byte for
+ * byte. */
 static void frame_save(Viewer *v, uint64_t samples)
 {
     char png[300], pfm[300];
@@ -215,19 +243,18 @@ static void frame_save(Viewer *v, uint64_t samples)
         fprintf(stderr, "clpt: error: cannot save: every name up to 99999 is taken\n");
         return;
     }
-    Status st = image_write_encoded(pfm, v->save_rgb, v->w, v->h, v->cfg->encoding, &err);
-    if (st == ST_OK && v->exposure != 0.0) {
-        float f = (float)pow(2.0, v->exposure);
-        for (size_t i = 0, n = (size_t)v->w * v->h * 3u; i < n; i++) v->save_rgb[i] *= f;
-    }
-    if (st == ST_OK) st = image_write_encoded(png, v->save_rgb, v->w, v->h, v->cfg->encoding, &err);
+    ImageStyle style = { v->cfg->style.encoding, viewer_look(v) };
+    Status st = image_write_encoded(pfm, v->save_rgb, v->w, v->h, v->cfg->style.encoding, &err);
+    if (st == ST_OK) st = image_write_styled(png, v->save_rgb, v->w, v->h, &style, &err);
     if (st != ST_OK) {
         fprintf(stderr, "clpt: error: cannot save: %s\n", err.msg);
         error_clear(&err);
         return;
     }
-    fprintf(stderr, "clpt: saved %s and %s (%llu spp%s)\n", png, pfm, (unsigned long long)samples,
-            v->exposure != 0.0 ? ", the PNG with the exposure shown" : "");
+    char shown[80] = "";
+    if (!view_look_is_identity(&style.look))
+        snprintf(shown, sizeof shown, ", the PNG as shown: view %s, exposure %+.1f", view_name(v->view), v->exposure);
+    fprintf(stderr, "clpt: saved %s and %s (%llu spp%s)\n", png, pfm, (unsigned long long)samples, shown);
 }
 
 /* Takes the newest published frame when there is one (or a redraw was asked for), and
@@ -287,6 +314,10 @@ static void key_down(Viewer *v, const SDL_KeyboardEvent *k)
     case SDLK_MINUS: case SDLK_KP_MINUS:
         v->exposure -= 0.5;
         lut_fill(v);
+        v->refresh = 1;
+        return;
+    case SDLK_v:
+        v->view = v->view == VIEW_STANDARD ? VIEW_AGX : v->view == VIEW_AGX ? VIEW_FILMIC : VIEW_STANDARD;
         v->refresh = 1;
         return;
     case SDLK_SPACE:
@@ -489,6 +520,8 @@ Status viewer_run(const ViewerConfig *cfg, Error *err)
     v->cam = cfg->scene->camera;
     v->gen = 1;
     v->t_start = timer_now();
+    v->exposure = cfg->style.look.exposure;
+    v->view = cfg->style.look.view;
     lut_fill(v);
     steps_choose(v);
     devices_describe(v);

@@ -27,7 +27,8 @@ typedef struct {
     Device **devices;
     size_t n_devices;
     DeviceConfig device_config;   /* as the devices were opened (previews open them again) */
-    ImageEncoding encoding;       /* of the PNG saves, as the command line's */
+    ImageStyle style;             /* the command line's encoding, and its --view and
+                                   * --exposure: the first look shown, and the PNG saves' */
     uint fixed_batch;             /* --batch */
     int stats;                    /* --stats: timings on stdout at the end */
     int quiet;

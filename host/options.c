@@ -105,9 +105,10 @@
         "OUTPUT-normal.png etc.; an .exr output holds\n" \
         "them as channels normal.X/Y/Z (signed), Z\n" \
         "(distance) and albedo.R/G/B instead. Depth\n" \
-        "in .pfm and .exr is the distance, +inf where\n" \
-        "nothing is hit; in 8-bit images misses are\n" \
-        "black") \
+        "in .pfm and .exr is the distance (32-bit\n" \
+        "float), +inf where nothing is hit; in 8-bit\n" \
+        "images misses are black. Normals in .pfm are\n" \
+        "signed, as in .exr") \
     X(OUTPUT, CUSTOM, depth_near, "--depth-range", NULL, "NEAR,FAR", PARSE(parse_depth_range), \
         "the depth image is linear from white at NEAR to\n" \
         "black at FAR (NEAR > FAR inverts it; default:\n" \

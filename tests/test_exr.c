@@ -382,6 +382,53 @@ static void test_cli_depth_pfm_background_is_infinite(void)
     CHECK_EQ_INT(system(cmd), 0);
 }
 
+/* --aov normal into a PFM: the signed normal, misses 0, exactly the EXR output's
+ * normal.X/Y/Z channels (it was (n + 1) / 2, the 8-bit image's colours). */
+static void test_cli_normal_pfm_is_signed(void)
+{
+    char dir[] = "/tmp/clpt-test-normal-pfm-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char scene[64], pfm_out[64], exr_out[64], normal[64], cmd[1024];
+    snprintf(scene, sizeof scene, "%s/s.scene", dir);
+    snprintf(pfm_out, sizeof pfm_out, "%s/out.pfm", dir);
+    snprintf(exr_out, sizeof exr_out, "%s/out.exr", dir);
+    snprintf(normal, sizeof normal, "%s/out-normal.pfm", dir);
+    FILE *f = fopen(scene, "w");
+    fputs("image { width 16 height 12 spp 4 }\n"
+          "camera { from 0 0 5 at 0 0 0 fov 30 }\n"
+          "sphere { center 0 0 0 radius 1 material { type diffuse albedo 0.5 0.5 0.5 } }\n", f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "%s %s -q --device scalar -o %s --aov normal && %s %s -q --device scalar -o %s --aov "
+             "normal --exr-float", CLI_PROGRAM, scene, pfm_out, CLI_PROGRAM, scene, exr_out);
+    CHECK_EQ_INT(system(cmd), 0);
+    f = fopen(normal, "rb");
+    int w = 0, h = 0;
+    float scale = 0.0f, px[16 * 12 * 3];
+    CHECK(f && fscanf(f, "PF %d %d %f", &w, &h, &scale) == 3 && fgetc(f) == '\n');
+    CHECK(f && fread(px, sizeof px[0], 16 * 12 * 3, f) == 16 * 12 * 3);
+    if (f) fclose(f);
+    int ew = 0, eh = 0;
+    float *ch[3] = { read_channel(exr_out, "normal.X", &ew, &eh), read_channel(exr_out, "normal.Y", &ew, &eh),
+                     read_channel(exr_out, "normal.Z", &ew, &eh) };
+    CHECK(w == 16 && h == 12 && ew == 16 && eh == 12 && ch[0] && ch[1] && ch[2]);
+    if (w == 16 && h == 12 && ew == 16 && eh == 12 && ch[0] && ch[1] && ch[2]) {
+        int same = 1, negative = 0;
+        for (int y = 0; y < h; y++)   /* PFM rows run bottom to top */
+            for (int x = 0; x < w; x++)
+                for (int k = 0; k < 3; k++) {
+                    float v = px[3 * ((h - 1 - y) * w + x) + k];
+                    same &= v == ch[k][y * w + x];
+                    negative |= v < -0.5f;
+                }
+        CHECK_MSG(same, "the PFM's normals differ from the EXR's normal channels");
+        CHECK(negative);   /* signed: the sphere's left half points to -x */
+        CHECK(px[0] == 0.0f && px[1] == 0.0f && px[2] == 0.0f);   /* a miss */
+    }
+    for (int k = 0; k < 3; k++) free(ch[k]);
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    CHECK_EQ_INT(system(cmd), 0);
+}
+
 int main(void)
 {
     RUN(test_exr_half);
@@ -392,5 +439,6 @@ int main(void)
     RUN(test_hdr);
     RUN(test_cli_aov_channels);
     RUN(test_cli_depth_pfm_background_is_infinite);
+    RUN(test_cli_normal_pfm_is_signed);
     return harness_report();
 }

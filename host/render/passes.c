@@ -274,7 +274,13 @@ Status passes_after_image(const PassRequest *q, const PassContext *pc, const cha
         double secs = 0.0;
         DepthScale depth = { fmt == IMAGE_PFM ? DEPTH_RAW : (q->depth_far != q->depth_near ? DEPTH_RANGE : DEPTH_AUTO),
                              q->depth_near, q->depth_far };
-        st = passes_aov(pc, aov, spp, &depth, rgb, &secs, err);
+        /* a PFM holds data as the EXR's channels do: the signed normal (misses 0), not
+         * the colours (n + 1) / 2 an 8-bit image needs; a course's own -normals file
+         * keeps its course's convention */
+        if (fmt == IMAGE_PFM && aov == INTEGRATOR_AOV_NORMAL && !q->aov_files[aov - INTEGRATOR_AOV_NORMAL])
+            st = passes__aov_exr_data(pc, aov, spp, rgb, &secs, err);
+        else
+            st = passes_aov(pc, aov, spp, &depth, rgb, &secs, err);
         /* auxiliary images hold data, not light: no sRGB curve */
         if (!st) st = image_write_encoded(path, rgb, w, h, IMAGE_LINEAR, err);
         if (!st && !q->quiet)

@@ -637,7 +637,34 @@ static Status option_set(const OptionSpec *s, const char *a, const char *v, Opti
     return error_set(err, ST_INTERNAL, "%s: unknown kind of flag", a);
 }
 
-static void options_defaults(Options *o)
+/* A switch given a value (the library's settings): on or off. */
+static Status option_switch_value(const char *name, const char *v, int *dst, Error *err)
+{
+    static const char *const on[] = { "1", "on", "true", "yes" }, *const off[] = { "0", "off", "false", "no" };
+    for (size_t i = 0; i < 4; i++)
+        if (strcmp(v, on[i]) == 0 || strcmp(v, off[i]) == 0) {
+            *dst = strcmp(v, on[i]) == 0;
+            return ST_OK;
+        }
+    return error_set(err, ST_USAGE, "%s is a switch: expects 1, on, true or 0, off, false, got '%s'", name, v);
+}
+
+Status options_set(Options *o, const char *name, const char *value, Error *err)
+{
+    char flag[64];
+    if (!name || !value) return error_set(err, ST_USAGE, "an option needs a name and a value");
+    if (strncmp(name, "--", 2) == 0) name += 2;
+    if (strlen(name) + 3 > sizeof flag) return error_set(err, ST_USAGE, "unknown option '%s'", name);
+    snprintf(flag, sizeof flag, "--%s", name);
+    const OptionSpec *s = option_find(flag);
+    if (!s) return error_set(err, ST_USAGE, "unknown option '%s'", name);
+    /* a switch with choices (--stats=json) also takes one of them by name */
+    if (s->kind == OPTION_SWITCH && (!s->choices || option_switch_value(flag, value, &(int){ 0 }, NULL) == ST_OK))
+        return option_switch_value(flag, value, (int *)((char *)o + s->offset), err);
+    return option_set(s, flag, value, o, err);
+}
+
+void options_init(Options *o)
 {
     memset(o, 0, sizeof *o);
     o->spp = o->width = o->height = o->seed = o->max_depth = o->split = -1;
@@ -746,7 +773,7 @@ static Status options_check_stdout(const Options *o, Error *err)
 }
 
 /* What depends on several flags. */
-static Status options_finish(Options *o, Error *err)
+Status options_finish(Options *o, Error *err)
 {
     if (o->checkpoint_seconds > 0.0 && !o->checkpoint_path && !o->resume_path)
         return error_set(err, ST_USAGE, "--checkpoint-interval needs --checkpoint FILE (or --resume FILE)");
@@ -771,7 +798,7 @@ static Status options_finish(Options *o, Error *err)
 
 Status options_parse(int argc, char **argv, Options *o, Error *err)
 {
-    options_defaults(o);
+    options_init(o);
     int first = 1;
     CourseStyle course = course_args_style(argc, argv);
     if (course != COURSE_NONE) {

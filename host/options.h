@@ -53,6 +53,15 @@ const char *options_help_section(size_t i);
 /* What follows the flag's name in --help (" FILE", " bvh|kdtree", "[=text|json]",
  * or "" for a switch), into buf. */
 void option_value_text(const OptionSpec *s, char *buf, size_t size);
+
+/* The library's settings (api/) are Options set one flag at a time, by the same table:
+ * options_init gives the defaults of a command line without flags; options_set reads
+ * `value` for the flag `name` ("spp" or "--spp"; a switch takes 1/on/true or
+ * 0/off/false), keeping pointers into `value` for text flags; options_finish checks
+ * what depends on several flags (o->scene_path set), as options_parse does last. */
+void options_init(Options *o);
+Status options_set(Options *o, const char *name, const char *value, Error *err);
+Status options_finish(Options *o, Error *err);
 /* The i-th flag of the list, NULL past the last (the tests, the man page and the shell
  * completions read the list through it). */
 const OptionSpec *options_flag(size_t i);

@@ -25,14 +25,12 @@
 #include "device/ocl_program.h"
 #include "render/film.h"
 #include "io/image_write.h"
-#include "base/limit.h"
-#include "io/mesh_load.h"
-#include "io/mesh_view.h"
 #include "options.h"
 #include "render/passes.h"
 #include "base/progress.h"
 #include "render/render_scene.h"
 #include "scene/scene.h"
+#include "scene_options.h"
 #include "render/schedule.h"
 #include "render/stats.h"
 #include "io/scene_load.h"
@@ -171,21 +169,6 @@ static char *default_output(const char *scene_path)
         memcpy(out + n, ".png", 5);
     }
     return out;
-}
-
-static void apply_overrides(const Options *o, Scene *s)
-{
-    if (o->spp >= 0) s->image.spp = (uint)o->spp;
-    if (o->width >= 0) s->image.width = (uint)o->width;
-    if (o->height >= 0) s->image.height = (uint)o->height;
-    if (o->seed >= 0) s->image.seed = (uint)o->seed;
-    if (o->sampler >= 0) s->image.sampler = (uint)o->sampler;
-    if (o->accel >= 0) s->accel = (uint)o->accel;
-    if (o->max_depth >= 0) s->image.max_depth = (uint)o->max_depth;
-    if (o->split >= 0) s->image.split = (uint)o->split;
-    if (o->integrator >= 0) s->integrator = (uint)o->integrator;
-    if (o->gamma >= 0) s->linear_output = o->gamma == 1;
-    if (o->shadows >= 0) s->shadows = o->shadows;
 }
 
 /* What the passes after the main image need of the command line. */
@@ -329,12 +312,8 @@ static Status outputs_from_scene(Run *r, Error *err)
 static Status load_scene_input(const Options *o, Scene *scene, int *bare_mesh, Error *err)
 {
     SceneKind kind = SCENE_KIND_CLPT;
-    if (o->camera && mesh_kind(o->scene_path) != MESH_GLTF)
-        return error_set(err, ST_USAGE, "--camera picks a glTF file's camera; '%s' is not a .gltf or .glb file",
-                         o->scene_path);
-    scene->gltf_camera = o->camera;
-    scene->size_overridden = o->width >= 0 || o->height >= 0;
-    Status st = scene_load_file(o->scene_path, (SceneFormat)o->format, scene, &kind, err);
+    Status st = scene_options_before_load(o, scene, err);
+    if (st == ST_OK) st = scene_load_file(o->scene_path, (SceneFormat)o->format, scene, &kind, err);
     *bare_mesh = st == ST_OK && kind == SCENE_KIND_MESH;
     if (st == ST_OK)
         for (size_t i = 0; i < scene->n_warnings; i++) print_warning(NULL, scene->warnings[i]);
@@ -344,27 +323,11 @@ static Status load_scene_input(const Options *o, Scene *scene, int *bare_mesh, E
 /* The command line's overrides, checked against the scene they apply to. */
 static Status scene_apply_options(Run *r, Error *err)
 {
-    const Options *o = &r->o;
-    Status st;
-    apply_overrides(o, &r->scene);
-    /* the size rendered, whichever reader or flag set it (a pbrt Film's sides are
-     * checked one by one, and an image block's product is left to this check when a
-     * flag replaces its size) */
-    int flags = o->width >= 0 || o->height >= 0;
-    if ((st = limit_pixels(r->scene.image.width, r->scene.image.height, flags ? ST_USAGE : ST_INPUT,
-                           flags ? "--width/--height" : o->scene_path, err)))
-        return st;
-    /* a mesh file given in place of a scene is shown by a camera that frames it */
-    if (r->bare_mesh && (st = mesh_view_fit(&r->scene, err))) return st;
-    if (o->range_end > (long)r->scene.image.spp)
-        return error_set(err, ST_USAGE, "--sample-range %ld:%ld goes past the render's %u samples per pixel",
-                         o->range_first, o->range_end, r->scene.image.spp);
-    if (o->adaptive > 0.0 && r->scene.integrator != INTEGRATOR_WHITTED)
-        return error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
+    Status st = scene_options_apply(&r->o, &r->scene, r->bare_mesh, err);
     r->style.encoding = (ImageEncoding)((r->scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB) |
                                         (r->o.exr_float ? IMAGE_EXR_FLOAT : 0));
     r->style.look = (ViewLook){ (ViewTransform)r->o.view, r->o.exposure };
-    return ST_OK;
+    return st;
 }
 
 /* How the whitted integrator places a pixel's samples at `spp` (render_scene_strata). */

@@ -1,0 +1,52 @@
+/* scene_options.c — see scene_options.h. */
+#include "scene_options.h"
+
+#include "base/limit.h"
+#include "io/mesh_load.h"
+#include "io/mesh_view.h"
+
+Status scene_options_before_load(const Options *o, Scene *s, Error *err)
+{
+    if (o->camera && mesh_kind(o->scene_path) != MESH_GLTF)
+        return error_set(err, ST_USAGE, "--camera picks a glTF file's camera; '%s' is not a .gltf or .glb file",
+                         o->scene_path);
+    s->gltf_camera = o->camera;
+    s->size_overridden = o->width >= 0 || o->height >= 0;
+    return ST_OK;
+}
+
+static void apply_overrides(const Options *o, Scene *s)
+{
+    if (o->spp >= 0) s->image.spp = (uint)o->spp;
+    if (o->width >= 0) s->image.width = (uint)o->width;
+    if (o->height >= 0) s->image.height = (uint)o->height;
+    if (o->seed >= 0) s->image.seed = (uint)o->seed;
+    if (o->sampler >= 0) s->image.sampler = (uint)o->sampler;
+    if (o->accel >= 0) s->accel = (uint)o->accel;
+    if (o->max_depth >= 0) s->image.max_depth = (uint)o->max_depth;
+    if (o->split >= 0) s->image.split = (uint)o->split;
+    if (o->integrator >= 0) s->integrator = (uint)o->integrator;
+    if (o->gamma >= 0) s->linear_output = o->gamma == 1;
+    if (o->shadows >= 0) s->shadows = o->shadows;
+}
+
+Status scene_options_apply(const Options *o, Scene *s, int bare_mesh, Error *err)
+{
+    Status st;
+    apply_overrides(o, s);
+    /* the size rendered, whichever reader or flag set it (a pbrt Film's sides are
+     * checked one by one, and an image block's product is left to this check when a
+     * flag replaces its size) */
+    int flags = o->width >= 0 || o->height >= 0;
+    if ((st = limit_pixels(s->image.width, s->image.height, flags ? ST_USAGE : ST_INPUT,
+                           flags ? "--width/--height" : o->scene_path, err)))
+        return st;
+    /* a mesh file given in place of a scene is shown by a camera that frames it */
+    if (bare_mesh && (st = mesh_view_fit(s, err))) return st;
+    if (o->range_end > (long)s->image.spp)
+        return error_set(err, ST_USAGE, "--sample-range %ld:%ld goes past the render's %u samples per pixel",
+                         o->range_first, o->range_end, s->image.spp);
+    if (o->adaptive > 0.0 && s->integrator != INTEGRATOR_WHITTED)
+        return error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
+    return ST_OK;
+}

@@ -1,0 +1,21 @@
+/* scene_options.h — the command line's settings applied to a loaded scene, shared by
+ * the program (main.c) and the library (api/), so that both render the same scene from
+ * the same flags. */
+#ifndef CLPT_SCENE_OPTIONS_H
+#define CLPT_SCENE_OPTIONS_H
+
+#include "option_values.h"
+#include "scene/scene.h"
+
+/* What the load needs of the flags (--camera, whether --width/--height replace the
+ * file's size), set in an initialised scene before it is read. ST_USAGE when --camera
+ * is given for a file that is not glTF. */
+Status scene_options_before_load(const Options *o, Scene *s, Error *err);
+
+/* The overrides (--spp, --width ... --shadows) applied to the loaded scene and checked
+ * against it: the size's limits, --sample-range within the samples, --adaptive with
+ * the whitted integrator. A bare mesh (`bare_mesh`) gets the camera that frames it for
+ * the final size. */
+Status scene_options_apply(const Options *o, Scene *s, int bare_mesh, Error *err);
+
+#endif /* CLPT_SCENE_OPTIONS_H */

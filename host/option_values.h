@@ -6,6 +6,7 @@
 
 /* --stats: none, the text tables (--stats), or one JSON object (--stats=json) */
 enum { STATS_NONE, STATS_TEXT, STATS_JSON };
+#define OPTIONS_MAX_SETS 64
 
 typedef struct {
     const char *scene_path;
@@ -50,6 +51,9 @@ typedef struct {
     double depth_near, depth_far; /* --depth-range; near == far (0) = automatic */
     int view;                     /* --view: enum ViewTransform (io/view_transform.h) */
     double exposure;              /* --exposure: stops, before the view */
+    /* --set KEY=VALUE, in the order given: scene parameters by path (scene/scene_param.h) */
+    const char *sets[OPTIONS_MAX_SETS];
+    unsigned n_sets;
 } Options;
 
 #endif /* CLPT_OPTION_VALUES_H */

@@ -161,6 +161,13 @@
         "whether lights can be blocked (shadow rays), in\n" \
         "both integrators; default: on, off for classic\n" \
         "scenes (as the course ray casters)") \
+    X(SCENE, CUSTOM, n_sets, "--set", NULL, "KEY=VALUE", PARSE(parse_set), \
+        "set a scene parameter by path once the scene is\n" \
+        "read: camera.fov=30, image.spp=16,\n" \
+        "material.red.albedo=0.8,0.2,0.2,\n" \
+        "light.0.intensity=5 (repeatable; docs/\n" \
+        "scene-format.md, \"Parameters by path\"); --spp\n" \
+        "and the like still win") \
     X(SCENE, CUSTOM, adaptive, "--adaptive", NULL, "THRESHOLD", PARSE(parse_adaptive), \
         "whitted: after the first pass, render\n" \
         "--adaptive-spp more samples in each pixel that\n" \
@@ -413,6 +420,18 @@ static Status parse_exposure(const char *v, Options *o, Error *err)
     if (!*v || *end || errno || starts_blank(v) || !(ev >= -32.0 && ev <= 32.0))
         return error_set(err, ST_USAGE, "--exposure expects a number of stops from -32 to 32, got '%s'", v);
     o->exposure = ev;
+    return ST_OK;
+}
+
+/* --set KEY=VALUE: kept as given, checked against the scene once it is read */
+static Status parse_set(const char *v, Options *o, Error *err)
+{
+    const char *eq = strchr(v, '=');
+    if (!eq || eq == v)
+        return error_set(err, ST_USAGE, "--set expects KEY=VALUE (camera.fov=30, material.NAME.albedo=0.8,0.2,0.2), "
+                         "got '%s'", v);
+    if (o->n_sets == OPTIONS_MAX_SETS) return error_set(err, ST_USAGE, "more than %d --set", OPTIONS_MAX_SETS);
+    o->sets[o->n_sets++] = v;
     return ST_OK;
 }
 

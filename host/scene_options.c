@@ -4,6 +4,10 @@
 #include "base/limit.h"
 #include "io/mesh_load.h"
 #include "io/mesh_view.h"
+#include "scene/scene_param.h"
+
+#include <stdlib.h>
+#include <string.h>
 
 Status scene_options_before_load(const Options *o, Scene *s, Error *err)
 {
@@ -30,9 +34,28 @@ static void apply_overrides(const Options *o, Scene *s)
     if (o->shadows >= 0) s->shadows = o->shadows;
 }
 
+/* --set KEY=VALUE, in order, before the flags that override a parameter (--spp beats
+ * --set image.spp, as it beats the scene file). */
+static Status apply_sets(const Options *o, Scene *s, Error *err)
+{
+    for (unsigned i = 0; i < o->n_sets; i++) {
+        const char *eq = strchr(o->sets[i], '=');
+        size_t n = (size_t)(eq - o->sets[i]);
+        char *key = malloc(n + 1);
+        if (!key) return error_set(err, ST_INTERNAL, "out of memory");
+        memcpy(key, o->sets[i], n);
+        key[n] = '\0';
+        Status st = scene_param_set(s, key, eq + 1, err);
+        free(key);
+        if (st) return st;
+    }
+    return ST_OK;
+}
+
 Status scene_options_apply(const Options *o, Scene *s, int bare_mesh, Error *err)
 {
-    Status st;
+    Status st = apply_sets(o, s, err);
+    if (st) return st;
     apply_overrides(o, s);
     /* the size rendered, whichever reader or flag set it (a pbrt Film's sides are
      * checked one by one, and an image block's product is left to this check when a

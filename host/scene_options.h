@@ -12,7 +12,7 @@
  * is given for a file that is not glTF. */
 Status scene_options_before_load(const Options *o, Scene *s, Error *err);
 
-/* The overrides (--spp, --width ... --shadows) applied to the loaded scene and checked
+/* The overrides (--set, then --spp, --width ... --shadows) applied to the loaded scene and checked
  * against it: the size's limits, --sample-range within the samples, --adaptive with
  * the whitted integrator. A bare mesh (`bare_mesh`) gets the camera that frames it for
  * the final size. */

@@ -201,11 +201,9 @@ int passes_aov_in_exr(const PassRequest *q, const char *output, unsigned aov)
     return fmt == IMAGE_EXR && !q->aov_files[aov - INTEGRATOR_AOV_NORMAL];
 }
 
-/* An auxiliary image as the EXR output's channels hold it: the normal signed (the
- * normal image rendered with grey misses, (n + 1) / 2, gives 2c - 1 = the pixel's mean
- * normal with misses counting 0), the mean distance to the pixel's hits (+inf where
- * none), the albedo as it is. */
-static Status passes__aov_exr_data(const PassContext *pc, unsigned aov, uint spp, float *rgb, double *secs, Error *err)
+/* The normal image rendered with grey misses, (n + 1) / 2, gives 2c - 1 = the
+ * pixel's mean normal with misses counting 0. */
+Status passes_aov_data(const PassContext *pc, unsigned aov, uint spp, float *rgb, double *secs, Error *err)
 {
     RenderParams *p = &pc->rs->ds.params;
     uint grey = p->normal_miss_grey;
@@ -257,7 +255,7 @@ Status passes_after_image(const PassRequest *q, const PassContext *pc, const cha
         float **slot = &in_exr[aov - INTEGRATOR_AOV_NORMAL];
         double secs = 0.0;
         if (!(*slot = malloc((size_t)w * h * 3u * sizeof **slot))) st = error_set(err, ST_INTERNAL, "out of memory");
-        if (!st) st = passes__aov_exr_data(pc, aov, spp, *slot, &secs, err);
+        if (!st) st = passes_aov_data(pc, aov, spp, *slot, &secs, err);
         if (!st && !q->quiet) fprintf(stderr, "clpt: %s image in %.2f s\n", passes_aov_name(aov), secs);
     }
     if (!st) st = passes__write_exr_layers(q, output, rgb, in_exr, w, h, err);
@@ -278,7 +276,7 @@ Status passes_after_image(const PassRequest *q, const PassContext *pc, const cha
          * the colours (n + 1) / 2 an 8-bit image needs; a course's own -normals file
          * keeps its course's convention */
         if (fmt == IMAGE_PFM && aov == INTEGRATOR_AOV_NORMAL && !q->aov_files[aov - INTEGRATOR_AOV_NORMAL])
-            st = passes__aov_exr_data(pc, aov, spp, rgb, &secs, err);
+            st = passes_aov_data(pc, aov, spp, rgb, &secs, err);
         else
             st = passes_aov(pc, aov, spp, &depth, rgb, &secs, err);
         /* auxiliary images hold data, not light: no sRGB curve */

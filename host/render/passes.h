@@ -58,6 +58,12 @@ void passes_depth_grey(float *rgb, size_t n, const DepthScale *scale);
 Status passes_aov(const PassContext *pc, uint aov, uint spp, const DepthScale *depth, float *rgb,
                   double *seconds, Error *err);
 
+/* Renders auxiliary image `aov` as data, as the EXR output's channels and the library
+ * (api/) hold it: the normal signed (the pixel's mean normal, misses counting 0), the
+ * mean distance to the pixel's hits in every channel (+inf where none), the albedo as
+ * it is. */
+Status passes_aov_data(const PassContext *pc, unsigned aov, uint spp, float *rgb, double *seconds, Error *err);
+
 /* The file name of an auxiliary image: "out.png" and "normal" give "out-normal.png". */
 char *passes_aov_path(const char *output, const char *name);
 

@@ -468,7 +468,9 @@ static void monitor_run(Shared *sh, Monitor *m, uint done_before, ScheduleStats 
         wait_tick(sh, poll);
         size_t active = active_workers(sh);
         if (check_interrupt(sh)) stats->interrupted = 1;
-        progress_update(&progress, (double)(batch_queue_completed(&sh->queue) - done_before) * pixels);
+        uint completed = batch_queue_completed(&sh->queue);
+        progress_update(&progress, (double)(completed - done_before) * pixels);
+        if (cfg->on_poll) cfg->on_poll(cfg->ctx, completed);
         if (active == 0) break;
         monitor_callbacks(sh, m, stats);
     }

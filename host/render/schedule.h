@@ -64,6 +64,10 @@ typedef struct {
     void (*on_checkpoint)(void *ctx, const ScheduleSnapshot *snap);
     double checkpoint_seconds;
     void (*on_warning)(void *ctx, const char *message);
+    /* Called from the calling thread at every poll (about every poll_seconds) and once
+     * at the end, with the samples per pixel finished so far: the library's progress
+     * callback, which may set *stop. NULL for none. */
+    void (*on_poll)(void *ctx, uint spp_done);
     void *ctx;
 } ScheduleConfig;
 

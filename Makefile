@@ -27,9 +27,13 @@ WARN      := -Wall -Wextra -Wpedantic -Wshadow -Wstrict-prototypes -Wmissing-pro
 # The scalar device must compute the same bits as OpenCL: no contraction into FMA, no
 # fast-math (see kernels/util/compat.h).
 FPFLAGS   := -ffp-contract=off -fno-fast-math
-CPPFLAGS  := -D_GNU_SOURCE -DCL_TARGET_OPENCL_VERSION=120 -Ihost -Ikernels -I$(BUILD) \
+CPPFLAGS  := -D_GNU_SOURCE -DCL_TARGET_OPENCL_VERSION=120 -Ihost -Ikernels -Iinclude -I$(BUILD) \
              -I/usr/include/stb -I/usr/include/OpenEXR
-CFLAGS    := -std=c11 $(OPT) -g $(WARN) $(FPFLAGS) -pthread $(EXTRA_CFLAGS)
+# One object set serves the program, the tests and libclpt.so: position-independent,
+# and hidden unless marked CLPT_API (include/clpt/clpt.h), so that the shared library
+# exports the public functions only. Hidden symbols cannot be interposed, so the code is
+# what the compiler's default -fPIE makes (docs/api.md has the timing).
+CFLAGS    := -std=c11 $(OPT) -g $(WARN) $(FPFLAGS) -pthread -fPIC -fvisibility=hidden $(EXTRA_CFLAGS)
 LDFLAGS   := -pthread $(EXTRA_LDFLAGS)
 LDLIBS    := -lOpenCL -lstb -lOpenEXRCore -lOpenEXR -lcjson -lz -lm
 
@@ -65,13 +69,13 @@ FUZZ_BIN  := $(FUZZ_SRC:fuzz/%.c=$(BUILD)/fuzz/%)
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: FORCE all deps install uninstall test render bench bench-peers xcheck clean test-asan test-valgrind fuzz fuzz-build
+.PHONY: FORCE all lib deps install uninstall test render bench bench-peers xcheck clean test-asan test-valgrind fuzz fuzz-build
 .DEFAULT_GOAL := all
 
 # The man page and the shell completions, written from the option list (docs/cli.md).
 GENERATED_DOCS := $(BUILD)/$(PROG).1 $(BUILD)/$(PROG).bash $(BUILD)/_$(PROG)
 
-all: $(BUILD)/$(PROG) $(GENERATED_DOCS)
+all: $(BUILD)/$(PROG) lib $(GENERATED_DOCS)
 
 # ---------------------------------------------------------------- system packages
 deps:
@@ -141,6 +145,37 @@ $(BUILD)/lib$(PROG).a: $(HOST_OBJ)
 # the library without it.
 $(BUILD)/$(PROG): $(BUILD)/host/main.o $(BUILD)/version.o $(BUILD)/lib$(PROG).a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS) $(MPI_LIBS) -lSDL2
+
+# ---------------------------------------------------------------- the shared library
+# libclpt.so.MAJOR.MINOR.PATCH (SONAME libclpt.so.MAJOR), the version read from the public
+# header. Everything but the viewer (SDL2), the distributed renders (MPI) and main: the
+# library links neither SDL2 nor MPI.
+API_VERSION := $(shell sed -n 's/^\#define CLPT_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\)$$/\2/p' include/clpt/clpt.h | paste -sd.)
+API_MAJOR   := $(firstword $(subst ., ,$(API_VERSION)))
+SO_NAME     := lib$(PROG).so.$(API_MAJOR)
+SO_FILE     := $(BUILD)/lib$(PROG).so.$(API_VERSION)
+SO_OBJ      := $(filter-out $(BUILD)/host/viewer/% $(BUILD)/host/dist/%,$(HOST_OBJ))
+
+lib: $(BUILD)/lib$(PROG).so
+
+$(SO_FILE): $(SO_OBJ)
+	$(CC) -shared -Wl,-soname,$(SO_NAME) -Wl,--no-undefined -Wl,-z,defs $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
+$(BUILD)/lib$(PROG).so: $(SO_FILE)
+	ln -sf $(notdir $(SO_FILE)) $(BUILD)/$(SO_NAME)
+	ln -sf $(SO_NAME) $@
+
+# The example and the API's test see the public header only, and link the shared
+# library (found beside them through the run path), as a user's program does.
+API_CFLAGS := -std=c11 $(OPT) -g $(WARN) -Iinclude
+$(BUILD)/examples/%: examples/%.c include/clpt/clpt.h $(BUILD)/lib$(PROG).so
+	@mkdir -p $(@D)
+	$(CC) $(API_CFLAGS) -o $@ $< -L$(BUILD) -l$(PROG) -Wl,-rpath,'$$ORIGIN/..'
+
+$(BUILD)/tests/test_api: tests/test_api.c tests/harness.h include/clpt/clpt.h $(BUILD)/lib$(PROG).so
+	@mkdir -p $(@D)
+	$(CC) $(API_CFLAGS) -D_GNU_SOURCE -Itests -DCLPT_BUILD_DIR='"$(BUILD)"' -pthread -o $@ $< -L$(BUILD) -l$(PROG) \
+	    -Wl,-rpath,'$$ORIGIN/..' -lm
 
 $(BUILD)/tests/%: tests/%.c tests/harness.h $(BUILD)/lib$(PROG).a
 	@mkdir -p $(@D)
@@ -222,8 +257,11 @@ uninstall:
 	rm -rf $(DESTDIR)$(INCLUDEDIR)/$(PROG)
 
 # ---------------------------------------------------------------- use
-test: $(BUILD)/$(PROG) $(GENERATED_DOCS) $(BUILD)/$(PROG).pc $(TEST_BIN) $(FUZZ_REPLAY)
+EXAMPLE_BIN := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
+
+test: $(BUILD)/$(PROG) $(GENERATED_DOCS) $(BUILD)/$(PROG).pc $(TEST_BIN) $(FUZZ_REPLAY) $(EXAMPLE_BIN)
 	@sh tools/check_layers.sh
+	@sh tools/check_exports.sh $(BUILD)
 	@sh tests/run.sh $(BUILD)
 
 render: $(BUILD)/$(PROG)

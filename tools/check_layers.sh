@@ -12,13 +12,16 @@
 #   dist    one image from many processes: merging --sample-range parts, the MPI
 #           driver (docs/distributed.md)
 #   viewer  the interactive window (docs/viewer.md): its camera, its renderer, SDL
-#   app     host/*.c: options and main, on top of everything
+#   app     host/*.c: options and main
+#   api     the library's public interface (include/clpt/clpt.h, docs/api.md): a render
+#           through it reads its settings with the program's option table, so it sits
+#           on top of everything, the app layer's own files included
 #
 # Headers of kernels/ (shared structs, math) may be included from any layer. Prints
 # every include that points up and exits 1 if there is one; run by `make test`.
 set -eu
 cd "$(dirname "$0")/.."
-layers="base scene io accel device render dist viewer app"
+layers="base scene io accel device render dist viewer app api"
 
 rank() {
     i=0
@@ -50,8 +53,9 @@ for f in host/*.[ch] host/*/*.[ch]; do
         case "$inc" in
             */*) layer=${inc%%/*} ;;
             *)
-                # a bare name is a header of the app layer
-                if [ -f "$dir/$inc" ] && [ "$own" = app ]; then continue; fi
+                # a bare name is a header of the app layer (host/), which only the app
+                # and api layers may include
+                if [ -f "host/$inc" ] && [ "$own_rank" -ge "$(rank app)" ]; then continue; fi
                 echo "check_layers: $f includes \"$inc\": name the layer (\"LAYER/$inc\")" >&2
                 bad=1
                 continue ;;

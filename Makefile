@@ -259,7 +259,13 @@ uninstall:
 # ---------------------------------------------------------------- use
 EXAMPLE_BIN := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
 
-test: $(BUILD)/$(PROG) $(GENERATED_DOCS) $(BUILD)/$(PROG).pc $(TEST_BIN) $(FUZZ_REPLAY) $(EXAMPLE_BIN)
+# The Python module's tests, one program of the suite (tools/test_python.sh says how).
+$(BUILD)/tests/test_python: tools/test_python.sh $(BUILD)/lib$(PROG).so
+	@mkdir -p $(@D)
+	cp tools/test_python.sh $@ && chmod +x $@
+
+test: $(BUILD)/$(PROG) $(GENERATED_DOCS) $(BUILD)/$(PROG).pc $(TEST_BIN) $(FUZZ_REPLAY) $(EXAMPLE_BIN) \
+      $(BUILD)/tests/test_python
 	@sh tools/check_layers.sh
 	@sh tools/check_exports.sh $(BUILD)
 	@sh tests/run.sh $(BUILD)

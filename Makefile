@@ -27,7 +27,7 @@ WARN      := -Wall -Wextra -Wpedantic -Wshadow -Wstrict-prototypes -Wmissing-pro
 # The scalar device must compute the same bits as OpenCL: no contraction into FMA, no
 # fast-math (see kernels/util/compat.h).
 FPFLAGS   := -ffp-contract=off -fno-fast-math
-CPPFLAGS  := -D_GNU_SOURCE -DCL_TARGET_OPENCL_VERSION=120 -Ihost -Ikernels -Iinclude -I$(BUILD) \
+CPPFLAGS  := -D_GNU_SOURCE -DCL_TARGET_OPENCL_VERSION=120 -Ihost -Ikernels -Iinclude -I$(BUILD)/include -I$(BUILD) \
              -I/usr/include/stb -I/usr/include/OpenEXR
 # One object set serves the program, the tests and libclpt.so: position-independent,
 # and hidden unless marked CLPT_API (include/clpt/clpt.h), so that the shared library
@@ -122,16 +122,24 @@ $(BUILD)/kernel_source.o $(BUILD)/bench_kernel_source.o: %.o: %.c
 # links nothing again.
 $(BUILD)/version.c: VERSION FORCE
 	@mkdir -p $(@D)
-	@printf '/* written by the Makefile from VERSION and git */\n#include "version.h"\nconst char clpt_version[] = "%s";\nconst char clpt_commit[] = "%s";\n' \
+	@printf '/* written by the Makefile from VERSION and git */\n#include "version.h"\nconst char clpt_version_text[] = "%s";\nconst char clpt_commit[] = "%s";\n' \
 	    '$(VERSION)' '$(COMMIT)' > $@.tmp
 	@if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv $@.tmp $@; fi
+
+# The public header's version macros, from the same VERSION (include/clpt/clpt.h
+# includes it; installed beside it).
+VERSION_H := $(BUILD)/include/$(PROG)/clpt_version.h
+$(VERSION_H): VERSION
+	@mkdir -p $(@D)
+	@printf '/* written by the Makefile from VERSION: do not edit */\n#ifndef CLPT_VERSION_MACROS_H\n#define CLPT_VERSION_MACROS_H\n#define CLPT_VERSION_MAJOR %s\n#define CLPT_VERSION_MINOR %s\n#define CLPT_VERSION_PATCH %s\n#endif\n' \
+	    $(subst ., ,$(VERSION)) > $@.tmp && mv $@.tmp $@
 
 $(BUILD)/version.o: $(BUILD)/version.c host/version.h
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c -o $@ $<
 
 FORCE:
 
-$(BUILD)/host/%.o: host/%.c
+$(BUILD)/host/%.o: host/%.c | $(VERSION_H)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(FILE_WARN) -MMD -MP -c -o $@ $<
 
@@ -150,7 +158,7 @@ $(BUILD)/$(PROG): $(BUILD)/host/main.o $(BUILD)/version.o $(BUILD)/lib$(PROG).a
 # libclpt.so.MAJOR.MINOR.PATCH (SONAME libclpt.so.MAJOR), the version read from the public
 # header. Everything but the viewer (SDL2), the distributed renders (MPI) and main: the
 # library links neither SDL2 nor MPI.
-API_VERSION := $(shell sed -n 's/^\#define CLPT_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\)$$/\2/p' include/clpt/clpt.h | paste -sd.)
+API_VERSION := $(VERSION)
 API_MAJOR   := $(firstword $(subst ., ,$(API_VERSION)))
 SO_NAME     := lib$(PROG).so.$(API_MAJOR)
 SO_FILE     := $(BUILD)/lib$(PROG).so.$(API_VERSION)
@@ -167,12 +175,12 @@ $(BUILD)/lib$(PROG).so: $(SO_FILE)
 
 # The example and the API's test see the public header only, and link the shared
 # library (found beside them through the run path), as a user's program does.
-API_CFLAGS := -std=c11 $(OPT) -g $(WARN) -Iinclude
-$(BUILD)/examples/%: examples/%.c include/clpt/clpt.h $(BUILD)/lib$(PROG).so
+API_CFLAGS := -std=c11 $(OPT) -g $(WARN) -Iinclude -I$(BUILD)/include
+$(BUILD)/examples/%: examples/%.c include/clpt/clpt.h $(VERSION_H) $(BUILD)/lib$(PROG).so
 	@mkdir -p $(@D)
 	$(CC) $(API_CFLAGS) -o $@ $< -L$(BUILD) -l$(PROG) -Wl,-rpath,'$$ORIGIN/..'
 
-$(BUILD)/tests/test_api: tests/test_api.c tests/harness.h include/clpt/clpt.h $(BUILD)/lib$(PROG).so
+$(BUILD)/tests/test_api: tests/test_api.c tests/harness.h include/clpt/clpt.h $(VERSION_H) $(BUILD)/lib$(PROG).so
 	@mkdir -p $(@D)
 	$(CC) $(API_CFLAGS) -D_GNU_SOURCE -Itests -DCLPT_BUILD_DIR='"$(BUILD)"' -pthread -o $@ $< -L$(BUILD) -l$(PROG) \
 	    -Wl,-rpath,'$$ORIGIN/..' -lm
@@ -224,7 +232,7 @@ INSTALL     ?= install
 # links; the headers of include/clpt/), and then clpt.pc. Extend the patterns, not
 # the recipe.
 INSTALL_LIBS    ?= $(BUILD)/lib$(PROG).so*
-INSTALL_HEADERS ?= include/$(PROG)/*.h
+INSTALL_HEADERS ?= include/$(PROG)/*.h $(BUILD)/include/$(PROG)/*.h
 
 $(BUILD)/$(PROG).pc: tools/$(PROG).pc.in VERSION FORCE
 	@sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBDIR@|$(LIBDIR)|' -e 's|@INCLUDEDIR@|$(INCLUDEDIR)|' \

@@ -227,7 +227,7 @@ static Status run_info_command(const Options *o, int *done, Error *err)
     if (o->help) {
         options_print_help(stdout);
     } else if (o->version) {
-        printf("clpt %s (commit %s)\n", clpt_version, clpt_commit);
+        printf("clpt %s (commit %s)\n", clpt_version_text, clpt_commit);
     } else if (o->list_devices) {
         DeviceDesc *all = NULL;
         size_t n = 0;
@@ -500,7 +500,7 @@ static const char *output_name(const char *output)
 /* --stats=json: the run as one object (stats.h). */
 static void results_print_json(const Run *r, const char *result)
 {
-    RenderStatsRun run = { clpt_version, r->o.scene_path, output_name(r->output), result, r->film.width,
+    RenderStatsRun run = { clpt_version_text, r->o.scene_path, output_name(r->output), result, r->film.width,
                            r->film.height, r->scene.image.spp, timer_now() - r->t_start };
     render_stats_print_json(r->report, &run, &r->scene, &r->stats);
 }

@@ -6,7 +6,7 @@
 #define CLPT_VERSION_H
 
 /* The semantic version, "MAJOR.MINOR.PATCH" (VERSION). */
-extern const char clpt_version[];
+extern const char clpt_version_text[];
 /* The commit built from, abbreviated, with "-dirty" when the work tree had changes;
  * "unknown" when not built from a git checkout (a release tarball). */
 extern const char clpt_commit[];

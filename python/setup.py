@@ -43,4 +43,13 @@ class BinaryDistribution(Distribution):
         return True
 
 
-setup(cmdclass={"build_py": BuildWithLibrary}, distclass=BinaryDistribution)
+def version():
+    """The one version of clpt: the repository's VERSION file (CLPT_VERSION outside it)."""
+    path = os.path.join(REPO, "VERSION")
+    if os.path.exists(path):
+        with open(path) as f:
+            return f.read().strip()
+    return os.environ.get("CLPT_VERSION", "0.0.0")
+
+
+setup(version=version(), cmdclass={"build_py": BuildWithLibrary}, distclass=BinaryDistribution)

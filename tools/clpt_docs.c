@@ -155,7 +155,7 @@ static void write_man(FILE *f)
 {
     size_t n_sections = options_help_sections();
     fprintf(f, ".\\\" clpt.1: written by clpt_docs from the option list in host/options.c; do not edit.\n");
-    fprintf(f, ".TH CLPT 1 \"\" \"clpt %s\" \"User Commands\"\n", clpt_version);
+    fprintf(f, ".TH CLPT 1 \"\" \"clpt %s\" \"User Commands\"\n", clpt_version_text);
     /* no hyphenation, ragged right: paths and flag names stay whole and copyable */
     fputs(".nh\n.ad l\n.SH NAME\nclpt \\- a portable OpenCL path tracer\n", f);
     const char *description = roff_synopsis(f, options_help_section(0));

@@ -38,11 +38,10 @@
 extern "C" {
 #endif
 
-/* The library's version (semantic: a new MAJOR breaks this interface, and is the
- * SONAME's number, libclpt.so.MAJOR). */
-#define CLPT_VERSION_MAJOR 0
-#define CLPT_VERSION_MINOR 1
-#define CLPT_VERSION_PATCH 0
+/* The library's version, CLPT_VERSION_MAJOR, _MINOR and _PATCH (semantic: a new MAJOR
+ * breaks this interface, and is the SONAME's number, libclpt.so.MAJOR), written by the
+ * build from the one VERSION file into clpt/clpt_version.h and installed beside this. */
+#include "clpt/clpt_version.h"
 
 #if defined(__GNUC__)
 #define CLPT_API __attribute__((visibility("default")))
@@ -66,7 +65,7 @@ typedef struct clpt_context clpt_context;
 typedef struct clpt_scene clpt_scene;
 typedef struct clpt_settings clpt_settings;
 
-/* "0.1.0": the version of the library loaded (may differ from the header's). */
+/* "0.2.0": the version of the library loaded (may differ from the header's). */
 CLPT_API const char *clpt_version(void);
 
 /* ------------------------------------------------------------------ contexts */

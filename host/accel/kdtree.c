@@ -27,6 +27,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "base/array.h"
 #include "base/jobs.h"
 #include "base/pages.h"
 #include "base/timer.h"

@@ -50,3 +50,18 @@ const char *fault_build_options(unsigned index)
                ? "-D__kernel=clpt_test_build_failure_forced_by_CLPT_TEST_BUILD_FAIL"
                : NULL;
 }
+
+long fault_device_batch(size_t device_index)
+{
+    const char *spec = getenv("CLPT_TEST_FAIL");
+    while (spec && *spec) {
+        char *end;
+        unsigned long dev = strtoul(spec, &end, 10);
+        if (*end != ':') break;
+        long batch = strtol(end + 1, &end, 10);
+        if (dev == device_index) return batch;
+        if (*end != ',') break;
+        spec = end + 1;
+    }
+    return -1;
+}

@@ -15,12 +15,16 @@
  *   CLPT_TEST_BUILD_FAIL=I[,I...]  OpenCL device I builds the kernels with an extra
  *                                  option that breaks them (-D__kernel=<unknown type>):
  *                                  a real compile failure, with a build log
+ *   CLPT_TEST_FAIL=D:B[,D:B...]    the device at position D of the render's selection
+ *                                  fails when it starts its B-th batch (from 0), as a
+ *                                  real fault would: its batches go back to the queue
  *
  * docs/hardening.md lists them too.
  */
 #ifndef CLPT_FAULT_H
 #define CLPT_FAULT_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 /* 1 when CLPT_TEST_FAIL_ALLOC names `site`. */
@@ -33,5 +37,9 @@ void fault_device_memory(unsigned index, uint64_t *global_mem, uint64_t *max_all
 /* The extra build options that make device `index`'s build fail when
  * CLPT_TEST_BUILD_FAIL names it; NULL otherwise. */
 const char *fault_build_options(unsigned index);
+
+/* The batch (counted from 0) at which the device at position `device_index` of the
+ * selection is to fail, from CLPT_TEST_FAIL; -1: never. */
+long fault_device_batch(size_t device_index);
 
 #endif /* CLPT_FAULT_H */

@@ -12,6 +12,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base/timer.h"
+
 /* At most this often, so a fast render loop does not spend its time writing to the terminal
  * (and a slow terminal or ssh link does not flicker). */
 #define REDRAW_INTERVAL_S 0.1
@@ -241,13 +243,6 @@ void progress_format_log(const Progress *p, double now, char *buf, size_t size)
 
 /* ------------------------------------------------------------------ clock and terminal */
 
-static double monotonic_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
-
 static int terminal_columns(void)
 {
     struct winsize ws;
@@ -283,7 +278,7 @@ int progress_should_enable(int quiet)
 void progress_begin(Progress *p, const char *label, double total_units, const char *unit_name,
                     int mode)
 {
-    progress_begin_at(p, label, total_units, unit_name, mode, monotonic_seconds());
+    progress_begin_at(p, label, total_units, unit_name, mode, timer_now());
     /* a log's first line waits for the first update, so that progress_set_step is in
      * effect (and a log gets no line for work that ends at once) */
     if (p->enabled == PROGRESS_TERMINAL) progress_draw(p, p->start, 0);
@@ -291,7 +286,7 @@ void progress_begin(Progress *p, const char *label, double total_units, const ch
 
 void progress_update(Progress *p, double done_units)
 {
-    double now = monotonic_seconds();
+    double now = timer_now();
     progress_observe(p, now, done_units);
     if (!p->enabled) return;
     double interval = p->enabled == PROGRESS_LOG ? PROGRESS_LOG_INTERVAL_S : REDRAW_INTERVAL_S;
@@ -302,7 +297,7 @@ void progress_update(Progress *p, double done_units)
 void progress_end(Progress *p)
 {
     /* a log's last word is the caller's summary */
-    if (p->enabled == PROGRESS_TERMINAL) progress_draw(p, monotonic_seconds(), 1);
+    if (p->enabled == PROGRESS_TERMINAL) progress_draw(p, timer_now(), 1);
     /* A second end (say, on an error path after the normal one) prints nothing more. */
     p->enabled = PROGRESS_OFF;
 }

@@ -18,6 +18,7 @@
 #include "base/atomic_file.h"
 #include "base/bytes.h"
 #include "base/sha256.h"
+#include "base/timer.h"
 
 /* Cache file layout (integers little-endian):
  *   0  8  magic "CLPTKBIN"
@@ -32,13 +33,6 @@
 #define OCLP__HEADER 88
 /* No device binary of this program comes near this; a larger length is corruption. */
 #define OCLP__MAX_PAYLOAD ((uint64_t)1 << 30)
-
-static double oclp__now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
 
 /* ---------------------------------------------------------------- source and options */
 
@@ -435,12 +429,12 @@ static OclpTrial oclp__try_entry(const OclDeviceInfo *dev, const char *path,
     free(envp);
     if (spawned != 0) return OCLP__TRIAL_UNKNOWN;
     int wstatus = 0;
-    double deadline = oclp__now() + OCLP__TRIAL_SECONDS;
+    double deadline = timer_now() + OCLP__TRIAL_SECONDS;
     for (;;) {
         pid_t got = waitpid(pid, &wstatus, WNOHANG);
         if (got == pid) break;
         if (got < 0 && errno != EINTR) return OCLP__TRIAL_UNKNOWN;
-        if (oclp__now() > deadline) {
+        if (timer_now() > deadline) {
             kill(pid, SIGKILL);
             while (waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {}
             return OCLP__TRIAL_REFUSED;
@@ -674,7 +668,7 @@ Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *k
                          const char *extra_options, cl_program *out, OclProgramStats *stats,
                          Error *err)
 {
-    double t0 = oclp__now();
+    double t0 = timer_now();
     OclProgramStats local;
     if (!stats) stats = &local;
     memset(stats, 0, sizeof *stats);
@@ -696,7 +690,7 @@ Status ocl_program_build(cl_context ctx, const OclDeviceInfo *dev, const char *k
     }
     st = oclp__build(ctx, dev, src, src_len, kernel_dir != NULL, stats->options, out, stats, err);
     free(file_src);
-    stats->seconds = oclp__now() - t0;
+    stats->seconds = timer_now() - t0;
     return st;
 }
 
@@ -704,14 +698,14 @@ Status ocl_program_build_source(cl_context ctx, const OclDeviceInfo *dev, const 
                                 size_t src_len, const char *extra_options, cl_program *out,
                                 OclProgramStats *stats, Error *err)
 {
-    double t0 = oclp__now();
+    double t0 = timer_now();
     OclProgramStats local;
     if (!stats) stats = &local;
     memset(stats, 0, sizeof *stats);
     *out = NULL;
     Status st = oclp__options(dev, NULL, extra_options, stats->options, sizeof stats->options, err);
     if (st == ST_OK) st = oclp__build(ctx, dev, src, src_len, 0, stats->options, out, stats, err);
-    stats->seconds = oclp__now() - t0;
+    stats->seconds = timer_now() - t0;
     return st;
 }
 

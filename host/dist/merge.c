@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "base/atomic_file.h"
 #include "base/file_id.h"
 #include "io/image_write.h"

@@ -1,6 +1,7 @@
 /* mtl.c — the MTL reader and the mapping onto clpt materials (mtl.h). */
 #include "io/mtl.h"
 
+#include "base/array.h"
 #include "util/kmath.h"
 #include "io/lexer.h"
 #include "io/mesh_text.h"

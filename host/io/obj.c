@@ -7,6 +7,7 @@
  * few digits take an exact fast path (see parse_float); the rest go to strtof.
  */
 #include "io/obj.h"
+#include "base/array.h"
 #include "io/texture.h"
 
 #include "util/kmath.h"

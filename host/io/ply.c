@@ -13,6 +13,7 @@
  */
 #include "io/ply.h"
 
+#include "base/array.h"
 #include "base/strmap.h"
 
 #include "util/kmath.h"

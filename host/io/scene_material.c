@@ -4,6 +4,7 @@
  */
 #include "io/scene_reader.h"
 
+#include "base/array.h"
 #include "util/kmath.h"
 #include "io/lexer.h"
 #include "io/reader.h"

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "scene/scene.h"
+#include "base/array.h"
 
 int batch_queue_init(BatchQueue *q, uint end)
 {

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/fault.h"
 #include "base/timer.h"
 
 #define DEFAULT_BATCH_SECONDS 0.25
@@ -46,24 +47,6 @@ struct Shared {
     Worker *workers;
     size_t n_workers;
 };
-
-/* Tests make a device fail on purpose: CLPT_TEST_FAIL="DEVICE:BATCH[,DEVICE:BATCH...]"
- * makes the device at position DEVICE of the selection fail when it starts its BATCH-th
- * batch (counting from 0), as a real fault would: its batches go back to the queue. */
-static long injected_failure(size_t device_index)
-{
-    const char *spec = getenv("CLPT_TEST_FAIL");
-    while (spec && *spec) {
-        char *end;
-        unsigned long dev = strtoul(spec, &end, 10);
-        if (*end != ':') break;
-        long batch = strtol(end + 1, &end, 10);
-        if (dev == device_index) return batch;
-        if (*end != ',') break;
-        spec = end + 1;
-    }
-    return -1;
-}
 
 static void warn(Shared *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void warn(Shared *sh, const char *fmt, ...)
@@ -372,7 +355,7 @@ static Status workers_create(Shared *sh, Device **devices, size_t n, Error *err)
         w->shared = sh;
         w->dev = devices[i];
         w->index = i;
-        w->fail_at_batch = injected_failure(i);
+        w->fail_at_batch = fault_device_batch(i);
         snprintf(w->stats.name, sizeof w->stats.name, "%s", devices[i]->desc.name);
         w->scratch = calloc(film_len, sizeof *w->scratch);
         if (!w->scratch) return error_set(err, ST_INTERNAL, "out of memory for device films");

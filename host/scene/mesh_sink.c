@@ -1,6 +1,7 @@
 /* mesh_sink.c — mesh options, the triangle sink, bounds, the procedural sphere (mesh_sink.h). */
 #include "scene/mesh_sink.h"
 
+#include "base/array.h"
 #include "util/kmath.h"
 
 #include <math.h>

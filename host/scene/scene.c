@@ -1,6 +1,7 @@
 /* scene.c — scene storage, material helpers and the light list. */
 #include "scene/scene.h"
 
+#include "base/array.h"
 #include "scene/env_dist.h"
 
 #include "util/kmath.h"
@@ -76,22 +77,6 @@ void scene_free(Scene *s)
     strmap_free(&s->texture_by_name);
     strmap_free(&s->texture_by_source);
     memset(s, 0, sizeof *s);
-}
-
-int array_reserve(void **ptr, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap) return 0;
-    size_t new_cap = *cap ? *cap : 16;
-    while (new_cap < need) {
-        if (new_cap > SIZE_MAX / 2) return -1;
-        new_cap *= 2;
-    }
-    if (new_cap > SIZE_MAX / elem) return -1;
-    void *p = realloc(*ptr, new_cap * elem);
-    if (!p) return -1;
-    *ptr = p;
-    *cap = new_cap;
-    return 0;
 }
 
 /* One generic append for every primitive array: the id space is 32-bit (NO_INDEX is

@@ -254,8 +254,4 @@ uint scene_mix_depth(const Scene *s, uint index);
  * cone of 30 degrees (cos_outer) with no soft edge. */
 Light light_default(uint type);
 
-/* Grows *ptr (an array of `elem`-byte items with capacity *cap) to hold `need` items.
- * Returns 0 on success, -1 when out of memory (the array is then unchanged). */
-int array_reserve(void **ptr, size_t *cap, size_t need, size_t elem);
-
 #endif /* CLPT_SCENE_H */

@@ -139,7 +139,14 @@ $(BUILD)/version.o: $(BUILD)/version.c host/version.h
 
 FORCE:
 
-$(BUILD)/host/%.o: host/%.c | $(VERSION_H)
+# The compile flags as last used: objects built with other flags (an older checkout,
+# another EXTRA_CFLAGS) are rebuilt rather than linked with the new ones.
+$(BUILD)/.flags: FORCE
+	@mkdir -p $(@D)
+	@echo '$(CC) $(CPPFLAGS) $(CFLAGS)' > $@.tmp
+	@if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv $@.tmp $@; fi
+
+$(BUILD)/host/%.o: host/%.c $(BUILD)/.flags | $(VERSION_H)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(FILE_WARN) -MMD -MP -c -o $@ $<
 

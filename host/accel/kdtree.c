@@ -18,7 +18,7 @@
  * afterwards in depth-first order, so the result does not depend on the thread count.
  * Constants and layout: docs/kdtree.md.
  */
-#include "accel/kdtree.h"
+#include "accel/kd_build.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -33,322 +33,6 @@
 #include "base/timer.h"
 #include "scene/scene.h"
 
-/* Cost factor of a split that leaves one child empty (Wald & Havran's lambda). */
-#ifndef KD_EMPTY_BONUS
-#define KD_EMPTY_BONUS 0.8
-#endif
-/* Consecutive splits whose estimated cost is not below the leaf's that are tried
- * before giving up (pbrt's badRefines); kept only if the subtree beats the leaf. */
-#ifndef KD_MAX_BAD_REFINES
-#define KD_MAX_BAD_REFINES 1
-#endif
-/* Subtrees with at least this many primitives are handed to other threads. */
-#ifndef KD_TASK_MIN_PRIMS
-#define KD_TASK_MIN_PRIMS 2048
-#endif
-#define POOL_CHUNK_BYTES (1u << 20)
-
-typedef uint64_t Event;
-enum { EV_END = 0, EV_PLANAR = 1, EV_START = 2 };
-enum { SIDE_LEFT = 0, SIDE_RIGHT = 1, SIDE_BOTH = 2 };
-
-typedef struct { float lo[3], hi[3]; } Aabb;
-
-/* ------------------------------------------------------------------ events */
-
-/* Float to unsigned with the same order (-0 is normalised to +0 by the callers). */
-static uint32_t float_key(float f)
-{
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
-}
-
-static float key_float(uint32_t k)
-{
-    uint32_t u = (k & 0x80000000u) ? (k & 0x7fffffffu) : ~k;
-    float f;
-    memcpy(&f, &u, sizeof f);
-    return f;
-}
-
-/* Ordered by position, then end < planar < start (the sweep relies on it), then
- * primitive: a total order, so any correct sort gives the same lists. */
-static Event event_make(float pos, uint type, uint prim)
-{
-    return ((uint64_t)float_key(pos + 0.0f) << 32) | ((uint64_t)type << 30) | prim;
-}
-static uint32_t event_pos(Event e) { return (uint32_t)(e >> 32); }
-static uint event_type(Event e) { return (uint)(e >> 30) & 3u; }
-static uint event_prim(Event e) { return (uint)e & KD_MAX_PRIMS; }
-
-/* Appends the events of one primitive's box on axis k. */
-static size_t events_emit(Event *out, const Aabb *b, int k, uint prim)
-{
-    if (b->lo[k] == b->hi[k]) {
-        out[0] = event_make(b->lo[k], EV_PLANAR, prim);
-        return 1;
-    }
-    out[0] = event_make(b->lo[k], EV_START, prim);
-    out[1] = event_make(b->hi[k], EV_END, prim);
-    return 2;
-}
-
-#define RADIX_BIG_BITS 16
-#define RADIX_BUCKETS (1u << RADIX_BIG_BITS)
-
-/* LSD radix sort of bits [low, 64) of the keys, `bits` at a time (tmp holds n events;
- * count holds RADIX_BUCKETS counters), skipping digits that all keys share. It is
- * stable, so keys equal in those bits keep their order. */
-static inline void radix_sort_from(Event *a, Event *tmp, size_t *count, size_t n, int low, int bits)
-{
-    size_t buckets = (size_t)1 << bits, mask = buckets - 1;
-    Event *src = a, *dst = tmp;
-    for (int shift = low; shift < 64; shift += bits) {
-        memset(count, 0, buckets * sizeof *count);
-        for (size_t i = 0; i < n; i++) count[(src[i] >> shift) & mask]++;
-        if (count[(src[0] >> shift) & mask] == n) continue;
-        size_t sum = 0;
-        for (size_t d = 0; d < buckets; d++) {
-            size_t c = count[d];
-            count[d] = sum;
-            sum += c;
-        }
-        for (size_t i = 0; i < n; i++) dst[count[(src[i] >> shift) & mask]++] = src[i];
-        Event *swap = src;
-        src = dst;
-        dst = swap;
-    }
-    if (src != a) memcpy(a, src, n * sizeof *a);
-}
-
-/* Sorts any list of events: 16-bit digits for big lists, 8-bit ones for the straddling
- * primitives' few new events, insertion sort for tiny lists. */
-static void events_sort(Event *a, Event *tmp, size_t *count, size_t n)
-{
-    if (n < 64) {
-        for (size_t i = 1; i < n; i++) {
-            Event e = a[i];
-            size_t j = i;
-            for (; j > 0 && a[j - 1] > e; j--) a[j] = a[j - 1];
-            a[j] = e;
-        }
-        return;
-    }
-    /* constant digits, so that each call is specialised where it is inlined */
-    if (n >= RADIX_BUCKETS) radix_sort_from(a, tmp, count, n, 0, RADIX_BIG_BITS);
-    else radix_sort_from(a, tmp, count, n, 0, 8);
-}
-
-/* Sorts a list emitted in increasing primitive order, as the root's are. The sort is
- * stable, so only the bits above the primitive's need sorting: from bit 28, three
- * 12-bit digits (bits 28 and 29 of the primitive are then in order already). Three
- * passes over 4096 buckets instead of four over 65536: half the time on the dragon. */
-static void events_sort_by_prim_order(Event *a, Event *tmp, size_t *count, size_t n)
-{
-    radix_sort_from(a, tmp, count, n, 28, 12);
-}
-
-static int uint_cmp(const void *a, const void *b)
-{
-    uint x = *(const uint *)a, y = *(const uint *)b;
-    return (x > y) - (x < y);
-}
-
-static void ids_sort(uint *ids, uint n)
-{
-    if (n > 32) {
-        qsort(ids, n, sizeof *ids, uint_cmp);
-        return;
-    }
-    for (uint i = 1; i < n; i++) {
-        uint x = ids[i], j = i;
-        for (; j > 0 && ids[j - 1] > x; j--) ids[j] = ids[j - 1];
-        ids[j] = x;
-    }
-}
-
-/* ------------------------------------------------------------------ geometry */
-
-static double box_half_area(const Aabb *b)
-{
-    double dx = (double)b->hi[0] - b->lo[0], dy = (double)b->hi[1] - b->lo[1];
-    double dz = (double)b->hi[2] - b->lo[2];
-    return dx * dy + dy * dz + dz * dx;
-}
-
-static int box_intersect_with(Aabb *b, const Aabb *with)
-{
-    for (int k = 0; k < 3; k++) {
-        b->lo[k] = k_fmax(b->lo[k], with->lo[k]);   /* compat.h: inlined, unlike fmaxf */
-        b->hi[k] = k_fmin(b->hi[k], with->hi[k]);
-        if (!(b->lo[k] <= b->hi[k])) return 0;
-    }
-    return 1;
-}
-
-static float round_down(double d)
-{
-    float f = (float)d;
-    return (double)f > d ? nextafterf(f, -INFINITY) : f;
-}
-
-static float round_up(double d)
-{
-    float f = (float)d;
-    return (double)f < d ? nextafterf(f, INFINITY) : f;
-}
-
-static Aabb triangle_bounds(const Triangle *t)
-{
-    Aabb a = { { t->p0.x, t->p0.y, t->p0.z }, { t->p0.x, t->p0.y, t->p0.z } };
-    const vec3 *v[2] = { &t->p1, &t->p2 };
-    for (int i = 0; i < 2; i++) {
-        const float p[3] = { v[i]->x, v[i]->y, v[i]->z };
-        for (int k = 0; k < 3; k++) {
-            a.lo[k] = k_fmin(a.lo[k], p[k]);
-            a.hi[k] = k_fmax(a.hi[k], p[k]);
-        }
-    }
-    return a;
-}
-
-/* Clips the polygon in[0..n) to the side of the plane x_k = bound inside the box (below
- * it when `upper`, above it otherwise) into res; returns the new vertex count. */
-static int clip_polygon_plane(double (*in)[3], int n, int k, int upper, double bound, double (*res)[3])
-{
-    int m = 0;
-    for (int i = 0; i < n; i++) {
-        const double *a = in[i], *b = in[(i + 1) % n];
-        int a_in = upper ? a[k] <= bound : a[k] >= bound;
-        int b_in = upper ? b[k] <= bound : b[k] >= bound;
-        if (a_in) {
-            memcpy(res[m], a, sizeof res[m]);
-            m++;
-        }
-        if (a_in != b_in) {
-            double s = (bound - a[k]) / (b[k] - a[k]);
-            for (int j = 0; j < 3; j++) res[m][j] = a[j] + s * (b[j] - a[j]);
-            res[m][k] = bound;
-            m++;
-        }
-    }
-    return m;
-}
-
-/* Box of the polygon v[0..n), rounded outward to float so that it is conservative. */
-static Aabb polygon_bounds(double (*v)[3], int n)
-{
-    double lo[3], hi[3];
-    for (int j = 0; j < 3; j++) lo[j] = hi[j] = v[0][j];
-    for (int i = 1; i < n; i++)
-        for (int j = 0; j < 3; j++) {
-            lo[j] = fmin(lo[j], v[i][j]);
-            hi[j] = fmax(hi[j], v[i][j]);
-        }
-    Aabb out;
-    for (int j = 0; j < 3; j++) {
-        out.lo[j] = round_down(lo[j]);
-        out.hi[j] = round_up(hi[j]);
-    }
-    return out;
-}
-
-/* Box of the part of triangle t inside box c (Sutherland-Hodgman in double, rounded
- * outward to float so the box is conservative); 0 when nothing is inside. */
-static int clip_triangle(const Triangle *t, const Aabb *c, Aabb *out)
-{
-    /* A convex polygon gains at most one vertex per plane (3 + 6); rounding could in
-     * principle make it slightly non-convex, so there is room for more, and a
-     * polygon that still outgrows it gets the conservative box instead. */
-    double buf[2][32][3];
-    const vec3 *v[3] = { &t->p0, &t->p1, &t->p2 };
-    for (int i = 0; i < 3; i++) {
-        buf[0][i][0] = v[i]->x;
-        buf[0][i][1] = v[i]->y;
-        buf[0][i][2] = v[i]->z;
-    }
-    int n = 3, cur = 0;
-    for (int plane = 0; plane < 6; plane++) {
-        int k = plane >> 1, upper = plane & 1;
-        double bound = upper ? c->hi[k] : c->lo[k];
-        double (*in)[3] = buf[cur];
-        int outside = 0;
-        for (int i = 0; i < n; i++)
-            outside += upper ? in[i][k] > bound : in[i][k] < bound;
-        if (outside == 0) continue;
-        if (outside == n) return 0;
-        if (n > 16) {
-            *out = triangle_bounds(t);
-            return box_intersect_with(out, c);
-        }
-        n = clip_polygon_plane(in, n, k, upper, bound, buf[cur ^ 1]);
-        cur ^= 1;
-    }
-    *out = polygon_bounds(buf[cur], n);
-    return box_intersect_with(out, c);
-}
-
-/* ------------------------------------------------------------------ pools */
-
-/* Bump allocator in chunks, with marks to roll back to (retracted subtrees). */
-typedef struct PoolChunk {
-    struct PoolChunk *next;
-    size_t cap, used;
-    max_align_t data[];
-} PoolChunk;
-
-typedef struct { PoolChunk *first, *cur; } Pool;
-typedef struct { PoolChunk *chunk; size_t used; } PoolMark;
-
-static void *pool_alloc(Pool *p, size_t size)
-{
-    size = (size + 15u) & ~(size_t)15u;
-    PoolChunk *c = p->cur;
-    if (!c || c->used + size > c->cap) {
-        size_t cap = size > POOL_CHUNK_BYTES ? size : POOL_CHUNK_BYTES;
-        PoolChunk *fresh = malloc(sizeof *fresh + cap);
-        if (!fresh) return NULL;
-        fresh->next = NULL;
-        fresh->cap = cap;
-        fresh->used = 0;
-        if (c) c->next = fresh;
-        else p->first = fresh;
-        p->cur = c = fresh;
-    }
-    void *r = (char *)c->data + c->used;
-    c->used += size;
-    return r;
-}
-
-static PoolMark pool_mark(const Pool *p)
-{
-    PoolMark m = { p->cur, p->cur ? p->cur->used : 0 };
-    return m;
-}
-
-static void pool_free_from(PoolChunk *c)
-{
-    while (c) {
-        PoolChunk *next = c->next;
-        free(c);
-        c = next;
-    }
-}
-
-static void pool_release(Pool *p, PoolMark m)
-{
-    if (!m.chunk) {
-        pool_free_from(p->first);
-        p->first = p->cur = NULL;
-        return;
-    }
-    pool_free_from(m.chunk->next);
-    m.chunk->next = NULL;
-    m.chunk->used = m.used;
-    p->cur = m.chunk;
-}
-
 /* reserve_*(&array, &capacity, need): array_reserve (scene.h: doubling, overflow
  * checked) with the element type checked; 0 on success, -1 when out of memory (the
  * array is then unchanged). */
@@ -357,56 +41,6 @@ static void pool_release(Pool *p, PoolMark m)
     {                                                                                  \
         return array_reserve((void **)ptr, cap, need, sizeof **ptr);                   \
     }
-
-/* ------------------------------------------------------------------ build state */
-
-typedef struct BNode {
-    uint axis;                  /* 0..2, or KD_LEAF */
-    float split;
-    uint count;                 /* leaf: number of ids */
-    uint *ids;                  /* leaf: sorted global ids (count > 1) */
-    uint id;                    /* leaf: the id when count == 1 */
-    struct BNode *child[2];     /* below, above */
-} BNode;
-
-typedef struct {
-    Event *lists;               /* the three axes' lists, back to back (malloc) */
-    uint n[3], nprims;
-    Aabb box;
-    int depth, bad;
-    BNode **out;
-} Task;
-
-typedef struct Build Build;
-
-typedef struct {
-    Build *b;
-    uint8_t *side;                  /* per primitive: SIDE_* for the node being split */
-    Event *arena;  size_t arena_cap, top;
-    Event *fresh;  size_t fresh_cap;
-    Event *sort_tmp; size_t sort_tmp_cap;
-    size_t *radix_count;            /* RADIX_BUCKETS counters */
-    uint *both;    size_t both_cap;
-    uint *saved;   size_t saved_cap, saved_top;   /* a tentative node's ids, for retraction */
-    Pool nodes, ids;
-} Worker;
-
-struct Build {
-    uint n_prims;
-    uint *gid;                  /* global id of each primitive */
-    uint *tri;                  /* triangle index, or NO_INDEX for spheres and boxes */
-    Aabb *bounds;               /* box of each whole primitive */
-    const Triangle *triangles;
-    int max_depth;
-    int threads;
-
-    pthread_mutex_t lock;
-    pthread_cond_t cond;
-    Worker *workers;  int n_workers;
-    Task *queue;  size_t q_head, q_len, q_cap;
-    int outstanding;            /* queued + running tasks */
-    int failed;
-};
 
 DEFINE_RESERVE(reserve_events, Event)
 DEFINE_RESERVE(reserve_uints, uint)
@@ -546,7 +180,7 @@ static void collect_ids(const Worker *w, const NodeLists *nl, uint *ids)
     uint m = 0;
     for (uint i = 0; i < nl->n[0]; i++)
         if (event_type(e[i]) != EV_END) ids[m++] = w->b->gid[event_prim(e[i])];
-    ids_sort(ids, m);
+    kd_ids_sort(ids, m);
 }
 
 static int make_leaf(Worker *w, const NodeLists *nl, BNode *node)
@@ -636,12 +270,12 @@ static int clip_straddlers(Worker *w, uint n_both, const Aabb child[2], uint n_s
         uint p = w->both[i];
         for (int c = 0; c < 2; c++) {
             Aabb clipped = b->bounds[p];
-            int inside = b->tri[p] != NO_INDEX ? clip_triangle(&b->triangles[b->tri[p]], &child[c], &clipped)
-                                               : box_intersect_with(&clipped, &child[c]);
+            int inside = b->tri[p] != NO_INDEX ? kd_clip_triangle(&b->triangles[b->tri[p]], &child[c], &clipped)
+                                               : kd_box_intersect(&clipped, &child[c]);
             if (!inside) continue;
             n_side[c]++;
             for (int j = 0; j < 3; j++)
-                f->n[c][j] += events_emit(f->list[c][j] + f->n[c][j], &clipped, j, p);
+                f->n[c][j] += kd_events_emit(f->list[c][j] + f->n[c][j], &clipped, j, p);
         }
     }
     size_t most = 0;
@@ -649,7 +283,7 @@ static int clip_straddlers(Worker *w, uint n_both, const Aabb child[2], uint n_s
         for (int j = 0; j < 3; j++) most = f->n[c][j] > most ? f->n[c][j] : most;
     if (reserve_events(&w->sort_tmp, &w->sort_tmp_cap, most + 1)) return -1;
     for (int c = 0; c < 2; c++)
-        for (int j = 0; j < 3; j++) events_sort(f->list[c][j], w->sort_tmp, w->radix_count, f->n[c][j]);
+        for (int j = 0; j < 3; j++) kd_events_sort(f->list[c][j], w->sort_tmp, w->radix_count, f->n[c][j]);
     return 0;
 }
 
@@ -845,7 +479,7 @@ static int build_node(Worker *w, NodeLists nl, int depth, int bad, int tentative
     BNode *node = pool_alloc(&w->nodes, sizeof *node);
     if (!node) return -1;
     *out = node;
-    double sa = box_half_area(&nl.box);
+    double sa = kd_box_half_area(&nl.box);
     double leaf_cost = kd_leaf_cost(nl.nprims);
     *cost = leaf_cost * sa;
 
@@ -934,383 +568,6 @@ static void *worker_thread(void *arg)
     return NULL;
 }
 
-/* ------------------------------------------------------------------ input */
-
-static int aabb_finite(const Aabb *a)
-{
-    for (int k = 0; k < 3; k++)
-        if (!isfinite(a->lo[k]) || !isfinite(a->hi[k])) return 0;
-    return 1;
-}
-
-/* An ellipsoid's box: the unit sphere under M reaches sqrt(sum_j M_ij^2) along world
- * axis i from M's origin (the row's length: max of row . n over unit n). A relative
- * 2^-20 more covers the kernels' rounding of the object-space test near the rim. */
-static Aabb ellipsoid_bounds(const SphereXform *x)
-{
-    Aabb a;
-    for (int k = 0; k < 3; k++) {
-        const float *row = x->to_world + 4 * k;
-        double e = sqrt((double)row[0] * row[0] + (double)row[1] * row[1] + (double)row[2] * row[2]);
-        e *= 1.0 + 0x1p-20;
-        a.lo[k] = nextafterf((float)(row[3] - e), -INFINITY);
-        a.hi[k] = nextafterf((float)(row[3] + e), INFINITY);
-    }
-    return a;
-}
-
-static Aabb sphere_bounds(const KdInput *in, const Sphere *s)
-{
-    if (s->xform != 0u && s->xform <= in->n_sphere_xforms) return ellipsoid_bounds(&in->sphere_xforms[s->xform - 1u]);
-    /* Rounded outward: the centre +- radius in float can land a hair inside. */
-    float r = fabsf(s->radius);
-    const float c[3] = { s->center.x, s->center.y, s->center.z };
-    Aabb a;
-    for (int k = 0; k < 3; k++) {
-        a.lo[k] = nextafterf(c[k] - r, -INFINITY);
-        a.hi[k] = nextafterf(c[k] + r, INFINITY);
-    }
-    return a;
-}
-
-static int triangle_finite(const Triangle *t)
-{
-    return isfinite(t->p0.x) && isfinite(t->p0.y) && isfinite(t->p0.z) &&
-           isfinite(t->p1.x) && isfinite(t->p1.y) && isfinite(t->p1.z) &&
-           isfinite(t->p2.x) && isfinite(t->p2.y) && isfinite(t->p2.z);
-}
-
-static Aabb box_bounds(const Box *bx)
-{
-    const float lo[3] = { bx->lo.x, bx->lo.y, bx->lo.z }, hi[3] = { bx->hi.x, bx->hi.y, bx->hi.z };
-    Aabb a;
-    for (int k = 0; k < 3; k++) {
-        a.lo[k] = fminf(lo[k], hi[k]);
-        a.hi[k] = fmaxf(lo[k], hi[k]);
-    }
-    /* fminf drops a NaN operand: keep it so the finiteness test sees it. */
-    for (int k = 0; k < 3; k++)
-        if (isnan(lo[k]) || isnan(hi[k])) a.lo[k] = NAN;
-    return a;
-}
-
-int kd_prim_box(const KdInput *in, uint gid, float lo[3], float hi[3])
-{
-    Aabb a;
-    int finite;
-    size_t n_sph = in->n_spheres, n_tri = in->n_triangles, n_box = in->n_boxes;
-    if (gid < n_sph) {
-        a = sphere_bounds(in, &in->spheres[gid]);
-        finite = aabb_finite(&a);
-    } else if ((gid -= (uint)n_sph) < n_tri) {
-        a = triangle_bounds(&in->triangles[gid]);
-        finite = triangle_finite(&in->triangles[gid]);
-    } else if ((gid -= (uint)n_tri) < n_box) {
-        a = box_bounds(&in->boxes[gid]);
-        finite = aabb_finite(&a);
-    } else {
-        gid -= (uint)n_box;
-        Box bx = { in->revs[gid].lo, 0u, in->revs[gid].hi, 0u };
-        a = box_bounds(&bx);
-        finite = aabb_finite(&a);
-    }
-    memcpy(lo, a.lo, sizeof a.lo);
-    memcpy(hi, a.hi, sizeof a.hi);
-    return finite;
-}
-
-/* The bounds of primitives [first, end), each at its own index, and whether they are
- * finite. */
-typedef struct { const KdInput *in; Aabb *bounds; uint8_t *finite; uint first, end; } BoundsJob;
-
-static void *bounds_range(void *arg)
-{
-    const BoundsJob *j = arg;
-    for (uint gid = j->first; gid < j->end; gid++)
-        j->finite[gid] = (uint8_t)kd_prim_box(j->in, gid, j->bounds[gid].lo, j->bounds[gid].hi);
-    return NULL;
-}
-
-/* Collects the primitives (global ids, bounds). A primitive whose bounds are not
- * finite (a NaN or inf coordinate or radius) is left out of the tree, and so can never
- * be hit: no finite ray could hit it meaningfully, and one infinite box would make
- * every SAH area infinite. The bounds are computed on the build's threads, then the
- * finite ones moved down in order. */
-static Status gather(Build *b, const KdInput *in, uint *skipped, Error *err)
-{
-    size_t total = in->n_spheres + in->n_triangles + in->n_boxes + in->n_revs;
-    if (total > KD_MAX_PRIMS)
-        return error_set(err, ST_INPUT, "kd-tree: %zu primitives, more than the %u supported",
-                         total, KD_MAX_PRIMS);
-    b->gid = malloc((total + 1) * sizeof *b->gid);
-    b->tri = malloc((total + 1) * sizeof *b->tri);
-    b->bounds = malloc((total + 1) * sizeof *b->bounds);
-    uint8_t *finite = malloc(total + 1);
-    if (!b->gid || !b->tri || !b->bounds || !finite) {
-        free(finite);
-        return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu primitives", total);
-    }
-    int n_jobs = jobs_threads(b->threads, total, 65536);
-    BoundsJob jobs[JOBS_MAX];
-    for (int i = 0; i < n_jobs; i++)
-        jobs[i] = (BoundsJob){ in, b->bounds, finite, (uint)(total * (size_t)i / (size_t)n_jobs),
-                               (uint)(total * (size_t)(i + 1) / (size_t)n_jobs) };
-    jobs_run(bounds_range, jobs, sizeof *jobs, n_jobs);
-
-    uint first_tri = (uint)in->n_spheres, end_tri = first_tri + (uint)in->n_triangles, n = 0;
-    for (uint gid = 0; gid < (uint)total; gid++) {
-        if (!finite[gid]) continue;
-        b->gid[n] = gid;
-        b->tri[n] = gid >= first_tri && gid < end_tri ? gid - first_tri : NO_INDEX;
-        b->bounds[n++] = b->bounds[gid];
-    }
-    free(finite);
-    b->n_prims = n;
-    *skipped = (uint)(total - n);
-    b->triangles = in->triangles;
-    return ST_OK;
-}
-
-/* ------------------------------------------------------------------ flatten */
-
-/* scale: the product of the empty-space bonus over the node's ancestors that have an
- * empty child (the factor the builder's cost applies to this node's terms). */
-typedef struct { const BNode *node; uint parent; int depth; Aabb box; double scale; } FlatItem;
-
-static int leaf_is_empty(const BNode *n) { return n->axis == KD_LEAF && n->count == 0; }
-
-/* A leaf's sorted global ids. */
-static const uint *leaf_ids(const BNode *n) { return n->count == 1 ? &n->id : n->ids; }
-
-/* How many of a leaf's sorted ids are triangles (they come after the spheres, before
- * the boxes: a contiguous run), and where they start. */
-static void ids_split(const uint *ids, uint count, const KdInput *in, uint *first_tri, uint *n_tri)
-{
-    uint lo = (uint)in->n_spheres, hi = lo + (uint)in->n_triangles;
-    uint a = 0, c = 0;
-    while (a < count && ids[a] < lo) a++;
-    while (a + c < count && ids[a + c] < hi) c++;
-    *first_tri = a;
-    *n_tri = c;
-}
-
-size_t kd_leaf_record_words(const KdInput *in, const uint *ids, uint count)
-{
-    uint first, nt;
-    ids_split(ids, count, in, &first, &nt);
-    size_t w = (size_t)(nt + KD_GROUP - 1) / KD_GROUP * KD_GROUP_WORDS;
-    uint others = count - nt;
-    return w + (others ? 1 + others : 0);
-}
-
-uint kd_leaf_record_write(const KdInput *in, const uint *ids, uint count, uint *out)
-{
-    uint first, nt;
-    ids_split(ids, count, in, &first, &nt);
-    uint base = (uint)in->n_spheres;
-    for (uint g = 0; g < nt; g += KD_GROUP, out += KD_GROUP_WORDS) {
-        for (uint l = 0; l < KD_GROUP; l++) {
-            uint id = ids[first + (g + l < nt ? g + l : nt - 1)];
-            const Triangle *t = &in->triangles[id - base];
-            const vec3 *c[3] = { &t->p0, &t->p1, &t->p2 };
-            out[l] = id;
-            for (int v = 0; v < 3; v++) {
-                const float f[3] = { c[v]->x, c[v]->y, c[v]->z };
-                for (int k = 0; k < 3; k++) memcpy(&out[KD_GROUP + (uint)(3 * v + k) * KD_GROUP + l], &f[k], sizeof(float));
-            }
-        }
-    }
-    uint others = count - nt;
-    if (others) {
-        *out++ = others;
-        for (uint i = 0; i < count; i++)
-            if (i < first || i >= first + nt) *out++ = ids[i];
-    }
-    uint ng = (nt + KD_GROUP - 1) / KD_GROUP;
-    return KD_LEAF | (others ? KD_LEAF_OTHERS : 0u) | (ng << 3);
-}
-
-static void leaf_split_ids(const BNode *n, const KdInput *in, uint *first_tri, uint *n_tri)
-{
-    ids_split(leaf_ids(n), n->count, in, first_tri, n_tri);
-}
-
-static size_t leaf_words(const BNode *n, const KdInput *in)
-{
-    return kd_leaf_record_words(in, leaf_ids(n), n->count);
-}
-
-/* Nodes and words of leaf data of the tree below root, to allocate them exactly. */
-static void flat_size(const BNode *root, const KdInput *in, size_t *n_nodes, size_t *n_words)
-{
-    const BNode *stack[KD_MAX_DEPTH + 2];
-    int sp = 0;
-    stack[sp++] = root;
-    *n_nodes = *n_words = 0;
-    while (sp) {
-        const BNode *n = stack[--sp];
-        ++*n_nodes;
-        if (n->axis == KD_LEAF) {
-            *n_words += leaf_words(n, in);
-        } else {
-            stack[sp++] = n->child[1];
-            stack[sp++] = n->child[0];
-        }
-    }
-}
-
-static Status flat_alloc(KdTree *t, size_t n_nodes, size_t n_words, Error *err)
-{
-    if (n_nodes > (UINT32_MAX >> 4) || n_words > UINT32_MAX - 1)
-        return error_set(err, ST_INTERNAL, "kd-tree: %zu nodes and %zu words of leaf data do not fit the node layout",
-                         n_nodes, n_words);
-    /* Cache-line aligned, so that no row of a group's corners straddles two lines (the
-     * groups are 320 bytes long; OpenCL buffers are aligned at least as well), and on
-     * huge pages when large (base/pages.h): the walk reads both at random. */
-    t->nodes = pages_alloc_large(n_nodes * sizeof *t->nodes);
-    t->leaf_prims = pages_alloc_large((n_words + 1) * sizeof *t->leaf_prims);
-    if (!t->nodes || !t->leaf_prims)
-        return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu nodes", n_nodes);
-    return ST_OK;
-}
-
-/* A leaf whose record is still to be written, at `words` in the leaf data. */
-typedef struct { const BNode *node; uint words; } LeafRecord;
-
-/* The flat arrays being written, and the sums behind the statistics. */
-typedef struct {
-    KdTree *t;
-    const KdInput *in;
-    size_t refs, groups;        /* leaf references, groups of triangles */
-    uint words;                 /* leaf data laid out so far */
-    LeafRecord *records;        /* the non-empty leaves, in order */
-    size_t n_records;
-} Flat;
-
-/* Writes leaf node `me` and lists its record for records_write; rel: its box's area
- * relative to the root's. */
-static void flat_leaf(Flat *f, const FlatItem *it, uint me, double rel)
-{
-    const BNode *n = it->node;
-    KdStats *st = &f->t->stats;
-    st->n_leaves++;
-    if (n->count == 0) st->n_empty_leaves++;
-    f->refs += n->count;
-    st->sah_cost += kd_leaf_cost(n->count) * rel;
-    st->sah_cost_bonus += kd_leaf_cost(n->count) * rel * it->scale;
-    uint first, nt;
-    leaf_split_ids(n, f->in, &first, &nt);
-    uint ng = (nt + KD_GROUP - 1) / KD_GROUP;
-    f->groups += ng;
-    f->t->nodes[me].bits = KD_LEAF | (n->count > nt ? KD_LEAF_OTHERS : 0u) | (ng << 3);
-    f->t->nodes[me].data = n->count ? f->words : 0u;
-    if (n->count) f->records[f->n_records++] = (LeafRecord){ n, f->words };
-    f->words += (uint)leaf_words(n, f->in);
-}
-
-/* Writes interior node `me` (its above child's index is added when that is reached)
- * and pushes its children, below on top, onto items. */
-static void flat_interior(Flat *f, const FlatItem *it, uint me, double rel, FlatItem *items, int *ip)
-{
-    const BNode *n = it->node;
-    KdStats *st = &f->t->stats;
-    int empty_below = leaf_is_empty(n->child[0]), empty_above = leaf_is_empty(n->child[1]);
-    double scale = it->scale * (empty_below || empty_above ? KD_EMPTY_BONUS : 1.0);
-    st->sah_cost += KD_COST_TRAVERSAL * rel;
-    st->sah_cost_bonus += KD_COST_TRAVERSAL * rel * scale;
-    uint split_bits;
-    memcpy(&split_bits, &n->split, sizeof split_bits);
-    f->t->nodes[me].data = split_bits;
-    f->t->nodes[me].bits = n->axis | (empty_below ? KD_EMPTY_BELOW : 0u) | (empty_above ? KD_EMPTY_ABOVE : 0u);
-    FlatItem above = { n->child[1], me, it->depth + 1, it->box, scale };
-    FlatItem below = { n->child[0], NO_INDEX, it->depth + 1, it->box, scale };
-    above.box.lo[n->axis] = n->split;
-    below.box.hi[n->axis] = n->split;
-    items[(*ip)++] = above;
-    items[(*ip)++] = below;
-}
-
-static void flat_stats_finish(Flat *f)
-{
-    KdStats *st = &f->t->stats;
-    st->n_nodes = f->t->n_nodes;
-    uint full = st->n_leaves - st->n_empty_leaves;
-    st->mean_prims_per_leaf = full ? (double)f->refs / full : 0.0;
-    st->bytes = (size_t)f->t->n_nodes * sizeof(KdNode) + (size_t)f->words * sizeof(uint);
-    st->bytes_corners = f->groups * KD_GROUP * 9 * sizeof(float);
-}
-
-/* Writes leaf records [first, end): the records are most of the flattening's time
- * (each gathers its triangles' corners), and independent of each other. */
-typedef struct { const Flat *f; size_t first, end; } RecordJob;
-
-static void *records_write(void *arg)
-{
-    const RecordJob *j = arg;
-    const Flat *f = j->f;
-    for (size_t i = j->first; i < j->end; i++) {
-        const BNode *n = f->records[i].node;
-        kd_leaf_record_write(f->in, leaf_ids(n), n->count, f->t->leaf_prims + f->records[i].words);
-    }
-    return NULL;
-}
-
-/* Writes the tree into t's node and leaf arrays in depth-first order, the below child
- * first, and sums the statistics on the way; the leaf records are written afterwards,
- * on up to `threads` threads (the result does not depend on how many). */
-static Status flatten(const BNode *root, const Aabb *root_box, const KdInput *in, int threads, KdTree *t,
-                      Error *err)
-{
-    size_t n_nodes, n_words;
-    flat_size(root, in, &n_nodes, &n_words);
-    Status s = flat_alloc(t, n_nodes, n_words, err);
-    if (s != ST_OK) return s;
-
-    Flat f = { t, in, 0, 0, 0, malloc(n_nodes * sizeof(LeafRecord) + 1), 0 };
-    if (!f.records) return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu nodes", n_nodes);
-    double inv_root = box_half_area(root_box) > 0.0 ? 1.0 / box_half_area(root_box) : 0.0;
-    uint idx = 0;
-    FlatItem items[KD_MAX_DEPTH + 2];
-    int ip = 0;
-    items[ip++] = (FlatItem){ root, NO_INDEX, 0, *root_box, 1.0 };
-    while (ip) {
-        FlatItem it = items[--ip];
-        uint me = idx++;
-        if (it.parent != NO_INDEX) t->nodes[it.parent].bits |= me << 4;
-        if ((uint)it.depth > t->stats.max_depth) t->stats.max_depth = (uint)it.depth;
-        double rel = inv_root > 0.0 ? box_half_area(&it.box) * inv_root : 1.0;
-        if (it.node->axis == KD_LEAF) flat_leaf(&f, &it, me, rel);
-        else flat_interior(&f, &it, me, rel, items, &ip);
-    }
-    t->n_nodes = idx;
-    t->n_leaf_prims = f.words;
-    flat_stats_finish(&f);
-
-    int n_jobs = jobs_threads(threads, f.n_records, 2048);
-    RecordJob jobs[JOBS_MAX];
-    for (int i = 0; i < n_jobs; i++)
-        jobs[i] = (RecordJob){ &f, f.n_records * (size_t)i / (size_t)n_jobs, f.n_records * (size_t)(i + 1) / (size_t)n_jobs };
-    jobs_run(records_write, jobs, sizeof *jobs, n_jobs);
-    free(f.records);
-    return ST_OK;
-}
-
-/* A leaf's primitive ids (its triangles without the repeated lanes, then the others). */
-uint kd_leaf_ids(const KdTree *t, uint node, uint *out, uint cap)
-{
-    KdNode n = t->nodes[node];
-    uint m = 0;
-    if ((n.bits & 3u) != KD_LEAF) return 0;
-    const uint *g = t->leaf_prims + n.data;
-    for (uint i = 0; i < n.bits >> 3; i++, g += KD_GROUP_WORDS)
-        for (uint l = 0; l < KD_GROUP; l++)
-            if ((l == 0 || g[l] != g[l - 1]) && m < cap) out[m++] = g[l];
-    if (n.bits & KD_LEAF_OTHERS)
-        for (uint i = 1; i <= g[0]; i++)
-            if (m < cap) out[m++] = g[i];
-    return m;
-}
-
 /* ------------------------------------------------------------------ entry points */
 
 /* threads <= 0 means every core; more than 256 would only add idle workers. */
@@ -1388,10 +645,10 @@ static void *axis_job(void *arg)
 {
     AxisJob *j = arg;
     size_t m = 0;
-    for (uint i = 0; i < j->b->n_prims; i++) m += events_emit(j->list + m, &j->b->bounds[i], j->axis, i);
+    for (uint i = 0; i < j->b->n_prims; i++) m += kd_events_emit(j->list + m, &j->b->bounds[i], j->axis, i);
     Event *tmp = malloc(j->n * sizeof *tmp + 1);
     size_t *count = malloc(RADIX_BUCKETS * sizeof *count);
-    if (tmp && count) events_sort_by_prim_order(j->list, tmp, count, j->n);
+    if (tmp && count) kd_events_sort_by_prim_order(j->list, tmp, count, j->n);
     else j->failed = 1;
     free(tmp);
     free(count);
@@ -1464,7 +721,7 @@ static Status build_tree(Build *b, const KdInput *in, KdTree *out, Error *err)
     if ((st = workers_create(b, err))) return st;
     if ((st = root_events(b, &root, &nl, err))) return st;
     if ((st = subtrees_build(b, nl, &root_node, err))) return st;
-    if ((st = flatten(root_node, &root, in, b->threads, out, err))) return st;
+    if ((st = kd_flatten(root_node, &root, in, b->threads, out, err))) return st;
     out->lo = (vec3){ root.lo[0], root.lo[1], root.lo[2] };
     out->hi = (vec3){ root.hi[0], root.hi[1], root.hi[2] };
     out->stats.leaf_sah_cost = kd_leaf_cost(b->n_prims);
@@ -1495,7 +752,7 @@ Status kd_build(const KdInput *in, int threads, KdTree *out, Error *err)
     memset(out, 0, sizeof *out);
     Build b;
     build_init(&b, threads_resolve(threads));
-    Status st = gather(&b, in, &out->stats.n_skipped, err);
+    Status st = kd_gather(&b, in, &out->stats.n_skipped, err);
     if (st == ST_OK) {
         out->stats.n_prims = b.n_prims;
         st = b.n_prims == 0 ? build_single_leaf(out, err) : build_tree(&b, in, out, err);
@@ -1515,3 +772,4 @@ void kd_free(KdTree *t)
     t->n_nodes = 0;
     t->n_leaf_prims = 0;
 }
+

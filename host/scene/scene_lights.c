@@ -1,0 +1,286 @@
+/* scene_lights.c — the light list: area lights from the emissive primitives (quads paired),
+ * the delta lights and the environment map's light, each chosen in proportion to an
+ * estimate of its power (scene_prepare_lights). */
+#include "scene/scene.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/array.h"
+#include "scene/env_dist.h"
+#include "util/kmath.h"
+
+Light light_default(uint type)
+{
+    Light l;
+    memset(&l, 0, sizeof l);
+    l.type = type;
+    l.prim = NO_INDEX;
+    l.atten2 = 1.0f;
+    l.direction = v3(0.0f, -1.0f, 0.0f);
+    l.cos_outer = (float)cos(M_PI / 6.0);
+    l.cos_inner = l.cos_outer;
+    return l;
+}
+
+static int is_emissive(const Scene *s, uint material)
+{
+    if (material >= s->n_materials) return 0;
+    /* any material may emit (a diffuse emitter is what the furnace test needs). An
+     * emission texture or an alpha cut-out makes the emitted radiance vary over the
+     * surface in a way light sampling does not know: such surfaces are found by BSDF
+     * sampling alone (full weight), like the background, which keeps them unbiased. */
+    const Material *m = &s->materials[material];
+    if (m->texture_emission != NO_INDEX || (m->flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND))) return 0;
+    return v3_luminance(m->emission) > 0.0f;
+}
+
+static double triangle_area(const Triangle *t)
+{
+    vec3 c = v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0));
+    return 0.5 * sqrt((double)c.x * c.x + (double)c.y * c.y + (double)c.z * c.z);
+}
+
+static int v3_same(vec3 a, vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+/* Whether triangles a and b (lights of one material, unit normals na and nb) are the two
+ * halves of one parallelogram: they share two corners (the diagonal, bit for bit), b's
+ * third corner is the reflection of a's across the diagonal's middle (to 1e-5 of the
+ * diagonal), their areas agree to 1e-5 and their winding normals point the same way.
+ * Then *corner is a's corner off the diagonal and *e1, *e2 the edges from it, so the
+ * parallelogram is corner + s e1 + t e2 over [0,1)^2. */
+static int triangles_form_quad(const Triangle *a, const Triangle *b, vec3 na, vec3 nb, vec3 *corner, vec3 *e1,
+                               vec3 *e2)
+{
+    const vec3 pa[3] = { a->p0, a->p1, a->p2 }, pb[3] = { b->p0, b->p1, b->p2 };
+    for (int i = 0; i < 3; i++) {
+        vec3 d0 = pa[(i + 1) % 3], d1 = pa[(i + 2) % 3];
+        int j0 = -1, j1 = -1;
+        for (int j = 0; j < 3; j++) {
+            if (v3_same(pb[j], d0)) j0 = j;
+            else if (v3_same(pb[j], d1)) j1 = j;
+        }
+        if (j0 < 0 || j1 < 0) continue;
+        vec3 far = v3_sub(v3_add(d0, d1), pa[i]), off = v3_sub(pb[3 - j0 - j1], far), diag = v3_sub(d1, d0);
+        double off2 = (double)v3_dot(off, off), diag2 = (double)v3_dot(diag, diag);
+        double area_a = triangle_area(a), area_b = triangle_area(b);
+        if (!(off2 <= 1e-10 * diag2) || !(fabs(area_a - area_b) <= 1e-5 * area_a) || !(area_a > 0.0) ||
+            !(v3_dot(na, nb) > 0.0f))
+            return 0;
+        *corner = pa[i];
+        *e1 = v3_sub(d0, pa[i]);
+        *e2 = v3_sub(d1, pa[i]);
+        return 1;
+    }
+    return 0;
+}
+
+/* Marks consecutive triangle lights [first, end), their normals set, that are the halves
+ * of a parallelogram (types.h, LIGHT_QUAD_*) and gives each pair equal power, hence equal
+ * choice probabilities, so that the pair's first light-sample coordinate can run across
+ * both. */
+static void pair_quad_lights(const Scene *s, Light *lights, double *power, size_t first, size_t end)
+{
+    uint first_tri = scene_first_triangle(s);
+    for (size_t k = first; k + 1 < end; k++) {
+        const Triangle *a = &s->triangles[lights[k].prim - first_tri];
+        const Triangle *b = &s->triangles[lights[k + 1].prim - first_tri];
+        vec3 corner, e1, e2;
+        if (a->material != b->material ||
+            !triangles_form_quad(a, b, lights[k].normal, lights[k + 1].normal, &corner, &e1, &e2))
+            continue;
+        double mean = 0.5 * (power[k] + power[k + 1]);
+        for (size_t h = k; h <= k + 1; h++) {
+            lights[h].quad = h == k ? LIGHT_QUAD_FIRST : LIGHT_QUAD_SECOND;
+            lights[h].position = corner;
+            lights[h].direction = e1;
+            lights[h].intensity = e2;
+            power[h] = mean;
+        }
+        k++;
+    }
+}
+
+static double box_area(const Box *b)
+{
+    double dx = (double)b->hi.x - b->lo.x, dy = (double)b->hi.y - b->lo.y, dz = (double)b->hi.z - b->lo.z;
+    return 2.0 * (dx * dy + dy * dz + dz * dx);
+}
+
+/* Radius of the bounding sphere of the finite primitives (1 when there are none): the
+ * size of the region a point or directional light shines on, for its power estimate. */
+static double scene_radius(const Scene *s)
+{
+    double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+#define GROW(p, r)                                                                        \
+    do {                                                                                  \
+        double c_[3] = { (p).x, (p).y, (p).z };                                           \
+        for (int a_ = 0; a_ < 3; a_++) {                                                  \
+            if (c_[a_] - (r) < lo[a_]) lo[a_] = c_[a_] - (r);                             \
+            if (c_[a_] + (r) > hi[a_]) hi[a_] = c_[a_] + (r);                             \
+        }                                                                                 \
+    } while (0)
+    for (size_t i = 0; i < s->n_spheres; i++) GROW(s->spheres[i].center, (double)s->spheres[i].radius);
+    for (size_t i = 0; i < s->n_triangles; i++) {
+        GROW(s->triangles[i].p0, 0.0);
+        GROW(s->triangles[i].p1, 0.0);
+        GROW(s->triangles[i].p2, 0.0);
+    }
+    for (size_t i = 0; i < s->n_boxes; i++) {
+        GROW(s->boxes[i].lo, 0.0);
+        GROW(s->boxes[i].hi, 0.0);
+    }
+#undef GROW
+    if (!(hi[0] >= lo[0])) return 1.0;
+    double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
+    double r = 0.5 * sqrt(dx * dx + dy * dy + dz * dz);
+    return r > 0.0 && isfinite(r) ? r : 1.0;
+}
+
+/* Estimated power of a delta light over a scene of radius r (see scene.h). */
+static double delta_light_power(const Light *l, double r)
+{
+    double lum = v3_luminance(l->intensity);
+    if (light_has(l->type, LT_INFINITE)) return M_PI * r * r * lum;
+    double atten = (double)l->atten0 + (double)l->atten1 * r + (double)l->atten2 * r * r;
+    double solid_angle = 4.0 * M_PI;
+    if (light_has(l->type, LT_CONE))
+        solid_angle = 2.0 * M_PI * (1.0 - 0.5 * ((double)l->cos_inner + (double)l->cos_outer));
+    return atten > 0.0 ? solid_angle * r * r * lum / atten : 0.0;
+}
+
+Status scene_set_envmap_texels(Scene *s, const uint *texels, uint width, uint height, float intensity, Error *err)
+{
+    uint offset, index;
+    Status st = scene_add_texels(s, texels, 3u * (size_t)width * height, &offset, err);
+    if (st) return st;
+    Texture t;
+    memset(&t, 0, sizeof t);
+    t.type = TEX_IMAGE;
+    t.flags = TEX_FLOAT;
+    t.offset = offset;
+    t.width = width;
+    t.height = height;
+    if ((st = scene_add_texture(s, NULL, NULL, t, &index, err))) return st;
+    return scene_set_envmap(s, index, intensity, 0.0f, err);
+}
+
+Status scene_set_envmap(Scene *s, uint texture, float intensity, float rotate, Error *err)
+{
+    const Texture *t = &s->textures[texture];
+    if (!(t->flags & TEX_FLOAT))
+        return error_set(err, ST_INPUT, "'%s': an environment map must be a high-dynamic-range image (.hdr or "
+                         ".exr)", s->texture_sources[texture] ? s->texture_sources[texture] : "");
+    /* the guide tables (kernels/light/envmap.h) hold pixel indices as exact floats */
+    if (t->width > (1u << 24) || t->height > (1u << 24))
+        return error_set(err, ST_INPUT, "'%s': an environment map is at most 16777216 pixels wide and high, not %ux%u",
+                         s->texture_sources[texture] ? s->texture_sources[texture] : "", t->width, t->height);
+    float *cdf;
+    size_t n;
+    double mean;
+    Status st = env_dist_build(s->texels + t->offset, t->width, t->height, &cdf, &n, &mean, err);
+    if (st) return st;
+    free(s->env_cdf);
+    s->env_cdf = cdf;
+    s->n_env_cdf = n;
+    s->env_mean = mean * (double)intensity;
+    if (!(intensity > 0.0f)) {
+        /* a black map is no light */
+        free(s->env_cdf);
+        s->env_cdf = NULL;
+        s->n_env_cdf = 0;
+    }
+    s->bg_type = BG_MAP;
+    s->bg_cubemap = texture;
+    s->bg_color = v3s(intensity);
+    s->bg_zenith = v3s(intensity);
+    s->bg_rotate = rotate;
+    return ST_OK;
+}
+
+Status scene_prepare_lights(Scene *s, Error *err)
+{
+    free(s->lights);
+    s->lights = NULL;
+    s->n_lights = 0;
+    s->env_light = NO_INDEX;
+    int env = s->bg_type == BG_MAP && s->n_env_cdf > 0;
+    size_t n = (size_t)env;
+    for (size_t i = 0; i < s->n_spheres; i++) {
+        /* the kernels sample sphere lights by the cone a sphere subtends: an ellipsoid
+         * has none (the pbrt reader makes emitting ones meshes) */
+        if (s->spheres[i].xform && is_emissive(s, s->spheres[i].material))
+            return error_set(err, ST_INPUT, "sphere %zu is an ellipsoid that emits light, which clpt cannot "
+                             "sample; make it a mesh", i);
+        n += (size_t)is_emissive(s, s->spheres[i].material);
+    }
+    for (size_t i = 0; i < s->n_triangles; i++) n += (size_t)is_emissive(s, s->triangles[i].material);
+    for (size_t i = 0; i < s->n_boxes; i++) n += (size_t)is_emissive(s, s->boxes[i].material);
+    n += s->n_delta_lights;
+    if (n == 0) return ST_OK;
+    if (n >= (size_t)NO_INDEX) return error_set(err, ST_INPUT, "too many emissive primitives");
+    Light *lights = calloc(n, sizeof *lights);
+    double *power = calloc(n, sizeof *power);
+    if (!lights || !power) {
+        free(lights);
+        free(power);
+        return error_set(err, ST_INTERNAL, "out of memory building the light list");
+    }
+    size_t k = 0;
+    double total = 0.0;
+#define ADD_LIGHT(arr, count, first, area_expr)                                          \
+    for (size_t i = 0; i < (count); i++) {                                                \
+        if (!is_emissive(s, arr[i].material)) continue;                                   \
+        double area = (area_expr);                                                        \
+        lights[k].type = LIGHT_AREA;                                                      \
+        lights[k].prim = (uint)((first) + i);                                             \
+        lights[k].area = (float)area;                                                     \
+        power[k] = M_PI * area * v3_luminance(s->materials[arr[i].material].emission);   \
+        total += power[k];                                                                \
+        arr[i].light = (uint)k;                                                           \
+        k++;                                                                              \
+    }
+    ADD_LIGHT(s->spheres, s->n_spheres, 0, 4.0 * M_PI * (double)s->spheres[i].radius * s->spheres[i].radius)
+    size_t first_tri_light = k;
+    uint first_tri = scene_first_triangle(s);
+    ADD_LIGHT(s->triangles, s->n_triangles, first_tri, triangle_area(&s->triangles[i]))
+    for (size_t j = first_tri_light; j < k; j++) {
+        /* the normal surface_at computes for the triangle: the same float operations */
+        const Triangle *t = &s->triangles[lights[j].prim - first_tri];
+        lights[j].normal = v3_norm(v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0)));
+    }
+    pair_quad_lights(s, lights, power, first_tri_light, k);
+    ADD_LIGHT(s->boxes, s->n_boxes, scene_first_box(s), box_area(&s->boxes[i]))
+#undef ADD_LIGHT
+    double radius = s->n_delta_lights || env ? scene_radius(s) : 1.0;
+    for (size_t i = 0; i < s->n_delta_lights; i++, k++) {
+        lights[k] = s->delta_lights[i];
+        lights[k].prim = NO_INDEX;
+        power[k] = delta_light_power(&s->delta_lights[i], radius);
+        if (!(power[k] >= 0.0) || !isfinite(power[k])) power[k] = 0.0;
+        total += power[k];
+    }
+    if (env) {
+        lights[k].type = LIGHT_ENV;
+        lights[k].prim = NO_INDEX;
+        power[k] = M_PI * s->env_mean * 4.0 * M_PI * radius * radius;
+        if (!(power[k] >= 0.0) || !isfinite(power[k])) power[k] = 0.0;
+        total += power[k];
+        s->env_light = (uint)k++;
+    }
+    /* Degenerate or black lights get zero power; if all are, choose uniformly so the
+     * distribution stays valid. */
+    double acc = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double p = total > 0.0 ? power[i] / total : 1.0 / (double)n;
+        acc += p;
+        lights[i].pick_pdf = (float)p;
+        lights[i].cdf = (float)acc;
+    }
+    lights[n - 1].cdf = 1.0f;  /* exact top so a uniform sample in [0,1) always lands */
+    free(power);
+    s->lights = lights;
+    s->n_lights = n;
+    return ST_OK;
+}

@@ -151,7 +151,7 @@ $(BUILD)/host/%.o: host/%.c $(BUILD)/.flags | $(VERSION_H)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(FILE_WARN) -MMD -MP -c -o $@ $<
 
 $(BUILD)/host/device/device_scalar.o: FILE_WARN := $(KERNEL_C_WARN)
-$(BUILD)/host/dist/mpi_driver.o: FILE_WARN := $(MPI_CFLAGS)
+$(BUILD)/host/dist/mpi_driver.o $(BUILD)/host/dist/mpi_wire.o $(BUILD)/host/dist/mpi_workers.o: FILE_WARN := $(MPI_CFLAGS)
 
 $(BUILD)/lib$(PROG).a: $(HOST_OBJ)
 	rm -f $@ && ar rcs $@ $^

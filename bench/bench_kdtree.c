@@ -20,15 +20,9 @@
 #include <time.h>
 
 #include "accel/kdtree.h"
+#include "base/timer.h"
 #include "io/mesh_load.h"
 #include "accel/traverse.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
 static float frand(void)
@@ -124,12 +118,12 @@ int main(int argc, char **argv)
     int threads = argc > 2 ? atoi(argv[2]) : 0;
     long n_rays = argc > 3 ? atol(argv[3]) : 300000;
     Mesh m = { 0 };
-    double t0 = now();
+    double t0 = timer_now();
     int rc = !strncmp(mesh, "soup:", 5) ? make_soup(&m, atol(mesh + 5))
            : !strncmp(mesh, "sphere:", 7) ? make_sphere(&m, atol(mesh + 7))
            : load_mesh(mesh, &m);
     if (rc) return 1;
-    printf("mesh %s: %zu triangles (loaded in %.2f s)\n", mesh, m.n, now() - t0);
+    printf("mesh %s: %zu triangles (loaded in %.2f s)\n", mesh, m.n, timer_now() - t0);
 
     KdInput in = { .triangles = m.t, .n_triangles = m.n };
     KdTree tree, tree1;
@@ -178,14 +172,14 @@ int main(int argc, char **argv)
     }
     printf("checked %d rays against brute force: %d differ\n", n_check, bad);
 
-    double t = now();
+    double t = timer_now();
     long hits = 0;
     for (long i = 0; i < n_rays; i++) hits += trace_closest(&sc, rays[i]).prim != NO_INDEX;
-    double closest = now() - t;
-    t = now();
+    double closest = timer_now() - t;
+    t = timer_now();
     long any = 0;
     for (long i = 0; i < n_rays; i++) any += trace_any(&sc, rays[i]);
-    double anyt = now() - t;
+    double anyt = timer_now() - t;
     printf("closest: %.2f Mrays/s (%ld hits), any: %.2f Mrays/s (%ld hits), 1 core, scalar C\n",
            n_rays / closest * 1e-6, hits, n_rays / anyt * 1e-6, any);
     free(rays);

@@ -21,6 +21,8 @@
 #include "render/schedule.h"
 #include "base/timer.h"
 
+#include "bench_util.h"
+
 typedef struct {
     const char *path;
     uint width, height, spp;
@@ -38,18 +40,6 @@ typedef struct {
     double ratio;                /* median over the rounds of samples/s over the scalar device's */
     int from_cache, ok;
 } Result;
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 #define MAX_REPS 32
 
@@ -120,7 +110,7 @@ static void bench_devices(const DeviceDesc *all, size_t n_all, const RenderScene
     for (int r = 0; r < reps; r++)
         for (size_t k = n_all; k-- > 0;)
             if (dr[k].dev) device_round(&all[k], rs, spp, &dr[k]);
-    /* the rounds' ratios first: median() sorts its array in place, which would part
+    /* the rounds' ratios first: bench_median() sorts its array in place, which would part
      * the rounds of the two sides */
     const DeviceRuns *ref = &dr[n_all - 1];
     int have_ref = ref->dev && ref->n == reps;
@@ -128,12 +118,12 @@ static void bench_devices(const DeviceDesc *all, size_t n_all, const RenderScene
         if (!dr[k].dev || dr[k].n < reps || !have_ref) continue;
         double ratio[MAX_REPS];
         for (int r = 0; r < reps; r++) ratio[r] = dr[k].sps[r] / ref->sps[r];
-        res[k].ratio = median(ratio, reps);
+        res[k].ratio = bench_median(ratio, reps);
     }
     for (size_t k = 0; k < n_all; k++) {
         if (!dr[k].dev || dr[k].n < reps) continue;
-        res[k].samples_per_s = median(dr[k].sps, reps);
-        res[k].rays_per_s = median(dr[k].rps, reps);
+        res[k].samples_per_s = bench_median(dr[k].sps, reps);
+        res[k].rays_per_s = bench_median(dr[k].rps, reps);
         res[k].ok = 1;
     }
     for (size_t k = 0; k < n_all; k++) device_close(dr[k].dev);

@@ -27,28 +27,7 @@
 #include "render/schedule.h"
 #include "scene/curve.h"
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-static void print_load(const char *when)
-{
-    FILE *f = fopen("/proc/loadavg", "r");
-    char line[128] = "?";
-    if (f) {
-        if (!fgets(line, sizeof line, f)) strcpy(line, "?\n");
-        fclose(f);
-    }
-    printf("load average %s: %s", when, line);
-}
+#include "bench_util.h"
 
 /* Replaces every surface of revolution of s by its mesh. */
 static Status to_mesh(Scene *s, unsigned steps, unsigned around, Error *err)
@@ -129,7 +108,7 @@ int main(int argc, char **argv)
     printf("exact: %zu surfaces of revolution, %zu triangles, kd-tree %.3f s; mesh: %zu triangles, kd-tree %.3f s\n",
            sc[0].n_revsurfaces, sc[0].n_triangles, rs[0].kd.stats.build_seconds, sc[1].n_triangles,
            rs[1].kd.stats.build_seconds);
-    print_load("before");
+    bench_print_load("before");
 
     DeviceDesc *all = NULL;
     size_t n_all = 0;
@@ -154,7 +133,7 @@ int main(int argc, char **argv)
             }
         if (!ok) fprintf(stderr, "bench_revsurface: %s: %s\n", all[d].name, err.msg);
         else {
-            double e = median(secs[0], reps), m = median(secs[1], reps);
+            double e = bench_median(secs[0], reps), m = bench_median(secs[1], reps);
             printf("%-40.40s exact %8.3f s   mesh %8.3f s   exact/mesh %.2f\n",
                    all[d].kind == DEVICE_SCALAR ? "scalar (all cores)" : all[d].name, e, m, e / m);
         }
@@ -168,7 +147,7 @@ int main(int argc, char **argv)
         if (v > worst) worst = v;
     }
     printf("images (scalar): mean |exact - mesh| %.5f, largest %.4f\n", sum / (double)npx, worst);
-    print_load("after");
+    bench_print_load("after");
     free(img[0]);
     free(img[1]);
     free(all);

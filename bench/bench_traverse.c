@@ -77,6 +77,8 @@
 #include "base/timer.h"
 #include "accel/traverse.h"
 
+#include "bench_util.h"
+
 #define MAX_REPS 31
 #define MAX_THREADS 2
 
@@ -96,25 +98,6 @@ static size_t pocl_local;
  * the last timed run: the machines this runs on are shared, and CPU time, unlike wall
  * time, does not count the time other jobs had the cores. */
 static double last_cpu_seconds;
-
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 /* ------------------------------------------------------------------ the mesh */
 
@@ -248,13 +231,13 @@ static double trace_c(const SceneView *sc, const RaySet *s, int threads, int wal
     j.occ = occ;
     atomic_init(&j.next, 0u);
     pthread_t tid[MAX_THREADS];
-    double c0 = cpu_now(), t0 = timer_now();
+    double c0 = bench_cpu_now(), t0 = timer_now();
     int started = 0;
     for (int i = 1; i < threads; i++)
         if (pthread_create(&tid[started], NULL, trace_worker, &j) == 0) started++;
     trace_worker(&j);
     for (int i = 0; i < started; i++) pthread_join(tid[i], NULL);
-    last_cpu_seconds = cpu_now() - c0;
+    last_cpu_seconds = bench_cpu_now() - c0;
     return timer_now() - t0;
 }
 
@@ -516,14 +499,14 @@ static double pocl_trace(Pocl *pc, const RaySet *s, PoclKernel kind)
     if (clSetKernelArg(k, SC_N + 1, sizeof n, &n) != CL_SUCCESS) return -1.0;
     size_t items = (n + pocl_kernels[kind].rays_per_item - 1u) / pocl_kernels[kind].rays_per_item;
     size_t local = pocl_local, global = local ? (items + local - 1) / local * local : items;
-    double c0 = cpu_now(), t0 = timer_now();
+    double c0 = bench_cpu_now(), t0 = timer_now();
     cl_int rc = clEnqueueNDRangeKernel(pc->q, k, 1, NULL, &global, local ? &local : NULL, 0, NULL, NULL);
     if (rc == CL_SUCCESS) rc = clFinish(pc->q);
     if (rc != CL_SUCCESS) {
         pocl_fail("k_trace", rc);
         return -1.0;
     }
-    last_cpu_seconds = cpu_now() - c0;
+    last_cpu_seconds = bench_cpu_now() - c0;
     return timer_now() - t0;
 }
 
@@ -730,12 +713,12 @@ static double embree_trace(RTCScene scene, const RaySet *s, int packets, int thr
     atomic_init(&j.next, 0u);
     pthread_t tid[MAX_THREADS];
     int started = 0;
-    double c0 = cpu_now(), t0 = timer_now();
+    double c0 = bench_cpu_now(), t0 = timer_now();
     for (int i = 1; i < threads; i++)
         if (pthread_create(&tid[started], NULL, embree_worker, &j) == 0) started++;
     embree_worker(&j);
     for (int i = 0; i < started; i++) pthread_join(tid[i], NULL);
-    last_cpu_seconds = cpu_now() - c0;
+    last_cpu_seconds = bench_cpu_now() - c0;
     return timer_now() - t0;
 }
 
@@ -771,7 +754,7 @@ typedef struct {
 
 static double rate(uint n, double *secs, int reps)
 {
-    double m = median(secs, reps);
+    double m = bench_median(secs, reps);
     return m > 0.0 ? n / m * 1e-6 : 0.0;
 }
 
@@ -814,7 +797,7 @@ static void build_rounds(const Mesh *m, const Options *o)
     }
     printf("builds in turns, %d rounds, %d threads: kd-tree %.3f s, BVH %.3f s, Embree HIGH %.3f s (medians); "
            "kd / Embree %.2f, BVH / Embree %.2f (medians of the rounds' ratios)\n",
-           n, threads, median(kd, n), median(bvh, n), median(em, n), median(kd_ratio, n), median(bvh_ratio, n));
+           n, threads, bench_median(kd, n), bench_median(bvh, n), bench_median(em, n), bench_median(kd_ratio, n), bench_median(bvh_ratio, n));
 }
 
 static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS], int have_pocl)

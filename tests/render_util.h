@@ -11,9 +11,14 @@
 #include "render/render_scene.h"
 #include "render/schedule.h"
 
-/* devices: a --device spec; batch: fixed batch size (0 = adaptive). The film is
- * initialised here; free it with film_free. */
-static inline Status render_util_run(Scene *s, const char *devices, uint batch, Film *film, Error *err)
+/* render_util_run_mis's mode for "the scene's own MIS mode". */
+#define RENDER_UTIL_SCENE_MIS 0xffffffffu
+
+/* devices: a --device spec; batch: fixed batch size (0 = adaptive); mis_mode: enum
+ * MisMode set on the prepared scene (the tests of each strategy alone), or
+ * RENDER_UTIL_SCENE_MIS. The film is initialised here; free it with film_free. */
+static inline Status render_util_run_mis(Scene *s, uint mis_mode, const char *devices, uint batch, Film *film,
+                                         Error *err)
 {
     RenderScene rs;
     DeviceDesc *all = NULL;
@@ -25,6 +30,7 @@ static inline Status render_util_run(Scene *s, const char *devices, uint batch, 
     memset(film, 0, sizeof *film);
     Status st = render_scene_prepare(s, 0, &rs, err);
     if (st) return st;
+    if (mis_mode != RENDER_UTIL_SCENE_MIS) rs.ds.params.mis_mode = mis_mode;
     if ((st = device_list(&all, &n_all, warning, sizeof warning, err))) goto out;
     if ((st = device_select(devices, all, n_all, &chosen, &n_chosen, err))) goto out;
     devs = calloc(n_chosen, sizeof *devs);
@@ -46,6 +52,22 @@ out:
     free(chosen);
     free(all);
     render_scene_free(&rs);
+    return st;
+}
+
+static inline Status render_util_run(Scene *s, const char *devices, uint batch, Film *film, Error *err)
+{
+    return render_util_run_mis(s, RENDER_UTIL_SCENE_MIS, devices, batch, film, err);
+}
+
+/* The linear image of s rendered with MIS mode `mode` on `devices`, into rgb (the
+ * scene's width x height x 3 floats). */
+static inline Status render_util_rgb_mis(Scene *s, uint mode, const char *devices, float *rgb, Error *err)
+{
+    Film film;
+    Status st = render_util_run_mis(s, mode, devices, 0, &film, err);
+    if (st == ST_OK) film_resolve(&film, rgb);
+    film_free(&film);
     return st;
 }
 

@@ -17,6 +17,7 @@
 #include "render/render_scene.h"
 #include "scene/scene.h"
 #include "base/timer.h"
+#include "file_util.h"
 
 static char dir[64];
 static char path_ref[128], path_out[128], path_ck[128];
@@ -41,33 +42,14 @@ static void make_dir(void)
 /* Removes the folder and whatever is left in it (temporary files of killed writes). */
 static void remove_dir(void)
 {
-    DIR *d = opendir(dir);
-    if (d) {
-        struct dirent *e;
-        char p[512];
-        while ((e = readdir(d)))
-            if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
-                snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-                unlink(p);
-            }
-        closedir(d);
-    }
-    rmdir(dir);
+    file_util_remove_dir(dir);
 }
 
 static int read_file(const char *path, unsigned char **data, size_t *len)
 {
-    *data = NULL;
     *len = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) return 0;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    *data = malloc(n > 0 ? (size_t)n : 1);
-    *len = fread(*data, 1, (size_t)n, f);
-    fclose(f);
-    return *len == (size_t)n;
+    *data = (unsigned char *)file_util_read(path, len);
+    return *data != NULL;
 }
 
 static int write_file(const char *path, const unsigned char *data, size_t len)

@@ -319,48 +319,6 @@ static Status load_own(const char *text, Scene *s, Error *err)
     return scene_load_file(path, SCENE_FORMAT_AUTO, s, NULL, err);
 }
 
-/* Renders s with MIS mode `mode` (set on the prepared scene) on `devices`; the linear
- * film in a new array, NULL on failure. */
-static float *render_mode(Scene *s, uint mode, const char *devices, Error *err)
-{
-    RenderScene rs;
-    DeviceDesc *all = NULL;
-    size_t n_all = 0, *chosen = NULL, n_chosen = 0, n_open = 0;
-    Device *devs[4];
-    char warning[1100];
-    Film film;
-    memset(&film, 0, sizeof film);
-    float *rgb = NULL;
-    Status st = render_scene_prepare(s, 0, &rs, err);
-    if (st) return NULL;
-    rs.ds.params.mis_mode = mode;
-    if ((st = device_list(&all, &n_all, warning, sizeof warning, err))) goto out;
-    if ((st = device_select(devices, all, n_all, &chosen, &n_chosen, err))) goto out;
-    for (size_t i = 0; i < n_chosen && i < 4; i++) {
-        if ((st = device_open(&all[chosen[i]], NULL, &devs[i], err))) goto out;
-        n_open++;
-        if ((st = devs[i]->ops->load_scene(devs[i], &rs.ds, err))) goto out;
-    }
-    if ((st = film_init(&film, s->image.width, s->image.height, err))) goto out;
-    ScheduleConfig cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.spp = s->image.spp;
-    ScheduleStats stats;
-    st = schedule_run(devs, n_open, &cfg, &film, &stats, err);
-    schedule_stats_free(&stats);
-    if (!st) {
-        rgb = malloc((size_t)film.width * film.height * 3u * sizeof *rgb);
-        if (rgb) film_resolve(&film, rgb);
-    }
-out:
-    for (size_t i = 0; i < n_open; i++) device_close(devs[i]);
-    film_free(&film);
-    free(all);
-    free(chosen);
-    render_scene_free(&rs);
-    return rgb;
-}
-
 /* The resampled map's texels: in a uniform cube map every one is the faces' value
  * (the mean of equal lookups, taken in double, gives it back), so the environment
  * light's mean is that value's luminance; the map's size follows the faces'. */
@@ -392,6 +350,16 @@ static void test_env_map_uniform(void)
     CHECK_EQ_INT(cube_env_height(4096), CUBE_ENV_MAX_HEIGHT);
     scene_free(&s);
     error_clear(&err);
+}
+
+/* Renders s with MIS mode `mode` on `devices`; the linear film in a new array, NULL on
+ * failure. */
+static float *render_mode(Scene *s, uint mode, const char *devices, Error *err)
+{
+    float *rgb = malloc((size_t)s->image.width * s->image.height * 3u * sizeof *rgb);
+    if (rgb && render_util_rgb_mis(s, mode, devices, rgb, err) == ST_OK) return rgb;
+    free(rgb);
+    return NULL;
 }
 
 /* A white diffuse sphere (albedo 1) inside a uniform cube map is lit by it alone and

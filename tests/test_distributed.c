@@ -15,6 +15,7 @@
 
 #include "cli_util.h"
 #include "harness.h"
+#include "file_util.h"
 
 static char dir[64];
 static CliResult r;
@@ -41,18 +42,7 @@ static void make_dir(void)
 
 static void remove_dir(void)
 {
-    DIR *d = opendir(dir);
-    if (d) {
-        struct dirent *e;
-        char p[512];
-        while ((e = readdir(d)))
-            if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
-                snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-                unlink(p);
-            }
-        closedir(d);
-    }
-    rmdir(dir);
+    file_util_remove_dir(dir);
 }
 
 /* The reference: every sample in one process. */

@@ -297,43 +297,6 @@ static void check_furnace(float albedo)
 static void test_furnace_albedo_1(void) { check_furnace(1.0f); }
 static void test_furnace_albedo_half(void) { check_furnace(0.5f); }
 
-/* Renders with one MIS mode (set on the prepared scene) on `devices`. */
-static Status render_mode(Scene *s, uint mode, const char *devices, float *rgb, Error *err)
-{
-    RenderScene rs;
-    DeviceDesc *all = NULL;
-    size_t n_all = 0, *chosen = NULL, n_chosen = 0, n_open = 0;
-    Device *devs[4];
-    char warning[1100];
-    Film film;
-    memset(&film, 0, sizeof film);
-    Status st = render_scene_prepare(s, 0, &rs, err);
-    if (st) return st;
-    rs.ds.params.mis_mode = mode;
-    if ((st = device_list(&all, &n_all, warning, sizeof warning, err))) goto out;
-    if ((st = device_select(devices, all, n_all, &chosen, &n_chosen, err))) goto out;
-    for (size_t i = 0; i < n_chosen && i < 4; i++) {
-        if ((st = device_open(&all[chosen[i]], NULL, &devs[i], err))) goto out;
-        n_open++;
-        if ((st = devs[i]->ops->load_scene(devs[i], &rs.ds, err))) goto out;
-    }
-    if ((st = film_init(&film, s->image.width, s->image.height, err))) goto out;
-    ScheduleConfig cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.spp = s->image.spp;
-    ScheduleStats stats;
-    st = schedule_run(devs, n_open, &cfg, &film, &stats, err);
-    schedule_stats_free(&stats);
-    if (!st) film_resolve(&film, rgb);
-out:
-    for (size_t i = 0; i < n_open; i++) device_close(devs[i]);
-    film_free(&film);
-    free(all);
-    free(chosen);
-    render_scene_free(&rs);
-    return st;
-}
-
 /* A diffuse sphere on a diffuse floor under the structured map, direct light only:
  * light sampling alone, BSDF sampling alone and their MIS combination must agree
  * (means of 8x8 blocks and of the image). */
@@ -357,7 +320,7 @@ static void test_strategies_agree(void)
     Error err = { 0 };
     for (uint m = 0; m < 3; m++) {
         img[m] = malloc(W * H * 3 * sizeof *img[m]);
-        Status st = render_mode(&s, m, "scalar", img[m], &err);
+        Status st = render_util_rgb_mis(&s, m, "scalar", img[m], &err);
         CHECK_MSG(st == ST_OK, "%s", err.msg);
         for (uint y = 0; y < H; y++)
             for (uint x = 0; x < W; x++) {
@@ -407,7 +370,7 @@ static void test_opencl_matches_scalar(void)
     Error err = { 0 };
     for (int d = 0; d < 2; d++) {
         img[d] = malloc(W * H * 3 * sizeof *img[d]);
-        Status st = render_mode(&s, MIS_BOTH, devs[d], img[d], &err);
+        Status st = render_util_rgb_mis(&s, MIS_BOTH, devs[d], img[d], &err);
         CHECK_MSG(st == ST_OK, "%s: %s", devs[d], err.msg);
     }
     uint same = 0;
@@ -448,7 +411,7 @@ static void test_whitted_sees_map(void)
         }
     const char *devs[2] = { "scalar", TEST_OPENCL };
     for (int d = 0; d < 2; d++) {
-        CHECK(render_mode(&s, MIS_BOTH, devs[d], got, &err) == ST_OK);
+        CHECK(render_util_rgb_mis(&s, MIS_BOTH, devs[d], got, &err) == ST_OK);
         double worst = 0.0;
         for (uint i = 0; i < W * H * 3; i++) worst = fmax(worst, fabs(got[i] - want[i]));
         fprintf(stderr, "  whitted on %s: largest difference to the map's pixels %.2g\n", devs[d], worst);

@@ -74,44 +74,6 @@ static void prepared_view(Scene *s, RenderScene *rs, SceneView *v)
     device_scene_view(&rs->ds, v);
 }
 
-/* Renders with one MIS mode; the scheduler is bypassed by setting the mode on the
- * prepared scene, so render_util's prepare is redone here. */
-static Status render_mode(Scene *s, uint mode, const char *devices, float *rgb, Error *err)
-{
-    RenderScene rs;
-    DeviceDesc *all = NULL;
-    size_t n_all = 0, *chosen = NULL, n_chosen = 0, n_open = 0;
-    Device *devs[4];
-    char warning[1100];
-    Film film;
-    memset(&film, 0, sizeof film);
-    Status st = render_scene_prepare(s, 0, &rs, err);
-    if (st) return st;
-    rs.ds.params.mis_mode = mode;
-    if ((st = device_list(&all, &n_all, warning, sizeof warning, err))) goto out;
-    if ((st = device_select(devices, all, n_all, &chosen, &n_chosen, err))) goto out;
-    for (size_t i = 0; i < n_chosen && i < 4; i++) {
-        if ((st = device_open(&all[chosen[i]], NULL, &devs[i], err))) goto out;
-        n_open++;
-        if ((st = devs[i]->ops->load_scene(devs[i], &rs.ds, err))) goto out;
-    }
-    if ((st = film_init(&film, W, H, err))) goto out;
-    ScheduleConfig cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.spp = s->image.spp;
-    ScheduleStats stats;
-    st = schedule_run(devs, n_open, &cfg, &film, &stats, err);
-    schedule_stats_free(&stats);
-    if (!st) film_resolve(&film, rgb);
-out:
-    for (size_t i = 0; i < n_open; i++) device_close(devs[i]);
-    film_free(&film);
-    free(all);
-    free(chosen);
-    render_scene_free(&rs);
-    return st;
-}
-
 /* Mean of each BLOCK x BLOCK block (12 of them) and of the whole image. */
 static void block_means(const float *rgb, double blocks[12], double *mean)
 {
@@ -139,7 +101,7 @@ static void check_strategies_agree(const char *name, Material floor_mat, uint sp
     Error err = {0};
     for (uint m = 0; m < 3; m++) {
         img[m] = malloc(W * H * 3 * sizeof *img[m]);
-        Status st = render_mode(&s, m, "scalar", img[m], &err);
+        Status st = render_util_rgb_mis(&s, m, "scalar", img[m], &err);
         CHECK_MSG(st == ST_OK, "%s", err.msg);
         block_means(img[m], blocks[m], &mean[m]);
     }
@@ -208,7 +170,7 @@ static void test_mis_box_lamp(void)
     Error err = {0};
     for (uint m = 0; m < 3; m++) {
         img[m] = malloc(W * H * 3 * sizeof *img[m]);
-        CHECK(render_mode(&s, m, "scalar", img[m], &err) == ST_OK);
+        CHECK(render_util_rgb_mis(&s, m, "scalar", img[m], &err) == ST_OK);
         block_means(img[m], blocks[m], &mean[m]);
     }
     fprintf(stderr, "  with a box lamp, 512 spp: image mean MIS %.4f, light sampling %.4f, BSDF sampling %.4f\n",
@@ -437,9 +399,9 @@ static void test_delta_lights_match_whitted(void)
     scene_add_light(&s, dl, NULL);
     float *path = malloc(W * H * 3 * sizeof *path), *whitted = malloc(W * H * 3 * sizeof *whitted);
     Error err = {0};
-    CHECK(render_mode(&s, MIS_BOTH, "scalar", path, &err) == ST_OK);
+    CHECK(render_util_rgb_mis(&s, MIS_BOTH, "scalar", path, &err) == ST_OK);
     s.integrator = INTEGRATOR_WHITTED;
-    CHECK(render_mode(&s, MIS_BOTH, TEST_OPENCL, whitted, &err) == ST_OK);
+    CHECK(render_util_rgb_mis(&s, MIS_BOTH, TEST_OPENCL, whitted, &err) == ST_OK);
     double cos_t = 1.0 / sqrt(0.09 + 1.0 + 0.04), want = 0.7 / M_PI * 2.0 * cos_t, worst = 0.0;
     for (uint i = 0; i < W * H; i++) {
         if (path[3 * i] == 0.0f) continue;          /* sky */
@@ -455,9 +417,9 @@ static void test_delta_lights_match_whitted(void)
     scene_add_light(&s, pl, NULL);
     s.image.spp = 16;
     s.integrator = INTEGRATOR_PATH;
-    CHECK(render_mode(&s, MIS_BOTH, "scalar", path, &err) == ST_OK);
+    CHECK(render_util_rgb_mis(&s, MIS_BOTH, "scalar", path, &err) == ST_OK);
     s.integrator = INTEGRATOR_WHITTED;
-    CHECK(render_mode(&s, MIS_BOTH, "scalar", whitted, &err) == ST_OK);
+    CHECK(render_util_rgb_mis(&s, MIS_BOTH, "scalar", whitted, &err) == ST_OK);
     double sp = 0.0, sw = 0.0;
     for (uint i = 0; i < W * H * 3; i++) {
         sp += path[i];
@@ -491,7 +453,7 @@ static void test_phong_energy(void)
         scene_add_sphere(&s, sp, NULL);
         float *rgb = malloc(W * H * 3 * sizeof *rgb);
         Error err = {0};
-        CHECK(render_mode(&s, MIS_BOTH, "scalar", rgb, &err) == ST_OK);
+        CHECK(render_util_rgb_mis(&s, MIS_BOTH, "scalar", rgb, &err) == ST_OK);
         double mean = 0.0;
         for (uint k = 0; k < W * H * 3; k++) mean += rgb[k] / (W * H * 3);
         fprintf(stderr, "  furnace, kd %g ks %g n %g: mean %.4f\n", (double)mats[i][0], (double)mats[i][1],

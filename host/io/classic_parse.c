@@ -426,10 +426,8 @@ int classic_detect(const char *text, size_t len)
 /* classic_load and classic_load_text: `text` NULL reads the file `path`. */
 static Status load(const char *path, const char *text, size_t len, Scene *s, Error *err)
 {
-    free(s->path);
-    s->path = malloc(strlen(path) + 1);
-    if (!s->path) return error_set(err, ST_INTERNAL, "out of memory");
-    strcpy(s->path, path);
+    Status path_st = scene_set_path(s, path, err);
+    if (path_st) return path_st;
     Classic c;
     memset(&c, 0, sizeof c);
     c.s = s;

@@ -82,11 +82,8 @@ Status mesh_view_load(const char *path, Scene *s, Error *err)
 
 Status mesh_view_frame(const char *path, Scene *s, Error *err)
 {
-    free(s->path);
-    s->path = malloc(strlen(path) + 1);
-    if (!s->path) return error_set(err, ST_INTERNAL, "out of memory");
-    strcpy(s->path, path);
-    Status st;
+    Status st = scene_set_path(s, path, err);
+    if (st) return st;
     double c[3], r;
     if (!mesh_sphere(s, c, &r))
         return error_set(err, ST_INPUT, "%s: the mesh has no triangles to show", path);

@@ -39,10 +39,8 @@ static Status gltf_scene(const char *path, const char *text, size_t len, Scene *
     if (st) return st;
     if (!v.has_camera) return mesh_view_frame(path, s, err);
     if (kind) *kind = SCENE_KIND_CLPT;
-    free(s->path);
-    s->path = malloc(strlen(path) + 1);
-    if (!s->path) return error_set(err, ST_INTERNAL, "out of memory");
-    strcpy(s->path, path);
+    Status path_st = scene_set_path(s, path, err);
+    if (path_st) return path_st;
     if (!v.has_lights) {
         s->bg_type = BG_SKY;
         s->bg_color = v3(0.35f, 0.38f, 0.42f);

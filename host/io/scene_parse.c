@@ -509,11 +509,8 @@ static Status parse_file(Parser *p, const char *path)
 /* scene_load and scene_load_text: `text` NULL reads the file `path`. */
 static Status load(const char *path, const char *text, size_t len, Scene *s, Error *err)
 {
-    free(s->path);
-    size_t n = strlen(path);
-    s->path = malloc(n + 1);
-    if (!s->path) return error_set(err, ST_INTERNAL, "out of memory");
-    memcpy(s->path, path, n + 1);
+    Status path_st = scene_set_path(s, path, err);
+    if (path_st) return path_st;
     Parser p;
     memset(&p, 0, sizeof p);
     p.s = s;

@@ -96,6 +96,17 @@ static Status append(void **arr, size_t *n, size_t *cap, const void *item, size_
     return ST_OK;
 }
 
+Status scene_set_path(Scene *s, const char *path, Error *err)
+{
+    size_t n = strlen(path);
+    char *copy = malloc(n + 1);
+    if (!copy) return error_set(err, ST_INTERNAL, "out of memory");
+    memcpy(copy, path, n + 1);
+    free(s->path);
+    s->path = copy;
+    return ST_OK;
+}
+
 Status scene_add_material(Scene *s, const char *name, Material m, uint *index, Error *err)
 {
     /* Both arrays share cap_materials. The names grow first, through a copy of it: if

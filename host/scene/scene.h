@@ -116,6 +116,9 @@ Status scene_load(const char *path, Scene *s, Error *err);
  * included files and meshes are still read from disk, beside `path`. */
 Status scene_load_text(const char *path, const char *text, size_t len, Scene *s, Error *err);
 
+/* The file the scene was read from (for messages and relative paths), copied. */
+Status scene_set_path(Scene *s, const char *path, Error *err);
+
 /* Appending; each fails only when memory runs out (ST_INTERNAL). */
 Status scene_add_material(Scene *s, const char *name, Material m, uint *index, Error *err);
 Status scene_add_sphere(Scene *s, Sphere sp, Error *err);

@@ -66,4 +66,11 @@ Status options_finish(Options *o, Error *err);
  * completions read the list through it). */
 const OptionSpec *options_flag(size_t i);
 
+/* Shared by options.c and options_parse.c: an integer in [lo, hi]; a positive number
+ * of seconds (each value whole, no blank at either end); a choice's words joined by
+ * '|' or, quoted, for a message ("'a', 'b' or 'c'"). */
+Status option_parse_long(const char *flag, const char *s, long lo, long hi, long *out, Error *err);
+Status option_parse_seconds(const char *flag, const char *s, double *out, Error *err);
+void option_choices_text(const OptionChoice *c, int quoted, char *buf, size_t size);
+
 #endif /* CLPT_OPTIONS_H */

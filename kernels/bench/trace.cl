@@ -57,18 +57,6 @@ KFN_INLINE void trace_one_item(const SceneView *sc, __global const Ray *rays, ui
     if (i < n) trace_one_ray(sc, rays, i, tree, any, hits, occluded);
 }
 
-__kernel void k_trace_closest1(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
-{
-    SCENE_VIEW(sc);
-    trace_one_item(&sc, rays, n, TREE_KD, 0, hits, 0);
-}
-
-__kernel void k_trace_any1(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
-{
-    SCENE_VIEW(sc);
-    trace_one_item(&sc, rays, n, TREE_KD, 1, 0, occluded);
-}
-
 /* Closest hits (any == 0) or occlusion (any == 1: 1 or 0 in hits[i].prim's place, as
  * occluded[]) of rays[8i .. 8i+7], walked as one packet through the given tree
  * (trace_packet, trace_packet_wide). */
@@ -92,66 +80,38 @@ KFN_INLINE void trace_packet_item(const SceneView *sc, __global const Ray *rays,
     }
 }
 
-__kernel void k_trace_closest8(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
-{
-    SCENE_VIEW(sc);
-    trace_packet_item(&sc, rays, n, TREE_KD, 0, hits, 0);
-}
-
-__kernel void k_trace_any8(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
-{
-    SCENE_VIEW(sc);
-    trace_packet_item(&sc, rays, n, TREE_KD, 1, 0, occluded);
-}
-
-/* The same through the 8-wide BVH (trace_packet_wide). */
-__kernel void k_trace_closest_wide8(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
-{
-    SCENE_VIEW(sc);
-    trace_packet_item(&sc, rays, n, TREE_BVH, 0, hits, 0);
-}
-
-__kernel void k_trace_any_wide8(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
-{
-    SCENE_VIEW(sc);
-    trace_packet_item(&sc, rays, n, TREE_BVH, 1, 0, occluded);
-}
-
-/* The same through the 8-wide BVH. */
-__kernel void k_trace_closest_wide(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
-{
-    SCENE_VIEW(sc);
-    trace_one_item(&sc, rays, n, TREE_BVH, 0, hits, 0);
-}
-
-__kernel void k_trace_any_wide(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
-{
-    SCENE_VIEW(sc);
-    trace_one_item(&sc, rays, n, TREE_BVH, 1, 0, occluded);
-}
-
 /* Closest hits (any == 0) or occlusion (any == 1) of rays[PATH_LANES i] to
  * rays[PATH_LANES i + PATH_LANES - 1], walked one after another in one work-item through
  * the BVH: the form in which k_path_lanes, the renderer's kernel on CPUs, calls the walk
  * (its lanes' rays in turn). PoCL computes the addresses of a work-item's private
  * arrays, the walk's stack among them, once per item: k_trace_closest_wide pays that
  * per ray. */
-KFN_INLINE void trace_lanes_item(const SceneView *sc, __global const Ray *rays, uint n, int any,
+KFN_INLINE void trace_lanes_item(const SceneView *sc, __global const Ray *rays, uint n, int tree, int any,
                                  __global Hit *hits, __global uint *occluded)
 {
     uint first = PATH_LANES * (uint)get_global_id(0);
     for (uint i = first; i < first + PATH_LANES && i < n; i++)
-        trace_one_ray(sc, rays, i, TREE_BVH, any, hits, occluded);
+        trace_one_ray(sc, rays, i, tree, any, hits, occluded);
 }
 
-__kernel void k_trace_closest_lanes(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
-{
-    SCENE_VIEW(sc);
-    trace_lanes_item(&sc, rays, n, 0, hits, 0);
-}
+/* Each walk above as a pair of kernels: k_trace_closest<suffix> writes hits[i],
+ * k_trace_any<suffix> occluded[i] (1 or 0). */
+#define TRACE_KERNELS(suffix, walk, tree)                                                    \
+    __kernel void k_trace_closest##suffix(SCENE_ARGS __global const Ray *rays, uint n,       \
+                                          __global Hit *hits)                                \
+    {                                                                                        \
+        SCENE_VIEW(sc);                                                                      \
+        walk(&sc, rays, n, tree, 0, hits, 0);                                                \
+    }                                                                                        \
+    __kernel void k_trace_any##suffix(SCENE_ARGS __global const Ray *rays, uint n,           \
+                                      __global uint *occluded)                               \
+    {                                                                                        \
+        SCENE_VIEW(sc);                                                                      \
+        walk(&sc, rays, n, tree, 1, 0, occluded);                                            \
+    }
 
-__kernel void k_trace_any_lanes(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
-{
-    SCENE_VIEW(sc);
-    trace_lanes_item(&sc, rays, n, 1, 0, occluded);
-}
+TRACE_KERNELS(1, trace_one_item, TREE_KD)            /* the kd-tree, one ray per item */
+TRACE_KERNELS(8, trace_packet_item, TREE_KD)         /* the kd-tree, packets of eight */
+TRACE_KERNELS(_wide, trace_one_item, TREE_BVH)       /* the BVH, one ray per item */
+TRACE_KERNELS(_wide8, trace_packet_item, TREE_BVH)   /* the BVH, packets of eight */
+TRACE_KERNELS(_lanes, trace_lanes_item, TREE_BVH)    /* the BVH, eight rays in turn per item */

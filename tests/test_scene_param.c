@@ -54,6 +54,9 @@ static void test_errors(void)
         { "image.spp", "1.5", "scene parameter 'image.spp' expects an integer in [1, 1000000], got '1.5'" },
         { "material.red.albedo", "-1", "scene parameter 'material.red.albedo' expects a colour: one number >= 0 "
                                        "or three (\"0.8,0.2,0.2\"), got '-1'" },
+        /* finite as a double, +inf as the float the scene stores (found by fuzz_param) */
+        { "material.red.albedo", "1e39", "scene parameter 'material.red.albedo' expects a colour: one number >= 0 "
+                                         "or three (\"0.8,0.2,0.2\"), got '1e39'" },
         { "material.red.albdo", "1", "unknown scene parameter 'material.red.albdo': a material has albedo, "
                                      "emission, radiance, specular, reflective, transparent, eta, k, "
                                      "specular_color, sheen_color, ior, fuzz, shininess, roughness, anisotropy, "

@@ -4,6 +4,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stddef.h>
@@ -127,7 +128,8 @@ static void suggest(Error *err, const char *typed, size_t len, const char *const
 /* ---------------------------------------------------------------- values */
 
 /* Up to `max` numbers separated by commas or blanks; returns how many, -1 when the text
- * is not that. */
+ * is not that. A number must be a finite float too: the scene stores floats, and 1e39
+ * would become +inf there. */
 static int read_numbers(const char *v, double *out, int max)
 {
     int n = 0;
@@ -139,7 +141,7 @@ static int read_numbers(const char *v, double *out, int max)
         char *end;
         errno = 0;
         double x = strtod(p, &end);
-        if (end == p || errno || !isfinite(x)) return -1;
+        if (end == p || errno || !isfinite(x) || fabs(x) > FLT_MAX) return -1;
         out[n++] = x;
         p = end;
         while (isspace((unsigned char)*p)) p++;

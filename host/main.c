@@ -622,6 +622,9 @@ static Status run_interactive(Run *r, Error *err)
     if (!r->o.wave_paths) r->o.wave_paths = VIEWER_WAVE_PATHS;
     st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
     if (st == ST_OK) st = scene_apply_options(r, err);
+    /* the viewer shows the whole image: a scene's crop window (pbrt's) is for renders
+     * to a file, and --crop is refused with --interactive */
+    r->scene.crop.kind = CROP_NONE;
     if (st == ST_OK) st = render_prepare(r, 0, 0, err);
     if (st == ST_OK) st = open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
     if (st == ST_OK) {

@@ -540,7 +540,7 @@ enum MisMode { MIS_BOTH = 0, MIS_LIGHT_ONLY = 1, MIS_BSDF_ONLY = 2 };
 enum Sampler { SAMPLER_SOBOL = 0, SAMPLER_INDEPENDENT = 1 };
 
 /* Everything constant over a render, uploaded once per device. */
-typedef struct {                                        /* 304 bytes */
+typedef struct {                                        /* 320 bytes */
     Camera camera;
     vec3 bg_color;    uint bg_type;   /* constant colour, the sky's horizon colour, or
                                        * BG_MAP: the map's scale (intensity) */
@@ -575,7 +575,13 @@ typedef struct {                                        /* 304 bytes */
                                        * next-event estimation), or NO_INDEX */
     uint split;                       /* path: continuations per camera sample from its
                                        * first hit (>= 1; shade_path.h, first-hit splitting) */
-    uint pad_split0, pad_split1, pad_split2;
+    /* A crop (--crop, --pixel-bounds, pbrt's cropwindow): the film is the width x height
+     * window of a larger image, which leaves crop_left columns out on its left,
+     * crop_right on its right, crop_top rows above and crop_bottom below. Samples are
+     * numbered and placed by the whole image's pixel (params_image_pixel), so the
+     * window's pixels are the whole render's, bit for bit. All 0: no crop. */
+    uint crop_left, crop_top, crop_right;
+    uint crop_bottom, pad_crop0, pad_crop1, pad_crop2;
 } RenderParams;
 
 /* One path of the wavefront; lives in a device buffer between kernel launches. */
@@ -625,7 +631,7 @@ CLPT_CHECK_SIZE(RevSurface, 48);
 CLPT_CHECK_SIZE(Material, 288);
 CLPT_CHECK_SIZE(Light, 96);
 CLPT_CHECK_SIZE(Camera, 112);
-CLPT_CHECK_SIZE(RenderParams, 304);
+CLPT_CHECK_SIZE(RenderParams, 320);
 CLPT_CHECK_SIZE(PathState, 64);
 CLPT_CHECK_SIZE(Texture, 112);
 _Static_assert(offsetof(RenderParams, bg_color) == 112, "RenderParams.bg_color");
@@ -636,6 +642,7 @@ _Static_assert(offsetof(RenderParams, strata) == 256, "RenderParams.strata");
 _Static_assert(offsetof(RenderParams, shadows) == 264, "RenderParams.shadows");
 _Static_assert(offsetof(RenderParams, normal_miss_grey) == 268, "RenderParams.normal_miss_grey");
 _Static_assert(offsetof(RenderParams, bg_light) == 284, "RenderParams.bg_light");
+_Static_assert(offsetof(RenderParams, crop_left) == 292, "RenderParams.crop_left");
 _Static_assert(offsetof(Material, reflective) == 64, "Material.reflective");
 _Static_assert(offsetof(Light, cos_inner) == 60, "Light.cos_inner");
 _Static_assert(offsetof(Texture, m) == 32, "Texture.m");

@@ -77,10 +77,22 @@ static int wants(const clpt_image *img, unsigned aov)
          : aov == INTEGRATOR_AOV_DEPTH ? img->depth != NULL : img->albedo != NULL;
 }
 
+/* The size of the image a render of s gives: its crop's window (--crop), else the
+ * whole image. (A window that selects nothing is the whole image's size here, and
+ * refused by the render, which says why.) */
+static void render_image_size(const Scene *s, uint *w, uint *h)
+{
+    CropWindow win;
+    int cropped = crop_window(&s->crop, s->image.width, s->image.height, &win);
+    *w = cropped ? win.width : s->image.width;
+    *h = cropped ? win.height : s->image.height;
+}
+
 /* The image's buffers against the render: its size, and a buffer for each --aov asked. */
 static Status image_check(const ApiRun *r, const clpt_image *img, Error *err)
 {
-    uint w = r->scene.image.width, h = r->scene.image.height;
+    uint w, h;
+    render_image_size(&r->scene, &w, &h);
     if (!img || !img->rgb) return error_set(err, ST_USAGE, "clpt_render needs an image with an rgb buffer");
     if (img->width != w || img->height != h)
         return error_set(err, ST_USAGE, "the image is %ux%u, the render %ux%u (clpt_render_size)", img->width,
@@ -246,8 +258,10 @@ clpt_status clpt_render_size(clpt_scene *sc, const clpt_settings *settings, unsi
     scene_init(&s);
     Status st = api_render_options(sc, settings, &o, &ctx->err);
     if (st == ST_OK) st = api_scene_read(sc, &o, &s, &ctx->err);
-    *width = st == ST_OK ? s.image.width : 0;
-    *height = st == ST_OK ? s.image.height : 0;
+    uint w = 0, h = 0;
+    if (st == ST_OK) render_image_size(&s, &w, &h);
+    *width = w;
+    *height = h;
     scene_free(&s);
     return (clpt_status)st;
 }

@@ -62,6 +62,27 @@ static Status tree_build(const Scene *s, int threads, RenderScene *out, Error *e
     return ST_OK;
 }
 
+/* The film's size and where it lies in the image: the crop's window, the whole image
+ * without one. The camera spans the whole image either way. */
+static Status crop_params(const Scene *s, RenderParams *p, Error *err)
+{
+    CropWindow w;
+    if (!crop_window(&s->crop, s->image.width, s->image.height, &w))
+        return error_set(err, ST_INPUT, s->crop.kind == CROP_PIXELS ? "%s: the pixel bounds %g,%g,%g,%g go past the "
+                                                                      "%ux%u image"
+                                                                    : "%s: the crop window %g,%g,%g,%g selects no "
+                                                                      "pixel of the %ux%u image",
+                         s->path ? s->path : "scene", s->crop.x0, s->crop.x1, s->crop.y0, s->crop.y1,
+                         s->image.width, s->image.height);
+    p->width = w.width;
+    p->height = w.height;
+    p->crop_left = w.x0;
+    p->crop_top = w.y0;
+    p->crop_right = s->image.width - w.x0 - w.width;
+    p->crop_bottom = s->image.height - w.y0 - w.height;
+    return ST_OK;
+}
+
 Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error *err)
 {
     memset(out, 0, sizeof *out);
@@ -85,8 +106,7 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
     p->bg_rot_cos = (float)cos(rot);
     p->bg_rot_sin = (float)sin(rot);
     p->bg_light = s->env_light;
-    p->width = s->image.width;
-    p->height = s->image.height;
+    if ((st = crop_params(s, p, err))) return st;
     p->max_depth = s->image.max_depth;
     p->split = s->image.split ? s->image.split : 1u;
     p->rr_depth = RR_START_BOUNCE;

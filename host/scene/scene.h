@@ -11,6 +11,7 @@
 #include "base/status.h"
 #include "base/strmap.h"
 #include "types.h"
+#include "scene/crop.h"
 #include "scene/transform.h"
 
 typedef struct {
@@ -49,6 +50,8 @@ typedef struct {
                                   * index or name; NULL: the file's first */
     SceneCamera camera;
     SceneImage image;
+    SceneCrop crop;              /* the window rendered (pbrt's cropwindow, --crop ...);
+                                  * CROP_NONE: the whole image */
     char *output_hint;           /* the image file the scene asks for (pbrt's Film
                                   * "filename"), used when -o is not given; NULL: none */
     uint bg_type;                /* enum BackgroundType */

@@ -134,7 +134,8 @@ CLPT_API void clpt_settings_free(clpt_settings *settings);
 
 /* ------------------------------------------------------------------ rendering */
 
-/* The size of the image `scene` renders with `settings` (settings may be NULL). */
+/* The size of the image `scene` renders with `settings` (settings may be NULL): with a
+ * crop ("crop", "pixel-bounds", a pbrt Film's cropwindow), the window's. */
 CLPT_API clpt_status clpt_render_size(clpt_scene *scene, const clpt_settings *settings, unsigned *width,
                                       unsigned *height);
 

@@ -9,6 +9,29 @@
 #include "sample/rng.h"
 #include "sample/sampling.h"
 
+/* Film pixel `pixel` as the whole image's pixel: its column *x and row *y there, and
+ * its index, which keys its samples' random numbers. Without a crop it is `pixel`; with
+ * one, the film is a window of the image (RenderParams.crop_left ...), and a window
+ * pixel's samples are the ones the whole render gives that pixel. */
+KFN uint params_image_pixel(GLOBAL const RenderParams *p, uint pixel, uint *x, uint *y)
+{
+    *x = p->crop_left + pixel % p->width;
+    *y = p->crop_top + pixel / p->width;
+    return *y * (p->crop_left + p->width + p->crop_right) + *x;
+}
+
+/* The film position (s, t) in [0,1]^2 of point (jx, jy) of image pixel (x, y): over
+ * the whole image's size, so that a crop sees what the whole image sees there. */
+KFN float params_film_s(GLOBAL const RenderParams *p, uint x, float jx)
+{
+    return ((float)x + jx) / (float)(p->crop_left + p->width + p->crop_right);
+}
+
+KFN float params_film_t(GLOBAL const RenderParams *p, uint y, float jy)
+{
+    return ((float)y + jy) / (float)(p->crop_top + p->height + p->crop_bottom);
+}
+
 /* The camera ray through film position (s, t) (see Camera in types.h); `key` gives
  * the lens sample when the aperture is open. */
 KFN Ray camera_ray(GLOBAL const RenderParams *p, float s, float t, RngKey key)
@@ -38,13 +61,11 @@ KFN Ray camera_ray(GLOBAL const RenderParams *p, float s, float t, RngKey key)
 KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
                      GLOBAL PathState *ps, GLOBAL Ray *ray)
 {
-    RngKey key = rng_key_make(p, pixel, sample);
-    uint x = pixel % p->width, y = pixel / p->width;
+    uint x, y;
+    RngKey key = rng_key_make(p, params_image_pixel(p, pixel, &x, &y), sample);
     float jx, jy;
     rng_uniform2(key, 0u, DIM_PIXEL_X, &jx, &jy);
-    float s = ((float)x + jx) / (float)p->width;
-    float t = ((float)y + jy) / (float)p->height;
-    *ray = camera_ray(p, s, t, key);
+    *ray = camera_ray(p, params_film_s(p, x, jx), params_film_t(p, y, jy), key);
 
     ps->throughput = v3s(1.0f);
     ps->radiance = v3s(0.0f);

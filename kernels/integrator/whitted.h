@@ -49,8 +49,8 @@ typedef struct {
  * lens (and jitter) numbers come from the key of sample + sample_offset. */
 KFN Ray whitted_camera_ray(GLOBAL const RenderParams *p, uint pixel, uint sample, RngKey *key_out)
 {
-    RngKey key = rng_key_make(p, pixel, sample + p->sample_offset);
-    uint x = pixel % p->width, y = pixel / p->width;
+    uint x, y;
+    RngKey key = rng_key_make(p, params_image_pixel(p, pixel, &x, &y), sample + p->sample_offset);
     uint m = p->strata;
     float jx = 0.5f, jy = 0.5f;
     if (m == 1u) {
@@ -62,7 +62,7 @@ KFN Ray whitted_camera_ray(GLOBAL const RenderParams *p, uint pixel, uint sample
         jy = ((float)(cell / m) + rng_uniform(key, 0u, DIM_PIXEL_Y)) / (float)m;
     }
     *key_out = key;
-    return camera_ray(p, ((float)x + jx) / (float)p->width, ((float)y + jy) / (float)p->height, key);
+    return camera_ray(p, params_film_s(p, x, jx), params_film_t(p, y, jy), key);
 }
 
 /* The refracted direction of unit d at a boundary with normal n facing d's side and

@@ -51,6 +51,10 @@ typedef struct {
     double depth_near, depth_far; /* --depth-range; near == far (0) = automatic */
     int view;                     /* --view: enum ViewTransform (io/view_transform.h) */
     double exposure;              /* --exposure: stops, before the view */
+    /* --crop or --pixel-bounds: the window of the image rendered (scene/crop.h) */
+    unsigned crop_kind;           /* enum CropKind: 0 the scene's, else fractions or pixels */
+    double crop[4];               /* x0, x1, y0, y1 as given */
+    const char *crop_text;        /* the value as typed, for messages */
     /* --set KEY=VALUE, in the order given: scene parameters by path (scene/scene_param.h) */
     const char *sets[OPTIONS_MAX_SETS];
     unsigned n_sets;

@@ -13,6 +13,7 @@
 #include "io/scene_load.h"
 #include "io/view_transform.h"
 #include "render/passes.h"
+#include "scene/crop.h"
 #include "base/limit.h"
 #include "types.h"
 
@@ -58,6 +59,17 @@
         "image width in pixels (overrides the scene)") \
     X(OUTPUT, LONG, height, "--height", NULL, "N", RANGE(1, CLPT_MAX_IMAGE_SIDE), \
         "image height in pixels (overrides the scene)") \
+    X(OUTPUT, CUSTOM, crop_kind, "--crop", NULL, "X0,X1,Y0,Y1", PARSE(parse_crop), \
+        "render only this window of the image, in\n" \
+        "fractions of its width and height (0 <= X0 <\n" \
+        "X1 <= 1, 0 <= Y0 < Y1 <= 1, rows from the top;\n" \
+        "pbrt's cropwindow): the output is the window,\n" \
+        "its pixels the same bits as the whole render's") \
+    X(OUTPUT, CUSTOM, crop_kind, "--pixel-bounds", NULL, "X0,X1,Y0,Y1", PARSE(parse_pixel_bounds), \
+        "render only pixel columns X0..X1-1 and rows\n" \
+        "Y0..Y1-1 (row 0 at the top; pbrt's\n" \
+        "pixelbounds): the output is that window, as\n" \
+        "with --crop") \
     X(OUTPUT, LONG, seed, "--seed", NULL, "N", RANGE(0, 4294967295L), \
         "random seed; the same seed gives the same image\n" \
         "on any devices and batch sizes") \
@@ -409,6 +421,58 @@ static Status parse_sample_range(const char *v, Options *o, Error *err)
     o->range_first = a;
     o->range_end = b;
     return ST_OK;
+}
+
+/* n numbers separated by commas, nothing else (no blanks: what was typed is what
+ * counts), into out; 0 unless exactly that. */
+static int read_number_list(const char *v, double *out, int n)
+{
+    const char *p = v;
+    for (int i = 0; i < n; i++) {
+        char *end;
+        errno = 0;
+        out[i] = strtod(p, &end);
+        if (end == p || errno || starts_blank(p) || !isfinite(out[i])) return 0;
+        if (*end != (i + 1 < n ? ',' : '\0')) return 0;
+        p = end + 1;
+    }
+    return 1;
+}
+
+/* The window of --crop or --pixel-bounds (`kind`, enum CropKind); one of the two. */
+static Status set_crop(unsigned kind, const char *v, const double a[4], Options *o, Error *err)
+{
+    if (o->crop_kind && o->crop_kind != kind)
+        return error_set(err, ST_USAGE, "--crop and --pixel-bounds both choose the window to render: give one");
+    o->crop_kind = kind;
+    memcpy(o->crop, a, sizeof o->crop);
+    o->crop_text = v;
+    return ST_OK;
+}
+
+/* --crop X0,X1,Y0,Y1: fractions, 0 <= X0 < X1 <= 1 (pbrt's cropwindow); whether it
+ * holds a pixel is known once the image's size is (scene_options.c). */
+static Status parse_crop(const char *v, Options *o, Error *err)
+{
+    double a[4];
+    if (!read_number_list(v, a, 4) || !(a[0] >= 0.0 && a[0] < a[1] && a[1] <= 1.0) ||
+        !(a[2] >= 0.0 && a[2] < a[3] && a[3] <= 1.0))
+        return error_set(err, ST_USAGE, "--crop expects X0,X1,Y0,Y1, fractions of the image with "
+                         "0 <= X0 < X1 <= 1 and 0 <= Y0 < Y1 <= 1, got '%s'", v);
+    return set_crop(CROP_FRACTIONS, v, a, o, err);
+}
+
+/* --pixel-bounds X0,X1,Y0,Y1: columns [X0, X1) and rows [Y0, Y1); within the image is
+ * checked once its size is known (scene_options.c). */
+static Status parse_pixel_bounds(const char *v, Options *o, Error *err)
+{
+    double a[4];
+    int ok = read_number_list(v, a, 4);
+    for (int i = 0; ok && i < 4; i++) ok = a[i] == floor(a[i]) && a[i] >= 0.0 && a[i] <= CLPT_MAX_IMAGE_SIDE;
+    if (!ok || !(a[0] < a[1]) || !(a[2] < a[3]))
+        return error_set(err, ST_USAGE, "--pixel-bounds expects X0,X1,Y0,Y1, whole pixels with 0 <= X0 < X1 "
+                         "and 0 <= Y0 < Y1 (columns X0..X1-1, rows Y0..Y1-1), got '%s'", v);
+    return set_crop(CROP_PIXELS, v, a, o, err);
 }
 
 /* --exposure EV: stops, as Blender's (-32..32) */

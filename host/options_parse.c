@@ -11,6 +11,7 @@
 #include "io/scene_load.h"
 #include "io/view_transform.h"
 #include "render/passes.h"
+#include "scene/crop.h"
 #include "base/limit.h"
 #include "types.h"
 
@@ -239,7 +240,9 @@ static Status options_check_interactive(const Options *o, Error *err)
     const char *flag = o->output ? "--output" : o->checkpoint_path ? (o->resume_path ? "--resume" : "--checkpoint")
                      : o->time_limit > 0.0 ? "--time-limit" : o->progressive_seconds > 0.0 ? "--progressive-output"
                      : o->aovs ? "--aov" : o->adaptive > 0.0 ? "--adaptive"
-                     : o->range_end >= 0 ? "--sample-range" : o->stats == STATS_JSON ? "--stats=json" : NULL;
+                     : o->range_end >= 0 ? "--sample-range" : o->stats == STATS_JSON ? "--stats=json"
+                     : o->crop_kind == CROP_FRACTIONS ? "--crop" : o->crop_kind == CROP_PIXELS ? "--pixel-bounds"
+                     : NULL;
     if (flag)
         return error_set(err, ST_USAGE, "--interactive cannot be combined with %s (the viewer saves frames "
                                         "with the C key; see docs/viewer.md)", flag);

@@ -52,6 +52,26 @@ static Status apply_sets(const Options *o, Scene *s, Error *err)
     return ST_OK;
 }
 
+/* --crop or --pixel-bounds replaces the scene's window (pbrt's cropwindow), and must
+ * select pixels of the image as the flags and the scene sized it. A crop, the flags'
+ * or the scene's, rules out --adaptive, which compares each pixel with its neighbours:
+ * at the window's edge some would be missing, and the pixels would not be the whole
+ * render's. */
+static Status apply_crop(const Options *o, Scene *s, Error *err)
+{
+    if (o->crop_kind) s->crop = (SceneCrop){ o->crop_kind, o->crop[0], o->crop[1], o->crop[2], o->crop[3] };
+    CropWindow w;
+    if (o->crop_kind && !crop_window(&s->crop, s->image.width, s->image.height, &w))
+        return error_set(err, ST_USAGE, o->crop_kind == CROP_PIXELS ? "--pixel-bounds %s goes past the %ux%u image"
+                                                                    : "--crop %s selects no pixel of the %ux%u image",
+                         o->crop_text, s->image.width, s->image.height);
+    if (s->crop.kind != CROP_NONE && o->adaptive > 0.0)
+        return error_set(err, ST_USAGE, "--adaptive cannot render a crop (%s): it compares each pixel with its "
+                         "neighbours, which the window's edge leaves out", o->crop_kind == CROP_PIXELS
+                         ? "--pixel-bounds" : o->crop_kind ? "--crop" : "the scene's crop window");
+    return ST_OK;
+}
+
 Status scene_options_apply(const Options *o, Scene *s, int bare_mesh, Error *err)
 {
     Status st = apply_sets(o, s, err);
@@ -66,6 +86,7 @@ Status scene_options_apply(const Options *o, Scene *s, int bare_mesh, Error *err
         return st;
     /* a mesh file given in place of a scene is shown by a camera that frames it */
     if (bare_mesh && (st = mesh_view_fit(s, err))) return st;
+    if ((st = apply_crop(o, s, err))) return st;
     if (o->range_end > (long)s->image.spp)
         return error_set(err, ST_USAGE, "--sample-range %ld:%ld goes past the render's %u samples per pixel",
                          o->range_first, o->range_end, s->image.spp);

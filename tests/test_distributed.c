@@ -298,6 +298,22 @@ static void test_mpi_two_and_three_ranks_are_bit_identical(void)
     CHECK(files_equal(in_dir("mmerged.pfm"), in_dir("whole.pfm")));
 }
 
+/* A crop (--pixel-bounds) rendered by two ranks is the one-process crop's bytes: every
+ * rank renders the same window of the same image, the scene read by each or sent. */
+static void test_mpi_crop(void)
+{
+#define CROP "--pixel-bounds", "3,20,4,15"
+    cli_run(ARGS(RENDER, CROP, "-o", in_dir("crop1.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    spawn_run(ARGS(MPIRUN, "-np", "2", CLI_PROGRAM, RENDER, CROP, "-o", in_dir("crop2.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(in_dir("crop1.pfm"), in_dir("crop2.pfm")));
+    spawn_run(ARGS(MPIRUN, "-np", "2", CLI_PROGRAM, RENDER, CROP, "--mpi-broadcast", "-o", in_dir("crop3.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(in_dir("crop1.pfm"), in_dir("crop3.pfm")));
+#undef CROP
+}
+
 /* Ranks on different devices: rank 0 on the scalar device, rank 1 on PoCL's CPU device
  * (MPMD, the way docs/distributed.md gives ranks different devices). The film is the
  * same integers whichever device rendered a batch, so the image is still the bytes of
@@ -508,6 +524,7 @@ int main(void)
     RUN(test_sample_range_usage_errors);
     if (have_mpirun()) {
         RUN(test_mpi_two_and_three_ranks_are_bit_identical);
+        RUN(test_mpi_crop);
         RUN(test_mpi_ranks_with_other_settings_are_refused);
         RUN(test_mpi_a_rank_that_cannot_start_ends_the_job);
         RUN(test_mpi_ranks_given_different_commands_are_refused);

@@ -1,7 +1,7 @@
 /* test_cli_camera.c — the flags that choose what the camera sees and which part of the
  * image is rendered (issue 44): --crop and --pixel-bounds, whose pixels must be the
  * whole render's bit for bit (on the scalar device and on OpenCL), with checkpoints,
- * resume and merge; and their errors, with the exact messages. */
+ * resume and merge, and pbrt's Film crop; and their errors, with the exact messages. */
 #include <stdint.h>
 
 #include "cli_util.h"
@@ -162,12 +162,58 @@ static void test_crop_errors(void)
 #undef SCENE
 }
 
+/* A pbrt-v4 scene of 32x24 pixels seen from `lookat` (pbrt's LookAt's nine numbers),
+ * whose Film has `film_extra` ("" for none), in path. */
+static void pbrt_scene(const char *path, const char *lookat, const char *film_extra)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) return;
+    fprintf(f, "LookAt %s\n"
+               "Camera \"perspective\" \"float fov\" 40\n"
+               "Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 24 %s\n"
+               "Sampler \"zsobol\" \"integer pixelsamples\" 4\n"
+               "WorldBegin\n"
+               "LightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]\n"
+               "Material \"diffuse\" \"rgb reflectance\" [0.5 0.3 0.2]\n"
+               "Shape \"sphere\" \"float radius\" 0.8\n", lookat, film_extra);
+    fclose(f);
+}
+
+/* pbrt's Film "cropwindow" and "pixelbounds" crop as --crop and --pixel-bounds do
+ * (the bounds of a crop window in either order, as pbrt takes them); the flags win. */
+#define PBRT_LOOKAT "0 1 4  0 0.5 0  0 1 0"
+static void test_pbrt_film_crop(void)
+{
+#define PBRT(file) file, "--device", "scalar", "-q"
+    pbrt_scene(DIR "/whole.pbrt", PBRT_LOOKAT, "");
+    pbrt_scene(DIR "/cropwindow.pbrt", PBRT_LOOKAT, "\"float cropwindow\" [0.5 0.25 0 0.5]");
+    pbrt_scene(DIR "/pixelbounds.pbrt", PBRT_LOOKAT, "\"integer pixelbounds\" [3 20 2 9]");
+    pbrt_scene(DIR "/past.pbrt", PBRT_LOOKAT, "\"integer pixelbounds\" [0 40 0 4]");
+    cli_run(ARGS(PBRT(DIR "/whole.pbrt"), "-o", DIR "/pbrt-whole.pfm"), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS(PBRT(DIR "/cropwindow.pbrt"), "-o", DIR "/pbrt-cw.pfm"), &r);
+    CHECK_MSG(r.status == 0 && r.err[0] == '\0', "%s", r.err);
+    CHECK(is_window_of(DIR "/pbrt-cw.pfm", DIR "/pbrt-whole.pfm", 8, 0, 8, 12));
+    cli_run(ARGS(PBRT(DIR "/pixelbounds.pbrt"), "-o", DIR "/pbrt-pb.pfm"), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(is_window_of(DIR "/pbrt-pb.pfm", DIR "/pbrt-whole.pfm", 3, 2, 17, 7));
+    cli_run(ARGS(PBRT(DIR "/pixelbounds.pbrt"), "--crop", "0,1,0.5,1", "-o", DIR "/pbrt-flag.pfm"), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(is_window_of(DIR "/pbrt-flag.pfm", DIR "/pbrt-whole.pfm", 0, 12, 32, 12));
+    cli_run(ARGS(PBRT(DIR "/past.pbrt"), "-o", DIR "/pbrt-past.pfm"), &r);
+    CHECK_EQ_INT(r.status, 3);
+    CHECK_MSG(strcmp(r.err, "clpt: error: " DIR "/past.pbrt: the pixel bounds 0,40,0,4 go past the 32x24 image\n") == 0,
+              "%s", r.err);
+#undef PBRT
+}
+
 int main(void)
 {
     if (system("rm -rf " DIR " && mkdir -p " DIR) != 0) return 1;
     RUN(test_crop_errors);
     RUN(test_crop_pixels_are_the_whole_renders);
     RUN(test_crop_with_checkpoints_and_merge);
+    RUN(test_pbrt_film_crop);
     if (system("rm -rf " DIR) != 0) return 1;
     return harness_report();
 }

@@ -257,9 +257,37 @@ static Status d_camera(Parser *p, Lexer *lx, const Token *kw)
     return pbrt_warn_unused(p, lx, "Camera");
 }
 
+/* Film "pixelbounds" [x0 x1 y0 y1] (integers) or "cropwindow" (floats): the window
+ * clpt renders, as --pixel-bounds and --crop (scene/crop.h). As pbrt-v4: pixelbounds
+ * wins when both are given (with a warning), and a crop window's bounds are put in
+ * order and clamped to [0, 1]. A window that selects no pixel, or pixel bounds past the
+ * image, is refused once the image's size is final (--width may change it). */
+static Status film_crop(Parser *p, Lexer *lx, const Token *kw)
+{
+    Param *pb = pbrt_param_find(p, "pixelbounds"), *cw = pbrt_param_find(p, "cropwindow");
+    if (pb && (pb->type != PT_INTEGER || pb->n != 4)) return pbrt_param_type_error(p, lx, pb, "four integers");
+    if (cw && ((cw->type != PT_FLOAT && cw->type != PT_INTEGER) || cw->n != 4))
+        return pbrt_param_type_error(p, lx, cw, "four floats");
+    Status st;
+    if (pb && cw && (st = warn_once(p, lx, kw, "Film crop", "Film has both \"pixelbounds\" and \"cropwindow\"; "
+                                    "pixelbounds is used, as pbrt does")))
+        return st;
+    SceneCrop *c = &p->s->crop;
+    if (pb) {
+        const double *v = p->pl.nums + pb->first;
+        for (int i = 0; i < 4; i++)
+            if (v[i] < 0) return pbrt_param_type_error(p, lx, pb, "four integers >= 0");
+        *c = (SceneCrop){ CROP_PIXELS, v[0], v[1], v[2], v[3] };
+    } else if (cw) {
+        const double *v = p->pl.nums + cw->first;
+        *c = (SceneCrop){ CROP_FRACTIONS, fmin(fmax(fmin(v[0], v[1]), 0.0), 1.0), fmin(fmax(fmax(v[0], v[1]), 0.0), 1.0),
+                          fmin(fmax(fmin(v[2], v[3]), 0.0), 1.0), fmin(fmax(fmax(v[2], v[3]), 0.0), 1.0) };
+    }
+    return ST_OK;
+}
+
 static Status d_film(Parser *p, Lexer *lx, const Token *kw)
 {
-    (void)kw;
     Token type;
     Status st = pbrt_expect_string(p, lx, "a quoted film type", &type);
     if (!st) st = pbrt_parse_params(p, lx);
@@ -285,6 +313,7 @@ static Status d_film(Parser *p, Lexer *lx, const Token *kw)
         free(p->s->output_hint);
         p->s->output_hint = name;
     }
+    if ((st = film_crop(p, lx, kw))) return st;
     return pbrt_warn_unused(p, lx, "Film");
 }
 

@@ -51,6 +51,10 @@ typedef struct {
     double depth_near, depth_far; /* --depth-range; near == far (0) = automatic */
     int view;                     /* --view: enum ViewTransform (io/view_transform.h) */
     double exposure;              /* --exposure: stops, before the view */
+    /* --lookat and --fov, checked and kept as typed; applied as --set camera.from, .at,
+     * .up and .fov are (scene_options.c). NULL: the scene's */
+    const char *lookat;           /* "EX,EY,EZ,AX,AY,AZ,UX,UY,UZ" */
+    const char *fov;              /* degrees, vertical */
     /* --crop or --pixel-bounds: the window of the image rendered (scene/crop.h) */
     unsigned crop_kind;           /* enum CropKind: 0 the scene's, else fractions or pixels */
     double crop[4];               /* x0, x1, y0, y1 as given */

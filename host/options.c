@@ -19,6 +19,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -161,6 +162,15 @@
     X(SCENE, TEXT, camera, "--camera", NULL, "N|NAME", WHAT("camera index or name"), \
         "glTF: look through camera N (from 0) or the camera\n" \
         "(or camera node) named NAME; default: the first") \
+    X(SCENE, CUSTOM, lookat, "--lookat", NULL, "EYE,AT,UP", PARSE(parse_lookat), \
+        "look from EYE at AT, UP upwards: nine numbers\n" \
+        "EX,EY,EZ,AX,AY,AZ,UX,UY,UZ (--lookat\n" \
+        "0,1,5,0,1,0,0,1,0); replaces the camera's frame\n" \
+        "in every scene format, as --set camera.from=,\n" \
+        "camera.at= and camera.up= do") \
+    X(SCENE, CUSTOM, fov, "--fov", NULL, "DEGREES", PARSE(parse_fov), \
+        "vertical field of view of a perspective camera,\n" \
+        "in (0, 180) degrees (as --set camera.fov=)") \
     X(SCENE, CHOICE, integrator, "--integrator", NULL, NULL, \
         ONE_OF({ "path", INTEGRATOR_PATH }, { "whitted", INTEGRATOR_WHITTED }), \
         "path tracing (default) or the classic ray tracer\n" \
@@ -473,6 +483,45 @@ static Status parse_pixel_bounds(const char *v, Options *o, Error *err)
         return error_set(err, ST_USAGE, "--pixel-bounds expects X0,X1,Y0,Y1, whole pixels with 0 <= X0 < X1 "
                          "and 0 <= Y0 < Y1 (columns X0..X1-1, rows Y0..Y1-1), got '%s'", v);
     return set_crop(CROP_PIXELS, v, a, o, err);
+}
+
+/* --lookat EX,EY,EZ,AX,AY,AZ,UX,UY,UZ: the eye, the point looked at and the up
+ * direction. They need nothing of the scene, so the frame is checked here as a whole,
+ * as the scene readers check a camera block: distinct points, an up direction that is
+ * neither zero nor along the view. Every number must fit a float, as the camera's. */
+static Status parse_lookat(const char *v, Options *o, Error *err)
+{
+    double a[9];
+    int ok = read_number_list(v, a, 9);
+    for (int i = 0; ok && i < 9; i++) ok = fabs(a[i]) <= FLT_MAX;
+    if (!ok)
+        return error_set(err, ST_USAGE, "--lookat expects EX,EY,EZ,AX,AY,AZ,UX,UY,UZ, nine numbers: the eye, the "
+                         "point looked at and the up direction, got '%s'", v);
+    double d[3] = { a[3] - a[0], a[4] - a[1], a[5] - a[2] }, *u = a + 6;
+    double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), ul = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    double c[3] = { d[1] * u[2] - d[2] * u[1], d[2] * u[0] - d[0] * u[2], d[0] * u[1] - d[1] * u[0] };
+    if (!(dl > 0.0))
+        return error_set(err, ST_USAGE, "--lookat %s: the eye and the point looked at are the same point", v);
+    if (!(ul > 0.0)) return error_set(err, ST_USAGE, "--lookat %s: the up direction is 0,0,0", v);
+    /* the sine of the angle between up and the view, as the scene reader's test */
+    if (!(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) > 1e-6 * dl * ul))
+        return error_set(err, ST_USAGE, "--lookat %s: the up direction is parallel to the view direction (from the "
+                         "eye to the point looked at)", v);
+    o->lookat = v;
+    return ST_OK;
+}
+
+/* --fov DEGREES: in (0, 180), as a camera block's fov */
+static Status parse_fov(const char *v, Options *o, Error *err)
+{
+    char *end;
+    errno = 0;
+    double f = strtod(v, &end);
+    if (!*v || *end || errno || starts_blank(v) || !(f > 0.0 && f < 180.0))
+        return error_set(err, ST_USAGE, "--fov expects a vertical field of view in degrees, more than 0 and less "
+                         "than 180, got '%s'", v);
+    o->fov = v;
+    return ST_OK;
 }
 
 /* --exposure EV: stops, as Blender's (-32..32) */

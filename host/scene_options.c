@@ -34,22 +34,59 @@ static void apply_overrides(const Options *o, Scene *s)
     if (o->shadows >= 0) s->shadows = o->shadows;
 }
 
+/* Scene parameter `key` (its first key_len bytes) set to the value_len bytes at value. */
+static Status set_param(Scene *s, const char *key, size_t key_len, const char *value, size_t value_len, Error *err)
+{
+    char *k = malloc(key_len + 1), *v = malloc(value_len + 1);
+    Status st = k && v ? ST_OK : error_set(err, ST_INTERNAL, "out of memory");
+    if (st == ST_OK) {
+        memcpy(k, key, key_len);
+        k[key_len] = '\0';
+        memcpy(v, value, value_len);
+        v[value_len] = '\0';
+        st = scene_param_set(s, k, v, err);
+    }
+    free(k);
+    free(v);
+    return st;
+}
+
 /* --set KEY=VALUE, in order, before the flags that override a parameter (--spp beats
- * --set image.spp, as it beats the scene file). */
-static Status apply_sets(const Options *o, Scene *s, Error *err)
+ * --set image.spp, as it beats the scene file): those of the camera (`camera` 1) or
+ * the others (0). The camera's come after a bare mesh's framing camera is made, which
+ * they would otherwise be lost under. */
+static Status apply_sets(const Options *o, Scene *s, int camera, Error *err)
 {
     for (unsigned i = 0; i < o->n_sets; i++) {
         const char *eq = strchr(o->sets[i], '=');
         size_t n = (size_t)(eq - o->sets[i]);
-        char *key = malloc(n + 1);
-        if (!key) return error_set(err, ST_INTERNAL, "out of memory");
-        memcpy(key, o->sets[i], n);
-        key[n] = '\0';
-        Status st = scene_param_set(s, key, eq + 1, err);
-        free(key);
+        if ((strncmp(o->sets[i], "camera.", 7) == 0) != camera) continue;
+        Status st = set_param(s, o->sets[i], n, eq + 1, strlen(eq + 1), err);
         if (st) return st;
     }
     return ST_OK;
+}
+
+/* --lookat and --fov, through the parameters --set reaches (camera.from, .at, .up and
+ * .fov): one way into the camera whatever the flag and the scene's format. options.c
+ * checked the values. */
+static Status apply_camera_flags(const Options *o, Scene *s, Error *err)
+{
+    static const char *const lookat_keys[3] = { "camera.from", "camera.at", "camera.up" };
+    const char *p = o->lookat;
+    Status st = ST_OK;
+    for (int i = 0; p && i < 3 && !st; i++) {
+        /* the i-th three numbers: up to the third comma, or the end */
+        const char *end = p;
+        for (int commas = 0; *end && !(*end == ',' && ++commas == 3); end++) {}
+        st = set_param(s, lookat_keys[i], strlen(lookat_keys[i]), p, (size_t)(end - p), err);
+        p = *end ? end + 1 : end;
+    }
+    if (st || !o->fov) return st;
+    if (s->camera.type == CAMERA_ORTHOGRAPHIC)
+        return error_set(err, ST_USAGE, "--fov sets a perspective camera's field of view; the scene's camera is "
+                         "orthographic");
+    return scene_param_set(s, "camera.fov", o->fov, err);
 }
 
 /* --crop or --pixel-bounds replaces the scene's window (pbrt's cropwindow), and must
@@ -74,7 +111,7 @@ static Status apply_crop(const Options *o, Scene *s, Error *err)
 
 Status scene_options_apply(const Options *o, Scene *s, int bare_mesh, Error *err)
 {
-    Status st = apply_sets(o, s, err);
+    Status st = apply_sets(o, s, 0, err);
     if (st) return st;
     apply_overrides(o, s);
     /* the size rendered, whichever reader or flag set it (a pbrt Film's sides are
@@ -86,6 +123,8 @@ Status scene_options_apply(const Options *o, Scene *s, int bare_mesh, Error *err
         return st;
     /* a mesh file given in place of a scene is shown by a camera that frames it */
     if (bare_mesh && (st = mesh_view_fit(s, err))) return st;
+    /* then what the flags say of the camera, which replaces that framing */
+    if ((st = apply_sets(o, s, 1, err)) || (st = apply_camera_flags(o, s, err))) return st;
     if ((st = apply_crop(o, s, err))) return st;
     if (o->range_end > (long)s->image.spp)
         return error_set(err, ST_USAGE, "--sample-range %ld:%ld goes past the render's %u samples per pixel",

@@ -1,7 +1,8 @@
 /* test_cli_camera.c — the flags that choose what the camera sees and which part of the
  * image is rendered (issue 44): --crop and --pixel-bounds, whose pixels must be the
  * whole render's bit for bit (on the scalar device and on OpenCL), with checkpoints,
- * resume and merge, and pbrt's Film crop; and their errors, with the exact messages. */
+ * resume and merge, and pbrt's Film crop; --lookat and --fov, the scene's camera
+ * edited in every format; and their errors, with the exact messages. */
 #include <stdint.h>
 
 #include "cli_util.h"
@@ -207,6 +208,143 @@ static void test_pbrt_film_crop(void)
 #undef PBRT
 }
 
+/* Writes `text` to path. */
+static void write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+static void test_lookat_and_fov_errors(void)
+{
+#define SCENE "scenes/cornell-box.scene", "--device", "scalar"
+#define LOOKAT_EXPECTS "clpt: error: --lookat expects EX,EY,EZ,AX,AY,AZ,UX,UY,UZ, nine numbers: the eye, the point " \
+                       "looked at and the up direction, got "
+    CHECK_USAGE(ARGS(SCENE, "--lookat", "0,0,0,0,0,1,0,1"), LOOKAT_EXPECTS "'0,0,0,0,0,1,0,1'\n" HINT);
+    CHECK_USAGE(ARGS(SCENE, "--lookat", "0 0 0 0 0 1 0 1 0"), LOOKAT_EXPECTS "'0 0 0 0 0 1 0 1 0'\n" HINT);
+    CHECK_USAGE(ARGS(SCENE, "--lookat", "0,0,0,0,0,1,0,1,1e39"), LOOKAT_EXPECTS "'0,0,0,0,0,1,0,1,1e39'\n" HINT);
+    CHECK_USAGE(ARGS(SCENE, "--lookat", "1,2,3,1,2,3,0,1,0"),
+                "clpt: error: --lookat 1,2,3,1,2,3,0,1,0: the eye and the point looked at are the same point\n" HINT);
+    CHECK_USAGE(ARGS(SCENE, "--lookat", "0,0,0,0,0,-1,0,0,0"),
+                "clpt: error: --lookat 0,0,0,0,0,-1,0,0,0: the up direction is 0,0,0\n" HINT);
+    CHECK_USAGE(ARGS(SCENE, "--lookat", "0,5,0,0,0,0,0,1,0"),
+                "clpt: error: --lookat 0,5,0,0,0,0,0,1,0: the up direction is parallel to the view direction (from the "
+                "eye to the point looked at)\n" HINT);
+    CHECK_USAGE(ARGS(SCENE, "--fov", "180"),
+                "clpt: error: --fov expects a vertical field of view in degrees, more than 0 and less than 180, got "
+                "'180'\n" HINT);
+    CHECK_USAGE(ARGS(SCENE, "--fov", "0"),
+                "clpt: error: --fov expects a vertical field of view in degrees, more than 0 and less than 180, got "
+                "'0'\n" HINT);
+    CHECK_USAGE(ARGS(SCENE, "--fov", "wide"),
+                "clpt: error: --fov expects a vertical field of view in degrees, more than 0 and less than 180, got "
+                "'wide'\n" HINT);
+    CHECK_USAGE(ARGS("scenes/classic/ortho.txt", "--device", "scalar", "--fov", "30"),
+                "clpt: error: --fov sets a perspective camera's field of view; the scene's camera is orthographic\n"
+                HINT);
+#undef LOOKAT_EXPECTS
+#undef SCENE
+}
+
+#define LOOKAT "1,2,4,0,0.5,0,0,1,0"
+#define TINY_RENDER "--device", "scalar", "--width", "32", "--height", "24", "--spp", "4", "-q"
+
+/* A clpt scene seen by `camera` (a camera block's keys). */
+static void clpt_scene(const char *path, const char *camera)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) return;
+    fprintf(f, "camera { %s }\n"
+               "background { horizon 1 1 1  zenith 0.5 0.7 1.0 }\n"
+               "material floor { type diffuse albedo 0.7 0.7 0.7 }\n"
+               "plane { point 0 0 0  normal 0 1 0  material floor }\n"
+               "sphere { center 0 0.5 0  radius 0.5  material { type diffuse albedo 0.8 0.2 0.2 } }\n", camera);
+    fclose(f);
+}
+
+/* --lookat and --fov are the scene's camera edited: the same bits as the scene file
+ * with that camera written in it. */
+static void test_lookat_and_fov_equal_editing_the_scene(void)
+{
+    clpt_scene(DIR "/cam-a.scene", "from 0 1 5  at 0 0.5 0  fov 40");
+    clpt_scene(DIR "/cam-b.scene", "from 1 2 4  at 0 0.5 0  up 0 1 0  fov 30");
+    cli_run(ARGS(DIR "/cam-a.scene", TINY_RENDER, "--lookat", LOOKAT, "--fov", "30", "-o", DIR "/cam-flags.pfm"), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS(DIR "/cam-b.scene", TINY_RENDER, "-o", DIR "/cam-edited.pfm"), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(DIR "/cam-flags.pfm", DIR "/cam-edited.pfm"));
+    /* the flags win over --set, as --spp does */
+    cli_run(ARGS(DIR "/cam-a.scene", TINY_RENDER, "--set", "camera.fov=60", "--fov", "30", "--lookat", LOOKAT, "-o",
+                 DIR "/cam-set.pfm"), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(DIR "/cam-set.pfm", DIR "/cam-edited.pfm"));
+}
+
+/* In the other formats the flags replace the file's camera whole: two files that differ
+ * only in their camera give the same bits under the same --lookat and --fov. */
+static void check_camera_replaced(const char *a, const char *b, const char *what)
+{
+    cli_run(ARGS(a, TINY_RENDER, "--lookat", LOOKAT, "--fov", "30", "-o", DIR "/replaced-a.pfm"), &r);
+    CHECK_MSG(r.status == 0, "%s: %s", what, r.err);
+    cli_run(ARGS(b, TINY_RENDER, "--lookat", LOOKAT, "--fov", "30", "-o", DIR "/replaced-b.pfm"), &r);
+    CHECK_MSG(r.status == 0, "%s: %s", what, r.err);
+    CHECK_MSG(files_equal(DIR "/replaced-a.pfm", DIR "/replaced-b.pfm"), "%s", what);
+    cli_run(ARGS(a, TINY_RENDER, "-o", DIR "/replaced-none.pfm"), &r);
+    CHECK_MSG(!files_equal(DIR "/replaced-a.pfm", DIR "/replaced-none.pfm"), "%s: the flags changed nothing", what);
+}
+
+/* A glTF file with one triangle and a camera at `camera_at` (a node translation). */
+static void gltf_scene(const char *path, const char *camera_at)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) return;
+    fprintf(f, "{\"asset\": {\"version\": \"2.0\"},\n"
+               " \"buffers\": [{\"byteLength\": 36, \"uri\": \"data:application/octet-stream;base64,"
+               "AACAvwAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAwD8AAAAA\"}],\n"
+               " \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}],\n"
+               " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\"}],\n"
+               " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}}]}],\n"
+               " \"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0.6, \"znear\": 0.1}}],\n"
+               " \"nodes\": [{\"mesh\": 0}, {\"camera\": 0, \"translation\": [%s]}],\n"
+               " \"scenes\": [{\"nodes\": [0, 1]}], \"scene\": 0}\n", camera_at);
+    fclose(f);
+}
+
+static void test_lookat_and_fov_in_every_format(void)
+{
+    pbrt_scene(DIR "/cam-a.pbrt", "0 1 4  0 0.5 0  0 1 0", "");
+    pbrt_scene(DIR "/cam-b.pbrt", "2 3 5  0 0 0  0 1 0", "");
+    check_camera_replaced(DIR "/cam-a.pbrt", DIR "/cam-b.pbrt", "pbrt");
+    gltf_scene(DIR "/cam-a.gltf", "0, 0.5, 3");
+    gltf_scene(DIR "/cam-b.gltf", "0.5, 1, 5");
+    check_camera_replaced(DIR "/cam-a.gltf", DIR "/cam-b.gltf", "glTF");
+    /* the course format: the same scene under another PerspectiveCamera */
+    write_text(DIR "/cam-a.txt", "PerspectiveCamera { center 0 1 5 direction 0 -0.1 -1 up 0 1 0 angle 35 }\n"
+                                 "Lights { numLights 1 DirectionalLight { direction -0.5 -1 -0.5 color 1 1 1 } }\n"
+                                 "Background { color 0.2 0.3 0.4 }\n"
+                                 "Materials { numMaterials 1 Material { diffuseColor 0.8 0.2 0.2 } }\n"
+                                 "Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0.5 0 radius 0.5 } }\n");
+    write_text(DIR "/cam-b.txt", "PerspectiveCamera { center 3 0 2 direction -1 0 0 up 0 1 0 angle 60 }\n"
+                                 "Lights { numLights 1 DirectionalLight { direction -0.5 -1 -0.5 color 1 1 1 } }\n"
+                                 "Background { color 0.2 0.3 0.4 }\n"
+                                 "Materials { numMaterials 1 Material { diffuseColor 0.8 0.2 0.2 } }\n"
+                                 "Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0.5 0 radius 0.5 } }\n");
+    check_camera_replaced(DIR "/cam-a.txt", DIR "/cam-b.txt", "classic");
+    /* a mesh shown alone gets a camera that frames it; the flags, and --set, replace it */
+    cli_run(ARGS("tests/data/good/square.obj", TINY_RENDER, "--lookat", LOOKAT, "--fov", "30", "-o",
+                 DIR "/mesh-flags.pfm"), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS("tests/data/good/square.obj", TINY_RENDER, "--set", "camera.from=1,2,4", "--set", "camera.at=0,0.5,0",
+                 "--set", "camera.up=0,1,0", "--set", "camera.fov=30", "-o", DIR "/mesh-set.pfm"), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(DIR "/mesh-flags.pfm", DIR "/mesh-set.pfm"));
+    cli_run(ARGS("tests/data/good/square.obj", TINY_RENDER, "-o", DIR "/mesh-framed.pfm"), &r);
+    CHECK(!files_equal(DIR "/mesh-flags.pfm", DIR "/mesh-framed.pfm"));
+}
+
 int main(void)
 {
     if (system("rm -rf " DIR " && mkdir -p " DIR) != 0) return 1;
@@ -214,6 +352,9 @@ int main(void)
     RUN(test_crop_pixels_are_the_whole_renders);
     RUN(test_crop_with_checkpoints_and_merge);
     RUN(test_pbrt_film_crop);
+    RUN(test_lookat_and_fov_errors);
+    RUN(test_lookat_and_fov_equal_editing_the_scene);
+    RUN(test_lookat_and_fov_in_every_format);
     if (system("rm -rf " DIR) != 0) return 1;
     return harness_report();
 }

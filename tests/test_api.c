@@ -135,7 +135,7 @@ static void test_errors(void)
     CHECK(clpt_scene_load(ctx, SCENE, &s) == CLPT_OK);
     CHECK(clpt_scene_set(s, "camera.fvo", "40") == CLPT_ERROR_USAGE);
     CHECK(strcmp(clpt_last_error(ctx), "unknown scene parameter 'camera.fvo': the camera has from, eye, at, "
-                                       "look_at, up, fov, aperture, focus (did you mean 'fov'?)") == 0);
+                                       "look_at, up, fov, aperture, focus, width (did you mean 'fov'?)") == 0);
     CHECK(clpt_scene_set(s, "material.rde.albedo", "1") == CLPT_ERROR_USAGE);
     CHECK(strcmp(clpt_last_error(ctx), "scene parameter 'material.rde.albedo': the scene has no material named "
                                        "'rde' (did you mean 'red'?)") == 0);

@@ -2,7 +2,8 @@
  * image is rendered (issue 44): --crop and --pixel-bounds, whose pixels must be the
  * whole render's bit for bit (on the scalar device and on OpenCL), with checkpoints,
  * resume and merge, and pbrt's Film crop; --lookat and --fov, the scene's camera
- * edited in every format; and their errors, with the exact messages. */
+ * edited in every format; the orthographic camera of clpt's format against its
+ * analytic image; and their errors, with the exact messages. */
 #include <stdint.h>
 
 #include "cli_util.h"
@@ -345,6 +346,100 @@ static void test_lookat_and_fov_in_every_format(void)
     CHECK(!files_equal(DIR "/mesh-flags.pfm", DIR "/mesh-framed.pfm"));
 }
 
+/* An orthographic scene of 64x32 pixels: a lamp of radiance 1, 1 wide and 0.5 tall,
+ * facing a camera `camera` (a camera block's keys) on black. */
+static void ortho_scene(const char *path, const char *camera)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) return;
+    fprintf(f, "image { width 64 height 32 spp 4 }\n"
+               "camera { %s }\n"
+               "background { color 0 0 0 }\n"
+               "material lamp { type emissive radiance 1 1 1 }\n"
+               "quad { v0 -0.5 -0.25 0  v1 0.5 -0.25 0  v2 0.5 0.25 0  v3 -0.5 0.25 0  material lamp }\n", camera);
+    fclose(f);
+}
+
+/* Whether the image at path is exactly 1 in columns [x0, x1) and rows [y0, y1), and
+ * exactly 0 elsewhere. */
+static int is_lit_rectangle(const char *path, unsigned x0, unsigned x1, unsigned y0, unsigned y1)
+{
+    Image a;
+    if (!pfm_read(path, &a)) return 0;
+    size_t wrong = 0;
+    for (unsigned y = 0; y < a.h; y++)
+        for (unsigned x = 0; x < a.w; x++)
+            for (int c = 0; c < 3; c++)
+                wrong += a.rgb[((size_t)y * a.w + x) * 3 + c] != (x >= x0 && x < x1 && y >= y0 && y < y1 ? 1.0f : 0.0f);
+    free(a.rgb);
+    if (wrong) fprintf(stderr, "    %s: %zu values are not the lit rectangle's\n", path, wrong);
+    return wrong == 0;
+}
+
+/* The analytic image: a view 2 wide over 64 columns is 32 pixels a unit, and 1 tall
+ * over 32 rows (the image's shape), so the lamp, 1 x 0.5 at the view's centre, covers
+ * columns 16..47 and rows 8..23 exactly, every sample of them. Parallel rays: the same
+ * bits from 10 times farther. On the scalar device and on OpenCL. */
+static void test_orthographic_camera(void)
+{
+    ortho_scene(DIR "/ortho.scene", "type orthographic  from 0 0 5  at 0 0 0  width 2");
+    ortho_scene(DIR "/ortho-far.scene", "type orthographic  from 0 0 50  at 0 0 0  width 2");
+    const char *devices[2] = { "scalar", TEST_OPENCL };
+    for (int d = 0; d < 2; d++) {
+        cli_run(ARGS(DIR "/ortho.scene", "--device", devices[d], "-q", "-o", DIR "/ortho.pfm"), &r);
+        CHECK_MSG(r.status == 0, "%s", r.err);
+        CHECK_MSG(is_lit_rectangle(DIR "/ortho.pfm", 16, 48, 8, 24), "on %s", devices[d]);
+    }
+    cli_run(ARGS(DIR "/ortho-far.scene", "--device", "scalar", "-q", "-o", DIR "/ortho-far.pfm"), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(DIR "/ortho.pfm", DIR "/ortho-far.pfm"));
+    /* --set camera.width: a view 4 wide draws the lamp 16 columns wide, 8 rows tall */
+    cli_run(ARGS(DIR "/ortho.scene", "--device", "scalar", "-q", "--set", "camera.width=4", "-o", DIR "/ortho4.pfm"),
+            &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(is_lit_rectangle(DIR "/ortho4.pfm", 24, 40, 12, 20));
+    /* --lookat moves it: a view centred 1 to the right shows the lamp 32 columns left */
+    cli_run(ARGS(DIR "/ortho.scene", "--device", "scalar", "-q", "--lookat", "1,0,5,1,0,0,0,1,0", "-o",
+                 DIR "/ortho-moved.pfm"), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(is_lit_rectangle(DIR "/ortho-moved.pfm", 0, 16, 8, 24));
+}
+
+/* The keys of one type of camera are refused on the other, in the file and by path. */
+static void test_orthographic_camera_errors(void)
+{
+    static const struct { const char *camera, *want; } bad[] = {
+        { "type orthographic  from 0 0 5  at 0 0 0",
+          ":2:1: an orthographic camera needs 'width', its view's width in scene units\n" },
+        { "type orthographic  from 0 0 5  at 0 0 0  width 2  fov 30",
+          ":2:60: 'fov' is for a perspective camera; an orthographic camera sees parallel rays across its 'width'\n" },
+        { "from 0 0 5  at 0 0 0  width 2", ":2:32: 'width' is the view's width of an orthographic camera (type "
+                                           "orthographic)\n" },
+        { "type fisheye  from 0 0 5  at 0 0 0", ":2:15: expected a camera type (perspective, orthographic) for "
+                                                "'type', found 'fisheye'\n" },
+        { "type orthographic  from 0 0 5  at 0 0 0  width 0", ":2:57: expected a width > 0 (scene units) for "
+                                                              "'width', found '0'\n" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        ortho_scene(DIR "/bad.scene", bad[i].camera);
+        cli_run(ARGS(DIR "/bad.scene", "--device", "scalar", "-q", "-o", DIR "/bad.pfm"), &r);
+        CHECK_EQ_INT(r.status, 3);
+        char want[512];
+        snprintf(want, sizeof want, "clpt: error: " DIR "/bad.scene%s", bad[i].want);
+        CHECK_MSG(strcmp(r.err, want) == 0, "stderr:\n%s\nwanted:\n%s", r.err, want);
+    }
+    ortho_scene(DIR "/ortho.scene", "type orthographic  from 0 0 5  at 0 0 0  width 2");
+    CHECK_USAGE(ARGS(DIR "/ortho.scene", "--set", "camera.fov=30"),
+                "clpt: error: scene parameter 'camera.fov': the camera is orthographic, with a view width "
+                "(camera.width) and no lens or field of view\n" HINT);
+    CHECK_USAGE(ARGS("scenes/cornell-box.scene", "--set", "camera.width=3"),
+                "clpt: error: scene parameter 'camera.width': the camera is perspective; camera.width is an "
+                "orthographic camera's view width\n" HINT);
+    CHECK_USAGE(ARGS(DIR "/ortho.scene", "--fov", "30"),
+                "clpt: error: --fov sets a perspective camera's field of view; the scene's camera is orthographic\n"
+                HINT);
+}
+
 int main(void)
 {
     if (system("rm -rf " DIR " && mkdir -p " DIR) != 0) return 1;
@@ -355,6 +450,8 @@ int main(void)
     RUN(test_lookat_and_fov_errors);
     RUN(test_lookat_and_fov_equal_editing_the_scene);
     RUN(test_lookat_and_fov_in_every_format);
+    RUN(test_orthographic_camera);
+    RUN(test_orthographic_camera_errors);
     if (system("rm -rf " DIR) != 0) return 1;
     return harness_report();
 }

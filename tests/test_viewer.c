@@ -44,6 +44,26 @@ static SceneCamera cornell_camera(void)
     return c;
 }
 
+/* An orthographic camera of clpt's format prints as one, and reads back the same. */
+static void test_print_orthographic(void)
+{
+    SceneCamera c = cornell_camera();
+    c.type = CAMERA_ORTHOGRAPHIC;
+    c.ortho_width = 555.5f;
+    char block[512];
+    FILE *f = fmemopen(block, sizeof block, "w");
+    CHECK_EQ_INT(view_camera_print(f, &c), 0);
+    fclose(f);
+    CHECK_STR_CONTAINS(block, "camera { type orthographic  from ");
+    Scene s;
+    scene_init(&s);
+    Error err = { 0 };
+    CHECK_EQ_INT(scene_load_bytes("printed.scene", block, strlen(block), SCENE_FORMAT_CLPT, &s, NULL, &err), ST_OK);
+    CHECK(s.camera.type == CAMERA_ORTHOGRAPHIC && s.camera.ortho_width == c.ortho_width);
+    CHECK_MSG(memcmp(&s.camera.from, &c.from, sizeof c.from) == 0, "from differs after the round trip");
+    scene_free(&s);
+}
+
 /* The printed block, pasted into a scene, gives back the very floats. */
 static void test_print_round_trip(void)
 {
@@ -513,6 +533,7 @@ static void test_session(void)
 int main(void)
 {
     RUN(test_print_round_trip);
+    RUN(test_print_orthographic);
     RUN(test_moves);
     RUN(test_no_display);
     RUN(test_driver_without_a_window);

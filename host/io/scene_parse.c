@@ -242,15 +242,41 @@ vec3 scene_cross_d(vec3 a, vec3 b, double *length)
 
 /* ------------------------------------------------------------------ statements */
 
-enum { CAM_FROM, CAM_AT, CAM_UP, CAM_FOV, CAM_APERTURE, CAM_FOCUS, CAM_N };
+enum { CAM_TYPE, CAM_FROM, CAM_AT, CAM_UP, CAM_FOV, CAM_APERTURE, CAM_FOCUS, CAM_WIDTH, CAM_N };
 static const KeySpec camera_keys[CAM_N] = {
+    [CAM_TYPE] = {"type", VK_WORD, 0, 0, 0, 0, 0, "a camera type (perspective, orthographic)"},
     [CAM_FROM] = {"from", VK_VEC3, 0, 0, 0, 0, 0, NULL},
     [CAM_AT] = {"at", VK_VEC3, 0, 0, 0, 0, 0, NULL},
     [CAM_UP] = {"up", VK_DIR, 0, 0, 0, 0, 0, NULL},
     [CAM_FOV] = {"fov", VK_NUMBER, 0, 0, 180, 1, 1, "a number of degrees in (0, 180)"},
     [CAM_APERTURE] = {"aperture", VK_NUMBER, 0, 0, INFINITY, 0, 1, "a number >= 0"},
     [CAM_FOCUS] = {"focus", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a distance > 0"},
+    [CAM_WIDTH] = {"width", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a width > 0 (scene units)"},
 };
+
+/* The camera's type, and the keys that belong to the other type refused (a perspective
+ * camera's fov, aperture and focus mean nothing to parallel rays; an orthographic view
+ * needs its width, which a perspective camera has no use for). */
+static Status camera_type(Parser *p, Lexer *lx, const Token *kw, const Value *v, SceneCamera *c)
+{
+    int ortho = v[CAM_TYPE].given && tok_is(&v[CAM_TYPE].word, "orthographic");
+    if (v[CAM_TYPE].given && !ortho && !tok_is(&v[CAM_TYPE].word, "perspective"))
+        return lex_expected(lx, &v[CAM_TYPE].word, "a camera type (perspective, orthographic) for 'type'", p->err);
+    if (!ortho && v[CAM_WIDTH].given)
+        return lex_error_at(lx, &v[CAM_WIDTH].key, p->err,
+                            "'width' is the view's width of an orthographic camera (type orthographic)");
+    static const int perspective_only[] = { CAM_FOV, CAM_APERTURE, CAM_FOCUS };
+    for (size_t i = 0; ortho && i < 3; i++)
+        if (v[perspective_only[i]].given)
+            return lex_error_at(lx, &v[perspective_only[i]].key, p->err, "'%s' is for a perspective camera; "
+                                "an orthographic camera sees parallel rays across its 'width'",
+                                camera_keys[perspective_only[i]].key);
+    if (ortho && !v[CAM_WIDTH].given)
+        return lex_error_at(lx, kw, p->err, "an orthographic camera needs 'width', its view's width in scene units");
+    c->type = ortho ? CAMERA_ORTHOGRAPHIC : CAMERA_PERSPECTIVE;
+    c->ortho_width = ortho ? v[CAM_WIDTH].f : 0.0f;
+    return ST_OK;
+}
 
 static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
 {
@@ -259,6 +285,7 @@ static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
     if (!st) st = scene_parse_block(p, lx, kw, 0, "camera", camera_keys, CAM_N, v);
     if (st) return st;
     SceneCamera *c = &p->s->camera;
+    if ((st = camera_type(p, lx, kw, v, c))) return st;
     if (v[CAM_FROM].given) c->from = v[CAM_FROM].v;
     if (v[CAM_AT].given) c->at = v[CAM_AT].v;
     if (v[CAM_UP].given) c->up = v[CAM_UP].v;
@@ -280,7 +307,7 @@ static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
         return lex_error_at(lx, v[CAM_UP].given ? &v[CAM_UP].key : view_tok, p->err,
                             "camera 'up' is parallel to the view direction (from 'from' to 'at')");
     double focus = camera_focus(c);
-    if (focus < camera_min_focus(c->from))
+    if (c->type == CAMERA_PERSPECTIVE && focus < camera_min_focus(c->from))
         return lex_error_at(lx, v[CAM_FOCUS].given ? &v[CAM_FOCUS].key : view_tok, p->err,
                             "the camera's focus distance (%s) %g is too short for single precision "
                             "with a lens at 'from' %g %g %g: at least %g",

@@ -62,9 +62,9 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
     double dist = sqrt(ddot(back, back));
     if (!(dist > 0.0) || !isfinite(dist))
         return error_set(err, ST_INPUT, "camera: 'from' and 'at' must be distinct finite points");
-    if (desc->type == CAMERA_ORTHOGRAPHIC && !(desc->ortho_height > 0.0f && isfinite(desc->ortho_height)))
-        return error_set(err, ST_INPUT, "camera: the orthographic view size must be > 0, got %g",
-                         (double)desc->ortho_height);
+    double ortho_h = desc->ortho_width > 0.0f ? (double)desc->ortho_width * height / width : desc->ortho_height;
+    if (desc->type == CAMERA_ORTHOGRAPHIC && !(ortho_h > 0.0 && isfinite(ortho_h)))
+        return error_set(err, ST_INPUT, "camera: the orthographic view size must be > 0, got %g", ortho_h);
     if (desc->type != CAMERA_ORTHOGRAPHIC && !(desc->vfov > 0.0f && desc->vfov < 180.0f))
         return error_set(err, ST_INPUT, "camera: fov must be between 0 and 180 degrees, got %g",
                          (double)desc->vfov);
@@ -81,8 +81,11 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
     if (desc->mirror_x) u = dscale(u, -1.0);
 
     if (desc->type == CAMERA_ORTHOGRAPHIC) {
-        /* the view rectangle through the camera centre, ortho_height tall */
-        double vp_h = desc->ortho_height, vp_w = vp_h * (double)width / (double)height;
+        /* the view rectangle through the camera centre: ortho_width wide when given
+         * (exactly: the width is not recomputed from the height), else ortho_height
+         * tall */
+        double vp_h = ortho_h, vp_w = desc->ortho_width > 0.0f ? (double)desc->ortho_width
+                                                               : vp_h * (double)width / (double)height;
         dvec3 horizontal = dscale(u, vp_w), vertical = dscale(v, vp_h);
         dvec3 corner = { from.x - horizontal.x / 2 + vertical.x / 2, from.y - horizontal.y / 2 + vertical.y / 2,
                          from.z - horizontal.z / 2 + vertical.z / 2 };

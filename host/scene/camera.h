@@ -5,7 +5,8 @@
 #include "scene/scene.h"
 
 /* Fails (ST_INPUT) for a degenerate description: from == at, up parallel to the view
- * direction, a field of view outside (0, 180), a non-positive focus distance. */
+ * direction, a field of view outside (0, 180), a non-positive focus distance or
+ * orthographic view size. */
 Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *out, Error *err);
 
 /* The shortest focus distance single precision renders from `from`: the kernels build

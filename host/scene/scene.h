@@ -21,6 +21,9 @@ typedef struct {
     float focus_dist;    /* distance to the plane in focus; <= 0 means |at - from| */
     uint type;           /* enum CameraType */
     float ortho_height;  /* orthographic: height of the view rectangle (world units) */
+    float ortho_width;   /* orthographic: > 0, the view rectangle's width instead (clpt's
+                          * format: it holds whatever --width and --height make the
+                          * image), its height following the image's shape */
     int course_basis;    /* perspective: span the image with normalize(view x up) and
                           * `up` as given (MIT 6.837 Fall 2019), not an orthonormal frame */
     int mirror_x;        /* the image's right is -(view x up): a left-handed camera frame,

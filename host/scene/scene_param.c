@@ -44,7 +44,22 @@ static const ParamSpec camera_params[] = {
     NUM("fov", SceneCamera, vfov, 0, 180, 1),
     NUM("aperture", SceneCamera, aperture, 0, INFINITY, 0),
     NUM("focus", SceneCamera, focus_dist, 0, INFINITY, 1),
+    NUM("width", SceneCamera, ortho_width, 0, INFINITY, 1),
 };
+
+/* A parameter of one type of camera is refused on the other, not silently ignored:
+ * fov, aperture and focus are a perspective camera's, width an orthographic one's. */
+static Status camera_param_check(const SceneCamera *c, const char *key, const char *name, Error *err)
+{
+    int ortho = c->type == CAMERA_ORTHOGRAPHIC;
+    if (ortho && (strcmp(name, "fov") == 0 || strcmp(name, "aperture") == 0 || strcmp(name, "focus") == 0))
+        return error_set(err, ST_USAGE, "scene parameter '%s': the camera is orthographic, with a view width "
+                         "(camera.width) and no lens or field of view", key);
+    if (!ortho && strcmp(name, "width") == 0)
+        return error_set(err, ST_USAGE, "scene parameter '%s': the camera is perspective; camera.width is an "
+                         "orthographic camera's view width", key);
+    return ST_OK;
+}
 
 static const ParamSpec image_params[] = {
     INT("width", SceneImage, width, 1, CLPT_MAX_IMAGE_SIDE),
@@ -277,8 +292,11 @@ Status scene_param_set(Scene *s, const char *key, const char *value, Error *err)
     const char *dot = strchr(key, '.');
     size_t len = dot ? (size_t)(dot - key) : strlen(key);
     const char *rest = dot ? dot + 1 : "";
-    if (len == 6 && strncmp(key, "camera", 6) == 0)
-        return set_simple(camera_params, COUNT(camera_params), &s->camera, "the camera", key, rest, value, err);
+    if (len == 6 && strncmp(key, "camera", 6) == 0) {
+        Status st = camera_param_check(&s->camera, key, rest, err);
+        return st ? st : set_simple(camera_params, COUNT(camera_params), &s->camera, "the camera", key, rest, value,
+                                    err);
+    }
     if (len == 5 && strncmp(key, "image", 5) == 0)
         return set_simple(image_params, COUNT(image_params), &s->image, "the image", key, rest, value, err);
     if (len == 10 && strncmp(key, "background", 10) == 0)

@@ -3,7 +3,8 @@
  * library's clpt_scene_set (docs/scene-format.md, "Parameters by path"):
  *
  *   camera.from|eye, camera.at|look_at, camera.up    three numbers "0,1,5"
- *   camera.fov, camera.aperture, camera.focus        one number
+ *   camera.fov, camera.aperture, camera.focus        one number (a perspective camera)
+ *   camera.width                                     one number (an orthographic one)
  *   image.width|height|spp|depth|seed|split          an integer
  *   background.color                                 a colour
  *   material.NAME.PARAM   albedo, emission, specular, eta, k, ... (colours: one number

@@ -85,13 +85,25 @@ void view_camera_aperture(SceneCamera *c, double factor, double first)
     c->aperture = (float)a;
 }
 
+/* An orthographic camera given by its view's width (clpt's format) prints as it is. */
+static void print_orthographic(FILE *f, const SceneCamera *c)
+{
+    fprintf(f, "camera { type orthographic  from %.9g %.9g %.9g  at %.9g %.9g %.9g  up %.9g %.9g %.9g  width %.9g }\n",
+            (double)c->from.x, (double)c->from.y, (double)c->from.z, (double)c->at.x, (double)c->at.y,
+            (double)c->at.z, (double)c->up.x, (double)c->up.y, (double)c->up.z, (double)c->ortho_width);
+}
+
 int view_camera_print(FILE *f, const SceneCamera *c)
 {
+    if (c->type == CAMERA_ORTHOGRAPHIC && c->ortho_width > 0.0f) {
+        print_orthographic(f, c);
+        return 0;
+    }
     int exact = c->type == CAMERA_PERSPECTIVE && !c->course_basis;
     if (!exact)
         fprintf(f, "# this scene's camera (%s) has no form in clpt's scene format; "
                    "the block below is a perspective camera at the same place\n",
-                c->type == CAMERA_ORTHOGRAPHIC ? "orthographic" : "the course's perspective basis");
+                c->type == CAMERA_ORTHOGRAPHIC ? "orthographic, sized by its height" : "the course's perspective basis");
     fprintf(f, "camera { from %.9g %.9g %.9g  at %.9g %.9g %.9g  up %.9g %.9g %.9g  fov %.9g",
             (double)c->from.x, (double)c->from.y, (double)c->from.z, (double)c->at.x, (double)c->at.y,
             (double)c->at.z, (double)c->up.x, (double)c->up.y, (double)c->up.z, (double)c->vfov);

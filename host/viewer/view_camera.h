@@ -37,7 +37,8 @@ void view_camera_aperture(SceneCamera *c, double factor, double first);
 /* Writes the camera as one scene-format line, `camera { from ... }`, and a newline.
  * Returns 0, or -1 when the description cannot be said in the scene format (the
  * course formats' orthographic and course-basis cameras): a comment line says so and
- * the block then gives the eye, the target and the field of view only. */
+ * the block then gives the eye, the target and the field of view only. An
+ * orthographic camera sized by its width (clpt's format) prints as such. */
 int view_camera_print(FILE *f, const SceneCamera *c);
 
 #endif /* CLPT_VIEW_CAMERA_H */

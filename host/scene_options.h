@@ -15,7 +15,8 @@ Status scene_options_before_load(const Options *o, Scene *s, Error *err);
 /* The overrides (--set, then --spp, --width ... --shadows) applied to the loaded scene and checked
  * against it: the size's limits, --sample-range within the samples, --adaptive with
  * the whitted integrator. A bare mesh (`bare_mesh`) gets the camera that frames it for
- * the final size. */
+ * the final size; then --set camera.*, --lookat and --fov change the camera, and
+ * --crop or --pixel-bounds the window rendered, checked against that size. */
 Status scene_options_apply(const Options *o, Scene *s, int bare_mesh, Error *err);
 
 #endif /* CLPT_SCENE_OPTIONS_H */

@@ -69,7 +69,7 @@ FUZZ_BIN  := $(FUZZ_SRC:fuzz/%.c=$(BUILD)/fuzz/%)
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: FORCE all lib deps install uninstall test render bench bench-peers xcheck clean test-asan test-valgrind fuzz fuzz-build
+.PHONY: FORCE all lib deps install uninstall deb test render bench bench-peers xcheck clean test-asan test-valgrind fuzz fuzz-build
 .DEFAULT_GOAL := all
 
 # The man page and the shell completions, written from the option list (docs/cli.md).
@@ -264,6 +264,12 @@ install: all $(BUILD)/$(PROG).pc
 	    $(INSTALL) -m 644 $$headers $(DESTDIR)$(INCLUDEDIR)/$(PROG)/; \
 	    $(INSTALL) -m 644 $(BUILD)/$(PROG).pc $(DESTDIR)$(PKGCONFIGDIR)/$(PROG).pc; \
 	fi
+
+# A Debian package (binary) of what `make install PREFIX=/usr` installs, built with
+# dpkg-deb, its Depends from dpkg-shlibdeps (dpkg-dev): tools/make_deb.sh.
+deb: all $(BUILD)/$(PROG).pc
+	@sh tools/deps.sh --check deb
+	@sh tools/make_deb.sh $(BUILD) $(VERSION)
 
 uninstall:
 	rm -f $(DESTDIR)$(BINDIR)/$(PROG) $(DESTDIR)$(MANDIR)/man1/$(PROG).1 $(DESTDIR)$(BASHCOMPDIR)/$(PROG) \

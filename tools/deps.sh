@@ -7,7 +7,7 @@
 #
 # Profiles: base (build and run clpt, run the tests), viewer-test (the viewer's test
 # under a virtual display; run.sh test and .ci/run install it), install-test (man and
-# zsh for the install test; likewise), sanitize (make test-asan),
+# zsh for the install test; likewise), deb (make deb), sanitize (make test-asan),
 # valgrind (make test-valgrind), fuzz (make fuzz), embree (the traversal benchmark),
 # peers (make bench-peers, make xcheck).
 # Missing packages are installed when run as root (apt-get); otherwise the exact
@@ -21,6 +21,8 @@ pkgs_for() {
         viewer-test) echo "xvfb xdotool" ;;
         # the install test (tests/test_install.c): man renders the page, zsh loads the completion
         install-test) echo "man-db zsh" ;;
+        # make deb: dpkg-deb (dpkg) and dpkg-shlibdeps (dpkg-dev)
+        deb) echo "dpkg dpkg-dev" ;;
         sanitize) echo "clang libclang-rt-14-dev" ;;
         valgrind) echo "valgrind" ;;
         fuzz) echo "clang libclang-rt-14-dev" ;;

@@ -17,5 +17,7 @@ esac
 # the test suite also runs the viewer under a virtual display (tests/test_viewer.c) and
 # checks the installed man page and zsh completion (tests/test_install.c)
 if [ "$what" = test ]; then sh tools/deps.sh base viewer-test install-test; else sh tools/deps.sh base; fi
+# --denoise's library (not a Debian package; optional: clpt works without it)
+sh tools/deps.sh oidn || echo "run.sh: going on without Open Image Denoise (--denoise will not work)" >&2
 jobs=$(getconf _NPROCESSORS_ONLN 2>/dev/null || echo 2)
 exec make -j"$jobs" "$what"

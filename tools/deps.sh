@@ -9,7 +9,8 @@
 # under a virtual display; run.sh test and .ci/run install it), install-test (man and
 # zsh for the install test; likewise), deb (make deb), sanitize (make test-asan),
 # valgrind (make test-valgrind), fuzz (make fuzz), embree (the traversal benchmark),
-# peers (make bench-peers, make xcheck).
+# peers (make bench-peers, make xcheck), oidn (Intel Open Image Denoise for --denoise:
+# no Debian package; tools/oidn_fetch.sh puts its official binaries into build/oidn).
 # Missing packages are installed when run as root (apt-get); otherwise the exact
 # command to run is printed and the script fails, so nothing half-works.
 set -eu
@@ -29,6 +30,8 @@ pkgs_for() {
         embree) echo "libembree-dev" ;;
         # make bench-peers and make xcheck: Cycles, and Mitsuba 3's LLVM variant (Mitsuba itself: pip)
         peers) echo "blender python3-numpy libllvm19" ;;
+        # not a package: fetched after the packages (fetch_oidn below)
+        oidn) echo "" ;;
         *) echo "deps.sh: unknown profile '$1'" >&2; exit 2 ;;
     esac
 }
@@ -37,11 +40,28 @@ check_only=0
 if [ "${1:-}" = "--check" ]; then check_only=1; shift; fi
 [ $# -gt 0 ] || set -- base
 wanted=""
-for profile in "$@"; do wanted="$wanted $(pkgs_for "$profile")"; done
+oidn=0
+for profile in "$@"; do
+    wanted="$wanted $(pkgs_for "$profile")"
+    [ "$profile" = oidn ] && oidn=1
+done
+
+# Open Image Denoise into build/oidn (tools/oidn_fetch.sh says why when it cannot). It is
+# optional: run.sh goes on without it, and --denoise then names this command.
+fetch_oidn() {
+    [ "$oidn" -eq 1 ] || return 0
+    if [ "$check_only" -eq 1 ]; then
+        [ -f "${BUILD:-build}/oidn/lib/libOpenImageDenoise.so.2" ] && return 0
+        echo "Open Image Denoise (for --denoise) is missing; fetch it with: sh tools/deps.sh oidn" >&2
+        return 1
+    fi
+    sh "$(dirname "$0")/oidn_fetch.sh"
+}
 
 if ! command -v dpkg-query >/dev/null 2>&1; then
     echo "deps.sh: this is not a Debian-based system; install the equivalents of:$wanted" >&2
-    exit 0
+    fetch_oidn
+    exit
 fi
 
 missing=""
@@ -50,7 +70,10 @@ for p in $wanted; do
         case " $missing " in *" $p "*) ;; *) missing="$missing $p" ;; esac
     fi
 done
-[ -z "$missing" ] && exit 0
+if [ -z "$missing" ]; then
+    fetch_oidn
+    exit
+fi
 
 if [ "$check_only" -eq 0 ] && [ "$(id -u)" -eq 0 ]; then
     echo "deps.sh: installing missing packages:$missing" >&2
@@ -58,6 +81,7 @@ if [ "$check_only" -eq 0 ] && [ "$(id -u)" -eq 0 ]; then
     apt-get update -qq >&2
     # shellcheck disable=SC2086
     apt-get install -y -qq --no-install-recommends $missing >&2
+    fetch_oidn
 else
     echo "clpt needs these Debian packages, which are missing:$missing" >&2
     echo "Install them with:" >&2

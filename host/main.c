@@ -535,6 +535,10 @@ static Status results_run_passes(Run *r, Error *err)
     film_resolve(&r->film, rgb);
     ScheduleConfig pcfg = r->cfg;
     pcfg.show_progress = 0;
+    /* a pass renders all its samples: those a resumed checkpoint held were the main
+     * image's, not the pass's (without this, --aov after --resume got only the rest) */
+    pcfg.done = NULL;
+    pcfg.n_done = 0;
     PassContext pc = { r->devs, r->n_devs, &r->rs, &pcfg };
     PassRequest q = pass_request(&r->o);
     Status st = passes_after_image(&q, &pc, r->output, &r->style, rgb, (uint)r->film.samples, err);

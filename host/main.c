@@ -21,6 +21,7 @@
 #include "dist/mpi_driver.h"
 #include "dist/mpi_job.h"
 #include "render/checkpoint.h"
+#include "render/denoise.h"
 #include "device/device.h"
 #include "device/ocl_program.h"
 #include "render/film.h"
@@ -175,7 +176,7 @@ static char *default_output(const char *scene_path)
 static PassRequest pass_request(const Options *o)
 {
     PassRequest q = { o->adaptive, o->adaptive_spp, o->aovs, { o->aov_files[0], o->aov_files[1], o->aov_files[2] },
-                      o->depth_near, o->depth_far, o->exr_float, o->quiet };
+                      o->depth_near, o->depth_far, o->exr_float, o->denoise, o->quiet };
     return q;
 }
 
@@ -191,6 +192,8 @@ typedef struct {
     Film film;
     Device **devs;
     size_t n_devs;
+    size_t n_local_devs;          /* devs[0..n_local_devs): this process's own, not MPI ranks */
+    Denoiser *denoiser;           /* --denoise: opened before the render */
     ScheduleConfig cfg;
     ScheduleStats stats;
     Status render_st;
@@ -205,6 +208,7 @@ static void run_free(Run *r)
     schedule_stats_free(&r->stats);
     for (size_t i = 0; i < r->n_devs; i++) device_close(r->devs[i]);
     free(r->devs);
+    denoiser_close(r->denoiser);
     film_free(&r->film);
     checkpoint_free(&r->resume);
     render_scene_free(&r->rs);
@@ -303,6 +307,13 @@ static Status outputs_from_scene(Run *r, Error *err)
     if (st) return st;
     r->output = r->scene.output_hint;
     return outputs_check(r, err);
+}
+
+/* --denoise: the library is loaded before anything slow, so that a machine without it
+ * says so in a second instead of after the render. */
+static Status denoise_prepare(Run *r, Error *err)
+{
+    return r->o.denoise ? denoiser_open(&r->denoiser, err) : ST_OK;
 }
 
 /* ------------------------------------------------------------------ scene */
@@ -443,6 +454,7 @@ static void render_run(Run *r, Dist *dist, Error *err)
 {
     install_signal_handlers(dist->active ? STOP_SAY_MPI : STOP_SAY);
     render_configure(r);
+    r->n_local_devs = r->n_devs;
     if (dist->active) {
         /* the other ranks join the render as devices of this one */
         dist->spp = r->scene.image.spp;
@@ -539,7 +551,8 @@ static Status results_run_passes(Run *r, Error *err)
      * image's, not the pass's (without this, --aov after --resume got only the rest) */
     pcfg.done = NULL;
     pcfg.n_done = 0;
-    PassContext pc = { r->devs, r->n_devs, &r->rs, &pcfg };
+    /* the passes' parameters reach only this process's devices (not MPI ranks') */
+    PassContext pc = { r->devs, r->n_local_devs, &r->rs, &pcfg, r->denoiser };
     PassRequest q = pass_request(&r->o);
     Status st = passes_after_image(&q, &pc, r->output, &r->style, rgb, (uint)r->film.samples, err);
     free(rgb);
@@ -560,7 +573,7 @@ static Status results_write(Run *r, Error *err)
     st = keep_first(st, err, image_st, &next);
     if (image_st != ST_OK) return st;   /* the summary's "-> OUTPUT" would be untrue */
     results_print_summary(r);
-    if (st == ST_OK && (r->o.adaptive > 0.0 || r->o.aovs)) st = results_run_passes(r, err);
+    if (st == ST_OK && (r->o.adaptive > 0.0 || r->o.aovs || r->o.denoise)) st = results_run_passes(r, err);
     return st;
 }
 
@@ -581,6 +594,7 @@ static Status rank_prepare(void *vr, int worker, int receive, Error *err)
     Status st = ST_OK;
     if (!worker) st = outputs_choose(r, err);
     if (st == ST_OK && !worker) st = outputs_check(r, err);
+    if (st == ST_OK && !worker) st = denoise_prepare(r, err);
     if (st == ST_OK && !receive) st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
     if (st == ST_OK && !worker) st = outputs_from_scene(r, err);
     if (st == ST_OK && !receive) st = scene_apply_options(r, err);
@@ -666,6 +680,7 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
     if (r.o.interactive) return run_interactive(&r, err);
     st = outputs_choose(&r, err);
     if (st == ST_OK) st = outputs_check(&r, err);
+    if (st == ST_OK) st = denoise_prepare(&r, err);
     if (st == ST_OK) st = load_scene_input(&r.o, &r.scene, &r.bare_mesh, err);
     if (st == ST_OK) st = outputs_from_scene(&r, err);
     if (st == ST_OK) st = scene_apply_options(&r, err);

@@ -31,6 +31,7 @@ typedef struct {
     int stats;                    /* STATS_NONE, _TEXT or _JSON */
     int interactive;              /* --interactive: the viewer (docs/viewer.md) */
     int exr_float;                /* EXR channels as 32-bit floats, not halves */
+    int denoise;                  /* --denoise: Open Image Denoise on the finished image */
     /* developer flags */
     const char *kernel_dir;
     unsigned batch;               /* fixed batch size, 0 = adaptive */

@@ -111,6 +111,14 @@
         "(-32..32; default 0). Not for float outputs") \
     X(OUTPUT, SWITCH, exr_float, "--exr-float", NULL, NULL, NONE, \
         "EXR channels as 32-bit floats (default: half)") \
+    X(OUTPUT, SWITCH, denoise, "--denoise", NULL, NULL, NONE, \
+        "denoise the finished image with Intel Open\n" \
+        "Image Denoise (its RT filter, with albedo and\n" \
+        "normal images rendered at the image's spp);\n" \
+        "an .exr output also keeps the noisy colour\n" \
+        "(noisy.R/G/B) and the features as channels.\n" \
+        "Needs OIDN: sh tools/deps.sh oidn\n" \
+        "(docs/denoise.md)") \
     X(OUTPUT, CUSTOM, aovs, "--aov", NULL, "LIST", PARSE(parse_aovs), \
         "also write auxiliary images of the first hit,\n" \
         "comma-separated: normal (as colours), depth\n" \
@@ -309,7 +317,9 @@ static const char *const help_sections[HELP_SECTIONS] = {
 "                             renders are refused (exit status 3); parts of\n"
 "                             a render whose --spp grew are one render. Also\n"
 "                             --checkpoint FILE, --gamma srgb|none, -q,\n"
-"                             --view and --exposure as a render's\n"
+"                             --view and --exposure as a render's, and\n"
+"                             --denoise (the colour alone: a part holds no\n"
+"                             albedo or normal image)\n"
 "\n"
 "MPI (mpirun -np N clpt SCENE ..., or srun; docs/distributed.md):\n"
 "                             one image from N processes, each on its own\n"
@@ -326,6 +336,9 @@ static const char *const help_sections[HELP_SECTIONS] = {
 "Environment:\n"
 "  CLPT_CACHE_DIR             where compiled kernels are cached (default:\n"
 "                             $XDG_CACHE_HOME/clpt or ~/.cache/clpt)\n"
+"  CLPT_OIDN_DIR              the only folder --denoise loads Open Image\n"
+"                             Denoise from (default: oidn/lib beside the\n"
+"                             program, else the system's library path)\n"
 "\n"
 "Exit status (docs/exit-codes.md):\n"
 "  0  success                 4  I/O error (a file could not be read or\n"

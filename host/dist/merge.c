@@ -10,6 +10,7 @@
 #include "base/atomic_file.h"
 #include "base/file_id.h"
 #include "io/image_write.h"
+#include "render/denoise.h"
 #include "scene/scene.h"
 
 /* One sample range and the part it came from, for the overlap and gap checks. */
@@ -110,6 +111,7 @@ typedef struct {
     const char *output, *checkpoint;
     int linear, quiet;
     ViewLook look;                /* --view, --exposure, as a render's */
+    int denoise;                  /* --denoise: the colour alone (the parts hold no features) */
     const char **parts;
     size_t n_parts;
 } MergeOptions;
@@ -157,6 +159,8 @@ static Status merge_parse(int argc, char **argv, MergeOptions *m, Error *err)
             if (st) return st;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             m->quiet = 1;
+        } else if (!strcmp(a, "--denoise")) {
+            m->denoise = 1;
         } else if (a[0] == '-' && a[1]) {
             return error_set(err, ST_USAGE, "merge: unknown option '%s' (usage: clpt merge -o OUT PART...)", a);
         } else {
@@ -193,8 +197,31 @@ static Status merge_check_outputs(const MergeOptions *m, Error *err)
     return ST_OK;
 }
 
+/* --denoise: the merged image through Open Image Denoise, colour alone (a checkpoint
+ * holds the film, not the albedo and normal images a render with --denoise makes), to
+ * the output; an EXR keeps the noisy colour as noisy.R/G/B. */
+static Status merge_write_denoised(const MergeOptions *m, Denoiser *dn, const Film *film, ImageFormat fmt,
+                                   const ImageStyle *style, Error *err)
+{
+    size_t n = (size_t)film->width * film->height * 3u;
+    float *noisy = malloc(n * sizeof *noisy), *rgb = malloc(n * sizeof *rgb);
+    Status st = noisy && rgb ? ST_OK : error_set(err, ST_INTERNAL, "out of memory");
+    if (st == ST_OK) {
+        film_resolve(film, noisy);
+        st = denoiser_run(dn, noisy, NULL, NULL, film->width, film->height, rgb, err);
+    }
+    ImageLayer layer = { { "noisy.R", "noisy.G", "noisy.B" }, noisy };
+    if (st == ST_OK && fmt == IMAGE_EXR) st = image_write_exr(m->output, rgb, &layer, 1, film->width, film->height, 0, err);
+    else if (st == ST_OK)
+        st = image_write_styled(m->output, rgb, film->width, film->height, style, err);
+    free(noisy);
+    free(rgb);
+    return st;
+}
+
 Status merge_command(int argc, char **argv, Error *err)
 {
+    Denoiser *dn = NULL;
     MergeOptions m;
     Checkpoint merged;
     memset(&merged, 0, sizeof merged);
@@ -206,14 +233,18 @@ Status merge_command(int argc, char **argv, Error *err)
     if (st == ST_OK) st = merge_check_outputs(&m, err);
     if (st == ST_OK) st = atomic_probe(m.output, "", err);
     if (st == ST_OK && m.checkpoint) st = atomic_probe(m.checkpoint, "checkpoint", err);
+    if (st == ST_OK && m.denoise) st = denoiser_open(&dn, err);
     if (st == ST_OK) st = merge_parts(m.parts, m.n_parts, &merged, err);
     if (st == ST_OK && m.checkpoint)
         st = checkpoint_write(m.checkpoint, &merged.id, &merged.film, merged.done, merged.n_done, err);
     ImageStyle style = { m.linear ? IMAGE_LINEAR : IMAGE_SRGB, m.look };
-    if (st == ST_OK) st = film_write(&merged.film, m.output, &style, err);
+    if (st == ST_OK && !dn) st = film_write(&merged.film, m.output, &style, err);
+    if (st == ST_OK && dn) st = merge_write_denoised(&m, dn, &merged.film, fmt, &style, err);
     if (st == ST_OK && !m.quiet)
-        fprintf(stderr, "clpt: merged %zu part%s: %ux%u, %llu spp -> %s\n", m.n_parts, m.n_parts == 1 ? "" : "s",
-                merged.film.width, merged.film.height, (unsigned long long)merged.film.samples, m.output);
+        fprintf(stderr, "clpt: merged %zu part%s: %ux%u, %llu spp%s -> %s\n", m.n_parts, m.n_parts == 1 ? "" : "s",
+                merged.film.width, merged.film.height, (unsigned long long)merged.film.samples,
+                dn ? ", denoised (colour alone)" : "", m.output);
+    denoiser_close(dn);
     checkpoint_free(&merged);
     free(m.parts);
     return st;

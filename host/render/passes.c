@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/timer.h"
+
 /* Gives every device the params block and pixel mask of pc->rs. */
 static Status update_devices(const PassContext *pc, Error *err)
 {
@@ -216,24 +218,105 @@ Status passes_aov_data(const PassContext *pc, unsigned aov, uint spp, float *rgb
     return st;
 }
 
-/* The EXR output again, with the auxiliary images as channels. */
+/* The EXR output again, with the auxiliary images (and, denoised, the noisy colour) as
+ * channels. */
 static Status passes__write_exr_layers(const PassRequest *q, const char *output, const float *rgb, float *const aov_rgb[3],
-                               uint w, uint h, Error *err)
+                               const float *noisy, uint w, uint h, Error *err)
 {
     static const char *const names[3][3] = { { "normal.X", "normal.Y", "normal.Z" }, { "Z", NULL, NULL },
                                              { "albedo.R", "albedo.G", "albedo.B" } };
-    ImageLayer layers[3];
+    static const char *const noisy_names[3] = { "noisy.R", "noisy.G", "noisy.B" };
+    ImageLayer layers[4];
     size_t n = 0;
     for (int a = 0; a < 3; a++) {
         if (!aov_rgb[a]) continue;
         memcpy(layers[n].names, names[a], sizeof names[a]);
         layers[n++].rgb = aov_rgb[a];
     }
+    if (noisy) {
+        memcpy(layers[n].names, noisy_names, sizeof noisy_names);
+        layers[n++].rgb = noisy;
+    }
     return n ? image_write_exr(output, rgb, layers, n, w, h, q->exr_float, err) : ST_OK;
 }
 
-/* The adaptive pass and the auxiliary images, after the main image is in rgb (and
- * written). A failure here is the run's failure; the main image stays written. */
+/* Whether the EXR output holds auxiliary image `aov` as channels: asked by --aov, or a
+ * feature the denoiser used (kept so that it can be run again elsewhere). */
+static int passes__aov_wanted_in_exr(const PassRequest *q, const char *output, unsigned aov)
+{
+    int feature = q->denoise && aov != INTEGRATOR_AOV_DEPTH;
+    return ((q->aovs & (1u << aov)) || feature) && passes_aov_in_exr(q, output, aov);
+}
+
+/* The denoiser's features, into aov[] (normal and albedo slots) as an EXR's channels
+ * hold them, where the EXR pass has not rendered them already. */
+static Status passes__features(const PassContext *pc, uint spp, float *aov[3], int quiet, Error *err)
+{
+    size_t n = (size_t)pc->rs->ds.params.width * pc->rs->ds.params.height * 3u;
+    Status st = ST_OK;
+    for (unsigned a = INTEGRATOR_AOV_NORMAL; a <= INTEGRATOR_AOV_ALBEDO && !st; a += 2) {
+        float **slot = &aov[a - INTEGRATOR_AOV_NORMAL];
+        if (*slot) continue;
+        double secs = 0.0;
+        if (!(*slot = malloc(n * sizeof **slot))) return error_set(err, ST_INTERNAL, "out of memory");
+        st = passes_aov_data(pc, a, spp, *slot, &secs, err);
+        if (!st && !quiet) fprintf(stderr, "clpt: %s image for the denoiser in %.2f s\n", passes_aov_name(a), secs);
+    }
+    return st;
+}
+
+/* Denoises rgb in place with the features in aov[]; *noisy keeps the colour as it was
+ * (freed by the caller). */
+static Status passes__denoise(const PassContext *pc, float *rgb, float *const aov[3], float **noisy, int quiet,
+                              Error *err)
+{
+    uint w = pc->rs->ds.params.width, h = pc->rs->ds.params.height;
+    size_t n = (size_t)w * h * 3u;
+    if (!(*noisy = malloc(n * sizeof **noisy))) return error_set(err, ST_INTERNAL, "out of memory");
+    memcpy(*noisy, rgb, n * sizeof *rgb);
+    double t0 = timer_now();
+    Status st = denoiser_run(pc->denoiser, *noisy, aov[INTEGRATOR_AOV_ALBEDO - INTEGRATOR_AOV_NORMAL],
+                             aov[0], w, h, rgb, err);
+    if (!st && !quiet)
+        fprintf(stderr, "clpt: denoised in %.2f s (Open Image Denoise, %s device, %s)\n", timer_now() - t0,
+                denoiser_device_kind(pc->denoiser), denoiser_library(pc->denoiser));
+    return st;
+}
+
+/* The features and the denoiser (q->denoise), and the channels of an EXR output: the
+ * image at `output` is rewritten when either changed it. */
+static Status passes__final_image(const PassRequest *q, const PassContext *pc, const char *output,
+                                  const ImageStyle *style, float *rgb, uint spp, Error *err)
+{
+    uint w = pc->rs->ds.params.width, h = pc->rs->ds.params.height;
+    float *in_exr[3] = { NULL, NULL, NULL }, *noisy = NULL;
+    Status st = ST_OK;
+    for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO && !st; aov++) {
+        if (!passes__aov_wanted_in_exr(q, output, aov)) continue;
+        float **slot = &in_exr[aov - INTEGRATOR_AOV_NORMAL];
+        double secs = 0.0;
+        if (!(*slot = malloc((size_t)w * h * 3u * sizeof **slot))) st = error_set(err, ST_INTERNAL, "out of memory");
+        if (!st) st = passes_aov_data(pc, aov, spp, *slot, &secs, err);
+        if (!st && !q->quiet) fprintf(stderr, "clpt: %s image in %.2f s\n", passes_aov_name(aov), secs);
+    }
+    if (!st && q->denoise) st = passes__features(pc, spp, in_exr, q->quiet, err);
+    if (!st && q->denoise) st = passes__denoise(pc, rgb, in_exr, &noisy, q->quiet, err);
+    int exr = passes_aov_in_exr(q, output, INTEGRATOR_AOV_NORMAL) || passes_aov_in_exr(q, output, INTEGRATOR_AOV_ALBEDO);
+    if (!st && exr) st = passes__write_exr_layers(q, output, rgb, in_exr, noisy, w, h, err);
+    else if (!st && q->denoise) st = image_write_styled(output, rgb, w, h, style, err);
+    if (!st && !q->quiet && exr && (in_exr[0] || in_exr[1] || in_exr[2]))
+        fprintf(stderr, "clpt: %sauxiliary images as channels -> %s\n", noisy ? "denoised image, noisy colour and " : "",
+                output);
+    else if (!st && !q->quiet && q->denoise)
+        fprintf(stderr, "clpt: denoised image -> %s\n", output);
+    for (int a = 0; a < 3; a++) free(in_exr[a]);
+    free(noisy);
+    return st;
+}
+
+/* The adaptive pass, the denoiser and the auxiliary images, after the main image is in
+ * rgb (and written). A failure here is the run's failure; the main image stays
+ * written. */
 Status passes_after_image(const PassRequest *q, const PassContext *pc, const char *output, const ImageStyle *style,
                          float *rgb, uint spp, Error *err)
 {
@@ -249,19 +332,7 @@ Status passes_after_image(const PassRequest *q, const PassContext *pc, const cha
             fprintf(stderr, "clpt: adaptive pass: %zu of %u pixels (%.1f%%) got %u more samples in %.2f s -> %s\n",
                     marked, w * h, 100.0 * (double)marked / ((double)w * h), q->adaptive_spp, secs, output);
     }
-    float *in_exr[3] = { NULL, NULL, NULL };
-    for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO && !st; aov++) {
-        if (!(q->aovs & (1u << aov)) || !passes_aov_in_exr(q, output, aov)) continue;
-        float **slot = &in_exr[aov - INTEGRATOR_AOV_NORMAL];
-        double secs = 0.0;
-        if (!(*slot = malloc((size_t)w * h * 3u * sizeof **slot))) st = error_set(err, ST_INTERNAL, "out of memory");
-        if (!st) st = passes_aov_data(pc, aov, spp, *slot, &secs, err);
-        if (!st && !q->quiet) fprintf(stderr, "clpt: %s image in %.2f s\n", passes_aov_name(aov), secs);
-    }
-    if (!st) st = passes__write_exr_layers(q, output, rgb, in_exr, w, h, err);
-    if (!st && !q->quiet && (in_exr[0] || in_exr[1] || in_exr[2]))
-        fprintf(stderr, "clpt: auxiliary images as channels -> %s\n", output);
-    for (int a = 0; a < 3; a++) free(in_exr[a]);
+    st = passes__final_image(q, pc, output, style, rgb, spp, err);
     if (st) return st;
     for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
         if (!(q->aovs & (1u << aov)) || passes_aov_in_exr(q, output, aov)) continue;

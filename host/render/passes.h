@@ -11,6 +11,7 @@
 #ifndef CLPT_PASSES_H
 #define CLPT_PASSES_H
 
+#include "render/denoise.h"
 #include "render/film.h"
 #include "render/render_scene.h"
 #include "render/schedule.h"
@@ -20,6 +21,7 @@ typedef struct {
     size_t n_devices;
     RenderScene *rs;                 /* its params are changed during a pass, restored after */
     const ScheduleConfig *cfg;       /* progress, stop flag, warnings of the main render */
+    Denoiser *denoiser;              /* opened before the render when --denoise asks; else NULL */
 } PassContext;
 
 /* Marks (mask[i] = 1) every pixel whose colour, clamped to [0,1], differs from one of its
@@ -79,6 +81,7 @@ typedef struct {
     const char *aov_files[3];     /* normal, depth, albedo image names; NULL: OUTPUT-normal.png etc. */
     double depth_near, depth_far; /* near == far: automatic depth grey */
     int exr_float;                /* EXR channels as 32-bit floats */
+    int denoise;                  /* --denoise: the written image is the denoised one */
     int quiet;
 } PassRequest;
 
@@ -88,9 +91,12 @@ char *passes_aov_output_path(const PassRequest *q, const char *output, unsigned 
 /* Whether auxiliary image `aov` goes into the EXR output as channels: the output is an
  * .exr and the course command line gave the image no file of its own. */
 int passes_aov_in_exr(const PassRequest *q, const char *output, unsigned aov);
-/* The adaptive pass and the auxiliary images, after the main image is in rgb (and
- * written to `output`): each image to its file, or as channels of an EXR output. A
- * failure here is the run's failure; the main image stays written. */
+/* The adaptive pass, the denoiser and the auxiliary images, after the main image is in
+ * rgb (and written to `output`): each image to its file, or as channels of an EXR
+ * output. With q->denoise the albedo and normal images are rendered (as an EXR's
+ * channels hold them), rgb is denoised with them and rewritten to `output`; an EXR
+ * output then also holds them and the noisy colour (noisy.R/G/B). A failure here is
+ * the run's failure; the main image stays written. */
 Status passes_after_image(const PassRequest *q, const PassContext *pc, const char *output, const ImageStyle *style,
                           float *rgb, uint spp, Error *err);
 

@@ -1,0 +1,204 @@
+/*
+ * test_denoise.c — --denoise (Open Image Denoise, render/denoise.h): without the library
+ * the exact message, before anything is rendered; with it (build/oidn, from `sh
+ * tools/deps.sh oidn`), a 16-spp Cornell box comes out finite and much nearer a
+ * converged reference (RMSE and SSIM), also after a resume and from `clpt merge`, and
+ * an EXR output keeps the noisy colour and the features as channels.
+ */
+#include "harness.h"
+
+#include "cli_util.h"
+#include "image_metrics.h"
+#include "render/denoise.h"
+
+#define SCENE "scenes/cornell-box.scene"
+#define SIZE "96"
+
+static char dir[] = "/tmp/clpt-denoise-XXXXXX";
+static char path_buf[8][512];
+static int have_oidn;
+
+/* A file in the test's folder (one of a few static buffers, by slot). */
+static const char *tmp_path(int slot, const char *name)
+{
+    snprintf(path_buf[slot], sizeof path_buf[slot], "%s/%s", dir, name);
+    return path_buf[slot];
+}
+
+/* clpt SCENE at SIZE x SIZE with spp samples, then the extra arguments; 0 on success. */
+static int render(const char *spp, const char *out, const char *a, const char *b, const char *c, const char *d)
+{
+    const char *args[] = { SCENE, "-q", "--width", SIZE, "--height", SIZE, "--spp", spp, "-o", out, a, b, c, d, NULL };
+    CliResult r;
+    cli_run(args, &r);
+    if (r.status != 0) fprintf(stderr, "  clpt -o %s failed (%d): %s\n", out, r.status, r.err);
+    return r.status;
+}
+
+static float *reference;
+static unsigned char away[96 * 96];   /* 1: away from the lamp (metrics_emitter_mask) */
+
+/* A PFM image's error against the reference: RMSE over the whole image and away from
+ * the lamp, and SSIM; all -1 when it is unreadable or not finite. */
+typedef struct {
+    double rmse, rmse_away, ssim;
+} ImageError;
+
+static ImageError error_of(const char *path)
+{
+    unsigned w = 0, h = 0;
+    float *img = metrics_read_pfm(path, &w, &h);
+    ImageError e = { -1.0, -1.0, -1.0 };
+    if (img && w == 96 && h == 96 && metrics_all_finite(img, (size_t)w * h)) {
+        e.rmse = metrics_rmse(img, reference, (size_t)w * h);
+        e.rmse_away = metrics_rmse_masked(img, reference, away, (size_t)w * h);
+        e.ssim = metrics_ssim(img, reference, w, h);
+    }
+    free(img);
+    return e;
+}
+
+static const char expected_missing[] =
+    "clpt: error: --denoise needs Intel Open Image Denoise 2 (libOpenImageDenoise.so.2), which is not in '%s' "
+    "(named by CLPT_OIDN_DIR); fetch it with: sh tools/deps.sh oidn (./run.sh does too)\n";
+
+/* An empty folder as the only place to look: the message, exit status 5, at once (no
+ * image written), from a render and from merge alike. */
+static void test_missing_library_message(void)
+{
+    const char *empty = tmp_path(0, "empty");
+    CHECK(mkdir(empty, 0700) == 0);
+    setenv(DENOISE_DIR_ENV, empty, 1);
+    char want[1024];
+    snprintf(want, sizeof want, expected_missing, empty);
+    const char *out = tmp_path(1, "never.png");
+    const char *args[] = { SCENE, "--denoise", "-o", out, NULL };
+    CliResult r;
+    cli_run(args, &r);
+    CHECK(r.status == 5);
+    CHECK_MSG(strcmp(r.err, want) == 0, "got: %s", r.err);
+    CHECK(!file_exists(out));
+    const char *margs[] = { "merge", "--denoise", "-o", out, "no-such-part.ckpt", NULL };
+    cli_run(margs, &r);
+    CHECK(r.status == 5);
+    CHECK_MSG(strcmp(r.err, want) == 0, "got: %s", r.err);
+    Denoiser *d = (Denoiser *)1;
+    Error err = { 0 };
+    CHECK(denoiser_open(&d, &err) == ST_DEVICE);
+    CHECK(d == NULL);
+    error_clear(&err);
+    unsetenv(DENOISE_DIR_ENV);
+    rmdir(empty);
+}
+
+/* The converged image the others are measured against (1024 spp), and the pixels
+ * away from its lamp (6 pixels from any brighter than 2). */
+static int make_reference(void)
+{
+    const char *ref = tmp_path(2, "ref.pfm");
+    unsigned w = 0, h = 0;
+    if (render("1024", ref, NULL, NULL, NULL, NULL) != 0) return 0;
+    reference = metrics_read_pfm(ref, &w, &h);
+    if (!reference || w != 96 || h != 96) return 0;
+    metrics_emitter_mask(reference, w, h, 2.0f, 6, away);
+    return 1;
+}
+
+static void print_error(const char *what, ImageError e)
+{
+    fprintf(stderr, "  %-34s RMSE %.5f (away from the lamp %.5f), SSIM %.4f\n", what, e.rmse, e.rmse_away, e.ssim);
+}
+
+/* 16 spp denoised against 16 spp as rendered: away from the lamp the error falls to
+ * under half; over the whole image the structure (SSIM) rises; every value is finite. */
+static void test_denoise_lowers_error(void)
+{
+    const char *noisy = tmp_path(3, "noisy.pfm"), *den = tmp_path(4, "denoised.pfm");
+    CHECK(render("16", noisy, NULL, NULL, NULL, NULL) == 0);
+    CHECK(render("16", den, "--denoise", NULL, NULL, NULL) == 0);
+    ImageError n = error_of(noisy), d = error_of(den);
+    print_error("16 spp:", n);
+    print_error("16 spp denoised:", d);
+    CHECK(n.rmse > 0.0 && d.rmse > 0.0);
+    CHECK_MSG(d.rmse_away < 0.5 * n.rmse_away, "denoised RMSE %g, noisy %g", d.rmse_away, n.rmse_away);
+    CHECK_MSG(d.ssim > n.ssim + 0.03, "denoised SSIM %g, noisy %g", d.ssim, n.ssim);
+}
+
+/* A render stopped after 8 of 16 samples and resumed is denoised once it is complete:
+ * the same image as a straight denoised render (the same film, the same features). */
+static void test_denoise_after_resume(void)
+{
+    const char *ck = tmp_path(5, "part.ckpt"), *part = tmp_path(6, "part.pfm"), *resumed = tmp_path(7, "resumed.pfm");
+    CHECK(render("16", part, "--sample-range", "0:8", "--checkpoint", ck) == 0);
+    CHECK(render("16", resumed, "--denoise", "--resume", ck, NULL) == 0);
+    CHECK(error_of(resumed).rmse > 0.0);
+    CHECK_MSG(files_equal(resumed, tmp_path(4, "denoised.pfm")), "resumed and straight denoised images differ");
+}
+
+/* Two parts merged with --denoise (the colour alone): finite, and nearer the reference
+ * than the merged image as rendered. */
+static void test_merge_denoise(void)
+{
+    const char *a = tmp_path(0, "a.ckpt"), *b = tmp_path(1, "b.ckpt"), *pa = tmp_path(5, "a.pfm");
+    const char *merged = tmp_path(6, "merged.pfm");
+    CHECK(render("16", pa, "--sample-range", "0:8", "--checkpoint", a) == 0);
+    CHECK(render("16", pa, "--sample-range", "8:16", "--checkpoint", b) == 0);
+    const char *args[] = { "merge", "-q", "--denoise", "-o", merged, a, b, NULL };
+    CliResult r;
+    cli_run(args, &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    ImageError m = error_of(merged), n = error_of(tmp_path(3, "noisy.pfm"));
+    print_error("merged 16 spp denoised, colour alone:", m);
+    CHECK(m.rmse > 0.0);
+    CHECK_MSG(m.rmse_away < 0.75 * n.rmse_away, "merged denoised RMSE %g, noisy %g", m.rmse_away, n.rmse_away);
+    CHECK_MSG(m.ssim > n.ssim, "merged denoised SSIM %g, noisy %g", m.ssim, n.ssim);
+}
+
+/* Whether the file holds the bytes of `s` (an EXR header's channel names are plain). */
+static int file_has(const char *path, const char *s)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    static char buf[1 << 16];
+    size_t n = fread(buf, 1, sizeof buf, f), k = strlen(s);
+    fclose(f);
+    for (size_t i = 0; i + k <= n; i++)
+        if (!memcmp(buf + i, s, k)) return 1;
+    return 0;
+}
+
+static void test_exr_keeps_noisy_and_features(void)
+{
+    const char *exr = tmp_path(7, "denoised.exr");
+    CHECK(render("4", exr, "--denoise", NULL, NULL, NULL) == 0);
+    static const char *const names[] = { "noisy.R", "noisy.B", "albedo.G", "normal.X", "normal.Z" };
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++) CHECK_MSG(file_has(exr, names[i]), "%s", names[i]);
+}
+
+int main(void)
+{
+    if (!mkdtemp(dir)) return 1;
+    RUN(test_missing_library_message);
+    Denoiser *d = NULL;
+    Error err = { 0 };
+    have_oidn = denoiser_open(&d, &err) == ST_OK;
+    if (!have_oidn) {
+        printf("     (skipped the denoising tests: %s)\n", err.msg);
+    } else if (!make_reference()) {
+        fprintf(stderr, "  the reference image could not be rendered\n");
+        harness_failed++;
+    } else {
+        printf("     (Open Image Denoise from %s, %s device)\n", denoiser_library(d), denoiser_device_kind(d));
+        RUN(test_denoise_lowers_error);
+        RUN(test_denoise_after_resume);
+        RUN(test_merge_denoise);
+        RUN(test_exr_keeps_noisy_and_features);
+    }
+    error_clear(&err);
+    denoiser_close(d);
+    free(reference);
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd) != 0) fprintf(stderr, "  could not remove %s\n", dir);
+    return harness_report();
+}

@@ -22,6 +22,7 @@
 #include "dist/mpi_job.h"
 #include "render/checkpoint.h"
 #include "render/denoise.h"
+#include "render/display.h"
 #include "device/device.h"
 #include "device/ocl_program.h"
 #include "render/film.h"
@@ -97,6 +98,9 @@ typedef struct {
     const char *checkpoint;       /* NULL: none */
     CheckpointId checkpoint_id;
     int checkpoint_failed;
+    double progressive_seconds;   /* 0: no progressive output */
+    double last_progressive;      /* when the output was last rewritten */
+    Display *display;             /* --display-server; NULL: none, or the connection was lost */
 } RenderContext;
 
 /* On a terminal the progress bar may be on the line: the warning first clears it. In
@@ -128,17 +132,53 @@ static Status keep_first(Status st, Error *err, Status next, Error *next_err)
     return next;
 }
 
-/* Progressive output: rewrites the image during the render (atomically, so a viewer
- * never sees half a file). A failure is reported once and does not stop the render. */
+/* The live display (--display-server) gets rgb; a lost connection is said once, and
+ * the display is dropped (the render goes on). */
+static void display_send(RenderContext *ctx, const float *rgb)
+{
+    Error err = { 0 };
+    if (ctx->display && display_update(ctx->display, rgb, &err) != ST_OK) {
+        print_warning(NULL, err.msg);
+        display_close(ctx->display);
+        ctx->display = NULL;
+    }
+    error_clear(&err);
+}
+
+/* The film as it is now, to the live display. */
+static void display_send_film(RenderContext *ctx, const Film *film)
+{
+    if (!ctx->display) return;
+    float *rgb = malloc((size_t)film->width * film->height * 3u * sizeof *rgb);
+    if (!rgb) return;   /* the next tick tries again */
+    film_resolve(film, rgb);
+    display_send(ctx, rgb);
+    free(rgb);
+}
+
+/* The periodic tick: progressive output rewrites the image (atomically, so a viewer
+ * never sees half a file) every progressive_seconds, a failure reported once and not
+ * stopping the render; the live display gets the image every tick. */
 static void on_progress_tick(void *vctx, const ScheduleSnapshot *snap)
 {
     RenderContext *ctx = vctx;
+    display_send_film(ctx, snap->film);
+    double now = timer_now();
+    /* ticks come at the progressive interval or sooner; the 0.1% slack keeps a tick that
+     * arrives a hair early at the same interval from being skipped */
+    if (ctx->progressive_seconds <= 0.0 || now - ctx->last_progressive < ctx->progressive_seconds * 0.999) return;
+    ctx->last_progressive = now;
     Error err = { 0 };
     if (film_write(snap->film, ctx->output, &ctx->style, &err) != ST_OK && !ctx->progressive_failed) {
         ctx->progressive_failed = 1;
         print_warning(NULL, err.msg);
     }
     error_clear(&err);
+}
+
+static void on_denoised(void *vctx, const float *rgb)
+{
+    display_send(vctx, rgb);
 }
 
 /* Periodic checkpoints; a failure is reported once (the next one may succeed) and does
@@ -209,6 +249,7 @@ static void run_free(Run *r)
     for (size_t i = 0; i < r->n_devs; i++) device_close(r->devs[i]);
     free(r->devs);
     denoiser_close(r->denoiser);
+    display_close(r->ctx.display);
     film_free(&r->film);
     checkpoint_free(&r->resume);
     render_scene_free(&r->rs);
@@ -314,6 +355,19 @@ static Status outputs_from_scene(Run *r, Error *err)
 static Status denoise_prepare(Run *r, Error *err)
 {
     return r->o.denoise ? denoiser_open(&r->denoiser, err) : ST_OK;
+}
+
+/* --display-server: connected once the image's size is known, before the render. A
+ * server that cannot be reached is a warning: the render is what was asked for. */
+static void display_prepare(Run *r)
+{
+    if (!r->o.display_server) return;
+    const char *base = strrchr(r->output, '/');
+    Error err = { 0 };
+    if (display_open(r->o.display_server, base ? base + 1 : r->output, r->film.width, r->film.height,
+                     &r->ctx.display, &err) != ST_OK)
+        print_warning(NULL, err.msg);
+    error_clear(&err);
 }
 
 /* ------------------------------------------------------------------ scene */
@@ -442,8 +496,13 @@ static void render_configure(Run *r)
     cfg->fixed_batch = o->batch;
     cfg->show_progress = progress_should_enable(o->quiet);
     cfg->stop = &stop_requested;
-    cfg->on_tick = o->progressive_seconds > 0.0 ? on_progress_tick : NULL;
-    cfg->tick_seconds = o->progressive_seconds;
+    /* one tick serves both: the display's every second (or sooner, for progressive
+     * output more often), progressive output at its own interval */
+    r->ctx.progressive_seconds = o->progressive_seconds;
+    r->ctx.last_progressive = timer_now();
+    cfg->on_tick = o->progressive_seconds > 0.0 || r->ctx.display ? on_progress_tick : NULL;
+    cfg->tick_seconds = !r->ctx.display ? o->progressive_seconds
+                      : o->progressive_seconds > 0.0 && o->progressive_seconds < 1.0 ? o->progressive_seconds : 1.0;
     cfg->on_warning = print_warning;
     cfg->ctx = &r->ctx;
 }
@@ -552,7 +611,7 @@ static Status results_run_passes(Run *r, Error *err)
     pcfg.done = NULL;
     pcfg.n_done = 0;
     /* the passes' parameters reach only this process's devices (not MPI ranks') */
-    PassContext pc = { r->devs, r->n_local_devs, &r->rs, &pcfg, r->denoiser };
+    PassContext pc = { r->devs, r->n_local_devs, &r->rs, &pcfg, r->denoiser, on_denoised, &r->ctx };
     PassRequest q = pass_request(&r->o);
     Status st = passes_after_image(&q, &pc, r->output, &r->style, rgb, (uint)r->film.samples, err);
     free(rgb);
@@ -572,6 +631,7 @@ static Status results_write(Run *r, Error *err)
     Status image_st = film_write(&r->film, r->output, &r->style, &next);
     st = keep_first(st, err, image_st, &next);
     if (image_st != ST_OK) return st;   /* the summary's "-> OUTPUT" would be untrue */
+    display_send_film(&r->ctx, &r->film);
     results_print_summary(r);
     if (st == ST_OK && (r->o.adaptive > 0.0 || r->o.aovs || r->o.denoise)) st = results_run_passes(r, err);
     return st;
@@ -599,6 +659,7 @@ static Status rank_prepare(void *vr, int worker, int receive, Error *err)
     if (st == ST_OK && !worker) st = outputs_from_scene(r, err);
     if (st == ST_OK && !receive) st = scene_apply_options(r, err);
     if (st == ST_OK && !receive) st = render_prepare(r, worker, 1, err);
+    if (st == ST_OK && !worker) display_prepare(r);
     return st;
 }
 
@@ -685,6 +746,7 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
     if (st == ST_OK) st = outputs_from_scene(&r, err);
     if (st == ST_OK) st = scene_apply_options(&r, err);
     if (st == ST_OK) st = render_prepare(&r, 0, 0, err);
+    if (st == ST_OK) display_prepare(&r);
     if (st == ST_OK) st = open_devices(&r.o, &r.rs.ds, &r.devs, &r.n_devs, err);
     if (st == ST_OK) {
         render_run(&r, dist, err);

@@ -32,6 +32,7 @@ typedef struct {
     int interactive;              /* --interactive: the viewer (docs/viewer.md) */
     int exr_float;                /* EXR channels as 32-bit floats, not halves */
     int denoise;                  /* --denoise: Open Image Denoise on the finished image */
+    const char *display_server;   /* --display-server HOST:PORT (tev); NULL: none */
     /* developer flags */
     const char *kernel_dir;
     unsigned batch;               /* fixed batch size, 0 = adaptive */

@@ -12,6 +12,7 @@
 #include "io/image_write.h"
 #include "io/scene_load.h"
 #include "io/view_transform.h"
+#include "render/display.h"
 #include "render/passes.h"
 #include "scene/crop.h"
 #include "base/limit.h"
@@ -119,6 +120,12 @@
         "(noisy.R/G/B) and the features as channels.\n" \
         "Needs OIDN: sh tools/deps.sh oidn\n" \
         "(docs/denoise.md)") \
+    X(OUTPUT, CUSTOM, display_server, "--display-server", NULL, "HOST:PORT", PARSE(parse_display_server), \
+        "show the image in the tev viewer listening at\n" \
+        "HOST:PORT as it converges (once a second, and\n" \
+        "the final image); a server that cannot be\n" \
+        "reached or goes away is a warning, and the\n" \
+        "render goes on (docs/display-server.md)") \
     X(OUTPUT, CUSTOM, aovs, "--aov", NULL, "LIST", PARSE(parse_aovs), \
         "also write auxiliary images of the first hit,\n" \
         "comma-separated: normal (as colours), depth\n" \
@@ -401,6 +408,14 @@ static Status parse_aovs(const char *list, Options *o, Error *err)
         p = end ? end + 1 : NULL;
     } while (p);
     return ST_OK;
+}
+
+/* --display-server HOST:PORT, checked now; connected once the scene is read */
+static Status parse_display_server(const char *v, Options *o, Error *err)
+{
+    Status st = display_check_address(v, err);
+    if (st == ST_OK) o->display_server = v;
+    return st;
 }
 
 /* --depth-range NEAR,FAR */

@@ -33,6 +33,7 @@ static void test_every_listed_flag_is_documented_and_parsed(void)
         { "--exposure", "-1.5" },
         { "--set", "camera.fov=30" }, { "--crop", "0,0.5,0,1" }, { "--pixel-bounds", "0,8,0,8" },
         { "--lookat", "0,0,5,0,0,0,0,1,0" }, { "--fov", "30" },
+        { "--display-server", "localhost:14158" },
     };
     cli_run(ARGS("--help"), &r);
     CHECK_EQ_INT(r.status, 0);

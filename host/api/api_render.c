@@ -172,7 +172,7 @@ static Status render_passes(ApiRun *r, clpt_image *img, Error *err)
     uint spp = (uint)r->film.samples;
     ScheduleConfig pcfg = r->cfg;
     pcfg.on_checkpoint = NULL;
-    PassContext pc = { r->devs, r->n_devs, &r->rs, &pcfg, NULL };   /* the API does not denoise (yet) */
+    PassContext pc = { r->devs, r->n_devs, &r->rs, &pcfg, NULL, NULL, NULL };   /* the API does not denoise (yet) */
     size_t n = (size_t)r->film.width * r->film.height;
     Status st = ST_OK;
     if (r->o.adaptive > 0.0) {

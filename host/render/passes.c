@@ -309,6 +309,7 @@ static Status passes__final_image(const PassRequest *q, const PassContext *pc, c
                 output);
     else if (!st && !q->quiet && q->denoise)
         fprintf(stderr, "clpt: denoised image -> %s\n", output);
+    if (!st && noisy && pc->on_denoised) pc->on_denoised(pc->on_denoised_ctx, rgb);
     for (int a = 0; a < 3; a++) free(in_exr[a]);
     free(noisy);
     return st;

@@ -22,6 +22,9 @@ typedef struct {
     RenderScene *rs;                 /* its params are changed during a pass, restored after */
     const ScheduleConfig *cfg;       /* progress, stop flag, warnings of the main render */
     Denoiser *denoiser;              /* opened before the render when --denoise asks; else NULL */
+    /* Called with the denoised image once it is written (the live display); NULL: none */
+    void (*on_denoised)(void *ctx, const float *rgb);
+    void *on_denoised_ctx;
 } PassContext;
 
 /* Marks (mask[i] = 1) every pixel whose colour, clamped to [0,1], differs from one of its

@@ -6,7 +6,8 @@
 #   ./run.sh test     install what is missing, build, run the test suite
 #
 # Packages are installed when run as root; otherwise the exact apt-get command is
-# printed and nothing else happens (see tools/deps.sh).
+# printed and nothing else happens (see tools/deps.sh). Open Image Denoise (--denoise)
+# is fetched into build/oidn too, when it can be: nothing else needs it.
 set -eu
 cd "$(dirname "$0")"
 what=${1:-render}

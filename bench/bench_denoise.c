@@ -7,9 +7,10 @@
  * RMSE over the image, RMSE away from the emitters seen directly (a denoiser spreads a
  * lamp's edge; tests/image_metrics.h), and SSIM. The question asked: does 16 spp
  * denoised reach the error of 256 spp as rendered? Last, the denoiser alone on a
- * 1920x1080 image (median of 3).
+ * 1920x1080 image, wall and CPU time, colour alone and with prefiltered features.
  *
- * Usage: bench_denoise [BUILD]   (BUILD: the folder holding clpt; default build).
+ * Usage: bench_denoise [BUILD]   (BUILD: the folder holding clpt; default build)
+ *        bench_denoise --full-hd (the 1920x1080 timing alone)
  * Needs Open Image Denoise (sh tools/deps.sh oidn); scenes that read ../shared are
  * skipped, said, when it is missing. Minutes long on two cores.
  */
@@ -21,6 +22,7 @@
 #include <unistd.h>
 
 #include "../tests/image_metrics.h"
+#include "bench_util.h"
 #include "base/timer.h"
 #include "render/denoise.h"
 
@@ -97,14 +99,19 @@ static void bench_scene(const BenchScene *s)
     free(r.away);
 }
 
-static int cmp_double(const void *a, const void *b)
+/* One denoise of the 1920x1080 image, with the features (prefiltered: three RT
+ * filters) or the colour alone (one): wall and CPU seconds (OIDN's threads included,
+ * which other jobs on the machine do not change). */
+static void full_hd_once(Denoiser *d, float *c, const float *a, const float *nr, int features, Error *err)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
+    double t0 = timer_now(), c0 = bench_cpu_now();
+    if (denoiser_run(d, c, features ? a : NULL, features ? nr : NULL, 1920, 1080, c, err) != ST_OK) return;
+    printf("1920x1080, %s: %.2f s wall, %.2f CPU-s\n",
+           features ? "albedo and normal prefiltered (three RT filters)" : "colour alone (one RT filter)",
+           timer_now() - t0, bench_cpu_now() - c0);
 }
 
-/* The denoiser alone (features included, cleanAux) on a 1920x1080 image: its time does
- * not depend on the content. */
+/* The denoiser alone on a 1920x1080 image: its time does not depend on the content. */
 static void bench_full_hd(void)
 {
     const unsigned w = 1920, h = 1080;
@@ -119,18 +126,12 @@ static void bench_full_hd(void)
             a[i] = 0.5f;
             nr[i] = i % 3 == 2 ? 1.0f : 0.0f;
         }
-        double t[3];
-        for (int k = 0; k < 3; k++) {
-            double t0 = timer_now();
-            if (denoiser_run(d, c, a, nr, w, h, c, &err) != ST_OK) break;
-            t[k] = timer_now() - t0;
-        }
-        qsort(t, 3, sizeof *t, cmp_double);
-        printf("\n1920x1080, albedo and normal prefiltered (three RT filters): median %.2f s of 3 (%.2f-%.2f), "
-               "OIDN %s device, %s\n", t[1], t[0], t[2], denoiser_device_kind(d), denoiser_library(d));
-    } else {
-        printf("\n1920x1080: not measured: %s\n", err.msg[0] ? err.msg : "out of memory");
+        printf("\nOIDN %s device, %s\n", denoiser_device_kind(d), denoiser_library(d));
+        full_hd_once(d, c, a, nr, 0, &err);   /* the first also warms OIDN up */
+        full_hd_once(d, c, a, nr, 1, &err);
+        full_hd_once(d, c, a, nr, 0, &err);
     }
+    if (err.msg[0] || !d) printf("\n1920x1080: not measured: %s\n", err.msg[0] ? err.msg : "out of memory");
     error_clear(&err);
     denoiser_close(d);
     free(c);
@@ -140,6 +141,12 @@ static void bench_full_hd(void)
 
 int main(int argc, char **argv)
 {
+    int full_hd_only = argc > 1 && !strcmp(argv[1], "--full-hd");
+    bench_print_load("at the start");
+    if (full_hd_only) {
+        bench_full_hd();
+        return 0;
+    }
     if (argc > 1) build = argv[1];
     if (!mkdtemp(tmpdir)) return 1;
     printf("Reference: %s spp. Time: the whole clpt run (with --denoise: features and denoiser too).\n"

@@ -172,6 +172,10 @@ static Status render_passes(ApiRun *r, clpt_image *img, Error *err)
     uint spp = (uint)r->film.samples;
     ScheduleConfig pcfg = r->cfg;
     pcfg.on_checkpoint = NULL;
+    /* a pass renders all its samples: those a resumed checkpoint held were the main
+     * image's, not the pass's (as results_run_passes in main.c) */
+    pcfg.done = NULL;
+    pcfg.n_done = 0;
     PassContext pc = { r->devs, r->n_devs, &r->rs, &pcfg, NULL, NULL, NULL };   /* the API does not denoise (yet) */
     size_t n = (size_t)r->film.width * r->film.height;
     Status st = ST_OK;

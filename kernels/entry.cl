@@ -109,7 +109,9 @@ __kernel KERNEL_SIZE void k_shade(SCENE_ARGS __global const uint *queue, uint n,
     if (i < n && i < counts[(slot - 1u) * QUEUE_COUNT_STRIDE]) {
         SCENE_VIEW(sc);
         path = queue[i];
-        r = shade_path(&sc, &rays[path], hits[path], &paths[path], &shadow_rays[path]);
+        /* a skipped pixel's camera ray was traced (k_raygen has no mask) but ends here */
+        if (!path_pixel_skipped(&sc, paths[path].pixel))
+            r = shade_path(&sc, &rays[path], hits[path], &paths[path], &shadow_rays[path]);
     }
     uint slot_next = 0u, slot_shadow = 0u;
     if (r & SHADE_CONTINUE) slot_next = atomic_inc(&group_count[0]);
@@ -210,6 +212,7 @@ KFN_CALL_CL uint path_run_lanes(const SceneView *sc, uint first, uint first_pixe
         if (i >= n_paths) continue;
         uint p = first_pixel + i;
         raygen_path(sc->params, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i]);
+        if (path_pixel_skipped(sc, p % n_pixels)) continue;
         first_ray[l] = rays[i];
         live |= 1u << l;
     }

@@ -561,10 +561,12 @@ typedef struct {                                        /* 320 bytes */
     uint mis_mode;                    /* enum MisMode */
     uint n_area_lights;               /* lights[0 .. n_area_lights) are area lights */
     uint n_textures;
-    uint use_mask;                    /* whitted: render only pixels with pixel_mask != 0 */
+    uint use_mask;                    /* render only pixels with pixel_mask != 0 (whitted's
+                                       * adaptive pass; the path tracer's noise threshold) */
     uint strata;                      /* whitted pixel samples: 0 the pixel centre, 1
                                        * uniform jitter, m >= 2 an m x m jittered grid */
-    uint sample_offset;               /* added to the sample index (adaptive passes) */
+    uint sample_offset;               /* whitted: added to the sample index (adaptive
+                                       * pass); path: with sample_step, see below */
     uint shadows;                     /* 0: lights are never occluded (no shadow rays,
                                        * as the course ray casters; --shadows off) */
     uint normal_miss_grey;            /* the normal image's misses: (0 + 1) / 2 grey (the
@@ -575,13 +577,16 @@ typedef struct {                                        /* 320 bytes */
                                        * next-event estimation), or NO_INDEX */
     uint split;                       /* path: continuations per camera sample from its
                                        * first hit (>= 1; shade_path.h, first-hit splitting) */
+    uint sample_step;                 /* path, when > 1: a batch's sample s is the pixel's
+                                       * sample s * step + sample_offset (the noise
+                                       * threshold renders its even and odd halves so) */
     /* A crop (--crop, --pixel-bounds, pbrt's cropwindow): the film is the width x height
      * window of a larger image, which leaves crop_left columns out on its left,
      * crop_right on its right, crop_top rows above and crop_bottom below. Samples are
      * numbered and placed by the whole image's pixel (params_image_pixel), so the
      * window's pixels are the whole render's, bit for bit. All 0: no crop. */
-    uint crop_left, crop_top, crop_right;
-    uint crop_bottom, pad_crop0, pad_crop1, pad_crop2;
+    uint crop_left, crop_top;
+    uint crop_right, crop_bottom, pad_crop0, pad_crop1;
 } RenderParams;
 
 /* One path of the wavefront; lives in a device buffer between kernel launches. */
@@ -642,7 +647,7 @@ _Static_assert(offsetof(RenderParams, strata) == 256, "RenderParams.strata");
 _Static_assert(offsetof(RenderParams, shadows) == 264, "RenderParams.shadows");
 _Static_assert(offsetof(RenderParams, normal_miss_grey) == 268, "RenderParams.normal_miss_grey");
 _Static_assert(offsetof(RenderParams, bg_light) == 284, "RenderParams.bg_light");
-_Static_assert(offsetof(RenderParams, crop_left) == 292, "RenderParams.crop_left");
+_Static_assert(offsetof(RenderParams, crop_left) == 296, "RenderParams.crop_left");
 _Static_assert(offsetof(Material, reflective) == 64, "Material.reflective");
 _Static_assert(offsetof(Light, cos_inner) == 60, "Light.cos_inner");
 _Static_assert(offsetof(Texture, m) == 32, "Texture.m");

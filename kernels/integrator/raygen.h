@@ -61,6 +61,9 @@ KFN Ray camera_ray(GLOBAL const RenderParams *p, float s, float t, RngKey key)
 KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
                      GLOBAL PathState *ps, GLOBAL Ray *ray)
 {
+    /* the noise threshold's halves: sample s of the batch is the pixel's sample
+     * step s + offset (host/render/adaptive.c); no step leaves the index as it is */
+    if (p->sample_step > 1u) sample = sample * p->sample_step + p->sample_offset;
     uint x, y;
     RngKey key = rng_key_make(p, params_image_pixel(p, pixel, &x, &y), sample);
     float jx, jy;

@@ -15,6 +15,14 @@
 #include "geom/surface.h"
 #include "material/texture.h"
 
+/* Whether the pixel mask leaves `pixel` out of this batch: the noise threshold's pixels
+ * that have converged (host/render/adaptive.c). Its path is born (raygen_path: no
+ * radiance) but traces and shades nothing. */
+KFN int path_pixel_skipped(const SceneView *sc, uint pixel)
+{
+    return sc->params->use_mask != 0u && sc->pixel_mask[pixel] == 0u;
+}
+
 /* Power heuristic (beta = 2) weight of a strategy with density a against one with b. */
 KFN float mis_power(float a, float b)
 {

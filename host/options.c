@@ -13,6 +13,7 @@
 #include "io/scene_load.h"
 #include "io/view_transform.h"
 #include "render/display.h"
+#include "render/adaptive.h"
 #include "render/passes.h"
 #include "scene/crop.h"
 #include "base/limit.h"
@@ -83,6 +84,14 @@
         "continuation weighted 1/N, sharing the camera ray\n" \
         "(1..64; overrides the scene's image split; 1: none,\n" \
         "the default)") \
+    X(OUTPUT, CUSTOM, noise_threshold, "--noise-threshold", NULL, "T", PARSE(parse_noise_threshold), \
+        "path tracer: adaptive sampling; a pixel stops once\n" \
+        "its estimated error is below T (0..1; 0.01 clean,\n" \
+        "0.1 quick; docs/adaptive.md), --spp is the most\n" \
+        "any pixel gets") \
+    X(OUTPUT, UINT, min_spp, "--min-spp", NULL, "N", RANGE(2, CLPT_MAX_SPP), \
+        "samples of every pixel before --noise-threshold\n" \
+        "stops any (default 16)") \
     X(OUTPUT, CHOICE, sampler, "--sampler", NULL, NULL, \
         ONE_OF({ "sobol", SAMPLER_SOBOL }, { "independent", SAMPLER_INDEPENDENT }), \
         "random numbers: Owen-scrambled Sobol points\n" \
@@ -584,6 +593,17 @@ static Status parse_adaptive(const char *v, Options *o, Error *err)
     if (!*v || *end || errno || starts_blank(v) || !(t > 0.0 && t <= 1.0))
         return error_set(err, ST_USAGE, "--adaptive expects a threshold in (0, 1], got '%s'", v);
     o->adaptive = t;
+    return ST_OK;
+}
+
+static Status parse_noise_threshold(const char *v, Options *o, Error *err)
+{
+    char *end;
+    errno = 0;
+    double t = strtod(v, &end);
+    if (!*v || *end || errno || starts_blank(v) || !(t > 0.0 && t <= 1.0))
+        return error_set(err, ST_USAGE, "--noise-threshold expects a threshold in (0, 1], got '%s'", v);
+    o->noise_threshold = t;
     return ST_OK;
 }
 

@@ -10,6 +10,7 @@
 #include "io/image_write.h"
 #include "io/scene_load.h"
 #include "io/view_transform.h"
+#include "render/adaptive.h"
 #include "render/passes.h"
 #include "scene/crop.h"
 #include "base/limit.h"
@@ -240,7 +241,7 @@ static Status options_check_interactive(const Options *o, Error *err)
     const char *flag = o->output ? "--output" : o->checkpoint_path ? (o->resume_path ? "--resume" : "--checkpoint")
                      : o->time_limit > 0.0 ? "--time-limit" : o->progressive_seconds > 0.0 ? "--progressive-output"
                      : o->aovs ? "--aov" : o->denoise ? "--denoise" : o->adaptive > 0.0 ? "--adaptive"
-                     : o->display_server ? "--display-server"
+                     : o->display_server ? "--display-server" : o->noise_threshold > 0.0 ? "--noise-threshold"
                      : o->range_end >= 0 ? "--sample-range" : o->stats == STATS_JSON ? "--stats=json"
                      : o->crop_kind == CROP_FRACTIONS ? "--crop" : o->crop_kind == CROP_PIXELS ? "--pixel-bounds"
                      : NULL;
@@ -277,6 +278,13 @@ Status options_finish(Options *o, Error *err)
         return error_set(err, ST_USAGE, "--adaptive-spp sets the samples of the adaptive pass, which --adaptive "
                          "THRESHOLD turns on; give both, or neither");
     if (!o->adaptive_spp) o->adaptive_spp = 16;
+    if (o->min_spp && !(o->noise_threshold > 0.0))
+        return error_set(err, ST_USAGE, "--min-spp sets the samples before --noise-threshold stops a pixel; give "
+                         "both, or neither");
+    if (!o->min_spp) o->min_spp = ADAPTIVE_DEFAULT_MIN_SPP;
+    if (o->range_end >= 0 && o->noise_threshold > 0.0)
+        return error_set(err, ST_USAGE, "--noise-threshold cannot be used with --sample-range (its decisions need "
+                         "the whole render)");
     if (o->depth_near != o->depth_far && !(o->aovs & (1u << INTEGRATOR_AOV_DEPTH)))
         return error_set(err, ST_USAGE, "--depth-range scales the depth image, which --aov depth turns on; "
                          "give both, or neither");

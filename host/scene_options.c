@@ -131,5 +131,8 @@ Status scene_options_apply(const Options *o, Scene *s, int bare_mesh, Error *err
                          o->range_first, o->range_end, s->image.spp);
     if (o->adaptive > 0.0 && s->integrator != INTEGRATOR_WHITTED)
         return error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
+    if (o->noise_threshold > 0.0 && s->integrator != INTEGRATOR_PATH)
+        return error_set(err, ST_USAGE, "--noise-threshold needs the path tracer (--integrator path); the whitted "
+                         "integrator has --adaptive");
     return ST_OK;
 }

@@ -236,6 +236,10 @@ clpt_status clpt_render(clpt_scene *sc, const clpt_settings *settings, clpt_imag
     r->user = user;
     scene_init(&r->scene);
     Status st = api_render_options(sc, settings, &r->o, err);
+    /* adaptive sampling's rounds are the program's alone so far (host/render/adaptive.c) */
+    if (st == ST_OK && r->o.noise_threshold > 0.0)
+        st = error_set(err, ST_USAGE, "noise_threshold (--noise-threshold) is not available in the library; render "
+                       "with the clpt program");
     if (st == ST_OK) st = api_scene_read(sc, &r->o, &r->scene, err);
     if (st == ST_OK) st = image_check(r, img, err);
     if (st == ST_OK) st = render_prepare(r, err);

@@ -85,6 +85,15 @@ static Status merge_note_ranges(const Checkpoint *c, size_t k, PartRange **r, si
     return ST_OK;
 }
 
+/* An adaptive render (--noise-threshold) is no part: its pixels stopped at counts that
+ * the whole film decided, so it is never split into sample ranges. */
+static Status merge_refuse_adaptive(const Checkpoint *c, const char *path, Error *err)
+{
+    if (!c->pixel_spp) return ST_OK;
+    return error_set(err, ST_INPUT, "cannot merge '%s': it is an adaptive render (--noise-threshold), whose pixels "
+                     "hold samples of their own counts; resume it with --resume instead", path);
+}
+
 Status merge_parts(const char *const *paths, size_t n, Checkpoint *out, Error *err)
 {
     memset(out, 0, sizeof *out);
@@ -92,10 +101,12 @@ Status merge_parts(const char *const *paths, size_t n, Checkpoint *out, Error *e
     PartRange *ranges = NULL;
     size_t n_ranges = 0, cap = 0;
     Status st = checkpoint_read(paths[0], out, err);
+    if (st == ST_OK) st = merge_refuse_adaptive(out, paths[0], err);
     if (st == ST_OK) st = merge_note_ranges(out, 0, &ranges, &n_ranges, &cap, err);
     for (size_t k = 1; k < n && st == ST_OK; k++) {
         Checkpoint c;
         st = checkpoint_read(paths[k], &c, err);
+        if (st == ST_OK) st = merge_refuse_adaptive(&c, paths[k], err);
         if (st == ST_OK) st = merge_add(out, &c, paths, k, err);
         if (st == ST_OK) st = merge_note_ranges(&c, k, &ranges, &n_ranges, &cap, err);
         checkpoint_free(&c);

@@ -20,6 +20,10 @@
 /* Version 2: the render key no longer covers the samples per pixel (a render can grow:
  * docs/checkpoint.md); the layout is version 1's. */
 #define CKPT_VERSION 2u
+/* Version 3: an adaptive render's (--noise-threshold): version 2's, its settings in the
+ * header and, after the film, the odd samples' sums and each pixel's sample count.
+ * Written only for those, so that version 2 readers still read every other render. */
+#define CKPT_VERSION_ADAPTIVE 3u
 #define CKPT_HEADER_SIZE 128u
 #define CKPT_TRAILER_SIZE SHA256_DIGEST_SIZE
 
@@ -77,8 +81,29 @@ static void out_put(CheckpointOut *o, const void *data, size_t n, int hashed)
     atomic_write(&o->af, data, n);
 }
 
-Status checkpoint_write(const char *path, const CheckpointId *id, const Film *film, const Batch *done,
-                        size_t n_done, Error *err)
+static void out_values(CheckpointOut *o, const int64_t *v, size_t n)
+{
+    unsigned char chunk[4096 * 8];
+    for (size_t i = 0; i < n && !o->af.failed_step;) {
+        size_t k = 0;
+        for (; k < 4096 && i < n; k++, i++) bytes_put_le64(chunk + 8 * k, (uint64_t)v[i]);
+        out_put(o, chunk, 8 * k, 1);
+    }
+}
+
+static void out_counts(CheckpointOut *o, const uint *v, size_t n)
+{
+    unsigned char chunk[4096 * 4];
+    for (size_t i = 0; i < n && !o->af.failed_step;) {
+        size_t k = 0;
+        for (; k < 4096 && i < n; k++, i++) bytes_put_le32(chunk + 4 * k, v[i]);
+        out_put(o, chunk, 4 * k, 1);
+    }
+}
+
+/* One checkpoint file; `af` (with `as`) adds an adaptive render's state. */
+static Status write_file(const char *path, const CheckpointId *id, const Film *film, const Batch *done,
+                         size_t n_done, const AdaptiveFilm *af, const AdaptiveSettings *as, Error *err)
 {
     CheckpointOut o;
     Status st = atomic_open(&o.af, path, "checkpoint", err);
@@ -86,11 +111,13 @@ Status checkpoint_write(const char *path, const CheckpointId *id, const Film *fi
     sha256_init(&o.hash);
 
     size_t n_values = (size_t)film->width * film->height * 3u;
+    size_t n_pixels = (size_t)film->width * film->height;
     uint64_t payload = (uint64_t)n_done * 8u + (uint64_t)n_values * 8u;
+    if (af) payload += (uint64_t)n_values * 8u + (uint64_t)n_pixels * 4u;
     unsigned char header[CKPT_HEADER_SIZE];
     memset(header, 0, sizeof header);
     memcpy(header, CKPT_MAGIC, 8);
-    bytes_put_le32(header + 8, CKPT_VERSION);
+    bytes_put_le32(header + 8, af ? CKPT_VERSION_ADAPTIVE : CKPT_VERSION);
     bytes_put_le32(header + 12, CKPT_HEADER_SIZE);
     memcpy(header + 16, id->key, CHECKPOINT_KEY_SIZE);
     bytes_put_le32(header + 48, id->width);
@@ -101,6 +128,12 @@ Status checkpoint_write(const char *path, const CheckpointId *id, const Film *fi
     bytes_put_le32(header + 68, (uint32_t)n_done);
     bytes_put_le64(header + 72, film->samples);
     bytes_put_le64(header + 80, payload);
+    if (af) {
+        uint64_t bits;
+        memcpy(&bits, &as->threshold, sizeof bits);
+        bytes_put_le64(header + 88, bits);
+        bytes_put_le32(header + 96, as->min_spp);
+    }
     out_put(&o, header, sizeof header, 1);
     for (size_t i = 0; i < n_done; i++) {
         unsigned char r[8];
@@ -108,16 +141,30 @@ Status checkpoint_write(const char *path, const CheckpointId *id, const Film *fi
         bytes_put_le32(r + 4, done[i].count);
         out_put(&o, r, sizeof r, 1);
     }
-    unsigned char chunk[4096 * 8];
-    for (size_t i = 0; i < n_values && !o.af.failed_step;) {
-        size_t k = 0;
-        for (; k < 4096 && i < n_values; k++, i++) bytes_put_le64(chunk + 8 * k, (uint64_t)film->sum[i]);
-        out_put(&o, chunk, 8 * k, 1);
+    out_values(&o, film->sum, n_values);
+    if (af) {
+        out_values(&o, af->odd, n_values);
+        out_counts(&o, af->spp, n_pixels);
     }
     unsigned char digest[SHA256_DIGEST_SIZE];
     sha256_final(&o.hash, digest);
     out_put(&o, digest, sizeof digest, 0);
     return atomic_commit(&o.af, err);
+}
+
+Status checkpoint_write(const char *path, const CheckpointId *id, const Film *film, const Batch *done,
+                        size_t n_done, Error *err)
+{
+    return write_file(path, id, film, done, n_done, NULL, NULL, err);
+}
+
+Status checkpoint_write_adaptive(const char *path, const CheckpointId *id, const AdaptiveFilm *af,
+                                 const AdaptiveSettings *s, Error *err)
+{
+    /* the pixels still rendering hold samples [0, film.samples); the others fewer,
+     * which their counts say */
+    Batch all = { 0, (uint)af->film.samples };
+    return write_file(path, id, &af->film, &all, all.count ? 1 : 0, af, s, err);
 }
 
 /* ------------------------------------------------------------------ reading */
@@ -126,6 +173,8 @@ void checkpoint_free(Checkpoint *c)
 {
     film_free(&c->film);
     free(c->done);
+    free(c->odd);
+    free(c->pixel_spp);
     memset(c, 0, sizeof *c);
 }
 
@@ -160,6 +209,33 @@ static Status read_film_values(const unsigned char *p, uint64_t n_values, uint64
         }
         sum[i] = (int64_t)v;
     }
+    return ST_OK;
+}
+
+/* An adaptive render's part (version 3): its settings from the header, then the odd
+ * sums (each between 0 and its pixel's whole sum) and the counts (none past the film's;
+ * the pixels at it hold samples [0, count), whose record must say so). */
+static Status read_adaptive(const unsigned char *header, const unsigned char *p, const char *path, Checkpoint *c,
+                            Error *err)
+{
+    uint64_t bits = bytes_get_le64(header + 88);
+    memcpy(&c->adaptive.threshold, &bits, sizeof bits);
+    c->adaptive.min_spp = bytes_get_le32(header + 96);
+    if (!(c->adaptive.threshold > 0.0 && c->adaptive.threshold <= 1.0) || c->adaptive.min_spp < 2u)
+        return bad(err, path, "inconsistent adaptive sampling settings");
+    if (c->n_done > 1 || (c->n_done == 1 && c->done[0].first != 0))
+        return bad(err, path, "inconsistent sample ranges");
+    size_t n_pixels = (size_t)c->film.width * c->film.height;
+    c->odd = malloc(n_pixels * 3u * sizeof *c->odd);
+    c->pixel_spp = malloc(n_pixels * sizeof *c->pixel_spp);
+    if (!c->odd || !c->pixel_spp) return error_set(err, ST_INTERNAL, "out of memory reading checkpoint '%s'", path);
+    for (size_t i = 0; i < n_pixels * 3u; i++, p += 8) {
+        uint64_t v = bytes_get_le64(p);
+        if (v > (uint64_t)c->film.sum[i]) return bad(err, path, "inconsistent odd-sample sums");
+        c->odd[i] = (int64_t)v;
+    }
+    for (size_t i = 0; i < n_pixels; i++, p += 4)
+        if ((c->pixel_spp[i] = bytes_get_le32(p)) > c->film.samples) return bad(err, path, "inconsistent pixel counts");
     return ST_OK;
 }
 
@@ -203,9 +279,10 @@ Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
         goto out;
     }
     uint32_t version = bytes_get_le32(data + 8);
-    if (version != CKPT_VERSION) {
+    if (version != CKPT_VERSION && version != CKPT_VERSION_ADAPTIVE) {
         char msg[128];
-        snprintf(msg, sizeof msg, "format version %u, this clpt reads version %u", version, CKPT_VERSION);
+        snprintf(msg, sizeof msg, "format version %u, this clpt reads versions %u and %u", version, CKPT_VERSION,
+                 CKPT_VERSION_ADAPTIVE);
         st = bad(err, path, msg);
         goto out;
     }
@@ -230,7 +307,9 @@ Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
     uint32_t n_done = bytes_get_le32(data + 68);
     uint64_t samples = bytes_get_le64(data + 72);
     uint64_t n_values = (uint64_t)id->width * id->height * 3u;
-    if (id->width == 0 || id->height == 0 || payload != (uint64_t)n_done * 8u + n_values * 8u) {
+    int adaptive = version == CKPT_VERSION_ADAPTIVE;
+    uint64_t extra = adaptive ? n_values * 8u + (n_values / 3u) * 4u : 0u;
+    if (id->width == 0 || id->height == 0 || payload != (uint64_t)n_done * 8u + n_values * 8u + extra) {
         st = bad(err, path, "inconsistent header (image size and payload disagree)");
         goto out;
     }
@@ -265,6 +344,7 @@ Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
     }
     c->film.samples = samples;
     if ((st = read_film_values(p, n_values, samples, path, c->film.sum, err))) goto out;
+    if (adaptive) st = read_adaptive(data, p + n_values * 8u, path, c, err);
 
 out:
     free(data);
@@ -301,5 +381,22 @@ Status checkpoint_check(const Checkpoint *c, const char *path, const CheckpointI
                          "checkpoint '%s' is a render of %u samples per pixel, this render asks for %u; a resume can "
                          "add samples, never take them away (resume with --spp %u or more)", path, c->id.spp, e->spp,
                          c->id.spp);
+    return ST_OK;
+}
+
+Status checkpoint_check_adaptive(const Checkpoint *c, const char *path, const AdaptiveSettings *s, Error *err)
+{
+    const AdaptiveSettings *had = c->pixel_spp ? &c->adaptive : NULL;
+    if (!had && !s) return ST_OK;
+    if (!had)
+        return error_set(err, ST_INPUT, "checkpoint '%s' is not an adaptive render (it was made without "
+                         "--noise-threshold); resume it without --noise-threshold, or start afresh", path);
+    if (!s)
+        return error_set(err, ST_INPUT, "checkpoint '%s' is an adaptive render (--noise-threshold %g --min-spp %u); "
+                         "resume it with those settings", path, had->threshold, had->min_spp);
+    if (had->threshold != s->threshold || had->min_spp != s->min_spp)
+        return error_set(err, ST_INPUT, "checkpoint '%s' is an adaptive render with --noise-threshold %g --min-spp "
+                         "%u, this render asks for --noise-threshold %g --min-spp %u; resume it with its settings",
+                         path, had->threshold, had->min_spp, s->threshold, s->min_spp);
     return ST_OK;
 }

@@ -20,6 +20,7 @@
 
 #include <stddef.h>
 
+#include "render/adaptive.h"
 #include "render/batch_queue.h"
 #include "device/device.h"
 #include "render/film.h"
@@ -39,6 +40,12 @@ typedef struct {
     Film film;            /* sums and samples per pixel */
     Batch *done;          /* the sample ranges in the film: sorted, disjoint */
     size_t n_done;
+    /* an adaptive render's (--noise-threshold; adaptive.h): the odd samples' sums and
+     * each pixel's count, and the settings that decided them; NULL/0 otherwise. The
+     * film then holds samples [0, film.samples) of the pixels still rendering. */
+    int64_t *odd;
+    uint *pixel_spp;
+    AdaptiveSettings adaptive;
 } Checkpoint;
 
 /* The identity of the render of `ds` with `spp` samples per pixel. */
@@ -48,6 +55,14 @@ void checkpoint_id(const DeviceScene *ds, uint spp, CheckpointId *id);
  * the failed step when it cannot be written. */
 Status checkpoint_write(const char *path, const CheckpointId *id, const Film *film, const Batch *done,
                         size_t n_done, Error *err);
+
+/* The same for an adaptive render's state (a format version of its own). */
+Status checkpoint_write_adaptive(const char *path, const CheckpointId *id, const AdaptiveFilm *af,
+                                 const AdaptiveSettings *s, Error *err);
+
+/* ST_INPUT unless `c` and this render agree on adaptive sampling: both without, or
+ * both with the same threshold and minimum (`s` NULL: this render has none). */
+Status checkpoint_check_adaptive(const Checkpoint *c, const char *path, const AdaptiveSettings *s, Error *err);
 
 /* Reads and validates a checkpoint: ST_IO when it cannot be read, ST_INPUT when it is not
  * a checkpoint, of an unknown version, truncated, corrupt (checksum) or inconsistent.

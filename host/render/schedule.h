@@ -86,6 +86,7 @@ typedef struct {
     double seconds;
     uint64_t samples, rays;          /* rendered in this run */
     uint spp_done;                   /* samples per pixel in the film (every pixel) */
+    int adaptive;                    /* adaptive.c's: spp_done is the most a pixel holds */
     int interrupted, time_up;
     unsigned checkpoints;            /* on_checkpoint calls */
     double snapshot_seconds;         /* copying the film under its lock, in total */

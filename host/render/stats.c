@@ -63,7 +63,11 @@ void render_stats_print_run(FILE *out, const ScheduleStats *st, uint spp, Device
            (unsigned long long)st->samples, st->seconds, "", (double)st->samples / secs / 1e6,
            (double)st->rays / secs / 1e6, 100.0);
     /* Batches cover the whole image, so every pixel holds the same samples. */
-    fprintf(out, "film: %u of %u samples per pixel, the same in every pixel; sample indices", st->spp_done, spp);
+    if (st->adaptive)
+        fprintf(out, "film: up to %u of %u samples per pixel, each pixel its own count (--noise-threshold); sample "
+                "indices", st->spp_done, spp);
+    else
+        fprintf(out, "film: %u of %u samples per pixel, the same in every pixel; sample indices", st->spp_done, spp);
     for (size_t i = 0; i < st->done.n && i < 8; i++)
         fprintf(out, " [%u,%u)", st->done.ranges[i].first, st->done.ranges[i].first + st->done.ranges[i].count);
     fprintf(out, "%s%s\n", st->done.n > 8 ? " ..." : "", st->done.n == 0 ? " none" : "");

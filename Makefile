@@ -35,7 +35,7 @@ CPPFLAGS  := -D_GNU_SOURCE -DCL_TARGET_OPENCL_VERSION=120 -Ihost -Ikernels -Iinc
 # what the compiler's default -fPIE makes (docs/api.md has the timing).
 CFLAGS    := -std=c11 $(OPT) -g $(WARN) $(FPFLAGS) -pthread -fPIC -fvisibility=hidden $(EXTRA_CFLAGS)
 LDFLAGS   := -pthread $(EXTRA_LDFLAGS)
-LDLIBS    := -lOpenCL -lstb -lOpenEXRCore -lOpenEXR -lcjson -lz -lm
+LDLIBS    := -lOpenCL -lstb -lpng -lOpenEXRCore -lOpenEXR -lcjson -lz -lm
 
 # Open MPI (docs/distributed.md): only host/dist/mpi_driver.c includes mpi.h, and only
 # the clpt program links libmpi; the tests and benchmarks never pull that file in.

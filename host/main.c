@@ -325,6 +325,22 @@ static Status run_info_command(const Options *o, int *done, Error *err)
 
 /* ------------------------------------------------------------------ outputs, checked first */
 
+/* --jpeg-quality and --png-depth shape one format: said, not ignored, for another. */
+static Status outputs_check_format_flags(const Options *o, const char *output, Error *err)
+{
+    ImageFormat fmt = IMAGE_PNG;
+    Error ignored = { 0 };
+    image_format_from_path(output, &fmt, &ignored);   /* outputs_choose reports a bad one */
+    error_clear(&ignored);
+    if (o->jpeg_quality && fmt != IMAGE_JPEG)
+        return error_set(err, ST_USAGE, "--jpeg-quality sets the quality of a JPEG output, and '%s' is none (write a "
+                         ".jpg or .jpeg, or leave it out)", output);
+    if (o->png_depth && fmt != IMAGE_PNG)
+        return error_set(err, ST_USAGE, "--png-depth sets the bits of a PNG output, and '%s' is none (write a .png, "
+                         "or leave it out)", output);
+    return ST_OK;
+}
+
 /* Each output can be written: checked now, so that a missing or unwritable folder is
  * found in a second, not after hours of rendering (when nothing could be saved). */
 static Status outputs_check(const Run *r, Error *err)
@@ -336,6 +352,7 @@ static Status outputs_check(const Run *r, Error *err)
     size_t n = 0;
     ViewLook look = { (ViewTransform)o->view, o->exposure };
     Status st = image_check_look(r->output, &look, err);
+    if (st == ST_OK) st = outputs_check_format_flags(o, r->output, err);
     if (st) return st;
     /* standard output is no file of the run's: nothing to probe or compare */
     if (image_path_is_stdout(r->output)) st = image_stdout_check(err);
@@ -427,8 +444,9 @@ static Status scene_apply_options(Run *r, Error *err)
 {
     Status st = scene_options_apply(&r->o, &r->scene, r->bare_mesh, err);
     r->style.encoding = (ImageEncoding)((r->scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB) |
-                                        (r->o.exr_float ? IMAGE_EXR_FLOAT : 0));
+                                        (r->o.exr_float ? IMAGE_EXR_FLOAT : 0) | (r->o.png_depth == 16 ? IMAGE_PNG16 : 0));
     r->style.look = (ViewLook){ (ViewTransform)r->o.view, r->o.exposure };
+    r->style.jpeg_quality = r->o.jpeg_quality;
     return st;
 }
 

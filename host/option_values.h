@@ -33,6 +33,8 @@ typedef struct {
     int exr_float;                /* EXR channels as 32-bit floats, not halves */
     int denoise;                  /* --denoise: Open Image Denoise on the finished image */
     const char *display_server;   /* --display-server HOST:PORT (tev); NULL: none */
+    unsigned jpeg_quality;        /* 1..100; 0: not given (IMAGE_JPEG_QUALITY) */
+    int png_depth;                /* 8 or 16; 0: not given (8) */
     /* developer flags */
     const char *kernel_dir;
     unsigned batch;               /* fixed batch size, 0 = adaptive */

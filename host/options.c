@@ -45,7 +45,8 @@
  */
 #define OPTIONS(X) \
     X(OUTPUT, TEXT, output, "--output", "-o", "FILE", WHAT("file name"), \
-        "image to write: .png, .ppm or .bmp (8-bit sRGB)\n" \
+        "image to write: .png, .jpg/.jpeg, .ppm or .bmp\n" \
+        "(8-bit sRGB; --png-depth 16, --jpeg-quality)\n" \
         "or .pfm, .exr (half; see --exr-float) or .hdr\n" \
         "(linear float); default: the file a pbrt\n" \
         "scene's Film names, else SCENE's name\n" \
@@ -55,7 +56,8 @@
         "regular file is replaced (a FIFO or device\n" \
         "is refused). Checked before rendering.\n" \
         "'-' writes PNG to standard output, FORMAT:-\n" \
-        "(exr:-, pfm:-, ppm:-, bmp:-, hdr:-) that format") \
+        "(jpg:-, exr:-, pfm:-, ppm:-, bmp:-, hdr:-) that\n" \
+        "format") \
     X(OUTPUT, LONG, spp, "--spp", NULL, "N", RANGE(1, CLPT_MAX_SPP), \
         "samples per pixel (overrides the scene)") \
     X(OUTPUT, LONG, width, "--width", NULL, "N", RANGE(1, CLPT_MAX_IMAGE_SIDE), \
@@ -135,6 +137,10 @@
         "the final image); a server that cannot be\n" \
         "reached or goes away is a warning, and the\n" \
         "render goes on (docs/display-server.md)") \
+    X(OUTPUT, UINT, jpeg_quality, "--jpeg-quality", NULL, "Q", RANGE(1, 100), \
+        "quality of a JPEG output, 1..100 (default 90)") \
+    X(OUTPUT, CHOICE, png_depth, "--png-depth", NULL, NULL, ONE_OF({ "8", 8 }, { "16", 16 }), \
+        "bits per channel of a PNG output (default 8)") \
     X(OUTPUT, CUSTOM, aovs, "--aov", NULL, "LIST", PARSE(parse_aovs), \
         "also write auxiliary images of the first hit,\n" \
         "comma-separated: normal (as colours), depth\n" \

@@ -98,9 +98,24 @@ static void test_usage_errors(void)
     cli_run(ARGS("-q"), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "no scene given");
-    cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.jpg"), &r);
+    cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.tga"), &r);
     CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, ".jpg");
+    CHECK_STR_CONTAINS(r.err, "unsupported extension '.tga' (supported: .png, .jpg, .jpeg, .ppm, .pfm, .bmp, .exr, "
+                              ".hdr)");
+    cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.png", "--jpeg-quality", "80"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --jpeg-quality sets the quality of a JPEG output, and 'image.png' is none "
+                              "(write a .jpg or .jpeg, or leave it out)\n");
+    cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.jpg", "--png-depth", "16"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --png-depth sets the bits of a PNG output, and 'image.jpg' is none "
+                              "(write a .png, or leave it out)\n");
+    cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.jpg", "--jpeg-quality", "0"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "--jpeg-quality must be between 1 and 100, got 0");
+    cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.png", "--png-depth", "12"), &r);
+    CHECK_EQ_INT(r.status, 2);
+    CHECK_STR_CONTAINS(r.err, "--png-depth expects '8' or '16', got '12'");
     cli_run(ARGS("scenes/cornell-box.scene", "--sampler", "halton"), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "--sampler expects 'sobol' or 'independent', got 'halton'");
@@ -271,7 +286,7 @@ static void test_view_flags(void)
     cli_run(ARGS(VIEW_RENDER, "--view", "agx", "-o", "/tmp/clpt-test-view.pfm"), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "clpt: error: --view and --exposure form the picture of 8-bit images; "
-                              "'/tmp/clpt-test-view.pfm' keeps the linear radiance (write a .png, .ppm or .bmp, or "
+                              "'/tmp/clpt-test-view.pfm' keeps the linear radiance (write a .png, .jpg, .ppm or .bmp, or "
                               "leave them out)\n");
     CHECK(!file_exists("/tmp/clpt-test-view.pfm"));
     /* merge: a part merged with --view agx is the render's agx PNG */
@@ -480,6 +495,15 @@ static void test_bad_outputs_found_before_rendering(void)
     CHECK_STR_CONTAINS(r.err, "cannot write checkpoint '/nonexistent-dir/x.ckpt'");
     CHECK(strstr(r.err, "Msamples/s") == NULL);
     CHECK(!file_exists(out));
+    /* JPEG and 16-bit PNG outputs are checked as early */
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", "/nonexistent-dir/x.jpg", "--jpeg-quality", "50"), &r);
+    CHECK_EQ_INT(r.status, 4);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: cannot write '/nonexistent-dir/x.jpg': cannot create a temporary file "
+                              "beside it: No such file or directory");
+    CHECK(strstr(r.err, "Msamples/s") == NULL);
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", "/nonexistent-dir/x.png", "--png-depth", "16"), &r);
+    CHECK_EQ_INT(r.status, 4);
+    CHECK(strstr(r.err, "Msamples/s") == NULL);
     cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", "/tmp"), &r);   /* a folder named like an image */
     CHECK_EQ_INT(r.status, 2);
     mkdir("/tmp/clpt-test-dir.png", 0700);

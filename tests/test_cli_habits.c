@@ -148,8 +148,8 @@ static void test_output_to_stdout(void)
     CHECK_MSG(r.status == 0, "%s", r.err);
     CHECK(memcmp(r.out, "\x76\x2f\x31\x01", 4) == 0);
     CHECK(!file_exists("-") && !file_exists("EXR:-"));
-    CHECK_USAGE(ARGS(TINY, "-o", "jpg:-"), "clpt: error: cannot write the image to standard output as 'jpg': -o - "
-                                          "writes PNG, and FORMAT:- one of png, ppm, pfm, bmp, exr, hdr\n" HINT);
+    CHECK_USAGE(ARGS(TINY, "-o", "tga:-"), "clpt: error: cannot write the image to standard output as 'tga': -o - "
+                                          "writes PNG, and FORMAT:- one of png, jpg, ppm, pfm, bmp, exr, hdr\n" HINT);
     CHECK_USAGE(ARGS(TINY, "-o", "-", "--aov", "normal"),
                 "clpt: error: --aov cannot be used with -o -: standard output takes the image once, and --aov "
                 "writes it again or beside it; name a file with -o\n" HINT);

@@ -97,12 +97,16 @@ static void test_format_from_path(void)
     CHECK_EQ_INT(f, IMAGE_PPM);
     CHECK_EQ_INT(image_format_from_path("/a.b/c.Pfm", &f, &err), ST_OK);
     CHECK_EQ_INT(f, IMAGE_PFM);
-    CHECK_EQ_INT(image_format_from_path("render.jpg", &f, &err), ST_USAGE);
-    CHECK_STR_CONTAINS(err.msg, "'.jpg'");
-    CHECK_STR_CONTAINS(err.msg, ".png, .ppm, .pfm");
+    CHECK_EQ_INT(image_format_from_path("render.jpg", &f, &err), ST_OK);
+    CHECK_EQ_INT(f, IMAGE_JPEG);
+    CHECK_EQ_INT(image_format_from_path("render.JPEG", &f, &err), ST_OK);
+    CHECK_EQ_INT(f, IMAGE_JPEG);
+    CHECK_EQ_INT(image_format_from_path("render.tga", &f, &err), ST_USAGE);
+    CHECK_STR_CONTAINS(err.msg, "cannot tell the image format of 'render.tga': unsupported extension '.tga' "
+                                "(supported: .png, .jpg, .jpeg, .ppm, .pfm, .bmp, .exr, .hdr)");
     CHECK_EQ_INT(image_format_from_path("render", &f, &err), ST_USAGE);
     CHECK_STR_CONTAINS(err.msg, "no extension");
-    CHECK_STR_CONTAINS(err.msg, ".png, .ppm, .pfm");
+    CHECK_STR_CONTAINS(err.msg, ".png, .jpg, .jpeg, .ppm, .pfm");
     /* the dot of a folder name is not the file's extension */
     CHECK_EQ_INT(image_format_from_path("out.png/render", &f, &err), ST_USAGE);
     CHECK_EQ_INT(image_format_from_path("out.png.bak", &f, &err), ST_USAGE);
@@ -167,6 +171,73 @@ static void test_png_round_trip(void)
     /* top row first: the bottom-right pixel is the brightest of the gradient */
     CHECK_EQ_INT(px[(W * H - 1) * 3], image_to_srgb8(0.9f + 0.08f));
     stbi_image_free(px);
+    CHECK_EQ_INT(count_temp_files(tmpdir), 0);
+    error_clear(&err);
+}
+
+/* 16-bit PNG: each value is the sRGB curve (or the linear value) times 65535, rounded
+ * to nearest, read back through stb_image's 16-bit loader. */
+static void test_png16_round_trip(void)
+{
+    float rgb[W * H * 3];
+    fill_gradient(rgb);
+    Error err = {0};
+    const char *path = path_in("grad16.png");
+    for (int linear = 0; linear < 2; linear++) {
+        ImageStyle style = { (ImageEncoding)(IMAGE_PNG16 | (linear ? IMAGE_LINEAR : 0)), { VIEW_STANDARD, 0.0 }, 0 };
+        CHECK_EQ_INT(image_write_styled(path, rgb, W, H, &style, &err), ST_OK);
+        int w = 0, h = 0, n = 0;
+        CHECK(stbi_is_16_bit(path));
+        stbi_us *px = stbi_load_16(path, &w, &h, &n, 3);
+        CHECK(px != NULL);
+        if (!px) return;
+        CHECK_EQ_INT(w, W);
+        CHECK_EQ_INT(h, H);
+        int mismatches = 0;
+        for (int i = 0; i < W * H * 3; i++) {
+            double x = rgb[i], c = !(x > 0.0) ? 0.0 : x >= 1.0 ? 1.0 : x;
+            if (!linear) c = c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055;
+            /* image_srgb_encode rounds to float before the scaling */
+            double v = linear ? c : (double)(float)c;
+            if (px[i] != (stbi_us)floor(v * 65535.0 + 0.5)) mismatches++;
+        }
+        CHECK_EQ_INT(mismatches, 0);
+        /* NaN, +inf, -inf, -0.25, 2 and 1 are the ends; 0.5 is 0.7354 in sRGB */
+        CHECK(px[0] == 0 && px[1] == 65535 && px[2] == 0 && px[3] == 0 && px[4] == 65535 && px[7] == 65535);
+        CHECK_EQ_INT(px[6], linear ? 32768 : 48192);
+        stbi_image_free(px);
+    }
+    CHECK_EQ_INT(count_temp_files(tmpdir), 0);
+    error_clear(&err);
+}
+
+/* JPEG is lossy: the decoded gradient stays within a few steps of the 8-bit sRGB
+ * bytes at the default quality, and a lower quality makes a smaller file. */
+static void test_jpeg_round_trip(void)
+{
+    float rgb[W * H * 3];
+    for (int i = 0; i < W * H * 3; i++) rgb[i] = (float)(i / 3 % W) / (float)W * 0.8f + 0.1f;
+    Error err = {0};
+    const char *path = path_in("grad.jpg");
+    CHECK_EQ_INT(image_write(path, rgb, W, H, &err), ST_OK);
+    int w = 0, h = 0, n = 0;
+    unsigned char *px = stbi_load(path, &w, &h, &n, 3);
+    CHECK(px != NULL);
+    if (!px) return;
+    CHECK_EQ_INT(w, W);
+    CHECK_EQ_INT(h, H);
+    int worst = 0;
+    for (int i = 0; i < W * H * 3; i++) {
+        int d = abs((int)px[i] - (int)image_to_srgb8(rgb[i]));
+        worst = d > worst ? d : worst;
+    }
+    CHECK_MSG(worst <= 6, "worst difference %d", worst);
+    stbi_image_free(px);
+    struct stat big, small;
+    CHECK(stat(path, &big) == 0);
+    ImageStyle low = { IMAGE_SRGB, { VIEW_STANDARD, 0.0 }, 5 };
+    CHECK_EQ_INT(image_write_styled(path, rgb, W, H, &low, &err), ST_OK);
+    CHECK(stat(path, &small) == 0 && small.st_size < big.st_size);
     CHECK_EQ_INT(count_temp_files(tmpdir), 0);
     error_clear(&err);
 }
@@ -247,6 +318,14 @@ static void test_missing_folder_fails_cleanly(void)
     CHECK_STR_CONTAINS(err.msg, "cannot write '");
     CHECK_STR_CONTAINS(err.msg, "no/such/dir/out.png");
     CHECK_STR_CONTAINS(err.msg, "No such file or directory");
+    /* the new formats go through the same atomic file */
+    snprintf(path, sizeof path, "%s/no/such/dir/out.jpg", sub);
+    CHECK_EQ_INT(image_write(path, rgb, W, H, &err), ST_IO);
+    CHECK_STR_CONTAINS(err.msg, "no/such/dir/out.jpg");
+    ImageStyle deep = { IMAGE_PNG16, { VIEW_STANDARD, 0.0 }, 0 };
+    snprintf(path, sizeof path, "%s/no/such/dir/out16.png", sub);
+    CHECK_EQ_INT(image_write_styled(path, rgb, W, H, &deep, &err), ST_IO);
+    CHECK_STR_CONTAINS(err.msg, "no/such/dir/out16.png");
     CHECK_EQ_INT(count_entries(sub), 0);
     error_clear(&err);
 }
@@ -358,6 +437,8 @@ int main(void)
     RUN(test_format_from_path);
     RUN(test_srgb_encode);
     RUN(test_png_round_trip);
+    RUN(test_png16_round_trip);
+    RUN(test_jpeg_round_trip);
     RUN(test_ppm_round_trip);
     RUN(test_pfm_round_trip);
     RUN(test_missing_folder_fails_cleanly);

@@ -172,7 +172,7 @@ static void test_styled_writer(void)
     if (fa >= 0) close(fa);
     if (fb >= 0) close(fb);
     Error err = { 0 };
-    ImageStyle same = { IMAGE_SRGB, { VIEW_STANDARD, 0.0 } }, agx = { IMAGE_SRGB, { VIEW_AGX, 0.5 } };
+    ImageStyle same = { IMAGE_SRGB, { VIEW_STANDARD, 0.0 }, 0 }, agx = { IMAGE_SRGB, { VIEW_AGX, 0.5 }, 0 };
     CHECK(image_write_encoded(a, rgb, W, H, IMAGE_SRGB, &err) == ST_OK);
     CHECK(image_write_styled(b, rgb, W, H, &same, &err) == ST_OK);
     unsigned char *da = NULL, *db = NULL;

@@ -248,7 +248,7 @@ Status merge_command(int argc, char **argv, Error *err)
     if (st == ST_OK) st = merge_parts(m.parts, m.n_parts, &merged, err);
     if (st == ST_OK && m.checkpoint)
         st = checkpoint_write(m.checkpoint, &merged.id, &merged.film, merged.done, merged.n_done, err);
-    ImageStyle style = { m.linear ? IMAGE_LINEAR : IMAGE_SRGB, m.look };
+    ImageStyle style = { m.linear ? IMAGE_LINEAR : IMAGE_SRGB, m.look, 0 };
     if (st == ST_OK && !dn) st = film_write(&merged.film, m.output, &style, err);
     if (st == ST_OK && dn) st = merge_write_denoised(&m, dn, &merged.film, fmt, &style, err);
     if (st == ST_OK && !m.quiet)

@@ -2,8 +2,9 @@
  * image_write.c — PNG/PPM/BMP/PFM/EXR/HDR encoding, written through atomic_file.h (temp file,
  * rename).
  *
- * PNG compression is stb_image_write's (Debian's libstb); it hands us the finished file
- * in memory through a callback, so every byte on disk goes through our own checked writes.
+ * 8-bit PNG and JPEG compression is stb_image_write's (Debian's libstb), 16-bit PNG
+ * libpng's (stb writes 8 bits only); both hand us the file through a callback, so every
+ * byte on disk goes through our own checked writes.
  */
 #include "io/image_write.h"
 
@@ -22,9 +23,11 @@
 #include <strings.h>
 #include <unistd.h>
 
+#include <png.h>
+#include <setjmp.h>
 #include <stb_image_write.h>
 
-#define SUPPORTED_EXTENSIONS ".png, .ppm, .pfm, .bmp, .exr, .hdr"
+#define SUPPORTED_EXTENSIONS ".png, .jpg, .jpeg, .ppm, .pfm, .bmp, .exr, .hdr"
 
 /* The formats by their extension, without the dot: also the FORMAT of "FORMAT:-". */
 static int format_from_word(const char *word, size_t len, ImageFormat *fmt)
@@ -32,6 +35,7 @@ static int format_from_word(const char *word, size_t len, ImageFormat *fmt)
     static const struct { const char *name; ImageFormat fmt; } formats[] = {
         { "png", IMAGE_PNG }, { "ppm", IMAGE_PPM }, { "pfm", IMAGE_PFM },
         { "bmp", IMAGE_BMP }, { "exr", IMAGE_EXR }, { "hdr", IMAGE_HDR },
+        { "jpg", IMAGE_JPEG }, { "jpeg", IMAGE_JPEG },
     };
     for (size_t i = 0; i < sizeof formats / sizeof formats[0]; i++)
         if (strlen(formats[i].name) == len && strncasecmp(word, formats[i].name, len) == 0) {
@@ -64,7 +68,7 @@ static Status stdout_format(const char *path, ImageFormat *fmt, Error *err)
     }
     if (!format_from_word(path, strlen(path) - 2, fmt))
         return error_set(err, ST_USAGE, "cannot write the image to standard output as '%.*s': -o - writes PNG, "
-                         "and FORMAT:- one of png, ppm, pfm, bmp, exr, hdr", (int)(strlen(path) - 2), path);
+                         "and FORMAT:- one of png, jpg, ppm, pfm, bmp, exr, hdr", (int)(strlen(path) - 2), path);
     return ST_OK;
 }
 
@@ -101,6 +105,19 @@ unsigned char image_to_srgb8(float linear)
     return (unsigned char)floor((double)image_srgb_encode(linear) * 255.0 + 0.5);
 }
 
+unsigned image_to_srgb16(float linear)
+{
+    return (unsigned)floor((double)image_srgb_encode(linear) * 65535.0 + 0.5);
+}
+
+unsigned image_to_linear16(float linear)
+{
+    double x = linear;
+    if (!(x > 0.0)) return 0;
+    if (x >= 1.0) return 65535;
+    return (unsigned)floor(x * 65535.0 + 0.5);
+}
+
 unsigned char image_to_linear8(float linear)
 {
     double x = linear;
@@ -132,6 +149,68 @@ static void write_png(AtomicFile *af, const unsigned char *srgb, unsigned w, uns
         if (!errno) errno = ENOMEM;
         atomic_fail(af, "PNG encoding");
     }
+}
+
+static void write_jpeg(AtomicFile *af, const unsigned char *srgb, unsigned w, unsigned h, unsigned quality)
+{
+    errno = 0;
+    if (!stbi_write_jpg_to_func(png_sink, af, (int)w, (int)h, 3, srgb, (int)quality)) {
+        /* as write_png: only an allocation fails */
+        if (!errno) errno = ENOMEM;
+        atomic_fail(af, "JPEG encoding");
+    }
+}
+
+static void png16_write(png_structp png, png_bytep data, size_t n)
+{
+    atomic_write(png_get_io_ptr(png), data, n);
+}
+
+static void png16_flush(png_structp png)
+{
+    (void)png;
+}
+
+/* libpng reports an error by longjmp to the setjmp in write_png16; nothing it owns
+ * outlives that function, and it prints nothing. */
+static void png16_error(png_structp png, png_const_charp msg)
+{
+    (void)msg;
+    png_longjmp(png, 1);
+}
+
+static void png16_warning(png_structp png, png_const_charp msg)
+{
+    (void)png;
+    (void)msg;
+}
+
+/* A 16-bit RGB PNG of `be16`: the big-endian samples PNG stores, rows top first. */
+static void write_png16(AtomicFile *af, const unsigned char *be16, unsigned w, unsigned h)
+{
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, png16_error, png16_warning);
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    if (!png || !info) {
+        png_destroy_write_struct(&png, NULL);
+        errno = ENOMEM;
+        atomic_fail(af, "PNG encoding");
+        return;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        if (!af->failed_step) {
+            errno = ENOMEM;   /* libpng fails on its allocations; our writes record their own */
+            atomic_fail(af, "PNG encoding");
+        }
+        return;
+    }
+    png_set_write_fn(png, af, png16_write, png16_flush);
+    png_set_IHDR(png, info, w, h, 16, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+                 PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+    for (unsigned y = 0; y < h; y++) png_write_row(png, be16 + (size_t)y * w * 6u);
+    png_write_end(png, NULL);
+    png_destroy_write_struct(&png, &info);
 }
 
 /* BMP: the 14-byte file header and the 40-byte BITMAPINFOHEADER, then 24-bit BGR rows
@@ -299,7 +378,7 @@ Status image_write(const char *path, const float *rgb, unsigned width, unsigned 
 
 int image_format_is_display(ImageFormat fmt)
 {
-    return fmt == IMAGE_PNG || fmt == IMAGE_PPM || fmt == IMAGE_BMP;
+    return fmt == IMAGE_PNG || fmt == IMAGE_PPM || fmt == IMAGE_BMP || fmt == IMAGE_JPEG;
 }
 
 Status image_check_look(const char *path, const ViewLook *look, Error *err)
@@ -310,14 +389,33 @@ Status image_check_look(const char *path, const ViewLook *look, Error *err)
     error_clear(&ignored);
     if (!known || image_format_is_display(fmt) || view_look_is_identity(look)) return ST_OK;
     return error_set(err, ST_USAGE, "--view and --exposure form the picture of 8-bit images; '%s' keeps the linear "
-                     "radiance (write a .png, .ppm or .bmp, or leave them out)", path);
+                     "radiance (write a .png, .jpg, .ppm or .bmp, or leave them out)", path);
 }
 
 Status image_write_encoded(const char *path, const float *rgb, unsigned width, unsigned height,
                            ImageEncoding encoding, Error *err)
 {
-    ImageStyle style = { encoding, { VIEW_STANDARD, 0.0 } };
+    ImageStyle style = { encoding, { VIEW_STANDARD, 0.0 }, 0 };
     return image_write_styled(path, rgb, width, height, &style, err);
+}
+
+/* A display format's samples of `count` values: bytes, or with `wide` big-endian 16-bit
+ * words (a 16-bit PNG's); NULL when out of memory. */
+static unsigned char *encode_display(const float *src, size_t count, ImageEncoding encoding, int wide)
+{
+    unsigned char *out = malloc(count * (wide ? 2u : 1u));
+    if (!out) return NULL;
+    int linear = (encoding & IMAGE_LINEAR) != 0;
+    for (size_t i = 0; i < count; i++) {
+        if (!wide) {
+            out[i] = linear ? image_to_linear8(src[i]) : image_to_srgb8(src[i]);
+            continue;
+        }
+        unsigned v = linear ? image_to_linear16(src[i]) : image_to_srgb16(src[i]);
+        out[2 * i] = (unsigned char)(v >> 8);
+        out[2 * i + 1] = (unsigned char)(v & 0xffu);
+    }
+    return out;
 }
 
 /* The picture a display format stores: rgb through the look, in a new buffer (*out);
@@ -351,15 +449,10 @@ Status image_write_styled(const char *path, const float *rgb, unsigned width, un
     /* Encode before creating the temporary file: running out of memory then leaves no
      * trace on disk. */
     unsigned char *srgb = NULL;
-    size_t count = (size_t)width * height * 3;
-    if (fmt == IMAGE_PNG || fmt == IMAGE_PPM || fmt == IMAGE_BMP) {
-        srgb = malloc(count);
-        if (!srgb) {
-            free(picture);
-            return error_set(err, ST_INTERNAL, "cannot write '%s': out of memory", path);
-        }
-        for (size_t i = 0; i < count; i++)
-            srgb[i] = (encoding & IMAGE_LINEAR) ? image_to_linear8(src[i]) : image_to_srgb8(src[i]);
+    int png16 = fmt == IMAGE_PNG && (encoding & IMAGE_PNG16);
+    if (image_format_is_display(fmt) && !(srgb = encode_display(src, (size_t)width * height * 3, encoding, png16))) {
+        free(picture);
+        return error_set(err, ST_INTERNAL, "cannot write '%s': out of memory", path);
     }
     free(picture);
 
@@ -370,7 +463,11 @@ Status image_write_styled(const char *path, const float *rgb, unsigned width, un
         return st;
     }
     switch (fmt) {
-    case IMAGE_PNG: write_png(&af, srgb, width, height); break;
+    case IMAGE_PNG:
+        if (png16) write_png16(&af, srgb, width, height);
+        else write_png(&af, srgb, width, height);
+        break;
+    case IMAGE_JPEG: write_jpeg(&af, srgb, width, height, style->jpeg_quality ? style->jpeg_quality : IMAGE_JPEG_QUALITY); break;
     case IMAGE_PPM: write_ppm(&af, srgb, width, height); break;
     case IMAGE_BMP: write_bmp(&af, srgb, width, height); break;
     case IMAGE_PFM: st = write_pfm(&af, rgb, width, height, err); break;

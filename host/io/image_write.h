@@ -1,6 +1,7 @@
 /*
- * image_write.h — writing the final image: PNG, PPM and BMP (8-bit sRGB, or 8-bit linear
- * when asked), or linear float: PFM, OpenEXR (half or 32-bit float channels, ZIP
+ * image_write.h — writing the final image: PNG (8-bit, or 16-bit through libpng), JPEG
+ * (stb_image_write, a quality from 1 to 100), PPM and BMP (sRGB, or linear when asked), or
+ * linear float: PFM, OpenEXR (half or 32-bit float channels, ZIP
  * compressed; with the auxiliary images as extra channels: image_write_exr) and
  * Radiance HDR (RGBE, through stb_image_write).
  *
@@ -9,8 +10,9 @@
  * target, so a reader (or a crash, a full disk, a Ctrl-C) never sees a half-written image
  * and a failed write leaves any earlier file at that path untouched.
  *
- * PNG, PPM and BMP store sRGB-encoded bytes: NaN becomes 0, values are clamped to [0,1],
- * the exact sRGB transfer function is applied and the result rounded to nearest. With
+ * PNG, JPEG, PPM and BMP store sRGB-encoded values: NaN becomes 0, values are clamped to
+ * [0,1], the exact sRGB transfer function is applied and the result scaled to 255 (or
+ * 65535 for a 16-bit PNG) and rounded to nearest. With
  * IMAGE_LINEAR the transfer function is left out (value * 255, rounded), which is how
  * the classic ray tracers of computer-graphics courses write their images.
  * PFM stores the linear radiance unchanged, bit for bit — NaN, infinities and negative
@@ -29,11 +31,15 @@
 
 #include <stddef.h>
 
-typedef enum { IMAGE_PNG, IMAGE_PPM, IMAGE_PFM, IMAGE_BMP, IMAGE_EXR, IMAGE_HDR } ImageFormat;
+typedef enum { IMAGE_PNG, IMAGE_PPM, IMAGE_PFM, IMAGE_BMP, IMAGE_EXR, IMAGE_HDR, IMAGE_JPEG } ImageFormat;
 
-/* How 8-bit formats encode linear values: IMAGE_SRGB or IMAGE_LINEAR, either with
- * IMAGE_EXR_FLOAT or-ed in for 32-bit float EXR channels (else half). */
-typedef enum { IMAGE_SRGB = 0, IMAGE_LINEAR = 1, IMAGE_EXR_FLOAT = 2 } ImageEncoding;
+/* How display formats encode linear values: IMAGE_SRGB or IMAGE_LINEAR, either with
+ * IMAGE_EXR_FLOAT or-ed in for 32-bit float EXR channels (else half) and IMAGE_PNG16
+ * for 16 bits a channel in a PNG (else 8). */
+typedef enum { IMAGE_SRGB = 0, IMAGE_LINEAR = 1, IMAGE_EXR_FLOAT = 2, IMAGE_PNG16 = 4 } ImageEncoding;
+
+/* JPEG quality when none is asked for (ImageStyle.jpeg_quality 0). */
+#define IMAGE_JPEG_QUALITY 90
 
 /* Everything that decides how linear radiance becomes the bytes of a file: the
  * encoding, and the look (exposure and view) of the formats meant for a display (PNG,
@@ -41,6 +47,7 @@ typedef enum { IMAGE_SRGB = 0, IMAGE_LINEAR = 1, IMAGE_EXR_FLOAT = 2 } ImageEnco
 typedef struct {
     ImageEncoding encoding;
     ViewLook look;
+    unsigned jpeg_quality;     /* 1..100; 0: IMAGE_JPEG_QUALITY */
 } ImageStyle;
 
 /* One named group of channels of a float image (an auxiliary image): `names` for up
@@ -50,7 +57,7 @@ typedef struct {
     const float *rgb;          /* width * height * 3 floats, top row first */
 } ImageLayer;
 
-/* The format named by path's extension (.png .ppm .pfm .bmp .exr .hdr, any case). An unknown or
+/* The format named by path's extension (.png .jpg .jpeg .ppm .pfm .bmp .exr .hdr, any case). An unknown or
  * missing extension is ST_USAGE, with a message that lists the supported ones. The
  * path "-" is standard output as PNG, and "FORMAT:-" (exr:-, pfm:-, any of the six)
  * standard output in that format; an unknown FORMAT is ST_USAGE too. */
@@ -94,6 +101,10 @@ Status image_write_exr(const char *path, const float *rgb, const ImageLayer *lay
 float image_srgb_encode(float linear);
 /* image_srgb_encode scaled to 0..255 and rounded to nearest: the byte PNG and PPM store. */
 unsigned char image_to_srgb8(float linear);
+/* The same scaled to 0..65535: a 16-bit PNG's value. */
+unsigned image_to_srgb16(float linear);
+/* A linear value clamped to [0,1] (NaN: 0), scaled to 0..65535 and rounded to nearest. */
+unsigned image_to_linear16(float linear);
 /* A linear value clamped to [0,1] (NaN: 0), scaled to 0..255 and rounded to nearest. */
 unsigned char image_to_linear8(float linear);
 

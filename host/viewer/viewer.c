@@ -243,7 +243,7 @@ static void frame_save(Viewer *v, uint64_t samples)
         fprintf(stderr, "clpt: error: cannot save: every name up to 99999 is taken\n");
         return;
     }
-    ImageStyle style = { v->cfg->style.encoding, viewer_look(v) };
+    ImageStyle style = { v->cfg->style.encoding, viewer_look(v), v->cfg->style.jpeg_quality };
     Status st = image_write_encoded(pfm, v->save_rgb, v->w, v->h, v->cfg->style.encoding, &err);
     if (st == ST_OK) st = image_write_styled(png, v->save_rgb, v->w, v->h, &style, &err);
     if (st != ST_OK) {

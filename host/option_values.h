@@ -49,6 +49,7 @@ typedef struct {
     double adaptive;              /* whitted: neighbour difference threshold, 0 = off */
     unsigned adaptive_spp;        /* extra samples per flagged pixel */
     double noise_threshold;       /* path: adaptive sampling's threshold, 0 = off */
+    double clamp;                 /* path: --clamp's limit on indirect light, 0 = off */
     unsigned min_spp;             /* samples before it stops a pixel */
     int gamma;                    /* -1 the scene's, 0 sRGB, 1 none (linear 8-bit) */
     int shadows;                  /* -1 the scene's, 0 off, 1 on */

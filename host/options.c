@@ -94,6 +94,11 @@
     X(OUTPUT, UINT, min_spp, "--min-spp", NULL, "N", RANGE(2, CLPT_MAX_SPP), \
         "samples of every pixel before --noise-threshold\n" \
         "stops any (default 16)") \
+    X(OUTPUT, CUSTOM, clamp, "--clamp", NULL, "V", PARSE(parse_clamp), \
+        "path tracer: no channel of a sample's indirect\n" \
+        "light (after the first bounce) passes V; takes\n" \
+        "out fireflies but is biased (darker); default:\n" \
+        "off (docs/adaptive.md, \"Clamping\")") \
     X(OUTPUT, CHOICE, sampler, "--sampler", NULL, NULL, \
         ONE_OF({ "sobol", SAMPLER_SOBOL }, { "independent", SAMPLER_INDEPENDENT }), \
         "random numbers: Owen-scrambled Sobol points\n" \
@@ -610,6 +615,17 @@ static Status parse_noise_threshold(const char *v, Options *o, Error *err)
     if (!*v || *end || errno || starts_blank(v) || !(t > 0.0 && t <= 1.0))
         return error_set(err, ST_USAGE, "--noise-threshold expects a threshold in (0, 1], got '%s'", v);
     o->noise_threshold = t;
+    return ST_OK;
+}
+
+static Status parse_clamp(const char *v, Options *o, Error *err)
+{
+    char *end;
+    errno = 0;
+    double c = strtod(v, &end);
+    if (!*v || *end || errno || starts_blank(v) || !(c > 0.0 && c <= 65536.0))
+        return error_set(err, ST_USAGE, "--clamp expects a radiance limit in (0, 65536], got '%s'", v);
+    o->clamp = c;
     return ST_OK;
 }
 

@@ -29,6 +29,7 @@ static void apply_overrides(const Options *o, Scene *s)
     if (o->accel >= 0) s->accel = (uint)o->accel;
     if (o->max_depth >= 0) s->image.max_depth = (uint)o->max_depth;
     if (o->split >= 0) s->image.split = (uint)o->split;
+    if (o->clamp > 0.0) s->image.clamp_indirect = (float)o->clamp;
     if (o->integrator >= 0) s->integrator = (uint)o->integrator;
     if (o->gamma >= 0) s->linear_output = o->gamma == 1;
     if (o->shadows >= 0) s->shadows = o->shadows;
@@ -131,6 +132,9 @@ Status scene_options_apply(const Options *o, Scene *s, int bare_mesh, Error *err
                          o->range_first, o->range_end, s->image.spp);
     if (o->adaptive > 0.0 && s->integrator != INTEGRATOR_WHITTED)
         return error_set(err, ST_USAGE, "--adaptive needs the whitted integrator (--integrator whitted)");
+    if (o->clamp > 0.0 && s->integrator != INTEGRATOR_PATH)
+        return error_set(err, ST_USAGE, "--clamp limits the path tracer's indirect light (--integrator path); the "
+                         "whitted integrator has none");
     if (o->noise_threshold > 0.0 && s->integrator != INTEGRATOR_PATH)
         return error_set(err, ST_USAGE, "--noise-threshold needs the path tracer (--integrator path); the whitted "
                          "integrator has --adaptive");

@@ -580,13 +580,16 @@ typedef struct {                                        /* 320 bytes */
     uint sample_step;                 /* path, when > 1: a batch's sample s is the pixel's
                                        * sample s * step + sample_offset (the noise
                                        * threshold renders its even and odd halves so) */
+    float clamp_indirect;             /* path, when > 0: no channel of light that reached
+                                       * the camera through two or more bounces passes
+                                       * it, per sample (--clamp; shade_path.h) */
     /* A crop (--crop, --pixel-bounds, pbrt's cropwindow): the film is the width x height
      * window of a larger image, which leaves crop_left columns out on its left,
      * crop_right on its right, crop_top rows above and crop_bottom below. Samples are
      * numbered and placed by the whole image's pixel (params_image_pixel), so the
      * window's pixels are the whole render's, bit for bit. All 0: no crop. */
-    uint crop_left, crop_top;
-    uint crop_right, crop_bottom, pad_crop0, pad_crop1;
+    uint crop_left;
+    uint crop_top, crop_right, crop_bottom, pad_crop0;
 } RenderParams;
 
 /* One path of the wavefront; lives in a device buffer between kernel launches. */
@@ -647,7 +650,7 @@ _Static_assert(offsetof(RenderParams, strata) == 256, "RenderParams.strata");
 _Static_assert(offsetof(RenderParams, shadows) == 264, "RenderParams.shadows");
 _Static_assert(offsetof(RenderParams, normal_miss_grey) == 268, "RenderParams.normal_miss_grey");
 _Static_assert(offsetof(RenderParams, bg_light) == 284, "RenderParams.bg_light");
-_Static_assert(offsetof(RenderParams, crop_left) == 296, "RenderParams.crop_left");
+_Static_assert(offsetof(RenderParams, crop_left) == 300, "RenderParams.crop_left");
 _Static_assert(offsetof(Material, reflective) == 64, "Material.reflective");
 _Static_assert(offsetof(Light, cos_inner) == 60, "Light.cos_inner");
 _Static_assert(offsetof(Texture, m) == 32, "Texture.m");

@@ -53,5 +53,6 @@ int kernel_lanes_scene(const DeviceScene *s, unsigned features)
 
 int kernel_lanes_params(const RenderParams *p)
 {
-    return p->sampler == SAMPLER_SOBOL && p->mis_mode == MIS_BOTH && p->shadows;
+    /* --clamp: the float8 light sample does not clamp; k_path does */
+    return p->sampler == SAMPLER_SOBOL && p->mis_mode == MIS_BOTH && p->shadows && !(p->clamp_indirect > 0.0f);
 }

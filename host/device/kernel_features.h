@@ -23,7 +23,7 @@ unsigned kernel_scene_features(const DeviceScene *s);
 int kernel_lanes_scene(const DeviceScene *s, unsigned features);
 
 /* ... and whether the render settings allow it too: the Sobol sampler, MIS and shadows,
- * which the float8 shading assumes. */
+ * which the float8 shading assumes, and no --clamp, which it does not apply. */
 int kernel_lanes_params(const RenderParams *p);
 
 #endif /* CLPT_KERNEL_FEATURES_H */

@@ -109,6 +109,7 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
     if ((st = crop_params(s, p, err))) return st;
     p->max_depth = s->image.max_depth;
     p->split = s->image.split ? s->image.split : 1u;
+    p->clamp_indirect = s->image.clamp_indirect;
     p->rr_depth = RR_START_BOUNCE;
     p->seed = s->image.seed;
     p->sampler = s->image.sampler;

@@ -42,6 +42,7 @@ typedef struct {
     uint seed;
     uint sampler;        /* enum Sampler (kernels/sample/rng.h); 0, Sobol, by default */
     uint split;          /* continuations per camera sample from its first hit (1: none) */
+    float clamp_indirect;  /* path: --clamp's limit on indirect light, 0 = none */
 } SceneImage;
 
 typedef struct {

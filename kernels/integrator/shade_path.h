@@ -23,6 +23,22 @@ KFN int path_pixel_skipped(const SceneView *sc, uint pixel)
     return sc->params->use_mask != 0u && sc->pixel_mask[pixel] == 0u;
 }
 
+/* --clamp (RenderParams.clamp_indirect > 0): indirect light scaled down so that no
+ * channel passes the limit, keeping its hue, as Cycles' "clamp indirect". Indirect is
+ * what a surface after the first one reflected: the light samples from the second hit
+ * on, and the emission and background that rays from the second hit on find. The first
+ * hit's direct light (its light sample, and what its scattered ray finds, the two
+ * strategies MIS weighs against each other) and what the camera sees stay whole.
+ * Biased (it removes energy), and it removes fireflies: rare paths to a bright light
+ * through diffuse bounces. Off (0), the contribution is returned as it was, bit for
+ * bit. */
+KFN vec3 clamp_indirect(GLOBAL const RenderParams *p, vec3 c)
+{
+    float limit = p->clamp_indirect, peak = v3_max_comp(c);
+    if (!(limit > 0.0f) || !(peak > limit)) return c;
+    return v3_scale(c, limit / peak);
+}
+
 /* Power heuristic (beta = 2) weight of a strategy with density a against one with b. */
 KFN float mis_power(float a, float b)
 {
@@ -77,6 +93,7 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
     float w = ls.delta || mis_mode == MIS_LIGHT_ONLY ? 1.0f : mis_power(ls.pdf, bsdf_pdf);
     vec3 f_cos = v3_scale(f, cos_s * w / ls.pdf);
     ps->shadow_L = v3_mul(v3_mul(ps->throughput, f_cos), ls.Le);
+    if (b >= 1u) ps->shadow_L = clamp_indirect(sc->params, ps->shadow_L);
     if (!sc->params->shadows) {
         /* shadows off: the light counts as visible, so no shadow ray is traced */
         shadow_resolve(ps, 0);
@@ -106,7 +123,9 @@ KFN_INLINE void shade_escape(const SceneView *sc, Ray r, GLOBAL PathState *ps)
     } else {
         Le = background_radiance(sc, r.d);
     }
-    ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, Le), w));
+    vec3 c = v3_scale(v3_mul(ps->throughput, Le), w);
+    if (ps->bounce >= 2u) c = clamp_indirect(p, c);   /* the ray of a later hit than the first */
+    ps->radiance = v3_add(ps->radiance, c);
 }
 
 /* The emission of surface s (material m) that ray r reached: emission found by BSDF
@@ -121,7 +140,9 @@ KFN_INLINE void shade_emission(const SceneView *sc, Ray r, Surface s, Material m
         if (!(ps->flags & PATH_SPECULAR) && s.light != NO_INDEX)
             w = p->mis_mode == MIS_BOTH ? mis_power(ps->bsdf_pdf, light_pdf(sc, s.light, r.o, s.p, s.ng))
                                         : (p->mis_mode == MIS_BSDF_ONLY ? 1.0f : 0.0f);
-        ps->radiance = v3_add(ps->radiance, v3_scale(v3_mul(ps->throughput, emission), w));
+        vec3 c = v3_scale(v3_mul(ps->throughput, emission), w);
+        if (ps->bounce >= 2u) c = clamp_indirect(p, c);   /* the ray of a later hit than the first */
+        ps->radiance = v3_add(ps->radiance, c);
     }
 }
 

@@ -2,7 +2,8 @@
  * installed program as a user meets it: it renders from another folder (nothing read
  * from the source tree), its man page renders without a warning, and the bash and zsh
  * completions load and complete a flag. The files come from BUILD (the Makefile's build
- * folder), which `make test` has built: the sub-make only copies. */
+ * folder), which `make test` has built: the sub-make only copies (INSTALL_NO_BUILD=1, so
+ * that under test-asan it does not rebuild the folder with the plain flags). */
 #include "cli_util.h"
 #include "harness.h"
 
@@ -43,8 +44,8 @@ static int install_ok;
 static void test_make_install_places_every_file(void)
 {
     snprintf(cmd, sizeof cmd,
-             "env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL make -s --no-print-directory BUILD=%s PREFIX=/usr DESTDIR=%s "
-             "install > %s/make.log 2>&1", CLPT_BUILD_DIR, stage, stage);
+             "env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL make -s --no-print-directory BUILD=%s INSTALL_NO_BUILD=1 "
+             "PREFIX=/usr DESTDIR=%s install > %s/make.log 2>&1", CLPT_BUILD_DIR, stage, stage);
     int st = sh(cmd);
     snprintf(cmd, sizeof cmd, "%s/make.log", stage);
     CHECK_MSG(st == 0, "make install: exit %d: %s", st, slurp(cmd));
@@ -75,6 +76,37 @@ static void test_installed_clpt_renders(void)
     CHECK_MSG(strcmp(slurp(path), r_version.out) == 0, "installed --version '%s', built '%s'", slurp(path), r_version.out);
     snprintf(path, sizeof path, "%s/out.png", stage);
     CHECK(file_exists(path));
+}
+
+/* A user's program built with pkg-config against an installed library: installed with
+ * PREFIX the stage itself (so clpt.pc names where the files are), examples/render.c
+ * compiled with `pkg-config --cflags --libs clpt` alone, run against the installed
+ * libclpt.so, and its image the program's bits. */
+static void test_pkg_config_builds_the_example(void)
+{
+    if (!install_ok || !file_exists("include/clpt/clpt.h")) return;
+    char prefix[128];
+    snprintf(prefix, sizeof prefix, "%s/prefix", stage);
+    snprintf(cmd, sizeof cmd,
+             "env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL make -s --no-print-directory BUILD=%s INSTALL_NO_BUILD=1 "
+             "PREFIX=%s install > %s/make-prefix.log 2>&1 && PKG_CONFIG_PATH=%s/lib/pkgconfig cc -std=c11 -o %s/example "
+             "examples/render.c $(PKG_CONFIG_PATH=%s/lib/pkgconfig pkg-config --cflags --libs clpt) "
+             "-Wl,-rpath,%s/lib > %s/cc.log 2>&1",
+             CLPT_BUILD_DIR, prefix, stage, prefix, stage, prefix, prefix, stage);
+    int st = sh(cmd);
+    char path[256];
+    snprintf(path, sizeof path, "%s/cc.log", stage);
+    CHECK_MSG(st == 0, "install with PREFIX and build the example with pkg-config: exit %d: %s", st, slurp(path));
+    if (st) return;
+    snprintf(cmd, sizeof cmd,
+             "%s/example scenes/cornell-box.scene %s/api.pfm --device=scalar --width=16 --height=12 --spp=2 "
+             "2> %s/example.log && %s/clpt scenes/cornell-box.scene --device scalar --width 16 --height 12 --spp 2 "
+             "-q -o %s/cli.pfm && cmp -s %s/api.pfm %s/cli.pfm && ldd %s/example | grep -q '%s/lib/libclpt.so'",
+             stage, stage, stage, CLPT_BUILD_DIR, stage, stage, stage, stage, prefix);
+    st = sh(cmd);
+    snprintf(path, sizeof path, "%s/example.log", stage);
+    CHECK_MSG(st == 0, "the example built with pkg-config, against the installed library: exit %d: %s", st,
+              slurp(path));
 }
 
 /* man renders the installed page without a warning (groff's, through man-db). */
@@ -171,6 +203,7 @@ int main(void)
     }
     RUN(test_make_install_places_every_file);
     RUN(test_installed_clpt_renders);
+    RUN(test_pkg_config_builds_the_example);
     RUN(test_man_page_renders_without_warnings);
     RUN(test_bash_completion);
     RUN(test_zsh_completion);

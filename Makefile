@@ -169,12 +169,15 @@ API_VERSION := $(VERSION)
 API_MAJOR   := $(firstword $(subst ., ,$(API_VERSION)))
 SO_NAME     := lib$(PROG).so.$(API_MAJOR)
 SO_FILE     := $(BUILD)/lib$(PROG).so.$(API_VERSION)
+# Every symbol the library needs resolved at its link (-z defs), except under the
+# sanitizers, whose runtime the program loading the library provides.
+SO_DEFS     ?= -Wl,--no-undefined -Wl,-z,defs
 SO_OBJ      := $(filter-out $(BUILD)/host/viewer/% $(BUILD)/host/dist/%,$(HOST_OBJ))
 
 lib: $(BUILD)/lib$(PROG).so
 
 $(SO_FILE): $(SO_OBJ)
-	$(CC) -shared -Wl,-soname,$(SO_NAME) -Wl,--no-undefined -Wl,-z,defs $(LDFLAGS) -o $@ $^ $(LDLIBS)
+	$(CC) -shared -Wl,-soname,$(SO_NAME) $(SO_DEFS) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
 $(BUILD)/lib$(PROG).so: $(SO_FILE)
 	ln -sf $(notdir $(SO_FILE)) $(BUILD)/$(SO_NAME)
@@ -182,15 +185,17 @@ $(BUILD)/lib$(PROG).so: $(SO_FILE)
 
 # The example and the API's test see the public header only, and link the shared
 # library (found beside them through the run path), as a user's program does.
-API_CFLAGS := -std=c11 $(OPT) -g $(WARN) -Iinclude -I$(BUILD)/include
+# (EXTRA_CFLAGS and LDFLAGS: a sanitizer build's program carries the runtime its
+# library needs.)
+API_CFLAGS := -std=c11 $(OPT) -g $(WARN) -Iinclude -I$(BUILD)/include $(EXTRA_CFLAGS)
 $(BUILD)/examples/%: examples/%.c include/clpt/clpt.h $(VERSION_H) $(BUILD)/lib$(PROG).so
 	@mkdir -p $(@D)
-	$(CC) $(API_CFLAGS) -o $@ $< -L$(BUILD) -l$(PROG) -Wl,-rpath,'$$ORIGIN/..'
+	$(CC) $(API_CFLAGS) $(LDFLAGS) -o $@ $< -L$(BUILD) -l$(PROG) -Wl,-rpath,'$$ORIGIN/..'
 
 $(BUILD)/tests/test_api: tests/test_api.c tests/harness.h include/clpt/clpt.h $(VERSION_H) $(BUILD)/lib$(PROG).so
 	@mkdir -p $(@D)
-	$(CC) $(API_CFLAGS) -D_GNU_SOURCE -Itests -DCLPT_BUILD_DIR='"$(BUILD)"' -pthread -o $@ $< -L$(BUILD) -l$(PROG) \
-	    -Wl,-rpath,'$$ORIGIN/..' -lm
+	$(CC) $(API_CFLAGS) $(LDFLAGS) -D_GNU_SOURCE -Itests -DCLPT_BUILD_DIR='"$(BUILD)"' -pthread -o $@ $< \
+	    -L$(BUILD) -l$(PROG) -Wl,-rpath,'$$ORIGIN/..' -lm
 
 $(BUILD)/tests/%: tests/%.c tests/harness.h $(BUILD)/lib$(PROG).a
 	@mkdir -p $(@D)
@@ -329,7 +334,7 @@ FUZZ_SECONDS ?= 60
 
 test-asan:
 	@sh tools/deps.sh --check base sanitize
-	@$(SAN_ENV) $(MAKE) --no-print-directory BUILD=build-asan CC=clang OPT=-O1 \
+	@$(SAN_ENV) $(MAKE) --no-print-directory BUILD=build-asan CC=clang OPT=-O1 SO_DEFS= \
 	    EXTRA_CFLAGS="$(SAN_FLAGS)" EXTRA_LDFLAGS="$(SAN_FLAGS)" test
 
 test-valgrind: $(BUILD)/$(PROG)

@@ -39,6 +39,7 @@
 #include "accel/traverse.h"
 #include "accel/alpha.h"
 #include "integrator/whitted.h"
+#include "medium/transmit.h"
 #include "kernel_args.h"
 
 /* CLPT_LOCAL_SIZE (set by the renderer, device_ocl.c, when it launches every kernel with
@@ -135,7 +136,7 @@ __kernel KERNEL_SIZE void k_shadow(SCENE_ARGS __global const uint *shadow_queue,
     if (i >= n || i >= counts[live_slot * QUEUE_COUNT_STRIDE]) return;
     SCENE_VIEW(sc);
     uint path = shadow_queue[i];
-    shadow_resolve(&paths[path], trace_occluded(&sc, shadow_rays[path]));
+    shadow_trace(&sc, &paths[path], shadow_rays[path]);   /* through media too */
 }
 
 #endif /* KF_HAS(KF_PATH) */
@@ -344,6 +345,11 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)sizeof(SphereXform);
     out[i++] = (uint)__builtin_offsetof(SphereXform, to_object);
     out[i++] = (uint)__builtin_offsetof(Sphere, xform);
+    out[i++] = (uint)sizeof(Medium);
+    out[i++] = (uint)__builtin_offsetof(Medium, sigma_s);
+    out[i++] = (uint)__builtin_offsetof(PathState, medium);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, has_media);
+    out[i++] = (uint)__builtin_offsetof(Material, medium_in);
 }
 #endif
 

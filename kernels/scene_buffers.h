@@ -55,7 +55,9 @@
     X(MANY, float,        env_cdf,    (ds)->n_env_cdf,           "environment map distribution") \
     /* read when params.use_mask is set: one entry per pixel */                              \
     X(MANY, uint,         pixel_mask, (ds)->pixel_mask ? (size_t)(ds)->params.width *        \
-                                      (ds)->params.height : 0u,  "pixel mask")
+                                      (ds)->params.height : 0u,  "pixel mask")               \
+    /* participating media (kernels/medium/), read only where params.has_media */           \
+    X(MANY, Medium,       media,      (ds)->params.n_media,      "participating media")
 
 /* Each buffer's position: SCENE_BUF_nodes ... The scene buffers are the first
  * SCENE_BUF_COUNT arguments of every kernel that takes SCENE_ARGS, in this order. */

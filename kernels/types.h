@@ -53,10 +53,12 @@
 #define KF_PATH_LANES 0x400000u /* the megakernel eight paths at a time (k_path_lanes, k_film;
                                  * kernels/integrator/shade_lanes.h): CPUs, scenes it shades fast */
 #define KF_SPHERE_XFORM 0x1000000u /* a sphere under a transform (an ellipsoid, SphereXform) */
+#define KF_MEDIA 0x2000000u     /* participating media or their boundaries (kernels/medium/,
+                                 * RenderParams.has_media; docs/media.md) */
 /* every bit above and every material type's */
 #define KF_ALL (KF_PATH | KF_WHITTED | KF_TEXTURES | KF_ALPHA | KF_ENV_MAP | KF_CUBEMAP | KF_REVSURFACE | \
                 KF_SPHERES | KF_BOXES | KF_PLANES | KF_DELTA_LIGHTS | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH | \
-                KF_PATH_LANES | KF_SPHERE_XFORM MATERIAL_TYPES(KF_MATERIAL_OR_))
+                KF_PATH_LANES | KF_SPHERE_XFORM | KF_MEDIA MATERIAL_TYPES(KF_MATERIAL_OR_))
 #define KF_MATERIAL_OR_(name, value, bit, traits, lobes) | (bit)
 #ifndef CLPT_FEATURES
 #define CLPT_FEATURES 0xffffffffu   /* every switch (KF_ALL, which is not usable here: a
@@ -358,7 +360,12 @@ typedef struct {                                        /* 288 bytes */
     uint layer_samples;                    /* ... walks per evaluation (nsamples) */
     uint layer_base;                       /* LAYER_BASE_*: albedo, or eta, k and ... */
     float base_roughness, base_anisotropy; /* ... the conductor's GGX */
-    uint pad_layer0, pad_layer1;
+    uint medium_in, medium_out;            /* the media this surface bounds (pbrt's
+                                            * MediumInterface; kernels/medium/medium.h):
+                                            * inside (behind the geometric normal) and
+                                            * outside, each 0 for vacuum or 1 + an index
+                                            * into media[]; equal: no boundary, a ray
+                                            * keeps its medium */
 } Material;
 
 #define MIX_MAX_DEPTH 8u        /* MAT_MIX: mixes nested at most this deep (mix.h) */
@@ -369,6 +376,9 @@ typedef struct {                                        /* 288 bytes */
 #define MAT_ALPHA_MASK 8u       /* glTF alphaMode MASK: cut out where alpha < alpha_cutoff */
 #define MAT_ALPHA_BLEND 16u     /* glTF alphaMode BLEND: a hit is kept with probability
                                  * alpha (kernels/accel/alpha.h) */
+#define MAT_INTERFACE 32u       /* no surface at all, only a boundary between media
+                                 * (`material none`, pbrt's "interface"): rays pass
+                                 * straight through it, changing medium (KF_MEDIA) */
 
 /* Every light type, listed once: X(name, value, feature bit, traits, keyword), as
  * MATERIAL_TYPES. The enum, the kernel feature a scene's lights need
@@ -532,6 +542,19 @@ enum Integrator {
     INTEGRATOR_AOV_ALBEDO = 4    /* diffuse colour (textured) */
 };
 
+/* A participating medium (kernels/medium/, docs/media.md): coefficients per unit of
+ * scene length, per RGB channel, already times the scene's `scale`. Homogeneous media
+ * are these constants everywhere they are bound. */
+enum MediumType { MEDIUM_HOMOGENEOUS = 0 };
+typedef struct {                                        /* 48 bytes */
+    uint type;                /* enum MediumType */
+    float g;                  /* Henyey-Greenstein asymmetry in (-1, 1); |g| < 1e-3 is
+                               * stored as 0 (the sampling formula divides by g) */
+    uint pad0, pad1;
+    vec3 sigma_a;  float pad2;   /* absorption */
+    vec3 sigma_s;  float pad3;   /* scattering */
+} Medium;
+
 /* Which strategies the path integrator combines for area lights: both with the power
  * heuristic, or one alone (tests/test_mis.c checks that all three agree). */
 enum MisMode { MIS_BOTH = 0, MIS_LIGHT_ONLY = 1, MIS_BSDF_ONLY = 2 };
@@ -540,7 +563,7 @@ enum MisMode { MIS_BOTH = 0, MIS_LIGHT_ONLY = 1, MIS_BSDF_ONLY = 2 };
 enum Sampler { SAMPLER_SOBOL = 0, SAMPLER_INDEPENDENT = 1 };
 
 /* Everything constant over a render, uploaded once per device. */
-typedef struct {                                        /* 320 bytes */
+typedef struct {                                        /* 336 bytes */
     Camera camera;
     vec3 bg_color;    uint bg_type;   /* constant colour, the sky's horizon colour, or
                                        * BG_MAP: the map's scale (intensity) */
@@ -590,10 +613,18 @@ typedef struct {                                        /* 320 bytes */
      * window's pixels are the whole render's, bit for bit. All 0: no crop. */
     uint crop_left;
     uint crop_top, crop_right, crop_bottom, pad_crop0;
+    /* participating media (kernels/medium/, docs/media.md) */
+    uint has_media;                   /* 1: paths may meet media or boundaries
+                                       * (MAT_INTERFACE); 0: the code of KF_MEDIA is
+                                       * skipped, and images are those of before media */
+    uint n_media;                     /* entries of media[] */
+    uint camera_medium;               /* where camera rays start: 0 vacuum, else 1 +
+                                       * an index into media[] */
+    uint pad_media;
 } RenderParams;
 
 /* One path of the wavefront; lives in a device buffer between kernel launches. */
-typedef struct {                                        /* 64 bytes */
+typedef struct {                                        /* 80 bytes */
     vec3 throughput;  uint pixel;
     vec3 radiance;    uint sample;
     vec3 shadow_L;    uint bounce;    /* contribution waiting for its shadow ray */
@@ -602,6 +633,14 @@ typedef struct {                                        /* 64 bytes */
     uint rng_key;                     /* RngKey.key of the camera sample (rng.h) */
     uint branch;                      /* which of RenderParams.split continuations from
                                        * the first hit this is (path_branch_next) */
+    uint medium;                      /* the medium the ray travels in: 0 vacuum, else
+                                       * 1 + an index into media[] (kernels/medium/) */
+    uint shadow_medium;               /* ... the one the shadow ray starts in */
+    uint crossings;                   /* boundaries passed straight through
+                                       * (MAT_INTERFACE): the random numbers of a bounce
+                                       * are those of bounce + crossings, so the segment
+                                       * after a boundary draws fresh ones */
+    uint pad_medium;
 } PathState;
 
 #define PATH_SPECULAR 1u      /* last bounce was a delta lobe: no MIS on emission */
@@ -639,8 +678,9 @@ CLPT_CHECK_SIZE(RevSurface, 48);
 CLPT_CHECK_SIZE(Material, 288);
 CLPT_CHECK_SIZE(Light, 96);
 CLPT_CHECK_SIZE(Camera, 112);
-CLPT_CHECK_SIZE(RenderParams, 320);
-CLPT_CHECK_SIZE(PathState, 64);
+CLPT_CHECK_SIZE(RenderParams, 336);
+CLPT_CHECK_SIZE(PathState, 80);
+CLPT_CHECK_SIZE(Medium, 48);
 CLPT_CHECK_SIZE(Texture, 112);
 _Static_assert(offsetof(RenderParams, bg_color) == 112, "RenderParams.bg_color");
 _Static_assert(offsetof(RenderParams, width) == 144, "RenderParams.width");
@@ -669,6 +709,10 @@ _Static_assert(offsetof(Material, texture_sheen_roughness) == 232, "Material.tex
 _Static_assert(offsetof(Material, layer_albedo) == 240, "Material.layer_albedo");
 _Static_assert(offsetof(Material, base_roughness) == 272, "Material.base_roughness");
 _Static_assert(offsetof(Light, position) == 32, "Light.position");
+_Static_assert(offsetof(Material, medium_in) == 280, "Material.medium_in");
+_Static_assert(offsetof(RenderParams, has_media) == 320, "RenderParams.has_media");
+_Static_assert(offsetof(PathState, medium) == 64, "PathState.medium");
+_Static_assert(offsetof(Medium, sigma_s) == 32, "Medium.sigma_s");
 #undef CLPT_CHECK_SIZE
 #endif
 

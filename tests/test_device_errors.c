@@ -133,7 +133,7 @@ static void test_device_too_small(void)
     cli_run(ARGS("scenes/cornell-box.scene", "--device", pocl_a, SMALL, "-o", OUT), &r);
     CHECK_EQ_INT(r.status, 5);
     CHECK_STR_CONTAINS(r.err, "clpt: error: device 'pthread");
-    CHECK_STR_CONTAINS(r.err, "the wave 1 path states need 4.0 MiB in one buffer, more than its largest allocation (1.0 MiB)");
+    CHECK_STR_CONTAINS(r.err, "the wave 1 path states need 5.0 MiB in one buffer, more than its largest allocation (1.0 MiB)");
     CHECK(!file_exists(OUT));
     /* 8 MB: every buffer fits alone, not all together */
     char cap[40];
@@ -141,7 +141,7 @@ static void test_device_too_small(void)
     setenv("CLPT_TEST_DEVICE_MEMORY", cap, 1);
     cli_run(ARGS("scenes/cornell-box.scene", "--device", pocl_a, SMALL, "-o", OUT), &r);
     CHECK_EQ_INT(r.status, 5);
-    CHECK_STR_CONTAINS(r.err, "the render needs 19.5 MiB (wave 1 path states 4.0 MiB, wave 2 path states 4.0 MiB");
+    CHECK_STR_CONTAINS(r.err, "the render needs 21.5 MiB (wave 1 path states 5.0 MiB, wave 2 path states 5.0 MiB");
     CHECK_STR_CONTAINS(r.err, "more than its 7.6 MiB of memory");
     /* fewer paths per wave fit */
     cli_run(ARGS("scenes/cornell-box.scene", "--device", pocl_a, "--wave-paths", "4096", SMALL, "-o", OUT), &r);

@@ -489,7 +489,9 @@ static void test_layout(void)
                     offsetof(Material, absorption), offsetof(Material, sheen_color),
                     offsetof(Material, texture_sheen_roughness),
                     offsetof(Material, layer_albedo), offsetof(Material, base_roughness), sizeof(SphereXform),
-                    offsetof(SphereXform, to_object), offsetof(Sphere, xform) };
+                    offsetof(SphereXform, to_object), offsetof(Sphere, xform), sizeof(Medium),
+                    offsetof(Medium, sigma_s), offsetof(PathState, medium), offsetof(RenderParams, has_media),
+                    offsetof(Material, medium_in) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);

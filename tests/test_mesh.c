@@ -276,7 +276,7 @@ static void test_scene_mesh_errors(void)
                     "s.scene:1:13: expected a mesh file name ending in .obj, .ply, .obj.gz, .ply.gz, .gltf "
                     "or .glb, found 'clpt-test-mesh-tri.stl'");
     check_scene_bad("mesh { file clpt-test-mesh-tri.obj shear 1 }",
-                    "expected a mesh key (file, material, translate, rotate, rx, ry, rz, scale, matrix) or '}'");
+                    "expected a mesh key (file, material, translate, rotate, rx, ry, rz, scale, matrix, interior, exterior) or '}'");
     /* the key after a one-number scale is read as a key */
     Scene s;
     Error err;

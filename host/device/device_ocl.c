@@ -40,6 +40,7 @@
 #include "base/timer.h"
 #include "device/kernel_features.h"
 #include "device/ocl_device.h"
+#include "medium/medium.h"
 
 /* What --stats says of the device's waves: their size and how one is run. */
 static void note_waves(Device *d, const OclDevice *od)
@@ -61,7 +62,7 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     SceneBufferBytes in[SCENE_N];
     for (unsigned i = 0; i < SCENE_N; i++) in[i] = device_scene_buffer(s, i);
     uint n_pixels = p->width * p->height;
-    od->max_bounces = p->max_depth + 1u;
+    od->max_bounces = path_max_shades(p->max_depth, p->has_media);
     Status st = ocld_alloc_render(od, in, n_pixels, err);
     if (st) return st;
     od->n_pixels = n_pixels;
@@ -103,9 +104,9 @@ static Status ocl_update_params(Device *d, const RenderParams *p, const uint *pi
     size_t mask_bytes = pixel_mask ? (size_t)od->n_pixels * sizeof(uint) : 0;
     if ((st = ocld_make_buffer(od, CL_MEM_READ_ONLY, mask_bytes, pixel_mask, "pixel mask",
                           &od->scene[SCENE_BUF_pixel_mask], err)) ||
-        (st = ocld_set_scene_arg(od, SCENE_BUF_pixel_mask, err)) || (st = ocld_grow_counts(od, p->max_depth + 1u, err)))
+        (st = ocld_set_scene_arg(od, SCENE_BUF_pixel_mask, err)) || (st = ocld_grow_counts(od, path_max_shades(p->max_depth, p->has_media), err)))
         return st;
-    od->max_bounces = p->max_depth + 1u;
+    od->max_bounces = path_max_shades(p->max_depth, p->has_media);
     d->counters.upload_seconds += timer_now() - t0;
     od->scene_features |= kernel_params_features(p);
     od->path_launch = p->split > 1u ? WAVE_LAUNCH_MEGAKERNEL : od->launch;

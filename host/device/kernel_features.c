@@ -3,7 +3,8 @@
 
 unsigned kernel_params_features(const RenderParams *p)
 {
-    return (p->bg_type == BG_MAP ? KF_ENV_MAP : 0u) | (p->bg_type == BG_CUBEMAP ? KF_CUBEMAP : 0u);
+    return (p->bg_type == BG_MAP ? KF_ENV_MAP : 0u) | (p->bg_type == BG_CUBEMAP ? KF_CUBEMAP : 0u) |
+           (p->has_media ? KF_MEDIA : 0u);
 }
 
 unsigned kernel_scene_features(const DeviceScene *s)

@@ -92,7 +92,9 @@ typedef struct {
     FilmSlot slots[FILM_SLOTS];
     uint n_slots;           /* 2, or 1 when two films do not fit the device */
     uint head, tail;        /* batches rendered and taken, counted from 0 */
-    uint max_bounces;       /* bounces 0 .. max_depth: 2 * max_bounces + 1 count slots */
+    uint max_bounces;       /* bounces 0 .. max_depth, and a launch per boundary a path
+                             * may pass in media (path_max_shades): 2 * max_bounces + 1
+                             * count slots */
     uint counts_bounces;    /* the bounces the wave count buffers have room for */
     uint wave_paths;        /* capacity of each wave's buffers */
     uint wave_auto;         /* a large default wave, used where it fits (load_scene); 0 if none */

@@ -18,6 +18,7 @@
 #include "io/path.h"
 #include "io/reader.h"
 #include "io/texture.h"
+#include "scene/media.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -48,6 +49,7 @@ static const char *kind_what(const KeySpec *k)
     case VK_ROTATE: return "an axis and an angle in degrees (4 numbers, the axis not 0 0 0)";
     case VK_SCALE: return "a non-zero scale factor, or three (x y z)";
     case VK_MATRIX: return "16 numbers (a 4x4 matrix, row by row)";
+    case VK_MEDIUM: return "a medium name or 'none'";
     case VK_NUMBER:
     case VK_UINT:
     case VK_WORD: return k->what;
@@ -149,6 +151,12 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
         }
         return ST_OK;
     }
+    case VK_MEDIUM: {
+        uint ref;
+        if ((st = scene_read_medium_ref(p, lx, &t, &ref))) return st;
+        v->u = ref;
+        return ST_OK;
+    }
     case VK_MATERIAL:
         if (t.kind == TOK_LBRACE) return scene_parse_material_block(p, lx, &v->key, 1, NULL, &v->material);
         if ((t.kind != TOK_WORD && t.kind != TOK_STRING) || t.len == 0)
@@ -157,6 +165,12 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
             char *name = tok_copy(&t);
             if (!name) return error_set(err, ST_INTERNAL, "out of memory");
             v->material = scene_find_material(p->s, name);
+            /* `none`, unless a material has that name: a boundary between media and
+             * no surface (docs/media.md) */
+            if (v->material == NO_INDEX && strcmp(name, "none") == 0) {
+                free(name);
+                return scene_interface_material(p->s, &v->material, err);
+            }
             if (v->material == NO_INDEX) {
                 char shown[64];
                 tok_describe(&t, shown, sizeof shown);
@@ -242,7 +256,7 @@ vec3 scene_cross_d(vec3 a, vec3 b, double *length)
 
 /* ------------------------------------------------------------------ statements */
 
-enum { CAM_TYPE, CAM_FROM, CAM_AT, CAM_UP, CAM_FOV, CAM_APERTURE, CAM_FOCUS, CAM_WIDTH, CAM_N };
+enum { CAM_TYPE, CAM_FROM, CAM_AT, CAM_UP, CAM_FOV, CAM_APERTURE, CAM_FOCUS, CAM_WIDTH, CAM_MEDIUM, CAM_N };
 static const KeySpec camera_keys[CAM_N] = {
     [CAM_TYPE] = {"type", VK_WORD, 0, 0, 0, 0, 0, "a camera type (perspective, orthographic)"},
     [CAM_FROM] = {"from", VK_VEC3, 0, 0, 0, 0, 0, NULL},
@@ -252,6 +266,7 @@ static const KeySpec camera_keys[CAM_N] = {
     [CAM_APERTURE] = {"aperture", VK_NUMBER, 0, 0, INFINITY, 0, 1, "a number >= 0"},
     [CAM_FOCUS] = {"focus", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a distance > 0"},
     [CAM_WIDTH] = {"width", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a width > 0 (scene units)"},
+    [CAM_MEDIUM] = {"medium", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
 };
 
 /* The camera's type, and the keys that belong to the other type refused (a perspective
@@ -292,6 +307,7 @@ static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
     if (v[CAM_FOV].given) c->vfov = v[CAM_FOV].f;
     if (v[CAM_APERTURE].given) c->aperture = v[CAM_APERTURE].f;
     if (v[CAM_FOCUS].given) c->focus_dist = v[CAM_FOCUS].f;
+    if (v[CAM_MEDIUM].given) p->s->camera_medium = (uint)v[CAM_MEDIUM].u;
     /* blame the key that made the camera invalid, or the block if the defaults did */
     const Token *view_tok = v[CAM_AT].given ? &v[CAM_AT].key : v[CAM_FROM].given ? &v[CAM_FROM].key : kw;
     vec3 dir = v3_sub(c->at, c->from);
@@ -367,7 +383,8 @@ static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-enum { BG_COLOR, BG_HORIZON, BG_ZENITH, BG_AMBIENT, BG_CUBE, BG_MAP_KEY, BG_INTENSITY, BG_ROTATE, BG_N };
+enum { BG_COLOR, BG_HORIZON, BG_ZENITH, BG_AMBIENT, BG_CUBE, BG_MAP_KEY, BG_INTENSITY, BG_ROTATE, BG_MEDIUM,
+       BG_N };
 static const KeySpec background_keys[BG_N] = {
     [BG_COLOR] = {"color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [BG_HORIZON] = {"horizon", VK_COLOR, 0, 0, 0, 0, 0, NULL},
@@ -377,6 +394,7 @@ static const KeySpec background_keys[BG_N] = {
     [BG_MAP_KEY] = {"map", VK_PATH, 0, 0, 0, 0, 0, NULL},
     [BG_INTENSITY] = {"intensity", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
     [BG_ROTATE] = {"rotate", VK_NUMBER, 0, -1e6, 1e6, 0, 0, "a number of degrees in [-1e6, 1e6]"},
+    [BG_MEDIUM] = {"medium", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
 };
 
 /* `map "FILE"`: an equirectangular environment map (kernels/light/envmap.h), the file found
@@ -420,6 +438,12 @@ static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
     if (st) return st;
     Scene *s = p->s;
     if (v[BG_AMBIENT].given) s->ambient = v[BG_AMBIENT].v;   /* the whitted integrator's */
+    /* the medium everywhere no boundary says otherwise (docs/media.md); alone, it keeps
+     * the black background */
+    if (v[BG_MEDIUM].given) s->world_medium = (uint)v[BG_MEDIUM].u;
+    int bg_keys = 0;
+    for (int i = 0; i < BG_N; i++) bg_keys += i != BG_MEDIUM && i != BG_AMBIENT && v[i].given;
+    if (v[BG_MEDIUM].given && bg_keys == 0) return ST_OK;
     int sky = v[BG_HORIZON].given || v[BG_ZENITH].given;
     if (!v[BG_MAP_KEY].given && (v[BG_INTENSITY].given || v[BG_ROTATE].given)) {
         const Token *t = v[BG_INTENSITY].given ? &v[BG_INTENSITY].key : &v[BG_ROTATE].key;
@@ -498,7 +522,7 @@ static const struct {
     {"triangle", scene_parse_triangle},       {"quad", scene_parse_quad},
     {"box", scene_parse_box},                 {"mesh", scene_parse_mesh},
     {"include", parse_include},               {"light", scene_parse_light},
-    {"texture", scene_parse_texture},
+    {"texture", scene_parse_texture},         {"medium", scene_parse_medium},
 };
 #define N_STATEMENTS (sizeof statements / sizeof statements[0])
 
@@ -515,7 +539,7 @@ static Status parse_statements(Parser *p, Lexer *lx)
         if (i == N_STATEMENTS) {
             st = lex_expected(lx, &t,
                               "a statement (camera, image, background, material, sphere, "
-                              "plane, triangle, quad, box, mesh, light, texture, include)", p->err);
+                              "plane, triangle, quad, box, mesh, light, texture, medium, include)", p->err);
             break;
         }
         if ((st = statements[i].parse(p, lx, &t))) break;

@@ -28,7 +28,8 @@ typedef enum {
     VK_TEXTURE,     /* the name of a texture defined before */
     VK_ROTATE,      /* an axis (three floats, not all zero) and an angle in degrees */
     VK_SCALE,       /* one non-zero float, or three */
-    VK_MATRIX       /* sixteen floats, a 4x4 matrix row by row */
+    VK_MATRIX,      /* sixteen floats, a 4x4 matrix row by row */
+    VK_MEDIUM       /* a medium name defined before, or none (vacuum): u = 0 or 1 + index */
 } ValueKind;
 
 typedef struct {
@@ -83,5 +84,15 @@ Status scene_parse_quad(Parser *p, Lexer *lx, const Token *kw);
 Status scene_parse_box(Parser *p, Lexer *lx, const Token *kw);
 Status scene_parse_mesh(Parser *p, Lexer *lx, const Token *kw);
 Status scene_parse_light(Parser *p, Lexer *lx, const Token *kw);
+
+/* scene_medium.c: the medium statement, shapes' interior and exterior media */
+Status scene_parse_medium(Parser *p, Lexer *lx, const Token *kw);
+/* A VK_MEDIUM value at token t: *ref = 0 for none, else 1 + the medium's index. */
+Status scene_read_medium_ref(Parser *p, Lexer *lx, const Token *t, uint *ref);
+/* The material a shape of `material` gets with its optional interior and exterior
+ * values (NULL or not given: the background's medium); itself when neither is given. */
+Status scene_shape_media(Parser *p, const Value *interior, const Value *exterior, uint material, uint *bound);
+/* The same for the triangles [first, n_triangles) of a mesh, each of its own material. */
+Status scene_mesh_media(Parser *p, const Value *interior, const Value *exterior, size_t first);
 
 #endif /* CLPT_SCENE_READER_H */

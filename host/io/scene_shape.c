@@ -13,11 +13,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { SPH_CENTER, SPH_RADIUS, SPH_MATERIAL, SPH_N };
+enum { SPH_CENTER, SPH_RADIUS, SPH_MATERIAL, SPH_INTERIOR, SPH_EXTERIOR, SPH_N };
 static const KeySpec sphere_keys[SPH_N] = {
     [SPH_CENTER] = {"center", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     [SPH_RADIUS] = {"radius", VK_NUMBER, 1, 0, INFINITY, 1, 1, "a radius > 0"},
     [SPH_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+    [SPH_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
+    [SPH_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
 };
 
 Status scene_parse_sphere(Parser *p, Lexer *lx, const Token *kw)
@@ -35,15 +37,18 @@ Status scene_parse_sphere(Parser *p, Lexer *lx, const Token *kw)
     memset(&sp, 0, sizeof sp);
     sp.center = c;
     sp.radius = r;
-    sp.material = v[SPH_MATERIAL].material;
+    if ((st = scene_shape_media(p, &v[SPH_INTERIOR], &v[SPH_EXTERIOR], v[SPH_MATERIAL].material, &sp.material)))
+        return st;
     return scene_add_sphere(p->s, sp, p->err);
 }
 
-enum { PL_POINT, PL_NORMAL, PL_MATERIAL, PL_N };
+enum { PL_POINT, PL_NORMAL, PL_MATERIAL, PL_INTERIOR, PL_EXTERIOR, PL_N };
 static const KeySpec plane_keys[PL_N] = {
     [PL_POINT] = {"point", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     [PL_NORMAL] = {"normal", VK_DIR, 1, 0, 0, 0, 0, NULL},
     [PL_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+    [PL_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
+    [PL_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
 };
 
 Status scene_parse_plane(Parser *p, Lexer *lx, const Token *kw)
@@ -60,7 +65,8 @@ Status scene_parse_plane(Parser *p, Lexer *lx, const Token *kw)
     memset(&pl, 0, sizeof pl);
     pl.normal = v3((float)nx, (float)ny, (float)nz);
     pl.offset = (float)(nx * q.x + ny * q.y + nz * q.z);
-    pl.material = v[PL_MATERIAL].material;
+    if ((st = scene_shape_media(p, &v[PL_INTERIOR], &v[PL_EXTERIOR], v[PL_MATERIAL].material, &pl.material)))
+        return st;
     return scene_add_plane(p->s, pl, p->err);
 }
 
@@ -86,12 +92,15 @@ static Status add_triangle(Parser *p, const Lexer *lx, const Token *kw, vec3 a, 
     return scene_add_triangle(p->s, t, p->err);
 }
 
-enum { TRI_V0, TRI_V1, TRI_V2, TRI_V3, TRI_MATERIAL, TRI_N };
+enum { TRI_V0, TRI_V1, TRI_V2, TRI_V3, TRI_MATERIAL, TRI_INTERIOR, TRI_EXTERIOR, TRI_N };
+/* a triangle's keys are a quad's without v3: TRI_V3 onwards one place earlier */
 static const KeySpec triangle_keys[TRI_N - 1] = {
     {"v0", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     {"v1", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     {"v2", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+    {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
+    {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
 };
 static const KeySpec quad_keys[TRI_N] = {
     [TRI_V0] = {"v0", VK_VEC3, 1, 0, 0, 0, 0, NULL},
@@ -99,6 +108,8 @@ static const KeySpec quad_keys[TRI_N] = {
     [TRI_V2] = {"v2", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     [TRI_V3] = {"v3", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     [TRI_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+    [TRI_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
+    [TRI_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
 };
 
 Status scene_parse_triangle(Parser *p, Lexer *lx, const Token *kw)
@@ -106,7 +117,10 @@ Status scene_parse_triangle(Parser *p, Lexer *lx, const Token *kw)
     Value v[TRI_N - 1];
     Status st = scene_parse_block(p, lx, kw, 0, "triangle", triangle_keys, TRI_N - 1, v);
     if (st) return st;
-    return add_triangle(p, lx, kw, v[0].v, v[1].v, v[2].v, v[3].material, "v0 v1 v2");
+    uint m;
+    if ((st = scene_shape_media(p, &v[TRI_INTERIOR - 1], &v[TRI_EXTERIOR - 1], v[TRI_MATERIAL - 1].material, &m)))
+        return st;
+    return add_triangle(p, lx, kw, v[0].v, v[1].v, v[2].v, m, "v0 v1 v2");
 }
 
 Status scene_parse_quad(Parser *p, Lexer *lx, const Token *kw)
@@ -114,17 +128,20 @@ Status scene_parse_quad(Parser *p, Lexer *lx, const Token *kw)
     Value v[TRI_N];
     Status st = scene_parse_block(p, lx, kw, 0, "quad", quad_keys, TRI_N, v);
     if (st) return st;
-    uint m = v[TRI_MATERIAL].material;
+    uint m;
+    if ((st = scene_shape_media(p, &v[TRI_INTERIOR], &v[TRI_EXTERIOR], v[TRI_MATERIAL].material, &m))) return st;
     st = add_triangle(p, lx, kw, v[TRI_V0].v, v[TRI_V1].v, v[TRI_V2].v, m, "v0 v1 v2");
     if (!st) st = add_triangle(p, lx, kw, v[TRI_V0].v, v[TRI_V2].v, v[TRI_V3].v, m, "v0 v2 v3");
     return st;
 }
 
-enum { BOX_MIN, BOX_MAX, BOX_MATERIAL, BOX_N };
+enum { BOX_MIN, BOX_MAX, BOX_MATERIAL, BOX_INTERIOR, BOX_EXTERIOR, BOX_N };
 static const KeySpec box_keys[BOX_N] = {
     [BOX_MIN] = {"min", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     [BOX_MAX] = {"max", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     [BOX_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
+    [BOX_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
+    [BOX_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
 };
 
 Status scene_parse_box(Parser *p, Lexer *lx, const Token *kw)
@@ -144,12 +161,13 @@ Status scene_parse_box(Parser *p, Lexer *lx, const Token *kw)
     memset(&b, 0, sizeof b);
     b.lo = lo;
     b.hi = hi;
-    b.material = v[BOX_MATERIAL].material;
+    if ((st = scene_shape_media(p, &v[BOX_INTERIOR], &v[BOX_EXTERIOR], v[BOX_MATERIAL].material, &b.material)))
+        return st;
     return scene_add_box(p->s, b, p->err);
 }
 
 enum { MESH_FILE, MESH_MATERIAL, MESH_TRANSLATE, MESH_ROTATE, MESH_RX, MESH_RY, MESH_RZ, MESH_SCALE,
-       MESH_MATRIX, MESH_N };
+       MESH_MATRIX, MESH_INTERIOR, MESH_EXTERIOR, MESH_N };
 static const KeySpec mesh_keys[MESH_N] = {
     [MESH_FILE] = {"file", VK_PATH, 1, 0, 0, 0, 0, NULL},
     [MESH_MATERIAL] = {"material", VK_MATERIAL, 0, 0, 0, 0, 0, NULL},
@@ -160,6 +178,8 @@ static const KeySpec mesh_keys[MESH_N] = {
     [MESH_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
     [MESH_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
     [MESH_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
+    [MESH_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
+    [MESH_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
 };
 
 /* The instance transform of a mesh block: scale, then rotate, rx, ry, rz, then
@@ -250,6 +270,7 @@ Status scene_parse_mesh(Parser *p, Lexer *lx, const Token *kw)
     st = mesh_load(path, p->s, &o, p->err);
     if (st) reader_note_nested(lx, f, kw, "in the mesh of", st, p->err);
     else st = check_mesh_size(p, lx, f, path, first);
+    if (!st) st = scene_mesh_media(p, &v[MESH_INTERIOR], &v[MESH_EXTERIOR], first);
     free(path);
     return st;
 }

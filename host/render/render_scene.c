@@ -6,6 +6,7 @@
 
 #include "scene/camera.h"
 #include "scene/cube_env.h"
+#include "scene/media.h"
 #include "scene/texel_pack.h"
 
 /* Russian roulette starts after this many bounces: early bounces carry most of the
@@ -83,6 +84,22 @@ static Status crop_params(const Scene *s, RenderParams *p, Error *err)
     return ST_OK;
 }
 
+/* The media's part of the device scene (kernels/medium/). First-hit splitting
+ * restarts a path at its first surface, which a path in a medium may never reach: the
+ * two are not combined. */
+static Status prepare_media(const Scene *s, RenderScene *out, Error *err)
+{
+    RenderParams *p = &out->ds.params;
+    p->has_media = scene_has_media(s) ? 1u : 0u;
+    p->n_media = (uint)s->n_media;
+    p->camera_medium = scene_medium_resolve(s, s->camera_medium);
+    out->ds.media = s->n_media ? s->media : NULL;
+    if (p->has_media && p->split > 1u)
+        return error_set(err, ST_USAGE, "first-hit splitting (--split %u) does not work in a scene with "
+                         "participating media; render it with --split 1", p->split);
+    return ST_OK;
+}
+
 Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error *err)
 {
     memset(out, 0, sizeof *out);
@@ -90,6 +107,8 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
     /* the path tracer samples a cube map as an environment light; Whitted keeps the
      * course's exact lookup (cube_env.h) */
     if (s->integrator == INTEGRATOR_PATH && s->bg_type == BG_CUBEMAP && (st = cube_env_convert(s, err))) return st;
+    /* the media first: a bound material's copy may emit (scene/media.h) */
+    scene_prepare_media(s);
     if ((st = scene_prepare_lights(s, err))) return st;
     /* after everything that reads float texels on the host (the map's distribution, the
      * cube map's conversion) */
@@ -110,6 +129,7 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
     p->max_depth = s->image.max_depth;
     p->split = s->image.split ? s->image.split : 1u;
     p->clamp_indirect = s->image.clamp_indirect;
+    if ((st = prepare_media(s, out, err))) return st;
     p->rr_depth = RR_START_BOUNCE;
     p->seed = s->image.seed;
     p->sampler = s->image.sampler;

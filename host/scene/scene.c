@@ -41,6 +41,7 @@ void scene_init(Scene *s)
     s->integrator = INTEGRATOR_PATH;
     s->linear_output = 0;
     s->shadows = 1;
+    s->camera_medium = SCENE_MEDIUM_UNSET;
 }
 
 void scene_free(Scene *s)
@@ -71,6 +72,10 @@ void scene_free(Scene *s)
     free(s->textures);
     free(s->texels);
     free(s->env_cdf);
+    for (size_t i = 0; i < s->n_media; i++) free(s->medium_names[i]);
+    free(s->medium_names);
+    free(s->media);
+    free(s->medium_bindings);
     free(s->path);
     free(s->output_hint);
     for (size_t i = 0; i < s->n_warnings; i++) free(s->warnings[i]);

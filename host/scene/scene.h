@@ -45,6 +45,14 @@ typedef struct {
     float clamp_indirect;  /* path: --clamp's limit on indirect light, 0 = none */
 } SceneImage;
 
+/* A material that a shape bounding media was given (scene/media.h): materials[material]
+ * is materials[origin] with the media `in` and `out` (0 vacuum, 1 + a medium's index, or
+ * SCENE_MEDIUM_UNSET: the background's, known only once the scene is read). */
+typedef struct {
+    uint material, origin, in, out;
+} SceneMediumBinding;
+#define SCENE_MEDIUM_UNSET 0xffffffffu
+
 typedef struct {
     char *path;                  /* scene file as given on the command line */
     int size_overridden;         /* in: --width or --height replaces the file's size, so
@@ -106,6 +114,15 @@ typedef struct {
      * that name, and "S" / "L" + image file -> the first texture read from it in sRGB /
      * linear encoding (texture_load_image shares its texels). */
     StrMap material_by_name, texture_by_name, texture_by_source;
+
+    /* Participating media (scene/media.h, docs/media.md): the named media, the
+     * background's (0 none, else 1 + index: the medium everywhere no boundary says
+     * otherwise) and the camera's (the same, or SCENE_MEDIUM_UNSET for the
+     * background's), and which materials are copies bound to media (the shapes'
+     * interior and exterior), resolved by scene_prepare_media. */
+    Medium *media;         char **medium_names;   size_t n_media, cap_media;
+    uint world_medium, camera_medium;
+    SceneMediumBinding *medium_bindings;   size_t n_medium_bindings, cap_medium_bindings;
 
     /* Problems the readers worked around (a missing map_Kd image), for main to print
      * once the scene is read; each names the file and line. */

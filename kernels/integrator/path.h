@@ -13,6 +13,7 @@
 #include "integrator/raygen.h"
 #include "integrator/shade_path.h"
 #include "accel/traverse.h"
+#include "medium/transmit.h"
 
 /* path_run's loop, written once: STAGE(phase) follows each of its stages (enum
  * DevicePhase, host/device/device.h). path_run passes an empty one; the scalar device's
@@ -45,8 +46,7 @@
         STAGE(PHASE_SHADE);                                                              \
         if (first && (r & SHADE_SCATTERED)) split = params_split(sc->params) - 1u;       \
         if (r & SHADE_SHADOW) {                                                          \
-            shadow_resolve(ps, trace_occluded(sc, *shadow_ray));                         \
-            n_rays++;                                                                    \
+            n_rays += shadow_trace(sc, ps, *shadow_ray);                                 \
             STAGE(PHASE_SHADOW);                                                         \
         }                                                                                \
         restart = 0;                                                                     \

@@ -80,6 +80,10 @@ KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
     ps->flags = PATH_SPECULAR;  /* what the camera sees directly gets full weight */
     ps->rng_key = key.key;
     ps->branch = 0u;
+    ps->medium = p->camera_medium;   /* 0 (vacuum) in scenes without media */
+    ps->shadow_medium = 0u;
+    ps->crossings = 0u;
+    ps->pad_medium = 0u;
 }
 
 /* Restarts the path of a camera sample as its next continuation from the first hit

@@ -65,7 +65,8 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
                            vec3 ng_face, Material m, vec3 albedo, int front, GLOBAL Ray *shadow_ray)
 {
     RngKey key = rng_key_of(ps, sc->params);
-    uint b = ps->bounce;
+    /* path_rng_bounce (kernels/medium/medium_path.h), defined below */
+    uint b = KF_HAS(KF_MEDIA) ? ps->bounce + ps->crossings : ps->bounce;
     uint mis_mode = sc->params->mis_mode;
     LightSample ls;
     float lu, lv;
@@ -163,6 +164,9 @@ KFN void shade_absorb(Ray r, Hit hit, Surface s, Material m, GLOBAL PathState *p
     ps->throughput = v3_mul(ps->throughput, v3(k_exp2(a.x * t), k_exp2(a.y * t), k_exp2(a.z * t)));
 }
 
+/* the medium's part of a bounce, which uses mis_power and shadow_resolve above */
+#include "medium/medium_path.h"
+
 /* One bounce. `ray` is the ray that produced `hit`; on SHADE_CONTINUE it is replaced by
  * the next ray. Returns SHADE_CONTINUE and/or SHADE_SHADOW, and SHADE_SCATTERED when
  * the surface scattered.
@@ -192,6 +196,12 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     Ray r = *ray;
     RngKey key = rng_key_of(ps, p);
     uint bounce = ps->bounce;
+    uint rb = KF_HAS(KF_MEDIA) ? path_rng_bounce(ps) : bounce;   /* past the boundaries crossed */
+
+    /* in a medium, the flight to the hit may stop short of it (kernels/medium/) */
+    uint medium_result;
+    if (KF_HAS(KF_MEDIA) && ps->medium != 0u && medium_flight(sc, ray, hit, ps, shadow_ray, &medium_result))
+        return medium_result;
 
     if (hit.prim == NO_INDEX) {
         shade_escape(sc, r, ps);
@@ -200,6 +210,7 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
 
     Surface s = surface_at(sc, r, hit);
     Material m = sc->materials[s.material];   /* a mix: its own emission (mix.h) */
+    if (KF_HAS(KF_MEDIA) && (m.flags & MAT_INTERFACE)) return medium_cross(ray, hit, s, m, ps);
     shade_absorb(r, hit, s, m, ps);
     int later_branch = bounce == 0u && ps->branch != 0u;
     if (!later_branch) shade_emission(sc, r, s, m, ps);
@@ -209,6 +220,7 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     /* normals turned toward the side the ray came from */
     int front = v3_dot(r.d, s.ng) < 0.0f;
     vec3 ng_face = front ? s.ng : v3_neg(s.ng);
+    uint medium_in = m.medium_in, medium_out = m.medium_out;   /* the stored material's */
     material_resolve(sc, &m, s, r.d, ng_face);
     if (!material_scatters(m.type)) return 0u;   /* pure emitters do not reflect */
     s.ns = material_normal(sc, m, s);
@@ -220,14 +232,17 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     material_at(sc, &m, s, ng_face);
 
     if (p->n_lights > 0u && bsdf_has_density(m, albedo) &&
-        shade_light_sample(sc, ps, s, r.d, ns_face, ng_face, m, albedo, front, shadow_ray))
+        shade_light_sample(sc, ps, s, r.d, ns_face, ng_face, m, albedo, front, shadow_ray)) {
         result |= SHADE_SHADOW;
+        if (KF_HAS(KF_MEDIA))
+            ps->shadow_medium = medium_beyond(medium_in, medium_out, ps->medium, shadow_ray->d, s.ng);
+    }
     /* a diffuse sample uses only the 2D pair: the other dimensions are left undrawn */
     int two_d = m.type == MAT_DIFFUSE;
     float bu, bv;
-    rng_uniform2(key, bounce, DIM_BSDF_U, &bu, &bv);
-    bs = bsdf_sample(m, albedo, r.d, ns_face, ng_face, front, two_d ? 0.0f : rng_uniform(key, bounce, DIM_BSDF_LOBE),
-                     bu, bv, two_d ? 0.0f : rng_uniform(key, bounce, DIM_BSDF_W));
+    rng_uniform2(key, rb, DIM_BSDF_U, &bu, &bv);
+    bs = bsdf_sample(m, albedo, r.d, ns_face, ng_face, front, two_d ? 0.0f : rng_uniform(key, rb, DIM_BSDF_LOBE),
+                     bu, bv, two_d ? 0.0f : rng_uniform(key, rb, DIM_BSDF_W));
 
     /* a reflected direction must leave on the incoming side, a transmitted one on the
      * other; anything else is a sample below the geometric surface and carries nothing */
@@ -243,13 +258,14 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
          * this far carries, so that a continuation is cut no more often than an
          * unsplit path */
         float q = k_fmin(v3_max_comp(thr) * (float)params_split(p), 0.95f);
-        if (!(rng_uniform(key, bounce, DIM_ROULETTE) < q)) return result;
+        if (!(rng_uniform(key, rb, DIM_ROULETTE) < q)) return result;
         thr = v3_scale(thr, 1.0f / q);
     }
     if (!(v3_max_comp(thr) > 0.0f)) return result;   /* also drops NaN */
     ps->throughput = thr;
     ps->bsdf_pdf = bs.pdf;
     ps->flags = bs.specular ? PATH_SPECULAR : 0u;
+    if (KF_HAS(KF_MEDIA)) ps->medium = medium_beyond(medium_in, medium_out, ps->medium, bs.wi, s.ng);
     ray->o = spawn_origin(s, transmitted ? v3_neg(ng_face) : ng_face);
     ray->d = bs.wi;
     ray->tmin = 0.0f;

@@ -37,6 +37,9 @@ enum RngDim {
                                                              * DIM_LIGHT_U, shade_path.h) */
     DIM_BSDF_LOBE, DIM_BSDF_U, DIM_BSDF_V, DIM_BSDF_W,      /* scattering */
     DIM_ROULETTE,                                            /* Russian roulette */
+    DIM_MEDIUM,                                              /* a medium's channel and
+                                                             * free-flight distance
+                                                             * (kernels/medium/) */
     RNG_DIMS_PER_BOUNCE = 16
 };
 

@@ -1,0 +1,53 @@
+/*
+ * media.h — participating media in the host's scene (kernels/medium/, docs/media.md):
+ * the named media, the materials of shapes that bound them, the boundary that is no
+ * surface (`material none`), and their resolution when a render is prepared.
+ *
+ * A shape bounds media through its material: the kernels read a surface's interior and
+ * exterior medium from Material.medium_in/medium_out, so a shape given media gets a copy
+ * of its material carrying them (one copy per material and pair of media, shared by
+ * every shape that asks for the same). The copies keep their original's name, so
+ * `--set material.NAME.*` reaches them too, and scene_prepare_media copies each
+ * original over its copies again before a render.
+ */
+#ifndef CLPT_SCENE_MEDIA_H
+#define CLPT_SCENE_MEDIA_H
+
+#include "scene/scene.h"
+
+/* A homogeneous medium: absorption and scattering per unit of scene length (already
+ * scaled), Henyey-Greenstein g in (-1, 1) (|g| < 1e-3 stored as 0, types.h). */
+Medium medium_homogeneous(vec3 sigma_a, vec3 sigma_s, float g);
+
+/* Adds medium m named `name` (the caller checks that the name is new). Fails only when
+ * memory runs out. */
+Status scene_add_medium(Scene *s, const char *name, Medium m, uint *index, Error *err);
+
+/* The index of the medium named name[0, len), or NO_INDEX. */
+uint scene_find_medium(const Scene *s, const char *name, size_t len);
+
+/* A material that is no surface, only a boundary between media (MAT_INTERFACE). */
+Material material_interface(void);
+
+/* The material of surfaces that are only a boundary (MAT_INTERFACE: `material none`,
+ * pbrt's "interface"), added on first use. Fails only when memory runs out. */
+Status scene_interface_material(Scene *s, uint *index, Error *err);
+
+/* The material a shape of material `material` gets when it bounds medium `in` inside
+ * and `out` outside (each 0 vacuum, 1 + a medium index, or SCENE_MEDIUM_UNSET: the
+ * background's): `material` itself when both are unset (the shape is no boundary of
+ * its own), else its copy bound to them. Fails only when memory runs out. */
+Status scene_bind_media(Scene *s, uint material, uint in, uint out, uint *bound, Error *err);
+
+/* 0 for vacuum or 1 + a medium index, with SCENE_MEDIUM_UNSET read as the background's. */
+uint scene_medium_resolve(const Scene *s, uint ref);
+
+/* Whether a path can meet a medium or a boundary: some medium is in use or some
+ * material is MAT_INTERFACE (RenderParams.has_media). */
+int scene_has_media(const Scene *s);
+
+/* Before a render: each bound material made again from its original, with the
+ * background's medium put where a side was left unset. */
+void scene_prepare_media(Scene *s);
+
+#endif /* CLPT_SCENE_MEDIA_H */

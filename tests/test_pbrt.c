@@ -218,8 +218,7 @@ static void test_materials_lights(void)
     CHECK_EQ_INT(m[5]->type, MAT_LAYERED);
     CHECK_EQ_INT(m[5]->layer_base, LAYER_BASE_DIFFUSE);
     CHECK_V3(m[5]->albedo, 0.2, 0.4, 0.6, 1e-6);
-    CHECK_EQ_INT(m[6]->type, MAT_DIELECTRIC);
-    CHECK_NEAR(m[6]->ior, 1, 0);
+    CHECK(m[6]->flags & MAT_INTERFACE);   /* "interface": a boundary, no surface */
     CHECK_EQ_INT(m[7]->type, MAT_MIX);   /* "a" and "b", b three times in four */
     CHECK_EQ_INT(s.materials[m[7]->mix_a].type, MAT_DIFFUSE);
     CHECK_EQ_INT(s.materials[m[7]->mix_b].type, MAT_DIELECTRIC);
@@ -261,7 +260,7 @@ static void test_warnings(void)
         DIR "warnings.pbrt:3: Film: parameter \"float iso\" is not supported; ignored",
         DIR "warnings.pbrt:5: Shape \"cone\" is not supported; skipped",
         DIR "warnings.pbrt:7: Shape: parameter \"float wobble\" is not supported; ignored",
-        DIR "warnings.pbrt:9: MakeNamedMedium is not supported; ignored",
+        DIR "warnings.pbrt:9: medium \"cloud\" is not supported; \"fog\" is left empty (vacuum)",
         DIR "warnings.pbrt:10: TransformTimes is not supported; ignored",
     };
     CHECK_EQ_INT(s.n_warnings, 6);
@@ -317,7 +316,8 @@ static void test_active_transform(void)
 }
 
 /* Material "" and "none" are pbrt-v4's "no material" (a medium's boundary, as
- * "interface"; pbrt-v4-scenes' clouds.pbrt): the invisible index-1 glass, no warning */
+ * "interface"; pbrt-v4-scenes' clouds.pbrt): a boundary rays pass straight through
+ * (MAT_INTERFACE, docs/media.md), no warning */
 static void test_no_material(void)
 {
     Scene s;
@@ -330,12 +330,12 @@ static void test_no_material(void)
     CHECK_EQ_INT(s.n_spheres, 2);
     for (size_t i = 0; i < 2 && i < s.n_spheres; i++) {
         const Material *m = &s.materials[s.spheres[i].material];
-        CHECK_EQ_INT(m->type, MAT_DIELECTRIC);
-        CHECK_NEAR(m->ior, 1, 0);
+        CHECK(m->flags & MAT_INTERFACE);
     }
     CHECK_EQ_INT(s.n_warnings, 0);
     scene_free(&s);
 }
+
 
 static void expect_error(const char *text, const char *msg);
 
@@ -711,6 +711,61 @@ static void expect_error(const char *text, const char *msg)
     CHECK_EQ_INT(st, ST_INPUT);
     CHECK_MSG(strcmp(err.msg, msg) == 0, "got '%s', expected '%s'", err.msg, msg);
     scene_free(&s);
+}
+
+/* MakeNamedMedium "homogeneous" (sigma_a, sigma_s, scale, g), MediumInterface (one name
+ * for both sides, or inside and outside; "" vacuum) kept by AttributeBegin/End, the
+ * camera in the outside medium at Camera, shapes bound to the media of the moment. */
+static void test_media(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.1 0.2 0.3]\n"
+                           "  \"rgb sigma_s\" [1 2 3] \"float scale\" 2 \"float g\" 0.5\n"
+                           "MakeNamedMedium \"smoke\" \"string type\" \"homogeneous\"\n"
+                           "MediumInterface \"\" \"fog\"\n"
+                           "Camera \"perspective\"\n"
+                           "WorldBegin\n"
+                           "AttributeBegin\n"
+                           "  MediumInterface \"smoke\" \"fog\"\n"
+                           "  Material \"interface\"\n"
+                           "  Shape \"sphere\" \"float radius\" 1\n"
+                           "  MediumInterface \"fog\"\n"
+                           "  Shape \"sphere\" \"float radius\" 0.5\n"
+                           "AttributeEnd\n"
+                           "Shape \"sphere\" \"float radius\" 2\n",
+                           &s, &err),
+                 ST_OK);
+    CHECK_EQ_INT(s.n_media, 2);
+    CHECK_EQ_INT(s.n_spheres, 3);
+    if (s.n_media == 2 && s.n_spheres == 3) {
+        CHECK_V3(s.media[0].sigma_a, 0.2, 0.4, 0.6, 1e-7);
+        CHECK_V3(s.media[0].sigma_s, 2, 4, 6, 0);
+        CHECK_NEAR(s.media[0].g, 0.5, 0);
+        CHECK_V3(s.media[1].sigma_a, 1, 1, 1, 0);   /* pbrt-v4's defaults */
+        CHECK_V3(s.media[1].sigma_s, 1, 1, 1, 0);
+        CHECK_EQ_INT(s.camera_medium, 1);           /* the outside one at Camera: fog */
+        const Material *m0 = &s.materials[s.spheres[0].material], *m1 = &s.materials[s.spheres[1].material],
+                       *m2 = &s.materials[s.spheres[2].material];
+        CHECK(m0->flags & MAT_INTERFACE);
+        CHECK_EQ_INT(m0->medium_in, 2);
+        CHECK_EQ_INT(m0->medium_out, 1);
+        CHECK_EQ_INT(m1->medium_in, m1->medium_out);   /* fog on both sides: no boundary */
+        CHECK(!(m2->flags & MAT_INTERFACE));           /* the default material, restored state */
+        CHECK_EQ_INT(m2->medium_in, 0);
+        CHECK_EQ_INT(m2->medium_out, 1);
+    }
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+    expect_error("WorldBegin\nMediumInterface \"haze\"\n",
+                 DIR "inline.pbrt:2:17: medium 'haze' is not defined (MakeNamedMedium defines it)");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"string preset\" \"Wholemilk\"\n",
+                 DIR "inline.pbrt:2:65: MakeNamedMedium \"m\": the preset \"Wholemilk\" is not supported (give \"rgb sigma_a\" and "
+                 "\"rgb sigma_s\" instead)");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float g\" 1\n",
+                 DIR "inline.pbrt:2:49: parameter 'g' must be a number in (-1, 1)");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [-1 0 0]\n",
+                 DIR "inline.pbrt:2:49: parameter 'sigma_a' must be an rgb colour >= 0");
 }
 
 static void test_errors(void)
@@ -1358,6 +1413,7 @@ int main(void)
     RUN(test_warnings);
     RUN(test_active_transform);
     RUN(test_no_material);
+    RUN(test_media);
     RUN(test_named_material_later);
     RUN(test_include);
     RUN(test_instances);

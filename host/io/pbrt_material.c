@@ -1,5 +1,6 @@
 /* pbrt_material.c — pbrt-v4 materials and textures (pbrt_reader.h, docs/pbrt.md). */
 #include "io/pbrt_reader.h"
+#include "scene/media.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -211,10 +212,11 @@ static Status make_material(Parser *p, const Lexer *lx, const Token *type, Mater
     } else if (pbrt_tok_eq(type, "coateddiffuse") || pbrt_tok_eq(type, "coatedconductor")) {
         st = make_coated(p, lx, pbrt_tok_eq(type, "coatedconductor"), m);
     } else if (pbrt_tok_eq(type, "interface") || pbrt_tok_eq(type, "") || pbrt_tok_eq(type, "none")) {
-        /* an invisible boundary (a medium's edge): glass of index 1 passes light unbent.
-         * pbrt-v4 makes no material for "" and "none" either (MaterialHandle::Create),
-         * as pbrt-v4-scenes' clouds.pbrt uses: Material "" on its medium's sphere. */
-        *m = material_dielectric(1.0f);
+        /* an invisible boundary (a medium's edge), which rays pass straight through
+         * (docs/media.md). pbrt-v4 makes no material for "" and "none" either
+         * (MaterialHandle::Create), as pbrt-v4-scenes' clouds.pbrt uses: Material "" on
+         * its medium's sphere. */
+        *m = material_interface();
         st = ST_OK;
     } else if (pbrt_tok_eq(type, "mix")) {
         st = make_mix(p, lx, type, m);
@@ -571,10 +573,7 @@ Status pbrt_shape_material(Parser *p, uint *out)
         if ((st = scene_add_material(p->s, "", material_diffuse(v3(0.5f, 0.5f, 0.5f)), &i, p->err))) return st;
         p->g.material = i;
     }
-    if (!p->g.area) {
-        *out = p->g.material;
-        return ST_OK;
-    }
+    if (!p->g.area) return pbrt_shape_media(p, p->g.material, out);
     if (p->g.area_material == NO_INDEX) {
         Material m = p->s->materials[p->g.material];
         m.emission = p->g.area_L;
@@ -590,6 +589,5 @@ Status pbrt_shape_material(Parser *p, uint *out)
             p->area_of_pending[p->n_area_pending++].base = p->g.material;
         }
     }
-    *out = p->g.area_material;
-    return ST_OK;
+    return pbrt_shape_media(p, p->g.area_material, out);
 }

@@ -230,6 +230,7 @@ static Status d_camera(Parser *p, Lexer *lx, const Token *kw)
         if (st) return st;
     }
     p->have_camera = 1;
+    p->s->camera_medium = p->g.medium_out;   /* pbrt-v4's CameraMedium: the outside one now */
     p->cam_ortho = pbrt_tok_eq(&type, "orthographic");
     p->cam_from_world = p->g.ctm;
     p->fov = 90;
@@ -464,8 +465,8 @@ static const struct {
     {"Accelerator", d_unsupported},
     {"TransformTimes", d_unsupported},
     {"ActiveTransform", d_active_transform},
-    {"MakeNamedMedium", d_unsupported},
-    {"MediumInterface", d_unsupported},
+    {"MakeNamedMedium", pbrt_make_named_medium},
+    {"MediumInterface", pbrt_medium_interface},
     {"Attribute", d_unsupported},
     {"ObjectBegin", pbrt_object_begin},
     {"ObjectEnd", pbrt_object_end},
@@ -615,6 +616,7 @@ Status pbrt_load_text(const char *path, const char *text, size_t len, Scene *s, 
     free(p.pl.nums);
     free(p.pl.strs);
     strmap_free(&p.named_material);
+    strmap_free(&p.named_medium);
     strmap_free(&p.coordsys);
     strmap_free(&p.tex_by_name);
     strmap_free(&p.warned);

@@ -8,6 +8,7 @@
  *   pbrt_material.c  materials and textures
  *   pbrt_light.c     area and other lights
  *   pbrt_shape.c     shapes and object instancing
+ *   pbrt_medium.c    participating media and the shapes that bound them
  * Not for use outside these files.
  */
 #ifndef CLPT_PBRT_READER_H
@@ -56,6 +57,7 @@ typedef struct {
     int area_twosided;
     uint area_material;      /* material + emission, made on first use */
     int end_time_only;       /* ActiveTransform EndTime: transforms move the shutter-close pose only */
+    uint medium_in, medium_out;   /* MediumInterface: 0 vacuum, else 1 + a medium's index */
 } GState;
 
 typedef struct {
@@ -92,6 +94,7 @@ typedef struct {
     GState g;
     GState *stack;  size_t n_stack, cap_stack;
     StrMap named_material;   /* name -> material index */
+    StrMap named_medium;     /* name -> 0 (a medium clpt leaves empty) or 1 + medium index */
     /* NamedMaterial before its MakeNamedMaterial (pbrt-v4 resolves names after the whole
      * file): a diffuse placeholder, replaced in place when the definition comes */
     PPending *pending;  size_t n_pending, cap_pending;
@@ -160,6 +163,12 @@ Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_object_instance(Parser *p, Lexer *lx, const Token *kw);
+
+/* pbrt_medium.c: MakeNamedMedium, MediumInterface, the media a shape bounds */
+Status pbrt_make_named_medium(Parser *p, Lexer *lx, const Token *kw);
+Status pbrt_medium_interface(Parser *p, Lexer *lx, const Token *kw);
+/* The material a shape of `material` gets in the current MediumInterface. */
+Status pbrt_shape_media(Parser *p, uint material, uint *out);
 
 /* pbrt_parse.c: directives, transforms, graphics state, files */
 Status pbrt_push_state(Parser *p);

@@ -1,0 +1,130 @@
+/*
+ * pbrt_medium.c — the pbrt-v4 reader's participating media (docs/media.md,
+ * docs/pbrt.md): MakeNamedMedium, MediumInterface, and the media a shape bounds and the
+ * camera is in; part of the reader of pbrt_parse.c (pbrt_reader.h).
+ *
+ * pbrt-v4 keeps an inside and an outside medium in the graphics state (MediumInterface
+ * sets them, AttributeBegin/End saves and restores them); every shape made afterwards
+ * bounds those two, and the camera is in the outside one at the Camera directive. A
+ * shape whose two are the same is no boundary. clpt's rule is the same
+ * (kernels/medium/medium.h), so the state maps directly.
+ */
+#include "io/pbrt_reader.h"
+
+#include "util/kmath.h"
+#include "scene/media.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+/* pbrt-v4's homogeneous medium: sigma_a and sigma_s (1 each by default), times
+ * `scale`; `g`. Its named presets and emission are not read: a preset is an error
+ * (it would decide the whole look), emission a warning. */
+static Status homogeneous(Parser *p, const Lexer *lx, const Token *name, Medium *out)
+{
+    Status st;
+    const Token *preset = NULL;
+    if ((st = pbrt_get_string(p, lx, "preset", &preset))) return st;
+    if (preset)
+        return lex_error_at(lx, preset, p->err, "MakeNamedMedium \"%.*s\": the preset \"%.*s\" is not supported "
+                            "(give \"rgb sigma_a\" and \"rgb sigma_s\" instead)", (int)(name->len > 40 ? 40 : name->len),
+                            name->text, (int)(preset->len > 40 ? 40 : preset->len), preset->text);
+    vec3 sa = v3s(1.0f), ss = v3s(1.0f);
+    double scale = 1.0, g = 0.0;
+    if ((st = pbrt_get_spectrum(p, lx, "sigma_a", &sa, NULL, NULL)) ||
+        (st = pbrt_get_spectrum(p, lx, "sigma_s", &ss, NULL, NULL)) || (st = pbrt_get_float(p, lx, "scale", &scale)) ||
+        (st = pbrt_get_float(p, lx, "g", &g)))
+        return st;
+    if (!(scale >= 0.0) || !(scale <= 1e30))
+        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "scale"), "a number in [0, 1e30]");
+    if (!(g > -1.0 && g < 1.0)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "g"), "a number in (-1, 1)");
+    sa = v3_scale(sa, (float)scale);
+    ss = v3_scale(ss, (float)scale);
+    vec3 t = v3_add(sa, ss);
+    if (!isfinite(t.x) || !isfinite(t.y) || !isfinite(t.z))
+        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": its extinction (sigma_a + sigma_s, times "
+                            "scale) is beyond the largest float (about 3.4e38)", (int)(name->len > 40 ? 40 : name->len),
+                            name->text);
+    *out = medium_homogeneous(sa, ss, (float)g);
+    return ST_OK;
+}
+
+Status pbrt_make_named_medium(Parser *p, Lexer *lx, const Token *kw)
+{
+    (void)kw;
+    Token name;
+    Status st = pbrt_expect_string(p, lx, "a quoted medium name", &name);
+    if (!st) st = pbrt_parse_params(p, lx);
+    if (st) return st;
+    if (name.len == 0) return lex_error_at(lx, &name, p->err, "a medium needs a name (\"\" is vacuum)");
+    const Token *type = NULL;
+    if ((st = pbrt_get_string(p, lx, "type", &type))) return st;
+    if (!type) return lex_error_at(lx, &name, p->err, "MakeNamedMedium needs \"string type\"");
+    uint32_t ref = 0u;   /* vacuum, for a medium clpt cannot render */
+    if (pbrt_tok_eq(type, "homogeneous")) {
+        Medium m;
+        if ((st = homogeneous(p, lx, &name, &m))) return st;
+        char *n = tok_copy(&name);
+        if (!n) return error_set(p->err, ST_INTERNAL, "out of memory");
+        uint index;
+        st = scene_add_medium(p->s, n, m, &index, p->err);
+        free(n);
+        if (st) return st;
+        ref = index + 1u;
+        if ((st = pbrt_warn_unused(p, lx, "MakeNamedMedium \"homogeneous\""))) return st;
+    } else {
+        char key[96];
+        snprintf(key, sizeof key, "Medium %.*s", (int)(type->len > 40 ? 40 : type->len), type->text);
+        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = 1;
+        if ((st = warn_once(p, lx, type, key, "medium \"%.*s\" is not supported; \"%.*s\" is left empty (vacuum)",
+                            (int)(type->len > 40 ? 40 : type->len), type->text, (int)(name.len > 40 ? 40 : name.len),
+                            name.text)))
+            return st;
+    }
+    /* a later definition of the name replaces the earlier, as in pbrt */
+    if (strmap_set(&p->named_medium, name.text, name.len, ref)) return error_set(p->err, ST_INTERNAL, "out of memory");
+    return ST_OK;
+}
+
+/* A medium name of MediumInterface: "" is vacuum, any other must be defined. */
+static Status medium_ref(Parser *p, const Lexer *lx, const Token *t, uint *ref)
+{
+    uint32_t r;
+    if (t->len == 0) {
+        *ref = 0u;
+        return ST_OK;
+    }
+    if (!strmap_find(&p->named_medium, t->text, t->len, &r))
+        return lex_error_at(lx, t, p->err, "medium '%.*s' is not defined (MakeNamedMedium defines it)",
+                            (int)(t->len > 40 ? 40 : t->len), t->text);
+    *ref = r;
+    return ST_OK;
+}
+
+Status pbrt_medium_interface(Parser *p, Lexer *lx, const Token *kw)
+{
+    (void)kw;
+    Token in, out;
+    Status st = pbrt_expect_string(p, lx, "a quoted medium name (\"\" for vacuum)", &in);
+    if (st) return st;
+    if ((st = lex_next(lx, &out, p->err))) return st;
+    if (out.kind != TOK_STRING) {   /* one name: both sides */
+        lex_unread(lx, &out);
+        out = in;
+    }
+    uint ri, ro;
+    if ((st = medium_ref(p, lx, &in, &ri)) || (st = medium_ref(p, lx, &out, &ro))) return st;
+    p->g.medium_in = ri;
+    p->g.medium_out = ro;
+    return ST_OK;
+}
+
+Status pbrt_shape_media(Parser *p, uint material, uint *out)
+{
+    if (p->g.medium_in == p->g.medium_out) {
+        *out = material;
+        return ST_OK;
+    }
+    return scene_bind_media(p->s, material, p->g.medium_in, p->g.medium_out, out, p->err);
+}

@@ -156,6 +156,38 @@ def scene_list():
         notes={"mitsuba": "specular 0.25 (F0 0.02 as an ior); " + DISNEY_SPEC,
                "cycles": "the importer sets Principled's Specular to 0.25 (Disney F0 = 0.08 x Specular); "
                "Disney's specular added without taking energy from diffuse"})
+    # --- participating media (docs/media.md): a sphere of a homogeneous medium, its
+    # boundary no surface (clpt's `material none`, Mitsuba's null BSDF) or glass. glTF has
+    # no scattering media, so Cycles (through its importer) has no equivalent.
+    def medium(sa, ss, g):
+        st = [a + b for a, b in zip(sa, ss)]
+        top = max(st)
+        clpt = "type homogeneous sigma_a %g %g %g sigma_s %g %g %g g %g" % (tuple(sa) + tuple(ss) + (g,))
+        # Mitsuba reads an RGB value as a reflectance (at most 1): sigma_t's largest
+        # channel goes into the scale, as for the volume scene
+        mi_med = {"type": "homogeneous", "albedo": _rgb([b / t for b, t in zip(ss, st)]),
+                  "sigma_t": _rgb([t / top for t in st]), "scale": top, "phase": {"type": "hg", "g": g}}
+        return clpt, mi_med
+    med = dict(material=_gltf_mat((1, 1, 1), 0.0, 1.0), no_cycles=True,
+               notes={"cycles": "no equivalent: glTF has no scattering media"})
+    c, m = medium((0.5, 0.5, 0.5), (1.5, 1.5, 1.5), 0.5)
+    add("medium", "a sphere of fog (sigma_a 0.5, sigma_s 1.5, g 0.5) behind a boundary that is no surface",
+        clpt_medium=c, clpt_mesh="material none interior fog",
+        mitsuba=lambda mi, t: {"type": "null"}, mitsuba_interior=m, **med)
+    c, m = medium((0.2, 0.1, 0.05), (0.5, 1.0, 2.0), -0.3)
+    add("medium-chromatic", "chromatic medium: sigma_a 0.2 0.1 0.05, sigma_s 0.5 1 2, g -0.3",
+        clpt_medium=c, clpt_mesh="material none interior fog",
+        mitsuba=lambda mi, t: {"type": "null"}, mitsuba_interior=m, **med)
+    c, m = medium((0.3, 0.2, 0.1), (1.0, 1.0, 1.0), 0.7)
+    add("medium-glass", "a forward-scattering medium (sigma_a 0.3 0.2 0.1, sigma_s 1, g 0.7) inside glass, "
+        "ior 1.5", clpt_medium=c, clpt_mesh="material m interior fog", clpt="type dielectric ior 1.5",
+        mitsuba=lambda mi, t: {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}, mitsuba_interior=m, **med)
+    c, m = medium((0.2, 0.1, 0.05), (0.5, 1.0, 2.0), 0.3)
+    add("medium-env", "the chromatic medium (g 0.3) under courtyard.hdr: light samples from inside the medium",
+        clpt_medium=c, clpt_mesh="material none interior fog", background="env",
+        mitsuba=lambda mi, t: {"type": "null"}, mitsuba_interior=m,
+        **dict(med, notes={"cycles": "no equivalent: glTF has no scattering media",
+                           "mitsuba": "bilinear map lookup (clpt: nearest texel)"}))
     # --- emission and textures, black background
     add("emission", "emissive 1 0.5 0.25 x strength 2 (KHR_materials_emissive_strength), black base",
         material=_gltf_mat((0, 0, 0), 0.0, 1.0, emissiveFactor=[1.0, 0.5, 0.25],

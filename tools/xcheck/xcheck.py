@@ -331,9 +331,12 @@ def render_clpt(a, s, gltf, seed, base):
     bg = {"white": "background { color 1 1 1 }\n", "black": "",
           "env": 'background { map "%s" }\n' % a.envmap}[s["background"]]
     mat = "material m { %s }\n" % s["clpt"] if s["clpt"] else ""
+    # a medium scene (docs/media.md): the medium `fog`, and the mesh's own keys
+    med = "medium fog { %s }\n" % s["clpt_medium"] if s.get("clpt_medium") else ""
+    mesh_keys = " " + s["clpt_mesh"] if s.get("clpt_mesh") else (" material m" if s["clpt"] else "")
     text = ("image { width %d height %d spp %d depth %d seed %d }\n" % (a.size, a.size, a.spp, DEPTH, seed) +
             "camera { from %g %g %g at %g %g %g up 0 1 0 fov %g }\n" % (cam_from + cam_at + (fov,)) + bg + mat +
-            'mesh { file "%s"%s }\n' % (os.path.basename(gltf), " material m" if s["clpt"] else ""))
+            med + 'mesh { file "%s"%s }\n' % (os.path.basename(gltf), mesh_keys))
     scene = base + ".scene"
     with open(scene, "w") as f:
         f.write(text)
@@ -549,11 +552,14 @@ def main():
         if p.name == "cycles":
             t0 = time.time()
             got = p.render_all([(s, files[s["name"]][0], seeds) for s in todo
-                                if not isinstance(imgs[("clpt", s["name"])], str)], folder)
+                                if not isinstance(imgs[("clpt", s["name"])], str) and not s.get("no_cycles")],
+                               folder)
             print("cycles: %d images in %.1f s" % (len(got), time.time() - t0), flush=True)
             for s in todo:
                 if isinstance(imgs[("clpt", s["name"])], str):
                     imgs[("cycles", s["name"])] = "not rendered"
+                elif s.get("no_cycles"):
+                    imgs[("cycles", s["name"])] = "no equivalent"
                 elif all((s["name"], k) in got for k in seeds):
                     imgs[("cycles", s["name"])] = [got[(s["name"], k)] for k in seeds]
                 else:

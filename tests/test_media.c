@@ -258,6 +258,46 @@ static void test_furnace(void)
     check_furnace("3", "1 2 3", "0.3", "glass");         /* seen from outside, through glass */
 }
 
+/* Single scattering against a numeric integral: the camera and a point light in one
+ * medium that fills the scene (the background's), paths of one bounce, so that the
+ * only light is that of one stop in the medium lit by the light sample there. Along the
+ * camera ray x(t) = t d, the radiance is
+ *   L = int_0^inf exp(-sigma_t t) sigma_s p(d . w(t)) I exp(-sigma_t r(t)) / r(t)^2 dt,
+ * w the direction from x(t) to the light and r its distance: the free-flight density,
+ * the phase function and the transmittance to the light all enter. */
+#define SINGLE_SCENE \
+    "image { width 4 height 4 spp 4096 depth 1 }\n" \
+    "medium fog { type homogeneous sigma_a 0.1 0.1 0.1 sigma_s 0.5 0.5 0.5 g 0.6 }\n" \
+    "camera { from 0 0 0 at 0 0 -1 up 0 1 0 fov 0.5 medium fog }\n" \
+    "background { color 0 0 0 medium fog }\n" \
+    "light { type point position 0 1 -2 intensity 10 10 10 }\n"
+
+static double single_scatter_integral(void)
+{
+    const double st = 0.6, ss = 0.5, g = 0.6, I = 10.0;
+    double sum = 0.0, h = 1e-4;
+    for (int k = 0; k < 600000; k++) {   /* midpoint rule over t in [0, 60] */
+        double t = (k + 0.5) * h, dz = -2.0 + t, r2 = 1.0 + dz * dz, dist = sqrt(r2);
+        double mu = -dz / dist;   /* d = (0, 0, -1); w = (0, 1, -2 + t) / dist */
+        double ph = (1.0 - g * g) / (4.0 * M_PI * pow(1.0 + g * g - 2.0 * g * mu, 1.5));
+        sum += exp(-st * t) * ss * ph * I * exp(-st * dist) / r2 * h;
+    }
+    return sum;
+}
+
+static void test_single_scattering(void)
+{
+    double want = single_scatter_integral();
+    const char *devices[] = { "scalar", TEST_OPENCL };
+    for (int d = 0; d < 2; d++) {
+        double m[3];
+        if (!render_means(SINGLE_SCENE, devices[d], m)) continue;
+        fprintf(stderr, "  single scattering on %s: %.5f %.5f %.5f (numeric integral %.5f)\n", devices[d], m[0], m[1],
+                m[2], want);
+        for (int c = 0; c < 3; c++) CHECK_NEAR(m[c], want, 0.01 * want);
+    }
+}
+
 /* A fog lit by a small spherical lamp: light sampling alone, phase (and BSDF) sampling
  * alone and their MIS estimate the same image. */
 static const char *mis_scene =
@@ -392,6 +432,7 @@ int main(void)
     RUN(test_channel_pick);
     RUN(test_slab_transmittance);
     RUN(test_furnace);
+    RUN(test_single_scattering);
     RUN(test_strategies_agree);
     RUN(test_devices_match_scalar);
     RUN(test_resume_matches_straight);

@@ -37,6 +37,7 @@
     X(MANY, uint,         leaf_prims, (ds)->params.n_leaf_prims, "kd-tree leaf lists")       \
     X(MANY, BvhNode,      bvh,        (ds)->params.n_bvh_nodes,  "8-wide BVH nodes")         \
     X(MANY, uint,         bvh_leaves, (ds)->n_bvh_leaves,        "8-wide BVH leaf lists")    \
+    X(MANY, Instance,     instances,  (ds)->params.n_instances,  "instances")                \
     X(MANY, Sphere,       spheres,    (ds)->params.n_spheres,    "spheres")                  \
     X(MANY, SphereXform,  sphere_xforms, (ds)->n_sphere_xforms,  "sphere transforms")        \
     X(MANY, Triangle,     triangles,  (ds)->params.n_triangles,  "triangles")                \

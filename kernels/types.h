@@ -55,10 +55,11 @@
 #define KF_SPHERE_XFORM 0x1000000u /* a sphere under a transform (an ellipsoid, SphereXform) */
 #define KF_MEDIA 0x2000000u     /* participating media or their boundaries (kernels/medium/,
                                  * RenderParams.has_media; docs/media.md) */
+#define KF_INSTANCES 0x10000000u /* instances of objects: the BVH's two levels (Instance) */
 /* every bit above and every material type's */
 #define KF_ALL (KF_PATH | KF_WHITTED | KF_TEXTURES | KF_ALPHA | KF_ENV_MAP | KF_CUBEMAP | KF_REVSURFACE | \
                 KF_SPHERES | KF_BOXES | KF_PLANES | KF_DELTA_LIGHTS | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH | \
-                KF_PATH_LANES | KF_SPHERE_XFORM | KF_MEDIA MATERIAL_TYPES(KF_MATERIAL_OR_))
+                KF_PATH_LANES | KF_SPHERE_XFORM | KF_MEDIA | KF_INSTANCES MATERIAL_TYPES(KF_MATERIAL_OR_))
 #define KF_MATERIAL_OR_(name, value, bit, traits, lobes) | (bit)
 #ifndef CLPT_FEATURES
 #define CLPT_FEATURES 0xffffffffu   /* every switch (KF_ALL, which is not usable here: a
@@ -175,10 +176,13 @@ typedef struct {                                        /* 32 bytes */
     vec3 d;  float tmax;
 } Ray;
 
-typedef struct {                                        /* 16 bytes */
+typedef struct {                                        /* 32 bytes */
     float t;        /* distance along the (unnormalised) ray direction */
     uint prim;      /* global primitive id (see RenderParams), NO_INDEX for a miss */
     float u, v;     /* triangles: barycentrics of p1 and p2; boxes: u = face index */
+    uint inst;      /* the instance whose prototype holds prim (Instance, below), or
+                     * NO_INDEX for the world's own primitives (docs/instancing.md) */
+    uint pad0, pad1, pad2;
 } Hit;
 
 /* kd-tree node, 8 bytes (layout in docs/kdtree.md).
@@ -218,11 +222,34 @@ typedef struct {
 #define BVH_STACK 128u
 #define BVH_CHILD_NONE 0u
 #define BVH_CHILD_NODE 1u
+/* A top-level child that is one instance (ref: its index in the instances buffer): the
+ * walk carries the ray into the instance's object space and goes on at its prototype's
+ * root (Instance.root). Only a scene with instances has them (docs/instancing.md). */
+#define BVH_CHILD_INSTANCE 2u
 typedef struct {                                        /* 256 bytes */
     float box[6][BVH_WIDTH];
     uint ref[BVH_WIDTH];
     uint kind[BVH_WIDTH];
 } BvhNode;
+
+/* An instance of an object (a prototype: primitives in the scene's arrays that no tree
+ * but their own holds) under an affine transform M, docs/instancing.md. Rays enter the
+ * prototype's BVH in its object space: origin and direction both mapped by M^-1, the
+ * direction not renormalised, so a hit's t is the world ray's. Both matrices are 3x4
+ * row-major, as SphereXform's; the normal matrix is the transpose of to_object's linear
+ * part. */
+#define INST_IDENTITY 1u   /* M is the identity: rays and surfaces are not transformed */
+#define INST_MIRROR 2u     /* det M < 0 (the host's: normals by M^-T keep their sides) */
+#define INST_WORLD 4u      /* the world's own primitives under the top level: hits carry
+                            * inst NO_INDEX, as in a scene without instances */
+typedef struct {                                        /* 112 bytes */
+    float to_world[12];       /* M: object -> world */
+    float to_object[12];      /* M^-1: world -> object */
+    uint root;                /* the BVH node of its prototype's root */
+    uint material;            /* the material that replaces every primitive's, or NO_INDEX */
+    uint flags;               /* INST_* */
+    uint object;              /* the prototype's index on the host (stats, flattening) */
+} Instance;
 
 /* Global primitive ids: [0, n_spheres) spheres, then triangles, then boxes, then
  * surfaces of revolution, then planes. All but the infinite planes are in the kd-tree. */
@@ -612,7 +639,8 @@ typedef struct {                                        /* 336 bytes */
      * numbered and placed by the whole image's pixel (params_image_pixel), so the
      * window's pixels are the whole render's, bit for bit. All 0: no crop. */
     uint crop_left;
-    uint crop_top, crop_right, crop_bottom, pad_crop0;
+    uint crop_top, crop_right, crop_bottom;
+    uint n_instances;                 /* Instance records (docs/instancing.md); 0: one level */
     /* participating media (kernels/medium/, docs/media.md) */
     uint has_media;                   /* 1: paths may meet media or boundaries
                                        * (MAT_INTERFACE); 0: the code of KF_MEDIA is
@@ -661,7 +689,11 @@ typedef struct {                                        /* 80 bytes */
 #define CLPT_CHECK_SIZE(T, n) _Static_assert(sizeof(T) == (n), #T " must be " #n " bytes")
 CLPT_CHECK_SIZE(vec3, 12);
 CLPT_CHECK_SIZE(Ray, 32);
-CLPT_CHECK_SIZE(Hit, 16);
+CLPT_CHECK_SIZE(Hit, 32);
+_Static_assert(offsetof(Hit, inst) == 16, "Hit.inst");
+CLPT_CHECK_SIZE(Instance, 112);
+_Static_assert(offsetof(Instance, root) == 96, "Instance.root");
+_Static_assert(offsetof(RenderParams, n_instances) == 316, "RenderParams.n_instances");
 CLPT_CHECK_SIZE(KdNode, 8);
 CLPT_CHECK_SIZE(BvhNode, 256);
 CLPT_CHECK_SIZE(Sphere, 32);

@@ -283,7 +283,7 @@ static void test_render_key_covers_every_scene_buffer(void)
     p->width = 2;
     p->height = 1;
     p->n_nodes = p->n_leaf_prims = p->n_spheres = p->n_triangles = p->n_boxes = p->n_planes = 2;
-    p->n_lights = p->n_textures = p->n_revsurfaces = p->n_bvh_nodes = p->n_media = 2;
+    p->n_lights = p->n_textures = p->n_revsurfaces = p->n_bvh_nodes = p->n_media = p->n_instances = 2;
     ds.n_materials = ds.n_shading = 2;
     ds.n_tri_extra_of = ds.n_tri_extras = 2;
     ds.n_texels = ds.n_rev_points = 2;

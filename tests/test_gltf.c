@@ -841,6 +841,7 @@ static Surface centroid_surface(const SceneView *v, const Scene *s, size_t tri)
     h.t = 1.0f;
     h.prim = (uint)(s->n_spheres + tri);
     h.u = h.v = 1.0f / 3.0f;
+    h.inst = NO_INDEX;
     return surface_at(v, r, h);
 }
 

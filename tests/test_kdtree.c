@@ -96,7 +96,7 @@ static void add_plane(vec3 n, float offset)
 /* Builds both trees and a SceneView of each for the kernel functions. */
 static Status scene_build(int threads)
 {
-    KdInput in = { scene.sph, scene.ns, scene.tri, scene.nt, scene.box, scene.nb, NULL, 0, scene.xf, scene.nxf };
+    KdInput in = { scene.sph, scene.ns, scene.tri, scene.nt, scene.box, scene.nb, NULL, 0, scene.xf, scene.nxf, NULL, 0 };
     Error err = { 0 };
     kd_free(&scene.tree);
     bvh_free(&scene.bvh);
@@ -160,7 +160,7 @@ static int prim_finite(uint id)
 static Hit brute_closest(Ray ray)
 {
     RayPre rp = ray_prepare(ray);
-    Hit best = { ray.tmax, NO_INDEX, 0.0f, 0.0f };
+    Hit best = { ray.tmax, NO_INDEX, 0.0f, 0.0f, NO_INDEX, 0u, 0u, 0u };
     uint n = scene.ns + scene.nt + scene.nb;
     for (uint id = 0; id < n + scene.np; id++) {
         Ray r = ray;
@@ -445,7 +445,7 @@ static void test_group_intersect(void)
         RayPre rp = ray_prepare(r);
         Hit g;
         uint mask = triangle_intersect_group(&rp, rows, r.tmin, r.tmax, &g);
-        Hit best = { r.tmax, NO_INDEX, 0.0f, 0.0f };
+        Hit best = { r.tmax, NO_INDEX, 0.0f, 0.0f, NO_INDEX, 0u, 0u, 0u };
         for (uint l = 0; l < KD_GROUP; l++) {
             Hit h;
             int one = triangle_intersect(&rp, &tri[l], r, &h);
@@ -927,7 +927,7 @@ static void test_ellipsoids(void)
     /* scale (2, 1, 0.5) turned 90 degrees about z: x reaches 1, y 2, z 0.5 */
     scene_clear();
     add_ellipsoid(v3(1.0f, 2.0f, 3.0f), v3(2.0f, 1.0f, 0.5f), v3(0.0f, 0.0f, 1.0f), 90.0f);
-    KdInput in = { scene.sph, scene.ns, NULL, 0, NULL, 0, NULL, 0, scene.xf, scene.nxf };
+    KdInput in = { scene.sph, scene.ns, NULL, 0, NULL, 0, NULL, 0, scene.xf, scene.nxf, NULL, 0 };
     CHECK(kd_prim_box(&in, 0, lo, hi));
     CHECK_NEAR(lo[0], 0.0, 1e-5);
     CHECK_NEAR(hi[1], 4.0, 1e-5);
@@ -1007,7 +1007,7 @@ static int mesh_scene_open(MeshScene *m, const char *what)
         MeshOptions o = mesh_options(0);
         st = mesh_load(what, &m->scene, &o, &err);
     }
-    KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0, NULL, 0, NULL, 0 };
+    KdInput in = { NULL, 0, m->scene.triangles, m->scene.n_triangles, NULL, 0, NULL, 0, NULL, 0, NULL, 0 };
     if (st == ST_OK) st = kd_build(&in, 0, &m->tree, &err);
     if (st == ST_OK) st = bvh_build(&in, 0, &m->bvh, &err);
     if (st != ST_OK) {
@@ -1345,7 +1345,7 @@ static void test_bvh_deterministic(void)
     Triangle *tri = cube_sphere(80, &nt);
     CHECK(tri != NULL);
     if (!tri) return;
-    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0, NULL, 0 };
+    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0, NULL, 0, NULL, 0 };
     Bvh one;
     Error err = { 0 };
     CHECK(bvh_build(&in, 1, &one, &err) == ST_OK);
@@ -1408,7 +1408,7 @@ static void test_pinned_trees(void)
     Triangle *tri = cube_sphere(40, &nt);
     CHECK(tri != NULL);
     if (!tri) return;
-    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0, NULL, 0 };
+    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0, NULL, 0, NULL, 0 };
     const int threads[] = { 1, 3, 0 };
     for (int i = 0; i < 3; i++) {
         KdTree t;
@@ -1459,7 +1459,7 @@ static void test_threaded_passes(void)
     CHECK(nt > 65536);
     tri[7].p1.y = NAN;
     tri[nt - 100].p2.x = INFINITY;
-    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0, NULL, 0 };
+    KdInput in = { NULL, 0, tri, nt, NULL, 0, NULL, 0, NULL, 0, NULL, 0 };
     KdTree one;
     Error err = { 0 };
     CHECK(kd_build(&in, 1, &one, &err) == ST_OK);
@@ -1529,7 +1529,7 @@ static void check_mesh_brute_force(const char *what, int rays)
         const SceneView *v = walk_bvh ? &m.wide_view : &m.view;
         Hit kd = trace_closest(v, ray);
         RayPre rp = ray_prepare(ray);
-        Hit bf = { ray.tmax, NO_INDEX, 0.0f, 0.0f };
+        Hit bf = { ray.tmax, NO_INDEX, 0.0f, 0.0f, NO_INDEX, 0u, 0u, 0u };
         for (uint id = 0; id < nt; id++) {
             Ray rr = ray;
             rr.tmax = bf.t;

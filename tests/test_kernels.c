@@ -296,7 +296,7 @@ static void build_scene(void)
     }
     /* the renderer walks the BVH (rs); the kd-tree's own kernels get the kd-tree too */
     KdInput in = { scene.spheres, scene.n_spheres, scene.triangles, scene.n_triangles, scene.boxes, scene.n_boxes,
-                   scene.revsurfaces, scene.n_revsurfaces, scene.sphere_xforms, scene.n_sphere_xforms };
+                   scene.revsurfaces, scene.n_revsurfaces, scene.sphere_xforms, scene.n_sphere_xforms, NULL, 0 };
     if (!st) st = kd_build(&in, 1, &kd, &err);
     if (st) fprintf(stderr, "scene setup failed: %s\n", err.msg);
     render_scene_use_kdtree(&rs.ds, &kd);

@@ -368,7 +368,7 @@ static void test_quad_lamp_samples_uniformly(void)
         /* the normal kept in the light is the one a BSDF-sampled ray finds on the lamp
          * (surface_at), bit for bit, so both strategies' densities agree for MIS */
         Ray r = { ref, 0.0f, ls.wi, INFINITY };
-        Hit hit = { ls.dist, v.lights[li].prim, 0.25f, 0.25f };
+        Hit hit = { ls.dist, v.lights[li].prim, 0.25f, 0.25f, NO_INDEX, 0u, 0u, 0u };
         Surface sf = surface_at(&v, r, hit);
         if (memcmp(&sf.ng, &ls.n, sizeof ls.n)) bad_normal++;
     }

@@ -310,22 +310,22 @@ static void test_surface_uv(void)
     memset(&s, 0, sizeof s);
     float u, v;
     s.prim = 0;
-    s.ng = v3(0, 0, 1);                                     /* facing +z: the map's centre */
+    s.ng = s.ngo = v3(0, 0, 1);                                     /* facing +z: the map's centre */
     surface_uv(&view, s, &u, &v);
     CHECK_NEAR(u, 0.5, 1e-6);
     CHECK_NEAR(v, 0.5, 1e-6);
-    s.ng = v3(1, 0, 0);                                     /* +x: a quarter turn east */
+    s.ng = s.ngo = v3(1, 0, 0);                                     /* +x: a quarter turn east */
     surface_uv(&view, s, &u, &v);
     CHECK_NEAR(u, 0.75, 1e-6);
-    s.ng = v3(0, 1, 0);                                     /* north pole: the top row */
+    s.ng = s.ngo = v3(0, 1, 0);                                     /* north pole: the top row */
     surface_uv(&view, s, &u, &v);
     CHECK_NEAR(v, 1.0, 1e-6);
-    s.ng = v3(0, -1, 0);
+    s.ng = s.ngo = v3(0, -1, 0);
     surface_uv(&view, s, &u, &v);
     CHECK_NEAR(v, 0.0, 1e-6);
     /* the floor: u along +x, v along -z */
     s.prim = 1;
-    s.ng = v3(0, 1, 0);
+    s.ng = s.ngo = v3(0, 1, 0);
     s.p = v3(2.5f, 0.0f, -1.25f);
     surface_uv(&view, s, &u, &v);
     CHECK_NEAR(u, 2.5, 1e-6);

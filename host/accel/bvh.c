@@ -34,6 +34,9 @@
  * the stack's size, nodes below take two children (one more entry per binary level, of
  * which there are at most BVH_MAX_DEPTH), so no tree can overflow it. */
 #define BVH_MAX_LEAF 32u       /* a larger set is split whatever the SAH says */
+/* The deepest a binary tree gets: BVH_MAX_DEPTH, or in an item build (one item a leaf)
+ * that plus the halving of at most 2^32 items that the bins could not split. */
+#define BVH_TREE_DEPTH (BVH_MAX_DEPTH + 33)
 /* With several threads, the top of the tree is built first, on this thread, and each
  * subtree below it of at most 1 / (BVH_SUBTREES_PER_THREAD threads) of the primitives
  * waits; then the threads take the waiting subtrees, largest first. */
@@ -72,6 +75,8 @@ typedef struct {
 
 typedef struct {
     const KdInput *in;
+    const BvhOptions *opt;     /* item builds (instances): opt->item_boxes */
+    uint budget;               /* the walk's stack entries this tree may use */
     uint n;                    /* primitives in the tree */
     PrimRef *ref;              /* the primitives, in tree order once built */
     uint first_tri, n_tri;     /* the triangles' global ids */
@@ -117,7 +122,10 @@ static double groups_of(uint n) { return (double)((n + 7u) / 8u); }
 /* What testing a leaf of these primitives costs. */
 static double leaf_tests(Count c) { return BVH_COST_GROUP * groups_of(c.tri) + BVH_COST_OTHER * c.other; }
 
-static int is_tri(const Build *b, const PrimRef *r) { return r->gid - b->first_tri < b->n_tri; }
+static int is_tri(const Build *b, const PrimRef *r) { return !b->opt->item_boxes && r->gid - b->first_tri < b->n_tri; }
+
+/* An item build (instances) puts every item in a leaf of its own. */
+static int one_per_leaf(const Build *b) { return b->opt->item_boxes != NULL; }
 
 /* The centre of a primitive's bounds on axis k: what the bins and the partition sort by. */
 static float centre(const PrimRef *r, int k) { return 0.5f * r->box.lo[k] + 0.5f * r->box.hi[k]; }
@@ -351,17 +359,21 @@ static void build_node(Build *b, Subtree t, int may_wait)
                                                 : (BinSplit){ -1, 0, INFINITY };
     double leaf_cost = leaf_tests(count) * area;
     double split_cost = BVH_COST_NODE * area + s.cost;
-    if (s.axis < 0 || (n <= BVH_MAX_LEAF && leaf_cost <= split_cost)) {
+    int median = 0;
+    if (one_per_leaf(b) && n > 1) {
+        /* items at one point, or past the depth the bins may go: halves in order */
+        median = s.axis < 0;
+    } else if (s.axis < 0 || (n <= BVH_MAX_LEAF && leaf_cost <= split_cost)) {
         b->nodes[me].first = first;
         b->nodes[me].count = n;
         b->nodes[me].child[0] = b->nodes[me].child[1] = NO_INDEX;
         return;
     }
     /* partition by the chosen bin boundary (the binning's own bin_of) */
-    int k = s.axis;
-    float scale = (float)BVH_BINS / (cb.hi[k] - cb.lo[k]);
-    uint lo = first, hi = first + n;
-    while (lo < hi) {
+    int k = median ? 0 : s.axis;
+    float scale = median ? 0.0f : (float)BVH_BINS / (cb.hi[k] - cb.lo[k]);
+    uint lo = median ? first + n / 2u : first, hi = first + n;
+    while (!median && lo < hi) {
         PrimRef r = b->ref[lo];
         int bi = bin_of(centre(&r, k), cb.lo[k], scale);
         if (bi <= s.bin) {
@@ -418,7 +430,7 @@ static uint build_tree(Build *b)
 /* The binary tree's leaves, deepest leaf and SAH cost (relative to the root's area). */
 static void tree_stats(const Build *b, uint root, BvhStats *st)
 {
-    uint stack[BVH_MAX_DEPTH + 2], depth[BVH_MAX_DEPTH + 2];
+    uint stack[BVH_TREE_DEPTH + 2], depth[BVH_TREE_DEPTH + 2];
     int sp = 0;
     double sah = 0.0;
     stack[sp] = root;
@@ -468,6 +480,9 @@ typedef struct {
     size_t n_slots;
     size_t words;
     uint max_pending;       /* the deepest the walk's stack can get */
+    uint depth_bound;       /* binary levels a path below any node may still take: BVH_MAX_DEPTH,
+                             * or an item build's own depth (a top level is shallow, and its
+                             * budget small: docs/instancing.md) */
 } Flat;
 
 static int uint_cmp(const void *a, const void *b)
@@ -515,7 +530,7 @@ static void flat_node(Flat *f, uint bn, uint me, uint depth, uint pending)
     BvhNode *w = &f->out->nodes[me];
     if (depth > f->out->stats.max_depth) f->out->stats.max_depth = depth;
     uint kids[BVH_WIDTH];
-    int width = pending + (BVH_WIDTH - 1u) <= BVH_STACK - BVH_MAX_DEPTH ? (int)BVH_WIDTH : 2;
+    int width = pending + (BVH_WIDTH - 1u) + f->depth_bound <= b->budget ? (int)BVH_WIDTH : 2;
     int n = b->n ? wide_children(b, bn, width, kids) : 0;
     if (n > 1) pending += (uint)n - 1u;
     if (pending > f->max_pending) f->max_pending = pending;
@@ -535,7 +550,10 @@ static void flat_node(Flat *f, uint bn, uint me, uint depth, uint pending)
             w->box[2 * k][i] = c->box.lo[k];
             w->box[2 * k + 1][i] = c->box.hi[k];
         }
-        if (c->count > 0) {
+        if (c->count > 0 && one_per_leaf(b)) {
+            w->kind[i] = BVH_CHILD_INSTANCE;
+            w->ref[i] = b->ref[c->first].gid;
+        } else if (c->count > 0) {
             w->ref[i] = (uint)f->words;
             f->slots[f->n_slots++] = (LeafSlot){ me, (uint)i, kids[i], (uint)f->words };
             f->words += f->node_words[kids[i]];
@@ -566,7 +584,7 @@ static void *leaves_measure(void *arg)
     j->words = 0;
     for (uint i = j->first; i < j->end; i++) {
         const BinNode *c = &b->nodes[i];
-        if (c->count == 0) continue;
+        if (c->count == 0 || one_per_leaf(b)) continue;
         uint *ids = j->f->ids + c->first;
         for (uint k = 0; k < c->count; k++) ids[k] = b->ref[c->first + k].gid;
         qsort(ids, c->count, sizeof *ids, uint_cmp);
@@ -600,7 +618,27 @@ static void build_free(Build *b)
     free(b->range_jobs);
 }
 
-/* The primitives with finite bounds: their records, in global id order. */
+/* The record of gid (a primitive, or in an item build an item's box) when its bounds
+ * are finite and not empty. */
+static int prim_ref(const Build *b, uint gid, PrimRef *r)
+{
+    Box3 a;
+    if (one_per_leaf(b)) {
+        const float *q = b->opt->item_boxes + 6u * (size_t)gid;
+        for (int k = 0; k < 3; k++) {
+            a.lo[k] = q[k];
+            a.hi[k] = q[3 + k];
+            if (!(isfinite(a.lo[k]) && isfinite(a.hi[k]) && a.lo[k] <= a.hi[k])) return 0;
+        }
+    } else if (!kd_prim_box(b->in, gid, a.lo, a.hi)) {
+        return 0;
+    }
+    *r = (PrimRef){ a, gid, 0u };
+    return 1;
+}
+
+/* The primitives with finite bounds (of in's ranges, when it has them): their records,
+ * in global id order. */
 static Status gather(Build *b, size_t total, Error *err)
 {
     b->ref = malloc((total + 1) * sizeof *b->ref);
@@ -609,11 +647,12 @@ static Status gather(Build *b, size_t total, Error *err)
         return error_set(err, ST_INTERNAL, "BVH: out of memory for %zu primitives", total);
     /* one thread: on several, the dragon's 0.05 s did not shorten (first touches of
      * the new memory, not the boxes, take the time) */
-    for (uint gid = 0; gid < (uint)total; gid++) {
-        Box3 a;
-        if (!kd_prim_box(b->in, gid, a.lo, a.hi)) continue;
-        b->ref[b->n++] = (PrimRef){ a, gid, 0u };
-    }
+    size_t n_ranges = one_per_leaf(b) ? 0 : b->in->n_ranges;
+    KdRange all = { 0u, (uint)total };
+    const KdRange *ranges = n_ranges ? b->in->ranges : &all;
+    for (size_t i = 0; i < (n_ranges ? n_ranges : 1u); i++)
+        for (uint gid = ranges[i].lo; gid < ranges[i].hi; gid++)
+            if (prim_ref(b, gid, &b->ref[b->n])) b->n++;
     return ST_OK;
 }
 
@@ -622,7 +661,8 @@ static Status collapse(Build *b, uint root, Bvh *out, Error *err)
 {
     uint n_bin = atomic_load(&b->n_nodes);
     Flat f = { b, out, malloc((b->n + 1) * sizeof(uint)), malloc(((size_t)n_bin + 1) * sizeof(uint)),
-               malloc((b->n + 1) * sizeof(LeafSlot)), 0, 0, 0 };
+               malloc((b->n + 1) * sizeof(LeafSlot)), 0, 0, 0,
+               one_per_leaf(b) ? out->stats.max_binary_depth : BVH_MAX_DEPTH };
     Status st = ST_OK;
     if (!f.ids || !f.node_words || !f.slots) {
         st = error_set(err, ST_INTERNAL, "BVH: out of memory for %u primitives", b->n);
@@ -660,9 +700,9 @@ static Status collapse(Build *b, uint root, Bvh *out, Error *err)
     jobs_run(slots_write, write, sizeof *write, n_jobs);
     out->n_leaf_prims = (uint)f.words;
     out->stats.max_stack = f.max_pending;
-    if (f.max_pending > BVH_STACK)
+    if (f.max_pending > b->budget)
         st = error_set(err, ST_INTERNAL, "BVH: a path leaves %u children on the walk's stack, more than its %u",
-                       f.max_pending, BVH_STACK);
+                       f.max_pending, b->budget);
 done:
     free(f.ids);
     free(f.node_words);
@@ -672,9 +712,25 @@ done:
 
 Status bvh_build(const KdInput *in, int threads, Bvh *out, Error *err)
 {
+    BvhOptions opt = { 0u, NULL, 0u };
+    return bvh_build_with(in, &opt, threads, out, err);
+}
+
+/* The number of primitives (or items) a build takes, before any is left out. */
+static size_t build_total(const KdInput *in, const BvhOptions *opt)
+{
+    if (opt->item_boxes) return opt->n_items;
+    if (in->n_ranges == 0) return in->n_spheres + in->n_triangles + in->n_boxes + in->n_revs;
+    size_t total = 0;
+    for (size_t i = 0; i < in->n_ranges; i++) total += in->ranges[i].hi - in->ranges[i].lo;
+    return total;
+}
+
+Status bvh_build_with(const KdInput *in, const BvhOptions *opt, int threads, Bvh *out, Error *err)
+{
     double t0 = timer_now();
     memset(out, 0, sizeof *out);
-    size_t total = in->n_spheres + in->n_triangles + in->n_boxes + in->n_revs;
+    size_t total = build_total(in, opt);
     if (total > KD_MAX_PRIMS)
         return error_set(err, ST_INPUT, "BVH: %zu primitives, more than the %u supported", total, KD_MAX_PRIMS);
     if (threads <= 0) {
@@ -684,6 +740,8 @@ Status bvh_build(const KdInput *in, int threads, Bvh *out, Error *err)
     Build b;
     memset(&b, 0, sizeof b);
     b.in = in;
+    b.opt = opt;
+    b.budget = opt->stack_budget ? opt->stack_budget : BVH_STACK;
     b.first_tri = (uint)in->n_spheres;
     b.n_tri = (uint)in->n_triangles;
     atomic_init(&b.n_nodes, 0u);

@@ -39,6 +39,19 @@ typedef struct {
  * empty input gives a root without children. Threads: 0 = all cores; the tree is the
  * same for any number. */
 Status bvh_build(const KdInput *in, int threads, Bvh *out, Error *err);
+
+/* What bvh_build_with may do differently (docs/instancing.md). */
+typedef struct {
+    uint stack_budget;        /* stack entries a walk of this tree may use (0: BVH_STACK);
+                               * the two levels of an instanced scene share BVH_STACK */
+    const float *item_boxes;  /* non-NULL: build over n_items boxes (6 floats each: lo x y z,
+                               * hi x y z) instead of in's primitives, each its own leaf, a
+                               * BVH_CHILD_INSTANCE child whose ref is the box's index; a
+                               * box that is empty or not finite is left out */
+    uint n_items;
+} BvhOptions;
+
+Status bvh_build_with(const KdInput *in, const BvhOptions *opt, int threads, Bvh *out, Error *err);
 void bvh_free(Bvh *b);
 
 #endif /* CLPT_BVH_H */

@@ -40,12 +40,19 @@ static inline double kd_leaf_cost(unsigned n)
  * key with the position and the event type. */
 #define KD_MAX_PRIMS ((1u << 30) - 1u)
 
+/* Global primitive ids [lo, hi): part of a KdInput (an object's primitives). */
+typedef struct { uint lo, hi; } KdRange;
+
 typedef struct {
     const Sphere *spheres;     size_t n_spheres;
     const Triangle *triangles; size_t n_triangles;
     const Box *boxes;          size_t n_boxes;
     const RevSurface *revs;    size_t n_revs;    /* after the boxes in the id space */
     const SphereXform *sphere_xforms; size_t n_sphere_xforms;   /* Sphere.xform's targets */
+    /* The BVH's builds only: the tree holds the primitives of these ranges (increasing,
+     * disjoint) rather than all of them (0 ranges). kd_build takes every primitive: a
+     * scene's instances reach it flattened (docs/instancing.md). */
+    const KdRange *ranges;     size_t n_ranges;
 } KdInput;
 
 typedef struct {

@@ -2,11 +2,13 @@
 #include "render/render_scene.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "scene/camera.h"
 #include "scene/cube_env.h"
 #include "scene/media.h"
+#include "scene/instance.h"
 #include "scene/texel_pack.h"
 
 /* Russian roulette starts after this many bounces: early bounces carry most of the
@@ -47,12 +49,81 @@ void render_scene_use_bvh(DeviceScene *ds, const Bvh *bvh)
     ds->n_bvh_leaves = bvh->n_leaf_prims;
 }
 
+/* The world's own primitives (in no object) as ranges of global ids into *out (freed
+ * by the caller), *n of them. */
+static Status world_ranges(const Scene *s, KdRange **out, size_t *n, Error *err)
+{
+    KdRange *r = malloc((OBJ_KINDS * (s->n_objects + 1) + 1) * sizeof *r);
+    if (!r) return error_set(err, ST_INTERNAL, "out of memory listing the world's primitives");
+    uint first[OBJ_KINDS] = { 0u, scene_first_triangle(s), scene_first_box(s), scene_first_revsurface(s) };
+    size_t count[OBJ_KINDS] = { s->n_spheres, s->n_triangles, s->n_boxes, s->n_revsurfaces };
+    size_t k = 0;
+    for (int kind = 0; kind < OBJ_KINDS; kind++) {
+        size_t at = 0;
+        for (size_t i = 0; i <= s->n_objects; i++) {
+            size_t stop = i < s->n_objects ? s->objects[i].first[kind] : count[kind];
+            if (stop > at) r[k++] = (KdRange){ first[kind] + (uint)at, first[kind] + (uint)stop };
+            if (i < s->n_objects) at = s->objects[i].end[kind];
+        }
+    }
+    *out = r;
+    *n = k;
+    return ST_OK;
+}
+
+/* The BVH of a scene with objects: a prototype per object and the world's own as the
+ * last, the scene's instances and one identity instance of the world's (INST_WORLD). */
+static Status tree_build_instanced(const Scene *s, const KdInput *in, int threads, RenderScene *out, Error *err)
+{
+    size_t n_protos = s->n_objects + 1;
+    BvhProto *protos = calloc(n_protos, sizeof *protos);
+    KdRange *obj_ranges = malloc((s->n_objects + 1) * OBJ_KINDS * sizeof *obj_ranges);
+    KdRange *world = NULL;
+    out->instances = malloc((s->n_instances + 1) * sizeof *out->instances);
+    Status st = ST_OK;
+    if (!protos || !obj_ranges || !out->instances) {
+        st = error_set(err, ST_INTERNAL, "out of memory for %zu instances", s->n_instances);
+        goto done;
+    }
+    for (uint i = 0; i < (uint)s->n_objects; i++) {
+        uint lo[OBJ_KINDS], hi[OBJ_KINDS];
+        size_t n = scene_object_ranges(s, i, lo, hi);
+        for (size_t r = 0; r < n; r++) obj_ranges[OBJ_KINDS * i + r] = (KdRange){ lo[r], hi[r] };
+        protos[i] = (BvhProto){ obj_ranges + OBJ_KINDS * i, n };
+    }
+    size_t n_world = 0;
+    if ((st = world_ranges(s, &world, &n_world, err))) goto done;
+    protos[s->n_objects] = (BvhProto){ world, n_world };
+    if (s->n_instances) memcpy(out->instances, s->instances, s->n_instances * sizeof *out->instances);
+    Instance w;
+    memset(&w, 0, sizeof w);
+    for (int i = 0; i < 3; i++) w.to_world[5 * i] = w.to_object[5 * i] = 1.0f;
+    w.material = NO_INDEX;
+    w.flags = INST_IDENTITY | INST_WORLD;
+    w.object = (uint)s->n_objects;
+    out->instances[s->n_instances] = w;
+    out->n_instances = s->n_instances + 1;
+    st = bvh_build_instanced(in, protos, n_protos, out->instances, out->n_instances, threads, &out->bvh,
+                             &out->levels, err);
+    if (st) goto done;
+    out->instanced = 1;
+    render_scene_use_bvh(&out->ds, &out->bvh);
+    out->ds.params.n_instances = (uint)out->n_instances;
+    out->ds.instances = out->instances;
+done:
+    free(protos);
+    free(obj_ranges);
+    free(world);
+    return st;
+}
+
 /* The scene's tree into out, and out->ds pointed at it. */
 static Status tree_build(const Scene *s, int threads, RenderScene *out, Error *err)
 {
     KdInput in = { s->spheres, s->n_spheres, s->triangles, s->n_triangles, s->boxes, s->n_boxes,
-                   s->revsurfaces, s->n_revsurfaces, s->sphere_xforms, s->n_sphere_xforms };
+                   s->revsurfaces, s->n_revsurfaces, s->sphere_xforms, s->n_sphere_xforms, NULL, 0 };
     Status st;
+    if (s->n_objects && s->accel != ACCEL_KDTREE) return tree_build_instanced(s, &in, threads, out, err);
     if (s->accel == ACCEL_KDTREE) {
         if ((st = kd_build(&in, threads, &out->kd, err))) return st;
         render_scene_use_kdtree(&out->ds, &out->kd);
@@ -104,6 +175,11 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
 {
     memset(out, 0, sizeof *out);
     Status st;
+    /* the kd-tree has one level: it takes an instanced scene's copies (docs/instancing.md) */
+    if (s->accel == ACCEL_KDTREE && s->n_objects) {
+        out->flattened = s->n_instances;
+        if ((st = scene_flatten_instances(s, err))) return st;
+    }
     /* the path tracer samples a cube map as an environment light; Whitted keeps the
      * course's exact lookup (cube_env.h) */
     if (s->integrator == INTEGRATOR_PATH && s->bg_type == BG_CUBEMAP && (st = cube_env_convert(s, err))) return st;
@@ -183,6 +259,7 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
 
 void render_scene_free(RenderScene *r)
 {
+    free(r->instances);
     kd_free(&r->kd);
     bvh_free(&r->bvh);
     memset(r, 0, sizeof *r);

@@ -8,6 +8,7 @@
 
 #include "device/device.h"
 #include "accel/bvh.h"
+#include "accel/bvh_inst.h"
 #include "accel/kdtree.h"
 #include "scene/scene.h"
 
@@ -15,6 +16,12 @@ typedef struct {
     KdTree kd;            /* the scene's tree (Scene.accel): one of these two, */
     Bvh bvh;              /* the other one empty */
     DeviceScene ds;       /* points into the Scene and the tree: keep both alive */
+    /* a scene with objects (docs/instancing.md): the BVH's two levels and the device's
+     * instance records (the scene's, their roots filled, then the world's own) */
+    Instance *instances;  size_t n_instances;
+    BvhLevels levels;
+    int instanced;        /* the BVH has two levels */
+    size_t flattened;     /* --accel kdtree: the instances copied into the world */
 } RenderScene;
 
 /* The scene's image settings (size, depth, seed) and its tree are taken as they are

@@ -16,6 +16,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene/instance.h"
+
 void scene_init(Scene *s)
 {
     memset(s, 0, sizeof *s);
@@ -83,6 +85,7 @@ void scene_free(Scene *s)
     strmap_free(&s->material_by_name);
     strmap_free(&s->texture_by_name);
     strmap_free(&s->texture_by_source);
+    scene_free_objects(s);
     memset(s, 0, sizeof *s);
 }
 

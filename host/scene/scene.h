@@ -53,6 +53,16 @@ typedef struct {
 } SceneMediumBinding;
 #define SCENE_MEDIUM_UNSET 0xffffffffu
 
+/* An object (docs/instancing.md): the primitives its block made, [first, end) of each
+ * kind in the scene's arrays (spheres, triangles, boxes, surfaces of revolution, in
+ * that order), which only its instances reach: no tree but its own holds them and they
+ * are no lights. Objects are made one after another, so their ranges increase. */
+enum { OBJ_SPHERES, OBJ_TRIANGLES, OBJ_BOXES, OBJ_REVS, OBJ_KINDS };
+typedef struct {
+    char *name;
+    size_t first[OBJ_KINDS], end[OBJ_KINDS];
+} SceneObject;
+
 typedef struct {
     char *path;                  /* scene file as given on the command line */
     int size_overridden;         /* in: --width or --height replaces the file's size, so
@@ -93,6 +103,10 @@ typedef struct {
     RevSurface *revsurfaces;  size_t n_revsurfaces, cap_revsurfaces;
     float *rev_points;     size_t n_rev_points, cap_rev_points;   /* (x, y) pairs: floats */
     Light *lights;         size_t n_lights;     /* filled by scene_prepare_lights */
+    /* objects and their instances (scene/instance.h); Instance.root is the build's */
+    SceneObject *objects;  size_t n_objects, cap_objects;
+    Instance *instances;   size_t n_instances, cap_instances;
+    StrMap object_by_name;
 
     /* the classic ray tracer's additions (docs/classic-format.md) */
     Light *delta_lights;   size_t n_delta_lights, cap_delta_lights;  /* point, spot, directional */

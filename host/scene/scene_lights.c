@@ -207,22 +207,37 @@ Status scene_prepare_lights(Scene *s, Error *err)
     s->env_light = NO_INDEX;
     int env = s->bg_type == BG_MAP && s->n_env_cdf > 0;
     size_t n = (size_t)env;
+    /* an object's primitives are in no place of the world until instanced: no lights
+     * (docs/instancing.md) */
+    uint8_t *in_object;
+    Status st = scene_object_mask(s, &in_object, err);
+    if (st) return st;
+    uint first_tri = scene_first_triangle(s), first_box = scene_first_box(s);
+#define IN_OBJECT(gid) (in_object && in_object[gid])
     for (size_t i = 0; i < s->n_spheres; i++) {
+        if (IN_OBJECT(i)) continue;
         /* the kernels sample sphere lights by the cone a sphere subtends: an ellipsoid
          * has none (the pbrt reader makes emitting ones meshes) */
-        if (s->spheres[i].xform && is_emissive(s, s->spheres[i].material))
+        if (s->spheres[i].xform && is_emissive(s, s->spheres[i].material)) {
+            free(in_object);
             return error_set(err, ST_INPUT, "sphere %zu is an ellipsoid that emits light, which clpt cannot "
                              "sample; make it a mesh", i);
+        }
         n += (size_t)is_emissive(s, s->spheres[i].material);
     }
-    for (size_t i = 0; i < s->n_triangles; i++) n += (size_t)is_emissive(s, s->triangles[i].material);
-    for (size_t i = 0; i < s->n_boxes; i++) n += (size_t)is_emissive(s, s->boxes[i].material);
+    for (size_t i = 0; i < s->n_triangles; i++)
+        n += (size_t)(is_emissive(s, s->triangles[i].material) && !IN_OBJECT(first_tri + i));
+    for (size_t i = 0; i < s->n_boxes; i++)
+        n += (size_t)(is_emissive(s, s->boxes[i].material) && !IN_OBJECT(first_box + i));
     n += s->n_delta_lights;
-    if (n == 0) return ST_OK;
-    if (n >= (size_t)NO_INDEX) return error_set(err, ST_INPUT, "too many emissive primitives");
+    if (n == 0 || n >= (size_t)NO_INDEX) {
+        free(in_object);
+        return n == 0 ? ST_OK : error_set(err, ST_INPUT, "too many emissive primitives");
+    }
     Light *lights = calloc(n, sizeof *lights);
     double *power = calloc(n, sizeof *power);
     if (!lights || !power) {
+        free(in_object);
         free(lights);
         free(power);
         return error_set(err, ST_INTERNAL, "out of memory building the light list");
@@ -231,7 +246,7 @@ Status scene_prepare_lights(Scene *s, Error *err)
     double total = 0.0;
 #define ADD_LIGHT(arr, count, first, area_expr)                                          \
     for (size_t i = 0; i < (count); i++) {                                                \
-        if (!is_emissive(s, arr[i].material)) continue;                                   \
+        if (!is_emissive(s, arr[i].material) || IN_OBJECT((first) + i)) continue;         \
         double area = (area_expr);                                                        \
         lights[k].type = LIGHT_AREA;                                                      \
         lights[k].prim = (uint)((first) + i);                                             \
@@ -243,7 +258,6 @@ Status scene_prepare_lights(Scene *s, Error *err)
     }
     ADD_LIGHT(s->spheres, s->n_spheres, 0, 4.0 * M_PI * (double)s->spheres[i].radius * s->spheres[i].radius)
     size_t first_tri_light = k;
-    uint first_tri = scene_first_triangle(s);
     ADD_LIGHT(s->triangles, s->n_triangles, first_tri, triangle_area(&s->triangles[i]))
     for (size_t j = first_tri_light; j < k; j++) {
         /* the normal surface_at computes for the triangle: the same float operations */
@@ -251,7 +265,9 @@ Status scene_prepare_lights(Scene *s, Error *err)
         lights[j].normal = v3_norm(v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0)));
     }
     pair_quad_lights(s, lights, power, first_tri_light, k);
-    ADD_LIGHT(s->boxes, s->n_boxes, scene_first_box(s), box_area(&s->boxes[i]))
+    ADD_LIGHT(s->boxes, s->n_boxes, first_box, box_area(&s->boxes[i]))
+    free(in_object);
+#undef IN_OBJECT
 #undef ADD_LIGHT
     double radius = s->n_delta_lights || env ? scene_radius(s) : 1.0;
     for (size_t i = 0; i < s->n_delta_lights; i++, k++) {

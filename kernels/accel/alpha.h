@@ -33,11 +33,15 @@
 
 #define ALPHA_MAX_LAYERS 64u
 
-/* Whether the material of primitive `prim` may be cut out anywhere. */
-KFN int prim_has_alpha(const SceneView *sc, uint prim)
+/* Whether the material of the hit's primitive (its instance's, where that replaces
+ * it) may be cut out anywhere. */
+KFN int hit_has_alpha(const SceneView *sc, Hit hit)
 {
     if (!KF_HAS(KF_ALPHA)) return 0;
-    return (sc->materials[prim_material(sc, prim)].flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) != 0u;
+    uint m = prim_material(sc, hit.prim);
+    if (SURFACE_INSTANCED(sc, hit) && sc->instances[hit.inst].material != NO_INDEX)
+        m = sc->instances[hit.inst].material;
+    return (sc->materials[m].flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) != 0u;
 }
 
 /* The BLEND coin of a hit: uniform in [0, 1), a hash of the ray's and the hit's bits. */
@@ -51,6 +55,8 @@ KFN float alpha_uniform(Ray ray, Hit hit)
     h = rng_hash(h ^ k_as_uint(ray.d.z));
     h = rng_hash(h ^ k_as_uint(hit.t));
     h = rng_hash(h ^ hit.prim);
+    /* instances of one prototype get coins of their own (the world's hits keep theirs) */
+    if (hit.inst != NO_INDEX) h = rng_hash(h ^ hit.inst);
     return (float)(h >> 8) * 5.9604645e-8f;
 }
 
@@ -66,7 +72,7 @@ KFN float material_alpha(const SceneView *sc, Material m, Surface s)
 /* 1 when `hit` (of `ray`) lies where its surface is cut out; 0 for no hit. */
 KFN int hit_cut_out(const SceneView *sc, Ray ray, Hit hit)
 {
-    if (hit.prim == NO_INDEX || !prim_has_alpha(sc, hit.prim)) return 0;
+    if (hit.prim == NO_INDEX || !hit_has_alpha(sc, hit)) return 0;
     Surface s = surface_at(sc, ray, hit);
     Material m = sc->materials[s.material];
     float a = material_alpha(sc, m, s);
@@ -94,7 +100,7 @@ KFN int trace_occluded(const SceneView *sc, Ray ray)
 {
     Hit h = trace_any_hit(sc, ray);
     if (h.prim == NO_INDEX) return 0;
-    if (!prim_has_alpha(sc, h.prim)) return 1;
+    if (!hit_has_alpha(sc, h)) return 1;
     return trace_closest_visible(sc, ray).prim != NO_INDEX;
 }
 

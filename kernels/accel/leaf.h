@@ -54,6 +54,28 @@ KFN_INLINE float leaf_tmax(const Hit *best)
     return best->prim == NO_INDEX ? best->t : k_next_up(best->t);
 }
 
+/* Whether a hit at t (<= best->t, which leaf_tmax ensures) on primitive id of instance
+ * inst replaces the closest so far: a nearer one always, one at the same t when
+ * (prim, inst) is lower. In a scene without instances inst is NO_INDEX throughout, and
+ * this is the rule on ids alone that every walk kept before instancing; with instances
+ * the same primitive of two instances at the same t is decided by the instance, so the
+ * order the walk meets them in still does not matter. */
+KFN_INLINE int hit_wins(const Hit *best, float t, uint id, uint inst)
+{
+    return t < best->t || id < best->prim || (id == best->prim && inst < best->inst);
+}
+
+/* best becomes h (t, u, v) on primitive id of instance inst; best's padding is left as
+ * hit_none wrote it, so hit buffers compare bit for bit between devices. */
+KFN_INLINE void hit_take(Hit *best, Hit h, uint id, uint inst)
+{
+    best->t = h.t;
+    best->u = h.u;
+    best->v = h.v;
+    best->prim = id;
+    best->inst = inst;
+}
+
 /* Tests the primitives of leaf n (its record in leaf_data) against the ray (tmax: the
  * closest hit so far, in best->t); returns 1 when an any-hit query hit. The triangles are
  * tested a group at a time (triangle_intersect_group), then the spheres and boxes one by
@@ -67,7 +89,7 @@ KFN_INLINE float leaf_tmax(const Hit *best)
  * starts at the closest hit). (A surface of revolution's t does depend on the hit found
  * before it, revsurface.h.) */
 KFN_INLINE int leaf_test(const SceneView *sc, GLOBAL const uint *leaf_data, Ray ray, const RayPre *rp, int any,
-                         KdNode n, Hit *best)
+                         KdNode n, uint inst, Hit *best)
 {
     GLOBAL const uint *g = leaf_data + n.data;
     uint groups = n.bits >> 3;
@@ -75,10 +97,9 @@ KFN_INLINE int leaf_test(const SceneView *sc, GLOBAL const uint *leaf_data, Ray 
     for (uint i = 0; i < groups; i++, g += KD_GROUP_WORDS) {
         Hit h;
         if (triangle_intersect_group(rp, (GLOBAL const float *)(g + KD_GROUP), ray.tmin, tmax, &h)) {
-            h.prim = g[h.prim];
-            /* h.t <= best->t: at the same t, the lower id */
-            if (h.t < best->t || h.prim < best->prim) {
-                *best = h;
+            uint id = g[h.prim];
+            if (hit_wins(best, h.t, id, inst)) {
+                hit_take(best, h, id, inst);
                 if (any) return 1;
                 tmax = k_next_up(h.t);
             }
@@ -91,9 +112,8 @@ KFN_INLINE int leaf_test(const SceneView *sc, GLOBAL const uint *leaf_data, Ray 
             Ray r = ray;
             r.tmax = tmax;
             Hit h;
-            if (trace_prim(sc, id, rp, r, &h) && (h.t < best->t || id < best->prim)) {
-                h.prim = id;
-                *best = h;
+            if (trace_prim(sc, id, rp, r, &h) && hit_wins(best, h.t, id, inst)) {
+                hit_take(best, h, id, inst);
                 if (any) return 1;
                 tmax = k_next_up(h.t);
             }
@@ -113,8 +133,7 @@ KFN_INLINE int trace_planes(const SceneView *sc, Ray ray, int any, Hit *best)
         r.tmax = best->t;
         Hit h;
         if (plane_intersect(sc->planes[i], r, &h)) {
-            h.prim = first_plane + i;
-            *best = h;
+            hit_take(best, h, first_plane + i, NO_INDEX);
             if (any) return 1;
         }
     }
@@ -128,6 +147,8 @@ KFN_INLINE Hit hit_none(Ray ray)
     h.prim = NO_INDEX;
     h.u = 0.0f;
     h.v = 0.0f;
+    h.inst = NO_INDEX;
+    h.pad0 = h.pad1 = h.pad2 = 0u;
     return h;
 }
 

@@ -25,6 +25,7 @@
 #define CLPT_TRAVERSE_BVH_H
 
 #include "accel/leaf.h"
+#include "geom/instance.h"
 
 #define BVH_TINY 1e-30f
 
@@ -148,12 +149,9 @@ KFN_INLINE uint bvh_push_children(uint ref, uint mask, const float *d, const uin
 #define BVH_WALK_FN KFN_INLINE
 #endif
 
-/* The walk shared by both queries: with `any` set it returns at the first hit;
- * otherwise it keeps the closest one in *best (whose t starts as the ray's tmax). */
-BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit *best)
+/* The slab tests' view of a ray. */
+KFN_INLINE BvhRay bvh_ray(Ray ray, const RayPre *rp)
 {
-    float s = ray.o.x + ray.o.y + ray.o.z + ray.d.x + ray.d.y + ray.d.z;
-    if (!(s == s) || sc->params->n_bvh_nodes == 0u) return;
     BvhRay w;
     w.ox = ray.o.x;
     w.oy = ray.o.y;
@@ -168,6 +166,41 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
     w.nx = rp->neg & 1u;
     w.ny = (rp->neg >> 1) & 1u;
     w.nz = (rp->neg >> 2) & 1u;
+    return w;
+}
+
+/* A stack entry that is no child but the way back out of an instance: pushed when the
+ * walk enters one, so the entries pushed inside it (in object space) are popped first,
+ * and popping it puts the world ray back. No node index reaches it (29 bits). */
+#define BVH_STACK_LEAVE 0xffffffffu
+
+/* The walk shared by both queries: with `any` set it returns at the first hit;
+ * otherwise it keeps the closest one in *best (whose t starts as the ray's tmax).
+ * With instances (KF_INSTANCES) the tree has two levels in one walk, as Embree's
+ * instance traversal has: the top level's instance children (BVH_CHILD_INSTANCE) lead,
+ * with the ray carried into the instance's object space, to its prototype's root, and
+ * the stack holds both levels' entries, with a BVH_STACK_LEAVE between them. Entry
+ * distances and the closest hit are in the world ray's t throughout (instance.h), so
+ * an entry pushed in the world is skipped by a hit found in an instance as usual. The
+ * builds keep both levels' stack depths within BVH_STACK together (host/accel/bvh_inst.c). */
+BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit *best)
+{
+    float s = ray.o.x + ray.o.y + ray.o.z + ray.d.x + ray.d.y + ray.d.z;
+    if (!(s == s) || sc->params->n_bvh_nodes == 0u) return;
+    BvhRay w = bvh_ray(ray, rp);
+#if KF_HAS(KF_INSTANCES)
+    BvhRay w_world = w;
+    Ray oray = ray;              /* the ray in the space being walked, and its constants */
+    RayPre orp = *rp;
+    uint inst = NO_INDEX;        /* the instance being walked (NO_INDEX: the world) */
+#define TW_RAY oray
+#define TW_RP (&orp)
+#define TW_INST inst
+#else
+#define TW_RAY ray
+#define TW_RP rp
+#define TW_INST NO_INDEX
+#endif
     /* an entry: the child's node and lane (node << 3 | lane; its reference and kind are
      * read back from the node, in cache, on the pop: a third less private memory than
      * keeping them), and its entry distance's bits */
@@ -188,22 +221,52 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
             ref = nd->ref[next];
             kind = nd->kind[next];
         }
+#if KF_HAS(KF_INSTANCES)
+        if (kind == BVH_CHILD_INSTANCE) {
+            /* into the instance: its object space, its prototype's root */
+            GLOBAL const Instance *x = sc->instances + ref;
+            st_child[sp] = BVH_STACK_LEAVE;
+            st_t[sp] = 0u;
+            sp++;
+            inst = (x->flags & INST_WORLD) ? NO_INDEX : ref;
+            oray = instance_ray(x, ray);
+            orp = ray_prepare(oray);
+            w = bvh_ray(oray, &orp);
+            ref = x->root;
+            kind = BVH_CHILD_NODE;
+            continue;
+        }
+#endif
         if (kind != BVH_CHILD_NODE) {
             KdNode leaf;
             leaf.data = ref;
             leaf.bits = kind;
-            if (leaf_test(sc, sc->bvh_leaves, ray, rp, any, leaf, best)) return;
+            if (leaf_test(sc, sc->bvh_leaves, TW_RAY, TW_RP, any, leaf, TW_INST, best)) return;
         }
         /* the next cell on the stack that starts before the closest hit so far */
-        do {
+        for (;;) {
             if (sp == 0) return;
             sp--;
-        } while (k_as_float(st_t[sp]) > best->t * KD_T_ABOVE);
+#if KF_HAS(KF_INSTANCES)
+            if (st_child[sp] == BVH_STACK_LEAVE) {
+                /* back out of the instance into the world */
+                w = w_world;
+                oray = ray;
+                orp = *rp;
+                inst = NO_INDEX;
+                continue;
+            }
+#endif
+            if (!(k_as_float(st_t[sp]) > best->t * KD_T_ABOVE)) break;
+        }
         GLOBAL const BvhNode *parent = sc->bvh + (st_child[sp] >> 3);
         uint lane = st_child[sp] & 7u;
         ref = parent->ref[lane];
         kind = parent->kind[lane];
     }
+#undef TW_RAY
+#undef TW_RP
+#undef TW_INST
 }
 
 
@@ -312,7 +375,7 @@ KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, con
             leaf.bits = kind;
             for (uint m = lanes; m != 0u; m &= m - 1u) {
                 uint l = k_lowest_bit(m);
-                if (leaf_test(sc, sc->bvh_leaves, rays[l], &rp[l], any, leaf, &best[l])) done |= 1u << l;
+                if (leaf_test(sc, sc->bvh_leaves, rays[l], &rp[l], any, leaf, NO_INDEX, &best[l])) done |= 1u << l;
                 tfar_a[l] = best[l].t * KD_T_ABOVE;
             }
         }
@@ -354,6 +417,10 @@ KFN_INLINE void trace_packet_wide(const SceneView *sc, const Ray *rays, int any,
         mixed |= rp[l].neg ^ neg;
         lanes |= 1u << l;
     }
+    /* the packet walk has one level: a scene with instances walks its rays one by one */
+#if KF_HAS(KF_INSTANCES)
+    if (sc->params->n_instances != 0u) mixed = 1u;
+#endif
     if (mixed) {
         for (uint l = 0; l < WIDE_PACKET; l++)
             if ((lanes >> l) & 1u) trace_wide(sc, rays[l], &rp[l], any, &hits[l]);

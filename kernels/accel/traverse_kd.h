@@ -124,7 +124,7 @@ KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, KdStack *st, int 
 KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, KdNode n, KdWalk *w,
                        const KdStack *st, Hit *best)
 {
-    if (leaf_test(sc, sc->leaf_prims, ray, rp, any, n, best)) return 1;
+    if (leaf_test(sc, sc->leaf_prims, ray, rp, any, n, NO_INDEX, best)) return 1;
     float reach = best->t * KD_T_ABOVE;
     if ((w->sp == 0) | (reach < w->t1)) return 1;
     int sp = w->sp - 1;
@@ -354,7 +354,7 @@ KFN_INLINE void trace_packet_walk(const SceneView *sc, TraceRay *tr, const RayPr
         k_store8(t1, end);
         for (uint l = 0; l < TRACE_PACKET; l++) {
             if (!((lanes >> l) & 1u)) continue;
-            if (leaf_test(sc, sc->leaf_prims, tr[l].ray, &rp[l], tr[l].any, n, &tr[l].best))
+            if (leaf_test(sc, sc->leaf_prims, tr[l].ray, &rp[l], tr[l].any, n, NO_INDEX, &tr[l].best))
                 done |= 1u << l;
             reach[l] = tr[l].best.t * KD_T_ABOVE;
             if (reach[l] < end[l]) done |= 1u << l;

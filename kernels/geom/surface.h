@@ -7,6 +7,7 @@
 #define CLPT_SURFACE_H
 
 #include "util/kmath.h"
+#include "geom/instance.h"
 #include "geom/intersect.h"
 #include "scene_view.h"
 
@@ -24,6 +25,10 @@ typedef struct {
                       * NO_INDEX; read only through the surface_* functions below */
     float b1, b2;    /* triangles: the hit's barycentrics of p1 and p2, to interpolate
                       * the extras' corners */
+    uint inst;       /* the instance the primitive was hit through (Hit.inst), NO_INDEX
+                      * for the world's own */
+    vec3 po, ngo;    /* p and ng in the primitive's own (object) space, where its (u, v)
+                      * and tangents are defined; p and ng themselves outside instances */
 } Surface;
 
 /* A bound on the rounding error of n floating-point operations, relative to the
@@ -160,7 +165,9 @@ KFN vec3 triangle_normal(Triangle tr)
     return v3_norm(c);
 }
 
-KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
+/* The surface of hit `hit` on a primitive in the space of `ray` (the world's, or an
+ * instance's object space: surface_at). */
+KFN Surface surface_local(const SceneView *sc, Ray ray, Hit hit)
 {
     GLOBAL const RenderParams *p = sc->params;
     Surface s;
@@ -247,7 +254,72 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
         s.ns = pl.normal;
         s.material = pl.material;
     }
+    s.inst = NO_INDEX;
+    s.po = s.p;
+    s.ngo = s.ng;
     return s;
+}
+
+/* The rounding error of p = M po for an instance (PBR 4th ed., 6.8.5, as
+ * sphere_xform_point): the transform's own rounding (gamma(3) of |M| |po| and the
+ * translation), po's bound err_o carried by |M|, and the rounding of M^-1 applied to a
+ * new ray's origin, since the walk decides which side of a primitive that origin is on
+ * in object space (4 roundings of |M^-1| |p| and its translation), as large in the
+ * world as |M| makes it. */
+KFN vec3 instance_point_error(GLOBAL const Instance *x, vec3 po, vec3 err_o, vec3 p)
+{
+    GLOBAL const float *m = x->to_world, *mi = x->to_object;
+    vec3 trans = v3(k_fabs(m[3]), k_fabs(m[7]), k_fabs(m[11]));
+    vec3 trans_i = v3(k_fabs(mi[3]), k_fabs(mi[7]), k_fabs(mi[11]));
+    vec3 fwd = v3_scale(v3_add(xform_abs_vector(m, v3_abs(po)), trans), K_ROUND_ERR(3));
+    vec3 carried = v3_scale(xform_abs_vector(m, err_o), 1.0f + K_ROUND_ERR(3));
+    vec3 back = v3_scale(v3_add(xform_abs_vector(mi, v3_abs(p)), trans_i), K_ROUND_ERR(4));
+    return v3_add(v3_add(fwd, carried), xform_abs_vector(m, back));
+}
+
+/* The surface of a hit through instance hit.inst: found in its object space with the
+ * walk's own object-space ray, then carried to the world (position by M, normals by
+ * M^-T, the error bound by instance_point_error). The instance's material replaces the
+ * primitive's when it names one. M^-T keeps every normal on its side under a mirroring
+ * M too, as a mirrored mesh block keeps its triangles' outward sides (its loader swaps
+ * two corners; scene_flatten_instances does the same). Prototype primitives are no
+ * lights (docs/instancing.md): BSDF sampling finds their emission at full weight. */
+KFN Surface surface_instanced(const SceneView *sc, Ray ray, Hit hit)
+{
+    GLOBAL const Instance *x = sc->instances + hit.inst;
+    Surface s = surface_local(sc, instance_ray(x, ray), hit);
+    s.inst = hit.inst;
+    s.light = NO_INDEX;
+    if (x->material != NO_INDEX) s.material = x->material;
+    if (x->flags & INST_IDENTITY) return s;
+    s.p = xform_point(x->to_world, s.po);
+    s.err = instance_point_error(x, s.po, s.err, s.p);
+    vec3 ng = instance_normal(x, s.ngo);
+    vec3 ns = instance_normal(x, s.ns);
+    s.ng = ng;
+    s.ns = v3_dot(ns, ng) < 0.0f ? v3_neg(ns) : ns;
+    return s;
+}
+
+/* Whether s (a Surface or Hit) was found through an instance. A scene without
+ * instances answers no whatever inst holds, so a hit made by hand (the tests') needs
+ * no instance. */
+#define SURFACE_INSTANCED(sc, s) (KF_HAS(KF_INSTANCES) && (s).inst != NO_INDEX && (sc)->params->n_instances != 0u)
+
+/* The surface at a hit of ray (world space). */
+KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
+{
+    if (SURFACE_INSTANCED(sc, hit)) return surface_instanced(sc, ray, hit);
+    return surface_local(sc, ray, hit);
+}
+
+/* An object-space vector of surface s (a tangent) in the world: M v through its
+ * instance, v itself outside one. */
+KFN vec3 surface_vector_to_world(const SceneView *sc, Surface s, vec3 v)
+{
+    if (!SURFACE_INSTANCED(sc, s)) return v;
+    GLOBAL const Instance *x = sc->instances + s.inst;
+    return (x->flags & INST_IDENTITY) ? v : xform_vector(x->to_world, v);
 }
 
 /* Corner attribute `a` (three corners of `n` floats, `stride` apart) at s's

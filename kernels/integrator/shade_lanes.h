@@ -162,6 +162,7 @@ KFN_INLINE int lane_surface(const SceneView *sc, GLOBAL const Ray *ray, Hit hit,
     GLOBAL const RenderParams *p = sc->params;
     uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
     if (hit.prim == NO_INDEX || hit.prim < first_tri || hit.prim >= first_box) return 0;
+    if (hit.inst != NO_INDEX) return 0;   /* (kernel_lanes_scene keeps instances away) */
     uint bounce = ps->bounce;
     if (bounce >= p->max_depth) return 0;
     GLOBAL const Triangle *tri = &sc->triangles[hit.prim - first_tri];

@@ -37,16 +37,17 @@ KFN void surface_uv(const SceneView *sc, Surface s, float *u, float *v)
             *u = s.u;     /* an ellipsoid: surface_at's, in its object space */
             *v = s.v;
         } else {
-            sphere_uv(s.ng, u, v);
+            sphere_uv(s.ngo, u, v);
         }
     } else if (s.prim < first_box || (s.prim >= first_rev && s.prim < first_plane)) {
         *u = s.u;     /* triangles: interpolated uv; surfaces of revolution: angle, s */
         *v = s.v;
     } else if (s.prim < first_plane) {
         Box b = sc->boxes[s.prim - first_box];
-        vec3 f = v3((s.p.x - b.lo.x) / (b.hi.x - b.lo.x), (s.p.y - b.lo.y) / (b.hi.y - b.lo.y),
-                    (s.p.z - b.lo.z) / (b.hi.z - b.lo.z));
-        float ax = k_fabs(s.ng.x), ay = k_fabs(s.ng.y);
+        /* in the box's own space (an instance's object space) */
+        vec3 f = v3((s.po.x - b.lo.x) / (b.hi.x - b.lo.x), (s.po.y - b.lo.y) / (b.hi.y - b.lo.y),
+                    (s.po.z - b.lo.z) / (b.hi.z - b.lo.z));
+        float ax = k_fabs(s.ngo.x), ay = k_fabs(s.ngo.y);
         *u = ax > 0.5f ? f.z : f.x;
         *v = ay > 0.5f ? f.z : f.y;
     } else {
@@ -247,22 +248,22 @@ KFN vec3 material_albedo(const SceneView *sc, Material m, Surface s, vec3 ng_fac
     return surface_color(sc, s, c) ? v3_mul(a, v3(c[0], c[1], c[2])) : a;
 }
 
-/* dp/du and dp/dv at s, for tangent-space normal maps: a triangle's from its corners
+/* dp/du and dp/dv at s in its object space, for tangent-space normal maps: a triangle's from its corners
  * and (u, v) (barycentric (u, v) when it has none), a sphere's from its (u, v)
  * parameterisation above. Returns 0 where there is none (boxes, planes) or the mapping
  * is degenerate. */
-KFN int surface_tangents(const SceneView *sc, Surface s, vec3 *dpdu, vec3 *dpdv)
+KFN int surface_tangents_local(const SceneView *sc, Surface s, vec3 *dpdu, vec3 *dpdv)
 {
     GLOBAL const RenderParams *p = sc->params;
     uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
     if (s.prim < first_tri) {
         /* u grows with atan2(x, z) about +y, v with y */
-        vec3 n = s.ng;
+        vec3 n = s.ngo;
         uint xf = KF_HAS(KF_SPHERE_XFORM) ? sc->spheres[s.prim].xform : 0u;
         if (xf != 0u) {
             /* an ellipsoid: the object space's tangents, carried to the world by M */
             GLOBAL const SphereXform *x = &sc->sphere_xforms[xf - 1u];
-            vec3 no = v3_norm(xform_point(x->to_object, s.p));
+            vec3 no = v3_norm(xform_point(x->to_object, s.po));
             vec3 du = v3(no.z, 0.0f, -no.x);
             *dpdu = xform_vector(x->to_world, du);
             *dpdv = xform_vector(x->to_world, v3_cross(no, du));
@@ -290,6 +291,15 @@ KFN int surface_tangents(const SceneView *sc, Surface s, vec3 *dpdu, vec3 *dpdv)
     float inv = 1.0f / det;
     *dpdu = v3_scale(v3_sub(v3_scale(e1, v2), v3_scale(e2, v1)), inv);
     *dpdv = v3_scale(v3_sub(v3_scale(e2, u1), v3_scale(e1, u2)), inv);
+    return 1;
+}
+
+/* The same in the world: an instance's object-space tangents carried by its M. */
+KFN int surface_tangents(const SceneView *sc, Surface s, vec3 *dpdu, vec3 *dpdv)
+{
+    if (!surface_tangents_local(sc, s, dpdu, dpdv)) return 0;
+    *dpdu = surface_vector_to_world(sc, s, *dpdu);
+    *dpdv = surface_vector_to_world(sc, s, *dpdv);
     return 1;
 }
 

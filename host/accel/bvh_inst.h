@@ -1,0 +1,42 @@
+/*
+ * bvh_inst.h — the 8-wide BVH in two levels, for scenes with instances
+ * (docs/instancing.md).
+ *
+ * Each prototype (an object, and the world's own primitives as one more) gets a BVH of
+ * its primitives in its own space; a top-level BVH holds the instances' world boxes, one
+ * instance a leaf (BVH_CHILD_INSTANCE). All of them are written into one node array and
+ * one leaf array, the top level first (node 0 is its root), so the kernels' scene
+ * buffers are the ones a one-level scene has, plus the instance records.
+ */
+#ifndef CLPT_BVH_INST_H
+#define CLPT_BVH_INST_H
+
+#include "accel/bvh.h"
+
+/* The walk's stack entries the top level may use; the prototypes get what is left of
+ * BVH_STACK after the deepest top-level path and one entry to come back out. */
+#define BVH_TOP_STACK 64u
+
+/* A prototype: its primitives, as ranges of global ids. */
+typedef struct {
+    const KdRange *ranges;  size_t n_ranges;
+} BvhProto;
+
+/* The two levels, for --stats. */
+typedef struct {
+    BvhStats top;                  /* the top level's tree */
+    uint n_protos_built;           /* prototypes some instance reaches */
+    uint top_nodes, proto_nodes;   /* nodes of each level (BvhNode, 256 bytes each) */
+    uint proto_leaf_words;         /* leaf data of the prototypes (32-bit words) */
+    uint max_proto_stack;          /* the deepest prototype walk's stack */
+    uint n_inst_skipped;           /* instances of an empty prototype, left out */
+} BvhLevels;
+
+/* Builds the prototypes protos[0 .. n_protos) and the top level over inst[0 .. n_inst)
+ * (Instance.object: the prototype's index), filling each instance's root. On success
+ * *out owns one node array and one leaf array (bvh_free); out->lo, hi bound the world.
+ * Threads: 0 = all cores. */
+Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_protos, Instance *inst, size_t n_inst,
+                           int threads, Bvh *out, BvhLevels *lv, Error *err);
+
+#endif /* CLPT_BVH_INST_H */

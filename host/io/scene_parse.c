@@ -523,6 +523,7 @@ static const struct {
     {"box", scene_parse_box},                 {"mesh", scene_parse_mesh},
     {"include", parse_include},               {"light", scene_parse_light},
     {"texture", scene_parse_texture},         {"medium", scene_parse_medium},
+    {"object", scene_parse_object},           {"instance", scene_parse_instance},
 };
 #define N_STATEMENTS (sizeof statements / sizeof statements[0])
 
@@ -539,7 +540,8 @@ static Status parse_statements(Parser *p, Lexer *lx)
         if (i == N_STATEMENTS) {
             st = lex_expected(lx, &t,
                               "a statement (camera, image, background, material, sphere, "
-                              "plane, triangle, quad, box, mesh, light, texture, medium, include)", p->err);
+                              "plane, triangle, quad, box, mesh, light, texture, medium, include, object, "
+                              "instance)", p->err);
             break;
         }
         if ((st = statements[i].parse(p, lx, &t))) break;
@@ -566,6 +568,7 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
     memset(&p, 0, sizeof p);
     p.s = s;
     p.err = err;
+    p.object = NO_INDEX;
     Status st;
     if (text) {
         Lexer lx;

@@ -6,6 +6,7 @@
  *                     includes, the statement loop, the entry points
  *   scene_material.c  materials (their keys and types) and textures
  *   scene_shape.c     spheres, planes, triangles, quads, boxes, meshes, lights
+ *   scene_object.c    objects and their instances
  * Not for use outside these files.
  */
 #ifndef CLPT_SCENE_READER_H
@@ -61,6 +62,8 @@ typedef struct {
     char **material_at;               /* per material index, where it was defined */
     size_t n_material_at, cap_material_at;
     int depth_exceeded;               /* the include limit error is not annotated further */
+    uint object;                      /* the object whose block is being read, or NO_INDEX */
+    Token object_name;                /* where that object was named */
 } Parser;
 
 /* scene_parse.c: blocks, paths, vector helpers */
@@ -84,6 +87,15 @@ Status scene_parse_quad(Parser *p, Lexer *lx, const Token *kw);
 Status scene_parse_box(Parser *p, Lexer *lx, const Token *kw);
 Status scene_parse_mesh(Parser *p, Lexer *lx, const Token *kw);
 Status scene_parse_light(Parser *p, Lexer *lx, const Token *kw);
+/* The transform of a block's keys translate, rotate, rx, ry, rz, scale, matrix (seven
+ * consecutive values from t, in that order); `what` names the block ("mesh",
+ * "instance") in the message for a singular one. */
+Status scene_parse_transform(Parser *p, const Lexer *lx, const Token *kw, const Value *t, const char *what,
+                             Transform *out);
+
+/* scene_object.c: object, instance (docs/instancing.md) */
+Status scene_parse_object(Parser *p, Lexer *lx, const Token *kw);
+Status scene_parse_instance(Parser *p, Lexer *lx, const Token *kw);
 
 /* scene_medium.c: the medium statement, shapes' interior and exterior media */
 Status scene_parse_medium(Parser *p, Lexer *lx, const Token *kw);

@@ -182,58 +182,63 @@ static const KeySpec mesh_keys[MESH_N] = {
     [MESH_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
 };
 
-/* The instance transform of a mesh block: scale, then rotate, rx, ry, rz, then
- * translate; or a whole affine matrix, which excludes the others. */
-static Status mesh_transform(Parser *p, const Lexer *lx, const Token *kw, const Value *v, Transform *out)
+/* The transform of a block's translate, rotate, rx, ry, rz, scale and matrix keys
+ * (t[0 .. 7), in that order): scale, then rotate, rx, ry, rz, then translate; or a whole
+ * affine matrix, which excludes the others. `what` names the block in the message for a
+ * singular one ("mesh": "the mesh transform is singular (it flattens the mesh)"). */
+Status scene_parse_transform(Parser *p, const Lexer *lx, const Token *kw, const Value *t, const char *what,
+                             Transform *out)
 {
-    Transform t = transform_identity();
-    if (v[MESH_MATRIX].given) {
-        for (int i = MESH_TRANSLATE; i < MESH_MATRIX; i++)
-            if (v[i].given) {
-                const Token *later = &v[i].key;
-                if (v[MESH_MATRIX].key.line > later->line ||
-                    (v[MESH_MATRIX].key.line == later->line && v[MESH_MATRIX].key.col > later->col))
-                    later = &v[MESH_MATRIX].key;
+    enum { T_TRANSLATE, T_ROTATE, T_RX, T_RY, T_RZ, T_SCALE, T_MATRIX };
+    Transform m = transform_identity();
+    if (t[T_MATRIX].given) {
+        for (int i = T_TRANSLATE; i < T_MATRIX; i++)
+            if (t[i].given) {
+                const Token *later = &t[i].key;
+                if (t[T_MATRIX].key.line > later->line ||
+                    (t[T_MATRIX].key.line == later->line && t[T_MATRIX].key.col > later->col))
+                    later = &t[T_MATRIX].key;
                 return lex_error_at(lx, later, p->err,
                                     "'matrix' cannot be combined with translate, rotate, rx, ry, rz or scale "
                                     "(fold them into the matrix)");
             }
-        const float *a = v[MESH_MATRIX].a;
+        const float *a = t[T_MATRIX].a;
         if (a[12] != 0.0f || a[13] != 0.0f || a[14] != 0.0f || a[15] != 1.0f)
-            return lex_error_at(lx, &v[MESH_MATRIX].key, p->err,
+            return lex_error_at(lx, &t[T_MATRIX].key, p->err,
                                 "the last row of 'matrix' must be 0 0 0 1 (an affine transform), found "
                                 "%g %g %g %g", (double)a[12], (double)a[13], (double)a[14], (double)a[15]);
         for (int i = 0; i < 3; i++)
-            for (int j = 0; j < 4; j++) t.m[i][j] = a[4 * i + j];
+            for (int j = 0; j < 4; j++) m.m[i][j] = a[4 * i + j];
     } else {
-        if (v[MESH_SCALE].given) {
-            const float *a = v[MESH_SCALE].a;
-            t = transform_scale(a[0], a[1], a[2]);
+        if (t[T_SCALE].given) {
+            const float *a = t[T_SCALE].a;
+            m = transform_scale(a[0], a[1], a[2]);
         }
         Transform r;
-        if (v[MESH_ROTATE].given) {
-            const float *a = v[MESH_ROTATE].a;
+        if (t[T_ROTATE].given) {
+            const float *a = t[T_ROTATE].a;
             r = transform_rotate(a[0], a[1], a[2], a[3]);
-            t = transform_compose(&r, &t);
+            m = transform_compose(&r, &m);
         }
         for (int axis = 0; axis < 3; axis++) {
-            const Value *rv = &v[MESH_RX + axis];
+            const Value *rv = &t[T_RX + axis];
             if (!rv->given) continue;
             r = transform_rotate(axis == 0, axis == 1, axis == 2, rv->f);
-            t = transform_compose(&r, &t);
+            m = transform_compose(&r, &m);
         }
-        if (v[MESH_TRANSLATE].given) {
-            vec3 d = v[MESH_TRANSLATE].v;
+        if (t[T_TRANSLATE].given) {
+            vec3 d = t[T_TRANSLATE].v;
             r = transform_translate(d.x, d.y, d.z);
-            t = transform_compose(&r, &t);
+            m = transform_compose(&r, &m);
         }
     }
-    double det = transform_det(&t);
+    double det = transform_det(&m);
     if (!(fabs(det) > 1e-300) || !isfinite(det)) {
-        const Token *at = v[MESH_MATRIX].given ? &v[MESH_MATRIX].key : v[MESH_SCALE].given ? &v[MESH_SCALE].key : kw;
-        return lex_error_at(lx, at, p->err, "the mesh transform is singular (it flattens the mesh)");
+        const Token *at = t[T_MATRIX].given ? &t[T_MATRIX].key : t[T_SCALE].given ? &t[T_SCALE].key : kw;
+        return lex_error_at(lx, at, p->err, "the %s transform is singular (it flattens the %s)", what,
+                            strcmp(what, "mesh") == 0 ? "mesh" : "object");
     }
-    *out = t;
+    *out = m;
     return ST_OK;
 }
 
@@ -259,7 +264,7 @@ Status scene_parse_mesh(Parser *p, Lexer *lx, const Token *kw)
     if (st) return st;
     const Token *f = &v[MESH_FILE].word;
     MeshOptions o = mesh_options(v[MESH_MATERIAL].given ? v[MESH_MATERIAL].material : NO_INDEX);
-    if ((st = mesh_transform(p, lx, kw, v, &o.xf))) return st;
+    if ((st = scene_parse_transform(p, lx, kw, v + MESH_TRANSLATE, "mesh", &o.xf))) return st;
     char *path = scene_path_beside(lx->path, f->text, f->len);
     if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
     if (mesh_kind(path) == MESH_NONE) {

@@ -1,0 +1,119 @@
+/*
+ * scene_object.c — the scene reader's objects and instances (docs/instancing.md);
+ * part of the reader of scene_parse.c (scene_reader.h).
+ *
+ *   object NAME { shapes... }                  the shapes once, in the object's space
+ *   instance NAME { translate ... material M }  the object placed in the world
+ *
+ * Instances nest one level deep: an object holds shapes, not instances.
+ */
+#include "io/scene_reader.h"
+
+#include "io/lexer.h"
+#include "scene/instance.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* The statements an object's block may hold: the shapes with a place in an object's
+ * space (an infinite plane has no bounds to instance, lights belong to the world). */
+static const struct {
+    const char *keyword;
+    Status (*parse)(Parser *p, Lexer *lx, const Token *kw);
+} object_statements[] = {
+    {"sphere", scene_parse_sphere}, {"triangle", scene_parse_triangle}, {"quad", scene_parse_quad},
+    {"box", scene_parse_box},       {"mesh", scene_parse_mesh},
+};
+#define N_OBJECT_STATEMENTS (sizeof object_statements / sizeof object_statements[0])
+
+/* An object's name: a word or a string, not empty. */
+static Status object_name(Parser *p, Lexer *lx, const char *after, Token *name)
+{
+    Status st = lex_next(lx, name, p->err);
+    if (st) return st;
+    if ((name->kind != TOK_WORD && name->kind != TOK_STRING) || name->len == 0) {
+        char what[64];
+        snprintf(what, sizeof what, "an object name after '%s'", after);
+        return lex_expected(lx, name, what, p->err);
+    }
+    return ST_OK;
+}
+
+/* The statements of an object's block, up to its closing brace. */
+static Status object_body(Parser *p, Lexer *lx, const Token *name)
+{
+    for (;;) {
+        Token t;
+        Status st = lex_next(lx, &t, p->err);
+        if (st) return st;
+        if (t.kind == TOK_RBRACE) return ST_OK;
+        if (t.kind == TOK_EOF)
+            return lex_error_at(lx, name, p->err, "object '%.*s' is not closed with '}'", (int)name->len, name->text);
+        if (t.kind == TOK_WORD && (tok_is(&t, "instance") || tok_is(&t, "object")))
+            return lex_error_at(lx, &t, p->err, "'%s' inside object '%.*s': objects hold shapes, not instances or "
+                                "objects (clpt instances one level deep)", tok_is(&t, "object") ? "object" : "instance",
+                                (int)name->len, name->text);
+        size_t i = N_OBJECT_STATEMENTS;
+        if (t.kind == TOK_WORD)
+            for (i = 0; i < N_OBJECT_STATEMENTS; i++)
+                if (tok_is(&t, object_statements[i].keyword)) break;
+        if (i == N_OBJECT_STATEMENTS)
+            return lex_expected(lx, &t, "a shape of the object (sphere, triangle, quad, box, mesh) or '}'", p->err);
+        if ((st = object_statements[i].parse(p, lx, &t))) return st;
+    }
+}
+
+Status scene_parse_object(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token name, brace;
+    Status st = object_name(p, lx, "object", &name);
+    if (st) return st;
+    if (scene_find_object(p->s, name.text, name.len) != NO_INDEX)
+        return lex_error_at(lx, &name, p->err, "object '%.*s' is defined twice", (int)name.len, name.text);
+    if ((st = lex_next(lx, &brace, p->err))) return st;
+    if (brace.kind != TOK_LBRACE) return lex_expected(lx, &brace, "'{' after the object's name", p->err);
+    uint index;
+    if ((st = scene_object_begin(p->s, name.text, name.len, &index, p->err)))
+        return st == ST_INPUT ? lex_error_at(lx, kw, p->err, "%s", p->err->msg) : st;
+    p->object = index;
+    p->object_name = name;
+    st = object_body(p, lx, &name);
+    p->object = NO_INDEX;
+    scene_object_end(p->s, index);
+    if (st) return st;
+    if (scene_object_prims(p->s, index) == 0)
+        return lex_error_at(lx, &name, p->err, "object '%.*s' holds no shapes", (int)name.len, name.text);
+    (void)kw;
+    return ST_OK;
+}
+
+enum { INST_MATERIAL, INST_TRANSLATE, INST_ROTATE, INST_RX, INST_RY, INST_RZ, INST_SCALE, INST_MATRIX, INST_N };
+static const KeySpec instance_keys[INST_N] = {
+    [INST_MATERIAL] = {"material", VK_MATERIAL, 0, 0, 0, 0, 0, NULL},
+    [INST_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [INST_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},
+    [INST_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [INST_RY] = {"ry", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [INST_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [INST_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
+    [INST_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
+};
+
+Status scene_parse_instance(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token name;
+    Status st = object_name(p, lx, "instance", &name);
+    if (st) return st;
+    uint object = scene_find_object(p->s, name.text, name.len);
+    if (object == NO_INDEX)
+        return lex_error_at(lx, &name, p->err, "no object named '%.*s' (define it with 'object %.*s { ... }' before "
+                            "its instances)", (int)name.len, name.text, (int)name.len, name.text);
+    Value v[INST_N];
+    if ((st = scene_parse_block(p, lx, kw, 0, "instance", instance_keys, INST_N, v))) return st;
+    Transform m;
+    if ((st = scene_parse_transform(p, lx, kw, v + INST_TRANSLATE, "instance", &m))) return st;
+    uint material = v[INST_MATERIAL].given ? v[INST_MATERIAL].material : NO_INDEX;
+    st = scene_add_instance(p->s, object, &m, material, p->err);
+    return st == ST_INPUT ? lex_error_at(lx, kw, p->err, "%s", p->err->msg) : st;
+}

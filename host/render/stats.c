@@ -3,6 +3,35 @@
 
 #include <stdio.h>
 
+/* The instancing line (docs/instancing.md): triangles stored once and as many times
+ * as the instances place them, and the memory of each level on the devices. */
+static void print_instances(FILE *out, const Scene *s, const RenderScene *rs)
+{
+    if (rs->flattened) {
+        fprintf(out, "instances: %zu, flattened into copies for the kd-tree\n", rs->flattened);
+        return;
+    }
+    if (!rs->instanced) return;
+    size_t in_objects = 0;
+    double instanced = 0.0;
+    for (size_t i = 0; i < s->n_objects; i++) in_objects += s->objects[i].end[OBJ_TRIANGLES] - s->objects[i].first[OBJ_TRIANGLES];
+    for (size_t i = 0; i < s->n_instances; i++) {
+        const SceneObject *o = &s->objects[s->instances[i].object];
+        instanced += (double)(o->end[OBJ_TRIANGLES] - o->first[OBJ_TRIANGLES]);
+    }
+    const BvhLevels *lv = &rs->levels;
+    double top = (double)lv->top_nodes * sizeof(BvhNode) + (double)rs->n_instances * sizeof(Instance);
+    double protos = (double)lv->proto_nodes * sizeof(BvhNode) + (double)lv->proto_leaf_words * sizeof(uint);
+    fprintf(out, "instances: %zu of %zu objects; triangles: %zu unique (%zu in objects), %.0f instanced "
+           "(%.0f with the world's)\n", s->n_instances, s->n_objects, s->n_triangles, in_objects, instanced,
+           instanced + (double)(s->n_triangles - in_objects));
+    fprintf(out, "levels: top %u nodes and %zu instance records, %.1f KiB (%.1f bytes per instance); "
+           "prototypes %u of %zu built, %u nodes and %.1f KiB of leaves, %.1f KiB; stack %u + 1 + %u of %u\n",
+           lv->top_nodes, rs->n_instances, top / 1024.0, rs->n_instances ? top / (double)rs->n_instances : 0.0,
+           lv->n_protos_built, s->n_objects + 1, lv->proto_nodes, (double)lv->proto_leaf_words * 4.0 / 1024.0,
+           protos / 1024.0, lv->top.max_stack, lv->max_proto_stack, BVH_STACK);
+}
+
 void render_stats_print_scene(FILE *out, const Scene *s, const RenderScene *rs)
 {
     const KdStats *k = &rs->kd.stats;
@@ -28,6 +57,7 @@ void render_stats_print_scene(FILE *out, const Scene *s, const RenderScene *rs)
                "per leaf, SAH cost %.2f, %.1f KiB (%.1f bytes per primitive)\n",
                b->build_seconds, b->n_nodes, b->n_leaves, b->max_depth, b->max_binary_depth,
                b->mean_prims_per_leaf, b->sah_cost, (double)bytes / 1024.0, (double)bytes * per);
+        print_instances(out, s, rs);
         return;
     }
     fprintf(out, "kd-tree: built in %.3f s; %u nodes, %u leaves (%u empty), depth %u, "
@@ -36,6 +66,7 @@ void render_stats_print_scene(FILE *out, const Scene *s, const RenderScene *rs)
            k->build_seconds, k->n_nodes, k->n_leaves, k->n_empty_leaves, k->max_depth,
            k->mean_prims_per_leaf, k->sah_cost, (double)k->bytes / 1024.0,
            (double)(k->bytes - k->bytes_corners) * per, (double)k->bytes_corners * per);
+    print_instances(out, s, rs);
 }
 
 void render_stats_print_run(FILE *out, const ScheduleStats *st, uint spp, Device **devs, size_t n)

@@ -1,0 +1,332 @@
+/*
+ * test_instance.c — instances of objects through the BVH's two levels
+ * (docs/instancing.md): an instanced scene against the same scene flattened into copies
+ * (bit for bit under identity transforms, within noise under others), hits and normals
+ * through rotated, non-uniformly scaled and mirrored instances against a test of every
+ * primitive of every instance, PoCL against the scalar device bit for bit, and the
+ * kd-tree's copies. Run from the project root.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+#include "render_util.h"
+#include "scene/instance.h"
+#include "scene/transform.h"
+#include "geom/surface.h"
+#include "accel/traverse.h"
+
+/* A floor, a lamp, and an object of a sphere, a box and two triangles (a quad). */
+#define HEAD                                                                             \
+    "camera { from 0 3 9 at 0 0.6 0 fov 40 }\n"                                          \
+    "image { width 48 height 36 spp 16 depth 4 seed 7 }\n"                               \
+    "background { color 0.3 0.35 0.4 }\n"                                                \
+    "material red { type diffuse albedo 0.8 0.25 0.2 }\n"                                \
+    "material grey { type diffuse albedo 0.5 0.5 0.5 }\n"                                \
+    "material gold { type conductor metal Au roughness 0.3 }\n"                          \
+    "material lamp { type emissive radiance 6 6 6 }\n"                                   \
+    "quad { v0 -1 4 -1 v1 1 4 -1 v2 1 4 1 v3 -1 4 1 material lamp }\n"                   \
+    "box { min -6 -0.1 -6 max 6 0 6 material grey }\n"                                  \
+    "object thing {\n"                                                                   \
+    "  sphere { center 0 0.5 0 radius 0.5 material red }\n"                              \
+    "  box { min 0.6 0 -0.3 max 1.2 0.6 0.3 material gold }\n"                           \
+    "  quad { v0 -1.3 0 0 v1 -0.7 0 0 v2 -0.7 1 0.2 v3 -1.3 1 0.2 material red }\n"      \
+    "}\n"
+
+/* Identities only: the world's own primitives and an identity instance. */
+static const char identity_scene[] = HEAD "instance thing { }\n"
+                                          "instance thing { material grey }\n";
+/* Translations, rotations, non-uniform scales and a mirror (no rotated box, which the
+ * kd-tree's copies cannot hold). */
+static const char moved_scene[] = HEAD "instance thing { translate 2.6 0 0 }\n"
+                                       "instance thing { translate -2.6 0 0.5 scale 0.7 1.6 0.9 material gold }\n"
+                                       "instance thing { translate 0 0 -2 scale -1 1 1 }\n"
+                                       "instance thing { translate 0 0 1.8 scale 0.5 }\n";
+
+static Status load_text(const char *text, Scene *s, Error *err)
+{
+    scene_init(s);
+    return scene_load_text("inst.scene", text, strlen(text), s, err);
+}
+
+/* Renders `text` on `devices`, instanced or flattened into copies first. */
+static Status render(const char *text, const char *devices, int flatten, uint accel, Film *film, Error *err)
+{
+    Scene s;
+    Status st = load_text(text, &s, err);
+    s.accel = accel;
+    if (!st && flatten) st = scene_flatten_instances(&s, err);
+    if (!st) st = render_util_run(&s, devices, 0, film, err);
+    scene_free(&s);
+    return st;
+}
+
+/* Channel sums that agree between two films, and the relative difference of the means. */
+static size_t films_same(const Film *a, const Film *b)
+{
+    size_t n = (size_t)a->width * a->height * 3u, same = 0;
+    for (size_t i = 0; i < n; i++) same += a->sum[i] == b->sum[i];
+    return same;
+}
+
+static void test_identity_bit_identical(void)
+{
+    Film a, b;
+    Error err = { 0 };
+    CHECK_MSG(render(identity_scene, "scalar", 0, ACCEL_BVH, &a, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render(identity_scene, "scalar", 1, ACCEL_BVH, &b, &err) == ST_OK, "%s", err.msg);
+    size_t n = (size_t)a.width * a.height * 3u, same = films_same(&a, &b);
+    fprintf(stderr, "  identity instances: %zu of %zu channel sums identical to the copies\n", same, n);
+    CHECK(same == n);
+    film_free(&a);
+    film_free(&b);
+}
+
+static void test_moved_matches_flattened(void)
+{
+    Film a, b;
+    Error err = { 0 };
+    CHECK_MSG(render(moved_scene, "scalar", 0, ACCEL_BVH, &a, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render(moved_scene, "scalar", 1, ACCEL_BVH, &b, &err) == ST_OK, "%s", err.msg);
+    if (!a.sum || !b.sum) return;
+    double ma = film_mean(&a), mb = film_mean(&b);
+    size_t n = (size_t)a.width * a.height * 3u, same = films_same(&a, &b);
+    fprintf(stderr, "  moved instances: mean %.6f, copies %.6f; %zu of %zu channel sums identical\n", ma, mb, same, n);
+    /* the lamp's light and 16 samples: the means of two renders of one scene whose
+     * rays differ by roundings agree far closer than this */
+    CHECK(fabs(ma - mb) < 0.01 * mb);
+    film_free(&a);
+    film_free(&b);
+}
+
+/* The kd-tree renders an instanced scene from its copies: the same images as copies
+ * made before, through the kd-tree. */
+static void test_kdtree_flattens(void)
+{
+    Film a, b;
+    Error err = { 0 };
+    CHECK_MSG(render(moved_scene, "scalar", 0, ACCEL_KDTREE, &a, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render(moved_scene, "scalar", 1, ACCEL_KDTREE, &b, &err) == ST_OK, "%s", err.msg);
+    CHECK(films_same(&a, &b) == (size_t)a.width * a.height * 3u);
+    film_free(&a);
+    film_free(&b);
+    Scene s;
+    CHECK(load_text(HEAD "instance thing { ry 30 }\n", &s, &err) == ST_OK);
+    s.accel = ACCEL_KDTREE;
+    RenderScene rs;
+    Status st = render_scene_prepare(&s, 1, &rs, &err);
+    CHECK(st == ST_INPUT);
+    CHECK_MSG(strcmp(err.msg, "object 'thing' holds a box that instance 0 rotates: the kd-tree has no rotated boxes "
+                              "(use --accel bvh)") == 0, "%s", err.msg);
+    render_scene_free(&rs);
+    scene_free(&s);
+    error_clear(&err);
+}
+
+static void test_opencl_matches_scalar(void)
+{
+    static const char *const scenes[] = { identity_scene, moved_scene };
+    for (size_t k = 0; k < 2; k++) {
+        Film a, b;
+        Error err = { 0 };
+        Status sa = render(scenes[k], TEST_OPENCL, 0, ACCEL_BVH, &a, &err);
+        CHECK_MSG(sa == ST_OK, "%s", err.msg);
+        Status sb = render(scenes[k], "scalar", 0, ACCEL_BVH, &b, &err);
+        CHECK_MSG(sb == ST_OK, "%s", err.msg);
+        if (sa == ST_OK && sb == ST_OK) {
+            size_t n = (size_t)a.width * a.height * 3u, same = films_same(&a, &b);
+            fprintf(stderr, "  scene %zu: %zu of %zu channel sums identical on OpenCL and scalar\n", k, same, n);
+            CHECK(same == n);
+        }
+        film_free(&a);
+        film_free(&b);
+    }
+}
+
+/* ------------------------------------------------------------------ hits */
+
+static uint32_t rng_state = 12345u;
+static float frand(void)
+{
+    rng_state = rng_state * 1664525u + 1013904223u;
+    return (float)(rng_state >> 8) * (1.0f / 16777216.0f);
+}
+
+/* The closest hit of ray over every primitive of the world and of every instance, each
+ * tested in its own space as the walk tests it, by the walk's tie rule. */
+static Hit brute_force(const Scene *s, const SceneView *sv, const RenderScene *rs, Ray ray)
+{
+    Hit best = hit_none(ray);
+    trace_planes(sv, ray, 0, &best);
+    uint8_t *mask = NULL;
+    Error err = { 0 };
+    scene_object_mask(s, &mask, &err);
+    for (size_t i = 0; i < rs->n_instances; i++) {
+        const Instance *x = &rs->instances[i];
+        Ray r = instance_ray(x, ray);
+        RayPre rp = ray_prepare(r);
+        uint inst = (x->flags & INST_WORLD) ? NO_INDEX : (uint)i;
+        for (uint id = 0; id < scene_first_plane(s); id++) {
+            int in_obj = mask && mask[id];
+            if (inst == NO_INDEX ? in_obj : !in_obj) continue;
+            if (inst != NO_INDEX) {
+                uint lo[OBJ_KINDS], hi[OBJ_KINDS];
+                size_t n = scene_object_ranges(s, x->object, lo, hi), k;
+                for (k = 0; k < n && !(id >= lo[k] && id < hi[k]); k++) continue;
+                if (k == n) continue;
+            }
+            Ray rr = r;
+            rr.tmax = leaf_tmax(&best);
+            Hit h;
+            if (trace_prim(sv, id, &rp, rr, &h) && hit_wins(&best, h.t, id, inst)) hit_take(&best, h, id, inst);
+        }
+    }
+    free(mask);
+    return best;
+}
+
+/* The world normal of hit h computed from the instance's transform in double: the
+ * triangle's transformed corners' winding normal, the ellipsoid's gradient. */
+static vec3 normal_double(const Scene *s, const RenderScene *rs, Ray ray, Hit h)
+{
+    const Instance *x = h.inst == NO_INDEX ? NULL : &rs->instances[h.inst];
+    Transform m = transform_identity();
+    if (x)
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 4; j++) m.m[i][j] = x->to_world[4 * i + j];
+    uint first_tri = scene_first_triangle(s), first_box = scene_first_box(s);
+    double n[3];
+    if (h.prim >= first_tri && h.prim < first_box) {
+        const Triangle *t = &s->triangles[h.prim - first_tri];
+        vec3 a = transform_point(&m, t->p0), b = transform_point(&m, t->p1), c = transform_point(&m, t->p2);
+        double e1[3] = { (double)b.x - a.x, (double)b.y - a.y, (double)b.z - a.z };
+        double e2[3] = { (double)c.x - a.x, (double)c.y - a.y, (double)c.z - a.z };
+        /* a mirror keeps the outward side (the copy's corners swapped) */
+        double sg = transform_det(&m) < 0.0 ? -1.0 : 1.0;
+        n[0] = sg * (e1[1] * e2[2] - e1[2] * e2[1]);
+        n[1] = sg * (e1[2] * e2[0] - e1[0] * e2[2]);
+        n[2] = sg * (e1[0] * e2[1] - e1[1] * e2[0]);
+    } else {
+        /* sphere or box: the object normal by the normal matrix */
+        double nm[3][3];
+        transform_normal_matrix(&m, nm);
+        Ray r = x ? instance_ray(x, ray) : ray;
+        vec3 po = v3_madd(r.o, r.d, h.t), no;
+        if (h.prim < first_tri) {
+            no = v3_sub(po, s->spheres[h.prim].center);
+        } else {
+            int face = (int)h.u, axis = face >> 1;
+            float sg = (face & 1) ? 1.0f : -1.0f;
+            no = v3(axis == 0 ? sg : 0.0f, axis == 1 ? sg : 0.0f, axis == 2 ? sg : 0.0f);
+        }
+        for (int i = 0; i < 3; i++) n[i] = nm[i][0] * no.x + nm[i][1] * no.y + nm[i][2] * no.z;
+    }
+    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    return v3((float)(n[0] / len), (float)(n[1] / len), (float)(n[2] / len));
+}
+
+static void test_hits_against_brute_force(void)
+{
+    static const char text[] = HEAD "instance thing { translate 2.6 0 0 ry 37 }\n"
+                                    "instance thing { translate -2.6 0.2 0.5 rotate 1 1 0 25 scale 0.6 1.7 0.9 }\n"
+                                    "instance thing { translate 0 0 -2 scale -1 1 1 rz 10 }\n"
+                                    "instance thing { matrix 1 0.4 0 0.5  0 1 0.3 0  0.2 0 1 1.5  0 0 0 1 }\n";
+    Scene s;
+    Error err = { 0 };
+    RenderScene rs;
+    CHECK_MSG(load_text(text, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_scene_prepare(&s, 1, &rs, &err) == ST_OK, "%s", err.msg);
+    SceneView sv;
+    device_scene_view(&rs.ds, &sv);
+    int rays = 20000, hits = 0, same = 0, any_ok = 0, normals_ok = 0, inst_hits = 0;
+    double worst = 0.0;
+    for (int i = 0; i < rays; i++) {
+        Ray ray;
+        ray.o = v3(frand() * 10.0f - 5.0f, frand() * 3.0f, frand() * 10.0f - 5.0f);
+        ray.d = v3(frand() * 2.0f - 1.0f, frand() * 2.0f - 1.0f, frand() * 2.0f - 1.0f);
+        ray.tmin = 0.0f;
+        ray.tmax = 1e30f;
+        Hit h = trace_closest(&sv, ray), b = brute_force(&s, &sv, &rs, ray);
+        int eq = h.prim == b.prim && h.inst == b.inst && h.t == b.t && h.u == b.u && h.v == b.v;
+        same += eq;
+        if (!eq && i - same < 5)
+            fprintf(stderr, "    ray %d: walk prim %u inst %u t %a, brute force prim %u inst %u t %a\n", i, h.prim,
+                    h.inst, (double)h.t, b.prim, b.inst, (double)b.t);
+        any_ok += trace_any(&sv, ray) == (b.prim != NO_INDEX);
+        if (h.prim == NO_INDEX || h.prim >= scene_first_plane(&s)) continue;
+        hits++;
+        inst_hits += h.inst != NO_INDEX;
+        Surface sf = surface_at(&sv, ray, h);
+        vec3 nd = normal_double(&s, &rs, ray, h);
+        double c = (double)sf.ng.x * nd.x + (double)sf.ng.y * nd.y + (double)sf.ng.z * nd.z;
+        if (1.0 - c > worst) worst = 1.0 - c;
+        normals_ok += c > 1.0 - 1e-5;
+    }
+    fprintf(stderr, "  %d rays, %d hits (%d through instances): %d as brute force, %d any-hit right, %d normals "
+            "within 1e-5 (worst 1 - cos %.2g)\n", rays, hits, inst_hits, same, any_ok, normals_ok, worst);
+    CHECK(inst_hits > 1000);
+    CHECK(same == rays);
+    CHECK(any_ok == rays);
+    CHECK(normals_ok == hits);
+    render_scene_free(&rs);
+    scene_free(&s);
+}
+
+/* Surfaces through instances are in the world: a hit point lies on the ray, and a ray
+ * leaving it by its error bound does not find the same surface again. */
+static void test_spawn_leaves_surface(void)
+{
+    static const char text[] = HEAD "instance thing { translate 1000 0 0 rotate 0 1 1 33 scale 3 0.2 7 }\n"
+                                    "instance thing { translate 0.001 0 0 scale 1e-3 2e-3 1e-3 }\n";
+    Scene s;
+    Error err = { 0 };
+    RenderScene rs;
+    CHECK_MSG(load_text(text, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_scene_prepare(&s, 1, &rs, &err) == ST_OK, "%s", err.msg);
+    SceneView sv;
+    device_scene_view(&rs.ds, &sv);
+    int tried = 0, self = 0;
+    for (int i = 0; i < 40000; i++) {
+        int far = i & 1;
+        vec3 c = far ? v3(1000.0f, 0.0f, 0.0f) : v3(0.001f, 0.0f, 0.0f);
+        float size = far ? 10.0f : 4e-3f;
+        Ray ray;
+        ray.o = v3_add(c, v3(size * (frand() * 2.0f - 1.0f), size * (1.0f + frand()), size * (frand() * 2.0f - 1.0f)));
+        ray.d = v3_sub(v3_add(c, v3(size * (frand() - 0.5f), size * frand() * 0.5f, size * (frand() - 0.5f))), ray.o);
+        ray.tmin = 0.0f;
+        ray.tmax = 1e30f;
+        Hit h = trace_closest(&sv, ray);
+        if (h.inst == NO_INDEX) continue;
+        tried++;
+        Surface sf = surface_at(&sv, ray, h);
+        vec3 n = v3_dot(ray.d, sf.ng) < 0.0f ? sf.ng : v3_neg(sf.ng);
+        Ray out;
+        out.o = spawn_origin(sf, n);
+        out.d = v3(n.x + 0.3f * (frand() - 0.5f), n.y + 0.3f * (frand() - 0.5f), n.z + 0.3f * (frand() - 0.5f));
+        out.tmin = 0.0f;
+        out.tmax = 1e30f;
+        Hit back = trace_closest(&sv, out);
+        /* (a ray may leave a sphere or box inward and meet its far side: triangles only) */
+        int tri = h.prim >= scene_first_triangle(&s) && h.prim < scene_first_box(&s);
+        self += tri && back.prim == h.prim && back.inst == h.inst;
+    }
+    fprintf(stderr, "  %d rays leaving surfaces of instances 1e-3 and 1e3 from the origin: %d found their own "
+            "primitive again\n", tried, self);
+    CHECK(tried > 5000);
+    CHECK(self == 0);
+    render_scene_free(&rs);
+    scene_free(&s);
+}
+
+int main(void)
+{
+    RUN(test_hits_against_brute_force);
+    RUN(test_spawn_leaves_surface);
+    RUN(test_identity_bit_identical);
+    RUN(test_moved_matches_flattened);
+    RUN(test_kdtree_flattens);
+    RUN(test_opencl_matches_scalar);
+    return harness_report();
+}

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/array.h"
 #include "util/kmath.h"
 
 /* The scene's current count of each object kind. */

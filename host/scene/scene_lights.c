@@ -9,6 +9,7 @@
 
 #include "base/array.h"
 #include "scene/env_dist.h"
+#include "scene/instance.h"
 #include "util/kmath.h"
 
 Light light_default(uint type)

@@ -12,8 +12,9 @@
 #            driver's libnvidia-opencl.so.1 (and at this machine's ICDs, so that it can
 #            be tried here), puts build/ and ../shared in place and runs gpu-check.sh
 #            with its arguments: sh DIR/run.sh OUT (GPU_CHECK_PARTS picks parts).
-# It makes the programs it packs first. The bundle is about 50 MB, under the 64 MiB that
-# one call carries with the working tree.
+# It makes the programs it packs first, then packs DIR as DIR.tar.xz (about 25 MB; DIR
+# itself grew to 59 MB, over the 64 MiB that one call carries with the working tree) and
+# removes DIR: there, `tar -xJf .gpu.tar.xz && sh .gpu/run.sh OUT`.
 set -eu
 build=${1:-build}
 dir=${2:-.gpu}
@@ -35,7 +36,7 @@ ldd $progs | awk '/=> \// { print $3 }' | sort -u |
     while read -r lib; do cp -L "$lib" "$dir/lib/"; done
 s=../shared
 cp -r "$s/peers" "$dir/shared/"
-cp -r "$s/models/cornell-box" "$s/models/gltf" "$dir/shared/models/"
+cp -r "$s/models/cornell-box" "$s/models/gltf" "$s/models/bunny" "$dir/shared/models/"  # bunny: scenes/instances.scene
 gzip -1 -c "$s/models/dragon/dragon_vrip.ply" >"$dir/shared/models/dragon/dragon_vrip.ply.gz"
 for m in courtyard.hdr courtyard-dwab.exr forest.hdr forest-dwab.exr; do cp "$s/envmaps/$m" "$dir/shared/envmaps/"; done
 chmod -R u+w "$dir"
@@ -56,4 +57,6 @@ mkdir -p build && cp -r "$here/build/." build/
 export OCL_ICD_VENDORS="$icd" LD_LIBRARY_PATH="$here/lib:/usr/local/nvidia/lib64:${LD_LIBRARY_PATH:-}"
 sh tools/gpu-check.sh build "${1:-gpu-check}"
 EOF
-echo "gpu-bundle: $(du -sh "$dir" | cut -f1) in $dir; run there: sh $dir/run.sh OUT"
+tar -cJf "$dir.tar.xz" "$dir"
+rm -rf "$dir"
+echo "gpu-bundle: $(du -sh "$dir.tar.xz" | cut -f1) in $dir.tar.xz; run there: tar -xJf $dir.tar.xz && sh $dir/run.sh OUT"

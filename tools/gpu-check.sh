@@ -24,7 +24,7 @@
 set -u
 # The tests run with the GPU as their OpenCL device, besides test_kernels (last); one
 # line, which tools/gpu-bundle.sh reads to pack them.
-image_tests="sampler render whitted envmap cubemap alpha curves mis gltf pbrt cli"
+image_tests="sampler render whitted envmap cubemap alpha curves mis gltf pbrt cli spawn bsdf media instance"
 build=${1:-build}
 out=${2:-gpu-check}
 dev=${GPU_CHECK_DEVICE:-gpu}    # another device spec tries the script out without a GPU
@@ -114,6 +114,12 @@ check dragon ../shared/peers/dragon.scene --width 256 --height 256 --spp 4
 check cornell-counted scenes/cornell-box.scene --width 256 --height 256 --spp 16 --wave-launch counted
 check cornell-megakernel scenes/cornell-box.scene --width 256 --height 256 --spp 16 --wave-launch megakernel
 check weekend-megakernel scenes/one-weekend.scene --width 400 --height 225 --spp 8 --wave-launch megakernel
+check fog scenes/fog.scene --width 192 --height 144 --spp 8
+check fog-megakernel scenes/fog.scene --width 192 --height 144 --spp 8 --wave-launch megakernel
+check instances scenes/instances.scene --width 192 --height 144 --spp 8
+check instances-megakernel scenes/instances.scene --width 192 --height 144 --spp 8 --wave-launch megakernel
+check coated scenes/coated.pbrt --width 160 --height 120 --spp 8
+check principled scenes/principled-extensions.scene --width 192 --height 144 --spp 8
 echo "$same same, $differ differ"
 fi
 

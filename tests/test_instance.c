@@ -123,6 +123,23 @@ static void test_kdtree_flattens(void)
     render_scene_free(&rs);
     scene_free(&s);
     error_clear(&err);
+
+    /* copies that would not fit are refused before they are made */
+    CHECK(load_text(HEAD "instance thing { }\ninstance thing { translate 3 0 0 }\n", &s, &err) == ST_OK);
+    s.accel = ACCEL_KDTREE;
+    size_t prims = s.n_spheres + s.n_triangles + s.n_boxes + s.n_revsurfaces + 2u * scene_object_prims(&s, 0);
+    setenv("CLPT_MAX_FLATTEN_BYTES", "1000", 1);
+    st = render_scene_prepare(&s, 1, &rs, &err);
+    unsetenv("CLPT_MAX_FLATTEN_BYTES");
+    CHECK(st == ST_INPUT);
+    char want[512];
+    snprintf(want, sizeof want, "--accel kdtree takes instances as copies: the scene's 2 instances make %zu primitives, "
+             "about %.1f GiB with the tree, more than the 0.0 GiB of CLPT_MAX_FLATTEN_BYTES; render it with --accel "
+             "bvh (the default), which keeps them as instances", prims, prims * 256.0 / (1024.0 * 1024.0 * 1024.0));
+    CHECK_MSG(strcmp(err.msg, want) == 0, "%s", err.msg);
+    render_scene_free(&rs);
+    scene_free(&s);
+    error_clear(&err);
 }
 
 static void test_opencl_matches_scalar(void)

@@ -19,6 +19,7 @@
 #include "io/image_write.h"
 #include "scene/mesh_sink.h"
 #include "scene/octa_env.h"
+#include "scene/instance.h"
 #include "scene/scene.h"
 #include "scene/subdiv.h"
 
@@ -537,27 +538,177 @@ static void test_load_budget(void)
     rmdir(dir);
 }
 
+/* ObjectBegin/End make a scene object whose shapes keep their own CTM; each
+ * ObjectInstance places it under the CTM of the moment (pbrt-v4's render-from-instance);
+ * flattened, the instances are the copies the reader made before objects. */
 static void test_instances(void)
 {
     Scene s;
     Error err = { 0 };
     CHECK_EQ_INT(load(DIR "instances.pbrt", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.n_objects, 1);
+    CHECK_EQ_INT(s.n_instances, 2);
+    CHECK_EQ_INT(s.n_triangles, 1);
+    CHECK_EQ_INT(s.n_spheres, 1);
+    if (s.n_instances == 2 && s.n_triangles == 1 && s.n_spheres == 1) {
+        CHECK_V3(s.triangles[0].p1, 1, 1, 0, 0);   /* the object's own Translate 0 1 0 */
+        CHECK_V3(s.spheres[0].center, 0, 1, 0, 0);
+        CHECK(s.instances[0].flags & INST_IDENTITY);
+        const float *m = s.instances[1].to_world;   /* Translate 5 0 0 . Scale 2 2 2 */
+        CHECK(m[0] == 2 && m[5] == 2 && m[10] == 2 && m[3] == 5 && m[7] == 0 && m[11] == 0);
+        CHECK_EQ_INT(s.instances[1].material, NO_INDEX);
+    }
+    CHECK_EQ_INT(scene_flatten_instances(&s, &err), ST_OK);
     CHECK_EQ_INT(s.n_triangles, 2);
     CHECK_EQ_INT(s.n_spheres, 2);
     if (s.n_triangles == 2 && s.n_spheres == 2) {
         CHECK_V3(s.triangles[0].p1, 1, 1, 0, 0);
         CHECK_V3(s.triangles[1].p1, 7, 2, 0, 0);   /* (1, 1, 0) scaled by 2, moved by 5 */
         CHECK_V3(s.spheres[0].center, 0, 1, 0, 0);
-        CHECK_V3(s.spheres[1].center, 5, 2, 0, 0);
-        CHECK_NEAR(s.spheres[1].radius, 1, 0);
+        CHECK_V3(s.spheres[1].center, 5, 2, 0, 0);   /* radius 1: an ellipsoid of scale 2 */
+        CHECK(s.spheres[1].xform && s.sphere_xforms[s.spheres[1].xform - 1].to_world[0] == 1.0f);
         CHECK(s.triangles[1].shading != NO_INDEX && s.shading[s.triangles[1].shading].n0.z == 1);
     }
     scene_free(&s);
+
+    /* a name defined again serves the instances after it; an object that emits light
+     * is copied at each instance, with a warning; a singular instance is skipped */
+    CHECK_EQ_INT(load_text("ObjectBegin \"a\" Shape \"sphere\" ObjectEnd ObjectInstance \"a\"\n"
+                           "ObjectBegin \"a\" Shape \"sphere\" \"float radius\" 2 ObjectEnd ObjectInstance \"a\"\n"
+                           "ObjectBegin \"lamp\" AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
+                           "  Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] ObjectEnd\n"
+                           "ObjectInstance \"lamp\" Translate 3 0 0 ObjectInstance \"lamp\"\n"
+                           "Scale 0 1 1 ObjectInstance \"a\"\n", &s, &err),
+                 ST_OK);
+    CHECK_EQ_INT(s.n_objects, 2);
+    CHECK_EQ_INT(s.n_instances, 2);
+    CHECK_EQ_INT(s.n_triangles, 2);
+    if (s.n_instances == 2 && s.n_objects == 2) {
+        CHECK_EQ_INT(s.instances[0].object, 0);
+        CHECK_EQ_INT(s.instances[1].object, 1);
+        CHECK(strcmp(s.objects[1].name, "a#1") == 0);
+    }
+    CHECK_EQ_INT(s.n_warnings, 2);
+    if (s.n_warnings == 2) {
+        CHECK_STR_CONTAINS(s.warnings[0], "inline.pbrt:4: ObjectBegin \"lamp\" holds an area light: its shapes are "
+                           "copied at each ObjectInstance (instanced emitters are not lights)");
+        CHECK_STR_CONTAINS(s.warnings[1], "inline.pbrt:6: ObjectInstance \"a\" under a singular transform is skipped");
+    }
+    scene_free(&s);
+
     expect_error("ObjectInstance \"nothing\"",
                  DIR "inline.pbrt:1:16: object 'nothing' is not defined (ObjectBegin defines it)");
     expect_error("ObjectBegin \"a\"\nAttributeEnd\nObjectEnd", DIR "inline.pbrt:3:1: ObjectEnd inside an "
                  "AttributeBegin of its object, or after one that closes more than it opened");
-    expect_error("ObjectBegin \"a\"\nShape \"sphere\"", DIR "inline.pbrt: ObjectBegin \"a\" has no ObjectEnd");
+    expect_error("ObjectBegin \"a\"\nShape \"sphere\"",
+                 DIR "inline.pbrt:1:1: ObjectBegin \"a\" has no ObjectEnd before the end of the file");
+    expect_error("Shape \"sphere\"\n  ObjectEnd", DIR "inline.pbrt:2:3: ObjectEnd without ObjectBegin");
+    expect_error("ObjectBegin \"a\"\nObjectBegin \"b\"",
+                 DIR "inline.pbrt:2:1: ObjectBegin \"b\" inside ObjectBegin \"a\" (objects do not nest)");
+    expect_error("ObjectBegin \"a\" Shape \"sphere\" ObjectEnd\nObjectBegin \"b\" ObjectInstance \"a\"",
+                 DIR "inline.pbrt:2:17: ObjectInstance inside ObjectBegin \"b\" (objects hold shapes, not instances)");
+}
+
+/* One scene two ways: its object placed by ObjectInstance, and its shapes written out
+ * under the same transforms. */
+#define INST_HEAD                                                                                         \
+    "LookAt 0 3 9  0 0.6 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n"                             \
+    "Film \"rgb\" \"integer xresolution\" 48 \"integer yresolution\" 36\n"                                \
+    "Sampler \"independent\" \"integer pixelsamples\" 16\nIntegrator \"path\" \"integer maxdepth\" 4\n"   \
+    "WorldBegin\nLightSource \"infinite\" \"rgb L\" [0.3 0.35 0.4]\n"                                     \
+    "AttributeBegin AreaLightSource \"diffuse\" \"rgb L\" [6 6 6]\n"                                      \
+    "  Shape \"trianglemesh\" \"point3 P\" [-1 4 -1 1 4 -1 1 4 1 -1 4 1] \"integer indices\" [0 1 2 0 2 3]\n" \
+    "AttributeEnd\n"                                                                                      \
+    "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n"                                            \
+    "Shape \"trianglemesh\" \"point3 P\" [-6 0 -6 6 0 -6 6 0 6 -6 0 6] \"integer indices\" [0 2 1 0 3 2]\n"
+#define INST_SHAPES                                                                                       \
+    "  AttributeBegin Material \"diffuse\" \"rgb reflectance\" [0.8 0.25 0.2]\n"                          \
+    "    Translate 0 0.5 0 Shape \"sphere\" \"float radius\" 0.5 AttributeEnd\n"                          \
+    "  Material \"conductor\" \"float roughness\" 0.3\n"                                                  \
+    "  Shape \"trianglemesh\" \"point3 P\" [0.6 0 -0.3 1.2 0 -0.3 1.2 0.6 0.3 0.6 0.6 0.3]\n"             \
+    "    \"integer indices\" [0 1 2 0 2 3]\n"
+#define INST_OBJECT "ObjectBegin \"thing\"\n" INST_SHAPES "ObjectEnd\n"
+#define PLACE_INST(xf) "AttributeBegin " xf " ObjectInstance \"thing\" AttributeEnd\n"
+#define PLACE_COPY(xf) "AttributeBegin " xf "\n" INST_SHAPES "AttributeEnd\n"
+#define MOVED_A "Translate 2.6 0 0"
+#define MOVED_B "Translate -2.4 0 0.5 Rotate 35 0 1 0 Scale 1 1.4 1"
+#define MOVED_C "Translate 0 0 -2 Scale -1 1 1"
+
+static const char inst_identity[] = INST_HEAD INST_OBJECT PLACE_INST("");
+static const char copy_identity[] = INST_HEAD PLACE_COPY("");
+static const char inst_moved[] = INST_HEAD INST_OBJECT PLACE_INST("") PLACE_INST(MOVED_A) PLACE_INST(MOVED_B)
+    PLACE_INST(MOVED_C);
+static const char copy_moved[] = INST_HEAD PLACE_COPY("") PLACE_COPY(MOVED_A) PLACE_COPY(MOVED_B) PLACE_COPY(MOVED_C);
+
+static Status render_text(const char *text, const char *devices, Film *f, Error *err)
+{
+    Scene s;
+    Status st = load_text(text, &s, err);
+    if (!st) st = render_util_run(&s, devices, 0, f, err);
+    scene_free(&s);
+    return st;
+}
+
+static size_t sums_same(const Film *a, const Film *b)
+{
+    size_t n = (size_t)a->width * a->height * 3u, same = 0;
+    for (size_t i = 0; i < n; i++) same += a->sum[i] == b->sum[i];
+    return same;
+}
+
+/* An identity ObjectInstance renders bit for bit as its shapes written out; moved,
+ * rotated, stretched and mirrored ones the same mean within noise; PoCL renders the
+ * instances bit for bit as the scalar device. */
+static void test_instances_render(void)
+{
+    Film a, b;
+    Error err = { 0 };
+    CHECK_MSG(render_text(inst_identity, "scalar", &a, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_text(copy_identity, "scalar", &b, &err) == ST_OK, "%s", err.msg);
+    if (a.sum && b.sum) {
+        size_t n = (size_t)a.width * a.height * 3u, same = sums_same(&a, &b);
+        fprintf(stderr, "  identity ObjectInstance: %zu of %zu channel sums identical to the shapes written out\n",
+                same, n);
+        CHECK(same == n);
+    }
+    film_free(&a);
+    film_free(&b);
+    CHECK_MSG(render_text(inst_moved, "scalar", &a, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_text(copy_moved, "scalar", &b, &err) == ST_OK, "%s", err.msg);
+    if (a.sum && b.sum) {
+        double ma = film_mean(&a), mb = film_mean(&b);
+        size_t n = (size_t)a.width * a.height * 3u, same = sums_same(&a, &b);
+        fprintf(stderr, "  moved ObjectInstances: mean %.6f, written out %.6f; %zu of %zu channel sums identical\n",
+                ma, mb, same, n);
+        CHECK(fabs(ma - mb) < 0.01 * mb);
+        CHECK(same > n / 2);
+    }
+    film_free(&b);
+    Film c;
+    Status sc = render_text(inst_moved, TEST_OPENCL, &c, &err);
+    CHECK_MSG(sc == ST_OK, "%s", err.msg);
+    if (!sc && a.sum) {
+        size_t n = (size_t)a.width * a.height * 3u, same = sums_same(&a, &c);
+        fprintf(stderr, "  moved ObjectInstances: %zu of %zu channel sums identical on OpenCL and scalar\n", same, n);
+        CHECK(same == n);
+        film_free(&c);
+    }
+    film_free(&a);
+}
+
+/* --stats counts the instances and the triangles they place. */
+static void test_instances_stats(void)
+{
+    char scene[64];
+    write_temp(scene, sizeof scene, ".pbrt", inst_moved);
+    CliResult r;
+    cli_run((const char *[]){ scene, "-q", "--device", "scalar", "--spp", "1", "--stats", "-o",
+                              CLPT_BUILD_DIR "/test-pbrt-inst.pfm", NULL }, &r);
+    CHECK_EQ_INT(r.status, 0);
+    CHECK_STR_CONTAINS(r.out, "instances: 4 of 1 objects; triangles: 6 unique (2 in objects), 8 instanced "
+                       "(12 with the world's)");
+    unlink(scene);
+    unlink(CLPT_BUILD_DIR "/test-pbrt-inst.pfm");
 }
 
 /* pbrt's camera space is left-handed: seen from +z with y up, world +x is on the left. */
@@ -837,15 +988,18 @@ static void test_squashed_spheres(void)
                                "ObjectInstance \"o\"\n"
                                "AttributeBegin Scale 2 1 1 ObjectInstance \"o\" AttributeEnd\n";
     CHECK_EQ_INT(load_text(inst, &s, &err), ST_OK);
+    /* the object keeps its two ellipsoids; its instances' copies compose the transforms */
+    CHECK_EQ_INT(s.n_spheres, 2);
+    CHECK_EQ_INT(s.n_instances, 2);
+    CHECK_EQ_INT(scene_flatten_instances(&s, &err), ST_OK);
     CHECK_EQ_INT(s.n_spheres, 4);
     CHECK_EQ_INT(s.n_sphere_xforms, 4);
-    if (s.n_sphere_xforms == 4) {
+    if (s.n_sphere_xforms == 4 && s.n_spheres == 4) {
         /* the second instance: Scale 2 1 1 . Scale 1 1 3 . Translate 5 0 0 */
-        const float *m = s.sphere_xforms[3].to_world;
+        const float *m = s.sphere_xforms[s.spheres[3].xform - 1].to_world;
         CHECK_NEAR(m[0], 2, 0);
         CHECK_NEAR(m[3], 10, 0);
         CHECK_NEAR(m[10], 3, 0);
-        CHECK_EQ_INT(s.spheres[3].xform, 4);
     }
     scene_free(&s);
 }
@@ -1420,6 +1574,8 @@ int main(void)
     RUN(test_orientation);
     RUN(test_disk_cylinder);
     RUN(test_compare);
+    RUN(test_instances_render);
+    RUN(test_instances_stats);
     RUN(test_errors);
     RUN(test_gzip);
     RUN(test_load_budget);

@@ -600,7 +600,9 @@ Status pbrt_load_text(const char *path, const char *text, size_t len, Scene *s, 
     s->image.spp = 16;
     s->image.max_depth = 5;
     Status st = parse_file(&p, path, text, len);
-    if (!st && p.in_object) st = error_set(err, ST_INPUT, "%s: ObjectBegin \"%s\" has no ObjectEnd", path, p.obj_name_buf);
+    if (!st && p.in_object)
+        st = error_set(err, ST_INPUT, "%s: ObjectBegin \"%s\" has no ObjectEnd before the end of the file", p.obj_where,
+                       p.obj_name_buf);
     for (size_t i = 0; !st && i < p.n_pending; i++)
         if (!p.pending[i].defined)
             st = error_set(err, ST_INPUT, "%s is used by NamedMaterial and never defined (MakeNamedMaterial defines it)",

@@ -76,8 +76,11 @@ typedef struct {
     char where[160];   /* "path:line:col: material 'name'" for the error at the end */
 } PPending;
 
-/* An ObjectBegin/End's shapes, taken out of the scene and copied in at each instance. */
+/* An ObjectBegin/End: a scene object its ObjectInstances place (docs/instancing.md),
+ * or, when it emits light or holds no shapes, its shapes taken out of the scene and
+ * copied in at each instance. */
 typedef struct {
+    uint object;          /* the scene's object, or NO_INDEX: copies of the arrays below */
     Sphere *spheres;      size_t n_spheres;
     SphereXform *sphere_xforms;  size_t n_sphere_xforms;   /* Sphere.xform indexes this */
     Triangle *triangles;  size_t n_triangles;
@@ -109,6 +112,8 @@ typedef struct {
     PObject *objects;  size_t n_objects, cap_objects;
     int in_object;           /* inside ObjectBegin: what it started with */
     size_t obj_spheres, obj_triangles, obj_shading, obj_stack, obj_sphere_xforms;
+    size_t obj_first[OBJ_KINDS];   /* the scene's counts at ObjectBegin (scene_object_counts) */
+    char obj_where[160];     /* "path:line:col" of the ObjectBegin, for an unclosed one */
     /* triangles made so far by tessellating what the file describes in a few numbers
      * (loopsubdiv, emitting ellipsoids): at most CLPT_MAX_TESSELLATED_TRIANGLES */
     size_t tessellated;

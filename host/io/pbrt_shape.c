@@ -17,6 +17,7 @@
 #include "io/texture.h"
 #include "util/kmath.h"
 #include "scene/mesh_sink.h"
+#include "scene/instance.h"
 #include "scene/octa_env.h"
 #include "scene/subdiv.h"
 #include "scene/transform.h"
@@ -487,8 +488,14 @@ Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw)
 
 /* ------------------------------------------------------------------ instancing */
 
-/* Instances are flattened: ObjectEnd takes the object's shapes out of the scene and
- * each ObjectInstance appends them again, moved by the instance's transform. */
+/* pbrt-v4's objects are clpt's (docs/instancing.md): the shapes between ObjectBegin and
+ * ObjectEnd stay once in the scene, in the space their own CTM gives them, and each
+ * ObjectInstance places them under the CTM of that moment (pbrt-v4's render-from-
+ * instance is the CTM at ObjectInstance times world-from-render: the object's shapes
+ * are not moved back by the CTM at ObjectBegin). Two kinds of object are copied in at
+ * each instance instead, as the reader did before objects: one whose shapes emit light
+ * (instanced emitters are no lights yet: copies keep next-event estimation), and one
+ * with no shapes (nothing to place). */
 #define PBRT_MAX_FLAT_TRIANGLES ((size_t)1 << 26)
 
 Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw)
@@ -496,7 +503,9 @@ Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw)
     Token name;
     Status st = pbrt_expect_string(p, lx, "a quoted object name", &name);
     if (st) return st;
-    if (p->in_object) return lex_error_at(lx, kw, p->err, "ObjectBegin inside another ObjectBegin");
+    if (p->in_object)
+        return lex_error_at(lx, kw, p->err, "ObjectBegin \"%.*s\" inside ObjectBegin \"%s\" (objects do not nest)",
+                            (int)(name.len > 60 ? 60 : name.len), name.text, p->obj_name_buf);
     if ((st = pbrt_push_state(p))) return st;
     p->in_object = 1;
     p->obj_stack = p->n_stack;
@@ -504,11 +513,81 @@ Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw)
     p->obj_sphere_xforms = p->s->n_sphere_xforms;
     p->obj_triangles = p->s->n_triangles;
     p->obj_shading = p->s->n_shading;
+    scene_object_counts(p->s, p->obj_first);
+    snprintf(p->obj_where, sizeof p->obj_where, "%s:%u:%u", lx->path, kw->line, kw->col);
     free(p->obj_name_buf);
     p->obj_name_buf = tok_copy(&name);
     if (!p->obj_name_buf) return error_set(p->err, ST_INTERNAL, "out of memory");
     p->obj_name = name;
     p->obj_name.text = p->obj_name_buf;
+    return ST_OK;
+}
+
+/* Whether a shape made since ObjectBegin emits light (an AreaLightSource's). */
+static int object_emits(const Parser *p)
+{
+    const Scene *s = p->s;
+    for (size_t i = p->obj_triangles; i < s->n_triangles; i++)
+        if (!v3_is_zero(s->materials[s->triangles[i].material].emission)) return 1;
+    for (size_t i = p->obj_spheres; i < s->n_spheres; i++)
+        if (!v3_is_zero(s->materials[s->spheres[i].material].emission)) return 1;
+    return 0;
+}
+
+/* The shapes since ObjectBegin as a scene object. pbrt lets a name be defined again
+ * (the later object serves the instances after it); the scene's names are unique, so
+ * a later one is told apart by its index. */
+static Status object_keep(Parser *p, PObject *o)
+{
+    char name[96];
+    const char *text = p->obj_name.text;
+    size_t len = p->obj_name.len;
+    if (scene_find_object(p->s, text, len) != NO_INDEX) {
+        snprintf(name, sizeof name, "%.*s#%zu", (int)(len > 60 ? 60 : len), text, p->s->n_objects);
+        text = name;
+        len = strlen(name);
+    }
+    Status st = scene_object_begin_from(p->s, text, len, p->obj_first, &o->object, p->err);
+    if (st) return st;
+    scene_object_end(p->s, o->object);
+    return ST_OK;
+}
+
+/* The shapes since ObjectBegin taken out of the scene, to be copied in at each instance. */
+static Status object_take(Parser *p, PObject *o)
+{
+    Scene *s = p->s;
+    o->object = NO_INDEX;
+    o->n_spheres = s->n_spheres - p->obj_spheres;
+    o->n_triangles = s->n_triangles - p->obj_triangles;
+    o->n_shading = s->n_shading - p->obj_shading;
+    o->n_sphere_xforms = s->n_sphere_xforms - p->obj_sphere_xforms;
+    o->sphere_xforms = malloc(o->n_sphere_xforms * sizeof *o->sphere_xforms + 1);
+    o->spheres = malloc(o->n_spheres * sizeof *o->spheres + 1);
+    o->triangles = malloc(o->n_triangles * sizeof *o->triangles + 1);
+    o->shading = malloc(o->n_shading * sizeof *o->shading + 1);
+    if (!o->spheres || !o->triangles || !o->shading || !o->sphere_xforms) {
+        free(o->spheres);
+        free(o->sphere_xforms);
+        free(o->triangles);
+        free(o->shading);
+        return error_set(p->err, ST_INTERNAL, "out of memory");
+    }
+    /* an object may hold no spheres (or no triangles), and the scene's array may then
+     * still be NULL: C gives no NULL + 0, so the empty copies are skipped */
+    if (o->n_sphere_xforms)
+        memcpy(o->sphere_xforms, s->sphere_xforms + p->obj_sphere_xforms, o->n_sphere_xforms * sizeof *o->sphere_xforms);
+    if (o->n_spheres) memcpy(o->spheres, s->spheres + p->obj_spheres, o->n_spheres * sizeof *o->spheres);
+    if (o->n_triangles) memcpy(o->triangles, s->triangles + p->obj_triangles, o->n_triangles * sizeof *o->triangles);
+    if (o->n_shading) memcpy(o->shading, s->shading + p->obj_shading, o->n_shading * sizeof *o->shading);
+    for (size_t i = 0; i < o->n_triangles; i++)
+        if (o->triangles[i].shading != NO_INDEX) o->triangles[i].shading -= (uint)p->obj_shading;
+    for (size_t i = 0; i < o->n_spheres; i++)
+        if (o->spheres[i].xform) o->spheres[i].xform -= (uint)p->obj_sphere_xforms;
+    s->n_sphere_xforms = p->obj_sphere_xforms;
+    s->n_spheres = p->obj_spheres;
+    s->n_triangles = p->obj_triangles;
+    s->n_shading = p->obj_shading;
     return ST_OK;
 }
 
@@ -518,41 +597,17 @@ Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw)
     if (p->n_stack != p->obj_stack)
         return lex_error_at(lx, kw, p->err, "ObjectEnd inside an AttributeBegin of its object, or after one "
                             "that closes more than it opened");
-    Scene *s = p->s;
     PObject o;
     memset(&o, 0, sizeof o);
-    o.n_spheres = s->n_spheres - p->obj_spheres;
-    o.n_triangles = s->n_triangles - p->obj_triangles;
-    o.n_shading = s->n_shading - p->obj_shading;
-    o.n_sphere_xforms = s->n_sphere_xforms - p->obj_sphere_xforms;
-    o.sphere_xforms = malloc(o.n_sphere_xforms * sizeof *o.sphere_xforms + 1);
-    if (!o.sphere_xforms) return error_set(p->err, ST_INTERNAL, "out of memory");
-    if (o.n_sphere_xforms)
-        memcpy(o.sphere_xforms, s->sphere_xforms + p->obj_sphere_xforms, o.n_sphere_xforms * sizeof *o.sphere_xforms);
-    s->n_sphere_xforms = p->obj_sphere_xforms;
-    o.spheres = malloc(o.n_spheres * sizeof *o.spheres + 1);
-    o.triangles = malloc(o.n_triangles * sizeof *o.triangles + 1);
-    o.shading = malloc(o.n_shading * sizeof *o.shading + 1);
-    if (!o.spheres || !o.triangles || !o.shading ||
-        pbrt_grow((void **)&p->objects, &p->cap_objects, p->n_objects + 1, sizeof(PObject))) {
-        free(o.spheres);
-        free(o.sphere_xforms);
-        free(o.triangles);
-        free(o.shading);
+    int empty = p->s->n_triangles == p->obj_triangles && p->s->n_spheres == p->obj_spheres;
+    int emits = !empty && object_emits(p);
+    Status st;
+    if (emits && (st = warn_once(p, lx, kw, "object-emits", "ObjectBegin \"%s\" holds an area light: its shapes are "
+                                 "copied at each ObjectInstance (instanced emitters are not lights)", p->obj_name_buf)))
+        return st;
+    if (pbrt_grow((void **)&p->objects, &p->cap_objects, p->n_objects + 1, sizeof(PObject)))
         return error_set(p->err, ST_INTERNAL, "out of memory");
-    }
-    /* an object may hold no spheres (or no triangles), and the scene's array may then
-     * still be NULL: C gives no NULL + 0, so the empty copies are skipped */
-    if (o.n_spheres) memcpy(o.spheres, s->spheres + p->obj_spheres, o.n_spheres * sizeof *o.spheres);
-    if (o.n_triangles) memcpy(o.triangles, s->triangles + p->obj_triangles, o.n_triangles * sizeof *o.triangles);
-    if (o.n_shading) memcpy(o.shading, s->shading + p->obj_shading, o.n_shading * sizeof *o.shading);
-    for (size_t i = 0; i < o.n_triangles; i++)
-        if (o.triangles[i].shading != NO_INDEX) o.triangles[i].shading -= (uint)p->obj_shading;
-    for (size_t i = 0; i < o.n_spheres; i++)
-        if (o.spheres[i].xform) o.spheres[i].xform -= (uint)p->obj_sphere_xforms;
-    s->n_spheres = p->obj_spheres;
-    s->n_triangles = p->obj_triangles;
-    s->n_shading = p->obj_shading;
+    if ((st = empty || emits ? object_take(p, &o) : object_keep(p, &o))) return st;
     /* a name defined again replaces the earlier object, for the instances after it */
     if (strmap_set(&p->object_by_name, p->obj_name.text, p->obj_name.len, (uint32_t)p->n_objects)) {
         free(o.spheres);
@@ -591,13 +646,28 @@ static Status instance_ellipsoid(Parser *p, const Lexer *lx, const Token *name, 
     return st;
 }
 
+/* An instance of a scene object: the CTM is its transform. A singular one (a Scale 0,
+ * say) places nothing that can be seen: skipped with a warning. */
+static Status instance_place(Parser *p, const Lexer *lx, const Token *name, uint object)
+{
+    Transform inv;
+    if (!transform_invert(&p->g.ctm, &inv))
+        return warn_once(p, lx, name, "instance-singular", "ObjectInstance \"%.*s\" under a singular transform is "
+                         "skipped", (int)(name->len > 60 ? 60 : name->len), name->text);
+    Status st = scene_add_instance(p->s, object, &p->g.ctm, NO_INDEX, p->err);
+    return st == ST_INPUT ? lex_error_at(lx, name, p->err, "%s", p->err->msg) : st;
+}
+
 Status pbrt_object_instance(Parser *p, Lexer *lx, const Token *kw)
 {
-    (void)kw;
     Token name;
     uint32_t i;
     Status st = pbrt_expect_defined(p, lx, &p->object_by_name, "object", "ObjectBegin", &name, &i);
     if (st) return st;
+    if (p->in_object)
+        return lex_error_at(lx, kw, p->err, "ObjectInstance inside ObjectBegin \"%s\" (objects hold shapes, not "
+                            "instances)", p->obj_name_buf);
+    if (p->objects[i].object != NO_INDEX) return instance_place(p, lx, &name, p->objects[i].object);
     const PObject *o = &p->objects[i];
     if (p->s->n_triangles + o->n_triangles > PBRT_MAX_FLAT_TRIANGLES)
         return lex_error_at(lx, &name, p->err, "the flattened instances would hold more than %zu triangles",

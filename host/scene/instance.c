@@ -8,8 +8,7 @@
 #include "base/array.h"
 #include "util/kmath.h"
 
-/* The scene's current count of each object kind. */
-static void kind_counts(const Scene *s, size_t n[OBJ_KINDS])
+void scene_object_counts(const Scene *s, size_t n[OBJ_KINDS])
 {
     n[OBJ_SPHERES] = s->n_spheres;
     n[OBJ_TRIANGLES] = s->n_triangles;
@@ -28,6 +27,14 @@ static void kind_firsts(const Scene *s, uint first[OBJ_KINDS])
 
 Status scene_object_begin(Scene *s, const char *name, size_t len, uint *index, Error *err)
 {
+    size_t now[OBJ_KINDS];
+    scene_object_counts(s, now);
+    return scene_object_begin_from(s, name, len, now, index, err);
+}
+
+Status scene_object_begin_from(Scene *s, const char *name, size_t len, const size_t first[OBJ_KINDS], uint *index,
+                               Error *err)
+{
     if (s->n_objects >= SCENE_MAX_OBJECTS)
         return error_set(err, ST_INPUT, "too many objects (the limit is %u)", SCENE_MAX_OBJECTS);
     if (array_reserve((void **)&s->objects, &s->cap_objects, s->n_objects + 1, sizeof *s->objects))
@@ -41,15 +48,15 @@ Status scene_object_begin(Scene *s, const char *name, size_t len, uint *index, E
     }
     memcpy(o->name, name, len);
     o->name[len] = '\0';
-    kind_counts(s, o->first);
-    kind_counts(s, o->end);
+    memcpy(o->first, first, sizeof o->first);
+    scene_object_counts(s, o->end);
     *index = (uint)s->n_objects++;
     return ST_OK;
 }
 
 void scene_object_end(Scene *s, uint index)
 {
-    kind_counts(s, s->objects[index].end);
+    scene_object_counts(s, s->objects[index].end);
 }
 
 uint scene_find_object(const Scene *s, const char *name, size_t len)

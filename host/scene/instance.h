@@ -25,6 +25,14 @@
  * scene's current primitive counts; *index receives it. Fails when memory runs out
  * (ST_INTERNAL) or past SCENE_MAX_OBJECTS (ST_INPUT, no location). */
 Status scene_object_begin(Scene *s, const char *name, size_t len, uint *index, Error *err);
+/* The same for an object whose primitives were made already: those added since the
+ * scene held `first` of each kind (scene_object_counts, read when they began). Readers
+ * that learn only at its end whether a block becomes an object (pbrt's ObjectEnd) use
+ * it; no other object may have begun since. */
+Status scene_object_begin_from(Scene *s, const char *name, size_t len, const size_t first[OBJ_KINDS], uint *index,
+                               Error *err);
+/* The scene's current count of each kind of primitive. */
+void scene_object_counts(const Scene *s, size_t n[OBJ_KINDS]);
 /* Ends object `index`: the primitives added since its start are its own. */
 void scene_object_end(Scene *s, uint index);
 /* The object named so, or NO_INDEX. */

@@ -20,6 +20,7 @@
 #include "io/mesh_load.h"
 #include "io/scene_load.h"
 #include "render_util.h"
+#include "scene/instance.h"
 
 #include "integrator/shade_path.h"     /* the kernels' shading functions, compiled as C (test_extras) */
 #include "accel/alpha.h"
@@ -282,43 +283,56 @@ static void test_shared_buffer_file(void)
     rmdir(dir);
 }
 
-/* A strip of 1-byte indices makes a triangle per byte, and each node that instances it
+/* A strip of 1-byte indices makes a triangle per byte, and each mesh that copies it
  * as many again: a 4 MB strip in 16 nodes made 2^26 triangles (issue 39). A file makes
  * at most 2^20 + one per byte of it and its buffers; the primitive that would pass that
  * is refused before it makes any, named with its node. Here 4096 zero indices (a strip
- * of degenerate triangles, dropped quickly) in 300 nodes. */
+ * of degenerate triangles, dropped quickly) in 300 meshes of one node each. One mesh
+ * in 300 nodes is an object made once and instanced: within the bound. */
 static void test_triangle_bound(void)
 {
-    size_t idx_b64 = 4096 / 3 * 4 + 4, cap = 64 * 300 + idx_b64 + 4096;
-    char *text = malloc(cap);
-    CHECK(text != NULL);
-    if (!text) return;
-    size_t n = (size_t)snprintf(text, cap, "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[");
-    for (int i = 0; i < 300; i++) n += (size_t)snprintf(text + n, cap - n, "%s%d", i ? "," : "", i);
-    n += (size_t)snprintf(text + n, cap - n, "]}],\"nodes\":[");
-    for (int i = 0; i < 300; i++) n += (size_t)snprintf(text + n, cap - n, "%s{\"mesh\":0}", i ? "," : "");
-    n += (size_t)snprintf(text + n, cap - n, "],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,"
-                          "\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5121,"
-                          "\"count\":4096,\"type\":\"SCALAR\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},"
-                          "{\"buffer\":1,\"byteLength\":4096}],\"buffers\":[{\"byteLength\":36,\"uri\":\"data:;base64,"
-                          "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"},{\"byteLength\":4096,\"uri\":\"data:;base64,");
-    for (size_t i = 0; i < 4096 / 3 * 4 + 4; i++) text[n++] = 'A';
-    n += (size_t)snprintf(text + n, cap - n, "\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},"
-                          "\"indices\":1,\"mode\":5}]}]}");
-    Scene s;
-    Error err = { 0 };
-    Status st = load_text("strip.gltf", text, &s, &err);
-    CHECK(st == ST_INPUT);
-    /* the bound: 2^20 + the 4132 buffer bytes + the document's bytes */
-    char msg[400];
-    size_t bound = ((size_t)1 << 20) + 4132 + n, per = 4094, node = bound / per;
-    snprintf(msg, sizeof msg, "strip.gltf: meshes[0].primitives[0] (in nodes[%zu]): its 4094 triangles bring the "
-             "file's to %zu, more than the %zu a file of its size may make (2^20 and one per byte of the file and "
-             "its buffers, at most 2^26; every node's instance counts)", node, (node + 1) * per, bound);
-    CHECK_MSG(strcmp(err.msg, msg) == 0, "got      '%s'\n  expected '%s'", err.msg, msg);
-    error_clear(&err);
-    scene_free(&s);
-    free(text);
+    for (int shared = 0; shared < 2; shared++) {
+        size_t idx_b64 = 4096 / 3 * 4 + 4, cap = 160 * 300 + idx_b64 + 4096;
+        char *text = malloc(cap);
+        CHECK(text != NULL);
+        if (!text) return;
+        size_t n = (size_t)snprintf(text, cap, "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[");
+        for (int i = 0; i < 300; i++) n += (size_t)snprintf(text + n, cap - n, "%s%d", i ? "," : "", i);
+        n += (size_t)snprintf(text + n, cap - n, "]}],\"nodes\":[");
+        for (int i = 0; i < 300; i++) n += (size_t)snprintf(text + n, cap - n, "%s{\"mesh\":%d}", i ? "," : "", shared ? 0 : i);
+        n += (size_t)snprintf(text + n, cap - n, "],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,"
+                              "\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5121,"
+                              "\"count\":4096,\"type\":\"SCALAR\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},"
+                              "{\"buffer\":1,\"byteLength\":4096}],\"buffers\":[{\"byteLength\":36,\"uri\":\"data:;base64,"
+                              "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"},{\"byteLength\":4096,\"uri\":\"data:;base64,");
+        for (size_t i = 0; i < 4096 / 3 * 4 + 4; i++) text[n++] = 'A';
+        n += (size_t)snprintf(text + n, cap - n, "\"}],\"meshes\":[");
+        for (int i = 0; i < (shared ? 1 : 300); i++)
+            n += (size_t)snprintf(text + n, cap - n, "%s{\"primitives\":[{\"attributes\":{\"POSITION\":0},"
+                                  "\"indices\":1,\"mode\":5}]}", i ? "," : "");
+        n += (size_t)snprintf(text + n, cap - n, "]}");
+        Scene s;
+        Error err = { 0 };
+        Status st = load_text("strip.gltf", text, &s, &err);
+        if (shared) {
+            CHECK_MSG(st == ST_OK, "%s", err.msg);
+            CHECK_EQ_INT(s.n_objects, 1);
+            scene_free(&s);
+            free(text);
+            continue;
+        }
+        CHECK(st == ST_INPUT);
+        /* the bound: 2^20 + the 4132 buffer bytes + the document's bytes */
+        char msg[400];
+        size_t bound = ((size_t)1 << 20) + 4132 + n, per = 4094, node = bound / per;
+        snprintf(msg, sizeof msg, "strip.gltf: meshes[%zu].primitives[0] (in nodes[%zu]): its 4094 triangles bring the "
+                 "file's to %zu, more than the %zu a file of its size may make (2^20 and one per byte of the file and "
+                 "its buffers, at most 2^26; every node's instance counts)", node, node, (node + 1) * per, bound);
+        CHECK_MSG(strcmp(err.msg, msg) == 0, "got      '%s'\n  expected '%s'", err.msg, msg);
+        error_clear(&err);
+        scene_free(&s);
+        free(text);
+    }
 }
 
 /* glTF URIs are RFC 3986's: percent-encoded bytes are decoded (test_shared_buffer_file
@@ -963,6 +977,158 @@ static void test_extras(void)
     scene_free(&s);
 }
 
+/* ------------------------------------------------------------------ instancing */
+
+/* A file rendered small on `devices`; flattened into copies first when `flatten`. */
+static Status render_gltf(const char *path, const char *devices, int flatten, Film *f, Error *err)
+{
+    Scene s;
+    scene_init(&s);
+    Status st = scene_load_file(path, SCENE_FORMAT_AUTO, &s, NULL, err);
+    s.image.width = 48;
+    s.image.height = 36;
+    s.image.spp = 16;
+    s.image.max_depth = 4;
+    if (!st && flatten) st = scene_flatten_instances(&s, err);
+    if (!st) st = render_util_run(&s, devices, 0, f, err);
+    scene_free(&s);
+    return st;
+}
+
+static size_t sums_same(const Film *a, const Film *b)
+{
+    size_t n = (size_t)a->width * a->height * 3u, same = 0;
+    for (size_t i = 0; i < n; i++) same += a->sum[i] == b->sum[i];
+    return same;
+}
+
+/* Two renders of one scene whose rays differ by roundings: the same mean within noise. */
+static void check_same_scene(const char *what, const char *a_path, int a_flat, const char *b_path, int b_flat)
+{
+    Film a, b;
+    Error err = { 0 };
+    Status sa = render_gltf(a_path, "scalar", a_flat, &a, &err);
+    CHECK_MSG(sa == ST_OK, "%s", err.msg);
+    Status sb = render_gltf(b_path, "scalar", b_flat, &b, &err);
+    CHECK_MSG(sb == ST_OK, "%s", err.msg);
+    if (!sa && !sb) {
+        double ma = film_mean(&a), mb = film_mean(&b);
+        size_t n = (size_t)a.width * a.height * 3u, same = sums_same(&a, &b);
+        fprintf(stderr, "  %s: mean %.6f vs %.6f; %zu of %zu channel sums identical\n", what, ma, mb, same, n);
+        CHECK(fabs(ma - mb) < 0.01 * mb);
+        CHECK(same > n / 2);
+    }
+    if (!sa) film_free(&a);
+    if (!sb) film_free(&b);
+}
+
+/* A mesh in two or more nodes is one object with an instance per node (the node's world
+ * matrix; a mirroring parent's too); EXT_mesh_gpu_instancing makes an instance per entry,
+ * node . T . R . S; a mesh in one node stays a copy. Each renders as its copies. */
+static void test_instancing(void)
+{
+    Scene s;
+    Error err = { 0 };
+    scene_init(&s);
+    CHECK_MSG(scene_load_file(DIR_GLTF "instancing-reuse.gltf", SCENE_FORMAT_AUTO, &s, NULL, &err) == ST_OK, "%s",
+              err.msg);
+    CHECK_EQ_INT(s.n_objects, 1);
+    CHECK_EQ_INT(s.n_instances, 4);
+    CHECK_EQ_INT(s.n_triangles, 14);   /* the floor's 2, the cube's 12 once */
+    if (s.n_instances == 4) {
+        CHECK(!(s.instances[0].flags & INST_MIRROR) && (s.instances[3].flags & INST_MIRROR));
+        const float *m = s.instances[3].to_world;   /* (-1, 1, 1) . (x + 1, y + 0.5, z - 2) */
+        CHECK(m[0] == -1 && m[3] == -1 && m[7] == 0.5f && m[11] == -2);
+    }
+    scene_free(&s);
+    scene_init(&s);
+    CHECK_MSG(scene_load_file(DIR_GLTF "instancing-copies.gltf", SCENE_FORMAT_AUTO, &s, NULL, &err) == ST_OK, "%s",
+              err.msg);
+    CHECK_EQ_INT(s.n_objects, 0);
+    CHECK_EQ_INT(s.n_triangles, 50);
+    scene_free(&s);
+    scene_init(&s);
+    CHECK_MSG(scene_load_file(DIR_GLTF "instancing-gpu.gltf", SCENE_FORMAT_AUTO, &s, NULL, &err) == ST_OK, "%s",
+              err.msg);
+    CHECK_EQ_INT(s.n_objects, 1);
+    CHECK_EQ_INT(s.n_instances, 4);
+    if (s.n_instances == 4) {
+        const float *m = s.instances[0].to_world;   /* node (0, 0, 2) . entry 0: (-1.5, 0.3, 0), scale 0.3 */
+        CHECK_NEAR(m[0], 0.3, 1e-6);
+        CHECK_NEAR(m[3], -1.5, 1e-6);
+        CHECK_NEAR(m[7], 0.3, 1e-6);
+        CHECK_NEAR(m[11], 2, 1e-6);
+    }
+    scene_free(&s);
+
+    check_same_scene("reused mesh vs a mesh per node", DIR_GLTF "instancing-reuse.gltf", 0,
+                     DIR_GLTF "instancing-copies.gltf", 0);
+    check_same_scene("reused mesh vs its instances flattened", DIR_GLTF "instancing-reuse.gltf", 0,
+                     DIR_GLTF "instancing-reuse.gltf", 1);
+    check_same_scene("EXT_mesh_gpu_instancing vs its entries as nodes", DIR_GLTF "instancing-gpu.gltf", 0,
+                     DIR_GLTF "instancing-gpu-copies.gltf", 0);
+
+    /* PoCL (or the GPU) renders the instances bit for bit as the scalar device */
+    Film a, b;
+    Status sa = render_gltf(DIR_GLTF "instancing-gpu.gltf", TEST_OPENCL, 0, &a, &err);
+    CHECK_MSG(sa == ST_OK, "%s", err.msg);
+    Status sb = render_gltf(DIR_GLTF "instancing-gpu.gltf", "scalar", 0, &b, &err);
+    CHECK_MSG(sb == ST_OK, "%s", err.msg);
+    if (!sa && !sb) {
+        size_t n = (size_t)a.width * a.height * 3u, same = sums_same(&a, &b);
+        fprintf(stderr, "  EXT_mesh_gpu_instancing: %zu of %zu channel sums identical on OpenCL and scalar\n", same, n);
+        CHECK(same == n);
+    }
+    if (!sa) film_free(&a);
+    if (!sb) film_free(&b);
+}
+
+/* What stays copies: a mesh that emits light (instanced emitters are no lights), with a
+ * warning; a glTF read inside a clpt object (instances nest one level deep); a node
+ * scaled to nothing places no instance. */
+static void test_instancing_copies(void)
+{
+    Scene s;
+    Error err = { 0 };
+    /* one triangle in three nodes, the last scaled by s; emitting or not */
+#define THREE_NODES(material, s)                                                                                 \
+    "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1,2]}],"                             \
+    "\"nodes\":[{\"mesh\":0},{\"mesh\":0,\"translation\":[2,0,0]},{\"mesh\":0,\"scale\":[" s "]}],"              \
+    "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","                     \
+    "\"min\":[0,0,0],\"max\":[1,1,0]}],"                                                                        \
+    "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"                          \
+    "\"materials\":[" material "],"                                                                             \
+    "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],\"buffers\":[{\"byteLength\":36,\"uri\":\"data:;base64," \
+    "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}]}"
+    CHECK_MSG(load_text("plain.gltf", THREE_NODES("{}", "0,0,0"), &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_objects, 1);
+    CHECK_EQ_INT(s.n_instances, 2);
+    CHECK(s.n_warnings == 1 && strcmp(s.warnings[0], "plain.gltf: mesh instances under a singular transform (a scale "
+                                      "of 0) are skipped: 1") == 0);
+    scene_free(&s);
+    const char *fixed = THREE_NODES("{\"emissiveFactor\":[1,1,1]}", "1,1,1");
+    CHECK_MSG(load_text("lamp.gltf", fixed, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_objects, 0);
+    CHECK_EQ_INT(s.n_triangles, 3);
+    int warned = 0;
+    for (size_t i = 0; i < s.n_warnings; i++)
+        warned |= strstr(s.warnings[i], "lamp.gltf: meshes[0] emits light: copied at each of its nodes (instanced "
+                         "emitters are not lights)") != NULL;
+    CHECK(warned);
+    scene_free(&s);
+
+    static const char in_object[] = "camera { from 0 3 9 at 0 0 0 }\n"
+                                    "object o { mesh { file \"instancing-reuse.gltf\" } }\n"
+                                    "instance o { translate 1 0 0 }\n";
+    scene_init(&s);
+    CHECK_MSG(scene_load_bytes(DIR_GLTF "in-object.scene", in_object, strlen(in_object), SCENE_FORMAT_AUTO, &s, NULL,
+                               &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_objects, 1);
+    CHECK_EQ_INT(s.n_instances, 1);
+    CHECK_EQ_INT(s.n_triangles, 50);
+    scene_free(&s);
+}
+
 int main(void)
 {
     RUN(test_volume_specular_sheen);
@@ -981,6 +1147,8 @@ int main(void)
     RUN(test_triangle_bound);
     RUN(test_uri_policy);
     RUN(test_extras);
+    RUN(test_instancing);
+    RUN(test_instancing_copies);
     RUN(test_cornell_box);
     RUN(test_material_spheres);
     RUN(test_suzanne_texture);

@@ -522,7 +522,7 @@ Status gltf_acc_read_either(Gltf *g, int a, int width, int width2, const char *u
 static const char *const supported_ext[] = {
     "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_ior",
     "KHR_materials_transmission", "KHR_materials_clearcoat", "KHR_texture_transform",
-    "KHR_materials_volume", "KHR_materials_specular", "KHR_materials_sheen",
+    "KHR_materials_volume", "KHR_materials_specular", "KHR_materials_sheen", "EXT_mesh_gpu_instancing",
 };
 
 static int ext_supported(const char *name)
@@ -652,6 +652,7 @@ Status gltf_parse(const char *path, const char *data, size_t len, Scene *s, cons
     free(g.mats);
     free(g.tex);
     free(g.visited);
+    free(g.placed);
     strmap_free(&g.buffer_files);
     strmap_free(&g.image_sources[0]);
     strmap_free(&g.image_sources[1]);

@@ -49,6 +49,14 @@ typedef struct {
     int n;
 } Table;
 
+/* Where the node tree puts a mesh. The meshes are made once the walk has counted every
+ * mesh's uses: one used once is copied in place, one used more becomes an object. */
+typedef struct {
+    int mesh, node;
+    int gpu_instanced;     /* the node has EXT_mesh_gpu_instancing */
+    Transform w;           /* the node's world matrix (with the MeshOptions' transform) */
+} GltfPlacement;
+
 typedef struct {
     const char *path;
     Scene *s;
@@ -66,6 +74,8 @@ typedef struct {
     uint *tex;        int n_images;    /* per image: sRGB [2i], linear [2i+1] texture */
     unsigned char *visited;  int n_nodes;
     size_t triangles, max_triangles;
+    GltfPlacement *placed;  size_t n_placed, cap_placed;
+    size_t singular;                 /* instances skipped for a singular transform */
     int has_lights;
     Table t[T_N];
 } Gltf;

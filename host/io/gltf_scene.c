@@ -8,6 +8,7 @@
 #include "io/path.h"
 #include "io/reader.h"
 #include "io/texture.h"
+#include "scene/instance.h"
 #include "util/kmath.h"
 
 #include <math.h>
@@ -229,6 +230,23 @@ static Status mesh_instance(Gltf *g, int mesh, const Transform *xf, const char *
 
 /* ------------------------------------------------------------------ nodes */
 
+/* T . R . S (glTF 2.0, 3.5.3): translation t, unit-normalised quaternion q (x, y, z, w),
+ * scale s; NULL t or s: none. q must not be zero. */
+static void trs_matrix(const double *t, const double *q, const double *s, Transform *out)
+{
+    double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    double x = q[0] / l, y = q[1] / l, z = q[2] / l, w = q[3] / l;
+    const double r[3][3] = {
+        { 1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w) },
+        { 2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w) },
+        { 2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y) },
+    };
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) out->m[i][j] = r[i][j] * (s ? s[j] : 1.0);
+        out->m[i][3] = t ? t[i] : 0.0;
+    }
+}
+
 static Status node_local(Gltf *g, const cJSON *node, const char *jp, Transform *out)
 {
     double m[16];
@@ -247,16 +265,7 @@ static Status node_local(Gltf *g, const cJSON *node, const char *jp, Transform *
         return st;
     double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     if (!(l > 0)) return gltf_bad(g, jp, "rotation: a zero quaternion");
-    double x = q[0] / l, y = q[1] / l, z = q[2] / l, w = q[3] / l;
-    const double r[3][3] = {
-        { 1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w) },
-        { 2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w) },
-        { 2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y) },
-    };
-    for (int i = 0; i < 3; i++) {
-        for (int j = 0; j < 3; j++) out->m[i][j] = r[i][j] * sc[j];
-        out->m[i][3] = t[i];
-    }
+    trs_matrix(t, q, sc, out);
     return ST_OK;
 }
 
@@ -364,6 +373,190 @@ static Status light_add(Gltf *g, int li, const Transform *xf, const char *jp)
     return scene_add_light(g->s, L, g->err);
 }
 
+/* ------------------------------------------------------------------ instances */
+
+static int placed_grow(Gltf *g)
+{
+    if (g->n_placed < g->cap_placed) return 0;
+    size_t cap = g->cap_placed ? 2 * g->cap_placed : 16;
+    GltfPlacement *p = realloc(g->placed, cap * sizeof *p);
+    if (!p) return -1;
+    g->placed = p;
+    g->cap_placed = cap;
+    return 0;
+}
+
+/* What a mesh used more than once became: not yet seen, copies, or a scene object. */
+#define MESH_UNSEEN NO_INDEX
+#define MESH_COPIES (NO_INDEX - 1u)
+
+/* Whether a primitive of mesh `mesh` emits light: instanced emitters are no lights yet
+ * (docs/instancing.md), so such a mesh is copied wherever it is placed. */
+static Status mesh_emits(Gltf *g, int mesh, const char *jp, int *emits)
+{
+    *emits = 0;
+    const cJSON *prims = cJSON_GetObjectItemCaseSensitive(gltf_item_at(g, "meshes", mesh), "primitives");
+    if (!cJSON_IsArray(prims)) return gltf_bad(g, jp, "primitives: expected an array");
+    int i = 0;
+    for (const cJSON *p = gltf_first_of(prims); p; p = p->next, i++) {
+        char jpp[96];
+        snprintf(jpp, sizeof jpp, "%s.primitives[%d]", jp, i);
+        int mi;
+        uint mat;
+        Status st = gltf_get_index(g, p, "material", 0, "materials", jpp, &mi);
+        if (!st) st = gltf_material_get(g, mi, &mat);
+        if (st) return st;
+        if (mat != NO_INDEX && mat < g->s->n_materials && !v3_is_zero(g->s->materials[mat].emission)) *emits = 1;
+    }
+    return ST_OK;
+}
+
+/* Mesh `mesh` made once as a scene object in its own space (*out), or MESH_COPIES when
+ * it emits light; an object of no triangles is made and never placed. */
+static Status mesh_object(Gltf *g, int mesh, const char *node, uint *out)
+{
+    char jp[64], name[600];
+    snprintf(jp, sizeof jp, "meshes[%d]", mesh);
+    int emits;
+    Status st = mesh_emits(g, mesh, jp, &emits);
+    if (st) return st;
+    if (emits) {
+        *out = MESH_COPIES;
+        return scene_warn(g->s, g->err, "%s: %s emits light: copied at each of its nodes (instanced emitters are not "
+                          "lights)", g->path, jp);
+    }
+    snprintf(name, sizeof name, "%.500s:%s", g->path, jp);
+    if ((st = scene_object_begin(g->s, name, strlen(name), out, g->err))) return st;
+    const Transform id = transform_identity();
+    st = mesh_instance(g, mesh, &id, node);
+    scene_object_end(g->s, *out);
+    return st;
+}
+
+/* One instance of `object` (or a copy of mesh `mesh`) under w; a singular w (a scale
+ * of 0 that hides a node) places nothing and is counted for one warning. */
+static Status place(Gltf *g, int mesh, uint object, const Transform *w, const char *jp)
+{
+    if (object == MESH_COPIES) return mesh_instance(g, mesh, w, jp);
+    if (scene_object_prims(g->s, object) == 0) return ST_OK;
+    Transform inv;
+    if (!transform_invert(w, &inv)) {
+        g->singular++;
+        return ST_OK;
+    }
+    Status st = scene_add_instance(g->s, object, w, NO_INDEX, g->err);
+    if (st == ST_INPUT) {
+        char msg[sizeof g->err->msg];
+        snprintf(msg, sizeof msg, "%s", g->err->msg);
+        return gltf_bad(g, jp, msg);
+    }
+    return st;
+}
+
+/* One EXT_mesh_gpu_instancing attribute: `width` floats per instance (ROTATION also
+ * normalized bytes or shorts), as many as the others (*count, 0 until one is read). */
+static Status gpu_attribute(Gltf *g, const cJSON *attrs, const char *name, int width, const char *jp, double **out,
+                            size_t *count)
+{
+    *out = NULL;
+    char use[200], at[180];
+    snprintf(at, sizeof at, "%s.attributes", jp);
+    snprintf(use, sizeof use, "%s.%s", at, name);
+    int ai;
+    Status st = gltf_get_index(g, attrs, name, 0, "accessors", at, &ai);
+    if (st || ai < 0) return st;
+    const cJSON *acc = gltf_item_at(g, "accessors", ai);
+    const cJSON *ct = cJSON_GetObjectItemCaseSensitive(acc, "componentType");
+    double c = cJSON_IsNumber(ct) ? ct->valuedouble : 0;
+    int norm = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(acc, "normalized"));
+    int rotation = width == 4;
+    if (!(c == 5126 || (rotation && (c == 5120 || c == 5122) && norm)))
+        return error_set(g->err, ST_INPUT, "%s: %s: accessor %d: componentType must be 5126 (float)%s", g->path, use,
+                         ai, rotation ? ", or 5120 or 5122 (byte or short) with normalized true" : "");
+    size_t n;
+    if ((st = gltf_acc_read(g, ai, width, use, out, &n))) return st;
+    if (*count && n != *count) {
+        free(*out);
+        *out = NULL;
+        return error_set(g->err, ST_INPUT, "%s: %s: accessor %d has %zu elements, another attribute has %zu (all "
+                         "must have the same count)", g->path, use, ai, n, *count);
+    }
+    *count = n;
+    return ST_OK;
+}
+
+/* The instances of a node with EXT_mesh_gpu_instancing: node world . T . R . S of each
+ * entry (the extension's "Transformation Order"; a rotation's quaternion normalised, as
+ * a node's is). */
+static Status gpu_instances(Gltf *g, const GltfPlacement *pl, uint object, const char *node)
+{
+    char jp[120];
+    snprintf(jp, sizeof jp, "%s.extensions.EXT_mesh_gpu_instancing", node);
+    const cJSON *ext = gltf_ext_of(gltf_item_at(g, "nodes", pl->node), "EXT_mesh_gpu_instancing");
+    const cJSON *attrs = cJSON_GetObjectItemCaseSensitive(ext, "attributes");
+    if (!cJSON_IsObject(attrs)) return gltf_bad(g, jp, "attributes: expected an object");
+    double *tr = NULL, *rot = NULL, *sc = NULL;
+    size_t n = 0;
+    Status st = gpu_attribute(g, attrs, "TRANSLATION", 3, jp, &tr, &n);
+    if (!st) st = gpu_attribute(g, attrs, "ROTATION", 4, jp, &rot, &n);
+    if (!st) st = gpu_attribute(g, attrs, "SCALE", 3, jp, &sc, &n);
+    if (!st && n == 0) st = gltf_bad(g, jp, "attributes: none of TRANSLATION, ROTATION, SCALE");
+    for (size_t i = 0; i < n && !st; i++) {
+        char ji[160];
+        snprintf(ji, sizeof ji, "%s (instance %zu)", jp, i);
+        double q[4] = { 0, 0, 0, 1 };
+        if (rot) memcpy(q, rot + 4 * i, sizeof q);
+        double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        if (!(l > 0)) {
+            st = gltf_bad(g, ji, "ROTATION: a zero quaternion");
+            break;
+        }
+        Transform local;
+        trs_matrix(tr ? tr + 3 * i : NULL, q, sc ? sc + 3 * i : NULL, &local);
+        Transform w = transform_compose(&pl->w, &local);
+        st = place(g, pl->mesh, object, &w, ji);
+    }
+    free(tr);
+    free(rot);
+    free(sc);
+    return st;
+}
+
+/* The meshes the node walk placed, in its order. */
+static Status meshes_place(Gltf *g)
+{
+    int n_meshes = g->t[T_MESHES].n;
+    unsigned *uses = calloc((size_t)n_meshes + 1, sizeof *uses);
+    uint *made = malloc(((size_t)n_meshes + 1) * sizeof *made);
+    if (!uses || !made) {
+        free(uses);
+        free(made);
+        return error_set(g->err, ST_INTERNAL, "out of memory");
+    }
+    for (int m = 0; m < n_meshes; m++) made[m] = MESH_UNSEEN;
+    /* a node with EXT_mesh_gpu_instancing places its mesh many times */
+    for (size_t i = 0; i < g->n_placed; i++) uses[g->placed[i].mesh] += g->placed[i].gpu_instanced ? 2u : 1u;
+    Status st = ST_OK;
+    for (size_t i = 0; i < g->n_placed && !st; i++) {
+        const GltfPlacement *pl = &g->placed[i];
+        char jp[64];
+        snprintf(jp, sizeof jp, "nodes[%d]", pl->node);
+        if (uses[pl->mesh] < 2 || g->o->no_instances) {
+            if (pl->gpu_instanced) st = gpu_instances(g, pl, MESH_COPIES, jp);
+            else st = mesh_instance(g, pl->mesh, &pl->w, jp);
+            continue;
+        }
+        if (made[pl->mesh] == MESH_UNSEEN && (st = mesh_object(g, pl->mesh, jp, &made[pl->mesh]))) break;
+        st = pl->gpu_instanced ? gpu_instances(g, pl, made[pl->mesh], jp) : place(g, pl->mesh, made[pl->mesh], &pl->w, jp);
+    }
+    free(uses);
+    free(made);
+    if (!st && g->singular)
+        st = scene_warn(g->s, g->err, "%s: mesh instances under a singular transform (a scale of 0) are skipped: %zu",
+                        g->path, g->singular);
+    return st;
+}
+
 static Status node_visit(Gltf *g, int n, const Transform *parent, int depth)
 {
     char jp[64];
@@ -379,9 +572,17 @@ static Status node_visit(Gltf *g, int n, const Transform *parent, int depth)
     int mesh, cam;
     if ((st = gltf_get_index(g, node, "mesh", 0, "meshes", jp, &mesh))) return st;
     if ((st = gltf_get_index(g, node, "camera", 0, "cameras", jp, &cam))) return st;
+    const cJSON *gpu = gltf_ext_of(node, "EXT_mesh_gpu_instancing");
     if (mesh >= 0) {
-        Transform w = transform_compose(&g->o->xf, &xf);
-        if ((st = mesh_instance(g, mesh, &w, jp))) return st;
+        if (placed_grow(g)) return error_set(g->err, ST_INTERNAL, "out of memory");
+        GltfPlacement *pl = &g->placed[g->n_placed++];
+        pl->mesh = mesh;
+        pl->node = n;
+        pl->gpu_instanced = gpu != NULL;
+        pl->w = transform_compose(&g->o->xf, &xf);
+    } else if (gpu && (st = scene_warn(g->s, g->err, "%s: %s.extensions.EXT_mesh_gpu_instancing: the node has no "
+                                       "mesh; ignored", g->path, jp))) {
+        return st;
     }
     if (cam >= 0 && g->view && camera_wanted(g, cam, node)) {
         Transform w = transform_compose(&g->o->xf, &xf);
@@ -424,7 +625,7 @@ Status gltf_scene_walk(Gltf *g)
                 return gltf_bad(g, jp, "an entry is not the index of a node");
             if ((st = node_visit(g, (int)r->valuedouble, &id, 0))) return st;
         }
-        return ST_OK;
+        return meshes_place(g);
     }
     /* no scenes: every node that is no other node's child is a root */
     unsigned char *child = calloc((size_t)g->n_nodes + 1, 1);
@@ -438,5 +639,5 @@ Status gltf_scene_walk(Gltf *g)
     for (int n = 0; n < g->n_nodes && !st; n++)
         if (!child[n]) st = node_visit(g, n, &id, 0);
     free(child);
-    return st;
+    return st ? st : meshes_place(g);
 }

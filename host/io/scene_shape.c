@@ -265,6 +265,7 @@ Status scene_parse_mesh(Parser *p, Lexer *lx, const Token *kw)
     const Token *f = &v[MESH_FILE].word;
     MeshOptions o = mesh_options(v[MESH_MATERIAL].given ? v[MESH_MATERIAL].material : NO_INDEX);
     if ((st = scene_parse_transform(p, lx, kw, v + MESH_TRANSLATE, "mesh", &o.xf))) return st;
+    o.no_instances = p->object != NO_INDEX;
     char *path = scene_path_beside(lx->path, f->text, f->len);
     if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
     if (mesh_kind(path) == MESH_NONE) {

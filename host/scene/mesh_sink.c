@@ -15,6 +15,7 @@ MeshOptions mesh_options(uint material)
     o.default_material = NO_INDEX;
     o.xf = transform_identity();
     o.smooth_by_index = 0;
+    o.no_instances = 0;
     return o;
 }
 

@@ -28,6 +28,9 @@ typedef struct {
     /* Faces without normals get smooth ones over the faces sharing each vertex index
      * (mesh_smooth_normals; OBJ only, MIT 6.837 Fall 2019's convention). */
     int smooth_by_index;
+    /* The file's meshes are copied wherever it places them, never made objects with
+     * instances (a glTF read inside an object: instances nest one level deep). */
+    int no_instances;
 } MeshOptions;
 
 /* Every triangle gets `material` (NO_INDEX: the file's own), no transform. */

@@ -189,6 +189,133 @@ def nodes():
     return d, raw
 
 
+def quat_axis(axis, degrees):
+    import math
+    x, y, z = axis
+    n = math.sqrt(x * x + y * y + z * z)
+    h = math.radians(degrees) / 2
+    s = math.sin(h) / n
+    return [x * s, y * s, z * s, math.cos(h)]
+
+
+def trs(t=(0, 0, 0), q=(0, 0, 0, 1), s=(1, 1, 1)):
+    """T . R . S as a row-major 4x4 (glTF 2.0, 3.5.3), the quaternion normalised."""
+    import math
+    n = math.sqrt(sum(c * c for c in q))
+    x, y, z, w = (c / n for c in q)
+    r = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+         [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+         [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    return [[r[i][0] * s[0], r[i][1] * s[1], r[i][2] * s[2], t[i]] for i in range(3)] + [[0, 0, 0, 1]]
+
+
+def matmul(a, b):
+    return [[sum(a[i][k] * b[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
+
+
+def column_major(m):
+    return [m[r][c] for c in range(4) for r in range(4)]
+
+
+# The instanced cube's placements (issue 42): moved, rotated, stretched, and a child of
+# a mirroring parent. EXT_mesh_gpu_instancing's entries, under a node moved by (0, 0, -1):
+# TRANSLATION floats, ROTATION normalized shorts, SCALE floats.
+CUBE_NODES = [
+    {"translation": [0, 0.5, 0]},
+    {"translation": [2, 0.5, 0], "rotation": quat_axis((0, 1, 0), 30)},
+    {"translation": [-2, 0.7, 0.5], "rotation": quat_axis((1, 1, 0), 25), "scale": [1, 1.4, 0.6]},
+]
+MIRROR_PARENT = {"translation": [0, 0, -2], "scale": [-1, 1, 1]}
+MIRROR_CHILD = {"translation": [1, 0.5, 0]}
+GPU_NODE = {"translation": [0, 0, 2]}
+GPU_T = [(-1.5, 0.3, 0), (0, 0.3, 0.3), (1.5, 0.5, 0), (0.5, 1.4, -0.5)]
+GPU_R = [quat_axis((0, 1, 0), 0), quat_axis((0, 1, 0), 45), quat_axis((1, 0, 1), 60), quat_axis((0, 0, 1), -20)]
+GPU_S = [(0.3, 0.3, 0.3), (0.5, 0.25, 0.4), (0.3, 0.5, 0.3), (0.2, 0.2, 0.6)]
+
+
+def short_norm(q):
+    return [max(-32767, min(32767, round(c * 32767))) for c in q]
+
+
+def instancing(mode):
+    """A cube placed several times over a floor, seen by a camera and lit by a point
+    light. mode "reuse": one mesh in four nodes; "copies": a mesh per node (the same
+    accessors); "gpu": one node with EXT_mesh_gpu_instancing; "gpu-copies": its entries
+    written out as nodes with matrices."""
+    cube_p = [(x, y, z) for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)]
+    # outward-wound faces of the cube over corners index = 4x + 2y + z
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    cube_i = []
+    for a, b, c, d in faces:
+        cube_i += [a, b, c, a, c, d]
+    floor_p = [(-6, 0, -6), (-6, 0, 6), (6, 0, 6), (6, 0, -6)]
+    raw = f32(*[c for p in cube_p for c in p]) + struct.pack("<36H", *cube_i) + f32(*[c for p in floor_p for c in p])
+    raw += struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+    views = [{"buffer": 0, "byteOffset": 0, "byteLength": 96}, {"buffer": 0, "byteOffset": 96, "byteLength": 72},
+             {"buffer": 0, "byteOffset": 168, "byteLength": 48}, {"buffer": 0, "byteOffset": 216, "byteLength": 12}]
+    accessors = [{"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3",
+                  "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]},
+                 {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"},
+                 {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC3",
+                  "min": [-6, 0, -6], "max": [6, 0, 6]},
+                 {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}]
+    cube = {"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}
+    floor = {"primitives": [{"attributes": {"POSITION": 2}, "indices": 3, "material": 1}]}
+    meshes = [cube, floor]
+    import math
+    pitch = math.degrees(math.atan2(2.4, 9))
+    nodes = [{"camera": 0, "translation": [0, 3, 9], "rotation": quat_axis((1, 0, 0), -pitch)},
+             {"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [0, 5, 3]},
+             {"mesh": 1}]
+    roots = [0, 1, 2]
+
+    def cube_mesh():
+        if mode in ("reuse", "gpu"):
+            return 0
+        meshes.append(json.loads(json.dumps(cube)))
+        return len(meshes) - 1
+
+    if mode in ("reuse", "copies"):
+        for n in CUBE_NODES:
+            nodes.append(dict(n, mesh=cube_mesh()))
+            roots.append(len(nodes) - 1)
+        nodes.append(dict(MIRROR_PARENT, children=[len(nodes) + 1]))
+        roots.append(len(nodes) - 1)
+        nodes.append(dict(MIRROR_CHILD, mesh=cube_mesh()))
+    elif mode == "gpu":
+        count = len(GPU_T)
+        base = len(raw)
+        raw += f32(*[c for v in GPU_T for c in v])
+        raw += struct.pack("<%dh" % (4 * count), *[c for q in GPU_R for c in short_norm(q)])
+        raw += f32(*[c for v in GPU_S for c in v])
+        views += [{"buffer": 0, "byteOffset": base, "byteLength": 12 * count},
+                  {"buffer": 0, "byteOffset": base + 12 * count, "byteLength": 8 * count},
+                  {"buffer": 0, "byteOffset": base + 20 * count, "byteLength": 12 * count}]
+        accessors += [{"bufferView": 4, "componentType": 5126, "count": count, "type": "VEC3"},
+                      {"bufferView": 5, "componentType": 5122, "normalized": True, "count": count, "type": "VEC4"},
+                      {"bufferView": 6, "componentType": 5126, "count": count, "type": "VEC3"}]
+        nodes.append(dict(GPU_NODE, mesh=0, extensions={"EXT_mesh_gpu_instancing": {
+            "attributes": {"TRANSLATION": 4, "ROTATION": 5, "SCALE": 6}}}))
+        roots.append(len(nodes) - 1)
+    else:
+        node = trs(GPU_NODE["translation"])
+        for t_, q, s in zip(GPU_T, GPU_R, GPU_S):
+            qs = [c / 32767 for c in short_norm(q)]
+            nodes.append({"mesh": cube_mesh(), "matrix": column_major(matmul(node, trs(t_, qs, s)))})
+            roots.append(len(nodes) - 1)
+    d = doc([{"byteLength": len(raw), "uri": data_uri(raw)}], views, accessors, meshes, nodes, {
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.7, "aspectRatio": 4 / 3, "znear": 0.1}}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.25, 0.2, 1], "metallicFactor": 0,
+                                                "roughnessFactor": 1}},
+                      {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0,
+                                                "roughnessFactor": 1}}],
+        "extensionsUsed": ["KHR_lights_punctual"] + (["EXT_mesh_gpu_instancing"] if mode == "gpu" else []),
+        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 683 * 40}]}},
+    })
+    d["scenes"] = [{"nodes": roots}]
+    return d
+
+
 def png(width, height, rgb):
     """A minimal 8-bit RGB PNG of the given rows of (r, g, b) pixels."""
     def chunk(kind, data):
@@ -302,6 +429,8 @@ def main():
         f.write(extras_glb())
     nd, _ = nodes()
     write_json(os.path.join(GOOD, "nodes.gltf"), nd)
+    for mode in ("reuse", "copies", "gpu", "gpu-copies"):
+        write_json(os.path.join(GOOD, "instancing-%s.gltf" % mode), instancing(mode))
 
     # the same triangle as a .glb (buffer 0 the BIN chunk) and as a .gltf with an
     # external .bin file
@@ -377,6 +506,29 @@ def main():
     d["samplers"][0]["wrapT"] = 10496
     write_bad("gltf-sampler-wrap.gltf", json.dumps(d), "input",
               "%(p)s: samplers[0].wrapT: expected 10497 (REPEAT), 33071 (CLAMP_TO_EDGE) or 33648 (MIRRORED_REPEAT)")
+    gpu_node = "nodes[3].extensions.EXT_mesh_gpu_instancing"
+    d = instancing("gpu")
+    d["accessors"][6]["count"] = 3
+    write_bad("gltf-gpu-instancing-count.gltf", json.dumps(d), "input",
+              "%(p)s: " + gpu_node + ".attributes.SCALE: accessor 6 has 3 elements, another attribute has 4 (all "
+              "must have the same count)")
+    d = instancing("gpu")
+    d["accessors"][4]["type"] = "VEC4"
+    write_bad("gltf-gpu-instancing-type.gltf", json.dumps(d), "input",
+              "%(p)s: " + gpu_node + ".attributes.TRANSLATION: accessor 4: type must be VEC3 here")
+    d = instancing("gpu")
+    del d["accessors"][5]["normalized"]
+    write_bad("gltf-gpu-instancing-component.gltf", json.dumps(d), "input",
+              "%(p)s: " + gpu_node + ".attributes.ROTATION: accessor 5: componentType must be 5126 (float), or "
+              "5120 or 5122 (byte or short) with normalized true")
+    d = instancing("gpu")
+    d["nodes"][3]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"] = 9
+    write_bad("gltf-gpu-instancing-index.gltf", json.dumps(d), "input",
+              "%(p)s: " + gpu_node + ".attributes.SCALE: accessors[9] does not exist (the file has 7)")
+    d = instancing("gpu")
+    d["nodes"][3]["extensions"]["EXT_mesh_gpu_instancing"] = {"attributes": {}}
+    write_bad("gltf-gpu-instancing-empty.gltf", json.dumps(d), "input",
+              "%(p)s: " + gpu_node + ": attributes: none of TRANSLATION, ROTATION, SCALE")
     write_bad("gltf-not-json.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [", "input",
               "%(p)s: not valid glTF JSON")
 

@@ -327,7 +327,7 @@ static void test_triangle_bound(void)
         size_t bound = ((size_t)1 << 20) + 4132 + n, per = 4094, node = bound / per;
         snprintf(msg, sizeof msg, "strip.gltf: meshes[%zu].primitives[0] (in nodes[%zu]): its 4094 triangles bring the "
                  "file's to %zu, more than the %zu a file of its size may make (2^20 and one per byte of the file and "
-                 "its buffers, at most 2^26; every node's instance counts)", node, node, (node + 1) * per, bound);
+                 "its buffers, at most 2^26; every node's copy counts)", node, node, (node + 1) * per, bound);
         CHECK_MSG(strcmp(err.msg, msg) == 0, "got      '%s'\n  expected '%s'", err.msg, msg);
         error_clear(&err);
         scene_free(&s);

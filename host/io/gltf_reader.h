@@ -23,12 +23,14 @@
 /* glTF lights are photometric (candela, lux); clpt's are radiometric: divided by the
  * luminous efficacy of 555 nm light, 683 lm/W (docs/gltf.md). */
 #define LUMENS_PER_WATT 683.0
-/* Triangles one file may make, nodes times primitives included: a small file that
- * instances a large mesh many times must not exhaust memory (each triangle costs clpt
- * a few hundred bytes with its shading record and kd-tree), so the count is bounded by
- * the input's size, and absolutely. A real file's mesh data takes 20 bytes or more per
- * triangle, so one per byte still lets each be instanced some 20 times; 16 per byte
- * let a 4 MB strip of 1-byte indices, instanced, make 2^26 triangles (issue 39). */
+/* Triangles one file may make, every copy included: a small file that copies a large
+ * mesh many times must not exhaust memory (each triangle costs clpt a few hundred
+ * bytes with its shading record and tree), so the count is bounded by the input's
+ * size, and absolutely. A real file's mesh data takes 20 bytes or more per triangle,
+ * so one per byte still lets each be copied some 20 times; 16 per byte let a 4 MB
+ * strip of 1-byte indices in 16 nodes make 2^26 triangles (issue 39). A mesh in
+ * several nodes is an object now, its triangles counted once; copies remain for
+ * meshes that emit light and for a file read inside a clpt object. */
 #define GLTF_TRIANGLES_PER_BYTE 1u
 #define GLTF_MAX_TRIANGLES ((size_t)1 << 26)
 

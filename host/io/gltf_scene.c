@@ -162,7 +162,7 @@ static Status triangles_count(Gltf *g, size_t n, const char *node, const char *j
     }
     return error_set(g->err, ST_INPUT, "%s: %s (in %s): its %zu triangles bring the file's to %llu, more than the %zu "
                      "a file of its size may make (2^20 and one per byte of the file and its buffers, at most 2^26; "
-                     "every node's instance counts)", g->path, jp, node, n,
+                     "every node's copy counts)", g->path, jp, node, n,
                      (unsigned long long)g->triangles + n, g->max_triangles);
 }
 

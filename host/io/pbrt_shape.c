@@ -607,7 +607,8 @@ Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw)
         return st;
     if (pbrt_grow((void **)&p->objects, &p->cap_objects, p->n_objects + 1, sizeof(PObject)))
         return error_set(p->err, ST_INTERNAL, "out of memory");
-    if ((st = empty || emits ? object_take(p, &o) : object_keep(p, &o))) return st;
+    if ((st = empty || emits ? object_take(p, &o) : object_keep(p, &o)))
+        return st == ST_INPUT ? lex_error_at(lx, kw, p->err, "%s", p->err->msg) : st;
     /* a name defined again replaces the earlier object, for the instances after it */
     if (strmap_set(&p->object_by_name, p->obj_name.text, p->obj_name.len, (uint32_t)p->n_objects)) {
         free(o.spheres);

@@ -20,9 +20,8 @@
 #include "dist/merge.h"
 #include "dist/mpi_driver.h"
 #include "dist/mpi_job.h"
+#include "job_options.h"
 #include "render/adaptive.h"
-#include "render/checkpoint.h"
-#include "render/denoise.h"
 #include "render/display.h"
 #include "device/device.h"
 #include "device/ocl_program.h"
@@ -31,7 +30,7 @@
 #include "options.h"
 #include "render/passes.h"
 #include "base/progress.h"
-#include "render/render_scene.h"
+#include "render/render_job.h"
 #include "scene/scene.h"
 #include "scene_options.h"
 #include "render/schedule.h"
@@ -91,22 +90,15 @@ static void install_signal_handlers(StopVoice voice)
     sigaction(SIGTERM, &sa, NULL);
 }
 
+/* What the render's hooks need of the run: its output and the live display (the job,
+ * render_job.h, holds the rest, and hands this to the hooks as its `user`). */
 typedef struct {
     const char *output;
-    int quiet;
     int progressive_failed;
     ImageStyle style;
-    const char *checkpoint;       /* NULL: none */
-    CheckpointId checkpoint_id;
-    int checkpoint_failed;
     double progressive_seconds;   /* 0: no progressive output */
     double last_progressive;      /* when the output was last rewritten */
     Display *display;             /* --display-server; NULL: none, or the connection was lost */
-    /* --noise-threshold: the render's settings (NULL: uniform sampling), and when the
-     * rounds last wrote the image and the checkpoint */
-    const AdaptiveSettings *adaptive;
-    double tick_seconds, checkpoint_seconds;
-    double last_tick, last_checkpoint;
 } RenderContext;
 
 /* On a terminal the progress bar may be on the line: the warning first clears it. In
@@ -165,9 +157,9 @@ static void display_send_film(RenderContext *ctx, const Film *film)
 /* The periodic tick: progressive output rewrites the image (atomically, so a viewer
  * never sees half a file) every progressive_seconds, a failure reported once and not
  * stopping the render; the live display gets the image every tick. */
-static void on_progress_tick(void *vctx, const ScheduleSnapshot *snap)
+static void on_progress_tick(void *vjob, const ScheduleSnapshot *snap)
 {
-    RenderContext *ctx = vctx;
+    RenderContext *ctx = ((RenderJob *)vjob)->user;
     display_send_film(ctx, snap->film);
     double now = timer_now();
     /* ticks come at the progressive interval or sooner; the 0.1% slack keeps a tick that
@@ -187,45 +179,21 @@ static void on_denoised(void *vctx, const float *rgb)
     display_send(vctx, rgb);
 }
 
-/* Periodic checkpoints; a failure is reported once (the next one may succeed) and does
- * not stop the render. */
-static void on_checkpoint(void *vctx, const ScheduleSnapshot *snap)
+/* After each round of an adaptive render: progressive output, at most as often as its
+ * interval (a round's film is whole; the scheduler's snapshots in the middle of one
+ * are not the render's state). The job writes the checkpoints. */
+static void on_adaptive_round(void *vjob, const AdaptiveFilm *af)
 {
-    RenderContext *ctx = vctx;
+    RenderContext *ctx = ((RenderJob *)vjob)->user;
     Error err = { 0 };
-    if (checkpoint_write(ctx->checkpoint, &ctx->checkpoint_id, snap->film, snap->done, snap->n_done, &err) != ST_OK &&
-        !ctx->checkpoint_failed) {
-        ctx->checkpoint_failed = 1;
+    double now = timer_now();
+    if (ctx->progressive_seconds <= 0.0 || now - ctx->last_progressive < ctx->progressive_seconds) return;
+    ctx->last_progressive = now;
+    if (adaptive_film_write(af, ctx->output, &ctx->style, &err) != ST_OK && !ctx->progressive_failed) {
+        ctx->progressive_failed = 1;
         print_warning(NULL, err.msg);
     }
     error_clear(&err);
-}
-
-/* After each round of an adaptive render: progressive output and checkpoints, at most
- * as often as their intervals (a round's film is whole; the scheduler's snapshots in
- * the middle of one are not the render's state). */
-static void on_adaptive_round(void *vctx, const AdaptiveFilm *af)
-{
-    RenderContext *ctx = vctx;
-    Error err = { 0 };
-    double now = timer_now();
-    if (ctx->tick_seconds > 0.0 && now - ctx->last_tick >= ctx->tick_seconds) {
-        ctx->last_tick = now;
-        if (adaptive_film_write(af, ctx->output, &ctx->style, &err) != ST_OK && !ctx->progressive_failed) {
-            ctx->progressive_failed = 1;
-            print_warning(NULL, err.msg);
-        }
-        error_clear(&err);
-    }
-    if (ctx->checkpoint && now - ctx->last_checkpoint >= ctx->checkpoint_seconds) {
-        ctx->last_checkpoint = now;
-        if (checkpoint_write_adaptive(ctx->checkpoint, &ctx->checkpoint_id, af, ctx->adaptive, &err) != ST_OK &&
-            !ctx->checkpoint_failed) {
-            ctx->checkpoint_failed = 1;
-            print_warning(NULL, err.msg);
-        }
-        error_clear(&err);
-    }
 }
 
 /* Output name when -o is not given: the scene's file name with .png, in the current
@@ -261,19 +229,7 @@ typedef struct {
     ImageStyle style;
     int bare_mesh;
     Scene scene;
-    RenderScene rs;
-    Film film;
-    AdaptiveSettings adapt;       /* --noise-threshold: adaptive sampling, into af */
-    int adaptive;
-    AdaptiveFilm af;
-    Device **devs;
-    size_t n_devs;
-    size_t n_local_devs;          /* devs[0..n_local_devs): this process's own, not MPI ranks */
-    Denoiser *denoiser;           /* --denoise: opened before the render */
-    ScheduleConfig cfg;
-    ScheduleStats stats;
-    Status render_st;
-    Checkpoint resume;
+    RenderJob job;                /* the render itself (render/render_job.h) */
     RenderContext ctx;
     double t_start;
     FILE *report;                 /* --stats and --profile: stdout, stderr when the image goes there */
@@ -281,25 +237,17 @@ typedef struct {
 
 static void run_free(Run *r)
 {
-    schedule_stats_free(&r->stats);
-    for (size_t i = 0; i < r->n_devs; i++) device_close(r->devs[i]);
-    free(r->devs);
-    denoiser_close(r->denoiser);
+    render_job_free(&r->job);
     display_close(r->ctx.display);
-    film_free(&r->film);
-    adaptive_film_free(&r->af);
-    checkpoint_free(&r->resume);
-    render_scene_free(&r->rs);
     scene_free(&r->scene);
     free(r->default_out);
 }
 
-/* The chosen devices (device_open_all), each given the scene. */
-static Status open_devices(const Options *o, const DeviceScene *ds, Device ***out, size_t *n_out, Error *err)
+/* The chosen devices, each given the scene; "compiling kernels..." said unless quiet. */
+static Status open_devices(Run *r, Error *err)
 {
-    DeviceConfig cfg = { o->threads, o->kernel_dir, o->wave_paths, o->profile, o->wave_launch };
-    ocl_program_announce_builds(!o->quiet);
-    return device_open_all(o->device_spec, &cfg, ds, print_warning, NULL, out, n_out, err);
+    ocl_program_announce_builds(!r->o.quiet);
+    return render_job_open_devices(&r->job, err);
 }
 
 /* --help, --version and --list-devices: print and exit. *done tells whether one ran. */
@@ -404,11 +352,11 @@ static Status outputs_from_scene(Run *r, Error *err)
     return outputs_check(r, err);
 }
 
-/* --denoise: the library is loaded before anything slow, so that a machine without it
- * says so in a second instead of after the render. */
-static Status denoise_prepare(Run *r, Error *err)
+/* The render job from the command line; the program's warnings, and its hooks' state. */
+static void job_init(Run *r)
 {
-    return r->o.denoise ? denoiser_open(&r->denoiser, err) : ST_OK;
+    RenderJobSettings set = job_options_settings(&r->o);
+    render_job_init(&r->job, &set, print_warning, NULL, &r->ctx);
 }
 
 /* --display-server: connected once the image's size is known, before the render. A
@@ -418,7 +366,7 @@ static void display_prepare(Run *r)
     if (!r->o.display_server) return;
     const char *base = strrchr(r->output, '/');
     Error err = { 0 };
-    if (display_open(r->o.display_server, base ? base + 1 : r->output, r->film.width, r->film.height,
+    if (display_open(r->o.display_server, base ? base + 1 : r->output, r->job.film.width, r->job.film.height,
                      &r->ctx.display, &err) != ST_OK)
         print_warning(NULL, err.msg);
     error_clear(&err);
@@ -450,116 +398,28 @@ static Status scene_apply_options(Run *r, Error *err)
     return st;
 }
 
-/* How the whitted integrator places a pixel's samples at `spp` (render_scene_strata). */
-static void grid_words(uint spp, char *buf, size_t size)
-{
-    uint m = render_scene_strata(spp);
-    if (m >= 2u) snprintf(buf, size, "a %ux%u grid", m, m);
-    else snprintf(buf, size, "%s", m ? "uniform jitter" : "the pixel centre");
-}
-
-/* A whitted render places its samples in an m x m grid when its samples per pixel are
- * m^2 (render_scene_strata): grown to a count with another grid, its first samples
- * would be other samples than the checkpoint's. (The render key differs then too; this
- * says why.) */
-static Status resume_check_grid(const Run *r, const Checkpoint *ck, Error *err)
-{
-    uint had = ck->id.spp, want = r->scene.image.spp;
-    if (r->scene.integrator != INTEGRATOR_WHITTED || had >= want ||
-        render_scene_strata(had) == render_scene_strata(want))
-        return ST_OK;
-    char a[32], b[32];
-    grid_words(had, a, sizeof a);
-    grid_words(want, b, sizeof b);
-    return error_set(err, ST_INPUT, "checkpoint '%s' is a whitted render of %u samples per pixel, placed in %s; %u "
-                     "would be placed in %s, so it cannot grow to %u (resume with --spp %u, or a count placed "
-                     "alike)", r->o.resume_path, had, a, want, b, want, had);
-}
-
-/* --resume: the checkpoint, checked against this render, becomes the film's start. */
-static Status resume_film(Run *r, Checkpoint *ck, Error *err)
-{
-    const char *path = r->o.resume_path;
-    Status st = checkpoint_read(path, ck, err);
-    if (st == ST_OK) st = resume_check_grid(r, ck, err);
-    if (st == ST_OK) st = checkpoint_check(ck, path, &r->ctx.checkpoint_id, err);
-    if (st == ST_OK) st = checkpoint_check_adaptive(ck, path, r->adaptive ? &r->adapt : NULL, err);
-    if (st != ST_OK) return st;
-    Film *film = &r->film;
-    size_t n = (size_t)film->width * film->height;
-    memcpy(film->sum, ck->film.sum, n * 3u * sizeof *film->sum);
-    film->samples = ck->film.samples;
-    if (r->adaptive) {
-        memcpy(r->af.film.sum, ck->film.sum, n * 3u * sizeof *film->sum);
-        memcpy(r->af.odd, ck->odd, n * 3u * sizeof *r->af.odd);
-        memcpy(r->af.spp, ck->pixel_spp, n * sizeof *r->af.spp);
-        r->af.film.samples = ck->film.samples;
-    }
-    if (!r->o.quiet && ck->id.spp < r->ctx.checkpoint_id.spp)
-        fprintf(stderr, "clpt: resuming from '%s': %llu samples per pixel already done, growing the render from %u "
-                "to %u\n", path, (unsigned long long)film->samples, ck->id.spp, r->ctx.checkpoint_id.spp);
-    else if (!r->o.quiet)
-        fprintf(stderr, "clpt: resuming from '%s': %llu of %u samples per pixel already done\n", path,
-                (unsigned long long)film->samples, r->ctx.checkpoint_id.spp);
-    return ST_OK;
-}
-
-/* A part (--sample-range) resumed from a checkpoint must not carry samples outside
- * its range: the part's film would then hold samples another part renders too. */
-static Status resume_check_range(const Options *o, const Checkpoint *ck, Error *err)
-{
-    if (o->range_end < 0) return ST_OK;
-    for (size_t i = 0; i < ck->n_done; i++) {
-        Batch b = ck->done[i];
-        if ((long)b.first < o->range_first || (long)b.first + (long)b.count > o->range_end)
-            return error_set(err, ST_INPUT, "checkpoint '%s' holds samples [%u,%u), outside --sample-range %ld:%ld; "
-                             "resume it with the range it was made with", o->resume_path, b.first, b.first + b.count,
-                             o->range_first, o->range_end);
-    }
-    return ST_OK;
-}
-
 /* kd-tree and device buffers, the film (from --resume), and the render's identity where
- * something compares or records it (a checkpoint, a resume, the ranks of an MPI job:
- * `keyed`): it hashes every scene buffer, a tenth of a second for a million triangles. */
+ * something compares or records it (render_job_prepare_film). --stats describes the
+ * scene as the devices get it. */
 static Status render_prepare(Run *r, int worker, int keyed, Error *err)
 {
-    Status st;
-    if ((st = render_scene_prepare(&r->scene, 0, &r->rs, err))) return st;
-    const DeviceScene *ds = &r->rs.ds;
-    if (r->o.stats == STATS_TEXT && !worker) render_stats_print_scene(r->report, &r->scene, &r->rs);
-    if (keyed || r->o.checkpoint_path || r->o.resume_path) checkpoint_id(ds, r->scene.image.spp, &r->ctx.checkpoint_id);
-    if ((st = film_init(&r->film, ds->params.width, ds->params.height, err))) return st;
-    r->adaptive = r->o.noise_threshold > 0.0;
-    r->adapt = (AdaptiveSettings){ r->o.noise_threshold, r->o.min_spp };
-    if (r->adaptive && (st = adaptive_film_init(&r->af, ds->params.width, ds->params.height, err))) return st;
-    if (!r->o.resume_path || worker) return ST_OK;
-    if ((st = resume_film(r, &r->resume, err))) return st;
-    return resume_check_range(&r->o, &r->resume, err);
+    Status st = render_job_prepare_scene(&r->job, &r->scene, err);
+    if (st == ST_OK && r->o.stats == STATS_TEXT && !worker) render_stats_print_scene(r->report, &r->scene, &r->job.rs);
+    return st == ST_OK ? render_job_prepare_film(&r->job, keyed, worker, err) : st;
 }
 
 /* ------------------------------------------------------------------ render */
 
+/* The job's scheduler settings, and the program's hooks: the progress bar, the stop
+ * signal, progressive output and the live display. */
 static void render_configure(Run *r)
 {
     const Options *o = &r->o;
-    ScheduleConfig *cfg = &r->cfg;
+    RenderJob *job = &r->job;
+    ScheduleConfig *cfg = &job->cfg;
+    render_job_configure(job);
     r->ctx.output = r->output;
-    r->ctx.quiet = o->quiet;
-    r->ctx.checkpoint = o->checkpoint_path;
     r->ctx.style = r->style;
-    memset(cfg, 0, sizeof *cfg);
-    cfg->spp = r->scene.image.spp;
-    cfg->done = r->resume.done;
-    cfg->n_done = r->resume.n_done;
-    if (o->range_end >= 0) {
-        cfg->range_first = (uint)o->range_first;
-        cfg->range_end = (uint)o->range_end;
-    }
-    cfg->on_checkpoint = o->checkpoint_path ? on_checkpoint : NULL;
-    cfg->checkpoint_seconds = o->checkpoint_seconds;
-    cfg->time_limit = o->time_limit;
-    cfg->fixed_batch = o->batch;
     cfg->show_progress = progress_should_enable(o->quiet);
     cfg->stop = &stop_requested;
     /* one tick serves both: the display's every second (or sooner, for progressive
@@ -569,35 +429,24 @@ static void render_configure(Run *r)
     cfg->on_tick = o->progressive_seconds > 0.0 || r->ctx.display ? on_progress_tick : NULL;
     cfg->tick_seconds = !r->ctx.display ? o->progressive_seconds
                       : o->progressive_seconds > 0.0 && o->progressive_seconds < 1.0 ? o->progressive_seconds : 1.0;
-    cfg->on_warning = print_warning;
-    cfg->ctx = &r->ctx;
-    r->ctx.adaptive = r->adaptive ? &r->adapt : NULL;
-    r->ctx.tick_seconds = o->progressive_seconds;
-    r->ctx.checkpoint_seconds = o->checkpoint_seconds;
-    r->ctx.last_tick = r->ctx.last_checkpoint = timer_now();
+    job->on_round = on_adaptive_round;
 }
 
-/* The render itself. Its status is kept apart: after a failure or an interrupt, what
- * was finished is still saved. */
+/* The render itself, this process's devices joined by the other ranks' under MPI. Its
+ * status is kept apart (job.render_st): after a failure or an interrupt, what was
+ * finished is still saved. */
 static void render_run(Run *r, Dist *dist, Error *err)
 {
     install_signal_handlers(dist->active ? STOP_SAY_MPI : STOP_SAY);
     render_configure(r);
-    r->n_local_devs = r->n_devs;
     if (dist->active) {
         /* the other ranks join the render as devices of this one */
         dist->spp = r->scene.image.spp;
-        r->render_st = dist_add_remote_devices(dist, r->film.width * r->film.height, &r->devs, &r->n_devs, err);
-        if (r->render_st != ST_OK) return;
+        r->job.render_st = dist_add_remote_devices(dist, r->job.film.width * r->job.film.height, &r->job.devs,
+                                                   &r->job.n_devs, err);
+        if (r->job.render_st != ST_OK) return;
     }
-    if (r->adaptive) {
-        AdaptiveRun run = { r->devs, r->n_devs, &r->rs, &r->cfg, on_adaptive_round, &r->ctx };
-        r->render_st = adaptive_run(&run, &r->adapt, &r->af, &r->stats, err);
-        /* what the results below ask of the film: its count (the image is af's) */
-        r->film.samples = r->af.film.samples;
-        return;
-    }
-    r->render_st = schedule_run(r->devs, r->n_devs, &r->cfg, &r->film, &r->stats, err);
+    render_job_run(&r->job, err);
 }
 
 /* ------------------------------------------------------------------ results */
@@ -606,8 +455,8 @@ static void render_run(Run *r, Dist *dist, Error *err)
  * helps nobody), and the exit status says so. */
 static Status results_nothing_rendered(const Run *r, Error *err)
 {
-    if (r->render_st != ST_OK) return r->render_st;
-    if (r->stats.interrupted) {
+    if (r->job.render_st != ST_OK) return r->job.render_st;
+    if (r->job.stats.interrupted) {
         fprintf(stderr, "clpt: interrupted before the first batch finished: nothing was rendered, and '%s' was "
                         "left as it was\n", r->output);
         return ST_INTERRUPTED;
@@ -616,29 +465,6 @@ static Status results_nothing_rendered(const Run *r, Error *err)
                      "the time limit of %g s was reached before the first batch finished: nothing was rendered, "
                      "and '%s' was left as it was (allow more time, or a smaller --batch)",
                      r->o.time_limit, r->output);
-}
-
-/* The last checkpoint holds everything finished: after an interrupt, a time limit or
- * a failure it is what a resume starts from, so it is written before the image, and
- * failing to write it is then an error. After a complete render the image is what
- * matters, and a failed checkpoint only a warning. */
-static Status results_write_checkpoint(Run *r, Error *cerr)
-{
-    if (!r->o.checkpoint_path) return ST_OK;
-    Status cst = r->adaptive ? checkpoint_write_adaptive(r->o.checkpoint_path, &r->ctx.checkpoint_id, &r->af,
-                                                         &r->adapt, cerr)
-                 : batch_set_total(&r->stats.done) == r->film.samples
-                     ? checkpoint_write(r->o.checkpoint_path, &r->ctx.checkpoint_id, &r->film,
-                                        r->stats.done.ranges, r->stats.done.n, cerr)
-                     : error_set(cerr, ST_INTERNAL, "the record of finished samples is incomplete; "
-                                                    "no final checkpoint written");
-    int complete = r->render_st == ST_OK && !r->stats.interrupted && !r->stats.time_up;
-    if (cst != ST_OK && complete) {
-        print_warning(NULL, cerr->msg);
-        error_clear(cerr);
-        return ST_OK;
-    }
-    return cst;
 }
 
 /* The output as the summary names it. */
@@ -650,9 +476,9 @@ static const char *output_name(const char *output)
 /* --stats=json: the run as one object (stats.h). */
 static void results_print_json(const Run *r, const char *result)
 {
-    RenderStatsRun run = { clpt_version_text, r->o.scene_path, output_name(r->output), result, r->film.width,
-                           r->film.height, r->scene.image.spp, timer_now() - r->t_start };
-    render_stats_print_json(r->report, &run, &r->scene, &r->stats);
+    RenderStatsRun run = { clpt_version_text, r->o.scene_path, output_name(r->output), result, r->job.film.width,
+                           r->job.film.height, r->scene.image.spp, timer_now() - r->t_start };
+    render_stats_print_json(r->report, &run, &r->scene, &r->job.stats);
 }
 
 /* An adaptive render's samples per pixel in words: "16..256 spp (mean 41.2)". */
@@ -671,52 +497,51 @@ static void adaptive_spp_words(const AdaptiveFilm *af, char *buf, size_t size)
 
 static void results_print_summary(const Run *r)
 {
-    const ScheduleStats *s = &r->stats;
+    const RenderJob *job = &r->job;
+    const Film *film = &job->film;
+    const ScheduleStats *s = &job->stats;
     const char *result = s->interrupted ? "interrupted" : (s->time_up ? "time limit reached" : "rendered");
     if (r->o.stats == STATS_JSON) results_print_json(r, result);
-    else if (r->o.stats || r->o.profile) render_stats_print_run(r->report, s, r->scene.image.spp, r->devs, r->n_devs);
+    else if (r->o.stats || r->o.profile) render_stats_print_run(r->report, s, r->scene.image.spp, job->devs, job->n_devs);
     if (r->o.profile) {
-        render_stats_print_profile(r->report, s, r->devs, r->n_devs);
+        render_stats_print_profile(r->report, s, job->devs, job->n_devs);
         if (r->scene.image.split > 1 && r->scene.integrator == INTEGRATOR_PATH)
             fprintf(r->report, "profile: with --split, OpenCL devices run each path as one kernel (k_path), whose "
                     "time is all under shade\n");
     }
-    if (r->o.quiet && r->render_st == ST_OK && !s->interrupted) return;
+    if (r->o.quiet && job->render_st == ST_OK && !s->interrupted) return;
     double secs = s->seconds > 0.0 ? s->seconds : 1e-9;
-    if (r->adaptive) {
+    if (job->adaptive) {
         char words[96];
-        adaptive_spp_words(&r->af, words, sizeof words);
+        adaptive_spp_words(&job->af, words, sizeof words);
         fprintf(stderr, "clpt: %s%s %ux%u, %s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n",
-                result, strcmp(result, "rendered") ? ":" : "", r->film.width, r->film.height, words, s->seconds,
+                result, strcmp(result, "rendered") ? ":" : "", film->width, film->height, words, s->seconds,
                 timer_now() - r->t_start, (double)s->samples / secs / 1e6, (double)s->rays / secs / 1e6,
                 output_name(r->output));
         return;
     }
     fprintf(stderr, "clpt: %s%s %ux%u, %llu spp%s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n",
-            result, strcmp(result, "rendered") ? ":" : "", r->film.width,
-            r->film.height, (unsigned long long)r->film.samples,
-            r->film.samples < r->scene.image.spp ? " (partial)" : "", s->seconds, timer_now() - r->t_start,
+            result, strcmp(result, "rendered") ? ":" : "", film->width,
+            film->height, (unsigned long long)film->samples,
+            film->samples < r->scene.image.spp ? " (partial)" : "", s->seconds, timer_now() - r->t_start,
             (double)s->samples / secs / 1e6, (double)s->rays / secs / 1e6, output_name(r->output));
 }
 
-/* The adaptive pass and the auxiliary images, after a complete main image. */
+/* The adaptive pass, the denoiser and the auxiliary images, after a complete main
+ * image (passes.h). */
 static Status results_run_passes(Run *r, Error *err)
 {
-    size_t n = (size_t)r->film.width * r->film.height * 3u;
-    float *rgb = malloc(n * sizeof *rgb);
+    RenderJob *job = &r->job;
+    float *rgb = malloc((size_t)job->film.width * job->film.height * 3u * sizeof *rgb);
     if (!rgb) return error_set(err, ST_INTERNAL, "out of memory");
-    if (r->adaptive) adaptive_film_resolve(&r->af, rgb);
-    else film_resolve(&r->film, rgb);
-    ScheduleConfig pcfg = r->cfg;
-    pcfg.show_progress = 0;
-    /* a pass renders all its samples: those a resumed checkpoint held were the main
-     * image's, not the pass's (without this, --aov after --resume got only the rest) */
-    pcfg.done = NULL;
-    pcfg.n_done = 0;
-    /* the passes' parameters reach only this process's devices (not MPI ranks') */
-    PassContext pc = { r->devs, r->n_local_devs, &r->rs, &pcfg, r->denoiser, on_denoised, &r->ctx };
+    render_job_resolve(job, rgb);
+    ScheduleConfig pcfg;
+    PassContext pc;
+    render_job_pass_context(job, &pcfg, &pc);
+    pc.on_denoised = on_denoised;
+    pc.on_denoised_ctx = &r->ctx;
     PassRequest q = pass_request(&r->o);
-    Status st = passes_after_image(&q, &pc, r->output, &r->style, rgb, (uint)r->film.samples, err);
+    Status st = passes_after_image(&q, &pc, r->output, &r->style, rgb, (uint)job->film.samples, err);
     free(rgb);
     if (st == ST_OK && stop_requested) st = ST_INTERRUPTED;
     return st;
@@ -727,15 +552,15 @@ static Status results_run_passes(Run *r, Error *err)
  * interrupt, else a write's. */
 static Status results_write(Run *r, Error *err)
 {
-    if (r->film.samples == 0) return results_nothing_rendered(r, err);
-    Status st = r->render_st != ST_OK ? r->render_st : (r->stats.interrupted ? ST_INTERRUPTED : ST_OK);
+    RenderJob *job = &r->job;
+    if (job->film.samples == 0) return results_nothing_rendered(r, err);
+    Status st = job->render_st != ST_OK ? job->render_st : (job->stats.interrupted ? ST_INTERRUPTED : ST_OK);
     Error next = { 0 };
-    st = keep_first(st, err, results_write_checkpoint(r, &next), &next);
-    Status image_st = r->adaptive ? adaptive_film_write(&r->af, r->output, &r->style, &next)
-                                  : film_write(&r->film, r->output, &r->style, &next);
+    st = keep_first(st, err, render_job_final_checkpoint(job, &next), &next);
+    Status image_st = render_job_write_image(job, r->output, &r->style, &next);
     st = keep_first(st, err, image_st, &next);
     if (image_st != ST_OK) return st;   /* the summary's "-> OUTPUT" would be untrue */
-    display_send_film(&r->ctx, &r->film);
+    display_send_film(&r->ctx, &job->film);
     results_print_summary(r);
     if (st == ST_OK && (r->o.adaptive > 0.0 || r->o.aovs || r->o.denoise)) st = results_run_passes(r, err);
     return st;
@@ -758,7 +583,7 @@ static Status rank_prepare(void *vr, int worker, int receive, Error *err)
     Status st = ST_OK;
     if (!worker) st = outputs_choose(r, err);
     if (st == ST_OK && !worker) st = outputs_check(r, err);
-    if (st == ST_OK && !worker) st = denoise_prepare(r, err);
+    if (st == ST_OK && !worker) st = render_job_open_denoiser(&r->job, err);
     if (st == ST_OK && !receive) st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
     if (st == ST_OK && !worker) st = outputs_from_scene(r, err);
     if (st == ST_OK && !receive) st = scene_apply_options(r, err);
@@ -770,7 +595,7 @@ static Status rank_prepare(void *vr, int worker, int receive, Error *err)
 static Status rank_open_devices(void *vr, Error *err)
 {
     Run *r = vr;
-    return open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
+    return open_devices(r, err);
 }
 
 static void rank_worker_starts(void *vr)
@@ -790,8 +615,9 @@ static Status rank_render(void *vr, Dist *dist, Error *err)
 static Status run_rank(Run *r, Dist *dist, Error *err)
 {
     if (dist->rank > 0) r->o.quiet = 1;
+    job_init(r);
     DistRankSteps s = { r, rank_prepare, rank_open_devices, rank_worker_starts, rank_render,
-                        &r->rs.ds, &r->scene.image.spp, &r->ctx.checkpoint_id, &r->devs, &r->n_devs,
+                        &r->job.rs.ds, &r->scene.image.spp, &r->job.checkpoint_id, &r->job.devs, &r->job.n_devs,
                         &stop_requested, r->o.stats == STATS_TEXT ? r->report : NULL };
     return dist_run_rank(dist, &s, err);
 }
@@ -803,15 +629,16 @@ static Status run_interactive(Run *r, Error *err)
     Status st = viewer_open_display(err);
     if (st != ST_OK) return st;
     if (!r->o.wave_paths) r->o.wave_paths = VIEWER_WAVE_PATHS;
+    job_init(r);
     st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
     if (st == ST_OK) st = scene_apply_options(r, err);
     /* the viewer shows the whole image: a scene's crop window (pbrt's) is for renders
      * to a file, and --crop is refused with --interactive */
     r->scene.crop.kind = CROP_NONE;
     if (st == ST_OK) st = render_prepare(r, 0, 0, err);
-    if (st == ST_OK) st = open_devices(&r->o, &r->rs.ds, &r->devs, &r->n_devs, err);
+    if (st == ST_OK) st = open_devices(r, err);
     if (st == ST_OK) {
-        ViewerConfig vc = { r->o.scene_path, &r->scene, &r->rs, r->devs, r->n_devs,
+        ViewerConfig vc = { r->o.scene_path, &r->scene, &r->job.rs, r->job.devs, r->job.n_devs,
                             { r->o.threads, r->o.kernel_dir, r->o.wave_paths, 0, r->o.wave_launch }, r->style,
                             r->o.batch, r->o.stats, r->o.quiet };
         st = viewer_run(&vc, err);
@@ -846,15 +673,17 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
         return st;
     }
     if (r.o.interactive) return run_interactive(&r, err);
+    job_init(&r);
     st = outputs_choose(&r, err);
     if (st == ST_OK) st = outputs_check(&r, err);
-    if (st == ST_OK) st = denoise_prepare(&r, err);
+    /* --denoise's library loaded before anything slow: a machine without it says so at once */
+    if (st == ST_OK) st = render_job_open_denoiser(&r.job, err);
     if (st == ST_OK) st = load_scene_input(&r.o, &r.scene, &r.bare_mesh, err);
     if (st == ST_OK) st = outputs_from_scene(&r, err);
     if (st == ST_OK) st = scene_apply_options(&r, err);
     if (st == ST_OK) st = render_prepare(&r, 0, 0, err);
     if (st == ST_OK) display_prepare(&r);
-    if (st == ST_OK) st = open_devices(&r.o, &r.rs.ds, &r.devs, &r.n_devs, err);
+    if (st == ST_OK) st = open_devices(&r, err);
     if (st == ST_OK) {
         render_run(&r, dist, err);
         st = results_write(&r, err);

@@ -147,7 +147,9 @@ CLPT_API clpt_status clpt_render_size(clpt_scene *scene, const clpt_settings *se
  *   depth   width * height floats, or NULL: the mean distance to the first hit, +inf
  *           where nothing is hit
  * An auxiliary image is rendered when its pointer is not NULL (after the main image,
- * with as many samples per pixel). `spp` receives the samples per pixel in rgb. */
+ * with as many samples per pixel). `spp` receives the samples per pixel in rgb (with
+ * the setting "noise-threshold", the most a pixel got). With "denoise", rgb is the
+ * denoised image (docs/api.md). */
 typedef struct {
     unsigned width, height;
     float *rgb;

@@ -62,6 +62,23 @@ def test_scene_set_same_bits_as_set_flag(tmp_path):
     assert not np.array_equal(img, clpt.render(SCENE, device="scalar", **SMALL))
 
 
+def test_noise_threshold_same_bits_as_command_line(tmp_path):
+    settings = dict(SMALL, spp=48)
+    img = clpt.render(SCENE, device="scalar", noise_threshold=0.05, min_spp=8, **settings)
+    ref = cli(tmp_path, "--device", "scalar", "--spp", "48", "--noise-threshold", "0.05", "--min-spp", "8")
+    assert np.array_equal(img, ref)
+
+
+def test_denoise_same_bits_as_command_line(tmp_path, monkeypatch):
+    oidn = os.path.join(REPO, "build", "oidn", "lib")
+    if not os.path.isdir(oidn):
+        pytest.skip("no Open Image Denoise in build/oidn (sh tools/deps.sh oidn)")
+    # the library looks beside the program, which here is python: name the folder
+    monkeypatch.setenv("CLPT_OIDN_DIR", oidn)
+    img = clpt.render(SCENE, device="scalar", denoise=True, **SMALL)
+    assert np.array_equal(img, cli(tmp_path, "--device", "scalar", "--denoise"))
+
+
 def test_aovs():
     out = clpt.load(SCENE, device="scalar").render(aovs=("albedo", "normal", "depth"), **SMALL)
     assert out["rgb"].shape == (48, 64, 3) and out["depth"].shape == (48, 64)

@@ -163,8 +163,9 @@ $(BUILD)/$(PROG): $(BUILD)/host/main.o $(BUILD)/version.o $(BUILD)/lib$(PROG).a
 
 # ---------------------------------------------------------------- the shared library
 # libclpt.so.MAJOR.MINOR.PATCH (SONAME libclpt.so.MAJOR), the version read from the public
-# header. Everything but the viewer (SDL2), the distributed renders (MPI) and main: the
-# library links neither SDL2 nor MPI.
+# header. Everything but the viewer (SDL2), the distributed renders (MPI) and the
+# program's own files (main, its output files, its stop signals): the library links
+# neither SDL2 nor MPI, and keeps no global state.
 API_VERSION := $(VERSION)
 API_MAJOR   := $(firstword $(subst ., ,$(API_VERSION)))
 SO_NAME     := lib$(PROG).so.$(API_MAJOR)
@@ -172,7 +173,8 @@ SO_FILE     := $(BUILD)/lib$(PROG).so.$(API_VERSION)
 # Every symbol the library needs resolved at its link (-z defs), except under the
 # sanitizers, whose runtime the program loading the library provides.
 SO_DEFS     ?= -Wl,--no-undefined -Wl,-z,defs
-SO_OBJ      := $(filter-out $(BUILD)/host/viewer/% $(BUILD)/host/dist/%,$(HOST_OBJ))
+SO_OBJ      := $(filter-out $(BUILD)/host/viewer/% $(BUILD)/host/dist/% $(BUILD)/host/outputs.o \
+                            $(BUILD)/host/stop_signal.o,$(HOST_OBJ))
 
 lib: $(BUILD)/lib$(PROG).so
 

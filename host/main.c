@@ -15,8 +15,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "base/atomic_file.h"
-#include "base/file_id.h"
 #include "dist/merge.h"
 #include "dist/mpi_driver.h"
 #include "dist/mpi_job.h"
@@ -28,67 +26,19 @@
 #include "render/film.h"
 #include "io/image_write.h"
 #include "options.h"
+#include "outputs.h"
 #include "render/passes.h"
 #include "base/progress.h"
 #include "render/render_job.h"
 #include "scene/scene.h"
 #include "scene_options.h"
+#include "stop_signal.h"
 #include "render/schedule.h"
 #include "render/stats.h"
 #include "io/scene_load.h"
 #include "base/timer.h"
 #include "version.h"
 #include "viewer/viewer.h"
-
-static volatile sig_atomic_t stop_requested;
-/* What the first stop prints, chosen before the handlers are installed (the handler
- * reads nothing else but the flag); NULL: nothing. */
-static const char *stop_message;
-static size_t stop_message_len;
-
-/* Who says that the render stops. */
-typedef enum {
-    STOP_SAY,       /* one process */
-    STOP_SAY_MPI,   /* rank 0 of an MPI job */
-    STOP_QUIET      /* an MPI worker: rank 0 says it */
-} StopVoice;
-
-/* The first SIGINT or SIGTERM stops the render within about a second and writes what
- * is finished (exit 6); a second one, of either kind, ends the process at once by the
- * signal's default action, writing nothing more. */
-static void on_stop_signal(int sig)
-{
-    if (stop_requested) {
-        signal(sig, SIG_DFL);
-        raise(sig);   /* delivered as soon as this handler returns */
-        return;
-    }
-    stop_requested = 1;
-    if (!stop_message) return;
-    ssize_t w = write(STDERR_FILENO, stop_message, stop_message_len);
-    (void)w;
-}
-
-static void install_signal_handlers(StopVoice voice)
-{
-    /* on a terminal the progress bar holds the line: start a fresh one */
-    static const char msg[] = "\nclpt: stopping: writing what is finished (press Ctrl-C again to quit at once)\n";
-    /* mpirun ends a job with SIGTERM to every rank also when one of them died */
-    static const char mpi_msg[] = "\nclpt: stopping on SIGINT/SIGTERM (from you, or from mpirun because another MPI "
-                                  "rank died; mpirun names it): writing what is finished\n";
-    size_t skip = isatty(STDERR_FILENO) ? 0 : 1;
-    stop_message = NULL;
-    if (voice != STOP_QUIET) {
-        stop_message = (voice == STOP_SAY_MPI ? mpi_msg : msg) + skip;
-        stop_message_len = (voice == STOP_SAY_MPI ? sizeof mpi_msg - 1 : sizeof msg - 1) - skip;
-    }
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
-}
 
 /* What the render's hooks need of the run: its output and the live display (the job,
  * render_job.h, holds the rest, and hands this to the hooks as its `user`). */
@@ -196,31 +146,6 @@ static void on_adaptive_round(void *vjob, const AdaptiveFilm *af)
     error_clear(&err);
 }
 
-/* Output name when -o is not given: the scene's file name with .png, in the current
- * folder. */
-static char *default_output(const char *scene_path)
-{
-    const char *base = strrchr(scene_path, '/');
-    base = base ? base + 1 : scene_path;
-    size_t n = strlen(base);
-    const char *dot = strrchr(base, '.');
-    if (dot && dot != base) n = (size_t)(dot - base);
-    char *out = malloc(n + 5);
-    if (out) {
-        memcpy(out, base, n);
-        memcpy(out + n, ".png", 5);
-    }
-    return out;
-}
-
-/* What the passes after the main image need of the command line. */
-static PassRequest pass_request(const Options *o)
-{
-    PassRequest q = { o->adaptive, o->adaptive_spp, o->aovs, { o->aov_files[0], o->aov_files[1], o->aov_files[2] },
-                      o->depth_near, o->depth_far, o->exr_float, o->denoise, o->quiet };
-    return q;
-}
-
 /* Everything one render holds, freed by run_free whatever step failed. */
 typedef struct {
     Options o;
@@ -269,87 +194,6 @@ static Status run_info_command(const Options *o, int *done, Error *err)
         free(all);
     }
     return ST_OK;
-}
-
-/* ------------------------------------------------------------------ outputs, checked first */
-
-/* --jpeg-quality and --png-depth shape one format: said, not ignored, for another. */
-static Status outputs_check_format_flags(const Options *o, const char *output, Error *err)
-{
-    ImageFormat fmt = IMAGE_PNG;
-    Error ignored = { 0 };
-    image_format_from_path(output, &fmt, &ignored);   /* outputs_choose reports a bad one */
-    error_clear(&ignored);
-    if (o->jpeg_quality && fmt != IMAGE_JPEG)
-        return error_set(err, ST_USAGE, "--jpeg-quality sets the quality of a JPEG output, and '%s' is none (write a "
-                         ".jpg or .jpeg, or leave it out)", output);
-    if (o->png_depth && fmt != IMAGE_PNG)
-        return error_set(err, ST_USAGE, "--png-depth sets the bits of a PNG output, and '%s' is none (write a .png, "
-                         "or leave it out)", output);
-    return ST_OK;
-}
-
-/* Each output can be written: checked now, so that a missing or unwritable folder is
- * found in a second, not after hours of rendering (when nothing could be saved). */
-static Status outputs_check(const Run *r, Error *err)
-{
-    const Options *o = &r->o;
-    PassRequest q = pass_request(o);
-    NamedFile files[8];
-    char *aov_paths[3] = { NULL, NULL, NULL };
-    size_t n = 0;
-    ViewLook look = { (ViewTransform)o->view, o->exposure };
-    Status st = image_check_look(r->output, &look, err);
-    if (st == ST_OK) st = outputs_check_format_flags(o, r->output, err);
-    if (st) return st;
-    /* standard output is no file of the run's: nothing to probe or compare */
-    if (image_path_is_stdout(r->output)) st = image_stdout_check(err);
-    else named_file_init(&files[n++], r->output, "the output image", FILE_IMAGE);
-    if (st) return st;
-    for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO; aov++) {
-        if (!(o->aovs & (1u << aov)) || passes_aov_in_exr(&q, r->output, aov)) continue;
-        char *path = aov_paths[aov - INTEGRATOR_AOV_NORMAL] = passes_aov_output_path(&q, r->output, aov);
-        if (!path) {
-            st = error_set(err, ST_INTERNAL, "out of memory");
-            goto out;
-        }
-        named_file_init(&files[n++], path, "the --aov image", FILE_IMAGE);
-    }
-    if (o->checkpoint_path) named_file_init(&files[n++], o->checkpoint_path, "the checkpoint", FILE_CHECKPOINT);
-    if (o->resume_path) named_file_init(&files[n++], o->resume_path, "the checkpoint to resume", FILE_RESUME);
-    named_file_init(&files[n++], o->scene_path, "the scene", FILE_SCENE);
-    if ((st = named_files_check_distinct(files, n, err))) goto out;
-    for (size_t i = 0; i < n && st == ST_OK; i++)
-        if (file_role_is_output(files[i].role))
-            st = atomic_probe(files[i].id.path, files[i].role == FILE_CHECKPOINT ? "checkpoint" : "", err);
-out:
-    for (size_t i = 0; i < 3; i++) free(aov_paths[i]);
-    return st;
-}
-
-/* The output's name (-o, or the scene's name with .png) and its format; a scene that
- * names its own image (outputs_from_scene) may still change the default. */
-static Status outputs_choose(Run *r, Error *err)
-{
-    ImageFormat format;
-    r->output = r->o.output;
-    if (!r->output && !(r->output = r->default_out = default_output(r->o.scene_path)))
-        return error_set(err, ST_INTERNAL, "out of memory");
-    return image_format_from_path(r->output, &format, err);
-}
-
-/* Without -o, the image the scene file asks for (pbrt's Film "filename", relative to
- * the current folder as pbrt writes it) replaces the default name, and is checked as
- * the default was: the outputs are chosen before the scene is read so that a bad -o
- * fails at once, and only a scene can say this name. */
-static Status outputs_from_scene(Run *r, Error *err)
-{
-    if (r->o.output || !r->scene.output_hint) return ST_OK;
-    ImageFormat format;
-    Status st = image_format_from_path(r->scene.output_hint, &format, err);
-    if (st) return st;
-    r->output = r->scene.output_hint;
-    return outputs_check(r, err);
 }
 
 /* The render job from the command line; the program's warnings, and its hooks' state. */
@@ -481,27 +325,11 @@ static void results_print_json(const Run *r, const char *result)
     render_stats_print_json(r->report, &run, &r->scene, &r->job.stats);
 }
 
-/* An adaptive render's samples per pixel in words: "16..256 spp (mean 41.2)". */
-static void adaptive_spp_words(const AdaptiveFilm *af, char *buf, size_t size)
-{
-    size_t n = (size_t)af->film.width * af->film.height;
-    uint lo = af->spp[0], hi = af->spp[0];
-    double sum = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        lo = af->spp[i] < lo ? af->spp[i] : lo;
-        hi = af->spp[i] > hi ? af->spp[i] : hi;
-        sum += af->spp[i];
-    }
-    snprintf(buf, size, "adaptive %u..%u spp (mean %.1f)", lo, hi, sum / (double)n);
-}
-
 static void results_print_summary(const Run *r)
 {
     const RenderJob *job = &r->job;
-    const Film *film = &job->film;
     const ScheduleStats *s = &job->stats;
-    const char *result = s->interrupted ? "interrupted" : (s->time_up ? "time limit reached" : "rendered");
-    if (r->o.stats == STATS_JSON) results_print_json(r, result);
+    if (r->o.stats == STATS_JSON) results_print_json(r, render_stats_result(s));
     else if (r->o.stats || r->o.profile) render_stats_print_run(r->report, s, r->scene.image.spp, job->devs, job->n_devs);
     if (r->o.profile) {
         render_stats_print_profile(r->report, s, job->devs, job->n_devs);
@@ -510,21 +338,7 @@ static void results_print_summary(const Run *r)
                     "time is all under shade\n");
     }
     if (r->o.quiet && job->render_st == ST_OK && !s->interrupted) return;
-    double secs = s->seconds > 0.0 ? s->seconds : 1e-9;
-    if (job->adaptive) {
-        char words[96];
-        adaptive_spp_words(&job->af, words, sizeof words);
-        fprintf(stderr, "clpt: %s%s %ux%u, %s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n",
-                result, strcmp(result, "rendered") ? ":" : "", film->width, film->height, words, s->seconds,
-                timer_now() - r->t_start, (double)s->samples / secs / 1e6, (double)s->rays / secs / 1e6,
-                output_name(r->output));
-        return;
-    }
-    fprintf(stderr, "clpt: %s%s %ux%u, %llu spp%s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n",
-            result, strcmp(result, "rendered") ? ":" : "", film->width,
-            film->height, (unsigned long long)film->samples,
-            film->samples < r->scene.image.spp ? " (partial)" : "", s->seconds, timer_now() - r->t_start,
-            (double)s->samples / secs / 1e6, (double)s->rays / secs / 1e6, output_name(r->output));
+    render_stats_print_summary(stderr, job, timer_now() - r->t_start, output_name(r->output));
 }
 
 /* The adaptive pass, the denoiser and the auxiliary images, after a complete main
@@ -540,7 +354,7 @@ static Status results_run_passes(Run *r, Error *err)
     render_job_pass_context(job, &pcfg, &pc);
     pc.on_denoised = on_denoised;
     pc.on_denoised_ctx = &r->ctx;
-    PassRequest q = pass_request(&r->o);
+    PassRequest q = outputs_pass_request(&r->o);
     Status st = passes_after_image(&q, &pc, r->output, &r->style, rgb, (uint)job->film.samples, err);
     free(rgb);
     if (st == ST_OK && stop_requested) st = ST_INTERRUPTED;
@@ -581,11 +395,11 @@ static Status rank_prepare(void *vr, int worker, int receive, Error *err)
 {
     Run *r = vr;
     Status st = ST_OK;
-    if (!worker) st = outputs_choose(r, err);
-    if (st == ST_OK && !worker) st = outputs_check(r, err);
+    if (!worker) st = outputs_choose(&r->o, &r->output, &r->default_out, err);
+    if (st == ST_OK && !worker) st = outputs_check(&r->o, r->output, err);
     if (st == ST_OK && !worker) st = render_job_open_denoiser(&r->job, err);
     if (st == ST_OK && !receive) st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
-    if (st == ST_OK && !worker) st = outputs_from_scene(r, err);
+    if (st == ST_OK && !worker) st = outputs_from_scene(&r->o, &r->scene, &r->output, err);
     if (st == ST_OK && !receive) st = scene_apply_options(r, err);
     if (st == ST_OK && !receive) st = render_prepare(r, worker, 1, err);
     if (st == ST_OK && !worker) display_prepare(r);
@@ -674,12 +488,12 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
     }
     if (r.o.interactive) return run_interactive(&r, err);
     job_init(&r);
-    st = outputs_choose(&r, err);
-    if (st == ST_OK) st = outputs_check(&r, err);
+    st = outputs_choose(&r.o, &r.output, &r.default_out, err);
+    if (st == ST_OK) st = outputs_check(&r.o, r.output, err);
     /* --denoise's library loaded before anything slow: a machine without it says so at once */
     if (st == ST_OK) st = render_job_open_denoiser(&r.job, err);
     if (st == ST_OK) st = load_scene_input(&r.o, &r.scene, &r.bare_mesh, err);
-    if (st == ST_OK) st = outputs_from_scene(&r, err);
+    if (st == ST_OK) st = outputs_from_scene(&r.o, &r.scene, &r.output, err);
     if (st == ST_OK) st = scene_apply_options(&r, err);
     if (st == ST_OK) st = render_prepare(&r, 0, 0, err);
     if (st == ST_OK) display_prepare(&r);

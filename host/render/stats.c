@@ -2,6 +2,7 @@
 #include "render/stats.h"
 
 #include <stdio.h>
+#include <string.h>
 
 /* The instancing line (docs/instancing.md): triangles stored once and as many times
  * as the instances place them, and the memory of each level on the devices. */
@@ -187,4 +188,42 @@ void render_stats_print_json(FILE *out, const RenderStatsRun *run, const Scene *
     fputc(',', out);
     json_devices(out, st);
     fprintf(out, "}\n");
+}
+
+const char *render_stats_result(const ScheduleStats *st)
+{
+    return st->interrupted ? "interrupted" : (st->time_up ? "time limit reached" : "rendered");
+}
+
+/* The samples per pixel in words: "16 spp", "12 spp (partial)", or an adaptive
+ * render's "adaptive 16..256 spp (mean 41.2)". */
+static void spp_words(const RenderJob *job, char *buf, size_t size)
+{
+    const AdaptiveFilm *af = &job->af;
+    if (!job->adaptive) {
+        snprintf(buf, size, "%llu spp%s", (unsigned long long)job->film.samples,
+                 job->film.samples < job->scene->image.spp ? " (partial)" : "");
+        return;
+    }
+    size_t n = (size_t)af->film.width * af->film.height;
+    uint lo = af->spp[0], hi = af->spp[0];
+    double sum = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        lo = af->spp[i] < lo ? af->spp[i] : lo;
+        hi = af->spp[i] > hi ? af->spp[i] : hi;
+        sum += af->spp[i];
+    }
+    snprintf(buf, size, "adaptive %u..%u spp (mean %.1f)", lo, hi, sum / (double)n);
+}
+
+void render_stats_print_summary(FILE *out, const RenderJob *job, double total_seconds, const char *output)
+{
+    const ScheduleStats *s = &job->stats;
+    const char *result = render_stats_result(s);
+    double secs = s->seconds > 0.0 ? s->seconds : 1e-9;
+    char words[96];
+    spp_words(job, words, sizeof words);
+    fprintf(out, "clpt: %s%s %ux%u, %s in %.2f s (%.2f s total): %.3f Msamples/s, %.3f Mrays/s -> %s\n", result,
+            strcmp(result, "rendered") ? ":" : "", job->film.width, job->film.height, words, s->seconds,
+            total_seconds, (double)s->samples / secs / 1e6, (double)s->rays / secs / 1e6, output);
 }

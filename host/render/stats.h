@@ -10,6 +10,7 @@
 #include <stdio.h>
 
 #include "device/device.h"
+#include "render/render_job.h"
 #include "render/render_scene.h"
 #include "render/schedule.h"
 #include "scene/scene.h"
@@ -34,5 +35,13 @@ typedef struct {
 
 /* --stats=json: the render as one JSON object on one line. */
 void render_stats_print_json(FILE *out, const RenderStatsRun *run, const Scene *s, const ScheduleStats *st);
+
+/* The run's result in words: "rendered", "interrupted" or "time limit reached". */
+const char *render_stats_result(const ScheduleStats *st);
+
+/* The run's line: "clpt: rendered 64x48, 16 spp in 0.52 s (0.80 s total): 1.2
+ * Msamples/s, 4.5 Mrays/s -> OUTPUT"; an adaptive render's samples per pixel as
+ * "adaptive 16..256 spp (mean 41.2)". */
+void render_stats_print_summary(FILE *out, const RenderJob *job, double total_seconds, const char *output);
 
 #endif /* CLPT_RENDER_STATS_H */

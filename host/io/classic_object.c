@@ -151,6 +151,14 @@ static Status tessellate_sphere(Classic *c, const Token *kw, vec3 center, float 
     return ST_OK;
 }
 
+/* An object's block read into v, and the material it gets (object_material). */
+static Status read_object(Classic *c, const Token *kw, const char *name, const ClassicKey *keys, size_t n,
+                          ClassicValue *v, uint *material)
+{
+    Status st = classic_read_block(c, kw, name, keys, n, v);
+    return st ? st : object_material(c, material);
+}
+
 enum { SPH_CENTER, SPH_RADIUS, SPH_N };
 static const ClassicKey sphere_keys[SPH_N] = {
     [SPH_CENTER] = {"center", CK_VEC3, 0}, [SPH_RADIUS] = {"radius", CK_POSITIVE, 1},
@@ -159,9 +167,9 @@ static const ClassicKey sphere_keys[SPH_N] = {
 static Status parse_sphere(Classic *c, const Token *kw, const Transform *m)
 {
     ClassicValue v[SPH_N];
-    Status st = classic_read_block(c, kw, "Sphere", sphere_keys, SPH_N, v);
     uint material;
-    if (st || (st = object_material(c, &material))) return st;
+    Status st = read_object(c, kw, "Sphere", sphere_keys, SPH_N, v, &material);
+    if (st) return st;
     vec3 center = v[SPH_CENTER].v;   /* the origin when not given */
     double scale;
     int rotates;
@@ -187,9 +195,9 @@ static const ClassicKey plane_keys[PL_N] = {
 static Status parse_plane(Classic *c, const Token *kw, const Transform *m)
 {
     ClassicValue v[PL_N];
-    Status st = classic_read_block(c, kw, "Plane", plane_keys, PL_N, v);
     uint material;
-    if (st || (st = object_material(c, &material))) return st;
+    Status st = read_object(c, kw, "Plane", plane_keys, PL_N, v, &material);
+    if (st) return st;
     vec3 n = v[PL_NORMAL].v;
     double n2 = (double)n.x * n.x + (double)n.y * n.y + (double)n.z * n.z;
     double k = v[PL_OFFSET].f / n2;
@@ -214,9 +222,9 @@ static const ClassicKey triangle_keys[TRI_N] = {
 static Status parse_triangle(Classic *c, const Token *kw, const Transform *m)
 {
     ClassicValue v[TRI_N];
-    Status st = classic_read_block(c, kw, "Triangle", triangle_keys, TRI_N, v);
     uint material;
-    if (st || (st = object_material(c, &material))) return st;
+    Status st = read_object(c, kw, "Triangle", triangle_keys, TRI_N, v, &material);
+    if (st) return st;
     vec3 a = transform_point(m, v[TRI_V0].v), b = transform_point(m, v[TRI_V1].v), d = transform_point(m, v[TRI_V2].v);
     /* a mirroring transform turns the winding around; keep the outward side outward */
     return transform_det(m) < 0.0 ? add_tri(c, a, d, b, material, NO_INDEX) : add_tri(c, a, b, d, material, NO_INDEX);
@@ -228,9 +236,9 @@ static const ClassicKey mesh_keys[MESH_N] = { [MESH_FILE] = {"obj_file", CK_PATH
 static Status parse_mesh(Classic *c, const Token *kw, const Transform *m)
 {
     ClassicValue v[MESH_N];
-    Status st = classic_read_block(c, kw, "TriangleMesh", mesh_keys, MESH_N, v);
     uint material;
-    if (st || (st = object_material(c, &material))) return st;
+    Status st = read_object(c, kw, "TriangleMesh", mesh_keys, MESH_N, v, &material);
+    if (st) return st;
     char *path;
     if ((st = classic_resolve_path(c, &v[MESH_FILE].word, &path))) return st;
     /* the sink applies the transform as it does to a mesh of our format */

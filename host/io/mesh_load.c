@@ -30,25 +30,22 @@ MeshKind mesh_kind(const char *path)
     return MESH_NONE;
 }
 
+Status mesh_read_with(const char *path, MeshParseFn parse, Scene *s, const MeshOptions *o, Error *err)
+{
+    char *data;
+    size_t len;
+    Status st = lex_read_file(path, &data, &len, err);
+    if (st) return st;
+    st = parse(path, data, len, s, o, err);
+    free(data);
+    return st;
+}
+
 Status mesh_load(const char *path, Scene *s, const MeshOptions *o, Error *err)
 {
-    switch (mesh_kind(path)) {
-    case MESH_OBJ: return obj_load_with(path, s, o, err);
-    case MESH_PLY: return ply_load(path, s, o, err);
-    case MESH_GLTF: {
-        char *data;
-        size_t len;
-        Status st = lex_read_file(path, &data, &len, err);
-        if (st) return st;
-        st = gltf_parse(path, data, len, s, o, NULL, err);
-        free(data);
-        return st;
-    }
-    case MESH_NONE: break;
-    }
-    return error_set(err, ST_INPUT,
-                     "'%s': not a mesh file (expected a name ending in .obj, .ply, .obj.gz, .ply.gz, .gltf or .glb)",
-                     path);
+    /* a name that is no mesh's is refused before the file is read (mesh_parse says why) */
+    if (mesh_kind(path) == MESH_NONE) return mesh_parse(path, "", 0, s, o, err);
+    return mesh_read_with(path, mesh_parse, s, o, err);
 }
 
 Status mesh_parse(const char *path, const char *data, size_t len, Scene *s, const MeshOptions *o, Error *err)

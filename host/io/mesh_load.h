@@ -16,6 +16,14 @@ Status mesh_load(const char *path, Scene *s, const MeshOptions *o, Error *err);
  * beside `path`. */
 Status mesh_parse(const char *path, const char *data, size_t len, Scene *s, const MeshOptions *o, Error *err);
 
+/* A reader of a mesh file's bytes in memory: obj_parse_with, ply_parse, mesh_parse. */
+typedef Status (*MeshParseFn)(const char *path, const char *data, size_t len, Scene *s, const MeshOptions *o,
+                              Error *err);
+
+/* The file read whole (lex_read_file: limits, .gz inflated) and given to `parse`: how
+ * every mesh reader loads from disk. */
+Status mesh_read_with(const char *path, MeshParseFn parse, Scene *s, const MeshOptions *o, Error *err);
+
 typedef enum { MESH_NONE = 0, MESH_OBJ, MESH_PLY, MESH_GLTF } MeshKind;
 MeshKind mesh_kind(const char *path);
 

@@ -12,6 +12,7 @@
 
 #include "util/kmath.h"
 #include "io/lexer.h"
+#include "io/mesh_load.h"
 #include "io/mesh_text.h"
 #include "io/path.h"
 #include "io/mtl.h"
@@ -514,13 +515,7 @@ Status obj_parse(const char *path, const char *text, size_t len, Scene *s, uint 
 
 Status obj_load_with(const char *path, Scene *s, const MeshOptions *o, Error *err)
 {
-    char *text;
-    size_t len;
-    Status st = lex_read_file(path, &text, &len, err);
-    if (st) return st;
-    st = obj_parse_with(path, text, len, s, o, err);
-    free(text);
-    return st;
+    return mesh_read_with(path, obj_parse_with, s, o, err);
 }
 
 Status obj_load(const char *path, Scene *s, uint material, Error *err)

@@ -217,40 +217,47 @@ Status pbrt_get_float(Parser *p, const Lexer *lx, const char *name, double *out)
     return ST_OK;
 }
 
+/* The parameter `name` into *out when given (else NULL), checked to hold `n` values of
+ * one of `types` (bits 1 << PT_x); `what` names them in the error. */
+static Status param_of(Parser *p, const Lexer *lx, const char *name, unsigned types, size_t n, const char *what,
+                       const Param **out)
+{
+    const Param *pa = *out = pbrt_param_find(p, name);
+    if (pa && (!(types & (1u << pa->type)) || pa->n != n)) return pbrt_param_type_error(p, lx, pa, what);
+    return ST_OK;
+}
+
 Status pbrt_get_int(Parser *p, const Lexer *lx, const char *name, long *out)
 {
-    Param *pa = pbrt_param_find(p, name);
-    if (!pa) return ST_OK;
-    if (pa->type != PT_INTEGER || pa->n != 1) return pbrt_param_type_error(p, lx, pa, "one integer");
-    *out = (long)p->pl.nums[pa->first];
-    return ST_OK;
+    const Param *pa;
+    Status st = param_of(p, lx, name, 1u << PT_INTEGER, 1, "one integer", &pa);
+    if (st == ST_OK && pa) *out = (long)p->pl.nums[pa->first];
+    return st;
 }
 
 Status pbrt_get_bool(Parser *p, const Lexer *lx, const char *name, int *out)
 {
-    Param *pa = pbrt_param_find(p, name);
-    if (!pa) return ST_OK;
-    if (pa->type != PT_BOOL || pa->n != 1) return pbrt_param_type_error(p, lx, pa, "one bool");
-    *out = pbrt_tok_eq(&p->pl.strs[pa->first], "true");
-    return ST_OK;
+    const Param *pa;
+    Status st = param_of(p, lx, name, 1u << PT_BOOL, 1, "one bool", &pa);
+    if (st == ST_OK && pa) *out = pbrt_tok_eq(&p->pl.strs[pa->first], "true");
+    return st;
 }
 
 /* The string value of a string parameter, or NULL when not given. */
 Status pbrt_get_string(Parser *p, const Lexer *lx, const char *name, const Token **out)
 {
-    Param *pa = pbrt_param_find(p, name);
-    if (!pa) return ST_OK;
-    if (pa->type != PT_STRING || pa->n != 1) return pbrt_param_type_error(p, lx, pa, "one string");
-    *out = &p->pl.strs[pa->first];
-    return ST_OK;
+    const Param *pa;
+    Status st = param_of(p, lx, name, 1u << PT_STRING, 1, "one string", &pa);
+    if (st == ST_OK && pa) *out = &p->pl.strs[pa->first];
+    return st;
 }
 
 Status pbrt_get_point(Parser *p, const Lexer *lx, const char *name, vec3 *out)
 {
-    Param *pa = pbrt_param_find(p, name);
-    if (!pa) return ST_OK;
-    if ((pa->type != PT_POINT3 && pa->type != PT_VECTOR3 && pa->type != PT_NORMAL) || pa->n != 3)
-        return pbrt_param_type_error(p, lx, pa, "one point3");
+    const Param *pa;
+    Status st = param_of(p, lx, name, (1u << PT_POINT3) | (1u << PT_VECTOR3) | (1u << PT_NORMAL), 3, "one point3",
+                         &pa);
+    if (st != ST_OK || !pa) return st;
     const double *d = p->pl.nums + pa->first;
     *out = v3((float)d[0], (float)d[1], (float)d[2]);
     return ST_OK;

@@ -18,6 +18,7 @@
 
 #include "util/kmath.h"
 #include "io/lexer.h"
+#include "io/mesh_load.h"
 #include "io/mesh_text.h"
 
 #include <math.h>
@@ -663,11 +664,5 @@ Status ply_parse(const char *path, const char *data, size_t len, Scene *s, const
 
 Status ply_load(const char *path, Scene *s, const MeshOptions *o, Error *err)
 {
-    char *data;
-    size_t len;
-    Status st = lex_read_file(path, &data, &len, err);
-    if (st) return st;
-    st = ply_parse(path, data, len, s, o, err);
-    free(data);
-    return st;
+    return mesh_read_with(path, ply_parse, s, o, err);
 }

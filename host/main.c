@@ -49,6 +49,7 @@ typedef struct {
     double progressive_seconds;   /* 0: no progressive output */
     double last_progressive;      /* when the output was last rewritten */
     Display *display;             /* --display-server; NULL: none, or the connection was lost */
+    uint width, height;           /* the image's */
 } RenderContext;
 
 /* On a terminal the progress bar may be on the line: the warning first clears it. In
@@ -93,13 +94,14 @@ static void display_send(RenderContext *ctx, const float *rgb)
     error_clear(&err);
 }
 
-/* The film as it is now, to the live display. */
-static void display_send_film(RenderContext *ctx, const Film *film)
+/* The film as it is now (or, without one, the job's image), to the live display. */
+static void display_send_film(RenderContext *ctx, const Film *film, const RenderJob *job)
 {
     if (!ctx->display) return;
-    float *rgb = malloc((size_t)film->width * film->height * 3u * sizeof *rgb);
+    float *rgb = malloc((size_t)ctx->width * ctx->height * 3u * sizeof *rgb);
     if (!rgb) return;   /* the next tick tries again */
-    film_resolve(film, rgb);
+    if (film) film_resolve(film, rgb);
+    else render_job_resolve(job, rgb);
     display_send(ctx, rgb);
     free(rgb);
 }
@@ -110,7 +112,7 @@ static void display_send_film(RenderContext *ctx, const Film *film)
 static void on_progress_tick(void *vjob, const ScheduleSnapshot *snap)
 {
     RenderContext *ctx = ((RenderJob *)vjob)->user;
-    display_send_film(ctx, snap->film);
+    display_send_film(ctx, snap->film, NULL);
     double now = timer_now();
     /* ticks come at the progressive interval or sooner; the 0.1% slack keeps a tick that
      * arrives a hair early at the same interval from being skipped */
@@ -264,6 +266,8 @@ static void render_configure(Run *r)
     render_job_configure(job);
     r->ctx.output = r->output;
     r->ctx.style = r->style;
+    r->ctx.width = job->film.width;
+    r->ctx.height = job->film.height;
     cfg->show_progress = progress_should_enable(o->quiet);
     cfg->stop = &stop_requested;
     /* one tick serves both: the display's every second (or sooner, for progressive
@@ -374,7 +378,8 @@ static Status results_write(Run *r, Error *err)
     Status image_st = render_job_write_image(job, r->output, &r->style, &next);
     st = keep_first(st, err, image_st, &next);
     if (image_st != ST_OK) return st;   /* the summary's "-> OUTPUT" would be untrue */
-    display_send_film(&r->ctx, &job->film);
+    /* an adaptive render's image is not its film's: the job resolves it */
+    display_send_film(&r->ctx, NULL, job);
     results_print_summary(r);
     if (st == ST_OK && (r->o.adaptive > 0.0 || r->o.aovs || r->o.denoise)) st = results_run_passes(r, err);
     return st;

@@ -122,7 +122,7 @@ static Status render_results(ApiRun *r, clpt_image *img, Error *err)
     if (st != ST_OK) return st;
     if (job->stats.interrupted) return error_set(err, ST_INTERRUPTED, "cancelled: %u of %u samples per pixel rendered",
                                                  img->spp, r->scene.image.spp);
-    if (job->stats.time_up) return ST_OK;
+    /* after a time limit, as in the program: the passes at the samples the image got */
     RenderJobAovs aovs = { img->normal, img->albedo, img->depth };
     job->passes_spp = job->scene->image.spp;
     return render_job_passes_to_memory(job, img->rgb, &aovs, err);

@@ -210,6 +210,19 @@ static void test_same_as_cli(void)
     check_same_as_cli("scalar", set_pairs, set_flags);
 }
 
+typedef struct {
+    unsigned calls, last_done, total, cancel_at;
+} Progress;
+
+static int on_progress(void *user, unsigned done, unsigned total)
+{
+    Progress *p = user;
+    p->calls++;
+    p->last_done = done;
+    p->total = total;
+    return p->cancel_at && done >= p->cancel_at;
+}
+
 /* noise_threshold is the program's --noise-threshold: adaptive sampling gives the same
  * bits through the library, on the scalar and the OpenCL CPU device; img.spp is the
  * most a pixel got. */
@@ -219,6 +232,23 @@ static void test_adaptive_same_as_cli(void)
     static const char *const flags[] = { "--spp", "48", "--noise-threshold", "0.05", "--min-spp", "8", NULL };
     check_same_as_cli_spp("scalar", 48, pairs, flags);
     check_same_as_cli_spp(TEST_OPENCL, 48, pairs, flags);
+    /* progress comes after each round, and a cancel stops at the next one */
+    static const char *const more[] = { "width", "64", "height", "48", "spp", "512", "threads", "2",
+                                        "noise-threshold", "0.0001", "min-spp", "8", NULL };
+    Api a;
+    if (!api_open(&a, "scalar", more)) {
+        api_close(&a);
+        return;
+    }
+    float *rgb = malloc(W * H * 3 * sizeof *rgb);
+    clpt_image img = { 0, 0, rgb, NULL, NULL, NULL, 0 };
+    Progress p = { 0, 0, 0, 16 };
+    clpt_status st = api_render(&a, &img, on_progress, &p);
+    CHECK_MSG(st == CLPT_INTERRUPTED, "%d: %s", st, clpt_last_error(a.ctx));
+    CHECK(p.calls >= 1 && p.total == 512 && p.last_done >= 16);
+    CHECK_MSG(img.spp >= 16 && img.spp < 512, "%u spp", img.spp);
+    free(rgb);
+    api_close(&a);
 }
 
 /* denoise is the program's --denoise: the denoised image's bits, where Open Image
@@ -344,19 +374,6 @@ static void test_aovs(void)
 }
 
 /* The progress callback cancels: the render stops with the whole batches finished. */
-typedef struct {
-    unsigned calls, last_done, total, cancel_at;
-} Progress;
-
-static int on_progress(void *user, unsigned done, unsigned total)
-{
-    Progress *p = user;
-    p->calls++;
-    p->last_done = done;
-    p->total = total;
-    return p->cancel_at && done >= p->cancel_at;
-}
-
 static void test_cancel(void)
 {
     static const char *const pairs[] = { "width", "64", "height", "48", "spp", "512", "batch", "1", "threads", "2",

@@ -350,6 +350,9 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(PathState, medium);
     out[i++] = (uint)__builtin_offsetof(RenderParams, has_media);
     out[i++] = (uint)__builtin_offsetof(Material, medium_in);
+    out[i++] = (uint)sizeof(GridMedium);
+    out[i++] = (uint)__builtin_offsetof(GridMedium, nx);
+    out[i++] = (uint)__builtin_offsetof(GridMedium, max_density);
 }
 #endif
 

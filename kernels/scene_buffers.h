@@ -58,7 +58,10 @@
     X(MANY, uint,         pixel_mask, (ds)->pixel_mask ? (size_t)(ds)->params.width *        \
                                       (ds)->params.height : 0u,  "pixel mask")               \
     /* participating media (kernels/medium/), read only where params.has_media */           \
-    X(MANY, Medium,       media,      (ds)->params.n_media,      "participating media")
+    X(MANY, Medium,       media,      (ds)->params.n_media,      "participating media")    \
+    /* heterogeneous media: grids of MEDIUM_GRID media; their densities and majorants */  \
+    X(MANY, GridMedium,   grids,      (ds)->params.n_grids,      "density grids")          \
+    X(MANY, float,        grid_data,  (ds)->n_grid_data,         "density grid values")
 
 /* Each buffer's position: SCENE_BUF_nodes ... The scene buffers are the first
  * SCENE_BUF_COUNT arguments of every kernel that takes SCENE_ARGS, in this order. */

@@ -572,15 +572,32 @@ enum Integrator {
 /* A participating medium (kernels/medium/, docs/media.md): coefficients per unit of
  * scene length, per RGB channel, already times the scene's `scale`. Homogeneous media
  * are these constants everywhere they are bound. */
-enum MediumType { MEDIUM_HOMOGENEOUS = 0 };
+enum MediumType { MEDIUM_HOMOGENEOUS = 0, MEDIUM_GRID = 1 };
 typedef struct {                                        /* 48 bytes */
     uint type;                /* enum MediumType */
     float g;                  /* Henyey-Greenstein asymmetry in (-1, 1); |g| < 1e-3 is
                                * stored as 0 (the sampling formula divides by g) */
-    uint pad0, pad1;
-    vec3 sigma_a;  float pad2;   /* absorption */
-    vec3 sigma_s;  float pad3;   /* scattering */
+    uint grid;                /* MEDIUM_GRID: its GridMedium in grids[] */
+    uint pad1;
+    vec3 sigma_a;  float pad2;   /* absorption; MEDIUM_GRID: per unit of density */
+    vec3 sigma_s;  float pad3;   /* scattering; MEDIUM_GRID: per unit of density */
 } Medium;
+
+/* A heterogeneous medium's density (kernels/medium/grid.h, docs/media.md): nx ny nz
+ * values, x fastest, at the centres of the cells of its box, trilinearly interpolated
+ * (clamped to the outermost centres, as Mitsuba 3's gridvolume), 0 outside the box;
+ * and a coarse majorant grid of mx my mz cells, each the largest density the
+ * interpolation takes in it, which delta and ratio tracking walk cell by cell. Both
+ * live in grid_data[] from their offsets. Medium.sigma_a / sigma_s are per unit of
+ * density. */
+typedef struct {                                        /* 96 bytes */
+    float to_grid[12];        /* world point -> the box's unit cube [0, 1]^3: a 3x4
+                               * affine matrix, row by row */
+    uint nx, ny, nz, density_at;    /* the density's size; its offset in grid_data */
+    uint mx, my, mz, majorant_at;   /* the majorant grid's size; its offset */
+    float max_density;        /* the largest of all (0: the grid is empty) */
+    uint pad0, pad1, pad2;
+} GridMedium;
 
 /* Which strategies the path integrator combines for area lights: both with the power
  * heuristic, or one alone (tests/test_mis.c checks that all three agree). */
@@ -648,7 +665,7 @@ typedef struct {                                        /* 336 bytes */
     uint n_media;                     /* entries of media[] */
     uint camera_medium;               /* where camera rays start: 0 vacuum, else 1 +
                                        * an index into media[] */
-    uint pad_media;
+    uint n_grids;                     /* entries of grids[] (MEDIUM_GRID media) */
 } RenderParams;
 
 /* One path of the wavefront; lives in a device buffer between kernel launches. */
@@ -713,6 +730,7 @@ CLPT_CHECK_SIZE(Camera, 112);
 CLPT_CHECK_SIZE(RenderParams, 336);
 CLPT_CHECK_SIZE(PathState, 80);
 CLPT_CHECK_SIZE(Medium, 48);
+CLPT_CHECK_SIZE(GridMedium, 96);
 CLPT_CHECK_SIZE(Texture, 112);
 _Static_assert(offsetof(RenderParams, bg_color) == 112, "RenderParams.bg_color");
 _Static_assert(offsetof(RenderParams, width) == 144, "RenderParams.width");
@@ -745,6 +763,8 @@ _Static_assert(offsetof(Material, medium_in) == 280, "Material.medium_in");
 _Static_assert(offsetof(RenderParams, has_media) == 320, "RenderParams.has_media");
 _Static_assert(offsetof(PathState, medium) == 64, "PathState.medium");
 _Static_assert(offsetof(Medium, sigma_s) == 32, "Medium.sigma_s");
+_Static_assert(offsetof(GridMedium, nx) == 48, "GridMedium.nx");
+_Static_assert(offsetof(GridMedium, max_density) == 80, "GridMedium.max_density");
 #undef CLPT_CHECK_SIZE
 #endif
 

@@ -491,7 +491,8 @@ static void test_layout(void)
                     offsetof(Material, layer_albedo), offsetof(Material, base_roughness), sizeof(SphereXform),
                     offsetof(SphereXform, to_object), offsetof(Sphere, xform), sizeof(Medium),
                     offsetof(Medium, sigma_s), offsetof(PathState, medium), offsetof(RenderParams, has_media),
-                    offsetof(Material, medium_in) };
+                    offsetof(Material, medium_in), sizeof(GridMedium), offsetof(GridMedium, nx),
+                    offsetof(GridMedium, max_density) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);

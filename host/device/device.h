@@ -51,6 +51,7 @@ typedef struct {
     size_t n_rev_points;        /* floats: two per profile control point */
     size_t n_env_cdf;
     size_t n_bvh_leaves;        /* words of the BVH's leaf records */
+    size_t n_grid_data;         /* floats of the density grids and their majorants */
 } DeviceScene;
 #undef DEVICE_SCENE_FIELD_
 #undef DEVICE_SCENE_FIELD_MANY_

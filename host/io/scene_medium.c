@@ -13,9 +13,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define MEDIUM_TYPES "a medium type (homogeneous, grid)"
+
 enum { MED_TYPE, MED_SIGMA_A, MED_SIGMA_S, MED_ALBEDO, MED_DENSITY, MED_SCALE, MED_G, MED_N };
 static const KeySpec medium_keys[MED_N] = {
-    [MED_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0, "a medium type (homogeneous)"},
+    [MED_TYPE] = {"type", VK_WORD, 0, 0, 0, 0, 0, MEDIUM_TYPES},
     [MED_SIGMA_A] = {"sigma_a", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MED_SIGMA_S] = {"sigma_s", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MED_ALBEDO] = {"albedo", VK_COLOR, 0, 0, 0, 0, 0, NULL},
@@ -24,10 +26,37 @@ static const KeySpec medium_keys[MED_N] = {
     [MED_G] = {"g", VK_NUMBER, 0, -1, 1, 1, 1, "a number in (-1, 1)"},
 };
 
-/* The coefficients of a homogeneous medium: sigma_a and sigma_s, or the scattering
- * albedo and the extinction `density` (sigma_s = albedo density, sigma_a = (1 - albedo)
- * density), times `scale`. */
-static Status medium_coefficients(Parser *p, const Lexer *lx, const Token *kw, const Value *v, vec3 *sa, vec3 *ss)
+/* A grid medium's keys: the coefficients (per unit of the grid's density) in the same
+ * places as medium_keys, so medium_coefficients reads both; `scale` is the transform's
+ * here, as in every block with a transform (the coefficients take no extra factor). */
+enum { GM_TYPE, GM_SIGMA_A, GM_SIGMA_S, GM_ALBEDO, GM_DENSITY, GM_G, GM_SIZE, GM_DATA, GM_FILE, GM_MIN, GM_MAX,
+       GM_TRANSLATE, GM_ROTATE, GM_RX, GM_RY, GM_RZ, GM_SCALE, GM_MATRIX, GM_N };
+static const KeySpec grid_keys[GM_N] = {
+    [GM_TYPE] = {"type", VK_WORD, 0, 0, 0, 0, 0, MEDIUM_TYPES},
+    [GM_SIGMA_A] = {"sigma_a", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [GM_SIGMA_S] = {"sigma_s", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [GM_ALBEDO] = {"albedo", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [GM_DENSITY] = {"density", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
+    [GM_G] = {"g", VK_NUMBER, 0, -1, 1, 1, 1, "a number in (-1, 1)"},
+    [GM_SIZE] = {"size", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [GM_DATA] = {"data", VK_NUMBER_LIST, 0, 0, 0, 0, 0, NULL},
+    [GM_FILE] = {"file", VK_PATH, 0, 0, 0, 0, 0, NULL},
+    [GM_MIN] = {"min", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [GM_MAX] = {"max", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [GM_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [GM_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},
+    [GM_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [GM_RY] = {"ry", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [GM_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [GM_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
+    [GM_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
+};
+
+/* The coefficients of a medium: sigma_a and sigma_s, or the scattering albedo and the
+ * extinction `density` (sigma_s = albedo density, sigma_a = (1 - albedo) density),
+ * times `scale`. v holds the values at the MED_* places (grid_keys keeps them there). */
+static Status medium_coefficients(Parser *p, const Lexer *lx, const Token *kw, const Value *v, float scale,
+                                  vec3 *sa, vec3 *ss)
 {
     int sigmas = v[MED_SIGMA_A].given || v[MED_SIGMA_S].given;
     int albedo = v[MED_ALBEDO].given || v[MED_DENSITY].given;
@@ -53,7 +82,6 @@ static Status medium_coefficients(Parser *p, const Lexer *lx, const Token *kw, c
         *sa = v[MED_SIGMA_A].v;   /* a key not given is 0 */
         *ss = v[MED_SIGMA_S].v;
     }
-    float scale = v[MED_SCALE].given ? v[MED_SCALE].f : 1.0f;
     *sa = v3_scale(*sa, scale);
     *ss = v3_scale(*ss, scale);
     vec3 t = v3_add(*sa, *ss);
@@ -61,6 +89,116 @@ static Status medium_coefficients(Parser *p, const Lexer *lx, const Token *kw, c
         return lex_error_at(lx, kw, p->err, "the medium's extinction (sigma_a + sigma_s, times scale) is beyond "
                             "the largest float (about 3.4e38)");
     return ST_OK;
+}
+
+/* The grid's size: three whole numbers >= 1, at most SCENE_LIST_MAX cells in all. */
+static Status grid_size(Parser *p, const Lexer *lx, const Value *v, uint n[3])
+{
+    float c[3] = { v->v.x, v->v.y, v->v.z };
+    double cells = 1.0;
+    for (int i = 0; i < 3; i++) {
+        if (!(c[i] >= 1.0f) || c[i] != floorf(c[i]) || c[i] > (float)SCENE_LIST_MAX)
+            return lex_error_at(lx, &v->value, p->err, "a grid's 'size' is three whole numbers >= 1 (cells along "
+                                "x, y, z), found %g %g %g", (double)c[0], (double)c[1], (double)c[2]);
+        n[i] = (uint)c[i];
+        cells *= c[i];
+    }
+    if (cells > (double)SCENE_LIST_MAX)
+        return lex_error_at(lx, &v->value, p->err, "a grid of %u x %u x %u cells is more than %u", n[0], n[1], n[2],
+                            SCENE_LIST_MAX);
+    return ST_OK;
+}
+
+/* A grid's densities from a raw file: n little-endian 32-bit floats, x fastest. */
+static Status grid_file(Parser *p, const Lexer *lx, const Value *v, size_t n, float **out)
+{
+    char *path = scene_path_beside(lx->path, v->word.text, v->word.len);
+    if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
+    char *data;
+    size_t len;
+    Status st = lex_read_file(path, &data, &len, p->err);
+    if (st) {
+        free(path);
+        return st;
+    }
+    if (len != n * sizeof(float)) {
+        st = lex_error_at(lx, &v->value, p->err, "'%s' has %zu bytes; the grid's 'size' wants %zu (4-byte "
+                          "little-endian floats)", path, len, n * sizeof(float));
+        free(data);
+        free(path);
+        return st;
+    }
+    free(path);
+    float *d = malloc(n * sizeof(float));
+    if (!d) {
+        free(data);
+        return error_set(p->err, ST_INTERNAL, "out of memory");
+    }
+    memcpy(d, data, n * sizeof(float));   /* the hosts clpt runs on are little-endian */
+    free(data);
+    *out = d;
+    return ST_OK;
+}
+
+/* `medium NAME { type grid ... }` from after `type grid` (typed: where they were). */
+static Status parse_grid_medium(Parser *p, Lexer *lx, const Token *kw, const Token *name, const Token *type_key)
+{
+    Value v[GM_N];
+    Status st = scene_parse_block(p, lx, kw, 1, "grid medium", grid_keys, GM_N, v);
+    if (st) return st;
+    if (v[GM_TYPE].given)
+        return lex_error_at(lx, &v[GM_TYPE].key, p->err, "key 'type' repeated in the medium block (first given at "
+                            "%u:%u)", type_key->line, type_key->col);
+    vec3 sa, ss;
+    if ((st = medium_coefficients(p, lx, kw, v, 1.0f, &sa, &ss))) return st;
+    uint n[3];
+    if ((st = grid_size(p, lx, &v[GM_SIZE], n))) return st;
+    size_t cells = (size_t)n[0] * n[1] * n[2];
+    if (v[GM_DATA].given == v[GM_FILE].given)
+        return lex_error_at(lx, v[GM_DATA].given ? &v[GM_FILE].key : kw, p->err,
+                            v[GM_DATA].given ? "a grid medium has 'data' or 'file', not both"
+                                             : "a grid medium needs its densities: 'data [ ... ]' or 'file NAME'");
+    float *density = NULL;
+    if (v[GM_DATA].given) {
+        if (v[GM_DATA].u != cells)
+            return lex_error_at(lx, &v[GM_DATA].key, p->err, "the grid's 'size' %u %u %u is %zu cells, but 'data' "
+                                "has %llu numbers", n[0], n[1], n[2], cells, v[GM_DATA].u);
+        density = malloc(cells * sizeof(float));
+        if (!density) return error_set(p->err, ST_INTERNAL, "out of memory");
+        memcpy(density, p->list + v[GM_DATA].list_at, cells * sizeof(float));
+    } else if ((st = grid_file(p, lx, &v[GM_FILE], cells, &density))) {
+        return st;
+    }
+    const Token *src = v[GM_DATA].given ? &v[GM_DATA].key : &v[GM_FILE].key;
+    for (size_t i = 0; i < cells; i++)
+        if (!(density[i] >= 0.0f) || !isfinite(density[i])) {
+            st = lex_error_at(lx, src, p->err, "density %g at cell %zu %zu %zu of the grid: densities are finite "
+                              "numbers >= 0", (double)density[i], i % n[0], i / n[0] % n[1], i / n[0] / n[1]);
+            free(density);
+            return st;
+        }
+    vec3 lo = v[GM_MIN].given ? v[GM_MIN].v : v3s(0.0f), hi = v[GM_MAX].given ? v[GM_MAX].v : v3s(1.0f);
+    if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) {
+        free(density);
+        return lex_error_at(lx, v[GM_MAX].given ? &v[GM_MAX].key : &v[GM_MIN].key, p->err,
+                            "a grid's 'max' must be greater than its 'min' on every axis, found min %g %g %g, "
+                            "max %g %g %g", (double)lo.x, (double)lo.y, (double)lo.z, (double)hi.x, (double)hi.y,
+                            (double)hi.z);
+    }
+    Transform to_world;
+    if ((st = scene_parse_transform(p, lx, kw, v + GM_TRANSLATE, "grid medium", &to_world))) {
+        free(density);
+        return st;
+    }
+    uint grid;
+    st = scene_add_grid(p->s, density, n[0], n[1], n[2], lo, hi, &to_world, &grid, p->err);
+    free(density);
+    if (st) return st;
+    char *copy = tok_copy(name);
+    if (!copy) return error_set(p->err, ST_INTERNAL, "out of memory");
+    st = scene_add_medium(p->s, copy, medium_grid(sa, ss, v[GM_G].given ? v[GM_G].f : 0.0f, grid), NULL, p->err);
+    free(copy);
+    return st;
 }
 
 Status scene_parse_medium(Parser *p, Lexer *lx, const Token *kw)
@@ -75,12 +213,42 @@ Status scene_parse_medium(Parser *p, Lexer *lx, const Token *kw)
         tok_describe(&t, shown, sizeof shown);
         return lex_error_at(lx, &t, p->err, "medium '%s' is already defined", shown);
     }
+    /* The type picks the block's keys (a grid's `scale` is its transform's): a grid
+     * says `type grid` first; a block that does not start with `type` is read as
+     * homogeneous, as before grids. */
+    Token brace, key, type;
+    if ((st = lex_next(lx, &brace, p->err))) return st;
+    if (brace.kind != TOK_LBRACE) return lex_expected(lx, &brace, "'{' to open the medium block", p->err);
+    if ((st = lex_next(lx, &key, p->err))) return st;
+    int typed = tok_is(&key, "type");
+    if (typed) {
+        if ((st = lex_next(lx, &type, p->err))) return st;
+        if (type.kind != TOK_WORD) return lex_expected(lx, &type, MEDIUM_TYPES " for 'type'", p->err);
+        if (tok_is(&type, "grid")) return parse_grid_medium(p, lx, kw, &t, &key);
+    } else {
+        lex_unread(lx, &key);
+    }
     Value v[MED_N];
-    if ((st = scene_parse_block(p, lx, kw, 0, "medium", medium_keys, MED_N, v))) return st;
+    if ((st = scene_parse_block(p, lx, kw, 1, "medium", medium_keys, MED_N, v))) return st;
+    /* `type` is required, but may have been taken before the block's keys */
+    if (!typed && !v[MED_TYPE].given)
+        return lex_error_at(lx, kw, p->err, "the medium block needs 'type' (it has no default)");
+    if (typed) {
+        if (v[MED_TYPE].given)
+            return lex_error_at(lx, &v[MED_TYPE].key, p->err, "key 'type' repeated in the medium block (first "
+                                "given at %u:%u)", key.line, key.col);
+        v[MED_TYPE].given = 1;
+        v[MED_TYPE].key = key;
+        v[MED_TYPE].word = type;
+    }
+    if (tok_is(&v[MED_TYPE].word, "grid"))
+        return lex_error_at(lx, &v[MED_TYPE].key, p->err, "'type grid' must be the first key of its medium block "
+                            "(a grid's keys are not a homogeneous medium's)");
     if (!tok_is(&v[MED_TYPE].word, "homogeneous"))
-        return lex_expected(lx, &v[MED_TYPE].word, medium_keys[MED_TYPE].what, p->err);
+        return lex_expected(lx, &v[MED_TYPE].word, MEDIUM_TYPES, p->err);
     vec3 sa, ss;
-    if ((st = medium_coefficients(p, lx, kw, v, &sa, &ss))) return st;
+    float scale = v[MED_SCALE].given ? v[MED_SCALE].f : 1.0f;
+    if ((st = medium_coefficients(p, lx, kw, v, scale, &sa, &ss))) return st;
     char *name = tok_copy(&t);
     if (!name) return error_set(p->err, ST_INTERNAL, "out of memory");
     st = scene_add_medium(p->s, name, medium_homogeneous(sa, ss, v[MED_G].given ? v[MED_G].f : 0.0f), NULL, p->err);

@@ -12,6 +12,7 @@
 #include "io/scene_reader.h"
 
 #include "util/kmath.h"
+#include "base/array.h"
 #include "scene/camera.h"
 #include "io/lexer.h"
 #include "base/limit.h"
@@ -50,6 +51,7 @@ static const char *kind_what(const KeySpec *k)
     case VK_SCALE: return "a non-zero scale factor, or three (x y z)";
     case VK_MATRIX: return "16 numbers (a 4x4 matrix, row by row)";
     case VK_MEDIUM: return "a medium name or 'none'";
+    case VK_NUMBER_LIST: return "'[' and numbers, then ']'";
     case VK_NUMBER:
     case VK_UINT:
     case VK_WORD: return k->what;
@@ -151,6 +153,24 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
         }
         return ST_OK;
     }
+    case VK_NUMBER_LIST: {
+        if (t.kind != TOK_LBRACKET) return lex_expected(lx, &t, what, err);
+        v->list_at = p->n_list;
+        v->u = 0;
+        for (;;) {
+            if ((st = lex_next(lx, &t, p->err))) return st;
+            if (t.kind == TOK_RBRACKET) return ST_OK;
+            float x;
+            if (tok_float(&t, &x)) return lex_expected(lx, &t, "a number or ']'", err);
+            if (v->u >= SCENE_LIST_MAX)
+                return lex_error_at(lx, &v->value, err, "more than %u numbers in the list of '%s'",
+                                    SCENE_LIST_MAX, k->key);
+            if (array_reserve((void **)&p->list, &p->cap_list, p->n_list + 1, sizeof *p->list))
+                return error_set(err, ST_INTERNAL, "out of memory");
+            p->list[p->n_list++] = x;
+            v->u++;
+        }
+    }
     case VK_MEDIUM: {
         uint ref;
         if ((st = scene_read_medium_ref(p, lx, &t, &ref))) return st;
@@ -194,6 +214,7 @@ Status scene_parse_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
 {
     Error *err = p->err;
     memset(vals, 0, n * sizeof *vals);
+    p->n_list = 0;
     Token t;
     Status st = brace_taken ? ST_OK : lex_next(lx, &t, p->err);
     if (st) return st;
@@ -584,6 +605,7 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
     free(p.background_at);
     for (size_t i = 0; i < p.n_material_at; i++) free(p.material_at[i]);
     free(p.material_at);
+    free(p.list);
     return st;
 }
 

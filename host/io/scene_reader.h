@@ -30,8 +30,13 @@ typedef enum {
     VK_ROTATE,      /* an axis (three floats, not all zero) and an angle in degrees */
     VK_SCALE,       /* one non-zero float, or three */
     VK_MATRIX,      /* sixteen floats, a 4x4 matrix row by row */
-    VK_MEDIUM       /* a medium name defined before, or none (vacuum): u = 0 or 1 + index */
+    VK_MEDIUM,      /* a medium name defined before, or none (vacuum): u = 0 or 1 + index */
+    VK_NUMBER_LIST  /* [ numbers ... ]: u of them, in Parser.list from list_at */
 } ValueKind;
+
+/* The most numbers one VK_NUMBER_LIST may hold (a 256^3 density grid): a bound on what
+ * a scene file can make the reader allocate. */
+#define SCENE_LIST_MAX (1u << 24)
 
 typedef struct {
     const char *key;
@@ -52,6 +57,7 @@ typedef struct {
     uint material;
     Token word;             /* VK_WORD, VK_PATH */
     float a[16];            /* VK_ROTATE (axis, degrees), VK_SCALE (x y z), VK_MATRIX */
+    size_t list_at;         /* VK_NUMBER_LIST: where its numbers start in Parser.list */
 } Value;
 
 typedef struct {
@@ -64,6 +70,9 @@ typedef struct {
     int depth_exceeded;               /* the include limit error is not annotated further */
     uint object;                      /* the object whose block is being read, or NO_INDEX */
     Token object_name;                /* where that object was named */
+    float *list;                      /* VK_NUMBER_LIST values of the block being read
+                                       * (emptied when a block starts; freed at the end) */
+    size_t n_list, cap_list;
 } Parser;
 
 /* scene_parse.c: blocks, paths, vector helpers */

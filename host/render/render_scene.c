@@ -166,6 +166,10 @@ static Status prepare_media(const Scene *s, RenderScene *out, Error *err)
     p->n_media = (uint)s->n_media;
     p->camera_medium = scene_medium_resolve(s, s->camera_medium);
     out->ds.media = s->n_media ? s->media : NULL;
+    p->n_grids = (uint)s->n_grids;
+    out->ds.grids = s->n_grids ? s->grids : NULL;
+    out->ds.grid_data = s->n_grid_data ? s->grid_data : NULL;
+    out->ds.n_grid_data = s->n_grid_data;
     if (p->has_media && p->split > 1u)
         return error_set(err, ST_USAGE, "first-hit splitting (--split %u) does not work in a scene with "
                          "participating media; render it with --split 1", p->split);

@@ -21,6 +21,84 @@ Medium medium_homogeneous(vec3 sigma_a, vec3 sigma_s, float g)
     return m;
 }
 
+Medium medium_grid(vec3 sigma_a, vec3 sigma_s, float g, uint grid)
+{
+    Medium m = medium_homogeneous(sigma_a, sigma_s, g);
+    m.type = MEDIUM_GRID;
+    m.grid = grid;
+    return m;
+}
+
+/* The sample indices whose interpolation reaches into majorant cell c of m along an
+ * axis of n samples at cell centres (kernels/medium/grid.h: x = q n - 0.5, clamped). */
+static void majorant_span(uint c, uint m, uint n, uint *first, uint *last)
+{
+    double lo = (double)c / m * n - 0.5, hi = (double)(c + 1u) / m * n - 0.5;
+    double f = floor(lo), l = ceil(hi);
+    *first = f < 0.0 ? 0u : (uint)f;
+    *last = l > (double)(n - 1u) ? n - 1u : (uint)l;
+    if (*first > n - 1u) *first = n - 1u;
+}
+
+Status scene_add_grid(Scene *s, const float *density, uint nx, uint ny, uint nz, vec3 lo, vec3 hi,
+                      const Transform *to_world, uint *grid, Error *err)
+{
+    GridMedium g;
+    memset(&g, 0, sizeof g);
+    g.nx = nx;
+    g.ny = ny;
+    g.nz = nz;
+    g.mx = nx < GRID_MAJORANT_RES ? nx : GRID_MAJORANT_RES;
+    g.my = ny < GRID_MAJORANT_RES ? ny : GRID_MAJORANT_RES;
+    g.mz = nz < GRID_MAJORANT_RES ? nz : GRID_MAJORANT_RES;
+    size_t n_density = (size_t)nx * ny * nz, n_major = (size_t)g.mx * g.my * g.mz;
+    size_t at = s->n_grid_data;
+    if (at + n_density + n_major > 0xffffffffu)
+        return error_set(err, ST_INPUT, "the density grids hold more than 2^32 values together");
+    if (array_reserve((void **)&s->grid_data, &s->cap_grid_data, at + n_density + n_major, sizeof(float)) ||
+        array_reserve((void **)&s->grids, &s->cap_grids, s->n_grids + 1, sizeof g))
+        return error_set(err, ST_INTERNAL, "out of memory for a density grid");
+    g.density_at = (uint)at;
+    g.majorant_at = (uint)(at + n_density);
+    float *d = s->grid_data + at, *maj = s->grid_data + at + n_density;
+    memcpy(d, density, n_density * sizeof(float));
+    float top = 0.0f;
+    for (size_t i = 0; i < n_density; i++) top = d[i] > top ? d[i] : top;
+    g.max_density = top;
+    /* each majorant cell: the largest sample the trilinear lookup blends anywhere in it */
+    for (uint cz = 0; cz < g.mz; cz++)
+        for (uint cy = 0; cy < g.my; cy++)
+            for (uint cx = 0; cx < g.mx; cx++) {
+                uint x0, x1, y0, y1, z0, z1;
+                majorant_span(cx, g.mx, nx, &x0, &x1);
+                majorant_span(cy, g.my, ny, &y0, &y1);
+                majorant_span(cz, g.mz, nz, &z0, &z1);
+                float m = 0.0f;
+                for (uint z = z0; z <= z1; z++)
+                    for (uint y = y0; y <= y1; y++)
+                        for (uint x = x0; x <= x1; x++) {
+                            float v = d[((size_t)z * ny + y) * nx + x];
+                            m = v > m ? v : m;
+                        }
+                maj[((size_t)cz * g.my + cy) * g.mx + cx] = m;
+            }
+    /* world -> medium space -> the box's unit cube */
+    int ok;
+    Transform inv = transform_inverse(to_world, &ok);
+    if (!ok) return error_set(err, ST_INPUT, "the grid medium's transform is singular");
+    Transform unit = transform_scale(1.0 / ((double)hi.x - lo.x), 1.0 / ((double)hi.y - lo.y),
+                                     1.0 / ((double)hi.z - lo.z));
+    Transform shift = transform_translate(-(double)lo.x, -(double)lo.y, -(double)lo.z);
+    Transform box = transform_compose(&unit, &shift);
+    Transform to_grid = transform_compose(&box, &inv);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++) g.to_grid[4 * i + j] = (float)to_grid.m[i][j];
+    s->n_grid_data = at + n_density + n_major;
+    s->grids[s->n_grids] = g;
+    *grid = (uint)s->n_grids++;
+    return ST_OK;
+}
+
 Status scene_add_medium(Scene *s, const char *name, Medium m, uint *index, Error *err)
 {
     size_t cap_names = s->cap_media;

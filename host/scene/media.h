@@ -14,10 +14,25 @@
 #define CLPT_SCENE_MEDIA_H
 
 #include "scene/scene.h"
+#include "scene/transform.h"
 
 /* A homogeneous medium: absorption and scattering per unit of scene length (already
  * scaled), Henyey-Greenstein g in (-1, 1) (|g| < 1e-3 stored as 0, types.h). */
 Medium medium_homogeneous(vec3 sigma_a, vec3 sigma_s, float g);
+
+/* The most cells per axis of a grid's majorant grid (pbrt-v4's MajorantGrid is 16^3). */
+#define GRID_MAJORANT_RES 16u
+
+/* Adds a density grid to s->grids for a MEDIUM_GRID medium (*grid its index): nx ny nz
+ * densities (x fastest, each finite and >= 0: the reader checks), at the cell centres
+ * of the box [lo, hi] of the medium's space, which to_world places in the scene (an
+ * invertible affine transform). Computes its majorant grid. Fails only when memory
+ * runs out or the grids grow past 2^32 floats. */
+Status scene_add_grid(Scene *s, const float *density, uint nx, uint ny, uint nz, vec3 lo, vec3 hi,
+                      const Transform *to_world, uint *grid, Error *err);
+
+/* A grid medium: coefficients per unit of density, HG g, its grid in s->grids. */
+Medium medium_grid(vec3 sigma_a, vec3 sigma_s, float g, uint grid);
 
 /* Adds medium m named `name` (the caller checks that the name is new). Fails only when
  * memory runs out. */

@@ -78,6 +78,8 @@ void scene_free(Scene *s)
     free(s->medium_names);
     free(s->media);
     free(s->medium_bindings);
+    free(s->grids);
+    free(s->grid_data);
     free(s->path);
     free(s->output_hint);
     for (size_t i = 0; i < s->n_warnings; i++) free(s->warnings[i]);

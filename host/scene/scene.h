@@ -137,6 +137,10 @@ typedef struct {
     Medium *media;         char **medium_names;   size_t n_media, cap_media;
     uint world_medium, camera_medium;
     SceneMediumBinding *medium_bindings;   size_t n_medium_bindings, cap_medium_bindings;
+    /* the grids of heterogeneous media (Medium.grid) and their densities and
+     * majorants, as the devices get them (scene_add_grid) */
+    GridMedium *grids;     size_t n_grids, cap_grids;
+    float *grid_data;      size_t n_grid_data, cap_grid_data;
 
     /* Problems the readers worked around (a missing map_Kd image), for main to print
      * once the scene is read; each names the file and line. */

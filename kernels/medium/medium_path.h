@@ -15,6 +15,7 @@
 #define CLPT_MEDIUM_PATH_H
 
 #include "medium/medium.h"
+#include "medium/grid.h"
 #include "medium/phase.h"
 #include "light/lights.h"
 #include "sample/rng.h"
@@ -99,11 +100,41 @@ KFN uint medium_scatter(const SceneView *sc, GLOBAL Ray *ray, vec3 x, float g, G
  * before it, the path stops there (weight T sigma_s / pdf) and scatters, and 1 is
  * returned with the bounce's result in *result (0 when the path ended there). A
  * medium that only absorbs needs no distance: the throughput takes T, exactly. */
+/* medium_flight through a grid medium (grid.h): delta tracking to a stop or past the
+ * surface, or, for a medium that only absorbs, ratio tracking's transmittance (an
+ * unbiased estimate, where the homogeneous media have the exact value). */
+KFN int medium_flight_grid(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathState *ps,
+                           GLOBAL Ray *shadow_ray, uint *result, Medium md)
+{
+    Ray r = *ray;
+    float len = v3_len(r.d);
+    float dist = hit.prim == NO_INDEX ? INFINITY : (hit.t - r.tmin) * len;
+    vec3 d = v3_scale(r.d, 1.0f / len);
+    vec3 x = v3_madd(r.o, r.d, r.tmin);
+    RngKey key = rng_key_of(ps, sc->params);
+    uint rb = path_rng_bounce(ps);
+    uint rng = grid_rng_seed(key, rb, GRID_TAG_FLIGHT);
+    *result = 0u;
+    if (v3_is_zero(md.sigma_s)) {
+        ps->throughput = v3_mul(ps->throughput, grid_transmittance(sc, md, x, d, dist, &rng));
+        return !(v3_max_comp(ps->throughput) > 0.0f);
+    }
+    vec3 thr = ps->throughput;
+    float ts;
+    int ev = grid_track(sc, md, x, d, dist, &thr, rng_uniform(key, rb, DIM_MEDIUM), &rng, &ts);
+    if (ev == GRID_ENDED || !(v3_max_comp(thr) > 0.0f)) return 1;
+    ps->throughput = thr;
+    if (ev == GRID_PASSED) return 0;
+    *result = medium_scatter(sc, ray, v3_madd(x, d, ts), md.g, ps, shadow_ray, key, rb);
+    return 1;
+}
+
 KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL PathState *ps, GLOBAL Ray *shadow_ray,
                       uint *result)
 {
     Ray r = *ray;
     Medium md = sc->media[ps->medium - 1u];
+    if (md.type == MEDIUM_GRID) return medium_flight_grid(sc, ray, hit, ps, shadow_ray, result, md);
     vec3 sigma_t = medium_sigma_t(md);
     float len = v3_len(r.d);
     float dist = hit.prim == NO_INDEX ? INFINITY : (hit.t - r.tmin) * len;

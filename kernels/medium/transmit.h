@@ -23,11 +23,25 @@ KFN uint shadow_trace_media(const SceneView *sc, GLOBAL PathState *ps, Ray r)
     vec3 tr = v3s(1.0f);
     float len = v3_len(r.d);
     uint n = 0u;
+    uint rng = 0u;
+    int rng_ready = 0;
     for (;;) {
         Hit h = trace_closest_visible(sc, r);
         n++;
         float t_end = h.prim == NO_INDEX ? r.tmax : h.t;
-        if (med != 0u) tr = v3_mul(tr, medium_tr(medium_sigma_t(sc->media[med - 1u]), (t_end - r.tmin) * len));
+        if (med != 0u) {
+            Medium md = sc->media[med - 1u];
+            float dist = (t_end - r.tmin) * len;
+            if (md.type == MEDIUM_GRID) {
+                /* one stream for all the grid stretches of this shadow ray */
+                if (!rng_ready) rng = grid_rng_seed(rng_key_of(ps, sc->params), path_rng_bounce(ps), GRID_TAG_SHADOW);
+                rng_ready = 1;
+                tr = v3_mul(tr, grid_transmittance(sc, md, v3_madd(r.o, r.d, r.tmin), v3_scale(r.d, 1.0f / len),
+                                                   dist, &rng));
+            } else {
+                tr = v3_mul(tr, medium_tr(medium_sigma_t(md), dist));
+            }
+        }
         if (h.prim == NO_INDEX) break;
         Material m = sc->materials[prim_material(sc, h.prim)];
         if (!(m.flags & MAT_INTERFACE) || n > MEDIUM_MAX_CROSSINGS) {

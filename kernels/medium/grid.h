@@ -1,0 +1,271 @@
+/*
+ * grid.h — heterogeneous media: a density grid (GridMedium, types.h) times the
+ * medium's per-density coefficients. Free-flight distances by delta tracking and
+ * shadow-ray transmittance by ratio tracking, both against a piecewise-constant
+ * majorant that a 3D DDA walks cell by cell, so that empty space costs one step per
+ * cell and no collision. docs/media.md derives the estimators.
+ *
+ * Delta tracking (Woodcock et al. 1965) with a majorant: tentative collisions are
+ * drawn from the exponential of the majorant sigma_bar; at each, the real extinction
+ * mu_t(x) decides between a real collision and a null one. Chromatic media use
+ * spectral tracking (Kutz, Habel, Li, Novák, "Spectral and decomposition tracking for
+ * rendering heterogeneous volumes", SIGGRAPH 2017): one majorant for all channels (the
+ * largest sigma_t times the cell's density), the real collision chosen with the
+ * probability P = sum_c q_c mu_t,c / sigma_bar, q the path's throughput shares (its
+ * history, as Kutz's "history-aware" variant), and every channel weighted by the
+ * ratio of its own event density to that probability: mu_s,c / sum_c q_c mu_t,c at a
+ * real collision (the stop's scattering weight; absorption is not sampled, as for the
+ * homogeneous media), (sigma_bar - mu_t,c) / (sigma_bar - sum_c q_c mu_t,c) at a null
+ * one. Each channel's estimate is unbiased whatever the probabilities; with equal
+ * channels the weights are the albedo and 1, plain delta tracking.
+ *
+ * Ratio tracking (Novák, Selle, Jarosz, "Residual ratio tracking for estimating
+ * attenuation in participating media", SIGGRAPH Asia 2014, sec. 3): the same tentative
+ * collisions, each multiplying the transmittance by 1 - mu_t,c / sigma_bar, with
+ * Russian roulette once it falls below 0.05 (as pbrt-v4).
+ *
+ * Random numbers: the first distance of a flight is the sampler's DIM_MEDIUM (so the
+ * first, most important, collision is stratified as the homogeneous media's are);
+ * every further number comes from a counter-based hash stream of the path's key, its
+ * sample, its bounce and a tag (grid_rng_seed), so the same bits on every device.
+ */
+#ifndef CLPT_GRID_H
+#define CLPT_GRID_H
+
+#include "util/kmath.h"
+#include "types.h"
+#include "sample/rng.h"
+#include "scene_view.h"
+#include "medium/medium.h"
+
+/* The most tentative collisions one flight or shadow stretch takes: a hang guard for
+ * absurd optical depths (a majorant's optical depth of tens of thousands along one
+ * ray is opaque long before). A flight that reaches it ends the path, a shadow ray
+ * counts as blocked. */
+#define GRID_MAX_STEPS 65536u
+
+/* Where a flight through a grid ended (grid_track). */
+enum GridFlight { GRID_PASSED = 0, GRID_STOPPED = 1, GRID_ENDED = 2 };
+
+/* Stream tags: a flight's numbers and a shadow ray's differ at the same bounce. */
+#define GRID_TAG_FLIGHT 0x5f3759dfu
+#define GRID_TAG_SHADOW 0x2545f491u
+
+KFN uint grid_rng_seed(RngKey k, uint bounce, uint tag)
+{
+    return rng_hash(k.key ^ rng_hash(k.sample * 0x9e3779b9u ^ rng_hash(bounce * (uint)RNG_DIMS_PER_BOUNCE + tag)));
+}
+
+/* The stream's next uniform in [0, 1). */
+KFN float grid_rng_next(uint *state)
+{
+    *state = *state + 0x9e3779b9u;
+    return rng_to_float(rng_hash(*state));
+}
+
+/* A distance of the exponential of rate sigma > 0. */
+KFN float grid_exp_step(float sigma, float u)
+{
+    return -k_log2(1.0f - u) * 0.693147181f / sigma;
+}
+
+KFN vec3 grid_to_unit(const GridMedium *g, vec3 p)
+{
+    return v3(g->to_grid[0] * p.x + g->to_grid[1] * p.y + g->to_grid[2] * p.z + g->to_grid[3],
+              g->to_grid[4] * p.x + g->to_grid[5] * p.y + g->to_grid[6] * p.z + g->to_grid[7],
+              g->to_grid[8] * p.x + g->to_grid[9] * p.y + g->to_grid[10] * p.z + g->to_grid[11]);
+}
+
+KFN vec3 grid_dir_to_unit(const GridMedium *g, vec3 d)
+{
+    return v3(g->to_grid[0] * d.x + g->to_grid[1] * d.y + g->to_grid[2] * d.z,
+              g->to_grid[4] * d.x + g->to_grid[5] * d.y + g->to_grid[6] * d.z,
+              g->to_grid[8] * d.x + g->to_grid[9] * d.y + g->to_grid[10] * d.z);
+}
+
+/* Along one axis of n samples at cell centres: the lower sample's index, the upper
+ * one's and the weight of the upper, for unit coordinate q (clamped to the outermost
+ * centres). */
+KFN void grid_axis(float q, uint n, uint *i0, uint *i1, float *f)
+{
+    float x = k_clamp(q * (float)n - 0.5f, 0.0f, (float)(n - 1u));
+    uint i = (uint)x;
+    if (i > n - 1u) i = n - 1u;
+    *i0 = i;
+    *i1 = i + 1u < n ? i + 1u : i;
+    *f = x - (float)i;
+}
+
+KFN float grid_lerp(float a, float b, float f) { return a + (b - a) * f; }
+
+/* The density at unit-cube point q: trilinear between the 8 nearest cell centres. */
+KFN float grid_density(const SceneView *sc, const GridMedium *g, vec3 q)
+{
+    uint x0, x1, y0, y1, z0, z1;
+    float fx, fy, fz;
+    grid_axis(q.x, g->nx, &x0, &x1, &fx);
+    grid_axis(q.y, g->ny, &y0, &y1, &fy);
+    grid_axis(q.z, g->nz, &z0, &z1, &fz);
+    GLOBAL const float *v = sc->grid_data + g->density_at;
+    uint nx = g->nx, nxy = g->nx * g->ny;
+    float c00 = grid_lerp(v[z0 * nxy + y0 * nx + x0], v[z0 * nxy + y0 * nx + x1], fx);
+    float c10 = grid_lerp(v[z0 * nxy + y1 * nx + x0], v[z0 * nxy + y1 * nx + x1], fx);
+    float c01 = grid_lerp(v[z1 * nxy + y0 * nx + x0], v[z1 * nxy + y0 * nx + x1], fx);
+    float c11 = grid_lerp(v[z1 * nxy + y1 * nx + x0], v[z1 * nxy + y1 * nx + x1], fx);
+    return grid_lerp(grid_lerp(c00, c10, fy), grid_lerp(c01, c11, fy), fz);
+}
+
+/* A 3D DDA over the majorant grid (Amanatides and Woo, "A fast voxel traversal
+ * algorithm", Eurographics 1987), in the ray's distance t: each step gives one cell
+ * and the stretch [t, t_end of the cell) the ray spends in it. */
+typedef struct {
+    float t, t_end;
+    int cell[3], step[3], stop[3];
+    float next[3], delta[3];
+} GridWalk;
+
+/* Starts the walk of unit-space ray o + t d over t in [t_lo, t_hi], clipped to the
+ * unit cube; 0 when the ray misses the box within that interval. */
+KFN int grid_walk_begin(const GridMedium *g, vec3 o, vec3 d, float t_lo, float t_hi, GridWalk *w)
+{
+    float t0 = t_lo, t1 = t_hi;
+    uint res[3] = { g->mx, g->my, g->mz };
+    for (int a = 0; a < 3; a++) {
+        float oa = v3_get(o, a), da = v3_get(d, a);
+        if (da == 0.0f) {
+            if (oa < 0.0f || oa > 1.0f) return 0;
+            continue;
+        }
+        float ta = (0.0f - oa) / da, tb = (1.0f - oa) / da;
+        t0 = k_fmax(t0, k_fmin(ta, tb));
+        t1 = k_fmin(t1, k_fmax(ta, tb));
+    }
+    if (!(t0 < t1)) return 0;
+    w->t = t0;
+    w->t_end = t1;
+    for (int a = 0; a < 3; a++) {
+        float oa = v3_get(o, a), da = v3_get(d, a);
+        float m = (float)res[a];
+        float pa = oa + da * t0;
+        int c = (int)k_clamp(pa * m, 0.0f, m - 1.0f);
+        w->cell[a] = c;
+        if (da > 0.0f) {
+            w->next[a] = t0 + ((float)(c + 1) / m - pa) / da;
+            w->delta[a] = 1.0f / (m * da);
+            w->step[a] = 1;
+            w->stop[a] = (int)res[a];
+        } else if (da < 0.0f) {
+            w->next[a] = t0 + ((float)c / m - pa) / da;
+            w->delta[a] = -1.0f / (m * da);
+            w->step[a] = -1;
+            w->stop[a] = -1;
+        } else {
+            w->next[a] = k_as_float(0x7f800000u);
+            w->delta[a] = 0.0f;
+            w->step[a] = 0;
+            w->stop[a] = -1;
+        }
+    }
+    return 1;
+}
+
+/* The next cell: its index in the majorant grid and the stretch [*lo, *hi) of it; 0
+ * when the walk is over. */
+KFN int grid_walk_next(const GridMedium *g, GridWalk *w, float *lo, float *hi, uint *cell)
+{
+    if (!(w->t < w->t_end)) return 0;
+    int a = w->next[0] < w->next[1] ? (w->next[0] < w->next[2] ? 0 : 2) : (w->next[1] < w->next[2] ? 1 : 2);
+    *lo = w->t;
+    *hi = k_fmin(w->next[a], w->t_end);
+    *cell = ((uint)w->cell[2] * g->my + (uint)w->cell[1]) * g->mx + (uint)w->cell[0];
+    w->t = *hi;
+    w->cell[a] += w->step[a];
+    w->next[a] += w->delta[a];
+    if (w->cell[a] == w->stop[a]) w->t = w->t_end;
+    return 1;
+}
+
+/* Delta (spectral) tracking of the world ray x + t d (d unit length) for t in
+ * [0, dist) through grid medium md: GRID_STOPPED with the real collision's distance in
+ * *t_stop, GRID_PASSED when it flies past dist, GRID_ENDED when the weight vanished or
+ * the walk gave up. *thr takes every null collision's weight and the stop's. u_first is
+ * the first tentative collision's number, *rng the stream of the others. */
+KFN int grid_track(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, vec3 *thr, float u_first,
+                   uint *rng, float *t_stop)
+{
+    GridMedium g = sc->grids[md.grid];
+    vec3 sig_t = v3_add(md.sigma_a, md.sigma_s);
+    float sig_max = v3_max_comp(sig_t);
+    vec3 o = grid_to_unit(&g, x), du = grid_dir_to_unit(&g, d);
+    GridWalk w;
+    if (!(sig_max > 0.0f) || !grid_walk_begin(&g, o, du, 0.0f, dist, &w)) return GRID_PASSED;
+    float lo, hi;
+    uint cell, steps = 0u;
+    int first = 1;
+    while (grid_walk_next(&g, &w, &lo, &hi, &cell)) {
+        float bar = sc->grid_data[g.majorant_at + cell] * sig_max;
+        if (!(bar > 0.0f)) continue;
+        float t = lo;
+        for (;;) {
+            if (++steps > GRID_MAX_STEPS) return GRID_ENDED;
+            float u = first ? u_first : grid_rng_next(rng);
+            first = 0;
+            t = t + grid_exp_step(bar, u);
+            if (!(t < hi)) break;   /* memoryless: the next cell starts afresh at hi */
+            float dens = grid_density(sc, &g, v3_madd(o, du, t));
+            vec3 mu_t = v3_scale(sig_t, dens);
+            vec3 q = medium_channel_pdf(*thr);
+            float real = v3_dot(q, mu_t);
+            if (grid_rng_next(rng) * bar < real) {
+                *thr = v3_scale(v3_mul(*thr, v3_scale(md.sigma_s, dens)), 1.0f / real);
+                *t_stop = t;
+                return GRID_STOPPED;
+            }
+            /* the majorant bounds the density up to rounding at the cells' faces: a
+             * null density below 0 is taken as 0 */
+            vec3 mu_n = v3(k_fmax(bar - mu_t.x, 0.0f), k_fmax(bar - mu_t.y, 0.0f), k_fmax(bar - mu_t.z, 0.0f));
+            *thr = v3_scale(v3_mul(*thr, mu_n), 1.0f / (bar - real));
+            if (!(v3_max_comp(*thr) > 0.0f)) return GRID_ENDED;
+        }
+    }
+    return GRID_PASSED;
+}
+
+/* Ratio tracking's estimate of the transmittance of grid medium md along the world ray
+ * x + t d (d unit length), t in [0, dist); numbers from *rng. */
+KFN vec3 grid_transmittance(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, uint *rng)
+{
+    GridMedium g = sc->grids[md.grid];
+    vec3 sig_t = v3_add(md.sigma_a, md.sigma_s);
+    float sig_max = v3_max_comp(sig_t);
+    vec3 o = grid_to_unit(&g, x), du = grid_dir_to_unit(&g, d);
+    vec3 tr = v3s(1.0f);
+    GridWalk w;
+    if (!(sig_max > 0.0f) || !grid_walk_begin(&g, o, du, 0.0f, dist, &w)) return tr;
+    float lo, hi;
+    uint cell, steps = 0u;
+    while (grid_walk_next(&g, &w, &lo, &hi, &cell)) {
+        float bar = sc->grid_data[g.majorant_at + cell] * sig_max;
+        if (!(bar > 0.0f)) continue;
+        float inv = 1.0f / bar;
+        float t = lo;
+        for (;;) {
+            if (++steps > GRID_MAX_STEPS) return v3s(0.0f);
+            t = t + grid_exp_step(bar, grid_rng_next(rng));
+            if (!(t < hi)) break;
+            float dens = grid_density(sc, &g, v3_madd(o, du, t));
+            vec3 mu_t = v3_scale(sig_t, dens);
+            tr = v3_mul(tr, v3(k_fmax(1.0f - mu_t.x * inv, 0.0f), k_fmax(1.0f - mu_t.y * inv, 0.0f),
+                               k_fmax(1.0f - mu_t.z * inv, 0.0f)));
+            float m = v3_max_comp(tr);
+            if (m < 0.05f) {
+                /* Russian roulette: kept with probability 1/4, then 4 times as large */
+                if (!(m > 0.0f) || grid_rng_next(rng) < 0.75f) return v3s(0.0f);
+                tr = v3_scale(tr, 4.0f);
+            }
+        }
+    }
+    return tr;
+}
+
+#endif /* CLPT_GRID_H */

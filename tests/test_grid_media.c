@@ -1,0 +1,304 @@
+/*
+ * test_grid_media.c — heterogeneous (grid) media (kernels/medium/grid.h, docs/media.md):
+ * delta tracking and ratio tracking against exact transmittances (a constant grid is
+ * Beer-Lambert and renders as the homogeneous medium does; a linear ramp against its
+ * integral; a sphere of density in a mostly empty majorant grid against a fine march of
+ * the same trilinear field), the white furnace, and the same bits on every device.
+ * Run from the project root.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "harness.h"
+#include "cli_util.h"
+#include "util/kmath.h"
+#include "render_util.h"
+
+#define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
+
+static CliResult r;
+
+static void film_channel_means(const Film *f, double mean[3])
+{
+    size_t n = (size_t)f->width * f->height;
+    float *rgb = malloc(n * 3 * sizeof *rgb);
+    film_resolve(f, rgb);
+    mean[0] = mean[1] = mean[2] = 0.0;
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) mean[c] += rgb[3 * i + c] / (double)n;
+    free(rgb);
+}
+
+/* Renders `text` on `devices` and returns its channel means. */
+static int render_means(const char *text, const char *devices, double mean[3])
+{
+    Scene s;
+    Error err = { 0 };
+    Film f;
+    memset(&f, 0, sizeof f);
+    scene_init(&s);
+    Status st = scene_load_text("grid-test.scene", text, strlen(text), &s, &err);
+    if (!st) st = render_util_run(&s, devices, 0, &f, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (!st) film_channel_means(&f, mean);
+    film_free(&f);
+    scene_free(&s);
+    error_clear(&err);
+    return st == ST_OK;
+}
+
+/* "[ v v v ... ]" of n values f(i) into a growing string. */
+static char *number_list(size_t n, double (*f)(size_t i, void *ctx), void *ctx)
+{
+    char *out = malloc(n * 16 + 8);
+    size_t o = 0;
+    o += (size_t)sprintf(out + o, "[");
+    for (size_t i = 0; i < n; i++) o += (size_t)sprintf(out + o, " %.7g", f(i, ctx));
+    sprintf(out + o, " ]");
+    return out;
+}
+
+/* ------------------------------------------------------------------ a slab of constant density */
+
+/* A camera looking through a slab 2 thick at a white lamp, no bounce: only light that
+ * flew straight through counts (as test_media.c's slab), the medium `m` given by %s. */
+#define SLAB_SCENE \
+    "image { width 16 height 16 spp 256 depth 0 }\n" \
+    "camera { from 0 0 5 at 0 0 0 up 0 1 0 fov 2 }\n" \
+    "%s\n" \
+    "material lamp { type emissive radiance 1 1 1 }\n" \
+    "box { min -2 -2 -1 max 2 2 1 material none interior m }\n" \
+    "quad { v0 -3 -3 -2 v1 3 -3 -2 v2 3 3 -2 v3 -3 3 -2 material lamp }\n"
+
+/* The mean over the film of exp(-tau(len)), len the slab's crossing (2 / cos: the rays
+ * of the 2-degree field cross at up to 1.4 degrees) and tau = depth(len) per channel. */
+static void slab_expected(vec3 sigma_t, double depth_per_len, double want[3])
+{
+    double half = tan(1.0 * M_PI / 180.0), sum[3] = { 0.0, 0.0, 0.0 };
+    int n = 200;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+            double x = half * (2.0 * (i + 0.5) / n - 1.0), y = half * (2.0 * (j + 0.5) / n - 1.0);
+            double len = 2.0 * sqrt(1.0 + x * x + y * y) * depth_per_len;
+            sum[0] += exp(-sigma_t.x * len);
+            sum[1] += exp(-sigma_t.y * len);
+            sum[2] += exp(-sigma_t.z * len);
+        }
+    for (int c = 0; c < 3; c++) want[c] = sum[c] / ((double)n * n);
+}
+
+static void check_slab(const char *what, const char *medium, vec3 sigma_t, double depth_per_len, double tol,
+                       double out[3])
+{
+    char text[4096];
+    snprintf(text, sizeof text, SLAB_SCENE, medium);
+    const char *devices[] = { "scalar", TEST_OPENCL };
+    double want[3];
+    slab_expected(sigma_t, depth_per_len, want);
+    for (int d = 0; d < 2; d++) {
+        double m[3];
+        if (!render_means(text, devices[d], m)) continue;
+        fprintf(stderr, "  %s on %s: %.5f %.5f %.5f (exact %.5f %.5f %.5f)\n", what, devices[d], m[0], m[1], m[2],
+                want[0], want[1], want[2]);
+        for (int c = 0; c < 3; c++) CHECK_NEAR(m[c], want[c], tol);
+        if (out && d == 0) memcpy(out, m, sizeof m);
+    }
+}
+
+/* A grid of constant density is Beer-Lambert, and renders as the homogeneous medium of
+ * the same coefficients within noise: delta tracking (scattering, chromatic) and ratio
+ * tracking (absorption only). The grid's box is smaller than the slab's boundary in x
+ * and y only where the camera does not look. */
+static void test_constant_grid(void)
+{
+    double grid[3], homo[3];
+    check_slab("constant grid, scattering", "medium m { type grid sigma_a 0.05 0.1 0.2 sigma_s 0.15 0.05 0.25 "
+               "size 2 2 2 data [ 2 2 2 2 2 2 2 2 ] min -1 -1 -1 max 1 1 1 }",
+               v3(0.4f, 0.3f, 0.9f), 1.0, 0.01, grid);
+    check_slab("the homogeneous medium", "medium m { type homogeneous sigma_a 0.1 0.2 0.4 sigma_s 0.3 0.1 0.5 }",
+               v3(0.4f, 0.3f, 0.9f), 1.0, 0.01, homo);
+    for (int c = 0; c < 3; c++) CHECK_NEAR(grid[c], homo[c], 0.012);
+    check_slab("constant grid, absorbing", "medium m { type grid sigma_a 0.1 0.7 1.5 size 1 1 1 data [ 1 ] "
+               "scale 2 translate 0 0 0 min -0.5 -0.5 -0.5 max 0.5 0.5 0.5 }",
+               v3(0.1f, 0.7f, 1.5f), 1.0, 0.01, NULL);
+}
+
+/* ------------------------------------------------------------------ a linear ramp */
+
+enum { RAMP_N = 8 };
+static double ramp_value(size_t i, void *ctx)
+{
+    (void)ctx;
+    return (double)(i % RAMP_N) * 0.25;   /* only z varies: x y z sizes 1 1 RAMP_N */
+}
+
+/* The mean density along z through a grid of RAMP_N cell-centred samples 0, 0.25, ...:
+ * linear between the first and last centre, constant in the half cells at the ends. */
+static double ramp_mean(void)
+{
+    double sum = 0.0;
+    int n = 1 << 20;
+    for (int k = 0; k < n; k++) {
+        double u = (k + 0.5) / n, x = u * RAMP_N - 0.5;
+        x = x < 0.0 ? 0.0 : x > RAMP_N - 1 ? RAMP_N - 1 : x;
+        sum += x * 0.25;
+    }
+    return sum / n;
+}
+
+static void test_ramp(void)
+{
+    char *list = number_list(RAMP_N, ramp_value, NULL);
+    char medium[2048];
+    double mean = ramp_mean();
+    snprintf(medium, sizeof medium, "medium m { type grid sigma_a 0.3 0.6 0.9 size 1 1 %d data %s "
+             "min -2 -2 -1 max 2 2 1 }", RAMP_N, list);
+    check_slab("density ramp, absorbing (ratio tracking)", medium, v3(0.3f, 0.6f, 0.9f), mean, 0.01, NULL);
+    snprintf(medium, sizeof medium, "medium m { type grid sigma_a 0.1 0.2 0.3 sigma_s 0.2 0.4 0.6 size 1 1 %d "
+             "data %s min -2 -2 -1 max 2 2 1 }", RAMP_N, list);
+    check_slab("density ramp, scattering (delta tracking)", medium, v3(0.3f, 0.6f, 0.9f), mean, 0.012, NULL);
+    free(list);
+}
+
+/* ------------------------------------------------------------------ a sphere in empty space */
+
+enum { SPH_N = 32 };
+static double sphere_value(size_t i, void *ctx)
+{
+    (void)ctx;
+    double x = ((double)(i % SPH_N) + 0.5) / SPH_N * 2.0 - 1.0;
+    double y = ((double)(i / SPH_N % SPH_N) + 0.5) / SPH_N * 2.0 - 1.0;
+    double z = ((double)(i / SPH_N / SPH_N) + 0.5) / SPH_N * 2.0 - 1.0;
+    return x * x + y * y + z * z < 0.25 ? 3.0 : 0.0;
+}
+
+static double sph_at(int x, int y, int z)
+{
+    return sphere_value(((size_t)z * SPH_N + (size_t)y) * SPH_N + (size_t)x, NULL);
+}
+
+/* The grid's trilinear density at p in [-1, 1]^3, as grid.h interpolates it. */
+static double sph_density(double px, double py, double pz)
+{
+    double q[3] = { (px + 1.0) / 2.0, (py + 1.0) / 2.0, (pz + 1.0) / 2.0 }, f[3];
+    int i0[3], i1[3];
+    for (int a = 0; a < 3; a++) {
+        double x = q[a] * SPH_N - 0.5;
+        x = x < 0.0 ? 0.0 : x > SPH_N - 1 ? SPH_N - 1 : x;
+        i0[a] = (int)x;
+        i1[a] = i0[a] + 1 < SPH_N ? i0[a] + 1 : i0[a];
+        f[a] = x - i0[a];
+    }
+    double v = 0.0;
+    for (int k = 0; k < 8; k++) {
+        int bx = k & 1, by = (k >> 1) & 1, bz = k >> 2;
+        double w = (bx ? f[0] : 1 - f[0]) * (by ? f[1] : 1 - f[1]) * (bz ? f[2] : 1 - f[2]);
+        v += w * sph_at(bx ? i1[0] : i0[0], by ? i1[1] : i0[1], bz ? i1[2] : i0[2]);
+    }
+    return v;
+}
+
+/* An orthographic view of the grid along -z: the film's mean of exp(-sigma_t tau(x, y)),
+ * tau marched finely through the trilinear field. */
+static double sphere_expected(double sigma_t)
+{
+    int n = 128, steps = 1024;
+    double sum = 0.0;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+            double x = -1.0 + 2.0 * (i + 0.5) / n, y = -1.0 + 2.0 * (j + 0.5) / n, tau = 0.0;
+            for (int k = 0; k < steps; k++) tau += sph_density(x, y, -1.0 + 2.0 * (k + 0.5) / steps) * 2.0 / steps;
+            sum += exp(-sigma_t * tau);
+        }
+    return sum / ((double)n * n);
+}
+
+static void test_sphere_in_box(void)
+{
+    char *list = number_list((size_t)SPH_N * SPH_N * SPH_N, sphere_value, NULL);
+    size_t size = strlen(list) + 1024;
+    char *text = malloc(size);
+    double want = sphere_expected(0.8);
+    const char *kinds[] = { "sigma_a 0.8 0.8 0.8", "sigma_a 0.2 0.2 0.2 sigma_s 0.6 0.6 0.6" };
+    for (int k = 0; k < 2; k++) {
+        snprintf(text, size, "image { width 32 height 32 spp 64 depth 0 }\n"
+                 "camera { type orthographic from 0 0 5 at 0 0 0 up 0 1 0 width 2 }\n"
+                 "medium m { type grid %s size %d %d %d data %s min -1 -1 -1 max 1 1 1 }\n"
+                 "material lamp { type emissive radiance 1 1 1 }\n"
+                 "box { min -1.5 -1.5 -1.5 max 1.5 1.5 1.5 material none interior m }\n"
+                 "quad { v0 -3 -3 -2 v1 3 -3 -2 v2 3 3 -2 v3 -3 3 -2 material lamp }\n",
+                 kinds[k], SPH_N, SPH_N, SPH_N, list);
+        const char *devices[] = { "scalar", TEST_OPENCL };
+        for (int d = 0; d < 2; d++) {
+            double m[3];
+            if (!render_means(text, devices[d], m)) continue;
+            fprintf(stderr, "  sphere of density in a %d^3 grid, %s, on %s: %.5f %.5f %.5f (marched %.5f)\n", SPH_N,
+                    kinds[k], devices[d], m[0], m[1], m[2], want);
+            for (int c = 0; c < 3; c++) CHECK_NEAR(m[c], want, 0.005);
+        }
+    }
+    free(text);
+    free(list);
+}
+
+/* ------------------------------------------------------------------ the furnace */
+
+/* A non-absorbing grid (albedo 1, any density) inside a sphere under a white
+ * background: every pixel's expected value is 1. */
+static void test_furnace(void)
+{
+    char *list = number_list((size_t)SPH_N * SPH_N * SPH_N, sphere_value, NULL);
+    size_t size = strlen(list) + 1024;
+    char *text = malloc(size);
+    const char *kinds[] = { "sigma_s 2 2 2 g 0.5", "sigma_s 0.5 2 4 g -0.3" };
+    for (int k = 0; k < 2; k++) {
+        snprintf(text, size, "image { width 16 height 16 spp 128 depth 512 }\n"
+                 "camera { from 0 0 0.2 at 0 0 -1 up 0 1 0 fov 60 }\n"
+                 "background { color 1 1 1 }\n"
+                 "medium m { type grid %s size %d %d %d data %s min -1 -1 -1 max 1 1 1 }\n"
+                 "sphere { center 0 0 0 radius 1 material none interior m }\n",
+                 kinds[k], SPH_N, SPH_N, SPH_N, list);
+        double m[3];
+        if (!render_means(text, "scalar", m)) continue;
+        fprintf(stderr, "  furnace, grid %s: %.4f %.4f %.4f (expected 1)\n", kinds[k], m[0], m[1], m[2]);
+        for (int c = 0; c < 3; c++) CHECK_NEAR(m[c], 1.0, 0.02);
+    }
+    free(text);
+    free(list);
+}
+
+/* ------------------------------------------------------------------ devices */
+
+/* Every wave launch of an OpenCL device gives the scalar device's bits on the smoke. */
+static void test_devices_match_scalar(void)
+{
+    const char *scene = "scenes/smoke.scene";
+    const char *modes[] = { "counted", "bounded", "megakernel" };
+    const char *ref = "/tmp/clpt-test-grid-scalar.pfm", *out = "/tmp/clpt-test-grid-ocl.pfm";
+    cli_run(ARGS(scene, "--device", "scalar", "--width", "40", "--height", "30", "--spp", "4", "-q", "-o", ref), &r);
+    CHECK_MSG(r.status == 0, "%s: %s", scene, r.err);
+    for (int i = 0; i < 3; i++) {
+        cli_run(ARGS(scene, "--device", TEST_OPENCL, "--width", "40", "--height", "30", "--spp", "4",
+                     "--wave-launch", modes[i], "--wave-paths", "1000", "--batch", "2", "-q", "-o", out), &r);
+        CHECK_MSG(r.status == 0, "%s, %s: %s", scene, modes[i], r.err);
+        CHECK_MSG(files_equal(ref, out), "%s, --wave-launch %s: the image differs from the scalar device's", scene,
+                  modes[i]);
+        fprintf(stderr, "  %s, --wave-launch %s: %s\n", scene, modes[i],
+                files_equal(ref, out) ? "the scalar device's bits" : "DIFFERENT");
+    }
+    unlink(ref);
+    unlink(out);
+}
+
+int main(void)
+{
+    RUN(test_constant_grid);
+    RUN(test_ramp);
+    RUN(test_sphere_in_box);
+    RUN(test_furnace);
+    RUN(test_devices_match_scalar);
+    return harness_report();
+}

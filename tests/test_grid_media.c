@@ -256,7 +256,7 @@ static void test_furnace(void)
     const char *kinds[] = { "sigma_s 2 2 2 g 0.5", "sigma_s 0.5 2 4 g -0.3" };
     for (int k = 0; k < 2; k++) {
         snprintf(text, size, "image { width 16 height 16 spp 128 depth 512 }\n"
-                 "camera { from 0 0 0.2 at 0 0 -1 up 0 1 0 fov 60 }\n"
+                 "camera { from 0 0 2.5 at 0 0 0 up 0 1 0 fov 50 }\n"
                  "background { color 1 1 1 }\n"
                  "medium m { type grid %s size %d %d %d data %s min -1 -1 -1 max 1 1 1 }\n"
                  "sphere { center 0 0 0 radius 1 material none interior m }\n",

@@ -919,6 +919,49 @@ static void test_media(void)
                  DIR "inline.pbrt:2:49: parameter 'sigma_a' must be an rgb colour >= 0");
 }
 
+/* MakeNamedMedium "uniformgrid": the density grid (x fastest) over p0 p1 placed by the
+ * current transform, sigma_a and sigma_s times scale per unit of density. */
+static void test_uniform_grid(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text("Translate 1 0 0\n"
+                           "MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\" \"rgb sigma_a\" [0.5 0.5 0.5]\n"
+                           "  \"rgb sigma_s\" [1 2 3] \"float scale\" 2 \"float g\" 0.3\n"
+                           "  \"integer nx\" 2 \"integer ny\" 1 \"integer nz\" 1 \"float density\" [0.25 4]\n"
+                           "  \"point3 p0\" [0 0 0] \"point3 p1\" [2 1 1]\n"
+                           "WorldBegin\n",
+                           &s, &err),
+                 ST_OK);
+    CHECK_EQ_INT(s.n_media, 1);
+    CHECK_EQ_INT(s.n_grids, 1);
+    if (s.n_media == 1 && s.n_grids == 1) {
+        CHECK_EQ_INT(s.media[0].type, MEDIUM_GRID);
+        CHECK_V3(s.media[0].sigma_a, 1, 1, 1, 0);
+        CHECK_V3(s.media[0].sigma_s, 2, 4, 6, 0);
+        const GridMedium *g = &s.grids[0];
+        CHECK_EQ_INT(g->nx, 2);
+        CHECK_EQ_INT(g->nz, 1);
+        CHECK_NEAR(s.grid_data[g->density_at + 1], 4, 0);
+        CHECK_NEAR(g->max_density, 4, 0);
+        /* world x = 1 is the box's x = 0; world x = 3 its x = 1 (unit cube) */
+        CHECK_NEAR(g->to_grid[0] * 3.0f + g->to_grid[3], 1.0, 1e-6);
+        CHECK_NEAR(g->to_grid[0] * 1.0f + g->to_grid[3], 0.0, 1e-6);
+    }
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"integer nx\" 2 "
+                 "\"float density\" [1 2 3]\n",
+                 DIR "inline.pbrt:2:64: MakeNamedMedium \"m\": nx ny nz 2 1 1 are 2 cells, but \"density\" has 3 "
+                 "values");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [-1]\n",
+                 DIR "inline.pbrt:2:49: MakeNamedMedium \"m\": density -1 (value 0) must be a finite number >= 0");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [1] "
+                 "\"point3 p0\" [0 0 0] \"point3 p1\" [1 0 1]\n",
+                 DIR "inline.pbrt:2:17: MakeNamedMedium \"m\": p1 must be greater than p0 on every axis, found p0 0 0 "
+                 "0, p1 1 0 1");
+}
+
 static void test_errors(void)
 {
     expect_error("Shape \"sphere\" \"float radius\" [ 1 ",
@@ -1568,6 +1611,7 @@ int main(void)
     RUN(test_active_transform);
     RUN(test_no_material);
     RUN(test_media);
+    RUN(test_uniform_grid);
     RUN(test_named_material_later);
     RUN(test_include);
     RUN(test_instances);

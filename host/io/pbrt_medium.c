@@ -50,6 +50,69 @@ static Status homogeneous(Parser *p, const Lexer *lx, const Token *name, Medium 
     return ST_OK;
 }
 
+/* pbrt-v4's "uniformgrid" medium: "float density" of nx ny nz values (x fastest, as
+ * pbrt's SampledGrid) over the box p0 p1 of the medium's space, which the current
+ * transform places; sigma_a, sigma_s (1 each by default) times `scale` per unit of
+ * density; `g`. pbrt's grid is zero outside its samples' centres' half cell at the
+ * border where clpt's clamps to the outermost value (docs/media.md); its emission
+ * ("Le", "temperature") is not read (a warning). */
+static Status uniform_grid(Parser *p, const Lexer *lx, const Token *name, Medium *out)
+{
+    Status st;
+    int nlen = (int)(name->len > 40 ? 40 : name->len);
+    Medium base;
+    if ((st = homogeneous(p, lx, name, &base))) return st;
+    long n[3] = { 1, 1, 1 };
+    if ((st = pbrt_get_int(p, lx, "nx", &n[0])) || (st = pbrt_get_int(p, lx, "ny", &n[1])) ||
+        (st = pbrt_get_int(p, lx, "nz", &n[2])))
+        return st;
+    double cells = 1.0;
+    for (int i = 0; i < 3; i++) {
+        if (n[i] < 1)
+            return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": nx, ny and nz must be >= 1, found "
+                                "%ld %ld %ld", nlen, name->text, n[0], n[1], n[2]);
+        cells *= (double)n[i];
+    }
+    if (cells > (double)(1u << 24))
+        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": a grid of %ld x %ld x %ld cells is more "
+                            "than %u", nlen, name->text, n[0], n[1], n[2], 1u << 24);
+    Param *pd = pbrt_param_find(p, "density");
+    if (!pd) return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": a \"uniformgrid\" needs \"float "
+                                 "density\" (clpt does not read its temperature or emission grids)", nlen, name->text);
+    if (pd->type != PT_FLOAT) return pbrt_param_type_error(p, lx, pd, "floats");
+    if ((double)pd->n != cells)
+        return lex_error_at(lx, &pd->decl, p->err, "MakeNamedMedium \"%.*s\": nx ny nz %ld %ld %ld are %.0f cells, "
+                            "but \"density\" has %zu values", nlen, name->text, n[0], n[1], n[2], cells, pd->n);
+    float *d = malloc(pd->n * sizeof(float));
+    if (!d) return error_set(p->err, ST_INTERNAL, "out of memory");
+    for (size_t i = 0; i < pd->n; i++) {
+        double v = p->pl.nums[pd->first + i];
+        if (!(v >= 0.0) || !(v <= 3.4e38)) {
+            free(d);
+            return lex_error_at(lx, &pd->decl, p->err, "MakeNamedMedium \"%.*s\": density %g (value %zu) must be "
+                                "a finite number >= 0", nlen, name->text, v, i);
+        }
+        d[i] = (float)v;
+    }
+    vec3 lo = v3s(0.0f), hi = v3s(1.0f);
+    if ((st = pbrt_get_point(p, lx, "p0", &lo)) || (st = pbrt_get_point(p, lx, "p1", &hi))) {
+        free(d);
+        return st;
+    }
+    if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) {
+        free(d);
+        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": p1 must be greater than p0 on every "
+                            "axis, found p0 %g %g %g, p1 %g %g %g", nlen, name->text, (double)lo.x, (double)lo.y,
+                            (double)lo.z, (double)hi.x, (double)hi.y, (double)hi.z);
+    }
+    uint grid;
+    st = scene_add_grid(p->s, d, (uint)n[0], (uint)n[1], (uint)n[2], lo, hi, &p->g.ctm, &grid, p->err);
+    free(d);
+    if (st) return st;
+    *out = medium_grid(base.sigma_a, base.sigma_s, base.g, grid);
+    return ST_OK;
+}
+
 Status pbrt_make_named_medium(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
@@ -62,9 +125,10 @@ Status pbrt_make_named_medium(Parser *p, Lexer *lx, const Token *kw)
     if ((st = pbrt_get_string(p, lx, "type", &type))) return st;
     if (!type) return lex_error_at(lx, &name, p->err, "MakeNamedMedium needs \"string type\"");
     uint32_t ref = 0u;   /* vacuum, for a medium clpt cannot render */
-    if (pbrt_tok_eq(type, "homogeneous")) {
+    int grid = pbrt_tok_eq(type, "uniformgrid");
+    if (pbrt_tok_eq(type, "homogeneous") || grid) {
         Medium m;
-        if ((st = homogeneous(p, lx, &name, &m))) return st;
+        if ((st = grid ? uniform_grid(p, lx, &name, &m) : homogeneous(p, lx, &name, &m))) return st;
         char *n = tok_copy(&name);
         if (!n) return error_set(p->err, ST_INTERNAL, "out of memory");
         uint index;
@@ -72,7 +136,8 @@ Status pbrt_make_named_medium(Parser *p, Lexer *lx, const Token *kw)
         free(n);
         if (st) return st;
         ref = index + 1u;
-        if ((st = pbrt_warn_unused(p, lx, "MakeNamedMedium \"homogeneous\""))) return st;
+        if ((st = pbrt_warn_unused(p, lx, grid ? "MakeNamedMedium \"uniformgrid\""
+                                               : "MakeNamedMedium \"homogeneous\""))) return st;
     } else {
         char key[96];
         snprintf(key, sizeof key, "Medium %.*s", (int)(type->len > 40 ? 40 : type->len), type->text);

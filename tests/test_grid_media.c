@@ -270,6 +270,66 @@ static void test_furnace(void)
     free(list);
 }
 
+/* ------------------------------------------------------------------ the reader */
+
+/* `file` reads the same densities as `data`; the majorant of each coarse cell bounds the
+ * samples the interpolation blends in it; the transform maps the box onto the unit cube. */
+static void test_file_and_majorant(void)
+{
+    enum { N = 20 };
+    static float d[N * N * N];
+    for (int i = 0; i < N * N * N; i++) d[i] = (float)((i * 7919) % 1000) / 500.0f;
+    const char *raw = "/tmp/clpt-test-grid.raw";
+    FILE *f = fopen(raw, "wb");
+    CHECK(f != NULL);
+    if (!f) return;
+    fwrite(d, sizeof d, 1, f);
+    fclose(f);
+    char text[256];
+    snprintf(text, sizeof text, "medium m { type grid sigma_s 1 1 1 size %d %d %d file \"%s\" min 0 0 0 max 2 4 8 "
+             "translate 1 0 0 }\n", N, N, N, raw);
+    Scene s;
+    Error err = { 0 };
+    scene_init(&s);
+    Status st = scene_load_text("grid-test.scene", text, strlen(text), &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (!st && s.n_grids == 1) {
+        const GridMedium *g = &s.grids[0];
+        CHECK(memcmp(s.grid_data + g->density_at, d, sizeof d) == 0);
+        CHECK_EQ_INT(g->mx, 16);
+        /* every sample bounded by the majorant of every coarse cell its support touches */
+        int bad = 0;
+        for (int z = 0; z < N; z++)
+            for (int y = 0; y < N; y++)
+                for (int x = 0; x < N; x++) {
+                    float v = d[(z * N + y) * N + x];
+                    /* the sample's support: centre +- one cell, in unit coordinates */
+                    int c[3][2];
+                    int p[3] = { x, y, z };
+                    for (int a = 0; a < 3; a++) {
+                        double lo = (p[a] - 0.5) / N, hi = (p[a] + 1.5) / N;
+                        c[a][0] = (int)(lo * 16) < 0 ? 0 : (int)(lo * 16);
+                        c[a][1] = (int)(hi * 16) > 15 ? 15 : (int)(hi * 16);
+                        if ((p[a] + 1.5) / N * 16 == c[a][1]) c[a][1]--;   /* open end */
+                        if (c[a][0] < 0) c[a][0] = 0;
+                    }
+                    for (int cz = c[2][0]; cz <= c[2][1]; cz++)
+                        for (int cy = c[1][0]; cy <= c[1][1]; cy++)
+                            for (int cx = c[0][0]; cx <= c[0][1]; cx++)
+                                if (s.grid_data[g->majorant_at + (cz * 16 + cy) * 16 + cx] < v) bad++;
+                }
+        CHECK_MSG(bad == 0, "%d samples above a majorant of a cell they reach", bad);
+        /* world (1, 0, 0) is the box's corner min; (3, 4, 8) its corner max */
+        CHECK_NEAR(g->to_grid[0] * 3.0f + g->to_grid[3], 1.0, 1e-6);
+        CHECK_NEAR(g->to_grid[5] * 4.0f + g->to_grid[7], 1.0, 1e-6);
+        CHECK_NEAR(g->to_grid[10] * 8.0f + g->to_grid[11], 1.0, 1e-6);
+        CHECK_NEAR(g->to_grid[0] * 1.0f + g->to_grid[3], 0.0, 1e-6);
+    }
+    scene_free(&s);
+    error_clear(&err);
+    unlink(raw);
+}
+
 /* ------------------------------------------------------------------ devices */
 
 /* Every wave launch of an OpenCL device gives the scalar device's bits on the smoke. */
@@ -299,6 +359,7 @@ int main(void)
     RUN(test_ramp);
     RUN(test_sphere_in_box);
     RUN(test_furnace);
+    RUN(test_file_and_majorant);
     RUN(test_devices_match_scalar);
     return harness_report();
 }

@@ -188,6 +188,38 @@ def scene_list():
         mitsuba=lambda mi, t: {"type": "null"}, mitsuba_interior=m,
         **dict(med, notes={"cycles": "no equivalent: glTF has no scattering media",
                            "mitsuba": "bilinear map lookup (clpt: nearest texel)"}))
+    # a heterogeneous medium: a 16^3 density grid over the sphere's box [-1, 1]^3 (clpt's
+    # `type grid`, Mitsuba's gridvolume; both interpolate between cell centres and clamp
+    # at the border), chromatic extinction, delta and ratio tracking against volpath's
+    def grid_density(n=16):
+        d = []
+        for k in range(n):
+            for j in range(n):
+                for i in range(n):
+                    x, y, z = ((c + 0.5) / n * 2.0 - 1.0 for c in (i, j, k))
+                    d.append(0.5 + 0.5 * math.sin(3.0 * x) * math.cos(2.0 * y) * math.sin(2.5 * z + 0.5))
+        return n, d
+
+    def grid_medium(sa, ss, g):
+        n, d = grid_density()
+        st = [a + b for a, b in zip(sa, ss)]
+        top = max(st)
+        clpt = ("type grid sigma_a %g %g %g sigma_s %g %g %g g %g size %d %d %d min -1 -1 -1 max 1 1 1 data [ %s ]" %
+                (tuple(sa) + tuple(ss) + (g, n, n, n, " ".join("%.6g" % v for v in d))))
+
+        def mitsuba(mi):
+            import numpy as np
+            grid = np.array(d, dtype=np.float32).reshape(n, n, n, 1) * np.array([t / top for t in st], np.float32)
+            to_world = mi.ScalarTransform4f().translate([-1.0, -1.0, -1.0]) @ mi.ScalarTransform4f().scale(2.0)
+            return {"type": "heterogeneous", "scale": top,
+                    "sigma_t": {"type": "gridvolume", "grid": mi.VolumeGrid(grid), "to_world": to_world},
+                    "albedo": _rgb([b / t for b, t in zip(ss, st)]), "phase": {"type": "hg", "g": g}}
+        return clpt, mitsuba
+    c, m = grid_medium((0.3, 0.2, 0.1), (1.0, 2.0, 3.0), 0.4)
+    add("medium-grid", "a heterogeneous medium: a 16^3 density grid (0 .. 1) times sigma_a 0.3 0.2 0.1, "
+        "sigma_s 1 2 3, g 0.4, behind a boundary that is no surface",
+        clpt_medium=c, clpt_mesh="material none interior fog",
+        mitsuba=lambda mi, t: {"type": "null"}, mitsuba_interior=m, **med)
     # --- emission and textures, black background
     add("emission", "emissive 1 0.5 0.25 x strength 2 (KHR_materials_emissive_strength), black base",
         material=_gltf_mat((0, 0, 0), 0.0, 1.0, emissiveFactor=[1.0, 0.5, 0.25],

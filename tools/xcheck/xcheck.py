@@ -394,7 +394,8 @@ class Mitsuba:
             d["sphere"]["emitter"] = {"type": "area", "radiance": t[em] if isinstance(em, str) else
                                       {"type": "rgb", "value": list(em)}}
         if s.get("mitsuba_interior"):
-            d["sphere"]["interior"] = s["mitsuba_interior"]
+            interior = s["mitsuba_interior"]   # a dict, or a function of mi (a grid needs mi.VolumeGrid)
+            d["sphere"]["interior"] = interior(mi) if callable(interior) else interior
         if s["floor"]:
             fl = os.path.join(folder, s["name"] + "-floor.ply")
             write_ply(fl, floor_quad())

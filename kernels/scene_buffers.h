@@ -38,6 +38,8 @@
     X(MANY, BvhNode,      bvh,        (ds)->params.n_bvh_nodes,  "8-wide BVH nodes")         \
     X(MANY, uint,         bvh_leaves, (ds)->n_bvh_leaves,        "8-wide BVH leaf lists")    \
     X(MANY, Instance,     instances,  (ds)->params.n_instances,  "instances")                \
+    /* per instance, its first light (types.h, LIGHT_INSTANCED); none without them */    \
+    X(MANY, uint,         instance_lights, (ds)->n_instance_lights, "instanced lights")      \
     X(MANY, Sphere,       spheres,    (ds)->params.n_spheres,    "spheres")                  \
     X(MANY, SphereXform,  sphere_xforms, (ds)->n_sphere_xforms,  "sphere transforms")        \
     X(MANY, Triangle,     triangles,  (ds)->params.n_triangles,  "triangles")                \

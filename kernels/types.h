@@ -415,13 +415,17 @@ typedef struct {                                        /* 288 bytes */
  *   LIGHT_POINT        a point radiating `intensity` (W/sr) evenly
  *   LIGHT_DIRECTIONAL  parallel light from infinitely far (irradiance, W/m^2)
  *   LIGHT_SPOT         a point light within a cone (cos_inner, cos_outer, spot_falloff)
- *   LIGHT_ENV          the environment map's light (kernels/light/envmap.h) */
+ *   LIGHT_ENV          the environment map's light (kernels/light/envmap.h)
+ *   LIGHT_INSTANCED    an emissive triangle of an object as one instance places it
+ *                      (docs/instancing.md): an area light whose geometry the record
+ *                      holds in the world (below), compiled in with the instances */
 #define LIGHT_TYPES(X) \
     X(LIGHT_AREA,        0, 0u,              0u,                              area)        \
     X(LIGHT_POINT,       1, KF_DELTA_LIGHTS, LT_DELTA,                        point)       \
     X(LIGHT_DIRECTIONAL, 2, KF_DELTA_LIGHTS, LT_DELTA | LT_INFINITE,          directional) \
     X(LIGHT_SPOT,        3, KF_DELTA_LIGHTS, LT_DELTA | LT_CONE,              spot)        \
-    X(LIGHT_ENV,         4, KF_ENV_MAP,      LT_INFINITE,                     environment)
+    X(LIGHT_ENV,         4, KF_ENV_MAP,      LT_INFINITE,                     environment) \
+    X(LIGHT_INSTANCED,   5, KF_INSTANCES,    0u,                              instanced)
 
 /* Traits of a light type. */
 #define LT_DELTA 1u     /* a single direction reaches a point from it: no MIS, hard
@@ -456,7 +460,8 @@ KFN uint light_feature(uint type)
 
 /* Every light, in one array with a cumulative distribution for choosing one
  * proportionally to its estimated power (host/scene/scene.c). Area lights come first
- * (RenderParams.n_area_lights of them), then the delta lights, then the environment
+ * (RenderParams.n_area_lights of them: the world's emissive primitives, then the
+ * instanced ones, LIGHT_INSTANCED), then the delta lights, then the environment
  * map's light (LIGHT_ENV, RenderParams.bg_light) when the background is a map with any
  * light in it; its other fields are unused (kernels/light/envmap.h reads the map).
  * A delta light's `intensity` is radiant intensity (point, spot: W/sr) or irradiance
@@ -497,6 +502,17 @@ enum SpotFalloff { SPOT_SMOOTHSTEP = 0, SPOT_GLTF = 1 };
 #define LIGHT_QUAD_NONE 0u
 #define LIGHT_QUAD_FIRST 1u
 #define LIGHT_QUAD_SECOND 2u
+
+/* A LIGHT_INSTANCED light is triangle `prim` of an object (its own material's emission)
+ * carried to the world by one instance's M, computed once on the host in double: its
+ * world `area` and unit `normal` (M^-T of the winding normal, the side surface_at gives
+ * a hit through the instance), and in `position`, `direction` and `intensity` its world
+ * corner p0 and edges p1 - p0, p2 - p0, or, for the halves of a quad (`quad`), the world
+ * parallelogram as above. An affine map keeps a uniform density on a triangle uniform,
+ * so a point sampled on the world triangle has density 1 / area, as the hit's
+ * light_pdf reads (kernels/light/lights.h). A hit through instance i on a triangle whose
+ * `light` is j (its index among its object's emitters) is light instance_lights[i] + j
+ * (scene_buffers.h; NO_INDEX there: the instance's triangles are no lights). */
 
 enum CameraType { CAMERA_PERSPECTIVE = 0, CAMERA_ORTHOGRAPHIC = 1 };
 

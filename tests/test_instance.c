@@ -45,6 +45,31 @@ static const char moved_scene[] = HEAD "instance thing { translate 2.6 0 0 }\n"
                                        "instance thing { translate 0 0 -2 scale -1 1 1 }\n"
                                        "instance thing { translate 0 0 1.8 scale 0.5 }\n";
 
+/* A lamp object: a dark triangle, an emissive quad (two triangle lights, one
+ * parallelogram) and a dimmer emissive triangle, facing down in object space; three
+ * instances under rotations and non-uniform scales (one mirrored) above a diffuse floor,
+ * and a fourth whose material replaces the lamp's, which makes it no light. Direct light
+ * only (depth 1), so that the strategies are the two estimators and nothing else. */
+#define LAMPS(spp, seed)                                                                       \
+    "camera { from 0 4.5 7.5 at 0 0.4 0 fov 45 }\n"                                            \
+    "image { width 48 height 36 spp " #spp " depth 1 seed " #seed " }\n"                       \
+    "background { color 0 0 0 }\n"                                                             \
+    "material floor { type diffuse albedo 0.7 0.7 0.7 }\n"                                     \
+    "material glow { type emissive radiance 8 7 5.5 }\n"                                       \
+    "material dim { type emissive radiance 2 3 4 }\n"                                          \
+    "box { min -6 -0.1 -6 max 6 0 6 material floor }\n"                                       \
+    "object lamp {\n"                                                                          \
+    "  triangle { v0 -0.5 0.1 -0.3 v1 0.5 0.1 -0.3 v2 0 0.1 -0.6 material floor }\n"           \
+    "  quad { v0 -0.5 0 -0.3 v1 0.5 0 -0.3 v2 0.5 0 0.3 v3 -0.5 0 0.3 material glow }\n"       \
+    "  triangle { v0 -0.5 0 0.4 v1 0.5 0 0.4 v2 0 0 0.8 material dim }\n"                      \
+    "}\n"                                                                                      \
+    "instance lamp { rz 25 translate -1.8 2.2 0 }\n"                                           \
+    "instance lamp { scale 1.6 0.5 0.8 ry 40 translate 1.6 1.8 -0.6 }\n"                       \
+    "instance lamp { rx -30 scale -0.7 0.7 0.7 translate 0 2.6 1.6 }\n"                        \
+    "instance lamp { translate 0 3 -2 material floor }\n"
+
+static const char lamps_scene[] = LAMPS(64, 3);
+
 static Status load_text(const char *text, Scene *s, Error *err)
 {
     scene_init(s);
@@ -144,8 +169,8 @@ static void test_kdtree_flattens(void)
 
 static void test_opencl_matches_scalar(void)
 {
-    static const char *const scenes[] = { identity_scene, moved_scene };
-    for (size_t k = 0; k < 2; k++) {
+    static const char *const scenes[] = { identity_scene, moved_scene, lamps_scene };
+    for (size_t k = 0; k < 3; k++) {
         Film a, b;
         Error err = { 0 };
         Status sa = render(scenes[k], TEST_OPENCL, 0, ACCEL_BVH, &a, &err);
@@ -160,6 +185,147 @@ static void test_opencl_matches_scalar(void)
         film_free(&a);
         film_free(&b);
     }
+}
+
+/* ------------------------------------------------------------------ instanced emitters */
+
+
+/* The instances' lights are the flattened copies' lights, in the same order: the same
+ * kinds of record, world areas, normals, parallelograms and choice probabilities. */
+static void test_lamps_are_lights(void)
+{
+    Scene a, b;
+    Error err = { 0 };
+    RenderScene ra, rb;
+    CHECK(load_text(lamps_scene, &a, &err) == ST_OK);
+    CHECK(load_text(lamps_scene, &b, &err) == ST_OK);
+    CHECK(scene_flatten_instances(&b, &err) == ST_OK);
+    CHECK_MSG(render_scene_prepare(&a, 1, &ra, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_scene_prepare(&b, 1, &rb, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(a.n_lights, 9);
+    CHECK_EQ_INT(b.n_lights, 9);
+    CHECK(a.instance_lights != NULL && ra.ds.n_instance_lights == 4);
+    if (a.n_lights == 9 && b.n_lights == 9 && a.instance_lights) {
+        CHECK(a.instance_lights[0] == 0 && a.instance_lights[1] == 3 && a.instance_lights[2] == 6);
+        CHECK(a.instance_lights[3] == NO_INDEX);
+        double worst = 0.0;
+        for (size_t i = 0; i < 9; i++) {
+            const Light *x = &a.lights[i], *y = &b.lights[i];
+            CHECK(x->type == LIGHT_INSTANCED && y->type == LIGHT_AREA);
+            CHECK(x->quad == y->quad);
+            double d = fabs(x->area - y->area) / y->area;
+            d = fmax(d, fabs(x->pick_pdf - y->pick_pdf) / y->pick_pdf);
+            d = fmax(d, 1.0 - v3_dot(x->normal, y->normal));
+            if (x->quad != LIGHT_QUAD_NONE) {
+                /* the copies' parallelogram: the same corner and edges (a mirror swaps
+                 * the copies' corners, which turns the parallelogram's edges round) */
+                vec3 ya = y->position, ye1 = y->direction, ye2 = y->intensity;
+                int swapped = v3_len(v3_sub(x->direction, ye1)) > 1e-4f;
+                d = fmax(d, v3_len(v3_sub(x->position, ya)));
+                d = fmax(d, v3_len(v3_sub(x->direction, swapped ? ye2 : ye1)));
+                d = fmax(d, v3_len(v3_sub(x->intensity, swapped ? ye1 : ye2)));
+            }
+            if (d > worst) worst = d;
+        }
+        fprintf(stderr, "  lamps: 9 lights, worst difference to the copies' %.2g\n", worst);
+        CHECK(worst < 1e-5);
+    }
+    render_scene_free(&ra);
+    render_scene_free(&rb);
+    scene_free(&a);
+    scene_free(&b);
+    error_clear(&err);
+}
+
+/* The mean of each 8 x 6 block of a 48 x 36 film (36 blocks) and of the whole. */
+static void lamp_blocks(const float *rgb, double blocks[36], double *mean)
+{
+    memset(blocks, 0, 36 * sizeof *blocks);
+    *mean = 0.0;
+    for (uint y = 0; y < 36; y++)
+        for (uint x = 0; x < 48; x++) {
+            const float *c = rgb + 3 * (y * 48 + x);
+            double v = (c[0] + c[1] + c[2]) / 3.0;
+            blocks[(y / 6) * 6 + x / 8] += v / 48.0;
+            *mean += v / (48.0 * 36.0);
+        }
+}
+
+/* The worst relative difference of two images' blocks (relative to at least 0.05). */
+static double blocks_differ(const double a[36], const double b[36])
+{
+    double worst = 0.0;
+    for (int i = 0; i < 36; i++) {
+        double rel = fabs(a[i] - b[i]) / (b[i] > 0.05 ? b[i] : 0.05);
+        if (rel > worst) worst = rel;
+    }
+    return worst;
+}
+
+/* MIS, light sampling alone and BSDF sampling alone agree on the instanced lamps, and
+ * MIS on the instances agrees with MIS on their copies. */
+static void test_lamps_strategies_agree(void)
+{
+    static const char *const names[4] = { "MIS", "light sampling", "BSDF sampling", "copies (MIS)" };
+    static const char scene_text[] = LAMPS(1024, 3);
+    float *img[4];
+    double blocks[4][36], mean[4];
+    Error err = { 0 };
+    for (uint m = 0; m < 4; m++) {
+        Scene s;
+        img[m] = malloc(48 * 36 * 3 * sizeof *img[m]);
+        CHECK(load_text(scene_text, &s, &err) == ST_OK);
+        if (m == 3) CHECK(scene_flatten_instances(&s, &err) == ST_OK);
+        Status st = render_util_rgb_mis(&s, m == 3 ? MIS_BOTH : m, "scalar", img[m], &err);
+        CHECK_MSG(st == ST_OK, "%s", err.msg);
+        lamp_blocks(img[m], blocks[m], &mean[m]);
+        scene_free(&s);
+    }
+    fprintf(stderr, "  lamps, 1024 spp: mean %s %.4f, %s %.4f, %s %.4f, %s %.4f; worst block difference to MIS: "
+            "light %.1f%%, BSDF %.1f%%, copies %.1f%%\n", names[0], mean[0], names[1], mean[1], names[2], mean[2],
+            names[3], mean[3], 100.0 * blocks_differ(blocks[1], blocks[0]), 100.0 * blocks_differ(blocks[2], blocks[0]),
+            100.0 * blocks_differ(blocks[3], blocks[0]));
+    CHECK(mean[0] > 0.05);
+    for (uint m = 1; m < 4; m++) CHECK(fabs(mean[m] - mean[0]) < 0.01 * mean[0]);
+    CHECK(blocks_differ(blocks[1], blocks[0]) < 0.05);
+    CHECK(blocks_differ(blocks[2], blocks[0]) < 0.08);
+    CHECK(blocks_differ(blocks[3], blocks[0]) < 0.03);
+    for (uint m = 0; m < 4; m++) free(img[m]);
+    error_clear(&err);
+}
+
+/* The noise of the lamps' light with MIS and with BSDF sampling alone, which is how the
+ * instanced lamps were found before they were lights: the mean over pixels of each
+ * pixel's variance over 8 renders of 4 samples with different seeds. */
+static void test_lamps_less_noise(void)
+{
+    enum { RUNS = 8, N = 48 * 36 * 3 };
+    static const char *const texts[RUNS] = { LAMPS(4, 1), LAMPS(4, 2), LAMPS(4, 3), LAMPS(4, 4),
+                                             LAMPS(4, 5), LAMPS(4, 6), LAMPS(4, 7), LAMPS(4, 8) };
+    double var[2];
+    Error err = { 0 };
+    float *img = malloc(N * sizeof *img);
+    double *sum = calloc(N, sizeof *sum), *sum2 = calloc(N, sizeof *sum2);
+    for (uint m = 0; m < 2; m++) {
+        memset(sum, 0, N * sizeof *sum);
+        memset(sum2, 0, N * sizeof *sum2);
+        for (int r = 0; r < RUNS; r++) {
+            Scene s;
+            CHECK(load_text(texts[r], &s, &err) == ST_OK);
+            CHECK(render_util_rgb_mis(&s, m == 0 ? MIS_BOTH : MIS_BSDF_ONLY, "scalar", img, &err) == ST_OK);
+            for (int i = 0; i < N; i++) sum[i] += img[i], sum2[i] += (double)img[i] * img[i];
+            scene_free(&s);
+        }
+        var[m] = 0.0;
+        for (int i = 0; i < N; i++) var[m] += (sum2[i] - sum[i] * sum[i] / RUNS) / (RUNS - 1) / N;
+    }
+    fprintf(stderr, "  lamps, 4 spp: mean pixel variance MIS %.4g, BSDF sampling alone %.4g (%.1fx)\n", var[0],
+            var[1], var[1] / var[0]);
+    CHECK(var[0] * 10.0 < var[1]);
+    free(img);
+    free(sum);
+    free(sum2);
+    error_clear(&err);
 }
 
 /* ------------------------------------------------------------------ hits */
@@ -344,6 +510,9 @@ int main(void)
     RUN(test_identity_bit_identical);
     RUN(test_moved_matches_flattened);
     RUN(test_kdtree_flattens);
+    RUN(test_lamps_are_lights);
+    RUN(test_lamps_strategies_agree);
+    RUN(test_lamps_less_noise);
     RUN(test_opencl_matches_scalar);
     return harness_report();
 }

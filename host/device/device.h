@@ -47,6 +47,7 @@ typedef struct {
     uint n_tri_extra_of;        /* n_shading, or 0 when no triangle has extras */
     uint n_tri_extras;
     uint n_sphere_xforms;       /* Sphere.xform's targets */
+    uint n_instance_lights;     /* the scene's instances when any has lights, else 0 */
     size_t n_texels;
     size_t n_rev_points;        /* floats: two per profile control point */
     size_t n_env_cdf;

@@ -260,6 +260,8 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
     out->ds.sphere_xforms = s->n_sphere_xforms ? s->sphere_xforms : NULL;
     out->ds.n_sphere_xforms = (uint)s->n_sphere_xforms;
     out->ds.triangles = s->triangles;
+    out->ds.instance_lights = s->instance_lights;
+    out->ds.n_instance_lights = s->instance_lights ? (uint)s->n_instances : 0u;
     out->ds.boxes = s->boxes;
     out->ds.planes = s->planes;
     out->ds.revsurfaces = s->revsurfaces;

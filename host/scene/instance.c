@@ -312,8 +312,10 @@ void scene_free_objects(Scene *s)
     for (size_t i = 0; i < s->n_objects; i++) free(s->objects[i].name);
     free(s->objects);
     free(s->instances);
+    free(s->instance_lights);
     strmap_free(&s->object_by_name);
     s->objects = NULL;
     s->instances = NULL;
+    s->instance_lights = NULL;
     s->n_objects = s->cap_objects = s->n_instances = s->cap_instances = 0;
 }

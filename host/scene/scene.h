@@ -106,6 +106,9 @@ typedef struct {
     /* objects and their instances (scene/instance.h); Instance.root is the build's */
     SceneObject *objects;  size_t n_objects, cap_objects;
     Instance *instances;   size_t n_instances, cap_instances;
+    /* per instance: its first light (LIGHT_INSTANCED, kernels/types.h), or NO_INDEX;
+     * NULL when no instance has lights (scene_prepare_lights) */
+    uint *instance_lights;
     StrMap object_by_name;
 
     /* the classic ray tracer's additions (docs/classic-format.md) */
@@ -223,11 +226,13 @@ Status scene_set_envmap(Scene *s, uint texture, float intensity, float rotate, E
  * texture, then scene_set_envmap with `intensity` and no rotation. */
 Status scene_set_envmap_texels(Scene *s, const uint *texels, uint width, uint height, float intensity, Error *err);
 
-/* Builds the light list: the emissive spheres, triangles and boxes (area lights), then
- * the delta lights, then the environment map when the background is one with light in
+/* Builds the light list: the emissive spheres, triangles and boxes (area lights), the
+ * emissive triangles of objects once per instance that keeps their material
+ * (LIGHT_INSTANCED, docs/instancing.md; sets `instance_lights`), then the delta lights, then the environment map when the background is one with light in
  * it, with a choice probability proportional to each light's estimated power (area
- * lights: pi x area x luminance of the emission; point and spot lights: the power
- * through a sphere of the scene's radius around them; directional lights: the power
+ * lights: pi x area x luminance of the emission, the area in the world; point and spot
+ * lights: the power through a sphere of the scene's radius (its instances' world boxes
+ * counted) around them; directional lights: the power
  * through a disc of the scene's radius; the environment map: pi x its mean luminance x
  * the area 4 pi r^2 of a sphere of the scene's radius, as an area light of that size
  * shining inward), and sets each primitive's `light` and `env_light`. */

@@ -10,6 +10,7 @@
 #include "base/array.h"
 #include "scene/env_dist.h"
 #include "scene/instance.h"
+#include "scene/transform.h"
 #include "util/kmath.h"
 
 Light light_default(uint type)
@@ -109,34 +110,85 @@ static double box_area(const Box *b)
     return 2.0 * (dx * dy + dy * dz + dz * dx);
 }
 
-/* Radius of the bounding sphere of the finite primitives (1 when there are none): the
- * size of the region a point or directional light shines on, for its power estimate. */
-static double scene_radius(const Scene *s)
+/* [lo, hi] grown to hold the ball of radius r about (x, y, z). */
+static void bounds_grow(double lo[3], double hi[3], const double c[3], double r)
 {
-    double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    for (int a = 0; a < 3; a++) {
+        if (c[a] - r < lo[a]) lo[a] = c[a] - r;
+        if (c[a] + r > hi[a]) hi[a] = c[a] + r;
+    }
+}
+
+/* [lo, hi] grown by the spheres, triangles and boxes of global ids whose in_object mark
+ * is `mark` among [first, end) of each kind (all of them when in_object is NULL). */
+static void bounds_of_prims(const Scene *s, const uint8_t *in_object, int mark, const size_t first[OBJ_KINDS],
+                            const size_t end[OBJ_KINDS], double lo[3], double hi[3])
+{
+    uint first_tri = scene_first_triangle(s), first_box = scene_first_box(s);
+#define SKIP(gid) (in_object && in_object[gid] != mark)
 #define GROW(p, r)                                                                        \
     do {                                                                                  \
         double c_[3] = { (p).x, (p).y, (p).z };                                           \
-        for (int a_ = 0; a_ < 3; a_++) {                                                  \
-            if (c_[a_] - (r) < lo[a_]) lo[a_] = c_[a_] - (r);                             \
-            if (c_[a_] + (r) > hi[a_]) hi[a_] = c_[a_] + (r);                             \
-        }                                                                                 \
+        bounds_grow(lo, hi, c_, (r));                                                     \
     } while (0)
-    for (size_t i = 0; i < s->n_spheres; i++) GROW(s->spheres[i].center, (double)s->spheres[i].radius);
-    for (size_t i = 0; i < s->n_triangles; i++) {
+    for (size_t i = first[OBJ_SPHERES]; i < end[OBJ_SPHERES]; i++)
+        if (!SKIP(i)) GROW(s->spheres[i].center, (double)s->spheres[i].radius);
+    for (size_t i = first[OBJ_TRIANGLES]; i < end[OBJ_TRIANGLES]; i++) {
+        if (SKIP(first_tri + i)) continue;
         GROW(s->triangles[i].p0, 0.0);
         GROW(s->triangles[i].p1, 0.0);
         GROW(s->triangles[i].p2, 0.0);
     }
-    for (size_t i = 0; i < s->n_boxes; i++) {
+    for (size_t i = first[OBJ_BOXES]; i < end[OBJ_BOXES]; i++) {
+        if (SKIP(first_box + i)) continue;
         GROW(s->boxes[i].lo, 0.0);
         GROW(s->boxes[i].hi, 0.0);
     }
 #undef GROW
-    if (!(hi[0] >= lo[0])) return 1.0;
+#undef SKIP
+}
+
+/* Radius of the bounding sphere of the finite primitives where the world has them (1
+ * when there are none): the size of the region a point or directional light shines on,
+ * for its power estimate. An object's primitives count where its instances put them:
+ * each instance adds the world box of its object's box's eight corners. */
+static Status scene_radius(const Scene *s, const uint8_t *in_object, double *radius, Error *err)
+{
+    double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    size_t none[OBJ_KINDS] = { 0 }, all[OBJ_KINDS];
+    all[OBJ_SPHERES] = s->n_spheres;
+    all[OBJ_TRIANGLES] = s->n_triangles;
+    all[OBJ_BOXES] = s->n_boxes;
+    all[OBJ_REVS] = 0;
+    bounds_of_prims(s, in_object, 0, none, all, lo, hi);
+    if (s->n_instances) {
+        double *box = malloc(s->n_objects * 6 * sizeof *box);
+        if (!box) return error_set(err, ST_INTERNAL, "out of memory bounding the instances");
+        for (size_t o = 0; o < s->n_objects; o++) {
+            double *b = box + 6 * o;
+            for (int a = 0; a < 3; a++) b[a] = INFINITY, b[3 + a] = -INFINITY;
+            bounds_of_prims(s, NULL, 1, s->objects[o].first, s->objects[o].end, b, b + 3);
+        }
+        for (size_t i = 0; i < s->n_instances; i++) {
+            const Instance *x = &s->instances[i];
+            const double *b = box + 6 * x->object;
+            if (!(b[3] >= b[0])) continue;
+            for (int corner = 0; corner < 8; corner++) {
+                double p[3] = { b[(corner & 1) ? 3 : 0], b[(corner & 2) ? 4 : 1], b[(corner & 4) ? 5 : 2] }, w[3];
+                for (int r = 0; r < 3; r++)
+                    w[r] = (double)x->to_world[4 * r] * p[0] + (double)x->to_world[4 * r + 1] * p[1] +
+                           (double)x->to_world[4 * r + 2] * p[2] + (double)x->to_world[4 * r + 3];
+                bounds_grow(lo, hi, w, 0.0);
+            }
+        }
+        free(box);
+    }
+    *radius = 1.0;
+    if (!(hi[0] >= lo[0])) return ST_OK;
     double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
     double r = 0.5 * sqrt(dx * dx + dy * dy + dz * dz);
-    return r > 0.0 && isfinite(r) ? r : 1.0;
+    if (r > 0.0 && isfinite(r)) *radius = r;
+    return ST_OK;
 }
 
 /* Estimated power of a delta light over a scene of radius r (see scene.h). */
@@ -200,16 +252,132 @@ Status scene_set_envmap(Scene *s, uint texture, float intensity, float rotate, E
     return ST_OK;
 }
 
+/* ------------------------------------------------------------------ instanced emitters */
+
+/* The most lights instanced emitters make (one per instance and emissive triangle, 96
+ * bytes each on every device): past it they stay out of the light list, found by BSDF
+ * sampling alone, as before they were lights (docs/instancing.md). */
+#define MAX_INSTANCED_LIGHTS (1u << 22)
+
+/* The objects' emitters in their object spaces: object o's emissive triangles are
+ * tpl[first[o] .. first[o + 1]) (LIGHT_INSTANCED, with their object-space winding
+ * normals, and quad halves paired as the world's are), and each of them gets its index
+ * among its object's as its `light`; every other primitive of an object gets NO_INDEX.
+ * Spheres and boxes of objects are no lights: an instance makes an ellipsoid of a sphere
+ * and a parallelepiped of a box, which light sampling has no density for. */
+static Status object_emitters(Scene *s, Light **tpl_out, size_t **first_out, Error *err)
+{
+    *tpl_out = NULL;
+    *first_out = NULL;
+    size_t *first = malloc((s->n_objects + 1) * sizeof *first);
+    size_t n = 0;
+    if (!first) return error_set(err, ST_INTERNAL, "out of memory listing the objects' emitters");
+    for (size_t o = 0; o < s->n_objects; o++) {
+        const SceneObject *ob = &s->objects[o];
+        first[o] = n;
+        for (size_t i = ob->first[OBJ_SPHERES]; i < ob->end[OBJ_SPHERES]; i++) s->spheres[i].light = NO_INDEX;
+        for (size_t i = ob->first[OBJ_BOXES]; i < ob->end[OBJ_BOXES]; i++) s->boxes[i].light = NO_INDEX;
+        for (size_t i = ob->first[OBJ_TRIANGLES]; i < ob->end[OBJ_TRIANGLES]; i++) {
+            int emits = is_emissive(s, s->triangles[i].material);
+            s->triangles[i].light = emits ? (uint)(n - first[o]) : NO_INDEX;
+            n += (size_t)emits;
+        }
+    }
+    first[s->n_objects] = n;
+    Light *tpl = n ? calloc(n, sizeof *tpl) : NULL;
+    double *power = n ? calloc(n, sizeof *power) : NULL;
+    if (n && (!tpl || !power)) {
+        free(first);
+        free(tpl);
+        free(power);
+        return error_set(err, ST_INTERNAL, "out of memory listing the objects' emitters");
+    }
+    uint first_tri = scene_first_triangle(s);
+    for (size_t o = 0; o < s->n_objects; o++) {
+        const SceneObject *ob = &s->objects[o];
+        for (size_t i = ob->first[OBJ_TRIANGLES]; i < ob->end[OBJ_TRIANGLES]; i++) {
+            const Triangle *t = &s->triangles[i];
+            if (t->light == NO_INDEX) continue;
+            Light *l = &tpl[first[o] + t->light];
+            l->type = LIGHT_INSTANCED;
+            l->prim = first_tri + (uint)i;
+            l->normal = v3_norm(v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0)));
+        }
+        pair_quad_lights(s, tpl, power, first[o], first[o + 1]);
+    }
+    free(power);
+    *tpl_out = tpl;
+    *first_out = first;
+    return ST_OK;
+}
+
+/* How many lights instance x makes of its object's emitters: none when its
+ * material replaces the object's (an emissive one emits where no light record says,
+ * found by BSDF sampling alone; a dark one does not emit). */
+static size_t instance_light_count(const Instance *x, const size_t *first)
+{
+    return x->material != NO_INDEX ? 0 : first[x->object + 1] - first[x->object];
+}
+
+/* Template tpl (object space) as instance x places it (types.h, LIGHT_INSTANCED): the
+ * world corner and edges of its triangle, or of its quad's parallelogram, computed in
+ * double and rounded once; the normal by M^-T; the area of the world triangle, which
+ * *area gets in double. An affine map carries the uniform density on the object's
+ * triangle to the uniform density on the world's, so 1 / area is the sample's density. */
+static Light instanced_light(const Scene *s, const Light *tpl, const Instance *x, double *area)
+{
+    double m[3][4], nm[3][3];
+    Transform t;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 4; c++) t.m[r][c] = m[r][c] = (double)x->to_world[4 * r + c];
+    double c0[3], e1[3], e2[3];
+    if (tpl->quad != LIGHT_QUAD_NONE) {
+        const vec3 a = tpl->position, b = tpl->direction, c = tpl->intensity;
+        double cc[3] = { a.x, a.y, a.z }, bb[3] = { b.x, b.y, b.z }, dd[3] = { c.x, c.y, c.z };
+        memcpy(c0, cc, sizeof c0);
+        memcpy(e1, bb, sizeof e1);
+        memcpy(e2, dd, sizeof e2);
+    } else {
+        const Triangle *tr = &s->triangles[tpl->prim - scene_first_triangle(s)];
+        double p0[3] = { tr->p0.x, tr->p0.y, tr->p0.z }, p1[3] = { tr->p1.x, tr->p1.y, tr->p1.z },
+               p2[3] = { tr->p2.x, tr->p2.y, tr->p2.z };
+        for (int a = 0; a < 3; a++) c0[a] = p0[a], e1[a] = p1[a] - p0[a], e2[a] = p2[a] - p0[a];
+    }
+    double wc[3], w1[3], w2[3];
+    for (int r = 0; r < 3; r++) {
+        wc[r] = m[r][0] * c0[0] + m[r][1] * c0[1] + m[r][2] * c0[2] + m[r][3];
+        w1[r] = m[r][0] * e1[0] + m[r][1] * e1[1] + m[r][2] * e1[2];
+        w2[r] = m[r][0] * e2[0] + m[r][1] * e2[1] + m[r][2] * e2[2];
+    }
+    double cx = w1[1] * w2[2] - w1[2] * w2[1], cy = w1[2] * w2[0] - w1[0] * w2[2], cz = w1[0] * w2[1] - w1[1] * w2[0];
+    *area = 0.5 * sqrt(cx * cx + cy * cy + cz * cz);
+    Light l = *tpl;
+    l.position = v3((float)wc[0], (float)wc[1], (float)wc[2]);
+    l.direction = v3((float)w1[0], (float)w1[1], (float)w1[2]);
+    l.intensity = v3((float)w2[0], (float)w2[1], (float)w2[2]);
+    l.area = (float)*area;
+    if (transform_normal_matrix(&t, nm)) {
+        vec3 n = tpl->normal;
+        double v[3];
+        for (int r = 0; r < 3; r++) v[r] = nm[r][0] * n.x + nm[r][1] * n.y + nm[r][2] * n.z;
+        double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if (len > 0.0) l.normal = v3((float)(v[0] / len), (float)(v[1] / len), (float)(v[2] / len));
+    }
+    return l;
+}
+
 Status scene_prepare_lights(Scene *s, Error *err)
 {
     free(s->lights);
+    free(s->instance_lights);
     s->lights = NULL;
+    s->instance_lights = NULL;
     s->n_lights = 0;
     s->env_light = NO_INDEX;
     int env = s->bg_type == BG_MAP && s->n_env_cdf > 0;
     size_t n = (size_t)env;
-    /* an object's primitives are in no place of the world until instanced: no lights
-     * (docs/instancing.md) */
+    /* an object's primitives are in no place of the world until instanced: they become
+     * lights once per instance, after the world's own (docs/instancing.md) */
     uint8_t *in_object;
     Status st = scene_object_mask(s, &in_object, err);
     if (st) return st;
@@ -230,18 +398,42 @@ Status scene_prepare_lights(Scene *s, Error *err)
         n += (size_t)(is_emissive(s, s->triangles[i].material) && !IN_OBJECT(first_tri + i));
     for (size_t i = 0; i < s->n_boxes; i++)
         n += (size_t)(is_emissive(s, s->boxes[i].material) && !IN_OBJECT(first_box + i));
-    n += s->n_delta_lights;
-    if (n == 0 || n >= (size_t)NO_INDEX) {
-        free(in_object);
-        return n == 0 ? ST_OK : error_set(err, ST_INPUT, "too many emissive primitives");
+    Light *tpl = NULL;
+    size_t *tpl_first = NULL, n_instanced = 0;
+    if (s->n_instances) {
+        if ((st = object_emitters(s, &tpl, &tpl_first, err))) {
+            free(in_object);
+            return st;
+        }
+        for (size_t i = 0; i < s->n_instances; i++) n_instanced += instance_light_count(&s->instances[i], tpl_first);
+        if (n_instanced > MAX_INSTANCED_LIGHTS) n_instanced = 0;
+        if (n_instanced) s->instance_lights = malloc(s->n_instances * sizeof *s->instance_lights);
+        if (n_instanced == 0 || !s->instance_lights) {
+            /* no instance's triangles are lights: none may name one (surface_instanced) */
+            for (size_t o = 0; o < s->n_objects; o++)
+                for (size_t i = s->objects[o].first[OBJ_TRIANGLES]; i < s->objects[o].end[OBJ_TRIANGLES]; i++)
+                    s->triangles[i].light = NO_INDEX;
+            if (n_instanced) {
+                free(in_object);
+                free(tpl);
+                free(tpl_first);
+                return error_set(err, ST_INTERNAL, "out of memory listing the instances' lights");
+            }
+        }
     }
-    Light *lights = calloc(n, sizeof *lights);
-    double *power = calloc(n, sizeof *power);
+    n += n_instanced;
+    n += s->n_delta_lights;
+    Light *lights = NULL;
+    double *power = NULL;
+    if (n == 0 || n >= (size_t)NO_INDEX) {
+        st = n == 0 ? ST_OK : error_set(err, ST_INPUT, "too many emissive primitives");
+        goto done;
+    }
+    lights = calloc(n, sizeof *lights);
+    power = calloc(n, sizeof *power);
     if (!lights || !power) {
-        free(in_object);
-        free(lights);
-        free(power);
-        return error_set(err, ST_INTERNAL, "out of memory building the light list");
+        st = error_set(err, ST_INTERNAL, "out of memory building the light list");
+        goto done;
     }
     size_t k = 0;
     double total = 0.0;
@@ -267,10 +459,24 @@ Status scene_prepare_lights(Scene *s, Error *err)
     }
     pair_quad_lights(s, lights, power, first_tri_light, k);
     ADD_LIGHT(s->boxes, s->n_boxes, first_box, box_area(&s->boxes[i]))
-    free(in_object);
 #undef IN_OBJECT
 #undef ADD_LIGHT
-    double radius = s->n_delta_lights || env ? scene_radius(s) : 1.0;
+    for (size_t i = 0; n_instanced && i < s->n_instances; i++) {
+        const Instance *x = &s->instances[i];
+        size_t count = instance_light_count(x, tpl_first);
+        s->instance_lights[i] = count ? (uint)k : NO_INDEX;
+        for (size_t j = 0; j < count; j++, k++) {
+            const Light *t = &tpl[tpl_first[x->object] + j];
+            double area;
+            lights[k] = instanced_light(s, t, x, &area);
+            uint material = s->triangles[t->prim - first_tri].material;
+            power[k] = M_PI * area * v3_luminance(s->materials[material].emission);
+            if (!(power[k] >= 0.0) || !isfinite(power[k])) power[k] = 0.0;
+            total += power[k];
+        }
+    }
+    double radius = 1.0;
+    if ((s->n_delta_lights || env) && (st = scene_radius(s, in_object, &radius, err))) goto done;
     for (size_t i = 0; i < s->n_delta_lights; i++, k++) {
         lights[k] = s->delta_lights[i];
         lights[k].prim = NO_INDEX;
@@ -296,8 +502,14 @@ Status scene_prepare_lights(Scene *s, Error *err)
         lights[i].cdf = (float)acc;
     }
     lights[n - 1].cdf = 1.0f;  /* exact top so a uniform sample in [0,1) always lands */
-    free(power);
     s->lights = lights;
     s->n_lights = n;
-    return ST_OK;
+    lights = NULL;
+done:
+    free(lights);
+    free(power);
+    free(in_object);
+    free(tpl);
+    free(tpl_first);
+    return st;
 }

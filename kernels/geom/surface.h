@@ -282,14 +282,19 @@ KFN vec3 instance_point_error(GLOBAL const Instance *x, vec3 po, vec3 err_o, vec
  * M^-T, the error bound by instance_point_error). The instance's material replaces the
  * primitive's when it names one. M^-T keeps every normal on its side under a mirroring
  * M too, as a mirrored mesh block keeps its triangles' outward sides (its loader swaps
- * two corners; scene_flatten_instances does the same). Prototype primitives are no
- * lights (docs/instancing.md): BSDF sampling finds their emission at full weight. */
+ * two corners; scene_flatten_instances does the same). A prototype's emissive triangle
+ * holds its index among its object's emitters as its `light`: the instance's lights
+ * start at instance_lights[inst] (types.h, LIGHT_INSTANCED), so that MIS weighs the
+ * emission that BSDF sampling finds with the density light sampling had for it. */
 KFN Surface surface_instanced(const SceneView *sc, Ray ray, Hit hit)
 {
     GLOBAL const Instance *x = sc->instances + hit.inst;
     Surface s = surface_local(sc, instance_ray(x, ray), hit);
     s.inst = hit.inst;
-    s.light = NO_INDEX;
+    if (s.light != NO_INDEX) {
+        uint first = sc->instance_lights[hit.inst];
+        s.light = first == NO_INDEX ? NO_INDEX : first + s.light;
+    }
     if (x->material != NO_INDEX) s.material = x->material;
     if (x->flags & INST_IDENTITY) return s;
     s.p = xform_point(x->to_world, s.po);

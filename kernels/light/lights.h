@@ -215,7 +215,19 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, int reuse, flo
             ls->p = v3_madd(sp.center, n, sp.radius);
         }
     } else if (l.prim < first_box) {
-        if (reuse && l.quad != LIGHT_QUAD_NONE) {
+        if (KF_HAS(KF_INSTANCES) && l.type == LIGHT_INSTANCED) {
+            /* the world triangle (types.h): the corner and edges the record holds. A
+             * quad's half samples the whole parallelogram, as below, with or without
+             * the light pair: the two halves together then cover it uniformly. */
+            float s1, s2;    /* along the first edge and the second */
+            if (l.quad != LIGHT_QUAD_NONE) {
+                s1 = (l.quad == LIGHT_QUAD_SECOND ? 0.5f : 0.0f) + 0.5f * u1;
+                s2 = u2;
+            } else {
+                sample_triangle(u1, u2, &s1, &s2);
+            }
+            ls->p = v3_add(l.position, v3_add(v3_scale(l.direction, s1), v3_scale(l.intensity, s2)));
+        } else if (reuse && l.quad != LIGHT_QUAD_NONE) {
             /* half of a parallelogram (types.h): the rest of the choice number, u1, is
              * the coordinate along the edge, the first half's on [0, 1/2) and the
              * second's on [1/2, 1), so the pair's points cover the quad uniformly and

@@ -70,6 +70,25 @@ static const char moved_scene[] = HEAD "instance thing { translate 2.6 0 0 }\n"
 
 static const char lamps_scene[] = LAMPS(64, 3);
 
+/* Spheres of objects: two instances under similarities (one mirrored) are sphere lights
+ * in the world, and render as world spheres at the places the transforms put them do
+ * (their copies would be ellipsoids, which the world does not take as lights); under a
+ * non-uniform scale (BULB_SQUASHED) an ellipsoid, whose light has no power: never
+ * chosen, its emission found by BSDF sampling at full weight. */
+#define BULB_HEAD(spp)                                                                         \
+    "camera { from 0 4.5 7.5 at 0 0.4 0 fov 45 }\n"                                            \
+    "image { width 48 height 36 spp " #spp " depth 1 seed 5 }\n"                               \
+    "background { color 0 0 0 }\n"                                                             \
+    "material floor { type diffuse albedo 0.7 0.7 0.7 }\n"                                     \
+    "material glow { type emissive radiance 8 7 5.5 }\n"                                       \
+    "box { min -6 -0.1 -6 max 6 0 6 material floor }\n"
+#define BULBS(spp)                                                                             \
+    BULB_HEAD(spp) "object bulb { sphere { center 0 0.2 0 radius 0.3 material glow } }\n"      \
+    "instance bulb { scale 0.8 ry 30 translate -1 1.5 0 }\n"                                   \
+    "instance bulb { scale -1.2 1.2 1.2 rx 20 translate 1.2 1.2 0.5 }\n"
+#define BULB_SQUASHED "instance bulb { scale 1 0.5 1 translate 0 2.5 -1.5 }\n"
+
+
 static Status load_text(const char *text, Scene *s, Error *err)
 {
     scene_init(s);
@@ -169,8 +188,8 @@ static void test_kdtree_flattens(void)
 
 static void test_opencl_matches_scalar(void)
 {
-    static const char *const scenes[] = { identity_scene, moved_scene, lamps_scene };
-    for (size_t k = 0; k < 3; k++) {
+    static const char *const scenes[] = { identity_scene, moved_scene, lamps_scene, BULBS(16) BULB_SQUASHED };
+    for (size_t k = 0; k < 4; k++) {
         Film a, b;
         Error err = { 0 };
         Status sa = render(scenes[k], TEST_OPENCL, 0, ACCEL_BVH, &a, &err);
@@ -325,6 +344,66 @@ static void test_lamps_less_noise(void)
     free(img);
     free(sum);
     free(sum2);
+    error_clear(&err);
+}
+
+/* Spheres of objects as sphere lights, and a squashed one as no light (BULBS). */
+static void test_bulbs_are_sphere_lights(void)
+{
+    static const char instanced[] = BULBS(1024);
+    /* the same spheres in the world: centre M (0 0.2 0), radius 0.3 times the scale */
+    char world[2048];
+    double a = 20.0 * M_PI / 180.0;
+    snprintf(world, sizeof world, BULB_HEAD(1024) "sphere { center -1 1.66 0 radius 0.24 material glow }\n"
+             "sphere { center 1.2 %.9f %.9f radius 0.36 material glow }\n", 1.2 + 0.24 * cos(a), 0.5 + 0.24 * sin(a));
+    Error err = { 0 };
+    Scene s;
+    RenderScene rs;
+    CHECK(load_text(instanced, &s, &err) == ST_OK);
+    CHECK_MSG(render_scene_prepare(&s, 1, &rs, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_lights, 2);
+    if (s.n_lights == 2) {
+        CHECK(fabsf(s.lights[0].atten0 - 0.24f) < 1e-6f && fabsf(s.lights[1].atten0 - 0.36f) < 1e-6f);
+        CHECK(fabsf(s.lights[0].position.y - 1.66f) < 1e-6f);
+    }
+    render_scene_free(&rs);
+    scene_free(&s);
+    const char *texts[4] = { instanced, instanced, instanced, world };
+    double blocks[4][36], mean[4];
+    float *img = malloc(48 * 36 * 3 * sizeof *img);
+    for (uint m = 0; m < 4; m++) {
+        CHECK(load_text(texts[m], &s, &err) == ST_OK);
+        CHECK_MSG(render_util_rgb_mis(&s, m == 3 ? MIS_BOTH : m, "scalar", img, &err) == ST_OK, "%s", err.msg);
+        lamp_blocks(img, blocks[m], &mean[m]);
+        scene_free(&s);
+    }
+    fprintf(stderr, "  bulbs, 1024 spp: mean MIS %.4f, light %.4f, BSDF %.4f, world spheres %.4f; worst block "
+            "difference to MIS: light %.1f%%, BSDF %.1f%%, world %.1f%%\n", mean[0], mean[1], mean[2], mean[3],
+            100.0 * blocks_differ(blocks[1], blocks[0]), 100.0 * blocks_differ(blocks[2], blocks[0]),
+            100.0 * blocks_differ(blocks[3], blocks[0]));
+    CHECK(mean[0] > 0.02);
+    for (uint m = 1; m < 4; m++) CHECK(fabs(mean[m] - mean[0]) < 0.01 * mean[0]);
+    CHECK(blocks_differ(blocks[1], blocks[0]) < 0.05);
+    CHECK(blocks_differ(blocks[2], blocks[0]) < 0.08);
+    CHECK(blocks_differ(blocks[3], blocks[0]) < 0.03);
+
+    /* the squashed bulb: a light of no power, and MIS still agrees with BSDF sampling */
+    static const char squashed[] = BULBS(1024) BULB_SQUASHED;
+    CHECK(load_text(squashed, &s, &err) == ST_OK);
+    CHECK_MSG(render_scene_prepare(&s, 1, &rs, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_lights, 3);
+    if (s.n_lights == 3) CHECK(s.lights[2].pick_pdf == 0.0f && s.lights[0].pick_pdf > 0.0f);
+    render_scene_free(&rs);
+    scene_free(&s);
+    for (uint m = 0; m < 2; m++) {
+        CHECK(load_text(squashed, &s, &err) == ST_OK);
+        CHECK(render_util_rgb_mis(&s, m == 0 ? MIS_BOTH : MIS_BSDF_ONLY, "scalar", img, &err) == ST_OK);
+        lamp_blocks(img, blocks[m], &mean[m]);
+        scene_free(&s);
+    }
+    fprintf(stderr, "  squashed bulb: mean MIS %.4f, BSDF %.4f\n", mean[0], mean[1]);
+    CHECK(fabs(mean[1] - mean[0]) < 0.01 * mean[0]);
+    free(img);
     error_clear(&err);
 }
 
@@ -513,6 +592,7 @@ int main(void)
     RUN(test_lamps_are_lights);
     RUN(test_lamps_strategies_agree);
     RUN(test_lamps_less_noise);
+    RUN(test_bulbs_are_sphere_lights);
     RUN(test_opencl_matches_scalar);
     return harness_report();
 }

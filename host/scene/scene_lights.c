@@ -259,12 +259,13 @@ Status scene_set_envmap(Scene *s, uint texture, float intensity, float rotate, E
  * sampling alone, as before they were lights (docs/instancing.md). */
 #define MAX_INSTANCED_LIGHTS (1u << 22)
 
-/* The objects' emitters in their object spaces: object o's emissive triangles are
- * tpl[first[o] .. first[o + 1]) (LIGHT_INSTANCED, with their object-space winding
- * normals, and quad halves paired as the world's are), and each of them gets its index
- * among its object's as its `light`; every other primitive of an object gets NO_INDEX.
- * Spheres and boxes of objects are no lights: an instance makes an ellipsoid of a sphere
- * and a parallelepiped of a box, which light sampling has no density for. */
+/* The objects' emitters in their object spaces: object o's emissive spheres, then its
+ * emissive triangles, are tpl[first[o] .. first[o + 1]) (LIGHT_INSTANCED; a sphere's
+ * centre and radius, a triangle's object-space winding normal, quad halves paired as
+ * the world's are), and each of them gets its index among its object's as its `light`;
+ * every other primitive of an object gets NO_INDEX. Boxes and ellipsoids of objects are
+ * no lights: an instance may make a parallelepiped of a box, and light sampling has no
+ * density for ellipsoids (the world refuses emitting ones). */
 static Status object_emitters(Scene *s, Light **tpl_out, size_t **first_out, Error *err)
 {
     *tpl_out = NULL;
@@ -275,7 +276,11 @@ static Status object_emitters(Scene *s, Light **tpl_out, size_t **first_out, Err
     for (size_t o = 0; o < s->n_objects; o++) {
         const SceneObject *ob = &s->objects[o];
         first[o] = n;
-        for (size_t i = ob->first[OBJ_SPHERES]; i < ob->end[OBJ_SPHERES]; i++) s->spheres[i].light = NO_INDEX;
+        for (size_t i = ob->first[OBJ_SPHERES]; i < ob->end[OBJ_SPHERES]; i++) {
+            int emits = s->spheres[i].xform == 0 && is_emissive(s, s->spheres[i].material);
+            s->spheres[i].light = emits ? (uint)(n - first[o]) : NO_INDEX;
+            n += (size_t)emits;
+        }
         for (size_t i = ob->first[OBJ_BOXES]; i < ob->end[OBJ_BOXES]; i++) s->boxes[i].light = NO_INDEX;
         for (size_t i = ob->first[OBJ_TRIANGLES]; i < ob->end[OBJ_TRIANGLES]; i++) {
             int emits = is_emissive(s, s->triangles[i].material);
@@ -295,6 +300,17 @@ static Status object_emitters(Scene *s, Light **tpl_out, size_t **first_out, Err
     uint first_tri = scene_first_triangle(s);
     for (size_t o = 0; o < s->n_objects; o++) {
         const SceneObject *ob = &s->objects[o];
+        size_t tri_lights = first[o];
+        for (size_t i = ob->first[OBJ_SPHERES]; i < ob->end[OBJ_SPHERES]; i++) {
+            const Sphere *sp = &s->spheres[i];
+            if (sp->light == NO_INDEX) continue;
+            Light *l = &tpl[first[o] + sp->light];
+            l->type = LIGHT_INSTANCED;
+            l->prim = (uint)i;
+            l->position = sp->center;
+            l->atten0 = sp->radius;
+            tri_lights++;
+        }
         for (size_t i = ob->first[OBJ_TRIANGLES]; i < ob->end[OBJ_TRIANGLES]; i++) {
             const Triangle *t = &s->triangles[i];
             if (t->light == NO_INDEX) continue;
@@ -303,7 +319,7 @@ static Status object_emitters(Scene *s, Light **tpl_out, size_t **first_out, Err
             l->prim = first_tri + (uint)i;
             l->normal = v3_norm(v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0)));
         }
-        pair_quad_lights(s, tpl, power, first[o], first[o + 1]);
+        pair_quad_lights(s, tpl, power, tri_lights, first[o + 1]);
     }
     free(power);
     *tpl_out = tpl;
@@ -319,6 +335,37 @@ static size_t instance_light_count(const Instance *x, const size_t *first)
     return x->material != NO_INDEX ? 0 : first[x->object + 1] - first[x->object];
 }
 
+/* The scale s when the linear part of m is s times a rotation (or a mirror), each
+ * column's length and each pair's dot product within 1e-5 of s^2's; else 0. */
+static double similarity_scale(double m[3][4])
+{
+    double g[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) g[i][j] = m[0][i] * m[0][j] + m[1][i] * m[1][j] + m[2][i] * m[2][j];
+    double s2 = (g[0][0] + g[1][1] + g[2][2]) / 3.0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (!(fabs(g[i][j] - (i == j ? s2 : 0.0)) <= 1e-5 * s2)) return 0.0;
+    return sqrt(s2);
+}
+
+/* Sphere template tpl under m: under a similarity the world sphere (centre M c, radius
+ * s r) that light sampling samples by its cone (kernels/light/lights.h); under any other
+ * map an ellipsoid, whose light keeps no area and so no power: it is never chosen, and
+ * a hit on it, whose density is then 0, counts at BSDF sampling's full weight. */
+static Light instanced_sphere_light(const Light *tpl, double m[3][4], double *area)
+{
+    Light l = *tpl;
+    double scale = similarity_scale(m), c[3] = { tpl->position.x, tpl->position.y, tpl->position.z }, w[3];
+    for (int r = 0; r < 3; r++) w[r] = m[r][0] * c[0] + m[r][1] * c[1] + m[r][2] * c[2] + m[r][3];
+    double radius = scale * tpl->atten0;
+    *area = 4.0 * M_PI * radius * radius;
+    l.position = v3((float)w[0], (float)w[1], (float)w[2]);
+    l.atten0 = (float)radius;
+    l.area = (float)*area;
+    return l;
+}
+
 /* Template tpl (object space) as instance x places it (types.h, LIGHT_INSTANCED): the
  * world corner and edges of its triangle, or of its quad's parallelogram, computed in
  * double and rounded once; the normal by M^-T; the area of the world triangle, which
@@ -330,6 +377,7 @@ static Light instanced_light(const Scene *s, const Light *tpl, const Instance *x
     Transform t;
     for (int r = 0; r < 3; r++)
         for (int c = 0; c < 4; c++) t.m[r][c] = m[r][c] = (double)x->to_world[4 * r + c];
+    if (tpl->prim < scene_first_triangle(s)) return instanced_sphere_light(tpl, m, area);
     double c0[3], e1[3], e2[3];
     if (tpl->quad != LIGHT_QUAD_NONE) {
         const vec3 a = tpl->position, b = tpl->direction, c = tpl->intensity;
@@ -469,7 +517,8 @@ Status scene_prepare_lights(Scene *s, Error *err)
             const Light *t = &tpl[tpl_first[x->object] + j];
             double area;
             lights[k] = instanced_light(s, t, x, &area);
-            uint material = s->triangles[t->prim - first_tri].material;
+            uint material = t->prim < first_tri ? s->spheres[t->prim].material
+                                                : s->triangles[t->prim - first_tri].material;
             power[k] = M_PI * area * v3_luminance(s->materials[material].emission);
             if (!(power[k] >= 0.0) || !isfinite(power[k])) power[k] = 0.0;
             total += power[k];

@@ -100,6 +100,18 @@ KFN float light_pdf_by_area(float area, vec3 n, vec3 to, float dist2, float inv_
     return dist2 / (cos_l * area);
 }
 
+/* The sphere that sphere light l is: its primitive, or the world sphere an instanced
+ * light's record holds (types.h, LIGHT_INSTANCED: centre in position, radius in atten0). */
+KFN Sphere light_sphere(const SceneView *sc, Light l)
+{
+    Sphere sp = sc->spheres[l.prim];
+    if (KF_HAS(KF_INSTANCES) && l.type == LIGHT_INSTANCED) {
+        sp.center = l.position;
+        sp.radius = l.atten0;
+    }
+    return sp;
+}
+
 /* Solid-angle density at ref of area light `li` producing point x (normal n), the
  * choice of the light excluded. */
 KFN float light_pdf_area(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
@@ -108,7 +120,7 @@ KFN float light_pdf_area(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
     vec3 to = v3_sub(x, ref);
     float dist2 = v3_dot(to, to);
     if (KF_HAS(KF_SPHERES) && l.prim < sc->params->n_spheres) {
-        Sphere sp = sc->spheres[l.prim];
+        Sphere sp = light_sphere(sc, l);
         vec3 wc = v3_sub(sp.center, ref);
         float dc2 = v3_dot(wc, wc);
         if (sphere_cone_sampling(sp, dc2))
@@ -120,7 +132,11 @@ KFN float light_pdf_area(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
 /* The same with the choice of the light among all lights included (for MIS). */
 KFN float light_pdf(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
 {
-    return sc->lights[li].pick_pdf * light_pdf_area(sc, li, ref, x, n);
+    float pick = sc->lights[li].pick_pdf;
+    /* the light of an ellipsoid an instance makes of a sphere has no power, so it is
+     * never chosen, and no sphere to read a density from (host/scene/scene_lights.c) */
+    if (KF_HAS(KF_INSTANCES) && !(pick > 0.0f)) return 0.0f;
+    return pick * light_pdf_area(sc, li, ref, x, n);
 }
 
 /* The density with which light sampling picks direction d toward the environment map
@@ -188,7 +204,7 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, int reuse, flo
     ls->delta = 0;
 
     if (KF_HAS(KF_SPHERES) && l.prim < first_tri) {
-        Sphere sp = sc->spheres[l.prim];
+        Sphere sp = light_sphere(sc, l);
         vec3 wc = v3_sub(sp.center, ref);
         float dc2 = v3_dot(wc, wc);
         if (sphere_cone_sampling(sp, dc2)) {

@@ -256,7 +256,8 @@ typedef struct {                                        /* 112 bytes */
 typedef struct {                                        /* 32 bytes */
     vec3 center;  float radius;
     uint material;
-    uint light;     /* index into lights[] if emissive, else NO_INDEX */
+    uint light;     /* index into lights[] if emissive, else NO_INDEX; in an object,
+                     * its index among the object's emitters (LIGHT_INSTANCED) */
     uint xform;     /* 0: a plain sphere (centre, radius); else 1 + its index in the
                      * sphere_xforms buffer: the unit sphere under that transform, an
                      * ellipsoid, whose centre and radius are then only a bounding

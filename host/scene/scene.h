@@ -55,8 +55,9 @@ typedef struct {
 
 /* An object (docs/instancing.md): the primitives its block made, [first, end) of each
  * kind in the scene's arrays (spheres, triangles, boxes, surfaces of revolution, in
- * that order), which only its instances reach: no tree but its own holds them and they
- * are no lights. Objects are made one after another, so their ranges increase. */
+ * that order), which only its instances reach: no tree but its own holds them, and
+ * their emitters are lights once per instance (scene_prepare_lights). Objects are made
+ * one after another, so their ranges increase. */
 enum { OBJ_SPHERES, OBJ_TRIANGLES, OBJ_BOXES, OBJ_REVS, OBJ_KINDS };
 typedef struct {
     char *name;

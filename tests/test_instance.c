@@ -3,8 +3,10 @@
  * (docs/instancing.md): an instanced scene against the same scene flattened into copies
  * (bit for bit under identity transforms, within noise under others), hits and normals
  * through rotated, non-uniformly scaled and mirrored instances against a test of every
- * primitive of every instance, PoCL against the scalar device bit for bit, and the
- * kd-tree's copies. Run from the project root.
+ * primitive of every instance, PoCL against the scalar device bit for bit, the
+ * kd-tree's copies, and instanced emitters as lights (against their copies, each
+ * sampling strategy alone, their noise before and after) and the scene radius that
+ * delta lights are chosen by. Run from the project root.
  */
 #include <math.h>
 #include <stdio.h>
@@ -407,6 +409,47 @@ static void test_bulbs_are_sphere_lights(void)
     error_clear(&err);
 }
 
+/* The choice of a directional light reads the scene's radius, which counts the world
+ * boxes of the instances: under axis-aligned scales and translations those are the
+ * copies' bounds, so the light is chosen with the copies' probability, and the far
+ * instance makes it far likelier than the world's own primitives alone would. */
+static void test_radius_counts_instances(void)
+{
+    static const char text[] =
+        "camera { from 0 4 9 at 0 0 0 fov 40 }\n"
+        "image { width 8 height 8 spp 1 }\n"
+        "material grey { type diffuse albedo 0.5 0.5 0.5 }\n"
+        "material lamp { type emissive radiance 5 5 5 }\n"
+        "quad { v0 -0.5 3 -0.5 v1 0.5 3 -0.5 v2 0.5 3 0.5 v3 -0.5 3 0.5 material lamp }\n"
+        "light { type directional direction 0 -1 0 intensity 1 1 1 }\n"
+        "object block { box { min -1 0 -1 max 1 1 1 material grey } }\n"
+        "instance block { scale 2 1 3 translate 40 0 -10 }\n"
+        "instance block { translate -5 0 0 }\n";
+    Scene a, b, c;
+    Error err = { 0 };
+    CHECK(load_text(text, &a, &err) == ST_OK);
+    CHECK(load_text(text, &b, &err) == ST_OK);
+    CHECK(scene_flatten_instances(&b, &err) == ST_OK);
+    CHECK(scene_prepare_lights(&a, &err) == ST_OK && scene_prepare_lights(&b, &err) == ST_OK);
+    /* without the instances: the quad alone bounds the world */
+    CHECK(load_text(text, &c, &err) == ST_OK);
+    c.n_instances = 0;
+    CHECK(scene_prepare_lights(&c, &err) == ST_OK);
+    CHECK_EQ_INT(a.n_lights, 3);
+    CHECK_EQ_INT(b.n_lights, 3);
+    if (a.n_lights == 3 && b.n_lights == 3 && c.n_lights == 3) {
+        float pa = a.lights[2].pick_pdf, pb = b.lights[2].pick_pdf, pc = c.lights[2].pick_pdf;
+        fprintf(stderr, "  directional light chosen with %.6f (copies %.6f; without instances %.6f)\n", pa, pb, pc);
+        CHECK(a.lights[2].type == LIGHT_DIRECTIONAL && fabsf(pa - pb) <= 1e-6f * pb);
+        CHECK(pa > 10.0f * pc);
+    }
+    scene_free(&a);
+    scene_free(&b);
+    c.n_instances = 2;
+    scene_free(&c);
+    error_clear(&err);
+}
+
 /* ------------------------------------------------------------------ hits */
 
 static uint32_t rng_state = 12345u;
@@ -593,6 +636,7 @@ int main(void)
     RUN(test_lamps_strategies_agree);
     RUN(test_lamps_less_noise);
     RUN(test_bulbs_are_sphere_lights);
+    RUN(test_radius_counts_instances);
     RUN(test_opencl_matches_scalar);
     return harness_report();
 }

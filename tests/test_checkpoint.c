@@ -287,14 +287,18 @@ static void test_render_key_covers_every_scene_buffer(void)
     ds.n_materials = ds.n_shading = 2;
     ds.n_tri_extra_of = ds.n_tri_extras = 2;
     ds.n_texels = ds.n_rev_points = 2;
-    ds.n_env_cdf = ds.n_bvh_leaves = ds.n_sphere_xforms = ds.n_instance_lights = 2;
+    ds.n_env_cdf = ds.n_bvh_leaves = ds.n_sphere_xforms = ds.n_instance_lights = ds.n_grid_data = 2;
+    p->n_grids = 2;
     CheckpointId base, changed;
     checkpoint_id(&ds, 4u, &base);
     for (unsigned i = 0; i < SCENE_BUF_COUNT; i++) {
         SceneBufferBytes b = device_scene_buffer(&ds, i);
         CHECK_MSG(b.bytes > 0 && b.bytes <= sizeof key_pool[i], "buffer %u (%s): %zu bytes", i, b.what, b.bytes);
         if (b.bytes == 0 || b.bytes > sizeof key_pool[i]) continue;
-        size_t at[3] = { 0, b.bytes / 2, b.bytes - 1 };
+        /* the parameters end in a count (n_grids): its last byte flipped would make it
+         * 2^24 + 2 and the grids' bytes overrun the pool, so flip that count's low byte */
+        size_t last = i == SCENE_BUF_params ? b.bytes - sizeof(uint) : b.bytes - 1;
+        size_t at[3] = { 0, b.bytes / 2, last };
         for (int k = 0; k < 3; k++) {
             unsigned char *byte = (unsigned char *)(uintptr_t)b.data + at[k];
             *byte ^= 0x01u;

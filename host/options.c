@@ -131,7 +131,8 @@
     X(OUTPUT, SWITCH, denoise, "--denoise", NULL, NULL, NONE, \
         "denoise the finished image with Intel Open\n" \
         "Image Denoise (its RT filter, with albedo and\n" \
-        "normal images rendered at the image's spp);\n" \
+        "normal images rendered at the image's spp,\n" \
+        "through mirrors and clear glass);\n" \
         "an .exr output also keeps the noisy colour\n" \
         "(noisy.R/G/B) and the features as channels.\n" \
         "Needs OIDN: sh tools/deps.sh oidn\n" \

@@ -576,14 +576,18 @@ enum BackgroundType { BG_CONSTANT = 0, BG_SKY = 1, BG_CUBEMAP = 2, BG_MAP = 3 };
  * RenderParams.bg_cubemap on, in the course's order (kernels/light/background.h). */
 enum CubeFace { CUBE_LEFT = 0, CUBE_RIGHT = 1, CUBE_UP = 2, CUBE_DOWN = 3, CUBE_FRONT = 4, CUBE_BACK = 5 };
 
-/* What a sample computes: light transport (path, whitted) or an auxiliary image of the
- * first hit (kernels/integrator/whitted.h). */
+/* What a sample computes: light transport (path, whitted), an auxiliary image of the
+ * first hit, or a feature image of the denoiser (kernels/integrator/whitted.h). */
 enum Integrator {
     INTEGRATOR_PATH = 0,
     INTEGRATOR_WHITTED = 1,
     INTEGRATOR_AOV_NORMAL = 2,   /* shading normal n as (n + 1) / 2 */
     INTEGRATOR_AOV_DEPTH = 3,    /* (distance, 1, 0) at a hit, 0 0 0 for a miss */
-    INTEGRATOR_AOV_ALBEDO = 4    /* diffuse colour (textured) */
+    INTEGRATOR_AOV_ALBEDO = 4,   /* diffuse colour (textured) */
+    /* the denoiser's features (--denoise, docs/denoise.md): as the two above, but at the
+     * first surface that is not perfectly specular, seen through mirrors and clear glass */
+    INTEGRATOR_FEATURE_NORMAL = 5,
+    INTEGRATOR_FEATURE_ALBEDO = 6
 };
 
 /* A participating medium (kernels/medium/, docs/media.md): coefficients per unit of

@@ -3,13 +3,17 @@
  * the exact message, before anything is rendered; with it (build/oidn, from `sh
  * tools/deps.sh oidn`), a 16-spp Cornell box comes out finite and much nearer a
  * converged reference (RMSE and SSIM), also after a resume and from `clpt merge`, and
- * an EXR output keeps the noisy colour and the features as channels.
+ * an EXR output keeps the noisy colour and the features as channels. Without the
+ * library too: the features are those of the surface seen through a mirror or clear
+ * glass, the same on the scalar device and OpenCL, while --aov's images stay first-hit.
  */
 #include "harness.h"
 
 #include "cli_util.h"
 #include "image_metrics.h"
+#include "render_util.h"
 #include "render/denoise.h"
+#include "util/kmath.h"
 
 #define SCENE "scenes/cornell-box.scene"
 #define SIZE "96"
@@ -175,10 +179,99 @@ static void test_exr_keeps_noisy_and_features(void)
     for (size_t i = 0; i < sizeof names / sizeof *names; i++) CHECK_MSG(file_has(exr, names[i]), "%s", names[i]);
 }
 
+/* ------------------------------------------------------------ features through mirrors */
+
+#define FW 8
+#define FH 6
+#define WALL_RED v3(0.8f, 0.1f, 0.1f)
+
+/* An infinite plane {p : normal . p = offset} of material m. */
+static void add_plane(Scene *s, vec3 normal, float offset, uint m)
+{
+    Plane pl;
+    memset(&pl, 0, sizeof pl);
+    pl.normal = normal;
+    pl.offset = offset;
+    pl.material = m;
+    CHECK(scene_add_plane(s, pl, NULL) == ST_OK);
+}
+
+/* The camera at the origin looking down -z at `front` (a perfect mirror at z = -2, or a
+ * clear thin glass sheet at z = -1), and a red diffuse wall where its rays go next: at
+ * z = +5 facing the mirror (behind the camera), or at z = -3 behind the glass. */
+static void specular_scene(Scene *s, int glass)
+{
+    scene_init(s);
+    s->image.width = FW;
+    s->image.height = FH;
+    s->image.spp = 1;
+    s->camera.from = v3(0.0f, 0.0f, 0.0f);
+    s->camera.at = v3(0.0f, 0.0f, -1.0f);
+    s->camera.up = v3(0.0f, 1.0f, 0.0f);
+    s->camera.vfov = 30.0f;
+    uint wall, front;
+    Material sheet = material_dielectric(1.5f);
+    sheet.flags |= MAT_THIN;
+    CHECK(scene_add_material(s, "wall", material_diffuse(WALL_RED), &wall, NULL) == ST_OK);
+    CHECK(scene_add_material(s, "front", glass ? sheet : material_metal(v3s(1.0f), 0.0f), &front, NULL) == ST_OK);
+    add_plane(s, v3(0.0f, 0.0f, 1.0f), glass ? -1.0f : -2.0f, front);
+    if (glass) add_plane(s, v3(0.0f, 0.0f, 1.0f), -3.0f, wall);
+    else add_plane(s, v3(0.0f, 0.0f, -1.0f), -5.0f, wall);
+}
+
+/* Image `mode` (enum Integrator) of the scene on `devices`, into rgb (FW x FH x 3). */
+static int render_mode(int glass, uint mode, const char *devices, float *rgb)
+{
+    Scene s;
+    specular_scene(&s, glass);
+    s.integrator = mode;
+    Error err = { 0 };
+    Status st = render_util_rgb_mis(&s, RENDER_UTIL_SCENE_MIS, devices, rgb, &err);
+    if (st) fprintf(stderr, "  rendering image %u on %s: %s\n", mode, devices, err.msg);
+    error_clear(&err);
+    scene_free(&s);
+    return st == ST_OK;
+}
+
+/* Whether every pixel of rgb is within 1e-4 of c. */
+static int all_near(const float *rgb, vec3 c)
+{
+    for (int i = 0; i < FW * FH; i++)
+        if (fabsf(rgb[3 * i] - c.x) > 1e-4f || fabsf(rgb[3 * i + 1] - c.y) > 1e-4f || fabsf(rgb[3 * i + 2] - c.z) > 1e-4f)
+            return 0;
+    return 1;
+}
+
+/* A red wall seen in a perfect mirror, and through a thin glass sheet: the denoiser's
+ * albedo is the wall's, its normal the wall's ((n + 1) / 2), on the scalar device and
+ * OpenCL bit for bit; --aov albedo and normal still show the mirror itself. */
+static void test_features_through_specular(void)
+{
+    static float a[FW * FH * 3], b[FW * FH * 3];
+    for (int glass = 0; glass <= 1; glass++) {
+        const char *what = glass ? "glass" : "mirror";
+        vec3 wall_normal = glass ? v3(0.5f, 0.5f, 1.0f) : v3(0.5f, 0.5f, 0.0f);
+        if (!render_mode(glass, INTEGRATOR_FEATURE_ALBEDO, "scalar", a)) return;
+        CHECK_MSG(all_near(a, WALL_RED), "%s: albedo feature %g %g %g, not the wall's", what, a[0], a[1], a[2]);
+        if (!render_mode(glass, INTEGRATOR_FEATURE_ALBEDO, TEST_OPENCL, b)) return;
+        CHECK_MSG(!memcmp(a, b, sizeof a), "%s: the albedo feature differs between scalar and OpenCL", what);
+        if (!render_mode(glass, INTEGRATOR_FEATURE_NORMAL, "scalar", a)) return;
+        CHECK_MSG(all_near(a, wall_normal), "%s: normal feature %g %g %g, not the wall's", what, a[0], a[1], a[2]);
+        if (!render_mode(glass, INTEGRATOR_FEATURE_NORMAL, TEST_OPENCL, b)) return;
+        CHECK_MSG(!memcmp(a, b, sizeof a), "%s: the normal feature differs between scalar and OpenCL", what);
+        /* the first-hit images --aov writes are unchanged: the mirror's (or glass's) own */
+        if (!render_mode(glass, INTEGRATOR_AOV_ALBEDO, "scalar", a)) return;
+        CHECK_MSG(all_near(a, v3s(1.0f)), "%s: --aov albedo %g %g %g", what, a[0], a[1], a[2]);
+        if (!render_mode(glass, INTEGRATOR_AOV_NORMAL, "scalar", a)) return;
+        CHECK_MSG(all_near(a, v3(0.5f, 0.5f, 1.0f)), "%s: --aov normal %g %g %g", what, a[0], a[1], a[2]);
+    }
+}
+
 int main(void)
 {
     if (!mkdtemp(dir)) return 1;
     RUN(test_missing_library_message);
+    RUN(test_features_through_specular);
     Denoiser *d = NULL;
     Error err = { 0 };
     have_oidn = denoiser_open(&d, &err) == ST_OK;

@@ -1057,8 +1057,8 @@ static void test_film(void)
     clReleaseMemObject(fb);
 }
 
-/* k_whitted against whitted_sample in C: the classic ray tracer and each auxiliary
- * image, pixel centres and a jittered grid, with and without the adaptive pass's mask. */
+/* k_whitted against whitted_sample in C: the classic ray tracer, each auxiliary image
+ * and the denoiser's features (through the scene's mirrors and glass), pixel centres and a jittered grid, with and without the adaptive pass's mask. */
 static void test_whitted(void)
 {
     const RenderParams *base = &rs.ds.params;
@@ -1075,6 +1075,8 @@ static void test_whitted(void)
         { INTEGRATOR_AOV_NORMAL, 0, 0, 0, "normal image" },
         { INTEGRATOR_AOV_DEPTH, 1, 0, 0, "depth image" },
         { INTEGRATOR_AOV_ALBEDO, 0, 0, 0, "albedo image" },
+        { INTEGRATOR_FEATURE_NORMAL, 1, 0, 0, "denoiser's normal, through mirrors" },
+        { INTEGRATOR_FEATURE_ALBEDO, 3, 0, 1, "denoiser's albedo, through mirrors" },
     };
     for (size_t m = 0; m < sizeof modes / sizeof modes[0]; m++) {
         RenderParams p = *base;

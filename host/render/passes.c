@@ -209,11 +209,12 @@ Status passes_aov_data(const PassContext *pc, unsigned aov, uint spp, float *rgb
 {
     RenderParams *p = &pc->rs->ds.params;
     uint grey = p->normal_miss_grey;
-    if (aov == INTEGRATOR_AOV_NORMAL) p->normal_miss_grey = 1;
+    int normal = aov == INTEGRATOR_AOV_NORMAL || aov == INTEGRATOR_FEATURE_NORMAL;
+    if (normal) p->normal_miss_grey = 1;
     DepthScale raw = { DEPTH_RAW, 0.0, 0.0 };
     Status st = passes_aov(pc, aov, spp, &raw, rgb, secs, err);
     p->normal_miss_grey = grey;
-    if (!st && aov == INTEGRATOR_AOV_NORMAL)
+    if (!st && normal)
         for (size_t i = 0; i < (size_t)p->width * p->height * 3u; i++) rgb[i] = 2.0f * rgb[i] - 1.0f;
     return st;
 }
@@ -240,6 +241,16 @@ static Status passes__write_exr_layers(const PassRequest *q, const char *output,
     return n ? image_write_exr(output, rgb, layers, n, w, h, q->exr_float, err) : ST_OK;
 }
 
+/* What the albedo and normal channels of an EXR output and the denoiser's inputs are
+ * rendered as: with --denoise, its features (seen through mirrors and clear glass,
+ * INTEGRATOR_FEATURE_*), so that the EXR keeps what the denoiser saw; else the
+ * first-hit images of --aov. */
+static unsigned passes__channel_mode(const PassRequest *q, unsigned aov)
+{
+    if (!q->denoise || aov == INTEGRATOR_AOV_DEPTH) return aov;
+    return aov == INTEGRATOR_AOV_NORMAL ? INTEGRATOR_FEATURE_NORMAL : INTEGRATOR_FEATURE_ALBEDO;
+}
+
 /* Whether the EXR output holds auxiliary image `aov` as channels: asked by --aov, or a
  * feature the denoiser used (kept so that it can be run again elsewhere). */
 static int passes__aov_wanted_in_exr(const PassRequest *q, const char *output, unsigned aov)
@@ -248,8 +259,9 @@ static int passes__aov_wanted_in_exr(const PassRequest *q, const char *output, u
     return ((q->aovs & (1u << aov)) || feature) && passes_aov_in_exr(q, output, aov);
 }
 
-/* The denoiser's features, into aov[] (normal and albedo slots) as an EXR's channels
- * hold them, where the EXR pass has not rendered them already. */
+/* The denoiser's features (INTEGRATOR_FEATURE_*: through mirrors and clear glass), into
+ * aov[] (normal and albedo slots) as an EXR's channels hold them, where the EXR pass has
+ * not rendered them already. */
 static Status passes__features(const PassContext *pc, uint spp, float *aov[3], int quiet, Error *err)
 {
     size_t n = (size_t)pc->rs->ds.params.width * pc->rs->ds.params.height * 3u;
@@ -259,7 +271,8 @@ static Status passes__features(const PassContext *pc, uint spp, float *aov[3], i
         if (*slot) continue;
         double secs = 0.0;
         if (!(*slot = malloc(n * sizeof **slot))) return error_set(err, ST_INTERNAL, "out of memory");
-        st = passes_aov_data(pc, a, spp, *slot, &secs, err);
+        st = passes_aov_data(pc, a == INTEGRATOR_AOV_NORMAL ? INTEGRATOR_FEATURE_NORMAL : INTEGRATOR_FEATURE_ALBEDO,
+                             spp, *slot, &secs, err);
         if (!st && !quiet) fprintf(stderr, "clpt: %s image for the denoiser in %.2f s\n", passes_aov_name(a), secs);
     }
     return st;
@@ -296,7 +309,7 @@ static Status passes__final_image(const PassRequest *q, const PassContext *pc, c
         float **slot = &in_exr[aov - INTEGRATOR_AOV_NORMAL];
         double secs = 0.0;
         if (!(*slot = malloc((size_t)w * h * 3u * sizeof **slot))) st = error_set(err, ST_INTERNAL, "out of memory");
-        if (!st) st = passes_aov_data(pc, aov, spp, *slot, &secs, err);
+        if (!st) st = passes_aov_data(pc, passes__channel_mode(q, aov), spp, *slot, &secs, err);
         if (!st && !q->quiet) fprintf(stderr, "clpt: %s image in %.2f s\n", passes_aov_name(aov), secs);
     }
     if (!st && q->denoise) st = passes__features(pc, spp, in_exr, q->quiet, err);

@@ -63,10 +63,10 @@ void passes_depth_grey(float *rgb, size_t n, const DepthScale *scale);
 Status passes_aov(const PassContext *pc, uint aov, uint spp, const DepthScale *depth, float *rgb,
                   double *seconds, Error *err);
 
-/* Renders auxiliary image `aov` as data, as the EXR output's channels and the library
- * (api/) hold it: the normal signed (the pixel's mean normal, misses counting 0), the
- * mean distance to the pixel's hits in every channel (+inf where none), the albedo as
- * it is. */
+/* Renders auxiliary image `aov` (INTEGRATOR_AOV_*, or a denoiser's feature
+ * INTEGRATOR_FEATURE_*) as data, as the EXR output's channels and the library (api/)
+ * hold it: the normal signed (the pixel's mean normal, misses counting 0), the mean
+ * distance to the pixel's hits in every channel (+inf where none), the albedo as it is. */
 Status passes_aov_data(const PassContext *pc, unsigned aov, uint spp, float *rgb, double *seconds, Error *err);
 
 /* The file name of an auxiliary image: "out.png" and "normal" give "out-normal.png". */
@@ -96,8 +96,8 @@ char *passes_aov_output_path(const PassRequest *q, const char *output, unsigned 
 int passes_aov_in_exr(const PassRequest *q, const char *output, unsigned aov);
 /* The adaptive pass, the denoiser and the auxiliary images, after the main image is in
  * rgb (and written to `output`): each image to its file, or as channels of an EXR
- * output. With q->denoise the albedo and normal images are rendered (as an EXR's
- * channels hold them), rgb is denoised with them and rewritten to `output`; an EXR
+ * output. With q->denoise the albedo and normal features are rendered (as an EXR's
+ * channels hold them; through mirrors and clear glass), rgb is denoised with them and rewritten to `output`; an EXR
  * output then also holds them and the noisy colour (noisy.R/G/B). A failure here is
  * the run's failure; the main image stays written. */
 Status passes_after_image(const PassRequest *q, const PassContext *pc, const char *output, const ImageStyle *style,

@@ -1,6 +1,7 @@
 /*
  * whitted.h — the classic ray tracer (Whitted 1980, as taught in MIT 6.837 and the
- * courses derived from it), and the auxiliary images of the first hit.
+ * courses derived from it), the auxiliary images of the first hit, and the denoiser's
+ * feature images (through mirrors and clear glass).
  *
  * One call computes one pixel sample from its camera ray to the end: at every hit the
  * local Phong shading from each point, spot and directional light (with a hard shadow
@@ -251,6 +252,16 @@ KFN vec3 whitted_radiance(const SceneView *sc, Ray camera, RngKey key, uint *ray
     return L;
 }
 
+/* The albedo image's value at surface s of (resolved) material m: its diffuse colour,
+ * 1 for glass (as Open Image Denoise's documentation advises for dielectrics), 0 for
+ * what does not scatter (a lamp). */
+KFN vec3 aov_albedo_at(const SceneView *sc, Material m, Surface s, vec3 ng)
+{
+    if (!material_scatters(m.type)) return v3s(0.0f);
+    if (m.type == MAT_DIELECTRIC) return v3s(1.0f);
+    return material_albedo(sc, m, s, ng);
+}
+
 /* An auxiliary image's value at the first hit (enum Integrator). */
 KFN vec3 whitted_aov(const SceneView *sc, Ray ray, uint mode, uint *rays)
 {
@@ -264,9 +275,104 @@ KFN vec3 whitted_aov(const SceneView *sc, Ray ray, uint mode, uint *rays)
     vec3 ng = v3_dot(ray.d, s.ng) < 0.0f ? s.ng : v3_neg(s.ng);
     Material m = sc->materials[s.material];
     material_resolve(sc, &m, s, ray.d, ng);
-    if (!material_scatters(m.type)) return v3s(0.0f);
-    if (m.type == MAT_DIELECTRIC) return v3s(1.0f);
-    return material_albedo(sc, m, s, ng);
+    return aov_albedo_at(sc, m, s, ng);
+}
+
+/* How many perfectly specular surfaces in a row the denoiser's features pass through;
+ * the surface after them gives its own, specular or not. */
+#define FEATURE_SPECULAR_DEPTH 8u
+
+/* Each channel of c limited to 0..1 (OIDN's range for the albedo; NaN becomes 0). */
+KFN vec3 feature_unit(vec3 c)
+{
+    return v3(k_clamp(c.x, 0.0f, 1.0f), k_clamp(c.y, 0.0f, 1.0f), k_clamp(c.z, 0.0f, 1.0f));
+}
+
+/* Whether the features go on past surface s of (resolved) material m, seen along d: only
+ * when m is perfectly specular (no lobe with a density, bsdf_has_density, and for the
+ * classic metal no fuzz), and then along one lobe chosen without random numbers:
+ *   - smooth glass: the refracted ray (straight on through a thin sheet), the mirror
+ *     ray on total internal reflection; weight 1 (glass is white in the albedo);
+ *   - a classic Phong material that is only mirror and see-through: the larger of the
+ *     two by luminance, weighted by its colour;
+ *   - metal, smooth conductors, a smooth coat over a smooth conductor: the mirror ray,
+ *     weighted by the reflectance the classic tracer gives it (whitted_radiance).
+ * *next and *weight receive the ray and what it multiplies the albedo by. */
+KFN int feature_specular_next(const SceneView *sc, Material m, Surface s, vec3 d, vec3 ng, vec3 kd, Ray *next,
+                              vec3 *weight)
+{
+    (void)sc;
+    if (!material_scatters(m.type) || m.type == MAT_PRINCIPLED || bsdf_has_density(m, kd)) return 0;
+    if (m.type == MAT_METAL && m.fuzz > 0.0f) return 0;
+    int front = v3_dot(d, s.ng) < 0.0f;
+    vec3 ns = bsdf_normal(m, d, front ? s.ns : v3_neg(s.ns), ng);
+    float c = k_clamp(-v3_dot(d, ns), 0.0f, 1.0f);
+    int transmit = 0;
+    vec3 w = v3s(1.0f);
+    if (m.type == MAT_DIELECTRIC) {
+        transmit = 1;
+    } else if (m.type == MAT_PHONG) {
+        PhongLobes l = phong_lobes(m, kd);
+        transmit = v3_luminance(l.kt) > v3_luminance(l.kr);
+        w = transmit ? l.kt : l.kr;
+    } else if (m.type == MAT_METAL) {
+        w = kd;
+    } else if (m.type == MAT_CONDUCTOR) {
+        w = conductor_fresnel(bsdf_conductor(m, kd), c);
+    } else if (m.type == MAT_LAYERED) {
+        float F = fresnel_dielectric(c, m.ior);
+        w = v3_add(v3s(F), v3_scale(conductor_fresnel(bsdf_layered(m, kd).c, c), 1.0f - F));
+    }
+    if (v3_is_zero(w)) return 0;
+    vec3 dir = d;
+    if (transmit && !(m.type == MAT_DIELECTRIC && (m.flags & MAT_THIN))) {
+        /* as whitted_radiance refracts: through the shading normal, else the geometric one */
+        float eta = front ? m.ior : 1.0f / m.ior;
+        transmit = refract_dir(d, ns, eta, &dir);
+        if (transmit && v3_dot(dir, ng) >= 0.0f) transmit = refract_dir(d, ng, eta, &dir);
+    }
+    if (!transmit) {
+        dir = reflect_dir(d, ns);
+        if (v3_dot(dir, ng) <= 0.0f) dir = reflect_dir(d, ng);
+    }
+    next->o = spawn_origin(s, transmit ? v3_neg(ng) : ng);
+    next->d = dir;
+    next->tmin = 0.0f;
+    next->tmax = INFINITY;
+    *weight = w;
+    return 1;
+}
+
+/* A feature image of the denoiser (INTEGRATOR_FEATURE_*) along a camera ray: the albedo
+ * and the shading normal (as (n + 1) / 2) of the first surface that is not perfectly
+ * specular, seen through up to FEATURE_SPECULAR_DEPTH mirrors and clear glass, as Open
+ * Image Denoise's documentation recommends for its auxiliary images; the albedo times
+ * the weights of the specular surfaces passed (feature_specular_next). A ray that
+ * escapes gives the environment's colour (clamped to 0..1) as albedo and no normal. */
+KFN vec3 whitted_feature(const SceneView *sc, Ray ray, uint mode, uint *rays)
+{
+    vec3 tint = v3s(1.0f);
+    for (uint bounce = 0u;; bounce++) {
+        Hit hit = trace_closest_visible(sc, ray);
+        (*rays)++;
+        if (hit.prim == NO_INDEX) {
+            if (mode == INTEGRATOR_FEATURE_NORMAL) return v3s(sc->params->normal_miss_grey ? 0.5f : 0.0f);
+            return feature_unit(v3_mul(tint, background_radiance(sc, ray.d)));
+        }
+        Surface s = surface_at(sc, ray, hit);
+        vec3 ng = v3_dot(ray.d, s.ng) < 0.0f ? s.ng : v3_neg(s.ng);
+        Material m = sc->materials[s.material];
+        material_resolve(sc, &m, s, ray.d, ng);
+        vec3 kd = material_albedo(sc, m, s, ng), w;
+        Ray next;
+        if (bounce < FEATURE_SPECULAR_DEPTH && feature_specular_next(sc, m, s, ray.d, ng, kd, &next, &w)) {
+            tint = v3_mul(tint, w);
+            ray = next;
+            continue;
+        }
+        if (mode == INTEGRATOR_FEATURE_NORMAL) return v3_scale(v3_add(material_normal(sc, m, s), v3s(1.0f)), 0.5f);
+        return feature_unit(v3_mul(tint, aov_albedo_at(sc, m, s, ng)));
+    }
 }
 
 /* One pixel sample of the whitted integrator or of an auxiliary image; *rays counts
@@ -279,6 +385,7 @@ KFN vec3 whitted_sample(const SceneView *sc, uint pixel, uint sample, uint *rays
     RngKey key;
     Ray r = whitted_camera_ray(p, pixel, sample, &key);
     if (p->integrator == INTEGRATOR_WHITTED) return whitted_radiance(sc, r, key, rays);
+    if (p->integrator >= INTEGRATOR_FEATURE_NORMAL) return whitted_feature(sc, r, p->integrator, rays);
     return whitted_aov(sc, r, p->integrator, rays);
 }
 

@@ -248,6 +248,15 @@ INSTALL     ?= install
 INSTALL_LIBS    ?= $(BUILD)/lib$(PROG).so*
 INSTALL_HEADERS ?= include/$(PROG)/*.h $(BUILD)/include/$(PROG)/*.h
 
+# Open Image Denoise (--denoise), when `sh tools/deps.sh oidn` has fetched it into
+# BUILD/oidn: copied whole (its libraries, TBB, SOURCE) to BINDIR/../lib/clpt/oidn, the
+# one folder relative to the program that clpt's dlopen search looks in once installed
+# (host/render/denoise.c; docs/denoise.md). A private folder, not LIBDIR itself, so that
+# its own TBB never shadows a system one. INSTALL_OIDN=0 leaves it out (make deb does: a
+# Debian package depends on packaged libraries, not on a wheel's binaries).
+INSTALL_OIDN    ?= 1
+OIDN_INSTALL_DIR = $(BINDIR)/../lib/$(PROG)/oidn
+
 $(BUILD)/$(PROG).pc: tools/$(PROG).pc.in VERSION FORCE
 	@sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBDIR@|$(LIBDIR)|' -e 's|@INCLUDEDIR@|$(INCLUDEDIR)|' \
 	    -e 's|@VERSION@|$(VERSION)|' $< > $@.tmp
@@ -273,6 +282,11 @@ install: $(if $(INSTALL_NO_BUILD),,all) $(BUILD)/$(PROG).pc
 	    $(INSTALL) -d $(DESTDIR)$(INCLUDEDIR)/$(PROG) $(DESTDIR)$(PKGCONFIGDIR); \
 	    $(INSTALL) -m 644 $$headers $(DESTDIR)$(INCLUDEDIR)/$(PROG)/; \
 	    $(INSTALL) -m 644 $(BUILD)/$(PROG).pc $(DESTDIR)$(PKGCONFIGDIR)/$(PROG).pc; \
+	fi; \
+	if [ "$(INSTALL_OIDN)" = 1 ] && [ -e $(BUILD)/oidn/lib/libOpenImageDenoise.so.2 ]; then \
+	    echo install $(BUILD)/oidn "->" $(DESTDIR)$(OIDN_INSTALL_DIR); \
+	    rm -rf $(DESTDIR)$(OIDN_INSTALL_DIR) && $(INSTALL) -d $(DESTDIR)$(OIDN_INSTALL_DIR) && \
+	    cp -RP $(BUILD)/oidn/. $(DESTDIR)$(OIDN_INSTALL_DIR)/; \
 	fi
 
 # A Debian package (binary) of what `make install PREFIX=/usr` installs, built with
@@ -285,7 +299,8 @@ uninstall:
 	rm -f $(DESTDIR)$(BINDIR)/$(PROG) $(DESTDIR)$(MANDIR)/man1/$(PROG).1 $(DESTDIR)$(BASHCOMPDIR)/$(PROG) \
 	      $(DESTDIR)$(ZSHCOMPDIR)/_$(PROG) $(DESTDIR)$(PKGCONFIGDIR)/$(PROG).pc
 	rm -f $(DESTDIR)$(LIBDIR)/lib$(PROG).so*
-	rm -rf $(DESTDIR)$(INCLUDEDIR)/$(PROG)
+	rm -rf $(DESTDIR)$(INCLUDEDIR)/$(PROG) $(DESTDIR)$(OIDN_INSTALL_DIR)
+	-rmdir $(DESTDIR)$(BINDIR)/../lib/$(PROG) 2>/dev/null
 
 # ---------------------------------------------------------------- use
 EXAMPLE_BIN := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))

@@ -1,9 +1,10 @@
 /* test_install.c — `make install` as a packager runs it (PREFIX, DESTDIR), then the
  * installed program as a user meets it: it renders from another folder (nothing read
- * from the source tree), its man page renders without a warning, and the bash and zsh
- * completions load and complete a flag. The files come from BUILD (the Makefile's build
- * folder), which `make test` has built: the sub-make only copies (INSTALL_NO_BUILD=1, so
- * that under test-asan it does not rebuild the folder with the plain flags). */
+ * from the source tree), finds the Open Image Denoise installed beside it, its man page
+ * renders without a warning, and the bash and zsh completions load and complete a flag.
+ * The files come from BUILD (the Makefile's build folder), which `make test` has built:
+ * the sub-make only copies (INSTALL_NO_BUILD=1, so that under test-asan it does not
+ * rebuild the folder with the plain flags). */
 #include "cli_util.h"
 #include "harness.h"
 
@@ -76,6 +77,31 @@ static void test_installed_clpt_renders(void)
     CHECK_MSG(strcmp(slurp(path), r_version.out) == 0, "installed --version '%s', built '%s'", slurp(path), r_version.out);
     snprintf(path, sizeof path, "%s/out.png", stage);
     CHECK(file_exists(path));
+}
+
+/* With Open Image Denoise fetched into BUILD/oidn, make install copies it to
+ * PREFIX/lib/clpt/oidn (BINDIR/../lib/clpt/oidn), and the installed clpt's --denoise
+ * loads it from there: from the stage, not from the build folder or the system. */
+static void test_installed_clpt_finds_oidn(void)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/oidn/lib/libOpenImageDenoise.so.2", CLPT_BUILD_DIR);
+    if (!install_ok) return;
+    if (!file_exists(path)) {
+        printf("     (skipped: no Open Image Denoise in %s/oidn; sh tools/deps.sh oidn fetches it)\n", CLPT_BUILD_DIR);
+        return;
+    }
+    CHECK(installed("lib/clpt/oidn/lib/libOpenImageDenoise.so.2"));
+    CHECK(installed("lib/clpt/oidn/SOURCE"));
+    snprintf(cmd, sizeof cmd, "cd %s && env -u CLPT_OIDN_DIR ./usr/bin/clpt box.scene --device scalar --width 16 "
+             "--height 12 --spp 2 --denoise -o denoised.png 2> denoise.log", stage);
+    int st = sh(cmd);
+    snprintf(path, sizeof path, "%s/denoise.log", stage);
+    const char *log = slurp(path);
+    CHECK_MSG(st == 0, "installed clpt --denoise: exit %d: %s", st, log);
+    char want[256];
+    snprintf(want, sizeof want, "%s/usr/lib/clpt/oidn/lib/libOpenImageDenoise.so.2", stage);
+    CHECK_STR_CONTAINS(log, want);
 }
 
 /* A user's program built with pkg-config against an installed library: installed with
@@ -209,6 +235,7 @@ int main(void)
     }
     RUN(test_make_install_places_every_file);
     RUN(test_installed_clpt_renders);
+    RUN(test_installed_clpt_finds_oidn);
     RUN(test_pkg_config_builds_the_example);
     RUN(test_man_page_renders_without_warnings);
     RUN(test_bash_completion);

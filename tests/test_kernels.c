@@ -1058,7 +1058,8 @@ static void test_film(void)
 }
 
 /* k_whitted against whitted_sample in C: the classic ray tracer, each auxiliary image
- * and the denoiser's features (through the scene's mirrors and glass), pixel centres and a jittered grid, with and without the adaptive pass's mask. */
+ * and the denoiser's features (through the scene's mirrors and glass), pixel centres
+ * and a jittered grid, with and without the adaptive pass's mask. */
 static void test_whitted(void)
 {
     const RenderParams *base = &rs.ds.params;

@@ -12,7 +12,9 @@ name=clpt_${version}_${arch}
 stage=$build/deb/$name
 rm -rf "$build/deb"
 mkdir -p "$stage/DEBIAN"
-make --no-print-directory install PREFIX=/usr DESTDIR="$stage" BUILD="$build" >/dev/null
+# OIDN (build/oidn, a wheel's binaries) is left out: --denoise finds a packaged OIDN 2 on
+# the system's library path (docs/denoise.md)
+make --no-print-directory install PREFIX=/usr DESTDIR="$stage" BUILD="$build" INSTALL_OIDN=0 >/dev/null
 # Debian's layout: man pages compressed, the licence in the package's doc folder
 gzip -9n "$stage/usr/share/man/man1/clpt.1"
 doc=$stage/usr/share/doc/clpt

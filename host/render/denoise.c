@@ -84,7 +84,9 @@ static void *open_in(const char *dir, char *path, size_t size, Error *err, Statu
 
 /* Where clpt looks, in order: only $CLPT_OIDN_DIR when it is set; else oidn/lib beside
  * the program (build/clpt) or one folder up (build/tests/..., build/bench/...), where
- * tools/oidn_fetch.sh puts it; else the system's library path. */
+ * tools/oidn_fetch.sh puts it, or ../lib/clpt/oidn/lib (PREFIX/bin/clpt finds
+ * PREFIX/lib/clpt/oidn/lib, where `make install` copies it: a private folder, so that
+ * its TBB is not put on the system's library path); else the system's library path. */
 static void *denoiser_load(char *path, size_t size, Error *err, Status *st)
 {
     const char *env = getenv(DENOISE_DIR_ENV);
@@ -97,8 +99,8 @@ static void *denoiser_load(char *path, size_t size, Error *err, Status *st)
     }
     char exe[PATH_MAX], dir[PATH_MAX + 16];
     if (program_dir(exe, sizeof exe)) {
-        static const char *const below[] = { "oidn/lib", "../oidn/lib" };
-        for (size_t i = 0; i < 2 && !lib && *st == ST_OK; i++) {
+        static const char *const below[] = { "oidn/lib", "../oidn/lib", "../lib/clpt/oidn/lib" };
+        for (size_t i = 0; i < sizeof below / sizeof *below && !lib && *st == ST_OK; i++) {
             snprintf(dir, sizeof dir, "%s/%s", exe, below[i]);
             lib = open_in(dir, path, size, err, st);
         }
@@ -106,8 +108,8 @@ static void *denoiser_load(char *path, size_t size, Error *err, Status *st)
     if (lib || *st != ST_OK) return lib;
     snprintf(path, size, "%s", OIDN_SONAME);
     if (!(lib = dlopen(OIDN_SONAME, RTLD_NOW | RTLD_LOCAL)))
-        *st = error_set(err, ST_DEVICE, "--denoise needs Intel Open Image Denoise 2 (%s), found neither in oidn/lib "
-                        "beside the program nor on the system's library path; %s", OIDN_SONAME, OIDN_FETCH_HINT);
+        *st = error_set(err, ST_DEVICE, "--denoise needs Intel Open Image Denoise 2 (%s), found neither beside "
+                        "the program (oidn/lib, ../lib/clpt/oidn/lib) nor on the system's library path; %s", OIDN_SONAME, OIDN_FETCH_HINT);
     return lib;
 }
 

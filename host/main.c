@@ -446,10 +446,14 @@ static Status run_rank(Run *r, Dist *dist, Error *err)
 static Status run_interactive(Run *r, Error *err)
 {
     Status st = viewer_open_display(err);
-    if (st != ST_OK) return st;
+    if (st != ST_OK) {
+        run_free(r);
+        return st;
+    }
     if (!r->o.wave_paths) r->o.wave_paths = VIEWER_WAVE_PATHS;
     job_init(r);
-    st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
+    st = render_job_open_denoiser(&r->job, err);   /* --denoise: the denoised view starts on */
+    if (st == ST_OK) st = load_scene_input(&r->o, &r->scene, &r->bare_mesh, err);
     if (st == ST_OK) st = scene_apply_options(r, err);
     /* the viewer shows the whole image: a scene's crop window (pbrt's) is for renders
      * to a file, and --crop is refused with --interactive */
@@ -459,7 +463,7 @@ static Status run_interactive(Run *r, Error *err)
     if (st == ST_OK) {
         ViewerConfig vc = { r->o.scene_path, &r->scene, &r->job.rs, r->job.devs, r->job.n_devs,
                             { r->o.threads, r->o.kernel_dir, r->o.wave_paths, 0, r->o.wave_launch }, r->style,
-                            r->o.batch, r->o.stats, r->o.quiet };
+                            r->o.batch, r->job.denoiser, r->o.stats, r->o.quiet };
         st = viewer_run(&vc, err);
     }
     run_free(r);

@@ -241,7 +241,8 @@
         "move, R/F or Q/E up/down, drag the mouse to\n" \
         "look, wheel forward/back, Z/X field of view,\n" \
         "Up/Down focus distance, Right/Left aperture,\n" \
-        "+/- exposure, V view, Space pause, C save the image\n" \
+        "+/- exposure, V view, N denoised view (on with\n" \
+        "--denoise), Space pause, C save the image\n" \
         "(SCENE-view-NNN.png and .pfm, never over an\n" \
         "earlier save), P print the camera as a scene\n" \
         "block, H help, F11 full screen, Esc quit.\n" \

@@ -240,7 +240,7 @@ static Status options_check_interactive(const Options *o, Error *err)
     if (!o->interactive) return ST_OK;
     const char *flag = o->output ? "--output" : o->checkpoint_path ? (o->resume_path ? "--resume" : "--checkpoint")
                      : o->time_limit > 0.0 ? "--time-limit" : o->progressive_seconds > 0.0 ? "--progressive-output"
-                     : o->aovs ? "--aov" : o->denoise ? "--denoise" : o->adaptive > 0.0 ? "--adaptive"
+                     : o->aovs ? "--aov" : o->adaptive > 0.0 ? "--adaptive"
                      : o->display_server ? "--display-server" : o->noise_threshold > 0.0 ? "--noise-threshold"
                      : o->range_end >= 0 ? "--sample-range" : o->stats == STATS_JSON ? "--stats=json"
                      : o->crop_kind == CROP_FRACTIONS ? "--crop" : o->crop_kind == CROP_PIXELS ? "--pixel-bounds"

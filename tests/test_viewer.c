@@ -9,7 +9,9 @@
  * be, bit for bit, the command-line render of the printed camera with as many samples
  * as the viewer says it saved. Every wait has a time limit; the Xvfb started here and
  * the viewer are killed whatever happens. Without Xvfb or xdotool (tools/deps.sh
- * viewer-test) the session is skipped with a message.
+ * viewer-test) the session is skipped with a message. A second session, with
+ * --denoise and Open Image Denoise present, waits for the denoised frame of the last
+ * pass, saves (the noisy film: the command line's bits), and turns N off and on again.
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -29,6 +31,7 @@
 #include "cli_util.h"
 #include "harness.h"
 #include "io/scene_load.h"
+#include "render/denoise.h"
 #include "viewer/view_camera.h"
 
 /* ------------------------------------------------------------------ camera units */
@@ -395,6 +398,7 @@ typedef struct {
     char dir[64], out[128], err[128], display[32];
     pid_t xvfb, viewer;
     char window[64];
+    const char *extra;            /* one more flag for the viewer, or NULL */
 } Session;
 
 static int xdo(const char *a, const char *b, const char *c, const char *d, const char *e)
@@ -418,7 +422,7 @@ static int session_start(Session *s)
         dup2(e, 2);
         setenv("DISPLAY", s->display, 1);
         execl(prog, prog, "--interactive", scene, "--width", "128", "--height", "128", "--spp", "4", "--seed", "5",
-              (char *)NULL);
+              s->extra, (char *)NULL);
         _exit(127);
     }
     if (!wait_text(s->err, "clpt: viewer: ", 1, 120.0)) return 0;
@@ -497,15 +501,12 @@ static void session_check(Session *s)
     }
 }
 
-static void test_session(void)
+/* Xvfb and the viewer in it, session_user's part done by `user`, then the check's. */
+static void session_run(const char *extra, void (*user)(Session *), void (*check)(Session *))
 {
-    if (!on_path("Xvfb") || !on_path("xdotool")) {
-        fprintf(stderr, "  Xvfb or xdotool not installed (sh tools/deps.sh viewer-test): the viewer session is "
-                        "skipped\n");
-        return;
-    }
     Session s;
     memset(&s, 0, sizeof s);
+    s.extra = extra;
     snprintf(s.dir, sizeof s.dir, "/tmp/clpt-test-viewer-XXXXXX");
     CHECK(mkdtemp(s.dir) != NULL);
     s.xvfb = xvfb_start(s.display, sizeof s.display);
@@ -514,7 +515,7 @@ static void test_session(void)
     setenv("DISPLAY", s.display, 1);   /* for xdotool */
     int started = session_start(&s);
     CHECK_MSG(started, "the viewer did not open its window");
-    if (started) session_user(&s);
+    if (started) user(&s);
     if (s.viewer > 0) {
         kill(s.viewer, SIGKILL);
         waitpid(s.viewer, NULL, 0);
@@ -524,10 +525,70 @@ static void test_session(void)
     }
     xvfb_stop(s.xvfb);
     unsetenv("DISPLAY");
-    if (started) session_check(&s);
+    if (started) check(&s);
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", s.dir);
     if (system(cmd) != 0) fprintf(stderr, "  could not remove %s\n", s.dir);
+}
+
+/* --denoise starts with the denoised view on: the last pass (4 spp) is shown denoised;
+ * C saves the film as rendered; N off shows the noisy frame, N on the denoised one again
+ * (denoised once: the film has not changed). */
+static void denoise_user(Session *s)
+{
+    CHECK(wait_text(s->err, "clpt: viewer: showing the 4-spp frame denoised", 1, 120.0));
+    CHECK(xdo("key", "c", NULL, NULL, NULL) == 0);
+    CHECK(wait_text(s->err, "clpt: saved ", 1, 60.0));
+    CHECK(xdo("key", "n", NULL, NULL, NULL) == 0);
+    CHECK(wait_text(s->err, "clpt: viewer: denoised view off", 1, 20.0));
+    CHECK(xdo("key", "n", NULL, NULL, NULL) == 0);
+    CHECK(wait_text(s->err, "clpt: viewer: showing the 4-spp frame denoised", 2, 20.0));
+    CHECK(xdo("key", "Escape", NULL, NULL, NULL) == 0);
+    int status = wait_timeout(s->viewer, 30.0);
+    s->viewer = 0;
+    CHECK_EQ_INT(status, 0);
+}
+
+static void denoise_check(Session *s)
+{
+    char png[256], pfm[256], path[512], ref[512];
+    unsigned spp = 0;
+    CHECK(parse_save(s->err, 0, png, pfm, &spp));
+    CHECK_EQ_INT(spp, 4);
+    CHECK_EQ_INT(count_in(s->err, "clpt: viewer: showing the 4-spp frame denoised"), 2);
+    snprintf(ref, sizeof ref, "%s/cli.pfm", s->dir);
+    const char *args[] = { "scenes/cornell-box.scene", "--width", "128", "--height", "128", "--spp", "4", "--seed",
+                           "5", "-q", "-o", ref, NULL };
+    CliResult *r = malloc(sizeof *r);
+    cli_run(args, r);
+    CHECK_EQ_INT(r->status, 0);
+    free(r);
+    snprintf(path, sizeof path, "%s/%s", s->dir, pfm);
+    CHECK_MSG(files_equal(path, ref), "the save with the denoised view on is not the film as rendered");
+}
+
+static void test_session_denoise(void)
+{
+    Denoiser *d = NULL;
+    Error err = { 0 };
+    if (!on_path("Xvfb") || !on_path("xdotool") || denoiser_open(&d, &err) != ST_OK) {
+        fprintf(stderr, "  Xvfb, xdotool or Open Image Denoise missing: the denoised session is skipped (%s)\n",
+                err.msg);
+        error_clear(&err);
+        return;
+    }
+    denoiser_close(d);
+    session_run("--denoise", denoise_user, denoise_check);
+}
+
+static void test_session(void)
+{
+    if (!on_path("Xvfb") || !on_path("xdotool")) {
+        fprintf(stderr, "  Xvfb or xdotool not installed (sh tools/deps.sh viewer-test): the viewer session is "
+                        "skipped\n");
+        return;
+    }
+    session_run(NULL, session_user, session_check);
 }
 
 int main(void)
@@ -539,5 +600,6 @@ int main(void)
     RUN(test_driver_without_a_window);
     RUN(test_usage);
     RUN(test_session);
+    RUN(test_session_denoise);
     return harness_report();
 }

@@ -217,10 +217,12 @@ static Status run_filter(Denoiser *d, OidnBuffer const *buf, const char *const *
     return st;
 }
 
-/* The filters of a prefiltered denoise: albedo, normal, then the colour with both. */
-static Status run_filters(Denoiser *d, OidnBuffer *buf, unsigned w, unsigned h, Error *err)
+static const char *const slot_names[IMG_OUTPUT] = { "color", "albedo", "normal" };
+
+/* Prefilters the features in buf (those present), each alone, in place. */
+static Status prefilter(Denoiser *d, OidnBuffer *buf, unsigned w, unsigned h, Error *err)
 {
-    static const char *const names[IMG_OUTPUT] = { "color", "albedo", "normal" };
+    const char *const *names = slot_names;
     Status st = ST_OK;
     for (int s = IMG_ALBEDO; s <= IMG_NORMAL && st == ST_OK; s++) {
         if (!buf[s]) continue;
@@ -229,10 +231,14 @@ static Status run_filters(Denoiser *d, OidnBuffer *buf, unsigned w, unsigned h, 
         st = run_filter(d, alone, names, buf[s], w, h, 0, 0, s == IMG_ALBEDO ? "denoising the albedo"
                                                                               : "denoising the normals", err);
     }
-    if (st == ST_OK)
-        st = run_filter(d, buf, names, buf[IMG_OUTPUT], w, h, 1, buf[IMG_ALBEDO] || buf[IMG_NORMAL],
-                        "denoising the image", err);
     return st;
+}
+
+/* The colour through the RT filter with the (clean) features as they are in buf. */
+static Status run_color(Denoiser *d, OidnBuffer *buf, unsigned w, unsigned h, Error *err)
+{
+    return run_filter(d, buf, slot_names, buf[IMG_OUTPUT], w, h, 1, buf[IMG_ALBEDO] || buf[IMG_NORMAL],
+                      "denoising the image", err);
 }
 
 /* The inputs, cleaned, into device buffers; NULL inputs get none. */
@@ -257,14 +263,16 @@ static Status upload(Denoiser *d, const float *const *in, OidnBuffer *buf, size_
     return st;
 }
 
-Status denoiser_run(Denoiser *d, const float *color, const float *albedo, const float *normal, unsigned width,
-                    unsigned height, float *out, Error *err)
+/* denoiser_run, with the features prefiltered here or not (already clean). */
+static Status denoise_image(Denoiser *d, const float *color, const float *albedo, const float *normal,
+                            unsigned width, unsigned height, float *out, int features_raw, Error *err)
 {
     size_t n = (size_t)width * height * 3u;
     const float *in[IMG_COUNT] = { color, albedo, normal, NULL };
     OidnBuffer buf[IMG_COUNT] = { NULL, NULL, NULL, NULL };
     Status st = upload(d, in, buf, n, err);
-    if (st == ST_OK) st = run_filters(d, buf, width, height, err);
+    if (st == ST_OK && features_raw) st = prefilter(d, buf, width, height, err);
+    if (st == ST_OK) st = run_color(d, buf, width, height, err);
     if (st == ST_OK) {
         d->oidnReadBuffer(buf[IMG_OUTPUT], 0, n * sizeof *out, out);
         st = denoiser_check(d, "reading the image back", err);
@@ -272,6 +280,36 @@ Status denoiser_run(Denoiser *d, const float *color, const float *albedo, const 
     /* the network's output is finite for finite input; kept so whatever comes back */
     if (st == ST_OK)
         for (size_t i = 0; i < n; i++) out[i] = clampf(out[i], 0.0f, FLT_MAX);
+    for (int s = 0; s < IMG_COUNT; s++)
+        if (buf[s]) d->oidnReleaseBuffer(buf[s]);
+    return st;
+}
+
+Status denoiser_run(Denoiser *d, const float *color, const float *albedo, const float *normal, unsigned width,
+                    unsigned height, float *out, Error *err)
+{
+    return denoise_image(d, color, albedo, normal, width, height, out, 1, err);
+}
+
+Status denoiser_run_clean(Denoiser *d, const float *color, const float *albedo, const float *normal, unsigned width,
+                          unsigned height, float *out, Error *err)
+{
+    return denoise_image(d, color, albedo, normal, width, height, out, 0, err);
+}
+
+Status denoiser_clean_features(Denoiser *d, float *albedo, float *normal, unsigned width, unsigned height,
+                               Error *err)
+{
+    size_t n = (size_t)width * height * 3u;
+    const float *in[IMG_COUNT] = { NULL, albedo, normal, NULL };
+    OidnBuffer buf[IMG_COUNT] = { NULL, NULL, NULL, NULL };
+    Status st = upload(d, in, buf, n, err);
+    if (st == ST_OK) st = prefilter(d, buf, width, height, err);
+    for (int s = IMG_ALBEDO; s <= IMG_NORMAL && st == ST_OK; s++)
+        if (buf[s]) {
+            d->oidnReadBuffer(buf[s], 0, n * sizeof(float), s == IMG_ALBEDO ? albedo : normal);
+            st = denoiser_check(d, "reading the features back", err);
+        }
     for (int s = 0; s < IMG_COUNT; s++)
         if (buf[s]) d->oidnReleaseBuffer(buf[s]);
     return st;

@@ -38,6 +38,16 @@ Status denoiser_open(Denoiser **out, Error *err);
 Status denoiser_run(Denoiser *d, const float *color, const float *albedo, const float *normal, unsigned width,
                     unsigned height, float *out, Error *err);
 
+/* Prefilters the features in place (each through an RT filter of its own, as
+ * denoiser_run does first), so that several colour images of one view (the viewer's
+ * passes) are denoised with them by denoiser_run_clean without filtering them again:
+ * a third of the work per image. Either may be NULL. */
+Status denoiser_clean_features(Denoiser *d, float *albedo, float *normal, unsigned width, unsigned height,
+                               Error *err);
+/* denoiser_run with features denoiser_clean_features has already prefiltered. */
+Status denoiser_run_clean(Denoiser *d, const float *color, const float *albedo, const float *normal, unsigned width,
+                          unsigned height, float *out, Error *err);
+
 /* The file the library was loaded from, and its device's kind ("CPU", "CUDA", ...). */
 const char *denoiser_library(const Denoiser *d);
 const char *denoiser_device_kind(const Denoiser *d);

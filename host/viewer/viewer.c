@@ -28,7 +28,7 @@
 
 static const char HELP_TITLE[] =
     "W/A/S/D move  R/F Q/E up/down  drag look  wheel fwd/back  Z/X fov  Up/Down focus  "
-    "Left/Right aperture  +/- exposure  V view  Space pause  C save  P camera  F11 full screen  H help  Esc quit";
+    "Left/Right aperture  +/- exposure  V view  N denoise  Space pause  C save  P camera  F11 full screen  H help  Esc quit";
 
 static const char HELP_TEXT[] =
     "clpt viewer keys:\n"
@@ -41,6 +41,7 @@ static const char HELP_TEXT[] =
     "  Right/Left     aperture wider / narrower (0: pinhole)\n"
     "  +/-            exposure up / down by half a stop (display and PNG)\n"
     "  V              next view transform: standard, agx, filmic (display and PNG)\n"
+    "  N              denoised view on / off (Open Image Denoise, each finished pass)\n"
     "  Space          pause / resume rendering\n"
     "  C              save the image: SCENE-view-NNN.png and .pfm\n"
     "  P              print the camera as a scene-format block\n"
@@ -66,6 +67,9 @@ typedef struct {
     double exposure;              /* stops */
     ViewTransform view;           /* --view, then V */
     int paused, help, fullscreen, quit;
+    int denoise;                  /* N: show the denoised frames */
+    int showing_denoised;         /* what is on screen is vr.denoised ... */
+    unsigned shown_denoised_seq;  /* ... publication number shown_denoised_seq */
     int save_pending, refresh;
     double drag_x, drag_y;        /* mouse motion with the button down, not yet applied */
     int moved;                    /* the camera changed in this round of events */
@@ -195,6 +199,8 @@ static void title_update(Viewer *v)
     pthread_mutex_lock(&v->vr.lock);
     double msps = v->vr.view_seconds > 0.0 ? v->vr.view_samples / v->vr.view_seconds / 1e6 : 0.0;
     const char *failed = v->vr.failure != ST_OK ? " | rendering failed (see the terminal)" : "";
+    const char *denoised = !v->denoise ? "" : v->vr.denoise_state == -1 ? " | cannot denoise (see the terminal)"
+                         : v->showing_denoised ? " | denoised" : " | denoising";
     pthread_mutex_unlock(&v->vr.lock);
     const char *base = strrchr(v->cfg->scene_path, '/');
     uint64_t spp = v->shown_gen == v->gen ? v->shown_samples : 0;
@@ -210,6 +216,8 @@ static void title_update(Viewer *v)
         size_t len = strlen(title);
         snprintf(title + len, sizeof title - len, " | view %s", view_name(v->view));
     }
+    size_t len = strlen(title);
+    snprintf(title + len, sizeof title - len, "%s", denoised);
     SDL_SetWindowTitle(v->win, title);
 }
 
@@ -258,19 +266,32 @@ static void frame_save(Viewer *v, uint64_t samples)
 }
 
 /* Takes the newest published frame when there is one (or a redraw was asked for), and
- * the frame to save when a save waits for a whole frame of the current view. */
+ * the frame to save when a save waits for a whole frame of the current view. With N on,
+ * the newest denoised frame of the current view is shown instead, once there is one
+ * (until then the noisy frames); the passes' ticks in between do not replace it. */
 static void frame_take(Viewer *v)
 {
-    int save = 0;
+    int save = 0, announce = 0;
     uint64_t save_samples = 0;
+    double denoise_secs = 0.0;
     pthread_mutex_lock(&v->vr.lock);
-    int fresh = v->vr.frame_seq != v->shown_seq;
-    if (fresh || v->refresh) {
+    int denoised = v->denoise && v->vr.denoised && v->vr.denoised_gen == v->gen;
+    int fresh = denoised ? !v->showing_denoised || v->vr.denoised_seq != v->shown_denoised_seq
+                         : v->showing_denoised || v->vr.frame_seq != v->shown_seq;
+    if ((fresh || v->refresh) && denoised) {
+        frame_convert(v, v->vr.denoised);
+        announce = !v->showing_denoised || v->vr.denoised_seq != v->shown_denoised_seq;
+        v->shown_denoised_seq = v->vr.denoised_seq;
+        v->shown_gen = v->vr.denoised_gen;
+        v->shown_samples = v->vr.denoised_samples;
+        denoise_secs = v->vr.denoise_last;
+    } else if (fresh || v->refresh) {
         frame_convert(v, v->vr.rgb);
         v->shown_seq = v->vr.frame_seq;
         v->shown_gen = v->vr.frame_gen;
         v->shown_samples = v->vr.samples;
     }
+    if (fresh || v->refresh) v->showing_denoised = denoised;
     if (v->save_pending && v->vr.frame_gen == v->gen && v->vr.frame_prefix) {
         memcpy(v->save_rgb, v->vr.rgb, (size_t)v->w * v->h * 3u * sizeof *v->save_rgb);
         save = 1;
@@ -280,6 +301,9 @@ static void frame_take(Viewer *v)
     pthread_mutex_unlock(&v->vr.lock);
     if (fresh || v->refresh) frame_draw(v);
     v->refresh = 0;
+    if (announce && !v->cfg->quiet)
+        fprintf(stderr, "clpt: viewer: showing the %llu-spp frame denoised (Open Image Denoise, %.2f s)\n",
+                (unsigned long long)v->shown_samples, denoise_secs);
     if (save) frame_save(v, save_samples);
 }
 
@@ -318,6 +342,13 @@ static void key_down(Viewer *v, const SDL_KeyboardEvent *k)
         return;
     case SDLK_v:
         v->view = v->view == VIEW_STANDARD ? VIEW_AGX : v->view == VIEW_AGX ? VIEW_FILMIC : VIEW_STANDARD;
+        v->refresh = 1;
+        return;
+    case SDLK_n:
+        v->denoise = !v->denoise;
+        viewer_render_set_denoise(&v->vr, v->denoise);
+        if (!v->cfg->quiet)
+            fprintf(stderr, "clpt: viewer: denoised view %s\n", v->denoise ? "on (each finished pass)" : "off");
         v->refresh = 1;
         return;
     case SDLK_SPACE:
@@ -507,6 +538,9 @@ static void stats_print(Viewer *v)
     double msps = v->vr.view_seconds > 0.0 ? v->vr.view_samples / v->vr.view_seconds / 1e6 : 0.0;
     printf("viewer: last view: %llu spp, %.0f samples in %.2f s of passes: %.3f Msamples/s\n",
            (unsigned long long)v->shown_samples, v->vr.view_samples, v->vr.view_seconds, msps);
+    if (v->vr.denoise_count)
+        printf("viewer: %u frames denoised, %.3f s each on average\n", v->vr.denoise_count,
+               v->vr.denoise_seconds / v->vr.denoise_count);
     pthread_mutex_unlock(&v->vr.lock);
 }
 
@@ -522,6 +556,7 @@ Status viewer_run(const ViewerConfig *cfg, Error *err)
     v->t_start = timer_now();
     v->exposure = cfg->style.look.exposure;
     v->view = cfg->style.look.view;
+    v->denoise = cfg->denoiser != NULL;
     lut_fill(v);
     steps_choose(v);
     devices_describe(v);
@@ -533,7 +568,7 @@ Status viewer_run(const ViewerConfig *cfg, Error *err)
     if (st == ST_OK) st = window_open(v, err);
     if (st == ST_OK)
         st = viewer_render_start(&v->vr, cfg->devices, cfg->n_devices, &cfg->rs->ds, &cfg->device_config, &v->cam,
-                                 cfg->scene->image.spp, cfg->fixed_batch, err);
+                                 cfg->scene->image.spp, cfg->fixed_batch, cfg->denoiser, err);
     if (st == ST_OK) {
         threads_lower_priority();
         if (!cfg->quiet)

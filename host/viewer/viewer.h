@@ -11,6 +11,7 @@
 #define CLPT_VIEWER_H
 
 #include "io/image_write.h"
+#include "render/denoise.h"
 #include "render/render_scene.h"
 #include "scene/scene.h"
 
@@ -30,6 +31,8 @@ typedef struct {
     ImageStyle style;             /* the command line's encoding, and its --view and
                                    * --exposure: the first look shown, and the PNG saves' */
     uint fixed_batch;             /* --batch */
+    Denoiser *denoiser;           /* --denoise: opened by the caller, denoising starts on;
+                                   * NULL: the N key opens Open Image Denoise itself */
     int stats;                    /* --stats: timings on stdout at the end */
     int quiet;
 } ViewerConfig;

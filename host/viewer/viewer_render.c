@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/timer.h"
+#include "render/passes.h"
 #include "scene/camera.h"
 
 /* How often a pass publishes what is finished, and how often the scheduler looks at the
@@ -61,6 +63,117 @@ static void set_failure(ViewerRender *vr, Status st, const char *msg)
     pthread_mutex_unlock(&vr->lock);
     fprintf(stderr, "clpt: error: %s\n", msg);
 }
+
+/* ------------------------------------------------------------------ denoising */
+
+/* Open Image Denoise and the denoiser's images, at the first request; when it is not
+ * there, that is said once and the window's title says so. */
+static int denoiser_ready(ViewerRender *vr)
+{
+    if (vr->denoise_state != 0) return vr->denoise_state == 1;
+    Error err = { 0 };
+    Status st = ST_OK;
+    if (!vr->denoiser) {
+        st = denoiser_open(&vr->denoiser, &err);
+        vr->own_denoiser = st == ST_OK;
+    }
+    size_t n = frame_floats(vr);
+    float **bufs[] = { &vr->albedo, &vr->normal, &vr->noisy, &vr->denoise_out, &vr->denoised };
+    for (size_t i = 0; st == ST_OK && i < sizeof bufs / sizeof *bufs; i++)
+        if (!(*bufs[i] = calloc(n, sizeof **bufs[i]))) st = error_set(&err, ST_INTERNAL, "out of memory");
+    if (st != ST_OK) fprintf(stderr, "clpt: warning: the viewer cannot denoise: %s\n", err.msg);
+    error_clear(&err);
+    pthread_mutex_lock(&vr->lock);
+    vr->denoise_state = st == ST_OK ? 1 : -1;
+    pthread_mutex_unlock(&vr->lock);
+    return st == ST_OK;
+}
+
+/* The denoiser's albedo and normal images of the current view, as --denoise renders
+ * them (passes_aov_data), on the render's devices, which get the view's parameters back
+ * after; then prefiltered once for all the view's passes (denoiser_clean_features).
+ * 0 when a camera change or a pause cancelled them, or they failed. */
+static int features_render(ViewerRender *vr)
+{
+    RenderScene rs;
+    memset(&rs, 0, sizeof rs);
+    rs.ds = *vr->scene;
+    rs.ds.params = vr->params;
+    ScheduleConfig cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.fixed_batch = vr->fixed_batch;
+    cfg.stop = &vr->stop;
+    cfg.poll_seconds = VIEWER_POLL_SECONDS;
+    cfg.on_warning = on_warning;
+    PassContext pc = { vr->devices, vr->n_devices, &rs, &cfg, NULL, NULL, NULL };
+    double secs = 0.0;
+    Error err = { 0 };
+    Status st = passes_aov_data(&pc, INTEGRATOR_FEATURE_ALBEDO, VIEWER_FEATURE_SPP, vr->albedo, &secs, &err);
+    if (st == ST_OK) st = passes_aov_data(&pc, INTEGRATOR_FEATURE_NORMAL, VIEWER_FEATURE_SPP, vr->normal, &secs, &err);
+    if (st != ST_OK) set_failure(vr, st, err.msg);
+    error_clear(&err);
+    if (st != ST_OK || vr->stop) return 0;
+    st = denoiser_clean_features(vr->denoiser, vr->albedo, vr->normal, vr->params.width, vr->params.height, &err);
+    if (st != ST_OK) {
+        fprintf(stderr, "clpt: warning: the viewer cannot denoise: %s\n", err.msg);
+        error_clear(&err);
+        pthread_mutex_lock(&vr->lock);
+        vr->denoise_state = -1;
+        pthread_mutex_unlock(&vr->lock);
+        return 0;
+    }
+    vr->feature_gen = vr->my_gen;
+    return 1;
+}
+
+/* Whether the film holds samples [0, film.samples) exactly: a finished pass. */
+static int film_is_prefix(const ViewerRender *vr)
+{
+    return vr->film.samples > 0 && vr->done.n == 1 && vr->done.ranges[0].first == 0 &&
+           vr->done.ranges[0].count == vr->film.samples;
+}
+
+/* Under the lock: whether the frame of the finished pass waits to be denoised. */
+static int denoise_due(const ViewerRender *vr)
+{
+    return vr->denoise && vr->denoise_state != -1 && !vr->paused && vr->failure == ST_OK && vr->view_ok &&
+           film_is_prefix(vr) && !(vr->tried_gen == vr->my_gen && vr->tried_samples == vr->film.samples);
+}
+
+/* Denoises the finished pass's frame and publishes it beside the noisy one. */
+static void denoise_step(ViewerRender *vr)
+{
+    uint64_t samples = vr->film.samples;
+    if (!denoiser_ready(vr)) return;
+    if (vr->feature_gen != vr->my_gen && !features_render(vr)) return;   /* tried again unless it failed */
+    double t0 = timer_now();
+    film_resolve(&vr->film, vr->noisy);
+    Error err = { 0 };
+    Status st = denoiser_run_clean(vr->denoiser, vr->noisy, vr->albedo, vr->normal, vr->params.width, vr->params.height,
+                             vr->denoise_out, &err);
+    double secs = timer_now() - t0;
+    vr->tried_gen = vr->my_gen;
+    vr->tried_samples = samples;
+    if (st != ST_OK) fprintf(stderr, "clpt: warning: the viewer cannot denoise: %s\n", err.msg);
+    error_clear(&err);
+    pthread_mutex_lock(&vr->lock);
+    if (st != ST_OK) {
+        vr->denoise_state = -1;
+    } else if (vr->gen == vr->my_gen) {
+        float *t = vr->denoised;
+        vr->denoised = vr->denoise_out;
+        vr->denoise_out = t;
+        vr->denoised_samples = samples;
+        vr->denoised_gen = vr->my_gen;
+        vr->denoised_seq++;
+        vr->denoise_count++;
+        vr->denoise_seconds += secs;
+        vr->denoise_last = secs;
+    }
+    pthread_mutex_unlock(&vr->lock);
+}
+
+/* ------------------------------------------------------------------ passes */
 
 /* Gives every device the new view's camera and empties the film. A camera that cannot
  * be set up (the view functions keep it valid; this is the defensive check) leaves the
@@ -264,6 +377,13 @@ static void *render_main(void *arg)
             pthread_mutex_lock(&vr->lock);
             continue;
         }
+        if (denoise_due(vr)) {
+            vr->stop = 0;   /* as for a pass: a change made after this cancels the features */
+            pthread_mutex_unlock(&vr->lock);
+            denoise_step(vr);
+            pthread_mutex_lock(&vr->lock);
+            continue;
+        }
         if (vr->paused || vr->failure != ST_OK || !vr->view_ok || vr->film.samples >= vr->spp_cap) {
             pthread_cond_wait(&vr->wake, &vr->lock);
             continue;
@@ -280,9 +400,11 @@ static void *render_main(void *arg)
 
 Status viewer_render_start(ViewerRender *vr, Device **devices, size_t n, const DeviceScene *scene,
                            const DeviceConfig *device_config, const SceneCamera *camera, uint spp_cap,
-                           uint fixed_batch, Error *err)
+                           uint fixed_batch, Denoiser *denoiser, Error *err)
 {
     memset(vr, 0, sizeof *vr);
+    vr->denoiser = denoiser;
+    vr->denoise = denoiser != NULL;
     vr->devices = devices;
     vr->n_devices = n;
     vr->scene = scene;
@@ -325,6 +447,14 @@ void viewer_render_set_camera(ViewerRender *vr, const SceneCamera *camera)
     pthread_mutex_unlock(&vr->lock);
 }
 
+void viewer_render_set_denoise(ViewerRender *vr, int on)
+{
+    pthread_mutex_lock(&vr->lock);
+    vr->denoise = on;
+    pthread_cond_signal(&vr->wake);
+    pthread_mutex_unlock(&vr->lock);
+}
+
 void viewer_render_set_paused(ViewerRender *vr, int paused)
 {
     pthread_mutex_lock(&vr->lock);
@@ -355,5 +485,12 @@ Status viewer_render_stop(ViewerRender *vr, Error *err)
     free(vr->rgb);
     free(vr->spare);
     vr->rgb = vr->spare = NULL;
+    if (vr->own_denoiser) denoiser_close(vr->denoiser);
+    vr->denoiser = NULL;
+    float **bufs[] = { &vr->albedo, &vr->normal, &vr->noisy, &vr->denoise_out, &vr->denoised };
+    for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++) {
+        free(*bufs[i]);
+        *bufs[i] = NULL;
+    }
     return st;
 }

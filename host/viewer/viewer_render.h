@@ -18,6 +18,15 @@
  * Pausing cancels the pass; the film keeps its whole batches and the next pass renders
  * only the others.
  *
+ * Denoising (the N key, or --denoise): after each pass that completes (the film holds
+ * samples [0, n) exactly, n = 1, 2, 4, ...) the render thread denoises that frame with
+ * Open Image Denoise and publishes it beside the noisy one: once per finished pass, so
+ * once per displayed step of the doubling, never per tick. The albedo and normal
+ * features (through mirrors and glass, as --denoise's) are rendered once per view, at
+ * VIEWER_FEATURE_SPP samples per pixel, on the same devices. OIDN cannot be cancelled:
+ * a camera change during a denoise waits for it (tens of milliseconds for 512 x 512 on
+ * a GPU, a few tenths on two cores). The library is opened at the first request.
+ *
  * Preview: when one sample per pixel of the whole image took longer than
  * VIEWER_PREVIEW_AFTER seconds, every new view is first rendered at 1 spp in an image k
  * times smaller each way (k chosen so that it takes about a fortieth of a second) and
@@ -34,12 +43,16 @@
 #include <stdint.h>
 
 #include "render/batch_queue.h"
+#include "render/denoise.h"
 #include "render/film.h"
 #include "render/schedule.h"
 #include "scene/scene.h"
 
 /* A pass of 1 spp slower than this (seconds) makes new views start with a preview. */
 #define VIEWER_PREVIEW_AFTER 0.1
+/* Samples per pixel of the denoiser's albedo and normal images, once per view: a
+ * feature sample traces a ray or a few (mirrors), far less than a path. */
+#define VIEWER_FEATURE_SPP 4u
 
 typedef struct {
     /* set by viewer_render_start, then read-only */
@@ -59,6 +72,7 @@ typedef struct {
     SceneCamera camera;
     unsigned gen;                 /* incremented by each camera change */
     int paused, quit;
+    int denoise;                  /* show denoised frames: denoise each finished pass */
     volatile sig_atomic_t stop;   /* the running pass's stop flag */
 
     /* the published frame, under lock */
@@ -70,6 +84,14 @@ typedef struct {
     double view_samples, view_seconds;   /* rendered for this view, for Msamples/s */
     Status failure;               /* ST_OK, or why rendering stopped for good */
     char failure_msg[1024];
+    /* the published denoised frame, under lock */
+    float *denoised;              /* width * height * 3, of view denoised_gen */
+    uint64_t denoised_samples;    /* per pixel in the frame it was made from */
+    unsigned denoised_gen;        /* its view; 0: none yet */
+    unsigned denoised_seq;        /* incremented by each publication */
+    int denoise_state;            /* 0 not opened yet, 1 open, -1 unavailable (said once) */
+    unsigned denoise_count;       /* denoises done, and their time (--stats) */
+    double denoise_seconds, denoise_last;
 
     /* the render thread's own */
     Film film;
@@ -79,6 +101,14 @@ typedef struct {
     SceneCamera camera_shown;     /* the view being rendered */
     int view_ok;                  /* the current view's camera could be set up */
     double one_spp_seconds;       /* the last first pass of a view, 0 before */
+
+    /* the denoiser's: the library, this view's features, the frames in and out */
+    Denoiser *denoiser;
+    int own_denoiser;             /* opened here (not given by the caller): closed here */
+    unsigned feature_gen;         /* the view albedo and normal hold; 0: none */
+    float *albedo, *normal, *noisy, *denoise_out;
+    unsigned tried_gen;           /* the last (view, spp) denoised or tried */
+    uint64_t tried_samples;
 
     /* the preview: its devices, their image size, film and parameters */
     int preview_state;            /* 0 not needed yet, 1 ready, -1 could not be opened */
@@ -91,10 +121,14 @@ typedef struct {
 } ViewerRender;
 
 /* Starts rendering view `camera` of the scene the devices loaded (its size, seed,
- * integrator), up to `spp_cap` samples per pixel. */
+ * integrator), up to `spp_cap` samples per pixel. denoiser: an open Open Image Denoise
+ * (--denoise: denoising starts on), or NULL (opened when viewer_render_set_denoise
+ * first asks); the caller keeps and closes its own. */
 Status viewer_render_start(ViewerRender *vr, Device **devices, size_t n, const DeviceScene *scene,
                            const DeviceConfig *device_config, const SceneCamera *camera, uint spp_cap,
-                           uint fixed_batch, Error *err);
+                           uint fixed_batch, Denoiser *denoiser, Error *err);
+/* Denoising of each finished pass on or off (the window shows vr->denoised when on). */
+void viewer_render_set_denoise(ViewerRender *vr, int on);
 /* A new view: the old one's batches are cancelled and accumulation restarts at 0. */
 void viewer_render_set_camera(ViewerRender *vr, const SceneCamera *camera);
 void viewer_render_set_paused(ViewerRender *vr, int paused);

@@ -77,13 +77,18 @@ static int denoiser_ready(ViewerRender *vr)
         st = denoiser_open(&vr->denoiser, &err);
         vr->own_denoiser = st == ST_OK;
     }
+    /* the thread's own images; the published one is set under the lock (the window
+     * reads it) */
     size_t n = frame_floats(vr);
-    float **bufs[] = { &vr->albedo, &vr->normal, &vr->noisy, &vr->denoise_out, &vr->denoised };
+    float **bufs[] = { &vr->albedo, &vr->normal, &vr->noisy, &vr->denoise_out };
     for (size_t i = 0; st == ST_OK && i < sizeof bufs / sizeof *bufs; i++)
         if (!(*bufs[i] = calloc(n, sizeof **bufs[i]))) st = error_set(&err, ST_INTERNAL, "out of memory");
+    float *published = st == ST_OK ? calloc(n, sizeof *published) : NULL;
+    if (st == ST_OK && !published) st = error_set(&err, ST_INTERNAL, "out of memory");
     if (st != ST_OK) fprintf(stderr, "clpt: warning: the viewer cannot denoise: %s\n", err.msg);
     error_clear(&err);
     pthread_mutex_lock(&vr->lock);
+    vr->denoised = published;
     vr->denoise_state = st == ST_OK ? 1 : -1;
     pthread_mutex_unlock(&vr->lock);
     return st == ST_OK;
@@ -149,8 +154,8 @@ static void denoise_step(ViewerRender *vr)
     double t0 = timer_now();
     film_resolve(&vr->film, vr->noisy);
     Error err = { 0 };
-    Status st = denoiser_run_clean(vr->denoiser, vr->noisy, vr->albedo, vr->normal, vr->params.width, vr->params.height,
-                             vr->denoise_out, &err);
+    Status st = denoiser_run_clean(vr->denoiser, vr->noisy, vr->albedo, vr->normal, vr->params.width,
+                                   vr->params.height, vr->denoise_out, &err);
     double secs = timer_now() - t0;
     vr->tried_gen = vr->my_gen;
     vr->tried_samples = samples;

@@ -298,10 +298,8 @@ KFN vec3 feature_unit(vec3 c)
  *   - metal, smooth conductors, a smooth coat over a smooth conductor: the mirror ray,
  *     weighted by the reflectance the classic tracer gives it (whitted_radiance).
  * *next and *weight receive the ray and what it multiplies the albedo by. */
-KFN int feature_specular_next(const SceneView *sc, Material m, Surface s, vec3 d, vec3 ng, vec3 kd, Ray *next,
-                              vec3 *weight)
+KFN int feature_specular_next(Material m, Surface s, vec3 d, vec3 ng, vec3 kd, Ray *next, vec3 *weight)
 {
-    (void)sc;
     if (!material_scatters(m.type) || m.type == MAT_PRINCIPLED || bsdf_has_density(m, kd)) return 0;
     if (m.type == MAT_METAL && m.fuzz > 0.0f) return 0;
     int front = v3_dot(d, s.ng) < 0.0f;
@@ -365,7 +363,7 @@ KFN vec3 whitted_feature(const SceneView *sc, Ray ray, uint mode, uint *rays)
         material_resolve(sc, &m, s, ray.d, ng);
         vec3 kd = material_albedo(sc, m, s, ng), w;
         Ray next;
-        if (bounce < FEATURE_SPECULAR_DEPTH && feature_specular_next(sc, m, s, ray.d, ng, kd, &next, &w)) {
+        if (bounce < FEATURE_SPECULAR_DEPTH && feature_specular_next(m, s, ray.d, ng, kd, &next, &w)) {
             tint = v3_mul(tint, w);
             ray = next;
             continue;

@@ -291,8 +291,10 @@ KFN vec3 feature_unit(vec3 c)
 /* Whether the features go on past surface s of (resolved) material m, seen along d: only
  * when m is perfectly specular (no lobe with a density, bsdf_has_density, and for the
  * classic metal no fuzz), and then along one lobe chosen without random numbers:
- *   - smooth glass: the refracted ray (straight on through a thin sheet), the mirror
- *     ray on total internal reflection; weight 1 (glass is white in the albedo);
+ *   - smooth glass: the larger of its two parts by the Fresnel reflectance F at this
+ *     angle (both faces of a thin sheet), as whitted_radiance splits them, weighted by
+ *     it: the refracted ray (straight on through a thin sheet) with 1 - F where F < 1/2,
+ *     else the mirror ray with F (near grazing angles, total internal reflection);
  *   - a classic Phong material that is only mirror and see-through: the larger of the
  *     two by luminance, weighted by its colour;
  *   - metal, smooth conductors, a smooth coat over a smooth conductor: the mirror ray,
@@ -307,8 +309,12 @@ KFN int feature_specular_next(Material m, Surface s, vec3 d, vec3 ng, vec3 kd, R
     float c = k_clamp(-v3_dot(d, ns), 0.0f, 1.0f);
     int transmit = 0;
     vec3 w = v3s(1.0f);
+    int thin = m.type == MAT_DIELECTRIC && (m.flags & MAT_THIN);
     if (m.type == MAT_DIELECTRIC) {
-        transmit = 1;
+        float F = thin ? dielectric_facet_fresnel(bsdf_dielectric(m, front), c)
+                       : fresnel_dielectric(c, front ? m.ior : 1.0f / m.ior);
+        transmit = F < 0.5f;
+        w = v3s(transmit ? 1.0f - F : F);
     } else if (m.type == MAT_PHONG) {
         PhongLobes l = phong_lobes(m, kd);
         transmit = v3_luminance(l.kt) > v3_luminance(l.kr);
@@ -323,7 +329,7 @@ KFN int feature_specular_next(Material m, Surface s, vec3 d, vec3 ng, vec3 kd, R
     }
     if (v3_is_zero(w)) return 0;
     vec3 dir = d;
-    if (transmit && !(m.type == MAT_DIELECTRIC && (m.flags & MAT_THIN))) {
+    if (transmit && !thin) {
         /* as whitted_radiance refracts: through the shading normal, else the geometric one */
         float eta = front ? m.ior : 1.0f / m.ior;
         transmit = refract_dir(d, ns, eta, &dir);

@@ -5,10 +5,12 @@
  * raygen.h, traverse.h, shade_path.h and film.h, which the scalar C device calls too.
  * Queueing (which paths are still alive) happens here, not in the stage functions.
  *
- * Paths are numbered sample-major over the image: path number p renders pixel
- * p % n_pixels with sample index p / n_pixels (counted from the batch's first sample),
- * and a wave is a contiguous run of path numbers starting at pixel `first_pixel`, so
- * every wave of a batch is full whatever the image size. Each bounce is intersect →
+ * Paths are numbered sample-major over the pixels a sample covers (n_pixels: the
+ * image's, or the pixel list's, RenderParams.pixel_list_size): path number p renders
+ * pixel batch_pixel(p % n_pixels) (scene_view.h) with sample index p / n_pixels (counted
+ * from the batch's first sample), and a wave is a contiguous run of path numbers
+ * starting at pixel number `first_pixel`, so every wave of a batch is full whatever the
+ * image size, and a pixel left out of the list costs nothing. Each bounce is intersect →
  * shade → shadow over the queue of live paths; shade appends survivors to the next
  * queue and counts them, and the host launches the next bounce over exactly that many.
  *
@@ -63,14 +65,15 @@
 #if KF_HAS(KF_PATH)
 /* Births the wave's paths and queues them all: path i of the wave is path number
  * first_pixel + i of the batch (see the top of this file). */
-__kernel KERNEL_SIZE void k_raygen(__global const RenderParams *params, uint first_pixel, uint first_sample,
+__kernel KERNEL_SIZE void k_raygen(SCENE_ARGS uint first_pixel, uint first_sample,
                        uint n_pixels, uint n_paths, __global PathState *paths,
                        __global Ray *rays, __global uint *queue)
 {
     uint i = (uint)get_global_id(0);
     if (i >= n_paths) return;
+    SCENE_VIEW(sc);
     uint p = first_pixel + i;
-    raygen_path(params, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i]);
+    raygen_path(sc.params, batch_pixel(&sc, p % n_pixels), first_sample + p / n_pixels, &paths[i], &rays[i]);
     queue[i] = i;
 }
 
@@ -110,9 +113,7 @@ __kernel KERNEL_SIZE void k_shade(SCENE_ARGS __global const uint *queue, uint n,
     if (i < n && i < counts[(slot - 1u) * QUEUE_COUNT_STRIDE]) {
         SCENE_VIEW(sc);
         path = queue[i];
-        /* a skipped pixel's camera ray was traced (k_raygen has no mask) but ends here */
-        if (!path_pixel_skipped(&sc, paths[path].pixel))
-            r = shade_path(&sc, &rays[path], hits[path], &paths[path], &shadow_rays[path]);
+        r = shade_path(&sc, &rays[path], hits[path], &paths[path], &shadow_rays[path]);
     }
     uint slot_next = 0u, slot_shadow = 0u;
     if (r & SHADE_CONTINUE) slot_next = atomic_inc(&group_count[0]);
@@ -181,7 +182,8 @@ __kernel KERNEL_SIZE void k_path(SCENE_ARGS uint first_pixel, uint first_sample,
     if (i < n_paths) {
         SCENE_VIEW(sc);
         uint p = first_pixel + i;
-        n_rays = path_run(&sc, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i], &shadow_rays[i]);
+        n_rays = path_run(&sc, batch_pixel(&sc, p % n_pixels), first_sample + p / n_pixels, &paths[i], &rays[i],
+                          &shadow_rays[i]);
     }
     add_group_rays(&group_rays, n_rays, counters);
 }
@@ -212,8 +214,7 @@ KFN_CALL_CL uint path_run_lanes(const SceneView *sc, uint first, uint first_pixe
         split[l] = 0u;
         if (i >= n_paths) continue;
         uint p = first_pixel + i;
-        raygen_path(sc->params, p % n_pixels, first_sample + p / n_pixels, &paths[i], &rays[i]);
-        if (path_pixel_skipped(sc, p % n_pixels)) continue;
+        raygen_path(sc->params, batch_pixel(sc, p % n_pixels), first_sample + p / n_pixels, &paths[i], &rays[i]);
         first_ray[l] = rays[i];
         live |= 1u << l;
     }
@@ -273,15 +274,16 @@ __kernel KERNEL_SIZE_LANES void k_path_lanes(SCENE_ARGS uint first_pixel, uint f
 #endif /* KF_HAS(KF_PATH_LANES) */
 
 /* Adds the finished wave of n_paths paths to the film. Work-item j owns one pixel, the
- * one of wave path j, and adds every path of the wave on that pixel (j, j + n_pixels,
- * ...), so no two work-items touch the same film entry; launched over
- * min(n_paths, n_pixels) work-items. */
-__kernel KERNEL_SIZE void k_film(__global const PathState *paths, uint first_pixel, uint n_pixels,
-                     uint n_paths, __global long *film)
+ * one of wave path j (its PathState.pixel, which raygen_path and k_whitted set), and
+ * adds every path of the wave on that pixel (j, j + n_pixels, ...), so no two
+ * work-items touch the same film entry; launched over min(n_paths, n_pixels)
+ * work-items. */
+__kernel KERNEL_SIZE void k_film(__global const PathState *paths, uint n_pixels, uint n_paths,
+                     __global long *film)
 {
     uint j = (uint)get_global_id(0);
     if (j >= n_paths || j >= n_pixels) return;
-    uint pixel = (first_pixel + j) % n_pixels;
+    uint pixel = paths[j].pixel;
     for (uint i = j; i < n_paths; i += n_pixels) film_add(film, pixel, paths[i].radiance);
 }
 
@@ -374,8 +376,9 @@ __kernel KERNEL_SIZE void k_whitted(SCENE_ARGS uint first_pixel, uint first_samp
     uint rays = 0u;
     if (i < n_paths) {
         SCENE_VIEW(sc);
-        uint p = first_pixel + i;
-        paths[i].radiance = whitted_sample(&sc, p % n_pixels, first_sample + p / n_pixels, &rays);
+        uint p = first_pixel + i, pixel = batch_pixel(&sc, p % n_pixels);
+        paths[i].pixel = pixel;
+        paths[i].radiance = whitted_sample(&sc, pixel, first_sample + p / n_pixels, &rays);
     }
     if (rays) atomic_add(&group_rays, rays);
     barrier(CLK_LOCAL_MEM_FENCE);

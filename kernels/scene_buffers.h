@@ -56,9 +56,8 @@
     X(MANY, Texture,      textures,   (ds)->params.n_textures,   "textures")                 \
     X(MANY, uint,         texels,     (ds)->n_texels,            "texture images")           \
     X(MANY, float,        env_cdf,    (ds)->n_env_cdf,           "environment map distribution") \
-    /* read when params.use_mask is set: one entry per pixel */                              \
-    X(MANY, uint,         pixel_mask, (ds)->pixel_mask ? (size_t)(ds)->params.width *        \
-                                      (ds)->params.height : 0u,  "pixel mask")               \
+    /* the pixels a batch covers when params.pixel_list_size > 0 (batch_pixel) */           \
+    X(MANY, uint,         pixel_list, (ds)->params.pixel_list_size, "pixel list")            \
     /* participating media (kernels/medium/), read only where params.has_media */           \
     X(MANY, Medium,       media,      (ds)->params.n_media,      "participating media")    \
     /* heterogeneous media: grids of MEDIUM_GRID media; their densities and majorants */  \

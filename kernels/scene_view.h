@@ -16,4 +16,14 @@ typedef struct {
 } SceneView;
 #undef SCENE_VIEW_FIELD_
 
+/* The film pixel of a batch's pixel number `index` (in [0, pixels a sample covers)):
+ * itself, or with a pixel list (RenderParams.pixel_list_size) the listed pixel, so that
+ * the waves of a batch hold only the pixels still rendering and a pixel left out costs
+ * nothing. A pixel's random numbers are keyed by the pixel and its sample index, never
+ * by its place in the batch, so a listed pixel computes the bits it computes unlisted. */
+KFN uint batch_pixel(const SceneView *sc, uint index)
+{
+    return sc->params->pixel_list_size ? sc->pixel_list[index] : index;
+}
+
 #endif /* CLPT_SCENE_VIEW_H */

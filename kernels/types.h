@@ -649,8 +649,10 @@ typedef struct {                                        /* 336 bytes */
     uint mis_mode;                    /* enum MisMode */
     uint n_area_lights;               /* lights[0 .. n_area_lights) are area lights */
     uint n_textures;
-    uint use_mask;                    /* render only pixels with pixel_mask != 0 (whitted's
-                                       * adaptive pass; the path tracer's noise threshold) */
+    uint pixel_list_size;             /* 0: a batch's samples cover every pixel; else only
+                                       * the pixels pixel_list names, this many (the noise
+                                       * threshold's pixels still rendering, whitted's
+                                       * adaptive pass; batch_pixel, scene_view.h) */
     uint strata;                      /* whitted pixel samples: 0 the pixel centre, 1
                                        * uniform jitter, m >= 2 an m x m jittered grid */
     uint sample_offset;               /* whitted: added to the sample index (adaptive

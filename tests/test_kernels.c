@@ -514,14 +514,14 @@ static void test_raygen(void)
     cl_mem paths = buffer(n * sizeof(PathState), NULL), rays = buffer(n * sizeof(Ray), NULL),
            queue = buffer(n * sizeof(uint), NULL);
     cl_kernel k = kernel("k_raygen");
-    SET(k, 0, cl.scene[SCENE_BUF_params]);
-    SET(k, 1, first_pixel);
-    SET(k, 2, first_sample);
-    SET(k, 3, npix);
-    SET(k, 4, n);
-    SET(k, 5, paths);
-    SET(k, 6, rays);
-    SET(k, 7, queue);
+    set_scene_args(k);
+    SET(k, N_SCENE + 0, first_pixel);
+    SET(k, N_SCENE + 1, first_sample);
+    SET(k, N_SCENE + 2, npix);
+    SET(k, N_SCENE + 3, n);
+    SET(k, N_SCENE + 4, paths);
+    SET(k, N_SCENE + 5, rays);
+    SET(k, N_SCENE + 6, queue);
     run(k, n);
     PathState *dp = malloc(n * sizeof *dp);
     Ray *dr = malloc(n * sizeof *dr);
@@ -556,18 +556,37 @@ static void test_raygen(void)
  * into a low word and a carry word. Launched with surplus work-items. k_path_lanes
  * (per_item PATH_LANES paths per work-item) must give the same; the last work-item has
  * fewer than eight paths. */
-static void check_path_kernel(const char *name, uint per_item, const RenderScene *scn, const SceneView *v,
-                              const cl_mem *bufs, uint plain)
+static void check_path_kernel(const char *name, uint per_item, const RenderScene *scn, const SceneView *scene_view,
+                              const cl_mem *bufs, uint plain, int listed)
 {
-    const RenderParams *p = &scn->ds.params;
+    /* listed: a batch over a pixel list (RenderParams.pixel_list_size): every third
+     * pixel and the last, whose paths must be those an unlisted batch gives them */
+    RenderParams lp = scn->ds.params;
+    uint *list = malloc((size_t)lp.width * lp.height * sizeof *list);
+    if (listed) {
+        for (uint i = 0; i < lp.width * lp.height; i++)
+            if (i % 3u == 1u || i + 1u == lp.width * lp.height) list[lp.pixel_list_size++] = i;
+    }
+    SceneView lv = *scene_view;
+    lv.params = &lp;
+    lv.pixel_list = list;
+    const SceneView *v = &lv;
+    const RenderParams *p = &lp;
     /* a last work-item of k_path_lanes with fewer than eight paths */
-    uint npix = p->width * p->height, n = npix * LAYERS - (per_item > 1u ? 5u : 0u), first_pixel = 7, first_sample = 3;
+    uint npix = listed ? lp.pixel_list_size : p->width * p->height;
+    uint n = npix * LAYERS - (per_item > 1u ? 5u : 0u), first_pixel = 7, first_sample = 3;
     cl_uint init[2 * QUEUE_COUNT_STRIDE] = { 0 };
     init[0] = 0xfffff000u;   /* near the top: the count wraps the low word and carries */
     cl_mem paths = buffer(n * sizeof(PathState), NULL), rays = buffer(n * sizeof(Ray), NULL),
            shadow = buffer(n * sizeof(Ray), NULL), counters = buffer(sizeof init, init);
+    cl_mem list_params = listed ? buffer(sizeof lp, &lp) : NULL;
+    cl_mem list_pixels = listed ? buffer(lp.pixel_list_size * sizeof *list, list) : NULL;
     cl_kernel k = kernel(name);
     set_scene_bufs(k, bufs);
+    if (listed) {
+        SET(k, SCENE_BUF_params, list_params);
+        SET(k, SCENE_BUF_pixel_list, list_pixels);
+    }
     SET(k, N_SCENE + 0, first_pixel);
     SET(k, N_SCENE + 1, first_sample);
     SET(k, N_SCENE + 2, npix);
@@ -588,7 +607,7 @@ static void check_path_kernel(const char *name, uint per_item, const RenderScene
         Ray cr, cs;
         memset(&cs, 0, sizeof cs);
         uint path = first_pixel + i;
-        raygen_path(p, path % npix, first_sample + path / npix, &cp, &cr);
+        raygen_path(p, batch_pixel(v, path % npix), first_sample + path / npix, &cp, &cr);
         for (;;) {
             Hit hit = trace_closest_visible(v, cr);
             c_rays++;
@@ -609,15 +628,26 @@ static void check_path_kernel(const char *name, uint per_item, const RenderScene
         if (!same && i + 1 - exact <= 3) report_words("path state", i, &cp, &dp[i], sizeof cp);
     }
     uint64_t d_rays = (uint64_t)got[0] + ((uint64_t)got[QUEUE_COUNT_STRIDE] << 32);
-    fprintf(stderr, "  %s: %u paths, %u lit, %llu rays (%u hits on plain diffuse triangles), %u bit-identical to C\n",
-            name, n, lit, (unsigned long long)c_rays, plain_hits, exact);
+    fprintf(stderr, "  %s%s: %u paths, %u lit, %llu rays (%u hits on plain diffuse triangles), %u bit-identical to C\n",
+            name, listed ? " over a pixel list" : "", n, lit, (unsigned long long)c_rays, plain_hits, exact);
     CHECK_EQ_INT(exact, n);
     CHECK(plain_hits > n / 4);
     CHECK(lit > n / 4);
     CHECK_MSG(d_rays == 0xfffff000ull + c_rays, "rays: device %llu, C %llu", (unsigned long long)(d_rays - 0xfffff000ull),
               (unsigned long long)c_rays);
-    CHECK_EQ_INT(got[QUEUE_COUNT_STRIDE], 1);
+    /* the whole batches carry; a listed one may trace too few rays to */
+    CHECK_EQ_INT(got[QUEUE_COUNT_STRIDE], (uint)((0xfffff000ull + c_rays) >> 32));
+    if (!listed) CHECK_EQ_INT(got[QUEUE_COUNT_STRIDE], 1);
+    if (listed) {
+        /* the pixels left out appear in no path */
+        uint outside = 0;
+        for (uint i = 0; i < n; i++) outside += dp[i].pixel % 3u != 1u && dp[i].pixel + 1u != p->width * p->height;
+        CHECK_EQ_INT(outside, 0);
+        clReleaseMemObject(list_params);
+        clReleaseMemObject(list_pixels);
+    }
     free(dp);
+    free(list);
     clReleaseKernel(k);
     clReleaseMemObject(paths);
     clReleaseMemObject(rays);
@@ -625,7 +655,14 @@ static void check_path_kernel(const char *name, uint per_item, const RenderScene
     clReleaseMemObject(counters);
 }
 
-static void test_path_kernel(void) { check_path_kernel("k_path", 1u, &rs, &view, cl.scene, plain_material); }
+static void test_path_kernel(void) { check_path_kernel("k_path", 1u, &rs, &view, cl.scene, plain_material, 0); }
+
+/* k_path over a pixel list (the noise threshold's rounds): each listed pixel's paths
+ * are the bits it gets without a list. */
+static void test_path_kernel_listed(void)
+{
+    check_path_kernel("k_path", 1u, &rs, &view, cl.scene, plain_material, 1);
+}
 
 /* k_path_lanes on the scene of its kind (it holds no shade_path, so it renders only
  * those), and which scenes are of that kind. */
@@ -652,7 +689,8 @@ static void test_path_lanes_kernel(void)
     q = ds->params;
     q.mis_mode = MIS_LIGHT_ONLY;
     CHECK(!kernel_lanes_params(&q));
-    check_path_kernel("k_path_lanes", PATH_LANES, &lanes_rs, &lanes_view, lanes_bufs, lanes_plain);
+    check_path_kernel("k_path_lanes", PATH_LANES, &lanes_rs, &lanes_view, lanes_bufs, lanes_plain, 0);
+    check_path_kernel("k_path_lanes", PATH_LANES, &lanes_rs, &lanes_view, lanes_bufs, lanes_plain, 1);
 }
 
 /* Random rays through the scene's box, from inside and outside it. */
@@ -1027,6 +1065,7 @@ static void test_film(void)
     uint n_film = 600, first_pixel = 100, n_paths = 2000;
     PathState *ps = calloc(n_paths, sizeof *ps);
     for (uint i = 0; i < n_paths; i++) {
+        ps[i].pixel = (first_pixel + i) % n_film;   /* as raygen_path leaves it */
         ps[i].radiance = vrand(0.0f, 3.0f);
         if (i % 97 == 0) ps[i].radiance.x = NAN;           /* dropped, not propagated */
         if (i % 89 == 0) ps[i].radiance.y = 1e30f;         /* clamped */
@@ -1037,10 +1076,9 @@ static void test_film(void)
     cl_mem pb = buffer((size_t)n_paths * sizeof *ps, ps), fb = buffer((size_t)n_film * 3 * sizeof *film, film);
     cl_kernel k = kernel("k_film");
     SET(k, 0, pb);
-    SET(k, 1, first_pixel);
-    SET(k, 2, n_film);
-    SET(k, 3, n_paths);
-    SET(k, 4, fb);
+    SET(k, 1, n_film);
+    SET(k, 2, n_paths);
+    SET(k, 3, fb);
     run(k, n_film);
     read_back(fb, (size_t)n_film * 3 * sizeof *film, film);
     for (uint i = 0; i < n_paths; i++) film_add(cfilm, (first_pixel + i) % n_film, ps[i].radiance);
@@ -1059,19 +1097,21 @@ static void test_film(void)
 
 /* k_whitted against whitted_sample in C: the classic ray tracer, each auxiliary image
  * and the denoiser's features (through the scene's mirrors and glass), pixel centres
- * and a jittered grid, with and without the adaptive pass's mask. */
+ * and a jittered grid, with and without the adaptive pass's pixel list. */
 static void test_whitted(void)
 {
     const RenderParams *base = &rs.ds.params;
-    uint npix = base->width * base->height, layers = 2, n = npix * layers, first_sample = 3;
-    uint *mask = malloc(npix * sizeof *mask);
-    for (uint i = 0; i < npix; i++) mask[i] = (i * 7u) % 5u < 2u;
-    cl_mem mb = buffer(npix * sizeof *mask, mask), pb = buffer(n * sizeof(PathState), NULL);
+    uint npix = base->width * base->height, layers = 2, n_all = npix * layers, first_sample = 3;
+    /* the adaptive pass's pixel list: the pixels it renders again */
+    uint *list = malloc(npix * sizeof *list), n_list = 0;
+    for (uint i = 0; i < npix; i++)
+        if ((i * 7u) % 5u < 2u) list[n_list++] = i;
+    cl_mem lb = buffer(n_list * sizeof *list, list), pb = buffer(n_all * sizeof(PathState), NULL);
     cl_kernel k = kernel("k_whitted");
-    struct { uint integrator, strata, use_mask, cube; const char *name; } modes[] = {
+    struct { uint integrator, strata, listed, cube; const char *name; } modes[] = {
         { INTEGRATOR_WHITTED, 0, 0, 0, "whitted, pixel centres" },
         { INTEGRATOR_WHITTED, 3, 0, 0, "whitted, 3x3 jittered" },
-        { INTEGRATOR_WHITTED, 1, 1, 0, "whitted, jittered, masked" },
+        { INTEGRATOR_WHITTED, 1, 1, 0, "whitted, jittered, a pixel list" },
         { INTEGRATOR_WHITTED, 1, 0, 1, "whitted, cube-map background" },
         { INTEGRATOR_AOV_NORMAL, 0, 0, 0, "normal image" },
         { INTEGRATOR_AOV_DEPTH, 1, 0, 0, "depth image" },
@@ -1083,7 +1123,8 @@ static void test_whitted(void)
         RenderParams p = *base;
         p.integrator = modes[m].integrator;
         p.strata = modes[m].strata;
-        p.use_mask = modes[m].use_mask;
+        p.pixel_list_size = modes[m].listed ? n_list : 0u;
+        uint n_pixels = modes[m].listed ? n_list : npix, n = n_pixels * layers;
         p.sample_offset = 5;
         if (modes[m].cube) {
             p.bg_type = BG_CUBEMAP;
@@ -1094,11 +1135,11 @@ static void test_whitted(void)
         cl_mem cb = buffer(sizeof zero, &zero);
         set_scene_args(k);
         SET(k, 0, parb);
-        SET(k, SCENE_BUF_pixel_mask, mb);
+        SET(k, SCENE_BUF_pixel_list, lb);
         uint first_pixel = 0;
         SET(k, N_SCENE + 0, first_pixel);
         SET(k, N_SCENE + 1, first_sample);
-        SET(k, N_SCENE + 2, npix);
+        SET(k, N_SCENE + 2, n_pixels);
         SET(k, N_SCENE + 3, n);
         SET(k, N_SCENE + 4, pb);
         SET(k, N_SCENE + 5, cb);
@@ -1112,11 +1153,12 @@ static void test_whitted(void)
         read_back(cb, sizeof drays, &drays);
         SceneView v = view;
         v.params = &p;
-        v.pixel_mask = mask;
+        v.pixel_list = list;
         uint exact = 0, bad = 0, crays = 0, lit = 0;
         for (uint i = 0; i < n; i++) {
-            uint r = 0;
-            vec3 L = whitted_sample(&v, i % npix, first_sample + i / npix, &r);
+            uint r = 0, pixel = batch_pixel(&v, i % n_pixels);
+            vec3 L = whitted_sample(&v, pixel, first_sample + i / n_pixels, &r);
+            if (dp[i].pixel != pixel) bad++;   /* k_film adds the sample there */
             crays += r;
             lit += v3_max_comp(L) > 0.0f;
             exact += memcmp(&L, &dp[i].radiance, sizeof L) == 0;
@@ -1132,9 +1174,9 @@ static void test_whitted(void)
         clReleaseMemObject(cb);
     }
     clReleaseKernel(k);
-    clReleaseMemObject(mb);
+    clReleaseMemObject(lb);
     clReleaseMemObject(pb);
-    free(mask);
+    free(list);
 }
 
 /* Builds a test kernel, SOURCE, as the renderer builds its own: the same options (so
@@ -1453,6 +1495,7 @@ int main(void)
     RUN(test_layout);
     RUN(test_raygen);
     RUN(test_path_kernel);
+    RUN(test_path_kernel_listed);
     RUN(test_path_lanes_kernel);
     RUN(test_intersect);
     RUN(test_shade_and_shadow);

@@ -604,11 +604,11 @@ static void test_kernel_argument_names(void)
 #define BUFFER_NAME_(kind, Type, name, count, what) #name,
     static const char *const buffers[SCENE_BUF_COUNT] = { SCENE_BUFFERS(BUFFER_NAME_) };
 #undef BUFFER_NAME_
-    static const char *const scene_kernels[] = { "k_intersect", "k_shade", "k_shadow", "k_whitted" };
+    static const char *const scene_kernels[] = { "k_raygen", "k_intersect", "k_shade", "k_shadow", "k_whitted" };
     for (size_t k = 0; k < sizeof scene_kernels / sizeof scene_kernels[0]; k++)
         for (cl_uint i = 0; i < SCENE_BUF_COUNT; i++) check_arg_name(prog, scene_kernels[k], i, buffers[i]);
     static const struct { const char *kernel; cl_uint arg; const char *name; } named[] = {
-        { "k_raygen", ARG_RAYGEN_PARAMS, "params" }, { "k_raygen", ARG_RAYGEN_FIRST_PIXEL, "first_pixel" },
+        { "k_raygen", ARG_RAYGEN_FIRST_PIXEL, "first_pixel" },
         { "k_raygen", ARG_RAYGEN_FIRST_SAMPLE, "first_sample" }, { "k_raygen", ARG_RAYGEN_N_PIXELS, "n_pixels" },
         { "k_raygen", ARG_RAYGEN_N_PATHS, "n_paths" }, { "k_raygen", ARG_RAYGEN_PATHS, "paths" },
         { "k_raygen", ARG_RAYGEN_RAYS, "rays" }, { "k_raygen", ARG_RAYGEN_QUEUE, "queue" },
@@ -623,7 +623,7 @@ static void test_kernel_argument_names(void)
         { "k_shadow", ARG_SHADOW_QUEUE, "shadow_queue" }, { "k_shadow", ARG_SHADOW_N, "n" },
         { "k_shadow", ARG_SHADOW_RAYS, "shadow_rays" }, { "k_shadow", ARG_SHADOW_PATHS, "paths" },
         { "k_shadow", ARG_SHADOW_COUNTS, "counts" }, { "k_shadow", ARG_SHADOW_LIVE_SLOT, "live_slot" },
-        { "k_film", ARG_FILM_PATHS, "paths" }, { "k_film", ARG_FILM_FIRST_PIXEL, "first_pixel" },
+        { "k_film", ARG_FILM_PATHS, "paths" },
         { "k_film", ARG_FILM_N_PIXELS, "n_pixels" }, { "k_film", ARG_FILM_N_PATHS, "n_paths" },
         { "k_film", ARG_FILM_FILM, "film" },
         { "k_path", ARG_PATH_FIRST_PIXEL, "first_pixel" }, { "k_path", ARG_PATH_FIRST_SAMPLE, "first_sample" },

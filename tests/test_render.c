@@ -195,9 +195,9 @@ static int films_equal(const Film *a, const Film *b)
     return a->sum && b->sum && a->samples == b->samples && memcmp(a->sum, b->sum, n * sizeof *a->sum) == 0;
 }
 
-/* One change of the params block and mask, made with update_params on a loaded device,
- * must give the very film a device given the changed scene whole gives. */
-static void check_update(const DeviceDesc *desc, RenderScene *rs, const RenderParams *changed, const uint *mask)
+/* One change of the params block and pixel list, made with update_params on a loaded
+ * device, must give the very film a device given the changed scene whole gives. */
+static void check_update(const DeviceDesc *desc, RenderScene *rs, const RenderParams *changed, const uint *list)
 {
     Error err = { 0 };
     Device *kept = NULL, *fresh = NULL;
@@ -210,12 +210,12 @@ static void check_update(const DeviceDesc *desc, RenderScene *rs, const RenderPa
     if (st == ST_OK) st = kept->ops->load_scene(kept, &ds, &err);
     CHECK_MSG(st == ST_OK, "%s", err.msg);
     if (st == ST_OK && render_on(kept, &ds.params, 4, &before)) {
-        st = kept->ops->update_params(kept, changed, mask, &err);
+        st = kept->ops->update_params(kept, changed, list, &err);
         CHECK_MSG(st == ST_OK, "update_params: %s", err.msg);
         if (st == ST_OK) render_on(kept, changed, 4, &updated);
     }
     ds.params = *changed;
-    ds.pixel_mask = mask;
+    ds.pixel_list = list;
     st = device_open(desc, NULL, &fresh, &err);
     if (st == ST_OK) st = fresh->ops->load_scene(fresh, &ds, &err);
     CHECK_MSG(st == ST_OK, "%s", err.msg);
@@ -223,6 +223,19 @@ static void check_update(const DeviceDesc *desc, RenderScene *rs, const RenderPa
     CHECK_MSG(films_equal(&updated, &reloaded), "device %s: update_params and a full load differ", desc->name);
     CHECK_MSG(before.sum && updated.sum && !films_equal(&before, &updated), "device %s: update_params changed nothing",
               desc->name);
+    if (list && before.sum && updated.sum && changed->integrator == rs->ds.params.integrator &&
+        changed->seed == rs->ds.params.seed) {
+        /* the same render over a pixel list: its pixels hold the bits they hold without
+         * one, the others nothing */
+        size_t wrong = 0, listed = 0, n = (size_t)changed->width * changed->height;
+        for (size_t i = 0; i < n; i++) {
+            int in = listed < changed->pixel_list_size && list[listed] == i;
+            listed += in;
+            for (int c = 0; c < 3; c++) wrong += updated.sum[3 * i + c] != (in ? before.sum[3 * i + c] : 0);
+        }
+        CHECK_MSG(wrong == 0, "device %s: %zu film entries of the listed render differ from the whole one's",
+                  desc->name, wrong);
+    }
     film_free(&before);
     film_free(&updated);
     film_free(&reloaded);
@@ -233,7 +246,7 @@ static void check_update(const DeviceDesc *desc, RenderScene *rs, const RenderPa
 
 /* update_params (the passes' way to change the render without uploading the scene
  * again) on the scalar device and on PoCL: another seed and a deeper path, then the
- * classic integrator over a pixel mask. */
+ * classic integrator and the path tracer over a pixel list. */
 static void check_update_params(const char *spec)
 {
     Scene s;
@@ -258,13 +271,18 @@ static void check_update_params(const char *spec)
         p.seed = 1234u;
         p.max_depth = 9u;   /* more bounces than loaded: the OpenCL counters grow */
         check_update(&all[chosen[0]], &rs, &p, NULL);
-        uint mask[24 * 16];
+        uint mask[24 * 16], list[24 * 16];
         for (uint i = 0; i < 24u * 16u; i++) mask[i] = (i % 3u) != 0u;
         p = rs.ds.params;
         p.integrator = INTEGRATOR_WHITTED;
-        p.use_mask = 1;
+        p.pixel_list_size = render_scene_list_pixels(mask, 24u * 16u, list);
         p.strata = 1;
-        check_update(&all[chosen[0]], &rs, &p, mask);
+        check_update(&all[chosen[0]], &rs, &p, list);
+        /* the path tracer over a pixel list: the listed pixels as an unlisted render
+         * gives them, the others empty (adaptive.c's rounds) */
+        p = rs.ds.params;
+        p.pixel_list_size = render_scene_list_pixels(mask, 24u * 16u, list);
+        check_update(&all[chosen[0]], &rs, &p, list);
     }
     free(chosen);
     free(all);

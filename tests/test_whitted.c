@@ -699,7 +699,7 @@ static void test_adaptive(void)
     CHECK(marked > 40 && marked < 400);                   /* the silhouette, not the image */
     CHECK_EQ_INT(changed_unmarked, 0);
     CHECK(between > 20);
-    CHECK(rs.ds.params.use_mask == 0 && rs.ds.pixel_mask == NULL);   /* restored */
+    CHECK(rs.ds.params.pixel_list_size == 0 && rs.ds.pixel_list == NULL);   /* restored */
     for (size_t i = 0; i < n_dev; i++) device_close(devs[i]);
     free(all);
     free(chosen);

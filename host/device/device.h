@@ -36,7 +36,8 @@
 /* Everything a device needs, in kernel layout: one field per line of
  * kernels/scene_buffers.h (the params block by value, every other buffer as a pointer,
  * NULL when its count is 0), then the counts that list finds here rather than in params.
- * pixel_mask has width * height entries when params.use_mask is set, else it is NULL. */
+ * pixel_list has params.pixel_list_size entries, the pixels a batch covers, or is NULL
+ * (0: every pixel). */
 #define DEVICE_SCENE_FIELD_ONE_(Type, name) Type name;
 #define DEVICE_SCENE_FIELD_MANY_(Type, name) const Type *name;
 #define DEVICE_SCENE_FIELD_(kind, Type, name, count, what) DEVICE_SCENE_FIELD_##kind##_(Type, name)
@@ -140,13 +141,14 @@ typedef struct Device Device;
 
 typedef struct {
     Status (*load_scene)(Device *d, const DeviceScene *scene, Error *err);
-    /* Replaces the params block and the pixel mask of the loaded scene, keeping every
-     * other buffer (a pass that changes the integrator, the samples or the mask need
-     * not upload the kd-tree again). The image size must be the one loaded; pixel_mask
-     * NULL is no mask. */
-    Status (*update_params)(Device *d, const RenderParams *params, const uint *pixel_mask, Error *err);
-    /* Renders samples [first_sample, first_sample + count) of every pixel; ST_INTERRUPTED,
-     * with nothing of the batch kept, when *d->cancel was set meanwhile. */
+    /* Replaces the params block and the pixel list of the loaded scene, keeping every
+     * other buffer (a pass that changes the integrator, the samples or the pixels need
+     * not upload the kd-tree again). The image size must be the one loaded; pixel_list
+     * holds params->pixel_list_size pixel indices (NULL when 0: every pixel). */
+    Status (*update_params)(Device *d, const RenderParams *params, const uint *pixel_list, Error *err);
+    /* Renders samples [first_sample, first_sample + count) of every pixel, or of every
+     * pixel of the list; ST_INTERRUPTED, with nothing of the batch kept, when *d->cancel
+     * was set meanwhile. */
     Status (*render)(Device *d, uint first_sample, uint count, Error *err);
     /* Adds the film of the oldest batch not yet taken into `film` (n_pixels * 3). */
     Status (*take_film)(Device *d, int64_t *film, Error *err);

@@ -66,6 +66,7 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     Status st = ocld_alloc_render(od, in, n_pixels, err);
     if (st) return st;
     od->n_pixels = n_pixels;
+    od->batch_pixels = p->pixel_list_size ? p->pixel_list_size : n_pixels;
     /* a program built for an earlier scene serves this one if it has its features */
     od->scene_features = kernel_scene_features(s);
     od->path_launch = s->params.split > 1u ? WAVE_LAUNCH_MEGAKERNEL : od->launch;
@@ -86,9 +87,9 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     return ST_OK;
 }
 
-/* The params block is written in place (the buffer keeps its size); the pixel mask
+/* The params block is written in place (the buffer keeps its size); the pixel list
  * gets a buffer of its own size, set as every kernel's argument. */
-static Status ocl_update_params(Device *d, const RenderParams *p, const uint *pixel_mask, Error *err)
+static Status ocl_update_params(Device *d, const RenderParams *p, const uint *pixel_list, Error *err)
 {
     OclDevice *od = d->impl;
     if (p->width * p->height != od->n_pixels)
@@ -96,16 +97,17 @@ static Status ocl_update_params(Device *d, const RenderParams *p, const uint *pi
                          "loaded for %u pixels", od->info.name, p->width, p->height, od->n_pixels);
     double t0 = timer_now();
     Status st;
-    /* every launch so far has read the old block and mask */
+    /* every launch so far has read the old block and list */
     OCL_TRY("clFinish", clFinish(od->queue));
     OCL_TRY("clEnqueueWriteBuffer", clEnqueueWriteBuffer(od->queue, od->scene[SCENE_BUF_params], CL_TRUE, 0,
                                                          sizeof *p, p, 0, NULL, NULL));
-    ocl_release_mem(&od->scene[SCENE_BUF_pixel_mask]);
-    size_t mask_bytes = pixel_mask ? (size_t)od->n_pixels * sizeof(uint) : 0;
-    if ((st = ocld_make_buffer(od, CL_MEM_READ_ONLY, mask_bytes, pixel_mask, "pixel mask",
-                          &od->scene[SCENE_BUF_pixel_mask], err)) ||
-        (st = ocld_set_scene_arg(od, SCENE_BUF_pixel_mask, err)) || (st = ocld_grow_counts(od, path_max_shades(p->max_depth, p->has_media), err)))
+    ocl_release_mem(&od->scene[SCENE_BUF_pixel_list]);
+    size_t list_bytes = pixel_list ? (size_t)p->pixel_list_size * sizeof(uint) : 0;
+    if ((st = ocld_make_buffer(od, CL_MEM_READ_ONLY, list_bytes, pixel_list, "pixel list",
+                          &od->scene[SCENE_BUF_pixel_list], err)) ||
+        (st = ocld_set_scene_arg(od, SCENE_BUF_pixel_list, err)) || (st = ocld_grow_counts(od, path_max_shades(p->max_depth, p->has_media), err)))
         return st;
+    od->batch_pixels = p->pixel_list_size ? p->pixel_list_size : od->n_pixels;
     od->max_bounces = path_max_shades(p->max_depth, p->has_media);
     d->counters.upload_seconds += timer_now() - t0;
     od->scene_features |= kernel_params_features(p);
@@ -139,12 +141,13 @@ static Status ocl_render(Device *d, uint first_sample, uint count, Error *err)
     FilmSlot *fs = &od->slots[od->head % od->n_slots];
     if (fs->read_done)
         return error_set(err, ST_INTERNAL, "device '%s': more than %u batches in flight", od->info.name, od->n_slots);
-    uint64_t n_pixels = od->n_pixels, total = n_pixels * count;
+    /* paths are numbered over the pixels a sample covers (entry.cl); the film holds all */
+    uint64_t n_pixels = od->batch_pixels, total = n_pixels * count;
     if (fs->stale) {
         /* in order on the queue: cleared before the batch's kernels add to it */
         cl_long zero = 0;
         OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, fs->film, &zero, sizeof zero, 0,
-                                                           (size_t)n_pixels * 3u * sizeof(cl_long), 0, NULL, NULL));
+                                                           (size_t)od->n_pixels * 3u * sizeof(cl_long), 0, NULL, NULL));
         fs->stale = 0;
     }
     /* Waves of equal size, at least two when the batch is big enough to split. */
@@ -184,7 +187,7 @@ static Status ocl_render(Device *d, uint first_sample, uint count, Error *err)
         return st;
     }
     /* The film comes back while the next batch renders; zeroed on the device after. */
-    size_t bytes = (size_t)n_pixels * 3u * sizeof(cl_long);
+    size_t bytes = (size_t)od->n_pixels * 3u * sizeof(cl_long);
     OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, fs->film, CL_FALSE, 0, bytes, fs->host, 0, NULL,
                                                        &fs->read_done));
     cl_long zero = 0;

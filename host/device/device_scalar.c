@@ -103,7 +103,8 @@ static int cancel_requested(CpuDevice *cd)
 /* Renders chunks of the current batch until none is left or the batch is cancelled. */
 static void render_chunks(CpuDevice *cd)
 {
-    uint n_pixels = cd->params.width * cd->params.height;
+    /* the pixels a sample covers: the image's, or the list's (batch_pixel) */
+    uint n_pixels = cd->params.pixel_list_size ? cd->params.pixel_list_size : cd->params.width * cd->params.height;
     uint64_t rays = 0;
     double t[PHASE_N] = { 0 };
     for (;;) {
@@ -112,7 +113,8 @@ static void render_chunks(CpuDevice *cd)
         if (chunk >= (n_pixels + cd->chunk_pixels - 1) / cd->chunk_pixels) break;
         uint begin = chunk * cd->chunk_pixels;
         uint end = n_pixels - begin > cd->chunk_pixels ? begin + cd->chunk_pixels : n_pixels;
-        for (uint pixel = begin; pixel < end; pixel++) {
+        for (uint index = begin; index < end; index++) {
+            uint pixel = batch_pixel(&cd->view, index);
             for (uint s = 0; s < cd->count; s++) {
                 vec3 L;
                 if (cd->params.integrator == INTEGRATOR_PATH && cd->phases) {
@@ -175,14 +177,14 @@ static Status cpu_load_scene(Device *d, const DeviceScene *scene, Error *err)
     return ST_OK;
 }
 
-static Status cpu_update_params(Device *d, const RenderParams *params, const uint *pixel_mask, Error *err)
+static Status cpu_update_params(Device *d, const RenderParams *params, const uint *pixel_list, Error *err)
 {
     CpuDevice *cd = d->impl;
     if (params->width != cd->params.width || params->height != cd->params.height)
         return error_set(err, ST_INTERNAL, "scalar device: new render parameters for %ux%u pixels, the scene "
                          "was loaded for %ux%u", params->width, params->height, cd->params.width, cd->params.height);
     cd->params = *params;
-    cd->view.pixel_mask = pixel_mask;
+    cd->view.pixel_list = pixel_list;
     return ST_OK;
 }
 
@@ -217,7 +219,7 @@ static Status cpu_render(Device *d, uint first_sample, uint count, Error *err)
         cd->film_stale = 1;
         return error_set(err, ST_INTERRUPTED, "scalar device: batch cancelled");
     }
-    d->counters.samples += (uint64_t)d->n_pixels * count;
+    d->counters.samples += (uint64_t)(cd->params.pixel_list_size ? cd->params.pixel_list_size : d->n_pixels) * count;
     return ST_OK;
 }
 

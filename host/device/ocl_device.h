@@ -111,7 +111,9 @@ typedef struct {
      * leave the float8 shading). lanes_scene: the loaded scene allows it, whatever the
      * settings. */
     int lanes, lanes_scene;
-    uint n_pixels;
+    uint n_pixels;          /* the film's */
+    uint batch_pixels;      /* the pixels each sample of a batch covers: n_pixels, or the
+                             * pixel list's (RenderParams.pixel_list_size) */
     const atomic_int *cancel;   /* the Device's, while a batch renders */
     cl_mem film;            /* the film the batch being rendered goes to */
     uint64_t rays;          /* rays of the batch being rendered */

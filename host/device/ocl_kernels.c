@@ -29,29 +29,26 @@ static Status set_scene_args(OclDevice *od, cl_kernel k, Error *err)
 }
 
 /* The arguments of a wave's kernels that stay the same for the whole render, set once
- * after the upload; per launch only queues, counts, positions and the film change. */
+ * after the upload; per launch only queues, counts, positions, the pixels a sample
+ * covers and the film change. */
 static Status set_fixed_args(OclDevice *od, WaveSlot *w, Error *err)
 {
     Status st;
     cl_kernel k = w->k_film;
     ARG(k, ARG_FILM_PATHS, w->paths);
-    ARG(k, ARG_FILM_N_PIXELS, od->n_pixels);
     if (w->k_path) {
         if ((st = set_scene_args(od, w->k_path, err))) return st;
         k = w->k_path;
-        ARG(k, ARG_PATH_N_PIXELS, od->n_pixels);
         ARG(k, ARG_PATH_PATHS, w->paths);
         ARG(k, ARG_PATH_RAYS, w->rays);
         ARG(k, ARG_PATH_SHADOW_RAYS, w->shadow_rays);
         ARG(k, ARG_PATH_COUNTERS, w->counts);
         return ST_OK;
     }
-    if ((st = set_scene_args(od, w->k_intersect, err)) || (st = set_scene_args(od, w->k_shade, err)) ||
-        (st = set_scene_args(od, w->k_shadow, err)))
+    if ((st = set_scene_args(od, w->k_raygen, err)) || (st = set_scene_args(od, w->k_intersect, err)) ||
+        (st = set_scene_args(od, w->k_shade, err)) || (st = set_scene_args(od, w->k_shadow, err)))
         return st;
     k = w->k_raygen;
-    ARG(k, ARG_RAYGEN_PARAMS, od->scene[SCENE_BUF_params]);
-    ARG(k, ARG_RAYGEN_N_PIXELS, od->n_pixels);
     ARG(k, ARG_RAYGEN_PATHS, w->paths);
     ARG(k, ARG_RAYGEN_RAYS, w->rays);
     ARG(k, ARG_RAYGEN_QUEUE, w->queue_a);
@@ -170,6 +167,7 @@ Status ocld_set_scene_arg(OclDevice *od, unsigned b, Error *err)
             ARG(w->k_path, b, od->scene[b]);
             continue;
         }
+        ARG(w->k_raygen, b, od->scene[b]);
         ARG(w->k_intersect, b, od->scene[b]);
         ARG(w->k_shade, b, od->scene[b]);
         ARG(w->k_shadow, b, od->scene[b]);

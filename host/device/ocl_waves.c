@@ -75,10 +75,10 @@ static Status bounce_launch(OclDevice *od, WaveSlot *w, uint b, uint n, Error *e
 static Status wave_film(OclDevice *od, WaveSlot *w, Error *err)
 {
     cl_kernel k = w->k_film;
-    ARG(k, ARG_FILM_FIRST_PIXEL, w->first_pixel);
+    ARG(k, ARG_FILM_N_PIXELS, od->batch_pixels);
     ARG(k, ARG_FILM_N_PATHS, w->n_paths);
     ARG(k, ARG_FILM_FILM, od->film);
-    return launch(od, k, "k_film", w->n_paths < od->n_pixels ? w->n_paths : od->n_pixels, err);
+    return launch(od, k, "k_film", w->n_paths < od->batch_pixels ? w->n_paths : od->batch_pixels, err);
 }
 
 /* GPUs: enqueues every bounce of the wave at once, each launch over the wave's size,
@@ -119,6 +119,7 @@ static Status wave_run_paths(OclDevice *od, WaveSlot *w, Error *err)
     cl_kernel k = w->k_path;
     ARG(k, ARG_PATH_FIRST_PIXEL, w->first_pixel);
     ARG(k, ARG_PATH_FIRST_SAMPLE, w->first_sample);
+    ARG(k, ARG_PATH_N_PIXELS, od->batch_pixels);
     ARG(k, ARG_PATH_N_PATHS, w->n_paths);
     /* k_path_lanes: work-groups of as many paths as k_path's (KERNEL_SIZE_LANES) */
     uint items = od->lanes ? (w->n_paths + PATH_LANES - 1u) / PATH_LANES : w->n_paths;
@@ -131,7 +132,7 @@ static Status wave_run_paths(OclDevice *od, WaveSlot *w, Error *err)
 }
 
 /* Starts a wave of path numbers [first_pixel, first_pixel + n_paths) counted from pixel
- * 0 of sample first_sample (entry.cl). */
+ * number 0 of sample first_sample (entry.cl; od->batch_pixels to a sample). */
 Status ocld_wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint first_sample, uint n_paths, Error *err)
 {
     Status st;
@@ -153,6 +154,7 @@ Status ocld_wave_start(OclDevice *od, WaveSlot *w, uint first_pixel, uint first_
     cl_kernel k = w->k_raygen;
     ARG(k, ARG_RAYGEN_FIRST_PIXEL, first_pixel);
     ARG(k, ARG_RAYGEN_FIRST_SAMPLE, first_sample);
+    ARG(k, ARG_RAYGEN_N_PIXELS, od->batch_pixels);
     ARG(k, ARG_RAYGEN_N_PATHS, n_paths);
     if ((st = launch(od, k, "k_raygen", n_paths, err))) return st;
     w->cur = w->queue_a;
@@ -213,25 +215,25 @@ Status ocld_render_whitted(OclDevice *od, uint first_sample, uint64_t total, Err
     for (uint64_t next_path = 0; next_path < total;) {
         if (ocld_cancel_requested(od)) return ST_INTERRUPTED;
         uint n = total - next_path < od->wave_paths ? (uint)(total - next_path) : od->wave_paths;
-        uint first_pixel = (uint)(next_path % od->n_pixels), sample = first_sample + (uint)(next_path / od->n_pixels);
+        uint first_pixel = (uint)(next_path % od->batch_pixels);
+        uint sample = first_sample + (uint)(next_path / od->batch_pixels);
         cl_uint zero = 0, count = 0;
         OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, w->counts, &zero, sizeof zero, 0,
                                                            sizeof zero, 0, NULL, NULL));
         cl_kernel k = od->k_whitted;
         ARG(k, ARG_WHITTED_FIRST_PIXEL, first_pixel);
         ARG(k, ARG_WHITTED_FIRST_SAMPLE, sample);
-        ARG(k, ARG_WHITTED_N_PIXELS, od->n_pixels);
+        ARG(k, ARG_WHITTED_N_PIXELS, od->batch_pixels);
         ARG(k, ARG_WHITTED_N_PATHS, n);
         ARG(k, ARG_WHITTED_PATHS, w->paths);
         ARG(k, ARG_WHITTED_COUNTERS, w->counts);
         if ((st = launch(od, k, "k_whitted", n, err))) return st;
         k = od->k_whitted_film;
         ARG(k, ARG_FILM_PATHS, w->paths);
-        ARG(k, ARG_FILM_N_PIXELS, od->n_pixels);
-        ARG(k, ARG_FILM_FIRST_PIXEL, first_pixel);
+        ARG(k, ARG_FILM_N_PIXELS, od->batch_pixels);
         ARG(k, ARG_FILM_N_PATHS, n);
         ARG(k, ARG_FILM_FILM, od->film);
-        if ((st = launch(od, k, "k_film", n < od->n_pixels ? n : od->n_pixels, err))) return st;
+        if ((st = launch(od, k, "k_film", n < od->batch_pixels ? n : od->batch_pixels, err))) return st;
         OCL_TRY("clEnqueueReadBuffer", clEnqueueReadBuffer(od->queue, w->counts, CL_TRUE, 0, sizeof count, &count,
                                                            0, NULL, NULL));
         od->rays += count;

@@ -131,13 +131,13 @@ Status adaptive_mask(const AdaptiveSettings *s, const AdaptiveFilm *af, uint *ma
 
 /* ------------------------------------------------------------------ the rounds */
 
-/* Gives every device the params block and pixel mask of the run's scene. */
+/* Gives every device the params block and pixel list of the run's scene. */
 static Status update_devices(const AdaptiveRun *run, Error *err)
 {
     const DeviceScene *ds = &run->rs->ds;
     for (size_t i = 0; i < run->n_devices; i++) {
         Device *d = run->devices[i];
-        Status st = d->ops->update_params(d, &ds->params, ds->pixel_mask, err);
+        Status st = d->ops->update_params(d, &ds->params, ds->pixel_list, err);
         if (st) return st;
     }
     return ST_OK;
@@ -180,7 +180,7 @@ static Status stats_add(ScheduleStats *sum, const ScheduleStats *one, Error *err
 }
 
 /* The half-samples [first, end) of parity `half` (sample_step 2, sample_offset half)
- * of the masked pixels into `film`, a fresh film. *whole: every one of them was
+ * of the listed pixels into `film`, a fresh film. *whole: every one of them was
  * rendered (no interrupt, time limit or lost samples). */
 static Status render_half(const AdaptiveRun *run, uint half, uint first, uint end, double time_left, Film *film,
                           ScheduleStats *sum, int *whole, Error *err)
@@ -260,11 +260,14 @@ Status adaptive_run(const AdaptiveRun *run, const AdaptiveSettings *s, AdaptiveF
     DeviceScene *ds = &run->rs->ds;
     size_t n = (size_t)ds->params.width * ds->params.height;
     uint spp = run->cfg->spp;
-    uint *mask = malloc(n * sizeof *mask);
-    if (!mask) return error_set(err, ST_INTERNAL, "out of memory for the adaptive sampling mask");
+    uint *mask = malloc(n * sizeof *mask), *list = malloc(n * sizeof *list);
+    if (!mask || !list) {
+        free(mask);
+        free(list);
+        return error_set(err, ST_INTERNAL, "out of memory for the adaptive sampling mask");
+    }
     RenderParams saved = ds->params;
-    ds->params.use_mask = 1u;
-    ds->pixel_mask = mask;
+    ds->pixel_list = list;
     Progress prog;
     progress_begin(&prog, "render", (double)spp, "spp", run->cfg->show_progress);
     double t0 = timer_now();
@@ -273,6 +276,8 @@ Status adaptive_run(const AdaptiveRun *run, const AdaptiveSettings *s, AdaptiveF
     while (st == ST_OK && af->film.samples < spp && !(run->cfg->stop && *run->cfg->stop)) {
         size_t active = 0;
         if ((st = adaptive_mask(s, af, mask, &active, err)) || active == 0) break;
+        /* the round's waves hold the pixels still rendering only */
+        ds->params.pixel_list_size = render_scene_list_pixels(mask, n, list);
         int whole = 0;
         st = render_round(run, af, mask, adaptive_next_stop(s, (uint)af->film.samples, spp), t0, stats, &whole, err);
         if (st || !whole) break;
@@ -289,9 +294,10 @@ Status adaptive_run(const AdaptiveRun *run, const AdaptiveSettings *s, AdaptiveF
     if (af->film.samples && batch_set_add(&stats->done, (Batch){ 0, (uint)af->film.samples }) != 0 && st == ST_OK)
         st = error_set(err, ST_INTERNAL, "out of memory");
     ds->params = saved;
-    ds->pixel_mask = NULL;
-    /* the devices too: none keeps the mask freed below */
+    ds->pixel_list = NULL;
+    /* the devices too: none keeps the list freed below */
     Status restored = update_devices(run, st == ST_OK ? err : NULL);
     free(mask);
+    free(list);
     return st ? st : restored;
 }

@@ -16,9 +16,10 @@
  * the count reached, all of which a checkpoint holds.
  *
  * A round renders the even and the odd samples of [reached, next stop) as two batches
- * of "half" samples (RenderParams.sample_step 2, sample_offset 0 or 1; raygen.h) with
- * the converged pixels masked out (RenderParams.use_mask, kernels/integrator/
- * shade_path.h), each through the scheduler, so every selected device works on it.
+ * of "half" samples (RenderParams.sample_step 2, sample_offset 0 or 1; raygen.h) over
+ * the list of the pixels still rendering (RenderParams.pixel_list_size: the waves hold
+ * only theirs, so a converged pixel costs nothing), each through the scheduler, so
+ * every selected device works on it.
  * A round interrupted or cut by the time limit is dropped whole: the film keeps whole
  * rounds only, and a resume renders that round again.
  */
@@ -83,7 +84,7 @@ typedef void (*AdaptiveRoundFn)(void *ctx, const AdaptiveFilm *af);
 typedef struct {
     Device **devices;
     size_t n_devices;
-    RenderScene *rs;               /* its params and mask change during the render, restored after */
+    RenderScene *rs;               /* its params and pixel list change during the render, restored after */
     const ScheduleConfig *cfg;     /* stop flag, time limit, warnings, batch size; spp the most a pixel gets */
     AdaptiveRoundFn on_round;      /* NULL: none */
     void *round_ctx;

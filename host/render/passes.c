@@ -8,19 +8,19 @@
 
 #include "base/timer.h"
 
-/* Gives every device the params block and pixel mask of pc->rs. */
+/* Gives every device the params block and pixel list of pc->rs. */
 static Status update_devices(const PassContext *pc, Error *err)
 {
     const DeviceScene *ds = &pc->rs->ds;
     Status st;
     for (size_t i = 0; i < pc->n_devices; i++) {
         Device *d = pc->devices[i];
-        if ((st = d->ops->update_params(d, &ds->params, ds->pixel_mask, err))) return st;
+        if ((st = d->ops->update_params(d, &ds->params, ds->pixel_list, err))) return st;
     }
     return ST_OK;
 }
 
-/* Gives every device the pass's params block and pixel mask (the scene's other buffers
+/* Gives every device the pass's params block and pixel list (the scene's other buffers
  * stay as loaded), renders spp samples into a new film. */
 static Status render_pass(const PassContext *pc, uint spp, Film *film, double *seconds, Error *err)
 {
@@ -74,24 +74,30 @@ Status passes_adaptive(const PassContext *pc, float *rgb, uint base_spp, float t
     size_t n = (size_t)p->width * p->height;
     *marked = 0;
     *seconds = 0.0;
-    uint *mask = malloc(n * sizeof *mask);
-    if (!mask) return error_set(err, ST_INTERNAL, "out of memory for the adaptive pass");
+    uint *mask = malloc(n * sizeof *mask), *list = malloc(n * sizeof *list);
+    if (!mask || !list) {
+        free(mask);
+        free(list);
+        return error_set(err, ST_INTERNAL, "out of memory for the adaptive pass");
+    }
     *marked = passes_mark_edges(rgb, p->width, p->height, threshold, mask);
     if (*marked == 0) {
         free(mask);
+        free(list);
         return ST_OK;
     }
     RenderParams saved = *p;
-    p->use_mask = 1;
+    /* the pass's batches cover only the marked pixels */
+    p->pixel_list_size = render_scene_list_pixels(mask, n, list);
     /* fresh jittered samples: keys after the main pass's, never the pixel centre again */
     p->strata = render_scene_strata(extra) ? render_scene_strata(extra) : 1u;
     p->sample_offset = saved.sample_offset + base_spp;
-    pc->rs->ds.pixel_mask = mask;
+    pc->rs->ds.pixel_list = list;
     Film film;
     Status st = render_pass(pc, extra, &film, seconds, err);
     *p = saved;
-    pc->rs->ds.pixel_mask = NULL;
-    /* the devices too: none keeps the mask freed below */
+    pc->rs->ds.pixel_list = NULL;
+    /* the devices too: none keeps the list freed below */
     Status restored = update_devices(pc, st == ST_OK ? err : NULL);
     if (st == ST_OK) st = restored;
     if (st == ST_OK && film.samples > 0) {
@@ -110,6 +116,7 @@ Status passes_adaptive(const PassContext *pc, float *rgb, uint base_spp, float t
     }
     film_free(&film);
     free(mask);
+    free(list);
     return st;
 }
 

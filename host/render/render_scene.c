@@ -283,7 +283,7 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
     p->mis_mode = MIS_BOTH;
     p->n_area_lights = (uint)(s->n_lights - s->n_delta_lights - (s->env_light != NO_INDEX ? 1u : 0u));
     p->n_textures = (uint)s->n_textures;
-    p->use_mask = 0;
+    p->pixel_list_size = 0;
     /* only the whitted camera (whitted and the auxiliary images) reads the grid; the
      * path tracer's samples must not depend on the samples per pixel, or a render could
      * not grow (render key, checkpoint.c) */
@@ -296,8 +296,16 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
     out->ds.n_texels = s->n_texels;
     out->ds.env_cdf = s->env_cdf;
     out->ds.n_env_cdf = s->n_env_cdf;
-    out->ds.pixel_mask = NULL;
+    out->ds.pixel_list = NULL;
     return ST_OK;
+}
+
+uint render_scene_list_pixels(const uint *mask, size_t n, uint *list)
+{
+    uint listed = 0;
+    for (size_t i = 0; i < n; i++)
+        if (mask[i]) list[listed++] = (uint)i;
+    return listed;
 }
 
 void render_scene_free(RenderScene *r)

@@ -41,4 +41,9 @@ void render_scene_use_bvh(DeviceScene *ds, const Bvh *bvh);
  * uniform jitter (1). */
 uint render_scene_strata(uint spp);
 
+/* The pixels a mask of n entries sets, in increasing order, written to list (room for
+ * n): a DeviceScene's pixel_list (RenderParams.pixel_list_size, the count returned), so
+ * that a pass or round over some pixels costs only theirs. */
+uint render_scene_list_pixels(const uint *mask, size_t n, uint *list);
+
 #endif /* CLPT_RENDER_SCENE_H */

@@ -272,8 +272,8 @@ static void preview_open(ViewerRender *vr)
     DeviceScene small = *vr->scene;
     small.params.width = (vr->params.width + vr->preview_factor - 1) / vr->preview_factor;
     small.params.height = (vr->params.height + vr->preview_factor - 1) / vr->preview_factor;
-    small.pixel_mask = NULL;
-    small.params.use_mask = 0;
+    small.pixel_list = NULL;
+    small.params.pixel_list_size = 0;
     vr->preview_params = small.params;
     Error err = { 0 };
     vr->preview_state = -1;

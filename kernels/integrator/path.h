@@ -31,8 +31,7 @@
     Hit first_hit;                                                                       \
     uint split = 0u;                                                                     \
     int restart = 0;                                                                     \
-    int skipped = path_pixel_skipped(sc, pixel);                                         \
-    for (int first = 1; !skipped; first = 0) {                                           \
+    for (int first = 1;; first = 0) {                                                    \
         Hit hit;                                                                         \
         if (restart) {                                                                   \
             hit = first_hit;                                                             \

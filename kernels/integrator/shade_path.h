@@ -15,14 +15,6 @@
 #include "geom/surface.h"
 #include "material/texture.h"
 
-/* Whether the pixel mask leaves `pixel` out of this batch: the noise threshold's pixels
- * that have converged (host/render/adaptive.c). Its path is born (raygen_path: no
- * radiance) but traces and shades nothing. */
-KFN int path_pixel_skipped(const SceneView *sc, uint pixel)
-{
-    return sc->params->use_mask != 0u && sc->pixel_mask[pixel] == 0u;
-}
-
 /* --clamp (RenderParams.clamp_indirect > 0): indirect light scaled down so that no
  * channel passes the limit, keeping its hue, as Cycles' "clamp indirect". Indirect is
  * what a surface after the first one reflected: the light samples from the second hit

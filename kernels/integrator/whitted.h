@@ -380,12 +380,11 @@ KFN vec3 whitted_feature(const SceneView *sc, Ray ray, uint mode, uint *rays)
 }
 
 /* One pixel sample of the whitted integrator or of an auxiliary image; *rays counts
- * what it traced. A pixel left out by the adaptive pass's mask is black. */
+ * what it traced. */
 KFN vec3 whitted_sample(const SceneView *sc, uint pixel, uint sample, uint *rays)
 {
     GLOBAL const RenderParams *p = sc->params;
     *rays = 0u;
-    if (p->use_mask && sc->pixel_mask[pixel] == 0u) return v3s(0.0f);
     RngKey key;
     Ray r = whitted_camera_ray(p, pixel, sample, &key);
     if (p->integrator == INTEGRATOR_WHITTED) return whitted_radiance(sc, r, key, rays);

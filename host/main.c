@@ -478,9 +478,6 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
     r.t_start = timer_now();
     int done = 0;
     Status st = options_parse(argc, argv, &r.o, err);
-    /* the rounds' masks and parameters would have to reach every rank (not done yet) */
-    if (st == ST_OK && dist_launched() && r.o.noise_threshold > 0.0)
-        st = error_set(err, ST_USAGE, "--noise-threshold is not available under MPI (run it in one process)");
     r.report = r.o.output && image_path_is_stdout(r.o.output) ? stderr : stdout;
     if (dist_launched()) {
         DistRequest q = dist_request(&r.o);

@@ -329,6 +329,36 @@ static void test_mpi_ranks_on_a_mix_of_devices(void)
     CHECK(files_equal(in_dir("mix.pfm"), in_dir("whole.pfm")));
 }
 
+/* --noise-threshold under MPI: rank 0 decides each round's pixels from the merged film
+ * and sends every rank the round's params and pixel list (TAG_PARAMS), so two and three
+ * ranks, on the scalar device or a mix with PoCL, give the one-process adaptive image;
+ * a checkpoint of a job resumes in one process to the same bytes. */
+#define ADAPTIVE_ON(device) "scenes/cornell-box.scene", "--width", "24", "--height", "18", "--spp", "96", \
+                            "--noise-threshold", "0.05", "--device", device, "--threads", "1", "-q", "--batch", "2"
+
+static void test_mpi_adaptive_is_bit_identical(void)
+{
+    cli_run(ARGS(ADAPTIVE_ON("scalar"), "--stats", "-o", in_dir("ad1.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_STR_CONTAINS(r.out, "each pixel its own count (--noise-threshold)");
+    spawn_run(ARGS(MPIRUN, "-np", "2", CLI_PROGRAM, ADAPTIVE_ON("scalar"), "-o", in_dir("ad2.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(in_dir("ad1.pfm"), in_dir("ad2.pfm")));
+    spawn_run(ARGS(MPIRUN, "-np", "3", CLI_PROGRAM, ADAPTIVE_ON("scalar"), "--mpi-broadcast", "--checkpoint",
+                   in_dir("ad3.ckpt"), "-o", in_dir("ad3.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(in_dir("ad1.pfm"), in_dir("ad3.pfm")));
+    spawn_run(ARGS(MPIRUN, "-np", "1", CLI_PROGRAM, ADAPTIVE_ON("scalar"), "-o", in_dir("ad4.pfm"), ":", "-np", "1",
+                   CLI_PROGRAM, ADAPTIVE_ON(TEST_OPENCL), "-o", in_dir("ad4.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(in_dir("ad1.pfm"), in_dir("ad4.pfm")));
+    /* the job's checkpoint is a finished adaptive render: resumed, the same image */
+    cli_run(ARGS(ADAPTIVE_ON("scalar"), "--resume", in_dir("ad3.ckpt"), "-o", in_dir("ad5.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK(files_equal(in_dir("ad1.pfm"), in_dir("ad5.pfm")));
+}
+#undef ADAPTIVE_ON
+
 static void test_mpi_ranks_with_other_settings_are_refused(void)
 {
     /* MPMD: rank 1 runs with another seed, so another render key */
@@ -525,6 +555,7 @@ int main(void)
     if (have_mpirun()) {
         RUN(test_mpi_two_and_three_ranks_are_bit_identical);
         RUN(test_mpi_crop);
+        RUN(test_mpi_adaptive_is_bit_identical);
         RUN(test_mpi_ranks_with_other_settings_are_refused);
         RUN(test_mpi_a_rank_that_cannot_start_ends_the_job);
         RUN(test_mpi_ranks_given_different_commands_are_refused);

@@ -23,7 +23,11 @@ enum {
     TAG_STATS,         /* w -> 0: WireStats: the worker's devices, at the end */
     TAG_ALIVE,         /* w -> 0: empty, every second: the worker is alive */
     TAG_START,         /* w -> 0: WireStart: what the worker's command line asks for */
-    TAG_GO             /* 0 -> w: int32: 1 when every rank may go on with the render */
+    TAG_GO,            /* 0 -> w: int32: 1 when every rank may go on with the render */
+    TAG_PARAMS         /* 0 -> w: bytes: a RenderParams, then its pixel_list_size uint32
+                        * pixel indices: the devices' new params block and pixel list
+                        * (an adaptive round, --noise-threshold); the batches after it
+                        * render with them */
 };
 
 #define ALIVE_SECONDS 1.0

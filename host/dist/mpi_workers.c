@@ -74,11 +74,32 @@ static Status remote_load_scene(Device *dev, const DeviceScene *scene, Error *er
     return remote_not_here(dev, "loading another scene", err);
 }
 
-static Status remote_update_params(Device *dev, const RenderParams *params, const uint *mask, Error *err)
+/* Sends the rank the params block and pixel list its devices render the next batches
+ * with (the rounds of --noise-threshold, render/adaptive.c: rank 0 decides which pixels
+ * go on from the merged film, so every rank renders the samples one process would).
+ * Messages from one rank to another arrive in order, so the batches sent after this
+ * are rendered with it; a worker that cannot apply it answers its next batch with the
+ * failure. */
+static Status remote_update_params(Device *dev, const RenderParams *params, const uint *pixel_list, Error *err)
 {
-    (void)params;
-    (void)mask;
-    return remote_not_here(dev, "a second pass (--adaptive, --aov)", err);
+    Remote *rm = dev->impl;
+    /* a rank given up renders nothing more (its batches fail): nothing to tell it */
+    if (rm->d->wire->gone && rm->d->wire->gone[rm->rank]) return ST_OK;
+    size_t listed = pixel_list ? params->pixel_list_size : 0u;
+    size_t bytes = sizeof *params + listed * sizeof *pixel_list;
+    if (bytes > (size_t)INT32_MAX) return error_set(err, ST_INTERNAL, "MPI rank %d: a pixel list too long to send",
+                                                     rm->rank);
+    unsigned char *msg = malloc(bytes);
+    if (!msg) return error_set(err, ST_INTERNAL, "out of memory sending the render parameters to the MPI ranks");
+    memcpy(msg, params, sizeof *params);
+    if (listed) memcpy(msg + sizeof *params, pixel_list, listed * sizeof *pixel_list);
+    int rc = wire_send(rm->d, msg, (int)bytes, MPI_BYTE, rm->rank, TAG_PARAMS);
+    free(msg);
+    if (rc != MPI_SUCCESS) {
+        if (rm->d->wire->gone) rm->d->wire->gone[rm->rank] = 1;
+        return mpi_failed(err, rc, rm->rank, "sending the render parameters");
+    }
+    return ST_OK;
 }
 
 static void remote_destroy(Device *dev)
@@ -160,9 +181,63 @@ static void stats_add(WireStats *tot, const ScheduleStats *s)
     }
 }
 
+/* What rank 0 last set with TAG_PARAMS (remote_update_params): the devices keep
+ * pointing at the pixel list, so it lives until the next one. A failure to apply it is
+ * the answer to every batch after it. */
+typedef struct {
+    RenderParams params;
+    uint *pixel_list;
+    Status st;
+    char msg[1024];
+} WorkerParams;
+
+/* Receives a TAG_PARAMS message of `bytes` bytes and gives its params block and pixel
+ * list to every device of this worker. Only an MPI failure is returned; a bad message
+ * or a device that fails is kept in wp for the next batch's answer. */
+static Status worker_params(Dist *d, Device **devs, size_t n, int bytes, WorkerParams *wp, Error *err)
+{
+    unsigned char *msg = malloc(bytes > 0 ? (size_t)bytes : 1u);
+    if (!msg) return error_set(err, ST_INTERNAL, "out of memory for the render parameters");
+    Status st = wire_receive(d, 0, TAG_PARAMS, msg, bytes, err);
+    if (st != ST_OK) {
+        free(msg);
+        return st;
+    }
+    RenderParams p;
+    size_t size = (size_t)bytes;
+    if (size >= sizeof p) memcpy(&p, msg, sizeof p);
+    if (size < sizeof p || (size - sizeof p) / sizeof(uint) != p.pixel_list_size || (size - sizeof p) % sizeof(uint)) {
+        free(msg);
+        wp->st = ST_INTERNAL;
+        snprintf(wp->msg, sizeof wp->msg, "render parameters of %d bytes, which hold no whole pixel list", bytes);
+        return ST_OK;
+    }
+    uint *list = NULL;
+    if (p.pixel_list_size) {
+        list = malloc((size_t)p.pixel_list_size * sizeof *list);
+        if (list) memcpy(list, msg + sizeof p, (size_t)p.pixel_list_size * sizeof *list);
+    }
+    free(msg);
+    if (p.pixel_list_size && !list) {
+        wp->st = ST_INTERNAL;
+        snprintf(wp->msg, sizeof wp->msg, "out of memory for the pixel list");
+        return ST_OK;
+    }
+    Error e = { 0 };
+    wp->st = ST_OK;
+    for (size_t i = 0; i < n && wp->st == ST_OK; i++) wp->st = devs[i]->ops->update_params(devs[i], &p, list, &e);
+    if (wp->st != ST_OK) snprintf(wp->msg, sizeof wp->msg, "%s", e.msg);
+    error_clear(&e);
+    /* the devices read the new list from now on; the old one is no longer theirs */
+    free(wp->pixel_list);
+    wp->pixel_list = list;
+    wp->params = p;
+    return ST_OK;
+}
+
 /* Renders one batch with the worker's devices and sends rank 0 its result and film. */
 static Status worker_batch(Dist *d, Device **devs, size_t n, Film *film, const uint32_t *batch,
-                           volatile sig_atomic_t *stop, WireStats *tot, Error *err)
+                           const WorkerParams *wp, volatile sig_atomic_t *stop, WireStats *tot, Error *err)
 {
     ScheduleConfig cfg;
     memset(&cfg, 0, sizeof cfg);
@@ -183,6 +258,8 @@ static Status worker_batch(Dist *d, Device **devs, size_t n, Film *film, const u
     Status st;
     if (*stop)
         st = ST_INTERRUPTED;
+    else if (wp->st != ST_OK)
+        st = error_set(&e, wp->st, "%s", wp->msg);
     else if (batch[2] == 0 || batch[1] == 0 || batch[0] + batch[1] < batch[0] || batch[0] + batch[1] > batch[2])
         st = error_set(&e, ST_INTERNAL, "a batch outside the render's samples");
     else
@@ -202,20 +279,28 @@ static Status worker_batch(Dist *d, Device **devs, size_t n, Film *film, const u
     return rc == MPI_SUCCESS ? ST_OK : mpi_failed(err, rc, d->rank, "sending a batch's film");
 }
 
-/* Waits for rank 0's next word: a batch (1) or stop (0). */
-static int worker_next(Dist *d, uint32_t *batch, Status *st, Error *err)
+/* Waits for rank 0's next word: a batch (1) or stop (0). New render parameters
+ * (TAG_PARAMS) on the way are given to the devices. */
+static int worker_next(Dist *d, Device **devs, size_t n, WorkerParams *wp, uint32_t *batch, Status *st, Error *err)
 {
     for (;;) {
-        int flag = 0;
+        int flag = 0, params = 0, bytes = 0;
         MPI_Status ms;
         wire_lock(d);
         int rc = MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms);
-        if (rc == MPI_SUCCESS && flag)
+        params = rc == MPI_SUCCESS && flag && ms.MPI_TAG == TAG_PARAMS;
+        if (params)
+            MPI_Get_count(&ms, MPI_BYTE, &bytes);
+        else if (rc == MPI_SUCCESS && flag)
             rc = MPI_Recv(batch, 3, MPI_UINT32_T, 0, ms.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
         wire_unlock(d);
         if (rc != MPI_SUCCESS) {
             *st = mpi_failed(err, rc, d->rank, "waiting for a batch");
             return 0;
+        }
+        if (params) {
+            if ((*st = worker_params(d, devs, n, bytes, wp, err)) != ST_OK) return 0;
+            continue;
         }
         if (flag) return ms.MPI_TAG == TAG_BATCH;
         sleep_seconds(POLL_SECONDS);
@@ -232,9 +317,11 @@ Status dist_worker_run(Dist *d, Device **devs, size_t n, unsigned width, unsigne
     atomic_init(&hb.quit, 0);
     hb.running = pthread_create(&hb.thread, NULL, heartbeat_main, &hb) == 0;
     WireStats *tot = calloc(1, sizeof *tot);
+    WorkerParams wp;
+    memset(&wp, 0, sizeof wp);
     uint32_t batch[3];
-    while (st == ST_OK && tot && worker_next(d, batch, &st, err))
-        st = worker_batch(d, devs, n, &film, batch, stop, tot, err);
+    while (st == ST_OK && tot && worker_next(d, devs, n, &wp, batch, &st, err))
+        st = worker_batch(d, devs, n, &film, batch, &wp, stop, tot, err);
     atomic_store(&hb.quit, 1);
     if (hb.running) pthread_join(hb.thread, NULL);
     if (st == ST_OK && tot) {
@@ -244,6 +331,9 @@ Status dist_worker_run(Dist *d, Device **devs, size_t n, unsigned width, unsigne
     if (!tot && st == ST_OK) st = error_set(err, ST_INTERNAL, "out of memory");
     free(tot);
     film_free(&film);
+    /* rank 0 ends every adaptive render by sending no list; after a failure the devices
+     * may still hold this one, but they render nothing more (closed by the caller) */
+    free(wp.pixel_list);
     return st;
 }
 

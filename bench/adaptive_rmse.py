@@ -8,8 +8,9 @@ usage: bench/adaptive_rmse.py [--clpt build/clpt] [--scene scenes/cornell-box.sc
                               [--out DIR] [--repeats 3]
 
 Renders a converged reference, then for each threshold, --repeats times, an adaptive
-render (seed 1, at most --max-spp samples a pixel) and right after it a uniform render
-(seed 1) whose spp is chosen to take the same CPU time (the adaptive run's user + system
+render (seed 1, 2, ... for repeat 1, 2, ...: the repeats are independent images, at
+most --max-spp samples a pixel) and right after it a uniform render (the same seed)
+whose spp is chosen to take the same CPU time (the adaptive run's user + system
 seconds over the uniform renders' CPU seconds per spp measured so far). Each process is
 timed by its CPU seconds (os.wait4), which a machine shared with other jobs disturbs
 far less than the wall clock; the wall seconds are printed too (the adaptive rounds
@@ -119,11 +120,12 @@ def main():
             l0 = load()
             a_out = os.path.join(args.out, 'adaptive-%s.pfm' % t)
             u_out = os.path.join(args.out, 'uniform-%s.pfm' % t)
-            a_cpu, a_wall, err = run(args, ['--spp', str(args.max_spp), '--noise-threshold', t, '--seed', '1'] + extra,
+            seed = str(rep + 1)
+            a_cpu, a_wall, err = run(args, ['--spp', str(args.max_spp), '--noise-threshold', t, '--seed', seed] + extra,
                                      a_out)
             a_spp = mean_spp(err)
             u_n = max(1, int(round(a_cpu / statistics.median(unif_rate))))
-            u_cpu, u_wall, _ = run(args, ['--spp', str(u_n), '--seed', '1'], u_out)
+            u_cpu, u_wall, _ = run(args, ['--spp', str(u_n), '--seed', seed], u_out)
             unif_rate.append(u_cpu / u_n)
             ea, eu = mse(a_out), mse(u_out)
             rows.append((l0, a_cpu, a_wall, a_spp, ea, u_cpu, u_wall, u_n, eu, eu / ea, (eu * u_cpu) / (ea * a_cpu)))

@@ -73,8 +73,8 @@ static void test_decision_counts(void)
     AdaptiveSettings s = { 0.01, 16 };
     CHECK(adaptive_decides_at(&s, 16));
     CHECK(!adaptive_decides_at(&s, 17) && !adaptive_decides_at(&s, 18) && !adaptive_decides_at(&s, 8));
-    /* each about a quarter more: 16 + 2 max(1, 16/8) = 20, 24, 30, 36, 44, 54 */
-    uint want[] = { 20, 24, 30, 36, 44, 54 };
+    /* 4, 5 or 6 times a power of two: a fifth to a third more each */
+    uint want[] = { 20, 24, 32, 40, 48, 64, 80, 96, 128 };
     uint at = 16;
     for (size_t i = 0; i < sizeof want / sizeof *want; i++) {
         at = adaptive_next_stop(&s, at, 1000);
@@ -83,6 +83,8 @@ static void test_decision_counts(void)
     }
     CHECK_EQ_INT(adaptive_next_stop(&s, 0, 1000), 16);
     CHECK_EQ_INT(adaptive_next_stop(&s, 17, 1000), 20);   /* a grown render's odd count */
+    CHECK_EQ_INT(adaptive_next_stop(&s, 600, 1000), 640);
+    CHECK_EQ_INT(adaptive_next_stop(&s, 640, 1000), 768);
     CHECK_EQ_INT(adaptive_next_stop(&s, 20, 22), 22);     /* capped at the render's spp */
     CHECK_EQ_INT(adaptive_next_stop(&s, 0, 10), 10);
     AdaptiveSettings odd = { 0.01, 5 };   /* rounded up to even: the halves hold as many */

@@ -9,7 +9,7 @@
  * device, batch or process added it.
  *
  * Decisions are taken only at fixed sample counts (adaptive_decides_at: min_spp, then
- * each about a quarter more), from the integer sums alone, in double arithmetic on the
+ * each a fifth to a third more), from the integer sums alone, in double arithmetic on the
  * host; between two of them every pixel still rendering gets the same sample indices.
  * So which pixels stop, and the image, are the same bits on any device mix, batch size,
  * or resume: the state after a round is the film, the odd half, each pixel's count and
@@ -65,9 +65,10 @@ Status adaptive_film_write(const AdaptiveFilm *af, const char *path, const Image
 double adaptive_pixel_error(const AdaptiveFilm *af, size_t pixel);
 
 /* Whether the render decides which pixels stop when they hold n samples: at min_spp
- * (rounded up to even), then at each count s + 2 max(1, floor(s / 8)), about a quarter
- * more, so that a pixel overshoots its stop by a quarter at most. Every such count is
- * even: the halves then hold as many samples each. */
+ * (rounded up to even), then at each count 4, 5 or 6 times a power of two above it
+ * (16, 20, 24, 32, 40, 48, 64, ...), a fifth to a third more, so that a pixel
+ * overshoots its stop by a third at most, and stops where Sobol points are well spread.
+ * Every such count is even: the halves then hold as many samples each. */
 int adaptive_decides_at(const AdaptiveSettings *s, uint n);
 /* The next count after `reached` at which the render decides, capped at spp. */
 uint adaptive_next_stop(const AdaptiveSettings *s, uint reached, uint spp);

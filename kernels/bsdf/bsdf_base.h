@@ -122,6 +122,22 @@ KFN Ggx bsdf_ggx(Material m) { return ggx_make(m.roughness, m.anisotropy); }
  * are delta lobes, with no density. */
 KFN int bsdf_ggx_rough(Material m) { return !ggx_smooth(bsdf_ggx(m)); }
 
+/* The has_density of the families whose every material has a lobe with a density
+ * (diffuse, principled). */
+KFN int bsdf_density_always(Material m, vec3 albedo)
+{
+    (void)m;
+    (void)albedo;
+    return 1;
+}
+
+/* The has_density of the GGX families (conductor, dielectric): rough ones only. */
+KFN int bsdf_density_if_rough(Material m, vec3 albedo)
+{
+    (void)albedo;
+    return bsdf_ggx_rough(m);
+}
+
 /* A sample that failed: no direction, no weight. */
 KFN BsdfSample bsdf_failed(vec3 ns)
 {
@@ -132,6 +148,36 @@ KFN BsdfSample bsdf_failed(vec3 ns)
     s.specular = 0;
     s.transmitted = 0;
     return s;
+}
+
+/* A delta lobe's sample: direction wi, weight (f cos over the lobe's choice), no
+ * density. */
+KFN BsdfSample bsdf_delta_sample(vec3 wi, vec3 weight, int transmitted)
+{
+    BsdfSample s;
+    s.wi = wi;
+    s.weight = weight;
+    s.pdf = 0.0f;
+    s.specular = 1;
+    s.transmitted = transmitted;
+    return s;
+}
+
+/* The mirror direction of d about the shading normal ns, or about the geometric
+ * normal ng where the first would go below the surface. */
+KFN vec3 bsdf_mirror_dir(vec3 d, vec3 ns, vec3 ng)
+{
+    vec3 wi = reflect_dir(d, ns);
+    return v3_dot(wi, ng) <= 0.0f ? reflect_dir(d, ng) : wi;
+}
+
+/* The frame of the hit's shading normal, and in *wo the direction back along the ray
+ * in it: where every lobe with a density starts. */
+KFN BsdfFrame bsdf_hit_frame(BsdfHit h, vec3 *wo)
+{
+    BsdfFrame F = bsdf_frame(h.ns);
+    *wo = bsdf_frame_local(F, v3_neg(h.d));
+    return F;
 }
 
 /* A rough lobe's sample from its local direction wl, f and density pdf (0: failed): f

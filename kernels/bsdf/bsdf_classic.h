@@ -30,15 +30,9 @@ KFN BsdfSample bsdf_sample_diffuse(vec3 albedo, vec3 n, float u1, float u2)
  * keeps the estimator unbiased. */
 KFN BsdfSample bsdf_sample_metal(vec3 albedo, float fuzz, vec3 d, vec3 n, float u1, float u2, float u3)
 {
-    BsdfSample s;
     vec3 r = reflect_dir(d, n);
     if (fuzz > 0.0f) r = v3_madd(r, sample_ball(u1, u2, u3), fuzz);
-    s.wi = v3_norm(r);
-    s.weight = albedo;
-    s.pdf = 0.0f;
-    s.specular = 1;
-    s.transmitted = 0;
-    return s;
+    return bsdf_delta_sample(v3_norm(r), albedo, 0);
 }
 
 /* ---------------------------------------------------------------- Phong
@@ -129,13 +123,7 @@ KFN BsdfSample phong_sample(PhongLobes l, Material m, vec3 d, vec3 ns, vec3 ng, 
     }
     if (u_lobe < l.p_glossy + l.p_mirror) {
         /* about the shading normal, unless that would go below the surface */
-        s.wi = reflect_dir(d, ns);
-        if (v3_dot(s.wi, ng) <= 0.0f) s.wi = reflect_dir(d, ng);
-        s.weight = v3_scale(l.kr, 1.0f / l.p_mirror);
-        s.pdf = 0.0f;
-        s.specular = 1;
-        s.transmitted = 0;
-        return s;
+        return bsdf_delta_sample(bsdf_mirror_dir(d, ns, ng), v3_scale(l.kr, 1.0f / l.p_mirror), 0);
     }
     /* The refracting part, like glass, tinted by kt: the glass sample (a delta lobe) as
      * it is, with kt's weight. Returned whole rather than copied field by field into s:
@@ -148,12 +136,7 @@ KFN BsdfSample phong_sample(PhongLobes l, Material m, vec3 d, vec3 ns, vec3 ng, 
 }
 
 /* ---------------------------------------------------------------- MAT_DIFFUSE */
-KFN int diffuse_bsdf_has_density(Material m, vec3 albedo)
-{
-    (void)m;
-    (void)albedo;
-    return 1;
-}
+KFN int diffuse_bsdf_has_density(Material m, vec3 albedo) { return bsdf_density_always(m, albedo); }
 
 KFN vec3 diffuse_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)
 {

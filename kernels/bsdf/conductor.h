@@ -64,29 +64,18 @@ KFN Conductor bsdf_conductor(Material m, vec3 albedo)
  * below the surface), weighted by the Fresnel colour. */
 KFN BsdfSample bsdf_sample_mirror_conductor(Conductor c, vec3 d, vec3 ns, vec3 ng)
 {
-    BsdfSample s;
-    s.wi = reflect_dir(d, ns);
-    if (v3_dot(s.wi, ng) <= 0.0f) s.wi = reflect_dir(d, ng);
-    s.weight = conductor_fresnel(c, -v3_dot(d, ns));
-    s.pdf = 0.0f;
-    s.specular = 1;
-    s.transmitted = 0;
-    return s;
+    return bsdf_delta_sample(bsdf_mirror_dir(d, ns, ng), conductor_fresnel(c, -v3_dot(d, ns)), 0);
 }
 
 /* ---------------------------------------------------------------- MAT_CONDUCTOR */
-KFN int conductor_bsdf_has_density(Material m, vec3 albedo)
-{
-    (void)albedo;
-    return bsdf_ggx_rough(m);
-}
+KFN int conductor_bsdf_has_density(Material m, vec3 albedo) { return bsdf_density_if_rough(m, albedo); }
 
 KFN vec3 conductor_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)
 {
     if (!conductor_bsdf_has_density(m, h.albedo)) return bsdf_no_eval(pdf);
-    BsdfFrame F = bsdf_frame(h.ns);
-    vec3 f;
-    *pdf = conductor_eval(bsdf_conductor(m, h.albedo), bsdf_frame_local(F, v3_neg(h.d)), bsdf_frame_local(F, wi), &f);
+    vec3 wo, f;
+    BsdfFrame F = bsdf_hit_frame(h, &wo);
+    *pdf = conductor_eval(bsdf_conductor(m, h.albedo), wo, bsdf_frame_local(F, wi), &f);
     return f;
 }
 
@@ -96,8 +85,8 @@ KFN BsdfSample conductor_bsdf_sample(Material m, BsdfHit h, float u_lobe, float 
     (void)u3;
     if (!conductor_bsdf_has_density(m, h.albedo))
         return bsdf_sample_mirror_conductor(bsdf_conductor(m, h.albedo), h.d, h.ns, h.ng);
-    BsdfFrame F = bsdf_frame(h.ns);
-    vec3 wo = bsdf_frame_local(F, v3_neg(h.d)), f = v3s(0.0f), wl = v3s(0.0f);
+    vec3 wo, f = v3s(0.0f), wl = v3s(0.0f);
+    BsdfFrame F = bsdf_hit_frame(h, &wo);
     float pdf = wo.z > 0.0f ? conductor_sample(bsdf_conductor(m, h.albedo), wo, u1, u2, &wl, &f) : 0.0f;
     return bsdf_rough_sample(F, pdf, wl, f);
 }

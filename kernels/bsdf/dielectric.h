@@ -139,29 +139,20 @@ KFN Dielectric bsdf_dielectric(Material m, int front)
 /* A smooth thin sheet: reflect with the sheet's reflectance, else pass straight on. */
 KFN BsdfSample bsdf_sample_thin(Dielectric g, vec3 d, vec3 ng, float u)
 {
-    BsdfSample s;
     float F = dielectric_facet_fresnel(g, -v3_dot(d, ng));
-    s.transmitted = !(u < F);
-    s.wi = s.transmitted ? d : reflect_dir(d, ng);
-    s.weight = v3s(1.0f);
-    s.pdf = 0.0f;
-    s.specular = 1;
-    return s;
+    int transmitted = !(u < F);
+    return bsdf_delta_sample(transmitted ? d : reflect_dir(d, ng), v3s(1.0f), transmitted);
 }
 
 /* ---------------------------------------------------------------- MAT_DIELECTRIC */
-KFN int dielectric_bsdf_has_density(Material m, vec3 albedo)
-{
-    (void)albedo;
-    return bsdf_ggx_rough(m);
-}
+KFN int dielectric_bsdf_has_density(Material m, vec3 albedo) { return bsdf_density_if_rough(m, albedo); }
 
 KFN vec3 dielectric_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)
 {
     if (!dielectric_bsdf_has_density(m, h.albedo)) return bsdf_no_eval(pdf);
-    BsdfFrame F = bsdf_frame(h.ns);
-    vec3 f;
-    *pdf = dielectric_eval(bsdf_dielectric(m, h.front), bsdf_frame_local(F, v3_neg(h.d)), bsdf_frame_local(F, wi), &f);
+    vec3 wo, f;
+    BsdfFrame F = bsdf_hit_frame(h, &wo);
+    *pdf = dielectric_eval(bsdf_dielectric(m, h.front), wo, bsdf_frame_local(F, wi), &f);
     return f;
 }
 
@@ -169,8 +160,8 @@ KFN BsdfSample dielectric_bsdf_sample(Material m, BsdfHit h, float u_lobe, float
 {
     (void)u3;
     if (dielectric_bsdf_has_density(m, h.albedo)) {
-        BsdfFrame F = bsdf_frame(h.ns);
-        vec3 wo = bsdf_frame_local(F, v3_neg(h.d)), f = v3s(0.0f), wl = v3s(0.0f);
+        vec3 wo, f = v3s(0.0f), wl = v3s(0.0f);
+        BsdfFrame F = bsdf_hit_frame(h, &wo);
         float pdf = wo.z > 0.0f ? dielectric_sample(bsdf_dielectric(m, h.front), wo, u_lobe, u1, u2, &wl, &f) : 0.0f;
         return bsdf_rough_sample(F, pdf, wl, f);
     }

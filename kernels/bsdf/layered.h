@@ -377,6 +377,17 @@ KFN vec3 layered_walk(Layered L, vec3 wi, LayerSample wos, LayerSample wis, uint
     return f;
 }
 
+/* The two ends of one walk, both refracted into the layer by the interface: wo's as
+ * radiance, wi's as importance, three numbers of *rng each; 0 where either fails. */
+KFN int layer_walk_ends(Layered L, vec3 wo, vec3 wi, uint *rng, LayerSample *wos, LayerSample *wis)
+{
+    float a = layer_rand(rng), b = layer_rand(rng), c = layer_rand(rng);
+    *wos = coat_sample(L, wo, a, b, c, 1, LAYER_T);
+    a = layer_rand(rng), b = layer_rand(rng), c = layer_rand(rng);
+    *wis = coat_sample(L, wi, a, b, c, 0, LAYER_T);
+    return wos->ok && wis->ok;
+}
+
 /* f(wo, wi), estimated: the interface's own reflection plus n_samples walks. */
 KFN vec3 layered_f(Layered L, vec3 wo, vec3 wi)
 {
@@ -385,11 +396,8 @@ KFN vec3 layered_f(Layered L, vec3 wo, vec3 wi)
     vec3 f = v3_scale(coat_eval(L, wo, wi, 1, LAYER_RT, &pdf), (float)L.n_samples);
     uint rng = layer_seed(0x1a7e4edu, wo, wi);
     for (uint i = 0u; i < L.n_samples; i++) {
-        float a = layer_rand(&rng), b = layer_rand(&rng), c = layer_rand(&rng);
-        LayerSample wos = coat_sample(L, wo, a, b, c, 1, LAYER_T);
-        a = layer_rand(&rng), b = layer_rand(&rng), c = layer_rand(&rng);
-        LayerSample wis = coat_sample(L, wi, a, b, c, 0, LAYER_T);
-        if (!wos.ok || !wis.ok) continue;
+        LayerSample wos, wis;
+        if (!layer_walk_ends(L, wo, wi, &rng, &wos, &wis)) continue;
         f = v3_add(f, layered_walk(L, wi, wos, wis, &rng));
     }
     return v3_scale(f, 1.0f / (float)L.n_samples);
@@ -407,17 +415,14 @@ KFN float layered_pdf(Layered L, vec3 wo, vec3 wi)
     sum *= (float)L.n_samples;
     uint rng = layer_seed(0x9df3c11u, wi, wo);
     for (uint i = 0u; i < L.n_samples; i++) {
-        float a = layer_rand(&rng), b = layer_rand(&rng), c = layer_rand(&rng);
-        LayerSample wos = coat_sample(L, wo, a, b, c, 1, LAYER_T);
-        a = layer_rand(&rng), b = layer_rand(&rng), c = layer_rand(&rng);
-        LayerSample wis = coat_sample(L, wi, a, b, c, 0, LAYER_T);
-        if (!wos.ok || !wis.ok) continue;
+        LayerSample wos, wis;
+        if (!layer_walk_ends(L, wo, wi, &rng, &wos, &wis)) continue;
         if (coat_smooth(L)) {
             base_eval(L, v3_neg(wos.wi), v3_neg(wis.wi), &p);
             sum += p;
             continue;
         }
-        a = layer_rand(&rng), b = layer_rand(&rng);
+        float a = layer_rand(&rng), b = layer_rand(&rng);
         LayerSample rs = base_sample(L, v3_neg(wos.wi), a, b);
         if (!rs.ok) continue;
         if (base_smooth(L)) {
@@ -560,8 +565,9 @@ KFN int layered_bsdf_has_density(Material m, vec3 albedo)
 KFN vec3 layered_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)
 {
     if (!layered_bsdf_has_density(m, h.albedo)) return bsdf_no_eval(pdf);
-    BsdfFrame F = bsdf_frame(h.ns);
-    vec3 wo = bsdf_frame_local(F, v3_neg(h.d)), wl = bsdf_frame_local(F, wi);
+    vec3 wo;
+    BsdfFrame F = bsdf_hit_frame(h, &wo);
+    vec3 wl = bsdf_frame_local(F, wi);
     Layered L = bsdf_layered(m, h.albedo);
     vec3 f = layered_f(L, wo, wl);
     *pdf = layered_pdf(L, wo, wl);

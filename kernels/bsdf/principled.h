@@ -292,27 +292,21 @@ KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
 }
 
 /* ---------------------------------------------------------------- MAT_PRINCIPLED */
-KFN int principled_bsdf_has_density(Material m, vec3 albedo)
-{
-    (void)m;
-    (void)albedo;
-    return 1;
-}
+KFN int principled_bsdf_has_density(Material m, vec3 albedo) { return bsdf_density_always(m, albedo); }
 
 KFN vec3 principled_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)
 {
-    BsdfFrame F = bsdf_frame(h.ns);
-    vec3 f;
-    *pdf = principled_eval(bsdf_principled(m, h.albedo, h.front), bsdf_frame_local(F, v3_neg(h.d)),
-                           bsdf_frame_local(F, wi), &f);
+    vec3 wo, f;
+    BsdfFrame F = bsdf_hit_frame(h, &wo);
+    *pdf = principled_eval(bsdf_principled(m, h.albedo, h.front), wo, bsdf_frame_local(F, wi), &f);
     return f;
 }
 
 KFN BsdfSample principled_bsdf_sample(Material m, BsdfHit h, float u_lobe, float u1, float u2, float u3)
 {
     (void)u3;
-    BsdfFrame F = bsdf_frame(h.ns);
-    vec3 wo = bsdf_frame_local(F, v3_neg(h.d)), f = v3s(0.0f), wl = v3s(0.0f);
+    vec3 wo, f = v3s(0.0f), wl = v3s(0.0f);
+    BsdfFrame F = bsdf_hit_frame(h, &wo);
     float pdf = wo.z > 0.0f ? principled_sample(bsdf_principled(m, h.albedo, h.front), wo, u_lobe, u1, u2, &wl, &f)
                             : 0.0f;
     return bsdf_rough_sample(F, pdf, wl, f);

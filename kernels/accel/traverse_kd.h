@@ -224,32 +224,30 @@ KFN_INLINE void trace_ray_finish(const SceneView *sc, TraceRay *t, const RayPre 
         trace_ray_finish(sc, &(b), &(pb), &(wb), &(sb));                                 \
     } while (0)
 
-/* trace_closest of two rays. */
-KFN void trace_closest2(const SceneView *sc, Ray ra, Ray rb, Hit *ha, Hit *hb)
+/* Two rays walked in turns: their closest hits, or with any set, any hit each. */
+KFN void trace_pair(const SceneView *sc, Ray ra, Ray rb, int any, Hit *ha, Hit *hb)
 {
     TraceRay a, b;
     RayPre pa, pb;
     KdWalk wa, wb;
     KdStack sa, sb;
-    trace_ray_begin(sc, ra, 0, &a, &pa, &wa);
-    trace_ray_begin(sc, rb, 0, &b, &pb, &wb);
+    trace_ray_begin(sc, ra, any, &a, &pa, &wa);
+    trace_ray_begin(sc, rb, any, &b, &pb, &wb);
     TRACE_PAIR(sc, a, pa, wa, sa, b, pb, wb, sb);
     *ha = a.best;
     *hb = b.best;
 }
 
+/* trace_closest of two rays. */
+KFN void trace_closest2(const SceneView *sc, Ray ra, Ray rb, Hit *ha, Hit *hb) { trace_pair(sc, ra, rb, 0, ha, hb); }
+
 /* trace_any of two rays. */
 KFN void trace_any2(const SceneView *sc, Ray ra, Ray rb, int *oa, int *ob)
 {
-    TraceRay a, b;
-    RayPre pa, pb;
-    KdWalk wa, wb;
-    KdStack sa, sb;
-    trace_ray_begin(sc, ra, 1, &a, &pa, &wa);
-    trace_ray_begin(sc, rb, 1, &b, &pb, &wb);
-    TRACE_PAIR(sc, a, pa, wa, sa, b, pb, wb, sb);
-    *oa = a.best.prim != NO_INDEX;
-    *ob = b.best.prim != NO_INDEX;
+    Hit ha, hb;
+    trace_pair(sc, ra, rb, 1, &ha, &hb);
+    *oa = ha.prim != NO_INDEX;
+    *ob = hb.prim != NO_INDEX;
 }
 
 /* ------------------------------------------------------------------ eight rays at once */

@@ -343,35 +343,37 @@ KFN GLOBAL const TriExtra *surface_extra(const SceneView *sc, Surface s, uint fl
     return (e->flags & flags) == flags ? e : 0;
 }
 
+/* The per-vertex attribute `which` (EXTRA_UV1: 2 floats, EXTRA_COLOR or
+ * EXTRA_TANGENT: 4) at s, into out; 0 where the surface has none. */
+KFN int surface_extra_at(const SceneView *sc, Surface s, uint which, float *out)
+{
+    GLOBAL const TriExtra *e = surface_extra(sc, s, which);
+    if (!e) return 0;
+    if (which == EXTRA_UV1) extra_lerp(&e->uv[0][0], 2u, 2u, s, out);
+    else if (which == EXTRA_COLOR) extra_lerp(&e->color[0][0], 4u, 4u, s, out);
+    else extra_lerp(&e->tangent[0][0], 4u, 4u, s, out);
+    return 1;
+}
+
 /* The second uv set (TEXCOORD_1) at s; 0 where the surface has none. */
 KFN int surface_uv1(const SceneView *sc, Surface s, float *u, float *v)
 {
-    GLOBAL const TriExtra *e = surface_extra(sc, s, EXTRA_UV1);
-    if (!e) return 0;
     float uv[2];
-    extra_lerp(&e->uv[0][0], 2u, 2u, s, uv);
+    if (!surface_extra_at(sc, s, EXTRA_UV1, uv)) return 0;
     *u = uv[0];
     *v = uv[1];
     return 1;
 }
 
 /* The vertex colour (COLOR_0, linear RGBA) at s; 0 where the surface has none. */
-KFN int surface_color(const SceneView *sc, Surface s, float *rgba)
-{
-    GLOBAL const TriExtra *e = surface_extra(sc, s, EXTRA_COLOR);
-    if (!e) return 0;
-    extra_lerp(&e->color[0][0], 4u, 4u, s, rgba);
-    return 1;
-}
+KFN int surface_color(const SceneView *sc, Surface s, float *rgba) { return surface_extra_at(sc, s, EXTRA_COLOR, rgba); }
 
 /* The given tangent (TANGENT) at s, not normalised, and its bitangent sign (+1 or -1,
  * the sign of the interpolated w); 0 where the surface has none. */
 KFN int surface_tangent(const SceneView *sc, Surface s, vec3 *t, float *sign)
 {
-    GLOBAL const TriExtra *e = surface_extra(sc, s, EXTRA_TANGENT);
-    if (!e) return 0;
     float q[4];
-    extra_lerp(&e->tangent[0][0], 4u, 4u, s, q);
+    if (!surface_extra_at(sc, s, EXTRA_TANGENT, q)) return 0;
     *t = v3(q[0], q[1], q[2]);
     *sign = q[3] < 0.0f ? -1.0f : 1.0f;
     return 1;

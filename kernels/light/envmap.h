@@ -63,15 +63,32 @@ KFN void env_pixel(GLOBAL const RenderParams *p, Texture tx, vec3 d, uint *x, ui
     *sin_theta = len > 0.0f ? r / len : 0.0f;
 }
 
+/* The map's pixel a direction falls in (env_pixel), with the map's texture. */
+typedef struct {
+    Texture tx;
+    uint x, y;
+    float sin_theta;
+} EnvPixel;
+
+KFN EnvPixel env_find(const SceneView *sc, vec3 d)
+{
+    EnvPixel e;
+    e.tx = sc->textures[sc->params->bg_cubemap];
+    env_pixel(sc->params, e.tx, d, &e.x, &e.y, &e.sin_theta);
+    return e;
+}
+
+/* The radiance of pixel (x, y) of the map tx: its texel times the background colour. */
+KFN vec3 env_texel_radiance(const SceneView *sc, Texture tx, uint x, uint y)
+{
+    return v3_mul(texel_fetch(sc, tx, x, y), sc->params->bg_color);
+}
+
 /* The radiance the map sends along -d toward the scene, from direction d. */
 KFN vec3 env_radiance(const SceneView *sc, vec3 d)
 {
-    GLOBAL const RenderParams *p = sc->params;
-    Texture tx = sc->textures[p->bg_cubemap];
-    uint x, y;
-    float st;
-    env_pixel(p, tx, d, &x, &y, &st);
-    return v3_mul(texel_fetch(sc, tx, x, y), p->bg_color);
+    EnvPixel e = env_find(sc, d);
+    return env_texel_radiance(sc, e.tx, e.x, e.y);
 }
 
 /* The solid-angle density with which env_sample picks a direction in pixel (x, y) of
@@ -90,13 +107,9 @@ KFN float env_pixel_pdf(const SceneView *sc, Texture tx, uint x, uint y, float s
  * fewer than apart). */
 KFN vec3 env_radiance_pdf(const SceneView *sc, vec3 d, float *pdf)
 {
-    GLOBAL const RenderParams *p = sc->params;
-    Texture tx = sc->textures[p->bg_cubemap];
-    uint x, y;
-    float sin_t;
-    env_pixel(p, tx, d, &x, &y, &sin_t);
-    *pdf = env_pixel_pdf(sc, tx, x, y, sin_t);
-    return v3_mul(texel_fetch(sc, tx, x, y), p->bg_color);
+    EnvPixel e = env_find(sc, d);
+    *pdf = env_pixel_pdf(sc, e.tx, e.x, e.y, e.sin_theta);
+    return env_texel_radiance(sc, e.tx, e.x, e.y);
 }
 
 /* The density alone (light_pdf_env, for the tests' checks of the sampler). */
@@ -157,7 +170,7 @@ KFN vec3 env_sample(const SceneView *sc, float u1, float u2, vec3 *Le, float *pd
     k_sincos(K_PI * v, &st, &ct);
     k_sincos(K_TWO_PI * u, &sp, &cp);
     *pdf = env_pixel_pdf(sc, tx, x, y, st);
-    *Le = v3_mul(texel_fetch(sc, tx, x, y), p->bg_color);
+    *Le = env_texel_radiance(sc, tx, x, y);
     vec3 m = v3(st * sp, ct, -st * cp);
     float c = p->bg_rot_cos, s = p->bg_rot_sin;
     return v3(c * m.x + s * m.z, m.y, c * m.z - s * m.x);

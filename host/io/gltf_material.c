@@ -246,25 +246,38 @@ static Status material_alpha(Gltf *g, const cJSON *m, const char *jp, double alp
     return ST_OK;
 }
 
+/* The defaults of the extensions' colour factors. */
+static const double white3[3] = { 1, 1, 1 }, black3[3] = { 0, 0, 0 };
+
+/* A colour read as doubles, as the renderer's floats. */
+static vec3 v3_of_doubles(const double c[3]) { return v3((float)c[0], (float)c[1], (float)c[2]); }
+
+/* The material m's extension `name`, or NULL; where it is there, its JSON path (below
+ * m's, jp) into jx, for the messages about its keys. */
+static const cJSON *material_ext(const cJSON *m, const char *name, const char *jp, char *jx, size_t jx_size)
+{
+    const cJSON *x = gltf_ext_of(m, name);
+    if (x) snprintf(jx, jx_size, "%s.extensions.%s", jp, name);
+    return x;
+}
+
 /* KHR_materials_volume: thicknessFactor > 0 makes the mesh the boundary of a solid (a
  * path tracer has the real thickness, so neither the factor's value nor thicknessTexture
  * is read), inside which attenuationColor / attenuationDistance absorb (Beer-Lambert,
  * kernels/integrator/shade_path.h). Thickness 0, the default, keeps the thin wall. */
 static Status material_volume(Gltf *g, const cJSON *m, const char *jp, Material *mt)
 {
-    const cJSON *x = gltf_ext_of(m, "KHR_materials_volume");
-    if (!x) return ST_OK;
     char jx[128];
-    snprintf(jx, sizeof jx, "%s.extensions.KHR_materials_volume", jp);
-    static const double white[3] = { 1, 1, 1 };
+    const cJSON *x = material_ext(m, "KHR_materials_volume", jp, jx, sizeof jx);
+    if (!x) return ST_OK;
     double thickness, distance, color[3];
     Status st = gltf_get_num(g, x, "thicknessFactor", 0.0, 0.0, 1e30, jx, &thickness);
     if (!st) st = gltf_get_num(g, x, "attenuationDistance", INFINITY, 1e-30, INFINITY, jx, &distance);
-    if (!st) st = gltf_get_nums(g, x, "attenuationColor", 3, white, jx, color);
+    if (!st) st = gltf_get_nums(g, x, "attenuationColor", 3, white3, jx, color);
     if (st) return st;
     if (!(thickness > 0.0)) return ST_OK;
     mt->flags &= ~MAT_THIN;
-    mt->absorption = material_absorption(v3((float)color[0], (float)color[1], (float)color[2]), (float)distance);
+    mt->absorption = material_absorption(v3_of_doubles(color), (float)distance);
     return ST_OK;
 }
 
@@ -273,19 +286,17 @@ static Status material_volume(Gltf *g, const cJSON *m, const char *jp, Material 
  * F90 (kernels/bsdf/principled.h). */
 static Status material_specular(Gltf *g, const cJSON *m, const char *jp, Material *mt)
 {
-    const cJSON *x = gltf_ext_of(m, "KHR_materials_specular");
-    if (!x) return ST_OK;
     char jx[128];
-    snprintf(jx, sizeof jx, "%s.extensions.KHR_materials_specular", jp);
-    static const double white[3] = { 1, 1, 1 };
+    const cJSON *x = material_ext(m, "KHR_materials_specular", jp, jx, sizeof jx);
+    if (!x) return ST_OK;
     double factor, color[3];
     Status st = gltf_get_num(g, x, "specularFactor", 1.0, 0.0, 1.0, jx, &factor);
-    if (!st) st = gltf_get_nums(g, x, "specularColorFactor", 3, white, jx, color);
+    if (!st) st = gltf_get_nums(g, x, "specularColorFactor", 3, white3, jx, color);
     if (!st) st = texinfo(g, x, "specularTexture", 1, jx, &mt->texture_specular, NULL);
     if (!st) st = texinfo(g, x, "specularColorTexture", 0, jx, &mt->texture_specular_color, NULL);
     if (st) return st;
     mt->specular_factor = (float)factor;
-    mt->specular_color = v3((float)color[0], (float)color[1], (float)color[2]);
+    mt->specular_color = v3_of_doubles(color);
     return ST_OK;
 }
 
@@ -293,18 +304,16 @@ static Status material_specular(Gltf *g, const cJSON *m, const char *jp, Materia
  * sheenRoughnessFactor (times sheenRoughnessTexture's alpha). */
 static Status material_sheen(Gltf *g, const cJSON *m, const char *jp, Material *mt)
 {
-    const cJSON *x = gltf_ext_of(m, "KHR_materials_sheen");
-    if (!x) return ST_OK;
     char jx[128];
-    snprintf(jx, sizeof jx, "%s.extensions.KHR_materials_sheen", jp);
-    static const double black[3] = { 0, 0, 0 };
+    const cJSON *x = material_ext(m, "KHR_materials_sheen", jp, jx, sizeof jx);
+    if (!x) return ST_OK;
     double color[3], rough;
-    Status st = gltf_get_nums(g, x, "sheenColorFactor", 3, black, jx, color);
+    Status st = gltf_get_nums(g, x, "sheenColorFactor", 3, black3, jx, color);
     if (!st) st = gltf_get_num(g, x, "sheenRoughnessFactor", 0.0, 0.0, 1.0, jx, &rough);
     if (!st) st = texinfo(g, x, "sheenColorTexture", 0, jx, &mt->texture_sheen_color, NULL);
     if (!st) st = texinfo(g, x, "sheenRoughnessTexture", 1, jx, &mt->texture_sheen_roughness, NULL);
     if (st) return st;
-    mt->sheen_color = v3((float)color[0], (float)color[1], (float)color[2]);
+    mt->sheen_color = v3_of_doubles(color);
     mt->sheen_roughness = (float)rough;
     return ST_OK;
 }
@@ -326,7 +335,7 @@ static Status material_build(Gltf *g, int i, uint *out)
     const cJSON *es = gltf_ext_of(m, "KHR_materials_emissive_strength");
     if (!st && es) st = gltf_get_num(g, es, "emissiveStrength", 1.0, 0.0, 1e30, jp, &strength);
     if (st) return st;
-    Material mt = material_principled(v3((float)base[0], (float)base[1], (float)base[2]), (float)metallic,
+    Material mt = material_principled(v3_of_doubles(base), (float)metallic,
                                       (float)rough);
     mt.emission = v3((float)(emit[0] * strength), (float)(emit[1] * strength), (float)(emit[2] * strength));
     if (emit[0] > 0 || emit[1] > 0 || emit[2] > 0) g->has_lights = 1;

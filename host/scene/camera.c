@@ -3,23 +3,11 @@
  * device starts from the same float values. */
 #include "scene/camera.h"
 
+#include "base/dvec3.h"
 #include "util/kmath.h"
 
 #include <math.h>
 #include <string.h>
-
-typedef struct { double x, y, z; } dvec3;
-
-static dvec3 dv(vec3 a) { dvec3 r = { a.x, a.y, a.z }; return r; }
-static dvec3 dsub(dvec3 a, dvec3 b) { dvec3 r = { a.x - b.x, a.y - b.y, a.z - b.z }; return r; }
-static dvec3 dscale(dvec3 a, double s) { dvec3 r = { a.x * s, a.y * s, a.z * s }; return r; }
-static double ddot(dvec3 a, dvec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static dvec3 dcross(dvec3 a, dvec3 b)
-{
-    dvec3 r = { a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x };
-    return r;
-}
-static vec3 fv(dvec3 a) { return v3((float)a.x, (float)a.y, (float)a.z); }
 
 double camera_min_focus(vec3 from)
 {
@@ -29,8 +17,8 @@ double camera_min_focus(vec3 from)
 
 double camera_focus(const SceneCamera *desc)
 {
-    dvec3 back = dsub(dv(desc->from), dv(desc->at));
-    double focus = desc->focus_dist > 0.0f ? (double)desc->focus_dist : sqrt(ddot(back, back));
+    dvec3 back = dv3_sub(dv3_of(desc->from), dv3_of(desc->at));
+    double focus = desc->focus_dist > 0.0f ? (double)desc->focus_dist : sqrt(dv3_dot(back, back));
     /* a pinhole's rays do not depend on the distance of the view rectangle: put it
      * where float keeps the directions precise (a target 1e-40 from the eye rendered
      * black) */
@@ -45,21 +33,21 @@ static void camera_fill(Camera *out, uint type, dvec3 from, dvec3 corner, dvec3 
 {
     memset(out, 0, sizeof *out);
     out->type = type;
-    out->origin = fv(from);
+    out->origin = dv3_to_float(from);
     out->lens_radius = lens_radius;
-    out->corner = fv(corner);
-    out->horizontal = fv(horizontal);
-    out->vertical = fv(vertical);
-    out->lens_u = fv(u);
-    out->lens_v = fv(v);
-    out->forward = fv(dscale(w, -1.0));
+    out->corner = dv3_to_float(corner);
+    out->horizontal = dv3_to_float(horizontal);
+    out->vertical = dv3_to_float(vertical);
+    out->lens_u = dv3_to_float(u);
+    out->lens_v = dv3_to_float(v);
+    out->forward = dv3_to_float(dv3_scale(w, -1.0));
 }
 
 Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *out, Error *err)
 {
-    dvec3 from = dv(desc->from), at = dv(desc->at), up = dv(desc->up);
-    dvec3 back = dsub(from, at);
-    double dist = sqrt(ddot(back, back));
+    dvec3 from = dv3_of(desc->from), at = dv3_of(desc->at), up = dv3_of(desc->up);
+    dvec3 back = dv3_sub(from, at);
+    double dist = sqrt(dv3_dot(back, back));
     if (!(dist > 0.0) || !isfinite(dist))
         return error_set(err, ST_INPUT, "camera: 'from' and 'at' must be distinct finite points");
     double ortho_h = desc->ortho_width > 0.0f ? (double)desc->ortho_width * height / width : desc->ortho_height;
@@ -70,15 +58,15 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
                          (double)desc->vfov);
     if (!(desc->aperture >= 0.0f) || !isfinite(desc->aperture))
         return error_set(err, ST_INPUT, "camera: aperture must be >= 0, got %g", (double)desc->aperture);
-    dvec3 w = dscale(back, 1.0 / dist);
-    dvec3 u = dcross(up, w);
-    double ulen = sqrt(ddot(u, u));
-    if (!(ulen > 1e-9 * sqrt(ddot(up, up))) || !(ulen > 0.0))
+    dvec3 w = dv3_scale(back, 1.0 / dist);
+    dvec3 u = dv3_cross(up, w);
+    double ulen = sqrt(dv3_dot(u, u));
+    if (!(ulen > 1e-9 * sqrt(dv3_dot(up, up))) || !(ulen > 0.0))
         return error_set(err, ST_INPUT, "camera: 'up' must not be zero or parallel to the view direction");
-    u = dscale(u, 1.0 / ulen);
-    dvec3 v = dcross(w, u);
+    u = dv3_scale(u, 1.0 / ulen);
+    dvec3 v = dv3_cross(w, u);
     /* a left-handed frame (pbrt's camera space) puts +x of the image the other way */
-    if (desc->mirror_x) u = dscale(u, -1.0);
+    if (desc->mirror_x) u = dv3_scale(u, -1.0);
 
     if (desc->type == CAMERA_ORTHOGRAPHIC) {
         /* the view rectangle through the camera centre: ortho_width wide when given
@@ -86,7 +74,7 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
          * tall */
         double vp_h = ortho_h, vp_w = desc->ortho_width > 0.0f ? (double)desc->ortho_width
                                                                : vp_h * (double)width / (double)height;
-        dvec3 horizontal = dscale(u, vp_w), vertical = dscale(v, vp_h);
+        dvec3 horizontal = dv3_scale(u, vp_w), vertical = dv3_scale(v, vp_h);
         dvec3 corner = { from.x - horizontal.x / 2 + vertical.x / 2, from.y - horizontal.y / 2 + vertical.y / 2,
                          from.z - horizontal.z / 2 + vertical.z / 2 };
         camera_fill(out, CAMERA_ORTHOGRAPHIC, from, corner, horizontal, vertical, u, v, w, 0.0f);
@@ -105,7 +93,7 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
     double vp_w = vp_h * (double)width / (double)height;
     /* the course's camera keeps `up` as given (length too) for the vertical axis, so
      * vertical lines stay vertical when it looks down or up */
-    dvec3 horizontal = dscale(u, vp_w), vertical = dscale(desc->course_basis ? up : v, vp_h);
+    dvec3 horizontal = dv3_scale(u, vp_w), vertical = dv3_scale(desc->course_basis ? up : v, vp_h);
     dvec3 corner = { from.x - horizontal.x / 2 + vertical.x / 2 - focus * w.x,
                      from.y - horizontal.y / 2 + vertical.y / 2 - focus * w.y,
                      from.z - horizontal.z / 2 + vertical.z / 2 - focus * w.z };

@@ -2,48 +2,31 @@
  * rounded to float once, as the scene parser stores it. */
 #include "viewer/view_camera.h"
 
+#include "base/dvec3.h"
+
 #include <math.h>
 
-typedef struct { double x, y, z; } dv3;
-
-static dv3 dv(vec3 a) { dv3 r = { a.x, a.y, a.z }; return r; }
-static vec3 fv(dv3 a) { vec3 r = { (float)a.x, (float)a.y, (float)a.z }; return r; }
-static dv3 add(dv3 a, dv3 b) { dv3 r = { a.x + b.x, a.y + b.y, a.z + b.z }; return r; }
-static dv3 sub(dv3 a, dv3 b) { dv3 r = { a.x - b.x, a.y - b.y, a.z - b.z }; return r; }
-static dv3 scale(dv3 a, double s) { dv3 r = { a.x * s, a.y * s, a.z * s }; return r; }
-static double dot(dv3 a, dv3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static dv3 cross(dv3 a, dv3 b)
-{
-    dv3 r = { a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x };
-    return r;
-}
-static dv3 norm(dv3 a)
-{
-    double l = sqrt(dot(a, a));
-    return l > 0.0 ? scale(a, 1.0 / l) : a;
-}
-
 /* The camera's orthonormal frame: forward f, right r (the image's +x), true up v. */
-typedef struct { dv3 f, r, v, up; double dist; } Frame;
+typedef struct { dvec3 f, r, v, up; double dist; } Frame;
 
 static Frame frame_of(const SceneCamera *c)
 {
     Frame fr;
-    dv3 view = sub(dv(c->at), dv(c->from));
-    fr.dist = sqrt(dot(view, view));
-    fr.f = norm(view);
-    fr.up = norm(dv(c->up));
-    fr.r = norm(cross(fr.f, fr.up));
-    fr.v = cross(fr.r, fr.f);
+    dvec3 view = dv3_sub(dv3_of(c->at), dv3_of(c->from));
+    fr.dist = sqrt(dv3_dot(view, view));
+    fr.f = dv3_norm(view);
+    fr.up = dv3_norm(dv3_of(c->up));
+    fr.r = dv3_norm(dv3_cross(fr.f, fr.up));
+    fr.v = dv3_cross(fr.r, fr.f);
     return fr;
 }
 
 void view_camera_move(SceneCamera *c, double right, double up, double forward)
 {
     Frame fr = frame_of(c);
-    dv3 d = add(add(scale(fr.r, right), scale(fr.up, up)), scale(fr.f, forward));
-    c->from = fv(add(dv(c->from), d));
-    c->at = fv(add(dv(c->at), d));
+    dvec3 d = dv3_add(dv3_add(dv3_scale(fr.r, right), dv3_scale(fr.up, up)), dv3_scale(fr.f, forward));
+    c->from = dv3_to_float(dv3_add(dv3_of(c->from), d));
+    c->at = dv3_to_float(dv3_add(dv3_of(c->at), d));
 }
 
 int view_camera_turn(SceneCamera *c, double yaw, double pitch)
@@ -51,13 +34,13 @@ int view_camera_turn(SceneCamera *c, double yaw, double pitch)
     const double deg = 3.14159265358979323846 / 180.0;
     Frame fr = frame_of(c);
     /* yaw in the forward-right plane, then pitch in the forward-up plane */
-    dv3 f = add(scale(fr.f, cos(yaw * deg)), scale(fr.r, sin(yaw * deg)));
-    dv3 r = norm(cross(f, fr.up));
-    dv3 v = cross(r, f);
-    f = norm(add(scale(f, cos(pitch * deg)), scale(v, sin(pitch * deg))));
-    if (fabs(dot(f, fr.up)) > 0.999) return 0;
-    dv3 at = add(dv(c->from), scale(f, fr.dist));
-    vec3 at_f = fv(at);
+    dvec3 f = dv3_add(dv3_scale(fr.f, cos(yaw * deg)), dv3_scale(fr.r, sin(yaw * deg)));
+    dvec3 r = dv3_norm(dv3_cross(f, fr.up));
+    dvec3 v = dv3_cross(r, f);
+    f = dv3_norm(dv3_add(dv3_scale(f, cos(pitch * deg)), dv3_scale(v, sin(pitch * deg))));
+    if (fabs(dv3_dot(f, fr.up)) > 0.999) return 0;
+    dvec3 at = dv3_add(dv3_of(c->from), dv3_scale(f, fr.dist));
+    vec3 at_f = dv3_to_float(at);
     if (at_f.x == c->from.x && at_f.y == c->from.y && at_f.z == c->from.z) return 0;
     c->at = at_f;
     return 1;

@@ -124,22 +124,11 @@ static vec3 normal_through(double nm[3][3], const double n[3])
 static Status mesh_tri(Scene *s, const vec3 p[3], const vec3 n[3], int flip, uint material, Error *err)
 {
     int i1 = flip ? 2 : 1, i2 = flip ? 1 : 2;
-    TriShading sh;
-    memset(&sh, 0, sizeof sh);
-    sh.n0 = n[0];
-    sh.n1 = n[i1];
-    sh.n2 = n[i2];
-    sh.flags = TRI_HAS_NORMALS;
+    TriShading sh = { .n0 = n[0], .n1 = n[i1], .n2 = n[i2], .flags = TRI_HAS_NORMALS };
     uint si;
     Status st = scene_add_shading(s, sh, &si, err);
     if (st) return st;
-    Triangle t;
-    memset(&t, 0, sizeof t);
-    t.p0 = p[0];
-    t.p1 = p[i1];
-    t.p2 = p[i2];
-    t.material = material;
-    t.shading = si;
+    Triangle t = { .p0 = p[0], .p1 = p[i1], .p2 = p[i2], .material = material, .shading = si };
     return scene_add_triangle(s, t, err);
 }
 

@@ -42,25 +42,26 @@ void octa_sphere_to_square(const double d[3], double *u, double *v)
     *v = (sv + 1.0) * 0.5;
 }
 
+/* Brings coordinate *a of an N x N square back from one past an edge across it: the
+ * sphere joins the two halves of that edge to each other, mirrored, so the other
+ * coordinate *b flips too. */
+static void octa_fold(long *a, long *b, long N)
+{
+    if (*a < 0) {
+        *a = -*a - 1;
+        *b = N - 1 - *b;
+    } else if (*a >= N) {
+        *a = 2 * N - 1 - *a;
+        *b = N - 1 - *b;
+    }
+}
+
 /* Texel (x, y), either possibly one past an edge, brought back as the sphere joins the
- * square's edges: the two halves of each edge meet each other, mirrored. */
+ * square's edges (octa_fold): x first, then y. */
 static const float *octa_texel(const float *rgb, uint n, long x, long y)
 {
-    long N = (long)n;
-    if (x < 0) {
-        x = -x - 1;
-        y = N - 1 - y;
-    } else if (x >= N) {
-        x = 2 * N - 1 - x;
-        y = N - 1 - y;
-    }
-    if (y < 0) {
-        y = -y - 1;
-        x = N - 1 - x;
-    } else if (y >= N) {
-        y = 2 * N - 1 - y;
-        x = N - 1 - x;
-    }
+    octa_fold(&x, &y, (long)n);
+    octa_fold(&y, &x, (long)n);
     return rgb + 3u * ((size_t)y * n + (size_t)x);
 }
 

@@ -38,19 +38,13 @@ Transform transform_compose(const Transform *a, const Transform *b)
 
 Transform transform_translate(double x, double y, double z)
 {
-    Transform t = transform_identity();
-    t.m[0][3] = x;
-    t.m[1][3] = y;
-    t.m[2][3] = z;
+    Transform t = { { { 1, 0, 0, x }, { 0, 1, 0, y }, { 0, 0, 1, z } } };
     return t;
 }
 
 Transform transform_scale(double x, double y, double z)
 {
-    Transform t = transform_identity();
-    t.m[0][0] = x;
-    t.m[1][1] = y;
-    t.m[2][2] = z;
+    Transform t = { { { x, 0, 0, 0 }, { 0, y, 0, 0 }, { 0, 0, z, 0 } } };
     return t;
 }
 

@@ -598,6 +598,8 @@ static void test_instances(void)
 
     expect_error("ObjectInstance \"nothing\"",
                  DIR "inline.pbrt:1:16: object 'nothing' is not defined (ObjectBegin defines it)");
+    expect_error("CoordSysTransform \"nowhere\"",
+                 DIR "inline.pbrt:1:19: coordinate system 'nowhere' is not defined (CoordinateSystem defines it)");
     expect_error("ObjectBegin \"a\"\nAttributeEnd\nObjectEnd", DIR "inline.pbrt:3:1: ObjectEnd inside an "
                  "AttributeBegin of its object, or after one that closes more than it opened");
     expect_error("ObjectBegin \"a\"\nShape \"sphere\"",

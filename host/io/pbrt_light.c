@@ -28,8 +28,7 @@ Status pbrt_area_light(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token type;
-    Status st = pbrt_expect_string(p, lx, "a quoted area light type", &type);
-    if (!st) st = pbrt_parse_params(p, lx);
+    Status st = pbrt_expect_head(p, lx, "a quoted area light type", &type);
     if (st) return st;
     if (!pbrt_tok_eq(&type, "diffuse"))
         return lex_error_at(lx, &type, p->err, "area light \"%.*s\" is not supported (diffuse is)",
@@ -150,8 +149,7 @@ Status pbrt_light(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token type;
-    Status st = pbrt_expect_string(p, lx, "a quoted light type", &type);
-    if (!st) st = pbrt_parse_params(p, lx);
+    Status st = pbrt_expect_head(p, lx, "a quoted light type", &type);
     if (st) return st;
     double scale = 1;
     if ((st = pbrt_get_float(p, lx, "scale", &scale))) return st;

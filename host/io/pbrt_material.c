@@ -244,8 +244,7 @@ Status pbrt_material(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token type;
-    Status st = pbrt_expect_string(p, lx, "a quoted material type", &type);
-    if (!st) st = pbrt_parse_params(p, lx);
+    Status st = pbrt_expect_head(p, lx, "a quoted material type", &type);
     if (st) return st;
     Material m;
     if ((st = make_material(p, lx, &type, &m, "Material"))) return st;
@@ -258,8 +257,7 @@ Status pbrt_make_named_material(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token name;
-    Status st = pbrt_expect_string(p, lx, "a quoted material name", &name);
-    if (!st) st = pbrt_parse_params(p, lx);
+    Status st = pbrt_expect_head(p, lx, "a quoted material name", &name);
     if (st) return st;
     const Token *type = NULL;
     if ((st = pbrt_get_string(p, lx, "type", &type))) return st;

@@ -117,8 +117,7 @@ Status pbrt_make_named_medium(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token name;
-    Status st = pbrt_expect_string(p, lx, "a quoted medium name", &name);
-    if (!st) st = pbrt_parse_params(p, lx);
+    Status st = pbrt_expect_head(p, lx, "a quoted medium name", &name);
     if (st) return st;
     if (name.len == 0) return lex_error_at(lx, &name, p->err, "a medium needs a name (\"\" is vacuum)");
     const Token *type = NULL;

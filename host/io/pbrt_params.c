@@ -454,6 +454,14 @@ Status pbrt_expect_string(Parser *p, Lexer *lx, const char *what, Token *t)
     return ST_OK;
 }
 
+/* The head of most directives: one quoted string (a type or a name), then the parameter
+ * list, read into p->pl. */
+Status pbrt_expect_head(Parser *p, Lexer *lx, const char *what, Token *t)
+{
+    Status st = pbrt_expect_string(p, lx, what, t);
+    return st ? st : pbrt_parse_params(p, lx);
+}
+
 /* A quoted name that `map` must hold (a named material, an object): its token and index,
  * or an error at the name saying which directive defines such names. */
 Status pbrt_expect_defined(Parser *p, Lexer *lx, const StrMap *map, const char *what, const char *definer,

@@ -143,12 +143,9 @@ static Status d_coordsys_transform(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token t;
-    Status st = pbrt_expect_string(p, lx, "a quoted coordinate system name", &t);
-    if (st) return st;
     uint32_t i;
-    if (!strmap_find(&p->coordsys, t.text, t.len, &i))
-        return lex_error_at(lx, &t, p->err, "coordinate system '%.*s' is not defined", (int)(t.len > 40 ? 40 : t.len),
-                            t.text);
+    Status st = pbrt_expect_defined(p, lx, &p->coordsys, "coordinate system", "CoordinateSystem", &t, &i);
+    if (st) return st;
     p->g.ctm = p->coordsys_xf[i];
     return ST_OK;
 }
@@ -220,8 +217,7 @@ static Status d_world_begin(Parser *p, Lexer *lx, const Token *kw)
 static Status d_camera(Parser *p, Lexer *lx, const Token *kw)
 {
     Token type;
-    Status st = pbrt_expect_string(p, lx, "a quoted camera type", &type);
-    if (!st) st = pbrt_parse_params(p, lx);
+    Status st = pbrt_expect_head(p, lx, "a quoted camera type", &type);
     if (st) return st;
     if (p->world) return lex_error_at(lx, kw, p->err, "Camera must come before WorldBegin");
     if (!pbrt_tok_eq(&type, "perspective") && !pbrt_tok_eq(&type, "orthographic")) {
@@ -290,8 +286,7 @@ static Status film_crop(Parser *p, Lexer *lx, const Token *kw)
 static Status d_film(Parser *p, Lexer *lx, const Token *kw)
 {
     Token type;
-    Status st = pbrt_expect_string(p, lx, "a quoted film type", &type);
-    if (!st) st = pbrt_parse_params(p, lx);
+    Status st = pbrt_expect_head(p, lx, "a quoted film type", &type);
     if (st) return st;
     long w = 1280, h = 720;   /* pbrt-v4's defaults */
     if ((st = pbrt_get_int(p, lx, "xresolution", &w)) || (st = pbrt_get_int(p, lx, "yresolution", &h))) return st;
@@ -322,8 +317,7 @@ static Status d_sampler(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token type;
-    Status st = pbrt_expect_string(p, lx, "a quoted sampler type", &type);
-    if (!st) st = pbrt_parse_params(p, lx);
+    Status st = pbrt_expect_head(p, lx, "a quoted sampler type", &type);
     if (st) return st;
     long n = 16;
     if ((st = pbrt_get_int(p, lx, "pixelsamples", &n))) return st;
@@ -337,8 +331,7 @@ static Status d_integrator(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token type;
-    Status st = pbrt_expect_string(p, lx, "a quoted integrator type", &type);
-    if (!st) st = pbrt_parse_params(p, lx);
+    Status st = pbrt_expect_head(p, lx, "a quoted integrator type", &type);
     if (st) return st;
     if (!pbrt_tok_eq(&type, "path") && !pbrt_tok_eq(&type, "volpath")) {
         st = warn_once(p, lx, &type, "Integrator", "Integrator \"%.*s\" is not supported; clpt's path tracer is used",

@@ -146,6 +146,7 @@ Status pbrt_get_spectrum(Parser *p, const Lexer *lx, const char *name, vec3 *out
 Status pbrt_get_float_tex(Parser *p, const Lexer *lx, const char *name, double *out);
 Status pbrt_warn_unused(Parser *p, const Lexer *lx, const char *what);
 Status pbrt_expect_string(Parser *p, Lexer *lx, const char *what, Token *t);
+Status pbrt_expect_head(Parser *p, Lexer *lx, const char *what, Token *t);
 Status pbrt_expect_defined(Parser *p, Lexer *lx, const StrMap *map, const char *what, const char *definer,
                            Token *name, uint32_t *index);
 Status pbrt_expect_numbers(Parser *p, Lexer *lx, double *out, int n, const char *what);

@@ -450,8 +450,7 @@ Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
     Token type;
-    Status st = pbrt_expect_string(p, lx, "a quoted shape type", &type);
-    if (!st) st = pbrt_parse_params(p, lx);
+    Status st = pbrt_expect_head(p, lx, "a quoted shape type", &type);
     if (st) return st;
     int known = pbrt_tok_eq(&type, "sphere") || pbrt_tok_eq(&type, "trianglemesh") || pbrt_tok_eq(&type, "plymesh") ||
                 pbrt_tok_eq(&type, "bilinearmesh") || pbrt_tok_eq(&type, "loopsubdiv") || pbrt_tok_eq(&type, "disk") ||

@@ -253,15 +253,18 @@ Status scene_parse_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
     return ST_OK;
 }
 
-/* Rejects a second camera/image/background block, naming where the first one was. */
-static Status once(Parser *p, const Lexer *lx, const Token *kw, char **seen)
+/* A block that stands at most once in a scene (camera, image, background): its keys
+ * into vals, as scene_parse_block; a second one is an error naming where the first was
+ * (*seen, set here). */
+static Status parse_once_block(Parser *p, Lexer *lx, const Token *kw, char **seen, const char *block,
+                               const KeySpec *keys, size_t n, Value *vals)
 {
     if (*seen)
         return lex_error_at(lx, kw, p->err, "a second %.*s block (the first is at %s)",
                             (int)kw->len, kw->text, *seen);
     *seen = reader_where(lx, kw);
     if (!*seen) return error_set(p->err, ST_INTERNAL, "out of memory");
-    return ST_OK;
+    return scene_parse_block(p, lx, kw, 0, block, keys, n, vals);
 }
 
 double scene_len_d(vec3 a) { return sqrt((double)a.x * a.x + (double)a.y * a.y + (double)a.z * a.z); }
@@ -317,8 +320,7 @@ static Status camera_type(Parser *p, Lexer *lx, const Token *kw, const Value *v,
 static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
 {
     Value v[CAM_N];
-    Status st = once(p, lx, kw, &p->camera_at);
-    if (!st) st = scene_parse_block(p, lx, kw, 0, "camera", camera_keys, CAM_N, v);
+    Status st = parse_once_block(p, lx, kw, &p->camera_at, "camera", camera_keys, CAM_N, v);
     if (st) return st;
     SceneCamera *c = &p->s->camera;
     if ((st = camera_type(p, lx, kw, v, c))) return st;
@@ -371,8 +373,7 @@ static const KeySpec image_keys[IMG_N] = {
 static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
 {
     Value v[IMG_N];
-    Status st = once(p, lx, kw, &p->image_at);
-    if (!st) st = scene_parse_block(p, lx, kw, 0, "image", image_keys, IMG_N, v);
+    Status st = parse_once_block(p, lx, kw, &p->image_at, "image", image_keys, IMG_N, v);
     if (st) return st;
     SceneImage *im = &p->s->image;
     if (v[IMG_WIDTH].given) im->width = (uint)v[IMG_WIDTH].u;
@@ -454,8 +455,7 @@ static Status parse_background_cubemap(Parser *p, Lexer *lx, const Value *v)
 static Status parse_background(Parser *p, Lexer *lx, const Token *kw)
 {
     Value v[BG_N];
-    Status st = once(p, lx, kw, &p->background_at);
-    if (!st) st = scene_parse_block(p, lx, kw, 0, "background", background_keys, BG_N, v);
+    Status st = parse_once_block(p, lx, kw, &p->background_at, "background", background_keys, BG_N, v);
     if (st) return st;
     Scene *s = p->s;
     if (v[BG_AMBIENT].given) s->ambient = v[BG_AMBIENT].v;   /* the whitted integrator's */

@@ -235,6 +235,17 @@ Status pbrt_get_int(Parser *p, const Lexer *lx, const char *name, long *out)
     return st;
 }
 
+/* pbrt_get_int of a value that must lie in lo..hi: an error at the parameter where the
+ * scene gives one outside (the default, *out on entry, is taken to lie inside). */
+Status pbrt_get_int_in(Parser *p, const Lexer *lx, const char *name, long lo, long hi, long *out)
+{
+    Status st = pbrt_get_int(p, lx, name, out);
+    if (st || (*out >= lo && *out <= hi)) return st;
+    char range[48];
+    snprintf(range, sizeof range, "in %ld..%ld", lo, hi);
+    return pbrt_param_type_error(p, lx, pbrt_param_find(p, name), range);
+}
+
 Status pbrt_get_bool(Parser *p, const Lexer *lx, const char *name, int *out)
 {
     const Param *pa;

@@ -289,9 +289,9 @@ static Status d_film(Parser *p, Lexer *lx, const Token *kw)
     Status st = pbrt_expect_head(p, lx, "a quoted film type", &type);
     if (st) return st;
     long w = 1280, h = 720;   /* pbrt-v4's defaults */
-    if ((st = pbrt_get_int(p, lx, "xresolution", &w)) || (st = pbrt_get_int(p, lx, "yresolution", &h))) return st;
-    if (w < 1 || w > CLPT_MAX_IMAGE_SIDE) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "xresolution"), "in 1..16384");
-    if (h < 1 || h > CLPT_MAX_IMAGE_SIDE) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "yresolution"), "in 1..16384");
+    if ((st = pbrt_get_int_in(p, lx, "xresolution", 1, CLPT_MAX_IMAGE_SIDE, &w)) ||
+        (st = pbrt_get_int_in(p, lx, "yresolution", 1, CLPT_MAX_IMAGE_SIDE, &h)))
+        return st;
     p->s->image.width = (uint)w;
     p->s->image.height = (uint)h;
     /* the image pbrt would write: clpt's output when -o does not name one (main.c) */
@@ -320,8 +320,7 @@ static Status d_sampler(Parser *p, Lexer *lx, const Token *kw)
     Status st = pbrt_expect_head(p, lx, "a quoted sampler type", &type);
     if (st) return st;
     long n = 16;
-    if ((st = pbrt_get_int(p, lx, "pixelsamples", &n))) return st;
-    if (n < 1 || n > CLPT_MAX_SPP) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "pixelsamples"), "in 1..1000000");
+    if ((st = pbrt_get_int_in(p, lx, "pixelsamples", 1, CLPT_MAX_SPP, &n))) return st;
     p->s->image.spp = (uint)n;
     pbrt_param_find(p, "seed");   /* clpt's seed is its own; pbrt's only picks other noise */
     return pbrt_warn_unused(p, lx, "Sampler");
@@ -339,8 +338,7 @@ static Status d_integrator(Parser *p, Lexer *lx, const Token *kw)
         if (st) return st;
     }
     long d = 5;
-    if ((st = pbrt_get_int(p, lx, "maxdepth", &d))) return st;
-    if (d < 0 || d > CLPT_MAX_DEPTH) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "maxdepth"), "in 0..1024");
+    if ((st = pbrt_get_int_in(p, lx, "maxdepth", 0, CLPT_MAX_DEPTH, &d))) return st;
     p->s->image.max_depth = (uint)d;
     pbrt_param_find(p, "regularize");
     return pbrt_warn_unused(p, lx, "Integrator");

@@ -139,6 +139,7 @@ Param *pbrt_param_find(Parser *p, const char *name);
 Status pbrt_param_type_error(Parser *p, const Lexer *lx, const Param *pa, const char *what);
 Status pbrt_get_float(Parser *p, const Lexer *lx, const char *name, double *out);
 Status pbrt_get_int(Parser *p, const Lexer *lx, const char *name, long *out);
+Status pbrt_get_int_in(Parser *p, const Lexer *lx, const char *name, long lo, long hi, long *out);
 Status pbrt_get_bool(Parser *p, const Lexer *lx, const char *name, int *out);
 Status pbrt_get_string(Parser *p, const Lexer *lx, const char *name, const Token **out);
 Status pbrt_get_point(Parser *p, const Lexer *lx, const char *name, vec3 *out);

@@ -121,10 +121,8 @@ KFN BsdfSample phong_sample(PhongLobes l, Material m, vec3 d, vec3 ns, vec3 ng, 
         s.transmitted = 0;
         return s;
     }
-    if (u_lobe < l.p_glossy + l.p_mirror) {
-        /* about the shading normal, unless that would go below the surface */
+    if (u_lobe < l.p_glossy + l.p_mirror)
         return bsdf_delta_sample(bsdf_mirror_dir(d, ns, ng), v3_scale(l.kr, 1.0f / l.p_mirror), 0);
-    }
     /* The refracting part, like glass, tinted by kt: the glass sample (a delta lobe) as
      * it is, with kt's weight. Returned whole rather than copied field by field into s:
      * NVIDIA's OpenCL compiler (driver 580.159) at its default optimisation kept the

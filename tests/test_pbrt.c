@@ -571,28 +571,38 @@ static void test_instances(void)
     }
     scene_free(&s);
 
-    /* a name defined again serves the instances after it; an object that emits light
-     * is copied at each instance, with a warning; a singular instance is skipped */
+    /* a name defined again serves the instances after it; an object whose emitters are
+     * triangles is instanced (they are lights under every instance); one that holds an
+     * emitting sphere is copied at each instance, with a warning; a singular instance is
+     * skipped */
     CHECK_EQ_INT(load_text("ObjectBegin \"a\" Shape \"sphere\" ObjectEnd ObjectInstance \"a\"\n"
                            "ObjectBegin \"a\" Shape \"sphere\" \"float radius\" 2 ObjectEnd ObjectInstance \"a\"\n"
                            "ObjectBegin \"lamp\" AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
                            "  Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] ObjectEnd\n"
                            "ObjectInstance \"lamp\" Translate 3 0 0 ObjectInstance \"lamp\"\n"
-                           "Scale 0 1 1 ObjectInstance \"a\"\n", &s, &err),
+                           "ObjectBegin \"ball\" AreaLightSource \"diffuse\" \"rgb L\" [1 1 1] Shape \"sphere\"\n"
+                           "ObjectEnd ObjectInstance \"ball\" Translate 0 3 0 ObjectInstance \"ball\"\n"
+                           "Scale 0 1 1 ObjectInstance \"a\"\n",
+                           &s, &err),
                  ST_OK);
-    CHECK_EQ_INT(s.n_objects, 2);
-    CHECK_EQ_INT(s.n_instances, 2);
-    CHECK_EQ_INT(s.n_triangles, 2);
-    if (s.n_instances == 2 && s.n_objects == 2) {
+    CHECK_EQ_INT(s.n_objects, 3);
+    CHECK_EQ_INT(s.n_instances, 4);
+    CHECK_EQ_INT(s.n_triangles, 1);
+    CHECK_EQ_INT(s.n_spheres, 4);   /* two in objects "a", two copies of "ball" */
+    if (s.n_instances == 4 && s.n_objects == 3) {
         CHECK_EQ_INT(s.instances[0].object, 0);
         CHECK_EQ_INT(s.instances[1].object, 1);
+        CHECK_EQ_INT(s.instances[2].object, 2);
+        CHECK_EQ_INT(s.instances[3].object, 2);
         CHECK(strcmp(s.objects[1].name, "a#1") == 0);
+        CHECK(strcmp(s.objects[2].name, "lamp") == 0);
     }
     CHECK_EQ_INT(s.n_warnings, 2);
     if (s.n_warnings == 2) {
-        CHECK_STR_CONTAINS(s.warnings[0], "inline.pbrt:4: ObjectBegin \"lamp\" holds an area light: its shapes are "
-                           "copied at each ObjectInstance (instanced emitters are not lights)");
-        CHECK_STR_CONTAINS(s.warnings[1], "inline.pbrt:6: ObjectInstance \"a\" under a singular transform is skipped");
+        CHECK_STR_CONTAINS(s.warnings[1], "inline.pbrt:8: ObjectInstance \"a\" under a singular transform is skipped");
+        CHECK_STR_CONTAINS(s.warnings[0], "inline.pbrt:7: ObjectBegin \"ball\" holds an emitting sphere: its shapes "
+                           "are copied at each ObjectInstance (an instance that is no similarity would make it an "
+                           "ellipsoid, which is no light)");
     }
     scene_free(&s);
 
@@ -711,6 +721,82 @@ static void test_instances_stats(void)
                        "(12 with the world's)");
     unlink(scene);
     unlink(CLPT_BUILD_DIR "/test-pbrt-inst.pfm");
+}
+
+/* An emitting object: a quad lamp and a triangle lamp of two colours, with a dark
+ * block, instanced three times (rotated; stretched; mirrored and scaled). Its emitting
+ * triangles are lights under each instance (LIGHT_INSTANCED), so the instances render
+ * the same mean as the shapes written out (lights of their own) within noise. */
+#define LAMP_SHAPES                                                                                        \
+    "  AttributeBegin AreaLightSource \"diffuse\" \"rgb L\" [5 4 3]\n"                                      \
+    "    Shape \"trianglemesh\" \"point3 P\" [-0.4 1.5 -0.4 0.4 1.5 -0.4 0.4 1.5 0.4 -0.4 1.5 0.4]\n"         \
+    "      \"integer indices\" [0 2 1 0 3 2] AttributeEnd\n"                                                 \
+    "  AttributeBegin AreaLightSource \"diffuse\" \"rgb L\" [1 3 6]\n"                                      \
+    "    Shape \"trianglemesh\" \"point3 P\" [0.6 0.2 0 1.1 0.2 0 0.8 0.9 0] AttributeEnd\n"                 \
+    "  Material \"diffuse\" \"rgb reflectance\" [0.6 0.6 0.3]\n"                                            \
+    "  Shape \"trianglemesh\" \"point3 P\" [-0.5 0 -0.5 0.5 0 -0.5 0.5 1 0.5 -0.5 1 0.5]\n"                \
+    "    \"integer indices\" [0 1 2 0 2 3]\n"
+#define LAMP_A "Translate 2.4 0 0 Rotate 30 0 1 0"
+#define LAMP_B "Translate -2.4 0 0.5 Scale 1 1.4 0.7"
+#define LAMP_C "Translate 0 0 -2 Scale -1.2 1.2 1.2"
+#define PLACE_LAMP(xf) "AttributeBegin " xf " ObjectInstance \"lamp\" AttributeEnd\n"
+#define COPY_LAMP(xf) "AttributeBegin " xf "\n" LAMP_SHAPES "AttributeEnd\n"
+static const char lamp_inst[] = INST_HEAD "ObjectBegin \"lamp\"\n" LAMP_SHAPES "ObjectEnd\n" PLACE_LAMP(LAMP_A)
+    PLACE_LAMP(LAMP_B) PLACE_LAMP(LAMP_C);
+static const char lamp_copy[] = INST_HEAD COPY_LAMP(LAMP_A) COPY_LAMP(LAMP_B) COPY_LAMP(LAMP_C);
+
+/* The instanced lamps: objects and instances, no warning; the same mean as the copies
+ * within noise; PoCL renders them bit for bit as the scalar device; --stats counts the
+ * instances and their lights. */
+static void test_instanced_emitters(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_MSG(load_text(lamp_inst, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_objects, 1);
+    CHECK_EQ_INT(s.n_instances, 3);
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+    Film a, b, c;
+    CHECK_MSG(render_text(lamp_inst, "scalar", &a, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_text(lamp_copy, "scalar", &b, &err) == ST_OK, "%s", err.msg);
+    if (a.sum && b.sum) {
+        double ma = film_mean(&a), mb = film_mean(&b);
+        fprintf(stderr, "  instanced lamps: mean %.6f, written out %.6f (%.2f%%)\n", ma, mb, 100.0 * (ma - mb) / mb);
+        CHECK(fabs(ma - mb) < 0.01 * mb);
+    }
+    if (b.sum) film_free(&b);
+    Status sc = render_text(lamp_inst, TEST_OPENCL, &c, &err);
+    CHECK_MSG(sc == ST_OK, "%s", err.msg);
+    if (!sc && a.sum) {
+        size_t n = (size_t)a.width * a.height * 3u, same = sums_same(&a, &c);
+        fprintf(stderr, "  instanced lamps: %zu of %zu channel sums identical on OpenCL and scalar\n", same, n);
+        CHECK(same == n);
+        film_free(&c);
+    }
+    if (a.sum) film_free(&a);
+
+    char scene[64];
+    write_temp(scene, sizeof scene, ".pbrt", lamp_inst);
+    CliResult r;
+    cli_run((const char *[]){ scene, "-q", "--device", "scalar", "--spp", "1", "--stats", "-o",
+                              CLPT_BUILD_DIR "/test-pbrt-lamp.pfm", NULL }, &r);
+    CHECK_EQ_INT(r.status, 0);
+    CHECK_STR_CONTAINS(r.out, "instances: 3 of 1 objects; triangles: 9 unique (5 in objects), 15 instanced");
+    /* as many lights as the copies make: each instance's quad and triangle */
+    const char *lights = strstr(r.out, " materials, ");
+    unlink(scene);
+    write_temp(scene, sizeof scene, ".pbrt", lamp_copy);
+    CliResult rc;
+    cli_run((const char *[]){ scene, "-q", "--device", "scalar", "--spp", "1", "--stats", "-o",
+                              CLPT_BUILD_DIR "/test-pbrt-lamp.pfm", NULL }, &rc);
+    CHECK_EQ_INT(rc.status, 0);
+    const char *copy_lights = strstr(rc.out, " materials, ");
+    CHECK(lights && copy_lights && atoi(lights + 12) == atoi(copy_lights + 12) && atoi(lights + 12) > 9);
+    if (lights && copy_lights)
+        fprintf(stderr, "  instanced lamps: %d lights, written out %d\n", atoi(lights + 12), atoi(copy_lights + 12));
+    unlink(scene);
+    unlink(CLPT_BUILD_DIR "/test-pbrt-lamp.pfm");
 }
 
 /* pbrt's camera space is left-handed: seen from +z with y up, world +x is on the left. */
@@ -1622,6 +1708,7 @@ int main(void)
     RUN(test_compare);
     RUN(test_instances_render);
     RUN(test_instances_stats);
+    RUN(test_instanced_emitters);
     RUN(test_errors);
     RUN(test_gzip);
     RUN(test_load_budget);

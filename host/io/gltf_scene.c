@@ -386,47 +386,22 @@ static int placed_grow(Gltf *g)
     return 0;
 }
 
-/* What a mesh used more than once became: not yet seen, copies, or a scene object. */
+/* What a mesh used more than once became: not yet seen, or a scene object; MESH_COPIES
+ * asks place() and gpu_instances() for copies (a mesh placed once). */
 #define MESH_UNSEEN NO_INDEX
 #define MESH_COPIES (NO_INDEX - 1u)
 
-/* Whether a primitive of mesh `mesh` emits light: instanced emitters are no lights yet
- * (docs/instancing.md), so such a mesh is copied wherever it is placed. */
-static Status mesh_emits(Gltf *g, int mesh, const char *jp, int *emits)
-{
-    *emits = 0;
-    const cJSON *prims = cJSON_GetObjectItemCaseSensitive(gltf_item_at(g, "meshes", mesh), "primitives");
-    if (!cJSON_IsArray(prims)) return gltf_bad(g, jp, "primitives: expected an array");
-    int i = 0;
-    for (const cJSON *p = gltf_first_of(prims); p; p = p->next, i++) {
-        char jpp[96];
-        snprintf(jpp, sizeof jpp, "%s.primitives[%d]", jp, i);
-        int mi;
-        uint mat;
-        Status st = gltf_get_index(g, p, "material", 0, "materials", jpp, &mi);
-        if (!st) st = gltf_material_get(g, mi, &mat);
-        if (st) return st;
-        if (mat != NO_INDEX && mat < g->s->n_materials && !v3_is_zero(g->s->materials[mat].emission)) *emits = 1;
-    }
-    return ST_OK;
-}
-
-/* Mesh `mesh` made once as a scene object in its own space (*out), or MESH_COPIES when
- * it emits light; an object of no triangles is made and never placed. */
+/* Mesh `mesh` made once as a scene object in its own space (*out); an object of no
+ * triangles is made and never placed. A mesh that emits is an object too: glTF's
+ * emitters are triangles, which are lights under every instance (LIGHT_INSTANCED,
+ * docs/instancing.md), so no transform needs a copy. */
 static Status mesh_object(Gltf *g, int mesh, const char *node, uint *out)
 {
     char jp[64], name[600];
     snprintf(jp, sizeof jp, "meshes[%d]", mesh);
-    int emits;
-    Status st = mesh_emits(g, mesh, jp, &emits);
-    if (st) return st;
-    if (emits) {
-        *out = MESH_COPIES;
-        return scene_warn(g->s, g->err, "%s: %s emits light: copied at each of its nodes (instanced emitters are not "
-                          "lights)", g->path, jp);
-    }
     snprintf(name, sizeof name, "%.500s:%s", g->path, jp);
-    if ((st = scene_object_begin(g->s, name, strlen(name), out, g->err))) return st;
+    Status st = scene_object_begin(g->s, name, strlen(name), out, g->err);
+    if (st) return st;
     const Transform id = transform_identity();
     st = mesh_instance(g, mesh, &id, node);
     scene_object_end(g->s, *out);

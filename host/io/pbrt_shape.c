@@ -492,9 +492,13 @@ Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw)
  * ObjectInstance places them under the CTM of that moment (pbrt-v4's render-from-
  * instance is the CTM at ObjectInstance times world-from-render: the object's shapes
  * are not moved back by the CTM at ObjectBegin). Two kinds of object are copied in at
- * each instance instead, as the reader did before objects: one whose shapes emit light
- * (instanced emitters are no lights yet: copies keep next-event estimation), and one
- * with no shapes (nothing to place). */
+ * each instance instead, as the reader did before objects: one that holds an emitting
+ * sphere, and one with no shapes (nothing to place). Emitting triangles are lights
+ * under every instance (LIGHT_INSTANCED), but a sphere only under a similarity: an
+ * instance that squashes it makes an ellipsoid, which light sampling has no density
+ * for. The instances' transforms come after ObjectEnd, so such an object is copied
+ * whole, as before: a copy under a similarity is a sphere light, and under any other
+ * CTM (instance_ellipsoid) its emitting sphere is still skipped with a warning. */
 #define PBRT_MAX_FLAT_TRIANGLES ((size_t)1 << 26)
 
 Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw)
@@ -522,12 +526,11 @@ Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-/* Whether a shape made since ObjectBegin emits light (an AreaLightSource's). */
-static int object_emits(const Parser *p)
+/* Whether a sphere made since ObjectBegin emits light (an AreaLightSource's); an
+ * emitting sphere under a CTM that is no similarity is already a mesh (shape_sphere). */
+static int object_sphere_emits(const Parser *p)
 {
     const Scene *s = p->s;
-    for (size_t i = p->obj_triangles; i < s->n_triangles; i++)
-        if (!v3_is_zero(s->materials[s->triangles[i].material].emission)) return 1;
     for (size_t i = p->obj_spheres; i < s->n_spheres; i++)
         if (!v3_is_zero(s->materials[s->spheres[i].material].emission)) return 1;
     return 0;
@@ -599,10 +602,11 @@ Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw)
     PObject o;
     memset(&o, 0, sizeof o);
     int empty = p->s->n_triangles == p->obj_triangles && p->s->n_spheres == p->obj_spheres;
-    int emits = !empty && object_emits(p);
+    int emits = !empty && object_sphere_emits(p);
     Status st;
-    if (emits && (st = warn_once(p, lx, kw, "object-emits", "ObjectBegin \"%s\" holds an area light: its shapes are "
-                                 "copied at each ObjectInstance (instanced emitters are not lights)", p->obj_name_buf)))
+    if (emits && (st = warn_once(p, lx, kw, "object-emits", "ObjectBegin \"%s\" holds an emitting sphere: its shapes "
+                                 "are copied at each ObjectInstance (an instance that is no similarity would make it "
+                                 "an ellipsoid, which is no light)", p->obj_name_buf)))
         return st;
     if (pbrt_grow((void **)&p->objects, &p->cap_objects, p->n_objects + 1, sizeof(PObject)))
         return error_set(p->err, ST_INTERNAL, "out of memory");

@@ -1126,6 +1126,53 @@ static void test_instancing_copies(void)
     scene_free(&s);
 }
 
+/* The emissive triangle in three nodes, lit floor below: the instanced lamps (one
+ * object, three instances, a light each) render the same mean as their copies within
+ * noise, and PoCL the same bits as the scalar device. */
+static void test_instanced_emitters(void)
+{
+    static const char lamp[] = THREE_NODES("{\"emissiveFactor\":[4,3,2]}", "1,1.5,1");
+    const char *gltf = CLPT_BUILD_DIR "/test-gltf-lamp.gltf";
+    FILE *f = fopen(gltf, "wb");
+    CHECK(f && fwrite(lamp, 1, strlen(lamp), f) == strlen(lamp));
+    if (f) fclose(f);
+    /* the scene's path is beside the glTF: its file name is relative to it */
+    static const char text[] = "image { width 48 height 36 spp 16 depth 4 }\n"
+                               "camera { from 1.5 2 6 at 1.5 0.2 0 fov 45 }\n"
+                               "material ground { type diffuse albedo 0.5 0.5 0.5 }\n"
+                               "plane { point 0 -0.5 0 normal 0 1 0 material ground }\n"
+                               "mesh { file \"test-gltf-lamp.gltf\" }\n";
+    Film film[3];
+    Status st[3];
+    for (int i = 0; i < 3; i++) {
+        Scene s;
+        Error err = { 0 };
+        scene_init(&s);
+        st[i] = scene_load_bytes(CLPT_BUILD_DIR "/lamp.scene", text, strlen(text), SCENE_FORMAT_AUTO, &s, NULL, &err);
+        if (!st[i] && i == 0) {
+            CHECK_EQ_INT(s.n_objects, 1);
+            CHECK_EQ_INT(s.n_instances, 3);
+        }
+        if (!st[i] && i == 1) st[i] = scene_flatten_instances(&s, &err);
+        if (!st[i]) st[i] = render_util_run(&s, i == 2 ? TEST_OPENCL : "scalar", 0, &film[i], &err);
+        CHECK_MSG(st[i] == ST_OK, "%s", err.msg);
+        scene_free(&s);
+    }
+    if (!st[0] && !st[1]) {
+        double ma = film_mean(&film[0]), mb = film_mean(&film[1]);
+        fprintf(stderr, "  instanced emissive mesh: mean %.6f, copies %.6f (%.2f%%)\n", ma, mb, 100.0 * (ma - mb) / mb);
+        CHECK(mb > 0 && fabs(ma - mb) < 0.01 * mb);
+    }
+    if (!st[0] && !st[2]) {
+        size_t n = (size_t)film[0].width * film[0].height * 3u, same = sums_same(&film[0], &film[2]);
+        fprintf(stderr, "  instanced emissive mesh: %zu of %zu channel sums identical on OpenCL and scalar\n", same, n);
+        CHECK(same == n);
+    }
+    for (int i = 0; i < 3; i++)
+        if (!st[i]) film_free(&film[i]);
+    unlink(gltf);
+}
+
 int main(void)
 {
     RUN(test_volume_specular_sheen);
@@ -1146,6 +1193,7 @@ int main(void)
     RUN(test_extras);
     RUN(test_instancing);
     RUN(test_instancing_copies);
+    RUN(test_instanced_emitters);
     RUN(test_cornell_box);
     RUN(test_material_spheres);
     RUN(test_suzanne_texture);

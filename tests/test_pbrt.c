@@ -573,7 +573,8 @@ static void test_instances(void)
 
     /* a name defined again serves the instances after it; an object whose emitters are
      * triangles is instanced (they are lights under every instance); one that holds an
-     * emitting sphere is copied at each instance, with a warning; a singular instance is
+     * emitting sphere is instanced under a similarity and copied, with a warning, under
+     * any other transform (its sphere a mesh light, facing out); a singular instance is
      * skipped */
     CHECK_EQ_INT(load_text("ObjectBegin \"a\" Shape \"sphere\" ObjectEnd ObjectInstance \"a\"\n"
                            "ObjectBegin \"a\" Shape \"sphere\" \"float radius\" 2 ObjectEnd ObjectInstance \"a\"\n"
@@ -582,27 +583,42 @@ static void test_instances(void)
                            "ObjectInstance \"lamp\" Translate 3 0 0 ObjectInstance \"lamp\"\n"
                            "ObjectBegin \"ball\" AreaLightSource \"diffuse\" \"rgb L\" [1 1 1] Shape \"sphere\"\n"
                            "ObjectEnd ObjectInstance \"ball\" Translate 0 3 0 ObjectInstance \"ball\"\n"
+                           "AttributeBegin Scale 1 2 1 ObjectInstance \"ball\" AttributeEnd\n"
                            "Scale 0 1 1 ObjectInstance \"a\"\n",
                            &s, &err),
                  ST_OK);
-    CHECK_EQ_INT(s.n_objects, 3);
-    CHECK_EQ_INT(s.n_instances, 4);
-    CHECK_EQ_INT(s.n_triangles, 1);
-    CHECK_EQ_INT(s.n_spheres, 4);   /* two in objects "a", two copies of "ball" */
-    if (s.n_instances == 4 && s.n_objects == 3) {
+    CHECK_EQ_INT(s.n_objects, 4);
+    CHECK_EQ_INT(s.n_instances, 6);
+    CHECK_EQ_INT(s.n_spheres, 3);   /* one in each object "a", one in "ball" */
+    CHECK_EQ_INT(s.n_triangles, 1 + 2 * 64 * 32 - 2 * 64);   /* "lamp"'s, the squashed ball's mesh */
+    if (s.n_instances == 6 && s.n_objects == 4) {
         CHECK_EQ_INT(s.instances[0].object, 0);
         CHECK_EQ_INT(s.instances[1].object, 1);
         CHECK_EQ_INT(s.instances[2].object, 2);
         CHECK_EQ_INT(s.instances[3].object, 2);
+        CHECK_EQ_INT(s.instances[4].object, 3);
+        CHECK_EQ_INT(s.instances[5].object, 3);
         CHECK(strcmp(s.objects[1].name, "a#1") == 0);
         CHECK(strcmp(s.objects[2].name, "lamp") == 0);
     }
+    size_t outward = 0, glowing = 0;
+    /* the copy's centre: the object's sphere at (3, 0, 0) (the CTM at its Shape), placed
+     * by Translate 3 0 0, Translate 0 3 0, Scale 1 2 1 */
+    for (size_t i = 1; i < s.n_triangles; i++) {
+        const Triangle *t = &s.triangles[i];
+        vec3 w = v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0));
+        vec3 c = v3_sub(v3_scale(v3_add(v3_add(t->p0, t->p1), t->p2), 1.0f / 3.0f), v3(6, 3, 0));
+        outward += v3_dot(w, c) > 0;
+        glowing += !v3_is_zero(s.materials[t->material].emission);
+    }
+    CHECK_EQ_INT(outward, s.n_triangles - 1);
+    CHECK_EQ_INT(glowing, s.n_triangles - 1);
     CHECK_EQ_INT(s.n_warnings, 2);
     if (s.n_warnings == 2) {
-        CHECK_STR_CONTAINS(s.warnings[1], "inline.pbrt:8: ObjectInstance \"a\" under a singular transform is skipped");
-        CHECK_STR_CONTAINS(s.warnings[0], "inline.pbrt:7: ObjectBegin \"ball\" holds an emitting sphere: its shapes "
-                           "are copied at each ObjectInstance (an instance that is no similarity would make it an "
-                           "ellipsoid, which is no light)");
+        CHECK_STR_CONTAINS(s.warnings[0], "inline.pbrt:8: ObjectInstance \"ball\" holds an emitting sphere under a "
+                           "transform that is no similarity: its shapes are copied (an instanced ellipsoid is no "
+                           "light)");
+        CHECK_STR_CONTAINS(s.warnings[1], "inline.pbrt:9: ObjectInstance \"a\" under a singular transform is skipped");
     }
     scene_free(&s);
 
@@ -723,16 +739,20 @@ static void test_instances_stats(void)
     unlink(CLPT_BUILD_DIR "/test-pbrt-inst.pfm");
 }
 
-/* An emitting object: a quad lamp and a triangle lamp of two colours, with a dark
- * block, instanced three times (rotated; stretched; mirrored and scaled). Its emitting
- * triangles are lights under each instance (LIGHT_INSTANCED), so the instances render
- * the same mean as the shapes written out (lights of their own) within noise. */
+/* An emitting object: a quad lamp, a triangle lamp and a sphere lamp of three colours,
+ * with a dark block, placed three times (rotated; stretched; mirrored and scaled). Its
+ * emitting triangles are lights under each instance (LIGHT_INSTANCED), and its sphere
+ * under the two similarities; the stretched one is copied, its sphere a mesh light, as
+ * the shapes written out make it. So the scene renders the same mean as the shapes
+ * written out within noise, with as many lights. */
 #define LAMP_SHAPES                                                                                        \
     "  AttributeBegin AreaLightSource \"diffuse\" \"rgb L\" [5 4 3]\n"                                      \
     "    Shape \"trianglemesh\" \"point3 P\" [-0.4 1.5 -0.4 0.4 1.5 -0.4 0.4 1.5 0.4 -0.4 1.5 0.4]\n"         \
     "      \"integer indices\" [0 2 1 0 3 2] AttributeEnd\n"                                                 \
     "  AttributeBegin AreaLightSource \"diffuse\" \"rgb L\" [1 3 6]\n"                                      \
     "    Shape \"trianglemesh\" \"point3 P\" [0.6 0.2 0 1.1 0.2 0 0.8 0.9 0] AttributeEnd\n"                 \
+    "  AttributeBegin AreaLightSource \"diffuse\" \"rgb L\" [2 5 2]\n"                                      \
+    "    Translate -0.8 0.4 0 Shape \"sphere\" \"float radius\" 0.15 AttributeEnd\n"                         \
     "  Material \"diffuse\" \"rgb reflectance\" [0.6 0.6 0.3]\n"                                            \
     "  Shape \"trianglemesh\" \"point3 P\" [-0.5 0 -0.5 0.5 0 -0.5 0.5 1 0.5 -0.5 1 0.5]\n"                \
     "    \"integer indices\" [0 1 2 0 2 3]\n"
@@ -745,7 +765,7 @@ static const char lamp_inst[] = INST_HEAD "ObjectBegin \"lamp\"\n" LAMP_SHAPES "
     PLACE_LAMP(LAMP_B) PLACE_LAMP(LAMP_C);
 static const char lamp_copy[] = INST_HEAD COPY_LAMP(LAMP_A) COPY_LAMP(LAMP_B) COPY_LAMP(LAMP_C);
 
-/* The instanced lamps: objects and instances, no warning; the same mean as the copies
+/* The instanced lamps: an object, two instances and a copy, with its warning; the same mean as the copies
  * within noise; PoCL renders them bit for bit as the scalar device; --stats counts the
  * instances and their lights. */
 static void test_instanced_emitters(void)
@@ -754,8 +774,8 @@ static void test_instanced_emitters(void)
     Error err = { 0 };
     CHECK_MSG(load_text(lamp_inst, &s, &err) == ST_OK, "%s", err.msg);
     CHECK_EQ_INT(s.n_objects, 1);
-    CHECK_EQ_INT(s.n_instances, 3);
-    CHECK_EQ_INT(s.n_warnings, 0);
+    CHECK_EQ_INT(s.n_instances, 2);
+    CHECK_EQ_INT(s.n_warnings, 1);
     scene_free(&s);
     Film a, b, c;
     CHECK_MSG(render_text(lamp_inst, "scalar", &a, &err) == ST_OK, "%s", err.msg);
@@ -782,8 +802,8 @@ static void test_instanced_emitters(void)
     cli_run((const char *[]){ scene, "-q", "--device", "scalar", "--spp", "1", "--stats", "-o",
                               CLPT_BUILD_DIR "/test-pbrt-lamp.pfm", NULL }, &r);
     CHECK_EQ_INT(r.status, 0);
-    CHECK_STR_CONTAINS(r.out, "instances: 3 of 1 objects; triangles: 9 unique (5 in objects), 15 instanced");
-    /* as many lights as the copies make: each instance's quad and triangle */
+    CHECK_STR_CONTAINS(r.out, "instances: 2 of 1 objects; triangles: 3982 unique (5 in objects), 10 instanced");
+    /* as many lights as the copies make: each instance's quad, triangle and sphere */
     const char *lights = strstr(r.out, " materials, ");
     unlink(scene);
     write_temp(scene, sizeof scene, ".pbrt", lamp_copy);
@@ -1195,6 +1215,17 @@ static void test_loop_limits(void)
         expect_error(big, DIR "inline.pbrt:5:7: loopsubdiv to level 9 of 1 triangles makes 262144 triangles; with "
                      "the 1048576 tessellated before it that is past the 1080256 a scene of 495 bytes may make "
                      "(1048576 and 64 per byte of its files)");
+        /* an emitting sphere copied under a transform that is no similarity is a mesh,
+         * counted against the same budget at each ObjectInstance */
+        char *lamps = malloc(16384);
+        size_t m = (size_t)snprintf(lamps, 16384, "ObjectBegin \"b\" AreaLightSource \"diffuse\" \"rgb L\" [1 1 1] "
+                                    "Shape \"sphere\" ObjectEnd Scale 1 2 1\n");
+        for (int i = 0; i < 600; i++) m += (size_t)snprintf(lamps + m, 16384 - m, "ObjectInstance \"b\"\n");
+        /* 449 copies of 3,968 triangles fit 1048576 + 64 x 11495 bytes; the 450th does not */
+        expect_error(lamps, DIR "inline.pbrt:451:16: an emitting sphere copied under a transform that is no "
+                     "similarity, as a mesh, makes 3968 triangles; with the 1781632 tessellated before it that is past "
+                     "the 1784256 a scene of 11495 bytes may make (1048576 and 64 per byte of its files)");
+        free(lamps);
         /* a larger file may make more: the same five shapes after 4 KB of comments load */
         char *padded = malloc(8192);
         size_t n = 0;

@@ -77,10 +77,12 @@ typedef struct {
 } PPending;
 
 /* An ObjectBegin/End: a scene object its ObjectInstances place (docs/instancing.md),
- * or, when it emits light or holds no shapes, its shapes taken out of the scene and
- * copied in at each instance. */
+ * or, when it holds no shapes, its shapes taken out of the scene and copied in at each
+ * instance. An object with an emitting sphere keeps its shapes here too, for the
+ * instances that copy them (a transform that is no similarity: pbrt_shape.c). */
 typedef struct {
     uint object;          /* the scene's object, or NO_INDEX: copies of the arrays below */
+    int sphere_emits;     /* copy, rather than place, under a transform no similarity */
     Sphere *spheres;      size_t n_spheres;
     SphereXform *sphere_xforms;  size_t n_sphere_xforms;   /* Sphere.xform indexes this */
     Triangle *triangles;  size_t n_triangles;

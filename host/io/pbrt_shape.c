@@ -491,14 +491,13 @@ Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw)
  * ObjectEnd stay once in the scene, in the space their own CTM gives them, and each
  * ObjectInstance places them under the CTM of that moment (pbrt-v4's render-from-
  * instance is the CTM at ObjectInstance times world-from-render: the object's shapes
- * are not moved back by the CTM at ObjectBegin). Two kinds of object are copied in at
- * each instance instead, as the reader did before objects: one that holds an emitting
- * sphere, and one with no shapes (nothing to place). Emitting triangles are lights
- * under every instance (LIGHT_INSTANCED), but a sphere only under a similarity: an
+ * are not moved back by the CTM at ObjectBegin). An object with no shapes is copied in
+ * at each instance instead (nothing to place). Emitting triangles are lights under
+ * every instance (LIGHT_INSTANCED), but an emitting sphere only under a similarity: an
  * instance that squashes it makes an ellipsoid, which light sampling has no density
- * for. The instances' transforms come after ObjectEnd, so such an object is copied
- * whole, as before: a copy under a similarity is a sphere light, and under any other
- * CTM (instance_ellipsoid) its emitting sphere is still skipped with a warning. */
+ * for. So an object holding an emitting sphere keeps its shapes for copies too, and
+ * each ObjectInstance decides by its CTM: a similarity places an instance, any other
+ * copies the shapes, the emitting sphere as a mesh light (instance_ellipsoid). */
 #define PBRT_MAX_FLAT_TRIANGLES ((size_t)1 << 26)
 
 Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw)
@@ -555,11 +554,10 @@ static Status object_keep(Parser *p, PObject *o)
     return ST_OK;
 }
 
-/* The shapes since ObjectBegin taken out of the scene, to be copied in at each instance. */
-static Status object_take(Parser *p, PObject *o)
+/* The shapes since ObjectBegin saved in o, to be copied in at an instance. */
+static Status object_save(Parser *p, PObject *o)
 {
-    Scene *s = p->s;
-    o->object = NO_INDEX;
+    const Scene *s = p->s;
     o->n_spheres = s->n_spheres - p->obj_spheres;
     o->n_triangles = s->n_triangles - p->obj_triangles;
     o->n_shading = s->n_shading - p->obj_shading;
@@ -586,6 +584,16 @@ static Status object_take(Parser *p, PObject *o)
         if (o->triangles[i].shading != NO_INDEX) o->triangles[i].shading -= (uint)p->obj_shading;
     for (size_t i = 0; i < o->n_spheres; i++)
         if (o->spheres[i].xform) o->spheres[i].xform -= (uint)p->obj_sphere_xforms;
+    return ST_OK;
+}
+
+/* The shapes since ObjectBegin taken out of the scene, to be copied in at each instance. */
+static Status object_take(Parser *p, PObject *o)
+{
+    Scene *s = p->s;
+    o->object = NO_INDEX;
+    Status st = object_save(p, o);
+    if (st) return st;
     s->n_sphere_xforms = p->obj_sphere_xforms;
     s->n_spheres = p->obj_spheres;
     s->n_triangles = p->obj_triangles;
@@ -602,16 +610,17 @@ Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw)
     PObject o;
     memset(&o, 0, sizeof o);
     int empty = p->s->n_triangles == p->obj_triangles && p->s->n_spheres == p->obj_spheres;
-    int emits = !empty && object_sphere_emits(p);
-    Status st;
-    if (emits && (st = warn_once(p, lx, kw, "object-emits", "ObjectBegin \"%s\" holds an emitting sphere: its shapes "
-                                 "are copied at each ObjectInstance (an instance that is no similarity would make it "
-                                 "an ellipsoid, which is no light)", p->obj_name_buf)))
-        return st;
+    o.sphere_emits = !empty && object_sphere_emits(p);
     if (pbrt_grow((void **)&p->objects, &p->cap_objects, p->n_objects + 1, sizeof(PObject)))
         return error_set(p->err, ST_INTERNAL, "out of memory");
-    if ((st = empty || emits ? object_take(p, &o) : object_keep(p, &o)))
-        return st == ST_INPUT ? lex_error_at(lx, kw, p->err, "%s", p->err->msg) : st;
+    Status st = empty ? object_take(p, &o) : o.sphere_emits ? object_save(p, &o) : ST_OK;
+    if (!st && !empty && (st = object_keep(p, &o))) {
+        free(o.spheres);
+        free(o.sphere_xforms);
+        free(o.triangles);
+        free(o.shading);
+    }
+    if (st) return st == ST_INPUT ? lex_error_at(lx, kw, p->err, "%s", p->err->msg) : st;
     /* a name defined again replaces the earlier object, for the instances after it */
     if (strmap_set(&p->object_by_name, p->obj_name.text, p->obj_name.len, (uint32_t)p->n_objects)) {
         free(o.spheres);
@@ -627,13 +636,12 @@ Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw)
 }
 
 /* An object's sphere sp under the instance's transform when either makes it an
- * ellipsoid: the unit sphere under ctm . (sp's own transform). Emitting ones are
- * skipped with a warning (their lights would need a mesh, made per instance). */
+ * ellipsoid: the unit sphere under ctm . (sp's own transform). An emitting one is a
+ * mesh, as shape_sphere makes an emitting ellipsoid (sphere lights are sampled by their
+ * cone, which an ellipsoid has not); the object's sphere faced outwards (a reversed one
+ * was a mesh already), so its copy does too, whatever the instance's orientation. */
 static Status instance_ellipsoid(Parser *p, const Lexer *lx, const Token *name, const PObject *o, const Sphere *sp)
 {
-    if (!v3_is_zero(p->s->materials[sp->material].emission))
-        return warn_once(p, lx, name, "instance-sphere", "an emitting sphere in an instance whose transform is not a "
-                         "similarity (an ellipsoid) is skipped");
     Transform own;
     if (sp->xform) {
         const float *m = o->sphere_xforms[sp->xform - 1u].to_world;
@@ -645,6 +653,20 @@ static Status instance_ellipsoid(Parser *p, const Lexer *lx, const Token *name, 
         own = transform_compose(&t, &sc);
     }
     Transform m = transform_compose(&p->g.ctm, &own);
+    if (!v3_is_zero(p->s->materials[sp->material].emission)) {
+        Status st = tessellation_budget(p, lx, name, SPHERE_MESH_TRIANGLES, "an emitting sphere copied under a "
+                                        "transform that is no similarity, as a mesh,");
+        MeshSink k;
+        size_t first = p->s->n_triangles;
+        if (!st) st = mesh_sink_open(&k, p->s, &m, lx->path, p->err);
+        if (!st) st = sphere_tessellate(p, &k, 1.0, sp->material);
+        if (st) return st;
+        int reverse = p->g.reverse;
+        p->g.reverse = 0;
+        orient_triangles(p, first);
+        p->g.reverse = reverse;
+        return ST_OK;
+    }
     Status st = scene_add_ellipsoid(p->s, &m, sp->material, p->err);
     if (st == ST_INPUT) error_prefix(p->err, "%s:%u:%u: the instanced sphere", lx->path, name->line, name->col);
     return st;
@@ -671,8 +693,17 @@ Status pbrt_object_instance(Parser *p, Lexer *lx, const Token *kw)
     if (p->in_object)
         return lex_error_at(lx, kw, p->err, "ObjectInstance inside ObjectBegin \"%s\" (objects hold shapes, not "
                             "instances)", p->obj_name_buf);
-    if (p->objects[i].object != NO_INDEX) return instance_place(p, lx, &name, p->objects[i].object);
     const PObject *o = &p->objects[i];
+    double scale;
+    int similar = is_similarity(&p->g.ctm, &scale);
+    Transform inv;
+    if (o->object != NO_INDEX && (similar || !o->sphere_emits || !transform_invert(&p->g.ctm, &inv)))
+        return instance_place(p, lx, &name, o->object);
+    if (o->object != NO_INDEX &&
+        (st = warn_once(p, lx, &name, "instance-emits", "ObjectInstance \"%.*s\" holds an emitting sphere under a "
+                        "transform that is no similarity: its shapes are copied (an instanced ellipsoid is no light)",
+                        (int)(name.len > 60 ? 60 : name.len), name.text)))
+        return st;
     if (p->s->n_triangles + o->n_triangles > PBRT_MAX_FLAT_TRIANGLES)
         return lex_error_at(lx, &name, p->err, "the flattened instances would hold more than %zu triangles",
                             PBRT_MAX_FLAT_TRIANGLES);
@@ -698,8 +729,6 @@ Status pbrt_object_instance(Parser *p, Lexer *lx, const Token *kw)
         }
         st = mesh_sink_triangle(&k, q, has_n ? n : NULL, has_uv ? uv : NULL, tr->material);
     }
-    double scale;
-    int similar = is_similarity(&p->g.ctm, &scale);
     for (size_t j = 0; j < o->n_spheres && !st; j++) {
         if (!similar || o->spheres[j].xform) {
             st = instance_ellipsoid(p, lx, &name, o, &o->spheres[j]);

@@ -150,7 +150,9 @@ $(BUILD)/host/%.o: host/%.c $(BUILD)/.flags | $(VERSION_H)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(FILE_WARN) -MMD -MP -c -o $@ $<
 
-$(BUILD)/host/device/device_scalar.o: FILE_WARN := $(KERNEL_C_WARN)
+# The scalar device and its builds of the kernels (scalar_paths_NAME.c, each with its own
+# CLPT_FEATURES), all with the same FPFLAGS as every object.
+$(BUILD)/host/device/device_scalar.o $(BUILD)/host/device/scalar_paths_%.o: FILE_WARN := $(KERNEL_C_WARN)
 $(BUILD)/host/dist/mpi_driver.o $(BUILD)/host/dist/mpi_wire.o $(BUILD)/host/dist/mpi_workers.o: FILE_WARN := $(MPI_CFLAGS)
 
 $(BUILD)/lib$(PROG).a: $(HOST_OBJ)

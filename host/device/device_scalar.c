@@ -2,7 +2,9 @@
  * device_scalar.c — the scalar C device: the kernel stage functions of kernels/ compiled as
  * plain C (one source with the OpenCL build, through kernels/util/compat.h) and run by a pool
  * of pthreads. It is the reference the tests compare OpenCL against, and it renders when
- * no OpenCL platform is installed.
+ * no OpenCL platform is installed. The paths' code is compiled in a few builds, each with
+ * other kernel features (scalar_paths.h), and a scene runs on the leanest that has its
+ * features, as the OpenCL device compiles a program with the scene's features alone.
  *
  * Where the OpenCL device runs the stages as a wavefront (all paths intersect, then all
  * shade, ...), this device runs each path from birth to death before the next, calling
@@ -16,16 +18,12 @@
 #include <unistd.h>
 
 #include "device/device.h"
+#include "device/kernel_features.h"
+#include "device/scalar_paths.h"
 #include "base/timer.h"
 
-/* The kernel sources, compiled here as C. */
+/* The film's kernel source, compiled here as C; the paths' is in scalar_paths_*.c. */
 #include "film/film.h"
-#include "integrator/raygen.h"
-#include "integrator/shade_path.h"
-#include "accel/traverse.h"
-#include "accel/alpha.h"
-#include "integrator/path.h"
-#include "integrator/whitted.h"
 
 /* Paths (pixels x samples of the batch) handed to a worker at a time: small enough that
  * the workers finish a batch together (a chunk takes well under a millisecond), large
@@ -37,6 +35,8 @@
 typedef struct {
     RenderParams params;
     SceneView view;
+    unsigned scene_features;     /* the loaded scene's kernel features (kernel_features.h) */
+    const ScalarPaths *paths;    /* the leanest build of the kernels that has them */
     int64_t *film;
     int film_stale;              /* holds part of a cancelled batch: cleared before the next */
     int threads;
@@ -57,40 +57,6 @@ typedef struct {
                                   * NULL: not profiling */
 } CpuDevice;
 
-/* Renders one camera sample's path to its end (path_run, kernels/integrator/path.h, as k_path
- * does); returns the number of rays it traced. */
-static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *radiance)
-{
-    PathState ps;
-    Ray ray, shadow;
-    memset(&shadow, 0, sizeof shadow);   /* written by shade_path only when it traces one */
-    uint64_t rays = path_run(sc, pixel, sample, &ps, &ray, &shadow);
-    *radiance = ps.radiance;
-    return rays;
-}
-
-/* render_path with the thread time of each stage added to t[enum DevicePhase]
- * (--profile; the clock reads cost some of the speed): path_run's loop, timed. */
-static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, vec3 *radiance, double *t)
-{
-    PathState path;
-    Ray ray_buf, shadow;
-    memset(&shadow, 0, sizeof shadow);
-    PathState *ps = &path;
-    Ray *ray = &ray_buf, *shadow_ray = &shadow;
-    double t_last = timer_now();
-#define PATH_STAGE_TIMED(phase)            \
-    do {                                   \
-        double now = timer_now();          \
-        t[phase] += now - t_last;          \
-        t_last = now;                      \
-    } while (0)
-    PATH_RUN_BODY(PATH_STAGE_TIMED)
-#undef PATH_STAGE_TIMED
-    *radiance = ps->radiance;
-    return n_rays;
-}
-
 /* Whether the batch is to be dropped; checked before each chunk, so a cancel is seen
  * within a chunk's time (well under a millisecond) on every worker. */
 static int cancel_requested(CpuDevice *cd)
@@ -107,6 +73,7 @@ static void render_chunks(CpuDevice *cd)
     uint n_pixels = cd->params.pixel_list_size ? cd->params.pixel_list_size : cd->params.width * cd->params.height;
     uint64_t rays = 0;
     double t[PHASE_N] = { 0 };
+    const ScalarPaths *paths = cd->paths;
     for (;;) {
         if (cancel_requested(cd)) break;
         uint chunk = atomic_fetch_add(&cd->next_chunk, 1u);
@@ -118,13 +85,13 @@ static void render_chunks(CpuDevice *cd)
             for (uint s = 0; s < cd->count; s++) {
                 vec3 L;
                 if (cd->params.integrator == INTEGRATOR_PATH && cd->phases) {
-                    rays += render_path_timed(&cd->view, pixel, cd->first_sample + s, &L, t);
+                    rays += paths->path_timed(&cd->view, pixel, cd->first_sample + s, &L, t);
                 } else if (cd->params.integrator == INTEGRATOR_PATH) {
-                    rays += render_path(&cd->view, pixel, cd->first_sample + s, &L);
+                    rays += paths->path(&cd->view, pixel, cd->first_sample + s, &L);
                 } else {
                     /* the classic ray tracer and the auxiliary images: kernels/integrator/whitted.h */
                     uint n = 0;
-                    L = whitted_sample(&cd->view, pixel, cd->first_sample + s, &n);
+                    L = paths->whitted(&cd->view, pixel, cd->first_sample + s, &n);
                     rays += n;
                 }
                 double t0 = cd->phases ? timer_now() : 0.0;
@@ -172,6 +139,9 @@ static Status cpu_load_scene(Device *d, const DeviceScene *scene, Error *err)
     cd->params = scene->params;
     device_scene_view(scene, &cd->view);
     cd->view.params = &cd->params;
+    cd->scene_features = kernel_scene_features(scene);
+    cd->paths = scalar_paths_pick(cd->scene_features);
+    d->counters.kernel_build = cd->paths->name;
     d->n_pixels = n_pixels;
     d->max_in_flight = 1;
     return ST_OK;
@@ -185,6 +155,10 @@ static Status cpu_update_params(Device *d, const RenderParams *params, const uin
                          "was loaded for %ux%u", params->width, params->height, cd->params.width, cd->params.height);
     cd->params = *params;
     cd->view.pixel_list = pixel_list;
+    /* new params may ask for more (a background map, media): as ocl_update_params does */
+    cd->scene_features |= kernel_params_features(params);
+    cd->paths = scalar_paths_pick(cd->scene_features);
+    d->counters.kernel_build = cd->paths->name;
     return ST_OK;
 }
 

@@ -78,6 +78,9 @@ void render_stats_print_run(FILE *out, const ScheduleStats *st, uint spp, Device
             fprintf(out, "device %zu '%s': kernels %s in %.3f s, scene upload %.3f s; waves of %u paths, %s\n", i,
                    devs[i]->desc.name, c->from_cache ? "loaded from cache" : "compiled", c->compile_seconds,
                    c->upload_seconds, c->wave_paths, c->wave_run ? c->wave_run : "-");
+        else if (c->kernel_build)
+            fprintf(out, "device %zu '%s': kernels of its '%s' build, the leanest with the scene's features\n", i,
+                    devs[i]->desc.name, c->kernel_build);
     }
     fprintf(out, "%-32s %7s %12s %8s %8s %12s %10s %6s %s\n", "device", "batches", "samples", "busy s",
            "idle s", "Msamples/s", "Mrays/s", "share", "batch sizes (min/max/last spp)");

@@ -17,8 +17,8 @@
 
 /* path_run's loop, written once: STAGE(phase) follows each of its stages (enum
  * DevicePhase, host/device/device.h). path_run passes an empty one; the scalar device's
- * --profile (render_path_timed, device_scalar.c) reads its clock there. Uses sc,
- * pixel, sample, ps, ray and shadow_ray, and declares n_rays, the rays traced.
+ * --profile (render_path_timed, host/device/scalar_paths_impl.h) reads its clock there.
+ * Uses sc, pixel, sample, ps, ray and shadow_ray, and declares n_rays, the rays traced.
  * First-hit splitting (shade_path.h) keeps the camera ray and first hit, the continuations
  * still to go (known once the first hit is shaded) and whether the path restarts from
  * the first hit. One call of the walk: inlined twice, it made k_path 5-9% slower on the

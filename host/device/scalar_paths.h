@@ -1,0 +1,47 @@
+/*
+ * scalar_paths.h — the scalar device's per-sample code (a path to its end, timed or not,
+ * and a whitted sample), compiled more than once with different kernel features.
+ *
+ * The OpenCL device builds each scene's program with only the features the scene has
+ * (-D CLPT_FEATURES, kernels/types.h); C code is compiled once, so the scalar device
+ * ships a few builds of the same kernel source and picks the leanest one whose features
+ * cover the scene's. Without that, every scene pays for the code of the rarest ones:
+ * participating media (the checks at each bounce of shade_path) and instancing (the BVH
+ * walk's second level) made the scalar device 14% slower on scenes that have neither
+ * (docs/design.md, "One kernel source, two compilers", has the numbers).
+ * A switch only removes code a scene cannot reach, so every build renders the same bits.
+ *
+ * Each build is a file scalar_paths_NAME.c that sets CLPT_FEATURES and includes
+ * scalar_paths_impl.h, which defines its ScalarPaths.
+ */
+#ifndef CLPT_SCALAR_PATHS_H
+#define CLPT_SCALAR_PATHS_H
+
+#include <stdint.h>
+
+#include "scene_view.h"
+
+typedef struct ScalarPaths {
+    const char *name;     /* for --profile and the tests: "diffuse", "lean", "all" */
+    unsigned features;    /* the CLPT_FEATURES it was compiled with */
+    /* one camera sample's path to its end (path_run, kernels/integrator/path.h, as k_path
+     * runs it): its radiance; returns the rays it traced */
+    uint64_t (*path)(const SceneView *sc, uint pixel, uint sample, vec3 *radiance);
+    /* ... with the thread time of each stage added to t[enum DevicePhase] (--profile) */
+    uint64_t (*path_timed)(const SceneView *sc, uint pixel, uint sample, vec3 *radiance, double *t);
+    /* the classic ray tracer's and the auxiliary images' sample (kernels/integrator/whitted.h) */
+    vec3 (*whitted)(const SceneView *sc, uint pixel, uint sample, uint *rays);
+} ScalarPaths;
+
+/* The builds, leanest first (each file's comment says what it has): diffuse and emissive
+ * materials alone, without textures, cut-outs, background maps or delta lights; every
+ * feature but media and instances; every feature. */
+extern const ScalarPaths scalar_paths_diffuse;
+extern const ScalarPaths scalar_paths_lean;
+extern const ScalarPaths scalar_paths_all;
+
+/* The leanest build whose features include `features` (kernel_scene_features's, with
+ * kernel_params_features's); the build of everything when none is leaner. */
+const ScalarPaths *scalar_paths_pick(unsigned features);
+
+#endif /* CLPT_SCALAR_PATHS_H */

@@ -1,0 +1,71 @@
+/*
+ * scalar_paths_impl.h — one build of the scalar device's per-sample code (scalar_paths.h):
+ * the kernel sources compiled as plain C (one source with the OpenCL build, through
+ * kernels/util/compat.h) with the features CLPT_FEATURES names.
+ *
+ * Included once by each scalar_paths_NAME.c, which first defines
+ *   CLPT_FEATURES        the kernel features of this build (before anything includes
+ *                        kernels/types.h, which otherwise compiles everything)
+ *   SCALAR_PATHS         the name of the ScalarPaths it defines (scalar_paths_NAME)
+ *   SCALAR_PATHS_LABEL   its name as text ("NAME")
+ * Everything else here is static: each build's copy of the kernels is its own.
+ */
+#if !defined(CLPT_FEATURES) || !defined(SCALAR_PATHS) || !defined(SCALAR_PATHS_LABEL)
+#error "define CLPT_FEATURES, SCALAR_PATHS and SCALAR_PATHS_LABEL before including scalar_paths_impl.h"
+#endif
+
+#include <string.h>
+
+#include "device/device.h"
+#include "device/scalar_paths.h"
+#include "base/timer.h"
+
+/* The kernel sources, compiled here as C. */
+#include "integrator/raygen.h"
+#include "integrator/shade_path.h"
+#include "accel/traverse.h"
+#include "accel/alpha.h"
+#include "integrator/path.h"
+#include "integrator/whitted.h"
+
+/* Renders one camera sample's path to its end (path_run, kernels/integrator/path.h, as k_path
+ * does); returns the number of rays it traced. */
+static uint64_t render_path(const SceneView *sc, uint pixel, uint sample, vec3 *radiance)
+{
+    PathState ps;
+    Ray ray, shadow;
+    memset(&shadow, 0, sizeof shadow);   /* written by shade_path only when it traces one */
+    uint64_t rays = path_run(sc, pixel, sample, &ps, &ray, &shadow);
+    *radiance = ps.radiance;
+    return rays;
+}
+
+/* render_path with the thread time of each stage added to t[enum DevicePhase]
+ * (--profile; the clock reads cost some of the speed): path_run's loop, timed. */
+static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, vec3 *radiance, double *t)
+{
+    PathState path;
+    Ray ray_buf, shadow;
+    memset(&shadow, 0, sizeof shadow);
+    PathState *ps = &path;
+    Ray *ray = &ray_buf, *shadow_ray = &shadow;
+    double t_last = timer_now();
+#define PATH_STAGE_TIMED(phase)            \
+    do {                                   \
+        double now = timer_now();          \
+        t[phase] += now - t_last;          \
+        t_last = now;                      \
+    } while (0)
+    PATH_RUN_BODY(PATH_STAGE_TIMED)
+#undef PATH_STAGE_TIMED
+    *radiance = ps->radiance;
+    return n_rays;
+}
+
+const ScalarPaths SCALAR_PATHS = {
+    .name = SCALAR_PATHS_LABEL,
+    .features = CLPT_FEATURES,
+    .path = render_path,
+    .path_timed = render_path_timed,
+    .whitted = whitted_sample,
+};

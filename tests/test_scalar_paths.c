@@ -12,7 +12,7 @@
 #include "io/scene_load.h"
 #include "render/render_scene.h"
 
-static const ScalarPaths *const builds[] = { &scalar_paths_diffuse, &scalar_paths_lean, &scalar_paths_all };
+static const ScalarPaths *const builds[] = { &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all };
 #define N_BUILDS (sizeof builds / sizeof builds[0])
 
 /* Whether build b has every feature of `features`. */
@@ -21,10 +21,12 @@ static int covers(const ScalarPaths *b, unsigned features) { return (features & 
 /* For any feature set: a build that has it, and no leaner one would do. */
 static void test_pick_leanest(void)
 {
-    CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_MAT_EMISSIVE) == &scalar_paths_diffuse);
-    CHECK(scalar_paths_pick(KF_KDTREE | KF_SPHERES | KF_BOXES | KF_PLANES | KF_MAT_DIFFUSE) == &scalar_paths_diffuse);
+    CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_MAT_EMISSIVE) == &scalar_paths_basic);
+    CHECK(scalar_paths_pick(KF_KDTREE | KF_SPHERES | KF_BOXES | KF_PLANES | KF_MAT_DIFFUSE) == &scalar_paths_basic);
     CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_TEXTURES) == &scalar_paths_lean);
-    CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIELECTRIC) == &scalar_paths_lean);
+    CHECK(scalar_paths_pick(KF_BVH | KF_SPHERES | KF_MAT_METAL | KF_MAT_DIELECTRIC) == &scalar_paths_basic);
+    CHECK(scalar_paths_pick(KF_BVH | KF_MAT_PRINCIPLED) == &scalar_paths_lean);
+    CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_ENV_MAP) == &scalar_paths_lean);
     CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_DELTA_LIGHTS) == &scalar_paths_lean);
     CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_MEDIA) == &scalar_paths_all);
     CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_INSTANCES) == &scalar_paths_all);
@@ -105,10 +107,10 @@ static void check_scene(const char *path, int kdtree, const ScalarPaths *expect)
 
 static void test_cornell_box(void)
 {
-    check_scene("scenes/cornell-box.scene", 0, &scalar_paths_diffuse);
-    check_scene("scenes/cornell-box.scene", 1, &scalar_paths_diffuse);
+    check_scene("scenes/cornell-box.scene", 0, &scalar_paths_basic);
+    check_scene("scenes/cornell-box.scene", 1, &scalar_paths_basic);
 }
-static void test_one_weekend(void) { check_scene("scenes/one-weekend.scene", 0, &scalar_paths_lean); }
+static void test_one_weekend(void) { check_scene("scenes/one-weekend.scene", 0, &scalar_paths_basic); }
 static void test_materials(void) { check_scene("scenes/materials.scene", 0, &scalar_paths_lean); }
 static void test_fog(void) { check_scene("scenes/fog.scene", 0, &scalar_paths_all); }
 

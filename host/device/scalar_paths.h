@@ -22,7 +22,7 @@
 #include "scene_view.h"
 
 typedef struct ScalarPaths {
-    const char *name;     /* for --profile and the tests: "diffuse", "lean", "all" */
+    const char *name;     /* for --profile and the tests: "basic", "lean", "all" */
     unsigned features;    /* the CLPT_FEATURES it was compiled with */
     /* one camera sample's path to its end (path_run, kernels/integrator/path.h, as k_path
      * runs it): its radiance; returns the rays it traced */
@@ -33,10 +33,10 @@ typedef struct ScalarPaths {
     vec3 (*whitted)(const SceneView *sc, uint pixel, uint sample, uint *rays);
 } ScalarPaths;
 
-/* The builds, leanest first (each file's comment says what it has): diffuse and emissive
- * materials alone, without textures, cut-outs, background maps or delta lights; every
- * feature but media and instances; every feature. */
-extern const ScalarPaths scalar_paths_diffuse;
+/* The builds, leanest first (each file's comment says what it has): the basic materials
+ * (diffuse, metal, dielectric, emissive) without textures, cut-outs, background maps or
+ * delta lights; every feature but media and instances; every feature. */
+extern const ScalarPaths scalar_paths_basic;
 extern const ScalarPaths scalar_paths_lean;
 extern const ScalarPaths scalar_paths_all;
 

@@ -14,7 +14,8 @@
 #            with its arguments: sh DIR/run.sh OUT (GPU_CHECK_PARTS picks parts).
 # It makes the programs it packs first, then packs DIR as DIR.tar.xz (about 25 MB; DIR
 # itself grew to 59 MB, over the 64 MiB that one call carries with the working tree) and
-# removes DIR: there, `tar -xJf .gpu.tar.xz && sh .gpu/run.sh OUT`.
+# removes DIR: there, `tar -xJf .gpu.tar.xz && sh .gpu/run.sh OUT`. Unpack it in every
+# call: the machine keeps ignored build outputs between calls, not the unpacked DIR.
 set -eu
 build=${1:-build}
 dir=${2:-.gpu}

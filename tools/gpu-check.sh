@@ -24,7 +24,7 @@
 set -u
 # The tests run with the GPU as their OpenCL device, besides test_kernels (last); one
 # line, which tools/gpu-bundle.sh reads to pack them.
-image_tests="sampler render whitted envmap cubemap alpha curves mis gltf pbrt cli spawn bsdf media instance"
+image_tests="sampler render whitted envmap cubemap alpha curves mis gltf pbrt cli spawn bsdf media instance grid_media"
 build=${1:-build}
 out=${2:-gpu-check}
 dev=${GPU_CHECK_DEVICE:-gpu}    # another device spec tries the script out without a GPU
@@ -120,6 +120,12 @@ check instances scenes/instances.scene --width 192 --height 144 --spp 8
 check instances-megakernel scenes/instances.scene --width 192 --height 144 --spp 8 --wave-launch megakernel
 check coated scenes/coated.pbrt --width 160 --height 120 --spp 8
 check principled scenes/principled-extensions.scene --width 192 --height 144 --spp 8
+check smoke scenes/smoke.scene --width 160 --height 120 --spp 8
+check smoke-megakernel scenes/smoke.scene --width 160 --height 120 --spp 8 --wave-launch megakernel
+check instanced-lamps scenes/instanced-lamps.scene --width 160 --height 120 --spp 8
+check pbrt-instances scenes/pbrt-instances.pbrt --width 180 --height 90 --spp 8
+check adaptive scenes/cornell-box.scene --width 128 --height 128 --spp 64 --noise-threshold 0.05
+check adaptive-megakernel scenes/cornell-box.scene --width 128 --height 128 --spp 64 --noise-threshold 0.05 --wave-launch megakernel
 echo "$same same, $differ differ"
 fi
 

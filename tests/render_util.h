@@ -82,4 +82,24 @@ static inline double film_mean(const Film *f)
     return sum / (double)n;
 }
 
+/* Mean of each channel of a film. */
+static inline void film_channel_means(const Film *f, double mean[3])
+{
+    size_t n = (size_t)f->width * f->height;
+    float *rgb = malloc(n * 3 * sizeof *rgb);
+    film_resolve(f, rgb);
+    mean[0] = mean[1] = mean[2] = 0.0;
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) mean[c] += rgb[3 * i + c] / (double)n;
+    free(rgb);
+}
+
+/* Channel sums that are the same in two films of one size (bit-for-bit comparisons). */
+static inline size_t film_sums_same(const Film *a, const Film *b)
+{
+    size_t n = (size_t)a->width * a->height * 3u, same = 0;
+    for (size_t i = 0; i < n; i++) same += a->sum[i] == b->sum[i];
+    return same;
+}
+
 #endif /* CLPT_RENDER_UTIL_H */

@@ -995,13 +995,6 @@ static Status render_gltf(const char *path, const char *devices, int flatten, Fi
     return st;
 }
 
-static size_t sums_same(const Film *a, const Film *b)
-{
-    size_t n = (size_t)a->width * a->height * 3u, same = 0;
-    for (size_t i = 0; i < n; i++) same += a->sum[i] == b->sum[i];
-    return same;
-}
-
 /* Two renders of one scene whose rays differ by roundings: the same mean within noise. */
 static void check_same_scene(const char *what, const char *a_path, int a_flat, const char *b_path, int b_flat)
 {
@@ -1013,7 +1006,7 @@ static void check_same_scene(const char *what, const char *a_path, int a_flat, c
     CHECK_MSG(sb == ST_OK, "%s", err.msg);
     if (!sa && !sb) {
         double ma = film_mean(&a), mb = film_mean(&b);
-        size_t n = (size_t)a.width * a.height * 3u, same = sums_same(&a, &b);
+        size_t n = (size_t)a.width * a.height * 3u, same = film_sums_same(&a, &b);
         fprintf(stderr, "  %s: mean %.6f vs %.6f; %zu of %zu channel sums identical\n", what, ma, mb, same, n);
         CHECK(fabs(ma - mb) < 0.01 * mb);
         CHECK(same > n / 2);
@@ -1075,7 +1068,7 @@ static void test_instancing(void)
     Status sb = render_gltf(DIR_GLTF "instancing-gpu.gltf", "scalar", 0, &b, &err);
     CHECK_MSG(sb == ST_OK, "%s", err.msg);
     if (!sa && !sb) {
-        size_t n = (size_t)a.width * a.height * 3u, same = sums_same(&a, &b);
+        size_t n = (size_t)a.width * a.height * 3u, same = film_sums_same(&a, &b);
         fprintf(stderr, "  EXT_mesh_gpu_instancing: %zu of %zu channel sums identical on OpenCL and scalar\n", same, n);
         CHECK(same == n);
     }
@@ -1164,7 +1157,7 @@ static void test_instanced_emitters(void)
         CHECK(mb > 0 && fabs(ma - mb) < 0.01 * mb);
     }
     if (!st[0] && !st[2]) {
-        size_t n = (size_t)film[0].width * film[0].height * 3u, same = sums_same(&film[0], &film[2]);
+        size_t n = (size_t)film[0].width * film[0].height * 3u, same = film_sums_same(&film[0], &film[2]);
         fprintf(stderr, "  instanced emissive mesh: %zu of %zu channel sums identical on OpenCL and scalar\n", same, n);
         CHECK(same == n);
     }

@@ -109,21 +109,13 @@ static Status render(const char *text, const char *devices, int flatten, uint ac
     return st;
 }
 
-/* Channel sums that agree between two films, and the relative difference of the means. */
-static size_t films_same(const Film *a, const Film *b)
-{
-    size_t n = (size_t)a->width * a->height * 3u, same = 0;
-    for (size_t i = 0; i < n; i++) same += a->sum[i] == b->sum[i];
-    return same;
-}
-
 static void test_identity_bit_identical(void)
 {
     Film a, b;
     Error err = { 0 };
     CHECK_MSG(render(identity_scene, "scalar", 0, ACCEL_BVH, &a, &err) == ST_OK, "%s", err.msg);
     CHECK_MSG(render(identity_scene, "scalar", 1, ACCEL_BVH, &b, &err) == ST_OK, "%s", err.msg);
-    size_t n = (size_t)a.width * a.height * 3u, same = films_same(&a, &b);
+    size_t n = (size_t)a.width * a.height * 3u, same = film_sums_same(&a, &b);
     fprintf(stderr, "  identity instances: %zu of %zu channel sums identical to the copies\n", same, n);
     CHECK(same == n);
     film_free(&a);
@@ -138,7 +130,7 @@ static void test_moved_matches_flattened(void)
     CHECK_MSG(render(moved_scene, "scalar", 1, ACCEL_BVH, &b, &err) == ST_OK, "%s", err.msg);
     if (!a.sum || !b.sum) return;
     double ma = film_mean(&a), mb = film_mean(&b);
-    size_t n = (size_t)a.width * a.height * 3u, same = films_same(&a, &b);
+    size_t n = (size_t)a.width * a.height * 3u, same = film_sums_same(&a, &b);
     fprintf(stderr, "  moved instances: mean %.6f, copies %.6f; %zu of %zu channel sums identical\n", ma, mb, same, n);
     /* the lamp's light and 16 samples: the means of two renders of one scene whose
      * rays differ by roundings agree far closer than this */
@@ -155,7 +147,7 @@ static void test_kdtree_flattens(void)
     Error err = { 0 };
     CHECK_MSG(render(moved_scene, "scalar", 0, ACCEL_KDTREE, &a, &err) == ST_OK, "%s", err.msg);
     CHECK_MSG(render(moved_scene, "scalar", 1, ACCEL_KDTREE, &b, &err) == ST_OK, "%s", err.msg);
-    CHECK(films_same(&a, &b) == (size_t)a.width * a.height * 3u);
+    CHECK(film_sums_same(&a, &b) == (size_t)a.width * a.height * 3u);
     film_free(&a);
     film_free(&b);
     Scene s;
@@ -199,7 +191,7 @@ static void test_opencl_matches_scalar(void)
         Status sb = render(scenes[k], "scalar", 0, ACCEL_BVH, &b, &err);
         CHECK_MSG(sb == ST_OK, "%s", err.msg);
         if (sa == ST_OK && sb == ST_OK) {
-            size_t n = (size_t)a.width * a.height * 3u, same = films_same(&a, &b);
+            size_t n = (size_t)a.width * a.height * 3u, same = film_sums_same(&a, &b);
             fprintf(stderr, "  scene %zu: %zu of %zu channel sums identical on OpenCL and scalar\n", k, same, n);
             CHECK(same == n);
         }

@@ -145,18 +145,6 @@ static Status load_text(Scene *s, const char *text, Error *err)
     return scene_load_text("media-test.scene", text, strlen(text), s, err);
 }
 
-/* Mean of each channel of a film. */
-static void film_channel_means(const Film *f, double mean[3])
-{
-    size_t n = (size_t)f->width * f->height;
-    float *rgb = malloc(n * 3 * sizeof *rgb);
-    film_resolve(f, rgb);
-    mean[0] = mean[1] = mean[2] = 0.0;
-    for (size_t i = 0; i < n; i++)
-        for (int c = 0; c < 3; c++) mean[c] += rgb[3 * i + c] / (double)n;
-    free(rgb);
-}
-
 /* Renders `text` on `devices` and returns its channel means. */
 static int render_means(const char *text, const char *devices, double mean[3])
 {

@@ -677,13 +677,6 @@ static Status render_text(const char *text, const char *devices, Film *f, Error 
     return st;
 }
 
-static size_t sums_same(const Film *a, const Film *b)
-{
-    size_t n = (size_t)a->width * a->height * 3u, same = 0;
-    for (size_t i = 0; i < n; i++) same += a->sum[i] == b->sum[i];
-    return same;
-}
-
 /* An identity ObjectInstance renders bit for bit as its shapes written out; moved,
  * rotated, stretched and mirrored ones the same mean within noise; PoCL renders the
  * instances bit for bit as the scalar device. */
@@ -694,7 +687,7 @@ static void test_instances_render(void)
     CHECK_MSG(render_text(inst_identity, "scalar", &a, &err) == ST_OK, "%s", err.msg);
     CHECK_MSG(render_text(copy_identity, "scalar", &b, &err) == ST_OK, "%s", err.msg);
     if (a.sum && b.sum) {
-        size_t n = (size_t)a.width * a.height * 3u, same = sums_same(&a, &b);
+        size_t n = (size_t)a.width * a.height * 3u, same = film_sums_same(&a, &b);
         fprintf(stderr, "  identity ObjectInstance: %zu of %zu channel sums identical to the shapes written out\n",
                 same, n);
         CHECK(same == n);
@@ -705,7 +698,7 @@ static void test_instances_render(void)
     CHECK_MSG(render_text(copy_moved, "scalar", &b, &err) == ST_OK, "%s", err.msg);
     if (a.sum && b.sum) {
         double ma = film_mean(&a), mb = film_mean(&b);
-        size_t n = (size_t)a.width * a.height * 3u, same = sums_same(&a, &b);
+        size_t n = (size_t)a.width * a.height * 3u, same = film_sums_same(&a, &b);
         fprintf(stderr, "  moved ObjectInstances: mean %.6f, written out %.6f; %zu of %zu channel sums identical\n",
                 ma, mb, same, n);
         CHECK(fabs(ma - mb) < 0.01 * mb);
@@ -716,7 +709,7 @@ static void test_instances_render(void)
     Status sc = render_text(inst_moved, TEST_OPENCL, &c, &err);
     CHECK_MSG(sc == ST_OK, "%s", err.msg);
     if (!sc && a.sum) {
-        size_t n = (size_t)a.width * a.height * 3u, same = sums_same(&a, &c);
+        size_t n = (size_t)a.width * a.height * 3u, same = film_sums_same(&a, &c);
         fprintf(stderr, "  moved ObjectInstances: %zu of %zu channel sums identical on OpenCL and scalar\n", same, n);
         CHECK(same == n);
         film_free(&c);
@@ -789,7 +782,7 @@ static void test_instanced_emitters(void)
     Status sc = render_text(lamp_inst, TEST_OPENCL, &c, &err);
     CHECK_MSG(sc == ST_OK, "%s", err.msg);
     if (!sc && a.sum) {
-        size_t n = (size_t)a.width * a.height * 3u, same = sums_same(&a, &c);
+        size_t n = (size_t)a.width * a.height * 3u, same = film_sums_same(&a, &c);
         fprintf(stderr, "  instanced lamps: %zu of %zu channel sums identical on OpenCL and scalar\n", same, n);
         CHECK(same == n);
         film_free(&c);

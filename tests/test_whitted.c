@@ -681,7 +681,7 @@ static void test_adaptive(void)
     float *base = malloc(40 * 40 * 3 * sizeof *base), *rgb = malloc(40 * 40 * 3 * sizeof *rgb);
     film_resolve(&film, base);
     memcpy(rgb, base, 40 * 40 * 3 * sizeof *rgb);
-    PassContext pc = { devs, n_dev, &rs, &cfg };
+    PassContext pc = { .devices = devs, .n_devices = n_dev, .rs = &rs, .cfg = &cfg };
     size_t marked = 0;
     double secs = 0.0;
     CHECK(passes_adaptive(&pc, rgb, 1, 0.25f, 16, &marked, &secs, &err) == ST_OK);

@@ -40,10 +40,12 @@ static float lerp(float t, float a, float b) { return (1.0f - t) * a + t * b; }
 
 float noise3(float x, float y, float z)
 {
-    /* large coordinates would overflow the lattice's int */
-    x = fmodf(x, (float)(1 << 30));
-    y = fmodf(y, (float)(1 << 30));
-    z = fmodf(z, (float)(1 << 30));
+    /* large coordinates would overflow the lattice's int (below 2^30 fmodf changes
+     * nothing, and costs more than the rest of the lookup) */
+    const float wrap = (float)(1 << 30);
+    if (!(fabsf(x) < wrap)) x = fmodf(x, wrap);
+    if (!(fabsf(y) < wrap)) y = fmodf(y, wrap);
+    if (!(fabsf(z) < wrap)) z = fmodf(z, wrap);
     float fx = floorf(x), fy = floorf(y), fz = floorf(z);
     float dx = x - fx, dy = y - fy, dz = z - fz;
     int ix = (int)fx & 255, iy = (int)fy & 255, iz = (int)fz & 255;

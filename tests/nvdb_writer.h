@@ -30,6 +30,15 @@ static void nvdbw_u64(unsigned char *p, uint64_t v) { memcpy(p, &v, 8); }
 static void nvdbw_f32(unsigned char *p, float v) { memcpy(p, &v, 4); }
 static void nvdbw_f64(unsigned char *p, double v) { memcpy(p, &v, 8); }
 
+/* The metadata's name key, which NanoVDB's own reader (32.3, pbrt-v4's) compares
+ * before the name: h = 67 h + byte + (h >> 56) over the name's bytes. */
+static uint64_t nvdbw_name_key(const char *name)
+{
+    uint64_t h = 0;
+    for (const unsigned char *c = (const unsigned char *)name; *c; c++) h = h * 67u + *c + (h >> 56);
+    return h;
+}
+
 #define NVDBW_VERSION ((32u << 21) | (7u << 10) | 0u)
 
 /* One grid's buffer (malloc'd), its size in *len. */
@@ -51,7 +60,7 @@ static unsigned char *nvdbw_grid(const NvdbGrid *g, size_t *len)
     unsigned char *b = calloc(1, size);
     if (!b) return NULL;
     /* GridData */
-    nvdbw_u64(b + grid, 0x314244566f6e614eull);   /* "NanoVDB1" */
+    nvdbw_u64(b + grid, 0x304244566f6e614eull);   /* "NanoVDB0": older readers (pbrt-v4's 32.3) know only this */
     nvdbw_u64(b + grid + 8, ~0ull);               /* checksum disabled */
     nvdbw_u32(b + grid + 16, NVDBW_VERSION);
     nvdbw_u32(b + grid + 28, 1);                  /* grid count */
@@ -155,7 +164,7 @@ static unsigned char *nvdb_write(const NvdbGrid *grids, int n, unsigned codec, s
     }
     unsigned char *f = calloc(1, total);
     if (!f) return NULL;
-    nvdbw_u64(f, 0x324244566f6e614eull);   /* "NanoVDB2" */
+    nvdbw_u64(f, 0x304244566f6e614eull);   /* "NanoVDB0", as the grid's */
     nvdbw_u32(f + 8, NVDBW_VERSION);
     nvdbw_u16(f + 12, (uint16_t)n);
     nvdbw_u16(f + 14, (uint16_t)codec);
@@ -165,6 +174,7 @@ static unsigned char *nvdb_write(const NvdbGrid *grids, int n, unsigned codec, s
         unsigned char *m = f + at;
         nvdbw_u64(m, blen[i]);
         nvdbw_u64(m + 8, stored[i]);
+        nvdbw_u64(m + 16, nvdbw_name_key(g->name));
         nvdbw_u64(m + 24, (uint64_t)g->nx * g->ny * g->nz);
         nvdbw_u32(m + 32, g->type ? g->type : 1u);
         nvdbw_u32(m + 36, g->cls ? g->cls : 2u);

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "harness.h"
 #include "base/noise.h"
@@ -223,6 +224,34 @@ static void test_pbrt_nanovdb(void)
     error_clear(&err);
 }
 
+/* A map that puts the box beyond the scene's coordinates is refused with the line. */
+static void test_pbrt_nanovdb_far(void)
+{
+    char *data;
+    size_t len;
+    Error err = { 0 };
+    CHECK_EQ_INT(lex_read_file(NDIR "ramp.nvdb", &data, &len, &err), ST_OK);
+    if (!data) return;
+    double scale = 1e20;   /* the map's matD[0][0] (grid at 200, map at 296, matD at +88) */
+    memcpy(data + 200 + 296 + 88, &scale, sizeof scale);
+    char path[64];
+    snprintf(path, sizeof path, "/tmp/clpt-test-nanovdb-%d.nvdb", (int)getpid());
+    FILE *f = fopen(path, "wb");
+    CHECK(f && fwrite(data, 1, len, f) == len);
+    if (f) fclose(f);
+    free(data);
+    char text[256];
+    snprintf(text, sizeof text, "MakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" \"%s\"\n", path);
+    Scene s;
+    CHECK_EQ_INT(load_text(text, &s, &err), ST_INPUT);
+    CHECK_MSG(strcmp(err.msg, NDIR "inline.pbrt:1:63: MakeNamedMedium \"m\": the grid's index-to-world map and the "
+                     "transform place its box beyond the scene's coordinates (2^62) or squash it to nothing") == 0,
+              "got '%s'", err.msg);
+    scene_free(&s);
+    error_clear(&err);
+    remove(path);
+}
+
 /* The trilinear lookup of a cell-centred grid with its border clamped (docs/media.md). */
 static float grid_lookup(const float *d, const unsigned n[3], const double u[3])
 {
@@ -353,6 +382,7 @@ int main(void)
     RUN(test_resample);
     RUN(test_bad_files);
     RUN(test_pbrt_nanovdb);
+    RUN(test_pbrt_nanovdb_far);
     RUN(test_cloud);
     RUN(test_rgbgrid);
     return harness_report();

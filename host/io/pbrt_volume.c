@@ -94,10 +94,24 @@ static Status nanovdb_medium(Parser *p, const Lexer *lx, const Token *name, Medi
     vec3 hi = v3((float)(dense.hi[0] - dense.lo[0]), (float)(dense.hi[1] - dense.lo[1]),
                  (float)(dense.hi[2] - dense.lo[2]));
     uint grid;
-    st = scene_add_grid(p->s, dense.density, dense.nx, dense.ny, dense.nz, v3s(0.0f), hi, &world_from_box, &grid,
-                        p->err);
+    /* the file's map may be any finite affine map: the box must land inside the scene's
+     * coordinates, and the kernels' float matrix back to the grid must be finite */
+    int placeable = 1;
+    for (int c = 0; c < 8; c++) {
+        vec3 corner = transform_point(&world_from_box, v3(c & 1 ? hi.x : 0.0f, c & 2 ? hi.y : 0.0f, c & 4 ? hi.z : 0.0f));
+        placeable &= fabsf(corner.x) <= SCENE_MAX_COORDINATE && fabsf(corner.y) <= SCENE_MAX_COORDINATE &&
+                     fabsf(corner.z) <= SCENE_MAX_COORDINATE;
+    }
+    st = placeable ? scene_add_grid(p->s, dense.density, dense.nx, dense.ny, dense.nz, v3s(0.0f), hi, &world_from_box,
+                                    &grid, p->err)
+                   : ST_OK;
     free(dense.density);
     if (st) return st;
+    for (int i = 0; placeable && i < 12; i++) placeable = isfinite(p->s->grids[grid].to_grid[i]);
+    if (!placeable)
+        return lex_error_at(lx, f, p->err, "MakeNamedMedium \"%.*s\": the grid's index-to-world map and the "
+                            "transform place its box beyond the scene's coordinates (2^62) or squash it to nothing",
+                            NAME_LEN(name), name->text);
     if (dense.stride > 1u) {
         char key[96];
         snprintf(key, sizeof key, "nanovdb-stride:%.*s", NAME_LEN(name), name->text);

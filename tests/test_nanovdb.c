@@ -141,7 +141,7 @@ static void test_bad_files(void)
     expect_bad(BAD "nvdb-type.nvdb.gz",
                BAD "nvdb-type.nvdb.gz: grid \"density\" holds double values (type 2); clpt reads float grids");
     expect_bad(BAD "nvdb-offset.nvdb.gz",
-               BAD "nvdb-offset.nvdb.gz: grid \"density\": the node at byte 736 of the grid points to a upper node at "
+               BAD "nvdb-offset.nvdb.gz: grid \"density\": the node at byte 736 of the grid points to an upper node at "
                "offset 1099511627776, outside the grid's 307232 bytes");
     expect_bad(BAD "nvdb-grid-size.nvdb.gz",
                BAD "nvdb-grid-size.nvdb.gz: grid \"density\" claims 307432 bytes but stores 307232 uncompressed");

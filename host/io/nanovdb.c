@@ -277,7 +277,7 @@ static Status child_at(Walk *w, size_t node, int64_t off, size_t size, const cha
 {
     int64_t at = (int64_t)node + off;
     if (off == 0 || at < 0 || (uint64_t)at > w->blen || w->blen - (size_t)at < size)
-        return error_set(w->err, ST_INPUT, "%s: grid \"%s\": the node at byte %zu of the grid points to a %s at offset %" PRId64
+        return error_set(w->err, ST_INPUT, "%s: grid \"%s\": the node at byte %zu of the grid points to %s at offset %" PRId64
                          ", outside the grid's %zu bytes", w->path, w->name, node, what, off, w->blen);
     *child = (size_t)at;
     return ST_OK;
@@ -318,7 +318,7 @@ static Status visit_lower(Walk *w, size_t lower, const int64_t o[3])
         const unsigned char *entry = w->b + lower + LOWER_OFF_TABLE + 8u * n;
         if ((rd32(w->b + lower + LOWER_OFF_CHILD_MASK + 4u * (n >> 5)) >> (n & 31u)) & 1u) {
             size_t leaf;
-            if ((st = child_at(w, lower, (int64_t)rd64(entry), LEAF_SIZE, "leaf node", &leaf)) ||
+            if ((st = child_at(w, lower, (int64_t)rd64(entry), LEAF_SIZE, "a leaf node", &leaf)) ||
                 (st = visit_leaf(w, leaf, c)))
                 return st;
         } else if ((st = add_tile(w, c, 8, rdf(entry)))) {
@@ -340,7 +340,7 @@ static Status visit_upper(Walk *w, size_t upper, const int64_t o[3])
         const unsigned char *entry = w->b + upper + UPPER_OFF_TABLE + 8u * n;
         if ((rd32(w->b + upper + UPPER_OFF_CHILD_MASK + 4u * (n >> 5)) >> (n & 31u)) & 1u) {
             size_t lower;
-            if ((st = child_at(w, upper, (int64_t)rd64(entry), LOWER_SIZE, "lower node", &lower)) ||
+            if ((st = child_at(w, upper, (int64_t)rd64(entry), LOWER_SIZE, "a lower node", &lower)) ||
                 (st = visit_lower(w, lower, c)))
                 return st;
         } else if ((st = add_tile(w, c, 128, rdf(entry)))) {
@@ -494,7 +494,7 @@ Status nanovdb_read_grid(const char *path, const unsigned char *data, size_t len
             if ((st = add_tile(&w, o, 4096, rdf(tile + TILE_OFF_VALUE)))) goto done;
         } else if (overlaps(&w, o, 4096)) {
             size_t upper;
-            if ((st = child_at(&w, root, child, UPPER_SIZE, "upper node", &upper)) ||
+            if ((st = child_at(&w, root, child, UPPER_SIZE, "an upper node", &upper)) ||
                 (st = visit_upper(&w, upper, o)))
                 goto done;
         }

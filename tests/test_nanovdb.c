@@ -330,6 +330,24 @@ static void test_cloud(void)
     scene_free(&s);
 }
 
+/* Grids made at load are bounded in all: a scene whose grids already hold nearly 2^27
+ * values refuses another (the count is set by hand: nothing that large is allocated). */
+static void test_grid_budget(void)
+{
+    const char *text = "MakeNamedMedium \"c\" \"string type\" \"cloud\"\n";
+    Scene s;
+    Error err = { 0 };
+    scene_init(&s);
+    s.n_grid_data = (1u << 27) - 1000u;
+    CHECK_EQ_INT(scene_load_bytes(NDIR "inline.pbrt", text, strlen(text), SCENE_FORMAT_AUTO, &s, NULL, &err),
+                 ST_INPUT);
+    CHECK_MSG(strcmp(err.msg, NDIR "inline.pbrt:1:17: MakeNamedMedium \"c\": its grid of 3869893 cells would take "
+                     "the scene's density grids past 2^27 values (512 MiB)") == 0, "got '%s'", err.msg);
+    s.n_grid_data = 0;
+    scene_free(&s);
+    error_clear(&err);
+}
+
 /* MakeNamedMedium "rgbgrid": one density (each voxel's luminance of sigma_a + sigma_s)
  * times one colour (the totals over the densities' total). */
 static void test_rgbgrid(void)
@@ -385,5 +403,6 @@ int main(void)
     RUN(test_pbrt_nanovdb_far);
     RUN(test_cloud);
     RUN(test_rgbgrid);
+    RUN(test_grid_budget);
     return harness_report();
 }

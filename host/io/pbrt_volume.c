@@ -49,6 +49,19 @@ static Status coefficients(Parser *p, const Lexer *lx, const Token *name, int re
     return ST_OK;
 }
 
+/* The values the density grids of one scene may hold once a grid made at load (a
+ * NanoVDB file's, a baked cloud) is added: 2^27 floats, 512 MiB. A few bytes of scene
+ * text can ask for a 16 MiB cloud or a file's 64 MiB grid, again and again; this bounds
+ * the memory (and a cloud's bake, about 3 s a 2^22 cells, to 32 of them). */
+#define PBRT_MADE_GRID_BUDGET (1u << 27)
+
+static Status grid_budget(Parser *p, const Lexer *lx, const Token *name, size_t cells)
+{
+    if (cells <= PBRT_MADE_GRID_BUDGET && p->s->n_grid_data <= PBRT_MADE_GRID_BUDGET - cells) return ST_OK;
+    return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": its grid of %zu cells would take the scene's "
+                        "density grids past 2^27 values (512 MiB)", NAME_LEN(name), name->text, cells);
+}
+
 /* ------------------------------------------------------------------ nanovdb */
 
 /* "filename" (beside the main file), "gridname" (default "density"); the temperature
@@ -96,6 +109,11 @@ static Status nanovdb_medium(Parser *p, const Lexer *lx, const Token *name, Medi
     uint grid;
     /* the file's map may be any finite affine map: the box must land inside the scene's
      * coordinates, and the kernels' float matrix back to the grid must be finite */
+    size_t cells = (size_t)dense.nx * dense.ny * dense.nz;
+    if ((st = grid_budget(p, lx, name, cells))) {
+        free(dense.density);
+        return st;
+    }
     int placeable = 1;
     for (int c = 0; c < 8; c++) {
         vec3 corner = transform_point(&world_from_box, v3(c & 1 ? hi.x : 0.0f, c & 2 ? hi.y : 0.0f, c & 4 ? hi.z : 0.0f));
@@ -222,6 +240,7 @@ static Status cloud_medium(Parser *p, const Lexer *lx, const Token *name, Medium
     unsigned n[3];
     pbrt_cloud_resolution(lo, hi, (float)freq, n);
     size_t cells = (size_t)n[0] * n[1] * n[2];
+    if ((st = grid_budget(p, lx, name, cells))) return st;
     float *d = malloc(cells * sizeof(float));
     if (!d) return error_set(p->err, ST_INTERNAL, "out of memory for the cloud \"%.*s\"", NAME_LEN(name), name->text);
     for (unsigned z = 0; z < n[2]; z++)

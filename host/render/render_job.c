@@ -154,6 +154,25 @@ Status render_job_open_devices(RenderJob *job, Error *err)
     return st;
 }
 
+void render_job_take_devices(RenderJob *job, Device ***devs, size_t *n_devs)
+{
+    *devs = job->devs;
+    *n_devs = job->n_devs;
+    job->devs = NULL;
+    job->n_devs = job->n_local_devs = 0;
+}
+
+Status render_job_adopt_devices(RenderJob *job, Device **devs, size_t n_devs, Error *err)
+{
+    job->devs = devs;
+    job->n_devs = job->n_local_devs = n_devs;
+    for (size_t i = 0; i < n_devs; i++) {
+        Status st = devs[i]->ops->load_scene(devs[i], &job->rs.ds, err);
+        if (st) return st;
+    }
+    return ST_OK;
+}
+
 /* ------------------------------------------------------------------ the render */
 
 static void job_warning(void *vjob, const char *msg)

@@ -101,6 +101,14 @@ Status render_job_prepare_film(RenderJob *job, int keyed, int skip_resume, Error
 /* The chosen devices (device_open_all), each given the scene. */
 Status render_job_open_devices(RenderJob *job, Error *err);
 
+/* An animation's next frame (docs/animation.md) renders on the devices the frame before
+ * opened: render_job_take_devices hands them out of the finished job (which then frees
+ * none), render_job_adopt_devices gives each the new job's scene. A device keeps the
+ * programs it built while the scene needs no feature they lack (device.h, load_scene),
+ * so the frames compile nothing again: only the scene's buffers are uploaded. */
+void render_job_take_devices(RenderJob *job, Device ***devs, size_t *n_devs);
+Status render_job_adopt_devices(RenderJob *job, Device **devs, size_t n_devs, Error *err);
+
 /* The scheduler's settings from the job's: spp, the resumed samples, the range, the
  * time limit, the batch, checkpoints, warnings; ctx the job. The caller adds its own
  * hooks (progress, ticks, the stop flag) after. */

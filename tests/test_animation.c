@@ -461,6 +461,17 @@ static void test_cli_frames(void)
     CHECK(!files_equal(CLI_DIR "/out_0023.pfm", CLI_DIR "/out_0024.pfm"));
     CHECK(!files_equal(CLI_DIR "/out_0024.pfm", CLI_DIR "/out_0025.pfm"));
     CHECK(file_size(CLI_DIR "/out_0023.pfm") > 24 * 16 * 12);
+    /* the OpenCL device (PoCL): the same bits, its kernels compiled (or loaded) once
+     * for the three frames */
+    const char *a0[] = { "--device", TEST_OPENCL, base[2], base[3], base[4], base[5], base[6], base[7], "--frames",
+                         "23:25", "-o", CLI_DIR "/ocl.pfm", CLI_DIR "/anim.gltf", NULL };
+    cli_run(a0, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    const char *c1 = strstr(r.err, "compiling kernels");
+    CHECK_MSG(!c1 || !strstr(c1 + 1, "compiling kernels"), "compiled more than once: %s", r.err);
+    CHECK(files_equal(CLI_DIR "/ocl_0023.pfm", CLI_DIR "/out_0023.pfm"));
+    CHECK(files_equal(CLI_DIR "/ocl_0024.pfm", CLI_DIR "/out_0024.pfm"));
+    CHECK(files_equal(CLI_DIR "/ocl_0025.pfm", CLI_DIR "/out_0025.pfm"));
     /* a rerun skips the frames that are there: one removed is made again, the same */
     (void)system("mv " CLI_DIR "/out_0024.pfm " CLI_DIR "/first_0024.pfm");
     const char *a2[] = { base[0], base[1], base[2], base[3], base[4], base[5], base[6], base[7], "--frames", "23:25",

@@ -410,8 +410,8 @@ static long frames_last_of(const Run *r)
 static Status frames_check(const Run *r, Error *err)
 {
     if (!r->scene.animation)
-        return error_set(err, ST_USAGE, "--frames renders the animation of a glTF file given as the scene; '%s' is "
-                         "none", r->o.scene_path);
+        return error_set(err, ST_USAGE, "--frames renders the animation of a glTF file given as the scene, or a "
+                         "clpt scene's camera_path; '%s' has neither", r->o.scene_path);
     long last = frames_last_of(r);
     if (r->o.frames_last > last)
         return error_set(err, ST_USAGE, "--frames %ld:%ld: frame %ld (at %g s) is after the end of the animation of "

@@ -4,9 +4,12 @@
  * a time (io/gltf_anim.c) makes the same scene, and the same image bit for bit, as a
  * static file whose nodes hold the pose evaluated for that time (a mesh copied, a mesh
  * instanced, the camera), posed again after a render too; bad animations give their
- * exact messages with the JSON path. The program's --frames is tested in
- * test_cli_frames below: numbered images that differ, a rerun that skips the frames
- * written, a frame resumed from its checkpoint, and the flags' errors.
+ * exact messages with the JSON path. clpt's camera_path: its values between and at keys
+ * (linear, step, Catmull-Rom), and a frame at a key renders as the camera block of the
+ * key's values. The program's --frames is tested in test_cli_frames below: numbered
+ * images that differ, the same on PoCL, a rerun that skips the frames written, a frame
+ * resumed from its checkpoint, a camera path's frame, and the flags' errors. (The
+ * camera_path's syntax errors are files in tests/data/bad/, test_bad_input.c.)
  */
 #include <math.h>
 #include <stdio.h>
@@ -428,6 +431,102 @@ static void test_bad_documents(void)
     free(doc);
 }
 
+/* ------------------------------------------------------------------ camera paths */
+
+#define PATH_SCENE_REST                                                                                  \
+    "material red { type diffuse albedo 0.8 0.1 0.1 }\n"                                                \
+    "sphere { center 0 0.5 0 radius 0.5 material red }\n"                                               \
+    "plane { point 0 0 0 normal 0 1 0 material red }\n"                                                 \
+    "light { type point position 2 4 2 intensity 30 30 30 }\n"
+
+static Status load_path_scene(const char *interp, int animated, Scene *s, Error *err)
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "image { width 24 height 16 spp 2 depth 2 }\n"
+             "camera { from 0 1 6 at 0 0.5 0 fov 40 }\n"
+             "camera_path { interpolation %s\n"
+             "    key 0 { }\n"
+             "    key 1 { from 3 1.5 5 fov 30 }\n"
+             "    key 2 { from 5 2 0 at 0 0.3 0 }\n"
+             "}\n" PATH_SCENE_REST, interp);
+    scene_init(s);
+    s->keep_animation = animated;
+    return scene_load_bytes("path.scene", text, strlen(text), SCENE_FORMAT_AUTO, s, NULL, err);
+}
+
+/* The camera at time t of a path with interpolation `interp`. */
+static SceneCamera path_camera(const char *interp, double t)
+{
+    Scene s;
+    Error err = { 0 };
+    SceneCamera c;
+    memset(&c, 0, sizeof c);
+    Status st = load_path_scene(interp, 1, &s, &err);
+    CHECK_MSG(st == ST_OK && s.animation, "%s: %s", interp, err.msg);
+    if (st == ST_OK && s.animation) {
+        CHECK(s.animation->end == 2.0);
+        CHECK(s.animation->pose(s.animation, &s, t, &err) == ST_OK);
+        c = s.camera;
+    }
+    scene_free(&s);
+    return c;
+}
+
+static void test_camera_path_values(void)
+{
+    /* a plain load keeps no animation and looks through the camera block */
+    Scene s;
+    Error err = { 0 };
+    CHECK(load_path_scene("linear", 0, &s, &err) == ST_OK);
+    CHECK(s.animation == NULL && s.camera.from.z == 6.0f && s.camera.vfov == 40.0f);
+    scene_free(&s);
+    /* at a key: its values, the rest the keys' before it */
+    SceneCamera c = path_camera("linear", 1.0);
+    CHECK(c.from.x == 3.0f && c.from.y == 1.5f && c.from.z == 5.0f && c.at.y == 0.5f && c.vfov == 30.0f);
+    c = path_camera("linear", 0.5);
+    CHECK(c.from.x == 1.5f && c.from.y == 1.25f && c.from.z == 5.5f && c.vfov == 35.0f);
+    c = path_camera("linear", 1.5);
+    CHECK(c.from.x == 4.0f && c.at.y == 0.4f && c.vfov == 30.0f);
+    c = path_camera("linear", 9.0);   /* after the end: the last key */
+    CHECK(c.from.x == 5.0f && c.from.z == 0.0f && c.at.y == 0.3f);
+    c = path_camera("step", 1.999);
+    CHECK(c.from.x == 3.0f && c.at.y == 0.5f);
+    /* smooth: Catmull-Rom tangents (3 - 0) / 1 at key 0 (one-sided), (5 - 0) / 2 at
+     * key 1; at u = 1/2 of [0, 1]: 0/2 + 3/8 + 3/2 - 2.5/8 = 1.5625 */
+    c = path_camera("smooth", 0.5);
+    CHECK(c.from.x == 1.5625f);
+    c = path_camera("smooth", 1.0);
+    CHECK(c.from.x == 3.0f && c.vfov == 30.0f);
+}
+
+/* A frame at a key renders what the camera block of the key's values renders. */
+static void test_camera_path_frame(void)
+{
+    Scene moving, still;
+    Error err = { 0 };
+    CHECK(load_path_scene("smooth", 1, &moving, &err) == ST_OK);
+    static const char text[] = "image { width 24 height 16 spp 2 depth 2 }\n"
+                               "camera { from 3 1.5 5 at 0 0.5 0 fov 30 }\n" PATH_SCENE_REST;
+    scene_init(&still);
+    CHECK(scene_load_bytes("still.scene", text, strlen(text), SCENE_FORMAT_AUTO, &still, NULL, &err) == ST_OK);
+    Film a, b;
+    memset(&a, 0, sizeof a);
+    memset(&b, 0, sizeof b);
+    if (moving.animation && moving.animation->pose(moving.animation, &moving, 0.3, &err) == ST_OK &&
+        render_sums(&moving, &a)) {
+        film_free(&a);
+        /* posed again after a render */
+        CHECK(moving.animation->pose(moving.animation, &moving, 1.0, &err) == ST_OK);
+        CHECK(memcmp(&moving.camera, &still.camera, sizeof still.camera) == 0);
+        if (render_sums(&moving, &a) && render_sums(&still, &b)) CHECK(films_equal(&a, &b));
+    }
+    film_free(&a);
+    film_free(&b);
+    scene_free(&moving);
+    scene_free(&still);
+}
+
 /* ------------------------------------------------------------------ the program */
 
 #define CLI_DIR "build/tests/frames-cli"
@@ -496,6 +595,27 @@ static void test_cli_frames(void)
     CHECK_STR_CONTAINS(r.err, "resuming from '" CLI_DIR "/ck_0024.ckpt': 1 samples per pixel already done, growing "
                               "the render from 1 to 2");
     CHECK(files_equal(CLI_DIR "/resumed_0024.pfm", CLI_DIR "/first_0024.pfm"));
+    /* clpt's camera_path: frame 1 at --fps 1 is key 1, what the camera block of its
+     * values renders */
+    static const char path_text[] = "image { width 24 height 16 spp 2 depth 2 }\n"
+                                    "camera { from 0 1 6 at 0 0.5 0 fov 40 }\n"
+                                    "camera_path { key 0 { } key 1 { from 3 1.5 5 fov 30 } }\n" PATH_SCENE_REST;
+    static const char still_text[] = "image { width 24 height 16 spp 2 depth 2 }\n"
+                                     "camera { from 3 1.5 5 at 0 0.5 0 fov 30 }\n" PATH_SCENE_REST;
+    FILE *pf = fopen(CLI_DIR "/path.scene", "w"), *sf = fopen(CLI_DIR "/still.scene", "w");
+    if (pf) fputs(path_text, pf);
+    if (sf) fputs(still_text, sf);
+    if (pf) fclose(pf);
+    if (sf) fclose(sf);
+    const char *a5[] = { "--device", "scalar", "-q", "--frames", "0:1", "--fps", "1", "-o", CLI_DIR "/path.pfm",
+                         CLI_DIR "/path.scene", NULL };
+    cli_run(a5, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    const char *a6[] = { "--device", "scalar", "-q", "-o", CLI_DIR "/still.pfm", CLI_DIR "/still.scene", NULL };
+    cli_run(a6, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    CHECK(files_equal(CLI_DIR "/path_0001.pfm", CLI_DIR "/still.pfm"));
+    CHECK(file_exists(CLI_DIR "/path_0000.pfm") && !files_equal(CLI_DIR "/path_0000.pfm", CLI_DIR "/still.pfm"));
 }
 
 static void test_cli_errors(void)
@@ -521,8 +641,8 @@ static void test_cli_errors(void)
     const char *a5[] = { "--frames", "0:1", "-o", CLI_DIR "/x.png", "scenes/cornell-box.scene", NULL };
     cli_run(a5, &r);
     CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --frames renders the animation of a glTF file given as the scene; "
-                              "'scenes/cornell-box.scene' is none");
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --frames renders the animation of a glTF file given as the scene, or a "
+                              "clpt scene's camera_path; 'scenes/cornell-box.scene' has neither");
     const char *a6[] = { "--frames", "1", CLI_DIR "/anim.gltf", NULL };
     cli_run(a6, &r);
     CHECK(r.status == ST_USAGE);
@@ -540,6 +660,8 @@ int main(void)
     RUN(test_pose_equals_static);
     RUN(test_bad_animations);
     RUN(test_bad_documents);
+    RUN(test_camera_path_values);
+    RUN(test_camera_path_frame);
     RUN(test_cli_frames);
     RUN(test_cli_errors);
     return harness_report();

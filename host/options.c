@@ -188,10 +188,11 @@
         "PART); -o gets the part's own image") \
     X(OUTPUT, CUSTOM, frames_first, "--frames", NULL, "A:B", PARSE(parse_frames), \
         "render frames A to B (both included) of a glTF\n" \
-        "file's animation, frame k at k/FPS seconds, each\n" \
-        "to its own numbered image: -o out.png gives\n" \
-        "out_0000.png ...; frames already written are\n" \
-        "skipped (docs/animation.md)") \
+        "file's animation or a scene's camera_path,\n" \
+        "frame k at k/FPS seconds, each to its own\n" \
+        "numbered image: -o out.png gives out_0000.png\n" \
+        "...; frames already written are skipped\n" \
+        "(docs/animation.md)") \
     X(OUTPUT, CUSTOM, fps, "--fps", NULL, "FPS", PARSE(parse_fps), \
         "frames per second of animation time for\n" \
         "--frames (default 24)") \

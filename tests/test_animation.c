@@ -595,6 +595,26 @@ static void test_cli_frames(void)
     CHECK_STR_CONTAINS(r.err, "resuming from '" CLI_DIR "/ck_0024.ckpt': 1 samples per pixel already done, growing "
                               "the render from 1 to 2");
     CHECK(files_equal(CLI_DIR "/resumed_0024.pfm", CLI_DIR "/first_0024.pfm"));
+    /* an unfinished frame (its time limit) writes its checkpoint and no image, exit
+     * status 7; --resume finishes it, the same bits as the frame rendered at once */
+    const char *a7[] = { base[0], base[1], "--spp", "64", base[4], base[5], base[6], base[7], "--batch", "1",
+                         "--time-limit", "0.001", "--frames", "24:24", "--checkpoint", CLI_DIR "/ck2.ckpt", "-o",
+                         CLI_DIR "/cut.pfm", CLI_DIR "/anim.gltf", NULL };
+    cli_run(a7, &r);
+    CHECK_MSG(r.status == 7, "status %d: %s", r.status, r.err);
+    CHECK_STR_CONTAINS(r.err, "clpt: the frame is unfinished: '" CLI_DIR "/cut_0024.pfm' is not written; --resume "
+                              "goes on from its checkpoint");
+    CHECK(!file_exists(CLI_DIR "/cut_0024.pfm") && file_exists(CLI_DIR "/ck2_0024.ckpt"));
+    const char *a8[] = { base[0], base[1], "--spp", "64", base[4], base[5], base[6], base[7], base[8], "--batch", "1",
+                         "--frames", "24:24", "--resume", CLI_DIR "/ck2.ckpt", "-o", CLI_DIR "/cut.pfm",
+                         CLI_DIR "/anim.gltf", NULL };
+    cli_run(a8, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    const char *a9[] = { base[0], base[1], "--spp", "64", base[4], base[5], base[6], base[7], base[8], "--frames",
+                         "24:24", "-o", CLI_DIR "/whole.pfm", CLI_DIR "/anim.gltf", NULL };
+    cli_run(a9, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    CHECK(files_equal(CLI_DIR "/cut_0024.pfm", CLI_DIR "/whole_0024.pfm"));
     /* clpt's camera_path: frame 1 at --fps 1 is key 1, what the camera block of its
      * values renders */
     static const char path_text[] = "image { width 24 height 16 spp 2 depth 2 }\n"

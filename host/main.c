@@ -449,30 +449,61 @@ static Status frame_paths(const Run *r, const char *base_output, long k, FramePa
     return failed ? error_set(err, ST_INTERNAL, "out of memory") : ST_OK;
 }
 
-/* One frame: the scene posed at its time, prepared, given to the devices (opened by
- * the first frame, kept by the others: nothing is compiled again), rendered and
- * written. *devs and *n_devs carry the devices from frame to frame. */
-static Status frame_render(Run *r, Dist *dist, long k, const FramePaths *p, Denoiser *denoiser, Device ***devs,
-                           size_t *n_devs, Error *err)
+/* What one frame hands the next: the devices (opened by the first frame: nothing is
+ * compiled again), the run's denoiser, and for an animation of the camera alone the
+ * prepared scene with its parameters as prepared (before any pass changed them). */
+typedef struct {
+    Device **devs;
+    size_t n_devs;
+    Denoiser *denoiser;
+    RenderScene rs;
+    RenderParams params;
+    int have_rs;
+} FrameCarry;
+
+/* The frame's scene prepared: in full, or (the camera alone moving, and a scene
+ * prepared before) the kept one with the new camera; then the film. */
+static Status frame_prepare(Run *r, FrameCarry *c, Error *err)
+{
+    if (!c->have_rs) {
+        Status st = render_prepare(r, 0, 0, err);
+        c->params = r->job.rs.ds.params;
+        return st;
+    }
+    c->rs.ds.params = c->params;
+    c->have_rs = 0;   /* the job holds it until render_job_take_scene */
+    Status st = render_job_adopt_scene(&r->job, &r->scene, &c->rs, err);
+    return st == ST_OK ? render_job_prepare_film(&r->job, 0, 0, err) : st;
+}
+
+/* One frame: the scene posed at its time, prepared, given to the devices, rendered and
+ * written. */
+static Status frame_render(Run *r, Dist *dist, long k, const FramePaths *p, FrameCarry *c, Error *err)
 {
     RenderJobSettings set = job_options_settings(&r->o);
     set.checkpoint_path = p->checkpoint;
     set.resume_path = p->resume;
     render_job_init(&r->job, &set, print_warning, NULL, &r->ctx);
-    r->job.denoiser = denoiser;   /* the run's, lent to each frame */
+    r->job.denoiser = c->denoiser;   /* the run's, lent to each frame */
     r->output = p->output;
     if (!r->o.quiet) fprintf(stderr, "clpt: frame %ld (%g s) -> %s\n", k, (double)k / r->o.fps, p->output);
     SceneAnimation *anim = r->scene.animation;
+    int kept = c->have_rs;
     Status st = anim->pose(anim, &r->scene, (double)k / r->o.fps, err);
     if (st == ST_OK) st = scene_options_apply_camera(&r->o, &r->scene, err);
-    if (st == ST_OK) st = render_prepare(r, 0, 0, err);
-    if (st == ST_OK && *devs) st = render_job_adopt_devices(&r->job, *devs, *n_devs, err);
+    if (st == ST_OK) st = frame_prepare(r, c, err);
+    if (st == ST_OK && c->devs && kept) st = render_job_update_devices(&r->job, c->devs, c->n_devs, err);
+    else if (st == ST_OK && c->devs) st = render_job_adopt_devices(&r->job, c->devs, c->n_devs, err);
     else if (st == ST_OK) st = open_devices(r, err);
     if (st == ST_OK) {
         render_run(r, dist, err);
         st = results_write(r, err);
     }
-    render_job_take_devices(&r->job, devs, n_devs);
+    render_job_take_devices(&r->job, &c->devs, &c->n_devs);
+    if (anim->camera_only && st == ST_OK) {
+        render_job_take_scene(&r->job, &c->rs);
+        c->have_rs = 1;
+    }
     r->job.denoiser = NULL;
     render_job_free(&r->job);
     memset(&r->job, 0, sizeof r->job);
@@ -486,11 +517,11 @@ static Status run_frames(Run *r, Dist *dist, Error *err)
 {
     Status st = frames_check(r, err);
     const char *base_output = r->output;
-    Device **devs = NULL;
-    size_t n_devs = 0;
+    FrameCarry c;
+    memset(&c, 0, sizeof c);
     r->frames = 1;
     /* each frame is a job of its own; the run's denoiser (--denoise) serves them all */
-    Denoiser *denoiser = r->job.denoiser;
+    c.denoiser = r->job.denoiser;
     r->job.denoiser = NULL;
     render_job_free(&r->job);
     memset(&r->job, 0, sizeof r->job);
@@ -500,15 +531,16 @@ static Status run_frames(Run *r, Dist *dist, Error *err)
         if (st == ST_OK && access(p.output, F_OK) == 0) {
             if (!r->o.quiet) fprintf(stderr, "clpt: frame %ld: '%s' is there already; skipped\n", k, p.output);
         } else if (st == ST_OK) {
-            st = frame_render(r, dist, k, &p, denoiser, &devs, &n_devs, err);
+            st = frame_render(r, dist, k, &p, &c, err);
         }
         frame_paths_free(&p);
         if (st == ST_OK && stop_requested) st = ST_INTERRUPTED;
     }
     r->output = base_output;
-    for (size_t i = 0; i < n_devs; i++) device_close(devs[i]);
-    free(devs);
-    r->job.denoiser = denoiser;   /* freed with the run's job */
+    for (size_t i = 0; i < c.n_devs; i++) device_close(c.devs[i]);
+    free(c.devs);
+    render_scene_free(&c.rs);
+    r->job.denoiser = c.denoiser;   /* freed with the run's job */
     return st;
 }
 

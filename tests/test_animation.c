@@ -636,6 +636,14 @@ static void test_cli_frames(void)
     CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
     CHECK(files_equal(CLI_DIR "/path_0001.pfm", CLI_DIR "/still.pfm"));
     CHECK(file_exists(CLI_DIR "/path_0000.pfm") && !files_equal(CLI_DIR "/path_0000.pfm", CLI_DIR "/still.pfm"));
+    /* frame 1 kept frame 0's trees and buffers and renewed the camera alone; the
+     * OpenCL device too, through its params block */
+    const char *a10[] = { "--device", TEST_OPENCL, "-q", "--frames", "0:1", "--fps", "1", "-o", CLI_DIR "/pathcl.pfm",
+                          CLI_DIR "/path.scene", NULL };
+    cli_run(a10, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    CHECK(files_equal(CLI_DIR "/pathcl_0001.pfm", CLI_DIR "/still.pfm"));
+    CHECK(files_equal(CLI_DIR "/pathcl_0000.pfm", CLI_DIR "/path_0000.pfm"));
 }
 
 static void test_cli_errors(void)

@@ -92,6 +92,16 @@ Status render_job_open_denoiser(RenderJob *job, Error *err);
  * until it is freed. */
 Status render_job_prepare_scene(RenderJob *job, Scene *scene, Error *err);
 
+/* An animation whose frames move only the camera (SceneAnimation.camera_only) keeps the
+ * scene prepared by the frame before: render_job_take_scene hands the prepared scene out
+ * of the finished job (which then frees none of it), render_job_adopt_scene gives it to
+ * the new job with the camera's parameters made again from scene->camera (checked
+ * as render_scene_prepare checks it), and render_job_update_devices gives the adopted
+ * devices the new parameters alone: no tree is built and no buffer uploaded again. */
+void render_job_take_scene(RenderJob *job, RenderScene *rs);
+Status render_job_adopt_scene(RenderJob *job, Scene *scene, RenderScene *rs, Error *err);
+Status render_job_update_devices(RenderJob *job, Device **devs, size_t n_devs, Error *err);
+
 /* The render's identity where something compares or records it (a checkpoint, a
  * resume, or `keyed`: the ranks of an MPI job): it hashes every scene buffer. Then the
  * film, and with a resume path (unless `skip_resume`: an MPI worker) the checkpoint,

@@ -14,6 +14,8 @@
 typedef struct SceneAnimation SceneAnimation;
 struct SceneAnimation {
     double end;           /* seconds: the last key's time (the animation starts at 0) */
+    int camera_only;      /* pose moves the camera alone: a frame keeps the scene's
+                           * trees and buffers and renews only the camera's parameters */
     /* Places the scene (a Scene *)'s moving parts (geometry, lights, the camera) as they are at
      * time t, in place of their pose before. Errors as the reader's. */
     Status (*pose)(SceneAnimation *a, void *scene, double t, Error *err);

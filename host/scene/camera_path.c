@@ -81,6 +81,7 @@ Status camera_path_animation(const CameraKey *keys, size_t n, int interp, SceneA
     cp->base.pose = path_pose;
     cp->base.free = path_free;
     cp->base.end = keys[n - 1].t;
+    cp->base.camera_only = 1;
     for (size_t k = 0; k < n; k++) cp->times[k] = keys[k].t;
     for (int i = 0; i < TRACK_N; i++) {
         int w = i == TRACK_FOV ? 1 : 3;

@@ -303,6 +303,33 @@ static void test_pose_equals_static(void)
     free(doc);
 }
 
+/* An animation of the camera's node alone keeps the geometry (SceneAnimation.camera_only)
+ * and still gives the static file's camera and image. */
+static void test_camera_only(void)
+{
+    static const char anim[] = "\"animations\":[{\"channels\":[{\"sampler\":0,\"target\":{\"node\":3,"
+                               "\"path\":\"translation\"}}],\"samplers\":[{\"input\":1,\"output\":6}]}],";
+    char *doc = malloc(16384);
+    doc_json(doc, 16384, anim_nodes, anim);
+    Scene s;
+    Error err = { 0 };
+    Status st = load_doc(doc, 1, &s, &err);
+    CHECK_MSG(st == ST_OK, "load: %s", err.msg);
+    if (st == ST_OK) {
+        CHECK(s.animation->camera_only);
+        check_pose(&s, 0.5, "camera only, t = 0.5");
+        check_pose(&s, 1.75, "camera only, t = 1.75");
+    }
+    scene_free(&s);
+    /* the document whose meshes move is no camera-only animation */
+    free(doc);
+    doc = animated_doc();
+    st = load_doc(doc, 1, &s, &err);
+    CHECK(st == ST_OK && !s.animation->camera_only);
+    scene_free(&s);
+    free(doc);
+}
+
 /* The pose the evaluation gives, by hand: node 0 at t = 0.5 is translated halfway to
  * (1, 0.5, 0), turned 45 degrees about y, and scaled by the cubic spline at u = 1/2:
  * x = 1/2 + (1/8) 0.5 + 1.5/2 = 1.3125 (h10 times the out-tangent 0.5, interval 1). */
@@ -537,6 +564,35 @@ static long file_size(const char *p)
     return stat(p, &st) == 0 ? (long)st.st_size : -1;
 }
 
+/* A glTF animation of the camera alone: frames in a row on the OpenCL device (the
+ * scene kept, the camera renewed) equal each frame rendered alone on the scalar
+ * device. */
+static void test_cli_camera_only(void)
+{
+    static const char anim[] = "\"animations\":[{\"channels\":[{\"sampler\":0,\"target\":{\"node\":3,"
+                               "\"path\":\"translation\"}}],\"samplers\":[{\"input\":1,\"output\":6}]}],";
+    char *doc = malloc(16384);
+    doc_json(doc, 16384, anim_nodes, anim);
+    FILE *f = fopen(CLI_DIR "/cam.gltf", "w");
+    CHECK(f != NULL);
+    if (f) {
+        fputs(doc, f);
+        fclose(f);
+    }
+    free(doc);
+    static CliResult r;
+    const char *a1[] = { "--device", TEST_OPENCL, "--spp", "2", "--width", "24", "--height", "16", "-q", "--frames",
+                         "10:12", "-o", CLI_DIR "/cam.pfm", CLI_DIR "/cam.gltf", NULL };
+    cli_run(a1, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    const char *a2[] = { "--device", "scalar", "--spp", "2", "--width", "24", "--height", "16", "-q", "--frames",
+                         "12:12", "-o", CLI_DIR "/camone.pfm", CLI_DIR "/cam.gltf", NULL };
+    cli_run(a2, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    CHECK(files_equal(CLI_DIR "/cam_0012.pfm", CLI_DIR "/camone_0012.pfm"));
+    CHECK(!files_equal(CLI_DIR "/cam_0010.pfm", CLI_DIR "/cam_0012.pfm"));
+}
+
 static void test_cli_frames(void)
 {
     char *doc = animated_doc();
@@ -686,11 +742,13 @@ int main(void)
     RUN(test_cubic_spline);
     RUN(test_node_pose);
     RUN(test_pose_equals_static);
+    RUN(test_camera_only);
     RUN(test_bad_animations);
     RUN(test_bad_documents);
     RUN(test_camera_path_values);
     RUN(test_camera_path_frame);
     RUN(test_cli_frames);
+    RUN(test_cli_camera_only);
     RUN(test_cli_errors);
     return harness_report();
 }

@@ -664,6 +664,7 @@ void gltf_init(Gltf *g, const char *path, Scene *s, const MeshOptions *o, GltfVi
     g->view = view;
     g->default_mat = NO_INDEX;
     g->reading_buffer = -1;
+    g->camera_node = g->camera_index = -1;
     if (view) view->has_camera = 0;
 }
 

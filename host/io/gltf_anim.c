@@ -249,19 +249,53 @@ Status gltf_anim_node_world(GltfAnimated *a, int node, double t, Transform *out,
     Gltf *g = &a->g;
     if (node < 0 || node >= g->n_nodes) return error_set(err, ST_INTERNAL, "no node %d", node);
     g->err = err;
+    /* the chain from the node up to its root */
+    int depth = 0;
+    for (int n = node; n >= 0; n = a->parent[n])
+        if (++depth > g->n_nodes) return gltf_bad(g, "nodes", "the node tree has a cycle");
+    int *chain = malloc((size_t)depth * sizeof *chain);
+    if (!chain) return error_set(err, ST_INTERNAL, "out of memory");
+    int i = depth;
+    for (int n = node; n >= 0; n = a->parent[n]) chain[--i] = n;
     gltf_anim_eval(a, t, a->pose);
     g->pose = a->pose;
-    Transform w = transform_identity();
+    /* composed from the root down, as the node walk composes it: the same bits */
+    Transform xf = transform_identity();
     Status st = ST_OK;
-    /* from the node up to its root: each parent's local transform on the left */
-    for (int n = node, depth = 0; n >= 0 && !st; n = a->parent[n], depth++) {
+    for (i = 0; i < depth && !st; i++) {
         Transform local;
-        if (depth > g->n_nodes) return gltf_bad(g, "nodes", "the node tree has a cycle");
-        if (!(st = gltf_node_local(g, n, &local))) w = transform_compose(&local, &w);
+        if (!(st = gltf_node_local(g, chain[i], &local))) xf = transform_compose(&xf, &local);
     }
     g->pose = NULL;
-    *out = transform_compose(&a->o.xf, &w);
+    free(chain);
+    *out = transform_compose(&a->o.xf, &xf);
     return st;
+}
+
+/* Whether node n or a node below it shows something but a camera: a mesh (with
+ * EXT_mesh_gpu_instancing or not) or a punctual light. */
+static int subtree_shows(const GltfAnimated *a, int n, int depth)
+{
+    const Gltf *g = &a->g;
+    const cJSON *node = gltf_item_at(g, "nodes", n);
+    if (depth > g->n_nodes || cJSON_GetObjectItemCaseSensitive(node, "mesh") ||
+        gltf_ext_of(node, "KHR_lights_punctual"))
+        return 1;
+    const cJSON *kids = cJSON_GetObjectItemCaseSensitive(node, "children");
+    for (const cJSON *c = gltf_first_of(kids); c; c = c->next)
+        if (cJSON_IsNumber(c) && c->valuedouble >= 0 && c->valuedouble < g->n_nodes &&
+            subtree_shows(a, (int)c->valuedouble, depth + 1))
+            return 1;
+    return 0;
+}
+
+/* An animation that moves only cameras: no animated node carries a mesh or a light,
+ * itself or below it. */
+static int moves_camera_only(const GltfAnimated *a)
+{
+    for (size_t i = 0; i < a->n_ch; i++)
+        if (subtree_shows(a, a->ch[i].node, 0)) return 0;
+    return 1;
 }
 
 /* ------------------------------------------------------------------ frames */
@@ -273,10 +307,20 @@ static Status anim_pose(SceneAnimation *base, void *vscene, double t, Error *err
     Gltf *g = &a->g;
     g->s = s;
     g->err = err;
+    uint width = s->image.width, height = s->image.height;
+    if (a->base.camera_only) {
+        /* the geometry stays as placed (the devices keep it): the camera alone, by the
+         * transform the walk would give its node */
+        Transform w;
+        Status st = g->camera_node < 0 ? ST_OK : gltf_anim_node_world(a, g->camera_node, t, &w, err);
+        if (!st && g->camera_node >= 0) st = gltf_camera_set(g, g->camera_index, &w);
+        s->image.width = width;
+        s->image.height = height;
+        return st;
+    }
     Status st = scene_rewind(s, &a->mark, err);
     if (st) return st;
     size_t n_warnings = s->n_warnings;
-    uint width = s->image.width, height = s->image.height;
     gltf_anim_eval(a, t, a->pose);
     g->pose = a->pose;
     st = gltf_place(g);
@@ -339,6 +383,7 @@ Status gltf_parse_animated(const char *path, const char *data, size_t len, Scene
     if (!st && a->n_ch == 0)
         st = error_set(err, ST_INPUT, "%s: the file has no animation of a node's translation, rotation or scale "
                        "to render frames of", path);
+    a->base.camera_only = !st && moves_camera_only(a);
     if (st) {
         anim_free(&a->base);
         return st;

@@ -88,6 +88,7 @@ typedef struct {
     size_t singular;                 /* instances skipped for a singular transform */
     int has_lights;
     const GltfNodePose *pose;        /* per node, an animation's pose; NULL: the file's own */
+    int camera_node, camera_index;   /* the node and camera the scene looks through, or -1 */
     Table t[T_N];
 } Gltf;
 
@@ -132,6 +133,9 @@ void gltf_close(Gltf *g);
 Status gltf_scene_walk(Gltf *g);
 /* gltf_scene_walk, then the camera asked for found (view->camera). */
 Status gltf_place(Gltf *g);
+/* The scene camera from glTF camera `cam` under the world transform xf (the MeshOptions'
+ * transform included); the image height from its aspect ratio. */
+Status gltf_camera_set(Gltf *g, int cam, const Transform *xf);
 /* Node n's local transform with g->pose's parts when set, checked (jp: "nodes[n]"). */
 Status gltf_node_local(Gltf *g, int n, Transform *out);
 

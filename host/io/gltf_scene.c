@@ -300,7 +300,7 @@ static int camera_wanted(const Gltf *g, int cam, const cJSON *node)
            (cJSON_IsString(nn) && strcmp(nn->valuestring, want) == 0);
 }
 
-static Status camera_set(Gltf *g, int cam, const Transform *xf)
+Status gltf_camera_set(Gltf *g, int cam, const Transform *xf)
 {
     char jp[64];
     snprintf(jp, sizeof jp, "cameras[%d]", cam);
@@ -570,7 +570,9 @@ static Status node_visit(Gltf *g, int n, const Transform *parent, int depth)
     }
     if (cam >= 0 && g->view && camera_wanted(g, cam, node)) {
         Transform w = transform_compose(&g->o->xf, &xf);
-        if ((st = camera_set(g, cam, &w))) return st;
+        if ((st = gltf_camera_set(g, cam, &w))) return st;
+        g->camera_node = n;
+        g->camera_index = cam;
     }
     const cJSON *lp = gltf_ext_of(node, "KHR_lights_punctual");
     if (lp) {

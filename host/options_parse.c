@@ -295,6 +295,9 @@ Status options_finish(Options *o, Error *err)
     if (!(o->fps > 0.0)) o->fps = 24.0;
     if (o->frames_first >= 0 && o->range_end >= 0)
         return error_set(err, ST_USAGE, "--frames cannot be used with --sample-range (render each frame whole)");
+    if (o->frames_first >= 0 && o->display_server)
+        return error_set(err, ST_USAGE, "--frames cannot be used with --display-server (the live display shows one "
+                         "image; open each frame's file instead)");
     if (!o->scene_path && !o->help && !o->version && !o->list_devices)
         return error_set(err, ST_USAGE, "no scene given (usage: clpt [options] SCENE)");
     Status st = options_check_stdout(o, err);

@@ -727,6 +727,19 @@ static void test_cli_errors(void)
     CHECK(r.status == ST_USAGE);
     CHECK_STR_CONTAINS(r.err, "clpt: error: --frames renders the animation of a glTF file given as the scene, or a "
                               "clpt scene's camera_path; 'scenes/cornell-box.scene' has neither");
+    const char *a7[] = { "--frames", "0:1", "--display-server", "localhost:14158", CLI_DIR "/anim.gltf", NULL };
+    cli_run(a7, &r);
+    CHECK(r.status == ST_USAGE);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --frames cannot be used with --display-server (the live display shows "
+                              "one image; open each frame's file instead)");
+    const char *a8[] = { "--frames", "0:1", "--sample-range", "0:1", CLI_DIR "/anim.gltf", NULL };
+    cli_run(a8, &r);
+    CHECK(r.status == ST_USAGE);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --frames cannot be used with --sample-range (render each frame whole)");
+    const char *a9[] = { "--frames", "0:1", "-o", "-", CLI_DIR "/anim.gltf", NULL };
+    cli_run(a9, &r);
+    CHECK(r.status == ST_USAGE);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --frames cannot be used with -o -");
     const char *a6[] = { "--frames", "1", CLI_DIR "/anim.gltf", NULL };
     cli_run(a6, &r);
     CHECK(r.status == ST_USAGE);

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/limit.h"
 #include "io/gltf_reader.h"
 #include "scene/keyframes.h"
 #include "scene/scene_mark.h"
@@ -278,7 +279,9 @@ static int subtree_shows(const GltfAnimated *a, int n, int depth)
 {
     const Gltf *g = &a->g;
     const cJSON *node = gltf_item_at(g, "nodes", n);
-    if (depth > g->n_nodes || cJSON_GetObjectItemCaseSensitive(node, "mesh") ||
+    /* deeper than a walk goes (an animated node outside the scene's tree, a cycle):
+     * not known to show nothing */
+    if (depth > CLPT_MAX_NESTING || cJSON_GetObjectItemCaseSensitive(node, "mesh") ||
         gltf_ext_of(node, "KHR_lights_punctual"))
         return 1;
     const cJSON *kids = cJSON_GetObjectItemCaseSensitive(node, "children");

@@ -22,6 +22,7 @@
 #include "harness.h"
 #include "io/gltf_anim.h"
 #include "io/scene_load.h"
+#include "outputs.h"
 #include "render_util.h"
 #include "scene/keyframes.h"
 
@@ -556,6 +557,23 @@ static void test_camera_path_frame(void)
 
 /* ------------------------------------------------------------------ the program */
 
+/* The numbered names (docs/animation.md): the stem, an underscore, four digits or more,
+ * the extension. */
+static void test_frame_names(void)
+{
+    static const struct { const char *path; long frame; const char *want; } cases[] = {
+        { "out.png", 0, "out_0000.png" },           { "out.png", 42, "out_0042.png" },
+        { "dir/a.b.exr", 7, "dir/a.b_0007.exr" },   { "frame.pfm", 12345, "frame_12345.pfm" },
+        { "ck", 3, "ck_0003" },                     { "dir.x/out", 3, "dir.x/out_0003" },
+        { ".hidden", 1, ".hidden_0001" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char *got = outputs_frame_path(cases[i].path, cases[i].frame);
+        CHECK_MSG(got && strcmp(got, cases[i].want) == 0, "%s %ld: %s", cases[i].path, cases[i].frame, got);
+        free(got);
+    }
+}
+
 #define CLI_DIR "build/tests/frames-cli"
 
 static long file_size(const char *p)
@@ -760,6 +778,7 @@ int main(void)
     RUN(test_bad_documents);
     RUN(test_camera_path_values);
     RUN(test_camera_path_frame);
+    RUN(test_frame_names);
     RUN(test_cli_frames);
     RUN(test_cli_camera_only);
     RUN(test_cli_errors);

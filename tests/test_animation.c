@@ -574,7 +574,7 @@ static void test_frame_names(void)
     }
 }
 
-#define CLI_DIR "build/tests/frames-cli"
+#define CLI_DIR CLPT_BUILD_DIR "/tests/frames-cli"
 
 static long file_size(const char *p)
 {

@@ -136,6 +136,10 @@ static const float anim_buffer[] = {
     2, 0, 0, 2, 1, 0, 2, 1, 1,
     /* 276: the camera's translation, 3 VEC3 (LINEAR) */
     0, 0.5f, 5, 0.5f, 0.5f, 5, 1, 1, 6,
+    /* 312: a rotation, 6 VEC4 (CUBICSPLINE, two keys): q and -q with flat tangents,
+     * which pass through zero halfway */
+    0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0,
+    0, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, 0,
 };
 
 static char anim_uri[600];
@@ -149,11 +153,13 @@ static char anim_uri[600];
     "{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"},"                                       \
     "{\"bufferView\":4,\"componentType\":5126,\"count\":9,\"type\":\"VEC3\"},"                                       \
     "{\"bufferView\":5,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"                                       \
-    "{\"bufferView\":6,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],"                                      \
+    "{\"bufferView\":6,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"                                      \
+    "{\"bufferView\":7,\"componentType\":5126,\"count\":6,\"type\":\"VEC4\"},"                                      \
+    "{\"bufferView\":1,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\"}],"                                   \
     "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":12},"         \
     "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":84,\"byteLength\":48},"        \
     "{\"buffer\":0,\"byteOffset\":132,\"byteLength\":108},{\"buffer\":0,\"byteOffset\":240,\"byteLength\":36},"     \
-    "{\"buffer\":0,\"byteOffset\":276,\"byteLength\":36}],"
+    "{\"buffer\":0,\"byteOffset\":276,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":312,\"byteLength\":96}],"
 
 /* The animations: node 0 translated, rotated and scaled, node 2 stepped, the camera's
  * node 3 moved. `bad` replaces the first channel when not NULL. */
@@ -403,7 +409,7 @@ static void test_bad_animations(void)
     check_bad("{\"sampler\":4,\"target\":{\"node\":1,\"path\":\"scale\"}}", ",{\"input\":5,\"output\":2}",
               "anim.gltf: animations[0].samplers[4].input: accessor 5: type must be SCALAR here");
     check_bad("{\"sampler\":4,\"target\":{\"node\":1,\"path\":\"scale\"}}", ",{\"input\":17,\"output\":2}",
-              "anim.gltf: animations[0].samplers[4].input: accessors[17] does not exist (the file has 7)");
+              "anim.gltf: animations[0].samplers[4].input: accessors[17] does not exist (the file has 9)");
     check_bad("{\"sampler\":1,\"target\":{\"node\":0,\"path\":\"rotation\"}}", NULL,
               "anim.gltf: animations[0].channels[1].target: nodes[0].rotation is animated by an earlier channel "
               "already");
@@ -425,13 +431,13 @@ static void test_bad_documents(void)
     scene_free(&s);
     /* times 0, 1, 2 read from the translation's floats instead: 0, 0, 0 */
     anim_json(anim, sizeof anim, "{\"sampler\":4,\"target\":{\"node\":1,\"path\":\"scale\"}}",
-              ",{\"input\":7,\"output\":2}");
+              ",{\"input\":9,\"output\":2}");
     doc_json(doc, 16384, anim_nodes, anim);
     char *at = strstr(doc, "\"accessors\":[");
     char patched[16384];
     snprintf(patched, sizeof patched, "%.*s\"accessors\":[%s", (int)(at - doc), doc,
              at + strlen("\"accessors\":[") - 0);
-    /* accessor 7: the first three floats of the translation (0, 0, 0) as times */
+    /* accessor 9: the first three floats of the translation (0, 0, 0) as times */
     char *end = strstr(patched, "}],\"bufferViews\"");
     char final[16384];
     snprintf(final, sizeof final, "%.*s},{\"bufferView\":2,\"componentType\":5126,\"count\":3,\"type\":\"SCALAR\"%s",
@@ -448,6 +454,20 @@ static void test_bad_documents(void)
     CHECK(load_doc(doc, 1, &s, &err) == ST_OK);
     CHECK(s.n_warnings == 1 && s.n_warnings && strstr(s.warnings[0], "animations[0].channels[0].target.path: morph "
                                                                       "target weights are not animated"));
+    scene_free(&s);
+    /* q to -q on a cubic spline with flat tangents passes through zero halfway: the
+     * file loads (its keys are rotations), the frame there is refused */
+    anim_json(anim, sizeof anim, "{\"sampler\":4,\"target\":{\"node\":1,\"path\":\"rotation\"}}",
+              ",{\"input\":8,\"output\":7,\"interpolation\":\"CUBICSPLINE\"}");
+    doc_json(doc, 16384, anim_nodes, anim);
+    error_clear(&err);
+    CHECK(load_doc(doc, 1, &s, &err) == ST_OK);
+    if (s.animation) {
+        CHECK(s.animation->pose(s.animation, &s, 0.25, &err) == ST_OK);
+        CHECK(s.animation->pose(s.animation, &s, 0.5, &err) == ST_INPUT);
+        CHECK_MSG(strcmp(err.msg, "anim.gltf: nodes[1]: rotation: the animation makes a zero quaternion") == 0,
+                  "got: %s", err.msg);
+    }
     scene_free(&s);
     /* no animation at all */
     doc_json(doc, 16384, anim_nodes, "");

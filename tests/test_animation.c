@@ -328,6 +328,20 @@ static void test_camera_only(void)
         check_pose(&s, 1.75, "camera only, t = 1.75");
     }
     scene_free(&s);
+    /* an animated node outside the scene's tree over 60 levels of children that repeat
+     * (2^60 paths): each node is looked at once, and none shows anything */
+    char nodes[8192];
+    size_t at = (size_t)snprintf(nodes, sizeof nodes, "%s", anim_nodes);
+    for (int k = 4; k < 64; k++)
+        at += (size_t)snprintf(nodes + at, sizeof nodes - at, ",{\"children\":[%d,%d]}", k + 1, k + 1);
+    snprintf(nodes + at, sizeof nodes - at, ",{}");
+    static const char far_anim[] = "\"animations\":[{\"channels\":[{\"sampler\":0,\"target\":{\"node\":4,"
+                                   "\"path\":\"translation\"}}],\"samplers\":[{\"input\":1,\"output\":6}]}],";
+    doc_json(doc, 16384, nodes, far_anim);
+    st = load_doc(doc, 1, &s, &err);
+    CHECK_MSG(st == ST_OK, "far: %s", err.msg);
+    CHECK(st != ST_OK || s.animation->camera_only);
+    scene_free(&s);
     /* the document whose meshes move is no camera-only animation */
     free(doc);
     doc = animated_doc();

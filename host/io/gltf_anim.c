@@ -15,7 +15,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "base/limit.h"
 #include "io/gltf_reader.h"
 #include "scene/keyframes.h"
 #include "scene/scene_mark.h"
@@ -273,32 +272,44 @@ Status gltf_anim_node_world(GltfAnimated *a, int node, double t, Transform *out,
     return st;
 }
 
-/* Whether node n or a node below it shows something but a camera: a mesh (with
- * EXT_mesh_gpu_instancing or not) or a punctual light. */
-static int subtree_shows(const GltfAnimated *a, int n, int depth)
+/* Whether a node shows something but a camera: a mesh (with EXT_mesh_gpu_instancing
+ * or not) or a punctual light. */
+static int node_shows(const Gltf *g, int n)
 {
-    const Gltf *g = &a->g;
     const cJSON *node = gltf_item_at(g, "nodes", n);
-    /* deeper than a walk goes (an animated node outside the scene's tree, a cycle):
-     * not known to show nothing */
-    if (depth > CLPT_MAX_NESTING || cJSON_GetObjectItemCaseSensitive(node, "mesh") ||
-        gltf_ext_of(node, "KHR_lights_punctual"))
-        return 1;
-    const cJSON *kids = cJSON_GetObjectItemCaseSensitive(node, "children");
-    for (const cJSON *c = gltf_first_of(kids); c; c = c->next)
-        if (cJSON_IsNumber(c) && c->valuedouble >= 0 && c->valuedouble < g->n_nodes &&
-            subtree_shows(a, (int)c->valuedouble, depth + 1))
-            return 1;
-    return 0;
+    return cJSON_GetObjectItemCaseSensitive(node, "mesh") || gltf_ext_of(node, "KHR_lights_punctual");
 }
 
 /* An animation that moves only cameras: no animated node carries a mesh or a light,
- * itself or below it. */
+ * itself or below it. A search over the nodes below the animated ones, each looked at
+ * once (an animated node outside the scene's tree was not checked by the walk: its
+ * children may repeat or loop). Without memory: no (the safe answer). */
 static int moves_camera_only(const GltfAnimated *a)
 {
-    for (size_t i = 0; i < a->n_ch; i++)
-        if (subtree_shows(a, a->ch[i].node, 0)) return 0;
-    return 1;
+    const Gltf *g = &a->g;
+    unsigned char *seen = calloc((size_t)g->n_nodes + 1, 1);
+    int *stack = malloc(((size_t)g->n_nodes + 1) * sizeof *stack);
+    int only = seen && stack, top = 0;
+    for (size_t i = 0; i < a->n_ch && only; i++) {
+        if (seen[a->ch[i].node]) continue;
+        seen[a->ch[i].node] = 1;
+        stack[top++] = a->ch[i].node;
+        while (top > 0 && only) {
+            int n = stack[--top];
+            if (node_shows(g, n)) only = 0;
+            const cJSON *kids = cJSON_GetObjectItemCaseSensitive(gltf_item_at(g, "nodes", n), "children");
+            for (const cJSON *c = gltf_first_of(kids); c && only; c = c->next) {
+                if (!cJSON_IsNumber(c) || !(c->valuedouble >= 0 && c->valuedouble < g->n_nodes)) continue;
+                int k = (int)c->valuedouble;
+                if (seen[k]) continue;
+                seen[k] = 1;
+                stack[top++] = k;
+            }
+        }
+    }
+    free(seen);
+    free(stack);
+    return only;
 }
 
 /* ------------------------------------------------------------------ frames */

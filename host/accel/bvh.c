@@ -511,16 +511,17 @@ static int uint_cmp(const void *a, const void *b)
  * least P(c0, j) + P(c1, i - j) (v's slots shared by its two children); each node adds
  * PACK_AREA times its area too. The binary tree, hence which items share a subtree, is
  * the SAH's as before; only its cut changes, so every walk finds the same hits (the
- * tie rule, accel/leaf.h). The grid of dragons: 1,756 nodes (4.6 children each), 2.4
- * times fewer, at the same speed; scenes/instances.scene: 567, against 597. */
+ * tie rule, accel/leaf.h). The grid of dragons: 1,764 nodes (4.7 children each), 2.4
+ * times fewer, at the same speed; scenes/instances.scene: 575, against 597. */
 
-/* Each node also costs its area over the root's, times this: among cuts of (nearly)
- * as few nodes, the one with the least SAH. Without it (node count alone) the cut
- * found for a grid of 10,000 dragons was 11 nodes deep, against 5, and the depth
- * spent the walk's stack: its lower nodes fell back to two children (a deeper path
- * leaves more entries behind), and the top level came out larger than the greedy's
- * on scenes/instances.scene. Weights from 0.25 to 4 gave the same node counts. */
-#define PACK_AREA 1.0
+/* Each node also costs its area over the root's, times this: among cuts of nearly as
+ * few nodes, a shallow one of little SAH. A deep top level spends the walk's stack,
+ * which the prototypes then lack (host/accel/bvh_inst.c: their nodes fall back to two
+ * children). By node count alone the grid of 10,000 dragons' top level was 11 nodes
+ * deep and left the dragon 75 entries, against 96, which made it 15,757 nodes, not
+ * 12,140; at 1 its top level took 46 entries, at 64 40, at 256 39 (instances.scene 46,
+ * 39, 32; the greedy's 31 and 29), for 1,756, 1,763 and 1,764 nodes (567, 572, 575). */
+#define PACK_AREA 256.0
 static float pack_split(const float *pack, uint c0, uint c1, uint i, uint *best_j)
 {
     float best = INFINITY;

@@ -692,6 +692,34 @@ static void test_nested_hits_against_brute_force(void)
                                   "instance rack { scale 0.5 0.8 0.5 rz 10 translate -2.5 0 1 }\n");
 }
 
+/* A top level of many instances (a 24 x 24 grid of the object, rotated and scaled, a
+ * row mirrored) is cut into fuller nodes (bvh.c, pack_measure): 128 here, where the
+ * greedy cut made 165 and at least (n - 1) / 7 = 83 are needed (the binary tree's
+ * shape and the weight on area keep it from that); and it is walked as the brute force
+ * walks it. */
+static void test_top_level_packed(void)
+{
+    char *text = malloc(64 * 1024);
+    size_t at = (size_t)snprintf(text, 64 * 1024, "%s", HEAD);
+    for (int i = 0; i < 24 * 24; i++)
+        at += (size_t)snprintf(text + at, 64 * 1024 - at, "instance thing { scale %s%.2f %.2f 0.3 ry %d translate %.1f 0 %.1f }\n",
+                               i / 24 == 5 ? "-" : "", 0.3 + 0.01 * (i % 7), 0.2 + 0.02 * (i % 5), (i * 37) % 360,
+                               -6.0 + 0.5 * (i % 24), -6.0 + 0.5 * (i / 24));
+    Scene s;
+    Error err = { 0 };
+    RenderScene rs;
+    CHECK_MSG(load_text(text, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_scene_prepare(&s, 1, &rs, &err) == ST_OK, "%s", err.msg);
+    uint n = (uint)rs.n_instances, least = (n - 1u + 6u) / 7u;
+    fprintf(stderr, "  %u instances: %u top-level nodes (at least %u), the walk's stack %u\n", n, rs.levels.top_nodes,
+            least, rs.levels.top.max_stack);
+    CHECK(rs.levels.top_nodes * 10u <= least * 16u);
+    render_scene_free(&rs);
+    scene_free(&s);
+    hits_against_brute_force(text);
+    free(text);
+}
+
 /* Surfaces through instances are in the world: a hit point lies on the ray, and a ray
  * leaving it by its error bound does not find the same surface again. */
 static void test_spawn_leaves_surface(void)
@@ -742,6 +770,7 @@ int main(void)
 {
     RUN(test_hits_against_brute_force);
     RUN(test_nested_hits_against_brute_force);
+    RUN(test_top_level_packed);
     RUN(test_spawn_leaves_surface);
     RUN(test_nested_equals_flat);
     RUN(test_nested_furnace);

@@ -202,7 +202,8 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
 
     Surface s = surface_at(sc, r, hit);
     Material m = sc->materials[s.material];   /* a mix: its own emission (mix.h) */
-    if (KF_HAS(KF_MEDIA) && (m.flags & MAT_INTERFACE)) return medium_cross(ray, hit, s, m, ps);
+    if (KF_HAS(KF_MEDIA) && (m.flags & MAT_INTERFACE))
+        return medium_cross(ray, hit, s, m, ps, path_max_crossings(p->has_media));
     shade_absorb(r, hit, s, m, ps);
     int later_branch = bounce == 0u && ps->branch != 0u;
     if (!later_branch) shade_emission(sc, r, s, m, ps);
@@ -243,8 +244,13 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     if (side == 0.0f || (side < 0.0f) != (transmitted != 0)) return result;
 
     vec3 thr = v3_mul(ps->throughput, bs.weight);
-    ps->bounce = bounce + 1u;
-    if (ps->bounce > p->rr_depth) {
+    if (KF_HAS(KF_MEDIA) && !front && !transmitted && (p->has_media & HAS_MEDIA_WALK) && MAT_IS(m, MAT_PRINCIPLED) &&
+        m.subsurface > 0.0f && !(m.flags & MAT_THIN)) {
+        /* reflected off the inside of a subsurface solid, back into its walk: a step of
+         * the walk, no bounce (medium_scatter) */
+        if (ps->crossings >= path_max_crossings(p->has_media)) return result;
+        ps->crossings = ps->crossings + 1u;
+    } else if ((ps->bounce = bounce + 1u) > p->rr_depth) {
         /* Russian roulette: continue with probability q, reweighted by 1/q; decided on
          * the throughput before first-hit splitting's weight 1/split, which every path
          * this far carries, so that a continuation is cut no more often than an

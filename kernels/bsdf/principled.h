@@ -39,9 +39,9 @@
  * Subsurface scattering (docs/subsurface.md): a share `subsurface` W of the diffuse lobe
  * of a solid refracts into it through the transmission lobe's facets instead, untinted
  * (the colour is the interior medium's, MEDIUM_WALK), so the refracting share is
- * t + (1 - t) W and its tint base t + (1 - t) W; what reaches the surface again from
- * inside meets only the dielectric boundary (bsdf_principled): reflected by F_d back
- * into the medium (always under total internal reflection) or refracted out.
+ * t + (1 - t) W and its tint base t + (1 - t) W. A walk that reaches the surface
+ * again from inside leaves it as a Lambertian transmission (shade_path,
+ * subsurface_exit_material), not through these lobes.
  */
 #ifndef CLPT_PRINCIPLED_H
 #define CLPT_PRINCIPLED_H
@@ -312,17 +312,6 @@ KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
                  k_clamp(m.sheen_color.z, 0.0f, 1.0f));
     p.sheen_roughness = k_clamp(m.sheen_roughness, SHEEN_ROUGHNESS_MIN, 1.0f);
     p.subsurface = p.thin ? 0.0f : k_clamp(m.subsurface, 0.0f, 1.0f);
-    if (!front && p.subsurface > 0.0f) {
-        /* from within a subsurface solid the surface is only the dielectric boundary to
-         * the outside, clear glass (Fresnel reflection back in, refraction out); the
-         * layers on top face the outside */
-        p.base = v3s(1.0f);
-        p.metallic = 0.0f;
-        p.transmission = 1.0f;
-        p.clearcoat = 0.0f;
-        p.sheen = v3s(0.0f);
-        p.subsurface = 0.0f;
-    }
     return p;
 }
 

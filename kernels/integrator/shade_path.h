@@ -216,12 +216,23 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     uint medium_in = m.medium_in, medium_out = m.medium_out;   /* the stored material's */
     material_resolve(sc, &m, s, r.d, ng_face);
     if (!material_scatters(m.type)) return 0u;   /* pure emitters do not reflect */
+    int exiting = KF_HAS(KF_MEDIA) && (p->has_media & HAS_MEDIA_WALK) && !front && subsurface_exits(m);
+    if (exiting) {
+        /* a subsurface walk reaching its surface from inside leaves through it as a
+         * Lambertian transmission (docs/subsurface.md): shaded as a white diffuse
+         * surface seen from outside, so that its light sample and its new direction
+         * are on the outside, and the medium beyond is the exterior */
+        m = subsurface_exit_material(m);
+        front = 1;
+        ng_face = s.ng;
+        r.d = v3_neg(r.d);
+    }
     s.ns = material_normal(sc, m, s);
     vec3 ns_face = bsdf_normal(m, r.d, front ? s.ns : v3_neg(s.ns), ng_face);
     uint result = SHADE_SCATTERED;
     BsdfSample bs;
 
-    vec3 albedo = material_albedo(sc, m, s, ng_face);
+    vec3 albedo = exiting ? v3s(1.0f) : material_albedo(sc, m, s, ng_face);
     material_at(sc, &m, s, ng_face);
 
     if (p->n_lights > 0u && bsdf_has_density(m, albedo) &&
@@ -244,13 +255,8 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     if (side == 0.0f || (side < 0.0f) != (transmitted != 0)) return result;
 
     vec3 thr = v3_mul(ps->throughput, bs.weight);
-    if (KF_HAS(KF_MEDIA) && !front && !transmitted && (p->has_media & HAS_MEDIA_WALK) && MAT_IS(m, MAT_PRINCIPLED) &&
-        m.subsurface > 0.0f && !(m.flags & MAT_THIN)) {
-        /* reflected off the inside of a subsurface solid, back into its walk: a step of
-         * the walk, no bounce (medium_scatter) */
-        if (ps->crossings >= path_max_crossings(p->has_media)) return result;
-        ps->crossings = ps->crossings + 1u;
-    } else if ((ps->bounce = bounce + 1u) > p->rr_depth) {
+    ps->bounce = bounce + 1u;
+    if (ps->bounce > p->rr_depth) {
         /* Russian roulette: continue with probability q, reweighted by 1/q; decided on
          * the throughput before first-hit splitting's weight 1/split, which every path
          * this far carries, so that a continuation is cut no more often than an

@@ -21,6 +21,29 @@
 #include "sample/rng.h"
 #include "geom/surface.h"
 
+/* Whether a path that reaches a surface of material m (resolved) from behind is a
+ * subsurface walk leaving its solid (docs/subsurface.md). */
+KFN int subsurface_exits(Material m)
+{
+    return MAT_IS(m, MAT_PRINCIPLED) && m.subsurface > 0.0f && !(m.flags & MAT_THIN);
+}
+
+/* The surface a subsurface walk leaves through: Lambertian, white (the colour is the
+ * walk's), as Cycles' random walk leaves; the albedo inversion (host/scene/subsurface.c)
+ * assumes a boundary without Fresnel reflection inside, as this one. Its emission was
+ * added already. The host compiles MAT_DIFFUSE into every scene with subsurface
+ * (kernel_features.c). */
+KFN Material subsurface_exit_material(Material m)
+{
+    Material d = m;
+    d.type = MAT_DIFFUSE;
+    d.albedo = v3s(1.0f);
+    d.texture = NO_INDEX;
+    d.texture_normal = NO_INDEX;
+    d.flags = 0u;
+    return d;
+}
+
 /* The bounce whose random numbers path ps draws: each boundary passed straight through
  * moves it on by one, so the flight after a boundary does not reuse the numbers that
  * decided the flight before it (which, being conditioned on having got there, are no

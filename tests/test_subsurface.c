@@ -18,6 +18,7 @@
 #include "cli_util.h"
 #include "util/kmath.h"
 #include "scene/subsurface.h"
+#include "io/scene_load.h"
 #include "render_util.h"
 
 #define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
@@ -184,6 +185,50 @@ static void test_devices_match_scalar(void)
     unlink(out);
 }
 
+/* pbrt-v4's subsurface material (host/io/pbrt_material.c): each way of giving the
+ * interior makes a principled material of subsurface 1 over a MEDIUM_WALK medium of
+ * the expected coefficients, and a measured name is one warning. */
+static void test_pbrt_mapping(void)
+{
+    const char *path = "tests/data/subsurface/pbrt-subsurface.pbrt";
+    Scene s;
+    Error err = { 0 };
+    scene_init(&s);
+    SceneKind kind = 0;
+    Status st = scene_load_file(path, SCENE_FORMAT_AUTO, &s, &kind, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    if (st) return;
+    CHECK_EQ_INT((int)s.n_spheres, 4);
+    CHECK_EQ_INT((int)s.n_warnings, 1);
+    if (s.n_warnings >= 1)
+        CHECK_MSG(strcmp(s.warnings[0], "tests/data/subsurface/pbrt-subsurface.pbrt:14: the measured medium "
+                                         "\"Ketchup\" is not supported; pbrt-v4's default sigma_a and sigma_s are "
+                                         "used") == 0, "got '%s'", s.warnings[0]);
+    vec3 want_sa[4], want_ss[4];
+    subsurface_coefficients(v3(0.8f, 0.5f, 0.2f), v3(2.0f, 1.0f, 0.5f), &want_sa[0], &want_ss[0]);
+    want_sa[1] = v3(1.0f, 2.0f, 3.0f);
+    want_ss[1] = v3(10.0f, 20.0f, 30.0f);
+    want_sa[2] = want_sa[3] = v3(0.0011f, 0.0024f, 0.014f);
+    want_ss[2] = want_ss[3] = v3(2.55f, 3.21f, 3.77f);
+    for (size_t i = 0; i < 4 && i < s.n_spheres; i++) {
+        const Material *m = &s.materials[s.spheres[i].material];
+        CHECK_EQ_INT((int)m->type, MAT_PRINCIPLED);
+        CHECK(m->subsurface == 1.0f && m->metallic == 0.0f);
+        CHECK_NEAR(m->ior, i == 0 ? 1.4 : 1.33, 1e-6);
+        CHECK_MSG(m->medium_in >= 1u && m->medium_in <= s.n_media, "sphere %zu: no interior", i);
+        if (!(m->medium_in >= 1u && m->medium_in <= s.n_media)) continue;
+        const Medium *md = &s.media[m->medium_in - 1u];
+        CHECK(md->flags & MEDIUM_WALK);
+        CHECK_NEAR(md->g, i == 0 ? 0.3 : 0.0, 1e-6);
+        CHECK_NEAR(md->sigma_a.x, want_sa[i].x, 1e-5);
+        CHECK_NEAR(md->sigma_a.z, want_sa[i].z, 1e-5);
+        CHECK_NEAR(md->sigma_s.x, want_ss[i].x, 1e-5);
+        CHECK_NEAR(md->sigma_s.z, want_ss[i].z, 1e-5);
+    }
+    scene_free(&s);
+}
+
 int main(void)
 {
     RUN(test_albedo_inversion);
@@ -191,5 +236,6 @@ int main(void)
     RUN(test_monotone);
     RUN(test_weight_zero_unchanged);
     RUN(test_devices_match_scalar);
+    RUN(test_pbrt_mapping);
     return harness_report();
 }

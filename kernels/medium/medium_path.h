@@ -85,12 +85,13 @@ KFN int medium_light_sample(const SceneView *sc, GLOBAL PathState *ps, vec3 x, v
 /* The path stopped at x inside its medium (phase g) and its throughput already holds
  * the stop's weight: a light sample, then a new direction from the phase function
  * (weight 1: it is sampled exactly), Russian roulette as at a surface. Returns the
- * bounce's SHADE_* result. */
-/* A stop of a subsurface walk (MEDIUM_WALK, docs/subsurface.md) is no bounce: it counts
- * as a crossing (which gives the next step fresh random numbers), samples no light (the
- * closed surface around it would block the shadow ray) and takes Russian roulette by
- * the throughput alone, without the 0.95 cap: a walk in a white medium keeps its
- * weight 1 and is never cut, however long, until MEDIUM_MAX_WALK. */
+ * bounce's SHADE_* result.
+ *
+ * A stop of a subsurface walk (`walk`: a MEDIUM_WALK medium, docs/subsurface.md) is no
+ * bounce: it counts as a crossing (which gives the next step fresh random numbers),
+ * samples no light (the closed surface around it would block the shadow ray) and takes
+ * Russian roulette by the throughput alone, without the 0.95 cap: a walk in a white
+ * medium keeps its weight 1 and is never cut, however long, until MEDIUM_MAX_WALK. */
 KFN uint medium_scatter(const SceneView *sc, GLOBAL Ray *ray, vec3 x, float g, uint walk, GLOBAL PathState *ps,
                         GLOBAL Ray *shadow_ray, RngKey key, uint rb)
 {

@@ -261,7 +261,7 @@ static void test_warnings(void)
         DIR "warnings.pbrt:3: Film: parameter \"float iso\" is not supported; ignored",
         DIR "warnings.pbrt:5: Shape \"cone\" is not supported; skipped",
         DIR "warnings.pbrt:7: Shape: parameter \"float wobble\" is not supported; ignored",
-        DIR "warnings.pbrt:9: medium \"cloud\" is not supported; \"fog\" is left empty (vacuum)",
+        DIR "warnings.pbrt:9: medium \"vapour\" is not supported; \"fog\" is left empty (vacuum)",
         DIR "warnings.pbrt:10: TransformTimes is not supported; ignored",
     };
     CHECK_EQ_INT(s.n_warnings, 6);

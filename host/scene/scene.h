@@ -11,6 +11,7 @@
 #include "base/status.h"
 #include "base/strmap.h"
 #include "types.h"
+#include "scene/animation.h"
 #include "scene/crop.h"
 #include "scene/transform.h"
 
@@ -71,6 +72,8 @@ typedef struct {
                                   * (the size rendered is, host/main.c) */
     const char *gltf_camera;     /* in: the glTF camera to look through (--camera), by
                                   * index or name; NULL: the file's first */
+    int keep_animation;          /* in: a reader keeps the file's animation (--frames) */
+    SceneAnimation *animation;   /* out: that animation, or NULL (scene/animation.h) */
     SceneCamera camera;
     SceneImage image;
     SceneCrop crop;              /* the window rendered (pbrt's cropwindow, --crop ...);

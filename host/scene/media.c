@@ -188,10 +188,14 @@ int scene_has_media(const Scene *s)
 
 void scene_prepare_media(Scene *s)
 {
+    /* a subsurface material's interior is its walk's medium (scene/subsurface.h), and
+     * its exterior the background's unless a shape says otherwise */
+    for (size_t i = 0; i < s->n_materials; i++)
+        if (s->materials[i].subsurface > 0.0f) s->materials[i].medium_out = s->world_medium;
     for (size_t i = 0; i < s->n_medium_bindings; i++) {
         const SceneMediumBinding *b = &s->medium_bindings[i];
         Material m = s->materials[b->origin];
-        m.medium_in = scene_medium_resolve(s, b->in);
+        if (!(m.subsurface > 0.0f)) m.medium_in = scene_medium_resolve(s, b->in);
         m.medium_out = scene_medium_resolve(s, b->out);
         s->materials[b->material] = m;
     }

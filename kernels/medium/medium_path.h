@@ -21,6 +21,29 @@
 #include "sample/rng.h"
 #include "geom/surface.h"
 
+/* Whether a path that reaches a surface of material m (resolved) from behind is a
+ * subsurface walk leaving its solid (docs/subsurface.md). */
+KFN int subsurface_exits(Material m)
+{
+    return MAT_IS(m, MAT_PRINCIPLED) && m.subsurface > 0.0f && !(m.flags & MAT_THIN);
+}
+
+/* The surface a subsurface walk leaves through: Lambertian, white (the colour is the
+ * walk's), as Cycles' random walk leaves; the albedo inversion (host/scene/subsurface.c)
+ * assumes a boundary without Fresnel reflection inside, as this one. Its emission was
+ * added already. The host compiles MAT_DIFFUSE into every scene with subsurface
+ * (kernel_features.c). */
+KFN Material subsurface_exit_material(Material m)
+{
+    Material d = m;
+    d.type = MAT_DIFFUSE;
+    d.albedo = v3s(1.0f);
+    d.texture = NO_INDEX;
+    d.texture_normal = NO_INDEX;
+    d.flags = 0u;
+    return d;
+}
+
 /* The bounce whose random numbers path ps draws: each boundary passed straight through
  * moves it on by one, so the flight after a boundary does not reuse the numbers that
  * decided the flight before it (which, being conditioned on having got there, are no
@@ -62,23 +85,34 @@ KFN int medium_light_sample(const SceneView *sc, GLOBAL PathState *ps, vec3 x, v
 /* The path stopped at x inside its medium (phase g) and its throughput already holds
  * the stop's weight: a light sample, then a new direction from the phase function
  * (weight 1: it is sampled exactly), Russian roulette as at a surface. Returns the
- * bounce's SHADE_* result. */
-KFN uint medium_scatter(const SceneView *sc, GLOBAL Ray *ray, vec3 x, float g, GLOBAL PathState *ps,
+ * bounce's SHADE_* result.
+ *
+ * A stop of a subsurface walk (`walk`: a MEDIUM_WALK medium, docs/subsurface.md) is no
+ * bounce: it counts as a crossing (which gives the next step fresh random numbers),
+ * samples no light (the closed surface around it would block the shadow ray) and takes
+ * Russian roulette by the throughput alone, without the 0.95 cap: a walk in a white
+ * medium keeps its weight 1 and is never cut, however long, until MEDIUM_MAX_WALK. */
+KFN uint medium_scatter(const SceneView *sc, GLOBAL Ray *ray, vec3 x, float g, uint walk, GLOBAL PathState *ps,
                         GLOBAL Ray *shadow_ray, RngKey key, uint rb)
 {
     GLOBAL const RenderParams *p = sc->params;
     uint bounce = ps->bounce;
-    if (bounce >= p->max_depth) return 0u;
+    if (walk ? ps->crossings >= path_max_crossings(p->has_media) : bounce >= p->max_depth) return 0u;
     vec3 d = v3_norm(ray->d);
     uint result = 0u;
-    if (p->n_lights > 0u && medium_light_sample(sc, ps, x, d, g, key, rb, shadow_ray)) result |= SHADE_SHADOW;
+    if (!walk && p->n_lights > 0u && medium_light_sample(sc, ps, x, d, g, key, rb, shadow_ray))
+        result |= SHADE_SHADOW;
     float u1, u2;
     rng_uniform2(key, rb, DIM_BSDF_U, &u1, &u2);
     float pdf;
     vec3 wi = phase_hg_sample(g, d, u1, u2, &pdf);
     vec3 thr = ps->throughput;
-    ps->bounce = bounce + 1u;
-    if (ps->bounce > p->rr_depth) {
+    if (walk) {
+        ps->crossings = ps->crossings + 1u;
+        float q = k_fmin(v3_max_comp(thr), 1.0f);
+        if (!(rng_uniform(key, rb, DIM_ROULETTE) < q)) return result;
+        thr = v3_scale(thr, 1.0f / q);
+    } else if ((ps->bounce = bounce + 1u) > p->rr_depth) {
         float q = k_fmin(v3_max_comp(thr) * (float)params_split(p), 0.95f);
         if (!(rng_uniform(key, rb, DIM_ROULETTE) < q)) return result;
         thr = v3_scale(thr, 1.0f / q);
@@ -125,7 +159,7 @@ KFN int medium_flight_grid(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL
     if (ev == GRID_ENDED || !(v3_max_comp(thr) > 0.0f)) return 1;
     ps->throughput = thr;
     if (ev == GRID_PASSED) return 0;
-    *result = medium_scatter(sc, ray, v3_madd(x, d, ts), md.g, ps, shadow_ray, key, rb);
+    *result = medium_scatter(sc, ray, v3_madd(x, d, ts), md.g, md.flags & MEDIUM_WALK, ps, shadow_ray, key, rb);
     return 1;
 }
 
@@ -161,7 +195,8 @@ KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL Path
     vec3 thr = v3_scale(v3_mul(v3_mul(ps->throughput, tr), md.sigma_s), 1.0f / pdf);
     if (!(pdf > 0.0f) || !(v3_max_comp(thr) > 0.0f)) return 1;
     ps->throughput = thr;
-    *result = medium_scatter(sc, ray, v3_madd(r.o, r.d, r.tmin + ts / len), md.g, ps, shadow_ray, key, rb);
+    *result = medium_scatter(sc, ray, v3_madd(r.o, r.d, r.tmin + ts / len), md.g, md.flags & MEDIUM_WALK, ps,
+                              shadow_ray, key, rb);
     return 1;
 }
 
@@ -170,11 +205,11 @@ KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL Path
  * scattered, which the MIS weight of a light it reaches is computed from; only tmin
  * moves up to the hit (the interval is open, so the same boundary is not found again,
  * as kernels/accel/alpha.h skips cut-out surfaces). Not a bounce. */
-KFN uint medium_cross(GLOBAL Ray *ray, Hit hit, Surface s, Material m, GLOBAL PathState *ps)
+KFN uint medium_cross(GLOBAL Ray *ray, Hit hit, Surface s, Material m, GLOBAL PathState *ps, uint max_crossings)
 {
     ps->medium = medium_beyond(m.medium_in, m.medium_out, ps->medium, ray->d, s.ng);
     ps->crossings = ps->crossings + 1u;
-    if (ps->crossings > MEDIUM_MAX_CROSSINGS) return 0u;
+    if (ps->crossings > max_crossings) return 0u;
     ray->tmin = hit.t;
     return SHADE_CONTINUE;
 }

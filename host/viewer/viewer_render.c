@@ -520,6 +520,8 @@ Status viewer_render_stop(ViewerRender *vr, Error *err)
     free(vr->rgb);
     free(vr->spare);
     vr->rgb = vr->spare = NULL;
+    /* a caller's denoiser outlives vr, its stop flag does not */
+    if (vr->denoiser && !vr->own_denoiser) denoiser_set_cancel(vr->denoiser, NULL);
     if (vr->own_denoiser) denoiser_close(vr->denoiser);
     vr->denoiser = NULL;
     float **bufs[] = { &vr->albedo, &vr->normal, &vr->noisy, &vr->denoise_out, &vr->denoised };

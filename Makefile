@@ -35,7 +35,16 @@ CPPFLAGS  := -D_GNU_SOURCE -DCL_TARGET_OPENCL_VERSION=120 -Ihost -Ikernels -Iinc
 # what the compiler's default -fPIE makes (docs/api.md has the timing).
 CFLAGS    := -std=c11 $(OPT) -g $(WARN) $(FPFLAGS) -pthread -fPIC -fvisibility=hidden $(EXTRA_CFLAGS)
 LDFLAGS   := -pthread $(EXTRA_LDFLAGS)
-LDLIBS    := -lOpenCL -lstb -lpng -lOpenEXRCore -lOpenEXR -lcjson -lz -lm
+LDLIBS    := -lOpenCL -lstb -lpng -lOpenEXRCore -lOpenEXR -lstdc++ -lcjson -lz -lm
+# host/io/exr_imf.cpp is clpt's one C++ file: OpenEXR's C++ reader, for the EXR images
+# its C interfaces cannot decode as floats (host/io/exr_imf.h says which). The C
+# compiler's driver compiles it as C++ (gcc and clang alike), with the C build's
+# optimisation and instrumentation; the sanitizer builds leave out UBSan's checks that
+# need its C++ runtime (vptr, function), which a program linked by the C driver lacks.
+CXX_SAN_OFF := -fno-sanitize=vptr,function
+CXX_FLAGS := -x c++ -std=c++14 $(OPT) -g -Wall -Wextra -Wshadow -pthread -fPIC -fvisibility=hidden \
+             $(EXTRA_CFLAGS) $(if $(findstring -fsanitize,$(EXTRA_CFLAGS)),$(CXX_SAN_OFF)) \
+             -Ihost -isystem /usr/include/OpenEXR -isystem /usr/include/Imath
 
 # Open MPI (docs/distributed.md): only host/dist/mpi_driver.c includes mpi.h, and only
 # the clpt program links libmpi; the tests and benchmarks never pull that file in.
@@ -55,7 +64,9 @@ COMMIT     := $(if $(GIT_COMMIT),$(GIT_COMMIT)$(GIT_DIRTY),unknown)
 KERNEL_C_WARN := -Wdouble-promotion -Werror=double-promotion
 
 HOST_SRC  := $(filter-out host/main.c,$(wildcard host/*.c host/*/*.c))
-HOST_OBJ  := $(HOST_SRC:host/%.c=$(BUILD)/host/%.o) $(BUILD)/kernel_source.o \
+HOST_CXX_SRC := $(wildcard host/*/*.cpp)
+HOST_OBJ  := $(HOST_SRC:host/%.c=$(BUILD)/host/%.o) $(HOST_CXX_SRC:host/%.cpp=$(BUILD)/host/%.o) \
+             $(BUILD)/kernel_source.o \
              $(BUILD)/bench_kernel_source.o
 KERNELS   := $(wildcard kernels/*.h kernels/*.cl kernels/*/*.h kernels/*/*.cl)
 TEST_SRC  := $(wildcard tests/test_*.c)
@@ -149,6 +160,10 @@ $(BUILD)/.flags: FORCE
 $(BUILD)/host/%.o: host/%.c $(BUILD)/.flags | $(VERSION_H)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(FILE_WARN) -MMD -MP -c -o $@ $<
+
+$(BUILD)/host/%.o: host/%.cpp $(BUILD)/.flags
+	@mkdir -p $(@D)
+	$(CC) $(CXX_FLAGS) -MMD -MP -c -o $@ $<
 
 # The scalar device and its builds of the kernels (scalar_paths_NAME.c, each with its own
 # CLPT_FEATURES), all with the same FPFLAGS as every object.

@@ -1,5 +1,6 @@
 /* exr.c — OpenEXR images through OpenEXRCore (see exr.h). */
 #include "io/exr.h"
+#include "io/exr_imf.h"
 
 #include "base/bytes.h"
 #include "base/strmap.h"
@@ -83,20 +84,43 @@ static Status exr_check_part(exr_context_t ctxt, const char *path, uint64_t max_
     if (w <= 0 || h <= 0 || (uint64_t)w * (uint64_t)h > max_pixels)
         return error_set(err, ST_INPUT, "'%s': a %dx%d EXR image is larger than the images clpt reads (at most "
                          "%llu pixels)", path, w, h, (unsigned long long)max_pixels);
-    /* the library's decompressor buffers one chunk of every channel: rows per chunk
-     * (up to 256 for DWAB) x width x the bytes of all channels, which a wide image with
-     * many channels makes gigabytes (found by fuzz_texture) */
-    int lines = 0;
+    /* the libraries' decompressors buffer one chunk of every channel: for a scanline
+     * image, rows per chunk (up to 256 for DWAB) x width x the bytes of all channels,
+     * which a wide image with many channels makes gigabytes (found by fuzz_texture); for
+     * a tiled one, a whole tile as the header sizes it, which may be far larger than the
+     * image (the C++ library allocates the full tile, even for a tile the image clips) */
     const exr_attr_chlist_t *ch = NULL;
-    if (exr_get_scanlines_per_chunk(ctxt, 0, &lines) != EXR_ERR_SUCCESS || lines <= 0) lines = 1;
     uint64_t pixel_bytes = 0;
     if (exr_get_channels(ctxt, 0, &ch) == EXR_ERR_SUCCESS)
         for (int i = 0; i < ch->num_channels; i++) pixel_bytes += ch->entries[i].pixel_type == EXR_PIXEL_HALF ? 2u : 4u;
+    int channels = ch ? ch->num_channels : 0;
+    if (storage == EXR_STORAGE_TILED) {
+        uint32_t tw = 0, th = 0;
+        exr_tile_level_mode_t levels;
+        exr_tile_round_mode_t round;
+        rv = exr_get_tile_descriptor(ctxt, 0, &tw, &th, &levels, &round);
+        if (rv != EXR_ERR_SUCCESS) return exr_fail(path, rv, err);
+        uint64_t tile = (uint64_t)tw * (uint64_t)th * pixel_bytes;
+        if (tile > EXR_MAX_CHUNK_BYTES)
+            return error_set(err, ST_INPUT, "'%s': the EXR image's tiles of %ux%u pixels x %d channels need %llu bytes "
+                             "each, more than clpt decodes (%u)", path, tw, th, channels, (unsigned long long)tile,
+                             EXR_MAX_CHUNK_BYTES);
+        /* the C++ library's InputFile reads a tiled image a row of tiles at a time,
+         * into a buffer of the image's width x the tiles' height */
+        uint64_t row = (uint64_t)w * (uint64_t)th * pixel_bytes;
+        if (row > EXR_MAX_CHUNK_BYTES)
+            return error_set(err, ST_INPUT, "'%s': a row of the EXR image's tiles (%d pixels wide, %u high, %d channels) "
+                             "needs %llu bytes, more than clpt decodes (%u)", path, w, th, channels,
+                             (unsigned long long)row, EXR_MAX_CHUNK_BYTES);
+        return ST_OK;
+    }
+    int lines = 0;
+    if (exr_get_scanlines_per_chunk(ctxt, 0, &lines) != EXR_ERR_SUCCESS || lines <= 0) lines = 1;
     uint64_t chunk = (uint64_t)lines * (uint64_t)w * pixel_bytes;
     if (chunk > EXR_MAX_CHUNK_BYTES)
         return error_set(err, ST_INPUT, "'%s': the EXR image's chunks of %d rows of %d pixels x %d channels need "
-                         "%llu bytes each, more than clpt decodes (%u)", path, lines, w,
-                         ch ? ch->num_channels : 0, (unsigned long long)chunk, EXR_MAX_CHUNK_BYTES);
+                         "%llu bytes each, more than clpt decodes (%u)", path, lines, w, channels,
+                         (unsigned long long)chunk, EXR_MAX_CHUNK_BYTES);
     return ST_OK;
 }
 
@@ -263,11 +287,11 @@ static ImfRgba *exr_frame_base(ImfRgba *px, int x0, int y0, int w)
     return (ImfRgba *)((uintptr_t)px - offset);
 }
 
-/* Decodes the pixels through the OpenEXR library's C interface to RgbaInputFile:
- * OpenEXRCore 3.1 (Debian 12) cannot decompress DWAA/DWAB, the compression real tools
- * write environment maps with; RgbaInputFile reads every compression, converts
- * luminance/chroma images to RGB and gives halves (16 bits: the precision of almost
- * every EXR environment map; float32 files lose their low bits). */
+/* Decodes the pixels through the OpenEXR library's C interface to RgbaInputFile
+ * (EXR_VIA_RGBA): it reads every layout and compression (DWAA/DWAB, which real tools
+ * write environment maps with, included), converts luminance/chroma images to RGB and
+ * gives halves, exact for colour stored in halves (the precision of almost every EXR
+ * environment map). */
 static Status exr_decode(const char *path, int w, int h, float *rgb, Error *err)
 {
     ImfInputFile *in = ImfOpenInputFile(path);
@@ -299,81 +323,158 @@ static Status exr_decode(const char *path, int w, int h, float *rgb, Error *err)
     return st;
 }
 
-/* Whether the image is read through exr_decode_float rather than as halves: a scanline
- * image whose colour has a 32-bit channel (float or uint), full-size, and no chroma
- * (luminance/chroma images need the library's conversion, which gives halves), not
- * DWAA or DWAB compressed (OpenEXRCore 3.1 cannot decompress those: "Decode pipeline
- * unable to decompress data"). A half holds at most 65504: a float sky's 70000-valued
- * sun was infinite as a half, and the image refused (issue 39). Tiled and DWA images
- * are read as halves still. */
-static int exr_wants_float(exr_context_t ctxt, const exr_attr_chlist_t *ch, const int pick[3])
+/* How the colour is decoded. A half holds at most 65504: a float sky's 70000-valued sun
+ * was infinite as a half, and the image refused (issue 39); so a colour channel of 32
+ * bits (float or uint) is read as float, whatever the layout. */
+typedef enum {
+    EXR_VIA_RGBA,    /* halves through RgbaInputFile (exr_decode): colour in halves only
+                      * (read exactly), and luminance/chroma images, which need the
+                      * library's conversion to RGB */
+    EXR_VIA_CORE,    /* floats through OpenEXRCore (exr_decode_float): scanline and tiled
+                      * images of every compression OpenEXRCore decompresses */
+    EXR_VIA_IMF,     /* floats through the C++ library (exr_imf.h): DWAA and DWAB, which
+                      * Debian 12's OpenEXRCore 3.1 cannot decompress ("DWA/B decompression
+                      * not yet implemented in C") */
+} ExrDecoder;
+
+static ExrDecoder exr_pick_decoder(exr_context_t ctxt, const exr_attr_chlist_t *ch, const int pick[3])
 {
-    exr_storage_t storage;
-    exr_compression_t comp;
-    if (exr_get_storage(ctxt, 0, &storage) != EXR_ERR_SUCCESS || storage != EXR_STORAGE_SCANLINE ||
-        exr_get_compression(ctxt, 0, &comp) != EXR_ERR_SUCCESS || comp == EXR_COMPRESSION_DWAA ||
-        comp == EXR_COMPRESSION_DWAB)
-        return 0;
-    int wide = 0;
     for (int i = 0; i < ch->num_channels; i++) {
         const char *n = ch->entries[i].name.str;
-        if (!strcmp(n, "RY") || !strcmp(n, "BY")) return 0;
+        if (!strcmp(n, "RY") || !strcmp(n, "BY")) return EXR_VIA_RGBA;
     }
+    int wide = 0;
     for (int k = 0; k < 3; k++) {
         if (pick[k] < 0) continue;
         const exr_attr_chlist_entry_t *e = &ch->entries[pick[k]];
-        if (e->x_sampling != 1 || e->y_sampling != 1) return 0;
+        if (e->x_sampling != 1 || e->y_sampling != 1) return EXR_VIA_RGBA;
         if (e->pixel_type != EXR_PIXEL_HALF) wide = 1;
     }
-    return wide;
+    exr_compression_t comp;
+    if (!wide || exr_get_compression(ctxt, 0, &comp) != EXR_ERR_SUCCESS) return EXR_VIA_RGBA;
+    return comp == EXR_COMPRESSION_DWAA || comp == EXR_COMPRESSION_DWAB ? EXR_VIA_IMF : EXR_VIA_CORE;
 }
 
-/* Decodes the colour channels pick[] of a scanline image (exr_wants_float) through
- * OpenEXRCore as 32-bit floats into rgb (w x h x 3, zeroed): halves convert exactly,
- * floats keep every bit. One channel (Y) picked for all three is decoded once and
- * copied. */
+/* One chunk of the image: a block of scanlines or a tile of level (0, 0), at (x, y)
+ * from the data window's corner, w x h pixels. */
+typedef struct {
+    exr_chunk_info_t info;
+    int64_t x, y, w, h;
+} ExrChunk;
+
+/* The number of chunks of level (0, 0) (the full resolution; a mipmapped or ripmapped
+ * image's smaller levels follow and are not read) and the blocks' size: tiles of tw x
+ * th pixels, or rows of th scanlines (tw = 0). */
+static exr_result_t exr_chunk_grid(exr_context_t ctxt, int w, int h, int *cols, int *rows, int *tw, int *th)
+{
+    exr_storage_t storage;
+    exr_result_t rv = exr_get_storage(ctxt, 0, &storage);
+    if (rv) return rv;
+    if (storage == EXR_STORAGE_TILED) {
+        uint32_t x = 0, y = 0;
+        exr_tile_level_mode_t levels;
+        exr_tile_round_mode_t round;
+        rv = exr_get_tile_descriptor(ctxt, 0, &x, &y, &levels, &round);
+        if (rv) return rv;
+        if (x == 0 || y == 0 || x > INT32_MAX || y > INT32_MAX) return EXR_ERR_INVALID_ATTR;
+        *tw = (int)x;
+        *th = (int)y;
+        *cols = (int)(((int64_t)w + x - 1) / x);
+        *rows = (int)(((int64_t)h + y - 1) / y);
+        return EXR_ERR_SUCCESS;
+    }
+    int lines = 0;
+    rv = exr_get_scanlines_per_chunk(ctxt, 0, &lines);
+    if (rv) return rv;
+    if (lines <= 0) return EXR_ERR_INVALID_ATTR;
+    *tw = 0;
+    *th = lines;
+    *cols = 1;
+    *rows = (int)(((int64_t)h + lines - 1) / lines);
+    return EXR_ERR_SUCCESS;
+}
+
+/* Reads the header of chunk (col, row) and where its pixels go. OpenEXRCore 3.1 gives a
+ * tile's start_x/start_y as tile indices (later versions as pixels), so a tile's place
+ * is computed here from the grid; the chunk's own size must be the one the grid gives
+ * it (the image clips the last column and row). */
+static exr_result_t exr_locate_chunk(exr_context_t ctxt, const exr_attr_box2i_t *dw, int w, int h, int col, int row,
+                                     int tw, int th, ExrChunk *c)
+{
+    exr_result_t rv;
+    if (tw > 0) {
+        rv = exr_read_tile_chunk_info(ctxt, 0, col, row, 0, 0, &c->info);
+        c->x = (int64_t)col * tw;
+    } else {
+        rv = exr_read_scanline_chunk_info(ctxt, 0, (int)(dw->min.y + (int64_t)row * th), &c->info);
+        c->x = 0;
+    }
+    if (rv) return rv;
+    c->y = (int64_t)row * th;
+    c->w = tw > 0 ? (w - c->x < tw ? w - c->x : tw) : w;
+    c->h = h - c->y < th ? h - c->y : th;
+    if (c->info.width != c->w || c->info.height != c->h || (tw == 0 && c->info.start_y != dw->min.y + c->y))
+        return EXR_ERR_CORRUPT_CHUNK;
+    return EXR_ERR_SUCCESS;
+}
+
+/* Decodes the colour channels pick[] of a scanline or tiled image (EXR_VIA_CORE)
+ * through OpenEXRCore as 32-bit floats into rgb (w x h x 3, zeroed): halves convert
+ * exactly, floats keep every bit. One channel (Y) picked for all three is decoded once
+ * and copied. */
 static Status exr_decode_float(exr_context_t ctxt, const char *path, const exr_attr_chlist_t *ch, const int pick[3],
                                const exr_attr_box2i_t *dw, int w, int h, float *rgb, Error *err)
 {
-    int lines = 0;
-    exr_result_t rv = exr_get_scanlines_per_chunk(ctxt, 0, &lines);
-    if (rv == EXR_ERR_SUCCESS && lines <= 0) rv = EXR_ERR_INVALID_ARGUMENT;
+    int cols = 0, rows = 0, tw = 0, th = 0;
+    exr_result_t rv = exr_chunk_grid(ctxt, w, h, &cols, &rows, &tw, &th);
     exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
     int started = 0;
-    for (int64_t y = dw->min.y; rv == EXR_ERR_SUCCESS && y <= dw->max.y; y += lines) {
-        exr_chunk_info_t ci;
-        rv = exr_read_scanline_chunk_info(ctxt, 0, (int)y, &ci);
-        if (rv) break;
-        rv = started ? exr_decoding_update(ctxt, 0, &ci, &dec) : exr_decoding_initialize(ctxt, 0, &ci, &dec);
-        if (rv) break;
-        started = 1;
-        int64_t row = (int64_t)ci.start_y - dw->min.y;
-        if (row < 0 || row + ci.height > h) {
-            rv = EXR_ERR_CORRUPT_CHUNK;
-            break;
-        }
-        for (int c = 0; c < dec.channel_count; c++) {
-            exr_coding_channel_info_t *cc = &dec.channels[c];
-            cc->decode_to_ptr = NULL;
-            for (int k = 0; k < 3; k++) {
-                if (pick[k] < 0 || (k > 0 && pick[k] == pick[k - 1])) continue;
-                if (strcmp(cc->channel_name, ch->entries[pick[k]].name.str) != 0) continue;
-                cc->decode_to_ptr = (uint8_t *)(rgb + 3u * ((size_t)row * (size_t)w) + k);
-                cc->user_pixel_stride = (int32_t)(3 * sizeof(float));
-                cc->user_line_stride = (int32_t)((size_t)w * 3 * sizeof(float));
-                cc->user_data_type = EXR_PIXEL_FLOAT;
-                cc->user_bytes_per_element = (int16_t)sizeof(float);
+    for (int row = 0; rv == EXR_ERR_SUCCESS && row < rows; row++)
+        for (int col = 0; rv == EXR_ERR_SUCCESS && col < cols; col++) {
+            ExrChunk c;
+            rv = exr_locate_chunk(ctxt, dw, w, h, col, row, tw, th, &c);
+            if (rv) break;
+            rv = started ? exr_decoding_update(ctxt, 0, &c.info, &dec) : exr_decoding_initialize(ctxt, 0, &c.info, &dec);
+            if (rv) break;
+            started = 1;
+            for (int i = 0; i < dec.channel_count; i++) {
+                exr_coding_channel_info_t *cc = &dec.channels[i];
+                cc->decode_to_ptr = NULL;
+                for (int k = 0; k < 3; k++) {
+                    if (pick[k] < 0 || (k > 0 && pick[k] == pick[k - 1])) continue;
+                    if (strcmp(cc->channel_name, ch->entries[pick[k]].name.str) != 0) continue;
+                    cc->decode_to_ptr = (uint8_t *)(rgb + 3u * ((size_t)c.y * (size_t)w + (size_t)c.x) + k);
+                    cc->user_pixel_stride = (int32_t)(3 * sizeof(float));
+                    cc->user_line_stride = (int32_t)((size_t)w * 3 * sizeof(float));
+                    cc->user_data_type = EXR_PIXEL_FLOAT;
+                    cc->user_bytes_per_element = (int16_t)sizeof(float);
+                }
             }
+            rv = exr_decoding_choose_default_routines(ctxt, 0, &dec);
+            if (!rv) rv = exr_decoding_run(ctxt, 0, &dec);
         }
-        rv = exr_decoding_choose_default_routines(ctxt, 0, &dec);
-        if (!rv) rv = exr_decoding_run(ctxt, 0, &dec);
-    }
     if (started) exr_decoding_destroy(ctxt, &dec);
     if (rv) return exr_fail(path, rv, err);
-    /* Y alone fills all three */
+    return ST_OK;
+}
+
+/* Y alone, picked for all three components, was decoded into the first: copy it. */
+static void exr_spread_grey(const int pick[3], float *rgb, int w, int h)
+{
     for (int k = 1; k < 3; k++)
         if (pick[k] >= 0 && pick[k] == pick[0])
             for (size_t i = 0; i < (size_t)w * (size_t)h; i++) rgb[3 * i + (size_t)k] = rgb[3 * i];
+}
+
+/* Decodes through the C++ library (EXR_VIA_IMF), after the same checks. */
+static Status exr_decode_imf(const char *path, const exr_attr_chlist_t *ch, const int pick[3],
+                             const exr_attr_box2i_t *dw, int w, int h, float *rgb, Error *err)
+{
+    const char *names[3];
+    for (int k = 0; k < 3; k++) names[k] = pick[k] < 0 ? NULL : ch->entries[pick[k]].name.str;
+    char why[256];
+    if (!exr_imf_read_float(path, names, dw->min.x, dw->min.y, w, h, rgb, why, sizeof why))
+        return error_set(err, ST_INPUT, "'%s': not an EXR file OpenEXR can read (%s)", path, why);
     return ST_OK;
 }
 
@@ -445,10 +546,12 @@ Status exr_read_rgb(const char *path, uint64_t max_pixels, float **rgb, int *wid
     float *px = NULL;
     if (!st && !(px = calloc((size_t)w * (size_t)h * 3u, sizeof *px)))
         st = error_set(err, ST_INTERNAL, "out of memory reading '%s'", path);
-    int as_float = !st && exr_wants_float(ctxt, ch, pick);
-    if (as_float) st = exr_decode_float(ctxt, path, ch, pick, &dw, (int)w, (int)h, px, err);
+    ExrDecoder via = st ? EXR_VIA_RGBA : exr_pick_decoder(ctxt, ch, pick);
+    if (!st && via == EXR_VIA_CORE) st = exr_decode_float(ctxt, path, ch, pick, &dw, (int)w, (int)h, px, err);
+    if (!st && via == EXR_VIA_IMF) st = exr_decode_imf(path, ch, pick, &dw, (int)w, (int)h, px, err);
+    if (!st && via != EXR_VIA_RGBA) exr_spread_grey(pick, px, (int)w, (int)h);
     exr_finish(&ctxt);
-    if (!st && !as_float) st = exr_decode(path, (int)w, (int)h, px, err);
+    if (!st && via == EXR_VIA_RGBA) st = exr_decode(path, (int)w, (int)h, px, err);
     if (!st) st = exr_finish_pixels(path, px, (int)w, (int)h, err);
     if (st) {
         free(px);

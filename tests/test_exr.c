@@ -271,6 +271,260 @@ static void test_exr_data_window(void)
     check_exr_window(1000000000, 1000000000, 65536, 2);
 }
 
+/* ------------------------------------------------------------ float layouts */
+
+/* The value of component k of pixel (x, y) of level `level` of a test image: every bit
+ * of the mantissa used, negatives, and a 70000-valued "sun" at pixel (1, 0), beyond a
+ * half's 65504 (issue 39: such a float image was read as halves and refused). */
+static float layout_value(int x, int y, int k, int level)
+{
+    if (x == 1 && y == 0 && k == 1) return 70000.0f;
+    return (float)((x * 131 + y * 71 + k * 37) % 997) / 7.0f - 20.0f + 1000.0f * (float)level;
+}
+
+/* Level `level` of a test image (w x h) as interleaved RGB floats. */
+static float *layout_pixels(int w, int h, int level)
+{
+    float *px = malloc((size_t)w * (size_t)h * 3 * sizeof *px);
+    for (int y = 0; px && y < h; y++)
+        for (int x = 0; x < w; x++)
+            for (int k = 0; k < 3; k++) px[3 * ((size_t)y * w + x) + k] = layout_value(x, y, k, level);
+    return px;
+}
+
+/* Points the encoder's channels (B, G, R, sorted by name) at the block of `px` (a
+ * level `lw` pixels wide) whose corner is (x, y). */
+static void layout_sources(exr_encode_pipeline_t *enc, const float *px, int lw, int x, int y)
+{
+    for (int c = 0; c < enc->channel_count; c++) {
+        exr_coding_channel_info_t *cc = &enc->channels[c];
+        int k = cc->channel_name[0] == 'R' ? 0 : cc->channel_name[0] == 'G' ? 1 : 2;
+        cc->encode_from_ptr = (const uint8_t *)(px + 3 * ((size_t)y * lw + x) + k);
+        cc->user_pixel_stride = 3 * sizeof(float);
+        cc->user_line_stride = lw * 3 * (int32_t)sizeof(float);
+        cc->user_data_type = EXR_PIXEL_FLOAT;
+        cc->user_bytes_per_element = sizeof(float);
+    }
+}
+
+/* Writes a tiled float RGB image (w x h, data window from (x0, y0), tw x th tiles)
+ * through OpenEXRCore, every level of `mode` (one or mipmaps: OpenEXRCore 3.1 numbers
+ * a ripmap's chunks wrongly): level l holds layout_value(..., l). OpenEXRCore 3.1
+ * garbles a tile that its compressor does not shrink (both OpenEXR readers then read
+ * noise), so small tiles are written uncompressed. Returns 1 when written. */
+static int write_tiled(const char *path, int x0, int y0, int w, int h, int tw, int th, exr_tile_level_mode_t mode,
+                       exr_compression_t comp)
+{
+    exr_context_t ctxt = NULL;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    int part = 0;
+    exr_attr_box2i_t dw;
+    dw.min.x = x0;
+    dw.min.y = y0;
+    dw.max.x = x0 + w - 1;
+    dw.max.y = y0 + h - 1;
+    exr_result_t rv = exr_start_write(&ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init);
+    if (!rv) rv = exr_add_part(ctxt, "image", EXR_STORAGE_TILED, &part);
+    if (!rv) rv = exr_initialize_required_attr_simple(ctxt, part, w, h, comp);
+    if (!rv) rv = exr_set_data_window(ctxt, part, &dw);
+    if (!rv) rv = exr_set_display_window(ctxt, part, &dw);
+    for (int k = 0; k < 3 && !rv; k++)
+        rv = exr_add_channel(ctxt, part, (const char *[]){ "R", "G", "B" }[k], EXR_PIXEL_FLOAT,
+                             EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+    if (!rv) rv = exr_set_tile_descriptor(ctxt, part, (uint32_t)tw, (uint32_t)th, mode, EXR_TILE_ROUND_DOWN);
+    if (!rv) rv = exr_write_header(ctxt);
+    int nx = 0, ny = 0, started = 0;
+    if (!rv) rv = exr_get_tile_levels(ctxt, part, &nx, &ny);
+    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
+    for (int ly = 0; ly < ny && !rv; ly++)
+        for (int lx = 0; lx < nx && !rv; lx++) {
+            if (mode == EXR_TILE_MIPMAP_LEVELS && lx != ly) continue;
+            int lw = 0, lh = 0;
+            rv = exr_get_level_sizes(ctxt, part, lx, ly, &lw, &lh);
+            float *px = rv ? NULL : layout_pixels(lw, lh, lx + ly);
+            for (int ty = 0; px && !rv && ty * th < lh; ty++)
+                for (int tx = 0; !rv && tx * tw < lw; tx++) {
+                    exr_chunk_info_t ci;
+                    rv = exr_write_tile_chunk_info(ctxt, part, tx, ty, lx, ly, &ci);
+                    if (!rv) rv = started ? exr_encoding_update(ctxt, part, &ci, &enc)
+                                          : exr_encoding_initialize(ctxt, part, &ci, &enc);
+                    if (rv) break;
+                    started = 1;
+                    layout_sources(&enc, px, lw, tx * tw, ty * th);
+                    rv = exr_encoding_choose_default_routines(ctxt, part, &enc);
+                    if (!rv) rv = exr_encoding_run(ctxt, part, &enc);
+                }
+            free(px);
+        }
+    if (started) exr_encoding_destroy(ctxt, &enc);
+    exr_result_t fin = exr_finish(&ctxt);
+    CHECK_MSG(!rv && !fin, "writing %s: %s", path, exr_get_error_code_as_string(rv ? rv : fin));
+    return !rv && !fin;
+}
+
+/* Reads `path` with clpt's reader and compares with level 0 of the test image, bit for
+ * bit; returns the pixels that differ. */
+static uint read_layout(const char *path, int w, int h)
+{
+    float *rgb = NULL, *want = layout_pixels(w, h, 0);
+    int gw = 0, gh = 0;
+    Error err = { 0 };
+    Status st = exr_read_rgb(path, 1u << 20, &rgb, &gw, &gh, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    uint bad = st ? (uint)(w * h) : 0;
+    if (!st) {
+        CHECK_EQ_INT(gw, w);
+        CHECK_EQ_INT(gh, h);
+        for (int i = 0; gw == w && gh == h && i < w * h; i++) bad += memcmp(rgb + 3 * i, want + 3 * i, 12) != 0;
+    }
+    free(rgb);
+    free(want);
+    error_clear(&err);
+    return bad;
+}
+
+/* Tiled float images (read as halves before: the 70000 sun was infinite, the image
+ * refused): through OpenEXRCore, every value bit for bit, with the last column and row
+ * of tiles cut by the image, tiles larger than the image, a data window off the
+ * origin; and the OpenEXR library's own ZIP-compressed tiles (generate_exr_float.cpp). */
+static void test_exr_tiled_float(void)
+{
+    char path[] = "/tmp/clpt-test-exr-tiled-XXXXXX.exr";
+    int fd = mkstemps(path, 4);
+    close(fd);
+    static const int cases[][7] = { { 0, 0, 37, 21, 16, 8, EXR_COMPRESSION_ZIP },
+                                    { -3, 7, 37, 21, 5, 3, EXR_COMPRESSION_NONE },
+                                    { 0, 0, 7, 5, 64, 64, EXR_COMPRESSION_RLE },
+                                    { 2, -9, 1, 1, 1, 1, EXR_COMPRESSION_NONE } };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const int *c = cases[i];
+        if (!write_tiled(path, c[0], c[1], c[2], c[3], c[4], c[5], EXR_TILE_ONE_LEVEL, (exr_compression_t)c[6]))
+            continue;
+        uint bad = read_layout(path, c[2], c[3]);
+        CHECK_MSG(bad == 0, "%dx%d from (%d, %d) in %dx%d tiles: %u pixels differ", c[2], c[3], c[0], c[1], c[4], c[5],
+                  bad);
+    }
+    unlink(path);
+    CHECK_EQ_INT(read_layout("tests/data/images/float-tiled-zip.exr", 19, 11), 0);
+}
+
+/* Mipmapped and ripmapped images: level (0, 0), the full resolution, is the image (the
+ * smaller levels hold other values, 1000 x level more, and must not leak in). The
+ * ripmap comes from the OpenEXR library (generate_exr_float.cpp). */
+static void test_exr_tiled_levels(void)
+{
+    char path[] = "/tmp/clpt-test-exr-levels-XXXXXX.exr";
+    int fd = mkstemps(path, 4);
+    close(fd);
+    if (write_tiled(path, 0, 0, 37, 21, 8, 8, EXR_TILE_MIPMAP_LEVELS, EXR_COMPRESSION_ZIP))
+        CHECK_EQ_INT(read_layout(path, 37, 21), 0);
+    unlink(path);
+    CHECK_EQ_INT(read_layout("tests/data/images/float-ripmap.exr", 19, 11), 0);
+}
+
+/* The uncompressed bytes of a scanline chunk of the test image: per row, the channels
+ * in name order (B, G, R), each w little-endian floats (the hosts clpt runs on are
+ * little-endian, as EXR is). */
+static unsigned char *scanline_bytes(const float *px, int w, int y0, int rows, size_t *size)
+{
+    *size = (size_t)rows * 3 * (size_t)w * sizeof(float);
+    unsigned char *b = malloc(*size), *o = b;
+    for (int y = y0; b && y < y0 + rows; y++)
+        for (int c = 2; c >= 0; c--)
+            for (int x = 0; x < w; x++, o += sizeof(float)) memcpy(o, px + 3 * ((size_t)y * w + x) + c, sizeof(float));
+    return b;
+}
+
+/* DWAB with float channels. OpenEXR 3.1's DWA coder classifies the channels by name
+ * (ImfDwaCompressor.cpp's default rules): R, G, B, Y, BY and RY, half or float, go
+ * through its lossy DCT, which codes halves (a float 70000 comes back 65248); other
+ * channels are stored losslessly, and so is any chunk that DWA would not make smaller:
+ * the library then stores it as it is, which a reader knows from its size. Such a
+ * chunk, written here with OpenEXRCore (which cannot compress DWA), holds every float
+ * bit, the sun included; the reader decodes it through the C++ library (OpenEXRCore 3.1
+ * cannot decompress DWA at all) and keeps every bit: it was read as halves before, and
+ * refused. */
+static void test_exr_dwab_float_stored(void)
+{
+    char path[] = "/tmp/clpt-test-exr-dwab-XXXXXX.exr";
+    int fd = mkstemps(path, 4);
+    close(fd);
+    const int w = 37, h = 21;
+    float *px = layout_pixels(w, h, 0);
+    size_t size = 0;
+    unsigned char *raw = scanline_bytes(px, w, 0, h, &size);
+    exr_context_t ctxt = NULL;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    int part = 0;
+    exr_result_t rv = exr_start_write(&ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init);
+    if (!rv) rv = exr_add_part(ctxt, "image", EXR_STORAGE_SCANLINE, &part);
+    if (!rv) rv = exr_initialize_required_attr_simple(ctxt, part, w, h, EXR_COMPRESSION_DWAB);
+    for (int k = 0; k < 3 && !rv; k++)
+        rv = exr_add_channel(ctxt, part, (const char *[]){ "R", "G", "B" }[k], EXR_PIXEL_FLOAT,
+                             EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+    if (!rv) rv = exr_write_header(ctxt);
+    if (!rv) rv = exr_write_scanline_chunk(ctxt, part, 0, raw, size);   /* one chunk: DWAB's is 256 rows */
+    exr_result_t fin = exr_finish(&ctxt);
+    CHECK_MSG(!rv && !fin, "writing %s: %s", path, exr_get_error_code_as_string(rv ? rv : fin));
+    CHECK_EQ_INT(read_layout(path, w, h), 0);
+    free(raw);
+    free(px);
+    unlink(path);
+}
+
+/* Reads `path` with clpt's reader and with the OpenEXR library's half interface
+ * (RgbaInputFile), and counts the pixels of the float reading that are the test image's
+ * exact values (*exact) and those that equal the half reading (*as_half). */
+static void read_dwa(const char *path, int w, int h, uint *exact, uint *as_half, float *sun)
+{
+    *exact = *as_half = 0;
+    float *rgb = NULL, *want = layout_pixels(w, h, 0);
+    int gw = 0, gh = 0;
+    Error err = { 0 };
+    CHECK_MSG(exr_read_rgb(path, 1u << 20, &rgb, &gw, &gh, &err) == ST_OK, "%s", err.msg);
+    CHECK(gw == w && gh == h);
+    ImfInputFile *in = ImfOpenInputFile(path);
+    CHECK_MSG(in != NULL, "%s", ImfErrorMessage());
+    ImfRgba *px = rgb && in && gw == w && gh == h ? malloc((size_t)w * (size_t)h * sizeof *px) : NULL;
+    if (px && ImfInputSetFrameBuffer(in, px, 1, (size_t)w) && ImfInputReadPixels(in, 0, h - 1)) {
+        for (int i = 0; i < w * h; i++) {
+            *exact += memcmp(rgb + 3 * i, want + 3 * i, 12) == 0;
+            *as_half += rgb[3 * i] == ImfHalfToFloat(px[i].r) && rgb[3 * i + 1] == ImfHalfToFloat(px[i].g) &&
+                        rgb[3 * i + 2] == ImfHalfToFloat(px[i].b);
+        }
+        *sun = rgb[4];
+    } else
+        CHECK_MSG(0, "the library could not read %s: %s", path, ImfErrorMessage());
+    free(px);
+    if (in) ImfCloseInputFile(in);
+    free(rgb);
+    free(want);
+    error_clear(&err);
+}
+
+/* Float images the OpenEXR library compressed with DWAB and DWAA (tiled, mipmapped:
+ * level 0), generate_exr_float.cpp. What holds: every pixel is either the exact float
+ * (a chunk DWA did not shrink, stored as it is) or what the library's half reading
+ * gives (its DCT codes R, G and B as halves, float channels or not); the 70000 sun
+ * comes back below 65504 from a DCT-coded chunk (DWA clamps; 64704 here, its
+ * neighbours' doing), not +inf, so the image is read, not refused. */
+static void test_exr_dwa_float_library(void)
+{
+    uint exact = 0, as_half = 0;
+    float sun = 0.0f;
+    read_dwa("tests/data/images/float-dwab.exr", 40, 24, &exact, &as_half, &sun);
+    fprintf(stderr, "  float DWAB 40x24: %u of %u pixels as the library's half reading, %u exact; the sun reads %g\n",
+            as_half, 40u * 24u, exact, (double)sun);
+    CHECK_EQ_INT(as_half, 40 * 24);
+    CHECK(sun > 60000.0f && sun <= 65504.0f);
+    read_dwa("tests/data/images/float-tiled-dwaa.exr", 37, 21, &exact, &as_half, &sun);
+    fprintf(stderr, "  float DWAA 37x21 in 16x16 tiles, mipmapped: %u of %u pixels exact (tiles stored as they "
+            "are), %u as the half reading; the sun reads %g\n", exact, 37u * 21u, as_half, (double)sun);
+    CHECK(exact > 0 && as_half > 0);
+    CHECK_EQ_INT(exact + as_half, 37 * 21);
+    CHECK(sun > 60000.0f && sun <= 65504.0f);
+}
+
 /* Radiance HDR: read back by stb_image within RGBE's precision (8 bits of mantissa
  * shared: 1/128 of the largest component); negative and NaN values come back 0. */
 static void test_hdr(void)
@@ -436,6 +690,10 @@ int main(void)
     RUN(test_exr_encoded);
     RUN(test_exr_beyond_half);
     RUN(test_exr_data_window);
+    RUN(test_exr_tiled_float);
+    RUN(test_exr_tiled_levels);
+    RUN(test_exr_dwab_float_stored);
+    RUN(test_exr_dwa_float_library);
     RUN(test_hdr);
     RUN(test_cli_aov_channels);
     RUN(test_cli_depth_pfm_background_is_infinite);

@@ -8,7 +8,8 @@
 # "seed", "bounces" (Cycles' max_bounces), "background": {"kind": "white" | "black" |
 # "env", "map", "rotz"}, "override": null | "diffuse:R,G,B"}. Each writes OUT.npy (H x W
 # x 3 float32, linear, top row first) and OUT.json (the lights and Principled BSDFs as
-# imported, the image mean).
+# imported, the image mean). "diffuse:R,G,B" makes every surface a Lambertian Diffuse
+# BSDF, fed by the normal map the importer made, if any.
 #
 # Conventions (matched with clpt; ../shared/peers/README.md found them first):
 # - punctual lights: the importer gives lights a 0.25 m radius and suns a 0.53 degree
@@ -44,20 +45,43 @@ def lights_points(sc, info):
         info["lights"].append(d)
 
 
-def override_diffuse(sc, rgb):
-    """Every mesh gets one Diffuse BSDF (Lambert: roughness 0) of colour rgb."""
-    m = bpy.data.materials.new("xcheck-diffuse")
-    m.use_nodes = True
-    nt = m.node_tree
-    nt.nodes.remove(nt.nodes["Principled BSDF"])
+def diffuse_node(nt, rgb):
     dn = nt.nodes.new("ShaderNodeBsdfDiffuse")
     dn.inputs["Color"].default_value = (*rgb, 1.0)
     dn.inputs["Roughness"].default_value = 0.0
-    nt.links.new(dn.outputs["BSDF"], nt.nodes["Material Output"].inputs["Surface"])
+    return dn
+
+
+def override_diffuse(sc, rgb):
+    """Every mesh's surface becomes one Diffuse BSDF (Lambert: roughness 0) of colour rgb.
+    An imported material keeps its nodes, and the normal map the importer linked to its
+    Principled BSDF's Normal (a Normal Map node: glTF's normalTexture) now feeds the
+    Diffuse BSDF's; a mesh slot with no node material gets a plain one."""
+    plain, done = None, set()
     for o in sc.objects:
-        if o.type == "MESH":
-            for k in range(len(o.material_slots)):
-                o.material_slots[k].material = m
+        if o.type != "MESH":
+            continue
+        for slot in o.material_slots:
+            m = slot.material
+            if m is None or not m.use_nodes:
+                if plain is None:
+                    plain = bpy.data.materials.new("xcheck-diffuse")
+                    plain.use_nodes = True
+                    nt = plain.node_tree
+                    nt.nodes.remove(nt.nodes["Principled BSDF"])
+                    nt.links.new(diffuse_node(nt, rgb).outputs["BSDF"], nt.nodes["Material Output"].inputs["Surface"])
+                slot.material = plain
+                continue
+            if m.name in done:
+                continue
+            done.add(m.name)
+            nt = m.node_tree
+            dn = diffuse_node(nt, rgb)
+            for n in nt.nodes:
+                if n.type == "BSDF_PRINCIPLED" and n.inputs["Normal"].is_linked:
+                    nt.links.new(n.inputs["Normal"].links[0].from_socket, dn.inputs["Normal"])
+            out = [n for n in nt.nodes if n.type == "OUTPUT_MATERIAL"]
+            nt.links.new(dn.outputs["BSDF"], out[0].inputs["Surface"])
 
 
 def world(sc, bgd):

@@ -18,6 +18,7 @@ A scene is a dict:
   light             None or a KHR_lights_punctual light with the node's place
   background        'white' (radiance 1 everywhere), 'black' or 'env' (an equirectangular map)
   floor             a 8 x 8 floor at y = -1 under the unit sphere
+  sphere            False: the floor alone (a plane), seen from the floor scenes' camera
   textures          {key: (kind, size)}: images the harness draws (base colour, normal, emission)
   notes             {peer: the known model difference for this scene}
 """
@@ -32,6 +33,11 @@ SEPARABLE_G = "separable Smith G1 G1 (clpt: height-correlated), darker when roug
 CY_SOLID = "Cycles' Principled transmission is solid glass: no thin walls"
 CY_SPOT = "Cycles multiplies spot lights by cos theta and smoothsteps the cone"
 MI_SPOT = "Mitsuba's spot falls off linearly in angle between beam_width and cutoff_angle"
+MAPPED_AWAY_MI = ("normalmap evaluates its BSDF in the mapped frame as it is: 0 where the viewer is below "
+                  "the mapped normal's horizon (clpt and Cycles bend such a normal back toward the geometric "
+                  "one), darker")
+MAPPED_AWAY_CY = ("ensure_valid_reflection bends a mapped normal that faces away from the viewer, as clpt's "
+                  "bsdf_normal does")
 
 
 def _rgb(v):
@@ -65,7 +71,7 @@ def scene_list():
     def add(name, what, **kw):
         s = {"name": name, "what": what, "material": _gltf_mat(), "ext": [], "needs": [], "clpt": None,
              "cycles": None, "mitsuba": None, "mitsuba_emitter": None, "light": None, "background": "white",
-             "floor": False, "textures": {}, "notes": {}}
+             "floor": False, "sphere": True, "textures": {}, "notes": {}}
         s.update(kw)
         S.append(s)
 
@@ -259,6 +265,29 @@ def scene_list():
                                "bsdf": _principled((0.8, 0.8, 0.8), 0.0, 1.0)},
         notes={"mitsuba": DISNEY_DIFFUSE + "; tangent frame from its own uv derivatives",
                "cycles": DISNEY_DIFFUSE + "; MikkTSpace tangents from the uvs"})
+    # the same normal map on a Lambertian base, in every renderer: glTF's principled with
+    # KHR_materials_specular's specularFactor 0 (no specular lobe, no Fresnel taken from
+    # the diffuse: Lambert), Mitsuba's normalmap over its diffuse, Cycles' Diffuse BSDF fed
+    # by the importer's Normal Map node. Without the Disney diffuse of the normal-map row,
+    # what is left is the normal mapping: the tangent frame, and what each renderer does
+    # where the mapped normal faces away from the viewer (MAPPED_AWAY_*).
+    lam_nm = dict(material=_gltf_mat((0.8, 0.8, 0.8), 0.0, 1.0, normalTexture="normal", extensions={
+                      "KHR_materials_specular": {"specularFactor": 0.0}}),
+                  textures={"normal": ("bumps", 128)}, background="black",
+                  ext=["KHR_lights_punctual", "KHR_materials_specular"],
+                  needs=["KHR_lights_punctual", "KHR_materials_specular"], cycles="diffuse:0.8,0.8,0.8",
+                  mitsuba=lambda mi, t: {"type": "normalmap", "normalmap": t["normal"],
+                                         "bsdf": {"type": "diffuse", "reflectance": _rgb((0.8, 0.8, 0.8))}},
+                  notes={"mitsuba": MAPPED_AWAY_MI + "; tangent frame from its own uv derivatives",
+                         "cycles": MAPPED_AWAY_CY + "; MikkTSpace tangents from the uvs"})
+    add("normal-map-lambert", "the normal-map row's bumps on a Lambertian 0.8 grey (glTF specularFactor 0), "
+        "directional light", light={"type": "directional", "color": [1, 1, 1], "intensity": 683.0 * 3,
+                                    "dir": (-1.0, -0.5, -1.0)}, **lam_nm)
+    add("normal-map-plane", "a plane of domes: the bumps' normal map on the 8 x 8 floor alone (Lambertian 0.8 "
+        "grey), seen from 17 to 40 degrees above it, lit from behind the domes (issue 39's black rims)",
+        floor=True, sphere=False,
+        light={"type": "directional", "color": [1, 1, 1], "intensity": 683.0 * 3, "dir": (0.3, -0.8, 1.0)},
+        **lam_nm)
     # --- environment map
     add("env-lambert", "Lambert 0.8 0.5 0.2 under courtyard.hdr",
         clpt="type diffuse albedo %g %g %g" % ORANGE, cycles="diffuse:%g,%g,%g" % ORANGE,

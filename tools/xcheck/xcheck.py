@@ -9,8 +9,8 @@ usage: python3 tools/xcheck/xcheck.py [--clpt build/clpt] [--out build/xcheck] [
            [--mitsuba-variant scalar_rgb]
 
 Each scene is a glTF file written here (a UV sphere of radius 1 at the origin, 64 x 32
-segments with normals, uvs and tangents; a floor for the light scenes; the camera; the
-lights): clpt renders it through `mesh { file ... }` in a scene of its own format (camera,
+segments with normals, uvs and tangents; a floor for the light scenes, or the floor alone;
+the camera; the lights): clpt renders it through `mesh { file ... }` in a scene of its own format (camera,
 background, image settings), Cycles through Blender's glTF importer (cycles_render.py,
 one Blender process for all scenes), Mitsuba from the same triangles as PLY files with its
 own BSDF. Paths are 16 bounces long after the camera ray (Mitsuba max_depth 17, Cycles
@@ -218,7 +218,8 @@ def write_gltf(s, folder, tex):
     g.j["materials"].append(mat)
     if s["ext"]:
         g.j["extensionsUsed"] = list(s["ext"])
-    g.mesh(uv_sphere(), 0)
+    if s["sphere"]:
+        g.mesh(uv_sphere(), 0)
     if s["floor"]:
         g.mesh(floor_quad(), 0)
     cam_from, cam_at, fov = CAMERAS["floor" if s["floor"] else "sphere"]
@@ -281,7 +282,7 @@ def object_ids(s, size, xs, ys):
     b = d @ o
     disc = b * b - (o @ o - 1.0)
     t_s = np.where(disc > 0, -b - np.sqrt(np.maximum(disc, 0)), np.inf)
-    t_s = np.where(t_s > 0, t_s, np.inf)
+    t_s = np.where((t_s > 0) & s["sphere"], t_s, np.inf)
     ids = np.where(np.isfinite(t_s), 1, 0)
     if s["floor"]:
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -379,7 +380,8 @@ class Mitsuba:
         t = {k: self.bitmap(p, k == "normal") for k, p in tex.items()}
         bsdf = s["mitsuba"](mi, t)
         sph = os.path.join(folder, s["name"] + "-sphere.ply")
-        write_ply(sph, uv_sphere())
+        if s["sphere"]:
+            write_ply(sph, uv_sphere())
         d = {"type": "scene",
              "integrator": {"type": "volpath" if s.get("mitsuba_interior") else "path", "max_depth": DEPTH + 1},
              "sensor": {"type": "perspective", "fov": fov, "fov_axis": "y",
@@ -387,8 +389,9 @@ class Mitsuba:
                                                                    up=[0, 1, 0]),
                         "film": {"type": "hdrfilm", "width": a.size, "height": a.size,
                                  "rfilter": {"type": "box"}, "pixel_format": "rgb"},
-                        "sampler": {"type": "independent", "sample_count": a.spp}},
-             "sphere": {"type": "ply", "filename": sph, "bsdf": bsdf, "face_normals": False}}
+                        "sampler": {"type": "independent", "sample_count": a.spp}}}
+        if s["sphere"]:
+            d["sphere"] = {"type": "ply", "filename": sph, "bsdf": bsdf, "face_normals": False}
         em = s["mitsuba_emitter"]
         if em is not None:
             d["sphere"]["emitter"] = {"type": "area", "radiance": t[em] if isinstance(em, str) else

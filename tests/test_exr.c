@@ -437,7 +437,7 @@ static unsigned char *scanline_bytes(const float *px, int w, int y0, int rows, s
 
 /* DWAB with float channels. OpenEXR 3.1's DWA coder classifies the channels by name
  * (ImfDwaCompressor.cpp's default rules): R, G, B, Y, BY and RY, half or float, go
- * through its lossy DCT, which codes halves (a float 70000 comes back 65248); other
+ * through its lossy DCT, which codes halves (a float 70000 comes back below 65504); other
  * channels are stored losslessly, and so is any chunk that DWA would not make smaller:
  * the library then stores it as it is, which a reader knows from its size. Such a
  * chunk, written here with OpenEXRCore (which cannot compress DWA), holds every float

@@ -115,13 +115,18 @@ KFN int medium_flight_grid(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL
     uint rb = path_rng_bounce(ps);
     uint rng = grid_rng_seed(key, rb, GRID_TAG_FLIGHT);
     *result = 0u;
+    vec3 emitted = v3s(0.0f);
     if (v3_is_zero(md.sigma_s)) {
-        ps->throughput = v3_mul(ps->throughput, grid_transmittance(sc, md, x, d, dist, &rng));
+        vec3 tr = grid_transmittance(sc, md, x, d, dist, &rng, &emitted);
+        if (md.emissive) ps->radiance = v3_add(ps->radiance, v3_mul(ps->throughput, emitted));
+        ps->throughput = v3_mul(ps->throughput, tr);
         return !(v3_max_comp(ps->throughput) > 0.0f);
     }
     vec3 thr = ps->throughput;
     float ts;
-    int ev = grid_track(sc, md, x, d, dist, &thr, rng_uniform(key, rb, DIM_MEDIUM), &rng, &ts);
+    int ev = grid_track(sc, md, x, d, dist, &thr, rng_uniform(key, rb, DIM_MEDIUM), &rng, &ts, &emitted);
+    /* emitted already carries the path's throughput (grid_track's weights start from it) */
+    if (md.emissive) ps->radiance = v3_add(ps->radiance, emitted);
     if (ev == GRID_ENDED || !(v3_max_comp(thr) > 0.0f)) return 1;
     ps->throughput = thr;
     if (ev == GRID_PASSED) return 0;
@@ -139,6 +144,9 @@ KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL Path
     float len = v3_len(r.d);
     float dist = hit.prim == NO_INDEX ? INFINITY : (hit.t - r.tmin) * len;
     *result = 0u;
+    /* the emission along the whole stretch, exactly, before the flight decides where
+     * the path goes on (docs/media.md, "Emission") */
+    if (md.emissive) ps->radiance = v3_add(ps->radiance, v3_mul(ps->throughput, medium_emitted(md, sigma_t, dist)));
     if (v3_is_zero(md.sigma_s)) {
         ps->throughput = v3_mul(ps->throughput, medium_tr(sigma_t, dist));
         return !(v3_max_comp(ps->throughput) > 0.0f);

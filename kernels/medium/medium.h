@@ -109,6 +109,23 @@ KFN float medium_stop_pdf(vec3 pc, vec3 sigma_t, vec3 tr)
     return pc.x * sigma_t.x * tr.x + pc.y * sigma_t.y * tr.y + pc.z * sigma_t.z * tr.z;
 }
 
+/* 1 - exp(-sigma dist) for one channel, the series sigma dist (1 - x / 2) below an
+ * optical depth of 1e-3, where the difference would lose its digits. */
+KFN float medium_absorbed1(float sigma, float dist)
+{
+    if (!(sigma > 0.0f)) return 0.0f;
+    float x = sigma * dist;
+    return x < 1e-3f ? x * (1.0f - 0.5f * x) : 1.0f - medium_tr1(sigma, dist);
+}
+
+/* The mixture probability of stopping before distance dist (1 - P(pass), computed
+ * without the cancellation of a thin medium). */
+KFN float medium_stop_prob(vec3 pc, vec3 sigma_t, float dist)
+{
+    return pc.x * medium_absorbed1(sigma_t.x, dist) + pc.y * medium_absorbed1(sigma_t.y, dist) +
+           pc.z * medium_absorbed1(sigma_t.z, dist);
+}
+
 /* The mixture probability of flying past a distance whose transmittance is tr. */
 KFN float medium_pass_prob(vec3 pc, vec3 tr)
 {

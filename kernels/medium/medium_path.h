@@ -127,9 +127,13 @@ KFN int medium_segment_light(const SceneView *sc, GLOBAL PathState *ps, Medium m
 {
     vec3 sigma_t = medium_sigma_t(md);
     Equiangular e;
+    e.delta = e.D = e.theta_a = e.theta_b = 0.0f;   /* unused unless c_eq > 0 */
     /* the share of equiangular samples: 1/2, or 1 for MIS_LIGHT_ONLY (the tests'
      * "light strategy only"); 0 where the ray passes through the light */
-    float c_eq = !equiangular_begin(x0, d, l.position, dist, &e) ? 0.0f
+    float t_lo = 0.0f, t_hi = dist;
+    int lit = !light_has(l.type, LT_CONE) || !(l.cos_outer > 0.0f) ||
+              equiangular_cone_clip(x0, d, l.position, l.direction, l.cos_outer, dist, &t_lo, &t_hi);
+    float c_eq = !lit || !equiangular_begin(x0, d, l.position, t_lo, t_hi, &e) ? 0.0f
                  : (sc->params->mis_mode == MIS_LIGHT_ONLY ? 1.0f : 0.5f);
     float t;
     if (lv < c_eq) {
@@ -142,7 +146,13 @@ KFN int medium_segment_light(const SceneView *sc, GLOBAL PathState *ps, Medium m
     if (!(t >= 0.0f && t < dist)) return 0;
     vec3 tr = medium_tr(sigma_t, t);
     float p_free = medium_stop_pdf(pc, sigma_t, tr);
-    float pdf = c_eq > 0.0f ? c_eq * equiangular_pdf(e, t) + (1.0f - c_eq) * p_free : p_free;
+    /* 0 outside the cone's part (a free-flight point there); an equiangular point is
+     * inside it but for rounding */
+    float pdf = p_free;
+    if (c_eq > 0.0f) {
+        float p_eq = lv < c_eq || (t >= t_lo && t < t_hi) ? equiangular_pdf(e, t) : 0.0f;
+        pdf = c_eq * p_eq + (1.0f - c_eq) * p_free;
+    }
     vec3 x = v3_madd(x0, d, t);
     LightSample ls;
     if (!(pdf > 0.0f) || !light_delta_at(l, x, &ls)) return 0;

@@ -18,7 +18,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     Scene s;
     scene_init(&s);
     Error err = { 0 };
+    s.keep_animation = 1;   /* a camera_path becomes the animation, posed halfway below */
     Status st = scene_load_text("fuzz.scene", (const char *)data, size, &s, &err);
+    if (st == ST_OK && s.animation) {
+        st = s.animation->pose(s.animation, &s, s.animation->end / 2, &err);
+        if (st) FUZZ_ASSERT(st == ST_INPUT && err.msg[0]);
+        else FUZZ_ASSERT(fuzz_finite3(s.camera.from) && fuzz_finite3(s.camera.at) && isfinite(s.camera.vfov));
+    }
     if (st) {
         FUZZ_ASSERT((st == ST_INPUT || st == ST_IO) && err.msg[0]);
     } else {

@@ -7,6 +7,7 @@
  * the status is the exit code.
  */
 #include <errno.h>
+#include <math.h>
 #include <poll.h>
 #include <signal.h>
 #include <stdio.h>
@@ -159,6 +160,7 @@ typedef struct {
     RenderJob job;                /* the render itself (render/render_job.h) */
     RenderContext ctx;
     double t_start;
+    int frames;                   /* --frames: this render is one frame of an animation */
     FILE *report;                 /* --stats and --profile: stdout, stderr when the image goes there */
 } Run;
 
@@ -375,6 +377,16 @@ static Status results_write(Run *r, Error *err)
     Status st = job->render_st != ST_OK ? job->render_st : (job->stats.interrupted ? ST_INTERRUPTED : ST_OK);
     Error next = { 0 };
     st = keep_first(st, err, render_job_final_checkpoint(job, &next), &next);
+    /* an animation's frame is written whole or not at all: a rerun skips the frames
+     * whose images are there (run_frames) and resumes this one from its checkpoint */
+    if (r->frames && !render_job_complete(job)) {
+        if (!r->o.quiet)
+            fprintf(stderr, "clpt: the frame is unfinished: '%s' is not written%s\n", r->output,
+                    r->job.set.checkpoint_path ? "; --resume goes on from its checkpoint" : "");
+        return st != ST_OK ? st : error_set(err, ST_NOTHING_RENDERED, "the time limit of %g s was reached before "
+                                            "the frame was finished: '%s' is not written", r->o.time_limit,
+                                            r->output);
+    }
     Status image_st = render_job_write_image(job, r->output, &r->style, &next);
     st = keep_first(st, err, image_st, &next);
     if (image_st != ST_OK) return st;   /* the summary's "-> OUTPUT" would be untrue */
@@ -382,6 +394,153 @@ static Status results_write(Run *r, Error *err)
     display_send_film(&r->ctx, NULL, job);
     results_print_summary(r);
     if (st == ST_OK && (r->o.adaptive > 0.0 || r->o.aovs || r->o.denoise)) st = results_run_passes(r, err);
+    return st;
+}
+
+/* ------------------------------------------------------------------ frames */
+
+/* The last frame of the scene's animation at --fps: the last whose time is at or before
+ * the last key (a microsecond's slack for key times stored as floats). */
+static long frames_last_of(const Run *r)
+{
+    return (long)floor(r->scene.animation->end * r->o.fps + 1e-6);
+}
+
+/* --frames A:B against the scene: it has an animation, and B is within it. */
+static Status frames_check(const Run *r, Error *err)
+{
+    if (!r->scene.animation)
+        return error_set(err, ST_USAGE, "--frames renders the animation of a glTF file given as the scene, or a "
+                         "clpt scene's camera_path; '%s' has neither", r->o.scene_path);
+    long last = frames_last_of(r);
+    if (r->o.frames_last > last)
+        return error_set(err, ST_USAGE, "--frames %ld:%ld: frame %ld (at %g s) is after the end of the animation of "
+                         "'%s' at %g s; at %g frames per second its frames are 0 to %ld", r->o.frames_first,
+                         r->o.frames_last, r->o.frames_last, (double)r->o.frames_last / r->o.fps, r->o.scene_path,
+                         r->scene.animation->end, r->o.fps, last);
+    return ST_OK;
+}
+
+/* Frame k's names: the image, and the checkpoint and the one to resume (NULL when
+ * none: a frame resumes from its own checkpoint only when it is there). */
+typedef struct {
+    char *output, *checkpoint, *resume;
+} FramePaths;
+
+static void frame_paths_free(FramePaths *p)
+{
+    free(p->output);
+    free(p->checkpoint);
+    free(p->resume);
+}
+
+static Status frame_paths(const Run *r, const char *base_output, long k, FramePaths *p, Error *err)
+{
+    memset(p, 0, sizeof *p);
+    int failed = !(p->output = outputs_frame_path(base_output, k));
+    if (r->o.checkpoint_path) failed |= !(p->checkpoint = outputs_frame_path(r->o.checkpoint_path, k));
+    if (r->o.resume_path) {
+        failed |= !(p->resume = outputs_frame_path(r->o.resume_path, k));
+        if (p->resume && access(p->resume, F_OK) != 0) {
+            free(p->resume);
+            p->resume = NULL;
+        }
+    }
+    return failed ? error_set(err, ST_INTERNAL, "out of memory") : ST_OK;
+}
+
+/* What one frame hands the next: the devices (opened by the first frame: nothing is
+ * compiled again), the run's denoiser, and for an animation of the camera alone the
+ * prepared scene with its parameters as prepared (before any pass changed them). */
+typedef struct {
+    Device **devs;
+    size_t n_devs;
+    Denoiser *denoiser;
+    RenderScene rs;
+    RenderParams params;
+    int have_rs;
+} FrameCarry;
+
+/* The frame's scene prepared: in full, or (the camera alone moving, and a scene
+ * prepared before) the kept one with the new camera; then the film. */
+static Status frame_prepare(Run *r, FrameCarry *c, Error *err)
+{
+    if (!c->have_rs) {
+        Status st = render_prepare(r, 0, 0, err);
+        c->params = r->job.rs.ds.params;
+        return st;
+    }
+    c->rs.ds.params = c->params;
+    c->have_rs = 0;   /* the job holds it until render_job_take_scene */
+    Status st = render_job_adopt_scene(&r->job, &r->scene, &c->rs, err);
+    return st == ST_OK ? render_job_prepare_film(&r->job, 0, 0, err) : st;
+}
+
+/* One frame: the scene posed at its time, prepared, given to the devices, rendered and
+ * written. */
+static Status frame_render(Run *r, Dist *dist, long k, const FramePaths *p, FrameCarry *c, Error *err)
+{
+    RenderJobSettings set = job_options_settings(&r->o);
+    set.checkpoint_path = p->checkpoint;
+    set.resume_path = p->resume;
+    render_job_init(&r->job, &set, print_warning, NULL, &r->ctx);
+    r->job.denoiser = c->denoiser;   /* the run's, lent to each frame */
+    r->output = p->output;
+    if (!r->o.quiet) fprintf(stderr, "clpt: frame %ld (%g s) -> %s\n", k, (double)k / r->o.fps, p->output);
+    SceneAnimation *anim = r->scene.animation;
+    int kept = c->have_rs;
+    Status st = anim->pose(anim, &r->scene, (double)k / r->o.fps, err);
+    if (st == ST_OK) st = scene_options_apply_camera(&r->o, &r->scene, err);
+    if (st == ST_OK) st = frame_prepare(r, c, err);
+    if (st == ST_OK && c->devs && kept) st = render_job_update_devices(&r->job, c->devs, c->n_devs, err);
+    else if (st == ST_OK && c->devs) st = render_job_adopt_devices(&r->job, c->devs, c->n_devs, err);
+    else if (st == ST_OK) st = open_devices(r, err);
+    if (st == ST_OK) {
+        render_run(r, dist, err);
+        st = results_write(r, err);
+    }
+    render_job_take_devices(&r->job, &c->devs, &c->n_devs);
+    if (anim->camera_only && st == ST_OK) {
+        render_job_take_scene(&r->job, &c->rs);
+        c->have_rs = 1;
+    }
+    r->job.denoiser = NULL;
+    render_job_free(&r->job);
+    memset(&r->job, 0, sizeof r->job);
+    return st;
+}
+
+/* --frames A:B: each frame to its numbered image (outputs_frame_path); a frame whose
+ * image is there already is skipped, so a rerun of an interrupted animation goes on
+ * where it stopped. */
+static Status run_frames(Run *r, Dist *dist, Error *err)
+{
+    Status st = frames_check(r, err);
+    const char *base_output = r->output;
+    FrameCarry c;
+    memset(&c, 0, sizeof c);
+    r->frames = 1;
+    /* each frame is a job of its own; the run's denoiser (--denoise) serves them all */
+    c.denoiser = r->job.denoiser;
+    r->job.denoiser = NULL;
+    render_job_free(&r->job);
+    memset(&r->job, 0, sizeof r->job);
+    for (long k = r->o.frames_first; k <= r->o.frames_last && st == ST_OK; k++) {
+        FramePaths p;
+        st = frame_paths(r, base_output, k, &p, err);
+        if (st == ST_OK && access(p.output, F_OK) == 0) {
+            if (!r->o.quiet) fprintf(stderr, "clpt: frame %ld: '%s' is there already; skipped\n", k, p.output);
+        } else if (st == ST_OK) {
+            st = frame_render(r, dist, k, &p, &c, err);
+        }
+        frame_paths_free(&p);
+        if (st == ST_OK && stop_requested) st = ST_INTERRUPTED;
+    }
+    r->output = base_output;
+    for (size_t i = 0; i < c.n_devs; i++) device_close(c.devs[i]);
+    free(c.devs);
+    render_scene_free(&c.rs);
+    r->job.denoiser = c.denoiser;   /* freed with the run's job */
     return st;
 }
 
@@ -479,6 +638,9 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
     int done = 0;
     Status st = options_parse(argc, argv, &r.o, err);
     r.report = r.o.output && image_path_is_stdout(r.o.output) ? stderr : stdout;
+    if (st == ST_OK && r.o.frames_first >= 0 && dist_launched())
+        st = error_set(err, ST_USAGE, "--frames is not rendered under MPI (render the frames in separate runs, "
+                       "each with its own --frames range)");
     if (dist_launched()) {
         DistRequest q = dist_request(&r.o);
         st = dist_join(dist, &q, st, err);
@@ -501,6 +663,11 @@ static Status run(int argc, char **argv, Dist *dist, Error *err)
     if (st == ST_OK) st = load_scene_input(&r.o, &r.scene, &r.bare_mesh, err);
     if (st == ST_OK) st = outputs_from_scene(&r.o, &r.scene, &r.output, err);
     if (st == ST_OK) st = scene_apply_options(&r, err);
+    if (st == ST_OK && r.o.frames_first >= 0) {
+        st = run_frames(&r, dist, err);
+        run_free(&r);
+        return st;
+    }
     if (st == ST_OK) st = render_prepare(&r, 0, 0, err);
     if (st == ST_OK) display_prepare(&r);
     if (st == ST_OK) st = open_devices(&r, err);

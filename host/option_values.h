@@ -24,6 +24,10 @@ typedef struct {
     /* --sample-range A:B: render only sample indices [A, B) of every pixel (an
      * independent part for `clpt merge`); -1/-1 = all of [0, spp) */
     long range_first, range_end;
+    /* --frames A:B: render frames A..B of the scene's animation (docs/animation.md) to
+     * numbered outputs; -1/-1 = one image, no animation */
+    long frames_first, frames_last;
+    double fps;                   /* --fps: frames per second of animation time; 0 = 24 */
     /* under mpirun (docs/distributed.md) */
     int mpi_broadcast;            /* the scene is read by rank 0 only and sent to the others */
     double mpi_timeout;           /* seconds of silence before a rank is given up; 0 = 30 */

@@ -26,6 +26,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* --frames' largest frame number: names keep four digits at least (OUT_0042.png), and
+ * a million frames is some eleven hours of film at 24 fps */
+#define CLPT_MAX_FRAME 999999
+
 /*
  * OPTIONS(X) calls X(section, kind, field, name, alias, metavar, extra, help) once per
  * flag, in the order of --help:
@@ -182,6 +186,16 @@
         "render only samples A..B-1 of every pixel: a part\n" \
         "of the render for 'clpt merge' (with --checkpoint\n" \
         "PART); -o gets the part's own image") \
+    X(OUTPUT, CUSTOM, frames_first, "--frames", NULL, "A:B", PARSE(parse_frames), \
+        "render frames A to B (both included) of a glTF\n" \
+        "file's animation or a scene's camera_path,\n" \
+        "frame k at k/FPS seconds, each to its own\n" \
+        "numbered image: -o out.png gives out_0000.png\n" \
+        "...; frames already written are skipped\n" \
+        "(docs/animation.md)") \
+    X(OUTPUT, CUSTOM, fps, "--fps", NULL, "FPS", PARSE(parse_fps), \
+        "frames per second of animation time for\n" \
+        "--frames (default 24)") \
     X(MPI, SWITCH, mpi_broadcast, "--mpi-broadcast", NULL, NULL, NONE, \
         "rank 0 reads the scene and sends it to the\n" \
         "others (default: every rank reads SCENE, which\n" \
@@ -480,6 +494,42 @@ static Status parse_sample_range(const char *v, Options *o, Error *err)
                          CLPT_MAX_SPP, v);
     o->range_first = a;
     o->range_end = b;
+    return ST_OK;
+}
+
+/* --frames A:B, 0 <= A <= B <= CLPT_MAX_FRAME (B is checked against the animation's
+ * length once the scene is read). */
+static Status parse_frames(const char *v, Options *o, Error *err)
+{
+    char *end;
+    errno = 0;
+    long a = strtol(v, &end, 10), b = -1;
+    int ok = end != v && *end == ':' && !errno && v[0] != '-' && v[0] != '+' && !starts_blank(v);
+    if (ok) {
+        const char *second = end + 1;
+        b = strtol(second, &end, 10);
+        ok = end != second && !*end && !errno && second[0] != '-' && second[0] != '+' && !starts_blank(second);
+    }
+    if (!ok || a < 0 || b > CLPT_MAX_FRAME)
+        return error_set(err, ST_USAGE, "--frames expects A:B, frame numbers with 0 <= A <= B <= %d, got '%s'",
+                         CLPT_MAX_FRAME, v);
+    if (a > b)
+        return error_set(err, ST_USAGE, "--frames %s: the first frame, %ld, is after the last, %ld", v, a, b);
+    o->frames_first = a;
+    o->frames_last = b;
+    return ST_OK;
+}
+
+/* --fps FPS: a number of frames per second in (0, 1000] */
+static Status parse_fps(const char *v, Options *o, Error *err)
+{
+    char *end;
+    errno = 0;
+    double f = strtod(v, &end);
+    if (!*v || *end || errno || starts_blank(v) || !(f > 0.0 && f <= 1000.0))
+        return error_set(err, ST_USAGE, "--fps expects a number of frames per second above 0 and at most 1000, "
+                         "got '%s'", v);
+    o->fps = f;
     return ST_OK;
 }
 

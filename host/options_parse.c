@@ -158,6 +158,7 @@ void options_init(Options *o)
     memset(o, 0, sizeof *o);
     o->spp = o->width = o->height = o->seed = o->max_depth = o->split = -1;
     o->range_first = o->range_end = -1;
+    o->frames_first = o->frames_last = -1;
     o->integrator = -1;
     o->gamma = -1;
     o->shadows = -1;
@@ -244,7 +245,7 @@ static Status options_check_interactive(const Options *o, Error *err)
                      : o->display_server ? "--display-server" : o->noise_threshold > 0.0 ? "--noise-threshold"
                      : o->range_end >= 0 ? "--sample-range" : o->stats == STATS_JSON ? "--stats=json"
                      : o->crop_kind == CROP_FRACTIONS ? "--crop" : o->crop_kind == CROP_PIXELS ? "--pixel-bounds"
-                     : NULL;
+                     : o->frames_first >= 0 ? "--frames" : NULL;
     if (flag)
         return error_set(err, ST_USAGE, "--interactive cannot be combined with %s (the viewer saves frames "
                                         "with the C key; see docs/viewer.md)", flag);
@@ -257,7 +258,7 @@ static Status options_check_stdout(const Options *o, Error *err)
 {
     if (!o->output || !image_path_is_stdout(o->output)) return ST_OK;
     const char *flag = o->progressive_seconds > 0.0 ? "--progressive-output" : o->aovs ? "--aov"
-                     : o->adaptive > 0.0 ? "--adaptive" : NULL;
+                     : o->adaptive > 0.0 ? "--adaptive" : o->frames_first >= 0 ? "--frames" : NULL;
     if (flag)
         return error_set(err, ST_USAGE, "%s cannot be used with -o %s: standard output takes the image once, "
                          "and %s writes it again or beside it; name a file with -o", flag, o->output, flag);
@@ -289,6 +290,14 @@ Status options_finish(Options *o, Error *err)
         return error_set(err, ST_USAGE, "--depth-range scales the depth image, which --aov depth turns on; "
                          "give both, or neither");
     if (o->checkpoint_seconds <= 0.0) o->checkpoint_seconds = 60.0;
+    if (o->fps > 0.0 && o->frames_first < 0)
+        return error_set(err, ST_USAGE, "--fps sets the frame rate of --frames A:B; give both, or neither");
+    if (!(o->fps > 0.0)) o->fps = 24.0;
+    if (o->frames_first >= 0 && o->range_end >= 0)
+        return error_set(err, ST_USAGE, "--frames cannot be used with --sample-range (render each frame whole)");
+    if (o->frames_first >= 0 && o->display_server)
+        return error_set(err, ST_USAGE, "--frames cannot be used with --display-server (the live display shows one "
+                         "image; open each frame's file instead)");
     if (!o->scene_path && !o->help && !o->version && !o->list_devices)
         return error_set(err, ST_USAGE, "no scene given (usage: clpt [options] SCENE)");
     Status st = options_check_stdout(o, err);

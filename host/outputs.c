@@ -114,3 +114,16 @@ Status outputs_from_scene(const Options *o, const Scene *scene, const char **out
     return outputs_check(o, *output, err);
 }
 
+char *outputs_frame_path(const char *path, long frame)
+{
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    const char *dot = strrchr(base, '.');
+    size_t stem = dot && dot != base ? (size_t)(dot - path) : strlen(path);
+    char number[32];
+    int n = snprintf(number, sizeof number, "_%04ld", frame);
+    size_t len = strlen(path) + (size_t)n + 1;
+    char *out = malloc(len);
+    if (out) snprintf(out, len, "%.*s%s%s", (int)stem, path, number, path + stem);
+    return out;
+}

@@ -25,4 +25,10 @@ Status outputs_check(const Options *o, const char *output, Error *err);
  * default name in *output, checked as the default was. */
 Status outputs_from_scene(const Options *o, const Scene *scene, const char **output, Error *err);
 
+/* --frames: frame `frame`'s file of `path` (an image, a checkpoint): the number, at
+ * least four digits, after the stem and an underscore, before the extension:
+ * "out.png" -> "out_0042.png", "dir/a.b.exr" -> "dir/a.b_0042.exr", "out" ->
+ * "out_0042". NULL without memory. */
+char *outputs_frame_path(const char *path, long frame);
+
 #endif /* CLPT_OUTPUTS_H */

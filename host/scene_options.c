@@ -15,6 +15,7 @@ Status scene_options_before_load(const Options *o, Scene *s, Error *err)
         return error_set(err, ST_USAGE, "--camera picks a glTF file's camera; '%s' is not a .gltf or .glb file",
                          o->scene_path);
     s->gltf_camera = o->camera;
+    s->keep_animation = o->frames_first >= 0;
     s->size_overridden = o->width >= 0 || o->height >= 0;
     return ST_OK;
 }
@@ -139,4 +140,10 @@ Status scene_options_apply(const Options *o, Scene *s, int bare_mesh, Error *err
         return error_set(err, ST_USAGE, "--noise-threshold needs the path tracer (--integrator path); the whitted "
                          "integrator has --adaptive");
     return ST_OK;
+}
+
+Status scene_options_apply_camera(const Options *o, Scene *s, Error *err)
+{
+    Status st = apply_sets(o, s, 1, err);
+    return st ? st : apply_camera_flags(o, s, err);
 }

@@ -19,4 +19,8 @@ Status scene_options_before_load(const Options *o, Scene *s, Error *err);
  * --crop or --pixel-bounds the window rendered, checked against that size. */
 Status scene_options_apply(const Options *o, Scene *s, int bare_mesh, Error *err);
 
+/* --set camera.*, --lookat and --fov again, on a camera an animation's frame has just
+ * placed (docs/animation.md): the flags hold for every frame. */
+Status scene_options_apply_camera(const Options *o, Scene *s, Error *err);
+
 #endif /* CLPT_SCENE_OPTIONS_H */

@@ -364,7 +364,10 @@ typedef struct {                                        /* 288 bytes */
     float alpha_cutoff;                    /* MAT_ALPHA_MASK: opaque where alpha >= this */
     uint texture_emission;                 /* MAT_PRINCIPLED: multiplies emission, or
                                             * NO_INDEX */
-    uint pad_alpha;
+    float subsurface;                      /* MAT_PRINCIPLED, solid: the share of the diffuse
+                                            * lobe that refracts into the interior instead
+                                            * and walks its medium (medium_in, a MEDIUM_WALK
+                                            * medium: docs/subsurface.md); 0: none */
     uint mix_a, mix_b;                     /* MAT_MIX: the two materials' indices */
     float mix_amount;                      /* MAT_MIX: mix_b's probability, times ... */
     uint mix_texture;                      /* ... this texture's red channel, or NO_INDEX */
@@ -599,13 +602,23 @@ typedef struct {                                        /* 64 bytes */
     float g;                  /* Henyey-Greenstein asymmetry in (-1, 1); |g| < 1e-3 is
                                * stored as 0 (the sampling formula divides by g) */
     uint grid;                /* MEDIUM_GRID: its GridMedium in grids[] */
-    uint emissive;            /* 1 when `emission` is not 0 0 0 (the flight adds it) */
+    uint flags;               /* MEDIUM_* flags */
     vec3 sigma_a;  float pad2;   /* absorption; MEDIUM_GRID: per unit of density */
     vec3 sigma_s;  float pad3;   /* scattering; MEDIUM_GRID: per unit of density */
     vec3 emission; float pad4;   /* radiance Le (pbrt-v4's Le times Lescale): a stretch
                                * ds emits sigma_a Le ds (medium_emitted, grid_emitted);
-                               * MEDIUM_GRID: times the cell's emission scale */
+                               * MEDIUM_GRID: times the cell's emission scale; with
+                               * MEDIUM_EMISSIVE set in flags when not 0 0 0 */
 } Medium;
+
+/* The interior of a subsurface material (docs/subsurface.md): its stops are the steps of
+ * a random walk, which cost no bounce of the path's depth (they count as crossings,
+ * against MEDIUM_MAX_WALK), sample no light (a light sample from inside the closed
+ * surface is blocked by it) and take Russian roulette by the throughput alone. */
+#define MEDIUM_WALK 1u
+/* The medium emits (Medium.emission is not 0 0 0): its flights add sigma_a Le
+ * (medium_emitted, grid_emitted; docs/media.md, "Emission"). */
+#define MEDIUM_EMISSIVE 2u
 
 /* A heterogeneous medium's density (kernels/medium/grid.h, docs/media.md): nx ny nz
  * values, x fastest, at the centres of the cells of its box, trilinearly interpolated
@@ -689,14 +702,18 @@ typedef struct {                                        /* 336 bytes */
     uint crop_top, crop_right, crop_bottom;
     uint n_instances;                 /* Instance records (docs/instancing.md); 0: one level */
     /* participating media (kernels/medium/, docs/media.md) */
-    uint has_media;                   /* 1: paths may meet media or boundaries
-                                       * (MAT_INTERFACE); 0: the code of KF_MEDIA is
-                                       * skipped, and images are those of before media */
+    uint has_media;                   /* HAS_MEDIA_*: paths may meet media or
+                                       * boundaries (MAT_INTERFACE); 0: the code of
+                                       * KF_MEDIA is skipped, and images are those of
+                                       * before media */
     uint n_media;                     /* entries of media[] */
     uint camera_medium;               /* where camera rays start: 0 vacuum, else 1 +
                                        * an index into media[] */
     uint n_grids;                     /* entries of grids[] (MEDIUM_GRID media) */
 } RenderParams;
+
+#define HAS_MEDIA_ANY 1u          /* RenderParams.has_media: some medium or boundary */
+#define HAS_MEDIA_WALK 2u         /* ... and some subsurface walk (MEDIUM_WALK) */
 
 /* One path of the wavefront; lives in a device buffer between kernel launches. */
 typedef struct {                                        /* 80 bytes */

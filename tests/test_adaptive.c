@@ -1,7 +1,7 @@
 /*
  * test_adaptive.c — adaptive sampling (--noise-threshold, host/render/adaptive.c): the
- * error measure against its formula, the counts at which it decides, the mask with its
- * widening; then whole renders through clpt: converged pixels stop while noisy ones go
+ * error measure against its formula, the counts at which it decides, the mask (3x3
+ * blocks' mean errors, or half a pixel's own) with its widening; then whole renders through clpt: converged pixels stop while noisy ones go
  * on, the same bits on PoCL, the scalar device, both together, other batch sizes, the
  * wavefront and resumed from a checkpoint, and a lower error against a converged
  * reference than uniform sampling with the same number of samples. No timings.
@@ -92,8 +92,12 @@ static void test_decision_counts(void)
     CHECK_EQ_INT(adaptive_next_stop(&odd, 6, 100), 8);
 }
 
-/* A 5x4 film at a decision count (16) with one noisy pixel at (1, 1) and one pixel
- * that stopped before (spp 12): the noisy one and its 3x3 go on, nothing else. */
+/* A 5x4 film at a decision count (16) with one pixel that stopped before (spp 12) and
+ * one noisy pixel. A decision judges the mean error of each 3x3 block (fewer pixels at
+ * the image's edges) or half the pixel's own, the larger: an estimate 1.5 times the
+ * threshold among quiet neighbours is outvoted, and nothing goes on; one eight times
+ * above it goes on, with the blocks its error lifts above the threshold, and the 3x3
+ * around each of those (the widening), nothing else. */
 static void test_mask(void)
 {
     AdaptiveFilm af;
@@ -105,14 +109,25 @@ static void test_mask(void)
         af.spp[i] = 16;
         for (int c = 0; c < 3; c++) af.odd[3 * i + c] = (af.film.sum[3 * i + c] = (int64_t)film_units(8.0)) / 2;
     }
-    af.odd[3 * 6] = (int64_t)film_units(1.0);   /* pixel (1, 1): halves 7 and 1 in red */
     af.spp[2] = 12;                             /* (2, 0): stopped at 12 */
     uint mask[20];
     size_t active = 0;
+    /* (2, 1): halves 4.75 and 3.25 in red, error 0.077 (half: 0.038); the blocks
+     * holding it have 6 pixels (along the top edge) or 9: means 0.013 or less */
+    af.odd[3 * 7] = (int64_t)film_units(3.25);
+    CHECK_NEAR(adaptive_pixel_error(&af, 7), 0.09375 / (1e-4 + sqrt(1.5)), 1e-12);
     CHECK(adaptive_mask(&s, &af, mask, &active, &err) == ST_OK);
-    uint want[20] = { 1, 1, 0, 0, 0,  1, 1, 1, 0, 0,  1, 1, 1, 0, 0,  0, 0, 0, 0, 0 };
+    CHECK_EQ_INT(active, 0);
+    /* (1, 1) instead: halves 8 and 0, error 0.408 (half: 0.204): it goes on; the
+     * blocks holding it have 4, 6 or 9 pixels, means 0.102, 0.068 (above) and 0.045
+     * (below: (2, 1), (1, 2), (2, 2)); with the widening, columns 0-1 and the
+     * neighbours of (1, 1) and (0, 2) */
+    af.odd[3 * 7] = (int64_t)film_units(4.0);
+    af.odd[3 * 6] = 0;
+    CHECK(adaptive_mask(&s, &af, mask, &active, &err) == ST_OK);
+    uint want[20] = { 1, 1, 0, 0, 0,  1, 1, 1, 0, 0,  1, 1, 1, 0, 0,  1, 1, 0, 0, 0 };
     for (size_t i = 0; i < 20; i++) CHECK_MSG(mask[i] == want[i], "pixel %zu", i);
-    CHECK_EQ_INT(active, 8);
+    CHECK_EQ_INT(active, 10);
     /* between decisions every pixel at the count goes on, and only those */
     af.film.samples = 18;
     for (size_t i = 0; i < 20; i++) af.spp[i] = i == 2 ? 12u : 18u;
@@ -284,7 +299,9 @@ static void test_equal_budget_error(void)
                                "--checkpoint", ref, NULL };
     cli_run(args_ref, &r);
     CHECK_EQ_INT(r.status, 0);
-    CHECK(render(img, ad, ARGS("--device", "cpu", "--spp", "512")) == 0);
+    /* 0.03: about 30 samples a pixel; at 0.05 nearly every pixel stops at the first
+     * decision (16), 18 on average, and there is little left to place */
+    CHECK(render_at("0.03", img, ad, ARGS("--device", "cpu", "--spp", "512")) == 0);
     uint w, h;
     uint64_t n_ref, n_ad, n_un;
     float *a = checkpoint_image(ad, &w, &h, &n_ad);

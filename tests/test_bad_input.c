@@ -20,7 +20,9 @@
 #include "harness.h"
 #include "util/kmath.h"
 #include "io/mesh_load.h"
+#include "io/lexer.h"
 #include "io/mtl.h"
+#include "io/nanovdb.h"
 #include "io/obj.h"
 #include "io/ply.h"
 #include "render_util.h"
@@ -82,6 +84,17 @@ static Status load(const char *path, Scene *s, Error *err)
         memset(&lib, 0, sizeof lib);
         Status st = mtl_load(path, &lib, err);
         mtl_free(&lib);
+        return st;
+    }
+    if (has_suffix(path, ".nvdb") || has_suffix(path, ".nvdb.gz")) {   /* its "density" grid */
+        char *data;
+        size_t len;
+        Status st = lex_read_file(path, &data, &len, err);
+        if (st) return st;
+        NanoDense d;
+        st = nanovdb_read_grid(path, (const unsigned char *)data, len, "density", &d, err);
+        free(data);
+        if (!st) free(d.density);
         return st;
     }
     static const char *const images[] = { ".png", ".bmp", ".tga", ".hdr", ".psd", ".ppm", ".pgm", ".jpg", ".exr" };

@@ -277,6 +277,32 @@ static void test_features_through_specular(void)
     }
 }
 
+
+/* A raised cancel flag (denoiser_set_cancel, the viewer's stop flag) stops a denoise
+ * before any filter with its own status and message; lowered, the same denoiser works
+ * again. (OIDN's own stop mid-filter, through its progress monitor, is test_viewer's
+ * test_quit_cancels_denoise.) */
+static Denoiser *opened;   /* main's, while the tests that need it run */
+
+static void test_cancel_flag(void)
+{
+    Denoiser *d = opened;
+    enum { W = 16, H = 16 };
+    static float color[W * H * 3], out[W * H * 3];
+    for (int i = 0; i < W * H * 3; i++) color[i] = 0.5f;
+    volatile sig_atomic_t cancel = 1;
+    denoiser_set_cancel(d, &cancel);
+    Error err = { 0 };
+    CHECK_EQ_INT(denoiser_run(d, color, NULL, NULL, W, H, out, &err), ST_INTERRUPTED);
+    CHECK_MSG(strcmp(err.msg, "denoising was cancelled") == 0, "message '%s'", err.msg);
+    error_clear(&err);
+    cancel = 0;
+    CHECK_EQ_INT(denoiser_run(d, color, NULL, NULL, W, H, out, &err), ST_OK);
+    CHECK_MSG(out[0] > 0.4f && out[0] < 0.6f, "a flat 0.5 image denoised to %g", out[0]);
+    denoiser_set_cancel(d, NULL);
+    error_clear(&err);
+}
+
 int main(void)
 {
     if (!mkdtemp(dir)) return 1;
@@ -292,6 +318,8 @@ int main(void)
         harness_failed++;
     } else {
         printf("     (Open Image Denoise from %s, %s device)\n", denoiser_library(d), denoiser_device_kind(d));
+        opened = d;
+        RUN(test_cancel_flag);
         RUN(test_denoise_lowers_error);
         RUN(test_denoise_after_resume);
         RUN(test_merge_denoise);

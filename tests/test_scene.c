@@ -525,7 +525,8 @@ static void test_bad_syntax(void)
 {
     check_bad("camera { }\ncam { }\n", ST_INPUT,
               ":2:1: expected a statement (camera, image, background, material, sphere, plane, "
-              "triangle, quad, box, mesh, light, texture, medium, include, object, instance), found 'cam'");
+              "triangle, quad, box, mesh, light, texture, medium, include, object, instance, camera_path), "
+              "found 'cam'");
     check_bad("}", ST_INPUT, ":1:1: expected a statement (camera");
     check_bad("camera fov 30", ST_INPUT, ":1:8: expected '{' to open the camera block, found 'fov'");
     check_bad("camera { fromm 1 2 3 }", ST_INPUT,

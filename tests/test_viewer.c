@@ -12,6 +12,8 @@
  * viewer-test) the session is skipped with a message. A second session, with
  * --denoise and Open Image Denoise present, waits for the denoised frame of the last
  * pass, saves (the noisy film: the command line's bits), and turns N off and on again.
+ * Without a window (the render thread alone, as the window drives it): quitting while a
+ * large frame is being denoised cancels the denoise rather than waiting for it.
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -32,7 +34,9 @@
 #include "harness.h"
 #include "io/scene_load.h"
 #include "render/denoise.h"
+#include "render/render_scene.h"
 #include "viewer/view_camera.h"
+#include "viewer/viewer_render.h"
 
 /* ------------------------------------------------------------------ camera units */
 
@@ -591,6 +595,84 @@ static void test_session(void)
     session_run(NULL, session_user, session_check);
 }
 
+
+/* ------------------------------------------------------------------ cancelling a denoise */
+
+/* The render thread (viewer_render.h) on the scalar device, the Cornell box at 640 x
+ * 640 with a cap of 1 spp and the denoised view on: its one pass is followed by a
+ * denoise of seconds on a CPU (features, their prefilter, the colour). Quitting during it
+ * (viewer_render_stop, what Esc does) must cancel it: no frame counted as denoised, one
+ * cancelled. Not a timing test: the counters say whether OIDN was stopped or ran to the
+ * end; the seconds are printed. Where the denoise ends before it can be stopped (OIDN on
+ * a GPU takes milliseconds), there is nothing to cancel and the test says so. */
+static void test_quit_cancels_denoise(void)
+{
+    Denoiser *d = NULL;
+    Error err = { 0 };
+    if (denoiser_open(&d, &err) != ST_OK) {
+        fprintf(stderr, "  Open Image Denoise missing: skipped (%s)\n", err.msg);
+        error_clear(&err);
+        return;
+    }
+    Scene s;
+    RenderScene rs;
+    memset(&rs, 0, sizeof rs);
+    Device **devs = NULL;
+    size_t n_devs = 0;
+    int prepared = 0;
+    scene_init(&s);
+    Status st = scene_load_file("scenes/cornell-box.scene", SCENE_FORMAT_AUTO, &s, NULL, &err);
+    if (st == ST_OK) {
+        s.image.width = s.image.height = 640;
+        s.image.spp = 1;
+        st = render_scene_prepare(&s, 0, &rs, &err);
+        prepared = st == ST_OK;
+    }
+    DeviceConfig dc;
+    memset(&dc, 0, sizeof dc);
+    if (st == ST_OK) st = device_open_all("scalar", &dc, &rs.ds, NULL, NULL, &devs, &n_devs, &err);
+    CHECK_MSG(st == ST_OK, "setting up: %s", err.msg);
+    ViewerRender *vr = calloc(1, sizeof *vr);
+    if (st == ST_OK && vr &&
+        (st = viewer_render_start(vr, devs, n_devs, &rs.ds, &dc, &s.camera, 1, 0, d, &err)) == ST_OK) {
+        /* the features are rendered and prefiltered; the colour's filter, the longest
+         * part, begins */
+        int in_denoise = 0;
+        for (double t0 = now_s(); now_s() - t0 < 300.0;) {
+            pthread_mutex_lock(&vr->lock);
+            in_denoise = vr->denoising == 2 || vr->denoise_count;
+            pthread_mutex_unlock(&vr->lock);
+            if (in_denoise) break;
+            usleep(2000);
+        }
+        CHECK_MSG(in_denoise, "the 1-spp frame was not denoised within 300 s");
+        usleep(200000);   /* into OIDN's filter */
+        pthread_mutex_lock(&vr->lock);
+        int ended = vr->denoise_count != 0;
+        pthread_mutex_unlock(&vr->lock);
+        double t0 = now_s();
+        st = viewer_render_stop(vr, &err);
+        double waited = now_s() - t0;
+        CHECK_MSG(st == ST_OK, "rendering failed: %s", err.msg);
+        if (ended) {
+            fprintf(stderr, "  the denoise ended before the stop (%s device): nothing to cancel\n",
+                    denoiser_device_kind(d));
+        } else {
+            CHECK_EQ_INT((int)vr->denoise_count, 0);
+            CHECK_EQ_INT((int)vr->denoise_cancels, 1);
+            printf("     (quitting during a 640x640 denoise took %.3f s)\n", waited);
+        }
+    }
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    free(vr);
+    for (size_t i = 0; i < n_devs; i++) device_close(devs[i]);
+    free(devs);
+    if (prepared) render_scene_free(&rs);
+    scene_free(&s);
+    error_clear(&err);
+    denoiser_close(d);
+}
+
 int main(void)
 {
     RUN(test_print_round_trip);
@@ -601,5 +683,6 @@ int main(void)
     RUN(test_usage);
     RUN(test_session);
     RUN(test_session_denoise);
+    RUN(test_quit_cancels_denoise);
     return harness_report();
 }

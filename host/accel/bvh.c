@@ -7,7 +7,9 @@
  * what a node costs is one visit plus its leaves' triangle groups, since a leaf tests
  * its triangles eight at a time. Then the collapse: a node takes its two children and,
  * while it has fewer than eight, replaces the interior child with the largest surface
- * area by that child's two children (Embree's BVH8 from a binary build). The wide nodes
+ * area by that child's two children (Embree's BVH8 from a binary build); a top level
+ * over instances is cut by dynamic programming instead, for full nodes (pack_measure).
+ * The wide nodes
  * are written depth first, a parent before its children, the leaves' records into the
  * leaf data in the kd-tree's layout (kd_leaf_record_write). With several threads, the
  * top of the binary tree is built first, its large nodes' passes cut into ranges, and
@@ -483,6 +485,9 @@ typedef struct {
     uint depth_bound;       /* binary levels a path below any node may still take: BVH_MAX_DEPTH,
                              * or an item build's own depth (a top level is shallow, and its
                              * budget small: docs/instancing.md) */
+    float *pack;            /* item builds: per binary node v and i in 1..BVH_WIDTH, at
+                             * v * BVH_WIDTH + i - 1, the fewest wide nodes that hold v's
+                             * subtree as at most i children of a parent (pack_measure) */
 } Flat;
 
 static int uint_cmp(const void *a, const void *b)
@@ -491,13 +496,95 @@ static int uint_cmp(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* ---- item builds: wide nodes packed full
+ *
+ * A top level holds one instance a leaf, and the greedy expansion below (largest
+ * area first) leaves the nodes above the leaves 2 or 3 wide: a balanced tree of 10,000
+ * leaves splits into 4,096 subtrees of 2.4 leaves at its fourth level (a grid of
+ * dragons: 4,258 nodes, 3.35 children each). Every node costs the devices 256 bytes,
+ * so for item builds the choice of which binary nodes become wide nodes is made by
+ * dynamic programming over the binary tree for the fewest wide nodes, as Ylitie et al.
+ * (2017, "Efficient incoherent ray traversal on GPUs through compressed wide BVHs")
+ * choose it for the least SAH cost: P(v, i), the fewest nodes that hold v's subtree as
+ * at most i children of a parent, is 0 for a leaf; for an interior v, the least of
+ * 1 + S(v, BVH_WIDTH) (v becomes a node of its own) and S(v, i), where S(v, i) is the
+ * least P(c0, j) + P(c1, i - j) (v's slots shared by its two children); each node adds
+ * PACK_AREA times its area too. The binary tree, hence which items share a subtree, is
+ * the SAH's as before; only its cut changes, so every walk finds the same hits (the
+ * tie rule, accel/leaf.h). The grid of dragons: 1,764 nodes (4.7 children each), 2.4
+ * times fewer, at the same speed; scenes/instances.scene: 575, against 597. */
+
+/* Each node also costs its area over the root's, times this: among cuts of nearly as
+ * few nodes, a shallow one of little SAH. A deep top level spends the walk's stack,
+ * which the prototypes then lack (host/accel/bvh_inst.c: their nodes fall back to two
+ * children). By node count alone the grid of 10,000 dragons' top level was 11 nodes
+ * deep and left the dragon 75 entries, against 96, which made it 15,757 nodes, not
+ * 12,140; at 1 its top level took 46 entries, at 64 40, at 256 39 (instances.scene 46,
+ * 39, 32; the greedy's 31 and 29), for 1,756, 1,763 and 1,764 nodes (567, 572, 575). */
+#define PACK_AREA 256.0
+static float pack_split(const float *pack, uint c0, uint c1, uint i, uint *best_j)
+{
+    float best = INFINITY;
+    for (uint j = 1; j < i; j++) {
+        float c = pack[(size_t)c0 * BVH_WIDTH + j - 1u] + pack[(size_t)c1 * BVH_WIDTH + (i - j) - 1u];
+        if (c < best) {
+            best = c;
+            *best_j = j;
+        }
+    }
+    return best;
+}
+
+/* Fills P (Flat.pack) for binary node v's subtree, children first. */
+static void pack_measure(const Build *b, float *pack, uint v, double root_area)
+{
+    const BinNode *c = &b->nodes[v];
+    float *p = pack + (size_t)v * BVH_WIDTH;
+    if (c->count > 0 || c->child[0] == NO_INDEX) {
+        for (uint i = 0; i < BVH_WIDTH; i++) p[i] = 0.0f;
+        return;
+    }
+    pack_measure(b, pack, c->child[0], root_area);
+    pack_measure(b, pack, c->child[1], root_area);
+    uint j;
+    float own = (float)(1.0 + PACK_AREA * box3_half_area(&c->box) / root_area) +
+                pack_split(pack, c->child[0], c->child[1], BVH_WIDTH, &j);
+    p[0] = own;
+    for (uint i = 2; i <= BVH_WIDTH; i++) {
+        float split = pack_split(pack, c->child[0], c->child[1], i, &j);
+        p[i - 1u] = split < own ? split : own;
+    }
+}
+
+/* The children binary node v makes with at most i slots: itself, or (when sharing
+ * them among its two children is no worse) theirs. */
+static void pack_kids(const Build *b, const float *pack, uint v, uint i, uint *kids, int *n)
+{
+    const BinNode *c = &b->nodes[v];
+    uint j = 1u;
+    if (i < 2u || c->count > 0 || c->child[0] == NO_INDEX ||
+        pack_split(pack, c->child[0], c->child[1], i, &j) > pack[(size_t)v * BVH_WIDTH]) {
+        kids[(*n)++] = v;
+        return;
+    }
+    pack_kids(b, pack, c->child[0], j, kids, n);
+    pack_kids(b, pack, c->child[1], i - j, kids, n);
+}
+
 /* Up to `width` binary nodes under binary interior node `bn` (or bn itself when it is
  * a leaf) that become one wide node's children; returns how many. */
-static int wide_children(const Build *b, uint bn, int width, uint *kids)
+static int wide_children(const Build *b, const float *pack, uint bn, int width, uint *kids)
 {
     int n = 0;
     if (b->nodes[bn].count > 0 || b->nodes[bn].child[0] == NO_INDEX) {
         kids[n++] = bn;
+        return n;
+    }
+    if (pack) {
+        uint j = 1u;
+        pack_split(pack, b->nodes[bn].child[0], b->nodes[bn].child[1], (uint)width, &j);
+        pack_kids(b, pack, b->nodes[bn].child[0], j, kids, &n);
+        pack_kids(b, pack, b->nodes[bn].child[1], (uint)width - j, kids, &n);
         return n;
     }
     kids[n++] = b->nodes[bn].child[0];
@@ -531,7 +618,7 @@ static void flat_node(Flat *f, uint bn, uint me, uint depth, uint pending)
     if (depth > f->out->stats.max_depth) f->out->stats.max_depth = depth;
     uint kids[BVH_WIDTH];
     int width = pending + (BVH_WIDTH - 1u) + f->depth_bound <= b->budget ? (int)BVH_WIDTH : 2;
-    int n = b->n ? wide_children(b, bn, width, kids) : 0;
+    int n = b->n ? wide_children(b, f->pack, bn, width, kids) : 0;
     if (n > 1) pending += (uint)n - 1u;
     if (pending > f->max_pending) f->max_pending = pending;
     for (uint i = 0; i < BVH_WIDTH; i++) {
@@ -662,12 +749,14 @@ static Status collapse(Build *b, uint root, Bvh *out, Error *err)
     uint n_bin = atomic_load(&b->n_nodes);
     Flat f = { b, out, malloc((b->n + 1) * sizeof(uint)), malloc(((size_t)n_bin + 1) * sizeof(uint)),
                malloc((b->n + 1) * sizeof(LeafSlot)), 0, 0, 0,
-               one_per_leaf(b) ? out->stats.max_binary_depth : BVH_MAX_DEPTH };
+               one_per_leaf(b) ? out->stats.max_binary_depth : BVH_MAX_DEPTH, NULL };
     Status st = ST_OK;
-    if (!f.ids || !f.node_words || !f.slots) {
+    if (one_per_leaf(b) && b->n) f.pack = malloc(((size_t)n_bin + 1) * BVH_WIDTH * sizeof *f.pack);
+    if (!f.ids || !f.node_words || !f.slots || (one_per_leaf(b) && b->n && !f.pack)) {
         st = error_set(err, ST_INTERNAL, "BVH: out of memory for %u primitives", b->n);
         goto done;
     }
+    if (f.pack) pack_measure(b, f.pack, root, fmax(box3_half_area(&b->nodes[root].box), 1e-300));
     int n_jobs = jobs_threads(b->threads, n_bin, BVH_COLLAPSE_PASS_MIN);
     MeasureJob measure[JOBS_MAX];
     for (int i = 0; i < n_jobs; i++)
@@ -704,6 +793,7 @@ static Status collapse(Build *b, uint root, Bvh *out, Error *err)
         st = error_set(err, ST_INTERNAL, "BVH: a path leaves %u children on the walk's stack, more than its %u",
                        f.max_pending, b->budget);
 done:
+    free(f.pack);
     free(f.ids);
     free(f.node_words);
     free(f.slots);

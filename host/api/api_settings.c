@@ -41,6 +41,8 @@ static const char *refused_reason(const char *name)
         { "device", "choose devices with clpt_context_set_devices" },
         { "list-devices", "use clpt_device_count and clpt_device_name" },
         { "interactive", "the viewer is the program's" },
+        { "frames", "an animation's numbered files are the program's (docs/animation.md)" },
+        { "fps", "an animation's numbered files are the program's (docs/animation.md)" },
         { "mpi-broadcast", "MPI jobs are the program's" },
         { "mpi-timeout", "MPI jobs are the program's" },
         { "stats", "it prints to stdout" },

@@ -20,6 +20,8 @@ unsigned kernel_scene_features(const DeviceScene *s)
             continue;
         }
         f |= material_feature(m->type);
+        /* a subsurface walk leaves its solid as a white diffuse surface (shade_path.h) */
+        if (m->type == MAT_PRINCIPLED && m->subsurface > 0.0f) f |= material_feature(MAT_DIFFUSE);
         if (m->texture != NO_INDEX || m->texture_emission != NO_INDEX || m->texture_rm != NO_INDEX ||
             m->texture_normal != NO_INDEX || m->texture_specular != NO_INDEX ||
             m->texture_specular_color != NO_INDEX || m->texture_sheen_color != NO_INDEX ||

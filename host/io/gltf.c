@@ -588,7 +588,7 @@ static Status glb_split(Gltf *g, const unsigned char *d, size_t len, const char 
     return ST_OK;
 }
 
-static Status gltf_read(Gltf *g, const char *data, size_t len)
+Status gltf_open(Gltf *g, const char *data, size_t len)
 {
     const char *json = data;
     size_t json_len = len;
@@ -624,38 +624,58 @@ static Status gltf_read(Gltf *g, const char *data, size_t len)
     if (!g->mats || !g->tex || !g->visited) return error_set(g->err, ST_INTERNAL, "out of memory");
     for (int i = 0; i < g->n_mats; i++) g->mats[i] = NO_INDEX;
     for (int i = 0; i < 2 * g->n_images; i++) g->tex[i] = NO_INDEX;
-    if ((st = gltf_scene_walk(g))) return st;
+    return ST_OK;
+}
+
+/* The node tree placed, and the camera asked for found. */
+Status gltf_place(Gltf *g)
+{
+    Status st = gltf_scene_walk(g);
+    if (st) return st;
     if (g->view && g->view->camera && !g->view->has_camera)
         return error_set(g->err, ST_INPUT, "%s: no camera '%s' (give a camera's index or its or its node's name)",
                          g->path, g->view->camera);
     return ST_OK;
 }
 
+void gltf_close(Gltf *g)
+{
+    cJSON_Delete(g->root);
+    for (int i = 0; i < g->n_bufs; i++) free(g->bufs[i].owned);
+    free(g->bufs);
+    free(g->mats);
+    free(g->tex);
+    free(g->visited);
+    free(g->placed);
+    strmap_free(&g->buffer_files);
+    strmap_free(&g->image_sources[0]);
+    strmap_free(&g->image_sources[1]);
+    for (int i = 0; i < T_N; i++) free(g->t[i].item);
+    memset(g, 0, sizeof *g);
+}
+
+void gltf_init(Gltf *g, const char *path, Scene *s, const MeshOptions *o, GltfView *view, Error *err)
+{
+    memset(g, 0, sizeof *g);
+    g->path = path;
+    g->s = s;
+    g->err = err;
+    g->o = o;
+    g->view = view;
+    g->default_mat = NO_INDEX;
+    g->reading_buffer = -1;
+    g->camera_node = g->camera_index = -1;
+    if (view) view->has_camera = 0;
+}
+
 Status gltf_parse(const char *path, const char *data, size_t len, Scene *s, const MeshOptions *o, GltfView *view,
                   Error *err)
 {
     Gltf g;
-    memset(&g, 0, sizeof g);
-    g.path = path;
-    g.s = s;
-    g.err = err;
-    g.o = o;
-    g.view = view;
-    g.default_mat = NO_INDEX;
-    g.reading_buffer = -1;
-    if (view) view->has_camera = 0;
-    Status st = gltf_read(&g, data, len);
+    gltf_init(&g, path, s, o, view, err);
+    Status st = gltf_open(&g, data, len);
+    if (!st) st = gltf_place(&g);
     if (view) view->has_lights = g.has_lights;
-    cJSON_Delete(g.root);
-    for (int i = 0; i < g.n_bufs; i++) free(g.bufs[i].owned);
-    free(g.bufs);
-    free(g.mats);
-    free(g.tex);
-    free(g.visited);
-    free(g.placed);
-    strmap_free(&g.buffer_files);
-    strmap_free(&g.image_sources[0]);
-    strmap_free(&g.image_sources[1]);
-    for (int i = 0; i < T_N; i++) free(g.t[i].item);
+    gltf_close(&g);
     return st;
 }

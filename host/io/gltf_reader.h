@@ -59,6 +59,14 @@ typedef struct {
     Transform w;           /* the node's world matrix (with the MeshOptions' transform) */
 } GltfPlacement;
 
+/* A node's pose at a time of the animation (gltf_anim.c): the parts a channel
+ * animates replace the node's own translation, rotation and scale. */
+enum { GLTF_ANIM_T = 1, GLTF_ANIM_R = 2, GLTF_ANIM_S = 4 };
+typedef struct {
+    unsigned animated;     /* GLTF_ANIM_* bits: which parts are the animation's */
+    double t[3], r[4], s[3];
+} GltfNodePose;
+
 typedef struct {
     const char *path;
     Scene *s;
@@ -79,6 +87,8 @@ typedef struct {
     GltfPlacement *placed;  size_t n_placed, cap_placed;
     size_t singular;                 /* instances skipped for a singular transform */
     int has_lights;
+    const GltfNodePose *pose;        /* per node, an animation's pose; NULL: the file's own */
+    int camera_node, camera_index;   /* the node and camera the scene looks through, or -1 */
     Table t[T_N];
 } Gltf;
 
@@ -110,7 +120,23 @@ Status gltf_acc_read_either(Gltf *g, int a, int width, int width2, const char *u
 /* gltf_material.c: materials, textures and samplers */
 Status gltf_material_get(Gltf *g, int i, uint *out);
 
+/* g set up as gltf_parse sets it up, nothing read. */
+void gltf_init(Gltf *g, const char *path, Scene *s, const MeshOptions *o, GltfView *view, Error *err);
+/* The file read and checked into g (its fields set as gltf_parse sets them), nothing
+ * placed yet; gltf_close frees what it holds. */
+Status gltf_open(Gltf *g, const char *data, size_t len);
+void gltf_close(Gltf *g);
+
 /* gltf_scene.c: primitives, nodes, cameras, lights */
+/* Places the chosen scene's node tree (with g->pose when set); the node walk's own
+ * state (visited, placed, counts) starts afresh each time. */
 Status gltf_scene_walk(Gltf *g);
+/* gltf_scene_walk, then the camera asked for found (view->camera). */
+Status gltf_place(Gltf *g);
+/* The scene camera from glTF camera `cam` under the world transform xf (the MeshOptions'
+ * transform included); the image height from its aspect ratio. */
+Status gltf_camera_set(Gltf *g, int cam, const Transform *xf);
+/* Node n's local transform with g->pose's parts when set, checked (jp: "nodes[n]"). */
+Status gltf_node_local(Gltf *g, int n, Transform *out);
 
 #endif /* CLPT_GLTF_READER_H */

@@ -247,12 +247,16 @@ static void trs_matrix(const double *t, const double *q, const double *s, Transf
     }
 }
 
-static Status node_local(Gltf *g, const cJSON *node, const char *jp, Transform *out)
+Status gltf_node_local(Gltf *g, int n, Transform *out)
 {
+    char jp[64];
+    snprintf(jp, sizeof jp, "nodes[%d]", n);
+    const cJSON *node = gltf_item_at(g, "nodes", n);
     double m[16];
     static const double ident[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
     static const double t0[3] = { 0, 0, 0 }, r0[4] = { 0, 0, 0, 1 }, s0[3] = { 1, 1, 1 };
     Status st;
+    /* an animated node has no matrix (gltf_anim.c refuses one) */
     if (cJSON_GetObjectItemCaseSensitive(node, "matrix")) {
         if ((st = gltf_get_nums(g, node, "matrix", 16, ident, jp, m))) return st;
         for (int r = 0; r < 3; r++)
@@ -263,8 +267,13 @@ static Status node_local(Gltf *g, const cJSON *node, const char *jp, Transform *
     if ((st = gltf_get_nums(g, node, "translation", 3, t0, jp, t)) || (st = gltf_get_nums(g, node, "rotation", 4, r0, jp, q)) ||
         (st = gltf_get_nums(g, node, "scale", 3, s0, jp, sc)))
         return st;
+    const GltfNodePose *p = g->pose ? &g->pose[n] : NULL;
+    if (p && (p->animated & GLTF_ANIM_T)) memcpy(t, p->t, sizeof t);
+    if (p && (p->animated & GLTF_ANIM_R)) memcpy(q, p->r, sizeof q);
+    if (p && (p->animated & GLTF_ANIM_S)) memcpy(sc, p->s, sizeof sc);
     double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    if (!(l > 0)) return gltf_bad(g, jp, "rotation: a zero quaternion");
+    if (!(l > 0)) return gltf_bad(g, jp, p && (p->animated & GLTF_ANIM_R) ? "rotation: the animation makes a zero "
+                                  "quaternion" : "rotation: a zero quaternion");
     trs_matrix(t, q, sc, out);
     return ST_OK;
 }
@@ -291,7 +300,7 @@ static int camera_wanted(const Gltf *g, int cam, const cJSON *node)
            (cJSON_IsString(nn) && strcmp(nn->valuestring, want) == 0);
 }
 
-static Status camera_set(Gltf *g, int cam, const Transform *xf)
+Status gltf_camera_set(Gltf *g, int cam, const Transform *xf)
 {
     char jp[64];
     snprintf(jp, sizeof jp, "cameras[%d]", cam);
@@ -541,7 +550,7 @@ static Status node_visit(Gltf *g, int n, const Transform *parent, int depth)
     g->visited[n] = 1;
     const cJSON *node = gltf_item_at(g, "nodes", n);
     Transform local, xf;
-    Status st = node_local(g, node, jp, &local);
+    Status st = gltf_node_local(g, n, &local);
     if (st) return st;
     xf = transform_compose(parent, &local);
     int mesh, cam;
@@ -561,7 +570,9 @@ static Status node_visit(Gltf *g, int n, const Transform *parent, int depth)
     }
     if (cam >= 0 && g->view && camera_wanted(g, cam, node)) {
         Transform w = transform_compose(&g->o->xf, &xf);
-        if ((st = camera_set(g, cam, &w))) return st;
+        if ((st = gltf_camera_set(g, cam, &w))) return st;
+        g->camera_node = n;
+        g->camera_index = cam;
     }
     const cJSON *lp = gltf_ext_of(node, "KHR_lights_punctual");
     if (lp) {
@@ -586,6 +597,12 @@ static Status node_visit(Gltf *g, int n, const Transform *parent, int depth)
 Status gltf_scene_walk(Gltf *g)
 {
     const Transform id = transform_identity();
+    /* a walk of an animation's frame starts as the first did */
+    memset(g->visited, 0, (size_t)g->n_nodes + 1);
+    g->n_placed = 0;
+    g->triangles = 0;
+    g->singular = 0;
+    if (g->view) g->view->has_camera = 0;
     int n_scenes = g->t[T_SCENES].n;
     long long sc;
     Status st = gltf_get_int(g, g->root, "scene", 0, 0, n_scenes > 0 ? n_scenes - 1 : 0, "(top level)", &sc);

@@ -1,6 +1,7 @@
 /* pbrt_material.c — pbrt-v4 materials and textures (pbrt_reader.h, docs/pbrt.md). */
 #include "io/pbrt_reader.h"
 #include "scene/media.h"
+#include "scene/subsurface.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -191,6 +192,64 @@ static Status make_coated(Parser *p, const Lexer *lx, int conductor, Material *m
     return coated_medium(p, lx, m);
 }
 
+/* pbrt-v4's subsurface material as clpt's principled material with subsurface 1
+ * (docs/subsurface.md, docs/pbrt.md): its interior from `reflectance` and `mfp`
+ * (default 1) by clpt's albedo inversion (pbrt-v4 inverts its photon-beam-diffusion
+ * table instead: SubsurfaceFromDiffuse), or from `sigma_a` and `sigma_s` as they are
+ * (default pbrt-v4's RGB .0011 .0024 .014 and 2.55 3.21 3.77), each times `scale`;
+ * `g`, `eta` (default 1.33) and the roughness keys. A measured medium by `name` is a
+ * warning, and the defaults stand in. The entry is the principled dielectric
+ * (Schlick's Fresnel, pbrt-v4 the exact one), the exit Lambertian (pbrt-v4's
+ * NormalizedFresnelBxDF weighs it by the Fresnel transmission). */
+static Status make_subsurface(Parser *p, const Lexer *lx, const Token *type, Material *m)
+{
+    Status st;
+    double eta = 1.33, g = 0.0, scale = 1.0;
+    vec3 sa = v3(0.0011f, 0.0024f, 0.014f), ss = v3(2.55f, 3.21f, 3.77f), refl = v3s(0.0f), mfp = v3s(1.0f);
+    int has_sa = 0, has_ss = 0, has_refl = 0;
+    const Token *name = NULL;
+    *m = material_principled(v3s(1.0f), 0.0f, 0.0f);
+    if ((st = pbrt_get_float(p, lx, "eta", &eta)) || (st = pbrt_get_float(p, lx, "g", &g)) ||
+        (st = pbrt_get_float(p, lx, "scale", &scale)) || (st = pbrt_get_string(p, lx, "name", &name)) ||
+        (st = pbrt_get_spectrum(p, lx, "sigma_a", &sa, NULL, &has_sa)) ||
+        (st = pbrt_get_spectrum(p, lx, "sigma_s", &ss, NULL, &has_ss)) ||
+        (st = pbrt_get_spectrum(p, lx, "reflectance", &refl, NULL, &has_refl)) ||
+        (st = pbrt_get_spectrum(p, lx, "mfp", &mfp, NULL, NULL)) || (st = get_roughness(p, lx, m, 0)))
+        return st;
+    if (!(eta > 0)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "eta"), "> 0");
+    if (!(g > -1 && g < 1)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "g"), "between -1 and 1");
+    if (!(scale > 0)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "scale"), "> 0");
+    if (has_sa != has_ss)
+        return lex_error_at(lx, type, p->err, "the subsurface material's \"%s\" needs its \"%s\"",
+                            has_sa ? "sigma_a" : "sigma_s", has_sa ? "sigma_s" : "sigma_a");
+    if (name) {
+        char key[96];
+        snprintf(key, sizeof key, "subsurface name %.*s", (int)(name->len > 40 ? 40 : name->len), name->text);
+        if ((st = warn_once(p, lx, name, key, "the measured medium \"%.*s\" is not supported; pbrt-v4's default "
+                            "sigma_a and sigma_s are used", (int)(name->len > 40 ? 40 : name->len), name->text)))
+            return st;
+    }
+    if (!(sa.x >= 0 && sa.y >= 0 && sa.z >= 0))
+        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "sigma_a"), "values >= 0");
+    if (!(ss.x >= 0 && ss.y >= 0 && ss.z >= 0))
+        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "sigma_s"), "values >= 0");
+    if (!(mfp.x > 0 && mfp.y > 0 && mfp.z > 0))
+        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "mfp"), "values > 0");
+    if (has_refl && !has_sa && !name) {
+        vec3 color = v3(fminf(refl.x, 1.0f), fminf(refl.y, 1.0f), fminf(refl.z, 1.0f));
+        subsurface_coefficients(color, v3_scale(mfp, (float)scale), &sa, &ss);
+    } else {
+        sa = v3_scale(sa, (float)scale);
+        ss = v3_scale(ss, (float)scale);
+    }
+    vec3 t = v3_add(sa, ss);
+    if (!isfinite(t.x) || !isfinite(t.y) || !isfinite(t.z))
+        return lex_error_at(lx, type, p->err, "the subsurface material's extinction (sigma_a + sigma_s, times "
+                            "scale) is beyond the largest float (about 3.4e38)");
+    m->ior = (float)eta;
+    return scene_add_subsurface(p->s, m, "pbrt subsurface", 1.0f, sa, ss, (float)g, p->err);
+}
+
 /* Builds the material of type `type` from the current parameter list. */
 static Status make_material(Parser *p, const Lexer *lx, const Token *type, Material *m, const char *what)
 {
@@ -220,6 +279,8 @@ static Status make_material(Parser *p, const Lexer *lx, const Token *type, Mater
         st = ST_OK;
     } else if (pbrt_tok_eq(type, "mix")) {
         st = make_mix(p, lx, type, m);
+    } else if (pbrt_tok_eq(type, "subsurface")) {
+        st = make_subsurface(p, lx, type, m);
     } else {
         *m = material_diffuse(v3(0.5f, 0.5f, 0.5f));
         char key[96];

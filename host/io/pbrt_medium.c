@@ -184,11 +184,13 @@ Status pbrt_make_named_medium(Parser *p, Lexer *lx, const Token *kw)
     if ((st = pbrt_get_string(p, lx, "type", &type))) return st;
     if (!type) return lex_error_at(lx, &name, p->err, "MakeNamedMedium needs \"string type\"");
     uint32_t ref = 0u;   /* vacuum, for a medium clpt cannot render */
-    int grid = pbrt_tok_eq(type, "uniformgrid");
-    if (pbrt_tok_eq(type, "homogeneous") || grid) {
+    int grid = pbrt_tok_eq(type, "uniformgrid"), volume = pbrt_volume_type(type);
+    if (pbrt_tok_eq(type, "homogeneous") || grid || volume) {
         Medium m;
-        if ((st = grid ? uniform_grid(p, lx, &name, &m) : homogeneous(p, lx, &name, &m))) return st;
-        if (!grid) {
+        if ((st = volume ? pbrt_volume_medium(p, lx, &name, type, &m)
+                  : grid ? uniform_grid(p, lx, &name, &m) : homogeneous(p, lx, &name, &m)))
+            return st;
+        if (!grid && !volume) {
             double le_scale = 1.0;
             vec3 le;
             if ((st = pbrt_get_float(p, lx, "Lescale", &le_scale)) ||
@@ -203,8 +205,9 @@ Status pbrt_make_named_medium(Parser *p, Lexer *lx, const Token *kw)
         free(n);
         if (st) return st;
         ref = index + 1u;
-        if ((st = pbrt_warn_unused(p, lx, grid ? "MakeNamedMedium \"uniformgrid\""
-                                               : "MakeNamedMedium \"homogeneous\""))) return st;
+        char what[64];
+        snprintf(what, sizeof what, "MakeNamedMedium \"%.*s\"", (int)(type->len > 40 ? 40 : type->len), type->text);
+        if ((st = pbrt_warn_unused(p, lx, what))) return st;
     } else {
         char key[96];
         snprintf(key, sizeof key, "Medium %.*s", (int)(type->len > 40 ? 40 : type->len), type->text);

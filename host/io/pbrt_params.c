@@ -109,8 +109,9 @@ static Status param_check(Parser *p, Lexer *lx, const Param *pa)
         what = pa->strings ? "one name" : "(wavelength, value) pairs";
     }
     int ok = pa->n > 0 && pa->n % per == 0;
-    if (pa->type == PT_RGB || pa->type == PT_BLACKBODY || (pa->type == PT_SPECTRUM && pa->strings))
-        ok = pa->n == per;
+    /* an "rgb" may hold several colours (pbrt-v4's rgbgrid); pbrt_get_spectrum checks
+     * that a single colour is one */
+    if (pa->type == PT_BLACKBODY || (pa->type == PT_SPECTRUM && pa->strings)) ok = pa->n == per;
     if (!ok)
         return lex_error_at(lx, &pa->decl, p->err, "parameter \"%.*s\" needs %s, has %zu value%s",
                             (int)pa->decl.len, pa->decl.text, pa->type == PT_BLACKBODY ? "1 temperature" : what,
@@ -372,6 +373,9 @@ Status pbrt_get_spectrum(Parser *p, const Lexer *lx, const char *name, vec3 *out
     const double *d = pa->strings ? NULL : p->pl.nums + pa->first;   /* no numbers: no array yet */
     switch (pa->type) {
     case PT_RGB:
+        if (pa->n != 3)
+            return lex_error_at(lx, &pa->decl, p->err, "parameter \"%.*s\" needs 3 numbers, has %zu values",
+                                (int)pa->decl.len, pa->decl.text, pa->n);
         if (d[0] < 0 || d[1] < 0 || d[2] < 0) return pbrt_param_type_error(p, lx, pa, "an rgb colour >= 0");
         *out = v3((float)d[0], (float)d[1], (float)d[2]);
         return ST_OK;

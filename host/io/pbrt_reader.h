@@ -9,6 +9,7 @@
  *   pbrt_light.c     area and other lights
  *   pbrt_shape.c     shapes and object instancing
  *   pbrt_medium.c    participating media and the shapes that bound them
+ *   pbrt_volume.c    the media made into density grids: nanovdb files, cloud, rgbgrid
  * Not for use outside these files.
  */
 #ifndef CLPT_PBRT_READER_H
@@ -178,6 +179,14 @@ Status pbrt_make_named_medium(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_medium_interface(Parser *p, Lexer *lx, const Token *kw);
 /* The material a shape of `material` gets in the current MediumInterface. */
 Status pbrt_shape_media(Parser *p, uint material, uint *out);
+
+/* pbrt_volume.c: media made into a density grid at load ("nanovdb", "cloud", "rgbgrid") */
+int pbrt_volume_type(const Token *type);
+Status pbrt_volume_medium(Parser *p, const Lexer *lx, const Token *name, const Token *type, Medium *out);
+/* pbrt-v4's cloud density at a point of the medium's space, and the bake's grid size
+ * for the box lo..hi (docs/media.md#clouds); for the tests. */
+float pbrt_cloud_density(float x, float y, float z, float density, float wispiness, float frequency);
+void pbrt_cloud_resolution(vec3 lo, vec3 hi, float frequency, unsigned n[3]);
 
 /* pbrt_parse.c: directives, transforms, graphics state, files */
 Status pbrt_push_state(Parser *p);

@@ -8,6 +8,7 @@
 #include "util/kmath.h"
 #include "io/classic_parse.h"
 #include "io/gltf.h"
+#include "io/gltf_anim.h"
 #include "io/lexer.h"
 #include "io/mesh_load.h"
 #include "io/mesh_view.h"
@@ -35,7 +36,9 @@ static Status gltf_scene(const char *path, const char *text, size_t len, Scene *
                          const MeshOptions *o, Error *err)
 {
     GltfView v = { s->gltf_camera, 0, 0 };
-    Status st = gltf_parse(path, text, len, s, o, &v, err);
+    /* --frames: the file and its animation kept to pose each frame (gltf_anim.h) */
+    Status st = s->keep_animation ? gltf_parse_animated(path, text, len, s, o, &v, err)
+                                  : gltf_parse(path, text, len, s, o, &v, err);
     if (st) return st;
     if (!v.has_camera) return mesh_view_frame(path, s, err);
     if (kind) *kind = SCENE_KIND_CLPT;

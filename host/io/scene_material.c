@@ -9,6 +9,7 @@
 #include "io/lexer.h"
 #include "io/reader.h"
 #include "io/texture.h"
+#include "scene/subsurface.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -21,7 +22,9 @@ enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE
        MAT_KEY_METALLIC, MAT_KEY_TRANSMISSION, MAT_KEY_CLEARCOAT, MAT_KEY_CLEARCOAT_ROUGHNESS, MAT_KEY_STRENGTH,
        MAT_KEY_METALLIC_ROUGHNESS, MAT_KEY_NORMAL_MAP, MAT_KEY_NORMAL_SCALE, MAT_KEY_ALPHA, MAT_KEY_ALPHA_MODE,
        MAT_KEY_ALPHA_CUTOFF, MAT_KEY_EMISSION_TEXTURE, MAT_KEY_ATTENUATION_COLOR, MAT_KEY_ATTENUATION_DISTANCE,
-       MAT_KEY_SPECULAR_FACTOR, MAT_KEY_SPECULAR_COLOR, MAT_KEY_SHEEN_COLOR, MAT_KEY_SHEEN_ROUGHNESS, MAT_KEY_N };
+       MAT_KEY_SPECULAR_FACTOR, MAT_KEY_SPECULAR_COLOR, MAT_KEY_SHEEN_COLOR, MAT_KEY_SHEEN_ROUGHNESS,
+       MAT_KEY_SUBSURFACE, MAT_KEY_SUBSURFACE_COLOR, MAT_KEY_SUBSURFACE_RADIUS, MAT_KEY_SUBSURFACE_SCALE,
+       MAT_KEY_SUBSURFACE_ANISOTROPY, MAT_KEY_N };
 static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0,
                       "a material type (diffuse, metal, conductor, dielectric, principled, emissive, phong)"},
@@ -61,6 +64,12 @@ static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_SPECULAR_COLOR] = {"specular_color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_SHEEN_COLOR] = {"sheen_color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
     [MAT_KEY_SHEEN_ROUGHNESS] = {"sheen_roughness", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_SUBSURFACE] = {"subsurface", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_SUBSURFACE_COLOR] = {"subsurface_color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_SUBSURFACE_RADIUS] = {"subsurface_radius", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MAT_KEY_SUBSURFACE_SCALE] = {"subsurface_scale", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
+    [MAT_KEY_SUBSURFACE_ANISOTROPY] = {"subsurface_anisotropy", VK_NUMBER, 0, -1, 1, 1, 1,
+                                       "a number in (-1, 1)"},
 };
 
 /* Which keys each material type takes (bit i = material_keys[i]), and which it needs. */
@@ -91,7 +100,9 @@ static const struct {
      1ull << MAT_KEY_METALLIC_ROUGHNESS | 1ull << MAT_KEY_NORMAL_MAP | 1ull << MAT_KEY_NORMAL_SCALE | 1ull << MAT_KEY_SIDES |
      1ull << MAT_KEY_ALPHA | 1ull << MAT_KEY_ALPHA_MODE | 1ull << MAT_KEY_ALPHA_CUTOFF | 1ull << MAT_KEY_EMISSION_TEXTURE |
      1ull << MAT_KEY_ATTENUATION_COLOR | 1ull << MAT_KEY_ATTENUATION_DISTANCE | 1ull << MAT_KEY_SPECULAR_FACTOR |
-     1ull << MAT_KEY_SPECULAR_COLOR | 1ull << MAT_KEY_SHEEN_COLOR | 1ull << MAT_KEY_SHEEN_ROUGHNESS,
+     1ull << MAT_KEY_SPECULAR_COLOR | 1ull << MAT_KEY_SHEEN_COLOR | 1ull << MAT_KEY_SHEEN_ROUGHNESS |
+     1ull << MAT_KEY_SUBSURFACE | 1ull << MAT_KEY_SUBSURFACE_COLOR | 1ull << MAT_KEY_SUBSURFACE_RADIUS |
+     1ull << MAT_KEY_SUBSURFACE_SCALE | 1ull << MAT_KEY_SUBSURFACE_ANISOTROPY,
      0},
     {"emissive", MAT_EMISSIVE, 1ull << MAT_KEY_RADIANCE | 1ull << MAT_KEY_SIDES, 1ull << MAT_KEY_RADIANCE},
     {"phong", MAT_PHONG,
@@ -162,6 +173,44 @@ static void parse_principled_layers(const Value *v, Material *m)
     if (v[MAT_KEY_SPECULAR_COLOR].given) m->specular_color = v[MAT_KEY_SPECULAR_COLOR].v;
     if (v[MAT_KEY_SHEEN_COLOR].given) m->sheen_color = v[MAT_KEY_SHEEN_COLOR].v;
     if (v[MAT_KEY_SHEEN_ROUGHNESS].given) m->sheen_roughness = v[MAT_KEY_SHEEN_ROUGHNESS].f;
+}
+
+/* Subsurface scattering (scene/subsurface.h, docs/subsurface.md): `subsurface` W > 0
+ * gives the material an interior medium from `subsurface_color` (default: the albedo)
+ * and `subsurface_radius` (the mean free path per channel, default 1 1 1) times
+ * `subsurface_scale` (default 1), with `subsurface_anisotropy` g (default 0). Only a
+ * solid has an inside, and its absorption would be charged twice, so `thin on` and the
+ * attenuation keys are refused with it. W = 0 (the default) makes no medium: the
+ * material is what it was before subsurface scattering, to the bit. */
+static Status parse_subsurface(Parser *p, Lexer *lx, const Value *v, const char *name, Material *m)
+{
+    if (!v[MAT_KEY_SUBSURFACE].given || !(v[MAT_KEY_SUBSURFACE].f > 0.0f)) return ST_OK;
+    const Token *key = &v[MAT_KEY_SUBSURFACE].key;
+    if (m->flags & MAT_THIN)
+        return lex_error_at(lx, key, p->err, "'subsurface' needs a solid: it cannot be combined with 'thin on'");
+    if (v[MAT_KEY_ATTENUATION_COLOR].given || v[MAT_KEY_ATTENUATION_DISTANCE].given)
+        return lex_error_at(lx, key, p->err, "'subsurface' cannot be combined with 'attenuation_color' or "
+                            "'attenuation_distance' (the subsurface medium absorbs by its colour)");
+    vec3 color = v[MAT_KEY_SUBSURFACE_COLOR].given ? v[MAT_KEY_SUBSURFACE_COLOR].v : m->albedo;
+    if (!(color.x <= 1.0f && color.y <= 1.0f && color.z <= 1.0f))
+        return lex_error_at(lx, v[MAT_KEY_SUBSURFACE_COLOR].given ? &v[MAT_KEY_SUBSURFACE_COLOR].value : key, p->err,
+                            "'subsurface_color' must be in [0, 1] (the share of light the interior gives back)%s",
+                            v[MAT_KEY_SUBSURFACE_COLOR].given ? "" : "; it defaults to 'albedo'");
+    vec3 radius = v[MAT_KEY_SUBSURFACE_RADIUS].given ? v[MAT_KEY_SUBSURFACE_RADIUS].v : v3s(1.0f);
+    if (!(radius.x > 0.0f && radius.y > 0.0f && radius.z > 0.0f))
+        return lex_error_at(lx, &v[MAT_KEY_SUBSURFACE_RADIUS].value, p->err,
+                            "'subsurface_radius' must be > 0 in every channel (a mean free path)");
+    float scale = v[MAT_KEY_SUBSURFACE_SCALE].given ? v[MAT_KEY_SUBSURFACE_SCALE].f : 1.0f;
+    vec3 mfp = v3_scale(radius, scale), sa, ss;
+    subsurface_coefficients(color, mfp, &sa, &ss);
+    vec3 t = v3_add(sa, ss);
+    if (!(mfp.x > 0.0f && mfp.y > 0.0f && mfp.z > 0.0f) || !isfinite(t.x) || !isfinite(t.y) || !isfinite(t.z))
+        return lex_error_at(lx, v[MAT_KEY_SUBSURFACE_SCALE].given ? &v[MAT_KEY_SUBSURFACE_SCALE].key
+                                                                  : &v[MAT_KEY_SUBSURFACE_RADIUS].key, p->err,
+                            "the subsurface extinction 1 / (subsurface_radius x subsurface_scale) is beyond the "
+                            "largest float (about 3.4e38)");
+    float g = v[MAT_KEY_SUBSURFACE_ANISOTROPY].given ? v[MAT_KEY_SUBSURFACE_ANISOTROPY].f : 0.0f;
+    return scene_add_subsurface(p->s, m, name ? name : "", v[MAT_KEY_SUBSURFACE].f, sa, ss, g, p->err);
 }
 
 /* Reads a material's `{ ... }`; a NULL name makes an anonymous (inline) material. */
@@ -246,6 +295,7 @@ Status scene_parse_material_block(Parser *p, Lexer *lx, const Token *kw, int bra
     if (v[MAT_KEY_TEXTURE].given) m.texture = (uint)v[MAT_KEY_TEXTURE].u;
     if (v[MAT_KEY_ROUGHNESS].given) m.roughness = v[MAT_KEY_ROUGHNESS].f;
     if (v[MAT_KEY_ANISOTROPY].given) m.anisotropy = v[MAT_KEY_ANISOTROPY].f;
+    if ((st = parse_subsurface(p, lx, v, name, &m))) return st;
     /* inline materials get the empty name, which no named material can have, so a
      * lookup never finds them */
     if ((st = scene_add_material(p->s, name ? name : "", m, index, p->err))) return st;

@@ -2,10 +2,14 @@
  * scene_object.c — the scene reader's objects and instances (docs/instancing.md);
  * part of the reader of scene_parse.c (scene_reader.h).
  *
- *   object NAME { shapes... }                  the shapes once, in the object's space
- *   instance NAME { translate ... material M }  the object placed in the world
+ *   object NAME { shapes... instances... }     the shapes once, in the object's space
+ *   instance NAME { translate ... material M }  the object placed in the world, or,
+ *                                               inside an object, in the object's space
  *
- * Instances nest one level deep: an object holds shapes, not instances.
+ * Instances nest: an object may hold instances of objects defined before it, up to
+ * SCENE_MAX_NESTING deep; each world instance is resolved into one instance per object
+ * with shapes on its way down (scene_place_object), so the devices see one level.
+ * Object definitions themselves do not nest.
  */
 #include "io/scene_reader.h"
 
@@ -50,16 +54,21 @@ static Status object_body(Parser *p, Lexer *lx, const Token *name)
         if (t.kind == TOK_RBRACE) return ST_OK;
         if (t.kind == TOK_EOF)
             return lex_error_at(lx, name, p->err, "object '%.*s' is not closed with '}'", (int)name->len, name->text);
-        if (t.kind == TOK_WORD && (tok_is(&t, "instance") || tok_is(&t, "object")))
-            return lex_error_at(lx, &t, p->err, "'%s' inside object '%.*s': objects hold shapes, not instances or "
-                                "objects (clpt instances one level deep)", tok_is(&t, "object") ? "object" : "instance",
-                                (int)name->len, name->text);
+        if (t.kind == TOK_WORD && tok_is(&t, "object"))
+            return lex_error_at(lx, &t, p->err, "'object' inside object '%.*s': objects are defined at the top level "
+                                "(an object may hold instances of objects defined before it)", (int)name->len,
+                                name->text);
+        if (t.kind == TOK_WORD && tok_is(&t, "instance")) {
+            if ((st = scene_parse_instance(p, lx, &t))) return st;
+            continue;
+        }
         size_t i = N_OBJECT_STATEMENTS;
         if (t.kind == TOK_WORD)
             for (i = 0; i < N_OBJECT_STATEMENTS; i++)
                 if (tok_is(&t, object_statements[i].keyword)) break;
         if (i == N_OBJECT_STATEMENTS)
-            return lex_expected(lx, &t, "a shape of the object (sphere, triangle, quad, box, mesh) or '}'", p->err);
+            return lex_expected(lx, &t, "a shape of the object (sphere, triangle, quad, box, mesh), an instance or '}'",
+                                p->err);
         if ((st = object_statements[i].parse(p, lx, &t))) return st;
     }
 }
@@ -82,8 +91,8 @@ Status scene_parse_object(Parser *p, Lexer *lx, const Token *kw)
     p->object = NO_INDEX;
     scene_object_end(p->s, index);
     if (st) return st;
-    if (scene_object_prims(p->s, index) == 0)
-        return lex_error_at(lx, &name, p->err, "object '%.*s' holds no shapes", (int)name.len, name.text);
+    if (scene_object_prims(p->s, index) == 0 && p->s->objects[index].leaves == 0)
+        return lex_error_at(lx, &name, p->err, "object '%.*s' holds no shapes or instances", (int)name.len, name.text);
     (void)kw;
     return ST_OK;
 }
@@ -106,6 +115,9 @@ Status scene_parse_instance(Parser *p, Lexer *lx, const Token *kw)
     Status st = object_name(p, lx, "instance", &name);
     if (st) return st;
     uint object = scene_find_object(p->s, name.text, name.len);
+    if (object != NO_INDEX && object == p->object)
+        return lex_error_at(lx, &name, p->err, "object '%.*s' instances itself (an object cannot hold itself)",
+                            (int)name.len, name.text);
     if (object == NO_INDEX)
         return lex_error_at(lx, &name, p->err, "no object named '%.*s' (define it with 'object %.*s { ... }' before "
                             "its instances)", (int)name.len, name.text, (int)name.len, name.text);
@@ -114,6 +126,7 @@ Status scene_parse_instance(Parser *p, Lexer *lx, const Token *kw)
     Transform m;
     if ((st = scene_parse_transform(p, lx, kw, v + INST_TRANSLATE, "instance", &m))) return st;
     uint material = v[INST_MATERIAL].given ? v[INST_MATERIAL].material : NO_INDEX;
-    st = scene_add_instance(p->s, object, &m, material, p->err);
+    st = p->object != NO_INDEX ? scene_object_nest(p->s, p->object, object, &m, material, p->err)
+                               : scene_place_object(p->s, object, &m, material, p->err);
     return st == ST_INPUT ? lex_error_at(lx, kw, p->err, "%s", p->err->msg) : st;
 }

@@ -319,6 +319,10 @@ static Status camera_type(Parser *p, Lexer *lx, const Token *kw, const Value *v,
 
 static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
 {
+    /* a path's first key starts from the camera block's values */
+    if (p->camera_path_at)
+        return lex_error_at(lx, kw, p->err, "the camera block must come before the camera_path (at %s), whose "
+                            "keys start from its values", p->camera_path_at);
     Value v[CAM_N];
     Status st = parse_once_block(p, lx, kw, &p->camera_at, "camera", camera_keys, CAM_N, v);
     if (st) return st;
@@ -545,6 +549,7 @@ static const struct {
     {"include", parse_include},               {"light", scene_parse_light},
     {"texture", scene_parse_texture},         {"medium", scene_parse_medium},
     {"object", scene_parse_object},           {"instance", scene_parse_instance},
+    {"camera_path", scene_parse_camera_path},
 };
 #define N_STATEMENTS (sizeof statements / sizeof statements[0])
 
@@ -562,7 +567,7 @@ static Status parse_statements(Parser *p, Lexer *lx)
             st = lex_expected(lx, &t,
                               "a statement (camera, image, background, material, sphere, "
                               "plane, triangle, quad, box, mesh, light, texture, medium, include, object, "
-                              "instance)", p->err);
+                              "instance, camera_path)", p->err);
             break;
         }
         if ((st = statements[i].parse(p, lx, &t))) break;
@@ -600,6 +605,9 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
         st = parse_file(&p, path);
     }
     if (!st) st = scene_check_precision(s, err);
+    if (!st) st = scene_camera_path_finish(&p);
+    free(p.camera_path_at);
+    free(p.path_keys);
     free(p.camera_at);
     free(p.image_at);
     free(p.background_at);

@@ -15,6 +15,7 @@
 #include <stddef.h>
 
 #include "io/lexer.h"
+#include "scene/camera_path.h"
 #include "scene/scene.h"
 
 typedef enum {
@@ -73,7 +74,16 @@ typedef struct {
     float *list;                      /* VK_NUMBER_LIST values of the block being read
                                        * (emptied when a block starts; freed at the end) */
     size_t n_list, cap_list;
+    char *camera_path_at;             /* "file:line:col" of the camera_path, once given */
+    CameraKey *path_keys;             /* its keys, each whole (scene_camera_path.c) */
+    size_t n_path_keys, cap_path_keys;
+    int path_interp;                  /* enum CameraPathInterp */
 } Parser;
+
+/* scene_camera_path.c: the camera_path statement, and the scene's animation made of it
+ * once the file is read (when the scene keeps animations) */
+Status scene_parse_camera_path(Parser *p, Lexer *lx, const Token *kw);
+Status scene_camera_path_finish(Parser *p);
 
 /* scene_parse.c: blocks, paths, vector helpers */
 char *scene_path_beside(const char *from, const char *file, size_t file_len);

@@ -74,9 +74,12 @@ int adaptive_decides_at(const AdaptiveSettings *s, uint n);
 uint adaptive_next_stop(const AdaptiveSettings *s, uint reached, uint spp);
 
 /* The pixels that render the next round, into mask (width * height, 1 = renders): those
- * at af->film.samples and, where that count is a decision, whose error or a neighbour's
- * (the 3x3 around it, among pixels still at that count) is at or above the threshold:
- * an edge's converged side goes on with its noisy side, as in Cycles. *active: how many. */
+ * at af->film.samples and, where that count is a decision, whose decision error or a
+ * neighbour's (the 3x3 around it, among pixels still at that count) is at or above the
+ * threshold: an edge's converged side goes on with its noisy side, as in Cycles. A
+ * pixel's decision error is the mean of adaptive_pixel_error over its 3x3 block (each
+ * pixel at its own count), or half its own error when that is larger: one estimate
+ * alone is too noisy to stop on (adaptive.c, decision_error). *active: how many. */
 Status adaptive_mask(const AdaptiveSettings *s, const AdaptiveFilm *af, uint *mask, size_t *active, Error *err);
 
 /* Called after each round, with the state: progressive output and checkpoints. */

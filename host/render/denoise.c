@@ -4,6 +4,7 @@
 #include <dlfcn.h>
 #include <float.h>
 #include <limits.h>
+#include <signal.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -22,6 +23,7 @@ typedef void *OidnBuffer;
 enum {
     OIDN_DEVICE_TYPE_DEFAULT = 0,   /* the fastest device OIDN supports here */
     OIDN_ERROR_NONE = 0,
+    OIDN_ERROR_CANCELLED = 6,       /* a progress monitor returned false */
     OIDN_FORMAT_FLOAT3 = 3
 };
 
@@ -43,6 +45,8 @@ enum {
     X(void, oidnSetFilterBool, (OidnFilter filter, const char *name, bool value)) \
     X(void, oidnCommitFilter, (OidnFilter filter)) \
     X(void, oidnExecuteFilter, (OidnFilter filter)) \
+    X(void, oidnSetFilterProgressMonitorFunction, (OidnFilter filter, bool (*func)(void *user, double n), \
+                                                   void *user)) \
     X(void, oidnReleaseFilter, (OidnFilter filter))
 
 struct Denoiser {
@@ -52,6 +56,7 @@ struct Denoiser {
     OIDN_FUNCTIONS(X)
 #undef X
     OidnDevice device;
+    const volatile sig_atomic_t *cancel;   /* denoiser_set_cancel's flag, or NULL */
 };
 
 #define OIDN_SONAME "libOpenImageDenoise.so.2"
@@ -138,6 +143,7 @@ static Status denoiser_check(const Denoiser *d, const char *step, Error *err)
     const char *msg = NULL;
     int code = d->oidnGetDeviceError(d->device, &msg);
     if (code == OIDN_ERROR_NONE) return ST_OK;
+    if (code == OIDN_ERROR_CANCELLED) return error_set(err, ST_INTERRUPTED, "denoising was cancelled");
     return error_set(err, ST_DEVICE, "Open Image Denoise (%s) failed %s: %s (error %d)", d->path, step,
                      msg && *msg ? msg : "no message", code);
 }
@@ -165,6 +171,8 @@ Status denoiser_open(Denoiser **out, Error *err)
 }
 
 const char *denoiser_library(const Denoiser *d) { return d->path; }
+
+void denoiser_set_cancel(Denoiser *d, const volatile sig_atomic_t *cancel) { d->cancel = cancel; }
 
 const char *denoiser_device_kind(const Denoiser *d)
 {
@@ -196,15 +204,35 @@ static void clean_input(const float *in, float *tmp, size_t n, ImageSlot slot)
     for (size_t i = 0; i < n; i++) tmp[i] = clampf(in[i], lo, hi);
 }
 
+/* OIDN's progress monitor: called from its threads between pieces of the filter's
+ * work; false stops the filter (oidnExecuteFilter returns, the device's error is
+ * OIDN_ERROR_CANCELLED). The flag is only read. */
+static bool keep_going(void *user, double progress)
+{
+    (void)progress;
+    const volatile sig_atomic_t *cancel = user;
+    return !*cancel;
+}
+
+/* Whether the caller's flag asks to stop: checked before each filter too, so that a
+ * raised flag costs no upload or filter at all. */
+static Status cancelled(const Denoiser *d, Error *err)
+{
+    return d->cancel && *d->cancel ? error_set(err, ST_INTERRUPTED, "denoising was cancelled") : ST_OK;
+}
+
 /* One RT filter over the buffers in buf (NULL: not an input), with `set` naming the
  * slot each is given as. The features are prefiltered by passing them alone, as
  * "albedo" or "normal", with the output in place. */
 static Status run_filter(Denoiser *d, OidnBuffer const *buf, const char *const *set, OidnBuffer output, unsigned w,
                          unsigned h, int hdr, int clean_aux, const char *step, Error *err)
 {
+    Status st = cancelled(d, err);
+    if (st != ST_OK) return st;
     OidnFilter f = d->oidnNewFilter(d->device, "RT");
-    Status st = denoiser_check(d, step, err);
+    st = denoiser_check(d, step, err);
     if (st != ST_OK || !f) return st ? st : error_set(err, ST_DEVICE, "Open Image Denoise has no RT filter");
+    if (d->cancel) d->oidnSetFilterProgressMonitorFunction(f, keep_going, (void *)(uintptr_t)d->cancel);
     for (int s = 0; s < IMG_OUTPUT; s++)
         if (buf[s]) d->oidnSetFilterImage(f, set[s], buf[s], OIDN_FORMAT_FLOAT3, w, h, 0, 0, 0);
     d->oidnSetFilterImage(f, "output", output, OIDN_FORMAT_FLOAT3, w, h, 0, 0, 0);

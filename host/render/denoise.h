@@ -16,6 +16,8 @@
 #ifndef CLPT_DENOISE_H
 #define CLPT_DENOISE_H
 
+#include <signal.h>
+
 #include "base/status.h"
 
 typedef struct Denoiser Denoiser;
@@ -47,6 +49,15 @@ Status denoiser_clean_features(Denoiser *d, float *albedo, float *normal, unsign
 /* denoiser_run with features denoiser_clean_features has already prefiltered. */
 Status denoiser_run_clean(Denoiser *d, const float *color, const float *albedo, const float *normal, unsigned width,
                           unsigned height, float *out, Error *err);
+
+/* A flag that stops the denoiser's work when raised (NULL: none): checked before each
+ * of its filters and, through OIDN's progress monitor, by OIDN itself between pieces of
+ * a filter's work, so a raised flag ends denoiser_run, denoiser_run_clean or
+ * denoiser_clean_features within a fraction of a second with ST_INTERRUPTED ("denoising
+ * was cancelled"), the outputs then unspecified. The viewer raises it when the view
+ * changes, it pauses or quits: OIDN's filter has no other way to be stopped. The flag
+ * must outlive the denoiser's use of it. */
+void denoiser_set_cancel(Denoiser *d, const volatile sig_atomic_t *cancel);
 
 /* The file the library was loaded from, and its device's kind ("CPU", "CUDA", ...). */
 const char *denoiser_library(const Denoiser *d);

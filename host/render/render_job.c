@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "base/timer.h"
+#include "scene/camera.h"
 
 void render_job_init(RenderJob *job, const RenderJobSettings *set, DeviceWarn warn, void *warn_ctx, void *user)
 {
@@ -51,6 +52,33 @@ Status render_job_prepare_scene(RenderJob *job, Scene *scene, Error *err)
 {
     job->scene = scene;
     return render_scene_prepare(scene, 0, &job->rs, err);
+}
+
+void render_job_take_scene(RenderJob *job, RenderScene *rs)
+{
+    *rs = job->rs;
+    memset(&job->rs, 0, sizeof job->rs);
+}
+
+Status render_job_adopt_scene(RenderJob *job, Scene *scene, RenderScene *rs, Error *err)
+{
+    job->scene = scene;
+    job->rs = *rs;
+    memset(rs, 0, sizeof *rs);
+    RenderParams *p = &job->rs.ds.params;
+    Status st = camera_setup(&scene->camera, scene->image.width, scene->image.height, &p->camera, err);
+    return st ? st : scene_check_precision(scene, err);
+}
+
+Status render_job_update_devices(RenderJob *job, Device **devs, size_t n_devs, Error *err)
+{
+    job->devs = devs;
+    job->n_devs = job->n_local_devs = n_devs;
+    for (size_t i = 0; i < n_devs; i++) {
+        Status st = devs[i]->ops->update_params(devs[i], &job->rs.ds.params, job->rs.ds.pixel_list, err);
+        if (st) return st;
+    }
+    return ST_OK;
 }
 
 /* ------------------------------------------------------------------ resuming */
@@ -152,6 +180,25 @@ Status render_job_open_devices(RenderJob *job, Error *err)
                                 &job->devs, &job->n_devs, err);
     job->n_local_devs = job->n_devs;
     return st;
+}
+
+void render_job_take_devices(RenderJob *job, Device ***devs, size_t *n_devs)
+{
+    *devs = job->devs;
+    *n_devs = job->n_devs;
+    job->devs = NULL;
+    job->n_devs = job->n_local_devs = 0;
+}
+
+Status render_job_adopt_devices(RenderJob *job, Device **devs, size_t n_devs, Error *err)
+{
+    job->devs = devs;
+    job->n_devs = job->n_local_devs = n_devs;
+    for (size_t i = 0; i < n_devs; i++) {
+        Status st = devs[i]->ops->load_scene(devs[i], &job->rs.ds, err);
+        if (st) return st;
+    }
+    return ST_OK;
 }
 
 /* ------------------------------------------------------------------ the render */

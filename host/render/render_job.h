@@ -92,6 +92,16 @@ Status render_job_open_denoiser(RenderJob *job, Error *err);
  * until it is freed. */
 Status render_job_prepare_scene(RenderJob *job, Scene *scene, Error *err);
 
+/* An animation whose frames move only the camera (SceneAnimation.camera_only) keeps the
+ * scene prepared by the frame before: render_job_take_scene hands the prepared scene out
+ * of the finished job (which then frees none of it), render_job_adopt_scene gives it to
+ * the new job with the camera's parameters made again from scene->camera (checked
+ * as render_scene_prepare checks it), and render_job_update_devices gives the adopted
+ * devices the new parameters alone: no tree is built and no buffer uploaded again. */
+void render_job_take_scene(RenderJob *job, RenderScene *rs);
+Status render_job_adopt_scene(RenderJob *job, Scene *scene, RenderScene *rs, Error *err);
+Status render_job_update_devices(RenderJob *job, Device **devs, size_t n_devs, Error *err);
+
 /* The render's identity where something compares or records it (a checkpoint, a
  * resume, or `keyed`: the ranks of an MPI job): it hashes every scene buffer. Then the
  * film, and with a resume path (unless `skip_resume`: an MPI worker) the checkpoint,
@@ -100,6 +110,14 @@ Status render_job_prepare_film(RenderJob *job, int keyed, int skip_resume, Error
 
 /* The chosen devices (device_open_all), each given the scene. */
 Status render_job_open_devices(RenderJob *job, Error *err);
+
+/* An animation's next frame (docs/animation.md) renders on the devices the frame before
+ * opened: render_job_take_devices hands them out of the finished job (which then frees
+ * none), render_job_adopt_devices gives each the new job's scene. A device keeps the
+ * programs it built while the scene needs no feature they lack (device.h, load_scene),
+ * so the frames compile nothing again: only the scene's buffers are uploaded. */
+void render_job_take_devices(RenderJob *job, Device ***devs, size_t *n_devs);
+Status render_job_adopt_devices(RenderJob *job, Device **devs, size_t n_devs, Error *err);
 
 /* The scheduler's settings from the job's: spp, the resumed samples, the range, the
  * time limit, the batch, checkpoints, warnings; ctx the job. The caller adds its own

@@ -9,6 +9,7 @@
 #include "scene/camera.h"
 #include "scene/cube_env.h"
 #include "scene/media.h"
+#include "scene/subsurface.h"
 #include "scene/instance.h"
 #include "scene/texel_pack.h"
 
@@ -162,7 +163,7 @@ static Status crop_params(const Scene *s, RenderParams *p, Error *err)
 static Status prepare_media(const Scene *s, RenderScene *out, Error *err)
 {
     RenderParams *p = &out->ds.params;
-    p->has_media = scene_has_media(s) ? 1u : 0u;
+    p->has_media = scene_has_media(s) ? HAS_MEDIA_ANY | (scene_has_subsurface(s) ? HAS_MEDIA_WALK : 0u) : 0u;
     p->n_media = (uint)s->n_media;
     p->camera_medium = scene_medium_resolve(s, s->camera_medium);
     out->ds.media = s->n_media ? s->media : NULL;

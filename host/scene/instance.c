@@ -50,13 +50,87 @@ Status scene_object_begin_from(Scene *s, const char *name, size_t len, const siz
     o->name[len] = '\0';
     memcpy(o->first, first, sizeof o->first);
     scene_object_counts(s, o->end);
+    o->first_nested = o->end_nested = s->n_nested;
+    o->depth = 1u;
+    o->leaves = 0u;
     *index = (uint)s->n_objects++;
     return ST_OK;
 }
 
+/* a + b, held at LEAVES_MAX: nesting multiplies counts (8 levels of a million
+ * instances each are 2^160), and past the limit only the message needs the number */
+#define LEAVES_MAX ((uint64_t)1 << 62)
+static uint64_t leaves_add(uint64_t a, uint64_t b)
+{
+    uint64_t sum = a + b;
+    return sum > LEAVES_MAX ? LEAVES_MAX : sum;
+}
+
 void scene_object_end(Scene *s, uint index)
 {
-    scene_object_counts(s, s->objects[index].end);
+    SceneObject *o = &s->objects[index];
+    scene_object_counts(s, o->end);
+    if (scene_object_prims(s, index)) o->leaves = leaves_add(o->leaves, 1u);
+}
+
+Status scene_object_nest(Scene *s, uint holder, uint object, const Transform *m, uint material, Error *err)
+{
+    SceneObject *h = &s->objects[holder];
+    const SceneObject *o = &s->objects[object];
+    if (object == holder)
+        return error_set(err, ST_INPUT, "object '%s' instances itself (an object cannot hold itself)", h->name);
+    /* objects are defined before their instances and not inside each other, so a
+     * holder's nested objects are all complete: recursion through others cannot be
+     * written, and depth and counts are known here */
+    if (o->depth + 1u > SCENE_MAX_NESTING)
+        return error_set(err, ST_INPUT, "an instance of '%s' inside object '%s' nests objects %u deep (the limit is %u)",
+                         o->name, h->name, o->depth + 1u, SCENE_MAX_NESTING);
+    Transform inv;
+    if (!transform_invert(m, &inv)) return error_set(err, ST_INPUT, "the instance transform is singular");
+    if (h->end_nested != s->n_nested)
+        return error_set(err, ST_INTERNAL, "object '%s' is not the one being read", h->name);
+    if (array_reserve((void **)&s->nested, &s->cap_nested, s->n_nested + 1, sizeof *s->nested))
+        return error_set(err, ST_INTERNAL, "out of memory for an instance");
+    s->nested[s->n_nested++] = (SceneNested){ *m, object, material };
+    h->end_nested = s->n_nested;
+    if (o->depth + 1u > h->depth) h->depth = o->depth + 1u;
+    h->leaves = leaves_add(h->leaves, o->leaves);
+    return ST_OK;
+}
+
+/* scene_place_object's walk: the object's own shapes, then what it nests, depth first
+ * in the order of its block; the outermost material given wins. */
+static Status place_nested(Scene *s, uint object, const Transform *m, uint material, Error *err)
+{
+    const SceneObject *o = &s->objects[object];
+    Status st = ST_OK;
+    if (scene_object_prims(s, object)) st = scene_add_instance(s, object, m, material, err);
+    for (size_t k = o->first_nested; !st && k < o->end_nested; k++) {
+        const SceneNested *n = &s->nested[k];
+        Transform c = transform_compose(m, &n->m);
+        st = place_nested(s, n->object, &c, material != NO_INDEX ? material : n->material, err);
+    }
+    return st;
+}
+
+Status scene_place_object(Scene *s, uint object, const Transform *m, uint material, Error *err)
+{
+    const SceneObject *o = &s->objects[object];
+    if (o->first_nested == o->end_nested) return scene_add_instance(s, object, m, material, err);
+    /* counted before anything is allocated: a few lines of nesting can ask for more
+     * instances than any memory holds */
+    if (o->leaves > SCENE_MAX_INSTANCES - s->n_instances) {
+        if (o->leaves == LEAVES_MAX)
+            return error_set(err, ST_INPUT, "an instance of '%s' places 2^62 or more instances through the objects "
+                             "it nests (the limit is %u)", o->name, SCENE_MAX_INSTANCES);
+        return error_set(err, ST_INPUT, "an instance of '%s' places %llu instances through the objects it nests, "
+                         "%zu more than the limit of %u", o->name, (unsigned long long)o->leaves,
+                         (size_t)(s->n_instances + o->leaves - SCENE_MAX_INSTANCES), SCENE_MAX_INSTANCES);
+    }
+    if (array_reserve((void **)&s->instances, &s->cap_instances, s->n_instances + (size_t)o->leaves,
+                      sizeof *s->instances))
+        return error_set(err, ST_INTERNAL, "out of memory for %llu instances", (unsigned long long)o->leaves);
+    return place_nested(s, object, m, material, err);
 }
 
 uint scene_find_object(const Scene *s, const char *name, size_t len)
@@ -313,9 +387,12 @@ void scene_free_objects(Scene *s)
     free(s->objects);
     free(s->instances);
     free(s->instance_lights);
+    free(s->nested);
     strmap_free(&s->object_by_name);
     s->objects = NULL;
     s->instances = NULL;
     s->instance_lights = NULL;
+    s->nested = NULL;
     s->n_objects = s->cap_objects = s->n_instances = s->cap_instances = 0;
+    s->n_nested = s->cap_nested = 0;
 }

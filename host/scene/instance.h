@@ -20,6 +20,10 @@
 #define SCENE_MAX_INSTANCES (1u << 24)
 /* The most objects a scene defines. */
 #define SCENE_MAX_OBJECTS (1u << 20)
+/* The deepest chain of objects that hold instances of objects (an object of shapes
+ * alone is 1 deep): nesting is resolved at load, and each level can multiply the
+ * instances, so the depth is bounded as the count is (docs/instancing.md). */
+#define SCENE_MAX_NESTING 8u
 
 /* Starts object `name` (len bytes; must not be defined yet: scene_find_object) at the
  * scene's current primitive counts; *index receives it. Fails when memory runs out
@@ -44,6 +48,20 @@ size_t scene_object_prims(const Scene *s, uint index);
  * own). ST_INPUT (message without a location) when m is singular, it or its inverse
  * does not fit in floats, or past SCENE_MAX_INSTANCES; ST_INTERNAL without memory. */
 Status scene_add_instance(Scene *s, uint object, const Transform *m, uint material, Error *err);
+
+/* An instance of `object` inside the block of `holder` (the object being read, begun
+ * last and not ended), under m in the holder's space, its primitives of `material`
+ * (NO_INDEX: their own). ST_INPUT (message without a location) when object is the
+ * holder, when the chain of objects would be more than SCENE_MAX_NESTING deep, or m is
+ * singular; ST_INTERNAL without memory. */
+Status scene_object_nest(Scene *s, uint holder, uint object, const Transform *m, uint material, Error *err);
+/* Places `object` in the world under m (scene_add_instance's arguments): one instance
+ * for its own primitives (when it has any), then each instance its block holds, under
+ * m times that instance's transform (composed in double), depth first in the order
+ * written. The outermost material given replaces all the others below it. The count
+ * is checked against SCENE_MAX_INSTANCES before anything is allocated (ST_INPUT,
+ * message without a location, naming the count); otherwise as scene_add_instance. */
+Status scene_place_object(Scene *s, uint object, const Transform *m, uint material, Error *err);
 
 /* Global primitive ids by kind: the ranges of object `index`, in increasing order
  * (empty kinds left out); returns how many (at most OBJ_KINDS). */

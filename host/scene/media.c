@@ -32,7 +32,7 @@ Medium medium_grid(vec3 sigma_a, vec3 sigma_s, float g, uint grid)
 Medium medium_with_emission(Medium m, vec3 le)
 {
     m.emission = le;
-    m.emissive = v3_is_zero(le) ? 0u : 1u;
+    m.flags = v3_is_zero(le) ? (m.flags & ~MEDIUM_EMISSIVE) : (m.flags | MEDIUM_EMISSIVE);
     return m;
 }
 
@@ -208,10 +208,14 @@ int scene_has_media(const Scene *s)
 
 void scene_prepare_media(Scene *s)
 {
+    /* a subsurface material's interior is its walk's medium (scene/subsurface.h), and
+     * its exterior the background's unless a shape says otherwise */
+    for (size_t i = 0; i < s->n_materials; i++)
+        if (s->materials[i].subsurface > 0.0f) s->materials[i].medium_out = s->world_medium;
     for (size_t i = 0; i < s->n_medium_bindings; i++) {
         const SceneMediumBinding *b = &s->medium_bindings[i];
         Material m = s->materials[b->origin];
-        m.medium_in = scene_medium_resolve(s, b->in);
+        if (!(m.subsurface > 0.0f)) m.medium_in = scene_medium_resolve(s, b->in);
         m.medium_out = scene_medium_resolve(s, b->out);
         s->materials[b->material] = m;
     }

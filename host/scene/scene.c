@@ -48,6 +48,8 @@ void scene_init(Scene *s)
 
 void scene_free(Scene *s)
 {
+    if (s->animation) s->animation->free(s->animation);
+    s->animation = NULL;
     for (size_t i = 0; i < s->n_materials; i++) free(s->material_names[i]);
     free(s->material_names);
     for (size_t i = 0; i < s->n_material_textures; i++) free(s->material_textures[i]);

@@ -7,10 +7,12 @@
 #define CLPT_SCENE_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "base/status.h"
 #include "base/strmap.h"
 #include "types.h"
+#include "scene/animation.h"
 #include "scene/crop.h"
 #include "scene/transform.h"
 
@@ -62,7 +64,21 @@ enum { OBJ_SPHERES, OBJ_TRIANGLES, OBJ_BOXES, OBJ_REVS, OBJ_KINDS };
 typedef struct {
     char *name;
     size_t first[OBJ_KINDS], end[OBJ_KINDS];
+    /* the instances its block holds (nesting): [first_nested, end_nested) of the
+     * scene's `nested`; an instance of this object places each of them too */
+    size_t first_nested, end_nested;
+    uint depth;          /* 1 for shapes alone, else 1 + its nested objects' deepest */
+    uint64_t leaves;     /* the world instances one instance of it makes (held at 2^62,
+                          * far past SCENE_MAX_INSTANCES, scene/instance.h) */
 } SceneObject;
+
+/* An instance inside an object's block: `object` under m (in the holder's space) with
+ * `material` (NO_INDEX: its own). Resolved into world instances when the holder is
+ * placed (scene_place_object, scene/instance.h), so the devices see one level. */
+typedef struct {
+    Transform m;
+    uint object, material;
+} SceneNested;
 
 typedef struct {
     char *path;                  /* scene file as given on the command line */
@@ -71,6 +87,8 @@ typedef struct {
                                   * (the size rendered is, host/main.c) */
     const char *gltf_camera;     /* in: the glTF camera to look through (--camera), by
                                   * index or name; NULL: the file's first */
+    int keep_animation;          /* in: a reader keeps the file's animation (--frames) */
+    SceneAnimation *animation;   /* out: that animation, or NULL (scene/animation.h) */
     SceneCamera camera;
     SceneImage image;
     SceneCrop crop;              /* the window rendered (pbrt's cropwindow, --crop ...);
@@ -107,6 +125,7 @@ typedef struct {
     /* objects and their instances (scene/instance.h); Instance.root is the build's */
     SceneObject *objects;  size_t n_objects, cap_objects;
     Instance *instances;   size_t n_instances, cap_instances;
+    SceneNested *nested;   size_t n_nested, cap_nested;
     /* per instance: its first light (LIGHT_INSTANCED, kernels/types.h), or NO_INDEX;
      * NULL when no instance has lights (scene_prepare_lights) */
     uint *instance_lights;

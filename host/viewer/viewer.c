@@ -541,6 +541,7 @@ static void stats_print(Viewer *v)
     if (v->vr.denoise_count)
         printf("viewer: %u frames denoised, %.3f s each on average\n", v->vr.denoise_count,
                v->vr.denoise_seconds / v->vr.denoise_count);
+    if (v->vr.denoise_cancels) printf("viewer: %u denoises cancelled (the view changed, a pause, N off)\n", v->vr.denoise_cancels);
     pthread_mutex_unlock(&v->vr.lock);
 }
 

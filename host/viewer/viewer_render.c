@@ -86,12 +86,25 @@ static int denoiser_ready(ViewerRender *vr)
     float *published = st == ST_OK ? calloc(n, sizeof *published) : NULL;
     if (st == ST_OK && !published) st = error_set(&err, ST_INTERNAL, "out of memory");
     if (st != ST_OK) fprintf(stderr, "clpt: warning: the viewer cannot denoise: %s\n", err.msg);
+    /* the render thread's stop flag also stops OIDN: a camera change, a pause, N off
+     * or quitting then waits no longer for a denoise than for a batch */
+    if (st == ST_OK) denoiser_set_cancel(vr->denoiser, &vr->stop);
     error_clear(&err);
     pthread_mutex_lock(&vr->lock);
     vr->denoised = published;
     vr->denoise_state = st == ST_OK ? 1 : -1;
     pthread_mutex_unlock(&vr->lock);
     return st == ST_OK;
+}
+
+/* Counts a denoise that the stop flag cancelled (--stats) and says so: its frame is
+ * not shown, and the request that raised the flag goes on at once. */
+static void denoise_cancelled(ViewerRender *vr, const char *during)
+{
+    pthread_mutex_lock(&vr->lock);
+    vr->denoise_cancels++;
+    pthread_mutex_unlock(&vr->lock);
+    fprintf(stderr, "clpt: viewer: denoise cancelled (during %s)\n", during);
 }
 
 /* The denoiser's albedo and normal images of the current view, as --denoise renders
@@ -117,8 +130,14 @@ static int features_render(ViewerRender *vr)
     if (st == ST_OK) st = passes_aov_data(&pc, INTEGRATOR_FEATURE_NORMAL, VIEWER_FEATURE_SPP, vr->normal, &secs, &err);
     if (st != ST_OK) set_failure(vr, st, err.msg);
     error_clear(&err);
+    if (st == ST_OK && vr->stop) denoise_cancelled(vr, "the features' render");
     if (st != ST_OK || vr->stop) return 0;
     st = denoiser_clean_features(vr->denoiser, vr->albedo, vr->normal, vr->params.width, vr->params.height, &err);
+    if (st == ST_INTERRUPTED) {   /* cancelled: rendered again for the next request */
+        error_clear(&err);
+        denoise_cancelled(vr, "the features' filter");
+        return 0;
+    }
     if (st != ST_OK) {
         fprintf(stderr, "clpt: warning: the viewer cannot denoise: %s\n", err.msg);
         error_clear(&err);
@@ -151,12 +170,20 @@ static void denoise_step(ViewerRender *vr)
     uint64_t samples = vr->film.samples;
     if (!denoiser_ready(vr)) return;
     if (vr->feature_gen != vr->my_gen && !features_render(vr)) return;   /* tried again unless it failed */
+    pthread_mutex_lock(&vr->lock);
+    vr->denoising = 2;
+    pthread_mutex_unlock(&vr->lock);
     double t0 = timer_now();
     film_resolve(&vr->film, vr->noisy);
     Error err = { 0 };
     Status st = denoiser_run_clean(vr->denoiser, vr->noisy, vr->albedo, vr->normal, vr->params.width,
                                    vr->params.height, vr->denoise_out, &err);
     double secs = timer_now() - t0;
+    if (st == ST_INTERRUPTED) {   /* not tried: the same frame is denoised again when still due */
+        error_clear(&err);
+        denoise_cancelled(vr, "the colour's filter");
+        return;
+    }
     vr->tried_gen = vr->my_gen;
     vr->tried_samples = samples;
     if (st != ST_OK) fprintf(stderr, "clpt: warning: the viewer cannot denoise: %s\n", err.msg);
@@ -383,10 +410,12 @@ static void *render_main(void *arg)
             continue;
         }
         if (denoise_due(vr)) {
-            vr->stop = 0;   /* as for a pass: a change made after this cancels the features */
+            vr->stop = 0;   /* as for a pass: a change made after this cancels the denoise */
+            vr->denoising = 1;
             pthread_mutex_unlock(&vr->lock);
             denoise_step(vr);
             pthread_mutex_lock(&vr->lock);
+            vr->denoising = 0;
             continue;
         }
         if (vr->paused || vr->failure != ST_OK || !vr->view_ok || vr->film.samples >= vr->spp_cap) {
@@ -456,6 +485,7 @@ void viewer_render_set_denoise(ViewerRender *vr, int on)
 {
     pthread_mutex_lock(&vr->lock);
     vr->denoise = on;
+    if (!on && vr->denoising) vr->stop = 1;   /* a denoise nobody will see: stopped, not awaited */
     pthread_cond_signal(&vr->wake);
     pthread_mutex_unlock(&vr->lock);
 }
@@ -490,6 +520,8 @@ Status viewer_render_stop(ViewerRender *vr, Error *err)
     free(vr->rgb);
     free(vr->spare);
     vr->rgb = vr->spare = NULL;
+    /* a caller's denoiser outlives vr, its stop flag does not */
+    if (vr->denoiser && !vr->own_denoiser) denoiser_set_cancel(vr->denoiser, NULL);
     if (vr->own_denoiser) denoiser_close(vr->denoiser);
     vr->denoiser = NULL;
     float **bufs[] = { &vr->albedo, &vr->normal, &vr->noisy, &vr->denoise_out, &vr->denoised };

@@ -23,9 +23,12 @@
  * Open Image Denoise and publishes it beside the noisy one: once per finished pass, so
  * once per displayed step of the doubling, never per tick. The albedo and normal
  * features (through mirrors and glass, as --denoise's) are rendered once per view, at
- * VIEWER_FEATURE_SPP samples per pixel, on the same devices. OIDN cannot be cancelled:
- * a camera change during a denoise waits for it (tens of milliseconds for 512 x 512 on
- * a GPU, a few tenths on two cores). The library is opened at the first request.
+ * VIEWER_FEATURE_SPP samples per pixel, on the same devices. A denoise takes from
+ * milliseconds (OIDN on a GPU) to seconds (1920 x 1080 on two busy cores: 40 s), so it
+ * is cancellable like a pass: the stop flag that a camera change, a pause or quitting
+ * raises (and N off, during a denoise) is OIDN's progress monitor's answer too
+ * (denoiser_set_cancel), and a cancelled denoise shows nothing; the next view does not
+ * wait for it, and quitting does not either. The library is opened at the first request.
  *
  * Preview: when one sample per pixel of the whole image took longer than
  * VIEWER_PREVIEW_AFTER seconds, every new view is first rendered at 1 spp in an image k
@@ -90,6 +93,9 @@ typedef struct {
     unsigned denoised_gen;        /* its view; 0: none yet */
     unsigned denoised_seq;        /* incremented by each publication */
     int denoise_state;            /* 0 not opened yet, 1 open, -1 unavailable (said once) */
+    int denoising;                /* the render thread is in a denoise (N off then stops it):
+                                   * 1 its features, 2 the colour's filter */
+    unsigned denoise_cancels;     /* denoises cancelled by the stop flag (--stats) */
     unsigned denoise_count;       /* denoises done, and their time (--stats) */
     double denoise_seconds, denoise_last;
 

@@ -35,6 +35,13 @@
  * visible facet and reflects from it with probability F_d (always under total internal
  * reflection), refracts otherwise. The whole mixture is then evaluated: its density is
  * the weighted sum.
+ *
+ * Subsurface scattering (docs/subsurface.md): a share `subsurface` W of the diffuse lobe
+ * of a solid refracts into it through the transmission lobe's facets instead, untinted
+ * (the colour is the interior medium's, MEDIUM_WALK), so the refracting share is
+ * t + (1 - t) W and its tint base t + (1 - t) W. A walk that reaches the surface
+ * again from inside leaves it as a Lambertian transmission (shade_path,
+ * subsurface_exit_material), not through these lobes.
  */
 #ifndef CLPT_PRINCIPLED_H
 #define CLPT_PRINCIPLED_H
@@ -53,7 +60,15 @@ typedef struct {
     vec3 specular_color;  /* ... and F0's colour */
     vec3 sheen;        /* KHR_materials_sheen's colour, 0 for none */
     float sheen_roughness;   /* perceptual, at least SHEEN_ROUGHNESS_MIN */
+    float subsurface;  /* the diffuse lobe's share that refracts into the solid */
 } Principled;
+
+/* The share of the dielectric part that refracts (through the transmission lobe): the
+ * transmission's and, with subsurface scattering, that much of the diffuse's. */
+KFN float principled_refracting(Principled p)
+{
+    return p.subsurface > 0.0f ? p.transmission + (1.0f - p.transmission) * p.subsurface : p.transmission;
+}
 
 KFN float schlick1(float f0, float c)
 {
@@ -181,10 +196,11 @@ KFN void principled_shares(Principled p, vec3 wo, float *w_cc, float *w_sheen, f
         *w_sheen = rest * k_fmin(v3_max_comp(p.sheen) * sheen_albedo(wo.z, p.sheen_roughness), 1.0f);
         rest -= *w_sheen;
     }
-    float diel = rest * (1.0f - p.metallic), opaque = diel * (1.0f - p.transmission);
+    float t = principled_refracting(p);
+    float diel = rest * (1.0f - p.metallic), opaque = diel * (1.0f - t);
     *w_spec = rest * p.metallic + opaque * fs;
     *w_diff = opaque * (1.0f - fs);
-    *w_trans = diel * p.transmission;
+    *w_trans = diel * t;
 }
 
 KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
@@ -204,7 +220,7 @@ KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
         vec3 fd = principled_fresnel_rgb(p, vh);
         vec3 fm = fresnel_schlick(p.base, vh);
         vec3 mat = v3_add(v3_scale(v3_mul(p.base, v3_sub(v3s(1.0f), fd)),
-                                   (1.0f - p.metallic) * (1.0f - p.transmission) * K_INV_PI),
+                                   (1.0f - p.metallic) * (1.0f - principled_refracting(p)) * K_INV_PI),
                           v3_scale(v3_add(v3_scale(fm, p.metallic), v3_scale(fd, 1.0f - p.metallic)), spec));
         if (w_sheen > 0.0f)
             mat = v3_add(v3_scale(mat, below), v3_scale(p.sheen, sheen_lobe(p.sheen_roughness, wo, wi)));
@@ -226,7 +242,14 @@ KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
         if (m.z < 0.0f) m = v3_neg(m);
     }
     vec3 fd = principled_fresnel_rgb(p, v3_dot(wo, m));
-    *f = v3_scale(v3_mul(p.base, v3_sub(v3s(1.0f), fd)), (1.0f - layer) * (1.0f - p.metallic) * p.transmission * btdf);
+    if (p.subsurface > 0.0f) {
+        /* the transmission tinted by the base colour, the subsurface share untinted */
+        vec3 tint = v3_add(v3_scale(p.base, p.transmission), v3s((1.0f - p.transmission) * p.subsurface));
+        *f = v3_scale(v3_mul(tint, v3_sub(v3s(1.0f), fd)), (1.0f - layer) * (1.0f - p.metallic) * btdf);
+    } else {
+        *f = v3_scale(v3_mul(p.base, v3_sub(v3s(1.0f), fd)),
+                      (1.0f - layer) * (1.0f - p.metallic) * p.transmission * btdf);
+    }
     if (w_sheen > 0.0f) *f = v3_scale(*f, below);
     return w_trans * (1.0f - principled_reflect_prob(fd)) * pdf_t;
 }
@@ -288,6 +311,7 @@ KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
     p.sheen = v3(k_clamp(m.sheen_color.x, 0.0f, 1.0f), k_clamp(m.sheen_color.y, 0.0f, 1.0f),
                  k_clamp(m.sheen_color.z, 0.0f, 1.0f));
     p.sheen_roughness = k_clamp(m.sheen_roughness, SHEEN_ROUGHNESS_MIN, 1.0f);
+    p.subsurface = p.thin ? 0.0f : k_clamp(m.subsurface, 0.0f, 1.0f);
     return p;
 }
 

@@ -202,7 +202,8 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
 
     Surface s = surface_at(sc, r, hit);
     Material m = sc->materials[s.material];   /* a mix: its own emission (mix.h) */
-    if (KF_HAS(KF_MEDIA) && (m.flags & MAT_INTERFACE)) return medium_cross(ray, hit, s, m, ps);
+    if (KF_HAS(KF_MEDIA) && (m.flags & MAT_INTERFACE))
+        return medium_cross(ray, hit, s, m, ps, path_max_crossings(p->has_media));
     shade_absorb(r, hit, s, m, ps);
     int later_branch = bounce == 0u && ps->branch != 0u;
     if (!later_branch) shade_emission(sc, r, s, m, ps);
@@ -215,12 +216,23 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     uint medium_in = m.medium_in, medium_out = m.medium_out;   /* the stored material's */
     material_resolve(sc, &m, s, r.d, ng_face);
     if (!material_scatters(m.type)) return 0u;   /* pure emitters do not reflect */
+    int exiting = KF_HAS(KF_MEDIA) && (p->has_media & HAS_MEDIA_WALK) && !front && subsurface_exits(m);
+    if (exiting) {
+        /* a subsurface walk reaching its surface from inside leaves through it as a
+         * Lambertian transmission (docs/subsurface.md): shaded as a white diffuse
+         * surface seen from outside, so that its light sample and its new direction
+         * are on the outside, and the medium beyond is the exterior */
+        m = subsurface_exit_material(m);
+        front = 1;
+        ng_face = s.ng;
+        r.d = v3_neg(r.d);
+    }
     s.ns = material_normal(sc, m, s);
     vec3 ns_face = bsdf_normal(m, r.d, front ? s.ns : v3_neg(s.ns), ng_face);
     uint result = SHADE_SCATTERED;
     BsdfSample bs;
 
-    vec3 albedo = material_albedo(sc, m, s, ng_face);
+    vec3 albedo = exiting ? v3s(1.0f) : material_albedo(sc, m, s, ng_face);
     material_at(sc, &m, s, ng_face);
 
     if (p->n_lights > 0u && bsdf_has_density(m, albedo) &&

@@ -237,7 +237,8 @@ KFN int grid_track(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, v
             if (!(t < hi)) break;   /* memoryless: the next cell starts afresh at hi */
             vec3 p = v3_madd(o, du, t);
             float dens = grid_density(sc, &g, p);
-            if (md.emissive) *emitted = v3_add(*emitted, grid_emitted(sc, &g, md, p, dens, *thr, bar));
+            if (md.flags & MEDIUM_EMISSIVE)
+                *emitted = v3_add(*emitted, grid_emitted(sc, &g, md, p, dens, *thr, bar));
             vec3 mu_t = v3_scale(sig_t, dens);
             vec3 q = medium_channel_pdf(*thr);
             float real = v3_dot(q, mu_t);
@@ -282,7 +283,8 @@ KFN vec3 grid_transmittance(const SceneView *sc, Medium md, vec3 x, vec3 d, floa
             if (!(t < hi)) break;
             vec3 p = v3_madd(o, du, t);
             float dens = grid_density(sc, &g, p);
-            if (emitted && md.emissive) *emitted = v3_add(*emitted, grid_emitted(sc, &g, md, p, dens, tr, bar));
+            if (emitted && (md.flags & MEDIUM_EMISSIVE))
+                *emitted = v3_add(*emitted, grid_emitted(sc, &g, md, p, dens, tr, bar));
             vec3 mu_t = v3_scale(sig_t, dens);
             tr = v3_mul(tr, v3(k_fmax(1.0f - mu_t.x * inv, 0.0f), k_fmax(1.0f - mu_t.y * inv, 0.0f),
                                k_fmax(1.0f - mu_t.z * inv, 0.0f)));

@@ -24,12 +24,26 @@
  * nested boundaries while it bounds the wavefront's launches (path_max_shades). */
 #define MEDIUM_MAX_CROSSINGS 64u
 
+/* The most steps of subsurface random walks (MEDIUM_WALK) a path takes, all its walks
+ * together: each step, and each reflection off the inside of a subsurface surface, is
+ * no bounce but counts as a crossing. 256 is Cycles' bound on one walk's steps; a walk
+ * cut there ends the path (and loses its light, as Cycles' does). */
+#define MEDIUM_MAX_WALK 1024u
+
+/* The most crossings (PathState.crossings) a path of a scene with RenderParams.has_media
+ * `has_media` may make: boundaries passed, and in scenes with subsurface walks their
+ * steps too. */
+KFN uint path_max_crossings(uint has_media)
+{
+    return MEDIUM_MAX_CROSSINGS + ((has_media & HAS_MEDIA_WALK) ? MEDIUM_MAX_WALK : 0u);
+}
+
 /* The most times shade_path runs for one path: once per bounce (0 .. max_depth) and
- * once per boundary passed straight through, which is no bounce. The wavefront launches
- * that many bounces of a wave at most (host/device/device_ocl.c). */
+ * once per crossing, which is no bounce. The wavefront launches that many bounces of a
+ * wave at most (host/device/device_ocl.c). */
 KFN uint path_max_shades(uint max_depth, uint has_media)
 {
-    return max_depth + 1u + (has_media ? MEDIUM_MAX_CROSSINGS : 0u);
+    return max_depth + 1u + (has_media ? path_max_crossings(has_media) : 0u);
 }
 
 KFN vec3 medium_sigma_t(Medium m) { return v3_add(m.sigma_a, m.sigma_s); }

@@ -22,6 +22,29 @@
 #include "sample/rng.h"
 #include "geom/surface.h"
 
+/* Whether a path that reaches a surface of material m (resolved) from behind is a
+ * subsurface walk leaving its solid (docs/subsurface.md). */
+KFN int subsurface_exits(Material m)
+{
+    return MAT_IS(m, MAT_PRINCIPLED) && m.subsurface > 0.0f && !(m.flags & MAT_THIN);
+}
+
+/* The surface a subsurface walk leaves through: Lambertian, white (the colour is the
+ * walk's), as Cycles' random walk leaves; the albedo inversion (host/scene/subsurface.c)
+ * assumes a boundary without Fresnel reflection inside, as this one. Its emission was
+ * added already. The host compiles MAT_DIFFUSE into every scene with subsurface
+ * (kernel_features.c). */
+KFN Material subsurface_exit_material(Material m)
+{
+    Material d = m;
+    d.type = MAT_DIFFUSE;
+    d.albedo = v3s(1.0f);
+    d.texture = NO_INDEX;
+    d.texture_normal = NO_INDEX;
+    d.flags = 0u;
+    return d;
+}
+
 /* The bounce whose random numbers path ps draws: each boundary passed straight through
  * moves it on by one, so the flight after a boundary does not reuse the numbers that
  * decided the flight before it (which, being conditioned on having got there, are no
@@ -64,24 +87,34 @@ KFN int medium_light_sample(const SceneView *sc, GLOBAL PathState *ps, vec3 x, v
  * the stop's weight: a light sample (unless the flight's segment estimate took this
  * bounce's, light_done), then a new direction from the phase function (weight 1: it is
  * sampled exactly), Russian roulette as at a surface. Returns the bounce's SHADE_*
- * result. */
-KFN uint medium_scatter(const SceneView *sc, GLOBAL Ray *ray, vec3 x, float g, GLOBAL PathState *ps,
+ * result.
+ *
+ * A stop of a subsurface walk (`walk`: a MEDIUM_WALK medium, docs/subsurface.md) is no
+ * bounce: it counts as a crossing (which gives the next step fresh random numbers),
+ * samples no light (the closed surface around it would block the shadow ray) and takes
+ * Russian roulette by the throughput alone, without the 0.95 cap: a walk in a white
+ * medium keeps its weight 1 and is never cut, however long, until MEDIUM_MAX_WALK. */
+KFN uint medium_scatter(const SceneView *sc, GLOBAL Ray *ray, vec3 x, float g, uint walk, GLOBAL PathState *ps,
                         GLOBAL Ray *shadow_ray, RngKey key, uint rb, int light_done)
 {
     GLOBAL const RenderParams *p = sc->params;
     uint bounce = ps->bounce;
-    if (bounce >= p->max_depth) return 0u;
+    if (walk ? ps->crossings >= path_max_crossings(p->has_media) : bounce >= p->max_depth) return 0u;
     vec3 d = v3_norm(ray->d);
     uint result = 0u;
-    if (!light_done && p->n_lights > 0u && medium_light_sample(sc, ps, x, d, g, key, rb, shadow_ray))
+    if (!walk && !light_done && p->n_lights > 0u && medium_light_sample(sc, ps, x, d, g, key, rb, shadow_ray))
         result |= SHADE_SHADOW;
     float u1, u2;
     rng_uniform2(key, rb, DIM_BSDF_U, &u1, &u2);
     float pdf;
     vec3 wi = phase_hg_sample(g, d, u1, u2, &pdf);
     vec3 thr = ps->throughput;
-    ps->bounce = bounce + 1u;
-    if (ps->bounce > p->rr_depth) {
+    if (walk) {
+        ps->crossings = ps->crossings + 1u;
+        float q = k_fmin(v3_max_comp(thr), 1.0f);
+        if (!(rng_uniform(key, rb, DIM_ROULETTE) < q)) return result;
+        thr = v3_scale(thr, 1.0f / q);
+    } else if ((ps->bounce = bounce + 1u) > p->rr_depth) {
         float q = k_fmin(v3_max_comp(thr) * (float)params_split(p), 0.95f);
         if (!(rng_uniform(key, rb, DIM_ROULETTE) < q)) return result;
         thr = v3_scale(thr, 1.0f / q);
@@ -193,7 +226,7 @@ KFN int medium_flight_grid(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL
     vec3 emitted = v3s(0.0f);
     if (v3_is_zero(md.sigma_s)) {
         vec3 tr = grid_transmittance(sc, md, x, d, dist, &rng, &emitted);
-        if (md.emissive) ps->radiance = v3_add(ps->radiance, v3_mul(ps->throughput, emitted));
+        if (md.flags & MEDIUM_EMISSIVE) ps->radiance = v3_add(ps->radiance, v3_mul(ps->throughput, emitted));
         ps->throughput = v3_mul(ps->throughput, tr);
         return !(v3_max_comp(ps->throughput) > 0.0f);
     }
@@ -201,11 +234,11 @@ KFN int medium_flight_grid(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL
     float ts;
     int ev = grid_track(sc, md, x, d, dist, &thr, rng_uniform(key, rb, DIM_MEDIUM), &rng, &ts, &emitted);
     /* emitted already carries the path's throughput (grid_track's weights start from it) */
-    if (md.emissive) ps->radiance = v3_add(ps->radiance, emitted);
+    if (md.flags & MEDIUM_EMISSIVE) ps->radiance = v3_add(ps->radiance, emitted);
     if (ev == GRID_ENDED || !(v3_max_comp(thr) > 0.0f)) return 1;
     ps->throughput = thr;
     if (ev == GRID_PASSED) return 0;
-    *result = medium_scatter(sc, ray, v3_madd(x, d, ts), md.g, ps, shadow_ray, key, rb, 0);
+    *result = medium_scatter(sc, ray, v3_madd(x, d, ts), md.g, md.flags & MEDIUM_WALK, ps, shadow_ray, key, rb, 0);
     return 1;
 }
 
@@ -221,7 +254,7 @@ KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL Path
     *result = 0u;
     /* the emission along the whole stretch, exactly, before the flight decides where
      * the path goes on (docs/media.md, "Emission") */
-    if (md.emissive) ps->radiance = v3_add(ps->radiance, v3_mul(ps->throughput, medium_emitted(md, sigma_t, dist)));
+    if (md.flags & MEDIUM_EMISSIVE) ps->radiance = v3_add(ps->radiance, v3_mul(ps->throughput, medium_emitted(md, sigma_t, dist)));
     if (v3_is_zero(md.sigma_s)) {
         ps->throughput = v3_mul(ps->throughput, medium_tr(sigma_t, dist));
         return !(v3_max_comp(ps->throughput) > 0.0f);
@@ -247,8 +280,8 @@ KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL Path
      * and free-flight sampling together (medium_segment_light), in place of the stop's */
     Light pl;
     float choice;
-    int segment = ps->bounce < sc->params->max_depth && sc->params->mis_mode != MIS_BSDF_ONLY &&
-                  medium_pick_point_light(sc, key, rb, &pl, &choice);
+    int segment = !(md.flags & MEDIUM_WALK) && ps->bounce < sc->params->max_depth &&
+                  sc->params->mis_mode != MIS_BSDF_ONLY && medium_pick_point_light(sc, key, rb, &pl, &choice);
     uint shadow = 0u;
     if (segment) {
         float lu, lv;
@@ -259,7 +292,8 @@ KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL Path
             shadow = SHADE_SHADOW;
     }
     ps->throughput = thr;
-    *result = medium_scatter(sc, ray, v3_madd(r.o, r.d, r.tmin + ts / len), md.g, ps, shadow_ray, key, rb, segment) |
+    *result = medium_scatter(sc, ray, v3_madd(r.o, r.d, r.tmin + ts / len), md.g, md.flags & MEDIUM_WALK, ps,
+                             shadow_ray, key, rb, segment) |
               shadow;
     return 1;
 }
@@ -269,11 +303,11 @@ KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL Path
  * scattered, which the MIS weight of a light it reaches is computed from; only tmin
  * moves up to the hit (the interval is open, so the same boundary is not found again,
  * as kernels/accel/alpha.h skips cut-out surfaces). Not a bounce. */
-KFN uint medium_cross(GLOBAL Ray *ray, Hit hit, Surface s, Material m, GLOBAL PathState *ps)
+KFN uint medium_cross(GLOBAL Ray *ray, Hit hit, Surface s, Material m, GLOBAL PathState *ps, uint max_crossings)
 {
     ps->medium = medium_beyond(m.medium_in, m.medium_out, ps->medium, ray->d, s.ng);
     ps->crossings = ps->crossings + 1u;
-    if (ps->crossings > MEDIUM_MAX_CROSSINGS) return 0u;
+    if (ps->crossings > max_crossings) return 0u;
     ray->tmin = hit.t;
     return SHADE_CONTINUE;
 }

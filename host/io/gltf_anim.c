@@ -1,0 +1,407 @@
+/*
+ * gltf_anim.c — glTF animations (glTF 2.0, 3.11): the samplers' keys read and checked,
+ * the channels that move nodes' translation, rotation and scale evaluated at a time
+ * (scene/keyframes.h), and the file's node tree placed again at that pose into the scene
+ * it was read into, from the JSON and buffers kept in memory (gltf_anim.h).
+ *
+ * A frame is placed by the very walk that reads a static file, with the animated parts
+ * of each node's TRS in place of its own: frame k of an animation is the same scene, bit
+ * for bit, as a static file whose nodes hold the pose evaluated for it.
+ */
+#include "io/gltf_anim.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/gltf_reader.h"
+#include "scene/keyframes.h"
+#include "scene/scene_mark.h"
+
+enum { PATH_T, PATH_R, PATH_S };
+
+typedef struct {
+    int node, path;       /* path: PATH_T, PATH_R, PATH_S */
+    KeyTrack track;       /* its times and values are owned here */
+} GltfChannel;
+
+struct GltfAnimated {
+    SceneAnimation base;  /* first: the scene frees and poses through it */
+    Gltf g;
+    char *data;           /* the file's bytes: a GLB's BIN chunk is read from them */
+    char *path;
+    MeshOptions o;
+    GltfView view;
+    GltfChannel *ch;      size_t n_ch;
+    GltfNodePose *pose;   /* per node */
+    int *parent;          /* per node: its parent, or -1 */
+    SceneMark mark;       /* the scene before the node tree was placed */
+};
+
+/* ------------------------------------------------------------------ reading */
+
+static Status anim_interp(Gltf *g, const cJSON *smp, const char *jp, int *out)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(smp, "interpolation");
+    *out = KEY_LINEAR;
+    if (!v) return ST_OK;
+    if (cJSON_IsString(v) && strcmp(v->valuestring, "LINEAR") == 0) return ST_OK;
+    if (cJSON_IsString(v) && strcmp(v->valuestring, "STEP") == 0) *out = KEY_STEP;
+    else if (cJSON_IsString(v) && strcmp(v->valuestring, "CUBICSPLINE") == 0) *out = KEY_CUBICSPLINE;
+    else return error_set(g->err, ST_INPUT, "%s: %s.interpolation: expected LINEAR, STEP or CUBICSPLINE", g->path, jp);
+    return ST_OK;
+}
+
+/* A sampler's key times: finite and increasing. */
+static Status anim_times(Gltf *g, const cJSON *smp, const char *jp, double **times, size_t *n)
+{
+    char use[128];
+    snprintf(use, sizeof use, "%s.input", jp);
+    int ai;
+    Status st = gltf_get_index(g, smp, "input", 1, "accessors", jp, &ai);
+    if (st || (st = gltf_acc_read(g, ai, 1, use, times, n))) return st;
+    if (*n == 0) return gltf_bad(g, use, "no key times (the accessor is empty)");
+    for (size_t i = 0; i < *n; i++) {
+        if (!isfinite((*times)[i]))
+            return error_set(g->err, ST_INPUT, "%s: %s: key %zu's time is not a finite number", g->path, use, i);
+        if (i > 0 && !((*times)[i] > (*times)[i - 1]))
+            return error_set(g->err, ST_INPUT, "%s: %s: key %zu's time %g is not after key %zu's (%g); key times "
+                             "must increase", g->path, use, i, (*times)[i], i - 1, (*times)[i - 1]);
+    }
+    return ST_OK;
+}
+
+/* A sampler's values for `path`: one per key time, three for CUBICSPLINE (in-tangent,
+ * value, out-tangent). */
+static Status anim_values(Gltf *g, const cJSON *smp, const char *jp, int path, size_t n_keys, int interp,
+                          double **values)
+{
+    char use[128];
+    snprintf(use, sizeof use, "%s.output", jp);
+    int ai;
+    size_t n;
+    Status st = gltf_get_index(g, smp, "output", 1, "accessors", jp, &ai);
+    if (st || (st = gltf_acc_read(g, ai, path == PATH_R ? 4 : 3, use, values, &n))) return st;
+    size_t want = interp == KEY_CUBICSPLINE ? 3 * n_keys : n_keys;
+    if (n != want)
+        return error_set(g->err, ST_INPUT, "%s: %s: accessor %d has %zu elements; the %zu key times of input ask for "
+                         "%zu%s", g->path, use, ai, n, n_keys, want,
+                         interp == KEY_CUBICSPLINE ? " (CUBICSPLINE: an in-tangent, a value and an out-tangent each)" : "");
+    int width = path == PATH_R ? 4 : 3;
+    for (size_t i = 0; i < n * (size_t)width; i++)
+        if (!isfinite((*values)[i]))
+            return error_set(g->err, ST_INPUT, "%s: %s: element %zu is not finite", g->path, use, i / (size_t)width);
+    return ST_OK;
+}
+
+static Status channel_add(GltfAnimated *a, const GltfChannel *c)
+{
+    GltfChannel *grown = realloc(a->ch, (a->n_ch + 1) * sizeof *grown);
+    if (!grown) return error_set(a->g.err, ST_INTERNAL, "out of memory");
+    a->ch = grown;
+    a->ch[a->n_ch++] = *c;
+    return ST_OK;
+}
+
+static void channel_free(GltfChannel *c)
+{
+    free((void *)c->track.times);
+    free((void *)c->track.values);
+}
+
+/* animations[ai].channels[ci]: its target checked and its sampler's keys read. */
+static Status channel_read(GltfAnimated *a, const cJSON *anim, int ai, const cJSON *chan, int ci)
+{
+    Gltf *g = &a->g;
+    char jp[96], jt[112], js[96];
+    snprintf(jp, sizeof jp, "animations[%d].channels[%d]", ai, ci);
+    snprintf(jt, sizeof jt, "%s.target", jp);
+    const cJSON *samplers = cJSON_GetObjectItemCaseSensitive(anim, "samplers");
+    int n_samplers = cJSON_IsArray(samplers) ? cJSON_GetArraySize(samplers) : 0;
+    if (n_samplers == 0) {
+        char ja[64];
+        snprintf(ja, sizeof ja, "animations[%d].samplers", ai);
+        return gltf_bad(g, ja, "missing or empty (a channel needs a sampler)");
+    }
+    long long si;
+    Status st = gltf_get_int(g, chan, "sampler", -1, 0, n_samplers - 1, jp, &si);
+    if (st) return st;
+    const cJSON *target = cJSON_GetObjectItemCaseSensitive(chan, "target");
+    if (!cJSON_IsObject(target)) return gltf_bad(g, jp, "target: expected an object");
+    const cJSON *path = cJSON_GetObjectItemCaseSensitive(target, "path");
+    const char *p = cJSON_IsString(path) ? path->valuestring : "";
+    int which = strcmp(p, "translation") == 0 ? PATH_T : strcmp(p, "rotation") == 0 ? PATH_R
+              : strcmp(p, "scale") == 0 ? PATH_S : -1;
+    if (which < 0 && strcmp(p, "weights") == 0)
+        return scene_warn(g->s, g->err, "%s: %s.path: morph target weights are not animated (clpt has no morph "
+                          "targets); the channel is ignored", g->path, jt);
+    if (which < 0) return gltf_bad(g, jt, "path: expected translation, rotation, scale or weights");
+    int node;
+    /* glTF 2.0, 3.11.3: a channel without a node is ignored (an extension may target
+     * something else) */
+    if ((st = gltf_get_index(g, target, "node", 0, "nodes", jt, &node)) || node < 0) return st;
+    if (cJSON_GetObjectItemCaseSensitive(gltf_item_at(g, "nodes", node), "matrix"))
+        return error_set(g->err, ST_INPUT, "%s: %s.node: nodes[%d] has a matrix; an animated node must give its "
+                         "translation, rotation and scale instead (glTF 2.0, 3.11)", g->path, jt, node);
+    for (size_t i = 0; i < a->n_ch; i++)
+        if (a->ch[i].node == node && a->ch[i].path == which)
+            return error_set(g->err, ST_INPUT, "%s: %s: nodes[%d].%s is animated by an earlier channel already",
+                             g->path, jt, node, p);
+    snprintf(js, sizeof js, "animations[%d].samplers[%lld]", ai, si);
+    const cJSON *smp = cJSON_GetArrayItem(samplers, (int)si);
+    GltfChannel c;
+    memset(&c, 0, sizeof c);
+    c.node = node;
+    c.path = which;
+    c.track.width = which == PATH_R ? 4 : 3;
+    c.track.rotation = which == PATH_R;
+    double *times = NULL, *values = NULL;
+    if (!(st = anim_interp(g, smp, js, &c.track.interp)) && !(st = anim_times(g, smp, js, &times, &c.track.n)))
+        st = anim_values(g, smp, js, which, c.track.n, c.track.interp, &values);
+    c.track.times = times;
+    c.track.values = values;
+    if (!st && which == PATH_R) {
+        /* the keys' own quaternions must have a direction (tangents may be zero) */
+        for (size_t k = 0; k < c.track.n && !st; k++) {
+            const double *q = values + (c.track.interp == KEY_CUBICSPLINE ? 3 * k + 1 : k) * 4;
+            if (!(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] > 0))
+                st = error_set(g->err, ST_INPUT, "%s: %s.output: key %zu is a zero quaternion", g->path, js, k);
+        }
+    }
+    if (!st) st = channel_add(a, &c);
+    if (st) channel_free(&c);
+    return st;
+}
+
+static Status animations_read(GltfAnimated *a)
+{
+    Gltf *g = &a->g;
+    const cJSON *anims = cJSON_GetObjectItemCaseSensitive(g->root, "animations");
+    if (anims && !cJSON_IsArray(anims)) return gltf_bad(g, "animations", "expected an array");
+    int ai = 0;
+    Status st = ST_OK;
+    for (const cJSON *an = gltf_first_of(anims); an && !st; an = an->next, ai++) {
+        const cJSON *chans = cJSON_GetObjectItemCaseSensitive(an, "channels");
+        char jp[64];
+        snprintf(jp, sizeof jp, "animations[%d]", ai);
+        if (!cJSON_IsArray(chans)) return gltf_bad(g, jp, "channels: expected an array");
+        int ci = 0;
+        for (const cJSON *c = gltf_first_of(chans); c && !st; c = c->next, ci++) st = channel_read(a, an, ai, c, ci);
+    }
+    return st;
+}
+
+/* Each node's parent (-1 for a root), for a node's world transform. */
+static Status parents_find(GltfAnimated *a)
+{
+    Gltf *g = &a->g;
+    a->parent = malloc(((size_t)g->n_nodes + 1) * sizeof *a->parent);
+    if (!a->parent) return error_set(g->err, ST_INTERNAL, "out of memory");
+    for (int n = 0; n < g->n_nodes; n++) a->parent[n] = -1;
+    for (int n = 0; n < g->n_nodes; n++) {
+        const cJSON *kids = cJSON_GetObjectItemCaseSensitive(gltf_item_at(g, "nodes", n), "children");
+        for (const cJSON *c = gltf_first_of(kids); c; c = c->next)
+            if (cJSON_IsNumber(c) && c->valuedouble >= 0 && c->valuedouble < g->n_nodes)
+                a->parent[(int)c->valuedouble] = n;
+    }
+    return ST_OK;
+}
+
+/* ------------------------------------------------------------------ evaluation */
+
+/* Every animated node's animated parts at time t into pose (per node). */
+static void gltf_anim_eval(const GltfAnimated *a, double t, GltfNodePose *pose)
+{
+    for (int n = 0; n < a->g.n_nodes; n++) pose[n].animated = 0;
+    for (size_t i = 0; i < a->n_ch; i++) {
+        const GltfChannel *c = &a->ch[i];
+        GltfNodePose *p = &pose[c->node];
+        double *out = c->path == PATH_T ? p->t : c->path == PATH_R ? p->r : p->s;
+        key_track_eval(&c->track, t, out);
+        p->animated |= c->path == PATH_T ? GLTF_ANIM_T : c->path == PATH_R ? GLTF_ANIM_R : GLTF_ANIM_S;
+    }
+}
+
+Status gltf_anim_node_trs(GltfAnimated *a, int node, double t, double tr[3], double r[4], double sc[3], Error *err)
+{
+    Gltf *g = &a->g;
+    if (node < 0 || node >= g->n_nodes) return error_set(err, ST_INTERNAL, "no node %d", node);
+    g->err = err;
+    static const double t0[3] = { 0, 0, 0 }, r0[4] = { 0, 0, 0, 1 }, s0[3] = { 1, 1, 1 };
+    char jp[64];
+    snprintf(jp, sizeof jp, "nodes[%d]", node);
+    const cJSON *n = gltf_item_at(g, "nodes", node);
+    Status st;
+    if ((st = gltf_get_nums(g, n, "translation", 3, t0, jp, tr)) || (st = gltf_get_nums(g, n, "rotation", 4, r0, jp, r)) ||
+        (st = gltf_get_nums(g, n, "scale", 3, s0, jp, sc)))
+        return st;
+    gltf_anim_eval(a, t, a->pose);
+    const GltfNodePose *p = &a->pose[node];
+    if (p->animated & GLTF_ANIM_T) memcpy(tr, p->t, sizeof p->t);
+    if (p->animated & GLTF_ANIM_R) memcpy(r, p->r, sizeof p->r);
+    if (p->animated & GLTF_ANIM_S) memcpy(sc, p->s, sizeof p->s);
+    return ST_OK;
+}
+
+Status gltf_anim_node_world(GltfAnimated *a, int node, double t, Transform *out, Error *err)
+{
+    Gltf *g = &a->g;
+    if (node < 0 || node >= g->n_nodes) return error_set(err, ST_INTERNAL, "no node %d", node);
+    g->err = err;
+    /* the chain from the node up to its root */
+    int depth = 0;
+    for (int n = node; n >= 0; n = a->parent[n])
+        if (++depth > g->n_nodes) return gltf_bad(g, "nodes", "the node tree has a cycle");
+    int *chain = malloc((size_t)depth * sizeof *chain);
+    if (!chain) return error_set(err, ST_INTERNAL, "out of memory");
+    int i = depth;
+    for (int n = node; n >= 0; n = a->parent[n]) chain[--i] = n;
+    gltf_anim_eval(a, t, a->pose);
+    g->pose = a->pose;
+    /* composed from the root down, as the node walk composes it: the same bits */
+    Transform xf = transform_identity();
+    Status st = ST_OK;
+    for (i = 0; i < depth && !st; i++) {
+        Transform local;
+        if (!(st = gltf_node_local(g, chain[i], &local))) xf = transform_compose(&xf, &local);
+    }
+    g->pose = NULL;
+    free(chain);
+    *out = transform_compose(&a->o.xf, &xf);
+    return st;
+}
+
+/* Whether a node shows something but a camera: a mesh (with EXT_mesh_gpu_instancing
+ * or not) or a punctual light. */
+static int node_shows(const Gltf *g, int n)
+{
+    const cJSON *node = gltf_item_at(g, "nodes", n);
+    return cJSON_GetObjectItemCaseSensitive(node, "mesh") || gltf_ext_of(node, "KHR_lights_punctual");
+}
+
+/* An animation that moves only cameras: no animated node carries a mesh or a light,
+ * itself or below it. A search over the nodes below the animated ones, each looked at
+ * once (an animated node outside the scene's tree was not checked by the walk: its
+ * children may repeat or loop). Without memory: no (the safe answer). */
+static int moves_camera_only(const GltfAnimated *a)
+{
+    const Gltf *g = &a->g;
+    unsigned char *seen = calloc((size_t)g->n_nodes + 1, 1);
+    int *stack = malloc(((size_t)g->n_nodes + 1) * sizeof *stack);
+    int only = seen && stack, top = 0;
+    for (size_t i = 0; i < a->n_ch && only; i++) {
+        if (seen[a->ch[i].node]) continue;
+        seen[a->ch[i].node] = 1;
+        stack[top++] = a->ch[i].node;
+        while (top > 0 && only) {
+            int n = stack[--top];
+            if (node_shows(g, n)) only = 0;
+            const cJSON *kids = cJSON_GetObjectItemCaseSensitive(gltf_item_at(g, "nodes", n), "children");
+            for (const cJSON *c = gltf_first_of(kids); c && only; c = c->next) {
+                if (!cJSON_IsNumber(c) || !(c->valuedouble >= 0 && c->valuedouble < g->n_nodes)) continue;
+                int k = (int)c->valuedouble;
+                if (seen[k]) continue;
+                seen[k] = 1;
+                stack[top++] = k;
+            }
+        }
+    }
+    free(seen);
+    free(stack);
+    return only;
+}
+
+/* ------------------------------------------------------------------ frames */
+
+static Status anim_pose(SceneAnimation *base, void *vscene, double t, Error *err)
+{
+    GltfAnimated *a = (GltfAnimated *)base;
+    Scene *s = vscene;
+    Gltf *g = &a->g;
+    g->s = s;
+    g->err = err;
+    uint width = s->image.width, height = s->image.height;
+    if (a->base.camera_only) {
+        /* the geometry stays as placed (the devices keep it): the camera alone, by the
+         * transform the walk would give its node */
+        Transform w;
+        Status st = g->camera_node < 0 ? ST_OK : gltf_anim_node_world(a, g->camera_node, t, &w, err);
+        if (!st && g->camera_node >= 0) st = gltf_camera_set(g, g->camera_index, &w);
+        s->image.width = width;
+        s->image.height = height;
+        return st;
+    }
+    Status st = scene_rewind(s, &a->mark, err);
+    if (st) return st;
+    size_t n_warnings = s->n_warnings;
+    gltf_anim_eval(a, t, a->pose);
+    g->pose = a->pose;
+    st = gltf_place(g);
+    g->pose = NULL;
+    /* the size was settled by the first frame and the command line */
+    s->image.width = width;
+    s->image.height = height;
+    /* the first placement's warnings were said; each frame's would be the same */
+    while (s->n_warnings > n_warnings) free(s->warnings[--s->n_warnings]);
+    return st;
+}
+
+static void anim_free(SceneAnimation *base)
+{
+    GltfAnimated *a = (GltfAnimated *)base;
+    if (!a) return;
+    gltf_close(&a->g);
+    for (size_t i = 0; i < a->n_ch; i++) channel_free(&a->ch[i]);
+    free(a->ch);
+    free(a->pose);
+    free(a->parent);
+    free(a->data);
+    free(a->path);
+    free(a);
+}
+
+Status gltf_parse_animated(const char *path, const char *data, size_t len, Scene *s, const MeshOptions *o,
+                           GltfView *view, Error *err)
+{
+    GltfAnimated *a = calloc(1, sizeof *a);
+    if (!a) return error_set(err, ST_INTERNAL, "out of memory");
+    a->base.pose = anim_pose;
+    a->base.free = anim_free;
+    a->data = malloc(len + 1);
+    a->path = strdup(path);
+    a->o = *o;
+    if (view) a->view = *view;
+    gltf_init(&a->g, a->path, s, &a->o, view ? &a->view : NULL, err);
+    if (!a->data || !a->path) {
+        anim_free(&a->base);
+        return error_set(err, ST_INTERNAL, "out of memory");
+    }
+    memcpy(a->data, data, len);
+    a->data[len] = '\0';
+    Status st = gltf_open(&a->g, a->data, len);
+    if (!st) st = animations_read(a);
+    if (!st) st = parents_find(a);
+    if (!st && !(a->pose = calloc((size_t)a->g.n_nodes + 1, sizeof *a->pose)))
+        st = error_set(err, ST_INTERNAL, "out of memory");
+    scene_mark(s, &a->mark);
+    if (!st) st = gltf_place(&a->g);
+    if (view) {
+        view->has_camera = a->view.has_camera;
+        view->has_lights = a->g.has_lights;
+    }
+    for (size_t i = 0; i < a->n_ch; i++) {
+        const KeyTrack *k = &a->ch[i].track;
+        a->base.end = fmax(a->base.end, k->times[k->n - 1]);
+    }
+    if (!st && a->n_ch == 0)
+        st = error_set(err, ST_INPUT, "%s: the file has no animation of a node's translation, rotation or scale "
+                       "to render frames of", path);
+    a->base.camera_only = !st && moves_camera_only(a);
+    if (st) {
+        anim_free(&a->base);
+        return st;
+    }
+    s->animation = &a->base;
+    return ST_OK;
+}

@@ -355,6 +355,8 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)sizeof(GridMedium);
     out[i++] = (uint)__builtin_offsetof(GridMedium, nx);
     out[i++] = (uint)__builtin_offsetof(GridMedium, max_density);
+    out[i++] = (uint)__builtin_offsetof(Medium, emission);
+    out[i++] = (uint)__builtin_offsetof(GridMedium, emission_at);
 }
 #endif
 

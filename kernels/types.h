@@ -597,7 +597,7 @@ enum Integrator {
  * scene length, per RGB channel, already times the scene's `scale`. Homogeneous media
  * are these constants everywhere they are bound. */
 enum MediumType { MEDIUM_HOMOGENEOUS = 0, MEDIUM_GRID = 1 };
-typedef struct {                                        /* 48 bytes */
+typedef struct {                                        /* 64 bytes */
     uint type;                /* enum MediumType */
     float g;                  /* Henyey-Greenstein asymmetry in (-1, 1); |g| < 1e-3 is
                                * stored as 0 (the sampling formula divides by g) */
@@ -605,6 +605,10 @@ typedef struct {                                        /* 48 bytes */
     uint flags;               /* MEDIUM_* flags */
     vec3 sigma_a;  float pad2;   /* absorption; MEDIUM_GRID: per unit of density */
     vec3 sigma_s;  float pad3;   /* scattering; MEDIUM_GRID: per unit of density */
+    vec3 emission; float pad4;   /* radiance Le (pbrt-v4's Le times Lescale): a stretch
+                               * ds emits sigma_a Le ds (medium_emitted, grid_emitted);
+                               * MEDIUM_GRID: times the cell's emission scale; with
+                               * MEDIUM_EMISSIVE set in flags when not 0 0 0 */
 } Medium;
 
 /* The interior of a subsurface material (docs/subsurface.md): its stops are the steps of
@@ -612,6 +616,9 @@ typedef struct {                                        /* 48 bytes */
  * against MEDIUM_MAX_WALK), sample no light (a light sample from inside the closed
  * surface is blocked by it) and take Russian roulette by the throughput alone. */
 #define MEDIUM_WALK 1u
+/* The medium emits (Medium.emission is not 0 0 0): its flights add sigma_a Le
+ * (medium_emitted, grid_emitted; docs/media.md, "Emission"). */
+#define MEDIUM_EMISSIVE 2u
 
 /* A heterogeneous medium's density (kernels/medium/grid.h, docs/media.md): nx ny nz
  * values, x fastest, at the centres of the cells of its box, trilinearly interpolated
@@ -626,7 +633,11 @@ typedef struct {                                        /* 96 bytes */
     uint nx, ny, nz, density_at;    /* the density's size; its offset in grid_data */
     uint mx, my, mz, majorant_at;   /* the majorant grid's size; its offset */
     float max_density;        /* the largest of all (0: the grid is empty) */
-    uint pad0, pad1, pad2;
+    uint emission_at;         /* the offset in grid_data of nx ny nz emission scales
+                               * (pbrt-v4's "Lescale" grid), trilinear as the density;
+                               * 0 when there is none (scale 1 everywhere): offset 0
+                               * is the first grid's densities, never an emission grid */
+    uint pad1, pad2;
 } GridMedium;
 
 /* Which strategies the path integrator combines for area lights: both with the power
@@ -765,7 +776,7 @@ CLPT_CHECK_SIZE(Light, 96);
 CLPT_CHECK_SIZE(Camera, 112);
 CLPT_CHECK_SIZE(RenderParams, 336);
 CLPT_CHECK_SIZE(PathState, 80);
-CLPT_CHECK_SIZE(Medium, 48);
+CLPT_CHECK_SIZE(Medium, 64);
 CLPT_CHECK_SIZE(GridMedium, 96);
 CLPT_CHECK_SIZE(Texture, 112);
 _Static_assert(offsetof(RenderParams, bg_color) == 112, "RenderParams.bg_color");
@@ -799,8 +810,10 @@ _Static_assert(offsetof(Material, medium_in) == 280, "Material.medium_in");
 _Static_assert(offsetof(RenderParams, has_media) == 320, "RenderParams.has_media");
 _Static_assert(offsetof(PathState, medium) == 64, "PathState.medium");
 _Static_assert(offsetof(Medium, sigma_s) == 32, "Medium.sigma_s");
+_Static_assert(offsetof(Medium, emission) == 48, "Medium.emission");
 _Static_assert(offsetof(GridMedium, nx) == 48, "GridMedium.nx");
 _Static_assert(offsetof(GridMedium, max_density) == 80, "GridMedium.max_density");
+_Static_assert(offsetof(GridMedium, emission_at) == 84, "GridMedium.emission_at");
 #undef CLPT_CHECK_SIZE
 #endif
 

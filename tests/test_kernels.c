@@ -492,7 +492,8 @@ static void test_layout(void)
                     offsetof(SphereXform, to_object), offsetof(Sphere, xform), sizeof(Medium),
                     offsetof(Medium, sigma_s), offsetof(PathState, medium), offsetof(RenderParams, has_media),
                     offsetof(Material, medium_in), sizeof(GridMedium), offsetof(GridMedium, nx),
-                    offsetof(GridMedium, max_density) };
+                    offsetof(GridMedium, max_density), offsetof(Medium, emission),
+                    offsetof(GridMedium, emission_at) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);

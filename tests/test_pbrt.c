@@ -1020,6 +1020,49 @@ static void test_media(void)
                  DIR "inline.pbrt:2:49: parameter 'sigma_a' must be an rgb colour >= 0");
 }
 
+/* Media emission: a homogeneous medium's "Le" times its "Lescale" (a float), a
+ * uniformgrid's "Le" and its "Lescale" grid (a value per cell, as the density). */
+static void test_media_emission(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"glow\" \"string type\" \"homogeneous\" \"rgb Le\" [1 2 3]\n"
+                           "  \"float Lescale\" 2\n"
+                           "MakeNamedMedium \"dark\" \"string type\" \"homogeneous\"\n"
+                           "MakeNamedMedium \"fire\" \"string type\" \"uniformgrid\" \"rgb Le\" [4 2 1]\n"
+                           "  \"integer nx\" 2 \"float density\" [1 0.5] \"float Lescale\" [0 3]\n"
+                           "WorldBegin\n",
+                           &s, &err),
+                 ST_OK);
+    CHECK_EQ_INT(s.n_media, 3);
+    CHECK_EQ_INT(s.n_grids, 1);
+    if (s.n_media == 3 && s.n_grids == 1) {
+        CHECK_V3(s.media[0].emission, 2, 4, 6, 0);
+        CHECK(s.media[0].flags & MEDIUM_EMISSIVE);
+        CHECK_V3(s.media[1].emission, 0, 0, 0, 0);
+        CHECK(!(s.media[1].flags & MEDIUM_EMISSIVE));
+        CHECK_V3(s.media[2].emission, 4, 2, 1, 0);
+        const GridMedium *g = &s.grids[0];
+        CHECK(g->emission_at != 0u);
+        CHECK_NEAR(s.grid_data[g->emission_at + 0], 0, 0);
+        CHECK_NEAR(s.grid_data[g->emission_at + 1], 3, 0);
+    }
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb Le\" [1 -1 0]\n",
+                 DIR "inline.pbrt:2:49: parameter 'Le' must be an rgb colour >= 0");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb Le\" [1 1 1] "
+                 "\"float Lescale\" -1\n",
+                 DIR "inline.pbrt:2:66: parameter 'Lescale' must be a number in [0, 1e30]");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"rgb Le\" [1 1 1] "
+                 "\"integer nx\" 2 \"float density\" [1 1] \"float Lescale\" [1]\n",
+                 DIR "inline.pbrt:2:103: MakeNamedMedium \"m\": nx ny nz 2 1 1 are 2 cells, but \"Lescale\" has 1 "
+                 "values");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"rgb Le\" [1 1 1] "
+                 "\"float density\" [1] \"float Lescale\" [-2]\n",
+                 DIR "inline.pbrt:2:86: MakeNamedMedium \"m\": Lescale -2 (value 0) must be a finite number >= 0");
+}
+
 /* MakeNamedMedium "uniformgrid": the density grid (x fastest) over p0 p1 placed by the
  * current transform, sigma_a and sigma_s times scale per unit of density. */
 static void test_uniform_grid(void)
@@ -1724,6 +1767,7 @@ int main(void)
     RUN(test_no_material);
     RUN(test_media);
     RUN(test_uniform_grid);
+    RUN(test_media_emission);
     RUN(test_named_material_later);
     RUN(test_include);
     RUN(test_instances);

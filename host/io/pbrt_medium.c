@@ -18,9 +18,30 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+/* pbrt-v4's "Le" of a medium (its emitted radiance; 0 when not given) times `scale`.
+ * pbrt-v4 divides an RGB illuminant by its illuminant's luminance, which leaves the
+ * RGB values themselves as the radiance, as clpt reads them. */
+static Status medium_le(Parser *p, const Lexer *lx, const Token *name, vec3 sigma_a, double scale, vec3 *le)
+{
+    Status st;
+    *le = v3s(0.0f);
+    if ((st = pbrt_get_spectrum(p, lx, "Le", le, NULL, NULL))) return st;
+    if (!(scale >= 0.0) || !(scale <= 1e30))
+        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "Lescale"), "a number in [0, 1e30]");
+    *le = v3_scale(*le, (float)scale);
+    vec3 e = v3_mul(*le, sigma_a);
+    if (!isfinite(le->x) || !isfinite(le->y) || !isfinite(le->z) || !isfinite(e.x) || !isfinite(e.y) ||
+        !isfinite(e.z))
+        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": its emission (Le times Lescale and "
+                            "sigma_a) is beyond the largest float (about 3.4e38)",
+                            (int)(name->len > 40 ? 40 : name->len), name->text);
+    return ST_OK;
+}
+
 /* pbrt-v4's homogeneous medium: sigma_a and sigma_s (1 each by default), times
- * `scale`; `g`. Its named presets and emission are not read: a preset is an error
- * (it would decide the whole look), emission a warning. */
+ * `scale`; `g`; its emission "Le" times "Lescale" (medium_le; the grid reads its own
+ * "Lescale", a grid). Its named presets are an error (one would decide the whole
+ * look). */
 static Status homogeneous(Parser *p, const Lexer *lx, const Token *name, Medium *out)
 {
     Status st;
@@ -50,12 +71,42 @@ static Status homogeneous(Parser *p, const Lexer *lx, const Token *name, Medium 
     return ST_OK;
 }
 
+/* A uniformgrid's "Lescale": nx ny nz emission scales (x fastest, as the density),
+ * each finite and >= 0; *out NULL when not given (scale 1 everywhere). */
+static Status grid_le_scale(Parser *p, const Lexer *lx, const Token *name, const long n[3], double cells,
+                            float **out)
+{
+    int nlen = (int)(name->len > 40 ? 40 : name->len);
+    *out = NULL;
+    Param *pl = pbrt_param_find(p, "Lescale");
+    if (!pl) return ST_OK;
+    if (pl->type != PT_FLOAT) return pbrt_param_type_error(p, lx, pl, "floats");
+    if ((double)pl->n != cells)
+        return lex_error_at(lx, &pl->decl, p->err, "MakeNamedMedium \"%.*s\": nx ny nz %ld %ld %ld are %.0f "
+                            "cells, but \"Lescale\" has %zu values", nlen, name->text, n[0], n[1], n[2], cells,
+                            pl->n);
+    float *v = malloc(pl->n * sizeof(float));
+    if (!v) return error_set(p->err, ST_INTERNAL, "out of memory");
+    for (size_t i = 0; i < pl->n; i++) {
+        double x = p->pl.nums[pl->first + i];
+        if (!(x >= 0.0) || !(x <= 3.4e38)) {
+            free(v);
+            return lex_error_at(lx, &pl->decl, p->err, "MakeNamedMedium \"%.*s\": Lescale %g (value %zu) must "
+                                "be a finite number >= 0", nlen, name->text, x, i);
+        }
+        v[i] = (float)x;
+    }
+    *out = v;
+    return ST_OK;
+}
+
 /* pbrt-v4's "uniformgrid" medium: "float density" of nx ny nz values (x fastest, as
  * pbrt's SampledGrid) over the box p0 p1 of the medium's space, which the current
  * transform places; sigma_a, sigma_s (1 each by default) times `scale` per unit of
  * density; `g`. pbrt's grid is zero outside its samples' centres' half cell at the
- * border where clpt's clamps to the outermost value (docs/media.md); its emission
- * ("Le", "temperature") is not read (a warning). */
+ * border where clpt's clamps to the outermost value (docs/media.md). Its emission:
+ * "Le" times the "Lescale" grid (pbrt-v4's GridMedium); a "temperature" grid
+ * (blackbody emission) is not read (a warning). */
 static Status uniform_grid(Parser *p, const Lexer *lx, const Token *name, Medium *out)
 {
     Status st;
@@ -78,7 +129,7 @@ static Status uniform_grid(Parser *p, const Lexer *lx, const Token *name, Medium
                             "than %u", nlen, name->text, n[0], n[1], n[2], 1u << 24);
     Param *pd = pbrt_param_find(p, "density");
     if (!pd) return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": a \"uniformgrid\" needs \"float "
-                                 "density\" (clpt does not read its temperature or emission grids)", nlen, name->text);
+                                 "density\" (clpt does not read its temperature grid)", nlen, name->text);
     if (pd->type != PT_FLOAT) return pbrt_param_type_error(p, lx, pd, "floats");
     if ((double)pd->n != cells)
         return lex_error_at(lx, &pd->decl, p->err, "MakeNamedMedium \"%.*s\": nx ny nz %ld %ld %ld are %.0f cells, "
@@ -105,11 +156,20 @@ static Status uniform_grid(Parser *p, const Lexer *lx, const Token *name, Medium
                             "axis, found p0 %g %g %g, p1 %g %g %g", nlen, name->text, (double)lo.x, (double)lo.y,
                             (double)lo.z, (double)hi.x, (double)hi.y, (double)hi.z);
     }
+    vec3 le;
+    float *le_scale = NULL;
+    if ((st = medium_le(p, lx, name, base.sigma_a, 1.0, &le)) ||
+        (st = grid_le_scale(p, lx, name, n, cells, &le_scale))) {
+        free(d);
+        return st;
+    }
     uint grid;
     st = scene_add_grid(p->s, d, (uint)n[0], (uint)n[1], (uint)n[2], lo, hi, &p->g.ctm, &grid, p->err);
     free(d);
+    if (!st && le_scale && !v3_is_zero(le)) st = scene_grid_set_emission(p->s, grid, le_scale, p->err);
+    free(le_scale);
     if (st) return st;
-    *out = medium_grid(base.sigma_a, base.sigma_s, base.g, grid);
+    *out = medium_with_emission(medium_grid(base.sigma_a, base.sigma_s, base.g, grid), le);
     return ST_OK;
 }
 
@@ -130,6 +190,14 @@ Status pbrt_make_named_medium(Parser *p, Lexer *lx, const Token *kw)
         if ((st = volume ? pbrt_volume_medium(p, lx, &name, type, &m)
                   : grid ? uniform_grid(p, lx, &name, &m) : homogeneous(p, lx, &name, &m)))
             return st;
+        if (!grid && !volume) {
+            double le_scale = 1.0;
+            vec3 le;
+            if ((st = pbrt_get_float(p, lx, "Lescale", &le_scale)) ||
+                (st = medium_le(p, lx, &name, m.sigma_a, le_scale, &le)))
+                return st;
+            m = medium_with_emission(m, le);
+        }
         char *n = tok_copy(&name);
         if (!n) return error_set(p->err, ST_INTERNAL, "out of memory");
         uint index;

@@ -15,7 +15,8 @@
 
 #define MEDIUM_TYPES "a medium type (homogeneous, grid)"
 
-enum { MED_TYPE, MED_SIGMA_A, MED_SIGMA_S, MED_ALBEDO, MED_DENSITY, MED_SCALE, MED_G, MED_N };
+enum { MED_TYPE, MED_SIGMA_A, MED_SIGMA_S, MED_ALBEDO, MED_DENSITY, MED_SCALE, MED_G, MED_EMISSION,
+       MED_EMISSION_SCALE, MED_N };
 static const KeySpec medium_keys[MED_N] = {
     [MED_TYPE] = {"type", VK_WORD, 0, 0, 0, 0, 0, MEDIUM_TYPES},
     [MED_SIGMA_A] = {"sigma_a", VK_COLOR, 0, 0, 0, 0, 0, NULL},
@@ -24,13 +25,16 @@ static const KeySpec medium_keys[MED_N] = {
     [MED_DENSITY] = {"density", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
     [MED_SCALE] = {"scale", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
     [MED_G] = {"g", VK_NUMBER, 0, -1, 1, 1, 1, "a number in (-1, 1)"},
+    [MED_EMISSION] = {"emission", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [MED_EMISSION_SCALE] = {"emission_scale", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
 };
 
 /* A grid medium's keys: the coefficients (per unit of the grid's density) in the same
  * places as medium_keys, so medium_coefficients reads both; `scale` is the transform's
  * here, as in every block with a transform (the coefficients take no extra factor). */
 enum { GM_TYPE, GM_SIGMA_A, GM_SIGMA_S, GM_ALBEDO, GM_DENSITY, GM_G, GM_SIZE, GM_DATA, GM_FILE, GM_MIN, GM_MAX,
-       GM_TRANSLATE, GM_ROTATE, GM_RX, GM_RY, GM_RZ, GM_SCALE, GM_MATRIX, GM_N };
+       GM_TRANSLATE, GM_ROTATE, GM_RX, GM_RY, GM_RZ, GM_SCALE, GM_MATRIX, GM_EMISSION, GM_EMISSION_SCALE,
+       GM_EMISSION_DATA, GM_EMISSION_FILE, GM_N };
 static const KeySpec grid_keys[GM_N] = {
     [GM_TYPE] = {"type", VK_WORD, 0, 0, 0, 0, 0, MEDIUM_TYPES},
     [GM_SIGMA_A] = {"sigma_a", VK_COLOR, 0, 0, 0, 0, 0, NULL},
@@ -50,6 +54,10 @@ static const KeySpec grid_keys[GM_N] = {
     [GM_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
     [GM_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
     [GM_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
+    [GM_EMISSION] = {"emission", VK_COLOR, 0, 0, 0, 0, 0, NULL},
+    [GM_EMISSION_SCALE] = {"emission_scale", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
+    [GM_EMISSION_DATA] = {"emission_data", VK_NUMBER_LIST, 0, 0, 0, 0, 0, NULL},
+    [GM_EMISSION_FILE] = {"emission_file", VK_PATH, 0, 0, 0, 0, 0, NULL},
 };
 
 /* The coefficients of a medium: sigma_a and sigma_s, or the scattering albedo and the
@@ -88,6 +96,28 @@ static Status medium_coefficients(Parser *p, const Lexer *lx, const Token *kw, c
     if (!isfinite(t.x) || !isfinite(t.y) || !isfinite(t.z))
         return lex_error_at(lx, kw, p->err, "the medium's extinction (sigma_a + sigma_s, times scale) is beyond "
                             "the largest float (about 3.4e38)");
+    return ST_OK;
+}
+
+/* A medium's emission: `emission` (radiance, pbrt-v4's Le) times `emission_scale`
+ * (1 when not given), 0 0 0 when there is none. Each channel times sigma_a must stay a
+ * float, since a stretch ds emits sigma_a Le ds. */
+static Status medium_emission(Parser *p, const Lexer *lx, const Value *emission, const Value *scale, vec3 sa,
+                              vec3 *le)
+{
+    *le = v3s(0.0f);
+    if (!emission->given) {
+        if (scale->given)
+            return lex_error_at(lx, &scale->key, p->err, "'emission_scale' needs 'emission' (the radiance it "
+                                "scales)");
+        return ST_OK;
+    }
+    *le = v3_scale(emission->v, scale->given ? scale->f : 1.0f);
+    vec3 e = v3_mul(*le, sa);
+    if (!isfinite(le->x) || !isfinite(le->y) || !isfinite(le->z) || !isfinite(e.x) || !isfinite(e.y) ||
+        !isfinite(e.z))
+        return lex_error_at(lx, &emission->key, p->err, "the medium's emission (times emission_scale and "
+                            "sigma_a) is beyond the largest float (about 3.4e38)");
     return ST_OK;
 }
 
@@ -140,6 +170,38 @@ static Status grid_file(Parser *p, const Lexer *lx, const Value *v, size_t n, fl
     return ST_OK;
 }
 
+/* A grid's n[0] n[1] n[2] values from an inline list (`data`) or a raw file (`file`),
+ * one of which was given, each finite and >= 0; `what` names one value in messages,
+ * `whats` several. */
+static Status grid_values(Parser *p, const Lexer *lx, const Value *data, const Value *file, const uint n[3],
+                          const char *what, const char *whats, float **out)
+{
+    size_t cells = (size_t)n[0] * n[1] * n[2];
+    float *values = NULL;
+    Status st;
+    if (data->given) {
+        if (data->u != cells)
+            return lex_error_at(lx, &data->key, p->err, "the grid's 'size' %u %u %u is %zu cells, but '%.*s' "
+                                "has %llu numbers", n[0], n[1], n[2], cells, (int)data->key.len, data->key.text,
+                                data->u);
+        values = malloc(cells * sizeof(float));
+        if (!values) return error_set(p->err, ST_INTERNAL, "out of memory");
+        memcpy(values, p->list + data->list_at, cells * sizeof(float));
+    } else if ((st = grid_file(p, lx, file, cells, &values))) {
+        return st;
+    }
+    const Token *src = data->given ? &data->key : &file->key;
+    for (size_t i = 0; i < cells; i++)
+        if (!(values[i] >= 0.0f) || !isfinite(values[i])) {
+            st = lex_error_at(lx, src, p->err, "%s %g at cell %zu %zu %zu of the grid: %s are finite numbers >= 0",
+                              what, (double)values[i], i % n[0], i / n[0] % n[1], i / n[0] / n[1], whats);
+            free(values);
+            return st;
+        }
+    *out = values;
+    return ST_OK;
+}
+
 /* `medium NAME { type grid ... }` from after `type grid` (typed: where they were). */
 static Status parse_grid_medium(Parser *p, Lexer *lx, const Token *kw, const Token *name, const Token *type_key)
 {
@@ -153,33 +215,38 @@ static Status parse_grid_medium(Parser *p, Lexer *lx, const Token *kw, const Tok
     if ((st = medium_coefficients(p, lx, kw, v, 1.0f, &sa, &ss))) return st;
     uint n[3];
     if ((st = grid_size(p, lx, &v[GM_SIZE], n))) return st;
-    size_t cells = (size_t)n[0] * n[1] * n[2];
     if (v[GM_DATA].given == v[GM_FILE].given)
         return lex_error_at(lx, v[GM_DATA].given ? &v[GM_FILE].key : kw, p->err,
                             v[GM_DATA].given ? "a grid medium has 'data' or 'file', not both"
                                              : "a grid medium needs its densities: 'data [ ... ]' or 'file NAME'");
     float *density = NULL;
-    if (v[GM_DATA].given) {
-        if (v[GM_DATA].u != cells)
-            return lex_error_at(lx, &v[GM_DATA].key, p->err, "the grid's 'size' %u %u %u is %zu cells, but 'data' "
-                                "has %llu numbers", n[0], n[1], n[2], cells, v[GM_DATA].u);
-        density = malloc(cells * sizeof(float));
-        if (!density) return error_set(p->err, ST_INTERNAL, "out of memory");
-        memcpy(density, p->list + v[GM_DATA].list_at, cells * sizeof(float));
-    } else if ((st = grid_file(p, lx, &v[GM_FILE], cells, &density))) {
+    if ((st = grid_values(p, lx, &v[GM_DATA], &v[GM_FILE], n, "density", "densities", &density))) return st;
+    vec3 le;
+    if ((st = medium_emission(p, lx, &v[GM_EMISSION], &v[GM_EMISSION_SCALE], sa, &le))) {
+        free(density);
         return st;
     }
-    const Token *src = v[GM_DATA].given ? &v[GM_DATA].key : &v[GM_FILE].key;
-    for (size_t i = 0; i < cells; i++)
-        if (!(density[i] >= 0.0f) || !isfinite(density[i])) {
-            st = lex_error_at(lx, src, p->err, "density %g at cell %zu %zu %zu of the grid: densities are finite "
-                              "numbers >= 0", (double)density[i], i % n[0], i / n[0] % n[1], i / n[0] / n[1]);
+    float *emission = NULL;
+    if (v[GM_EMISSION_DATA].given || v[GM_EMISSION_FILE].given) {
+        const Value *e = v[GM_EMISSION_DATA].given ? &v[GM_EMISSION_DATA] : &v[GM_EMISSION_FILE];
+        if (v[GM_EMISSION_DATA].given && v[GM_EMISSION_FILE].given)
+            st = lex_error_at(lx, &v[GM_EMISSION_FILE].key, p->err, "a grid medium has 'emission_data' or "
+                              "'emission_file', not both");
+        else if (!v[GM_EMISSION].given)
+            st = lex_error_at(lx, &e->key, p->err, "'%s' needs 'emission' (the radiance its values scale)",
+                              v[GM_EMISSION_DATA].given ? "emission_data" : "emission_file");
+        else
+            st = grid_values(p, lx, &v[GM_EMISSION_DATA], &v[GM_EMISSION_FILE], n, "emission scale",
+                             "emission scales", &emission);
+        if (st) {
             free(density);
             return st;
         }
+    }
     vec3 lo = v[GM_MIN].given ? v[GM_MIN].v : v3s(0.0f), hi = v[GM_MAX].given ? v[GM_MAX].v : v3s(1.0f);
     if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) {
         free(density);
+        free(emission);
         return lex_error_at(lx, v[GM_MAX].given ? &v[GM_MAX].key : &v[GM_MIN].key, p->err,
                             "a grid's 'max' must be greater than its 'min' on every axis, found min %g %g %g, "
                             "max %g %g %g", (double)lo.x, (double)lo.y, (double)lo.z, (double)hi.x, (double)hi.y,
@@ -188,15 +255,19 @@ static Status parse_grid_medium(Parser *p, Lexer *lx, const Token *kw, const Tok
     Transform to_world;
     if ((st = scene_parse_transform(p, lx, kw, v + GM_TRANSLATE, "grid medium", &to_world))) {
         free(density);
+        free(emission);
         return st;
     }
     uint grid;
     st = scene_add_grid(p->s, density, n[0], n[1], n[2], lo, hi, &to_world, &grid, p->err);
     free(density);
+    if (!st && emission) st = scene_grid_set_emission(p->s, grid, emission, p->err);
+    free(emission);
     if (st) return st;
     char *copy = tok_copy(name);
     if (!copy) return error_set(p->err, ST_INTERNAL, "out of memory");
-    st = scene_add_medium(p->s, copy, medium_grid(sa, ss, v[GM_G].given ? v[GM_G].f : 0.0f, grid), NULL, p->err);
+    Medium m = medium_with_emission(medium_grid(sa, ss, v[GM_G].given ? v[GM_G].f : 0.0f, grid), le);
+    st = scene_add_medium(p->s, copy, m, NULL, p->err);
     free(copy);
     return st;
 }
@@ -246,12 +317,14 @@ Status scene_parse_medium(Parser *p, Lexer *lx, const Token *kw)
                             "(a grid's keys are not a homogeneous medium's)");
     if (!tok_is(&v[MED_TYPE].word, "homogeneous"))
         return lex_expected(lx, &v[MED_TYPE].word, MEDIUM_TYPES, p->err);
-    vec3 sa, ss;
+    vec3 sa, ss, le;
     float scale = v[MED_SCALE].given ? v[MED_SCALE].f : 1.0f;
     if ((st = medium_coefficients(p, lx, kw, v, scale, &sa, &ss))) return st;
+    if ((st = medium_emission(p, lx, &v[MED_EMISSION], &v[MED_EMISSION_SCALE], sa, &le))) return st;
     char *name = tok_copy(&t);
     if (!name) return error_set(p->err, ST_INTERNAL, "out of memory");
-    st = scene_add_medium(p->s, name, medium_homogeneous(sa, ss, v[MED_G].given ? v[MED_G].f : 0.0f), NULL, p->err);
+    Medium m = medium_with_emission(medium_homogeneous(sa, ss, v[MED_G].given ? v[MED_G].f : 0.0f), le);
+    st = scene_add_medium(p->s, name, m, NULL, p->err);
     free(name);
     return st;
 }

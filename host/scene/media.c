@@ -29,6 +29,26 @@ Medium medium_grid(vec3 sigma_a, vec3 sigma_s, float g, uint grid)
     return m;
 }
 
+Medium medium_with_emission(Medium m, vec3 le)
+{
+    m.emission = le;
+    m.flags = v3_is_zero(le) ? (m.flags & ~MEDIUM_EMISSIVE) : (m.flags | MEDIUM_EMISSIVE);
+    return m;
+}
+
+Status scene_grid_set_emission(Scene *s, uint grid, const float *scale, Error *err)
+{
+    GridMedium *g = &s->grids[grid];
+    size_t n = (size_t)g->nx * g->ny * g->nz, at = s->n_grid_data;
+    if (at + n > 0xffffffffu) return error_set(err, ST_INPUT, "the density grids hold more than 2^32 values together");
+    if (array_reserve((void **)&s->grid_data, &s->cap_grid_data, at + n, sizeof(float)))
+        return error_set(err, ST_INTERNAL, "out of memory for an emission grid");
+    memcpy(s->grid_data + at, scale, n * sizeof(float));
+    g->emission_at = (uint)at;   /* > 0: the grid's densities come first */
+    s->n_grid_data = at + n;
+    return ST_OK;
+}
+
 /* The sample indices whose interpolation reaches into majorant cell c of m along an
  * axis of n samples at cell centres (kernels/medium/grid.h: x = q n - 0.5, clamped). */
 static void majorant_span(uint c, uint m, uint n, uint *first, uint *last)

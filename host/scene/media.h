@@ -34,6 +34,15 @@ Status scene_add_grid(Scene *s, const float *density, uint nx, uint ny, uint nz,
 /* A grid medium: coefficients per unit of density, HG g, its grid in s->grids. */
 Medium medium_grid(vec3 sigma_a, vec3 sigma_s, float g, uint grid);
 
+/* Medium m emitting radiance `le` (each channel finite and >= 0: the reader checks):
+ * a stretch ds of it adds sigma_a Le ds (docs/media.md, "Emission"). */
+Medium medium_with_emission(Medium m, vec3 le);
+
+/* Gives grid `grid` (scene_add_grid) a per-cell emission scale, nx ny nz values of its
+ * size (finite, >= 0: the reader checks), interpolated as its density: pbrt-v4's
+ * "Lescale" grid. Fails only when memory runs out or the grids pass 2^32 floats. */
+Status scene_grid_set_emission(Scene *s, uint grid, const float *scale, Error *err);
+
 /* Adds medium m named `name` (the caller checks that the name is new). Fails only when
  * memory runs out. */
 Status scene_add_medium(Scene *s, const char *name, Medium m, uint *index, Error *err);

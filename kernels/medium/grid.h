@@ -98,21 +98,42 @@ KFN void grid_axis(float q, uint n, uint *i0, uint *i1, float *f)
 
 KFN float grid_lerp(float a, float b, float f) { return a + (b - a) * f; }
 
-/* The density at unit-cube point q: trilinear between the 8 nearest cell centres. */
-KFN float grid_density(const SceneView *sc, const GridMedium *g, vec3 q)
+/* A grid of g's size stored in grid_data from `at` (the density, or the emission
+ * scale) at unit-cube point q: trilinear between the 8 nearest cell centres. */
+KFN float grid_lookup(const SceneView *sc, const GridMedium *g, uint at, vec3 q)
 {
     uint x0, x1, y0, y1, z0, z1;
     float fx, fy, fz;
     grid_axis(q.x, g->nx, &x0, &x1, &fx);
     grid_axis(q.y, g->ny, &y0, &y1, &fy);
     grid_axis(q.z, g->nz, &z0, &z1, &fz);
-    GLOBAL const float *v = sc->grid_data + g->density_at;
+    GLOBAL const float *v = sc->grid_data + at;
     uint nx = g->nx, nxy = g->nx * g->ny;
     float c00 = grid_lerp(v[z0 * nxy + y0 * nx + x0], v[z0 * nxy + y0 * nx + x1], fx);
     float c10 = grid_lerp(v[z0 * nxy + y1 * nx + x0], v[z0 * nxy + y1 * nx + x1], fx);
     float c01 = grid_lerp(v[z1 * nxy + y0 * nx + x0], v[z1 * nxy + y0 * nx + x1], fx);
     float c11 = grid_lerp(v[z1 * nxy + y1 * nx + x0], v[z1 * nxy + y1 * nx + x1], fx);
     return grid_lerp(grid_lerp(c00, c10, fy), grid_lerp(c01, c11, fy), fz);
+}
+
+KFN float grid_density(const SceneView *sc, const GridMedium *g, vec3 q)
+{
+    return grid_lookup(sc, g, g->density_at, q);
+}
+
+/* What a tentative collision at unit-cube point q of density dens adds to the path's
+ * emitted radiance, per unit of its weight w: w sigma_a(q) Le(q) / sigma_bar, where
+ * sigma_a(q) = dens sigma_a and Le(q) the medium's emission times the cell's scale
+ * (pbrt-v4's GridMedium: Le_spec times its "Lescale" grid). Collisions arrive at rate
+ * sigma_bar along the ray and w estimates the transmittance up to q, so the sum over
+ * a flight estimates the emission integral int T(t) sigma_a(t) Le(t) dt without bias
+ * (Pharr, Jakob, Humphreys, PBR 4th ed., sec. 14.2.2: pbrt-v4's VolPathIntegrator
+ * adds beta sigma_a Le / sigma_maj at every tentative collision). */
+KFN vec3 grid_emitted(const SceneView *sc, const GridMedium *g, Medium md, vec3 q, float dens, vec3 w, float bar)
+{
+    float scale = g->emission_at != 0u ? grid_lookup(sc, g, g->emission_at, q) : 1.0f;
+    vec3 le = v3_scale(v3_mul(md.sigma_a, md.emission), dens * scale / bar);
+    return v3_mul(w, le);
 }
 
 /* A 3D DDA over the majorant grid (Amanatides and Woo, "A fast voxel traversal
@@ -189,9 +210,11 @@ KFN int grid_walk_next(const GridMedium *g, GridWalk *w, float *lo, float *hi, u
  * [0, dist) through grid medium md: GRID_STOPPED with the real collision's distance in
  * *t_stop, GRID_PASSED when it flies past dist, GRID_ENDED when the weight vanished or
  * the walk gave up. *thr takes every null collision's weight and the stop's. u_first is
- * the first tentative collision's number, *rng the stream of the others. */
+ * the first tentative collision's number, *rng the stream of the others. An emissive
+ * medium adds each tentative collision's emission (grid_emitted, with the weight
+ * before that collision's) to *emitted. */
 KFN int grid_track(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, vec3 *thr, float u_first,
-                   uint *rng, float *t_stop)
+                   uint *rng, float *t_stop, vec3 *emitted)
 {
     GridMedium g = sc->grids[md.grid];
     vec3 sig_t = v3_add(md.sigma_a, md.sigma_s);
@@ -212,7 +235,10 @@ KFN int grid_track(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, v
             first = 0;
             t = t + grid_exp_step(bar, u);
             if (!(t < hi)) break;   /* memoryless: the next cell starts afresh at hi */
-            float dens = grid_density(sc, &g, v3_madd(o, du, t));
+            vec3 p = v3_madd(o, du, t);
+            float dens = grid_density(sc, &g, p);
+            if (md.flags & MEDIUM_EMISSIVE)
+                *emitted = v3_add(*emitted, grid_emitted(sc, &g, md, p, dens, *thr, bar));
             vec3 mu_t = v3_scale(sig_t, dens);
             vec3 q = medium_channel_pdf(*thr);
             float real = v3_dot(q, mu_t);
@@ -232,8 +258,10 @@ KFN int grid_track(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, v
 }
 
 /* Ratio tracking's estimate of the transmittance of grid medium md along the world ray
- * x + t d (d unit length), t in [0, dist); numbers from *rng. */
-KFN vec3 grid_transmittance(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, uint *rng)
+ * x + t d (d unit length), t in [0, dist); numbers from *rng. With `emitted` not NULL
+ * (a path's flight, not a shadow ray) an emissive medium adds each tentative
+ * collision's emission to it, weighted by the transmittance estimated up to there. */
+KFN vec3 grid_transmittance(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, uint *rng, vec3 *emitted)
 {
     GridMedium g = sc->grids[md.grid];
     vec3 sig_t = v3_add(md.sigma_a, md.sigma_s);
@@ -253,7 +281,10 @@ KFN vec3 grid_transmittance(const SceneView *sc, Medium md, vec3 x, vec3 d, floa
             if (++steps > GRID_MAX_STEPS) return v3s(0.0f);
             t = t + grid_exp_step(bar, grid_rng_next(rng));
             if (!(t < hi)) break;
-            float dens = grid_density(sc, &g, v3_madd(o, du, t));
+            vec3 p = v3_madd(o, du, t);
+            float dens = grid_density(sc, &g, p);
+            if (emitted && (md.flags & MEDIUM_EMISSIVE))
+                *emitted = v3_add(*emitted, grid_emitted(sc, &g, md, p, dens, tr, bar));
             vec3 mu_t = v3_scale(sig_t, dens);
             tr = v3_mul(tr, v3(k_fmax(1.0f - mu_t.x * inv, 0.0f), k_fmax(1.0f - mu_t.y * inv, 0.0f),
                                k_fmax(1.0f - mu_t.z * inv, 0.0f)));

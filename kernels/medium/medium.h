@@ -62,6 +62,28 @@ KFN vec3 medium_tr(vec3 sigma_t, float dist)
     return v3(medium_tr1(sigma_t.x, dist), medium_tr1(sigma_t.y, dist), medium_tr1(sigma_t.z, dist));
 }
 
+/* The radiance a homogeneous medium emits toward the start of a stretch `dist` long,
+ * per channel: the integral of T(t) sigma_a Le dt over [0, dist), which is
+ * Le sigma_a (1 - exp(-sigma_t dist)) / sigma_t, in closed form (the emission term of
+ * the radiative transfer equation, dL/ds = ... + sigma_a Le, as pbrt-v4's media; PBR
+ * 4th ed., sec. 11.1.2). Exact, so the flight adds it whatever distance it samples:
+ * no noise, and no random number. Below an optical depth of 1e-3 the series
+ * dist (1 - x / 2) keeps the digits that 1 - exp(-x) would lose. */
+KFN float medium_emitted1(float sigma_a, float sigma_t, float le, float dist)
+{
+    if (!(sigma_a > 0.0f) || !(le > 0.0f)) return 0.0f;
+    float x = sigma_t * dist;
+    float len = x < 1e-3f ? dist * (1.0f - 0.5f * x) : (1.0f - medium_tr1(sigma_t, dist)) / sigma_t;
+    return le * sigma_a * len;
+}
+
+KFN vec3 medium_emitted(Medium m, vec3 sigma_t, float dist)
+{
+    return v3(medium_emitted1(m.sigma_a.x, sigma_t.x, m.emission.x, dist),
+              medium_emitted1(m.sigma_a.y, sigma_t.y, m.emission.y, dist),
+              medium_emitted1(m.sigma_a.z, sigma_t.z, m.emission.z, dist));
+}
+
 /* The channel probabilities for the distance sampling: proportional to the path's
  * throughput (a channel that carries nothing is never chosen, so the distances follow
  * the channels that matter); uniform if the throughput is no use (0 or not finite). */
@@ -99,6 +121,23 @@ KFN float medium_sample_exp(float sigma, float u)
 KFN float medium_stop_pdf(vec3 pc, vec3 sigma_t, vec3 tr)
 {
     return pc.x * sigma_t.x * tr.x + pc.y * sigma_t.y * tr.y + pc.z * sigma_t.z * tr.z;
+}
+
+/* 1 - exp(-sigma dist) for one channel, the series sigma dist (1 - x / 2) below an
+ * optical depth of 1e-3, where the difference would lose its digits. */
+KFN float medium_absorbed1(float sigma, float dist)
+{
+    if (!(sigma > 0.0f)) return 0.0f;
+    float x = sigma * dist;
+    return x < 1e-3f ? x * (1.0f - 0.5f * x) : 1.0f - medium_tr1(sigma, dist);
+}
+
+/* The mixture probability of stopping before distance dist (1 - P(pass), computed
+ * without the cancellation of a thin medium). */
+KFN float medium_stop_prob(vec3 pc, vec3 sigma_t, float dist)
+{
+    return pc.x * medium_absorbed1(sigma_t.x, dist) + pc.y * medium_absorbed1(sigma_t.y, dist) +
+           pc.z * medium_absorbed1(sigma_t.z, dist);
 }
 
 /* The mixture probability of flying past a distance whose transmittance is tr. */

@@ -17,6 +17,7 @@
 #include "medium/medium.h"
 #include "medium/grid.h"
 #include "medium/phase.h"
+#include "medium/equiangular.h"
 #include "light/lights.h"
 #include "sample/rng.h"
 #include "geom/surface.h"
@@ -83,9 +84,10 @@ KFN int medium_light_sample(const SceneView *sc, GLOBAL PathState *ps, vec3 x, v
 }
 
 /* The path stopped at x inside its medium (phase g) and its throughput already holds
- * the stop's weight: a light sample, then a new direction from the phase function
- * (weight 1: it is sampled exactly), Russian roulette as at a surface. Returns the
- * bounce's SHADE_* result.
+ * the stop's weight: a light sample (unless the flight's segment estimate took this
+ * bounce's, light_done), then a new direction from the phase function (weight 1: it is
+ * sampled exactly), Russian roulette as at a surface. Returns the bounce's SHADE_*
+ * result.
  *
  * A stop of a subsurface walk (`walk`: a MEDIUM_WALK medium, docs/subsurface.md) is no
  * bounce: it counts as a crossing (which gives the next step fresh random numbers),
@@ -93,14 +95,14 @@ KFN int medium_light_sample(const SceneView *sc, GLOBAL PathState *ps, vec3 x, v
  * Russian roulette by the throughput alone, without the 0.95 cap: a walk in a white
  * medium keeps its weight 1 and is never cut, however long, until MEDIUM_MAX_WALK. */
 KFN uint medium_scatter(const SceneView *sc, GLOBAL Ray *ray, vec3 x, float g, uint walk, GLOBAL PathState *ps,
-                        GLOBAL Ray *shadow_ray, RngKey key, uint rb)
+                        GLOBAL Ray *shadow_ray, RngKey key, uint rb, int light_done)
 {
     GLOBAL const RenderParams *p = sc->params;
     uint bounce = ps->bounce;
     if (walk ? ps->crossings >= path_max_crossings(p->has_media) : bounce >= p->max_depth) return 0u;
     vec3 d = v3_norm(ray->d);
     uint result = 0u;
-    if (!walk && p->n_lights > 0u && medium_light_sample(sc, ps, x, d, g, key, rb, shadow_ray))
+    if (!walk && !light_done && p->n_lights > 0u && medium_light_sample(sc, ps, x, d, g, key, rb, shadow_ray))
         result |= SHADE_SHADOW;
     float u1, u2;
     rng_uniform2(key, rb, DIM_BSDF_U, &u1, &u2);
@@ -128,6 +130,78 @@ KFN uint medium_scatter(const SceneView *sc, GLOBAL Ray *ray, vec3 x, float g, u
     return result | SHADE_CONTINUE;
 }
 
+/* The point or spot light that this bounce's light sample picks (the same choice and
+ * numbers as light_sample, so a stop's own light sample would pick it too): 1 with it
+ * and its choice probability, 0 for any other kind of light. */
+KFN int medium_pick_point_light(const SceneView *sc, RngKey key, uint rb, Light *l, float *choice)
+{
+    if (!KF_HAS(KF_DELTA_LIGHTS) || sc->params->n_lights == 0u) return 0;
+    float lu, lv, u_rest;
+    rng_uniform2(key, rb, DIM_LIGHT_U, &lu, &lv);
+    float u = key.sampler == SAMPLER_SOBOL ? lu : rng_uniform(key, rb, DIM_LIGHT_PICK);
+    Light lt = sc->lights[light_choose(sc, u * 1.0f, &u_rest)];
+    if (lt.type == LIGHT_ENV || !light_is_delta(lt.type) || light_has(lt.type, LT_INFINITE)) return 0;
+    *l = lt;
+    *choice = lt.pick_pdf / 1.0f;
+    return 1;
+}
+
+/* Next-event estimation toward point or spot light l over a whole stretch [0, dist) of a
+ * homogeneous scattering medium, from x0 along unit d, for a path of throughput beta
+ * that stopped somewhere in it (probability p_stop): the point is drawn by one-sample
+ * MIS (balance heuristic, Veach 1997 sec. 9.2.4) between equiangular sampling toward
+ * the light and free-flight sampling, each with probability 1/2 (by lv, rescaled;
+ * MIS_BSDF_ONLY leaves the light sample at the stop, free-flight sampling alone), and
+ * the estimate beta T(t) sigma_s p Le / (choice pdf_mix(t) p_stop) has the expectation of
+ * the light's single scattering along the stretch; the path's own stop then takes no
+ * light sample for this light (light_done). Returns 1 when a shadow ray was written. */
+KFN int medium_segment_light(const SceneView *sc, GLOBAL PathState *ps, Medium md, vec3 x0, vec3 d, float dist,
+                             vec3 pc, float p_stop, Light l, float choice, float lv, GLOBAL Ray *shadow_ray)
+{
+    vec3 sigma_t = medium_sigma_t(md);
+    Equiangular e;
+    e.delta = e.D = e.theta_a = e.theta_b = 0.0f;   /* unused unless c_eq > 0 */
+    /* the share of equiangular samples: 1/2, or 1 for MIS_LIGHT_ONLY (the tests'
+     * "light strategy only"); 0 where the ray passes through the light */
+    float t_lo = 0.0f, t_hi = dist;
+    int lit = !light_has(l.type, LT_CONE) || !(l.cos_outer > 0.0f) ||
+              equiangular_cone_clip(x0, d, l.position, l.direction, l.cos_outer, dist, &t_lo, &t_hi);
+    float c_eq = !lit || !equiangular_begin(x0, d, l.position, t_lo, t_hi, &e) ? 0.0f
+                 : (sc->params->mis_mode == MIS_LIGHT_ONLY ? 1.0f : 0.5f);
+    float t;
+    if (lv < c_eq) {
+        t = equiangular_sample(e, lv / c_eq);
+    } else {
+        float u = k_fmin((lv - c_eq) / (1.0f - c_eq), 0.99999994f), u_rest;
+        int c = medium_pick_channel(pc, u, &u_rest);
+        t = medium_sample_exp(v3_get(sigma_t, c), u_rest);
+    }
+    if (!(t >= 0.0f && t < dist)) return 0;
+    vec3 tr = medium_tr(sigma_t, t);
+    float p_free = medium_stop_pdf(pc, sigma_t, tr);
+    /* 0 outside the cone's part (a free-flight point there); an equiangular point is
+     * inside it but for rounding */
+    float pdf = p_free;
+    if (c_eq > 0.0f) {
+        float p_eq = lv < c_eq || (t >= t_lo && t < t_hi) ? equiangular_pdf(e, t) : 0.0f;
+        pdf = c_eq * p_eq + (1.0f - c_eq) * p_free;
+    }
+    vec3 x = v3_madd(x0, d, t);
+    LightSample ls;
+    if (!(pdf > 0.0f) || !light_delta_at(l, x, &ls)) return 0;
+    float ph = phase_hg(md.g, d, ls.wi);
+    vec3 w = v3_scale(v3_mul(tr, md.sigma_s), ph / (choice * pdf * p_stop));
+    ps->shadow_L = v3_mul(v3_mul(ps->throughput, w), ls.Le);
+    ps->shadow_medium = ps->medium;
+    if (!sc->params->shadows) {
+        /* shadows off: the light counts as visible, through the medium too */
+        shadow_resolve(ps, 0);
+        return 0;
+    }
+    *shadow_ray = light_shadow_ray(x, v3s(0.0f), ls.wi, ls);
+    return 1;
+}
+
 /* The flight of ray *ray through the path's medium up to `hit` (without end when it
  * escaped). A distance is drawn (medium.h): past the surface, the throughput takes
  * T / P(pass) and 0 is returned (the caller shades the surface, or the escape);
@@ -149,17 +223,22 @@ KFN int medium_flight_grid(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL
     uint rb = path_rng_bounce(ps);
     uint rng = grid_rng_seed(key, rb, GRID_TAG_FLIGHT);
     *result = 0u;
+    vec3 emitted = v3s(0.0f);
     if (v3_is_zero(md.sigma_s)) {
-        ps->throughput = v3_mul(ps->throughput, grid_transmittance(sc, md, x, d, dist, &rng));
+        vec3 tr = grid_transmittance(sc, md, x, d, dist, &rng, &emitted);
+        if (md.flags & MEDIUM_EMISSIVE) ps->radiance = v3_add(ps->radiance, v3_mul(ps->throughput, emitted));
+        ps->throughput = v3_mul(ps->throughput, tr);
         return !(v3_max_comp(ps->throughput) > 0.0f);
     }
     vec3 thr = ps->throughput;
     float ts;
-    int ev = grid_track(sc, md, x, d, dist, &thr, rng_uniform(key, rb, DIM_MEDIUM), &rng, &ts);
+    int ev = grid_track(sc, md, x, d, dist, &thr, rng_uniform(key, rb, DIM_MEDIUM), &rng, &ts, &emitted);
+    /* emitted already carries the path's throughput (grid_track's weights start from it) */
+    if (md.flags & MEDIUM_EMISSIVE) ps->radiance = v3_add(ps->radiance, emitted);
     if (ev == GRID_ENDED || !(v3_max_comp(thr) > 0.0f)) return 1;
     ps->throughput = thr;
     if (ev == GRID_PASSED) return 0;
-    *result = medium_scatter(sc, ray, v3_madd(x, d, ts), md.g, md.flags & MEDIUM_WALK, ps, shadow_ray, key, rb);
+    *result = medium_scatter(sc, ray, v3_madd(x, d, ts), md.g, md.flags & MEDIUM_WALK, ps, shadow_ray, key, rb, 0);
     return 1;
 }
 
@@ -173,6 +252,9 @@ KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL Path
     float len = v3_len(r.d);
     float dist = hit.prim == NO_INDEX ? INFINITY : (hit.t - r.tmin) * len;
     *result = 0u;
+    /* the emission along the whole stretch, exactly, before the flight decides where
+     * the path goes on (docs/media.md, "Emission") */
+    if (md.flags & MEDIUM_EMISSIVE) ps->radiance = v3_add(ps->radiance, v3_mul(ps->throughput, medium_emitted(md, sigma_t, dist)));
     if (v3_is_zero(md.sigma_s)) {
         ps->throughput = v3_mul(ps->throughput, medium_tr(sigma_t, dist));
         return !(v3_max_comp(ps->throughput) > 0.0f);
@@ -194,9 +276,25 @@ KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL Path
     float pdf = medium_stop_pdf(pc, sigma_t, tr);
     vec3 thr = v3_scale(v3_mul(v3_mul(ps->throughput, tr), md.sigma_s), 1.0f / pdf);
     if (!(pdf > 0.0f) || !(v3_max_comp(thr) > 0.0f)) return 1;
+    /* a point or spot light's sample is taken over the whole stretch, by equiangular
+     * and free-flight sampling together (medium_segment_light), in place of the stop's */
+    Light pl;
+    float choice;
+    int segment = !(md.flags & MEDIUM_WALK) && ps->bounce < sc->params->max_depth &&
+                  sc->params->mis_mode != MIS_BSDF_ONLY && medium_pick_point_light(sc, key, rb, &pl, &choice);
+    uint shadow = 0u;
+    if (segment) {
+        float lu, lv;
+        rng_uniform2(key, rb, DIM_LIGHT_U, &lu, &lv);
+        vec3 x0 = v3_madd(r.o, r.d, r.tmin), d = v3_scale(r.d, 1.0f / len);
+        float p_stop = medium_stop_prob(pc, sigma_t, dist);
+        if (p_stop > 0.0f && medium_segment_light(sc, ps, md, x0, d, dist, pc, p_stop, pl, choice, lv, shadow_ray))
+            shadow = SHADE_SHADOW;
+    }
     ps->throughput = thr;
     *result = medium_scatter(sc, ray, v3_madd(r.o, r.d, r.tmin + ts / len), md.g, md.flags & MEDIUM_WALK, ps,
-                              shadow_ray, key, rb);
+                             shadow_ray, key, rb, segment) |
+              shadow;
     return 1;
 }
 

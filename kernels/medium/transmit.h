@@ -37,7 +37,7 @@ KFN uint shadow_trace_media(const SceneView *sc, GLOBAL PathState *ps, Ray r)
                 if (!rng_ready) rng = grid_rng_seed(rng_key_of(ps, sc->params), path_rng_bounce(ps), GRID_TAG_SHADOW);
                 rng_ready = 1;
                 tr = v3_mul(tr, grid_transmittance(sc, md, v3_madd(r.o, r.d, r.tmin), v3_scale(r.d, 1.0f / len),
-                                                   dist, &rng));
+                                                   dist, &rng, NULL));
             } else {
                 tr = v3_mul(tr, medium_tr(medium_sigma_t(md), dist));
             }

@@ -6,7 +6,8 @@
 #   make render     render the default scene to cornell-box.png
 #   make bench      throughput benchmarks (bench/)
 #   make bench-peers  clpt against Mitsuba 3 and Cycles at equal error (bench/peers.py)
-#   make xcheck     single-feature scenes against Mitsuba 3 and Cycles (tools/xcheck/)
+#   make xcheck     single-feature scenes against Mitsuba 3 and Cycles (tools/xcheck/);
+#                   PBRT=/path/to/pbrt adds the pbrt-v4 media scenes against that binary
 #   make test-asan  the test suite built with AddressSanitizer + UBSan (build-asan/)
 #   make test-valgrind  small renders (PoCL and scalar) under valgrind memcheck
 #   make fuzz       each libFuzzer target in fuzz/ for FUZZ_SECONDS (build-fuzz/)
@@ -353,7 +354,7 @@ xcheck: $(BUILD)/$(PROG)
 	@mkdir -p $(BUILD)/pocl-cache $(BUILD)/kernel-cache
 	@POCL_CACHE_DIR=$${POCL_CACHE_DIR:-$(CURDIR)/$(BUILD)/pocl-cache} \
 	 CLPT_CACHE_DIR=$${CLPT_CACHE_DIR:-$(CURDIR)/$(BUILD)/kernel-cache} \
-	 python3 tools/xcheck/xcheck.py --clpt $(BUILD)/$(PROG) --out $(BUILD)/xcheck $(XCHECK_ARGS)
+	 python3 tools/xcheck/xcheck.py --clpt $(BUILD)/$(PROG) --out $(BUILD)/xcheck $(if $(PBRT),--pbrt $(PBRT)) $(XCHECK_ARGS)
 
 # ---------------------------------------------------------------- hardening
 # The sanitizer and fuzzing builds are the ordinary build in their own folders, with

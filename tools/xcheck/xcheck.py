@@ -6,7 +6,7 @@ with the known model difference of that peer (docs/validation.md).
 
 usage: python3 tools/xcheck/xcheck.py [--clpt build/clpt] [--out build/xcheck] [--size 64]
            [--spp 256] [--only NAME,...] [--peers mitsuba,cycles] [--envmap FILE]
-           [--mitsuba-variant scalar_rgb]
+           [--mitsuba-variant scalar_rgb] [--pbrt PATH [--pbrt-threads 2]]
 
 Each scene is a glTF file written here (a UV sphere of radius 1 at the origin, 64 x 32
 segments with normals, uvs and tangents; a floor for the light scenes, or the floor alone;
@@ -28,6 +28,12 @@ A peer that is not installed is skipped with the line that installs it. A scene 
 feature clpt does not read yet (it warns that the scene's glTF extension is ignored) is
 reported 'unsupported' for clpt and the run goes on. Standard library and numpy (which
 Mitsuba needs anyway).
+
+With --pbrt PATH (`make xcheck PBRT=PATH`), a pbrt-v4 binary built outside the repository,
+the media scenes written in pbrt-v4's format (pbrt/*.pbrt and scenes/nanovdb-smoke.pbrt)
+are rendered by clpt and by pbrt-v4 from the very same files and compared per channel and
+as blurred images against each renderer's noise (pbrt_check.py says how); without it those
+rows are skipped with a line that says so.
 """
 import argparse
 import json
@@ -43,6 +49,7 @@ import zlib
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pbrt_check  # noqa: E402
 import scenes as xscenes  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -487,18 +494,25 @@ def main():
     ap.add_argument("--peers", default="mitsuba,cycles", help="the peers to try (comma-separated)")
     ap.add_argument("--envmap", default=None, help="the env scenes' map (default ../shared/envmaps/courtyard.hdr)")
     ap.add_argument("--mitsuba-variant", default="scalar_rgb")
+    ap.add_argument("--pbrt", default="", help="a pbrt-v4 binary: also render the pbrt-v4 media scenes with it")
+    ap.add_argument("--pbrt-threads", type=int, default=2, help="pbrt-v4's --nthreads")
     ap.add_argument("--list", action="store_true", help="list the scenes and exit")
     a = ap.parse_args()
     all_scenes = xscenes.scene_list()
     if a.list:
         for s in all_scenes:
             print("%-20s %s" % (s["name"], s["what"]))
+        for s in pbrt_check.SCENES:
+            print("%-20s %s (pbrt-v4 file; with --pbrt)" % (s[0], s[4]))
         return 0
     names = [n for n in a.only.split(",") if n]
-    unknown = set(names) - {s["name"] for s in all_scenes}
+    unknown = set(names) - {s["name"] for s in all_scenes} - set(pbrt_check.NAMES)
     if unknown:
         raise SystemExit("unknown scenes: %s (--list names them)" % ", ".join(sorted(unknown)))
+    pbrt_names = [n for n in names if n in pbrt_check.NAMES]
     todo = [s for s in all_scenes if not names or s["name"] in names]
+    if names and not todo and pbrt_names and not a.pbrt:
+        raise SystemExit("%s: pbrt-v4 scenes, rendered only with --pbrt PATH" % ", ".join(pbrt_names))
     a.clpt = os.path.abspath(a.clpt)
     if not os.path.exists(a.clpt):
         raise SystemExit("%s: build clpt first (make)" % a.clpt)
@@ -509,6 +523,19 @@ def main():
         todo = [s for s in todo if s["background"] != "env"]
     folder = os.path.abspath(a.out)
     os.makedirs(folder, exist_ok=True)
+    if a.pbrt and not (os.path.isfile(a.pbrt) and os.access(a.pbrt, os.X_OK)):
+        raise SystemExit("%s: not an executable pbrt-v4 binary (--pbrt / PBRT=)" % a.pbrt)
+    pbrt_results = {}
+    if not a.pbrt:
+        print("pbrt-v4: skipped, no binary given: `make xcheck PBRT=/path/to/pbrt` (a pbrt-v4 build; "
+              "nothing of it is in this repository)", flush=True)
+    elif not names or pbrt_names:
+        pbrt_results = pbrt_check.rows(a, pbrt_names, folder, read_pfm)
+        print(flush=True)
+    if names and not todo:
+        with open(os.path.join(folder, "results.json"), "w") as f:
+            json.dump({"pbrt/%s" % k: v for k, v in pbrt_results.items()}, f, indent=1)
+        return 0
 
     peers = []
     for cls in (Mitsuba, Cycles):
@@ -598,6 +625,7 @@ def main():
             c = imgs[("clpt", s["name"])]
             print("%-20s %s" % (s["name"], c if isinstance(c, str) else "image mean %.4f" % float(
                 ((c[0] + c[1]) / 2).mean())))
+    results.update({("pbrt", k): v for k, v in pbrt_results.items()})
     with open(os.path.join(folder, "results.json"), "w") as f:
         json.dump({"%s/%s" % k: v for k, v in results.items()}, f, indent=1)
     for (r, name), v in imgs.items():

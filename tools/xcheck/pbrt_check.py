@@ -38,9 +38,9 @@ WITHIN_NOISE = 1.5
 
 # name, file, files it reads (copied beside it), chromatic (5% tolerance), what it tests,
 # and the known model difference (docs/validation.md)
-SPECTRAL = ("pbrt-v4 renders spectrally (4 wavelengths a path, its RGB coefficients as "
-            "RGBUnboundedSpectrum) where clpt tracks RGB: a chromatic medium's transmittance is "
-            "averaged over wavelengths, not over channels")
+SPECTRAL = ("pbrt-v4 is spectral (rgb sigma as RGBUnboundedSpectrum, 4 wavelengths a path) where "
+            "clpt tracks R, G, B: pbrt's red channel also meets the medium's green-band absorption "
+            "(a grey control agrees to 0.1%)")
 SCENES = [
     ("pbrt-smoke-ball", "tools/xcheck/pbrt/smoke-ball.pbrt", [], False,
      "a uniformgrid smoke ball over a floor, sun and sky", ""),

@@ -73,7 +73,7 @@ __kernel KERNEL_SIZE void k_raygen(SCENE_ARGS uint first_pixel, uint first_sampl
     if (i >= n_paths) return;
     SCENE_VIEW(sc);
     uint p = first_pixel + i;
-    raygen_path(sc.params, batch_pixel(&sc, p % n_pixels), first_sample + p / n_pixels, &paths[i], &rays[i]);
+    raygen_path(sc.params, sc.motion_keys, batch_pixel(&sc, p % n_pixels), first_sample + p / n_pixels, &paths[i], &rays[i]);
     queue[i] = i;
 }
 
@@ -214,7 +214,7 @@ KFN_CALL_CL uint path_run_lanes(const SceneView *sc, uint first, uint first_pixe
         split[l] = 0u;
         if (i >= n_paths) continue;
         uint p = first_pixel + i;
-        raygen_path(sc->params, batch_pixel(sc, p % n_pixels), first_sample + p / n_pixels, &paths[i], &rays[i]);
+        raygen_path(sc->params, sc->motion_keys, batch_pixel(sc, p % n_pixels), first_sample + p / n_pixels, &paths[i], &rays[i]);
         first_ray[l] = rays[i];
         live |= 1u << l;
     }
@@ -357,6 +357,9 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(GridMedium, max_density);
     out[i++] = (uint)__builtin_offsetof(Medium, emission);
     out[i++] = (uint)__builtin_offsetof(GridMedium, emission_at);
+    out[i++] = (uint)sizeof(MotionKey);
+    out[i++] = (uint)__builtin_offsetof(MotionKey, stretch);
+    out[i++] = (uint)__builtin_offsetof(Camera, motion_keys);
 }
 #endif
 

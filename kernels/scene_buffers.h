@@ -62,7 +62,9 @@
     X(MANY, Medium,       media,      (ds)->params.n_media,      "participating media")    \
     /* heterogeneous media: grids of MEDIUM_GRID media; their densities and majorants */  \
     X(MANY, GridMedium,   grids,      (ds)->params.n_grids,      "density grids")          \
-    X(MANY, float,        grid_data,  (ds)->n_grid_data,         "density grid values")
+    X(MANY, float,        grid_data,  (ds)->n_grid_data,         "density grid values")    \
+    /* the keys of moving transforms (MotionKey; the camera's: Camera.motion_first) */     \
+    X(MANY, MotionKey,    motion_keys, (ds)->n_motion_keys,      "motion keys")
 
 /* Each buffer's position: SCENE_BUF_nodes ... The scene buffers are the first
  * SCENE_BUF_COUNT arguments of every kernel that takes SCENE_ARGS, in this order. */

@@ -56,10 +56,12 @@
 #define KF_MEDIA 0x2000000u     /* participating media or their boundaries (kernels/medium/,
                                  * RenderParams.has_media; docs/media.md) */
 #define KF_INSTANCES 0x10000000u /* instances of objects: the BVH's two levels (Instance) */
+#define KF_MOTION 0x40000000u   /* motion blur: a moving camera (Camera.motion_keys,
+                                 * MotionKey; docs/motion.md) */
 /* every bit above and every material type's */
 #define KF_ALL (KF_PATH | KF_WHITTED | KF_TEXTURES | KF_ALPHA | KF_ENV_MAP | KF_CUBEMAP | KF_REVSURFACE | \
                 KF_SPHERES | KF_BOXES | KF_PLANES | KF_DELTA_LIGHTS | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH | \
-                KF_PATH_LANES | KF_SPHERE_XFORM | KF_MEDIA | KF_INSTANCES MATERIAL_TYPES(KF_MATERIAL_OR_))
+                KF_PATH_LANES | KF_SPHERE_XFORM | KF_MEDIA | KF_INSTANCES | KF_MOTION MATERIAL_TYPES(KF_MATERIAL_OR_))
 #define KF_MATERIAL_OR_(name, value, bit, traits, lobes) | (bit)
 #ifndef CLPT_FEATURES
 #define CLPT_FEATURES 0xffffffffu   /* every switch (KF_ALL, which is not usable here: a
@@ -525,15 +527,36 @@ enum CameraType { CAMERA_PERSPECTIVE = 0, CAMERA_ORTHOGRAPHIC = 1 };
  * through corner + s*horizontal - t*vertical (corner is the top-left of the focus
  * plane). Orthographic: the ray starts at corner + s*horizontal - t*vertical (a
  * rectangle through the camera centre) and goes along `forward`. */
+/* A moving camera (motion_keys > 0, docs/motion.md) is prepared in its own space, the
+ * frame of its first key: each path draws a time in [shutter_open, shutter_close] and
+ * its ray is carried to the world by the camera's transform at that time, interpolated
+ * between motion_keys MotionKey records from motion_first on (kernels/geom/motion.h).
+ * A still camera (motion_keys 0, the shutter unread) is prepared in the world. */
 typedef struct {                                        /* 112 bytes */
     vec3 origin;      float lens_radius;
     vec3 corner;      uint type;
-    vec3 horizontal;  float pad0;
-    vec3 vertical;    float pad1;
-    vec3 lens_u;      float pad2;   /* unit vectors spanning the lens plane */
-    vec3 lens_v;      float pad3;
+    vec3 horizontal;  float shutter_open;
+    vec3 vertical;    float shutter_close;
+    vec3 lens_u;      uint motion_first;  /* unit vectors spanning the lens plane; the
+                                           * camera's first key in motion_keys[] */
+    vec3 lens_v;      uint motion_keys;   /* its keys; 0: the camera does not move */
     vec3 forward;     float pad4;   /* unit view direction */
 } Camera;
+
+/* One key of an animated transform (kernels/geom/motion.h): the transform at `time`
+ * decomposed as M = T R S, pbrt-v4's AnimatedTransform (PBR 4th ed., 3.10.1, after
+ * Shoemake and Duff, "Matrix Animation and Polar Decomposition", 1992): the
+ * translation T, the rotation R as a unit quaternion (x, y, z, w; the host flips its
+ * sign where that makes the arc to the next key the shorter) and the symmetric stretch
+ * S (its upper triangle: s00 s01 s02 s11 s12 s22). Between two keys T and S are
+ * interpolated linearly and R by slerp. A transform's keys are consecutive records in
+ * increasing time. */
+typedef struct {                                        /* 64 bytes */
+    float time;       vec3 translate;
+    float rotate[4];
+    float stretch[6];
+    float pad0, pad1;
+} MotionKey;
 
 /* Textures (kernels/material/texture.h), in one table; image texels live in one uint array. */
 enum TextureType {
@@ -774,6 +797,9 @@ CLPT_CHECK_SIZE(RevSurface, 48);
 CLPT_CHECK_SIZE(Material, 288);
 CLPT_CHECK_SIZE(Light, 96);
 CLPT_CHECK_SIZE(Camera, 112);
+CLPT_CHECK_SIZE(MotionKey, 64);
+_Static_assert(offsetof(Camera, motion_keys) == 92, "Camera.motion_keys");
+_Static_assert(offsetof(MotionKey, stretch) == 32, "MotionKey.stretch");
 CLPT_CHECK_SIZE(RenderParams, 336);
 CLPT_CHECK_SIZE(PathState, 80);
 CLPT_CHECK_SIZE(Medium, 64);

@@ -493,7 +493,8 @@ static void test_layout(void)
                     offsetof(Medium, sigma_s), offsetof(PathState, medium), offsetof(RenderParams, has_media),
                     offsetof(Material, medium_in), sizeof(GridMedium), offsetof(GridMedium, nx),
                     offsetof(GridMedium, max_density), offsetof(Medium, emission),
-                    offsetof(GridMedium, emission_at) };
+                    offsetof(GridMedium, emission_at), sizeof(MotionKey), offsetof(MotionKey, stretch),
+                    offsetof(Camera, motion_keys) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);
@@ -534,7 +535,7 @@ static void test_raygen(void)
     for (uint i = 0; i < n; i++) {
         PathState cp;
         Ray cr;
-        raygen_path(p, i % npix, first_sample + i / npix, &cp, &cr);
+        raygen_path(p, NULL, i % npix, first_sample + i / npix, &cp, &cr);
         exact += memcmp(&cp, &dp[i], sizeof cp) == 0 && memcmp(&cr, &dr[i], sizeof cr) == 0;
         if (dp[i].pixel != cp.pixel || dp[i].sample != cp.sample || dp[i].rng_key != cp.rng_key ||
             !v3_close(dr[i].o, cr.o, 1e-6f) || !v3_close(dr[i].d, cr.d, 1e-6f) || dq[i] != i)
@@ -608,7 +609,7 @@ static void check_path_kernel(const char *name, uint per_item, const RenderScene
         Ray cr, cs;
         memset(&cs, 0, sizeof cs);
         uint path = first_pixel + i;
-        raygen_path(p, batch_pixel(v, path % npix), first_sample + path / npix, &cp, &cr);
+        raygen_path(p, v->motion_keys, batch_pixel(v, path % npix), first_sample + path / npix, &cp, &cr);
         for (;;) {
             Hit hit = trace_closest_visible(v, cr);
             c_rays++;
@@ -872,7 +873,7 @@ static void test_shade_and_shadow(void)
     Hit *hits = malloc(N * sizeof *hits);
     uint *queue = malloc(N * sizeof *queue);
     for (uint i = 0; i < N; i++) {
-        raygen_path(p, i % (p->width * p->height), i, &ps[i], &rays[i]);
+        raygen_path(p, NULL, i % (p->width * p->height), i, &ps[i], &rays[i]);
         if (i % 2) rays[i] = random_ray();
         ps[i].bounce = i % (p->max_depth + 1);
         ps[i].throughput = vrand(0.05f, 1.0f);
@@ -1007,7 +1008,7 @@ static void test_shade_cubemap(void)
     Hit *hits = calloc(N, sizeof *hits);
     uint *queue = malloc(N * sizeof *queue);
     for (uint i = 0; i < N; i++) {
-        raygen_path(&p, i % (p.width * p.height), i, &ps[i], &rays[i]);
+        raygen_path(&p, NULL, i % (p.width * p.height), i, &ps[i], &rays[i]);
         rays[i] = random_ray();
         ps[i].throughput = vrand(0.05f, 1.0f);
         hits[i].prim = NO_INDEX;

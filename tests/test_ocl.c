@@ -26,7 +26,7 @@
 #include "types.h"
 
 /* Number of values k_layout writes (see kernels/entry.cl). */
-#define LAYOUT_VALUES 56
+#define LAYOUT_VALUES 59
 
 static char tmp_root[256];    /* everything this test writes lives below it */
 static char cache_dir[300];   /* CLPT_CACHE_DIR for the in-process tests */

@@ -525,12 +525,13 @@ static void test_bad_syntax(void)
 {
     check_bad("camera { }\ncam { }\n", ST_INPUT,
               ":2:1: expected a statement (camera, image, background, material, sphere, plane, "
-              "triangle, quad, box, mesh, light, texture, medium, include, object, instance, camera_path), "
+              "triangle, quad, box, mesh, light, texture, medium, include, object, instance, camera_path, "
+              "camera_key), "
               "found 'cam'");
     check_bad("}", ST_INPUT, ":1:1: expected a statement (camera");
     check_bad("camera fov 30", ST_INPUT, ":1:8: expected '{' to open the camera block, found 'fov'");
     check_bad("camera { fromm 1 2 3 }", ST_INPUT,
-              ":1:10: expected a camera key (type, from, at, up, fov, aperture, focus, width, medium) or '}', found 'fromm'");
+              ":1:10: expected a camera key (type, from, at, up, fov, aperture, focus, width, medium, shutter, time) or '}', found 'fromm'");
     check_bad("camera { fov }", ST_INPUT,
               ":1:14: expected a number of degrees in (0, 180) for 'fov', found '}'");
     check_bad("camera {\n  fov 30\n", ST_INPUT,

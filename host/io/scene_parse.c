@@ -20,6 +20,7 @@
 #include "io/reader.h"
 #include "io/texture.h"
 #include "scene/media.h"
+#include "scene/motion.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -52,6 +53,7 @@ static const char *kind_what(const KeySpec *k)
     case VK_MATRIX: return "16 numbers (a 4x4 matrix, row by row)";
     case VK_MEDIUM: return "a medium name or 'none'";
     case VK_NUMBER_LIST: return "'[' and numbers, then ']'";
+    case VK_PAIR: return k->what;
     case VK_NUMBER:
     case VK_UINT:
     case VK_WORD: return k->what;
@@ -106,9 +108,10 @@ static Status read_value(Parser *p, Lexer *lx, const KeySpec *k, Value *v)
             return lex_error_at(lx, &v->value, err, "expected %s, found 0 0 0", what);
         return ST_OK;
     }
+    case VK_PAIR:
     case VK_ROTATE:
     case VK_MATRIX: {
-        int n = k->kind == VK_ROTATE ? 4 : 16;
+        int n = k->kind == VK_PAIR ? 2 : k->kind == VK_ROTATE ? 4 : 16;
         for (int i = 0; i < n; i++) {
             if (i > 0 && (st = lex_next(lx, &t, p->err))) return st;
             if (tok_float(&t, &v->a[i])) return lex_expected(lx, &t, what, err);
@@ -280,7 +283,8 @@ vec3 scene_cross_d(vec3 a, vec3 b, double *length)
 
 /* ------------------------------------------------------------------ statements */
 
-enum { CAM_TYPE, CAM_FROM, CAM_AT, CAM_UP, CAM_FOV, CAM_APERTURE, CAM_FOCUS, CAM_WIDTH, CAM_MEDIUM, CAM_N };
+enum { CAM_TYPE, CAM_FROM, CAM_AT, CAM_UP, CAM_FOV, CAM_APERTURE, CAM_FOCUS, CAM_WIDTH, CAM_MEDIUM, CAM_SHUTTER,
+       CAM_TIME, CAM_N };
 static const KeySpec camera_keys[CAM_N] = {
     [CAM_TYPE] = {"type", VK_WORD, 0, 0, 0, 0, 0, "a camera type (perspective, orthographic)"},
     [CAM_FROM] = {"from", VK_VEC3, 0, 0, 0, 0, 0, NULL},
@@ -291,6 +295,8 @@ static const KeySpec camera_keys[CAM_N] = {
     [CAM_FOCUS] = {"focus", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a distance > 0"},
     [CAM_WIDTH] = {"width", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a width > 0 (scene units)"},
     [CAM_MEDIUM] = {"medium", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
+    [CAM_SHUTTER] = {"shutter", VK_PAIR, 0, 0, 0, 0, 0, "two times, the shutter's opening and closing"},
+    [CAM_TIME] = {"time", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "a time (a number)"},
 };
 
 /* The camera's type, and the keys that belong to the other type refused (a perspective
@@ -317,6 +323,9 @@ static Status camera_type(Parser *p, Lexer *lx, const Token *kw, const Value *v,
     return ST_OK;
 }
 
+static Status check_view(Parser *p, Lexer *lx, const Token *kw, const SceneCamera *c, const Value *vfrom,
+                         const Value *vat, const Value *vup, const Value *vfocus);
+
 static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
 {
     /* a path's first key starts from the camera block's values */
@@ -335,8 +344,25 @@ static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
     if (v[CAM_APERTURE].given) c->aperture = v[CAM_APERTURE].f;
     if (v[CAM_FOCUS].given) c->focus_dist = v[CAM_FOCUS].f;
     if (v[CAM_MEDIUM].given) p->s->camera_medium = (uint)v[CAM_MEDIUM].u;
-    /* blame the key that made the camera invalid, or the block if the defaults did */
-    const Token *view_tok = v[CAM_AT].given ? &v[CAM_AT].key : v[CAM_FROM].given ? &v[CAM_FROM].key : kw;
+    if (v[CAM_SHUTTER].given) {
+        if (!(v[CAM_SHUTTER].a[1] >= v[CAM_SHUTTER].a[0]))
+            return lex_error_at(lx, &v[CAM_SHUTTER].value, p->err, "the shutter closes (%g) before it opens (%g)",
+                                (double)v[CAM_SHUTTER].a[1], (double)v[CAM_SHUTTER].a[0]);
+        c->shutter_open = v[CAM_SHUTTER].a[0];
+        c->shutter_close = v[CAM_SHUTTER].a[1];
+    }
+    /* the pose's time: where the shutter opens unless given */
+    c->time = v[CAM_TIME].given ? v[CAM_TIME].f : c->shutter_open;
+    return check_view(p, lx, kw, c, &v[CAM_FROM], &v[CAM_AT], &v[CAM_UP], v[CAM_FOCUS].given ? &v[CAM_FOCUS] : NULL);
+}
+
+/* A camera's pose (c->from, at, up, from the keys vfrom, vat, vup where given) checked
+ * as a whole: blames the key that made it invalid, or the block kw if the defaults
+ * did. vfocus: the focus key, when given. */
+static Status check_view(Parser *p, Lexer *lx, const Token *kw, const SceneCamera *c, const Value *vfrom,
+                         const Value *vat, const Value *vup, const Value *vfocus)
+{
+    const Token *view_tok = vat->given ? &vat->key : vfrom->given ? &vfrom->key : kw;
     vec3 dir = v3_sub(c->at, c->from);
     double dist = scene_len_d(dir);
     if (!(dist > 0.0))
@@ -347,16 +373,69 @@ static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
     scene_cross_d(dir, c->up, &cl);
     /* sine of the angle between up and the view direction */
     if (!(cl / (dist * scene_len_d(c->up)) > 1e-6))
-        return lex_error_at(lx, v[CAM_UP].given ? &v[CAM_UP].key : view_tok, p->err,
+        return lex_error_at(lx, vup->given ? &vup->key : view_tok, p->err,
                             "camera 'up' is parallel to the view direction (from 'from' to 'at')");
     double focus = camera_focus(c);
     if (c->type == CAMERA_PERSPECTIVE && focus < camera_min_focus(c->from))
-        return lex_error_at(lx, v[CAM_FOCUS].given ? &v[CAM_FOCUS].key : view_tok, p->err,
+        return lex_error_at(lx, vfocus ? &vfocus->key : view_tok, p->err,
                             "the camera's focus distance (%s) %g is too short for single precision "
                             "with a lens at 'from' %g %g %g: at least %g",
-                            v[CAM_FOCUS].given ? "'focus'" : "from 'from' to 'at'", focus,
+                            vfocus ? "'focus'" : "from 'from' to 'at'", focus,
                             (double)c->from.x, (double)c->from.y, (double)c->from.z,
                             camera_min_focus(c->from));
+    return ST_OK;
+}
+
+/* camera_key { time T from ... at ... up ... }: a later pose of the camera (docs/motion.md),
+ * after the camera block and the keys before it in time; what it leaves out is the
+ * pose before it's. */
+enum { CK_TIME, CK_FROM, CK_AT, CK_UP, CK_N };
+static const KeySpec camera_key_keys[CK_N] = {
+    [CK_TIME] = {"time", VK_NUMBER, 1, -INFINITY, INFINITY, 0, 0, "a time (a number)"},
+    [CK_FROM] = {"from", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [CK_AT] = {"at", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [CK_UP] = {"up", VK_DIR, 0, 0, 0, 0, 0, NULL},
+};
+
+static Status parse_camera_key(Parser *p, Lexer *lx, const Token *kw)
+{
+    Value v[CK_N];
+    Scene *s = p->s;
+    if (!p->camera_at)
+        return lex_error_at(lx, kw, p->err, "camera_key before the camera block (a moving camera's keys follow it)");
+    if (s->n_camera_keys + 1 >= MOTION_MAX_KEYS)
+        return lex_error_at(lx, kw, p->err, "more than %u poses of the camera", MOTION_MAX_KEYS);
+    Status st = scene_parse_block(p, lx, kw, 0, "camera_key", camera_key_keys, CK_N, v);
+    if (st) return st;
+    SceneCamera pose = s->camera;
+    float before = s->camera.time;
+    if (s->n_camera_keys) {
+        const SceneCameraKey *last = &s->camera_keys[s->n_camera_keys - 1];
+        pose.from = last->from;
+        pose.at = last->at;
+        pose.up = last->up;
+        before = last->time;
+    }
+    if (!(v[CK_TIME].f > before))
+        return lex_error_at(lx, &v[CK_TIME].value, p->err,
+                            "camera_key time %g is not after the camera's pose before it (time %g): poses are given "
+                            "in increasing time", (double)v[CK_TIME].f, (double)before);
+    if (v[CK_FROM].given) pose.from = v[CK_FROM].v;
+    if (v[CK_AT].given) pose.at = v[CK_AT].v;
+    if (v[CK_UP].given) pose.up = v[CK_UP].v;
+    if ((st = check_view(p, lx, kw, &pose, &v[CK_FROM], &v[CK_AT], &v[CK_UP], NULL))) return st;
+    if (s->n_camera_keys == s->cap_camera_keys) {
+        size_t cap = s->cap_camera_keys ? 2 * s->cap_camera_keys : 4;
+        SceneCameraKey *grown = realloc(s->camera_keys, cap * sizeof *grown);
+        if (!grown) return error_set(p->err, ST_INTERNAL, "out of memory");
+        s->camera_keys = grown;
+        s->cap_camera_keys = cap;
+    }
+    SceneCameraKey *k = &s->camera_keys[s->n_camera_keys++];
+    k->time = v[CK_TIME].f;
+    k->from = pose.from;
+    k->at = pose.at;
+    k->up = pose.up;
     return ST_OK;
 }
 
@@ -541,7 +620,8 @@ static const struct {
     const char *keyword;
     Status (*parse)(Parser *p, Lexer *lx, const Token *kw);
 } statements[] = {
-    {"camera", parse_camera},                 {"image", parse_image},
+    {"camera", parse_camera},                 {"camera_key", parse_camera_key},
+    {"image", parse_image},
     {"background", parse_background},         {"material", scene_parse_material},
     {"sphere", scene_parse_sphere},           {"plane", scene_parse_plane},
     {"triangle", scene_parse_triangle},       {"quad", scene_parse_quad},
@@ -567,7 +647,7 @@ static Status parse_statements(Parser *p, Lexer *lx)
             st = lex_expected(lx, &t,
                               "a statement (camera, image, background, material, sphere, "
                               "plane, triangle, quad, box, mesh, light, texture, medium, include, object, "
-                              "instance, camera_path)", p->err);
+                              "instance, camera_path, camera_key)", p->err);
             break;
         }
         if ((st = statements[i].parse(p, lx, &t))) break;

@@ -32,7 +32,8 @@ typedef enum {
     VK_SCALE,       /* one non-zero float, or three */
     VK_MATRIX,      /* sixteen floats, a 4x4 matrix row by row */
     VK_MEDIUM,      /* a medium name defined before, or none (vacuum): u = 0 or 1 + index */
-    VK_NUMBER_LIST  /* [ numbers ... ]: u of them, in Parser.list from list_at */
+    VK_NUMBER_LIST, /* [ numbers ... ]: u of them, in Parser.list from list_at */
+    VK_PAIR         /* two numbers, in a[0] and a[1] */
 } ValueKind;
 
 /* The most numbers one VK_NUMBER_LIST may hold (a 256^3 density grid): a bound on what

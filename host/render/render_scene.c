@@ -232,7 +232,10 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
      * cube map's conversion) */
     if ((st = scene_pack_texels(s, err))) return st;
     RenderParams *p = &out->ds.params;
-    if ((st = camera_setup(&s->camera, s->image.width, s->image.height, &p->camera, err))) return st;
+    if ((st = camera_setup_moving(s, s->image.width, s->image.height, 0u, &p->camera, &out->motion_keys, err)))
+        return st;
+    out->ds.motion_keys = out->motion_keys;
+    out->ds.n_motion_keys = p->camera.motion_keys;
     if ((st = scene_check_precision(s, err))) return st;
     if ((st = tree_build(s, tree_threads, out, err))) return st;
     p->bg_type = s->bg_type;
@@ -312,6 +315,7 @@ uint render_scene_list_pixels(const uint *mask, size_t n, uint *list)
 void render_scene_free(RenderScene *r)
 {
     free(r->instances);
+    free(r->motion_keys);
     kd_free(&r->kd);
     bvh_free(&r->bvh);
     memset(r, 0, sizeof *r);

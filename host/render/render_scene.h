@@ -22,6 +22,7 @@ typedef struct {
     BvhLevels levels;
     int instanced;        /* the BVH has two levels */
     size_t flattened;     /* --accel kdtree: the instances copied into the world */
+    MotionKey *motion_keys;   /* the moving camera's keys (docs/motion.md), or NULL */
 } RenderScene;
 
 /* The scene's image settings (size, depth, seed) and its tree are taken as they are

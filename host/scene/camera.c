@@ -4,9 +4,11 @@
 #include "scene/camera.h"
 
 #include "base/dvec3.h"
+#include "scene/motion.h"
 #include "util/kmath.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 double camera_min_focus(vec3 from)
@@ -99,5 +101,73 @@ Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *ou
                      from.z - horizontal.z / 2 + vertical.z / 2 - focus * w.z };
 
     camera_fill(out, CAMERA_PERSPECTIVE, from, corner, horizontal, vertical, u, v, w, (float)(desc->aperture * 0.5));
+    return ST_OK;
+}
+
+/* The camera-to-world frame of a pose, as camera_setup spans the image: columns right
+ * (u, flipped for a left-handed frame), v and back (w), and `from`. */
+static Transform camera_frame(const SceneCamera *desc)
+{
+    dvec3 from = dv3_of(desc->from), at = dv3_of(desc->at), up = dv3_of(desc->up);
+    dvec3 w = dv3_norm(dv3_sub(from, at));
+    dvec3 u = dv3_norm(dv3_cross(up, w));
+    dvec3 v = dv3_cross(w, u);
+    if (desc->mirror_x) u = dv3_scale(u, -1.0);
+    Transform t = { { { u.x, v.x, w.x, from.x }, { u.y, v.y, w.y, from.y }, { u.z, v.z, w.z, from.z } } };
+    return t;
+}
+
+/* A world point or vector of the prepared camera carried into the frame f (whose
+ * linear part is orthonormal: its inverse is its transpose); w = 1 for a point. */
+static vec3 camera_local(const Transform *f, vec3 a, double w)
+{
+    double d[3] = { a.x - w * f->m[0][3], a.y - w * f->m[1][3], a.z - w * f->m[2][3] };
+    return v3((float)(f->m[0][0] * d[0] + f->m[1][0] * d[1] + f->m[2][0] * d[2]),
+              (float)(f->m[0][1] * d[0] + f->m[1][1] * d[1] + f->m[2][1] * d[2]),
+              (float)(f->m[0][2] * d[0] + f->m[1][2] * d[1] + f->m[2][2] * d[2]));
+}
+
+Status camera_setup_moving(const Scene *scene, uint width, uint height, uint motion_first, Camera *out,
+                           MotionKey **keys, Error *err)
+{
+    *keys = NULL;
+    const SceneCamera *desc = &scene->camera;
+    Status st = camera_setup(desc, width, height, out, err);
+    if (st || scene->n_camera_keys == 0) return st;
+    size_t n = scene->n_camera_keys + 1;
+    MotionKey *k = calloc(n, sizeof *k);
+    if (!k) return error_set(err, ST_INTERNAL, "out of memory");
+    for (size_t i = 0; i < n; i++) {
+        SceneCamera pose = *desc;
+        if (i > 0) {
+            const SceneCameraKey *ck = &scene->camera_keys[i - 1];
+            pose.from = ck->from;
+            pose.at = ck->at;
+            pose.up = ck->up;
+            pose.time = ck->time;
+            Camera check;
+            if ((st = camera_setup(&pose, width, height, &check, err))) break;
+        }
+        Transform f = camera_frame(&pose);
+        if ((st = motion_key_make(&f, pose.time, &k[i], err))) break;
+    }
+    if (st) {
+        free(k);
+        return st;
+    }
+    motion_keys_shortest_arcs(k, n);
+    Transform f0 = camera_frame(desc);
+    out->origin = camera_local(&f0, out->origin, 1.0);
+    out->corner = camera_local(&f0, out->corner, 1.0);
+    out->horizontal = camera_local(&f0, out->horizontal, 0.0);
+    out->vertical = camera_local(&f0, out->vertical, 0.0);
+    out->lens_u = camera_local(&f0, out->lens_u, 0.0);
+    out->lens_v = camera_local(&f0, out->lens_v, 0.0);
+    out->forward = camera_local(&f0, out->forward, 0.0);
+    out->shutter_open = desc->shutter_open;
+    out->shutter_close = desc->shutter_close;
+    out->motion_first = motion_first;
+    out->motion_keys = (uint)n;
+    *keys = k;
     return ST_OK;
 }

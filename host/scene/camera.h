@@ -9,6 +9,16 @@
  * orthographic view size. */
 Status camera_setup(const SceneCamera *desc, uint width, uint height, Camera *out, Error *err);
 
+/* A moving camera (scene->n_camera_keys > 0, docs/motion.md): *out as camera_setup
+ * makes it but in the camera's own space (the frame of its first pose: from at the
+ * origin, right, up and back along the axes), its shutter, and its keys from
+ * motion_first in *keys (malloc'd, freed by the caller; Camera.motion_keys of them):
+ * each pose's frame, the camera block's then each camera_key's. A still camera gets
+ * camera_setup's camera and no keys (*keys NULL). Fails (ST_INPUT) as camera_setup for
+ * any pose. */
+Status camera_setup_moving(const Scene *scene, uint width, uint height, uint motion_first, Camera *out,
+                           MotionKey **keys, Error *err);
+
 /* The shortest focus distance single precision renders from `from`: the kernels build
  * a ray's direction as a point on the plane in focus minus the eye, in float, so a
  * plane closer than 2^-12 of the eye's largest coordinate loses more than a pixel's

@@ -39,6 +39,8 @@ void scene_init(Scene *s)
     s->env_light = NO_INDEX;
     s->camera.type = CAMERA_PERSPECTIVE;
     s->camera.ortho_height = 1.0f;
+    s->camera.shutter_open = 0.0f;
+    s->camera.shutter_close = 1.0f;
     s->ambient = v3(0.0f, 0.0f, 0.0f);
     s->integrator = INTEGRATOR_PATH;
     s->linear_output = 0;
@@ -55,6 +57,7 @@ void scene_free(Scene *s)
     for (size_t i = 0; i < s->n_material_textures; i++) free(s->material_textures[i]);
     free(s->material_textures);
     free(s->materials);
+    free(s->camera_keys);
     free(s->spheres);
     free(s->sphere_xforms);
     free(s->triangles);

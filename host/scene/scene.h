@@ -30,7 +30,17 @@ typedef struct {
                           * `up` as given (MIT 6.837 Fall 2019), not an orthonormal frame */
     int mirror_x;        /* the image's right is -(view x up): a left-handed camera frame,
                           * as pbrt's LookAt makes (docs/pbrt.md) */
+    float shutter_open, shutter_close;   /* the times a moving scene is seen over
+                                          * (docs/motion.md); 0 and 1 by default */
+    float time;          /* the time of this pose when the camera moves (Scene.camera_keys) */
 } SceneCamera;
+
+/* A later pose of a moving camera (docs/motion.md): where it is at `time`, its other
+ * settings the camera's own. */
+typedef struct {
+    float time;
+    vec3 from, at, up;
+} SceneCameraKey;
 
 /* The tree the kernels find primitives through (host/accel): the 8-wide BVH by default
  * (faster on every bench mesh: bench/RESULTS.md), or the kd-tree. Images differ only
@@ -90,6 +100,9 @@ typedef struct {
     int keep_animation;          /* in: a reader keeps the file's animation (--frames) */
     SceneAnimation *animation;   /* out: that animation, or NULL (scene/animation.h) */
     SceneCamera camera;
+    /* a moving camera's poses after its own (SceneCamera.time), in increasing time;
+     * none for a camera that stands still */
+    SceneCameraKey *camera_keys;  size_t n_camera_keys, cap_camera_keys;
     SceneImage image;
     SceneCrop crop;              /* the window rendered (pbrt's cropwindow, --crop ...);
                                   * CROP_NONE: the whole image */

@@ -25,7 +25,7 @@
  * envmap, one-weekend and mesh scenes. */
 #define PATH_RUN_BODY(STAGE)                                                             \
     uint n_rays = 0u;                                                                    \
-    raygen_path(sc->params, pixel, sample, ps, ray);                                     \
+    raygen_path(sc->params, sc->motion_keys, pixel, sample, ps, ray);                    \
     STAGE(PHASE_RAYGEN);                                                                 \
     Ray first_ray = *ray;                                                                \
     Hit first_hit;                                                                       \

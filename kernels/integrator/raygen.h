@@ -1,11 +1,13 @@
 /*
  * raygen.h — where a path is born: the camera ray through a jittered point of its pixel
  * (box filter), from a point on the thin lens when the aperture is open; or, for an
- * orthographic camera, the parallel ray through that point of the view rectangle.
+ * orthographic camera, the parallel ray through that point of the view rectangle; from a
+ * moving camera, at a time in the shutter (geom/motion.h).
  */
 #ifndef CLPT_RAYGEN_H
 #define CLPT_RAYGEN_H
 
+#include "geom/motion.h"
 #include "sample/rng.h"
 #include "sample/sampling.h"
 
@@ -32,9 +34,10 @@ KFN float params_film_t(GLOBAL const RenderParams *p, uint y, float jy)
     return ((float)y + jy) / (float)(p->crop_top + p->height + p->crop_bottom);
 }
 
-/* The camera ray through film position (s, t) (see Camera in types.h); `key` gives
- * the lens sample when the aperture is open. */
-KFN Ray camera_ray(GLOBAL const RenderParams *p, float s, float t, RngKey key)
+/* The ray through film position (s, t) of the camera as prepared (see Camera in
+ * types.h): in the world, or in a moving camera's own space; `key` gives the lens
+ * sample when the aperture is open. */
+KFN Ray camera_ray_still(GLOBAL const RenderParams *p, float s, float t, RngKey key)
 {
     const Camera cam = p->camera;
     Ray ray;
@@ -58,7 +61,17 @@ KFN Ray camera_ray(GLOBAL const RenderParams *p, float s, float t, RngKey key)
     return ray;
 }
 
-KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
+/* The camera ray through film position (s, t) in the world: a moving camera's
+ * (KF_MOTION, Camera.motion_keys; geom/motion.h) at a time the key draws in the shutter,
+ * from its keys in motion_keys (which a still camera does not read: NULL will do). */
+KFN Ray camera_ray(GLOBAL const RenderParams *p, GLOBAL const MotionKey *motion_keys, float s, float t, RngKey key)
+{
+    Ray ray = camera_ray_still(p, s, t, key);
+    if (KF_HAS(KF_MOTION) && p->camera.motion_keys) ray = camera_ray_at(p, motion_keys, camera_time(p, key), ray);
+    return ray;
+}
+
+KFN void raygen_path(GLOBAL const RenderParams *p, GLOBAL const MotionKey *motion_keys, uint pixel, uint sample,
                      GLOBAL PathState *ps, GLOBAL Ray *ray)
 {
     /* the noise threshold's halves: sample s of the batch is the pixel's sample
@@ -68,7 +81,7 @@ KFN void raygen_path(GLOBAL const RenderParams *p, uint pixel, uint sample,
     RngKey key = rng_key_make(p, params_image_pixel(p, pixel, &x, &y), sample);
     float jx, jy;
     rng_uniform2(key, 0u, DIM_PIXEL_X, &jx, &jy);
-    *ray = camera_ray(p, params_film_s(p, x, jx), params_film_t(p, y, jy), key);
+    *ray = camera_ray(p, motion_keys, params_film_s(p, x, jx), params_film_t(p, y, jy), key);
 
     ps->throughput = v3s(1.0f);
     ps->radiance = v3s(0.0f);

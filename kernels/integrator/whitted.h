@@ -48,7 +48,8 @@ typedef struct {
 /* The camera ray of a pixel sample: through the pixel's centre (strata 0), a uniform
  * point of it (1), or a jittered point of cell (sample mod m^2) of an m x m grid. The
  * lens (and jitter) numbers come from the key of sample + sample_offset. */
-KFN Ray whitted_camera_ray(GLOBAL const RenderParams *p, uint pixel, uint sample, RngKey *key_out)
+KFN Ray whitted_camera_ray(GLOBAL const RenderParams *p, GLOBAL const MotionKey *motion_keys, uint pixel, uint sample,
+                           RngKey *key_out)
 {
     uint x, y;
     RngKey key = rng_key_make(p, params_image_pixel(p, pixel, &x, &y), sample + p->sample_offset);
@@ -63,7 +64,7 @@ KFN Ray whitted_camera_ray(GLOBAL const RenderParams *p, uint pixel, uint sample
         jy = ((float)(cell / m) + rng_uniform(key, 0u, DIM_PIXEL_Y)) / (float)m;
     }
     *key_out = key;
-    return camera_ray(p, params_film_s(p, x, jx), params_film_t(p, y, jy), key);
+    return camera_ray(p, motion_keys, params_film_s(p, x, jx), params_film_t(p, y, jy), key);
 }
 
 /* The refracted direction of unit d at a boundary with normal n facing d's side and
@@ -386,7 +387,7 @@ KFN vec3 whitted_sample(const SceneView *sc, uint pixel, uint sample, uint *rays
     GLOBAL const RenderParams *p = sc->params;
     *rays = 0u;
     RngKey key;
-    Ray r = whitted_camera_ray(p, pixel, sample, &key);
+    Ray r = whitted_camera_ray(p, sc->motion_keys, pixel, sample, &key);
     if (p->integrator == INTEGRATOR_WHITTED) return whitted_radiance(sc, r, key, rays);
     if (p->integrator >= INTEGRATOR_FEATURE_NORMAL) return whitted_feature(sc, r, p->integrator, rays);
     return whitted_aov(sc, r, p->integrator, rays);

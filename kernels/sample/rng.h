@@ -40,6 +40,9 @@ enum RngDim {
     DIM_MEDIUM,                                              /* a medium's channel and
                                                              * free-flight distance
                                                              * (kernels/medium/) */
+    DIM_TIME,                                                /* the path's time in the
+                                                             * shutter (bounce 0; only
+                                                             * scenes that move draw it) */
     RNG_DIMS_PER_BOUNCE = 16
 };
 

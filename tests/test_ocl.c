@@ -740,7 +740,7 @@ static void test_feature_switches_compile_cleanly(void)
 #define MATERIAL_SWITCH_(name, value, bit, traits, lobes) bit,
     static const unsigned switches[] = { 1u << 0, 1u << 1, 1u << 2, 1u << 3, 1u << 4, 1u << 5, 1u << 6, 1u << 7,
                                          1u << 8, 1u << 9, 1u << 10, KF_KDTREE, KF_BVH,
-                                         KF_SPHERES | KF_SPHERE_XFORM, KF_MEDIA, KF_BVH | KF_INSTANCES,
+                                         KF_SPHERES | KF_SPHERE_XFORM, KF_MEDIA, KF_BVH | KF_INSTANCES, KF_MOTION,
                                          MATERIAL_TYPES(MATERIAL_SWITCH_) };
 #undef MATERIAL_SWITCH_
     for (size_t bit = 0; bit < sizeof switches / sizeof switches[0]; bit++) {
@@ -761,7 +761,7 @@ static void test_feature_switches_compile_cleanly(void)
     /* the material types' bits are single bits that no other switch and no other type has */
     unsigned others = KF_PATH | KF_WHITTED | KF_TEXTURES | KF_ALPHA | KF_ENV_MAP | KF_CUBEMAP | KF_REVSURFACE |
                       KF_SPHERES | KF_BOXES | KF_PLANES | KF_DELTA_LIGHTS | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH |
-                      KF_PATH_LANES | KF_SPHERE_XFORM | KF_MEDIA | KF_INSTANCES;
+                      KF_PATH_LANES | KF_SPHERE_XFORM | KF_MEDIA | KF_INSTANCES | KF_MOTION;
     unsigned seen = others;
 #define MATERIAL_BIT_(name, value, bit, traits, lobes) \
     CHECK_MSG(((bit) & ((bit) - 1u)) == 0u && ((bit) & seen) == 0u, "%s: feature bit 0x%x", #name, (bit)); \

@@ -1,0 +1,243 @@
+/*
+ * test_motion.c — motion blur (docs/motion.md): a transform's keys decomposed and
+ * interpolated as pbrt-v4's AnimatedTransform (T R S; translation and stretch linear,
+ * rotation slerp); a moving camera's image against the average of still cameras at
+ * fixed times; a still scene with a shutter unchanged bit for bit; every device and
+ * wave launch giving the scalar device's bits on a moving scene, and after a resume.
+ * Bad input: tests/data/bad/motion-* (test_bad_input.c). Run from the project root.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "harness.h"
+#include "cli_util.h"
+#include "render_util.h"
+#include "scene/motion.h"
+#include "scene/transform.h"
+
+#define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
+
+static CliResult r;
+
+static double max_diff(const Transform *a, const Transform *b)
+{
+    double d = 0.0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++) d = fmax(d, fabs(a->m[i][j] - b->m[i][j]));
+    return d;
+}
+
+/* A key evaluated at its own time is its transform again: rotations, non-uniform
+ * scales, shears and mirrors, to float precision. */
+static void test_key_round_trip(void)
+{
+    Transform r1 = transform_rotate(1, 2, 3, 71), s1 = transform_scale(2, 0.5, 3), t1 = transform_translate(4, -5, 6);
+    Transform shear = transform_identity();
+    shear.m[0][1] = 0.7;
+    Transform mirror = transform_scale(-1, 1, 1);
+    Transform rs = transform_compose(&r1, &s1), cases[5];
+    cases[0] = transform_compose(&t1, &rs);
+    cases[1] = transform_compose(&cases[0], &shear);
+    cases[2] = transform_compose(&cases[0], &mirror);
+    cases[3] = transform_rotate(0, 1, 0, 180);
+    cases[4] = transform_identity();
+    for (int c = 0; c < 5; c++) {
+        MotionKey k;
+        Error err = { 0 };
+        CHECK_MSG(motion_key_make(&cases[c], 0.25f, &k, &err) == ST_OK, "%s", err.msg);
+        Transform back = motion_transform_at(&k, 1, 0.25f);
+        double d = max_diff(&back, &cases[c]);
+        CHECK_MSG(d < 2e-5 * 7.0, "case %d: the key's transform is %g away", c, d);
+    }
+    Transform singular = transform_scale(1, 0, 1);
+    MotionKey k;
+    Error err = { 0 };
+    CHECK(motion_key_make(&singular, 2.0f, &k, &err) == ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "a moving transform's key at time 2 is singular");
+    error_clear(&err);
+}
+
+/* Between two keys: translation and scale linear, rotation by slerp (an angle linear in
+ * time), before the first key the first's, after the last the last's; and the shorter
+ * arc whichever sign the quaternions were given. */
+static void test_interpolation(void)
+{
+    Transform a = transform_identity();
+    Transform r90 = transform_rotate(0, 1, 0, 90), s3 = transform_scale(3, 3, 3), t = transform_translate(2, 0, -4);
+    Transform rs = transform_compose(&r90, &s3), b = transform_compose(&t, &rs);
+    MotionKey k[2];
+    Error err = { 0 };
+    CHECK(motion_key_make(&a, 0.0f, &k[0], &err) == ST_OK);
+    CHECK(motion_key_make(&b, 2.0f, &k[1], &err) == ST_OK);
+    /* the same rotation with the other sign: the shorter arc again after the flip */
+    for (int i = 0; i < 4; i++) k[1].rotate[i] = -k[1].rotate[i];
+    motion_keys_shortest_arcs(k, 2);
+    for (int step = 0; step <= 8; step++) {
+        double u = step / 8.0;
+        Transform got = motion_transform_at(k, 2, (float)(2.0 * u));
+        Transform rot = transform_rotate(0, 1, 0, 90.0 * u), sc = transform_scale(1 + 2 * u, 1 + 2 * u, 1 + 2 * u);
+        Transform tr = transform_translate(2 * u, 0, -4 * u), want_rs = transform_compose(&rot, &sc);
+        Transform want = transform_compose(&tr, &want_rs);
+        double d = max_diff(&got, &want);
+        CHECK_MSG(d < 1e-5, "at u = %g the transform is %g from the expected", u, d);
+    }
+    Transform before = motion_transform_at(k, 2, -5.0f);
+    CHECK(max_diff(&before, &a) < 1e-6);
+    Transform after = motion_transform_at(k, 2, 9.0f);
+    CHECK(max_diff(&after, &b) < 1e-5);
+}
+
+static Status load_text(const char *text, Scene *s, Error *err)
+{
+    scene_init(s);
+    return scene_load_text("motion.scene", text, strlen(text), s, err);
+}
+
+static Status render_text(const char *text, Film *film, Error *err)
+{
+    Scene s;
+    Status st = load_text(text, &s, err);
+    if (!st) st = render_util_run(&s, "scalar", 0, film, err);
+    scene_free(&s);
+    return st;
+}
+
+#define STILL_SCENE                                                                      \
+    "image { width 40 height 30 spp %u depth 3 seed 5 }\n"                              \
+    "background { color 0.5 0.6 0.8 }\n"                                                 \
+    "material floor { type diffuse albedo 0.5 0.5 0.5 }\n"                               \
+    "plane { point 0 0 0 normal 0 1 0 material floor }\n"                                \
+    "sphere { center 0 1 0 radius 1 material { type diffuse albedo 0.8 0.2 0.2 } }\n"     \
+    "sphere { center 1.6 0.5 0.5 radius 0.5 material { type diffuse albedo 0.2 0.8 0.2 } }\n"
+
+/* The camera sweeping from x = -0.8 to 0.8 over the shutter sees, per pixel, the mean
+ * of what still cameras along the sweep see: the moving render against the average of
+ * 8 still renders at the times (k + 1/2) / 8, within noise (8 x 6 pixel blocks), while
+ * the still camera at the sweep's middle is far from it (the test would notice no blur). */
+static void test_moving_camera_is_average_of_still(void)
+{
+    enum { K = 8, SPP_STILL = 64 };
+    char text[2048];
+    Error err = { 0 };
+    Film moving, still;
+    snprintf(text, sizeof text,
+             STILL_SCENE "camera { from -0.8 1.4 6 at -0.8 1 0 fov 35 shutter 0 1 }\n"
+                         "camera_key { time 1 from 0.8 1.4 6 at 0.8 1 0 }\n",
+             (unsigned)(K * SPP_STILL));
+    CHECK_MSG(render_text(text, &moving, &err) == ST_OK, "%s", err.msg);
+    size_t n = (size_t)40 * 30 * 3;
+    float *a = calloc(n, sizeof *a), *avg = calloc(n, sizeof *avg), *mid = calloc(n, sizeof *mid);
+    film_resolve(&moving, a);
+    for (int k = 0; k < K; k++) {
+        double x = -0.8 + 1.6 * (k + 0.5) / K;
+        snprintf(text, sizeof text, STILL_SCENE "camera { from %.9g 1.4 6 at %.9g 1 0 fov 35 }\n", (unsigned)SPP_STILL,
+                 x, x);
+        CHECK_MSG(render_text(text, &still, &err) == ST_OK, "%s", err.msg);
+        float *rgb = calloc(n, sizeof *rgb);
+        film_resolve(&still, rgb);
+        for (size_t i = 0; i < n; i++) avg[i] += rgb[i] / K;
+        if (k == K / 2) memcpy(mid, rgb, n * sizeof *mid);
+        free(rgb);
+        film_free(&still);
+    }
+    /* block means: 8 x 6 pixel blocks (48 samples of 512 each) */
+    double worst = 0.0, worst_mid = 0.0;
+    for (int by = 0; by < 5; by++)
+        for (int bx = 0; bx < 5; bx++)
+            for (int c = 0; c < 3; c++) {
+                double sa = 0, sb = 0, sm = 0;
+                for (int y = by * 6; y < by * 6 + 6; y++)
+                    for (int x = bx * 8; x < bx * 8 + 8; x++) {
+                        size_t i = ((size_t)y * 40 + x) * 3 + c;
+                        sa += a[i];
+                        sb += avg[i];
+                        sm += mid[i];
+                    }
+                worst = fmax(worst, fabs(sa - sb) / fmax(sb, 1e-3));
+                worst_mid = fmax(worst_mid, fabs(sa - sm) / fmax(sb, 1e-3));
+            }
+    fprintf(stderr, "  blocks: moving against the average of still cameras %.2f%%, against the middle one %.2f%%\n",
+            100.0 * worst, 100.0 * worst_mid);
+    CHECK(worst < 0.02);
+    CHECK(worst_mid > 0.1);
+    free(a);
+    free(avg);
+    free(mid);
+    film_free(&moving);
+}
+
+/* A shutter without keys moves nothing: the same bits as the scene without it. */
+static void test_still_with_shutter_same_bits(void)
+{
+    char with[2048], without[2048];
+    snprintf(with, sizeof with, STILL_SCENE "camera { from 0 1.4 6 at 0 1 0 fov 35 shutter 0.2 0.7 }\n", 8u);
+    snprintf(without, sizeof without, STILL_SCENE "camera { from 0 1.4 6 at 0 1 0 fov 35 }\n", 8u);
+    Film a, b;
+    Error err = { 0 };
+    CHECK_MSG(render_text(with, &a, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_text(without, &b, &err) == ST_OK, "%s", err.msg);
+    size_t n = (size_t)a.width * a.height * 3u;
+    CHECK(film_sums_same(&a, &b) == n);
+    film_free(&a);
+    film_free(&b);
+}
+
+/* Every wave launch of the OpenCL device, and the classic ray tracer's kernel, give
+ * the scalar device's bits on the moving camera. */
+static void test_devices_match_scalar(void)
+{
+    const char *scene = "tests/data/motion/camera.scene";
+    const char *ref = "/tmp/clpt-test-motion-scalar.pfm", *out = "/tmp/clpt-test-motion-ocl.pfm";
+    const char *modes[] = { "counted", "bounded", "megakernel" };
+    cli_run(ARGS(scene, "--device", "scalar", "-q", "-o", ref), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    for (int i = 0; i < 3; i++) {
+        cli_run(ARGS(scene, "--device", TEST_OPENCL, "--wave-launch", modes[i], "--wave-paths", "1000", "--batch", "2",
+                     "-q", "-o", out), &r);
+        CHECK_MSG(r.status == 0, "%s: %s", modes[i], r.err);
+        CHECK_MSG(files_equal(ref, out), "--wave-launch %s: the image differs from the scalar device's", modes[i]);
+    }
+    cli_run(ARGS(scene, "--device", "scalar", "--integrator", "whitted", "-q", "-o", ref), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS(scene, "--device", TEST_OPENCL, "--integrator", "whitted", "-q", "-o", out), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_MSG(files_equal(ref, out), "whitted: the image differs from the scalar device's");
+    unlink(ref);
+    unlink(out);
+}
+
+/* Checkpointed at 4 samples and resumed to 8 on the OpenCL and scalar devices together:
+ * the straight 8-sample render bit for bit. */
+static void test_resume_matches_straight(void)
+{
+    const char *scene = "tests/data/motion/camera.scene";
+    const char *ref = "/tmp/clpt-test-motion-ref.pfm", *out = "/tmp/clpt-test-motion-out.pfm",
+               *ck = "/tmp/clpt-test-motion.ckpt";
+    unlink(ck);
+    cli_run(ARGS(scene, "--device", "scalar", "--spp", "8", "-q", "-o", ref), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS(scene, "--device", TEST_OPENCL, "--spp", "4", "-q", "-o", out, "--checkpoint", ck), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    char both[32];
+    snprintf(both, sizeof both, "%s,scalar", TEST_OPENCL);
+    cli_run(ARGS(scene, "--device", both, "--spp", "8", "--batch", "1", "-q", "-o", out, "--resume", ck), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_MSG(files_equal(ref, out), "4 samples resumed to 8 differ from a straight 8-sample render");
+    unlink(ref);
+    unlink(out);
+    unlink(ck);
+}
+
+int main(void)
+{
+    RUN(test_key_round_trip);
+    RUN(test_interpolation);
+    RUN(test_moving_camera_is_average_of_still);
+    RUN(test_still_with_shutter_same_bits);
+    RUN(test_devices_match_scalar);
+    RUN(test_resume_matches_straight);
+    return harness_report();
+}

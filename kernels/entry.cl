@@ -62,6 +62,14 @@
 #define KERNEL_SIZE_LANES
 #endif
 
+/* The view sc at path state ps's time (motion blur: SceneView.time); nothing without
+ * KF_MOTION. */
+#if KF_HAS(KF_MOTION)
+#define SCENE_VIEW_AT_TIME(sc, ps) sc.time = (ps).time
+#else
+#define SCENE_VIEW_AT_TIME(sc, ps)
+#endif
+
 #if KF_HAS(KF_PATH)
 /* Births the wave's paths and queues them all: path i of the wave is path number
  * first_pixel + i of the batch (see the top of this file). */
@@ -80,12 +88,13 @@ __kernel KERNEL_SIZE void k_raygen(SCENE_ARGS uint first_pixel, uint first_sampl
 /* Closest hit for every queued path. */
 __kernel KERNEL_SIZE void k_intersect(SCENE_ARGS __global const uint *queue, uint n,
                           __global const Ray *rays, __global Hit *hits,
-                          __global const uint *counts, uint live_slot)
+                          __global const uint *counts, uint live_slot, __global const PathState *paths)
 {
     uint i = (uint)get_global_id(0);
     if (i >= n || i >= counts[live_slot * QUEUE_COUNT_STRIDE]) return;
     SCENE_VIEW(sc);
     uint path = queue[i];
+    SCENE_VIEW_AT_TIME(sc, paths[path]);
     hits[path] = trace_closest_visible(&sc, rays[path]);
 }
 
@@ -113,6 +122,7 @@ __kernel KERNEL_SIZE void k_shade(SCENE_ARGS __global const uint *queue, uint n,
     if (i < n && i < counts[(slot - 1u) * QUEUE_COUNT_STRIDE]) {
         SCENE_VIEW(sc);
         path = queue[i];
+        SCENE_VIEW_AT_TIME(sc, paths[path]);
         r = shade_path(&sc, &rays[path], hits[path], &paths[path], &shadow_rays[path]);
     }
     uint slot_next = 0u, slot_shadow = 0u;
@@ -137,6 +147,7 @@ __kernel KERNEL_SIZE void k_shadow(SCENE_ARGS __global const uint *shadow_queue,
     if (i >= n || i >= counts[live_slot * QUEUE_COUNT_STRIDE]) return;
     SCENE_VIEW(sc);
     uint path = shadow_queue[i];
+    SCENE_VIEW_AT_TIME(sc, paths[path]);
     shadow_trace(&sc, &paths[path], shadow_rays[path]);   /* through media too */
 }
 

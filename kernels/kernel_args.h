@@ -17,6 +17,7 @@
 #define SCENE_VIEW_SET_(kind, Type, name, count, what) sc.name = name;
 #define SCENE_VIEW(sc)                                                                   \
     SceneView sc;                                                                        \
-    SCENE_BUFFERS(SCENE_VIEW_SET_)
+    SCENE_BUFFERS(SCENE_VIEW_SET_)                                                       \
+    sc.time = 0.0f;
 
 #endif /* CLPT_KERNEL_ARGS_H */

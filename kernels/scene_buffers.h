@@ -64,7 +64,9 @@
     X(MANY, GridMedium,   grids,      (ds)->params.n_grids,      "density grids")          \
     X(MANY, float,        grid_data,  (ds)->n_grid_data,         "density grid values")    \
     /* the keys of moving transforms (MotionKey; the camera's: Camera.motion_first) */     \
-    X(MANY, MotionKey,    motion_keys, (ds)->n_motion_keys,      "motion keys")
+    X(MANY, MotionKey,    motion_keys, (ds)->n_motion_keys,      "motion keys")            \
+    /* per instance, its first key when it moves (INST_MOTION); none when none moves */    \
+    X(MANY, uint,         instance_motion, (ds)->n_instance_motion, "instance motion")
 
 /* Each buffer's position: SCENE_BUF_nodes ... The scene buffers are the first
  * SCENE_BUF_COUNT arguments of every kernel that takes SCENE_ARGS, in this order. */

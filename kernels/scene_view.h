@@ -2,7 +2,8 @@
  * scene_view.h — the scene as the kernel stage functions see it: device pointers to
  * every scene buffer of scene_buffers.h, gathered into one private struct by each
  * __kernel wrapper (SCENE_VIEW in entry.cl) or by the scalar C device
- * (device_scene_view), and passed by pointer to the stage functions.
+ * (device_scene_view), and passed by pointer to the stage functions; and the time the
+ * path it serves sees the scene at (motion blur).
  */
 #ifndef CLPT_SCENE_VIEW_H
 #define CLPT_SCENE_VIEW_H
@@ -13,6 +14,10 @@
 #define SCENE_VIEW_FIELD_(kind, Type, name, count, what) GLOBAL const Type *name;
 typedef struct {
     SCENE_BUFFERS(SCENE_VIEW_FIELD_)
+    /* the time the scene is seen at: a path's (PathState.time), set by the stage that
+     * runs the path where the scene moves (Camera.moving, docs/motion.md), so that its
+     * rays walk moving instances where they are then; 0 otherwise */
+    float time;
 } SceneView;
 #undef SCENE_VIEW_FIELD_
 

@@ -56,8 +56,8 @@
 #define KF_MEDIA 0x2000000u     /* participating media or their boundaries (kernels/medium/,
                                  * RenderParams.has_media; docs/media.md) */
 #define KF_INSTANCES 0x10000000u /* instances of objects: the BVH's two levels (Instance) */
-#define KF_MOTION 0x40000000u   /* motion blur: a moving camera (Camera.motion_keys,
-                                 * MotionKey; docs/motion.md) */
+#define KF_MOTION 0x40000000u   /* motion blur: a moving camera or moving instances
+                                 * (Camera.moving, MotionKey; docs/motion.md) */
 /* every bit above and every material type's */
 #define KF_ALL (KF_PATH | KF_WHITTED | KF_TEXTURES | KF_ALPHA | KF_ENV_MAP | KF_CUBEMAP | KF_REVSURFACE | \
                 KF_SPHERES | KF_BOXES | KF_PLANES | KF_DELTA_LIGHTS | KF_PATH_MEGAKERNEL | KF_KDTREE | KF_BVH | \
@@ -244,6 +244,10 @@ typedef struct {                                        /* 256 bytes */
 #define INST_MIRROR 2u     /* det M < 0 (the host's: normals by M^-T keep their sides) */
 #define INST_WORLD 4u      /* the world's own primitives under the top level: hits carry
                             * inst NO_INDEX, as in a scene without instances */
+#define INST_MOTION 8u     /* M moves over the shutter (KF_MOTION, docs/motion.md): its keys
+                            * start at motion_keys[instance_motion[i]], and M and M^-1
+                            * are those at the path's time (geom/instance.h); to_world and
+                            * to_object hold its first key's pose, for the host */
 typedef struct {                                        /* 112 bytes */
     float to_world[12];       /* M: object -> world */
     float to_object[12];      /* M^-1: world -> object */
@@ -540,7 +544,9 @@ typedef struct {                                        /* 112 bytes */
     vec3 lens_u;      uint motion_first;  /* unit vectors spanning the lens plane; the
                                            * camera's first key in motion_keys[] */
     vec3 lens_v;      uint motion_keys;   /* its keys; 0: the camera does not move */
-    vec3 forward;     float pad4;   /* unit view direction */
+    vec3 forward;     uint moving;  /* unit view direction; moving: 1 when anything in
+                                     * the scene moves (the camera or an instance):
+                                     * each path draws its time (PathState.time) */
 } Camera;
 
 /* One key of an animated transform (kernels/geom/motion.h): the transform at `time`
@@ -555,7 +561,8 @@ typedef struct {                                        /* 64 bytes */
     float time;       vec3 translate;
     float rotate[4];
     float stretch[6];
-    float pad0, pad1;
+    uint count;       /* the keys of its transform (the same in each of them) */
+    float pad1;
 } MotionKey;
 
 /* Textures (kernels/material/texture.h), in one table; image texels live in one uint array. */
@@ -755,7 +762,9 @@ typedef struct {                                        /* 80 bytes */
                                        * (MAT_INTERFACE): the random numbers of a bounce
                                        * are those of bounce + crossings, so the segment
                                        * after a boundary draws fresh ones */
-    uint pad_medium;
+    float time;                       /* the path's time in the shutter (Camera.moving;
+                                       * else 0): every ray of the path sees the scene
+                                       * then (SceneView.time) */
 } PathState;
 
 #define PATH_SPECULAR 1u      /* last bounce was a delta lobe: no MIS on emission */
@@ -799,6 +808,7 @@ CLPT_CHECK_SIZE(Light, 96);
 CLPT_CHECK_SIZE(Camera, 112);
 CLPT_CHECK_SIZE(MotionKey, 64);
 _Static_assert(offsetof(Camera, motion_keys) == 92, "Camera.motion_keys");
+_Static_assert(offsetof(PathState, time) == 76, "PathState.time");
 _Static_assert(offsetof(MotionKey, stretch) == 32, "MotionKey.stretch");
 CLPT_CHECK_SIZE(RenderParams, 336);
 CLPT_CHECK_SIZE(PathState, 80);

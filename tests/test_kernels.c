@@ -730,6 +730,8 @@ static void test_intersect(void)
     SET(k, N_SCENE + 3, hb);
     SET(k, N_SCENE + 4, lcb);
     SET(k, N_SCENE + 5, live_slot);
+    cl_mem pb = buffer(N * sizeof(PathState), NULL);   /* read only where the scene moves */
+    SET(k, N_SCENE + 6, pb);
     run(k, N + 100);
     Hit *dh = malloc(N * sizeof *dh);
     read_back(hb, N * sizeof *dh, dh);
@@ -749,6 +751,7 @@ static void test_intersect(void)
     free(dh);
     clReleaseKernel(k);
     clReleaseMemObject(lcb);
+    clReleaseMemObject(pb);
     clReleaseMemObject(rb);
     clReleaseMemObject(qb);
     clReleaseMemObject(hb);

@@ -1,9 +1,11 @@
 /*
  * test_motion.c — motion blur (docs/motion.md): a transform's keys decomposed and
  * interpolated as pbrt-v4's AnimatedTransform (T R S; translation and stretch linear,
- * rotation slerp); a moving camera's image against the average of still cameras at
- * fixed times; a still scene with a shutter unchanged bit for bit; every device and
- * wave launch giving the scalar device's bits on a moving scene, and after a resume.
+ * rotation slerp); a moving camera's and a moving instance's images against the
+ * average of still ones at fixed times; the top level's box over an instance's motion;
+ * a still scene with a shutter unchanged bit for bit; every device and wave launch
+ * giving the scalar device's bits on moving scenes, and after a resume; the kd-tree's
+ * refusal.
  * Bad input: tests/data/bad/motion-* (test_bad_input.c). Run from the project root.
  */
 #include <math.h>
@@ -17,6 +19,7 @@
 #include "render_util.h"
 #include "scene/motion.h"
 #include "scene/transform.h"
+#include "util/kmath.h"
 
 #define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
 
@@ -169,6 +172,95 @@ static void test_moving_camera_is_average_of_still(void)
     film_free(&moving);
 }
 
+/* A sliding, turning and growing instance seen by a still camera: its image is the
+ * average of still instances at 8 fixed times (its keys' poses interpolated by hand:
+ * the translation and scale linear, the angle about y linear, as slerp about one axis
+ * is), within noise in 8 x 6 pixel blocks; a still instance at the middle time is far
+ * from it. */
+#define INSTANCE_SCENE                                                                   \
+    STILL_SCENE "camera { from 0 1.4 6 at 0 1 0 fov 35 shutter 0 1 }\n"                 \
+                "object thing { sphere { center 0 0 0 radius 0.5 material { type diffuse albedo 0.9 0.9 0.2 } }\n" \
+                "  box { min 0.3 -0.2 -0.2 max 0.9 0.2 0.2 material { type diffuse albedo 0.2 0.2 0.9 } } }\n"
+
+static void test_moving_instance_is_average_of_still(void)
+{
+    enum { K = 8, SPP_STILL = 64 };
+    char text[4096];
+    Error err = { 0 };
+    Film moving, still;
+    snprintf(text, sizeof text,
+             INSTANCE_SCENE "instance thing { translate -1.2 2 0.5 }\n"
+                            "instance_key { time 1 scale 1.5 ry 120 translate 1.2 2.2 0.5 }\n",
+             (unsigned)(K * SPP_STILL));
+    CHECK_MSG(render_text(text, &moving, &err) == ST_OK, "%s", err.msg);
+    size_t n = (size_t)40 * 30 * 3;
+    float *a = calloc(n, sizeof *a), *avg = calloc(n, sizeof *avg), *mid = calloc(n, sizeof *mid);
+    film_resolve(&moving, a);
+    for (int k = 0; k < K; k++) {
+        double u = (k + 0.5) / K;
+        snprintf(text, sizeof text, INSTANCE_SCENE "instance thing { scale %.9g ry %.9g translate %.9g %.9g 0.5 }\n",
+                 (unsigned)SPP_STILL, 1.0 + 0.5 * u, 120.0 * u, -1.2 + 2.4 * u, 2.0 + 0.2 * u);
+        CHECK_MSG(render_text(text, &still, &err) == ST_OK, "%s", err.msg);
+        float *rgb = calloc(n, sizeof *rgb);
+        film_resolve(&still, rgb);
+        for (size_t i = 0; i < n; i++) avg[i] += rgb[i] / K;
+        if (k == K / 2) memcpy(mid, rgb, n * sizeof *mid);
+        free(rgb);
+        film_free(&still);
+    }
+    double worst = 0.0, worst_mid = 0.0;
+    for (int by = 0; by < 5; by++)
+        for (int bx = 0; bx < 5; bx++)
+            for (int c = 0; c < 3; c++) {
+                double sa = 0, sb = 0, sm = 0;
+                for (int y = by * 6; y < by * 6 + 6; y++)
+                    for (int x = bx * 8; x < bx * 8 + 8; x++) {
+                        size_t i = ((size_t)y * 40 + x) * 3 + c;
+                        sa += a[i];
+                        sb += avg[i];
+                        sm += mid[i];
+                    }
+                worst = fmax(worst, fabs(sa - sb) / fmax(sb, 1e-3));
+                worst_mid = fmax(worst_mid, fabs(sa - sm) / fmax(sb, 1e-3));
+            }
+    fprintf(stderr, "  blocks: moving instance against the average of still ones %.2f%%, against the middle one %.2f%%\n",
+            100.0 * worst, 100.0 * worst_mid);
+    CHECK(worst < 0.03);
+    CHECK(worst_mid > 0.1);
+    free(a);
+    free(avg);
+    free(mid);
+    film_free(&moving);
+}
+
+/* motion_bounds holds the box's corners at every time, sampled far more finely than
+ * it samples: a half turn and more between keys, a stretch and a slide. */
+static void test_bounds_hold_the_motion(void)
+{
+    Transform r0 = transform_rotate(0.3, 1, 0.2, 10), r1 = transform_rotate(0.3, 1, 0.2, 185);
+    Transform s1 = transform_scale(2, 0.5, 1), t1 = transform_translate(3, -1, 2), r2 = transform_rotate(1, 0, 0, 90);
+    Transform a = r0, rs = transform_compose(&r1, &s1), b = transform_compose(&t1, &rs), c = r2;
+    MotionKey k[3];
+    Error err = { 0 };
+    CHECK(motion_key_make(&a, 0.0f, &k[0], &err) == ST_OK);
+    CHECK(motion_key_make(&b, 1.0f, &k[1], &err) == ST_OK);
+    CHECK(motion_key_make(&c, 3.0f, &k[2], &err) == ST_OK);
+    motion_keys_shortest_arcs(k, 3);
+    double lo[3] = { -1, -0.5, -2 }, hi[3] = { 2, 0.5, 1 }, wl[3], wh[3];
+    motion_bounds(k, 3, lo, hi, wl, wh);
+    int outside = 0;
+    for (int i = 0; i <= 30000; i++) {
+        Transform m = motion_transform_at(k, 3, (float)(3.0 * i / 30000.0));
+        for (int corner = 0; corner < 8; corner++) {
+            vec3 p = transform_point(&m, v3((float)((corner & 1) ? hi[0] : lo[0]), (float)((corner & 2) ? hi[1] : lo[1]),
+                                            (float)((corner & 4) ? hi[2] : lo[2])));
+            double w[3] = { p.x, p.y, p.z };
+            for (int q = 0; q < 3; q++) outside += !(w[q] >= wl[q] && w[q] <= wh[q]);
+        }
+    }
+    CHECK_EQ_INT(outside, 0);
+}
+
 /* A shutter without keys moves nothing: the same bits as the scene without it. */
 static void test_still_with_shutter_same_bits(void)
 {
@@ -186,34 +278,48 @@ static void test_still_with_shutter_same_bits(void)
 }
 
 /* Every wave launch of the OpenCL device, and the classic ray tracer's kernel, give
- * the scalar device's bits on the moving camera. */
+ * the scalar device's bits on the moving camera and on moving instances. */
 static void test_devices_match_scalar(void)
 {
-    const char *scene = "tests/data/motion/camera.scene";
+    const char *scenes[] = { "tests/data/motion/camera.scene", "tests/data/motion/instances.scene" };
     const char *ref = "/tmp/clpt-test-motion-scalar.pfm", *out = "/tmp/clpt-test-motion-ocl.pfm";
     const char *modes[] = { "counted", "bounded", "megakernel" };
-    cli_run(ARGS(scene, "--device", "scalar", "-q", "-o", ref), &r);
-    CHECK_MSG(r.status == 0, "%s", r.err);
-    for (int i = 0; i < 3; i++) {
-        cli_run(ARGS(scene, "--device", TEST_OPENCL, "--wave-launch", modes[i], "--wave-paths", "1000", "--batch", "2",
-                     "-q", "-o", out), &r);
-        CHECK_MSG(r.status == 0, "%s: %s", modes[i], r.err);
-        CHECK_MSG(files_equal(ref, out), "--wave-launch %s: the image differs from the scalar device's", modes[i]);
+    for (int k = 0; k < 2; k++) {
+        const char *scene = scenes[k];
+        cli_run(ARGS(scene, "--device", "scalar", "-q", "-o", ref), &r);
+        CHECK_MSG(r.status == 0, "%s", r.err);
+        for (int i = 0; i < 3; i++) {
+            cli_run(ARGS(scene, "--device", TEST_OPENCL, "--wave-launch", modes[i], "--wave-paths", "1000", "--batch",
+                         "2", "-q", "-o", out), &r);
+            CHECK_MSG(r.status == 0, "%s: %s", modes[i], r.err);
+            CHECK_MSG(files_equal(ref, out), "%s, --wave-launch %s: the image differs from the scalar device's", scene,
+                      modes[i]);
+        }
+        cli_run(ARGS(scene, "--device", "scalar", "--integrator", "whitted", "-q", "-o", ref), &r);
+        CHECK_MSG(r.status == 0, "%s", r.err);
+        cli_run(ARGS(scene, "--device", TEST_OPENCL, "--integrator", "whitted", "-q", "-o", out), &r);
+        CHECK_MSG(r.status == 0, "%s", r.err);
+        CHECK_MSG(files_equal(ref, out), "%s, whitted: the image differs from the scalar device's", scene);
     }
-    cli_run(ARGS(scene, "--device", "scalar", "--integrator", "whitted", "-q", "-o", ref), &r);
-    CHECK_MSG(r.status == 0, "%s", r.err);
-    cli_run(ARGS(scene, "--device", TEST_OPENCL, "--integrator", "whitted", "-q", "-o", out), &r);
-    CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK_MSG(files_equal(ref, out), "whitted: the image differs from the scalar device's");
     unlink(ref);
     unlink(out);
+}
+
+/* The kd-tree takes instances as copies, which cannot move: refused, naming the way. */
+static void test_kdtree_refuses_moving_instances(void)
+{
+    cli_run(ARGS("tests/data/motion/instances.scene", "--device", "scalar", "--accel", "kdtree", "-q", "-o",
+                 "/tmp/clpt-test-motion-kd.pfm"), &r);
+    CHECK_EQ_INT(r.status, 3);
+    CHECK_STR_CONTAINS(r.err, "--accel kdtree takes instances as copies, which cannot move: render a scene with "
+                              "moving instances with --accel bvh (the default)");
 }
 
 /* Checkpointed at 4 samples and resumed to 8 on the OpenCL and scalar devices together:
  * the straight 8-sample render bit for bit. */
 static void test_resume_matches_straight(void)
 {
-    const char *scene = "tests/data/motion/camera.scene";
+    const char *scene = "tests/data/motion/instances.scene";
     const char *ref = "/tmp/clpt-test-motion-ref.pfm", *out = "/tmp/clpt-test-motion-out.pfm",
                *ck = "/tmp/clpt-test-motion.ckpt";
     unlink(ck);
@@ -236,8 +342,11 @@ int main(void)
     RUN(test_key_round_trip);
     RUN(test_interpolation);
     RUN(test_moving_camera_is_average_of_still);
+    RUN(test_moving_instance_is_average_of_still);
+    RUN(test_bounds_hold_the_motion);
     RUN(test_still_with_shutter_same_bits);
     RUN(test_devices_match_scalar);
+    RUN(test_kdtree_refuses_moving_instances);
     RUN(test_resume_matches_straight);
     return harness_report();
 }

@@ -615,6 +615,7 @@ static void test_kernel_argument_names(void)
         { "k_intersect", ARG_INTERSECT_QUEUE, "queue" }, { "k_intersect", ARG_INTERSECT_N, "n" },
         { "k_intersect", ARG_INTERSECT_RAYS, "rays" }, { "k_intersect", ARG_INTERSECT_HITS, "hits" },
         { "k_intersect", ARG_INTERSECT_COUNTS, "counts" }, { "k_intersect", ARG_INTERSECT_LIVE_SLOT, "live_slot" },
+        { "k_intersect", ARG_INTERSECT_PATHS, "paths" },
         { "k_shade", ARG_SHADE_QUEUE, "queue" }, { "k_shade", ARG_SHADE_N, "n" },
         { "k_shade", ARG_SHADE_RAYS, "rays" }, { "k_shade", ARG_SHADE_HITS, "hits" },
         { "k_shade", ARG_SHADE_PATHS, "paths" }, { "k_shade", ARG_SHADE_SHADOW_RAYS, "shadow_rays" },

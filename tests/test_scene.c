@@ -526,7 +526,7 @@ static void test_bad_syntax(void)
     check_bad("camera { }\ncam { }\n", ST_INPUT,
               ":2:1: expected a statement (camera, image, background, material, sphere, plane, "
               "triangle, quad, box, mesh, light, texture, medium, include, object, instance, camera_path, "
-              "camera_key), "
+              "camera_key, instance_key), "
               "found 'cam'");
     check_bad("}", ST_INPUT, ":1:1: expected a statement (camera");
     check_bad("camera fov 30", ST_INPUT, ":1:8: expected '{' to open the camera block, found 'fov'");

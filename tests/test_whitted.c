@@ -608,14 +608,15 @@ static void test_pixel_sampling(void)
     p.camera.vertical = v3(0.0f, 10.0f, 0.0f);
     p.camera.forward = v3(0.0f, 0.0f, -1.0f);
     RngKey key;
-    Ray r = whitted_camera_ray(&p, NULL, 34, 0, &key);   /* pixel (4, 3) */
+    float wtime;
+    Ray r = whitted_camera_ray(&p, NULL, 34, 0, &key, &wtime);   /* pixel (4, 3) */
     CHECK(r.o.x == 4.5f && r.o.y == -3.5f);
-    r = whitted_camera_ray(&p, NULL, 34, 7, &key);
+    r = whitted_camera_ray(&p, NULL, 34, 7, &key, &wtime);
     CHECK(r.o.x == 4.5f && r.o.y == -3.5f);        /* every sample, without jitter */
     p.strata = 2;
     int cells[4] = { 0, 0, 0, 0 };
     for (uint sm = 0; sm < 4; sm++) {
-        r = whitted_camera_ray(&p, NULL, 34, sm, &key);
+        r = whitted_camera_ray(&p, NULL, 34, sm, &key, &wtime);
         float fx = r.o.x - 4.0f, fy = -r.o.y - 3.0f;
         CHECK(fx > 0.0f && fx < 1.0f && fy > 0.0f && fy < 1.0f);
         cells[(fx >= 0.5f) + 2 * (fy >= 0.5f)]++;

@@ -17,6 +17,7 @@
 
 #include "base/pages.h"
 #include "base/timer.h"
+#include "scene/motion.h"
 
 /* The box of a prototype's primitives (lo > hi when it has none with finite bounds). */
 static void proto_bounds(const KdInput *in, const BvhProto *p, double lo[3], double hi[3])
@@ -39,8 +40,10 @@ static void proto_bounds(const KdInput *in, const BvhProto *p, double lo[3], dou
 /* The world box of instance x over a prototype box: its eight corners under M, in
  * double, widened by 2^-18 of the box's size and position so that the float rounding
  * of the walk's object-space ray (instance.h) cannot put a hit outside it. Written as
- * an empty box (lo > hi) for an empty prototype. */
-static void instance_box(const Instance *x, const double lo[3], const double hi[3], float out[6])
+ * an empty box (lo > hi) for an empty prototype. A moving instance (keys, its first
+ * key, not NULL): the box of motion_bounds, widened as well. */
+static void instance_box(const Instance *x, const MotionKey *keys, const double lo[3], const double hi[3],
+                         float out[6])
 {
     double wl[3] = { INFINITY, INFINITY, INFINITY }, wh[3] = { -INFINITY, -INFINITY, -INFINITY };
     if (!(lo[0] <= hi[0])) {
@@ -50,7 +53,8 @@ static void instance_box(const Instance *x, const double lo[3], const double hi[
         }
         return;
     }
-    for (int c = 0; c < 8; c++) {
+    if (keys) motion_bounds(keys, keys->count, lo, hi, wl, wh);   /* a moving instance */
+    for (int c = 0; c < 8 && !keys; c++) {
         double p[3] = { (c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2] };
         for (int k = 0; k < 3; k++) {
             const float *m = x->to_world + 4 * k;
@@ -86,7 +90,7 @@ static void append_tree(const Bvh *t, Bvh *out, uint node_at, uint word_at)
 /* The top level over the instances' world boxes (built first: its depth sets the
  * prototypes' budget). */
 static Status build_top(const KdInput *in, const BvhProto *protos, size_t n_protos, const Instance *inst,
-                        size_t n_inst, int threads, Bvh *top, BvhLevels *lv, Error *err)
+                        size_t n_inst, const BvhMotion *motion, int threads, Bvh *top, BvhLevels *lv, Error *err)
 {
     double (*pb)[6] = malloc((n_protos + 1) * sizeof *pb);
     float *boxes = malloc((n_inst + 1) * 6 * sizeof *boxes);
@@ -97,7 +101,10 @@ static Status build_top(const KdInput *in, const BvhProto *protos, size_t n_prot
     }
     for (size_t p = 0; p < n_protos; p++) proto_bounds(in, &protos[p], pb[p], pb[p] + 3);
     for (size_t i = 0; i < n_inst; i++) {
-        instance_box(&inst[i], pb[inst[i].object], pb[inst[i].object] + 3, boxes + 6 * i);
+        const MotionKey *keys = motion && motion->inst_motion && motion->inst_motion[i] != NO_INDEX
+                                    ? motion->keys + motion->inst_motion[i]
+                                    : NULL;
+        instance_box(&inst[i], keys, pb[inst[i].object], pb[inst[i].object] + 3, boxes + 6 * i);
         lv->n_inst_skipped += !(boxes[6 * i] <= boxes[6 * i + 3]);
     }
     BvhOptions opt = { BVH_TOP_STACK, boxes, (uint)n_inst };
@@ -108,13 +115,13 @@ static Status build_top(const KdInput *in, const BvhProto *protos, size_t n_prot
 }
 
 Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_protos, Instance *inst, size_t n_inst,
-                           int threads, Bvh *out, BvhLevels *lv, Error *err)
+                           const BvhMotion *motion, int threads, Bvh *out, BvhLevels *lv, Error *err)
 {
     double t0 = timer_now();
     memset(out, 0, sizeof *out);
     memset(lv, 0, sizeof *lv);
     Bvh top;
-    Status st = build_top(in, protos, n_protos, inst, n_inst, threads, &top, lv, err);
+    Status st = build_top(in, protos, n_protos, inst, n_inst, motion, threads, &top, lv, err);
     if (st) return st;
     Bvh *pt = calloc(n_protos + 1, sizeof *pt);
     uint8_t *used = calloc(n_protos + 1, 1);

@@ -32,11 +32,20 @@ typedef struct {
     uint n_inst_skipped;           /* instances of an empty prototype, left out */
 } BvhLevels;
 
+/* Where moving instances' keys are (docs/motion.md): instance i moves when
+ * inst_motion is not NULL and inst_motion[i] is not NO_INDEX, its keys from
+ * keys[inst_motion[i]] (MotionKey.count of them). */
+typedef struct {
+    const uint *inst_motion;
+    const MotionKey *keys;
+} BvhMotion;
+
 /* Builds the prototypes protos[0 .. n_protos) and the top level over inst[0 .. n_inst)
- * (Instance.object: the prototype's index), filling each instance's root. On success
- * *out owns one node array and one leaf array (bvh_free); out->lo, hi bound the world.
- * Threads: 0 = all cores. */
+ * (Instance.object: the prototype's index), filling each instance's root. A moving
+ * instance's box bounds it over all its keys' times (motion_bounds, scene/motion.h).
+ * On success *out owns one node array and one leaf array (bvh_free); out->lo, hi bound
+ * the world. Threads: 0 = all cores. */
 Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_protos, Instance *inst, size_t n_inst,
-                           int threads, Bvh *out, BvhLevels *lv, Error *err);
+                           const BvhMotion *motion, int threads, Bvh *out, BvhLevels *lv, Error *err);
 
 #endif /* CLPT_BVH_INST_H */

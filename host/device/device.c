@@ -273,6 +273,7 @@ void device_scene_view(const DeviceScene *ds, SceneView *view)
 #define SCENE_VIEW_SET_(kind, Type, name, count, what) view->name = (const Type *)SCENE_DATA_##kind##_(ds, name);
     SCENE_BUFFERS(SCENE_VIEW_SET_)
 #undef SCENE_VIEW_SET_
+    view->time = 0.0f;
 }
 /* No device of the default choice could be used: warns, and replaces *chosen with the
  * next group of the default order; 0 when none is left. */

@@ -54,7 +54,8 @@ typedef struct {
     size_t n_env_cdf;
     size_t n_bvh_leaves;        /* words of the BVH's leaf records */
     size_t n_grid_data;         /* floats of the density grids and their majorants */
-    uint n_motion_keys;         /* keys of moving transforms (the camera's), else 0 */
+    uint n_motion_keys;         /* keys of moving transforms (instances', the camera's) */
+    uint n_instance_motion;     /* the device's instances when any moves, else 0 */
 } DeviceScene;
 #undef DEVICE_SCENE_FIELD_
 #undef DEVICE_SCENE_FIELD_MANY_

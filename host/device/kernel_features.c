@@ -33,7 +33,7 @@ unsigned kernel_scene_features(const DeviceScene *s)
     f |= (p->n_spheres ? KF_SPHERES : 0u) | (p->n_boxes ? KF_BOXES : 0u) | (p->n_planes ? KF_PLANES : 0u) |
          (p->n_revsurfaces ? KF_REVSURFACE : 0u) | (p->n_bvh_nodes ? KF_BVH : KF_KDTREE) |
          (s->n_sphere_xforms ? KF_SPHERE_XFORM : 0u) | (p->n_instances ? KF_INSTANCES : 0u) |
-         (p->camera.motion_keys ? KF_MOTION : 0u);
+         (p->camera.moving ? KF_MOTION : 0u);
     return f;
 }
 

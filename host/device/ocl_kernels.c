@@ -56,6 +56,7 @@ static Status set_fixed_args(OclDevice *od, WaveSlot *w, Error *err)
     ARG(k, ARG_INTERSECT_RAYS, w->rays);
     ARG(k, ARG_INTERSECT_HITS, w->hits);
     ARG(k, ARG_INTERSECT_COUNTS, w->counts);
+    ARG(k, ARG_INTERSECT_PATHS, w->paths);
     k = w->k_shade;
     ARG(k, ARG_SHADE_RAYS, w->rays);
     ARG(k, ARG_SHADE_HITS, w->hits);

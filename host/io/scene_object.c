@@ -5,6 +5,8 @@
  *   object NAME { shapes... instances... }     the shapes once, in the object's space
  *   instance NAME { translate ... material M }  the object placed in the world, or,
  *                                               inside an object, in the object's space
+ *   instance_key { time T translate ... }      a later pose of the world instance
+ *                                               before it (docs/motion.md)
  *
  * Instances nest: an object may hold instances of objects defined before it, up to
  * SCENE_MAX_NESTING deep; each world instance is resolved into one instance per object
@@ -15,6 +17,7 @@
 
 #include "io/lexer.h"
 #include "scene/instance.h"
+#include "scene/motion.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -97,9 +100,11 @@ Status scene_parse_object(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-enum { INST_MATERIAL, INST_TRANSLATE, INST_ROTATE, INST_RX, INST_RY, INST_RZ, INST_SCALE, INST_MATRIX, INST_N };
+enum { INST_MATERIAL, INST_TRANSLATE, INST_ROTATE, INST_RX, INST_RY, INST_RZ, INST_SCALE, INST_MATRIX, INST_TIME,
+       INST_N };
 static const KeySpec instance_keys[INST_N] = {
     [INST_MATERIAL] = {"material", VK_MATERIAL, 0, 0, 0, 0, 0, NULL},
+    [INST_TIME] = {"time", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "a time (a number)"},
     [INST_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},
     [INST_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},
     [INST_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
@@ -126,7 +131,53 @@ Status scene_parse_instance(Parser *p, Lexer *lx, const Token *kw)
     Transform m;
     if ((st = scene_parse_transform(p, lx, kw, v + INST_TRANSLATE, "instance", &m))) return st;
     uint material = v[INST_MATERIAL].given ? v[INST_MATERIAL].material : NO_INDEX;
-    st = p->object != NO_INDEX ? scene_object_nest(p->s, p->object, object, &m, material, p->err)
-                               : scene_place_object(p->s, object, &m, material, p->err);
-    return st == ST_INPUT ? lex_error_at(lx, kw, p->err, "%s", p->err->msg) : st;
+    if (p->object != NO_INDEX) {
+        /* instance_key moves a world instance; one inside an object is not one */
+        p->last_instance = NO_INDEX;
+        p->last_instance_nests = 1;
+        st = scene_object_nest(p->s, p->object, object, &m, material, p->err);
+        return st == ST_INPUT ? lex_error_at(lx, kw, p->err, "%s", p->err->msg) : st;
+    }
+    size_t first = p->s->n_instances;
+    st = scene_place_object(p->s, object, &m, material, p->err);
+    if (st) return st == ST_INPUT ? lex_error_at(lx, kw, p->err, "%s", p->err->msg) : st;
+    /* an object that nests others places one instance per leaf: instance_key moves
+     * a single record (docs/motion.md) */
+    p->last_instance_nests = p->s->n_instances - first != 1;
+    p->last_instance = p->last_instance_nests ? NO_INDEX : (uint)first;
+    p->last_instance_time = v[INST_TIME].given ? v[INST_TIME].f : 0.0f;
+    return ST_OK;
+}
+
+/* instance_key { time T  translate ... }: a later pose of the instance before it
+ * (docs/motion.md), its transform keys as an instance's, applied alone (the pose is
+ * the whole transform then, not a change of the one before). */
+enum { IK_TIME, IK_TRANSLATE, IK_ROTATE, IK_RX, IK_RY, IK_RZ, IK_SCALE, IK_MATRIX, IK_N };
+static const KeySpec instance_key_keys[IK_N] = {
+    [IK_TIME] = {"time", VK_NUMBER, 1, -INFINITY, INFINITY, 0, 0, "a time (a number)"},
+    [IK_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},
+    [IK_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},
+    [IK_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [IK_RY] = {"ry", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [IK_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
+    [IK_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
+    [IK_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
+};
+
+Status scene_parse_instance_key(Parser *p, Lexer *lx, const Token *kw)
+{
+    if (p->last_instance == NO_INDEX && p->last_instance_nests)
+        return lex_error_at(lx, kw, p->err, "instance_key after an instance inside an object or of an object that "
+                            "nests instances (only a single world instance moves)");
+    if (p->last_instance == NO_INDEX)
+        return lex_error_at(lx, kw, p->err, "instance_key before any instance (it moves the instance before it)");
+    Value v[IK_N];
+    Status st = scene_parse_block(p, lx, kw, 0, "instance_key", instance_key_keys, IK_N, v);
+    if (st) return st;
+    Transform m;
+    if ((st = scene_parse_transform(p, lx, kw, v + IK_TRANSLATE, "instance_key", &m))) return st;
+    st = scene_add_instance_key(p->s, p->last_instance_time, v[IK_TIME].f, &m, p->err);
+    return st == ST_INPUT ? lex_error_at(lx, strstr(p->err->msg, "is not after") ? &v[IK_TIME].value : kw,
+                                         p->err, "%s", p->err->msg)
+                          : st;
 }

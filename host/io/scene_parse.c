@@ -351,8 +351,8 @@ static Status parse_camera(Parser *p, Lexer *lx, const Token *kw)
         c->shutter_open = v[CAM_SHUTTER].a[0];
         c->shutter_close = v[CAM_SHUTTER].a[1];
     }
-    /* the pose's time: where the shutter opens unless given */
-    c->time = v[CAM_TIME].given ? v[CAM_TIME].f : c->shutter_open;
+    /* the pose's time: 0 unless given (as an instance's) */
+    c->time = v[CAM_TIME].given ? v[CAM_TIME].f : 0.0f;
     return check_view(p, lx, kw, c, &v[CAM_FROM], &v[CAM_AT], &v[CAM_UP], v[CAM_FOCUS].given ? &v[CAM_FOCUS] : NULL);
 }
 
@@ -630,6 +630,7 @@ static const struct {
     {"texture", scene_parse_texture},         {"medium", scene_parse_medium},
     {"object", scene_parse_object},           {"instance", scene_parse_instance},
     {"camera_path", scene_parse_camera_path},
+    {"instance_key", scene_parse_instance_key},
 };
 #define N_STATEMENTS (sizeof statements / sizeof statements[0])
 
@@ -647,7 +648,7 @@ static Status parse_statements(Parser *p, Lexer *lx)
             st = lex_expected(lx, &t,
                               "a statement (camera, image, background, material, sphere, "
                               "plane, triangle, quad, box, mesh, light, texture, medium, include, object, "
-                              "instance, camera_path, camera_key)", p->err);
+                              "instance, camera_path, camera_key, instance_key)", p->err);
             break;
         }
         if ((st = statements[i].parse(p, lx, &t))) break;
@@ -675,6 +676,7 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
     p.s = s;
     p.err = err;
     p.object = NO_INDEX;
+    p.last_instance = NO_INDEX;
     Status st;
     if (text) {
         Lexer lx;

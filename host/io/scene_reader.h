@@ -71,6 +71,12 @@ typedef struct {
     size_t n_material_at, cap_material_at;
     int depth_exceeded;               /* the include limit error is not annotated further */
     uint object;                      /* the object whose block is being read, or NO_INDEX */
+    uint last_instance;               /* the last instance read (instance_key moves it), or
+                                       * NO_INDEX */
+    float last_instance_time;         /* ... and the time of its own pose */
+    int last_instance_nests;          /* whether last_instance is NO_INDEX because the
+                                       * instance was inside an object or placed several
+                                       * (instance_key's message says which) */
     Token object_name;                /* where that object was named */
     float *list;                      /* VK_NUMBER_LIST values of the block being read
                                        * (emptied when a block starts; freed at the end) */
@@ -116,6 +122,7 @@ Status scene_parse_transform(Parser *p, const Lexer *lx, const Token *kw, const 
 /* scene_object.c: object, instance (docs/instancing.md) */
 Status scene_parse_object(Parser *p, Lexer *lx, const Token *kw);
 Status scene_parse_instance(Parser *p, Lexer *lx, const Token *kw);
+Status scene_parse_instance_key(Parser *p, Lexer *lx, const Token *kw);
 
 /* scene_medium.c: the medium statement, shapes' interior and exterior media */
 Status scene_parse_medium(Parser *p, Lexer *lx, const Token *kw);

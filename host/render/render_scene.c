@@ -105,7 +105,19 @@ static Status tree_build_instanced(const Scene *s, const KdInput *in, int thread
     w.object = (uint)s->n_objects;
     out->instances[s->n_instances] = w;
     out->n_instances = s->n_instances + 1;
-    st = bvh_build_instanced(in, protos, n_protos, out->instances, out->n_instances, threads, &out->bvh,
+    /* moving instances (docs/motion.md): each one's first key, the world's none */
+    if (s->instance_motion) {
+        if (!(out->instance_motion = malloc(out->n_instances * sizeof *out->instance_motion))) {
+            st = error_set(err, ST_INTERNAL, "out of memory for %zu instances", s->n_instances);
+            goto done;
+        }
+        for (size_t i = 0; i < out->n_instances; i++)
+            out->instance_motion[i] = i < s->n_instance_motion ? s->instance_motion[i] : NO_INDEX;
+        out->ds.instance_motion = out->instance_motion;
+        out->ds.n_instance_motion = (uint)out->n_instances;
+    }
+    BvhMotion motion = { out->instance_motion, s->motion_keys };
+    st = bvh_build_instanced(in, protos, n_protos, out->instances, out->n_instances, &motion, threads, &out->bvh,
                              &out->levels, err);
     if (st) goto done;
     out->instanced = 1;
@@ -212,12 +224,51 @@ static Status flatten_fits(const Scene *s, Error *err)
                      env && *env ? "CLPT_MAX_FLATTEN_BYTES" : "this machine's memory");
 }
 
+/* The moving parts (docs/motion.md): the camera (prepared here, in its own space when
+ * it moves) and the instances; their keys in one device buffer, the instances' first
+ * (their indices are the scene's), then the camera's. */
+static Status prepare_motion(const Scene *s, RenderScene *out, Error *err)
+{
+    RenderParams *p = &out->ds.params;
+    MotionKey *camera_keys = NULL;
+    Status st = camera_setup_moving(s, s->image.width, s->image.height, (uint)s->n_motion_keys, &p->camera,
+                                    &camera_keys, err);
+    if (st) return st;
+    size_t n = s->n_motion_keys + p->camera.motion_keys;
+    p->camera.moving = n != 0;
+    if (n == 0) return ST_OK;
+    if (!(out->motion_keys = malloc(n * sizeof *out->motion_keys))) {
+        free(camera_keys);
+        return error_set(err, ST_INTERNAL, "out of memory for %zu motion keys", n);
+    }
+    if (s->n_motion_keys) memcpy(out->motion_keys, s->motion_keys, s->n_motion_keys * sizeof *out->motion_keys);
+    if (camera_keys) {
+        for (uint i = 0; i < p->camera.motion_keys; i++) camera_keys[i].count = p->camera.motion_keys;
+        memcpy(out->motion_keys + s->n_motion_keys, camera_keys, p->camera.motion_keys * sizeof *camera_keys);
+    }
+    free(camera_keys);
+    out->ds.motion_keys = out->motion_keys;
+    out->ds.n_motion_keys = (uint)n;
+    return ST_OK;
+}
+
+/* Whether any instance of s moves. */
+static int instances_move(const Scene *s)
+{
+    for (size_t i = 0; i < s->n_instance_motion; i++)
+        if (s->instance_motion[i] != NO_INDEX) return 1;
+    return 0;
+}
+
 Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error *err)
 {
     memset(out, 0, sizeof *out);
     Status st;
     /* the kd-tree has one level: it takes an instanced scene's copies (docs/instancing.md) */
     if (s->accel == ACCEL_KDTREE && s->n_objects) {
+        if (instances_move(s))
+            return error_set(err, ST_INPUT, "--accel kdtree takes instances as copies, which cannot move: render a "
+                             "scene with moving instances with --accel bvh (the default)");
         if ((st = flatten_fits(s, err))) return st;
         out->flattened = s->n_instances;
         if ((st = scene_flatten_instances(s, err))) return st;
@@ -232,10 +283,7 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
      * cube map's conversion) */
     if ((st = scene_pack_texels(s, err))) return st;
     RenderParams *p = &out->ds.params;
-    if ((st = camera_setup_moving(s, s->image.width, s->image.height, 0u, &p->camera, &out->motion_keys, err)))
-        return st;
-    out->ds.motion_keys = out->motion_keys;
-    out->ds.n_motion_keys = p->camera.motion_keys;
+    if ((st = prepare_motion(s, out, err))) return st;
     if ((st = scene_check_precision(s, err))) return st;
     if ((st = tree_build(s, tree_threads, out, err))) return st;
     p->bg_type = s->bg_type;
@@ -316,6 +364,7 @@ void render_scene_free(RenderScene *r)
 {
     free(r->instances);
     free(r->motion_keys);
+    free(r->instance_motion);
     kd_free(&r->kd);
     bvh_free(&r->bvh);
     memset(r, 0, sizeof *r);

@@ -22,7 +22,10 @@ typedef struct {
     BvhLevels levels;
     int instanced;        /* the BVH has two levels */
     size_t flattened;     /* --accel kdtree: the instances copied into the world */
-    MotionKey *motion_keys;   /* the moving camera's keys (docs/motion.md), or NULL */
+    /* motion blur (docs/motion.md): the keys of the moving instances, then the moving
+     * camera's, or NULL; per device instance its first key or NO_INDEX, or NULL */
+    MotionKey *motion_keys;
+    uint *instance_motion;
 } RenderScene;
 
 /* The scene's image settings (size, depth, seed) and its tree are taken as they are

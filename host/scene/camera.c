@@ -133,7 +133,11 @@ Status camera_setup_moving(const Scene *scene, uint width, uint height, uint mot
     *keys = NULL;
     const SceneCamera *desc = &scene->camera;
     Status st = camera_setup(desc, width, height, out, err);
-    if (st || scene->n_camera_keys == 0) return st;
+    if (st) return st;
+    /* read only where something moves (Camera.moving) */
+    out->shutter_open = desc->shutter_open;
+    out->shutter_close = desc->shutter_close;
+    if (scene->n_camera_keys == 0) return ST_OK;
     size_t n = scene->n_camera_keys + 1;
     MotionKey *k = calloc(n, sizeof *k);
     if (!k) return error_set(err, ST_INTERNAL, "out of memory");
@@ -164,8 +168,6 @@ Status camera_setup_moving(const Scene *scene, uint width, uint height, uint mot
     out->lens_u = camera_local(&f0, out->lens_u, 0.0);
     out->lens_v = camera_local(&f0, out->lens_v, 0.0);
     out->forward = camera_local(&f0, out->forward, 0.0);
-    out->shutter_open = desc->shutter_open;
-    out->shutter_close = desc->shutter_close;
     out->motion_first = motion_first;
     out->motion_keys = (uint)n;
     *keys = k;

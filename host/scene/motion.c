@@ -4,6 +4,7 @@
 #include "scene/motion.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "geom/motion.h"
@@ -125,4 +126,130 @@ Transform motion_transform_at(const MotionKey *keys, size_t n, float time)
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 4; j++) t.m[i][j] = m[i * 4 + j];
     return t;
+}
+
+Status scene_add_instance_key(Scene *s, float own_time, float time, const Transform *m, Error *err)
+{
+    if (s->n_instances == 0) return error_set(err, ST_INPUT, "no instance to move");
+    size_t inst = s->n_instances - 1;
+    if (s->n_instance_motion < s->n_instances) {
+        uint *grown = realloc(s->instance_motion, s->n_instances * sizeof *grown);
+        if (!grown) return error_set(err, ST_INTERNAL, "out of memory");
+        for (size_t i = s->n_instance_motion; i < s->n_instances; i++) grown[i] = NO_INDEX;
+        s->instance_motion = grown;
+        s->n_instance_motion = s->n_instances;
+    }
+    Instance *x = &s->instances[inst];
+    uint first = s->instance_motion[inst];
+    size_t have = first == NO_INDEX ? 0 : s->n_motion_keys - first;
+    if (have + (first == NO_INDEX ? 2 : 1) > MOTION_MAX_KEYS)
+        return error_set(err, ST_INPUT, "more than %u poses of one instance", MOTION_MAX_KEYS);
+    float before = first == NO_INDEX ? own_time : s->motion_keys[s->n_motion_keys - 1].time;
+    if (!(time > before))
+        return error_set(err, ST_INPUT, "instance_key time %g is not after the instance's pose before it (time %g): "
+                         "poses are given in increasing time", (double)time, (double)before);
+    if (s->n_motion_keys + 2 > s->cap_motion_keys) {
+        size_t cap = s->cap_motion_keys ? 2 * s->cap_motion_keys : 8;
+        MotionKey *grown = realloc(s->motion_keys, cap * sizeof *grown);
+        if (!grown) return error_set(err, ST_INTERNAL, "out of memory");
+        s->motion_keys = grown;
+        s->cap_motion_keys = cap;
+    }
+    Status st;
+    if (first == NO_INDEX) {
+        /* its own pose first, from the record's M */
+        Transform own;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 4; j++) own.m[i][j] = x->to_world[4 * i + j];
+        if ((st = motion_key_make(&own, own_time, &s->motion_keys[s->n_motion_keys], err))) return st;
+        first = (uint)s->n_motion_keys++;
+    }
+    if ((st = motion_key_make(m, time, &s->motion_keys[s->n_motion_keys], err))) return st;
+    s->n_motion_keys++;
+    size_t n = s->n_motion_keys - first;
+    motion_keys_shortest_arcs(s->motion_keys + first, n);
+    for (size_t i = first; i < s->n_motion_keys; i++) s->motion_keys[i].count = (uint)n;
+    s->instance_motion[inst] = first;
+    x->flags = (x->flags & ~INST_IDENTITY) | INST_MOTION;
+    return ST_OK;
+}
+
+/* The world transform of the keys at time t, in double from the keys' floats (the
+ * kernels' interpolation, for bounds). */
+static void key_transform(const MotionKey *keys, size_t n, double t, double m[12])
+{
+    size_t i = 0;
+    while (i + 2 < n && !(t < keys[i + 1].time)) i++;
+    const MotionKey *k0 = keys + i, *k1 = keys + (n > 1 ? i + 1 : i);
+    double u = 0.0;
+    if (k1->time > k0->time) u = fmin(fmax((t - k0->time) / ((double)k1->time - k0->time), 0.0), 1.0);
+    double a[4], b[4], q[4], c = 0.0;
+    for (int j = 0; j < 4; j++) {
+        a[j] = k0->rotate[j];
+        b[j] = k1->rotate[j];
+        c += a[j] * b[j];
+    }
+    double wa = 1.0 - u, wb = u;
+    if (c < 0.9995) {
+        double theta = acos(fmin(fmax(c, -1.0), 1.0));
+        wa = sin((1.0 - u) * theta) / sin(theta);
+        wb = sin(u * theta) / sin(theta);
+    }
+    double len = 0.0;
+    for (int j = 0; j < 4; j++) {
+        q[j] = wa * a[j] + wb * b[j];
+        len += q[j] * q[j];
+    }
+    len = sqrt(len);
+    double x = q[0] / len, y = q[1] / len, z = q[2] / len, w = q[3] / len, sv[6];
+    for (int j = 0; j < 6; j++) sv[j] = (1.0 - u) * k0->stretch[j] + u * k1->stretch[j];
+    double r[9] = { 1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
+                    2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
+                    2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y) };
+    double sm[9] = { sv[0], sv[1], sv[2], sv[1], sv[3], sv[4], sv[2], sv[4], sv[5] };
+    for (int row = 0; row < 3; row++)
+        for (int col = 0; col < 3; col++)
+            m[row * 4 + col] = r[row * 3] * sm[col] + r[row * 3 + 1] * sm[3 + col] + r[row * 3 + 2] * sm[6 + col];
+    m[3] = (1.0 - u) * k0->translate.x + u * k1->translate.x;
+    m[7] = (1.0 - u) * k0->translate.y + u * k1->translate.y;
+    m[11] = (1.0 - u) * k0->translate.z + u * k1->translate.z;
+}
+
+#define MOTION_BOUND_STEPS 32
+
+void motion_bounds(const MotionKey *keys, size_t n, const double lo[3], const double hi[3], double wl[3], double wh[3])
+{
+    for (int k = 0; k < 3; k++) {
+        wl[k] = INFINITY;
+        wh[k] = -INFINITY;
+    }
+    if (!(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2])) return;
+    double prev[8][3], step = 0.0;
+    int have_prev = 0;
+    for (size_t seg = 0; seg + 1 < n || (n == 1 && seg == 0); seg++) {
+        double t0 = keys[seg].time, t1 = n > 1 ? keys[seg + 1].time : t0;
+        for (int i = 0; i <= MOTION_BOUND_STEPS; i++) {
+            double m[12];
+            key_transform(keys, n, t0 + (t1 - t0) * i / MOTION_BOUND_STEPS, m);
+            for (int c = 0; c < 8; c++) {
+                double p[3] = { (c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2] }, w[3];
+                for (int k = 0; k < 3; k++) {
+                    w[k] = m[4 * k] * p[0] + m[4 * k + 1] * p[1] + m[4 * k + 2] * p[2] + m[4 * k + 3];
+                    wl[k] = fmin(wl[k], w[k]);
+                    wh[k] = fmax(wh[k], w[k]);
+                }
+                if (have_prev) {
+                    double d2 = 0.0;
+                    for (int k = 0; k < 3; k++) d2 += (w[k] - prev[c][k]) * (w[k] - prev[c][k]);
+                    step = fmax(step, sqrt(d2));
+                }
+                memcpy(prev[c], w, sizeof w);
+            }
+            have_prev = 1;
+        }
+    }
+    for (int k = 0; k < 3; k++) {
+        wl[k] -= step;
+        wh[k] += step;
+    }
 }

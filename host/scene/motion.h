@@ -8,6 +8,7 @@
 #define CLPT_MOTION_H
 
 #include "base/status.h"
+#include "scene/scene.h"
 #include "scene/transform.h"
 #include "types.h"
 
@@ -24,6 +25,21 @@ Status motion_key_make(const Transform *m, float time, MotionKey *out, Error *er
 /* Flips the sign of each key's quaternion where that makes its arc from the key before
  * the shorter (q and -q are one rotation; slerp takes the arc between them as given). */
 void motion_keys_shortest_arcs(MotionKey *keys, size_t n);
+
+/* Gives the scene's last instance a pose m at `time`: its first call makes the
+ * instance move (INST_MOTION), with its own transform as its first key at own_time.
+ * Fails (ST_INPUT, no location) when time is not after the instance's last key, the
+ * instance would have more than MOTION_MAX_KEYS, or m is singular. */
+Status scene_add_instance_key(Scene *s, float own_time, float time, const Transform *m, Error *err);
+
+/* The world box over every time of the n keys of a moving transform, of an object box
+ * (lo, hi; empty when lo > hi: the result is too). Sampled: 32 times per key interval,
+ * the 8 corners under each, then every side widened by the longest step a corner made
+ * between samples, which covers the arc between them (a rotation of up to 180 degrees
+ * between keys turns a corner through at most pi/32 between samples, where an arc is
+ * within 0.05% of its chord; a chord bounds how far the path strays from either end). */
+void motion_bounds(const MotionKey *keys, size_t n, const double lo[3], const double hi[3], double wl[3],
+                   double wh[3]);
 
 /* The transform of the n keys at `time`, by the kernels' own interpolation (evaluated
  * here in float, as a device does): for tests and for bounds over the shutter. */

@@ -58,6 +58,8 @@ void scene_free(Scene *s)
     free(s->material_textures);
     free(s->materials);
     free(s->camera_keys);
+    free(s->instance_motion);
+    free(s->motion_keys);
     free(s->spheres);
     free(s->sphere_xforms);
     free(s->triangles);

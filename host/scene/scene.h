@@ -142,6 +142,12 @@ typedef struct {
     /* per instance: its first light (LIGHT_INSTANCED, kernels/types.h), or NO_INDEX;
      * NULL when no instance has lights (scene_prepare_lights) */
     uint *instance_lights;
+    /* moving instances (INST_MOTION, docs/motion.md): the first n_instance_motion
+     * instances' first keys in motion_keys, or NO_INDEX for one that stands still (so
+     * are the instances after them); NULL while none moves. Each moving instance's keys
+     * are consecutive, in increasing time (scene/motion.h). */
+    uint *instance_motion;        size_t n_instance_motion;
+    MotionKey *motion_keys;       size_t n_motion_keys, cap_motion_keys;
     StrMap object_by_name;
 
     /* the classic ray tracer's additions (docs/classic-format.md) */

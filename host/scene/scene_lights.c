@@ -332,7 +332,9 @@ static Status object_emitters(Scene *s, Light **tpl_out, size_t **first_out, Err
  * found by BSDF sampling alone; a dark one does not emit). */
 static size_t instance_light_count(const Instance *x, const size_t *first)
 {
-    return x->material != NO_INDEX ? 0 : first[x->object + 1] - first[x->object];
+    /* a moving instance's emitters have no one place to sample (docs/motion.md) */
+    if (x->material != NO_INDEX || (x->flags & INST_MOTION)) return 0;
+    return first[x->object + 1] - first[x->object];
 }
 
 /* The scale s when the linear part of m is s times a rotation (or a mirror), each

@@ -229,7 +229,7 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
             st_t[sp] = 0u;
             sp++;
             inst = (x->flags & INST_WORLD) ? NO_INDEX : ref;
-            oray = instance_ray(x, ray);
+            oray = instance_ray_seen(sc, ref, x, ray);
             orp = ray_prepare(oray);
             w = bvh_ray(oray, &orp);
             ref = x->root;

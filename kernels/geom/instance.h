@@ -13,6 +13,8 @@
 #define CLPT_GEOM_INSTANCE_H
 
 #include "geom/intersect.h"
+#include "geom/motion.h"
+#include "scene_view.h"
 
 /* The world ray in instance x's object space (unchanged for the identity). */
 KFN Ray instance_ray(GLOBAL const Instance *x, Ray ray)
@@ -30,6 +32,41 @@ KFN Ray instance_ray(GLOBAL const Instance *x, Ray ray)
 KFN vec3 instance_normal(GLOBAL const Instance *x, vec3 n)
 {
     GLOBAL const float *mi = x->to_object;
+    return v3_norm(v3(mi[0] * n.x + mi[4] * n.y + mi[8] * n.z, mi[1] * n.x + mi[5] * n.y + mi[9] * n.z,
+                      mi[2] * n.x + mi[6] * n.y + mi[10] * n.z));
+}
+
+/* ------------------------------------------------------------------ moving instances
+ * An instance flagged INST_MOTION (docs/motion.md) has no one M: the path's time
+ * (SceneView.time) picks it from the instance's keys (geom/motion.h), and the walk and
+ * surface_at compute it the same way, so a surface is found from the very ray the walk
+ * used. Its record's matrices (the first key's pose) are not read. */
+
+/* Whether instance x moves (only a program with KF_MOTION has such instances). */
+#define INSTANCE_MOVES(x) (KF_HAS(KF_MOTION) && ((x)->flags & INST_MOTION) != 0u)
+
+/* Moving instance i's M and M^-1 at the path's time. */
+KFN void instance_moving_at(const SceneView *sc, uint i, float *m, float *mi)
+{
+    motion_instance_at(sc->motion_keys + sc->instance_motion[i], sc->time, m, mi);
+}
+
+/* The world ray in the object space of instance i (x, its record) as the path sees it:
+ * instance_ray, or by a moving instance's M^-1 at the path's time. */
+KFN Ray instance_ray_seen(const SceneView *sc, uint i, GLOBAL const Instance *x, Ray ray)
+{
+    if (!INSTANCE_MOVES(x)) return instance_ray(x, ray);
+    float m[12], mi[12];
+    instance_moving_at(sc, i, m, mi);
+    Ray r = ray;
+    r.o = motion_point(mi, ray.o);
+    r.d = motion_vector(mi, ray.d);
+    return r;
+}
+
+/* instance_normal for a moving instance's M^-1 (mi, private). */
+KFN vec3 instance_normal_moving(const float *mi, vec3 n)
+{
     return v3_norm(v3(mi[0] * n.x + mi[4] * n.y + mi[8] * n.z, mi[1] * n.x + mi[5] * n.y + mi[9] * n.z,
                       mi[2] * n.x + mi[6] * n.y + mi[10] * n.z));
 }

@@ -8,8 +8,9 @@
  * transform is the first key's, after the last the last's. Only + - * / sqrt and the
  * k_* functions of kmath.h: every device computes the same bits (compat.h).
  *
- * And the camera's use of it (docs/motion.md): a moving camera's ray, made in the
- * camera's own space, carried to the world at the path's time.
+ * And its users (docs/motion.md): the path's time, a moving camera's ray (made in the
+ * camera's own space) carried to the world at that time, and a moving instance's M and
+ * M^-1 then (geom/instance.h).
  */
 #ifndef CLPT_GEOM_MOTION_H
 #define CLPT_GEOM_MOTION_H
@@ -82,11 +83,20 @@ KFN vec3 motion_vector(const float *m, vec3 d)
               m[8] * d.x + m[9] * d.y + m[10] * d.z);
 }
 
+/* |m| v: the linear part's magnitudes times v (error bounds, geom/surface.h). */
+KFN vec3 motion_abs_vector(const float *m, vec3 v)
+{
+    return v3(k_fabs(m[0]) * v.x + k_fabs(m[1]) * v.y + k_fabs(m[2]) * v.z,
+              k_fabs(m[4]) * v.x + k_fabs(m[5]) * v.y + k_fabs(m[6]) * v.z,
+              k_fabs(m[8]) * v.x + k_fabs(m[9]) * v.y + k_fabs(m[10]) * v.z);
+}
+
 /* The time of a camera sample: uniform over the shutter, from the sampler's DIM_TIME,
- * which only a scene that moves draws (so every other scene keeps its random numbers
- * and its bits). */
+ * which only a scene that moves (Camera.moving) draws, so every other scene keeps its
+ * random numbers and its bits; 0 there. */
 KFN float camera_time(GLOBAL const RenderParams *p, RngKey key)
 {
+    if (!KF_HAS(KF_MOTION) || !p->camera.moving) return 0.0f;
     float open = p->camera.shutter_open, close = p->camera.shutter_close;
     if (!(close > open)) return open;
     return open + (close - open) * rng_uniform(key, 0u, DIM_TIME);
@@ -102,6 +112,34 @@ KFN Ray camera_ray_at(GLOBAL const RenderParams *p, GLOBAL const MotionKey *moti
     ray.o = motion_point(m, ray.o);
     ray.d = v3_norm(motion_vector(m, ray.d));
     return ray;
+}
+
+/* The inverse of the affine 3x4 m into mi (cofactors over the determinant, in float:
+ * every device rounds the same steps). A singular m gives non-finite entries, which the
+ * walk's NaN check turns into a miss. */
+KFN void motion_invert(const float *m, float *mi)
+{
+    float c00 = m[5] * m[10] - m[6] * m[9], c01 = m[6] * m[8] - m[4] * m[10], c02 = m[4] * m[9] - m[5] * m[8];
+    float inv = 1.0f / (m[0] * c00 + m[1] * c01 + m[2] * c02);
+    mi[0] = c00 * inv;
+    mi[1] = (m[2] * m[9] - m[1] * m[10]) * inv;
+    mi[2] = (m[1] * m[6] - m[2] * m[5]) * inv;
+    mi[4] = c01 * inv;
+    mi[5] = (m[0] * m[10] - m[2] * m[8]) * inv;
+    mi[6] = (m[2] * m[4] - m[0] * m[6]) * inv;
+    mi[8] = c02 * inv;
+    mi[9] = (m[1] * m[8] - m[0] * m[9]) * inv;
+    mi[10] = (m[0] * m[5] - m[1] * m[4]) * inv;
+    for (int r = 0; r < 3; r++)
+        mi[4 * r + 3] = -(mi[4 * r] * m[3] + mi[4 * r + 1] * m[7] + mi[4 * r + 2] * m[11]);
+}
+
+/* A moving instance's M and M^-1 at `time` (Instance.flags INST_MOTION): its keys
+ * interpolated, then inverted. */
+KFN void motion_instance_at(GLOBAL const MotionKey *keys, float time, float *m, float *mi)
+{
+    motion_at(keys, keys->count, time, m);
+    motion_invert(m, mi);
 }
 
 #endif /* CLPT_GEOM_MOTION_H */

@@ -286,16 +286,43 @@ KFN vec3 instance_point_error(GLOBAL const Instance *x, vec3 po, vec3 err_o, vec
  * holds its index among its object's emitters as its `light`: the instance's lights
  * start at instance_lights[inst] (types.h, LIGHT_INSTANCED), so that MIS weighs the
  * emission that BSDF sampling finds with the density light sampling had for it. */
+/* instance_point_error for a moving instance's M and M^-1 at the path's time (private). */
+KFN vec3 instance_point_error_moving(const float *m, const float *mi, vec3 po, vec3 err_o, vec3 p)
+{
+    vec3 trans = v3(k_fabs(m[3]), k_fabs(m[7]), k_fabs(m[11]));
+    vec3 trans_i = v3(k_fabs(mi[3]), k_fabs(mi[7]), k_fabs(mi[11]));
+    vec3 fwd = v3_scale(v3_add(motion_abs_vector(m, v3_abs(po)), trans), K_ROUND_ERR(3));
+    vec3 carried = v3_scale(motion_abs_vector(m, err_o), 1.0f + K_ROUND_ERR(3));
+    vec3 back = v3_scale(v3_add(motion_abs_vector(mi, v3_abs(p)), trans_i), K_ROUND_ERR(4));
+    return v3_add(v3_add(fwd, carried), motion_abs_vector(m, back));
+}
+
+/* surface_instanced's carrying to the world for a moving instance: by its M and M^-1
+ * at the path's time (geom/instance.h). */
+KFN Surface surface_moving_to_world(const SceneView *sc, uint inst, Surface s)
+{
+    float m[12], mi[12];
+    instance_moving_at(sc, inst, m, mi);
+    s.p = motion_point(m, s.po);
+    s.err = instance_point_error_moving(m, mi, s.po, s.err, s.p);
+    vec3 ng = instance_normal_moving(mi, s.ngo);
+    vec3 ns = instance_normal_moving(mi, s.ns);
+    s.ng = ng;
+    s.ns = v3_dot(ns, ng) < 0.0f ? v3_neg(ns) : ns;
+    return s;
+}
+
 KFN Surface surface_instanced(const SceneView *sc, Ray ray, Hit hit)
 {
     GLOBAL const Instance *x = sc->instances + hit.inst;
-    Surface s = surface_local(sc, instance_ray(x, ray), hit);
+    Surface s = surface_local(sc, instance_ray_seen(sc, hit.inst, x, ray), hit);
     s.inst = hit.inst;
     if (s.light != NO_INDEX) {
         uint first = sc->instance_lights[hit.inst];
         s.light = first == NO_INDEX ? NO_INDEX : first + s.light;
     }
     if (x->material != NO_INDEX) s.material = x->material;
+    if (INSTANCE_MOVES(x)) return surface_moving_to_world(sc, hit.inst, s);
     if (x->flags & INST_IDENTITY) return s;
     s.p = xform_point(x->to_world, s.po);
     s.err = instance_point_error(x, s.po, s.err, s.p);
@@ -324,6 +351,11 @@ KFN vec3 surface_vector_to_world(const SceneView *sc, Surface s, vec3 v)
 {
     if (!SURFACE_INSTANCED(sc, s)) return v;
     GLOBAL const Instance *x = sc->instances + s.inst;
+    if (INSTANCE_MOVES(x)) {
+        float m[12], mi[12];
+        instance_moving_at(sc, s.inst, m, mi);
+        return motion_vector(m, v);
+    }
     return (x->flags & INST_IDENTITY) ? v : xform_vector(x->to_world, v);
 }
 

@@ -15,6 +15,20 @@
 #include "accel/traverse.h"
 #include "medium/transmit.h"
 
+/* Points sc at a copy of the view seen at path ps's time where the scene moves
+ * (SceneView.time, docs/motion.md); without KF_MOTION, nothing. */
+#if KF_HAS(KF_MOTION)
+#define PATH_AT_TIME(sc, ps)                                                             \
+    SceneView at_time_;                                                                  \
+    if ((sc)->params->camera.moving) {                                                   \
+        at_time_ = *(sc);                                                                \
+        at_time_.time = (ps)->time;                                                      \
+        sc = &at_time_;                                                                  \
+    }
+#else
+#define PATH_AT_TIME(sc, ps)
+#endif
+
 /* path_run's loop, written once: STAGE(phase) follows each of its stages (enum
  * DevicePhase, host/device/device.h). path_run passes an empty one; the scalar device's
  * --profile (render_path_timed, host/device/scalar_paths_impl.h) reads its clock there.
@@ -26,6 +40,7 @@
 #define PATH_RUN_BODY(STAGE)                                                             \
     uint n_rays = 0u;                                                                    \
     raygen_path(sc->params, sc->motion_keys, pixel, sample, ps, ray);                    \
+    PATH_AT_TIME(sc, ps);                                                                \
     STAGE(PHASE_RAYGEN);                                                                 \
     Ray first_ray = *ray;                                                                \
     Hit first_hit;                                                                       \

@@ -62,12 +62,13 @@ KFN Ray camera_ray_still(GLOBAL const RenderParams *p, float s, float t, RngKey 
 }
 
 /* The camera ray through film position (s, t) in the world: a moving camera's
- * (KF_MOTION, Camera.motion_keys; geom/motion.h) at a time the key draws in the shutter,
- * from its keys in motion_keys (which a still camera does not read: NULL will do). */
-KFN Ray camera_ray(GLOBAL const RenderParams *p, GLOBAL const MotionKey *motion_keys, float s, float t, RngKey key)
+ * (KF_MOTION, Camera.motion_keys; geom/motion.h) at `time` (camera_time), from its keys
+ * in motion_keys (which a still camera does not read: NULL will do). */
+KFN Ray camera_ray(GLOBAL const RenderParams *p, GLOBAL const MotionKey *motion_keys, float s, float t, RngKey key,
+                   float time)
 {
     Ray ray = camera_ray_still(p, s, t, key);
-    if (KF_HAS(KF_MOTION) && p->camera.motion_keys) ray = camera_ray_at(p, motion_keys, camera_time(p, key), ray);
+    if (KF_HAS(KF_MOTION) && p->camera.motion_keys) ray = camera_ray_at(p, motion_keys, time, ray);
     return ray;
 }
 
@@ -81,7 +82,8 @@ KFN void raygen_path(GLOBAL const RenderParams *p, GLOBAL const MotionKey *motio
     RngKey key = rng_key_make(p, params_image_pixel(p, pixel, &x, &y), sample);
     float jx, jy;
     rng_uniform2(key, 0u, DIM_PIXEL_X, &jx, &jy);
-    *ray = camera_ray(p, motion_keys, params_film_s(p, x, jx), params_film_t(p, y, jy), key);
+    float time = camera_time(p, key);
+    *ray = camera_ray(p, motion_keys, params_film_s(p, x, jx), params_film_t(p, y, jy), key, time);
 
     ps->throughput = v3s(1.0f);
     ps->radiance = v3s(0.0f);
@@ -96,7 +98,7 @@ KFN void raygen_path(GLOBAL const RenderParams *p, GLOBAL const MotionKey *motio
     ps->medium = p->camera_medium;   /* 0 (vacuum) in scenes without media */
     ps->shadow_medium = 0u;
     ps->crossings = 0u;
-    ps->pad_medium = 0u;
+    ps->time = time;
 }
 
 /* Restarts the path of a camera sample as its next continuation from the first hit

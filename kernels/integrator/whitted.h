@@ -47,9 +47,10 @@ typedef struct {
 
 /* The camera ray of a pixel sample: through the pixel's centre (strata 0), a uniform
  * point of it (1), or a jittered point of cell (sample mod m^2) of an m x m grid. The
- * lens (and jitter) numbers come from the key of sample + sample_offset. */
+ * lens (and jitter) numbers come from the key of sample + sample_offset; *time is the
+ * sample's time in the shutter (camera_time). */
 KFN Ray whitted_camera_ray(GLOBAL const RenderParams *p, GLOBAL const MotionKey *motion_keys, uint pixel, uint sample,
-                           RngKey *key_out)
+                           RngKey *key_out, float *time)
 {
     uint x, y;
     RngKey key = rng_key_make(p, params_image_pixel(p, pixel, &x, &y), sample + p->sample_offset);
@@ -64,7 +65,8 @@ KFN Ray whitted_camera_ray(GLOBAL const RenderParams *p, GLOBAL const MotionKey 
         jy = ((float)(cell / m) + rng_uniform(key, 0u, DIM_PIXEL_Y)) / (float)m;
     }
     *key_out = key;
-    return camera_ray(p, motion_keys, params_film_s(p, x, jx), params_film_t(p, y, jy), key);
+    *time = camera_time(p, key);
+    return camera_ray(p, motion_keys, params_film_s(p, x, jx), params_film_t(p, y, jy), key, *time);
 }
 
 /* The refracted direction of unit d at a boundary with normal n facing d's side and
@@ -387,7 +389,17 @@ KFN vec3 whitted_sample(const SceneView *sc, uint pixel, uint sample, uint *rays
     GLOBAL const RenderParams *p = sc->params;
     *rays = 0u;
     RngKey key;
-    Ray r = whitted_camera_ray(p, sc->motion_keys, pixel, sample, &key);
+    float time;
+    Ray r = whitted_camera_ray(p, sc->motion_keys, pixel, sample, &key, &time);
+#if KF_HAS(KF_MOTION)
+    /* the scene as it is at the sample's time (SceneView.time) */
+    SceneView at_time;
+    if (p->camera.moving) {
+        at_time = *sc;
+        at_time.time = time;
+        sc = &at_time;
+    }
+#endif
     if (p->integrator == INTEGRATOR_WHITTED) return whitted_radiance(sc, r, key, rays);
     if (p->integrator >= INTEGRATOR_FEATURE_NORMAL) return whitted_feature(sc, r, p->integrator, rays);
     return whitted_aov(sc, r, p->integrator, rays);

@@ -67,7 +67,7 @@
 #if KF_HAS(KF_MOTION)
 #define SCENE_VIEW_AT_TIME(sc, ps) sc.time = (ps).time
 #else
-#define SCENE_VIEW_AT_TIME(sc, ps)
+#define SCENE_VIEW_AT_TIME(sc, ps) (void)(ps)
 #endif
 
 #if KF_HAS(KF_PATH)

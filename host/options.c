@@ -401,6 +401,45 @@ static int starts_blank(const char *s)
     return isspace((unsigned char)s[0]);
 }
 
+/* The whole of `s` as one number (strtod's syntax, no blank at either end) into *out;
+ * 0 unless exactly that. Every flag that takes one real number reads it here. */
+static int read_real(const char *s, double *out)
+{
+    char *end;
+    errno = 0;
+    *out = strtod(s, &end);
+    return *s && !*end && !errno && !starts_blank(s);
+}
+
+/* n numbers separated by commas, nothing else (no blanks: what was typed is what
+ * counts), into out; 0 unless exactly that. */
+static int read_number_list(const char *v, double *out, int n)
+{
+    const char *p = v;
+    for (int i = 0; i < n; i++) {
+        char *end;
+        errno = 0;
+        out[i] = strtod(p, &end);
+        if (end == p || errno || starts_blank(p) || !isfinite(out[i])) return 0;
+        if (*end != (i + 1 < n ? ',' : '\0')) return 0;
+        p = end + 1;
+    }
+    return 1;
+}
+
+/* "A:B", two whole numbers without a sign (no blanks), into *a and *b; 0 unless
+ * exactly that. --sample-range and --frames read theirs here. */
+static int read_index_pair(const char *s, long *a, long *b)
+{
+    char *end;
+    errno = 0;
+    *a = strtol(s, &end, 10);
+    if (end == s || *end != ':' || errno || s[0] == '-' || s[0] == '+' || starts_blank(s)) return 0;
+    const char *second = end + 1;
+    *b = strtol(second, &end, 10);
+    return end != second && !*end && !errno && second[0] != '-' && second[0] != '+' && !starts_blank(second);
+}
+
 Status option_parse_long(const char *flag, const char *s, long lo, long hi, long *out, Error *err)
 {
     char *end;
@@ -416,10 +455,8 @@ Status option_parse_long(const char *flag, const char *s, long lo, long hi, long
 
 Status option_parse_seconds(const char *flag, const char *s, double *out, Error *err)
 {
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (!*s || *end || errno || starts_blank(s) || !isfinite(v) || v <= 0.0)
+    double v;
+    if (!read_real(s, &v) || !isfinite(v) || v <= 0.0)
         return error_set(err, ST_USAGE, "%s expects a positive number of seconds, got '%s'", flag, s);
     *out = v;
     return ST_OK;
@@ -457,22 +494,14 @@ static Status parse_display_server(const char *v, Options *o, Error *err)
 /* --depth-range NEAR,FAR */
 static Status parse_depth_range(const char *v, Options *o, Error *err)
 {
-    char *end;
-    errno = 0;
-    double lo = strtod(v, &end), hi = 0.0;
-    int ok = end != v && *end == ',' && !errno && !starts_blank(v);
-    if (ok) {
-        const char *second = end + 1;
-        hi = strtod(second, &end);
-        ok = end != second && !*end && !errno && !starts_blank(second);
-    }
+    double d[2];
     /* NEAR > FAR turns the ramp round: --depth-range 18,8 is the courses' -depth 8 18
      * (near black, far white) */
-    if (!ok || !isfinite(lo) || !isfinite(hi) || !(lo >= 0.0) || !(hi >= 0.0) || !(hi != lo))
+    if (!read_number_list(v, d, 2) || !(d[0] >= 0.0) || !(d[1] >= 0.0) || !(d[1] != d[0]))
         return error_set(err, ST_USAGE, "--depth-range expects NEAR,FAR, two different distances >= 0 "
                          "(NEAR > FAR inverts the grey), got '%s'", v);
-    o->depth_near = lo;
-    o->depth_far = hi;
+    o->depth_near = d[0];
+    o->depth_far = d[1];
     return ST_OK;
 }
 
@@ -480,16 +509,8 @@ static Status parse_depth_range(const char *v, Options *o, Error *err)
  * samples per pixel once the scene is read). */
 static Status parse_sample_range(const char *v, Options *o, Error *err)
 {
-    char *end;
-    errno = 0;
-    long a = strtol(v, &end, 10), b = -1;
-    int ok = end != v && *end == ':' && !errno && v[0] != '-' && v[0] != '+' && !starts_blank(v);
-    if (ok) {
-        const char *second = end + 1;
-        b = strtol(second, &end, 10);
-        ok = end != second && !*end && !errno && second[0] != '-' && second[0] != '+' && !starts_blank(second);
-    }
-    if (!ok || a < 0 || b <= a || b > CLPT_MAX_SPP)
+    long a, b;
+    if (!read_index_pair(v, &a, &b) || a < 0 || b <= a || b > CLPT_MAX_SPP)
         return error_set(err, ST_USAGE, "--sample-range expects A:B, sample indices with 0 <= A < B <= %d, got '%s'",
                          CLPT_MAX_SPP, v);
     o->range_first = a;
@@ -501,16 +522,8 @@ static Status parse_sample_range(const char *v, Options *o, Error *err)
  * length once the scene is read). */
 static Status parse_frames(const char *v, Options *o, Error *err)
 {
-    char *end;
-    errno = 0;
-    long a = strtol(v, &end, 10), b = -1;
-    int ok = end != v && *end == ':' && !errno && v[0] != '-' && v[0] != '+' && !starts_blank(v);
-    if (ok) {
-        const char *second = end + 1;
-        b = strtol(second, &end, 10);
-        ok = end != second && !*end && !errno && second[0] != '-' && second[0] != '+' && !starts_blank(second);
-    }
-    if (!ok || a < 0 || b > CLPT_MAX_FRAME)
+    long a, b;
+    if (!read_index_pair(v, &a, &b) || a < 0 || b > CLPT_MAX_FRAME)
         return error_set(err, ST_USAGE, "--frames expects A:B, frame numbers with 0 <= A <= B <= %d, got '%s'",
                          CLPT_MAX_FRAME, v);
     if (a > b)
@@ -518,35 +531,6 @@ static Status parse_frames(const char *v, Options *o, Error *err)
     o->frames_first = a;
     o->frames_last = b;
     return ST_OK;
-}
-
-/* --fps FPS: a number of frames per second in (0, 1000] */
-static Status parse_fps(const char *v, Options *o, Error *err)
-{
-    char *end;
-    errno = 0;
-    double f = strtod(v, &end);
-    if (!*v || *end || errno || starts_blank(v) || !(f > 0.0 && f <= 1000.0))
-        return error_set(err, ST_USAGE, "--fps expects a number of frames per second above 0 and at most 1000, "
-                         "got '%s'", v);
-    o->fps = f;
-    return ST_OK;
-}
-
-/* n numbers separated by commas, nothing else (no blanks: what was typed is what
- * counts), into out; 0 unless exactly that. */
-static int read_number_list(const char *v, double *out, int n)
-{
-    const char *p = v;
-    for (int i = 0; i < n; i++) {
-        char *end;
-        errno = 0;
-        out[i] = strtod(p, &end);
-        if (end == p || errno || starts_blank(p) || !isfinite(out[i])) return 0;
-        if (*end != (i + 1 < n ? ',' : '\0')) return 0;
-        p = end + 1;
-    }
-    return 1;
 }
 
 /* The window of --crop or --pixel-bounds (`kind`, enum CropKind); one of the two. */
@@ -585,6 +569,27 @@ static Status parse_pixel_bounds(const char *v, Options *o, Error *err)
     return set_crop(CROP_PIXELS, v, a, o, err);
 }
 
+/* The flags whose value is one real number in a range, into a double of Options: one
+ * parser each, written by REAL_FLAG from the test on x and the message's front (", got
+ * 'VALUE'" is added). */
+#define REAL_FLAG(function, field, test, expects)                                       \
+    static Status function(const char *v, Options *o, Error *err)                       \
+    {                                                                                   \
+        double x;                                                                       \
+        if (!read_real(v, &x) || !(test)) return error_set(err, ST_USAGE, expects ", got '%s'", v); \
+        o->field = x;                                                                   \
+        return ST_OK;                                                                   \
+    }
+REAL_FLAG(parse_fps, fps, x > 0.0 && x <= 1000.0,
+          "--fps expects a number of frames per second above 0 and at most 1000")
+/* --exposure EV: stops, as Blender's (-32..32) */
+REAL_FLAG(parse_exposure, exposure, x >= -32.0 && x <= 32.0, "--exposure expects a number of stops from -32 to 32")
+REAL_FLAG(parse_adaptive, adaptive, x > 0.0 && x <= 1.0, "--adaptive expects a threshold in (0, 1]")
+REAL_FLAG(parse_noise_threshold, noise_threshold, x > 0.0 && x <= 1.0,
+          "--noise-threshold expects a threshold in (0, 1]")
+REAL_FLAG(parse_clamp, clamp, x > 0.0 && x <= 65536.0, "--clamp expects a radiance limit in (0, 65536]")
+#undef REAL_FLAG
+
 /* --lookat EX,EY,EZ,AX,AY,AZ,UX,UY,UZ: the eye, the point looked at and the up
  * direction. They need nothing of the scene, so the frame is checked here as a whole,
  * as the scene readers check a camera block: distinct points, an up direction that is
@@ -614,25 +619,11 @@ static Status parse_lookat(const char *v, Options *o, Error *err)
 /* --fov DEGREES: in (0, 180), as a camera block's fov */
 static Status parse_fov(const char *v, Options *o, Error *err)
 {
-    char *end;
-    errno = 0;
-    double f = strtod(v, &end);
-    if (!*v || *end || errno || starts_blank(v) || !(f > 0.0 && f < 180.0))
+    double f;
+    if (!read_real(v, &f) || !(f > 0.0 && f < 180.0))
         return error_set(err, ST_USAGE, "--fov expects a vertical field of view in degrees, more than 0 and less "
                          "than 180, got '%s'", v);
     o->fov = v;
-    return ST_OK;
-}
-
-/* --exposure EV: stops, as Blender's (-32..32) */
-static Status parse_exposure(const char *v, Options *o, Error *err)
-{
-    char *end;
-    errno = 0;
-    double ev = strtod(v, &end);
-    if (!*v || *end || errno || starts_blank(v) || !(ev >= -32.0 && ev <= 32.0))
-        return error_set(err, ST_USAGE, "--exposure expects a number of stops from -32 to 32, got '%s'", v);
-    o->exposure = ev;
     return ST_OK;
 }
 
@@ -645,39 +636,6 @@ static Status parse_set(const char *v, Options *o, Error *err)
                          "got '%s'", v);
     if (o->n_sets == OPTIONS_MAX_SETS) return error_set(err, ST_USAGE, "more than %d --set", OPTIONS_MAX_SETS);
     o->sets[o->n_sets++] = v;
-    return ST_OK;
-}
-
-static Status parse_adaptive(const char *v, Options *o, Error *err)
-{
-    char *end;
-    errno = 0;
-    double t = strtod(v, &end);
-    if (!*v || *end || errno || starts_blank(v) || !(t > 0.0 && t <= 1.0))
-        return error_set(err, ST_USAGE, "--adaptive expects a threshold in (0, 1], got '%s'", v);
-    o->adaptive = t;
-    return ST_OK;
-}
-
-static Status parse_noise_threshold(const char *v, Options *o, Error *err)
-{
-    char *end;
-    errno = 0;
-    double t = strtod(v, &end);
-    if (!*v || *end || errno || starts_blank(v) || !(t > 0.0 && t <= 1.0))
-        return error_set(err, ST_USAGE, "--noise-threshold expects a threshold in (0, 1], got '%s'", v);
-    o->noise_threshold = t;
-    return ST_OK;
-}
-
-static Status parse_clamp(const char *v, Options *o, Error *err)
-{
-    char *end;
-    errno = 0;
-    double c = strtod(v, &end);
-    if (!*v || *end || errno || starts_blank(v) || !(c > 0.0 && c <= 65536.0))
-        return error_set(err, ST_USAGE, "--clamp expects a radiance limit in (0, 65536], got '%s'", v);
-    o->clamp = c;
     return ST_OK;
 }
 

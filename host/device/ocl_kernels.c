@@ -28,47 +28,68 @@ static Status set_scene_args(OclDevice *od, cl_kernel k, Error *err)
     return ST_OK;
 }
 
+/* The kernels of a wave that take the scene buffers: its megakernel, or the four
+ * stages of its wavefront; their count. */
+static int wave_scene_kernels(const WaveSlot *w, cl_kernel k[4])
+{
+    if (w->k_path) {
+        k[0] = w->k_path;
+        return 1;
+    }
+    k[0] = w->k_raygen;
+    k[1] = w->k_intersect;
+    k[2] = w->k_shade;
+    k[3] = w->k_shadow;
+    return 4;
+}
+
+/* The arguments of a wave's kernels that name a wave buffer and stay the same for the
+ * whole render, one line each: X(kernel, argument, buffer), kernel and buffer being
+ * WaveSlot members. The megakernel's list and the wavefront's; the film kernel's one
+ * belongs to both. */
+#define PATH_FIXED_ARGS(X)                          \
+    X(k_path, ARG_PATH_PATHS, paths)                \
+    X(k_path, ARG_PATH_RAYS, rays)                  \
+    X(k_path, ARG_PATH_SHADOW_RAYS, shadow_rays)    \
+    X(k_path, ARG_PATH_COUNTERS, counts)
+#define WAVEFRONT_FIXED_ARGS(X)                          \
+    X(k_raygen, ARG_RAYGEN_PATHS, paths)                 \
+    X(k_raygen, ARG_RAYGEN_RAYS, rays)                   \
+    X(k_raygen, ARG_RAYGEN_QUEUE, queue_a)               \
+    X(k_intersect, ARG_INTERSECT_RAYS, rays)             \
+    X(k_intersect, ARG_INTERSECT_HITS, hits)             \
+    X(k_intersect, ARG_INTERSECT_COUNTS, counts)         \
+    X(k_intersect, ARG_INTERSECT_PATHS, paths)           \
+    X(k_shade, ARG_SHADE_RAYS, rays)                     \
+    X(k_shade, ARG_SHADE_HITS, hits)                     \
+    X(k_shade, ARG_SHADE_PATHS, paths)                   \
+    X(k_shade, ARG_SHADE_SHADOW_RAYS, shadow_rays)       \
+    X(k_shade, ARG_SHADE_SHADOW_QUEUE, shadow_queue)     \
+    X(k_shade, ARG_SHADE_COUNTS, counts)                 \
+    X(k_shadow, ARG_SHADOW_QUEUE, shadow_queue)          \
+    X(k_shadow, ARG_SHADOW_RAYS, shadow_rays)            \
+    X(k_shadow, ARG_SHADOW_PATHS, paths)                 \
+    X(k_shadow, ARG_SHADOW_COUNTS, counts)
+
 /* The arguments of a wave's kernels that stay the same for the whole render, set once
  * after the upload; per launch only queues, counts, positions, the pixels a sample
  * covers and the film change. */
 static Status set_fixed_args(OclDevice *od, WaveSlot *w, Error *err)
 {
-    Status st;
-    cl_kernel k = w->k_film;
-    ARG(k, ARG_FILM_PATHS, w->paths);
-    if (w->k_path) {
-        if ((st = set_scene_args(od, w->k_path, err))) return st;
-        k = w->k_path;
-        ARG(k, ARG_PATH_PATHS, w->paths);
-        ARG(k, ARG_PATH_RAYS, w->rays);
-        ARG(k, ARG_PATH_SHADOW_RAYS, w->shadow_rays);
-        ARG(k, ARG_PATH_COUNTERS, w->counts);
-        return ST_OK;
+    ARG(w->k_film, ARG_FILM_PATHS, w->paths);
+    cl_kernel k[4];
+    int n = wave_scene_kernels(w, k);
+    for (int i = 0; i < n; i++) {
+        Status st = set_scene_args(od, k[i], err);
+        if (st) return st;
     }
-    if ((st = set_scene_args(od, w->k_raygen, err)) || (st = set_scene_args(od, w->k_intersect, err)) ||
-        (st = set_scene_args(od, w->k_shade, err)) || (st = set_scene_args(od, w->k_shadow, err)))
-        return st;
-    k = w->k_raygen;
-    ARG(k, ARG_RAYGEN_PATHS, w->paths);
-    ARG(k, ARG_RAYGEN_RAYS, w->rays);
-    ARG(k, ARG_RAYGEN_QUEUE, w->queue_a);
-    k = w->k_intersect;
-    ARG(k, ARG_INTERSECT_RAYS, w->rays);
-    ARG(k, ARG_INTERSECT_HITS, w->hits);
-    ARG(k, ARG_INTERSECT_COUNTS, w->counts);
-    ARG(k, ARG_INTERSECT_PATHS, w->paths);
-    k = w->k_shade;
-    ARG(k, ARG_SHADE_RAYS, w->rays);
-    ARG(k, ARG_SHADE_HITS, w->hits);
-    ARG(k, ARG_SHADE_PATHS, w->paths);
-    ARG(k, ARG_SHADE_SHADOW_RAYS, w->shadow_rays);
-    ARG(k, ARG_SHADE_SHADOW_QUEUE, w->shadow_queue);
-    ARG(k, ARG_SHADE_COUNTS, w->counts);
-    k = w->k_shadow;
-    ARG(k, ARG_SHADOW_QUEUE, w->shadow_queue);
-    ARG(k, ARG_SHADOW_RAYS, w->shadow_rays);
-    ARG(k, ARG_SHADOW_PATHS, w->paths);
-    ARG(k, ARG_SHADOW_COUNTS, w->counts);
+#define X(kernel, argument, buffer) ARG(w->kernel, argument, w->buffer);
+    if (w->k_path) {
+        PATH_FIXED_ARGS(X)
+    } else {
+        WAVEFRONT_FIXED_ARGS(X)
+    }
+#undef X
     return ST_OK;
 }
 
@@ -163,15 +184,9 @@ Status ocld_need_program(Device *d, OclDevice *od, uint integrator, Error *err)
 Status ocld_set_scene_arg(OclDevice *od, unsigned b, Error *err)
 {
     for (int i = 0; i < WAVE_SLOTS && od->programs[PROG_PATH]; i++) {
-        WaveSlot *w = &od->waves[i];
-        if (w->k_path) {
-            ARG(w->k_path, b, od->scene[b]);
-            continue;
-        }
-        ARG(w->k_raygen, b, od->scene[b]);
-        ARG(w->k_intersect, b, od->scene[b]);
-        ARG(w->k_shade, b, od->scene[b]);
-        ARG(w->k_shadow, b, od->scene[b]);
+        cl_kernel k[4];
+        int n = wave_scene_kernels(&od->waves[i], k);
+        for (int j = 0; j < n; j++) ARG(k[j], b, od->scene[b]);
     }
     if (od->programs[PROG_WHITTED]) ARG(od->k_whitted, b, od->scene[b]);
     return ST_OK;

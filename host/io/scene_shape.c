@@ -13,13 +13,30 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { SPH_CENTER, SPH_RADIUS, SPH_MATERIAL, SPH_INTERIOR, SPH_EXTERIOR, SPH_N };
+/* Every shape's surface takes the same last three keys: its material and the media on
+ * either side of it. One list for all of them, so that they read, check and bind
+ * their surface the same way; SURFACE_KEY_IDS keeps the three in this order, which
+ * shape_surface relies on. */
+#define SURFACE_KEY_IDS(prefix) prefix##_MATERIAL, prefix##_INTERIOR, prefix##_EXTERIOR
+#define MEDIUM_KEYS(prefix)                                              \
+    [prefix##_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL}, \
+    [prefix##_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL}
+#define SURFACE_KEYS(prefix)                                              \
+    [prefix##_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL}, \
+    MEDIUM_KEYS(prefix)
+
+/* The material a shape gets from its surface keys (v[prefix##_MATERIAL] onwards),
+ * bound to its interior and exterior media. */
+static Status shape_surface(Parser *p, const Value *surface, uint *material)
+{
+    return scene_shape_media(p, &surface[1], &surface[2], surface[0].material, material);
+}
+
+enum { SPH_CENTER, SPH_RADIUS, SURFACE_KEY_IDS(SPH), SPH_N };
 static const KeySpec sphere_keys[SPH_N] = {
     [SPH_CENTER] = {"center", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     [SPH_RADIUS] = {"radius", VK_NUMBER, 1, 0, INFINITY, 1, 1, "a radius > 0"},
-    [SPH_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
-    [SPH_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
-    [SPH_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
+    SURFACE_KEYS(SPH),
 };
 
 Status scene_parse_sphere(Parser *p, Lexer *lx, const Token *kw)
@@ -37,18 +54,15 @@ Status scene_parse_sphere(Parser *p, Lexer *lx, const Token *kw)
     memset(&sp, 0, sizeof sp);
     sp.center = c;
     sp.radius = r;
-    if ((st = scene_shape_media(p, &v[SPH_INTERIOR], &v[SPH_EXTERIOR], v[SPH_MATERIAL].material, &sp.material)))
-        return st;
+    if ((st = shape_surface(p, &v[SPH_MATERIAL], &sp.material))) return st;
     return scene_add_sphere(p->s, sp, p->err);
 }
 
-enum { PL_POINT, PL_NORMAL, PL_MATERIAL, PL_INTERIOR, PL_EXTERIOR, PL_N };
+enum { PL_POINT, PL_NORMAL, SURFACE_KEY_IDS(PL), PL_N };
 static const KeySpec plane_keys[PL_N] = {
     [PL_POINT] = {"point", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     [PL_NORMAL] = {"normal", VK_DIR, 1, 0, 0, 0, 0, NULL},
-    [PL_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
-    [PL_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
-    [PL_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
+    SURFACE_KEYS(PL),
 };
 
 Status scene_parse_plane(Parser *p, Lexer *lx, const Token *kw)
@@ -65,8 +79,7 @@ Status scene_parse_plane(Parser *p, Lexer *lx, const Token *kw)
     memset(&pl, 0, sizeof pl);
     pl.normal = v3((float)nx, (float)ny, (float)nz);
     pl.offset = (float)(nx * q.x + ny * q.y + nz * q.z);
-    if ((st = scene_shape_media(p, &v[PL_INTERIOR], &v[PL_EXTERIOR], v[PL_MATERIAL].material, &pl.material)))
-        return st;
+    if ((st = shape_surface(p, &v[PL_MATERIAL], &pl.material))) return st;
     return scene_add_plane(p->s, pl, p->err);
 }
 
@@ -92,56 +105,49 @@ static Status add_triangle(Parser *p, const Lexer *lx, const Token *kw, vec3 a, 
     return scene_add_triangle(p->s, t, p->err);
 }
 
-enum { TRI_V0, TRI_V1, TRI_V2, TRI_V3, TRI_MATERIAL, TRI_INTERIOR, TRI_EXTERIOR, TRI_N };
-/* a triangle's keys are a quad's without v3: TRI_V3 onwards one place earlier */
-static const KeySpec triangle_keys[TRI_N - 1] = {
-    {"v0", VK_VEC3, 1, 0, 0, 0, 0, NULL},
-    {"v1", VK_VEC3, 1, 0, 0, 0, 0, NULL},
-    {"v2", VK_VEC3, 1, 0, 0, 0, 0, NULL},
-    {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
-    {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
-    {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
-};
-static const KeySpec quad_keys[TRI_N] = {
+enum { TRI_V0, TRI_V1, TRI_V2, SURFACE_KEY_IDS(TRI), TRI_N };
+static const KeySpec triangle_keys[TRI_N] = {
     [TRI_V0] = {"v0", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     [TRI_V1] = {"v1", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     [TRI_V2] = {"v2", VK_VEC3, 1, 0, 0, 0, 0, NULL},
-    [TRI_V3] = {"v3", VK_VEC3, 1, 0, 0, 0, 0, NULL},
-    [TRI_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
-    [TRI_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
-    [TRI_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
+    SURFACE_KEYS(TRI),
+};
+enum { QUAD_V0, QUAD_V1, QUAD_V2, QUAD_V3, SURFACE_KEY_IDS(QUAD), QUAD_N };
+static const KeySpec quad_keys[QUAD_N] = {
+    [QUAD_V0] = {"v0", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [QUAD_V1] = {"v1", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [QUAD_V2] = {"v2", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    [QUAD_V3] = {"v3", VK_VEC3, 1, 0, 0, 0, 0, NULL},
+    SURFACE_KEYS(QUAD),
 };
 
 Status scene_parse_triangle(Parser *p, Lexer *lx, const Token *kw)
 {
-    Value v[TRI_N - 1];
-    Status st = scene_parse_block(p, lx, kw, 0, "triangle", triangle_keys, TRI_N - 1, v);
+    Value v[TRI_N];
+    Status st = scene_parse_block(p, lx, kw, 0, "triangle", triangle_keys, TRI_N, v);
     if (st) return st;
     uint m;
-    if ((st = scene_shape_media(p, &v[TRI_INTERIOR - 1], &v[TRI_EXTERIOR - 1], v[TRI_MATERIAL - 1].material, &m)))
-        return st;
-    return add_triangle(p, lx, kw, v[0].v, v[1].v, v[2].v, m, "v0 v1 v2");
+    if ((st = shape_surface(p, &v[TRI_MATERIAL], &m))) return st;
+    return add_triangle(p, lx, kw, v[TRI_V0].v, v[TRI_V1].v, v[TRI_V2].v, m, "v0 v1 v2");
 }
 
 Status scene_parse_quad(Parser *p, Lexer *lx, const Token *kw)
 {
-    Value v[TRI_N];
-    Status st = scene_parse_block(p, lx, kw, 0, "quad", quad_keys, TRI_N, v);
+    Value v[QUAD_N];
+    Status st = scene_parse_block(p, lx, kw, 0, "quad", quad_keys, QUAD_N, v);
     if (st) return st;
     uint m;
-    if ((st = scene_shape_media(p, &v[TRI_INTERIOR], &v[TRI_EXTERIOR], v[TRI_MATERIAL].material, &m))) return st;
-    st = add_triangle(p, lx, kw, v[TRI_V0].v, v[TRI_V1].v, v[TRI_V2].v, m, "v0 v1 v2");
-    if (!st) st = add_triangle(p, lx, kw, v[TRI_V0].v, v[TRI_V2].v, v[TRI_V3].v, m, "v0 v2 v3");
+    if ((st = shape_surface(p, &v[QUAD_MATERIAL], &m))) return st;
+    st = add_triangle(p, lx, kw, v[QUAD_V0].v, v[QUAD_V1].v, v[QUAD_V2].v, m, "v0 v1 v2");
+    if (!st) st = add_triangle(p, lx, kw, v[QUAD_V0].v, v[QUAD_V2].v, v[QUAD_V3].v, m, "v0 v2 v3");
     return st;
 }
 
-enum { BOX_MIN, BOX_MAX, BOX_MATERIAL, BOX_INTERIOR, BOX_EXTERIOR, BOX_N };
+enum { BOX_MIN, BOX_MAX, SURFACE_KEY_IDS(BOX), BOX_N };
 static const KeySpec box_keys[BOX_N] = {
     [BOX_MIN] = {"min", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     [BOX_MAX] = {"max", VK_VEC3, 1, 0, 0, 0, 0, NULL},
-    [BOX_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL},
-    [BOX_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
-    [BOX_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
+    SURFACE_KEYS(BOX),
 };
 
 Status scene_parse_box(Parser *p, Lexer *lx, const Token *kw)
@@ -161,8 +167,7 @@ Status scene_parse_box(Parser *p, Lexer *lx, const Token *kw)
     memset(&b, 0, sizeof b);
     b.lo = lo;
     b.hi = hi;
-    if ((st = scene_shape_media(p, &v[BOX_INTERIOR], &v[BOX_EXTERIOR], v[BOX_MATERIAL].material, &b.material)))
-        return st;
+    if ((st = shape_surface(p, &v[BOX_MATERIAL], &b.material))) return st;
     return scene_add_box(p->s, b, p->err);
 }
 
@@ -178,8 +183,7 @@ static const KeySpec mesh_keys[MESH_N] = {
     [MESH_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
     [MESH_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
     [MESH_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
-    [MESH_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
-    [MESH_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL},
+    MEDIUM_KEYS(MESH),
 };
 
 /* The transform of a block's translate, rotate, rx, ry, rz, scale and matrix keys

@@ -301,6 +301,20 @@ static Status set_material(Parser *p, uint index)
     return ST_OK;
 }
 
+/* Adds material m under the name `name` (a copy; the scene owns it) and records the
+ * name for NamedMaterial; its index into *index. */
+static Status add_named_material(Parser *p, const Token *name, Material m, uint *index)
+{
+    char *n = tok_copy(name);
+    if (!n) return error_set(p->err, ST_INTERNAL, "out of memory");
+    Status st = scene_add_material(p->s, n, m, index, p->err);
+    free(n);
+    if (st) return st;
+    if (strmap_set(&p->named_material, name->text, name->len, *index))
+        return error_set(p->err, ST_INTERNAL, "out of memory");
+    return ST_OK;
+}
+
 Status pbrt_material(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)kw;
@@ -341,14 +355,7 @@ Status pbrt_make_named_material(Parser *p, Lexer *lx, const Token *kw)
         p->s->materials[index] = m;
         return ST_OK;
     }
-    char *n = tok_copy(&name);
-    if (!n) return error_set(p->err, ST_INTERNAL, "out of memory");
-    st = scene_add_material(p->s, n, m, &index, p->err);
-    free(n);
-    if (st) return st;
-    if (strmap_set(&p->named_material, name.text, name.len, index))
-        return error_set(p->err, ST_INTERNAL, "out of memory");
-    return ST_OK;
+    return add_named_material(p, &name, m, &index);
 }
 
 Status pbrt_named_material(Parser *p, Lexer *lx, const Token *kw)
@@ -362,13 +369,8 @@ Status pbrt_named_material(Parser *p, Lexer *lx, const Token *kw)
     /* not defined yet: pbrt-v4 looks names up once the whole scene is read, so a
      * later MakeNamedMaterial (pbrt-v4-scenes' contemporary-bathroom.pbrt includes its
      * materials.pbrt at the end) defines it; a placeholder until then */
-    char *n = tok_copy(&name);
-    if (!n) return error_set(p->err, ST_INTERNAL, "out of memory");
-    st = scene_add_material(p->s, n, material_diffuse(v3(0.5f, 0.5f, 0.5f)), &i, p->err);
-    free(n);
-    if (st) return st;
-    if (strmap_set(&p->named_material, name.text, name.len, i) ||
-        pbrt_grow((void **)&p->pending, &p->cap_pending, p->n_pending + 1, sizeof(PPending)))
+    if ((st = add_named_material(p, &name, material_diffuse(v3(0.5f, 0.5f, 0.5f)), &i))) return st;
+    if (pbrt_grow((void **)&p->pending, &p->cap_pending, p->n_pending + 1, sizeof(PPending)))
         return error_set(p->err, ST_INTERNAL, "out of memory");
     PPending *pd = &p->pending[p->n_pending++];
     pd->index = i;

@@ -783,6 +783,7 @@ typedef struct {                                        /* 80 bytes */
 #ifndef KERNEL_OPENCL
 #include <stddef.h>
 #define CLPT_CHECK_SIZE(T, n) _Static_assert(sizeof(T) == (n), #T " must be " #n " bytes")
+/* One line a struct's size or a field's offset: a declarative list, alike by design. */
 CLPT_CHECK_SIZE(vec3, 12);
 CLPT_CHECK_SIZE(Ray, 32);
 CLPT_CHECK_SIZE(Hit, 32);

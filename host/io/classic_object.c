@@ -159,6 +159,9 @@ static Status read_object(Classic *c, const Token *kw, const char *name, const C
     return st ? st : object_material(c, material);
 }
 
+/* Each object below is its keys (an enum and a ClassicKey table) and a builder that
+ * starts with read_object: their openings are alike by design, what differs is the
+ * table and the geometry after it. */
 enum { SPH_CENTER, SPH_RADIUS, SPH_N };
 static const ClassicKey sphere_keys[SPH_N] = {
     [SPH_CENTER] = {"center", CK_VEC3, 0}, [SPH_RADIUS] = {"radius", CK_POSITIVE, 1},

@@ -156,6 +156,9 @@ Status pbrt_expect_defined(Parser *p, Lexer *lx, const StrMap *map, const char *
 Status pbrt_expect_numbers(Parser *p, Lexer *lx, double *out, int n, const char *what);
 char *pbrt_beside_main(const Parser *p, const Token *f);
 
+/* The directive handlers declared below all take (Parser, Lexer, the directive's
+ * token), the signature pbrt_parse.c's directive table calls: their declarations are
+ * alike by design, one per entry of that table. */
 /* pbrt_material.c: Material, MakeNamedMaterial, NamedMaterial, Texture */
 Status pbrt_material(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_make_named_material(Parser *p, Lexer *lx, const Token *kw);

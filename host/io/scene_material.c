@@ -25,6 +25,8 @@ enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE
        MAT_KEY_SPECULAR_FACTOR, MAT_KEY_SPECULAR_COLOR, MAT_KEY_SHEEN_COLOR, MAT_KEY_SHEEN_ROUGHNESS,
        MAT_KEY_SUBSURFACE, MAT_KEY_SUBSURFACE_COLOR, MAT_KEY_SUBSURFACE_RADIUS, MAT_KEY_SUBSURFACE_SCALE,
        MAT_KEY_SUBSURFACE_ANISOTROPY, MAT_KEY_N };
+/* One row per key, read and checked by scene_parse_block: a declarative table, so
+ * rows of keys of the same kind (colours, numbers in [0, 1]) are alike by design. */
 static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_TYPE] = {"type", VK_WORD, 1, 0, 0, 0, 0,
                       "a material type (diffuse, metal, conductor, dielectric, principled, emissive, phong)"},

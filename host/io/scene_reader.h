@@ -99,6 +99,9 @@ Status scene_parse_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
 double scene_len_d(vec3 a);
 vec3 scene_cross_d(vec3 a, vec3 b, double *length);
 
+/* The statement handlers declared below all take (Parser, Lexer, the statement's
+ * token), the signature scene_parse.c's statement table calls: their declarations are
+ * alike by design, one per entry of that table. */
 /* scene_material.c: material, texture */
 Status scene_parse_material_block(Parser *p, Lexer *lx, const Token *kw, int brace_taken,
                                   const char *name, uint *index);

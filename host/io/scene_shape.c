@@ -26,7 +26,9 @@
     MEDIUM_KEYS(prefix)
 
 /* The material a shape gets from its surface keys (v[prefix##_MATERIAL] onwards),
- * bound to its interior and exterior media. */
+ * bound to its interior and exterior media. Each shape below is a key table and a
+ * builder that starts with scene_parse_block and binds its surface here: their
+ * openings are alike by design, what differs is the table and the geometry. */
 static Status shape_surface(Parser *p, const Value *surface, uint *material)
 {
     return scene_shape_media(p, &surface[1], &surface[2], surface[0].material, material);

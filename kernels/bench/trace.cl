@@ -24,7 +24,9 @@ __kernel void k_trace_closest(SCENE_ARGS __global const Ray *rays, uint n, __glo
     }
 }
 
-/* Whether rays[2i] and rays[2i+1] hit anything, into occluded[] (1 or 0). */
+/* Whether rays[2i] and rays[2i+1] hit anything, into occluded[] (1 or 0). The pair
+ * walk of k_trace_closest for shadow rays: alike by design, as each is what the bench
+ * times for its own walk (trace_any2, not trace_closest2) and result type. */
 __kernel void k_trace_any(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
 {
     uint a = 2u * (uint)get_global_id(0), b = a + 1u;

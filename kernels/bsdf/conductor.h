@@ -67,7 +67,10 @@ KFN BsdfSample bsdf_sample_mirror_conductor(Conductor c, vec3 d, vec3 ns, vec3 n
     return bsdf_delta_sample(bsdf_mirror_dir(d, ns, ng), conductor_fresnel(c, -v3_dot(d, ns)), 0);
 }
 
-/* ---------------------------------------------------------------- MAT_CONDUCTOR */
+/* ---------------------------------------------------------------- MAT_CONDUCTOR
+ * The entry points bsdf.h dispatches to. Every lobe family's eval and sample have the
+ * same frame-in, frame-out shape (dielectric.h's too) by design: only the family's
+ * own lobe call differs, and OpenCL C has no function pointers to share the rest. */
 KFN int conductor_bsdf_has_density(Material m, vec3 albedo) { return bsdf_density_if_rough(m, albedo); }
 
 KFN vec3 conductor_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)

@@ -144,7 +144,8 @@ KFN BsdfSample bsdf_sample_thin(Dielectric g, vec3 d, vec3 ng, float u)
     return bsdf_delta_sample(transmitted ? d : reflect_dir(d, ng), v3s(1.0f), transmitted);
 }
 
-/* ---------------------------------------------------------------- MAT_DIELECTRIC */
+/* ---------------------------------------------------------------- MAT_DIELECTRIC
+ * The entry points bsdf.h dispatches to, shaped as conductor.h's by design. */
 KFN int dielectric_bsdf_has_density(Material m, vec3 albedo) { return bsdf_density_if_rough(m, albedo); }
 
 KFN vec3 dielectric_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)

@@ -2,8 +2,9 @@
 """Peer benchmark: clpt against Mitsuba 3 and Blender Cycles at equal quality.
 
 usage: bench/peers.py [--clpt build/clpt] [--clpt-args ARGS] [--peers DIR] [--out DIR]
-                      [--runs N] [--ref-spp cornell=4096,dragon=1024] [--device DEV]
-                      [--threads N] [--scenes cornell,dragon]
+                      [--runs N] [--ref-spp cornell=4096,dragon=1024,...] [--device DEV]
+                      [--threads N] [--scenes cornell,dragon,envmat,fog,smoke]
+                      [--renderers mitsuba,cycles]
 
 Renders the two scenes of ../shared/peers (its README says how they were matched across
 renderers; the scene files and peer scripts are used from there as they are, so every
@@ -11,9 +12,16 @@ renderer sees the same scene):
   cornell  McGuire's CornellBox-Original, 512x512, 64 spp, 8 bounces, light facing down
   dragon   the Stanford dragon (871k triangles) on a floor under a small area light,
            512x512, 16 spp
+and three that bench/peers_scenes.py writes into --out for clpt and Mitsuba from the same
+triangles (tools/xcheck's geometry and media), 256x256 (a quarter of the pixels, so that
+their references take minutes on two cores), 16 spp, 8 bounces:
+  envmat   rough gold, rough glass and Lambertian spheres on a floor under courtyard.hdr
+  fog      a sphere of homogeneous fog and a Lambertian sphere under a square area light
+  smoke    the same with a 16^3 density grid in the sphere (a heterogeneous medium)
 with clpt and, when installed, Mitsuba 3 (`pip install mitsuba`; its fast variant
 llvm_ad_rgb needs Debian's libllvm19, else scalar_rgb is used) and Cycles (Debian
-`blender` and `python3-numpy`; the Cornell box only, as in ../shared/peers). The renderers take turns within
+`blender` and `python3-numpy`; the Cornell box only, as in ../shared/peers); `sh
+tools/deps.sh peers` installs all three. The renderers take turns within
 each of --runs rounds (interleaved, so a change in the machine's load hits all of them
 alike); times are medians over the rounds, squared errors the mean over them (seed = round).
 
@@ -24,7 +32,9 @@ with different pixel filters compare on noise and bias. The reference is the mea
 halves rendered with seeds 777 and 778: a quarter of their squared difference is the
 reference's own squared error, which would otherwise add to every renderer's (the less
 noisy renderer's the most, in proportion), so it is taken off each MSE; at 64 times a
-scene's spp it is 1-2% of clpt's. time x MSE is the
+scene's spp it is 1-2% of clpt's. "mean / ref" is the kept pixels' mean over the
+reference's: a renderer that models the scene differently shows it there (and its
+bias adds to its RMSE). time x MSE is the
 error-per-time figure (lower is better; for unbiased Monte Carlo, MSE falls as 1/time),
 and "clpt time to equal error" is clpt's time x MSE over the peer's: the share of the
 peer's time that clpt needs to reach the peer's error (below 1: clpt is faster).
@@ -38,7 +48,8 @@ that is the Sobol points' faster convergence at twice the continuations, which t
 peers would also see at twice their samples (clpt's plain 32 spp on the dragon: 0.88
 of 16 spp's time x MSE).
 
-Standard library only; numpy is used for the error when it is importable (faster).
+Standard library only for the peers' scenes; numpy is used for the error when it is importable
+(faster), and the generated scenes need it (tools/xcheck's writers).
 """
 import argparse
 import array
@@ -57,11 +68,17 @@ except ImportError:
     np = None
 
 SCENES = {
-    # name: (clpt scene file in the peers folder, spp, whether Cycles has the scene)
+    # name: (clpt scene file in the peers folder, or None: written by peers_scenes.py into
+    # --out; spp; whether Cycles has the scene)
     'cornell': ('cornell-mcguire.scene', 64, True),
     'dragon': ('dragon.scene', 16, False),
+    'envmat': (None, 16, False),
+    'fog': (None, 16, False),
+    'smoke': (None, 16, False),
 }
-SIZE = 512
+# the reference's samples: 64 times the scene's on the peers' scenes, 32 times on the
+# generated ones (their references' own error is measured and taken off all the same)
+REF_SPP = {'cornell': 4096, 'dragon': 1024, 'envmat': 512, 'fog': 512, 'smoke': 512}
 LLVM19 = '/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1'
 
 
@@ -134,7 +151,7 @@ class Clpt:
         self.label = 'clpt (%s%s)' % (a.device or 'default device', ', ' + a.clpt_args if a.clpt_args else '')
 
     def cmd(self, scene, spp, seed, out):
-        c = [self.a.clpt, os.path.join(self.a.peers, SCENES[scene][0]), '--spp', str(spp), '--seed', str(seed),
+        c = [self.a.clpt, scene_file(self.a, scene), '--spp', str(spp), '--seed', str(seed),
              '--stats', '-q', '-o', out] + self.a.clpt_args.split()
         return c + (['--device', self.a.device] if self.a.device else [])
 
@@ -151,8 +168,8 @@ class Clpt:
 
 class Mitsuba:
     name = 'mitsuba'
-    install = ('not installed: `pip install mitsuba` (its fast variant llvm_ad_rgb also needs '
-               '`apt-get install libllvm19`)')
+    install = ('not installed: `sh tools/deps.sh peers` (pip installs mitsuba; Debian\'s libllvm19 '
+               'gives it its fast variant llvm_ad_rgb)')
 
     def __init__(self, a):
         self.a = a
@@ -171,6 +188,10 @@ class Mitsuba:
                               stderr=subprocess.DEVNULL).returncode == 0
 
     def cmd(self, scene, spp, seed, out):
+        if SCENES[scene][0] is None:
+            return [sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), 'peers_scenes.py'),
+                    'mitsuba', scene, str(spp), out, str(seed), self.variant, 'multijitter',
+                    os.path.abspath(self.a.out)]
         return [sys.executable, os.path.join(self.a.peers, 'mitsuba_render.py'), scene, str(spp), out, str(seed),
                 self.variant, 'multijitter']
 
@@ -194,7 +215,7 @@ class Mitsuba:
 
 class Cycles:
     name = 'cycles'
-    install = 'not installed: `apt-get install blender python3-numpy` (Debian 12: Blender 3.4)'
+    install = 'not installed: `sh tools/deps.sh peers` (Debian\'s blender and python3-numpy; Debian 12: Blender 3.4)'
 
     def __init__(self, a):
         self.a = a
@@ -219,6 +240,21 @@ class Cycles:
         return {'render_s': render_s, 'wall_s': wall, 'setup_s': wall - render_s}
 
 
+def scene_file(a, scene):
+    """The clpt scene file: the peers folder's, or the one peers_scenes.py wrote into --out."""
+    if SCENES[scene][0] is None:
+        return os.path.join(a.out, scene + '.scene')
+    return os.path.join(a.peers, SCENES[scene][0])
+
+
+def masked_mean(img, keep):
+    if np is not None:
+        return float(np.frombuffer(img, dtype=np.float32).astype(np.float64).reshape(-1, 3)[
+            np.asarray(keep, dtype=bool)].mean())
+    s = sum(img[3 * i] + img[3 * i + 1] + img[3 * i + 2] for i in range(len(img) // 3) if keep[i])
+    return s / max(3 * sum(1 for k in keep if k), 1)
+
+
 def reference(a, scene):
     """The scene's reference: (width, height, the mean of its two halves, the squared error
     of that mean as a quarter of the halves' mean squared difference, per kept pixel)."""
@@ -234,7 +270,7 @@ def reference(a, scene):
     (w, h, ha), (_, _, hb) = halves
     ref = array.array('f', ((x + y) * 0.5 for x, y in zip(ha, hb)))
     keep = silhouette_keep(w, h, ref)
-    return w, h, ref, keep, masked_mse(ha, hb, keep) / 4.0
+    return w, h, ref, keep, masked_mse(ha, hb, keep) / 4.0, masked_mean(ref, keep)
 
 
 def fmt_s(x):
@@ -248,13 +284,16 @@ def main():
     ap.add_argument('--peers', default='../shared/peers', help='the folder of the peer scenes and scripts')
     ap.add_argument('--out', default='build/peers')
     ap.add_argument('--runs', type=int, default=3, help='rounds (at least 1)')
-    ap.add_argument('--ref-spp', default='cornell=4096,dragon=1024')
+    ap.add_argument('--ref-spp', default='', help='SCENE=SPP,... the reference samples where not %s' % (
+        ','.join('%s=%d' % kv for kv in REF_SPP.items())))
     ap.add_argument('--device', default='', help="clpt's --device (default: clpt's default)")
     ap.add_argument('--threads', type=int, default=2, help="Cycles' render threads")
-    ap.add_argument('--scenes', default='cornell,dragon')
+    ap.add_argument('--scenes', default=','.join(SCENES))
+    ap.add_argument('--renderers', default='mitsuba,cycles', help='the peers to run when installed')
     a = ap.parse_args()
     a.peers = os.path.abspath(a.peers)   # the peer scripts run in --out
-    a.ref_spp = dict((k, int(v)) for k, v in (x.split('=', 1) for x in a.ref_spp.split(',')))
+    given = dict((k, int(v)) for k, v in (x.split('=', 1) for x in a.ref_spp.split(',') if x))
+    a.ref_spp = dict(REF_SPP, **given)
     if a.runs < 1:
         raise SystemExit('--runs %d: at least one round' % a.runs)
     for s, n in a.ref_spp.items():
@@ -267,9 +306,22 @@ def main():
     if not os.path.exists(os.path.join(a.peers, 'README.md')):
         raise SystemExit('%s: the peer scenes are not there (--peers DIR)' % a.peers)
     os.makedirs(a.out, exist_ok=True)
+    for s in scenes:
+        if SCENES[s][0] is None:
+            # tools/xcheck's writers need numpy (which Mitsuba needs anyway)
+            sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+            try:
+                import peers_scenes
+            except ImportError as e:
+                raise SystemExit('scene %s: %s (apt-get install python3-numpy, or --scenes cornell,dragon)' % (s, e))
+            if s == 'envmat' and not os.path.exists(peers_scenes.ENVMAP):
+                raise SystemExit('%s: the envmat scene\'s map is not there' % peers_scenes.ENVMAP)
+            peers_scenes.write_clpt(s, a.out)
 
     renderers = [Clpt(a)]
     for cls in (Mitsuba, Cycles):
+        if cls.name not in a.renderers.split(','):
+            continue
         if cls.available():
             renderers.append(cls(a))
         else:
@@ -282,24 +334,27 @@ def main():
     results = {}   # (scene, renderer name) -> list of (times dict, MSE less the reference's)
     for rnd in range(1, a.runs + 1):
         for s in scenes:
-            _, _, ref, keep, ref_mse = refs[s]
+            _, _, ref, keep, ref_mse, _ = refs[s]
             spp = SCENES[s][1]
             for r in renderers:
                 if r.name == 'cycles' and not SCENES[s][2]:
                     continue
                 out = os.path.join(a.out, '%s-%s-%d.pfm' % (s, r.name, rnd))
                 t = r.render(s, spp, rnd, out)
-                mse = masked_mse(read_pfm(out)[2], ref, keep) - ref_mse
+                img = read_pfm(out)[2]
+                mse = masked_mse(img, ref, keep) - ref_mse
+                t['mean'] = masked_mean(img, keep) / refs[s][5]
                 results.setdefault((s, r.name), []).append((t, mse))
                 print('round %d %-8s %-8s render %6.2f s  wall %6.2f s  RMSE %.5f' % (
                     rnd, s, r.name, t['render_s'], t['wall_s'], math.sqrt(max(mse, 0.0))), flush=True)
 
     print()
     print("| scene | renderer | render time | start-up + load + build | Msamples/s | RMSE (masked, less the reference's own) "
-          '| time x MSE | clpt time to equal error |')
-    print('|---|---|---|---|---|---|---|---|')
+          '| mean / ref | time x MSE | clpt time to equal error |')
+    print('|---|---|---|---|---|---|---|---|---|')
     for s in scenes:
         spp = SCENES[s][1]
+        w, h = refs[s][0], refs[s][1]
         rows = {}
         for r in renderers:
             got = results.get((s, r.name))
@@ -308,15 +363,16 @@ def main():
             render_s = statistics.median(t['render_s'] for t, _ in got)
             setup_s = statistics.median(t['setup_s'] for t, _ in got)
             mse = max(sum(x for _, x in got) / len(got), 0.0)
-            rows[r.name] = (r.label, render_s, setup_s, math.sqrt(mse), render_s * mse)
-        clpt_tm = rows['clpt'][4]
-        for name, (label, render_s, setup_s, e, tm) in rows.items():
+            mean = sum(t['mean'] for t, _ in got) / len(got)
+            rows[r.name] = (r.label, render_s, setup_s, math.sqrt(mse), mean, render_s * mse)
+        clpt_tm = rows['clpt'][5]
+        for name, (label, render_s, setup_s, e, mean, tm) in rows.items():
             ratio = '1 (itself)' if name == 'clpt' else '%.2f' % (clpt_tm / tm)
-            print('| %s | %s | %s | %s | %.2f | %.5f | %.2e | %s |' % (
-                s, label, fmt_s(render_s), fmt_s(setup_s), SIZE * SIZE * spp / render_s / 1e6, e, tm, ratio))
+            print('| %s | %s | %s | %s | %.2f | %.5f | %.4f | %.2e | %s |' % (
+                s, label, fmt_s(render_s), fmt_s(setup_s), w * h * spp / render_s / 1e6, e, mean, tm, ratio))
         if 'cycles' not in rows and any(r.name == 'cycles' for r in renderers):
             print('| %s | Cycles | not rendered: ../shared/peers has the Cornell box only for Cycles '
-                  '| | | | | |' % s)
+                  '| | | | | | |' % s)
 
 
 if __name__ == '__main__':

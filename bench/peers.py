@@ -39,14 +39,14 @@ error-per-time figure (lower is better; for unbiased Monte Carlo, MSE falls as 1
 and "clpt time to equal error" is clpt's time x MSE over the peer's: the share of the
 peer's time that clpt needs to reach the peer's error (below 1: clpt is faster).
 
-Each renderer runs with its best settings for these scenes: Mitsuba with its multijitter
-sampler, Cycles with PMJ, clpt with --clpt-args, by default `--split 2` (two
-continuations from each camera sample's first hit, sharing its camera ray: on both
-scenes a fifth to a quarter less time x MSE than without, with silhouettes left out as
-here; over whole images it costs the McGuire box 9% instead, bench/RESULTS.md). Part of
-that is the Sobol points' faster convergence at twice the continuations, which the
-peers would also see at twice their samples (clpt's plain 32 spp on the dragon: 0.88
-of 16 spp's time x MSE).
+Each peer runs with its best settings for these scenes: Mitsuba with its multijitter
+sampler, Cycles with PMJ; clpt with its defaults, as a user gets it (issue 45: a setting
+that wins becomes clpt's default), plus --clpt-args when given. `--clpt-args "--split
+2"` (two continuations from each camera sample's first hit, sharing its camera ray) gave
+the Cornell box and the dragon a fifth to a quarter less time x MSE with silhouettes left
+out as here, but costs the McGuire box 9% over whole images (bench/RESULTS.md), so it is
+not clpt's default. Part of its gain is the Sobol points' faster convergence at twice the
+continuations, which the peers would also see at twice their samples.
 
 Standard library only for the peers' scenes; numpy is used for the error when it is importable
 (faster), and the generated scenes need it (tools/xcheck's writers).
@@ -280,7 +280,7 @@ def fmt_s(x):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--clpt', default='build/clpt')
-    ap.add_argument('--clpt-args', default='--split 2', help="clpt's options for the scenes (default: --split 2)")
+    ap.add_argument('--clpt-args', default='', help="clpt's options for the scenes (default: none, clpt's defaults)")
     ap.add_argument('--peers', default='../shared/peers', help='the folder of the peer scenes and scripts')
     ap.add_argument('--out', default='build/peers')
     ap.add_argument('--runs', type=int, default=3, help='rounds (at least 1)')

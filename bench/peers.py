@@ -53,6 +53,8 @@ Standard library only for the peers' scenes; numpy is used for the error when it
 """
 import argparse
 import array
+import glob
+import hashlib
 import json
 import math
 import os
@@ -255,13 +257,25 @@ def masked_mean(img, keep):
     return s / max(3 * sum(1 for k in keep if k), 1)
 
 
+def ref_tag(a, scene):
+    """The name a reference is kept under: a generated scene's carries a hash of its files,
+    so that a changed scene is not compared with the reference of the scene before."""
+    if SCENES[scene][0] is None:
+        h = hashlib.sha256()
+        for path in [scene_file(a, scene)] + sorted(glob.glob(os.path.join(a.out, scene + '-*.ply'))):
+            with open(path, 'rb') as f:
+                h.update(f.read())
+        return '%s-%s' % (scene, h.hexdigest()[:8])
+    return scene
+
+
 def reference(a, scene):
     """The scene's reference: (width, height, the mean of its two halves, the squared error
     of that mean as a quarter of the halves' mean squared difference, per kept pixel)."""
     spp = a.ref_spp[scene]
     halves = []
     for seed, name in ((777, 'a'), (778, 'b')):
-        path = os.path.join(a.out, 'ref-%s-%d-%s.pfm' % (scene, spp, name))
+        path = os.path.join(a.out, 'ref-%s-%d-%s.pfm' % (ref_tag(a, scene), spp, name))
         if not os.path.exists(path):
             print('making half %s of the %s reference with clpt, %d spp (once; kept as %s)...' % (
                 name, scene, spp // 2, path), flush=True)

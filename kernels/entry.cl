@@ -371,6 +371,8 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)sizeof(MotionKey);
     out[i++] = (uint)__builtin_offsetof(MotionKey, stretch);
     out[i++] = (uint)__builtin_offsetof(Camera, motion_keys);
+    out[i++] = (uint)__builtin_offsetof(Material, diffuse_transmission);
+    out[i++] = (uint)__builtin_offsetof(Material, diffuse_transmission_color);
 }
 #endif
 

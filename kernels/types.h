@@ -103,7 +103,8 @@
  *   MAT_PRINCIPLED  glTF metallic-roughness (kernels/bsdf/principled.h): base colour =
  *                   albedo, metallic, roughness, transmission + ior (MAT_THIN),
  *                   clearcoat + clearcoat_roughness, specular_factor + specular_color,
- *                   sheen_color + sheen_roughness, and inside a solid (not MAT_THIN)
+ *                   sheen_color + sheen_roughness, diffuse_transmission (+ _color),
+ *                   and inside a solid (not MAT_THIN)
  *                   Beer-Lambert absorption
  *   MAT_MIX         pbrt's mix (kernels/material/mix.h): at each hit either material mix_a or,
  *                   with probability amount, mix_b scatters; its own emission and
@@ -345,7 +346,7 @@ typedef struct {                                        /* 32 bytes */
 #define LAYER_BASE_DIFFUSE 0u
 #define LAYER_BASE_CONDUCTOR 1u
 
-typedef struct {                                        /* 288 bytes */
+typedef struct {                                        /* 320 bytes */
     uint type;                /* enum MaterialType */
     uint texture;             /* albedo texture index, NO_INDEX when none */
     float ior;
@@ -389,7 +390,9 @@ typedef struct {                                        /* 288 bytes */
     uint texture_specular_color;           /* RGB times specular_color, or NO_INDEX */
     uint texture_sheen_color;              /* RGB times sheen_color, or NO_INDEX */
     uint texture_sheen_roughness;          /* alpha times sheen_roughness, or NO_INDEX */
-    uint pad_sheen;
+    float diffuse_transmission;            /* MAT_PRINCIPLED: the diffuse layer's share that
+                                            * passes to the back side, Lambertian
+                                            * (KHR_materials_diffuse_transmission); 0: none */
     vec3 layer_albedo;                     /* MAT_LAYERED: the medium's scattering albedo */
     float layer_thickness;                 /* ... its optical depth (extinction 1) */
     float layer_g;                         /* ... Henyey-Greenstein asymmetry */
@@ -403,6 +406,12 @@ typedef struct {                                        /* 288 bytes */
                                             * outside, each 0 for vacuum or 1 + an index
                                             * into media[]; equal: no boundary, a ray
                                             * keeps its medium */
+    vec3 diffuse_transmission_color;       /* MAT_PRINCIPLED: tints the diffuse
+                                            * transmission (1 1 1 by default) */
+    uint texture_diffuse_transmission;     /* alpha times diffuse_transmission, or NO_INDEX */
+    uint texture_diffuse_transmission_color;  /* RGB times diffuse_transmission_color, or
+                                               * NO_INDEX */
+    uint pad_dt0, pad_dt1, pad_dt2;
 } Material;
 
 #define MIX_MAX_DEPTH 8u        /* MAT_MIX: mixes nested at most this deep (mix.h) */
@@ -804,7 +813,7 @@ _Static_assert(offsetof(TriExtra, uv) == 96, "TriExtra.uv");
 CLPT_CHECK_SIZE(Box, 32);
 CLPT_CHECK_SIZE(Plane, 32);
 CLPT_CHECK_SIZE(RevSurface, 48);
-CLPT_CHECK_SIZE(Material, 288);
+CLPT_CHECK_SIZE(Material, 320);
 CLPT_CHECK_SIZE(Light, 96);
 CLPT_CHECK_SIZE(Camera, 112);
 CLPT_CHECK_SIZE(MotionKey, 64);
@@ -844,6 +853,8 @@ _Static_assert(offsetof(Material, layer_albedo) == 240, "Material.layer_albedo")
 _Static_assert(offsetof(Material, base_roughness) == 272, "Material.base_roughness");
 _Static_assert(offsetof(Light, position) == 32, "Light.position");
 _Static_assert(offsetof(Material, medium_in) == 280, "Material.medium_in");
+_Static_assert(offsetof(Material, diffuse_transmission) == 236, "Material.diffuse_transmission");
+_Static_assert(offsetof(Material, diffuse_transmission_color) == 288, "Material.diffuse_transmission_color");
 _Static_assert(offsetof(RenderParams, has_media) == 320, "RenderParams.has_media");
 _Static_assert(offsetof(PathState, medium) == 64, "PathState.medium");
 _Static_assert(offsetof(Medium, sigma_s) == 32, "Medium.sigma_s");

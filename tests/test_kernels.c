@@ -494,7 +494,8 @@ static void test_layout(void)
                     offsetof(Material, medium_in), sizeof(GridMedium), offsetof(GridMedium, nx),
                     offsetof(GridMedium, max_density), offsetof(Medium, emission),
                     offsetof(GridMedium, emission_at), sizeof(MotionKey), offsetof(MotionKey, stretch),
-                    offsetof(Camera, motion_keys) };
+                    offsetof(Camera, motion_keys), offsetof(Material, diffuse_transmission),
+                    offsetof(Material, diffuse_transmission_color) };
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);
@@ -1387,7 +1388,18 @@ static void test_bsdf(void)
                         material_coated_diffuse(v3(0.8f, 0.5f, 0.3f), 0.0f),
                         material_coated_diffuse(v3(0.3f, 0.6f, 0.9f), 0.4f),
                         material_coated_conductor(v3(0.2f, 0.9f, 1.1f), v3(3.6f, 2.6f, 2.4f), 0.3f, 0.2f),
-                        material_coated_conductor(v3(0.2f, 0.9f, 1.1f), v3(3.6f, 2.6f, 2.4f), 0.0f, 0.0f) };
+                        material_coated_conductor(v3(0.2f, 0.9f, 1.1f), v3(3.6f, 2.6f, 2.4f), 0.0f, 0.0f),
+                        material_principled(v3(0.7f, 0.8f, 0.4f), 0.0f, 0.5f),
+                        material_principled(v3(0.9f, 0.9f, 0.9f), 0.2f, 0.3f) };
+    /* KHR_materials_diffuse_transmission: on a solid, and on a thin sheet with the
+     * transmission and sheen lobes too */
+    mats[19].diffuse_transmission = 0.6f;
+    mats[19].diffuse_transmission_color = v3(0.9f, 0.4f, 0.2f);
+    mats[20].diffuse_transmission = 1.0f;
+    mats[20].transmission = 0.3f;
+    mats[20].sheen_color = v3s(0.5f);
+    mats[20].sheen_roughness = 0.6f;
+    mats[20].flags |= MAT_THIN;
     /* coated: a scattering medium in two of them, one conductor all smooth (deltas) */
     mats[17].layer_albedo = v3(0.9f, 0.6f, 0.3f);
     mats[17].layer_thickness = 0.4f;

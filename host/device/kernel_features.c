@@ -25,7 +25,8 @@ unsigned kernel_scene_features(const DeviceScene *s)
         if (m->texture != NO_INDEX || m->texture_emission != NO_INDEX || m->texture_rm != NO_INDEX ||
             m->texture_normal != NO_INDEX || m->texture_specular != NO_INDEX ||
             m->texture_specular_color != NO_INDEX || m->texture_sheen_color != NO_INDEX ||
-            m->texture_sheen_roughness != NO_INDEX)
+            m->texture_sheen_roughness != NO_INDEX || m->texture_diffuse_transmission != NO_INDEX ||
+            m->texture_diffuse_transmission_color != NO_INDEX)
             f |= KF_TEXTURES;
         if (m->flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) f |= KF_ALPHA;
     }

@@ -26,6 +26,8 @@ static Material material_base(uint type)
     m.specular_color = v3s(1.0f);
     m.texture_specular = m.texture_specular_color = NO_INDEX;
     m.texture_sheen_color = m.texture_sheen_roughness = NO_INDEX;
+    m.diffuse_transmission_color = v3s(1.0f);  /* KHR_materials_diffuse_transmission's */
+    m.texture_diffuse_transmission = m.texture_diffuse_transmission_color = NO_INDEX;
     return m;
 }
 

@@ -42,6 +42,15 @@
  * t + (1 - t) W and its tint base t + (1 - t) W. A walk that reaches the surface
  * again from inside leaves it as a Lambertian transmission (shade_path,
  * subsurface_exit_material), not through these lobes.
+ *
+ * KHR_materials_diffuse_transmission: of the diffuse layer that is left, a share dt
+ * passes to the back side as a Lambertian BTDF, the spec's
+ *   diffuse layer = mix(base / pi, dt_color / pi on the back side, dt)
+ * weighted by (1 - F_d) taken at the facet between wo and wi mirrored through the
+ * surface, as the reflected diffuse would be there: with dt_color = base the diffuse
+ * layer's energy only changes side (a white diffuse-transmitting sheet in a white furnace
+ * returns what the white opaque one does). Sampled as a cosine-weighted lower hemisphere.
+ * dt 0 keeps every other material's lobes, shares and densities to the bit.
  */
 #ifndef CLPT_PRINCIPLED_H
 #define CLPT_PRINCIPLED_H
@@ -61,6 +70,8 @@ typedef struct {
     vec3 sheen;        /* KHR_materials_sheen's colour, 0 for none */
     float sheen_roughness;   /* perceptual, at least SHEEN_ROUGHNESS_MIN */
     float subsurface;  /* the diffuse lobe's share that refracts into the solid */
+    float diffuse_transmission;  /* the remaining diffuse layer's share sent to the back */
+    vec3 dt_color;               /* ... its colour */
 } Principled;
 
 /* The share of the dielectric part that refracts (through the transmission lobe): the
@@ -180,12 +191,13 @@ KFN float sheen_scaling(Principled p, float mu_o, float mu_i)
     return k_fmax(1.0f - s * e, 0.0f);
 }
 
-/* The lobes' shares at wo: clearcoat, specular, diffuse and the transmission lobe.
+/* The lobes' shares at wo: clearcoat, specular, diffuse (reflected), diffuse
+ * transmission and the transmission lobe.
  * The transmission lobe reflects from its facet or refracts through it, split by the
  * facet's own F_d, so refraction keeps a share wherever some facet lets light through
  * (beyond the critical angle of the mean surface a rough facet still may). */
 KFN void principled_shares(Principled p, vec3 wo, float *w_cc, float *w_sheen, float *w_spec, float *w_diff,
-                           float *w_trans)
+                           float *w_dt, float *w_trans)
 {
     float fs = principled_reflect_prob(principled_fresnel_rgb(p, wo.z));
     *w_cc = p.clearcoat * schlick1(0.04f, wo.z);
@@ -200,6 +212,9 @@ KFN void principled_shares(Principled p, vec3 wo, float *w_cc, float *w_sheen, f
     float diel = rest * (1.0f - p.metallic), opaque = diel * (1.0f - t);
     *w_spec = rest * p.metallic + opaque * fs;
     *w_diff = opaque * (1.0f - fs);
+    /* subtracted, so that dt 0 leaves w_diff's bits */
+    *w_dt = *w_diff * p.diffuse_transmission;
+    *w_diff -= *w_dt;
     *w_trans = diel * t;
 }
 
@@ -207,8 +222,8 @@ KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
 {
     *f = v3s(0.0f);
     if (wo.z <= 0.0f || wi.z == 0.0f) return 0.0f;
-    float w_cc, w_sheen, w_spec, w_diff, w_trans;
-    principled_shares(p, wo, &w_cc, &w_sheen, &w_spec, &w_diff, &w_trans);
+    float w_cc, w_sheen, w_spec, w_diff, w_dt, w_trans;
+    principled_shares(p, wo, &w_cc, &w_sheen, &w_spec, &w_diff, &w_dt, &w_trans);
     float layer = w_cc;                      /* c F_c: the clearcoat's share */
     float below = sheen_scaling(p, wo.z, wi.z);
     if (wi.z > 0.0f) {
@@ -220,7 +235,8 @@ KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
         vec3 fd = principled_fresnel_rgb(p, vh);
         vec3 fm = fresnel_schlick(p.base, vh);
         vec3 mat = v3_add(v3_scale(v3_mul(p.base, v3_sub(v3s(1.0f), fd)),
-                                   (1.0f - p.metallic) * (1.0f - principled_refracting(p)) * K_INV_PI),
+                                   (1.0f - p.metallic) * (1.0f - principled_refracting(p)) *
+                                       (1.0f - p.diffuse_transmission) * K_INV_PI),
                           v3_scale(v3_add(v3_scale(fm, p.metallic), v3_scale(fd, 1.0f - p.metallic)), spec));
         if (w_sheen > 0.0f)
             mat = v3_add(v3_scale(mat, below), v3_scale(p.sheen, sheen_lobe(p.sheen_roughness, wo, wi)));
@@ -229,7 +245,22 @@ KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
         return w_cc * pdf_c + (w_spec + w_trans * principled_reflect_prob(fd)) * pdf_s +
                (w_diff + w_sheen) * wi.z * K_INV_PI;
     }
-    if (!(w_trans > 0.0f)) return 0.0f;
+    vec3 f_dt = v3s(0.0f);
+    float pdf_dt = 0.0f;
+    if (w_dt > 0.0f) {
+        /* Lambertian to the back, its Fresnel weight the reflected diffuse's at wi's mirror */
+        vec3 h = v3_norm(v3_add(wo, v3(wi.x, wi.y, -wi.z)));
+        vec3 fd = principled_fresnel_rgb(p, v3_dot(wo, h));
+        f_dt = v3_scale(v3_mul(p.dt_color, v3_sub(v3s(1.0f), fd)),
+                        (1.0f - layer) * (1.0f - p.metallic) * (1.0f - principled_refracting(p)) *
+                            p.diffuse_transmission * K_INV_PI);
+        if (w_sheen > 0.0f) f_dt = v3_scale(f_dt, below);
+        pdf_dt = w_dt * -wi.z * K_INV_PI;
+    }
+    if (!(w_trans > 0.0f)) {
+        *f = f_dt;
+        return pdf_dt;
+    }
     float btdf, pdf_t;
     vec3 m;
     if (p.thin) {
@@ -251,6 +282,10 @@ KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
                       (1.0f - layer) * (1.0f - p.metallic) * p.transmission * btdf);
     }
     if (w_sheen > 0.0f) *f = v3_scale(*f, below);
+    if (w_dt > 0.0f) {
+        *f = v3_add(*f, f_dt);
+        return w_trans * (1.0f - principled_reflect_prob(fd)) * pdf_t + pdf_dt;
+    }
     return w_trans * (1.0f - principled_reflect_prob(fd)) * pdf_t;
 }
 
@@ -259,8 +294,8 @@ KFN float principled_sample(Principled p, vec3 wo, float u_lobe, float u1, float
 {
     *f = v3s(0.0f);
     if (wo.z <= 0.0f) return 0.0f;
-    float w_cc, w_sheen, w_spec, w_diff, w_trans;
-    principled_shares(p, wo, &w_cc, &w_sheen, &w_spec, &w_diff, &w_trans);
+    float w_cc, w_sheen, w_spec, w_diff, w_dt, w_trans;
+    principled_shares(p, wo, &w_cc, &w_sheen, &w_spec, &w_diff, &w_dt, &w_trans);
     int up = 1;
     float w_up = w_cc + w_sheen + w_spec + w_diff;
     if (u_lobe < w_cc) {
@@ -269,13 +304,18 @@ KFN float principled_sample(Principled p, vec3 wo, float u_lobe, float u1, float
         *wi = sample_cosine_hemisphere(u1, u2);
     } else if (u_lobe < w_cc + w_sheen + w_spec) {
         *wi = mf_reflect(wo, ggx_sample_visible(p.g, wo, u1, u2));
-    } else if (u_lobe < w_up || !(w_trans > 0.0f)) {
+    } else if (u_lobe < w_up || (!(w_trans > 0.0f) && !(w_dt > 0.0f))) {
         *wi = sample_cosine_hemisphere(u1, u2);
+    } else if (u_lobe < w_up + w_dt || !(w_trans > 0.0f)) {
+        /* the diffuse transmission: the lower hemisphere, cosine-weighted */
+        *wi = sample_cosine_hemisphere(u1, u2);
+        wi->z = -wi->z;
+        up = 0;
     } else {
         vec3 m = ggx_sample_visible(p.g, wo, u1, u2);
         *wi = mf_reflect(wo, m);
         /* the rest of u_lobe, rescaled to [0, 1), chooses reflection from the facet */
-        float u_facet = k_fmin((u_lobe - w_up) / w_trans, 0.99999994f);
+        float u_facet = k_fmin((u_lobe - (w_up + w_dt)) / w_trans, 0.99999994f);
         if (!(u_facet < principled_reflect_prob(principled_fresnel_rgb(p, v3_dot(wo, m))))) {
             up = 0;
             if (p.thin) wi->z = -wi->z;
@@ -312,6 +352,11 @@ KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
                  k_clamp(m.sheen_color.z, 0.0f, 1.0f));
     p.sheen_roughness = k_clamp(m.sheen_roughness, SHEEN_ROUGHNESS_MIN, 1.0f);
     p.subsurface = p.thin ? 0.0f : k_clamp(m.subsurface, 0.0f, 1.0f);
+    p.diffuse_transmission = k_clamp(m.diffuse_transmission, 0.0f, 1.0f);
+    /* a tint brighter than white would pass on more than it receives */
+    p.dt_color = v3(k_clamp(m.diffuse_transmission_color.x, 0.0f, 1.0f),
+                    k_clamp(m.diffuse_transmission_color.y, 0.0f, 1.0f),
+                    k_clamp(m.diffuse_transmission_color.z, 0.0f, 1.0f));
     return p;
 }
 

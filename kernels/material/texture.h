@@ -358,7 +358,7 @@ KFN vec3 material_normal(const SceneView *sc, Material m, Surface s)
 /* Sets *m's textured parameters to their values at s: a principled material's
  * roughness and metallic factors times its metallic-roughness texture's G and B
  * (glTF's packing; the texture is read as declared, so it should be `encoding linear`),
- * and its specular and sheen factors times theirs.
+ * and its specular, sheen and diffuse-transmission factors times theirs.
  * In place, as material_resolve (mix.h). */
 KFN void material_at(const SceneView *sc, Material *m, Surface s, vec3 ng_face)
 {
@@ -376,6 +376,12 @@ KFN void material_at(const SceneView *sc, Material *m, Surface s, vec3 ng_face)
         m->sheen_color = v3_mul(m->sheen_color, texture_eval(sc, m->texture_sheen_color, s, ng_face));
     if (m->texture_sheen_roughness != NO_INDEX)
         m->sheen_roughness *= texture_alpha(sc, m->texture_sheen_roughness, s);
+    /* KHR_materials_diffuse_transmission: the same, the factor in alpha */
+    if (m->texture_diffuse_transmission != NO_INDEX)
+        m->diffuse_transmission *= texture_alpha(sc, m->texture_diffuse_transmission, s);
+    if (m->texture_diffuse_transmission_color != NO_INDEX)
+        m->diffuse_transmission_color =
+            v3_mul(m->diffuse_transmission_color, texture_eval(sc, m->texture_diffuse_transmission_color, s, ng_face));
 }
 
 #endif /* CLPT_TEXTURE_H */

@@ -117,6 +117,75 @@ static void test_volume_specular_sheen(void)
     scene_free(&s);
 }
 
+/* KHR_materials_diffuse_transmission onto the principled material: the factor and
+ * colour copied, a thin wall unless KHR_materials_volume makes a solid; factors
+ * outside [0, 1] and textures naming no texture are errors with the JSON path. */
+static void test_diffuse_transmission(void)
+{
+    Scene s;
+    Error err = { 0 };
+    Status st = load_triangle("{\"extensions\":{\"KHR_materials_diffuse_transmission\":{"
+                              "\"diffuseTransmissionFactor\":0.75,\"diffuseTransmissionColorFactor\":[1,0.5,0.25]}}}",
+                              &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    if (st == ST_OK) {
+        const Material *m = &s.materials[s.triangles[0].material];
+        CHECK((m->flags & MAT_THIN) != 0u);
+        CHECK_NEAR(m->diffuse_transmission, 0.75, 0);
+        check_v3(m->diffuse_transmission_color, 1.0, 0.5, 0.25, 0);
+        CHECK(m->texture_diffuse_transmission == NO_INDEX && m->texture_diffuse_transmission_color == NO_INDEX);
+        CHECK_EQ_INT(s.n_warnings, 0);
+    }
+    scene_free(&s);
+    /* with a volume: a solid; without the extension: none, the colour white */
+    st = load_triangle("{\"extensions\":{\"KHR_materials_diffuse_transmission\":{\"diffuseTransmissionFactor\":1},"
+                       "\"KHR_materials_volume\":{\"thicknessFactor\":0.2}}}", &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    if (st == ST_OK) CHECK((s.materials[s.triangles[0].material].flags & MAT_THIN) == 0u);
+    scene_free(&s);
+    st = load_triangle("{}", &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    if (st == ST_OK) {
+        const Material *m = &s.materials[s.triangles[0].material];
+        CHECK(m->diffuse_transmission == 0.0f && (m->flags & MAT_THIN) == 0u);
+        check_v3(m->diffuse_transmission_color, 1.0, 1.0, 1.0, 0);
+    }
+    scene_free(&s);
+    static const struct { const char *json, *msg; } bad[] = {
+        { "{\"diffuseTransmissionFactor\":1.5}",
+          "alpha.gltf: materials[0].extensions.KHR_materials_diffuse_transmission.diffuseTransmissionFactor: "
+          "expected a number from 0 to 1" },
+        { "{\"diffuseTransmissionFactor\":-0.1}",
+          "alpha.gltf: materials[0].extensions.KHR_materials_diffuse_transmission.diffuseTransmissionFactor: "
+          "expected a number from 0 to 1" },
+        { "{\"diffuseTransmissionColorFactor\":[1,1.2,1]}",
+          "alpha.gltf: materials[0].extensions.KHR_materials_diffuse_transmission.diffuseTransmissionColorFactor[1]: "
+          "expected a number from 0 to 1" },
+        { "{\"diffuseTransmissionColorFactor\":[1,1]}",
+          "alpha.gltf: materials[0].extensions.KHR_materials_diffuse_transmission.diffuseTransmissionColorFactor: "
+          "expected an array of 3 numbers" },
+        { "{\"diffuseTransmissionTexture\":{\"index\":3}}",
+          "alpha.gltf: materials[0].extensions.KHR_materials_diffuse_transmission.diffuseTransmissionTexture.index: textures[3] does not "
+          "exist (the file has 0)" },
+        { "{\"diffuseTransmissionColorTexture\":{\"index\":-1}}",
+          "alpha.gltf: materials[0].extensions.KHR_materials_diffuse_transmission.diffuseTransmissionColorTexture"
+          ".index: textures[-1] does not exist (the file has 0)" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char json[256];
+        snprintf(json, sizeof json, "{\"extensions\":{\"KHR_materials_diffuse_transmission\":%s}}", bad[i].json);
+        st = load_triangle(json, &s, &err);
+        CHECK_EQ_INT(st, ST_INPUT);
+        CHECK_STR_CONTAINS(err.msg, bad[i].msg);
+        fprintf(stderr, "  %s\n", err.msg);
+        error_clear(&err);
+        scene_free(&s);
+    }
+}
+
 /* alphaMode and alphaCutoff become the principled material's alpha mode (kernels/accel/alpha.h
  * renders them; test_alpha.c checks the pixels); emissiveTexture its emission texture. */
 static void test_alpha_modes(void)
@@ -1178,6 +1247,7 @@ int main(void)
     RUN(test_mesh_block);
     RUN(test_alpha_modes);
     RUN(test_volume_specular_sheen);
+    RUN(test_diffuse_transmission);
     RUN(test_texture_transform_range);
     RUN(test_shared_image_sources);
     RUN(test_shared_buffer_file);

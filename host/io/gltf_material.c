@@ -318,6 +318,34 @@ static Status material_sheen(Gltf *g, const cJSON *m, const char *jp, Material *
     return ST_OK;
 }
 
+/* KHR_materials_diffuse_transmission: diffuseTransmissionFactor (times
+ * diffuseTransmissionTexture's alpha) of the diffuse layer passes to the back side,
+ * tinted by diffuseTransmissionColorFactor (times diffuseTransmissionColorTexture,
+ * sRGB): the principled material's Lambertian transmission (kernels/bsdf/principled.h).
+ * Without KHR_materials_volume the surface is the spec's thin wall; the volume, read
+ * after, makes it a solid. Each colour component must lie in [0, 1], as the spec says. */
+static Status material_diffuse_transmission(Gltf *g, const cJSON *m, const char *jp, Material *mt)
+{
+    char jx[128];
+    const cJSON *x = material_ext(m, "KHR_materials_diffuse_transmission", jp, jx, sizeof jx);
+    if (!x) return ST_OK;
+    double factor, color[3];
+    Status st = gltf_get_num(g, x, "diffuseTransmissionFactor", 0.0, 0.0, 1.0, jx, &factor);
+    if (!st) st = gltf_get_nums(g, x, "diffuseTransmissionColorFactor", 3, white3, jx, color);
+    for (int k = 0; !st && k < 3; k++)
+        if (!(color[k] >= 0.0 && color[k] <= 1.0))
+            st = error_set(g->err, ST_INPUT, "%s: %s.diffuseTransmissionColorFactor[%d]: expected a number from 0 to 1",
+                           g->path, jx, k);
+    if (!st) st = texinfo(g, x, "diffuseTransmissionTexture", 1, jx, &mt->texture_diffuse_transmission, NULL);
+    if (!st)
+        st = texinfo(g, x, "diffuseTransmissionColorTexture", 0, jx, &mt->texture_diffuse_transmission_color, NULL);
+    if (st) return st;
+    mt->diffuse_transmission = (float)factor;
+    mt->diffuse_transmission_color = v3_of_doubles(color);
+    if (factor > 0.0) mt->flags |= MAT_THIN;
+    return ST_OK;
+}
+
 static Status material_build(Gltf *g, int i, uint *out)
 {
     char jp[64];
@@ -367,7 +395,8 @@ static Status material_build(Gltf *g, int i, uint *out)
         if ((st = gltf_get_num(g, x, "clearcoatRoughnessFactor", 0.0, 0.0, 1.0, jp, &v))) return st;
         mt.clearcoat_roughness = (float)v;
     }
-    if ((st = material_volume(g, m, jp, &mt)) || (st = material_specular(g, m, jp, &mt)) ||
+    if ((st = material_diffuse_transmission(g, m, jp, &mt)) || (st = material_volume(g, m, jp, &mt)) ||
+        (st = material_specular(g, m, jp, &mt)) ||
         (st = material_sheen(g, m, jp, &mt)))
         return st;
     const cJSON *name = cJSON_GetObjectItemCaseSensitive(m, "name");

@@ -24,7 +24,8 @@ enum { MAT_KEY_TYPE, MAT_KEY_ALBEDO, MAT_KEY_FUZZ, MAT_KEY_IOR, MAT_KEY_RADIANCE
        MAT_KEY_ALPHA_CUTOFF, MAT_KEY_EMISSION_TEXTURE, MAT_KEY_ATTENUATION_COLOR, MAT_KEY_ATTENUATION_DISTANCE,
        MAT_KEY_SPECULAR_FACTOR, MAT_KEY_SPECULAR_COLOR, MAT_KEY_SHEEN_COLOR, MAT_KEY_SHEEN_ROUGHNESS,
        MAT_KEY_SUBSURFACE, MAT_KEY_SUBSURFACE_COLOR, MAT_KEY_SUBSURFACE_RADIUS, MAT_KEY_SUBSURFACE_SCALE,
-       MAT_KEY_SUBSURFACE_ANISOTROPY, MAT_KEY_N };
+       MAT_KEY_SUBSURFACE_ANISOTROPY, MAT_KEY_DIFFUSE_TRANSMISSION, MAT_KEY_DIFFUSE_TRANSMISSION_COLOR,
+       MAT_KEY_N };
 /* One row per key, read and checked by scene_parse_block: a declarative table, so
  * rows of keys of the same kind (colours, numbers in [0, 1]) are alike by design. */
 static const KeySpec material_keys[MAT_KEY_N] = {
@@ -72,6 +73,8 @@ static const KeySpec material_keys[MAT_KEY_N] = {
     [MAT_KEY_SUBSURFACE_SCALE] = {"subsurface_scale", VK_NUMBER, 0, 0, INFINITY, 1, 1, "a number > 0"},
     [MAT_KEY_SUBSURFACE_ANISOTROPY] = {"subsurface_anisotropy", VK_NUMBER, 0, -1, 1, 1, 1,
                                        "a number in (-1, 1)"},
+    [MAT_KEY_DIFFUSE_TRANSMISSION] = {"diffuse_transmission", VK_NUMBER, 0, 0, 1, 0, 0, "a number in [0, 1]"},
+    [MAT_KEY_DIFFUSE_TRANSMISSION_COLOR] = {"diffuse_transmission_color", VK_COLOR, 0, 0, 0, 0, 0, NULL},
 };
 
 /* Which keys each material type takes (bit i = material_keys[i]), and which it needs. */
@@ -104,7 +107,8 @@ static const struct {
      1ull << MAT_KEY_ATTENUATION_COLOR | 1ull << MAT_KEY_ATTENUATION_DISTANCE | 1ull << MAT_KEY_SPECULAR_FACTOR |
      1ull << MAT_KEY_SPECULAR_COLOR | 1ull << MAT_KEY_SHEEN_COLOR | 1ull << MAT_KEY_SHEEN_ROUGHNESS |
      1ull << MAT_KEY_SUBSURFACE | 1ull << MAT_KEY_SUBSURFACE_COLOR | 1ull << MAT_KEY_SUBSURFACE_RADIUS |
-     1ull << MAT_KEY_SUBSURFACE_SCALE | 1ull << MAT_KEY_SUBSURFACE_ANISOTROPY,
+     1ull << MAT_KEY_SUBSURFACE_SCALE | 1ull << MAT_KEY_SUBSURFACE_ANISOTROPY | 1ull << MAT_KEY_DIFFUSE_TRANSMISSION |
+     1ull << MAT_KEY_DIFFUSE_TRANSMISSION_COLOR,
      0},
     {"emissive", MAT_EMISSIVE, 1ull << MAT_KEY_RADIANCE | 1ull << MAT_KEY_SIDES, 1ull << MAT_KEY_RADIANCE},
     {"phong", MAT_PHONG,
@@ -164,9 +168,10 @@ static Status parse_alpha(Parser *p, Lexer *lx, const Value *v, Material *m)
 }
 
 /* The principled keys of the glTF extensions: KHR_materials_volume's attenuation (read
- * in a solid, `thin off`), KHR_materials_specular's factor and colour, and
- * KHR_materials_sheen's colour and roughness. */
-static void parse_principled_layers(const Value *v, Material *m)
+ * in a solid, `thin off`), KHR_materials_specular's factor and colour,
+ * KHR_materials_sheen's colour and roughness, and KHR_materials_diffuse_transmission's
+ * share and colour (a colour above 1 would pass on more light than arrives). */
+static Status parse_principled_layers(Parser *p, Lexer *lx, const Value *v, Material *m)
 {
     vec3 color = v[MAT_KEY_ATTENUATION_COLOR].given ? v[MAT_KEY_ATTENUATION_COLOR].v : v3s(1.0f);
     float distance = v[MAT_KEY_ATTENUATION_DISTANCE].given ? v[MAT_KEY_ATTENUATION_DISTANCE].f : INFINITY;
@@ -175,6 +180,15 @@ static void parse_principled_layers(const Value *v, Material *m)
     if (v[MAT_KEY_SPECULAR_COLOR].given) m->specular_color = v[MAT_KEY_SPECULAR_COLOR].v;
     if (v[MAT_KEY_SHEEN_COLOR].given) m->sheen_color = v[MAT_KEY_SHEEN_COLOR].v;
     if (v[MAT_KEY_SHEEN_ROUGHNESS].given) m->sheen_roughness = v[MAT_KEY_SHEEN_ROUGHNESS].f;
+    if (v[MAT_KEY_DIFFUSE_TRANSMISSION].given) m->diffuse_transmission = v[MAT_KEY_DIFFUSE_TRANSMISSION].f;
+    if (v[MAT_KEY_DIFFUSE_TRANSMISSION_COLOR].given) {
+        vec3 c = v[MAT_KEY_DIFFUSE_TRANSMISSION_COLOR].v;
+        if (!(c.x <= 1.0f && c.y <= 1.0f && c.z <= 1.0f))
+            return lex_error_at(lx, &v[MAT_KEY_DIFFUSE_TRANSMISSION_COLOR].value, p->err,
+                                "'diffuse_transmission_color' must be in [0, 1]");
+        m->diffuse_transmission_color = c;
+    }
+    return ST_OK;
 }
 
 /* Subsurface scattering (scene/subsurface.h, docs/subsurface.md): `subsurface` W > 0
@@ -230,7 +244,7 @@ Status scene_parse_material_block(Parser *p, Lexer *lx, const Token *kw, int bra
     unsigned long long allowed = material_types[ti].allowed | 1ull << MAT_KEY_TYPE;
     for (int i = 0; i < MAT_KEY_N; i++) {
         if (!v[i].given || (allowed & (1ull << i))) continue;
-        char what[512];
+        char what[1024];   /* the principled list alone is over 500 characters */
         size_t o = (size_t)snprintf(what, sizeof what, "a %s material key (type",
                                     material_types[ti].name);
         for (int j = 1; j < MAT_KEY_N; j++)
@@ -267,7 +281,7 @@ Status scene_parse_material_block(Parser *p, Lexer *lx, const Token *kw, int bra
         if (v[MAT_KEY_NORMAL_SCALE].given) m.normal_scale = v[MAT_KEY_NORMAL_SCALE].f;
         if (v[MAT_KEY_EMISSION_TEXTURE].given) m.texture_emission = (uint)v[MAT_KEY_EMISSION_TEXTURE].u;
         if ((st = parse_alpha(p, lx, v, &m))) return st;
-        parse_principled_layers(v, &m);
+        if ((st = parse_principled_layers(p, lx, v, &m))) return st;
         break;
     case MAT_EMISSIVE:
         m = material_emissive(v[MAT_KEY_RADIANCE].v);

@@ -186,6 +186,92 @@ static void test_diffuse_transmission(void)
     }
 }
 
+/* KHR_materials_volume_scatter over a volume and a diffuse transmission: a subsurface
+ * walk whose weight is the diffuse transmission's share, sigma_t = -ln(c) / d split by
+ * the extension's single-scattering albedo (multiscatter 0 gives 0, 1 gives 1, 0.5 gives
+ * 1 - (4.09712 + 2.104315 - sqrt(9.59217 + 20.8404 + 4.42815))^2), g copied, no
+ * Beer-Lambert absorption left; without what it needs, a warning; bad values, errors. */
+static void test_volume_scatter(void)
+{
+    Scene s;
+    Error err = { 0 };
+    Status st = load_triangle("{\"name\":\"wax\",\"extensions\":{"
+                              "\"KHR_materials_volume\":{\"thicknessFactor\":1,"
+                              "\"attenuationColor\":[0.5,0.25,0.125],\"attenuationDistance\":2},"
+                              "\"KHR_materials_diffuse_transmission\":{\"diffuseTransmissionFactor\":0.8},"
+                              "\"KHR_materials_volume_scatter\":{\"multiscatterColor\":[0,0.5,1],"
+                              "\"scatterAnisotropy\":0.3}}}",
+                              &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    if (st == ST_OK) {
+        const Material *m = &s.materials[s.triangles[0].material];
+        CHECK((m->flags & MAT_THIN) == 0u);
+        CHECK_NEAR(m->subsurface, 0.8, 1e-6);
+        CHECK(m->diffuse_transmission == 0.0f);
+        check_v3(m->absorption, 0.0, 0.0, 0.0, 0);
+        CHECK(m->medium_in >= 1u && m->medium_in <= s.n_media);
+        if (m->medium_in >= 1u && m->medium_in <= s.n_media) {
+            const Medium *md = &s.media[m->medium_in - 1u];
+            double r = 4.09712 + 4.20863 * 0.5 - sqrt(9.59217 + 41.6808 * 0.5 + 17.7126 * 0.25), a = 1.0 - r * r;
+            double t[3] = { log(2.0) / 2.0, log(4.0) / 2.0, log(8.0) / 2.0 };
+            check_v3(md->sigma_s, 0.0, t[1] * a, t[2], 1e-5);
+            check_v3(md->sigma_a, t[0], t[1] * (1.0 - a), 0.0, 1e-5);
+            CHECK_NEAR(md->g, 0.3, 1e-6);
+            fprintf(stderr, "  multiscatter 0.5: single-scattering albedo %.4f\n", a);
+        }
+        CHECK_EQ_INT(s.n_warnings, 0);
+    }
+    scene_free(&s);
+    /* nothing scatters: a thin wall, no attenuation, no diffuse transmission */
+    static const char *const ignored[] = {
+        "{\"extensions\":{\"KHR_materials_diffuse_transmission\":{\"diffuseTransmissionFactor\":1},"
+        "\"KHR_materials_volume_scatter\":{\"multiscatterColor\":[1,1,1]}}}",
+        "{\"extensions\":{\"KHR_materials_volume\":{\"thicknessFactor\":1},"
+        "\"KHR_materials_diffuse_transmission\":{\"diffuseTransmissionFactor\":1},"
+        "\"KHR_materials_volume_scatter\":{\"multiscatterColor\":[1,1,1]}}}",
+        "{\"extensions\":{\"KHR_materials_volume\":{\"thicknessFactor\":1,\"attenuationDistance\":1,"
+        "\"attenuationColor\":[0.5,0.5,0.5]},\"KHR_materials_volume_scatter\":{\"multiscatterColor\":[1,1,1]}}}",
+    };
+    static const char *const why[] = { "KHR_materials_volume with thicknessFactor > 0",
+                                        "KHR_materials_volume's attenuationDistance and attenuationColor",
+                                        "KHR_materials_diffuse_transmission" };
+    for (int i = 0; i < 3; i++) {
+        st = load_triangle(ignored[i], &s, &err);
+        CHECK_MSG(st == ST_OK, "%s", err.msg);
+        error_clear(&err);
+        if (st == ST_OK) {
+            CHECK_EQ_INT(s.n_warnings, 1);
+            CHECK_EQ_INT((int)s.n_media, 0);
+            char want[200];
+            snprintf(want, sizeof want, "alpha.gltf: materials[0].extensions.KHR_materials_volume_scatter: ignored: "
+                     "nothing scatters inside without %s", why[i]);
+            if (s.n_warnings == 1) CHECK_STR_CONTAINS(s.warnings[0], want);
+        }
+        scene_free(&s);
+    }
+    static const struct { const char *json, *msg; } bad[] = {
+        { "{\"multiscatterColor\":[0.5,-0.5,0.5]}",
+          "alpha.gltf: materials[0].extensions.KHR_materials_volume_scatter.multiscatterColor[1]: expected a number "
+          "from 0 to 1" },
+        { "{\"scatterAnisotropy\":1}",
+          "alpha.gltf: materials[0].extensions.KHR_materials_volume_scatter.scatterAnisotropy: expected a number "
+          "between -1 and 1, both excluded" },
+        { "{\"scatterAnisotropy\":-3}",
+          "alpha.gltf: materials[0].extensions.KHR_materials_volume_scatter.scatterAnisotropy: expected a number "
+          "from -1 to 1" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char json[256];
+        snprintf(json, sizeof json, "{\"extensions\":{\"KHR_materials_volume_scatter\":%s}}", bad[i].json);
+        st = load_triangle(json, &s, &err);
+        CHECK_EQ_INT(st, ST_INPUT);
+        CHECK_STR_CONTAINS(err.msg, bad[i].msg);
+        error_clear(&err);
+        scene_free(&s);
+    }
+}
+
 /* alphaMode and alphaCutoff become the principled material's alpha mode (kernels/accel/alpha.h
  * renders them; test_alpha.c checks the pixels); emissiveTexture its emission texture. */
 static void test_alpha_modes(void)
@@ -1248,6 +1334,7 @@ int main(void)
     RUN(test_alpha_modes);
     RUN(test_volume_specular_sheen);
     RUN(test_diffuse_transmission);
+    RUN(test_volume_scatter);
     RUN(test_texture_transform_range);
     RUN(test_shared_image_sources);
     RUN(test_shared_buffer_file);

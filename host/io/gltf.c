@@ -523,7 +523,7 @@ static const char *const supported_ext[] = {
     "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_ior",
     "KHR_materials_transmission", "KHR_materials_clearcoat", "KHR_texture_transform",
     "KHR_materials_volume", "KHR_materials_specular", "KHR_materials_sheen", "EXT_mesh_gpu_instancing",
-    "KHR_materials_diffuse_transmission",
+    "KHR_materials_diffuse_transmission", "KHR_materials_volume_scatter",
 };
 
 static int ext_supported(const char *name)

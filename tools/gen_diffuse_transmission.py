@@ -4,7 +4,9 @@ KHR_materials_diffuse_transmission (docs/gltf.md): three thin sheets stand betwe
 camera and a warm point light behind them, over a grey floor under a dim sun. The left
 sheet is opaque white (no transmission), the middle one passes half its diffuse layer
 to the back, white, and the right one all of it, tinted leaf-green by
-diffuseTransmissionColorFactor. Blender 3.4's exporter does not write the extension,
+diffuseTransmissionColorFactor. A wax cube in front is a solid (KHR_materials_volume)
+whose diffuse transmission enters a scattering interior (KHR_materials_volume_scatter,
+read as a subsurface walk: docs/subsurface.md). Blender 3.4's exporter does not write the extension,
 hence this script. Deterministic: running it again writes the same bytes.
 
     python3 tools/gen_diffuse_transmission.py > scenes/diffuse-transmission.gltf
@@ -33,8 +35,27 @@ def quad(cx, cy, cz, hx, hy, normal_z):
     return pos, nrm, idx
 
 
+def cube(cx, cy, cz, h):
+    """A closed box of half size h, each face its own 4 corners and outward normal."""
+    pos, nrm, idx = [], [], []
+    for axis in range(3):
+        for sign in (1, -1):
+            u, v = (axis + 1) % 3, (axis + 2) % 3
+            base = len(pos) // 3
+            for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                p = [0, 0, 0]
+                p[axis], p[u], p[v] = sign * h, a * h, b * h * sign
+                pos += [cx + p[0], cy + p[1], cz + p[2]]
+                n = [0, 0, 0]
+                n[axis] = sign
+                nrm += n
+            idx += [base, base + 1, base + 2, base, base + 2, base + 3]
+    return pos, nrm, idx
+
+
 def main():
     shapes = [quad(0, 0, 0, 6, None, 0)] + [quad(x, 1.0, 0, 0.55, 0.9, 1) for x in (-1.3, 0.0, 1.3)]
+    shapes.append(cube(0.6, 0.35, 1.1, 0.35))
     blob, views, accessors, meshes = b"", [], [], []
     for i, (pos, nrm, idx) in enumerate(shapes):
         prim = {}
@@ -64,6 +85,13 @@ def main():
             "diffuseTransmissionFactor": 0.5}}),
         dict(sheet, name="leaf", extensions={"KHR_materials_diffuse_transmission": {
             "diffuseTransmissionFactor": 1.0, "diffuseTransmissionColorFactor": [0.35, 0.8, 0.2]}}),
+        {"name": "wax", "pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.8, 0.6, 1], "metallicFactor": 0,
+                                                 "roughnessFactor": 0.4},
+         "extensions": {"KHR_materials_volume": {"thicknessFactor": 0.7, "attenuationDistance": 0.05,
+                                                 "attenuationColor": [0.5, 0.5, 0.5]},
+                        "KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1.0},
+                        "KHR_materials_volume_scatter": {"multiscatterColor": [0.9, 0.6, 0.3],
+                                                         "scatterAnisotropy": 0.2}}},
     ]
     nodes = [{"mesh": i} for i in range(len(meshes))]
     nodes.append({"name": "lamp", "translation": [0, 1.1, -1.2], "extensions": {"KHR_lights_punctual": {"light": 0}}})
@@ -72,7 +100,8 @@ def main():
     nodes.append({"name": "camera", "camera": 0, "translation": [0, 1.3, 4.2], "rotation": [-0.0436194, 0, 0, 0.9990482]})
     d = {
         "asset": {"version": "2.0", "generator": "clpt tools/gen_diffuse_transmission.py"},
-        "extensionsUsed": ["KHR_materials_diffuse_transmission", "KHR_lights_punctual"],
+        "extensionsUsed": ["KHR_materials_diffuse_transmission", "KHR_materials_volume",
+                           "KHR_materials_volume_scatter", "KHR_lights_punctual"],
         "scene": 0,
         "scenes": [{"nodes": list(range(len(nodes)))}],
         "nodes": nodes,

@@ -15,47 +15,37 @@
 
 #define MEDIUM_TYPES "a medium type (homogeneous, grid)"
 
+/* The keys both kinds of medium take: the type, the coefficients and the emission. */
+#define MEDIUM_COEFFICIENT_KEYS(prefix)                                                                 \
+    [prefix##_TYPE] = {"type", VK_WORD, 0, 0, 0, 0, 0, MEDIUM_TYPES},                                   \
+    [prefix##_SIGMA_A] = {"sigma_a", VK_COLOR, 0, 0, 0, 0, 0, NULL},                                    \
+    [prefix##_SIGMA_S] = {"sigma_s", VK_COLOR, 0, 0, 0, 0, 0, NULL},                                    \
+    [prefix##_ALBEDO] = {"albedo", VK_COLOR, 0, 0, 0, 0, 0, NULL},                                      \
+    [prefix##_DENSITY] = {"density", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},             \
+    [prefix##_G] = {"g", VK_NUMBER, 0, -1, 1, 1, 1, "a number in (-1, 1)"},                             \
+    [prefix##_EMISSION] = {"emission", VK_COLOR, 0, 0, 0, 0, 0, NULL},                                  \
+    [prefix##_EMISSION_SCALE] = {"emission_scale", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"}
+
 enum { MED_TYPE, MED_SIGMA_A, MED_SIGMA_S, MED_ALBEDO, MED_DENSITY, MED_SCALE, MED_G, MED_EMISSION,
        MED_EMISSION_SCALE, MED_N };
 static const KeySpec medium_keys[MED_N] = {
-    [MED_TYPE] = {"type", VK_WORD, 0, 0, 0, 0, 0, MEDIUM_TYPES},
-    [MED_SIGMA_A] = {"sigma_a", VK_COLOR, 0, 0, 0, 0, 0, NULL},
-    [MED_SIGMA_S] = {"sigma_s", VK_COLOR, 0, 0, 0, 0, 0, NULL},
-    [MED_ALBEDO] = {"albedo", VK_COLOR, 0, 0, 0, 0, 0, NULL},
-    [MED_DENSITY] = {"density", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
+    MEDIUM_COEFFICIENT_KEYS(MED),
     [MED_SCALE] = {"scale", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
-    [MED_G] = {"g", VK_NUMBER, 0, -1, 1, 1, 1, "a number in (-1, 1)"},
-    [MED_EMISSION] = {"emission", VK_COLOR, 0, 0, 0, 0, 0, NULL},
-    [MED_EMISSION_SCALE] = {"emission_scale", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
 };
 
 /* A grid medium's keys: the coefficients (per unit of the grid's density) in the same
  * places as medium_keys, so medium_coefficients reads both; `scale` is the transform's
  * here, as in every block with a transform (the coefficients take no extra factor). */
 enum { GM_TYPE, GM_SIGMA_A, GM_SIGMA_S, GM_ALBEDO, GM_DENSITY, GM_G, GM_SIZE, GM_DATA, GM_FILE, GM_MIN, GM_MAX,
-       GM_TRANSLATE, GM_ROTATE, GM_RX, GM_RY, GM_RZ, GM_SCALE, GM_MATRIX, GM_EMISSION, GM_EMISSION_SCALE,
-       GM_EMISSION_DATA, GM_EMISSION_FILE, GM_N };
+       TRANSFORM_KEY_IDS(GM), GM_EMISSION, GM_EMISSION_SCALE, GM_EMISSION_DATA, GM_EMISSION_FILE, GM_N };
 static const KeySpec grid_keys[GM_N] = {
-    [GM_TYPE] = {"type", VK_WORD, 0, 0, 0, 0, 0, MEDIUM_TYPES},
-    [GM_SIGMA_A] = {"sigma_a", VK_COLOR, 0, 0, 0, 0, 0, NULL},
-    [GM_SIGMA_S] = {"sigma_s", VK_COLOR, 0, 0, 0, 0, 0, NULL},
-    [GM_ALBEDO] = {"albedo", VK_COLOR, 0, 0, 0, 0, 0, NULL},
-    [GM_DENSITY] = {"density", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
-    [GM_G] = {"g", VK_NUMBER, 0, -1, 1, 1, 1, "a number in (-1, 1)"},
+    MEDIUM_COEFFICIENT_KEYS(GM),
     [GM_SIZE] = {"size", VK_VEC3, 1, 0, 0, 0, 0, NULL},
     [GM_DATA] = {"data", VK_NUMBER_LIST, 0, 0, 0, 0, 0, NULL},
     [GM_FILE] = {"file", VK_PATH, 0, 0, 0, 0, 0, NULL},
     [GM_MIN] = {"min", VK_VEC3, 0, 0, 0, 0, 0, NULL},
     [GM_MAX] = {"max", VK_VEC3, 0, 0, 0, 0, 0, NULL},
-    [GM_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},
-    [GM_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},
-    [GM_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
-    [GM_RY] = {"ry", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
-    [GM_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
-    [GM_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
-    [GM_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
-    [GM_EMISSION] = {"emission", VK_COLOR, 0, 0, 0, 0, 0, NULL},
-    [GM_EMISSION_SCALE] = {"emission_scale", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
+    TRANSFORM_KEYS(GM),
     [GM_EMISSION_DATA] = {"emission_data", VK_NUMBER_LIST, 0, 0, 0, 0, 0, NULL},
     [GM_EMISSION_FILE] = {"emission_file", VK_PATH, 0, 0, 0, 0, 0, NULL},
 };

@@ -100,18 +100,11 @@ Status scene_parse_object(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-enum { INST_MATERIAL, INST_TRANSLATE, INST_ROTATE, INST_RX, INST_RY, INST_RZ, INST_SCALE, INST_MATRIX, INST_TIME,
-       INST_N };
+enum { INST_MATERIAL, TRANSFORM_KEY_IDS(INST), INST_TIME, INST_N };
 static const KeySpec instance_keys[INST_N] = {
     [INST_MATERIAL] = {"material", VK_MATERIAL, 0, 0, 0, 0, 0, NULL},
     [INST_TIME] = {"time", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "a time (a number)"},
-    [INST_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},
-    [INST_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},
-    [INST_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
-    [INST_RY] = {"ry", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
-    [INST_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
-    [INST_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
-    [INST_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
+    TRANSFORM_KEYS(INST),
 };
 
 Status scene_parse_instance(Parser *p, Lexer *lx, const Token *kw)
@@ -152,16 +145,10 @@ Status scene_parse_instance(Parser *p, Lexer *lx, const Token *kw)
 /* instance_key { time T  translate ... }: a later pose of the instance before it
  * (docs/motion.md), its transform keys as an instance's, applied alone (the pose is
  * the whole transform then, not a change of the one before). */
-enum { IK_TIME, IK_TRANSLATE, IK_ROTATE, IK_RX, IK_RY, IK_RZ, IK_SCALE, IK_MATRIX, IK_N };
+enum { IK_TIME, TRANSFORM_KEY_IDS(IK), IK_N };
 static const KeySpec instance_key_keys[IK_N] = {
     [IK_TIME] = {"time", VK_NUMBER, 1, -INFINITY, INFINITY, 0, 0, "a time (a number)"},
-    [IK_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},
-    [IK_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},
-    [IK_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
-    [IK_RY] = {"ry", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
-    [IK_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
-    [IK_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
-    [IK_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
+    TRANSFORM_KEYS(IK),
 };
 
 Status scene_parse_instance_key(Parser *p, Lexer *lx, const Token *kw)

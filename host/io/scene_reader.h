@@ -7,11 +7,13 @@
  *   scene_material.c  materials (their keys and types) and textures
  *   scene_shape.c     spheres, planes, triangles, quads, boxes, meshes, lights
  *   scene_object.c    objects and their instances
+ *   scene_medium.c    participating media
  * Not for use outside these files.
  */
 #ifndef CLPT_SCENE_READER_H
 #define CLPT_SCENE_READER_H
 
+#include <math.h>
 #include <stddef.h>
 
 #include "io/lexer.h"
@@ -48,6 +50,33 @@ typedef struct {
     int lo_open, hi_open;   /* whether the bound itself is excluded */
     const char *what;       /* VK_NUMBER, VK_UINT, VK_WORD: "a number in (0, 180)" */
 } KeySpec;
+
+/* Key lists more than one block takes, so that each reads and checks them the same
+ * way. A block's enum names its ids with the *_KEY_IDS list and its table takes the
+ * matching *_KEYS entries; the order is kept where a reader relies on it.
+ *
+ * A surface's material and the media on either side of it: shape_surface
+ * (scene_shape.c) reads the three from v[prefix##_MATERIAL] onwards. */
+#define SURFACE_KEY_IDS(prefix) prefix##_MATERIAL, prefix##_INTERIOR, prefix##_EXTERIOR
+#define MEDIUM_KEYS(prefix)                                              \
+    [prefix##_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL}, \
+    [prefix##_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL}
+#define SURFACE_KEYS(prefix)                                              \
+    [prefix##_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL}, \
+    MEDIUM_KEYS(prefix)
+
+/* A block's placement: scene_parse_transform reads these seven as consecutive values
+ * from v[prefix##_TRANSLATE], in this order. */
+#define TRANSFORM_KEY_IDS(prefix) \
+    prefix##_TRANSLATE, prefix##_ROTATE, prefix##_RX, prefix##_RY, prefix##_RZ, prefix##_SCALE, prefix##_MATRIX
+#define TRANSFORM_KEYS(prefix)                                                                  \
+    [prefix##_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},                        \
+    [prefix##_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},                            \
+    [prefix##_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"}, \
+    [prefix##_RY] = {"ry", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"}, \
+    [prefix##_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"}, \
+    [prefix##_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},                               \
+    [prefix##_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL}
 
 typedef struct {
     int given;

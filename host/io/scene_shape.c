@@ -13,18 +13,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Every shape's surface takes the same last three keys: its material and the media on
- * either side of it. One list for all of them, so that they read, check and bind
- * their surface the same way; SURFACE_KEY_IDS keeps the three in this order, which
- * shape_surface relies on. */
-#define SURFACE_KEY_IDS(prefix) prefix##_MATERIAL, prefix##_INTERIOR, prefix##_EXTERIOR
-#define MEDIUM_KEYS(prefix)                                              \
-    [prefix##_INTERIOR] = {"interior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL}, \
-    [prefix##_EXTERIOR] = {"exterior", VK_MEDIUM, 0, 0, 0, 0, 0, NULL}
-#define SURFACE_KEYS(prefix)                                              \
-    [prefix##_MATERIAL] = {"material", VK_MATERIAL, 1, 0, 0, 0, 0, NULL}, \
-    MEDIUM_KEYS(prefix)
-
 /* The material a shape gets from its surface keys (v[prefix##_MATERIAL] onwards),
  * bound to its interior and exterior media. Each shape below is a key table and a
  * builder that starts with scene_parse_block and binds its surface here: their
@@ -173,18 +161,11 @@ Status scene_parse_box(Parser *p, Lexer *lx, const Token *kw)
     return scene_add_box(p->s, b, p->err);
 }
 
-enum { MESH_FILE, MESH_MATERIAL, MESH_TRANSLATE, MESH_ROTATE, MESH_RX, MESH_RY, MESH_RZ, MESH_SCALE,
-       MESH_MATRIX, MESH_INTERIOR, MESH_EXTERIOR, MESH_N };
+enum { MESH_FILE, MESH_MATERIAL, TRANSFORM_KEY_IDS(MESH), MESH_INTERIOR, MESH_EXTERIOR, MESH_N };
 static const KeySpec mesh_keys[MESH_N] = {
     [MESH_FILE] = {"file", VK_PATH, 1, 0, 0, 0, 0, NULL},
     [MESH_MATERIAL] = {"material", VK_MATERIAL, 0, 0, 0, 0, 0, NULL},
-    [MESH_TRANSLATE] = {"translate", VK_VEC3, 0, 0, 0, 0, 0, NULL},
-    [MESH_ROTATE] = {"rotate", VK_ROTATE, 0, 0, 0, 0, 0, NULL},
-    [MESH_RX] = {"rx", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
-    [MESH_RY] = {"ry", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
-    [MESH_RZ] = {"rz", VK_NUMBER, 0, -INFINITY, INFINITY, 0, 0, "an angle in degrees"},
-    [MESH_SCALE] = {"scale", VK_SCALE, 0, 0, 0, 0, 0, NULL},
-    [MESH_MATRIX] = {"matrix", VK_MATRIX, 0, 0, 0, 0, 0, NULL},
+    TRANSFORM_KEYS(MESH),
     MEDIUM_KEYS(MESH),
 };
 

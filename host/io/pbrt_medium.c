@@ -38,6 +38,69 @@ static Status medium_le(Parser *p, const Lexer *lx, const Token *name, vec3 sigm
     return ST_OK;
 }
 
+/* pbrt_reader.h: every medium's sigma_a and sigma_s, times its scale, and g. */
+Status pbrt_medium_coefficients(Parser *p, const Lexer *lx, const Token *name, int read_scale, vec3 *sa, vec3 *ss,
+                                float *g_out)
+{
+    Status st;
+    vec3 a = v3s(1.0f), s = v3s(1.0f);
+    double scale = 1.0, g = 0.0;
+    if ((st = pbrt_get_spectrum(p, lx, "sigma_a", &a, NULL, NULL)) ||
+        (st = pbrt_get_spectrum(p, lx, "sigma_s", &s, NULL, NULL)) ||
+        (read_scale && (st = pbrt_get_float(p, lx, "scale", &scale))) || (st = pbrt_get_float(p, lx, "g", &g)))
+        return st;
+    if (!(scale >= 0.0) || !(scale <= 1e30))
+        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "scale"), "a number in [0, 1e30]");
+    if (!(g > -1.0 && g < 1.0)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "g"), "a number in (-1, 1)");
+    a = v3_scale(a, (float)scale);
+    s = v3_scale(s, (float)scale);
+    vec3 t = v3_add(a, s);
+    if (!isfinite(t.x) || !isfinite(t.y) || !isfinite(t.z))
+        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": its extinction (sigma_a + sigma_s, times "
+                            "scale) is beyond the largest float (about 3.4e38)", (int)(name->len > 40 ? 40 : name->len), name->text);
+    *sa = a;
+    *ss = s;
+    *g_out = (float)g;
+    return ST_OK;
+}
+
+/* pbrt_reader.h: a grid's nx ny nz (1 each by default), each >= 1, at most 2^24 cells. */
+Status pbrt_medium_grid_size(Parser *p, const Lexer *lx, const Token *name, long n[3], double *cells)
+{
+    Status st;
+    int nlen = (int)(name->len > 40 ? 40 : name->len);
+    n[0] = n[1] = n[2] = 1;
+    if ((st = pbrt_get_int(p, lx, "nx", &n[0])) || (st = pbrt_get_int(p, lx, "ny", &n[1])) ||
+        (st = pbrt_get_int(p, lx, "nz", &n[2])))
+        return st;
+    *cells = 1.0;
+    for (int i = 0; i < 3; i++) {
+        if (n[i] < 1)
+            return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": nx, ny and nz must be >= 1, found "
+                                "%ld %ld %ld", nlen, name->text, n[0], n[1], n[2]);
+        *cells *= (double)n[i];
+    }
+    if (*cells > (double)(1u << 24))
+        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": a grid of %ld x %ld x %ld cells is more "
+                            "than %u", nlen, name->text, n[0], n[1], n[2], 1u << 24);
+    return ST_OK;
+}
+
+/* pbrt_reader.h: a grid's box p0 p1 (the unit cube by default), p1 above p0 on every axis. */
+Status pbrt_medium_box(Parser *p, const Lexer *lx, const Token *name, vec3 *lo, vec3 *hi)
+{
+    Status st;
+    *lo = v3s(0.0f);
+    *hi = v3s(1.0f);
+    if ((st = pbrt_get_point(p, lx, "p0", lo)) || (st = pbrt_get_point(p, lx, "p1", hi))) return st;
+    if (!(lo->x < hi->x && lo->y < hi->y && lo->z < hi->z))
+        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": p1 must be greater than p0 on every "
+                            "axis, found p0 %g %g %g, p1 %g %g %g", (int)(name->len > 40 ? 40 : name->len),
+                            name->text, (double)lo->x, (double)lo->y, (double)lo->z, (double)hi->x, (double)hi->y,
+                            (double)hi->z);
+    return ST_OK;
+}
+
 /* pbrt-v4's homogeneous medium: sigma_a and sigma_s (1 each by default), times
  * `scale`; `g`; its emission "Le" times "Lescale" (medium_le; the grid reads its own
  * "Lescale", a grid). Its named presets are an error (one would decide the whole
@@ -51,23 +114,36 @@ static Status homogeneous(Parser *p, const Lexer *lx, const Token *name, Medium 
         return lex_error_at(lx, preset, p->err, "MakeNamedMedium \"%.*s\": the preset \"%.*s\" is not supported "
                             "(give \"rgb sigma_a\" and \"rgb sigma_s\" instead)", (int)(name->len > 40 ? 40 : name->len),
                             name->text, (int)(preset->len > 40 ? 40 : preset->len), preset->text);
-    vec3 sa = v3s(1.0f), ss = v3s(1.0f);
-    double scale = 1.0, g = 0.0;
-    if ((st = pbrt_get_spectrum(p, lx, "sigma_a", &sa, NULL, NULL)) ||
-        (st = pbrt_get_spectrum(p, lx, "sigma_s", &ss, NULL, NULL)) || (st = pbrt_get_float(p, lx, "scale", &scale)) ||
-        (st = pbrt_get_float(p, lx, "g", &g)))
-        return st;
-    if (!(scale >= 0.0) || !(scale <= 1e30))
-        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "scale"), "a number in [0, 1e30]");
-    if (!(g > -1.0 && g < 1.0)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "g"), "a number in (-1, 1)");
-    sa = v3_scale(sa, (float)scale);
-    ss = v3_scale(ss, (float)scale);
-    vec3 t = v3_add(sa, ss);
-    if (!isfinite(t.x) || !isfinite(t.y) || !isfinite(t.z))
-        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": its extinction (sigma_a + sigma_s, times "
-                            "scale) is beyond the largest float (about 3.4e38)", (int)(name->len > 40 ? 40 : name->len),
-                            name->text);
-    *out = medium_homogeneous(sa, ss, (float)g);
+    vec3 sa, ss;
+    float g;
+    if ((st = pbrt_medium_coefficients(p, lx, name, 1, &sa, &ss, &g))) return st;
+    *out = medium_homogeneous(sa, ss, g);
+    return ST_OK;
+}
+
+/* A grid parameter `key` of nx ny nz floats (x fastest, as pbrt's SampledGrid), each
+ * finite and >= 0, copied into a new array *out; `pv` is the parameter as given. */
+static Status grid_values(Parser *p, const Lexer *lx, const Token *name, const Param *pv, const char *key,
+                          const long n[3], double cells, float **out)
+{
+    int nlen = (int)(name->len > 40 ? 40 : name->len);
+    if (pv->type != PT_FLOAT) return pbrt_param_type_error(p, lx, pv, "floats");
+    if ((double)pv->n != cells)
+        return lex_error_at(lx, &pv->decl, p->err, "MakeNamedMedium \"%.*s\": nx ny nz %ld %ld %ld are %.0f "
+                            "cells, but \"%s\" has %zu values", nlen, name->text, n[0], n[1], n[2], cells, key,
+                            pv->n);
+    float *v = malloc(pv->n * sizeof(float));
+    if (!v) return error_set(p->err, ST_INTERNAL, "out of memory");
+    for (size_t i = 0; i < pv->n; i++) {
+        double x = p->pl.nums[pv->first + i];
+        if (!(x >= 0.0) || !(x <= 3.4e38)) {
+            free(v);
+            return lex_error_at(lx, &pv->decl, p->err, "MakeNamedMedium \"%.*s\": %s %g (value %zu) must be a "
+                                "finite number >= 0", nlen, name->text, key, x, i);
+        }
+        v[i] = (float)x;
+    }
+    *out = v;
     return ST_OK;
 }
 
@@ -76,28 +152,9 @@ static Status homogeneous(Parser *p, const Lexer *lx, const Token *name, Medium 
 static Status grid_le_scale(Parser *p, const Lexer *lx, const Token *name, const long n[3], double cells,
                             float **out)
 {
-    int nlen = (int)(name->len > 40 ? 40 : name->len);
     *out = NULL;
     Param *pl = pbrt_param_find(p, "Lescale");
-    if (!pl) return ST_OK;
-    if (pl->type != PT_FLOAT) return pbrt_param_type_error(p, lx, pl, "floats");
-    if ((double)pl->n != cells)
-        return lex_error_at(lx, &pl->decl, p->err, "MakeNamedMedium \"%.*s\": nx ny nz %ld %ld %ld are %.0f "
-                            "cells, but \"Lescale\" has %zu values", nlen, name->text, n[0], n[1], n[2], cells,
-                            pl->n);
-    float *v = malloc(pl->n * sizeof(float));
-    if (!v) return error_set(p->err, ST_INTERNAL, "out of memory");
-    for (size_t i = 0; i < pl->n; i++) {
-        double x = p->pl.nums[pl->first + i];
-        if (!(x >= 0.0) || !(x <= 3.4e38)) {
-            free(v);
-            return lex_error_at(lx, &pl->decl, p->err, "MakeNamedMedium \"%.*s\": Lescale %g (value %zu) must "
-                                "be a finite number >= 0", nlen, name->text, x, i);
-        }
-        v[i] = (float)x;
-    }
-    *out = v;
-    return ST_OK;
+    return pl ? grid_values(p, lx, name, pl, "Lescale", n, cells, out) : ST_OK;
 }
 
 /* pbrt-v4's "uniformgrid" medium: "float density" of nx ny nz values (x fastest, as
@@ -113,48 +170,18 @@ static Status uniform_grid(Parser *p, const Lexer *lx, const Token *name, Medium
     int nlen = (int)(name->len > 40 ? 40 : name->len);
     Medium base;
     if ((st = homogeneous(p, lx, name, &base))) return st;
-    long n[3] = { 1, 1, 1 };
-    if ((st = pbrt_get_int(p, lx, "nx", &n[0])) || (st = pbrt_get_int(p, lx, "ny", &n[1])) ||
-        (st = pbrt_get_int(p, lx, "nz", &n[2])))
-        return st;
-    double cells = 1.0;
-    for (int i = 0; i < 3; i++) {
-        if (n[i] < 1)
-            return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": nx, ny and nz must be >= 1, found "
-                                "%ld %ld %ld", nlen, name->text, n[0], n[1], n[2]);
-        cells *= (double)n[i];
-    }
-    if (cells > (double)(1u << 24))
-        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": a grid of %ld x %ld x %ld cells is more "
-                            "than %u", nlen, name->text, n[0], n[1], n[2], 1u << 24);
+    long n[3];
+    double cells;
+    if ((st = pbrt_medium_grid_size(p, lx, name, n, &cells))) return st;
     Param *pd = pbrt_param_find(p, "density");
     if (!pd) return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": a \"uniformgrid\" needs \"float "
                                  "density\" (clpt does not read its temperature grid)", nlen, name->text);
-    if (pd->type != PT_FLOAT) return pbrt_param_type_error(p, lx, pd, "floats");
-    if ((double)pd->n != cells)
-        return lex_error_at(lx, &pd->decl, p->err, "MakeNamedMedium \"%.*s\": nx ny nz %ld %ld %ld are %.0f cells, "
-                            "but \"density\" has %zu values", nlen, name->text, n[0], n[1], n[2], cells, pd->n);
-    float *d = malloc(pd->n * sizeof(float));
-    if (!d) return error_set(p->err, ST_INTERNAL, "out of memory");
-    for (size_t i = 0; i < pd->n; i++) {
-        double v = p->pl.nums[pd->first + i];
-        if (!(v >= 0.0) || !(v <= 3.4e38)) {
-            free(d);
-            return lex_error_at(lx, &pd->decl, p->err, "MakeNamedMedium \"%.*s\": density %g (value %zu) must be "
-                                "a finite number >= 0", nlen, name->text, v, i);
-        }
-        d[i] = (float)v;
-    }
-    vec3 lo = v3s(0.0f), hi = v3s(1.0f);
-    if ((st = pbrt_get_point(p, lx, "p0", &lo)) || (st = pbrt_get_point(p, lx, "p1", &hi))) {
+    float *d;
+    if ((st = grid_values(p, lx, name, pd, "density", n, cells, &d))) return st;
+    vec3 lo, hi;
+    if ((st = pbrt_medium_box(p, lx, name, &lo, &hi))) {
         free(d);
         return st;
-    }
-    if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) {
-        free(d);
-        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": p1 must be greater than p0 on every "
-                            "axis, found p0 %g %g %g, p1 %g %g %g", nlen, name->text, (double)lo.x, (double)lo.y,
-                            (double)lo.z, (double)hi.x, (double)hi.y, (double)hi.z);
     }
     vec3 le;
     float *le_scale = NULL;

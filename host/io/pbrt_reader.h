@@ -180,6 +180,15 @@ Status pbrt_object_instance(Parser *p, Lexer *lx, const Token *kw);
 /* pbrt_medium.c: MakeNamedMedium, MediumInterface, the media a shape bounds */
 Status pbrt_make_named_medium(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_medium_interface(Parser *p, Lexer *lx, const Token *kw);
+/* A medium's sigma_a and sigma_s (1 each by default, as pbrt-v4), times "scale" where
+ * read_scale (the types that read it), and g: the coefficients per unit of density,
+ * checked (scale in [0, 1e30], g in (-1, 1), a finite extinction). */
+Status pbrt_medium_coefficients(Parser *p, const Lexer *lx, const Token *name, int read_scale, vec3 *sa, vec3 *ss,
+                                float *g_out);
+/* A grid's nx ny nz and their product, and its box p0 p1: checked as every grid medium
+ * reads them (pbrt-v4's uniformgrid and rgbgrid). */
+Status pbrt_medium_grid_size(Parser *p, const Lexer *lx, const Token *name, long n[3], double *cells);
+Status pbrt_medium_box(Parser *p, const Lexer *lx, const Token *name, vec3 *lo, vec3 *hi);
 /* The material a shape of `material` gets in the current MediumInterface. */
 Status pbrt_shape_media(Parser *p, uint material, uint *out);
 

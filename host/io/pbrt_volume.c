@@ -22,33 +22,6 @@
 
 #define NAME_LEN(t) (int)((t)->len > 40 ? 40 : (t)->len)
 
-/* sigma_a and sigma_s (1 each by default, as pbrt-v4), times `scale` where the type
- * reads it, and g: the coefficients per unit of density. */
-static Status coefficients(Parser *p, const Lexer *lx, const Token *name, int read_scale, vec3 *sa, vec3 *ss,
-                           float *g_out)
-{
-    Status st;
-    vec3 a = v3s(1.0f), s = v3s(1.0f);
-    double scale = 1.0, g = 0.0;
-    if ((st = pbrt_get_spectrum(p, lx, "sigma_a", &a, NULL, NULL)) ||
-        (st = pbrt_get_spectrum(p, lx, "sigma_s", &s, NULL, NULL)) ||
-        (read_scale && (st = pbrt_get_float(p, lx, "scale", &scale))) || (st = pbrt_get_float(p, lx, "g", &g)))
-        return st;
-    if (!(scale >= 0.0) || !(scale <= 1e30))
-        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "scale"), "a number in [0, 1e30]");
-    if (!(g > -1.0 && g < 1.0)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "g"), "a number in (-1, 1)");
-    a = v3_scale(a, (float)scale);
-    s = v3_scale(s, (float)scale);
-    vec3 t = v3_add(a, s);
-    if (!isfinite(t.x) || !isfinite(t.y) || !isfinite(t.z))
-        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": its extinction (sigma_a + sigma_s, times "
-                            "scale) is beyond the largest float (about 3.4e38)", NAME_LEN(name), name->text);
-    *sa = a;
-    *ss = s;
-    *g_out = (float)g;
-    return ST_OK;
-}
-
 /* The values the density grids of one scene may hold once a grid made at load (a
  * NanoVDB file's, a baked cloud) is added: 2^27 floats, 512 MiB. A few bytes of scene
  * text can ask for a 16 MiB cloud or a file's 64 MiB grid, again and again; this bounds
@@ -71,7 +44,7 @@ static Status nanovdb_medium(Parser *p, const Lexer *lx, const Token *name, Medi
     Status st;
     vec3 sa, ss;
     float g;
-    if ((st = coefficients(p, lx, name, 1, &sa, &ss, &g))) return st;
+    if ((st = pbrt_medium_coefficients(p, lx, name, 1, &sa, &ss, &g))) return st;
     const Token *f = NULL, *gn = NULL, *tn = NULL;
     if ((st = pbrt_get_string(p, lx, "filename", &f)) || (st = pbrt_get_string(p, lx, "gridname", &gn)) ||
         (st = pbrt_get_string(p, lx, "temperaturename", &tn)))
@@ -222,7 +195,7 @@ static Status cloud_medium(Parser *p, const Lexer *lx, const Token *name, Medium
     Status st;
     vec3 sa, ss;
     float g;
-    if ((st = coefficients(p, lx, name, 0, &sa, &ss, &g))) return st;
+    if ((st = pbrt_medium_coefficients(p, lx, name, 0, &sa, &ss, &g))) return st;
     double density = 1.0, wisp = 1.0, freq = 5.0;
     if ((st = pbrt_get_float(p, lx, "density", &density)) || (st = pbrt_get_float(p, lx, "wispiness", &wisp)) ||
         (st = pbrt_get_float(p, lx, "frequency", &freq)))
@@ -300,32 +273,17 @@ static Status rgb_grid(Parser *p, const Lexer *lx, const Token *name, Medium *ou
     if (!(scale >= 0.0) || !(scale <= 1e30))
         return pbrt_param_type_error(p, lx, pbrt_param_find(p, "scale"), "a number in [0, 1e30]");
     if (!(g > -1.0 && g < 1.0)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "g"), "a number in (-1, 1)");
-    long n[3] = { 1, 1, 1 };
-    if ((st = pbrt_get_int(p, lx, "nx", &n[0])) || (st = pbrt_get_int(p, lx, "ny", &n[1])) ||
-        (st = pbrt_get_int(p, lx, "nz", &n[2])))
-        return st;
-    double cells = 1.0;
-    for (int i = 0; i < 3; i++) {
-        if (n[i] < 1)
-            return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": nx, ny and nz must be >= 1, found "
-                                "%ld %ld %ld", NAME_LEN(name), name->text, n[0], n[1], n[2]);
-        cells *= (double)n[i];
-    }
-    if (cells > (double)(1u << 24))
-        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": a grid of %ld x %ld x %ld cells is more "
-                            "than %u", NAME_LEN(name), name->text, n[0], n[1], n[2], 1u << 24);
+    long n[3];
+    double cells;
+    if ((st = pbrt_medium_grid_size(p, lx, name, n, &cells))) return st;
     const double *va, *vs;
     if ((st = rgb_array(p, lx, name, "sigma_a", cells, &va)) || (st = rgb_array(p, lx, name, "sigma_s", cells, &vs)))
         return st;
     if (!va && !vs)
         return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": an \"rgbgrid\" needs \"rgb sigma_a\" and/or "
                             "\"rgb sigma_s\"", NAME_LEN(name), name->text);
-    vec3 lo = v3s(0.0f), hi = v3s(1.0f);
-    if ((st = pbrt_get_point(p, lx, "p0", &lo)) || (st = pbrt_get_point(p, lx, "p1", &hi))) return st;
-    if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z))
-        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": p1 must be greater than p0 on every "
-                            "axis, found p0 %g %g %g, p1 %g %g %g", NAME_LEN(name), name->text, (double)lo.x,
-                            (double)lo.y, (double)lo.z, (double)hi.x, (double)hi.y, (double)hi.z);
+    vec3 lo, hi;
+    if ((st = pbrt_medium_box(p, lx, name, &lo, &hi))) return st;
     size_t count = (size_t)cells;
     float *d = malloc(count * sizeof(float));
     if (!d) return error_set(p->err, ST_INTERNAL, "out of memory");

@@ -860,6 +860,9 @@ Status bvh_build_with(const KdInput *in, const BvhOptions *opt, int threads, Bvh
     return ST_OK;
 }
 
+/* Alike kd_free by design: each tree owns a node array of its own node type and a
+ * leaf list; a shared helper would need a common struct for two layouts the kernels
+ * read differently. */
 void bvh_free(Bvh *b)
 {
     free(b->nodes);

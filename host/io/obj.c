@@ -447,6 +447,9 @@ static int word_is(const char *q, size_t len, const char *w)
     return strlen(w) == len && memcmp(q, w, len) == 0;
 }
 
+/* The opening below is alike ply_parse's by design: each reader points its own state
+ * at the bytes, and the two states share no part to set up in one place (OBJ keeps a
+ * line cursor for its messages, PLY a header and the binary or text body after it). */
 Status obj_parse_with(const char *path, const char *text, size_t len, Scene *s, const MeshOptions *o,
                       Error *err)
 {

@@ -236,6 +236,8 @@ static Status render_half(const AdaptiveRun *run, uint half, uint first, uint en
     p->sample_offset = half;
     Status st = update_devices(run, err);
     if (st) return st;
+    /* the run's config narrowed to this range, with its hooks off (the viewer's
+     * pass_run sets up other fields of a config of its own: alike only in shape) */
     ScheduleConfig cfg = *run->cfg;
     cfg.spp = end;
     cfg.range_first = first;

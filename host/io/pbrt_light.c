@@ -151,6 +151,8 @@ Status pbrt_light(Parser *p, Lexer *lx, const Token *kw)
     Token type;
     Status st = pbrt_expect_head(p, lx, "a quoted light type", &type);
     if (st) return st;
+    /* pbrt-v4 too uses a moving light's start transform */
+    if (pbrt_ctm_moves(p) && (st = pbrt_warn_still(p, lx, &type, "a LightSource"))) return st;
     double scale = 1;
     if ((st = pbrt_get_float(p, lx, "scale", &scale))) return st;
     vec3 from = v3(0, 0, 0), to = v3(0, 0, 1), c = v3(1, 1, 1);

@@ -114,10 +114,37 @@ static Status d_xform(Parser *p, Lexer *lx, const Token *kw)
     Status st = pbrt_expect_numbers(p, lx, v, xform_directives[i].numbers, xform_directives[i].what);
     if (!st) st = xform_directives[i].build(p, lx, kw, v, &t);
     if (st) return st;
-    if (xform_directives[i].replace)
-        p->g.ctm = t;
-    else
-        p->g.ctm = transform_compose(&p->g.ctm, &t);
+    /* each active transform of the two (ActiveTransform) takes it */
+    if (p->g.active & PBRT_ACTIVE_START) p->g.ctm = xform_directives[i].replace ? t : transform_compose(&p->g.ctm, &t);
+    if (p->g.active & PBRT_ACTIVE_END)
+        p->g.ctm_end = xform_directives[i].replace ? t : transform_compose(&p->g.ctm_end, &t);
+    return ST_OK;
+}
+
+int pbrt_ctm_moves(const Parser *p)
+{
+    return memcmp(&p->g.ctm, &p->g.ctm_end, sizeof p->g.ctm) != 0;
+}
+
+Status pbrt_warn_still(Parser *p, const Lexer *lx, const Token *at, const char *what)
+{
+    char key[96];
+    snprintf(key, sizeof key, "still %s", what);
+    return warn_once(p, lx, at, key, "%s under a moving transform (ActiveTransform) stands still at its start-time "
+                     "pose: only ObjectInstances and the camera move (docs/pbrt.md#motion)", what);
+}
+
+/* A coordinate system's pair of transforms, new or replaced, as name t. */
+static Status coordsys_set(Parser *p, const Token *t, const Transform *start, const Transform *end)
+{
+    uint32_t i;
+    if (!strmap_find(&p->coordsys, t->text, t->len, &i)) {
+        if (pbrt_grow((void **)&p->coordsys_xf, &p->cap_coordsys, p->n_coordsys + 1, sizeof(PTransformPair)) ||
+            strmap_add(&p->coordsys, t->text, t->len, (uint32_t)p->n_coordsys))
+            return error_set(p->err, ST_INTERNAL, "out of memory");
+        i = (uint32_t)p->n_coordsys++;
+    }
+    p->coordsys_xf[i] = (PTransformPair){*start, *end};
     return ST_OK;
 }
 
@@ -127,16 +154,7 @@ static Status d_coordsys(Parser *p, Lexer *lx, const Token *kw)
     Token t;
     Status st = pbrt_expect_string(p, lx, "a quoted coordinate system name", &t);
     if (st) return st;
-    uint32_t i;
-    if (strmap_find(&p->coordsys, t.text, t.len, &i)) {
-        p->coordsys_xf[i] = p->g.ctm;
-        return ST_OK;
-    }
-    if (pbrt_grow((void **)&p->coordsys_xf, &p->cap_coordsys, p->n_coordsys + 1, sizeof(Transform)) ||
-        strmap_add(&p->coordsys, t.text, t.len, (uint32_t)p->n_coordsys))
-        return error_set(p->err, ST_INTERNAL, "out of memory");
-    p->coordsys_xf[p->n_coordsys++] = p->g.ctm;
-    return ST_OK;
+    return coordsys_set(p, &t, &p->g.ctm, &p->g.ctm_end);
 }
 
 static Status d_coordsys_transform(Parser *p, Lexer *lx, const Token *kw)
@@ -146,14 +164,16 @@ static Status d_coordsys_transform(Parser *p, Lexer *lx, const Token *kw)
     uint32_t i;
     Status st = pbrt_expect_defined(p, lx, &p->coordsys, "coordinate system", "CoordinateSystem", &t, &i);
     if (st) return st;
-    p->g.ctm = p->coordsys_xf[i];
+    if (p->g.active & PBRT_ACTIVE_START) p->g.ctm = p->coordsys_xf[i].start;
+    if (p->g.active & PBRT_ACTIVE_END) p->g.ctm_end = p->coordsys_xf[i].end;
     return ST_OK;
 }
 
 static Status d_identity(Parser *p, Lexer *lx, const Token *kw)
 {
     (void)lx; (void)kw;
-    p->g.ctm = transform_identity();
+    if (p->g.active & PBRT_ACTIVE_START) p->g.ctm = transform_identity();
+    if (p->g.active & PBRT_ACTIVE_END) p->g.ctm_end = transform_identity();
     return ST_OK;
 }
 
@@ -191,7 +211,9 @@ static Status d_attr_end(Parser *p, Lexer *lx, const Token *kw)
 static Status d_transform_end(Parser *p, Lexer *lx, const Token *kw)
 {
     if (p->n_stack == 0) return lex_error_at(lx, kw, p->err, "TransformEnd without a matching TransformBegin");
-    p->g.ctm = p->stack[--p->n_stack].ctm;
+    --p->n_stack;
+    p->g.ctm = p->stack[p->n_stack].ctm;
+    p->g.ctm_end = p->stack[p->n_stack].ctm_end;
     return ST_OK;
 }
 
@@ -199,16 +221,11 @@ static Status d_world_begin(Parser *p, Lexer *lx, const Token *kw)
 {
     if (p->world) return lex_error_at(lx, kw, p->err, "WorldBegin given twice");
     p->world = 1;
-    p->g.ctm = transform_identity();
-    p->g.end_time_only = 0; /* pbrt-v4's WorldBegin makes all transforms active again */
+    p->g.ctm = p->g.ctm_end = transform_identity();
+    p->g.active = PBRT_ACTIVE_ALL; /* pbrt-v4's WorldBegin makes both transforms active again */
     Token t = {TOK_STRING, "world", 5, kw->line, kw->col};
     uint32_t i;
-    if (!strmap_find(&p->coordsys, t.text, t.len, &i)) {
-        if (pbrt_grow((void **)&p->coordsys_xf, &p->cap_coordsys, p->n_coordsys + 1, sizeof(Transform)) ||
-            strmap_add(&p->coordsys, t.text, t.len, (uint32_t)p->n_coordsys))
-            return error_set(p->err, ST_INTERNAL, "out of memory");
-        p->coordsys_xf[p->n_coordsys++] = p->g.ctm;
-    }
+    if (!strmap_find(&p->coordsys, t.text, t.len, &i)) return coordsys_set(p, &t, &p->g.ctm, &p->g.ctm_end);
     return ST_OK;
 }
 
@@ -229,6 +246,9 @@ static Status d_camera(Parser *p, Lexer *lx, const Token *kw)
     p->s->camera_medium = p->g.medium_out;   /* pbrt-v4's CameraMedium: the outside one now */
     p->cam_ortho = pbrt_tok_eq(&type, "orthographic");
     p->cam_from_world = p->g.ctm;
+    p->cam_from_world_end = p->g.ctm_end;
+    p->cam_time_start = p->time_start;
+    p->cam_time_end = p->time_end;
     p->fov = 90;
     p->lens_radius = 0;
     p->focal_distance = 1e6;
@@ -238,19 +258,32 @@ static Status d_camera(Parser *p, Lexer *lx, const Token *kw)
     if (!(p->fov > 0 && p->fov < 180)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "fov"), "in (0, 180) degrees");
     if (!(p->lens_radius >= 0)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "lensradius"), ">= 0");
     if (!(p->focal_distance > 0)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "focaldistance"), "> 0");
+    /* pbrt-v4's CameraBase: the shutter is open from 0 to 1 unless given; one that
+     * closes before it opens is swapped, with a warning, as pbrt does */
+    double open = 0, close = 1;
+    if ((st = pbrt_get_float(p, lx, "shutteropen", &open)) || (st = pbrt_get_float(p, lx, "shutterclose", &close)))
+        return st;
+    if (!isfinite(open) || !isfinite(close) || fabs(open) > 1e30 || fabs(close) > 1e30)
+        return pbrt_param_type_error(p, lx, pbrt_param_find(p, isfinite(open) && fabs(open) <= 1e30 ? "shutterclose"
+                                                                                                    : "shutteropen"),
+                                     "a finite time");
+    if (close < open) {
+        st = warn_once(p, lx, kw, "shutter swap", "Camera \"shutterclose\" %g is before \"shutteropen\" %g: they are "
+                       "swapped, as pbrt-v4 does", close, open);
+        if (st) return st;
+        double t = open;
+        open = close;
+        close = t;
+    }
+    p->s->camera.shutter_open = (float)open;
+    p->s->camera.shutter_close = (float)close;
     /* the camera's coordinate system, as pbrt names it */
     Token cn = {TOK_STRING, "camera", 6, kw->line, kw->col};
-    int ok;
-    Transform wfc = transform_inverse(&p->g.ctm, &ok);
+    int ok, ok_end;
+    Transform wfc = transform_inverse(&p->g.ctm, &ok), wfc_end = transform_inverse(&p->g.ctm_end, &ok_end);
     if (!ok) return lex_error_at(lx, kw, p->err, "the camera transform is singular");
-    uint32_t i;
-    if (!strmap_find(&p->coordsys, cn.text, cn.len, &i)) {
-        if (pbrt_grow((void **)&p->coordsys_xf, &p->cap_coordsys, p->n_coordsys + 1, sizeof(Transform)) ||
-            strmap_add(&p->coordsys, cn.text, cn.len, (uint32_t)p->n_coordsys))
-            return error_set(p->err, ST_INTERNAL, "out of memory");
-        i = (uint32_t)p->n_coordsys++;
-    }
-    p->coordsys_xf[i] = wfc;
+    if (!ok_end) return lex_error_at(lx, kw, p->err, "the camera's end-time transform (ActiveTransform EndTime) is singular");
+    if ((st = coordsys_set(p, &cn, &wfc, &wfc_end))) return st;
     return pbrt_warn_unused(p, lx, "Camera");
 }
 
@@ -388,28 +421,41 @@ static Status d_unsupported(Parser *p, Lexer *lx, const Token *kw)
     return warn_once(p, lx, kw, key, "%s is not supported; ignored", key);
 }
 
-/* ActiveTransform StartTime | EndTime | All (a bare word, not a string). clpt has no
- * motion blur: it renders the shutter-open pose, so a transform directive given while
- * only EndTime is active leaves the transform as it is. AttributeBegin/End keep the
- * setting with the rest of the graphics state, as pbrt-v4's does. */
+/* ActiveTransform StartTime | EndTime | All (a bare word, not a string): the transforms
+ * the transform directives change from now on (docs/pbrt.md#motion). AttributeBegin/End
+ * keep the setting with the rest of the graphics state, as pbrt-v4's does. */
 static Status d_active_transform(Parser *p, Lexer *lx, const Token *kw)
 {
+    (void)kw;
     Token t;
     Status st = lex_next(lx, &t, p->err);
     if (st) return st;
     if (t.kind == TOK_WORD && pbrt_tok_eq(&t, "StartTime"))
-        p->g.end_time_only = 0;
+        p->g.active = PBRT_ACTIVE_START;
     else if (t.kind == TOK_WORD && pbrt_tok_eq(&t, "All"))
-        p->g.end_time_only = 0;
+        p->g.active = PBRT_ACTIVE_ALL;
     else if (t.kind == TOK_WORD && pbrt_tok_eq(&t, "EndTime"))
-        p->g.end_time_only = 1;
+        p->g.active = PBRT_ACTIVE_END;
     else
         return lex_expected(lx, &t, "StartTime, EndTime or All (ActiveTransform)", p->err);
-    return warn_once(p, lx, kw, "ActiveTransform",
-                     "ActiveTransform: motion blur is not supported; the StartTime (shutter-open) transform is used");
+    return ST_OK;
 }
 
-static int is_transform_directive(Status (*fn)(Parser *, Lexer *, const Token *));
+/* TransformTimes start end: the times of the two transforms (0 and 1 unless given),
+ * an option before WorldBegin as in pbrt-v4. An end before the start is refused. */
+static Status d_transform_times(Parser *p, Lexer *lx, const Token *kw)
+{
+    double v[2];
+    Status st = pbrt_expect_numbers(p, lx, v, 2, "a number (TransformTimes start end)");
+    if (st) return st;
+    if (!isfinite(v[0]) || !isfinite(v[1]) || fabs(v[0]) > 1e30 || fabs(v[1]) > 1e30)
+        return lex_error_at(lx, kw, p->err, "TransformTimes: the times must be finite numbers");
+    if (v[1] < v[0])
+        return lex_error_at(lx, kw, p->err, "TransformTimes: the end time %g is before the start time %g", v[1], v[0]);
+    p->time_start = v[0];
+    p->time_end = v[1];
+    return ST_OK;
+}
 
 static Status d_ignored(Parser *p, Lexer *lx, const Token *kw)
 {
@@ -454,7 +500,7 @@ static const struct {
     {"ColorSpace", d_unsupported},
     {"Option", d_unsupported},
     {"Accelerator", d_unsupported},
-    {"TransformTimes", d_unsupported},
+    {"TransformTimes", d_transform_times},
     {"ActiveTransform", d_active_transform},
     {"MakeNamedMedium", pbrt_make_named_medium},
     {"MediumInterface", pbrt_medium_interface},
@@ -485,21 +531,14 @@ static Status parse_statements(Parser *p, Lexer *lx)
             break;
         }
         if (p->world && (directives[i].fn == d_camera || directives[i].fn == d_film ||
-                         directives[i].fn == d_sampler || directives[i].fn == d_integrator)) {
+                         directives[i].fn == d_sampler || directives[i].fn == d_integrator ||
+                         directives[i].fn == d_transform_times)) {
             st = lex_error_at(lx, &t, p->err, "%s must come before WorldBegin", directives[i].name);
             break;
         }
-        Transform before = p->g.ctm;
         if ((st = directives[i].fn(p, lx, &t))) break;
-        if (p->g.end_time_only && is_transform_directive(directives[i].fn)) p->g.ctm = before;
     }
     return st;
-}
-
-/* the directives that change the current transform (ActiveTransform EndTime skips them) */
-static int is_transform_directive(Status (*fn)(Parser *, Lexer *, const Token *))
-{
-    return fn == d_xform || fn == d_coordsys_transform || fn == d_identity;
 }
 
 static Status parse_file(Parser *p, const char *path, const char *text, size_t len)
@@ -514,6 +553,49 @@ static Status parse_file(Parser *p, const char *path, const char *text, size_t l
 
 /* ------------------------------------------------------------------ the camera */
 
+/* The pose of pbrt's camera at cam_from_world (invertible: d_camera checks): from, at
+ * one unit ahead, up, and whether pbrt's image right (the camera's +x) is the mirror of
+ * clpt's (forward x up). */
+static void camera_pose(const Transform *cam_from_world, vec3 *from, vec3 *at, vec3 *up, int *mirror_x)
+{
+    int ok;
+    Transform w = transform_inverse(cam_from_world, &ok);
+    vec3 o = transform_point(&w, v3(0, 0, 0));
+    vec3 f = pbrt_xf_dir(&w, v3(0, 0, 1)), u = pbrt_xf_dir(&w, v3(0, 1, 0)), r = pbrt_xf_dir(&w, v3(1, 0, 0));
+    float fl = sqrtf(v3_dot(f, f));
+    *from = o;
+    *at = v3_add(o, v3_scale(f, 1.0f / fl));
+    *up = u;
+    vec3 fu = v3(f.y * u.z - f.z * u.y, f.z * u.x - f.x * u.z, f.x * u.y - f.y * u.x);
+    *mirror_x = v3_dot(fu, r) < 0;
+}
+
+/* A camera whose two transforms differ moves (docs/motion.md): its own pose at the
+ * start time, a camera key at the end time. pbrt-v4 interpolates the camera's
+ * world-from-camera transforms; clpt's camera keys interpolate from, at and up, which
+ * is the same motion for the rigid moves a LookAt makes. */
+static Status camera_motion(Parser *p)
+{
+    SceneCamera *c = &p->s->camera;
+    c->time = (float)p->cam_time_start;
+    if (memcmp(&p->cam_from_world, &p->cam_from_world_end, sizeof p->cam_from_world) == 0) return ST_OK;
+    if (!(p->cam_time_end > p->cam_time_start))
+        return error_set(p->err, ST_INPUT, "%s: the camera moves (ActiveTransform) but TransformTimes gives its start "
+                         "and end the same time %g", p->top_path, p->cam_time_start);
+    SceneCameraKey k = {.time = (float)p->cam_time_end};
+    int mirror;
+    camera_pose(&p->cam_from_world_end, &k.from, &k.at, &k.up, &mirror);
+    if (mirror != c->mirror_x)
+        return error_set(p->err, ST_INPUT, "%s: the camera's end-time transform mirrors the image and its start-time "
+                         "one does not, or the other way round", p->top_path);
+    SceneCameraKey *grown = realloc(p->s->camera_keys, (p->s->n_camera_keys + 1) * sizeof *grown);
+    if (!grown) return error_set(p->err, ST_INTERNAL, "out of memory");
+    p->s->camera_keys = grown;
+    p->s->cap_camera_keys = p->s->n_camera_keys + 1;
+    p->s->camera_keys[p->s->n_camera_keys++] = k;
+    return ST_OK;
+}
+
 /* pbrt's camera at cam_from_world looks down its +z with +y up and +x to the image's
  * right; its field of view spans the shorter image side. */
 static Status finish_camera(Parser *p)
@@ -521,23 +603,17 @@ static Status finish_camera(Parser *p)
     SceneCamera *c = &p->s->camera;
     if (!p->have_camera) {
         /* pbrt's default: at the origin looking down +z, fov 90 */
-        p->cam_from_world = transform_identity();
+        p->cam_from_world = p->cam_from_world_end = transform_identity();
         p->fov = 90;
         p->lens_radius = 0;
         p->focal_distance = 1e6;
     }
     int ok;
-    Transform w = transform_inverse(&p->cam_from_world, &ok);
+    transform_inverse(&p->cam_from_world, &ok);
     if (!ok) return error_set(p->err, ST_INPUT, "%s: the camera transform is singular", p->top_path);
-    vec3 o = transform_point(&w, v3(0, 0, 0));
-    vec3 f = pbrt_xf_dir(&w, v3(0, 0, 1)), u = pbrt_xf_dir(&w, v3(0, 1, 0)), r = pbrt_xf_dir(&w, v3(1, 0, 0));
-    float fl = sqrtf(v3_dot(f, f));
-    c->from = o;
-    c->at = v3_add(o, v3_scale(f, 1.0f / fl));
-    c->up = u;
-    /* clpt's image right is forward x up; pbrt's is the camera's +x */
-    vec3 fu = v3(f.y * u.z - f.z * u.y, f.z * u.x - f.x * u.z, f.x * u.y - f.y * u.x);
-    c->mirror_x = v3_dot(fu, r) < 0;
+    camera_pose(&p->cam_from_world, &c->from, &c->at, &c->up, &c->mirror_x);
+    Status st = camera_motion(p);
+    if (st) return st;
     double w_px = p->s->image.width, h_px = p->s->image.height;
     double aspect = w_px / h_px;
     if (p->cam_ortho) {
@@ -582,7 +658,10 @@ Status pbrt_load_text(const char *path, const char *text, size_t len, Scene *s, 
     p.s = s;
     p.err = err;
     p.top_path = path;
-    p.g.ctm = transform_identity();
+    p.g.ctm = p.g.ctm_end = transform_identity();
+    p.g.active = PBRT_ACTIVE_ALL;
+    p.time_start = 0;   /* pbrt-v4's TransformTimes 0 1 */
+    p.time_end = 1;
     p.g.material = NO_INDEX;
     p.g.area_material = NO_INDEX;
     /* pbrt-v4's defaults where clpt's differ */

@@ -49,15 +49,21 @@ typedef struct {
 
 /* ------------------------------------------------------------------ parser state */
 
+/* pbrt-v4 keeps two current transforms, for the start and the end of TransformTimes
+ * (docs/pbrt.md#motion); ActiveTransform picks which of them the transform directives
+ * change. */
+enum { PBRT_ACTIVE_START = 1, PBRT_ACTIVE_END = 2, PBRT_ACTIVE_ALL = 3 };
+
 typedef struct {
-    Transform ctm;
+    Transform ctm;           /* at the start time: the pose every still thing takes */
+    Transform ctm_end;       /* at the end time (equal to ctm unless something moves) */
     int reverse;
     uint material;           /* NO_INDEX: pbrt's default (diffuse 0.5), made on first use */
     int area;                /* an AreaLightSource is active */
     vec3 area_L;
     int area_twosided;
     uint area_material;      /* material + emission, made on first use */
-    int end_time_only;       /* ActiveTransform EndTime: transforms move the shutter-close pose only */
+    int active;              /* PBRT_ACTIVE_*: the transforms the directives change */
     uint medium_in, medium_out;   /* MediumInterface: 0 vacuum, else 1 + a medium's index */
 } GState;
 
@@ -69,6 +75,10 @@ typedef struct {
     vec3 mean;               /* the texture's mean colour (a constant's is its colour):
                               * what stands in where only a constant fits */
 } PTexture;
+
+typedef struct {
+    Transform start, end;
+} PTransformPair;
 
 /* A material named by NamedMaterial and not yet defined: where it was first used. */
 typedef struct {
@@ -106,8 +116,9 @@ typedef struct {
     PPending *pending;  size_t n_pending, cap_pending;
     /* area-light copies of a placeholder (material + emission), patched with it */
     struct { uint area, base; } *area_of_pending;  size_t n_area_pending, cap_area_pending;
-    StrMap coordsys;         /* name -> index into coordsys_xf */
-    Transform *coordsys_xf;  size_t n_coordsys, cap_coordsys;
+    StrMap coordsys;         /* name -> index into coordsys_xf (a start and an end transform) */
+    PTransformPair *coordsys_xf;  size_t n_coordsys, cap_coordsys;
+    double time_start, time_end;  /* TransformTimes: the times of ctm and ctm_end (0 and 1) */
     StrMap tex_by_name;      /* name -> index into tex */
     PTexture *tex;  size_t n_tex, cap_tex;
     StrMap warned;           /* warning keys already given */
@@ -125,7 +136,8 @@ typedef struct {
     ParamList pl;
     /* the camera, finished once the film's size is known */
     int have_camera, cam_ortho;
-    Transform cam_from_world;
+    Transform cam_from_world, cam_from_world_end;
+    double cam_time_start, cam_time_end;   /* the TransformTimes when the Camera came */
     double fov, lens_radius, focal_distance, screen_half;
 } Parser;
 
@@ -202,5 +214,11 @@ void pbrt_cloud_resolution(vec3 lo, vec3 hi, float frequency, unsigned n[3]);
 
 /* pbrt_parse.c: directives, transforms, graphics state, files */
 Status pbrt_push_state(Parser *p);
+/* 1 when the current transform differs between the start and the end time: what it
+ * places moves (pbrt-v4's CTMIsAnimated). */
+int pbrt_ctm_moves(const Parser *p);
+/* Warns once, at `at`, that `what` (a shape, a light, ...) under a moving transform is
+ * placed at its start-time pose: only instances and the camera move in clpt. */
+Status pbrt_warn_still(Parser *p, const Lexer *lx, const Token *at, const char *what);
 
 #endif /* CLPT_PBRT_READER_H */

@@ -17,6 +17,7 @@
 #include "io/texture.h"
 #include "util/kmath.h"
 #include "scene/mesh_sink.h"
+#include "scene/motion.h"
 #include "scene/instance.h"
 #include "scene/octa_env.h"
 #include "scene/subdiv.h"
@@ -446,12 +447,14 @@ static Status shape_plymesh(Parser *p, const Lexer *lx, const Token *type, uint 
     return ST_OK;
 }
 
-Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw)
+static Status shape_moving(Parser *p, Lexer *lx, const Token *kw, const Token *type);
+static Status object_place(Parser *p, const Lexer *lx, const Token *name, const char *what, uint32_t i);
+
+/* A Shape of `type`, its parameters read, under the current transform's start pose. */
+static Status shape_make(Parser *p, Lexer *lx, const Token *type_tok)
 {
-    (void)kw;
-    Token type;
-    Status st = pbrt_expect_head(p, lx, "a quoted shape type", &type);
-    if (st) return st;
+    Token type = *type_tok;
+    Status st;
     int known = pbrt_tok_eq(&type, "sphere") || pbrt_tok_eq(&type, "trianglemesh") || pbrt_tok_eq(&type, "plymesh") ||
                 pbrt_tok_eq(&type, "bilinearmesh") || pbrt_tok_eq(&type, "loopsubdiv") || pbrt_tok_eq(&type, "disk") ||
                 pbrt_tok_eq(&type, "cylinder");
@@ -461,6 +464,8 @@ Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw)
         return warn_once(p, lx, &type, key, "Shape \"%.*s\" is not supported; skipped",
                          (int)(type.len > 40 ? 40 : type.len), type.text);
     }
+    /* an object's shapes are placed by its instances, which move: not the shapes */
+    if (pbrt_ctm_moves(p) && (st = pbrt_warn_still(p, lx, &type, "a Shape in an object"))) return st;
     uint material;
     if ((st = pbrt_shape_material(p, &material))) return st;
     if (pbrt_tok_eq(&type, "sphere")) {
@@ -485,6 +490,15 @@ Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw)
     return pbrt_warn_unused(p, lx, "Shape");
 }
 
+Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token type;
+    Status st = pbrt_expect_head(p, lx, "a quoted shape type", &type);
+    if (st) return st;
+    if (!p->in_object && pbrt_ctm_moves(p)) return shape_moving(p, lx, kw, &type);
+    return shape_make(p, lx, &type);
+}
+
 /* ------------------------------------------------------------------ instancing */
 
 /* pbrt-v4's objects are clpt's (docs/instancing.md): the shapes between ObjectBegin and
@@ -500,11 +514,11 @@ Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw)
  * copies the shapes, the emitting sphere as a mesh light (instance_ellipsoid). */
 #define PBRT_MAX_FLAT_TRIANGLES ((size_t)1 << 26)
 
-Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw)
+/* Starts object `name` (ObjectBegin's work after its name is read). */
+static Status object_open(Parser *p, const Lexer *lx, const Token *kw, const Token *name_tok)
 {
-    Token name;
-    Status st = pbrt_expect_string(p, lx, "a quoted object name", &name);
-    if (st) return st;
+    Token name = *name_tok;
+    Status st;
     if (p->in_object)
         return lex_error_at(lx, kw, p->err, "ObjectBegin \"%.*s\" inside ObjectBegin \"%s\" (objects do not nest)",
                             (int)(name.len > 60 ? 60 : name.len), name.text, p->obj_name_buf);
@@ -523,6 +537,14 @@ Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw)
     p->obj_name = name;
     p->obj_name.text = p->obj_name_buf;
     return ST_OK;
+}
+
+Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw)
+{
+    Token name;
+    Status st = pbrt_expect_string(p, lx, "a quoted object name", &name);
+    if (st) return st;
+    return object_open(p, lx, kw, &name);
 }
 
 /* Whether a sphere made since ObjectBegin emits light (an AreaLightSource's); an
@@ -601,9 +623,11 @@ static Status object_take(Parser *p, PObject *o)
     return ST_OK;
 }
 
-Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw)
+/* Ends the object begun (ObjectEnd's work): its index in p->objects in *index, under
+ * its name when `named` (an object made for a moving Shape has none: ObjectInstance
+ * cannot name it). */
+static Status object_close(Parser *p, const Lexer *lx, const Token *kw, int named, uint32_t *index)
 {
-    if (!p->in_object) return lex_error_at(lx, kw, p->err, "ObjectEnd without ObjectBegin");
     if (p->n_stack != p->obj_stack)
         return lex_error_at(lx, kw, p->err, "ObjectEnd inside an AttributeBegin of its object, or after one "
                             "that closes more than it opened");
@@ -622,17 +646,25 @@ Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw)
     }
     if (st) return st == ST_INPUT ? lex_error_at(lx, kw, p->err, "%s", p->err->msg) : st;
     /* a name defined again replaces the earlier object, for the instances after it */
-    if (strmap_set(&p->object_by_name, p->obj_name.text, p->obj_name.len, (uint32_t)p->n_objects)) {
+    if (named && strmap_set(&p->object_by_name, p->obj_name.text, p->obj_name.len, (uint32_t)p->n_objects)) {
         free(o.spheres);
         free(o.sphere_xforms);
         free(o.triangles);
         free(o.shading);
         return error_set(p->err, ST_INTERNAL, "out of memory");
     }
+    *index = (uint32_t)p->n_objects;
     p->objects[p->n_objects++] = o;
     p->in_object = 0;
     p->g = p->stack[--p->n_stack];
     return ST_OK;
+}
+
+Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw)
+{
+    if (!p->in_object) return lex_error_at(lx, kw, p->err, "ObjectEnd without ObjectBegin");
+    uint32_t index;
+    return object_close(p, lx, kw, 1, &index);
 }
 
 /* An object's sphere sp under the instance's transform when either makes it an
@@ -673,14 +705,26 @@ static Status instance_ellipsoid(Parser *p, const Lexer *lx, const Token *name, 
 }
 
 /* An instance of a scene object: the CTM is its transform. A singular one (a Scale 0,
- * say) places nothing that can be seen: skipped with a warning. */
-static Status instance_place(Parser *p, const Lexer *lx, const Token *name, uint object)
+ * say) places nothing that can be seen: skipped with a warning. Under a moving CTM
+ * (ActiveTransform) the instance moves: its own pose at the start time, a key at the
+ * end time (docs/motion.md), as pbrt-v4 animates an instance. */
+static Status instance_place(Parser *p, const Lexer *lx, const Token *name, const char *what, uint object)
 {
     Transform inv;
     if (!transform_invert(&p->g.ctm, &inv))
         return warn_once(p, lx, name, "instance-singular", "ObjectInstance \"%.*s\" under a singular transform is "
                          "skipped", (int)(name->len > 60 ? 60 : name->len), name->text);
     Status st = scene_add_instance(p->s, object, &p->g.ctm, NO_INDEX, p->err);
+    if (!st && pbrt_ctm_moves(p)) {
+        if (!(p->time_end > p->time_start))
+            return lex_error_at(lx, name, p->err, "%s \"%.*s\" moves (ActiveTransform) but TransformTimes gives its "
+                                "start and end the same time %g", what, (int)(name->len > 60 ? 60 : name->len),
+                                name->text, p->time_start);
+        st = scene_add_instance_key(p->s, (float)p->time_start, (float)p->time_end, &p->g.ctm_end, p->err);
+        if (st == ST_INPUT)
+            return lex_error_at(lx, name, p->err, "%s \"%.*s\" at its end time: %s", what,
+                                (int)(name->len > 60 ? 60 : name->len), name->text, p->err->msg);
+    }
     return st == ST_INPUT ? lex_error_at(lx, name, p->err, "%s", p->err->msg) : st;
 }
 
@@ -693,12 +737,42 @@ Status pbrt_object_instance(Parser *p, Lexer *lx, const Token *kw)
     if (p->in_object)
         return lex_error_at(lx, kw, p->err, "ObjectInstance inside ObjectBegin \"%s\" (objects hold shapes, not "
                             "instances)", p->obj_name_buf);
+    return object_place(p, lx, &name, "ObjectInstance", i);
+}
+
+/* A Shape outside any object under a moving transform: pbrt-v4 moves it (an animated
+ * primitive); clpt moves instances only (docs/motion.md), so the shape becomes an
+ * object of its own, made in its object space (both transforms the identity), and one
+ * instance of it under the two transforms, interpolated as pbrt-v4 interpolates the
+ * shape's (docs/pbrt.md#motion). */
+static Status shape_moving(Parser *p, Lexer *lx, const Token *kw, const Token *type)
+{
+    char buf[64];
+    snprintf(buf, sizeof buf, "moving Shape %u:%u", type->line, type->col);
+    Token name = {TOK_STRING, buf, strlen(buf), type->line, type->col};
+    Status st = object_open(p, lx, kw, &name);
+    if (st) return st;
+    p->g.ctm = p->g.ctm_end = transform_identity();
+    if ((st = shape_make(p, lx, type))) return st;
+    uint32_t index;
+    if ((st = object_close(p, lx, kw, 0, &index))) return st;
+    return object_place(p, lx, type, "Shape", index);
+}
+
+/* ObjectInstance of p->objects[i] under the current transforms; `what` and `name` for
+ * messages ("ObjectInstance" and its name, or "Shape" and its type). */
+static Status object_place(Parser *p, const Lexer *lx, const Token *name_tok, const char *what, uint32_t i)
+{
+    Token name = *name_tok;
+    Status st;
     const PObject *o = &p->objects[i];
     double scale;
     int similar = is_similarity(&p->g.ctm, &scale);
     Transform inv;
     if (o->object != NO_INDEX && (similar || !o->sphere_emits || !transform_invert(&p->g.ctm, &inv)))
-        return instance_place(p, lx, &name, o->object);
+        return instance_place(p, lx, &name, what, o->object);
+    if (pbrt_ctm_moves(p) && (st = pbrt_warn_still(p, lx, &name, "an ObjectInstance copied into the scene")))
+        return st;
     if (o->object != NO_INDEX &&
         (st = warn_once(p, lx, &name, "instance-emits", "ObjectInstance \"%.*s\" holds an emitting sphere under a "
                         "transform that is no similarity: its shapes are copied (an instanced ellipsoid is no light)",

@@ -1,0 +1,309 @@
+/*
+ * test_pbrt_motion.c — pbrt-v4's motion in clpt's reader (docs/pbrt.md#motion): the
+ * two current transforms ActiveTransform picks between and TransformTimes dates; a
+ * moving ObjectInstance, a moving Shape (made an object of its own) and a moving
+ * camera against the average of still renders at fixed times; a still scene with a
+ * shutter and idle motion directives unchanged bit for bit; a scene like pbrt-v4's
+ * killeroo-moving.pbrt (a spinning, sliding shape) read and rendered.
+ * Bad input: tests/data/bad/pbrt-motion-* (test_bad_input.c). Run from the project root.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+#include "render_util.h"
+#include "io/scene_load.h"
+
+static Status load_text(const char *text, Scene *s, Error *err)
+{
+    scene_init(s);
+    return scene_load_bytes("tests/data/inline.pbrt", text, strlen(text), SCENE_FORMAT_AUTO, s, NULL, err);
+}
+
+static Status render_text(const char *text, Film *film, Error *err)
+{
+    Scene s;
+    Status st = load_text(text, &s, err);
+    if (!st) st = render_util_run(&s, "scalar", 0, film, err);
+    scene_free(&s);
+    return st;
+}
+
+enum { W = 40, H = 30, K = 8, SPP_STILL = 64 };
+
+/* Each scene's head: %s the camera's transforms (before Camera), %s its parameters,
+ * %u samples per pixel. */
+#define HEAD                                                                             \
+    "%s\n"                                                                               \
+    "Camera \"perspective\" \"float fov\" 35 %s\n"                                       \
+    "Film \"rgb\" \"integer xresolution\" 40 \"integer yresolution\" 30\n"               \
+    "Sampler \"halton\" \"integer pixelsamples\" %u\n"                                   \
+    "Integrator \"path\" \"integer maxdepth\" 3\n"                                       \
+    "WorldBegin\n"                                                                       \
+    "LightSource \"infinite\" \"rgb L\" [0.5 0.6 0.8]\n"                                 \
+    "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n"                           \
+    "Shape \"trianglemesh\" \"point3 P\" [-10 0 -10 10 0 -10 10 0 10 -10 0 10]\n"         \
+    "  \"integer indices\" [0 1 2 0 2 3]\n"                                              \
+    "AttributeBegin\n"                                                                   \
+    "  Material \"diffuse\" \"rgb reflectance\" [0.8 0.2 0.2]\n"                         \
+    "  Translate 0 1 0\n"                                                                \
+    "  Shape \"sphere\" \"float radius\" 1\n"                                            \
+    "AttributeEnd\n"
+
+#define LOOK "LookAt 0 1.4 -6  0 1 0  0 1 0"
+
+/* An object whose turn shows: a yellow sphere and a blue slab beside it. */
+#define THING                                                                            \
+    "ObjectBegin \"thing\"\n"                                                            \
+    "  Material \"diffuse\" \"rgb reflectance\" [0.9 0.9 0.2]\n"                         \
+    "  Shape \"sphere\" \"float radius\" 0.5\n"                                          \
+    "  Material \"diffuse\" \"rgb reflectance\" [0.2 0.2 0.9]\n"                         \
+    "  Shape \"trianglemesh\" \"point3 P\" [0.3 -0.2 0 0.9 -0.2 0 0.9 0.2 0 0.3 0.2 0]\n" \
+    "    \"integer indices\" [0 1 2 0 2 3]\n"                                            \
+    "ObjectEnd\n"
+
+/* The largest relative difference of a and b over 8 x 6 pixel blocks, per channel. */
+static double block_diff(const float *a, const float *b)
+{
+    double worst = 0.0;
+    for (int by = 0; by < H / 6; by++)
+        for (int bx = 0; bx < W / 8; bx++)
+            for (int c = 0; c < 3; c++) {
+                double sa = 0, sb = 0;
+                for (int y = by * 6; y < by * 6 + 6; y++)
+                    for (int x = bx * 8; x < bx * 8 + 8; x++) {
+                        size_t i = ((size_t)y * W + x) * 3 + c;
+                        sa += a[i];
+                        sb += b[i];
+                    }
+                worst = fmax(worst, fabs(sa - sb) / fmax(sb, 1e-3));
+            }
+    return worst;
+}
+
+/* Renders `moving` (K * SPP_STILL samples) and the K still scenes still(k, u, text)
+ * writes for the times u = (k + 1/2) / K; checks the moving image is their average
+ * within `tol`, and far (> 0.1) from the middle still one. */
+typedef void (*StillText)(double u, char *text, size_t size);
+static void check_average(const char *what, const char *moving, StillText still, double tol)
+{
+    Error err = { 0 };
+    Film film;
+    size_t n = (size_t)W * H * 3;
+    float *a = calloc(n, sizeof *a), *avg = calloc(n, sizeof *avg), *mid = calloc(n, sizeof *mid),
+          *rgb = calloc(n, sizeof *rgb);
+    char *text = malloc(8192);
+    CHECK_MSG(render_text(moving, &film, &err) == ST_OK, "%s", err.msg);
+    film_resolve(&film, a);
+    film_free(&film);
+    for (int k = 0; k < K; k++) {
+        still((k + 0.5) / K, text, 8192);
+        CHECK_MSG(render_text(text, &film, &err) == ST_OK, "%s", err.msg);
+        film_resolve(&film, rgb);
+        film_free(&film);
+        for (size_t i = 0; i < n; i++) avg[i] += rgb[i] / K;
+        if (k == K / 2) memcpy(mid, rgb, n * sizeof *mid);
+    }
+    double worst = block_diff(a, avg), worst_mid = block_diff(a, mid);
+    fprintf(stderr, "  %s: blocks against the average of still ones %.2f%%, against the middle one %.2f%%\n", what,
+            100.0 * worst, 100.0 * worst_mid);
+    CHECK(worst < tol);
+    CHECK(worst_mid > 0.1);
+    free(a);
+    free(avg);
+    free(mid);
+    free(rgb);
+    free(text);
+}
+
+/* An ObjectInstance sliding, turning 120 degrees and growing by half between
+ * TransformTimes 0 1: pbrt-v4 interpolates translation and scale linearly and the
+ * rotation by slerp, so the still pose at u is Translate, Rotate 120u, Scale 1 + u/2. */
+static void instance_still(double u, char *text, size_t size)
+{
+    snprintf(text, size, HEAD THING "Translate %.9g %.9g 0.5 Rotate %.9g 0 1 0 Scale %.9g %.9g %.9g\n"
+             "ObjectInstance \"thing\"\n", LOOK, "", (unsigned)SPP_STILL, -1.2 + 2.4 * u, 2.0 + 0.2 * u, 120.0 * u,
+             1.0 + 0.5 * u, 1.0 + 0.5 * u, 1.0 + 0.5 * u);
+}
+
+static void test_moving_instance_is_average_of_still(void)
+{
+    char text[8192];
+    snprintf(text, sizeof text, HEAD THING "AttributeBegin\n"
+             "  ActiveTransform StartTime\n  Translate -1.2 2 0.5\n"
+             "  ActiveTransform EndTime\n  Translate 1.2 2.2 0.5\n  Rotate 120 0 1 0\n  Scale 1.5 1.5 1.5\n"
+             "  ActiveTransform All\n"
+             "  ObjectInstance \"thing\"\n"
+             "AttributeEnd\n", LOOK, "", (unsigned)(K * SPP_STILL));
+    Scene s;
+    Error err = { 0 };
+    CHECK_MSG(load_text(text, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_instances, 1);
+    CHECK(s.n_instance_motion == 1 && s.instance_motion[0] == 0);
+    CHECK_EQ_INT(s.n_motion_keys, 2);
+    if (s.n_motion_keys == 2) {
+        CHECK_NEAR(s.motion_keys[0].time, 0.0, 0.0);
+        CHECK_NEAR(s.motion_keys[1].time, 1.0, 0.0);
+    }
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+    check_average("moving ObjectInstance", text, instance_still, 0.03);
+}
+
+/* A Shape outside any object under a moving transform (as pbrt-v4's killeroo-moving)
+ * becomes an object of its own and a moving instance of it. TransformTimes 2 4 and the
+ * shutter 2 4: the times are the file's. */
+static void shape_still(double u, char *text, size_t size)
+{
+    snprintf(text, size, HEAD "Material \"diffuse\" \"rgb reflectance\" [0.9 0.9 0.2]\n"
+             "Translate %.9g 2 0.5 Scale %.9g %.9g %.9g Shape \"sphere\" \"float radius\" 0.5\n", LOOK, "",
+             (unsigned)SPP_STILL, -1.2 + 2.4 * u, 1.0 + u, 1.0 + u, 1.0 + u);
+}
+
+static void test_moving_shape_is_average_of_still(void)
+{
+    char text[8192];
+    snprintf(text, sizeof text, "TransformTimes 2 4\n" HEAD "Material \"diffuse\" \"rgb reflectance\" [0.9 0.9 0.2]\n"
+             "Translate -1.2 2 0.5\n"
+             "ActiveTransform EndTime Translate 2.4 0 0 Scale 2 2 2 ActiveTransform All\n"
+             "Shape \"sphere\" \"float radius\" 0.5\n",
+             LOOK, "\"float shutteropen\" 2 \"float shutterclose\" 4", (unsigned)(K * SPP_STILL));
+    Scene s;
+    Error err = { 0 };
+    CHECK_MSG(load_text(text, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_objects, 1);
+    CHECK_EQ_INT(s.n_instances, 1);
+    CHECK_EQ_INT(s.n_motion_keys, 2);
+    if (s.n_motion_keys == 2) {
+        CHECK_NEAR(s.motion_keys[0].time, 2.0, 0.0);
+        CHECK_NEAR(s.motion_keys[1].time, 4.0, 0.0);
+    }
+    CHECK_NEAR(s.camera.shutter_open, 2.0, 0.0);
+    CHECK_NEAR(s.camera.shutter_close, 4.0, 0.0);
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+    check_average("moving Shape", text, shape_still, 0.03);
+}
+
+/* The camera's two transforms: a camera key at the end time. It slides 1.5 to its
+ * left over the shutter (Translate before LookAt moves it in its own space). */
+static void camera_still(double u, char *text, size_t size)
+{
+    char look[160];
+    snprintf(look, sizeof look, "Translate %.9g 0 0 " LOOK, 1.5 * u);
+    snprintf(text, size, HEAD, look, "", (unsigned)SPP_STILL);
+}
+
+static void test_moving_camera_is_average_of_still(void)
+{
+    char text[8192];
+    snprintf(text, sizeof text, HEAD, "ActiveTransform EndTime Translate 1.5 0 0 ActiveTransform All " LOOK, "",
+             (unsigned)(K * SPP_STILL));
+    Scene s;
+    Error err = { 0 };
+    CHECK_MSG(load_text(text, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_camera_keys, 1);
+    if (s.n_camera_keys == 1) CHECK_NEAR(s.camera_keys[0].time, 1.0, 0.0);
+    CHECK_NEAR(s.camera.time, 0.0, 0.0);
+    scene_free(&s);
+    check_average("moving camera", text, camera_still, 0.03);
+}
+
+/* A still scene keeps its bits with a shutter, TransformTimes and ActiveTransform
+ * that move nothing (both transforms changed alike). */
+static void test_still_with_shutter_same_bits(void)
+{
+    char with[8192], without[8192];
+    snprintf(with, sizeof with, "TransformTimes 0.5 3\n" HEAD "ActiveTransform StartTime Translate 0 0 1\n"
+             "ActiveTransform EndTime Translate 0 0 1 ActiveTransform All\n" THING "ObjectInstance \"thing\"\n",
+             "ActiveTransform All " LOOK, "\"float shutteropen\" 0.2 \"float shutterclose\" 0.7", 8u);
+    snprintf(without, sizeof without, HEAD "Translate 0 0 1\n" THING "ObjectInstance \"thing\"\n", LOOK, "", 8u);
+    Scene s;
+    Error err = { 0 };
+    CHECK_MSG(load_text(with, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_camera_keys, 0);
+    CHECK(s.instance_motion == NULL);
+    scene_free(&s);
+    Film a, b;
+    CHECK_MSG(render_text(with, &a, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_text(without, &b, &err) == ST_OK, "%s", err.msg);
+    CHECK(film_sums_same(&a, &b) == (size_t)W * H * 3u);
+    film_free(&a);
+    film_free(&b);
+}
+
+/* As pbrt-v4-scenes' killeroo-moving.pbrt: a shape spinning about its own axis and
+ * sliding (here a sphere and a slab in an object, and a bare sphere), under a camera
+ * whose shutter is open half the time: read without warnings and rendered, finite, and
+ * unlike the start pose. A moving light stands still, with a warning, as in pbrt-v4. */
+static void test_killeroo_moving_like(void)
+{
+    char text[8192], still[8192];
+#define KILLEROO_LIKE                                                                    \
+        HEAD THING "AttributeBegin\n"                                                    \
+        "  Translate 0 2 0.5\n"                                                          \
+        "  ActiveTransform EndTime\n  Rotate 90 0 0 1\n  Translate 0.5 0 0\n  ActiveTransform All\n" \
+        "  ObjectInstance \"thing\"\n"                                                 \
+        "  Shape \"sphere\" \"float radius\" 0.3\n"                                    \
+        "AttributeEnd\n"
+    snprintf(text, sizeof text, KILLEROO_LIKE, LOOK, "\"float shutteropen\" 0 \"float shutterclose\" 0.5", 16u);
+    snprintf(still, sizeof still, KILLEROO_LIKE, LOOK, "\"float shutteropen\" 0 \"float shutterclose\" 0", 16u);
+    Scene s;
+    Error err = { 0 };
+    CHECK_MSG(load_text(text, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_instances, 2);
+    CHECK_EQ_INT(s.n_motion_keys, 4);
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+    Film a, b;
+    CHECK_MSG(render_text(text, &a, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_text(still, &b, &err) == ST_OK, "%s", err.msg);
+    size_t n = (size_t)W * H * 3;
+    float *rgb = calloc(n, sizeof *rgb);
+    film_resolve(&a, rgb);
+    int finite = 1;
+    for (size_t i = 0; i < n; i++) finite &= isfinite(rgb[i]) && rgb[i] >= 0;
+    CHECK(finite);
+    CHECK(film_sums_same(&a, &b) < n);
+    free(rgb);
+    film_free(&a);
+    film_free(&b);
+
+    snprintf(text, sizeof text, "WorldBegin\nActiveTransform EndTime Translate 1 0 0 ActiveTransform All\n"
+             "LightSource \"point\" \"rgb I\" [1 1 1]\n");
+    CHECK_MSG(load_text(text, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_warnings, 1);
+    if (s.n_warnings == 1)
+        CHECK_STR_CONTAINS(s.warnings[0], "inline.pbrt:3: a LightSource under a moving transform (ActiveTransform) "
+                           "stands still at its start-time pose");
+    scene_free(&s);
+}
+
+/* A shutter that closes before it opens is swapped with a warning, as pbrt-v4 does. */
+static void test_shutter_swapped(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_MSG(load_text("Camera \"perspective\" \"float shutteropen\" 1 \"float shutterclose\" 0.25\nWorldBegin\n", &s,
+                        &err) == ST_OK,
+              "%s", err.msg);
+    CHECK_NEAR(s.camera.shutter_open, 0.25, 0.0);
+    CHECK_NEAR(s.camera.shutter_close, 1.0, 0.0);
+    CHECK_EQ_INT(s.n_warnings, 1);
+    if (s.n_warnings == 1)
+        CHECK_STR_CONTAINS(s.warnings[0], "Camera \"shutterclose\" 0.25 is before \"shutteropen\" 1: they are swapped");
+    scene_free(&s);
+}
+
+int main(void)
+{
+    RUN(test_moving_instance_is_average_of_still);
+    RUN(test_moving_shape_is_average_of_still);
+    RUN(test_moving_camera_is_average_of_still);
+    RUN(test_still_with_shutter_same_bits);
+    RUN(test_killeroo_moving_like);
+    RUN(test_shutter_swapped);
+    return harness_report();
+}

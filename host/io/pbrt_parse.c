@@ -572,8 +572,10 @@ static void camera_pose(const Transform *cam_from_world, vec3 *from, vec3 *at, v
 
 /* A camera whose two transforms differ moves (docs/motion.md): its own pose at the
  * start time, a camera key at the end time. pbrt-v4 interpolates the camera's
- * world-from-camera transforms; clpt's camera keys interpolate from, at and up, which
- * is the same motion for the rigid moves a LookAt makes. */
+ * world-from-camera transforms (translation linearly, rotation by slerp); clpt's camera
+ * keys are the look-at frames of the poses, interpolated the same way, so a rigid
+ * camera moves as in pbrt (a scale in the camera transform is dropped, as for a still
+ * camera). */
 static Status camera_motion(Parser *p)
 {
     SceneCamera *c = &p->s->camera;

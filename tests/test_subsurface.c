@@ -159,8 +159,9 @@ static void test_weight_zero_unchanged(void)
 }
 
 /* Every wave launch of an OpenCL device (counted and bounded wavefront, megakernel)
- * gives the scalar device's bits on the example scene and on subsurface solids in a fog
- * and in an instance, with several waves and batches. */
+ * gives the scalar device's bits on subsurface solids in a fog and in an instance, with
+ * several waves and batches; the example scene (an 871k-triangle dragon, whose load and
+ * build dominate each run) on the default launch only. */
 static void test_devices_match_scalar(void)
 {
     const char *scenes[] = { "scenes/subsurface.scene", "tests/data/subsurface/fog-and-instances.scene" };
@@ -175,7 +176,7 @@ static void test_devices_match_scalar(void)
         cli_run(ARGS(scene, "--device", "scalar", "--width", "40", "--height", "25", "--spp", "4", "-q", "-o", ref),
                 &r);
         CHECK_MSG(r.status == 0, "%s", r.err);
-        for (int i = 0; i < 3; i++) {
+        for (int i = k == 0 ? 2 : 0; i < 3; i++) {
             cli_run(ARGS(scene, "--device", TEST_OPENCL, "--width", "40", "--height", "25", "--spp", "4",
                          "--wave-launch", modes[i], "--wave-paths", "500", "--batch", "2", "-q", "-o", out), &r);
             CHECK_MSG(r.status == 0, "%s: %s", modes[i], r.err);

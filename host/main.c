@@ -236,9 +236,29 @@ static Status load_scene_input(const Options *o, Scene *scene, int *bare_mesh, E
 }
 
 /* The command line's overrides, checked against the scene they apply to. */
+/* --time T: the scene posed at T seconds of its animation, as frame T*FPS of --frames
+ * would be (the same pose, then the camera flags again: frame_render's order), so a
+ * time on a frame gives that frame's bits. A time after the animation's end is refused
+ * as a frame after it is (the same microsecond's slack), not clamped: a still of the
+ * last pose is --time at the end. */
+static Status pose_at_time(Run *r, Error *err)
+{
+    SceneAnimation *anim = r->scene.animation;
+    double t = r->o.anim_time;
+    if (!anim)
+        return error_set(err, ST_USAGE, "--time poses the animation of a glTF file given as the scene, or a clpt "
+                         "scene's camera_path; '%s' has neither", r->o.scene_path);
+    if (t > anim->end + 1e-6)
+        return error_set(err, ST_USAGE, "--time %g is after the end of the animation of '%s' at %g s", t,
+                         r->o.scene_path, anim->end);
+    Status st = anim->pose(anim, &r->scene, t, err);
+    return st == ST_OK ? scene_options_apply_camera(&r->o, &r->scene, err) : st;
+}
+
 static Status scene_apply_options(Run *r, Error *err)
 {
     Status st = scene_options_apply(&r->o, &r->scene, r->bare_mesh, err);
+    if (st == ST_OK && r->o.anim_time >= 0.0) st = pose_at_time(r, err);
     r->style.encoding = (ImageEncoding)((r->scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB) |
                                         (r->o.exr_float ? IMAGE_EXR_FLOAT : 0) | (r->o.png_depth == 16 ? IMAGE_PNG16 : 0));
     r->style.look = (ViewLook){ (ViewTransform)r->o.view, r->o.exposure };

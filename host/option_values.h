@@ -28,6 +28,8 @@ typedef struct {
      * numbered outputs; -1/-1 = one image, no animation */
     long frames_first, frames_last;
     double fps;                   /* --fps: frames per second of animation time; 0 = 24 */
+    double anim_time;             /* --time T: one image of the animation's pose at T
+                                   * seconds; < 0: none (the file's own pose) */
     /* under mpirun (docs/distributed.md) */
     int mpi_broadcast;            /* the scene is read by rank 0 only and sent to the others */
     double mpi_timeout;           /* seconds of silence before a rank is given up; 0 = 30 */

@@ -196,6 +196,11 @@
     X(OUTPUT, CUSTOM, fps, "--fps", NULL, "FPS", PARSE(parse_fps), \
         "frames per second of animation time for\n" \
         "--frames (default 24)") \
+    X(OUTPUT, CUSTOM, anim_time, "--time", NULL, "T", PARSE(parse_anim_time), \
+        "render the pose of a glTF file's animation or a\n" \
+        "scene's camera_path at T seconds (0 to its\n" \
+        "end): one still image, as frame T*FPS of\n" \
+        "--frames (docs/animation.md)") \
     X(MPI, SWITCH, mpi_broadcast, "--mpi-broadcast", NULL, NULL, NONE, \
         "rank 0 reads the scene and sends it to the\n" \
         "others (default: every rank reads SCENE, which\n" \
@@ -582,6 +587,9 @@ static Status parse_pixel_bounds(const char *v, Options *o, Error *err)
     }
 REAL_FLAG(parse_fps, fps, x > 0.0 && x <= 1000.0,
           "--fps expects a number of frames per second above 0 and at most 1000")
+/* --time T: seconds, 0 or more (the animation's end is checked once the scene is read) */
+REAL_FLAG(parse_anim_time, anim_time, isfinite(x) && x >= 0.0,
+          "--time expects a time in seconds, a finite number 0 or more")
 /* --exposure EV: stops, as Blender's (-32..32) */
 REAL_FLAG(parse_exposure, exposure, x >= -32.0 && x <= 32.0, "--exposure expects a number of stops from -32 to 32")
 REAL_FLAG(parse_adaptive, adaptive, x > 0.0 && x <= 1.0, "--adaptive expects a threshold in (0, 1]")

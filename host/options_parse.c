@@ -159,6 +159,7 @@ void options_init(Options *o)
     o->spp = o->width = o->height = o->seed = o->max_depth = o->split = -1;
     o->range_first = o->range_end = -1;
     o->frames_first = o->frames_last = -1;
+    o->anim_time = -1.0;
     o->integrator = -1;
     o->gamma = -1;
     o->shadows = -1;
@@ -293,6 +294,9 @@ Status options_finish(Options *o, Error *err)
     if (o->fps > 0.0 && o->frames_first < 0)
         return error_set(err, ST_USAGE, "--fps sets the frame rate of --frames A:B; give both, or neither");
     if (!(o->fps > 0.0)) o->fps = 24.0;
+    if (o->anim_time >= 0.0 && o->frames_first >= 0)
+        return error_set(err, ST_USAGE, "--time poses the animation at one time and --frames at each frame's: give "
+                         "one");
     if (o->frames_first >= 0 && o->range_end >= 0)
         return error_set(err, ST_USAGE, "--frames cannot be used with --sample-range (render each frame whole)");
     if (o->frames_first >= 0 && o->display_server)

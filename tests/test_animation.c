@@ -488,7 +488,7 @@ static void test_bad_documents(void)
     error_clear(&err);
     CHECK(load_doc(doc, 1, &s, &err) == ST_INPUT);
     CHECK_MSG(strcmp(err.msg, "anim.gltf: the file has no animation of a node's translation, rotation or scale to "
-                              "render frames of") == 0, "got: %s", err.msg);
+                              "pose (--frames, --time)") == 0, "got: %s", err.msg);
     scene_free(&s);
     free(doc);
 }
@@ -754,6 +754,66 @@ static void test_cli_frames(void)
     CHECK(files_equal(CLI_DIR "/pathcl_0000.pfm", CLI_DIR "/path_0000.pfm"));
 }
 
+/* --time T: one image posed at T seconds, the bits of the frame at T of --frames (at a
+ * key and between keys, the scalar device and PoCL); a camera_path's --time at a key is
+ * the camera block of the key's values; the time's errors. Uses test_cli_frames' files. */
+static void test_cli_time(void)
+{
+    static CliResult r;
+    const char *const base[] = { "--device", "scalar", "--spp", "2", "--width", "24", "--height", "16", "-q" };
+    /* frame 12 at 24 fps is 0.5 s, between the keys at 0 and 1 s; frame 24 is 1 s, at one */
+    const char *a1[] = { base[0], base[1], base[2], base[3], base[4], base[5], base[6], base[7], base[8], "--frames",
+                         "12:12", "-o", CLI_DIR "/half.pfm", CLI_DIR "/anim.gltf", NULL };
+    cli_run(a1, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    const char *a2[] = { base[0], base[1], base[2], base[3], base[4], base[5], base[6], base[7], base[8], "--time",
+                         "0.5", "-o", CLI_DIR "/t05.pfm", CLI_DIR "/anim.gltf", NULL };
+    cli_run(a2, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    CHECK(files_equal(CLI_DIR "/t05.pfm", CLI_DIR "/half_0012.pfm"));
+    const char *a3[] = { "--device", TEST_OPENCL, base[2], base[3], base[4], base[5], base[6], base[7], base[8],
+                         "--time", "1", "-o", CLI_DIR "/t1cl.pfm", CLI_DIR "/anim.gltf", NULL };
+    cli_run(a3, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    CHECK(files_equal(CLI_DIR "/t1cl.pfm", CLI_DIR "/out_0024.pfm"));
+    CHECK(!files_equal(CLI_DIR "/t1cl.pfm", CLI_DIR "/t05.pfm"));
+    /* the end of the animation (2 s) is a time to pose, as the last frame is */
+    const char *a4[] = { base[0], base[1], base[2], base[3], base[4], base[5], base[6], base[7], base[8], "--time",
+                         "2", "-o", CLI_DIR "/t2.pfm", CLI_DIR "/anim.gltf", NULL };
+    cli_run(a4, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    const char *a5[] = { "--device", "scalar", "-q", "--time", "1", "-o", CLI_DIR "/patht1.pfm",
+                         CLI_DIR "/path.scene", NULL };
+    cli_run(a5, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    CHECK(files_equal(CLI_DIR "/patht1.pfm", CLI_DIR "/still.pfm"));
+    const char *e1[] = { "--time", "2.5", "-o", CLI_DIR "/x.png", CLI_DIR "/anim.gltf", NULL };
+    cli_run(e1, &r);
+    CHECK(r.status == ST_USAGE);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --time 2.5 is after the end of the animation of '" CLI_DIR "/anim.gltf' "
+                              "at 2 s");
+    const char *bad_times[] = { "-1", "nan", "inf", "1e999", "1s", "" };
+    for (size_t i = 0; i < sizeof bad_times / sizeof bad_times[0]; i++) {
+        const char *e2[] = { "--time", bad_times[i], CLI_DIR "/anim.gltf", NULL };
+        cli_run(e2, &r);
+        CHECK_MSG(r.status == ST_USAGE, "--time '%s': status %d", bad_times[i], r.status);
+        char want[160];
+        snprintf(want, sizeof want, "clpt: error: --time expects a time in seconds, a finite number 0 or more, "
+                 "got '%s'", bad_times[i]);
+        CHECK_STR_CONTAINS(r.err, want);
+    }
+    const char *e3[] = { "--time", "0", "-o", CLI_DIR "/x.png", "scenes/cornell-box.scene", NULL };
+    cli_run(e3, &r);
+    CHECK(r.status == ST_USAGE);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --time poses the animation of a glTF file given as the scene, or a "
+                              "clpt scene's camera_path; 'scenes/cornell-box.scene' has neither");
+    const char *e4[] = { "--time", "1", "--frames", "0:1", CLI_DIR "/anim.gltf", NULL };
+    cli_run(e4, &r);
+    CHECK(r.status == ST_USAGE);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --time poses the animation at one time and --frames at each frame's: "
+                              "give one");
+}
+
 static void test_cli_errors(void)
 {
     static CliResult r;
@@ -816,5 +876,6 @@ int main(void)
     RUN(test_cli_frames);
     RUN(test_cli_camera_only);
     RUN(test_cli_errors);
+    RUN(test_cli_time);
     return harness_report();
 }

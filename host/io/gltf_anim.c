@@ -396,7 +396,7 @@ Status gltf_parse_animated(const char *path, const char *data, size_t len, Scene
     }
     if (!st && a->n_ch == 0)
         st = error_set(err, ST_INPUT, "%s: the file has no animation of a node's translation, rotation or scale "
-                       "to render frames of", path);
+                       "to pose (--frames, --time)", path);
     a->base.camera_only = !st && moves_camera_only(a);
     if (st) {
         anim_free(&a->base);

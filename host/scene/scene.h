@@ -97,7 +97,7 @@ typedef struct {
                                   * (the size rendered is, host/main.c) */
     const char *gltf_camera;     /* in: the glTF camera to look through (--camera), by
                                   * index or name; NULL: the file's first */
-    int keep_animation;          /* in: a reader keeps the file's animation (--frames) */
+    int keep_animation;          /* in: a reader keeps the file's animation (--frames, --time) */
     SceneAnimation *animation;   /* out: that animation, or NULL (scene/animation.h) */
     SceneCamera camera;
     /* a moving camera's poses after its own (SceneCamera.time), in increasing time;

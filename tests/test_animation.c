@@ -787,6 +787,25 @@ static void test_cli_time(void)
     cli_run(a5, &r);
     CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
     CHECK(files_equal(CLI_DIR "/patht1.pfm", CLI_DIR "/still.pfm"));
+    /* a checkpoint of one time resumes that time to the straight render's bits, and is
+     * refused for another (the posed scene differs) */
+    const char *c1[] = { base[0], base[1], "--spp", "1", base[4], base[5], base[6], base[7], base[8], "--time",
+                         "0.5", "--checkpoint", CLI_DIR "/tck.ckpt", "-o", CLI_DIR "/thalf.pfm",
+                         CLI_DIR "/anim.gltf", NULL };
+    cli_run(c1, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    const char *c2[] = { base[0], base[1], base[2], base[3], base[4], base[5], base[6], base[7], base[8], "--time",
+                         "1", "--resume", CLI_DIR "/tck.ckpt", "-o", CLI_DIR "/tother.pfm", CLI_DIR "/anim.gltf",
+                         NULL };
+    cli_run(c2, &r);
+    CHECK_EQ_INT(r.status, ST_INPUT);
+    CHECK_STR_CONTAINS(r.err, "belongs to another render: the scene differs");
+    const char *c3[] = { base[0], base[1], base[2], base[3], base[4], base[5], base[6], base[7], base[8], "--time",
+                         "0.5", "--resume", CLI_DIR "/tck.ckpt", "-o", CLI_DIR "/tresumed.pfm",
+                         CLI_DIR "/anim.gltf", NULL };
+    cli_run(c3, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    CHECK(files_equal(CLI_DIR "/tresumed.pfm", CLI_DIR "/t05.pfm"));
     const char *e1[] = { "--time", "2.5", "-o", CLI_DIR "/x.png", CLI_DIR "/anim.gltf", NULL };
     cli_run(e1, &r);
     CHECK(r.status == ST_USAGE);

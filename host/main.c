@@ -255,10 +255,27 @@ static Status pose_at_time(Run *r, Error *err)
     return st == ST_OK ? scene_options_apply_camera(&r->o, &r->scene, err) : st;
 }
 
+/* --shutter A:B: the scene's animation sampled over the shutter (motion blur,
+ * docs/motion.md); a close after the end is refused as --time's is. */
+static Status pose_over_shutter(Run *r, Error *err)
+{
+    SceneAnimation *anim = r->scene.animation;
+    double open = r->o.shutter_open, close = r->o.shutter_close;
+    if (!anim || !anim->pose_shutter)
+        return error_set(err, ST_USAGE, "--shutter blurs the animation of a glTF file given as the scene; '%s' is "
+                         "not one", r->o.scene_path);
+    if (anim->end > 0.0 && close > anim->end + 1e-6)
+        return error_set(err, ST_USAGE, "--shutter %g:%g closes after the end of the animation of '%s' at %g s", open,
+                         close, r->o.scene_path, anim->end);
+    Status st = anim->pose_shutter(anim, &r->scene, open, close, err);
+    return st == ST_OK ? scene_options_apply_camera(&r->o, &r->scene, err) : st;
+}
+
 static Status scene_apply_options(Run *r, Error *err)
 {
     Status st = scene_options_apply(&r->o, &r->scene, r->bare_mesh, err);
     if (st == ST_OK && r->o.anim_time >= 0.0) st = pose_at_time(r, err);
+    if (st == ST_OK && r->o.shutter_close > r->o.shutter_open) st = pose_over_shutter(r, err);
     r->style.encoding = (ImageEncoding)((r->scene.linear_output ? IMAGE_LINEAR : IMAGE_SRGB) |
                                         (r->o.exr_float ? IMAGE_EXR_FLOAT : 0) | (r->o.png_depth == 16 ? IMAGE_PNG16 : 0));
     r->style.look = (ViewLook){ (ViewTransform)r->o.view, r->o.exposure };

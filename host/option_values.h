@@ -30,6 +30,8 @@ typedef struct {
     double fps;                   /* --fps: frames per second of animation time; 0 = 24 */
     double anim_time;             /* --time T: one image of the animation's pose at T
                                    * seconds; < 0: none (the file's own pose) */
+    /* --shutter A:B: a glTF animation blurred over [A, B] seconds; 0 and 0: none */
+    double shutter_open, shutter_close;
     /* under mpirun (docs/distributed.md) */
     int mpi_broadcast;            /* the scene is read by rank 0 only and sent to the others */
     double mpi_timeout;           /* seconds of silence before a rank is given up; 0 = 30 */

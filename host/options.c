@@ -201,6 +201,11 @@
         "scene's camera_path at T seconds (0 to its\n" \
         "end): one still image, as frame T*FPS of\n" \
         "--frames (docs/animation.md)") \
+    X(OUTPUT, CUSTOM, shutter_open, "--shutter", NULL, "A:B", PARSE(parse_shutter), \
+        "motion blur of a glTF file's animation: the\n" \
+        "shutter open from A to B seconds (0 <= A < B),\n" \
+        "moving meshes and the camera sampled over it\n" \
+        "(docs/motion.md)") \
     X(MPI, SWITCH, mpi_broadcast, "--mpi-broadcast", NULL, NULL, NONE, \
         "rank 0 reads the scene and sends it to the\n" \
         "others (default: every rank reads SCENE, which\n" \
@@ -587,6 +592,30 @@ static Status parse_pixel_bounds(const char *v, Options *o, Error *err)
     }
 REAL_FLAG(parse_fps, fps, x > 0.0 && x <= 1000.0,
           "--fps expects a number of frames per second above 0 and at most 1000")
+/* --shutter A:B: two finite times in seconds, 0 <= A < B (the animation's end is
+ * checked once the scene is read) */
+static Status parse_shutter(const char *v, Options *o, Error *err)
+{
+    const char *colon = strchr(v, ':');
+    char first[64];
+    double a, b;
+    size_t len = colon ? (size_t)(colon - v) : 0;
+    if (colon && len < sizeof first) {
+        memcpy(first, v, len);
+        first[len] = '\0';
+    }
+    if (!colon || len >= sizeof first || !read_real(first, &a) || !read_real(colon + 1, &b) || !isfinite(a) ||
+        !isfinite(b) || a < 0.0 || b < 0.0)
+        return error_set(err, ST_USAGE, "--shutter expects A:B, the times in seconds it opens and closes (finite, "
+                         "0 or more), got '%s'", v);
+    if (!(b > a))
+        return error_set(err, ST_USAGE, "--shutter %s: it closes at %g s, not after it opens at %g s (for one time, "
+                         "--time)", v, b, a);
+    o->shutter_open = a;
+    o->shutter_close = b;
+    return ST_OK;
+}
+
 /* --time T: seconds, 0 or more (the animation's end is checked once the scene is read) */
 REAL_FLAG(parse_anim_time, anim_time, isfinite(x) && x >= 0.0,
           "--time expects a time in seconds, a finite number 0 or more")

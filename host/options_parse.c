@@ -294,6 +294,12 @@ Status options_finish(Options *o, Error *err)
     if (o->fps > 0.0 && o->frames_first < 0)
         return error_set(err, ST_USAGE, "--fps sets the frame rate of --frames A:B; give both, or neither");
     if (!(o->fps > 0.0)) o->fps = 24.0;
+    if (o->shutter_close > o->shutter_open && o->anim_time >= 0.0)
+        return error_set(err, ST_USAGE, "--shutter blurs the animation over a time and --time poses it at one: "
+                         "give one");
+    if (o->shutter_close > o->shutter_open && o->frames_first >= 0)
+        return error_set(err, ST_USAGE, "--shutter is not combined with --frames yet (render each frame's "
+                         "shutter with --shutter A:B alone)");
     if (o->anim_time >= 0.0 && o->frames_first >= 0)
         return error_set(err, ST_USAGE, "--time poses the animation at one time and --frames at each frame's: give "
                          "one");

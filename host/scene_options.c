@@ -15,7 +15,8 @@ Status scene_options_before_load(const Options *o, Scene *s, Error *err)
         return error_set(err, ST_USAGE, "--camera picks a glTF file's camera; '%s' is not a .gltf or .glb file",
                          o->scene_path);
     s->gltf_camera = o->camera;
-    s->keep_animation = o->frames_first >= 0 || o->anim_time >= 0.0;
+    s->keep_animation = o->frames_first >= 0 || o->anim_time >= 0.0 ? KEEP_ANIMATION_NEEDED
+                      : o->shutter_close > o->shutter_open ? KEEP_ANIMATION_IF_ANY : KEEP_ANIMATION_NO;
     s->size_overridden = o->width >= 0 || o->height >= 0;
     return ST_OK;
 }

@@ -833,6 +833,166 @@ static void test_cli_time(void)
                               "give one");
 }
 
+/* ------------------------------------------------------------------ --shutter */
+
+/* Node 0's triangle sliding linearly from (0,0,0) at 0 s to (1,0.5,0) at 1 s (sampler 0's
+ * first two keys); the instanced mesh and the camera stand still. */
+static const char slide_anim[] = "\"animations\":[{\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,"
+                                 "\"path\":\"translation\"}}],\"samplers\":[{\"input\":1,\"output\":2}]}],";
+
+/* Each 8x8 block's mean of the film (sums over samples): 3 x 2 blocks of 24 x 16, RGB. */
+static void block_means(const Film *f, double out[6][3])
+{
+    memset(out, 0, 6 * sizeof out[0]);
+    for (uint y = 0; y < f->height; y++)
+        for (uint x = 0; x < f->width; x++)
+            for (int c = 0; c < 3; c++)
+                out[(y / 8) * 3 + x / 8][c] += (double)f->sum[((size_t)y * f->width + x) * 3 + (size_t)c] /
+                                               (64.0 * (double)f->samples);
+}
+
+/* The largest difference of two blocks' means, over the largest mean. */
+static double blocks_apart(double a[6][3], double b[6][3])
+{
+    double d = 0, top = 0;
+    for (int i = 0; i < 6; i++)
+        for (int c = 0; c < 3; c++) {
+            d = fmax(d, fabs(a[i][c] - b[i][c]));
+            top = fmax(top, fmax(a[i][c], b[i][c]));
+        }
+    return d / top;
+}
+
+/* A node moving linearly, blurred over [0, 1] (512 samples), against the average of 8
+ * still poses at the middles of eighths of the shutter (8 x 64): within noise, and
+ * far from the still pose at the middle. */
+static void test_shutter_equals_average(void)
+{
+    char *doc = malloc(16384);
+    doc_json(doc, 16384, anim_nodes, slide_anim);
+    Scene s;
+    Error err = { 0 };
+    Status st = load_doc(doc, KEEP_ANIMATION_IF_ANY, &s, &err);
+    CHECK_MSG(st == ST_OK, "load: %s", err.msg);
+    if (st == ST_OK) st = s.animation->pose_shutter(s.animation, &s, 0.0, 1.0, &err);
+    CHECK_MSG(st == ST_OK, "shutter: %s", err.msg);
+    /* the slid triangle is a moving instance now; the still ones are not */
+    CHECK(s.n_instances == 3 && s.n_motion_keys == 2 && s.camera.shutter_close == 1.0f);
+    s.image.spp = 512;
+    Film blurred;
+    double blur[6][3], avg[6][3], mid[6][3];
+    memset(avg, 0, sizeof avg);
+    if (st == ST_OK && render_sums(&s, &blurred)) {
+        block_means(&blurred, blur);
+        film_free(&blurred);
+    }
+    scene_free(&s);
+    for (int i = 0; i < 8; i++) {
+        Scene still;
+        st = load_doc(doc, KEEP_ANIMATION_NEEDED, &still, &err);
+        if (st == ST_OK) st = still.animation->pose(still.animation, &still, (i + 0.5) / 8.0, &err);
+        CHECK_MSG(st == ST_OK, "still %d: %s", i, err.msg);
+        still.image.spp = 64;
+        Film f;
+        if (st == ST_OK && render_sums(&still, &f)) {
+            double m[6][3];
+            block_means(&f, m);
+            for (int b = 0; b < 6; b++)
+                for (int c = 0; c < 3; c++) avg[b][c] += m[b][c] / 8.0;
+            film_free(&f);
+        }
+        scene_free(&still);
+    }
+    Scene middle;
+    st = load_doc(doc, KEEP_ANIMATION_NEEDED, &middle, &err);
+    if (st == ST_OK) st = middle.animation->pose(middle.animation, &middle, 0.5, &err);
+    middle.image.spp = 512;
+    Film f;
+    if (st == ST_OK && render_sums(&middle, &f)) {
+        block_means(&f, mid);
+        film_free(&f);
+    }
+    scene_free(&middle);
+    double near = blocks_apart(blur, avg), far = blocks_apart(blur, mid);
+    CHECK_MSG(near < 0.02, "blurred against the average of still poses: %.4f apart", near);
+    CHECK_MSG(far > 4 * near, "blurred against the middle pose: %.4f apart (average: %.4f)", far, near);
+    printf("     blurred vs average of 8 poses: %.4f; vs the middle pose: %.4f\n", near, far);
+    free(doc);
+}
+
+/* The program: a still glTF file keeps its bits under a shutter; PoCL gives the scalar
+ * device's bits on a blurred one; the shutter's errors. */
+static void test_cli_shutter(void)
+{
+    static CliResult r;
+    char *doc = malloc(16384);
+    doc_json(doc, 16384, anim_nodes, "");
+    FILE *f = fopen(CLI_DIR "/still.gltf", "w");
+    CHECK(f != NULL);
+    if (f) {
+        fputs(doc, f);
+        fclose(f);
+    }
+    free(doc);
+    const char *const base[] = { "--device", "scalar", "--spp", "2", "--width", "24", "--height", "16", "-q" };
+    const char *a1[] = { base[0], base[1], base[2], base[3], base[4], base[5], base[6], base[7], base[8], "-o",
+                         CLI_DIR "/still.pfm", CLI_DIR "/still.gltf", NULL };
+    cli_run(a1, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    const char *a2[] = { base[0], base[1], base[2], base[3], base[4], base[5], base[6], base[7], base[8], "--shutter",
+                         "0:1", "-o", CLI_DIR "/stillsh.pfm", CLI_DIR "/still.gltf", NULL };
+    cli_run(a2, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    CHECK(files_equal(CLI_DIR "/still.pfm", CLI_DIR "/stillsh.pfm"));
+    /* the whole animation (translation, slerp, a cubic spline, a step, the camera) */
+    const char *a3[] = { base[0], base[1], base[2], base[3], base[4], base[5], base[6], base[7], base[8], "--shutter",
+                         "0.5:1.5", "-o", CLI_DIR "/blur.pfm", CLI_DIR "/anim.gltf", NULL };
+    cli_run(a3, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    const char *a4[] = { "--device", TEST_OPENCL, base[2], base[3], base[4], base[5], base[6], base[7], base[8],
+                         "--shutter", "0.5:1.5", "-o", CLI_DIR "/blurcl.pfm", CLI_DIR "/anim.gltf", NULL };
+    cli_run(a4, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    CHECK(files_equal(CLI_DIR "/blur.pfm", CLI_DIR "/blurcl.pfm"));
+    CHECK(!files_equal(CLI_DIR "/blur.pfm", CLI_DIR "/t1cl.pfm"));
+    static const struct { const char *value, *msg; } bad[] = {
+        { "1:0.5", "clpt: error: --shutter 1:0.5: it closes at 0.5 s, not after it opens at 1 s (for one time, "
+                   "--time)" },
+        { "1:1", "clpt: error: --shutter 1:1: it closes at 1 s, not after it opens at 1 s (for one time, --time)" },
+        { "nan:1", "clpt: error: --shutter expects A:B, the times in seconds it opens and closes (finite, 0 or "
+                   "more), got 'nan:1'" },
+        { "0:inf", "clpt: error: --shutter expects A:B, the times in seconds it opens and closes (finite, 0 or "
+                   "more), got '0:inf'" },
+        { "-1:1", "clpt: error: --shutter expects A:B, the times in seconds it opens and closes (finite, 0 or "
+                  "more), got '-1:1'" },
+        { "1", "clpt: error: --shutter expects A:B, the times in seconds it opens and closes (finite, 0 or more), "
+               "got '1'" },
+        { "1.5:3", "clpt: error: --shutter 1.5:3 closes after the end of the animation of '" CLI_DIR "/anim.gltf' "
+                   "at 2 s" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        const char *e[] = { "--shutter", bad[i].value, "-o", CLI_DIR "/x.png", CLI_DIR "/anim.gltf", NULL };
+        cli_run(e, &r);
+        CHECK_MSG(r.status == ST_USAGE, "--shutter '%s': status %d", bad[i].value, r.status);
+        CHECK_STR_CONTAINS(r.err, bad[i].msg);
+    }
+    const char *e1[] = { "--shutter", "0:1", "-o", CLI_DIR "/x.png", "scenes/cornell-box.scene", NULL };
+    cli_run(e1, &r);
+    CHECK(r.status == ST_USAGE);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter blurs the animation of a glTF file given as the scene; "
+                              "'scenes/cornell-box.scene' is not one");
+    const char *e2[] = { "--shutter", "0:1", "--time", "1", CLI_DIR "/anim.gltf", NULL };
+    cli_run(e2, &r);
+    CHECK(r.status == ST_USAGE);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter blurs the animation over a time and --time poses it at one: "
+                              "give one");
+    const char *e3[] = { "--shutter", "0:1", "--frames", "0:1", CLI_DIR "/anim.gltf", NULL };
+    cli_run(e3, &r);
+    CHECK(r.status == ST_USAGE);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter is not combined with --frames yet (render each frame's "
+                              "shutter with --shutter A:B alone)");
+}
+
 static void test_cli_errors(void)
 {
     static CliResult r;
@@ -896,5 +1056,7 @@ int main(void)
     RUN(test_cli_camera_only);
     RUN(test_cli_errors);
     RUN(test_cli_time);
+    RUN(test_shutter_equals_average);
+    RUN(test_cli_shutter);
     return harness_report();
 }

@@ -30,7 +30,7 @@ static void test_every_listed_flag_is_documented_and_parsed(void)
 {
     static const struct { const char *flag, *value; } custom[] = {
         { "--aov", "normal" }, { "--depth-range", "1,2" }, { "--sample-range", "0:1" }, { "--adaptive", "0.5" },
-        { "--frames", "0:1" }, { "--fps", "30" }, { "--time", "1" },
+        { "--frames", "0:1" }, { "--fps", "30" }, { "--time", "1" }, { "--shutter", "0:1" },
         { "--exposure", "-1.5" }, { "--noise-threshold", "0.05" }, { "--clamp", "10" },
         { "--set", "camera.fov=30" }, { "--crop", "0,0.5,0,1" }, { "--pixel-bounds", "0,8,0,8" },
         { "--lookat", "0,0,5,0,0,0,0,1,0" }, { "--fov", "30" },

@@ -17,6 +17,7 @@
 
 #include "io/gltf_reader.h"
 #include "scene/keyframes.h"
+#include "scene/motion.h"
 #include "scene/scene_mark.h"
 
 enum { PATH_T, PATH_R, PATH_S };
@@ -35,6 +36,7 @@ struct GltfAnimated {
     GltfView view;
     GltfChannel *ch;      size_t n_ch;
     GltfNodePose *pose;   /* per node */
+    GltfNodePose *pose_at;   /* per node: the shutter's samples, while the walk uses pose */
     int *parent;          /* per node: its parent, or -1 */
     SceneMark mark;       /* the scene before the node tree was placed */
 };
@@ -244,7 +246,9 @@ Status gltf_anim_node_trs(GltfAnimated *a, int node, double t, double tr[3], dou
     return ST_OK;
 }
 
-Status gltf_anim_node_world(GltfAnimated *a, int node, double t, Transform *out, Error *err)
+/* Node `node`'s world transform at time t, evaluated into the per-node buffer `pose`
+ * (the walk's own, or the shutter's second one while the walk uses the first). */
+static Status node_world(GltfAnimated *a, GltfNodePose *pose, int node, double t, Transform *out, Error *err)
 {
     Gltf *g = &a->g;
     if (node < 0 || node >= g->n_nodes) return error_set(err, ST_INTERNAL, "no node %d", node);
@@ -257,8 +261,9 @@ Status gltf_anim_node_world(GltfAnimated *a, int node, double t, Transform *out,
     if (!chain) return error_set(err, ST_INTERNAL, "out of memory");
     int i = depth;
     for (int n = node; n >= 0; n = a->parent[n]) chain[--i] = n;
-    gltf_anim_eval(a, t, a->pose);
-    g->pose = a->pose;
+    gltf_anim_eval(a, t, pose);
+    const GltfNodePose *walk_pose = g->pose;
+    g->pose = pose;
     /* composed from the root down, as the node walk composes it: the same bits */
     Transform xf = transform_identity();
     Status st = ST_OK;
@@ -266,10 +271,15 @@ Status gltf_anim_node_world(GltfAnimated *a, int node, double t, Transform *out,
         Transform local;
         if (!(st = gltf_node_local(g, chain[i], &local))) xf = transform_compose(&xf, &local);
     }
-    g->pose = NULL;
+    g->pose = walk_pose;
     free(chain);
     *out = transform_compose(&a->o.xf, &xf);
     return st;
+}
+
+Status gltf_anim_node_world(GltfAnimated *a, int node, double t, Transform *out, Error *err)
+{
+    return node_world(a, a->pose, node, t, out, err);
 }
 
 /* Whether a node shows something but a camera: a mesh (with EXT_mesh_gpu_instancing
@@ -347,6 +357,155 @@ static Status anim_pose(SceneAnimation *base, void *vscene, double t, Error *err
     return st;
 }
 
+/* ------------------------------------------------------------------ shutter */
+
+/* Adds t to the increasing times[*n] (room for MOTION_MAX_KEYS + 1) unless it is not
+ * after the last as a float, the time a key keeps: keys must increase there. */
+static void time_add(double *times, size_t *n, double t)
+{
+    if (*n > MOTION_MAX_KEYS) return;
+    if (*n > 0 && !((float)t > (float)times[*n - 1])) return;
+    times[(*n)++] = t;
+}
+
+/* The times the shutter [open, close] is sampled at: the open, every key time of a
+ * channel inside it, the close; a CUBICSPLINE channel's curve between keys is followed
+ * by 3 more times in each interval (the keys' own interpolation is linear in
+ * translation and scale, slerp in rotation: exact for LINEAR channels of one node).
+ * More than MOTION_MAX_KEYS: that many times evenly over the shutter instead. */
+static size_t shutter_times(const GltfAnimated *a, double open, double close, double *times)
+{
+    size_t n_inside = 0;
+    int cubic = 0;
+    double *inside = NULL;
+    size_t cap = 0;
+    for (size_t i = 0; i < a->n_ch; i++) {
+        const KeyTrack *k = &a->ch[i].track;
+        cubic |= k->interp == KEY_CUBICSPLINE;
+        for (size_t j = 0; j < k->n; j++) {
+            if (!(k->times[j] > open && k->times[j] < close)) continue;
+            if (n_inside == cap) {
+                cap = cap ? 2 * cap : 16;
+                double *grown = realloc(inside, cap * sizeof *grown);
+                if (!grown) {
+                    /* without memory: the even spread (n_inside made too many) */
+                    n_inside = MOTION_MAX_KEYS + 1;
+                    break;
+                }
+                inside = grown;
+            }
+            inside[n_inside++] = k->times[j];
+        }
+    }
+    size_t n = 0;
+    size_t steps = cubic ? 4 : 1;
+    if ((n_inside + 1) * steps + 1 <= MOTION_MAX_KEYS) {
+        /* sorted by insertion: few keys lie inside a shutter */
+        for (size_t i = 1; i < n_inside; i++)
+            for (size_t j = i; j > 0 && inside[j - 1] > inside[j]; j--) {
+                double x = inside[j];
+                inside[j] = inside[j - 1];
+                inside[j - 1] = x;
+            }
+        double prev = open;
+        time_add(times, &n, open);
+        for (size_t i = 0; i <= n_inside; i++) {
+            double next = i < n_inside ? inside[i] : close;
+            if (!(next > prev)) continue;
+            for (size_t j = 1; j <= steps; j++)
+                time_add(times, &n, j == steps ? next : prev + (next - prev) * (double)j / (double)steps);
+            prev = next;
+        }
+    } else {
+        for (size_t j = 0; j < MOTION_MAX_KEYS; j++)
+            time_add(times, &n, j + 1 == MOTION_MAX_KEYS ? close : open + (close - open) * (double)j /
+                                                                   (double)(MOTION_MAX_KEYS - 1));
+    }
+    free(inside);
+    return n;
+}
+
+static Status blur_world_at(void *ctx, int node, double t, Transform *out, Error *err)
+{
+    GltfAnimated *a = ctx;
+    return node_world(a, a->pose_at, node, t, out, err);
+}
+
+/* The nodes whose world transform at some sampled time differs from the open's: a
+ * node animated while the shutter is open, or below one. One whose chain cannot be
+ * evaluated (the walk reports why) is taken as still. */
+static Status moving_nodes(GltfAnimated *a, const double *times, size_t n, unsigned char *moves, Error *err)
+{
+    for (int node = 0; node < a->g.n_nodes; node++) {
+        Transform w0, w;
+        Error ignored = { 0 };
+        if (node_world(a, a->pose_at, node, times[0], &w0, &ignored)) continue;
+        for (size_t k = 1; k < n && !moves[node]; k++) {
+            if (node_world(a, a->pose_at, node, times[k], &w, &ignored)) break;
+            moves[node] = memcmp(&w, &w0, sizeof w) != 0;
+        }
+    }
+    (void)err;
+    return ST_OK;
+}
+
+/* The camera's node moving: the camera's pose at times[0] is the walk's; a camera key
+ * at each later time (docs/motion.md). */
+static Status camera_keys_add(GltfAnimated *a, Scene *s, const double *times, size_t n, Error *err)
+{
+    free(s->camera_keys);
+    s->camera_keys = calloc(n, sizeof *s->camera_keys);
+    s->n_camera_keys = s->cap_camera_keys = 0;
+    if (!s->camera_keys) return error_set(err, ST_INTERNAL, "out of memory");
+    s->cap_camera_keys = n;
+    s->camera.time = (float)times[0];
+    for (size_t k = 1; k < n; k++) {
+        Transform w;
+        Status st = node_world(a, a->pose_at, a->g.camera_node, times[k], &w, err);
+        if (st) return st;
+        SceneCameraKey *ck = &s->camera_keys[s->n_camera_keys++];
+        ck->time = (float)times[k];
+        gltf_camera_frame(&w, &ck->from, &ck->at, &ck->up);
+    }
+    return ST_OK;
+}
+
+/* The scene placed at the open's pose, the nodes that move over [open, close] with
+ * keys sampled from the animation (meshes as moving instances, the camera with camera
+ * keys) and the camera's shutter [open, close]. Posed once, after the load. */
+static Status anim_pose_shutter(SceneAnimation *base, void *vscene, double open, double close, Error *err)
+{
+    GltfAnimated *a = (GltfAnimated *)base;
+    Scene *s = vscene;
+    double times[MOTION_MAX_KEYS + 1];
+    size_t n = shutter_times(a, open, close, times);
+    unsigned char *moves = calloc((size_t)a->g.n_nodes + 1, 1);
+    if (!moves) return error_set(err, ST_INTERNAL, "out of memory");
+    Status st = moving_nodes(a, times, n, moves, err);
+    int any = 0;
+    for (int i = 0; i < a->g.n_nodes; i++) any |= moves[i];
+    if (!st && !any) {
+        /* nothing moves while it is open: the still pose, the same bits as --time */
+        free(moves);
+        return anim_pose(base, vscene, open, err);
+    }
+    GltfBlur blur = { moves, times, n, blur_world_at, a };
+    /* the whole scene is placed again, with the moving meshes as instances */
+    int camera_only = a->base.camera_only;
+    a->base.camera_only = 0;
+    a->g.blur = &blur;
+    if (!st) st = anim_pose(base, vscene, open, err);
+    a->g.blur = NULL;
+    a->base.camera_only = camera_only;
+    if (!st && a->g.camera_node >= 0 && moves[a->g.camera_node]) st = camera_keys_add(a, s, times, n, err);
+    if (!st) {
+        s->camera.shutter_open = (float)open;
+        s->camera.shutter_close = (float)close;
+    }
+    free(moves);
+    return st;
+}
+
 static void anim_free(SceneAnimation *base)
 {
     GltfAnimated *a = (GltfAnimated *)base;
@@ -355,6 +514,7 @@ static void anim_free(SceneAnimation *base)
     for (size_t i = 0; i < a->n_ch; i++) channel_free(&a->ch[i]);
     free(a->ch);
     free(a->pose);
+    free(a->pose_at);
     free(a->parent);
     free(a->data);
     free(a->path);
@@ -367,6 +527,7 @@ Status gltf_parse_animated(const char *path, const char *data, size_t len, Scene
     GltfAnimated *a = calloc(1, sizeof *a);
     if (!a) return error_set(err, ST_INTERNAL, "out of memory");
     a->base.pose = anim_pose;
+    a->base.pose_shutter = anim_pose_shutter;
     a->base.free = anim_free;
     a->data = malloc(len + 1);
     a->path = strdup(path);
@@ -382,7 +543,8 @@ Status gltf_parse_animated(const char *path, const char *data, size_t len, Scene
     Status st = gltf_open(&a->g, a->data, len);
     if (!st) st = animations_read(a);
     if (!st) st = parents_find(a);
-    if (!st && !(a->pose = calloc((size_t)a->g.n_nodes + 1, sizeof *a->pose)))
+    if (!st && (!(a->pose = calloc((size_t)a->g.n_nodes + 1, sizeof *a->pose)) ||
+                !(a->pose_at = calloc((size_t)a->g.n_nodes + 1, sizeof *a->pose_at))))
         st = error_set(err, ST_INTERNAL, "out of memory");
     scene_mark(s, &a->mark);
     if (!st) st = gltf_place(&a->g);
@@ -394,7 +556,9 @@ Status gltf_parse_animated(const char *path, const char *data, size_t len, Scene
         const KeyTrack *k = &a->ch[i].track;
         a->base.end = fmax(a->base.end, k->times[k->n - 1]);
     }
-    if (!st && a->n_ch == 0)
+    /* --shutter takes a still file as it is (nothing moves); --frames and --time need
+     * something to pose */
+    if (!st && a->n_ch == 0 && s->keep_animation != KEEP_ANIMATION_IF_ANY)
         st = error_set(err, ST_INPUT, "%s: the file has no animation of a node's translation, rotation or scale "
                        "to pose (--frames, --time)", path);
     a->base.camera_only = !st && moves_camera_only(a);

@@ -67,6 +67,17 @@ typedef struct {
     double t[3], r[4], s[3];
 } GltfNodePose;
 
+/* Motion blur over a shutter (--shutter, gltf_anim.c): the nodes whose world transform
+ * changes while it is open, and their world transform at the times sampled over it. A
+ * moving node's mesh becomes an instance (an object even when used once) with a key
+ * at each of `times` after the first (the open, the walk's own pose). */
+typedef struct {
+    const unsigned char *moves;      /* per node: 1 when it moves over the shutter */
+    const double *times;  size_t n_times;   /* increasing; times[0] the open, the last the close */
+    Status (*world_at)(void *ctx, int node, double t, Transform *out, Error *err);
+    void *ctx;
+} GltfBlur;
+
 typedef struct {
     const char *path;
     Scene *s;
@@ -88,6 +99,7 @@ typedef struct {
     size_t singular;                 /* instances skipped for a singular transform */
     int has_lights;
     const GltfNodePose *pose;        /* per node, an animation's pose; NULL: the file's own */
+    const GltfBlur *blur;            /* NULL: still; else moving nodes' meshes get keys */
     int camera_node, camera_index;   /* the node and camera the scene looks through, or -1 */
     Table t[T_N];
 } Gltf;
@@ -128,6 +140,9 @@ Status gltf_open(Gltf *g, const char *data, size_t len);
 void gltf_close(Gltf *g);
 
 /* gltf_scene.c: primitives, nodes, cameras, lights */
+/* The from, at and up of a camera whose node's world transform is xf (looking down
+ * its -Z, up its +Y: glTF 2.0, 3.10). */
+void gltf_camera_frame(const Transform *xf, vec3 *from, vec3 *at, vec3 *up);
 /* Places the chosen scene's node tree (with g->pose when set); the node walk's own
  * state (visited, placed, counts) starts afresh each time. */
 Status gltf_scene_walk(Gltf *g);

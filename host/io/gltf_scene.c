@@ -9,6 +9,7 @@
 #include "io/reader.h"
 #include "io/texture.h"
 #include "scene/instance.h"
+#include "scene/motion.h"
 #include "util/kmath.h"
 
 #include <math.h>
@@ -300,6 +301,14 @@ static int camera_wanted(const Gltf *g, int cam, const cJSON *node)
            (cJSON_IsString(nn) && strcmp(nn->valuestring, want) == 0);
 }
 
+void gltf_camera_frame(const Transform *xf, vec3 *from, vec3 *at, vec3 *up)
+{
+    *from = transform_point(xf, v3(0.0f, 0.0f, 0.0f));
+    vec3 fwd = xf_dir(xf, 0, 0, -1);
+    *at = v3(from->x + fwd.x, from->y + fwd.y, from->z + fwd.z);
+    *up = xf_dir(xf, 0, 1, 0);
+}
+
 Status gltf_camera_set(Gltf *g, int cam, const Transform *xf)
 {
     char jp[64];
@@ -327,10 +336,7 @@ Status gltf_camera_set(Gltf *g, int cam, const Transform *xf)
         sc->type = CAMERA_PERSPECTIVE;
         sc->vfov = (float)(v * 180.0 / M_PI);
     }
-    sc->from = transform_point(xf, v3(0.0f, 0.0f, 0.0f));
-    vec3 fwd = xf_dir(xf, 0, 0, -1);
-    sc->at = v3(sc->from.x + fwd.x, sc->from.y + fwd.y, sc->from.z + fwd.z);
-    sc->up = xf_dir(xf, 0, 1, 0);
+    gltf_camera_frame(xf, &sc->from, &sc->at, &sc->up);
     sc->aperture = 0.0f;
     sc->focus_dist = 0.0f;
     if (!isfinite(sc->from.x) || !isfinite(sc->from.y) || !isfinite(sc->from.z) || !isfinite(sc->at.x) ||
@@ -417,9 +423,41 @@ static Status mesh_object(Gltf *g, int mesh, const char *node, uint *out)
     return st;
 }
 
+/* The error of a scene call (no location) put under the JSON path jp. */
+static Status scene_error_at(Gltf *g, Status st, const char *jp)
+{
+    if (st != ST_INPUT) return st;
+    char msg[sizeof g->err->msg];
+    snprintf(msg, sizeof msg, "%s", g->err->msg);
+    return gltf_bad(g, jp, msg);
+}
+
+/* The keys of the instance just placed for node pl->node, which moves over the
+ * shutter: its world transform at each time after the open, times `local` (an
+ * EXT_mesh_gpu_instancing entry's; NULL: none), as the walk composed w. */
+static Status place_keys(Gltf *g, const GltfPlacement *pl, const Transform *local, const char *jp)
+{
+    const GltfBlur *b = g->blur;
+    Status st = ST_OK;
+    for (size_t k = 1; k < b->n_times && !st; k++) {
+        Transform w;
+        if ((st = b->world_at(b->ctx, pl->node, b->times[k], &w, g->err))) return st;
+        if (local) w = transform_compose(&w, local);
+        st = scene_add_instance_key(g->s, (float)b->times[0], (float)b->times[k], &w, g->err);
+        if (st == ST_INPUT) {
+            char at[200];
+            snprintf(at, sizeof at, "%s (at %g s of the shutter)", jp, b->times[k]);
+            return scene_error_at(g, st, at);
+        }
+    }
+    return st;
+}
+
 /* One instance of `object` (or a copy of mesh `mesh`) under w; a singular w (a scale
- * of 0 that hides a node) places nothing and is counted for one warning. */
-static Status place(Gltf *g, int mesh, uint object, const Transform *w, const char *jp)
+ * of 0 that hides a node) places nothing and is counted for one warning. A node that
+ * moves over the shutter (pl given, g->blur) gets its keys. */
+static Status place(Gltf *g, int mesh, uint object, const Transform *w, const GltfPlacement *pl,
+                    const Transform *local, const char *jp)
 {
     if (object == MESH_COPIES) return mesh_instance(g, mesh, w, jp);
     if (scene_object_prims(g->s, object) == 0) return ST_OK;
@@ -428,12 +466,8 @@ static Status place(Gltf *g, int mesh, uint object, const Transform *w, const ch
         g->singular++;
         return ST_OK;
     }
-    Status st = scene_add_instance(g->s, object, w, NO_INDEX, g->err);
-    if (st == ST_INPUT) {
-        char msg[sizeof g->err->msg];
-        snprintf(msg, sizeof msg, "%s", g->err->msg);
-        return gltf_bad(g, jp, msg);
-    }
+    Status st = scene_error_at(g, scene_add_instance(g->s, object, w, NO_INDEX, g->err), jp);
+    if (!st && pl && g->blur && g->blur->moves[pl->node]) st = place_keys(g, pl, local, jp);
     return st;
 }
 
@@ -498,7 +532,7 @@ static Status gpu_instances(Gltf *g, const GltfPlacement *pl, uint object, const
         Transform local;
         trs_matrix(tr ? tr + 3 * i : NULL, q, sc ? sc + 3 * i : NULL, &local);
         Transform w = transform_compose(&pl->w, &local);
-        st = place(g, pl->mesh, object, &w, ji);
+        st = place(g, pl->mesh, object, &w, pl, &local, ji);
     }
     free(tr);
     free(rot);
@@ -525,13 +559,17 @@ static Status meshes_place(Gltf *g)
         const GltfPlacement *pl = &g->placed[i];
         char jp[64];
         snprintf(jp, sizeof jp, "nodes[%d]", pl->node);
-        if (uses[pl->mesh] < 2 || g->o->no_instances) {
+        /* a mesh that moves over the shutter is an instance even when used once:
+         * copies cannot move */
+        int moves = g->blur && g->blur->moves[pl->node];
+        if ((uses[pl->mesh] < 2 && !moves) || g->o->no_instances) {
             if (pl->gpu_instanced) st = gpu_instances(g, pl, MESH_COPIES, jp);
             else st = mesh_instance(g, pl->mesh, &pl->w, jp);
             continue;
         }
         if (made[pl->mesh] == MESH_UNSEEN && (st = mesh_object(g, pl->mesh, jp, &made[pl->mesh]))) break;
-        st = pl->gpu_instanced ? gpu_instances(g, pl, made[pl->mesh], jp) : place(g, pl->mesh, made[pl->mesh], &pl->w, jp);
+        st = pl->gpu_instanced ? gpu_instances(g, pl, made[pl->mesh], jp)
+                               : place(g, pl->mesh, made[pl->mesh], &pl->w, pl, NULL, jp);
     }
     free(uses);
     free(made);

@@ -19,6 +19,11 @@ struct SceneAnimation {
     /* Places the scene (a Scene *)'s moving parts (geometry, lights, the camera) as they are at
      * time t, in place of their pose before. Errors as the reader's. */
     Status (*pose)(SceneAnimation *a, void *scene, double t, Error *err);
+    /* --shutter: places the scene at time `open` with what moves until `close` given
+     * keys over [open, close] (moving instances, camera keys: docs/motion.md) and the
+     * camera's shutter set to it; NULL where the reader cannot (a camera_path). Once,
+     * after the load. */
+    Status (*pose_shutter)(SceneAnimation *a, void *scene, double open, double close, Error *err);
     void (*free)(SceneAnimation *a);
 };
 

@@ -47,6 +47,11 @@ typedef struct {
  * where two primitives are hit at exactly the same distance. */
 enum SceneAccel { ACCEL_BVH = 0, ACCEL_KDTREE = 1 };
 
+/* Scene.keep_animation: whether a reader keeps a file's animation (scene/animation.h),
+ * and whether a file without one is an error (--frames, --time) or read as it stands
+ * (--shutter: a still file with a shutter keeps its bits) */
+enum { KEEP_ANIMATION_NO = 0, KEEP_ANIMATION_NEEDED = 1, KEEP_ANIMATION_IF_ANY = 2 };
+
 typedef struct {
     uint width, height;
     uint spp;            /* samples per pixel */
@@ -97,7 +102,8 @@ typedef struct {
                                   * (the size rendered is, host/main.c) */
     const char *gltf_camera;     /* in: the glTF camera to look through (--camera), by
                                   * index or name; NULL: the file's first */
-    int keep_animation;          /* in: a reader keeps the file's animation (--frames, --time) */
+    int keep_animation;          /* in: a reader keeps the file's animation: KEEP_ANIMATION_*
+                                  * (--frames, --time: one is needed; --shutter: if any) */
     SceneAnimation *animation;   /* out: that animation, or NULL (scene/animation.h) */
     SceneCamera camera;
     /* a moving camera's poses after its own (SceneCamera.time), in increasing time;

@@ -376,27 +376,26 @@ static void time_add(double *times, size_t *n, double t)
 static size_t shutter_times(const GltfAnimated *a, double open, double close, double *times)
 {
     size_t n_inside = 0;
-    int cubic = 0;
+    int cubic = 0, no_memory = 0;
     double *inside = NULL;
     size_t cap = 0;
-    for (size_t i = 0; i < a->n_ch; i++) {
+    for (size_t i = 0; i < a->n_ch && !no_memory; i++) {
         const KeyTrack *k = &a->ch[i].track;
         cubic |= k->interp == KEY_CUBICSPLINE;
-        for (size_t j = 0; j < k->n; j++) {
+        for (size_t j = 0; j < k->n && !no_memory; j++) {
             if (!(k->times[j] > open && k->times[j] < close)) continue;
             if (n_inside == cap) {
-                cap = cap ? 2 * cap : 16;
-                double *grown = realloc(inside, cap * sizeof *grown);
-                if (!grown) {
-                    /* without memory: the even spread (n_inside made too many) */
-                    n_inside = MOTION_MAX_KEYS + 1;
-                    break;
-                }
+                double *grown = realloc(inside, (cap ? 2 * cap : 16) * sizeof *grown);
+                no_memory = !grown;
+                if (no_memory) break;
                 inside = grown;
+                cap = cap ? 2 * cap : 16;
             }
             inside[n_inside++] = k->times[j];
         }
     }
+    /* without memory for the key times: the even spread */
+    if (no_memory) n_inside = MOTION_MAX_KEYS + 1;
     size_t n = 0;
     size_t steps = cubic ? 4 : 1;
     if ((n_inside + 1) * steps + 1 <= MOTION_MAX_KEYS) {

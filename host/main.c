@@ -449,6 +449,9 @@ static Status frames_check(const Run *r, Error *err)
     if (!r->scene.animation)
         return error_set(err, ST_USAGE, "--frames renders the animation of a glTF file given as the scene, or a "
                          "clpt scene's camera_path; '%s' has neither", r->o.scene_path);
+    if (r->o.shutter_fraction > 0.0 && !r->scene.animation->pose_shutter)
+        return error_set(err, ST_USAGE, "--shutter blurs the animation of a glTF file given as the scene; '%s' is "
+                         "not one", r->o.scene_path);
     long last = frames_last_of(r);
     if (r->o.frames_last > last)
         return error_set(err, ST_USAGE, "--frames %ld:%ld: frame %ld (at %g s) is after the end of the animation of "
@@ -526,7 +529,12 @@ static Status frame_render(Run *r, Dist *dist, long k, const FramePaths *p, Fram
     if (!r->o.quiet) fprintf(stderr, "clpt: frame %ld (%g s) -> %s\n", k, (double)k / r->o.fps, p->output);
     SceneAnimation *anim = r->scene.animation;
     int kept = c->have_rs;
-    Status st = anim->pose(anim, &r->scene, (double)k / r->o.fps, err);
+    /* --shutter F: open from the frame's time for F of a frame's time; a last frame's
+     * shutter may run past the animation's end, where the last pose holds */
+    double t = (double)k / r->o.fps;
+    Status st = r->o.shutter_fraction > 0.0
+              ? anim->pose_shutter(anim, &r->scene, t, t + r->o.shutter_fraction / r->o.fps, err)
+              : anim->pose(anim, &r->scene, t, err);
     if (st == ST_OK) st = scene_options_apply_camera(&r->o, &r->scene, err);
     if (st == ST_OK) st = frame_prepare(r, c, err);
     if (st == ST_OK && c->devs && kept) st = render_job_update_devices(&r->job, c->devs, c->n_devs, err);
@@ -557,6 +565,8 @@ static Status run_frames(Run *r, Dist *dist, Error *err)
     FrameCarry c;
     memset(&c, 0, sizeof c);
     r->frames = 1;
+    /* a blurred frame places the whole scene (camera keys are no camera-only change) */
+    if (st == ST_OK && r->o.shutter_fraction > 0.0) r->scene.animation->camera_only = 0;
     /* each frame is a job of its own; the run's denoiser (--denoise) serves them all */
     c.denoiser = r->job.denoiser;
     r->job.denoiser = NULL;

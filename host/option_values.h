@@ -32,6 +32,8 @@ typedef struct {
                                    * seconds; < 0: none (the file's own pose) */
     /* --shutter A:B: a glTF animation blurred over [A, B] seconds; 0 and 0: none */
     double shutter_open, shutter_close;
+    double shutter_fraction;      /* --shutter F with --frames: open F of each frame's
+                                   * time, from the frame's time; 0: none */
     /* under mpirun (docs/distributed.md) */
     int mpi_broadcast;            /* the scene is read by rank 0 only and sent to the others */
     double mpi_timeout;           /* seconds of silence before a rank is given up; 0 = 30 */

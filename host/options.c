@@ -201,11 +201,13 @@
         "scene's camera_path at T seconds (0 to its\n" \
         "end): one still image, as frame T*FPS of\n" \
         "--frames (docs/animation.md)") \
-    X(OUTPUT, CUSTOM, shutter_open, "--shutter", NULL, "A:B", PARSE(parse_shutter), \
+    X(OUTPUT, CUSTOM, shutter_open, "--shutter", NULL, "A:B|F", PARSE(parse_shutter), \
         "motion blur of a glTF file's animation: the\n" \
         "shutter open from A to B seconds (0 <= A < B),\n" \
-        "moving meshes and the camera sampled over it\n" \
-        "(docs/motion.md)") \
+        "moving meshes and the camera sampled over it;\n" \
+        "with --frames, --shutter F: each frame open for\n" \
+        "the fraction F of a frame's time (0 < F <= 1),\n" \
+        "from the frame's time (docs/motion.md)") \
     X(MPI, SWITCH, mpi_broadcast, "--mpi-broadcast", NULL, NULL, NONE, \
         "rank 0 reads the scene and sends it to the\n" \
         "others (default: every rank reads SCENE, which\n" \
@@ -599,6 +601,14 @@ static Status parse_shutter(const char *v, Options *o, Error *err)
     const char *colon = strchr(v, ':');
     char first[64];
     double a, b;
+    if (!colon) {
+        /* F alone: a fraction of each frame's time, for --frames (checked there) */
+        if (!read_real(v, &a) || !(a > 0.0 && a <= 1.0))
+            return error_set(err, ST_USAGE, "--shutter expects A:B, the times in seconds it opens and closes, or with "
+                             "--frames F, the fraction of each frame's time it is open (0 < F <= 1), got '%s'", v);
+        o->shutter_fraction = a;
+        return ST_OK;
+    }
     size_t len = colon ? (size_t)(colon - v) : 0;
     if (colon && len < sizeof first) {
         memcpy(first, v, len);

@@ -298,8 +298,11 @@ Status options_finish(Options *o, Error *err)
         return error_set(err, ST_USAGE, "--shutter blurs the animation over a time and --time poses it at one: "
                          "give one");
     if (o->shutter_close > o->shutter_open && o->frames_first >= 0)
-        return error_set(err, ST_USAGE, "--shutter is not combined with --frames yet (render each frame's "
-                         "shutter with --shutter A:B alone)");
+        return error_set(err, ST_USAGE, "--shutter A:B opens once; with --frames give --shutter F, the fraction of "
+                         "each frame's time it is open");
+    if (o->shutter_fraction > 0.0 && o->frames_first < 0)
+        return error_set(err, ST_USAGE, "--shutter F is a fraction of each frame's time, for --frames; for one "
+                         "image give --shutter A:B in seconds");
     if (o->anim_time >= 0.0 && o->frames_first >= 0)
         return error_set(err, ST_USAGE, "--time poses the animation at one time and --frames at each frame's: give "
                          "one");

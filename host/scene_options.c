@@ -16,7 +16,8 @@ Status scene_options_before_load(const Options *o, Scene *s, Error *err)
                          o->scene_path);
     s->gltf_camera = o->camera;
     s->keep_animation = o->frames_first >= 0 || o->anim_time >= 0.0 ? KEEP_ANIMATION_NEEDED
-                      : o->shutter_close > o->shutter_open ? KEEP_ANIMATION_IF_ANY : KEEP_ANIMATION_NO;
+                      : o->shutter_close > o->shutter_open || o->shutter_fraction > 0.0 ? KEEP_ANIMATION_IF_ANY
+                      : KEEP_ANIMATION_NO;
     s->size_overridden = o->width >= 0 || o->height >= 0;
     return ST_OK;
 }

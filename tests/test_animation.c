@@ -921,7 +921,7 @@ static void test_shutter_equals_average(void)
 }
 
 /* The program: a still glTF file keeps its bits under a shutter; PoCL gives the scalar
- * device's bits on a blurred one; the shutter's errors. */
+ * device's bits on a blurred one; --frames with --shutter F; the shutter's errors. */
 static void test_cli_shutter(void)
 {
     static CliResult r;
@@ -965,8 +965,8 @@ static void test_cli_shutter(void)
                    "more), got '0:inf'" },
         { "-1:1", "clpt: error: --shutter expects A:B, the times in seconds it opens and closes (finite, 0 or "
                   "more), got '-1:1'" },
-        { "1", "clpt: error: --shutter expects A:B, the times in seconds it opens and closes (finite, 0 or more), "
-               "got '1'" },
+        { "0", "clpt: error: --shutter expects A:B, the times in seconds it opens and closes, or with --frames F, "
+               "the fraction of each frame's time it is open (0 < F <= 1), got '0'" },
         { "1.5:3", "clpt: error: --shutter 1.5:3 closes after the end of the animation of '" CLI_DIR "/anim.gltf' "
                    "at 2 s" },
     };
@@ -989,8 +989,45 @@ static void test_cli_shutter(void)
     const char *e3[] = { "--shutter", "0:1", "--frames", "0:1", CLI_DIR "/anim.gltf", NULL };
     cli_run(e3, &r);
     CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter is not combined with --frames yet (render each frame's "
-                              "shutter with --shutter A:B alone)");
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter A:B opens once; with --frames give --shutter F, the fraction "
+                              "of each frame's time it is open");
+    /* --frames with --shutter F: frame 1 at 2 fps open half a frame is --shutter
+     * 0.5:0.75, rendered in a row after a blurred frame 0 (its keys gone) and alone;
+     * PoCL the same */
+    const char *f1[] = { base[0], base[1], base[2], base[3], base[4], base[5], base[6], base[7], base[8], "--frames",
+                         "0:2", "--fps", "2", "--shutter", "0.5", "-o", CLI_DIR "/fblur.pfm", CLI_DIR "/anim.gltf",
+                         NULL };
+    cli_run(f1, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    const char *f2[] = { base[0], base[1], base[2], base[3], base[4], base[5], base[6], base[7], base[8], "--shutter",
+                         "0.5:0.75", "-o", CLI_DIR "/fone.pfm", CLI_DIR "/anim.gltf", NULL };
+    cli_run(f2, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    CHECK(files_equal(CLI_DIR "/fblur_0001.pfm", CLI_DIR "/fone.pfm"));
+    CHECK(!files_equal(CLI_DIR "/fblur_0000.pfm", CLI_DIR "/fblur_0001.pfm"));
+    const char *f3[] = { "--device", TEST_OPENCL, base[2], base[3], base[4], base[5], base[6], base[7], base[8],
+                         "--frames", "0:2", "--fps", "2", "--shutter", "0.5", "-o", CLI_DIR "/fblurcl.pfm",
+                         CLI_DIR "/anim.gltf", NULL };
+    cli_run(f3, &r);
+    CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
+    CHECK(files_equal(CLI_DIR "/fblur_0000.pfm", CLI_DIR "/fblurcl_0000.pfm"));
+    CHECK(files_equal(CLI_DIR "/fblur_0002.pfm", CLI_DIR "/fblurcl_0002.pfm"));
+    const char *e4[] = { "--shutter", "0.5", CLI_DIR "/anim.gltf", NULL };
+    cli_run(e4, &r);
+    CHECK(r.status == ST_USAGE);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter F is a fraction of each frame's time, for --frames; for one "
+                              "image give --shutter A:B in seconds");
+    const char *e5[] = { "--frames", "0:1", "--shutter", "1.5", CLI_DIR "/anim.gltf", NULL };
+    cli_run(e5, &r);
+    CHECK(r.status == ST_USAGE);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter expects A:B, the times in seconds it opens and closes, or with "
+                              "--frames F, the fraction of each frame's time it is open (0 < F <= 1), got '1.5'");
+    const char *e6[] = { "--frames", "0:1", "--fps", "1", "--shutter", "0.5", "-o", CLI_DIR "/x.pfm",
+                         CLI_DIR "/path.scene", NULL };
+    cli_run(e6, &r);
+    CHECK(r.status == ST_USAGE);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter blurs the animation of a glTF file given as the scene; '"
+                              CLI_DIR "/path.scene' is not one");
 }
 
 static void test_cli_errors(void)

@@ -471,11 +471,17 @@ static Status camera_keys_add(GltfAnimated *a, Scene *s, const double *times, si
 
 /* The scene placed at the open's pose, the nodes that move over [open, close] with
  * keys sampled from the animation (meshes as moving instances, the camera with camera
- * keys) and the camera's shutter [open, close]. Posed once, after the load. */
+ * keys) and the camera's shutter [open, close]. Again for each frame of --frames. */
 static Status anim_pose_shutter(SceneAnimation *base, void *vscene, double open, double close, Error *err)
 {
     GltfAnimated *a = (GltfAnimated *)base;
     Scene *s = vscene;
+    /* the keys of a frame before (--frames with --shutter F) go: this reader made every
+     * key the scene holds (scene_rewind keeps the instances before the node tree, and
+     * a glTF file's own have none) */
+    s->n_motion_keys = 0;
+    s->n_instance_motion = 0;
+    s->n_camera_keys = 0;
     double times[MOTION_MAX_KEYS + 1];
     size_t n = shutter_times(a, open, close, times);
     unsigned char *moves = calloc((size_t)a->g.n_nodes + 1, 1);

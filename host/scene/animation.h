@@ -21,8 +21,8 @@ struct SceneAnimation {
     Status (*pose)(SceneAnimation *a, void *scene, double t, Error *err);
     /* --shutter: places the scene at time `open` with what moves until `close` given
      * keys over [open, close] (moving instances, camera keys: docs/motion.md) and the
-     * camera's shutter set to it; NULL where the reader cannot (a camera_path). Once,
-     * after the load. */
+     * camera's shutter set to it, in place of the pose and keys before; NULL where the
+     * reader cannot (a camera_path). */
     Status (*pose_shutter)(SceneAnimation *a, void *scene, double open, double close, Error *err);
     void (*free)(SceneAnimation *a);
 };

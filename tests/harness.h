@@ -16,7 +16,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 static int harness_passed, harness_failed, harness_current_failed;
 static const char *harness_current = "";
@@ -154,6 +156,102 @@ static inline int count_dir_entries(const char *dir, const char *suffix)
     closedir(d);
     return n;
 }
+
+/* Scratch files private to this test process. Two test runs at once (two checkouts,
+ * a developer and CI) once shared fixed names under /tmp, so one run rewrote the image
+ * the other was about to compare. Every file a test writes now goes into one folder
+ * made with mkdtemp ($TMPDIR or /tmp) at its first use and removed, with what is in it,
+ * when the process exits.
+ *
+ *     const char *out = TEST_TMP("render.pfm");    the same pointer for the same name
+ *     test_tmp_path(buf, sizeof buf, "a.pfm");      into a caller's buffer
+ *
+ * A process that cannot make the folder stops at once: running on with a shared name
+ * would bring back the very collisions this avoids. */
+#define TEST_TMP_NAMES_MAX 256
+
+static inline void test_tmp_remove_tree(const char *path)
+{
+    struct stat st;
+    if (lstat(path, &st) != 0) return;
+    if (S_ISDIR(st.st_mode)) {
+        chmod(path, 0700);   /* a test may leave a read-only folder to check a write error */
+        DIR *d = opendir(path);
+        if (d) {
+            struct dirent *e;
+            char child[4096];
+            while ((e = readdir(d)))
+                if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..") &&
+                    snprintf(child, sizeof child, "%s/%s", path, e->d_name) < (int)sizeof child)
+                    test_tmp_remove_tree(child);
+            closedir(d);
+        }
+        rmdir(path);
+    } else {
+        unlink(path);
+    }
+}
+
+static char test_tmp_dir_buf[4096];
+static pid_t test_tmp_owner;
+static char *test_tmp_names[TEST_TMP_NAMES_MAX];
+static int test_tmp_name_count;
+
+static inline void test_tmp_cleanup(void)
+{
+    /* a forked child that exits through exit() runs this too; only the maker removes */
+    if (getpid() != test_tmp_owner) return;
+    test_tmp_remove_tree(test_tmp_dir_buf);
+    for (int i = 0; i < test_tmp_name_count; i++) free(test_tmp_names[i]);
+    test_tmp_name_count = 0;
+}
+
+/* This process's scratch folder, made at the first call. */
+static inline const char *test_tmp_dir(void)
+{
+    if (test_tmp_dir_buf[0]) return test_tmp_dir_buf;
+    const char *base = getenv("TMPDIR");
+    if (!base || !*base) base = "/tmp";
+    snprintf(test_tmp_dir_buf, sizeof test_tmp_dir_buf, "%s/clpt-test-XXXXXX", base);
+    if (!mkdtemp(test_tmp_dir_buf)) {
+        perror("test_tmp_dir: mkdtemp");
+        exit(2);
+    }
+    test_tmp_owner = getpid();
+    atexit(test_tmp_cleanup);
+    return test_tmp_dir_buf;
+}
+
+/* DIR/name written into buf; returns buf. */
+static inline char *test_tmp_path(char *buf, size_t size, const char *name)
+{
+    int n = snprintf(buf, size, "%s/%s", test_tmp_dir(), name);
+    if (n < 0 || (size_t)n >= size) {
+        fprintf(stderr, "test_tmp_path: '%s' does not fit in %zu bytes\n", name, size);
+        exit(2);
+    }
+    return buf;
+}
+
+/* DIR/name in a buffer kept until exit, one per name, so that it can sit in an
+ * initialiser or be compared with what the program printed. */
+static inline const char *test_tmp(const char *name)
+{
+    const char *dir = test_tmp_dir();
+    size_t dl = strlen(dir);
+    for (int i = 0; i < test_tmp_name_count; i++)
+        if (strcmp(test_tmp_names[i] + dl + 1, name) == 0) return test_tmp_names[i];
+    size_t size = dl + 1 + strlen(name) + 1;
+    char *p = malloc(size);
+    if (!p || test_tmp_name_count == TEST_TMP_NAMES_MAX) {
+        fprintf(stderr, "test_tmp: no room for '%s' (%d names at most)\n", name,
+                TEST_TMP_NAMES_MAX);
+        exit(2);
+    }
+    test_tmp_names[test_tmp_name_count++] = test_tmp_path(p, size, name);
+    return p;
+}
+#define TEST_TMP(name) test_tmp(name)
 
 static inline int harness_report(void)
 {

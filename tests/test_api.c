@@ -182,7 +182,7 @@ static clpt_status check_same_as_cli_spp(const char *devices, unsigned spp, cons
     n = 10;
     for (size_t i = 0; extra_flags[i]; i++) flags[n++] = extra_flags[i];
     flags[n] = NULL;
-    float *cli = cli_render("/tmp/clpt-test-api-cli.pfm", flags);
+    float *cli = cli_render(TEST_TMP("clpt-test-api-cli.pfm"), flags);
     CHECK_MSG(same_floats(rgb, cli, W * H * 3), "devices %s", devices);
     free(cli);
     free(rgb);
@@ -272,7 +272,7 @@ static void test_denoise_same_as_cli(void)
     clpt_status st = api_render(&a, &img, NULL, NULL);
     if (st != CLPT_ERROR_DEVICE) {
         CHECK_MSG(st == CLPT_OK, "%s", clpt_last_error(a.ctx));
-        float *cli = pfm_read("/tmp/clpt-test-api-cli.pfm", &img.width, &img.height);
+        float *cli = pfm_read(TEST_TMP("clpt-test-api-cli.pfm"), &img.width, &img.height);
         CHECK(same_floats(rgb, cli, W * H * 3));
         free(cli);
     }
@@ -297,7 +297,7 @@ static void test_scene_set(void)
     static const char *const flags[] = { "--device", "scalar", "--width", "64", "--height", "48", "--spp", "4",
                                          "--set", "camera.fov=50", "--set", "material.light.radiance=30,30,30",
                                          NULL };
-    float *cli = cli_render("/tmp/clpt-test-api-set.pfm", flags);
+    float *cli = cli_render(TEST_TMP("clpt-test-api-set.pfm"), flags);
     CHECK(same_floats(rgb, cli, W * H * 3));
     free(cli);
     free(rgb);
@@ -346,10 +346,10 @@ static void test_aovs(void)
     CHECK_MSG(api_render(&a, &img, NULL, NULL) == CLPT_OK, "%s", clpt_last_error(a.ctx));
     static const char *const flags[] = { "--device", "scalar", "--width", "64", "--height", "48", "--spp", "4",
                                          "--aov", "albedo,depth", NULL };
-    free(cli_render("/tmp/clpt-test-api-aov.pfm", flags));
+    free(cli_render(TEST_TMP("clpt-test-api-aov.pfm"), flags));
     unsigned w, h;
-    float *cli_albedo = pfm_read("/tmp/clpt-test-api-aov-albedo.pfm", &w, &h);
-    float *cli_depth = pfm_read("/tmp/clpt-test-api-aov-depth.pfm", &w, &h);
+    float *cli_albedo = pfm_read(TEST_TMP("clpt-test-api-aov-albedo.pfm"), &w, &h);
+    float *cli_depth = pfm_read(TEST_TMP("clpt-test-api-aov-depth.pfm"), &w, &h);
     CHECK(same_floats(albedo, cli_albedo, W * H * 3));
     int depth_same = cli_depth != NULL;
     size_t unit = 0, longer = 0;
@@ -398,7 +398,7 @@ static void test_cancel(void)
 /* Cancelled with a checkpoint, then resumed: the bits of the render never cancelled. */
 static void test_checkpoint_resume(void)
 {
-    const char *ck = "/tmp/clpt-test-api.ckpt";
+    const char *ck = TEST_TMP("clpt-test-api.ckpt");
     remove(ck);
     /* 512 samples, so that the cancel after 4 lands mid-render on a fast, idle machine
      * too (at 64 all were rendered before the callback's answer was seen) */
@@ -469,14 +469,17 @@ static void test_two_contexts(void)
 /* examples/render.c writes the program's .pfm, byte for byte. */
 static void test_example_program(void)
 {
-    const char *out = "/tmp/clpt-test-api-example.pfm";
-    int status = system(CLPT_BUILD_DIR "/examples/render " SCENE " /tmp/clpt-test-api-example.pfm --device=scalar "
-                        "--width=64 --height=48 --spp=4 --set=camera.fov=45 2>/dev/null");
+    const char *out = TEST_TMP("clpt-test-api-example.pfm");
+    char command[1024];
+    snprintf(command, sizeof command,
+             CLPT_BUILD_DIR "/examples/render " SCENE " '%s' --device=scalar "
+             "--width=64 --height=48 --spp=4 --set=camera.fov=45 2>/dev/null", out);
+    int status = system(command);
     CHECK_MSG(status == 0, "build/examples/render: status %d", status);
     static const char *const flags[] = { "--device", "scalar", "--width", "64", "--height", "48", "--spp", "4",
                                          "--set", "camera.fov=45", NULL };
-    free(cli_render("/tmp/clpt-test-api-example-cli.pfm", flags));
-    CHECK(files_equal(out, "/tmp/clpt-test-api-example-cli.pfm"));
+    free(cli_render(TEST_TMP("clpt-test-api-example-cli.pfm"), flags));
+    CHECK(files_equal(out, TEST_TMP("clpt-test-api-example-cli.pfm")));
 }
 
 int main(void)

@@ -157,9 +157,9 @@ static void test_usage_errors(void)
 static void test_wave_launches_match_scalar(void)
 {
     const char *modes[] = { "counted", "bounded", "megakernel" };
-    const char *outs[] = { "/tmp/clpt-test-launch-counted.pfm", "/tmp/clpt-test-launch-bounded.pfm",
-                           "/tmp/clpt-test-launch-megakernel.pfm" };
-    const char *ref = "/tmp/clpt-test-launch-scalar.pfm";
+    const char *outs[] = { TEST_TMP("clpt-test-launch-counted.pfm"), TEST_TMP("clpt-test-launch-bounded.pfm"),
+                           TEST_TMP("clpt-test-launch-megakernel.pfm") };
+    const char *ref = TEST_TMP("clpt-test-launch-scalar.pfm");
     double rays[3] = { 0.0, -1.0, -1.0 };
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", "--width", "40", "--height", "32", "--spp", "12",
                  "--seed", "9", "-q", "-o", ref),
@@ -191,7 +191,7 @@ static void test_wave_launches_match_scalar(void)
 
 static void test_missing_scene_is_io_error(void)
 {
-    cli_run(ARGS("/nonexistent/scene.scene", "-o", "/tmp/x.png"), &r);
+    cli_run(ARGS("/nonexistent/scene.scene", "-o", TEST_TMP("x.png")), &r);
     CHECK_EQ_INT(r.status, 4);
     CHECK_STR_CONTAINS(r.err, "/nonexistent/scene.scene");
 }
@@ -200,23 +200,23 @@ static void test_parse_error_names_line_and_column(void)
 {
     char path[256];
     write_temp(path, sizeof path, ".scene", "# a bad scene\ncamera { from 0 0 5 at 0 0 0 }\nsphere { center 0 0 zero radius 1 }\n");
-    cli_run(ARGS(path, "-o", "/tmp/clpt-never.png"), &r);
+    cli_run(ARGS(path, "-o", TEST_TMP("clpt-never.png")), &r);
     CHECK_EQ_INT(r.status, 3);
     char where[300];
     snprintf(where, sizeof where, "%s:3:", path);
     CHECK_STR_CONTAINS(r.err, where);
     CHECK_STR_CONTAINS(r.err, "zero");
-    CHECK(!file_exists("/tmp/clpt-never.png"));
+    CHECK(!file_exists(TEST_TMP("clpt-never.png")));
     unlink(path);
 }
 
 static void test_unknown_device_lists_devices(void)
 {
-    cli_run(ARGS("scenes/cornell-box.scene", "--device", "99", "-o", "/tmp/clpt-never.png"), &r);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "99", "-o", TEST_TMP("clpt-never.png")), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "no device matches '99'");
     CHECK_STR_CONTAINS(r.err, "scalar");
-    cli_run(ARGS("scenes/cornell-box.scene", "--device", "no-such-gpu", "-o", "/tmp/clpt-never.png"), &r);
+    cli_run(ARGS("scenes/cornell-box.scene", "--device", "no-such-gpu", "-o", TEST_TMP("clpt-never.png")), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "no-such-gpu");
 }
@@ -250,9 +250,9 @@ static void check_render(const char *device, const char *out, const char *magic)
 
 static void test_render_each_format(void)
 {
-    check_render("scalar", "/tmp/clpt-test-render.png", "\x89PNG");
-    check_render(TEST_OPENCL, "/tmp/clpt-test-render.ppm", "P6");
-    check_render("0", "/tmp/clpt-test-render.pfm", "PF");
+    check_render("scalar", TEST_TMP("clpt-test-render.png"), "\x89PNG");
+    check_render(TEST_OPENCL, TEST_TMP("clpt-test-render.ppm"), "P6");
+    check_render("0", TEST_TMP("clpt-test-render.pfm"), "PF");
 }
 
 /* --view and --exposure: the default and "--view standard --exposure 0" are the same
@@ -262,8 +262,8 @@ static void test_view_flags(void)
 {
 #define VIEW_RENDER "scenes/cornell-box.scene", "-q", "--device", "scalar", "--width", "16", "--height", "12", \
                     "--spp", "2"
-    const char *plain = "/tmp/clpt-test-view-plain.png", *same = "/tmp/clpt-test-view-same.png",
-               *other = "/tmp/clpt-test-view-other.png";
+    const char *plain = TEST_TMP("clpt-test-view-plain.png"), *same = TEST_TMP("clpt-test-view-same.png"),
+               *other = TEST_TMP("clpt-test-view-other.png");
     cli_run(ARGS(VIEW_RENDER, "-o", plain), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     cli_run(ARGS(VIEW_RENDER, "--view", "standard", "--exposure", "0", "-o", same), &r);
@@ -283,15 +283,18 @@ static void test_view_flags(void)
     CHECK_STR_CONTAINS(r.err, "clpt: error: --exposure expects a number of stops from -32 to 32, got '33'\n");
     cli_run(ARGS(VIEW_RENDER, "--exposure", "1 ", "-o", other), &r);
     CHECK_EQ_INT(r.status, 2);
-    unlink("/tmp/clpt-test-view.pfm");
-    cli_run(ARGS(VIEW_RENDER, "--view", "agx", "-o", "/tmp/clpt-test-view.pfm"), &r);
+    unlink(TEST_TMP("clpt-test-view.pfm"));
+    cli_run(ARGS(VIEW_RENDER, "--view", "agx", "-o", TEST_TMP("clpt-test-view.pfm")), &r);
     CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --view and --exposure form the picture of 8-bit images; "
-                              "'/tmp/clpt-test-view.pfm' keeps the linear radiance (write a .png, .jpg, .ppm or .bmp, or "
-                              "leave them out)\n");
-    CHECK(!file_exists("/tmp/clpt-test-view.pfm"));
+    char want[1024];
+    snprintf(want, sizeof want,
+             "clpt: error: --view and --exposure form the picture of 8-bit images; "
+             "'%s' keeps the linear radiance (write a .png, .jpg, .ppm or .bmp, or "
+             "leave them out)\n", TEST_TMP("clpt-test-view.pfm"));
+    CHECK_STR_CONTAINS(r.err, want);
+    CHECK(!file_exists(TEST_TMP("clpt-test-view.pfm")));
     /* merge: a part merged with --view agx is the render's agx PNG */
-    const char *part = "/tmp/clpt-test-view.ckpt", *merged = "/tmp/clpt-test-view-merged.png";
+    const char *part = TEST_TMP("clpt-test-view.ckpt"), *merged = TEST_TMP("clpt-test-view-merged.png");
     cli_run(ARGS(VIEW_RENDER, "--view", "agx", "--exposure", "0.5", "-o", other, "--checkpoint", part), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     cli_run(ARGS("merge", "-q", "--view", "agx", "--exposure", "0.5", "-o", merged, part), &r);
@@ -314,11 +317,11 @@ static void test_view_flags(void)
 static void test_quiet_prints_nothing(void)
 {
     cli_run(ARGS("scenes/cornell-box.scene", "-q", "--device", "scalar", "--width", "8", "--height", "8", "--spp", "1",
-                 "-o", "/tmp/clpt-test-quiet.png"),
+                 "-o", TEST_TMP("clpt-test-quiet.png")),
             &r);
     CHECK_EQ_INT(r.status, 0);
     CHECK_EQ_INT(strlen(r.err), 0);
-    unlink("/tmp/clpt-test-quiet.png");
+    unlink(TEST_TMP("clpt-test-quiet.png"));
 }
 
 static void test_unwritable_output_is_io_error(void)
@@ -333,22 +336,22 @@ static void test_unwritable_output_is_io_error(void)
 static void test_stats(void)
 {
     cli_run(ARGS("scenes/cornell-box.scene", "--stats", "-q", "--device", TEST_OPENCL, "--width", "8", "--height", "8",
-                 "--spp", "1", "-o", "/tmp/clpt-test-stats.png"),
+                 "--spp", "1", "-o", TEST_TMP("clpt-test-stats.png")),
             &r);
     CHECK_EQ_INT(r.status, 0);
     const char *want[] = { "BVH: built in", "nodes of 8", "leaves", "depth", "SAH cost", "kernels", "waves of",
                            "Msamples/s", "Mrays/s", "total" };
     for (size_t i = 0; i < sizeof want / sizeof want[0]; i++) CHECK_STR_CONTAINS(r.out, want[i]);
     /* the kd-tree on request, and the same image */
-    CHECK(rename("/tmp/clpt-test-stats.png", "/tmp/clpt-test-stats-bvh.png") == 0);
+    CHECK(rename(TEST_TMP("clpt-test-stats.png"), TEST_TMP("clpt-test-stats-bvh.png")) == 0);
     cli_run(ARGS("scenes/cornell-box.scene", "--stats", "-q", "--device", TEST_OPENCL, "--width", "8", "--height", "8",
-                 "--spp", "1", "--accel", "kdtree", "-o", "/tmp/clpt-test-stats.png"),
+                 "--spp", "1", "--accel", "kdtree", "-o", TEST_TMP("clpt-test-stats.png")),
             &r);
     CHECK_EQ_INT(r.status, 0);
     CHECK_STR_CONTAINS(r.out, "kd-tree: built in");
-    CHECK(files_equal("/tmp/clpt-test-stats.png", "/tmp/clpt-test-stats-bvh.png"));
-    unlink("/tmp/clpt-test-stats.png");
-    unlink("/tmp/clpt-test-stats-bvh.png");
+    CHECK(files_equal(TEST_TMP("clpt-test-stats.png"), TEST_TMP("clpt-test-stats-bvh.png")));
+    unlink(TEST_TMP("clpt-test-stats.png"));
+    unlink(TEST_TMP("clpt-test-stats-bvh.png"));
 }
 
 /* --profile: the stats, then each device's time per phase; the traversal and shading of
@@ -360,7 +363,7 @@ static void test_profile(void)
     const char *devices[] = { TEST_OPENCL, "scalar" };
     for (int i = 0; i < 2; i++) {
         cli_run(ARGS("scenes/cornell-box.scene", "--profile", "-q", "--device", devices[i], "--width", "128",
-                     "--height", "128", "--spp", "16", "-o", "/tmp/clpt-test-profile.png"),
+                     "--height", "128", "--spp", "16", "-o", TEST_TMP("clpt-test-profile.png")),
                 &r);
         CHECK_EQ_INT(r.status, 0);
         const char *want[] = { "Msamples/s", "profile (seconds", "raygen", "traverse", "shade", "shadow", "film",
@@ -374,7 +377,7 @@ static void test_profile(void)
         CHECK_MSG(n == 3 && t[1] > 0.0 && t[2] > 0.0, "%s: traversal %g s, shading %g s in:\n%s", devices[i], t[1],
                   t[2], r.out);
     }
-    unlink("/tmp/clpt-test-profile.png");
+    unlink(TEST_TMP("clpt-test-profile.png"));
 }
 
 #define SMALL "--device", "scalar", "--width", "8", "--height", "8", "--spp", "1"
@@ -482,7 +485,7 @@ static void test_readme_reference_is_help(void)
  * checkpoint, could be saved). */
 static void test_bad_outputs_found_before_rendering(void)
 {
-    const char *ck = "/tmp/clpt-test-early.ckpt", *out = "/tmp/clpt-test-early.png";
+    const char *ck = TEST_TMP("clpt-test-early.ckpt"), *out = TEST_TMP("clpt-test-early.png");
     unlink(ck);
     unlink(out);
     cli_run(ARGS("scenes/cornell-box.scene", SMALL, "--checkpoint", ck, "-o", "/nonexistent-dir/x.png"), &r);
@@ -505,44 +508,54 @@ static void test_bad_outputs_found_before_rendering(void)
     cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", "/nonexistent-dir/x.png", "--png-depth", "16"), &r);
     CHECK_EQ_INT(r.status, 4);
     CHECK(strstr(r.err, "Msamples/s") == NULL);
-    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", "/tmp"), &r);   /* a folder named like an image */
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", test_tmp_dir()), &r);   /* a folder named like an image */
     CHECK_EQ_INT(r.status, 2);
-    mkdir("/tmp/clpt-test-dir.png", 0700);
-    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", "/tmp/clpt-test-dir.png"), &r);
+    mkdir(TEST_TMP("clpt-test-dir.png"), 0700);
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", TEST_TMP("clpt-test-dir.png")), &r);
     CHECK_EQ_INT(r.status, 4);
-    CHECK_STR_CONTAINS(r.err, "cannot write '/tmp/clpt-test-dir.png': not a file: Is a directory");
-    rmdir("/tmp/clpt-test-dir.png");
+    char want[1024];
+    snprintf(want, sizeof want, "cannot write '%s': not a file: Is a directory", TEST_TMP("clpt-test-dir.png"));
+    CHECK_STR_CONTAINS(r.err, want);
+    rmdir(TEST_TMP("clpt-test-dir.png"));
     if (geteuid() == 0) {
         printf("     (skipped the read-only folder case: root writes anywhere)\n");
         return;
     }
-    mkdir("/tmp/clpt-test-ro", 0500);
-    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", "/tmp/clpt-test-ro/x.png"), &r);
+    mkdir(TEST_TMP("clpt-test-ro"), 0500);
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "-o", TEST_TMP("clpt-test-ro/x.png")), &r);
     CHECK_EQ_INT(r.status, 4);
     CHECK_STR_CONTAINS(r.err, "Permission denied");
     CHECK(strstr(r.err, "Msamples/s") == NULL);
-    rmdir("/tmp/clpt-test-ro");
+    rmdir(TEST_TMP("clpt-test-ro"));
 }
 
 /* Two outputs naming one file, or an output naming the scene: refused, nothing written. */
 static void test_outputs_must_be_distinct_files(void)
 {
-    const char *out = "/tmp/clpt-test-same.png";
+    const char *out = TEST_TMP("clpt-test-same.png");
     unlink(out);
     cli_run(ARGS("scenes/cornell-box.scene", SMALL, "--checkpoint", out, "-o", out), &r);
     CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: the output image '/tmp/clpt-test-same.png' and the checkpoint "
-                              "'/tmp/clpt-test-same.png' are the same file; give each its own name");
+    char want[1024];
+    snprintf(want, sizeof want,
+             "clpt: error: the output image '%s' and the checkpoint "
+             "'%s' are the same file; give each its own name", out, out);
+    CHECK_STR_CONTAINS(r.err, want);
     CHECK(!file_exists(out));
-    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "--checkpoint", "/tmp/../tmp/clpt-test-same.png", "-o", out), &r);
+    /* the same file by another spelling: DIR/../BASENAME(DIR)/name */
+    const char *dir = test_tmp_dir(), *dir_name = strrchr(dir, '/') + 1;
+    char roundabout[1024];
+    snprintf(roundabout, sizeof roundabout, "%s/../%s/clpt-test-same.png", dir, dir_name);
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "--checkpoint", roundabout, "-o", out), &r);
     CHECK_EQ_INT(r.status, 2);
-    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "--aov", "depth", "--checkpoint", "/tmp/clpt-test-same-depth.png",
+    cli_run(ARGS("scenes/cornell-box.scene", SMALL, "--aov", "depth", "--checkpoint", TEST_TMP("clpt-test-same-depth.png"),
                  "-o", out),
             &r);
     CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "the --aov image '/tmp/clpt-test-same-depth.png' and the checkpoint");
+    snprintf(want, sizeof want, "the --aov image '%s' and the checkpoint", TEST_TMP("clpt-test-same-depth.png"));
+    CHECK_STR_CONTAINS(r.err, want);
     /* the scene itself, by name and through a hard link */
-    const char *scene = "/tmp/clpt-test-scene.png", *link_name = "/tmp/clpt-test-scene-link.png";
+    const char *scene = TEST_TMP("clpt-test-scene.png"), *link_name = TEST_TMP("clpt-test-scene-link.png");
     char text[64 * 1024];
     FILE *f = fopen("scenes/cornell-box.scene", "r");
     size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
@@ -553,14 +566,16 @@ static void test_outputs_must_be_distinct_files(void)
     CHECK(link(scene, link_name) == 0);
     cli_run(ARGS(scene, "--format", "clpt", SMALL, "-o", scene), &r);
     CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "the output image '/tmp/clpt-test-scene.png' and the scene");
+    snprintf(want, sizeof want, "the output image '%s' and the scene", scene);
+    CHECK_STR_CONTAINS(r.err, want);
     cli_run(ARGS(scene, "--format", "clpt", SMALL, "-o", link_name), &r);
     CHECK_EQ_INT(r.status, 2);
     struct stat sb;
     CHECK(stat(scene, &sb) == 0 && (size_t)sb.st_size == n);   /* untouched */
     cli_run(ARGS(scene, "--format", "clpt", SMALL, "--checkpoint", scene, "-o", out), &r);
     CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "the checkpoint '/tmp/clpt-test-scene.png' and the scene");
+    snprintf(want, sizeof want, "the checkpoint '%s' and the scene", scene);
+    CHECK_STR_CONTAINS(r.err, want);
     CHECK(stat(scene, &sb) == 0 && (size_t)sb.st_size == n);
     unlink(scene);
     unlink(link_name);
@@ -570,7 +585,7 @@ static void test_outputs_must_be_distinct_files(void)
  * keeps its permissions. */
 static void test_output_symlink_and_mode_kept(void)
 {
-    const char *target = "/tmp/clpt-test-target.png", *sym = "/tmp/clpt-test-symlink.png";
+    const char *target = TEST_TMP("clpt-test-target.png"), *sym = TEST_TMP("clpt-test-symlink.png");
     unlink(target);
     unlink(sym);
     write_text(target, "old");
@@ -596,14 +611,17 @@ static void test_output_symlink_and_mode_kept(void)
  * status (7) says nothing was rendered. */
 static void test_time_limit_without_samples_keeps_the_output(void)
 {
-    const char *out = "/tmp/clpt-test-keep.png";
+    const char *out = TEST_TMP("clpt-test-keep.png");
     write_text(out, "keep");
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", "--width", "64", "--height", "64", "--spp", "100",
                  "--time-limit", "1e-9", "-o", out),
             &r);
     CHECK_EQ_INT(r.status, 7);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: the time limit of 1e-09 s was reached before the first batch "
-                              "finished: nothing was rendered, and '/tmp/clpt-test-keep.png' was left as it was");
+    char want[1024];
+    snprintf(want, sizeof want,
+             "clpt: error: the time limit of 1e-09 s was reached before the first batch "
+             "finished: nothing was rendered, and '%s' was left as it was", out);
+    CHECK_STR_CONTAINS(r.err, want);
     CHECK(file_holds(out, "keep"));
     unlink(out);
 }
@@ -616,7 +634,7 @@ static void test_failed_checkpoint_after_time_limit_says_why(void)
     if (!mkdtemp(ck_dir)) return;
     char ck[64];
     snprintf(ck, sizeof ck, "%s/c.ckpt", ck_dir);
-    const char *out = "/tmp/clpt-test-tl.pfm";
+    const char *out = TEST_TMP("clpt-test-tl.pfm");
     unlink(out);
     CliChild c = cli_start(ARGS("scenes/cornell-box.scene", "--device", "scalar", "--threads", "1", "--width", "32",
                                 "--height", "32", "--spp", "1000000", "--time-limit", "1.5", "--progressive-output",
@@ -643,16 +661,16 @@ static void test_stdout_failures(void)
         CHECK_STR_CONTAINS(r.err, "clpt: error: cannot write to standard output: No space left on device");
         run_with_stdout(ARGS("--list-devices"), full, &r);
         CHECK_EQ_INT(r.status, 4);
-        run_with_stdout(ARGS("scenes/cornell-box.scene", SMALL, "--stats", "-o", "/tmp/clpt-test-full.png"), full, &r);
+        run_with_stdout(ARGS("scenes/cornell-box.scene", SMALL, "--stats", "-o", TEST_TMP("clpt-test-full.png")), full, &r);
         CHECK_EQ_INT(r.status, 4);
-        CHECK(file_exists("/tmp/clpt-test-full.png"));
-        unlink("/tmp/clpt-test-full.png");
+        CHECK(file_exists(TEST_TMP("clpt-test-full.png")));
+        unlink(TEST_TMP("clpt-test-full.png"));
         close(full);
     }
     int fds[2];
     CHECK(pipe(fds) == 0);
     close(fds[0]);   /* the reader is gone before clpt writes */
-    const char *out = "/tmp/clpt-test-pipe.png";
+    const char *out = TEST_TMP("clpt-test-pipe.png");
     unlink(out);
     run_with_stdout(ARGS("scenes/cornell-box.scene", SMALL, "--stats", "-o", out), fds[1], &r);
     close(fds[1]);
@@ -667,25 +685,25 @@ static void test_device_list_with_empty_item(void)
     const char *specs[] = { ",", "scalar,", ",,scalar", " ", "scalar, ,0" };
     for (size_t i = 0; i < sizeof specs / sizeof specs[0]; i++) {
         cli_run(ARGS("scenes/cornell-box.scene", "--device", specs[i], "--width", "8", "--height", "8", "--spp", "1",
-                     "-o", "/tmp/clpt-never.png"),
+                     "-o", TEST_TMP("clpt-never.png")),
                 &r);
         CHECK_EQ_INT(r.status, 2);
         CHECK_STR_CONTAINS(r.err, "has an empty item");
     }
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "", "--width", "8", "--height", "8", "--spp", "1", "-o",
-                 "/tmp/clpt-never.png"),
+                 TEST_TMP("clpt-never.png")),
             &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "--device needs a device list");
-    CHECK(!file_exists("/tmp/clpt-never.png"));
+    CHECK(!file_exists(TEST_TMP("clpt-never.png")));
 }
 
 /* With no OpenCL platform the scalar device renders, and that is said once, as plain
  * text when stderr is not a terminal. */
 static void test_no_opencl_said_once_without_escapes(void)
 {
-    const char *out = "/tmp/clpt-test-noocl.png";
-    const char *vendors[] = { "/nonexistent", "/tmp/clpt-test-empty-vendors" };
+    const char *out = TEST_TMP("clpt-test-noocl.png");
+    const char *vendors[] = { "/nonexistent", TEST_TMP("clpt-test-empty-vendors") };
     mkdir(vendors[1], 0700);
     for (size_t i = 0; i < 2; i++) {
         setenv("OCL_ICD_VENDORS", vendors[i], 1);
@@ -713,7 +731,7 @@ static void test_no_opencl_said_once_without_escapes(void)
 static void test_log_shows_plain_progress(void)
 {
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", "--threads", "1", "--width", "64", "--height",
-                 "64", "--spp", "1000000", "--time-limit", "5.6", "-o", "/tmp/clpt-test-log.png"),
+                 "64", "--spp", "1000000", "--time-limit", "5.6", "-o", TEST_TMP("clpt-test-log.png")),
             &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     CHECK(strchr(r.err, '\r') == NULL);
@@ -729,7 +747,7 @@ static void test_log_shows_plain_progress(void)
         CHECK(strstr(second, "-- samples/s") == NULL);
     }
     CHECK_STR_CONTAINS(r.err, "clpt: time limit reached:");
-    unlink("/tmp/clpt-test-log.png");
+    unlink(TEST_TMP("clpt-test-log.png"));
 }
 
 /* The path tracer and the whitted integrator are programs of their own, each built on
@@ -742,7 +760,7 @@ static void test_kernel_programs_on_first_use(void)
     const char *saved = getenv("CLPT_CACHE_DIR");
     char *old = saved ? strdup(saved) : NULL;
     setenv("CLPT_CACHE_DIR", cache, 1);
-    const char *out = "/tmp/clpt-test-programs.png";
+    const char *out = TEST_TMP("clpt-test-programs.png");
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--width", "8", "--height", "8", "--spp", "1", "-o",
                  out), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
@@ -777,7 +795,7 @@ static void test_kernel_build_notice(void)
     const char *saved = getenv("CLPT_CACHE_DIR");
     char *old = saved ? strdup(saved) : NULL;
     setenv("CLPT_CACHE_DIR", cache, 1);
-    const char *out = "/tmp/clpt-test-notice.png";
+    const char *out = TEST_TMP("clpt-test-notice.png");
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", "--width", "8", "--height", "8", "--spp", "1", "-q",
                  "-o", out), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);

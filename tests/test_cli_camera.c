@@ -13,7 +13,6 @@ static CliResult r;   /* large: static */
 
 #define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
 #define HINT "Try 'clpt --help' for more information.\n"
-#define DIR "/tmp/clpt-test-camera"
 /* a render of well under a second on the scalar device: 40x30, 4 samples */
 #define SMALL "--width", "40", "--height", "30", "--spp", "4", "-q"
 
@@ -74,27 +73,27 @@ static void test_crop_pixels_are_the_whole_renders(void)
 {
     const char *devices[2] = { "scalar", TEST_OPENCL };
     for (int d = 0; d < 2; d++) {
-        cli_run(ARGS("scenes/cornell-box.scene", "--device", devices[d], SMALL, "-o", DIR "/whole.pfm"), &r);
+        cli_run(ARGS("scenes/cornell-box.scene", "--device", devices[d], SMALL, "-o", TEST_TMP("whole.pfm")), &r);
         CHECK_MSG(r.status == 0, "%s", r.err);
         cli_run(ARGS("scenes/cornell-box.scene", "--device", devices[d], SMALL, "--pixel-bounds", "5,23,7,20", "-o",
-                     DIR "/bounds.pfm"), &r);
+                     TEST_TMP("bounds.pfm")), &r);
         CHECK_MSG(r.status == 0, "%s", r.err);
-        CHECK_MSG(is_window_of(DIR "/bounds.pfm", DIR "/whole.pfm", 5, 7, 18, 13), "--pixel-bounds on %s", devices[d]);
+        CHECK_MSG(is_window_of(TEST_TMP("bounds.pfm"), TEST_TMP("whole.pfm"), 5, 7, 18, 13), "--pixel-bounds on %s", devices[d]);
         /* columns ceil(4) .. ceil(24) - 1, rows ceil(7.5) .. 29 */
         cli_run(ARGS("scenes/cornell-box.scene", "--device", devices[d], SMALL, "--crop", "0.1,0.6,0.25,1", "-o",
-                     DIR "/crop.pfm"), &r);
+                     TEST_TMP("crop.pfm")), &r);
         CHECK_MSG(r.status == 0, "%s", r.err);
-        CHECK_MSG(is_window_of(DIR "/crop.pfm", DIR "/whole.pfm", 4, 8, 20, 22), "--crop on %s", devices[d]);
+        CHECK_MSG(is_window_of(TEST_TMP("crop.pfm"), TEST_TMP("whole.pfm"), 4, 8, 20, 22), "--crop on %s", devices[d]);
     }
     /* the whitted integrator's samples and its auxiliary images; --crop=... as any flag */
     cli_run(ARGS("scenes/classic/spheres.txt", "--device", "scalar", "--spp", "4", "-q", "--aov", "depth",
-                 "-o", DIR "/classic.pfm"), &r);
+                 "-o", TEST_TMP("classic.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     cli_run(ARGS("scenes/classic/spheres.txt", "--device", TEST_OPENCL, "--spp", "4", "-q", "--aov", "depth",
-                 "--pixel-bounds=30,90,10,40", "-o", DIR "/classic-crop.pfm"), &r);
+                 "--pixel-bounds=30,90,10,40", "-o", TEST_TMP("classic-crop.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK(is_window_of(DIR "/classic-crop.pfm", DIR "/classic.pfm", 30, 10, 60, 30));
-    CHECK(is_window_of(DIR "/classic-crop-depth.pfm", DIR "/classic-depth.pfm", 30, 10, 60, 30));
+    CHECK(is_window_of(TEST_TMP("classic-crop.pfm"), TEST_TMP("classic.pfm"), 30, 10, 60, 30));
+    CHECK(is_window_of(TEST_TMP("classic-crop-depth.pfm"), TEST_TMP("classic-depth.pfm"), 30, 10, 60, 30));
 }
 
 /* A cropped render checkpoints, resumes, grows and merges like a whole one, and its
@@ -103,26 +102,26 @@ static void test_crop_with_checkpoints_and_merge(void)
 {
 #define CROPPED "scenes/cornell-box.scene", "--device", "scalar", "--width", "40", "--height", "30", "-q", \
                 "--pixel-bounds", "10,30,0,12"
-    cli_run(ARGS(CROPPED, "--spp", "6", "-o", DIR "/c6.pfm"), &r);
+    cli_run(ARGS(CROPPED, "--spp", "6", "-o", TEST_TMP("c6.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    cli_run(ARGS(CROPPED, "--spp", "2", "--checkpoint", DIR "/c.ckpt", "-o", DIR "/c2.pfm"), &r);
+    cli_run(ARGS(CROPPED, "--spp", "2", "--checkpoint", TEST_TMP("c.ckpt"), "-o", TEST_TMP("c2.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    cli_run(ARGS(CROPPED, "--spp", "6", "--resume", DIR "/c.ckpt", "-o", DIR "/c-resumed.pfm"), &r);
+    cli_run(ARGS(CROPPED, "--spp", "6", "--resume", TEST_TMP("c.ckpt"), "-o", TEST_TMP("c-resumed.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK(files_equal(DIR "/c-resumed.pfm", DIR "/c6.pfm"));
+    CHECK(files_equal(TEST_TMP("c-resumed.pfm"), TEST_TMP("c6.pfm")));
     /* parts of the cropped render merge to it */
-    cli_run(ARGS(CROPPED, "--spp", "6", "--sample-range", "0:4", "--checkpoint", DIR "/p1.ckpt", "-o", DIR "/p1.pfm"),
+    cli_run(ARGS(CROPPED, "--spp", "6", "--sample-range", "0:4", "--checkpoint", TEST_TMP("p1.ckpt"), "-o", TEST_TMP("p1.pfm")),
             &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    cli_run(ARGS(CROPPED, "--spp", "6", "--sample-range", "4:6", "--checkpoint", DIR "/p2.ckpt", "-o", DIR "/p2.pfm"),
+    cli_run(ARGS(CROPPED, "--spp", "6", "--sample-range", "4:6", "--checkpoint", TEST_TMP("p2.ckpt"), "-o", TEST_TMP("p2.pfm")),
             &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    cli_run(ARGS("merge", "-q", "-o", DIR "/merged.pfm", DIR "/p2.ckpt", DIR "/p1.ckpt"), &r);
+    cli_run(ARGS("merge", "-q", "-o", TEST_TMP("merged.pfm"), TEST_TMP("p2.ckpt"), TEST_TMP("p1.ckpt")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK(files_equal(DIR "/merged.pfm", DIR "/c6.pfm"));
+    CHECK(files_equal(TEST_TMP("merged.pfm"), TEST_TMP("c6.pfm")));
     /* another window is another render: its checkpoint is refused */
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", "--width", "40", "--height", "30", "-q",
-                 "--pixel-bounds", "10,30,1,13", "--spp", "6", "--resume", DIR "/c.ckpt", "-o", DIR "/other.pfm"), &r);
+                 "--pixel-bounds", "10,30,1,13", "--spp", "6", "--resume", TEST_TMP("c.ckpt"), "-o", TEST_TMP("other.pfm")), &r);
     CHECK_EQ_INT(r.status, 3);
 #undef CROPPED
 }
@@ -187,25 +186,27 @@ static void pbrt_scene(const char *path, const char *lookat, const char *film_ex
 static void test_pbrt_film_crop(void)
 {
 #define PBRT(file) file, "--device", "scalar", "-q"
-    pbrt_scene(DIR "/whole.pbrt", PBRT_LOOKAT, "");
-    pbrt_scene(DIR "/cropwindow.pbrt", PBRT_LOOKAT, "\"float cropwindow\" [0.5 0.25 0 0.5]");
-    pbrt_scene(DIR "/pixelbounds.pbrt", PBRT_LOOKAT, "\"integer pixelbounds\" [3 20 2 9]");
-    pbrt_scene(DIR "/past.pbrt", PBRT_LOOKAT, "\"integer pixelbounds\" [0 40 0 4]");
-    cli_run(ARGS(PBRT(DIR "/whole.pbrt"), "-o", DIR "/pbrt-whole.pfm"), &r);
+    pbrt_scene(TEST_TMP("whole.pbrt"), PBRT_LOOKAT, "");
+    pbrt_scene(TEST_TMP("cropwindow.pbrt"), PBRT_LOOKAT, "\"float cropwindow\" [0.5 0.25 0 0.5]");
+    pbrt_scene(TEST_TMP("pixelbounds.pbrt"), PBRT_LOOKAT, "\"integer pixelbounds\" [3 20 2 9]");
+    pbrt_scene(TEST_TMP("past.pbrt"), PBRT_LOOKAT, "\"integer pixelbounds\" [0 40 0 4]");
+    cli_run(ARGS(PBRT(TEST_TMP("whole.pbrt")), "-o", TEST_TMP("pbrt-whole.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    cli_run(ARGS(PBRT(DIR "/cropwindow.pbrt"), "-o", DIR "/pbrt-cw.pfm"), &r);
+    cli_run(ARGS(PBRT(TEST_TMP("cropwindow.pbrt")), "-o", TEST_TMP("pbrt-cw.pfm")), &r);
     CHECK_MSG(r.status == 0 && r.err[0] == '\0', "%s", r.err);
-    CHECK(is_window_of(DIR "/pbrt-cw.pfm", DIR "/pbrt-whole.pfm", 8, 0, 8, 12));
-    cli_run(ARGS(PBRT(DIR "/pixelbounds.pbrt"), "-o", DIR "/pbrt-pb.pfm"), &r);
+    CHECK(is_window_of(TEST_TMP("pbrt-cw.pfm"), TEST_TMP("pbrt-whole.pfm"), 8, 0, 8, 12));
+    cli_run(ARGS(PBRT(TEST_TMP("pixelbounds.pbrt")), "-o", TEST_TMP("pbrt-pb.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK(is_window_of(DIR "/pbrt-pb.pfm", DIR "/pbrt-whole.pfm", 3, 2, 17, 7));
-    cli_run(ARGS(PBRT(DIR "/pixelbounds.pbrt"), "--crop", "0,1,0.5,1", "-o", DIR "/pbrt-flag.pfm"), &r);
+    CHECK(is_window_of(TEST_TMP("pbrt-pb.pfm"), TEST_TMP("pbrt-whole.pfm"), 3, 2, 17, 7));
+    cli_run(ARGS(PBRT(TEST_TMP("pixelbounds.pbrt")), "--crop", "0,1,0.5,1", "-o", TEST_TMP("pbrt-flag.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK(is_window_of(DIR "/pbrt-flag.pfm", DIR "/pbrt-whole.pfm", 0, 12, 32, 12));
-    cli_run(ARGS(PBRT(DIR "/past.pbrt"), "-o", DIR "/pbrt-past.pfm"), &r);
+    CHECK(is_window_of(TEST_TMP("pbrt-flag.pfm"), TEST_TMP("pbrt-whole.pfm"), 0, 12, 32, 12));
+    cli_run(ARGS(PBRT(TEST_TMP("past.pbrt")), "-o", TEST_TMP("pbrt-past.pfm")), &r);
     CHECK_EQ_INT(r.status, 3);
-    CHECK_MSG(strcmp(r.err, "clpt: error: " DIR "/past.pbrt: the pixel bounds 0,40,0,4 go past the 32x24 image\n") == 0,
-              "%s", r.err);
+    char want[1024];
+    snprintf(want, sizeof want, "clpt: error: %s: the pixel bounds 0,40,0,4 go past the 32x24 image\n",
+             TEST_TMP("past.pbrt"));
+    CHECK_MSG(strcmp(r.err, want) == 0, "%s", r.err);
 #undef PBRT
 }
 
@@ -270,31 +271,31 @@ static void clpt_scene(const char *path, const char *camera)
  * with that camera written in it. */
 static void test_lookat_and_fov_equal_editing_the_scene(void)
 {
-    clpt_scene(DIR "/cam-a.scene", "from 0 1 5  at 0 0.5 0  fov 40");
-    clpt_scene(DIR "/cam-b.scene", "from 1 2 4  at 0 0.5 0  up 0 1 0  fov 30");
-    cli_run(ARGS(DIR "/cam-a.scene", TINY_RENDER, "--lookat", LOOKAT, "--fov", "30", "-o", DIR "/cam-flags.pfm"), &r);
+    clpt_scene(TEST_TMP("cam-a.scene"), "from 0 1 5  at 0 0.5 0  fov 40");
+    clpt_scene(TEST_TMP("cam-b.scene"), "from 1 2 4  at 0 0.5 0  up 0 1 0  fov 30");
+    cli_run(ARGS(TEST_TMP("cam-a.scene"), TINY_RENDER, "--lookat", LOOKAT, "--fov", "30", "-o", TEST_TMP("cam-flags.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    cli_run(ARGS(DIR "/cam-b.scene", TINY_RENDER, "-o", DIR "/cam-edited.pfm"), &r);
+    cli_run(ARGS(TEST_TMP("cam-b.scene"), TINY_RENDER, "-o", TEST_TMP("cam-edited.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK(files_equal(DIR "/cam-flags.pfm", DIR "/cam-edited.pfm"));
+    CHECK(files_equal(TEST_TMP("cam-flags.pfm"), TEST_TMP("cam-edited.pfm")));
     /* the flags win over --set, as --spp does */
-    cli_run(ARGS(DIR "/cam-a.scene", TINY_RENDER, "--set", "camera.fov=60", "--fov", "30", "--lookat", LOOKAT, "-o",
-                 DIR "/cam-set.pfm"), &r);
+    cli_run(ARGS(TEST_TMP("cam-a.scene"), TINY_RENDER, "--set", "camera.fov=60", "--fov", "30", "--lookat", LOOKAT, "-o",
+                 TEST_TMP("cam-set.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK(files_equal(DIR "/cam-set.pfm", DIR "/cam-edited.pfm"));
+    CHECK(files_equal(TEST_TMP("cam-set.pfm"), TEST_TMP("cam-edited.pfm")));
 }
 
 /* In the other formats the flags replace the file's camera whole: two files that differ
  * only in their camera give the same bits under the same --lookat and --fov. */
 static void check_camera_replaced(const char *a, const char *b, const char *what)
 {
-    cli_run(ARGS(a, TINY_RENDER, "--lookat", LOOKAT, "--fov", "30", "-o", DIR "/replaced-a.pfm"), &r);
+    cli_run(ARGS(a, TINY_RENDER, "--lookat", LOOKAT, "--fov", "30", "-o", TEST_TMP("replaced-a.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s: %s", what, r.err);
-    cli_run(ARGS(b, TINY_RENDER, "--lookat", LOOKAT, "--fov", "30", "-o", DIR "/replaced-b.pfm"), &r);
+    cli_run(ARGS(b, TINY_RENDER, "--lookat", LOOKAT, "--fov", "30", "-o", TEST_TMP("replaced-b.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s: %s", what, r.err);
-    CHECK_MSG(files_equal(DIR "/replaced-a.pfm", DIR "/replaced-b.pfm"), "%s", what);
-    cli_run(ARGS(a, TINY_RENDER, "-o", DIR "/replaced-none.pfm"), &r);
-    CHECK_MSG(!files_equal(DIR "/replaced-a.pfm", DIR "/replaced-none.pfm"), "%s: the flags changed nothing", what);
+    CHECK_MSG(files_equal(TEST_TMP("replaced-a.pfm"), TEST_TMP("replaced-b.pfm")), "%s", what);
+    cli_run(ARGS(a, TINY_RENDER, "-o", TEST_TMP("replaced-none.pfm")), &r);
+    CHECK_MSG(!files_equal(TEST_TMP("replaced-a.pfm"), TEST_TMP("replaced-none.pfm")), "%s: the flags changed nothing", what);
 }
 
 /* A glTF file with one triangle and a camera at `camera_at` (a node translation). */
@@ -316,34 +317,34 @@ static void gltf_scene(const char *path, const char *camera_at)
 
 static void test_lookat_and_fov_in_every_format(void)
 {
-    pbrt_scene(DIR "/cam-a.pbrt", "0 1 4  0 0.5 0  0 1 0", "");
-    pbrt_scene(DIR "/cam-b.pbrt", "2 3 5  0 0 0  0 1 0", "");
-    check_camera_replaced(DIR "/cam-a.pbrt", DIR "/cam-b.pbrt", "pbrt");
-    gltf_scene(DIR "/cam-a.gltf", "0, 0.5, 3");
-    gltf_scene(DIR "/cam-b.gltf", "0.5, 1, 5");
-    check_camera_replaced(DIR "/cam-a.gltf", DIR "/cam-b.gltf", "glTF");
+    pbrt_scene(TEST_TMP("cam-a.pbrt"), "0 1 4  0 0.5 0  0 1 0", "");
+    pbrt_scene(TEST_TMP("cam-b.pbrt"), "2 3 5  0 0 0  0 1 0", "");
+    check_camera_replaced(TEST_TMP("cam-a.pbrt"), TEST_TMP("cam-b.pbrt"), "pbrt");
+    gltf_scene(TEST_TMP("cam-a.gltf"), "0, 0.5, 3");
+    gltf_scene(TEST_TMP("cam-b.gltf"), "0.5, 1, 5");
+    check_camera_replaced(TEST_TMP("cam-a.gltf"), TEST_TMP("cam-b.gltf"), "glTF");
     /* the course format: the same scene under another PerspectiveCamera */
-    write_text(DIR "/cam-a.txt", "PerspectiveCamera { center 0 1 5 direction 0 -0.1 -1 up 0 1 0 angle 35 }\n"
+    write_text(TEST_TMP("cam-a.txt"), "PerspectiveCamera { center 0 1 5 direction 0 -0.1 -1 up 0 1 0 angle 35 }\n"
                                  "Lights { numLights 1 DirectionalLight { direction -0.5 -1 -0.5 color 1 1 1 } }\n"
                                  "Background { color 0.2 0.3 0.4 }\n"
                                  "Materials { numMaterials 1 Material { diffuseColor 0.8 0.2 0.2 } }\n"
                                  "Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0.5 0 radius 0.5 } }\n");
-    write_text(DIR "/cam-b.txt", "PerspectiveCamera { center 3 0 2 direction -1 0 0 up 0 1 0 angle 60 }\n"
+    write_text(TEST_TMP("cam-b.txt"), "PerspectiveCamera { center 3 0 2 direction -1 0 0 up 0 1 0 angle 60 }\n"
                                  "Lights { numLights 1 DirectionalLight { direction -0.5 -1 -0.5 color 1 1 1 } }\n"
                                  "Background { color 0.2 0.3 0.4 }\n"
                                  "Materials { numMaterials 1 Material { diffuseColor 0.8 0.2 0.2 } }\n"
                                  "Group { numObjects 1 MaterialIndex 0 Sphere { center 0 0.5 0 radius 0.5 } }\n");
-    check_camera_replaced(DIR "/cam-a.txt", DIR "/cam-b.txt", "classic");
+    check_camera_replaced(TEST_TMP("cam-a.txt"), TEST_TMP("cam-b.txt"), "classic");
     /* a mesh shown alone gets a camera that frames it; the flags, and --set, replace it */
     cli_run(ARGS("tests/data/good/square.obj", TINY_RENDER, "--lookat", LOOKAT, "--fov", "30", "-o",
-                 DIR "/mesh-flags.pfm"), &r);
+                 TEST_TMP("mesh-flags.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     cli_run(ARGS("tests/data/good/square.obj", TINY_RENDER, "--set", "camera.from=1,2,4", "--set", "camera.at=0,0.5,0",
-                 "--set", "camera.up=0,1,0", "--set", "camera.fov=30", "-o", DIR "/mesh-set.pfm"), &r);
+                 "--set", "camera.up=0,1,0", "--set", "camera.fov=30", "-o", TEST_TMP("mesh-set.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK(files_equal(DIR "/mesh-flags.pfm", DIR "/mesh-set.pfm"));
-    cli_run(ARGS("tests/data/good/square.obj", TINY_RENDER, "-o", DIR "/mesh-framed.pfm"), &r);
-    CHECK(!files_equal(DIR "/mesh-flags.pfm", DIR "/mesh-framed.pfm"));
+    CHECK(files_equal(TEST_TMP("mesh-flags.pfm"), TEST_TMP("mesh-set.pfm")));
+    cli_run(ARGS("tests/data/good/square.obj", TINY_RENDER, "-o", TEST_TMP("mesh-framed.pfm")), &r);
+    CHECK(!files_equal(TEST_TMP("mesh-flags.pfm"), TEST_TMP("mesh-framed.pfm")));
 }
 
 /* An orthographic scene of 64x32 pixels: a lamp of radiance 1, 1 wide and 0.5 tall,
@@ -382,27 +383,27 @@ static int is_lit_rectangle(const char *path, unsigned x0, unsigned x1, unsigned
  * bits from 10 times farther. On the scalar device and on OpenCL. */
 static void test_orthographic_camera(void)
 {
-    ortho_scene(DIR "/ortho.scene", "type orthographic  from 0 0 5  at 0 0 0  width 2");
-    ortho_scene(DIR "/ortho-far.scene", "type orthographic  from 0 0 50  at 0 0 0  width 2");
+    ortho_scene(TEST_TMP("ortho.scene"), "type orthographic  from 0 0 5  at 0 0 0  width 2");
+    ortho_scene(TEST_TMP("ortho-far.scene"), "type orthographic  from 0 0 50  at 0 0 0  width 2");
     const char *devices[2] = { "scalar", TEST_OPENCL };
     for (int d = 0; d < 2; d++) {
-        cli_run(ARGS(DIR "/ortho.scene", "--device", devices[d], "-q", "-o", DIR "/ortho.pfm"), &r);
+        cli_run(ARGS(TEST_TMP("ortho.scene"), "--device", devices[d], "-q", "-o", TEST_TMP("ortho.pfm")), &r);
         CHECK_MSG(r.status == 0, "%s", r.err);
-        CHECK_MSG(is_lit_rectangle(DIR "/ortho.pfm", 16, 48, 8, 24), "on %s", devices[d]);
+        CHECK_MSG(is_lit_rectangle(TEST_TMP("ortho.pfm"), 16, 48, 8, 24), "on %s", devices[d]);
     }
-    cli_run(ARGS(DIR "/ortho-far.scene", "--device", "scalar", "-q", "-o", DIR "/ortho-far.pfm"), &r);
+    cli_run(ARGS(TEST_TMP("ortho-far.scene"), "--device", "scalar", "-q", "-o", TEST_TMP("ortho-far.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK(files_equal(DIR "/ortho.pfm", DIR "/ortho-far.pfm"));
+    CHECK(files_equal(TEST_TMP("ortho.pfm"), TEST_TMP("ortho-far.pfm")));
     /* --set camera.width: a view 4 wide draws the lamp 16 columns wide, 8 rows tall */
-    cli_run(ARGS(DIR "/ortho.scene", "--device", "scalar", "-q", "--set", "camera.width=4", "-o", DIR "/ortho4.pfm"),
+    cli_run(ARGS(TEST_TMP("ortho.scene"), "--device", "scalar", "-q", "--set", "camera.width=4", "-o", TEST_TMP("ortho4.pfm")),
             &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK(is_lit_rectangle(DIR "/ortho4.pfm", 24, 40, 12, 20));
+    CHECK(is_lit_rectangle(TEST_TMP("ortho4.pfm"), 24, 40, 12, 20));
     /* --lookat moves it: a view centred 1 to the right shows the lamp 32 columns left */
-    cli_run(ARGS(DIR "/ortho.scene", "--device", "scalar", "-q", "--lookat", "1,0,5,1,0,0,0,1,0", "-o",
-                 DIR "/ortho-moved.pfm"), &r);
+    cli_run(ARGS(TEST_TMP("ortho.scene"), "--device", "scalar", "-q", "--lookat", "1,0,5,1,0,0,0,1,0", "-o",
+                 TEST_TMP("ortho-moved.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK(is_lit_rectangle(DIR "/ortho-moved.pfm", 0, 16, 8, 24));
+    CHECK(is_lit_rectangle(TEST_TMP("ortho-moved.pfm"), 0, 16, 8, 24));
 }
 
 /* The keys of one type of camera are refused on the other, in the file and by path. */
@@ -421,28 +422,27 @@ static void test_orthographic_camera_errors(void)
                                                               "'width', found '0'\n" },
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-        ortho_scene(DIR "/bad.scene", bad[i].camera);
-        cli_run(ARGS(DIR "/bad.scene", "--device", "scalar", "-q", "-o", DIR "/bad.pfm"), &r);
+        ortho_scene(TEST_TMP("bad.scene"), bad[i].camera);
+        cli_run(ARGS(TEST_TMP("bad.scene"), "--device", "scalar", "-q", "-o", TEST_TMP("bad.pfm")), &r);
         CHECK_EQ_INT(r.status, 3);
         char want[512];
-        snprintf(want, sizeof want, "clpt: error: " DIR "/bad.scene%s", bad[i].want);
+        snprintf(want, sizeof want, "clpt: error: %s%s", TEST_TMP("bad.scene"), bad[i].want);
         CHECK_MSG(strcmp(r.err, want) == 0, "stderr:\n%s\nwanted:\n%s", r.err, want);
     }
-    ortho_scene(DIR "/ortho.scene", "type orthographic  from 0 0 5  at 0 0 0  width 2");
-    CHECK_USAGE(ARGS(DIR "/ortho.scene", "--set", "camera.fov=30"),
+    ortho_scene(TEST_TMP("ortho.scene"), "type orthographic  from 0 0 5  at 0 0 0  width 2");
+    CHECK_USAGE(ARGS(TEST_TMP("ortho.scene"), "--set", "camera.fov=30"),
                 "clpt: error: scene parameter 'camera.fov': the camera is orthographic, with a view width "
                 "(camera.width) and no lens or field of view\n" HINT);
     CHECK_USAGE(ARGS("scenes/cornell-box.scene", "--set", "camera.width=3"),
                 "clpt: error: scene parameter 'camera.width': the camera is perspective; camera.width is an "
                 "orthographic camera's view width\n" HINT);
-    CHECK_USAGE(ARGS(DIR "/ortho.scene", "--fov", "30"),
+    CHECK_USAGE(ARGS(TEST_TMP("ortho.scene"), "--fov", "30"),
                 "clpt: error: --fov sets a perspective camera's field of view; the scene's camera is orthographic\n"
                 HINT);
 }
 
 int main(void)
 {
-    if (system("rm -rf " DIR " && mkdir -p " DIR) != 0) return 1;
     RUN(test_crop_errors);
     RUN(test_crop_pixels_are_the_whole_renders);
     RUN(test_crop_with_checkpoints_and_merge);
@@ -452,6 +452,5 @@ int main(void)
     RUN(test_lookat_and_fov_in_every_format);
     RUN(test_orthographic_camera);
     RUN(test_orthographic_camera_errors);
-    if (system("rm -rf " DIR) != 0) return 1;
     return harness_report();
 }

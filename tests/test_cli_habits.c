@@ -66,7 +66,7 @@ static void test_version_names_version_and_commit(void)
 /* "--" ends the options: what follows is the scene, even when it looks like a flag. */
 static void test_double_dash_ends_options(void)
 {
-    const char *out = "/tmp/clpt-test-habits-dd.pfm";
+    const char *out = TEST_TMP("clpt-test-habits-dd.pfm");
     remove(out);
     cli_run(ARGS("--device", "scalar", "--width", "8", "--height", "6", "--spp", "2", "-q", "-o", out, "--",
                  "scenes/cornell-box.scene"), &r);
@@ -82,14 +82,16 @@ static void test_double_dash_ends_options(void)
 /* -qo FILE, -qoFILE: one-letter flags bundled as getopt reads them. */
 static void test_bundled_short_options(void)
 {
-    const char *out = "/tmp/clpt-test-habits-bundle.pfm", *glued = "/tmp/clpt-test-habits-glued.pfm";
+    const char *out = TEST_TMP("clpt-test-habits-bundle.pfm"), *glued = TEST_TMP("clpt-test-habits-glued.pfm");
     remove(out);
     remove(glued);
     cli_run(ARGS(TINY, "-qo", out), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     CHECK_MSG(r.err[0] == '\0', "-q in a bundle: stderr '%s'", r.err);
     CHECK(file_exists(out));
-    cli_run(ARGS(TINY, "-qo/tmp/clpt-test-habits-glued.pfm"), &r);
+    char glued_flag[1024];
+    snprintf(glued_flag, sizeof glued_flag, "-qo%s", glued);
+    cli_run(ARGS(TINY, glued_flag), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     CHECK(files_equal(out, glued));
     CHECK_USAGE(ARGS(TINY, "-qz"), "clpt: error: unknown option '-z' in '-qz'\n" HINT);
@@ -115,9 +117,11 @@ static void test_did_you_mean(void)
 /* --flag=value for flags with values; a switch takes none, unless it lists words. */
 static void test_equals_values(void)
 {
-    const char *out = "/tmp/clpt-test-habits-eq.pfm";
+    const char *out = TEST_TMP("clpt-test-habits-eq.pfm");
+    char output_flag[1024];
+    snprintf(output_flag, sizeof output_flag, "--output=%s", out);
     cli_run(ARGS("scenes/cornell-box.scene", "--device=scalar", "--width=8", "--height=6", "--spp=2", "-q",
-                 "--output=/tmp/clpt-test-habits-eq.pfm"), &r);
+                 output_flag), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     CHECK(file_exists(out));
     CHECK_USAGE(ARGS("scenes/cornell-box.scene", "--quiet=yes"), "clpt: error: --quiet takes no value, got '--quiet=yes'\n" HINT);
@@ -132,7 +136,7 @@ static void test_equals_values(void)
 static void test_output_to_stdout(void)
 {
     static char file[CLI_OUT_MAX];
-    const char *pfm = "/tmp/clpt-test-habits-stdout.pfm";
+    const char *pfm = TEST_TMP("clpt-test-habits-stdout.pfm");
     size_t n = 0;
     cli_run(ARGS(TINY, "-q", "-o", pfm), &r);
     CHECK_MSG(r.status == 0 && read_file(pfm, file, sizeof file, &n), "%s", r.err);
@@ -162,7 +166,7 @@ static void test_output_to_stdout(void)
 /* --stats=json: one JSON object on stdout, with the render's numbers. */
 static void test_stats_json(void)
 {
-    cli_run(ARGS(TINY, "-q", "-o", "/tmp/clpt-test-habits-json.pfm", "--stats=json"), &r);
+    cli_run(ARGS(TINY, "-q", "-o", TEST_TMP("clpt-test-habits-json.pfm"), "--stats=json"), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     CHECK_MSG(strchr(r.out, '\n') == r.out + strlen(r.out) - 1, "not one line: %s", r.out);
     cJSON *j = cJSON_Parse(r.out);
@@ -173,7 +177,7 @@ static void test_stats_json(void)
         CHECK_EQ_INT(cJSON_GetObjectItem(j, "spp_done")->valueint, 2);
         CHECK_EQ_INT((int)cJSON_GetObjectItem(j, "samples")->valuedouble, 8 * 6 * 2);
         CHECK(strcmp(cJSON_GetObjectItem(j, "result")->valuestring, "rendered") == 0);
-        CHECK(strcmp(cJSON_GetObjectItem(j, "output")->valuestring, "/tmp/clpt-test-habits-json.pfm") == 0);
+        CHECK(strcmp(cJSON_GetObjectItem(j, "output")->valuestring, TEST_TMP("clpt-test-habits-json.pfm")) == 0);
         cJSON *devs = cJSON_GetObjectItem(j, "devices");
         CHECK(cJSON_IsArray(devs) && cJSON_GetArraySize(devs) == 1);
         CHECK_STR_CONTAINS(cJSON_GetObjectItem(cJSON_GetArrayItem(devs, 0), "name")->valuestring, "scalar");
@@ -183,7 +187,7 @@ static void test_stats_json(void)
     CHECK_USAGE(ARGS("scenes/cornell-box.scene", "--interactive", "--stats=json"),
                 "clpt: error: --interactive cannot be combined with --stats=json (the viewer saves frames with the C "
                 "key; see docs/viewer.md)\n" HINT);
-    remove("/tmp/clpt-test-habits-json.pfm");
+    remove(TEST_TMP("clpt-test-habits-json.pfm"));
 }
 
 int main(void)

@@ -16,7 +16,7 @@ static const char *const classic_scenes[] = { "spheres", "glass", "mesh", "ortho
 
 static void tmp_name(char *buf, size_t n, const char *what)
 {
-    snprintf(buf, n, "/tmp/clpt-course-%ld-%s", (long)getpid(), what);
+    test_tmp_path(buf, n, what);
 }
 
 /* MIT: -size 48 36 -bounces 2 -shadows -normals, against the whitted integrator, one
@@ -136,23 +136,23 @@ static void expect_usage(const char *const *args, const char *message)
 
 static void test_bad_course_command_lines(void)
 {
-    expect_usage(ARGS("-size", "64", "64", "-output", "/tmp/clpt-never.bmp"),
+    expect_usage(ARGS("-size", "64", "64", "-output", TEST_TMP("clpt-never.bmp")),
                  "the course command line needs -input FILE");
     expect_usage(ARGS("-input", "scenes/classic/spheres.txt", "-size", "64"), "-size needs a width and a height");
-    expect_usage(ARGS("-size", "64", "-input", "scenes/classic/spheres.txt", "-output", "/tmp/clpt-never.bmp"),
+    expect_usage(ARGS("-size", "64", "-input", "scenes/classic/spheres.txt", "-output", TEST_TMP("clpt-never.bmp")),
                  "-size needs a width and a height");
-    expect_usage(ARGS("-input", "scenes/classic/spheres.txt", "-output", "/tmp/clpt-never.bmp", "-jitter"),
+    expect_usage(ARGS("-input", "scenes/classic/spheres.txt", "-output", TEST_TMP("clpt-never.bmp"), "-jitter"),
                  "unknown option '-jitter' in the course command line");
     expect_usage(ARGS("-input", "scenes/classic/spheres.txt"), "the course command line needs -output FILE");
-    expect_usage(ARGS("-input", "scenes/classic/spheres.txt", "-output", "/tmp/clpt-never.bmp", "-bounces", "two"),
+    expect_usage(ARGS("-input", "scenes/classic/spheres.txt", "-output", TEST_TMP("clpt-never.bmp"), "-bounces", "two"),
                  "-bounces expects an integer in 0..1024, got 'two'");
-    expect_usage(ARGS("-input", "scenes/classic/spheres.txt", "-output", "/tmp/clpt-never.bmp", "-depth", "8", "8",
-                      "/tmp/clpt-never-d.bmp"), "-depth NEAR FAR FILE needs NEAR and FAR to differ, got 8 and 8");
-    expect_usage(ARGS("-input", "scenes/classic/spheres.txt", "-output", "/tmp/clpt-never.bmp", "-depth", "8",
+    expect_usage(ARGS("-input", "scenes/classic/spheres.txt", "-output", TEST_TMP("clpt-never.bmp"), "-depth", "8", "8",
+                      TEST_TMP("clpt-never-d.bmp")), "-depth NEAR FAR FILE needs NEAR and FAR to differ, got 8 and 8");
+    expect_usage(ARGS("-input", "scenes/classic/spheres.txt", "-output", TEST_TMP("clpt-never.bmp"), "-depth", "8",
                       "18"), "-depth needs NEAR FAR FILE");
-    expect_usage(ARGS("-input", "scenes/classic/spheres.txt", "-output", "/tmp/clpt-never.bmp", "extra.txt"),
+    expect_usage(ARGS("-input", "scenes/classic/spheres.txt", "-output", TEST_TMP("clpt-never.bmp"), "extra.txt"),
                  "unexpected argument 'extra.txt'");
-    CHECK(!file_exists("/tmp/clpt-never.bmp"));
+    CHECK(!file_exists(TEST_TMP("clpt-never.bmp")));
     /* two positional arguments whose second is no image name stay clpt's own error */
     cli_run(ARGS("scenes/classic/spheres.txt", "other.txt"), &r);
     CHECK_EQ_INT(r.status, 2);

@@ -45,8 +45,8 @@ static void find_pocl_devices(void)
 
 #define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
 #define SMALL "--width", "16", "--height", "12", "--spp", "2"
-/* per process: test runs of other checkouts on the same machine use /tmp too */
-static char out_path[64];
+/* in this process's scratch folder (harness.h): other test runs on the machine use /tmp too */
+static char out_path[512];
 #define OUT out_path
 
 static void test_broken_kernel_dir(void)
@@ -192,7 +192,7 @@ int main(void)
 {
     /* before anything loads the ICD in a child: two PoCL CPU devices, 0 and 1 */
     setenv("POCL_DEVICES", "pthread pthread", 1);
-    snprintf(out_path, sizeof out_path, "/tmp/clpt-test-device-errors-%ld.png", (long)getpid());
+    test_tmp_path(out_path, sizeof out_path, "clpt-test-device-errors.png");
     RUN(find_pocl_devices);
     RUN(test_memory_check);
     RUN(test_broken_kernel_dir);

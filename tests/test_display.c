@@ -172,7 +172,7 @@ static void test_stream_equals_output(void)
     int port = listener_start(&l, &t);
     CHECK(port > 0 && l.image);
     if (port <= 0 || !l.image) return;
-    const char *out = "/tmp/clpt-test-display.pfm";
+    const char *out = TEST_TMP("clpt-test-display.pfm");
     run_clpt(port, out, "48", &result);
     pthread_join(t, NULL);
     close(l.fd);
@@ -204,7 +204,7 @@ static void test_lost_connection(void)
     int port = listener_start(&l, &t);
     CHECK(port > 0);
     if (port <= 0) return;
-    const char *out = "/tmp/clpt-test-display-lost.png";
+    const char *out = TEST_TMP("clpt-test-display-lost.png");
     run_clpt(port, out, "16", &result);
     pthread_join(t, NULL);
     close(l.fd);
@@ -227,7 +227,7 @@ static void test_unreachable_server(void)
     shutdown(l.fd, SHUT_RDWR);
     close(l.fd);
     pthread_join(t, NULL);
-    const char *out = "/tmp/clpt-test-display-none.png";
+    const char *out = TEST_TMP("clpt-test-display-none.png");
     run_clpt(port, out, "4", &result);
     char want[200];
     snprintf(want, sizeof want, "clpt: warning: cannot reach the display server '127.0.0.1:%d': Connection refused\n",

@@ -14,7 +14,7 @@ static CliResult r;   /* large: static */
 
 static void test_0_success(void)
 {
-    const char *out = "/tmp/clpt-test-exit0.ppm";
+    const char *out = TEST_TMP("clpt-test-exit0.ppm");
     unlink(out);
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", SMALL, "-o", out), &r);
     CHECK_EQ_INT(r.status, 0);
@@ -24,7 +24,7 @@ static void test_0_success(void)
 
 static void test_1_internal(void)
 {
-    const char *out = "/tmp/clpt-test-exit1.png";
+    const char *out = TEST_TMP("clpt-test-exit1.png");
     unlink(out);
     setenv("CLPT_TEST_FAIL_ALLOC", "film", 1);
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", SMALL, "-o", out), &r);
@@ -41,17 +41,17 @@ static void test_2_usage(void)
     CHECK_STR_CONTAINS(r.err, "--spp must be between 1 and 1000000, got 0");
     CHECK_STR_CONTAINS(r.err, "Try 'clpt --help'");
     /* each side is allowed, the product is not */
-    cli_run(ARGS("scenes/cornell-box.scene", "--width", "16384", "--height", "16384", "-o", "/tmp/clpt-never.png"), &r);
+    cli_run(ARGS("scenes/cornell-box.scene", "--width", "16384", "--height", "16384", "-o", TEST_TMP("clpt-never.png")), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "--width/--height: an image of 16384x16384 pixels is larger than clpt renders");
-    CHECK(!file_exists("/tmp/clpt-never.png"));
+    CHECK(!file_exists(TEST_TMP("clpt-never.png")));
 }
 
 /* A scene's image too large to render is checked after --width and --height, which
  * can make it small: the parse refused it before the flags were looked at. */
 static void test_flags_rescue_a_large_scene_image(void)
 {
-    const char *out = "/tmp/clpt-test-rescued.png";
+    const char *out = TEST_TMP("clpt-test-rescued.png");
     unlink(out);
     cli_run(ARGS("tests/data/huge-image.scene", "--device", "scalar", "--threads", "1", "-q", "--width", "64",
                  "--height", "48", "-o", out), &r);
@@ -74,15 +74,15 @@ static void test_flags_rescue_a_large_scene_image(void)
 
 static void test_3_input(void)
 {
-    cli_run(ARGS("tests/data/bad/zero-radius.scene", "-o", "/tmp/clpt-never.png"), &r);
+    cli_run(ARGS("tests/data/bad/zero-radius.scene", "-o", TEST_TMP("clpt-never.png")), &r);
     CHECK_EQ_INT(r.status, 3);
     CHECK_STR_CONTAINS(r.err, "tests/data/bad/zero-radius.scene:3:30: expected a radius > 0 for 'radius', found '0'");
-    CHECK(!file_exists("/tmp/clpt-never.png"));
+    CHECK(!file_exists(TEST_TMP("clpt-never.png")));
 }
 
 static void test_4_io(void)
 {
-    cli_run(ARGS("tests/data/no-such.scene", "-o", "/tmp/clpt-never.png"), &r);
+    cli_run(ARGS("tests/data/no-such.scene", "-o", TEST_TMP("clpt-never.png")), &r);
     CHECK_EQ_INT(r.status, 4);
     CHECK_STR_CONTAINS(r.err, "cannot open 'tests/data/no-such.scene': No such file or directory");
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", SMALL, "-o", "/nonexistent-dir/x.png"), &r);
@@ -92,7 +92,7 @@ static void test_4_io(void)
 
 static void test_5_device(void)
 {
-    const char *out = "/tmp/clpt-test-exit5.png";
+    const char *out = TEST_TMP("clpt-test-exit5.png");
     unlink(out);
     setenv("CLPT_TEST_DEVICE_MEMORY", "0:1048576", 1);
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "0", SMALL, "-o", out), &r);
@@ -104,7 +104,7 @@ static void test_5_device(void)
 
 static void test_6_interrupted(void)
 {
-    const char *out = "/tmp/clpt-test-exit6.pfm";
+    const char *out = TEST_TMP("clpt-test-exit6.pfm");
     unlink(out);
     /* the first progressive image shows the render has started (the signal handlers
      * are in place by then) */
@@ -125,7 +125,7 @@ static void test_6_interrupted(void)
 
 static void test_7_nothing_rendered(void)
 {
-    const char *out = "/tmp/clpt-test-exit7.png";
+    const char *out = TEST_TMP("clpt-test-exit7.png");
     FILE *f = fopen(out, "w");
     if (f) {
         fputs("an older image", f);
@@ -133,7 +133,9 @@ static void test_7_nothing_rendered(void)
     }
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", SMALL, "--time-limit", "1e-9", "-o", out), &r);
     CHECK_EQ_INT(r.status, 7);
-    CHECK_STR_CONTAINS(r.err, "nothing was rendered, and '/tmp/clpt-test-exit7.png' was left as it was");
+    char want[512];
+    snprintf(want, sizeof want, "nothing was rendered, and '%s' was left as it was", out);
+    CHECK_STR_CONTAINS(r.err, want);
     struct stat sb;
     CHECK(stat(out, &sb) == 0 && sb.st_size == 14);
     unlink(out);

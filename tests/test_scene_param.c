@@ -95,19 +95,19 @@ static void test_flag(void)
     write_temp(edited, sizeof edited, ".scene", text);
     free(text);
     CliResult *r = malloc(sizeof *r);
-    const char *a1[] = { plain, "--device", "scalar", "-q", "--set", "camera.fov=25", "-o", "/tmp/clpt-test-set-a.pfm",
+    const char *a1[] = { plain, "--device", "scalar", "-q", "--set", "camera.fov=25", "-o", TEST_TMP("clpt-test-set-a.pfm"),
                          NULL };
     cli_run(a1, r);
     CHECK_MSG(r->status == 0, "%s", r->err);
-    const char *a2[] = { edited, "--device", "scalar", "-q", "-o", "/tmp/clpt-test-set-b.pfm", NULL };
+    const char *a2[] = { edited, "--device", "scalar", "-q", "-o", TEST_TMP("clpt-test-set-b.pfm"), NULL };
     cli_run(a2, r);
     CHECK(r->status == 0);
-    CHECK(files_equal("/tmp/clpt-test-set-a.pfm", "/tmp/clpt-test-set-b.pfm"));
-    const char *a3[] = { plain, "--device", "scalar", "--set", "camera.fvo=25", "-o", "/tmp/clpt-test-set-c.pfm", NULL };
+    CHECK(files_equal(TEST_TMP("clpt-test-set-a.pfm"), TEST_TMP("clpt-test-set-b.pfm")));
+    const char *a3[] = { plain, "--device", "scalar", "--set", "camera.fvo=25", "-o", TEST_TMP("clpt-test-set-c.pfm"), NULL };
     cli_run(a3, r);
     CHECK(r->status == 2);
     CHECK_STR_CONTAINS(r->err, "clpt: error: unknown scene parameter 'camera.fvo'");
-    CHECK(!file_exists("/tmp/clpt-test-set-c.pfm"));
+    CHECK(!file_exists(TEST_TMP("clpt-test-set-c.pfm")));
     const char *a4[] = { plain, "--set", "camera.fov", NULL };
     cli_run(a4, r);
     CHECK(r->status == 2);
@@ -115,8 +115,8 @@ static void test_flag(void)
     free(r);
     remove(plain);
     remove(edited);
-    remove("/tmp/clpt-test-set-a.pfm");
-    remove("/tmp/clpt-test-set-b.pfm");
+    remove(TEST_TMP("clpt-test-set-a.pfm"));
+    remove(TEST_TMP("clpt-test-set-b.pfm"));
 }
 
 int main(void)

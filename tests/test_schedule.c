@@ -224,7 +224,7 @@ static void test_pfm_identical_across_devices(void)
     char *ref = NULL;
     size_t ref_len = 0;
     for (int i = 0; i < 3; i++) {
-        const char *out = "/tmp/clpt-test-mix.pfm";
+        const char *out = TEST_TMP("clpt-test-mix.pfm");
         if (batches[i][0] == '0')
             cli_run(ARGS("scenes/cornell-box.scene", "-q", "--device", devs[i], "--width", "32", "--height", "24",
                          "--spp", "8", "-o", out), &r);
@@ -249,7 +249,7 @@ static void test_pfm_identical_across_devices(void)
 
 static void test_time_limit_within_one_batch(void)
 {
-    const char *out = "/tmp/clpt-test-time.png";
+    const char *out = TEST_TMP("clpt-test-time.png");
     unlink(out);
     double t0 = timer_now();
     cli_run(ARGS("scenes/cornell-box.scene", "--device", "scalar", "--width", "64", "--height", "64", "--spp",
@@ -265,7 +265,7 @@ static void test_time_limit_within_one_batch(void)
 
 static void test_sigint_writes_partial_image(void)
 {
-    const char *out = "/tmp/clpt-test-sigint.pfm";
+    const char *out = TEST_TMP("clpt-test-sigint.pfm");
     unlink(out);
     CliChild c = cli_start(ARGS("scenes/cornell-box.scene", "--device", "scalar", "--width", "64", "--height", "64",
                                 "--spp", "1000000", "-o", out));
@@ -339,7 +339,7 @@ static CliChild start_huge_batch(const char *out)
 
 static void check_signal_stops_huge_batch(int sig)
 {
-    const char *out = "/tmp/clpt-test-cancel.pfm";
+    const char *out = TEST_TMP("clpt-test-cancel.pfm");
     CliChild c = start_huge_batch(out);
     kill(c.pid, sig);
     double secs = finish_within(c, 10.0, &r);
@@ -366,7 +366,7 @@ static void test_sigterm_stops_within_a_second(void)
  * is repeated. */
 static void test_second_sigint_quits_at_once(void)
 {
-    const char *out = "/tmp/clpt-test-cancel2.pfm";
+    const char *out = TEST_TMP("clpt-test-cancel2.pfm");
     int caught = 0;
     for (int attempt = 0; attempt < 5 && !caught; attempt++) {
         CliChild c = start_huge_batch(out);

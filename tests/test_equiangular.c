@@ -113,7 +113,7 @@ static void test_variance_drops(void)
 static void test_devices_match_scalar(void)
 {
     const char *modes[] = { "counted", "megakernel" };
-    const char *ref = "/tmp/clpt-test-equiangular-scalar.pfm", *out = "/tmp/clpt-test-equiangular-ocl.pfm";
+    const char *ref = TEST_TMP("clpt-test-equiangular-scalar.pfm"), *out = TEST_TMP("clpt-test-equiangular-ocl.pfm");
     cli_run(ARGS(scene_path, "--device", "scalar", "--spp", "8", "-q", "-o", ref), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     for (int i = 0; i < 2; i++) {

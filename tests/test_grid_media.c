@@ -268,7 +268,7 @@ static void test_file_and_majorant(void)
     enum { N = 20 };
     static float d[N * N * N];
     for (int i = 0; i < N * N * N; i++) d[i] = (float)((i * 7919) % 1000) / 500.0f;
-    const char *raw = "/tmp/clpt-test-grid.raw";
+    const char *raw = TEST_TMP("clpt-test-grid.raw");
     FILE *f = fopen(raw, "wb");
     CHECK(f != NULL);
     if (!f) return;
@@ -326,7 +326,7 @@ static void test_devices_match_scalar(void)
 {
     const char *scene = "scenes/smoke.scene";
     const char *modes[] = { "counted", "bounded", "megakernel" };
-    const char *ref = "/tmp/clpt-test-grid-scalar.pfm", *out = "/tmp/clpt-test-grid-ocl.pfm";
+    const char *ref = TEST_TMP("clpt-test-grid-scalar.pfm"), *out = TEST_TMP("clpt-test-grid-ocl.pfm");
     cli_run(ARGS(scene, "--device", "scalar", "--width", "40", "--height", "30", "--spp", "4", "-q", "-o", ref), &r);
     CHECK_MSG(r.status == 0, "%s: %s", scene, r.err);
     for (int i = 0; i < 3; i++) {

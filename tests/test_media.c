@@ -360,7 +360,7 @@ static void test_devices_match_scalar(void)
 {
     const char *scenes[] = { "scenes/fog.scene", "tests/data/media/mix.scene" };
     const char *modes[] = { "counted", "bounded", "megakernel" };
-    const char *ref = "/tmp/clpt-test-media-scalar.pfm", *out = "/tmp/clpt-test-media-ocl.pfm";
+    const char *ref = TEST_TMP("clpt-test-media-scalar.pfm"), *out = TEST_TMP("clpt-test-media-ocl.pfm");
     for (int k = 0; k < 2; k++) {
         cli_run(ARGS(scenes[k], "--device", "scalar", "--width", "40", "--height", "30", "--spp", "6", "-q", "-o",
                      ref), &r);
@@ -384,8 +384,8 @@ static void test_devices_match_scalar(void)
 static void test_resume_matches_straight(void)
 {
     const char *scene = "tests/data/media/mix.scene";
-    const char *ref = "/tmp/clpt-test-media-ref.pfm", *out = "/tmp/clpt-test-media-out.pfm",
-               *ck = "/tmp/clpt-test-media.ckpt";
+    const char *ref = TEST_TMP("clpt-test-media-ref.pfm"), *out = TEST_TMP("clpt-test-media-out.pfm"),
+               *ck = TEST_TMP("clpt-test-media.ckpt");
     unlink(ck);
     cli_run(ARGS(scene, "--device", "scalar", "--spp", "8", "-q", "-o", ref), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
@@ -407,7 +407,7 @@ static void test_resume_matches_straight(void)
 static void test_split_refused(void)
 {
     cli_run(ARGS("tests/data/media/mix.scene", "--device", "scalar", "--split", "2", "-q", "-o",
-                 "/tmp/clpt-test-media-split.pfm"), &r);
+                 TEST_TMP("clpt-test-media-split.pfm")), &r);
     CHECK_EQ_INT(r.status, 2);
     CHECK_STR_CONTAINS(r.err, "first-hit splitting (--split 2) does not work in a scene with participating media; "
                               "render it with --split 1");

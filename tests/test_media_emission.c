@@ -231,7 +231,7 @@ static void test_devices_match_scalar(void)
 {
     const char *scene = "scenes/glow.scene";
     const char *modes[] = { "counted", "bounded", "megakernel" };
-    const char *ref = "/tmp/clpt-test-emission-scalar.pfm", *out = "/tmp/clpt-test-emission-ocl.pfm";
+    const char *ref = TEST_TMP("clpt-test-emission-scalar.pfm"), *out = TEST_TMP("clpt-test-emission-ocl.pfm");
     cli_run(ARGS(scene, "--device", "scalar", "--width", "40", "--height", "30", "--spp", "6", "-q", "-o", ref), &r);
     CHECK_MSG(r.status == 0, "%s: %s", scene, r.err);
     for (int i = 0; i < 3; i++) {

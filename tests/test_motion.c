@@ -282,7 +282,7 @@ static void test_still_with_shutter_same_bits(void)
 static void test_devices_match_scalar(void)
 {
     const char *scenes[] = { "tests/data/motion/camera.scene", "tests/data/motion/instances.scene" };
-    const char *ref = "/tmp/clpt-test-motion-scalar.pfm", *out = "/tmp/clpt-test-motion-ocl.pfm";
+    const char *ref = TEST_TMP("clpt-test-motion-scalar.pfm"), *out = TEST_TMP("clpt-test-motion-ocl.pfm");
     const char *modes[] = { "counted", "bounded", "megakernel" };
     for (int k = 0; k < 2; k++) {
         const char *scene = scenes[k];
@@ -309,7 +309,7 @@ static void test_devices_match_scalar(void)
 static void test_kdtree_refuses_moving_instances(void)
 {
     cli_run(ARGS("tests/data/motion/instances.scene", "--device", "scalar", "--accel", "kdtree", "-q", "-o",
-                 "/tmp/clpt-test-motion-kd.pfm"), &r);
+                 TEST_TMP("clpt-test-motion-kd.pfm")), &r);
     CHECK_EQ_INT(r.status, 3);
     CHECK_STR_CONTAINS(r.err, "--accel kdtree takes instances as copies, which cannot move: render a scene with "
                               "moving instances with --accel bvh (the default)");
@@ -320,8 +320,8 @@ static void test_kdtree_refuses_moving_instances(void)
 static void test_resume_matches_straight(void)
 {
     const char *scene = "tests/data/motion/instances.scene";
-    const char *ref = "/tmp/clpt-test-motion-ref.pfm", *out = "/tmp/clpt-test-motion-out.pfm",
-               *ck = "/tmp/clpt-test-motion.ckpt";
+    const char *ref = TEST_TMP("clpt-test-motion-ref.pfm"), *out = TEST_TMP("clpt-test-motion-out.pfm"),
+               *ck = TEST_TMP("clpt-test-motion.ckpt");
     unlink(ck);
     cli_run(ARGS(scene, "--device", "scalar", "--spp", "8", "-q", "-o", ref), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);

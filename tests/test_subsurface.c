@@ -131,8 +131,8 @@ static void test_monotone(void)
 /* `subsurface 0` makes no medium: the bits of the material without any subsurface key. */
 static void test_weight_zero_unchanged(void)
 {
-    const char *with = "/tmp/clpt-test-sss-w0.pfm", *without = "/tmp/clpt-test-sss-none.pfm";
-    const char *scene_with = "/tmp/clpt-test-sss-w0.scene", *scene_without = "/tmp/clpt-test-sss-none.scene";
+    const char *with = TEST_TMP("clpt-test-sss-w0.pfm"), *without = TEST_TMP("clpt-test-sss-none.pfm");
+    const char *scene_with = TEST_TMP("clpt-test-sss-w0.scene"), *scene_without = TEST_TMP("clpt-test-sss-none.scene");
     const char *common = "image { width 24 height 16 spp 8 depth 6 }\n"
                          "camera { from 0 0.5 3 at 0 0 0 up 0 1 0 fov 40 }\n"
                          "background { color 0.3 0.4 0.5 }\n"
@@ -166,7 +166,7 @@ static void test_devices_match_scalar(void)
 {
     const char *scenes[] = { "scenes/subsurface.scene", "tests/data/subsurface/fog-and-instances.scene" };
     const char *modes[] = { "counted", "bounded", "megakernel" };
-    const char *ref = "/tmp/clpt-test-sss-scalar.pfm", *out = "/tmp/clpt-test-sss-ocl.pfm";
+    const char *ref = TEST_TMP("clpt-test-sss-scalar.pfm"), *out = TEST_TMP("clpt-test-sss-ocl.pfm");
     for (int k = 0; k < 2; k++) {
         const char *scene = scenes[k];
         /* the example draws the dragon of the team's shared models */

@@ -188,7 +188,9 @@ static const char *write_file(const char *name, const char *text)
     static char path[8][256];
     static int next;
     char *p = path[next++ % 8];
-    snprintf(p, 256, "/tmp/clpt-test-mesh-%s", name);
+    char leaf[128];
+    snprintf(leaf, sizeof leaf, "clpt-test-mesh-%s", name);
+    test_tmp_path(p, 256, leaf);
     FILE *f = fopen(p, "w");
     if (f) {
         fputs(text, f);
@@ -339,15 +341,17 @@ static void test_mesh_view(void)
     /* nothing to show */
     write_file("empty.obj", "v 0 0 0\n");
     scene_init(&s);
-    CHECK_EQ_INT(mesh_view_load("/tmp/clpt-test-mesh-empty.obj", &s, &err), ST_INPUT);
+    CHECK_EQ_INT(mesh_view_load(TEST_TMP("clpt-test-mesh-empty.obj"), &s, &err), ST_INPUT);
     CHECK_STR_CONTAINS(err.msg, "clpt-test-mesh-empty.obj: the mesh has no triangles to show");
     scene_free(&s);
     /* corners near the float range: the camera that frames them would be beyond it (the
      * message named the camera, not the file) */
     write_file("far.obj", "v 2e38 0 0\nv 0 2e38 0\nv 0 0 0\nf 1 2 3\n");
     scene_init(&s);
-    CHECK_EQ_INT(mesh_view_load("/tmp/clpt-test-mesh-far.obj", &s, &err), ST_INPUT);
-    CHECK_STR_CONTAINS(err.msg, "/tmp/clpt-test-mesh-far.obj: the mesh is too large to ");
+    CHECK_EQ_INT(mesh_view_load(TEST_TMP("clpt-test-mesh-far.obj"), &s, &err), ST_INPUT);
+    char want[512];
+    snprintf(want, sizeof want, "%s: the mesh is too large to ", TEST_TMP("clpt-test-mesh-far.obj"));
+    CHECK_STR_CONTAINS(err.msg, want);
     CHECK_STR_CONTAINS(err.msg, "beyond the largest float (about 3.4e38)");
     scene_free(&s);
     error_clear(&err);
@@ -383,8 +387,8 @@ static void test_sink_huge_corners(void)
 /* `clpt model.ply -o model.png` renders, with the mesh's name as the default output. */
 static void test_cli(void)
 {
-    char out[64];
-    snprintf(out, sizeof out, "/tmp/clpt-test-mesh-%d.png", (int)getpid());
+    char out[512];
+    test_tmp_path(out, sizeof out, "clpt-test-mesh.png");
     const char *args[] = { "tests/data/models/bun_zipper_res4.ply", "-o", out, "--spp", "2", "--width", "24",
                            "--height", "16", "--device", "scalar", "-q", "--stats", NULL };
     CliResult *r = malloc(sizeof *r);

@@ -234,13 +234,13 @@ static void test_pbrt_nanovdb_far(void)
     if (!data) return;
     double scale = 1e20;   /* the map's matD[0][0] (grid at 200, map at 296, matD at +88) */
     memcpy(data + 200 + 296 + 88, &scale, sizeof scale);
-    char path[64];
-    snprintf(path, sizeof path, "/tmp/clpt-test-nanovdb-%d.nvdb", (int)getpid());
+    char path[512];
+    test_tmp_path(path, sizeof path, "clpt-test-nanovdb.nvdb");
     FILE *f = fopen(path, "wb");
     CHECK(f && fwrite(data, 1, len, f) == len);
     if (f) fclose(f);
     free(data);
-    char text[256];
+    char text[1024];
     snprintf(text, sizeof text, "MakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" \"%s\"\n", path);
     Scene s;
     CHECK_EQ_INT(load_text(text, &s, &err), ST_INPUT);

@@ -433,15 +433,17 @@ static void test_obj_materials(void)
     /* an error inside an MTL names the MTL's line */
     scene_init(&s);
     const char *bad = "mtllib clpt-test-bad.mtl\n";
-    FILE *f = fopen("/tmp/clpt-test-bad.mtl", "w");
+    FILE *f = fopen(TEST_TMP("clpt-test-bad.mtl"), "w");
     if (f) {
         fputs("newmtl x\nKd 1 1 q\n", f);
         fclose(f);
     }
-    st = obj_parse("/tmp/clpt-test-scene.obj", bad, strlen(bad), &s, NO_INDEX, &err);
+    st = obj_parse(TEST_TMP("clpt-test-scene.obj"), bad, strlen(bad), &s, NO_INDEX, &err);
     CHECK_EQ_INT(st, ST_INPUT);
-    CHECK_STR_CONTAINS(err.msg, "/tmp/clpt-test-bad.mtl:2:8: expected a colour");
-    remove("/tmp/clpt-test-bad.mtl");
+    char want[512];
+    snprintf(want, sizeof want, "%s:2:8: expected a colour", TEST_TMP("clpt-test-bad.mtl"));
+    CHECK_STR_CONTAINS(err.msg, want);
+    remove(TEST_TMP("clpt-test-bad.mtl"));
     scene_free(&s);
 }
 

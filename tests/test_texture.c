@@ -432,8 +432,8 @@ static void test_truncated_images(void)
 {
     static const char *const names[] = { "tiny.tga", "tiny-rle.tga", "tiny.bmp", "tiny.psd", "tiny-rle.psd",
                                          "tiny.hdr", "tiny-rle.hdr" };
-    char cut_path[64];
-    snprintf(cut_path, sizeof cut_path, "/tmp/clpt-test-cut-%d.img", (int)getpid());
+    char cut_path[512];
+    test_tmp_path(cut_path, sizeof cut_path, "clpt-test-cut.img");
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
         char path[128];
         snprintf(path, sizeof path, "tests/data/images/%s", names[i]);

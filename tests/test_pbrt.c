@@ -1736,12 +1736,12 @@ static void test_film_filename(void)
     CHECK_NEAR(px[2], 1.0, 1e-6);
     /* -o wins */
     unlink(out);
-    cli_run((const char *[]){ scene, "-q", "--device", "scalar", "-o", "/tmp/clpt-test-film-o.pfm", NULL },
+    cli_run((const char *[]){ scene, "-q", "--device", "scalar", "-o", TEST_TMP("clpt-test-film-o.pfm"), NULL },
             &r);
     CHECK_EQ_INT(r.status, 0);
-    CHECK(file_exists("/tmp/clpt-test-film-o.pfm"));
+    CHECK(file_exists(TEST_TMP("clpt-test-film-o.pfm")));
     CHECK(!file_exists(out));
-    unlink("/tmp/clpt-test-film-o.pfm");
+    unlink(TEST_TMP("clpt-test-film-o.pfm"));
     unlink(scene);
 
     expect_error("Film \"rgb\" \"string filename\" \"render.tga\"\n",

@@ -257,8 +257,10 @@ static void test_time_limit_within_one_batch(void)
     double secs = timer_now() - t0;
     CHECK_MSG(r.status == 0, "%s", r.err);
     CHECK_STR_CONTAINS(r.err, "time limit reached");
-    /* a batch is about 0.25 s; allow it, plus start-up and writing */
-    CHECK_MSG(secs < 1.5 + 0.25 + 1.0, "took %.2f s with a 1.5 s limit", secs);
+    /* a batch is about 0.25 s; allow it, plus start-up and writing, which took up to
+     * 1.3 s on a 2-core machine at load 12 (2.76 s in all, 2026-11-28); the render
+     * itself would take hours */
+    CHECK_MSG(secs < 1.5 + 0.25 + 2.0, "took %.2f s with a 1.5 s limit", secs);
     CHECK(file_exists(out));
     unlink(out);
 }

@@ -704,8 +704,10 @@ static void test_cli_frames(void)
                               "the render from 1 to 2");
     CHECK(files_equal(CLI_DIR "/resumed_0024.pfm", CLI_DIR "/first_0024.pfm"));
     /* an unfinished frame (its time limit) writes its checkpoint and no image, exit
-     * status 7; --resume finishes it, the same bits as the frame rendered at once */
-    const char *a7[] = { base[0], base[1], "--spp", "64", base[4], base[5], base[6], base[7], "--batch", "1",
+     * status 7; --resume finishes it, the same bits as the frame rendered at once.
+     * 4096 samples: on an idle machine the scheduler's growing batches finished 64
+     * before the limit was looked at */
+    const char *a7[] = { base[0], base[1], "--spp", "4096", base[4], base[5], base[6], base[7], "--batch", "1",
                          "--time-limit", "0.001", "--frames", "24:24", "--checkpoint", CLI_DIR "/ck2.ckpt", "-o",
                          CLI_DIR "/cut.pfm", CLI_DIR "/anim.gltf", NULL };
     cli_run(a7, &r);
@@ -713,12 +715,12 @@ static void test_cli_frames(void)
     CHECK_STR_CONTAINS(r.err, "clpt: the frame is unfinished: '" CLI_DIR "/cut_0024.pfm' is not written; --resume "
                               "goes on from its checkpoint");
     CHECK(!file_exists(CLI_DIR "/cut_0024.pfm") && file_exists(CLI_DIR "/ck2_0024.ckpt"));
-    const char *a8[] = { base[0], base[1], "--spp", "64", base[4], base[5], base[6], base[7], base[8], "--batch", "1",
+    const char *a8[] = { base[0], base[1], "--spp", "4096", base[4], base[5], base[6], base[7], base[8], "--batch", "1",
                          "--frames", "24:24", "--resume", CLI_DIR "/ck2.ckpt", "-o", CLI_DIR "/cut.pfm",
                          CLI_DIR "/anim.gltf", NULL };
     cli_run(a8, &r);
     CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
-    const char *a9[] = { base[0], base[1], "--spp", "64", base[4], base[5], base[6], base[7], base[8], "--frames",
+    const char *a9[] = { base[0], base[1], "--spp", "4096", base[4], base[5], base[6], base[7], base[8], "--frames",
                          "24:24", "-o", CLI_DIR "/whole.pfm", CLI_DIR "/anim.gltf", NULL };
     cli_run(a9, &r);
     CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);

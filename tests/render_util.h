@@ -102,4 +102,22 @@ static inline size_t film_sums_same(const Film *a, const Film *b)
     return same;
 }
 
+/* Loads the scene `text` (named `name` in messages), renders it on `devices` and puts
+ * its channel means in mean[3]: the whole-image check of the media, grid, emission and
+ * subsurface tests. */
+static inline Status render_util_text_means(const char *name, const char *text, const char *devices, double mean[3],
+                                            Error *err)
+{
+    Scene s;
+    Film f;
+    memset(&f, 0, sizeof f);
+    scene_init(&s);
+    Status st = scene_load_text(name, text, strlen(text), &s, err);
+    if (!st) st = render_util_run(&s, devices, 0, &f, err);
+    if (!st) film_channel_means(&f, mean);
+    film_free(&f);
+    scene_free(&s);
+    return st;
+}
+
 #endif /* CLPT_RENDER_UTIL_H */

@@ -26,17 +26,9 @@ static CliResult r;
 /* Renders `text` on `devices` and returns its channel means. */
 static int render_means(const char *text, const char *devices, double mean[3])
 {
-    Scene s;
     Error err = { 0 };
-    Film f;
-    memset(&f, 0, sizeof f);
-    scene_init(&s);
-    Status st = scene_load_text("emission-test.scene", text, strlen(text), &s, &err);
-    if (!st) st = render_util_run(&s, devices, 0, &f, &err);
+    Status st = render_util_text_means("emission-test.scene", text, devices, mean, &err);
     CHECK_MSG(st == ST_OK, "%s", err.msg);
-    if (!st) film_channel_means(&f, mean);
-    film_free(&f);
-    scene_free(&s);
     error_clear(&err);
     return st == ST_OK;
 }

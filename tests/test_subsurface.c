@@ -47,25 +47,12 @@ static void test_albedo_inversion(void)
     CHECK(sa.z == 0.0f);
 }
 
-static Status load_text(Scene *s, const char *text, Error *err)
-{
-    scene_init(s);
-    return scene_load_text("subsurface-test.scene", text, strlen(text), s, err);
-}
-
 /* Renders `text` on `devices` and returns its channel means. */
 static int render_means(const char *text, const char *devices, double mean[3])
 {
-    Scene s;
     Error err = { 0 };
-    Film f;
-    memset(&f, 0, sizeof f);
-    Status st = load_text(&s, text, &err);
-    if (!st) st = render_util_run(&s, devices, 0, &f, &err);
+    Status st = render_util_text_means("subsurface-test.scene", text, devices, mean, &err);
     CHECK_MSG(st == ST_OK, "%s", err.msg);
-    if (!st) film_channel_means(&f, mean);
-    film_free(&f);
-    scene_free(&s);
     error_clear(&err);
     return st == ST_OK;
 }

@@ -196,8 +196,9 @@ SO_OBJ      := $(filter-out $(BUILD)/host/viewer/% $(BUILD)/host/dist/% $(BUILD)
 
 lib: $(BUILD)/lib$(PROG).so
 
-$(SO_FILE): $(SO_OBJ)
-	$(CC) -shared -Wl,-soname,$(SO_NAME) $(SO_DEFS) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+$(SO_FILE): $(SO_OBJ) host/api/libclpt.map
+	$(CC) -shared -Wl,-soname,$(SO_NAME) -Wl,--version-script=host/api/libclpt.map $(SO_DEFS) \
+	    $(LDFLAGS) -o $@ $(SO_OBJ) $(LDLIBS)
 
 $(BUILD)/lib$(PROG).so: $(SO_FILE)
 	ln -sf $(notdir $(SO_FILE)) $(BUILD)/$(SO_NAME)

@@ -3,10 +3,12 @@
 #ifndef CLPT_RENDER_UTIL_H
 #define CLPT_RENDER_UTIL_H
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "device/device.h"
+#include "io/scene_load.h"
 #include "render/film.h"
 #include "render/render_scene.h"
 #include "render/schedule.h"
@@ -117,6 +119,99 @@ static inline Status render_util_text_means(const char *name, const char *text, 
     if (!st) film_channel_means(&f, mean);
     film_free(&f);
     scene_free(&s);
+    return st;
+}
+
+/* Loads the scene `text` (named `name` in messages, read as `format`) and renders it on
+ * `devices` into film (initialised here; free it with film_free). */
+static inline Status render_util_text_film(const char *name, const char *text, SceneFormat format,
+                                           const char *devices, Film *film, Error *err)
+{
+    Scene s;
+    memset(film, 0, sizeof *film);
+    scene_init(&s);
+    Status st = scene_load_bytes(name, text, strlen(text), format, &s, NULL, err);
+    if (!st) st = render_util_run(&s, devices, 0, film, err);
+    scene_free(&s);
+    return st;
+}
+
+/* The largest difference of a's and b's channel sums over bw x bh pixel blocks of a
+ * width x height image, relative to ref's sum in the same block (at least 1e-3): the
+ * within-noise comparison of the motion-blur tests, where a pixel alone is too noisy. */
+static inline double render_util_block_diff(const float *a, const float *b, const float *ref, int width, int height,
+                                            int bw, int bh)
+{
+    double worst = 0.0;
+    for (int by = 0; by < height / bh; by++)
+        for (int bx = 0; bx < width / bw; bx++)
+            for (int c = 0; c < 3; c++) {
+                double sa = 0, sb = 0, sr = 0;
+                for (int y = by * bh; y < by * bh + bh; y++)
+                    for (int x = bx * bw; x < bx * bw + bw; x++) {
+                        size_t i = ((size_t)y * (size_t)width + (size_t)x) * 3 + (size_t)c;
+                        sa += a[i];
+                        sb += b[i];
+                        sr += ref[i];
+                    }
+                worst = fmax(worst, fabs(sa - sb) / fmax(sr, 1e-3));
+            }
+    return worst;
+}
+
+/* Writes the scene text of the still frame at shutter time u in [0, 1]. */
+typedef void (*RenderUtilStillText)(double u, char *text, size_t size);
+
+/* A motion-blurred render and the still ones it is checked against, each n floats of
+ * linear RGB: the still renders at the times u = (i + 1/2) / k (the shutter's midpoint
+ * rule) averaged, and the one at i = k / 2 alone. */
+typedef struct {
+    size_t n;
+    float *moving, *average, *middle;
+} RenderUtilMotionImages;
+
+static inline void render_util_motion_images_free(RenderUtilMotionImages *im)
+{
+    free(im->moving);
+    free(im->average);
+    free(im->middle);
+    memset(im, 0, sizeof *im);
+}
+
+/* Renders the scene text `moving` and the k still scenes `still` writes (all named
+ * `name`, read as `format`, on the scalar device) into im (freed with
+ * render_util_motion_images_free, on failure too). */
+static inline Status render_util_motion_images(const char *name, SceneFormat format, const char *moving,
+                                               RenderUtilStillText still, int k, RenderUtilMotionImages *im,
+                                               Error *err)
+{
+    enum { TEXT_SIZE = 8192 };
+    Film film;
+    memset(im, 0, sizeof *im);
+    Status st = render_util_text_film(name, moving, format, "scalar", &film, err);
+    if (st) return st;
+    im->n = (size_t)film.width * film.height * 3u;
+    im->moving = calloc(im->n, sizeof *im->moving);
+    im->average = calloc(im->n, sizeof *im->average);
+    im->middle = calloc(im->n, sizeof *im->middle);
+    char *text = malloc(TEXT_SIZE);
+    float *rgb = malloc(im->n * sizeof *rgb);
+    if (!im->moving || !im->average || !im->middle || !text || !rgb)
+        st = error_set(err, ST_INTERNAL, "out of memory");
+    else
+        film_resolve(&film, im->moving);
+    film_free(&film);
+    for (int i = 0; !st && i < k; i++) {
+        still((i + 0.5) / k, text, TEXT_SIZE);
+        st = render_util_text_film(name, text, format, "scalar", &film, err);
+        if (!st) film_resolve(&film, rgb);
+        film_free(&film);
+        if (st) break;
+        for (size_t j = 0; j < im->n; j++) im->average[j] += rgb[j] / k;
+        if (i == k / 2) memcpy(im->middle, rgb, im->n * sizeof *im->middle);
+    }
+    free(rgb);
+    free(text);
     return st;
 }
 

@@ -93,19 +93,9 @@ static void test_interpolation(void)
     CHECK(max_diff(&after, &b) < 1e-5);
 }
 
-static Status load_text(const char *text, Scene *s, Error *err)
-{
-    scene_init(s);
-    return scene_load_text("motion.scene", text, strlen(text), s, err);
-}
-
 static Status render_text(const char *text, Film *film, Error *err)
 {
-    Scene s;
-    Status st = load_text(text, &s, err);
-    if (!st) st = render_util_run(&s, "scalar", 0, film, err);
-    scene_free(&s);
-    return st;
+    return render_util_text_film("motion.scene", text, SCENE_FORMAT_CLPT, "scalar", film, err);
 }
 
 #define STILL_SCENE                                                                      \
@@ -116,60 +106,49 @@ static Status render_text(const char *text, Film *film, Error *err)
     "sphere { center 0 1 0 radius 1 material { type diffuse albedo 0.8 0.2 0.2 } }\n"     \
     "sphere { center 1.6 0.5 0.5 radius 0.5 material { type diffuse albedo 0.2 0.8 0.2 } }\n"
 
+enum { W = 40, H = 30, K = 8, SPP_STILL = 64 };
+
+/* Renders `moving` (K * SPP_STILL samples) and the K still scenes `still` writes;
+ * checks, in 8 x 6 pixel blocks, that the moving image is their average within `tol`
+ * and far (> 0.1, relative to the average) from the middle still one, so that a render
+ * with no blur at all fails. */
+static void check_moving_against_stills(const char *what, const char *moving, RenderUtilStillText still, double tol)
+{
+    Error err = { 0 };
+    RenderUtilMotionImages im;
+    Status st = render_util_motion_images("motion.scene", SCENE_FORMAT_CLPT, moving, still, K, &im, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (st == ST_OK) {
+        double worst = render_util_block_diff(im.moving, im.average, im.average, W, H, 8, 6);
+        double worst_mid = render_util_block_diff(im.moving, im.middle, im.average, W, H, 8, 6);
+        fprintf(stderr, "  blocks: %s against the average of still ones %.2f%%, against the middle one %.2f%%\n", what,
+                100.0 * worst, 100.0 * worst_mid);
+        CHECK(worst < tol);
+        CHECK(worst_mid > 0.1);
+    }
+    render_util_motion_images_free(&im);
+}
+
+/* The still camera at x on the sweep below, at shutter time u. */
+static void camera_still(double u, char *text, size_t size)
+{
+    double x = -0.8 + 1.6 * u;
+    snprintf(text, size, STILL_SCENE "camera { from %.9g 1.4 6 at %.9g 1 0 fov 35 }\n", (unsigned)SPP_STILL, x, x);
+}
+
 /* The camera sweeping from x = -0.8 to 0.8 over the shutter sees, per pixel, the mean
  * of what still cameras along the sweep see: the moving render against the average of
- * 8 still renders at the times (k + 1/2) / 8, within noise (8 x 6 pixel blocks), while
- * the still camera at the sweep's middle is far from it (the test would notice no blur). */
+ * 8 still renders at the times (k + 1/2) / 8, within noise (8 x 6 pixel blocks, 48
+ * samples of 512 each), while the still camera at the sweep's middle is far from it
+ * (the test would notice no blur). */
 static void test_moving_camera_is_average_of_still(void)
 {
-    enum { K = 8, SPP_STILL = 64 };
     char text[2048];
-    Error err = { 0 };
-    Film moving, still;
     snprintf(text, sizeof text,
              STILL_SCENE "camera { from -0.8 1.4 6 at -0.8 1 0 fov 35 shutter 0 1 }\n"
                          "camera_key { time 1 from 0.8 1.4 6 at 0.8 1 0 }\n",
              (unsigned)(K * SPP_STILL));
-    CHECK_MSG(render_text(text, &moving, &err) == ST_OK, "%s", err.msg);
-    size_t n = (size_t)40 * 30 * 3;
-    float *a = calloc(n, sizeof *a), *avg = calloc(n, sizeof *avg), *mid = calloc(n, sizeof *mid);
-    film_resolve(&moving, a);
-    for (int k = 0; k < K; k++) {
-        double x = -0.8 + 1.6 * (k + 0.5) / K;
-        snprintf(text, sizeof text, STILL_SCENE "camera { from %.9g 1.4 6 at %.9g 1 0 fov 35 }\n", (unsigned)SPP_STILL,
-                 x, x);
-        CHECK_MSG(render_text(text, &still, &err) == ST_OK, "%s", err.msg);
-        float *rgb = calloc(n, sizeof *rgb);
-        film_resolve(&still, rgb);
-        for (size_t i = 0; i < n; i++) avg[i] += rgb[i] / K;
-        if (k == K / 2) memcpy(mid, rgb, n * sizeof *mid);
-        free(rgb);
-        film_free(&still);
-    }
-    /* block means: 8 x 6 pixel blocks (48 samples of 512 each) */
-    double worst = 0.0, worst_mid = 0.0;
-    for (int by = 0; by < 5; by++)
-        for (int bx = 0; bx < 5; bx++)
-            for (int c = 0; c < 3; c++) {
-                double sa = 0, sb = 0, sm = 0;
-                for (int y = by * 6; y < by * 6 + 6; y++)
-                    for (int x = bx * 8; x < bx * 8 + 8; x++) {
-                        size_t i = ((size_t)y * 40 + x) * 3 + c;
-                        sa += a[i];
-                        sb += avg[i];
-                        sm += mid[i];
-                    }
-                worst = fmax(worst, fabs(sa - sb) / fmax(sb, 1e-3));
-                worst_mid = fmax(worst_mid, fabs(sa - sm) / fmax(sb, 1e-3));
-            }
-    fprintf(stderr, "  blocks: moving against the average of still cameras %.2f%%, against the middle one %.2f%%\n",
-            100.0 * worst, 100.0 * worst_mid);
-    CHECK(worst < 0.02);
-    CHECK(worst_mid > 0.1);
-    free(a);
-    free(avg);
-    free(mid);
-    film_free(&moving);
+    check_moving_against_stills("moving camera", text, camera_still, 0.02);
 }
 
 /* A sliding, turning and growing instance seen by a still camera: its image is the
@@ -182,55 +161,20 @@ static void test_moving_camera_is_average_of_still(void)
                 "object thing { sphere { center 0 0 0 radius 0.5 material { type diffuse albedo 0.9 0.9 0.2 } }\n" \
                 "  box { min 0.3 -0.2 -0.2 max 0.9 0.2 0.2 material { type diffuse albedo 0.2 0.2 0.9 } } }\n"
 
+static void instance_still(double u, char *text, size_t size)
+{
+    snprintf(text, size, INSTANCE_SCENE "instance thing { scale %.9g ry %.9g translate %.9g %.9g 0.5 }\n",
+             (unsigned)SPP_STILL, 1.0 + 0.5 * u, 120.0 * u, -1.2 + 2.4 * u, 2.0 + 0.2 * u);
+}
+
 static void test_moving_instance_is_average_of_still(void)
 {
-    enum { K = 8, SPP_STILL = 64 };
     char text[4096];
-    Error err = { 0 };
-    Film moving, still;
     snprintf(text, sizeof text,
              INSTANCE_SCENE "instance thing { translate -1.2 2 0.5 }\n"
                             "instance_key { time 1 scale 1.5 ry 120 translate 1.2 2.2 0.5 }\n",
              (unsigned)(K * SPP_STILL));
-    CHECK_MSG(render_text(text, &moving, &err) == ST_OK, "%s", err.msg);
-    size_t n = (size_t)40 * 30 * 3;
-    float *a = calloc(n, sizeof *a), *avg = calloc(n, sizeof *avg), *mid = calloc(n, sizeof *mid);
-    film_resolve(&moving, a);
-    for (int k = 0; k < K; k++) {
-        double u = (k + 0.5) / K;
-        snprintf(text, sizeof text, INSTANCE_SCENE "instance thing { scale %.9g ry %.9g translate %.9g %.9g 0.5 }\n",
-                 (unsigned)SPP_STILL, 1.0 + 0.5 * u, 120.0 * u, -1.2 + 2.4 * u, 2.0 + 0.2 * u);
-        CHECK_MSG(render_text(text, &still, &err) == ST_OK, "%s", err.msg);
-        float *rgb = calloc(n, sizeof *rgb);
-        film_resolve(&still, rgb);
-        for (size_t i = 0; i < n; i++) avg[i] += rgb[i] / K;
-        if (k == K / 2) memcpy(mid, rgb, n * sizeof *mid);
-        free(rgb);
-        film_free(&still);
-    }
-    double worst = 0.0, worst_mid = 0.0;
-    for (int by = 0; by < 5; by++)
-        for (int bx = 0; bx < 5; bx++)
-            for (int c = 0; c < 3; c++) {
-                double sa = 0, sb = 0, sm = 0;
-                for (int y = by * 6; y < by * 6 + 6; y++)
-                    for (int x = bx * 8; x < bx * 8 + 8; x++) {
-                        size_t i = ((size_t)y * 40 + x) * 3 + c;
-                        sa += a[i];
-                        sb += avg[i];
-                        sm += mid[i];
-                    }
-                worst = fmax(worst, fabs(sa - sb) / fmax(sb, 1e-3));
-                worst_mid = fmax(worst_mid, fabs(sa - sm) / fmax(sb, 1e-3));
-            }
-    fprintf(stderr, "  blocks: moving instance against the average of still ones %.2f%%, against the middle one %.2f%%\n",
-            100.0 * worst, 100.0 * worst_mid);
-    CHECK(worst < 0.03);
-    CHECK(worst_mid > 0.1);
-    free(a);
-    free(avg);
-    free(mid);
-    film_free(&moving);
+    check_moving_against_stills("moving instance", text, instance_still, 0.03);
 }
 
 /* motion_bounds holds the box's corners at every time, sampled far more finely than

@@ -24,11 +24,7 @@ static Status load_text(const char *text, Scene *s, Error *err)
 
 static Status render_text(const char *text, Film *film, Error *err)
 {
-    Scene s;
-    Status st = load_text(text, &s, err);
-    if (!st) st = render_util_run(&s, "scalar", 0, film, err);
-    scene_free(&s);
-    return st;
+    return render_util_text_film("tests/data/inline.pbrt", text, SCENE_FORMAT_AUTO, "scalar", film, err);
 }
 
 enum { W = 40, H = 30, K = 8, SPP_STILL = 64 };
@@ -64,58 +60,25 @@ enum { W = 40, H = 30, K = 8, SPP_STILL = 64 };
     "    \"integer indices\" [0 1 2 0 2 3]\n"                                            \
     "ObjectEnd\n"
 
-/* The largest relative difference of a and b over 8 x 6 pixel blocks, per channel. */
-static double block_diff(const float *a, const float *b)
-{
-    double worst = 0.0;
-    for (int by = 0; by < H / 6; by++)
-        for (int bx = 0; bx < W / 8; bx++)
-            for (int c = 0; c < 3; c++) {
-                double sa = 0, sb = 0;
-                for (int y = by * 6; y < by * 6 + 6; y++)
-                    for (int x = bx * 8; x < bx * 8 + 8; x++) {
-                        size_t i = ((size_t)y * W + x) * 3 + c;
-                        sa += a[i];
-                        sb += b[i];
-                    }
-                worst = fmax(worst, fabs(sa - sb) / fmax(sb, 1e-3));
-            }
-    return worst;
-}
-
-/* Renders `moving` (K * SPP_STILL samples) and the K still scenes still(k, u, text)
- * writes for the times u = (k + 1/2) / K; checks the moving image is their average
- * within `tol`, and far (> 0.1) from the middle still one. */
-typedef void (*StillText)(double u, char *text, size_t size);
-static void check_average(const char *what, const char *moving, StillText still, double tol)
+/* Renders `moving` (K * SPP_STILL samples) and the K still scenes `still` writes for
+ * the times u = (k + 1/2) / K; checks the moving image is their average within `tol`,
+ * and far (> 0.1, relative to the middle one) from the middle still one, in 8 x 6
+ * pixel blocks. */
+static void check_average(const char *what, const char *moving, RenderUtilStillText still, double tol)
 {
     Error err = { 0 };
-    Film film;
-    size_t n = (size_t)W * H * 3;
-    float *a = calloc(n, sizeof *a), *avg = calloc(n, sizeof *avg), *mid = calloc(n, sizeof *mid),
-          *rgb = calloc(n, sizeof *rgb);
-    char *text = malloc(8192);
-    CHECK_MSG(render_text(moving, &film, &err) == ST_OK, "%s", err.msg);
-    film_resolve(&film, a);
-    film_free(&film);
-    for (int k = 0; k < K; k++) {
-        still((k + 0.5) / K, text, 8192);
-        CHECK_MSG(render_text(text, &film, &err) == ST_OK, "%s", err.msg);
-        film_resolve(&film, rgb);
-        film_free(&film);
-        for (size_t i = 0; i < n; i++) avg[i] += rgb[i] / K;
-        if (k == K / 2) memcpy(mid, rgb, n * sizeof *mid);
+    RenderUtilMotionImages im;
+    Status st = render_util_motion_images("tests/data/inline.pbrt", SCENE_FORMAT_AUTO, moving, still, K, &im, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (st == ST_OK) {
+        double worst = render_util_block_diff(im.moving, im.average, im.average, W, H, 8, 6);
+        double worst_mid = render_util_block_diff(im.moving, im.middle, im.middle, W, H, 8, 6);
+        fprintf(stderr, "  %s: blocks against the average of still ones %.2f%%, against the middle one %.2f%%\n", what,
+                100.0 * worst, 100.0 * worst_mid);
+        CHECK(worst < tol);
+        CHECK(worst_mid > 0.1);
     }
-    double worst = block_diff(a, avg), worst_mid = block_diff(a, mid);
-    fprintf(stderr, "  %s: blocks against the average of still ones %.2f%%, against the middle one %.2f%%\n", what,
-            100.0 * worst, 100.0 * worst_mid);
-    CHECK(worst < tol);
-    CHECK(worst_mid > 0.1);
-    free(a);
-    free(avg);
-    free(mid);
-    free(rgb);
-    free(text);
+    render_util_motion_images_free(&im);
 }
 
 /* An ObjectInstance sliding, turning 120 degrees and growing by half between

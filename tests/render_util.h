@@ -4,6 +4,7 @@
 #define CLPT_RENDER_UTIL_H
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -166,6 +167,7 @@ typedef void (*RenderUtilStillText)(double u, char *text, size_t size);
  * linear RGB: the still renders at the times u = (i + 1/2) / k (the shutter's midpoint
  * rule) averaged, and the one at i = k / 2 alone. */
 typedef struct {
+    uint width, height;
     size_t n;
     float *moving, *average, *middle;
 } RenderUtilMotionImages;
@@ -190,6 +192,8 @@ static inline Status render_util_motion_images(const char *name, SceneFormat for
     memset(im, 0, sizeof *im);
     Status st = render_util_text_film(name, moving, format, "scalar", &film, err);
     if (st) return st;
+    im->width = film.width;
+    im->height = film.height;
     im->n = (size_t)film.width * film.height * 3u;
     im->moving = calloc(im->n, sizeof *im->moving);
     im->average = calloc(im->n, sizeof *im->average);
@@ -212,6 +216,29 @@ static inline Status render_util_motion_images(const char *name, SceneFormat for
     }
     free(rgb);
     free(text);
+    return st;
+}
+
+/* The motion-blur check's two measures over 8 x 6 pixel blocks: *worst, how far the
+ * moving render is from the still ones' average (relative to the average), and
+ * *worst_mid, how far from the middle still one (relative to the middle one's sums when
+ * mid_by_middle, else the average's: each test keeps the measure it was written with).
+ * Both are 0 when a render failed; both are printed to stderr after `what`. */
+static inline Status render_util_motion_diffs(const char *what, const char *name, SceneFormat format,
+                                              const char *moving, RenderUtilStillText still, int k, int mid_by_middle,
+                                              double *worst, double *worst_mid, Error *err)
+{
+    RenderUtilMotionImages im;
+    *worst = *worst_mid = 0.0;
+    Status st = render_util_motion_images(name, format, moving, still, k, &im, err);
+    if (!st) {
+        int w = (int)im.width, h = (int)im.height;
+        *worst = render_util_block_diff(im.moving, im.average, im.average, w, h, 8, 6);
+        *worst_mid = render_util_block_diff(im.moving, im.middle, mid_by_middle ? im.middle : im.average, w, h, 8, 6);
+        fprintf(stderr, "  %s: blocks against the average of still ones %.2f%%, against the middle one %.2f%%\n",
+                what, 100.0 * *worst, 100.0 * *worst_mid);
+    }
+    render_util_motion_images_free(&im);
     return st;
 }
 

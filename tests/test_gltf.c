@@ -65,6 +65,50 @@ static Status load_triangle(const char *material_json, Scene *s, Error *err)
     return scene_load_bytes("alpha.gltf", text, strlen(text), SCENE_FORMAT_AUTO, s, NULL, err);
 }
 
+/* The material of load_triangle's triangle when its material is `json`; NULL (and a
+ * failed check) when the file did not load. */
+static const Material *triangle_material(const char *json, Scene *s)
+{
+    Error err = { 0 };
+    Status st = load_triangle(json, s, &err);
+    CHECK_MSG(st == ST_OK, "%s: %s", json, err.msg);
+    error_clear(&err);
+    return st == ST_OK ? &s->materials[s->triangles[0].material] : NULL;
+}
+
+/* A material the reader refuses, and the message it must give. */
+typedef struct {
+    const char *json, *msg;
+} RefusedMaterial;
+
+/* The material `json` on load_triangle's triangle: refused (ST_INPUT) with `msg` as the
+ * whole message when `exact`, else within it. */
+static void check_refused(const char *json, const char *msg, int exact)
+{
+    Scene s;
+    Error err = { 0 };
+    Status st = load_triangle(json, &s, &err);
+    CHECK_EQ_INT(st, ST_INPUT);
+    if (exact)
+        CHECK_MSG(strcmp(err.msg, msg) == 0, "got '%s'", err.msg);
+    else
+        CHECK_STR_CONTAINS(err.msg, msg);
+    fprintf(stderr, "  %s\n", err.msg);
+    error_clear(&err);
+    scene_free(&s);
+}
+
+/* check_refused for each case's json as the object of the material's extension
+ * `extension`, its message within the error's. */
+static void check_refused_extension(const char *extension, const RefusedMaterial *cases, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        char json[256];
+        snprintf(json, sizeof json, "{\"extensions\":{\"%s\":%s}}", extension, cases[i].json);
+        check_refused(json, cases[i].msg, 0);
+    }
+}
+
 /* KHR_materials_volume, _specular and _sheen map onto the principled material: a volume
  * with thickness > 0 is a solid (no MAT_THIN) with sigma_a = -ln(attenuationColor) /
  * attenuationDistance; thickness 0 stays a thin wall; the specular and sheen factors
@@ -72,20 +116,15 @@ static Status load_triangle(const char *material_json, Scene *s, Error *err)
 static void test_volume_specular_sheen(void)
 {
     Scene s;
-    Error err = { 0 };
-    Status st = load_triangle("{\"extensions\":{"
-                              "\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
-                              "\"KHR_materials_volume\":{\"thicknessFactor\":0.1,"
-                              "\"attenuationColor\":[0.5,0.25,1],\"attenuationDistance\":2},"
-                              "\"KHR_materials_specular\":{\"specularFactor\":0.3,"
-                              "\"specularColorFactor\":[1,0.5,2]},"
-                              "\"KHR_materials_sheen\":{\"sheenColorFactor\":[0.9,0.8,0.7],"
-                              "\"sheenRoughnessFactor\":0.6}}}",
-                              &s, &err);
-    CHECK_MSG(st == ST_OK, "%s", err.msg);
-    error_clear(&err);
-    if (st == ST_OK) {
-        const Material *m = &s.materials[s.triangles[0].material];
+    const Material *m = triangle_material("{\"extensions\":{"
+                                          "\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+                                          "\"KHR_materials_volume\":{\"thicknessFactor\":0.1,"
+                                          "\"attenuationColor\":[0.5,0.25,1],\"attenuationDistance\":2},"
+                                          "\"KHR_materials_specular\":{\"specularFactor\":0.3,"
+                                          "\"specularColorFactor\":[1,0.5,2]},"
+                                          "\"KHR_materials_sheen\":{\"sheenColorFactor\":[0.9,0.8,0.7],"
+                                          "\"sheenRoughnessFactor\":0.6}}}", &s);
+    if (m) {
         CHECK((m->flags & MAT_THIN) == 0u);
         check_v3(m->absorption, log(2.0) / 2.0, log(4.0) / 2.0, 0.0, 1e-6);
         CHECK_NEAR(m->specular_factor, 0.3, 1e-6);
@@ -97,24 +136,17 @@ static void test_volume_specular_sheen(void)
     }
     scene_free(&s);
     /* thickness 0 (the default): the thin wall of KHR_materials_transmission stays */
-    st = load_triangle("{\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
-                       "\"KHR_materials_volume\":{\"attenuationColor\":[0.5,0.5,0.5]}}}", &s, &err);
-    CHECK_MSG(st == ST_OK, "%s", err.msg);
-    error_clear(&err);
-    if (st == ST_OK) {
-        const Material *m = &s.materials[s.triangles[0].material];
+    m = triangle_material("{\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+                          "\"KHR_materials_volume\":{\"attenuationColor\":[0.5,0.5,0.5]}}}", &s);
+    if (m) {
         CHECK((m->flags & MAT_THIN) != 0u);
         check_v3(m->specular_color, 1.0, 1.0, 1.0, 0);
         CHECK_NEAR(m->specular_factor, 1.0, 0);
     }
     scene_free(&s);
     /* values out of range are errors naming the JSON path */
-    st = load_triangle("{\"extensions\":{\"KHR_materials_sheen\":{\"sheenRoughnessFactor\":2}}}", &s, &err);
-    CHECK(st == ST_INPUT);
-    CHECK_STR_CONTAINS(err.msg, "materials[0].extensions.KHR_materials_sheen.sheenRoughnessFactor: expected a "
-                                "number from 0 to 1");
-    error_clear(&err);
-    scene_free(&s);
+    check_refused("{\"extensions\":{\"KHR_materials_sheen\":{\"sheenRoughnessFactor\":2}}}",
+                  "materials[0].extensions.KHR_materials_sheen.sheenRoughnessFactor: expected a number from 0 to 1", 0);
 }
 
 /* KHR_materials_diffuse_transmission onto the principled material: the factor and
@@ -123,14 +155,9 @@ static void test_volume_specular_sheen(void)
 static void test_diffuse_transmission(void)
 {
     Scene s;
-    Error err = { 0 };
-    Status st = load_triangle("{\"extensions\":{\"KHR_materials_diffuse_transmission\":{"
-                              "\"diffuseTransmissionFactor\":0.75,\"diffuseTransmissionColorFactor\":[1,0.5,0.25]}}}",
-                              &s, &err);
-    CHECK_MSG(st == ST_OK, "%s", err.msg);
-    error_clear(&err);
-    if (st == ST_OK) {
-        const Material *m = &s.materials[s.triangles[0].material];
+    const Material *m = triangle_material("{\"extensions\":{\"KHR_materials_diffuse_transmission\":{"
+                                          "\"diffuseTransmissionFactor\":0.75,\"diffuseTransmissionColorFactor\":[1,0.5,0.25]}}}", &s);
+    if (m) {
         CHECK((m->flags & MAT_THIN) != 0u);
         CHECK_NEAR(m->diffuse_transmission, 0.75, 0);
         check_v3(m->diffuse_transmission_color, 1.0, 0.5, 0.25, 0);
@@ -139,22 +166,17 @@ static void test_diffuse_transmission(void)
     }
     scene_free(&s);
     /* with a volume: a solid; without the extension: none, the colour white */
-    st = load_triangle("{\"extensions\":{\"KHR_materials_diffuse_transmission\":{\"diffuseTransmissionFactor\":1},"
-                       "\"KHR_materials_volume\":{\"thicknessFactor\":0.2}}}", &s, &err);
-    CHECK_MSG(st == ST_OK, "%s", err.msg);
-    error_clear(&err);
-    if (st == ST_OK) CHECK((s.materials[s.triangles[0].material].flags & MAT_THIN) == 0u);
+    m = triangle_material("{\"extensions\":{\"KHR_materials_diffuse_transmission\":{\"diffuseTransmissionFactor\":1},"
+                          "\"KHR_materials_volume\":{\"thicknessFactor\":0.2}}}", &s);
+    if (m) CHECK((m->flags & MAT_THIN) == 0u);
     scene_free(&s);
-    st = load_triangle("{}", &s, &err);
-    CHECK_MSG(st == ST_OK, "%s", err.msg);
-    error_clear(&err);
-    if (st == ST_OK) {
-        const Material *m = &s.materials[s.triangles[0].material];
+    m = triangle_material("{}", &s);
+    if (m) {
         CHECK(m->diffuse_transmission == 0.0f && (m->flags & MAT_THIN) == 0u);
         check_v3(m->diffuse_transmission_color, 1.0, 1.0, 1.0, 0);
     }
     scene_free(&s);
-    static const struct { const char *json, *msg; } bad[] = {
+    static const RefusedMaterial bad[] = {
         { "{\"diffuseTransmissionFactor\":1.5}",
           "alpha.gltf: materials[0].extensions.KHR_materials_diffuse_transmission.diffuseTransmissionFactor: "
           "expected a number from 0 to 1" },
@@ -174,16 +196,7 @@ static void test_diffuse_transmission(void)
           "alpha.gltf: materials[0].extensions.KHR_materials_diffuse_transmission.diffuseTransmissionColorTexture"
           ".index: textures[-1] does not exist (the file has 0)" },
     };
-    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-        char json[256];
-        snprintf(json, sizeof json, "{\"extensions\":{\"KHR_materials_diffuse_transmission\":%s}}", bad[i].json);
-        st = load_triangle(json, &s, &err);
-        CHECK_EQ_INT(st, ST_INPUT);
-        CHECK_STR_CONTAINS(err.msg, bad[i].msg);
-        fprintf(stderr, "  %s\n", err.msg);
-        error_clear(&err);
-        scene_free(&s);
-    }
+    check_refused_extension("KHR_materials_diffuse_transmission", bad, sizeof bad / sizeof bad[0]);
 }
 
 /* KHR_materials_volume_scatter over a volume and a diffuse transmission: a subsurface
@@ -194,18 +207,13 @@ static void test_diffuse_transmission(void)
 static void test_volume_scatter(void)
 {
     Scene s;
-    Error err = { 0 };
-    Status st = load_triangle("{\"name\":\"wax\",\"extensions\":{"
-                              "\"KHR_materials_volume\":{\"thicknessFactor\":1,"
-                              "\"attenuationColor\":[0.5,0.25,0.125],\"attenuationDistance\":2},"
-                              "\"KHR_materials_diffuse_transmission\":{\"diffuseTransmissionFactor\":0.8},"
-                              "\"KHR_materials_volume_scatter\":{\"multiscatterColor\":[0,0.5,1],"
-                              "\"scatterAnisotropy\":0.3}}}",
-                              &s, &err);
-    CHECK_MSG(st == ST_OK, "%s", err.msg);
-    error_clear(&err);
-    if (st == ST_OK) {
-        const Material *m = &s.materials[s.triangles[0].material];
+    const Material *m = triangle_material("{\"name\":\"wax\",\"extensions\":{"
+                                          "\"KHR_materials_volume\":{\"thicknessFactor\":1,"
+                                          "\"attenuationColor\":[0.5,0.25,0.125],\"attenuationDistance\":2},"
+                                          "\"KHR_materials_diffuse_transmission\":{\"diffuseTransmissionFactor\":0.8},"
+                                          "\"KHR_materials_volume_scatter\":{\"multiscatterColor\":[0,0.5,1],"
+                                          "\"scatterAnisotropy\":0.3}}}", &s);
+    if (m) {
         CHECK((m->flags & MAT_THIN) == 0u);
         CHECK_NEAR(m->subsurface, 0.8, 1e-6);
         CHECK(m->diffuse_transmission == 0.0f);
@@ -237,10 +245,7 @@ static void test_volume_scatter(void)
                                         "KHR_materials_volume's attenuationDistance and attenuationColor",
                                         "KHR_materials_diffuse_transmission" };
     for (int i = 0; i < 3; i++) {
-        st = load_triangle(ignored[i], &s, &err);
-        CHECK_MSG(st == ST_OK, "%s", err.msg);
-        error_clear(&err);
-        if (st == ST_OK) {
+        if (triangle_material(ignored[i], &s)) {
             CHECK_EQ_INT(s.n_warnings, 1);
             CHECK_EQ_INT((int)s.n_media, 0);
             char want[200];
@@ -250,7 +255,7 @@ static void test_volume_scatter(void)
         }
         scene_free(&s);
     }
-    static const struct { const char *json, *msg; } bad[] = {
+    static const RefusedMaterial bad[] = {
         { "{\"multiscatterColor\":[0.5,-0.5,0.5]}",
           "alpha.gltf: materials[0].extensions.KHR_materials_volume_scatter.multiscatterColor[1]: expected a number "
           "from 0 to 1" },
@@ -261,15 +266,7 @@ static void test_volume_scatter(void)
           "alpha.gltf: materials[0].extensions.KHR_materials_volume_scatter.scatterAnisotropy: expected a number "
           "from -1 to 1" },
     };
-    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-        char json[256];
-        snprintf(json, sizeof json, "{\"extensions\":{\"KHR_materials_volume_scatter\":%s}}", bad[i].json);
-        st = load_triangle(json, &s, &err);
-        CHECK_EQ_INT(st, ST_INPUT);
-        CHECK_STR_CONTAINS(err.msg, bad[i].msg);
-        error_clear(&err);
-        scene_free(&s);
-    }
+    check_refused_extension("KHR_materials_volume_scatter", bad, sizeof bad / sizeof bad[0]);
 }
 
 /* alphaMode and alphaCutoff become the principled material's alpha mode (kernels/accel/alpha.h
@@ -287,33 +284,21 @@ static void test_alpha_modes(void)
     };
     for (size_t i = 0; i < sizeof ok / sizeof ok[0]; i++) {
         Scene s;
-        Error err = { 0 };
-        Status st = load_triangle(ok[i].json, &s, &err);
-        CHECK_MSG(st == ST_OK, "%s: %s", ok[i].json, err.msg);
-        if (st == ST_OK) {
-            const Material *m = &s.materials[s.triangles[0].material];
+        const Material *m = triangle_material(ok[i].json, &s);
+        if (m) {
             CHECK(m->type == MAT_PRINCIPLED);
             CHECK((m->flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) == ok[i].flags);
             CHECK(m->alpha == ok[i].alpha);
             CHECK(m->alpha_cutoff == ok[i].cutoff);
             CHECK(m->texture_emission == NO_INDEX);
         }
-        error_clear(&err);
         scene_free(&s);
     }
-    static const struct { const char *json, *msg; } bad[] = {
+    static const RefusedMaterial bad[] = {
         { "{\"alphaMode\":\"CUTOUT\"}", "alpha.gltf: materials[0].alphaMode: expected \"OPAQUE\", \"MASK\" or \"BLEND\"" },
         { "{\"alphaMode\":1}", "alpha.gltf: materials[0].alphaMode: expected \"OPAQUE\", \"MASK\" or \"BLEND\"" },
     };
-    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-        Scene s;
-        Error err = { 0 };
-        Status st = load_triangle(bad[i].json, &s, &err);
-        CHECK(st == ST_INPUT);
-        CHECK_MSG(strcmp(err.msg, bad[i].msg) == 0, "got '%s'", err.msg);
-        error_clear(&err);
-        scene_free(&s);
-    }
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) check_refused(bad[i].json, bad[i].msg, 1);
 }
 
 /* KHR_texture_transform's scale of 1e308 is infinite as a float, and its lookups were
@@ -334,13 +319,7 @@ static void test_texture_transform_range(void)
         char mat[600];
         snprintf(mat, sizeof mat, "{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":"
                  "{\"KHR_texture_transform\":{\"scale\":%s}}}}}%s", cases[i].scale, tex);
-        Scene s;
-        Error err = { 0 };
-        Status st = load_triangle(mat, &s, &err);
-        CHECK(st == ST_INPUT);
-        CHECK_MSG(strcmp(err.msg, cases[i].msg) == 0, "got '%s'", err.msg);
-        error_clear(&err);
-        scene_free(&s);
+        check_refused(mat, cases[i].msg, 1);
     }
 }
 

@@ -282,41 +282,63 @@ static Status material_volume(Gltf *g, const cJSON *m, const char *jp, Material 
     return ST_OK;
 }
 
+/* An extension that is a factor in [0, 1] and a colour factor, each times a texture of
+ * its own (the factor's by the texture's alpha, linear; the colour's sRGB): the shape
+ * KHR_materials_specular, _sheen and _diffuse_transmission share. */
+typedef struct {
+    const char *name;                        /* the extension */
+    const char *factor, *factor_texture;     /* its keys ... */
+    const char *color, *color_texture;
+    double factor_default;                   /* ... and their defaults */
+    const double *color_default;
+    int color_in_unit;                       /* each colour component must lie in [0, 1] */
+} FactorColorExt;
+
+/* Material m's extension e, where it is there: the factor into *factor, the colour into
+ * *color and the two textures' indices, and the factor as read into *factor_read (0
+ * where the extension is absent; NULL: not wanted). Nothing but the textures is written
+ * unless all of it reads. */
+static Status factor_color_ext(Gltf *g, const cJSON *m, const char *jp, const FactorColorExt *e, float *factor,
+                               vec3 *color, uint *factor_texture, uint *color_texture, double *factor_read)
+{
+    char jx[128];
+    if (factor_read) *factor_read = 0.0;
+    const cJSON *x = material_ext(m, e->name, jp, jx, sizeof jx);
+    if (!x) return ST_OK;
+    double f, c[3];
+    Status st = gltf_get_num(g, x, e->factor, e->factor_default, 0.0, 1.0, jx, &f);
+    if (!st) st = gltf_get_nums(g, x, e->color, 3, e->color_default, jx, c);
+    for (int k = 0; !st && e->color_in_unit && k < 3; k++)
+        if (!(c[k] >= 0.0 && c[k] <= 1.0))
+            st = error_set(g->err, ST_INPUT, "%s: %s.%s[%d]: expected a number from 0 to 1", g->path, jx, e->color, k);
+    if (!st) st = texinfo(g, x, e->factor_texture, 1, jx, factor_texture, NULL);
+    if (!st) st = texinfo(g, x, e->color_texture, 0, jx, color_texture, NULL);
+    if (st) return st;
+    *factor = (float)f;
+    *color = v3_of_doubles(c);
+    if (factor_read) *factor_read = f;
+    return ST_OK;
+}
+
 /* KHR_materials_specular: specularFactor (times specularTexture's alpha) and
  * specularColorFactor (times specularColorTexture, sRGB) scale the dielectric F0 and
  * F90 (kernels/bsdf/principled.h). */
 static Status material_specular(Gltf *g, const cJSON *m, const char *jp, Material *mt)
 {
-    char jx[128];
-    const cJSON *x = material_ext(m, "KHR_materials_specular", jp, jx, sizeof jx);
-    if (!x) return ST_OK;
-    double factor, color[3];
-    Status st = gltf_get_num(g, x, "specularFactor", 1.0, 0.0, 1.0, jx, &factor);
-    if (!st) st = gltf_get_nums(g, x, "specularColorFactor", 3, white3, jx, color);
-    if (!st) st = texinfo(g, x, "specularTexture", 1, jx, &mt->texture_specular, NULL);
-    if (!st) st = texinfo(g, x, "specularColorTexture", 0, jx, &mt->texture_specular_color, NULL);
-    if (st) return st;
-    mt->specular_factor = (float)factor;
-    mt->specular_color = v3_of_doubles(color);
-    return ST_OK;
+    static const FactorColorExt e = { "KHR_materials_specular", "specularFactor", "specularTexture",
+                                      "specularColorFactor", "specularColorTexture", 1.0, white3, 0 };
+    return factor_color_ext(g, m, jp, &e, &mt->specular_factor, &mt->specular_color, &mt->texture_specular,
+                            &mt->texture_specular_color, NULL);
 }
 
 /* KHR_materials_sheen: sheenColorFactor (times sheenColorTexture, sRGB) and
  * sheenRoughnessFactor (times sheenRoughnessTexture's alpha). */
 static Status material_sheen(Gltf *g, const cJSON *m, const char *jp, Material *mt)
 {
-    char jx[128];
-    const cJSON *x = material_ext(m, "KHR_materials_sheen", jp, jx, sizeof jx);
-    if (!x) return ST_OK;
-    double color[3], rough;
-    Status st = gltf_get_nums(g, x, "sheenColorFactor", 3, black3, jx, color);
-    if (!st) st = gltf_get_num(g, x, "sheenRoughnessFactor", 0.0, 0.0, 1.0, jx, &rough);
-    if (!st) st = texinfo(g, x, "sheenColorTexture", 0, jx, &mt->texture_sheen_color, NULL);
-    if (!st) st = texinfo(g, x, "sheenRoughnessTexture", 1, jx, &mt->texture_sheen_roughness, NULL);
-    if (st) return st;
-    mt->sheen_color = v3_of_doubles(color);
-    mt->sheen_roughness = (float)rough;
-    return ST_OK;
+    static const FactorColorExt e = { "KHR_materials_sheen", "sheenRoughnessFactor", "sheenRoughnessTexture",
+                                      "sheenColorFactor", "sheenColorTexture", 0.0, black3, 0 };
+    return factor_color_ext(g, m, jp, &e, &mt->sheen_roughness, &mt->sheen_color, &mt->texture_sheen_roughness,
+                            &mt->texture_sheen_color, NULL);
 }
 
 /* KHR_materials_diffuse_transmission: diffuseTransmissionFactor (times
@@ -327,24 +349,14 @@ static Status material_sheen(Gltf *g, const cJSON *m, const char *jp, Material *
  * after, makes it a solid. Each colour component must lie in [0, 1], as the spec says. */
 static Status material_diffuse_transmission(Gltf *g, const cJSON *m, const char *jp, Material *mt)
 {
-    char jx[128];
-    const cJSON *x = material_ext(m, "KHR_materials_diffuse_transmission", jp, jx, sizeof jx);
-    if (!x) return ST_OK;
-    double factor, color[3];
-    Status st = gltf_get_num(g, x, "diffuseTransmissionFactor", 0.0, 0.0, 1.0, jx, &factor);
-    if (!st) st = gltf_get_nums(g, x, "diffuseTransmissionColorFactor", 3, white3, jx, color);
-    for (int k = 0; !st && k < 3; k++)
-        if (!(color[k] >= 0.0 && color[k] <= 1.0))
-            st = error_set(g->err, ST_INPUT, "%s: %s.diffuseTransmissionColorFactor[%d]: expected a number from 0 to 1",
-                           g->path, jx, k);
-    if (!st) st = texinfo(g, x, "diffuseTransmissionTexture", 1, jx, &mt->texture_diffuse_transmission, NULL);
-    if (!st)
-        st = texinfo(g, x, "diffuseTransmissionColorTexture", 0, jx, &mt->texture_diffuse_transmission_color, NULL);
-    if (st) return st;
-    mt->diffuse_transmission = (float)factor;
-    mt->diffuse_transmission_color = v3_of_doubles(color);
-    if (factor > 0.0) mt->flags |= MAT_THIN;
-    return ST_OK;
+    static const FactorColorExt e = { "KHR_materials_diffuse_transmission", "diffuseTransmissionFactor",
+                                      "diffuseTransmissionTexture", "diffuseTransmissionColorFactor",
+                                      "diffuseTransmissionColorTexture", 0.0, white3, 1 };
+    double factor;
+    Status st = factor_color_ext(g, m, jp, &e, &mt->diffuse_transmission, &mt->diffuse_transmission_color,
+                                 &mt->texture_diffuse_transmission, &mt->texture_diffuse_transmission_color, &factor);
+    if (!st && factor > 0.0) mt->flags |= MAT_THIN;
+    return st;
 }
 
 /* The single-scattering albedo of the multiple-scattering albedo ms in [0, 1]:

@@ -68,6 +68,16 @@ static int exr_pick_channel(const exr_attr_chlist_t *ch, int k)
     return any_rgb ? -1 : y;
 }
 
+/* A buffer the decoders take for one piece of the image (a tile, a row of tiles, a
+ * chunk of scanlines), refused above EXR_MAX_CHUNK_BYTES: `piece` says what the piece
+ * is and ends in its verb ("... need"), `each` follows the byte count. */
+static Status chunk_fits(const char *path, const char *piece, uint64_t bytes, const char *each, Error *err)
+{
+    if (bytes <= EXR_MAX_CHUNK_BYTES) return ST_OK;
+    return error_set(err, ST_INPUT, "'%s': %s %llu bytes%s, more than clpt decodes (%u)", path, piece,
+                     (unsigned long long)bytes, each, EXR_MAX_CHUNK_BYTES);
+}
+
 /* Checks the first part's header (read by OpenEXRCore, which bounds what a header may
  * ask for) before any pixel memory exists. */
 static Status exr_check_part(exr_context_t ctxt, const char *path, uint64_t max_pixels, const int pick[3], int w,
@@ -100,28 +110,21 @@ static Status exr_check_part(exr_context_t ctxt, const char *path, uint64_t max_
         exr_tile_round_mode_t round;
         rv = exr_get_tile_descriptor(ctxt, 0, &tw, &th, &levels, &round);
         if (rv != EXR_ERR_SUCCESS) return exr_fail(path, rv, err);
-        uint64_t tile = (uint64_t)tw * (uint64_t)th * pixel_bytes;
-        if (tile > EXR_MAX_CHUNK_BYTES)
-            return error_set(err, ST_INPUT, "'%s': the EXR image's tiles of %ux%u pixels x %d channels need %llu bytes "
-                             "each, more than clpt decodes (%u)", path, tw, th, channels, (unsigned long long)tile,
-                             EXR_MAX_CHUNK_BYTES);
+        char piece[160];
+        snprintf(piece, sizeof piece, "the EXR image's tiles of %ux%u pixels x %d channels need", tw, th, channels);
+        Status st = chunk_fits(path, piece, (uint64_t)tw * (uint64_t)th * pixel_bytes, " each", err);
         /* the C++ library's InputFile reads a tiled image a row of tiles at a time,
          * into a buffer of the image's width x the tiles' height */
-        uint64_t row = (uint64_t)w * (uint64_t)th * pixel_bytes;
-        if (row > EXR_MAX_CHUNK_BYTES)
-            return error_set(err, ST_INPUT, "'%s': a row of the EXR image's tiles (%d pixels wide, %u high, %d channels) "
-                             "needs %llu bytes, more than clpt decodes (%u)", path, w, th, channels,
-                             (unsigned long long)row, EXR_MAX_CHUNK_BYTES);
-        return ST_OK;
+        snprintf(piece, sizeof piece, "a row of the EXR image's tiles (%d pixels wide, %u high, %d channels) needs", w,
+                 th, channels);
+        return st ? st : chunk_fits(path, piece, (uint64_t)w * (uint64_t)th * pixel_bytes, "", err);
     }
     int lines = 0;
     if (exr_get_scanlines_per_chunk(ctxt, 0, &lines) != EXR_ERR_SUCCESS || lines <= 0) lines = 1;
-    uint64_t chunk = (uint64_t)lines * (uint64_t)w * pixel_bytes;
-    if (chunk > EXR_MAX_CHUNK_BYTES)
-        return error_set(err, ST_INPUT, "'%s': the EXR image's chunks of %d rows of %d pixels x %d channels need "
-                         "%llu bytes each, more than clpt decodes (%u)", path, lines, w, channels,
-                         (unsigned long long)chunk, EXR_MAX_CHUNK_BYTES);
-    return ST_OK;
+    char piece[160];
+    snprintf(piece, sizeof piece, "the EXR image's chunks of %d rows of %d pixels x %d channels need", lines, w,
+             channels);
+    return chunk_fits(path, piece, (uint64_t)lines * (uint64_t)w * pixel_bytes, " each", err);
 }
 
 /* A NUL-terminated string of at most 255 characters from f into buf[256]; 0 when the

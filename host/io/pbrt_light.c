@@ -24,15 +24,13 @@
 
 /* ------------------------------------------------------------------ lights */
 
-Status pbrt_area_light(Parser *p, Lexer *lx, const Token *kw)
+Status pbrt_area_light(Parser *p, Lexer *lx, const Token *kw, const Token *type)
 {
     (void)kw;
-    Token type;
-    Status st = pbrt_expect_head(p, lx, "a quoted area light type", &type);
-    if (st) return st;
-    if (!pbrt_tok_eq(&type, "diffuse"))
-        return lex_error_at(lx, &type, p->err, "area light \"%.*s\" is not supported (diffuse is)",
-                            (int)(type.len > 40 ? 40 : type.len), type.text);
+    Status st = ST_OK;
+    if (!pbrt_tok_eq(type, "diffuse"))
+        return lex_error_at(lx, type, p->err, "area light \"%.*s\" is not supported (diffuse is)",
+                            (int)(type->len > 40 ? 40 : type->len), type->text);
     vec3 L = v3(1, 1, 1);
     double scale = 1;
     int two = 0;
@@ -145,20 +143,18 @@ static Status infinite_light(Parser *p, const Lexer *lx, const Token *type, doub
     return ST_OK;
 }
 
-Status pbrt_light(Parser *p, Lexer *lx, const Token *kw)
+Status pbrt_light(Parser *p, Lexer *lx, const Token *kw, const Token *type)
 {
     (void)kw;
-    Token type;
-    Status st = pbrt_expect_head(p, lx, "a quoted light type", &type);
-    if (st) return st;
+    Status st = ST_OK;
     /* pbrt-v4 too uses a moving light's start transform */
-    if (pbrt_ctm_moves(p) && (st = pbrt_warn_still(p, lx, &type, "a LightSource"))) return st;
+    if (pbrt_ctm_moves(p) && (st = pbrt_warn_still(p, lx, type, "a LightSource"))) return st;
     double scale = 1;
     if ((st = pbrt_get_float(p, lx, "scale", &scale))) return st;
     vec3 from = v3(0, 0, 0), to = v3(0, 0, 1), c = v3(1, 1, 1);
     if ((st = pbrt_get_point(p, lx, "from", &from)) || (st = pbrt_get_point(p, lx, "to", &to))) return st;
-    if (pbrt_tok_eq(&type, "point") || pbrt_tok_eq(&type, "spot")) {
-        int spot = pbrt_tok_eq(&type, "spot");
+    if (pbrt_tok_eq(type, "point") || pbrt_tok_eq(type, "spot")) {
+        int spot = pbrt_tok_eq(type, "spot");
         if ((st = pbrt_get_spectrum(p, lx, "I", &c, NULL, NULL))) return st;
         Light l = light_default(spot ? LIGHT_SPOT : LIGHT_POINT);
         l.intensity = v3_scale(c, (float)scale);
@@ -168,25 +164,25 @@ Status pbrt_light(Parser *p, Lexer *lx, const Token *kw)
             if ((st = pbrt_get_float(p, lx, "coneangle", &cone)) || (st = pbrt_get_float(p, lx, "conedelta", &delta))) return st;
             if (!(cone > 0 && cone < 180)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "coneangle"), "in (0, 180)");
             if (!(delta >= 0)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "conedelta"), ">= 0");
-            if ((st = light_dir(p, lx, &type, pbrt_xf_dir(&p->g.ctm, v3_sub(to, from)), &l.direction))) return st;
+            if ((st = light_dir(p, lx, type, pbrt_xf_dir(&p->g.ctm, v3_sub(to, from)), &l.direction))) return st;
             l.cos_outer = (float)cos(cone * M_PI / 180);
             l.cos_inner = (float)cos(fmax(cone - delta, 0) * M_PI / 180);
         }
         if ((st = scene_add_light(p->s, l, p->err))) return st;
-    } else if (pbrt_tok_eq(&type, "distant")) {
+    } else if (pbrt_tok_eq(type, "distant")) {
         if ((st = pbrt_get_spectrum(p, lx, "L", &c, NULL, NULL))) return st;
         Light l = light_default(LIGHT_DIRECTIONAL);
         l.intensity = v3_scale(c, (float)scale);
-        if ((st = light_dir(p, lx, &type, pbrt_xf_dir(&p->g.ctm, v3_sub(to, from)), &l.direction))) return st;
+        if ((st = light_dir(p, lx, type, pbrt_xf_dir(&p->g.ctm, v3_sub(to, from)), &l.direction))) return st;
         if ((st = scene_add_light(p->s, l, p->err))) return st;
-    } else if (pbrt_tok_eq(&type, "infinite")) {
-        if ((st = infinite_light(p, lx, &type, scale))) return st;
+    } else if (pbrt_tok_eq(type, "infinite")) {
+        if ((st = infinite_light(p, lx, type, scale))) return st;
     } else {
         char key[96];
-        snprintf(key, sizeof key, "LightSource %.*s", (int)(type.len > 40 ? 40 : type.len), type.text);
+        snprintf(key, sizeof key, "LightSource %.*s", (int)(type->len > 40 ? 40 : type->len), type->text);
         for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = 1;
-        return warn_once(p, lx, &type, key, "LightSource \"%.*s\" is not supported; skipped",
-                         (int)(type.len > 40 ? 40 : type.len), type.text);
+        return warn_once(p, lx, type, key, "LightSource \"%.*s\" is not supported; skipped",
+                         (int)(type->len > 40 ? 40 : type->len), type->text);
     }
     return pbrt_warn_unused(p, lx, "LightSource");
 }

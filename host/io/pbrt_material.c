@@ -315,33 +315,29 @@ static Status add_named_material(Parser *p, const Token *name, Material m, uint 
     return ST_OK;
 }
 
-Status pbrt_material(Parser *p, Lexer *lx, const Token *kw)
+Status pbrt_material(Parser *p, Lexer *lx, const Token *kw, const Token *type)
 {
     (void)kw;
-    Token type;
-    Status st = pbrt_expect_head(p, lx, "a quoted material type", &type);
-    if (st) return st;
+    Status st = ST_OK;
     Material m;
-    if ((st = make_material(p, lx, &type, &m, "Material"))) return st;
+    if ((st = make_material(p, lx, type, &m, "Material"))) return st;
     uint index;
     if ((st = scene_add_material(p->s, "", m, &index, p->err))) return st;
     return set_material(p, index);
 }
 
-Status pbrt_make_named_material(Parser *p, Lexer *lx, const Token *kw)
+Status pbrt_make_named_material(Parser *p, Lexer *lx, const Token *kw, const Token *name)
 {
     (void)kw;
-    Token name;
-    Status st = pbrt_expect_head(p, lx, "a quoted material name", &name);
-    if (st) return st;
+    Status st = ST_OK;
     const Token *type = NULL;
     if ((st = pbrt_get_string(p, lx, "type", &type))) return st;
-    if (!type) return lex_error_at(lx, &name, p->err, "MakeNamedMaterial needs \"string type\"");
+    if (!type) return lex_error_at(lx, name, p->err, "MakeNamedMaterial needs \"string type\"");
     Material m;
     if ((st = make_material(p, lx, type, &m, "MakeNamedMaterial"))) return st;
     uint index;
     PPending *pd;
-    if (strmap_find(&p->named_material, name.text, name.len, &index) && (pd = pending_of(p, index))) {
+    if (strmap_find(&p->named_material, name->text, name->len, &index) && (pd = pending_of(p, index))) {
         /* used before: the placeholder and its area-light copies become this material */
         pd->defined = 1;
         for (size_t i = 0; i < p->n_area_pending; i++) {
@@ -355,7 +351,7 @@ Status pbrt_make_named_material(Parser *p, Lexer *lx, const Token *kw)
         p->s->materials[index] = m;
         return ST_OK;
     }
-    return add_named_material(p, &name, m, &index);
+    return add_named_material(p, name, m, &index);
 }
 
 Status pbrt_named_material(Parser *p, Lexer *lx, const Token *kw)

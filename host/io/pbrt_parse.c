@@ -231,20 +231,17 @@ static Status d_world_begin(Parser *p, Lexer *lx, const Token *kw)
 
 /* ------------------------------------------------------------------ options */
 
-static Status d_camera(Parser *p, Lexer *lx, const Token *kw)
+static Status d_camera(Parser *p, Lexer *lx, const Token *kw, const Token *type)
 {
-    Token type;
-    Status st = pbrt_expect_head(p, lx, "a quoted camera type", &type);
-    if (st) return st;
-    if (p->world) return lex_error_at(lx, kw, p->err, "Camera must come before WorldBegin");
-    if (!pbrt_tok_eq(&type, "perspective") && !pbrt_tok_eq(&type, "orthographic")) {
-        st = warn_once(p, lx, &type, "Camera", "Camera \"%.*s\" is not supported; a perspective camera is used",
-                       (int)(type.len > 40 ? 40 : type.len), type.text);
+    Status st = ST_OK;
+    if (!pbrt_tok_eq(type, "perspective") && !pbrt_tok_eq(type, "orthographic")) {
+        st = warn_once(p, lx, type, "Camera", "Camera \"%.*s\" is not supported; a perspective camera is used",
+                       (int)(type->len > 40 ? 40 : type->len), type->text);
         if (st) return st;
     }
     p->have_camera = 1;
     p->s->camera_medium = p->g.medium_out;   /* pbrt-v4's CameraMedium: the outside one now */
-    p->cam_ortho = pbrt_tok_eq(&type, "orthographic");
+    p->cam_ortho = pbrt_tok_eq(type, "orthographic");
     p->cam_from_world = p->g.ctm;
     p->cam_from_world_end = p->g.ctm_end;
     p->cam_time_start = p->time_start;
@@ -316,11 +313,10 @@ static Status film_crop(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
-static Status d_film(Parser *p, Lexer *lx, const Token *kw)
+static Status d_film(Parser *p, Lexer *lx, const Token *kw, const Token *type)
 {
-    Token type;
-    Status st = pbrt_expect_head(p, lx, "a quoted film type", &type);
-    if (st) return st;
+    (void)type;
+    Status st;
     long w = 1280, h = 720;   /* pbrt-v4's defaults */
     if ((st = pbrt_get_int_in(p, lx, "xresolution", 1, CLPT_MAX_IMAGE_SIDE, &w)) ||
         (st = pbrt_get_int_in(p, lx, "yresolution", 1, CLPT_MAX_IMAGE_SIDE, &h)))
@@ -346,12 +342,11 @@ static Status d_film(Parser *p, Lexer *lx, const Token *kw)
     return pbrt_warn_unused(p, lx, "Film");
 }
 
-static Status d_sampler(Parser *p, Lexer *lx, const Token *kw)
+static Status d_sampler(Parser *p, Lexer *lx, const Token *kw, const Token *type)
 {
     (void)kw;
-    Token type;
-    Status st = pbrt_expect_head(p, lx, "a quoted sampler type", &type);
-    if (st) return st;
+    (void)type;
+    Status st;
     long n = 16;
     if ((st = pbrt_get_int_in(p, lx, "pixelsamples", 1, CLPT_MAX_SPP, &n))) return st;
     p->s->image.spp = (uint)n;
@@ -359,15 +354,13 @@ static Status d_sampler(Parser *p, Lexer *lx, const Token *kw)
     return pbrt_warn_unused(p, lx, "Sampler");
 }
 
-static Status d_integrator(Parser *p, Lexer *lx, const Token *kw)
+static Status d_integrator(Parser *p, Lexer *lx, const Token *kw, const Token *type)
 {
     (void)kw;
-    Token type;
-    Status st = pbrt_expect_head(p, lx, "a quoted integrator type", &type);
-    if (st) return st;
-    if (!pbrt_tok_eq(&type, "path") && !pbrt_tok_eq(&type, "volpath")) {
-        st = warn_once(p, lx, &type, "Integrator", "Integrator \"%.*s\" is not supported; clpt's path tracer is used",
-                       (int)(type.len > 40 ? 40 : type.len), type.text);
+    Status st = ST_OK;
+    if (!pbrt_tok_eq(type, "path") && !pbrt_tok_eq(type, "volpath")) {
+        st = warn_once(p, lx, type, "Integrator", "Integrator \"%.*s\" is not supported; clpt's path tracer is used",
+                       (int)(type->len > 40 ? 40 : type->len), type->text);
         if (st) return st;
     }
     long d = 5;
@@ -463,51 +456,58 @@ static Status d_ignored(Parser *p, Lexer *lx, const Token *kw)
     return ST_OK;
 }
 
+/* The directives: `fn` reads all that follows its keyword; `headed`, the directives
+ * whose head is one quoted string (a type or a name, `head` says which) and a parameter
+ * list, gets the head read and the parameters in p->pl (pbrt_expect_head); the options
+ * that must come before WorldBegin say so. */
 static const struct {
     const char *name;
     Status (*fn)(Parser *p, Lexer *lx, const Token *kw);
+    Status (*headed)(Parser *p, Lexer *lx, const Token *kw, const Token *head);
+    const char *head;
+    int before_world;
 } directives[] = {
-    {"Translate", d_xform},
-    {"Scale", d_xform},
-    {"Rotate", d_xform},
-    {"LookAt", d_xform},
-    {"Transform", d_xform},
-    {"ConcatTransform", d_xform},
-    {"CoordinateSystem", d_coordsys},
-    {"CoordSysTransform", d_coordsys_transform},
-    {"Identity", d_identity},
-    {"ReverseOrientation", d_reverse},
-    {"AttributeBegin", d_attr_begin},
-    {"AttributeEnd", d_attr_end},
-    {"TransformBegin", d_attr_begin},
-    {"TransformEnd", d_transform_end},
-    {"WorldBegin", d_world_begin},
-    {"WorldEnd", d_ignored},        /* pbrt-v3's end of file */
-    {"Camera", d_camera},
-    {"Film", d_film},
-    {"Sampler", d_sampler},
-    {"Integrator", d_integrator},
-    {"Material", pbrt_material},
-    {"MakeNamedMaterial", pbrt_make_named_material},
-    {"NamedMaterial", pbrt_named_material},
-    {"Texture", pbrt_texture},
-    {"AreaLightSource", pbrt_area_light},
-    {"LightSource", pbrt_light},
-    {"Shape", pbrt_shape},
-    {"Include", d_include},
-    {"Import", d_include},
-    {"PixelFilter", d_unsupported},
-    {"ColorSpace", d_unsupported},
-    {"Option", d_unsupported},
-    {"Accelerator", d_unsupported},
-    {"TransformTimes", d_transform_times},
-    {"ActiveTransform", d_active_transform},
-    {"MakeNamedMedium", pbrt_make_named_medium},
-    {"MediumInterface", pbrt_medium_interface},
-    {"Attribute", d_unsupported},
-    {"ObjectBegin", pbrt_object_begin},
-    {"ObjectEnd", pbrt_object_end},
-    {"ObjectInstance", pbrt_object_instance},
+    {"Translate", .fn = d_xform},
+    {"Scale", .fn = d_xform},
+    {"Rotate", .fn = d_xform},
+    {"LookAt", .fn = d_xform},
+    {"Transform", .fn = d_xform},
+    {"ConcatTransform", .fn = d_xform},
+    {"CoordinateSystem", .fn = d_coordsys},
+    {"CoordSysTransform", .fn = d_coordsys_transform},
+    {"Identity", .fn = d_identity},
+    {"ReverseOrientation", .fn = d_reverse},
+    {"AttributeBegin", .fn = d_attr_begin},
+    {"AttributeEnd", .fn = d_attr_end},
+    {"TransformBegin", .fn = d_attr_begin},
+    {"TransformEnd", .fn = d_transform_end},
+    {"WorldBegin", .fn = d_world_begin},
+    {"WorldEnd", .fn = d_ignored},        /* pbrt-v3's end of file */
+    {"Camera", .headed = d_camera, .head = "a quoted camera type", .before_world = 1},
+    {"Film", .headed = d_film, .head = "a quoted film type", .before_world = 1},
+    {"Sampler", .headed = d_sampler, .head = "a quoted sampler type", .before_world = 1},
+    {"Integrator", .headed = d_integrator, .head = "a quoted integrator type", .before_world = 1},
+    {"Material", .headed = pbrt_material, .head = "a quoted material type"},
+    {"MakeNamedMaterial", .headed = pbrt_make_named_material, .head = "a quoted material name"},
+    {"NamedMaterial", .fn = pbrt_named_material},
+    {"Texture", .fn = pbrt_texture},
+    {"AreaLightSource", .headed = pbrt_area_light, .head = "a quoted area light type"},
+    {"LightSource", .headed = pbrt_light, .head = "a quoted light type"},
+    {"Shape", .headed = pbrt_shape, .head = "a quoted shape type"},
+    {"Include", .fn = d_include},
+    {"Import", .fn = d_include},
+    {"PixelFilter", .fn = d_unsupported},
+    {"ColorSpace", .fn = d_unsupported},
+    {"Option", .fn = d_unsupported},
+    {"Accelerator", .fn = d_unsupported},
+    {"TransformTimes", .fn = d_transform_times, .before_world = 1},
+    {"ActiveTransform", .fn = d_active_transform},
+    {"MakeNamedMedium", .fn = pbrt_make_named_medium},
+    {"MediumInterface", .fn = pbrt_medium_interface},
+    {"Attribute", .fn = d_unsupported},
+    {"ObjectBegin", .fn = pbrt_object_begin},
+    {"ObjectEnd", .fn = pbrt_object_end},
+    {"ObjectInstance", .fn = pbrt_object_instance},
 };
 #define N_DIRECTIVES (sizeof directives / sizeof directives[0])
 
@@ -530,13 +530,18 @@ static Status parse_statements(Parser *p, Lexer *lx)
             st = lex_expected(lx, &t, "a pbrt directive (Shape, Material, LightSource, AttributeBegin, ...)", p->err);
             break;
         }
-        if (p->world && (directives[i].fn == d_camera || directives[i].fn == d_film ||
-                         directives[i].fn == d_sampler || directives[i].fn == d_integrator ||
-                         directives[i].fn == d_transform_times)) {
+        if (p->world && directives[i].before_world) {
             st = lex_error_at(lx, &t, p->err, "%s must come before WorldBegin", directives[i].name);
             break;
         }
-        if ((st = directives[i].fn(p, lx, &t))) break;
+        if (directives[i].headed) {
+            Token head;
+            if ((st = pbrt_expect_head(p, lx, directives[i].head, &head)) ||
+                (st = directives[i].headed(p, lx, &t, &head)))
+                break;
+        } else if ((st = directives[i].fn(p, lx, &t))) {
+            break;
+        }
     }
     return st;
 }

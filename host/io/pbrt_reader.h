@@ -170,21 +170,23 @@ char *pbrt_beside_main(const Parser *p, const Token *f);
 
 /* The directive handlers declared below all take (Parser, Lexer, the directive's
  * token), the signature pbrt_parse.c's directive table calls: their declarations are
- * alike by design, one per entry of that table. */
+ * alike by design, one per entry of that table. Those whose head is one quoted type or
+ * name (Material, Shape, LightSource, ...) also take that head, which the table's
+ * dispatcher has read with its parameter list (pbrt_expect_head). */
 /* pbrt_material.c: Material, MakeNamedMaterial, NamedMaterial, Texture */
-Status pbrt_material(Parser *p, Lexer *lx, const Token *kw);
-Status pbrt_make_named_material(Parser *p, Lexer *lx, const Token *kw);
+Status pbrt_material(Parser *p, Lexer *lx, const Token *kw, const Token *type);
+Status pbrt_make_named_material(Parser *p, Lexer *lx, const Token *kw, const Token *name);
 Status pbrt_named_material(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_texture(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_shape_material(Parser *p, uint *out);
 
 /* pbrt_light.c: AreaLightSource, LightSource */
-Status pbrt_area_light(Parser *p, Lexer *lx, const Token *kw);
+Status pbrt_area_light(Parser *p, Lexer *lx, const Token *kw, const Token *type);
 vec3 pbrt_xf_dir(const Transform *t, vec3 d);
-Status pbrt_light(Parser *p, Lexer *lx, const Token *kw);
+Status pbrt_light(Parser *p, Lexer *lx, const Token *kw, const Token *type);
 
 /* pbrt_shape.c: Shape, ObjectBegin/End/Instance */
-Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw);
+Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw, const Token *type);
 Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_object_instance(Parser *p, Lexer *lx, const Token *kw);

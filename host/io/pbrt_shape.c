@@ -490,13 +490,10 @@ static Status shape_make(Parser *p, Lexer *lx, const Token *type_tok)
     return pbrt_warn_unused(p, lx, "Shape");
 }
 
-Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw)
+Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw, const Token *type)
 {
-    Token type;
-    Status st = pbrt_expect_head(p, lx, "a quoted shape type", &type);
-    if (st) return st;
-    if (!p->in_object && pbrt_ctm_moves(p)) return shape_moving(p, lx, kw, &type);
-    return shape_make(p, lx, &type);
+    if (!p->in_object && pbrt_ctm_moves(p)) return shape_moving(p, lx, kw, type);
+    return shape_make(p, lx, type);
 }
 
 /* ------------------------------------------------------------------ instancing */

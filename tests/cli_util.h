@@ -11,6 +11,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "harness.h"
+
 /* The Makefile passes its build folder (build, build-asan), so each build's tests run
  * that build's program. */
 #ifndef CLPT_BUILD_DIR
@@ -134,6 +136,26 @@ static inline void write_temp(char *path, size_t size, const char *suffix, const
         ssize_t w = write(fd, text, strlen(text));
         (void)w;
         close(fd);
+    }
+}
+
+/* A command line clpt must refuse (argv without the program name; the unused tail of
+ * args is NULL) and a part of what it must say on stderr (NULL: only the status is
+ * checked). */
+typedef struct {
+    const char *args[16];
+    const char *msg;
+} CliRefusal;
+
+/* Runs each case and checks clpt exits with `status` and says its message: the tables of
+ * bad command lines. */
+static inline void cli_check_refusals(const CliRefusal *cases, size_t n, int status)
+{
+    static CliResult r;
+    for (size_t i = 0; i < n; i++) {
+        cli_run(cases[i].args, &r);
+        CHECK_MSG(r.status == status, "case %zu (%s ...): status %d, not %d", i, cases[i].args[0], r.status, status);
+        if (cases[i].msg) CHECK_STR_CONTAINS(r.err, cases[i].msg);
     }
 }
 

@@ -978,21 +978,18 @@ static void test_cli_shutter(void)
         CHECK_MSG(r.status == ST_USAGE, "--shutter '%s': status %d", bad[i].value, r.status);
         CHECK_STR_CONTAINS(r.err, bad[i].msg);
     }
-    const char *e1[] = { "--shutter", "0:1", "-o", CLI_DIR "/x.png", "scenes/cornell-box.scene", NULL };
-    cli_run(e1, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter blurs the animation of a glTF file given as the scene; "
-                              "'scenes/cornell-box.scene' is not one");
-    const char *e2[] = { "--shutter", "0:1", "--time", "1", CLI_DIR "/anim.gltf", NULL };
-    cli_run(e2, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter blurs the animation over a time and --time poses it at one: "
-                              "give one");
-    const char *e3[] = { "--shutter", "0:1", "--frames", "0:1", CLI_DIR "/anim.gltf", NULL };
-    cli_run(e3, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter A:B opens once; with --frames give --shutter F, the fraction "
-                              "of each frame's time it is open");
+    static const CliRefusal refused[] = {
+        { { "--shutter", "0:1", "-o", CLI_DIR "/x.png", "scenes/cornell-box.scene" },
+          "clpt: error: --shutter blurs the animation of a glTF file given as the scene; "
+          "'scenes/cornell-box.scene' is not one" },
+        { { "--shutter", "0:1", "--time", "1", CLI_DIR "/anim.gltf" },
+          "clpt: error: --shutter blurs the animation over a time and --time poses it at one: "
+          "give one" },
+        { { "--shutter", "0:1", "--frames", "0:1", CLI_DIR "/anim.gltf" },
+          "clpt: error: --shutter A:B opens once; with --frames give --shutter F, the fraction "
+          "of each frame's time it is open" },
+    };
+    cli_check_refusals(refused, sizeof refused / sizeof refused[0], ST_USAGE);
     /* --frames with --shutter F: frame 1 at 2 fps open half a frame is --shutter
      * 0.5:0.75, rendered in a row after a blurred frame 0 (its keys gone) and alone;
      * PoCL the same */
@@ -1014,66 +1011,46 @@ static void test_cli_shutter(void)
     CHECK_MSG(r.status == 0, "status %d: %s", r.status, r.err);
     CHECK(files_equal(CLI_DIR "/fblur_0000.pfm", CLI_DIR "/fblurcl_0000.pfm"));
     CHECK(files_equal(CLI_DIR "/fblur_0002.pfm", CLI_DIR "/fblurcl_0002.pfm"));
-    const char *e4[] = { "--shutter", "0.5", CLI_DIR "/anim.gltf", NULL };
-    cli_run(e4, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter F is a fraction of each frame's time, for --frames; for one "
-                              "image give --shutter A:B in seconds");
-    const char *e5[] = { "--frames", "0:1", "--shutter", "1.5", CLI_DIR "/anim.gltf", NULL };
-    cli_run(e5, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter expects A:B, the times in seconds it opens and closes, or with "
-                              "--frames F, the fraction of each frame's time it is open (0 < F <= 1), got '1.5'");
-    const char *e6[] = { "--frames", "0:1", "--fps", "1", "--shutter", "0.5", "-o", CLI_DIR "/x.pfm",
-                         CLI_DIR "/path.scene", NULL };
-    cli_run(e6, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --shutter blurs the animation of a glTF file given as the scene; '"
-                              CLI_DIR "/path.scene' is not one");
+    static const CliRefusal refused_frames[] = {
+        { { "--shutter", "0.5", CLI_DIR "/anim.gltf" },
+          "clpt: error: --shutter F is a fraction of each frame's time, for --frames; for one "
+          "image give --shutter A:B in seconds" },
+        { { "--frames", "0:1", "--shutter", "1.5", CLI_DIR "/anim.gltf" },
+          "clpt: error: --shutter expects A:B, the times in seconds it opens and closes, or with "
+          "--frames F, the fraction of each frame's time it is open (0 < F <= 1), got '1.5'" },
+        { { "--frames", "0:1", "--fps", "1", "--shutter", "0.5", "-o", CLI_DIR "/x.pfm", CLI_DIR "/path.scene" },
+          "clpt: error: --shutter blurs the animation of a glTF file given as the scene; '"
+          CLI_DIR "/path.scene' is not one" },
+    };
+    cli_check_refusals(refused_frames, sizeof refused_frames / sizeof refused_frames[0], ST_USAGE);
 }
 
 static void test_cli_errors(void)
 {
-    static CliResult r;
-    const char *a1[] = { "--frames", "5:3", CLI_DIR "/anim.gltf", NULL };
-    cli_run(a1, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --frames 5:3: the first frame, 5, is after the last, 3");
-    const char *a2[] = { "--frames", "40:49", "-o", CLI_DIR "/x.png", CLI_DIR "/anim.gltf", NULL };
-    cli_run(a2, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --frames 40:49: frame 49 (at 2.04167 s) is after the end of the animation "
-                              "of '" CLI_DIR "/anim.gltf' at 2 s; at 24 frames per second its frames are 0 to 48");
-    const char *a3[] = { "--frames", "0:10", "--fps", "4", "-o", CLI_DIR "/x.png", CLI_DIR "/anim.gltf", NULL };
-    cli_run(a3, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "at 4 frames per second its frames are 0 to 8");
-    const char *a4[] = { "--fps", "30", CLI_DIR "/anim.gltf", NULL };
-    cli_run(a4, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --fps sets the frame rate of --frames A:B; give both, or neither");
-    const char *a5[] = { "--frames", "0:1", "-o", CLI_DIR "/x.png", "scenes/cornell-box.scene", NULL };
-    cli_run(a5, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --frames renders the animation of a glTF file given as the scene, or a "
-                              "clpt scene's camera_path; 'scenes/cornell-box.scene' has neither");
-    const char *a7[] = { "--frames", "0:1", "--display-server", "localhost:14158", CLI_DIR "/anim.gltf", NULL };
-    cli_run(a7, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --frames cannot be used with --display-server (the live display shows "
-                              "one image; open each frame's file instead)");
-    const char *a8[] = { "--frames", "0:1", "--sample-range", "0:1", CLI_DIR "/anim.gltf", NULL };
-    cli_run(a8, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --frames cannot be used with --sample-range (render each frame whole)");
-    const char *a9[] = { "--frames", "0:1", "-o", "-", CLI_DIR "/anim.gltf", NULL };
-    cli_run(a9, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --frames cannot be used with -o -");
-    const char *a6[] = { "--frames", "1", CLI_DIR "/anim.gltf", NULL };
-    cli_run(a6, &r);
-    CHECK(r.status == ST_USAGE);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --frames expects A:B, frame numbers with 0 <= A <= B <= 999999, got '1'");
+    static const CliRefusal bad[] = {
+        { { "--frames", "5:3", CLI_DIR "/anim.gltf" },
+          "clpt: error: --frames 5:3: the first frame, 5, is after the last, 3" },
+        { { "--frames", "40:49", "-o", CLI_DIR "/x.png", CLI_DIR "/anim.gltf" },
+          "clpt: error: --frames 40:49: frame 49 (at 2.04167 s) is after the end of the animation "
+          "of '" CLI_DIR "/anim.gltf' at 2 s; at 24 frames per second its frames are 0 to 48" },
+        { { "--frames", "0:10", "--fps", "4", "-o", CLI_DIR "/x.png", CLI_DIR "/anim.gltf" },
+          "at 4 frames per second its frames are 0 to 8" },
+        { { "--fps", "30", CLI_DIR "/anim.gltf" },
+          "clpt: error: --fps sets the frame rate of --frames A:B; give both, or neither" },
+        { { "--frames", "0:1", "-o", CLI_DIR "/x.png", "scenes/cornell-box.scene" },
+          "clpt: error: --frames renders the animation of a glTF file given as the scene, or a "
+          "clpt scene's camera_path; 'scenes/cornell-box.scene' has neither" },
+        { { "--frames", "0:1", "--display-server", "localhost:14158", CLI_DIR "/anim.gltf" },
+          "clpt: error: --frames cannot be used with --display-server (the live display shows "
+          "one image; open each frame's file instead)" },
+        { { "--frames", "0:1", "--sample-range", "0:1", CLI_DIR "/anim.gltf" },
+          "clpt: error: --frames cannot be used with --sample-range (render each frame whole)" },
+        { { "--frames", "0:1", "-o", "-", CLI_DIR "/anim.gltf" },
+          "clpt: error: --frames cannot be used with -o -" },
+        { { "--frames", "1", CLI_DIR "/anim.gltf" },
+          "clpt: error: --frames expects A:B, frame numbers with 0 <= A <= B <= 999999, got '1'" },
+    };
+    cli_check_refusals(bad, sizeof bad / sizeof bad[0], ST_USAGE);
 }
 
 int main(void)

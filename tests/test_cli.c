@@ -82,71 +82,56 @@ static void test_every_listed_flag_is_documented_and_parsed(void)
 
 static void test_usage_errors(void)
 {
-    cli_run(ARGS("--spp"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "--spp needs a value");
-    cli_run(ARGS("scenes/cornell-box.scene", "--spp", "ten"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "--spp expects an integer, got 'ten'");
-    cli_run(ARGS("scenes/cornell-box.scene", "--width", "0"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    cli_run(ARGS("scenes/cornell-box.scene", "--split", "0"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "--split must be between 1 and 64, got 0");
-    cli_run(ARGS("--frobnicate"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "unknown option '--frobnicate'");
-    cli_run(ARGS("-q"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "no scene given");
-    cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.tga"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "unsupported extension '.tga' (supported: .png, .jpg, .jpeg, .ppm, .pfm, .bmp, .exr, "
-                              ".hdr)");
-    cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.png", "--jpeg-quality", "80"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --jpeg-quality sets the quality of a JPEG output, and 'image.png' is none "
-                              "(write a .jpg or .jpeg, or leave it out)\n");
-    cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.jpg", "--png-depth", "16"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --png-depth sets the bits of a PNG output, and 'image.jpg' is none "
-                              "(write a .png, or leave it out)\n");
-    cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.jpg", "--jpeg-quality", "0"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "--jpeg-quality must be between 1 and 100, got 0");
-    cli_run(ARGS("scenes/cornell-box.scene", "-o", "image.png", "--png-depth", "12"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "--png-depth expects '8' or '16', got '12'");
-    cli_run(ARGS("scenes/cornell-box.scene", "--sampler", "halton"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "--sampler expects 'sobol' or 'independent', got 'halton'");
-    cli_run(ARGS("scenes/cornell-box.scene", "--accel", "octree"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "--accel expects 'bvh' or 'kdtree', got 'octree'");
-    cli_run(ARGS("scenes/cornell-box.scene", "--wave-launch", "fast"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "--wave-launch expects 'counted', 'bounded' or 'megakernel', got 'fast'");
-    /* a blank before a number was skipped (" 5" was 5, "5 " refused): refused too */
-    cli_run(ARGS("scenes/cornell-box.scene", "--spp", " 5"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --spp expects an integer, got ' 5'");
-    cli_run(ARGS("scenes/cornell-box.scene", "--time-limit", " 5"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "--time-limit expects a positive number of seconds, got ' 5'");
-    cli_run(ARGS("scenes/cornell-box.scene", "--sample-range", "0: 5"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "--sample-range expects A:B");
-    /* flags that shape what another flag turns on were ignored alone */
-    cli_run(ARGS("scenes/cornell-box.scene", "--adaptive-spp", "8"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --adaptive-spp sets the samples of the adaptive pass, which --adaptive "
-                              "THRESHOLD turns on; give both, or neither");
-    cli_run(ARGS("scenes/cornell-box.scene", "--depth-range", "1,10"), &r);
-    CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "clpt: error: --depth-range scales the depth image, which --aov depth turns on; "
-                              "give both, or neither");
-    cli_run(ARGS("scenes/cornell-box.scene", "--depth-range", "1,10", "--aov", "normal"), &r);
-    CHECK_EQ_INT(r.status, 2);
+    static const CliRefusal refused[] = {
+        { { "--spp" },
+          "--spp needs a value" },
+        { { "scenes/cornell-box.scene", "--spp", "ten" },
+          "--spp expects an integer, got 'ten'" },
+        { { "scenes/cornell-box.scene", "--width", "0" },
+          NULL },
+        { { "scenes/cornell-box.scene", "--split", "0" },
+          "--split must be between 1 and 64, got 0" },
+        { { "--frobnicate" },
+          "unknown option '--frobnicate'" },
+        { { "-q" },
+          "no scene given" },
+        { { "scenes/cornell-box.scene", "-o", "image.tga" },
+          "unsupported extension '.tga' (supported: .png, .jpg, .jpeg, .ppm, .pfm, .bmp, .exr, "
+          ".hdr)" },
+        { { "scenes/cornell-box.scene", "-o", "image.png", "--jpeg-quality", "80" },
+          "clpt: error: --jpeg-quality sets the quality of a JPEG output, and 'image.png' is none "
+          "(write a .jpg or .jpeg, or leave it out)\n" },
+        { { "scenes/cornell-box.scene", "-o", "image.jpg", "--png-depth", "16" },
+          "clpt: error: --png-depth sets the bits of a PNG output, and 'image.jpg' is none "
+          "(write a .png, or leave it out)\n" },
+        { { "scenes/cornell-box.scene", "-o", "image.jpg", "--jpeg-quality", "0" },
+          "--jpeg-quality must be between 1 and 100, got 0" },
+        { { "scenes/cornell-box.scene", "-o", "image.png", "--png-depth", "12" },
+          "--png-depth expects '8' or '16', got '12'" },
+        { { "scenes/cornell-box.scene", "--sampler", "halton" },
+          "--sampler expects 'sobol' or 'independent', got 'halton'" },
+        { { "scenes/cornell-box.scene", "--accel", "octree" },
+          "--accel expects 'bvh' or 'kdtree', got 'octree'" },
+        { { "scenes/cornell-box.scene", "--wave-launch", "fast" },
+          "--wave-launch expects 'counted', 'bounded' or 'megakernel', got 'fast'" },
+        /* a blank before a number was skipped (" 5" was 5, "5 " refused): refused too */
+        { { "scenes/cornell-box.scene", "--spp", " 5" },
+          "clpt: error: --spp expects an integer, got ' 5'" },
+        { { "scenes/cornell-box.scene", "--time-limit", " 5" },
+          "--time-limit expects a positive number of seconds, got ' 5'" },
+        { { "scenes/cornell-box.scene", "--sample-range", "0: 5" },
+          "--sample-range expects A:B" },
+        /* flags that shape what another flag turns on were ignored alone */
+        { { "scenes/cornell-box.scene", "--adaptive-spp", "8" },
+          "clpt: error: --adaptive-spp sets the samples of the adaptive pass, which --adaptive "
+          "THRESHOLD turns on; give both, or neither" },
+        { { "scenes/cornell-box.scene", "--depth-range", "1,10" },
+          "clpt: error: --depth-range scales the depth image, which --aov depth turns on; "
+          "give both, or neither" },
+        { { "scenes/cornell-box.scene", "--depth-range", "1,10", "--aov", "normal" },
+          NULL },
+    };
+    cli_check_refusals(refused, sizeof refused / sizeof refused[0], ST_USAGE);
 }
 
 /* The three ways an OpenCL device runs a wave (--wave-launch: counted; bounded, the

@@ -159,4 +159,31 @@ static inline void cli_check_refusals(const CliRefusal *cases, size_t n, int sta
     }
 }
 
+/* `scene` checkpointed at 4 samples (into ck) on the OpenCL devices the tests compare
+ * (TEST_OPENCL) and resumed to 8 on those and the scalar device together (into out)
+ * must be the straight 8-sample scalar render (ref) bit for bit: the resume check of
+ * the media and motion tests. */
+static inline void cli_check_resume_matches_straight(const char *scene, const char *ref, const char *out,
+                                                     const char *ck)
+{
+    static CliResult r;
+    char both[32];
+    snprintf(both, sizeof both, "%s,scalar", TEST_OPENCL);
+    unlink(ck);
+    const char *straight[] = { scene, "--device", "scalar", "--spp", "8", "-q", "-o", ref, NULL };
+    const char *first[] = { scene, "--device", TEST_OPENCL, "--spp", "4", "-q", "-o", out, "--checkpoint", ck, NULL };
+    const char *resumed[] = { scene, "--device", both, "--spp", "8", "--batch", "1", "-q", "-o", out, "--resume", ck,
+                              NULL };
+    cli_run(straight, &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(first, &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(resumed, &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_MSG(files_equal(ref, out), "4 samples resumed to 8 differ from a straight 8-sample render");
+    unlink(ref);
+    unlink(out);
+    unlink(ck);
+}
+
 #endif /* CLPT_CLI_UTIL_H */

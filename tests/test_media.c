@@ -376,23 +376,8 @@ static void test_devices_match_scalar(void)
  * device together, is the straight 8-sample render bit for bit. */
 static void test_resume_matches_straight(void)
 {
-    const char *scene = "tests/data/media/mix.scene";
-    const char *ref = TEST_TMP("clpt-test-media-ref.pfm"), *out = TEST_TMP("clpt-test-media-out.pfm"),
-               *ck = TEST_TMP("clpt-test-media.ckpt");
-    unlink(ck);
-    cli_run(ARGS(scene, "--device", "scalar", "--spp", "8", "-q", "-o", ref), &r);
-    CHECK_MSG(r.status == 0, "%s", r.err);
-    cli_run(ARGS(scene, "--device", TEST_OPENCL, "--spp", "4", "-q", "-o", out, "--checkpoint", ck), &r);
-    CHECK_MSG(r.status == 0, "%s", r.err);
-    char both[32];
-    snprintf(both, sizeof both, "%s,scalar", TEST_OPENCL);
-    cli_run(ARGS(scene, "--device", both, "--spp", "8", "--batch", "1", "-q", "-o", out, "--resume",
-                 ck), &r);
-    CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK_MSG(files_equal(ref, out), "4 samples resumed to 8 differ from a straight 8-sample render");
-    unlink(ref);
-    unlink(out);
-    unlink(ck);
+    cli_check_resume_matches_straight("tests/data/media/mix.scene", TEST_TMP("clpt-test-media-ref.pfm"),
+                                      TEST_TMP("clpt-test-media-out.pfm"), TEST_TMP("clpt-test-media.ckpt"));
 }
 
 /* First-hit splitting restarts paths at their first surface, which media can take

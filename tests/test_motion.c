@@ -256,22 +256,8 @@ static void test_kdtree_refuses_moving_instances(void)
  * the straight 8-sample render bit for bit. */
 static void test_resume_matches_straight(void)
 {
-    const char *scene = "tests/data/motion/instances.scene";
-    const char *ref = TEST_TMP("clpt-test-motion-ref.pfm"), *out = TEST_TMP("clpt-test-motion-out.pfm"),
-               *ck = TEST_TMP("clpt-test-motion.ckpt");
-    unlink(ck);
-    cli_run(ARGS(scene, "--device", "scalar", "--spp", "8", "-q", "-o", ref), &r);
-    CHECK_MSG(r.status == 0, "%s", r.err);
-    cli_run(ARGS(scene, "--device", TEST_OPENCL, "--spp", "4", "-q", "-o", out, "--checkpoint", ck), &r);
-    CHECK_MSG(r.status == 0, "%s", r.err);
-    char both[32];
-    snprintf(both, sizeof both, "%s,scalar", TEST_OPENCL);
-    cli_run(ARGS(scene, "--device", both, "--spp", "8", "--batch", "1", "-q", "-o", out, "--resume", ck), &r);
-    CHECK_MSG(r.status == 0, "%s", r.err);
-    CHECK_MSG(files_equal(ref, out), "4 samples resumed to 8 differ from a straight 8-sample render");
-    unlink(ref);
-    unlink(out);
-    unlink(ck);
+    cli_check_resume_matches_straight("tests/data/motion/instances.scene", TEST_TMP("clpt-test-motion-ref.pfm"),
+                                      TEST_TMP("clpt-test-motion-out.pfm"), TEST_TMP("clpt-test-motion.ckpt"));
 }
 
 int main(void)

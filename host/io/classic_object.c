@@ -159,20 +159,16 @@ static Status read_object(Classic *c, const Token *kw, const char *name, const C
     return st ? st : object_material(c, material);
 }
 
-/* Each object below is its keys (an enum and a ClassicKey table) and a builder that
- * starts with read_object: their openings are alike by design, what differs is the
- * table and the geometry after it. */
+/* Each object below is its keys (an enum and a ClassicKey table) and a builder of its
+ * geometry from the values read and its material (keyed_objects, which
+ * classic_parse_object reads the block by). */
 enum { SPH_CENTER, SPH_RADIUS, SPH_N };
 static const ClassicKey sphere_keys[SPH_N] = {
     [SPH_CENTER] = {"center", CK_VEC3, 0}, [SPH_RADIUS] = {"radius", CK_POSITIVE, 1},
 };
 
-static Status parse_sphere(Classic *c, const Token *kw, const Transform *m)
+static Status build_sphere(Classic *c, const Token *kw, const Transform *m, const ClassicValue *v, uint material)
 {
-    ClassicValue v[SPH_N];
-    uint material;
-    Status st = read_object(c, kw, "Sphere", sphere_keys, SPH_N, v, &material);
-    if (st) return st;
     vec3 center = v[SPH_CENTER].v;   /* the origin when not given */
     double scale;
     int rotates;
@@ -195,12 +191,9 @@ static const ClassicKey plane_keys[PL_N] = {
 };
 
 /* The plane dot(normal, p) = offset (normal of any length). */
-static Status parse_plane(Classic *c, const Token *kw, const Transform *m)
+static Status build_plane(Classic *c, const Token *kw, const Transform *m, const ClassicValue *v, uint material)
 {
-    ClassicValue v[PL_N];
-    uint material;
-    Status st = read_object(c, kw, "Plane", plane_keys, PL_N, v, &material);
-    if (st) return st;
+    (void)kw;
     vec3 n = v[PL_NORMAL].v;
     double n2 = (double)n.x * n.x + (double)n.y * n.y + (double)n.z * n.z;
     double k = v[PL_OFFSET].f / n2;
@@ -222,12 +215,10 @@ static const ClassicKey triangle_keys[TRI_N] = {
     [TRI_V0] = {"vertex0", CK_VEC3, 1}, [TRI_V1] = {"vertex1", CK_VEC3, 1}, [TRI_V2] = {"vertex2", CK_VEC3, 1},
 };
 
-static Status parse_triangle(Classic *c, const Token *kw, const Transform *m)
+static Status build_triangle(Classic *c, const Token *kw, const Transform *m, const ClassicValue *v,
+                             uint material)
 {
-    ClassicValue v[TRI_N];
-    uint material;
-    Status st = read_object(c, kw, "Triangle", triangle_keys, TRI_N, v, &material);
-    if (st) return st;
+    (void)kw;
     vec3 a = transform_point(m, v[TRI_V0].v), b = transform_point(m, v[TRI_V1].v), d = transform_point(m, v[TRI_V2].v);
     /* a mirroring transform turns the winding around; keep the outward side outward */
     return transform_det(m) < 0.0 ? add_tri(c, a, d, b, material, NO_INDEX) : add_tri(c, a, b, d, material, NO_INDEX);
@@ -236,14 +227,11 @@ static Status parse_triangle(Classic *c, const Token *kw, const Transform *m)
 enum { MESH_FILE, MESH_N };
 static const ClassicKey mesh_keys[MESH_N] = { [MESH_FILE] = {"obj_file", CK_PATH, 1} };
 
-static Status parse_mesh(Classic *c, const Token *kw, const Transform *m)
+static Status build_mesh(Classic *c, const Token *kw, const Transform *m, const ClassicValue *v, uint material)
 {
-    ClassicValue v[MESH_N];
-    uint material;
-    Status st = read_object(c, kw, "TriangleMesh", mesh_keys, MESH_N, v, &material);
-    if (st) return st;
     char *path;
-    if ((st = classic_resolve_path(c, &v[MESH_FILE].word, &path))) return st;
+    Status st = classic_resolve_path(c, &v[MESH_FILE].word, &path);
+    if (st) return st;
     /* the sink applies the transform as it does to a mesh of our format */
     MeshOptions o = mesh_options(material);
     o.xf = *m;
@@ -565,6 +553,24 @@ static Status enter_block(Classic *c, const Token *kw)
     return ST_OK;
 }
 
+/* The objects that are one block of keys: read by read_object, then built. */
+typedef Status (*ObjectBuild)(Classic *c, const Token *kw, const Transform *m, const ClassicValue *v, uint material);
+static const struct {
+    const char *name;
+    const ClassicKey *keys;
+    size_t n_keys;
+    ObjectBuild build;
+} keyed_objects[] = {
+    {"Sphere", sphere_keys, SPH_N, build_sphere},
+    {"Plane", plane_keys, PL_N, build_plane},
+    {"Triangle", triangle_keys, TRI_N, build_triangle},
+    {"TriangleMesh", mesh_keys, MESH_N, build_mesh},
+};
+enum { OBJECT_MAX_KEYS = 3 };
+_Static_assert((int)SPH_N <= (int)OBJECT_MAX_KEYS && (int)PL_N <= (int)OBJECT_MAX_KEYS &&
+               (int)TRI_N <= (int)OBJECT_MAX_KEYS && (int)MESH_N <= (int)OBJECT_MAX_KEYS,
+               "keyed_objects: a block with more keys than OBJECT_MAX_KEYS");
+
 Status classic_parse_object(Classic *c, const Token *kw, const Transform *m)
 {
     if (tok_is(kw, "Group") || tok_is(kw, "Transform")) {
@@ -574,10 +580,14 @@ Status classic_parse_object(Classic *c, const Token *kw, const Transform *m)
         c->depth--;
         return st;
     }
-    if (tok_is(kw, "Sphere")) return parse_sphere(c, kw, m);
-    if (tok_is(kw, "Plane")) return parse_plane(c, kw, m);
-    if (tok_is(kw, "Triangle")) return parse_triangle(c, kw, m);
-    if (tok_is(kw, "TriangleMesh")) return parse_mesh(c, kw, m);
+    for (size_t i = 0; i < sizeof keyed_objects / sizeof keyed_objects[0]; i++)
+        if (tok_is(kw, keyed_objects[i].name)) {
+            ClassicValue v[OBJECT_MAX_KEYS];
+            uint material;
+            Status st = read_object(c, kw, keyed_objects[i].name, keyed_objects[i].keys, keyed_objects[i].n_keys, v,
+                                    &material);
+            return st ? st : keyed_objects[i].build(c, kw, m, v, material);
+        }
     if (tok_is(kw, "RevSurface")) return parse_revsurface(c, kw, m);
     if (tok_is(kw, "BezierCurve") || tok_is(kw, "BsplineCurve")) return parse_lone_curve(c, kw);
     return classic_expected(c, kw, "an object (Group, Sphere, Plane, Triangle, TriangleMesh, Transform, RevSurface, "

@@ -29,8 +29,8 @@ static const struct {
     const char *keyword;
     Status (*parse)(Parser *p, Lexer *lx, const Token *kw);
 } object_statements[] = {
-    {"sphere", scene_parse_sphere}, {"triangle", scene_parse_triangle}, {"quad", scene_parse_quad},
-    {"box", scene_parse_box},       {"mesh", scene_parse_mesh},
+    {"sphere", scene_parse_shape}, {"triangle", scene_parse_shape}, {"quad", scene_parse_shape},
+    {"box", scene_parse_shape},    {"mesh", scene_parse_mesh},
 };
 #define N_OBJECT_STATEMENTS (sizeof object_statements / sizeof object_statements[0])
 

@@ -138,11 +138,8 @@ Status scene_parse_material(Parser *p, Lexer *lx, const Token *kw);
 Status scene_parse_texture(Parser *p, Lexer *lx, const Token *kw);
 
 /* scene_shape.c: sphere, plane, triangle, quad, box, mesh, light */
-Status scene_parse_sphere(Parser *p, Lexer *lx, const Token *kw);
-Status scene_parse_plane(Parser *p, Lexer *lx, const Token *kw);
-Status scene_parse_triangle(Parser *p, Lexer *lx, const Token *kw);
-Status scene_parse_quad(Parser *p, Lexer *lx, const Token *kw);
-Status scene_parse_box(Parser *p, Lexer *lx, const Token *kw);
+/* sphere, plane, triangle, quad and box: the shape kw names */
+Status scene_parse_shape(Parser *p, Lexer *lx, const Token *kw);
 Status scene_parse_mesh(Parser *p, Lexer *lx, const Token *kw);
 Status scene_parse_light(Parser *p, Lexer *lx, const Token *kw);
 /* The transform of a block's keys translate, rotate, rx, ry, rz, scale, matrix (seven

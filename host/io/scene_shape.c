@@ -15,8 +15,8 @@
 
 /* The material a shape gets from its surface keys (v[prefix##_MATERIAL] onwards),
  * bound to its interior and exterior media. Each shape below is a key table and a
- * builder that starts with scene_parse_block and binds its surface here: their
- * openings are alike by design, what differs is the table and the geometry. */
+ * builder of its geometry from the values read, which binds its surface here;
+ * surface_shapes pairs them and scene_parse_shape reads the block. */
 static Status shape_surface(Parser *p, const Value *surface, uint *material)
 {
     return scene_shape_media(p, &surface[1], &surface[2], surface[0].material, material);
@@ -29,11 +29,10 @@ static const KeySpec sphere_keys[SPH_N] = {
     SURFACE_KEYS(SPH),
 };
 
-Status scene_parse_sphere(Parser *p, Lexer *lx, const Token *kw)
+static Status build_sphere(Parser *p, const Lexer *lx, const Token *kw, const Value *v)
 {
-    Value v[SPH_N];
-    Status st = scene_parse_block(p, lx, kw, 0, "sphere", sphere_keys, SPH_N, v);
-    if (st) return st;
+    (void)kw;
+    Status st;
     vec3 c = v[SPH_CENTER].v;
     float r = v[SPH_RADIUS].f;
     /* a bounding box that overflows would leave the sphere out of the kd-tree */
@@ -55,11 +54,10 @@ static const KeySpec plane_keys[PL_N] = {
     SURFACE_KEYS(PL),
 };
 
-Status scene_parse_plane(Parser *p, Lexer *lx, const Token *kw)
+static Status build_plane(Parser *p, const Lexer *lx, const Token *kw, const Value *v)
 {
-    Value v[PL_N];
-    Status st = scene_parse_block(p, lx, kw, 0, "plane", plane_keys, PL_N, v);
-    if (st) return st;
+    (void)kw;
+    Status st;
     vec3 n = v[PL_NORMAL].v, q = v[PL_POINT].v;
     double len = scene_len_d(n);
     if (!isfinite(len))
@@ -111,21 +109,17 @@ static const KeySpec quad_keys[QUAD_N] = {
     SURFACE_KEYS(QUAD),
 };
 
-Status scene_parse_triangle(Parser *p, Lexer *lx, const Token *kw)
+static Status build_triangle(Parser *p, const Lexer *lx, const Token *kw, const Value *v)
 {
-    Value v[TRI_N];
-    Status st = scene_parse_block(p, lx, kw, 0, "triangle", triangle_keys, TRI_N, v);
-    if (st) return st;
+    Status st;
     uint m;
     if ((st = shape_surface(p, &v[TRI_MATERIAL], &m))) return st;
     return add_triangle(p, lx, kw, v[TRI_V0].v, v[TRI_V1].v, v[TRI_V2].v, m, "v0 v1 v2");
 }
 
-Status scene_parse_quad(Parser *p, Lexer *lx, const Token *kw)
+static Status build_quad(Parser *p, const Lexer *lx, const Token *kw, const Value *v)
 {
-    Value v[QUAD_N];
-    Status st = scene_parse_block(p, lx, kw, 0, "quad", quad_keys, QUAD_N, v);
-    if (st) return st;
+    Status st;
     uint m;
     if ((st = shape_surface(p, &v[QUAD_MATERIAL], &m))) return st;
     st = add_triangle(p, lx, kw, v[QUAD_V0].v, v[QUAD_V1].v, v[QUAD_V2].v, m, "v0 v1 v2");
@@ -140,11 +134,10 @@ static const KeySpec box_keys[BOX_N] = {
     SURFACE_KEYS(BOX),
 };
 
-Status scene_parse_box(Parser *p, Lexer *lx, const Token *kw)
+static Status build_box(Parser *p, const Lexer *lx, const Token *kw, const Value *v)
 {
-    Value v[BOX_N];
-    Status st = scene_parse_block(p, lx, kw, 0, "box", box_keys, BOX_N, v);
-    if (st) return st;
+    (void)kw;
+    Status st;
     vec3 lo = v[BOX_MIN].v, hi = v[BOX_MAX].v;
     static const char axis[3] = {'x', 'y', 'z'};
     for (int i = 0; i < 3; i++)
@@ -159,6 +152,38 @@ Status scene_parse_box(Parser *p, Lexer *lx, const Token *kw)
     b.hi = hi;
     if ((st = shape_surface(p, &v[BOX_MATERIAL], &b.material))) return st;
     return scene_add_box(p->s, b, p->err);
+}
+
+/* The shapes with a surface: each one's block, read by scene_parse_shape, and its
+ * builder. */
+typedef Status (*ShapeBuild)(Parser *p, const Lexer *lx, const Token *kw, const Value *v);
+static const struct {
+    const char *name;
+    const KeySpec *keys;
+    uint n_keys;
+    ShapeBuild build;
+} surface_shapes[] = {
+    {"sphere", sphere_keys, SPH_N, build_sphere},
+    {"plane", plane_keys, PL_N, build_plane},
+    {"triangle", triangle_keys, TRI_N, build_triangle},
+    {"quad", quad_keys, QUAD_N, build_quad},
+    {"box", box_keys, BOX_N, build_box},
+};
+enum { SHAPE_MAX_KEYS = 7 };
+_Static_assert((int)SPH_N <= (int)SHAPE_MAX_KEYS && (int)PL_N <= (int)SHAPE_MAX_KEYS &&
+               (int)TRI_N <= (int)SHAPE_MAX_KEYS && (int)QUAD_N <= (int)SHAPE_MAX_KEYS &&
+               (int)BOX_N <= (int)SHAPE_MAX_KEYS, "surface_shapes: a block with more keys than SHAPE_MAX_KEYS");
+
+Status scene_parse_shape(Parser *p, Lexer *lx, const Token *kw)
+{
+    for (size_t i = 0; i < sizeof surface_shapes / sizeof surface_shapes[0]; i++)
+        if (tok_is(kw, surface_shapes[i].name)) {
+            Value v[SHAPE_MAX_KEYS];
+            Status st = scene_parse_block(p, lx, kw, 0, surface_shapes[i].name, surface_shapes[i].keys,
+                                          surface_shapes[i].n_keys, v);
+            return st ? st : surface_shapes[i].build(p, lx, kw, v);
+        }
+    return error_set(p->err, ST_INTERNAL, "no shape '%.*s'", (int)kw->len, kw->text);
 }
 
 enum { MESH_FILE, MESH_MATERIAL, TRANSFORM_KEY_IDS(MESH), MESH_INTERIOR, MESH_EXTERIOR, MESH_N };

@@ -59,21 +59,6 @@ static void worker_free(Worker *w)
     pool_release(&w->ids, (PoolMark){ NULL, 0 });
 }
 
-static int build_failed(Build *b)
-{
-    pthread_mutex_lock(&b->lock);
-    int f = b->failed;
-    pthread_mutex_unlock(&b->lock);
-    return f;
-}
-
-static void build_fail(Build *b)
-{
-    pthread_mutex_lock(&b->lock);
-    b->failed = 1;
-    pthread_mutex_unlock(&b->lock);
-}
-
 /* The root's sweep and list split take as long as a whole level of nodes below it, and
  * the other threads would only wait for work meanwhile: at the root, the three axes run
  * side by side (each axis's work is independent, and the result is the same bits). */
@@ -699,14 +684,16 @@ static Status subtrees_build(Build *b, NodeLists root, BNode **out, Error *err)
         else break;
     if (n_started == 0) b->threads = 1;
     double cost;
-    if (build_node(&b->workers[0], root, 0, 0, 0, out, &cost)) build_fail(b);
-    pthread_mutex_lock(&b->lock);
+    int fail = build_node(&b->workers[0], root, 0, 0, 0, out, &cost);
+    pthread_mutex_lock(&b->lock);   /* as worker_run ends a task: the others may be running */
+    if (fail) b->failed = 1;
     if (--b->outstanding == 0) pthread_cond_broadcast(&b->cond);
     pthread_mutex_unlock(&b->lock);
     worker_run(&b->workers[0]);
     for (int i = 1; i <= n_started; i++) pthread_join(tid[i], NULL);
     free(tid);
-    if (build_failed(b)) return error_set(err, ST_INTERNAL, "kd-tree: out of memory building the tree");
+    /* every worker has returned (joined): failed is read without the lock */
+    if (b->failed) return error_set(err, ST_INTERNAL, "kd-tree: out of memory building the tree");
     return ST_OK;
 }
 

@@ -12,9 +12,10 @@ build=${1:-build}
 here=$(dirname "$0")
 # PoCL compiles kernels on first use; keep its cache inside the build folder so test
 # runs do not write to the user's home and reruns are fast.
-: "${POCL_CACHE_DIR:=$PWD/$build/pocl-cache}"
+case "$build" in /*) dir=$build ;; *) dir=$PWD/$build ;; esac
+: "${POCL_CACHE_DIR:=$dir/pocl-cache}"
 export POCL_CACHE_DIR
-export CLPT_CACHE_DIR="${CLPT_CACHE_DIR:-$PWD/$build/kernel-cache}"
+export CLPT_CACHE_DIR="${CLPT_CACHE_DIR:-$dir/kernel-cache}"
 mkdir -p "$POCL_CACHE_DIR" "$CLPT_CACHE_DIR"
 jobs=${TEST_JOBS:-$(getconf _NPROCESSORS_ONLN 2>/dev/null || echo 1)}
 case "$jobs" in ''|*[!0-9]*|0) echo "run.sh: TEST_JOBS must be a positive number, not '$jobs'" >&2; exit 2 ;; esac

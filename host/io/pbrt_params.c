@@ -1,6 +1,8 @@
 /* pbrt_params.c — pbrt-v4 parameter lists, spectra and positional arguments (pbrt_reader.h). */
 #include "io/pbrt_reader.h"
 
+#include "scene/blackbody.h"
+
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -277,47 +279,6 @@ Status pbrt_get_point(Parser *p, const Lexer *lx, const char *name, vec3 *out)
 
 /* ------------------------------------------------------------------ spectra */
 
-/* CIE 1931 colour matching functions, the multi-lobe Gaussian fit of Wyman, Sloan and
- * Shirley (JCGT 2013); enough for a blackbody's colour to a few parts in a thousand. */
-static double g_lobe(double x, double mu, double s1, double s2)
-{
-    double t = (x - mu) / (x < mu ? s1 : s2);
-    return exp(-0.5 * t * t);
-}
-
-static void cie_xyz(double nm, double *x, double *y, double *z)
-{
-    *x = 1.056 * g_lobe(nm, 599.8, 37.9, 31.0) + 0.362 * g_lobe(nm, 442.0, 16.0, 26.7) -
-         0.065 * g_lobe(nm, 501.1, 20.4, 26.2);
-    *y = 0.821 * g_lobe(nm, 568.8, 46.9, 40.5) + 0.286 * g_lobe(nm, 530.9, 16.3, 31.1);
-    *z = 1.217 * g_lobe(nm, 437.0, 11.8, 36.0) + 0.681 * g_lobe(nm, 459.0, 26.0, 13.8);
-}
-
-/* Linear sRGB of a blackbody at `kelvin`, scaled to luminance 1: pbrt-v4 divides a
- * light's spectrum by its luminance (SpectrumToPhotometric), so only the colour counts. */
-static vec3 blackbody_rgb(double kelvin)
-{
-    const double c = 299792458.0, h = 6.62606957e-34, kb = 1.3806488e-23;
-    double X = 0, Y = 0, Z = 0;
-    for (double nm = 360.0; nm <= 830.0; nm += 1.0) {
-        double l = nm * 1e-9;
-        double le = (2 * h * c * c) / (pow(l, 5) * (exp((h * c) / (l * kb * kelvin)) - 1));
-        double x, y, z;
-        cie_xyz(nm, &x, &y, &z);
-        X += le * x;
-        Y += le * y;
-        Z += le * z;
-    }
-    if (!(Y > 0) || !isfinite(Y)) return v3(1, 1, 1);
-    X /= Y;
-    Z /= Y;
-    Y = 1;
-    double r = 3.2404542 * X - 1.5371385 * Y - 0.4985314 * Z;
-    double g = -0.9692660 * X + 1.8760108 * Y + 0.0415560 * Z;
-    double b = 0.0556434 * X - 0.2040259 * Y + 1.0572252 * Z;
-    return v3((float)fmax(r, 0), (float)fmax(g, 0), (float)fmax(b, 0));
-}
-
 /* pbrt-v4's named glasses, their index at 550 nm */
 static const struct { const char *name; float ior; } glasses[] = {
     {"glass-BK7", 1.5185f},  {"glass-BAF10", 1.6700f}, {"glass-FK51A", 1.4866f}, {"glass-LASF9", 1.8503f},
@@ -385,7 +346,7 @@ Status pbrt_get_spectrum(Parser *p, const Lexer *lx, const char *name, vec3 *out
         return ST_OK;
     case PT_BLACKBODY:
         if (!(d[0] > 0)) return pbrt_param_type_error(p, lx, pa, "a blackbody temperature > 0 (kelvin)");
-        *out = blackbody_rgb(d[0]);
+        *out = blackbody_rgb_unit_luminance(d[0]);
         return ST_OK;
     case PT_SPECTRUM:
         if (pa->strings) {

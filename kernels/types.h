@@ -646,7 +646,8 @@ typedef struct {                                        /* 64 bytes */
     vec3 sigma_s;  float pad3;   /* scattering; MEDIUM_GRID: per unit of density */
     vec3 emission; float pad4;   /* radiance Le (pbrt-v4's Le times Lescale): a stretch
                                * ds emits sigma_a Le ds (medium_emitted, grid_emitted);
-                               * MEDIUM_GRID: times the cell's emission scale; with
+                               * MEDIUM_GRID: times the cell's emission scale and
+                               * its colour (GridMedium.emission_rgb_at); with
                                * MEDIUM_EMISSIVE set in flags when not 0 0 0 */
 } Medium;
 
@@ -676,7 +677,12 @@ typedef struct {                                        /* 96 bytes */
                                * (pbrt-v4's "Lescale" grid), trilinear as the density;
                                * 0 when there is none (scale 1 everywhere): offset 0
                                * is the first grid's densities, never an emission grid */
-    uint pad1, pad2;
+    uint emission_rgb_at;     /* the offset in grid_data of three planes of nx ny nz values,
+                               * red, green, blue: a per-cell emission colour (a temperature
+                               * grid's blackbody radiance, baked at load), trilinear as the
+                               * density and multiplying Medium.emission; 0 when there is
+                               * none (colour 1 1 1 everywhere) */
+    uint pad2;
 } GridMedium;
 
 /* Which strategies the path integrator combines for area lights: both with the power
@@ -862,6 +868,7 @@ _Static_assert(offsetof(Medium, emission) == 48, "Medium.emission");
 _Static_assert(offsetof(GridMedium, nx) == 48, "GridMedium.nx");
 _Static_assert(offsetof(GridMedium, max_density) == 80, "GridMedium.max_density");
 _Static_assert(offsetof(GridMedium, emission_at) == 84, "GridMedium.emission_at");
+_Static_assert(offsetof(GridMedium, emission_rgb_at) == 88, "GridMedium.emission_rgb_at");
 #undef CLPT_CHECK_SIZE
 #endif
 

@@ -2,6 +2,7 @@
 #include "scene/media.h"
 
 #include "base/array.h"
+#include "scene/blackbody.h"
 
 #include "util/kmath.h"
 
@@ -46,6 +47,38 @@ Status scene_grid_set_emission(Scene *s, uint grid, const float *scale, Error *e
     memcpy(s->grid_data + at, scale, n * sizeof(float));
     g->emission_at = (uint)at;   /* > 0: the grid's densities come first */
     s->n_grid_data = at + n;
+    return ST_OK;
+}
+
+Status scene_grid_set_temperature(Scene *s, uint grid, const float *temperature, GridTemperature how, Error *err)
+{
+    GridMedium *g = &s->grids[grid];
+    size_t n = (size_t)g->nx * g->ny * g->nz, at = s->n_grid_data;
+    if (at + 3 * n > 0xffffffffu) return error_set(err, ST_INPUT, "the density grids hold more than 2^32 values together");
+    BlackbodyTable *table = malloc(sizeof *table);
+    if (!table || array_reserve((void **)&s->grid_data, &s->cap_grid_data, at + 3 * n, sizeof(float))) {
+        free(table);
+        return error_set(err, ST_INTERNAL, "out of memory for a temperature grid");
+    }
+    blackbody_table_init(table);
+    float *red = s->grid_data + at, *green = red + n, *blue = green + n;
+    /* neighbouring cells often share a temperature (the empty space around a flame
+     * above all): Planck's law is integrated once per run of equal values */
+    double last = -1.0;
+    vec3 rgb = v3s(0.0f);
+    for (size_t i = 0; i < n; i++) {
+        double kelvin = ((double)temperature[i] - how.offset) * how.scale;
+        if (i == 0 || kelvin != last) {
+            rgb = kelvin > GRID_TEMPERATURE_CUTOFF ? blackbody_rgb_peak_normalised(table, kelvin) : v3s(0.0f);
+            last = kelvin;
+        }
+        red[i] = rgb.x;
+        green[i] = rgb.y;
+        blue[i] = rgb.z;
+    }
+    free(table);
+    g->emission_rgb_at = (uint)at;   /* > 0: the grid's densities come first */
+    s->n_grid_data = at + 3 * n;
     return ST_OK;
 }
 

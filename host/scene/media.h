@@ -43,6 +43,22 @@ Medium medium_with_emission(Medium m, vec3 le);
  * "Lescale" grid. Fails only when memory runs out or the grids pass 2^32 floats. */
 Status scene_grid_set_emission(Scene *s, uint grid, const float *scale, Error *err);
 
+/* How a temperature grid's values become kelvin: T = (value - offset) * scale (pbrt-v4's
+ * "temperatureoffset" and "temperaturescale"); cells of T <= GRID_TEMPERATURE_CUTOFF
+ * emit nothing (pbrt-v4's fixed 100 K). */
+typedef struct {
+    double offset, scale;   /* finite; scale >= 0 */
+} GridTemperature;
+
+#define GRID_TEMPERATURE_CUTOFF 100.0
+
+/* Gives grid `grid` a per-cell emission colour from nx ny nz temperatures of its size
+ * (finite: the reader checks): each cell's pbrt-v4 BlackbodySpectrum(T) (peak 1) as
+ * linear sRGB (scene/blackbody.h), three planes in grid_data (GridMedium.emission_rgb_at),
+ * interpolated as its density. The medium's emission multiplies it (pbrt-v4's Lescale).
+ * Fails only when memory runs out or the grids pass 2^32 floats. */
+Status scene_grid_set_temperature(Scene *s, uint grid, const float *temperature, GridTemperature how, Error *err);
+
 /* Adds medium m named `name` (the caller checks that the name is new). Fails only when
  * memory runs out. */
 Status scene_add_medium(Scene *s, const char *name, Medium m, uint *index, Error *err);

@@ -124,7 +124,9 @@ KFN float grid_density(const SceneView *sc, const GridMedium *g, vec3 q)
 /* What a tentative collision at unit-cube point q of density dens adds to the path's
  * emitted radiance, per unit of its weight w: w sigma_a(q) Le(q) / sigma_bar, where
  * sigma_a(q) = dens sigma_a and Le(q) the medium's emission times the cell's scale
- * (pbrt-v4's GridMedium: Le_spec times its "Lescale" grid). Collisions arrive at rate
+ * (pbrt-v4's GridMedium: Le_spec times its "Lescale" grid) and, when the grid has one,
+ * the cell's colour (a temperature grid's blackbody, pbrt-v4's BlackbodySpectrum(T(q))
+ * baked to RGB per cell at load: docs/media.md, "Blackbody emission"). Collisions arrive at rate
  * sigma_bar along the ray and w estimates the transmittance up to q, so the sum over
  * a flight estimates the emission integral int T(t) sigma_a(t) Le(t) dt without bias
  * (Pharr, Jakob, Humphreys, PBR 4th ed., sec. 14.2.2: pbrt-v4's VolPathIntegrator
@@ -132,7 +134,13 @@ KFN float grid_density(const SceneView *sc, const GridMedium *g, vec3 q)
 KFN vec3 grid_emitted(const SceneView *sc, const GridMedium *g, Medium md, vec3 q, float dens, vec3 w, float bar)
 {
     float scale = g->emission_at != 0u ? grid_lookup(sc, g, g->emission_at, q) : 1.0f;
-    vec3 le = v3_scale(v3_mul(md.sigma_a, md.emission), dens * scale / bar);
+    vec3 e = md.emission;
+    if (g->emission_rgb_at != 0u) {
+        uint plane = g->nx * g->ny * g->nz;
+        e = v3_mul(e, v3(grid_lookup(sc, g, g->emission_rgb_at, q), grid_lookup(sc, g, g->emission_rgb_at + plane, q),
+                         grid_lookup(sc, g, g->emission_rgb_at + 2u * plane, q)));
+    }
+    vec3 le = v3_scale(v3_mul(md.sigma_a, e), dens * scale / bar);
     return v3_mul(w, le);
 }
 

@@ -15,6 +15,7 @@
 #include "io/pbrt_parse.h"
 #include "io/scene_load.h"
 #include "render_util.h"
+#include "scene/blackbody.h"
 #include "scene/camera.h"
 #include "io/image_write.h"
 #include "scene/mesh_sink.h"
@@ -1069,6 +1070,67 @@ static void test_media_emission(void)
                  DIR "inline.pbrt:2:86: MakeNamedMedium \"m\": Lescale -2 (value 0) must be a finite number >= 0");
 }
 
+/* A uniformgrid's "temperature" grid (pbrt-v4's GridMedium): each cell's blackbody,
+ * T = (value - temperatureoffset) * temperaturescale, baked to three planes of RGB
+ * (pbrt's BlackbodySpectrum, peak 1), nothing at T <= 100 K; the medium's emission 1 1 1
+ * times the "Lescale" grid when given; "temperaturecutoff" is the offset's older name. */
+static void test_grid_temperature(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"fire\" \"string type\" \"uniformgrid\" \"integer nx\" 3\n"
+                           "  \"float density\" [1 1 1] \"float temperature\" [20 1100 2900]\n"
+                           "  \"float temperatureoffset\" 100 \"float temperaturescale\" 2 \"float Lescale\" [1 2 3]\n"
+                           "MakeNamedMedium \"old\" \"string type\" \"uniformgrid\" \"float density\" [1]\n"
+                           "  \"float temperature\" [1600] \"float temperaturecutoff\" 100\n"
+                           "WorldBegin\n",
+                           &s, &err),
+                 ST_OK);
+    CHECK_EQ_INT(s.n_grids, 2);
+    if (s.n_media == 2 && s.n_grids == 2) {
+        BlackbodyTable t;
+        blackbody_table_init(&t);
+        vec3 k2000 = blackbody_rgb_peak_normalised(&t, 2000.0), k5600 = blackbody_rgb_peak_normalised(&t, 5600.0);
+        vec3 k1500 = blackbody_rgb_peak_normalised(&t, 1500.0);
+        CHECK_V3(s.media[0].emission, 1, 1, 1, 0);
+        CHECK(s.media[0].flags & MEDIUM_EMISSIVE);
+        const GridMedium *g = &s.grids[0];
+        CHECK(g->emission_rgb_at != 0u && g->emission_at != 0u);
+        const float *rgb = s.grid_data + g->emission_rgb_at;
+        /* cell 0: (20 - 100) 2 < 100 K emits nothing */
+        CHECK_V3(v3(rgb[0], rgb[3], rgb[6]), 0, 0, 0, 0);
+        CHECK_V3(v3(rgb[1], rgb[4], rgb[7]), k2000.x, k2000.y, k2000.z, 0);
+        CHECK_V3(v3(rgb[2], rgb[5], rgb[8]), k5600.x, k5600.y, k5600.z, 0);
+        CHECK_NEAR(s.grid_data[g->emission_at + 2], 3, 0);
+        const float *old = s.grid_data + s.grids[1].emission_rgb_at;
+        CHECK_V3(v3(old[0], old[1], old[2]), k1500.x, k1500.y, k1500.z, 0);
+        /* a blackbody reddens as it cools: red above green above blue */
+        CHECK(k2000.x > k2000.y && k2000.y > k2000.z && k2000.x > 0.0f);
+    }
+    CHECK_EQ_INT(s.n_warnings, 0);
+    scene_free(&s);
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [1] "
+                 "\"float temperature\" [1000] \"float temperaturescale\" -1\n",
+                 DIR "inline.pbrt:2:96: parameter 'temperaturescale' must be a number in [0, 1e30]");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"integer nx\" 2 "
+                 "\"float density\" [1 1] \"float temperature\" [1000]\n",
+                 DIR "inline.pbrt:2:86: MakeNamedMedium \"m\": nx ny nz 2 1 1 are 2 cells, but \"temperature\" has 1 "
+                 "values");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [1] "
+                 "\"float temperature\" [-5]\n",
+                 DIR "inline.pbrt:2:69: MakeNamedMedium \"m\": temperature -5 (value 0) must be a finite number >= 0");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [1] "
+                 "\"float temperature\" [1e39]\n",
+                 DIR "inline.pbrt:2:90: expected a finite number, found '1e39'");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [1] "
+                 "\"float temperature\" [1000] \"float temperatureoffset\" 1e31\n",
+                 DIR "inline.pbrt:2:96: parameter 'temperatureoffset' must be a number in [-1e30, 1e30]");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [1] "
+                 "\"float temperature\" [1000] \"rgb Le\" [1 1 1]\n",
+                 DIR "inline.pbrt:2:96: MakeNamedMedium \"m\": a \"uniformgrid\" has \"Le\" or \"temperature\", not "
+                 "both");
+}
+
 /* MakeNamedMedium "uniformgrid": the density grid (x fastest) over p0 p1 placed by the
  * current transform, sigma_a and sigma_s times scale per unit of density. */
 static void test_uniform_grid(void)
@@ -1774,6 +1836,7 @@ int main(void)
     RUN(test_media);
     RUN(test_uniform_grid);
     RUN(test_media_emission);
+    RUN(test_grid_temperature);
     RUN(test_named_material_later);
     RUN(test_include);
     RUN(test_instances);

@@ -157,13 +157,37 @@ static Status grid_le_scale(Parser *p, const Lexer *lx, const Token *name, const
     return pl ? grid_values(p, lx, name, pl, "Lescale", n, cells, out) : ST_OK;
 }
 
+/* pbrt_reader.h: "temperatureoffset" (pbrt-v4's older name "temperaturecutoff" when it
+ * is not given; 0 by default) and "temperaturescale" (1), each finite, the scale >= 0. */
+Status pbrt_medium_temperature(Parser *p, const Lexer *lx, GridTemperature *how)
+{
+    Status st;
+    double cutoff = 0.0, offset, scale = 1.0;
+    if ((st = pbrt_get_float(p, lx, "temperaturecutoff", &cutoff))) return st;
+    offset = cutoff;
+    if ((st = pbrt_get_float(p, lx, "temperatureoffset", &offset)) ||
+        (st = pbrt_get_float(p, lx, "temperaturescale", &scale)))
+        return st;
+    if (!(fabs(cutoff) <= 1e30))
+        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "temperaturecutoff"), "a number in [-1e30, 1e30]");
+    if (!(fabs(offset) <= 1e30))
+        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "temperatureoffset"), "a number in [-1e30, 1e30]");
+    if (!(scale >= 0.0) || !(scale <= 1e30))
+        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "temperaturescale"), "a number in [0, 1e30]");
+    how->offset = offset;
+    how->scale = scale;
+    return ST_OK;
+}
+
 /* pbrt-v4's "uniformgrid" medium: "float density" of nx ny nz values (x fastest, as
  * pbrt's SampledGrid) over the box p0 p1 of the medium's space, which the current
  * transform places; sigma_a, sigma_s (1 each by default) times `scale` per unit of
  * density; `g`. pbrt's grid is zero outside its samples' centres' half cell at the
  * border where clpt's clamps to the outermost value (docs/media.md). Its emission:
- * "Le" times the "Lescale" grid (pbrt-v4's GridMedium); a "temperature" grid
- * (blackbody emission) is not read (a warning). */
+ * "Le" times the "Lescale" grid, or a "temperature" grid of nx ny nz values, each
+ * cell's blackbody times the "Lescale" grid (pbrt-v4's GridMedium; the two are
+ * exclusive, as in pbrt). clpt bakes each cell's blackbody colour where pbrt
+ * interpolates the temperature (docs/media.md, "Blackbody emission"). */
 static Status uniform_grid(Parser *p, const Lexer *lx, const Token *name, Medium *out)
 {
     Status st;
@@ -175,7 +199,7 @@ static Status uniform_grid(Parser *p, const Lexer *lx, const Token *name, Medium
     if ((st = pbrt_medium_grid_size(p, lx, name, n, &cells))) return st;
     Param *pd = pbrt_param_find(p, "density");
     if (!pd) return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": a \"uniformgrid\" needs \"float "
-                                 "density\" (clpt does not read its temperature grid)", nlen, name->text);
+                                 "density\"", nlen, name->text);
     float *d;
     if ((st = grid_values(p, lx, name, pd, "density", n, cells, &d))) return st;
     vec3 lo, hi;
@@ -184,17 +208,28 @@ static Status uniform_grid(Parser *p, const Lexer *lx, const Token *name, Medium
         return st;
     }
     vec3 le;
-    float *le_scale = NULL;
-    if ((st = medium_le(p, lx, name, base.sigma_a, 1.0, &le)) ||
+    float *le_scale = NULL, *temperature = NULL;
+    GridTemperature how;
+    Param *pt = pbrt_param_find(p, "temperature"), *ple = pbrt_param_find(p, "Le");
+    if (pt && ple)
+        st = lex_error_at(lx, &ple->decl, p->err, "MakeNamedMedium \"%.*s\": a \"uniformgrid\" has \"Le\" or "
+                          "\"temperature\", not both", nlen, name->text);
+    else if (pt && !(st = grid_values(p, lx, name, pt, "temperature", n, cells, &temperature)))
+        st = pbrt_medium_temperature(p, lx, &how);
+    if (st || (st = medium_le(p, lx, name, base.sigma_a, 1.0, &le)) ||
         (st = grid_le_scale(p, lx, name, n, cells, &le_scale))) {
         free(d);
+        free(temperature);
         return st;
     }
+    if (temperature) le = v3s(1.0f);   /* the blackbody alone, times the Lescale grid */
     uint grid;
     st = scene_add_grid(p->s, d, (uint)n[0], (uint)n[1], (uint)n[2], lo, hi, &p->g.ctm, &grid, p->err);
     free(d);
     if (!st && le_scale && !v3_is_zero(le)) st = scene_grid_set_emission(p->s, grid, le_scale, p->err);
+    if (!st && temperature) st = scene_grid_set_temperature(p->s, grid, temperature, how, p->err);
     free(le_scale);
+    free(temperature);
     if (st) return st;
     *out = medium_with_emission(medium_grid(base.sigma_a, base.sigma_s, base.g, grid), le);
     return ST_OK;

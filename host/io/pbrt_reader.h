@@ -20,6 +20,7 @@
 #include "base/strmap.h"
 #include "io/lexer.h"
 #include "io/reader.h"
+#include "scene/media.h"
 #include "scene/mesh_sink.h"
 #include "scene/scene.h"
 #include "scene/transform.h"
@@ -203,6 +204,9 @@ Status pbrt_medium_coefficients(Parser *p, const Lexer *lx, const Token *name, i
  * reads them (pbrt-v4's uniformgrid and rgbgrid). */
 Status pbrt_medium_grid_size(Parser *p, const Lexer *lx, const Token *name, long n[3], double *cells);
 Status pbrt_medium_box(Parser *p, const Lexer *lx, const Token *name, vec3 *lo, vec3 *hi);
+/* How a temperature grid becomes kelvin: "temperatureoffset" (or pbrt-v4's older
+ * "temperaturecutoff"; 0) and "temperaturescale" (1, >= 0), checked (uniformgrid, nanovdb). */
+Status pbrt_medium_temperature(Parser *p, const Lexer *lx, GridTemperature *how);
 /* The material a shape of `material` gets in the current MediumInterface. */
 Status pbrt_shape_media(Parser *p, uint material, uint *out);
 

@@ -18,6 +18,9 @@
 #include "cli_util.h"
 #include "util/kmath.h"
 #include "render_util.h"
+#include "io/scene_load.h"
+#include "scene/blackbody.h"
+#include "scene/scene.h"
 
 #define ARGS(...) ((const char *const[]){ __VA_ARGS__, NULL })
 
@@ -181,6 +184,117 @@ static void test_grid_ramp(void)
                "min -1 -1 -1 max 1 1 1 emission 2 1 1 emission_data [ 1 0 2 0.5 ] }", &scattering, 0.006);
 }
 
+/* ------------------------------------------------------------------ temperature */
+
+/* A grid of uniform density and temperature is a homogeneous slab whose Le is the
+ * blackbody's colour at T = (value - offset) scale, times `emission` and
+ * `emission_scale`: Le sigma_a / sigma_t (1 - exp(-sigma_t d)) again, the colour from
+ * scene/blackbody.h (pbrt-v4's BlackbodySpectrum, peak 1). Ratio tracking (absorbing)
+ * and delta tracking (scattering). */
+static void test_temperature_slab(void)
+{
+    BlackbodyTable table;
+    blackbody_table_init(&table);
+    vec3 bb = blackbody_rgb_peak_normalised(&table, (3100.0 - 100.0) * 1.0);   /* 3000 K */
+    fprintf(stderr, "  blackbody 3000 K, peak 1: %.6f %.6f %.6f\n", (double)bb.x, (double)bb.y, (double)bb.z);
+    CHECK(bb.x > bb.y && bb.y > bb.z && bb.z > 0.0f);
+    /* emission 1 0.5 2 times emission_scale 4: a colour of the order of 1 */
+    Homog a = { { 0.6, 0.6, 0.6 }, { 0.6, 0.6, 0.6 }, { 4.0 * bb.x, 2.0 * bb.y, 8.0 * bb.z } };
+    double want[3];
+    slab_mean(homog_emitted, &a, want);
+    char text[2048];
+    snprintf(text, sizeof text, SLAB_SCENE, 256,
+             "medium m { type grid sigma_a 0.3 0.3 0.3 size 2 1 2 data [ 2 2 2 2 ] min -2 -2 -1 max 2 2 1 "
+             "temperature_data [ 3100 3100 3100 3100 ] temperature_offset 100 emission 1 0.5 2 emission_scale 4 }");
+    check_scene("uniform temperature slab, ratio tracking", text, want, 0.006 * want[0]);
+    Homog sc = { { 0.4, 0.4, 0.4 }, { 1.2, 1.2, 1.2 }, { 2.0 * bb.x, 2.0 * bb.y, 2.0 * bb.z } };
+    slab_mean(homog_emitted, &sc, want);
+    snprintf(text, sizeof text, SLAB_SCENE, 256,
+             "medium m { type grid sigma_a 0.2 0.2 0.2 sigma_s 0.4 0.4 0.4 size 1 1 1 data [ 2 ] min -2 -2 -1 "
+             "max 2 2 1 temperature_data [ 1500 ] temperature_scale 2 emission_scale 2 }");
+    check_scene("uniform temperature slab, delta tracking", text, want, 0.006 * want[0]);
+    /* below 100 K nothing glows */
+    snprintf(text, sizeof text, SLAB_SCENE, 4,
+             "medium m { type grid sigma_a 0.3 0.3 0.3 size 1 1 1 data [ 2 ] min -2 -2 -1 max 2 2 1 "
+             "temperature_data [ 150 ] temperature_offset 60 emission_scale 1e6 }");
+    double zero[3] = { 0, 0, 0 };
+    check_scene("90 K, no emission", text, zero, 0.0);
+}
+
+/* The same fire ball as pbrt-v4's uniformgrid (temperature, temperaturescale, the
+ * older temperaturecutoff as the offset, a Lescale grid) and in clpt's format: the same
+ * coefficients and the same baked colours, bit for bit, and the same image. */
+static const char fire_pbrt[] =
+    "LookAt 0 0 5  0 0 0  0 1 0\n"
+    "Camera \"perspective\" \"float fov\" 30\n"
+    "Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 16\n"
+    "Sampler \"independent\" \"integer pixelsamples\" 64\n"
+    "Integrator \"volpath\" \"integer maxdepth\" 0\n"
+    "WorldBegin\n"
+    "MakeNamedMedium \"fire\" \"string type\" \"uniformgrid\" \"rgb sigma_a\" [2 2 2] \"rgb sigma_s\" [0 0 0]\n"
+    "  \"integer nx\" 2 \"integer ny\" 2 \"integer nz\" 2 \"float density\" [0 1 1 0.5 1 0.25 0.5 1]\n"
+    "  \"float temperature\" [200 1400 900 1700 600 2300 1000 1200] \"float temperaturecutoff\" 150\n"
+    "  \"float temperaturescale\" 1.5 \"float Lescale\" [1 2 3 4 5 6 7 8]\n"
+    "  \"point3 p0\" [-1 -1 -1] \"point3 p1\" [1 1 1]\n"
+    "AttributeBegin\n"
+    "MediumInterface \"fire\" \"\"\n"
+    "Material \"interface\"\n"
+    "Shape \"sphere\" \"float radius\" 1.5\n"
+    "AttributeEnd\n";
+static const char fire_clpt[] =
+    "image { width 16 height 16 spp 64 depth 0 }\n"
+    "camera { from 0 0 5 at 0 0 0 up 0 1 0 fov 30 }\n"
+    "background { color 0 0 0 }\n"
+    "medium fire { type grid sigma_a 2 2 2 size 2 2 2 data [ 0 1 1 0.5 1 0.25 0.5 1 ] min -1 -1 -1 max 1 1 1\n"
+    "  temperature_data [ 200 1400 900 1700 600 2300 1000 1200 ] temperature_offset 150 temperature_scale 1.5\n"
+    "  emission_data [ 1 2 3 4 5 6 7 8 ] }\n"
+    "sphere { center 0 0 0 radius 1.5 material none interior fire }\n";
+
+static void test_temperature_pbrt_and_clpt(void)
+{
+    Scene a, b;
+    Error err = { 0 };
+    scene_init(&a);
+    scene_init(&b);
+    Status sa = scene_load_bytes("fire.pbrt", fire_pbrt, strlen(fire_pbrt), SCENE_FORMAT_AUTO, &a, NULL, &err);
+    CHECK_MSG(sa == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    Status sb = scene_load_text("fire.scene", fire_clpt, strlen(fire_clpt), &b, &err);
+    CHECK_MSG(sb == ST_OK, "%s", err.msg);
+    error_clear(&err);
+    if (!sa && !sb && a.n_grids == 1 && b.n_grids == 1 && a.n_media == 1 && b.n_media == 1) {
+        const GridMedium *ga = &a.grids[0], *gb = &b.grids[0];
+        CHECK(ga->emission_rgb_at != 0u && gb->emission_rgb_at != 0u && ga->emission_at != 0u);
+        CHECK(memcmp(a.grid_data + ga->emission_rgb_at, b.grid_data + gb->emission_rgb_at, 24 * sizeof(float)) == 0);
+        CHECK(memcmp(a.grid_data + ga->emission_at, b.grid_data + gb->emission_at, 8 * sizeof(float)) == 0);
+        CHECK(memcmp(&a.media[0].emission, &b.media[0].emission, sizeof(vec3)) == 0);
+        CHECK(memcmp(&a.media[0].sigma_a, &b.media[0].sigma_a, sizeof(vec3)) == 0);
+        /* cell 0: (200 - 150) 1.5 = 75 K, dark; cell 5: 3225 K */
+        const float *rgb = a.grid_data + ga->emission_rgb_at;
+        CHECK(rgb[0] == 0.0f && rgb[8] == 0.0f && rgb[16] == 0.0f && rgb[5] > rgb[13] && rgb[13] > rgb[21]);
+    }
+    double ma[3], mb[3];
+    Film fa, fb;
+    memset(&fa, 0, sizeof fa);
+    memset(&fb, 0, sizeof fb);
+    if (!sa && !sb && render_util_run(&a, "scalar", 0, &fa, &err) == ST_OK &&
+        render_util_run(&b, "scalar", 0, &fb, &err) == ST_OK) {
+        film_channel_means(&fa, ma);
+        film_channel_means(&fb, mb);
+        fprintf(stderr, "  fire ball, pbrt-v4 file: %.5f %.5f %.5f; clpt scene: %.5f %.5f %.5f\n", ma[0], ma[1], ma[2],
+                mb[0], mb[1], mb[2]);
+        for (int c = 0; c < 3; c++) CHECK_NEAR(ma[c], mb[c], 0.03 * mb[0]);
+        CHECK(ma[0] > ma[1] && ma[1] > ma[2] && ma[0] > 0.0);
+    } else if (!sa && !sb) {
+        CHECK_MSG(0, "%s", err.msg);
+    }
+    film_free(&fa);
+    film_free(&fb);
+    scene_free(&a);
+    scene_free(&b);
+    error_clear(&err);
+}
+
 /* ------------------------------------------------------------------ furnaces */
 
 /* A medium emitting Le inside a background of radiance Le: L = Le everywhere solves the
@@ -242,6 +356,8 @@ int main(void)
 {
     RUN(test_homogeneous_slab);
     RUN(test_grid_ramp);
+    RUN(test_temperature_slab);
+    RUN(test_temperature_pbrt_and_clpt);
     RUN(test_furnace);
     RUN(test_devices_match_scalar);
     return harness_report();

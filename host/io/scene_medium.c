@@ -37,7 +37,8 @@ static const KeySpec medium_keys[MED_N] = {
  * places as medium_keys, so medium_coefficients reads both; `scale` is the transform's
  * here, as in every block with a transform (the coefficients take no extra factor). */
 enum { GM_TYPE, GM_SIGMA_A, GM_SIGMA_S, GM_ALBEDO, GM_DENSITY, GM_G, GM_SIZE, GM_DATA, GM_FILE, GM_MIN, GM_MAX,
-       TRANSFORM_KEY_IDS(GM), GM_EMISSION, GM_EMISSION_SCALE, GM_EMISSION_DATA, GM_EMISSION_FILE, GM_N };
+       TRANSFORM_KEY_IDS(GM), GM_EMISSION, GM_EMISSION_SCALE, GM_EMISSION_DATA, GM_EMISSION_FILE,
+       GM_TEMPERATURE_DATA, GM_TEMPERATURE_FILE, GM_TEMPERATURE_OFFSET, GM_TEMPERATURE_SCALE, GM_N };
 static const KeySpec grid_keys[GM_N] = {
     MEDIUM_COEFFICIENT_KEYS(GM),
     [GM_SIZE] = {"size", VK_VEC3, 1, 0, 0, 0, 0, NULL},
@@ -48,6 +49,10 @@ static const KeySpec grid_keys[GM_N] = {
     TRANSFORM_KEYS(GM),
     [GM_EMISSION_DATA] = {"emission_data", VK_NUMBER_LIST, 0, 0, 0, 0, 0, NULL},
     [GM_EMISSION_FILE] = {"emission_file", VK_PATH, 0, 0, 0, 0, 0, NULL},
+    [GM_TEMPERATURE_DATA] = {"temperature_data", VK_NUMBER_LIST, 0, 0, 0, 0, 0, NULL},
+    [GM_TEMPERATURE_FILE] = {"temperature_file", VK_PATH, 0, 0, 0, 0, 0, NULL},
+    [GM_TEMPERATURE_OFFSET] = {"temperature_offset", VK_NUMBER, 0, -1e30, 1e30, 0, 0, "a number in [-1e30, 1e30]"},
+    [GM_TEMPERATURE_SCALE] = {"temperature_scale", VK_NUMBER, 0, 0, 1e30, 0, 0, "a number in [0, 1e30]"},
 };
 
 /* The coefficients of a medium: sigma_a and sigma_s, or the scattering albedo and the
@@ -90,23 +95,24 @@ static Status medium_coefficients(Parser *p, const Lexer *lx, const Token *kw, c
 }
 
 /* A medium's emission: `emission` (radiance, pbrt-v4's Le) times `emission_scale`
- * (1 when not given), 0 0 0 when there is none. Each channel times sigma_a must stay a
- * float, since a stretch ds emits sigma_a Le ds. */
+ * (1 when not given), 0 0 0 when there is none; with `tinted` (a temperature grid
+ * gives the colour) `emission` is a tint of 1 1 1 when not given. Each channel times
+ * sigma_a must stay a float, since a stretch ds emits sigma_a Le ds. */
 static Status medium_emission(Parser *p, const Lexer *lx, const Value *emission, const Value *scale, vec3 sa,
-                              vec3 *le)
+                              int tinted, vec3 *le)
 {
     *le = v3s(0.0f);
-    if (!emission->given) {
+    if (!emission->given && !tinted) {
         if (scale->given)
             return lex_error_at(lx, &scale->key, p->err, "'emission_scale' needs 'emission' (the radiance it "
                                 "scales)");
         return ST_OK;
     }
-    *le = v3_scale(emission->v, scale->given ? scale->f : 1.0f);
+    *le = v3_scale(emission->given ? emission->v : v3s(1.0f), scale->given ? scale->f : 1.0f);
     vec3 e = v3_mul(*le, sa);
     if (!isfinite(le->x) || !isfinite(le->y) || !isfinite(le->z) || !isfinite(e.x) || !isfinite(e.y) ||
         !isfinite(e.z))
-        return lex_error_at(lx, &emission->key, p->err, "the medium's emission (times emission_scale and "
+        return lex_error_at(lx, emission->given ? &emission->key : &scale->key, p->err, "the medium's emission (times emission_scale and "
                             "sigma_a) is beyond the largest float (about 3.4e38)");
     return ST_OK;
 }
@@ -211,9 +217,30 @@ static Status parse_grid_medium(Parser *p, Lexer *lx, const Token *kw, const Tok
                                              : "a grid medium needs its densities: 'data [ ... ]' or 'file NAME'");
     float *density = NULL;
     if ((st = grid_values(p, lx, &v[GM_DATA], &v[GM_FILE], n, "density", "densities", &density))) return st;
-    vec3 le;
-    if ((st = medium_emission(p, lx, &v[GM_EMISSION], &v[GM_EMISSION_SCALE], sa, &le))) {
+    /* a temperature grid: each cell's blackbody colour, times `emission` (1 1 1 when not
+     * given) and the emission scales */
+    float *temperature = NULL;
+    int tinted = v[GM_TEMPERATURE_DATA].given || v[GM_TEMPERATURE_FILE].given;
+    if (tinted) {
+        if (v[GM_TEMPERATURE_DATA].given && v[GM_TEMPERATURE_FILE].given)
+            st = lex_error_at(lx, &v[GM_TEMPERATURE_FILE].key, p->err, "a grid medium has 'temperature_data' or "
+                              "'temperature_file', not both");
+        else
+            st = grid_values(p, lx, &v[GM_TEMPERATURE_DATA], &v[GM_TEMPERATURE_FILE], n, "temperature",
+                             "temperatures", &temperature);
+    } else if (v[GM_TEMPERATURE_OFFSET].given || v[GM_TEMPERATURE_SCALE].given) {
+        const Value *t = v[GM_TEMPERATURE_OFFSET].given ? &v[GM_TEMPERATURE_OFFSET] : &v[GM_TEMPERATURE_SCALE];
+        st = lex_error_at(lx, &t->key, p->err, "'%.*s' needs 'temperature_data' or 'temperature_file'",
+                          (int)t->key.len, t->key.text);
+    }
+    if (st) {
         free(density);
+        return st;
+    }
+    vec3 le;
+    if ((st = medium_emission(p, lx, &v[GM_EMISSION], &v[GM_EMISSION_SCALE], sa, tinted, &le))) {
+        free(density);
+        free(temperature);
         return st;
     }
     float *emission = NULL;
@@ -222,7 +249,7 @@ static Status parse_grid_medium(Parser *p, Lexer *lx, const Token *kw, const Tok
         if (v[GM_EMISSION_DATA].given && v[GM_EMISSION_FILE].given)
             st = lex_error_at(lx, &v[GM_EMISSION_FILE].key, p->err, "a grid medium has 'emission_data' or "
                               "'emission_file', not both");
-        else if (!v[GM_EMISSION].given)
+        else if (!v[GM_EMISSION].given && !tinted)
             st = lex_error_at(lx, &e->key, p->err, "'%s' needs 'emission' (the radiance its values scale)",
                               v[GM_EMISSION_DATA].given ? "emission_data" : "emission_file");
         else
@@ -230,6 +257,7 @@ static Status parse_grid_medium(Parser *p, Lexer *lx, const Token *kw, const Tok
                              "emission scales", &emission);
         if (st) {
             free(density);
+            free(temperature);
             return st;
         }
     }
@@ -237,6 +265,7 @@ static Status parse_grid_medium(Parser *p, Lexer *lx, const Token *kw, const Tok
     if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) {
         free(density);
         free(emission);
+        free(temperature);
         return lex_error_at(lx, v[GM_MAX].given ? &v[GM_MAX].key : &v[GM_MIN].key, p->err,
                             "a grid's 'max' must be greater than its 'min' on every axis, found min %g %g %g, "
                             "max %g %g %g", (double)lo.x, (double)lo.y, (double)lo.z, (double)hi.x, (double)hi.y,
@@ -246,13 +275,20 @@ static Status parse_grid_medium(Parser *p, Lexer *lx, const Token *kw, const Tok
     if ((st = scene_parse_transform(p, lx, kw, v + GM_TRANSLATE, "grid medium", &to_world))) {
         free(density);
         free(emission);
+        free(temperature);
         return st;
     }
     uint grid;
     st = scene_add_grid(p->s, density, n[0], n[1], n[2], lo, hi, &to_world, &grid, p->err);
     free(density);
     if (!st && emission) st = scene_grid_set_emission(p->s, grid, emission, p->err);
+    if (!st && temperature) {
+        GridTemperature how = { v[GM_TEMPERATURE_OFFSET].given ? (double)v[GM_TEMPERATURE_OFFSET].f : 0.0,
+                                v[GM_TEMPERATURE_SCALE].given ? (double)v[GM_TEMPERATURE_SCALE].f : 1.0 };
+        st = scene_grid_set_temperature(p->s, grid, temperature, how, p->err);
+    }
     free(emission);
+    free(temperature);
     if (st) return st;
     char *copy = tok_copy(name);
     if (!copy) return error_set(p->err, ST_INTERNAL, "out of memory");
@@ -310,7 +346,7 @@ Status scene_parse_medium(Parser *p, Lexer *lx, const Token *kw)
     vec3 sa, ss, le;
     float scale = v[MED_SCALE].given ? v[MED_SCALE].f : 1.0f;
     if ((st = medium_coefficients(p, lx, kw, v, scale, &sa, &ss))) return st;
-    if ((st = medium_emission(p, lx, &v[MED_EMISSION], &v[MED_EMISSION_SCALE], sa, &le))) return st;
+    if ((st = medium_emission(p, lx, &v[MED_EMISSION], &v[MED_EMISSION_SCALE], sa, 0, &le))) return st;
     char *name = tok_copy(&t);
     if (!name) return error_set(p->err, ST_INTERNAL, "out of memory");
     Medium m = medium_with_emission(medium_homogeneous(sa, ss, v[MED_G].given ? v[MED_G].f : 0.0f), le);

@@ -196,22 +196,26 @@ static void test_temperature_slab(void)
     BlackbodyTable table;
     blackbody_table_init(&table);
     vec3 bb = blackbody_rgb_peak_normalised(&table, (3100.0 - 100.0) * 1.0);   /* 3000 K */
-    fprintf(stderr, "  blackbody 3000 K, peak 1: %.6f %.6f %.6f\n", (double)bb.x, (double)bb.y, (double)bb.z);
+    fprintf(stderr, "  blackbody 3000 K, peak 1: %.6f %.6f %.6f; the fit's y-bar integral %.4f\n", (double)bb.x,
+            (double)bb.y, (double)bb.z, table.y_integral);
     CHECK(bb.x > bb.y && bb.y > bb.z && bb.z > 0.0f);
-    /* emission 1 0.5 2 times emission_scale 4: a colour of the order of 1 */
-    Homog a = { { 0.6, 0.6, 0.6 }, { 0.6, 0.6, 0.6 }, { 4.0 * bb.x, 2.0 * bb.y, 8.0 * bb.z } };
+    /* pbrt-v4's CIE_Y_integral, 106.856895: the fit's own within 0.5% */
+    CHECK_NEAR(table.y_integral, 106.856895, 0.5);
+    /* emission 1 0.5 2 times emission_scale 0.04: a colour of the order of 1 (the film
+     * records the blackbody's integrals against the matching functions: ~78 in red) */
+    Homog a = { { 0.6, 0.6, 0.6 }, { 0.6, 0.6, 0.6 }, { 0.04 * bb.x, 0.02 * bb.y, 0.08 * bb.z } };
     double want[3];
     slab_mean(homog_emitted, &a, want);
     char text[2048];
     snprintf(text, sizeof text, SLAB_SCENE, 256,
              "medium m { type grid sigma_a 0.3 0.3 0.3 size 2 1 2 data [ 2 2 2 2 ] min -2 -2 -1 max 2 2 1 "
-             "temperature_data [ 3100 3100 3100 3100 ] temperature_offset 100 emission 1 0.5 2 emission_scale 4 }");
+             "temperature_data [ 3100 3100 3100 3100 ] temperature_offset 100 emission 1 0.5 2 emission_scale 0.04 }");
     check_scene("uniform temperature slab, ratio tracking", text, want, 0.006 * want[0]);
-    Homog sc = { { 0.4, 0.4, 0.4 }, { 1.2, 1.2, 1.2 }, { 2.0 * bb.x, 2.0 * bb.y, 2.0 * bb.z } };
+    Homog sc = { { 0.4, 0.4, 0.4 }, { 1.2, 1.2, 1.2 }, { 0.02 * bb.x, 0.02 * bb.y, 0.02 * bb.z } };
     slab_mean(homog_emitted, &sc, want);
     snprintf(text, sizeof text, SLAB_SCENE, 256,
              "medium m { type grid sigma_a 0.2 0.2 0.2 sigma_s 0.4 0.4 0.4 size 1 1 1 data [ 2 ] min -2 -2 -1 "
-             "max 2 2 1 temperature_data [ 1500 ] temperature_scale 2 emission_scale 2 }");
+             "max 2 2 1 temperature_data [ 1500 ] temperature_scale 2 emission_scale 0.02 }");
     check_scene("uniform temperature slab, delta tracking", text, want, 0.006 * want[0]);
     /* below 100 K nothing glows */
     snprintf(text, sizeof text, SLAB_SCENE, 4,
@@ -234,7 +238,7 @@ static const char fire_pbrt[] =
     "MakeNamedMedium \"fire\" \"string type\" \"uniformgrid\" \"rgb sigma_a\" [2 2 2] \"rgb sigma_s\" [0 0 0]\n"
     "  \"integer nx\" 2 \"integer ny\" 2 \"integer nz\" 2 \"float density\" [0 1 1 0.5 1 0.25 0.5 1]\n"
     "  \"float temperature\" [200 1400 900 1700 600 2300 1000 1200] \"float temperaturecutoff\" 150\n"
-    "  \"float temperaturescale\" 1.5 \"float Lescale\" [1 2 3 4 5 6 7 8]\n"
+    "  \"float temperaturescale\" 1.5 \"float Lescale\" [.01 .02 .03 .04 .05 .06 .07 .08]\n"
     "  \"point3 p0\" [-1 -1 -1] \"point3 p1\" [1 1 1]\n"
     "AttributeBegin\n"
     "MediumInterface \"fire\" \"\"\n"
@@ -247,7 +251,7 @@ static const char fire_clpt[] =
     "background { color 0 0 0 }\n"
     "medium fire { type grid sigma_a 2 2 2 size 2 2 2 data [ 0 1 1 0.5 1 0.25 0.5 1 ] min -1 -1 -1 max 1 1 1\n"
     "  temperature_data [ 200 1400 900 1700 600 2300 1000 1200 ] temperature_offset 150 temperature_scale 1.5\n"
-    "  emission_data [ 1 2 3 4 5 6 7 8 ] }\n"
+    "  emission_data [ .01 .02 .03 .04 .05 .06 .07 .08 ] }\n"
     "sphere { center 0 0 0 radius 1.5 material none interior fire }\n";
 
 static void test_temperature_pbrt_and_clpt(void)
@@ -331,22 +335,26 @@ static void test_furnace(void)
 
 /* ------------------------------------------------------------------ devices */
 
-/* scenes/glow.scene (emitting homogeneous and grid media, scattering, lit by a sun)
- * renders the same bits on the scalar device and on every wave launch of OpenCL. */
+/* scenes/glow.scene (emitting homogeneous and grid media, scattering, lit by a sun) and
+ * scenes/fireball.scene (a temperature grid's per-cell blackbody colours) render the
+ * same bits on the scalar device and on every wave launch of OpenCL. */
 static void test_devices_match_scalar(void)
 {
-    const char *scene = "scenes/glow.scene";
+    const char *scenes[] = { "scenes/glow.scene", "scenes/fireball.scene" };
     const char *modes[] = { "counted", "bounded", "megakernel" };
     const char *ref = TEST_TMP("clpt-test-emission-scalar.pfm"), *out = TEST_TMP("clpt-test-emission-ocl.pfm");
-    cli_run(ARGS(scene, "--device", "scalar", "--width", "40", "--height", "30", "--spp", "6", "-q", "-o", ref), &r);
-    CHECK_MSG(r.status == 0, "%s: %s", scene, r.err);
-    for (int i = 0; i < 3; i++) {
-        cli_run(ARGS(scene, "--device", TEST_OPENCL, "--width", "40", "--height", "30", "--spp", "6",
-                     "--wave-launch", modes[i], "--wave-paths", "1000", "--batch", "2", "-q", "-o", out), &r);
-        CHECK_MSG(r.status == 0, "%s, %s: %s", scene, modes[i], r.err);
-        int same = files_equal(ref, out);
-        CHECK_MSG(same, "%s, --wave-launch %s: the image differs from the scalar device's", scene, modes[i]);
-        fprintf(stderr, "  %s, --wave-launch %s: %s\n", scene, modes[i], same ? "the scalar device's bits" : "DIFFERENT");
+    for (int k = 0; k < 2; k++) {
+        const char *scene = scenes[k];
+        cli_run(ARGS(scene, "--device", "scalar", "--width", "40", "--height", "30", "--spp", "6", "-q", "-o", ref), &r);
+        CHECK_MSG(r.status == 0, "%s: %s", scene, r.err);
+        for (int i = 0; i < 3; i++) {
+            cli_run(ARGS(scene, "--device", TEST_OPENCL, "--width", "40", "--height", "30", "--spp", "6",
+                         "--wave-launch", modes[i], "--wave-paths", "1000", "--batch", "2", "-q", "-o", out), &r);
+            CHECK_MSG(r.status == 0, "%s, %s: %s", scene, modes[i], r.err);
+            int same = files_equal(ref, out);
+            CHECK_MSG(same, "%s, --wave-launch %s: the image differs from the scalar device's", scene, modes[i]);
+            fprintf(stderr, "  %s, --wave-launch %s: %s\n", scene, modes[i], same ? "the scalar device's bits" : "DIFFERENT");
+        }
     }
     unlink(ref);
     unlink(out);

@@ -81,5 +81,5 @@ vec3 blackbody_rgb_peak_normalised(const BlackbodyTable *t, double kelvin)
         Z += le * t->xyz[i][2];
     }
     if (!isfinite(X) || !isfinite(Y) || !isfinite(Z)) return v3s(0.0f);
-    return xyz_to_srgb(X / t->y_integral, Y / t->y_integral, Z / t->y_integral);
+    return xyz_to_srgb(X, Y, Z);
 }

@@ -6,9 +6,13 @@
  *    SpectrumToPhotometric), so only its colour counts: blackbody_rgb_unit_luminance;
  *  - a medium's temperature emission is pbrt-v4's BlackbodySpectrum(T), Planck's law
  *    divided by its value at the peak wavelength (Wien's displacement law), recorded as
- *    an RGB film with the CIE 1931 sensor records it (XYZ divided by the integral of
- *    y-bar): blackbody_rgb_peak_normalised. Pharr, Jakob, Humphreys, PBR 4th ed.,
- *    sec. 4.4.1 (blackbody emitters) and 5.4.2 (sensor response).
+ *    pbrt-v4's RGB film with its default CIE 1931 sensor records it: X, Y, Z are the
+ *    integrals of x-bar, y-bar, z-bar times the spectrum over nanometres, *not* divided
+ *    by the integral of y-bar (about 106.9), since nothing puts this emission in
+ *    photometric units as the lights are: blackbody_rgb_peak_normalised. A cell at
+ *    6500 K thus glows about 100 times as bright as an RGB 1 1 1 light would. Pharr,
+ *    Jakob, Humphreys, PBR 4th ed., sec. 4.4.1 (blackbody emitters), 4.6 (sensor
+ *    response, PixelSensor::ToSensorRGB).
  * Channels outside the sRGB gamut (below about 1900 K blue is negative) are clamped to 0.
  */
 #ifndef CLPT_BLACKBODY_H
@@ -23,7 +27,7 @@ vec3 blackbody_rgb_unit_luminance(double kelvin);
  * cells): blackbody_rgb_peak_normalised evaluates only Planck's law per call. */
 typedef struct {
     double xyz[471][3];     /* x-bar, y-bar, z-bar at 360, 361 ... 830 nm */
-    double y_integral;      /* the sum of y-bar over those (1 nm steps) */
+    double y_integral;      /* the sum of y-bar over those (1 nm steps): about 106.9 */
 } BlackbodyTable;
 
 void blackbody_table_init(BlackbodyTable *t);

@@ -368,7 +368,7 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(GridMedium, max_density);
     out[i++] = (uint)__builtin_offsetof(Medium, emission);
     out[i++] = (uint)__builtin_offsetof(GridMedium, emission_at);
-    out[i++] = (uint)__builtin_offsetof(GridMedium, emission_rgb_at);
+    out[i++] = (uint)__builtin_offsetof(GridMedium, temperature_at);
     out[i++] = (uint)sizeof(MotionKey);
     out[i++] = (uint)__builtin_offsetof(MotionKey, stretch);
     out[i++] = (uint)__builtin_offsetof(Camera, motion_keys);

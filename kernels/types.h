@@ -647,7 +647,7 @@ typedef struct {                                        /* 64 bytes */
     vec3 emission; float pad4;   /* radiance Le (pbrt-v4's Le times Lescale): a stretch
                                * ds emits sigma_a Le ds (medium_emitted, grid_emitted);
                                * MEDIUM_GRID: times the cell's emission scale and
-                               * its colour (GridMedium.emission_rgb_at); with
+                               * its blackbody colour (GridMedium.temperature_at); with
                                * MEDIUM_EMISSIVE set in flags when not 0 0 0 */
 } Medium;
 
@@ -677,13 +677,22 @@ typedef struct {                                        /* 96 bytes */
                                * (pbrt-v4's "Lescale" grid), trilinear as the density;
                                * 0 when there is none (scale 1 everywhere): offset 0
                                * is the first grid's densities, never an emission grid */
-    uint emission_rgb_at;     /* the offset in grid_data of three planes of nx ny nz values,
-                               * red, green, blue: a per-cell emission colour (a temperature
-                               * grid's blackbody radiance, baked at load), trilinear as the
-                               * density and multiplying Medium.emission; 0 when there is
-                               * none (colour 1 1 1 everywhere) */
+    uint temperature_at;      /* the offset in grid_data of nx ny nz temperatures in kelvin
+                               * (pbrt-v4's temperature grid, its offset and scale applied),
+                               * trilinear as the density, then the blackbody table of
+                               * GridBlackbody; the cell's blackbody colour multiplies
+                               * Medium.emission. 0 when there is none (colour 1 1 1) */
     uint pad2;
 } GridMedium;
+
+/* A temperature grid's blackbody table (kernels/medium/grid.h, grid_blackbody): after
+ * the grid's nx ny nz kelvin values in grid_data, one float (GRID_BLACKBODY_STEPS - 1)
+ * / t_max, t_max the grid's hottest value, then GRID_BLACKBODY_STEPS RGB triples, the
+ * colour of pbrt-v4's BlackbodySpectrum at kelvin k t_max / (GRID_BLACKBODY_STEPS - 1),
+ * k = 0, 1, ...; linear between them. At or below GRID_TEMPERATURE_CUTOFF kelvin
+ * nothing glows (pbrt-v4's fixed cutoff). */
+#define GRID_BLACKBODY_STEPS 4096u
+#define GRID_TEMPERATURE_CUTOFF 100.0f
 
 /* Which strategies the path integrator combines for area lights: both with the power
  * heuristic, or one alone (tests/test_mis.c checks that all three agree). */
@@ -868,7 +877,7 @@ _Static_assert(offsetof(Medium, emission) == 48, "Medium.emission");
 _Static_assert(offsetof(GridMedium, nx) == 48, "GridMedium.nx");
 _Static_assert(offsetof(GridMedium, max_density) == 80, "GridMedium.max_density");
 _Static_assert(offsetof(GridMedium, emission_at) == 84, "GridMedium.emission_at");
-_Static_assert(offsetof(GridMedium, emission_rgb_at) == 88, "GridMedium.emission_rgb_at");
+_Static_assert(offsetof(GridMedium, temperature_at) == 88, "GridMedium.temperature_at");
 #undef CLPT_CHECK_SIZE
 #endif
 

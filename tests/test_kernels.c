@@ -494,7 +494,7 @@ static void test_layout(void)
                     offsetof(Material, medium_in), sizeof(GridMedium), offsetof(GridMedium, nx),
                     offsetof(GridMedium, max_density), offsetof(Medium, emission),
                     offsetof(GridMedium, emission_at),
-                    offsetof(GridMedium, emission_rgb_at), sizeof(MotionKey), offsetof(MotionKey, stretch),
+                    offsetof(GridMedium, temperature_at), sizeof(MotionKey), offsetof(MotionKey, stretch),
                     offsetof(Camera, motion_keys), offsetof(Material, diffuse_transmission),
                     offsetof(Material, diffuse_transmission_color) };
     enum { N = sizeof host / sizeof host[0] };

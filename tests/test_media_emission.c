@@ -268,14 +268,15 @@ static void test_temperature_pbrt_and_clpt(void)
     error_clear(&err);
     if (!sa && !sb && a.n_grids == 1 && b.n_grids == 1 && a.n_media == 1 && b.n_media == 1) {
         const GridMedium *ga = &a.grids[0], *gb = &b.grids[0];
-        CHECK(ga->emission_rgb_at != 0u && gb->emission_rgb_at != 0u && ga->emission_at != 0u);
-        CHECK(memcmp(a.grid_data + ga->emission_rgb_at, b.grid_data + gb->emission_rgb_at, 24 * sizeof(float)) == 0);
+        CHECK(ga->temperature_at != 0u && gb->temperature_at != 0u && ga->emission_at != 0u);
+        CHECK(memcmp(a.grid_data + ga->temperature_at, b.grid_data + gb->temperature_at,
+                     (8 + 1 + 3 * GRID_BLACKBODY_STEPS) * sizeof(float)) == 0);
         CHECK(memcmp(a.grid_data + ga->emission_at, b.grid_data + gb->emission_at, 8 * sizeof(float)) == 0);
         CHECK(memcmp(&a.media[0].emission, &b.media[0].emission, sizeof(vec3)) == 0);
         CHECK(memcmp(&a.media[0].sigma_a, &b.media[0].sigma_a, sizeof(vec3)) == 0);
-        /* cell 0: (200 - 150) 1.5 = 75 K, dark; cell 5: 3225 K */
-        const float *rgb = a.grid_data + ga->emission_rgb_at;
-        CHECK(rgb[0] == 0.0f && rgb[8] == 0.0f && rgb[16] == 0.0f && rgb[5] > rgb[13] && rgb[13] > rgb[21]);
+        /* cell 0: (200 - 150) 1.5 = 75 K, no glow; cell 5: 3225 K, the hottest */
+        const float *kelvin = a.grid_data + ga->temperature_at;
+        CHECK(kelvin[0] == 75.0f && kelvin[5] == 3225.0f && kelvin[8] == (GRID_BLACKBODY_STEPS - 1u) / 3225.0f);
     }
     double ma[3], mb[3];
     Film fa, fb;

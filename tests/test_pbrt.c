@@ -1071,8 +1071,8 @@ static void test_media_emission(void)
 }
 
 /* A uniformgrid's "temperature" grid (pbrt-v4's GridMedium): each cell's blackbody,
- * T = (value - temperatureoffset) * temperaturescale, baked to three planes of RGB
- * (pbrt's BlackbodySpectrum, peak 1), nothing at T <= 100 K; the medium's emission 1 1 1
+ * T = (value - temperatureoffset) * temperaturescale per cell, then a table of colours
+ * up to the hottest (pbrt's BlackbodySpectrum, peak 1); the medium's emission 1 1 1
  * times the "Lescale" grid when given; "temperaturecutoff" is the offset's older name. */
 static void test_grid_temperature(void)
 {
@@ -1091,19 +1091,21 @@ static void test_grid_temperature(void)
         BlackbodyTable t;
         blackbody_table_init(&t);
         vec3 k2000 = blackbody_rgb_peak_normalised(&t, 2000.0), k5600 = blackbody_rgb_peak_normalised(&t, 5600.0);
-        vec3 k1500 = blackbody_rgb_peak_normalised(&t, 1500.0);
         CHECK_V3(s.media[0].emission, 1, 1, 1, 0);
         CHECK(s.media[0].flags & MEDIUM_EMISSIVE);
         const GridMedium *g = &s.grids[0];
-        CHECK(g->emission_rgb_at != 0u && g->emission_at != 0u);
-        const float *rgb = s.grid_data + g->emission_rgb_at;
-        /* cell 0: (20 - 100) 2 < 100 K emits nothing */
-        CHECK_V3(v3(rgb[0], rgb[3], rgb[6]), 0, 0, 0, 0);
-        CHECK_V3(v3(rgb[1], rgb[4], rgb[7]), k2000.x, k2000.y, k2000.z, 0);
-        CHECK_V3(v3(rgb[2], rgb[5], rgb[8]), k5600.x, k5600.y, k5600.z, 0);
+        CHECK(g->temperature_at != 0u && g->emission_at != 0u);
+        /* kelvin per cell: (20 - 100) 2 (at or below 100 K: no glow), 2000, 5600 */
+        const float *kelvin = s.grid_data + g->temperature_at;
+        CHECK_V3(v3(kelvin[0], kelvin[1], kelvin[2]), -160, 2000, 5600, 0);
+        /* the table runs to the hottest: its last step is 5600 K */
+        CHECK_NEAR(kelvin[3], (GRID_BLACKBODY_STEPS - 1u) / 5600.0f, 0);
+        const float *top = kelvin + 4 + 3 * (GRID_BLACKBODY_STEPS - 1u);
+        CHECK_V3(v3(top[0], top[1], top[2]), k5600.x, k5600.y, k5600.z, 0);
+        CHECK_V3(v3(kelvin[4], kelvin[5], kelvin[6]), 0, 0, 0, 0);
         CHECK_NEAR(s.grid_data[g->emission_at + 2], 3, 0);
-        const float *old = s.grid_data + s.grids[1].emission_rgb_at;
-        CHECK_V3(v3(old[0], old[1], old[2]), k1500.x, k1500.y, k1500.z, 0);
+        const float *old = s.grid_data + s.grids[1].temperature_at;
+        CHECK_NEAR(old[0], 1500, 0);
         /* a blackbody reddens as it cools: red above green above blue */
         CHECK(k2000.x > k2000.y && k2000.y > k2000.z && k2000.x > 0.0f);
     }

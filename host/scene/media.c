@@ -54,31 +54,35 @@ Status scene_grid_set_temperature(Scene *s, uint grid, const float *temperature,
 {
     GridMedium *g = &s->grids[grid];
     size_t n = (size_t)g->nx * g->ny * g->nz, at = s->n_grid_data;
-    if (at + 3 * n > 0xffffffffu) return error_set(err, ST_INPUT, "the density grids hold more than 2^32 values together");
+    size_t total = n + 1 + 3 * (size_t)GRID_BLACKBODY_STEPS;
+    if (at + total > 0xffffffffu) return error_set(err, ST_INPUT, "the density grids hold more than 2^32 values together");
     BlackbodyTable *table = malloc(sizeof *table);
-    if (!table || array_reserve((void **)&s->grid_data, &s->cap_grid_data, at + 3 * n, sizeof(float))) {
+    if (!table || array_reserve((void **)&s->grid_data, &s->cap_grid_data, at + total, sizeof(float))) {
         free(table);
         return error_set(err, ST_INTERNAL, "out of memory for a temperature grid");
     }
-    blackbody_table_init(table);
-    float *red = s->grid_data + at, *green = red + n, *blue = green + n;
-    /* neighbouring cells often share a temperature (the empty space around a flame
-     * above all): Planck's law is integrated once per run of equal values */
-    double last = -1.0;
-    vec3 rgb = v3s(0.0f);
+    float *kelvin = s->grid_data + at, *head = kelvin + n, *rgb = head + 1;
+    float hottest = 0.0f;
     for (size_t i = 0; i < n; i++) {
-        double kelvin = ((double)temperature[i] - how.offset) * how.scale;
-        if (i == 0 || kelvin != last) {
-            rgb = kelvin > GRID_TEMPERATURE_CUTOFF ? blackbody_rgb_peak_normalised(table, kelvin) : v3s(0.0f);
-            last = kelvin;
-        }
-        red[i] = rgb.x;
-        green[i] = rgb.y;
-        blue[i] = rgb.z;
+        double k = ((double)temperature[i] - how.offset) * how.scale;
+        kelvin[i] = (float)(k > GRID_TEMPERATURE_MAX ? GRID_TEMPERATURE_MAX : k);
+        hottest = kelvin[i] > hottest ? kelvin[i] : hottest;
+    }
+    /* a grid that nowhere passes the cutoff still gets a table (of black, but for its
+     * top step): the kernels' lookup stays in it */
+    if (hottest < 2.0f * GRID_TEMPERATURE_CUTOFF) hottest = 2.0f * GRID_TEMPERATURE_CUTOFF;
+    blackbody_table_init(table);
+    head[0] = (float)(GRID_BLACKBODY_STEPS - 1u) / hottest;
+    for (uint k = 0; k < GRID_BLACKBODY_STEPS; k++) {
+        double t = (double)hottest * k / (GRID_BLACKBODY_STEPS - 1u);
+        vec3 c = blackbody_rgb_peak_normalised(table, t);
+        rgb[3 * k + 0] = c.x;
+        rgb[3 * k + 1] = c.y;
+        rgb[3 * k + 2] = c.z;
     }
     free(table);
-    g->emission_rgb_at = (uint)at;   /* > 0: the grid's densities come first */
-    s->n_grid_data = at + 3 * n;
+    g->temperature_at = (uint)at;   /* > 0: the grid's densities come first */
+    s->n_grid_data = at + total;
     return ST_OK;
 }
 

@@ -44,19 +44,22 @@ Medium medium_with_emission(Medium m, vec3 le);
 Status scene_grid_set_emission(Scene *s, uint grid, const float *scale, Error *err);
 
 /* How a temperature grid's values become kelvin: T = (value - offset) * scale (pbrt-v4's
- * "temperatureoffset" and "temperaturescale"); cells of T <= GRID_TEMPERATURE_CUTOFF
- * emit nothing (pbrt-v4's fixed 100 K). */
+ * "temperatureoffset" and "temperaturescale"); where T <= GRID_TEMPERATURE_CUTOFF
+ * (types.h) nothing glows (pbrt-v4's fixed 100 K). */
 typedef struct {
     double offset, scale;   /* finite; scale >= 0 */
 } GridTemperature;
 
-#define GRID_TEMPERATURE_CUTOFF 100.0
+/* Temperatures above this are taken as this: beyond it the table's steps would grow
+ * past 2 400 K and the glow is no fire's (pbrt-v4 takes any value). */
+#define GRID_TEMPERATURE_MAX 1e7
 
-/* Gives grid `grid` a per-cell emission colour from nx ny nz temperatures of its size
- * (finite: the reader checks): each cell's pbrt-v4 BlackbodySpectrum(T) (peak 1) as
- * linear sRGB (scene/blackbody.h), three planes in grid_data (GridMedium.emission_rgb_at),
- * interpolated as its density. The medium's emission multiplies it (pbrt-v4's Lescale).
- * Fails only when memory runs out or the grids pass 2^32 floats. */
+/* Gives grid `grid` a temperature per cell from nx ny nz values of its size (finite,
+ * >= 0: the reader checks), made kelvin as `how` says, and the blackbody table of its
+ * hottest (types.h, GridBlackbody: pbrt-v4's BlackbodySpectrum(T), peak 1, as linear
+ * sRGB, scene/blackbody.h). The kernels interpolate the temperature as the density and
+ * take its colour; the medium's emission multiplies it (pbrt-v4's Lescale). Fails only
+ * when memory runs out or the grids pass 2^32 floats. */
 Status scene_grid_set_temperature(Scene *s, uint grid, const float *temperature, GridTemperature how, Error *err);
 
 /* Adds medium m named `name` (the caller checks that the name is new). Fails only when

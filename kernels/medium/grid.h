@@ -121,12 +121,29 @@ KFN float grid_density(const SceneView *sc, const GridMedium *g, vec3 q)
     return grid_lookup(sc, g, g->density_at, q);
 }
 
+/* The blackbody colour of a temperature grid's `kelvin` (an interpolated cell value):
+ * its table (types.h, GridBlackbody) linear between steps; 0 0 0 at or below the
+ * cutoff. Interpolating the temperature first and taking its colour after is pbrt-v4's
+ * order (GridMedium::SamplePoint), which a baked colour per cell would not keep: the
+ * colour is convex in T. */
+KFN vec3 grid_blackbody(const SceneView *sc, const GridMedium *g, float kelvin)
+{
+    if (!(kelvin > GRID_TEMPERATURE_CUTOFF)) return v3s(0.0f);
+    GLOBAL const float *head = sc->grid_data + g->temperature_at + g->nx * g->ny * g->nz;
+    float x = k_fmin(kelvin * head[0], (float)(GRID_BLACKBODY_STEPS - 1u));
+    uint i = (uint)x;
+    if (i > GRID_BLACKBODY_STEPS - 2u) i = GRID_BLACKBODY_STEPS - 2u;
+    float f = x - (float)i;
+    GLOBAL const float *lo = head + 1u + 3u * i;
+    return v3(grid_lerp(lo[0], lo[3], f), grid_lerp(lo[1], lo[4], f), grid_lerp(lo[2], lo[5], f));
+}
+
 /* What a tentative collision at unit-cube point q of density dens adds to the path's
  * emitted radiance, per unit of its weight w: w sigma_a(q) Le(q) / sigma_bar, where
  * sigma_a(q) = dens sigma_a and Le(q) the medium's emission times the cell's scale
- * (pbrt-v4's GridMedium: Le_spec times its "Lescale" grid) and, when the grid has one,
- * the cell's colour (a temperature grid's blackbody, pbrt-v4's BlackbodySpectrum(T(q))
- * baked to RGB per cell at load: docs/media.md, "Blackbody emission"). Collisions arrive at rate
+ * (pbrt-v4's GridMedium: Le_spec times its "Lescale" grid) and, when the grid has a
+ * temperature grid, the blackbody colour of its temperature at q (pbrt-v4's
+ * BlackbodySpectrum(T(q)); docs/media.md, "Blackbody emission"). Collisions arrive at rate
  * sigma_bar along the ray and w estimates the transmittance up to q, so the sum over
  * a flight estimates the emission integral int T(t) sigma_a(t) Le(t) dt without bias
  * (Pharr, Jakob, Humphreys, PBR 4th ed., sec. 14.2.2: pbrt-v4's VolPathIntegrator
@@ -135,11 +152,7 @@ KFN vec3 grid_emitted(const SceneView *sc, const GridMedium *g, Medium md, vec3 
 {
     float scale = g->emission_at != 0u ? grid_lookup(sc, g, g->emission_at, q) : 1.0f;
     vec3 e = md.emission;
-    if (g->emission_rgb_at != 0u) {
-        uint plane = g->nx * g->ny * g->nz;
-        e = v3_mul(e, v3(grid_lookup(sc, g, g->emission_rgb_at, q), grid_lookup(sc, g, g->emission_rgb_at + plane, q),
-                         grid_lookup(sc, g, g->emission_rgb_at + 2u * plane, q)));
-    }
+    if (g->temperature_at != 0u) e = v3_mul(e, grid_blackbody(sc, g, grid_lookup(sc, g, g->temperature_at, q)));
     vec3 le = v3_scale(v3_mul(md.sigma_a, e), dens * scale / bar);
     return v3_mul(w, le);
 }

@@ -50,6 +50,10 @@ SCENES = [
      "a dense uniformgrid cumulus (albedo 0.995, g 0.5), sun and sky", ""),
     ("pbrt-fog", "tools/xcheck/pbrt/fog.pbrt", [], False,
      "homogeneous fog around the camera (its medium), a sphere on a floor", ""),
+    ("pbrt-fire-ball", "tools/xcheck/pbrt/fire-ball.pbrt", [], True,
+     "a uniformgrid temperature grid: blackbody emission, 1200-4500 K, over a floor",
+     "clpt takes a blackbody's RGB from a table (Wyman's CIE fit, 4096 steps to the hottest "
+     "cell, clamped at 0 out of gamut) where pbrt-v4 samples Planck's law at 4 wavelengths a path"),
     ("pbrt-nanovdb-smoke", "scenes/nanovdb-smoke.pbrt", ["scenes/nanovdb-smoke.nvdb"], False,
      "scenes/nanovdb-smoke.pbrt: a NanoVDB grid read by each renderer", ""),
 ]

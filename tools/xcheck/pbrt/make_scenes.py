@@ -85,6 +85,22 @@ def cloud_density(n=24):
     return np.round(d, 3)
 
 
+def fire_ball(n=16):
+    """A fire ball in the unit cube: (density, temperature in kelvin) per cell. The
+    density falls from 1 at the centre to 0 at radius 0.45 (of the cube's side); the
+    temperature from 4500 K at the centre to 1200 K at the rim, 0 outside (no emission:
+    pbrt-v4 and clpt emit only above 100 K), with a gentle flicker of two sines."""
+    c = centers(n)
+    z, y, x = np.meshgrid(c, c, c, indexing="ij")
+    r = np.sqrt((x - 0.5) ** 2 + (y - 0.5) ** 2 + (z - 0.5) ** 2) / 0.45
+    inside = r < 1
+    d = np.where(inside, np.clip(1 - r * r, 0, None) * (0.8 + 0.2 * np.sin(7 * x + 3 * y) * np.cos(5 * z)), 0)
+    t = np.where(inside, 1200 + 3300 * (1 - r * r) * (0.9 + 0.1 * np.sin(11 * y)), 0)
+    for a in (d, t):
+        a[0, :, :] = a[-1, :, :] = a[:, 0, :] = a[:, -1, :] = a[:, :, 0] = a[:, :, -1] = 0
+    return np.round(d, 3), np.round(t, 0)
+
+
 def scenes():
     out = {}
     n = 20
@@ -135,6 +151,27 @@ Camera) and a diffuse sphere on a floor, all inside a fog box, under a sun and a
         '  Shape "sphere" "float radius" 1\nAttributeEnd\n'
         'AttributeBegin\n  MediumInterface "fog" ""\n  Material "interface"\n' +
         box((-6, -1.001, -6), (6, 4, 7)) + "AttributeEnd\n")
+    n = 16
+    dens, temp = fire_ball(n)
+    out["fire-ball"] = (
+        head("""A fire ball (a uniformgrid, 16^3, with a "temperature" grid: blackbody emission,
+1200 K at its rim to 4500 K in its core) over a grey floor under a dim sky: the medium
+absorbs (sigma_a 4) and scatters a little (sigma_s 1); its light reaches the floor only
+through paths (no light samples toward media).""",
+             (0, 0.6, 5), (0, -0.1, 0), 36, "fire-ball") + "WorldBegin\n" +
+        'LightSource "infinite" "rgb L" [0.03 0.04 0.06]\n' + FLOOR +
+        'MakeNamedMedium "fire" "string type" "uniformgrid"\n'
+        '  "integer nx" %d "integer ny" %d "integer nz" %d\n' % (n, n, n) +
+        '  "point3 p0" [-1.1 -0.98 -1.1] "point3 p1" [1.1 1.2 1.1]\n'
+        '  "rgb sigma_a" [4 4 4] "rgb sigma_s" [1 1 1] "float scale" 1 "float g" 0\n'
+        '  "float density" [\n    %s ]\n' % grid_text(dens) +
+        '  "float temperature" [\n    %s ]\n' % grid_text(temp) +
+        # an explicit Lescale grid of ones: without one pbrt-v4 looks its emission scale up
+        # in a 1 x 1 x 1 grid, which its trilinear lookup fades to 0.5 at each face (a
+        # tent, 0.125 at the corners); clpt takes the scale as 1 everywhere
+        '  "float Lescale" [\n    %s ]\n' % grid_text(np.ones((n, n, n))) +
+        'AttributeBegin\n  MediumInterface "fire" ""\n  Material "interface"\n' +
+        box((-1.1, -0.98, -1.1), (1.1, 1.2, 1.1)) + "AttributeEnd\n")
     return out
 
 

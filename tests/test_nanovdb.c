@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "harness.h"
+#include "nvdb_writer.h"
 #include "base/noise.h"
 #include "io/lexer.h"
 #include "io/nanovdb.h"
@@ -169,7 +170,8 @@ static void test_bad_files(void)
 }
 
 /* MakeNamedMedium "nanovdb": the grid placed by its map and the current transform,
- * sigma_a, sigma_s times scale; the temperature grid and Lescale are warnings. */
+ * sigma_a, sigma_s times scale; the temperature grid (here on the density's voxels)
+ * made kelvin by temperatureoffset and temperaturescale, its glow times Lescale. */
 static void test_pbrt_nanovdb(void)
 {
     Scene s;
@@ -177,6 +179,7 @@ static void test_pbrt_nanovdb(void)
     CHECK_EQ_INT(load_text("Translate 10 0 0\n"
                            "MakeNamedMedium \"smoke\" \"string type\" \"nanovdb\" \"string filename\" \"ramp-zip.nvdb\"\n"
                            "  \"rgb sigma_a\" [0.5 0.5 0.5] \"rgb sigma_s\" [1 2 3] \"float scale\" 2 \"float Lescale\" 3\n"
+                           "  \"float temperatureoffset\" 500 \"float temperaturescale\" 2\n"
                            "WorldBegin\n",
                            &s, &err),
                  ST_OK);
@@ -196,15 +199,32 @@ static void test_pbrt_nanovdb(void)
         for (int r = 0; r < 3; r++)
             CHECK_NEAR(m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3], want[r], 1e-5);
         CHECK_NEAR(s.grid_data[g->density_at + 7], 11, 0);   /* x 1, y 1 */
+        /* the temperatures 1000 + i: kelvin (1000 + i - 500) 2 */
+        CHECK(g->temperature_at != 0u);
+        CHECK_NEAR(s.grid_data[g->temperature_at], 1000, 0);
+        CHECK_NEAR(s.grid_data[g->temperature_at + 119], 1238, 0);
+        CHECK_NEAR(s.media[0].emission.y, 3, 0);
+        CHECK(s.media[0].flags & MEDIUM_EMISSIVE);
     }
-    CHECK_EQ_INT(s.n_warnings, 2);
-    if (s.n_warnings == 2) {
-        CHECK_MSG(strcmp(s.warnings[0], NDIR "inline.pbrt:2: MakeNamedMedium \"smoke\": the \"temperature\" grid "
-                         "(emission) is not read; the medium does not glow") == 0, "got '%s'", s.warnings[0]);
-        CHECK_MSG(strcmp(s.warnings[1], NDIR "inline.pbrt:3: MakeNamedMedium \"nanovdb\": parameter \"float "
-                         "Lescale\" is not supported; ignored") == 0, "got '%s'", s.warnings[1]);
-    }
+    CHECK_EQ_INT(s.n_warnings, 0);
     scene_free(&s);
+    /* Lescale 0: no glow, the temperature grid not read */
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"smoke\" \"string type\" \"nanovdb\" \"string filename\" \"ramp-zip.nvdb\"\n"
+                           "  \"float Lescale\" 0\n", &s, &err), ST_OK);
+    if (s.n_grids == 1) CHECK(s.grids[0].temperature_at == 0u && !(s.media[0].flags & MEDIUM_EMISSIVE));
+    scene_free(&s);
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" \"ramp-zip.nvdb\" "
+                           "\"float Lescale\" -1\n", &s, &err), ST_INPUT);
+    CHECK_MSG(strcmp(err.msg, NDIR "inline.pbrt:1:79: parameter 'Lescale' must be a number in [0, 1e30]") == 0,
+              "got '%s'", err.msg);
+    scene_free(&s);
+    error_clear(&err);
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" \"ramp-zip.nvdb\" "
+                           "\"float temperaturescale\" -2\n", &s, &err), ST_INPUT);
+    CHECK_MSG(strcmp(err.msg, NDIR "inline.pbrt:1:79: parameter 'temperaturescale' must be a number in [0, 1e30]") == 0,
+              "got '%s'", err.msg);
+    scene_free(&s);
+    error_clear(&err);
     /* a file's error carries the line that named it */
     CHECK_EQ_INT(load_text("MakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" "
                            "\"../bad/nvdb-type.nvdb.gz\"\n", &s, &err), ST_INPUT);
@@ -222,6 +242,45 @@ static void test_pbrt_nanovdb(void)
     CHECK_STR_CONTAINS(err.msg, "inline.pbrt:1:63: cannot open");
     scene_free(&s);
     error_clear(&err);
+}
+
+/* A temperature grid on voxels of its own (half as wide, shifted a quarter voxel): the
+ * density's cells take it at their centres through both maps, trilinear (exact for a
+ * linear temperature), 0 beyond its voxels as NanoVDB's sampler reads a fog volume. */
+static void test_pbrt_nanovdb_temperature_map(void)
+{
+    float ones[4 * 4 * 4], temp[8 * 8 * 8];
+    for (int i = 0; i < 64; i++) ones[i] = 1.0f;
+    /* temperature voxel (i, j, k) at world 0.5 (i, j, k) + 0.25: T = 1000 + 100 x + 10 y + z */
+    for (int k = 0; k < 8; k++)
+        for (int j = 0; j < 8; j++)
+            for (int i = 0; i < 8; i++)
+                temp[(k * 8 + j) * 8 + i] = (float)(1000 + 100 * (0.5 * i + 0.25) + 10 * (0.5 * j + 0.25) + (0.5 * k + 0.25));
+    NvdbGrid grids[2] = { { "density", 0, 0, 0, 4, 4, 4, ones, { 1, 1, 1 }, { 0, 0, 0 }, 0, 0 },
+                          { "temperature", 0, 0, 0, 8, 8, 8, temp, { 0.5, 0.5, 0.5 }, { 0.25, 0.25, 0.25 }, 0, 0 } };
+    size_t n;
+    unsigned char *f = nvdb_write(grids, 2, 0, &n);
+    char path[512], text[1024];
+    test_tmp_path(path, sizeof path, "clpt-test-temperature.nvdb");
+    FILE *out = fopen(path, "wb");
+    CHECK(f && out && fwrite(f, 1, n, out) == n);
+    if (out) fclose(out);
+    free(f);
+    snprintf(text, sizeof text, "MakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" \"%s\"\n", path);
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text(text, &s, &err), ST_OK);
+    if (s.n_grids == 1 && s.grids[0].temperature_at) {
+        const float *k = s.grid_data + s.grids[0].temperature_at;
+        /* density cell (x, y, z) centred at world (x, y, z) */
+        CHECK_NEAR(k[(2 * 4 + 1) * 4 + 3], 1000 + 300 + 10 + 2, 1e-3);
+        CHECK_NEAR(k[(3 * 4 + 3) * 4 + 1], 1000 + 100 + 30 + 3, 1e-3);
+        /* x = 0: half way between voxel -1 (background 0) and voxel 0 (x 0.25) */
+        CHECK_NEAR(k[(2 * 4 + 2) * 4 + 0], 0.5 * (1000 + 25 + 20 + 2), 1e-3);
+    }
+    scene_free(&s);
+    error_clear(&err);
+    remove(path);
 }
 
 /* A map that puts the box beyond the scene's coordinates is refused with the line. */
@@ -400,6 +459,7 @@ int main(void)
     RUN(test_resample);
     RUN(test_bad_files);
     RUN(test_pbrt_nanovdb);
+    RUN(test_pbrt_nanovdb_temperature_map);
     RUN(test_pbrt_nanovdb_far);
     RUN(test_cloud);
     RUN(test_rgbgrid);

@@ -37,14 +37,75 @@ static Status grid_budget(Parser *p, const Lexer *lx, const Token *name, size_t 
 
 /* ------------------------------------------------------------------ nanovdb */
 
-/* "filename" (beside the main file), "gridname" (default "density"); the temperature
- * grid and its Lescale/temperature* parameters are emission, not read (a warning). */
+/* One value of dense grid t at continuous cell coordinates x (cell c's centre at c):
+ * trilinear between its cells, those outside it 0 (a fog volume's background, which
+ * NanoVDB's trilinear sampler reads beyond the active voxels). */
+static double dense_trilinear(const NanoDense *t, const double x[3])
+{
+    unsigned n[3] = { t->nx, t->ny, t->nz };
+    double f[3], v = 0.0;
+    long i0[3];
+    for (int a = 0; a < 3; a++) {
+        double fl = floor(x[a]);
+        if (!(fl > -2.0 && fl < (double)n[a] + 1.0)) return 0.0;   /* far outside (or NaN) */
+        i0[a] = (long)fl;
+        f[a] = x[a] - fl;
+    }
+    for (int c = 0; c < 8; c++) {
+        long ix = i0[0] + (c & 1), iy = i0[1] + ((c >> 1) & 1), iz = i0[2] + ((c >> 2) & 1);
+        if (ix < 0 || iy < 0 || iz < 0 || ix >= (long)n[0] || iy >= (long)n[1] || iz >= (long)n[2]) continue;
+        double w = (c & 1 ? f[0] : 1.0 - f[0]) * (c & 2 ? f[1] : 1.0 - f[1]) * (c & 4 ? f[2] : 1.0 - f[2]);
+        v += w * t->density[((size_t)iz * n[1] + (size_t)iy) * n[0] + (size_t)ix];
+    }
+    return v;
+}
+
+/* The temperature grid t at the centres of the cells of density grid d, as pbrt-v4's
+ * NanoVDBMedium looks it up (its own map and trilinear sampler): each centre taken to
+ * the medium's space by d's map, to t's index space by the inverse of t's, and sampled
+ * there. Both grids usually share their map and box, where this copies t. *out: d's
+ * nx ny nz values (free it); 0 when t's map is singular (it is then no grid). */
+static int temperature_on_density(const NanoDense *d, const NanoDense *t, float **out)
+{
+    Transform t_from_medium;
+    if (!transform_invert(&t->index_to_world, &t_from_medium)) return 0;
+    Transform t_from_d = transform_compose(&t_from_medium, &d->index_to_world);
+    size_t cells = (size_t)d->nx * d->ny * d->nz;
+    float *v = malloc(cells * sizeof(float));
+    if (!v) return -1;
+    for (unsigned z = 0; z < d->nz; z++)
+        for (unsigned y = 0; y < d->ny; y++)
+            for (unsigned x = 0; x < d->nx; x++) {
+                double c[3] = { d->lo[0] + d->stride * (x + 0.5), d->lo[1] + d->stride * (y + 0.5),
+                                d->lo[2] + d->stride * (z + 0.5) }, q[3];
+                for (int r = 0; r < 3; r++) {
+                    double idx = t_from_d.m[r][0] * c[0] + t_from_d.m[r][1] * c[1] + t_from_d.m[r][2] * c[2] +
+                                 t_from_d.m[r][3];
+                    q[r] = (idx - t->lo[r]) / t->stride - 0.5;   /* t's cell coordinates */
+                }
+                double k = dense_trilinear(t, q);
+                v[((size_t)z * d->ny + y) * d->nx + x] = (float)(k > 3.4e38 ? 3.4e38 : k);
+            }
+    *out = v;
+    return 1;
+}
+
+/* "filename" (beside the main file), "gridname" (default "density"); the emission:
+ * the "temperaturename" grid (default "temperature"; none in the file: no glow, as in
+ * pbrt-v4), its blackbody times "Lescale" (1), temperatureoffset/temperaturescale as a
+ * uniformgrid's (pbrt_medium_temperature). */
 static Status nanovdb_medium(Parser *p, const Lexer *lx, const Token *name, Medium *out)
 {
     Status st;
     vec3 sa, ss;
     float g;
-    if ((st = pbrt_medium_coefficients(p, lx, name, 1, &sa, &ss, &g))) return st;
+    double le_scale = 1.0;
+    GridTemperature how;
+    if ((st = pbrt_medium_coefficients(p, lx, name, 1, &sa, &ss, &g)) ||
+        (st = pbrt_get_float(p, lx, "Lescale", &le_scale)) || (st = pbrt_medium_temperature(p, lx, &how)))
+        return st;
+    if (!(le_scale >= 0.0) || !(le_scale <= 1e30))
+        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "Lescale"), "a number in [0, 1e30]");
     const Token *f = NULL, *gn = NULL, *tn = NULL;
     if ((st = pbrt_get_string(p, lx, "filename", &f)) || (st = pbrt_get_string(p, lx, "gridname", &gn)) ||
         (st = pbrt_get_string(p, lx, "temperaturename", &tn)))
@@ -61,16 +122,27 @@ static Status nanovdb_medium(Parser *p, const Lexer *lx, const Token *name, Medi
     if (!path) return error_set(p->err, ST_INTERNAL, "out of memory");
     char *data = NULL;
     size_t len = 0;
-    NanoDense dense;
+    NanoDense dense, temp;
     memset(&dense, 0, sizeof dense);
+    memset(&temp, 0, sizeof temp);
     st = lex_read_file(path, &data, &len, p->err);
     if (!st) st = nanovdb_read_grid(path, (const unsigned char *)data, len, grid_name, &dense, p->err);
-    int has_temperature = !st && nanovdb_has_grid((const unsigned char *)data, len, temp_name);
+    int has_temperature = !st && le_scale > 0.0 && nanovdb_has_grid((const unsigned char *)data, len, temp_name);
+    if (has_temperature && (st = nanovdb_read_grid(path, (const unsigned char *)data, len, temp_name, &temp, p->err)))
+        free(dense.density);
     free(data);
     free(path);
     if (st) {
         if (st == ST_IO || st == ST_INPUT) reader_annotate(lx, f, p->err);
         return st;
+    }
+    float *kelvin = NULL;   /* the temperature at the density's cells */
+    int made = has_temperature ? temperature_on_density(&dense, &temp, &kelvin) : 0;
+    free(temp.density);
+    if (made < 0) {
+        free(dense.density);
+        return error_set(p->err, ST_INTERNAL, "out of memory for the temperature grid of \"%.*s\"", NAME_LEN(name),
+                         name->text);
     }
     /* the dense box starts at index lo; folding lo into the transform keeps the box's
      * numbers small (exact in single precision) whatever the grid's index offset */
@@ -83,8 +155,10 @@ static Status nanovdb_medium(Parser *p, const Lexer *lx, const Token *name, Medi
     /* the file's map may be any finite affine map: the box must land inside the scene's
      * coordinates, and the kernels' float matrix back to the grid must be finite */
     size_t cells = (size_t)dense.nx * dense.ny * dense.nz;
-    if ((st = grid_budget(p, lx, name, cells))) {
+    /* the temperatures count against the budget too (and their table, 12 289 floats) */
+    if ((st = grid_budget(p, lx, name, kelvin ? 2 * cells + 1 + 3 * GRID_BLACKBODY_STEPS : cells))) {
         free(dense.density);
+        free(kelvin);
         return st;
     }
     int placeable = 1;
@@ -97,6 +171,8 @@ static Status nanovdb_medium(Parser *p, const Lexer *lx, const Token *name, Medi
                                     &grid, p->err)
                    : ST_OK;
     free(dense.density);
+    if (!st && placeable && kelvin) st = scene_grid_set_temperature(p->s, grid, kelvin, how, p->err);
+    free(kelvin);
     if (st) return st;
     for (int i = 0; placeable && i < 12; i++) placeable = isfinite(p->s->grids[grid].to_grid[i]);
     if (!placeable)
@@ -114,14 +190,8 @@ static Status nanovdb_medium(Parser *p, const Lexer *lx, const Token *name, Medi
                             dense.ny, dense.nz, dense.stride)))
             return st;
     }
-    if (has_temperature) {
-        char key[96];
-        snprintf(key, sizeof key, "nanovdb-temperature:%.*s", NAME_LEN(name), name->text);
-        if ((st = warn_once(p, lx, f, key, "MakeNamedMedium \"%.*s\": the \"%s\" grid (emission) is not read; the "
-                            "medium does not glow", NAME_LEN(name), name->text, temp_name)))
-            return st;
-    }
     *out = medium_grid(sa, ss, g, grid);
+    if (kelvin) *out = medium_with_emission(*out, v3s((float)le_scale));
     return ST_OK;
 }
 

@@ -112,8 +112,9 @@ static Status medium_emission(Parser *p, const Lexer *lx, const Value *emission,
     vec3 e = v3_mul(*le, sa);
     if (!isfinite(le->x) || !isfinite(le->y) || !isfinite(le->z) || !isfinite(e.x) || !isfinite(e.y) ||
         !isfinite(e.z))
-        return lex_error_at(lx, emission->given ? &emission->key : &scale->key, p->err, "the medium's emission (times emission_scale and "
-                            "sigma_a) is beyond the largest float (about 3.4e38)");
+        return lex_error_at(lx, emission->given ? &emission->key : &scale->key, p->err,
+                            "the medium's emission (times emission_scale and sigma_a) is beyond the largest float "
+                            "(about 3.4e38)");
     return ST_OK;
 }
 

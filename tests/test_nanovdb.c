@@ -220,6 +220,13 @@ static void test_pbrt_nanovdb(void)
     scene_free(&s);
     error_clear(&err);
     CHECK_EQ_INT(load_text("MakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" \"ramp-zip.nvdb\" "
+                           "\"float Lescale\" 1e30 \"rgb sigma_a\" [1 1e10 1]\n", &s, &err), ST_INPUT);
+    CHECK_MSG(strcmp(err.msg, NDIR "inline.pbrt:1:17: MakeNamedMedium \"m\": its emission (Lescale times sigma_a and a "
+                     "blackbody's colour, up to 256) is beyond the largest float (about 3.4e38)") == 0, "got '%s'",
+              err.msg);
+    scene_free(&s);
+    error_clear(&err);
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" \"ramp-zip.nvdb\" "
                            "\"float temperaturescale\" -2\n", &s, &err), ST_INPUT);
     CHECK_MSG(strcmp(err.msg, NDIR "inline.pbrt:1:79: parameter 'temperaturescale' must be a number in [0, 1e30]") == 0,
               "got '%s'", err.msg);

@@ -1131,6 +1131,10 @@ static void test_grid_temperature(void)
                  "\"float temperature\" [1000] \"rgb Le\" [1 1 1]\n",
                  DIR "inline.pbrt:2:96: MakeNamedMedium \"m\": a \"uniformgrid\" has \"Le\" or \"temperature\", not "
                  "both");
+    expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [1] "
+                 "\"float temperature\" [1000] \"rgb sigma_a\" [1e10 1 1] \"float Lescale\" [1e30]\n",
+                 DIR "inline.pbrt:2:17: MakeNamedMedium \"m\": its emission (Lescale times sigma_a and a blackbody's "
+                 "colour, up to 256) is beyond the largest float (about 3.4e38)");
 }
 
 /* MakeNamedMedium "uniformgrid": the density grid (x fastest) over p0 p1 placed by the

@@ -12,6 +12,7 @@
 #include "io/pbrt_reader.h"
 
 #include "util/kmath.h"
+#include "scene/blackbody.h"
 #include "scene/media.h"
 
 #include <math.h>
@@ -179,6 +180,17 @@ Status pbrt_medium_temperature(Parser *p, const Lexer *lx, GridTemperature *how)
     return ST_OK;
 }
 
+/* pbrt_reader.h: sigma_a times the largest emission scale times a blackbody's colour
+ * (at most BLACKBODY_RGB_MAX) must stay a float. */
+Status pbrt_medium_glow_check(Parser *p, const Lexer *lx, const Token *name, vec3 sa, double scale)
+{
+    double e = (double)v3_max_comp(sa) * scale * BLACKBODY_RGB_MAX;
+    if (e <= 3.4e38) return ST_OK;
+    return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": its emission (Lescale times sigma_a and a "
+                        "blackbody's colour, up to 256) is beyond the largest float (about 3.4e38)",
+                        (int)(name->len > 40 ? 40 : name->len), name->text);
+}
+
 /* pbrt-v4's "uniformgrid" medium: "float density" of nx ny nz values (x fastest, as
  * pbrt's SampledGrid) over the box p0 p1 of the medium's space, which the current
  * transform places; sigma_a, sigma_s (1 each by default) times `scale` per unit of
@@ -222,7 +234,17 @@ static Status uniform_grid(Parser *p, const Lexer *lx, const Token *name, Medium
         free(temperature);
         return st;
     }
-    if (temperature) le = v3s(1.0f);   /* the blackbody alone, times the Lescale grid */
+    if (temperature) {
+        le = v3s(1.0f);   /* the blackbody alone, times the Lescale grid */
+        double top = 1.0;
+        for (size_t i = 0; le_scale && i < (size_t)cells; i++) top = le_scale[i] > top ? le_scale[i] : top;
+        if ((st = pbrt_medium_glow_check(p, lx, name, base.sigma_a, top))) {
+            free(d);
+            free(temperature);
+            free(le_scale);
+            return st;
+        }
+    }
     uint grid;
     st = scene_add_grid(p->s, d, (uint)n[0], (uint)n[1], (uint)n[2], lo, hi, &p->g.ctm, &grid, p->err);
     free(d);

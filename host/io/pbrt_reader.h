@@ -207,6 +207,9 @@ Status pbrt_medium_box(Parser *p, const Lexer *lx, const Token *name, vec3 *lo, 
 /* How a temperature grid becomes kelvin: "temperatureoffset" (or pbrt-v4's older
  * "temperaturecutoff"; 0) and "temperaturescale" (1, >= 0), checked (uniformgrid, nanovdb). */
 Status pbrt_medium_temperature(Parser *p, const Lexer *lx, GridTemperature *how);
+/* A temperature grid's emission, sigma_a times `scale` (its largest Lescale) times a
+ * blackbody's colour, checked to stay a float (the error names the medium). */
+Status pbrt_medium_glow_check(Parser *p, const Lexer *lx, const Token *name, vec3 sa, double scale);
 /* The material a shape of `material` gets in the current MediumInterface. */
 Status pbrt_shape_media(Parser *p, uint material, uint *out);
 

@@ -144,6 +144,11 @@ static Status nanovdb_medium(Parser *p, const Lexer *lx, const Token *name, Medi
         return error_set(p->err, ST_INTERNAL, "out of memory for the temperature grid of \"%.*s\"", NAME_LEN(name),
                          name->text);
     }
+    if (kelvin && (st = pbrt_medium_glow_check(p, lx, name, sa, le_scale))) {
+        free(dense.density);
+        free(kelvin);
+        return st;
+    }
     /* the dense box starts at index lo; folding lo into the transform keeps the box's
      * numbers small (exact in single precision) whatever the grid's index offset */
     Transform to_index = transform_translate(dense.lo[0], dense.lo[1], dense.lo[2]);

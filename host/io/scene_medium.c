@@ -7,6 +7,7 @@
 
 #include "util/kmath.h"
 #include "io/lexer.h"
+#include "scene/blackbody.h"
 #include "scene/media.h"
 
 #include <math.h>
@@ -109,12 +110,14 @@ static Status medium_emission(Parser *p, const Lexer *lx, const Value *emission,
         return ST_OK;
     }
     *le = v3_scale(emission->given ? emission->v : v3s(1.0f), scale->given ? scale->f : 1.0f);
-    vec3 e = v3_mul(*le, sa);
+    vec3 e = v3_scale(v3_mul(*le, sa), tinted ? BLACKBODY_RGB_MAX : 1.0f);
     if (!isfinite(le->x) || !isfinite(le->y) || !isfinite(le->z) || !isfinite(e.x) || !isfinite(e.y) ||
         !isfinite(e.z))
         return lex_error_at(lx, emission->given ? &emission->key : &scale->key, p->err,
-                            "the medium's emission (times emission_scale and sigma_a) is beyond the largest float "
-                            "(about 3.4e38)");
+                            tinted ? "the medium's emission (times emission_scale, sigma_a and a blackbody's colour, "
+                                     "up to 256) is beyond the largest float (about 3.4e38)"
+                                   : "the medium's emission (times emission_scale and sigma_a) is beyond the largest "
+                                     "float (about 3.4e38)");
     return ST_OK;
 }
 

@@ -32,6 +32,11 @@ typedef struct {
 
 void blackbody_table_init(BlackbodyTable *t);
 
+/* A bound on every channel of blackbody_rgb_peak_normalised at any temperature (about
+ * 130 at its largest, near 4560 K): readers check that an emission times it stays a
+ * float. */
+#define BLACKBODY_RGB_MAX 256.0f
+
 /* pbrt-v4's BlackbodySpectrum(kelvin) (peak 1) as linear sRGB; 0 0 0 for kelvin <= 0. */
 vec3 blackbody_rgb_peak_normalised(const BlackbodyTable *t, double kelvin);
 

@@ -300,8 +300,8 @@ __kernel KERNEL_SIZE void k_film(__global const PathState *paths, uint n_pixels,
 
 /* Writes sizeof and offsetof of the shared structs, for the host to compare with its
  * own layout (tests/test_kernels.c): a mismatch would silently corrupt every buffer.
- * tests/test_ocl.c's LAYOUT_VALUES is the number of values written here: its buffer
- * holds exactly that many. */
+ * tests/layout.h lists the host's values in this order, and the tests size the output
+ * buffer from that list: add an entry there and here together. */
 #if KF_HAS(KF_PATH) && KF_HAS(KF_WHITTED)
 __kernel void k_layout(__global uint *out)
 {

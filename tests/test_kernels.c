@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "harness.h"
+#include "layout.h"
 #include "device/kernel_features.h"
 #include "base/timer.h"
 #include "device/ocl_program.h"
@@ -471,32 +472,7 @@ static void report_words(const char *what, uint index, const void *c, const void
 
 static void test_layout(void)
 {
-    uint host[] = { sizeof(vec3), sizeof(Ray), sizeof(Hit), sizeof(KdNode), sizeof(Sphere), sizeof(Triangle),
-                    sizeof(TriShading), sizeof(Box), sizeof(Plane), sizeof(Material), sizeof(Light),
-                    sizeof(Camera), sizeof(RenderParams), sizeof(PathState), offsetof(RenderParams, bg_color),
-                    offsetof(RenderParams, width), offsetof(RenderParams, bounds_lo), offsetof(PathState, bsdf_pdf),
-                    offsetof(Material, albedo), offsetof(Light, position), offsetof(Camera, lens_u),
-                    offsetof(TriShading, uv0), sizeof(Texture), offsetof(Texture, m),
-                    offsetof(Texture, color1), offsetof(RenderParams, ambient),
-                    offsetof(RenderParams, strata), offsetof(Material, reflective),
-                    offsetof(Light, cos_inner), offsetof(Camera, forward),
-                    offsetof(RenderParams, shadows), offsetof(RenderParams, normal_miss_grey),
-                    offsetof(Material, roughness), offsetof(Material, k),
-                    offsetof(Material, clearcoat_roughness), offsetof(Material, texture_rm),
-                    offsetof(Material, normal_scale),
-                    sizeof(RevSurface), offsetof(RevSurface, axis_x), offsetof(RenderParams, n_revsurfaces),
-                    offsetof(RenderParams, bg_light), sizeof(TriExtra), offsetof(TriExtra, uv),
-                    offsetof(Material, absorption), offsetof(Material, sheen_color),
-                    offsetof(Material, texture_sheen_roughness),
-                    offsetof(Material, layer_albedo), offsetof(Material, base_roughness), sizeof(SphereXform),
-                    offsetof(SphereXform, to_object), offsetof(Sphere, xform), sizeof(Medium),
-                    offsetof(Medium, sigma_s), offsetof(PathState, medium), offsetof(RenderParams, has_media),
-                    offsetof(Material, medium_in), sizeof(GridMedium), offsetof(GridMedium, nx),
-                    offsetof(GridMedium, max_density), offsetof(Medium, emission),
-                    offsetof(GridMedium, emission_at),
-                    offsetof(GridMedium, temperature_at), sizeof(MotionKey), offsetof(MotionKey, stretch),
-                    offsetof(Camera, motion_keys), offsetof(Material, diffuse_transmission),
-                    offsetof(Material, diffuse_transmission_color) };
+    uint host[] = LAYOUT_HOST_VALUES;
     enum { N = sizeof host / sizeof host[0] };
     uint dev[N];
     cl_mem out = buffer(sizeof dev, NULL);

@@ -19,14 +19,12 @@
 #include <unistd.h>
 
 #include "harness.h"
+#include "layout.h"
 #include "device/ocl.h"
 #include "device/ocl_args.h"
 #include "device/ocl_program.h"
 #include "base/sha256.h"
 #include "types.h"
-
-/* Number of values k_layout writes (see kernels/entry.cl). */
-#define LAYOUT_VALUES 59
 
 static char tmp_root[256];    /* everything this test writes lives below it */
 static char cache_dir[300];   /* CLPT_CACHE_DIR for the in-process tests */

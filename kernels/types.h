@@ -249,13 +249,14 @@ typedef struct {                                        /* 256 bytes */
                             * start at motion_keys[instance_motion[i]], and M and M^-1
                             * are those at the path's time (geom/instance.h); to_world and
                             * to_object hold its first key's pose, for the host */
-typedef struct {                                        /* 112 bytes */
+typedef struct {                                        /* 108 bytes */
     float to_world[12];       /* M: object -> world */
     float to_object[12];      /* M^-1: world -> object */
     uint root;                /* the BVH node of its prototype's root */
     uint material;            /* the material that replaces every primitive's, or NO_INDEX */
     uint flags;               /* INST_* */
-    uint object;              /* the prototype's index on the host (stats, flattening) */
+    /* the prototype's index is the host's alone (stats, flattening, lights): it lives
+     * in Scene.instance_objects, not in what every device holds per instance */
 } Instance;
 
 /* Global primitive ids: [0, n_spheres) spheres, then triangles, then boxes, then
@@ -812,7 +813,7 @@ CLPT_CHECK_SIZE(vec3, 12);
 CLPT_CHECK_SIZE(Ray, 32);
 CLPT_CHECK_SIZE(Hit, 32);
 _Static_assert(offsetof(Hit, inst) == 16, "Hit.inst");
-CLPT_CHECK_SIZE(Instance, 112);
+CLPT_CHECK_SIZE(Instance, 108);
 _Static_assert(offsetof(Instance, root) == 96, "Instance.root");
 _Static_assert(offsetof(RenderParams, n_instances) == 316, "RenderParams.n_instances");
 CLPT_CHECK_SIZE(KdNode, 8);

@@ -239,8 +239,7 @@ static void test_nested_equals_flat(void)
     size_t same = 0;
     for (size_t i = 0; i < a.n_instances && i < b.n_instances; i++) {
         Instance x = a.instances[i], y = b.instances[i];
-        int named = strcmp(a.objects[x.object].name, b.objects[y.object].name) == 0;
-        x.object = y.object = 0;
+        int named = strcmp(a.objects[a.instance_objects[i]].name, b.objects[b.instance_objects[i]].name) == 0;
         same += named && memcmp(&x, &y, sizeof x) == 0;
     }
     fprintf(stderr, "  nested: %zu instances, %zu the same records as the flat-written ones\n", a.n_instances, same);
@@ -569,7 +568,7 @@ static Hit brute_force(const Scene *s, const SceneView *sv, const RenderScene *r
             if (inst == NO_INDEX ? in_obj : !in_obj) continue;
             if (inst != NO_INDEX) {
                 uint lo[OBJ_KINDS], hi[OBJ_KINDS];
-                size_t n = scene_object_ranges(s, x->object, lo, hi), k;
+                size_t n = scene_object_ranges(s, s->instance_objects[i], lo, hi), k;
                 for (k = 0; k < n && !(id >= lo[k] && id < hi[k]); k++) continue;
                 if (k == n) continue;
             }

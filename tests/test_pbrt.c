@@ -599,12 +599,12 @@ static void test_instances(void)
     CHECK_EQ_INT(s.n_spheres, 3);   /* one in each object "a", one in "ball" */
     CHECK_EQ_INT(s.n_triangles, 1 + 2 * 64 * 32 - 2 * 64);   /* "lamp"'s, the squashed ball's mesh */
     if (s.n_instances == 6 && s.n_objects == 4) {
-        CHECK_EQ_INT(s.instances[0].object, 0);
-        CHECK_EQ_INT(s.instances[1].object, 1);
-        CHECK_EQ_INT(s.instances[2].object, 2);
-        CHECK_EQ_INT(s.instances[3].object, 2);
-        CHECK_EQ_INT(s.instances[4].object, 3);
-        CHECK_EQ_INT(s.instances[5].object, 3);
+        CHECK_EQ_INT(s.instance_objects[0], 0);
+        CHECK_EQ_INT(s.instance_objects[1], 1);
+        CHECK_EQ_INT(s.instance_objects[2], 2);
+        CHECK_EQ_INT(s.instance_objects[3], 2);
+        CHECK_EQ_INT(s.instance_objects[4], 3);
+        CHECK_EQ_INT(s.instance_objects[5], 3);
         CHECK(strcmp(s.objects[1].name, "a#1") == 0);
         CHECK(strcmp(s.objects[2].name, "lamp") == 0);
     }

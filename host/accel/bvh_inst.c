@@ -90,7 +90,7 @@ static void append_tree(const Bvh *t, Bvh *out, uint node_at, uint word_at)
 /* The top level over the instances' world boxes (built first: its depth sets the
  * prototypes' budget). */
 static Status build_top(const KdInput *in, const BvhProto *protos, size_t n_protos, const Instance *inst,
-                        size_t n_inst, const BvhMotion *motion, int threads, Bvh *top, BvhLevels *lv, Error *err)
+                        const uint *object, size_t n_inst, const BvhMotion *motion, int threads, Bvh *top, BvhLevels *lv, Error *err)
 {
     double (*pb)[6] = malloc((n_protos + 1) * sizeof *pb);
     float *boxes = malloc((n_inst + 1) * 6 * sizeof *boxes);
@@ -104,7 +104,7 @@ static Status build_top(const KdInput *in, const BvhProto *protos, size_t n_prot
         const MotionKey *keys = motion && motion->inst_motion && motion->inst_motion[i] != NO_INDEX
                                     ? motion->keys + motion->inst_motion[i]
                                     : NULL;
-        instance_box(&inst[i], keys, pb[inst[i].object], pb[inst[i].object] + 3, boxes + 6 * i);
+        instance_box(&inst[i], keys, pb[object[i]], pb[object[i]] + 3, boxes + 6 * i);
         lv->n_inst_skipped += !(boxes[6 * i] <= boxes[6 * i + 3]);
     }
     BvhOptions opt = { BVH_TOP_STACK, boxes, (uint)n_inst };
@@ -114,14 +114,14 @@ static Status build_top(const KdInput *in, const BvhProto *protos, size_t n_prot
     return st;
 }
 
-Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_protos, Instance *inst, size_t n_inst,
-                           const BvhMotion *motion, int threads, Bvh *out, BvhLevels *lv, Error *err)
+Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_protos, Instance *inst,
+                           const uint *object, size_t n_inst, const BvhMotion *motion, int threads, Bvh *out, BvhLevels *lv, Error *err)
 {
     double t0 = timer_now();
     memset(out, 0, sizeof *out);
     memset(lv, 0, sizeof *lv);
     Bvh top;
-    Status st = build_top(in, protos, n_protos, inst, n_inst, motion, threads, &top, lv, err);
+    Status st = build_top(in, protos, n_protos, inst, object, n_inst, motion, threads, &top, lv, err);
     if (st) return st;
     Bvh *pt = calloc(n_protos + 1, sizeof *pt);
     uint8_t *used = calloc(n_protos + 1, 1);
@@ -129,7 +129,7 @@ Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_p
         st = error_set(err, ST_INTERNAL, "BVH: out of memory for %zu prototypes", n_protos);
         goto done;
     }
-    for (size_t i = 0; i < n_inst; i++) used[inst[i].object] = 1;
+    for (size_t i = 0; i < n_inst; i++) used[object[i]] = 1;
     /* what the top level's deepest path left, and the entry that leads back out */
     BvhOptions opt = { BVH_STACK - 1u - top.stats.max_stack, NULL, 0u };
     uint64_t nodes = top.n_nodes, words = top.n_leaf_prims;
@@ -176,7 +176,7 @@ Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_p
         node_at += pt[p].n_nodes;
         word_at += pt[p].n_leaf_prims;
     }
-    for (size_t i = 0; i < n_inst; i++) inst[i].root = root[inst[i].object];
+    for (size_t i = 0; i < n_inst; i++) inst[i].root = root[object[i]];
     free(root);
     out->n_nodes = (uint)nodes;
     out->n_leaf_prims = (uint)words;

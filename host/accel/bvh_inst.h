@@ -41,11 +41,11 @@ typedef struct {
 } BvhMotion;
 
 /* Builds the prototypes protos[0 .. n_protos) and the top level over inst[0 .. n_inst)
- * (Instance.object: the prototype's index), filling each instance's root. A moving
+ * (object[i]: instance i's prototype), filling each instance's root. A moving
  * instance's box bounds it over all its keys' times (motion_bounds, scene/motion.h).
  * On success *out owns one node array and one leaf array (bvh_free); out->lo, hi bound
  * the world. Threads: 0 = all cores. */
-Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_protos, Instance *inst, size_t n_inst,
-                           const BvhMotion *motion, int threads, Bvh *out, BvhLevels *lv, Error *err);
+Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_protos, Instance *inst,
+                           const uint *object, size_t n_inst, const BvhMotion *motion, int threads, Bvh *out, BvhLevels *lv, Error *err);
 
 #endif /* CLPT_BVH_INST_H */

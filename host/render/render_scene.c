@@ -82,8 +82,9 @@ static Status tree_build_instanced(const Scene *s, const KdInput *in, int thread
     KdRange *obj_ranges = malloc((s->n_objects + 1) * OBJ_KINDS * sizeof *obj_ranges);
     KdRange *world = NULL;
     out->instances = malloc((s->n_instances + 1) * sizeof *out->instances);
+    uint *objects = malloc((s->n_instances + 1) * sizeof *objects);   /* each instance's prototype */
     Status st = ST_OK;
-    if (!protos || !obj_ranges || !out->instances) {
+    if (!protos || !obj_ranges || !out->instances || !objects) {
         st = error_set(err, ST_INTERNAL, "out of memory for %zu instances", s->n_instances);
         goto done;
     }
@@ -96,13 +97,16 @@ static Status tree_build_instanced(const Scene *s, const KdInput *in, int thread
     size_t n_world = 0;
     if ((st = world_ranges(s, &world, &n_world, err))) goto done;
     protos[s->n_objects] = (BvhProto){ world, n_world };
-    if (s->n_instances) memcpy(out->instances, s->instances, s->n_instances * sizeof *out->instances);
+    if (s->n_instances) {
+        memcpy(out->instances, s->instances, s->n_instances * sizeof *out->instances);
+        memcpy(objects, s->instance_objects, s->n_instances * sizeof *objects);
+    }
     Instance w;
     memset(&w, 0, sizeof w);
     for (int i = 0; i < 3; i++) w.to_world[5 * i] = w.to_object[5 * i] = 1.0f;
     w.material = NO_INDEX;
     w.flags = INST_IDENTITY | INST_WORLD;
-    w.object = (uint)s->n_objects;
+    objects[s->n_instances] = (uint)s->n_objects;
     out->instances[s->n_instances] = w;
     out->n_instances = s->n_instances + 1;
     /* moving instances (docs/motion.md): each one's first key, the world's none */
@@ -117,14 +121,15 @@ static Status tree_build_instanced(const Scene *s, const KdInput *in, int thread
         out->ds.n_instance_motion = (uint)out->n_instances;
     }
     BvhMotion motion = { out->instance_motion, s->motion_keys };
-    st = bvh_build_instanced(in, protos, n_protos, out->instances, out->n_instances, &motion, threads, &out->bvh,
-                             &out->levels, err);
+    st = bvh_build_instanced(in, protos, n_protos, out->instances, objects, out->n_instances, &motion, threads,
+                             &out->bvh, &out->levels, err);
     if (st) goto done;
     out->instanced = 1;
     render_scene_use_bvh(&out->ds, &out->bvh);
     out->ds.params.n_instances = (uint)out->n_instances;
     out->ds.instances = out->instances;
 done:
+    free(objects);
     free(protos);
     free(obj_ranges);
     free(world);
@@ -200,7 +205,7 @@ static Status prepare_media(const Scene *s, RenderScene *out, Error *err)
 static Status flatten_fits(const Scene *s, Error *err)
 {
     uint64_t prims = s->n_spheres + s->n_triangles + s->n_boxes + s->n_revsurfaces;
-    for (size_t i = 0; i < s->n_instances; i++) prims += scene_object_prims(s, s->instances[i].object);
+    for (size_t i = 0; i < s->n_instances; i++) prims += scene_object_prims(s, s->instance_objects[i]);
     long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
     uint64_t budget = pages > 0 && page > 0 ? (uint64_t)pages * (uint64_t)page : UINT64_MAX;
     const char *env = getenv("CLPT_MAX_FLATTEN_BYTES");

@@ -17,7 +17,7 @@ static void print_instances(FILE *out, const Scene *s, const RenderScene *rs)
     double instanced = 0.0;
     for (size_t i = 0; i < s->n_objects; i++) in_objects += s->objects[i].end[OBJ_TRIANGLES] - s->objects[i].first[OBJ_TRIANGLES];
     for (size_t i = 0; i < s->n_instances; i++) {
-        const SceneObject *o = &s->objects[s->instances[i].object];
+        const SceneObject *o = &s->objects[s->instance_objects[i]];
         instanced += (double)(o->end[OBJ_TRIANGLES] - o->first[OBJ_TRIANGLES]);
     }
     const BvhLevels *lv = &rs->levels;

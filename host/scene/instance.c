@@ -128,7 +128,9 @@ Status scene_place_object(Scene *s, uint object, const Transform *m, uint materi
                          (size_t)(s->n_instances + o->leaves - SCENE_MAX_INSTANCES), SCENE_MAX_INSTANCES);
     }
     if (array_reserve((void **)&s->instances, &s->cap_instances, s->n_instances + (size_t)o->leaves,
-                      sizeof *s->instances))
+                      sizeof *s->instances) ||
+        array_reserve((void **)&s->instance_objects, &s->cap_instance_objects, s->n_instances + (size_t)o->leaves,
+                      sizeof *s->instance_objects))
         return error_set(err, ST_INTERNAL, "out of memory for %llu instances", (unsigned long long)o->leaves);
     return place_nested(s, object, m, material, err);
 }
@@ -164,10 +166,11 @@ Status scene_add_instance(Scene *s, uint object, const Transform *m, uint materi
             return error_set(err, ST_INPUT, "the instance transform or its inverse does not fit in floats");
     x.root = 0u;
     x.material = material;
-    x.object = object;
     x.flags = (transform_is_identity(m) ? INST_IDENTITY : 0u) | (transform_det(m) < 0.0 ? INST_MIRROR : 0u);
-    if (array_reserve((void **)&s->instances, &s->cap_instances, s->n_instances + 1, sizeof x))
+    if (array_reserve((void **)&s->instances, &s->cap_instances, s->n_instances + 1, sizeof x) ||
+        array_reserve((void **)&s->instance_objects, &s->cap_instance_objects, s->n_instances + 1, sizeof object))
         return error_set(err, ST_INTERNAL, "out of memory for an instance");
+    s->instance_objects[s->n_instances] = object;
     s->instances[s->n_instances++] = x;
     return ST_OK;
 }
@@ -227,7 +230,7 @@ static Status flatten_check(const Scene *s, Error *err)
 {
     for (size_t i = 0; i < s->n_instances; i++) {
         const Instance *x = &s->instances[i];
-        const SceneObject *o = &s->objects[x->object];
+        const SceneObject *o = &s->objects[s->instance_objects[i]];
         if (x->flags & INST_IDENTITY) continue;
         Transform t = instance_transform(x);
         if (o->end[OBJ_BOXES] > o->first[OBJ_BOXES] && !keeps_boxes(&t))
@@ -326,9 +329,9 @@ static Status copy_box(Scene *s, size_t i, const Instance *x, const Transform *t
 }
 
 /* The copies of instance x's object. */
-static Status copy_instance(Scene *s, const Instance *x, Error *err)
+static Status copy_instance(Scene *s, const Instance *x, uint object, Error *err)
 {
-    const SceneObject o = s->objects[x->object];
+    const SceneObject o = s->objects[object];
     Transform t = instance_transform(x);
     double nm[3][3];
     if (!transform_normal_matrix(&t, nm)) return error_set(err, ST_INPUT, "the instance transform is singular");
@@ -370,7 +373,7 @@ Status scene_flatten_instances(Scene *s, Error *err)
     Status st = flatten_check(s, err);
     for (size_t i = 0; !st && i < s->n_instances; i++) {
         Instance x = s->instances[i];
-        st = copy_instance(s, &x, err);
+        st = copy_instance(s, &x, s->instance_objects[i], err);
     }
     if (st) return st;
     s->n_spheres = drop_objects(s, OBJ_SPHERES, s->spheres, s->n_spheres, sizeof *s->spheres);
@@ -386,13 +389,15 @@ void scene_free_objects(Scene *s)
     for (size_t i = 0; i < s->n_objects; i++) free(s->objects[i].name);
     free(s->objects);
     free(s->instances);
+    free(s->instance_objects);
     free(s->instance_lights);
     free(s->nested);
     strmap_free(&s->object_by_name);
     s->objects = NULL;
     s->instances = NULL;
+    s->instance_objects = NULL;
     s->instance_lights = NULL;
     s->nested = NULL;
-    s->n_objects = s->cap_objects = s->n_instances = s->cap_instances = 0;
+    s->n_objects = s->cap_objects = s->n_instances = s->cap_instances = s->cap_instance_objects = 0;
     s->n_nested = s->cap_nested = 0;
 }

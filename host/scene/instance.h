@@ -15,7 +15,7 @@
 
 #include "scene/scene.h"
 
-/* The most instances a scene holds: every one costs a device record (Instance, 112
+/* The most instances a scene holds: every one costs a device record (Instance, 108
  * bytes) and a top-level leaf, and the top level's node indices must fit the walk's. */
 #define SCENE_MAX_INSTANCES (1u << 24)
 /* The most objects a scene defines. */

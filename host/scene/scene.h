@@ -144,6 +144,7 @@ typedef struct {
     /* objects and their instances (scene/instance.h); Instance.root is the build's */
     SceneObject *objects;  size_t n_objects, cap_objects;
     Instance *instances;   size_t n_instances, cap_instances;
+    uint *instance_objects;  size_t cap_instance_objects;   /* per instance, its object */
     SceneNested *nested;   size_t n_nested, cap_nested;
     /* per instance: its first light (LIGHT_INSTANCED, kernels/types.h), or NO_INDEX;
      * NULL when no instance has lights (scene_prepare_lights) */

@@ -171,7 +171,7 @@ static Status scene_radius(const Scene *s, const uint8_t *in_object, double *rad
         }
         for (size_t i = 0; i < s->n_instances; i++) {
             const Instance *x = &s->instances[i];
-            const double *b = box + 6 * x->object;
+            const double *b = box + 6 * s->instance_objects[i];
             if (!(b[3] >= b[0])) continue;
             for (int corner = 0; corner < 8; corner++) {
                 double p[3] = { b[(corner & 1) ? 3 : 0], b[(corner & 2) ? 4 : 1], b[(corner & 4) ? 5 : 2] }, w[3];
@@ -330,11 +330,11 @@ static Status object_emitters(Scene *s, Light **tpl_out, size_t **first_out, Err
 /* How many lights instance x makes of its object's emitters: none when its
  * material replaces the object's (an emissive one emits where no light record says,
  * found by BSDF sampling alone; a dark one does not emit). */
-static size_t instance_light_count(const Instance *x, const size_t *first)
+static size_t instance_light_count(const Instance *x, uint object, const size_t *first)
 {
     /* a moving instance's emitters have no one place to sample (docs/motion.md) */
     if (x->material != NO_INDEX || (x->flags & INST_MOTION)) return 0;
-    return first[x->object + 1] - first[x->object];
+    return first[object + 1] - first[object];
 }
 
 /* The scale s when the linear part of m is s times a rotation (or a mirror), each
@@ -455,7 +455,7 @@ Status scene_prepare_lights(Scene *s, Error *err)
             free(in_object);
             return st;
         }
-        for (size_t i = 0; i < s->n_instances; i++) n_instanced += instance_light_count(&s->instances[i], tpl_first);
+        for (size_t i = 0; i < s->n_instances; i++) n_instanced += instance_light_count(&s->instances[i], s->instance_objects[i], tpl_first);
         if (n_instanced > MAX_INSTANCED_LIGHTS) n_instanced = 0;
         if (n_instanced) s->instance_lights = malloc(s->n_instances * sizeof *s->instance_lights);
         if (n_instanced == 0 || !s->instance_lights) {
@@ -513,10 +513,10 @@ Status scene_prepare_lights(Scene *s, Error *err)
 #undef ADD_LIGHT
     for (size_t i = 0; n_instanced && i < s->n_instances; i++) {
         const Instance *x = &s->instances[i];
-        size_t count = instance_light_count(x, tpl_first);
+        size_t count = instance_light_count(x, s->instance_objects[i], tpl_first);
         s->instance_lights[i] = count ? (uint)k : NO_INDEX;
         for (size_t j = 0; j < count; j++, k++) {
-            const Light *t = &tpl[tpl_first[x->object] + j];
+            const Light *t = &tpl[tpl_first[s->instance_objects[i]] + j];
             double area;
             lights[k] = instanced_light(s, t, x, &area);
             uint material = t->prim < first_tri ? s->spheres[t->prim].material

@@ -37,6 +37,8 @@
     X(MANY, uint,         leaf_prims, (ds)->params.n_leaf_prims, "kd-tree leaf lists")       \
     X(MANY, BvhNode,      bvh,        (ds)->params.n_bvh_nodes,  "8-wide BVH nodes")         \
     X(MANY, uint,         bvh_leaves, (ds)->n_bvh_leaves,        "8-wide BVH leaf lists")    \
+    /* the top level over instances, compressed (types.h); none without instances */     \
+    X(MANY, BvhTopNode,   bvh_top,    (ds)->n_bvh_top,           "top-level BVH nodes")      \
     X(MANY, Instance,     instances,  (ds)->params.n_instances,  "instances")                \
     /* per instance, its first light (types.h, LIGHT_INSTANCED); none without them */    \
     X(MANY, uint,         instance_lights, (ds)->n_instance_lights, "instanced lights")      \

@@ -235,6 +235,29 @@ typedef struct {                                        /* 256 bytes */
     uint kind[BVH_WIDTH];
 } BvhNode;
 
+/* A node of the top level over instances, compressed (after Ylitie, Karras and Laine
+ * 2017, "Efficient incoherent ray traversal on GPUs through compressed wide BVHs", and
+ * Embree's compressed BVH nodes): a child's box planes are 8-bit steps q from the node's
+ * low corner, plane = origin[axis] + (float)q * 2^(e - 127) with one step 2^(e - 127)
+ * per axis, its biased float exponent e in meta. The product is exact (q < 2^8, the
+ * step a power of two), so the plane is one correctly rounded add on every device, an
+ * fma included, and the host (host/accel/bvh_top.c) checks each rounded plane against
+ * the child's float box: lower planes rounded down, upper planes up, every child box
+ * holds its instance. The walk then enters at least the boxes the float nodes gave it
+ * and finds the same closest hit by the tie rule (docs/instancing.md). The children
+ * are in lanes 0 .. n-1 (n in meta's top byte; other lanes are never entered); ref is
+ * a top-level node index, or an instance index with BVH_TOP_INSTANCE set. The
+ * prototypes below stay BvhNode: they hold the triangles, where a wider box would cost
+ * leaf tests, and the issue's memory is per instance. */
+#define BVH_TOP_INSTANCE 0x80000000u
+typedef struct {                                        /* 96 bytes */
+    float origin[3];        /* the low corner of the children's boxes */
+    uint meta;              /* bits 0-7, 8-15, 16-23: e of x, y, z; bits 24-31: n */
+    uint q[6][2];           /* rows lo x, hi x, lo y, hi y, lo z, hi z; lane l is byte
+                             * l % 4 (the low byte first) of word l / 4 */
+    uint ref[BVH_WIDTH];
+} BvhTopNode;
+
 /* An instance of an object (a prototype: primitives in the scene's arrays that no tree
  * but their own holds) under an affine transform M, docs/instancing.md. Rays enter the
  * prototype's BVH in its object space: origin and direction both mapped by M^-1, the
@@ -818,6 +841,8 @@ _Static_assert(offsetof(Instance, root) == 96, "Instance.root");
 _Static_assert(offsetof(RenderParams, n_instances) == 316, "RenderParams.n_instances");
 CLPT_CHECK_SIZE(KdNode, 8);
 CLPT_CHECK_SIZE(BvhNode, 256);
+CLPT_CHECK_SIZE(BvhTopNode, 96);
+_Static_assert(offsetof(BvhTopNode, ref) == 64, "BvhTopNode.ref");
 CLPT_CHECK_SIZE(Sphere, 32);
 CLPT_CHECK_SIZE(SphereXform, 96);
 _Static_assert(offsetof(Sphere, xform) == 24, "Sphere.xform");

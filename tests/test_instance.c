@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "accel/bvh_top.h"
 #include "harness.h"
 #include "render_util.h"
 #include "scene/instance.h"
@@ -719,6 +720,73 @@ static void test_top_level_packed(void)
     free(text);
 }
 
+/* The compressed top level (BvhTopNode, host/accel/bvh_top.c): over 4,000 nodes of
+ * random child boxes of every size and place (1e-30 to 1e30 from the origin, extents
+ * from 0 to 1e30, a child much smaller than its siblings, planes one ulp apart), every
+ * plane the kernels decode (bvh_top_plane, their very expression) holds its child's:
+ * lower planes at or below, upper at or above. And they stay tight: a plane is within
+ * two steps of its child's, the step at most twice the node's extent / 255 (the
+ * exponent's choice), where the 2^-100 floor of the step allows. */
+static void test_top_level_compressed(void)
+{
+    enum { NODES = 4096 };
+    Bvh t;
+    memset(&t, 0, sizeof t);
+    t.nodes = calloc(NODES, sizeof *t.nodes);
+    t.n_nodes = NODES;
+    for (uint i = 0; i < NODES; i++) {
+        BvhNode *nd = &t.nodes[i];
+        uint n = 1u + (uint)(frand() * 8.0f) % 8u;
+        float scale = powf(10.0f, -30.0f + 60.0f * frand()), at = scale * (frand() * 20.0f - 10.0f);
+        for (uint l = 0; l < BVH_WIDTH; l++) {
+            for (int k = 0; k < 3; k++) {
+                float lo = at + scale * (frand() - 0.5f), ext = scale * frand();
+                if (l == 1u) ext *= 1e-6f;                       /* a small sibling */
+                if (l == 2u) ext = 0.0f;                         /* a flat one */
+                if (l == 3u) ext = nextafterf(lo, INFINITY) - lo;   /* one ulp */
+                nd->box[2 * k][l] = l < n ? lo : INFINITY;
+                nd->box[2 * k + 1][l] = l < n ? lo + ext : -INFINITY;
+            }
+            nd->kind[l] = l < n ? (l % 2u ? BVH_CHILD_INSTANCE : BVH_CHILD_NODE) : BVH_CHILD_NONE;
+            nd->ref[l] = l < n ? i * 8u + l : 0u;
+        }
+    }
+    BvhTopNode *c = NULL;
+    Error err = { 0 };
+    CHECK_MSG(bvh_top_compress(&t, &c, &err) == ST_OK, "%s", err.msg);
+    size_t held = 0, planes = 0, tight = 0;
+    for (uint i = 0; c && i < NODES; i++) {
+        const BvhNode *nd = &t.nodes[i];
+        uint n = c[i].meta >> 24;
+        CHECK(n == 0u || nd->kind[n - 1u] != BVH_CHILD_NONE);
+        for (uint l = 0; l < n; l++) {
+            uint want = nd->kind[l] == BVH_CHILD_INSTANCE ? nd->ref[l] | BVH_TOP_INSTANCE : nd->ref[l];
+            CHECK(c[i].ref[l] == want);
+            for (uint r = 0; r < 6u; r++) {
+                uint k = r / 2u, e = (c[i].meta >> (8u * k)) & 0xffu;
+                uint q = (c[i].q[r][l / 4u] >> (8u * (l % 4u))) & 0xffu;
+                float v = bvh_top_plane(c[i].origin[k], e, q), want_v = nd->box[r][l];
+                held += (r % 2u) ? v >= want_v : v <= want_v;
+                planes++;
+                float node_lo = INFINITY, node_hi = -INFINITY;
+                for (uint m = 0; m < n; m++) {
+                    node_lo = fminf(node_lo, nd->box[2u * k][m]);
+                    node_hi = fmaxf(node_hi, nd->box[2u * k + 1u][m]);
+                }
+                double step = ldexp(1.0, (int)e - 127);
+                int step_ok = step <= fmax(2.0 * ((double)node_hi - (double)node_lo) / 255.0, 0x1p-100) * 1.0000001;
+                tight += step_ok && fabs((double)v - (double)want_v) <= 2.0 * step;
+            }
+        }
+    }
+    fprintf(stderr, "  %d compressed nodes: %zu of %zu planes hold their child's, %zu tight\n", NODES, held, planes,
+            tight);
+    CHECK(held == planes && planes > 0);
+    CHECK(tight == planes);
+    free(c);
+    free(t.nodes);
+}
+
 /* Surfaces through instances are in the world: a hit point lies on the ray, and a ray
  * leaving it by its error bound does not find the same surface again. */
 static void test_spawn_leaves_surface(void)
@@ -770,6 +838,7 @@ int main(void)
     RUN(test_hits_against_brute_force);
     RUN(test_nested_hits_against_brute_force);
     RUN(test_top_level_packed);
+    RUN(test_top_level_compressed);
     RUN(test_spawn_leaves_surface);
     RUN(test_nested_equals_flat);
     RUN(test_nested_furnace);

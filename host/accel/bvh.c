@@ -867,7 +867,9 @@ void bvh_free(Bvh *b)
 {
     free(b->nodes);
     free(b->leaf_prims);
+    free(b->top);
     b->nodes = NULL;
     b->leaf_prims = NULL;
-    b->n_nodes = b->n_leaf_prims = 0;
+    b->top = NULL;
+    b->n_nodes = b->n_leaf_prims = b->n_top = 0;
 }

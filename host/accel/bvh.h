@@ -31,6 +31,9 @@ typedef struct {
 typedef struct {
     BvhNode *nodes;     uint n_nodes;             /* nodes[0] is the root */
     uint *leaf_prims;   uint n_leaf_prims;
+    /* a scene with instances: its top level, compressed (bvh_top.h), whose node 0 is
+     * the root, and nodes[] the prototypes' trees; NULL and 0 otherwise */
+    BvhTopNode *top;    uint n_top;
     vec3 lo, hi;                                  /* box of every primitive in it */
     BvhStats stats;
 } Bvh;

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "accel/bvh_top.h"
 #include "base/pages.h"
 #include "base/timer.h"
 #include "scene/motion.h"
@@ -132,7 +133,8 @@ Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_p
     for (size_t i = 0; i < n_inst; i++) used[object[i]] = 1;
     /* what the top level's deepest path left, and the entry that leads back out */
     BvhOptions opt = { BVH_STACK - 1u - top.stats.max_stack, NULL, 0u };
-    uint64_t nodes = top.n_nodes, words = top.n_leaf_prims;
+    /* the top level goes to its own compressed array; nodes[] holds the prototypes */
+    uint64_t nodes = 0u, words = top.n_leaf_prims;
     for (size_t p = 0; p < n_protos && !st; p++) {
         if (!used[p]) continue;
         KdInput pin = *in;
@@ -162,8 +164,10 @@ Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_p
         st = error_set(err, ST_INTERNAL, "BVH: out of memory for %llu nodes", (unsigned long long)nodes);
         goto done;
     }
-    append_tree(&top, out, 0u, 0u);
-    uint node_at = top.n_nodes, word_at = top.n_leaf_prims;
+    if ((st = bvh_top_compress(&top, &out->top, err))) goto done;
+    out->n_top = top.n_nodes;
+    if (top.n_leaf_prims) memcpy(out->leaf_prims, top.leaf_prims, top.n_leaf_prims * sizeof *top.leaf_prims);
+    uint node_at = 0u, word_at = top.n_leaf_prims;
     uint *root = calloc(n_protos + 1, sizeof *root);
     if (!root) {
         st = error_set(err, ST_INTERNAL, "BVH: out of memory for %zu prototypes", n_protos);
@@ -183,10 +187,10 @@ Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_p
     out->lo = top.lo;
     out->hi = top.hi;
     out->stats = top.stats;
-    out->stats.n_nodes = (uint)nodes;
+    out->stats.n_nodes = (uint)nodes + top.n_nodes;   /* both levels' */
     lv->top = top.stats;
     lv->top_nodes = top.n_nodes;
-    lv->proto_nodes = (uint)(nodes - top.n_nodes);
+    lv->proto_nodes = (uint)nodes;
     lv->proto_leaf_words = (uint)(words - top.n_leaf_prims);
 done:
     bvh_free(&top);

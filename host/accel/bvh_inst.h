@@ -26,7 +26,7 @@ typedef struct {
 typedef struct {
     BvhStats top;                  /* the top level's tree */
     uint n_protos_built;           /* prototypes some instance reaches */
-    uint top_nodes, proto_nodes;   /* nodes of each level (BvhNode, 256 bytes each) */
+    uint top_nodes, proto_nodes;   /* nodes of each level (BvhTopNode, 96 bytes; BvhNode, 256) */
     uint proto_leaf_words;         /* leaf data of the prototypes (32-bit words) */
     uint max_proto_stack;          /* the deepest prototype walk's stack */
     uint n_inst_skipped;           /* instances of an empty prototype, left out */

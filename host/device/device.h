@@ -53,6 +53,7 @@ typedef struct {
     size_t n_rev_points;        /* floats: two per profile control point */
     size_t n_env_cdf;
     size_t n_bvh_leaves;        /* words of the BVH's leaf records */
+    uint n_bvh_top;             /* the top level's nodes (BvhTopNode); 0 without instances */
     size_t n_grid_data;         /* floats of the density grids and their majorants */
     uint n_motion_keys;         /* keys of moving transforms (instances', the camera's) */
     uint n_instance_motion;     /* the device's instances when any moves, else 0 */

@@ -225,7 +225,7 @@ Status dist_start(Dist *d, DistPlan plan, int broadcast, Status st, Error *err)
 
 typedef struct {
     int32_t status;
-    uint32_t spp, n_materials, n_shading, n_tri_extra_of, n_tri_extras;
+    uint32_t spp, n_materials, n_shading, n_tri_extra_of, n_tri_extras, n_bvh_top;
     uint64_t n_texels, n_rev_points, n_env_cdf, n_bvh_leaves;
     uint64_t bytes[SCENE_BUF_COUNT];
 } WireScene;
@@ -272,6 +272,7 @@ static Status scene_receive(Dist *d, const WireScene *h, DeviceScene *ds, Error 
     ds->n_rev_points = (size_t)h->n_rev_points;
     ds->n_env_cdf = (size_t)h->n_env_cdf;
     ds->n_bvh_leaves = (size_t)h->n_bvh_leaves;
+    ds->n_bvh_top = h->n_bvh_top;
     for (unsigned i = 0; i < SCENE_BUF_COUNT; i++) {
         if (h->bytes[i] == 0) continue;
         if (h->bytes[i] > SIZE_MAX || !(d->scene_bufs[i] = malloc((size_t)h->bytes[i])))
@@ -305,6 +306,7 @@ Status dist_share_scene(Dist *d, Status rank0_status, DeviceScene *ds, unsigned 
         h.n_rev_points = ds->n_rev_points;
         h.n_env_cdf = ds->n_env_cdf;
         h.n_bvh_leaves = ds->n_bvh_leaves;
+        h.n_bvh_top = ds->n_bvh_top;
         for (unsigned i = 0; rank0_status == ST_OK && i < SCENE_BUF_COUNT; i++)
             h.bytes[i] = device_scene_buffer(ds, i).bytes;
     }

@@ -49,6 +49,8 @@ void render_scene_use_bvh(DeviceScene *ds, const Bvh *bvh)
     ds->bvh = bvh->nodes;
     ds->bvh_leaves = bvh->leaf_prims;
     ds->n_bvh_leaves = bvh->n_leaf_prims;
+    ds->bvh_top = bvh->top;
+    ds->n_bvh_top = bvh->n_top;
 }
 
 /* The world's own primitives (in no object) as ranges of global ids into *out (freed

@@ -21,7 +21,7 @@ static void print_instances(FILE *out, const Scene *s, const RenderScene *rs)
         instanced += (double)(o->end[OBJ_TRIANGLES] - o->first[OBJ_TRIANGLES]);
     }
     const BvhLevels *lv = &rs->levels;
-    double top = (double)lv->top_nodes * sizeof(BvhNode) + (double)rs->n_instances * sizeof(Instance);
+    double top = (double)lv->top_nodes * sizeof(BvhTopNode) + (double)rs->n_instances * sizeof(Instance);
     double protos = (double)lv->proto_nodes * sizeof(BvhNode) + (double)lv->proto_leaf_words * sizeof(uint);
     fprintf(out, "instances: %zu of %zu objects; triangles: %zu unique (%zu in objects), %.0f instanced "
            "(%.0f with the world's)\n", s->n_instances, s->n_objects, s->n_triangles, in_objects, instanced,
@@ -53,7 +53,8 @@ void render_stats_print_scene(FILE *out, const Scene *s, const RenderScene *rs)
     double per = in_tree ? 1.0 / (double)in_tree : 0.0;
     if (s->accel == ACCEL_BVH) {
         const BvhStats *b = &rs->bvh.stats;
-        size_t bytes = (size_t)rs->bvh.n_nodes * sizeof(BvhNode) + (size_t)rs->bvh.n_leaf_prims * sizeof(uint);
+        size_t bytes = (size_t)rs->bvh.n_nodes * sizeof(BvhNode) + (size_t)rs->bvh.n_top * sizeof(BvhTopNode) +
+                       (size_t)rs->bvh.n_leaf_prims * sizeof(uint);
         fprintf(out, "BVH: built in %.3f s; %u nodes of 8, %u leaves, depth %u (binary tree %u), %.2f primitives "
                "per leaf, SAH cost %.2f, %.1f KiB (%.1f bytes per primitive)\n",
                b->build_seconds, b->n_nodes, b->n_leaves, b->max_depth, b->max_binary_depth,

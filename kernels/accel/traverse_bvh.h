@@ -36,16 +36,16 @@
  * 8-wide vectors badly (as triangle_intersect_group, intersect.h); the same operations
  * per lane give the same bits either way. min and max are selects: no NaN reaches them
  * (see above). */
-#define BVH_LANES_BODY(VT, IT, W, LOAD, STORE, SPLAT, SELECT, BITS)                      \
+#define BVH_LANES_BODY(BOX, VT, IT, W, LOAD, STORE, SPLAT, SELECT, BITS)                 \
     VT a, b;                                                                             \
-    LOAD(a, nd->box[w->nx] + first);                                                     \
-    LOAD(b, nd->box[1u - w->nx] + first);                                                \
+    LOAD(a, BOX[w->nx] + first);                                                         \
+    LOAD(b, BOX[1u - w->nx] + first);                                                    \
     VT tx = (a - w->ox) * w->ix, ux = (b - w->ox) * w->fx;                               \
-    LOAD(a, nd->box[2u + w->ny] + first);                                                \
-    LOAD(b, nd->box[3u - w->ny] + first);                                                \
+    LOAD(a, BOX[2u + w->ny] + first);                                                    \
+    LOAD(b, BOX[3u - w->ny] + first);                                                    \
     VT ty = (a - w->oy) * w->iy, uy = (b - w->oy) * w->fy;                               \
-    LOAD(a, nd->box[4u + w->nz] + first);                                                \
-    LOAD(b, nd->box[5u - w->nz] + first);                                                \
+    LOAD(a, BOX[4u + w->nz] + first);                                                    \
+    LOAD(b, BOX[5u - w->nz] + first);                                                    \
     VT tz = (a - w->oz) * w->iz, uz = (b - w->oz) * w->fz;                               \
     VT lo = SPLAT(w->tmin), hi = SPLAT(tfar);                                            \
     tx = SELECT(tx, ty, ty > tx);                                                        \
@@ -68,7 +68,13 @@ typedef struct {
 #define K_SPLAT8(x) ((float8)(x))
 KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
 {
-    BVH_LANES_BODY(float8, int8, 8, k_load8, k_store8, K_SPLAT8, k_select8, k_bits8)
+    BVH_LANES_BODY(nd->box, float8, int8, 8, k_load8, k_store8, K_SPLAT8, k_select8, k_bits8)
+    return mask;
+}
+/* The same on rows decoded into private memory (a compressed top-level node). */
+KFN_INLINE uint bvh_lanes_rows(const float (*box)[BVH_WIDTH], const BvhRay *w, uint first, float tfar, float *ta)
+{
+    BVH_LANES_BODY(box, float8, int8, 8, k_load8, k_store8, K_SPLAT8, k_select8, k_bits8)
     return mask;
 }
 #else
@@ -76,7 +82,12 @@ KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first,
 #define k_select4(a, b, m) ((float4)(((int4)(a) & ~(m)) | ((int4)(b) & (m))))
 KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
 {
-    BVH_LANES_BODY(float4, int4, 4, k_load4, k_store4, K_SPLAT4, k_select4, k_bits4)
+    BVH_LANES_BODY(nd->box, float4, int4, 4, k_load4, k_store4, K_SPLAT4, k_select4, k_bits4)
+    return mask;
+}
+KFN_INLINE uint bvh_lanes_rows(const float (*box)[BVH_WIDTH], const BvhRay *w, uint first, float tfar, float *ta)
+{
+    BVH_LANES_BODY(box, float4, int4, 4, k_load4, k_store4, K_SPLAT4, k_select4, k_bits4)
     return mask;
 }
 #endif
@@ -92,6 +103,43 @@ KFN_INLINE uint bvh_node_test(GLOBAL const BvhNode *nd, const BvhRay *w, float t
     return bvh_lanes(nd, w, 0u, tfar, ta) | (bvh_lanes(nd, w, 4u, tfar, ta) << 4);
 #endif
 }
+
+#if KF_HAS(KF_INSTANCES)
+/* A compressed top-level node's child boxes as the six float rows bvh_lanes reads
+ * (BvhTopNode, types.h): origin + q * 2^(e - 127), the product exact, the add rounded
+ * once, as host/accel/bvh_top.c's bvh_top_plane computes the planes it checks. */
+KFN_INLINE void bvh_top_rows(GLOBAL const BvhTopNode *nd, float box[6][BVH_WIDTH])
+{
+    uint meta = nd->meta;
+    for (uint r = 0; r < 6u; r++) {
+        uint k = r >> 1;
+        float step = k_as_float(((meta >> (8u * k)) & 0xffu) << 23);
+        float origin = nd->origin[k];
+        uint w0 = nd->q[r][0], w1 = nd->q[r][1];
+        for (uint l = 0; l < 4u; l++) {
+            box[r][l] = origin + (float)((w0 >> (8u * l)) & 0xffu) * step;
+            box[r][4u + l] = origin + (float)((w1 >> (8u * l)) & 0xffu) * step;
+        }
+    }
+}
+
+/* Lanes of a compressed top-level node whose box the ray enters before tmax (bits),
+ * their entry distances in ta: the children's lanes only. */
+KFN_INLINE uint bvh_top_test(GLOBAL const BvhTopNode *nd, const BvhRay *w, float tmax, float *ta)
+{
+    float box[6][BVH_WIDTH];
+    bvh_top_rows(nd, box);
+    float tfar = tmax * KD_T_ABOVE;
+    uint n = nd->meta >> 24;
+#ifdef KERNEL_OPENCL
+    uint mask = bvh_lanes_rows((const float (*)[BVH_WIDTH])box, w, 0u, tfar, ta);
+#else
+    uint mask = bvh_lanes_rows((const float (*)[BVH_WIDTH])box, w, 0u, tfar, ta) |
+                (bvh_lanes_rows((const float (*)[BVH_WIDTH])box, w, 4u, tfar, ta) << 4);
+#endif
+    return mask & ((1u << n) - 1u);
+}
+#endif
 
 KFN_INLINE float bvh_inv(float d)
 {
@@ -182,6 +230,9 @@ KFN_INLINE BvhRay bvh_ray(Ray ray, const RayPre *rp)
  * the stack holds both levels' entries, with a BVH_STACK_LEAVE between them. Entry
  * distances and the closest hit are in the world ray's t throughout (instance.h), so
  * an entry pushed in the world is skipped by a hit found in an instance as usual. The
+ * top level's nodes are compressed (BvhTopNode, sc->bvh_top, decoded by bvh_top_test):
+ * `top` says which level the walk is in, and so which array a stack entry's node is
+ * in (the top level's entries lie below a BVH_STACK_LEAVE, the prototype's above). The
  * builds keep both levels' stack depths within BVH_STACK together (host/accel/bvh_inst.c). */
 BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit *best)
 {
@@ -189,6 +240,7 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
     if (!(s == s) || sc->params->n_bvh_nodes == 0u) return;
     BvhRay w = bvh_ray(ray, rp);
 #if KF_HAS(KF_INSTANCES)
+    int top = sc->params->n_instances != 0u;   /* walking the top level's nodes */
     BvhRay w_world = w;
     Ray oray = ray;              /* the ray in the space being walked, and its constants */
     RayPre orp = *rp;
@@ -211,8 +263,22 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
     for (;;) {
         /* down through nodes until a leaf, or a node none of whose boxes the ray enters */
         while (kind == BVH_CHILD_NODE) {
-            GLOBAL const BvhNode *nd = sc->bvh + ref;
             float ta[BVH_WIDTH];
+#if KF_HAS(KF_INSTANCES)
+            if (top) {
+                GLOBAL const BvhTopNode *tn = sc->bvh_top + ref;
+                uint tmask = bvh_top_test(tn, &w, best->t, ta);
+                if (!tmask) break;
+                uint tnext = k_lowest_bit(tmask);
+                if (tmask & (tmask - 1u))
+                    tnext = bvh_push_children(ref, tmask, ta, 0, any, st_child, st_t, &sp);
+                ref = tn->ref[tnext];
+                kind = (ref & BVH_TOP_INSTANCE) ? BVH_CHILD_INSTANCE : BVH_CHILD_NODE;
+                ref &= ~BVH_TOP_INSTANCE;
+                continue;
+            }
+#endif
+            GLOBAL const BvhNode *nd = sc->bvh + ref;
             uint mask = bvh_node_test(nd, &w, best->t, ta);
             if (!mask) break;
             uint next = k_lowest_bit(mask);
@@ -228,6 +294,7 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
             st_child[sp] = BVH_STACK_LEAVE;
             st_t[sp] = 0u;
             sp++;
+            top = 0;
             inst = (x->flags & INST_WORLD) ? NO_INDEX : ref;
             oray = instance_ray_seen(sc, ref, x, ray);
             orp = ray_prepare(oray);
@@ -254,11 +321,20 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
                 oray = ray;
                 orp = *rp;
                 inst = NO_INDEX;
+                top = 1;
                 continue;
             }
 #endif
             if (!(k_as_float(st_t[sp]) > best->t * KD_T_ABOVE)) break;
         }
+#if KF_HAS(KF_INSTANCES)
+        if (top) {
+            ref = sc->bvh_top[st_child[sp] >> 3].ref[st_child[sp] & 7u];
+            kind = (ref & BVH_TOP_INSTANCE) ? BVH_CHILD_INSTANCE : BVH_CHILD_NODE;
+            ref &= ~BVH_TOP_INSTANCE;
+            continue;
+        }
+#endif
         GLOBAL const BvhNode *parent = sc->bvh + (st_child[sp] >> 3);
         uint lane = st_child[sp] & 7u;
         ref = parent->ref[lane];

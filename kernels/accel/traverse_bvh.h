@@ -31,21 +31,22 @@
 
 /* The slab test of a node's child boxes in lanes [first, first + W) (vectors VT of W
  * floats, comparisons IT): leaves the lanes whose box the ray enters within [tmin,
- * tmax] as bits in `mask`, and each lane's entry distance in ta. OpenCL runs the 8 lanes
- * as one float8; C runs them as two float4 halves, because without AVX gcc splits
- * 8-wide vectors badly (as triangle_intersect_group, intersect.h); the same operations
- * per lane give the same bits either way. min and max are selects: no NaN reaches them
- * (see above). */
-#define BVH_LANES_BODY(BOX, VT, IT, W, LOAD, STORE, SPLAT, SELECT, BITS)                 \
+ * tmax] as bits in `mask`, and each lane's entry distance in ta. ROW(v, r) puts row r
+ * of the boxes (lo x, hi x, lo y, hi y, lo z, hi z) into v: loaded from a float node,
+ * or decoded from a compressed top-level node. OpenCL runs the 8 lanes as one float8;
+ * C runs them as two float4 halves, because without AVX gcc splits 8-wide vectors
+ * badly (as triangle_intersect_group, intersect.h); the same operations per lane give
+ * the same bits either way. min and max are selects: no NaN reaches them (see above). */
+#define BVH_LANES_BODY(ROW, VT, IT, W, STORE, SPLAT, SELECT, BITS)                       \
     VT a, b;                                                                             \
-    LOAD(a, BOX[w->nx] + first);                                                         \
-    LOAD(b, BOX[1u - w->nx] + first);                                                    \
+    ROW(a, w->nx);                                                                       \
+    ROW(b, 1u - w->nx);                                                                  \
     VT tx = (a - w->ox) * w->ix, ux = (b - w->ox) * w->fx;                               \
-    LOAD(a, BOX[2u + w->ny] + first);                                                    \
-    LOAD(b, BOX[3u - w->ny] + first);                                                    \
+    ROW(a, 2u + w->ny);                                                                  \
+    ROW(b, 3u - w->ny);                                                                  \
     VT ty = (a - w->oy) * w->iy, uy = (b - w->oy) * w->fy;                               \
-    LOAD(a, BOX[4u + w->nz] + first);                                                    \
-    LOAD(b, BOX[5u - w->nz] + first);                                                    \
+    ROW(a, 4u + w->nz);                                                                  \
+    ROW(b, 5u - w->nz);                                                                  \
     VT tz = (a - w->oz) * w->iz, uz = (b - w->oz) * w->fz;                               \
     VT lo = SPLAT(w->tmin), hi = SPLAT(tfar);                                            \
     tx = SELECT(tx, ty, ty > tx);                                                        \
@@ -64,32 +65,59 @@ typedef struct {
     uint nx, ny, nz;             /* 1 where the direction is negative: near plane is hi */
 } BvhRay;
 
+/* The step of a compressed node's axis k: 2^(e - 127), e its biased exponent in meta
+ * (BvhTopNode, types.h). */
+#define BVH_TOP_STEP(meta, k) k_as_float((((meta) >> (8u * (k))) & 0xffu) << 23)
+
 #ifdef KERNEL_OPENCL
 #define K_SPLAT8(x) ((float8)(x))
+#define BVH_ROW8(v, r) k_load8(v, nd->box[r] + first)
 KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
 {
-    BVH_LANES_BODY(nd->box, float8, int8, 8, k_load8, k_store8, K_SPLAT8, k_select8, k_bits8)
+    BVH_LANES_BODY(BVH_ROW8, float8, int8, 8, k_store8, K_SPLAT8, k_select8, k_bits8)
     return mask;
 }
-/* The same on rows decoded into private memory (a compressed top-level node). */
-KFN_INLINE uint bvh_lanes_rows(const float (*box)[BVH_WIDTH], const BvhRay *w, uint first, float tfar, float *ta)
+#if KF_HAS(KF_INSTANCES)
+/* A compressed top-level node's row r decoded as bvh_top_plane (host/accel/bvh_top.c)
+ * computes the planes it checks: origin + q * step, the product exact, the add rounded
+ * once (an fma gives the same). Its eight bytes are one uchar8 load: in memory order,
+ * the order of the C decode's shifts on the little-endian devices we run (x86, NVIDIA). */
+#define BVH_TOP_ROW8(v, r)                                                               \
+    ((v) = (float8)(nd->origin[(r) >> 1]) +                                              \
+           convert_float8(vload8(0, (GLOBAL const uchar *)nd->q[r])) * (float8)(BVH_TOP_STEP(meta, (r) >> 1)))
+KFN_INLINE uint bvh_top_lanes(GLOBAL const BvhTopNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
 {
-    BVH_LANES_BODY(box, float8, int8, 8, k_load8, k_store8, K_SPLAT8, k_select8, k_bits8)
+    uint meta = nd->meta;
+    BVH_LANES_BODY(BVH_TOP_ROW8, float8, int8, 8, k_store8, K_SPLAT8, k_select8, k_bits8)
     return mask;
 }
+#endif
 #else
 #define K_SPLAT4(x) ((float4){ (x), (x), (x), (x) })
 #define k_select4(a, b, m) ((float4)(((int4)(a) & ~(m)) | ((int4)(b) & (m))))
+#define BVH_ROW4(v, r) k_load4(v, nd->box[r] + first)
 KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
 {
-    BVH_LANES_BODY(nd->box, float4, int4, 4, k_load4, k_store4, K_SPLAT4, k_select4, k_bits4)
+    BVH_LANES_BODY(BVH_ROW4, float4, int4, 4, k_store4, K_SPLAT4, k_select4, k_bits4)
     return mask;
 }
-KFN_INLINE uint bvh_lanes_rows(const float (*box)[BVH_WIDTH], const BvhRay *w, uint first, float tfar, float *ta)
+#if KF_HAS(KF_INSTANCES)
+/* Lanes first .. first + 3 of a compressed node's row r: bytes 0 .. 3 of one word. */
+KFN_INLINE float4 bvh_top_row4(GLOBAL const BvhTopNode *nd, uint meta, uint r, uint first)
 {
-    BVH_LANES_BODY(box, float4, int4, 4, k_load4, k_store4, K_SPLAT4, k_select4, k_bits4)
+    uint q = nd->q[r][first >> 2];
+    float o = nd->origin[r >> 1], step = BVH_TOP_STEP(meta, r >> 1);
+    float4 qf = { (float)(q & 0xffu), (float)((q >> 8) & 0xffu), (float)((q >> 16) & 0xffu), (float)(q >> 24) };
+    return K_SPLAT4(o) + qf * K_SPLAT4(step);
+}
+#define BVH_TOP_ROW4(v, r) ((v) = bvh_top_row4(nd, meta, r, first))
+KFN_INLINE uint bvh_top_lanes(GLOBAL const BvhTopNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
+{
+    uint meta = nd->meta;
+    BVH_LANES_BODY(BVH_TOP_ROW4, float4, int4, 4, k_store4, K_SPLAT4, k_select4, k_bits4)
     return mask;
 }
+#endif
 #endif
 
 /* Lanes of node nd whose box the ray enters before tmax (bits), their entry distances
@@ -105,37 +133,16 @@ KFN_INLINE uint bvh_node_test(GLOBAL const BvhNode *nd, const BvhRay *w, float t
 }
 
 #if KF_HAS(KF_INSTANCES)
-/* A compressed top-level node's child boxes as the six float rows bvh_lanes reads
- * (BvhTopNode, types.h): origin + q * 2^(e - 127), the product exact, the add rounded
- * once, as host/accel/bvh_top.c's bvh_top_plane computes the planes it checks. */
-KFN_INLINE void bvh_top_rows(GLOBAL const BvhTopNode *nd, float box[6][BVH_WIDTH])
-{
-    uint meta = nd->meta;
-    for (uint r = 0; r < 6u; r++) {
-        uint k = r >> 1;
-        float step = k_as_float(((meta >> (8u * k)) & 0xffu) << 23);
-        float origin = nd->origin[k];
-        uint w0 = nd->q[r][0], w1 = nd->q[r][1];
-        for (uint l = 0; l < 4u; l++) {
-            box[r][l] = origin + (float)((w0 >> (8u * l)) & 0xffu) * step;
-            box[r][4u + l] = origin + (float)((w1 >> (8u * l)) & 0xffu) * step;
-        }
-    }
-}
-
-/* Lanes of a compressed top-level node whose box the ray enters before tmax (bits),
- * their entry distances in ta: the children's lanes only. */
+/* The same for a compressed top-level node (BvhTopNode, types.h): its children's lanes
+ * only (lanes n .. 7 hold no box). */
 KFN_INLINE uint bvh_top_test(GLOBAL const BvhTopNode *nd, const BvhRay *w, float tmax, float *ta)
 {
-    float box[6][BVH_WIDTH];
-    bvh_top_rows(nd, box);
     float tfar = tmax * KD_T_ABOVE;
     uint n = nd->meta >> 24;
 #ifdef KERNEL_OPENCL
-    uint mask = bvh_lanes_rows((const float (*)[BVH_WIDTH])box, w, 0u, tfar, ta);
+    uint mask = bvh_top_lanes(nd, w, 0u, tfar, ta);
 #else
-    uint mask = bvh_lanes_rows((const float (*)[BVH_WIDTH])box, w, 0u, tfar, ta) |
-                (bvh_lanes_rows((const float (*)[BVH_WIDTH])box, w, 4u, tfar, ta) << 4);
+    uint mask = bvh_top_lanes(nd, w, 0u, tfar, ta) | (bvh_top_lanes(nd, w, 4u, tfar, ta) << 4);
 #endif
     return mask & ((1u << n) - 1u);
 }

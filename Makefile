@@ -5,7 +5,9 @@
 #   make install    install under PREFIX (/usr/local), into DESTDIR if set; make uninstall
 #   make render     render the default scene to cornell-box.png
 #   make bench      throughput benchmarks (bench/)
-#   make bench-peers  clpt against Mitsuba 3 and Cycles at equal error (bench/peers.py)
+#   make bench-peers  clpt against Mitsuba 3 and Cycles at equal error (bench/peers.py);
+#                   PBRT=/path/to/pbrt adds pbrt-v4 on scenes written as pbrt-v4 files,
+#                   PBRT_SCENES=DIR (pbrt-v4-scenes) its killeroo-simple.pbrt
 #   make xcheck     single-feature scenes against Mitsuba 3 and Cycles (tools/xcheck/);
 #                   PBRT=/path/to/pbrt adds the pbrt-v4 media scenes against that binary
 #   make test-asan  the test suite built with AddressSanitizer + UBSan (build-asan/)
@@ -342,11 +344,13 @@ bench: $(BUILD)/$(PROG) $(BENCH_BIN)
 	@sh bench/run.sh $(BUILD)
 
 # Minutes long and needs ../shared/peers; peers that are not installed are skipped.
+# PBRT (a pbrt-v4 binary, never part of the repository) and PBRT_SCENES are passed on.
 bench-peers: $(BUILD)/$(PROG)
 	@mkdir -p $(BUILD)/pocl-cache $(BUILD)/kernel-cache
 	@POCL_CACHE_DIR=$${POCL_CACHE_DIR:-$(CURDIR)/$(BUILD)/pocl-cache} \
 	 CLPT_CACHE_DIR=$${CLPT_CACHE_DIR:-$(CURDIR)/$(BUILD)/kernel-cache} \
-	 python3 bench/peers.py --clpt $(BUILD)/$(PROG) --out $(BUILD)/peers $(PEERS_ARGS)
+	 python3 bench/peers.py --clpt $(BUILD)/$(PROG) --out $(BUILD)/peers $(if $(PBRT),--pbrt $(PBRT)) \
+	   $(if $(PBRT_SCENES),--pbrt-scenes $(PBRT_SCENES)) $(PEERS_ARGS)
 
 # The cross-check (docs/validation.md): minutes long, not part of `make test`; Mitsuba 3
 # (pip) and Cycles (Debian's blender) are used when installed and skipped otherwise.

@@ -5,6 +5,7 @@ usage: bench/peers.py [--clpt build/clpt] [--clpt-args ARGS] [--peers DIR] [--ou
                       [--runs N] [--ref-spp cornell=4096,dragon=1024,...] [--device DEV]
                       [--threads N] [--scenes cornell,dragon,envmat,fog,smoke]
                       [--renderers mitsuba,cycles]
+                      [--pbrt PATH [--pbrt-scenes DIR] [--pbrt-threads N]]
 
 Renders the two scenes of ../shared/peers (its README says how they were matched across
 renderers; the scene files and peer scripts are used from there as they are, so every
@@ -48,7 +49,21 @@ out as here, but costs the McGuire box 9% over whole images (bench/RESULTS.md), 
 not clpt's default. Part of its gain is the Sobol points' faster convergence at twice the
 continuations, which the peers would also see at twice their samples.
 
-Standard library only for the peers' scenes; numpy is used for the error when it is importable
+With --pbrt PATH (`make bench-peers PBRT=PATH`), a pbrt-v4 binary built outside the
+repository (nothing of pbrt-v4 is in it: no code, binary or build script), the scenes
+pbrt-cornell and pbrt-dragon (and pbrt-killeroo, pbrt-v4-scenes' killeroo-simple.pbrt,
+with --pbrt-scenes DIR, a checkout of mmp/pbrt-v4-scenes; `make bench-peers
+PBRT_SCENES=DIR`) are added: bench/peers_pbrt.py writes them as pbrt-v4 files into
+--out/pbrt/, and clpt (which reads pbrt-v4's format, docs/pbrt.md) and pbrt-v4 render the
+very same files, pbrt-v4 with its zsobol sampler, both with a box pixel filter and 8
+bounces, in turns, timed as whole processes (wall time), each against ITS OWN converged
+render (pbrt-v4 is spectral, clpt RGB; the bias between the two references is printed per
+channel, for the correctness comparison, not the speed one); its docstring says how. They
+print a table of their own after the one above; `--scenes pbrt-cornell,pbrt-dragon` runs
+them alone. The reference samples are 64 times each scene's by default, as above, which
+for pbrt-v4 on two cores means hours: `--ref-spp pbrt-cornell=256,...` for a quick run.
+
+Standard library only for the peers' scenes (the pbrt-v4 scenes need numpy); numpy is used for the error when it is importable
 (faster), and the generated scenes need it (tools/xcheck's writers).
 """
 import argparse
@@ -81,6 +96,8 @@ SCENES = {
 # the reference's samples: 64 times the scene's on the peers' scenes, 32 times on the
 # generated ones (their references' own error is measured and taken off all the same)
 REF_SPP = {'cornell': 4096, 'dragon': 1024, 'envmat': 512, 'fog': 512, 'smoke': 512}
+# --pbrt's scenes (bench/peers_pbrt.py): name -> (spp, reference spp)
+PBRT_SCENES = {'pbrt-cornell': (64, 4096), 'pbrt-dragon': (16, 1024), 'pbrt-killeroo': (16, 1024)}
 LLVM19 = '/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1'
 
 
@@ -304,10 +321,20 @@ def main():
     ap.add_argument('--threads', type=int, default=2, help="Cycles' render threads")
     ap.add_argument('--scenes', default=','.join(SCENES))
     ap.add_argument('--renderers', default='mitsuba,cycles', help='the peers to run when installed')
+    ap.add_argument('--pbrt', default='', help='a pbrt-v4 binary: adds the scenes %s, written as pbrt-v4 files that '
+                    'clpt and it read (bench/peers_pbrt.py)' % ','.join(PBRT_SCENES))
+    ap.add_argument('--pbrt-scenes', default='', help='a checkout of mmp/pbrt-v4-scenes: adds pbrt-killeroo '
+                    '(killeroos/killeroo-simple.pbrt) to the pbrt-v4 scenes')
+    ap.add_argument('--pbrt-threads', type=int, default=2, help="pbrt-v4's --nthreads")
     a = ap.parse_args()
     a.peers = os.path.abspath(a.peers)   # the peer scripts run in --out
     given = dict((k, int(v)) for k, v in (x.split('=', 1) for x in a.ref_spp.split(',') if x))
-    a.ref_spp = dict(REF_SPP, **given)
+    a.ref_spp = dict(REF_SPP)
+    a.ref_spp.update((k, v[1]) for k, v in PBRT_SCENES.items())
+    a.ref_spp.update(given)
+    if a.scenes == ap.get_default('scenes') and a.pbrt:
+        # --pbrt adds its scenes to the default list (pbrt-killeroo only with --pbrt-scenes)
+        a.scenes += ',pbrt-cornell,pbrt-dragon' + (',pbrt-killeroo' if a.pbrt_scenes else '')
     if a.runs < 1:
         raise SystemExit('--runs %d: at least one round' % a.runs)
     for s, n in a.ref_spp.items():
@@ -315,8 +342,22 @@ def main():
             raise SystemExit('--ref-spp %s=%d: an even number of samples, at least 2 (two halves)' % (s, n))
     scenes = [s for s in a.scenes.split(',') if s]
     for s in scenes:
-        if s not in SCENES:
-            raise SystemExit('unknown scene %s (known: %s)' % (s, ', '.join(SCENES)))
+        if s in PBRT_SCENES and not a.pbrt:
+            raise SystemExit('scene %s: --pbrt PATH (a pbrt-v4 binary) is needed' % s)
+        if s not in SCENES and s not in PBRT_SCENES:
+            raise SystemExit('unknown scene %s (known: %s)' % (s, ', '.join(list(SCENES) + list(PBRT_SCENES))))
+    pbrt_scenes = [s for s in scenes if s in PBRT_SCENES]
+    scenes = [s for s in scenes if s not in PBRT_SCENES]
+    if pbrt_scenes:
+        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+        try:
+            import peers_pbrt
+        except ImportError as e:
+            raise SystemExit('the pbrt-v4 scenes: %s (apt-get install python3-numpy)' % e)
+        a.pbrt_spp = dict((k, v[0]) for k, v in PBRT_SCENES.items())
+        why = peers_pbrt.check(a, pbrt_scenes)
+        if why:
+            raise SystemExit(why)
     if not os.path.exists(os.path.join(a.peers, 'README.md')):
         raise SystemExit('%s: the peer scenes are not there (--peers DIR)' % a.peers)
     os.makedirs(a.out, exist_ok=True)
@@ -332,6 +373,10 @@ def main():
                 raise SystemExit('%s: the envmat scene\'s map is not there' % peers_scenes.ENVMAP)
             peers_scenes.write_clpt(s, a.out)
 
+    if not scenes:
+        os.makedirs(a.out, exist_ok=True)
+        peers_pbrt.run(a, pbrt_scenes)
+        return
     renderers = [Clpt(a)]
     for cls in (Mitsuba, Cycles):
         if cls.name not in a.renderers.split(','):
@@ -387,6 +432,9 @@ def main():
         if 'cycles' not in rows and any(r.name == 'cycles' for r in renderers):
             print('| %s | Cycles | not rendered: ../shared/peers has the Cornell box only for Cycles '
                   '| | | | | | |' % s)
+    if pbrt_scenes:
+        print()
+        peers_pbrt.run(a, pbrt_scenes)
 
 
 if __name__ == '__main__':

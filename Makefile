@@ -384,7 +384,7 @@ test-valgrind: $(BUILD)/$(PROG)
 fuzz-build:
 	@sh tools/deps.sh --check base fuzz
 	@$(MAKE) --no-print-directory BUILD=build-fuzz CC=clang OPT=-O1 \
-	    EXTRA_CFLAGS="$(SAN_FLAGS) -fsanitize=fuzzer-no-link" EXTRA_LDFLAGS="$(SAN_FLAGS)" \
+	    EXTRA_CFLAGS="$(SAN_FLAGS) -fsanitize=fuzzer-no-link -DCLPT_FUZZ_BUILD" EXTRA_LDFLAGS="$(SAN_FLAGS)" \
 	    $(FUZZ_SRC:fuzz/%.c=build-fuzz/fuzz/%)
 
 fuzz: fuzz-build

@@ -33,6 +33,25 @@
 #include "scene_view.h"
 #include "types.h"
 
+/* The counts kernels/scene_buffers.h finds in a DeviceScene rather than in params, one
+ * list: whatever copies a scene to another place (dist/mpi_driver.c's broadcast) copies
+ * every one of them. */
+#define DEVICE_SCENE_COUNTS(X)                                                               \
+    X(uint, n_materials)                                                                     \
+    X(uint, n_shading)                                                                       \
+    X(uint, n_tri_extra_of)     /* n_shading, or 0 when no triangle has extras */            \
+    X(uint, n_tri_extras)                                                                    \
+    X(uint, n_sphere_xforms)    /* Sphere.xform's targets */                                 \
+    X(uint, n_instance_lights)  /* the scene's instances when any has lights, else 0 */      \
+    X(size_t, n_texels)                                                                      \
+    X(size_t, n_rev_points)     /* floats: two per profile control point */                  \
+    X(size_t, n_env_cdf)                                                                     \
+    X(size_t, n_bvh_leaves)     /* words of the BVH's leaf records */                        \
+    X(uint, n_bvh_top)          /* the top level's nodes (BvhTopNode); 0 without instances */ \
+    X(size_t, n_grid_data)      /* floats of the density grids and their majorants */        \
+    X(uint, n_motion_keys)      /* keys of moving transforms (instances', the camera's) */   \
+    X(uint, n_instance_motion)  /* the device's instances when any moves, else 0 */
+
 /* Everything a device needs, in kernel layout: one field per line of
  * kernels/scene_buffers.h (the params block by value, every other buffer as a pointer,
  * NULL when its count is 0), then the counts that list finds here rather than in params.
@@ -41,22 +60,10 @@
 #define DEVICE_SCENE_FIELD_ONE_(Type, name) Type name;
 #define DEVICE_SCENE_FIELD_MANY_(Type, name) const Type *name;
 #define DEVICE_SCENE_FIELD_(kind, Type, name, count, what) DEVICE_SCENE_FIELD_##kind##_(Type, name)
+#define DEVICE_SCENE_COUNT_FIELD_(Type, name) Type name;
 typedef struct {
     SCENE_BUFFERS(DEVICE_SCENE_FIELD_)
-    uint n_materials;
-    uint n_shading;
-    uint n_tri_extra_of;        /* n_shading, or 0 when no triangle has extras */
-    uint n_tri_extras;
-    uint n_sphere_xforms;       /* Sphere.xform's targets */
-    uint n_instance_lights;     /* the scene's instances when any has lights, else 0 */
-    size_t n_texels;
-    size_t n_rev_points;        /* floats: two per profile control point */
-    size_t n_env_cdf;
-    size_t n_bvh_leaves;        /* words of the BVH's leaf records */
-    uint n_bvh_top;             /* the top level's nodes (BvhTopNode); 0 without instances */
-    size_t n_grid_data;         /* floats of the density grids and their majorants */
-    uint n_motion_keys;         /* keys of moving transforms (instances', the camera's) */
-    uint n_instance_motion;     /* the device's instances when any moves, else 0 */
+    DEVICE_SCENE_COUNTS(DEVICE_SCENE_COUNT_FIELD_)
 } DeviceScene;
 #undef DEVICE_SCENE_FIELD_
 #undef DEVICE_SCENE_FIELD_MANY_

@@ -223,10 +223,16 @@ Status dist_start(Dist *d, DistPlan plan, int broadcast, Status st, Error *err)
 
 /* ------------------------------------------------------------------ the scene */
 
+#define WIRE_COUNT_ONE_(Type, name) +1
+enum { WIRE_COUNTS = 0 DEVICE_SCENE_COUNTS(WIRE_COUNT_ONE_) };
+#undef WIRE_COUNT_ONE_
+
+/* The scene's header: rank 0's status, the spp, every count of DEVICE_SCENE_COUNTS in its
+ * order, and each buffer's size. */
 typedef struct {
     int32_t status;
-    uint32_t spp, n_materials, n_shading, n_tri_extra_of, n_tri_extras, n_bvh_top;
-    uint64_t n_texels, n_rev_points, n_env_cdf, n_bvh_leaves;
+    uint32_t spp;
+    uint64_t counts[WIRE_COUNTS];
     uint64_t bytes[SCENE_BUF_COUNT];
 } WireScene;
 
@@ -264,15 +270,10 @@ static void scene_set_buffer(DeviceScene *ds, unsigned i, void *buf)
 static Status scene_receive(Dist *d, const WireScene *h, DeviceScene *ds, Error *err)
 {
     memset(ds, 0, sizeof *ds);
-    ds->n_materials = h->n_materials;
-    ds->n_shading = h->n_shading;
-    ds->n_tri_extra_of = h->n_tri_extra_of;
-    ds->n_tri_extras = h->n_tri_extras;
-    ds->n_texels = (size_t)h->n_texels;
-    ds->n_rev_points = (size_t)h->n_rev_points;
-    ds->n_env_cdf = (size_t)h->n_env_cdf;
-    ds->n_bvh_leaves = (size_t)h->n_bvh_leaves;
-    ds->n_bvh_top = h->n_bvh_top;
+    unsigned k = 0;
+#define GET_COUNT_(Type, name) ds->name = (Type)h->counts[k++];
+    DEVICE_SCENE_COUNTS(GET_COUNT_)
+#undef GET_COUNT_
     for (unsigned i = 0; i < SCENE_BUF_COUNT; i++) {
         if (h->bytes[i] == 0) continue;
         if (h->bytes[i] > SIZE_MAX || !(d->scene_bufs[i] = malloc((size_t)h->bytes[i])))
@@ -298,15 +299,10 @@ Status dist_share_scene(Dist *d, Status rank0_status, DeviceScene *ds, unsigned 
     if (d->rank == 0) {
         h.status = rank0_status;
         h.spp = *spp;
-        h.n_materials = ds->n_materials;
-        h.n_shading = ds->n_shading;
-        h.n_tri_extra_of = ds->n_tri_extra_of;
-        h.n_tri_extras = ds->n_tri_extras;
-        h.n_texels = ds->n_texels;
-        h.n_rev_points = ds->n_rev_points;
-        h.n_env_cdf = ds->n_env_cdf;
-        h.n_bvh_leaves = ds->n_bvh_leaves;
-        h.n_bvh_top = ds->n_bvh_top;
+        unsigned k = 0;
+#define PUT_COUNT_(Type, name) h.counts[k++] = (uint64_t)ds->name;
+        DEVICE_SCENE_COUNTS(PUT_COUNT_)
+#undef PUT_COUNT_
         for (unsigned i = 0; rank0_status == ST_OK && i < SCENE_BUF_COUNT; i++)
             h.bytes[i] = device_scene_buffer(ds, i).bytes;
     }

@@ -147,8 +147,8 @@ static void test_bad_files(void)
     expect_bad(BAD "nvdb-grid-size.nvdb.gz",
                BAD "nvdb-grid-size.nvdb.gz: grid \"density\" claims 307432 bytes but stores 307232 uncompressed");
     expect_bad(BAD "nvdb-negative.nvdb.gz",
-               BAD "nvdb-negative.nvdb.gz: grid \"density\": voxel (8, 16, 130) has the value -1; a density must be "
-               "finite and >= 0");
+               BAD "nvdb-negative.nvdb.gz: grid \"density\": voxel (8, 16, 130) has the value -1; a density or "
+               "temperature must be finite and >= 0");
     /* every prefix of a good file is refused with a message, never read past its end */
     char *data;
     size_t len;

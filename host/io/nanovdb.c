@@ -241,8 +241,8 @@ static Status add_tile(Walk *w, const int64_t o[3], int64_t size, float v)
     if (v == w->background || !overlaps(w, o, size)) return ST_OK;
     if (!(v >= 0.0f) || !isfinite(v))
         return error_set(w->err, ST_INPUT, "%s: grid \"%s\": a tile at voxel (%" PRId64 ", %" PRId64 ", %" PRId64
-                         ") has the value %g; a density must be finite and >= 0", w->path, w->name, o[0], o[1], o[2],
-                         (double)v);
+                         ") has the value %g; a density or temperature must be finite and >= 0", w->path, w->name,
+                         o[0], o[1], o[2], (double)v);
     int64_t c0[3], c1[3];
     for (int a = 0; a < 3; a++) {
         int64_t s = o[a] > w->lo[a] ? o[a] : w->lo[a], e = o[a] + size - 1 < w->hi[a] ? o[a] + size - 1 : w->hi[a];
@@ -297,8 +297,8 @@ static Status visit_leaf(Walk *w, size_t leaf, const int64_t o[3])
         float v = rdf(vals + 4u * n);
         if (!(v >= 0.0f) || !isfinite(v))
             return error_set(w->err, ST_INPUT, "%s: grid \"%s\": voxel (%" PRId64 ", %" PRId64 ", %" PRId64 ") has "
-                             "the value %g; a density must be finite and >= 0", w->path, w->name, p[0], p[1], p[2],
-                             (double)v);
+                             "the value %g; a density or temperature must be finite and >= 0", w->path, w->name,
+                             p[0], p[1], p[2], (double)v);
         size_t x = (size_t)((p[0] - w->lo[0]) / w->k), y = (size_t)((p[1] - w->lo[1]) / w->k),
                z = (size_t)((p[2] - w->lo[2]) / w->k);
         w->delta[(z * w->n[1] + y) * w->n[0] + x] += v - w->background;
@@ -462,7 +462,7 @@ Status nanovdb_read_grid(const char *path, const unsigned char *data, size_t len
     w.err = err;
     w.background = rdf(b + root + ROOT_OFF_BACKGROUND);
     if (!(w.background >= 0.0f) || !isfinite(w.background)) {
-        st = error_set(err, ST_INPUT, "%s: grid \"%s\": its background value %g is not a density (finite, >= 0)",
+        st = error_set(err, ST_INPUT, "%s: grid \"%s\": its background value %g is not a density or temperature (finite, >= 0)",
                        path, name, (double)w.background);
         goto done;
     }

@@ -28,7 +28,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (st) {
         FUZZ_ASSERT((st == ST_INPUT || st == ST_IO) && err.msg[0]);
     } else {
-        size_t n_prims = s.n_spheres + s.n_triangles + s.n_boxes + s.n_planes;
+        size_t n_prims = s.n_spheres + s.n_triangles + s.n_boxes + s.n_planes + s.n_instances;
         for (size_t i = 0; i < s.n_spheres; i++)
             FUZZ_ASSERT(s.spheres[i].material < s.n_materials && s.spheres[i].radius > 0.0f);
         for (size_t i = 0; i < s.n_triangles; i++) FUZZ_ASSERT(s.triangles[i].material < s.n_materials);

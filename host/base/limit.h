@@ -52,6 +52,14 @@
  * level 3 (64 triangles of one, pbrt's default) fits whatever its size, where a 4 KB
  * file stays near CLPT_MAX_TESSELLATED_TRIANGLES. */
 #define CLPT_TESSELLATED_PER_INPUT_BYTE 64u
+/* World instances a scene may make through nested objects (docs/instancing.md): each
+ * level multiplies, so a 3 KB file of eight nested objects asked for ten million
+ * instances, 1.2 GB of records (fuzz_scene, 2026-11-28). A world instance written out
+ * takes 20 or more bytes of text, so a flat scene is bounded by its size already;
+ * what nesting places may reach 2^20 instances (about 130 MB on the devices) and 64
+ * more a byte of the load's text, up to SCENE_MAX_INSTANCES (scene/instance.h). */
+#define CLPT_MAX_NESTED_INSTANCES (1u << 20)
+#define CLPT_NESTED_INSTANCES_PER_INPUT_BYTE 64u
 /* Any one input file: it is read whole into memory. */
 #define CLPT_MAX_FILE_BYTES ((uint64_t)4 << 30)
 /* The text one scene load reads, all its files together (includes, meshes, MTL files,

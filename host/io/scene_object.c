@@ -15,6 +15,7 @@
  */
 #include "io/scene_reader.h"
 
+#include "base/limit.h"
 #include "io/lexer.h"
 #include "scene/instance.h"
 #include "scene/motion.h"
@@ -107,6 +108,27 @@ static const KeySpec instance_keys[INST_N] = {
     TRANSFORM_KEYS(INST),
 };
 
+/* A world instance of an object that nests others may place a great many records from
+ * one line: the scene's instances may then reach CLPT_MAX_NESTED_INSTANCES and
+ * CLPT_NESTED_INSTANCES_PER_INPUT_BYTE for each byte the load has read (base/limit.h),
+ * checked before anything is placed. Counts of 2^62 and more are scene_place_object's
+ * to name. */
+static Status check_nested_budget(Parser *p, Lexer *lx, const Token *kw, uint object)
+{
+    const SceneObject *o = &p->s->objects[object];
+    if (o->first_nested == o->end_nested || o->leaves >= ((uint64_t)1 << 62)) return ST_OK;
+    uint64_t bytes = lex_load_bytes();
+    uint64_t budget = CLPT_MAX_NESTED_INSTANCES + CLPT_NESTED_INSTANCES_PER_INPUT_BYTE * bytes;
+    uint64_t total = (uint64_t)p->s->n_instances + o->leaves;
+    if (total <= budget || total <= 1) return ST_OK;
+    return lex_error_at(lx, kw, p->err,
+                        "an instance of '%s' places %llu instances through the objects it nests: with the %zu "
+                        "placed before, past the %llu a scene of %llu bytes may place (%u and %u a byte; "
+                        "docs/instancing.md)",
+                        o->name, (unsigned long long)o->leaves, p->s->n_instances, (unsigned long long)budget,
+                        (unsigned long long)bytes, CLPT_MAX_NESTED_INSTANCES, CLPT_NESTED_INSTANCES_PER_INPUT_BYTE);
+}
+
 Status scene_parse_instance(Parser *p, Lexer *lx, const Token *kw)
 {
     Token name;
@@ -131,6 +153,7 @@ Status scene_parse_instance(Parser *p, Lexer *lx, const Token *kw)
         st = scene_object_nest(p->s, p->object, object, &m, material, p->err);
         return st == ST_INPUT ? lex_error_at(lx, kw, p->err, "%s", p->err->msg) : st;
     }
+    if ((st = check_nested_budget(p, lx, kw, object))) return st;
     size_t first = p->s->n_instances;
     st = scene_place_object(p->s, object, &m, material, p->err);
     if (st) return st == ST_INPUT ? lex_error_at(lx, kw, p->err, "%s", p->err->msg) : st;

@@ -23,7 +23,7 @@ pbrt-v4's default is a Gaussian, and clpt ignores PixelFilter with a warning),
 `Integrator "path"` with `maxdepth` 8 (clpt's depth: the same bounce count), `Film "rgb"`
 with `savefp16` false (pbrt-v4 writes half floats to EXR by default) and
 `Sampler "zsobol"`, pbrt-v4's default and its best general-purpose sampler; its
-blue-noise and pmj02bn tables may be stubbed in a build made without them (as
+blue-noise and pmj02bn tables may be zero-filled in a build made without them (as
 /work/pbrt-v4-build's are), and zsobol uses neither (clpt reads the sampler's pixelsamples
 only; its own Sobol sampler renders). The Cornell box and the dragon put `Scale -1 1 1`
 before `LookAt`, so that their images are the right-handed renderers' ones.

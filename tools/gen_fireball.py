@@ -11,6 +11,8 @@ exactly by running this again.
 """
 import math
 
+import gridgen
+
 NX, NY, NZ = 12, 16, 12
 
 
@@ -25,20 +27,10 @@ def fire(x, y, z):
 
 
 def main():
-    dens, heat = [], []
-    for k in range(NZ):
-        for j in range(NY):
-            for i in range(NX):
-                x, y, z = ((i + 0.5) / NX) * 2 - 1, ((j + 0.5) / NY) * 2 - 1, ((k + 0.5) / NZ) * 2 - 1
-                d, h = fire(x, y, z)
-                dens.append(d)
-                heat.append(h)
+    dens, heat = gridgen.sample(fire, NX, NY, NZ)
 
     def block(values):
-        rows = []
-        for a in range(0, len(values), NX):
-            rows.append("        " + " ".join("0" if v == 0 else "%.4g" % v for v in values[a:a + NX]))
-        return "\n".join(rows)
+        return gridgen.block(values, NX)
 
     print("""# Fireball: blackbody emission from a temperature grid (docs/media.md, "Blackbody
 # emission"). A %dx%dx%d grid medium holds a density and a heat per cell; the heat becomes

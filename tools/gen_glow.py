@@ -10,6 +10,8 @@ running this again.
 """
 import math
 
+import gridgen
+
 NX, NY, NZ = 12, 24, 12
 
 
@@ -24,20 +26,10 @@ def flame(x, y, z):
 
 
 def main():
-    dens, heat = [], []
-    for k in range(NZ):
-        for j in range(NY):
-            for i in range(NX):
-                x, y, z = ((i + 0.5) / NX) * 2 - 1, (j + 0.5) / NY, ((k + 0.5) / NZ) * 2 - 1
-                d, h = flame(x, y, z)
-                dens.append(d)
-                heat.append(h)
+    dens, heat = gridgen.sample(flame, NX, NY, NZ, y_from_zero=True)
 
     def block(values):
-        rows = []
-        for a in range(0, len(values), NX):
-            rows.append("        " + " ".join("%.4g" % v for v in values[a:a + NX]))
-        return "\n".join(rows)
+        return gridgen.block(values, NX)
 
     print("""# Glow: emission from media (docs/media.md, "Emission"). A fog ball that glows
 # (a homogeneous medium emitting Le, absorbing and scattering) and a flame (a %dx%dx%d

@@ -693,7 +693,7 @@ static void test_nested_hits_against_brute_force(void)
 }
 
 /* A top level of many instances (a 24 x 24 grid of the object, rotated and scaled, a
- * row mirrored) is cut into fuller nodes (bvh.c, pack_measure): 128 here, where the
+ * row mirrored) is cut into fuller nodes (bvh_collapse.c, pack_measure): 128 here, where the
  * greedy cut made 165 and at least (n - 1) / 7 = 83 are needed (the binary tree's
  * shape and the weight on area keep it from that); and it is walked as the brute force
  * walks it. */

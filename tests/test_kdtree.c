@@ -1,7 +1,8 @@
 /*
  * test_kdtree.c -- the two trees: the kd-tree build (host/accel/kdtree.c) and the 8-wide
- * BVH build (host/accel/bvh.c), the primitive intersections (kernels/geom/intersect.h) and
- * both walks (kernels/accel/traverse.h and traverse_bvh.h, compiled here as C).
+ * BVH build (host/accel/bvh.c, bvh_collapse.c), the primitive intersections
+ * (kernels/geom/intersect.h) and both walks (kernels/accel/traverse.h and traverse_bvh.h,
+ * compiled here as C).
  *
  * Each tree's structure is checked directly (nesting, which primitives each leaf must
  * hold, the statistics), and the walks against brute force: every primitive tested
@@ -868,7 +869,7 @@ static void test_bvh_degenerate(void)
     CHECK(scene_build(0) == ST_OK);
     check_bvh();
     /* deep enough that nodes near the bottom had to turn binary (past BVH_STACK - 40 - 7
-     * entries, bvh.c), and still within the walk's stack */
+     * entries, bvh_collapse.c), and still within the walk's stack */
     CHECK(scene.bvh.stats.max_stack > BVH_STACK - 40 - 7 && scene.bvh.stats.max_stack <= BVH_STACK);
     rng_seed(23);
     int bad = 0;

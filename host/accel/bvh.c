@@ -5,18 +5,14 @@
  * heuristic over 32 centroid bins on each axis is lowest (Wald 2007, "On fast
  * construction of SAH-based bounding volume hierarchies"; pbrt-v4's BVHAggregate):
  * what a node costs is one visit plus its leaves' triangle groups, since a leaf tests
- * its triangles eight at a time. Then the collapse: a node takes its two children and,
- * while it has fewer than eight, replaces the interior child with the largest surface
- * area by that child's two children (Embree's BVH8 from a binary build); a top level
- * over instances is cut by dynamic programming instead, for full nodes (pack_measure).
- * The wide nodes
- * are written depth first, a parent before its children, the leaves' records into the
- * leaf data in the kd-tree's layout (kd_leaf_record_write). With several threads, the
- * top of the binary tree is built first, its large nodes' passes cut into ranges, and
- * the subtrees below it by the threads (build_tree); the collapse sorts and writes the
- * leaves on the threads too. docs/bvh.md has the measurements behind the choices.
+ * its triangles eight at a time. Then the collapse into 8-wide nodes and leaf records
+ * (bvh_collapse.c, whose head comment tells how). With several threads, the top of the
+ * binary tree is built first, its large nodes' passes cut into ranges, and the
+ * subtrees below it by the threads (build_tree); the collapse sorts and writes the
+ * leaves on the threads too. The state both files share is accel/bvh_build.h.
+ * docs/bvh.md has the measurements behind the choices.
  */
-#include "accel/bvh.h"
+#include "accel/bvh_build.h"
 
 #include <math.h>
 #include <stdatomic.h>
@@ -26,15 +22,9 @@
 #include <unistd.h>
 
 #include "base/jobs.h"
-#include "base/pages.h"
 #include "base/timer.h"
 
 #define BVH_BINS 32
-#define BVH_MAX_DEPTH 40       /* binary levels; a node this deep becomes a leaf */
-/* The walk's stack (BVH_STACK, types.h) holds the children a path leaves behind: at
- * most the sum of (children - 1) over the wide nodes above a leaf. Once that sum nears
- * the stack's size, nodes below take two children (one more entry per binary level, of
- * which there are at most BVH_MAX_DEPTH), so no tree can overflow it. */
 #define BVH_MAX_LEAF 32u       /* a larger set is split whatever the SAH says */
 /* The deepest a binary tree gets: BVH_MAX_DEPTH, or in an item build (one item a leaf)
  * that plus the halving of at most 2^32 items that the bins could not split. */
@@ -54,44 +44,6 @@
 #define BVH_COST_GROUP 0.4
 #define BVH_COST_OTHER 0.2
 
-typedef struct { float lo[3], hi[3]; } Box3;
-
-/* A node of the binary tree: a leaf when count > 0 (its primitives are
- * ref[first .. first + count)), else an interior node with two children. */
-typedef struct {
-    Box3 box;
-    uint child[2];
-    uint first, count;
-} BinNode;
-
-/* A primitive as the build moves it: its bounds and global id, 32 bytes. The build
- * partitions these records themselves, not indices to them, so that every pass over a
- * node reads memory in order: with an index array, each pass over a large node
- * gathered boxes from all over the scene's 28 MB of bounds and centres (the dragon's
- * binary tree took 0.9 s on two threads). */
-typedef struct {
-    Box3 box;
-    uint gid;
-    uint pad;
-} PrimRef;
-
-typedef struct {
-    const KdInput *in;
-    const BvhOptions *opt;     /* item builds (instances): opt->item_boxes */
-    uint budget;               /* the walk's stack entries this tree may use */
-    uint n;                    /* primitives in the tree */
-    PrimRef *ref;              /* the primitives, in tree order once built */
-    uint first_tri, n_tri;     /* the triangles' global ids */
-    BinNode *nodes;            /* room for every node: a binary tree of n leaves has 2n - 1 */
-    atomic_uint n_nodes;
-    int threads;               /* threads the build may use */
-    struct RangeJob *range_jobs; /* the top's passes on `threads` threads (the calling thread's) */
-    uint defer_at_most;        /* subtrees of at most this many primitives wait (0: none) */
-    struct Subtree *waiting;   /* those subtrees, their nodes already numbered */
-    size_t n_waiting, cap_waiting;
-    atomic_size_t next_waiting; /* the next one a thread takes */
-} Build;
-
 static Box3 box3_empty(void)
 {
     Box3 b = { { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY } };
@@ -109,13 +61,6 @@ static void box3_grow(Box3 *b, const Box3 *a)
     }
 }
 
-static double box3_half_area(const Box3 *b)
-{
-    double dx = (double)b->hi[0] - b->lo[0], dy = (double)b->hi[1] - b->lo[1], dz = (double)b->hi[2] - b->lo[2];
-    if (!(dx >= 0.0 && dy >= 0.0 && dz >= 0.0)) return 0.0;
-    return dx * dy + dy * dz + dz * dx;
-}
-
 /* Primitives of a set: triangles (tested in groups of eight) and the others. */
 typedef struct { uint tri, other; } Count;
 
@@ -124,10 +69,7 @@ static double groups_of(uint n) { return (double)((n + 7u) / 8u); }
 /* What testing a leaf of these primitives costs. */
 static double leaf_tests(Count c) { return BVH_COST_GROUP * groups_of(c.tri) + BVH_COST_OTHER * c.other; }
 
-static int is_tri(const Build *b, const PrimRef *r) { return !b->opt->item_boxes && r->gid - b->first_tri < b->n_tri; }
-
-/* An item build (instances) puts every item in a leaf of its own. */
-static int one_per_leaf(const Build *b) { return b->opt->item_boxes != NULL; }
+static int is_tri(const BvhBuild *b, const PrimRef *r) { return !b->opt->item_boxes && r->gid - b->first_tri < b->n_tri; }
 
 /* The centre of a primitive's bounds on axis k: what the bins and the partition sort by. */
 static float centre(const PrimRef *r, int k) { return 0.5f * r->box.lo[k] + 0.5f * r->box.hi[k]; }
@@ -138,7 +80,7 @@ static void count_add(Count *c, Count a)
     c->other += a.other;
 }
 
-static uint node_new(Build *b) { return atomic_fetch_add(&b->n_nodes, 1u); }
+static uint node_new(BvhBuild *b) { return atomic_fetch_add(&b->n_nodes, 1u); }
 
 typedef struct { int axis, bin; double cost; } BinSplit;
 
@@ -173,7 +115,7 @@ static void bins_clear(Bins *bins)
 }
 
 /* ref[first .. first + n) into cleared bins, all axes in one pass. */
-static void bins_fill(const Build *b, uint first, uint n, const BinAxes *ax, Bins *bins)
+static void bins_fill(const BvhBuild *b, uint first, uint n, const BinAxes *ax, Bins *bins)
 {
     for (const PrimRef *r = b->ref + first, *end = r + n; r < end; r++) {
         int tri = is_tri(b, r);
@@ -199,7 +141,7 @@ static void bins_merge(Bins *into, const Bins *next, const BinAxes *ax)
 
 /* A pass over part of a node's primitives on a thread of its own. */
 typedef struct RangeJob {
-    const Build *b;
+    const BvhBuild *b;
     uint first, n;
     const BinAxes *ax;     /* binning: the axes; NULL for bounds */
     Bins bins;             /* binning's result */
@@ -207,7 +149,7 @@ typedef struct RangeJob {
     Count count;
 } RangeJob;
 
-static void range_bounds(const Build *b, uint first, uint n, Box3 *box, Box3 *cb, Count *count)
+static void range_bounds(const BvhBuild *b, uint first, uint n, Box3 *box, Box3 *cb, Count *count)
 {
     for (const PrimRef *r = b->ref + first, *end = r + n; r < end; r++) {
         if (is_tri(b, r)) count->tri++;
@@ -235,7 +177,7 @@ static void *range_run(void *arg)
 /* ref[first .. first + n) cut into `threads` ranges, each passed over (bounds, or bins
  * with `ax`) on a thread of its own; the results are merged in range order, so they are
  * the bits of one pass. */
-static void ranges_run(const Build *b, uint first, uint n, int threads, const BinAxes *ax, RangeJob *jobs)
+static void ranges_run(const BvhBuild *b, uint first, uint n, int threads, const BinAxes *ax, RangeJob *jobs)
 {
     for (int i = 0; i < threads; i++) {
         uint lo = (uint)((uint64_t)n * (uint)i / (uint)threads), hi = (uint)((uint64_t)n * (uint)(i + 1) / (uint)threads);
@@ -250,7 +192,7 @@ static void ranges_run(const Build *b, uint first, uint n, int threads, const Bi
 /* The cheapest of the 31 bin boundaries on each axis for ref[first .. first + n),
  * whose centres span cb, binned on `threads` threads; cost +inf when every centre is
  * the same point. */
-static BinSplit best_split(const Build *b, uint first, uint n, const Box3 *cb, int threads, RangeJob *jobs)
+static BinSplit best_split(const BvhBuild *b, uint first, uint n, const Box3 *cb, int threads, RangeJob *jobs)
 {
     BinSplit best = { -1, 0, INFINITY };
     BinAxes ax = { .n_axes = 0 };
@@ -308,11 +250,11 @@ typedef struct Subtree {
     int depth;
 } Subtree;
 
-static void build_node(Build *b, Subtree t, int may_wait);
+static void build_node(BvhBuild *b, Subtree t, int may_wait);
 
 /* Builds subtree t now, or, when may_wait and it is small enough, puts it on the
  * waiting list for the threads. */
-static void build_or_wait(Build *b, Subtree t, int may_wait)
+static void build_or_wait(BvhBuild *b, Subtree t, int may_wait)
 {
     if (!may_wait || t.n > b->defer_at_most) {
         build_node(b, t, may_wait);
@@ -336,7 +278,7 @@ static void build_or_wait(Build *b, Subtree t, int may_wait)
  * alone, so the tree is the same whichever threads built which subtree (only the
  * binary nodes' numbering differs, and the wide nodes are numbered by walking the
  * tree). */
-static void build_node(Build *b, Subtree t, int may_wait)
+static void build_node(BvhBuild *b, Subtree t, int may_wait)
 {
     uint me = t.node, first = t.first, n = t.n;
     int depth = t.depth;
@@ -405,13 +347,13 @@ static int subtree_larger(const void *a, const void *b)
 /* One thread's share of the waiting subtrees: the next one until none is left. */
 static void *waiting_run(void *arg)
 {
-    Build *b = *(Build **)arg;
+    BvhBuild *b = *(BvhBuild **)arg;
     for (size_t i; (i = atomic_fetch_add(&b->next_waiting, 1)) < b->n_waiting;) build_node(b, b->waiting[i], 0);
     return NULL;
 }
 
 /* The binary tree of all b->n primitives on b->threads threads; returns its root. */
-static uint build_tree(Build *b)
+static uint build_tree(BvhBuild *b)
 {
     uint root = node_new(b);
     int threads = b->threads;
@@ -423,14 +365,14 @@ static uint build_tree(Build *b)
     if (b->n_waiting == 0) return root;
     qsort(b->waiting, b->n_waiting, sizeof *b->waiting, subtree_larger);
     int n_jobs = (size_t)threads < b->n_waiting ? threads : (int)b->n_waiting;
-    Build *jobs[JOBS_MAX];
+    BvhBuild *jobs[JOBS_MAX];
     for (int i = 0; i < n_jobs; i++) jobs[i] = b;
     jobs_run(waiting_run, jobs, sizeof *jobs, n_jobs);
     return root;
 }
 
 /* The binary tree's leaves, deepest leaf and SAH cost (relative to the root's area). */
-static void tree_stats(const Build *b, uint root, BvhStats *st)
+static void tree_stats(const BvhBuild *b, uint root, BvhStats *st)
 {
     uint stack[BVH_TREE_DEPTH + 2], depth[BVH_TREE_DEPTH + 2];
     int sp = 0;
@@ -463,241 +405,7 @@ static void tree_stats(const Build *b, uint root, BvhStats *st)
     st->sah_cost = root_area > 0.0 ? sah / root_area : 0.0;
 }
 
-/* ------------------------------------------------------------------ collapse */
-
-/* A leaf's record to write: at `words` in the leaf data, for binary leaf `bin`, whose
- * kind goes to lane `lane` of wide node `node`. */
-typedef struct { uint node, lane, bin, words; } LeafSlot;
-
-/* The collapse in three steps: each binary leaf's ids sorted and its record's size
- * (leaves_measure, by ranges of nodes on the threads); the wide nodes, depth first,
- * with the leaves' places in the leaf data (flat_node, on this thread); the records
- * (slots_write, by ranges of leaves on the threads). */
-typedef struct {
-    Build *b;
-    Bvh *out;
-    uint *ids;              /* per primitive, in tree order: its global id, sorted within each leaf */
-    uint *node_words;       /* per binary leaf: the words of its record */
-    LeafSlot *slots;        /* the records, in the order flat_node meets them */
-    size_t n_slots;
-    size_t words;
-    uint max_pending;       /* the deepest the walk's stack can get */
-    uint depth_bound;       /* binary levels a path below any node may still take: BVH_MAX_DEPTH,
-                             * or an item build's own depth (a top level is shallow, and its
-                             * budget small: docs/instancing.md) */
-    float *pack;            /* item builds: per binary node v and i in 1..BVH_WIDTH, at
-                             * v * BVH_WIDTH + i - 1, the fewest wide nodes that hold v's
-                             * subtree as at most i children of a parent (pack_measure) */
-} Flat;
-
-static int uint_cmp(const void *a, const void *b)
-{
-    uint x = *(const uint *)a, y = *(const uint *)b;
-    return (x > y) - (x < y);
-}
-
-/* ---- item builds: wide nodes packed full
- *
- * A top level holds one instance a leaf, and the greedy expansion below (largest
- * area first) leaves the nodes above the leaves 2 or 3 wide: a balanced tree of 10,000
- * leaves splits into 4,096 subtrees of 2.4 leaves at its fourth level (a grid of
- * dragons: 4,258 nodes, 3.35 children each). Every node costs the devices 256 bytes,
- * so for item builds the choice of which binary nodes become wide nodes is made by
- * dynamic programming over the binary tree for the fewest wide nodes, as Ylitie et al.
- * (2017, "Efficient incoherent ray traversal on GPUs through compressed wide BVHs")
- * choose it for the least SAH cost: P(v, i), the fewest nodes that hold v's subtree as
- * at most i children of a parent, is 0 for a leaf; for an interior v, the least of
- * 1 + S(v, BVH_WIDTH) (v becomes a node of its own) and S(v, i), where S(v, i) is the
- * least P(c0, j) + P(c1, i - j) (v's slots shared by its two children); each node adds
- * PACK_AREA times its area too. The binary tree, hence which items share a subtree, is
- * the SAH's as before; only its cut changes, so every walk finds the same hits (the
- * tie rule, accel/leaf.h). The grid of dragons: 1,764 nodes (4.7 children each), 2.4
- * times fewer, at the same speed; scenes/instances.scene: 575, against 597. */
-
-/* Each node also costs its area over the root's, times this: among cuts of nearly as
- * few nodes, a shallow one of little SAH. A deep top level spends the walk's stack,
- * which the prototypes then lack (host/accel/bvh_inst.c: their nodes fall back to two
- * children). By node count alone the grid of 10,000 dragons' top level was 11 nodes
- * deep and left the dragon 75 entries, against 96, which made it 15,757 nodes, not
- * 12,140; at 1 its top level took 46 entries, at 64 40, at 256 39 (instances.scene 46,
- * 39, 32; the greedy's 31 and 29), for 1,756, 1,763 and 1,764 nodes (567, 572, 575). */
-#define PACK_AREA 256.0
-static float pack_split(const float *pack, uint c0, uint c1, uint i, uint *best_j)
-{
-    float best = INFINITY;
-    for (uint j = 1; j < i; j++) {
-        float c = pack[(size_t)c0 * BVH_WIDTH + j - 1u] + pack[(size_t)c1 * BVH_WIDTH + (i - j) - 1u];
-        if (c < best) {
-            best = c;
-            *best_j = j;
-        }
-    }
-    return best;
-}
-
-/* Fills P (Flat.pack) for binary node v's subtree, children first. */
-static void pack_measure(const Build *b, float *pack, uint v, double root_area)
-{
-    const BinNode *c = &b->nodes[v];
-    float *p = pack + (size_t)v * BVH_WIDTH;
-    if (c->count > 0 || c->child[0] == NO_INDEX) {
-        for (uint i = 0; i < BVH_WIDTH; i++) p[i] = 0.0f;
-        return;
-    }
-    pack_measure(b, pack, c->child[0], root_area);
-    pack_measure(b, pack, c->child[1], root_area);
-    uint j;
-    float own = (float)(1.0 + PACK_AREA * box3_half_area(&c->box) / root_area) +
-                pack_split(pack, c->child[0], c->child[1], BVH_WIDTH, &j);
-    p[0] = own;
-    for (uint i = 2; i <= BVH_WIDTH; i++) {
-        float split = pack_split(pack, c->child[0], c->child[1], i, &j);
-        p[i - 1u] = split < own ? split : own;
-    }
-}
-
-/* The children binary node v makes with at most i slots: itself, or (when sharing
- * them among its two children is no worse) theirs. */
-static void pack_kids(const Build *b, const float *pack, uint v, uint i, uint *kids, int *n)
-{
-    const BinNode *c = &b->nodes[v];
-    uint j = 1u;
-    if (i < 2u || c->count > 0 || c->child[0] == NO_INDEX ||
-        pack_split(pack, c->child[0], c->child[1], i, &j) > pack[(size_t)v * BVH_WIDTH]) {
-        kids[(*n)++] = v;
-        return;
-    }
-    pack_kids(b, pack, c->child[0], j, kids, n);
-    pack_kids(b, pack, c->child[1], i - j, kids, n);
-}
-
-/* Up to `width` binary nodes under binary interior node `bn` (or bn itself when it is
- * a leaf) that become one wide node's children; returns how many. */
-static int wide_children(const Build *b, const float *pack, uint bn, int width, uint *kids)
-{
-    int n = 0;
-    if (b->nodes[bn].count > 0 || b->nodes[bn].child[0] == NO_INDEX) {
-        kids[n++] = bn;
-        return n;
-    }
-    if (pack) {
-        uint j = 1u;
-        pack_split(pack, b->nodes[bn].child[0], b->nodes[bn].child[1], (uint)width, &j);
-        pack_kids(b, pack, b->nodes[bn].child[0], j, kids, &n);
-        pack_kids(b, pack, b->nodes[bn].child[1], (uint)width - j, kids, &n);
-        return n;
-    }
-    kids[n++] = b->nodes[bn].child[0];
-    kids[n++] = b->nodes[bn].child[1];
-    while (n < width) {
-        int pick = -1;
-        double pick_area = -1.0;
-        for (int i = 0; i < n; i++) {
-            const BinNode *c = &b->nodes[kids[i]];
-            if (c->count > 0) continue;
-            double a = box3_half_area(&c->box);
-            if (a > pick_area) {
-                pick_area = a;
-                pick = i;
-            }
-        }
-        if (pick < 0) break;
-        uint c = kids[pick];
-        kids[pick] = b->nodes[c].child[0];
-        kids[n++] = b->nodes[c].child[1];
-    }
-    return n;
-}
-
-/* Writes wide node `me` for binary node bn and, depth first, the nodes below it;
- * `pending` children are left behind on the walk's stack above it. */
-static void flat_node(Flat *f, uint bn, uint me, uint depth, uint pending)
-{
-    Build *b = f->b;
-    BvhNode *w = &f->out->nodes[me];
-    if (depth > f->out->stats.max_depth) f->out->stats.max_depth = depth;
-    uint kids[BVH_WIDTH];
-    int width = pending + (BVH_WIDTH - 1u) + f->depth_bound <= b->budget ? (int)BVH_WIDTH : 2;
-    int n = b->n ? wide_children(b, f->pack, bn, width, kids) : 0;
-    if (n > 1) pending += (uint)n - 1u;
-    if (pending > f->max_pending) f->max_pending = pending;
-    for (uint i = 0; i < BVH_WIDTH; i++) {
-        for (int k = 0; k < 3; k++) {
-            w->box[2 * k][i] = INFINITY;
-            w->box[2 * k + 1][i] = -INFINITY;
-        }
-        w->ref[i] = 0u;
-        w->kind[i] = BVH_CHILD_NONE;
-    }
-    uint interior[BVH_WIDTH];
-    int n_interior = 0;
-    for (int i = 0; i < n; i++) {
-        const BinNode *c = &b->nodes[kids[i]];
-        for (int k = 0; k < 3; k++) {
-            w->box[2 * k][i] = c->box.lo[k];
-            w->box[2 * k + 1][i] = c->box.hi[k];
-        }
-        if (c->count > 0 && one_per_leaf(b)) {
-            w->kind[i] = BVH_CHILD_INSTANCE;
-            w->ref[i] = b->ref[c->first].gid;
-        } else if (c->count > 0) {
-            w->ref[i] = (uint)f->words;
-            f->slots[f->n_slots++] = (LeafSlot){ me, (uint)i, kids[i], (uint)f->words };
-            f->words += f->node_words[kids[i]];
-        } else {
-            w->kind[i] = BVH_CHILD_NODE;
-            w->ref[i] = f->out->n_nodes++;
-            interior[n_interior++] = (uint)i;
-        }
-    }
-    for (int j = 0; j < n_interior; j++) {
-        uint i = interior[j];
-        uint kid = kids[i];
-        flat_node(f, kid, w->ref[i], depth + 1, pending);
-        w = &f->out->nodes[me];
-    }
-}
-
-/* Fewer binary nodes or leaves than this are measured or written on one thread. */
-#define BVH_COLLAPSE_PASS_MIN 2048u
-
-/* Binary nodes [first, end): each leaf's ids sorted, its record's words, their sum. */
-typedef struct { Flat *f; uint first, end; size_t words; } MeasureJob;
-
-static void *leaves_measure(void *arg)
-{
-    MeasureJob *j = arg;
-    const Build *b = j->f->b;
-    j->words = 0;
-    for (uint i = j->first; i < j->end; i++) {
-        const BinNode *c = &b->nodes[i];
-        if (c->count == 0 || one_per_leaf(b)) continue;
-        uint *ids = j->f->ids + c->first;
-        for (uint k = 0; k < c->count; k++) ids[k] = b->ref[c->first + k].gid;
-        qsort(ids, c->count, sizeof *ids, uint_cmp);
-        j->f->node_words[i] = (uint)kd_leaf_record_words(b->in, ids, c->count);
-        j->words += j->f->node_words[i];
-    }
-    return NULL;
-}
-
-/* Slots [first, end): their records written, their kinds set. */
-typedef struct { Flat *f; size_t first, end; } WriteJob;
-
-static void *slots_write(void *arg)
-{
-    const WriteJob *j = arg;
-    const Flat *f = j->f;
-    for (size_t i = j->first; i < j->end; i++) {
-        LeafSlot s = f->slots[i];
-        const BinNode *c = &f->b->nodes[s.bin];
-        f->out->nodes[s.node].kind[s.lane] =
-            kd_leaf_record_write(f->b->in, f->ids + c->first, c->count, f->out->leaf_prims + s.words);
-    }
-    return NULL;
-}
-
-static void build_free(Build *b)
+static void build_free(BvhBuild *b)
 {
     free(b->ref);
     free(b->nodes);
@@ -707,7 +415,7 @@ static void build_free(Build *b)
 
 /* The record of gid (a primitive, or in an item build an item's box) when its bounds
  * are finite and not empty. */
-static int prim_ref(const Build *b, uint gid, PrimRef *r)
+static int prim_ref(const BvhBuild *b, uint gid, PrimRef *r)
 {
     Box3 a;
     if (one_per_leaf(b)) {
@@ -726,7 +434,7 @@ static int prim_ref(const Build *b, uint gid, PrimRef *r)
 
 /* The primitives with finite bounds (of in's ranges, when it has them): their records,
  * in global id order. */
-static Status gather(Build *b, size_t total, Error *err)
+static Status gather(BvhBuild *b, size_t total, Error *err)
 {
     b->ref = malloc((total + 1) * sizeof *b->ref);
     b->nodes = malloc((2 * total + 1) * sizeof *b->nodes);
@@ -741,63 +449,6 @@ static Status gather(Build *b, size_t total, Error *err)
         for (uint gid = ranges[i].lo; gid < ranges[i].hi; gid++)
             if (prim_ref(b, gid, &b->ref[b->n])) b->n++;
     return ST_OK;
-}
-
-/* The wide nodes and leaf records of the binary tree under root. */
-static Status collapse(Build *b, uint root, Bvh *out, Error *err)
-{
-    uint n_bin = atomic_load(&b->n_nodes);
-    Flat f = { b, out, malloc((b->n + 1) * sizeof(uint)), malloc(((size_t)n_bin + 1) * sizeof(uint)),
-               malloc((b->n + 1) * sizeof(LeafSlot)), 0, 0, 0,
-               one_per_leaf(b) ? out->stats.max_binary_depth : BVH_MAX_DEPTH, NULL };
-    Status st = ST_OK;
-    if (one_per_leaf(b) && b->n) f.pack = malloc(((size_t)n_bin + 1) * BVH_WIDTH * sizeof *f.pack);
-    if (!f.ids || !f.node_words || !f.slots || (one_per_leaf(b) && b->n && !f.pack)) {
-        st = error_set(err, ST_INTERNAL, "BVH: out of memory for %u primitives", b->n);
-        goto done;
-    }
-    if (f.pack) pack_measure(b, f.pack, root, fmax(box3_half_area(&b->nodes[root].box), 1e-300));
-    int n_jobs = jobs_threads(b->threads, n_bin, BVH_COLLAPSE_PASS_MIN);
-    MeasureJob measure[JOBS_MAX];
-    for (int i = 0; i < n_jobs; i++)
-        measure[i] = (MeasureJob){ &f, (uint)((uint64_t)n_bin * (uint)i / (uint)n_jobs),
-                                   (uint)((uint64_t)n_bin * (uint)(i + 1) / (uint)n_jobs), 0 };
-    jobs_run(leaves_measure, measure, sizeof *measure, n_jobs);
-    size_t words = 0;
-    for (int i = 0; i < n_jobs; i++) words += measure[i].words;
-    /* every wide node but the root stands for a binary interior node */
-    size_t max_nodes = (size_t)n_bin + 1;
-    /* the walk's stack keeps a node index in 29 bits */
-    if (words > UINT32_MAX - 1 || max_nodes > (1u << 29)) {
-        st = error_set(err, ST_INTERNAL, "BVH: %zu nodes and %zu words of leaf data do not fit its layout", max_nodes,
-                       words);
-        goto done;
-    }
-    /* the walk reads both at random: on huge pages when large (base/pages.h) */
-    out->nodes = pages_alloc_large(max_nodes * sizeof *out->nodes);
-    out->leaf_prims = pages_alloc_large((words + 1) * sizeof *out->leaf_prims);
-    if (!out->nodes || !out->leaf_prims) {
-        st = error_set(err, ST_INTERNAL, "BVH: out of memory for %zu nodes", max_nodes);
-        goto done;
-    }
-    out->n_nodes = 1;
-    flat_node(&f, root, 0u, 1u, 0u);
-    n_jobs = jobs_threads(b->threads, f.n_slots, BVH_COLLAPSE_PASS_MIN);
-    WriteJob write[JOBS_MAX];
-    for (int i = 0; i < n_jobs; i++)
-        write[i] = (WriteJob){ &f, f.n_slots * (size_t)i / (size_t)n_jobs, f.n_slots * (size_t)(i + 1) / (size_t)n_jobs };
-    jobs_run(slots_write, write, sizeof *write, n_jobs);
-    out->n_leaf_prims = (uint)f.words;
-    out->stats.max_stack = f.max_pending;
-    if (f.max_pending > b->budget)
-        st = error_set(err, ST_INTERNAL, "BVH: a path leaves %u children on the walk's stack, more than its %u",
-                       f.max_pending, b->budget);
-done:
-    free(f.pack);
-    free(f.ids);
-    free(f.node_words);
-    free(f.slots);
-    return st;
 }
 
 Status bvh_build(const KdInput *in, int threads, Bvh *out, Error *err)
@@ -827,7 +478,7 @@ Status bvh_build_with(const KdInput *in, const BvhOptions *opt, int threads, Bvh
         long nc = sysconf(_SC_NPROCESSORS_ONLN);
         threads = nc > 0 ? (int)nc : 1;
     }
-    Build b;
+    BvhBuild b;
     memset(&b, 0, sizeof b);
     b.in = in;
     b.opt = opt;
@@ -847,7 +498,7 @@ Status bvh_build_with(const KdInput *in, const BvhOptions *opt, int threads, Bvh
             out->lo = (vec3){ rb->lo[0], rb->lo[1], rb->lo[2] };
             out->hi = (vec3){ rb->hi[0], rb->hi[1], rb->hi[2] };
         }
-        st = collapse(&b, root, out, err);
+        st = bvh_collapse(&b, root, out, err);
     }
     build_free(&b);
     if (st != ST_OK) {

@@ -7,7 +7,8 @@
  *   pbrt_params.c    "type name" [values] parameter lists, spectra, positional arguments
  *   pbrt_material.c  materials and textures
  *   pbrt_light.c     area and other lights
- *   pbrt_shape.c     shapes and object instancing
+ *   pbrt_shape.c     shapes: each type's reader, the Shape dispatch
+ *   pbrt_object.c    object instancing, and shapes under a moving transform
  *   pbrt_medium.c    participating media and the shapes that bound them
  *   pbrt_volume.c    the media made into density grids: nanovdb files, cloud, rgbgrid
  * Not for use outside these files.
@@ -186,8 +187,20 @@ Status pbrt_area_light(Parser *p, Lexer *lx, const Token *kw, const Token *type)
 vec3 pbrt_xf_dir(const Transform *t, vec3 d);
 Status pbrt_light(Parser *p, Lexer *lx, const Token *kw, const Token *type);
 
-/* pbrt_shape.c: Shape, ObjectBegin/End/Instance */
+/* pbrt_shape.c: Shape */
 Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw, const Token *type);
+/* A Shape of `type`, its parameters read, under the current transform's start pose. */
+Status pbrt_shape_make(Parser *p, Lexer *lx, const Token *type);
+/* Whether t is a similarity (a rotation, uniform scale and translation), and its scale. */
+int pbrt_is_similarity(const Transform *t, double *scale);
+/* A sphere of radius r under xf as a mesh of triangles (the kernels sample only round
+ * sphere lights), counted against the scene's tessellation budget (`what` names it in
+ * the message, at `at`), facing out, or in when `reverse`. */
+Status pbrt_sphere_mesh(Parser *p, const Lexer *lx, const Token *at, const char *what, const Transform *xf, double r,
+                        uint material, int reverse);
+
+/* pbrt_object.c: ObjectBegin/End/Instance, a Shape under a moving transform */
+Status pbrt_shape_moving(Parser *p, Lexer *lx, const Token *kw, const Token *type);
 Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_object_instance(Parser *p, Lexer *lx, const Token *kw);

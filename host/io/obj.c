@@ -263,11 +263,8 @@ static Status face_material(ObjReader *r, uint *out)
         *out = r->material;
         return ST_OK;
     }
-    if (r->default_material == NO_INDEX) {
-        Status st = scene_add_material(r->s, "", material_diffuse(v3s(MESH_DEFAULT_ALBEDO)),
-                                       &r->default_material, r->err);
-        if (st) return st;
-    }
+    Status st = mesh_default_material(r->s, &r->default_material, r->err);
+    if (st) return st;
     *out = r->default_material;
     return ST_OK;
 }
@@ -447,24 +444,13 @@ static int word_is(const char *q, size_t len, const char *w)
     return strlen(w) == len && memcmp(q, w, len) == 0;
 }
 
-/* The opening below is alike ply_parse's by design: each reader points its own state
- * at the bytes, and the two states share no part to set up in one place (OBJ keeps a
- * line cursor for its messages, PLY a header and the binary or text body after it). */
 Status obj_parse_with(const char *path, const char *text, size_t len, Scene *s, const MeshOptions *o,
                       Error *err)
 {
-    ObjReader r;
-    memset(&r, 0, sizeof r);
-    r.path = path;
-    r.p = text;
-    r.end = text + len;
-    r.line_start = text;
-    r.line = 1;
-    r.s = s;
-    r.opt = o;
-    r.material = NO_INDEX;
-    r.default_material = o->default_material;
-    r.err = err;
+    /* the reader's own state (a line cursor for its messages) at the first line; the
+     * members not named start at zero */
+    ObjReader r = { .path = path, .p = text, .end = text + len, .line_start = text, .line = 1, .s = s, .opt = o,
+                    .material = NO_INDEX, .default_material = o->default_material, .err = err };
     size_t first = s->n_triangles;
     Status st = mesh_sink_open(&r.sink, s, &o->xf, path, err);
     while (!st && r.p < r.end) {

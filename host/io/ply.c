@@ -608,9 +608,7 @@ static Status emit_triangles(PlyReader *r, Scene *s, const MeshOptions *o)
     if (!st) st = mesh_sink_reserve(&k, r->n_tri, r->has_nrm || r->has_uv ? r->n_tri : 0);
     if (st) return st;
     uint material = o->material != NO_INDEX ? o->material : o->default_material;
-    if (material == NO_INDEX && r->n_tri > 0 &&
-        (st = scene_add_material(s, "", material_diffuse(v3s(MESH_DEFAULT_ALBEDO)), &material, r->err)))
-        return st;
+    if (r->n_tri > 0 && (st = mesh_default_material(s, &material, r->err))) return st;
     for (size_t i = 0; i < r->n_tri && !st; i++) {
         const uint *t = &r->tri[3 * i];
         vec3 p[3], n[3];
@@ -631,12 +629,7 @@ static Status emit_triangles(PlyReader *r, Scene *s, const MeshOptions *o)
 
 Status ply_parse(const char *path, const char *data, size_t len, Scene *s, const MeshOptions *o, Error *err)
 {
-    PlyReader r;
-    memset(&r, 0, sizeof r);
-    r.path = path;
-    r.data = data;
-    r.end = data + len;
-    r.err = err;
+    PlyReader r = { .path = path, .data = data, .end = data + len, .err = err };
     uint16_t one = 1;
     unsigned char first;
     memcpy(&first, &one, 1);

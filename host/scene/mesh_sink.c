@@ -19,6 +19,12 @@ MeshOptions mesh_options(uint material)
     return o;
 }
 
+Status mesh_default_material(Scene *s, uint *material, Error *err)
+{
+    if (*material != NO_INDEX) return ST_OK;
+    return scene_add_material(s, "", material_diffuse(v3s(MESH_DEFAULT_ALBEDO)), material, err);
+}
+
 /* ------------------------------------------------------------------ the sink */
 
 Status mesh_sink_open(MeshSink *k, Scene *s, const Transform *xf, const char *path, Error *err)

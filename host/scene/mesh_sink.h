@@ -39,6 +39,11 @@ MeshOptions mesh_options(uint material);
 /* The neutral grey of a mesh that names no material. */
 #define MESH_DEFAULT_ALBEDO 0.75f
 
+/* *material, when it is NO_INDEX, becomes a new diffuse material of that grey: the mesh
+ * readers add it only once a triangle needs it, so that a file that names its materials
+ * leaves no unused one in the scene. */
+Status mesh_default_material(Scene *s, uint *material, Error *err);
+
 typedef struct {
     Scene *s;
     Error *err;

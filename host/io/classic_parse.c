@@ -428,12 +428,7 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
 {
     Status path_st = scene_set_path(s, path, err);
     if (path_st) return path_st;
-    Classic c;
-    memset(&c, 0, sizeof c);
-    c.s = s;
-    c.err = err;
-    c.current = NO_INDEX;
-    c.fallback = NO_INDEX;
+    Classic c = { .s = s, .err = err, .current = NO_INDEX, .fallback = NO_INDEX };
     Status st = text ? lex_open_text(&c.lx, path, text, len, err) : lex_open_file(&c.lx, path, err);
     if (st) return st;
     /* how the course's reference ray tracer draws a scene (docs/classic-format.md) */

@@ -660,17 +660,10 @@ Status pbrt_load_text(const char *path, const char *text, size_t len, Scene *s, 
 {
     Status path_st = scene_set_path(s, path, err);
     if (path_st) return path_st;
-    Parser p;
-    memset(&p, 0, sizeof p);
-    p.s = s;
-    p.err = err;
-    p.top_path = path;
-    p.g.ctm = p.g.ctm_end = transform_identity();
-    p.g.active = PBRT_ACTIVE_ALL;
-    p.time_start = 0;   /* pbrt-v4's TransformTimes 0 1 */
-    p.time_end = 1;
-    p.g.material = NO_INDEX;
-    p.g.area_material = NO_INDEX;
+    Parser p = { .s = s, .err = err, .top_path = path,
+                 .time_start = 0, .time_end = 1,   /* pbrt-v4's TransformTimes 0 1 */
+                 .g = { .ctm = transform_identity(), .ctm_end = transform_identity(), .active = PBRT_ACTIVE_ALL,
+                        .material = NO_INDEX, .area_material = NO_INDEX } };
     /* pbrt-v4's defaults where clpt's differ */
     s->image.width = 1280;
     s->image.height = 720;

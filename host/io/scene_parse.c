@@ -671,12 +671,7 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
 {
     Status path_st = scene_set_path(s, path, err);
     if (path_st) return path_st;
-    Parser p;
-    memset(&p, 0, sizeof p);
-    p.s = s;
-    p.err = err;
-    p.object = NO_INDEX;
-    p.last_instance = NO_INDEX;
+    Parser p = { .s = s, .err = err, .object = NO_INDEX, .last_instance = NO_INDEX };
     Status st;
     if (text) {
         Lexer lx;

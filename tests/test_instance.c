@@ -500,6 +500,35 @@ static void test_bulbs_are_sphere_lights(void)
     error_clear(&err);
 }
 
+/* An emissive sphere of an object whose only instance replaces its material makes no
+ * light, and then no instance has lights: the sphere names none either (surface_instanced
+ * would read the empty instance_lights; this crashed). Its image is the dark replacing
+ * material's, lit by nothing but the background. */
+static void test_replaced_bulb_is_no_light(void)
+{
+    static const char text[] =
+        "image { width 16 height 12 spp 2 }\n"
+        "camera { from 0 3 6 at 0 0.6 0 fov 40 }\n"
+        "background { color 0.5 0.5 0.5 }\n"
+        "material grey { type diffuse albedo 0.5 0.5 0.5 }\n"
+        "material hot { type emissive radiance 4 6 8 }\n"
+        "plane { point 0 0 0 normal 0 1 0 material grey }\n"
+        "object ball { sphere { center 0 0 0 radius 0.5 material hot } }\n"
+        "instance ball { translate 0 1 0 material grey }\n";
+    Scene s;
+    Error err = { 0 };
+    float img[16 * 12 * 3];
+    CHECK(load_text(text, &s, &err) == ST_OK);
+    CHECK_MSG(render_util_rgb_mis(&s, MIS_BOTH, "scalar", img, &err) == ST_OK, "%s", err.msg);
+    CHECK(s.n_lights == 0 && s.instance_lights == NULL);
+    for (uint i = 0; i < s.n_spheres; i++) CHECK(s.spheres[i].light == NO_INDEX);
+    float top = 0.0f;
+    for (int i = 0; i < 16 * 12 * 3; i++) top = img[i] > top ? img[i] : top;
+    CHECK(top <= 0.5f);
+    scene_free(&s);
+    error_clear(&err);
+}
+
 /* The choice of a directional light reads the scene's radius, which counts the world
  * boxes of the instances: under axis-aligned scales and translations those are the
  * copies' bounds, so the light is chosen with the copies' probability, and the far
@@ -849,6 +878,7 @@ int main(void)
     RUN(test_lamps_strategies_agree);
     RUN(test_lamps_less_noise);
     RUN(test_bulbs_are_sphere_lights);
+    RUN(test_replaced_bulb_is_no_light);
     RUN(test_radius_counts_instances);
     RUN(test_opencl_matches_scalar);
     return harness_report();

@@ -459,10 +459,14 @@ Status scene_prepare_lights(Scene *s, Error *err)
         if (n_instanced > MAX_INSTANCED_LIGHTS) n_instanced = 0;
         if (n_instanced) s->instance_lights = malloc(s->n_instances * sizeof *s->instance_lights);
         if (n_instanced == 0 || !s->instance_lights) {
-            /* no instance's triangles are lights: none may name one (surface_instanced) */
-            for (size_t o = 0; o < s->n_objects; o++)
+            /* no instance's emitters are lights: none may name one (surface_instanced
+             * reads instance_lights, which is then empty) */
+            for (size_t o = 0; o < s->n_objects; o++) {
+                for (size_t i = s->objects[o].first[OBJ_SPHERES]; i < s->objects[o].end[OBJ_SPHERES]; i++)
+                    s->spheres[i].light = NO_INDEX;
                 for (size_t i = s->objects[o].first[OBJ_TRIANGLES]; i < s->objects[o].end[OBJ_TRIANGLES]; i++)
                     s->triangles[i].light = NO_INDEX;
+            }
             if (n_instanced) {
                 free(in_object);
                 free(tpl);

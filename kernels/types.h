@@ -461,14 +461,19 @@ typedef struct {                                        /* 320 bytes */
  *   LIGHT_ENV          the environment map's light (kernels/light/envmap.h)
  *   LIGHT_INSTANCED    an emissive triangle of an object as one instance places it
  *                      (docs/instancing.md): an area light whose geometry the record
- *                      holds in the world (below), compiled in with the instances */
+ *                      holds in the world (below), compiled in with the instances
+ *   LIGHT_MOVING       the same for an instance that moves (INST_MOTION, docs/motion.md):
+ *                      the record holds the object-space geometry and the instance,
+ *                      placed at the path's time when sampled (below); compiled in
+ *                      with motion (a scene with moving instances has KF_INSTANCES too) */
 #define LIGHT_TYPES(X) \
     X(LIGHT_AREA,        0, 0u,              0u,                              area)        \
     X(LIGHT_POINT,       1, KF_DELTA_LIGHTS, LT_DELTA,                        point)       \
     X(LIGHT_DIRECTIONAL, 2, KF_DELTA_LIGHTS, LT_DELTA | LT_INFINITE,          directional) \
     X(LIGHT_SPOT,        3, KF_DELTA_LIGHTS, LT_DELTA | LT_CONE,              spot)        \
     X(LIGHT_ENV,         4, KF_ENV_MAP,      LT_INFINITE,                     environment) \
-    X(LIGHT_INSTANCED,   5, KF_INSTANCES,    0u,                              instanced)
+    X(LIGHT_INSTANCED,   5, KF_INSTANCES,    0u,                              instanced)   \
+    X(LIGHT_MOVING,      6, KF_MOTION,       0u,                              moving)
 
 /* Traits of a light type. */
 #define LT_DELTA 1u     /* a single direction reaches a point from it: no MIS, hard
@@ -555,7 +560,22 @@ enum SpotFalloff { SPOT_SMOOTHSTEP = 0, SPOT_GLTF = 1 };
  * so a point sampled on the world triangle has density 1 / area, as the hit's
  * light_pdf reads (kernels/light/lights.h). A hit through instance i on a triangle whose
  * `light` is j (its index among its object's emitters) is light instance_lights[i] + j
- * (scene_buffers.h; NO_INDEX there: the instance's triangles are no lights). */
+ * (scene_buffers.h; NO_INDEX there: the instance's triangles are no lights).
+ *
+ * A LIGHT_MOVING light is the same emitter of an instance that moves: it has no one
+ * world place, so the record keeps the object-space one and the instance, and the
+ * kernels place it at the path's time with the very transform a ray into that instance
+ * gets then (light_moving_at, kernels/light/lights.h: the LIGHT_INSTANCED record of
+ * that moment). `position`, `direction` and `intensity` hold the object-space corner
+ * and edges (or the parallelogram of a quad's halves, `quad`), `normal` the
+ * object-space winding normal (a sphere: centre in `position`, radius in `atten0`), and
+ * the word a spot light's falloff takes holds the instance (light_instance). `area` is
+ * the area of the instance's first pose, which only the power estimate reads: the
+ * sample's density uses the area at the path's time. A sphere is a light only when
+ * every key of its instance is a similarity (else its `area` is 0: never chosen). */
+
+/* The instance that carries LIGHT_MOVING light l (above). */
+KFN uint light_instance(Light l) { return l.spot_falloff; }
 
 enum CameraType { CAMERA_PERSPECTIVE = 0, CAMERA_ORTHOGRAPHIC = 1 };
 

@@ -170,6 +170,178 @@ static void test_moving_instance_is_average_of_still(void)
     check_moving_against_stills("moving instance", text, instance_still, 0.03);
 }
 
+/* Moving emitters (LIGHT_MOVING, docs/motion.md): a quad lamp and an emissive triangle
+ * of one object, sliding and turning about y, and a glowing ball rising and growing,
+ * over a floor and a block, the camera still. */
+#define LAMPS_HEAD                                                                       \
+    "image { width 48 height 32 spp %u depth 4 seed %u }\n"                              \
+    "camera { from 0 3 6 at 0 0.6 0 fov 40 shutter 0 1 }\n"                             \
+    "background { color 0.02 0.02 0.03 }\n"                                              \
+    "material floor { type diffuse albedo 0.6 0.6 0.6 }\n"                               \
+    "material glow { type emissive radiance 6 5 4 }\n"                                   \
+    "material hot { type emissive radiance 4 6 8 }\n"                                    \
+    "plane { point 0 0 0 normal 0 1 0 material floor }\n"                                \
+    "box { min -0.4 0 -0.4 max 0.4 0.8 0.4 material { type diffuse albedo 0.7 0.3 0.2 } }\n" \
+    "object lamp {\n"                                                                    \
+    "  quad { v0 -0.5 0 -0.3 v1 0.5 0 -0.3 v2 0.5 0 0.3 v3 -0.5 0 0.3 material glow }\n" \
+    "  triangle { v0 0.6 0 -0.2 v1 0.9 0 0.2 v2 0.6 0 0.2 material hot } }\n"          \
+    "object ball { sphere { center 0 0 0 radius 0.2 material hot } }\n"
+
+static void lamps_text(uint spp, uint seed, char *text, size_t size)
+{
+    snprintf(text, size, LAMPS_HEAD "instance lamp { translate -1.5 2 0 }\n"
+                                    "instance_key { time 1 ry 40 translate 1.5 1.6 0.3 }\n"
+                                    "instance ball { translate 1.2 0.4 1.2 }\n"
+                                    "instance_key { time 1 scale 1.8 translate 0.8 1.2 1 }\n", spp, seed);
+}
+
+/* The lamp still at shutter time u: its keys interpolated by hand (the slide linear,
+ * the angle about y linear, as slerp about one axis is). The ball is left out: the
+ * camera sees it, and the midpoint rule's 8 stills miss the last sixteenth of its
+ * streak on the dark background, a difference of the stills and not of the light;
+ * the lamp faces away from the camera, so only its light is compared. */
+static void lamp_still(double u, char *text, size_t size)
+{
+    snprintf(text, size, LAMPS_HEAD "instance lamp { ry %.9g translate %.9g %.9g %.9g }\n", (unsigned)SPP_STILL, 5u,
+             40.0 * u, -1.5 + 3.0 * u, 2.0 - 0.4 * u, 0.3 * u);
+}
+
+static Status lamps_rgb(uint spp, uint seed, uint mis_mode, float *rgb, Error *err)
+{
+    char text[4096];
+    Scene s;
+    lamps_text(spp, seed, text, sizeof text);
+    scene_init(&s);
+    Status st = scene_load_text("lamps.scene", text, strlen(text), &s, err);
+    if (!st) st = render_util_rgb_mis(&s, mis_mode, "scalar", rgb, err);
+    scene_free(&s);
+    return st;
+}
+
+/* The mean of 8 x 8 pixel blocks (6 x 4 of them), for comparisons within noise. */
+static void lamps_blocks(const float *rgb, double blocks[24], double *mean)
+{
+    *mean = 0.0;
+    for (int b = 0; b < 24; b++) blocks[b] = 0.0;
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 48; x++)
+            for (int c = 0; c < 3; c++) {
+                double v = rgb[3 * (48 * y + x) + c];
+                blocks[(y / 8) * 6 + x / 8] += v / (8 * 8 * 3);
+                *mean += v / (48 * 32 * 3);
+            }
+}
+
+static double blocks_apart(const double *a, const double *b)
+{
+    double worst = 0.0;
+    for (int i = 0; i < 24; i++) worst = fmax(worst, fabs(a[i] - b[i]) / fmax(b[i], 1e-3));
+    return worst;
+}
+
+/* Every emitter of a moving instance is a light placed at the path's time: the quad's
+ * two halves, the triangle and the ball (its instance a similarity at both keys), each
+ * with its instance and a share of the choice. */
+static void test_moving_lamps_are_lights(void)
+{
+    char text[4096];
+    Scene s;
+    RenderScene rs;
+    Error err = { 0 };
+    lamps_text(1, 1, text, sizeof text);
+    scene_init(&s);
+    CHECK_MSG(scene_load_text("lamps.scene", text, strlen(text), &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_scene_prepare(&s, 1, &rs, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_lights, 4);
+    CHECK(s.instance_lights != NULL);
+    if (s.n_lights == 4 && s.instance_lights) {
+        CHECK(s.instance_lights[0] == 0 && s.instance_lights[1] == 3);
+        for (uint i = 0; i < 4; i++) {
+            CHECK(s.lights[i].type == LIGHT_MOVING && s.lights[i].pick_pdf > 0.0f);
+            CHECK(light_instance(s.lights[i]) == (i < 3 ? 0u : 1u));
+        }
+        CHECK(s.lights[0].quad == LIGHT_QUAD_FIRST && s.lights[1].quad == LIGHT_QUAD_SECOND);
+        /* the ball's area at its first pose (radius 0.2) sets its power */
+        CHECK(fabsf(s.lights[3].area - (float)(4.0 * M_PI * 0.04)) < 1e-5f);
+    }
+    render_scene_free(&rs);
+    scene_free(&s);
+
+    /* a ball whose instance squashes it at a key is an ellipsoid then: no power, never
+     * chosen (found by BSDF sampling at full weight, as a still squashed one) */
+    static const char squashed[] =
+        "camera { from 0 3 6 at 0 0.6 0 fov 40 shutter 0 1 }\n"
+        "material hot { type emissive radiance 4 6 8 }\n"
+        "object ball { sphere { center 0 0 0 radius 0.2 material hot } }\n"
+        "instance ball { translate 1.2 0.4 1.2 }\n"
+        "instance_key { time 1 scale 1 2 1 translate 0.8 1.2 1 }\n"
+        "quad { v0 -1 4 -1 v1 1 4 -1 v2 1 4 1 v3 -1 4 1 material hot }\n";
+    scene_init(&s);
+    CHECK_MSG(scene_load_text("squashed.scene", squashed, strlen(squashed), &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_scene_prepare(&s, 1, &rs, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_lights, 3);
+    if (s.n_lights == 3) CHECK(s.lights[2].type == LIGHT_MOVING && s.lights[2].pick_pdf == 0.0f);
+    render_scene_free(&rs);
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* The moving lamps' image is the same under MIS, light sampling alone and BSDF sampling
+ * alone (1024 spp; image means within 1%, 8 x 8 pixel blocks within noise), so the light
+ * samples, their densities at the path's time and MIS's weights at a hit agree; and at
+ * 16 spp MIS is far closer to that image than BSDF sampling alone (how the moving lamps
+ * were found before they were lights): RMSE over the pixels below 1 in the image. */
+static void test_moving_lamps_strategies_agree(void)
+{
+    enum { N = 48 * 32 * 3 };
+    static const uint modes[3] = { MIS_BOTH, MIS_LIGHT_ONLY, MIS_BSDF_ONLY };
+    static const char *const names[3] = { "MIS", "light", "BSDF" };
+    float *img[3], *noisy = malloc(N * sizeof *noisy);
+    double blocks[3][24], mean[3], rmse[2];
+    Error err = { 0 };
+    for (int m = 0; m < 3; m++) {
+        img[m] = malloc(N * sizeof *img[m]);
+        CHECK_MSG(lamps_rgb(1024, 1, modes[m], img[m], &err) == ST_OK, "%s", err.msg);
+        lamps_blocks(img[m], blocks[m], &mean[m]);
+    }
+    for (int m = 0; m < 2; m++) {
+        CHECK_MSG(lamps_rgb(16, 2, modes[2 * m], noisy, &err) == ST_OK, "%s", err.msg);
+        /* over the pixels the lamps light, not those that see the ball itself, whose
+         * blur (the time's noise) neither strategy changes */
+        double e = 0.0, n = 0.0;
+        for (int i = 0; i < N; i++) {
+            if (!(img[0][i] < 1.0f)) continue;
+            e += ((double)noisy[i] - img[0][i]) * ((double)noisy[i] - img[0][i]);
+            n += 1.0;
+        }
+        rmse[m] = sqrt(e / fmax(n, 1.0));
+    }
+    fprintf(stderr, "  moving lamps, 1024 spp: mean %s %.4f, %s %.4f, %s %.4f; worst block difference to MIS: "
+            "light %.1f%%, BSDF %.1f%%\n", names[0], mean[0], names[1], mean[1], names[2], mean[2],
+            100.0 * blocks_apart(blocks[1], blocks[0]), 100.0 * blocks_apart(blocks[2], blocks[0]));
+    fprintf(stderr, "  moving lamps, 16 spp: RMSE to MIS at 1024 spp: MIS %.4g, BSDF sampling alone %.4g (%.1fx)\n",
+            rmse[0], rmse[1], rmse[1] / rmse[0]);
+    CHECK(mean[0] > 0.05);
+    for (int m = 1; m < 3; m++) CHECK(fabs(mean[m] - mean[0]) < 0.01 * mean[0]);
+    CHECK(blocks_apart(blocks[1], blocks[0]) < 0.05);
+    CHECK(blocks_apart(blocks[2], blocks[0]) < 0.08);
+    CHECK(rmse[0] * 2.0 < rmse[1]);
+    for (int m = 0; m < 3; m++) free(img[m]);
+    free(noisy);
+    error_clear(&err);
+}
+
+/* The moving lamp (light sampled at each path's time) against the average of the still
+ * lamp at 8 times, within noise in 8 x 6 pixel blocks; the middle still one is far. */
+static void test_moving_lamp_is_average_of_still(void)
+{
+    char text[4096];
+    snprintf(text, sizeof text, LAMPS_HEAD "instance lamp { translate -1.5 2 0 }\n"
+                                           "instance_key { time 1 ry 40 translate 1.5 1.6 0.3 }\n",
+             (unsigned)(K * SPP_STILL), 5u);
+    check_moving_against_stills("moving lamp", text, lamp_still, 0.03);
+}
+
 /* motion_bounds holds the box's corners at every time, sampled far more finely than
  * it samples: a half turn and more between keys, a stretch and a slide. */
 static void test_bounds_hold_the_motion(void)
@@ -218,10 +390,11 @@ static void test_still_with_shutter_same_bits(void)
  * the scalar device's bits on the moving camera and on moving instances. */
 static void test_devices_match_scalar(void)
 {
-    const char *scenes[] = { "tests/data/motion/camera.scene", "tests/data/motion/instances.scene" };
+    const char *scenes[] = { "tests/data/motion/camera.scene", "tests/data/motion/instances.scene",
+                             "tests/data/motion/lamps.scene" };
     const char *ref = TEST_TMP("clpt-test-motion-scalar.pfm"), *out = TEST_TMP("clpt-test-motion-ocl.pfm");
     const char *modes[] = { "counted", "bounded", "megakernel" };
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < 3; k++) {
         const char *scene = scenes[k];
         cli_run(ARGS(scene, "--device", "scalar", "-q", "-o", ref), &r);
         CHECK_MSG(r.status == 0, "%s", r.err);
@@ -266,6 +439,9 @@ int main(void)
     RUN(test_interpolation);
     RUN(test_moving_camera_is_average_of_still);
     RUN(test_moving_instance_is_average_of_still);
+    RUN(test_moving_lamps_are_lights);
+    RUN(test_moving_lamps_strategies_agree);
+    RUN(test_moving_lamp_is_average_of_still);
     RUN(test_bounds_hold_the_motion);
     RUN(test_still_with_shutter_same_bits);
     RUN(test_devices_match_scalar);

@@ -329,12 +329,29 @@ static Status object_emitters(Scene *s, Light **tpl_out, size_t **first_out, Err
 
 /* How many lights instance x makes of its object's emitters: none when its
  * material replaces the object's (an emissive one emits where no light record says,
- * found by BSDF sampling alone; a dark one does not emit). */
+ * found by BSDF sampling alone; a dark one does not emit). A moving instance makes
+ * them too, placed at each path's time by the kernels (LIGHT_MOVING). */
 static size_t instance_light_count(const Instance *x, uint object, const size_t *first)
 {
-    /* a moving instance's emitters have no one place to sample (docs/motion.md) */
-    if (x->material != NO_INDEX || (x->flags & INST_MOTION)) return 0;
+    if (x->material != NO_INDEX) return 0;
     return first[object + 1] - first[object];
+}
+
+/* Whether every key of a moving transform is a similarity: its stretch S (M = T R S,
+ * types.h MotionKey) s I, within 1e-5 of s, with s of one sign at every key. Between
+ * such keys the kernels interpolate S linearly (a multiple of I again) and R by slerp,
+ * so the transform at any time is a similarity and carries a sphere to a sphere. */
+static int keys_are_similarities(const MotionKey *keys)
+{
+    double s0 = keys[0].stretch[0];
+    for (uint k = 0; k < keys[0].count; k++) {
+        const float *st = keys[k].stretch;    /* s00 s01 s02 s11 s12 s22 */
+        double sk = st[0], tol = 1e-5 * fabs(sk);
+        if (!(sk * s0 > 0.0) || !(fabs(st[3] - sk) <= tol) || !(fabs(st[5] - sk) <= tol) ||
+            !(fabs(st[1]) <= tol) || !(fabs(st[2]) <= tol) || !(fabs(st[4]) <= tol))
+            return 0;
+    }
+    return 1;
 }
 
 /* The scale s when the linear part of m is s times a rotation (or a mirror), each
@@ -412,6 +429,40 @@ static Light instanced_light(const Scene *s, const Light *tpl, const Instance *x
         for (int r = 0; r < 3; r++) v[r] = nm[r][0] * n.x + nm[r][1] * n.y + nm[r][2] * n.z;
         double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         if (len > 0.0) l.normal = v3((float)(v[0] / len), (float)(v[1] / len), (float)(v[2] / len));
+    }
+    return l;
+}
+
+/* Template tpl (object space) of moving instance i, whose keys start at `keys`, as a
+ * LIGHT_MOVING record (types.h): the object-space corner and edges (or sphere) the
+ * kernels place at each path's time, the instance, and in `area` (*area in double) the
+ * area of its first pose (the instance record's M), which sets its power: the choice
+ * among lights is one distribution for the whole shutter. A sphere whose instance is
+ * not a similarity at every key is an ellipsoid somewhere: area 0, never chosen, found
+ * by BSDF sampling at full weight (as a still instance's, instanced_sphere_light). */
+static Light moving_light(const Scene *s, const Light *tpl, uint i, const MotionKey *keys, double *area)
+{
+    Light l = instanced_light(s, tpl, &s->instances[i], area);
+    uint first_tri = scene_first_triangle(s);
+    l.type = LIGHT_MOVING;
+    l.spot_falloff = i;    /* light_instance */
+    if (tpl->prim < first_tri) {
+        l.position = tpl->position;
+        l.atten0 = tpl->atten0;
+        if (!keys_are_similarities(keys)) *area = 0.0;
+        l.area = (float)*area;
+        return l;
+    }
+    l.normal = tpl->normal;
+    if (tpl->quad != LIGHT_QUAD_NONE) {
+        l.position = tpl->position;
+        l.direction = tpl->direction;
+        l.intensity = tpl->intensity;
+    } else {
+        const Triangle *tr = &s->triangles[tpl->prim - first_tri];
+        l.position = tr->p0;
+        l.direction = v3_sub(tr->p1, tr->p0);
+        l.intensity = v3_sub(tr->p2, tr->p0);
     }
     return l;
 }
@@ -522,7 +573,11 @@ Status scene_prepare_lights(Scene *s, Error *err)
         for (size_t j = 0; j < count; j++, k++) {
             const Light *t = &tpl[tpl_first[s->instance_objects[i]] + j];
             double area;
-            lights[k] = instanced_light(s, t, x, &area);
+            uint key0 = i < s->n_instance_motion ? s->instance_motion[i] : NO_INDEX;
+            if ((x->flags & INST_MOTION) && key0 != NO_INDEX)
+                lights[k] = moving_light(s, t, (uint)i, s->motion_keys + key0, &area);
+            else
+                lights[k] = instanced_light(s, t, x, &area);
             uint material = t->prim < first_tri ? s->spheres[t->prim].material
                                                 : s->triangles[t->prim - first_tri].material;
             power[k] = M_PI * area * v3_luminance(s->materials[material].emission);

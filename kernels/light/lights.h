@@ -100,6 +100,43 @@ KFN float light_pdf_by_area(float area, vec3 n, vec3 to, float dist2, float inv_
     return dist2 / (cos_l * area);
 }
 
+/* Moving light l (types.h, LIGHT_MOVING) as its instance places it at the path's time
+ * (SceneView.time): the LIGHT_INSTANCED record of that moment. Its instance's M and
+ * M^-1 come from instance_moving_at, the function a ray entering the instance and
+ * surface_at use, so a light sample lies on the surface a ray then hits and its density
+ * is the one MIS reads for that hit (light_pdf). The map is affine, so a point drawn
+ * uniformly on the object's triangle (or parallelogram) and mapped is uniform on the
+ * world's, of density 1 / (its area then): 0.5 |M e1 x M e2|. A sphere (its instance a
+ * similarity at every key, host/scene/scene_lights.c) has centre M c and radius
+ * |M x| r, x the first axis. The normal is M^-T n, as surface_moving_to_world turns
+ * a hit's. */
+KFN Light light_moving_at(const SceneView *sc, Light l)
+{
+    float m[12], mi[12];
+    instance_moving_at(sc, light_instance(l), m, mi);
+    l.type = LIGHT_INSTANCED;
+    l.position = motion_point(m, l.position);
+    if (l.prim < sc->params->n_spheres) {
+        l.atten0 *= k_sqrt(m[0] * m[0] + m[4] * m[4] + m[8] * m[8]);
+        return l;
+    }
+    l.direction = motion_vector(m, l.direction);
+    l.intensity = motion_vector(m, l.intensity);
+    vec3 c = v3_cross(l.direction, l.intensity);
+    l.area = 0.5f * k_sqrt(v3_dot(c, c));
+    l.normal = instance_normal_moving(mi, l.normal);
+    return l;
+}
+
+/* Light li as the path sees it: its record, or a moving light placed at the path's
+ * time (light_moving_at). */
+KFN Light light_seen(const SceneView *sc, uint li)
+{
+    Light l = sc->lights[li];
+    if (KF_HAS(KF_MOTION) && l.type == LIGHT_MOVING) return light_moving_at(sc, l);
+    return l;
+}
+
 /* The sphere that sphere light l is: its primitive, or the world sphere an instanced
  * light's record holds (types.h, LIGHT_INSTANCED: centre in position, radius in atten0). */
 KFN Sphere light_sphere(const SceneView *sc, Light l)
@@ -112,11 +149,10 @@ KFN Sphere light_sphere(const SceneView *sc, Light l)
     return sp;
 }
 
-/* Solid-angle density at ref of area light `li` producing point x (normal n), the
- * choice of the light excluded. */
-KFN float light_pdf_area(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
+/* Solid-angle density at ref of area light l (as the path sees it, light_seen)
+ * producing point x (normal n), the choice of the light excluded. */
+KFN float light_pdf_area_of(const SceneView *sc, Light l, vec3 ref, vec3 x, vec3 n)
 {
-    Light l = sc->lights[li];
     vec3 to = v3_sub(x, ref);
     float dist2 = v3_dot(to, to);
     if (KF_HAS(KF_SPHERES) && l.prim < sc->params->n_spheres) {
@@ -127,6 +163,12 @@ KFN float light_pdf_area(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
             return 1.0f / (K_TWO_PI * sphere_cone_one_minus_cos(sp.radius, dc2));
     }
     return light_pdf_by_area(l.area, n, to, dist2, 1.0f / k_sqrt(dist2));
+}
+
+/* The same for light li. */
+KFN float light_pdf_area(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
+{
+    return light_pdf_area_of(sc, light_seen(sc, li), ref, x, n);
 }
 
 /* The same with the choice of the light among all lights included (for MIS). */
@@ -198,7 +240,7 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, int reuse, flo
                           LightSample *ls)
 {
     GLOBAL const RenderParams *p = sc->params;
-    Light l = sc->lights[li];
+    Light l = light_seen(sc, li);
     uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
     ls->Le = sc->materials[prim_material(sc, l.prim)].emission;
     ls->delta = 0;
@@ -287,7 +329,7 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, int reuse, flo
     ls->wi = v3_scale(to, inv_dist);
     /* a sphere sampled by its cone has its own density; every other area light is
      * sampled by area, whose density needs no second square root or division */
-    ls->pdf = KF_HAS(KF_SPHERES) && l.prim < first_tri ? light_pdf_area(sc, li, ref, ls->p, ls->n)
+    ls->pdf = KF_HAS(KF_SPHERES) && l.prim < first_tri ? light_pdf_area_of(sc, l, ref, ls->p, ls->n)
                                                        : light_pdf_by_area(l.area, ls->n, to, dist2, inv_dist);
     return ls->pdf > 0.0f && light_faces(sc, l.prim, ls->n, v3_sub(ref, ls->p));
 }

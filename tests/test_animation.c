@@ -933,6 +933,41 @@ static void test_shutter_equals_average(void)
     free(doc);
 }
 
+/* An emissive mesh on a moving node is a moving instance under --shutter, and its
+ * triangle a light placed at each path's time (LIGHT_MOVING, docs/motion.md), not
+ * only found by BSDF sampling: the sliding node's mesh made emissive. */
+static void test_shutter_emitter_is_light(void)
+{
+    char *doc = malloc(16384);
+    doc_json(doc, 16384, anim_nodes, slide_anim);
+    /* mesh 0 (node 0's, which slides) glows; mesh 1 does not */
+    static const char plain[] = "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]},";
+    static const char glowing[] = "\"materials\":[{\"emissiveFactor\":[1,0.8,0.6]}],"
+                                  "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]},";
+    char *at = strstr(doc, plain), *glow = malloc(16384);
+    CHECK(at != NULL);
+    if (at) {
+        snprintf(glow, 16384, "%.*s%s%s", (int)(at - doc), doc, glowing, at + strlen(plain));
+        Scene s;
+        RenderScene rs;
+        Error err = { 0 };
+        Status st = load_doc(glow, KEEP_ANIMATION_IF_ANY, &s, &err);
+        if (st == ST_OK) st = s.animation->pose_shutter(s.animation, &s, 0.0, 1.0, &err);
+        CHECK_MSG(st == ST_OK, "shutter: %s", err.msg);
+        if (st == ST_OK) st = render_scene_prepare(&s, 1, &rs, &err);
+        CHECK_MSG(st == ST_OK, "prepare: %s", err.msg);
+        if (st == ST_OK) {
+            CHECK_EQ_INT(s.n_lights, 1);
+            if (s.n_lights == 1) CHECK(s.lights[0].type == LIGHT_MOVING && s.lights[0].pick_pdf == 1.0f);
+            render_scene_free(&rs);
+        }
+        scene_free(&s);
+        error_clear(&err);
+    }
+    free(glow);
+    free(doc);
+}
+
 /* The program: a still glTF file keeps its bits under a shutter; PoCL gives the scalar
  * device's bits on a blurred one; --frames with --shutter F; the shutter's errors. */
 static void test_cli_shutter(void)
@@ -1084,6 +1119,7 @@ int main(void)
     RUN(test_cli_errors);
     RUN(test_cli_time);
     RUN(test_shutter_equals_average);
+    RUN(test_shutter_emitter_is_light);
     RUN(test_cli_shutter);
     return harness_report();
 }

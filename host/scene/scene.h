@@ -146,7 +146,8 @@ typedef struct {
     Instance *instances;   size_t n_instances, cap_instances;
     uint *instance_objects;  size_t cap_instance_objects;   /* per instance, its object */
     SceneNested *nested;   size_t n_nested, cap_nested;
-    /* per instance: its first light (LIGHT_INSTANCED, kernels/types.h), or NO_INDEX;
+    /* per instance: its first light (LIGHT_INSTANCED, or LIGHT_MOVING for an instance
+     * that moves; kernels/types.h), or NO_INDEX;
      * NULL when no instance has lights (scene_prepare_lights) */
     uint *instance_lights;
     /* moving instances (INST_MOTION, docs/motion.md): the first n_instance_motion
@@ -274,7 +275,8 @@ Status scene_set_envmap_texels(Scene *s, const uint *texels, uint width, uint he
 
 /* Builds the light list: the emissive spheres, triangles and boxes (area lights), the
  * emissive triangles of objects once per instance that keeps their material
- * (LIGHT_INSTANCED, docs/instancing.md; sets `instance_lights`), then the delta lights, then the environment map when the background is one with light in
+ * (LIGHT_INSTANCED, docs/instancing.md; a moving instance's LIGHT_MOVING, placed at
+ * each path's time, docs/motion.md; sets `instance_lights`), then the delta lights, then the environment map when the background is one with light in
  * it, with a choice probability proportional to each light's estimated power (area
  * lights: pi x area x luminance of the emission, the area in the world; point and spot
  * lights: the power through a sphere of the scene's radius (its instances' world boxes

@@ -374,6 +374,7 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Camera, motion_keys);
     out[i++] = (uint)__builtin_offsetof(Material, diffuse_transmission);
     out[i++] = (uint)__builtin_offsetof(Material, diffuse_transmission_color);
+    out[i++] = (uint)__builtin_offsetof(GridMedium, minorant_at);
 }
 #endif
 

@@ -708,7 +708,8 @@ typedef struct {                                        /* 64 bytes */
  * values, x fastest, at the centres of the cells of its box, trilinearly interpolated
  * (clamped to the outermost centres, as Mitsuba 3's gridvolume), 0 outside the box;
  * and a coarse majorant grid of mx my mz cells, each the largest density the
- * interpolation takes in it, which delta and ratio tracking walk cell by cell. Both
+ * interpolation takes in it, which delta and ratio tracking walk cell by cell, and a
+ * minorant grid of the same cells (the smallest), residual ratio tracking's control. Both
  * live in grid_data[] from their offsets. Medium.sigma_a / sigma_s are per unit of
  * density. */
 typedef struct {                                        /* 96 bytes */
@@ -726,7 +727,10 @@ typedef struct {                                        /* 96 bytes */
                                * trilinear as the density, then the blackbody table of
                                * GridBlackbody; the cell's blackbody colour multiplies
                                * Medium.emission. 0 when there is none (colour 1 1 1) */
-    uint pad2;
+    uint minorant_at;         /* the offset in grid_data of mx my mz minorants, after the
+                               * majorants: each the smallest sample the interpolation
+                               * blends in the cell, the control extinction of residual
+                               * ratio tracking (grid_transmittance_residual) */
 } GridMedium;
 
 /* A temperature grid's blackbody table (kernels/medium/grid.h, grid_blackbody): after
@@ -924,6 +928,7 @@ _Static_assert(offsetof(GridMedium, nx) == 48, "GridMedium.nx");
 _Static_assert(offsetof(GridMedium, max_density) == 80, "GridMedium.max_density");
 _Static_assert(offsetof(GridMedium, emission_at) == 84, "GridMedium.emission_at");
 _Static_assert(offsetof(GridMedium, temperature_at) == 88, "GridMedium.temperature_at");
+_Static_assert(offsetof(GridMedium, minorant_at) == 92, "GridMedium.minorant_at");
 #undef CLPT_CHECK_SIZE
 #endif
 

@@ -108,21 +108,26 @@ Status scene_add_grid(Scene *s, const float *density, uint nx, uint ny, uint nz,
     g.mx = nx < GRID_MAJORANT_RES ? nx : GRID_MAJORANT_RES;
     g.my = ny < GRID_MAJORANT_RES ? ny : GRID_MAJORANT_RES;
     g.mz = nz < GRID_MAJORANT_RES ? nz : GRID_MAJORANT_RES;
+    /* the densities, then the majorant cells, then the minorant cells */
     size_t n_density = (size_t)nx * ny * nz, n_major = (size_t)g.mx * g.my * g.mz;
-    size_t at = s->n_grid_data;
-    if (at + n_density + n_major > 0xffffffffu)
+    size_t at = s->n_grid_data, n_all = n_density + 2 * n_major;
+    if (at + n_all > 0xffffffffu)
         return error_set(err, ST_INPUT, "the density grids hold more than 2^32 values together");
-    if (array_reserve((void **)&s->grid_data, &s->cap_grid_data, at + n_density + n_major, sizeof(float)) ||
+    if (array_reserve((void **)&s->grid_data, &s->cap_grid_data, at + n_all, sizeof(float)) ||
         array_reserve((void **)&s->grids, &s->cap_grids, s->n_grids + 1, sizeof g))
         return error_set(err, ST_INTERNAL, "out of memory for a density grid");
     g.density_at = (uint)at;
     g.majorant_at = (uint)(at + n_density);
-    float *d = s->grid_data + at, *maj = s->grid_data + at + n_density;
+    g.minorant_at = (uint)(at + n_density + n_major);
+    float *d = s->grid_data + at, *maj = s->grid_data + g.majorant_at, *mnr = s->grid_data + g.minorant_at;
     memcpy(d, density, n_density * sizeof(float));
     float top = 0.0f;
     for (size_t i = 0; i < n_density; i++) top = d[i] > top ? d[i] : top;
     g.max_density = top;
-    /* each majorant cell: the largest sample the trilinear lookup blends anywhere in it */
+    /* each majorant cell: the largest sample the trilinear lookup blends anywhere in it,
+     * and the smallest (the lookup is a convex blend of those samples, so it lies
+     * between the two everywhere in the cell: the minorant is residual ratio tracking's
+     * control, kernels/medium/grid.h) */
     for (uint cz = 0; cz < g.mz; cz++)
         for (uint cy = 0; cy < g.my; cy++)
             for (uint cx = 0; cx < g.mx; cx++) {
@@ -130,14 +135,16 @@ Status scene_add_grid(Scene *s, const float *density, uint nx, uint ny, uint nz,
                 majorant_span(cx, g.mx, nx, &x0, &x1);
                 majorant_span(cy, g.my, ny, &y0, &y1);
                 majorant_span(cz, g.mz, nz, &z0, &z1);
-                float m = 0.0f;
+                float m = 0.0f, least = d[((size_t)z0 * ny + y0) * nx + x0];
                 for (uint z = z0; z <= z1; z++)
                     for (uint y = y0; y <= y1; y++)
                         for (uint x = x0; x <= x1; x++) {
                             float v = d[((size_t)z * ny + y) * nx + x];
                             m = v > m ? v : m;
+                            least = v < least ? v : least;
                         }
                 maj[((size_t)cz * g.my + cy) * g.mx + cx] = m;
+                mnr[((size_t)cz * g.my + cy) * g.mx + cx] = least;
             }
     /* world -> medium space -> the box's unit cube */
     int ok;
@@ -150,7 +157,7 @@ Status scene_add_grid(Scene *s, const float *density, uint nx, uint ny, uint nz,
     Transform to_grid = transform_compose(&box, &inv);
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 4; j++) g.to_grid[4 * i + j] = (float)to_grid.m[i][j];
-    s->n_grid_data = at + n_density + n_major;
+    s->n_grid_data = at + n_all;
     s->grids[s->n_grids] = g;
     *grid = (uint)s->n_grids++;
     return ST_OK;

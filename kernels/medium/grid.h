@@ -22,7 +22,12 @@
  * Ratio tracking (Novák, Selle, Jarosz, "Residual ratio tracking for estimating
  * attenuation in participating media", SIGGRAPH Asia 2014, sec. 3): the same tentative
  * collisions, each multiplying the transmittance by 1 - mu_t,c / sigma_bar, with
- * Russian roulette once it falls below 0.05 (as pbrt-v4).
+ * Russian roulette once it falls below 0.05 (as pbrt-v4). Residual ratio tracking (the
+ * same paper, sec. 4), for every transmittance that carries no emission: per majorant
+ * cell a control extinction mu_c = sigma_t d_min (the cell's minorant) whose
+ * transmittance exp(-mu_c len) is exact, and ratio tracking of the residual mu_t - mu_c
+ * only, against the residual majorant sigma_t,max (d_max - d_min); a cell of constant
+ * density costs no collision and adds no noise.
  *
  * Random numbers: the first distance of a flight is the sampler's DIM_MEDIUM (so the
  * first, most important, collision is stratified as the homogeneous media's are);
@@ -278,11 +283,27 @@ KFN int grid_track(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, v
     return GRID_PASSED;
 }
 
-/* Ratio tracking's estimate of the transmittance of grid medium md along the world ray
- * x + t d (d unit length), t in [0, dist); numbers from *rng. With `emitted` not NULL
- * (a path's flight, not a shadow ray) an emissive medium adds each tentative
- * collision's emission to it, weighted by the transmittance estimated up to there. */
-KFN vec3 grid_transmittance(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, uint *rng, vec3 *emitted)
+/* Russian roulette on a transmittance estimate that has fallen below 0.05 in every
+ * channel: kept with probability 1/4 and then 4 times as large (as pbrt-v4), so that
+ * an opaque stretch stops early without bias. 0 when the estimate ends. */
+KFN int grid_tr_roulette(vec3 *tr, uint *rng)
+{
+    float m = v3_max_comp(*tr);
+    if (m < 0.05f) {
+        if (!(m > 0.0f) || grid_rng_next(rng) < 0.75f) return 0;
+        *tr = v3_scale(*tr, 4.0f);
+    }
+    return 1;
+}
+
+/* Ratio tracking's estimate of the transmittance of emissive grid medium md along the
+ * world ray x + t d (d unit length), t in [0, dist); numbers from *rng. Each tentative
+ * collision's emission is added to *emitted, weighted by the transmittance estimated up
+ * to there: the collisions must come at the full majorant's rate for that sum to
+ * estimate the emission integral, which is why emissive flights keep plain ratio
+ * tracking (residual tracking finds no collision in a cell of constant density). */
+KFN vec3 grid_transmittance_ratio(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, uint *rng,
+                                  vec3 *emitted)
 {
     GridMedium g = sc->grids[md.grid];
     vec3 sig_t = v3_add(md.sigma_a, md.sigma_s);
@@ -304,20 +325,76 @@ KFN vec3 grid_transmittance(const SceneView *sc, Medium md, vec3 x, vec3 d, floa
             if (!(t < hi)) break;
             vec3 p = v3_madd(o, du, t);
             float dens = grid_density(sc, &g, p);
-            if (emitted && (md.flags & MEDIUM_EMISSIVE))
-                *emitted = v3_add(*emitted, grid_emitted(sc, &g, md, p, dens, tr, bar));
+            *emitted = v3_add(*emitted, grid_emitted(sc, &g, md, p, dens, tr, bar));
             vec3 mu_t = v3_scale(sig_t, dens);
             tr = v3_mul(tr, v3(k_fmax(1.0f - mu_t.x * inv, 0.0f), k_fmax(1.0f - mu_t.y * inv, 0.0f),
                                k_fmax(1.0f - mu_t.z * inv, 0.0f)));
-            float m = v3_max_comp(tr);
-            if (m < 0.05f) {
-                /* Russian roulette: kept with probability 1/4, then 4 times as large */
-                if (!(m > 0.0f) || grid_rng_next(rng) < 0.75f) return v3s(0.0f);
-                tr = v3_scale(tr, 4.0f);
-            }
+            if (!grid_tr_roulette(&tr, rng)) return v3s(0.0f);
         }
     }
     return tr;
+}
+
+/* Residual ratio tracking's estimate of the transmittance of grid medium md along the
+ * world ray x + t d (d unit length), t in [0, dist); numbers from *rng (Novák, Selle,
+ * Jarosz, "Residual ratio tracking for estimating attenuation in participating media",
+ * SIGGRAPH Asia 2014, sec. 4). T = exp(-int mu_t) splits, for any control mu_c, into
+ * exp(-int mu_c) exp(-int (mu_t - mu_c)): the first factor is exact when mu_c is
+ * constant on each stretch, and ratio tracking estimates the second against a
+ * majorant of the residual mu_t - mu_c. In majorant cell k the control is sigma_t
+ * d_min,k and the residual majorant sigma_t,max (d_max,k - d_min,k) (types.h,
+ * GridMedium.minorant_at): the residual's factors 1 - sigma_t,c (d - d_min) / that
+ * majorant stay in [0, 1] in every channel, the estimate is unbiased for any control,
+ * and its variance and its number of collisions shrink with the residual (none in a
+ * cell of constant density, where the estimate is exact). The minorant is the
+ * smallest sample the interpolation blends, so d >= d_min but for rounding at a
+ * cell's face, where a factor a hair above 1 keeps the estimate unbiased still. */
+KFN vec3 grid_transmittance_residual(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, uint *rng)
+{
+    GridMedium g = sc->grids[md.grid];
+    vec3 sig_t = v3_add(md.sigma_a, md.sigma_s);
+    float sig_max = v3_max_comp(sig_t);
+    vec3 o = grid_to_unit(&g, x), du = grid_dir_to_unit(&g, d);
+    vec3 tr = v3s(1.0f);
+    GridWalk w;
+    if (!(sig_max > 0.0f) || !grid_walk_begin(&g, o, du, 0.0f, dist, &w)) return tr;
+    float lo, hi;
+    uint cell, steps = 0u;
+    while (grid_walk_next(&g, &w, &lo, &hi, &cell)) {
+        float d_max = sc->grid_data[g.majorant_at + cell];
+        if (!(d_max > 0.0f)) continue;
+        float d_min = sc->grid_data[g.minorant_at + cell];
+        if (d_min > 0.0f) {
+            /* the control's transmittance over the stretch, exactly */
+            tr = v3_mul(tr, medium_tr(v3_scale(sig_t, d_min), hi - lo));
+            if (!grid_tr_roulette(&tr, rng)) return v3s(0.0f);
+        }
+        float bar = (d_max - d_min) * sig_max;
+        if (!(bar > 0.0f)) continue;
+        float inv = 1.0f / bar;
+        float t = lo;
+        for (;;) {
+            if (++steps > GRID_MAX_STEPS) return v3s(0.0f);
+            t = t + grid_exp_step(bar, grid_rng_next(rng));
+            if (!(t < hi)) break;
+            float res = grid_density(sc, &g, v3_madd(o, du, t)) - d_min;
+            vec3 mu_r = v3_scale(sig_t, res);
+            tr = v3_mul(tr, v3(k_fmax(1.0f - mu_r.x * inv, 0.0f), k_fmax(1.0f - mu_r.y * inv, 0.0f),
+                               k_fmax(1.0f - mu_r.z * inv, 0.0f)));
+            if (!grid_tr_roulette(&tr, rng)) return v3s(0.0f);
+        }
+    }
+    return tr;
+}
+
+/* An estimate of the transmittance of grid medium md along the world ray x + t d (d
+ * unit length), t in [0, dist); numbers from *rng. With `emitted` not NULL (a path's
+ * flight, not a shadow ray) an emissive medium adds its emission along the ray to it
+ * (grid_transmittance_ratio); every other transmittance is residual ratio tracking's. */
+KFN vec3 grid_transmittance(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, uint *rng, vec3 *emitted)
+{
+    if (emitted && (md.flags & MEDIUM_EMISSIVE)) return grid_transmittance_ratio(sc, md, x, d, dist, rng, emitted);
+    return grid_transmittance_residual(sc, md, x, d, dist, rng);
 }
 
 #endif /* CLPT_GRID_H */

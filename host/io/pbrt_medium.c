@@ -15,6 +15,7 @@
 #include "scene/blackbody.h"
 #include "scene/media.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -158,6 +159,19 @@ static Status grid_le_scale(Parser *p, const Lexer *lx, const Token *name, const
     return pl ? grid_values(p, lx, name, pl, "Lescale", n, cells, out) : ST_OK;
 }
 
+/* A uniformgrid's "Le" (times sigma_a, which medium_le checked alone) times every value
+ * of its "Lescale" grid must stay a float: the kernels multiply them (grid_emitted). */
+static Status grid_le_check(Parser *p, const Lexer *lx, const Token *name, vec3 le, vec3 sa, const float *scale,
+                            size_t cells)
+{
+    size_t top = 0;
+    for (size_t i = 1; i < cells; i++) top = scale[i] > scale[top] ? i : top;
+    if ((double)v3_max_comp(v3_mul(le, sa)) * scale[top] <= (double)FLT_MAX) return ST_OK;
+    return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": its emission (Le times sigma_a and the "
+                        "Lescale grid's %g, value %zu) is beyond the largest float (about 3.4e38)",
+                        (int)(name->len > 40 ? 40 : name->len), name->text, (double)scale[top], top);
+}
+
 /* pbrt_reader.h: "temperatureoffset" (pbrt-v4's older name "temperaturecutoff" when it
  * is not given; 0 by default) and "temperaturescale" (1), each finite, the scale >= 0. */
 Status pbrt_medium_temperature(Parser *p, const Lexer *lx, GridTemperature *how)
@@ -232,6 +246,11 @@ static Status uniform_grid(Parser *p, const Lexer *lx, const Token *name, Medium
         (st = grid_le_scale(p, lx, name, n, cells, &le_scale))) {
         free(d);
         free(temperature);
+        return st;
+    }
+    if (!temperature && le_scale && (st = grid_le_check(p, lx, name, le, base.sigma_a, le_scale, (size_t)cells))) {
+        free(d);
+        free(le_scale);
         return st;
     }
     if (temperature) {

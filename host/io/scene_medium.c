@@ -10,6 +10,7 @@
 #include "scene/blackbody.h"
 #include "scene/media.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -119,6 +120,23 @@ static Status medium_emission(Parser *p, const Lexer *lx, const Value *emission,
                                    : "the medium's emission (times emission_scale and sigma_a) is beyond the largest "
                                      "float (about 3.4e38)");
     return ST_OK;
+}
+
+/* A grid's emission scales (`emission_data` / `emission_file`, given at `key`) times its
+ * emission le and sigma_a sa (and a blackbody's colour, up to BLACKBODY_RGB_MAX, when
+ * `tinted`) must stay a float in every cell, as medium_emission checks for a scale of 1:
+ * the kernels multiply them (kernels/medium/grid.h, grid_emitted). */
+static Status grid_emission_check(Parser *p, const Lexer *lx, const Token *key, vec3 le, vec3 sa, int tinted,
+                                  const float *scale, size_t cells, const uint n[3])
+{
+    size_t top = 0;
+    for (size_t i = 1; i < cells; i++) top = scale[i] > scale[top] ? i : top;
+    double e = (double)v3_max_comp(v3_mul(le, sa)) * scale[top] * (tinted ? BLACKBODY_RGB_MAX : 1.0);
+    if (e <= (double)FLT_MAX) return ST_OK;
+    return lex_error_at(lx, key, p->err, "the medium's emission (times emission_scale, sigma_a%s and the emission "
+                        "scale %g at cell %zu %zu %zu) is beyond the largest float (about 3.4e38)",
+                        tinted ? ", a blackbody's colour (up to 256)" : "", (double)scale[top], top % n[0],
+                        top / n[0] % n[1], top / n[0] / n[1]);
 }
 
 /* The grid's size: three whole numbers >= 1, at most SCENE_LIST_MAX cells in all. */
@@ -256,10 +274,11 @@ static Status parse_grid_medium(Parser *p, Lexer *lx, const Token *kw, const Tok
         else if (!v[GM_EMISSION].given && !tinted)
             st = lex_error_at(lx, &e->key, p->err, "'%s' needs 'emission' (the radiance its values scale)",
                               v[GM_EMISSION_DATA].given ? "emission_data" : "emission_file");
-        else
-            st = grid_values(p, lx, &v[GM_EMISSION_DATA], &v[GM_EMISSION_FILE], n, "emission scale",
-                             "emission scales", &emission);
+        else if (!(st = grid_values(p, lx, &v[GM_EMISSION_DATA], &v[GM_EMISSION_FILE], n, "emission scale",
+                                    "emission scales", &emission)))
+            st = grid_emission_check(p, lx, &e->key, le, sa, tinted, emission, (size_t)n[0] * n[1] * n[2], n);
         if (st) {
+            free(emission);
             free(density);
             free(temperature);
             return st;

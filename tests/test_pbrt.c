@@ -1071,8 +1071,8 @@ static void test_media_emission(void)
     /* Le times sigma_a is a float, but not times the grid's largest Lescale */
     expect_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"rgb Le\" [1 1 1] "
                  "\"rgb sigma_a\" [1e10 1 1] \"integer nx\" 2 \"float density\" [1 1] \"float Lescale\" [1 1e30]\n",
-                 DIR "inline.pbrt:2:17: MakeNamedMedium \"m\": its emission (Le times sigma_a and the Lescale grid's "
-                 "1e+30, value 1) is beyond the largest float (about 3.4e38)");
+                 DIR "inline.pbrt:2:17: MakeNamedMedium \"m\": its Lescale grid's 1e+30 (value 1), times Le and "
+                 "sigma_a or times the largest density, is beyond the largest float (about 3.4e38)");
 }
 
 /* A uniformgrid's "temperature" grid (pbrt-v4's GridMedium): each cell's blackbody,

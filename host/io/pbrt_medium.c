@@ -15,7 +15,6 @@
 #include "scene/blackbody.h"
 #include "scene/media.h"
 
-#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -160,15 +159,15 @@ static Status grid_le_scale(Parser *p, const Lexer *lx, const Token *name, const
 }
 
 /* A uniformgrid's "Le" (times sigma_a, which medium_le checked alone) times every value
- * of its "Lescale" grid must stay a float: the kernels multiply them (grid_emitted). */
-static Status grid_le_check(Parser *p, const Lexer *lx, const Token *name, vec3 le, vec3 sa, const float *scale,
-                            size_t cells)
+ * of its "Lescale" grid, and its densities times them, must stay a float
+ * (grid_emission_fits). */
+static Status grid_le_check(Parser *p, const Lexer *lx, const Token *name, vec3 le, vec3 sa, const float *density,
+                            const float *scale, size_t cells)
 {
-    size_t top = 0;
-    for (size_t i = 1; i < cells; i++) top = scale[i] > scale[top] ? i : top;
-    if ((double)v3_max_comp(v3_mul(le, sa)) * scale[top] <= (double)FLT_MAX) return ST_OK;
-    return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": its emission (Le times sigma_a and the "
-                        "Lescale grid's %g, value %zu) is beyond the largest float (about 3.4e38)",
+    size_t top;
+    if (grid_emission_fits(density, scale, cells, v3_max_comp(v3_mul(le, sa)), 1.0, &top)) return ST_OK;
+    return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": its Lescale grid's %g (value %zu), times Le and "
+                        "sigma_a or times the largest density, is beyond the largest float (about 3.4e38)",
                         (int)(name->len > 40 ? 40 : name->len), name->text, (double)scale[top], top);
 }
 
@@ -248,7 +247,7 @@ static Status uniform_grid(Parser *p, const Lexer *lx, const Token *name, Medium
         free(temperature);
         return st;
     }
-    if (!temperature && le_scale && (st = grid_le_check(p, lx, name, le, base.sigma_a, le_scale, (size_t)cells))) {
+    if (!temperature && le_scale && (st = grid_le_check(p, lx, name, le, base.sigma_a, d, le_scale, (size_t)cells))) {
         free(d);
         free(le_scale);
         return st;

@@ -10,7 +10,6 @@
 #include "scene/blackbody.h"
 #include "scene/media.h"
 
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -124,19 +123,19 @@ static Status medium_emission(Parser *p, const Lexer *lx, const Value *emission,
 
 /* A grid's emission scales (`emission_data` / `emission_file`, given at `key`) times its
  * emission le and sigma_a sa (and a blackbody's colour, up to BLACKBODY_RGB_MAX, when
- * `tinted`) must stay a float in every cell, as medium_emission checks for a scale of 1:
- * the kernels multiply them (kernels/medium/grid.h, grid_emitted). */
+ * `tinted`), and times its densities, must stay a float, as medium_emission checks for
+ * a scale of 1 (grid_emission_fits). */
 static Status grid_emission_check(Parser *p, const Lexer *lx, const Token *key, vec3 le, vec3 sa, int tinted,
-                                  const float *scale, size_t cells, const uint n[3])
+                                  const float *density, const float *scale, const uint n[3])
 {
-    size_t top = 0;
-    for (size_t i = 1; i < cells; i++) top = scale[i] > scale[top] ? i : top;
-    double e = (double)v3_max_comp(v3_mul(le, sa)) * scale[top] * (tinted ? BLACKBODY_RGB_MAX : 1.0);
-    if (e <= (double)FLT_MAX) return ST_OK;
-    return lex_error_at(lx, key, p->err, "the medium's emission (times emission_scale, sigma_a%s and the emission "
-                        "scale %g at cell %zu %zu %zu) is beyond the largest float (about 3.4e38)",
-                        tinted ? ", a blackbody's colour (up to 256)" : "", (double)scale[top], top % n[0],
-                        top / n[0] % n[1], top / n[0] / n[1]);
+    size_t top;
+    if (grid_emission_fits(density, scale, (size_t)n[0] * n[1] * n[2], v3_max_comp(v3_mul(le, sa)),
+                           tinted ? BLACKBODY_RGB_MAX : 1.0, &top))
+        return ST_OK;
+    return lex_error_at(lx, key, p->err, "the grid's emission scale %g at cell %zu %zu %zu, times emission, "
+                        "emission_scale and sigma_a%s or times the largest density, is beyond the largest float "
+                        "(about 3.4e38)", (double)scale[top], top % n[0], top / n[0] % n[1], top / n[0] / n[1],
+                        tinted ? " (and a blackbody's colour, up to 256)" : "");
 }
 
 /* The grid's size: three whole numbers >= 1, at most SCENE_LIST_MAX cells in all. */
@@ -276,7 +275,7 @@ static Status parse_grid_medium(Parser *p, Lexer *lx, const Token *kw, const Tok
                               v[GM_EMISSION_DATA].given ? "emission_data" : "emission_file");
         else if (!(st = grid_values(p, lx, &v[GM_EMISSION_DATA], &v[GM_EMISSION_FILE], n, "emission scale",
                                     "emission scales", &emission)))
-            st = grid_emission_check(p, lx, &e->key, le, sa, tinted, emission, (size_t)n[0] * n[1] * n[2], n);
+            st = grid_emission_check(p, lx, &e->key, le, sa, tinted, density, emission, n);
         if (st) {
             free(emission);
             free(density);

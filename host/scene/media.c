@@ -6,6 +6,7 @@
 
 #include "util/kmath.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -48,6 +49,19 @@ Status scene_grid_set_emission(Scene *s, uint grid, const float *scale, Error *e
     g->emission_at = (uint)at;   /* > 0: the grid's densities come first */
     s->n_grid_data = at + n;
     return ST_OK;
+}
+
+int grid_emission_fits(const float *density, const float *scale, size_t n, double sa_le, double factor,
+                       size_t *top)
+{
+    double dens = 0.0;
+    *top = 0;
+    for (size_t i = 0; i < n; i++) {
+        dens = density[i] > dens ? density[i] : dens;
+        *top = scale[i] > scale[*top] ? i : *top;
+    }
+    double s = n ? scale[*top] : 0.0;
+    return dens * s <= (double)FLT_MAX && sa_le * s * factor <= (double)FLT_MAX;
 }
 
 Status scene_grid_set_temperature(Scene *s, uint grid, const float *temperature, GridTemperature how, Error *err)

@@ -42,6 +42,15 @@ Medium medium_with_emission(Medium m, vec3 le);
  * size (finite, >= 0: the reader checks), interpolated as its density: pbrt-v4's
  * "Lescale" grid. Fails only when memory runs out or the grids pass 2^32 floats. */
 Status scene_grid_set_emission(Scene *s, uint grid, const float *scale, Error *err);
+/* Whether a grid's emission fits single precision: the kernels multiply a lookup of the
+ * density by one of the n emission scales, and sigma_a times Le (sa_le, its largest
+ * channel, times `factor`: a blackbody's brightest for a temperature grid, else 1) by
+ * that over the majorant, which the density cancels (kernels/medium/grid.h,
+ * grid_emitted). So the largest density times the largest scale, and sa_le times the
+ * largest scale, must each stay below the largest float. *top: the largest scale's
+ * index, for the readers' messages. */
+int grid_emission_fits(const float *density, const float *scale, size_t n, double sa_le, double factor,
+                       size_t *top);
 
 /* How a temperature grid's values become kelvin: T = (value - offset) * scale (pbrt-v4's
  * "temperatureoffset" and "temperaturescale"); where T <= GRID_TEMPERATURE_CUTOFF

@@ -460,6 +460,69 @@ static void test_rgbgrid(void)
     error_clear(&err);
 }
 
+/* An rgbgrid's "Le" grid times "Lescale": one colour times an emission scale per voxel
+ * (its luminance), exact when the voxels' Le share a hue; a warning when they do not;
+ * "Le" without "sigma_a" and an emission past the largest float refused. */
+static void test_rgbgrid_emission(void)
+{
+    Scene s;
+    Error err = { 0 };
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"r\" \"string type\" \"rgbgrid\" \"integer nx\" 2\n"
+                           "  \"rgb sigma_a\" [1 1 1 2 2 2] \"rgb sigma_s\" [1 1 1 2 2 2] \"rgb Le\" [1 0.5 0.25 2 1 0.5] "
+                           "\"float Lescale\" 2\n",
+                           &s, &err),
+                 ST_OK);
+    CHECK_EQ_INT(s.n_warnings, 0);
+    if (s.n_grids == 1 && s.n_media == 1) {
+        const GridMedium *g = &s.grids[0];
+        const Medium *m = &s.media[0];
+        CHECK(m->flags & MEDIUM_EMISSIVE);
+        CHECK(g->emission_at != 0);
+        /* the colour times each voxel's scale gives back its Le times Lescale, in
+         * pbrt-v4's unit for an rgbgrid's Le (106.857 a unit of RGB) */
+        if (g->emission_at) {
+            const float *e = s.grid_data + g->emission_at;
+            double unit = 106.856895;
+            CHECK_NEAR(e[0] * m->emission.x, 2.0 * unit, 2e-4);
+            CHECK_NEAR(e[0] * m->emission.z, 0.5 * unit, 1e-4);
+            CHECK_NEAR(e[1] * m->emission.y, 2.0 * unit, 2e-4);
+        }
+    }
+    scene_free(&s);
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"r\" \"string type\" \"rgbgrid\" \"integer nx\" 2\n"
+                           "  \"rgb sigma_a\" [1 1 1 1 1 1] \"rgb Le\" [1 0 0 0 0 1]\n", &s, &err),
+                 ST_OK);
+    CHECK_EQ_INT(s.n_warnings, 1);
+    if (s.n_warnings == 1)
+        CHECK_MSG(strcmp(s.warnings[0], NDIR "inline.pbrt:1: MakeNamedMedium \"r\": clpt's grids hold one emission "
+                         "colour, so the rgbgrid's voxel Le colours become one colour times their luminance "
+                         "(docs/media.md)") == 0, "got '%s'", s.warnings[0]);
+    scene_free(&s);
+    /* Lescale 0: no emission */
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"r\" \"string type\" \"rgbgrid\" \"rgb sigma_a\" [1 1 1] "
+                           "\"rgb Le\" [1 1 1] \"float Lescale\" 0\n", &s, &err), ST_OK);
+    CHECK(s.n_media == 1 && !(s.media[0].flags & MEDIUM_EMISSIVE) && s.grids[0].emission_at == 0);
+    scene_free(&s);
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"r\" \"string type\" \"rgbgrid\" \"rgb sigma_s\" [1 1 1] "
+                           "\"rgb Le\" [1 1 1]\n", &s, &err), ST_INPUT);
+    CHECK_MSG(strcmp(err.msg, NDIR "inline.pbrt:1:17: MakeNamedMedium \"r\": an \"rgbgrid\" with \"Le\" needs \"rgb "
+                     "sigma_a\" (what absorbs emits)") == 0, "got '%s'", err.msg);
+    scene_free(&s);
+    error_clear(&err);
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"r\" \"string type\" \"rgbgrid\" \"integer nx\" 2 \"rgb sigma_a\" "
+                           "[1e10 1 1 1e10 1 1] \"rgb Le\" [1 1 1 1e30 1e30 1e30]\n", &s, &err), ST_INPUT);
+    CHECK_MSG(strcmp(err.msg, NDIR "inline.pbrt:1:17: MakeNamedMedium \"r\": its Le (voxel 1) times Lescale and "
+                     "sigma_a, or times the density, is beyond the largest float (about 3.4e38)") == 0, "got '%s'",
+              err.msg);
+    scene_free(&s);
+    error_clear(&err);
+    CHECK_EQ_INT(load_text("MakeNamedMedium \"r\" \"string type\" \"rgbgrid\" \"rgb sigma_a\" [1 1 1] "
+                           "\"rgb Le\" [1 1 1] \"float Lescale\" -1\n", &s, &err), ST_INPUT);
+    CHECK_MSG(strstr(err.msg, "parameter 'Lescale' must be a number in [0, 1e30]") != NULL, "got '%s'", err.msg);
+    scene_free(&s);
+    error_clear(&err);
+}
+
 int main(void)
 {
     RUN(test_ramp);
@@ -470,6 +533,7 @@ int main(void)
     RUN(test_pbrt_nanovdb_far);
     RUN(test_cloud);
     RUN(test_rgbgrid);
+    RUN(test_rgbgrid_emission);
     RUN(test_grid_budget);
     return harness_report();
 }

@@ -341,29 +341,96 @@ static Status rgb_array(Parser *p, const Lexer *lx, const Token *name, const cha
 /* Rec. 709 luminance, the weights of an RGB colour's brightness. */
 static double luminance(double r, double g, double b) { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
 
+/* The integral of the CIE 1931 y-bar curve (pbrt-v4's CIE_Y_integral). pbrt-v4 divides
+ * the Le of its homogeneous and uniformgrid media by their illuminant's luminance
+ * (media.cpp, "LeScale /= SpectrumToPhotometric(Le)"), which makes an RGB Le of 1 1 1 a
+ * radiance of 1 on its RGB film, but not the rgbgrid's "Le" grid: there 1 1 1 renders
+ * as 106.857 (measured: the same grid as a uniformgrid and as an rgbgrid in pbrt-v4, the
+ * ratio 106.857 in every channel). clpt reads the rgbgrid as pbrt-v4 renders it. */
+#define PBRT_RGBGRID_LE_UNIT 106.856895
+
+/* An rgbgrid's emission: the count voxel colours vle (x fastest) times le_scale > 0 as
+ * one colour *le (their sum over the sum of their luminances, times le_scale and
+ * PBRT_RGBGRID_LE_UNIT) and a new
+ * array *scale of each voxel's luminance (NULL, *le 0 0 0, when every Le is black);
+ * *uniform 0 when the voxels' hues differ. With sigma_a sa and the densities d it must
+ * fit single precision (grid_emission_fits). */
+static Status rgb_grid_emission(Parser *p, const Lexer *lx, const Token *name, const double *vle, size_t count,
+                                double le_scale, vec3 sa, const float *d, vec3 *le, float **scale, int *uniform)
+{
+    double sum[3] = { 0, 0, 0 }, sum_y = 0.0, first[3] = { 0, 0, 0 };
+    int have_first = 0;
+    *uniform = 1;
+    *le = v3s(0.0f);
+    *scale = NULL;
+    for (size_t i = 0; i < count; i++) {
+        const double *c = vle + 3 * i;
+        double y = luminance(c[0], c[1], c[2]);
+        for (int k = 0; k < 3; k++) sum[k] += c[k];
+        sum_y += y;
+        if (!(y > 0.0)) continue;
+        if (!have_first)
+            for (int k = 0; k < 3; k++) first[k] = c[k] / y;
+        else
+            for (int k = 0; k < 3; k++) *uniform &= fabs(c[k] / y - first[k]) <= 1e-6 * (1.0 + first[k]);
+        have_first = 1;
+    }
+    if (!(sum_y > 0.0)) return ST_OK;   /* black everywhere */
+    double col[3], sa_le = 0.0;
+    for (int k = 0; k < 3; k++) {
+        col[k] = le_scale * PBRT_RGBGRID_LE_UNIT * sum[k] / sum_y;
+        sa_le = fmax(sa_le, col[k] * (double)v3_get(sa, k));
+    }
+    float *v = malloc(count * sizeof(float));
+    if (!v) return error_set(p->err, ST_INTERNAL, "out of memory");
+    for (size_t i = 0; i < count; i++) v[i] = (float)luminance(vle[3 * i], vle[3 * i + 1], vle[3 * i + 2]);
+    size_t top;
+    if (!grid_emission_fits(d, v, count, sa_le, 1.0, &top)) {
+        free(v);
+        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": its Le (voxel %zu) times Lescale and "
+                            "sigma_a, or times the density, is beyond the largest float (about 3.4e38)",
+                            NAME_LEN(name), name->text, top);
+    }
+    *le = v3((float)col[0], (float)col[1], (float)col[2]);
+    *scale = v;
+    return ST_OK;
+}
+
 /* pbrt-v4's RGBGridMedium: "rgb sigma_a" and/or "rgb sigma_s", nx ny nz colours each
  * (a missing one is 1 everywhere, as pbrt's), times `scale`, over p0 p1; g. clpt's grid
  * holds one density, so each voxel keeps d = the luminance of its sigma_a + sigma_s,
  * and the medium the colours A = sum sigma_a / sum d and S = sum sigma_s / sum d: exact
  * when every voxel has the same colour (in proportion), and the grid's total extinction
- * per channel is kept whatever they are. A one-time warning says so. Le: a warning. */
+ * per channel is kept whatever they are. A one-time warning says so. Its emission "rgb
+ * Le" (nx ny nz colours, which pbrt-v4 allows only with "sigma_a") times "Lescale" (1)
+ * becomes the same way one colour, C = sum Le / sum lum(Le), times an emission scale
+ * per voxel, lum(Le): exact when every voxel's Le has the same hue (and the sigma
+ * colours are uniform), else the mean hue and a one-time warning. */
 static Status rgb_grid(Parser *p, const Lexer *lx, const Token *name, Medium *out)
 {
     Status st;
-    double scale = 1.0, g = 0.0;
-    if ((st = pbrt_get_float(p, lx, "scale", &scale)) || (st = pbrt_get_float(p, lx, "g", &g))) return st;
+    double scale = 1.0, g = 0.0, le_scale = 1.0;
+    if ((st = pbrt_get_float(p, lx, "scale", &scale)) || (st = pbrt_get_float(p, lx, "g", &g)) ||
+        (st = pbrt_get_float(p, lx, "Lescale", &le_scale)))
+        return st;
     if (!(scale >= 0.0) || !(scale <= 1e30))
         return pbrt_param_type_error(p, lx, pbrt_param_find(p, "scale"), "a number in [0, 1e30]");
+    if (!(le_scale >= 0.0) || !(le_scale <= 1e30))
+        return pbrt_param_type_error(p, lx, pbrt_param_find(p, "Lescale"), "a number in [0, 1e30]");
     if (!(g > -1.0 && g < 1.0)) return pbrt_param_type_error(p, lx, pbrt_param_find(p, "g"), "a number in (-1, 1)");
     long n[3];
     double cells;
     if ((st = pbrt_medium_grid_size(p, lx, name, n, &cells))) return st;
-    const double *va, *vs;
-    if ((st = rgb_array(p, lx, name, "sigma_a", cells, &va)) || (st = rgb_array(p, lx, name, "sigma_s", cells, &vs)))
+    const double *va, *vs, *vle;
+    if ((st = rgb_array(p, lx, name, "sigma_a", cells, &va)) || (st = rgb_array(p, lx, name, "sigma_s", cells, &vs)) ||
+        (st = rgb_array(p, lx, name, "Le", cells, &vle)))
         return st;
     if (!va && !vs)
         return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": an \"rgbgrid\" needs \"rgb sigma_a\" and/or "
                             "\"rgb sigma_s\"", NAME_LEN(name), name->text);
+    if (vle && !va)
+        return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": an \"rgbgrid\" with \"Le\" needs \"rgb "
+                            "sigma_a\" (what absorbs emits)", NAME_LEN(name), name->text);
     vec3 lo, hi;
     if ((st = pbrt_medium_box(p, lx, name, &lo, &hi))) return st;
     size_t count = (size_t)cells;
@@ -399,15 +466,29 @@ static Status rgb_grid(Parser *p, const Lexer *lx, const Token *name, Medium *ou
         return lex_error_at(lx, name, p->err, "MakeNamedMedium \"%.*s\": its extinction (sigma_a + sigma_s, times "
                             "scale) is beyond the largest float (about 3.4e38)", NAME_LEN(name), name->text);
     }
+    vec3 le = v3s(0.0f);
+    float *emission = NULL;
+    int le_uniform = 1;
+    if (vle && le_scale > 0.0 && (st = rgb_grid_emission(p, lx, name, vle, count, le_scale, sa, d, &le, &emission,
+                                                         &le_uniform))) {
+        free(d);
+        return st;
+    }
     uint grid;
     st = scene_add_grid(p->s, d, (uint)n[0], (uint)n[1], (uint)n[2], lo, hi, &p->g.ctm, &grid, p->err);
     free(d);
+    if (!st && emission) st = scene_grid_set_emission(p->s, grid, emission, p->err);
+    free(emission);
     if (st) return st;
     if (!uniform && (st = warn_once(p, lx, name, "rgbgrid-colours", "MakeNamedMedium \"%.*s\": clpt's grids hold one "
                                     "density, so the rgbgrid's voxel colours become one colour times their luminance "
                                     "(docs/media.md)", NAME_LEN(name), name->text)))
         return st;
-    *out = medium_grid(sa, ss, (float)g, grid);
+    if (!le_uniform && (st = warn_once(p, lx, name, "rgbgrid-le", "MakeNamedMedium \"%.*s\": clpt's grids hold one "
+                                       "emission colour, so the rgbgrid's voxel Le colours become one colour times "
+                                       "their luminance (docs/media.md)", NAME_LEN(name), name->text)))
+        return st;
+    *out = medium_with_emission(medium_grid(sa, ss, (float)g, grid), le);
     return ST_OK;
 }
 

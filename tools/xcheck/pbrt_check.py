@@ -3,7 +3,8 @@
 pbrt-v4's format, docs/pbrt.md) and by a pbrt-v4 binary built outside the repository.
 
 The scenes are this folder's pbrt/*.pbrt (written by pbrt/make_scenes.py: a smoke ball, a
-chromatic medium in glass, a uniformgrid cloud, a homogeneous fog) and
+chromatic medium in glass, a uniformgrid cloud, a homogeneous fog, a fire ball and an
+rgbgrid that glows) and
 scenes/nanovdb-smoke.pbrt. Each is copied into the output folder with its film set to
 size x size and its sampler to pbrt's `independent` (clpt's sampler is its own), and both
 renderers render that copy with --spp and --seed 1 and 2; pbrt writes OpenEXR (read by
@@ -54,6 +55,10 @@ SCENES = [
      "a uniformgrid temperature grid: blackbody emission, 1200-4500 K, over a floor",
      "clpt takes a blackbody's RGB from a table (Wyman's CIE fit, 4096 steps to the hottest "
      "cell, clamped at 0 out of gamut) where pbrt-v4 samples Planck's law at 4 wavelengths a path"),
+    ("pbrt-rgbgrid-glow", "tools/xcheck/pbrt/rgbgrid-glow.pbrt", [], True,
+     "an rgbgrid with an \"Le\" grid of one hue (orange) times Lescale, over a floor",
+     "pbrt-v4 upsamples the orange Le and the grey sigma to spectra (RGBIlluminantSpectrum, "
+     "RGBUnboundedSpectrum) where clpt keeps RGB"),
     ("pbrt-nanovdb-smoke", "scenes/nanovdb-smoke.pbrt", ["scenes/nanovdb-smoke.nvdb"], False,
      "scenes/nanovdb-smoke.pbrt: a NanoVDB grid read by each renderer", ""),
 ]

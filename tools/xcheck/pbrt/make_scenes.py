@@ -172,6 +172,31 @@ through paths (no light samples toward media).""",
         '  "float Lescale" [\n    %s ]\n' % grid_text(np.ones((n, n, n))) +
         'AttributeBegin\n  MediumInterface "fire" ""\n  Material "interface"\n' +
         box((-1.1, -0.98, -1.1), (1.1, 1.2, 1.1)) + "AttributeEnd\n")
+    # the same ball as an rgbgrid: sigma_a and sigma_s colours per voxel (grey, in
+    # proportion to the density) and an orange "Le" grid of one hue, whose brightness
+    # follows the fire ball's heat; clpt reads it as one colour times a scale per voxel,
+    # exact for one hue (docs/media.md, "RGB grids"); pbrt-v4 does not normalise an
+    # rgbgrid's Le by its illuminant's luminance, so a unit of it is 106.857 of radiance
+    # (as clpt reads it too) and Lescale 0.005 makes the hottest voxel about 1.6 in red
+    glow = np.clip((temp - 1200) / 3300, 0, None) * 3
+    def rgb_text(a, colour):
+        vals = ["0 0 0" if v == 0 else " ".join("%.4g" % (v * c) for c in colour) for v in a.reshape(-1)]
+        return "\n    ".join(" ".join(vals[i:i + 8]) for i in range(0, len(vals), 8))
+    out["rgbgrid-glow"] = (
+        head("""The fire ball as an rgbgrid (16^3): sigma_a 3 and sigma_s 1 per unit of its density,
+given per voxel, and an orange "Le" grid (one hue, up to 3 1.35 0.45) times "Lescale" 0.005,
+over a grey floor under a dim sky: emission read from pbrt-v4's RGBGridMedium.""",
+             (0, 0.6, 5), (0, -0.1, 0), 36, "rgbgrid-glow") + "WorldBegin\n" +
+        'LightSource "infinite" "rgb L" [0.03 0.04 0.06]\n' + FLOOR +
+        'MakeNamedMedium "glow" "string type" "rgbgrid"\n'
+        '  "integer nx" %d "integer ny" %d "integer nz" %d\n' % (n, n, n) +
+        '  "point3 p0" [-1.1 -0.98 -1.1] "point3 p1" [1.1 1.2 1.1] "float scale" 1 "float g" 0\n'
+        '  "rgb sigma_a" [\n    %s ]\n' % rgb_text(dens, (3, 3, 3)) +
+        '  "rgb sigma_s" [\n    %s ]\n' % rgb_text(dens, (1, 1, 1)) +
+        '  "rgb Le" [\n    %s ]\n' % rgb_text(glow, (1, 0.45, 0.15)) +
+        '  "float Lescale" 0.005\n'
+        'AttributeBegin\n  MediumInterface "glow" ""\n  Material "interface"\n' +
+        box((-1.1, -0.98, -1.1), (1.1, 1.2, 1.1)) + "AttributeEnd\n")
     return out
 
 

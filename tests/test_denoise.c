@@ -219,11 +219,22 @@ static void specular_scene(Scene *s, int glass)
     else add_plane(s, v3(0.0f, 0.0f, -1.0f), -5.0f, wall);
 }
 
-/* Image `mode` (enum Integrator) of the scene on `devices`, into rgb (FW x FH x 3). */
-static int render_mode(int glass, uint mode, const char *devices, float *rgb)
+/* The front of the mirror scene made a rough metal: Schlick's conductor with the given
+ * reflectance at normal incidence (kernels/bsdf/conductor.h), or, with f0 zero, the
+ * measured complex index of gold. */
+#define METAL_F0 v3(0.9f, 0.6f, 0.3f)
+#define GOLD_ETA v3(0.1678f, 0.3504f, 1.5085f)   /* host/scene/material.c's Au */
+#define GOLD_K v3(3.1378f, 2.7141f, 1.8788f)
+enum { FRONT_MIRROR, FRONT_GLASS, FRONT_ROUGH_F0, FRONT_ROUGH_GOLD };
+
+/* Image `mode` (enum Integrator) of the scene with `front` (FRONT_*) on `devices`, into
+ * rgb (FW x FH x 3). */
+static int render_mode(int front, uint mode, const char *devices, float *rgb)
 {
     Scene s;
-    specular_scene(&s, glass);
+    specular_scene(&s, front == FRONT_GLASS);
+    if (front == FRONT_ROUGH_F0) s.materials[1] = material_conductor_f0(METAL_F0, 0.4f);
+    if (front == FRONT_ROUGH_GOLD) s.materials[1] = material_conductor(GOLD_ETA, GOLD_K, 0.4f);
     s.integrator = mode;
     Error err = { 0 };
     Status st = render_util_rgb_mis(&s, RENDER_UTIL_SCENE_MIS, devices, rgb, &err);
@@ -259,24 +270,50 @@ static void test_features_through_specular(void)
     for (int glass = 0; glass <= 1; glass++) {
         const char *what = glass ? "glass" : "mirror";
         vec3 wall_normal = glass ? v3(0.5f, 0.5f, 1.0f) : v3(0.5f, 0.5f, 0.0f);
-        if (!render_mode(glass, INTEGRATOR_FEATURE_ALBEDO, "scalar", a)) return;
+        if (!render_mode(glass ? FRONT_GLASS : FRONT_MIRROR, INTEGRATOR_FEATURE_ALBEDO, "scalar", a)) return;
         CHECK_MSG(all_near_scaled(a, WALL_RED, glass ? 0.85f : 1.0f - 1e-4f), "%s: albedo feature %g %g %g, not the wall's",
                   what, a[0], a[1], a[2]);
         if (glass) CHECK_MSG(a[0] < 0.8f * 0.95f, "glass: albedo feature %g, not dimmed by the reflection", a[0]);
-        if (!render_mode(glass, INTEGRATOR_FEATURE_ALBEDO, TEST_OPENCL, b)) return;
+        if (!render_mode(glass ? FRONT_GLASS : FRONT_MIRROR, INTEGRATOR_FEATURE_ALBEDO, TEST_OPENCL, b)) return;
         CHECK_MSG(!memcmp(a, b, sizeof a), "%s: the albedo feature differs between scalar and OpenCL", what);
-        if (!render_mode(glass, INTEGRATOR_FEATURE_NORMAL, "scalar", a)) return;
+        if (!render_mode(glass ? FRONT_GLASS : FRONT_MIRROR, INTEGRATOR_FEATURE_NORMAL, "scalar", a)) return;
         CHECK_MSG(all_near(a, wall_normal), "%s: normal feature %g %g %g, not the wall's", what, a[0], a[1], a[2]);
-        if (!render_mode(glass, INTEGRATOR_FEATURE_NORMAL, TEST_OPENCL, b)) return;
+        if (!render_mode(glass ? FRONT_GLASS : FRONT_MIRROR, INTEGRATOR_FEATURE_NORMAL, TEST_OPENCL, b)) return;
         CHECK_MSG(!memcmp(a, b, sizeof a), "%s: the normal feature differs between scalar and OpenCL", what);
         /* the first-hit images --aov writes are unchanged: the mirror's (or glass's) own */
-        if (!render_mode(glass, INTEGRATOR_AOV_ALBEDO, "scalar", a)) return;
+        if (!render_mode(glass ? FRONT_GLASS : FRONT_MIRROR, INTEGRATOR_AOV_ALBEDO, "scalar", a)) return;
         CHECK_MSG(all_near(a, v3s(1.0f)), "%s: --aov albedo %g %g %g", what, a[0], a[1], a[2]);
-        if (!render_mode(glass, INTEGRATOR_AOV_NORMAL, "scalar", a)) return;
+        if (!render_mode(glass ? FRONT_GLASS : FRONT_MIRROR, INTEGRATOR_AOV_NORMAL, "scalar", a)) return;
         CHECK_MSG(all_near(a, v3(0.5f, 0.5f, 1.0f)), "%s: --aov normal %g %g %g", what, a[0], a[1], a[2]);
     }
 }
 
+
+/* A rough metal is the first surface the features stop at; its albedo there is its
+ * reflectance at normal incidence (OIDN's documentation, "Albedo"), not the tint of 1
+ * that --aov albedo shows: Schlick's F0 as given, and for a complex index eta + i k the
+ * conductor Fresnel reflectance at normal incidence, ((eta - 1)^2 + k^2) / ((eta + 1)^2
+ * + k^2) per channel (Born and Wolf, "Principles of Optics", 14.2). Scalar and OpenCL
+ * agree bit for bit. */
+static void test_metal_albedo_feature(void)
+{
+    static float a[FW * FH * 3], b[FW * FH * 3];
+    if (!render_mode(FRONT_ROUGH_F0, INTEGRATOR_FEATURE_ALBEDO, "scalar", a)) return;
+    CHECK_MSG(all_near(a, METAL_F0), "rough metal: albedo feature %g %g %g, not its F0", a[0], a[1], a[2]);
+    if (!render_mode(FRONT_ROUGH_F0, INTEGRATOR_FEATURE_ALBEDO, TEST_OPENCL, b)) return;
+    CHECK_MSG(!memcmp(a, b, sizeof a), "rough metal: the albedo feature differs between scalar and OpenCL");
+    if (!render_mode(FRONT_ROUGH_GOLD, INTEGRATOR_FEATURE_ALBEDO, "scalar", a)) return;
+    vec3 eta = GOLD_ETA, k = GOLD_K, f0;
+    f0.x = ((eta.x - 1) * (eta.x - 1) + k.x * k.x) / ((eta.x + 1) * (eta.x + 1) + k.x * k.x);
+    f0.y = ((eta.y - 1) * (eta.y - 1) + k.y * k.y) / ((eta.y + 1) * (eta.y + 1) + k.y * k.y);
+    f0.z = ((eta.z - 1) * (eta.z - 1) + k.z * k.z) / ((eta.z + 1) * (eta.z + 1) + k.z * k.z);
+    CHECK_MSG(all_near_scaled(a, f0, 1.0f - 1e-3f), "gold: albedo feature %g %g %g, not its F0 %g %g %g", a[0], a[1],
+              a[2], f0.x, f0.y, f0.z);
+    if (!render_mode(FRONT_ROUGH_GOLD, INTEGRATOR_FEATURE_ALBEDO, TEST_OPENCL, b)) return;
+    CHECK_MSG(!memcmp(a, b, sizeof a), "gold: the albedo feature differs between scalar and OpenCL");
+    if (!render_mode(FRONT_ROUGH_F0, INTEGRATOR_AOV_ALBEDO, "scalar", a)) return;
+    CHECK_MSG(all_near(a, v3s(1.0f)), "rough metal: --aov albedo %g %g %g, not its tint", a[0], a[1], a[2]);
+}
 
 /* A raised cancel flag (denoiser_set_cancel, the viewer's stop flag) stops a denoise
  * before any filter with its own status and message; lowered, the same denoiser works
@@ -308,6 +345,7 @@ int main(void)
     if (!mkdtemp(dir)) return 1;
     RUN(test_missing_library_message);
     RUN(test_features_through_specular);
+    RUN(test_metal_albedo_feature);
     Denoiser *d = NULL;
     Error err = { 0 };
     have_oidn = denoiser_open(&d, &err) == ST_OK;

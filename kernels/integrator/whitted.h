@@ -291,6 +291,24 @@ KFN vec3 feature_unit(vec3 c)
     return v3(k_clamp(c.x, 0.0f, 1.0f), k_clamp(c.y, 0.0f, 1.0f), k_clamp(c.z, 0.0f, 1.0f));
 }
 
+/* The denoiser's albedo at the first surface that is not perfectly specular: the albedo
+ * image's (aov_albedo_at), except on metals, where Open Image Denoise's documentation
+ * (the RT filter's "Albedo" section) asks for the reflectivity at normal incidence: a
+ * rough conductor's Fresnel colour at cos = 1 times its tint, and for the coated
+ * conductor the same seen through its clear coat, F + (1 - F) F0 with the coat's own F
+ * at normal incidence (as feature_specular_next weighs the smooth one). A conductor's
+ * tint is 1 unless given, so without this every metal looks white to the denoiser,
+ * whatever its colour and however dark (iron and titanium reflect about 55%). */
+KFN vec3 feature_albedo_at(const SceneView *sc, Material m, Surface s, vec3 ng, vec3 kd)
+{
+    if (m.type == MAT_CONDUCTOR) return conductor_fresnel(bsdf_conductor(m, kd), 1.0f);
+    if (m.type == MAT_LAYERED && m.layer_base == LAYER_BASE_CONDUCTOR) {
+        float F = fresnel_dielectric(1.0f, m.ior);
+        return v3_add(v3s(F), v3_scale(conductor_fresnel(bsdf_layered(m, kd).c, 1.0f), 1.0f - F));
+    }
+    return aov_albedo_at(sc, m, s, ng);
+}
+
 /* Whether the features go on past surface s of (resolved) material m, seen along d: only
  * when m is perfectly specular (no lobe with a density, bsdf_has_density, and for the
  * classic metal no fuzz), and then along one lobe chosen without random numbers:
@@ -378,7 +396,7 @@ KFN vec3 whitted_feature(const SceneView *sc, Ray ray, uint mode, uint *rays)
             continue;
         }
         if (mode == INTEGRATOR_FEATURE_NORMAL) return v3_scale(v3_add(material_normal(sc, m, s), v3s(1.0f)), 0.5f);
-        return feature_unit(v3_mul(tint, aov_albedo_at(sc, m, s, ng)));
+        return feature_unit(v3_mul(tint, feature_albedo_at(sc, m, s, ng, kd)));
     }
 }
 

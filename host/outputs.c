@@ -32,7 +32,7 @@ static char *default_output(const char *scene_path)
 PassRequest outputs_pass_request(const Options *o)
 {
     PassRequest q = { o->adaptive, o->adaptive_spp, o->aovs, { o->aov_files[0], o->aov_files[1], o->aov_files[2] },
-                      o->depth_near, o->depth_far, o->exr_float, o->denoise, o->quiet };
+                      o->depth_near, o->depth_far, o->exr_float, o->denoise, o->quiet, o->noise_threshold > 0.0 };
     return q;
 }
 

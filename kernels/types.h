@@ -673,7 +673,11 @@ enum Integrator {
     /* the denoiser's features (--denoise, docs/denoise.md): as the two above, but at the
      * first surface that is not perfectly specular, seen through mirrors and clear glass */
     INTEGRATOR_FEATURE_NORMAL = 5,
-    INTEGRATOR_FEATURE_ALBEDO = 6
+    INTEGRATOR_FEATURE_ALBEDO = 6,
+    /* what the path integrator's camera ray sees emitted at its first hit (or the
+     * background where it escapes), along the path integrator's own camera rays: the
+     * part of the image the denoiser is not given (host/render/passes.c) */
+    INTEGRATOR_FEATURE_EMISSION = 7
 };
 
 /* A participating medium (kernels/medium/, docs/media.md): coefficients per unit of

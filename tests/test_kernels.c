@@ -1101,6 +1101,7 @@ static void test_whitted(void)
         { INTEGRATOR_AOV_ALBEDO, 0, 0, 0, "albedo image" },
         { INTEGRATOR_FEATURE_NORMAL, 1, 0, 0, "denoiser's normal, through mirrors" },
         { INTEGRATOR_FEATURE_ALBEDO, 3, 0, 1, "denoiser's albedo, through mirrors" },
+        { INTEGRATOR_FEATURE_EMISSION, 1, 0, 1, "denoiser's emission, the path's camera rays" },
     };
     for (size_t m = 0; m < sizeof modes / sizeof modes[0]; m++) {
         RenderParams p = *base;

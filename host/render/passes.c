@@ -285,18 +285,58 @@ static Status passes__features(const PassContext *pc, uint spp, float *aov[3], i
     return st;
 }
 
+int passes_emission_splits(const RenderParams *p, int uniform)
+{
+    return uniform && p->integrator == INTEGRATOR_PATH && !p->has_media;
+}
+
+/* The emission feature with `spp` samples per pixel into e, timed to stderr unless quiet. */
+static Status passes__emission(const PassContext *pc, uint spp, float *e, int quiet, Error *err)
+{
+    double secs = 0.0;
+    Status st = passes_aov_data(pc, INTEGRATOR_FEATURE_EMISSION, spp, e, &secs, err);
+    if (!st && !quiet) fprintf(stderr, "clpt: emission image (%u spp) for the denoiser in %.2f s\n", spp, secs);
+    return st;
+}
+
+Status passes_denoise(const PassContext *pc, uint spp, int uniform, const float *noisy, const float *albedo,
+                      const float *normal, float *out, int quiet, Error *err)
+{
+    uint w = pc->rs->ds.params.width, h = pc->rs->ds.params.height;
+    if (!passes_emission_splits(&pc->rs->ds.params, uniform))
+        return denoiser_run(pc->denoiser, noisy, albedo, normal, w, h, out, err);
+    size_t n = (size_t)w * h * 3u;
+    float *e = malloc(n * sizeof *e), *rest = malloc(n * sizeof *rest);
+    Status st = e && rest ? ST_OK : error_set(err, ST_INTERNAL, "out of memory for the denoiser");
+    if (!st) st = passes__emission(pc, spp, e, quiet, err);
+    /* the same rays: the image's samples each hold at least their emission, and the
+     * film rounds both alike, so nothing is below 0 but what the colour never had
+     * (NaN, which fails the test, becomes 0 as the denoiser would make it) */
+    for (size_t i = 0; i < n && !st; i++) {
+        float d = noisy[i] - e[i];
+        rest[i] = d > 0.0f ? d : 0.0f;
+    }
+    uint more = spp <= UINT32_MAX / PASSES_EMISSION_SPP_FACTOR ? spp * PASSES_EMISSION_SPP_FACTOR : spp;
+    if (!st) st = passes__emission(pc, more, e, quiet, err);
+    if (!st) st = denoiser_run(pc->denoiser, rest, albedo, normal, w, h, out, err);
+    for (size_t i = 0; i < n && !st; i++) out[i] += e[i];
+    free(e);
+    free(rest);
+    return st;
+}
+
 /* Denoises rgb in place with the features in aov[]; *noisy keeps the colour as it was
  * (freed by the caller). */
-static Status passes__denoise(const PassContext *pc, float *rgb, float *const aov[3], float **noisy, int quiet,
-                              Error *err)
+static Status passes__denoise(const PassContext *pc, uint spp, int uniform, float *rgb, float *const aov[3],
+                              float **noisy, int quiet, Error *err)
 {
     uint w = pc->rs->ds.params.width, h = pc->rs->ds.params.height;
     size_t n = (size_t)w * h * 3u;
     if (!(*noisy = malloc(n * sizeof **noisy))) return error_set(err, ST_INTERNAL, "out of memory");
     memcpy(*noisy, rgb, n * sizeof *rgb);
     double t0 = timer_now();
-    Status st = denoiser_run(pc->denoiser, *noisy, aov[INTEGRATOR_AOV_ALBEDO - INTEGRATOR_AOV_NORMAL],
-                             aov[0], w, h, rgb, err);
+    Status st = passes_denoise(pc, spp, uniform, *noisy, aov[INTEGRATOR_AOV_ALBEDO - INTEGRATOR_AOV_NORMAL], aov[0],
+                               rgb, quiet, err);
     if (!st && !quiet)
         fprintf(stderr, "clpt: denoised in %.2f s (Open Image Denoise, %s device, %s)\n", timer_now() - t0,
                 denoiser_device_kind(pc->denoiser), denoiser_library(pc->denoiser));
@@ -320,7 +360,7 @@ static Status passes__final_image(const PassRequest *q, const PassContext *pc, c
         if (!st && !q->quiet) fprintf(stderr, "clpt: %s image in %.2f s\n", passes_aov_name(aov), secs);
     }
     if (!st && q->denoise) st = passes__features(pc, spp, in_exr, q->quiet, err);
-    if (!st && q->denoise) st = passes__denoise(pc, rgb, in_exr, &noisy, q->quiet, err);
+    if (!st && q->denoise) st = passes__denoise(pc, spp, !q->varying_spp, rgb, in_exr, &noisy, q->quiet, err);
     int exr = passes_aov_in_exr(q, output, INTEGRATOR_AOV_NORMAL) || passes_aov_in_exr(q, output, INTEGRATOR_AOV_ALBEDO);
     if (!st && exr) st = passes__write_exr_layers(q, output, rgb, in_exr, noisy, w, h, err);
     else if (!st && q->denoise) st = image_write_styled(output, rgb, w, h, style, err);

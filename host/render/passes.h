@@ -69,6 +69,31 @@ Status passes_aov(const PassContext *pc, uint aov, uint spp, const DepthScale *d
  * distance to the pixel's hits in every channel (+inf where none), the albedo as it is. */
 Status passes_aov_data(const PassContext *pc, unsigned aov, uint spp, float *rgb, double *seconds, Error *err);
 
+/* Samples per pixel of the emission added back after denoising (passes_denoise), per
+ * sample of the image: the emission feature costs one camera ray a sample where a path
+ * costs several, so four times the image's samples cost about one more bounce of its
+ * paths, and halve the noise of how much of an edge pixel a lamp covers. */
+#define PASSES_EMISSION_SPP_FACTOR 4u
+
+/* Whether passes_denoise leaves the directly seen emission out of what it denoises: the
+ * emission feature traces the path tracer's own camera rays, so only a path-traced
+ * image whose pixels all have their `spp` samples (`uniform`: no noise threshold) holds
+ * exactly that emission; a scene with media is left whole (the camera's rays may be
+ * dimmed before they reach a lamp). */
+int passes_emission_splits(const RenderParams *p, int uniform);
+
+/* Denoises `noisy` (the image, `spp` samples per pixel) with the features into out (not
+ * noisy). Where passes_emission_splits: the emission the image's camera rays see
+ * directly (INTEGRATOR_FEATURE_EMISSION, the same rays, so exactly the image's part) is
+ * subtracted before the denoiser, and the same emission rendered with
+ * PASSES_EMISSION_SPP_FACTOR times the samples is added to its output. The emission has
+ * no noise but a pixel's coverage, so there is nothing to denoise in it, and left in,
+ * OIDN spreads a lamp's edge over its neighbours and moves the lamp's own flat value
+ * (docs/denoise.md, "Emitters' edges"). The expectation is the image's: both emission
+ * images estimate the same thing. */
+Status passes_denoise(const PassContext *pc, uint spp, int uniform, const float *noisy, const float *albedo,
+                      const float *normal, float *out, int quiet, Error *err);
+
 /* The file name of an auxiliary image: "out.png" and "normal" give "out-normal.png". */
 char *passes_aov_path(const char *output, const char *name);
 
@@ -86,6 +111,7 @@ typedef struct {
     int exr_float;                /* EXR channels as 32-bit floats */
     int denoise;                  /* --denoise: the written image is the denoised one */
     int quiet;
+    int varying_spp;              /* --noise-threshold: pixels have samples of their own */
 } PassRequest;
 
 /* Where auxiliary image `aov` goes: the name the course command line gave it, else

@@ -349,13 +349,15 @@ static Status job_aov(RenderJob *job, const PassContext *pc, unsigned aov, float
 
 /* The denoiser on rgb, with the features rendered above (as the program's --denoise:
  * passes.c renders them with the same settings, so the same bits). */
-static Status job_denoise(RenderJob *job, float *rgb, const float *albedo, const float *normal, Error *err)
+static Status job_denoise(RenderJob *job, const PassContext *pc, float *rgb, const float *albedo, const float *normal,
+                          Error *err)
 {
     size_t n = (size_t)job->film.width * job->film.height * 3u;
     float *noisy = malloc(n * sizeof *noisy);
     if (!noisy) return error_set(err, ST_INTERNAL, "out of memory");
     memcpy(noisy, rgb, n * sizeof *rgb);
-    Status st = denoiser_run(job->denoiser, noisy, albedo, normal, job->film.width, job->film.height, rgb, err);
+    Status st = passes_denoise(pc, (uint)job->film.samples, !(job->set.adaptive.threshold > 0.0), noisy, albedo,
+                               normal, rgb, 1, err);
     free(noisy);
     return st;
 }
@@ -383,7 +385,7 @@ Status render_job_passes_to_memory(RenderJob *job, float *rgb, const RenderJobAo
             st = error_set(err, ST_INTERNAL, "out of memory");
     for (unsigned a = INTEGRATOR_AOV_NORMAL; a <= INTEGRATOR_AOV_ALBEDO && st == ST_OK && !job_stopped(job); a++)
         if (out[a - INTEGRATOR_AOV_NORMAL]) st = job_aov(job, &pc, a, data, out[a - INTEGRATOR_AOV_NORMAL], err);
-    if (st == ST_OK && !job_stopped(job) && job->set.denoise) st = job_denoise(job, rgb, out[2], out[0], err);
+    if (st == ST_OK && !job_stopped(job) && job->set.denoise) st = job_denoise(job, &pc, rgb, out[2], out[0], err);
     free(data);
     free(feature[0]);
     free(feature[1]);

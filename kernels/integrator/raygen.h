@@ -72,18 +72,31 @@ KFN Ray camera_ray(GLOBAL const RenderParams *p, GLOBAL const MotionKey *motion_
     return ray;
 }
 
+/* The path integrator's camera ray for sample `sample` of pixel `pixel` (its index in the
+ * image, or in the pixel list), with the sample's key and time: one function, so that
+ * the denoiser's emission feature (INTEGRATOR_FEATURE_EMISSION) traces the very rays
+ * the image's paths start with. */
+KFN Ray path_camera_ray(GLOBAL const RenderParams *p, GLOBAL const MotionKey *motion_keys, uint pixel, uint sample,
+                        RngKey *key_out, float *time)
+{
+    uint x, y;
+    RngKey key = rng_key_make(p, params_image_pixel(p, pixel, &x, &y), sample);
+    float jx, jy;
+    rng_uniform2(key, 0u, DIM_PIXEL_X, &jx, &jy);
+    *key_out = key;
+    *time = camera_time(p, key);
+    return camera_ray(p, motion_keys, params_film_s(p, x, jx), params_film_t(p, y, jy), key, *time);
+}
+
 KFN void raygen_path(GLOBAL const RenderParams *p, GLOBAL const MotionKey *motion_keys, uint pixel, uint sample,
                      GLOBAL PathState *ps, GLOBAL Ray *ray)
 {
     /* the noise threshold's halves: sample s of the batch is the pixel's sample
      * step s + offset (host/render/adaptive.c); no step leaves the index as it is */
     if (p->sample_step > 1u) sample = sample * p->sample_step + p->sample_offset;
-    uint x, y;
-    RngKey key = rng_key_make(p, params_image_pixel(p, pixel, &x, &y), sample);
-    float jx, jy;
-    rng_uniform2(key, 0u, DIM_PIXEL_X, &jx, &jy);
-    float time = camera_time(p, key);
-    *ray = camera_ray(p, motion_keys, params_film_s(p, x, jx), params_film_t(p, y, jy), key, time);
+    RngKey key;
+    float time;
+    *ray = path_camera_ray(p, motion_keys, pixel, sample, &key, &time);
 
     ps->throughput = v3s(1.0f);
     ps->radiance = v3s(0.0f);

@@ -400,6 +400,23 @@ KFN vec3 whitted_feature(const SceneView *sc, Ray ray, uint mode, uint *rays)
     }
 }
 
+/* The denoiser's emission feature (INTEGRATOR_FEATURE_EMISSION) along a camera ray of
+ * the path integrator: the emission of the first surface it meets, as shade_emission
+ * counts it there (front faces, or both of a two-sided emitter; a mix's own emission;
+ * full weight, since what the camera sees directly takes no MIS), or the background's
+ * radiance where it escapes, as shade_escape counts it at the first bounce. It has no
+ * noise but the pixel's coverage: the path's first-hit emission for the same samples. */
+KFN vec3 feature_emission(const SceneView *sc, Ray ray, uint *rays)
+{
+    Hit hit = trace_closest_visible(sc, ray);
+    (*rays)++;
+    if (hit.prim == NO_INDEX) return background_radiance(sc, ray.d);
+    Surface s = surface_at(sc, ray, hit);
+    Material m = sc->materials[s.material];
+    if (!(m.flags & MAT_TWO_SIDED) && v3_dot(ray.d, s.ng) >= 0.0f) return v3s(0.0f);
+    return material_emission(sc, m, s);
+}
+
 /* One pixel sample of the whitted integrator or of an auxiliary image; *rays counts
  * what it traced. */
 KFN vec3 whitted_sample(const SceneView *sc, uint pixel, uint sample, uint *rays)
@@ -408,7 +425,9 @@ KFN vec3 whitted_sample(const SceneView *sc, uint pixel, uint sample, uint *rays
     *rays = 0u;
     RngKey key;
     float time;
-    Ray r = whitted_camera_ray(p, sc->motion_keys, pixel, sample, &key, &time);
+    Ray r = p->integrator == INTEGRATOR_FEATURE_EMISSION
+                ? path_camera_ray(p, sc->motion_keys, pixel, sample, &key, &time)
+                : whitted_camera_ray(p, sc->motion_keys, pixel, sample, &key, &time);
 #if KF_HAS(KF_MOTION)
     /* the scene as it is at the sample's time (SceneView.time) */
     SceneView at_time;
@@ -419,6 +438,7 @@ KFN vec3 whitted_sample(const SceneView *sc, uint pixel, uint sample, uint *rays
     }
 #endif
     if (p->integrator == INTEGRATOR_WHITTED) return whitted_radiance(sc, r, key, rays);
+    if (p->integrator == INTEGRATOR_FEATURE_EMISSION) return feature_emission(sc, r, rays);
     if (p->integrator >= INTEGRATOR_FEATURE_NORMAL) return whitted_feature(sc, r, p->integrator, rays);
     return whitted_aov(sc, r, p->integrator, rays);
 }

@@ -309,6 +309,16 @@ Status passes_denoise(const PassContext *pc, uint spp, int uniform, const float 
     float *e = malloc(n * sizeof *e), *rest = malloc(n * sizeof *rest);
     Status st = e && rest ? ST_OK : error_set(err, ST_INTERNAL, "out of memory for the denoiser");
     if (!st) st = passes__emission(pc, spp, e, quiet, err);
+    int lit = 0;
+    for (size_t i = 0; i < n && !st && !lit; i++) lit = e[i] != 0.0f;
+    if (!st && !lit) {
+        /* nothing seen emitted (the dragon's lamp out of view, a black background):
+         * the colour as it is, without the second pass, which would only add its
+         * rare emitter a few samples found (E(spp) = 0 estimates the same) */
+        free(e);
+        free(rest);
+        return denoiser_run(pc->denoiser, noisy, albedo, normal, w, h, out, err);
+    }
     /* the same rays: the image's samples each hold at least their emission, and the
      * film rounds both alike, so nothing is below 0 but what the colour never had
      * (NaN, which fails the test, becomes 0 as the denoiser would make it) */

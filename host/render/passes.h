@@ -86,7 +86,8 @@ int passes_emission_splits(const RenderParams *p, int uniform);
  * noisy). Where passes_emission_splits: the emission the image's camera rays see
  * directly (INTEGRATOR_FEATURE_EMISSION, the same rays, so exactly the image's part) is
  * subtracted before the denoiser, and the same emission rendered with
- * PASSES_EMISSION_SPP_FACTOR times the samples is added to its output. The emission has
+ * PASSES_EMISSION_SPP_FACTOR times the samples is added to its output (where nothing
+ * is seen emitted, the colour is denoised whole, without that pass). The emission has
  * no noise but a pixel's coverage, so there is nothing to denoise in it, and left in,
  * OIDN spreads a lamp's edge over its neighbours and moves the lamp's own flat value
  * (docs/denoise.md, "Emitters' edges"). The expectation is the image's: both emission

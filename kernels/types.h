@@ -237,21 +237,23 @@ typedef struct {                                        /* 256 bytes */
 
 /* A node of the top level over instances, compressed (after Ylitie, Karras and Laine
  * 2017, "Efficient incoherent ray traversal on GPUs through compressed wide BVHs", and
- * Embree's compressed BVH nodes): a child's box planes are 8-bit steps q from the node's
- * low corner, plane = origin[axis] + (float)q * 2^(e - 127) with one step 2^(e - 127)
- * per axis, its biased float exponent e in meta. The product is exact (q < 2^8, the
- * step a power of two), so the plane is one correctly rounded add on every device, an
- * fma included, and the host (host/accel/bvh_top.c) checks each rounded plane against
- * the child's float box: lower planes rounded down, upper planes up, every child box
- * holds its instance. The walk then enters at least the boxes the float nodes gave it
- * and finds the same closest hit by the tie rule (docs/instancing.md). The children
- * are in lanes 0 .. n-1 (n in meta's top byte; other lanes are never entered); ref is
- * a top-level node index, or an instance index with BVH_TOP_INSTANCE set. The
- * prototypes below stay BvhNode: they hold the triangles, where a wider box would cost
- * leaf tests, and the issue's memory is per instance. */
+ * Embree's compressed BVH nodes): a child's box planes are 8-bit steps q, one step
+ * 2^(e - 150) per axis, its e in meta. A plane decodes as
+ *     as_float(e << 23 | q) + offset[axis]
+ * the float of exponent e whose mantissa is q, which is 2^(e - 127) + q * step exactly
+ * (q < 2^8 stays in the mantissa's low bits), plus the axis's offset: an integer or,
+ * no conversion and no multiply, and one correctly rounded add on every device. The
+ * host (host/accel/bvh_top.c) checks each plane against the child's float box with that
+ * very expression: lower planes rounded down, upper planes up, every child box holds
+ * its instance. The walk then enters at least the boxes the float nodes gave it and
+ * finds the same closest hit by the tie rule (docs/instancing.md). The children are in
+ * lanes 0 .. n-1 (n in meta's top byte; other lanes are never entered); ref is a
+ * top-level node index, or an instance index with BVH_TOP_INSTANCE set. The prototypes
+ * below stay BvhNode: they hold the triangles, where a wider box would cost leaf tests,
+ * and the issue's memory is per instance. */
 #define BVH_TOP_INSTANCE 0x80000000u
 typedef struct {                                        /* 96 bytes */
-    float origin[3];        /* the low corner of the children's boxes */
+    float offset[3];        /* per axis: the decoded plane of q = 0 is 2^(e - 127) + offset */
     uint meta;              /* bits 0-7, 8-15, 16-23: e of x, y, z; bits 24-31: n */
     uint q[6][2];           /* rows lo x, hi x, lo y, hi y, lo z, hi z; lane l is byte
                              * l % 4 (the low byte first) of word l / 4 */

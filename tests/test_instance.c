@@ -754,7 +754,7 @@ static void test_top_level_packed(void)
  * from 0 to 1e30, a child much smaller than its siblings, planes one ulp apart), every
  * plane the kernels decode (bvh_top_plane, their very expression) holds its child's:
  * lower planes at or below, upper at or above. And they stay tight: a plane is within
- * two steps of its child's, the step at most twice the node's extent / 255 (the
+ * two steps of its child's, the step at most twice the node's extent / 254 (the
  * exponent's choice), where the 2^-100 floor of the step allows. */
 static void test_top_level_compressed(void)
 {
@@ -794,7 +794,7 @@ static void test_top_level_compressed(void)
             for (uint r = 0; r < 6u; r++) {
                 uint k = r / 2u, e = (c[i].meta >> (8u * k)) & 0xffu;
                 uint q = (c[i].q[r][l / 4u] >> (8u * (l % 4u))) & 0xffu;
-                float v = bvh_top_plane(c[i].origin[k], e, q), want_v = nd->box[r][l];
+                float v = bvh_top_plane(c[i].offset[k], e, q), want_v = nd->box[r][l];
                 held += (r % 2u) ? v >= want_v : v <= want_v;
                 planes++;
                 float node_lo = INFINITY, node_hi = -INFINITY;
@@ -802,8 +802,11 @@ static void test_top_level_compressed(void)
                     node_lo = fminf(node_lo, nd->box[2u * k][m]);
                     node_hi = fmaxf(node_hi, nd->box[2u * k + 1u][m]);
                 }
-                double step = ldexp(1.0, (int)e - 127);
-                int step_ok = step <= fmax(2.0 * ((double)node_hi - (double)node_lo) / 255.0, 0x1p-100) * 1.0000001;
+                double step = ldexp(1.0, (int)e - 150);
+                /* 254: the planes lie on a grid of the step (the offset's float
+                 * holds no finer), so the least lower plane may start up to a step
+                 * below its child's, and 255 steps must span the extent and that */
+                int step_ok = step <= fmax(2.0 * ((double)node_hi - (double)node_lo) / 254.0, 0x1p-100) * 1.0000001;
                 tight += step_ok && fabs((double)v - (double)want_v) <= 2.0 * step;
             }
         }

@@ -65,9 +65,9 @@ typedef struct {
     uint nx, ny, nz;             /* 1 where the direction is negative: near plane is hi */
 } BvhRay;
 
-/* The step of a compressed node's axis k: 2^(e - 127), e its biased exponent in meta
- * (BvhTopNode, types.h). */
-#define BVH_TOP_STEP(meta, k) k_as_float((((meta) >> (8u * (k))) & 0xffu) << 23)
+/* A compressed node's axis k (BvhTopNode, types.h): the bits of 2^(e - 127), e in
+ * meta, which a step count q < 2^8 ors into the mantissa. */
+#define BVH_TOP_BIAS(meta, k) ((((meta) >> (8u * (k))) & 0xffu) << 23)
 
 #ifdef KERNEL_OPENCL
 #define K_SPLAT8(x) ((float8)(x))
@@ -79,12 +79,14 @@ KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first,
 }
 #if KF_HAS(KF_INSTANCES)
 /* A compressed top-level node's row r decoded as bvh_top_plane (host/accel/bvh_top.c)
- * computes the planes it checks: origin + q * step, the product exact, the add rounded
- * once (an fma gives the same). Its eight bytes are one uchar8 load: in memory order,
- * the order of the C decode's shifts on the little-endian devices we run (x86, NVIDIA). */
+ * computes the planes it checks: the bytes or'ed into the bias's mantissa, then one add
+ * of the offset; no conversion and no multiply in the chain from the node's load to its
+ * slab distances (docs/instancing.md). Its eight bytes are one uchar8 load: in memory
+ * order, as the C decode's (little-endian devices: x86, NVIDIA). */
 #define BVH_TOP_ROW8(v, r)                                                               \
-    ((v) = (float8)(nd->origin[(r) >> 1]) +                                              \
-           convert_float8(vload8(0, (GLOBAL const uchar *)nd->q[r])) * (float8)(BVH_TOP_STEP(meta, (r) >> 1)))
+    ((v) = as_float8(convert_uint8(vload8(0, (GLOBAL const uchar *)nd->q[r])) |          \
+                     (uint8)(BVH_TOP_BIAS(meta, (r) >> 1))) +                            \
+           (float8)(nd->offset[(r) >> 1]))
 KFN_INLINE uint bvh_top_lanes(GLOBAL const BvhTopNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
 {
     uint meta = nd->meta;
@@ -102,13 +104,15 @@ KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first,
     return mask;
 }
 #if KF_HAS(KF_INSTANCES)
-/* Lanes first .. first + 3 of a compressed node's row r: bytes 0 .. 3 of one word. */
+/* Lanes first .. first + 3 of a compressed node's row r: bytes 0 .. 3 of one word,
+ * widened as one vector (SSE2's unpacks) rather than shifted out one by one. */
+typedef unsigned char bvh_top_bytes4 __attribute__((vector_size(4)));
 KFN_INLINE float4 bvh_top_row4(GLOBAL const BvhTopNode *nd, uint meta, uint r, uint first)
 {
-    uint q = nd->q[r][first >> 2];
-    float o = nd->origin[r >> 1], step = BVH_TOP_STEP(meta, r >> 1);
-    float4 qf = { (float)(q & 0xffu), (float)((q >> 8) & 0xffu), (float)((q >> 16) & 0xffu), (float)(q >> 24) };
-    return K_SPLAT4(o) + qf * K_SPLAT4(step);
+    bvh_top_bytes4 q;
+    memcpy(&q, &nd->q[r][first >> 2], sizeof q);
+    int4 bits = __builtin_convertvector(q, int4) | (int)BVH_TOP_BIAS(meta, r >> 1);
+    return (float4)bits + K_SPLAT4(nd->offset[r >> 1]);
 }
 #define BVH_TOP_ROW4(v, r) ((v) = bvh_top_row4(nd, meta, r, first))
 KFN_INLINE uint bvh_top_lanes(GLOBAL const BvhTopNode *nd, const BvhRay *w, uint first, float tfar, float *ta)

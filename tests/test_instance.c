@@ -819,6 +819,43 @@ static void test_top_level_compressed(void)
     free(t.nodes);
 }
 
+/* The compressed top level holds finite boxes within 2^110 (bvh_top.h): an instance
+ * whose world box reaches beyond, or overflows floats, is refused when the tree is
+ * built, naming the instance and its object, rather than decoded to infinite planes
+ * (a child never entered) or given a box that does not hold it. */
+static void test_top_level_refuses_far_boxes(void)
+{
+    static const struct {
+        const char *text, *want;
+    } cases[] = {
+        { HEAD "instance thing { }\ninstance thing { scale 1e34 }\n",
+          "instance 1 (of object 'thing'): its world box reaches 1.30002e+34, beyond the 1.29807e+33 (2^110) instanced "
+          "scenes hold" },
+        { HEAD "instance thing { translate 3.4028e38 0 0 }\n",
+          "instance 0 (of object 'thing'): its world box does not fit in floats" },
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        Scene s;
+        RenderScene rs;
+        Error err = { 0 };
+        CHECK_MSG(load_text(cases[c].text, &s, &err) == ST_OK, "%s", err.msg);
+        Status st = render_scene_prepare(&s, 1, &rs, &err);
+        CHECK_MSG(st == ST_INPUT, "case %zu: status %d", c, st);
+        CHECK_MSG(strcmp(err.msg, cases[c].want) == 0, "case %zu:\n    got:      %s\n    expected: %s", c, err.msg,
+                  cases[c].want);
+        if (st == ST_OK) render_scene_free(&rs);
+        scene_free(&s);
+        error_clear(&err);
+    }
+    /* and 2^100 from the origin still renders: its boxes are held */
+    Film f;
+    Error err = { 0 };
+    CHECK_MSG(render(HEAD "instance thing { }\ninstance thing { translate 1e30 0 0 }\n", "scalar", 0, ACCEL_BVH, &f,
+                     &err) == ST_OK, "%s", err.msg);
+    film_free(&f);
+    error_clear(&err);
+}
+
 /* Surfaces through instances are in the world: a hit point lies on the ray, and a ray
  * leaving it by its error bound does not find the same surface again. */
 static void test_spawn_leaves_surface(void)
@@ -871,6 +908,7 @@ int main(void)
     RUN(test_nested_hits_against_brute_force);
     RUN(test_top_level_packed);
     RUN(test_top_level_compressed);
+    RUN(test_top_level_refuses_far_boxes);
     RUN(test_spawn_leaves_surface);
     RUN(test_nested_equals_flat);
     RUN(test_nested_furnace);

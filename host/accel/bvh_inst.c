@@ -105,8 +105,22 @@ static Status build_top(const KdInput *in, const BvhProto *protos, size_t n_prot
         const MotionKey *keys = motion && motion->inst_motion && motion->inst_motion[i] != NO_INDEX
                                     ? motion->keys + motion->inst_motion[i]
                                     : NULL;
-        instance_box(&inst[i], keys, pb[object[i]], pb[object[i]] + 3, boxes + 6 * i);
-        lv->n_inst_skipped += !(boxes[6 * i] <= boxes[6 * i + 3]);
+        float *b = boxes + 6 * i;
+        instance_box(&inst[i], keys, pb[object[i]], pb[object[i]] + 3, b);
+        int empty = !(b[0] <= b[3]);
+        lv->n_inst_skipped += empty;
+        if (!empty && !bvh_top_box_fits(b, b + 3)) {
+            /* the compressed nodes hold finite boxes within 2^110 (bvh_top.h): none is
+             * left "always entered", none decodes to an infinity */
+            float far = 0.0f;
+            for (int k = 0; k < 6; k++) far = isnan(b[k]) ? INFINITY : fmaxf(far, fabsf(b[k]));
+            lv->inst_beyond = (uint)i;
+            lv->inst_beyond_at = far;
+            free(pb);
+            free(boxes);
+            return error_set(err, ST_INPUT, "BVH: instance %zu's world box reaches %g, beyond the top level's %g",
+                             i, (double)far, (double)BVH_TOP_COORD_MAX);
+        }
     }
     BvhOptions opt = { BVH_TOP_STACK, boxes, (uint)n_inst };
     Status st = bvh_build_with(in, &opt, threads, top, err);
@@ -121,6 +135,7 @@ Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_p
     double t0 = timer_now();
     memset(out, 0, sizeof *out);
     memset(lv, 0, sizeof *lv);
+    lv->inst_beyond = NO_INDEX;
     Bvh top;
     Status st = build_top(in, protos, n_protos, inst, object, n_inst, motion, threads, &top, lv, err);
     if (st) return st;

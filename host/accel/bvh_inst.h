@@ -30,6 +30,9 @@ typedef struct {
     uint proto_leaf_words;         /* leaf data of the prototypes (32-bit words) */
     uint max_proto_stack;          /* the deepest prototype walk's stack */
     uint n_inst_skipped;           /* instances of an empty prototype, left out */
+    uint inst_beyond;              /* when the build refused one: an instance whose world box
+                                    * bvh_top_box_fits refuses (NO_INDEX: none) */
+    float inst_beyond_at;          /* and the farthest coordinate of that box */
 } BvhLevels;
 
 /* Where moving instances' keys are (docs/motion.md): instance i moves when
@@ -43,6 +46,9 @@ typedef struct {
 /* Builds the prototypes protos[0 .. n_protos) and the top level over inst[0 .. n_inst)
  * (object[i]: instance i's prototype), filling each instance's root. A moving
  * instance's box bounds it over all its keys' times (motion_bounds, scene/motion.h).
+ * An instance whose world box is not finite or reaches beyond BVH_TOP_COORD_MAX
+ * (bvh_top.h) is refused: ST_INPUT, its index in lv->inst_beyond for the caller's
+ * message.
  * On success *out owns one node array and one leaf array (bvh_free); out->lo, hi bound
  * the world. Threads: 0 = all cores. */
 Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_protos, Instance *inst,

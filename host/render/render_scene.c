@@ -6,6 +6,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "accel/bvh_top.h"
 #include "scene/camera.h"
 #include "scene/cube_env.h"
 #include "scene/media.h"
@@ -125,6 +126,18 @@ static Status tree_build_instanced(const Scene *s, const KdInput *in, int thread
     BvhMotion motion = { out->instance_motion, s->motion_keys };
     st = bvh_build_instanced(in, protos, n_protos, out->instances, objects, out->n_instances, &motion, threads,
                              &out->bvh, &out->levels, err);
+    if (st == ST_INPUT && out->levels.inst_beyond < s->n_instances) {
+        /* named as the file wrote it (the world's own shapes, within 2^62 since they
+         * were read, never reach this far: bvh_inst.c's message stays for them) */
+        uint i = out->levels.inst_beyond;
+        const char *name = s->objects[objects[i]].name;
+        if (isinf(out->levels.inst_beyond_at))
+            st = error_set(err, ST_INPUT, "instance %u (of object '%s'): its world box does not fit in floats", i, name);
+        else
+            st = error_set(err, ST_INPUT, "instance %u (of object '%s'): its world box reaches %g, beyond the %g (2^110) "
+                           "instanced scenes hold", i, name, (double)out->levels.inst_beyond_at,
+                           (double)BVH_TOP_COORD_MAX);
+    }
     if (st) goto done;
     out->instanced = 1;
     render_scene_use_bvh(&out->ds, &out->bvh);

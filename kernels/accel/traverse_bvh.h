@@ -104,14 +104,11 @@ KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first,
     return mask;
 }
 #if KF_HAS(KF_INSTANCES)
-/* Lanes first .. first + 3 of a compressed node's row r: bytes 0 .. 3 of one word,
- * widened as one vector (SSE2's unpacks) rather than shifted out one by one. */
-typedef unsigned char bvh_top_bytes4 __attribute__((vector_size(4)));
+/* Lanes first .. first + 3 of a compressed node's row r: bytes 0 .. 3 of one word
+ * (k_bytes4: the low byte first, as OpenCL's load reads them on little-endian devices). */
 KFN_INLINE float4 bvh_top_row4(GLOBAL const BvhTopNode *nd, uint meta, uint r, uint first)
 {
-    bvh_top_bytes4 q;
-    memcpy(&q, &nd->q[r][first >> 2], sizeof q);
-    int4 bits = __builtin_convertvector(q, int4) | (int)BVH_TOP_BIAS(meta, r >> 1);
+    int4 bits = k_bytes4(nd->q[r][first >> 2]) | (int)BVH_TOP_BIAS(meta, r >> 1);
     return (float4)bits + K_SPLAT4(nd->offset[r >> 1]);
 }
 #define BVH_TOP_ROW4(v, r) ((v) = bvh_top_row4(nd, meta, r, first))
@@ -146,7 +143,9 @@ KFN_INLINE uint bvh_top_test(GLOBAL const BvhTopNode *nd, const BvhRay *w, float
 #ifdef KERNEL_OPENCL
     uint mask = bvh_top_lanes(nd, w, 0u, tfar, ta);
 #else
-    uint mask = bvh_top_lanes(nd, w, 0u, tfar, ta) | (bvh_top_lanes(nd, w, 4u, tfar, ta) << 4);
+    /* lanes 4 .. 7 only when they hold children (ta is read for entered lanes alone) */
+    uint mask = bvh_top_lanes(nd, w, 0u, tfar, ta);
+    if (n > 4u) mask |= bvh_top_lanes(nd, w, 4u, tfar, ta) << 4;
 #endif
     return mask & ((1u << n) - 1u);
 }

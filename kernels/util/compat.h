@@ -114,6 +114,23 @@ typedef float float4 __attribute__((vector_size(16)));
 typedef int int4 __attribute__((vector_size(16)));
 #define k_load4(v, p) memcpy(&(v), (p), sizeof(float4))
 #define k_store4(v, p) memcpy((p), &(v), sizeof(float4))
+/* The four bytes of w, the low one first, as the lanes of an int4 (the compressed
+ * top level's step counts, traverse_bvh.h): on x86 two unpacks with zero (SSE2, in
+ * every x86-64), where gcc makes eleven scalar instructions of the lane-by-lane form
+ * and of __builtin_convertvector. */
+#if defined(__SSE2__)
+#include <emmintrin.h>
+static inline int4 k_bytes4(uint w)
+{
+    __m128i zero = _mm_setzero_si128();
+    return (int4)_mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128((int)w), zero), zero);
+}
+#else
+static inline int4 k_bytes4(uint w)
+{
+    return (int4){ (int)(w & 0xffu), (int)((w >> 8) & 0xffu), (int)((w >> 16) & 0xffu), (int)(w >> 24) };
+}
+#endif
 /* 8 lanes for the packet walk (traverse.h), whose C build is its reference, not a
  * fast path */
 typedef float float8 __attribute__((vector_size(32)));

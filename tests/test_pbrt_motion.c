@@ -2,7 +2,8 @@
  * test_pbrt_motion.c — pbrt-v4's motion in clpt's reader (docs/pbrt.md#motion): the
  * two current transforms ActiveTransform picks between and TransformTimes dates; a
  * moving ObjectInstance, a moving Shape (made an object of its own) and a moving
- * camera against the average of still renders at fixed times; a still scene with a
+ * camera against the average of still renders at fixed times; a turning instance at
+ * one time at its own pose, not pbrt-v4's camera-pivoted one; a still scene with a
  * shutter and idle motion directives unchanged bit for bit; a scene like pbrt-v4's
  * killeroo-moving.pbrt (a spinning, sliding shape) read and rendered.
  * Bad input: tests/data/bad/pbrt-motion-* (test_bad_input.c). Run from the project root.
@@ -167,6 +168,61 @@ static void test_moving_camera_is_average_of_still(void)
     check_average("moving camera", text, camera_still, 0.03);
 }
 
+/* A turn seen at one time: a shutter open and closed at 0.8 shows the instance at
+ * the pose of its own transform's decomposition, Rotate 96 about the instance's origin
+ * (Shoemake's slerp, as pbrt-v4's AnimatedTransform), wherever the camera is. pbrt-v4
+ * itself shows another pose there (docs/pbrt.md#motion): it decomposes the instance's
+ * transform conjugated by its render space, a translation by the camera position c,
+ * so its turn pivots on the camera: translation t + (1 - u) c + u R(120) c - R(120 u) c.
+ * The render must be the first still one and far from the second. */
+static void turn_at_fixed_time(char *text, size_t size, const char *camera, const char *instance)
+{
+    snprintf(text, size, HEAD THING "AttributeBegin\n%s\n  ObjectInstance \"thing\"\nAttributeEnd\n", LOOK, camera,
+             (unsigned)SPP_STILL, instance);
+}
+
+static void test_turn_at_fixed_time_pivots_on_instance(void)
+{
+    const double u = 0.8, deg = 3.14159265358979323846 / 180.0, cam[3] = { 0.0, 1.4, -6.0 };
+    char moving[8192], ours[8192], camera_pivot[8192], key[256];
+    turn_at_fixed_time(moving, sizeof moving, "\"float shutteropen\" 0.8 \"float shutterclose\" 0.8",
+                       "  ActiveTransform StartTime\n  Translate 0 1 0.5\n"
+                       "  ActiveTransform EndTime\n  Translate 0 1 0.5\n  Rotate 120 0 1 0\n  ActiveTransform All");
+    turn_at_fixed_time(ours, sizeof ours, "", "  Translate 0 1 0.5 Rotate 96 0 1 0");
+    /* R(a) c about y: (c.x cos a + c.z sin a, c.y, -c.x sin a + c.z cos a). */
+    double a1 = 120.0 * deg, au = 120.0 * u * deg;
+    double shift_x = (1 - u) * cam[0] + u * (cam[0] * cos(a1) + cam[2] * sin(a1)) - (cam[0] * cos(au) + cam[2] * sin(au));
+    double shift_z = (1 - u) * cam[2] + u * (-cam[0] * sin(a1) + cam[2] * cos(a1)) -
+                     (-cam[0] * sin(au) + cam[2] * cos(au));
+    snprintf(key, sizeof key, "  Translate %.9g 1 %.9g Rotate 96 0 1 0", shift_x, 0.5 + shift_z);
+    turn_at_fixed_time(camera_pivot, sizeof camera_pivot, "", key);
+    Film fm, fo, fp;
+    Error err = { 0 };
+    CHECK_MSG(render_text(moving, &fm, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_text(ours, &fo, &err) == ST_OK, "%s", err.msg);
+    CHECK_MSG(render_text(camera_pivot, &fp, &err) == ST_OK, "%s", err.msg);
+    size_t n = (size_t)W * H * 3u;
+    float *m = malloc(n * sizeof *m), *o = malloc(n * sizeof *o), *pv = malloc(n * sizeof *pv);
+    CHECK(m && o && pv);
+    if (m && o && pv) {
+        film_resolve(&fm, m);
+        film_resolve(&fo, o);
+        film_resolve(&fp, pv);
+        double to_ours = render_util_block_diff(m, o, o, W, H, 8, 6);
+        double to_pivot = render_util_block_diff(m, pv, o, W, H, 8, 6);
+        printf("  turn at u = 0.8: %.4f from the instance-pivot still, %.4f from the camera-pivot one\n", to_ours,
+               to_pivot);
+        CHECK(to_ours < 0.01);
+        CHECK(to_pivot > 0.1);
+    }
+    free(m);
+    free(o);
+    free(pv);
+    film_free(&fm);
+    film_free(&fo);
+    film_free(&fp);
+}
+
 /* A still scene keeps its bits with a shutter, TransformTimes and ActiveTransform
  * that move nothing (both transforms changed alike). */
 static void test_still_with_shutter_same_bits(void)
@@ -258,6 +314,7 @@ int main(void)
     RUN(test_moving_instance_is_average_of_still);
     RUN(test_moving_shape_is_average_of_still);
     RUN(test_moving_camera_is_average_of_still);
+    RUN(test_turn_at_fixed_time_pivots_on_instance);
     RUN(test_still_with_shutter_same_bits);
     RUN(test_killeroo_moving_like);
     RUN(test_shutter_swapped);

@@ -232,6 +232,31 @@ KFN int grid_walk_next(const GridMedium *g, GridWalk *w, float *lo, float *hi, u
     return 1;
 }
 
+/* What every flight through a grid medium starts with (grid_track and both
+ * transmittance estimators): the medium's grid, sigma_t and its largest channel (the
+ * majorant's scale), the world ray x + t d in the grid's unit space, and the walk over
+ * t in [0, dist) along it. */
+typedef struct {
+    GridMedium g;
+    vec3 sig_t;
+    float sig_max;
+    vec3 o, du;                  /* origin and direction in unit space */
+    GridWalk w;
+} GridFlight;
+
+/* Sets *fl up; 0 when there is nothing to walk (a medium that neither absorbs nor
+ * scatters, or a ray that misses the grid's box before dist). Inlined as the three
+ * set-ups it replaces were, so that the flight's fields stay in registers. */
+KFN_INLINE int grid_flight_begin(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, GridFlight *fl)
+{
+    fl->g = sc->grids[md.grid];
+    fl->sig_t = v3_add(md.sigma_a, md.sigma_s);
+    fl->sig_max = v3_max_comp(fl->sig_t);
+    fl->o = grid_to_unit(&fl->g, x);
+    fl->du = grid_dir_to_unit(&fl->g, d);
+    return fl->sig_max > 0.0f && grid_walk_begin(&fl->g, fl->o, fl->du, 0.0f, dist, &fl->w);
+}
+
 /* Delta (spectral) tracking of the world ray x + t d (d unit length) for t in
  * [0, dist) through grid medium md: GRID_STOPPED with the real collision's distance in
  * *t_stop, GRID_PASSED when it flies past dist, GRID_ENDED when the weight vanished or
@@ -242,17 +267,13 @@ KFN int grid_walk_next(const GridMedium *g, GridWalk *w, float *lo, float *hi, u
 KFN int grid_track(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, vec3 *thr, float u_first,
                    uint *rng, float *t_stop, vec3 *emitted)
 {
-    GridMedium g = sc->grids[md.grid];
-    vec3 sig_t = v3_add(md.sigma_a, md.sigma_s);
-    float sig_max = v3_max_comp(sig_t);
-    vec3 o = grid_to_unit(&g, x), du = grid_dir_to_unit(&g, d);
-    GridWalk w;
-    if (!(sig_max > 0.0f) || !grid_walk_begin(&g, o, du, 0.0f, dist, &w)) return GRID_PASSED;
+    GridFlight fl;
+    if (!grid_flight_begin(sc, md, x, d, dist, &fl)) return GRID_PASSED;
     float lo, hi;
     uint cell, steps = 0u;
     int first = 1;
-    while (grid_walk_next(&g, &w, &lo, &hi, &cell)) {
-        float bar = sc->grid_data[g.majorant_at + cell] * sig_max;
+    while (grid_walk_next(&fl.g, &fl.w, &lo, &hi, &cell)) {
+        float bar = sc->grid_data[fl.g.majorant_at + cell] * fl.sig_max;
         if (!(bar > 0.0f)) continue;
         float t = lo;
         for (;;) {
@@ -261,11 +282,11 @@ KFN int grid_track(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, v
             first = 0;
             t = t + grid_exp_step(bar, u);
             if (!(t < hi)) break;   /* memoryless: the next cell starts afresh at hi */
-            vec3 p = v3_madd(o, du, t);
-            float dens = grid_density(sc, &g, p);
+            vec3 p = v3_madd(fl.o, fl.du, t);
+            float dens = grid_density(sc, &fl.g, p);
             if (md.flags & MEDIUM_EMISSIVE)
-                *emitted = v3_add(*emitted, grid_emitted(sc, &g, md, p, dens, *thr, bar));
-            vec3 mu_t = v3_scale(sig_t, dens);
+                *emitted = v3_add(*emitted, grid_emitted(sc, &fl.g, md, p, dens, *thr, bar));
+            vec3 mu_t = v3_scale(fl.sig_t, dens);
             vec3 q = medium_channel_pdf(*thr);
             float real = v3_dot(q, mu_t);
             if (grid_rng_next(rng) * bar < real) {
@@ -305,17 +326,13 @@ KFN int grid_tr_roulette(vec3 *tr, uint *rng)
 KFN vec3 grid_transmittance_ratio(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, uint *rng,
                                   vec3 *emitted)
 {
-    GridMedium g = sc->grids[md.grid];
-    vec3 sig_t = v3_add(md.sigma_a, md.sigma_s);
-    float sig_max = v3_max_comp(sig_t);
-    vec3 o = grid_to_unit(&g, x), du = grid_dir_to_unit(&g, d);
+    GridFlight fl;
     vec3 tr = v3s(1.0f);
-    GridWalk w;
-    if (!(sig_max > 0.0f) || !grid_walk_begin(&g, o, du, 0.0f, dist, &w)) return tr;
+    if (!grid_flight_begin(sc, md, x, d, dist, &fl)) return tr;
     float lo, hi;
     uint cell, steps = 0u;
-    while (grid_walk_next(&g, &w, &lo, &hi, &cell)) {
-        float bar = sc->grid_data[g.majorant_at + cell] * sig_max;
+    while (grid_walk_next(&fl.g, &fl.w, &lo, &hi, &cell)) {
+        float bar = sc->grid_data[fl.g.majorant_at + cell] * fl.sig_max;
         if (!(bar > 0.0f)) continue;
         float inv = 1.0f / bar;
         float t = lo;
@@ -323,10 +340,10 @@ KFN vec3 grid_transmittance_ratio(const SceneView *sc, Medium md, vec3 x, vec3 d
             if (++steps > GRID_MAX_STEPS) return v3s(0.0f);
             t = t + grid_exp_step(bar, grid_rng_next(rng));
             if (!(t < hi)) break;
-            vec3 p = v3_madd(o, du, t);
-            float dens = grid_density(sc, &g, p);
-            *emitted = v3_add(*emitted, grid_emitted(sc, &g, md, p, dens, tr, bar));
-            vec3 mu_t = v3_scale(sig_t, dens);
+            vec3 p = v3_madd(fl.o, fl.du, t);
+            float dens = grid_density(sc, &fl.g, p);
+            *emitted = v3_add(*emitted, grid_emitted(sc, &fl.g, md, p, dens, tr, bar));
+            vec3 mu_t = v3_scale(fl.sig_t, dens);
             tr = v3_mul(tr, v3(k_fmax(1.0f - mu_t.x * inv, 0.0f), k_fmax(1.0f - mu_t.y * inv, 0.0f),
                                k_fmax(1.0f - mu_t.z * inv, 0.0f)));
             if (!grid_tr_roulette(&tr, rng)) return v3s(0.0f);
@@ -351,25 +368,21 @@ KFN vec3 grid_transmittance_ratio(const SceneView *sc, Medium md, vec3 x, vec3 d
  * cell's face, where a factor a hair above 1 keeps the estimate unbiased still. */
 KFN vec3 grid_transmittance_residual(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, uint *rng)
 {
-    GridMedium g = sc->grids[md.grid];
-    vec3 sig_t = v3_add(md.sigma_a, md.sigma_s);
-    float sig_max = v3_max_comp(sig_t);
-    vec3 o = grid_to_unit(&g, x), du = grid_dir_to_unit(&g, d);
+    GridFlight fl;
     vec3 tr = v3s(1.0f);
-    GridWalk w;
-    if (!(sig_max > 0.0f) || !grid_walk_begin(&g, o, du, 0.0f, dist, &w)) return tr;
+    if (!grid_flight_begin(sc, md, x, d, dist, &fl)) return tr;
     float lo, hi;
     uint cell, steps = 0u;
-    while (grid_walk_next(&g, &w, &lo, &hi, &cell)) {
-        float d_max = sc->grid_data[g.majorant_at + cell];
+    while (grid_walk_next(&fl.g, &fl.w, &lo, &hi, &cell)) {
+        float d_max = sc->grid_data[fl.g.majorant_at + cell];
         if (!(d_max > 0.0f)) continue;
-        float d_min = sc->grid_data[g.minorant_at + cell];
+        float d_min = sc->grid_data[fl.g.minorant_at + cell];
         if (d_min > 0.0f) {
             /* the control's transmittance over the stretch, exactly */
-            tr = v3_mul(tr, medium_tr(v3_scale(sig_t, d_min), hi - lo));
+            tr = v3_mul(tr, medium_tr(v3_scale(fl.sig_t, d_min), hi - lo));
             if (!grid_tr_roulette(&tr, rng)) return v3s(0.0f);
         }
-        float bar = (d_max - d_min) * sig_max;
+        float bar = (d_max - d_min) * fl.sig_max;
         if (!(bar > 0.0f)) continue;
         float inv = 1.0f / bar;
         float t = lo;
@@ -377,8 +390,8 @@ KFN vec3 grid_transmittance_residual(const SceneView *sc, Medium md, vec3 x, vec
             if (++steps > GRID_MAX_STEPS) return v3s(0.0f);
             t = t + grid_exp_step(bar, grid_rng_next(rng));
             if (!(t < hi)) break;
-            float res = grid_density(sc, &g, v3_madd(o, du, t)) - d_min;
-            vec3 mu_r = v3_scale(sig_t, res);
+            float res = grid_density(sc, &fl.g, v3_madd(fl.o, fl.du, t)) - d_min;
+            vec3 mu_r = v3_scale(fl.sig_t, res);
             tr = v3_mul(tr, v3(k_fmax(1.0f - mu_r.x * inv, 0.0f), k_fmax(1.0f - mu_r.y * inv, 0.0f),
                                k_fmax(1.0f - mu_r.z * inv, 0.0f)));
             if (!grid_tr_roulette(&tr, rng)) return v3s(0.0f);

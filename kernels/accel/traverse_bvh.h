@@ -71,38 +71,26 @@ typedef struct {
 
 #ifdef KERNEL_OPENCL
 #define K_SPLAT8(x) ((float8)(x))
-#define BVH_ROW8(v, r) k_load8(v, nd->box[r] + first)
-KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
-{
-    BVH_LANES_BODY(BVH_ROW8, float8, int8, 8, k_store8, K_SPLAT8, k_select8, k_bits8)
-    return mask;
-}
+/* BVH_LANES_BODY on this target's vectors: one float8 */
+#define BVH_LANES(ROW) BVH_LANES_BODY(ROW, float8, int8, 8, k_store8, K_SPLAT8, k_select8, k_bits8)
+#define BVH_ROW(v, r) k_load8(v, nd->box[r] + first)
 #if KF_HAS(KF_INSTANCES)
 /* A compressed top-level node's row r decoded as bvh_top_plane (host/accel/bvh_top.c)
  * computes the planes it checks: the bytes or'ed into the bias's mantissa, then one add
  * of the offset; no conversion and no multiply in the chain from the node's load to its
  * slab distances (docs/instancing.md). Its eight bytes are one uchar8 load: in memory
  * order, as the C decode's (little-endian devices: x86, NVIDIA). */
-#define BVH_TOP_ROW8(v, r)                                                               \
+#define BVH_TOP_ROW(v, r)                                                                \
     ((v) = as_float8(convert_uint8(vload8(0, (GLOBAL const uchar *)nd->q[r])) |          \
                      (uint8)(BVH_TOP_BIAS(meta, (r) >> 1))) +                            \
            (float8)(nd->offset[(r) >> 1]))
-KFN_INLINE uint bvh_top_lanes(GLOBAL const BvhTopNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
-{
-    uint meta = nd->meta;
-    BVH_LANES_BODY(BVH_TOP_ROW8, float8, int8, 8, k_store8, K_SPLAT8, k_select8, k_bits8)
-    return mask;
-}
 #endif
 #else
 #define K_SPLAT4(x) ((float4){ (x), (x), (x), (x) })
 #define k_select4(a, b, m) ((float4)(((int4)(a) & ~(m)) | ((int4)(b) & (m))))
-#define BVH_ROW4(v, r) k_load4(v, nd->box[r] + first)
-KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
-{
-    BVH_LANES_BODY(BVH_ROW4, float4, int4, 4, k_store4, K_SPLAT4, k_select4, k_bits4)
-    return mask;
-}
+/* BVH_LANES_BODY on this target's vectors: a float4 half (lanes first .. first + 3) */
+#define BVH_LANES(ROW) BVH_LANES_BODY(ROW, float4, int4, 4, k_store4, K_SPLAT4, k_select4, k_bits4)
+#define BVH_ROW(v, r) k_load4(v, nd->box[r] + first)
 #if KF_HAS(KF_INSTANCES)
 /* Lanes first .. first + 3 of a compressed node's row r: bytes 0 .. 3 of one word
  * (k_bytes4: the low byte first, as OpenCL's load reads them on little-endian devices). */
@@ -111,14 +99,24 @@ KFN_INLINE float4 bvh_top_row4(GLOBAL const BvhTopNode *nd, uint meta, uint r, u
     int4 bits = k_bytes4(nd->q[r][first >> 2]) | (int)BVH_TOP_BIAS(meta, r >> 1);
     return (float4)bits + K_SPLAT4(nd->offset[r >> 1]);
 }
-#define BVH_TOP_ROW4(v, r) ((v) = bvh_top_row4(nd, meta, r, first))
+#define BVH_TOP_ROW(v, r) ((v) = bvh_top_row4(nd, meta, r, first))
+#endif
+#endif
+
+/* The slab test of float node nd's lanes from `first` (all 8 in OpenCL, a half in C). */
+KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
+{
+    BVH_LANES(BVH_ROW)
+    return mask;
+}
+#if KF_HAS(KF_INSTANCES)
+/* The same for a compressed top-level node, its rows decoded by BVH_TOP_ROW. */
 KFN_INLINE uint bvh_top_lanes(GLOBAL const BvhTopNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
 {
     uint meta = nd->meta;
-    BVH_LANES_BODY(BVH_TOP_ROW4, float4, int4, 4, k_store4, K_SPLAT4, k_select4, k_bits4)
+    BVH_LANES(BVH_TOP_ROW)
     return mask;
 }
-#endif
 #endif
 
 /* Lanes of node nd whose box the ray enters before tmax (bits), their entry distances

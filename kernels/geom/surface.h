@@ -265,16 +265,44 @@ KFN Surface surface_local(const SceneView *sc, Ray ray, Hit hit)
  * translation), po's bound err_o carried by |M|, and the rounding of M^-1 applied to a
  * new ray's origin, since the walk decides which side of a primitive that origin is on
  * in object space (4 roundings of |M^-1| |p| and its translation), as large in the
- * world as |M| makes it. */
-KFN vec3 instance_point_error(GLOBAL const Instance *x, vec3 po, vec3 err_o, vec3 p)
+ * world as |M| makes it. M and M^-1 are m and mi, in private memory: a moving
+ * instance's at the path's time, or a static one's copied (instance_point_error). */
+KFN vec3 instance_point_error_by(const float *m, const float *mi, vec3 po, vec3 err_o, vec3 p)
 {
-    GLOBAL const float *m = x->to_world, *mi = x->to_object;
     vec3 trans = v3(k_fabs(m[3]), k_fabs(m[7]), k_fabs(m[11]));
     vec3 trans_i = v3(k_fabs(mi[3]), k_fabs(mi[7]), k_fabs(mi[11]));
-    vec3 fwd = v3_scale(v3_add(xform_abs_vector(m, v3_abs(po)), trans), K_ROUND_ERR(3));
-    vec3 carried = v3_scale(xform_abs_vector(m, err_o), 1.0f + K_ROUND_ERR(3));
-    vec3 back = v3_scale(v3_add(xform_abs_vector(mi, v3_abs(p)), trans_i), K_ROUND_ERR(4));
-    return v3_add(v3_add(fwd, carried), xform_abs_vector(m, back));
+    vec3 fwd = v3_scale(v3_add(motion_abs_vector(m, v3_abs(po)), trans), K_ROUND_ERR(3));
+    vec3 carried = v3_scale(motion_abs_vector(m, err_o), 1.0f + K_ROUND_ERR(3));
+    vec3 back = v3_scale(v3_add(motion_abs_vector(mi, v3_abs(p)), trans_i), K_ROUND_ERR(4));
+    return v3_add(v3_add(fwd, carried), motion_abs_vector(m, back));
+}
+
+/* instance_point_error_by for a static instance x: its M and M^-1 copied out of global
+ * memory, since an OpenCL C 1.2 function takes one address space per pointer (moving
+ * instances' M and M^-1 are computed into private memory). */
+KFN vec3 instance_point_error(GLOBAL const Instance *x, vec3 po, vec3 err_o, vec3 p)
+{
+    float m[12], mi[12];
+    for (int k = 0; k < 12; k++) {
+        m[k] = x->to_world[k];
+        mi[k] = x->to_object[k];
+    }
+    return instance_point_error_by(m, mi, po, err_o, p);
+}
+
+/* surface_instanced's carrying to the world for a moving instance: by its M and M^-1
+ * at the path's time (geom/instance.h). */
+KFN Surface surface_moving_to_world(const SceneView *sc, uint inst, Surface s)
+{
+    float m[12], mi[12];
+    instance_moving_at(sc, inst, m, mi);
+    s.p = motion_point(m, s.po);
+    s.err = instance_point_error_by(m, mi, s.po, s.err, s.p);
+    vec3 ng = instance_normal_moving(mi, s.ngo);
+    vec3 ns = instance_normal_moving(mi, s.ns);
+    s.ng = ng;
+    s.ns = v3_dot(ns, ng) < 0.0f ? v3_neg(ns) : ns;
+    return s;
 }
 
 /* The surface of a hit through instance hit.inst: found in its object space with the
@@ -286,32 +314,6 @@ KFN vec3 instance_point_error(GLOBAL const Instance *x, vec3 po, vec3 err_o, vec
  * holds its index among its object's emitters as its `light`: the instance's lights
  * start at instance_lights[inst] (types.h, LIGHT_INSTANCED), so that MIS weighs the
  * emission that BSDF sampling finds with the density light sampling had for it. */
-/* instance_point_error for a moving instance's M and M^-1 at the path's time (private). */
-KFN vec3 instance_point_error_moving(const float *m, const float *mi, vec3 po, vec3 err_o, vec3 p)
-{
-    vec3 trans = v3(k_fabs(m[3]), k_fabs(m[7]), k_fabs(m[11]));
-    vec3 trans_i = v3(k_fabs(mi[3]), k_fabs(mi[7]), k_fabs(mi[11]));
-    vec3 fwd = v3_scale(v3_add(motion_abs_vector(m, v3_abs(po)), trans), K_ROUND_ERR(3));
-    vec3 carried = v3_scale(motion_abs_vector(m, err_o), 1.0f + K_ROUND_ERR(3));
-    vec3 back = v3_scale(v3_add(motion_abs_vector(mi, v3_abs(p)), trans_i), K_ROUND_ERR(4));
-    return v3_add(v3_add(fwd, carried), motion_abs_vector(m, back));
-}
-
-/* surface_instanced's carrying to the world for a moving instance: by its M and M^-1
- * at the path's time (geom/instance.h). */
-KFN Surface surface_moving_to_world(const SceneView *sc, uint inst, Surface s)
-{
-    float m[12], mi[12];
-    instance_moving_at(sc, inst, m, mi);
-    s.p = motion_point(m, s.po);
-    s.err = instance_point_error_moving(m, mi, s.po, s.err, s.p);
-    vec3 ng = instance_normal_moving(mi, s.ngo);
-    vec3 ns = instance_normal_moving(mi, s.ns);
-    s.ng = ng;
-    s.ns = v3_dot(ns, ng) < 0.0f ? v3_neg(ns) : ns;
-    return s;
-}
-
 KFN Surface surface_instanced(const SceneView *sc, Ray ray, Hit hit)
 {
     GLOBAL const Instance *x = sc->instances + hit.inst;

@@ -8,40 +8,6 @@
 #include "accel/traverse.h"
 #include "kernel_args.h"
 
-/* Closest hits of rays[2i] and rays[2i+1], walked in turns (trace_closest2). */
-__kernel void k_trace_closest(SCENE_ARGS __global const Ray *rays, uint n, __global Hit *hits)
-{
-    uint a = 2u * (uint)get_global_id(0), b = a + 1u;
-    if (a >= n) return;
-    SCENE_VIEW(sc);
-    if (b < n) {
-        Hit ha, hb;
-        trace_closest2(&sc, rays[a], rays[b], &ha, &hb);
-        hits[a] = ha;
-        hits[b] = hb;
-    } else {
-        hits[a] = trace_closest_in(&sc, TREE_KD, rays[a]);
-    }
-}
-
-/* Whether rays[2i] and rays[2i+1] hit anything, into occluded[] (1 or 0). The pair
- * walk of k_trace_closest for shadow rays: alike by design, as each is what the bench
- * times for its own walk (trace_any2, not trace_closest2) and result type. */
-__kernel void k_trace_any(SCENE_ARGS __global const Ray *rays, uint n, __global uint *occluded)
-{
-    uint a = 2u * (uint)get_global_id(0), b = a + 1u;
-    if (a >= n) return;
-    SCENE_VIEW(sc);
-    if (b < n) {
-        int oa, ob;
-        trace_any2(&sc, rays[a], rays[b], &oa, &ob);
-        occluded[a] = (uint)oa;
-        occluded[b] = (uint)ob;
-    } else {
-        occluded[a] = (uint)trace_any_in(&sc, TREE_KD, rays[a]);
-    }
-}
-
 /* The closest hit of rays[i] (any == 0) or whether it hits anything (any == 1), through
  * the given tree (trace_closest as k_intersect, trace_any as k_shadow). */
 KFN_INLINE void trace_one_ray(const SceneView *sc, __global const Ray *rays, uint i, int tree, int any,
@@ -57,6 +23,29 @@ KFN_INLINE void trace_one_item(const SceneView *sc, __global const Ray *rays, ui
 {
     uint i = (uint)get_global_id(0);
     if (i < n) trace_one_ray(sc, rays, i, tree, any, hits, occluded);
+}
+
+/* Closest hits (any == 0) or occlusion (any == 1) of rays[2i] and rays[2i+1], walked in
+ * turns through the kd-tree (trace_closest2, trace_any2; `tree` is TREE_KD); a last
+ * ray without a partner walks alone. */
+KFN_INLINE void trace_pair_item(const SceneView *sc, __global const Ray *rays, uint n, int tree, int any,
+                                __global Hit *hits, __global uint *occluded)
+{
+    uint a = 2u * (uint)get_global_id(0), b = a + 1u;
+    if (a >= n) return;
+    if (!(b < n)) {
+        trace_one_ray(sc, rays, a, tree, any, hits, occluded);
+    } else if (any) {
+        int oa, ob;
+        trace_any2(sc, rays[a], rays[b], &oa, &ob);
+        occluded[a] = (uint)oa;
+        occluded[b] = (uint)ob;
+    } else {
+        Hit ha, hb;
+        trace_closest2(sc, rays[a], rays[b], &ha, &hb);
+        hits[a] = ha;
+        hits[b] = hb;
+    }
 }
 
 /* Closest hits (any == 0) or occlusion (any == 1: 1 or 0 in hits[i].prim's place, as
@@ -112,6 +101,7 @@ KFN_INLINE void trace_lanes_item(const SceneView *sc, __global const Ray *rays, 
         walk(&sc, rays, n, tree, 1, 0, occluded);                                            \
     }
 
+TRACE_KERNELS(, trace_pair_item, TREE_KD)            /* the kd-tree, two rays in turns per item */
 TRACE_KERNELS(1, trace_one_item, TREE_KD)            /* the kd-tree, one ray per item */
 TRACE_KERNELS(8, trace_packet_item, TREE_KD)         /* the kd-tree, packets of eight */
 TRACE_KERNELS(_wide, trace_one_item, TREE_BVH)       /* the BVH, one ray per item */

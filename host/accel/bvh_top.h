@@ -23,7 +23,7 @@
 /* The plane a kernel decodes from step q of a node's axis of exponent e (the bias
  * 2^(e - 127), a step of 2^(e - 150); e from 50 to 254) and offset: the float of
  * exponent e and mantissa q, plus the offset (kernels/accel/traverse_bvh.h,
- * BVH_TOP_ROW8), exact but for the add's one rounding. */
+ * BVH_TOP_ROW), exact but for the add's one rounding. */
 float bvh_top_plane(float offset, uint e, uint q);
 
 /* 1 when the box lo .. hi is finite and within +-BVH_TOP_COORD_MAX on every axis. */

@@ -234,27 +234,28 @@ KFN int grid_walk_next(const GridMedium *g, GridWalk *w, float *lo, float *hi, u
 
 /* What every flight through a grid medium starts with (grid_track and both
  * transmittance estimators): the medium's grid, sigma_t and its largest channel (the
- * majorant's scale), the world ray x + t d in the grid's unit space, and the walk over
- * t in [0, dist) along it. */
+ * majorant's scale) and the world ray x + t d in the grid's unit space. */
 typedef struct {
     GridMedium g;
     vec3 sig_t;
     float sig_max;
     vec3 o, du;                  /* origin and direction in unit space */
-    GridWalk w;
 } GridFlight;
 
-/* Sets *fl up; 0 when there is nothing to walk (a medium that neither absorbs nor
- * scatters, or a ray that misses the grid's box before dist). Inlined as the three
- * set-ups it replaces were, so that the flight's fields stay in registers. */
-KFN_INLINE int grid_flight_begin(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, GridFlight *fl)
+/* Sets *fl up and begins the walk *w over t in [0, dist); 0 when there is nothing to
+ * walk (a medium that neither absorbs nor scatters, or a ray that misses the grid's
+ * box before dist). Inlined as the three set-ups it replaces were. The walk stays out
+ * of GridFlight: with it inside (its address goes to grid_walk_begin, out of line),
+ * gcc stopped inlining grid_rng_next into the scalar device's grid loops. */
+KFN_INLINE int grid_flight_begin(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, GridFlight *fl,
+                                 GridWalk *w)
 {
     fl->g = sc->grids[md.grid];
     fl->sig_t = v3_add(md.sigma_a, md.sigma_s);
     fl->sig_max = v3_max_comp(fl->sig_t);
     fl->o = grid_to_unit(&fl->g, x);
     fl->du = grid_dir_to_unit(&fl->g, d);
-    return fl->sig_max > 0.0f && grid_walk_begin(&fl->g, fl->o, fl->du, 0.0f, dist, &fl->w);
+    return fl->sig_max > 0.0f && grid_walk_begin(&fl->g, fl->o, fl->du, 0.0f, dist, w);
 }
 
 /* Delta (spectral) tracking of the world ray x + t d (d unit length) for t in
@@ -268,11 +269,12 @@ KFN int grid_track(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, v
                    uint *rng, float *t_stop, vec3 *emitted)
 {
     GridFlight fl;
-    if (!grid_flight_begin(sc, md, x, d, dist, &fl)) return GRID_PASSED;
+    GridWalk w;
+    if (!grid_flight_begin(sc, md, x, d, dist, &fl, &w)) return GRID_PASSED;
     float lo, hi;
     uint cell, steps = 0u;
     int first = 1;
-    while (grid_walk_next(&fl.g, &fl.w, &lo, &hi, &cell)) {
+    while (grid_walk_next(&fl.g, &w, &lo, &hi, &cell)) {
         float bar = sc->grid_data[fl.g.majorant_at + cell] * fl.sig_max;
         if (!(bar > 0.0f)) continue;
         float t = lo;
@@ -327,11 +329,12 @@ KFN vec3 grid_transmittance_ratio(const SceneView *sc, Medium md, vec3 x, vec3 d
                                   vec3 *emitted)
 {
     GridFlight fl;
+    GridWalk w;
     vec3 tr = v3s(1.0f);
-    if (!grid_flight_begin(sc, md, x, d, dist, &fl)) return tr;
+    if (!grid_flight_begin(sc, md, x, d, dist, &fl, &w)) return tr;
     float lo, hi;
     uint cell, steps = 0u;
-    while (grid_walk_next(&fl.g, &fl.w, &lo, &hi, &cell)) {
+    while (grid_walk_next(&fl.g, &w, &lo, &hi, &cell)) {
         float bar = sc->grid_data[fl.g.majorant_at + cell] * fl.sig_max;
         if (!(bar > 0.0f)) continue;
         float inv = 1.0f / bar;
@@ -369,11 +372,12 @@ KFN vec3 grid_transmittance_ratio(const SceneView *sc, Medium md, vec3 x, vec3 d
 KFN vec3 grid_transmittance_residual(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, uint *rng)
 {
     GridFlight fl;
+    GridWalk w;
     vec3 tr = v3s(1.0f);
-    if (!grid_flight_begin(sc, md, x, d, dist, &fl)) return tr;
+    if (!grid_flight_begin(sc, md, x, d, dist, &fl, &w)) return tr;
     float lo, hi;
     uint cell, steps = 0u;
-    while (grid_walk_next(&fl.g, &fl.w, &lo, &hi, &cell)) {
+    while (grid_walk_next(&fl.g, &w, &lo, &hi, &cell)) {
         float d_max = sc->grid_data[fl.g.majorant_at + cell];
         if (!(d_max > 0.0f)) continue;
         float d_min = sc->grid_data[fl.g.minorant_at + cell];

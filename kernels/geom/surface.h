@@ -267,7 +267,7 @@ KFN Surface surface_local(const SceneView *sc, Ray ray, Hit hit)
  * in object space (4 roundings of |M^-1| |p| and its translation), as large in the
  * world as |M| makes it. M and M^-1 are m and mi, in private memory: a moving
  * instance's at the path's time, or a static one's copied (instance_point_error). */
-KFN vec3 instance_point_error_by(const float *m, const float *mi, vec3 po, vec3 err_o, vec3 p)
+KFN_INLINE vec3 instance_point_error_by(const float *m, const float *mi, vec3 po, vec3 err_o, vec3 p)
 {
     vec3 trans = v3(k_fabs(m[3]), k_fabs(m[7]), k_fabs(m[11]));
     vec3 trans_i = v3(k_fabs(mi[3]), k_fabs(mi[7]), k_fabs(mi[11]));

@@ -280,9 +280,8 @@ static int instances_move(const Scene *s)
     return 0;
 }
 
-Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error *err)
+static Status prepare(Scene *s, int tree_threads, RenderScene *out, Error *err)
 {
-    memset(out, 0, sizeof *out);
     Status st;
     /* the kd-tree has one level: it takes an instanced scene's copies (docs/instancing.md) */
     if (s->accel == ACCEL_KDTREE && s->n_objects) {
@@ -370,6 +369,16 @@ Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error 
     out->ds.n_env_cdf = s->n_env_cdf;
     out->ds.pixel_list = NULL;
     return ST_OK;
+}
+
+/* What a failed preparation had made is freed here: the caller has nothing to free
+ * (a refused instance box left the instance records behind, found by LeakSanitizer). */
+Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error *err)
+{
+    memset(out, 0, sizeof *out);
+    Status st = prepare(s, tree_threads, out, err);
+    if (st != ST_OK) render_scene_free(out);
+    return st;
 }
 
 uint render_scene_list_pixels(const uint *mask, size_t n, uint *list)

@@ -30,7 +30,7 @@ typedef struct {
 
 /* The scene's image settings (size, depth, seed) and its tree are taken as they are
  * now, so apply command-line overrides first. tree_threads (the build's): 0 = every
- * core. */
+ * core. On failure nothing is left to free. */
 Status render_scene_prepare(Scene *s, int tree_threads, RenderScene *out, Error *err);
 void render_scene_free(RenderScene *r);
 

@@ -743,8 +743,9 @@ void option_value_text(const OptionSpec *s, char *buf, size_t size)
     char words[96];
     if (s->choices) option_choices_text(s->choices, 0, words, sizeof words);
     else snprintf(words, sizeof words, "%s", s->metavar ? s->metavar : "");
-    if (s->kind == OPTION_SWITCH) snprintf(buf, size, s->choices ? "[=%s]" : "", words);
-    else snprintf(buf, size, " %s", words);
+    if (s->kind != OPTION_SWITCH) snprintf(buf, size, " %s", words);
+    else if (s->choices) snprintf(buf, size, "[=%s]", words);
+    else if (size) buf[0] = '\0';
 }
 
 /* "  -o, --output FILE", then the help from column 29 (on a line of its own when the

@@ -149,7 +149,7 @@ Status options_set(Options *o, const char *name, const char *value, Error *err)
     if (!s) return error_set(err, ST_USAGE, "unknown option '%s'", name);
     /* a switch with choices (--stats=json) also takes one of them by name */
     if (s->kind == OPTION_SWITCH && (!s->choices || option_switch_value(flag, value, &(int){ 0 }, NULL) == ST_OK))
-        return option_switch_value(flag, value, (int *)((char *)o + s->offset), err);
+        return option_switch_value(flag, value, (int *)(void *)((char *)o + s->offset), err);
     return option_set(s, flag, value, o, err);
 }
 

@@ -129,7 +129,7 @@ static void suggest(Error *err, const char *typed, size_t len, const char *const
     const char *best = NULL;
     size_t best_d = 3;
     for (size_t i = 0; i < n; i++) {
-        const char *name = *(const char *const *)((const char *)first + i * stride);
+        const char *name = *(const char *const *)(const void *)((const char *)first + i * stride);
         if (!name) continue;
         size_t d = edit_distance(typed, len, name);
         if (d < best_d) {

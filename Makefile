@@ -237,14 +237,14 @@ $(BUILD)/bench/%: bench/%.c $(BUILD)/lib$(PROG).a
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -o $@ $< $(BUILD)/lib$(PROG).a $(LDFLAGS) $(LDLIBS)
 
-# The traversal benchmark compares with Embree 3: only it links libembree3, and only
+# The traversal and build benchmarks compare with Embree 3: only they link libembree3, and only
 # `make bench` builds it, so the renderer and the tests never need Embree.
 $(BUILD)/.embree-ok:
 	@sh tools/deps.sh --check embree
 	@mkdir -p $(BUILD) && touch $@
 
-$(BUILD)/bench/bench_traverse: LDLIBS += -lembree3
-$(BUILD)/bench/bench_traverse: | $(BUILD)/.embree-ok
+$(BUILD)/bench/bench_traverse $(BUILD)/bench/bench_build: LDLIBS += -lembree3
+$(BUILD)/bench/bench_traverse $(BUILD)/bench/bench_build: | $(BUILD)/.embree-ok
 
 -include $(wildcard $(BUILD)/host/*.d $(BUILD)/host/*/*.d $(BUILD)/tests/*.d $(BUILD)/bench/*.d)
 

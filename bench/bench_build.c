@@ -1,0 +1,247 @@
+/*
+ * bench_build.c -- the default BVH's load and build time on a large unique mesh,
+ * against Embree 3's RTC_BUILD_QUALITY_HIGH build of the same triangles (issue 42:
+ * "a 10-million-triangle unique mesh loads and builds at least as fast as Embree's
+ * HIGH build per triangle, memory per triangle stated").
+ *
+ *   bench_build [--tris N] [--rounds R] [--no-embree]
+ *
+ * The mesh is mesh_make_sphere's closed bumpy sphere (host/scene/mesh_sink.c) of at
+ * least N triangles (default 10,000,000): deterministic, every triangle its own (no
+ * instancing), made through the mesh sink every file reader appends through, so the
+ * "load" column is the scene side of a load less the file's parsing. Each round, on 1
+ * and then 2 threads, in turns: clpt loads the mesh into a Scene and builds its BVH
+ * (bvh_build, what render_scene.c builds for a scene without instances: binned SAH,
+ * collapse to 8-wide nodes, leaf records), then Embree builds the same triangles
+ * (rtcCommitScene; the vertex copy into Embree's buffers is not timed). Printed: each
+ * round, then the medians over R rounds (default 3) and the median of the rounds'
+ * build ratios clpt / Embree; bytes per triangle: clpt's BVH nodes plus leaf records
+ * (the arrays it keeps and uploads), Embree's as its memory monitor counts what
+ * rtcCommitScene allocates (as bench_traverse measures it).
+ *
+ * Checked before the numbers mean anything: every clpt build's nodes and leaf records
+ * hash (SHA-256) to the same digest, whatever the threads (the tree must not depend on
+ * them, and a change to the build that should keep the tree can be checked against the
+ * printed digest), and Embree's scene bounds equal clpt's root box.
+ */
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/types.h>
+
+#include <embree3/rtcore.h>
+
+#include "accel/bvh.h"
+#include "base/sha256.h"
+#include "base/timer.h"
+#include "bench_util.h"
+#include "scene/mesh_sink.h"
+#include "scene/scene.h"
+
+#define MAX_ROUNDS 15
+
+typedef struct {
+    double load_s, build_s, embree_s;
+    double bytes, embree_bytes;      /* per triangle */
+} Round;
+
+/* ------------------------------------------------------------------ clpt */
+
+typedef struct {
+    size_t n_triangles;
+    double load_s, build_s, bytes_per_tri;
+    char digest[65];
+    vec3 lo, hi;
+} ClptRun;
+
+/* Loads the mesh into sc (left loaded for Embree) and builds its BVH. */
+static int clpt_run(Scene *sc, size_t min_tris, int threads, ClptRun *r)
+{
+    Error err = { 0 };
+    scene_init(sc);
+    double t0 = timer_now();
+    if (mesh_make_sphere(sc, min_tris, 0, &err)) {
+        fprintf(stderr, "bench_build: %s\n", err.msg);
+        return -1;
+    }
+    r->load_s = timer_now() - t0;
+    r->n_triangles = sc->n_triangles;
+    KdInput in = { .triangles = sc->triangles, .n_triangles = sc->n_triangles };
+    Bvh bvh;
+    t0 = timer_now();
+    if (bvh_build(&in, threads, &bvh, &err)) {
+        fprintf(stderr, "bench_build: %s\n", err.msg);
+        return -1;
+    }
+    r->build_s = timer_now() - t0;
+    size_t bytes = (size_t)bvh.n_nodes * sizeof *bvh.nodes + (size_t)bvh.n_leaf_prims * sizeof *bvh.leaf_prims;
+    r->bytes_per_tri = (double)bytes / (double)(r->n_triangles ? r->n_triangles : 1);
+    Sha256 h;
+    unsigned char d[SHA256_DIGEST_SIZE];
+    sha256_init(&h);
+    sha256_update(&h, bvh.nodes, (size_t)bvh.n_nodes * sizeof *bvh.nodes);
+    sha256_update(&h, bvh.leaf_prims, (size_t)bvh.n_leaf_prims * sizeof *bvh.leaf_prims);
+    sha256_final(&h, d);
+    sha256_hex(d, r->digest);
+    r->lo = bvh.lo;
+    r->hi = bvh.hi;
+    bvh_free(&bvh);
+    return 0;
+}
+
+/* ------------------------------------------------------------------ Embree */
+
+static atomic_llong embree_bytes;
+
+static bool embree_memory(void *ptr, ssize_t bytes, bool post)
+{
+    (void)ptr;
+    (void)post;
+    atomic_fetch_add(&embree_bytes, (long long)bytes);
+    return true;
+}
+
+/* Builds sc's triangles with RTC_BUILD_QUALITY_HIGH on `threads` threads; the build's
+ * seconds and allocated bytes into *seconds, *bytes, its bounds into lo, hi. */
+static int embree_run(const Scene *sc, int threads, double *seconds, double *bytes, float lo[3], float hi[3])
+{
+    char cfg[64];
+    snprintf(cfg, sizeof cfg, "threads=%d", threads);
+    RTCDevice dev = rtcNewDevice(cfg);
+    if (!dev) {
+        fprintf(stderr, "bench_build: rtcNewDevice failed (error %d)\n", (int)rtcGetDeviceError(NULL));
+        return -1;
+    }
+    size_t n = sc->n_triangles;
+    RTCScene scene = rtcNewScene(dev);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
+    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n);
+    unsigned *idx = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), n);
+    int rc = -1;
+    if (v && idx) {
+        for (size_t i = 0; i < n; i++) {
+            const Triangle *t = &sc->triangles[i];
+            const vec3 *c[3] = { &t->p0, &t->p1, &t->p2 };
+            for (int k = 0; k < 3; k++) {
+                v[9 * i + 3 * k + 0] = c[k]->x;
+                v[9 * i + 3 * k + 1] = c[k]->y;
+                v[9 * i + 3 * k + 2] = c[k]->z;
+                idx[3 * i + k] = (unsigned)(3 * i + k);
+            }
+        }
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(scene, g);
+        atomic_store(&embree_bytes, 0);
+        rtcSetDeviceMemoryMonitorFunction(dev, embree_memory, NULL);
+        double t0 = timer_now();
+        rtcCommitScene(scene);
+        *seconds = timer_now() - t0;
+        *bytes = (double)atomic_load(&embree_bytes) / (double)(n ? n : 1);
+        rtcSetDeviceMemoryMonitorFunction(dev, NULL, NULL);
+        struct RTCBounds b;
+        rtcGetSceneBounds(scene, &b);
+        lo[0] = b.lower_x, lo[1] = b.lower_y, lo[2] = b.lower_z;
+        hi[0] = b.upper_x, hi[1] = b.upper_y, hi[2] = b.upper_z;
+        rc = rtcGetDeviceError(dev) == RTC_ERROR_NONE ? 0 : -1;
+    }
+    rtcReleaseGeometry(g);
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(dev);
+    return rc;
+}
+
+/* ------------------------------------------------------------------ main */
+
+static double median_of(const Round *r, int n, size_t field)
+{
+    double v[MAX_ROUNDS];
+    for (int i = 0; i < n; i++) v[i] = *(const double *)((const char *)&r[i] + field);
+    return bench_median(v, n);
+}
+
+int main(int argc, char **argv)
+{
+    size_t min_tris = 10000000;
+    int rounds = 3, embree = 1;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--tris") && i + 1 < argc) min_tris = (size_t)atol(argv[++i]);
+        else if (!strcmp(argv[i], "--rounds") && i + 1 < argc) rounds = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--no-embree")) embree = 0;
+        else {
+            fprintf(stderr, "usage: bench_build [--tris N] [--rounds R] [--no-embree]\n");
+            return 2;
+        }
+    }
+    if (rounds < 1 || rounds > MAX_ROUNDS || min_tris < 1) {
+        fprintf(stderr, "bench_build: --rounds takes 1 to %d, --tris at least 1\n", MAX_ROUNDS);
+        return 2;
+    }
+    const int thread_counts[2] = { 1, 2 };
+    Round res[2][MAX_ROUNDS];
+    char first_digest[65] = "";
+    size_t n_tris = 0;
+    int bad = 0;
+    bench_print_load("before");
+    for (int r = 0; r < rounds; r++)
+        for (int ti = 0; ti < 2; ti++) {
+            int threads = thread_counts[ti];
+            Scene sc;
+            ClptRun c;
+            if (clpt_run(&sc, min_tris, threads, &c)) return 1;
+            n_tris = c.n_triangles;
+            if (!first_digest[0]) memcpy(first_digest, c.digest, sizeof first_digest);
+            if (strcmp(first_digest, c.digest)) {
+                printf("round %d, %d threads: the BVH differs (sha256 %s, first %s)\n", r + 1, threads, c.digest,
+                       first_digest);
+                bad = 1;
+            }
+            Round *o = &res[ti][r];
+            o->load_s = c.load_s;
+            o->build_s = c.build_s;
+            o->bytes = c.bytes_per_tri;
+            o->embree_s = o->embree_bytes = 0.0;
+            if (embree) {
+                float lo[3], hi[3];
+                if (embree_run(&sc, threads, &o->embree_s, &o->embree_bytes, lo, hi)) {
+                    fprintf(stderr, "bench_build: Embree's build failed\n");
+                    return 1;
+                }
+                if (lo[0] != c.lo.x || lo[1] != c.lo.y || lo[2] != c.lo.z || hi[0] != c.hi.x || hi[1] != c.hi.y ||
+                    hi[2] != c.hi.z) {
+                    printf("round %d: Embree's bounds differ from clpt's root box\n", r + 1);
+                    bad = 1;
+                }
+            }
+            scene_free(&sc);
+            printf("round %d, %d thread%s: %zu triangles, clpt load %.3f s, BVH build %.3f s; Embree HIGH build "
+                   "%.3f s; ratio %.2f\n", r + 1, threads, threads > 1 ? "s" : "", n_tris, o->load_s, o->build_s,
+                   o->embree_s, o->embree_s > 0.0 ? o->build_s / o->embree_s : 0.0);
+            fflush(stdout);
+        }
+    bench_print_load("after");
+    printf("\nBVH sha256 %s (the same in every round and thread count: %s)\n", first_digest, bad ? "NO" : "yes");
+    printf("\nmedians of %d rounds (ratio: the median of the rounds' clpt build / Embree build; below 1 is faster "
+           "than Embree)\n\n", rounds);
+    printf("| triangles | threads | clpt load s | clpt build s | Embree HIGH build s | build ratio | "
+           "clpt load+build / Embree | clpt bytes/tri | Embree bytes/tri |\n");
+    printf("|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (int ti = 0; ti < 2; ti++) {
+        Round *rs = res[ti];
+        double ratio[MAX_ROUNDS], whole[MAX_ROUNDS];
+        for (int r = 0; r < rounds; r++) {
+            ratio[r] = rs[r].embree_s > 0.0 ? rs[r].build_s / rs[r].embree_s : 0.0;
+            whole[r] = rs[r].embree_s > 0.0 ? (rs[r].load_s + rs[r].build_s) / rs[r].embree_s : 0.0;
+        }
+        printf("| %zu | %d | %.3f | %.3f | %.3f | %.2f | %.2f | %.1f | %.1f |\n", n_tris, thread_counts[ti],
+               median_of(rs, rounds, offsetof(Round, load_s)), median_of(rs, rounds, offsetof(Round, build_s)),
+               median_of(rs, rounds, offsetof(Round, embree_s)), bench_median(ratio, rounds),
+               bench_median(whole, rounds), median_of(rs, rounds, offsetof(Round, bytes)),
+               median_of(rs, rounds, offsetof(Round, embree_bytes)));
+    }
+    return bad;
+}

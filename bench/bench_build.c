@@ -173,7 +173,7 @@ static int embree_run(const Scene *sc, int threads, double *seconds, double *byt
 static double median_of(const Round *r, int n, size_t field)
 {
     double v[MAX_ROUNDS];
-    for (int i = 0; i < n; i++) v[i] = *(const double *)((const char *)&r[i] + field);
+    for (int i = 0; i < n; i++) v[i] = *(const double *)(const void *)((const char *)&r[i] + field);
     return bench_median(v, n);
 }
 

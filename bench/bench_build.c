@@ -40,6 +40,7 @@
 #include "accel/bvh.h"
 #include "base/sha256.h"
 #include "base/timer.h"
+#include "bench_embree.h"
 #include "bench_util.h"
 #include "scene/mesh_sink.h"
 #include "scene/scene.h"
@@ -107,16 +108,6 @@ static int clpt_run(Scene *sc, size_t min_tris, int threads, ClptRun *r)
 
 /* ------------------------------------------------------------------ Embree */
 
-static atomic_llong embree_bytes;
-
-static bool embree_memory(void *ptr, ssize_t bytes, bool post)
-{
-    (void)ptr;
-    (void)post;
-    atomic_fetch_add(&embree_bytes, (long long)bytes);
-    return true;
-}
-
 /* Builds sc's triangles with RTC_BUILD_QUALITY_HIGH on `threads` threads; the build's
  * seconds and allocated bytes into *seconds, *bytes, its bounds into lo, hi. */
 static int embree_run(const Scene *sc, int threads, double *seconds, double *bytes, float lo[3], float hi[3])
@@ -131,38 +122,19 @@ static int embree_run(const Scene *sc, int threads, double *seconds, double *byt
     size_t n = sc->n_triangles;
     RTCScene scene = rtcNewScene(dev);
     rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
-    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
-    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n);
-    unsigned *idx = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), n);
+    RTCGeometry g = bench_embree_triangles(dev, sc->triangles, n);
     int rc = -1;
-    if (v && idx) {
-        for (size_t i = 0; i < n; i++) {
-            const Triangle *t = &sc->triangles[i];
-            const vec3 *c[3] = { &t->p0, &t->p1, &t->p2 };
-            for (int k = 0; k < 3; k++) {
-                v[9 * i + 3 * k + 0] = c[k]->x;
-                v[9 * i + 3 * k + 1] = c[k]->y;
-                v[9 * i + 3 * k + 2] = c[k]->z;
-                idx[3 * i + k] = (unsigned)(3 * i + k);
-            }
-        }
-        rtcCommitGeometry(g);
+    if (g) {
         rtcAttachGeometry(scene, g);
-        atomic_store(&embree_bytes, 0);
-        rtcSetDeviceMemoryMonitorFunction(dev, embree_memory, NULL);
-        double t0 = timer_now();
-        rtcCommitScene(scene);
-        *seconds = timer_now() - t0;
-        *bytes = (double)atomic_load(&embree_bytes) / (double)(n ? n : 1);
-        rtcSetDeviceMemoryMonitorFunction(dev, NULL, NULL);
+        long long allocated = 0;
+        rc = bench_embree_commit(dev, scene, seconds, &allocated);
+        *bytes = (double)allocated / (double)(n ? n : 1);
         struct RTCBounds b;
         rtcGetSceneBounds(scene, &b);
         lo[0] = b.lower_x, lo[1] = b.lower_y, lo[2] = b.lower_z;
         hi[0] = b.upper_x, hi[1] = b.upper_y, hi[2] = b.upper_z;
-        rc = rtcGetDeviceError(dev) == RTC_ERROR_NONE ? 0 : -1;
     }
-    rtcReleaseGeometry(g);
+    if (g) rtcReleaseGeometry(g);
     rtcReleaseScene(scene);
     rtcReleaseDevice(dev);
     return rc;

@@ -77,6 +77,7 @@
 #include "base/timer.h"
 #include "accel/traverse.h"
 
+#include "bench_embree.h"
 #include "bench_util.h"
 
 #define MAX_REPS 31
@@ -542,15 +543,6 @@ static long pocl_compare(Pocl *pc, const RaySet *s, int wide)
 
 /* ------------------------------------------------------------------ Embree */
 
-static atomic_llong embree_bytes;
-
-static bool embree_memory(void *ptr, ssize_t bytes, bool post)
-{
-    (void)ptr;
-    (void)post;
-    atomic_fetch_add(&embree_bytes, (long long)bytes);
-    return true;
-}
 
 typedef struct {
     RTCDevice dev;
@@ -575,32 +567,14 @@ static int embree_build(Embree *e, const Mesh *m, int threads)
     e->scene = rtcNewScene(e->dev);
     rtcSetSceneBuildQuality(e->scene, RTC_BUILD_QUALITY_HIGH);
     if (embree_robust) rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_ROBUST);
-    RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
-    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n);
-    unsigned *idx = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), n);
-    if (!v || !idx) return -1;
-    for (size_t i = 0; i < n; i++) {
-        const Triangle *t = &m->scene.triangles[i];
-        const vec3 *c[3] = { &t->p0, &t->p1, &t->p2 };
-        for (int k = 0; k < 3; k++) {
-            v[9 * i + 3 * k + 0] = c[k]->x;
-            v[9 * i + 3 * k + 1] = c[k]->y;
-            v[9 * i + 3 * k + 2] = c[k]->z;
-            idx[3 * i + k] = (unsigned)(3 * i + k);
-        }
-    }
-    rtcCommitGeometry(g);
+    RTCGeometry g = bench_embree_triangles(e->dev, m->scene.triangles, n);
+    if (!g) return -1;
     rtcAttachGeometry(e->scene, g);
     rtcReleaseGeometry(g);
-    atomic_store(&embree_bytes, 0);
-    rtcSetDeviceMemoryMonitorFunction(e->dev, embree_memory, NULL);
-    double t0 = timer_now();
-    rtcCommitScene(e->scene);
-    e->build_seconds = timer_now() - t0;
-    e->build_bytes = atomic_load(&embree_bytes);
-    rtcSetDeviceMemoryMonitorFunction(e->dev, NULL, NULL);
-    return rtcGetDeviceError(e->dev) == RTC_ERROR_NONE ? 0 : -1;
+    long long allocated = 0;
+    int rc = bench_embree_commit(e->dev, e->scene, &e->build_seconds, &allocated);
+    e->build_bytes = allocated;
+    return rc;
 }
 
 static void embree_free(Embree *e)

@@ -9,27 +9,9 @@ is reproduced exactly by running this again.
 """
 import math
 
+from gridgen import value_noise
+
 N = 32
-
-
-def hash3(x, y, z):
-    h = (x * 73856093) ^ (y * 19349663) ^ (z * 83492791)
-    h = (h ^ (h >> 13)) * 0x5bd1e995 & 0xffffffff
-    return ((h ^ (h >> 15)) & 0xffff) / 65535.0
-
-
-def value_noise(x, y, z):
-    """Trilinear value noise on the integer lattice, smoothstepped."""
-    xi, yi, zi = math.floor(x), math.floor(y), math.floor(z)
-    fx, fy, fz = x - xi, y - yi, z - zi
-    sx, sy, sz = (f * f * (3 - 2 * f) for f in (fx, fy, fz))
-    v = 0.0
-    for dz in (0, 1):
-        for dy in (0, 1):
-            for dx in (0, 1):
-                w = (sx if dx else 1 - sx) * (sy if dy else 1 - sy) * (sz if dz else 1 - sz)
-                v += w * hash3(xi + dx, yi + dy, zi + dz)
-    return v
 
 
 def density(x, y, z):

@@ -296,21 +296,24 @@ static void test_transforms(void)
         CHECK(n.z > 0.0f);
     }
     scene_free(&s);
-    /* a sphere that a transform squashes, or a textured one it turns, becomes a mesh
-     * with normals and texture coordinates */
+    /* a sphere that a transform squashes, or a textured one it turns, becomes an exact
+     * ellipsoid: the unit sphere under the transform times the sphere's own place */
     CHECK_EQ_INT(load_objects("Group { numObjects 2\n"
-                              " Transform { Scale 1 0.5 1 Sphere { radius 1 } }\n"
+                              " Transform { Scale 1 0.5 1 Sphere { center 0 2 0 radius 3 } }\n"
                               " MaterialIndex 1 Transform { YRotate 45 Sphere { radius 1 } }\n"
                               "}", &s, &err), ST_OK);
-    CHECK_EQ_INT(s.n_spheres, 0);
-    CHECK_EQ_INT(s.n_triangles, 2 * (2 * 48 * 96 - 2 * 96));
-    CHECK_EQ_INT(s.n_shading, s.n_triangles);
-    int on_ellipsoid = 1;
-    for (size_t i = 0; i < s.n_triangles / 2; i++) {
-        vec3 p = s.triangles[i].p0;
-        on_ellipsoid &= fabs(p.x * p.x + 4.0 * p.y * p.y + p.z * p.z - 1.0) < 1e-5;
+    CHECK_EQ_INT(s.n_spheres, 2);
+    CHECK_EQ_INT(s.n_sphere_xforms, 2);
+    CHECK_EQ_INT(s.n_triangles, 0);
+    if (s.n_spheres == 2 && s.n_sphere_xforms == 2) {
+        CHECK(s.spheres[0].xform == 1u && s.spheres[1].xform == 2u);
+        const float *m = s.sphere_xforms[0].to_world;
+        static const float want[12] = { 3, 0, 0, 0, 0, 1.5f, 0, 1, 0, 0, 3, 0 };
+        int same = 1;
+        for (int i = 0; i < 12; i++) same &= fabsf(m[i] - want[i]) < 1e-6f;
+        CHECK(same);
+        CHECK_EQ_INT(s.spheres[1].material, 1);
     }
-    CHECK(on_ellipsoid);
     scene_free(&s);
     /* a singular transform flattens its object */
     CHECK_EQ_INT(load_objects("Group { numObjects 1 Transform { Scale 0 1 1 Sphere { radius 1 } } }", &s, &err),
@@ -319,10 +322,11 @@ static void test_transforms(void)
     scene_free(&s);
 }
 
-/* Each sphere that a transform squashes becomes 9,024 triangles: 1,000 of them in a 65
- * KB file made 9 million triangles and took 4.6 GB. Past CLPT_MAX_TESSELLATED_TRIANGLES
- * (116 such spheres), the sphere that would cross it is an error. */
-static void test_tessellation_limit(void)
+/* Each sphere that a transform squashed became 9,024 triangles: 1,000 of them in a 65
+ * KB file made 9 million triangles and took 4.6 GB, and past 116 of them the scene was
+ * refused (CLPT_MAX_TESSELLATED_TRIANGLES). As ellipsoids they are a Sphere and a
+ * SphereXform each, 128 bytes. */
+static void test_squashed_spheres_memory(void)
 {
     enum { N = 1000 };
     size_t cap = 200 + (size_t)N * 80, len = 0;
@@ -337,17 +341,14 @@ static void test_tessellation_limit(void)
     snprintf(text, cap + 1024, "%sMaterials { numMaterials 1 Material { } }\n%s", camera, objects);
     Scene s;
     Error err;
-    CHECK_EQ_INT(load("ellipsoids.txt", text, &s, &err), ST_INPUT);
-    char want[512];
-    /* the camera block's lines, the materials line, the Group line, then sphere 117 */
-    int line = 2;
-    for (const char *q = camera; *q; q++) line += *q == '\n';
-    snprintf(want, sizeof want, "%s/ellipsoids.txt:%d:27: its transform makes this sphere a mesh of 9024 "
-             "triangles, and the meshes of the scene's spheres would then hold more than 1048576 "
-             "(CLPT_MAX_TESSELLATED_TRIANGLES, 116 such spheres): scale spheres uniformly, or use fewer",
-             dir, line + 117);
-    CHECK_MSG(strcmp(err.msg, want) == 0, "%s", err.msg);
-    CHECK(s.n_triangles <= CLPT_MAX_TESSELLATED_TRIANGLES);
+    Status st = load("ellipsoids.txt", text, &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    size_t bytes = s.n_spheres * sizeof(Sphere) + s.n_sphere_xforms * sizeof(SphereXform) +
+                   s.n_triangles * sizeof(Triangle) + s.n_shading * sizeof(TriShading);
+    fprintf(stderr, "  %d squashed spheres: %zu bytes of primitives (%zu per sphere)\n", N, bytes, bytes / N);
+    CHECK_EQ_INT(s.n_spheres, N);
+    CHECK_EQ_INT(s.n_triangles, 0);
+    CHECK(bytes <= (size_t)N * (sizeof(Sphere) + sizeof(SphereXform)));
     scene_free(&s);
     free(text);
     free(objects);
@@ -886,7 +887,7 @@ int main(void)
     RUN(test_every_keyword);
     RUN(test_orthographic);
     RUN(test_transforms);
-    RUN(test_tessellation_limit);
+    RUN(test_squashed_spheres_memory);
     RUN(test_material_scoping);
     RUN(test_crlf);
     RUN(test_paths);

@@ -1,8 +1,8 @@
 /*
  * classic_object.c — the classic reader's objects: Group and Transform blocks, spheres,
  * planes, triangles, OBJ meshes, curves and surfaces of revolution, with their
- * transforms applied while reading; part of the reader of classic_parse.c
- * (classic_reader.h).
+ * transforms applied while reading (squashed spheres as ellipsoids); part of the
+ * reader of classic_parse.c (classic_reader.h).
  */
 #include "io/classic_reader.h"
 
@@ -18,11 +18,6 @@
 #include "io/obj.h"
 #include "scene/curve.h"
 #include "scene/transform.h"
-
-/* The tessellation of a sphere that a transform makes an ellipsoid (or rotates, when
- * it is textured): latitude bands x longitude segments. */
-#define SPHERE_BANDS 48
-#define SPHERE_SEGMENTS 96
 
 /* The mesh of a surface of revolution that a transform tilts off the vertical: rows per
  * profile segment x columns around the axis. */
@@ -97,60 +92,6 @@ static Status add_tri(Classic *c, vec3 a, vec3 b, vec3 d, uint material, uint sh
     return scene_add_triangle(c->s, t, c->err);
 }
 
-/* A sphere under a transform that does not keep it a (plain) sphere: a latitude-
- * longitude mesh with the sphere's normals and (u, v) (kernels/material/texture.h) carried over.
- * The kernels have no ellipsoids, so the mesh costs 9,024 triangles a sphere; their
- * total is capped (CLPT_MAX_TESSELLATED_TRIANGLES) before they are made. */
-static Status tessellate_sphere(Classic *c, const Token *kw, vec3 center, float radius, const Transform *m,
-                                uint material)
-{
-    enum { PER_SPHERE = 2 * SPHERE_SEGMENTS * (SPHERE_BANDS - 1) };
-    if (PER_SPHERE > CLPT_MAX_TESSELLATED_TRIANGLES - c->tessellated)
-        return lex_error_at(&c->lx, kw, c->err, "its transform makes this sphere a mesh of %d triangles, and the "
-                            "meshes of the scene's spheres would then hold more than %u "
-                            "(CLPT_MAX_TESSELLATED_TRIANGLES, %u such spheres): scale spheres uniformly, or "
-                            "use fewer", PER_SPHERE, CLPT_MAX_TESSELLATED_TRIANGLES,
-                            CLPT_MAX_TESSELLATED_TRIANGLES / PER_SPHERE);
-    c->tessellated += PER_SPHERE;
-    double nm[3][3];
-    if (!transform_normal_matrix(m, nm)) return error_set(c->err, ST_INTERNAL, "singular transform");
-    int flip = transform_det(m) < 0.0;
-    enum { NB = SPHERE_BANDS, NS = SPHERE_SEGMENTS };
-    for (int i = 0; i < NB; i++)
-        for (int j = 0; j < NS; j++) {
-            vec3 p[4], n[4];
-            float uv[4][2];
-            for (int k = 0; k < 4; k++) {
-                int bi = i + (k >= 2), sj = j + (k == 1 || k == 2);
-                double theta = M_PI * bi / NB, phi = 2.0 * M_PI * sj / NS;
-                /* u = 0.5 + atan2(x, z) / 2pi: phi measured from -z through +x */
-                vec3 dir = v3((float)(-sin(theta) * sin(phi)), (float)cos(theta), (float)(-sin(theta) * cos(phi)));
-                p[k] = transform_point(m, v3_madd(center, dir, radius));
-                n[k] = normal_apply(nm, dir);
-                uv[k][0] = (float)sj / NS;
-                uv[k][1] = 1.0f - (float)bi / NB;
-            }
-            /* quad 0 1 2 3 (0 top-left, going around); the poles give one triangle */
-            int tris[2][3] = { { 0, 3, 2 }, { 0, 2, 1 } };
-            for (int t = 0; t < 2; t++) {
-                if ((t == 0 && i == NB - 1) || (t == 1 && i == 0)) continue;
-                int a = tris[t][0], b = tris[t][flip ? 2 : 1], d = tris[t][flip ? 1 : 2];
-                TriShading sh;
-                memset(&sh, 0, sizeof sh);
-                sh.n0 = n[a]; sh.n1 = n[b]; sh.n2 = n[d];
-                memcpy(sh.uv0, uv[a], sizeof sh.uv0);
-                memcpy(sh.uv1, uv[b], sizeof sh.uv1);
-                memcpy(sh.uv2, uv[d], sizeof sh.uv2);
-                sh.flags = TRI_HAS_NORMALS | TRI_HAS_UV;
-                uint si;
-                Status st = scene_add_shading(c->s, sh, &si, c->err);
-                if (!st) st = add_tri(c, p[a], p[b], p[d], material, si);
-                if (st) return st;
-            }
-        }
-    return ST_OK;
-}
-
 /* An object's block read into v, and the material it gets (object_material). */
 static Status read_object(Classic *c, const Token *kw, const char *name, const ClassicKey *keys, size_t n,
                           ClassicValue *v, uint *material)
@@ -167,14 +108,29 @@ static const ClassicKey sphere_keys[SPH_N] = {
     [SPH_CENTER] = {"center", CK_VEC3, 0}, [SPH_RADIUS] = {"radius", CK_POSITIVE, 1},
 };
 
+/* A sphere stays a plain one (centre, radius) under a similarity, so that scenes that
+ * only move and scale spheres uniformly render as before. Any other transform, or a
+ * rotation of a textured sphere (whose texture must turn with it), makes it the unit
+ * sphere under m . T(center) . S(radius): an exact ellipsoid (scene_add_ellipsoid, as
+ * the pbrt reader's), 128 bytes however it is squashed, whose (u, v) follow the
+ * untransformed sphere's longitude and latitude (kernels/material/texture.h). Its
+ * normals are M^-T of the sphere's, outward under a mirror too. Classic materials emit
+ * no light, which an ellipsoid may not. */
 static Status build_sphere(Classic *c, const Token *kw, const Transform *m, const ClassicValue *v, uint material)
 {
     vec3 center = v[SPH_CENTER].v;   /* the origin when not given */
     double scale;
     int rotates;
     int textured = c->s->materials[material].texture != NO_INDEX;
-    if (!similarity(m, &scale, &rotates) || (rotates && textured))
-        return tessellate_sphere(c, kw, center, v[SPH_RADIUS].f, m, material);
+    if (!similarity(m, &scale, &rotates) || (rotates && textured)) {
+        double r = v[SPH_RADIUS].f;
+        Transform place = transform_translate(center.x, center.y, center.z), size = transform_scale(r, r, r);
+        place = transform_compose(&place, &size);
+        Transform unit_to_world = transform_compose(m, &place);
+        Status st = scene_add_ellipsoid(c->s, &unit_to_world, material, c->err);
+        if (st == ST_INPUT) reader_annotate(&c->lx, kw, c->err);
+        return st;
+    }
     Sphere sp;
     memset(&sp, 0, sizeof sp);
     sp.center = transform_point(m, center);
@@ -377,8 +333,8 @@ static Status add_revsurface(Classic *c, const Token *kw, float *xy, unsigned n_
     size_t tris = 2u * REV_MESH_STEPS * REV_MESH_AROUND * (size_t)n_segments;
     if (tris > CLPT_MAX_TESSELLATED_TRIANGLES - c->tessellated)
         return lex_error_at(&c->lx, kw, c->err, "its transform tilts this RevSurface's axis, which makes it a mesh "
-                            "of %zu triangles, and the scene's meshes made from spheres and surfaces would then "
-                            "hold more than %u (CLPT_MAX_TESSELLATED_TRIANGLES)", tris,
+                            "of %zu triangles, and the scene's meshes made from tilted surfaces would then hold "
+                            "more than %u (CLPT_MAX_TESSELLATED_TRIANGLES)", tris,
                             CLPT_MAX_TESSELLATED_TRIANGLES);
     c->tessellated += tris;
     return curve_mesh_revsurface(c->s, xy, n_segments, degree, m, material, REV_MESH_STEPS, REV_MESH_AROUND,

@@ -31,7 +31,7 @@ typedef struct {
     int camera_sized;      /* the camera gave width/height: Tsinghua's dialect */
     int keys_2004;         /* a material gave a key only MIT 2004 has (reflectiveColor,
                             * transparentColor, indexOfRefraction, exponent) */
-    size_t tessellated;        /* triangles made from spheres so far */
+    size_t tessellated;        /* triangles made from tilted surfaces of revolution so far */
     uint depth;                /* Group and Transform blocks open around the reader */
 } Classic;
 

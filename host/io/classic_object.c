@@ -1,8 +1,8 @@
 /*
  * classic_object.c — the classic reader's objects: Group and Transform blocks, spheres,
  * planes, triangles, OBJ meshes, curves and surfaces of revolution, with their
- * transforms applied while reading (squashed spheres as ellipsoids); part of the
- * reader of classic_parse.c (classic_reader.h).
+ * transforms applied while reading (meshes under a Transform as instances, squashed
+ * spheres as ellipsoids); part of the reader of classic_parse.c (classic_reader.h).
  */
 #include "io/classic_reader.h"
 
@@ -17,6 +17,7 @@
 #include "io/reader.h"
 #include "io/obj.h"
 #include "scene/curve.h"
+#include "scene/instance.h"
 #include "scene/transform.h"
 
 /* The mesh of a surface of revolution that a transform tilts off the vertical: rows per
@@ -183,20 +184,23 @@ static Status build_triangle(Classic *c, const Token *kw, const Transform *m, co
 enum { MESH_FILE, MESH_N };
 static const ClassicKey mesh_keys[MESH_N] = { [MESH_FILE] = {"obj_file", CK_PATH, 1} };
 
-static Status build_mesh(Classic *c, const Token *kw, const Transform *m, const ClassicValue *v, uint material)
+/* Loads the OBJ at `path` into the scene: under m when `object` is NULL, else once
+ * untransformed into a new object named `name` (*object receives it). */
+static Status load_mesh(Classic *c, const Token *kw, const ClassicValue *v, const char *path, const Transform *m,
+                        uint material, const char *name, uint *object)
 {
-    char *path;
-    Status st = classic_resolve_path(c, &v[MESH_FILE].word, &path);
+    Status st = ST_OK;
+    if (object) st = scene_object_begin(c->s, name, strlen(name), object, c->err);
     if (st) return st;
     /* the sink applies the transform as it does to a mesh of our format */
     MeshOptions o = mesh_options(material);
-    o.xf = *m;
+    if (!object) o.xf = *m;
     /* MIT Fall 2019's loader smooths a mesh's normals over shared vertex indices;
      * Tsinghua's (a sized camera) keeps one normal per face (docs/classic-format.md,
      * "Conventions") */
     o.smooth_by_index = !c->camera_sized;
     st = obj_load_with(path, c->s, &o, c->err);
-    free(path);
+    if (object) scene_object_end(c->s, *object);
     if (st == ST_IO) {
         reader_annotate(&c->lx, &v[MESH_FILE].word, c->err);
         return st;
@@ -206,6 +210,39 @@ static Status build_mesh(Classic *c, const Token *kw, const Transform *m, const 
         snprintf(c->err->msg + len, sizeof c->err->msg - len, " (in the TriangleMesh of %s:%u:%u)", c->lx.path,
                  kw->line, kw->col);
     }
+    return st;
+}
+
+/* A mesh outside any Transform is read into the world as it always was. Under a
+ * Transform it becomes an instance (docs/instancing.md) of one object per mesh file,
+ * material and normal convention, read the first time that mesh is met: the same OBJ
+ * under N transforms is stored once and placed N times. The object's name is that key,
+ * so the scene's own table of objects finds it again. An instance's normals go by
+ * M^-T, which keeps a mirrored mesh's outward side outward as the sink's swapped
+ * corners did. */
+static Status build_mesh(Classic *c, const Token *kw, const Transform *m, const ClassicValue *v, uint material)
+{
+    char *path;
+    Status st = classic_resolve_path(c, &v[MESH_FILE].word, &path);
+    if (st) return st;
+    if (transform_is_identity(m)) {
+        st = load_mesh(c, kw, v, path, m, material, NULL, NULL);
+        free(path);
+        return st;
+    }
+    size_t cap = strlen(path) + 64;
+    char *name = malloc(cap);
+    if (!name) {
+        free(path);
+        return error_set(c->err, ST_INTERNAL, "out of memory");
+    }
+    snprintf(name, cap, "TriangleMesh %s, material %u%s", path, material, c->camera_sized ? "" : ", smoothed");
+    uint object = scene_find_object(c->s, name, strlen(name));
+    if (object == NO_INDEX) st = load_mesh(c, kw, v, path, m, material, name, &object);
+    free(name);
+    free(path);
+    if (st || !scene_object_prims(c->s, object)) return st;
+    if ((st = scene_add_instance(c->s, object, m, NO_INDEX, c->err)) == ST_INPUT) reader_annotate(&c->lx, kw, c->err);
     return st;
 }
 

@@ -996,6 +996,126 @@ static void test_mesh_instances(void)
     free(r);
 }
 
+/* The old tessellation of a classic sphere (48 bands x 96 segments, the sphere's
+ * normals and (u, v) at its corners) as an OBJ of the unit sphere. */
+static void write_tessellated_sphere(const char *name)
+{
+    enum { NB = 48, NS = 96 };
+    size_t cap = 1u << 20, n = 0;
+    char *text = malloc(cap);
+    if (!text) abort();
+    for (int bi = 0; bi <= NB; bi++)
+        for (int sj = 0; sj <= NS; sj++) {
+            double theta = M_PI * bi / NB, phi = 2.0 * M_PI * sj / NS;
+            double x = -sin(theta) * sin(phi), y = cos(theta), z = -sin(theta) * cos(phi);
+            n += (size_t)snprintf(text + n, cap - n, "v %.9g %.9g %.9g\nvn %.9g %.9g %.9g\nvt %.9g %.9g\n", x, y,
+                                  z, x, y, z, (double)sj / NS, 1.0 - (double)bi / NB);
+        }
+    for (int i = 0; i < NB; i++)
+        for (int j = 0; j < NS; j++) {
+            int k[4] = { 1 + i * (NS + 1) + j, 1 + i * (NS + 1) + j + 1, 1 + (i + 1) * (NS + 1) + j + 1,
+                         1 + (i + 1) * (NS + 1) + j };
+            if (i < NB - 1)
+                n += (size_t)snprintf(text + n, cap - n, "f %d/%d/%d %d/%d/%d %d/%d/%d\n", k[0], k[0], k[0], k[3],
+                                      k[3], k[3], k[2], k[2], k[2]);
+            if (i > 0)
+                n += (size_t)snprintf(text + n, cap - n, "f %d/%d/%d %d/%d/%d %d/%d/%d\n", k[0], k[0], k[0], k[2],
+                                      k[2], k[2], k[1], k[1], k[1]);
+        }
+    write_file(name, text);
+    free(text);
+}
+
+/* A squashed, turned sphere (plain and textured) renders as the old 9,024-triangle
+ * mesh did, within that mesh's error (its facets stray up to 1 - cos(pi / 96) = 5.4e-4
+ * of the radius inside the sphere, and its normals are interpolated); its silhouette
+ * is exact: with flat colours and an orthographic camera, each pixel is the object's
+ * exactly when the ray through the pixel's centre meets the analytic ellipsoid. The
+ * kd-tree draws it the same. */
+static void test_squashed_sphere_image(void)
+{
+    write_tessellated_sphere("sphere48.obj");
+    const char *xf = "Translate 0 0.2 0 ZRotate 30 Scale 1.6 0.7 1";
+    char text[4096];
+    Scene exact, mesh, kd;
+    Error err;
+    for (int shape = 0; shape < 2; shape++) {
+        snprintf(text, sizeof text,
+                 "%sGroup { numObjects 3 MaterialIndex 0 Plane { normal 0 1 0 offset -1 }\n"
+                 " MaterialIndex 1 Transform { Translate -1.2 0 0 %s %s }\n"
+                 " MaterialIndex 2 Transform { Translate 1.6 0 0 YRotate 60 %s %s }\n}\n", lit_header, xf,
+                 shape ? "TriangleMesh { obj_file sphere48.obj }" : "Sphere { radius 1 }", xf,
+                 shape ? "TriangleMesh { obj_file sphere48.obj }" : "Sphere { radius 1 }");
+        Status st = load("squashed.txt", text, shape ? &mesh : &exact, &err);
+        CHECK_MSG(st == ST_OK, "%s", err.msg);
+        if (st) return;
+    }
+    CHECK_EQ_INT(exact.n_sphere_xforms, 2);
+    CHECK_EQ_INT(exact.n_triangles, 0);
+    load("squashed.txt", text, &kd, &err);
+    snprintf(text, sizeof text,
+             "%sGroup { numObjects 3 MaterialIndex 0 Plane { normal 0 1 0 offset -1 }\n"
+             " MaterialIndex 1 Transform { Translate -1.2 0 0 %s Sphere { radius 1 } }\n"
+             " MaterialIndex 2 Transform { Translate 1.6 0 0 YRotate 60 %s Sphere { radius 1 } }\n}\n", lit_header,
+             xf, xf);
+    scene_free(&kd);
+    Status kst = load("squashed.txt", text, &kd, &err);
+    kd.accel = ACCEL_KDTREE;
+    float *a = render_rgb(&exact), *b = render_rgb(&mesh), *k = kst ? NULL : render_rgb(&kd);
+    size_t n = (size_t)exact.image.width * exact.image.height, n_far = 0, kd_far = 0;
+    if (a && b) {
+        double mad = mean_abs_diff(a, b, n, 0.1, &n_far);
+        fprintf(stderr, "  ellipsoids vs the old 9,024-triangle meshes: mean abs difference %.2e, %zu of %zu "
+                "pixels off by > 0.1\n", mad, n_far, n);
+        CHECK(mad < 2e-3);
+        CHECK(n_far <= n / 200);
+    }
+    if (a && k) {
+        double mad = mean_abs_diff(a, k, n, 0.0, &kd_far);
+        fprintf(stderr, "  kd-tree vs BVH: mean abs difference %.2e, %zu pixels differ\n", mad, kd_far);
+        CHECK(kd_far == 0);
+    }
+    free(a);
+    free(b);
+    free(k);
+    scene_free(&exact);
+    scene_free(&mesh);
+    scene_free(&kd);
+
+    /* the silhouette: flat colours (no lights), a black background, the view down -z */
+    enum { W = 120, H = 80 };
+    for (int shape = 0; shape < 2; shape++) {
+        snprintf(text, sizeof text,
+                 "OrthographicCamera { center 0 0 5 direction 0 0 -1 up 0 1 0 size 4 width %d height %d }\n"
+                 "Background { color 0 0 0 }\n"
+                 "Materials { numMaterials 1 Material { diffuseColor 1 1 1 } }\n"
+                 "Group { numObjects 1 Transform { ZRotate 30 Scale 1.6 0.7 1 %s } }\n", W, H,
+                 shape ? "TriangleMesh { obj_file sphere48.obj }" : "Sphere { radius 1 }");
+        Scene s;
+        Status st = load("silhouette.txt", text, &s, &err);
+        CHECK_MSG(st == ST_OK, "%s", err.msg);
+        float *rgb = st ? NULL : render_rgb(&s);
+        size_t wrong = 0, near_edge = 0;
+        double c = cos(M_PI / 6.0), sn = sin(M_PI / 6.0);
+        for (int j = 0; rgb && j < H; j++)
+            for (int i = 0; i < W; i++) {
+                /* the pixel centre's ray, turned back by -30 degrees and unsquashed */
+                double x = ((i + 0.5) / W - 0.5) * 4.0 * W / H, y = (0.5 - (j + 0.5) / H) * 4.0;
+                double xo = (c * x + sn * y) / 1.6, yo = (-sn * x + c * y) / 0.7, q = xo * xo + yo * yo;
+                if (fabs(q - 1.0) < 1e-5) {
+                    near_edge++;
+                    continue;
+                }
+                wrong += (rgb[3 * ((size_t)j * W + i)] > 0.5f) != (q < 1.0);
+            }
+        fprintf(stderr, "  %s: %zu of %d pixels on the wrong side of the silhouette (%zu within 1e-5 of it)\n",
+                shape ? "the old mesh" : "the ellipsoid", wrong, W * H, near_edge);
+        if (!shape) CHECK_EQ_INT(wrong, 0);
+        free(rgb);
+        scene_free(&s);
+    }
+}
+
 /* Mirroring transforms keep outward normals outward: with the view down -z through an
  * orthographic camera, the first hit's normal (the normal image, (n + 1) / 2, not
  * turned to face the viewer) points back at the camera on every pixel of a mirrored
@@ -1067,6 +1187,7 @@ int main(void)
     RUN(test_mesh_normals_by_index);
     RUN(test_cli);
     RUN(test_mesh_instances);
+    RUN(test_squashed_sphere_image);
     RUN(test_mirror_normals);
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);

@@ -356,6 +356,36 @@ static void test_squashed_spheres_memory(void)
     free(objects);
 }
 
+/* A RevSurface that a transform tilts still becomes a mesh (16 x 96 quads a segment,
+ * 3,072 triangles for one cubic): those meshes hold at most
+ * CLPT_MAX_TESSELLATED_TRIANGLES, so the 342nd such surface is an error naming it. */
+static void test_revsurface_tessellation_limit(void)
+{
+    enum { N = 342 };
+    const char *one = "Transform { ZRotate 90 RevSurface { profile BezierCurve { controls [ 1 0 0 ] [ 2 1 0 ] "
+                      "[ 1 2 0 ] [ 1 3 0 ] } } }\n";
+    size_t cap = 1024 + (size_t)N * (strlen(one) + 1), len = 0;
+    char *text = malloc(cap);
+    if (!text) abort();
+    len += (size_t)snprintf(text, cap, "%sMaterials { numMaterials 1 Material { } }\nGroup { numObjects %d\n", camera,
+                            N);
+    for (int i = 0; i < N; i++) len += (size_t)snprintf(text + len, cap - len, "%s", one);
+    snprintf(text + len, cap - len, "}\n");
+    Scene s;
+    Error err;
+    CHECK_EQ_INT(load("tilted.txt", text, &s, &err), ST_INPUT);
+    int line = 2;
+    for (const char *q = camera; *q; q++) line += *q == '\n';
+    char want[512];
+    snprintf(want, sizeof want, "%s/tilted.txt:%d:24: its transform tilts this RevSurface's axis, which makes it a "
+             "mesh of 3072 triangles, and the scene's meshes made from tilted surfaces would then hold more than "
+             "1048576 (CLPT_MAX_TESSELLATED_TRIANGLES)", dir, line + N);
+    CHECK_MSG(strcmp(err.msg, want) == 0, "%s", err.msg);
+    CHECK(s.n_triangles <= CLPT_MAX_TESSELLATED_TRIANGLES);
+    scene_free(&s);
+    free(text);
+}
+
 /* MaterialIndex ignores the group hierarchy, as in the course's parser; objects before
  * any MaterialIndex get material 0. */
 static void test_material_scoping(void)
@@ -1174,6 +1204,7 @@ int main(void)
     RUN(test_orthographic);
     RUN(test_transforms);
     RUN(test_squashed_spheres_memory);
+    RUN(test_revsurface_tessellation_limit);
     RUN(test_material_scoping);
     RUN(test_crlf);
     RUN(test_paths);

@@ -42,10 +42,10 @@
  * from a few bytes, so the size is read from the header before decoding. */
 #define CLPT_MAX_TEXTURE_PIXELS (8192u * 8192u)
 /* Triangles one scene may make from a few numbers in its file: the classic format's
- * spheres under non-uniform transforms (each becomes a mesh of 9,024 triangles): about
- * 116 such spheres, and 0.5 GB with their shading records and kd-tree (a 65 KB file of
- * 1,000 squashed spheres made 9 million triangles and took 4.6 GB); pbrt's loopsubdiv
- * levels (a 4 KB file asked for 33 million) and emitting ellipsoids. */
+ * surfaces of revolution whose axis a transform tilts (3,072 triangles a profile
+ * segment; its squashed spheres, once 9,024 triangles each, so that a 65 KB file of
+ * 1,000 took 4.6 GB, are exact ellipsoids now); pbrt's loopsubdiv levels (a 4 KB file
+ * asked for 33 million) and emitting ellipsoids. */
 #define CLPT_MAX_TESSELLATED_TRIANGLES (1u << 20)
 /* pbrt scenes may tessellate this many more triangles per byte of input they read: a
  * real mesh written as text takes 20 or more bytes a triangle, so its loopsubdiv to

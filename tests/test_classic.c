@@ -1005,6 +1005,17 @@ static void test_mesh_instances(void)
     scene_free(&s);
     scene_free(&flat);
 
+    /* the shipped example: one cube placed eight times, four ellipsoids */
+    scene_init(&s);
+    error_clear(&err);
+    st = scene_load_file("scenes/classic/instances.txt", SCENE_FORMAT_AUTO, &s, NULL, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_objects, 1);
+    CHECK_EQ_INT(s.n_instances, 8);
+    CHECK_EQ_INT(s.n_triangles, 12);
+    CHECK_EQ_INT(s.n_sphere_xforms, 4);
+    scene_free(&s);
+
     /* --stats: one mesh stored, three placed */
     char scene[256], out[256];
     snprintf(scene, sizeof scene, "%s/three.txt", dir);

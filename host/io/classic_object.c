@@ -190,7 +190,8 @@ static Status load_mesh(Classic *c, const Token *kw, const ClassicValue *v, cons
                         uint material, const char *name, uint *object)
 {
     Status st = ST_OK;
-    if (object) st = scene_object_begin(c->s, name, strlen(name), object, c->err);
+    if (object && (st = scene_object_begin(c->s, name, strlen(name), object, c->err)) == ST_INPUT)
+        reader_annotate(&c->lx, kw, c->err);    /* past SCENE_MAX_OBJECTS */
     if (st) return st;
     /* the sink applies the transform as it does to a mesh of our format */
     MeshOptions o = mesh_options(material);

@@ -957,7 +957,7 @@ static const char *lit_header =
 
 /* The same OBJ under three transforms (one a mirror) is one object placed three times;
  * under another material it is a second object; outside any Transform it is read into
- * the world as before. Each image equals the one of the meshes carried to the world
+ * the world as before, and so are all meshes of a file that places none twice. Each image equals the one of the meshes carried to the world
  * vertex by vertex (scene_flatten_instances, what the kd-tree renders, as the reader did
  * before) within float rounding. */
 static void test_mesh_instances(void)
@@ -1004,6 +1004,21 @@ static void test_mesh_instances(void)
     free(b);
     scene_free(&s);
     scene_free(&flat);
+
+    /* a mesh placed once is carried into the world, as before: no object is left */
+    snprintf(text, sizeof text, "%sGroup { numObjects 2 MaterialIndex 1\n"
+             " Transform { Translate 5 0 0 TriangleMesh { obj_file cube24.obj } }\n"
+             " MaterialIndex 2 Transform { Translate -5 0 0 TriangleMesh { obj_file cube24.obj } } }\n", lit_header);
+    st = load("once.txt", text, &s, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_objects, 0);
+    CHECK_EQ_INT(s.n_instances, 0);
+    CHECK_EQ_INT(s.n_triangles, 24);
+    int moved = 1;
+    for (size_t i = 0; i < s.n_triangles; i++)
+        moved &= fabsf(s.triangles[i].p0.x) >= 4.0f && fabsf(s.triangles[i].p0.x) <= 6.0f;   /* a unit cube */
+    CHECK(moved);
+    scene_free(&s);
 
     /* the shipped example: one cube placed eight times, four ellipsoids */
     scene_init(&s);
@@ -1173,9 +1188,10 @@ static void test_mirror_normals(void)
             snprintf(text, sizeof text,
                      "OrthographicCamera { center 0 0 5 direction 0 0 -1 up 0 1 0 size 3 width %d height %d }\n"
                      "Materials { numMaterials 1 Material { diffuseColor 1 1 1 } }\n"
-                     "Group { numObjects 2\n"
+                     "Group { numObjects 3\n"
                      " Transform { Translate -1.5 0 0 %sRotate { 1 1 0 35 } Translate -0.5 -0.5 -0.5 "
                      "TriangleMesh { obj_file cube24.obj } }\n"
+                     " Transform { Translate 100 0 0 TriangleMesh { obj_file cube24.obj } }\n"
                      " Transform { Translate 1.5 0 0 %sRotate { 1 1 0 35 } Scale 1 0.6 0.8 Sphere { radius 1 } }\n"
                      "}\n", W, H, m, m);
             Scene s;
@@ -1183,7 +1199,7 @@ static void test_mirror_normals(void)
             Status st = load("mirror.txt", text, &s, &err);
             CHECK_MSG(st == ST_OK, "%s", err.msg);
             if (st) continue;
-            CHECK_EQ_INT(s.n_instances, 1);
+            CHECK_EQ_INT(s.n_instances, 2);     /* placed twice (the second out of view): shared */
             s.integrator = INTEGRATOR_AOV_NORMAL;
             s.accel = accel ? ACCEL_KDTREE : ACCEL_BVH;
             float *rgb = render_rgb(&s);

@@ -7,6 +7,7 @@
 #include "io/classic_reader.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -245,6 +246,22 @@ static Status build_mesh(Classic *c, const Token *kw, const Transform *m, const 
     if (st || !scene_object_prims(c->s, object)) return st;
     if ((st = scene_add_instance(c->s, object, m, NO_INDEX, c->err)) == ST_INPUT) reader_annotate(&c->lx, kw, c->err);
     return st;
+}
+
+Status classic_finish_instances(Classic *c)
+{
+    Scene *s = c->s;
+    if (s->n_objects == 0) return ST_OK;
+    /* an object placed twice is what instancing is for; when none is, the copies are
+     * what the reader made before (the same corners, within rounding), and the scene
+     * keeps the one-level tree and the lean kernels */
+    uint8_t *placed = calloc(s->n_objects, 1);
+    if (!placed) return error_set(c->err, ST_INTERNAL, "out of memory");
+    int shared = 0;
+    for (size_t i = 0; i < s->n_instances && !shared; i++) shared = placed[s->instance_objects[i]]++ > 0;
+    free(placed);
+    if (shared) return ST_OK;
+    return scene_flatten_instances(s, c->err);    /* objects hold triangles alone: no refusal */
 }
 
 /* A profile curve: `{ controls [ x y z ] [ x y z ] ... }` as the Tsinghua PA2/PA3

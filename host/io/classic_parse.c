@@ -454,6 +454,7 @@ static Status load(const char *path, const char *text, size_t len, Scene *s, Err
                           "Materials, Group)");
         if (st) break;
     }
+    if (!st) st = classic_finish_instances(&c);
     if (!st && !c.seen_camera)
         st = lex_error_at(&c.lx, &t, err, "the scene has no camera (a PerspectiveCamera or OrthographicCamera block)");
     /* as in the course's parser: a scene without lights is drawn in flat colours */

@@ -80,5 +80,8 @@ Status classic_parse_materials(Classic *c, const Token *kw);
 /* classic_object.c: objects and their transforms */
 Status classic_parse_transform_ops(Classic *c, Transform *m, Token *stop);
 Status classic_parse_object(Classic *c, const Token *kw, const Transform *m);
+/* At the end of the file: when no mesh object is placed more than once, its instances
+ * become the world copies they stand for (scene_flatten_instances). */
+Status classic_finish_instances(Classic *c);
 
 #endif /* CLPT_CLASSIC_READER_H */

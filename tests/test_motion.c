@@ -17,6 +17,7 @@
 #include "harness.h"
 #include "cli_util.h"
 #include "render_util.h"
+#include "io/scene_load.h"
 #include "scene/motion.h"
 #include "scene/transform.h"
 #include "util/kmath.h"
@@ -261,7 +262,8 @@ static void test_moving_lamps_are_lights(void)
             CHECK(light_instance(s.lights[i]) == (i < 3 ? 0u : 1u));
         }
         CHECK(s.lights[0].quad == LIGHT_QUAD_FIRST && s.lights[1].quad == LIGHT_QUAD_SECOND);
-        /* the ball's area at its first pose (radius 0.2) sets its power */
+        /* the ball's record keeps its first pose's area (radius 0.2); its power is its
+         * mean area's over the shutter (test_growing_lamp_chosen_by_mean_power) */
         CHECK(fabsf(s.lights[3].area - (float)(4.0 * M_PI * 0.04)) < 1e-5f);
     }
     render_scene_free(&rs);
@@ -281,6 +283,90 @@ static void test_moving_lamps_are_lights(void)
     CHECK_MSG(render_scene_prepare(&s, 1, &rs, &err) == ST_OK, "%s", err.msg);
     CHECK_EQ_INT(s.n_lights, 3);
     if (s.n_lights == 3) CHECK(s.lights[2].type == LIGHT_MOVING && s.lights[2].pick_pdf == 0.0f);
+    render_scene_free(&rs);
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* The mean area over the shutter (motion_mean_area): exact for a similarity's keys,
+ * whose area is quadratic in time (a unit square growing from 0.25 to 2 across: the
+ * mean of s^2 is (2^3 - 0.25^3) / (3 x 1.75)), held before the first key, and within
+ * 1e-6 of a fine midpoint sum for a stretch that makes it the root of a quartic. */
+static void test_mean_area(void)
+{
+    Error err = { 0 };
+    MotionKey k[2];
+    Transform a = transform_scale(0.25, 0.25, 0.25), b = transform_scale(2, 2, 2);
+    CHECK(motion_key_make(&a, 0.0f, &k[0], &err) == ST_OK && motion_key_make(&b, 1.0f, &k[1], &err) == ST_OK);
+    k[0].count = k[1].count = 2;
+    const double ex[3] = { 1, 0, 0 }, ey[3] = { 0, 1, 0 };
+    double exact = (8.0 - 0.25 * 0.25 * 0.25) / (3.0 * 1.75);
+    double got = motion_mean_area(k, 2, 0.0, 1.0, ex, ey);
+    CHECK_MSG(fabs(got - exact) < 1e-9, "similarity: %.12g, exact %.12g", got, exact);
+    /* a shutter open from -1: half of it at the first pose */
+    got = motion_mean_area(k, 2, -1.0, 1.0, ex, ey);
+    CHECK_MSG(fabs(got - 0.5 * (0.0625 + exact)) < 1e-9, "shutter before the keys: %.12g", got);
+    CHECK(fabs(motion_mean_area(k, 2, 1.5, 1.5, ex, ey) - 4.0) < 1e-9);
+
+    /* three keys, a stretch along x turned: S(t) not diagonal in the edges' frame */
+    MotionKey m[3];
+    Transform turn = transform_rotate(0, 0, 1, 30), sx = transform_scale(3, 0.5, 1), rt = transform_rotate(0, 0, 1, -30);
+    Transform rs = transform_compose(&turn, &sx), c1 = transform_compose(&rs, &rt), c2 = transform_scale(1, 1, 2),
+              c0 = transform_identity();
+    CHECK(motion_key_make(&c0, 0.0f, &m[0], &err) == ST_OK && motion_key_make(&c1, 0.5f, &m[1], &err) == ST_OK &&
+          motion_key_make(&c2, 1.0f, &m[2], &err) == ST_OK);
+    m[0].count = m[1].count = m[2].count = 3;
+    const double e1[3] = { 1, 1, 0 }, e2[3] = { 0, 1, 1 };
+    double sum = 0.0;
+    enum { STEPS = 200000 };
+    for (int i = 0; i < STEPS; i++) {
+        double t = 0.1 + 0.8 * (i + 0.5) / STEPS;
+        Transform mt = motion_transform_at(m, 3, (float)t);
+        double u[3], v[3];
+        for (int j = 0; j < 3; j++) {
+            u[j] = mt.m[j][0] * e1[0] + mt.m[j][1] * e1[1] + mt.m[j][2] * e1[2];
+            v[j] = mt.m[j][0] * e2[0] + mt.m[j][1] * e2[1] + mt.m[j][2] * e2[2];
+        }
+        double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2], cz = u[0] * v[1] - u[1] * v[0];
+        sum += sqrt(cx * cx + cy * cy + cz * cz);
+    }
+    double fine = sum / STEPS;
+    got = motion_mean_area(m, 3, 0.1, 0.9, e1, e2);
+    fprintf(stderr, "  mean area over [0.1, 0.9] of a turned stretch: Simpson %.9f, 200000 midpoints of the "
+            "kernels' transform %.9f\n", got, fine);
+    CHECK_MSG(fabs(got - fine) < 1e-6 * fine, "Simpson %.9g against %.9g", got, fine);
+    error_clear(&err);
+}
+
+/* A growing lamp is chosen by its mean power over the shutter
+ * (tests/data/motion/growing-lamp.scene): a 1 x 0.6 quad scaled from 0.25 to 2, mean
+ * area 0.6 x 1.5208, beside a still 1.2 x 0.8 quad of the same radiance; each is two
+ * lights (its quad's halves) of half its power. At its first pose it would get 3.8%
+ * of the choice, over the shutter it gives 48.7% of the light. The kernels' records keep
+ * the first pose's area (and the still scene's lights their bits). */
+static void test_growing_lamp_chosen_by_mean_power(void)
+{
+    Scene s;
+    RenderScene rs;
+    Error err = { 0 };
+    scene_init(&s);
+    CHECK_MSG(scene_load_file("tests/data/motion/growing-lamp.scene", SCENE_FORMAT_AUTO, &s, NULL, &err) == ST_OK,
+              "%s", err.msg);
+    CHECK_MSG(render_scene_prepare(&s, 1, &rs, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_lights, 4);
+    if (s.n_lights == 4) {
+        double still = 1.2 * 0.8, moving = 0.6 * (8.0 - 0.25 * 0.25 * 0.25) / (3.0 * 1.75);
+        double want = 0.5 * moving / (still + moving);
+        CHECK(s.lights[2].type == LIGHT_MOVING && s.lights[3].type == LIGHT_MOVING);
+        for (int i = 0; i < 4; i++) {
+            double p = i < 2 ? 0.5 - want : want;
+            CHECK_MSG(fabs(s.lights[i].pick_pdf - p) < 1e-6, "light %d: chosen with %g, not %g", i,
+                      (double)s.lights[i].pick_pdf, p);
+        }
+        CHECK(fabsf(s.lights[2].area - (float)(0.5 * 0.6 * 0.0625)) < 1e-6f);
+        fprintf(stderr, "  growing lamp: each half chosen with %.4f (its first pose's power would give %.4f)\n",
+                (double)s.lights[2].pick_pdf, 0.5 * 0.6 * 0.0625 / (still + 0.6 * 0.0625));
+    }
     render_scene_free(&rs);
     scene_free(&s);
     error_clear(&err);
@@ -440,6 +526,8 @@ int main(void)
     RUN(test_moving_camera_is_average_of_still);
     RUN(test_moving_instance_is_average_of_still);
     RUN(test_moving_lamps_are_lights);
+    RUN(test_mean_area);
+    RUN(test_growing_lamp_chosen_by_mean_power);
     RUN(test_moving_lamps_strategies_agree);
     RUN(test_moving_lamp_is_average_of_still);
     RUN(test_bounds_hold_the_motion);

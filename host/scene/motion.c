@@ -253,3 +253,58 @@ void motion_bounds(const MotionKey *keys, size_t n, const double lo[3], const do
         wh[k] += step;
     }
 }
+
+/* |S a x S b| for the symmetric stretch sv (s00 s01 s02 s11 s12 s22). */
+static double stretched_area(const double sv[6], const double a[3], const double b[3])
+{
+    const double sm[3][3] = { { sv[0], sv[1], sv[2] }, { sv[1], sv[3], sv[4] }, { sv[2], sv[4], sv[5] } };
+    double sa[3], sb[3];
+    for (int r = 0; r < 3; r++) {
+        sa[r] = sm[r][0] * a[0] + sm[r][1] * a[1] + sm[r][2] * a[2];
+        sb[r] = sm[r][0] * b[0] + sm[r][1] * b[1] + sm[r][2] * b[2];
+    }
+    double cx = sa[1] * sb[2] - sa[2] * sb[1], cy = sa[2] * sb[0] - sa[0] * sb[2], cz = sa[0] * sb[1] - sa[1] * sb[0];
+    return sqrt(cx * cx + cy * cy + cz * cz);
+}
+
+/* The area under the keys' stretch at time t (key_transform's interpolation). */
+static double area_at(const MotionKey *keys, size_t n, double t, const double a[3], const double b[3])
+{
+    size_t i = 0;
+    while (i + 2 < n && !(t < keys[i + 1].time)) i++;
+    const MotionKey *k0 = keys + i, *k1 = keys + (n > 1 ? i + 1 : i);
+    double u = 0.0, sv[6];
+    if (k1->time > k0->time) u = fmin(fmax((t - k0->time) / ((double)k1->time - k0->time), 0.0), 1.0);
+    for (int j = 0; j < 6; j++) sv[j] = (1.0 - u) * k0->stretch[j] + u * k1->stretch[j];
+    return stretched_area(sv, a, b);
+}
+
+/* Panels of Simpson's rule per stretch between key times. Between two keys the area is
+ * |c(u)|, c a quadratic in u: a square root of a quartic, smooth unless c passes near
+ * zero (a stretch that flattens the shape), where it is still continuous. */
+#define MOTION_AREA_PANELS 8
+
+double motion_mean_area(const MotionKey *keys, size_t n, double open, double close, const double a[3],
+                        const double b[3])
+{
+    if (n == 0) return 0.0;
+    if (!(close > open)) return area_at(keys, n, open, a, b);
+    /* the shutter cut at the key times inside it, where the area has kinks; Simpson's
+     * rule (composite, even panel count) on each piece (Press et al., Numerical
+     * Recipes, 3rd ed., 4.1) */
+    double sum = 0.0, t0 = open;
+    for (size_t k = 0; k <= n; k++) {
+        double t1 = k < n ? (double)keys[k].time : close;
+        if (!(t1 > t0)) continue;
+        if (t1 > close) t1 = close;
+        double h = (t1 - t0) / MOTION_AREA_PANELS, piece = 0.0;
+        for (int j = 0; j <= MOTION_AREA_PANELS; j++) {
+            double w = (j == 0 || j == MOTION_AREA_PANELS) ? 1.0 : (j % 2 ? 4.0 : 2.0);
+            piece += w * area_at(keys, n, t0 + h * j, a, b);
+        }
+        sum += piece * h / 3.0;
+        t0 = t1;
+        if (!(t0 < close)) break;
+    }
+    return sum / (close - open);
+}

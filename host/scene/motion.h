@@ -45,4 +45,14 @@ void motion_bounds(const MotionKey *keys, size_t n, const double lo[3], const do
  * here in float, as a device does): for tests and for bounds over the shutter. */
 Transform motion_transform_at(const MotionKey *keys, size_t n, float time);
 
+/* The mean over the shutter [open, close] of |S(t) a x S(t) b|, S(t) the stretch of the
+ * n keys at time t as the kernels interpolate it (linear between keys, held before the
+ * first and after the last): the area a parallelogram of edges a, b has at time t under
+ * the moving transform, since its rotation and translation change no area. In double,
+ * by Simpson's rule on MOTION_AREA_PANELS panels of each stretch of the shutter between
+ * key times; exact for a similarity's keys (the area is then quadratic in t), within
+ * 1e-6 of the integral for any stretch (test_motion.c). close <= open: the area at open. */
+double motion_mean_area(const MotionKey *keys, size_t n, double open, double close, const double a[3],
+                        const double b[3]);
+
 #endif /* CLPT_MOTION_H */

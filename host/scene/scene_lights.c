@@ -10,6 +10,7 @@
 #include "base/array.h"
 #include "scene/env_dist.h"
 #include "scene/instance.h"
+#include "scene/motion.h"
 #include "scene/transform.h"
 #include "util/kmath.h"
 
@@ -435,22 +436,35 @@ static Light instanced_light(const Scene *s, const Light *tpl, const Instance *x
 
 /* Template tpl (object space) of moving instance i, whose keys start at `keys`, as a
  * LIGHT_MOVING record (types.h): the object-space corner and edges (or sphere) the
- * kernels place at each path's time, the instance, and in `area` (*area in double) the
- * area of its first pose (the instance record's M), which sets its power: the choice
- * among lights is one distribution for the whole shutter. A sphere whose instance is
- * not a similarity at every key is an ellipsoid somewhere: area 0, never chosen, found
- * by BSDF sampling at full weight (as a still instance's, instanced_sphere_light). */
+ * kernels place at each path's time, and the instance. Its `area` is its first pose's
+ * (the instance record's M), as a still instance's light would have. *area gets, in
+ * double, its mean area over the shutter (motion_mean_area), which sets its power: the
+ * choice among lights is one distribution for the whole shutter, and a path's time is
+ * uniform over it, so a lamp that grows is chosen in proportion to the light it gives
+ * on average, not at the opening (docs/motion.md, Moving emitters). A sphere whose
+ * instance is not a similarity at every key is an ellipsoid somewhere: area 0, never
+ * chosen, found by BSDF sampling at full weight (as a still instance's,
+ * instanced_sphere_light). */
 static Light moving_light(const Scene *s, const Light *tpl, uint i, const MotionKey *keys, double *area)
 {
     Light l = instanced_light(s, tpl, &s->instances[i], area);
     uint first_tri = scene_first_triangle(s);
+    double open = s->camera.shutter_open, close = s->camera.shutter_close;
     l.type = LIGHT_MOVING;
     l.spot_falloff = i;    /* light_instance */
     if (tpl->prim < first_tri) {
         l.position = tpl->position;
         l.atten0 = tpl->atten0;
-        if (!keys_are_similarities(keys)) *area = 0.0;
-        l.area = (float)*area;
+        if (!keys_are_similarities(keys)) {
+            *area = 0.0;
+            l.area = 0.0f;
+            return l;
+        }
+        /* under a similarity s(t) I the sphere's area is 4 pi r^2 s(t)^2, and s(t)^2 is
+         * the area the stretch gives a unit square */
+        const double ex[3] = { 1.0, 0.0, 0.0 }, ey[3] = { 0.0, 1.0, 0.0 };
+        double r = tpl->atten0;
+        *area = 4.0 * M_PI * r * r * motion_mean_area(keys, keys[0].count, open, close, ex, ey);
         return l;
     }
     l.normal = tpl->normal;
@@ -464,6 +478,10 @@ static Light moving_light(const Scene *s, const Light *tpl, uint i, const Motion
         l.direction = v3_sub(tr->p1, tr->p0);
         l.intensity = v3_sub(tr->p2, tr->p0);
     }
+    /* half the parallelogram of its two edges, as instanced_light's area */
+    const double e1[3] = { l.direction.x, l.direction.y, l.direction.z },
+                 e2[3] = { l.intensity.x, l.intensity.y, l.intensity.z };
+    *area = 0.5 * motion_mean_area(keys, keys[0].count, open, close, e1, e2);
     return l;
 }
 

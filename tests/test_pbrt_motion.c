@@ -5,7 +5,8 @@
  * camera against the average of still renders at fixed times; a turning instance at
  * one time at its own pose, not pbrt-v4's camera-pivoted one; a still scene with a
  * shutter and idle motion directives unchanged bit for bit; a scene like pbrt-v4's
- * killeroo-moving.pbrt (a spinning, sliding shape) read and rendered.
+ * killeroo-moving.pbrt (a spinning, sliding shape) read and rendered; a moving Shape
+ * inside ObjectBegin/End moving within each of its instances, as pbrt-v4's does.
  * Bad input: tests/data/bad/pbrt-motion-* (test_bad_input.c). Run from the project root.
  */
 #include <math.h>
@@ -16,6 +17,8 @@
 #include "harness.h"
 #include "render_util.h"
 #include "io/scene_load.h"
+#include "scene/motion.h"
+#include "scene/transform.h"
 
 static Status load_text(const char *text, Scene *s, Error *err)
 {
@@ -293,6 +296,145 @@ static void test_killeroo_moving_like(void)
     scene_free(&s);
 }
 
+/* An object with a still red sphere and a yellow one that rises and grows inside it
+ * (its own transforms: Translate 0.9 0 0, and at the end Translate 0.9 1 0 Scale
+ * 2.5): pbrt-v4 moves such a shape within each instance (an AnimatedPrimitive in the
+ * instance's BVH, src/pbrt/scene.cpp). %s: the instances. */
+#define PARTS                                                                            \
+    "ObjectBegin \"parts\"\n"                                                             \
+    "  Material \"diffuse\" \"rgb reflectance\" [0.8 0.2 0.2]\n"                         \
+    "  Shape \"sphere\" \"float radius\" 0.3\n"                                          \
+    "  AttributeBegin\n"                                                                \
+    "    Material \"diffuse\" \"rgb reflectance\" [0.9 0.9 0.2]\n"                       \
+    "    Translate 0.9 0 0\n"                                                           \
+    "    ActiveTransform EndTime Translate 0 1 0 Scale 2.5 2.5 2.5 ActiveTransform All\n" \
+    "    Shape \"sphere\" \"float radius\" 0.25\n"                                       \
+    "  AttributeEnd\n"                                                                  \
+    "ObjectEnd\n%s"
+
+static double transform_apart(const Transform *a, const Transform *b)
+{
+    double d = 0.0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++) d = fmax(d, fabs(a->m[i][j] - b->m[i][j]));
+    return d;
+}
+
+/* W times the part's own transform at time u (Translate 0.9 u 0, Scale 1 + 1.5u). */
+static Transform part_pose(const Transform *w, double u)
+{
+    Transform t = transform_translate(0.9, u, 0), sc = transform_scale(1 + 1.5 * u, 1 + 1.5 * u, 1 + 1.5 * u);
+    Transform c = transform_compose(&t, &sc);
+    return transform_compose(w, &c);
+}
+
+/* Three instances of PARTS: under a still similarity (its part a moving instance of 2
+ * keys, W C0 and W C1: exact), under a still non-uniform scale and under a sliding
+ * transform (17 keys each, W(t) C(t) at each). Every one places the red sphere as a
+ * still instance and the yellow one as a moving instance, with no warning; a key's
+ * transform is W(t) C(t) at its time, and between keys within 1e-3. */
+static void test_object_shape_moves_within_instances(void)
+{
+    char text[8192];
+    snprintf(text, sizeof text, HEAD PARTS, LOOK, "", 16u,
+             "AttributeBegin Translate -1.5 2 0.5 Rotate 30 0 1 0 ObjectInstance \"parts\" AttributeEnd\n"
+             "AttributeBegin Translate 1.5 2 0.5 Scale 1 1.5 1 ObjectInstance \"parts\" AttributeEnd\n"
+             "AttributeBegin Translate 0 3 0.5 ActiveTransform EndTime Translate 0.5 0 0 ActiveTransform All\n"
+             "  ObjectInstance \"parts\"\nAttributeEnd\n");
+    Scene s;
+    Error err = { 0 };
+    CHECK_MSG(load_text(text, &s, &err) == ST_OK, "%s", err.msg);
+    CHECK_EQ_INT(s.n_warnings, 0);
+    CHECK_EQ_INT(s.n_objects, 2);
+    CHECK_EQ_INT(s.n_instances, 6);
+    CHECK_EQ_INT(s.n_motion_keys, 2 + 17 + 2 + 17);   /* the third instance moves its red sphere too */
+    Transform r = transform_rotate(0, 1, 0, 30), t = transform_translate(-1.5, 2, 0.5), sc = transform_scale(1, 1.5, 1),
+              t2 = transform_translate(1.5, 2, 0.5), t3 = transform_translate(0, 3, 0.5);
+    Transform w[3] = { transform_compose(&t, &r), transform_compose(&t2, &sc), t3 };
+    const uint counts[3] = { 2, 17, 17 };
+    for (int k = 0; k < 3 && s.n_instances == 6 && s.n_motion_keys == 38; k++) {
+        uint inst = (uint)(2 * k + 1);
+        CHECK(inst < s.n_instance_motion && s.instance_motion[inst] != NO_INDEX);
+        if (k < 2) CHECK(2 * (size_t)k >= s.n_instance_motion || s.instance_motion[2 * k] == NO_INDEX);
+        if (!(inst < s.n_instance_motion) || s.instance_motion[inst] == NO_INDEX) continue;
+        const MotionKey *keys = s.motion_keys + s.instance_motion[inst];
+        CHECK_EQ_INT(keys[0].count, counts[k]);
+        const double times[4] = { 0.0, 0.5, 1.0, 0.53 };
+        for (int j = 0; j < 4; j++) {
+            Transform wt = w[k];
+            if (k == 2) wt.m[0][3] += 0.5 * times[j];    /* the slide */
+            Transform want = part_pose(&wt, times[j]), got = motion_transform_at(keys, counts[k], (float)times[j]);
+            double d = transform_apart(&got, &want);
+            /* 0.53 lies between keys of the 17; of the 2 (a similarity) it is exact */
+            CHECK_MSG(d < (j == 3 && k > 0 ? 1e-3 : 2e-5), "instance %d at %g: %g from W(t) C(t)", k, times[j], d);
+        }
+    }
+    scene_free(&s);
+
+    /* an emitting moving Shape in an object is a light placed at each path's time, as a
+     * bare one is (pbrt-v4 refuses any animated area light) */
+    snprintf(text, sizeof text, HEAD "ObjectBegin \"lamp\"\n"
+             "  AreaLightSource \"diffuse\" \"rgb L\" [4 4 4]\n"
+             "  ActiveTransform EndTime Translate 0.5 0 0 ActiveTransform All\n"
+             "  Shape \"trianglemesh\" \"point3 P\" [0 3 0 1 3 0 0 3 1] \"integer indices\" [0 2 1]\n"
+             "ObjectEnd\nObjectInstance \"lamp\"\n", LOOK, "", 16u);
+    CHECK_MSG(load_text(text, &s, &err) == ST_OK, "%s", err.msg);
+    RenderScene rs;
+    CHECK_MSG(render_scene_prepare(&s, 1, &rs, &err) == ST_OK, "%s", err.msg);
+    uint moving = 0;
+    for (size_t i = 0; i < s.n_lights; i++) moving += s.lights[i].type == LIGHT_MOVING;
+    CHECK_EQ_INT(moving, 1);
+    render_scene_free(&rs);
+    scene_free(&s);
+    error_clear(&err);
+}
+
+/* The yellow sphere moving within its instance against the average of 8 still renders
+ * with it at its pose then. */
+static void parts_still(double u, char *text, size_t size)
+{
+    snprintf(text, size, HEAD "ObjectBegin \"parts\"\n"
+             "  Material \"diffuse\" \"rgb reflectance\" [0.8 0.2 0.2]\n"
+             "  Shape \"sphere\" \"float radius\" 0.3\n"
+             "  Material \"diffuse\" \"rgb reflectance\" [0.9 0.9 0.2]\n"
+             "  Translate 0.9 %.9g 0 Scale %.9g %.9g %.9g Shape \"sphere\" \"float radius\" 0.25\n"
+             "ObjectEnd\n"
+             "Translate 1.2 1.6 -0.5 Rotate 30 0 1 0 ObjectInstance \"parts\"\n", LOOK, "", (unsigned)SPP_STILL,
+             u, 1 + 1.5 * u, 1 + 1.5 * u, 1 + 1.5 * u);
+}
+
+static void test_object_shape_is_average_of_still(void)
+{
+    char text[8192];
+    snprintf(text, sizeof text, HEAD PARTS, LOOK, "", (unsigned)(K * SPP_STILL),
+             "Translate 1.2 1.6 -0.5 Rotate 30 0 1 0 ObjectInstance \"parts\"\n");
+    check_average("moving Shape in an object", text, parts_still, 0.03);
+}
+
+/* The poses moving Shapes in objects take are bounded: 64 moving spheres in an object,
+ * instanced 1000 times under a non-uniform scale (17 poses each), would take 1,088,000,
+ * more than the 2^20 allowed: an error at the instance that passes it. */
+static void test_object_shape_poses_bounded(void)
+{
+    size_t size = 64 * 120 + 1000 * 32 + 256, len = 0;
+    char *text = malloc(size);
+    len += (size_t)snprintf(text + len, size - len, "WorldBegin\nObjectBegin \"o\"\n");
+    for (int i = 0; i < 64; i++)
+        len += (size_t)snprintf(text + len, size - len, "AttributeBegin Translate %d 0 0 ActiveTransform EndTime "
+                                "Translate 0 1 0 ActiveTransform All Shape \"sphere\" AttributeEnd\n", i);
+    len += (size_t)snprintf(text + len, size - len, "ObjectEnd\nScale 1 2 1\n");
+    for (int i = 0; i < 1000; i++) len += (size_t)snprintf(text + len, size - len, "ObjectInstance \"o\"\n");
+    Scene s;
+    Error err = { 0 };
+    CHECK(load_text(text, &s, &err) == ST_INPUT);
+    /* 963 instances take 963 x 64 x 17 = 1,047,744 poses; the 964th passes 2^20 */
+    CHECK_STR_CONTAINS(err.msg, "inline.pbrt:1032:16: ObjectInstance \"o\": the moving Shapes in objects would take "
+                       "more than 1048576 poses (2 per instance under a still similarity, else 17)");
+    scene_free(&s);
+    free(text);
+    error_clear(&err);
+}
+
 /* A shutter that closes before it opens is swapped with a warning, as pbrt-v4 does. */
 static void test_shutter_swapped(void)
 {
@@ -318,5 +460,8 @@ int main(void)
     RUN(test_still_with_shutter_same_bits);
     RUN(test_killeroo_moving_like);
     RUN(test_shutter_swapped);
+    RUN(test_object_shape_moves_within_instances);
+    RUN(test_object_shape_is_average_of_still);
+    RUN(test_object_shape_poses_bounded);
     return harness_report();
 }

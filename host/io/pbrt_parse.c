@@ -693,13 +693,7 @@ Status pbrt_load_text(const char *path, const char *text, size_t len, Scene *s, 
     strmap_free(&p.tex_by_name);
     strmap_free(&p.warned);
     strmap_free(&p.object_by_name);
-    for (size_t i = 0; i < p.n_objects; i++) {
-        free(p.objects[i].spheres);
-        free(p.objects[i].sphere_xforms);
-        free(p.objects[i].triangles);
-        free(p.objects[i].shading);
-    }
-    free(p.objects);
+    pbrt_objects_free(&p);
     free(p.obj_name_buf);
     return st;
 }

@@ -93,6 +93,8 @@ typedef struct {
  * or, when it holds no shapes, its shapes taken out of the scene and copied in at each
  * instance. An object with an emitting sphere keeps its shapes here too, for the
  * instances that copy them (a transform that is no similarity: pbrt_shape.c). */
+typedef struct PMovingPart PMovingPart;
+
 typedef struct {
     uint object;          /* the scene's object, or NO_INDEX: copies of the arrays below */
     int sphere_emits;     /* copy, rather than place, under a transform no similarity */
@@ -100,7 +102,21 @@ typedef struct {
     SphereXform *sphere_xforms;  size_t n_sphere_xforms;   /* Sphere.xform indexes this */
     Triangle *triangles;  size_t n_triangles;
     TriShading *shading;  size_t n_shading;   /* Triangle.shading indexes this */
+    PMovingPart *moving;  size_t n_moving;    /* its Shapes under a moving transform */
 } PObject;
+
+/* A Shape inside ObjectBegin/End under a moving transform, which pbrt-v4 moves within
+ * its object (docs/pbrt.md#motion): its shapes, made in their own space (both
+ * transforms the identity), kept in `shapes` until ObjectEnd makes them an object of
+ * their own (`object`, an index into Parser.objects), and the CTM's two transforms at
+ * the Shape. Each ObjectInstance places that object as a moving instance under its own
+ * transform times these. */
+struct PMovingPart {
+    PObject shapes;       /* until ObjectEnd: the shapes taken out of the object's */
+    uint32_t object;      /* after it: Parser.objects' entry of its own object */
+    Transform start, end;
+    unsigned line, col;   /* the Shape's type, for messages */
+};
 
 typedef struct {
     Scene *s;
@@ -130,6 +146,8 @@ typedef struct {
     size_t obj_spheres, obj_triangles, obj_shading, obj_stack, obj_sphere_xforms;
     size_t obj_first[OBJ_KINDS];   /* the scene's counts at ObjectBegin (scene_object_counts) */
     char obj_where[160];     /* "path:line:col" of the ObjectBegin, for an unclosed one */
+    PMovingPart *obj_moving;  size_t n_obj_moving, cap_obj_moving;   /* its moving Shapes */
+    size_t part_keys;        /* poses made for moving Shapes in objects (PBRT_MAX_PART_KEYS) */
     /* triangles made so far by tessellating what the file describes in a few numbers
      * (loopsubdiv, emitting ellipsoids): at most CLPT_MAX_TESSELLATED_TRIANGLES */
     size_t tessellated;
@@ -199,8 +217,11 @@ int pbrt_is_similarity(const Transform *t, double *scale);
 Status pbrt_sphere_mesh(Parser *p, const Lexer *lx, const Token *at, const char *what, const Transform *xf, double r,
                         uint material, int reverse);
 
-/* pbrt_object.c: ObjectBegin/End/Instance, a Shape under a moving transform */
+/* pbrt_object.c: ObjectBegin/End/Instance, a Shape under a moving transform (outside
+ * an object, and inside one), and freeing the objects' copies at the end */
 Status pbrt_shape_moving(Parser *p, Lexer *lx, const Token *kw, const Token *type);
+Status pbrt_object_shape_moving(Parser *p, Lexer *lx, const Token *type);
+void pbrt_objects_free(Parser *p);
 Status pbrt_object_begin(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_object_end(Parser *p, Lexer *lx, const Token *kw);
 Status pbrt_object_instance(Parser *p, Lexer *lx, const Token *kw);

@@ -462,8 +462,6 @@ Status pbrt_shape_make(Parser *p, Lexer *lx, const Token *type_tok)
         return warn_once(p, lx, &type, key, "Shape \"%.*s\" is not supported; skipped",
                          (int)(type.len > 40 ? 40 : type.len), type.text);
     }
-    /* an object's shapes are placed by its instances, which move: not the shapes */
-    if (pbrt_ctm_moves(p) && (st = pbrt_warn_still(p, lx, &type, "a Shape in an object"))) return st;
     uint material;
     if ((st = pbrt_shape_material(p, &material))) return st;
     if (pbrt_tok_eq(&type, "sphere")) {
@@ -490,6 +488,7 @@ Status pbrt_shape_make(Parser *p, Lexer *lx, const Token *type_tok)
 
 Status pbrt_shape(Parser *p, Lexer *lx, const Token *kw, const Token *type)
 {
-    if (!p->in_object && pbrt_ctm_moves(p)) return pbrt_shape_moving(p, lx, kw, type);
+    if (pbrt_ctm_moves(p))
+        return p->in_object ? pbrt_object_shape_moving(p, lx, type) : pbrt_shape_moving(p, lx, kw, type);
     return pbrt_shape_make(p, lx, type);
 }

@@ -572,8 +572,8 @@ enum SpotFalloff { SPOT_SMOOTHSTEP = 0, SPOT_GLTF = 1 };
  * and edges (or the parallelogram of a quad's halves, `quad`), `normal` the
  * object-space winding normal (a sphere: centre in `position`, radius in `atten0`), and
  * the word a spot light's falloff takes holds the instance (light_instance). `area` is
- * the area of the instance's first pose (the sample's density uses the area at the
- * path's time); the choice's power is the mean area's over the shutter, on the host
+ * the area of the instance's first pose (a sphere's: its object-space area; the
+ * sample's density uses the area at the path's time); the choice's power is the mean area's over the shutter, on the host
  * (host/scene/scene_lights.c). A sphere is a light only when every key of its instance
  * is a similarity (else its `area` is 0: never chosen). */
 

@@ -437,7 +437,8 @@ static Light instanced_light(const Scene *s, const Light *tpl, const Instance *x
 /* Template tpl (object space) of moving instance i, whose keys start at `keys`, as a
  * LIGHT_MOVING record (types.h): the object-space corner and edges (or sphere) the
  * kernels place at each path's time, and the instance. Its `area` is its first pose's
- * (the instance record's M), as a still instance's light would have. *area gets, in
+ * (the instance record's M), as a still instance's light would have; a sphere's is its
+ * object-space area, which light_moving_at scales with the radius. *area gets, in
  * double, its mean area over the shutter (motion_mean_area), which sets its power: the
  * choice among lights is one distribution for the whole shutter, and a path's time is
  * uniform over it, so a lamp that grows is chosen in proportion to the light it gives
@@ -465,6 +466,8 @@ static Light moving_light(const Scene *s, const Light *tpl, uint i, const Motion
         const double ex[3] = { 1.0, 0.0, 0.0 }, ey[3] = { 0.0, 1.0, 0.0 };
         double r = tpl->atten0;
         *area = 4.0 * M_PI * r * r * motion_mean_area(keys, keys[0].count, open, close, ex, ey);
+        /* the object-space area: light_moving_at scales it by s(t)^2 with the radius */
+        l.area = (float)(4.0 * M_PI * r * r);
         return l;
     }
     l.normal = tpl->normal;

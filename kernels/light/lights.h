@@ -117,7 +117,10 @@ KFN Light light_moving_at(const SceneView *sc, Light l)
     l.type = LIGHT_INSTANCED;
     l.position = motion_point(m, l.position);
     if (l.prim < sc->params->n_spheres) {
-        l.atten0 *= k_sqrt(m[0] * m[0] + m[4] * m[4] + m[8] * m[8]);
+        /* the radius, and the area a point on or inside the sphere samples by */
+        float s = k_sqrt(m[0] * m[0] + m[4] * m[4] + m[8] * m[8]);
+        l.atten0 *= s;
+        l.area *= s * s;
         return l;
     }
     l.direction = motion_vector(m, l.direction);

@@ -430,7 +430,11 @@ static Status results_write(Run *r, Error *err)
     /* an adaptive render's image is not its film's: the job resolves it */
     display_send_film(&r->ctx, NULL, job);
     results_print_summary(r);
-    if (st == ST_OK && (r->o.adaptive > 0.0 || r->o.aovs || r->o.denoise)) st = results_run_passes(r, err);
+    /* a --denoise part keeps the denoiser's inputs for merge instead of denoising its
+     * share (render_job_part_features) */
+    int part = r->o.range_end >= 0;
+    if (st == ST_OK && part && r->o.denoise) st = render_job_part_features(job, err);
+    if (st == ST_OK && (r->o.adaptive > 0.0 || r->o.aovs || (r->o.denoise && !part))) st = results_run_passes(r, err);
     return st;
 }
 

@@ -138,7 +138,11 @@
         "normal images rendered at the image's spp,\n" \
         "through mirrors and clear glass);\n" \
         "an .exr output also keeps the noisy colour\n" \
-        "(noisy.R/G/B) and the features as channels.\n" \
+        "(noisy.R/G/B), the features and the emission\n" \
+        "left out and added back (emission.R/G/B,\n" \
+        "emission4x.R/G/B) as channels. With\n" \
+        "--sample-range and --checkpoint PART: PART\n" \
+        "keeps the denoiser's inputs for merge --denoise.\n" \
         "Needs OIDN: sh tools/deps.sh oidn\n" \
         "(docs/denoise.md)") \
     X(OUTPUT, CUSTOM, display_server, "--display-server", NULL, "HOST:PORT", PARSE(parse_display_server), \
@@ -373,8 +377,9 @@ static const char *const help_sections[HELP_SECTIONS] = {
 "                             a render whose --spp grew are one render. Also\n"
 "                             --checkpoint FILE, --gamma srgb|none, -q,\n"
 "                             --view and --exposure as a render's, and\n"
-"                             --denoise (the colour alone: a part holds no\n"
-"                             albedo or normal image)\n"
+"                             --denoise (as one process's --denoise when\n"
+"                             the parts were rendered with --denoise and\n"
+"                             hold its features; else the colour alone)\n"
 "\n"
 "MPI (mpirun -np N clpt SCENE ..., or srun; docs/distributed.md):\n"
 "                             one image from N processes, each on its own\n"

@@ -272,6 +272,9 @@ Status options_finish(Options *o, Error *err)
     if (o->checkpoint_seconds > 0.0 && !o->checkpoint_path && !o->resume_path)
         return error_set(err, ST_USAGE, "--checkpoint-interval needs --checkpoint FILE (or --resume FILE)");
     if (o->resume_path && !o->checkpoint_path) o->checkpoint_path = o->resume_path;
+    if (o->range_end >= 0 && o->denoise && !o->checkpoint_path)
+        return error_set(err, ST_USAGE, "--denoise with --sample-range keeps the denoiser's inputs in the part's "
+                         "checkpoint for clpt merge --denoise: give --checkpoint PART");
     if (o->range_end >= 0 && o->adaptive > 0.0)
         return error_set(err, ST_USAGE, "--adaptive cannot be used with --sample-range (it needs the whole image)");
     /* Flags that shape what another flag turns on do nothing alone: said, not ignored

@@ -28,11 +28,13 @@ static char *default_output(const char *scene_path)
     return out;
 }
 
-/* What the passes after the main image need of the command line. */
+/* What the passes after the main image need of the command line. A --sample-range
+ * part does not denoise: it keeps the denoiser's inputs for clpt merge (main.c). */
 PassRequest outputs_pass_request(const Options *o)
 {
     PassRequest q = { o->adaptive, o->adaptive_spp, o->aovs, { o->aov_files[0], o->aov_files[1], o->aov_files[2] },
-                      o->depth_near, o->depth_far, o->exr_float, o->denoise, o->quiet, o->noise_threshold > 0.0 };
+                      o->depth_near, o->depth_far, o->exr_float, o->denoise && o->range_end < 0, o->quiet,
+                      o->noise_threshold > 0.0 };
     return q;
 }
 

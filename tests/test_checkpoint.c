@@ -215,6 +215,69 @@ static void test_film_values_are_bounded(void)
     expect_film_refused(0, 4000000000u, "samples per pixel outside 1..1000000");
 }
 
+/* A --denoise part's features (format version 4): read back as written, and refused
+ * when their counts disagree with the film's or the header's, or a value is beyond
+ * what their samples can hold. */
+static Status write_read_features(Film *films, uint n, uint features_spp, Checkpoint *c, Error *err)
+{
+    CheckpointId id;
+    memset(&id, 0, sizeof id);
+    id.width = 3;
+    id.height = 2;
+    id.spp = 16;
+    Film f;
+    fill_film(&f, 3, 2, 5);
+    const Batch done[] = { { 3, 5 } };
+    char p[160];
+    snprintf(p, sizeof p, "%s/features.ckpt", dir);
+    Status st = checkpoint_write_features(p, &id, &f, done, 1, films, n, features_spp, err);
+    film_free(&f);
+    if (st == ST_OK) st = checkpoint_read(p, c, err);
+    unlink(p);
+    return st;
+}
+
+static void test_denoise_features_round_trip(void)
+{
+    Film films[CKPT_FEATURES_MAX];
+    for (uint k = 0; k < CKPT_FEATURES_MAX; k++)
+        fill_film(&films[k], 3, 2, k == CKPT_FEATURE_EMISSION_MORE ? 20 : 5);
+    Checkpoint c;
+    Error err = { 0 };
+    CHECK_EQ_INT(write_read_features(films, CKPT_FEATURES_MAX, 16, &c, &err), ST_OK);
+    CHECK(c.n_features == CKPT_FEATURES_MAX && c.features_spp == 16 && c.film.samples == 5);
+    for (uint k = 0; k < CKPT_FEATURES_MAX && c.n_features == CKPT_FEATURES_MAX; k++)
+        CHECK(c.features[k].samples == films[k].samples &&
+              memcmp(c.features[k].sum, films[k].sum, 3 * 2 * 3 * sizeof *films[k].sum) == 0);
+    checkpoint_free(&c);
+    CHECK_EQ_INT(write_read_features(films, 2, 16, &c, &err), ST_OK);   /* albedo and normal alone */
+    CHECK(c.n_features == 2 && !c.features[CKPT_FEATURE_EMISSION].sum);
+    checkpoint_free(&c);
+    static const struct {
+        uint n, spp;
+        const char *words;
+    } bad[] = { { 3, 16, "is not a usable clpt checkpoint: inconsistent header (denoiser features)" },
+                { 4, 12, "inconsistent header (denoiser features)" } };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        CHECK_EQ_INT(write_read_features(films, bad[i].n, bad[i].spp, &c, &err), ST_INPUT);
+        CHECK_STR_CONTAINS(err.msg, bad[i].words);
+        checkpoint_free(&c);
+        error_clear(&err);
+    }
+    films[CKPT_FEATURE_EMISSION_MORE].samples = 5;   /* not 4 x the film's */
+    CHECK_EQ_INT(write_read_features(films, CKPT_FEATURES_MAX, 16, &c, &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "is not a usable clpt checkpoint: inconsistent feature sample counts");
+    checkpoint_free(&c);
+    error_clear(&err);
+    films[CKPT_FEATURE_EMISSION_MORE].samples = 20;
+    films[CKPT_FEATURE_NORMAL].sum[4] = ((int64_t)5 << 40) + 1;
+    CHECK_EQ_INT(write_read_features(films, CKPT_FEATURES_MAX, 16, &c, &err), ST_INPUT);
+    CHECK_STR_CONTAINS(err.msg, "film value 5497558138881 of pixel 1 is outside what 5 samples can hold");
+    checkpoint_free(&c);
+    error_clear(&err);
+    for (uint k = 0; k < CKPT_FEATURES_MAX; k++) film_free(&films[k]);
+}
+
 /* The render key: stable for the same scene and settings, different when anything that
  * changes the image changes, with a message naming what differs. */
 static void test_render_key(void)
@@ -532,6 +595,7 @@ int main(void)
     RUN(test_write_read_round_trip);
     RUN(test_damaged_files_are_refused);
     RUN(test_film_values_are_bounded);
+    RUN(test_denoise_features_round_trip);
     RUN(test_render_key);
     RUN(test_render_key_covers_every_scene_buffer);
     RUN(render_reference);

@@ -39,6 +39,17 @@ static int render(const char *spp, const char *out, const char *a, const char *b
     return r.status;
 }
 
+/* A part rendered with --denoise: samples `range` of spp, its features kept in `ckpt`. */
+static int render_denoise_part(const char *spp, const char *out, const char *range, const char *ckpt)
+{
+    const char *args[] = { SCENE, "-q", "--width", SIZE, "--height", SIZE, "--spp", spp, "-o", out, "--denoise",
+                           "--sample-range", range, "--checkpoint", ckpt, NULL };
+    CliResult r;
+    cli_run(args, &r);
+    if (r.status != 0) fprintf(stderr, "  clpt -o %s failed (%d): %s\n", out, r.status, r.err);
+    return r.status;
+}
+
 static float *reference;
 static unsigned char away[96 * 96];   /* 1: away from the lamp (metrics_emitter_mask) */
 
@@ -143,23 +154,109 @@ static void test_denoise_after_resume(void)
     CHECK_MSG(files_equal(resumed, tmp_path(4, "denoised.pfm")), "resumed and straight denoised images differ");
 }
 
-/* Two parts merged with --denoise (the colour alone): finite, and nearer the reference
- * than the merged image as rendered. */
+/* Two parts rendered without --denoise, merged with --denoise: the colour alone (the
+ * parts hold no features); finite, and nearer the reference than the merged image as
+ * rendered. */
 static void test_merge_denoise(void)
 {
     const char *a = tmp_path(0, "a.ckpt"), *b = tmp_path(1, "b.ckpt"), *pa = tmp_path(5, "a.pfm");
     const char *merged = tmp_path(6, "merged.pfm");
     CHECK(render("16", pa, "--sample-range", "0:8", "--checkpoint", a) == 0);
     CHECK(render("16", pa, "--sample-range", "8:16", "--checkpoint", b) == 0);
-    const char *args[] = { "merge", "-q", "--denoise", "-o", merged, a, b, NULL };
+    const char *args[] = { "merge", "--denoise", "-o", merged, a, b, NULL };
     CliResult r;
     cli_run(args, &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_STR_CONTAINS(r.err, "denoised (colour alone: the parts hold no features; render them with --denoise");
     ImageError m = error_of(merged), n = error_of(tmp_path(3, "noisy.pfm"));
     print_error("merged 16 spp denoised, colour alone:", m);
     CHECK(m.rmse > 0.0);
     CHECK_MSG(m.rmse_away < 0.75 * n.rmse_away, "merged denoised RMSE %g, noisy %g", m.rmse_away, n.rmse_away);
     CHECK_MSG(m.ssim > n.ssim, "merged denoised SSIM %g, noisy %g", m.ssim, n.ssim);
+}
+
+/* Parts rendered with --denoise keep the denoiser's inputs for their samples (the
+ * features, and the lamp's emission left out and added back); merged with --denoise,
+ * in any order and split unevenly, they are one process's --denoise image, bit for bit,
+ * and so is the merged checkpoint merged again. */
+static void test_merge_denoise_is_one_process(void)
+{
+    const char *a = tmp_path(0, "da.ckpt"), *b = tmp_path(1, "db.ckpt"), *pa = tmp_path(5, "da.pfm");
+    const char *merged = tmp_path(6, "dmerged.pfm"), *ck = tmp_path(2, "dmerged.ckpt");
+    CHECK(render_denoise_part("16", pa, "0:5", a) == 0);
+    CHECK(render_denoise_part("16", pa, "5:16", b) == 0);
+    const char *args[] = { "merge", "--denoise", "-o", merged, "--checkpoint", ck, b, a, NULL };
+    CliResult r;
+    cli_run(args, &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_STR_CONTAINS(r.err, "16 spp, denoised with the parts' features -> ");
+    CHECK_MSG(files_equal(merged, tmp_path(4, "denoised.pfm")), "merged and one process's denoised images differ");
+    const char *again[] = { "merge", "-q", "--denoise", "-o", merged, ck, NULL };
+    cli_run(again, &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_MSG(files_equal(merged, tmp_path(4, "denoised.pfm")), "the merged checkpoint's denoised image differs");
+}
+
+/* Parts that cannot give one process's --denoise image are refused, naming them: one
+ * without the features, or features of a render of another count (the albedo and
+ * normal's pixel grid follows it); a --denoise part must keep them in a checkpoint. */
+static void test_merge_denoise_refusals(void)
+{
+    const char *with = tmp_path(0, "da.ckpt"), *without = tmp_path(1, "b.ckpt"), *four = tmp_path(2, "d4.ckpt");
+    const char *out = tmp_path(6, "refused.pfm");
+    char msg[2400];
+    CliResult r;
+    const char *mixed[] = { "merge", "--denoise", "-o", out, with, without, NULL };
+    cli_run(mixed, &r);
+    CHECK(r.status == 3);
+    snprintf(msg, sizeof msg, "clpt: error: cannot merge '%s' with '%s': '%s' holds the denoiser's features (a part "
+             "rendered with --denoise) and '%s' does not; render every part with --denoise, or none\n", without, with,
+             with, without);
+    CHECK_STR_CONTAINS(r.err, msg);
+    /* without --denoise the features are not needed: the same parts merge */
+    const char *plain[] = { "merge", "-q", "-o", out, with, without, NULL };
+    cli_run(plain, &r);
+    CHECK(r.status == 3);   /* refused for the samples missing, not for the features */
+    CHECK_STR_CONTAINS(r.err, "no part holds samples [5,8)");
+    CHECK(render_denoise_part("4", tmp_path(5, "d4.pfm"), "0:4", four) == 0);
+    const char *grown[] = { "merge", "--denoise", "-o", out, four, tmp_path(1, "db.ckpt"), NULL };
+    cli_run(grown, &r);
+    CHECK(r.status == 3);
+    snprintf(msg, sizeof msg, "clpt: error: cannot merge '%s' with '%s': their denoiser features were rendered for 16 "
+             "and 4 samples per pixel; render every part with the same --spp\n", tmp_path(1, "db.ckpt"), four);
+    CHECK_STR_CONTAINS(r.err, msg);
+    const char *args[] = { SCENE, "--denoise", "--sample-range", "0:4", "-o", tmp_path(5, "x.pfm"), NULL };
+    cli_run(args, &r);
+    CHECK(r.status == 2);
+    CHECK_STR_CONTAINS(r.err, "clpt: error: --denoise with --sample-range keeps the denoiser's inputs in the part's "
+                 "checkpoint for clpt merge --denoise: give --checkpoint PART\nTry 'clpt --help' for more "
+                 "information.\n");
+}
+
+/* Under MPI rank 0 renders the features on its own devices and denoises: the same image
+ * as one process's --denoise, and a part rendered by two ranks merges with one rendered
+ * alone to it too. Skipped without mpirun. */
+static void test_mpi_denoise_is_one_process(void)
+{
+    if (system("command -v mpirun >/dev/null 2>&1") != 0) {
+        printf("     (skipped: no mpirun)\n");
+        return;
+    }
+    const char *mpi = tmp_path(5, "mpi.pfm"), *a = tmp_path(0, "ma.ckpt"), *b = tmp_path(1, "mb.ckpt");
+    char cmd[2400];
+    const char *run = "mpirun --oversubscribe --allow-run-as-root --mca btl self,vader -np 2 " CLI_PROGRAM " " SCENE
+                      " -q --width " SIZE " --height " SIZE " --spp 16 --denoise";
+    snprintf(cmd, sizeof cmd, "%s -o '%s' >/dev/null 2>&1", run, mpi);
+    CHECK(system(cmd) == 0);
+    CHECK_MSG(files_equal(mpi, tmp_path(4, "denoised.pfm")), "MPI and one process's denoised images differ");
+    snprintf(cmd, sizeof cmd, "%s --sample-range 0:7 --checkpoint '%s' -o '%s' >/dev/null 2>&1", run, a, mpi);
+    CHECK(system(cmd) == 0);
+    CHECK(render_denoise_part("16", mpi, "7:16", b) == 0);
+    const char *args[] = { "merge", "-q", "--denoise", "-o", mpi, a, b, NULL };
+    CliResult r;
+    cli_run(args, &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_MSG(files_equal(mpi, tmp_path(4, "denoised.pfm")), "a part of two ranks merged differs");
 }
 
 /* Whether the file holds the bytes of `s` (an EXR header's channel names are plain). */
@@ -179,7 +276,9 @@ static void test_exr_keeps_noisy_and_features(void)
 {
     const char *exr = tmp_path(7, "denoised.exr");
     CHECK(render("4", exr, "--denoise", NULL, NULL, NULL) == 0);
-    static const char *const names[] = { "noisy.R", "noisy.B", "albedo.G", "normal.X", "normal.Z" };
+    /* and the lamp's emission left out of the denoiser and added back */
+    static const char *const names[] = { "noisy.R", "noisy.B", "albedo.G", "normal.X", "normal.Z", "emission.R",
+                                         "emission.B", "emission4x.G" };
     for (size_t i = 0; i < sizeof names / sizeof *names; i++) CHECK_MSG(file_has(exr, names[i]), "%s", names[i]);
 }
 
@@ -409,6 +508,9 @@ int main(void)
         RUN(test_denoise_lowers_error);
         RUN(test_denoise_after_resume);
         RUN(test_merge_denoise);
+        RUN(test_merge_denoise_is_one_process);
+        RUN(test_merge_denoise_refusals);
+        RUN(test_mpi_denoise_is_one_process);
         RUN(test_exr_keeps_noisy_and_features);
     }
     error_clear(&err);

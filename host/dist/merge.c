@@ -11,6 +11,7 @@
 #include "base/file_id.h"
 #include "io/image_write.h"
 #include "render/denoise.h"
+#include "render/passes.h"
 #include "scene/scene.h"
 
 /* One sample range and the part it came from, for the overlap and gap checks. */
@@ -34,7 +35,21 @@ static Status merge_add(Checkpoint *out, const Checkpoint *c, const char *const 
                          paths[k], paths[0], what,
                          c->id.spp != out->id.spp ? "; a whitted render's pixel grid follows its samples per pixel, "
                                                     "so it grows only between counts with the same grid" : "");
+    if (c->n_features != out->n_features || c->features_spp != out->features_spp) {
+        const char *with = c->n_features ? paths[k] : paths[0], *without = c->n_features ? paths[0] : paths[k];
+        if (c->n_features && out->n_features)
+            return error_set(err, ST_INPUT, "cannot merge '%s' with '%s': their denoiser features were rendered for "
+                             "%u and %u samples per pixel; render every part with the same --spp", paths[k],
+                             paths[0], c->features_spp, out->features_spp);
+        return error_set(err, ST_INPUT, "cannot merge '%s' with '%s': '%s' holds the denoiser's features (a part "
+                         "rendered with --denoise) and '%s' does not; render every part with --denoise, or none",
+                         paths[k], paths[0], with, without);
+    }
     size_t n = (size_t)out->film.width * out->film.height * 3u;
+    for (uint f = 0; f < c->n_features; f++) {
+        for (size_t i = 0; i < n; i++) out->features[f].sum[i] += c->features[f].sum[i];
+        out->features[f].samples += c->features[f].samples;
+    }
     /* Each part's values are bounded by its samples (checkpoint_read), and the parts'
      * samples add up to at most spp (checked after), so the sums cannot overflow. */
     for (size_t i = 0; i < n; i++) out->film.sum[i] += c->film.sum[i];
@@ -94,18 +109,28 @@ static Status merge_refuse_adaptive(const Checkpoint *c, const char *path, Error
                      "hold samples of their own counts; resume it with --resume instead", path);
 }
 
-Status merge_parts(const char *const *paths, size_t n, Checkpoint *out, Error *err)
+/* Without --denoise a part's features are not needed: dropped, so that parts with and
+ * without them merge. */
+static void merge_drop_features(Checkpoint *c)
+{
+    for (uint k = 0; k < CKPT_FEATURES_MAX; k++) film_free(&c->features[k]);
+    c->n_features = c->features_spp = 0;
+}
+
+Status merge_parts(const char *const *paths, size_t n, int features, Checkpoint *out, Error *err)
 {
     memset(out, 0, sizeof *out);
     if (n == 0) return error_set(err, ST_USAGE, "merge needs at least one PART");
     PartRange *ranges = NULL;
     size_t n_ranges = 0, cap = 0;
     Status st = checkpoint_read(paths[0], out, err);
+    if (!features) merge_drop_features(out);
     if (st == ST_OK) st = merge_refuse_adaptive(out, paths[0], err);
     if (st == ST_OK) st = merge_note_ranges(out, 0, &ranges, &n_ranges, &cap, err);
     for (size_t k = 1; k < n && st == ST_OK; k++) {
         Checkpoint c;
         st = checkpoint_read(paths[k], &c, err);
+        if (!features) merge_drop_features(&c);
         if (st == ST_OK) st = merge_refuse_adaptive(&c, paths[k], err);
         if (st == ST_OK) st = merge_add(out, &c, paths, k, err);
         if (st == ST_OK) st = merge_note_ranges(&c, k, &ranges, &n_ranges, &cap, err);
@@ -122,7 +147,7 @@ typedef struct {
     const char *output, *checkpoint;
     int linear, quiet;
     ViewLook look;                /* --view, --exposure, as a render's */
-    int denoise;                  /* --denoise: the colour alone (the parts hold no features) */
+    int denoise;                  /* --denoise: with the parts' features, else the colour alone */
     const char **parts;
     size_t n_parts;
 } MergeOptions;
@@ -208,25 +233,42 @@ static Status merge_check_outputs(const MergeOptions *m, Error *err)
     return ST_OK;
 }
 
-/* --denoise: the merged image through Open Image Denoise, colour alone (a checkpoint
- * holds the film, not the albedo and normal images a render with --denoise makes), to
- * the output; an EXR keeps the noisy colour as noisy.R/G/B. */
-static Status merge_write_denoised(const MergeOptions *m, Denoiser *dn, const Film *film, ImageFormat fmt,
+/* --denoise: the merged image through Open Image Denoise. Parts rendered with --denoise
+ * hold the denoiser's inputs for their samples (checkpoint.h, CKPT_FEATURE_*): added up,
+ * they are the films one process renders, resolved and denoised by the same functions
+ * (passes_resolve_data, passes_denoise_split), so the image is that process's, bit for
+ * bit. Parts without them get the colour alone, as before. An EXR keeps what the
+ * denoiser saw as channels, as a render's does. */
+static Status merge_write_denoised(const MergeOptions *m, Denoiser *dn, const Checkpoint *merged, ImageFormat fmt,
                                    const ImageStyle *style, Error *err)
 {
-    size_t n = (size_t)film->width * film->height * 3u;
+    const Film *film = &merged->film;
+    uint w = film->width, h = film->height;
+    size_t n = (size_t)w * h * 3u;
     float *noisy = malloc(n * sizeof *noisy), *rgb = malloc(n * sizeof *rgb);
+    float *feature[CKPT_FEATURES_MAX] = { NULL, NULL, NULL, NULL };
+    static const unsigned mode[CKPT_FEATURES_MAX] = { INTEGRATOR_FEATURE_ALBEDO, INTEGRATOR_FEATURE_NORMAL,
+                                                      INTEGRATOR_FEATURE_EMISSION, INTEGRATOR_FEATURE_EMISSION };
     Status st = noisy && rgb ? ST_OK : error_set(err, ST_INTERNAL, "out of memory");
+    for (uint k = 0; k < merged->n_features && st == ST_OK; k++) {
+        if (!(feature[k] = malloc(n * sizeof *feature[k]))) st = error_set(err, ST_INTERNAL, "out of memory");
+        else passes_resolve_data(mode[k], &merged->features[k], feature[k]);
+    }
+    /* as passes_denoise_emission: nothing seen emitted, the colour whole */
+    float *e = feature[CKPT_FEATURE_EMISSION], *more = feature[CKPT_FEATURE_EMISSION_MORE];
+    if (e && !passes_emission_lit(e, n)) e = more = NULL;
     if (st == ST_OK) {
         film_resolve(film, noisy);
-        st = denoiser_run(dn, noisy, NULL, NULL, film->width, film->height, rgb, err);
+        st = passes_denoise_split(dn, noisy, feature[CKPT_FEATURE_ALBEDO], feature[CKPT_FEATURE_NORMAL], e, more, w,
+                                  h, 0, rgb, err);
     }
-    ImageLayer layer = { { "noisy.R", "noisy.G", "noisy.B" }, noisy };
-    if (st == ST_OK && fmt == IMAGE_EXR) st = image_write_exr(m->output, rgb, &layer, 1, film->width, film->height, 0, err);
+    float *aov[3] = { feature[CKPT_FEATURE_NORMAL], NULL, feature[CKPT_FEATURE_ALBEDO] };
+    if (st == ST_OK && fmt == IMAGE_EXR) st = passes_write_exr_layers(m->output, rgb, aov, noisy, e, more, w, h, 0, err);
     else if (st == ST_OK)
-        st = image_write_styled(m->output, rgb, film->width, film->height, style, err);
+        st = image_write_styled(m->output, rgb, w, h, style, err);
     free(noisy);
     free(rgb);
+    for (uint k = 0; k < CKPT_FEATURES_MAX; k++) free(feature[k]);
     return st;
 }
 
@@ -245,16 +287,21 @@ Status merge_command(int argc, char **argv, Error *err)
     if (st == ST_OK) st = atomic_probe(m.output, "", err);
     if (st == ST_OK && m.checkpoint) st = atomic_probe(m.checkpoint, "checkpoint", err);
     if (st == ST_OK && m.denoise) st = denoiser_open(&dn, err);
-    if (st == ST_OK) st = merge_parts(m.parts, m.n_parts, &merged, err);
+    if (st == ST_OK) st = merge_parts(m.parts, m.n_parts, m.denoise, &merged, err);
     if (st == ST_OK && m.checkpoint)
-        st = checkpoint_write(m.checkpoint, &merged.id, &merged.film, merged.done, merged.n_done, err);
+        st = merged.n_features ? checkpoint_write_features(m.checkpoint, &merged.id, &merged.film, merged.done,
+                                                           merged.n_done, merged.features, merged.n_features,
+                                                           merged.features_spp, err)
+                               : checkpoint_write(m.checkpoint, &merged.id, &merged.film, merged.done, merged.n_done,
+                                                  err);
     ImageStyle style = { m.linear ? IMAGE_LINEAR : IMAGE_SRGB, m.look, 0 };
     if (st == ST_OK && !dn) st = film_write(&merged.film, m.output, &style, err);
-    if (st == ST_OK && dn) st = merge_write_denoised(&m, dn, &merged.film, fmt, &style, err);
+    if (st == ST_OK && dn) st = merge_write_denoised(&m, dn, &merged, fmt, &style, err);
     if (st == ST_OK && !m.quiet)
         fprintf(stderr, "clpt: merged %zu part%s: %ux%u, %llu spp%s -> %s\n", m.n_parts, m.n_parts == 1 ? "" : "s",
                 merged.film.width, merged.film.height, (unsigned long long)merged.film.samples,
-                dn ? ", denoised (colour alone)" : "", m.output);
+                !dn ? "" : merged.n_features ? ", denoised with the parts' features" : ", denoised (colour alone: the parts "
+                "hold no features; render them with --denoise for those)", m.output);
     denoiser_close(dn);
     checkpoint_free(&merged);
     free(m.parts);

@@ -24,6 +24,11 @@
  * header and, after the film, the odd samples' sums and each pixel's sample count.
  * Written only for those, so that version 2 readers still read every other render. */
 #define CKPT_VERSION_ADAPTIVE 3u
+/* Version 4: a part rendered with --denoise (checkpoint.h, CKPT_FEATURE_*): version 2's,
+ * the number of feature films and the samples per pixel they were rendered for in the
+ * header, and after the film each feature film as its sample count and its sums.
+ * Written only for those parts. */
+#define CKPT_VERSION_FEATURES 4u
 #define CKPT_HEADER_SIZE 128u
 #define CKPT_TRAILER_SIZE SHA256_DIGEST_SIZE
 
@@ -101,9 +106,17 @@ static void out_counts(CheckpointOut *o, const uint *v, size_t n)
     }
 }
 
-/* One checkpoint file; `af` (with `as`) adds an adaptive render's state. */
+/* What a version-4 file adds: the feature films of a --denoise part. */
+typedef struct {
+    const Film *films;
+    uint n, spp;
+} FeatureFilms;
+
+/* One checkpoint file; `af` (with `as`) adds an adaptive render's state, `ff` a --denoise
+ * part's features. */
 static Status write_file(const char *path, const CheckpointId *id, const Film *film, const Batch *done,
-                         size_t n_done, const AdaptiveFilm *af, const AdaptiveSettings *as, Error *err)
+                         size_t n_done, const AdaptiveFilm *af, const AdaptiveSettings *as, const FeatureFilms *ff,
+                         Error *err)
 {
     CheckpointOut o;
     Status st = atomic_open(&o.af, path, "checkpoint", err);
@@ -114,10 +127,11 @@ static Status write_file(const char *path, const CheckpointId *id, const Film *f
     size_t n_pixels = (size_t)film->width * film->height;
     uint64_t payload = (uint64_t)n_done * 8u + (uint64_t)n_values * 8u;
     if (af) payload += (uint64_t)n_values * 8u + (uint64_t)n_pixels * 4u;
+    if (ff) payload += (uint64_t)ff->n * (8u + (uint64_t)n_values * 8u);
     unsigned char header[CKPT_HEADER_SIZE];
     memset(header, 0, sizeof header);
     memcpy(header, CKPT_MAGIC, 8);
-    bytes_put_le32(header + 8, af ? CKPT_VERSION_ADAPTIVE : CKPT_VERSION);
+    bytes_put_le32(header + 8, af ? CKPT_VERSION_ADAPTIVE : ff ? CKPT_VERSION_FEATURES : CKPT_VERSION);
     bytes_put_le32(header + 12, CKPT_HEADER_SIZE);
     memcpy(header + 16, id->key, CHECKPOINT_KEY_SIZE);
     bytes_put_le32(header + 48, id->width);
@@ -134,6 +148,10 @@ static Status write_file(const char *path, const CheckpointId *id, const Film *f
         bytes_put_le64(header + 88, bits);
         bytes_put_le32(header + 96, as->min_spp);
     }
+    if (ff) {
+        bytes_put_le32(header + 88, ff->n);
+        bytes_put_le32(header + 92, ff->spp);
+    }
     out_put(&o, header, sizeof header, 1);
     for (size_t i = 0; i < n_done; i++) {
         unsigned char r[8];
@@ -146,6 +164,12 @@ static Status write_file(const char *path, const CheckpointId *id, const Film *f
         out_values(&o, af->odd, n_values);
         out_counts(&o, af->spp, n_pixels);
     }
+    for (uint k = 0; ff && k < ff->n; k++) {
+        unsigned char count[8];
+        bytes_put_le64(count, ff->films[k].samples);
+        out_put(&o, count, sizeof count, 1);
+        out_values(&o, ff->films[k].sum, n_values);
+    }
     unsigned char digest[SHA256_DIGEST_SIZE];
     sha256_final(&o.hash, digest);
     out_put(&o, digest, sizeof digest, 0);
@@ -155,7 +179,14 @@ static Status write_file(const char *path, const CheckpointId *id, const Film *f
 Status checkpoint_write(const char *path, const CheckpointId *id, const Film *film, const Batch *done,
                         size_t n_done, Error *err)
 {
-    return write_file(path, id, film, done, n_done, NULL, NULL, err);
+    return write_file(path, id, film, done, n_done, NULL, NULL, NULL, err);
+}
+
+Status checkpoint_write_features(const char *path, const CheckpointId *id, const Film *film, const Batch *done,
+                                 size_t n_done, const Film *features, uint n_features, uint features_spp, Error *err)
+{
+    FeatureFilms ff = { features, n_features, features_spp };
+    return write_file(path, id, film, done, n_done, NULL, NULL, &ff, err);
 }
 
 Status checkpoint_write_adaptive(const char *path, const CheckpointId *id, const AdaptiveFilm *af,
@@ -164,7 +195,7 @@ Status checkpoint_write_adaptive(const char *path, const CheckpointId *id, const
     /* the pixels still rendering hold samples [0, film.samples); the others fewer,
      * which their counts say */
     Batch all = { 0, (uint)af->film.samples };
-    return write_file(path, id, &af->film, &all, all.count ? 1 : 0, af, s, err);
+    return write_file(path, id, &af->film, &all, all.count ? 1 : 0, af, s, NULL, err);
 }
 
 /* ------------------------------------------------------------------ reading */
@@ -175,6 +206,7 @@ void checkpoint_free(Checkpoint *c)
     free(c->done);
     free(c->odd);
     free(c->pixel_spp);
+    for (uint k = 0; k < CKPT_FEATURES_MAX; k++) film_free(&c->features[k]);
     memset(c, 0, sizeof *c);
 }
 
@@ -239,6 +271,26 @@ static Status read_adaptive(const unsigned char *header, const unsigned char *p,
     return ST_OK;
 }
 
+/* A --denoise part's feature films (version 4): each one's sample count, then its sums,
+ * each bounded by that count as the film's are. The albedo, normal and emission hold
+ * the part's own samples; the emission added back PASSES_EMISSION_SPP_FACTOR (4) times
+ * as many. */
+static Status read_features(const unsigned char *p, uint64_t n_values, const char *path, Checkpoint *c, Error *err)
+{
+    for (uint k = 0; k < c->n_features; k++) {
+        uint64_t samples = bytes_get_le64(p);
+        uint64_t expected = k == CKPT_FEATURE_EMISSION_MORE ? 4u * c->film.samples : c->film.samples;
+        if (samples != expected) return bad(err, path, "inconsistent feature sample counts");
+        Film *f = &c->features[k];
+        Status st = film_init(f, c->film.width, c->film.height, err);
+        if (st) return st;
+        f->samples = samples;
+        if ((st = read_film_values(p + 8, n_values, samples, path, f->sum, err))) return st;
+        p += 8u + n_values * 8u;
+    }
+    return ST_OK;
+}
+
 Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
 {
     memset(c, 0, sizeof *c);
@@ -279,10 +331,10 @@ Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
         goto out;
     }
     uint32_t version = bytes_get_le32(data + 8);
-    if (version != CKPT_VERSION && version != CKPT_VERSION_ADAPTIVE) {
+    if (version != CKPT_VERSION && version != CKPT_VERSION_ADAPTIVE && version != CKPT_VERSION_FEATURES) {
         char msg[128];
-        snprintf(msg, sizeof msg, "format version %u, this clpt reads versions %u and %u", version, CKPT_VERSION,
-                 CKPT_VERSION_ADAPTIVE);
+        snprintf(msg, sizeof msg, "format version %u, this clpt reads versions %u to %u", version, CKPT_VERSION,
+                 CKPT_VERSION_FEATURES);
         st = bad(err, path, msg);
         goto out;
     }
@@ -309,6 +361,15 @@ Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
     uint64_t n_values = (uint64_t)id->width * id->height * 3u;
     int adaptive = version == CKPT_VERSION_ADAPTIVE;
     uint64_t extra = adaptive ? n_values * 8u + (n_values / 3u) * 4u : 0u;
+    if (version == CKPT_VERSION_FEATURES) {
+        c->n_features = bytes_get_le32(data + 88);
+        c->features_spp = bytes_get_le32(data + 92);
+        if ((c->n_features != 2u && c->n_features != CKPT_FEATURES_MAX) || c->features_spp != id->spp) {
+            st = bad(err, path, "inconsistent header (denoiser features)");
+            goto out;
+        }
+        extra = (uint64_t)c->n_features * (8u + n_values * 8u);
+    }
     if (id->width == 0 || id->height == 0 || payload != (uint64_t)n_done * 8u + n_values * 8u + extra) {
         st = bad(err, path, "inconsistent header (image size and payload disagree)");
         goto out;
@@ -345,6 +406,7 @@ Status checkpoint_read(const char *path, Checkpoint *c, Error *err)
     c->film.samples = samples;
     if ((st = read_film_values(p, n_values, samples, path, c->film.sum, err))) goto out;
     if (adaptive) st = read_adaptive(data, p + n_values * 8u, path, c, err);
+    if (c->n_features) st = read_features(p + n_values * 8u, n_values, path, c, err);
 
 out:
     free(data);

@@ -35,9 +35,29 @@ typedef struct {
     uint width, height, spp, seed, max_depth;
 } CheckpointId;
 
+/* The denoiser's inputs a part (--sample-range A:B) rendered with --denoise carries
+ * (format version 4), so that `clpt merge --denoise` denoises as one process would:
+ * the albedo and normal features and, for an image whose directly seen emission is
+ * left out of the denoiser (passes_emission_splits), the emission of the part's own
+ * samples and of its share of the emission added back (PASSES_EMISSION_SPP_FACTOR
+ * times as many samples). Each is a film of its own samples: integer sums add up
+ * across parts exactly as the image's do. */
+enum {
+    CKPT_FEATURE_ALBEDO,
+    CKPT_FEATURE_NORMAL,          /* as passes_aov_data renders it: (n + 1) / 2, misses 1/2 */
+    CKPT_FEATURE_EMISSION,        /* samples [A, B) */
+    CKPT_FEATURE_EMISSION_MORE,   /* samples [4A, 4B) of the 4x emission image */
+    CKPT_FEATURES_MAX
+};
+
 typedef struct {
     CheckpointId id;
     Film film;            /* sums and samples per pixel */
+    /* a --denoise part's (version 4): 2 films (albedo, normal) or all 4, rendered for
+     * features_spp samples per pixel in all (the albedo and normal's pixel grid follows
+     * it); n_features 0 otherwise */
+    Film features[CKPT_FEATURES_MAX];
+    uint n_features, features_spp;
     Batch *done;          /* the sample ranges in the film: sorted, disjoint */
     size_t n_done;
     /* an adaptive render's (--noise-threshold; adaptive.h): the odd samples' sums and
@@ -55,6 +75,11 @@ void checkpoint_id(const DeviceScene *ds, uint spp, CheckpointId *id);
  * the failed step when it cannot be written. */
 Status checkpoint_write(const char *path, const CheckpointId *id, const Film *film, const Batch *done,
                         size_t n_done, Error *err);
+
+/* The same with a --denoise part's features (n_features 2 or 4, for features_spp samples
+ * per pixel in all): format version 4. */
+Status checkpoint_write_features(const char *path, const CheckpointId *id, const Film *film, const Batch *done,
+                                 size_t n_done, const Film *features, uint n_features, uint features_spp, Error *err);
 
 /* The same for an adaptive render's state (a format version of its own). */
 Status checkpoint_write_adaptive(const char *path, const CheckpointId *id, const AdaptiveFilm *af,

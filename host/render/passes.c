@@ -21,8 +21,11 @@ static Status update_devices(const PassContext *pc, Error *err)
 }
 
 /* Gives every device the pass's params block and pixel list (the scene's other buffers
- * stay as loaded), renders spp samples into a new film. */
-static Status render_pass(const PassContext *pc, uint spp, Film *film, double *seconds, Error *err)
+ * stay as loaded), renders samples [first, end) of a render of spp samples per pixel
+ * into a new film (end 0: all of them; never the main render's --sample-range, which a
+ * pass of another count would fall outside). */
+static Status render_pass_range(const PassContext *pc, uint spp, uint first, uint end, Film *film, double *seconds,
+                                Error *err)
 {
     const DeviceScene *ds = &pc->rs->ds;
     Status st;
@@ -31,6 +34,8 @@ static Status render_pass(const PassContext *pc, uint spp, Film *film, double *s
     if ((st = film_init(film, ds->params.width, ds->params.height, err))) return st;
     ScheduleConfig cfg = *pc->cfg;
     cfg.spp = spp;
+    cfg.range_first = end ? first : 0u;
+    cfg.range_end = end;
     cfg.on_tick = NULL;
     cfg.time_limit = 0.0;
     ScheduleStats stats;
@@ -38,6 +43,11 @@ static Status render_pass(const PassContext *pc, uint spp, Film *film, double *s
     *seconds += stats.seconds;
     schedule_stats_free(&stats);
     return st;
+}
+
+static Status render_pass(const PassContext *pc, uint spp, Film *film, double *seconds, Error *err)
+{
+    return render_pass_range(pc, spp, 0u, 0u, film, seconds, err);
 }
 
 static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; }
@@ -153,22 +163,30 @@ void passes_depth_grey(float *rgb, size_t n, const DepthScale *scale)
     }
 }
 
-Status passes_aov(const PassContext *pc, uint aov, uint spp, const DepthScale *depth, float *rgb,
-                  double *seconds, Error *err)
+/* Auxiliary image `aov` with samples [first, end) of `spp` (end 0: all) into *film, the
+ * devices given the main render's parameters back after. */
+static Status passes__aov_film(const PassContext *pc, uint aov, uint spp, uint first, uint end, Film *film,
+                               double *seconds, Error *err)
 {
     RenderParams *p = &pc->rs->ds.params;
     RenderParams saved = *p;
     p->integrator = aov;
     p->strata = render_scene_strata(spp);
-    *seconds = 0.0;
-    Film film;
-    Status st = render_pass(pc, spp, &film, seconds, err);
+    Status st = render_pass_range(pc, spp, first, end, film, seconds, err);
     *p = saved;
     Status restored = update_devices(pc, st == ST_OK ? err : NULL);
-    if (st == ST_OK) st = restored;
+    return st == ST_OK ? restored : st;
+}
+
+Status passes_aov(const PassContext *pc, uint aov, uint spp, const DepthScale *depth, float *rgb,
+                  double *seconds, Error *err)
+{
+    *seconds = 0.0;
+    Film film;
+    Status st = passes__aov_film(pc, aov, spp, 0u, 0u, &film, seconds, err);
     if (st == ST_OK) {
         film_resolve(&film, rgb);
-        if (aov == INTEGRATOR_AOV_DEPTH) passes_depth_grey(rgb, (size_t)p->width * p->height, depth);
+        if (aov == INTEGRATOR_AOV_DEPTH) passes_depth_grey(rgb, (size_t)film.width * film.height, depth);
     }
     film_free(&film);
     return st;
@@ -210,31 +228,55 @@ int passes_aov_in_exr(const PassRequest *q, const char *output, unsigned aov)
     return fmt == IMAGE_EXR && !q->aov_files[aov - INTEGRATOR_AOV_NORMAL];
 }
 
+static int passes__is_normal(unsigned aov)
+{
+    return aov == INTEGRATOR_AOV_NORMAL || aov == INTEGRATOR_FEATURE_NORMAL;
+}
+
 /* The normal image rendered with grey misses, (n + 1) / 2, gives 2c - 1 = the
  * pixel's mean normal with misses counting 0. */
-Status passes_aov_data(const PassContext *pc, unsigned aov, uint spp, float *rgb, double *secs, Error *err)
+void passes_resolve_data(unsigned aov, const Film *film, float *rgb)
+{
+    film_resolve(film, rgb);
+    if (aov == INTEGRATOR_AOV_DEPTH) {
+        DepthScale raw = { DEPTH_RAW, 0.0, 0.0 };
+        passes_depth_grey(rgb, (size_t)film->width * film->height, &raw);
+    }
+    if (passes__is_normal(aov))
+        for (size_t i = 0; i < (size_t)film->width * film->height * 3u; i++) rgb[i] = 2.0f * rgb[i] - 1.0f;
+}
+
+Status passes_data_film(const PassContext *pc, unsigned aov, uint spp, uint first, uint end, Film *film,
+                        double *secs, Error *err)
 {
     RenderParams *p = &pc->rs->ds.params;
     uint grey = p->normal_miss_grey;
-    int normal = aov == INTEGRATOR_AOV_NORMAL || aov == INTEGRATOR_FEATURE_NORMAL;
-    if (normal) p->normal_miss_grey = 1;
-    DepthScale raw = { DEPTH_RAW, 0.0, 0.0 };
-    Status st = passes_aov(pc, aov, spp, &raw, rgb, secs, err);
+    if (passes__is_normal(aov)) p->normal_miss_grey = 1;
+    Status st = passes__aov_film(pc, aov, spp, first, end, film, secs, err);
     p->normal_miss_grey = grey;
-    if (!st && normal)
-        for (size_t i = 0; i < (size_t)p->width * p->height * 3u; i++) rgb[i] = 2.0f * rgb[i] - 1.0f;
     return st;
 }
 
-/* The EXR output again, with the auxiliary images (and, denoised, the noisy colour) as
- * channels. */
-static Status passes__write_exr_layers(const PassRequest *q, const char *output, const float *rgb, float *const aov_rgb[3],
-                               const float *noisy, uint w, uint h, Error *err)
+Status passes_aov_data(const PassContext *pc, unsigned aov, uint spp, float *rgb, double *secs, Error *err)
+{
+    *secs = 0.0;
+    Film film;
+    Status st = passes_data_film(pc, aov, spp, 0u, 0u, &film, secs, err);
+    if (!st) passes_resolve_data(aov, &film, rgb);
+    film_free(&film);
+    return st;
+}
+
+Status passes_write_exr_layers(const char *output, const float *rgb, float *const aov_rgb[3], const float *noisy,
+                               const float *emission, const float *emission_more, uint w, uint h, int exr_float,
+                               Error *err)
 {
     static const char *const names[3][3] = { { "normal.X", "normal.Y", "normal.Z" }, { "Z", NULL, NULL },
                                              { "albedo.R", "albedo.G", "albedo.B" } };
     static const char *const noisy_names[3] = { "noisy.R", "noisy.G", "noisy.B" };
-    ImageLayer layers[4];
+    static const char *const emission_names[2][3] = { { "emission.R", "emission.G", "emission.B" },
+                                                      { "emission4x.R", "emission4x.G", "emission4x.B" } };
+    ImageLayer layers[6];
     size_t n = 0;
     for (int a = 0; a < 3; a++) {
         if (!aov_rgb[a]) continue;
@@ -245,7 +287,12 @@ static Status passes__write_exr_layers(const PassRequest *q, const char *output,
         memcpy(layers[n].names, noisy_names, sizeof noisy_names);
         layers[n++].rgb = noisy;
     }
-    return n ? image_write_exr(output, rgb, layers, n, w, h, q->exr_float, err) : ST_OK;
+    const float *e[2] = { emission, emission_more };
+    for (int k = 0; k < 2 && emission && emission_more; k++) {
+        memcpy(layers[n].names, emission_names[k], sizeof emission_names[k]);
+        layers[n++].rgb = e[k];
+    }
+    return n ? image_write_exr(output, rgb, layers, n, w, h, exr_float, err) : ST_OK;
 }
 
 /* What the albedo and normal channels of an EXR output and the denoiser's inputs are
@@ -299,46 +346,85 @@ static Status passes__emission(const PassContext *pc, uint spp, float *e, int qu
     return st;
 }
 
-Status passes_denoise(const PassContext *pc, uint spp, int uniform, const float *noisy, const float *albedo,
-                      const float *normal, float *out, int quiet, Error *err)
+int passes_emission_lit(const float *e, size_t n)
 {
-    uint w = pc->rs->ds.params.width, h = pc->rs->ds.params.height;
-    if (!passes_emission_splits(&pc->rs->ds.params, uniform))
-        return denoiser_run(pc->denoiser, noisy, albedo, normal, w, h, out, err);
+    for (size_t i = 0; i < n; i++)
+        if (e[i] != 0.0f) return 1;
+    return 0;
+}
+
+Status passes_denoise_split(Denoiser *dn, const float *noisy, const float *albedo, const float *normal,
+                            const float *e, const float *more, uint w, uint h, int clean, float *out, Error *err)
+{
     size_t n = (size_t)w * h * 3u;
-    float *e = malloc(n * sizeof *e), *rest = malloc(n * sizeof *rest);
-    Status st = e && rest ? ST_OK : error_set(err, ST_INTERNAL, "out of memory for the denoiser");
-    if (!st) st = passes__emission(pc, spp, e, quiet, err);
-    int lit = 0;
-    for (size_t i = 0; i < n && !st && !lit; i++) lit = e[i] != 0.0f;
-    if (!st && !lit) {
-        /* nothing seen emitted (the dragon's lamp out of view, a black background):
-         * the colour as it is, without the second pass, which would only add its
-         * rare emitter a few samples found (E(spp) = 0 estimates the same) */
-        free(e);
-        free(rest);
-        return denoiser_run(pc->denoiser, noisy, albedo, normal, w, h, out, err);
+    if (!e || !more) {
+        return clean ? denoiser_run_clean(dn, noisy, albedo, normal, w, h, out, err)
+                     : denoiser_run(dn, noisy, albedo, normal, w, h, out, err);
     }
+    float *rest = malloc(n * sizeof *rest);
+    if (!rest) return error_set(err, ST_INTERNAL, "out of memory for the denoiser");
     /* the same rays: the image's samples each hold at least their emission, and the
      * film rounds both alike, so nothing is below 0 but what the colour never had
      * (NaN, which fails the test, becomes 0 as the denoiser would make it) */
-    for (size_t i = 0; i < n && !st; i++) {
+    for (size_t i = 0; i < n; i++) {
         float d = noisy[i] - e[i];
         rest[i] = d > 0.0f ? d : 0.0f;
     }
-    uint more = spp <= UINT32_MAX / PASSES_EMISSION_SPP_FACTOR ? spp * PASSES_EMISSION_SPP_FACTOR : spp;
-    if (!st) st = passes__emission(pc, more, e, quiet, err);
-    if (!st) st = denoiser_run(pc->denoiser, rest, albedo, normal, w, h, out, err);
-    for (size_t i = 0; i < n && !st; i++) out[i] += e[i];
-    free(e);
+    Status st = clean ? denoiser_run_clean(dn, rest, albedo, normal, w, h, out, err)
+                      : denoiser_run(dn, rest, albedo, normal, w, h, out, err);
+    for (size_t i = 0; i < n && !st; i++) out[i] += more[i];
     free(rest);
     return st;
 }
 
-/* Denoises rgb in place with the features in aov[]; *noisy keeps the colour as it was
- * (freed by the caller). */
+uint passes_emission_more_spp(uint spp)
+{
+    return spp <= UINT32_MAX / PASSES_EMISSION_SPP_FACTOR ? spp * PASSES_EMISSION_SPP_FACTOR : spp;
+}
+
+Status passes_denoise_emission(const PassContext *pc, uint spp, int uniform, float **e, float **more, int quiet,
+                               Error *err)
+{
+    *e = *more = NULL;
+    if (!passes_emission_splits(&pc->rs->ds.params, uniform)) return ST_OK;
+    size_t n = (size_t)pc->rs->ds.params.width * pc->rs->ds.params.height * 3u;
+    Status st = (*e = malloc(n * sizeof **e)) ? ST_OK : error_set(err, ST_INTERNAL, "out of memory for the denoiser");
+    if (!st) st = passes__emission(pc, spp, *e, quiet, err);
+    /* nothing seen emitted (the dragon's lamp out of view, a black background): the
+     * colour as it is, without the second pass, which would only add its rare emitter
+     * a few samples found (E(spp) = 0 estimates the same) */
+    if (!st && !passes_emission_lit(*e, n)) {
+        free(*e);
+        *e = NULL;
+        return ST_OK;
+    }
+    if (!st && !(*more = malloc(n * sizeof **more))) st = error_set(err, ST_INTERNAL, "out of memory for the denoiser");
+    if (!st) st = passes__emission(pc, passes_emission_more_spp(spp), *more, quiet, err);
+    return st;
+}
+
+Status passes_denoise(const PassContext *pc, uint spp, int uniform, const float *noisy, const float *albedo,
+                      const float *normal, float *out, float **emission, float **emission_more, int quiet, Error *err)
+{
+    uint w = pc->rs->ds.params.width, h = pc->rs->ds.params.height;
+    float *e = NULL, *more = NULL;
+    Status st = passes_denoise_emission(pc, spp, uniform, &e, &more, quiet, err);
+    if (!st) st = passes_denoise_split(pc->denoiser, noisy, albedo, normal, e, more, w, h, 0, out, err);
+    if (!st && emission && emission_more) {
+        *emission = e;
+        *emission_more = more;
+    } else {
+        free(e);
+        free(more);
+    }
+    return st;
+}
+
+/* Denoises rgb in place with the features in aov[]; *noisy keeps the colour as it was,
+ * emission[0] and [1] the emission left out and added back (NULL when the colour was
+ * denoised whole); all freed by the caller. */
 static Status passes__denoise(const PassContext *pc, uint spp, int uniform, float *rgb, float *const aov[3],
-                              float **noisy, int quiet, Error *err)
+                              float **noisy, float *emission[2], int quiet, Error *err)
 {
     uint w = pc->rs->ds.params.width, h = pc->rs->ds.params.height;
     size_t n = (size_t)w * h * 3u;
@@ -346,7 +432,7 @@ static Status passes__denoise(const PassContext *pc, uint spp, int uniform, floa
     memcpy(*noisy, rgb, n * sizeof *rgb);
     double t0 = timer_now();
     Status st = passes_denoise(pc, spp, uniform, *noisy, aov[INTEGRATOR_AOV_ALBEDO - INTEGRATOR_AOV_NORMAL], aov[0],
-                               rgb, quiet, err);
+                               rgb, &emission[0], &emission[1], quiet, err);
     if (!st && !quiet)
         fprintf(stderr, "clpt: denoised in %.2f s (Open Image Denoise, %s device, %s)\n", timer_now() - t0,
                 denoiser_device_kind(pc->denoiser), denoiser_library(pc->denoiser));
@@ -359,7 +445,7 @@ static Status passes__final_image(const PassRequest *q, const PassContext *pc, c
                                   const ImageStyle *style, float *rgb, uint spp, Error *err)
 {
     uint w = pc->rs->ds.params.width, h = pc->rs->ds.params.height;
-    float *in_exr[3] = { NULL, NULL, NULL }, *noisy = NULL;
+    float *in_exr[3] = { NULL, NULL, NULL }, *noisy = NULL, *emission[2] = { NULL, NULL };
     Status st = ST_OK;
     for (unsigned aov = INTEGRATOR_AOV_NORMAL; aov <= INTEGRATOR_AOV_ALBEDO && !st; aov++) {
         if (!passes__aov_wanted_in_exr(q, output, aov)) continue;
@@ -370,9 +456,10 @@ static Status passes__final_image(const PassRequest *q, const PassContext *pc, c
         if (!st && !q->quiet) fprintf(stderr, "clpt: %s image in %.2f s\n", passes_aov_name(aov), secs);
     }
     if (!st && q->denoise) st = passes__features(pc, spp, in_exr, q->quiet, err);
-    if (!st && q->denoise) st = passes__denoise(pc, spp, !q->varying_spp, rgb, in_exr, &noisy, q->quiet, err);
+    if (!st && q->denoise) st = passes__denoise(pc, spp, !q->varying_spp, rgb, in_exr, &noisy, emission, q->quiet, err);
     int exr = passes_aov_in_exr(q, output, INTEGRATOR_AOV_NORMAL) || passes_aov_in_exr(q, output, INTEGRATOR_AOV_ALBEDO);
-    if (!st && exr) st = passes__write_exr_layers(q, output, rgb, in_exr, noisy, w, h, err);
+    if (!st && exr)
+        st = passes_write_exr_layers(output, rgb, in_exr, noisy, emission[0], emission[1], w, h, q->exr_float, err);
     else if (!st && q->denoise) st = image_write_styled(output, rgb, w, h, style, err);
     if (!st && !q->quiet && exr && (in_exr[0] || in_exr[1] || in_exr[2]))
         fprintf(stderr, "clpt: %sauxiliary images as channels -> %s\n", noisy ? "denoised image, noisy colour and " : "",
@@ -382,6 +469,8 @@ static Status passes__final_image(const PassRequest *q, const PassContext *pc, c
     if (!st && noisy && pc->on_denoised) pc->on_denoised(pc->on_denoised_ctx, rgb);
     for (int a = 0; a < 3; a++) free(in_exr[a]);
     free(noisy);
+    free(emission[0]);
+    free(emission[1]);
     return st;
 }
 

@@ -82,18 +82,55 @@ Status passes_aov_data(const PassContext *pc, unsigned aov, uint spp, float *rgb
  * dimmed before they reach a lamp). */
 int passes_emission_splits(const RenderParams *p, int uniform);
 
-/* Denoises `noisy` (the image, `spp` samples per pixel) with the features into out (not
- * noisy). Where passes_emission_splits: the emission the image's camera rays see
- * directly (INTEGRATOR_FEATURE_EMISSION, the same rays, so exactly the image's part) is
- * subtracted before the denoiser, and the same emission rendered with
- * PASSES_EMISSION_SPP_FACTOR times the samples is added to its output (where nothing
- * is seen emitted, the colour is denoised whole, without that pass). The emission has
+/* Auxiliary image or feature `aov` as passes_aov_data makes it, as a film of samples
+ * [first, end) of a render of `spp` samples per pixel (end 0: all): the film a --denoise
+ * part keeps in its checkpoint (checkpoint.h). Free *film with film_free, also after a
+ * failure. */
+Status passes_data_film(const PassContext *pc, unsigned aov, uint spp, uint first, uint end, Film *film,
+                        double *seconds, Error *err);
+/* A film of passes_data_film (the parts' films added up) resolved as passes_aov_data
+ * resolves it: the same bits as one render of its samples. */
+void passes_resolve_data(unsigned aov, const Film *film, float *rgb);
+
+/* Samples per pixel of the emission added back: PASSES_EMISSION_SPP_FACTOR x spp. */
+uint passes_emission_more_spp(uint spp);
+/* Whether any of the n values is not 0: something is seen emitted. */
+int passes_emission_lit(const float *e, size_t n);
+
+/* The emission images passes_denoise uses, rendered: where passes_emission_splits and
+ * something is seen emitted, *e the emission of the image's own `spp` samples and *more
+ * that of passes_emission_more_spp(spp); else both NULL (the colour is denoised
+ * whole). Freed by the caller, also after a failure. */
+Status passes_denoise_emission(const PassContext *pc, uint spp, int uniform, float **e, float **more, int quiet,
+                               Error *err);
+
+/* out = OIDN(noisy - e, albedo, normal) + more (e and more given), else OIDN(noisy,
+ * albedo, normal): the one formula of --denoise, clpt merge --denoise and the viewer.
+ * `clean`: the features are prefiltered already (denoiser_run_clean). The emission has
  * no noise but a pixel's coverage, so there is nothing to denoise in it, and left in,
  * OIDN spreads a lamp's edge over its neighbours and moves the lamp's own flat value
  * (docs/denoise.md, "Emitters' edges"). The expectation is the image's: both emission
  * images estimate the same thing. */
+Status passes_denoise_split(Denoiser *dn, const float *noisy, const float *albedo, const float *normal,
+                            const float *e, const float *more, uint w, uint h, int clean, float *out, Error *err);
+
+/* Denoises `noisy` (the image, `spp` samples per pixel) with the features into out (not
+ * noisy): passes_denoise_emission, then passes_denoise_split. Where the emission is
+ * left out (the emission feature, INTEGRATOR_FEATURE_EMISSION, traces the image's own
+ * camera rays, so it is exactly the image's part), *emission and *emission_more receive
+ * the two emission images when both are not NULL (the caller frees them; NULL when the
+ * colour was denoised whole). */
 Status passes_denoise(const PassContext *pc, uint spp, int uniform, const float *noisy, const float *albedo,
-                      const float *normal, float *out, int quiet, Error *err);
+                      const float *normal, float *out, float **emission, float **emission_more, int quiet,
+                      Error *err);
+
+/* An EXR output with the denoiser's or the auxiliary images as channels: aov_rgb[0..2]
+ * normal.X/Y/Z, Z, albedo.R/G/B (NULL: none), noisy.R/G/B, and the emission left out
+ * and added back as emission.R/G/B and emission4x.R/G/B (both or neither). Nothing is
+ * written when there is no channel to add. */
+Status passes_write_exr_layers(const char *output, const float *rgb, float *const aov_rgb[3], const float *noisy,
+                               const float *emission, const float *emission_more, uint w, uint h, int exr_float,
+                               Error *err);
 
 /* The file name of an auxiliary image: "out.png" and "normal" give "out-normal.png". */
 char *passes_aov_path(const char *output, const char *name);

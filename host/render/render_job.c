@@ -357,7 +357,7 @@ static Status job_denoise(RenderJob *job, const PassContext *pc, float *rgb, con
     if (!noisy) return error_set(err, ST_INTERNAL, "out of memory");
     memcpy(noisy, rgb, n * sizeof *rgb);
     Status st = passes_denoise(pc, (uint)job->film.samples, !(job->set.adaptive.threshold > 0.0), noisy, albedo,
-                               normal, rgb, 1, err);
+                               normal, rgb, NULL, NULL, 1, err);
     free(noisy);
     return st;
 }
@@ -390,4 +390,46 @@ Status render_job_passes_to_memory(RenderJob *job, float *rgb, const RenderJobAo
     free(feature[0]);
     free(feature[1]);
     return st == ST_OK && job_stopped(job) ? ST_INTERRUPTED : st;
+}
+
+/* ------------------------------------------------------------------ a --denoise part */
+
+Status render_job_part_features(RenderJob *job, Error *err)
+{
+    const RenderJobSettings *s = &job->set;
+    if (!s->denoise || s->range_end < 0 || !s->checkpoint_path || !render_job_complete(job) || job->adaptive)
+        return ST_OK;
+    ScheduleConfig pcfg;
+    PassContext pc;
+    render_job_pass_context(job, &pcfg, &pc);
+    uint spp = job->checkpoint_id.spp, first = (uint)s->range_first, end = (uint)s->range_end;
+    uint more = passes_emission_more_spp(spp), factor = more / spp;
+    /* a part cannot know whether another part's samples see an emitter: where the
+     * emission can be left out, every part renders both emission films */
+    int emission = passes_emission_splits(&job->rs.ds.params, 1);
+    struct {
+        unsigned mode;
+        uint spp, first, end;
+    } want[CKPT_FEATURES_MAX] = {
+        [CKPT_FEATURE_ALBEDO] = { INTEGRATOR_FEATURE_ALBEDO, spp, first, end },
+        [CKPT_FEATURE_NORMAL] = { INTEGRATOR_FEATURE_NORMAL, spp, first, end },
+        [CKPT_FEATURE_EMISSION] = { INTEGRATOR_FEATURE_EMISSION, spp, first, end },
+        [CKPT_FEATURE_EMISSION_MORE] = { INTEGRATOR_FEATURE_EMISSION, more, first * factor, end * factor },
+    };
+    uint n = emission ? CKPT_FEATURES_MAX : 2u;
+    Film films[CKPT_FEATURES_MAX];
+    memset(films, 0, sizeof films);
+    double secs = 0.0;
+    Status st = ST_OK;
+    for (uint k = 0; k < n && st == ST_OK && !job_stopped(job); k++)
+        st = passes_data_film(&pc, want[k].mode, want[k].spp, want[k].first, want[k].end, &films[k], &secs, err);
+    if (st == ST_OK && job_stopped(job)) st = ST_INTERRUPTED;
+    if (st == ST_OK)
+        st = checkpoint_write_features(s->checkpoint_path, &job->checkpoint_id, &job->film, job->stats.done.ranges,
+                                       job->stats.done.n, films, n, spp, err);
+    if (st == ST_OK && !s->quiet)
+        fprintf(stderr, "clpt: the denoiser's features of samples [%u,%u) in %.2f s -> %s (clpt merge --denoise "
+                "denoises the parts)\n", first, end, secs, s->checkpoint_path);
+    for (uint k = 0; k < CKPT_FEATURES_MAX; k++) film_free(&films[k]);
+    return st;
 }

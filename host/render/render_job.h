@@ -162,4 +162,13 @@ typedef struct {
  * ST_INTERRUPTED. job->passes_spp counts the passes' samples as they finish. */
 Status render_job_passes_to_memory(RenderJob *job, float *rgb, const RenderJobAovs *aovs, Error *err);
 
+/* A part (--sample-range A:B, --checkpoint PART) rendered with --denoise does not
+ * denoise its share: it renders the denoiser's inputs for its samples (the albedo and
+ * normal features of samples [A, B) of the whole render's count, and where the emission
+ * is left out of the denoiser its emission for samples [A, B) and [4A, 4B): checkpoint.h,
+ * CKPT_FEATURE_*) and writes them into its checkpoint beside its film, so that `clpt
+ * merge --denoise` of the parts is the one-process --denoise image, bit for bit.
+ * Nothing to do unless the part is complete and asks for --denoise. */
+Status render_job_part_features(RenderJob *job, Error *err);
+
 #endif /* CLPT_RENDER_JOB_H */

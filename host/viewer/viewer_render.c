@@ -111,19 +111,28 @@ static void denoise_cancelled(ViewerRender *vr, const char *during)
  * them (passes_aov_data), on the render's devices, which get the view's parameters back
  * after; then prefiltered once for all the view's passes (denoiser_clean_features).
  * 0 when a camera change or a pause cancelled them, or they failed. */
+/* A pass of the current view (the features, the emission) on the render's devices: the
+ * view's parameters, the stop flag, the render's batches. */
+static void view_pass_context(ViewerRender *vr, RenderScene *rs, ScheduleConfig *cfg, PassContext *pc)
+{
+    memset(rs, 0, sizeof *rs);
+    rs->ds = *vr->scene;
+    rs->ds.params = vr->params;
+    memset(cfg, 0, sizeof *cfg);
+    cfg->fixed_batch = vr->fixed_batch;
+    cfg->stop = &vr->stop;
+    cfg->poll_seconds = VIEWER_POLL_SECONDS;
+    cfg->on_warning = on_warning;
+    PassContext c = { vr->devices, vr->n_devices, rs, cfg, vr->denoiser, NULL, NULL };
+    *pc = c;
+}
+
 static int features_render(ViewerRender *vr)
 {
     RenderScene rs;
-    memset(&rs, 0, sizeof rs);
-    rs.ds = *vr->scene;
-    rs.ds.params = vr->params;
     ScheduleConfig cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.fixed_batch = vr->fixed_batch;
-    cfg.stop = &vr->stop;
-    cfg.poll_seconds = VIEWER_POLL_SECONDS;
-    cfg.on_warning = on_warning;
-    PassContext pc = { vr->devices, vr->n_devices, &rs, &cfg, NULL, NULL, NULL };
+    PassContext pc;
+    view_pass_context(vr, &rs, &cfg, &pc);
     double secs = 0.0;
     Error err = { 0 };
     Status st = passes_aov_data(&pc, INTEGRATOR_FEATURE_ALBEDO, VIEWER_FEATURE_SPP, vr->albedo, &secs, &err);
@@ -170,14 +179,38 @@ static void denoise_step(ViewerRender *vr)
     uint64_t samples = vr->film.samples;
     if (!denoiser_ready(vr)) return;
     if (vr->feature_gen != vr->my_gen && !features_render(vr)) return;   /* tried again unless it failed */
+    double t0 = timer_now();
+    Error err = { 0 };
+    /* the lamps seen directly are left out of the denoiser and added back, as --denoise
+     * does: the emission of the frame's own samples [0, n) and of 4n, rendered for this
+     * frame (camera rays alone: about a bounce of the pass's paths) */
+    RenderScene rs;
+    ScheduleConfig cfg;
+    PassContext pc;
+    view_pass_context(vr, &rs, &cfg, &pc);
+    float *e = NULL, *more = NULL;
+    Status st = passes_denoise_emission(&pc, (uint)samples, 1, &e, &more, 1, &err);
+    if (st == ST_OK && vr->stop) {   /* cancelled: the same frame again when still due */
+        free(e);
+        free(more);
+        denoise_cancelled(vr, "the emission's render");
+        return;
+    }
+    if (st != ST_OK) {
+        set_failure(vr, st, err.msg);
+        error_clear(&err);
+        free(e);
+        free(more);
+        return;
+    }
     pthread_mutex_lock(&vr->lock);
     vr->denoising = 2;
     pthread_mutex_unlock(&vr->lock);
-    double t0 = timer_now();
     film_resolve(&vr->film, vr->noisy);
-    Error err = { 0 };
-    Status st = denoiser_run_clean(vr->denoiser, vr->noisy, vr->albedo, vr->normal, vr->params.width,
-                                   vr->params.height, vr->denoise_out, &err);
+    st = passes_denoise_split(vr->denoiser, vr->noisy, vr->albedo, vr->normal, e, more, vr->params.width,
+                              vr->params.height, 1, vr->denoise_out, &err);
+    free(e);
+    free(more);
     double secs = timer_now() - t0;
     if (st == ST_INTERRUPTED) {   /* not tried: the same frame is denoised again when still due */
         error_clear(&err);

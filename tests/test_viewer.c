@@ -34,6 +34,7 @@
 #include "harness.h"
 #include "io/scene_load.h"
 #include "render/denoise.h"
+#include "render/passes.h"
 #include "render/render_scene.h"
 #include "viewer/view_camera.h"
 #include "viewer/viewer_render.h"
@@ -705,6 +706,7 @@ static void test_denoised_view_keeps_the_lamp(void)
     if (st == ST_OK) st = device_open_all("scalar", &dc, &rs.ds, NULL, NULL, &devs, &n_devs, &err);
     CHECK_MSG(st == ST_OK, "setting up: %s", err.msg);
     ViewerRender *vr = calloc(1, sizeof *vr);
+    static int64_t acc[2][64 * 64 * 3];
     if (st == ST_OK && vr &&
         (st = viewer_render_start(vr, devs, n_devs, &rs.ds, &dc, &s.camera, 4, 0, d, &err)) == ST_OK) {
         int done = 0;
@@ -726,11 +728,28 @@ static void test_denoised_view_keeps_the_lamp(void)
                 CHECK_MSG(lamp >= 4, "%zu lamp pixels", lamp);
                 CHECK_MSG(worst < 0.1f, "the lamp's pixels moved by %g in the denoised view", worst);
                 printf("     (%zu lamp pixels, denoised within %.2g of the lamp)\n", lamp, worst);
+                /* the emission accumulated along the passes 1, 2, 4 */
+                for (int k = 0; k < 2; k++) {
+                    CHECK_EQ_INT((long long)vr->emission[k].samples, k ? 16 : 4);
+                    if (vr->emission[k].sum) memcpy(acc[k], vr->emission[k].sum, sizeof acc[k]);
+                }
             }
             pthread_mutex_unlock(&vr->lock);
         }
         CHECK_MSG(done, "the 4-spp frame was not denoised within 300 s");
         st = viewer_render_stop(vr, &err);
+        /* ... is the emission of those samples rendered at once, to the bit */
+        ScheduleConfig cfg;
+        memset(&cfg, 0, sizeof cfg);
+        PassContext pc = { devs, n_devs, &rs, &cfg, NULL, NULL, NULL };
+        for (int k = 0; k < 2 && st == ST_OK; k++) {
+            Film once;
+            double secs = 0.0;
+            st = passes_data_film(&pc, INTEGRATOR_FEATURE_EMISSION, k ? 16 : 4, 0, 0, &once, &secs, &err);
+            CHECK_MSG(st == ST_OK && memcmp(once.sum, acc[k], sizeof acc[k]) == 0,
+                      "the emission accumulated along the passes differs from one render (%d)", k);
+            film_free(&once);
+        }
     }
     CHECK_MSG(st == ST_OK, "%s", err.msg);
     free(vr);

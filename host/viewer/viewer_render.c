@@ -159,6 +159,65 @@ static int features_render(ViewerRender *vr)
     return 1;
 }
 
+/* Adds samples [have, want) of the emission image of `want` samples per pixel to *acc
+ * (vr->emission[]): the frame's emission grows with its passes as the film does, in
+ * the same integer sums, so it is the emission image of [0, want) rendered at once. A
+ * stopped render adds nothing. */
+static Status emission_extend(ViewerRender *vr, const PassContext *pc, Film *acc, uint want, Error *err)
+{
+    uint have = (uint)acc->samples;
+    if (have >= want) return ST_OK;
+    Film part;
+    double secs = 0.0;
+    Status st = passes_data_film(pc, INTEGRATOR_FEATURE_EMISSION, want, have, want, &part, &secs, err);
+    if (st == ST_OK && !vr->stop && part.samples == want - have) {
+        for (size_t i = 0; i < (size_t)acc->width * acc->height * 3u; i++) acc->sum[i] += part.sum[i];
+        acc->samples += part.samples;
+    }
+    film_free(&part);
+    return st;
+}
+
+/* The emission images of the frame of `n` samples per pixel (its samples [0, n), and
+ * [0, 4n) to add back), as passes_denoise_emission makes them for --denoise, but
+ * accumulated along the view's passes: each pass renders only the emission samples the
+ * last did not (camera rays alone). *e and *more stay NULL where --denoise would give
+ * the colour whole (the whitted integrator, media, nothing seen emitted). Freed by the
+ * caller. */
+static Status emission_images(ViewerRender *vr, uint n, float **e, float **more, Error *err)
+{
+    *e = *more = NULL;
+    if (!passes_emission_splits(&vr->params, 1)) return ST_OK;
+    Status st = ST_OK;
+    if (vr->emission_gen != vr->my_gen || vr->emission[0].samples > n) {   /* a new view */
+        for (int k = 0; k < 2 && st == ST_OK; k++) {
+            film_free(&vr->emission[k]);
+            st = film_init(&vr->emission[k], vr->params.width, vr->params.height, err);
+        }
+        if (st != ST_OK) return st;
+        vr->emission_gen = vr->my_gen;
+    }
+    RenderScene rs;
+    ScheduleConfig cfg;
+    PassContext pc;
+    view_pass_context(vr, &rs, &cfg, &pc);
+    size_t floats = (size_t)vr->params.width * vr->params.height * 3u;
+    st = emission_extend(vr, &pc, &vr->emission[0], n, err);
+    if (st != ST_OK || vr->stop) return st;
+    if (!(*e = malloc(floats * sizeof **e))) return error_set(err, ST_INTERNAL, "out of memory for the denoiser");
+    passes_resolve_data(INTEGRATOR_FEATURE_EMISSION, &vr->emission[0], *e);
+    if (!passes_emission_lit(*e, floats)) {   /* nothing seen emitted: the colour whole */
+        free(*e);
+        *e = NULL;
+        return ST_OK;
+    }
+    st = emission_extend(vr, &pc, &vr->emission[1], passes_emission_more_spp(n), err);
+    if (st != ST_OK || vr->stop) return st;
+    if (!(*more = malloc(floats * sizeof **more))) return error_set(err, ST_INTERNAL, "out of memory for the denoiser");
+    passes_resolve_data(INTEGRATOR_FEATURE_EMISSION, &vr->emission[1], *more);
+    return ST_OK;
+}
+
 /* Whether the film holds samples [0, film.samples) exactly: a finished pass. */
 static int film_is_prefix(const ViewerRender *vr)
 {
@@ -181,15 +240,10 @@ static void denoise_step(ViewerRender *vr)
     if (vr->feature_gen != vr->my_gen && !features_render(vr)) return;   /* tried again unless it failed */
     double t0 = timer_now();
     Error err = { 0 };
-    /* the lamps seen directly are left out of the denoiser and added back, as --denoise
-     * does: the emission of the frame's own samples [0, n) and of 4n, rendered for this
-     * frame (camera rays alone: about a bounce of the pass's paths) */
-    RenderScene rs;
-    ScheduleConfig cfg;
-    PassContext pc;
-    view_pass_context(vr, &rs, &cfg, &pc);
+    /* the lamps seen directly are left out of the denoiser and added back, as
+     * --denoise leaves them out (docs/denoise.md, "Emitters' edges") */
     float *e = NULL, *more = NULL;
-    Status st = passes_denoise_emission(&pc, (uint)samples, 1, &e, &more, 1, &err);
+    Status st = emission_images(vr, (uint)samples, &e, &more, &err);
     if (st == ST_OK && vr->stop) {   /* cancelled: the same frame again when still due */
         free(e);
         free(more);
@@ -549,6 +603,9 @@ Status viewer_render_stop(ViewerRender *vr, Error *err)
     }
     preview_close(vr);
     film_free(&vr->film);
+    film_free(&vr->emission[0]);
+    film_free(&vr->emission[1]);
+    vr->emission_gen = 0;
     batch_set_free(&vr->done);
     free(vr->rgb);
     free(vr->spare);

@@ -113,6 +113,11 @@ typedef struct {
     int own_denoiser;             /* opened here (not given by the caller): closed here */
     unsigned feature_gen;         /* the view albedo and normal hold; 0: none */
     float *albedo, *normal, *noisy, *denoise_out;
+    /* the view's directly seen emission, left out of the denoiser and added back as
+     * --denoise does, accumulated along its passes: [0] the frame's own samples [0, n),
+     * [1] samples [0, 4n); of view emission_gen (0: none) */
+    Film emission[2];
+    unsigned emission_gen;
     unsigned tried_gen;           /* the last (view, spp) denoised or tried */
     uint64_t tried_samples;
 

@@ -15,6 +15,7 @@
 #include "base/limit.h"
 #include "device/kernel_source.h"
 #include "base/sha256.h"
+#include "render/passes.h"
 
 #define CKPT_MAGIC "CLPTCKPT"
 /* Version 2: the render key no longer covers the samples per pixel (a render can grow:
@@ -273,13 +274,14 @@ static Status read_adaptive(const unsigned char *header, const unsigned char *p,
 
 /* A --denoise part's feature films (version 4): each one's sample count, then its sums,
  * each bounded by that count as the film's are. The albedo, normal and emission hold
- * the part's own samples; the emission added back PASSES_EMISSION_SPP_FACTOR (4) times
- * as many. */
+ * the part's own samples; the emission added back PASSES_EMISSION_SPP_FACTOR times as
+ * many. */
 static Status read_features(const unsigned char *p, uint64_t n_values, const char *path, Checkpoint *c, Error *err)
 {
     for (uint k = 0; k < c->n_features; k++) {
         uint64_t samples = bytes_get_le64(p);
-        uint64_t expected = k == CKPT_FEATURE_EMISSION_MORE ? 4u * c->film.samples : c->film.samples;
+        uint64_t expected = k == CKPT_FEATURE_EMISSION_MORE ? PASSES_EMISSION_SPP_FACTOR * c->film.samples
+                                                            : c->film.samples;
         if (samples != expected) return bad(err, path, "inconsistent feature sample counts");
         Film *f = &c->features[k];
         Status st = film_init(f, c->film.width, c->film.height, err);

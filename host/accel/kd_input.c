@@ -102,13 +102,69 @@ static void *bounds_range(void *arg)
     return NULL;
 }
 
+/* The bounds of the listed primitives gids[first .. end), each at its place in the
+ * list (a prototype's ranges, KdInput.ranges). */
+typedef struct { const KdInput *in; const uint *gids; Aabb *bounds; uint8_t *finite; uint first, end; } ListJob;
+
+static void *bounds_list(void *arg)
+{
+    const ListJob *j = arg;
+    for (uint i = j->first; i < j->end; i++)
+        j->finite[i] = (uint8_t)kd_prim_box(j->in, j->gids[i], j->bounds[i].lo, j->bounds[i].hi);
+    return NULL;
+}
+
+/* kd_gather over the primitives of in->ranges alone (a prototype of an instanced scene,
+ * docs/instancing.md): the same result as over a KdInput holding just those, in
+ * increasing global id. */
+static Status gather_ranges(Build *b, const KdInput *in, uint *skipped, Error *err)
+{
+    uint64_t total = 0;
+    for (size_t r = 0; r < in->n_ranges; r++)
+        if (in->ranges[r].hi > in->ranges[r].lo) total += in->ranges[r].hi - in->ranges[r].lo;
+    if (total > KD_MAX_PRIMS)
+        return error_set(err, ST_INPUT, "kd-tree: %llu primitives, more than the %u supported",
+                         (unsigned long long)total, KD_MAX_PRIMS);
+    b->gid = malloc((total + 1) * sizeof *b->gid);
+    b->tri = malloc((total + 1) * sizeof *b->tri);
+    b->bounds = malloc((total + 1) * sizeof *b->bounds);
+    uint8_t *finite = malloc(total + 1);
+    if (!b->gid || !b->tri || !b->bounds || !finite) {
+        free(finite);
+        return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %llu primitives", (unsigned long long)total);
+    }
+    uint listed = 0;
+    for (size_t r = 0; r < in->n_ranges; r++)
+        for (uint gid = in->ranges[r].lo; gid < in->ranges[r].hi; gid++) b->gid[listed++] = gid;
+    int n_jobs = jobs_threads(b->threads, total, 65536);
+    ListJob jobs[JOBS_MAX];
+    for (int i = 0; i < n_jobs; i++)
+        jobs[i] = (ListJob){ in, b->gid, b->bounds, finite, (uint)(total * (uint64_t)i / (uint64_t)n_jobs),
+                             (uint)(total * (uint64_t)(i + 1) / (uint64_t)n_jobs) };
+    jobs_run(bounds_list, jobs, sizeof *jobs, n_jobs);
+    uint first_tri = (uint)in->n_spheres, end_tri = first_tri + (uint)in->n_triangles, n = 0;
+    for (uint i = 0; i < listed; i++) {
+        if (!finite[i]) continue;
+        uint gid = b->gid[i];
+        b->gid[n] = gid;
+        b->tri[n] = gid >= first_tri && gid < end_tri ? gid - first_tri : NO_INDEX;
+        b->bounds[n++] = b->bounds[i];
+    }
+    free(finite);
+    b->n_prims = n;
+    *skipped = listed - n;
+    b->triangles = in->triangles;
+    return ST_OK;
+}
+
 /* Collects the primitives (global ids, bounds). A primitive whose bounds are not
  * finite (a NaN or inf coordinate or radius) is left out of the tree, and so can never
  * be hit: no finite ray could hit it meaningfully, and one infinite box would make
  * every SAH area infinite. The bounds are computed on the build's threads, then the
- * finite ones moved down in order. */
+ * finite ones moved down in order. With in->ranges, only the primitives they list. */
 Status kd_gather(Build *b, const KdInput *in, uint *skipped, Error *err)
 {
+    if (in->n_ranges) return gather_ranges(b, in, skipped, err);
     size_t total = in->n_spheres + in->n_triangles + in->n_boxes + in->n_revs;
     if (total > KD_MAX_PRIMS)
         return error_set(err, ST_INPUT, "kd-tree: %zu primitives, more than the %u supported",

@@ -49,9 +49,9 @@ typedef struct {
     const Box *boxes;          size_t n_boxes;
     const RevSurface *revs;    size_t n_revs;    /* after the boxes in the id space */
     const SphereXform *sphere_xforms; size_t n_sphere_xforms;   /* Sphere.xform's targets */
-    /* The BVH's builds only: the tree holds the primitives of these ranges (increasing,
-     * disjoint) rather than all of them (0 ranges). kd_build takes every primitive: a
-     * scene's instances reach it flattened (docs/instancing.md). */
+    /* A prototype's build (an object of an instanced scene, docs/instancing.md): the
+     * tree holds the primitives of these ranges (increasing, disjoint) rather than all
+     * of them (0 ranges). Both trees take them. */
     const KdRange *ranges;     size_t n_ranges;
 } KdInput;
 

@@ -375,6 +375,8 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(Material, diffuse_transmission);
     out[i++] = (uint)__builtin_offsetof(Material, diffuse_transmission_color);
     out[i++] = (uint)__builtin_offsetof(GridMedium, minorant_at);
+    out[i++] = (uint)sizeof(KdProto);
+    out[i++] = (uint)__builtin_offsetof(KdProto, hi);
 }
 #endif
 

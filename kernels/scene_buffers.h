@@ -40,6 +40,8 @@
     /* the top level over instances, compressed (types.h); none without instances */     \
     X(MANY, BvhTopNode,   bvh_top,    (ds)->n_bvh_top,           "top-level BVH nodes")      \
     X(MANY, Instance,     instances,  (ds)->params.n_instances,  "instances")                \
+    /* --accel kdtree with instances: each prototype's kd-tree (types.h); else none */     \
+    X(MANY, KdProto,      kd_protos,  (ds)->n_kd_protos,         "kd-tree prototypes")       \
     /* per instance, its first light (types.h, LIGHT_INSTANCED); none without them */    \
     X(MANY, uint,         instance_lights, (ds)->n_instance_lights, "instanced lights")      \
     X(MANY, Sphere,       spheres,    (ds)->params.n_spheres,    "spheres")                  \

@@ -277,12 +277,25 @@ typedef struct {                                        /* 96 bytes */
 typedef struct {                                        /* 108 bytes */
     float to_world[12];       /* M: object -> world */
     float to_object[12];      /* M^-1: world -> object */
-    uint root;                /* the BVH node of its prototype's root */
+    uint root;                /* the BVH node of its prototype's root; under --accel
+                               * kdtree its prototype's KdProto (kd_protos) */
     uint material;            /* the material that replaces every primitive's, or NO_INDEX */
     uint flags;               /* INST_* */
     /* the prototype's index is the host's alone (stats, flattening, lights): it lives
      * in Scene.instance_objects, not in what every device holds per instance */
 } Instance;
+
+/* A prototype's kd-tree under --accel kdtree in a scene with instances (host/accel/
+ * kd_inst.c, docs/instancing.md): the top level stays the compressed BVH over instances
+ * and each prototype's kd-tree lies in the shared kd node and leaf arrays (nodes,
+ * leaf_prims), its interior nodes' "above" indices and its leaves' record offsets
+ * already moved to where it lies. Instance.root is then the prototype's index in the
+ * kd_protos buffer; the walk clips the object-space ray to lo, hi as a one-level kd
+ * walk clips it to RenderParams.bounds_lo, hi. */
+typedef struct {                                        /* 32 bytes */
+    vec3 lo;   uint root;     /* the box of the tree's root; its root node in nodes[] */
+    vec3 hi;   uint pad0;
+} KdProto;
 
 /* Global primitive ids: [0, n_spheres) spheres, then triangles, then boxes, then
  * surfaces of revolution, then planes. All but the infinite planes are in the kd-tree. */
@@ -874,6 +887,8 @@ CLPT_CHECK_SIZE(KdNode, 8);
 CLPT_CHECK_SIZE(BvhNode, 256);
 CLPT_CHECK_SIZE(BvhTopNode, 96);
 _Static_assert(offsetof(BvhTopNode, ref) == 64, "BvhTopNode.ref");
+CLPT_CHECK_SIZE(KdProto, 32);
+_Static_assert(offsetof(KdProto, hi) == 16, "KdProto.hi");
 CLPT_CHECK_SIZE(Sphere, 32);
 CLPT_CHECK_SIZE(SphereXform, 96);
 _Static_assert(offsetof(Sphere, xform) == 24, "Sphere.xform");

@@ -40,7 +40,8 @@
         offsetof(GridMedium, emission_at),                                                      \
         offsetof(GridMedium, temperature_at), sizeof(MotionKey), offsetof(MotionKey, stretch),  \
         offsetof(Camera, motion_keys), offsetof(Material, diffuse_transmission),                \
-        offsetof(Material, diffuse_transmission_color), offsetof(GridMedium, minorant_at)       \
+        offsetof(Material, diffuse_transmission_color), offsetof(GridMedium, minorant_at),      \
+        sizeof(KdProto), offsetof(KdProto, hi)                                                  \
     }
 
 /* how many values k_layout writes */

@@ -48,6 +48,7 @@
     X(size_t, n_env_cdf)                                                                     \
     X(size_t, n_bvh_leaves)     /* words of the BVH's leaf records */                        \
     X(uint, n_bvh_top)          /* the top level's nodes (BvhTopNode); 0 without instances */ \
+    X(uint, n_kd_protos)        /* --accel kdtree with instances: prototypes' kd-trees */    \
     X(size_t, n_grid_data)      /* floats of the density grids and their majorants */        \
     X(uint, n_motion_keys)      /* keys of moving transforms (instances', the camera's) */   \
     X(uint, n_instance_motion)  /* the device's instances when any moves, else 0 */

@@ -33,6 +33,8 @@ unsigned kernel_scene_features(const DeviceScene *s)
     for (uint i = 0; i < p->n_lights; i++) f |= light_feature(s->lights[i].type);
     f |= (p->n_spheres ? KF_SPHERES : 0u) | (p->n_boxes ? KF_BOXES : 0u) | (p->n_planes ? KF_PLANES : 0u) |
          (p->n_revsurfaces ? KF_REVSURFACE : 0u) | (p->n_bvh_nodes ? KF_BVH : KF_KDTREE) |
+         /* --accel kdtree with instances: the BVH's top level over kd-tree prototypes */
+         (p->n_instances ? KF_BVH : 0u) |
          (s->n_sphere_xforms ? KF_SPHERE_XFORM : 0u) | (p->n_instances ? KF_INSTANCES : 0u) |
          (p->camera.moving ? KF_MOTION : 0u);
     return f;

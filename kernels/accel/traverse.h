@@ -15,16 +15,22 @@
 #include "geom/intersect.h"
 #include "scene_view.h"
 
+#if TRACE_PACKET != WIDE_PACKET
+#error "the kd-tree's and the BVH's packets are of the same size (k_trace_closest8, k_trace_closest_wide8)"
+#endif
+
 /* Which tree holds the scene: the kd-tree (TREE_KD) or the 8-wide BVH (TREE_BVH). A
  * program compiled for one (CLPT_FEATURES with KF_KDTREE or KF_BVH alone) knows it at
- * compile time; otherwise the scene says, by having BVH nodes. */
+ * compile time; otherwise the scene says, by having BVH nodes or instances: under
+ * --accel kdtree a scene with instances is walked from the BVH's top level, whose
+ * instances lead to kd-trees (trace_wide, docs/instancing.md). */
 #define TREE_KD 0
 #define TREE_BVH 1
 KFN_INLINE int trace_tree_kind(const SceneView *sc)
 {
     if (!KF_HAS(KF_BVH)) return TREE_KD;
     if (!KF_HAS(KF_KDTREE)) return TREE_BVH;
-    return sc->params->n_bvh_nodes != 0u ? TREE_BVH : TREE_KD;
+    return (sc->params->n_bvh_nodes | sc->params->n_instances) != 0u ? TREE_BVH : TREE_KD;
 }
 
 /* The walk of the given tree (which, when it is the BVH, must be there). */

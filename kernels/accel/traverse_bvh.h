@@ -25,6 +25,7 @@
 #define CLPT_TRAVERSE_BVH_H
 
 #include "accel/leaf.h"
+#include "accel/traverse_kd.h"
 #include "geom/instance.h"
 
 #define BVH_TINY 1e-30f
@@ -241,14 +242,23 @@ KFN_INLINE BvhRay bvh_ray(Ray ray, const RayPre *rp)
  * top level's nodes are compressed (BvhTopNode, sc->bvh_top, decoded by bvh_top_test):
  * `top` says which level the walk is in, and so which array a stack entry's node is
  * in (the top level's entries lie below a BVH_STACK_LEAVE, the prototype's above). The
- * builds keep both levels' stack depths within BVH_STACK together (host/accel/bvh_inst.c). */
+ * builds keep both levels' stack depths within BVH_STACK together (host/accel/bvh_inst.c).
+ * Under --accel kdtree (a scene with kd nodes and instances) the prototypes are
+ * kd-trees instead (KdProto): an instance is walked whole by trace_kd_proto, with the
+ * kd walk's own stack, and the walk goes on in the top level; no BVH_STACK_LEAVE. */
 BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int any, Hit *best)
 {
     float s = ray.o.x + ray.o.y + ray.o.z + ray.d.x + ray.d.y + ray.d.z;
+#if KF_HAS(KF_INSTANCES)
+    if (!(s == s) || (sc->params->n_bvh_nodes | sc->params->n_instances) == 0u) return;
+#else
     if (!(s == s) || sc->params->n_bvh_nodes == 0u) return;
+#endif
     BvhRay w = bvh_ray(ray, rp);
 #if KF_HAS(KF_INSTANCES)
     int top = sc->params->n_instances != 0u;   /* walking the top level's nodes */
+    /* the prototypes are kd-trees (--accel kdtree): the scene has kd nodes */
+    int kd_protos = KF_HAS(KF_KDTREE) && sc->params->n_nodes != 0u;
     BvhRay w_world = w;
     Ray oray = ray;              /* the ray in the space being walked, and its constants */
     RayPre orp = *rp;
@@ -295,6 +305,19 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
             ref = nd->ref[next];
             kind = nd->kind[next];
         }
+#if KF_HAS(KF_INSTANCES) && KF_HAS(KF_KDTREE)
+        if (kind == BVH_CHILD_INSTANCE && kd_protos) {
+            /* the instance's kd-tree, walked whole in its object space; then on in the
+             * top level, whose entries are on this stack still */
+            GLOBAL const Instance *x = sc->instances + ref;
+            oray = instance_ray_seen(sc, ref, x, ray);
+            orp = ray_prepare(oray);
+            trace_kd_proto(sc, sc->kd_protos + x->root, oray, &orp, any, (x->flags & INST_WORLD) ? NO_INDEX : ref,
+                           best);
+            if (any && best->prim != NO_INDEX) return;
+            kind = BVH_CHILD_NODE;   /* nothing for the leaf test below: on to the pop */
+        } else
+#endif
 #if KF_HAS(KF_INSTANCES)
         if (kind == BVH_CHILD_INSTANCE) {
             /* into the instance: its object space, its prototype's root */

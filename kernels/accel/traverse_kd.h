@@ -17,25 +17,31 @@
 #include "geom/intersect.h"
 #include "scene_view.h"
 
-/* Clips the ray's [tmin, tmax] to the root box; 0 if nothing is left. The far end is
- * widened by a few ulps (pbrt's 1 + 2*gamma(3)) so that rounding in the slab test
- * cannot cut off a primitive lying on the box's far face. */
-KFN int trace_clip_root(GLOBAL const RenderParams *pr, Ray ray, const RayPre *rp,
-                        float *t0, float *t1)
+/* Clips the ray's [tmin, tmax] to the box lo, hi of a tree's root; 0 if nothing is
+ * left. The far end is widened by a few ulps (pbrt's 1 + 2*gamma(3)) so that rounding
+ * in the slab test cannot cut off a primitive lying on the box's far face. */
+KFN int trace_clip_box(GLOBAL const vec3 *lo, GLOBAL const vec3 *hi, Ray ray, const RayPre *rp, float *t0,
+                       float *t1)
 {
     /* A NaN (or +inf - inf) in the ray would make every split plane "in the plane" and
      * the walk visit the whole tree; such a ray hits nothing anyway. */
     float s = ray.o.x + ray.o.y + ray.o.z + ray.d.x + ray.d.y + ray.d.z;
     if (!(s == s)) return 0;
     float nx, fx, ny, fy, nz, fz;
-    k_slab(pr->bounds_lo.x, pr->bounds_hi.x, ray.o.x, rp->inv_d[0], &nx, &fx);
-    k_slab(pr->bounds_lo.y, pr->bounds_hi.y, ray.o.y, rp->inv_d[1], &ny, &fy);
-    k_slab(pr->bounds_lo.z, pr->bounds_hi.z, ray.o.z, rp->inv_d[2], &nz, &fz);
+    k_slab(lo->x, hi->x, ray.o.x, rp->inv_d[0], &nx, &fx);
+    k_slab(lo->y, hi->y, ray.o.y, rp->inv_d[1], &ny, &fy);
+    k_slab(lo->z, hi->z, ray.o.z, rp->inv_d[2], &nz, &fz);
     float tn = k_fmax(ray.tmin, k_fmax(nx, k_fmax(ny, nz)));
     float tf = k_fmin(ray.tmax, k_fmin(fx, k_fmin(fy, fz)) * 1.00000036f);
     *t0 = tn;
     *t1 = tf;
     return tn <= tf;
+}
+
+/* The same for the scene's one tree: its root box is RenderParams.bounds_lo, hi. */
+KFN int trace_clip_root(GLOBAL const RenderParams *pr, Ray ray, const RayPre *rp, float *t0, float *t1)
+{
+    return trace_clip_box(&pr->bounds_lo, &pr->bounds_hi, ray, rp, t0, t1);
 }
 
 /* A kd-tree walk in progress: the node about to be visited, the part [t0, t1] of the
@@ -109,7 +115,8 @@ KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, KdStack *st, int 
     w->node = k_select_u(near, far, far_only);
 }
 
-/* The visit of leaf n: its primitives (leaf_test); returns 1 when the walk is over:
+/* The visit of leaf n: its primitives (leaf_test; hits carry instance inst, NO_INDEX
+ * in a one-level tree); returns 1 when the walk is over:
  * an any-hit query hit, or nothing is left on the stack, or the next cell starts beyond
  * the closest hit. Otherwise pops the next cell.
  *
@@ -122,9 +129,9 @@ KFN_INLINE void kd_step(const RayPre *rp, KdNode n, KdWalk *w, KdStack *st, int 
  * the corners and edges of meshes). Cells on the stack start at or after this one's
  * end, so a hit well short of it ends the walk without looking. */
 KFN_INLINE int kd_leaf(const SceneView *sc, Ray ray, const RayPre *rp, int any, KdNode n, KdWalk *w,
-                       const KdStack *st, Hit *best)
+                       const KdStack *st, Hit *best, uint inst)
 {
-    if (leaf_test(sc, sc->leaf_prims, ray, rp, any, n, NO_INDEX, best)) return 1;
+    if (leaf_test(sc, sc->leaf_prims, ray, rp, any, n, inst, best)) return 1;
     float reach = best->t * KD_T_ABOVE;
     if ((w->sp == 0) | (reach < w->t1)) return 1;
     int sp = w->sp - 1;
@@ -155,9 +162,38 @@ KFN_INLINE void trace_tree(const SceneView *sc, Ray ray, const RayPre *rp, int a
     for (;;) {
         KdNode n = nodes[w.node];
         if ((n.bits & 3u) != KD_LEAF) kd_step(rp, n, &w, &st, 1);
-        else if (kd_leaf(sc, ray, rp, any, n, &w, &st, best)) return;
+        else if (kd_leaf(sc, ray, rp, any, n, &w, &st, best, NO_INDEX)) return;
     }
 }
+
+#if KF_HAS(KF_INSTANCES)
+/* The walk of a prototype's kd-tree (KdProto p: --accel kdtree in a scene with
+ * instances, docs/instancing.md) for the ray already in its object space, from the
+ * top level's walk (trace_wide) when it enters instance inst (NO_INDEX: the world's
+ * own primitives). It is trace_tree's walk from the prototype's root and box, with
+ * its own stack (KD_MAX_DEPTH entries, which the prototype's build keeps to, as every
+ * kd-tree's): the top level's entries stay on trace_wide's stack, untouched. The ray's
+ * t is the world's (instance.h), so the walk ends where the closest hit so far, in any
+ * instance, ends it, and its cells end there too: a prototype's primitive at that very
+ * t is still tested (KD_T_ABOVE), which the tie rule may give it. */
+KFN_INLINE void trace_kd_proto(const SceneView *sc, GLOBAL const KdProto *p, Ray ray, const RayPre *rp, int any,
+                               uint inst, Hit *best)
+{
+    KdWalk w;
+    KdStack st;
+    w.node = p->root;
+    w.sp = 0;
+    if (!trace_clip_box(&p->lo, &p->hi, ray, rp, &w.t0, &w.t1)) return;
+    w.t1 = k_fmin(w.t1, best->t * KD_T_ABOVE);
+    if (!(w.t0 <= w.t1)) return;
+    GLOBAL const KdNode *nodes = sc->nodes;
+    for (;;) {
+        KdNode n = nodes[w.node];
+        if ((n.bits & 3u) != KD_LEAF) kd_step(rp, n, &w, &st, 1);
+        else if (kd_leaf(sc, ray, rp, any, n, &w, &st, best, inst)) return;
+    }
+}
+#endif
 
 /* ------------------------------------------------------------------ two rays at once */
 
@@ -199,7 +235,7 @@ KFN_INLINE void trace_ray_finish(const SceneView *sc, TraceRay *t, const RayPre 
     while (t->active) {
         KdNode n = nodes[w->node];
         if ((n.bits & 3u) != KD_LEAF) kd_step(rp, n, w, st, 1);
-        else t->active = !kd_leaf(sc, t->ray, rp, t->any, n, w, st, &t->best);
+        else t->active = !kd_leaf(sc, t->ray, rp, t->any, n, w, st, &t->best, NO_INDEX);
     }
 }
 
@@ -215,9 +251,9 @@ KFN_INLINE void trace_ray_finish(const SceneView *sc, TraceRay *t, const RayPre 
                 kd_step(&(pb), nb, &(wb), &(sb), 0);                                     \
                 continue;                                                                \
             }                                                                            \
-            if (la) (a).active = !kd_leaf(sc, (a).ray, &(pa), (a).any, na, &(wa), &(sa), &(a).best); \
+            if (la) (a).active = !kd_leaf(sc, (a).ray, &(pa), (a).any, na, &(wa), &(sa), &(a).best, NO_INDEX); \
             else kd_step(&(pa), na, &(wa), &(sa), 0);                                    \
-            if (lb) (b).active = !kd_leaf(sc, (b).ray, &(pb), (b).any, nb, &(wb), &(sb), &(b).best); \
+            if (lb) (b).active = !kd_leaf(sc, (b).ray, &(pb), (b).any, nb, &(wb), &(sb), &(b).best, NO_INDEX); \
             else kd_step(&(pb), nb, &(wb), &(sb), 0);                                    \
         }                                                                                \
         trace_ray_finish(sc, &(a), &(pa), &(wa), &(sa));                                 \
@@ -265,10 +301,7 @@ KFN void trace_any2(const SceneView *sc, Ray ra, Ray rb, int *oa, int *ob)
  * hit so far, and stops where its walk stops: its hit is bit for bit trace_closest's
  * (trace_any's), which test_kdtree checks in C and bench_traverse on PoCL. Rays whose
  * signs differ from the others' are walked one after the other instead. */
-#define TRACE_PACKET 8
-#if TRACE_PACKET != WIDE_PACKET
-#error "the kd-tree's and the BVH's packets are of the same size (k_trace_closest8, k_trace_closest_wide8)"
-#endif
+#define TRACE_PACKET 8   /* as WIDE_PACKET (traverse.h checks) */
 
 typedef struct {
     uint node[KD_MAX_DEPTH];

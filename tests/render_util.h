@@ -20,8 +20,10 @@
 /* devices: a --device spec; batch: fixed batch size (0 = adaptive); mis_mode: enum
  * MisMode set on the prepared scene (the tests of each strategy alone), or
  * RENDER_UTIL_SCENE_MIS. The film is initialised here; free it with film_free. */
-static inline Status render_util_run_mis(Scene *s, uint mis_mode, const char *devices, uint batch, Film *film,
-                                         Error *err)
+/* render_util_run_mis with the devices opened under cfg (NULL: the defaults), e.g. an
+ * OpenCL device's --wave-launch. */
+static inline Status render_util_run_cfg(Scene *s, uint mis_mode, const char *devices, const DeviceConfig *cfg,
+                                         uint batch, Film *film, Error *err)
 {
     RenderScene rs;
     DeviceDesc *all = NULL;
@@ -38,16 +40,16 @@ static inline Status render_util_run_mis(Scene *s, uint mis_mode, const char *de
     if ((st = device_select(devices, all, n_all, &chosen, &n_chosen, err))) goto out;
     devs = calloc(n_chosen, sizeof *devs);
     for (size_t i = 0; i < n_chosen; i++) {
-        if ((st = device_open(&all[chosen[i]], NULL, &devs[i], err))) goto out;
+        if ((st = device_open(&all[chosen[i]], cfg, &devs[i], err))) goto out;
         n_open++;
         if ((st = devs[i]->ops->load_scene(devs[i], &rs.ds, err))) goto out;
     }
     if ((st = film_init(film, rs.ds.params.width, rs.ds.params.height, err))) goto out;
-    ScheduleConfig cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.spp = s->image.spp;
-    cfg.fixed_batch = batch;
-    st = schedule_run(devs, n_chosen, &cfg, film, &stats, err);
+    ScheduleConfig sched;
+    memset(&sched, 0, sizeof sched);
+    sched.spp = s->image.spp;
+    sched.fixed_batch = batch;
+    st = schedule_run(devs, n_chosen, &sched, film, &stats, err);
 out:
     schedule_stats_free(&stats);
     for (size_t i = 0; i < n_open; i++) device_close(devs[i]);
@@ -56,6 +58,12 @@ out:
     free(all);
     render_scene_free(&rs);
     return st;
+}
+
+static inline Status render_util_run_mis(Scene *s, uint mis_mode, const char *devices, uint batch, Film *film,
+                                         Error *err)
+{
+    return render_util_run_cfg(s, mis_mode, devices, NULL, batch, film, err);
 }
 
 static inline Status render_util_run(Scene *s, const char *devices, uint batch, Film *film, Error *err)

@@ -302,7 +302,7 @@ static void test_pose_equals_static(void)
         check_pose(&s, 1.5, "t = 1.5");
         check_pose(&s, 1.0, "t = 1 (a key)");
         check_pose(&s, 0.25, "t = 0.25 (back)");
-        s.accel = ACCEL_KDTREE;   /* instances flattened, then posed again */
+        s.accel = ACCEL_KDTREE;   /* the kd-tree's prototypes, posed again */
         check_pose(&s, 0.75, "kdtree t = 0.75");
         check_pose(&s, 1.75, "kdtree t = 1.75");
     }

@@ -4,8 +4,8 @@
  * rotation slerp); a moving camera's and a moving instance's images against the
  * average of still ones at fixed times; the top level's box over an instance's motion;
  * a still scene with a shutter unchanged bit for bit; every device and wave launch
- * giving the scalar device's bits on moving scenes, and after a resume; the kd-tree's
- * refusal.
+ * giving the scalar device's bits on moving scenes, and after a resume; moving
+ * instances under the kd-tree's prototypes as under the BVH's.
  * Bad input: tests/data/bad/motion-* (test_bad_input.c). Run from the project root.
  */
 #include <math.h>
@@ -501,14 +501,40 @@ static void test_devices_match_scalar(void)
     unlink(out);
 }
 
-/* The kd-tree takes instances as copies, which cannot move: refused, naming the way. */
-static void test_kdtree_refuses_moving_instances(void)
+/* Moving instances under --accel kdtree: the top level (the BVH's, over the instances'
+ * boxes of their whole motion) carries the ray into each instance where it is at the
+ * path's time, and the prototype's kd-tree finds what the BVH's finds: the BVH's image
+ * bit for bit, on the scalar device, and on OpenCL under every wave launch and with the
+ * classic ray tracer's kernel. */
+static void test_kdtree_moving_instances(void)
 {
-    cli_run(ARGS("tests/data/motion/instances.scene", "--device", "scalar", "--accel", "kdtree", "-q", "-o",
-                 TEST_TMP("clpt-test-motion-kd.pfm")), &r);
-    CHECK_EQ_INT(r.status, 3);
-    CHECK_STR_CONTAINS(r.err, "--accel kdtree takes instances as copies, which cannot move: render a scene with "
-                              "moving instances with --accel bvh (the default)");
+    const char *scenes[] = { "tests/data/motion/instances.scene", "tests/data/motion/lamps.scene" };
+    const char *ref = TEST_TMP("clpt-test-motion-bvh.pfm"), *out = TEST_TMP("clpt-test-motion-kd.pfm");
+    const char *modes[] = { "counted", "bounded", "megakernel" };
+    for (int k = 0; k < 2; k++) {
+        cli_run(ARGS(scenes[k], "--device", "scalar", "-q", "-o", ref), &r);
+        CHECK_MSG(r.status == 0, "%s", r.err);
+        cli_run(ARGS(scenes[k], "--device", "scalar", "--accel", "kdtree", "-q", "-o", out), &r);
+        CHECK_MSG(r.status == 0, "%s", r.err);
+        CHECK_MSG(files_equal(ref, out), "%s: the kd-tree's image differs from the BVH's", scenes[k]);
+        for (int i = 0; i < 3; i++) {
+            cli_run(ARGS(scenes[k], "--device", TEST_OPENCL, "--accel", "kdtree", "--wave-launch", modes[i],
+                         "--wave-paths", "1000", "--batch", "2", "-q", "-o", out), &r);
+            CHECK_MSG(r.status == 0, "%s: %s", modes[i], r.err);
+            CHECK_MSG(files_equal(ref, out), "%s, --accel kdtree --wave-launch %s: the image differs from the scalar "
+                      "BVH's", scenes[k], modes[i]);
+        }
+        /* the classic ray tracer's kernel (k_whitted) */
+        cli_run(ARGS(scenes[k], "--device", "scalar", "--integrator", "whitted", "-q", "-o", ref), &r);
+        CHECK_MSG(r.status == 0, "%s", r.err);
+        cli_run(ARGS(scenes[k], "--device", TEST_OPENCL, "--accel", "kdtree", "--integrator", "whitted", "-q", "-o",
+                     out), &r);
+        CHECK_MSG(r.status == 0, "%s", r.err);
+        CHECK_MSG(files_equal(ref, out), "%s, --accel kdtree, whitted: the image differs from the scalar BVH's",
+                  scenes[k]);
+    }
+    unlink(ref);
+    unlink(out);
 }
 
 /* Checkpointed at 4 samples and resumed to 8 on the OpenCL and scalar devices together:
@@ -533,7 +559,7 @@ int main(void)
     RUN(test_bounds_hold_the_motion);
     RUN(test_still_with_shutter_same_bits);
     RUN(test_devices_match_scalar);
-    RUN(test_kdtree_refuses_moving_instances);
+    RUN(test_kdtree_moving_instances);
     RUN(test_resume_matches_straight);
     return harness_report();
 }

@@ -217,3 +217,28 @@ done:
     else out->stats.build_seconds = timer_now() - t0;
     return st;
 }
+
+Status bvh_build_top_level(const KdInput *in, const BvhProto *protos, size_t n_protos, const Instance *inst,
+                           const uint *object, size_t n_inst, const BvhMotion *motion, int threads, Bvh *out,
+                           BvhLevels *lv, Error *err)
+{
+    double t0 = timer_now();
+    memset(out, 0, sizeof *out);
+    memset(lv, 0, sizeof *lv);
+    lv->inst_beyond = NO_INDEX;
+    Bvh top;
+    Status st = build_top(in, protos, n_protos, inst, object, n_inst, motion, threads, &top, lv, err);
+    if (st) return st;
+    if ((st = bvh_top_compress(&top, &out->top, err)) == ST_OK) {
+        out->n_top = top.n_nodes;
+        out->lo = top.lo;
+        out->hi = top.hi;
+        out->stats = top.stats;
+        out->stats.build_seconds = timer_now() - t0;
+        lv->top = top.stats;
+        lv->top_nodes = top.n_nodes;
+    }
+    bvh_free(&top);
+    if (st) bvh_free(out);
+    return st;
+}

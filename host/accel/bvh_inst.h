@@ -54,4 +54,13 @@ typedef struct {
 Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_protos, Instance *inst,
                            const uint *object, size_t n_inst, const BvhMotion *motion, int threads, Bvh *out, BvhLevels *lv, Error *err);
 
+/* The top level alone, as bvh_build_instanced builds it (the same boxes, the same
+ * refusals), for prototypes of another kind: the kd-trees of --accel kdtree
+ * (accel/kd_inst.h). *out owns the compressed top level (top, n_top) and nothing else
+ * (no nodes, no leaves); out->lo, hi bound the world. Instance roots are left as they
+ * are: the caller fills them. */
+Status bvh_build_top_level(const KdInput *in, const BvhProto *protos, size_t n_protos, const Instance *inst,
+                           const uint *object, size_t n_inst, const BvhMotion *motion, int threads, Bvh *out,
+                           BvhLevels *lv, Error *err);
+
 #endif /* CLPT_BVH_INST_H */

@@ -4,7 +4,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "accel/bvh_top.h"
 #include "scene/camera.h"
@@ -76,8 +75,10 @@ static Status world_ranges(const Scene *s, KdRange **out, size_t *n, Error *err)
     return ST_OK;
 }
 
-/* The BVH of a scene with objects: a prototype per object and the world's own as the
- * last, the scene's instances and one identity instance of the world's (INST_WORLD). */
+/* The two levels of a scene with objects: a prototype per object and the world's own as
+ * the last, the scene's instances and one identity instance of the world's (INST_WORLD).
+ * The top level is the BVH's; the prototypes are BVHs, or under --accel kdtree kd-trees
+ * (accel/kd_inst.h, docs/instancing.md). */
 static Status tree_build_instanced(const Scene *s, const KdInput *in, int threads, RenderScene *out, Error *err)
 {
     size_t n_protos = s->n_objects + 1;
@@ -124,8 +125,17 @@ static Status tree_build_instanced(const Scene *s, const KdInput *in, int thread
         out->ds.n_instance_motion = (uint)out->n_instances;
     }
     BvhMotion motion = { out->instance_motion, s->motion_keys };
-    st = bvh_build_instanced(in, protos, n_protos, out->instances, objects, out->n_instances, &motion, threads,
-                             &out->bvh, &out->levels, err);
+    int kd = s->accel == ACCEL_KDTREE;
+    if (kd) {
+        st = bvh_build_top_level(in, protos, n_protos, out->instances, objects, out->n_instances, &motion, threads,
+                                 &out->bvh, &out->levels, err);
+        if (!st)
+            st = kd_build_prototypes(in, protos, n_protos, out->instances, objects, out->n_instances, threads,
+                                     &out->kd, &out->kd_protos, &out->kd_levels, err);
+    } else {
+        st = bvh_build_instanced(in, protos, n_protos, out->instances, objects, out->n_instances, &motion, threads,
+                                 &out->bvh, &out->levels, err);
+    }
     if (st == ST_INPUT && out->levels.inst_beyond < s->n_instances) {
         /* named as the file wrote it (the world's own shapes, within 2^62 since they
          * were read, never reach this far: bvh_inst.c's message stays for them) */
@@ -140,7 +150,17 @@ static Status tree_build_instanced(const Scene *s, const KdInput *in, int thread
     }
     if (st) goto done;
     out->instanced = 1;
+    if (kd) {
+        /* the kd-trees' nodes and leaves (no root box of their own: each is in its
+         * record), then the top level, whose box is the world's */
+        render_scene_use_kdtree(&out->ds, &out->kd);
+        out->n_kd_protos = n_protos;
+        out->ds.kd_protos = out->kd_protos;
+        out->ds.n_kd_protos = (uint)n_protos;
+    }
     render_scene_use_bvh(&out->ds, &out->bvh);
+    out->ds.params.bounds_lo = out->bvh.lo;
+    out->ds.params.bounds_hi = out->bvh.hi;
     out->ds.params.n_instances = (uint)out->n_instances;
     out->ds.instances = out->instances;
 done:
@@ -157,7 +177,7 @@ static Status tree_build(const Scene *s, int threads, RenderScene *out, Error *e
     KdInput in = { s->spheres, s->n_spheres, s->triangles, s->n_triangles, s->boxes, s->n_boxes,
                    s->revsurfaces, s->n_revsurfaces, s->sphere_xforms, s->n_sphere_xforms, NULL, 0 };
     Status st;
-    if (s->n_objects && s->accel != ACCEL_KDTREE) return tree_build_instanced(s, &in, threads, out, err);
+    if (s->n_objects) return tree_build_instanced(s, &in, threads, out, err);
     if (s->accel == ACCEL_KDTREE) {
         if ((st = kd_build(&in, threads, &out->kd, err))) return st;
         render_scene_use_kdtree(&out->ds, &out->kd);
@@ -209,41 +229,6 @@ static Status prepare_media(const Scene *s, RenderScene *out, Error *err)
     return ST_OK;
 }
 
-/* What the kd-tree's copies of an instanced scene would take, checked before they are
- * made: scenes/instances.scene's 3,600 bunnies are 250 million triangles, whose copies
- * were made before the tree's build failed for want of memory. The estimate is per primitive:
- * the copy's record and shading data, the build's event lists (two events on each of
- * three axes, kept three deep, 8 bytes each) and the finished tree (docs/kdtree.md:
- * about 70 bytes a triangle); CLPT_MAX_FLATTEN_BYTES replaces the machine's memory as
- * the budget. */
-#define FLATTEN_BYTES_PER_PRIM 256u
-static Status flatten_fits(const Scene *s, Error *err)
-{
-    uint64_t prims = s->n_spheres + s->n_triangles + s->n_boxes + s->n_revsurfaces;
-    for (size_t i = 0; i < s->n_instances; i++) prims += scene_object_prims(s, s->instance_objects[i]);
-    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-    uint64_t budget = pages > 0 && page > 0 ? (uint64_t)pages * (uint64_t)page : UINT64_MAX;
-    const char *env = getenv("CLPT_MAX_FLATTEN_BYTES");
-    char *end = NULL;
-    if (env && *env) {
-        unsigned long long v = strtoull(env, &end, 10);
-        if (*end || env[0] == '-')
-            return error_set(err, ST_USAGE, "CLPT_MAX_FLATTEN_BYTES='%.64s': expected a whole number of bytes", env);
-        budget = v;
-    }
-    if (prims <= KD_MAX_PRIMS && prims * FLATTEN_BYTES_PER_PRIM <= budget) return ST_OK;
-    const double gib = 1024.0 * 1024.0 * 1024.0;
-    if (prims > KD_MAX_PRIMS)
-        return error_set(err, ST_INPUT, "--accel kdtree takes instances as copies: the scene's %zu instances make %llu "
-                         "primitives, more than the kd-tree's 2^30; render it with --accel bvh (the default), which "
-                         "keeps them as instances", s->n_instances, (unsigned long long)prims);
-    return error_set(err, ST_INPUT, "--accel kdtree takes instances as copies: the scene's %zu instances make %llu "
-                     "primitives, about %.1f GiB with the tree, more than the %.1f GiB of %s; render it with --accel "
-                     "bvh (the default), which keeps them as instances", s->n_instances, (unsigned long long)prims,
-                     (double)prims * FLATTEN_BYTES_PER_PRIM / gib, (double)budget / gib,
-                     env && *env ? "CLPT_MAX_FLATTEN_BYTES" : "this machine's memory");
-}
-
 /* The moving parts (docs/motion.md): the camera (prepared here, in its own space when
  * it moves) and the instances; their keys in one device buffer, the instances' first
  * (their indices are the scene's), then the camera's. */
@@ -272,26 +257,9 @@ static Status prepare_motion(const Scene *s, RenderScene *out, Error *err)
     return ST_OK;
 }
 
-/* Whether any instance of s moves. */
-static int instances_move(const Scene *s)
-{
-    for (size_t i = 0; i < s->n_instance_motion; i++)
-        if (s->instance_motion[i] != NO_INDEX) return 1;
-    return 0;
-}
-
 static Status prepare(Scene *s, int tree_threads, RenderScene *out, Error *err)
 {
     Status st;
-    /* the kd-tree has one level: it takes an instanced scene's copies (docs/instancing.md) */
-    if (s->accel == ACCEL_KDTREE && s->n_objects) {
-        if (instances_move(s))
-            return error_set(err, ST_INPUT, "--accel kdtree takes instances as copies, which cannot move: render a "
-                             "scene with moving instances with --accel bvh (the default)");
-        if ((st = flatten_fits(s, err))) return st;
-        out->flattened = s->n_instances;
-        if ((st = scene_flatten_instances(s, err))) return st;
-    }
     /* the path tracer samples a cube map as an environment light; Whitted keeps the
      * course's exact lookup (cube_env.h) */
     if (s->integrator == INTEGRATOR_PATH && s->bg_type == BG_CUBEMAP && (st = cube_env_convert(s, err))) return st;
@@ -394,6 +362,7 @@ void render_scene_free(RenderScene *r)
     free(r->instances);
     free(r->motion_keys);
     free(r->instance_motion);
+    free(r->kd_protos);
     kd_free(&r->kd);
     bvh_free(&r->bvh);
     memset(r, 0, sizeof *r);

@@ -9,19 +9,24 @@
 #include "device/device.h"
 #include "accel/bvh.h"
 #include "accel/bvh_inst.h"
+#include "accel/kd_inst.h"
 #include "accel/kdtree.h"
 #include "scene/scene.h"
 
 typedef struct {
     KdTree kd;            /* the scene's tree (Scene.accel): one of these two, */
-    Bvh bvh;              /* the other one empty */
+    Bvh bvh;              /* the other one empty; with objects under --accel kdtree the
+                           * top level in bvh, the prototypes' kd-trees in kd */
     DeviceScene ds;       /* points into the Scene and the tree: keep both alive */
     /* a scene with objects (docs/instancing.md): the BVH's two levels and the device's
      * instance records (the scene's, their roots filled, then the world's own) */
     Instance *instances;  size_t n_instances;
     BvhLevels levels;
-    int instanced;        /* the BVH has two levels */
-    size_t flattened;     /* --accel kdtree: the instances copied into the world */
+    int instanced;        /* the tree has two levels */
+    /* --accel kdtree with objects: each prototype's kd-tree's record (n_objects + 1 of
+     * them, the world's last) and the trees' sizes */
+    KdProto *kd_protos;   size_t n_kd_protos;
+    KdProtoStats kd_levels;
     /* motion blur (docs/motion.md): the keys of the moving instances, then the moving
      * camera's, or NULL; per device instance its first key or NO_INDEX, or NULL */
     MotionKey *motion_keys;

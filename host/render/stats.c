@@ -8,10 +8,6 @@
  * as the instances place them, and the memory of each level on the devices. */
 static void print_instances(FILE *out, const Scene *s, const RenderScene *rs)
 {
-    if (rs->flattened) {
-        fprintf(out, "instances: %zu, flattened into copies for the kd-tree\n", rs->flattened);
-        return;
-    }
     if (!rs->instanced) return;
     size_t in_objects = 0;
     double instanced = 0.0;
@@ -26,6 +22,17 @@ static void print_instances(FILE *out, const Scene *s, const RenderScene *rs)
     fprintf(out, "instances: %zu of %zu objects; triangles: %zu unique (%zu in objects), %.0f instanced "
            "(%.0f with the world's)\n", s->n_instances, s->n_objects, s->n_triangles, in_objects, instanced,
            instanced + (double)(s->n_triangles - in_objects));
+    if (s->accel == ACCEL_KDTREE) {
+        /* the prototypes are kd-trees (accel/kd_inst.h): their walk has its own stack */
+        const KdProtoStats *kp = &rs->kd_levels;
+        fprintf(out, "levels: top %u nodes and %zu instance records, %.1f KiB (%.1f bytes per instance); "
+               "prototypes %u of %zu built as kd-trees, %u nodes and %.1f KiB of leaves, %.1f KiB; stack %u of %u, "
+               "kd depth %u of %u\n",
+               lv->top_nodes, rs->n_instances, top / 1024.0, rs->n_instances ? top / (double)rs->n_instances : 0.0,
+               kp->n_protos_built, s->n_objects + 1, kp->n_nodes, (double)kp->n_leaf_words * 4.0 / 1024.0,
+               (double)kp->bytes / 1024.0, lv->top.max_stack, BVH_STACK, kp->max_depth, KD_MAX_DEPTH - 1u);
+        return;
+    }
     fprintf(out, "levels: top %u nodes and %zu instance records, %.1f KiB (%.1f bytes per instance); "
            "prototypes %u of %zu built, %u nodes and %.1f KiB of leaves, %.1f KiB; stack %u + 1 + %u of %u\n",
            lv->top_nodes, rs->n_instances, top / 1024.0, rs->n_instances ? top / (double)rs->n_instances : 0.0,
@@ -59,6 +66,16 @@ void render_stats_print_scene(FILE *out, const Scene *s, const RenderScene *rs)
                "per leaf, SAH cost %.2f, %.1f KiB (%.1f bytes per primitive)\n",
                b->build_seconds, b->n_nodes, b->n_leaves, b->max_depth, b->max_binary_depth,
                b->mean_prims_per_leaf, b->sah_cost, (double)bytes / 1024.0, (double)bytes * per);
+        print_instances(out, s, rs);
+        return;
+    }
+    if (rs->instanced) {
+        /* the prototypes' trees (accel/kd_inst.h): each its own SAH cost, so none here */
+        fprintf(out, "kd-tree: prototypes' trees built in %.3f s; %u nodes, %u leaves (%u empty), deepest %u, "
+               "%.2f primitives per non-empty leaf, %.1f KiB (nodes and leaf ids %.1f, copies of the triangles' "
+               "corners in the leaves %.1f bytes per primitive stored)\n",
+               k->build_seconds, k->n_nodes, k->n_leaves, k->n_empty_leaves, k->max_depth, k->mean_prims_per_leaf,
+               (double)k->bytes / 1024.0, (double)(k->bytes - k->bytes_corners) * per, (double)k->bytes_corners * per);
         print_instances(out, s, rs);
         return;
     }

@@ -84,7 +84,8 @@ Status scene_object_mask(const Scene *s, uint8_t **mask, Error *err);
  * objects: the scene is then one without instances. An identity instance copies the
  * primitives bit for bit. ST_INPUT (no location) for what has no copy in the world's
  * kinds: a box under a rotation, a surface of revolution under any transform but the
- * identity; the scene is unchanged then. ST_INTERNAL without memory. */
+ * identity; the scene is unchanged then. ST_INTERNAL without memory. The renderer keeps
+ * instances under both trees (docs/instancing.md); the tests compare against the copies. */
 Status scene_flatten_instances(Scene *s, Error *err);
 
 /* Frees the objects and instances (scene_free calls it). */

@@ -30,7 +30,11 @@ KFN_INLINE int trace_tree_kind(const SceneView *sc)
 {
     if (!KF_HAS(KF_BVH)) return TREE_KD;
     if (!KF_HAS(KF_KDTREE)) return TREE_BVH;
+#if KF_HAS(KF_INSTANCES)
     return (sc->params->n_bvh_nodes | sc->params->n_instances) != 0u ? TREE_BVH : TREE_KD;
+#else
+    return sc->params->n_bvh_nodes != 0u ? TREE_BVH : TREE_KD;   /* the programs without instances: as before */
+#endif
 }
 
 /* The walk of the given tree (which, when it is the BVH, must be there). */

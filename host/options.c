@@ -110,7 +110,9 @@
         "(clpt's earlier sampler, the same images)") \
     X(OUTPUT, CHOICE, accel, "--accel", NULL, NULL, ONE_OF({ "bvh", ACCEL_BVH }, { "kdtree", ACCEL_KDTREE }), \
         "the tree rays find primitives through: an 8-wide\n" \
-        "BVH (default; faster) or the SAH kd-tree") \
+        "BVH (default; faster) or the SAH kd-tree (with\n" \
+        "instances: a kd-tree per object under the BVH's\n" \
+        "top level)") \
     X(OUTPUT, SECONDS, time_limit, "--time-limit", NULL, "SECONDS", NONE, \
         "stop starting new batches after this long; the\n" \
         "image holds the whole batches finished by then\n" \

@@ -191,6 +191,8 @@ static void test_kdtree_prototypes(void)
  * copies could not hold) renders under --accel kdtree, small, as under the BVH. */
 static void test_kdtree_bunnies(void)
 {
+    if (!shared_model_present("../shared/models/bunny/bun_zipper.ply", "scenes/instances.scene is not rendered"))
+        return;
     Scene s;
     Error err = { 0 };
     Film kd, bvh;

@@ -129,6 +129,20 @@ static Status build_top(const KdInput *in, const BvhProto *protos, size_t n_prot
     return st;
 }
 
+KdInput bvh_proto_input(const KdInput *in, const BvhProto *proto, KdRange *none)
+{
+    KdInput pin = *in;
+    pin.ranges = proto->ranges;
+    pin.n_ranges = proto->n_ranges;
+    /* an empty range list would mean every primitive: an empty prototype has none */
+    if (pin.n_ranges == 0) {
+        *none = (KdRange){ 0u, 0u };
+        pin.ranges = none;
+        pin.n_ranges = 1;
+    }
+    return pin;
+}
+
 Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_protos, Instance *inst,
                            const uint *object, size_t n_inst, const BvhMotion *motion, int threads, Bvh *out, BvhLevels *lv, Error *err)
 {
@@ -152,15 +166,8 @@ Status bvh_build_instanced(const KdInput *in, const BvhProto *protos, size_t n_p
     uint64_t nodes = 0u, words = top.n_leaf_prims;
     for (size_t p = 0; p < n_protos && !st; p++) {
         if (!used[p]) continue;
-        KdInput pin = *in;
-        pin.ranges = protos[p].ranges;
-        pin.n_ranges = protos[p].n_ranges;
-        /* an empty range list would mean every primitive: an empty prototype has none */
-        KdRange none = { 0u, 0u };
-        if (pin.n_ranges == 0) {
-            pin.ranges = &none;
-            pin.n_ranges = 1;
-        }
+        KdRange none;
+        KdInput pin = bvh_proto_input(in, &protos[p], &none);
         st = bvh_build_with(&pin, &opt, threads, &pt[p], err);
         nodes += pt[p].n_nodes;
         words += pt[p].n_leaf_prims;

@@ -22,6 +22,11 @@ typedef struct {
     const KdRange *ranges;  size_t n_ranges;
 } BvhProto;
 
+/* The scene's input narrowed to prototype proto's primitives, for either tree's build;
+ * *none holds the empty range an empty prototype is given (no ranges would mean every
+ * primitive), so it must live as long as the result. */
+KdInput bvh_proto_input(const KdInput *in, const BvhProto *proto, KdRange *none);
+
 /* The two levels, for --stats. */
 typedef struct {
     BvhStats top;                  /* the top level's tree */

@@ -102,6 +102,40 @@ static void *bounds_range(void *arg)
     return NULL;
 }
 
+/* The build's lists for `total` primitives (global ids, triangle indices, bounds) and a
+ * flag a primitive for finite bounds, which is returned (NULL: out of memory; the lists
+ * the build frees). */
+static uint8_t *alloc_lists(Build *b, size_t total)
+{
+    b->gid = malloc((total + 1) * sizeof *b->gid);
+    b->tri = malloc((total + 1) * sizeof *b->tri);
+    b->bounds = malloc((total + 1) * sizeof *b->bounds);
+    uint8_t *finite = malloc(total + 1);
+    if (!b->gid || !b->tri || !b->bounds || !finite) {
+        free(finite);
+        return NULL;
+    }
+    return finite;
+}
+
+/* Moves the `listed` primitives whose bounds are finite down, in order, and frees the
+ * flags: slot i is global id b->gid[i] (by_list) or i. */
+static void keep_finite(Build *b, const KdInput *in, uint8_t *finite, uint listed, int by_list, uint *skipped)
+{
+    uint first_tri = (uint)in->n_spheres, end_tri = first_tri + (uint)in->n_triangles, n = 0;
+    for (uint i = 0; i < listed; i++) {
+        if (!finite[i]) continue;
+        uint gid = by_list ? b->gid[i] : i;
+        b->gid[n] = gid;
+        b->tri[n] = gid >= first_tri && gid < end_tri ? gid - first_tri : NO_INDEX;
+        b->bounds[n++] = b->bounds[i];
+    }
+    free(finite);
+    b->n_prims = n;
+    *skipped = listed - n;
+    b->triangles = in->triangles;
+}
+
 /* The bounds of the listed primitives gids[first .. end), each at its place in the
  * list (a prototype's ranges, KdInput.ranges). */
 typedef struct { const KdInput *in; const uint *gids; Aabb *bounds; uint8_t *finite; uint first, end; } ListJob;
@@ -125,14 +159,8 @@ static Status gather_ranges(Build *b, const KdInput *in, uint *skipped, Error *e
     if (total > KD_MAX_PRIMS)
         return error_set(err, ST_INPUT, "kd-tree: %llu primitives, more than the %u supported",
                          (unsigned long long)total, KD_MAX_PRIMS);
-    b->gid = malloc((total + 1) * sizeof *b->gid);
-    b->tri = malloc((total + 1) * sizeof *b->tri);
-    b->bounds = malloc((total + 1) * sizeof *b->bounds);
-    uint8_t *finite = malloc(total + 1);
-    if (!b->gid || !b->tri || !b->bounds || !finite) {
-        free(finite);
-        return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %llu primitives", (unsigned long long)total);
-    }
+    uint8_t *finite = alloc_lists(b, (size_t)total);
+    if (!finite) return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %llu primitives", (unsigned long long)total);
     uint listed = 0;
     for (size_t r = 0; r < in->n_ranges; r++)
         for (uint gid = in->ranges[r].lo; gid < in->ranges[r].hi; gid++) b->gid[listed++] = gid;
@@ -142,18 +170,7 @@ static Status gather_ranges(Build *b, const KdInput *in, uint *skipped, Error *e
         jobs[i] = (ListJob){ in, b->gid, b->bounds, finite, (uint)(total * (uint64_t)i / (uint64_t)n_jobs),
                              (uint)(total * (uint64_t)(i + 1) / (uint64_t)n_jobs) };
     jobs_run(bounds_list, jobs, sizeof *jobs, n_jobs);
-    uint first_tri = (uint)in->n_spheres, end_tri = first_tri + (uint)in->n_triangles, n = 0;
-    for (uint i = 0; i < listed; i++) {
-        if (!finite[i]) continue;
-        uint gid = b->gid[i];
-        b->gid[n] = gid;
-        b->tri[n] = gid >= first_tri && gid < end_tri ? gid - first_tri : NO_INDEX;
-        b->bounds[n++] = b->bounds[i];
-    }
-    free(finite);
-    b->n_prims = n;
-    *skipped = listed - n;
-    b->triangles = in->triangles;
+    keep_finite(b, in, finite, listed, 1, skipped);
     return ST_OK;
 }
 
@@ -169,32 +186,15 @@ Status kd_gather(Build *b, const KdInput *in, uint *skipped, Error *err)
     if (total > KD_MAX_PRIMS)
         return error_set(err, ST_INPUT, "kd-tree: %zu primitives, more than the %u supported",
                          total, KD_MAX_PRIMS);
-    b->gid = malloc((total + 1) * sizeof *b->gid);
-    b->tri = malloc((total + 1) * sizeof *b->tri);
-    b->bounds = malloc((total + 1) * sizeof *b->bounds);
-    uint8_t *finite = malloc(total + 1);
-    if (!b->gid || !b->tri || !b->bounds || !finite) {
-        free(finite);
-        return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu primitives", total);
-    }
+    uint8_t *finite = alloc_lists(b, total);
+    if (!finite) return error_set(err, ST_INTERNAL, "kd-tree: out of memory for %zu primitives", total);
     int n_jobs = jobs_threads(b->threads, total, 65536);
     BoundsJob jobs[JOBS_MAX];
     for (int i = 0; i < n_jobs; i++)
         jobs[i] = (BoundsJob){ in, b->bounds, finite, (uint)(total * (size_t)i / (size_t)n_jobs),
                                (uint)(total * (size_t)(i + 1) / (size_t)n_jobs) };
     jobs_run(bounds_range, jobs, sizeof *jobs, n_jobs);
-
-    uint first_tri = (uint)in->n_spheres, end_tri = first_tri + (uint)in->n_triangles, n = 0;
-    for (uint gid = 0; gid < (uint)total; gid++) {
-        if (!finite[gid]) continue;
-        b->gid[n] = gid;
-        b->tri[n] = gid >= first_tri && gid < end_tri ? gid - first_tri : NO_INDEX;
-        b->bounds[n++] = b->bounds[gid];
-    }
-    free(finite);
-    b->n_prims = n;
-    *skipped = (uint)(total - n);
-    b->triangles = in->triangles;
+    keep_finite(b, in, finite, (uint)total, 0, skipped);
     return ST_OK;
 }
 

@@ -58,15 +58,8 @@ Status kd_build_prototypes(const KdInput *in, const BvhProto *protos, size_t n_p
     uint64_t nodes = 1u, words = 0u;   /* node 0: the empty leaf of prototypes no instance reaches */
     for (size_t p = 0; p < n_protos && !st; p++) {
         if (!used[p]) continue;
-        KdInput pin = *in;
-        pin.ranges = protos[p].ranges;
-        pin.n_ranges = protos[p].n_ranges;
-        /* an empty range list would mean every primitive: an empty prototype has none */
-        KdRange none = { 0u, 0u };
-        if (pin.n_ranges == 0) {
-            pin.ranges = &none;
-            pin.n_ranges = 1;
-        }
+        KdRange none;
+        KdInput pin = bvh_proto_input(in, &protos[p], &none);
         st = kd_build(&pin, threads, &pt[p], err);
         nodes += pt[p].n_nodes;
         words = align_words(words) + pt[p].n_leaf_prims;

@@ -234,11 +234,11 @@ static Status flatten_check(const Scene *s, Error *err)
         if (x->flags & INST_IDENTITY) continue;
         Transform t = instance_transform(x);
         if (o->end[OBJ_BOXES] > o->first[OBJ_BOXES] && !keeps_boxes(&t))
-            return error_set(err, ST_INPUT, "object '%s' holds a box that instance %zu rotates: the kd-tree has no "
-                             "rotated boxes (use --accel bvh)", o->name, i);
+            return error_set(err, ST_INPUT, "object '%s' holds a box that instance %zu rotates: flattening has no "
+                             "world copy for a rotated box", o->name, i);
         if (o->end[OBJ_REVS] > o->first[OBJ_REVS])
             return error_set(err, ST_INPUT, "object '%s' holds a surface of revolution that instance %zu "
-                             "transforms: the kd-tree cannot (use --accel bvh)", o->name, i);
+                             "transforms: flattening has no world copy for it", o->name, i);
     }
     return ST_OK;
 }

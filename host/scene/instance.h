@@ -5,8 +5,9 @@
  * scene_object_end; an instance places it in the world under an affine transform, with
  * an optional material that replaces its primitives'. The primitives stay once in the
  * scene's arrays however many instances there are: the BVH walks them in the object's
- * space (host/accel/bvh_inst.c). scene_flatten_instances makes copies instead, for the
- * kd-tree and for the tests that compare the two.
+ * space under either tree (host/accel/bvh_inst.c, kd_inst.c). scene_flatten_instances
+ * makes copies instead, for the classic reader's meshes placed once and for the tests
+ * that compare the two.
  */
 #ifndef CLPT_SCENE_INSTANCE_H
 #define CLPT_SCENE_INSTANCE_H

@@ -351,7 +351,7 @@ static void test_render_key_covers_every_scene_buffer(void)
     ds.n_tri_extra_of = ds.n_tri_extras = 2;
     ds.n_texels = ds.n_rev_points = 2;
     ds.n_env_cdf = ds.n_bvh_leaves = ds.n_sphere_xforms = ds.n_instance_lights = ds.n_grid_data = 2;
-    ds.n_motion_keys = ds.n_instance_motion = ds.n_bvh_top = 2;
+    ds.n_motion_keys = ds.n_instance_motion = ds.n_bvh_top = ds.n_kd_protos = 2;
     p->n_grids = p->pixel_list_size = 2;
     CheckpointId base, changed;
     checkpoint_id(&ds, 4u, &base);

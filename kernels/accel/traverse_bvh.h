@@ -257,8 +257,10 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
     BvhRay w = bvh_ray(ray, rp);
 #if KF_HAS(KF_INSTANCES)
     int top = sc->params->n_instances != 0u;   /* walking the top level's nodes */
+#if KF_HAS(KF_KDTREE)
     /* the prototypes are kd-trees (--accel kdtree): the scene has kd nodes */
-    int kd_protos = KF_HAS(KF_KDTREE) && sc->params->n_nodes != 0u;
+    int kd_protos = sc->params->n_nodes != 0u;
+#endif
     BvhRay w_world = w;
     Ray oray = ray;              /* the ray in the space being walked, and its constants */
     RayPre orp = *rp;

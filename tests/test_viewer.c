@@ -599,6 +599,56 @@ static void test_session(void)
 
 /* ------------------------------------------------------------------ cancelling a denoise */
 
+/* What the two denoised-view tests below share: Open Image Denoise, the Cornell box at
+ * size x size and spp prepared, the scalar device. f->st is the set-up's status;
+ * f->opened is 0 where OIDN is missing (the test is skipped, saying so). */
+typedef struct {
+    Denoiser *d;
+    Error err;
+    Scene s;
+    RenderScene rs;
+    Device **devs;
+    size_t n_devs;
+    DeviceConfig dc;
+    int prepared, opened;
+    Status st;
+} DenoiseViewFixture;
+
+static void denoise_view_open(DenoiseViewFixture *f, int size, int spp)
+{
+    memset(f, 0, sizeof *f);
+    if (denoiser_open(&f->d, &f->err) != ST_OK) {
+        fprintf(stderr, "  Open Image Denoise missing: skipped (%s)\n", f->err.msg);
+        error_clear(&f->err);
+        return;
+    }
+    f->opened = 1;
+    scene_init(&f->s);
+    f->st = scene_load_file("scenes/cornell-box.scene", SCENE_FORMAT_AUTO, &f->s, NULL, &f->err);
+    if (f->st == ST_OK) {
+        f->s.image.width = f->s.image.height = size;
+        f->s.image.spp = spp;
+        f->st = render_scene_prepare(&f->s, 0, &f->rs, &f->err);
+        f->prepared = f->st == ST_OK;
+    }
+    if (f->st == ST_OK)
+        f->st = device_open_all("scalar", &f->dc, &f->rs.ds, NULL, NULL, &f->devs, &f->n_devs, &f->err);
+    CHECK_MSG(f->st == ST_OK, "setting up: %s", f->err.msg);
+}
+
+/* The test's last status checked, then everything denoise_view_open made freed. */
+static void denoise_view_close(DenoiseViewFixture *f, Status st)
+{
+    CHECK_MSG(st == ST_OK, "%s", f->err.msg);
+    for (size_t i = 0; i < f->n_devs; i++) device_close(f->devs[i]);
+    free(f->devs);
+    if (f->prepared) render_scene_free(&f->rs);
+    scene_free(&f->s);
+    error_clear(&f->err);
+    denoiser_close(f->d);
+}
+
+
 /* The render thread (viewer_render.h) on the scalar device, the Cornell box at 640 x
  * 640 with a cap of 1 spp and the denoised view on: its one pass is followed by a
  * denoise of seconds on a CPU (features, their prefilter, the colour). Quitting during it
@@ -608,34 +658,13 @@ static void test_session(void)
  * a GPU takes milliseconds), there is nothing to cancel and the test says so. */
 static void test_quit_cancels_denoise(void)
 {
-    Denoiser *d = NULL;
-    Error err = { 0 };
-    if (denoiser_open(&d, &err) != ST_OK) {
-        fprintf(stderr, "  Open Image Denoise missing: skipped (%s)\n", err.msg);
-        error_clear(&err);
-        return;
-    }
-    Scene s;
-    RenderScene rs;
-    memset(&rs, 0, sizeof rs);
-    Device **devs = NULL;
-    size_t n_devs = 0;
-    int prepared = 0;
-    scene_init(&s);
-    Status st = scene_load_file("scenes/cornell-box.scene", SCENE_FORMAT_AUTO, &s, NULL, &err);
-    if (st == ST_OK) {
-        s.image.width = s.image.height = 640;
-        s.image.spp = 1;
-        st = render_scene_prepare(&s, 0, &rs, &err);
-        prepared = st == ST_OK;
-    }
-    DeviceConfig dc;
-    memset(&dc, 0, sizeof dc);
-    if (st == ST_OK) st = device_open_all("scalar", &dc, &rs.ds, NULL, NULL, &devs, &n_devs, &err);
-    CHECK_MSG(st == ST_OK, "setting up: %s", err.msg);
+    DenoiseViewFixture f;
+    denoise_view_open(&f, 640, 1);
+    if (!f.opened) return;
+    Status st = f.st;
     ViewerRender *vr = calloc(1, sizeof *vr);
     if (st == ST_OK && vr &&
-        (st = viewer_render_start(vr, devs, n_devs, &rs.ds, &dc, &s.camera, 1, 0, d, &err)) == ST_OK) {
+        (st = viewer_render_start(vr, f.devs, f.n_devs, &f.rs.ds, &f.dc, &f.s.camera, 1, 0, f.d, &f.err)) == ST_OK) {
         /* the features are rendered and prefiltered; the colour's filter, the longest
          * part, begins */
         int in_denoise = 0;
@@ -652,26 +681,20 @@ static void test_quit_cancels_denoise(void)
         int ended = vr->denoise_count != 0;
         pthread_mutex_unlock(&vr->lock);
         double t0 = now_s();
-        st = viewer_render_stop(vr, &err);
+        st = viewer_render_stop(vr, &f.err);
         double waited = now_s() - t0;
-        CHECK_MSG(st == ST_OK, "rendering failed: %s", err.msg);
+        CHECK_MSG(st == ST_OK, "rendering failed: %s", f.err.msg);
         if (ended) {
             fprintf(stderr, "  the denoise ended before the stop (%s device): nothing to cancel\n",
-                    denoiser_device_kind(d));
+                    denoiser_device_kind(f.d));
         } else {
             CHECK_EQ_INT((int)vr->denoise_count, 0);
             CHECK_EQ_INT((int)vr->denoise_cancels, 1);
             printf("     (quitting during a 640x640 denoise took %.3f s)\n", waited);
         }
     }
-    CHECK_MSG(st == ST_OK, "%s", err.msg);
     free(vr);
-    for (size_t i = 0; i < n_devs; i++) device_close(devs[i]);
-    free(devs);
-    if (prepared) render_scene_free(&rs);
-    scene_free(&s);
-    error_clear(&err);
-    denoiser_close(d);
+    denoise_view_close(&f, st);
 }
 
 /* The denoised view keeps the lamp as --denoise does: its directly seen emission is left
@@ -680,35 +703,14 @@ static void test_quit_cancels_denoise(void)
  * 0.03 of the lamp's 17 here); given to OIDN they moved by up to 2.6. */
 static void test_denoised_view_keeps_the_lamp(void)
 {
-    Denoiser *d = NULL;
-    Error err = { 0 };
-    if (denoiser_open(&d, &err) != ST_OK) {
-        fprintf(stderr, "  Open Image Denoise missing: skipped (%s)\n", err.msg);
-        error_clear(&err);
-        return;
-    }
-    Scene s;
-    RenderScene rs;
-    memset(&rs, 0, sizeof rs);
-    Device **devs = NULL;
-    size_t n_devs = 0;
-    int prepared = 0;
-    scene_init(&s);
-    Status st = scene_load_file("scenes/cornell-box.scene", SCENE_FORMAT_AUTO, &s, NULL, &err);
-    if (st == ST_OK) {
-        s.image.width = s.image.height = 64;
-        s.image.spp = 4;
-        st = render_scene_prepare(&s, 0, &rs, &err);
-        prepared = st == ST_OK;
-    }
-    DeviceConfig dc;
-    memset(&dc, 0, sizeof dc);
-    if (st == ST_OK) st = device_open_all("scalar", &dc, &rs.ds, NULL, NULL, &devs, &n_devs, &err);
-    CHECK_MSG(st == ST_OK, "setting up: %s", err.msg);
+    DenoiseViewFixture f;
+    denoise_view_open(&f, 64, 4);
+    if (!f.opened) return;
+    Status st = f.st;
     ViewerRender *vr = calloc(1, sizeof *vr);
     static int64_t acc[2][64 * 64 * 3];
     if (st == ST_OK && vr &&
-        (st = viewer_render_start(vr, devs, n_devs, &rs.ds, &dc, &s.camera, 4, 0, d, &err)) == ST_OK) {
+        (st = viewer_render_start(vr, f.devs, f.n_devs, &f.rs.ds, &f.dc, &f.s.camera, 4, 0, f.d, &f.err)) == ST_OK) {
         int done = 0;
         for (double t0 = now_s(); now_s() - t0 < 300.0 && !done;) {
             usleep(2000);
@@ -737,28 +739,22 @@ static void test_denoised_view_keeps_the_lamp(void)
             pthread_mutex_unlock(&vr->lock);
         }
         CHECK_MSG(done, "the 4-spp frame was not denoised within 300 s");
-        st = viewer_render_stop(vr, &err);
+        st = viewer_render_stop(vr, &f.err);
         /* ... is the emission of those samples rendered at once, to the bit */
         ScheduleConfig cfg;
         memset(&cfg, 0, sizeof cfg);
-        PassContext pc = { devs, n_devs, &rs, &cfg, NULL, NULL, NULL };
+        PassContext pc = { f.devs, f.n_devs, &f.rs, &cfg, NULL, NULL, NULL };
         for (int k = 0; k < 2 && st == ST_OK; k++) {
             Film once;
             double secs = 0.0;
-            st = passes_data_film(&pc, INTEGRATOR_FEATURE_EMISSION, k ? 16 : 4, 0, 0, &once, &secs, &err);
+            st = passes_data_film(&pc, INTEGRATOR_FEATURE_EMISSION, k ? 16 : 4, 0, 0, &once, &secs, &f.err);
             CHECK_MSG(st == ST_OK && memcmp(once.sum, acc[k], sizeof acc[k]) == 0,
                       "the emission accumulated along the passes differs from one render (%d)", k);
             film_free(&once);
         }
     }
-    CHECK_MSG(st == ST_OK, "%s", err.msg);
     free(vr);
-    for (size_t i = 0; i < n_devs; i++) device_close(devs[i]);
-    free(devs);
-    if (prepared) render_scene_free(&rs);
-    scene_free(&s);
-    error_clear(&err);
-    denoiser_close(d);
+    denoise_view_close(&f, st);
 }
 
 int main(void)

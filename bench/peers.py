@@ -3,7 +3,7 @@
 
 usage: bench/peers.py [--clpt build/clpt] [--clpt-args ARGS] [--peers DIR] [--out DIR]
                       [--runs N] [--ref-spp cornell=4096,dragon=1024,...] [--device DEV]
-                      [--threads N] [--scenes cornell,dragon,envmat,fog,smoke]
+                      [--threads N] [--scenes cornell,dragon,envmat,fog,smoke,gltf-cornell,...]
                       [--renderers mitsuba,cycles]
                       [--pbrt PATH [--pbrt-scenes DIR] [--pbrt-threads N]]
 
@@ -21,7 +21,7 @@ their references take minutes on two cores), 16 spp, 8 bounces:
   smoke    the same with a 16^3 density grid in the sphere (a heterogeneous medium)
 with clpt and, when installed, Mitsuba 3 (`pip install mitsuba`; its fast variant
 llvm_ad_rgb needs Debian's libllvm19, else scalar_rgb is used) and Cycles (Debian
-`blender` and `python3-numpy`; the Cornell box only, as in ../shared/peers); `sh
+`blender` and `python3-numpy`; of these five the Cornell box only, as in ../shared/peers); `sh
 tools/deps.sh peers` installs all three. The renderers take turns within
 each of --runs rounds (interleaved, so a change in the machine's load hits all of them
 alike); times are medians over the rounds, squared errors the mean over them (seed = round).
@@ -63,6 +63,13 @@ print a table of their own after the one above; `--scenes pbrt-cornell,pbrt-drag
 them alone. The reference samples are 64 times each scene's by default, as above, which
 for pbrt-v4 on two cores means hours: `--ref-spp pbrt-cornell=256,...` for a quick run.
 
+When Blender is installed (and cycles is among --renderers), the default scenes also
+include gltf-cornell, gltf-spheres and gltf-suzanne: the three Blender-exported files of
+../shared/models/gltf, read by clpt and imported by Blender's own glTF importer for
+Cycles, each renderer timed by its render alone and measured against its own converged
+render, since Cycles' Principled BSDF is Disney's rather than glTF's
+(bench/peers_gltf.py says how; they print a table of their own).
+
 Standard library only for the peers' scenes (the pbrt-v4 scenes need numpy); numpy is used for the error when it is importable
 (faster), and the generated scenes need it (tools/xcheck's writers).
 """
@@ -98,6 +105,9 @@ SCENES = {
 REF_SPP = {'cornell': 4096, 'dragon': 1024, 'envmat': 512, 'fog': 512, 'smoke': 512}
 # --pbrt's scenes (bench/peers_pbrt.py): name -> (spp, reference spp)
 PBRT_SCENES = {'pbrt-cornell': (64, 4096), 'pbrt-dragon': (16, 1024), 'pbrt-killeroo': (16, 1024)}
+# the glTF scenes against Cycles (bench/peers_gltf.py): name -> reference spp (each
+# renderer's own; Cycles renders them at about a million samples a second on two cores)
+GLTF_REF_SPP = {'gltf-cornell': 2048, 'gltf-spheres': 1024, 'gltf-suzanne': 1024}
 LLVM19 = '/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1'
 
 
@@ -316,7 +326,7 @@ def main():
     ap.add_argument('--out', default='build/peers')
     ap.add_argument('--runs', type=int, default=3, help='rounds (at least 1)')
     ap.add_argument('--ref-spp', default='', help='SCENE=SPP,... the reference samples where not %s' % (
-        ','.join('%s=%d' % kv for kv in REF_SPP.items())))
+        ','.join('%s=%d' % kv for kv in list(REF_SPP.items()) + list(GLTF_REF_SPP.items()))))
     ap.add_argument('--device', default='', help="clpt's --device (default: clpt's default)")
     ap.add_argument('--threads', type=int, default=2, help="Cycles' render threads")
     ap.add_argument('--scenes', default=','.join(SCENES))
@@ -331,7 +341,10 @@ def main():
     given = dict((k, int(v)) for k, v in (x.split('=', 1) for x in a.ref_spp.split(',') if x))
     a.ref_spp = dict(REF_SPP)
     a.ref_spp.update((k, v[1]) for k, v in PBRT_SCENES.items())
+    a.ref_spp.update(GLTF_REF_SPP)
     a.ref_spp.update(given)
+    if a.scenes == ap.get_default('scenes') and 'cycles' in a.renderers.split(',') and Cycles.available():
+        a.scenes += ',' + ','.join(GLTF_REF_SPP)
     if a.scenes == ap.get_default('scenes') and a.pbrt:
         # --pbrt adds its scenes to the default list (pbrt-killeroo only with --pbrt-scenes)
         a.scenes += ',pbrt-cornell,pbrt-dragon' + (',pbrt-killeroo' if a.pbrt_scenes else '')
@@ -344,10 +357,21 @@ def main():
     for s in scenes:
         if s in PBRT_SCENES and not a.pbrt:
             raise SystemExit('scene %s: --pbrt PATH (a pbrt-v4 binary) is needed' % s)
-        if s not in SCENES and s not in PBRT_SCENES:
-            raise SystemExit('unknown scene %s (known: %s)' % (s, ', '.join(list(SCENES) + list(PBRT_SCENES))))
+        if s not in SCENES and s not in PBRT_SCENES and s not in GLTF_REF_SPP:
+            raise SystemExit('unknown scene %s (known: %s)' % (s, ', '.join(
+                list(SCENES) + list(GLTF_REF_SPP) + list(PBRT_SCENES))))
     pbrt_scenes = [s for s in scenes if s in PBRT_SCENES]
-    scenes = [s for s in scenes if s not in PBRT_SCENES]
+    gltf_scenes = [s for s in scenes if s in GLTF_REF_SPP]
+    scenes = [s for s in scenes if s in SCENES]
+    if gltf_scenes:
+        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+        try:
+            import peers_gltf
+        except ImportError as e:
+            raise SystemExit('the glTF scenes: %s (apt-get install python3-numpy)' % e)
+        why = peers_gltf.check(a)
+        if why:
+            raise SystemExit(why)
     if pbrt_scenes:
         sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
         try:
@@ -374,8 +398,11 @@ def main():
             peers_scenes.write_clpt(s, a.out)
 
     if not scenes:
-        os.makedirs(a.out, exist_ok=True)
-        peers_pbrt.run(a, pbrt_scenes)
+        if gltf_scenes:
+            peers_gltf.run(a, gltf_scenes)
+            print()
+        if pbrt_scenes:
+            peers_pbrt.run(a, pbrt_scenes)
         return
     renderers = [Clpt(a)]
     for cls in (Mitsuba, Cycles):
@@ -432,6 +459,9 @@ def main():
         if 'cycles' not in rows and any(r.name == 'cycles' for r in renderers):
             print('| %s | Cycles | not rendered: ../shared/peers has the Cornell box only for Cycles '
                   '| | | | | | |' % s)
+    if gltf_scenes:
+        print()
+        peers_gltf.run(a, gltf_scenes)
     if pbrt_scenes:
         print()
         peers_pbrt.run(a, pbrt_scenes)

@@ -42,20 +42,18 @@ pixels are left out as peers.py does, where either reference has an edge.
 usage: called by peers.py (run(a, scenes) with its parsed options; a.pbrt_spp: each scene's spp); needs numpy and
 tools/xcheck/exr.py (pbrt-v4 writes OpenEXR).
 """
-import math
 import os
 import re
-import shutil
-import statistics
 import subprocess
 import sys
-import time
 
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(HERE, '..', 'tools', 'xcheck'))
 from exr import read_exr  # noqa: E402
+from peers_own import Renderer, compare, read_pfm, timed  # noqa: E402
 
 DEPTH = 8
 HEADER = ('# bench/peers_pbrt.py: %s, written for clpt and pbrt-v4 alike (generated)\n'
@@ -135,31 +133,6 @@ def write_scenes(a, scenes):
     return paths
 
 
-def read_pfm(path):
-    with open(path, 'rb') as f:
-        if f.readline().strip() != b'PF':
-            raise SystemExit('%s: not a colour PFM' % path)
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        a = np.frombuffer(f.read(), dtype='<f4' if scale < 0 else '>f4')
-    return a.reshape(h, w, 3)[::-1].astype(np.float64)
-
-
-def timed(cmd, cwd):
-    """Runs a command; returns its wall seconds. A failure ends the benchmark with its output."""
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    wall = time.perf_counter() - t0
-    if p.returncode != 0:
-        raise SystemExit('failed (exit %d): %s\n%s' % (p.returncode, ' '.join(cmd), p.stdout[-4000:]))
-    return wall
-
-
-class Renderer:
-    def __init__(self, name, label, render):
-        self.name, self.label, self.render = name, label, render
-
-
 def renderers(a):
     folder = os.path.join(os.path.abspath(a.out), 'pbrt')
     clpt = os.path.abspath(a.clpt)
@@ -167,13 +140,13 @@ def renderers(a):
 
     def clpt_render(path, spp, seed, out):
         cmd = [clpt, path, '--spp', str(spp), '--seed', str(seed), '-q', '-o', out] + a.clpt_args.split()
-        wall = timed(cmd + (['--device', a.device] if a.device else []), folder)
+        wall, _ = timed(cmd + (['--device', a.device] if a.device else []), folder)
         return wall, read_pfm(out)
 
     def pbrt_render(path, spp, seed, out):
         exr = os.path.splitext(out)[0] + '.exr'
-        wall = timed([pbrt, '--quiet', '--nthreads', str(a.pbrt_threads), '--spp', str(spp), '--seed', str(seed),
-                      '--outfile', exr, path], folder)
+        wall, _ = timed([pbrt, '--quiet', '--nthreads', str(a.pbrt_threads), '--spp', str(spp), '--seed', str(seed),
+                         '--outfile', exr, path], folder)
         return wall, read_exr(exr).astype(np.float64)
 
     return [Renderer('clpt', 'clpt (%s%s)' % (a.device or 'default device', ', ' + a.clpt_args if a.clpt_args else ''),
@@ -181,90 +154,11 @@ def renderers(a):
             Renderer('pbrt', 'pbrt-v4 (CPU, zsobol, path, %d threads)' % a.pbrt_threads, pbrt_render)]
 
 
-def edges(ref):
-    """True where the reference's 3x3 neighbourhood spans more than 0.05 in mean RGB (peers.py's rule)."""
-    lum = ref.mean(-1)
-    h, w = lum.shape
-    pad = np.pad(lum, 1, mode='edge')
-    nb = np.stack([pad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)])
-    return nb.max(0) - nb.min(0) > 0.05
-
-
-def reference(a, r, scene, path):
-    """r's converged render of scene: (mean of two halves, its own squared error per channel value
-    as a quarter of the halves' mean squared difference, over the image's pixels: taken off later
-    over the kept pixels)."""
-    spp = a.ref_spp[scene]
-    halves = []
-    for seed, half in ((777, 'a'), (778, 'b')):
-        out = os.path.join(os.path.abspath(a.out), 'pbrt', 'ref-%s-%s-%d-%s.pfm' % (scene, r.name, spp, half))
-        npy = out + '.npy'
-        if not os.path.exists(npy):
-            print('making half %s of the %s reference with %s, %d spp (once; kept as %s)...' % (
-                half, scene, r.name, spp // 2, npy), flush=True)
-            _, img = r.render(path, spp // 2, seed, out)
-            np.save(npy, img)
-        halves.append(np.load(npy))
-    return halves
-
-
 def run(a, scenes):
     """Renders scenes (of peers.py's PBRT_SCENES) with clpt and pbrt-v4 in a.runs interleaved rounds; prints the table."""
     paths = write_scenes(a, scenes)
-    rs = renderers(a)
-    refs, keep = {}, {}
-    for s in scenes:
-        for r in rs:
-            refs[s, r.name] = reference(a, r, s, paths[s])
-        keep[s] = ~np.logical_or.reduce([edges((ha + hb) / 2) for (ha, hb) in (refs[s, r.name] for r in rs)])
-    own = {}   # (scene, renderer) -> (reference, its own MSE over the kept pixels)
-    for s in scenes:
-        for r in rs:
-            ha, hb = refs[s, r.name]
-            own[s, r.name] = ((ha + hb) / 2, float(((ha - hb)[keep[s]] ** 2).mean()) / 4)
-        print('%s: %d spp; references %d spp in two halves, their own RMSE %s; %.1f%% of the pixels kept' % (
-            s, a.pbrt_spp[s], a.ref_spp[s], ', '.join('%s %.5f' % (r.name, math.sqrt(own[s, r.name][1])) for r in rs),
-            100.0 * keep[s].mean()), flush=True)
-
-    results = {}
-    for rnd in range(1, a.runs + 1):
-        for s in scenes:
-            for r in rs:
-                out = os.path.join(os.path.abspath(a.out), 'pbrt', '%s-%s-%d.pfm' % (s, r.name, rnd))
-                wall, img = r.render(paths[s], a.pbrt_spp[s], rnd, out)
-                ref, ref_mse = own[s, r.name]
-                mse = float(((img - ref)[keep[s]] ** 2).mean()) - ref_mse
-                results.setdefault((s, r.name), []).append((wall, mse))
-                print('round %d %-14s %-5s wall %7.2f s  RMSE %.5f' % (rnd, s, r.name, wall,
-                                                                     math.sqrt(max(mse, 0.0))), flush=True)
-
-    print()
-    print('| scene | renderer | wall time (whole process) | RMSE against its own reference (masked, less the '
-          "reference's own) | time x MSE | clpt time to equal error |")
-    print('|---|---|---|---|---|---|')
-    for s in scenes:
-        rows = {}
-        for r in rs:
-            got = results[s, r.name]
-            wall = statistics.median(t for t, _ in got)
-            mse = max(sum(m for _, m in got) / len(got), 0.0)
-            rows[r.name] = (r.label, wall, math.sqrt(mse), wall * mse)
-        for name, (label, wall, e, tm) in rows.items():
-            ratio = '1 (itself)' if name == 'clpt' else '%.2f' % (rows['clpt'][3] / tm if tm > 0 else float('nan'))
-            print('| %s | %s | %.2f s | %.5f | %.2e | %s |' % (s, label, wall, e, tm, ratio))
-    print()
-    for s in scenes:
-        print(bias_line(s, own[s, 'clpt'][0], own[s, 'pbrt'][0], keep[s]))
-
-
-def bias_line(scene, clpt_ref, pbrt_ref, keep):
-    """The two references' mean ratio per channel: over the kept pixels and over the whole image
-    (the kept pixels leave out edges, the light's among them, so the two differ where the
-    spectral and the RGB renders differ most in the light's or the walls' saturated colours)."""
-    def ratio(c, p):
-        return ' '.join('%.4f' % x for x in c.mean(0) / p.mean(0))
-    return '%s: bias clpt / pbrt-v4 (R G B), mean over the kept pixels %s, over the whole image %s' % (
-        scene, ratio(clpt_ref[keep], pbrt_ref[keep]), ratio(clpt_ref.reshape(-1, 3), pbrt_ref.reshape(-1, 3)))
+    compare(a, scenes, paths, a.pbrt_spp, renderers(a), os.path.join(os.path.abspath(a.out), 'pbrt'),
+            'wall time (whole process)')
 
 
 def check(a, scenes):

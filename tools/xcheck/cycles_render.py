@@ -8,7 +8,8 @@
 # "seed", "bounces" (Cycles' max_bounces), "background": {"kind": "white" | "black" |
 # "env", "map", "rotz"}, "override": null | "diffuse:R,G,B"}. Each writes OUT.npy (H x W
 # x 3 float32, linear, top row first) and OUT.json (the lights and Principled BSDFs as
-# imported, the image mean). "diffuse:R,G,B" makes every surface a Lambertian Diffuse
+# imported, the image mean, the render's seconds). An optional "threads" sets Cycles'
+# render threads (default 2). "diffuse:R,G,B" makes every surface a Lambertian Diffuse
 # BSDF, fed by the normal map the importer made, if any.
 #
 # Conventions (matched with clpt; ../shared/peers/README.md found them first):
@@ -21,6 +22,7 @@
 import json
 import math
 import sys
+import time
 
 import bpy
 import numpy as np
@@ -171,7 +173,9 @@ def render(job):
     settings(sc, job)
     out = job["out"]
     sc.render.filepath = out + ".exr"
+    t0 = time.perf_counter()
     bpy.ops.render.render(write_still=True)
+    info["render_s"] = time.perf_counter() - t0   # scene sync, BVH build, render, EXR write
     img = bpy.data.images.load(out + ".exr")
     W, H = job["width"], job["height"]
     px = np.array(img.pixels[:], dtype=np.float32).reshape(H, W, 4)[::-1, :, :3]

@@ -433,6 +433,75 @@ static void test_delta_lights_match_whitted(void)
     error_clear(&err);
 }
 
+/* Among delta lights the choice is made at the shading point (light_choose_delta):
+ * area_scene's two lamps, then a sun, a point light and a spot aimed away from ref. Over
+ * a stratified sweep of the choice number, with and without reuse of u1: the lamps keep
+ * their power shares; the spot, which sends nothing to ref, is never chosen; the sun
+ * and the point light share their group's power in proportion to what each sends to
+ * ref, each sample's density saying so; and the mean of Le / pdf over the delta samples
+ * is what the three send together (the estimate is unbiased). */
+static void test_delta_light_choice_at_point(void)
+{
+    enum { N = 20000 };
+    Scene s;
+    area_scene(&s, material_diffuse(v3s(0.5f)), 1);
+    Light sun = light_default(LIGHT_DIRECTIONAL);
+    sun.direction = v3_norm(v3(0.3f, -1.0f, 0.2f));
+    sun.intensity = v3(3.0f, 3.0f, 2.0f);
+    Light pt = light_default(LIGHT_POINT);
+    pt.position = v3(0.5f, 2.0f, 1.0f);
+    pt.intensity = v3s(5.0f);
+    Light spot = light_default(LIGHT_SPOT);
+    spot.position = v3(0.0f, 3.0f, 0.0f);
+    spot.direction = v3(0.0f, 1.0f, 0.0f);
+    spot.intensity = v3s(50.0f);
+    CHECK(scene_add_light(&s, sun, NULL) == ST_OK);
+    CHECK(scene_add_light(&s, pt, NULL) == ST_OK);
+    CHECK(scene_add_light(&s, spot, NULL) == ST_OK);
+    RenderScene rs;
+    SceneView v;
+    prepared_view(&s, &rs, &v);
+    uint first = rs.ds.params.n_area_lights;
+    CHECK_EQ_INT(rs.ds.params.n_lights, first + 3u);
+    vec3 ref = v3(0.2f, 0.0f, 0.3f);
+    vec3 to = v3_sub(pt.position, ref);
+    double w_sun = 8.0, w_pt = 15.0 / v3_dot(to, to), group = v.lights[first + 2].cdf - v.lights[first - 1].cdf;
+    double want_sum = 3.0 + 5.0 / v3_dot(to, to);   /* the red channel of what the three send */
+    for (int reuse = 0; reuse <= 1; reuse++) {
+        uint n_sun = 0, n_pt = 0, n_spot = 0, n_area = 0, bad_pdf = 0;
+        double sum = 0.0;
+        for (uint i = 0; i < N; i++) {
+            float u = ((float)i + 0.5f) / (float)N, u2 = (float)((i * 2654435769u) >> 8) * 5.9604645e-8f;
+            LightSample ls;
+            int ok = reuse ? light_sample(&v, ref, 1, 0.0f, u, u2, &ls) : light_sample(&v, ref, 0, u, u2, 0.5f, &ls);
+            if (!ok) continue;
+            if (!ls.delta) {
+                n_area++;
+                continue;
+            }
+            int is_sun = !(ls.dist < INFINITY), is_pt = !is_sun && ls.p.y == 2.0f;
+            n_sun += is_sun;
+            n_pt += is_pt;
+            n_spot += !is_sun && !is_pt;
+            double want = group * (is_sun ? w_sun : w_pt) / (w_sun + w_pt);
+            if (fabs(ls.pdf - want) > 1e-5 * want) bad_pdf++;
+            sum += ls.Le.x / ls.pdf;
+        }
+        double mean = sum / N;
+        fprintf(stderr, "  delta lights chosen at the point (reuse %d): sun %u, point %u, spot %u, area %u of %d "
+                "(group %.4f; sun's share by what it sends %.4f); %u with another density; mean Le/pdf %.5f, "
+                "want %.5f\n", reuse, n_sun, n_pt, n_spot, n_area, N, group, w_sun / (w_sun + w_pt), bad_pdf, mean,
+                want_sum);
+        CHECK_EQ_INT(n_spot, 0);
+        CHECK_EQ_INT(bad_pdf, 0);
+        CHECK(fabs(n_sun - N * group * w_sun / (w_sun + w_pt)) <= 2.0);
+        CHECK(fabs(n_pt - N * group * w_pt / (w_sun + w_pt)) <= 2.0);
+        CHECK(fabs(mean - want_sum) < 1e-3 * want_sum);
+    }
+    render_scene_free(&rs);
+    scene_free(&s);
+}
+
 /* A Phong sphere in a white furnace (background 1, no lights): with kd + ks <= 1 it can
  * only darken; kd 1 alone reflects everything. */
 static void test_phong_energy(void)
@@ -475,6 +544,7 @@ int main(void)
     RUN(test_quad_lights_pair);
     RUN(test_quad_lamp_samples_uniformly);
     RUN(test_delta_lights_match_whitted);
+    RUN(test_delta_light_choice_at_point);
     RUN(test_phong_energy);
     return harness_report();
 }

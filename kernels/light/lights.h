@@ -337,6 +337,57 @@ KFN int light_sample_area(const SceneView *sc, uint li, vec3 ref, int reuse, flo
     return ls->pdf > 0.0f && light_faces(sc, l.prim, ls->n, v3_sub(ref, ls->p));
 }
 
+/* At most this many delta lights are chosen among by what each sends to the shading
+ * point (light_choose_delta); a scene with more keeps the choice by power alone, whose
+ * cost does not grow with the lights. */
+#define LIGHT_DELTA_LOCAL_MAX 16u
+
+/* What delta light l sends to ref, occlusion aside: the sum of the channels of its
+ * irradiance across the direction to it (attenuation and a spot's falloff included). */
+KFN float light_delta_weight(Light l, vec3 ref)
+{
+    LightSample t;
+    if (!light_delta_at(l, ref, &t)) return 0.0f;
+    return t.Le.x + t.Le.y + t.Le.z;
+}
+
+/* Having chosen light li of the delta lights' group by its power, chooses again within
+ * the group in proportion to light_delta_weight at ref, with uniform u; returns the
+ * light's index and sets *pick to the probability of choosing it among all lights. A
+ * light that sends nothing to ref is never chosen, and adds nothing there. Why: a
+ * sun's share of the power is pi r^2 E over the scene's bounding sphere
+ * (scene_lights.c), and on a large floor it took 91% of the choices from a lamp that
+ * lit a third of the floor near the camera, whose light then came in few, heavy
+ * samples (bench/RESULTS.md, "Cycles on the glTF files"); what a delta light sends to
+ * a point costs a division to know, so the choice among a few is made where the point
+ * is. With one delta light, more than LIGHT_DELTA_LOCAL_MAX, or weights that sum to
+ * nothing finite, li stays, with its power share. A ray never hits a delta light, so
+ * no MIS weight needs these probabilities again. */
+KFN uint light_choose_delta(const SceneView *sc, vec3 ref, uint li, float u, float *pick)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    uint first = p->n_area_lights;
+    uint n = p->n_lights - first - (p->bg_light != NO_INDEX ? 1u : 0u);
+    *pick = sc->lights[li].pick_pdf;
+    if (n < 2u || n > LIGHT_DELTA_LOCAL_MAX) return li;
+    float total = 0.0f;
+    for (uint i = 0; i < n; i++) total += light_delta_weight(sc->lights[first + i], ref);
+    if (!(total > 0.0f) || !(total < k_as_float(0x7f800000u))) return li;
+    float group = sc->lights[first + n - 1u].cdf - (first > 0u ? sc->lights[first - 1u].cdf : 0.0f);
+    float target = u * total, acc = 0.0f, w_chosen = 0.0f;
+    uint chosen = li;
+    for (uint i = 0; i < n; i++) {
+        float w = light_delta_weight(sc->lights[first + i], ref);
+        if (!(w > 0.0f)) continue;
+        chosen = first + i;
+        w_chosen = w;
+        acc += w;
+        if (target < acc) break;
+    }
+    *pick = group * (w_chosen / total);
+    return chosen;
+}
+
 /* Chooses a light among the first ones whose cdf reaches `cdf_top` (1: all of them;
  * the area lights' total: only those) and samples it from ref. The pdf includes the
  * choice. Returns 0 if the sample carries no light.
@@ -369,9 +420,13 @@ KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, int reuse,
         return ls->pdf > 0.0f;
     }
     if (KF_HAS(KF_DELTA_LIGHTS) && light_is_delta(l.type)) {
-        if (!light_delta_at(l, ref, ls)) return 0;
-        ls->pdf = choice;
-        return choice > 0.0f;
+        /* the group of delta lights by power, then one of them by what it sends to ref,
+         * with the rest of the choice number (a delta light needs no point on it) */
+        float pick;
+        li = light_choose_delta(sc, ref, li, u_rest, &pick);
+        if (!light_delta_at(sc->lights[li], ref, ls)) return 0;
+        ls->pdf = pick / cdf_top;
+        return ls->pdf > 0.0f;
     }
     if (!light_sample_area(sc, li, ref, reuse, u_rest, u1, u2, ls)) return 0;
     ls->pdf *= choice;

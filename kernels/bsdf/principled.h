@@ -63,6 +63,7 @@ typedef struct {
     vec3 base;
     float metallic, transmission, clearcoat;
     Ggx g, gc;         /* base and clearcoat roughness (alpha at least GGX_SMOOTH_ALPHA) */
+    int smooth, cc_smooth;  /* below GGX_SMOOTH_ALPHA: the lobe is a delta lobe */
     float eta;         /* n_t / n_i for the refraction */
     int thin;
     float specular;    /* KHR_materials_specular: F90, and F0's scale ... */
@@ -227,9 +228,9 @@ KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
     float layer = w_cc;                      /* c F_c: the clearcoat's share */
     float below = sheen_scaling(p, wo.z, wi.z);
     if (wi.z > 0.0f) {
-        float spec, coat = 0.0f, pdf_c = 0.0f;
-        float pdf_s = ggx_reflection(p.g, wo, wi, &spec);
-        if (p.clearcoat > 0.0f) pdf_c = ggx_reflection(p.gc, wo, wi, &coat);
+        float spec = 0.0f, coat = 0.0f, pdf_c = 0.0f, pdf_s = 0.0f;
+        if (!p.smooth) pdf_s = ggx_reflection(p.g, wo, wi, &spec);
+        if (p.clearcoat > 0.0f && !p.cc_smooth) pdf_c = ggx_reflection(p.gc, wo, wi, &coat);
         vec3 h = v3_norm(v3_add(wo, wi));
         float vh = v3_dot(wo, h);
         vec3 fd = principled_fresnel_rgb(p, vh);
@@ -257,7 +258,7 @@ KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
         if (w_sheen > 0.0f) f_dt = v3_scale(f_dt, below);
         pdf_dt = w_dt * -wi.z * K_INV_PI;
     }
-    if (!(w_trans > 0.0f)) {
+    if (!(w_trans > 0.0f) || p.smooth) {
         *f = f_dt;
         return pdf_dt;
     }
@@ -289,7 +290,8 @@ KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
     return w_trans * (1.0f - principled_reflect_prob(fd)) * pdf_t;
 }
 
-/* A direction for wo, *f and the density as principled_eval's (0: failed sample). */
+/* A direction for wo, *f and the density as principled_eval's (0: failed sample; -1:
+ * u_lobe chose a smooth lobe, which principled_sample_smooth samples). */
 KFN float principled_sample(Principled p, vec3 wo, float u_lobe, float u1, float u2, vec3 *wi, vec3 *f)
 {
     *f = v3s(0.0f);
@@ -298,6 +300,12 @@ KFN float principled_sample(Principled p, vec3 wo, float u_lobe, float u1, float
     principled_shares(p, wo, &w_cc, &w_sheen, &w_spec, &w_diff, &w_dt, &w_trans);
     int up = 1;
     float w_up = w_cc + w_sheen + w_spec + w_diff;
+    /* a smooth lobe: the clearcoat, the specular or the transmission lobe (the order
+     * of the branches below), which principled_sample_smooth samples */
+    if (u_lobe < w_cc ? p.cc_smooth
+                      : !(u_lobe < w_cc + w_sheen) && p.smooth &&
+                            (u_lobe < w_cc + w_sheen + w_spec || (w_trans > 0.0f && !(u_lobe < w_up + w_dt))))
+        return -1.0f;
     if (u_lobe < w_cc) {
         *wi = mf_reflect(wo, ggx_sample_visible(p.gc, wo, u1, u2));
     } else if (u_lobe < w_cc + w_sheen) {
@@ -327,8 +335,56 @@ KFN float principled_sample(Principled p, vec3 wo, float u_lobe, float u1, float
     return principled_eval(p, wo, *wi, f);
 }
 
-/* The principled lobes; alphas below GGX_SMOOTH_ALPHA are raised to it, as the
- * material mixes its lobes by density and has no delta branch. */
+/* The sample of a smooth lobe that u_lobe chose (principled_sample returned -1): the
+ * mirror direction (the clearcoat, the specular lobe, the transmission lobe's
+ * reflection) or the refraction (straight through a thin sheet) of wo about the
+ * shading normal, and in *weight f cos over the probability of choosing that
+ * direction. The mirror is reached by three lobes (the transmission lobe reflecting
+ * with probability F_d), so its weight is its whole reflectance over their summed
+ * probability, whichever chose it. Returns whether the direction is the refraction;
+ * *weight 0: none (a refraction past the critical angle, which F_d = 1 never
+ * chooses but rounding might). */
+KFN int principled_sample_smooth(Principled p, vec3 wo, float u_lobe, vec3 *wi, vec3 *weight)
+{
+    float w_cc, w_sheen, w_spec, w_diff, w_dt, w_trans;
+    principled_shares(p, wo, &w_cc, &w_sheen, &w_spec, &w_diff, &w_dt, &w_trans);
+    *wi = v3(-wo.x, -wo.y, wo.z);
+    if (u_lobe < w_cc) {
+        /* the clearcoat reflects its share c F_c, white: f cos / P = 1 */
+        *weight = v3s(1.0f);
+        return 0;
+    }
+    vec3 fd = principled_fresnel_rgb(p, wo.z);
+    float reflect_t = principled_reflect_prob(fd), layer = w_cc;
+    float w_up = w_cc + w_sheen + w_spec + w_diff;
+    float u_facet = w_trans > 0.0f ? k_fmin((u_lobe - (w_up + w_dt)) / w_trans, 0.99999994f) : 0.0f;
+    if (u_lobe < w_cc + w_sheen + w_spec || u_facet < reflect_t) {
+        vec3 r = v3_add(v3_scale(fresnel_schlick(p.base, wo.z), p.metallic), v3_scale(fd, 1.0f - p.metallic));
+        float below = w_sheen > 0.0f ? sheen_scaling(p, wo.z, wo.z) : 1.0f;
+        *weight = v3_scale(r, (1.0f - layer) * below / (w_spec + w_trans * reflect_t));
+        return 0;
+    }
+    if (p.thin) {
+        *wi = v3_neg(wo);
+    } else if (!mf_refract(wo, v3(0.0f, 0.0f, 1.0f), p.eta, wi)) {
+        *weight = v3s(0.0f);
+        return 1;
+    }
+    /* principled_eval's transmission lobe, whose btdf integrates to 1 when smooth */
+    vec3 tint = p.subsurface > 0.0f ? v3_add(v3_scale(p.base, p.transmission), v3s((1.0f - p.transmission) * p.subsurface))
+                                    : v3_scale(p.base, p.transmission);
+    float below = w_sheen > 0.0f ? sheen_scaling(p, wo.z, k_fabs(wi->z)) : 1.0f;
+    *weight = v3_scale(v3_mul(tint, v3_sub(v3s(1.0f), fd)),
+                       (1.0f - layer) * (1.0f - p.metallic) * below / (w_trans * (1.0f - reflect_t)));
+    return 1;
+}
+
+/* The principled lobes. Alphas below GGX_SMOOTH_ALPHA make their lobes delta lobes
+ * (smooth, cc_smooth), sampled by principled_sample_smooth and left out of
+ * principled_eval, as the conductor and the dielectric do: at alpha 1e-3 a point
+ * light's highlight in a roughness-0 sphere was a spot of GGX density 3e5 that a few
+ * camera samples hit, fireflies of thousands in a pixel (the glTF material spheres,
+ * bench/RESULTS.md). The alphas are still raised to it, for the GGX functions' sake. */
 KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
 {
     Principled p;
@@ -337,6 +393,8 @@ KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
     p.transmission = k_clamp(m.transmission, 0.0f, 1.0f);
     p.clearcoat = k_clamp(m.clearcoat, 0.0f, 1.0f);
     p.g = bsdf_ggx(m);
+    p.smooth = ggx_smooth(p.g);
+    p.cc_smooth = m.clearcoat_roughness * m.clearcoat_roughness < GGX_SMOOTH_ALPHA;
     p.g.ax = k_fmax(p.g.ax, GGX_SMOOTH_ALPHA);
     p.g.ay = k_fmax(p.g.ay, GGX_SMOOTH_ALPHA);
     float ac = k_fmax(m.clearcoat_roughness * m.clearcoat_roughness, GGX_SMOOTH_ALPHA);
@@ -361,7 +419,12 @@ KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
 }
 
 /* ---------------------------------------------------------------- MAT_PRINCIPLED */
-KFN int principled_bsdf_has_density(Material m, vec3 albedo) { return bsdf_density_always(m, albedo); }
+/* A lobe with a density: any but a smooth metal with no rough clearcoat and no sheen. */
+KFN int principled_bsdf_has_density(Material m, vec3 albedo)
+{
+    Principled p = bsdf_principled(m, albedo, 1);
+    return !(p.smooth && p.metallic >= 1.0f && v3_max_comp(p.sheen) <= 0.0f && (p.clearcoat <= 0.0f || p.cc_smooth));
+}
 
 KFN vec3 principled_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)
 {
@@ -376,8 +439,21 @@ KFN BsdfSample principled_bsdf_sample(Material m, BsdfHit h, float u_lobe, float
     (void)u3;
     vec3 wo, f = v3s(0.0f), wl = v3s(0.0f);
     BsdfFrame F = bsdf_hit_frame(h, &wo);
-    float pdf = wo.z > 0.0f ? principled_sample(bsdf_principled(m, h.albedo, h.front), wo, u_lobe, u1, u2, &wl, &f)
-                            : 0.0f;
+    Principled p = bsdf_principled(m, h.albedo, h.front);
+    float pdf = wo.z > 0.0f ? principled_sample(p, wo, u_lobe, u1, u2, &wl, &f) : 0.0f;
+    if (pdf < 0.0f) {
+        vec3 weight;
+        int transmitted = principled_sample_smooth(p, wo, u_lobe, &wl, &weight);
+        if (v3_is_zero(weight)) return bsdf_failed(F.n);
+        vec3 wi = v3_norm(k_to_world(wl, F.t, F.b, F.n));
+        /* a direction on the wrong side of the geometric surface is taken about ng, as
+         * the dielectric does (bsdf_sample_dielectric) */
+        if (transmitted ? !(v3_dot(wi, h.ng) < 0.0f) : !(v3_dot(wi, h.ng) > 0.0f)) {
+            if (transmitted) return bsdf_failed(F.n);
+            wi = reflect_dir(h.d, h.ng);
+        }
+        return bsdf_delta_sample(wi, weight, transmitted);
+    }
     return bsdf_rough_sample(F, pdf, wl, f);
 }
 

@@ -419,11 +419,14 @@ KFN Principled bsdf_principled(Material m, vec3 albedo, int front)
 }
 
 /* ---------------------------------------------------------------- MAT_PRINCIPLED */
-/* A lobe with a density: any but a smooth metal with no rough clearcoat and no sheen. */
+/* A lobe with a density: any but a smooth metal with no rough clearcoat and no sheen
+ * (read from the material's fields as bsdf_principled clamps them, without building the
+ * lobes, which shading builds again). */
 KFN int principled_bsdf_has_density(Material m, vec3 albedo)
 {
-    Principled p = bsdf_principled(m, albedo, 1);
-    return !(p.smooth && p.metallic >= 1.0f && v3_max_comp(p.sheen) <= 0.0f && (p.clearcoat <= 0.0f || p.cc_smooth));
+    (void)albedo;
+    int rough_coat = m.clearcoat > 0.0f && !(m.clearcoat_roughness * m.clearcoat_roughness < GGX_SMOOTH_ALPHA);
+    return !ggx_smooth(bsdf_ggx(m)) || !(m.metallic >= 1.0f) || rough_coat || v3_max_comp(m.sheen_color) > 0.0f;
 }
 
 KFN vec3 principled_bsdf_eval(Material m, BsdfHit h, vec3 wi, float *pdf)

@@ -377,6 +377,7 @@ __kernel void k_layout(__global uint *out)
     out[i++] = (uint)__builtin_offsetof(GridMedium, minorant_at);
     out[i++] = (uint)sizeof(KdProto);
     out[i++] = (uint)__builtin_offsetof(KdProto, hi);
+    out[i++] = (uint)__builtin_offsetof(RenderParams, has_alpha);
 }
 #endif
 

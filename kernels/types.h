@@ -770,7 +770,7 @@ enum MisMode { MIS_BOTH = 0, MIS_LIGHT_ONLY = 1, MIS_BSDF_ONLY = 2 };
 enum Sampler { SAMPLER_SOBOL = 0, SAMPLER_INDEPENDENT = 1 };
 
 /* Everything constant over a render, uploaded once per device. */
-typedef struct {                                        /* 336 bytes */
+typedef struct {                                        /* 352 bytes */
     Camera camera;
     vec3 bg_color;    uint bg_type;   /* constant colour, the sky's horizon colour, or
                                        * BG_MAP: the map's scale (intensity) */
@@ -832,6 +832,11 @@ typedef struct {                                        /* 336 bytes */
     uint camera_medium;               /* where camera rays start: 0 vacuum, else 1 +
                                        * an index into media[] */
     uint n_grids;                     /* entries of grids[] (MEDIUM_GRID media) */
+    uint has_alpha;                   /* 1: some material may be cut out (alphaMode MASK
+                                       * or BLEND, kernels/accel/alpha.h); 0: no hit
+                                       * looks its material up for it (the scalar
+                                       * device's builds have KF_ALPHA for every scene) */
+    uint pad0, pad1, pad2;
 } RenderParams;
 
 #define HAS_MEDIA_ANY 1u          /* RenderParams.has_media: some medium or boundary */
@@ -907,7 +912,7 @@ CLPT_CHECK_SIZE(MotionKey, 64);
 _Static_assert(offsetof(Camera, motion_keys) == 92, "Camera.motion_keys");
 _Static_assert(offsetof(PathState, time) == 76, "PathState.time");
 _Static_assert(offsetof(MotionKey, stretch) == 32, "MotionKey.stretch");
-CLPT_CHECK_SIZE(RenderParams, 336);
+CLPT_CHECK_SIZE(RenderParams, 352);
 CLPT_CHECK_SIZE(PathState, 80);
 CLPT_CHECK_SIZE(Medium, 64);
 CLPT_CHECK_SIZE(GridMedium, 96);
@@ -943,6 +948,7 @@ _Static_assert(offsetof(Material, medium_in) == 280, "Material.medium_in");
 _Static_assert(offsetof(Material, diffuse_transmission) == 236, "Material.diffuse_transmission");
 _Static_assert(offsetof(Material, diffuse_transmission_color) == 288, "Material.diffuse_transmission_color");
 _Static_assert(offsetof(RenderParams, has_media) == 320, "RenderParams.has_media");
+_Static_assert(offsetof(RenderParams, has_alpha) == 336, "RenderParams.has_alpha");
 _Static_assert(offsetof(PathState, medium) == 64, "PathState.medium");
 _Static_assert(offsetof(Medium, sigma_s) == 32, "Medium.sigma_s");
 _Static_assert(offsetof(Medium, emission) == 48, "Medium.emission");

@@ -41,7 +41,7 @@
         offsetof(GridMedium, temperature_at), sizeof(MotionKey), offsetof(MotionKey, stretch),  \
         offsetof(Camera, motion_keys), offsetof(Material, diffuse_transmission),                \
         offsetof(Material, diffuse_transmission_color), offsetof(GridMedium, minorant_at),      \
-        sizeof(KdProto), offsetof(KdProto, hi)                                                  \
+        sizeof(KdProto), offsetof(KdProto, hi), offsetof(RenderParams, has_alpha)               \
     }
 
 /* how many values k_layout writes */

@@ -34,10 +34,13 @@
 #define ALPHA_MAX_LAYERS 64u
 
 /* Whether the material of the hit's primitive (its instance's, where that replaces
- * it) may be cut out anywhere. */
-KFN int hit_has_alpha(const SceneView *sc, Hit hit)
+ * it) may be cut out anywhere. A scene without such materials answers from its
+ * parameters: the scalar device runs its scenes on a few builds, KF_ALPHA in them all,
+ * and the material lookup for every hit cost it 4% on an environment-lit scene
+ * (bench/RESULTS.md). */
+KFN_INLINE int hit_has_alpha(const SceneView *sc, Hit hit)
 {
-    if (!KF_HAS(KF_ALPHA)) return 0;
+    if (!KF_HAS(KF_ALPHA) || !sc->params->has_alpha) return 0;
     uint m = prim_material(sc, hit.prim);
     if (SURFACE_INSTANCED(sc, hit) && sc->instances[hit.inst].material != NO_INDEX)
         m = sc->instances[hit.inst].material;
@@ -84,6 +87,7 @@ KFN int hit_cut_out(const SceneView *sc, Ray ray, Hit hit)
  * alpha); prim = NO_INDEX when there is none. */
 KFN Hit trace_closest_visible(const SceneView *sc, Ray ray)
 {
+    if (!KF_HAS(KF_ALPHA) || !sc->params->has_alpha) return trace_closest(sc, ray);
     for (uint layer = 0u;; layer++) {
         Hit h = trace_closest(sc, ray);
         if (layer == ALPHA_MAX_LAYERS || !hit_cut_out(sc, ray, h)) return h;

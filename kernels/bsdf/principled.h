@@ -219,12 +219,19 @@ KFN void principled_shares(Principled p, vec3 wo, float *w_cc, float *w_sheen, f
     *w_trans = diel * t;
 }
 
-KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
+/* The lobes' shares at one wo (principled_shares), for principled_eval_shares. */
+typedef struct {
+    float cc, sheen, spec, diff, dt, trans;
+} PrincipledShares;
+
+/* principled_eval with the shares at wo already known: principled_sample has them for
+ * the direction it samples (computing them again was a third of principled_shares'
+ * 5% of a textured glTF render on PoCL, bench/RESULTS.md). wo.z > 0. */
+KFN float principled_eval_shares(Principled p, PrincipledShares sh, vec3 wo, vec3 wi, vec3 *f)
 {
     *f = v3s(0.0f);
-    if (wo.z <= 0.0f || wi.z == 0.0f) return 0.0f;
-    float w_cc, w_sheen, w_spec, w_diff, w_dt, w_trans;
-    principled_shares(p, wo, &w_cc, &w_sheen, &w_spec, &w_diff, &w_dt, &w_trans);
+    if (wi.z == 0.0f) return 0.0f;
+    float w_cc = sh.cc, w_sheen = sh.sheen, w_spec = sh.spec, w_diff = sh.diff, w_dt = sh.dt, w_trans = sh.trans;
     float layer = w_cc;                      /* c F_c: the clearcoat's share */
     float below = sheen_scaling(p, wo.z, wi.z);
     if (wi.z > 0.0f) {
@@ -290,6 +297,15 @@ KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
     return w_trans * (1.0f - principled_reflect_prob(fd)) * pdf_t;
 }
 
+KFN float principled_eval(Principled p, vec3 wo, vec3 wi, vec3 *f)
+{
+    *f = v3s(0.0f);
+    if (wo.z <= 0.0f || wi.z == 0.0f) return 0.0f;
+    PrincipledShares sh;
+    principled_shares(p, wo, &sh.cc, &sh.sheen, &sh.spec, &sh.diff, &sh.dt, &sh.trans);
+    return principled_eval_shares(p, sh, wo, wi, f);
+}
+
 /* A direction for wo, *f and the density as principled_eval's (0: failed sample; -1:
  * u_lobe chose a smooth lobe, which principled_sample_smooth samples). */
 KFN float principled_sample(Principled p, vec3 wo, float u_lobe, float u1, float u2, vec3 *wi, vec3 *f)
@@ -332,7 +348,8 @@ KFN float principled_sample(Principled p, vec3 wo, float u_lobe, float u1, float
     }
     /* as for the dielectric: a lobe's sample on the other side is lost */
     if (up ? wi->z <= 0.0f : wi->z >= 0.0f) return 0.0f;
-    return principled_eval(p, wo, *wi, f);
+    PrincipledShares sh = { w_cc, w_sheen, w_spec, w_diff, w_dt, w_trans };
+    return principled_eval_shares(p, sh, wo, *wi, f);
 }
 
 /* The sample of a smooth lobe that u_lobe chose (principled_sample returned -1): the

@@ -36,8 +36,8 @@
 /* Whether the material of the hit's primitive (its instance's, where that replaces
  * it) may be cut out anywhere. A scene without such materials answers from its
  * parameters: the scalar device runs its scenes on a few builds, KF_ALPHA in them all,
- * and the material lookup for every hit cost it 4% on an environment-lit scene
- * (bench/RESULTS.md). */
+ * and the material lookup for every hit cost it 1-3% on an environment-lit scene and a
+ * textured glTF (bench/RESULTS.md). */
 KFN_INLINE int hit_has_alpha(const SceneView *sc, Hit hit)
 {
     if (!KF_HAS(KF_ALPHA) || !sc->params->has_alpha) return 0;

@@ -461,6 +461,9 @@ typedef struct {                                        /* 320 bytes */
 #define MAT_ALPHA_MASK 8u       /* glTF alphaMode MASK: cut out where alpha < alpha_cutoff */
 #define MAT_ALPHA_BLEND 16u     /* glTF alphaMode BLEND: a hit is kept with probability
                                  * alpha (kernels/accel/alpha.h) */
+/* either: the material may be cut out somewhere (the alpha check, the kernels' KF_ALPHA,
+ * RenderParams.has_alpha and light sampling all ask this) */
+#define MAT_ALPHA_ANY (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)
 #define MAT_INTERFACE 32u       /* no surface at all, only a boundary between media
                                  * (`material none`, pbrt's "interface"): rays pass
                                  * straight through it, changing medium (KF_MEDIA) */
@@ -836,7 +839,7 @@ typedef struct {                                        /* 352 bytes */
                                        * or BLEND, kernels/accel/alpha.h); 0: no hit
                                        * looks its material up for it (the scalar
                                        * device's builds have KF_ALPHA for every scene) */
-    uint pad0, pad1, pad2;
+    uint pad0, pad1, pad2;            /* to a multiple of 16 bytes */
 } RenderParams;
 
 #define HAS_MEDIA_ANY 1u          /* RenderParams.has_media: some medium or boundary */

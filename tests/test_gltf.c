@@ -287,7 +287,7 @@ static void test_alpha_modes(void)
         const Material *m = triangle_material(ok[i].json, &s);
         if (m) {
             CHECK(m->type == MAT_PRINCIPLED);
-            CHECK((m->flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) == ok[i].flags);
+            CHECK((m->flags & MAT_ALPHA_ANY) == ok[i].flags);
             CHECK(m->alpha == ok[i].alpha);
             CHECK(m->alpha_cutoff == ok[i].cutoff);
             CHECK(m->texture_emission == NO_INDEX);

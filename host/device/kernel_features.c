@@ -28,7 +28,7 @@ unsigned kernel_scene_features(const DeviceScene *s)
             m->texture_sheen_roughness != NO_INDEX || m->texture_diffuse_transmission != NO_INDEX ||
             m->texture_diffuse_transmission_color != NO_INDEX)
             f |= KF_TEXTURES;
-        if (m->flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) f |= KF_ALPHA;
+        if (m->flags & MAT_ALPHA_ANY) f |= KF_ALPHA;
     }
     for (uint i = 0; i < p->n_lights; i++) f |= light_feature(s->lights[i].type);
     f |= (p->n_spheres ? KF_SPHERES : 0u) | (p->n_boxes ? KF_BOXES : 0u) | (p->n_planes ? KF_PLANES : 0u) |

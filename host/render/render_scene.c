@@ -310,7 +310,7 @@ static Status prepare(Scene *s, int tree_threads, RenderScene *out, Error *err)
     out->ds.n_materials = (uint)s->n_materials;
     p->has_alpha = 0u;
     for (size_t i = 0; i < s->n_materials; i++)
-        if (s->materials[i].flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) p->has_alpha = 1u;
+        if (s->materials[i].flags & MAT_ALPHA_ANY) p->has_alpha = 1u;
     out->ds.lights = s->lights;
     out->ds.shading = s->shading;
     out->ds.n_shading = (uint)s->n_shading;

@@ -35,7 +35,7 @@ static int is_emissive(const Scene *s, uint material)
      * surface in a way light sampling does not know: such surfaces are found by BSDF
      * sampling alone (full weight), like the background, which keeps them unbiased. */
     const Material *m = &s->materials[material];
-    if (m->texture_emission != NO_INDEX || (m->flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND))) return 0;
+    if (m->texture_emission != NO_INDEX || (m->flags & MAT_ALPHA_ANY)) return 0;
     return v3_luminance(m->emission) > 0.0f;
 }
 

@@ -44,7 +44,7 @@ KFN_INLINE int hit_has_alpha(const SceneView *sc, Hit hit)
     uint m = prim_material(sc, hit.prim);
     if (SURFACE_INSTANCED(sc, hit) && sc->instances[hit.inst].material != NO_INDEX)
         m = sc->instances[hit.inst].material;
-    return (sc->materials[m].flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) != 0u;
+    return (sc->materials[m].flags & MAT_ALPHA_ANY) != 0u;
 }
 
 /* The BLEND coin of a hit: uniform in [0, 1), a hash of the ray's and the hit's bits. */

@@ -97,7 +97,8 @@ static int make_sphere(Mesh *m, long n)
 
 static Hit brute_closest(const SceneView *sc, Ray ray)
 {
-    RayPre rp = ray_prepare(ray);
+    RayPre rp;
+    ray_prepare(ray, &rp);
     Hit best = { ray.tmax, NO_INDEX, 0.0f, 0.0f };
     for (uint i = 0; i < sc->params->n_triangles; i++) {
         Ray r = ray;

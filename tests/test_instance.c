@@ -641,7 +641,8 @@ static Hit brute_force(const Scene *s, const SceneView *sv, const RenderScene *r
     for (size_t i = 0; i < rs->n_instances; i++) {
         const Instance *x = &rs->instances[i];
         Ray r = instance_ray(x, ray);
-        RayPre rp = ray_prepare(r);
+        RayPre rp;
+        ray_prepare(r, &rp);
         uint inst = (x->flags & INST_WORLD) ? NO_INDEX : (uint)i;
         for (uint id = 0; id < scene_first_plane(s); id++) {
             int in_obj = mask && mask[id];

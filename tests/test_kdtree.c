@@ -160,7 +160,8 @@ static int prim_finite(uint id)
 
 static Hit brute_closest(Ray ray)
 {
-    RayPre rp = ray_prepare(ray);
+    RayPre rp;
+    ray_prepare(ray, &rp);
     Hit best = { ray.tmax, NO_INDEX, 0.0f, 0.0f, NO_INDEX, 0u, 0u, 0u };
     uint n = scene.ns + scene.nt + scene.nb;
     for (uint id = 0; id < n + scene.np; id++) {
@@ -312,7 +313,8 @@ static void test_triangle(void)
     for (int i = 0; i < 1000; i++) {
         vec3 o = vrand(-3.0f, 3.0f), target = v3(frange(0.0f, 2.0f), frange(0.0f, 2.0f), -2.0f);
         Ray r = make_ray(o, v3_scale(v3_sub(target, o), frange(0.5f, 3.0f)), 0.0f, K_INF);
-        RayPre rp = ray_prepare(r);
+        RayPre rp;
+        ray_prepare(r, &rp);
         Hit h;
         int inside = target.x + target.y < 2.0f;
         int hit = triangle_intersect(&rp, &t, r, &h);
@@ -328,7 +330,9 @@ static void test_triangle(void)
     Hit h;
     Ray down = make_ray(v3(0.5f, 0.5f, 0.0f), v3(0.0f, 0.0f, -1.0f), 0.0f, K_INF);
     Ray up = make_ray(v3(0.5f, 0.5f, -4.0f), v3(0.0f, 0.0f, 1.0f), 0.0f, K_INF);
-    RayPre rpd = ray_prepare(down), rpu = ray_prepare(up);
+    RayPre rpd, rpu;
+    ray_prepare(down, &rpd);
+    ray_prepare(up, &rpu);
     CHECK(triangle_intersect(&rpd, &t, down, &h));
     CHECK_NEAR(h.t, 2.0f, 1e-6);
     CHECK_NEAR(h.u, 0.25f, 1e-6);
@@ -339,10 +343,12 @@ static void test_triangle(void)
     Triangle flat = { v3(0.0f, 0.0f, -2.0f), 0, v3(1.0f, 1.0f, -2.0f), NO_INDEX, v3(2.0f, 2.0f, -2.0f), NO_INDEX };
     CHECK(!triangle_intersect(&rpd, &flat, down, &h));
     Ray side = make_ray(v3(-1.0f, 0.5f, -2.0f), v3(1.0f, 0.0f, 0.0f), 0.0f, K_INF);
-    RayPre rps = ray_prepare(side);
+    RayPre rps;
+    ray_prepare(side, &rps);
     CHECK(!triangle_intersect(&rps, &t, side, &h));
     Ray nan_ray = make_ray(v3(NAN, 0.0f, 0.0f), v3(0.0f, 0.0f, -1.0f), 0.0f, K_INF);
-    RayPre rpn = ray_prepare(nan_ray);
+    RayPre rpn;
+    ray_prepare(nan_ray, &rpn);
     CHECK(!triangle_intersect(&rpn, &t, nan_ray, &h));
 }
 
@@ -380,7 +386,8 @@ static void test_watertight(void)
         vec3 o = v3_add(target, v3_scale(vrand(-1.0f, 1.0f), 5.0f));
         if (k % 7 == 0) o = v3(target.x, target.y, 10.0f);   /* d has two zero components */
         Ray r = make_ray(o, v3_sub(target, o), 0.0f, K_INF);
-        RayPre rp = ray_prepare(r);
+        RayPre rp;
+        ray_prepare(r, &rp);
         int hit = 0;
         Hit h;
         for (int t = 0; t < n; t++) hit |= triangle_intersect(&rp, &tris[t], r, &h);
@@ -443,7 +450,8 @@ static void test_group_intersect(void)
         }
         float tmax = k % 5 == 0 ? frange(0.2f, 1.2f) : K_INF;
         Ray r = make_ray(o, v3_sub(target, o), k % 7 == 0 ? 0.5f : 0.0f, tmax);
-        RayPre rp = ray_prepare(r);
+        RayPre rp;
+        ray_prepare(r, &rp);
         Hit g;
         uint mask = triangle_intersect_group(&rp, rows, r.tmin, r.tmax, &g);
         Hit best = { r.tmax, NO_INDEX, 0.0f, 0.0f, NO_INDEX, 0u, 0u, 0u };
@@ -478,28 +486,30 @@ static void test_box(void)
             float dir = sgn ? -1.0f : 1.0f;
             vec3 d = v3(axis == 0 ? dir : 0.0f, axis == 1 ? dir : 0.0f, axis == 2 ? dir : 0.0f);
             r = make_ray(v3_scale(d, -3.0f), v3_scale(d, 2.0f), 0.0f, K_INF);
-            RayPre rp = ray_prepare(r);
+            RayPre rp;
+            ray_prepare(r, &rp);
             CHECK(box_intersect(&rp, b, r, &h));
             CHECK_NEAR(h.t, 1.0f, 1e-6);
             CHECK_EQ_INT((int)h.u, 2 * axis + sgn);           /* entering +x hits the -x face */
             r = make_ray(v3(0.1f, 0.2f, 0.3f), d, 0.0f, K_INF);
-            rp = ray_prepare(r);
+            ray_prepare(r, &rp);
             CHECK(box_intersect(&rp, b, r, &h));
             CHECK_EQ_INT((int)h.u, 2 * axis + (1 - sgn));     /* leaving +x through +x */
         }
     /* oblique, hits the +y face first */
     r = make_ray(v3(0.0f, 5.0f, 0.0f), v3(0.1f, -1.0f, 0.05f), 0.0f, K_INF);
-    RayPre rp = ray_prepare(r);
+    RayPre rp;
+    ray_prepare(r, &rp);
     CHECK(box_intersect(&rp, b, r, &h));
     CHECK_EQ_INT((int)h.u, 3);
     CHECK_NEAR(h.t, 4.0f, 1e-6);
     /* miss, parallel outside, a flat box hit on its face */
     r = make_ray(v3(0.0f, 5.0f, 0.0f), v3(1.0f, 0.0f, 0.0f), 0.0f, K_INF);
-    rp = ray_prepare(r);
+    ray_prepare(r, &rp);
     CHECK(!box_intersect(&rp, b, r, &h));
     Box flat = { v3(-1.0f, 0.0f, -1.0f), 0, v3(1.0f, 0.0f, 1.0f), NO_INDEX };
     r = make_ray(v3(0.2f, 3.0f, 0.1f), v3(0.0f, -1.0f, 0.0f), 0.0f, K_INF);
-    rp = ray_prepare(r);
+    ray_prepare(r, &rp);
     CHECK(box_intersect(&rp, flat, r, &h));
     CHECK_NEAR(h.t, 3.0f, 1e-6);
     CHECK_EQ_INT((int)h.u, 3);
@@ -1109,7 +1119,8 @@ static void packets_check(int wide)
             if (i % 17 == 0) r[(i + 5) % TRACE_PACKET].d = v3_neg(r[(i + 5) % TRACE_PACKET].d);
             uint neg = 0, mixed = 0;
             for (int l = 0; l < TRACE_PACKET; l++) {
-                RayPre p = ray_prepare(r[l]);
+                RayPre p;
+                ray_prepare(r[l], &p);
                 if (l == 0) neg = p.neg;
                 mixed |= p.neg ^ neg;
             }
@@ -1529,7 +1540,8 @@ static void check_mesh_brute_force(const char *what, int rays)
         }
         const SceneView *v = walk_bvh ? &m.wide_view : &m.view;
         Hit kd = trace_closest(v, ray);
-        RayPre rp = ray_prepare(ray);
+        RayPre rp;
+        ray_prepare(ray, &rp);
         Hit bf = { ray.tmax, NO_INDEX, 0.0f, 0.0f, NO_INDEX, 0u, 0u, 0u };
         for (uint id = 0; id < nt; id++) {
             Ray rr = ray;
@@ -1606,7 +1618,8 @@ static void watertight_mesh(void)
         Hit h = trace_closest(v, ray);
         if (h.prim == NO_INDEX) {
             if (misses++ < 3) {
-                RayPre rp = ray_prepare(ray);
+                RayPre rp;
+                ray_prepare(ray, &rp);
                 int bf = 0;
                 for (uint id = 0; id < nt; id++) { Hit hh; bf += triangle_intersect(&rp, &m.scene.triangles[id], ray, &hh); }
                 fprintf(stderr, "  miss: o=(%.9g %.9g %.9g) target=(%.9g %.9g %.9g) brute force hits %d\n", o.x, o.y, o.z, target.x,

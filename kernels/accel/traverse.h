@@ -50,7 +50,8 @@ KFN Hit trace_closest_in(const SceneView *sc, int tree, Ray ray)
 {
     Hit best = hit_none(ray);
     trace_planes(sc, ray, 0, &best);
-    RayPre rp = ray_prepare(ray);
+    RayPre rp;
+    ray_prepare(ray, &rp);
     trace_walk(sc, tree, ray, &rp, 0, &best);
     return best;
 }
@@ -61,7 +62,8 @@ KFN Hit trace_any_hit_in(const SceneView *sc, int tree, Ray ray)
 {
     Hit h = hit_none(ray);
     if (trace_planes(sc, ray, 1, &h)) return h;
-    RayPre rp = ray_prepare(ray);
+    RayPre rp;
+    ray_prepare(ray, &rp);
     trace_walk(sc, tree, ray, &rp, 1, &h);
     return h;
 }

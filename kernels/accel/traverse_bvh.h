@@ -313,7 +313,7 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
              * top level, whose entries are on this stack still */
             GLOBAL const Instance *x = sc->instances + ref;
             oray = instance_ray_seen(sc, ref, x, ray);
-            orp = ray_prepare(oray);
+            ray_prepare(oray, &orp);
             trace_kd_proto(sc, sc->kd_protos + x->root, oray, &orp, any, (x->flags & INST_WORLD) ? NO_INDEX : ref,
                            best);
             if (any && best->prim != NO_INDEX) return;
@@ -330,7 +330,7 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
             top = 0;
             inst = (x->flags & INST_WORLD) ? NO_INDEX : ref;
             oray = instance_ray_seen(sc, ref, x, ray);
-            orp = ray_prepare(oray);
+            ray_prepare(oray, &orp);
             w = bvh_ray(oray, &orp);
             ref = x->root;
             kind = BVH_CHILD_NODE;
@@ -521,7 +521,7 @@ KFN_INLINE void trace_packet_wide(const SceneView *sc, const Ray *rays, int any,
         if (trace_planes(sc, ray, any, &hits[l]) && any) continue;
         float s = ray.o.x + ray.o.y + ray.o.z + ray.d.x + ray.d.y + ray.d.z;
         if (!(s == s) || sc->params->n_bvh_nodes == 0u) continue;
-        rp[l] = ray_prepare(ray);
+        ray_prepare(ray, &rp[l]);
         if (lanes == 0u) neg = rp[l].neg;
         mixed |= rp[l].neg ^ neg;
         lanes |= 1u << l;

@@ -232,7 +232,7 @@ KFN_INLINE void trace_ray_begin(const SceneView *sc, Ray ray, int any, TraceRay 
     w->sp = 0;
     w->t0 = w->t1 = 0.0f;
     if (trace_planes(sc, ray, any, &t->best)) return;
-    *rp = ray_prepare(ray);
+    ray_prepare(ray, rp);
     t->active = kd_walk_begin(sc, ray, rp, w);
 }
 

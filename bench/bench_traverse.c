@@ -41,8 +41,10 @@
  * BVH's against the C BVH walk;
  * "BVH vs kd" counts rays whose closest hit, all of it, or occlusion differs between
  * the trees: both follow one tie rule, leaf_test); the
- * scalar C traversal (kernels compiled as C) of the kd-tree in pairs (C) and of the BVH
- * (C-W) on 1 and 2 threads; Embree rtcIntersect1 /
+ * scalar C traversal (kernels compiled as C) of the kd-tree in pairs (C, compiled here for
+ * any x86-64) and of the BVH (C-W: the scalar device's own walk, ScalarPaths' closest and
+ * any of the build it picks for the mesh, which on a processor with AVX2 is the build
+ * for AVX2; its name is printed) on 1 and 2 threads; Embree rtcIntersect1 /
  * rtcOccluded1 and rtcIntersect8 / rtcOccluded8 packets (8 consecutive rays) on 1 and 2
  * threads; the ratios of each PoCL kernel to Embree single rays per CPU-second (issue 3
  * asked 0.5 or more on bunny and dragon, issue 12 asks 1.0 for every kind of ray). Per
@@ -68,6 +70,8 @@
 #include "accel/bvh.h"
 #include "accel/kdtree.h"
 #include "device/device.h"
+#include "device/kernel_features.h"
+#include "device/scalar_paths.h"
 #include "io/mesh_load.h"
 #include "device/ocl_program.h"
 #include "render/render_scene.h"
@@ -110,6 +114,7 @@ typedef struct {
     Bvh bvh;                     /* the 8-wide BVH (one thread) */
     DeviceScene ds;              /* both trees and the triangles, every other buffer empty */
     SceneView view;
+    const ScalarPaths *paths;    /* the scalar device's build of the kernels for this mesh */
     double load_seconds;
 } Mesh;
 
@@ -140,6 +145,7 @@ static int mesh_open(Mesh *m, const char *name, Error *err)
     render_scene_use_kdtree(&m->ds, &m->tree);
     render_scene_use_bvh(&m->ds, &m->bvh);
     device_scene_view(&m->ds, &m->view);
+    m->paths = scalar_paths_pick(kernel_scene_features(&m->ds));
     return 0;
 }
 
@@ -178,6 +184,7 @@ static vec3 unit_d(double x, double y, double z)
 
 typedef struct {
     const SceneView *sc;
+    const ScalarPaths *paths;    /* WALK_WIDE: the scalar device's build for the mesh */
     const RaySet *set;
     int walk;                    /* WALK_*: the kd-tree one ray or two at a time, or the BVH */
     Hit *hits;
@@ -199,8 +206,8 @@ static void *trace_worker(void *arg)
         uint i = begin;
         if (j->walk == WALK_WIDE) {
             for (; i < end; i++) {
-                if (s->any) j->occ[i] = (uint)trace_any_in(j->sc, TREE_BVH, s->rays[i]);
-                else j->hits[i] = trace_closest_in(j->sc, TREE_BVH, s->rays[i]);
+                if (s->any) j->occ[i] = (uint)j->paths->any(j->sc, s->rays[i]);
+                else j->hits[i] = j->paths->closest(j->sc, s->rays[i]);
             }
         } else if (j->walk == WALK_PAIRS && s->any) {
             for (; i + 1 < end; i += 2) {
@@ -222,10 +229,11 @@ static void *trace_worker(void *arg)
 
 /* Traces the set with `threads` threads by `walk` (WALK_*); returns the seconds it
  * took. */
-static double trace_c(const SceneView *sc, const RaySet *s, int threads, int walk, Hit *hits, uint *occ)
+static double trace_c(const Mesh *m, const RaySet *s, int threads, int walk, Hit *hits, uint *occ)
 {
     TraceJob j;
-    j.sc = sc;
+    j.sc = &m->view;
+    j.paths = m->paths;
     j.set = s;
     j.walk = walk;
     j.hits = hits;
@@ -290,7 +298,7 @@ static int make_rays(Mesh *m, int size, RaySet sets[N_SETS])
             p->rays[(size_t)y * size + x] = ray;
         }
     p->n = n;
-    trace_c(&m->view, p, 2, WALK_SINGLE, hits, NULL);
+    trace_c(m, p, 2, WALK_SINGLE, hits, NULL);
     for (uint i = 0; i < n; i++) {
         if (hits[i].prim == NO_INDEX) continue;
         const Triangle *t = &m->scene.triangles[hits[i].prim];
@@ -323,8 +331,8 @@ static int make_rays(Mesh *m, int size, RaySet sets[N_SETS])
         sets[k].wide_hits = malloc((sets[k].n + 1) * sizeof *sets[k].wide_hits);
         sets[k].wide_occ = malloc((sets[k].n + 1) * sizeof *sets[k].wide_occ);
         if (!sets[k].ref_hits || !sets[k].ref_occ || !sets[k].wide_hits || !sets[k].wide_occ) return -1;
-        trace_c(&m->view, &sets[k], 2, WALK_SINGLE, sets[k].ref_hits, sets[k].ref_occ);
-        trace_c(&m->view, &sets[k], 2, WALK_WIDE, sets[k].wide_hits, sets[k].wide_occ);
+        trace_c(m, &sets[k], 2, WALK_SINGLE, sets[k].ref_hits, sets[k].ref_occ);
+        trace_c(m, &sets[k], 2, WALK_WIDE, sets[k].wide_hits, sets[k].wide_occ);
     }
     return 0;
 }
@@ -813,6 +821,7 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
            (double)((size_t)m.bvh.n_nodes * sizeof(BvhNode) + (size_t)m.bvh.n_leaf_prims * 4u) / (double)(nt ? nt : 1),
            (double)((size_t)m.bvh.n_nodes * sizeof(BvhNode)) / (double)(nt ? nt : 1),
            (double)((size_t)m.bvh.n_leaf_prims * 4u) / (double)(nt ? nt : 1));
+    printf("C-W: the scalar device's walk, its build '%s'\n", m.paths->name);
     if (have_embree) {
         char ratio[96] = "";
         /* a ratio of times below a millisecond says nothing */
@@ -871,9 +880,9 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
             double sc[MAX_REPS], cc[MAX_REPS], sw[MAX_REPS], cw[MAX_REPS], sp[N_KERNELS][MAX_REPS],
                 cp[N_KERNELS][MAX_REPS], s1[MAX_REPS], c1[MAX_REPS], s8[MAX_REPS], c8[MAX_REPS];
             for (int i = 0; i < o->reps; i++) {
-                sc[i] = trace_c(&m.view, s, th, WALK_PAIRS, tmp_h, tmp_o);
+                sc[i] = trace_c(&m, s, th, WALK_PAIRS, tmp_h, tmp_o);
                 cc[i] = last_cpu_seconds;
-                sw[i] = trace_c(&m.view, s, th, WALK_WIDE, tmp_h, tmp_o);
+                sw[i] = trace_c(&m, s, th, WALK_WIDE, tmp_h, tmp_o);
                 cw[i] = last_cpu_seconds;
                 for (int kp = 0; kp < N_KERNELS && pocl_ok[t]; kp++) {
                     sp[kp][i] = pocl_trace(&pocl[t], s, kp);

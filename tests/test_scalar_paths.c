@@ -2,7 +2,8 @@
  * test_scalar_paths.c — the scalar device's builds of its per-sample code
  * (host/device/scalar_paths.h): the leanest that covers a scene's kernel features is
  * picked, and every build renders a scene it covers with the same bits as the build of
- * everything (which the other tests compare with PoCL).
+ * everything (which the other tests compare with PoCL); on a processor with AVX2 the
+ * same for the builds compiled for it, which the scalar device then picks.
  */
 #include <string.h>
 
@@ -12,15 +13,33 @@
 #include "io/scene_load.h"
 #include "render/render_scene.h"
 
-static const ScalarPaths *const builds[] = { &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all };
-#define N_BUILDS (sizeof builds / sizeof builds[0])
+/* The builds for any x86-64 processor (or any other), then those for AVX2: the latter
+ * run only where the processor has it (n_builds). */
+static const ScalarPaths *const builds[] = {
+    &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all,
+#if SCALAR_PATHS_HAVE_AVX2
+    &scalar_paths_basic_avx2, &scalar_paths_lean_avx2, &scalar_paths_all_avx2,
+#endif
+};
+#define N_BASE_BUILDS 3u
+static size_t n_builds;
 
 /* Whether build b has every feature of `features`. */
 static int covers(const ScalarPaths *b, unsigned features) { return (features & ~b->features) == 0u; }
 
-/* For any feature set: a build that has it, and no leaner one would do. */
+/* The build for AVX2 of the same features as build b (one of the first N_BASE_BUILDS). */
+static const ScalarPaths *avx2_twin(const ScalarPaths *b)
+{
+    for (size_t k = 0; k < N_BASE_BUILDS; k++)
+        if (builds[k] == b && N_BASE_BUILDS + k < sizeof builds / sizeof builds[0]) return builds[N_BASE_BUILDS + k];
+    return NULL;
+}
+
+/* For any feature set: a build that has it, and no leaner one would do; on this
+ * processor the AVX2 twin where it has AVX2. */
 static void test_pick_leanest(void)
 {
+#define scalar_paths_pick(f) scalar_paths_pick_isa(f, 0)
     CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_MAT_EMISSIVE) == &scalar_paths_basic);
     CHECK(scalar_paths_pick(KF_KDTREE | KF_SPHERES | KF_BOXES | KF_PLANES | KF_MAT_DIFFUSE) == &scalar_paths_basic);
     CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_TEXTURES) == &scalar_paths_lean);
@@ -42,9 +61,14 @@ static void test_pick_leanest(void)
         }
         const ScalarPaths *p = scalar_paths_pick(f);
         CHECK_MSG(covers(p, f), "features 0x%x: picked '%s' (0x%x)", f, p->name, p->features);
-        for (size_t k = 0; k < N_BUILDS && builds[k] != p; k++)
+        for (size_t k = 0; k < N_BASE_BUILDS && builds[k] != p; k++)
             CHECK_MSG(!covers(builds[k], f), "features 0x%x: picked '%s', but '%s' has them", f, p->name,
                       builds[k]->name);
+#undef scalar_paths_pick
+        const ScalarPaths *q = scalar_paths_pick_isa(f, 1), *twin = avx2_twin(p);
+        CHECK_MSG(q == (twin ? twin : p), "features 0x%x: for AVX2 picked '%s'", f, q->name);
+        CHECK(q->features == p->features && q->avx2 == (twin != NULL) && p->avx2 == 0);
+        CHECK(scalar_paths_pick(f) == (scalar_paths_avx2_usable() ? q : p));
     }
 }
 
@@ -74,14 +98,14 @@ static void check_scene(const char *path, int kdtree, const ScalarPaths *expect)
     CHECK_MSG((st = render_scene_prepare(&s, 1, &rs, &err)) == ST_OK, "%s: %s", path, err.msg);
     if (st == ST_OK) {
         unsigned f = kernel_scene_features(&rs.ds);
-        const ScalarPaths *p = scalar_paths_pick(f);
+        const ScalarPaths *p = scalar_paths_pick_isa(f, 0);
         CHECK_MSG(p == expect, "%s (features 0x%x): picked '%s', expected '%s'", path, f, p->name, expect->name);
         SceneView sv;
         device_scene_view(&rs.ds, &sv);
         uint n_pixels = rs.ds.params.width * rs.ds.params.height;
-        for (size_t k = 0; k + 1 < N_BUILDS; k++) {
+        for (size_t k = 0; k < n_builds; k++) {
             const ScalarPaths *b = builds[k];
-            if (!covers(b, f)) continue;
+            if (b == &scalar_paths_all || !covers(b, f)) continue;
             size_t samples = 0, same = 0;
             for (uint pixel = 0; pixel < n_pixels; pixel++) {
                 for (uint sample = 0; sample < 3u; sample++) {
@@ -95,9 +119,28 @@ static void check_scene(const char *path, int kdtree, const ScalarPaths *expect)
                     same += (ra == rb && same_bits(la, lb)) + (wa == wb && same_bits(wla, wlb));
                 }
             }
-            fprintf(stderr, "  %s: build '%s': %zu of %zu samples bit-identical to build 'all'\n", path, b->name,
-                    same, samples);
-            CHECK(same == samples);
+            /* the queries alone (bench_traverse times them): rays in a spread of
+             * directions from the middle of the camera's focus plane, inside the
+             * scene, every other one stopped short */
+            const Camera *cam = &rs.ds.params.camera;
+            vec3 mid = { cam->corner.x + 0.5f * (cam->horizontal.x - cam->vertical.x),
+                         cam->corner.y + 0.5f * (cam->horizontal.y - cam->vertical.y),
+                         cam->corner.z + 0.5f * (cam->horizontal.z - cam->vertical.z) };
+            size_t rays = 0, same_rays = 0, hits = 0;
+            for (uint i = 0; i < 512u; i++) {
+                float z = 1.0f - (2.0f * (float)i + 1.0f) / 512.0f, r = sqrtf(1.0f - z * z);
+                float phi = 2.39996323f * (float)i;   /* the golden angle: a Fibonacci sphere */
+                Ray ray = { .o = mid, .tmin = 0.0f,
+                            .d = { r * cosf(phi), r * sinf(phi), z }, .tmax = (i & 1u) ? 2.0f : 1e30f };
+                Hit ha = scalar_paths_all.closest(&sv, ray), hb = b->closest(&sv, ray);
+                rays++;
+                hits += ha.prim != NO_INDEX;
+                same_rays += memcmp(&ha, &hb, sizeof ha) == 0 &&
+                             scalar_paths_all.any(&sv, ray) == b->any(&sv, ray);
+            }
+            fprintf(stderr, "  %s: build '%s': %zu of %zu samples and %zu of %zu rays (%zu hits) bit-identical to "
+                    "build 'all'\n", path, b->name, same, samples, same_rays, rays, hits);
+            CHECK(same == samples && same_rays == rays && hits > 0);
         }
     }
     render_scene_free(&rs);
@@ -121,6 +164,9 @@ static void test_fog(void) { check_scene("scenes/fog.scene", 0, &scalar_paths_al
 
 int main(void)
 {
+    n_builds = scalar_paths_avx2_usable() ? sizeof builds / sizeof builds[0] : N_BASE_BUILDS;
+    if (n_builds == N_BASE_BUILDS && SCALAR_PATHS_HAVE_AVX2)
+        fprintf(stderr, "  this processor has no AVX2: its builds are not rendered\n");
     RUN(test_pick_leanest);
     RUN(test_cornell_box);
     RUN(test_one_weekend);

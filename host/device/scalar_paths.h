@@ -22,8 +22,10 @@
 #include "scene_view.h"
 
 typedef struct ScalarPaths {
-    const char *name;     /* for --profile and the tests: "basic", "lean", "all" */
+    const char *name;     /* for --profile and the tests: "basic", "lean", "all", and with
+                           * "-avx2" for the builds for AVX2 */
     unsigned features;    /* the CLPT_FEATURES it was compiled with */
+    int avx2;             /* 1: compiled for x86-64 processors with AVX2 (-mavx2) */
     /* one camera sample's path to its end (path_run, kernels/integrator/path.h, as k_path
      * runs it): its radiance; returns the rays it traced */
     uint64_t (*path)(const SceneView *sc, uint pixel, uint sample, vec3 *radiance);
@@ -31,6 +33,10 @@ typedef struct ScalarPaths {
     uint64_t (*path_timed)(const SceneView *sc, uint pixel, uint sample, vec3 *radiance, double *t);
     /* the classic ray tracer's and the auxiliary images' sample (kernels/integrator/whitted.h) */
     vec3 (*whitted)(const SceneView *sc, uint pixel, uint sample, uint *rays);
+    /* the closest-hit and any-hit queries of the renderer (trace_closest, trace_any,
+     * kernels/accel/traverse.h), alone: bench_traverse times the scalar device's walk */
+    Hit (*closest)(const SceneView *sc, Ray ray);
+    int (*any)(const SceneView *sc, Ray ray);
 } ScalarPaths;
 
 /* The builds, leanest first (each file's comment says what it has): the basic materials
@@ -40,8 +46,30 @@ extern const ScalarPaths scalar_paths_basic;
 extern const ScalarPaths scalar_paths_lean;
 extern const ScalarPaths scalar_paths_all;
 
+/* On x86-64 each build is compiled twice: for any x86-64 processor (SSE2), and with
+ * -mavx2 for the processors that have AVX2 (Intel since 2013, AMD since 2015), where a
+ * BVH node's eight boxes and a group of eight triangles are each tested as one 8-wide
+ * vector instead of two 4-wide halves (K_VEC8, kernels/util/compat.h). Both compute
+ * the same IEEE operations per lane without contraction, so they render the same bits;
+ * the processor decides which runs (as Cycles and Embree pick their kernels). */
+#if defined(__x86_64__)
+#define SCALAR_PATHS_HAVE_AVX2 1
+extern const ScalarPaths scalar_paths_basic_avx2;
+extern const ScalarPaths scalar_paths_lean_avx2;
+extern const ScalarPaths scalar_paths_all_avx2;
+#else
+#define SCALAR_PATHS_HAVE_AVX2 0
+#endif
+
+/* 1 when this processor and its operating system run the AVX2 builds. */
+int scalar_paths_avx2_usable(void);
+
 /* The leanest build whose features include `features` (kernel_scene_features's, with
- * kernel_params_features's); the build of everything when none is leaner. */
+ * kernel_params_features's), the build of everything when none is leaner: for AVX2
+ * when `avx2` is set and there are such builds. */
+const ScalarPaths *scalar_paths_pick_isa(unsigned features, int avx2);
+
+/* The same for this processor: the AVX2 builds where it has AVX2. */
 const ScalarPaths *scalar_paths_pick(unsigned features);
 
 #endif /* CLPT_SCALAR_PATHS_H */

@@ -8,10 +8,27 @@
  *                        kernels/types.h, which otherwise compiles everything)
  *   SCALAR_PATHS         the name of the ScalarPaths it defines (scalar_paths_NAME)
  *   SCALAR_PATHS_LABEL   its name as text ("NAME")
+ * and the Makefile compiles each file a second time on x86-64 with -mavx2
+ * -DSCALAR_PATHS_AVX2, which appends _avx2 to the name (scalar_paths.h says why).
  * Everything else here is static: each build's copy of the kernels is its own.
  */
 #if !defined(CLPT_FEATURES) || !defined(SCALAR_PATHS) || !defined(SCALAR_PATHS_LABEL)
 #error "define CLPT_FEATURES, SCALAR_PATHS and SCALAR_PATHS_LABEL before including scalar_paths_impl.h"
+#endif
+
+#ifdef SCALAR_PATHS_AVX2
+#ifndef __AVX2__
+#error "SCALAR_PATHS_AVX2: compile with -mavx2"
+#endif
+#define SCALAR_PATHS_PASTE2(a, b) a##b
+#define SCALAR_PATHS_PASTE(a, b) SCALAR_PATHS_PASTE2(a, b)
+#define SCALAR_PATHS_BUILD SCALAR_PATHS_PASTE(SCALAR_PATHS, _avx2)
+#define SCALAR_PATHS_NAME SCALAR_PATHS_LABEL "-avx2"
+#define SCALAR_PATHS_ISA_AVX2 1
+#else
+#define SCALAR_PATHS_BUILD SCALAR_PATHS
+#define SCALAR_PATHS_NAME SCALAR_PATHS_LABEL
+#define SCALAR_PATHS_ISA_AVX2 0
 #endif
 
 #include <string.h>
@@ -62,10 +79,16 @@ static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, 
     return n_rays;
 }
 
-const ScalarPaths SCALAR_PATHS = {
-    .name = SCALAR_PATHS_LABEL,
+static Hit query_closest(const SceneView *sc, Ray ray) { return trace_closest(sc, ray); }
+static int query_any(const SceneView *sc, Ray ray) { return trace_any(sc, ray); }
+
+const ScalarPaths SCALAR_PATHS_BUILD = {
+    .name = SCALAR_PATHS_NAME,
     .features = CLPT_FEATURES,
+    .avx2 = SCALAR_PATHS_ISA_AVX2,
     .path = render_path,
     .path_timed = render_path_timed,
     .whitted = whitted_sample,
+    .closest = query_closest,
+    .any = query_any,
 };

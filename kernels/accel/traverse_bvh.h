@@ -34,10 +34,12 @@
  * floats, comparisons IT): leaves the lanes whose box the ray enters within [tmin,
  * tmax] as bits in `mask`, and each lane's entry distance in ta. ROW(v, r) puts row r
  * of the boxes (lo x, hi x, lo y, hi y, lo z, hi z) into v: loaded from a float node,
- * or decoded from a compressed top-level node. OpenCL runs the 8 lanes as one float8;
- * C runs them as two float4 halves, because without AVX gcc splits 8-wide vectors
- * badly (as triangle_intersect_group, intersect.h); the same operations per lane give
- * the same bits either way. min and max are selects: no NaN reaches them (see above). */
+ * or decoded from a compressed top-level node. OpenCL runs the 8 lanes as one float8,
+ * and so does C compiled for AVX2 (K_VEC8, compat.h; the scalar device's AVX2 builds);
+ * other C runs them as two float4 halves, because without AVX gcc splits 8-wide
+ * vectors badly (as triangle_intersect_group, intersect.h); the same operations per
+ * lane give the same bits either way. min and max are selects: no NaN reaches them
+ * (see above). */
 #define BVH_LANES_BODY(ROW, VT, IT, W, STORE, SPLAT, SELECT, BITS)                       \
     VT a, b;                                                                             \
     ROW(a, w->nx);                                                                       \
@@ -70,11 +72,11 @@ typedef struct {
  * meta, which a step count q < 2^8 ors into the mantissa. */
 #define BVH_TOP_BIAS(meta, k) ((((meta) >> (8u * (k))) & 0xffu) << 23)
 
+/* BVH_LANES_BODY on one float8 (all 8 lanes, first 0) and on a float4 half (lanes first
+ * .. first + 3): K_VEC8 (compat.h) says which a float node's test uses. */
+#define BVH_LANES8(ROW) BVH_LANES_BODY(ROW, float8, int8, 8, k_store8, k_splat8, k_select8, k_bits8)
+#define BVH_ROW8(v, r) k_load8(v, nd->box[r] + first)
 #ifdef KERNEL_OPENCL
-#define K_SPLAT8(x) ((float8)(x))
-/* BVH_LANES_BODY on this target's vectors: one float8 */
-#define BVH_LANES(ROW) BVH_LANES_BODY(ROW, float8, int8, 8, k_store8, K_SPLAT8, k_select8, k_bits8)
-#define BVH_ROW(v, r) k_load8(v, nd->box[r] + first)
 #if KF_HAS(KF_INSTANCES)
 /* A compressed top-level node's row r decoded as bvh_top_plane (host/accel/bvh_top.c)
  * computes the planes it checks: the bytes or'ed into the bias's mantissa, then one add
@@ -85,37 +87,44 @@ typedef struct {
     ((v) = as_float8(convert_uint8(vload8(0, (GLOBAL const uchar *)nd->q[r])) |          \
                      (uint8)(BVH_TOP_BIAS(meta, (r) >> 1))) +                            \
            (float8)(nd->offset[(r) >> 1]))
+#define BVH_TOP_LANES(ROW) BVH_LANES8(ROW)
 #endif
 #else
 #define K_SPLAT4(x) ((float4){ (x), (x), (x), (x) })
 #define k_select4(a, b, m) ((float4)(((int4)(a) & ~(m)) | ((int4)(b) & (m))))
-/* BVH_LANES_BODY on this target's vectors: a float4 half (lanes first .. first + 3) */
-#define BVH_LANES(ROW) BVH_LANES_BODY(ROW, float4, int4, 4, k_store4, K_SPLAT4, k_select4, k_bits4)
-#define BVH_ROW(v, r) k_load4(v, nd->box[r] + first)
+#define BVH_LANES4(ROW) BVH_LANES_BODY(ROW, float4, int4, 4, k_store4, K_SPLAT4, k_select4, k_bits4)
+#define BVH_ROW4(v, r) k_load4(v, nd->box[r] + first)
 #if KF_HAS(KF_INSTANCES)
 /* Lanes first .. first + 3 of a compressed node's row r: bytes 0 .. 3 of one word
- * (k_bytes4: the low byte first, as OpenCL's load reads them on little-endian devices). */
+ * (k_bytes4: the low byte first, as OpenCL's load reads them on little-endian devices).
+ * The top level stays in halves with AVX too: its levels are few. */
 KFN_INLINE float4 bvh_top_row4(GLOBAL const BvhTopNode *nd, uint meta, uint r, uint first)
 {
     int4 bits = k_bytes4(nd->q[r][first >> 2]) | (int)BVH_TOP_BIAS(meta, r >> 1);
     return (float4)bits + K_SPLAT4(nd->offset[r >> 1]);
 }
 #define BVH_TOP_ROW(v, r) ((v) = bvh_top_row4(nd, meta, r, first))
+#define BVH_TOP_LANES(ROW) BVH_LANES4(ROW)
 #endif
 #endif
 
-/* The slab test of float node nd's lanes from `first` (all 8 in OpenCL, a half in C). */
+/* The slab test of float node nd's lanes from `first` (all 8 with K_VEC8, else a half). */
 KFN_INLINE uint bvh_lanes(GLOBAL const BvhNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
 {
-    BVH_LANES(BVH_ROW)
+#if K_VEC8
+    BVH_LANES8(BVH_ROW8)
+#else
+    BVH_LANES4(BVH_ROW4)
+#endif
     return mask;
 }
 #if KF_HAS(KF_INSTANCES)
-/* The same for a compressed top-level node, its rows decoded by BVH_TOP_ROW. */
+/* The same for a compressed top-level node, its rows decoded by BVH_TOP_ROW (all 8 lanes
+ * in OpenCL, a half in C). */
 KFN_INLINE uint bvh_top_lanes(GLOBAL const BvhTopNode *nd, const BvhRay *w, uint first, float tfar, float *ta)
 {
     uint meta = nd->meta;
-    BVH_LANES(BVH_TOP_ROW)
+    BVH_TOP_LANES(BVH_TOP_ROW)
     return mask;
 }
 #endif
@@ -125,7 +134,7 @@ KFN_INLINE uint bvh_top_lanes(GLOBAL const BvhTopNode *nd, const BvhRay *w, uint
 KFN_INLINE uint bvh_node_test(GLOBAL const BvhNode *nd, const BvhRay *w, float tmax, float *ta)
 {
     float tfar = tmax * KD_T_ABOVE;
-#ifdef KERNEL_OPENCL
+#if K_VEC8
     return bvh_lanes(nd, w, 0u, tfar, ta);
 #else
     return bvh_lanes(nd, w, 0u, tfar, ta) | (bvh_lanes(nd, w, 4u, tfar, ta) << 4);

@@ -184,9 +184,10 @@ KFN int triangle_intersect(const RayPre *rp, GLOBAL const Triangle *tri, Ray ray
  * `rows` are the group's corners, 9 rows of KD_GROUP floats (types.h). Each lane
  * computes the very operations of triangle_intersect, so a lane's t, u and v are bit
  * for bit what triangle_intersect gives for that triangle, tmax fixed for the group.
- * OpenCL runs the 8 lanes as one float8; C runs them as two float4 halves, because
- * without AVX (the C build targets any x86-64) gcc splits 8-wide vectors badly, and
- * the same operations per lane give the same bits either way.
+ * OpenCL runs the 8 lanes as one float8, as does C compiled with AVX (K_VEC8,
+ * compat.h: the scalar device's AVX2 builds); C for any x86-64 runs them as two float4
+ * halves, because without AVX gcc splits 8-wide vectors badly. The same operations per
+ * lane give the same bits either way.
  *
  * TRI_LANES_BODY is the body for W lanes of vector type VT (comparisons IT) starting
  * at lane `first`: it leaves the lanes hit as bits in `mask` and, when there are any,
@@ -241,7 +242,7 @@ KFN int triangle_intersect(const RayPre *rp, GLOBAL const Triangle *tri, Ray ray
         STORE(v, va + first);                                                            \
     }
 
-#ifdef KERNEL_OPENCL
+#if K_VEC8
 KFN_INLINE uint tri_lanes(const RayPre *rp, GLOBAL const float *rows, int first, float tmin, float tmax,
                           float *ta, float *ua, float *va)
 {
@@ -264,7 +265,7 @@ KFN_INLINE uint triangle_intersect_group(const RayPre *rp, GLOBAL const float *r
                                          Hit *hit)
 {
     float ta[KD_GROUP], ua[KD_GROUP], va[KD_GROUP];
-#ifdef KERNEL_OPENCL
+#if K_VEC8
     uint mask = tri_lanes(rp, rows, 0, tmin, tmax, ta, ua, va);
 #else
     uint mask = tri_lanes(rp, rows, 0, tmin, tmax, ta, ua, va);

@@ -66,6 +66,9 @@ typedef long kint64;         /* 64-bit in every OpenCL C implementation */
 #define k_store8(v, p) vstore8(v, 0, p)
 /* per lane: b where the mask m's lane is set (-1), else a */
 #define k_select8(a, b, m) select(a, b, m)
+#define k_splat8(x) ((float8)(x))
+/* 8 lanes run as one vector (float8): in OpenCL always */
+#define K_VEC8 1
 /* A comparison's 8 lanes (-1 or 0 each) as bits, lane i at 1 << i, and whether any is
  * set. On x86 CPUs with AVX (PoCL) one vmovmskps: LLVM compiles the lane-by-lane form
  * below into a tree of shuffles and ORs, and these reductions sit in every node and
@@ -108,8 +111,9 @@ static inline float k_int_as_float(int i) { float f; memcpy(&f, &i, sizeof f); r
  * same IEEE operation as OpenCL does. Kernel code uses only operators (with vector or
  * scalar operands), comparisons (-1 or 0 per lane, as OpenCL's), lane subscripts,
  * k_load4 (v = the 4 floats at p) and k_store4 on them. Kernels that use 8 lanes on
- * OpenCL (float8, k_load8, k_store8) run them as two halves of 4 in C: without AVX gcc
- * splits 8-wide vectors badly (intersect.h). */
+ * OpenCL (float8, k_load8, k_store8) run them as two halves of 4 in C unless it is
+ * compiled with AVX (K_VEC8 below): without AVX gcc splits 8-wide vectors badly
+ * (intersect.h). */
 typedef float float4 __attribute__((vector_size(16)));
 typedef int int4 __attribute__((vector_size(16)));
 #define k_load4(v, p) memcpy(&(v), (p), sizeof(float4))
@@ -131,14 +135,25 @@ static inline int4 k_bytes4(uint w)
     return (int4){ (int)(w & 0xffu), (int)((w >> 8) & 0xffu), (int)((w >> 16) & 0xffu), (int)(w >> 24) };
 }
 #endif
-/* 8 lanes for the packet walk (traverse.h), whose C build is its reference, not a
- * fast path */
+/* 8 lanes: the packet walk's (traverse.h; in C its reference, not a fast path), and
+ * with AVX the node and triangle-group tests' */
 typedef float float8 __attribute__((vector_size(32)));
 typedef int int8 __attribute__((vector_size(32)));
 #define k_load8(v, p) memcpy(&(v), (p), sizeof(float8))
 #define k_store8(v, p) memcpy((p), &(v), sizeof(float8))
 /* a vector cast keeps the bits (GCC's vector extension) */
 #define k_select8(a, b, m) ((float8)(((int8)(a) & ~(m)) | ((int8)(b) & (m))))
+#define k_splat8(x) ((float8){ (x), (x), (x), (x), (x), (x), (x), (x) })
+/* Whether the hot 8-lane tests (a BVH node's boxes, a group of triangles) run as one
+ * float8 (K_VEC8 1) or as two float4 halves: with AVX (a build for x86-64-v3) one
+ * vector register holds the 8 lanes; without it gcc splits 8-wide vectors badly. */
+#if defined(__AVX__)
+#define K_VEC8 1
+#define k_bits8(m) ((uint)__builtin_ia32_movmskps256((float8)(m)))
+#define k_any8(m) (k_bits8(m) != 0u)
+#else
+#define K_VEC8 0
+#endif
 /* A comparison's 4 lanes as bits (as k_bits8 above): one movmskps on x86 (SSE, in every
  * x86-64), which gcc does not find in the lane-by-lane form. */
 #if defined(__SSE__)

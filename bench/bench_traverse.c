@@ -206,8 +206,8 @@ static void *trace_worker(void *arg)
         uint i = begin;
         if (j->walk == WALK_WIDE) {
             for (; i < end; i++) {
-                if (s->any) j->occ[i] = (uint)j->paths->any(j->sc, s->rays[i]);
-                else j->hits[i] = j->paths->closest(j->sc, s->rays[i]);
+                if (s->any) j->occ[i] = (uint)j->paths->any(j->sc, &s->rays[i]);
+                else j->paths->closest(j->sc, &s->rays[i], &j->hits[i]);
             }
         } else if (j->walk == WALK_PAIRS && s->any) {
             for (; i + 1 < end; i += 2) {

@@ -132,11 +132,13 @@ static void check_scene(const char *path, int kdtree, const ScalarPaths *expect)
                 float phi = 2.39996323f * (float)i;   /* the golden angle: a Fibonacci sphere */
                 Ray ray = { .o = mid, .tmin = 0.0f,
                             .d = { r * cosf(phi), r * sinf(phi), z }, .tmax = (i & 1u) ? 2.0f : 1e30f };
-                Hit ha = scalar_paths_all.closest(&sv, ray), hb = b->closest(&sv, ray);
+                Hit ha, hb;
+                scalar_paths_all.closest(&sv, &ray, &ha);
+                b->closest(&sv, &ray, &hb);
                 rays++;
                 hits += ha.prim != NO_INDEX;
                 same_rays += memcmp(&ha, &hb, sizeof ha) == 0 &&
-                             scalar_paths_all.any(&sv, ray) == b->any(&sv, ray);
+                             scalar_paths_all.any(&sv, &ray) == b->any(&sv, &ray);
             }
             fprintf(stderr, "  %s: build '%s': %zu of %zu samples and %zu of %zu rays (%zu hits) bit-identical to "
                     "build 'all'\n", path, b->name, same, samples, same_rays, rays, hits);

@@ -33,10 +33,12 @@ typedef struct ScalarPaths {
     uint64_t (*path_timed)(const SceneView *sc, uint pixel, uint sample, vec3 *radiance, double *t);
     /* the classic ray tracer's and the auxiliary images' sample (kernels/integrator/whitted.h) */
     vec3 (*whitted)(const SceneView *sc, uint pixel, uint sample, uint *rays);
-    /* the closest-hit and any-hit queries of the renderer (trace_closest, trace_any,
-     * kernels/accel/traverse.h), alone: bench_traverse times the scalar device's walk */
-    Hit (*closest)(const SceneView *sc, Ray ray);
-    int (*any)(const SceneView *sc, Ray ray);
+    /* the closest-hit and any-hit queries of the renderer (trace_closest_visible,
+     * trace_occluded, kernels/accel/alpha.h), alone: bench_traverse times the scalar
+     * device's walk. The ray and the hit by address: a Ray passed by value goes through
+     * the stack, where its copy cost a fifth of a walk that misses (bench_traverse) */
+    void (*closest)(const SceneView *sc, const Ray *ray, Hit *hit);
+    int (*any)(const SceneView *sc, const Ray *ray);
 } ScalarPaths;
 
 /* The builds, leanest first (each file's comment says what it has): the basic materials

@@ -79,8 +79,8 @@ static uint64_t render_path_timed(const SceneView *sc, uint pixel, uint sample, 
     return n_rays;
 }
 
-static Hit query_closest(const SceneView *sc, Ray ray) { return trace_closest(sc, ray); }
-static int query_any(const SceneView *sc, Ray ray) { return trace_any(sc, ray); }
+static void query_closest(const SceneView *sc, const Ray *ray, Hit *hit) { *hit = trace_closest_visible(sc, *ray); }
+static int query_any(const SceneView *sc, const Ray *ray) { return trace_occluded(sc, *ray); }
 
 const ScalarPaths SCALAR_PATHS_BUILD = {
     .name = SCALAR_PATHS_NAME,

@@ -35,21 +35,23 @@ static const ScalarPaths *avx2_twin(const ScalarPaths *b)
     return NULL;
 }
 
+/* The builds for any x86-64 processor alone. */
+static const ScalarPaths *pick_sse2(unsigned features) { return scalar_paths_pick_isa(features, 0); }
+
 /* For any feature set: a build that has it, and no leaner one would do; on this
  * processor the AVX2 twin where it has AVX2. */
 static void test_pick_leanest(void)
 {
-#define scalar_paths_pick(f) scalar_paths_pick_isa(f, 0)
-    CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_MAT_EMISSIVE) == &scalar_paths_basic);
-    CHECK(scalar_paths_pick(KF_KDTREE | KF_SPHERES | KF_BOXES | KF_PLANES | KF_MAT_DIFFUSE) == &scalar_paths_basic);
-    CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_TEXTURES) == &scalar_paths_lean);
-    CHECK(scalar_paths_pick(KF_BVH | KF_SPHERES | KF_MAT_METAL | KF_MAT_DIELECTRIC) == &scalar_paths_basic);
-    CHECK(scalar_paths_pick(KF_BVH | KF_MAT_PRINCIPLED) == &scalar_paths_lean);
-    CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_ENV_MAP) == &scalar_paths_lean);
-    CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_DELTA_LIGHTS) == &scalar_paths_lean);
-    CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_MEDIA) == &scalar_paths_all);
-    CHECK(scalar_paths_pick(KF_BVH | KF_MAT_DIFFUSE | KF_INSTANCES) == &scalar_paths_all);
-    CHECK(scalar_paths_pick(0xffffffffu) == &scalar_paths_all);
+    CHECK(pick_sse2(KF_BVH | KF_MAT_DIFFUSE | KF_MAT_EMISSIVE) == &scalar_paths_basic);
+    CHECK(pick_sse2(KF_KDTREE | KF_SPHERES | KF_BOXES | KF_PLANES | KF_MAT_DIFFUSE) == &scalar_paths_basic);
+    CHECK(pick_sse2(KF_BVH | KF_MAT_DIFFUSE | KF_TEXTURES) == &scalar_paths_lean);
+    CHECK(pick_sse2(KF_BVH | KF_SPHERES | KF_MAT_METAL | KF_MAT_DIELECTRIC) == &scalar_paths_basic);
+    CHECK(pick_sse2(KF_BVH | KF_MAT_PRINCIPLED) == &scalar_paths_lean);
+    CHECK(pick_sse2(KF_BVH | KF_MAT_DIFFUSE | KF_ENV_MAP) == &scalar_paths_lean);
+    CHECK(pick_sse2(KF_BVH | KF_MAT_DIFFUSE | KF_DELTA_LIGHTS) == &scalar_paths_lean);
+    CHECK(pick_sse2(KF_BVH | KF_MAT_DIFFUSE | KF_MEDIA) == &scalar_paths_all);
+    CHECK(pick_sse2(KF_BVH | KF_MAT_DIFFUSE | KF_INSTANCES) == &scalar_paths_all);
+    CHECK(pick_sse2(0xffffffffu) == &scalar_paths_all);
     CHECK(scalar_paths_all.features == 0xffffffffu);
     /* each bit alone and with a few others */
     unsigned state = 1u;
@@ -59,12 +61,11 @@ static void test_pick_leanest(void)
             state = state * 1664525u + 1013904223u;   /* Numerical Recipes' LCG */
             f |= state & (state >> 7) & (state >> 13);
         }
-        const ScalarPaths *p = scalar_paths_pick(f);
+        const ScalarPaths *p = pick_sse2(f);
         CHECK_MSG(covers(p, f), "features 0x%x: picked '%s' (0x%x)", f, p->name, p->features);
         for (size_t k = 0; k < N_BASE_BUILDS && builds[k] != p; k++)
             CHECK_MSG(!covers(builds[k], f), "features 0x%x: picked '%s', but '%s' has them", f, p->name,
                       builds[k]->name);
-#undef scalar_paths_pick
         const ScalarPaths *q = scalar_paths_pick_isa(f, 1), *twin = avx2_twin(p);
         CHECK_MSG(q == (twin ? twin : p), "features 0x%x: for AVX2 picked '%s'", f, q->name);
         CHECK(q->features == p->features && q->avx2 == (twin != NULL) && p->avx2 == 0);

@@ -32,7 +32,7 @@ typedef struct {
 /* Fills *p for the ray. In place rather than returned: gcc built a returned RayPre
  * field by field and then copied it with 16-byte loads, each waiting for the narrower
  * stores before it to retire (no store-to-load forwarding), 10-18% of the scalar walk's
- * samples; in place, its camera any-hit rays got 15-19% faster (bench/RESULTS.md). */
+ * samples; in place, its camera any-hit rays got 19% faster (bench/RESULTS.md). */
 KFN_INLINE void ray_prepare(Ray ray, RayPre *p)
 {
     p->org[0] = ray.o.x; p->org[1] = ray.o.y; p->org[2] = ray.o.z;

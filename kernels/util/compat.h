@@ -145,8 +145,8 @@ typedef int int8 __attribute__((vector_size(32)));
 #define k_select8(a, b, m) ((float8)(((int8)(a) & ~(m)) | ((int8)(b) & (m))))
 #define k_splat8(x) ((float8){ (x), (x), (x), (x), (x), (x), (x), (x) })
 /* Whether the hot 8-lane tests (a BVH node's boxes, a group of triangles) run as one
- * float8 (K_VEC8 1) or as two float4 halves: with AVX (a build for x86-64-v3) one
- * vector register holds the 8 lanes; without it gcc splits 8-wide vectors badly. */
+ * float8 (K_VEC8 1) or as two float4 halves: with AVX (the scalar device's -mavx2
+ * builds) one register holds the 8 lanes; without it gcc splits 8-wide vectors badly. */
 #if defined(__AVX__)
 #define K_VEC8 1
 #define k_bits8(m) ((uint)__builtin_ia32_movmskps256((float8)(m)))

@@ -12,6 +12,7 @@
 #include "device/scalar_paths.h"
 #include "io/scene_load.h"
 #include "render/render_scene.h"
+#include "sample/sampling.h"
 
 /* The builds for any x86-64 processor (or any other), then those for AVX2: the latter
  * run only where the processor has it (n_builds). */
@@ -124,15 +125,11 @@ static void check_scene(const char *path, int kdtree, const ScalarPaths *expect)
              * directions from the middle of the camera's focus plane, inside the
              * scene, every other one stopped short */
             const Camera *cam = &rs.ds.params.camera;
-            vec3 mid = { cam->corner.x + 0.5f * (cam->horizontal.x - cam->vertical.x),
-                         cam->corner.y + 0.5f * (cam->horizontal.y - cam->vertical.y),
-                         cam->corner.z + 0.5f * (cam->horizontal.z - cam->vertical.z) };
+            vec3 mid = v3_add(cam->corner, v3_scale(v3_sub(cam->horizontal, cam->vertical), 0.5f));
             size_t rays = 0, same_rays = 0, hits = 0;
             for (uint i = 0; i < 512u; i++) {
-                float z = 1.0f - (2.0f * (float)i + 1.0f) / 512.0f, r = sqrtf(1.0f - z * z);
-                float phi = 2.39996323f * (float)i;   /* the golden angle: a Fibonacci sphere */
-                Ray ray = { .o = mid, .tmin = 0.0f,
-                            .d = { r * cosf(phi), r * sinf(phi), z }, .tmax = (i & 1u) ? 2.0f : 1e30f };
+                float u1 = ((float)i + 0.5f) / 512.0f, u2 = (float)((i * 317u) % 512u) / 512.0f;
+                Ray ray = { .o = mid, .tmin = 0.0f, .d = sample_sphere_dir(u1, u2), .tmax = (i & 1u) ? 2.0f : 1e30f };
                 Hit ha, hb;
                 scalar_paths_all.closest(&sv, &ray, &ha);
                 b->closest(&sv, &ray, &hb);

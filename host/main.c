@@ -364,7 +364,7 @@ static const char *output_name(const char *output)
 static void results_print_json(const Run *r, const char *result)
 {
     RenderStatsRun run = { clpt_version_text, r->o.scene_path, output_name(r->output), result, r->job.film.width,
-                           r->job.film.height, r->scene.image.spp, timer_now() - r->t_start };
+                           r->job.film.height, r->scene.image.spp, timer_now() - r->t_start, &r->job.split_pilot };
     render_stats_print_json(r->report, &run, &r->scene, &r->job.stats);
 }
 
@@ -373,10 +373,14 @@ static void results_print_summary(const Run *r)
     const RenderJob *job = &r->job;
     const ScheduleStats *s = &job->stats;
     if (r->o.stats == STATS_JSON) results_print_json(r, render_stats_result(s));
-    else if (r->o.stats || r->o.profile) render_stats_print_run(r->report, s, r->scene.image.spp, job->devs, job->n_devs);
+    else if (r->o.stats || r->o.profile) {
+        if (r->scene.integrator == INTEGRATOR_PATH)
+            render_stats_print_split(r->report, &job->split_pilot, r->scene.image.split);
+        render_stats_print_run(r->report, s, r->scene.image.spp, job->devs, job->n_devs);
+    }
     if (r->o.profile) {
         render_stats_print_profile(r->report, s, job->devs, job->n_devs);
-        if (r->scene.image.split > 1 && r->scene.integrator == INTEGRATOR_PATH)
+        if (job->rs.ds.params.split > 1 && r->scene.integrator == INTEGRATOR_PATH)
             fprintf(r->report, "profile: with --split, OpenCL devices run each path as one kernel (k_path), whose "
                     "time is all under shade\n");
     }

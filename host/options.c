@@ -84,12 +84,16 @@
         "on any devices and batch sizes") \
     X(OUTPUT, LONG, max_depth, "--max-depth", NULL, "N", RANGE(0, CLPT_MAX_DEPTH), \
         "longest path, in bounces (overrides the scene)") \
-    X(OUTPUT, LONG, split, "--split", NULL, "N", RANGE(1, CLPT_MAX_SPLIT), \
+    X(OUTPUT, CUSTOM, split, "--split", NULL, "N|auto", PARSE(parse_split), \
         "path tracer: shade each camera sample's first hit\n" \
         "N times, each with its own light sample and\n" \
         "continuation weighted 1/N, sharing the camera ray\n" \
-        "(1..64; overrides the scene's image split; 1: none,\n" \
-        "the default)") \
+        "(1..64; 1: none; overrides the scene's image\n" \
+        "split). auto, the default: a short pilot render\n" \
+        "of a sparse grid of pixels measures 1, 2 and 4,\n" \
+        "and the render takes the one of least error x\n" \
+        "rays, the same on any devices; small renders\n" \
+        "keep 1 (docs/design.md, First-hit splitting)") \
     X(OUTPUT, CUSTOM, noise_threshold, "--noise-threshold", NULL, "T", PARSE(parse_noise_threshold), \
         "path tracer: adaptive sampling; a pixel stops once\n" \
         "its estimated error is below T (0..1; 0.01 clean,\n" \
@@ -643,6 +647,20 @@ REAL_FLAG(parse_noise_threshold, noise_threshold, x > 0.0 && x <= 1.0,
           "--noise-threshold expects a threshold in (0, 1]")
 REAL_FLAG(parse_clamp, clamp, x > 0.0 && x <= 65536.0, "--clamp expects a radiance limit in (0, 65536]")
 #undef REAL_FLAG
+
+/* --split N|auto: a count in 1..CLPT_MAX_SPLIT, or auto (0, SCENE_SPLIT_AUTO) */
+static Status parse_split(const char *v, Options *o, Error *err)
+{
+    double x;
+    if (strcmp(v, "auto") == 0) {
+        o->split = 0;
+        return ST_OK;
+    }
+    if (!read_real(v, &x) || x != floor(x) || x < 1.0 || x > CLPT_MAX_SPLIT)
+        return error_set(err, ST_USAGE, "--split expects auto or an integer in 1..%d, got '%s'", CLPT_MAX_SPLIT, v);
+    o->split = (long)x;
+    return ST_OK;
+}
 
 /* --lookat EX,EY,EZ,AX,AY,AZ,UX,UY,UZ: the eye, the point looked at and the up
  * direction. They need nothing of the scene, so the frame is checked here as a whole,

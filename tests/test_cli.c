@@ -34,7 +34,7 @@ static void test_every_listed_flag_is_documented_and_parsed(void)
         { "--exposure", "-1.5" }, { "--noise-threshold", "0.05" }, { "--clamp", "10" },
         { "--set", "camera.fov=30" }, { "--crop", "0,0.5,0,1" }, { "--pixel-bounds", "0,8,0,8" },
         { "--lookat", "0,0,5,0,0,0,0,1,0" }, { "--fov", "30" },
-        { "--display-server", "localhost:14158" },
+        { "--display-server", "localhost:14158" }, { "--split", "auto" },
     };
     cli_run(ARGS("--help"), &r);
     CHECK_EQ_INT(r.status, 0);
@@ -90,7 +90,9 @@ static void test_usage_errors(void)
         { { "scenes/cornell-box.scene", "--width", "0" },
           NULL },
         { { "scenes/cornell-box.scene", "--split", "0" },
-          "--split must be between 1 and 64, got 0" },
+          "--split expects auto or an integer in 1..64, got '0'" },
+        { { "scenes/cornell-box.scene", "--split", "some" },
+          "--split expects auto or an integer in 1..64, got 'some'" },
         { { "--frobnicate" },
           "unknown option '--frobnicate'" },
         { { "-q" },
@@ -172,6 +174,57 @@ static void test_wave_launches_match_scalar(void)
         CHECK_MSG(rays[0] > 1.0 && fabs(rays[0] - rays[i]) < 0.01 * rays[0], "rays per sample: counted %.3f, %s %.3f",
                   rays[0], modes[i], rays[i]);
     unlink(ref);
+}
+
+/* --split auto, the default: the pilot chooses the same split on the scalar device, on
+ * OpenCL and on both at once, and the image is that split's, bit for bit, also when a
+ * render of fewer samples is grown to these; an image too small for a pilot keeps
+ * split 1 (one-weekend.scene at 400x225: its pilot chooses 2, 0.74 of split 1's error
+ * x rays, with 4 no better). */
+static void test_split_auto_chooses_alike(void)
+{
+    const char *devices[] = { "scalar", TEST_OPENCL };
+    const char *outs[] = { TEST_TMP("clpt-test-split-scalar.pfm"), TEST_TMP("clpt-test-split-opencl.pfm") };
+    const char *ref = TEST_TMP("clpt-test-split-2.pfm"), *ck = TEST_TMP("clpt-test-split.ckpt");
+    cli_run(ARGS("scenes/one-weekend.scene", "--device", "scalar", "--spp", "6", "--split", "2", "-q", "-o", ref), &r);
+    CHECK_EQ_INT(r.status, 0);
+    for (int i = 0; i < 2; i++) {
+        cli_run(ARGS("scenes/one-weekend.scene", "--device", devices[i], "--spp", "6", "--batch", i ? "2" : "6",
+                     "--stats=json", "-q", "-o", outs[i]),
+                &r);
+        CHECK_MSG(r.status == 0, "%s: %s", devices[i], r.err);
+        CHECK_STR_CONTAINS(r.out, "\"split\":{\"chosen\":2,\"auto\":true,\"pilot\":{\"pixels\":1100,\"spp\":4");
+        CHECK_MSG(files_equal(ref, outs[i]), "%s: split auto's image differs from --split 2's", devices[i]);
+        unlink(outs[i]);
+    }
+    /* 2 samples with a checkpoint, grown to 6 on both devices: the same split and image */
+    unlink(ck);
+    cli_run(ARGS("scenes/one-weekend.scene", "--device", "scalar", "--spp", "2", "--checkpoint", ck, "-q", "-o",
+                 outs[0]),
+            &r);
+    CHECK_EQ_INT(r.status, 0);
+    cli_run(ARGS("scenes/one-weekend.scene", "--device", "cpu,scalar", "--spp", "6", "--resume", ck,
+                 "--stats", "-q", "-o", outs[1]),
+            &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_STR_CONTAINS(r.out, "split: 2, chosen by a pilot of 1100 pixels x 4 spp in ");
+    CHECK_STR_CONTAINS(r.out, "(error x rays against split 1: 2 0.");
+    CHECK_MSG(files_equal(ref, outs[1]), "grown from 2 to 6 samples: the image differs from --split 2's");
+    /* too small for a pilot: split 1's image */
+    cli_run(ARGS("scenes/one-weekend.scene", "--device", "scalar", "--width", "64", "--height", "48", "--spp", "16",
+                 "--split", "1", "-q", "-o", ref),
+            &r);
+    CHECK_EQ_INT(r.status, 0);
+    cli_run(ARGS("scenes/one-weekend.scene", "--device", TEST_OPENCL, "--width", "64", "--height", "48", "--spp", "16",
+                 "--stats", "-q", "-o", outs[1]),
+            &r);
+    CHECK_EQ_INT(r.status, 0);
+    CHECK_STR_CONTAINS(r.out, "split: 1 (auto without a pilot");
+    CHECK(files_equal(ref, outs[1]));
+    unlink(outs[0]);
+    unlink(outs[1]);
+    unlink(ref);
+    unlink(ck);
 }
 
 static void test_missing_scene_is_io_error(void)
@@ -954,6 +1007,7 @@ int main(void)
     RUN(test_unwritable_output_is_io_error);
     RUN(test_stats);
     RUN(test_wave_launches_match_scalar);
+    RUN(test_split_auto_chooses_alike);
     RUN(test_profile);
     RUN(test_help_fits_80_columns);
     RUN(test_readme_reference_is_help);

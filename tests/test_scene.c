@@ -141,6 +141,10 @@ static void test_camera_and_image(void)
     CHECK_EQ_INT(s.image.split, 4);
     CHECK(s.path && strstr(s.path, "cam.scene"));
     scene_free(&s);
+    /* split auto: the pilot's choice (the default) */
+    CHECK_EQ_INT(load_text("auto.scene", "image { split auto }\n", &s, &err), ST_OK);
+    CHECK_EQ_INT(s.image.split, SCENE_SPLIT_AUTO);
+    scene_free(&s);
 }
 
 static void test_defaults_kept(void)
@@ -161,7 +165,7 @@ static void test_defaults_kept(void)
     CHECK_EQ_INT(s.image.spp, 2);
     CHECK_EQ_INT(s.image.max_depth, 8);
     CHECK_EQ_INT(s.image.seed, 1);
-    CHECK_EQ_INT(s.image.split, 1);
+    CHECK_EQ_INT(s.image.split, SCENE_SPLIT_AUTO);
     CHECK_EQ_INT(s.bg_type, BG_CONSTANT);
     CHECK(vec_eq(s.bg_color, 0, 0, 0));
     scene_free(&s);
@@ -565,8 +569,10 @@ static void test_bad_values(void)
     check_bad("image { width 99999999999999999999999 }", ST_INPUT,
               ":1:15: expected an integer in 1..1048576 for 'width', found '99999999999999999999999'");
     check_bad("image { depth 1025 }", ST_INPUT, ":1:15: expected an integer in 0..1024 for 'depth'");
-    check_bad("image { split 0 }", ST_INPUT, ":1:15: expected an integer in 1..64 for 'split', found '0'");
-    check_bad("image { split 65 }", ST_INPUT, ":1:15: expected an integer in 1..64 for 'split', found '65'");
+    check_bad("image { split 0 }", ST_INPUT, ":1:15: expected auto or an integer in 1..64 for 'split', found '0'");
+    check_bad("image { split 65 }", ST_INPUT, ":1:15: expected auto or an integer in 1..64 for 'split', found '65'");
+    check_bad("image { split some }", ST_INPUT,
+              ":1:15: expected auto or an integer in 1..64 for 'split', found 'some'");
     check_bad("image { spp -1 }", ST_INPUT, ":1:13: expected an integer in 1..1000000 for 'spp', found '-1'");
     check_bad("camera { fov 180 }", ST_INPUT, ":1:14: expected a number of degrees in (0, 180) for 'fov', found '180'");
     check_bad("camera { fov nan }", ST_INPUT, ":1:14: expected a number of degrees in (0, 180) for 'fov', found 'nan'");

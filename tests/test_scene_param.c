@@ -31,6 +31,8 @@ static void test_sets(void)
     CHECK(scene_param_set(&s, "camera.eye", "1,2,3", &err) == ST_OK && s.camera.from.y == 2.0f);
     CHECK(scene_param_set(&s, "camera.look_at", "0 0 0", &err) == ST_OK && s.camera.at.z == 0.0f);
     CHECK(scene_param_set(&s, "image.spp", "16", &err) == ST_OK && s.image.spp == 16);
+    CHECK(scene_param_set(&s, "image.split", "3", &err) == ST_OK && s.image.split == 3);
+    CHECK(scene_param_set(&s, "image.split", "auto", &err) == ST_OK && s.image.split == SCENE_SPLIT_AUTO);
     CHECK(scene_param_set(&s, "material.red.albedo", "0.2,0.3,0.4", &err) == ST_OK);
     CHECK(s.materials[0].albedo.y == 0.3f);
     CHECK(scene_param_set(&s, "material.red.albedo", "0.5", &err) == ST_OK && s.materials[0].albedo.z == 0.5f);
@@ -52,6 +54,8 @@ static void test_errors(void)
         { "camera.up", "0,0,0", "scene parameter 'camera.up' expects a direction, three numbers not all 0 "
                                 "(\"0,1,0\"), got '0,0,0'" },
         { "image.spp", "1.5", "scene parameter 'image.spp' expects an integer in [1, 1000000], got '1.5'" },
+        { "image.split", "0", "scene parameter 'image.split' expects auto or an integer in [1, 64], got '0'" },
+        { "image.split", "Auto", "scene parameter 'image.split' expects auto or an integer in [1, 64], got 'Auto'" },
         { "material.red.albedo", "-1", "scene parameter 'material.red.albedo' expects a colour: one number >= 0 "
                                        "or three (\"0.8,0.2,0.2\"), got '-1'" },
         /* finite as a double, +inf as the float the scene stores (found by fuzz_param) */

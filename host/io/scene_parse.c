@@ -450,7 +450,7 @@ static const KeySpec image_keys[IMG_N] = {
     [IMG_SEED] = {"seed", VK_UINT, 0, 0, 4294967295.0, 0, 0, "an integer in 0..4294967295"},
     [IMG_SHADOWS] = {"shadows", VK_WORD, 0, 0, 0, 0, 0, "on or off"},
     [IMG_SAMPLER] = {"sampler", VK_WORD, 0, 0, 0, 0, 0, "sobol or independent"},
-    [IMG_SPLIT] = {"split", VK_UINT, 0, 1, CLPT_MAX_SPLIT, 0, 0, "an integer in 1.." CLPT_STR(CLPT_MAX_SPLIT)},
+    [IMG_SPLIT] = {"split", VK_WORD, 0, 1, CLPT_MAX_SPLIT, 0, 0, "auto or an integer in 1.." CLPT_STR(CLPT_MAX_SPLIT)},
 };
 
 static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
@@ -464,7 +464,14 @@ static Status parse_image(Parser *p, Lexer *lx, const Token *kw)
     if (v[IMG_SPP].given) im->spp = (uint)v[IMG_SPP].u;
     if (v[IMG_DEPTH].given) im->max_depth = (uint)v[IMG_DEPTH].u;
     if (v[IMG_SEED].given) im->seed = (uint)v[IMG_SEED].u;
-    if (v[IMG_SPLIT].given) im->split = (uint)v[IMG_SPLIT].u;
+    if (v[IMG_SPLIT].given) {
+        /* auto (SCENE_SPLIT_AUTO: the render's pilot chooses) or a count */
+        const Token *w = &v[IMG_SPLIT].word;
+        unsigned long long n = 0;
+        if (!tok_is(w, "auto") && (tok_uint(w, &n) || !in_range(&image_keys[IMG_SPLIT], (double)n)))
+            return lex_expected(lx, w, "auto or an integer in 1.." CLPT_STR(CLPT_MAX_SPLIT) " for 'split'", p->err);
+        im->split = tok_is(w, "auto") ? SCENE_SPLIT_AUTO : (uint)n;
+    }
     if (v[IMG_SHADOWS].given) {
         const Token *w = &v[IMG_SHADOWS].word;
         if (!tok_is(w, "on") && !tok_is(w, "off")) return lex_expected(lx, w, image_keys[IMG_SHADOWS].what, p->err);

@@ -66,6 +66,9 @@ Status render_job_adopt_scene(RenderJob *job, Scene *scene, RenderScene *rs, Err
     job->rs = *rs;
     memset(rs, 0, sizeof *rs);
     RenderParams *p = &job->rs.ds.params;
+    /* split auto is chosen again for each frame (render_job_run), as a frame rendered
+     * alone chooses */
+    p->split = scene->image.split;
     Status st = camera_setup(&scene->camera, scene->image.width, scene->image.height, &p->camera, err);
     return st ? st : scene_check_precision(scene, err);
 }
@@ -262,6 +265,10 @@ void render_job_configure(RenderJob *job)
 
 Status render_job_run(RenderJob *job, Error *err)
 {
+    /* --split auto: the pilot chooses, and the devices get the choice (split_pilot.h) */
+    AdaptiveRun pilot = { job->devs, job->n_devs, &job->rs, &job->cfg, NULL, NULL };
+    job->render_st = split_pilot_run(&pilot, &job->split_pilot, err);
+    if (job->render_st != ST_OK) return job->render_st;
     if (job->adaptive) {
         AdaptiveRun run = { job->devs, job->n_devs, &job->rs, &job->cfg, job_round, job };
         job->render_st = adaptive_run(&run, &job->set.adaptive, &job->af, &job->stats, err);

@@ -31,6 +31,7 @@
 #include "render/passes.h"
 #include "render/render_scene.h"
 #include "render/schedule.h"
+#include "render/split_pilot.h"
 
 /* What a run is asked: the command line's options that shape the render (the app
  * layer fills it from its Options: job_options.h). */
@@ -78,6 +79,7 @@ typedef struct {
     ScheduleConfig cfg;
     ScheduleStats stats;
     Status render_st;              /* the render's own status (render_job_run) */
+    SplitPilot split_pilot;        /* --split auto's choice, and what the pilot measured */
     uint passes_spp;               /* samples per pixel of the passes finished (progress) */
 } RenderJob;
 

@@ -283,7 +283,7 @@ static Status prepare(Scene *s, int tree_threads, RenderScene *out, Error *err)
     p->bg_light = s->env_light;
     if ((st = crop_params(s, p, err))) return st;
     p->max_depth = s->image.max_depth;
-    p->split = s->image.split ? s->image.split : 1u;
+    p->split = s->image.split;   /* 0: auto, chosen by render_job_run's pilot (split_pilot.h); 1 until then */
     p->clamp_indirect = s->image.clamp_indirect;
     if ((st = prepare_media(s, out, err))) return st;
     p->rr_depth = RR_START_BOUNCE;

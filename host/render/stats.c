@@ -187,6 +187,46 @@ static void json_devices(FILE *out, const ScheduleStats *st)
     fputc(']', out);
 }
 
+/* A candidate's error x rays over split 1's. */
+static double pilot_ratio(const SplitPilot *sp, uint i)
+{
+    double one = sp->error[0] * (double)sp->rays[0];
+    return one > 0.0 ? sp->error[i] * (double)sp->rays[i] / one : 0.0;
+}
+
+void render_stats_print_split(FILE *out, const SplitPilot *sp, uint scene_split)
+{
+    if (scene_split != SCENE_SPLIT_AUTO) {
+        fprintf(out, "split: %u, as asked\n", sp->chosen);
+        return;
+    }
+    if (!sp->ran) {
+        fprintf(out, "split: 1 (auto without a pilot: a render too small for one, media, the whitted integrator, or "
+                "an interrupt)\n");
+        return;
+    }
+    fprintf(out, "split: %u, chosen by a pilot of %u pixels x %u spp in %.2f s (error x rays against split 1:",
+            sp->chosen, sp->pixels, sp->spp, sp->seconds);
+    for (uint i = 1; i < sp->measured; i++) fprintf(out, "%s %u %.3f", i > 1 ? "," : "", sp->split[i], pilot_ratio(sp, i));
+    fprintf(out, ")\n");
+}
+
+/* "split":{"chosen":2,"auto":true,"pilot":{"pixels":1024,"spp":16,"seconds":0.12,
+ * "measured":[{"split":1,"error":..,"rays":..},...]}} */
+static void json_split(FILE *out, const SplitPilot *sp, uint scene_split)
+{
+    fprintf(out, ",\"split\":{\"chosen\":%u,\"auto\":%s", sp->chosen, scene_split == SCENE_SPLIT_AUTO ? "true" : "false");
+    if (sp->ran) {
+        fprintf(out, ",\"pilot\":{\"pixels\":%u,\"spp\":%u,\"seconds\":%.6f,\"measured\":[", sp->pixels, sp->spp,
+                sp->seconds);
+        for (uint i = 0; i < sp->measured; i++)
+            fprintf(out, "%s{\"split\":%u,\"error\":%.9g,\"rays\":%llu}", i ? "," : "", sp->split[i], sp->error[i],
+                    (unsigned long long)sp->rays[i]);
+        fprintf(out, "]}");
+    }
+    fputc('}', out);
+}
+
 void render_stats_print_json(FILE *out, const RenderStatsRun *run, const Scene *s, const ScheduleStats *st)
 {
     fprintf(out, "{\"clpt\":");
@@ -206,6 +246,7 @@ void render_stats_print_json(FILE *out, const RenderStatsRun *run, const Scene *
     fprintf(out, ",\"scene_contents\":{\"spheres\":%zu,\"triangles\":%zu,\"boxes\":%zu,\"planes\":%zu,"
             "\"materials\":%zu,\"lights\":%zu,\"textures\":%zu}", s->n_spheres, s->n_triangles, s->n_boxes,
             s->n_planes, s->n_materials, s->n_lights, s->n_textures);
+    if (run->split && s->integrator == INTEGRATOR_PATH) json_split(out, run->split, s->image.split);
     fputc(',', out);
     json_devices(out, st);
     fprintf(out, "}\n");

@@ -31,7 +31,13 @@ typedef struct {
     const char *result;           /* "rendered", "interrupted" or "time limit reached" */
     unsigned width, height, spp;  /* the image, and the samples per pixel asked for */
     double total_seconds;         /* from the start of the program */
+    const SplitPilot *split;      /* the split rendered, and --split auto's pilot */
 } RenderStatsRun;
+
+/* The split rendered and, for --split auto, what its pilot measured: "split: 2, chosen
+ * by a pilot of 1024 pixels x 16 spp in 0.12 s (error x rays against split 1: 2 0.69, 4
+ * 0.72)". */
+void render_stats_print_split(FILE *out, const SplitPilot *sp, uint scene_split);
 
 /* --stats=json: the render as one JSON object on one line. */
 void render_stats_print_json(FILE *out, const RenderStatsRun *run, const Scene *s, const ScheduleStats *st);

@@ -31,7 +31,7 @@ void scene_init(Scene *s)
     s->image.height = 512;
     s->image.spp = 64;
     s->image.max_depth = 8;
-    s->image.split = 1;
+    s->image.split = SCENE_SPLIT_AUTO;
     s->image.seed = 1;
     s->bg_type = BG_CONSTANT;
     s->bg_color = v3(0.0f, 0.0f, 0.0f);

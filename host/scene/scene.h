@@ -58,9 +58,12 @@ typedef struct {
     uint max_depth;      /* bounces after the camera ray */
     uint seed;
     uint sampler;        /* enum Sampler (kernels/sample/rng.h); 0, Sobol, by default */
-    uint split;          /* continuations per camera sample from its first hit (1: none) */
+    uint split;          /* continuations per camera sample from its first hit (1: none;
+                          * SCENE_SPLIT_AUTO: chosen by a pilot render, render/split_pilot.h) */
     float clamp_indirect;  /* path: --clamp's limit on indirect light, 0 = none */
 } SceneImage;
+/* SceneImage.split: the render's pilot chooses (the default; render/split_pilot.h) */
+#define SCENE_SPLIT_AUTO 0u
 
 /* A material that a shape bounding media was given (scene/media.h): materials[material]
  * is materials[origin] with the media `in` and `out` (0 vacuum, 1 + a medium's index, or

@@ -19,7 +19,8 @@ typedef enum {
     PK_POINT,    /* three finite floats */
     PK_DIR,      /* three floats, not all 0; stored normalised */
     PK_COLOR,    /* one or three floats >= 0 (one: grey) */
-    PK_UINT      /* an integer in [lo, hi] */
+    PK_UINT,     /* an integer in [lo, hi] */
+    PK_UINT_AUTO /* the same, or auto (stored as 0) */
 } ParamKind;
 
 typedef struct {
@@ -36,6 +37,7 @@ typedef struct {
 #define DIR(n, T, f, unit) { n, PK_DIR, offsetof(T, f), 0, 0, 0, unit }
 #define COL(n, T, f) { n, PK_COLOR, offsetof(T, f), 0, 0, 0, 0 }
 #define INT(n, T, f, l, h) { n, PK_UINT, offsetof(T, f), l, h, 0, 0 }
+#define INT_AUTO(n, T, f, l, h) { n, PK_UINT_AUTO, offsetof(T, f), l, h, 0, 0 }
 
 static const ParamSpec camera_params[] = {
     PNT("from", SceneCamera, from), PNT("eye", SceneCamera, from),
@@ -67,7 +69,7 @@ static const ParamSpec image_params[] = {
     INT("spp", SceneImage, spp, 1, CLPT_MAX_SPP),
     INT("depth", SceneImage, max_depth, 0, CLPT_MAX_DEPTH),
     INT("seed", SceneImage, seed, 0, 4294967295.0),
-    INT("split", SceneImage, split, 1, CLPT_MAX_SPLIT),
+    INT_AUTO("split", SceneImage, split, 1, CLPT_MAX_SPLIT),
 };
 
 static const ParamSpec background_params[] = {
@@ -191,9 +193,15 @@ static Status param_write(const ParamSpec *p, void *obj, const char *key, const 
         *(float *)dst = (float)x[0];
         return ST_OK;
     case PK_UINT:
+    case PK_UINT_AUTO:
+        if (p->kind == PK_UINT_AUTO && strcmp(v, "auto") == 0) {
+            *(uint *)dst = 0u;
+            return ST_OK;
+        }
         if (n != 1 || x[0] != floor(x[0]) || x[0] < p->lo || x[0] > p->hi) {
             char what[96];
-            snprintf(what, sizeof what, "an integer in [%.0f, %.0f]", p->lo, p->hi);
+            snprintf(what, sizeof what, "%san integer in [%.0f, %.0f]", p->kind == PK_UINT_AUTO ? "auto or " : "",
+                     p->lo, p->hi);
             return bad_value(err, key, what, v);
         }
         *(uint *)dst = (uint)x[0];

@@ -1,0 +1,168 @@
+/* split_pilot.c — `--split auto`: the pilot render that chooses first-hit splitting
+ * (see split_pilot.h). */
+#include "render/split_pilot.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/progress.h"
+#include "base/timer.h"
+#include "render/render_scene.h"
+
+static const uint candidates[SPLIT_PILOT_CANDIDATES] = { 1u, 2u, 4u };
+
+uint split_pilot_plan(uint width, uint height, uint *stride, uint *pilot_spp)
+{
+    *stride = 0u;
+    *pilot_spp = 0u;
+    uint64_t n = (uint64_t)width * height;
+    if (n < SPLIT_PILOT_MIN_IMAGE) return 0u;
+    uint64_t want = n / 128u > SPLIT_PILOT_MIN_PIXELS ? n / 128u : SPLIT_PILOT_MIN_PIXELS;
+    /* the grid's step: the largest whose grid still holds `want` pixels */
+    uint k = (uint)floor(sqrt((double)n / (double)want));
+    if (k == 0u) k = 1u;
+    *stride = k;
+    *pilot_spp = SPLIT_PILOT_SPP;
+    return ((width + k - 1u - k / 2u) / k) * ((height + k - 1u - k / 2u) / k);
+}
+
+uint split_pilot_choose(const SplitPilot *sp)
+{
+    uint best = 0u;
+    for (uint i = 1u; i < sp->measured; i++) {
+        double e = sp->error[i] * (double)sp->rays[i], b = sp->error[best] * (double)sp->rays[best];
+        if (e < SPLIT_PILOT_GAIN * b) best = i;
+    }
+    return sp->measured ? sp->split[best] : 1u;
+}
+
+/* The params, as they now are, to every device. */
+static Status update_devices(const AdaptiveRun *run, Error *err)
+{
+    const DeviceScene *ds = &run->rs->ds;
+    for (size_t i = 0; i < run->n_devices; i++) {
+        Device *d = run->devices[i];
+        Status st = d->ops->update_params(d, &ds->params, ds->pixel_list, err);
+        if (st) return st;
+    }
+    return ST_OK;
+}
+
+/* Samples [0, spp) of the listed pixels with `seed` into `film` (fresh); their rays
+ * added to *rays. *whole: every one of them was rendered. */
+static Status render_seed(const AdaptiveRun *run, uint seed, uint spp, Film *film, uint64_t *rays, int *whole,
+                          Error *err)
+{
+    run->rs->ds.params.seed = seed;
+    Status st = update_devices(run, err);
+    if (st) return st;
+    /* the render's config narrowed to the pilot's samples, with its hooks off */
+    ScheduleConfig cfg = *run->cfg;
+    cfg.spp = spp;
+    cfg.range_first = 0u;
+    cfg.range_end = spp;
+    cfg.done = NULL;
+    cfg.n_done = 0;
+    cfg.time_limit = 0.0;
+    cfg.show_progress = PROGRESS_OFF;
+    cfg.on_tick = NULL;
+    cfg.on_checkpoint = NULL;
+    cfg.on_poll = NULL;
+    ScheduleStats one;
+    st = schedule_run(run->devices, run->n_devices, &cfg, film, &one, err);
+    *whole = st == ST_OK && !one.interrupted && !one.time_up && film->samples == spp;
+    *rays += one.rays;
+    schedule_stats_free(&one);
+    return st;
+}
+
+/* The pilot at the params' split: the listed pixels' samples [0, spp) with the render's
+ * seed and with another, two independent estimates of each pixel (the even and odd
+ * samples of one Sobol sequence are not: they stratify each other, and their difference
+ * put the Cornell box's split 2 at 0.72 of split 1 where it is at 1.24). Each film is
+ * reduced to the listed pixels' sums before the next is made, so that one film of the
+ * image's size is kept at a time. */
+static Status measure(const AdaptiveRun *run, const uint *list, uint n, uint spp, double *error, uint64_t *rays,
+                      int *whole, Error *err)
+{
+    double *sums = calloc((size_t)n * 6u, sizeof *sums);
+    if (!sums) return error_set(err, ST_INTERNAL, "out of memory for the split pilot");
+    RenderParams *p = &run->rs->ds.params;
+    uint seeds[2] = { p->seed, p->seed ^ SPLIT_PILOT_SEED };
+    Status st = ST_OK;
+    *whole = 1;
+    *rays = 0;
+    for (uint h = 0; h < 2u && st == ST_OK && *whole; h++) {
+        Film film;
+        if ((st = film_init(&film, p->width, p->height, err))) break;
+        st = render_seed(run, seeds[h], spp, &film, rays, whole, err);
+        for (uint i = 0; st == ST_OK && i < n; i++)
+            for (uint c = 0; c < 3u; c++) sums[6u * i + 3u * h + c] = (double)film.sum[3u * (size_t)list[i] + c];
+        film_free(&film);
+    }
+    p->seed = seeds[0];
+    /* film units to radiance: each film holds spp samples of a pixel */
+    double unit = 1.0 / ((double)(1u << FILM_FRAC_BITS) * (double)spp);
+    double e = 0.0;
+    for (uint i = 0; i < n; i++)
+        for (uint c = 0; c < 3u; c++) {
+            double a = sums[6u * i + c] * unit, b = sums[6u * i + 3u + c] * unit, m = 0.5 * (a + b);
+            e += (a - b) * (a - b) / (m * m + SPLIT_PILOT_REL_EPS);
+        }
+    *error = e;
+    free(sums);
+    return st;
+}
+
+static Status set_split(const AdaptiveRun *run, uint split, Error *err)
+{
+    run->rs->ds.params.split = split;
+    return update_devices(run, err);
+}
+
+Status split_pilot_run(const AdaptiveRun *run, SplitPilot *sp, Error *err)
+{
+    memset(sp, 0, sizeof *sp);
+    sp->chosen = 1u;
+    DeviceScene *ds = &run->rs->ds;
+    RenderParams *p = &ds->params;
+    if (p->split != 0u) {
+        sp->chosen = p->split;
+        return ST_OK;
+    }
+    uint stride, pilot_spp;
+    uint n = p->integrator == INTEGRATOR_PATH && !p->has_media
+                 ? split_pilot_plan(p->width, p->height, &stride, &pilot_spp) : 0u;
+    if (n == 0u) return set_split(run, 1u, err);
+    uint *list = malloc((size_t)n * sizeof *list);
+    if (!list) return error_set(err, ST_INTERNAL, "out of memory for the split pilot");
+    uint k = 0;
+    for (uint y = stride / 2u; y < p->height; y += stride)
+        for (uint x = stride / 2u; x < p->width; x += stride) list[k++] = y * p->width + x;
+    RenderParams saved = *p;
+    const uint *saved_list = ds->pixel_list;
+    ds->pixel_list = list;
+    p->pixel_list_size = n;
+    double t0 = timer_now();
+    Status st = ST_OK;
+    int whole = 1;
+    for (uint c = 0; c < SPLIT_PILOT_CANDIDATES && st == ST_OK && whole; c++) {
+        /* a larger split only after the one before it won */
+        if (c >= 2u && split_pilot_choose(sp) != sp->split[c - 1u]) break;
+        if ((st = set_split(run, candidates[c], err))) break;
+        st = measure(run, list, n, pilot_spp, &sp->error[c], &sp->rays[c], &whole, err);
+        if (st == ST_OK && whole) sp->split[sp->measured++] = candidates[c];
+    }
+    sp->seconds = timer_now() - t0;
+    sp->pixels = n;
+    sp->spp = pilot_spp;
+    sp->ran = st == ST_OK && whole;
+    *p = saved;
+    ds->pixel_list = saved_list;
+    free(list);
+    if (st) return st;
+    sp->chosen = sp->ran ? split_pilot_choose(sp) : 1u;
+    /* the devices get the params back, with the split chosen, and drop the list */
+    return set_split(run, sp->chosen, err);
+}

@@ -277,6 +277,17 @@ static void test_mpi_two_and_three_ranks_are_bit_identical(void)
     spawn_run(ARGS(MPIRUN, "-np", "3", CLI_PROGRAM, RENDER, "--mpi-broadcast", "-o", in_dir("np3.pfm")), &r);
     CHECK_MSG(r.status == 0, "%s", r.err);
     CHECK(files_equal(in_dir("np3.pfm"), in_dir("whole.pfm")));
+    /* --split auto: rank 0's pilot runs on every rank's devices and chooses as one
+     * process does (one-weekend at 400x225 is large enough for a pilot; it chooses 2) */
+#define PILOT_RENDER "scenes/one-weekend.scene", "--spp", "2", "--device", "scalar", "--threads", "1", "--stats", "-q"
+    cli_run(ARGS(PILOT_RENDER, "-o", in_dir("pilot1.pfm")), &r);
+    CHECK_EQ_INT(r.status, 0);
+    CHECK_STR_CONTAINS(r.out, "split: 2, chosen by a pilot");
+    spawn_run(ARGS(MPIRUN, "-np", "2", CLI_PROGRAM, PILOT_RENDER, "-o", in_dir("pilot2.pfm")), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_STR_CONTAINS(r.out, "split: 2, chosen by a pilot");
+    CHECK(files_equal(in_dir("pilot1.pfm"), in_dir("pilot2.pfm")));
+#undef PILOT_RENDER
     /* every buffer travels, those whose counts are not in the params block too (the
      * environment map's distribution, the BVH's leaves) */
     if (shared_model_present("../shared/envmaps/courtyard.hdr", "the broadcast of an environment map is not checked")) {

@@ -329,6 +329,15 @@ static size_t device__open_chosen(const DeviceDesc *all, const size_t *chosen, s
     return n;
 }
 
+Status device_update_all(Device **devs, size_t n, const DeviceScene *ds, Error *err)
+{
+    for (size_t i = 0; i < n; i++) {
+        Status st = devs[i]->ops->update_params(devs[i], &ds->params, ds->pixel_list, err);
+        if (st) return st;
+    }
+    return ST_OK;
+}
+
 Status device_open_all(const char *spec, const DeviceConfig *cfg, const DeviceScene *ds, DeviceWarn warn,
                        void *warn_ctx, Device ***out, size_t *n_out, Error *err)
 {

@@ -215,6 +215,10 @@ typedef void (*DeviceWarn)(void *ctx, const char *msg);
 Status device_open_all(const char *spec, const DeviceConfig *cfg, const DeviceScene *ds, DeviceWarn warn,
                        void *warn_ctx, Device ***out, size_t *n_out, Error *err);
 
+/* Gives each of n devices ds's params block and pixel list (update_params): the step
+ * every pass, adaptive round and pilot that changes the params takes. */
+Status device_update_all(Device **devs, size_t n, const DeviceScene *ds, Error *err);
+
 /* Constructors used by device_open. */
 Status device_scalar_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err);
 Status device_ocl_open(const DeviceDesc *desc, const DeviceConfig *cfg, Device **out, Error *err);

@@ -178,17 +178,6 @@ Status adaptive_mask(const AdaptiveSettings *s, const AdaptiveFilm *af, uint *ma
 /* ------------------------------------------------------------------ the rounds */
 
 /* Gives every device the params block and pixel list of the run's scene. */
-static Status update_devices(const AdaptiveRun *run, Error *err)
-{
-    const DeviceScene *ds = &run->rs->ds;
-    for (size_t i = 0; i < run->n_devices; i++) {
-        Device *d = run->devices[i];
-        Status st = d->ops->update_params(d, &ds->params, ds->pixel_list, err);
-        if (st) return st;
-    }
-    return ST_OK;
-}
-
 /* Adds one scheduler run's statistics into the render's. */
 static Status stats_add(ScheduleStats *sum, const ScheduleStats *one, Error *err)
 {
@@ -234,21 +223,9 @@ static Status render_half(const AdaptiveRun *run, uint half, uint first, uint en
     RenderParams *p = &run->rs->ds.params;
     p->sample_step = 2u;
     p->sample_offset = half;
-    Status st = update_devices(run, err);
+    Status st = device_update_all(run->devices, run->n_devices, &run->rs->ds, err);
     if (st) return st;
-    /* the run's config narrowed to this range, with its hooks off (the viewer's
-     * pass_run sets up other fields of a config of its own: alike only in shape) */
-    ScheduleConfig cfg = *run->cfg;
-    cfg.spp = end;
-    cfg.range_first = first;
-    cfg.range_end = end;
-    cfg.done = NULL;
-    cfg.n_done = 0;
-    cfg.time_limit = time_left;
-    cfg.show_progress = PROGRESS_OFF;
-    cfg.on_tick = NULL;
-    cfg.on_checkpoint = NULL;
-    cfg.on_poll = NULL;
+    ScheduleConfig cfg = schedule_config_part(run->cfg, first, end, time_left);
     ScheduleStats one;
     st = schedule_run(run->devices, run->n_devices, &cfg, film, &one, err);
     *whole = st == ST_OK && !one.interrupted && !one.time_up && film->samples == end - first;
@@ -344,7 +321,7 @@ Status adaptive_run(const AdaptiveRun *run, const AdaptiveSettings *s, AdaptiveF
     ds->params = saved;
     ds->pixel_list = NULL;
     /* the devices too: none keeps the list freed below */
-    Status restored = update_devices(run, st == ST_OK ? err : NULL);
+    Status restored = device_update_all(run->devices, run->n_devices, &run->rs->ds, st == ST_OK ? err : NULL);
     free(mask);
     free(list);
     return st ? st : restored;

@@ -8,18 +8,6 @@
 
 #include "base/timer.h"
 
-/* Gives every device the params block and pixel list of pc->rs. */
-static Status update_devices(const PassContext *pc, Error *err)
-{
-    const DeviceScene *ds = &pc->rs->ds;
-    Status st;
-    for (size_t i = 0; i < pc->n_devices; i++) {
-        Device *d = pc->devices[i];
-        if ((st = d->ops->update_params(d, &ds->params, ds->pixel_list, err))) return st;
-    }
-    return ST_OK;
-}
-
 /* Gives every device the pass's params block and pixel list (the scene's other buffers
  * stay as loaded), renders samples [first, end) of a render of spp samples per pixel
  * into a new film (end 0: all of them; never the main render's --sample-range, which a
@@ -30,7 +18,7 @@ static Status render_pass_range(const PassContext *pc, uint spp, uint first, uin
     const DeviceScene *ds = &pc->rs->ds;
     Status st;
     memset(film, 0, sizeof *film);   /* the caller frees it whatever happens */
-    if ((st = update_devices(pc, err))) return st;
+    if ((st = device_update_all(pc->devices, pc->n_devices, &pc->rs->ds, err))) return st;
     if ((st = film_init(film, ds->params.width, ds->params.height, err))) return st;
     ScheduleConfig cfg = *pc->cfg;
     cfg.spp = spp;
@@ -108,7 +96,7 @@ Status passes_adaptive(const PassContext *pc, float *rgb, uint base_spp, float t
     *p = saved;
     pc->rs->ds.pixel_list = NULL;
     /* the devices too: none keeps the list freed below */
-    Status restored = update_devices(pc, st == ST_OK ? err : NULL);
+    Status restored = device_update_all(pc->devices, pc->n_devices, &pc->rs->ds, st == ST_OK ? err : NULL);
     if (st == ST_OK) st = restored;
     if (st == ST_OK && film.samples > 0) {
         float *more = malloc(n * 3 * sizeof *more);
@@ -174,7 +162,7 @@ static Status passes__aov_film(const PassContext *pc, uint aov, uint spp, uint f
     p->strata = render_scene_strata(spp);
     Status st = render_pass_range(pc, spp, first, end, film, seconds, err);
     *p = saved;
-    Status restored = update_devices(pc, st == ST_OK ? err : NULL);
+    Status restored = device_update_all(pc->devices, pc->n_devices, &pc->rs->ds, st == ST_OK ? err : NULL);
     return st == ST_OK ? restored : st;
 }
 

@@ -77,11 +77,7 @@ Status render_job_update_devices(RenderJob *job, Device **devs, size_t n_devs, E
 {
     job->devs = devs;
     job->n_devs = job->n_local_devs = n_devs;
-    for (size_t i = 0; i < n_devs; i++) {
-        Status st = devs[i]->ops->update_params(devs[i], &job->rs.ds.params, job->rs.ds.pixel_list, err);
-        if (st) return st;
-    }
-    return ST_OK;
+    return device_update_all(devs, n_devs, &job->rs.ds, err);
 }
 
 /* ------------------------------------------------------------------ resuming */

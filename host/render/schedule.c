@@ -491,6 +491,22 @@ static Status collect_stats(Shared *sh, const Film *film, ScheduleStats *stats, 
     return ST_OK;
 }
 
+ScheduleConfig schedule_config_part(const ScheduleConfig *cfg, uint first, uint end, double time_limit)
+{
+    ScheduleConfig part = *cfg;
+    part.spp = end;
+    part.range_first = first;
+    part.range_end = end;
+    part.done = NULL;
+    part.n_done = 0;
+    part.time_limit = time_limit;
+    part.show_progress = PROGRESS_OFF;
+    part.on_tick = NULL;
+    part.on_checkpoint = NULL;
+    part.on_poll = NULL;
+    return part;
+}
+
 Status schedule_run(Device **devices, size_t n, const ScheduleConfig *cfg, Film *film,
                     ScheduleStats *stats, Error *err)
 {

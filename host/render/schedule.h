@@ -100,6 +100,12 @@ typedef struct {
  * samples of cfg->done). Fails (ST_DEVICE) only when every device failed; the film then
  * keeps what was finished, and stats->done says which samples those are. Free the stats
  * with schedule_stats_free in every case. */
+/* A render's config narrowed to the sample indices [first, end) of a fresh film, for a
+ * part of it run on its own (an adaptive round's half, the split pilot): no samples
+ * done, no progress bar, tick, checkpoint or poll hooks; the stop flag, batch size and
+ * warnings kept; time_limit 0 for none. */
+ScheduleConfig schedule_config_part(const ScheduleConfig *cfg, uint first, uint end, double time_limit);
+
 Status schedule_run(Device **devices, size_t n, const ScheduleConfig *cfg, Film *film,
                     ScheduleStats *stats, Error *err);
 void schedule_stats_free(ScheduleStats *s);

@@ -6,7 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "base/progress.h"
 #include "base/timer.h"
 #include "render/render_scene.h"
 
@@ -37,38 +36,15 @@ uint split_pilot_choose(const SplitPilot *sp)
     return sp->measured ? sp->split[best] : 1u;
 }
 
-/* The params, as they now are, to every device. */
-static Status update_devices(const AdaptiveRun *run, Error *err)
-{
-    const DeviceScene *ds = &run->rs->ds;
-    for (size_t i = 0; i < run->n_devices; i++) {
-        Device *d = run->devices[i];
-        Status st = d->ops->update_params(d, &ds->params, ds->pixel_list, err);
-        if (st) return st;
-    }
-    return ST_OK;
-}
-
 /* Samples [0, spp) of the listed pixels with `seed` into `film` (fresh); their rays
  * added to *rays. *whole: every one of them was rendered. */
 static Status render_seed(const AdaptiveRun *run, uint seed, uint spp, Film *film, uint64_t *rays, int *whole,
                           Error *err)
 {
     run->rs->ds.params.seed = seed;
-    Status st = update_devices(run, err);
+    Status st = device_update_all(run->devices, run->n_devices, &run->rs->ds, err);
     if (st) return st;
-    /* the render's config narrowed to the pilot's samples, with its hooks off */
-    ScheduleConfig cfg = *run->cfg;
-    cfg.spp = spp;
-    cfg.range_first = 0u;
-    cfg.range_end = spp;
-    cfg.done = NULL;
-    cfg.n_done = 0;
-    cfg.time_limit = 0.0;
-    cfg.show_progress = PROGRESS_OFF;
-    cfg.on_tick = NULL;
-    cfg.on_checkpoint = NULL;
-    cfg.on_poll = NULL;
+    ScheduleConfig cfg = schedule_config_part(run->cfg, 0u, spp, 0.0);
     ScheduleStats one;
     st = schedule_run(run->devices, run->n_devices, &cfg, film, &one, err);
     *whole = st == ST_OK && !one.interrupted && !one.time_up && film->samples == spp;
@@ -118,7 +94,7 @@ static Status measure(const AdaptiveRun *run, const uint *list, uint n, uint spp
 static Status set_split(const AdaptiveRun *run, uint split, Error *err)
 {
     run->rs->ds.params.split = split;
-    return update_devices(run, err);
+    return device_update_all(run->devices, run->n_devices, &run->rs->ds, err);
 }
 
 Status split_pilot_run(const AdaptiveRun *run, SplitPilot *sp, Error *err)

@@ -90,7 +90,7 @@
         "continuation weighted 1/N, sharing the camera ray\n" \
         "(1..64; 1: none; overrides the scene's image\n" \
         "split). auto, the default: a short pilot render\n" \
-        "of a sparse grid of pixels measures 1, 2 and 4,\n" \
+        "of a sparse grid of pixels measures 1, 2, 4, 8,\n" \
         "and the render takes the one of least error x\n" \
         "rays, the same on any devices; small renders\n" \
         "keep 1 (docs/design.md, First-hit splitting)") \

@@ -33,7 +33,7 @@ static void test_plan(void)
 static SplitPilot measured(uint n, const double *error, const uint64_t *rays)
 {
     SplitPilot sp = { 0 };
-    static const uint splits[] = { 1, 2, 4 };
+    static const uint splits[] = { 1, 2, 4, 8 };
     for (uint i = 0; i < n; i++) {
         sp.split[i] = splits[i];
         sp.error[i] = error[i];
@@ -43,22 +43,33 @@ static SplitPilot measured(uint n, const double *error, const uint64_t *rays)
     return sp;
 }
 
-/* Least error x rays, a larger split only for a gain of SPLIT_PILOT_GAIN or more. */
+/* Least error x rays; splitting at all for a gain of SPLIT_PILOT_GAIN or more, a larger
+ * split for SPLIT_PILOT_GAIN_MORE. */
 static void test_choose(void)
 {
-    const uint64_t rays[] = { 1000, 1600, 2800 };
+    const uint64_t rays[] = { 1000, 1600, 2800, 5200 };
     /* split 2 halves the error for 1.6 times the rays: 0.8 of split 1's */
     SplitPilot sp = measured(2, (const double[]){ 1.0, 0.5 }, rays);
     CHECK_EQ_INT(split_pilot_choose(&sp), 2);
-    /* 0.96: not enough to split */
-    sp = measured(2, (const double[]){ 1.0, 0.6 }, rays);
+    /* 0.92: not enough to split */
+    sp = measured(2, (const double[]){ 1.0, 0.575 }, rays);
     CHECK_EQ_INT(split_pilot_choose(&sp), 1);
     /* split 4 after split 2: 0.8 then 0.7 of split 1's (0.875 of split 2's) */
     sp = measured(3, (const double[]){ 1.0, 0.5, 0.25 }, rays);
     CHECK_EQ_INT(split_pilot_choose(&sp), 4);
-    /* split 4 no better than split 2 by the margin */
+    /* split 4 at 0.93 of split 2's: enough to split more */
+    sp = measured(3, (const double[]){ 1.0, 0.5, 0.265 }, rays);
+    CHECK_EQ_INT(split_pilot_choose(&sp), 4);
+    /* split 4 at 0.98 of split 2's: not */
     sp = measured(3, (const double[]){ 1.0, 0.5, 0.28 }, rays);
     CHECK_EQ_INT(split_pilot_choose(&sp), 2);
+    /* split 8 after 4 */
+    sp = measured(4, (const double[]){ 1.0, 0.5, 0.25, 0.12 }, rays);
+    CHECK_EQ_INT(split_pilot_choose(&sp), 8);
+    /* a later split compared with the choice, not with the one measured before it:
+     * 2 not enough (0.96), 4 at 0.84 of split 1's */
+    sp = measured(3, (const double[]){ 1.0, 0.6, 0.3 }, rays);
+    CHECK_EQ_INT(split_pilot_choose(&sp), 4);
     /* nothing measured (an interrupted pilot) */
     sp = measured(0, (const double[]){ 0.0 }, rays);
     CHECK_EQ_INT(split_pilot_choose(&sp), 1);

@@ -270,9 +270,11 @@ Status render_job_run(RenderJob *job, Error *err)
         job->render_st = adaptive_run(&run, &job->set.adaptive, &job->af, &job->stats, err);
         /* what the results ask of the film: its count (the image is af's) */
         job->film.samples = job->af.film.samples;
-        return job->render_st;
+    } else {
+        job->render_st = schedule_run(job->devs, job->n_devs, &job->cfg, &job->film, &job->stats, err);
     }
-    job->render_st = schedule_run(job->devs, job->n_devs, &job->cfg, &job->film, &job->stats, err);
+    /* the pilot is part of the render's time (its rates and the peers' benchmark) */
+    job->stats.seconds += job->split_pilot.seconds;
     return job->render_st;
 }
 

@@ -9,7 +9,7 @@
 #include "base/timer.h"
 #include "render/render_scene.h"
 
-static const uint candidates[SPLIT_PILOT_CANDIDATES] = { 1u, 2u, 4u };
+static const uint candidates[SPLIT_PILOT_CANDIDATES] = { 1u, 2u, 4u, 8u };
 
 uint split_pilot_plan(uint width, uint height, uint *stride, uint *pilot_spp)
 {
@@ -31,7 +31,7 @@ uint split_pilot_choose(const SplitPilot *sp)
     uint best = 0u;
     for (uint i = 1u; i < sp->measured; i++) {
         double e = sp->error[i] * (double)sp->rays[i], b = sp->error[best] * (double)sp->rays[best];
-        if (e < SPLIT_PILOT_GAIN * b) best = i;
+        if (e < (best == 0u ? SPLIT_PILOT_GAIN : SPLIT_PILOT_GAIN_MORE) * b) best = i;
     }
     return sp->measured ? sp->split[best] : 1u;
 }
@@ -53,8 +53,8 @@ static Status render_seed(const AdaptiveRun *run, uint seed, uint spp, Film *fil
     return st;
 }
 
-/* The pilot at the params' split: the listed pixels' samples [0, spp) with the render's
- * seed and with another, two independent estimates of each pixel (the even and odd
+/* The pilot at the params' split: the listed pixels' samples [0, spp) with two seeds of
+ * its own, two independent estimates of each pixel (the even and odd
  * samples of one Sobol sequence are not: they stratify each other, and their difference
  * put the Cornell box's split 2 at 0.72 of split 1 where it is at 1.24). Each film is
  * reduced to the listed pixels' sums before the next is made, so that one film of the
@@ -65,7 +65,7 @@ static Status measure(const AdaptiveRun *run, const uint *list, uint n, uint spp
     double *sums = calloc((size_t)n * 6u, sizeof *sums);
     if (!sums) return error_set(err, ST_INTERNAL, "out of memory for the split pilot");
     RenderParams *p = &run->rs->ds.params;
-    uint seeds[2] = { p->seed, p->seed ^ SPLIT_PILOT_SEED };
+    uint seeds[2] = { SPLIT_PILOT_SEED_A, SPLIT_PILOT_SEED_B }, render_seed_was = p->seed;
     Status st = ST_OK;
     *whole = 1;
     *rays = 0;
@@ -77,7 +77,7 @@ static Status measure(const AdaptiveRun *run, const uint *list, uint n, uint spp
             for (uint c = 0; c < 3u; c++) sums[6u * i + 3u * h + c] = (double)film.sum[3u * (size_t)list[i] + c];
         film_free(&film);
     }
-    p->seed = seeds[0];
+    p->seed = render_seed_was;
     /* film units to radiance: each film holds spp samples of a pixel */
     double unit = 1.0 / ((double)(1u << FILM_FRAC_BITS) * (double)spp);
     double e = 0.0;

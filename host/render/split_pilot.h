@@ -10,19 +10,21 @@
  * lamp's edge). Which holds depends on the scene and on the samples per pixel (Sobol
  * points make both parts fall faster than 1/n, each at its own rate), so it is
  * measured rather than guessed: a sparse grid of pixels renders SPLIT_PILOT_SPP
- * samples per pixel twice, with the render's seed and with another, at split 1, then 2, then 4 while the last one won. Each split's error is the
- * relative squared difference of its two films (two independent estimates of every
- * pixel; SPLIT_PILOT_REL_EPS), its
- * cost the rays it traced; the render takes the N of least error x rays, a larger N
- * only where it promises at most SPLIT_PILOT_GAIN of the smaller one's (efficiency as
- * variance x cost, the measure of Veach's thesis, 1997, section 2.4.1).
+ * samples per pixel twice, with two seeds of its own, at split 1, then
+ * 2, 4 and 8 while the last one won. Each split's error is the relative squared
+ * difference of its two films (two independent estimates of every pixel;
+ * SPLIT_PILOT_REL_EPS), its cost the rays it traced; the render takes the N of least
+ * error x rays, a larger N only where it promises at most SPLIT_PILOT_GAIN (from 1) or
+ * SPLIT_PILOT_GAIN_MORE of the smaller one's (efficiency as variance x cost, the
+ * measure of Veach's thesis, 1997, section 2.4.1).
  *
  * Ray counts and film sums are integers that every device, batch size and MPI rank
- * produce alike, the pilot's pixels and samples depend only on the image's size, and the decision is taken in double arithmetic on the host: every
- * device, rank, resume and part (--sample-range) of a render chooses the same N, so a
- * seed still gives the same image everywhere. Rays, not seconds, because seconds differ
- * between machines (and they track seconds: the dragon's split 2 traces 1.61 times the
- * rays of split 1 in 1.58 times the time, the McGuire box 1.84 in 1.85).
+ * produce alike, the pilot's pixels and samples depend only on the image's size, and
+ * the decision is taken in double arithmetic on the host: every device, rank, resume
+ * and part (--sample-range) of a render chooses the same N, so a seed still gives the
+ * same image everywhere. Rays, not seconds, because seconds differ between machines
+ * (and they track seconds: the dragon's split 2 traces 1.61 times the rays of split 1
+ * in 1.58 times the time, the McGuire box 1.84 in 1.85).
  */
 #ifndef CLPT_SPLIT_PILOT_H
 #define CLPT_SPLIT_PILOT_H
@@ -30,21 +32,24 @@
 #include "render/adaptive.h"
 
 /* The splits the pilot may measure, in order; each after the one before won. */
-#define SPLIT_PILOT_CANDIDATES 3
-/* A larger split is chosen where its error x rays is below this share of the smaller
- * one's: the estimates are noisy, and on a GPU a split render also runs the megakernel. */
+#define SPLIT_PILOT_CANDIDATES 4
+/* Splitting at all is chosen where its error x rays is below this share of split 1's
+ * (the estimates are noisy, and on a GPU a split render also runs the megakernel), a
+ * larger split where it is below the second share of the smaller one's (noise alone). */
 #define SPLIT_PILOT_GAIN 0.9
+#define SPLIT_PILOT_GAIN_MORE 0.95
 /* The pilot's samples per pixel in each of its two films. Fixed, as everything the
  * pilot does is by the image's size alone: a render of N samples per pixel is the first
  * N of one of more (a checkpoint or part grown to more, docs/checkpoint.md), so the
  * split must not depend on N. */
-#define SPLIT_PILOT_SPP 4u
-/* The grid holds at least this many pixels, or a 128th of a large image. */
+#define SPLIT_PILOT_SPP 8u
+/* The grid holds at least this many pixels, or a 128th of a larger image. */
 #define SPLIT_PILOT_MIN_PIXELS 1024u
-/* Images of fewer pixels keep split 1 without a pilot: it would cost them more than
- * 0.7 samples per pixel (at 256 x 256, 1024 pixels x 2 films x 4 samples at split 1,
- * 0.125 per pixel, and about 5.4 times that with splits 2 and 4; 0.36 from 362 x 362
- * up, where the grid is a 128th of the pixels). */
+/* Images of fewer pixels keep split 1 without a pilot: it renders 2 films x 8 samples
+ * of a 128th of the pixels at split 1, 0.125 samples per pixel of the image, about 5.4
+ * times that where it goes on to split 4 and 10.6 times to split 8 (where the render's
+ * own samples cost 2.8 and 5.2 times split 1's); below 256 x 256 the grid's 1024 pixels
+ * would be more than a 64th, and its cost twice that or more. */
 #define SPLIT_PILOT_MIN_IMAGE (256u * 256u)
 /* The error is relative (relMSE: a pixel's squared difference over its squared value
  * plus this, in radiance squared), as the error of images whose pixels span many stops
@@ -55,8 +60,11 @@
  * and a pilot of a 121st of the pixels saw the whole image's split 2 at 0.81 of split
  * 1's error x rays where it is at 1.23; relative, 0.86 against the whole image's 0.86). */
 #define SPLIT_PILOT_REL_EPS 0.01
-/* The second film's seed: the render's with these bits flipped. */
-#define SPLIT_PILOT_SEED 0x5bd1e995u
+/* The two films' seeds, the pilot's own: the choice is the scene's and the image
+ * size's, the same whatever --seed a render is given (with the render's seed, envmat
+ * chose split 4 for one seed and 8 for another). */
+#define SPLIT_PILOT_SEED_A 0x9e3779b9u
+#define SPLIT_PILOT_SEED_B 0x5bd1e995u
 
 typedef struct {
     uint chosen;                 /* the split the render uses (1 when the pilot did not run) */
@@ -75,8 +83,9 @@ typedef struct {
  * tests. */
 uint split_pilot_plan(uint width, uint height, uint *stride, uint *pilot_spp);
 
-/* The split of least error x rays among the first n measured candidates (each only
- * where it beats the choice before it by SPLIT_PILOT_GAIN). Pure, for the tests. */
+/* The split of least error x rays among the measured candidates, each only where it
+ * beats the choice before it by SPLIT_PILOT_GAIN (from split 1) or SPLIT_PILOT_GAIN_MORE.
+ * Pure, for the tests. */
 uint split_pilot_choose(const SplitPilot *sp);
 
 /* Runs the pilot for run->rs when its params ask for split auto (RenderParams.split 0)

@@ -201,8 +201,8 @@ void render_stats_print_split(FILE *out, const SplitPilot *sp, uint scene_split)
         return;
     }
     if (!sp->ran) {
-        fprintf(out, "split: 1 (auto without a pilot: a render too small for one, media, the whitted integrator, or "
-                "an interrupt)\n");
+        fprintf(out, sp->pixels ? "split: 1 (auto: the pilot was interrupted)\n"
+                                : "split: 1 (auto without a pilot: an image under 256x256, or media)\n");
         return;
     }
     fprintf(out, "split: %u, chosen by a pilot of %u pixels x %u spp in %.2f s (error x rays against split 1:",

@@ -143,7 +143,7 @@ for sc in ../shared/peers/cornell-mcguire.scene:256 ../shared/peers/dragon.scene
         for wl in counted bounded; do
             for wp in 1048576 4194304; do
                 r=$(lim 120 "$clpt" "$f" --device "$dev" --width 1024 --height 1024 --spp "$spp" --wave-paths $wp \
-                    --wave-launch $wl --stats -q -o "$out/waves.pfm" 2>&1 | grep '^total' | awk '{print $(NF-2)}')
+                    --wave-launch $wl --split 1 --stats -q -o "$out/waves.pfm" 2>&1 | grep '^total' | awk '{print $(NF-2)}')
                 echo "$(basename "$f") 1024x1024 ${spp} spp, round $round, --wave-launch $wl --wave-paths $wp: $r Msamples/s"
             done
         done
@@ -164,9 +164,29 @@ for sc in scenes/cornell-box.scene:512:16 ../shared/peers/cornell-mcguire.scene:
     for wl in bounded megakernel; do
         for acc in bvh kdtree; do
             r=$(lim 120 "$clpt" "$f" --device "$dev" --width "$size" --height "$size" --spp "$spp" --accel $acc \
-                --wave-launch $wl --stats -q -o "$out/trees.pfm" 2>&1 | grep '^total' | awk '{print $(NF-2)}')
+                --wave-launch $wl --split 1 --stats -q -o "$out/trees.pfm" 2>&1 | grep '^total' | awk '{print $(NF-2)}')
             echo "$(basename "$f") ${size}x${size} ${spp} spp, --wave-launch $wl --accel $acc: $r Msamples/s"
         done
+    done
+done
+fi
+
+# --split auto (the default since 2026-11-29) chooses the same split on every device, and
+# a split render runs the megakernel on a GPU (slower than bounded launches on four of
+# five renders of the third check). The images are the same bits as the CPU's, so their
+# error is the CPU's: the GPU's time at the chosen split against its time at split 1,
+# times the error ratio measured on the CPU (bench/RESULTS.md, "First-hit splitting
+# chosen per render"), says whether auto pays on the GPU. The launch and tree steps above
+# pin --split 1 to compare launches.
+if want split; then
+step "split auto against --split 1 (render seconds, the total line of --stats)"
+for sc in ../shared/peers/cornell-mcguire.scene:64 ../shared/peers/dragon.scene:16 scenes/mesh.scene:16; do
+    f=${sc%:*}; spp=${sc##*:}
+    [ -f "$f" ] || continue
+    for split in auto 1; do
+        r=$(lim 120 "$clpt" "$f" --device "$dev" --width 1024 --height 1024 --spp "$spp" --split $split --stats -q \
+            -o "$out/split.pfm" 2>&1 | grep -E '^split|^total' | awk '/^split/ {c=$2; sub(",", "", c)} /^total/ {t=$3} END {print c, t}')
+        echo "$(basename "$f") 1024x1024 ${spp} spp, --split $split: split and seconds $r"
     done
 done
 fi

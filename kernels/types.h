@@ -839,7 +839,11 @@ typedef struct {                                        /* 352 bytes */
                                        * or BLEND, kernels/accel/alpha.h); 0: no hit
                                        * looks its material up for it (the scalar
                                        * device's builds have KF_ALPHA for every scene) */
-    uint pad0, pad1, pad2;            /* to a multiple of 16 bytes */
+    uint env_mis_dist;                /* BG_MAP: where in env_cdf the compensated
+                                       * distribution starts, which MIS-weighted light
+                                       * samples draw from; 0: the map's own serves
+                                       * (kernels/light/envmap.h) */
+    uint pad1, pad2;                  /* to a multiple of 16 bytes */
 } RenderParams;
 
 #define HAS_MEDIA_ANY 1u          /* RenderParams.has_media: some medium or boundary */

@@ -137,14 +137,21 @@ static void test_orientation(void)
 
 /* Directions from env_sample, binned by the pixel env_pixel puts them in, against
  * each pixel's probability computed here in double from the map (luminance x
- * sin(theta) at the row's centre); every sample's radiance and light_sample pdf are
- * what env_radiance and light_pdf_env give its direction (the density to rounding:
- * the sample keeps its pixel and sin(theta), the others find them from the direction);
- * the density integrates to 1 over the sphere. */
-static void check_sampling(float rotate)
+ * sin(theta) at the row's centre; with `mis`, the compensated distribution's:
+ * luminance less its mean over the sphere, at least 0, x sin(theta)); every sample's
+ * radiance and light_sample pdf are what env_radiance and light_pdf_env give its
+ * direction (the density to rounding: the sample keeps its pixel and sin(theta), the
+ * others find them from the direction); the density integrates to 1 over the sphere. */
+static void check_sampling(float rotate, int mis)
 {
     enum { MW = 24, MH = 12, N = 400000 };
     float *rgb = structured_map(MW, MH);
+    if (mis) {
+        /* a dimmer sun: the compensated distribution keeps about half the map, not the
+         * sun alone, and the chi-square has pixels to count */
+        for (uint i = 0; i < MW * MH * 3u; i++)
+            if (rgb[i] == 40.0f) rgb[i] = 2.0f;
+    }
     Scene s;
     scene_init(&s);
     set_map(&s, rgb, MW, MH, 1.5f, rotate);
@@ -156,14 +163,27 @@ static void check_sampling(float rotate)
     SceneView v;
     device_scene_view(&rs.ds, &v);
     Texture tx = v.textures[rs.ds.params.bg_cubemap];
-    double prob[MW * MH], total = 0.0;
-    for (uint y = 0; y < MH; y++)
-        for (uint x = 0; x < MW; x++) {
-            const float *p = rgb + 3u * (y * MW + x);
-            double lum = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-            prob[y * MW + x] = lum * sin(M_PI * (y + 0.5) / MH);
-            total += prob[y * MW + x];
-        }
+    /* the structured map has a compensated distribution; where it starts */
+    CHECK_EQ_INT(rs.ds.params.env_mis_dist, (int)env_dist_floats(MW, MH));
+    double prob[MW * MH], total = 0.0, floor = 0.0, sin_sum = 0.0;
+    for (int pass = mis ? 0 : 1; pass < 2; pass++) {
+        /* pass 0 (mis): the mean luminance over the sphere, the compensation's floor */
+        for (uint y = 0; y < MH; y++)
+            for (uint x = 0; x < MW; x++) {
+                const float *p = rgb + 3u * (y * MW + x);
+                double lum = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2], st = sin(M_PI * (y + 0.5) / MH);
+                if (pass == 0) {
+                    floor += lum * st;
+                    sin_sum += st;
+                    continue;
+                }
+                prob[y * MW + x] = (lum > floor * (1.0 + 1e-6) ? lum - floor * (1.0 + 1e-6) : 0.0) * st;
+                total += prob[y * MW + x];
+            }
+        if (pass == 0) floor /= sin_sum;
+    }
+    uint zero_pixels = 0;
+    for (uint i = 0; i < MW * MH; i++) zero_pixels += prob[i] == 0.0;
     static uint count[MW * MH];
     memset(count, 0, sizeof count);
     uint rng = 1u, pdf_mismatch = 0, rejected = 0;
@@ -175,7 +195,7 @@ static void check_sampling(float rotate)
             u[k] = (float)(rng >> 8) * (1.0f / 16777216.0f);
         }
         LightSample ls;
-        if (!light_sample(&v, v3s(0.0f), 0, u[0], u[1], u[2], &ls)) {
+        if (!light_sample(&v, v3s(0.0f), mis, 0, u[0], u[1], u[2], &ls)) {
             /* a point on a pole (sin(theta) 0) has density 0 and is dropped: rare */
             rejected++;
             continue;
@@ -188,7 +208,7 @@ static void check_sampling(float rotate)
          * direction's density finds the pixel and sin(theta) again from the direction:
          * the same to rounding, unless rounding put the direction across the pixel's
          * edge (rare) */
-        float pdf_dir = light_pdf_env(&v, ls.wi);
+        float pdf_dir = light_pdf_env(&v, ls.wi, mis);
         double rel = fabs((double)ls.pdf - (double)pdf_dir) / (double)pdf_dir;
         vec3 Le_dir = env_radiance(&v, ls.wi);
         if (!(rel <= 1e-5) || ls.Le.x != Le_dir.x || ls.Le.y != Le_dir.y || ls.Le.z != Le_dir.z) pdf_mismatch++;
@@ -222,13 +242,16 @@ static void check_sampling(float rotate)
         float u1 = (float)(rng >> 8) * (1.0f / 16777216.0f);
         rng = rng * 1664525u + 1013904223u;
         float u2 = (float)(rng >> 8) * (1.0f / 16777216.0f);
-        integral += env_pdf(&v, sample_sphere_dir(u1, u2));
+        integral += env_pdf(&v, sample_sphere_dir(u1, u2), mis);
     }
     integral *= 4.0 * M_PI / M;
-    fprintf(stderr, "  rotate %g: chi-square %.1f with %d degrees of freedom, p-value %.3f; %u samples in black "
-            "pixels; %u radiances or densities differ from the direction's (densities by more than 1e-5; the others by %.1e at most); "
-            "%u samples rejected; density integrates to %.4f\n",
-            (double)rotate, chi2, dof, p_value, in_black, pdf_mismatch, worst_rel, rejected, integral);
+    fprintf(stderr, "  %s, rotate %g: chi-square %.1f with %d degrees of freedom, p-value %.3f; %u samples in "
+            "the %u pixels of probability 0; %u radiances or densities differ from the direction's (densities by "
+            "more than 1e-5; the others by %.1e at most); %u samples rejected; density integrates to %.4f\n",
+            mis ? "compensated" : "full", (double)rotate, chi2, dof, p_value, in_black, zero_pixels, pdf_mismatch,
+            worst_rel, rejected, integral);
+    /* the compensated distribution leaves the pixels below the mean out */
+    CHECK(mis ? zero_pixels > MW * MH / 4 && zero_pixels < MW * MH * 3 / 4 : zero_pixels == MW);
     CHECK(rejected < N / 10000);
     CHECK(p_value > 1e-3);
     CHECK_EQ_INT(in_black, 0);
@@ -239,8 +262,10 @@ static void check_sampling(float rotate)
     free(rgb);
 }
 
-static void test_sampling_matches_density(void) { check_sampling(0.0f); }
-static void test_sampling_matches_density_rotated(void) { check_sampling(37.0f); }
+static void test_sampling_matches_density(void) { check_sampling(0.0f, 0); }
+static void test_sampling_matches_density_rotated(void) { check_sampling(37.0f, 0); }
+static void test_compensated_sampling_matches_density(void) { check_sampling(0.0f, 1); }
+static void test_compensated_sampling_matches_density_rotated(void) { check_sampling(37.0f, 1); }
 
 /* ------------------------------------------------------------------ images */
 
@@ -272,6 +297,8 @@ static void check_furnace(float albedo)
     for (int i = 0; i < 8 * 4 * 3; i++) rgb[i] = 0.8f;
     Scene s;
     sphere_scene(&s, rgb, 8, 4, albedo, 64, 4);
+    /* a constant map is at its mean everywhere: no compensated distribution */
+    CHECK(s.n_env_cdf == env_dist_floats(8, 4) && s.env_mis_dist == 0u);
     Film f;
     Error err = { 0 };
     Status st = render_util_run(&s, "scalar", 0, &f, &err);
@@ -298,12 +325,16 @@ static void test_furnace_albedo_1(void) { check_furnace(1.0f); }
 static void test_furnace_albedo_half(void) { check_furnace(0.5f); }
 
 /* A diffuse sphere on a diffuse floor under the structured map, direct light only:
- * light sampling alone, BSDF sampling alone and their MIS combination must agree
- * (means of 8x8 blocks and of the image). */
-static void test_strategies_agree(void)
+ * light sampling alone (the map's own distribution), BSDF sampling alone and their MIS
+ * combination (light samples from the compensated distribution) must agree (means of
+ * 8x8 blocks and of the image). With the bright sun the compensated distribution is
+ * the sun alone; with a dim one about half the map. */
+static void check_strategies_agree(float sun)
 {
     enum { MW = 48, MH = 24 };
     float *map = structured_map(MW, MH);
+    for (uint i = 0; i < MW * MH * 3u; i++)
+        if (map[i] == 40.0f) map[i] = sun;
     Scene s;
     sphere_scene(&s, map, MW, MH, 0.7f, 1024, 1);
     uint fm;
@@ -336,8 +367,9 @@ static void test_strategies_agree(void)
             double rel = fabs(block[m][b] - block[0][b]) / (block[0][b] > 0.05 ? block[0][b] : 0.05);
             if (rel > worst[m]) worst[m] = rel;
         }
-    fprintf(stderr, "  image mean: MIS %.4f, light sampling %.4f, BSDF sampling %.4f; worst 8x8 block difference "
-            "to MIS: light %.1f%%, BSDF %.1f%%\n", mean[0], mean[1], mean[2], 100.0 * worst[1], 100.0 * worst[2]);
+    fprintf(stderr, "  sun %g: image mean: MIS %.4f, light sampling %.4f, BSDF sampling %.4f; worst 8x8 block "
+            "difference to MIS: light %.1f%%, BSDF %.1f%%\n", (double)sun, mean[0], mean[1], mean[2], 100.0 * worst[1],
+            100.0 * worst[2]);
     CHECK(mean[0] > 0.1);
     CHECK_NEAR(mean[1], mean[0], 0.01 * mean[0]);
     CHECK_NEAR(mean[2], mean[0], 0.01 * mean[0]);
@@ -348,6 +380,9 @@ static void test_strategies_agree(void)
     free(map);
     error_clear(&err);
 }
+
+static void test_strategies_agree_bright_sun(void) { check_strategies_agree(40.0f); }
+static void test_strategies_agree_dim_sun(void) { check_strategies_agree(2.0f); }
 
 /* The same small render with a map (diffuse, metal and glass, every path kind) on PoCL
  * and on the scalar device: the same bits. */
@@ -510,8 +545,8 @@ static uint check_cdf_search(const float *cdf, const float *guide, uint n)
     return tried;
 }
 
-/* The guide tables env_dist_build writes lead env_cdf_find to the cell a plain walk
- * finds, for maps of 1 to 1024 pixels a row with runs of black pixels (cells of zero
+/* The guide tables env_dist_build writes (for both distributions) lead env_cdf_find to
+ * the cell a plain walk finds, for maps of 1 to 1024 pixels a row with runs of black pixels (cells of zero
  * probability, where the cdf repeats), single bright pixels and black rows; and the
  * distribution holds exactly the cdfs and guides that kernels/light/envmap.h lays out. */
 static void test_guided_search_finds_the_walks_cell(void)
@@ -533,20 +568,21 @@ static void test_guided_search_finds_the_walks_cell(void)
         rgb[0] = rgb[1] = rgb[2] = 1.0f; /* never all black */
         uint *bits = malloc((size_t)w * h * 3u * sizeof *bits);
         memcpy(bits, rgb, (size_t)w * h * 3u * sizeof *bits);
-        float *cdf;
-        size_t n;
-        double mean;
-        CHECK(env_dist_build(bits, w, h, &cdf, &n, &mean, NULL) == ST_OK);
-        size_t cdfs = (h + 1u) + (size_t)h * (w + 1u);
-        CHECK_EQ_INT(n, cdfs + env_guide_cells(h) + (size_t)h * env_guide_cells(w));
-        CHECK(cdf != NULL);
-        if (cdf) {
-            const float *guide = cdf + cdfs;
+        EnvDist dist;
+        CHECK(env_dist_build(bits, w, h, &dist, NULL) == ST_OK);
+        size_t cdfs = (h + 1u) + (size_t)h * (w + 1u), one = cdfs + env_guide_cells(h) + (size_t)h * env_guide_cells(w);
+        CHECK_EQ_INT(env_dist_floats(w, h), one);
+        /* two distributions, the compensated one second, unless the map is constant (1 x 1) */
+        CHECK_EQ_INT(dist.n, w * h > 1u ? 2u * one : one);
+        CHECK_EQ_INT(dist.mis_offset, w * h > 1u ? one : 0u);
+        CHECK(dist.cdf != NULL);
+        for (size_t at = 0; dist.cdf && at < dist.n; at += one) {
+            const float *cdf = dist.cdf + at, *guide = cdf + cdfs;
             tried += check_cdf_search(cdf, guide, h);
             for (uint j = 0; j < h; j++)
                 tried += check_cdf_search(cdf + (h + 1u) + j * (w + 1u), guide + env_guide_cells(h) + j * env_guide_cells(w), w);
         }
-        free(cdf);
+        free(dist.cdf);
         free(bits);
         free(rgb);
     }
@@ -567,7 +603,9 @@ static void test_scene_keys(void)
     CHECK_MSG(st == ST_OK, "%s", err.msg);
     CHECK_EQ_INT(s.bg_type, BG_MAP);
     CHECK(s.bg_color.x == 2.5f && s.bg_rotate == 45.0f);
-    CHECK(s.n_env_cdf == 513u + 512u * 1025u + 128u + 512u * 256u); /* cdfs, then guides */
+    /* cdfs, then guides; the map's own distribution and the compensated one */
+    CHECK(s.n_env_cdf == 2u * (513u + 512u * 1025u + 128u + 512u * 256u));
+    CHECK(s.env_mis_dist == 513u + 512u * 1025u + 128u + 512u * 256u);
     scene_free(&s);
     scene_init(&s);
     text = "background { map \"../shared/envmaps/courtyard.hdr\" }\n";
@@ -582,9 +620,12 @@ int main(void)
     RUN(test_orientation);
     RUN(test_sampling_matches_density);
     RUN(test_sampling_matches_density_rotated);
+    RUN(test_compensated_sampling_matches_density);
+    RUN(test_compensated_sampling_matches_density_rotated);
     RUN(test_furnace_albedo_1);
     RUN(test_furnace_albedo_half);
-    RUN(test_strategies_agree);
+    RUN(test_strategies_agree_bright_sun);
+    RUN(test_strategies_agree_dim_sun);
     RUN(test_opencl_matches_scalar);
     RUN(test_whitted_sees_map);
     RUN(test_shared_exr_maps_load);

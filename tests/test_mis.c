@@ -214,7 +214,7 @@ static void test_light_choice_reuses_u1(void)
         uint li = light_choose(&v, u1, &rest);
         chosen[li]++;
         LightSample a, b;
-        int ok_a = light_sample(&v, ref, 1, 0.0f, u1, u2, &a);
+        int ok_a = light_sample(&v, ref, 1, 1, 0.0f, u1, u2, &a);
         if (v.lights[li].prim >= rs.ds.params.n_spheres + rs.ds.params.n_triangles) {
             light_of_box = li;
             if (!ok_a) continue;
@@ -241,7 +241,7 @@ static void test_light_choice_reuses_u1(void)
             if (!ok_a || memcmp(&a.p, &want, sizeof want) || a.pdf != light_pdf(&v, li, ref, a.p, a.n)) differ++;
             continue;
         }
-        int ok_b = light_sample(&v, ref, 0, u1, rest, u2, &b);
+        int ok_b = light_sample(&v, ref, 1, 0, u1, rest, u2, &b);
         if (ok_a != ok_b || (ok_a && (memcmp(&a.p, &b.p, sizeof a.p) || a.pdf != b.pdf))) differ++;
     }
     fprintf(stderr, "  reuse sweep of %d: lights chosen %u %u %u %u (pick pdf %.4f %.4f %.4f %.4f); box faces %u %u "
@@ -346,7 +346,7 @@ static void test_quad_lamp_samples_uniformly(void)
         float u1 = lo + (hi - lo) * a;
         if (!(u1 < hi)) continue;
         LightSample ls;
-        if (!light_sample(&v, ref, 1, 0.0f, u1, u2, &ls)) continue;
+        if (!light_sample(&v, ref, 1, 1, 0.0f, u1, u2, &ls)) continue;
         float rest;
         uint li = light_choose(&v, u1, &rest);
         if (li != 1u && li != 2u) continue;
@@ -473,7 +473,8 @@ static void test_delta_light_choice_at_point(void)
         for (uint i = 0; i < N; i++) {
             float u = ((float)i + 0.5f) / (float)N, u2 = (float)((i * 2654435769u) >> 8) * 5.9604645e-8f;
             LightSample ls;
-            int ok = reuse ? light_sample(&v, ref, 1, 0.0f, u, u2, &ls) : light_sample(&v, ref, 0, u, u2, 0.5f, &ls);
+            int ok = reuse ? light_sample(&v, ref, 1, 1, 0.0f, u, u2, &ls)
+                           : light_sample(&v, ref, 1, 0, u, u2, 0.5f, &ls);
             if (!ok) continue;
             if (!ls.delta) {
                 n_area++;

@@ -281,6 +281,7 @@ static Status prepare(Scene *s, int tree_threads, RenderScene *out, Error *err)
     p->bg_rot_cos = (float)cos(rot);
     p->bg_rot_sin = (float)sin(rot);
     p->bg_light = s->env_light;
+    p->env_mis_dist = (uint)s->env_mis_dist;   /* env_dist_build keeps it below 2^32 */
     if ((st = crop_params(s, p, err))) return st;
     p->max_depth = s->image.max_depth;
     p->split = s->image.split;   /* 0: auto, chosen by render_job_run's pilot (split_pilot.h); 1 until then */

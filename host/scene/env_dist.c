@@ -4,6 +4,7 @@
 #include "light/envmap.h" /* env_guide_cells: the kernels' lookups must agree with these tables */
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -42,29 +43,21 @@ static void guide_write(const float *cdf, size_t n, size_t g, float *out)
     }
 }
 
-Status env_dist_build(const uint *texels, uint width, uint height, float **cdf, size_t *n, double *mean, Error *err)
+/* Writes one distribution of the W x H map into out (env_dist_floats(W, H) floats: the
+ * cdfs, then their guides), the weight of a pixel its luminance less `floor` (at least
+ * 0) times sin(theta) at its row's centre, the solid angle of its pixels. row and
+ * row_sum are scratch of W and H doubles. Returns the weights' total. */
+static double dist_write(const uint *texels, size_t W, size_t H, double floor, double *row, double *row_sum,
+                         float *out)
 {
-    *cdf = NULL;
-    *n = 0;
-    *mean = 0.0;
-    size_t W = width, H = height, cdfs = (H + 1) + H * (W + 1);
-    size_t guide_h = env_guide_cells(height), guide_w = env_guide_cells(width);
-    size_t count = cdfs + guide_h + H * guide_w;
-    double *row = malloc(W * sizeof *row), *row_sum = calloc(H, sizeof *row_sum);
-    float *out = malloc(count * sizeof *out);
-    if (!row || !row_sum || !out) {
-        free(row);
-        free(row_sum);
-        free(out);
-        return error_set(err, ST_INTERNAL, "out of memory building the environment map's distribution");
-    }
+    size_t cdfs = (H + 1) + H * (W + 1), guide_h = env_guide_cells((uint)H), guide_w = env_guide_cells((uint)W);
     double total = 0.0;
     for (size_t j = 0; j < H; j++) {
-        /* sin(theta) at the row's centre: the solid angle of its pixels */
         double sin_t = sin(M_PI * ((double)j + 0.5) / (double)H);
         row_sum[j] = 0.0;
         for (size_t i = 0; i < W; i++) {
-            row[i] = texel_luminance(texels, j * W + i) * sin_t;
+            double y = texel_luminance(texels, j * W + i) - floor;
+            row[i] = (y > 0.0 ? y : 0.0) * sin_t;
             row_sum[j] += row[i];
         }
         cdf_write(row, W, row_sum[j], out + (H + 1) + j * (W + 1));
@@ -74,16 +67,50 @@ Status env_dist_build(const uint *texels, uint width, uint height, float **cdf, 
     guide_write(out, H, guide_h, out + cdfs);
     for (size_t j = 0; j < H; j++)
         guide_write(out + (H + 1) + j * (W + 1), W, guide_w, out + cdfs + guide_h + j * guide_w);
-    free(row);
-    free(row_sum);
+    return total;
+}
+
+size_t env_dist_floats(uint width, uint height)
+{
+    size_t W = width, H = height;
+    return (H + 1) + H * (W + 1) + env_guide_cells(height) + H * env_guide_cells(width);
+}
+
+Status env_dist_build(const uint *texels, uint width, uint height, EnvDist *out, Error *err)
+{
+    memset(out, 0, sizeof *out);
+    size_t W = width, H = height, one = env_dist_floats(width, height);
+    double *row = malloc(W * sizeof *row), *row_sum = calloc(H, sizeof *row_sum);
+    float *cdf = malloc(2 * one * sizeof *cdf);
+    if (!row || !row_sum || !cdf) {
+        free(row);
+        free(row_sum);
+        free(cdf);
+        return error_set(err, ST_INTERNAL, "out of memory building the environment map's distribution");
+    }
+    double total = dist_write(texels, W, H, 0.0, row, row_sum, cdf);
     /* each pixel spans (2 pi / W) (pi / H) sin(theta) steradians of the 4 pi */
     double m = total * (2.0 * M_PI * M_PI / ((double)W * (double)H)) / (4.0 * M_PI);
     if (!(m > 0.0) || !isfinite(m)) {
-        free(out);
+        free(row);
+        free(row_sum);
+        free(cdf);
         return ST_OK;
     }
-    *cdf = out;
-    *n = count;
-    *mean = m;
+    /* The compensated distribution (env_dist.h): luminance less its mean over the sphere,
+     * the sum of the weights above over that of sin(theta) alone, raised by a millionth
+     * so that a constant map's pixels, which the mean's rounding may leave a few ulps
+     * above it, are left out (no compensated distribution) rather than sampled by that
+     * rounding alone. */
+    double sin_sum = 0.0;
+    for (size_t j = 0; j < H; j++) sin_sum += (double)W * sin(M_PI * ((double)j + 0.5) / (double)H);
+    double floor = total / sin_sum * (1.0 + 1e-6);
+    double comp = one <= UINT32_MAX ? dist_write(texels, W, H, floor, row, row_sum, cdf + one) : 0.0;
+    free(row);
+    free(row_sum);
+    out->cdf = cdf;
+    out->n = comp > 0.0 && isfinite(comp) ? 2 * one : one;
+    out->mis_offset = out->n > one ? one : 0;
+    out->mean = m;
     return ST_OK;
 }

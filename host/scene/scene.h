@@ -122,7 +122,8 @@ typedef struct {
     uint bg_cubemap;             /* BG_CUBEMAP: index of the first of its six textures;
                                   * BG_MAP: the map's texture (scene_set_envmap) */
     float bg_rotate;             /* BG_MAP: degrees about +y */
-    float *env_cdf;  size_t n_env_cdf;   /* BG_MAP: its distribution (kernels/light/envmap.h) */
+    float *env_cdf;  size_t n_env_cdf;   /* BG_MAP: its distributions (kernels/light/envmap.h) */
+    size_t env_mis_dist;         /* ... where the compensated one starts, or 0 (env_dist.h) */
     double env_mean;             /* BG_MAP: mean luminance over the sphere, scaled */
     uint env_light;              /* its light in `lights`, or NO_INDEX (scene_prepare_lights) */
 

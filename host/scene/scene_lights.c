@@ -230,20 +230,20 @@ Status scene_set_envmap(Scene *s, uint texture, float intensity, float rotate, E
     if (t->width > (1u << 24) || t->height > (1u << 24))
         return error_set(err, ST_INPUT, "'%s': an environment map is at most 16777216 pixels wide and high, not %ux%u",
                          s->texture_sources[texture] ? s->texture_sources[texture] : "", t->width, t->height);
-    float *cdf;
-    size_t n;
-    double mean;
-    Status st = env_dist_build(s->texels + t->offset, t->width, t->height, &cdf, &n, &mean, err);
+    EnvDist dist;
+    Status st = env_dist_build(s->texels + t->offset, t->width, t->height, &dist, err);
     if (st) return st;
     free(s->env_cdf);
-    s->env_cdf = cdf;
-    s->n_env_cdf = n;
-    s->env_mean = mean * (double)intensity;
+    s->env_cdf = dist.cdf;
+    s->n_env_cdf = dist.n;
+    s->env_mis_dist = dist.mis_offset;
+    s->env_mean = dist.mean * (double)intensity;
     if (!(intensity > 0.0f)) {
         /* a black map is no light */
         free(s->env_cdf);
         s->env_cdf = NULL;
         s->n_env_cdf = 0;
+        s->env_mis_dist = 0;
     }
     s->bg_type = BG_MAP;
     s->bg_cubemap = texture;

@@ -70,7 +70,7 @@ KFN int shade_light_sample(const SceneView *sc, GLOBAL PathState *ps, Surface s,
      * their own dimension for the choice, and with it clpt's earlier images. */
     int reuse = key.sampler == SAMPLER_SOBOL;
     float u_pick = reuse ? 0.0f : rng_uniform(key, b, DIM_LIGHT_PICK);
-    if (!light_sample(sc, s.p, reuse, u_pick, lu, lv, &ls))
+    if (!light_sample(sc, s.p, mis_mode == MIS_BOTH, reuse, u_pick, lu, lv, &ls))
         return 0;
     if (!ls.delta && mis_mode == MIS_BSDF_ONLY) return 0;
     vec3 wi = ls.wi;
@@ -107,9 +107,10 @@ KFN_INLINE void shade_escape(const SceneView *sc, Ray r, GLOBAL PathState *ps)
     vec3 Le;
     if (!(ps->flags & PATH_SPECULAR) && KF_HAS(KF_ENV_MAP) && p->bg_type == BG_MAP && p->bg_light != NO_INDEX) {
         /* the map's radiance and its light-sampling density from one lookup of the
-         * direction's pixel (light_pdf_env's value) */
+         * direction's pixel (light_pdf_env's value; the compensated distribution's,
+         * which next-event estimation draws from where MIS weighs, envmap.h) */
         float env_pdf_d;
-        Le = env_radiance_pdf(sc, r.d, &env_pdf_d);
+        Le = env_radiance_pdf(sc, r.d, 1, &env_pdf_d);
         float light_pdf = sc->lights[p->bg_light].pick_pdf * env_pdf_d;
         w = p->mis_mode == MIS_BOTH ? mis_power(ps->bsdf_pdf, light_pdf)
                                     : (p->mis_mode == MIS_BSDF_ONLY ? 1.0f : 0.0f);

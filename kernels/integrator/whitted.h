@@ -118,8 +118,8 @@ KFN vec3 whitted_direct(const SceneView *sc, Surface s, vec3 d, vec3 ns, vec3 ng
         float top = sc->lights[p->n_area_lights - 1u].cdf;
         LightSample ls;
         if (top > 0.0f &&
-            light_sample_in(sc, s.p, top, 0, rng_uniform(key, node, DIM_LIGHT_PICK), rng_uniform(key, node, DIM_LIGHT_U),
-                            rng_uniform(key, node, DIM_LIGHT_V), &ls) &&
+            light_sample_in(sc, s.p, top, 0, 0, rng_uniform(key, node, DIM_LIGHT_PICK),
+                            rng_uniform(key, node, DIM_LIGHT_U), rng_uniform(key, node, DIM_LIGHT_V), &ls) &&
             !ls.delta && v3_dot(ns, ls.wi) > 0.0f && v3_dot(ng, ls.wi) > 0.0f) {
             if (!whitted_occluded(sc, s, ng, ls, rays))
                 L = v3_add(L, whitted_phong(kd, ks, shininess, r, ns, ls.wi, v3_scale(ls.Le, 1.0f / ls.pdf)));

@@ -33,6 +33,12 @@
  * at most of its ten steps, and the guides made scenes/envmap.scene 7-8% faster on both
  * devices. They find the same cell, so images did not change. The marginal's guide is
  * at H + 1 + H (W + 1), row j's G(H) + j G(W) floats after it.
+ *
+ * env_cdf holds a second distribution of that layout at RenderParams.env_mis_dist (0
+ * when there is none): the map's luminance less its mean over the sphere, at least 0,
+ * times sin(theta) (MIS compensation, host/scene/env_dist.h). Light samples that MIS
+ * weighs against BSDF sampling draw from it (`mis` set below), and MIS reads their
+ * density from it; light sampling alone keeps the map's own.
  * Valid C11 and OpenCL C 1.2.
  */
 #ifndef CLPT_ENVMAP_H
@@ -91,32 +97,39 @@ KFN vec3 env_radiance(const SceneView *sc, vec3 d)
     return env_texel_radiance(sc, e.tx, e.x, e.y);
 }
 
+/* The distribution light samples draw from: with `mis` (the sample is weighted by MIS
+ * against BSDF sampling) the compensated one where the map has it, else the map's own. */
+KFN GLOBAL const float *env_dist(const SceneView *sc, int mis)
+{
+    return sc->env_cdf + (mis ? sc->params->env_mis_dist : 0u);
+}
+
 /* The solid-angle density with which env_sample picks a direction in pixel (x, y) of
- * the map, sin_t its sin(theta) (env_pixel). */
-KFN float env_pixel_pdf(const SceneView *sc, Texture tx, uint x, uint y, float sin_t)
+ * the map from distribution `dist` (env_dist), sin_t its sin(theta) (env_pixel). */
+KFN float env_pixel_pdf(GLOBAL const float *dist, Texture tx, uint x, uint y, float sin_t)
 {
     if (!(sin_t > 0.0f)) return 0.0f;
-    GLOBAL const float *marg = sc->env_cdf;
+    GLOBAL const float *marg = dist;
     GLOBAL const float *cond = marg + tx.height + 1u + y * (tx.width + 1u);
     float p_uv = (marg[y + 1u] - marg[y]) * (float)tx.height * ((cond[x + 1u] - cond[x]) * (float)tx.width);
     return p_uv / (2.0f * K_PI * K_PI * sin_t);
 }
 
 /* env_radiance of direction d and, in *pdf, the solid-angle density with which
- * env_sample picks d, its pixel found once (what the renderer asks for both: two atan2
- * fewer than apart). */
-KFN vec3 env_radiance_pdf(const SceneView *sc, vec3 d, float *pdf)
+ * env_sample(sc, mis, ...) picks d, its pixel found once (what the renderer asks for
+ * both: two atan2 fewer than apart). */
+KFN vec3 env_radiance_pdf(const SceneView *sc, vec3 d, int mis, float *pdf)
 {
     EnvPixel e = env_find(sc, d);
-    *pdf = env_pixel_pdf(sc, e.tx, e.x, e.y, e.sin_theta);
+    *pdf = env_pixel_pdf(env_dist(sc, mis), e.tx, e.x, e.y, e.sin_theta);
     return env_texel_radiance(sc, e.tx, e.x, e.y);
 }
 
 /* The density alone (light_pdf_env, for the tests' checks of the sampler). */
-KFN float env_pdf(const SceneView *sc, vec3 d)
+KFN float env_pdf(const SceneView *sc, vec3 d, int mis)
 {
     float pdf;
-    env_radiance_pdf(sc, d, &pdf);
+    env_radiance_pdf(sc, d, mis, &pdf);
     return pdf;
 }
 
@@ -148,19 +161,19 @@ KFN uint env_cdf_find(GLOBAL const float *cdf, GLOBAL const float *guide, uint n
     return lo;
 }
 
-/* A direction drawn from the map's distribution with (u1, u2) in [0, 1)^2: a row by
- * the marginal cdf, a pixel in it by the row's cdf, a uniform point in the pixel's
- * (u, v) rectangle. Returns the unit direction in the world, and in *Le and *pdf the
+/* A direction drawn from the map's distribution (env_dist(sc, mis)) with (u1, u2) in
+ * [0, 1)^2: a row by the marginal cdf, a pixel in it by the row's cdf, a uniform point
+ * in the pixel's (u, v) rectangle. Returns the unit direction in the world, and in *Le and *pdf the
  * radiance of the pixel drawn and the solid-angle density of the point, from the pixel
  * and sin(theta) the sample already has, as pbrt-v4's image light. Finding them again
  * from the direction cost two atan2, and where rounding put a direction just across its
  * pixel's edge it paired the neighbour's radiance with this pixel's probability. */
-KFN vec3 env_sample(const SceneView *sc, float u1, float u2, vec3 *Le, float *pdf)
+KFN vec3 env_sample(const SceneView *sc, int mis, float u1, float u2, vec3 *Le, float *pdf)
 {
     GLOBAL const RenderParams *p = sc->params;
     Texture tx = sc->textures[p->bg_cubemap];
     uint W = tx.width, H = tx.height;
-    GLOBAL const float *marg = sc->env_cdf, *marg_guide = marg + (H + 1u) + H * (W + 1u);
+    GLOBAL const float *marg = env_dist(sc, mis), *marg_guide = marg + (H + 1u) + H * (W + 1u);
     float fy, fx;
     uint y = env_cdf_find(marg, marg_guide, H, u1, &fy);
     uint x = env_cdf_find(marg + (H + 1u) + y * (W + 1u), marg_guide + env_guide_cells(H) + y * env_guide_cells(W), W,
@@ -169,7 +182,7 @@ KFN vec3 env_sample(const SceneView *sc, float u1, float u2, vec3 *Le, float *pd
     float st, ct, sp, cp;
     k_sincos(K_PI * v, &st, &ct);
     k_sincos(K_TWO_PI * u, &sp, &cp);
-    *pdf = env_pixel_pdf(sc, tx, x, y, st);
+    *pdf = env_pixel_pdf(marg, tx, x, y, st);
     *Le = env_texel_radiance(sc, tx, x, y);
     vec3 m = v3(st * sp, ct, -st * cp);
     float c = p->bg_rot_cos, s = p->bg_rot_sin;

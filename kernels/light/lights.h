@@ -184,14 +184,16 @@ KFN float light_pdf(const SceneView *sc, uint li, vec3 ref, vec3 x, vec3 n)
     return pick * light_pdf_area(sc, li, ref, x, n);
 }
 
-/* The density with which light sampling picks direction d toward the environment map
- * (the choice of the map among all lights included); 0 when the map is no light. MIS
- * in shade_path computes the same value from env_radiance_pdf's lookup; the tests
- * check light samples against this. */
-KFN float light_pdf_env(const SceneView *sc, vec3 d)
+/* The density with which light sampling (light_sample(sc, ..., mis, ...)) picks
+ * direction d toward the environment map (the choice of the map among all lights
+ * included); 0 when the map is no light. MIS in shade_path computes the same value
+ * from env_radiance_pdf's lookup; the tests check light samples against this. */
+KFN float light_pdf_env(const SceneView *sc, vec3 d, int mis)
 {
     uint li = sc->params->bg_light;
-    return !KF_HAS(KF_ENV_MAP) || li == NO_INDEX || sc->params->bg_type != BG_MAP ? 0.0f : sc->lights[li].pick_pdf * env_pdf(sc, d);
+    return !KF_HAS(KF_ENV_MAP) || li == NO_INDEX || sc->params->bg_type != BG_MAP
+               ? 0.0f
+               : sc->lights[li].pick_pdf * env_pdf(sc, d, mis);
 }
 
 /* The share of a spot light's intensity sent at cosine c from its axis (enum
@@ -399,9 +401,13 @@ KFN uint light_choose_delta(const SceneView *sc, vec3 ref, uint li, float u, flo
  * one of u1's 24 bits for each halving of the light's choice probability: a light
  * chosen once in 8192 samples still gets 2048 positions along u1. Without `reuse`
  * u_pick chooses, as for independent samples, where there is no stratification to
- * keep. */
-KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, int reuse, float u_pick, float u1, float u2,
-                        LightSample *ls)
+ * keep.
+ *
+ * `mis` says that MIS weighs the sample against BSDF sampling, which finds what it
+ * leaves out: the environment map is then sampled from its compensated distribution
+ * (kernels/light/envmap.h). */
+KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, int mis, int reuse, float u_pick, float u1,
+                        float u2, LightSample *ls)
 {
     float u_rest;
     uint li = light_choose(sc, (reuse ? u1 : u_pick) * cdf_top, &u_rest);
@@ -411,7 +417,7 @@ KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, int reuse,
     if (KF_HAS(KF_ENV_MAP) && l.type == LIGHT_ENV) {
         /* the environment map: a direction from its distribution, infinitely far */
         float pdf;
-        ls->wi = env_sample(sc, u1, u2, &ls->Le, &pdf);
+        ls->wi = env_sample(sc, mis, u1, u2, &ls->Le, &pdf);
         ls->pdf = choice * pdf;
         ls->p = ref;
         ls->n = v3s(0.0f);
@@ -433,10 +439,11 @@ KFN int light_sample_in(const SceneView *sc, vec3 ref, float cdf_top, int reuse,
     return ls->pdf > 0.0f;
 }
 
-/* Samples any light (next-event estimation of the path integrator). */
-KFN int light_sample(const SceneView *sc, vec3 ref, int reuse, float u_pick, float u1, float u2, LightSample *ls)
+/* Samples any light (next-event estimation of the path integrator; `mis` as above). */
+KFN int light_sample(const SceneView *sc, vec3 ref, int mis, int reuse, float u_pick, float u1, float u2,
+                     LightSample *ls)
 {
-    return light_sample_in(sc, ref, 1.0f, reuse, u_pick, u1, u2, ls);
+    return light_sample_in(sc, ref, 1.0f, mis, reuse, u_pick, u1, u2, ls);
 }
 
 /* The shadow ray from surface point p (error bound p_err, geometric normal ng turned

@@ -68,7 +68,7 @@ KFN int medium_light_sample(const SceneView *sc, GLOBAL PathState *ps, vec3 x, v
     int reuse = key.sampler == SAMPLER_SOBOL;
     float u_pick = reuse ? 0.0f : rng_uniform(key, rb, DIM_LIGHT_PICK);
     LightSample ls;
-    if (!light_sample(sc, x, reuse, u_pick, lu, lv, &ls)) return 0;
+    if (!light_sample(sc, x, p->mis_mode == MIS_BOTH, reuse, u_pick, lu, lv, &ls)) return 0;
     if (!ls.delta && p->mis_mode == MIS_BSDF_ONLY) return 0;
     float ph = phase_hg(g, d, ls.wi);
     float w = ls.delta || p->mis_mode == MIS_LIGHT_ONLY ? 1.0f : mis_power(ls.pdf, ph);

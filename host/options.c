@@ -91,8 +91,8 @@
         "(1..64; 1: none; overrides the scene's image\n" \
         "split). auto, the default: a short pilot render\n" \
         "of a sparse grid of pixels measures 1, 2, 4, 8,\n" \
-        "and the render takes the one of least error x\n" \
-        "rays, the same on any devices; small renders\n" \
+        "16, and the render takes the one of least error\n" \
+        "x rays, the same on any devices; small renders\n" \
         "keep 1 (docs/design.md, First-hit splitting)") \
     X(OUTPUT, CUSTOM, noise_threshold, "--noise-threshold", NULL, "T", PARSE(parse_noise_threshold), \
         "path tracer: adaptive sampling; a pixel stops once\n" \

@@ -882,7 +882,9 @@ typedef struct {                                        /* 80 bytes */
 #define SHADE_CONTINUE 1u     /* the path goes on with the ray written back */
 #define SHADE_SHADOW 2u       /* a shadow ray was written; shadow_L waits on it */
 #define SHADE_SCATTERED 4u    /* the surface scatters (a BSDF was sampled, whether or not
-                               * the sample went on): at the first hit, the path splits */
+                               * the sample went on), or the camera ray's first hit is a
+                               * medium's boundary and the path crossed it: at the
+                               * first hit, the path splits */
 
 #ifndef KERNEL_OPENCL
 #include <stddef.h>

@@ -219,7 +219,7 @@ static void test_split_auto_chooses_alike(void)
                  "--stats", "-q", "-o", outs[1]),
             &r);
     CHECK_EQ_INT(r.status, 0);
-    CHECK_STR_CONTAINS(r.out, "split: 1 (auto without a pilot: an image under 256x256, or media)");
+    CHECK_STR_CONTAINS(r.out, "split: 1 (auto without a pilot: an image under 256x256, or a camera in a medium)");
     CHECK(files_equal(ref, outs[1]));
     unlink(outs[0]);
     unlink(outs[1]);

@@ -160,7 +160,7 @@ static int render_means(const char *text, const char *devices, double mean[3])
  * channel. With scattering the free-flight sampling decides it (chosen by one channel,
  * weighted by all three); without, the transmittance is exact. */
 #define SLAB_SCENE \
-    "image { width 16 height 16 spp 256 depth 0 }\n" \
+    "image { width 16 height 16 spp %s depth 0 split %s }\n" \
     "camera { from 0 0 5 at 0 0 0 up 0 1 0 fov 2 }\n" \
     "medium m { type homogeneous sigma_a %s sigma_s %s }\n" \
     "material lamp { type emissive radiance 1 1 1 }\n" \
@@ -185,26 +185,32 @@ static void slab_expected(vec3 sigma_t, double want[3])
     for (int c = 0; c < 3; c++) want[c] = sum[c] / ((double)n * n);
 }
 
-static void check_slab(const char *sa, const char *ss, vec3 sigma_t, double tol)
+/* split > 1: first-hit splitting, whose first hit is the slab's boundary (each branch
+ * flies through the slab on its own), at the same number of flights */
+static void check_slab(const char *sa, const char *ss, vec3 sigma_t, double tol, int split)
 {
-    char text[1024];
-    snprintf(text, sizeof text, SLAB_SCENE, sa, ss);
+    char text[1024], spp[16], splits[16];
+    snprintf(spp, sizeof spp, "%d", 256 / split);
+    snprintf(splits, sizeof splits, "%d", split);
+    snprintf(text, sizeof text, SLAB_SCENE, spp, splits, sa, ss);
     const char *devices[] = { "scalar", TEST_OPENCL };
     for (int d = 0; d < 2; d++) {
         double m[3];
         if (!render_means(text, devices[d], m)) continue;
         double want[3];
         slab_expected(sigma_t, want);
-        fprintf(stderr, "  slab sigma_a %s sigma_s %s on %s: %.5f %.5f %.5f (exp(-sigma_t d / cos): %.5f %.5f %.5f)\n", sa,
-                ss, devices[d], m[0], m[1], m[2], want[0], want[1], want[2]);
+        fprintf(stderr, "  slab sigma_a %s sigma_s %s, split %d, on %s: %.5f %.5f %.5f (exp(-sigma_t d / cos): %.5f "
+                "%.5f %.5f)\n", sa, ss, split, devices[d], m[0], m[1], m[2], want[0], want[1], want[2]);
         for (int c = 0; c < 3; c++) CHECK_NEAR(m[c], want[c], tol);
     }
 }
 
 static void test_slab_transmittance(void)
 {
-    check_slab("0.1 0.2 0.4", "0.3 0.1 0.5", v3(0.4f, 0.3f, 0.9f), 0.006);
-    check_slab("0.1 0.7 1.5", "0 0 0", v3(0.1f, 0.7f, 1.5f), 2e-5);
+    check_slab("0.1 0.2 0.4", "0.3 0.1 0.5", v3(0.4f, 0.3f, 0.9f), 0.006, 1);
+    check_slab("0.1 0.7 1.5", "0 0 0", v3(0.1f, 0.7f, 1.5f), 2e-5, 1);
+    check_slab("0.1 0.2 0.4", "0.3 0.1 0.5", v3(0.4f, 0.3f, 0.9f), 0.006, 4);
+    check_slab("0.1 0.7 1.5", "0 0 0", v3(0.1f, 0.7f, 1.5f), 2e-5, 4);
 }
 
 /* The white furnace: a non-absorbing medium (albedo 1) inside a sphere, under a white
@@ -213,30 +219,35 @@ static void test_slab_transmittance(void)
  * boundary is `material none`, or glass (whose refraction clpt does not scale by
  * 1/eta^2, so the radiance inside is 1 too). */
 #define FURNACE_SCENE \
-    "image { width 16 height 16 spp 128 depth 512 }\n" \
+    "image { width 16 height 16 spp %s depth 512 split %s }\n" \
     "camera { from 0 0 %s at 0 0 -1 up 0 1 0 fov 60 }\n" \
     "background { color 1 1 1 }\n" \
     "medium m { type homogeneous sigma_a 0 0 0 sigma_s %s g %s }\n" \
     "material glass { type dielectric ior 1.5 }\n" \
     "sphere { center 0 0 0 radius 1 material %s interior m }\n"
 
-static void check_furnace(const char *cam_z, const char *ss, const char *g, const char *boundary)
+static void check_furnace(const char *cam_z, const char *ss, const char *g, const char *boundary, int split)
 {
-    char text[1024];
-    snprintf(text, sizeof text, FURNACE_SCENE, cam_z, ss, g, boundary);
+    char text[1024], spp[16], splits[16];
+    snprintf(spp, sizeof spp, "%d", 128 / split);
+    snprintf(splits, sizeof splits, "%d", split);
+    snprintf(text, sizeof text, FURNACE_SCENE, spp, splits, cam_z, ss, g, boundary);
     double m[3];
     if (!render_means(text, "scalar", m)) return;
-    fprintf(stderr, "  furnace sigma_s %s, g %s, %s, camera at z %s: %.4f %.4f %.4f (expected 1)\n", ss, g, boundary,
-            cam_z, m[0], m[1], m[2]);
+    fprintf(stderr, "  furnace sigma_s %s, g %s, %s, camera at z %s, split %d: %.4f %.4f %.4f (expected 1)\n", ss, g,
+            boundary, cam_z, split, m[0], m[1], m[2]);
     for (int c = 0; c < 3; c++) CHECK_NEAR(m[c], 1.0, 0.02);
 }
 
 static void test_furnace(void)
 {
-    check_furnace("0", "2 2 2", "0", "none");
-    check_furnace("0", "2 2 2", "0.7", "none");
-    check_furnace("0", "0.5 2 4", "-0.5", "none");      /* chromatic */
-    check_furnace("3", "1 2 3", "0.3", "glass");         /* seen from outside, through glass */
+    check_furnace("0", "2 2 2", "0", "none", 1);
+    check_furnace("0", "2 2 2", "0.7", "none", 1);
+    check_furnace("0", "0.5 2 4", "-0.5", "none", 1);   /* chromatic */
+    check_furnace("3", "1 2 3", "0.3", "glass", 1);      /* seen from outside, through glass */
+    /* first-hit splitting from outside: at the boundary, and at the glass */
+    check_furnace("3", "1 2 3", "0.3", "none", 4);
+    check_furnace("3", "1 2 3", "0.3", "glass", 4);
 }
 
 /* Single scattering against a numeric integral: the camera and a point light in one
@@ -380,15 +391,49 @@ static void test_resume_matches_straight(void)
                                       TEST_TMP("clpt-test-media-out.pfm"), TEST_TMP("clpt-test-media.ckpt"));
 }
 
-/* First-hit splitting restarts paths at their first surface, which media can take
- * away: refused, with the way out. */
+/* First-hit splitting restarts paths at the camera ray's first hit, which a camera
+ * inside a medium may never reach: refused there, with the way out. */
 static void test_split_refused(void)
 {
     cli_run(ARGS("tests/data/media/mix.scene", "--device", "scalar", "--split", "2", "-q", "-o",
                  TEST_TMP("clpt-test-media-split.pfm")), &r);
     CHECK_EQ_INT(r.status, 2);
-    CHECK_STR_CONTAINS(r.err, "first-hit splitting (--split 2) does not work in a scene with participating media; "
-                              "render it with --split 1");
+    CHECK_STR_CONTAINS(r.err, "first-hit splitting (--split 2) does not work with the camera inside a "
+                              "participating medium; render it with --split 1");
+}
+
+/* First-hit splitting with the camera in vacuum: a fog lit by a lamp over a floor (the
+ * camera rays' first hits the floor, the lamp and the fog's boundary) at split 4 and 64
+ * samples has the means of split 1 at 256, on both devices; and scenes/fog.scene at
+ * split 3 on PoCL is the scalar device's render bit for bit. */
+static void test_split_in_vacuum(void)
+{
+    const char *rest = strchr(mis_scene, '\n') + 1;   /* all but its image line */
+    char text[2048];
+    double m[3][3];
+    const char *devices[] = { "scalar", "scalar", TEST_OPENCL };
+    const int split[] = { 1, 4, 4 };
+    for (int i = 0; i < 3; i++) {
+        snprintf(text, sizeof text, "image { width 24 height 24 spp %d depth 6 split %d }\n%s", 256 / split[i],
+                 split[i], rest);
+        if (!render_means(text, devices[i], m[i])) return;
+        fprintf(stderr, "  fog over a floor, split %d on %s: %.4f %.4f %.4f\n", split[i], devices[i], m[i][0], m[i][1],
+                m[i][2]);
+    }
+    for (int c = 0; c < 3; c++) {
+        CHECK_NEAR(m[1][c], m[0][c], 0.02 * m[0][c]);
+        CHECK(m[2][c] == m[1][c]);
+    }
+    const char *ref = TEST_TMP("clpt-test-media-split-scalar.pfm"), *out = TEST_TMP("clpt-test-media-split-ocl.pfm");
+    cli_run(ARGS("scenes/fog.scene", "--device", "scalar", "--width", "40", "--height", "30", "--spp", "4", "--split",
+                 "3", "-q", "-o", ref), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    cli_run(ARGS("scenes/fog.scene", "--device", TEST_OPENCL, "--width", "40", "--height", "30", "--spp", "4",
+                 "--split", "3", "--batch", "2", "-q", "-o", out), &r);
+    CHECK_MSG(r.status == 0, "%s", r.err);
+    CHECK_MSG(files_equal(ref, out), "scenes/fog.scene at --split 3: PoCL's image differs from the scalar device's");
+    unlink(ref);
+    unlink(out);
 }
 
 int main(void)
@@ -403,5 +448,6 @@ int main(void)
     RUN(test_devices_match_scalar);
     RUN(test_resume_matches_straight);
     RUN(test_split_refused);
+    RUN(test_split_in_vacuum);
     return harness_report();
 }

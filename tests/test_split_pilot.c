@@ -33,7 +33,7 @@ static void test_plan(void)
 static SplitPilot measured(uint n, const double *error, const uint64_t *rays)
 {
     SplitPilot sp = { 0 };
-    static const uint splits[] = { 1, 2, 4, 8 };
+    static const uint splits[] = { 1, 2, 4, 8, 16 };
     for (uint i = 0; i < n; i++) {
         sp.split[i] = splits[i];
         sp.error[i] = error[i];
@@ -47,7 +47,7 @@ static SplitPilot measured(uint n, const double *error, const uint64_t *rays)
  * split for SPLIT_PILOT_GAIN_MORE. */
 static void test_choose(void)
 {
-    const uint64_t rays[] = { 1000, 1600, 2800, 5200 };
+    const uint64_t rays[] = { 1000, 1600, 2800, 5200, 10000 };
     /* split 2 halves the error for 1.6 times the rays: 0.8 of split 1's */
     SplitPilot sp = measured(2, (const double[]){ 1.0, 0.5 }, rays);
     CHECK_EQ_INT(split_pilot_choose(&sp), 2);
@@ -65,6 +65,12 @@ static void test_choose(void)
     CHECK_EQ_INT(split_pilot_choose(&sp), 2);
     /* split 8 after 4 */
     sp = measured(4, (const double[]){ 1.0, 0.5, 0.25, 0.12 }, rays);
+    CHECK_EQ_INT(split_pilot_choose(&sp), 8);
+    /* split 16 after 8: 0.624 then 0.55 of split 1's (0.88 of split 8's) */
+    sp = measured(5, (const double[]){ 1.0, 0.5, 0.25, 0.12, 0.055 }, rays);
+    CHECK_EQ_INT(split_pilot_choose(&sp), 16);
+    /* split 16 at 0.96 of split 8's (the dragon's pilot, about): 8 */
+    sp = measured(5, (const double[]){ 1.0, 0.5, 0.25, 0.12, 0.06 }, rays);
     CHECK_EQ_INT(split_pilot_choose(&sp), 8);
     /* a later split compared with the choice, not with the one measured before it:
      * 2 not enough (0.96), 4 at 0.84 of split 1's */

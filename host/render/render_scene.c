@@ -210,8 +210,9 @@ static Status crop_params(const Scene *s, RenderParams *p, Error *err)
 }
 
 /* The media's part of the device scene (kernels/medium/). First-hit splitting
- * restarts a path at its first surface, which a path in a medium may never reach: the
- * two are not combined. */
+ * restarts a path at the camera ray's first hit, which a camera inside a medium may
+ * never reach (the flight toward it may scatter first): there the two are not
+ * combined. */
 static Status prepare_media(const Scene *s, RenderScene *out, Error *err)
 {
     RenderParams *p = &out->ds.params;
@@ -223,9 +224,9 @@ static Status prepare_media(const Scene *s, RenderScene *out, Error *err)
     out->ds.grids = s->n_grids ? s->grids : NULL;
     out->ds.grid_data = s->n_grid_data ? s->grid_data : NULL;
     out->ds.n_grid_data = s->n_grid_data;
-    if (p->has_media && p->split > 1u)
-        return error_set(err, ST_USAGE, "first-hit splitting (--split %u) does not work in a scene with "
-                         "participating media; render it with --split 1", p->split);
+    if (p->camera_medium != 0u && p->split > 1u)
+        return error_set(err, ST_USAGE, "first-hit splitting (--split %u) does not work with the camera inside a "
+                         "participating medium; render it with --split 1", p->split);
     return ST_OK;
 }
 

@@ -9,7 +9,7 @@
 #include "base/timer.h"
 #include "render/render_scene.h"
 
-static const uint candidates[SPLIT_PILOT_CANDIDATES] = { 1u, 2u, 4u, 8u };
+static const uint candidates[SPLIT_PILOT_CANDIDATES] = { 1u, 2u, 4u, 8u, 16u };
 
 uint split_pilot_plan(uint width, uint height, uint *stride, uint *pilot_spp)
 {
@@ -108,7 +108,7 @@ Status split_pilot_run(const AdaptiveRun *run, SplitPilot *sp, Error *err)
         return ST_OK;
     }
     uint stride, pilot_spp;
-    uint n = p->integrator == INTEGRATOR_PATH && !p->has_media
+    uint n = p->integrator == INTEGRATOR_PATH && p->camera_medium == 0u
                  ? split_pilot_plan(p->width, p->height, &stride, &pilot_spp) : 0u;
     if (n == 0u) return set_split(run, 1u, err);
     uint *list = malloc((size_t)n * sizeof *list);

@@ -11,7 +11,7 @@
  * points make both parts fall faster than 1/n, each at its own rate), so it is
  * measured rather than guessed: a sparse grid of pixels renders SPLIT_PILOT_SPP
  * samples per pixel twice, with two seeds of its own, at split 1, then
- * 2, 4 and 8 while the last one won. Each split's error is the relative squared
+ * 2, 4, 8 and 16 while the last one won. Each split's error is the relative squared
  * difference of its two films (two independent estimates of every pixel;
  * SPLIT_PILOT_REL_EPS), its cost the rays it traced; the render takes the N of least
  * error x rays, a larger N only where it promises at most SPLIT_PILOT_GAIN (from 1) or
@@ -32,7 +32,7 @@
 #include "render/adaptive.h"
 
 /* The splits the pilot may measure, in order; each after the one before won. */
-#define SPLIT_PILOT_CANDIDATES 4
+#define SPLIT_PILOT_CANDIDATES 5
 /* Splitting at all is chosen where its error x rays is below this share of split 1's
  * (the estimates are noisy, and on a GPU a split render also runs the megakernel), a
  * larger split where it is below the second share of the smaller one's (noise alone). */
@@ -89,7 +89,7 @@ uint split_pilot_plan(uint width, uint height, uint *stride, uint *pilot_spp);
 uint split_pilot_choose(const SplitPilot *sp);
 
 /* Runs the pilot for run->rs when its params ask for split auto (RenderParams.split 0)
- * on the path tracer without media, and writes the chosen split into the params (and so
+ * on the path tracer with the camera in vacuum, and writes the chosen split into the params (and so
  * to the devices, with update_params): 1 without a pilot. The params' pixel list and
  * sample step are restored. An interrupt during the pilot chooses 1. */
 Status split_pilot_run(const AdaptiveRun *run, SplitPilot *sp, Error *err);

@@ -202,7 +202,7 @@ void render_stats_print_split(FILE *out, const SplitPilot *sp, uint scene_split)
     }
     if (!sp->ran) {
         fprintf(out, sp->pixels ? "split: 1 (auto: the pilot was interrupted)\n"
-                                : "split: 1 (auto without a pilot: an image under 256x256, or media)\n");
+                                : "split: 1 (auto without a pilot: an image under 256x256, or a camera in a medium)\n");
         return;
     }
     fprintf(out, "split: %u, chosen by a pilot of %u pixels x %u spp in %.2f s (error x rays against split 1:",

@@ -117,8 +117,10 @@ KFN void raygen_path(GLOBAL const RenderParams *p, GLOBAL const MotionKey *motio
 /* Restarts the path of a camera sample as its next continuation from the first hit
  * (first-hit splitting, RenderParams.split): the state raygen_path gave it, but with the
  * radiance gathered so far and the next branch. The caller shades the first hit again,
- * which for a later branch samples a light and scatters but adds no emission
- * (shade_path). */
+ * which for a later branch samples a light and scatters (or crosses the boundary of a
+ * medium) but adds no emission (shade_path). The camera is in vacuum wherever a render
+ * splits (host/render/render_scene.c), so the path starts there again, with no
+ * boundary crossed. */
 KFN void path_branch_next(GLOBAL PathState *ps)
 {
     ps->throughput = v3s(1.0f);
@@ -127,6 +129,9 @@ KFN void path_branch_next(GLOBAL PathState *ps)
     ps->bsdf_pdf = 0.0f;
     ps->flags = PATH_SPECULAR;
     ps->branch = ps->branch + 1u;
+    ps->medium = 0u;
+    ps->shadow_medium = 0u;
+    ps->crossings = 0u;
 }
 
 #endif /* CLPT_RAYGEN_H */

@@ -190,6 +190,10 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
     RngKey key = rng_key_of(ps, p);
     uint bounce = ps->bounce;
     uint rb = KF_HAS(KF_MEDIA) ? path_rng_bounce(ps) : bounce;   /* past the boundaries crossed */
+    /* the camera ray's hit: what first-hit splitting shades once per branch (a surface
+     * reached through a boundary, not scattered at, is a later hit) */
+    uint crossings = KF_HAS(KF_MEDIA) ? ps->crossings : 0u;
+    int first_hit = bounce == 0u && crossings == 0u;
 
     /* in a medium, the flight to the hit may stop short of it (kernels/medium/) */
     uint medium_result;
@@ -203,13 +207,22 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
 
     Surface s = surface_at(sc, r, hit);
     Material m = sc->materials[s.material];   /* a mix: its own emission (mix.h) */
-    if (KF_HAS(KF_MEDIA) && (m.flags & MAT_INTERFACE))
-        return medium_cross(ray, hit, s, m, ps, path_max_crossings(p->has_media));
+    if (KF_HAS(KF_MEDIA) && (m.flags & MAT_INTERFACE)) {
+        uint crossed = medium_cross(ray, hit, s, m, ps, path_max_crossings(p->has_media));
+        /* the camera ray's first hit is a medium's boundary: each branch crosses it and
+         * flies on through the medium with its own numbers, weighted 1/B (the camera
+         * ray decides that its first hit is a boundary, whatever the numbers) */
+        if (crossed && first_hit && p->split > 1u) {
+            ps->throughput = v3_scale(ps->throughput, 1.0f / (float)p->split);
+            crossed |= SHADE_SCATTERED;
+        }
+        return crossed;
+    }
     shade_absorb(r, hit, s, m, ps);
-    int later_branch = bounce == 0u && ps->branch != 0u;
+    int later_branch = first_hit && ps->branch != 0u;
     if (!later_branch) shade_emission(sc, r, s, m, ps);
     if (bounce >= p->max_depth) return 0u;
-    if (bounce == 0u && p->split > 1u) ps->throughput = v3_scale(ps->throughput, 1.0f / (float)p->split);
+    if (first_hit && p->split > 1u) ps->throughput = v3_scale(ps->throughput, 1.0f / (float)p->split);
 
     /* normals turned toward the side the ray came from */
     int front = v3_dot(r.d, s.ng) < 0.0f;

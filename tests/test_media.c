@@ -359,13 +359,14 @@ static void test_strategies_agree(void)
 }
 
 /* Every wave launch of an OpenCL device (counted and bounded wavefront, megakernel)
- * gives the scalar device's bits on media scenes, with several waves and batches. */
+ * gives the scalar device's bits on media scenes, with several waves and batches (a
+ * split render, split.scene, runs the megakernel whatever the launch asked). */
 static void test_devices_match_scalar(void)
 {
-    const char *scenes[] = { "scenes/fog.scene", "tests/data/media/mix.scene" };
+    const char *scenes[] = { "scenes/fog.scene", "tests/data/media/mix.scene", "tests/data/media/split.scene" };
     const char *modes[] = { "counted", "bounded", "megakernel" };
     const char *ref = TEST_TMP("clpt-test-media-scalar.pfm"), *out = TEST_TMP("clpt-test-media-ocl.pfm");
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < 3; k++) {
         cli_run(ARGS(scenes[k], "--device", "scalar", "--width", "40", "--height", "30", "--spp", "6", "-q", "-o",
                      ref), &r);
         CHECK_MSG(r.status == 0, "%s: %s", scenes[k], r.err);
@@ -384,10 +385,12 @@ static void test_devices_match_scalar(void)
 }
 
 /* A media render checkpointed at 4 samples and resumed to 8, on PoCL and the scalar
- * device together, is the straight 8-sample render bit for bit. */
+ * device together, is the straight 8-sample render bit for bit; also split 3. */
 static void test_resume_matches_straight(void)
 {
     cli_check_resume_matches_straight("tests/data/media/mix.scene", TEST_TMP("clpt-test-media-ref.pfm"),
+                                      TEST_TMP("clpt-test-media-out.pfm"), TEST_TMP("clpt-test-media.ckpt"));
+    cli_check_resume_matches_straight("tests/data/media/split.scene", TEST_TMP("clpt-test-media-ref.pfm"),
                                       TEST_TMP("clpt-test-media-out.pfm"), TEST_TMP("clpt-test-media.ckpt"));
 }
 

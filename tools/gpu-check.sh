@@ -116,6 +116,8 @@ check cornell-megakernel scenes/cornell-box.scene --width 256 --height 256 --spp
 check weekend-megakernel scenes/one-weekend.scene --width 400 --height 225 --spp 8 --wave-launch megakernel
 check fog scenes/fog.scene --width 192 --height 144 --spp 8
 check fog-megakernel scenes/fog.scene --width 192 --height 144 --spp 8 --wave-launch megakernel
+check fog-split scenes/fog.scene --width 192 --height 144 --spp 4 --split 3
+check media-split tests/data/media/split.scene
 check instances scenes/instances.scene --width 192 --height 144 --spp 8
 check instances-megakernel scenes/instances.scene --width 192 --height 144 --spp 8 --wave-launch megakernel
 check coated scenes/coated.pbrt --width 160 --height 120 --spp 8

@@ -44,10 +44,10 @@ static void guide_write(const float *cdf, size_t n, size_t g, float *out)
 }
 
 /* Writes one distribution of the W x H map into out (env_dist_floats(W, H) floats: the
- * cdfs, then their guides), the weight of a pixel its luminance less `floor` (at least
+ * cdfs, then their guides), the weight of a pixel its luminance less `level` (at least
  * 0) times sin(theta) at its row's centre, the solid angle of its pixels. row and
  * row_sum are scratch of W and H doubles. Returns the weights' total. */
-static double dist_write(const uint *texels, size_t W, size_t H, double floor, double *row, double *row_sum,
+static double dist_write(const uint *texels, size_t W, size_t H, double level, double *row, double *row_sum,
                          float *out)
 {
     size_t cdfs = (H + 1) + H * (W + 1), guide_h = env_guide_cells((uint)H), guide_w = env_guide_cells((uint)W);
@@ -56,7 +56,7 @@ static double dist_write(const uint *texels, size_t W, size_t H, double floor, d
         double sin_t = sin(M_PI * ((double)j + 0.5) / (double)H);
         row_sum[j] = 0.0;
         for (size_t i = 0; i < W; i++) {
-            double y = texel_luminance(texels, j * W + i) - floor;
+            double y = texel_luminance(texels, j * W + i) - level;
             row[i] = (y > 0.0 ? y : 0.0) * sin_t;
             row_sum[j] += row[i];
         }
@@ -104,12 +104,17 @@ Status env_dist_build(const uint *texels, uint width, uint height, EnvDist *out,
      * rounding alone. */
     double sin_sum = 0.0;
     for (size_t j = 0; j < H; j++) sin_sum += (double)W * sin(M_PI * ((double)j + 0.5) / (double)H);
-    double floor = total / sin_sum * (1.0 + 1e-6);
-    double comp = one <= UINT32_MAX ? dist_write(texels, W, H, floor, row, row_sum, cdf + one) : 0.0;
+    double level = total / sin_sum * (1.0 + 1e-6);
+    double comp = one <= UINT32_MAX ? dist_write(texels, W, H, level, row, row_sum, cdf + one) : 0.0;
     free(row);
     free(row_sum);
-    out->cdf = cdf;
     out->n = comp > 0.0 && isfinite(comp) ? 2 * one : one;
+    if (out->n == one) {
+        /* no compensated distribution: give its room back */
+        float *shrunk = realloc(cdf, one * sizeof *cdf);
+        if (shrunk) cdf = shrunk;
+    }
+    out->cdf = cdf;
     out->mis_offset = out->n > one ? one : 0;
     out->mean = m;
     return ST_OK;

@@ -21,8 +21,8 @@
  * light: where a map is near its mean, BSDF sampling finds its light well, and light
  * sampling spent there only dilutes its samples of the bright parts. BSDF sampling
  * covers every direction the compensated distribution leaves out, so the MIS sum stays
- * unbiased; light sampling weighted alone (the whitted integrator, --mis light) keeps
- * the full one. A map at its mean everywhere (a constant one) has no compensated
+ * unbiased; light sampling weighted alone (RenderParams.mis_mode's light-only switch,
+ * which the tests set) keeps the full one. A map at its mean everywhere (a constant one) has no compensated
  * distribution: mis_offset is 0, the full one serves both. */
 typedef struct {
     float *cdf;         /* n floats (free with free); NULL for a black map: no light */

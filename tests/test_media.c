@@ -439,6 +439,33 @@ static void test_split_in_vacuum(void)
     unlink(out);
 }
 
+/* A shadow ray decides by the material the path sees: an instance's where it replaces
+ * its object's. A floor lit by a point light only through a lid, an instance of an
+ * object whose quad bounds a medium (`material none`, which a shadow ray passes
+ * through) but which the instance makes black and opaque: seen from below the lid the
+ * floor is in its shadow, every pixel exactly 0, on both devices. (The shadow rays once
+ * took the object's material and lit it through the lid.) */
+static void test_instance_material_blocks_shadows(void)
+{
+    static const char *text =
+        "image { width 16 height 16 spp 4 depth 1 }\n"
+        "camera { from 0 1 0 at 0 0 0 up 0 0 1 fov 40 }\n"
+        "medium m { type homogeneous sigma_a 0.1 0.1 0.1 sigma_s 0 0 0 }\n"
+        "material white { type diffuse albedo 1 1 1 }\n"
+        "material black { type diffuse albedo 0 0 0 }\n"
+        "quad { v0 -50 0 -50 v1 -50 0 50 v2 50 0 50 v3 50 0 -50 material white }\n"
+        "object lid { quad { v0 -50 0 -50 v1 50 0 -50 v2 50 0 50 v3 -50 0 50 material none interior m } }\n"
+        "instance lid { translate 0 2 0 material black }\n"
+        "light { type point position 0 5 0 intensity 10 10 10 }\n";
+    const char *devices[] = { "scalar", TEST_OPENCL };
+    for (int d = 0; d < 2; d++) {
+        double m[3];
+        if (!render_means(text, devices[d], m)) continue;
+        fprintf(stderr, "  floor under an instanced opaque lid on %s: %g %g %g\n", devices[d], m[0], m[1], m[2]);
+        for (int c = 0; c < 3; c++) CHECK(m[c] == 0.0);
+    }
+}
+
 int main(void)
 {
     RUN(test_hg_sampling_matches_density);
@@ -452,5 +479,6 @@ int main(void)
     RUN(test_resume_matches_straight);
     RUN(test_split_refused);
     RUN(test_split_in_vacuum);
+    RUN(test_instance_material_blocks_shadows);
     return harness_report();
 }

@@ -41,10 +41,7 @@
 KFN_INLINE int hit_has_alpha(const SceneView *sc, Hit hit)
 {
     if (!KF_HAS(KF_ALPHA) || !sc->params->has_alpha) return 0;
-    uint m = prim_material(sc, hit.prim);
-    if (SURFACE_INSTANCED(sc, hit) && sc->instances[hit.inst].material != NO_INDEX)
-        m = sc->instances[hit.inst].material;
-    return (sc->materials[m].flags & MAT_ALPHA_ANY) != 0u;
+    return (sc->materials[hit_material(sc, hit)].flags & MAT_ALPHA_ANY) != 0u;
 }
 
 /* The BLEND coin of a hit: uniform in [0, 1), a hash of the ray's and the hit's bits. */

@@ -340,6 +340,31 @@ KFN Surface surface_instanced(const SceneView *sc, Ray ray, Hit hit)
  * no instance. */
 #define SURFACE_INSTANCED(sc, s) (KF_HAS(KF_INSTANCES) && (s).inst != NO_INDEX && (sc)->params->n_instances != 0u)
 
+/* The material of primitive `prim` as stored (in its object's space: an instance may
+ * replace it, hit_material). */
+KFN uint prim_material(const SceneView *sc, uint prim)
+{
+    GLOBAL const RenderParams *p = sc->params;
+    uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
+    uint first_rev = first_box + p->n_boxes, first_plane = first_rev + p->n_revsurfaces;
+    if (prim < first_tri) return sc->spheres[prim].material;
+    if (prim < first_box) return sc->triangles[prim - first_tri].material;
+    if (prim < first_rev) return sc->boxes[prim - first_box].material;
+    if (prim < first_plane) return sc->revsurfaces[prim - first_rev].material;
+    return sc->planes[prim - first_plane].material;
+}
+
+/* The material a hit shows: its primitive's, or its instance's where that replaces it,
+ * as surface_at gives it, without the rest of the surface. Every query that decides by
+ * the material alone (cut-outs, a shadow ray's boundaries) asks this, so that it sees
+ * what the path sees. */
+KFN uint hit_material(const SceneView *sc, Hit hit)
+{
+    if (SURFACE_INSTANCED(sc, hit) && sc->instances[hit.inst].material != NO_INDEX)
+        return sc->instances[hit.inst].material;
+    return prim_material(sc, hit.prim);
+}
+
 /* The surface at a hit of ray (world space). */
 KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
 {

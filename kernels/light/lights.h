@@ -36,18 +36,6 @@ typedef struct {
     int delta;     /* a point, spot or directional light */
 } LightSample;
 
-KFN uint prim_material(const SceneView *sc, uint prim)
-{
-    GLOBAL const RenderParams *p = sc->params;
-    uint first_tri = p->n_spheres, first_box = first_tri + p->n_triangles;
-    uint first_rev = first_box + p->n_boxes, first_plane = first_rev + p->n_revsurfaces;
-    if (prim < first_tri) return sc->spheres[prim].material;
-    if (prim < first_box) return sc->triangles[prim - first_tri].material;
-    if (prim < first_rev) return sc->boxes[prim - first_box].material;
-    if (prim < first_plane) return sc->revsurfaces[prim - first_rev].material;
-    return sc->planes[prim - first_plane].material;
-}
-
 /* Whether primitive `prim` (a light) emits toward direction `toward` from a point with
  * outward/winding normal n. */
 KFN int light_faces(const SceneView *sc, uint prim, vec3 n, vec3 toward)

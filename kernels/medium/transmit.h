@@ -43,7 +43,7 @@ KFN uint shadow_trace_media(const SceneView *sc, GLOBAL PathState *ps, Ray r)
             }
         }
         if (h.prim == NO_INDEX) break;
-        Material m = sc->materials[prim_material(sc, h.prim)];
+        Material m = sc->materials[hit_material(sc, h)];   /* an instance's where it replaces it */
         if (!(m.flags & MAT_INTERFACE) || n > MEDIUM_MAX_CROSSINGS) {
             tr = v3s(0.0f);
             break;

@@ -372,6 +372,18 @@ KFN Surface surface_at(const SceneView *sc, Ray ray, Hit hit)
     return surface_local(sc, ray, hit);
 }
 
+/* surface_at(sc, ray, hit).ng, the same bits: for a triangle outside any instance (a
+ * medium's boundary, mostly) its winding normal alone, without the point, its error
+ * bound, the shading normal and the texture coordinates that a shadow ray crossing the
+ * boundary has no use for. */
+KFN vec3 hit_geometric_normal(const SceneView *sc, Ray ray, Hit hit)
+{
+    uint first_tri = sc->params->n_spheres;
+    if (!SURFACE_INSTANCED(sc, hit) && hit.prim >= first_tri && hit.prim - first_tri < sc->params->n_triangles)
+        return triangle_normal(sc->triangles[hit.prim - first_tri]);
+    return surface_at(sc, ray, hit).ng;
+}
+
 /* An object-space vector of surface s (a tangent) in the world: M v through its
  * instance, v itself outside one. */
 KFN vec3 surface_vector_to_world(const SceneView *sc, Surface s, vec3 v)

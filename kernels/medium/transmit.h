@@ -48,8 +48,7 @@ KFN uint shadow_trace_media(const SceneView *sc, GLOBAL PathState *ps, Ray r)
             tr = v3s(0.0f);
             break;
         }
-        Surface s = surface_at(sc, r, h);
-        med = medium_beyond(m.medium_in, m.medium_out, med, r.d, s.ng);
+        med = medium_beyond(m.medium_in, m.medium_out, med, r.d, hit_geometric_normal(sc, r, h));
         r.tmin = h.t;
     }
     ps->shadow_L = v3_mul(ps->shadow_L, tr);

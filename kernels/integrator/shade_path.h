@@ -205,10 +205,12 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
         return 0u;
     }
 
-    Surface s = surface_at(sc, r, hit);
-    Material m = sc->materials[s.material];   /* a mix: its own emission (mix.h) */
-    if (KF_HAS(KF_MEDIA) && (m.flags & MAT_INTERFACE)) {
-        uint crossed = medium_cross(ray, hit, s, m, ps, path_max_crossings(p->has_media));
+    /* a medium's boundary is crossed knowing its material and normal alone */
+    uint boundary = KF_HAS(KF_MEDIA) ? hit_material(sc, hit) : NO_INDEX;
+    if (boundary != NO_INDEX && (sc->materials[boundary].flags & MAT_INTERFACE)) {
+        GLOBAL const Material *bm = &sc->materials[boundary];
+        uint crossed = medium_cross(ray, hit, hit_geometric_normal(sc, r, hit), bm->medium_in, bm->medium_out, ps,
+                                    path_max_crossings(p->has_media));
         /* the camera ray's first hit is a medium's boundary: each branch crosses it and
          * flies on through the medium with its own numbers, weighted 1/B (the camera
          * ray decides that its first hit is a boundary, whatever the numbers) */
@@ -218,6 +220,8 @@ SHADE_PATH_FN uint shade_path(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLO
         }
         return crossed;
     }
+    Surface s = surface_at(sc, r, hit);
+    Material m = sc->materials[s.material];   /* a mix: its own emission (mix.h) */
     shade_absorb(r, hit, s, m, ps);
     int later_branch = first_hit && ps->branch != 0u;
     if (!later_branch) shade_emission(sc, r, s, m, ps);

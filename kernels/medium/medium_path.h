@@ -303,9 +303,10 @@ KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL Path
  * scattered, which the MIS weight of a light it reaches is computed from; only tmin
  * moves up to the hit (the interval is open, so the same boundary is not found again,
  * as kernels/accel/alpha.h skips cut-out surfaces). Not a bounce. */
-KFN uint medium_cross(GLOBAL Ray *ray, Hit hit, Surface s, Material m, GLOBAL PathState *ps, uint max_crossings)
+KFN uint medium_cross(GLOBAL Ray *ray, Hit hit, vec3 ng, uint medium_in, uint medium_out, GLOBAL PathState *ps,
+                      uint max_crossings)
 {
-    ps->medium = medium_beyond(m.medium_in, m.medium_out, ps->medium, ray->d, s.ng);
+    ps->medium = medium_beyond(medium_in, medium_out, ps->medium, ray->d, ng);
     ps->crossings = ps->crossings + 1u;
     if (ps->crossings > max_crossings) return 0u;
     ray->tmin = hit.t;

@@ -306,6 +306,11 @@ KFN int grid_track(const SceneView *sc, Medium md, vec3 x, vec3 d, float dist, v
     return GRID_PASSED;
 }
 
+/* An optical depth past which a transmittance estimate may be below the roulette's
+ * level (exp(-3) = 0.0498 < 0.05): residual tracking takes its controls' exponentials
+ * there, not per cell. */
+#define GRID_TAU_ROULETTE 3.0f
+
 /* Russian roulette on a transmittance estimate that has fallen below 0.05 in every
  * channel: kept with probability 1/4 and then 4 times as large (as pbrt-v4), so that
  * an opaque stretch stops early without bias. 0 when the estimate ends. */
@@ -374,6 +379,10 @@ KFN vec3 grid_transmittance_residual(const SceneView *sc, Medium md, vec3 x, vec
     GridFlight fl;
     GridWalk w;
     vec3 tr = v3s(1.0f);
+    /* the controls' optical depth not yet in tr: its exponentials are taken where the
+     * estimate needs its value (before a collision's factor and roulette, once the
+     * depth alone could take it below the roulette's level, at the end), not per cell */
+    vec3 tau = v3s(0.0f);
     if (!grid_flight_begin(sc, md, x, d, dist, &fl, &w)) return tr;
     float lo, hi;
     uint cell, steps = 0u;
@@ -382,9 +391,13 @@ KFN vec3 grid_transmittance_residual(const SceneView *sc, Medium md, vec3 x, vec
         if (!(d_max > 0.0f)) continue;
         float d_min = sc->grid_data[fl.g.minorant_at + cell];
         if (d_min > 0.0f) {
-            /* the control's transmittance over the stretch, exactly */
-            tr = v3_mul(tr, medium_tr(v3_scale(fl.sig_t, d_min), hi - lo));
-            if (!grid_tr_roulette(&tr, rng)) return v3s(0.0f);
+            /* the control's transmittance over the stretch is exp(-sigma_t d_min len) */
+            tau = v3_add(tau, v3_scale(v3_scale(fl.sig_t, d_min), hi - lo));
+            if (v3_min_comp(tau) > GRID_TAU_ROULETTE) {
+                tr = v3_mul(tr, medium_tr(tau, 1.0f));
+                tau = v3s(0.0f);
+                if (!grid_tr_roulette(&tr, rng)) return v3s(0.0f);
+            }
         }
         float bar = (d_max - d_min) * fl.sig_max;
         if (!(bar > 0.0f)) continue;
@@ -396,12 +409,14 @@ KFN vec3 grid_transmittance_residual(const SceneView *sc, Medium md, vec3 x, vec
             if (!(t < hi)) break;
             float res = grid_density(sc, &fl.g, v3_madd(fl.o, fl.du, t)) - d_min;
             vec3 mu_r = v3_scale(fl.sig_t, res);
-            tr = v3_mul(tr, v3(k_fmax(1.0f - mu_r.x * inv, 0.0f), k_fmax(1.0f - mu_r.y * inv, 0.0f),
-                               k_fmax(1.0f - mu_r.z * inv, 0.0f)));
+            tr = v3_mul(v3_mul(tr, medium_tr(tau, 1.0f)), v3(k_fmax(1.0f - mu_r.x * inv, 0.0f),
+                                                            k_fmax(1.0f - mu_r.y * inv, 0.0f),
+                                                            k_fmax(1.0f - mu_r.z * inv, 0.0f)));
+            tau = v3s(0.0f);
             if (!grid_tr_roulette(&tr, rng)) return v3s(0.0f);
         }
     }
-    return tr;
+    return v3_mul(tr, medium_tr(tau, 1.0f));
 }
 
 /* An estimate of the transmittance of grid medium md along the world ray x + t d (d

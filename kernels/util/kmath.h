@@ -31,6 +31,7 @@ KFN vec3 v3_cross(vec3 a, vec3 b)
 KFN float v3_len(vec3 a) { return k_sqrt(v3_dot(a, a)); }
 KFN vec3 v3_norm(vec3 a) { return v3_scale(a, 1.0f / v3_len(a)); }
 KFN float v3_max_comp(vec3 a) { return k_fmax(a.x, k_fmax(a.y, a.z)); }
+KFN float v3_min_comp(vec3 a) { return k_fmin(a.x, k_fmin(a.y, a.z)); }
 KFN float v3_get(vec3 a, int axis) { return axis == 0 ? a.x : (axis == 1 ? a.y : a.z); }
 KFN float v3_luminance(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 KFN int v3_is_zero(vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }

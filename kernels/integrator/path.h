@@ -43,22 +43,33 @@
     PATH_AT_TIME(sc, ps);                                                                \
     STAGE(PHASE_RAYGEN);                                                                 \
     Ray first_ray = *ray;                                                                \
-    Hit first_hit;                                                                       \
+    Hit first_hit, beyond_hit;                                                           \
     uint split = 0u;                                                                     \
-    int restart = 0;                                                                     \
+    int restart = 0, beyond = 0, beyond_kept = 0;                                        \
     for (int first = 1;; first = 0) {                                                    \
         Hit hit;                                                                         \
         if (restart) {                                                                   \
             hit = first_hit;                                                             \
+        } else if (beyond && beyond_kept) {                                              \
+            hit = beyond_hit;                                                            \
         } else {                                                                         \
             hit = trace_closest_visible(sc, *ray);                                       \
             n_rays++;                                                                    \
+            if (beyond) {                                                                \
+                beyond_hit = hit;                                                        \
+                beyond_kept = 1;                                                         \
+            }                                                                            \
         }                                                                                \
         if (first) first_hit = hit;                                                      \
+        int at_first = first || restart;                                                 \
         STAGE(PHASE_TRAVERSE);                                                           \
         uint r = shade_path(sc, ray, hit, ps, shadow_ray);                               \
         STAGE(PHASE_SHADE);                                                              \
         if (first && (r & SHADE_SCATTERED)) split = params_split(sc->params) - 1u;       \
+        /* a first hit that is a medium's boundary: every continuation crosses it on the \
+         * camera ray's line, so the hit beyond it is the same for all, traced once */   \
+        beyond = KF_HAS(KF_MEDIA) && at_first && (r & SHADE_CONTINUE) && params_split(sc->params) > 1u && \
+                 ps->bounce == 0u && ps->crossings == 1u;                                \
         if (r & SHADE_SHADOW) {                                                          \
             n_rays += shadow_trace(sc, ps, *shadow_ray);                                 \
             STAGE(PHASE_SHADOW);                                                         \

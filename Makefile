@@ -173,14 +173,19 @@ $(BUILD)/host/%.o: host/%.cpp $(BUILD)/.flags
 $(BUILD)/host/device/device_scalar.o $(BUILD)/host/device/scalar_paths_%.o: FILE_WARN := $(KERNEL_C_WARN)
 $(BUILD)/host/dist/mpi_driver.o $(BUILD)/host/dist/mpi_wire.o $(BUILD)/host/dist/mpi_workers.o: FILE_WARN := $(MPI_CFLAGS)
 
-# On x86-64 the scalar device's builds of the kernels again, for processors with AVX2
-# (host/device/scalar_paths.h); the processor picks at run time.
+# On x86-64 the scalar device's builds of the kernels twice more, for processors with AVX2
+# and for those with AVX-512 (x86-64-v4: F, VL, BW, DQ, CD; host/device/scalar_paths.h);
+# the processor picks at run time.
 ifneq ($(findstring x86_64,$(shell $(CC) -dumpmachine)),)
 SCALAR_AVX2_OBJ := $(patsubst host/device/%.c,$(BUILD)/host/device/%.avx2.o,$(wildcard host/device/scalar_paths_*.c))
-HOST_OBJ += $(SCALAR_AVX2_OBJ)
+SCALAR_AVX512_OBJ := $(patsubst host/device/%.c,$(BUILD)/host/device/%.avx512.o,$(wildcard host/device/scalar_paths_*.c))
+HOST_OBJ += $(SCALAR_AVX2_OBJ) $(SCALAR_AVX512_OBJ)
 $(BUILD)/host/device/%.avx2.o: host/device/%.c $(BUILD)/.flags | $(VERSION_H)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(KERNEL_C_WARN) -mavx2 -DSCALAR_PATHS_AVX2 -MMD -MP -c -o $@ $<
+$(BUILD)/host/device/%.avx512.o: host/device/%.c $(BUILD)/.flags | $(VERSION_H)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(KERNEL_C_WARN) -march=x86-64-v4 -DSCALAR_PATHS_AVX512 -MMD -MP -c -o $@ $<
 endif
 
 $(BUILD)/lib$(PROG).a: $(HOST_OBJ)

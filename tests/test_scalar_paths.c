@@ -2,8 +2,8 @@
  * test_scalar_paths.c — the scalar device's builds of its per-sample code
  * (host/device/scalar_paths.h): the leanest that covers a scene's kernel features is
  * picked, and every build renders a scene it covers with the same bits as the build of
- * everything (which the other tests compare with PoCL); on a processor with AVX2 the
- * same for the builds compiled for it, which the scalar device then picks.
+ * everything (which the other tests compare with PoCL); on a processor with AVX2 or
+ * AVX-512 the same for the builds compiled for it, which the scalar device then picks.
  */
 #include <string.h>
 
@@ -14,33 +14,37 @@
 #include "render/render_scene.h"
 #include "sample/sampling.h"
 
-/* The builds for any x86-64 processor (or any other), then those for AVX2: the latter
- * run only where the processor has it (n_builds). */
+/* The builds for any x86-64 processor (or any other), then those for AVX2, then those
+ * for AVX-512, N_BASE_BUILDS of each: each set runs only where the processor has its
+ * instruction set (n_builds). */
 static const ScalarPaths *const builds[] = {
     &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all,
 #if SCALAR_PATHS_HAVE_AVX2
     &scalar_paths_basic_avx2, &scalar_paths_lean_avx2, &scalar_paths_all_avx2,
+    &scalar_paths_basic_avx512, &scalar_paths_lean_avx512, &scalar_paths_all_avx512,
 #endif
 };
 #define N_BASE_BUILDS 3u
+#define N_ISAS (sizeof builds / sizeof builds[0] / N_BASE_BUILDS)
 static size_t n_builds;
 
 /* Whether build b has every feature of `features`. */
 static int covers(const ScalarPaths *b, unsigned features) { return (features & ~b->features) == 0u; }
 
-/* The build for AVX2 of the same features as build b (one of the first N_BASE_BUILDS). */
-static const ScalarPaths *avx2_twin(const ScalarPaths *b)
+/* The build for instruction set `isa` of the same features as build b (one of the
+ * first N_BASE_BUILDS); NULL where there is none. */
+static const ScalarPaths *isa_twin(const ScalarPaths *b, ScalarIsa isa)
 {
     for (size_t k = 0; k < N_BASE_BUILDS; k++)
-        if (builds[k] == b && N_BASE_BUILDS + k < sizeof builds / sizeof builds[0]) return builds[N_BASE_BUILDS + k];
+        if (builds[k] == b && (size_t)isa < N_ISAS) return builds[(size_t)isa * N_BASE_BUILDS + k];
     return NULL;
 }
 
 /* The builds for any x86-64 processor alone. */
-static const ScalarPaths *pick_sse2(unsigned features) { return scalar_paths_pick_isa(features, 0); }
+static const ScalarPaths *pick_sse2(unsigned features) { return scalar_paths_pick_isa(features, SCALAR_ISA_BASE); }
 
-/* For any feature set: a build that has it, and no leaner one would do; on this
- * processor the AVX2 twin where it has AVX2. */
+/* For any feature set: a build that has it, and no leaner one would do; for each
+ * instruction set its twin, and on this processor the twin for the best it has. */
 static void test_pick_leanest(void)
 {
     CHECK(pick_sse2(KF_BVH | KF_MAT_DIFFUSE | KF_MAT_EMISSIVE) == &scalar_paths_basic);
@@ -67,10 +71,15 @@ static void test_pick_leanest(void)
         for (size_t k = 0; k < N_BASE_BUILDS && builds[k] != p; k++)
             CHECK_MSG(!covers(builds[k], f), "features 0x%x: picked '%s', but '%s' has them", f, p->name,
                       builds[k]->name);
-        const ScalarPaths *q = scalar_paths_pick_isa(f, 1), *twin = avx2_twin(p);
-        CHECK_MSG(q == (twin ? twin : p), "features 0x%x: for AVX2 picked '%s'", f, q->name);
-        CHECK(q->features == p->features && q->avx2 == (twin != NULL) && p->avx2 == 0);
-        CHECK(scalar_paths_pick(f) == (scalar_paths_avx2_usable() ? q : p));
+        CHECK(p->isa == SCALAR_ISA_BASE);
+        for (ScalarIsa isa = SCALAR_ISA_AVX2; isa <= SCALAR_ISA_AVX512; isa++) {
+            const ScalarPaths *q = scalar_paths_pick_isa(f, isa), *twin = isa_twin(p, isa);
+            CHECK_MSG(q == (twin ? twin : p), "features 0x%x: for %s picked '%s'", f, scalar_paths_isa_name(isa),
+                      q->name);
+            CHECK(q->features == p->features && q->isa == (twin ? isa : SCALAR_ISA_BASE));
+        }
+        const ScalarPaths *here = isa_twin(p, scalar_paths_isa_usable());
+        CHECK(scalar_paths_pick(f) == (here ? here : p));
     }
 }
 
@@ -164,9 +173,12 @@ static void test_fog(void) { check_scene("scenes/fog.scene", 0, &scalar_paths_al
 
 int main(void)
 {
-    n_builds = scalar_paths_avx2_usable() ? sizeof builds / sizeof builds[0] : N_BASE_BUILDS;
-    if (n_builds == N_BASE_BUILDS && SCALAR_PATHS_HAVE_AVX2)
-        fprintf(stderr, "  this processor has no AVX2: its builds are not rendered\n");
+    /* the sets up to the best this processor runs */
+    ScalarIsa isa = scalar_paths_isa_usable();
+    n_builds = ((size_t)isa + 1u < N_ISAS ? (size_t)isa + 1u : N_ISAS) * N_BASE_BUILDS;
+    if (n_builds < sizeof builds / sizeof builds[0])
+        fprintf(stderr, "  this processor runs the builds up to %s: the others are not rendered\n",
+                scalar_paths_isa_name(isa));
     RUN(test_pick_leanest);
     RUN(test_cornell_box);
     RUN(test_one_weekend);

@@ -81,7 +81,9 @@ void device_list_print(FILE *f, const DeviceDesc *all, size_t n)
             format_bytes(pages > 0 && page > 0 ? (unsigned long long)pages * (unsigned long long)page : 0,
                          mem, sizeof mem);
             /* which of its builds this processor runs (scalar_paths.h) */
-            const char *isa = scalar_paths_avx2_usable() ? " for AVX2" : SCALAR_PATHS_HAVE_AVX2 ? " for SSE2" : "";
+            const char *isa_name = scalar_paths_isa_name(scalar_paths_isa_usable());
+            char isa[32] = "";
+            if (*isa_name) snprintf(isa, sizeof isa, " for %s", isa_name);
             /* no index: it is chosen by name (--device scalar), see select_item */
             fprintf(f, "%-3s %-8s %-6s %-5ld %-10s scalar C device (the kernels compiled as C%s, one thread per "
                     "core)\n", "-", "scalar", "CPU", cores > 0 ? cores : 1, mem, isa);

@@ -2,31 +2,44 @@
  * (scalar_paths.h). */
 #include "device/scalar_paths.h"
 
-int scalar_paths_avx2_usable(void)
+ScalarIsa scalar_paths_isa_usable(void)
 {
 #if SCALAR_PATHS_HAVE_AVX2
-    /* gcc's and clang's check also asks the operating system whether it saves the
-     * 256-bit registers (XGETBV), which AVX needs as much as the processor */
+    /* gcc's and clang's checks also ask the operating system whether it saves the
+     * 256-bit registers (XGETBV), and for AVX-512 the 512-bit and mask registers, which
+     * the instructions need as much as the processor. x86-64-v4 is v3 (AVX2, FMA, BMI1
+     * and 2, ...) and AVX-512 F, VL, BW, DQ and CD; every processor with the last
+     * three has the rest. */
     __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") != 0;
+    if (!__builtin_cpu_supports("avx2")) return SCALAR_ISA_BASE;
+    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+        __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
+        __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi2"))
+        return SCALAR_ISA_AVX512;
+    return SCALAR_ISA_AVX2;
 #else
-    return 0;
+    return SCALAR_ISA_BASE;
 #endif
 }
 
-const ScalarPaths *scalar_paths_pick_isa(unsigned features, int avx2)
+const char *scalar_paths_isa_name(ScalarIsa isa)
 {
-    /* leanest first; the last has every feature */
-    static const ScalarPaths *const builds[] = { &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all };
+    if (!SCALAR_PATHS_HAVE_AVX2) return "";
+    return isa == SCALAR_ISA_AVX512 ? "AVX-512" : isa == SCALAR_ISA_AVX2 ? "AVX2" : "SSE2";
+}
+
+const ScalarPaths *scalar_paths_pick_isa(unsigned features, ScalarIsa isa)
+{
+    /* per instruction set, leanest first; the last has every feature */
+    static const ScalarPaths *const builds[][3] = {
+        { &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all },
 #if SCALAR_PATHS_HAVE_AVX2
-    static const ScalarPaths *const builds_avx2[] = { &scalar_paths_basic_avx2, &scalar_paths_lean_avx2,
-                                                      &scalar_paths_all_avx2 };
-    const ScalarPaths *const *list = avx2 ? builds_avx2 : builds;
-#else
-    (void)avx2;
-    const ScalarPaths *const *list = builds;
+        { &scalar_paths_basic_avx2, &scalar_paths_lean_avx2, &scalar_paths_all_avx2 },
+        { &scalar_paths_basic_avx512, &scalar_paths_lean_avx512, &scalar_paths_all_avx512 },
 #endif
-    size_t n = sizeof builds / sizeof builds[0];
+    };
+    size_t n_isa = sizeof builds / sizeof builds[0], n = sizeof builds[0] / sizeof builds[0][0];
+    const ScalarPaths *const *list = builds[(size_t)isa < n_isa ? (size_t)isa : 0u];
     for (size_t i = 0; i + 1 < n; i++)
         if ((features & ~list[i]->features) == 0u) return list[i];
     return list[n - 1];
@@ -34,5 +47,5 @@ const ScalarPaths *scalar_paths_pick_isa(unsigned features, int avx2)
 
 const ScalarPaths *scalar_paths_pick(unsigned features)
 {
-    return scalar_paths_pick_isa(features, scalar_paths_avx2_usable());
+    return scalar_paths_pick_isa(features, scalar_paths_isa_usable());
 }

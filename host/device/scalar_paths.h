@@ -21,11 +21,18 @@
 
 #include "scene_view.h"
 
+/* The instruction sets a build is compiled for, each a superset of the one before. */
+typedef enum {
+    SCALAR_ISA_BASE = 0,   /* any processor of the target (on x86-64: SSE2) */
+    SCALAR_ISA_AVX2 = 1,   /* x86-64 with AVX2 (-mavx2) */
+    SCALAR_ISA_AVX512 = 2  /* x86-64 with AVX-512 F, VL, BW, DQ and CD (-march=x86-64-v4) */
+} ScalarIsa;
+
 typedef struct ScalarPaths {
     const char *name;     /* for --profile and the tests: "basic", "lean", "all", and with
-                           * "-avx2" for the builds for AVX2 */
+                           * "-avx2" or "-avx512" for the builds for those */
     unsigned features;    /* the CLPT_FEATURES it was compiled with */
-    int avx2;             /* 1: compiled for x86-64 processors with AVX2 (-mavx2) */
+    ScalarIsa isa;        /* the instruction set it was compiled for */
     /* one camera sample's path to its end (path_run, kernels/integrator/path.h, as k_path
      * runs it): its radiance; returns the rays it traced */
     uint64_t (*path)(const SceneView *sc, uint pixel, uint sample, vec3 *radiance);
@@ -48,10 +55,13 @@ extern const ScalarPaths scalar_paths_basic;
 extern const ScalarPaths scalar_paths_lean;
 extern const ScalarPaths scalar_paths_all;
 
-/* On x86-64 each build is compiled twice: for any x86-64 processor (SSE2), and with
+/* On x86-64 each build is compiled three times: for any x86-64 processor (SSE2); with
  * -mavx2 for the processors that have AVX2 (Intel since 2013, AMD since 2015), where a
  * BVH node's eight boxes and a group of eight triangles are each tested as one 8-wide
- * vector instead of two 4-wide halves (K_VEC8, kernels/util/compat.h). Both compute
+ * vector instead of two 4-wide halves (K_VEC8, kernels/util/compat.h); and for
+ * x86-64-v4, the processors with AVX-512 (Intel's servers since 2017, AMD since Zen 4),
+ * whose mask registers take the lanes' comparisons and whose 32 vector registers hold
+ * a walk's state (the walks 5-30% faster in bench_traverse, docs/design.md). All compute
  * the same IEEE operations per lane without contraction, so they render the same bits;
  * the processor decides which runs (as Cycles and Embree pick their kernels). */
 #if defined(__x86_64__)
@@ -59,19 +69,27 @@ extern const ScalarPaths scalar_paths_all;
 extern const ScalarPaths scalar_paths_basic_avx2;
 extern const ScalarPaths scalar_paths_lean_avx2;
 extern const ScalarPaths scalar_paths_all_avx2;
+extern const ScalarPaths scalar_paths_basic_avx512;
+extern const ScalarPaths scalar_paths_lean_avx512;
+extern const ScalarPaths scalar_paths_all_avx512;
 #else
 #define SCALAR_PATHS_HAVE_AVX2 0
 #endif
 
-/* 1 when this processor and its operating system run the AVX2 builds. */
-int scalar_paths_avx2_usable(void);
+/* The best instruction set this processor and its operating system run of those the
+ * builds were compiled for. */
+ScalarIsa scalar_paths_isa_usable(void);
+
+/* Its name for listings: "SSE2", "AVX2", "AVX-512"; "" where there is one build. */
+const char *scalar_paths_isa_name(ScalarIsa isa);
 
 /* The leanest build whose features include `features` (kernel_scene_features's, with
- * kernel_params_features's), the build of everything when none is leaner: for AVX2
- * when `avx2` is set and there are such builds. */
-const ScalarPaths *scalar_paths_pick_isa(unsigned features, int avx2);
+ * kernel_params_features's), the build of everything when none is leaner, among the
+ * builds for instruction set `isa` (those for SCALAR_ISA_BASE where there are no
+ * others). */
+const ScalarPaths *scalar_paths_pick_isa(unsigned features, ScalarIsa isa);
 
-/* The same for this processor: the AVX2 builds where it has AVX2. */
+/* The same for this processor: the builds for the best instruction set it has. */
 const ScalarPaths *scalar_paths_pick(unsigned features);
 
 #endif /* CLPT_SCALAR_PATHS_H */

@@ -8,27 +8,35 @@
  *                        kernels/types.h, which otherwise compiles everything)
  *   SCALAR_PATHS         the name of the ScalarPaths it defines (scalar_paths_NAME)
  *   SCALAR_PATHS_LABEL   its name as text ("NAME")
- * and the Makefile compiles each file a second time on x86-64 with -mavx2
- * -DSCALAR_PATHS_AVX2, which appends _avx2 to the name (scalar_paths.h says why).
+ * and the Makefile compiles each file twice more on x86-64, with -mavx2
+ * -DSCALAR_PATHS_AVX2, which appends _avx2 to the name, and with -march=x86-64-v4
+ * -DSCALAR_PATHS_AVX512, which appends _avx512 (scalar_paths.h says why).
  * Everything else here is static: each build's copy of the kernels is its own.
  */
 #if !defined(CLPT_FEATURES) || !defined(SCALAR_PATHS) || !defined(SCALAR_PATHS_LABEL)
 #error "define CLPT_FEATURES, SCALAR_PATHS and SCALAR_PATHS_LABEL before including scalar_paths_impl.h"
 #endif
 
-#ifdef SCALAR_PATHS_AVX2
+#define SCALAR_PATHS_PASTE2(a, b) a##b
+#define SCALAR_PATHS_PASTE(a, b) SCALAR_PATHS_PASTE2(a, b)
+#if defined(SCALAR_PATHS_AVX512)
+#if !defined(__AVX512F__) || !defined(__AVX512VL__) || !defined(__AVX512BW__) || !defined(__AVX512DQ__)
+#error "SCALAR_PATHS_AVX512: compile with -march=x86-64-v4"
+#endif
+#define SCALAR_PATHS_BUILD SCALAR_PATHS_PASTE(SCALAR_PATHS, _avx512)
+#define SCALAR_PATHS_NAME SCALAR_PATHS_LABEL "-avx512"
+#define SCALAR_PATHS_ISA SCALAR_ISA_AVX512
+#elif defined(SCALAR_PATHS_AVX2)
 #ifndef __AVX2__
 #error "SCALAR_PATHS_AVX2: compile with -mavx2"
 #endif
-#define SCALAR_PATHS_PASTE2(a, b) a##b
-#define SCALAR_PATHS_PASTE(a, b) SCALAR_PATHS_PASTE2(a, b)
 #define SCALAR_PATHS_BUILD SCALAR_PATHS_PASTE(SCALAR_PATHS, _avx2)
 #define SCALAR_PATHS_NAME SCALAR_PATHS_LABEL "-avx2"
-#define SCALAR_PATHS_ISA_AVX2 1
+#define SCALAR_PATHS_ISA SCALAR_ISA_AVX2
 #else
 #define SCALAR_PATHS_BUILD SCALAR_PATHS
 #define SCALAR_PATHS_NAME SCALAR_PATHS_LABEL
-#define SCALAR_PATHS_ISA_AVX2 0
+#define SCALAR_PATHS_ISA SCALAR_ISA_BASE
 #endif
 
 #include <string.h>
@@ -85,7 +93,7 @@ static int query_any(const SceneView *sc, const Ray *ray) { return trace_occlude
 const ScalarPaths SCALAR_PATHS_BUILD = {
     .name = SCALAR_PATHS_NAME,
     .features = CLPT_FEATURES,
-    .avx2 = SCALAR_PATHS_ISA_AVX2,
+    .isa = SCALAR_PATHS_ISA,
     .path = render_path,
     .path_timed = render_path_timed,
     .whitted = whitted_sample,

@@ -43,8 +43,8 @@
  * the trees: both follow one tie rule, leaf_test); the
  * scalar C traversal (kernels compiled as C) of the kd-tree in pairs (C, compiled here for
  * any x86-64) and of the BVH (C-W: the scalar device's own walk, ScalarPaths' closest and
- * any of the build it picks for the mesh, which on a processor with AVX2 is the build
- * for AVX2; its name is printed) on 1 and 2 threads; Embree rtcIntersect1 /
+ * any of the build it picks for the mesh, which on a processor with AVX2 or AVX-512 is
+ * the build for that; its name is printed) on 1 and 2 threads; Embree rtcIntersect1 /
  * rtcOccluded1 and rtcIntersect8 / rtcOccluded8 packets (8 consecutive rays) on 1 and 2
  * threads; the ratios of each PoCL kernel to Embree single rays per CPU-second (issue 3
  * asked 0.5 or more on bunny and dragon, issue 12 asks 1.0 for every kind of ray). Per

@@ -43,12 +43,13 @@ KFN uint shadow_trace_media(const SceneView *sc, GLOBAL PathState *ps, Ray r)
             }
         }
         if (h.prim == NO_INDEX) break;
-        Material m = sc->materials[hit_material(sc, h)];   /* an instance's where it replaces it */
-        if (!(m.flags & MAT_INTERFACE) || n > MEDIUM_MAX_CROSSINGS) {
+        /* the material the path sees there: an instance's where it replaces it */
+        GLOBAL const Material *m = &sc->materials[hit_material(sc, h)];
+        if (!(m->flags & MAT_INTERFACE) || n > MEDIUM_MAX_CROSSINGS) {
             tr = v3s(0.0f);
             break;
         }
-        med = medium_beyond(m.medium_in, m.medium_out, med, r.d, hit_geometric_normal(sc, r, h));
+        med = medium_beyond(m->medium_in, m->medium_out, med, r.d, hit_geometric_normal(sc, r, h));
         r.tmin = h.t;
     }
     ps->shadow_L = v3_mul(ps->shadow_L, tr);

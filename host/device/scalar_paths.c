@@ -8,8 +8,8 @@ ScalarIsa scalar_paths_isa_usable(void)
     /* gcc's and clang's checks also ask the operating system whether it saves the
      * 256-bit registers (XGETBV), and for AVX-512 the 512-bit and mask registers, which
      * the instructions need as much as the processor. x86-64-v4 is v3 (AVX2, FMA, BMI1
-     * and 2, ...) and AVX-512 F, VL, BW, DQ and CD; every processor with the last
-     * three has the rest. */
+     * and 2, LZCNT, MOVBE) and AVX-512 F, VL, BW, DQ and CD; asked are the five, AVX2,
+     * FMA and BMI2: every processor with those has the rest of v3. */
     __builtin_cpu_init();
     if (!__builtin_cpu_supports("avx2")) return SCALAR_ISA_BASE;
     if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&

@@ -61,7 +61,7 @@ extern const ScalarPaths scalar_paths_all;
  * vector instead of two 4-wide halves (K_VEC8, kernels/util/compat.h); and for
  * x86-64-v4, the processors with AVX-512 (Intel's servers since 2017, AMD since Zen 4),
  * whose mask registers take the lanes' comparisons and whose 32 vector registers hold
- * a walk's state (the walks 5-30% faster in bench_traverse, docs/design.md). All compute
+ * a walk's state (the walks up to 33% faster in bench_traverse, docs/design.md). All compute
  * the same IEEE operations per lane without contraction, so they render the same bits;
  * the processor decides which runs (as Cycles and Embree pick their kernels). */
 #if defined(__x86_64__)

@@ -20,7 +20,7 @@ set -eu
 
 pkgs_for() {
     case "$1" in
-        base) echo "make gcc g++ libc6-dev pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers libstb-dev libpng-dev openmpi-bin libopenmpi-dev pkg-config libsdl2-dev libopenexr-dev libcjson-dev zlib1g-dev" ;;
+        base) echo "make gcc g++ clang-15 libc6-dev pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers libstb-dev libpng-dev openmpi-bin libopenmpi-dev pkg-config libsdl2-dev libopenexr-dev libcjson-dev zlib1g-dev" ;;
         # the viewer's test (tests/test_viewer.c): a virtual display and input to send it
         viewer-test) echo "xvfb xdotool" ;;
         # the install test (tests/test_install.c): man renders the page, zsh loads the completion

@@ -68,10 +68,10 @@ KERNEL_C_WARN := -Wdouble-promotion -Werror=double-promotion
 # The scalar device's builds of the kernels (host/device/scalar_paths_*.c) are compiled by
 # clang where it is installed: pocl-opencl-icd, in tools/deps.sh's base profile, depends
 # on clang-15, so every machine that builds clpt from the README has it. From the same
-# kernel code, clang's walk traced 1.1-1.5 times gcc 12's rays per second on
-# bench_traverse's diffuse and any-hit rays and the scalar device rendered 8-19% faster
-# (bench/RESULTS.md, "The scalar device compiled by clang"); the images are the same bits
-# (FPFLAGS: IEEE operations only). Any C compiler serves: SCALAR_CC=cc uses gcc.
+# kernel code, clang's walk traced 1.2-1.5 times gcc 12's diffuse rays per second in
+# bench_traverse (Sponza's shadow rays 0.8 times) and the scalar device rendered 6-19%
+# faster (bench/RESULTS.md, "The scalar device compiled by clang"); the images are the
+# same bits (FPFLAGS: IEEE operations only). Any C compiler serves: SCALAR_CC=cc uses gcc.
 SCALAR_CC ?= $(firstword $(shell command -v clang-15 clang 2>/dev/null) $(CC))
 # Their debug information as DWARF 4: Debian 12's valgrind (3.19, make test-valgrind)
 # cannot read the DWARF 5 forms clang 15 writes by default and gives up on the program.

@@ -72,7 +72,9 @@ KERNEL_C_WARN := -Wdouble-promotion -Werror=double-promotion
 # bench_traverse (Sponza's shadow rays 0.8 times) and the scalar device rendered 6-19%
 # faster (bench/RESULTS.md, "The scalar device compiled by clang"); the images are the
 # same bits (FPFLAGS: IEEE operations only). Any C compiler serves: SCALAR_CC=cc uses gcc.
-SCALAR_CC ?= $(firstword $(shell command -v clang-15 clang 2>/dev/null) $(CC))
+ifeq ($(origin SCALAR_CC),undefined)
+SCALAR_CC := $(firstword $(shell command -v clang-15 clang 2>/dev/null) $(CC))
+endif
 # Their debug information as DWARF 4: Debian 12's valgrind (3.19, make test-valgrind)
 # cannot read the DWARF 5 forms clang 15 writes by default and gives up on the program.
 SCALAR_CFLAGS := -gdwarf-4

@@ -37,7 +37,10 @@
  * k_path_lanes, the renderer's kernel on CPUs, calls it for its lanes) and in packets
  * of eight consecutive rays (PoCL-W8: k_trace_closest_wide8/
  * k_trace_any_wide8, trace_packet_wide), each on a sub-device of 1 compute unit and on
- * the whole device (the kd-tree kernels checked bit for bit against the C kd walk, the
+ * the whole device, the program built per mesh as the renderer builds its own for a
+ * scene of it: the scene's features (-D CLPT_FEATURES: no instances, spheres or motion
+ * compiled in) and k_path_lanes' walk as a call, with the kd-tree for the kd columns
+ * (the kd-tree kernels checked bit for bit against the C kd walk, the
  * BVH's against the C BVH walk;
  * "BVH vs kd" counts rays whose closest hit, all of it, or occlusion differs between
  * the trees: both follow one tie rule, leaf_test); the
@@ -379,6 +382,7 @@ typedef struct {
     cl_command_queue q;
     cl_kernel k[N_KERNELS][2];   /* per PoclKernel: closest-hit, any-hit */
     cl_program prog;
+    unsigned features;           /* the CLPT_FEATURES prog was built with (0: none built) */
     cl_mem scene[SC_N], rays, out;
     size_t rays_cap;
 } Pocl;
@@ -404,9 +408,29 @@ static int pocl_open(Pocl *pc, const OclDeviceInfo *dev, cl_device_id sub)
     if (rc != CL_SUCCESS) return pocl_fail("clCreateContext", rc);
     pc->q = clCreateCommandQueue(pc->ctx, pc->info.id, 0, &rc);
     if (rc != CL_SUCCESS) return pocl_fail("clCreateCommandQueue", rc);
+    pc->ok = 1;
+    return 0;
+}
+
+/* The bench program built for `features` (CLPT_FEATURES, kernels/types.h) unless it
+ * already is: the code the renderer's program has for a scene of the mesh (see
+ * bench_mesh), not every feature's, whose instance and primitive cases the walk would
+ * carry otherwise. */
+static int pocl_program(Pocl *pc, unsigned features)
+{
+    if (pc->prog && pc->features == features) return 0;
+    for (int kp = 0; kp < N_KERNELS; kp++)
+        for (int any = 0; any < 2; any++)
+            if (pc->k[kp][any]) clReleaseKernel(pc->k[kp][any]);
+    memset(pc->k, 0, sizeof pc->k);
+    if (pc->prog) clReleaseProgram(pc->prog);
+    pc->prog = NULL;
+    pc->features = 0;
+    char options[48];
+    snprintf(options, sizeof options, "-D CLPT_FEATURES=0x%xu", features);
     Error err = { 0 };
     Status st = ocl_program_build_source(pc->ctx, &pc->info, clpt_bench_kernel_source,
-                                         clpt_bench_kernel_source_len, NULL, &pc->prog, NULL, &err);
+                                         clpt_bench_kernel_source_len, options, &pc->prog, NULL, &err);
     for (int kp = 0; kp < N_KERNELS && st == ST_OK; kp++) {
         st = ocl_program_kernel(pc->prog, &pc->info, pocl_kernels[kp].closest, &pc->k[kp][0], &err);
         if (st == ST_OK) st = ocl_program_kernel(pc->prog, &pc->info, pocl_kernels[kp].any, &pc->k[kp][1], &err);
@@ -416,7 +440,7 @@ static int pocl_open(Pocl *pc, const OclDeviceInfo *dev, cl_device_id sub)
         error_clear(&err);
         return -1;
     }
-    pc->ok = 1;
+    pc->features = features;
     return 0;
 }
 
@@ -841,7 +865,11 @@ static void bench_mesh(const char *name, const Options *o, Pocl pocl[MAX_THREADS
     uint max_n = 0;
     for (int k = 0; k < N_SETS; k++) max_n = sets[k].n > max_n ? sets[k].n : max_n;
     int pocl_ok[MAX_THREADS] = { 0 };
-    for (int t = 0; t < MAX_THREADS && have_pocl; t++) pocl_ok[t] = pocl[t].ok && pocl_upload(&pocl[t], &m, max_n) == 0;
+    /* as the renderer's program on a CPU for this mesh: its scene's features and the
+     * lanes kernel's walk (a called function), with the kd-tree for the kd columns */
+    unsigned features = kernel_scene_features(&m.ds) | KF_KDTREE | KF_BVH | KF_PATH_LANES;
+    for (int t = 0; t < MAX_THREADS && have_pocl; t++)
+        pocl_ok[t] = pocl[t].ok && pocl_program(&pocl[t], features) == 0 && pocl_upload(&pocl[t], &m, max_n) == 0;
     Hit *eh = malloc((max_n + 1) * sizeof *eh);
     uint *eo = malloc((max_n + 1) * sizeof *eo);
     for (int k = 0; k < N_SETS && eh && eo; k++) {

@@ -18,13 +18,13 @@
  * for AVX-512, N_BASE_BUILDS of each: each set runs only where the processor has its
  * instruction set (n_builds). */
 static const ScalarPaths *const builds[] = {
-    &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all,
+    &scalar_paths_mesh, &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all,
 #if SCALAR_PATHS_HAVE_AVX2
-    &scalar_paths_basic_avx2, &scalar_paths_lean_avx2, &scalar_paths_all_avx2,
-    &scalar_paths_basic_avx512, &scalar_paths_lean_avx512, &scalar_paths_all_avx512,
+    &scalar_paths_mesh_avx2, &scalar_paths_basic_avx2, &scalar_paths_lean_avx2, &scalar_paths_all_avx2,
+    &scalar_paths_mesh_avx512, &scalar_paths_basic_avx512, &scalar_paths_lean_avx512, &scalar_paths_all_avx512,
 #endif
 };
-#define N_BASE_BUILDS 3u
+#define N_BASE_BUILDS 4u
 #define N_ISAS (sizeof builds / sizeof builds[0] / N_BASE_BUILDS)
 static size_t n_builds;
 
@@ -47,7 +47,10 @@ static const ScalarPaths *pick_sse2(unsigned features) { return scalar_paths_pic
  * instruction set its twin, and on this processor the twin for the best it has. */
 static void test_pick_leanest(void)
 {
-    CHECK(pick_sse2(KF_BVH | KF_MAT_DIFFUSE | KF_MAT_EMISSIVE) == &scalar_paths_basic);
+    CHECK(pick_sse2(KF_BVH | KF_MAT_DIFFUSE | KF_MAT_EMISSIVE) == &scalar_paths_mesh);
+    CHECK(pick_sse2(KF_KDTREE | KF_PLANES | KF_MAT_DIFFUSE | KF_MAT_DIELECTRIC) == &scalar_paths_mesh);
+    CHECK(pick_sse2(KF_BVH | KF_SPHERES | KF_MAT_DIFFUSE) == &scalar_paths_basic);
+    CHECK(pick_sse2(KF_BVH | KF_BOXES | KF_MAT_DIFFUSE) == &scalar_paths_basic);
     CHECK(pick_sse2(KF_KDTREE | KF_SPHERES | KF_BOXES | KF_PLANES | KF_MAT_DIFFUSE) == &scalar_paths_basic);
     CHECK(pick_sse2(KF_BVH | KF_MAT_DIFFUSE | KF_TEXTURES) == &scalar_paths_lean);
     CHECK(pick_sse2(KF_BVH | KF_SPHERES | KF_MAT_METAL | KF_MAT_DIELECTRIC) == &scalar_paths_basic);
@@ -159,8 +162,8 @@ static void check_scene(const char *path, int kdtree, const ScalarPaths *expect)
 
 static void test_cornell_box(void)
 {
-    check_scene("scenes/cornell-box.scene", 0, &scalar_paths_basic);
-    check_scene("scenes/cornell-box.scene", 1, &scalar_paths_basic);
+    check_scene("scenes/cornell-box.scene", 0, &scalar_paths_mesh);
+    check_scene("scenes/cornell-box.scene", 1, &scalar_paths_mesh);
 }
 static void test_one_weekend(void) { check_scene("scenes/one-weekend.scene", 0, &scalar_paths_basic); }
 static void test_materials(void)

@@ -144,7 +144,7 @@ typedef struct {
     unsigned wave_paths;
     const char *wave_run;
     /* the scalar device, for --stats: the build of the kernels the loaded scene runs on
-     * (a static string, scalar_paths.h: "basic", "lean", "all") */
+     * (a static string, scalar_paths.h: "mesh", "basic", "lean", "all") */
     const char *kernel_build;
     uint64_t rays;                /* every ray traced: camera, bounce and shadow rays */
     uint64_t samples;             /* pixel samples rendered (pixels x samples) */

@@ -31,11 +31,12 @@ const char *scalar_paths_isa_name(ScalarIsa isa)
 const ScalarPaths *scalar_paths_pick_isa(unsigned features, ScalarIsa isa)
 {
     /* per instruction set, leanest first; the last has every feature */
-    static const ScalarPaths *const builds[][3] = {
-        { &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all },
+    static const ScalarPaths *const builds[][4] = {
+        { &scalar_paths_mesh, &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all },
 #if SCALAR_PATHS_HAVE_AVX2
-        { &scalar_paths_basic_avx2, &scalar_paths_lean_avx2, &scalar_paths_all_avx2 },
-        { &scalar_paths_basic_avx512, &scalar_paths_lean_avx512, &scalar_paths_all_avx512 },
+        { &scalar_paths_mesh_avx2, &scalar_paths_basic_avx2, &scalar_paths_lean_avx2, &scalar_paths_all_avx2 },
+        { &scalar_paths_mesh_avx512, &scalar_paths_basic_avx512, &scalar_paths_lean_avx512,
+          &scalar_paths_all_avx512 },
 #endif
     };
     size_t n_isa = sizeof builds / sizeof builds[0], n = sizeof builds[0] / sizeof builds[0][0];

@@ -29,7 +29,7 @@ typedef enum {
 } ScalarIsa;
 
 typedef struct ScalarPaths {
-    const char *name;     /* for --profile and the tests: "basic", "lean", "all", and with
+    const char *name;     /* for --profile and the tests: "mesh", "basic", "lean", "all", and with
                            * "-avx2" or "-avx512" for the builds for those */
     unsigned features;    /* the CLPT_FEATURES it was compiled with */
     ScalarIsa isa;        /* the instruction set it was compiled for */
@@ -48,9 +48,11 @@ typedef struct ScalarPaths {
     int (*any)(const SceneView *sc, const Ray *ray);
 } ScalarPaths;
 
-/* The builds, leanest first (each file's comment says what it has): the basic materials
- * (diffuse, metal, dielectric, emissive) without textures, cut-outs, background maps or
- * delta lights; every feature but media and instances; every feature. */
+/* The builds, leanest first (each file's comment says what it has): triangles and
+ * planes of the basic materials (diffuse, metal, dielectric, emissive) without textures,
+ * cut-outs, background maps or delta lights; the same with spheres and boxes; every
+ * feature but media and instances; every feature. */
+extern const ScalarPaths scalar_paths_mesh;
 extern const ScalarPaths scalar_paths_basic;
 extern const ScalarPaths scalar_paths_lean;
 extern const ScalarPaths scalar_paths_all;
@@ -66,9 +68,11 @@ extern const ScalarPaths scalar_paths_all;
  * the processor decides which runs (as Cycles and Embree pick their kernels). */
 #if defined(__x86_64__)
 #define SCALAR_PATHS_HAVE_AVX2 1
+extern const ScalarPaths scalar_paths_mesh_avx2;
 extern const ScalarPaths scalar_paths_basic_avx2;
 extern const ScalarPaths scalar_paths_lean_avx2;
 extern const ScalarPaths scalar_paths_all_avx2;
+extern const ScalarPaths scalar_paths_mesh_avx512;
 extern const ScalarPaths scalar_paths_basic_avx512;
 extern const ScalarPaths scalar_paths_lean_avx512;
 extern const ScalarPaths scalar_paths_all_avx512;

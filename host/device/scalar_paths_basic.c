@@ -1,10 +1,10 @@
 /* scalar_paths_basic.c — the scalar device's build for scenes of the basic materials
  * alone (scalar_paths.h): diffuse, metal, dielectric and emissive, untextured and never
  * cut out, lit by area lights under a plain background; spheres, boxes, planes and
- * triangles under either tree; no media, no instances. The Cornell box, most meshes,
- * one-weekend: without the other materials' dispatch, the texture lookups and the
- * other lights' code their paths took 12-15% fewer instructions than on the 'lean'
- * build (docs/design.md). */
+ * triangles under either tree; no media, no instances. one-weekend, the scenes of
+ * spheres or boxes (triangles alone run on 'mesh', scalar_paths_mesh.c): without the
+ * other materials' dispatch, the texture lookups and the other lights' code their paths
+ * took 12-15% fewer instructions than on the 'lean' build (docs/design.md). */
 
 /* Expanded where KF_HAS is used, after kernels/types.h has defined the names. The
  * material bits are numbers because KF_MAT_* are enum constants, which #if reads as 0

@@ -6,13 +6,8 @@
  * other materials' dispatch, the texture lookups and the other lights' code their paths
  * took 12-15% fewer instructions than on the 'lean' build (docs/design.md). */
 
-/* Expanded where KF_HAS is used, after kernels/types.h has defined the names. The
- * material bits are numbers because KF_MAT_* are enum constants, which #if reads as 0
- * (checked below). */
-#define SCALAR_PATHS_MAT_DIFFUSE 0x800u
-#define SCALAR_PATHS_MAT_METAL 0x1000u
-#define SCALAR_PATHS_MAT_DIELECTRIC 0x2000u
-#define SCALAR_PATHS_MAT_EMISSIVE 0x4000u
+/* Expanded where KF_HAS is used, after kernels/types.h has defined the names; the
+ * material bits are scalar_paths_impl.h's. */
 #define CLPT_FEATURES                                                                                        \
     (KF_PATH | KF_WHITTED | KF_PATH_MEGAKERNEL | KF_PATH_LANES | KF_KDTREE | KF_BVH | KF_SPHERES | KF_BOXES | \
      KF_PLANES | SCALAR_PATHS_MAT_DIFFUSE | SCALAR_PATHS_MAT_METAL | SCALAR_PATHS_MAT_DIELECTRIC |          \
@@ -20,7 +15,3 @@
 #define SCALAR_PATHS scalar_paths_basic
 #define SCALAR_PATHS_LABEL "basic"
 #include "device/scalar_paths_impl.h"
-
-_Static_assert(SCALAR_PATHS_MAT_DIFFUSE == KF_MAT_DIFFUSE && SCALAR_PATHS_MAT_METAL == KF_MAT_METAL &&
-                   SCALAR_PATHS_MAT_DIELECTRIC == KF_MAT_DIELECTRIC && SCALAR_PATHS_MAT_EMISSIVE == KF_MAT_EMISSIVE,
-               "scalar_paths_basic: the material bits of kernels/types.h");

@@ -17,6 +17,14 @@
 #error "define CLPT_FEATURES, SCALAR_PATHS and SCALAR_PATHS_LABEL before including scalar_paths_impl.h"
 #endif
 
+/* The basic materials' feature bits as numbers, for the CLPT_FEATURES of the builds
+ * that name them ('mesh', 'basic'), expanded where KF_HAS is used: KF_MAT_* are enum
+ * constants, which #if reads as 0 (checked below). */
+#define SCALAR_PATHS_MAT_DIFFUSE 0x800u
+#define SCALAR_PATHS_MAT_METAL 0x1000u
+#define SCALAR_PATHS_MAT_DIELECTRIC 0x2000u
+#define SCALAR_PATHS_MAT_EMISSIVE 0x4000u
+
 #define SCALAR_PATHS_PASTE2(a, b) a##b
 #define SCALAR_PATHS_PASTE(a, b) SCALAR_PATHS_PASTE2(a, b)
 #if defined(SCALAR_PATHS_AVX512)
@@ -52,6 +60,10 @@
 #include "accel/alpha.h"
 #include "integrator/path.h"
 #include "integrator/whitted.h"
+
+_Static_assert(SCALAR_PATHS_MAT_DIFFUSE == KF_MAT_DIFFUSE && SCALAR_PATHS_MAT_METAL == KF_MAT_METAL &&
+                   SCALAR_PATHS_MAT_DIELECTRIC == KF_MAT_DIELECTRIC && SCALAR_PATHS_MAT_EMISSIVE == KF_MAT_EMISSIVE,
+               "scalar_paths_impl.h: the material bits of kernels/types.h");
 
 /* Renders one camera sample's path to its end (path_run, kernels/integrator/path.h, as k_path
  * does); returns the number of rays it traced. */

@@ -6,18 +6,10 @@
  * infinite planes under either tree: the Cornell boxes, the dragon, most OBJ and PLY
  * files. */
 
-/* The material bits as numbers, as in scalar_paths_basic.c (checked below). */
-#define SCALAR_PATHS_MAT_DIFFUSE 0x800u
-#define SCALAR_PATHS_MAT_METAL 0x1000u
-#define SCALAR_PATHS_MAT_DIELECTRIC 0x2000u
-#define SCALAR_PATHS_MAT_EMISSIVE 0x4000u
+/* As in scalar_paths_basic.c, less KF_SPHERES and KF_BOXES. */
 #define CLPT_FEATURES                                                                                     \
     (KF_PATH | KF_WHITTED | KF_PATH_MEGAKERNEL | KF_PATH_LANES | KF_KDTREE | KF_BVH | KF_PLANES |         \
      SCALAR_PATHS_MAT_DIFFUSE | SCALAR_PATHS_MAT_METAL | SCALAR_PATHS_MAT_DIELECTRIC | SCALAR_PATHS_MAT_EMISSIVE)
 #define SCALAR_PATHS scalar_paths_mesh
 #define SCALAR_PATHS_LABEL "mesh"
 #include "device/scalar_paths_impl.h"
-
-_Static_assert(SCALAR_PATHS_MAT_DIFFUSE == KF_MAT_DIFFUSE && SCALAR_PATHS_MAT_METAL == KF_MAT_METAL &&
-                   SCALAR_PATHS_MAT_DIELECTRIC == KF_MAT_DIELECTRIC && SCALAR_PATHS_MAT_EMISSIVE == KF_MAT_EMISSIVE,
-               "scalar_paths_mesh: the material bits of kernels/types.h");

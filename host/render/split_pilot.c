@@ -45,6 +45,11 @@ static Status render_seed(const AdaptiveRun *run, uint seed, uint spp, Film *fil
     Status st = device_update_all(run->devices, run->n_devices, &run->rs->ds, err);
     if (st) return st;
     ScheduleConfig cfg = schedule_config_part(run->cfg, 0u, spp, 0.0);
+    /* The pilot's samples in a batch per device: grown from one sample, as a render's
+     * batches are, they took four batches a film, each with its launch and its film read
+     * back, a quarter of the dragon's pilot (bench/RESULTS.md). The film's fixed-point
+     * sums do not depend on the batches, so neither does the choice. */
+    cfg.fixed_batch = (spp + (uint)run->n_devices - 1u) / (uint)run->n_devices;
     ScheduleStats one;
     st = schedule_run(run->devices, run->n_devices, &cfg, film, &one, err);
     *whole = st == ST_OK && !one.interrupted && !one.time_up && film->samples == spp;

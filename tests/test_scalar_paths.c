@@ -14,29 +14,19 @@
 #include "render/render_scene.h"
 #include "sample/sampling.h"
 
-/* The builds for any x86-64 processor (or any other), then those for AVX2, then those
- * for AVX-512, N_BASE_BUILDS of each: each set runs only where the processor has its
- * instruction set (n_builds). */
-static const ScalarPaths *const builds[] = {
-    &scalar_paths_mesh, &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all,
-#if SCALAR_PATHS_HAVE_AVX2
-    &scalar_paths_mesh_avx2, &scalar_paths_basic_avx2, &scalar_paths_lean_avx2, &scalar_paths_all_avx2,
-    &scalar_paths_mesh_avx512, &scalar_paths_basic_avx512, &scalar_paths_lean_avx512, &scalar_paths_all_avx512,
-#endif
-};
-#define N_BASE_BUILDS 4u
-#define N_ISAS (sizeof builds / sizeof builds[0] / N_BASE_BUILDS)
-static size_t n_builds;
+/* The rows of scalar_paths_builds this processor runs (the instruction sets up to the
+ * best it has); the others are not rendered. */
+static size_t n_rows;
 
 /* Whether build b has every feature of `features`. */
 static int covers(const ScalarPaths *b, unsigned features) { return (features & ~b->features) == 0u; }
 
 /* The build for instruction set `isa` of the same features as build b (one of the
- * first N_BASE_BUILDS); NULL where there is none. */
+ * first row); NULL where there is none. */
 static const ScalarPaths *isa_twin(const ScalarPaths *b, ScalarIsa isa)
 {
-    for (size_t k = 0; k < N_BASE_BUILDS; k++)
-        if (builds[k] == b && (size_t)isa < N_ISAS) return builds[(size_t)isa * N_BASE_BUILDS + k];
+    for (size_t k = 0; k < SCALAR_PATHS_BUILDS; k++)
+        if (scalar_paths_builds[0][k] == b && (size_t)isa < SCALAR_PATHS_ISAS) return scalar_paths_builds[isa][k];
     return NULL;
 }
 
@@ -71,9 +61,9 @@ static void test_pick_leanest(void)
         }
         const ScalarPaths *p = pick_sse2(f);
         CHECK_MSG(covers(p, f), "features 0x%x: picked '%s' (0x%x)", f, p->name, p->features);
-        for (size_t k = 0; k < N_BASE_BUILDS && builds[k] != p; k++)
-            CHECK_MSG(!covers(builds[k], f), "features 0x%x: picked '%s', but '%s' has them", f, p->name,
-                      builds[k]->name);
+        for (size_t k = 0; k < SCALAR_PATHS_BUILDS && scalar_paths_builds[0][k] != p; k++)
+            CHECK_MSG(!covers(scalar_paths_builds[0][k], f), "features 0x%x: picked '%s', but '%s' has them", f,
+                      p->name, scalar_paths_builds[0][k]->name);
         CHECK(p->isa == SCALAR_ISA_BASE);
         for (ScalarIsa isa = SCALAR_ISA_AVX2; isa <= SCALAR_ISA_AVX512; isa++) {
             const ScalarPaths *q = scalar_paths_pick_isa(f, isa), *twin = isa_twin(p, isa);
@@ -117,8 +107,8 @@ static void check_scene(const char *path, int kdtree, const ScalarPaths *expect)
         SceneView sv;
         device_scene_view(&rs.ds, &sv);
         uint n_pixels = rs.ds.params.width * rs.ds.params.height;
-        for (size_t k = 0; k < n_builds; k++) {
-            const ScalarPaths *b = builds[k];
+        for (size_t k = 0; k < n_rows * SCALAR_PATHS_BUILDS; k++) {
+            const ScalarPaths *b = scalar_paths_builds[k / SCALAR_PATHS_BUILDS][k % SCALAR_PATHS_BUILDS];
             if (b == &scalar_paths_all || !covers(b, f)) continue;
             size_t samples = 0, same = 0;
             for (uint pixel = 0; pixel < n_pixels; pixel++) {
@@ -178,8 +168,8 @@ int main(void)
 {
     /* the sets up to the best this processor runs */
     ScalarIsa isa = scalar_paths_isa_usable();
-    n_builds = ((size_t)isa + 1u < N_ISAS ? (size_t)isa + 1u : N_ISAS) * N_BASE_BUILDS;
-    if (n_builds < sizeof builds / sizeof builds[0])
+    n_rows = (size_t)isa + 1u < SCALAR_PATHS_ISAS ? (size_t)isa + 1u : SCALAR_PATHS_ISAS;
+    if (n_rows < SCALAR_PATHS_ISAS)
         fprintf(stderr, "  this processor runs the builds up to %s: the others are not rendered\n",
                 scalar_paths_isa_name(isa));
     RUN(test_pick_leanest);

@@ -28,22 +28,20 @@ const char *scalar_paths_isa_name(ScalarIsa isa)
     return isa == SCALAR_ISA_AVX512 ? "AVX-512" : isa == SCALAR_ISA_AVX2 ? "AVX2" : "SSE2";
 }
 
+const ScalarPaths *const scalar_paths_builds[SCALAR_PATHS_ISAS][SCALAR_PATHS_BUILDS] = {
+    { &scalar_paths_mesh, &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all },
+#if SCALAR_PATHS_HAVE_AVX2
+    { &scalar_paths_mesh_avx2, &scalar_paths_basic_avx2, &scalar_paths_lean_avx2, &scalar_paths_all_avx2 },
+    { &scalar_paths_mesh_avx512, &scalar_paths_basic_avx512, &scalar_paths_lean_avx512, &scalar_paths_all_avx512 },
+#endif
+};
+
 const ScalarPaths *scalar_paths_pick_isa(unsigned features, ScalarIsa isa)
 {
-    /* per instruction set, leanest first; the last has every feature */
-    static const ScalarPaths *const builds[][4] = {
-        { &scalar_paths_mesh, &scalar_paths_basic, &scalar_paths_lean, &scalar_paths_all },
-#if SCALAR_PATHS_HAVE_AVX2
-        { &scalar_paths_mesh_avx2, &scalar_paths_basic_avx2, &scalar_paths_lean_avx2, &scalar_paths_all_avx2 },
-        { &scalar_paths_mesh_avx512, &scalar_paths_basic_avx512, &scalar_paths_lean_avx512,
-          &scalar_paths_all_avx512 },
-#endif
-    };
-    size_t n_isa = sizeof builds / sizeof builds[0], n = sizeof builds[0] / sizeof builds[0][0];
-    const ScalarPaths *const *list = builds[(size_t)isa < n_isa ? (size_t)isa : 0u];
-    for (size_t i = 0; i + 1 < n; i++)
-        if ((features & ~list[i]->features) == 0u) return list[i];
-    return list[n - 1];
+    const ScalarPaths *const *row = scalar_paths_builds[(size_t)isa < SCALAR_PATHS_ISAS ? (size_t)isa : 0u];
+    for (size_t i = 0; i + 1u < SCALAR_PATHS_BUILDS; i++)
+        if ((features & ~row[i]->features) == 0u) return row[i];
+    return row[SCALAR_PATHS_BUILDS - 1u];
 }
 
 const ScalarPaths *scalar_paths_pick(unsigned features)

@@ -80,6 +80,14 @@ extern const ScalarPaths scalar_paths_all_avx512;
 #define SCALAR_PATHS_HAVE_AVX2 0
 #endif
 
+/* Every build in one table, which the pick walks and test_scalar_paths renders with:
+ * a row per instruction set from SCALAR_ISA_BASE up (one row where there are no
+ * others), each row leanest first, its last build the one of every feature. A new build
+ * is a file scalar_paths_NAME.c, its externs above and a column here. */
+#define SCALAR_PATHS_ISAS (SCALAR_PATHS_HAVE_AVX2 ? 3 : 1)
+#define SCALAR_PATHS_BUILDS 4
+extern const ScalarPaths *const scalar_paths_builds[SCALAR_PATHS_ISAS][SCALAR_PATHS_BUILDS];
+
 /* The best instruction set this processor and its operating system run of those the
  * builds were compiled for. */
 ScalarIsa scalar_paths_isa_usable(void);

@@ -81,9 +81,31 @@ static void test_choose(void)
     CHECK_EQ_INT(split_pilot_choose(&sp), 1);
 }
 
+/* The first SPLIT_PILOT_ALWAYS candidates are measured whatever they read; then the next
+ * while the last is within SPLIT_PILOT_GO_ON of the least error x rays so far, whether
+ * or not it won. */
+static void test_go_on(void)
+{
+    const uint64_t rays[] = { 1000, 1600, 2800, 5200, 10000 };
+    CHECK_EQ_INT(SPLIT_PILOT_ALWAYS, 3);
+    CHECK_EQ_INT(split_pilot_go_on(&(SplitPilot){ 0 }), 1);
+    /* 2 and 4 at 0.80 and 0.84 of split 1's: 4 did not win, but it is within 1.2 of 2 */
+    SplitPilot sp = measured(3, (const double[]){ 1.0, 0.5, 0.3 }, rays);
+    CHECK_EQ_INT(split_pilot_go_on(&sp), 1);
+    CHECK_EQ_INT(split_pilot_choose(&sp), 2);
+    /* 4 at 1.12: more than 1.2 times 2's 0.80 */
+    sp = measured(3, (const double[]){ 1.0, 0.5, 0.4 }, rays);
+    CHECK_EQ_INT(split_pilot_go_on(&sp), 0);
+    /* 2 read worse than 1 (noise) and 4 within 1.2 of 1: on to 8, which wins */
+    sp = measured(4, (const double[]){ 1.0, 0.7, 0.4, 0.12 }, rays);
+    CHECK_EQ_INT(split_pilot_go_on(&sp), 1);
+    CHECK_EQ_INT(split_pilot_choose(&sp), 8);
+}
+
 int main(void)
 {
     RUN(test_plan);
     RUN(test_choose);
+    RUN(test_go_on);
     return harness_report();
 }

@@ -36,6 +36,15 @@ uint split_pilot_choose(const SplitPilot *sp)
     return sp->measured ? sp->split[best] : 1u;
 }
 
+int split_pilot_go_on(const SplitPilot *sp)
+{
+    if (sp->measured == 0u) return 1;
+    double least = sp->error[0] * (double)sp->rays[0];
+    for (uint i = 1u; i < sp->measured; i++) least = fmin(least, sp->error[i] * (double)sp->rays[i]);
+    uint last = sp->measured - 1u;
+    return sp->error[last] * (double)sp->rays[last] <= SPLIT_PILOT_GO_ON * least;
+}
+
 /* Samples [0, spp) of the listed pixels with `seed` into `film` (fresh); their rays
  * added to *rays. *whole: every one of them was rendered. */
 static Status render_seed(const AdaptiveRun *run, uint seed, uint spp, Film *film, uint64_t *rays, int *whole,
@@ -58,14 +67,42 @@ static Status render_seed(const AdaptiveRun *run, uint seed, uint spp, Film *fil
     return st;
 }
 
+/* The pilot's weights: 1 / (v^2 + SPLIT_PILOT_REL_EPS) for each listed pixel's channel
+ * value v in a film of their own (split 1, SPLIT_PILOT_SEED_W), into w[3n]. Each split's
+ * films are weighed by these, not by their own mean: a pixel where one film drew a rare
+ * bright path (a highlight of the sun) then also had a large mean, which capped its
+ * relative error near 4 whatever that path's size, so the pilot read envmat's split 16 at
+ * 0.83 of split 1's error x rays where it is at 0.59 (bench/RESULTS.md). With one film's
+ * weights for every split, the splits are compared on the same measure, and none of
+ * them is weighed by its own samples. */
+static Status weigh(const AdaptiveRun *run, const uint *list, uint n, uint spp, double *w, int *whole, Error *err)
+{
+    RenderParams *p = &run->rs->ds.params;
+    uint render_seed_was = p->seed;
+    uint64_t rays = 0;
+    Film film;
+    Status st = film_init(&film, p->width, p->height, err);
+    if (st) return st;
+    st = render_seed(run, SPLIT_PILOT_SEED_W, spp, &film, &rays, whole, err);
+    double unit = 1.0 / ((double)(1u << FILM_FRAC_BITS) * (double)spp);
+    for (uint i = 0; st == ST_OK && i < n; i++)
+        for (uint c = 0; c < 3u; c++) {
+            double v = (double)film.sum[3u * (size_t)list[i] + c] * unit;
+            w[3u * i + c] = 1.0 / (v * v + SPLIT_PILOT_REL_EPS);
+        }
+    film_free(&film);
+    p->seed = render_seed_was;
+    return st;
+}
+
 /* The pilot at the params' split: the listed pixels' samples [0, spp) with two seeds of
  * its own, two independent estimates of each pixel (the even and odd
  * samples of one Sobol sequence are not: they stratify each other, and their difference
- * put the Cornell box's split 2 at 0.72 of split 1 where it is at 1.24). Each film is
- * reduced to the listed pixels' sums before the next is made, so that one film of the
- * image's size is kept at a time. */
-static Status measure(const AdaptiveRun *run, const uint *list, uint n, uint spp, double *error, uint64_t *rays,
-                      int *whole, Error *err)
+ * put the Cornell box's split 2 at 0.72 of split 1 where it is at 1.24), their squared
+ * difference weighed by w (weigh). Each film is reduced to the listed pixels' sums
+ * before the next is made, so that one film of the image's size is kept at a time. */
+static Status measure(const AdaptiveRun *run, const uint *list, uint n, uint spp, const double *w, double *error,
+                      uint64_t *rays, int *whole, Error *err)
 {
     double *sums = calloc((size_t)n * 6u, sizeof *sums);
     if (!sums) return error_set(err, ST_INTERNAL, "out of memory for the split pilot");
@@ -88,8 +125,8 @@ static Status measure(const AdaptiveRun *run, const uint *list, uint n, uint spp
     double e = 0.0;
     for (uint i = 0; i < n; i++)
         for (uint c = 0; c < 3u; c++) {
-            double a = sums[6u * i + c] * unit, b = sums[6u * i + 3u + c] * unit, m = 0.5 * (a + b);
-            e += (a - b) * (a - b) / (m * m + SPLIT_PILOT_REL_EPS);
+            double d = (sums[6u * i + c] - sums[6u * i + 3u + c]) * unit;
+            e += d * d * w[3u * i + c];
         }
     *error = e;
     free(sums);
@@ -117,7 +154,12 @@ Status split_pilot_run(const AdaptiveRun *run, SplitPilot *sp, Error *err)
                  ? split_pilot_plan(p->width, p->height, &stride, &pilot_spp) : 0u;
     if (n == 0u) return set_split(run, 1u, err);
     uint *list = malloc((size_t)n * sizeof *list);
-    if (!list) return error_set(err, ST_INTERNAL, "out of memory for the split pilot");
+    double *w = malloc((size_t)n * 3u * sizeof *w);
+    if (!list || !w) {
+        free(list);
+        free(w);
+        return error_set(err, ST_INTERNAL, "out of memory for the split pilot");
+    }
     uint k = 0;
     for (uint y = stride / 2u; y < p->height; y += stride)
         for (uint x = stride / 2u; x < p->width; x += stride) list[k++] = y * p->width + x;
@@ -128,11 +170,11 @@ Status split_pilot_run(const AdaptiveRun *run, SplitPilot *sp, Error *err)
     double t0 = timer_now();
     Status st = ST_OK;
     int whole = 1;
+    if ((st = set_split(run, 1u, err)) == ST_OK) st = weigh(run, list, n, pilot_spp, w, &whole, err);
     for (uint c = 0; c < SPLIT_PILOT_CANDIDATES && st == ST_OK && whole; c++) {
-        /* a larger split only after the one before it won */
-        if (c >= 2u && split_pilot_choose(sp) != sp->split[c - 1u]) break;
+        if (c >= SPLIT_PILOT_ALWAYS && !split_pilot_go_on(sp)) break;
         if ((st = set_split(run, candidates[c], err))) break;
-        st = measure(run, list, n, pilot_spp, &sp->error[c], &sp->rays[c], &whole, err);
+        st = measure(run, list, n, pilot_spp, w, &sp->error[c], &sp->rays[c], &whole, err);
         if (st == ST_OK && whole) sp->split[sp->measured++] = candidates[c];
     }
     sp->seconds = timer_now() - t0;
@@ -142,6 +184,7 @@ Status split_pilot_run(const AdaptiveRun *run, SplitPilot *sp, Error *err)
     *p = saved;
     ds->pixel_list = saved_list;
     free(list);
+    free(w);
     if (st) return st;
     sp->chosen = sp->ran ? split_pilot_choose(sp) : 1u;
     /* the devices get the params back, with the split chosen, and drop the list */

@@ -10,10 +10,12 @@
  * lamp's edge). Which holds depends on the scene and on the samples per pixel (Sobol
  * points make both parts fall faster than 1/n, each at its own rate), so it is
  * measured rather than guessed: a sparse grid of pixels renders SPLIT_PILOT_SPP
- * samples per pixel twice, with two seeds of its own, at split 1, then
- * 2, 4, 8 and 16 while the last one won. Each split's error is the relative squared
- * difference of its two films (two independent estimates of every pixel;
- * SPLIT_PILOT_REL_EPS), its cost the rays it traced; the render takes the N of least
+ * samples per pixel twice, with two seeds of its own, at split 1, 2 and 4, then 8
+ * and 16 while the last one came near the best (SPLIT_PILOT_GO_ON). Each split's error
+ * is the squared difference of its two films (two independent estimates of every
+ * pixel), relative to the pixel's value in a third film of split 1 that weighs every
+ * split alike (SPLIT_PILOT_REL_EPS; split_pilot.c, weigh), its cost the rays it
+ * traced; the render takes the N of least
  * error x rays, a larger N only where it promises at most SPLIT_PILOT_GAIN (from 1) or
  * SPLIT_PILOT_GAIN_MORE of the smaller one's (efficiency as variance x cost, the
  * measure of Veach's thesis, 1997, section 2.4.1).
@@ -31,8 +33,15 @@
 
 #include "render/adaptive.h"
 
-/* The splits the pilot may measure, in order; each after the one before won. */
+/* The splits the pilot may measure, in order: the first SPLIT_PILOT_ALWAYS always, each
+ * after them while the one before it came within SPLIT_PILOT_GO_ON of the least error x
+ * rays so far. Not only after a win: a sparse grid's error is noisy where a few pixels
+ * hold it (highlights), and stopping at the first split that did not win left materials
+ * and envmap at split 1 in half the seeds where 8 and 16 are at 0.66-0.69 and 0.54-0.57
+ * of its error x rays (bench/RESULTS.md). */
 #define SPLIT_PILOT_CANDIDATES 5
+#define SPLIT_PILOT_ALWAYS 3
+#define SPLIT_PILOT_GO_ON 1.2
 /* Splitting at all is chosen where its error x rays is below this share of split 1's
  * (the estimates are noisy, and on a GPU a split render also runs the megakernel), a
  * larger split where it is below the second share of the smaller one's (noise alone). */
@@ -65,6 +74,8 @@
  * chose split 4 for one seed and 8 for another). */
 #define SPLIT_PILOT_SEED_A 0x9e3779b9u
 #define SPLIT_PILOT_SEED_B 0x5bd1e995u
+/* The seed of the film that weighs every split's error (split_pilot.c, weigh). */
+#define SPLIT_PILOT_SEED_W 0x2545f491u
 
 typedef struct {
     uint chosen;                 /* the split the render uses (1 when the pilot did not run) */
@@ -87,6 +98,10 @@ uint split_pilot_plan(uint width, uint height, uint *stride, uint *pilot_spp);
  * beats the choice before it by SPLIT_PILOT_GAIN (from split 1) or SPLIT_PILOT_GAIN_MORE.
  * Pure, for the tests. */
 uint split_pilot_choose(const SplitPilot *sp);
+
+/* Whether the pilot measures the next candidate: the last one measured is within
+ * SPLIT_PILOT_GO_ON of the least error x rays measured. Pure, for the tests. */
+int split_pilot_go_on(const SplitPilot *sp);
 
 /* Runs the pilot for run->rs when its params ask for split auto (RenderParams.split 0)
  * on the path tracer with the camera in vacuum, and writes the chosen split into the params (and so

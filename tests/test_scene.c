@@ -387,7 +387,7 @@ static void test_cornell_box(void)
     CHECK_EQ_INT(s.n_spheres + s.n_boxes + s.n_planes, 0);
     CHECK_EQ_INT(s.image.width, 512);
     CHECK_EQ_INT(s.image.height, 512);
-    CHECK_EQ_INT(s.image.spp, 64);
+    CHECK_EQ_INT(s.image.spp, 16);
     CHECK_EQ_INT(s.image.max_depth, 8);
     CHECK(vec_eq(s.camera.from, 278, 273, -800));
     CHECK(vec_eq(s.camera.at, 278, 273, 0));

@@ -36,9 +36,9 @@
 /* The splits the pilot may measure, in order: the first SPLIT_PILOT_ALWAYS always, each
  * after them while the one before it came within SPLIT_PILOT_GO_ON of the least error x
  * rays so far. Not only after a win: a sparse grid's error is noisy where a few pixels
- * hold it (highlights), and stopping at the first split that did not win left materials
- * and envmap at split 1 in half the seeds where 8 and 16 are at 0.66-0.69 and 0.54-0.57
- * of its error x rays (bench/RESULTS.md). */
+ * hold it (highlights), and stopping at the first split that did not win left
+ * scenes/materials at split 1 in half of the pilots simulated from independent renders,
+ * where 8 and 16 are at 0.69 and 0.66 of its error x rays (bench/RESULTS.md). */
 #define SPLIT_PILOT_CANDIDATES 5
 #define SPLIT_PILOT_ALWAYS 3
 #define SPLIT_PILOT_GO_ON 1.2

@@ -45,25 +45,38 @@ int split_pilot_go_on(const SplitPilot *sp)
     return sp->error[last] * (double)sp->rays[last] <= SPLIT_PILOT_GO_ON * least;
 }
 
-/* Samples [0, spp) of the listed pixels with `seed` into `film` (fresh); their rays
- * added to *rays. *whole: every one of them was rendered. */
-static Status render_seed(const AdaptiveRun *run, uint seed, uint spp, Film *film, uint64_t *rays, int *whole,
-                          Error *err)
+/* Samples [0, spp) of the listed pixels with `seed`, in a film of their own: each pixel's
+ * channel values (radiance, the film's sums over spp) into v[3n], its rays added to
+ * *rays. *whole: every sample was rendered. The params' seed is restored; the film of
+ * the image's size lives only in here, so one is kept at a time. */
+static Status render_pixels(const AdaptiveRun *run, const uint *list, uint n, uint seed, uint spp, double *v,
+                            uint64_t *rays, int *whole, Error *err)
 {
-    run->rs->ds.params.seed = seed;
-    Status st = device_update_all(run->devices, run->n_devices, &run->rs->ds, err);
+    RenderParams *p = &run->rs->ds.params;
+    uint render_seed_was = p->seed;
+    Film film;
+    Status st = film_init(&film, p->width, p->height, err);
     if (st) return st;
-    ScheduleConfig cfg = schedule_config_part(run->cfg, 0u, spp, 0.0);
-    /* The pilot's samples in a batch per device: grown from one sample, as a render's
-     * batches are, they took four batches a film, each with its launch and its film read
-     * back, a quarter of the dragon's pilot (bench/RESULTS.md). The film's fixed-point
-     * sums do not depend on the batches, so neither does the choice. */
-    cfg.fixed_batch = (spp + (uint)run->n_devices - 1u) / (uint)run->n_devices;
-    ScheduleStats one;
-    st = schedule_run(run->devices, run->n_devices, &cfg, film, &one, err);
-    *whole = st == ST_OK && !one.interrupted && !one.time_up && film->samples == spp;
-    *rays += one.rays;
-    schedule_stats_free(&one);
+    p->seed = seed;
+    if ((st = device_update_all(run->devices, run->n_devices, &run->rs->ds, err)) == ST_OK) {
+        ScheduleConfig cfg = schedule_config_part(run->cfg, 0u, spp, 0.0);
+        /* The pilot's samples in a batch per device: grown from one sample, as a render's
+         * batches are, they took four batches a film, each with its launch and its film
+         * read back, a quarter of the dragon's pilot (bench/RESULTS.md). The film's
+         * fixed-point sums do not depend on the batches, so neither does the choice. */
+        cfg.fixed_batch = (spp + (uint)run->n_devices - 1u) / (uint)run->n_devices;
+        ScheduleStats one;
+        st = schedule_run(run->devices, run->n_devices, &cfg, &film, &one, err);
+        *whole = st == ST_OK && !one.interrupted && !one.time_up && film.samples == spp;
+        *rays += one.rays;
+        schedule_stats_free(&one);
+    }
+    /* film units to radiance: the film holds spp samples of a pixel */
+    double unit = 1.0 / ((double)(1u << FILM_FRAC_BITS) * (double)spp);
+    for (uint i = 0; st == ST_OK && i < n; i++)
+        for (uint c = 0; c < 3u; c++) v[3u * i + c] = (double)film.sum[3u * (size_t)list[i] + c] * unit;
+    film_free(&film);
+    p->seed = render_seed_was;
     return st;
 }
 
@@ -77,21 +90,9 @@ static Status render_seed(const AdaptiveRun *run, uint seed, uint spp, Film *fil
  * them is weighed by its own samples. */
 static Status weigh(const AdaptiveRun *run, const uint *list, uint n, uint spp, double *w, int *whole, Error *err)
 {
-    RenderParams *p = &run->rs->ds.params;
-    uint render_seed_was = p->seed;
     uint64_t rays = 0;
-    Film film;
-    Status st = film_init(&film, p->width, p->height, err);
-    if (st) return st;
-    st = render_seed(run, SPLIT_PILOT_SEED_W, spp, &film, &rays, whole, err);
-    double unit = 1.0 / ((double)(1u << FILM_FRAC_BITS) * (double)spp);
-    for (uint i = 0; st == ST_OK && i < n; i++)
-        for (uint c = 0; c < 3u; c++) {
-            double v = (double)film.sum[3u * (size_t)list[i] + c] * unit;
-            w[3u * i + c] = 1.0 / (v * v + SPLIT_PILOT_REL_EPS);
-        }
-    film_free(&film);
-    p->seed = render_seed_was;
+    Status st = render_pixels(run, list, n, SPLIT_PILOT_SEED_W, spp, w, &rays, whole, err);
+    for (uint i = 0; st == ST_OK && i < 3u * n; i++) w[i] = 1.0 / (w[i] * w[i] + SPLIT_PILOT_REL_EPS);
     return st;
 }
 
@@ -99,37 +100,20 @@ static Status weigh(const AdaptiveRun *run, const uint *list, uint n, uint spp, 
  * its own, two independent estimates of each pixel (the even and odd
  * samples of one Sobol sequence are not: they stratify each other, and their difference
  * put the Cornell box's split 2 at 0.72 of split 1 where it is at 1.24), their squared
- * difference weighed by w (weigh). Each film is reduced to the listed pixels' sums
- * before the next is made, so that one film of the image's size is kept at a time. */
+ * difference weighed by w (weigh). */
 static Status measure(const AdaptiveRun *run, const uint *list, uint n, uint spp, const double *w, double *error,
                       uint64_t *rays, int *whole, Error *err)
 {
-    double *sums = calloc((size_t)n * 6u, sizeof *sums);
-    if (!sums) return error_set(err, ST_INTERNAL, "out of memory for the split pilot");
-    RenderParams *p = &run->rs->ds.params;
-    uint seeds[2] = { SPLIT_PILOT_SEED_A, SPLIT_PILOT_SEED_B }, render_seed_was = p->seed;
-    Status st = ST_OK;
+    double *a = malloc((size_t)n * 6u * sizeof *a), *b = a + (size_t)n * 3u;
+    if (!a) return error_set(err, ST_INTERNAL, "out of memory for the split pilot");
     *whole = 1;
     *rays = 0;
-    for (uint h = 0; h < 2u && st == ST_OK && *whole; h++) {
-        Film film;
-        if ((st = film_init(&film, p->width, p->height, err))) break;
-        st = render_seed(run, seeds[h], spp, &film, rays, whole, err);
-        for (uint i = 0; st == ST_OK && i < n; i++)
-            for (uint c = 0; c < 3u; c++) sums[6u * i + 3u * h + c] = (double)film.sum[3u * (size_t)list[i] + c];
-        film_free(&film);
-    }
-    p->seed = render_seed_was;
-    /* film units to radiance: each film holds spp samples of a pixel */
-    double unit = 1.0 / ((double)(1u << FILM_FRAC_BITS) * (double)spp);
+    Status st = render_pixels(run, list, n, SPLIT_PILOT_SEED_A, spp, a, rays, whole, err);
+    if (st == ST_OK && *whole) st = render_pixels(run, list, n, SPLIT_PILOT_SEED_B, spp, b, rays, whole, err);
     double e = 0.0;
-    for (uint i = 0; i < n; i++)
-        for (uint c = 0; c < 3u; c++) {
-            double d = (sums[6u * i + c] - sums[6u * i + 3u + c]) * unit;
-            e += d * d * w[3u * i + c];
-        }
+    for (uint i = 0; st == ST_OK && *whole && i < 3u * n; i++) e += (a[i] - b[i]) * (a[i] - b[i]) * w[i];
     *error = e;
-    free(sums);
+    free(a);
     return st;
 }
 

@@ -90,9 +90,10 @@
         "continuation weighted 1/N, sharing the camera ray\n" \
         "(1..64; 1: none; overrides the scene's image\n" \
         "split). auto, the default: a short pilot render\n" \
-        "of a sparse grid of pixels measures 1, 2, 4, 8,\n" \
-        "16, and the render takes the one of least error\n" \
-        "x rays, the same on any devices; small renders\n" \
+        "of a sparse grid of pixels measures 1, 2, 4 and\n" \
+        "16, and the render takes the one of 1, 2, 4, 8, 16\n" \
+        "of least error x rays on the curve fitted to\n" \
+        "them, the same on any devices; small renders\n" \
         "keep 1 (docs/design.md, First-hit splitting)") \
     X(OUTPUT, CUSTOM, noise_threshold, "--noise-threshold", NULL, "T", PARSE(parse_noise_threshold), \
         "path tracer: adaptive sampling; a pixel stops once\n" \

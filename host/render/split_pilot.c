@@ -9,7 +9,8 @@
 #include "base/timer.h"
 #include "render/render_scene.h"
 
-static const uint candidates[SPLIT_PILOT_CANDIDATES] = { 1u, 2u, 4u, 8u, 16u };
+const uint split_pilot_candidates[SPLIT_PILOT_CANDIDATES] = { 1u, 2u, 4u, 8u, 16u };
+const uint split_pilot_measured_splits[SPLIT_PILOT_MEASURED] = { 1u, 2u, 4u, 16u };
 
 uint split_pilot_plan(uint width, uint height, uint *stride, uint *pilot_spp)
 {
@@ -26,23 +27,63 @@ uint split_pilot_plan(uint width, uint height, uint *stride, uint *pilot_spp)
     return ((width + k - 1u - k / 2u) / k) * ((height + k - 1u - k / 2u) / k);
 }
 
-uint split_pilot_choose(const SplitPilot *sp)
+int split_pilot_fit(const SplitPilot *sp, SplitModel *m)
 {
-    uint best = 0u;
-    for (uint i = 1u; i < sp->measured; i++) {
-        double e = sp->error[i] * (double)sp->rays[i], b = sp->error[best] * (double)sp->rays[best];
-        if (e < (best == 0u ? SPLIT_PILOT_GAIN : SPLIT_PILOT_GAIN_MORE) * b) best = i;
+    uint n = sp->measured;
+    if (n < 3u) return 0;
+    /* the normal equations of y ~ c0 + c1 x + c2 x^2 over the readings, x = log2 N,
+     * y = log(error x rays): sums of x^0..x^4 and of y x^0..x^2 */
+    double sx[5] = { 0.0 }, sy[3] = { 0.0 };
+    for (uint i = 0; i < n; i++) {
+        double e = sp->error[i] * (double)sp->rays[i];
+        if (!(e > 0.0) || !isfinite(e) || sp->split[i] == 0u) return 0;
+        double x = log2((double)sp->split[i]), y = log(e), xp = 1.0;
+        for (uint k = 0; k < 5u; k++, xp *= x) {
+            sx[k] += xp;
+            if (k < 3u) sy[k] += xp * y;
+        }
     }
-    return sp->measured ? sp->split[best] : 1u;
+    /* Cramer's rule on the 3 x 3 system (well conditioned for x in 0..4) */
+    double a[3][3] = { { sx[0], sx[1], sx[2] }, { sx[1], sx[2], sx[3] }, { sx[2], sx[3], sx[4] } };
+    double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                 a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    if (!(fabs(det) > 1e-9)) return 0;
+    double c[3];
+    for (uint j = 0; j < 3u; j++) {
+        double t[3][3];
+        memcpy(t, a, sizeof t);
+        for (uint r = 0; r < 3u; r++) t[r][j] = sy[r];
+        c[j] = (t[0][0] * (t[1][1] * t[2][2] - t[1][2] * t[2][1]) - t[0][1] * (t[1][0] * t[2][2] - t[1][2] * t[2][0]) +
+                t[0][2] * (t[1][0] * t[2][1] - t[1][1] * t[2][0])) / det;
+    }
+    m->c0 = c[0];
+    m->c1 = c[1];
+    m->c2 = c[2];
+    return 1;
 }
 
-int split_pilot_go_on(const SplitPilot *sp)
+/* The fitted log(error x rays) at split n: log2 of a power of two is exact */
+static double model_log_cost(const SplitModel *m, uint n)
 {
-    if (sp->measured == 0u) return 1;
-    double least = sp->error[0] * (double)sp->rays[0];
-    for (uint i = 1u; i < sp->measured; i++) least = fmin(least, sp->error[i] * (double)sp->rays[i]);
-    uint last = sp->measured - 1u;
-    return sp->error[last] * (double)sp->rays[last] <= SPLIT_PILOT_GO_ON * least;
+    double x = log2((double)n);
+    return m->c0 + m->c1 * x + m->c2 * x * x;
+}
+
+double split_model_cost(const SplitModel *m, uint n)
+{
+    return exp(model_log_cost(m, n));
+}
+
+uint split_pilot_choose(const SplitPilot *sp)
+{
+    if (!sp->fitted) return 1u;
+    uint best = 0u;
+    for (uint i = 1; i < SPLIT_PILOT_CANDIDATES; i++)
+        if (model_log_cost(&sp->model, split_pilot_candidates[i]) < model_log_cost(&sp->model, split_pilot_candidates[best]))
+            best = i;
+    /* compared as logarithms: no exp between the fit and the choice */
+    return model_log_cost(&sp->model, split_pilot_candidates[best]) - model_log_cost(&sp->model, 1u) < log(SPLIT_PILOT_GAIN)
+               ? split_pilot_candidates[best] : 1u;
 }
 
 /* Samples [0, spp) of the listed pixels with `seed`, in a film of their own: each pixel's
@@ -155,16 +196,16 @@ Status split_pilot_run(const AdaptiveRun *run, SplitPilot *sp, Error *err)
     Status st = ST_OK;
     int whole = 1;
     if ((st = set_split(run, 1u, err)) == ST_OK) st = weigh(run, list, n, pilot_spp, w, &whole, err);
-    for (uint c = 0; c < SPLIT_PILOT_CANDIDATES && st == ST_OK && whole; c++) {
-        if (c >= SPLIT_PILOT_ALWAYS && !split_pilot_go_on(sp)) break;
-        if ((st = set_split(run, candidates[c], err))) break;
+    for (uint c = 0; c < SPLIT_PILOT_MEASURED && st == ST_OK && whole; c++) {
+        if ((st = set_split(run, split_pilot_measured_splits[c], err))) break;
         st = measure(run, list, n, pilot_spp, w, &sp->error[c], &sp->rays[c], &whole, err);
-        if (st == ST_OK && whole) sp->split[sp->measured++] = candidates[c];
+        if (st == ST_OK && whole) sp->split[sp->measured++] = split_pilot_measured_splits[c];
     }
     sp->seconds = timer_now() - t0;
     sp->pixels = n;
     sp->spp = pilot_spp;
     sp->ran = st == ST_OK && whole;
+    sp->fitted = sp->ran && split_pilot_fit(sp, &sp->model);
     *p = saved;
     ds->pixel_list = saved_list;
     free(list);

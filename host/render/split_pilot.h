@@ -10,15 +10,26 @@
  * lamp's edge). Which holds depends on the scene and on the samples per pixel (Sobol
  * points make both parts fall faster than 1/n, each at its own rate), so it is
  * measured rather than guessed: a sparse grid of pixels renders SPLIT_PILOT_SPP
- * samples per pixel twice, with two seeds of its own, at split 1, 2 and 4, then 8
- * and 16 while the last one came near the best (SPLIT_PILOT_GO_ON). Each split's error
- * is the squared difference of its two films (two independent estimates of every
- * pixel), relative to the pixel's value in a third film of split 1 that weighs every
- * split alike (SPLIT_PILOT_REL_EPS; split_pilot.c, weigh), its cost the rays it
- * traced; the render takes the N of least
- * error x rays, a larger N only where it promises at most SPLIT_PILOT_GAIN (from 1) or
- * SPLIT_PILOT_GAIN_MORE of the smaller one's (efficiency as variance x cost, the
- * measure of Veach's thesis, 1997, section 2.4.1).
+ * samples per pixel twice, with two seeds of its own, at each split it measures
+ * (SPLIT_PILOT_MEASURED). Each split's error is the squared difference of its two films
+ * (two independent estimates of every pixel), relative to the pixel's value in a third
+ * film of split 1 that weighs every split alike (SPLIT_PILOT_REL_EPS; split_pilot.c,
+ * weigh), its cost the rays it traced. The readings are noisy where a few pixels hold
+ * the error (a highlight of the sun, a glint of a lamp): one split's reading may be
+ * 20-60% off on one grid and not on another (envmat's split 16 reads 0.32-0.89 of split
+ * 1's error x rays on nine grids in ten, 0.59 over whole images). So the choice is
+ * not taken from the readings one by one but from the curve they fit together: the
+ * parabola in log2 N of least squares through the readings' log(error x rays) (the
+ * curve of a split's efficiency is convex with one minimum, where what the camera
+ * sample's own error costs balances the continuations' rays), evaluated at every
+ * candidate (SPLIT_PILOT_CANDIDATES). The render takes the one of least fitted error x
+ * rays (efficiency as variance x cost, the measure of Veach's thesis, 1997, section
+ * 2.4.1), splitting at all only where that is below SPLIT_PILOT_GAIN of the fitted split 1.
+ * A fit of the model of two-stage sampling, error V0 + V1 / N for rays R0 + R1 N (whose
+ * best N Cochran's "Sampling Techniques", 1977, chapter 10, derives), chose better than
+ * the parabola on most scenes but kept one-weekend at split 1 in a third of the
+ * simulated pilots, where it gains a quarter at 2 and 4: Sobol points make the
+ * continuations' error fall faster than 1 / N.
  *
  * Ray counts and film sums are integers that every device, batch size and MPI rank
  * produce alike, the pilot's pixels and samples depend only on the image's size, and
@@ -33,20 +44,18 @@
 
 #include "render/adaptive.h"
 
-/* The splits the pilot may measure, in order: the first SPLIT_PILOT_ALWAYS always, each
- * after them while the one before it came within SPLIT_PILOT_GO_ON of the least error x
- * rays so far. Not only after a win: a sparse grid's error is noisy where a few pixels
- * hold it (highlights), and stopping at the first split that did not win left
- * scenes/materials at split 1 in half of the pilots simulated from independent renders,
- * where 8 and 16 are at 0.69 and 0.66 of its error x rays (bench/RESULTS.md). */
+/* The splits a render may take, and how many of them the pilot measures (SPLIT_PILOT_MEASURED,
+ * split_pilot.c: 1, 2, 4 and 16; the parabola puts 8 between 4 and 16). Every reading
+ * goes into the fit: pilots simulated from independent renders of ten scenes chose
+ * within 0-4% of the best split's efficiency on average, where taking the least reading
+ * after the go-on rule of before was 1-11% from it (envmat: 0.620 and 0.659 of split 1's
+ * error x rays, the best 0.592; bench/RESULTS.md, "The split pilot's curve"). */
 #define SPLIT_PILOT_CANDIDATES 5
-#define SPLIT_PILOT_ALWAYS 3
-#define SPLIT_PILOT_GO_ON 1.2
-/* Splitting at all is chosen where its error x rays is below this share of split 1's
- * (the estimates are noisy, and on a GPU a split render also runs the megakernel), a
- * larger split where it is below the second share of the smaller one's (noise alone). */
+#define SPLIT_PILOT_MEASURED 4
+/* Splitting at all is chosen where the fitted error x rays is below this share of
+ * split 1's (the estimates are noisy, and on a GPU a split render also runs the
+ * megakernel). */
 #define SPLIT_PILOT_GAIN 0.9
-#define SPLIT_PILOT_GAIN_MORE 0.95
 /* The pilot's samples per pixel in each of its two films. Fixed, as everything the
  * pilot does is by the image's size alone: a render of N samples per pixel is the first
  * N of one of more (a checkpoint or part grown to more, docs/checkpoint.md), so the
@@ -77,15 +86,23 @@
 /* The seed of the film that weighs every split's error (split_pilot.c, weigh). */
 #define SPLIT_PILOT_SEED_W 0x2545f491u
 
+/* The fitted curve: log(error x rays) at N continuations is c0 + c1 x + c2 x^2,
+ * x = log2 N. */
+typedef struct {
+    double c0, c1, c2;
+} SplitModel;
+
 typedef struct {
     uint chosen;                 /* the split the render uses (1 when the pilot did not run) */
     int ran;                     /* the pilot rendered (split auto, a path-traced render large enough) */
     uint pixels, spp;            /* its pixels and samples per pixel */
-    uint measured;               /* how many candidates it rendered */
-    uint split[SPLIT_PILOT_CANDIDATES];
-    double error[SPLIT_PILOT_CANDIDATES];   /* the films' relative squared difference, summed over
-                                             * pixels and channels */
-    uint64_t rays[SPLIT_PILOT_CANDIDATES];
+    uint measured;               /* how many splits it rendered */
+    uint split[SPLIT_PILOT_MEASURED];
+    double error[SPLIT_PILOT_MEASURED];   /* the films' relative squared difference, summed over
+                                           * pixels and channels */
+    uint64_t rays[SPLIT_PILOT_MEASURED];
+    int fitted;                  /* model holds the fit (split_pilot_fit) */
+    SplitModel model;
     double seconds;
 } SplitPilot;
 
@@ -94,14 +111,24 @@ typedef struct {
  * tests. */
 uint split_pilot_plan(uint width, uint height, uint *stride, uint *pilot_spp);
 
-/* The split of least error x rays among the measured candidates, each only where it
- * beats the choice before it by SPLIT_PILOT_GAIN (from split 1) or SPLIT_PILOT_GAIN_MORE.
- * Pure, for the tests. */
-uint split_pilot_choose(const SplitPilot *sp);
+/* The splits a render may take, SPLIT_PILOT_CANDIDATES of them in increasing order,
+ * and the ones the pilot measures, SPLIT_PILOT_MEASURED, split 1 first. */
+extern const uint split_pilot_candidates[SPLIT_PILOT_CANDIDATES];
+extern const uint split_pilot_measured_splits[SPLIT_PILOT_MEASURED];
 
-/* Whether the pilot measures the next candidate: the last one measured is within
- * SPLIT_PILOT_GO_ON of the least error x rays measured. Pure, for the tests. */
-int split_pilot_go_on(const SplitPilot *sp);
+/* Fits the curve to what sp measured by least squares. 0 (and no curve) where fewer
+ * than three splits were measured or a reading is not positive (a scene without
+ * noise). The logarithm is the one step whose last bit may differ between two
+ * machines' maths libraries; a choice could then differ only where two candidates'
+ * fitted costs agree to 15 digits. Pure, for the tests. */
+int split_pilot_fit(const SplitPilot *sp, SplitModel *m);
+
+/* The fitted error x rays at split n. */
+double split_model_cost(const SplitModel *m, uint n);
+
+/* The candidate of least fitted cost, where it is below SPLIT_PILOT_GAIN of split 1's;
+ * else (or without a fit) 1. Pure, for the tests. */
+uint split_pilot_choose(const SplitPilot *sp);
 
 /* Runs the pilot for run->rs when its params ask for split auto (RenderParams.split 0)
  * on the path tracer with the camera in vacuum, and writes the chosen split into the params (and so

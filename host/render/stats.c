@@ -205,14 +205,22 @@ void render_stats_print_split(FILE *out, const SplitPilot *sp, uint scene_split)
                                 : "split: 1 (auto without a pilot: an image under 256x256, or a camera in a medium)\n");
         return;
     }
-    fprintf(out, "split: %u, chosen by a pilot of %u pixels x %u spp in %.2f s (error x rays against split 1:",
+    fprintf(out, "split: %u, chosen by a pilot of %u pixels x %u spp in %.2f s (error x rays against split 1,",
             sp->chosen, sp->pixels, sp->spp, sp->seconds);
+    fprintf(out, " measured:");
     for (uint i = 1; i < sp->measured; i++) fprintf(out, "%s %u %.3f", i > 1 ? "," : "", sp->split[i], pilot_ratio(sp, i));
+    if (sp->fitted) {
+        double one = split_model_cost(&sp->model, 1u);
+        fprintf(out, "; fitted:");
+        for (uint i = 1; i < SPLIT_PILOT_CANDIDATES; i++)
+            fprintf(out, "%s %u %.3f", i > 1 ? "," : "", split_pilot_candidates[i],
+                    one > 0.0 ? split_model_cost(&sp->model, split_pilot_candidates[i]) / one : 0.0);
+    }
     fprintf(out, ")\n");
 }
 
 /* "split":{"chosen":2,"auto":true,"pilot":{"pixels":1024,"spp":16,"seconds":0.12,
- * "measured":[{"split":1,"error":..,"rays":..},...]}} */
+ * "measured":[{"split":1,"error":..,"rays":..},...],"fitted":[{"split":1,"error_x_rays":..},...]}} */
 static void json_split(FILE *out, const SplitPilot *sp, uint scene_split)
 {
     fprintf(out, ",\"split\":{\"chosen\":%u,\"auto\":%s", sp->chosen, scene_split == SCENE_SPLIT_AUTO ? "true" : "false");
@@ -222,7 +230,15 @@ static void json_split(FILE *out, const SplitPilot *sp, uint scene_split)
         for (uint i = 0; i < sp->measured; i++)
             fprintf(out, "%s{\"split\":%u,\"error\":%.9g,\"rays\":%llu}", i ? "," : "", sp->split[i], sp->error[i],
                     (unsigned long long)sp->rays[i]);
-        fprintf(out, "]}");
+        fprintf(out, "]");
+        if (sp->fitted) {
+            fprintf(out, ",\"fitted\":[");
+            for (uint i = 0; i < SPLIT_PILOT_CANDIDATES; i++)
+                fprintf(out, "%s{\"split\":%u,\"error_x_rays\":%.9g}", i ? "," : "", split_pilot_candidates[i],
+                        split_model_cost(&sp->model, split_pilot_candidates[i]));
+            fputc(']', out);
+        }
+        fprintf(out, "}");
     }
     fputc('}', out);
 }

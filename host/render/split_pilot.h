@@ -47,7 +47,7 @@
 /* The splits a render may take, and how many of them the pilot measures (SPLIT_PILOT_MEASURED,
  * split_pilot.c: 1, 2, 4 and 16; the parabola puts 8 between 4 and 16). Every reading
  * goes into the fit: pilots simulated from independent renders of ten scenes chose
- * within 0-4% of the best split's efficiency on average, where taking the least reading
+ * within 0-5% of the best split's efficiency on average, where taking the least reading
  * after the go-on rule of before was 1-11% from it (envmat: 0.620 and 0.659 of split 1's
  * error x rays, the best 0.592; bench/RESULTS.md, "The split pilot's curve"). */
 #define SPLIT_PILOT_CANDIDATES 5

@@ -27,6 +27,12 @@ uint split_pilot_plan(uint width, uint height, uint *stride, uint *pilot_spp)
     return ((width + k - 1u - k / 2u) / k) * ((height + k - 1u - k / 2u) / k);
 }
 
+static double det3(double a[3][3])
+{
+    return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+           a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+}
+
 int split_pilot_fit(const SplitPilot *sp, SplitModel *m)
 {
     uint n = sp->measured;
@@ -45,16 +51,14 @@ int split_pilot_fit(const SplitPilot *sp, SplitModel *m)
     }
     /* Cramer's rule on the 3 x 3 system (well conditioned for x in 0..4) */
     double a[3][3] = { { sx[0], sx[1], sx[2] }, { sx[1], sx[2], sx[3] }, { sx[2], sx[3], sx[4] } };
-    double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-                 a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    double det = det3(a);
     if (!(fabs(det) > 1e-9)) return 0;
     double c[3];
     for (uint j = 0; j < 3u; j++) {
         double t[3][3];
         memcpy(t, a, sizeof t);
         for (uint r = 0; r < 3u; r++) t[r][j] = sy[r];
-        c[j] = (t[0][0] * (t[1][1] * t[2][2] - t[1][2] * t[2][1]) - t[0][1] * (t[1][0] * t[2][2] - t[1][2] * t[2][0]) +
-                t[0][2] * (t[1][0] * t[2][1] - t[1][1] * t[2][0])) / det;
+        c[j] = det3(t) / det;
     }
     m->c0 = c[0];
     m->c1 = c[1];
@@ -145,8 +149,9 @@ static Status weigh(const AdaptiveRun *run, const uint *list, uint n, uint spp, 
 static Status measure(const AdaptiveRun *run, const uint *list, uint n, uint spp, const double *w, double *error,
                       uint64_t *rays, int *whole, Error *err)
 {
-    double *a = malloc((size_t)n * 6u * sizeof *a), *b = a + (size_t)n * 3u;
+    double *a = malloc((size_t)n * 6u * sizeof *a);
     if (!a) return error_set(err, ST_INTERNAL, "out of memory for the split pilot");
+    double *b = a + (size_t)n * 3u;
     *whole = 1;
     *rays = 0;
     Status st = render_pixels(run, list, n, SPLIT_PILOT_SEED_A, spp, a, rays, whole, err);

@@ -159,10 +159,15 @@ KFN_INLINE uint bvh_top_test(GLOBAL const BvhTopNode *nd, const BvhRay *w, float
 }
 #endif
 
-KFN_INLINE float bvh_inv(float d)
+/* The slab tests' reciprocal of direction component d, given inv = 1.0f / d (RayPre's
+ * inv_d): inv itself, or for |d| < BVH_TINY (0 included) 1 / +-BVH_TINY, a constant.
+ * The same bits as dividing again, without the division: a ray's set-up divided nine
+ * times, which on a 2-vCPU Zen 3 held about a tenth of the scalar walk's samples on
+ * Sponza, where most rays leave the tree after a few nodes (bench/RESULTS.md). */
+KFN_INLINE float bvh_inv(float d, float inv)
 {
-    float s = (k_as_uint(d) >> 31) ? -BVH_TINY : BVH_TINY;
-    return 1.0f / (k_fabs(d) < BVH_TINY ? s : d);
+    float huge = (k_as_uint(d) >> 31) ? 1.0f / -BVH_TINY : 1.0f / BVH_TINY;
+    return k_fabs(d) < BVH_TINY ? huge : inv;
 }
 
 /* Of a node's children entered (the lanes in mask), returns the one to
@@ -222,9 +227,9 @@ KFN_INLINE BvhRay bvh_ray(Ray ray, const RayPre *rp)
     w.ox = ray.o.x;
     w.oy = ray.o.y;
     w.oz = ray.o.z;
-    w.ix = bvh_inv(ray.d.x);
-    w.iy = bvh_inv(ray.d.y);
-    w.iz = bvh_inv(ray.d.z);
+    w.ix = bvh_inv(ray.d.x, rp->inv_d[0]);
+    w.iy = bvh_inv(ray.d.y, rp->inv_d[1]);
+    w.iz = bvh_inv(ray.d.z, rp->inv_d[2]);
     w.tmin = ray.tmin;
     w.fx = w.ix * KD_T_ABOVE;
     w.fy = w.iy * KD_T_ABOVE;
@@ -443,9 +448,9 @@ KFN_INLINE void trace_wide_packet_walk(const SceneView *sc, const Ray *rays, con
         a[0 * WIDE_PACKET + l] = on ? rays[l].o.x : 0.0f;
         a[1 * WIDE_PACKET + l] = on ? rays[l].o.y : 0.0f;
         a[2 * WIDE_PACKET + l] = on ? rays[l].o.z : 0.0f;
-        a[3 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.x) : 1.0f;
-        a[4 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.y) : 1.0f;
-        a[5 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.z) : 1.0f;
+        a[3 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.x, rp[l].inv_d[0]) : 1.0f;
+        a[4 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.y, rp[l].inv_d[1]) : 1.0f;
+        a[5 * WIDE_PACKET + l] = on ? bvh_inv(rays[l].d.z, rp[l].inv_d[2]) : 1.0f;
         a[6 * WIDE_PACKET + l] = on ? rays[l].tmin : 0.0f;
         tfar_a[l] = best[l].t * KD_T_ABOVE;
     }

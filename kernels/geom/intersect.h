@@ -51,7 +51,7 @@ KFN_INLINE void ray_prepare(Ray ray, RayPre *p)
     p->kx = kx; p->ky = ky; p->kz = kz;
     p->sx = p->dir[kx] / dz;
     p->sy = p->dir[ky] / dz;
-    p->sz = 1.0f / dz;
+    p->sz = p->inv_d[kz];   /* 1.0f / dz, computed above: a division costs ~10 cycles */
 }
 
 /* ------------------------------------------------------------------ sphere */

@@ -366,6 +366,7 @@ test: $(BUILD)/$(PROG) $(GENERATED_DOCS) $(BUILD)/$(PROG).pc $(TEST_BIN) $(FUZZ_
       $(BUILD)/tests/test_python
 	@sh tools/check_layers.sh
 	@sh tools/check_exports.sh $(BUILD)
+	@sh tools/check_kernel_warnings.sh
 	@sh tests/run.sh $(BUILD)
 
 render: $(BUILD)/$(PROG)

@@ -95,7 +95,7 @@ __kernel KERNEL_SIZE void k_intersect(SCENE_ARGS __global const uint *queue, uin
     SCENE_VIEW(sc);
     uint path = queue[i];
     SCENE_VIEW_AT_TIME(sc, paths[path]);
-    hits[path] = trace_closest_visible(&sc, rays[path]);
+    hits[path] = trace_flight(&sc, rays[path], &paths[path]);
 }
 
 /* Shades every queued path; count slot `slot` counts the shadow rays, slot + 1 the next

@@ -185,7 +185,11 @@ typedef struct {                                        /* 32 bytes */
     float u, v;     /* triangles: barycentrics of p1 and p2; boxes: u = face index */
     uint inst;      /* the instance whose prototype holds prim (Instance, below), or
                      * NO_INDEX for the world's own primitives (docs/instancing.md) */
-    uint pad0, pad1, pad2;
+    float flight_stop;   /* flight_drawn 1: the distance at which the flight through
+                          * the path's medium stops, drawn before the walk that found
+                          * this hit (trace_flight, kernels/medium/medium_path.h) */
+    uint flight_drawn;   /* 1 as above; 0 from every other walk */
+    uint pad2;
 } Hit;
 
 /* kd-tree node, 8 bytes (layout in docs/kdtree.md).

@@ -708,7 +708,11 @@ static void test_intersect(void)
     SET(k, N_SCENE + 3, hb);
     SET(k, N_SCENE + 4, lcb);
     SET(k, N_SCENE + 5, live_slot);
-    cl_mem pb = buffer(N * sizeof(PathState), NULL);   /* read only where the scene moves */
+    /* the paths' states: their time where the scene moves, and the medium each ray is
+     * in (trace_flight): vacuum here, so that the walk looks as far as the ray goes */
+    PathState *states = calloc(N, sizeof *states);
+    cl_mem pb = buffer(N * sizeof(PathState), states);
+    free(states);
     SET(k, N_SCENE + 6, pb);
     run(k, N + 100);
     Hit *dh = malloc(N * sizeof *dh);
@@ -733,6 +737,86 @@ static void test_intersect(void)
     clReleaseMemObject(rb);
     clReleaseMemObject(qb);
     clReleaseMemObject(hb);
+}
+
+/* trace_flight (kernels/medium/medium_path.h) for random rays through scene view `base`
+ * in a homogeneous medium that scatters, each with a path state of its own; returns the
+ * stops drawn before the walk. Where one is drawn it is the one medium_flight would
+ * draw, where the whole walk's hit lies before it the shorter walk's is that hit bit for
+ * bit, and everywhere else the flight stops there too; where none is drawn, the hit is
+ * the whole walk's. *cut counts the walks that missed where the whole one hit. */
+static uint check_flight_walk(const SceneView *base, uint n, uint *cut)
+{
+    Medium md;
+    memset(&md, 0, sizeof md);
+    md.type = MEDIUM_HOMOGENEOUS;
+    md.sigma_a = v3(0.05f, 0.1f, 0.2f);
+    md.sigma_s = v3(0.6f, 0.4f, 0.25f);   /* chromatic: the stop's channel varies */
+    md.g = 0.3f;
+    RenderParams p = *base->params;
+    p.has_media = HAS_MEDIA_ANY;
+    p.n_media = 1u;
+    SceneView v = *base;
+    v.params = &p;
+    v.media = &md;
+    uint drawn = 0, same = 0, passed = 0;
+    *cut = 0;
+    for (uint i = 0; i < n; i++) {
+        Ray r = random_ray();
+        PathState ps;
+        memset(&ps, 0, sizeof ps);
+        ps.medium = 1u;
+        ps.throughput = v3(frange(0.0f, 1.0f), frange(0.0f, 1.0f), frange(0.0f, 1.0f));
+        ps.pixel = i;
+        ps.sample = i % 7u;
+        ps.rng_key = 0x9e3779b9u * (i + 1u);
+        ps.bounce = i % 4u;
+        ps.crossings = i % 3u;
+        Hit whole = trace_closest_visible(&v, r);
+        Hit h = trace_flight(&v, r, &ps);
+        if (!h.flight_drawn) {
+            same += memcmp(&whole, &h, sizeof h) == 0;
+            passed++;
+            continue;
+        }
+        drawn++;
+        float ts = medium_flight_stop(medium_sigma_t(md), medium_channel_pdf(ps.throughput), rng_key_of(&ps, &p),
+                                      path_rng_bounce(&ps));
+        CHECK(h.flight_stop == ts);
+        float len = v3_len(r.d);
+        float dist = whole.prim == NO_INDEX ? INFINITY : (whole.t - r.tmin) * len;
+        float dist_h = h.prim == NO_INDEX ? INFINITY : (h.t - r.tmin) * len;
+        if (!(ts < dist)) {   /* the flight passes to the whole walk's hit: the same hit */
+            passed++;
+            Hit w = whole;
+            w.flight_stop = h.flight_stop;
+            w.flight_drawn = h.flight_drawn;
+            same += memcmp(&w, &h, sizeof h) == 0;
+        } else {              /* it stops short of it: so it must with the shorter walk's */
+            CHECK_MSG(ts < dist_h, "ray %u: the flight stops at %g, the whole walk's hit at %g, the shorter "
+                      "walk's at %g", i, ts, dist, dist_h);
+            *cut += whole.prim != NO_INDEX && h.prim == NO_INDEX;
+        }
+    }
+    CHECK_MSG(same == passed, "%u of %u hits differ from the whole walk's", passed - same, passed);
+    return drawn;
+}
+
+/* The walk that stops looking at a medium's stop: on the lanes scene (triangles, no
+ * point light) a stop is drawn for every ray and most walks are cut short of a hit;
+ * on the kernels' scene, which has surfaces of revolution, none is drawn. */
+static void test_flight_walk(void)
+{
+    enum { N = 20000 };
+    uint cut, drawn = check_flight_walk(&lanes_view, N, &cut);
+    fprintf(stderr, "  trace_flight, triangles: %u rays, %u stops drawn, %u walks cut short of a hit\n",
+            (uint)N, drawn, cut);
+    CHECK_EQ_INT(drawn, N);
+    CHECK(cut > N / 10);
+    CHECK(view.params->n_revsurfaces > 0u);
+    drawn = check_flight_walk(&view, N, &cut);
+    fprintf(stderr, "  trace_flight, with surfaces of revolution: %u rays, %u stops drawn\n", (uint)N, drawn);
+    CHECK_EQ_INT(drawn, 0);
 }
 
 /* The trace-only kernels bench_traverse times (kernels/bench/trace.cl): one ray per
@@ -1493,6 +1577,7 @@ int main(void)
     RUN(test_path_kernel_listed);
     RUN(test_path_lanes_kernel);
     RUN(test_intersect);
+    RUN(test_flight_walk);
     RUN(test_shade_and_shadow);
     RUN(test_shade_cubemap);
     RUN(test_film);

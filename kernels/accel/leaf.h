@@ -148,7 +148,8 @@ KFN_INLINE Hit hit_none(Ray ray)
     h.u = 0.0f;
     h.v = 0.0f;
     h.inst = NO_INDEX;
-    h.pad0 = h.pad1 = h.pad2 = 0u;
+    h.flight_stop = 0.0f;
+    h.flight_drawn = h.pad2 = 0u;
     return h;
 }
 

@@ -53,14 +53,19 @@
         } else if (beyond && beyond_kept) {                                              \
             hit = beyond_hit;                                                            \
         } else {                                                                         \
-            hit = trace_closest_visible(sc, *ray);                                       \
+            /* the hit beyond a boundary is kept for every continuation: the whole   \
+             * walk's; any other stops looking where a flight in fog will stop */   \
+            hit = beyond ? trace_closest_visible(sc, *ray) : trace_flight(sc, *ray, ps); \
             n_rays++;                                                                    \
             if (beyond) {                                                                \
                 beyond_hit = hit;                                                        \
                 beyond_kept = 1;                                                         \
             }                                                                            \
         }                                                                                \
-        if (first) first_hit = hit;                                                      \
+        if (first) {                                                                     \
+            first_hit = hit;                                                             \
+            first_hit.flight_drawn = 0u;   /* each branch draws its own flight */       \
+        }                                                                                \
         int at_first = first || restart;                                                 \
         STAGE(PHASE_TRAVERSE);                                                           \
         uint r = shade_path(sc, ray, hit, ps, shadow_ray);                               \

@@ -21,6 +21,7 @@
 #include "light/lights.h"
 #include "sample/rng.h"
 #include "geom/surface.h"
+#include "accel/alpha.h"
 
 /* Whether a path that reaches a surface of material m (resolved) from behind is a
  * subsurface walk leaving its solid (docs/subsurface.md). */
@@ -202,6 +203,76 @@ KFN int medium_segment_light(const SceneView *sc, GLOBAL PathState *ps, Medium m
     return 1;
 }
 
+/* The distance (scene length) at which a flight through homogeneous extinction sigma_t
+ * stops, drawn for bounce rb by one-sample MIS over the channels (pc: their
+ * probabilities, medium_channel_pdf): one function for medium_flight and for
+ * medium_walk_tmax, which must draw the same bits. */
+KFN float medium_flight_stop(vec3 sigma_t, vec3 pc, RngKey key, uint rb)
+{
+    float u;
+    int c = medium_pick_channel(pc, rng_uniform(key, rb, DIM_MEDIUM), &u);
+    return medium_sample_exp(v3_get(sigma_t, c), u);
+}
+
+/* Whether a stop in homogeneous medium md takes its point or spot light's sample over
+ * the whole stretch to the surface (medium_segment_light), and that light. */
+KFN int medium_takes_segment(const SceneView *sc, Medium md, GLOBAL const PathState *ps, RngKey key, uint rb,
+                             Light *l, float *choice)
+{
+    return !(md.flags & MEDIUM_WALK) && ps->bounce < sc->params->max_depth &&
+           sc->params->mis_mode != MIS_BSDF_ONLY && medium_pick_point_light(sc, key, rb, l, choice);
+}
+
+/* How far the closest-hit walk for path ps's ray must look: in a homogeneous medium
+ * that scatters, medium_flight needs the surface only where it lies before the distance
+ * the flight stops at, so that distance is drawn here, before the walk (into *stop,
+ * *drawn = 1), and the walk stops looking just past it, skipping every node beyond.
+ * Everywhere else, the ray's own tmax (*drawn = 0): outside media, in grids (tracked
+ * along the stretch), in media that emit or only absorb (the whole stretch's emission
+ * or transmittance), where the stop takes a point light's sample over the whole
+ * stretch (medium_takes_segment), and in scenes with surfaces of revolution, whose
+ * Newton search divides the ray's interval up to its tmax (revsurface.h), so that a
+ * shorter interval finds their hits with other rounding.
+ *
+ * The same hit, so the same bits: every other primitive's hit distance does not depend
+ * on tmax, and the margin of 2^-12 (relative, twice) is far above the rounding of
+ * medium_flight's distance (hit.t - tmin) len, so every surface that distance puts
+ * before the stop is found; one found beyond it, or none, means a stop at the same
+ * distance as the whole walk's hit would (tests/test_kernels.c, test_flight_walk). */
+KFN float medium_walk_tmax(const SceneView *sc, Ray ray, GLOBAL const PathState *ps, float *stop, uint *drawn)
+{
+    *drawn = 0u;
+    if (ps->medium == 0u) return ray.tmax;
+    if (KF_HAS(KF_REVSURFACE) && sc->params->n_revsurfaces != 0u) return ray.tmax;
+    Medium md = sc->media[ps->medium - 1u];
+    if (md.type == MEDIUM_GRID || (md.flags & MEDIUM_EMISSIVE) || v3_is_zero(md.sigma_s)) return ray.tmax;
+    RngKey key = rng_key_of(ps, sc->params);
+    uint rb = path_rng_bounce(ps);
+    Light pl;
+    float choice;
+    if (medium_takes_segment(sc, md, ps, key, rb, &pl, &choice)) return ray.tmax;
+    float ts = medium_flight_stop(medium_sigma_t(md), medium_channel_pdf(ps->throughput), key, rb);
+    *stop = ts;
+    *drawn = 1u;
+    const float margin = 1.0f + 1.0f / 4096.0f;
+    float t = (ray.tmin + ts / v3_len(ray.d) * margin) * margin;
+    return t < ray.tmax ? t : ray.tmax;
+}
+
+/* The closest hit of path ps's ray, as far as shade_path needs it (medium_walk_tmax),
+ * with the flight's stop when it was drawn for the walk. */
+KFN Hit trace_flight(const SceneView *sc, Ray ray, GLOBAL const PathState *ps)
+{
+    if (!KF_HAS(KF_MEDIA)) return trace_closest_visible(sc, ray);
+    float stop = 0.0f;
+    uint drawn;
+    ray.tmax = medium_walk_tmax(sc, ray, ps, &stop, &drawn);
+    Hit h = trace_closest_visible(sc, ray);
+    h.flight_stop = stop;
+    h.flight_drawn = drawn;
+    return h;
+}
+
 /* The flight of ray *ray through the path's medium up to `hit` (without end when it
  * escaped). A distance is drawn (medium.h): past the surface, the throughput takes
  * T / P(pass) and 0 is returned (the caller shades the surface, or the escape);
@@ -262,9 +333,7 @@ KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL Path
     RngKey key = rng_key_of(ps, sc->params);
     uint rb = path_rng_bounce(ps);
     vec3 pc = medium_channel_pdf(ps->throughput);
-    float u;
-    int c = medium_pick_channel(pc, rng_uniform(key, rb, DIM_MEDIUM), &u);
-    float ts = medium_sample_exp(v3_get(sigma_t, c), u);
+    float ts = hit.flight_drawn ? hit.flight_stop : medium_flight_stop(sigma_t, pc, key, rb);
     if (!(ts < dist)) {
         vec3 tr = medium_tr(sigma_t, dist);
         float pass = medium_pass_prob(pc, tr);
@@ -280,8 +349,7 @@ KFN int medium_flight(const SceneView *sc, GLOBAL Ray *ray, Hit hit, GLOBAL Path
      * and free-flight sampling together (medium_segment_light), in place of the stop's */
     Light pl;
     float choice;
-    int segment = !(md.flags & MEDIUM_WALK) && ps->bounce < sc->params->max_depth &&
-                  sc->params->mis_mode != MIS_BSDF_ONLY && medium_pick_point_light(sc, key, rb, &pl, &choice);
+    int segment = !hit.flight_drawn && medium_takes_segment(sc, md, ps, key, rb, &pl, &choice);
     uint shadow = 0u;
     if (segment) {
         float lu, lv;

@@ -29,6 +29,7 @@
 #include "integrator/shade_path.h"
 #include "accel/traverse.h"
 #include "integrator/whitted.h"
+#include "medium/transmit.h"
 
 /* Scene buffers every kernel takes first (SCENE_ARGS in entry.cl). */
 #define N_SCENE SCENE_BUF_COUNT
@@ -819,6 +820,144 @@ static void test_flight_walk(void)
     CHECK_EQ_INT(drawn, 0);
 }
 
+/* A scene of media boundaries for test_shadow_through: a sphere of medium a holding a
+ * box of b (its exterior a), a closed octahedron of triangles holding the grid medium g
+ * and overlapping both, a second sphere of b inside the octahedron, and opaque shapes
+ * among them (a sphere, a box, two triangles, a floor plane). */
+static void shadow_through_scene_text(char *text, size_t size)
+{
+    int n = snprintf(text, size,
+                     "image { width 8 height 8 spp 1 }\n"
+                     "camera { from 0 0 12 at 0 0 0 up 0 1 0 fov 40 }\n"
+                     "medium a { type homogeneous sigma_a 0.1 0.2 0.3 sigma_s 0.4 0.3 0.2 }\n"
+                     "medium b { type homogeneous sigma_a 0.3 0.2 0.1 sigma_s 0.2 0.2 0.2 }\n"
+                     "medium g { type grid sigma_a 0.2 0.2 0.2 sigma_s 0.5 0.6 0.7 size 2 2 2 "
+                     "min 0 0 -1.5 max 3 3 1.5 data [ 0.1 0.9 0.5 0.2 1 0.3 0.7 0.4 ] }\n"
+                     "material white { type diffuse albedo 0.5 0.5 0.5 }\n"
+                     "sphere { center 0 0 0 radius 3 material none interior a }\n"
+                     "box { min -1 -1 -1 max 1 1 1 material none interior b exterior a }\n"
+                     "sphere { center 1.5 1.5 0 radius 0.4 material none interior b }\n"
+                     "sphere { center -1.5 -2 0.5 radius 0.5 material white }\n"
+                     "box { min 2 -2 -2 max 2.5 -1 2 material white }\n"
+                     "triangle { v0 -4 3 -1 v1 -2 3 -1 v2 -3 3.5 1 material white }\n"
+                     "triangle { v0 -1 -1.5 2 v1 1 -1.5 2 v2 0 -0.5 2.5 material white }\n"
+                     "plane { point 0 -5 0 normal 0 1 0 material white }\n");
+    /* five slabs of b above it all: a ray up through them crosses ten boundaries, more
+     * than the one walk keeps (THROUGH_MAX), and is walked from hit to hit */
+    for (int k = 0; k < 5; k++)
+        n += snprintf(text + n, size - (size_t)n, "box { min -4 %g -4 max 4 %g 4 material none interior b }\n",
+                      3.5 + 0.2 * k, 3.6 + 0.2 * k);
+    /* the octahedron around (1.5, 1.5, 0), radius 1.5, its faces outward */
+    const float c[3] = { 1.5f, 1.5f, 0.0f }, r = 1.5f;
+    for (int f = 0; f < 8; f++) {
+        float sx = (f & 1) ? -r : r, sy = (f & 2) ? -r : r, sz = (f & 4) ? -r : r;
+        float v[3][3] = { { c[0] + sx, c[1], c[2] }, { c[0], c[1] + sy, c[2] }, { c[0], c[1], c[2] + sz } };
+        int odd = (sx < 0) ^ (sy < 0) ^ (sz < 0);   /* the winding that faces out */
+        int i1 = odd ? 2 : 1, i2 = odd ? 1 : 2;
+        n += snprintf(text + n, size - (size_t)n,
+                      "triangle { v0 %g %g %g v1 %g %g %g v2 %g %g %g material none interior g }\n", v[0][0],
+                      v[0][1], v[0][2], v[i1][0], v[i1][1], v[i1][2], v[i2][0], v[i2][1], v[i2][2]);
+    }
+}
+
+/* shadow_trace_media's one walk (trace_through) against the walk from hit to hit
+ * (shadow_steps) for n random shadow rays through the boundaries scene of view v, each
+ * from a random medium: the same path state afterwards, bit for bit (the contribution
+ * the light brings, or nothing). tally: rays that crossed two or more boundaries, rays
+ * blocked, rays the one walk could not answer. */
+static void check_shadow_through(const SceneView *v, uint n, uint tally[3])
+{
+    for (uint i = 0; i < n; i++) {
+        Ray r;
+        r.o = vrand(-4.5f, 4.5f);
+        vec3 to = vrand(-4.5f, 4.5f);
+        if (i % 5u == 0u) to = v3_add(v3(1.5f, 1.5f, 0.0f), vrand(-0.1f, 0.1f));   /* through the octahedron's tips */
+        r.d = v3_sub(to, r.o);
+        r.tmin = 0.0f;
+        r.tmax = i % 7u == 0u ? INFINITY : 0.999f;
+        PathState ps;
+        memset(&ps, 0, sizeof ps);
+        ps.shadow_medium = i % (v->params->n_media + 1u);
+        ps.shadow_L = v3(0.5f + frand(), 0.5f + frand(), 0.5f + frand());
+        ps.radiance = v3(0.25f, 0.5f, 0.75f);
+        ps.pixel = i;
+        ps.rng_key = 0x9e3779b9u * (i + 1u);
+        ps.bounce = i % 4u;
+        PathState ref = ps;
+        ShadowStretches st;
+        st.tr = v3s(1.0f);
+        st.len = v3_len(r.d);
+        st.rng = 0u;
+        st.rng_ready = 0;
+        uint steps = shadow_steps(v, &ref, r, &st);
+        ref.shadow_L = v3_mul(ref.shadow_L, st.tr);
+        shadow_resolve(&ref, v3_is_zero(st.tr));
+        uint walks = shadow_trace_media(v, &ps, r);
+        CHECK_MSG(memcmp(&ps, &ref, sizeof ps) == 0, "ray %u: the one walk gives (%g %g %g), the walk from hit to "
+                  "hit (%g %g %g)", i, ps.radiance.x, ps.radiance.y, ps.radiance.z, ref.radiance.x,
+                  ref.radiance.y, ref.radiance.z);
+        tally[0] += steps > 2u;
+        tally[1] += v3_is_zero(st.tr);
+        tally[2] += walks != 1u;
+    }
+}
+
+/* Shadow rays through media in one walk (trace_through, kernels/medium/transmit.h): the
+ * same transmittance as walking from boundary to boundary, through spheres, boxes and
+ * triangles that bound media (nested, overlapping, a grid among them), past opaque
+ * shapes and a plane, through the BVH and the kd-tree (which finds a triangle in two
+ * cells: kept once); most rays cross several boundaries, and all but those through more
+ * than THROUGH_MAX of them are answered by the one walk. */
+static void test_shadow_through(void)
+{
+    enum { N = 20000 };
+    static char text[16384];
+    shadow_through_scene_text(text, sizeof text);
+    Scene sc;
+    scene_init(&sc);
+    Error err = { 0 };
+    Status st = scene_load_text("shadow-through.scene", text, strlen(text), &sc, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    RenderScene trs;
+    KdTree tkd;
+    memset(&tkd, 0, sizeof tkd);
+    if (st == ST_OK) st = render_scene_prepare(&sc, 1, &trs, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (st != ST_OK) {
+        scene_free(&sc);
+        return;
+    }
+    SceneView v;
+    device_scene_view(&trs.ds, &v);
+    CHECK(v.params->has_media && v.params->n_media == 3u && v.params->n_planes == 1u);
+    uint tally[3] = { 0, 0, 0 };
+    check_shadow_through(&v, N, tally);
+    fprintf(stderr, "  trace_through, BVH: %u shadow rays, %u across two boundaries or more, %u blocked, %u "
+            "walked from hit to hit\n", (uint)N, tally[0], tally[1], tally[2]);
+    CHECK(tally[0] > N / 4 && tally[1] > N / 20 && tally[2] > 0u && tally[2] < N / 10);
+    KdInput in = { sc.spheres, sc.n_spheres, sc.triangles, sc.n_triangles, sc.boxes, sc.n_boxes,
+                   sc.revsurfaces, sc.n_revsurfaces, sc.sphere_xforms, sc.n_sphere_xforms, NULL, 0 };
+    st = kd_build(&in, 1, &tkd, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (st == ST_OK) {
+        render_scene_use_kdtree(&trs.ds, &tkd);
+        device_scene_view(&trs.ds, &v);
+        RenderParams p = *v.params;   /* no BVH: the walks take the kd-tree */
+        p.n_bvh_nodes = 0u;
+        v.params = &p;
+        CHECK(trace_tree_kind(&v) == TREE_KD);
+        memset(tally, 0, sizeof tally);
+        check_shadow_through(&v, N, tally);
+        fprintf(stderr, "  trace_through, kd-tree: %u shadow rays, %u across two boundaries or more, %u blocked, "
+                "%u walked from hit to hit\n", (uint)N, tally[0], tally[1], tally[2]);
+        CHECK(tally[0] > N / 4 && tally[2] > 0u && tally[2] < N / 10);
+    }
+    error_clear(&err);
+    kd_free(&tkd);
+    render_scene_free(&trs);
+    scene_free(&sc);
+}
+
 /* The trace-only kernels bench_traverse times (kernels/bench/trace.cl): one ray per
  * work-item, two in turns (trace_closest2 / trace_any2), eight one after another (the
  * BVH walk as k_path_lanes calls it) and packets of eight (trace_packet;
@@ -1578,6 +1717,7 @@ int main(void)
     RUN(test_path_lanes_kernel);
     RUN(test_intersect);
     RUN(test_flight_walk);
+    RUN(test_shadow_through);
     RUN(test_shade_and_shadow);
     RUN(test_shade_cubemap);
     RUN(test_film);

@@ -11,7 +11,16 @@
 #define CLPT_LEAF_H
 
 #include "geom/intersect.h"
+#include "geom/surface.h"
 #include "scene_view.h"
+
+/* The queries a walk answers (the walks' `any` argument): the closest hit; any hit (a
+ * shadow ray in a scene without media); and the closest hit that is not a boundary
+ * between media, with the boundaries crossed before it (WALK_THROUGH, ThroughWalk
+ * below: a shadow ray through media, kernels/medium/transmit.h). */
+#define WALK_CLOSEST 0
+#define WALK_ANY 1
+#define WALK_THROUGH 2
 
 /* Tests global primitive `id` (a sphere, triangle, box or surface of revolution: planes
  * are not in the tree) against the ray, whose tmax is the closest hit so far. The walk
@@ -76,11 +85,113 @@ KFN_INLINE void hit_take(Hit *best, Hit h, uint id, uint inst)
     best->inst = inst;
 }
 
+#if KF_HAS(KF_MEDIA)
+/* What a WALK_THROUGH walk finds. A shadow ray through media needs the boundaries
+ * (MAT_INTERFACE surfaces) it crosses, in order, up to the light or the first surface
+ * that blocks it; walking from hit to hit takes one walk per boundary, each testing
+ * again the leaves around the boundary it starts from. This walk finds them all at
+ * once: `hit` is what a closest-hit walk would find if boundaries were not there (the
+ * tree's walks cull by its t, and get a pointer to it: it is the first member), and the
+ * boundaries hit before it are kept, nearest first, in `crossing`. Every hit of a
+ * primitive counts, not only its first (a sphere's or box's far side: the walk tests
+ * them again from the hit found). A primitive found twice at the same t (a kd-tree
+ * cell's neighbour holds it too) is kept once. More than THROUGH_MAX boundaries set
+ * `overflow`, and the caller walks hit by hit instead. Cut-out surfaces and surfaces of
+ * revolution (whose t depends on the walk's tmax) are not supported: the caller does
+ * not ask for such scenes. */
+#define THROUGH_MAX 8u
+typedef struct {
+    Hit hit;
+    Hit crossing[THROUGH_MAX];
+    uint n;
+    uint overflow;
+} ThroughWalk;
+
+/* Whether primitive id (of instance inst) is a boundary between media, nothing else. */
+KFN_INLINE int prim_is_crossing(const SceneView *sc, uint id, uint inst)
+{
+    Hit h;
+    h.prim = id;
+    h.inst = inst;
+    return (sc->materials[hit_material(sc, h)].flags & MAT_INTERFACE) != 0u;
+}
+
+/* Whether crossing a comes before b: by t, then (prim, inst), the closest-hit walk's
+ * tie rule (hit_wins). */
+KFN_INLINE int crossing_before(Hit a, Hit b)
+{
+    return a.t < b.t || (a.t == b.t && (a.prim < b.prim || (a.prim == b.prim && a.inst < b.inst)));
+}
+
+/* Keeps boundary hit h (on primitive id of instance inst) in the ThroughWalk that
+ * `best` is the first member of, in order. */
+KFN_INLINE void through_keep(Hit *best, Hit h, uint id, uint inst)
+{
+    ThroughWalk *tw = (ThroughWalk *)best;
+    Hit c = *best;   /* hit_none's padding, so that every word is set */
+    hit_take(&c, h, id, inst);
+    h = c;
+    uint i = tw->n;
+    while (i > 0u && crossing_before(h, tw->crossing[i - 1u])) i--;
+    if (i > 0u && tw->crossing[i - 1u].t == h.t && tw->crossing[i - 1u].prim == id && tw->crossing[i - 1u].inst == inst)
+        return;
+    if (tw->n == THROUGH_MAX) {
+        tw->overflow = 1u;
+        return;
+    }
+    for (uint j = tw->n; j > i; j--) tw->crossing[j] = tw->crossing[j - 1u];
+    tw->crossing[i] = h;
+    tw->n++;
+}
+
+/* The rest of a triangle group for a WALK_THROUGH walk, whose nearest hit in
+ * (tmin, *tmax) is h: boundaries are kept and the group tested again beyond each, until
+ * a surface that is not one, which becomes the closest hit if it wins (and shortens
+ * *tmax). The lanes at a boundary's very t are passed over, as a walk from that
+ * boundary would pass them (its interval is open). */
+KFN_INLINE void leaf_group_through(const SceneView *sc, GLOBAL const uint *g, const RayPre *rp, Hit h, uint inst,
+                                   Hit *best, float *tmax)
+{
+    for (;;) {
+        uint id = g[h.prim];
+        if (!prim_is_crossing(sc, id, inst)) {
+            if (hit_wins(best, h.t, id, inst)) {
+                hit_take(best, h, id, inst);
+                *tmax = k_next_up(h.t);
+            }
+            return;
+        }
+        through_keep(best, h, id, inst);
+        if (!triangle_intersect_group(rp, (GLOBAL const float *)(g + KD_GROUP), h.t, *tmax, &h)) return;
+    }
+}
+
+/* The same for primitive id, not a triangle of a group, whose nearest hit is h: a
+ * sphere or box that is a boundary is crossed again at its far side. */
+KFN_INLINE void leaf_prim_through(const SceneView *sc, uint id, Ray ray, const RayPre *rp, Hit h, uint inst,
+                                  Hit *best, float *tmax)
+{
+    if (!prim_is_crossing(sc, id, inst)) {
+        if (hit_wins(best, h.t, id, inst)) {
+            hit_take(best, h, id, inst);
+            *tmax = k_next_up(h.t);
+        }
+        return;
+    }
+    through_keep(best, h, id, inst);
+    Ray r = ray;
+    r.tmin = h.t;
+    r.tmax = *tmax;
+    if (trace_prim(sc, id, rp, r, &h)) through_keep(best, h, id, inst);
+}
+#endif
+
 /* Tests the primitives of leaf n (its record in leaf_data) against the ray (tmax: the
  * closest hit so far, in best->t); returns 1 when an any-hit query hit. The triangles are
  * tested a group at a time (triangle_intersect_group), then the spheres and boxes one by
- * one. The closest hit is the primitive of least t and, of those at the same t (a ray
- * through an edge two triangles share, coplanar triangles), of least global id (a leaf's
+ * one; `any` is the query (WALK_CLOSEST, WALK_ANY or WALK_THROUGH). The closest hit is
+ * the primitive of least t and, of those at the same t (a ray through an edge two
+ * triangles share, coplanar triangles), of least global id (a leaf's
  * ids are sorted, so within a leaf that is the first of equals, which is what
  * triangle_intersect_group keeps; across leaves the id decides): a rule
  * that does not depend on the order in which leaves are met, so the single-ray walk and
@@ -97,10 +208,16 @@ KFN_INLINE int leaf_test(const SceneView *sc, GLOBAL const uint *leaf_data, Ray 
     for (uint i = 0; i < groups; i++, g += KD_GROUP_WORDS) {
         Hit h;
         if (triangle_intersect_group(rp, (GLOBAL const float *)(g + KD_GROUP), ray.tmin, tmax, &h)) {
+#if KF_HAS(KF_MEDIA)
+            if (any == WALK_THROUGH) {
+                leaf_group_through(sc, g, rp, h, inst, best, &tmax);
+                continue;
+            }
+#endif
             uint id = g[h.prim];
             if (hit_wins(best, h.t, id, inst)) {
                 hit_take(best, h, id, inst);
-                if (any) return 1;
+                if (any == WALK_ANY) return 1;
                 tmax = k_next_up(h.t);
             }
         }
@@ -112,9 +229,15 @@ KFN_INLINE int leaf_test(const SceneView *sc, GLOBAL const uint *leaf_data, Ray 
             Ray r = ray;
             r.tmax = tmax;
             Hit h;
+#if KF_HAS(KF_MEDIA)
+            if (any == WALK_THROUGH) {
+                if (trace_prim(sc, id, rp, r, &h)) leaf_prim_through(sc, id, ray, rp, h, inst, best, &tmax);
+                continue;
+            }
+#endif
             if (trace_prim(sc, id, rp, r, &h) && hit_wins(best, h.t, id, inst)) {
                 hit_take(best, h, id, inst);
-                if (any) return 1;
+                if (any == WALK_ANY) return 1;
                 tmax = k_next_up(h.t);
             }
         }
@@ -133,8 +256,14 @@ KFN_INLINE int trace_planes(const SceneView *sc, Ray ray, int any, Hit *best)
         r.tmax = best->t;
         Hit h;
         if (plane_intersect(sc->planes[i], r, &h)) {
+#if KF_HAS(KF_MEDIA)
+            if (any == WALK_THROUGH && prim_is_crossing(sc, first_plane + i, NO_INDEX)) {
+                through_keep(best, h, first_plane + i, NO_INDEX);
+                continue;
+            }
+#endif
             hit_take(best, h, first_plane + i, NO_INDEX);
-            if (any) return 1;
+            if (any == WALK_ANY) return 1;
         }
     }
     return 0;

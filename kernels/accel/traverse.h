@@ -49,10 +49,10 @@ KFN_INLINE void trace_walk(const SceneView *sc, int tree, Ray ray, const RayPre 
 KFN Hit trace_closest_in(const SceneView *sc, int tree, Ray ray)
 {
     Hit best = hit_none(ray);
-    trace_planes(sc, ray, 0, &best);
+    trace_planes(sc, ray, WALK_CLOSEST, &best);
     RayPre rp;
     ray_prepare(ray, &rp);
-    trace_walk(sc, tree, ray, &rp, 0, &best);
+    trace_walk(sc, tree, ray, &rp, WALK_CLOSEST, &best);
     return best;
 }
 
@@ -61,12 +61,28 @@ KFN Hit trace_closest_in(const SceneView *sc, int tree, Ray ray)
 KFN Hit trace_any_hit_in(const SceneView *sc, int tree, Ray ray)
 {
     Hit h = hit_none(ray);
-    if (trace_planes(sc, ray, 1, &h)) return h;
+    if (trace_planes(sc, ray, WALK_ANY, &h)) return h;
     RayPre rp;
     ray_prepare(ray, &rp);
-    trace_walk(sc, tree, ray, &rp, 1, &h);
+    trace_walk(sc, tree, ray, &rp, WALK_ANY, &h);
     return h;
 }
+
+#if KF_HAS(KF_MEDIA)
+/* The closest hit in (ray.tmin, ray.tmax) that is not a boundary between media, and the
+ * boundaries before it, in one walk (ThroughWalk, leaf.h): a shadow ray through media.
+ * Not for scenes with cut-out surfaces or surfaces of revolution. */
+KFN void trace_through(const SceneView *sc, Ray ray, ThroughWalk *tw)
+{
+    tw->hit = hit_none(ray);
+    tw->n = 0u;
+    tw->overflow = 0u;
+    trace_planes(sc, ray, WALK_THROUGH, &tw->hit);
+    RayPre rp;
+    ray_prepare(ray, &rp);
+    trace_walk(sc, trace_tree_kind(sc), ray, &rp, WALK_THROUGH, &tw->hit);
+}
+#endif
 
 /* The queries the renderer asks, through the scene's tree. */
 KFN Hit trace_closest(const SceneView *sc, Ray ray)

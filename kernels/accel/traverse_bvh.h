@@ -182,7 +182,7 @@ KFN_INLINE uint bvh_push_children(uint ref, uint mask, const float *d, const uin
                                   uint *st_word, int *sp)
 {
     uint next = k_lowest_bit(mask), second = BVH_WIDTH;
-    if (!any)
+    if (any != WALK_ANY)
         for (uint m = mask & (mask - 1u); m != 0u; m &= m - 1u) {
             uint l = k_lowest_bit(m);
             if (d[l] < d[next]) {
@@ -330,7 +330,7 @@ BVH_WALK_FN void trace_wide(const SceneView *sc, Ray ray, const RayPre *rp, int 
             ray_prepare(oray, &orp);
             trace_kd_proto(sc, sc->kd_protos + x->root, oray, &orp, any, (x->flags & INST_WORLD) ? NO_INDEX : ref,
                            best);
-            if (any && best->prim != NO_INDEX) return;
+            if (any == WALK_ANY && best->prim != NO_INDEX) return;
             kind = BVH_CHILD_NODE;   /* nothing for the leaf test below: on to the pop */
         } else
 #endif

@@ -71,8 +71,11 @@ KFN Hit trace_any_hit_in(const SceneView *sc, int tree, Ray ray)
 #if KF_HAS(KF_MEDIA)
 /* The closest hit in (ray.tmin, ray.tmax) that is not a boundary between media, and the
  * boundaries before it, in one walk (ThroughWalk, leaf.h): a shadow ray through media.
- * Not for scenes with cut-out surfaces or surfaces of revolution. */
-KFN void trace_through(const SceneView *sc, Ray ray, ThroughWalk *tw)
+ * Not for scenes with cut-out surfaces or surfaces of revolution. A call on OpenCL
+ * (KFN_CALL_CL): its walk is a second copy of the tree's walk, and inlined where shadow
+ * rays are answered it made a media program's cold build 1.3 s longer
+ * (bench/RESULTS.md, "A shadow ray through media in one walk"). */
+KFN_CALL_CL void trace_through(const SceneView *sc, Ray ray, ThroughWalk *tw)
 {
     tw->hit = hit_none(ray);
     tw->n = 0u;

@@ -13,8 +13,8 @@
 #include "integrator/shade_path.h"
 #include "medium/medium.h"
 
-/* What the shadow rays of one path vertex carry through the media they cross: the
- * transmittance so far and the grid media's stream of random numbers. */
+/* What a shadow ray carries through the media it crosses: the transmittance so far and
+ * the grid media's stream of random numbers. */
 typedef struct {
     vec3 tr;
     float len;        /* |r.d|: the rays' t is along the unnormalised direction */
@@ -42,10 +42,9 @@ KFN void shadow_stretch(const SceneView *sc, GLOBAL PathState *ps, Ray r, uint m
 }
 
 /* The medium beyond boundary hit h of r (whose tmin is where the stretch before it
- * began), coming from med. */
-KFN uint shadow_beyond(const SceneView *sc, Ray r, Hit h, uint med)
+ * began), of material m, coming from med. */
+KFN uint shadow_beyond(const SceneView *sc, Ray r, Hit h, GLOBAL const Material *m, uint med)
 {
-    GLOBAL const Material *m = &sc->materials[hit_material(sc, h)];
     return medium_beyond(m->medium_in, m->medium_out, med, r.d, hit_geometric_normal(sc, r, h));
 }
 
@@ -68,7 +67,7 @@ KFN uint shadow_steps(const SceneView *sc, GLOBAL PathState *ps, Ray r, ShadowSt
             st->tr = v3s(0.0f);
             break;
         }
-        med = shadow_beyond(sc, r, h, med);
+        med = shadow_beyond(sc, r, h, m, med);
         r.tmin = h.t;
     }
     return n;
@@ -101,7 +100,7 @@ KFN int shadow_through(const SceneView *sc, GLOBAL PathState *ps, Ray r, const T
         if (!(c.t > tmin)) continue;   /* a second primitive at the same t: the walk from there passes it */
         shadow_stretch(sc, ps, r, med, tmin, c.t, st);
         r.tmin = tmin;
-        med = shadow_beyond(sc, r, c, med);
+        med = shadow_beyond(sc, r, c, &sc->materials[hit_material(sc, c)], med);
         tmin = c.t;
     }
     shadow_stretch(sc, ps, r, med, tmin, r.tmax, st);
@@ -131,19 +130,16 @@ KFN uint shadow_trace_media(const SceneView *sc, GLOBAL PathState *ps, Ray r)
     st.rng = 0u;
     st.rng_ready = 0;
     uint n = 0u;
+    int answered = 0;
 #if KF_HAS(KF_MEDIA)
     if (shadow_walks_through(sc)) {
         ThroughWalk tw;
         trace_through(sc, r, &tw);
         n = 1u;
-        if (shadow_through(sc, ps, r, &tw, &st)) {
-            ps->shadow_L = v3_mul(ps->shadow_L, st.tr);
-            shadow_resolve(ps, v3_is_zero(st.tr));
-            return n;
-        }
+        answered = shadow_through(sc, ps, r, &tw, &st);
     }
 #endif
-    n += shadow_steps(sc, ps, r, &st);
+    if (!answered) n += shadow_steps(sc, ps, r, &st);
     ps->shadow_L = v3_mul(ps->shadow_L, st.tr);
     shadow_resolve(ps, v3_is_zero(st.tr));
     return n;

@@ -28,6 +28,12 @@
 
 static char tmp_root[256];    /* everything this test writes lives below it */
 static char cache_dir[300];   /* CLPT_CACHE_DIR for the in-process tests */
+/* The options of the program the cache tests build (set first in main, for the child
+ * runs too): the wave kernels and the Whitted integrator's, which k_layout (run_layout)
+ * needs both of, and no other feature. What the cache does is the same for any program,
+ * and the whole program (every feature, which test_kernels builds and runs) cost PoCL
+ * half a minute or more per cold build, five of them here. */
+static char cache_test_options[64];
 static OclDeviceInfo *devices;
 static size_t n_devices;
 static cl_context ctx;
@@ -116,7 +122,7 @@ static int child_two_devices(void)
         for (int d = 0; rc == CL_SUCCESS && d < 2; d++) {
             cl_program prog = NULL;
             OclProgramStats stats;
-            Status st = ocl_program_build(c, &list[d], NULL, NULL, &prog, &stats, &err);
+            Status st = ocl_program_build(c, &list[d], NULL, cache_test_options, &prog, &stats, &err);
             printf("build %d status %d from_cache %d\n", d, (int)st, stats.from_cache);
             if (prog) clReleaseProgram(prog);
         }
@@ -145,7 +151,7 @@ static int child_build(void)
     memset(&stats, 0, sizeof stats);
     if (rc == CL_SUCCESS) {
         cl_program prog = NULL;
-        st = ocl_program_build(c, &list[0], NULL, NULL, &prog, &stats, &err);
+        st = ocl_program_build(c, &list[0], NULL, cache_test_options, &prog, &stats, &err);
         if (prog) clReleaseProgram(prog);
         clReleaseContext(c);
     }
@@ -342,7 +348,7 @@ static void test_build_and_cache(void)
     Error err = {0};
     cl_program cold = NULL, warm = NULL;
     OclProgramStats s1, s2;
-    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, NULL, &cold, &s1, &err), ST_OK);
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &cold, &s1, &err), ST_OK);
     CHECK_MSG(cold != NULL, "%s", err.msg);
     if (!cold) return;
     CHECK_EQ_INT(s1.from_cache, 0);
@@ -354,15 +360,15 @@ static void test_build_and_cache(void)
     CHECK(file_size(s1.cache_path) > 88);
     CHECK_EQ_INT(count_dir_entries(cache_dir, ""), 1); /* no temporary file left behind */
 
-    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, NULL, &warm, &s2, &err), ST_OK);
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &warm, &s2, &err), ST_OK);
     CHECK(warm != NULL);
     CHECK_EQ_INT(s2.from_cache, 1);
     CHECK(strcmp(s1.cache_path, s2.cache_path) == 0);
     CHECK(strcmp(s1.options, s2.options) == 0);
     CHECK_MSG(s2.seconds < s1.seconds, "cache load %.3f s, cold build %.3f s", s2.seconds,
               s1.seconds);
-    fprintf(stderr, "  embedded source (%zu bytes): cold build %.3f s, cache load %.3f s, "
-            "cache entry %ld bytes\n", clpt_kernel_source_len, s1.seconds, s2.seconds,
+    fprintf(stderr, "  embedded source (%zu bytes), %s: cold build %.3f s, cache load %.3f s, "
+            "cache entry %ld bytes\n", clpt_kernel_source_len, cache_test_options, s1.seconds, s2.seconds,
             file_size(s1.cache_path));
 
     /* The cached binary must run and agree with the freshly built one and the host. */
@@ -376,8 +382,9 @@ static void test_build_and_cache(void)
     /* Other options are another entry. */
     cl_program other = NULL;
     OclProgramStats s3;
-    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, "-DCLPT_TEST_VARIANT=1", &other, &s3, &err),
-                 ST_OK);
+    char variant[96];
+    snprintf(variant, sizeof variant, "%s -DCLPT_TEST_VARIANT=1", cache_test_options);
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, variant, &other, &s3, &err), ST_OK);
     CHECK_EQ_INT(s3.from_cache, 0);
     CHECK_STR_CONTAINS(s3.options, " -DCLPT_TEST_VARIANT=1");
     CHECK(strcmp(s3.cache_path, s1.cache_path) != 0);
@@ -412,14 +419,14 @@ static void expect_recovery(const char *what, void (*damage)(const char *path))
     Error err = {0};
     cl_program prog = NULL;
     OclProgramStats s;
-    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, NULL, &prog, &s, &err), ST_OK);
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &prog, &s, &err), ST_OK);
     if (prog) clReleaseProgram(prog);
     damage(s.cache_path);
     long bad_size, new_size;
     unsigned char *bad = slurp(s.cache_path, &bad_size);
 
     prog = NULL;
-    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, NULL, &prog, &s, &err), ST_OK);
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &prog, &s, &err), ST_OK);
     CHECK_MSG(s.from_cache == 0, "%s: damaged entry was used", what);
     unsigned char *fresh = slurp(s.cache_path, &new_size);
     CHECK_MSG(bad && fresh && (bad_size != new_size || memcmp(bad, fresh, (size_t)bad_size)),
@@ -431,7 +438,7 @@ static void expect_recovery(const char *what, void (*damage)(const char *path))
     if (prog) clReleaseProgram(prog);
 
     prog = NULL;
-    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, NULL, &prog, &s, &err), ST_OK);
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &prog, &s, &err), ST_OK);
     CHECK_MSG(s.from_cache == 1, "%s: replaced entry not used", what);
     CHECK(prog && run_layout(prog, v) == 0);
     if (prog) clReleaseProgram(prog);
@@ -517,7 +524,7 @@ static void test_crashing_cache_entry(void)
     Error err = {0};
     cl_program prog = NULL;
     OclProgramStats s;
-    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, NULL, &prog, &s, &err), ST_OK);
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &prog, &s, &err), ST_OK);
     if (prog) clReleaseProgram(prog);
     char dir[400], pocl[400], entry[600], out[512];
     snprintf(dir, sizeof dir, "%s/crash-cache", tmp_root);
@@ -558,13 +565,13 @@ static void test_special_cache_entries(void)
         Error err = {0};
         cl_program prog = NULL;
         OclProgramStats s;
-        CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, NULL, &prog, &s, &err), ST_OK);
+        CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &prog, &s, &err), ST_OK);
         if (prog) clReleaseProgram(prog);
         CHECK(remove(s.cache_path) == 0);
         CHECK(kind ? mkdir(s.cache_path, 0755) == 0 : mkfifo(s.cache_path, 0644) == 0);
         alarm(120);   /* a hang fails the test instead of stopping the suite */
         prog = NULL;
-        CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, NULL, &prog, &s, &err), ST_OK);
+        CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &prog, &s, &err), ST_OK);
         alarm(0);
         CHECK_MSG(s.from_cache == 0, "%s: used as an entry", kind ? "a folder" : "a FIFO");
         struct stat sb;
@@ -595,8 +602,12 @@ static void test_kernel_argument_names(void)
 {
     Error err = {0};
     cl_program prog = NULL;
-    /* argument names are kept only when asked for (PoCL drops them from a binary) */
-    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, "-cl-kernel-arg-info", &prog, NULL, &err), ST_OK);
+    /* argument names are kept only when asked for (PoCL drops them from a binary); the
+     * program of every kernel named below and no other feature */
+    char options[96];
+    snprintf(options, sizeof options, "-D CLPT_FEATURES=0x%xu -cl-kernel-arg-info",
+             KF_PATH | KF_WHITTED | KF_PATH_MEGAKERNEL);
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, options, &prog, NULL, &err), ST_OK);
     CHECK_MSG(prog != NULL, "%s", err.msg);
     if (!prog) return;
 #define BUFFER_NAME_(kind, Type, name, count, what) #name,
@@ -799,7 +810,7 @@ static void test_cache_location(void)
     Error err = {0};
     cl_program prog = NULL;
     OclProgramStats s;
-    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, NULL, &prog, &s, &err), ST_OK);
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &prog, &s, &err), ST_OK);
     CHECK(prog != NULL);
     CHECK_EQ_INT(s.from_cache, 0);
     CHECK(s.cache_path[0] == '\0');
@@ -893,6 +904,7 @@ static void test_build_failure(void)
 
 int main(int argc, char **argv)
 {
+    snprintf(cache_test_options, sizeof cache_test_options, "-D CLPT_FEATURES=0x%xu", KF_PATH | KF_WHITTED);
     if (argc == 2 && strcmp(argv[1], "--two-devices") == 0) return child_two_devices();
     if (argc == 2 && strcmp(argv[1], "--enumerate") == 0) return child_enumerate();
     if (argc == 2 && strcmp(argv[1], "--build") == 0) return child_build();
@@ -934,7 +946,7 @@ int main(int argc, char **argv)
         RUN(test_special_cache_entries);
         RUN(test_kernel_argument_names);
         RUN(test_program_per_integrator);
-    RUN(test_kernels_declare_the_launch_size);
+        RUN(test_kernels_declare_the_launch_size);
         RUN(test_cache_location);
         RUN(test_kernel_dir);
         RUN(test_build_failure);

@@ -134,7 +134,7 @@ static int child_two_devices(void)
 
 /* Child mode: builds the embedded program for the first device, as a run of clpt does,
  * and prints what happened. */
-static int child_build(void)
+static int child_build(int variant, int show_path)
 {
     OclDeviceInfo *list = NULL;
     size_t n = 0;
@@ -151,11 +151,14 @@ static int child_build(void)
     memset(&stats, 0, sizeof stats);
     if (rc == CL_SUCCESS) {
         cl_program prog = NULL;
-        st = ocl_program_build(c, &list[0], NULL, cache_test_options, &prog, &stats, &err);
+        char options[96];
+        snprintf(options, sizeof options, "%s%s", cache_test_options, variant ? " -DCLPT_TEST_VARIANT=1" : "");
+        st = ocl_program_build(c, &list[0], NULL, options, &prog, &stats, &err);
         if (prog) clReleaseProgram(prog);
         clReleaseContext(c);
     }
-    printf("build status %d from_cache %d\n", (int)st, stats.from_cache);
+    printf("build status %d from_cache %d%s\n", (int)st, stats.from_cache,
+           !show_path ? "" : stats.cache_path[0] ? " cache_path 1" : " cache_path 0");
     free(list);
     error_clear(&err);
     return st == ST_OK ? 0 : 1;
@@ -557,6 +560,137 @@ static void test_crashing_cache_entry(void)
     error_clear(&err);
 }
 
+/* Runs that start together, as MPI's ranks or a farm's tasks over one shared cache do,
+ * all load the entry (proven by a trial before): none finds the entry gone while another
+ * reads it. Before, a run moved the entry aside while its driver read it, and about half
+ * of six runs started at once compiled from source. */
+static void test_runs_together(void)
+{
+    char dir[400], pocl[400];
+    snprintf(dir, sizeof dir, "%s/together", tmp_root);
+    snprintf(pocl, sizeof pocl, "%s/together-pocl", tmp_root);
+    char out[512];
+    /* the entry, then a run that proves it in its trial */
+    CHECK_EQ_INT(run_child("--build", "CLPT_TEST_UNUSED", "1", dir, pocl, out, sizeof out), 0);
+    CHECK_STR_CONTAINS(out, "from_cache 0\n");
+    CHECK_EQ_INT(run_child("--build", "CLPT_TEST_UNUSED", "1", dir, pocl, out, sizeof out), 0);
+    CHECK_STR_CONTAINS(out, "from_cache 1\n");
+    enum { RUNS = 8 };
+    int fds[RUNS][2];
+    pid_t pids[RUNS];
+    for (int i = 0; i < RUNS; i++) {
+        pids[i] = -1;
+        if (pipe(fds[i]) != 0) continue;
+        pids[i] = fork();
+        if (pids[i] == 0) {
+            dup2(fds[i][1], 1);
+            close(fds[i][0]);
+            close(fds[i][1]);
+            setenv("CLPT_CACHE_DIR", dir, 1);
+            setenv("POCL_CACHE_DIR", pocl, 1);
+            execl("/proc/self/exe", "test_ocl", "--build", (char *)NULL);
+            _exit(127);
+        }
+        close(fds[i][1]);
+    }
+    int loaded = 0;
+    for (int i = 0; i < RUNS; i++) {
+        CHECK(pids[i] > 0);
+        if (pids[i] <= 0) continue;
+        size_t n = 0;
+        ssize_t got;
+        while (n < sizeof out - 1 && (got = read(fds[i][0], out + n, sizeof out - 1 - n)) > 0) n += (size_t)got;
+        out[n] = '\0';
+        close(fds[i][0]);
+        int wstatus = 0;
+        CHECK(waitpid(pids[i], &wstatus, 0) == pids[i] && WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0);
+        loaded += strstr(out, "build status 0 from_cache 1\n") != NULL;
+    }
+    CHECK_MSG(loaded == RUNS, "%d of %d runs started together loaded the entry", loaded, RUNS);
+    CHECK_EQ_INT(count_dir_entries(dir, ".trying"), 0);   /* every mark taken away */
+}
+
+/* The mark of a run that died while its driver read the entry (a process of this
+ * machine that is gone): the next run does not load the entry but builds afresh,
+ * compiling past the driver's own cache (the .crashed mark), and stores an entry that
+ * the run after loads. A mark of another machine, whose processes this one cannot ask
+ * after, is left alone and the entry loaded. */
+static void test_died_reading_entry(void)
+{
+    Error err = {0};
+    cl_program prog = NULL;
+    OclProgramStats s;
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &prog, &s, &err), ST_OK);
+    if (prog) clReleaseProgram(prog);
+    char host[256], mark[1400], crashed[1100];
+    CHECK(gethostname(host, sizeof host) == 0);
+    host[sizeof host - 1] = '\0';
+
+    /* another machine's mark, of a process number nothing here runs under */
+    snprintf(mark, sizeof mark, "%s.%s-elsewhere.999999999.trying", s.cache_path, host);
+    CHECK(write_text(mark, "") == 0);
+    prog = NULL;
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &prog, &s, &err), ST_OK);
+    CHECK_MSG(s.from_cache == 1, "another machine's mark made the run build");
+    CHECK(access(mark, F_OK) == 0);
+    unlink(mark);
+    if (prog) clReleaseProgram(prog);
+
+    /* this machine's mark of a process that is gone */
+    pid_t gone = fork();
+    if (gone == 0) _exit(0);
+    CHECK(gone > 0 && waitpid(gone, NULL, 0) == gone);
+    snprintf(mark, sizeof mark, "%s.%s.%ld.trying", s.cache_path, host, (long)gone);
+    snprintf(crashed, sizeof crashed, "%s.crashed", s.cache_path);
+    unlink(crashed);
+    CHECK(write_text(mark, "") == 0);
+    prog = NULL;
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &prog, &s, &err), ST_OK);
+    CHECK_MSG(s.from_cache == 0, "an entry a run died reading was loaded again");
+    CHECK_MSG(access(mark, F_OK) != 0, "the dead run's mark was left");
+    CHECK_MSG(access(crashed, F_OK) == 0, "no .crashed mark");
+    CHECK(access(s.cache_path, F_OK) == 0);   /* a new entry in its place */
+    if (prog) clReleaseProgram(prog);
+    prog = NULL;
+    CHECK_EQ_INT(ocl_program_build(ctx, dev, NULL, cache_test_options, &prog, &s, &err), ST_OK);
+    CHECK_EQ_INT(s.from_cache, 1);
+    if (prog) clReleaseProgram(prog);
+    error_clear(&err);
+}
+
+/* A cache folder that cannot be written, as a farm may share a filled one read-only:
+ * a run loads its entry (it used to compile whenever the folder was not writable) and
+ * builds what is not there without claiming to store it. Read-only through a bind
+ * mount in a mount namespace of its own (root writes through file modes); skipped
+ * where unshare cannot make one. */
+static void test_read_only_cache(void)
+{
+    char dir[400], pocl[400], out[512], cmd[4096];
+    snprintf(dir, sizeof dir, "%s/read-only", tmp_root);
+    snprintf(pocl, sizeof pocl, "%s/read-only-pocl", tmp_root);
+    CHECK_EQ_INT(run_child("--build", "CLPT_TEST_UNUSED", "1", dir, pocl, out, sizeof out), 0);
+    CHECK_STR_CONTAINS(out, "from_cache 0\n");
+    const char *tries[] = { "--build-path", "--build-variant-path" };
+    for (int k = 0; k < 2; k++) {
+        snprintf(cmd, sizeof cmd, "unshare -m sh -c 'mount --bind -o ro \"%s\" \"%s\" && touch \"%s/x\" 2>/dev/null; "
+                 "test ! -e \"%s/x\" && CLPT_CACHE_DIR=\"%s\" POCL_CACHE_DIR=\"%s\" /proc/%ld/exe %s' 2>/dev/null",
+                 dir, dir, dir, dir, dir, pocl, (long)getpid(), tries[k]);
+        FILE *p = popen(cmd, "r");
+        size_t n = p ? fread(out, 1, sizeof out - 1, p) : 0;
+        out[n] = '\0';
+        int rc = p ? pclose(p) : -1;
+        if (k == 0 && n == 0) {
+            fprintf(stderr, "  (skipped: no read-only mount here: %d)\n", rc);
+            return;
+        }
+        CHECK_EQ_INT(rc, 0);
+        /* the entry there is loaded; the variant, not there, is built and not stored */
+        CHECK_STR_CONTAINS(out, k == 0 ? "build status 0 from_cache 1 cache_path 1\n"
+                                       : "build status 0 from_cache 0 cache_path 0\n");
+    }
+    CHECK_EQ_INT(count_dir_entries(dir, ".bin"), 1);
+}
+
 /* A FIFO or a folder in the entry's place: a cache miss, at once (a FIFO hung the
  * build for ever, waiting for a writer), and a regular entry stored in its place. */
 static void test_special_cache_entries(void)
@@ -907,7 +1041,9 @@ int main(int argc, char **argv)
     snprintf(cache_test_options, sizeof cache_test_options, "-D CLPT_FEATURES=0x%xu", KF_PATH | KF_WHITTED);
     if (argc == 2 && strcmp(argv[1], "--two-devices") == 0) return child_two_devices();
     if (argc == 2 && strcmp(argv[1], "--enumerate") == 0) return child_enumerate();
-    if (argc == 2 && strcmp(argv[1], "--build") == 0) return child_build();
+    if (argc == 2 && strcmp(argv[1], "--build") == 0) return child_build(0, 0);
+    if (argc == 2 && strcmp(argv[1], "--build-path") == 0) return child_build(0, 1);
+    if (argc == 2 && strcmp(argv[1], "--build-variant-path") == 0) return child_build(1, 1);
 
     snprintf(tmp_root, sizeof tmp_root, "%s/clpt-test-ocl-XXXXXX",
              getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -944,6 +1080,9 @@ int main(int argc, char **argv)
         RUN(test_corrupt_cache);
         RUN(test_crashing_cache_entry);
         RUN(test_special_cache_entries);
+        RUN(test_runs_together);
+        RUN(test_died_reading_entry);
+        RUN(test_read_only_cache);
         RUN(test_kernel_argument_names);
         RUN(test_program_per_integrator);
         RUN(test_kernels_declare_the_launch_size);

@@ -109,7 +109,8 @@ int ocl_program_cache_dir(char *buf, size_t cap)
     return n > 0 && (size_t)n < cap;
 }
 
-/* mkdir -p; returns 0 on success. */
+/* mkdir -p; returns 0 when the folder is there and writable, 1 when it is there but
+ * cannot be written (a read-only shared cache: read, never written), -1 otherwise. */
 static int oclp__make_dirs(const char *path)
 {
     char tmp[1024];
@@ -124,7 +125,8 @@ static int oclp__make_dirs(const char *path)
     }
     if (mkdir(tmp, 0755) != 0 && errno != EEXIST) return -1;
     struct stat sb;
-    return stat(tmp, &sb) == 0 && S_ISDIR(sb.st_mode) && access(tmp, W_OK) == 0 ? 0 : -1;
+    if (stat(tmp, &sb) != 0 || !S_ISDIR(sb.st_mode)) return -1;
+    return access(tmp, W_OK) == 0 ? 0 : 1;
 }
 
 /* Hashes one field as length + bytes, so that no two different field lists can give the
@@ -457,17 +459,36 @@ static void oclp__mark(const char *path)
     if (mark) fclose(mark);
 }
 
-/* Whether an earlier run died while its driver read the entry at `path`: it left
- * PATH.PID.trying behind (oclp__cache_load) and process PID is gone. Removes such
- * leftovers. A run still trying the entry is left alone. */
+/* The name of the mark a run of this machine leaves beside entry `path` while its
+ * driver reads the entry: PATH.HOST.PID.trying for process pid (prefix only, "PATH.HOST.",
+ * with pid < 0). The host is in the name because a cache folder may be shared between
+ * machines (a farm's), and only a process of this machine can be asked whether it still
+ * runs. 0 when the name does not fit. */
+static int oclp__trying_name(char *buf, size_t cap, const char *path, long pid)
+{
+    char host[256];
+    if (gethostname(host, sizeof host) != 0) host[0] = '\0';
+    host[sizeof host - 1] = '\0';
+    for (char *c = host; *c; c++)
+        if (*c == '/') *c = '_';
+    int n = pid < 0 ? snprintf(buf, cap, "%s.%s.", path, host[0] ? host : "localhost")
+                    : snprintf(buf, cap, "%s.%s.%ld.trying", path, host[0] ? host : "localhost", pid);
+    return n > 0 && (size_t)n < cap;
+}
+
+/* Whether a run of this machine died while its driver read the entry at `path`: it
+ * left its mark behind (oclp__cache_load) and its process is gone. Removes such marks.
+ * A run still reading the entry, and the marks of other machines, are left alone. */
 static int oclp__crashed_before(const char *path)
 {
-    char dir[1024];
-    const char *slash = strrchr(path, '/');
-    if (!slash || (size_t)(slash - path) >= sizeof dir) return 0;
-    memcpy(dir, path, (size_t)(slash - path));
-    dir[slash - path] = '\0';
-    const char *base = slash + 1;
+    char prefix[1400];   /* an entry's path (at most 1024) and a host name (at most 255) */
+    if (!oclp__trying_name(prefix, sizeof prefix, path, -1)) return 0;
+    const char *slash = strrchr(prefix, '/');
+    if (!slash) return 0;
+    char dir[1400];
+    memcpy(dir, prefix, (size_t)(slash - prefix));
+    dir[slash - prefix] = '\0';
+    const char *base = slash + 1;   /* ENTRY.HOST. */
     size_t base_len = strlen(base);
     DIR *d = opendir(dir);
     if (!d) return 0;
@@ -475,16 +496,16 @@ static int oclp__crashed_before(const char *path)
     for (struct dirent *e; (e = readdir(d));) {
         const char *name = e->d_name;
         size_t len = strlen(name);
-        if (len <= base_len + 8 || strncmp(name, base, base_len) != 0 || name[base_len] != '.' ||
-            strcmp(name + len - 7, ".trying") != 0)
+        if (len <= base_len + 7 || strncmp(name, base, base_len) != 0 || strcmp(name + len - 7, ".trying") != 0)
             continue;
         char *end = NULL;
-        long pid = strtol(name + base_len + 1, &end, 10);
+        long pid = strtol(name + base_len, &end, 10);
         if (pid <= 0 || end != name + len - 7) continue;
         if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;   /* still running */
-        char stale[1100];
-        if (snprintf(stale, sizeof stale, "%s/%s", dir, name) < (int)sizeof stale) unlink(stale);
-        crashed = 1;
+        /* gone, and its mark still there: a run that ends well takes its mark away
+         * before it exits, so one that ended between readdir and kill is not counted */
+        char stale[2700];
+        if (snprintf(stale, sizeof stale, "%s/%s", dir, name) < (int)sizeof stale && unlink(stale) == 0) crashed = 1;
     }
     closedir(d);
     return crashed;
@@ -494,23 +515,26 @@ static int oclp__crashed_before(const char *path)
  * has proven is loaded in a child process first (oclp__try_entry), and removed when the
  * driver refuses it or crashes on it there (PoCL 3 aborts or faults on some damaged
  * binaries whose checksum is right, in clCreateProgramWithBinary or clBuildProgram).
- * Should the driver still crash here (no trial could run, or a proven entry), the
- * entry is moved aside to PATH.PID.trying while the driver reads it, and put back only
- * once the program proved usable, so that it costs at most the one run it crashed. A
- * refused entry is deleted. A concurrent run meanwhile finds no entry and builds from
- * source.
+ * Should the driver still crash here (no trial could run, or a proven entry), this
+ * run's mark stays beside the entry (oclp__trying_name), and the next run of this
+ * machine that meets the entry finds the mark of a process that is gone and builds
+ * afresh: the entry costs at most the runs that read it together. The entry itself
+ * stays where it is while it is read, so runs started at the same moment (MPI's ranks,
+ * a farm's tasks over a shared cache) all load it; moving it aside, as clpt did before,
+ * made them find no entry and compile. A refused entry is deleted. A cache folder that
+ * cannot be written (a read-only shared one) is read without the mark.
  *
  * The driver may have kept what it read in a cache of its own (PoCL does, under the
  * program's hash, and then crashes on it when the same source is built again): when a
- * trial crashed or a run died trying the entry, `path`.crashed is left as a mark, and
+ * trial crashed or a run died reading the entry, `path`.crashed is left as a mark, and
  * while it exists the source is built with a line that changes the driver's key
  * (oclp__from_source). */
 static int oclp__cache_load(cl_context ctx, const OclDeviceInfo *dev, const char *path,
                             const unsigned char key[SHA256_DIGEST_SIZE], const char *options,
                             cl_program *out)
 {
-    char trying[1100], crashed[1100];
-    if (snprintf(trying, sizeof trying, "%s.%ld.trying", path, (long)getpid()) >= (int)sizeof trying ||
+    char trying[1400], crashed[1100];
+    if (!oclp__trying_name(trying, sizeof trying, path, (long)getpid()) ||
         snprintf(crashed, sizeof crashed, "%s.crashed", path) >= (int)sizeof crashed)
         return 0;
     unsigned char *bin = NULL, digest[SHA256_DIGEST_SIZE];
@@ -518,6 +542,16 @@ static int oclp__cache_load(cl_context ctx, const OclDeviceInfo *dev, const char
     int got = oclp__cache_read(path, key, &bin, &bin_len, digest);
     if (got == 0) {
         if (oclp__crashed_before(path)) oclp__mark(crashed);
+        return 0;
+    }
+    if (oclp__crashed_before(path)) {
+        /* a run of this machine died reading this entry: not read again */
+        oclp__mark(crashed);
+        if (atomic_load(&oclp__announce_builds))
+            fprintf(stderr, "clpt: warning: a run died while the OpenCL driver loaded the kernel cache entry '%s'; "
+                    "removed it\n", path);
+        oclp__cache_remove(path);
+        free(bin);
         return 0;
     }
     OclpTrial trial = got < 0 || oclp__proven(path, digest) ? OCLP__TRIAL_LOADED
@@ -529,14 +563,15 @@ static int oclp__cache_load(cl_context ctx, const OclDeviceInfo *dev, const char
                     "trial process); removed it\n", path);
     }
     if (trial == OCLP__TRIAL_LOADED && got > 0) oclp__prove(path, digest);
-    if (got < 0 || trial == OCLP__TRIAL_REFUSED || trial == OCLP__TRIAL_CRASHED || rename(path, trying) != 0) {
+    if (got < 0 || trial == OCLP__TRIAL_REFUSED || trial == OCLP__TRIAL_CRASHED) {
         oclp__cache_remove(path);     /* damaged: rebuilt and replaced by the caller */
         free(bin);
         return 0;
     }
+    oclp__mark(trying);
     int ok = oclp__from_binary(ctx, dev, bin, bin_len, options, out);
-    if (ok && rename(trying, path) != 0) oclp__cache_write(path, key, bin, bin_len);
-    if (!ok) unlink(trying);
+    unlink(trying);
+    if (!ok) oclp__cache_remove(path);
     free(bin);
     return ok;
 }
@@ -610,7 +645,9 @@ static Status oclp__build(cl_context ctx, const OclDeviceInfo *dev, const char *
     /* Developer mode is never cached: the included files are not part of the key. */
     char dir[900], path[sizeof stats->cache_path] = "";
     unsigned char key[SHA256_DIGEST_SIZE];
-    if (!from_folder && ocl_program_cache_dir(dir, sizeof dir) && oclp__make_dirs(dir) == 0) {
+    int folder = from_folder || !ocl_program_cache_dir(dir, sizeof dir) ? -1 : oclp__make_dirs(dir);
+    int writable = folder == 0;
+    if (folder >= 0) {
         char hex[65];
         oclp__key(dev, src, src_len, options, key);
         sha256_hex(key, hex);
@@ -621,12 +658,12 @@ static Status oclp__build(cl_context ctx, const OclDeviceInfo *dev, const char *
 
     Status st = ST_OK;
     if (!stats->from_cache) {
-        oclp__announce(dev, path[0] != '\0');
+        oclp__announce(dev, path[0] != '\0' && writable);
         char crashed[sizeof path + 16];
         snprintf(crashed, sizeof crashed, "%s.crashed", path);
         int fresh = path[0] && access(crashed, F_OK) == 0;
         st = oclp__from_source(ctx, dev, src, src_len, options, fresh, out, err);
-        if (st == ST_OK && path[0]) {
+        if (st == ST_OK && path[0] && writable) {
             unsigned char *bin = NULL;
             size_t bin_len = 0;
             if (oclp__binary(*out, dev, &bin, &bin_len))
@@ -634,7 +671,7 @@ static Status oclp__build(cl_context ctx, const OclDeviceInfo *dev, const char *
             free(bin);
         }
     }
-    if (st == ST_OK) memcpy(stats->cache_path, path, sizeof path);
+    if (st == ST_OK && (stats->from_cache || writable)) memcpy(stats->cache_path, path, sizeof path);
     return st;
 }
 

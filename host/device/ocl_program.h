@@ -25,8 +25,10 @@
  * a folder: opened without blocking). A payload with a right checksum can still crash
  * the driver, so a new entry is first loaded in a trial process (ocl_program.c, "the
  * trial load"): a crash there costs nothing but a compile from source, past whatever
- * the driver kept of it. A cache that cannot be created or written only means building
- * from source: it never fails a run.
+ * the driver kept of it. A cache folder that cannot be created only means building from
+ * source, and one that cannot be written (a farm's read-only copy) is read but not
+ * written: it never fails a run. Runs that share the folder, on one machine or many
+ * (docs/design.md, "A cache for a farm"), all load an entry while one of them reads it.
  *
  * Storing an entry reads CL_PROGRAM_BINARIES right after the build, which makes PoCL 3.1
  * compile every kernel of the program (a work-group function for any local size) on top

@@ -313,6 +313,13 @@ static atomic_int oclp__announce_builds;   /* see ocl_program_announce_builds */
 #define OCLP__TRIAL_OPTIONS "CLPT_KERNEL_CACHE_TRIAL_OPTIONS" /* the build options */
 #define OCLP__TRIAL_SECONDS 120.0   /* a trial that takes longer is a driver hanging on it */
 
+/* The trial child's exit statuses. Not 1: a process that dies of a fault caught by a
+ * runtime (a sanitizer reports a driver's SIGSEGV and exits 1) or that the driver ends
+ * with exit(1) gave no verdict, and counts as a crash, as a fatal signal does. */
+#define OCLP__EXIT_LOADED 0
+#define OCLP__EXIT_REFUSED 64
+#define OCLP__EXIT_NO_TRIAL 65
+
 typedef enum {
     OCLP__TRIAL_LOADED,    /* the driver built it and the program is usable */
     OCLP__TRIAL_REFUSED,   /* the driver refused it, or hung on it */
@@ -349,28 +356,30 @@ static void oclp__prove(const char *path, const unsigned char digest[SHA256_DIGE
 }
 
 /* The child's side: loads the entry for the device named by the environment. Exit
- * status 0: loaded and usable; 1: refused; 2: the trial itself could not run. */
+ * status OCLP__EXIT_LOADED: loaded and usable; OCLP__EXIT_REFUSED: refused;
+ * OCLP__EXIT_NO_TRIAL: the trial itself could not run. */
 static int oclp__trial(const char *which, const char *path, const char *digest_hex, const char *options)
 {
     unsigned p = 0, d = 0;
-    if (!path || !digest_hex || !options || sscanf(which, "%u.%u", &p, &d) != 2) return 2;
+    if (!path || !digest_hex || !options || sscanf(which, "%u.%u", &p, &d) != 2) return OCLP__EXIT_NO_TRIAL;
     cl_uint n_platforms = 0, n_devices = 0;
     cl_platform_id platforms[64];
     cl_device_id devices[64];
-    if (clGetPlatformIDs(64, platforms, &n_platforms) != CL_SUCCESS || p >= n_platforms || p >= 64) return 2;
+    if (clGetPlatformIDs(64, platforms, &n_platforms) != CL_SUCCESS || p >= n_platforms || p >= 64)
+        return OCLP__EXIT_NO_TRIAL;
     if (clGetDeviceIDs(platforms[p], CL_DEVICE_TYPE_ALL, 64, devices, &n_devices) != CL_SUCCESS ||
         d >= n_devices || d >= 64)
-        return 2;
+        return OCLP__EXIT_NO_TRIAL;
     unsigned char *bin = NULL, digest[SHA256_DIGEST_SIZE];
     size_t len = 0;
     char hex[65];
-    if (oclp__cache_read(path, NULL, &bin, &len, digest) != 1) return 2;
+    if (oclp__cache_read(path, NULL, &bin, &len, digest) != 1) return OCLP__EXIT_NO_TRIAL;
     sha256_hex(digest, hex);
-    if (strcmp(hex, digest_hex) != 0) return 2;   /* replaced meanwhile: not what was asked */
+    if (strcmp(hex, digest_hex) != 0) return OCLP__EXIT_NO_TRIAL;   /* replaced meanwhile: not what was asked */
     cl_context_properties props[] = { CL_CONTEXT_PLATFORM, (cl_context_properties)platforms[p], 0 };
     cl_int rc;
     cl_context ctx = clCreateContext(props, 1, &devices[d], NULL, NULL, &rc);
-    if (rc != CL_SUCCESS) return 2;
+    if (rc != CL_SUCCESS) return OCLP__EXIT_NO_TRIAL;
     OclDeviceInfo dev;
     memset(&dev, 0, sizeof dev);
     dev.id = devices[d];
@@ -379,7 +388,7 @@ static int oclp__trial(const char *which, const char *path, const char *digest_h
     if (ok) clReleaseProgram(prog);
     clReleaseContext(ctx);
     free(bin);
-    return ok ? 0 : 1;
+    return ok ? OCLP__EXIT_LOADED : OCLP__EXIT_REFUSED;
 }
 
 /* Runs the trial when this process is a trial child; every other process returns at
@@ -444,8 +453,10 @@ static OclpTrial oclp__try_entry(const OclDeviceInfo *dev, const char *path,
         nanosleep(&(struct timespec){ 0, 5000000 }, NULL);
     }
     if (WIFEXITED(wstatus))
-        return WEXITSTATUS(wstatus) == 0 ? OCLP__TRIAL_LOADED
-             : WEXITSTATUS(wstatus) == 1 ? OCLP__TRIAL_REFUSED : OCLP__TRIAL_UNKNOWN;
+        return WEXITSTATUS(wstatus) == OCLP__EXIT_LOADED    ? OCLP__TRIAL_LOADED
+             : WEXITSTATUS(wstatus) == OCLP__EXIT_REFUSED   ? OCLP__TRIAL_REFUSED
+             : WEXITSTATUS(wstatus) == OCLP__EXIT_NO_TRIAL  ? OCLP__TRIAL_UNKNOWN
+                                                            : OCLP__TRIAL_CRASHED;   /* no verdict */
     switch (WTERMSIG(wstatus)) {
     case SIGSEGV: case SIGBUS: case SIGABRT: case SIGILL: case SIGFPE: case SIGSYS: return OCLP__TRIAL_CRASHED;
     default: return OCLP__TRIAL_UNKNOWN;   /* interrupted with the parent (Ctrl-C), or killed */

@@ -468,12 +468,13 @@ static void pocl_close(Pocl *pc)
     memset(pc, 0, sizeof *pc);
 }
 
-/* made as the renderer makes them (ocl_buffer): on huge pages where it puts them */
-static cl_mem pocl_buffer(Pocl *pc, const void *src, size_t bytes)
+/* made as the renderer makes them (ocl_buffer): the scene's read at random, on huge
+ * pages, the rays and hits in order, as a wave's */
+static cl_mem pocl_buffer(Pocl *pc, OclReads reads, const void *src, size_t bytes)
 {
     cl_int rc;
     const char *call;
-    cl_mem m = ocl_buffer(pc->ctx, CL_DEVICE_TYPE_CPU, CL_MEM_READ_WRITE, bytes, bytes ? src : NULL, &call, &rc);
+    cl_mem m = ocl_buffer(pc->ctx, CL_DEVICE_TYPE_CPU, CL_MEM_READ_WRITE, reads, bytes, bytes ? src : NULL, &call, &rc);
     if (!m) pocl_fail(call, rc);
     return m;
 }
@@ -483,10 +484,10 @@ static int pocl_upload(Pocl *pc, const Mesh *m, uint max_rays)
     pocl_release_buffers(pc);
     for (unsigned i = 0; i < SC_N; i++) {
         SceneBufferBytes b = device_scene_buffer(&m->ds, i);
-        pc->scene[i] = pocl_buffer(pc, b.data, b.bytes);
+        pc->scene[i] = pocl_buffer(pc, OCL_READ_AT_RANDOM, b.data, b.bytes);
     }
-    pc->rays = pocl_buffer(pc, NULL, (size_t)max_rays * sizeof(Ray));
-    pc->out = pocl_buffer(pc, NULL, (size_t)max_rays * sizeof(Hit));
+    pc->rays = pocl_buffer(pc, OCL_READ_IN_ORDER, NULL, (size_t)max_rays * sizeof(Ray));
+    pc->out = pocl_buffer(pc, OCL_READ_IN_ORDER, NULL, (size_t)max_rays * sizeof(Hit));
     for (int i = 0; i < SC_N; i++)
         if (!pc->scene[i]) return -1;
     if (!pc->rays || !pc->out) return -1;

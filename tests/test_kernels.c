@@ -352,12 +352,13 @@ static void build_lanes_scene(void)
     device_scene_view(&lanes_rs.ds, &lanes_view);
 }
 
-/* a buffer made as the renderer makes its own (ocl_buffer: on huge pages on a CPU) */
+/* a buffer made as the renderer makes a scene's (ocl_buffer: on huge pages on a CPU,
+ * handed to the driver), so that the kernels' bits are compared on that memory too */
 static cl_mem buffer(size_t bytes, const void *src)
 {
     cl_int rc;
     const char *call;
-    cl_mem m = ocl_buffer(cl.ctx, cl.dev.type, CL_MEM_READ_WRITE, bytes, src, &call, &rc);
+    cl_mem m = ocl_buffer(cl.ctx, cl.dev.type, CL_MEM_READ_WRITE, OCL_READ_AT_RANDOM, bytes, src, &call, &rc);
     CHECK_MSG(m != NULL, "%s: %s", call, ocl_error_name(rc));
     return m;
 }

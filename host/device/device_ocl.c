@@ -103,7 +103,7 @@ static Status ocl_update_params(Device *d, const RenderParams *p, const uint *pi
                                                          sizeof *p, p, 0, NULL, NULL));
     ocl_release_mem(&od->scene[SCENE_BUF_pixel_list]);
     size_t list_bytes = pixel_list ? (size_t)p->pixel_list_size * sizeof(uint) : 0;
-    if ((st = ocld_make_buffer(od, CL_MEM_READ_ONLY, list_bytes, pixel_list, "pixel list",
+    if ((st = ocld_make_buffer(od, CL_MEM_READ_ONLY, OCL_READ_IN_ORDER, list_bytes, pixel_list, "pixel list",
                           &od->scene[SCENE_BUF_pixel_list], err)) ||
         (st = ocld_set_scene_arg(od, SCENE_BUF_pixel_list, err)) || (st = ocld_grow_counts(od, path_max_shades(p->max_depth, p->has_media), err)))
         return st;

@@ -325,8 +325,8 @@ static void CL_CALLBACK free_host_memory(cl_mem mem, void *host)
     free(host);
 }
 
-cl_mem ocl_buffer(cl_context ctx, cl_device_type type, cl_mem_flags flags, size_t bytes, const void *src,
-                  const char **call, cl_int *rc)
+cl_mem ocl_buffer(cl_context ctx, cl_device_type type, cl_mem_flags flags, OclReads reads, size_t bytes,
+                  const void *src, const char **call, cl_int *rc)
 {
     size_t size = bytes < OCL_BUFFER_MIN ? OCL_BUFFER_MIN : bytes;
     /* CL_MEM_COPY_HOST_PTR copies `size` bytes: a source shorter than the minimum (a
@@ -337,7 +337,8 @@ cl_mem ocl_buffer(cl_context ctx, cl_device_type type, cl_mem_flags flags, size_
         src = padded;
     }
     void *host = NULL;
-    if ((type & CL_DEVICE_TYPE_CPU) && size >= PAGES_HUGE_BYTES && (host = pages_alloc_huge(size))) {
+    if ((type & CL_DEVICE_TYPE_CPU) && reads == OCL_READ_AT_RANDOM && size >= PAGES_HUGE_BYTES &&
+        (host = pages_alloc_huge(size))) {
         if (src) memcpy(host, src, size);
         flags |= CL_MEM_USE_HOST_PTR;
     } else if (src) {

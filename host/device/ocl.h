@@ -68,14 +68,28 @@ Status ocl_failf(Error *err, const OclDeviceInfo *dev, const char *call, cl_int 
  * caller frees *out with free(). */
 Status ocl_enumerate(OclDeviceInfo **out, size_t *n, Error *err);
 
+/* How a buffer's bytes are read: which decides whether a CPU device gets it on huge
+ * pages. */
+typedef enum {
+    OCL_READ_IN_ORDER,  /* each work-item its own records (a wave's paths, rays and
+                         * queues, a film, the pixel list): a 4 KiB page serves dozens
+                         * of neighbouring work-items, so huge pages would only add
+                         * their first touch, which on a VM that hands free memory back
+                         * to its host costs 11-14 ms per MiB against 0.7 on small pages
+                         * (bench/RESULTS.md, "A wave's buffers on small pages") */
+    OCL_READ_AT_RANDOM, /* a scene's arrays, which every ray reads at random: on huge
+                         * pages the TLB holds them (base/pages.h) */
+} OclReads;
+
 /* A buffer of `bytes` bytes, at least OCL_BUFFER_MIN (OpenCL has no empty buffers),
  * for devices of `type`, holding src's bytes when src is given (the rest zero). On a CPU
- * device, which computes in host memory, a buffer of PAGES_HUGE_BYTES or more is memory
- * clpt allocates on huge pages (base/pages.h) and hands over with CL_MEM_USE_HOST_PTR,
- * freed when OpenCL deletes the buffer; elsewhere CL_MEM_COPY_HOST_PTR copies src. On
- * failure NULL, with the failed call in *call and its code in *rc. */
+ * device, which computes in host memory, a buffer read OCL_READ_AT_RANDOM of
+ * PAGES_HUGE_BYTES or more is memory clpt allocates on huge pages (base/pages.h) and
+ * hands over with CL_MEM_USE_HOST_PTR, freed when OpenCL deletes the buffer; otherwise
+ * the driver allocates it, CL_MEM_COPY_HOST_PTR copying src. On failure NULL, with the
+ * failed call in *call and its code in *rc. */
 #define OCL_BUFFER_MIN 16u
-cl_mem ocl_buffer(cl_context ctx, cl_device_type type, cl_mem_flags flags, size_t bytes, const void *src,
-                  const char **call, cl_int *rc);
+cl_mem ocl_buffer(cl_context ctx, cl_device_type type, cl_mem_flags flags, OclReads reads, size_t bytes,
+                  const void *src, const char **call, cl_int *rc);
 
 #endif /* CLPT_OCL_H */

@@ -64,9 +64,9 @@ void ocld_release_buffers(OclDevice *od)
 }
 
 /* A device buffer of `bytes` (at least 16: OpenCL has no empty buffers), filled from
- * `src` when given. */
-Status ocld_make_buffer(OclDevice *od, cl_mem_flags flags, size_t bytes, const void *src,
-                          const char *what, cl_mem *out, Error *err)
+ * `src` when given, its bytes read as `reads` says (ocl_buffer). */
+Status ocld_make_buffer(OclDevice *od, cl_mem_flags flags, OclReads reads, size_t bytes, const void *src,
+                        const char *what, cl_mem *out, Error *err)
 {
     size_t size = bytes < OCL_BUFFER_MIN ? OCL_BUFFER_MIN : bytes;
     if ((cl_ulong)size > od->info.max_alloc)
@@ -75,7 +75,7 @@ Status ocld_make_buffer(OclDevice *od, cl_mem_flags flags, size_t bytes, const v
                          od->info.name, what, (double)size / 1048576.0, (double)od->info.max_alloc / 1048576.0);
     const char *call;
     cl_int rc;
-    *out = ocl_buffer(od->ctx, od->info.type, flags, bytes, bytes ? src : NULL, &call, &rc);
+    *out = ocl_buffer(od->ctx, od->info.type, flags, reads, bytes, bytes ? src : NULL, &call, &rc);
     if (!*out) {
         ocl_fail(err, &od->info, call, rc);
         error_prefix(err, "allocating %.1f MiB for the %s", (double)size / 1048576.0, what);
@@ -104,7 +104,7 @@ static Status alloc_films(OclDevice *od, size_t film_bytes, Error *err)
     cl_long zero = 0;
     for (uint i = 0; i < od->n_slots; i++) {
         FilmSlot *fs = &od->slots[i];
-        if ((st = ocld_make_buffer(od, CL_MEM_READ_WRITE, film_bytes, NULL, "film", &fs->film, err))) return st;
+        if ((st = ocld_make_buffer(od, CL_MEM_READ_WRITE, OCL_READ_IN_ORDER, film_bytes, NULL, "film", &fs->film, err))) return st;
         if (!(fs->host = malloc(film_bytes < 16 ? 16 : film_bytes)))
             return error_set(err, ST_INTERNAL, "out of memory for the read-back of the film");
         OCL_TRY("clEnqueueFillBuffer", clEnqueueFillBuffer(od->queue, fs->film, &zero, sizeof zero, 0,
@@ -141,12 +141,12 @@ Status ocld_alloc_render(OclDevice *od, const SceneBufferBytes *in, uint n_pixel
     else
         od->n_slots = 1;
     for (int i = 0; i < SCENE_N; i++)
-        if ((st = ocld_make_buffer(od, CL_MEM_READ_ONLY, in[i].bytes, in[i].data, in[i].what, &od->scene[i], err)))
+        if ((st = ocld_make_buffer(od, CL_MEM_READ_ONLY, OCL_READ_AT_RANDOM, in[i].bytes, in[i].data, in[i].what, &od->scene[i], err)))
             return st;
     for (int i = 0; i < WAVE_SLOTS; i++) {
         WaveSlot *w = &od->waves[i];
         for (int j = 0; j < WAVE_N; j++)
-            if ((st = ocld_make_buffer(od, CL_MEM_READ_WRITE, wave_buffer_bytes(j, wave, counts_bytes), NULL,
+            if ((st = ocld_make_buffer(od, CL_MEM_READ_WRITE, OCL_READ_IN_ORDER, wave_buffer_bytes(j, wave, counts_bytes), NULL,
                                        wave_buffers[j].what, wave_buffer(w, j), err)))
                 return st;
         if (!(w->all_counts = malloc(counts_bytes)))
@@ -167,7 +167,7 @@ Status ocld_grow_counts(OclDevice *od, uint bounces, Error *err)
     for (int i = 0; i < WAVE_SLOTS; i++) {
         WaveSlot *w = &od->waves[i];
         ocl_release_mem(&w->counts);
-        if ((st = ocld_make_buffer(od, CL_MEM_READ_WRITE, bytes, NULL, "queue counters", &w->counts, err))) return st;
+        if ((st = ocld_make_buffer(od, CL_MEM_READ_WRITE, OCL_READ_IN_ORDER, bytes, NULL, "queue counters", &w->counts, err))) return st;
         if (w->k_shade) ARG(w->k_shade, ARG_SHADE_COUNTS, w->counts);
         if (w->k_intersect) ARG(w->k_intersect, ARG_INTERSECT_COUNTS, w->counts);
         if (w->k_shadow) ARG(w->k_shadow, ARG_SHADOW_COUNTS, w->counts);

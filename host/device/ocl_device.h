@@ -154,8 +154,8 @@ Status ocld_set_arg(OclDevice *od, cl_kernel k, cl_uint i, size_t size, const vo
 #define ARG(k, i, v) do { Status st_ = ocld_set_arg(od, k, i, sizeof(v), &(v), err); if (st_) return st_; } while (0)
 
 /* ocl_buffers.c */
-Status ocld_make_buffer(OclDevice *od, cl_mem_flags flags, size_t bytes, const void *src, const char *what,
-                        cl_mem *out, Error *err);
+Status ocld_make_buffer(OclDevice *od, cl_mem_flags flags, OclReads reads, size_t bytes, const void *src,
+                        const char *what, cl_mem *out, Error *err);
 Status ocld_alloc_render(OclDevice *od, const SceneBufferBytes *in, uint n_pixels, Error *err);
 Status ocld_grow_counts(OclDevice *od, uint bounces, Error *err);
 void ocld_release_buffers(OclDevice *od);

@@ -21,9 +21,9 @@
  * MisMode set on the prepared scene (the tests of each strategy alone), or
  * RENDER_UTIL_SCENE_MIS. The film is initialised here; free it with film_free. */
 /* render_util_run_mis with the devices opened under cfg (NULL: the defaults), e.g. an
- * OpenCL device's --wave-launch. */
-static inline Status render_util_run_cfg(Scene *s, uint mis_mode, const char *devices, const DeviceConfig *cfg,
-                                         uint batch, Film *film, Error *err)
+ * OpenCL device's --wave-launch; the first device's counters into *first when given. */
+static inline Status render_util_run_counted(Scene *s, uint mis_mode, const char *devices, const DeviceConfig *cfg,
+                                             uint batch, Film *film, DeviceCounters *first, Error *err)
 {
     RenderScene rs;
     DeviceDesc *all = NULL;
@@ -50,6 +50,7 @@ static inline Status render_util_run_cfg(Scene *s, uint mis_mode, const char *de
     sched.spp = s->image.spp;
     sched.fixed_batch = batch;
     st = schedule_run(devs, n_chosen, &sched, film, &stats, err);
+    if (first && n_open) *first = devs[0]->counters;
 out:
     schedule_stats_free(&stats);
     for (size_t i = 0; i < n_open; i++) device_close(devs[i]);
@@ -58,6 +59,12 @@ out:
     free(all);
     render_scene_free(&rs);
     return st;
+}
+
+static inline Status render_util_run_cfg(Scene *s, uint mis_mode, const char *devices, const DeviceConfig *cfg,
+                                         uint batch, Film *film, Error *err)
+{
+    return render_util_run_counted(s, mis_mode, devices, cfg, batch, film, NULL, err);
 }
 
 static inline Status render_util_run_mis(Scene *s, uint mis_mode, const char *devices, uint batch, Film *film,

@@ -51,6 +51,29 @@ static void test_large_only_when_large(void)
     CHECK(pages_alloc_large(SIZE_MAX) == NULL);
 }
 
+/* pages_on_huge tells pages_alloc_huge's arrays (which an OpenCL CPU device then uses in
+ * place) from everything else: malloc's large blocks, small arrays, NULL. */
+static void test_on_huge(void)
+{
+    size_t big = 2u * PAGES_HUGE_BYTES;
+    unsigned char *h = pages_alloc_huge(big), *l = pages_alloc_large(big), *m = malloc(big), *s = pages_alloc_large(4096);
+    CHECK(h && l && m && s);
+    if (h && l && m && s) {
+        CHECK(pages_on_huge(h, big));
+        CHECK(pages_on_huge(h, PAGES_HUGE_BYTES));
+        CHECK(!pages_on_huge(h, PAGES_HUGE_BYTES - 1u));   /* too small to be worth it */
+        CHECK(pages_on_huge(l, big));
+        CHECK(!pages_on_huge(m, big));
+        CHECK(!pages_on_huge(s, 4096));
+        CHECK(!pages_on_huge(h + 64, big - 64));
+    }
+    CHECK(!pages_on_huge(NULL, big));
+    free(h);
+    free(l);
+    free(m);
+    free(s);
+}
+
 static void test_too_large(void)
 {
     CHECK(pages_alloc_huge(SIZE_MAX) == NULL);
@@ -90,6 +113,7 @@ int main(void)
 {
     RUN(test_aligned_and_rounded);
     RUN(test_large_only_when_large);
+    RUN(test_on_huge);
     RUN(test_too_large);
     RUN(test_report_huge_pages);
     return harness_report();

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 
 #include "harness.h"
+#include "base/pages.h"
 #include "util/kmath.h"
 #include "render_util.h"
 
@@ -429,6 +430,43 @@ static void test_ellipsoid_devices_trees(void)
     film_free(&fa);
 }
 
+/* A mesh whose tree is larger than a huge page: an OpenCL CPU device uses the tree's
+ * arrays where the host built them (on huge pages; ocl_buffers.c) instead of copying
+ * them, and renders the bits the scalar device renders from the same arrays. A GPU
+ * copies everything. */
+static void test_mesh_tree_in_place(void)
+{
+    Scene s;
+    ellipsoid_scene(&s, 1, INTEGRATOR_PATH);
+    s.image.spp = 4;
+    Film fa, fb;
+    DeviceCounters c;
+    memset(&c, 0, sizeof c);
+    Error err = { 0 };
+    Status st = render_util_run_counted(&s, RENDER_UTIL_SCENE_MIS, TEST_OPENCL, NULL, 0, &fa, &c, &err);
+    CHECK_MSG(st == ST_OK, "%s", err.msg);
+    if (st == ST_OK) {
+        fprintf(stderr, "  %.1f MiB of the scene used in place on %s\n", (double)c.bytes_in_place / 1048576.0,
+                TEST_OPENCL);
+        if (!TEST_OPENCL_IS_GPU) CHECK(c.bytes_in_place >= PAGES_HUGE_BYTES);
+        st = render_util_run(&s, "scalar", 0, &fb, &err);
+        CHECK_MSG(st == ST_OK, "%s", err.msg);
+        if (st == ST_OK) {
+            size_t n = (size_t)fa.width * fa.height * 3u, same = 0, lit = 0;
+            for (size_t i = 0; i < n; i++) {
+                same += fa.sum[i] == fb.sum[i];
+                lit += fa.sum[i] != 0;
+            }
+            CHECK_EQ_INT(same, n);
+            CHECK(lit > n / 2);
+            film_free(&fb);
+        }
+        film_free(&fa);
+    }
+    scene_free(&s);
+    error_clear(&err);
+}
+
 int main(void)
 {
     RUN(test_furnace_scalar);
@@ -440,5 +478,6 @@ int main(void)
     RUN(test_update_params_opencl);
     RUN(test_ellipsoid_like_mesh);
     RUN(test_ellipsoid_devices_trees);
+    RUN(test_mesh_tree_in_place);
     return harness_report();
 }

@@ -17,6 +17,11 @@ void *pages_alloc_huge(size_t bytes)
     return p;
 }
 
+int pages_on_huge(const void *p, size_t bytes)
+{
+    return p && bytes >= PAGES_HUGE_BYTES && ((uintptr_t)p & (PAGES_HUGE_BYTES - 1u)) == 0u;
+}
+
 void *pages_alloc_large(size_t bytes)
 {
     if (bytes >= PAGES_HUGE_BYTES) return pages_alloc_huge(bytes);

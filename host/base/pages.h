@@ -27,4 +27,9 @@ void *pages_alloc_huge(size_t bytes);
  * rounded up to a huge page; NULL when out of memory. Free with free(). */
 void *pages_alloc_large(size_t bytes);
 
+/* Whether the array p of `bytes` is pages_alloc_huge's memory: PAGES_HUGE_BYTES or more
+ * at a PAGES_HUGE_BYTES boundary. Nothing else in clpt asks for that alignment, and
+ * glibc's own large blocks start 16 bytes into a page. */
+int pages_on_huge(const void *p, size_t bytes);
+
 #endif /* CLPT_PAGES_H */

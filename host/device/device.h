@@ -139,6 +139,8 @@ typedef struct {
     double compile_seconds;       /* OpenCL program build or cache load */
     int from_cache;
     double upload_seconds;
+    uint64_t bytes_in_place;      /* OpenCL CPU devices: the loaded scene's bytes used
+                                   * where the host made them, not copied (ocl_buffers.c) */
     /* OpenCL, for --stats: the loaded scene's waves (paths each) and how one runs (a
      * static string: "bounded bounces", "megakernel k_path", ...) */
     unsigned wave_paths;
@@ -154,6 +156,10 @@ typedef struct {
 typedef struct Device Device;
 
 typedef struct {
+    /* Gives the device a scene. Its arrays may be read where they are until the next
+     * load_scene or the device's end (the scalar device reads them all in place, an
+     * OpenCL CPU device those on huge pages, ocl_buffers.c), so the caller keeps them,
+     * unchanged, until then; the params block is copied. */
     Status (*load_scene)(Device *d, const DeviceScene *scene, Error *err);
     /* Replaces the params block and the pixel list of the loaded scene, keeping every
      * other buffer (a pass that changes the integrator, the samples or the pixels need

@@ -65,6 +65,7 @@ static Status ocl_load_scene(Device *d, const DeviceScene *s, Error *err)
     od->max_bounces = path_max_shades(p->max_depth, p->has_media);
     Status st = ocld_alloc_render(od, in, n_pixels, err);
     if (st) return st;
+    d->counters.bytes_in_place = od->bytes_in_place;
     od->n_pixels = n_pixels;
     od->batch_pixels = p->pixel_list_size ? p->pixel_list_size : n_pixels;
     /* a program built for an earlier scene serves this one if it has its features */

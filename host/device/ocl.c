@@ -325,6 +325,14 @@ static void CL_CALLBACK free_host_memory(cl_mem mem, void *host)
     free(host);
 }
 
+cl_mem ocl_buffer_in_place(cl_context ctx, size_t bytes, const void *src, const char **call, cl_int *rc)
+{
+    *call = "clCreateBuffer";
+    /* CL_MEM_READ_ONLY: the kernels never write it, and the host never writes or maps
+     * it, so the const of src holds */
+    return clCreateBuffer(ctx, CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, bytes, (void *)(uintptr_t)src, rc);
+}
+
 cl_mem ocl_buffer(cl_context ctx, cl_device_type type, cl_mem_flags flags, OclReads reads, size_t bytes,
                   const void *src, const char **call, cl_int *rc)
 {

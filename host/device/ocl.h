@@ -92,4 +92,11 @@ typedef enum {
 cl_mem ocl_buffer(cl_context ctx, cl_device_type type, cl_mem_flags flags, OclReads reads, size_t bytes,
                   const void *src, const char **call, cl_int *rc);
 
+/* A read-only buffer of a CPU device over the host's own `bytes` at src, used in place
+ * (CL_MEM_USE_HOST_PTR; nothing is copied, and nothing freed with the buffer): for an
+ * array the host made on huge pages already (pages_on_huge), which a copy would only
+ * touch a second time. The array must stay, unchanged, until the buffer is released,
+ * as the scalar device's scene does (device.h). On failure NULL, as ocl_buffer. */
+cl_mem ocl_buffer_in_place(cl_context ctx, size_t bytes, const void *src, const char **call, cl_int *rc);
+
 #endif /* CLPT_OCL_H */

@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdlib.h>
 
+#include "base/pages.h"
 #include "device/device_memory.h"
 #include "device/ocl_device.h"
 
@@ -84,6 +85,34 @@ Status ocld_make_buffer(OclDevice *od, cl_mem_flags flags, OclReads reads, size_
     return ST_OK;
 }
 
+/* Scene buffer i, from `in`: on a CPU device an array the host made on huge pages (the
+ * trees' nodes and leaf lists, base/pages.h) is used in place, as the scalar device
+ * reads it; a copy would touch as many huge pages again, which on a VM that hands free
+ * memory back to its host costs 11-14 ms per MiB (the dragon's tree is 39 MB;
+ * bench/RESULTS.md, "The scene's trees used in place"). Everything else is copied
+ * (ocl_buffer). The scene's arrays stay until the next load_scene or the device's end
+ * (device.h). */
+static Status make_scene_buffer(OclDevice *od, int i, const SceneBufferBytes *in, Error *err)
+{
+    if (!od->cpu || !pages_on_huge(in->data, in->bytes))
+        return ocld_make_buffer(od, CL_MEM_READ_ONLY, OCL_READ_AT_RANDOM, in->bytes, in->data, in->what,
+                                &od->scene[i], err);
+    if ((cl_ulong)in->bytes > od->info.max_alloc)
+        return error_set(err, ST_DEVICE,
+                         "device '%s': the %s need %.1f MiB, more than the device's largest allocation (%.1f MiB)",
+                         od->info.name, in->what, (double)in->bytes / 1048576.0,
+                         (double)od->info.max_alloc / 1048576.0);
+    const char *call;
+    cl_int rc;
+    if ((od->scene[i] = ocl_buffer_in_place(od->ctx, in->bytes, in->data, &call, &rc))) {
+        od->bytes_in_place += in->bytes;
+        return ST_OK;
+    }
+    ocl_fail(err, &od->info, call, rc);
+    error_prefix(err, "using %.1f MiB of the %s in place", (double)in->bytes / 1048576.0, in->what);
+    return ST_DEVICE;
+}
+
 /* The large default waves only while they and the scene take at most half the device's
  * memory; else the smaller fallback. */
 static void choose_wave(OclDevice *od, const SceneBufferBytes *in, uint n_pixels, size_t counts_bytes)
@@ -140,9 +169,9 @@ Status ocld_alloc_render(OclDevice *od, const SceneBufferBytes *in, uint n_pixel
         return st;
     else
         od->n_slots = 1;
+    od->bytes_in_place = 0;
     for (int i = 0; i < SCENE_N; i++)
-        if ((st = ocld_make_buffer(od, CL_MEM_READ_ONLY, OCL_READ_AT_RANDOM, in[i].bytes, in[i].data, in[i].what, &od->scene[i], err)))
-            return st;
+        if ((st = make_scene_buffer(od, i, &in[i], err))) return st;
     for (int i = 0; i < WAVE_SLOTS; i++) {
         WaveSlot *w = &od->waves[i];
         for (int j = 0; j < WAVE_N; j++)

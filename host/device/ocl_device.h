@@ -105,6 +105,7 @@ typedef struct {
                              * with first-hit splitting, which only the megakernels do
                              * (RenderParams.split; path_run keeps the first hit) */
     int cpu;                /* a CPU device: the megakernel may take eight paths at a time */
+    uint64_t bytes_in_place;    /* of the loaded scene's buffers, used in place (ocl_buffers.c) */
     /* The megakernel is k_path_lanes: on a CPU, where it is faster, for a scene and
      * settings it can render (kernel_features.h; on PoCL the envmap scene rendered 11%
      * slower with eight paths per work-item, mesh.scene 19%: most of their lanes would

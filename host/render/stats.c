@@ -92,8 +92,7 @@ void render_stats_print_run(FILE *out, const ScheduleStats *st, uint spp, Device
 {
     for (size_t i = 0; i < n; i++) {
         const DeviceCounters *c = &devs[i]->counters;
-        if (devs[i]->desc.kind == DEVICE_OPENCL)
-        {
+        if (devs[i]->desc.kind == DEVICE_OPENCL) {
             char in_place[64] = "";
             if (c->bytes_in_place)
                 snprintf(in_place, sizeof in_place, " (%.1f MiB of it used in place)",
@@ -101,8 +100,7 @@ void render_stats_print_run(FILE *out, const ScheduleStats *st, uint spp, Device
             fprintf(out, "device %zu '%s': kernels %s in %.3f s, scene upload %.3f s%s; waves of %u paths, %s\n", i,
                    devs[i]->desc.name, c->from_cache ? "loaded from cache" : "compiled", c->compile_seconds,
                    c->upload_seconds, in_place, c->wave_paths, c->wave_run ? c->wave_run : "-");
-        }
-        else if (c->kernel_build)
+        } else if (c->kernel_build)
             fprintf(out, "device %zu '%s': kernels of its '%s' build, the leanest with the scene's features\n", i,
                     devs[i]->desc.name, c->kernel_build);
     }

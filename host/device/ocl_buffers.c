@@ -97,11 +97,7 @@ static Status make_scene_buffer(OclDevice *od, int i, const SceneBufferBytes *in
     if (!od->cpu || !pages_on_huge(in->data, in->bytes))
         return ocld_make_buffer(od, CL_MEM_READ_ONLY, OCL_READ_AT_RANDOM, in->bytes, in->data, in->what,
                                 &od->scene[i], err);
-    if ((cl_ulong)in->bytes > od->info.max_alloc)
-        return error_set(err, ST_DEVICE,
-                         "device '%s': the %s need %.1f MiB, more than the device's largest allocation (%.1f MiB)",
-                         od->info.name, in->what, (double)in->bytes / 1048576.0,
-                         (double)od->info.max_alloc / 1048576.0);
+    /* its size was checked with every other buffer's (ocld_alloc_render) */
     const char *call;
     cl_int rc;
     if ((od->scene[i] = ocl_buffer_in_place(od->ctx, in->bytes, in->data, &call, &rc))) {

@@ -163,11 +163,23 @@ KFN_INLINE uint bvh_top_test(GLOBAL const BvhTopNode *nd, const BvhRay *w, float
  * inv_d): inv itself, or for |d| < BVH_TINY (0 included) 1 / +-BVH_TINY, a constant.
  * The same bits as dividing again, without the division: a ray's set-up divided nine
  * times, which on a 2-vCPU Zen 3 held about a tenth of the scalar walk's samples on
- * Sponza, where most rays leave the tree after a few nodes (bench/RESULTS.md). */
+ * Sponza, where most rays leave the tree after a few nodes (bench/RESULTS.md).
+ * OpenCL divides again, as before that change: with the select, PoCL 3.1 (LLVM 15)
+ * on an AVX-512 processor (Zen 4) rendered walks under a top level that missed the
+ * world's triangles and boxes, where the scalar device and PoCL on AVX2 hit them
+ * (test_instance, test_pbrt; the values are the same, so the cause is in how PoCL
+ * built the select, not isolated further). PoCL's walk had gained nothing from it
+ * (+0.5%), the scalar device's 4.6-4.8% on Sponza, which it keeps. */
 KFN_INLINE float bvh_inv(float d, float inv)
 {
+#ifdef KERNEL_OPENCL
+    float s = (k_as_uint(d) >> 31) ? -BVH_TINY : BVH_TINY;
+    (void)inv;
+    return 1.0f / (k_fabs(d) < BVH_TINY ? s : d);
+#else
     float huge = (k_as_uint(d) >> 31) ? 1.0f / -BVH_TINY : 1.0f / BVH_TINY;
     return k_fabs(d) < BVH_TINY ? huge : inv;
+#endif
 }
 
 /* Of a node's children entered (the lanes in mask), returns the one to

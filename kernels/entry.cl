@@ -44,22 +44,36 @@
 #include "medium/transmit.h"
 #include "kernel_args.h"
 
-/* CLPT_LOCAL_SIZE (set by the renderer, device_ocl.c, when it launches every kernel with
- * that work-group size): declared on every kernel the renderer launches, so a driver
- * compiles them for that size once. PoCL compiles a work-group function per kernel and
- * size: for the program binary clpt caches, and again at the first launch unless the
- * sizes match. */
+/* Every kernel the renderer launches is declared KERNEL_SIZE (or KERNEL_SIZE_LANES): the
+ * vectoriser hint below, and CLPT_LOCAL_SIZE (set by the renderer, device_ocl.c, when it
+ * launches every kernel with that work-group size), so that a driver compiles them for
+ * that size once. PoCL compiles a work-group function per kernel and size: for the
+ * program binary clpt caches, and again at the first launch unless the sizes match. */
+/* Intel's CPU runtime (cl_intel_vec_len_hint) by default runs 8 or 16 work-items as the
+ * lanes of one SIMD instruction stream, masked where their branches part. A path's
+ * bounces, flights through a medium and BVH walks part at once, so every lane waited for
+ * the longest: the fog and smoke scenes of bench/peers.py rendered 8 times slower than
+ * with one work-item per stream, the counted wavefront 2-2.6 times, nothing got faster,
+ * and the kernels took 1.7-4.6 times longer to build (bench/RESULTS.md, "Intel's CPU
+ * runtime"). Length 1 asks for one work-item per stream, as PoCL runs them; where SIMD
+ * pays, clpt writes it itself (k_path_lanes, the eight-wide walks). Other compilers do
+ * not define the macro and see nothing. */
+#ifdef cl_intel_vec_len_hint
+#define KERNEL_NO_WI_SIMD __attribute__((intel_vec_len_hint(1)))
+#else
+#define KERNEL_NO_WI_SIMD
+#endif
 #ifdef CLPT_LOCAL_SIZE
-#define KERNEL_SIZE __attribute__((reqd_work_group_size(CLPT_LOCAL_SIZE, 1, 1)))
+#define KERNEL_SIZE KERNEL_NO_WI_SIMD __attribute__((reqd_work_group_size(CLPT_LOCAL_SIZE, 1, 1)))
 /* k_path_lanes' work-items hold PATH_LANES paths each, so its work-groups are that many
  * times smaller: as many paths per work-group as k_path's. With 64 work-items (512
  * paths) the last work-groups of a wave kept one CPU thread busy while the other
  * waited: 8 made the McGuire box 3.9% faster, cornell-box 4.6%, the dragon 1.3%; 4 was
  * no faster. */
-#define KERNEL_SIZE_LANES __attribute__((reqd_work_group_size(CLPT_LOCAL_SIZE / PATH_LANES, 1, 1)))
+#define KERNEL_SIZE_LANES KERNEL_NO_WI_SIMD __attribute__((reqd_work_group_size(CLPT_LOCAL_SIZE / PATH_LANES, 1, 1)))
 #else
-#define KERNEL_SIZE
-#define KERNEL_SIZE_LANES
+#define KERNEL_SIZE KERNEL_NO_WI_SIMD
+#define KERNEL_SIZE_LANES KERNEL_NO_WI_SIMD
 #endif
 
 /* The view sc at path state ps's time (motion blur: SceneView.time); nothing without

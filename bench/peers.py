@@ -2,7 +2,7 @@
 """Peer benchmark: clpt against Mitsuba 3 and Blender Cycles at equal quality.
 
 usage: bench/peers.py [--clpt build/clpt] [--clpt-args ARGS] [--peers DIR] [--out DIR]
-                      [--runs N] [--ref-spp cornell=4096,dragon=1024,...] [--device DEV]
+                      [--runs N] [--ref-spp cornell=1024,dragon=512,...] [--device DEV]
                       [--threads N] [--scenes cornell,dragon,envmat,fog,smoke,gltf-cornell,...]
                       [--renderers mitsuba,cycles]
                       [--pbrt PATH [--pbrt-scenes DIR] [--pbrt-threads N]]
@@ -32,8 +32,11 @@ reused), with silhouette pixels left out as ../shared/peers/compare.py does (pix
 with different pixel filters compare on noise and bias. The reference is the mean of two
 halves rendered with seeds 777 and 778: a quarter of their squared difference is the
 reference's own squared error, which would otherwise add to every renderer's (the less
-noisy renderer's the most, in proportion), so it is taken off each MSE; at 64 times a
-scene's spp it is 1-2% of clpt's. "mean / ref" is the kept pixels' mean over the
+noisy renderer's the most, in proportion), so it is taken off each MSE; at 16 to 32
+times a scene's spp it is 3-6% of clpt's (bench/RESULTS.md: 2026-12-02, the McGuire box
+at 1024 spp 5.9%, the dragon at 512 spp 2.8%). clpt renders the McGuire box and the
+dragon with 16 continuations a camera sample (`--split auto` chooses 16 there), so a
+reference of 64 times their spp took about two hours for the box alone on two cores. "mean / ref" is the kept pixels' mean over the
 reference's: a renderer that models the scene differently shows it there (and its
 bias adds to its RMSE). time x MSE is the
 error-per-time figure (lower is better; for unbiased Monte Carlo, MSE falls as 1/time),
@@ -60,7 +63,7 @@ bounces, in turns, timed as whole processes (wall time), each against ITS OWN co
 render (pbrt-v4 is spectral, clpt RGB; the bias between the two references is printed per
 channel, for the correctness comparison, not the speed one); its docstring says how. They
 print a table of their own after the one above; `--scenes pbrt-cornell,pbrt-dragon` runs
-them alone. The reference samples are 64 times each scene's by default, as above, which
+them alone. Their reference samples are 64 times each scene's by default, which
 for pbrt-v4 on two cores means hours: `--ref-spp pbrt-cornell=256,...` for a quick run.
 
 When Blender is installed (and cycles is among --renderers), the default scenes also
@@ -100,9 +103,10 @@ SCENES = {
     'fog': (None, 16, False),
     'smoke': (None, 16, False),
 }
-# the reference's samples: 64 times the scene's on the peers' scenes, 32 times on the
-# generated ones (their references' own error is measured and taken off all the same)
-REF_SPP = {'cornell': 4096, 'dragon': 1024, 'envmat': 512, 'fog': 512, 'smoke': 512}
+# the reference's samples: 16 times the scene's on the McGuire box (half an hour on two
+# cores at split 16), 32 times on the others (their references' own error is measured
+# and taken off all the same)
+REF_SPP = {'cornell': 1024, 'dragon': 512, 'envmat': 512, 'fog': 512, 'smoke': 512}
 # --pbrt's scenes (bench/peers_pbrt.py): name -> (spp, reference spp)
 PBRT_SCENES = {'pbrt-cornell': (64, 4096), 'pbrt-dragon': (16, 1024), 'pbrt-killeroo': (16, 1024)}
 # the glTF scenes against Cycles (bench/peers_gltf.py): name -> reference spp (each

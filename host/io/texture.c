@@ -75,9 +75,13 @@ static uint pack_rgba(const unsigned char *p)
 /* A binary PNM (P5, P6) must hold the pixels its header declares. stb_image 2.27
  * (Debian 12's libstb) reads past its buffer when a 16-bit one (maxval > 255) is short,
  * and fills a short 8-bit one with black; both are truncated files, so both are errors,
- * found before stb_image sees them. Anything that is not a binary PNM header passes. */
+ * found before stb_image sees them. Its header numbers must fit an int: stb_image reads
+ * them into one without a check, so a height of 46 digits wrapped to 198 and a short
+ * 16-bit file got past the size check below (found by fuzz_texture). Anything that is
+ * not a binary PNM header passes. */
 static Status pnm_check(const char *path, Error *err)
 {
+    static const char *const field[3] = { "width", "height", "maxval" };
     FILE *f = fopen(path, "rb");
     if (!f) return ST_OK;   /* stb_image reports it */
     unsigned char head[4096];
@@ -95,9 +99,15 @@ static Status pnm_check(const char *path, Error *err)
             while (p < n && head[p] != '\n' && head[p] != '\r') p++;
         }
         if (p >= n || !isdigit(head[p])) return ST_OK;   /* malformed: stb_image rejects it */
+        size_t first = p;
         v[i] = 0;
-        while (p < n && isdigit(head[p]))
-            if ((v[i] = v[i] * 10 + (uint64_t)(head[p++] - '0')) > UINT32_MAX) return ST_OK;
+        while (p < n && isdigit(head[p])) {
+            if (v[i] <= INT32_MAX) v[i] = v[i] * 10 + (uint64_t)(head[p] - '0');
+            p++;
+        }
+        if (v[i] > INT32_MAX)
+            return error_set(err, ST_INPUT, "%s: the header's %s, a number of %zu digits, is larger than %d: the "
+                             "file is corrupt", path, field[i], p - first, INT32_MAX);
     }
     p++;   /* the one blank after maxval */
     uint64_t channels = head[1] == '6' ? 3 : 1, bytes = v[2] > 255 ? 2 : 1;

@@ -36,8 +36,8 @@ noisy renderer's the most, in proportion), so it is taken off each MSE; at 16 to
 times a scene's spp it is 3-6% of clpt's (bench/RESULTS.md: 2026-12-02, the McGuire box
 at 1024 spp 5.9%, the dragon at 512 spp 2.8%). clpt renders the McGuire box and the
 dragon with 16 continuations a camera sample (`--split auto` chooses 16 there), so a
-reference of 64 times their spp took about two hours for the box alone on two cores. "mean / ref" is the kept pixels' mean over the
-reference's: a renderer that models the scene differently shows it there (and its
+reference of 64 times their spp took about two hours for the box alone on two cores.
+"mean / ref" is the kept pixels' mean over the reference's: a renderer that models the scene differently shows it there (and its
 bias adds to its RMSE). time x MSE is the
 error-per-time figure (lower is better; for unbiased Monte Carlo, MSE falls as 1/time),
 and "clpt time to equal error" is clpt's time x MSE over the peer's: the share of the

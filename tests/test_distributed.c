@@ -449,15 +449,31 @@ static void test_mpi_ranks_given_different_commands_are_refused(void)
     CHECK(strncmp(r.out, "clpt ", 5) == 0 && strchr(r.out, '\n') == r.out + strlen(r.out) - 1);
 }
 
-/* A process of the job that never joins MPI (here `true`, which ends at once with status
- * 0) held the others in MPI_Init for ever: they now give up after --mpi-timeout. */
+/* A process of the job that never joins MPI held the others in MPI_Init for ever: they
+ * now give up after --mpi-timeout. `sleep 30` never joins and outlives the timeout, so
+ * only clpt's watchdog can end the job, with its message and status 5. */
 static void test_mpi_a_process_that_never_joins_ends_the_job(void)
 {
     expect_start_refused(ARGS(BOUNDED, MPIRUN, "-np", "1", CLI_PROGRAM, RENDER, "--mpi-timeout", "2", "-o",
-                              in_dir("refused.pfm"), ":", "-np", "1", "true"), 5,
+                              in_dir("refused.pfm"), ":", "-np", "1", "sleep", "30"), 5,
                          "clpt: MPI rank 0: error: the MPI job did not start within 2 s: a process of the job never "
                          "joined it (in an MPMD job, one that is not a clpt render, or that ended first), or the "
                          "launcher hangs; see --mpi-timeout\n");
+}
+
+/* A process that ends at once without joining (`true`, status 0) races clpt's start: if
+ * it is gone before rank 0 registers with Open MPI, rank 0 waits in MPI_Init and its
+ * watchdog ends the job (status 5, the message above); if it ends after, mpirun itself
+ * ends the job as "exiting improperly" (status 1; CI once saw that status with nothing
+ * on stderr). 20 ms either way decides, so a loaded machine sees both; each ends the job
+ * in bounded time without an image. */
+static void test_mpi_a_process_that_ends_without_joining_ends_the_job(void)
+{
+    spawn_run(ARGS(BOUNDED, MPIRUN, "-np", "1", CLI_PROGRAM, RENDER, "--mpi-timeout", "2", "-o", in_dir("refused.pfm"),
+                   ":", "-np", "1", "true"), &r);
+    CHECK_MSG(r.status == 5 || r.status == 1, "status %d, stderr: %s", r.status, r.err);
+    if (r.status == 5) CHECK_STR_CONTAINS(r.err, "clpt: MPI rank 0: error: the MPI job did not start within 2 s");
+    CHECK(!file_exists(in_dir("refused.pfm")));
 }
 
 /* A longer render, so that a rank can be killed in it: 1440 spp of 24 x 18 pixels is 0.6
@@ -586,6 +602,7 @@ int main(void)
         RUN(test_mpi_a_rank_that_cannot_start_ends_the_job);
         RUN(test_mpi_ranks_given_different_commands_are_refused);
         RUN(test_mpi_a_process_that_never_joins_ends_the_job);
+        RUN(test_mpi_a_process_that_ends_without_joining_ends_the_job);
         RUN(test_mpi_ranks_on_a_mix_of_devices);
         RUN(test_mpi_killed_rank_then_resume);
         RUN(test_mpi_recovery_goes_on_without_the_dead_rank);
